@@ -1,0 +1,60 @@
+//! The `robocal` command line: simulate, calibrate, demo, solve, serve.
+
+use clap::{Parser, Subcommand};
+
+pub mod calibrate;
+pub mod demo;
+pub mod serve;
+pub mod simulate;
+pub mod solve;
+
+#[derive(Debug, Parser)]
+#[command(
+    name = "robocal",
+    version,
+    about = "Robot calibration and false targets for offline programming"
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Simulate a "true" robot and write measurements in the CSV format.
+    Simulate(simulate::SimulateArgs),
+    /// Identify calibrated models from measurement CSVs and compare methods.
+    Calibrate(calibrate::CalibrateArgs),
+    /// Run a built-in end-to-end study.
+    Demo(demo::DemoArgs),
+    /// Solve target poses into joint commands and false targets.
+    Solve(solve::SolveArgs),
+    /// Run the HTTP service.
+    Serve(serve::ServeArgs),
+}
+
+/// Runs the parsed command line.
+pub fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        Command::Simulate(a) => simulate::run(a),
+        Command::Calibrate(a) => calibrate::run(a),
+        Command::Demo(a) => demo::run(a),
+        Command::Solve(a) => solve::run(a),
+        Command::Serve(a) => serve::run(a),
+    }
+}
+
+/// Loads a model from a preset name or a model JSON file path.
+pub fn load_model(arg: &str) -> anyhow::Result<crate::model::RobotModel> {
+    let path = std::path::Path::new(arg);
+    if path.exists() {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| anyhow::anyhow!("cannot read model file {arg}: {e}"))?;
+        crate::model::RobotModel::from_json(&text)
+            .map_err(|e| anyhow::anyhow!("model file {arg}: {e}"))
+    } else if arg.ends_with(".json") {
+        anyhow::bail!("model file {arg} does not exist")
+    } else {
+        crate::model::preset(arg).map_err(|e| anyhow::anyhow!("{e}"))
+    }
+}

@@ -1,0 +1,208 @@
+//! Forward kinematics (seed eqs. 2.9, 4.1–4.4, 4.6) with every intermediate frame
+//! kept for the Jacobians.
+//!
+//! Input `q`: active joint values in the model convention [rad] (see
+//! `model::robot`). Output poses are in the robot base frame [m]. For a
+//! closed-loop robot the active joint at the passive index is the crank motor and
+//! the passive chain angle comes from `loop_closure::solve_loop`.
+
+use super::loop_closure::{solve_loop, LoopOpen, LoopPartials};
+use crate::model::pose::{rpy_matrix, Pose};
+use crate::model::robot::{Link, RobotModel};
+
+/// Kinematics errors.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum KinematicsError {
+    #[error("expected {expected} joint values, got {got}")]
+    DimensionMismatch { expected: usize, got: usize },
+    #[error("joint value {index} is not finite")]
+    NotFinite { index: usize },
+    #[error(transparent)]
+    LoopOpen(#[from] LoopOpen),
+}
+
+/// The frames one link passes through (all in the base frame).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LinkFrames {
+    /// Frame k−1 (identity for the base link).
+    pub start: Pose,
+    /// After `Rot(x,α)·Tr(x,a)` (base: after `Tr(a0,b0,d1)·Rot(x,α0)`).
+    pub after_a: Pose,
+    /// After `Rot(y,β)` (equal to `after_a` when the link has no β).
+    pub after_beta: Pose,
+    /// Frame k, after `Tr(z,d)·Rot(z,θ)`.
+    pub frame: Pose,
+}
+
+/// Forward kinematics with all intermediate frames.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Chain {
+    pub links: Vec<LinkFrames>,
+    /// Chain joint angles θ_k actually used (passive angle for the loop joint) [rad].
+    pub angles: Vec<f64>,
+    /// Frame N (before the tool).
+    pub flange: Pose,
+    /// Tool centre point frame.
+    pub tcp: Pose,
+    /// Loop partials when the model has a closed loop.
+    pub loop_partials: Option<LoopPartials>,
+}
+
+fn check_q(model: &RobotModel, q: &[f64]) -> Result<(), KinematicsError> {
+    if q.len() != model.dof() {
+        return Err(KinematicsError::DimensionMismatch {
+            expected: model.dof(),
+            got: q.len(),
+        });
+    }
+    if let Some(index) = q.iter().position(|x| !x.is_finite()) {
+        return Err(KinematicsError::NotFinite { index });
+    }
+    Ok(())
+}
+
+/// Chain joint angles for active joints `q`, with loop partials.
+fn chain_angles(
+    model: &RobotModel,
+    q: &[f64],
+    out: &mut [f64],
+) -> Result<Option<LoopPartials>, KinematicsError> {
+    for (k, (o, l)) in out.iter_mut().zip(&model.links).enumerate() {
+        *o = q[k] + l.theta;
+    }
+    if let Some(cl) = &model.closed_loop {
+        let k = cl.passive;
+        let sol = solve_loop(
+            out[k - 1],
+            out[k],
+            model.links[k].a,
+            cl.l3,
+            cl.l4,
+            cl.l5,
+            cl.xi,
+        )?;
+        out[k] = sol.passive;
+        return Ok(Some(sol.partials));
+    }
+    Ok(None)
+}
+
+/// Applies one link's transform to `pose` (frame k−1 → frame k).
+#[inline]
+fn link_step(k: usize, l: &Link, angle: f64, pose: &mut Pose) -> LinkFrames {
+    let start = *pose;
+    if k == 0 {
+        pose.tr_x(l.a);
+        pose.tr_y(l.b);
+        pose.tr_z(l.d);
+        pose.rot_x(l.alpha);
+        let after_a = *pose;
+        pose.rot_y(l.beta);
+        let after_beta = *pose;
+        pose.rot_z(angle);
+        LinkFrames {
+            start,
+            after_a,
+            after_beta,
+            frame: *pose,
+        }
+    } else {
+        pose.rot_x(l.alpha);
+        pose.tr_x(l.a);
+        let after_a = *pose;
+        if l.parallel {
+            pose.rot_y(l.beta);
+        }
+        let after_beta = *pose;
+        pose.tr_z(l.d);
+        pose.rot_z(angle);
+        LinkFrames {
+            start,
+            after_a,
+            after_beta,
+            frame: *pose,
+        }
+    }
+}
+
+/// The tool transform of the model.
+pub fn tool_pose(model: &RobotModel) -> Pose {
+    let t = &model.tool;
+    Pose::new(rpy_matrix(t.rpy[0], t.rpy[1], t.rpy[2]), t.p)
+}
+
+/// Forward kinematics with every intermediate frame.
+pub fn chain(model: &RobotModel, q: &[f64]) -> Result<Chain, KinematicsError> {
+    check_q(model, q)?;
+    let n = model.dof();
+    let mut angles = vec![0.0; n];
+    let loop_partials = chain_angles(model, q, &mut angles)?;
+    let mut pose = Pose::identity();
+    let links = model
+        .links
+        .iter()
+        .enumerate()
+        .map(|(k, l)| link_step(k, l, angles[k], &mut pose))
+        .collect();
+    let flange = pose;
+    let tcp = flange.compose(&tool_pose(model));
+    Ok(Chain {
+        links,
+        angles,
+        flange,
+        tcp,
+        loop_partials,
+    })
+}
+
+/// Forward kinematics: the TCP pose in the base frame.
+pub fn fk(model: &RobotModel, q: &[f64]) -> Result<Pose, KinematicsError> {
+    check_q(model, q)?;
+    let n = model.dof();
+    let mut buf = [0.0; 8];
+    let mut heap = Vec::new();
+    let angles: &mut [f64] = if n <= buf.len() {
+        &mut buf[..n]
+    } else {
+        heap.resize(n, 0.0);
+        &mut heap
+    };
+    chain_angles(model, q, angles)?;
+    let mut pose = Pose::identity();
+    for (k, l) in model.links.iter().enumerate() {
+        link_step(k, l, angles[k], &mut pose);
+    }
+    Ok(pose.compose(&tool_pose(model)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::presets::preset;
+
+    #[test]
+    fn chain_and_fk_agree() {
+        let m = preset("hh800").unwrap();
+        let q = [0.3, 1.4, 0.2, -0.5, 0.7, 1.1];
+        let c = chain(&m, &q).unwrap();
+        let p = fk(&m, &q).unwrap();
+        assert!((c.tcp.p - p.p).norm() < 1e-14);
+        assert!((c.tcp.r - p.r).norm() < 1e-14);
+    }
+
+    #[test]
+    fn bad_joint_vectors_are_rejected() {
+        let m = preset("ys100").unwrap();
+        assert_eq!(
+            fk(&m, &[0.0; 5]).unwrap_err(),
+            KinematicsError::DimensionMismatch {
+                expected: 6,
+                got: 5
+            }
+        );
+        assert_eq!(
+            fk(&m, &[0.0, f64::NAN, 0.0, 0.0, 0.0, 0.0]).unwrap_err(),
+            KinematicsError::NotFinite { index: 1 }
+        );
+    }
+}

@@ -1,0 +1,68 @@
+//! Gravity torques at the joints (seed eqs. 3.7–3.9 / 7.1–7.2) and the joint
+//! deflection of the compliance model (eqs. 2.5, 7.4–7.5).
+//!
+//! `τ_i = Σ_{j≥i} (z_i × l_{i,j})ᵀ F_j = z_i · Σ_{j≥i} (c_j − o_i) × (M_j g)`, where
+//! `c_j` is the centre of mass of link j (and of the payload, j = N+1), `o_i`, `z_i`
+//! the origin and axis of joint i, and `g` the gravity vector in the base frame
+//! (the seed's `[0 0 −M g]` for a floor-mounted robot). Units: N·m. The sum is
+//! accumulated from the tip: `τ_i = z_i · ((S_i − M_i·o_i) × g)` with
+//! `M_i = Σ_{j≥i} M_j`, `S_i = Σ_{j≥i} M_j c_j`.
+//!
+//! For a closed loop, the open-chain torque on the passive joint maps to the
+//! driver and the crank motor by virtual work (`τ_a = (∂θ3p/∂θ_a)·τ_3p`); the
+//! masses of the crank and rod are neglected. The joint deflection is
+//! `Δθ = c ∘ τ` at the commanded configuration, with the given payload mass.
+
+use super::chain::{chain, Chain, KinematicsError};
+use crate::model::robot::RobotModel;
+use nalgebra::Vector3;
+
+/// Gravity torques [N·m] at the active joints for a computed chain.
+pub fn gravity_torques_of(model: &RobotModel, chain: &Chain, payload_mass: f64) -> Vec<f64> {
+    let n = model.dof();
+    let g = model.gravity;
+    let mut tau_chain = vec![0.0; n];
+    let mut m_sum = payload_mass;
+    let mut s_sum: Vector3<f64> = chain.tcp.transform_point(&model.payload.com) * payload_mass;
+    for k in (0..n).rev() {
+        let f = &chain.links[k].frame;
+        let l = &model.links[k];
+        m_sum += l.mass;
+        s_sum += f.transform_point(&l.com) * l.mass;
+        let moment = (s_sum - f.p * m_sum).cross(&g);
+        tau_chain[k] = f.z_axis().dot(&moment);
+    }
+    if let (Some(cl), Some(lp)) = (&model.closed_loop, &chain.loop_partials) {
+        let k = cl.passive;
+        let t = tau_chain[k];
+        tau_chain[k - 1] += lp.d_driver * t;
+        tau_chain[k] = lp.d_motor * t;
+    }
+    tau_chain
+}
+
+/// Gravity torques [N·m] at the active joints `q` (model convention, rad).
+pub fn gravity_torques(
+    model: &RobotModel,
+    q: &[f64],
+    payload_mass: f64,
+) -> Result<Vec<f64>, KinematicsError> {
+    Ok(gravity_torques_of(model, &chain(model, q)?, payload_mass))
+}
+
+/// Joint values after compliance deflection: `q + c ∘ τ(q)` (eq. 7.9).
+pub fn deflected_joints(
+    model: &RobotModel,
+    q: &[f64],
+    payload_mass: f64,
+) -> Result<Vec<f64>, KinematicsError> {
+    if !model.has_compliance() {
+        return Ok(q.to_vec());
+    }
+    let tau = gravity_torques(model, q, payload_mass)?;
+    Ok(q.iter()
+        .zip(&tau)
+        .zip(&model.links)
+        .map(|((q, t), l)| q + l.compliance * t)
+        .collect())
+}

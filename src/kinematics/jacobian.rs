@@ -1,0 +1,169 @@
+//! Jacobians of the TCP (base frame, SI units).
+//!
+//! - Geometric Jacobian w.r.t. the active joints: rows `[v; ω]` (linear velocity
+//!   of the TCP, then angular velocity), closed-loop joints chain-ruled through
+//!   the passive angle (eqs. 4.13–4.14).
+//! - Identification Jacobian (eq. 4.9 extended with β, base, tool and loop
+//!   columns, and the compliance columns `J_θ·diag(τ)` of eqs. 2.8 / 4.17):
+//!   a parameter that rotates the distal chain about axis `u` through point `o`
+//!   contributes `[u × (p − o); u]`; one that translates it along `u`
+//!   contributes `[u; 0]`. The torque τ is held fixed (computed at the commanded
+//!   configuration), as in the seed's iterative SKCM.
+
+use super::chain::Chain;
+use crate::model::params::{ParamId, ParamKind};
+use crate::model::pose::Pose;
+use crate::model::robot::RobotModel;
+use nalgebra::{DMatrix, Vector3};
+
+type Col = (Vector3<f64>, Vector3<f64>);
+
+fn rot_col(u: Vector3<f64>, o: Vector3<f64>, p: &Vector3<f64>) -> Col {
+    (u.cross(&(p - o)), u)
+}
+fn trans_col(u: Vector3<f64>) -> Col {
+    (u, Vector3::zeros())
+}
+fn scale(c: Col, s: f64) -> Col {
+    (c.0 * s, c.1 * s)
+}
+fn add(a: Col, b: Col) -> Col {
+    (a.0 + b.0, a.1 + b.1)
+}
+
+/// Column of chain joint k (derivative w.r.t. the chain angle θ_k).
+fn chain_col(chain: &Chain, k: usize) -> Col {
+    let f = &chain.links[k].frame;
+    rot_col(f.z_axis(), f.p, &chain.tcp.p)
+}
+
+/// Column of active joint k, with the loop chain rule.
+fn active_col(model: &RobotModel, chain: &Chain, k: usize) -> Col {
+    if let (Some(cl), Some(lp)) = (&model.closed_loop, &chain.loop_partials) {
+        if k == cl.passive {
+            return scale(chain_col(chain, k), lp.d_motor);
+        }
+        if k + 1 == cl.passive {
+            return add(
+                chain_col(chain, k),
+                scale(chain_col(chain, cl.passive), lp.d_driver),
+            );
+        }
+    }
+    chain_col(chain, k)
+}
+
+/// Geometric Jacobian (6×N) of the TCP w.r.t. the active joints.
+pub fn geometric_jacobian(model: &RobotModel, chain: &Chain) -> DMatrix<f64> {
+    let n = model.dof();
+    let mut j = DMatrix::zeros(6, n);
+    for k in 0..n {
+        let (v, w) = active_col(model, chain, k);
+        j.fixed_view_mut::<3, 1>(0, k).copy_from(&v);
+        j.fixed_view_mut::<3, 1>(3, k).copy_from(&w);
+    }
+    j
+}
+
+fn loop_col(model: &RobotModel, chain: &Chain, d: impl Fn(&super::LoopPartials) -> f64) -> Col {
+    match (&model.closed_loop, &chain.loop_partials) {
+        (Some(cl), Some(lp)) => scale(chain_col(chain, cl.passive), d(lp)),
+        _ => (Vector3::zeros(), Vector3::zeros()),
+    }
+}
+
+/// Column of one parameter. `tau` are the active joint torques [N·m] used by
+/// compliance columns.
+pub fn param_column(
+    model: &RobotModel,
+    chain: &Chain,
+    id: ParamId,
+    tau: &[f64],
+) -> (Vector3<f64>, Vector3<f64>) {
+    use ParamKind::*;
+    let p = &chain.tcp.p;
+    let k = id.link;
+    match id.kind {
+        Alpha => {
+            let lf = &chain.links[k];
+            let o = if k == 0 { lf.after_a.p } else { lf.start.p };
+            rot_col(lf.start.x_axis(), o, p)
+        }
+        A => {
+            let c = trans_col(chain.links[k].start.x_axis());
+            match &model.closed_loop {
+                Some(cl) if cl.passive == k => add(c, loop_col(model, chain, |lp| lp.d_sp)),
+                _ => c,
+            }
+        }
+        B => trans_col(chain.links[k].start.y_axis()),
+        Beta => {
+            let a = &chain.links[k].after_a;
+            rot_col(a.y_axis(), a.p, p)
+        }
+        D => {
+            let lf = &chain.links[k];
+            if k == 0 {
+                trans_col(lf.start.z_axis())
+            } else {
+                trans_col(lf.after_beta.z_axis())
+            }
+        }
+        Theta => active_col(model, chain, k),
+        ToolX => trans_col(chain.flange.x_axis()),
+        ToolY => trans_col(chain.flange.y_axis()),
+        ToolZ => trans_col(chain.flange.z_axis()),
+        ToolRz => (Vector3::zeros(), chain.flange.z_axis()),
+        ToolRy => {
+            let mut f: Pose = chain.flange;
+            f.rot_z(model.tool.rpy[2]);
+            (Vector3::zeros(), f.y_axis())
+        }
+        ToolRx => (Vector3::zeros(), chain.tcp.x_axis()),
+        LoopL3 => loop_col(model, chain, |lp| lp.d_l3),
+        LoopL4 => loop_col(model, chain, |lp| lp.d_l4),
+        LoopL5 => loop_col(model, chain, |lp| lp.d_l5),
+        Compliance => scale(
+            active_col(model, chain, k),
+            tau.get(k).copied().unwrap_or(0.0),
+        ),
+    }
+}
+
+/// Writes the identification Jacobian rows of one pose into `out`, starting at
+/// row `row0`: 3 position rows, then 3 orientation rows when `orientation`.
+pub fn fill_identification_rows(
+    model: &RobotModel,
+    chain: &Chain,
+    ids: &[ParamId],
+    tau: &[f64],
+    orientation: bool,
+    out: &mut DMatrix<f64>,
+    row0: usize,
+) {
+    for (c, id) in ids.iter().enumerate() {
+        let (v, w) = param_column(model, chain, *id, tau);
+        out[(row0, c)] = v.x;
+        out[(row0 + 1, c)] = v.y;
+        out[(row0 + 2, c)] = v.z;
+        if orientation {
+            out[(row0 + 3, c)] = w.x;
+            out[(row0 + 4, c)] = w.y;
+            out[(row0 + 5, c)] = w.z;
+        }
+    }
+}
+
+/// Identification Jacobian of one pose: 3 (position) or 6 rows × `ids.len()`.
+pub fn identification_jacobian(
+    model: &RobotModel,
+    chain: &Chain,
+    ids: &[ParamId],
+    tau: &[f64],
+    orientation: bool,
+) -> DMatrix<f64> {
+    let rows = if orientation { 6 } else { 3 };
+    let mut j = DMatrix::zeros(rows, ids.len());
+    fill_identification_rows(model, chain, ids, tau, orientation, &mut j, 0);
+    j
+}

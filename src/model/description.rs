@@ -1,0 +1,530 @@
+//! The model JSON description: what users write and what robocal stores.
+//!
+//! Boundary units: millimetres, degrees, kilograms, m/s², compliance in
+//! rad/(N·m). Two conventions for the joint rows:
+//! - `"modified"` (default): row i holds Craig's α_{i-1}, a_{i-1}, d_i, θ_i offset
+//!   (seed eq. 4.1); row 1 also takes the base's `b_mm` and `beta_deg` (eq. 4.3);
+//!   `parallel: true` (auto-detected when omitted) adds Hayati's β_{i-1} (eq. 4.6).
+//! - `"standard"`: distal DH rows a_i, α_i, d_i, θ_i offset, imported exactly by
+//!   regrouping `Tx(a)·Rx(α) = Rx(α)·Tx(a)`; the last row's `Rx(α_n)·Tx(a_n)` moves
+//!   into the tool, and centres of mass given in the distal frames are moved to the
+//!   proximal (modified) frames.
+//!
+//! `from_description` validates every field and names the offending one.
+
+use super::pose::{rpy_matrix, Pose};
+use super::robot::{ClosedLoop, Link, Payload, RobotModel, Tool, G0};
+use nalgebra::{Matrix3, Vector3};
+use serde::{Deserialize, Serialize};
+
+const MM: f64 = 1e-3;
+
+/// An error in a model description, naming the field.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ModelError {
+    #[error("model field `{field}`: {reason}")]
+    InvalidField { field: String, reason: String },
+    #[error("unknown robot preset `{0}` (known presets: ys100, hh800, ur5, ur10)")]
+    UnknownPreset(String),
+    #[error("cannot read model JSON: {0}")]
+    Parse(String),
+}
+
+fn invalid(field: impl Into<String>, reason: impl Into<String>) -> ModelError {
+    ModelError::InvalidField {
+        field: field.into(),
+        reason: reason.into(),
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DhConvention {
+    #[default]
+    Modified,
+    Standard,
+}
+
+/// One joint row of the description.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointDescription {
+    #[serde(default)]
+    pub alpha_deg: f64,
+    #[serde(default)]
+    pub a_mm: f64,
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub beta_deg: f64,
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub b_mm: f64,
+    #[serde(default)]
+    pub d_mm: f64,
+    #[serde(default)]
+    pub theta_offset_deg: f64,
+    /// Hayati link (modified convention only); detected from α when omitted.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub parallel: Option<bool>,
+    #[serde(default = "default_limits")]
+    pub limits_deg: [f64; 2],
+    #[serde(default = "one")]
+    pub sign: f64,
+    #[serde(default)]
+    pub zero_deg: f64,
+    #[serde(default)]
+    pub mass_kg: f64,
+    #[serde(default)]
+    pub com_mm: [f64; 3],
+    #[serde(default)]
+    pub compliance_rad_per_nm: f64,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+fn one() -> f64 {
+    1.0
+}
+fn default_limits() -> [f64; 2] {
+    [-180.0, 180.0]
+}
+fn default_gravity() -> [f64; 3] {
+    [0.0, 0.0, -G0]
+}
+
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ToolDescription {
+    #[serde(default)]
+    pub xyz_mm: [f64; 3],
+    /// `[rx, ry, rz]`, tool rotation `Rz(rz)·Ry(ry)·Rx(rx)`.
+    #[serde(default)]
+    pub rpy_deg: [f64; 3],
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClosedLoopDescription {
+    /// 1-based index of the passive joint (3 on the HH800).
+    pub passive_joint: usize,
+    pub l3_mm: f64,
+    pub l4_mm: f64,
+    pub l5_mm: f64,
+    pub xi_deg: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PayloadDescription {
+    #[serde(default)]
+    pub mass_kg: f64,
+    /// Centre of mass in the tool frame.
+    #[serde(default)]
+    pub com_mm: [f64; 3],
+}
+
+/// The JSON description of a robot model (mm/deg).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelDescription {
+    #[serde(default)]
+    pub name: String,
+    #[serde(default)]
+    pub convention: DhConvention,
+    pub joints: Vec<JointDescription>,
+    #[serde(default)]
+    pub tool: ToolDescription,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub closed_loop: Option<ClosedLoopDescription>,
+    #[serde(default)]
+    pub payload: PayloadDescription,
+    #[serde(default = "default_gravity")]
+    pub gravity_mps2: [f64; 3],
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub assumptions: Vec<String>,
+}
+
+fn finite(field: &str, v: f64) -> Result<f64, ModelError> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(invalid(field, format!("must be a finite number, got {v}")))
+    }
+}
+
+fn finite3(field: &str, v: [f64; 3]) -> Result<Vector3<f64>, ModelError> {
+    for (i, x) in v.iter().enumerate() {
+        finite(&format!("{field}[{i}]"), *x)?;
+    }
+    Ok(Vector3::new(v[0], v[1], v[2]))
+}
+
+impl ModelDescription {
+    /// Parses and validates a JSON text.
+    pub fn parse_model(text: &str) -> Result<RobotModel, ModelError> {
+        let d: ModelDescription =
+            serde_json::from_str(text).map_err(|e| ModelError::Parse(e.to_string()))?;
+        d.to_model()
+    }
+
+    /// Validates the description and builds the SI model.
+    pub fn to_model(&self) -> Result<RobotModel, ModelError> {
+        let n = self.joints.len();
+        if !(2..=7).contains(&n) {
+            return Err(invalid(
+                "joints",
+                format!("a robot needs 2 to 7 revolute joints, got {n}"),
+            ));
+        }
+        let mut links = Vec::with_capacity(n);
+        for (i, j) in self.joints.iter().enumerate() {
+            let f = |name: &str| format!("joints[{i}].{name}");
+            let mut link = Link::new(
+                finite(&f("alpha_deg"), j.alpha_deg)?.to_radians(),
+                finite(&f("a_mm"), j.a_mm)? * MM,
+                finite(&f("d_mm"), j.d_mm)? * MM,
+                finite(&f("theta_offset_deg"), j.theta_offset_deg)?.to_radians(),
+            );
+            link.beta = finite(&f("beta_deg"), j.beta_deg)?.to_radians();
+            link.b = finite(&f("b_mm"), j.b_mm)? * MM;
+            if i > 0 && link.b != 0.0 {
+                return Err(invalid(
+                    f("b_mm"),
+                    "only the first joint (the base, eq. 4.3) has a y offset b",
+                ));
+            }
+            let lim = [
+                finite(&f("limits_deg[0]"), j.limits_deg[0])?,
+                finite(&f("limits_deg[1]"), j.limits_deg[1])?,
+            ];
+            if lim[0] >= lim[1] {
+                return Err(invalid(
+                    f("limits_deg"),
+                    format!(
+                        "lower limit {} must be below upper limit {}",
+                        lim[0], lim[1]
+                    ),
+                ));
+            }
+            link.limits = [lim[0].to_radians(), lim[1].to_radians()];
+            if j.sign != 1.0 && j.sign != -1.0 {
+                return Err(invalid(
+                    f("sign"),
+                    format!("must be 1 or -1, got {}", j.sign),
+                ));
+            }
+            link.sign = j.sign;
+            link.zero = finite(&f("zero_deg"), j.zero_deg)?.to_radians();
+            link.mass = finite(&f("mass_kg"), j.mass_kg)?;
+            if link.mass < 0.0 {
+                return Err(invalid(f("mass_kg"), "must not be negative"));
+            }
+            link.com = finite3(&f("com_mm"), j.com_mm)? * MM;
+            link.compliance = finite(&f("compliance_rad_per_nm"), j.compliance_rad_per_nm)?;
+            if link.compliance < 0.0 {
+                return Err(invalid(f("compliance_rad_per_nm"), "must not be negative"));
+            }
+            if self.convention == DhConvention::Standard && (j.beta_deg != 0.0 || j.b_mm != 0.0) {
+                return Err(invalid(
+                    f("beta_deg"),
+                    "beta and b belong to the modified convention; use \"convention\": \"modified\"",
+                ));
+            }
+            links.push((link, j.parallel));
+        }
+
+        let tool_p = finite3("tool.xyz_mm", self.tool.xyz_mm)? * MM;
+        let tool_rpy = finite3("tool.rpy_deg", self.tool.rpy_deg)?.map(f64::to_radians);
+        let mut tool = Tool {
+            p: tool_p,
+            rpy: [tool_rpy.x, tool_rpy.y, tool_rpy.z],
+        };
+
+        let mut out: Vec<Link> = Vec::with_capacity(n);
+        match self.convention {
+            DhConvention::Modified => {
+                for (k, (link, parallel)) in links.into_iter().enumerate() {
+                    let mut link = link;
+                    if let Some(p) = parallel {
+                        if p && k == 0 {
+                            return Err(invalid(
+                                "joints[0].parallel",
+                                "the first joint has no previous axis to be parallel to",
+                            ));
+                        }
+                        link.parallel = p;
+                    } else {
+                        link.parallel =
+                            k > 0 && link.alpha.sin().abs() < RobotModel::parallel_threshold();
+                    }
+                    if !link.parallel && k > 0 && link.beta != 0.0 {
+                        return Err(invalid(
+                            format!("joints[{k}].beta_deg"),
+                            "beta is only used on parallel (Hayati) links; set \"parallel\": true",
+                        ));
+                    }
+                    out.push(link);
+                }
+            }
+            DhConvention::Standard => {
+                // Standard row k: Rz(θ_k)Tz(d_k)Tx(a_k)Rx(α_k). Regrouped: modified link k
+                // takes α_{k-1}, a_{k-1} of the previous standard row.
+                let std_rows: Vec<Link> = links.iter().map(|(l, _)| l.clone()).collect();
+                for (k, (link, parallel)) in links.into_iter().enumerate() {
+                    let mut m = link.clone();
+                    if k == 0 {
+                        m.alpha = 0.0;
+                        m.a = 0.0;
+                    } else {
+                        m.alpha = std_rows[k - 1].alpha;
+                        m.a = std_rows[k - 1].a;
+                    }
+                    // Centre of mass given in the distal frame k: x_prox = Tx(a_k)Rx(α_k) x_dist.
+                    let mut distal = Pose::identity();
+                    distal.tr_x(link.a);
+                    distal.rot_x(link.alpha);
+                    m.com = distal.transform_point(&link.com);
+                    m.parallel = match parallel {
+                        Some(p) => p,
+                        None => k > 0 && m.alpha.sin().abs() < RobotModel::parallel_threshold(),
+                    };
+                    out.push(m);
+                }
+                // The last row's Tx(a_n)Rx(α_n) goes into the tool.
+                let last = &std_rows[n - 1];
+                let mut t = Pose::identity();
+                t.tr_x(last.a);
+                t.rot_x(last.alpha);
+                let user = Pose::new(rpy_matrix(tool.rpy[0], tool.rpy[1], tool.rpy[2]), tool.p);
+                let combined = t.compose(&user);
+                tool = Tool {
+                    p: combined.p,
+                    rpy: matrix_to_rpy(&combined.r),
+                };
+            }
+        }
+
+        let closed_loop = match &self.closed_loop {
+            None => None,
+            Some(c) => {
+                if c.passive_joint < 2 || c.passive_joint > n {
+                    return Err(invalid(
+                        "closed_loop.passive_joint",
+                        format!(
+                            "must name a joint from 2 to {n} (1-based) driven by the joint before it, got {}",
+                            c.passive_joint
+                        ),
+                    ));
+                }
+                let l3 = finite("closed_loop.l3_mm", c.l3_mm)? * MM;
+                let l4 = finite("closed_loop.l4_mm", c.l4_mm)? * MM;
+                let l5 = finite("closed_loop.l5_mm", c.l5_mm)? * MM;
+                for (name, v) in [("l3_mm", l3), ("l4_mm", l4), ("l5_mm", l5)] {
+                    if v <= 0.0 {
+                        return Err(invalid(format!("closed_loop.{name}"), "must be positive"));
+                    }
+                }
+                let passive = c.passive_joint - 1;
+                if out[passive].a <= 0.0 {
+                    return Err(invalid(
+                        format!("joints[{passive}].a_mm"),
+                        "the passive joint's a (the loop side SP) must be positive",
+                    ));
+                }
+                Some(ClosedLoop {
+                    passive,
+                    l3,
+                    l4,
+                    l5,
+                    xi: finite("closed_loop.xi_deg", c.xi_deg)?.to_radians(),
+                })
+            }
+        };
+
+        let payload_mass = finite("payload.mass_kg", self.payload.mass_kg)?;
+        if payload_mass < 0.0 {
+            return Err(invalid("payload.mass_kg", "must not be negative"));
+        }
+        let payload = Payload {
+            mass: payload_mass,
+            com: finite3("payload.com_mm", self.payload.com_mm)? * MM,
+        };
+        let gravity = finite3("gravity_mps2", self.gravity_mps2)?;
+        if gravity.norm() > 100.0 {
+            return Err(invalid(
+                "gravity_mps2",
+                format!(
+                    "norm {:.1} m/s² is implausible; give gravity in m/s² (e.g. [0, 0, -9.81])",
+                    gravity.norm()
+                ),
+            ));
+        }
+        let name = if self.name.is_empty() {
+            "robot".to_string()
+        } else {
+            self.name.clone()
+        };
+        Ok(RobotModel {
+            name,
+            links: out,
+            tool,
+            closed_loop,
+            payload,
+            gravity,
+            assumptions: self.assumptions.clone(),
+        })
+    }
+
+    /// The description (modified convention, mm/deg) of a model.
+    pub fn from_model(m: &RobotModel) -> Self {
+        let joints = m
+            .links
+            .iter()
+            .map(|l| JointDescription {
+                alpha_deg: l.alpha.to_degrees(),
+                a_mm: l.a / MM,
+                beta_deg: l.beta.to_degrees(),
+                b_mm: l.b / MM,
+                d_mm: l.d / MM,
+                theta_offset_deg: l.theta.to_degrees(),
+                parallel: Some(l.parallel),
+                limits_deg: [l.limits[0].to_degrees(), l.limits[1].to_degrees()],
+                sign: l.sign,
+                zero_deg: l.zero.to_degrees(),
+                mass_kg: l.mass,
+                com_mm: [l.com.x / MM, l.com.y / MM, l.com.z / MM],
+                compliance_rad_per_nm: l.compliance,
+            })
+            .collect();
+        ModelDescription {
+            name: m.name.clone(),
+            convention: DhConvention::Modified,
+            joints,
+            tool: ToolDescription {
+                xyz_mm: [m.tool.p.x / MM, m.tool.p.y / MM, m.tool.p.z / MM],
+                rpy_deg: m.tool.rpy.map(f64::to_degrees),
+            },
+            closed_loop: m.closed_loop.as_ref().map(|c| ClosedLoopDescription {
+                passive_joint: c.passive + 1,
+                l3_mm: c.l3 / MM,
+                l4_mm: c.l4 / MM,
+                l5_mm: c.l5 / MM,
+                xi_deg: c.xi.to_degrees(),
+            }),
+            payload: PayloadDescription {
+                mass_kg: m.payload.mass,
+                com_mm: [
+                    m.payload.com.x / MM,
+                    m.payload.com.y / MM,
+                    m.payload.com.z / MM,
+                ],
+            },
+            gravity_mps2: [m.gravity.x, m.gravity.y, m.gravity.z],
+            assumptions: m.assumptions.clone(),
+        }
+    }
+}
+
+/// Fixed-axis XYZ angles `[rx, ry, rz]` with `R = Rz·Ry·Rx` (rad).
+pub fn matrix_to_rpy(r: &Matrix3<f64>) -> [f64; 3] {
+    let ry = (-r[(2, 0)]).clamp(-1.0, 1.0).asin();
+    if r[(2, 0)].abs() < 1.0 - 1e-12 {
+        let rx = r[(2, 1)].atan2(r[(2, 2)]);
+        let rz = r[(1, 0)].atan2(r[(0, 0)]);
+        [rx, ry, rz]
+    } else {
+        // Gimbal lock: put everything into rz.
+        let rz = (-r[(0, 1)]).atan2(r[(1, 1)]);
+        [0.0, ry, rz]
+    }
+}
+
+impl RobotModel {
+    /// Parses a model JSON description (mm/deg) and validates it.
+    pub fn from_json(text: &str) -> Result<RobotModel, ModelError> {
+        ModelDescription::parse_model(text)
+    }
+
+    /// The model as a JSON description (mm/deg).
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(&ModelDescription::from_model(self))
+            .expect("model description serialises")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rpy_round_trip() {
+        for rpy in [[0.1, 0.2, 0.3], [-2.0, 1.0, 3.0], [0.5, -1.4, -0.2]] {
+            let r = rpy_matrix(rpy[0], rpy[1], rpy[2]);
+            let back = matrix_to_rpy(&r);
+            let r2 = rpy_matrix(back[0], back[1], back[2]);
+            assert!((r - r2).norm() < 1e-12);
+        }
+        let r = rpy_matrix(0.3, std::f64::consts::FRAC_PI_2, 0.2);
+        let back = matrix_to_rpy(&r);
+        assert!((r - rpy_matrix(back[0], back[1], back[2])).norm() < 1e-9);
+    }
+
+    fn minimal() -> serde_json::Value {
+        serde_json::json!({
+            "name": "two",
+            "joints": [ {"d_mm": 400.0}, {"alpha_deg": 90.0, "a_mm": 300.0} ]
+        })
+    }
+
+    #[test]
+    fn rejects_bad_fields_by_name() {
+        let mut v = minimal();
+        v["joints"][1]["limits_deg"] = serde_json::json!([90.0, -90.0]);
+        let e = RobotModel::from_json(&v.to_string()).unwrap_err();
+        assert!(e.to_string().contains("joints[1].limits_deg"), "{e}");
+
+        let mut v = minimal();
+        v["joints"][0]["sign"] = serde_json::json!(2.0);
+        let e = RobotModel::from_json(&v.to_string()).unwrap_err();
+        assert!(e.to_string().contains("joints[0].sign"), "{e}");
+
+        let mut v = minimal();
+        v["joints"][1]["mass_kg"] = serde_json::json!(-3.0);
+        let e = RobotModel::from_json(&v.to_string()).unwrap_err();
+        assert!(e.to_string().contains("joints[1].mass_kg"), "{e}");
+
+        let mut v = minimal();
+        v["joints"] = serde_json::json!([{"d_mm": 1.0}]);
+        let e = RobotModel::from_json(&v.to_string()).unwrap_err();
+        assert!(e.to_string().contains("joints"), "{e}");
+
+        let mut v = minimal();
+        v["joints"][0]["bogus"] = serde_json::json!(1.0);
+        let e = RobotModel::from_json(&v.to_string()).unwrap_err();
+        assert!(e.to_string().contains("bogus"), "{e}");
+
+        let mut v = minimal();
+        v["gravity_mps2"] = serde_json::json!([0.0, 0.0, -9810.0]);
+        let e = RobotModel::from_json(&v.to_string()).unwrap_err();
+        assert!(e.to_string().contains("gravity_mps2"), "{e}");
+
+        let mut v = minimal();
+        v["closed_loop"] = serde_json::json!({"passive_joint": 1, "l3_mm": 1, "l4_mm": 1, "l5_mm": 1, "xi_deg": 0});
+        let e = RobotModel::from_json(&v.to_string()).unwrap_err();
+        assert!(e.to_string().contains("closed_loop.passive_joint"), "{e}");
+
+        let e = RobotModel::from_json("{\"joints\": [ {\"d_mm\": 1e999} ]}").unwrap_err();
+        assert!(matches!(e, ModelError::Parse(_)), "{e}");
+    }
+
+    #[test]
+    fn json_round_trip_preserves_model() {
+        let m = RobotModel::from_json(&minimal().to_string()).unwrap();
+        let back = RobotModel::from_json(&m.to_json()).unwrap();
+        assert_eq!(m.links.len(), back.links.len());
+        for (a, b) in m.links.iter().zip(&back.links) {
+            assert!((a.a - b.a).abs() < 1e-15 && (a.alpha - b.alpha).abs() < 1e-15);
+            assert!((a.d - b.d).abs() < 1e-15);
+        }
+        assert!(!m.links[1].parallel);
+    }
+}

@@ -1,0 +1,15 @@
+//! The robot model: geometry, compliance, inertia, limits, parameter vector and
+//! the JSON description.
+
+pub mod description;
+pub mod orientation;
+pub mod params;
+pub mod pose;
+pub mod presets;
+pub mod robot;
+
+pub use description::{ModelDescription, ModelError};
+pub use params::{ParamId, ParamKind, ParamLayout};
+pub use pose::Pose;
+pub use presets::preset;
+pub use robot::{ClosedLoop, Link, Payload, RobotModel, Tool};

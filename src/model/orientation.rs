@@ -1,0 +1,1001 @@
+//! Orientation conventions used by robot controllers, and conversion to and
+//! from rotation matrices.
+//!
+//! Conventions at this boundary (read carefully, they are easy to get wrong):
+//!
+//! * **Angles are in DEGREES** in every `values` slice accepted or returned by
+//!   [`rotation_from`] / [`rotation_to`]. Only [`rotation_angle_between`]
+//!   returns radians (it is an internal error metric, not a controller value).
+//! * A rotation matrix `R` maps **tool-frame vectors into the base/cell
+//!   frame**: `v_base = R * v_tool`. Its columns are the tool x, y and z axes
+//!   expressed in the base frame.
+//! * Quaternions are **Hamilton** quaternions ordered **(w, x, y, z)**
+//!   (scalar first, as on ABB controllers) and must be unit length.
+//!   Quaternions returned by this module always have `w >= 0`.
+//! * KUKA `A, B, C`: `R = Rz(A) · Ry(B) · Rx(C)` (C about x is applied first
+//!   to a tool vector, then B about y, then A about z).
+//! * Fanuc `W, P, R`: fixed-axis XYZ, `R = Rz(R) · Ry(P) · Rx(W)`, i.e. W is
+//!   about x and applied first. Numerically the same matrix as KUKA with
+//!   `A = R`, `B = P`, `C = W`.
+//! * Matrix: nine values in **row-major** order `r11 r12 r13 r21 ... r33`.
+//!
+//! Euler angles returned by [`rotation_to`] lie in `(-180, 180]`, with the
+//! middle angle (B or P) in `[-90, 90]`. At gimbal lock (B or P = ±90°) the
+//! first/last split is arbitrary; this module then reports `C = 0` (KUKA) or
+//! `W = 0` (Fanuc) and puts the whole rotation about the vertical into A / R.
+
+use std::fmt;
+use std::str::FromStr;
+
+use nalgebra::{Matrix3, Vector3};
+
+/// Allowed deviation of an input quaternion's norm from 1 before it is
+/// rejected (within this it is silently normalised).
+pub const QUATERNION_NORM_TOLERANCE: f64 = 1e-3;
+
+/// Allowed max-abs deviation of `RᵀR` from the identity for an input matrix
+/// before it is rejected (within this it is re-orthonormalised).
+pub const MATRIX_ORTHONORMALITY_TOLERANCE: f64 = 1e-6;
+
+/// When `cos(B)` (resp. `cos(P)`) is below this, the rotation is treated as
+/// being exactly at gimbal lock and C (resp. W) is reported as 0. This is
+/// about 6e-12 degrees from ±90°, far above the ~1e-16 rounding noise of a
+/// matrix built at exactly ±90°. Forcing C = 0 changes the reconstructed
+/// rotation by at most about this much (radians); above the threshold the
+/// reconstruction is exact to rounding even though C itself is then poorly
+/// determined.
+const GIMBAL_COS_THRESHOLD: f64 = 1e-13;
+
+/// How an orientation is written in a controller export / CSV file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum OrientationConvention {
+    /// Unit Hamilton quaternion `(w, x, y, z)`, scalar first (ABB style).
+    Quaternion,
+    /// KUKA `A, B, C` in degrees: `R = Rz(A)·Ry(B)·Rx(C)`.
+    KukaAbc,
+    /// Fanuc `W, P, R` in degrees: `R = Rz(R)·Ry(P)·Rx(W)`.
+    FanucWpr,
+    /// Full rotation matrix, nine values, row-major.
+    Matrix,
+}
+
+impl OrientationConvention {
+    /// All conventions, in declaration order.
+    pub const ALL: [OrientationConvention; 4] = [
+        OrientationConvention::Quaternion,
+        OrientationConvention::KukaAbc,
+        OrientationConvention::FanucWpr,
+        OrientationConvention::Matrix,
+    ];
+
+    /// Number of values that make up one orientation in this convention.
+    pub fn n_values(self) -> usize {
+        match self {
+            OrientationConvention::Quaternion => 4,
+            OrientationConvention::KukaAbc | OrientationConvention::FanucWpr => 3,
+            OrientationConvention::Matrix => 9,
+        }
+    }
+
+    /// Canonical (snake_case) name, as used by serde.
+    pub fn name(self) -> &'static str {
+        match self {
+            OrientationConvention::Quaternion => "quaternion",
+            OrientationConvention::KukaAbc => "kuka_abc",
+            OrientationConvention::FanucWpr => "fanuc_wpr",
+            OrientationConvention::Matrix => "matrix",
+        }
+    }
+
+    /// Parse a convention name, case-insensitively, ignoring surrounding
+    /// whitespace and treating `-` and spaces like `_`.
+    ///
+    /// Accepted: `quaternion | quat | wxyz | abb`, `kuka_abc | abc | kuka`,
+    /// `fanuc_wpr | wpr | fanuc`, `matrix | rotation_matrix`.
+    pub fn from_name(name: &str) -> Result<Self, OrientationError> {
+        let key: String = name
+            .trim()
+            .chars()
+            .map(|c| match c {
+                '-' | ' ' => '_',
+                c => c.to_ascii_lowercase(),
+            })
+            .collect();
+        match key.as_str() {
+            "quaternion" | "quat" | "wxyz" | "abb" => Ok(OrientationConvention::Quaternion),
+            "kuka_abc" | "abc" | "kuka" => Ok(OrientationConvention::KukaAbc),
+            "fanuc_wpr" | "wpr" | "fanuc" => Ok(OrientationConvention::FanucWpr),
+            "matrix" | "rotation_matrix" => Ok(OrientationConvention::Matrix),
+            _ => Err(OrientationError::UnknownConvention {
+                name: name.to_string(),
+            }),
+        }
+    }
+
+    /// CSV column names for the values of this convention, in order.
+    pub fn column_names(self) -> &'static [&'static str] {
+        match self {
+            OrientationConvention::Quaternion => &["qw", "qx", "qy", "qz"],
+            OrientationConvention::KukaAbc => &["a", "b", "c"],
+            OrientationConvention::FanucWpr => &["w", "p", "r"],
+            OrientationConvention::Matrix => &[
+                "r11", "r12", "r13", "r21", "r22", "r23", "r31", "r32", "r33",
+            ],
+        }
+    }
+}
+
+impl fmt::Display for OrientationConvention {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for OrientationConvention {
+    type Err = OrientationError;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::from_name(s)
+    }
+}
+
+/// Why a set of orientation values could not be turned into a rotation.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum OrientationError {
+    #[error(
+        "unknown orientation convention '{name}'; expected one of: quaternion (aliases quat, \
+         wxyz, abb), kuka_abc (abc, kuka), fanuc_wpr (wpr, fanuc), matrix (rotation_matrix)"
+    )]
+    UnknownConvention { name: String },
+
+    #[error(
+        "{convention} orientation needs {expected} values ({columns}), got {got}",
+        columns = convention.column_names().join(", ")
+    )]
+    WrongCount {
+        convention: OrientationConvention,
+        expected: usize,
+        got: usize,
+    },
+
+    #[error(
+        "{convention} orientation value '{column}' (position {index}) is {value}; all values \
+         must be finite numbers"
+    )]
+    NotFinite {
+        convention: OrientationConvention,
+        /// Zero-based position in the values slice.
+        index: usize,
+        /// CSV column name of the offending value.
+        column: &'static str,
+        value: f64,
+    },
+
+    #[error(
+        "quaternion (w,x,y,z) has norm {norm:.4}; expected a unit quaternion (|norm - 1| <= \
+         {QUATERNION_NORM_TOLERANCE:e}). Check the column order (w first) and that the values \
+         are not scaled or truncated"
+    )]
+    NonUnitQuaternion { norm: f64 },
+
+    #[error("matrix is not a rotation: {detail}")]
+    NotARotation { detail: String },
+}
+
+// ---------------------------------------------------------------------------
+// Building blocks
+// ---------------------------------------------------------------------------
+
+/// Rotation matrix of a Hamilton quaternion `[w, x, y, z]`.
+///
+/// The input is normalised implicitly (any non-zero quaternion gives a proper
+/// rotation); a zero or non-finite quaternion yields NaN entries. Use
+/// [`rotation_from`] for validated input.
+pub fn matrix_from_quaternion(q: [f64; 4]) -> Matrix3<f64> {
+    let [w, x, y, z] = q;
+    let n2 = w * w + x * x + y * y + z * z;
+    let s = 2.0 / n2;
+    let (xx, yy, zz) = (s * x * x, s * y * y, s * z * z);
+    let (xy, xz, yz) = (s * x * y, s * x * z, s * y * z);
+    let (wx, wy, wz) = (s * w * x, s * w * y, s * w * z);
+    Matrix3::new(
+        1.0 - (yy + zz),
+        xy - wz,
+        xz + wy,
+        xy + wz,
+        1.0 - (xx + zz),
+        yz - wx,
+        xz - wy,
+        yz + wx,
+        1.0 - (xx + yy),
+    )
+}
+
+/// Unit Hamilton quaternion `[w, x, y, z]` of a rotation matrix.
+///
+/// Uses Shepperd's method (pivot on the largest of the trace and the diagonal
+/// entries), so it is accurate for every rotation including 180° ones. The
+/// result is normalised and canonicalised: `w >= 0`, and for `w == 0` the
+/// first non-zero of `x, y, z` is positive. `r` is assumed to be a rotation.
+pub fn quaternion_from_matrix(r: &Matrix3<f64>) -> [f64; 4] {
+    let (r11, r12, r13) = (r[(0, 0)], r[(0, 1)], r[(0, 2)]);
+    let (r21, r22, r23) = (r[(1, 0)], r[(1, 1)], r[(1, 2)]);
+    let (r31, r32, r33) = (r[(2, 0)], r[(2, 1)], r[(2, 2)]);
+    let trace = r11 + r22 + r33;
+
+    let q = if trace >= r11 && trace >= r22 && trace >= r33 {
+        let w = 0.5 * (1.0 + trace).max(0.0).sqrt();
+        let f = 0.25 / w;
+        [w, (r32 - r23) * f, (r13 - r31) * f, (r21 - r12) * f]
+    } else if r11 >= r22 && r11 >= r33 {
+        let x = 0.5 * (1.0 + r11 - r22 - r33).max(0.0).sqrt();
+        let f = 0.25 / x;
+        [(r32 - r23) * f, x, (r12 + r21) * f, (r13 + r31) * f]
+    } else if r22 >= r33 {
+        let y = 0.5 * (1.0 - r11 + r22 - r33).max(0.0).sqrt();
+        let f = 0.25 / y;
+        [(r13 - r31) * f, (r12 + r21) * f, y, (r23 + r32) * f]
+    } else {
+        let z = 0.5 * (1.0 - r11 - r22 + r33).max(0.0).sqrt();
+        let f = 0.25 / z;
+        [(r21 - r12) * f, (r13 + r31) * f, (r23 + r32) * f, z]
+    };
+    canonical_quaternion(q)
+}
+
+/// Normalise and choose the sign so that `w >= 0` (and, for `w == 0`, the
+/// first non-zero vector component is positive). Also clears negative zeros.
+fn canonical_quaternion(q: [f64; 4]) -> [f64; 4] {
+    let n = q.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let mut q = q.map(|v| v / n);
+    let leading = q.iter().copied().find(|v| *v != 0.0).unwrap_or(1.0);
+    if leading < 0.0 {
+        q = q.map(|v| -v);
+    }
+    // `+ 0.0` turns -0.0 into +0.0.
+    q.map(|v| v + 0.0)
+}
+
+/// Angle in **radians**, in `[0, π]`, of the relative rotation `aᵀ·b`.
+///
+/// Computed as `atan2(|skew part|, trace - 1)`, which stays accurate for tiny
+/// angles (where `acos` of the trace loses about half the digits) and near π.
+pub fn rotation_angle_between(a: &Matrix3<f64>, b: &Matrix3<f64>) -> f64 {
+    let m = a.transpose() * b;
+    let skew = Vector3::new(
+        m[(2, 1)] - m[(1, 2)],
+        m[(0, 2)] - m[(2, 0)],
+        m[(1, 0)] - m[(0, 1)],
+    );
+    // |skew| = 2 sin θ, trace - 1 = 2 cos θ.
+    skew.norm().atan2(m.trace() - 1.0)
+}
+
+/// `Rz(a)·Ry(b)·Rx(c)` with angles in radians.
+fn rz_ry_rx(a: f64, b: f64, c: f64) -> Matrix3<f64> {
+    let (sa, ca) = a.sin_cos();
+    let (sb, cb) = b.sin_cos();
+    let (sc, cc) = c.sin_cos();
+    Matrix3::new(
+        ca * cb,
+        ca * sb * sc - sa * cc,
+        ca * sb * cc + sa * sc,
+        sa * cb,
+        sa * sb * sc + ca * cc,
+        sa * sb * cc - ca * sc,
+        -sb,
+        cb * sc,
+        cb * cc,
+    )
+}
+
+/// Inverse of [`rz_ry_rx`]: `(a, b, c)` in radians with `b ∈ [-π/2, π/2]`.
+///
+/// `c` is taken from the last row; then `a` and `b` are read off
+/// `M = R·Rx(c)ᵀ = Rz(a)·Ry(b)`, whose entries are well conditioned whatever
+/// `c` is. The reconstruction is therefore accurate even arbitrarily close to
+/// gimbal lock, where `c` itself is ill-determined (and is set to 0 once
+/// `cos b < GIMBAL_COS_THRESHOLD`).
+fn rz_ry_rx_angles(r: &Matrix3<f64>) -> (f64, f64, f64) {
+    let (r32, r33) = (r[(2, 1)], r[(2, 2)]);
+    let c = if r32.hypot(r33) < GIMBAL_COS_THRESHOLD {
+        0.0
+    } else {
+        r32.atan2(r33)
+    };
+    let (sc, cc) = c.sin_cos();
+    // Second column of M is (-sin a, cos a, 0).
+    let m12 = r[(0, 1)] * cc - r[(0, 2)] * sc;
+    let m22 = r[(1, 1)] * cc - r[(1, 2)] * sc;
+    let a = (-m12).atan2(m22);
+    // Third row of M is (-sin b, 0, cos b), with cos b = hypot(r32, r33) >= 0.
+    let m31 = r[(2, 0)];
+    let m33 = r32 * sc + r33 * cc;
+    let b = (-m31).atan2(m33);
+    (a, b, c)
+}
+
+/// Radians to degrees, wrapped into `(-180, 180]`, without negative zero.
+fn wrap_degrees(rad: f64) -> f64 {
+    let mut d = rad.to_degrees();
+    if d > 180.0 {
+        d -= 360.0;
+    } else if d <= -180.0 {
+        d += 360.0;
+    }
+    d + 0.0
+}
+
+/// Middle Euler angle (radians, nominally in `[-π/2, π/2]`) to degrees,
+/// clamped so that rounding in the conversion cannot leave `[-90, 90]`.
+fn middle_degrees(rad: f64) -> f64 {
+    rad.to_degrees().clamp(-90.0, 90.0) + 0.0
+}
+
+/// Polar-decomposition projection onto SO(3) via SVD: the rotation closest
+/// (in Frobenius norm) to `m`.
+fn nearest_rotation(m: &Matrix3<f64>) -> Matrix3<f64> {
+    let svd = m.svd(true, true);
+    // Both are present because we asked for them.
+    let (Some(u), Some(v_t)) = (svd.u, svd.v_t) else {
+        return *m;
+    };
+    let mut r = u * v_t;
+    if r.determinant() < 0.0 {
+        // Flip the axis of the smallest singular value.
+        let (k, _) =
+            svd.singular_values
+                .iter()
+                .enumerate()
+                .fold(
+                    (0, f64::INFINITY),
+                    |acc, (i, &s)| {
+                        if s < acc.1 {
+                            (i, s)
+                        } else {
+                            acc
+                        }
+                    },
+                );
+        let mut u = u;
+        u.column_mut(k).neg_mut();
+        r = u * v_t;
+    }
+    r
+}
+
+// ---------------------------------------------------------------------------
+// Public conversion API
+// ---------------------------------------------------------------------------
+
+/// Build a rotation matrix from the values of one orientation.
+///
+/// Angles are in degrees. Validates the number of values, that all are
+/// finite, that a quaternion is unit within [`QUATERNION_NORM_TOLERANCE`]
+/// (then normalises it) and that a matrix is orthonormal within
+/// [`MATRIX_ORTHONORMALITY_TOLERANCE`] with determinant +1 (then projects it
+/// exactly onto the nearest rotation).
+pub fn rotation_from(
+    conv: OrientationConvention,
+    values: &[f64],
+) -> Result<Matrix3<f64>, OrientationError> {
+    let expected = conv.n_values();
+    if values.len() != expected {
+        return Err(OrientationError::WrongCount {
+            convention: conv,
+            expected,
+            got: values.len(),
+        });
+    }
+    if let Some((index, &value)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        return Err(OrientationError::NotFinite {
+            convention: conv,
+            index,
+            column: conv.column_names()[index],
+            value,
+        });
+    }
+    match conv {
+        OrientationConvention::Quaternion => {
+            let q = [values[0], values[1], values[2], values[3]];
+            let norm = q.iter().map(|v| v * v).sum::<f64>().sqrt();
+            if (norm - 1.0).abs() > QUATERNION_NORM_TOLERANCE {
+                return Err(OrientationError::NonUnitQuaternion { norm });
+            }
+            Ok(matrix_from_quaternion(q))
+        }
+        OrientationConvention::KukaAbc => Ok(rz_ry_rx(
+            values[0].to_radians(),
+            values[1].to_radians(),
+            values[2].to_radians(),
+        )),
+        OrientationConvention::FanucWpr => Ok(rz_ry_rx(
+            values[2].to_radians(),
+            values[1].to_radians(),
+            values[0].to_radians(),
+        )),
+        OrientationConvention::Matrix => {
+            let m = Matrix3::from_row_slice(values);
+            let gram_err = (m.transpose() * m - Matrix3::identity()).amax();
+            if gram_err > MATRIX_ORTHONORMALITY_TOLERANCE {
+                return Err(OrientationError::NotARotation {
+                    detail: format!(
+                        "columns are not orthonormal: max |RᵀR - I| = {gram_err:.3e} \
+                         (tolerance {MATRIX_ORTHONORMALITY_TOLERANCE:e}). Check that the nine \
+                         values are row-major (r11 r12 r13 r21 ...) and not rounded too coarsely"
+                    ),
+                });
+            }
+            let det = m.determinant();
+            if det <= 0.0 {
+                return Err(OrientationError::NotARotation {
+                    detail: format!(
+                        "determinant is {det:.4}, so it is a reflection (left-handed frame), \
+                         not a rotation. One axis probably has the wrong sign"
+                    ),
+                });
+            }
+            Ok(nearest_rotation(&m))
+        }
+    }
+}
+
+/// Express a rotation matrix in the given convention (inverse of
+/// [`rotation_from`]).
+///
+/// `r` is assumed to be a proper rotation. Euler angles are in degrees within
+/// `(-180, 180]` (middle angle within `[-90, 90]`); at gimbal lock C (KUKA) or
+/// W (Fanuc) is 0. Quaternions have `w >= 0`. Matrices are row-major.
+pub fn rotation_to(conv: OrientationConvention, r: &Matrix3<f64>) -> Vec<f64> {
+    match conv {
+        OrientationConvention::Quaternion => quaternion_from_matrix(r).to_vec(),
+        OrientationConvention::KukaAbc => {
+            let (a, b, c) = rz_ry_rx_angles(r);
+            vec![wrap_degrees(a), middle_degrees(b), wrap_degrees(c)]
+        }
+        OrientationConvention::FanucWpr => {
+            let (a, b, c) = rz_ry_rx_angles(r);
+            vec![wrap_degrees(c), middle_degrees(b), wrap_degrees(a)]
+        }
+        OrientationConvention::Matrix => (0..3)
+            .flat_map(|i| (0..3).map(move |j| r[(i, j)]))
+            .collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Rotation3, Unit, UnitQuaternion};
+    use proptest::prelude::*;
+    use std::f64::consts::{FRAC_1_SQRT_2, FRAC_PI_2, PI};
+
+    const ALL: [OrientationConvention; 4] = OrientationConvention::ALL;
+
+    /// Independent reference: elementary rotations from nalgebra, degrees.
+    fn rx(deg: f64) -> Matrix3<f64> {
+        Rotation3::from_axis_angle(&Vector3::x_axis(), deg.to_radians()).into_inner()
+    }
+    fn ry(deg: f64) -> Matrix3<f64> {
+        Rotation3::from_axis_angle(&Vector3::y_axis(), deg.to_radians()).into_inner()
+    }
+    fn rz(deg: f64) -> Matrix3<f64> {
+        Rotation3::from_axis_angle(&Vector3::z_axis(), deg.to_radians()).into_inner()
+    }
+
+    fn max_diff(a: &Matrix3<f64>, b: &Matrix3<f64>) -> f64 {
+        (a - b).amax()
+    }
+
+    fn assert_mat_close(a: &Matrix3<f64>, b: &Matrix3<f64>, tol: f64) {
+        let d = max_diff(a, b);
+        assert!(d <= tol, "matrices differ by {d:e} > {tol:e}:\n{a}\n{b}");
+    }
+
+    fn assert_vec_close(a: &Vector3<f64>, b: &Vector3<f64>, tol: f64) {
+        let d = (a - b).amax();
+        assert!(d <= tol, "vectors differ by {d:e}: {a} vs {b}");
+    }
+
+    /// Angle difference in degrees modulo 360, in [0, 180].
+    fn angle_diff_deg(a: f64, b: f64) -> f64 {
+        let d = (a - b).rem_euclid(360.0);
+        d.min(360.0 - d)
+    }
+
+    fn is_orthonormal(r: &Matrix3<f64>) -> bool {
+        (r.transpose() * r - Matrix3::identity()).amax() < 1e-12 && r.determinant() > 0.0
+    }
+
+    // ---- names / metadata -------------------------------------------------
+
+    #[test]
+    fn n_values_and_column_names_agree() {
+        let expected = [4, 3, 3, 9];
+        for (conv, n) in ALL.into_iter().zip(expected) {
+            assert_eq!(conv.n_values(), n);
+            assert_eq!(conv.column_names().len(), n);
+        }
+        assert_eq!(
+            OrientationConvention::Quaternion.column_names(),
+            &["qw", "qx", "qy", "qz"]
+        );
+        assert_eq!(
+            OrientationConvention::KukaAbc.column_names(),
+            &["a", "b", "c"]
+        );
+        assert_eq!(
+            OrientationConvention::FanucWpr.column_names(),
+            &["w", "p", "r"]
+        );
+        assert_eq!(
+            OrientationConvention::Matrix.column_names(),
+            &["r11", "r12", "r13", "r21", "r22", "r23", "r31", "r32", "r33"]
+        );
+    }
+
+    #[test]
+    fn from_name_accepts_aliases_case_insensitively() {
+        use OrientationConvention::*;
+        let cases = [
+            ("quaternion", Quaternion),
+            ("QUAT", Quaternion),
+            ("wxyz", Quaternion),
+            ("ABB", Quaternion),
+            ("kuka_abc", KukaAbc),
+            ("Abc", KukaAbc),
+            ("KUKA", KukaAbc),
+            ("kuka-abc", KukaAbc),
+            ("fanuc_wpr", FanucWpr),
+            ("WPR", FanucWpr),
+            (" Fanuc ", FanucWpr),
+            ("matrix", Matrix),
+            ("Rotation_Matrix", Matrix),
+        ];
+        for (name, conv) in cases {
+            assert_eq!(OrientationConvention::from_name(name), Ok(conv), "{name}");
+            assert_eq!(name.parse::<OrientationConvention>(), Ok(conv), "{name}");
+        }
+        for conv in ALL {
+            assert_eq!(OrientationConvention::from_name(conv.name()), Ok(conv));
+        }
+    }
+
+    #[test]
+    fn from_name_rejects_unknown() {
+        let err = OrientationConvention::from_name("xyzw").unwrap_err();
+        assert_eq!(
+            err,
+            OrientationError::UnknownConvention {
+                name: "xyzw".into()
+            }
+        );
+        let msg = err.to_string();
+        assert!(msg.contains("'xyzw'") && msg.contains("kuka_abc"), "{msg}");
+    }
+
+    #[test]
+    fn serde_uses_snake_case_names() {
+        for conv in ALL {
+            let json = serde_json::to_string(&conv).unwrap();
+            assert_eq!(json, format!("\"{}\"", conv.name()));
+            let back: OrientationConvention = serde_json::from_str(&json).unwrap();
+            assert_eq!(back, conv);
+        }
+    }
+
+    // ---- closed-form expectations -----------------------------------------
+
+    #[test]
+    fn kuka_a90_maps_x_to_y() {
+        let r = rotation_from(OrientationConvention::KukaAbc, &[90.0, 0.0, 0.0]).unwrap();
+        assert_vec_close(&(r * Vector3::x()), &Vector3::y(), 1e-15);
+        assert_vec_close(&(r * Vector3::z()), &Vector3::z(), 1e-15);
+    }
+
+    #[test]
+    fn kuka_b90_maps_z_to_x_and_c90_maps_y_to_z() {
+        let r = rotation_from(OrientationConvention::KukaAbc, &[0.0, 90.0, 0.0]).unwrap();
+        assert_vec_close(&(r * Vector3::z()), &Vector3::x(), 1e-15);
+        let r = rotation_from(OrientationConvention::KukaAbc, &[0.0, 0.0, 90.0]).unwrap();
+        assert_vec_close(&(r * Vector3::y()), &Vector3::z(), 1e-15);
+    }
+
+    #[test]
+    fn kuka_order_is_rz_ry_rx() {
+        // A=90, C=90: tool y -> (Rx) z -> (Rz) z; tool z -> (Rx) -y -> (Rz) x.
+        let r = rotation_from(OrientationConvention::KukaAbc, &[90.0, 0.0, 90.0]).unwrap();
+        assert_vec_close(&(r * Vector3::y()), &Vector3::z(), 1e-15);
+        assert_vec_close(&(r * Vector3::z()), &Vector3::x(), 1e-15);
+        let (a, b, c) = (30.0, -20.0, 110.0);
+        let r = rotation_from(OrientationConvention::KukaAbc, &[a, b, c]).unwrap();
+        assert_mat_close(&r, &(rz(a) * ry(b) * rx(c)), 1e-15);
+    }
+
+    #[test]
+    fn fanuc_w90_maps_y_to_z() {
+        let r = rotation_from(OrientationConvention::FanucWpr, &[90.0, 0.0, 0.0]).unwrap();
+        assert_vec_close(&(r * Vector3::y()), &Vector3::z(), 1e-15);
+        assert_vec_close(&(r * Vector3::x()), &Vector3::x(), 1e-15);
+    }
+
+    #[test]
+    fn fanuc_r90_is_about_z_and_order_is_fixed_xyz() {
+        let r = rotation_from(OrientationConvention::FanucWpr, &[0.0, 0.0, 90.0]).unwrap();
+        assert_vec_close(&(r * Vector3::x()), &Vector3::y(), 1e-15);
+        // W=90 then R=90 about fixed axes: tool y -> z (W) -> z (R).
+        // tool z -> -y (W) -> x (R).
+        let r = rotation_from(OrientationConvention::FanucWpr, &[90.0, 0.0, 90.0]).unwrap();
+        assert_vec_close(&(r * Vector3::y()), &Vector3::z(), 1e-15);
+        assert_vec_close(&(r * Vector3::z()), &Vector3::x(), 1e-15);
+        let (w, p, rr) = (-45.0, 33.0, 170.0);
+        let r = rotation_from(OrientationConvention::FanucWpr, &[w, p, rr]).unwrap();
+        assert_mat_close(&r, &(rz(rr) * ry(p) * rx(w)), 1e-15);
+    }
+
+    #[test]
+    fn quaternion_cos45_sin45_is_rz90() {
+        let q = [FRAC_1_SQRT_2, 0.0, 0.0, FRAC_1_SQRT_2];
+        let r = rotation_from(OrientationConvention::Quaternion, &q).unwrap();
+        assert_mat_close(&r, &rz(90.0), 1e-15);
+        assert_vec_close(&(r * Vector3::x()), &Vector3::y(), 1e-15);
+    }
+
+    #[test]
+    fn quaternion_of_x_axis_half_turn() {
+        let r = rotation_from(OrientationConvention::Quaternion, &[0.0, 1.0, 0.0, 0.0]).unwrap();
+        assert_mat_close(
+            &r,
+            &Matrix3::from_diagonal(&Vector3::new(1.0, -1.0, -1.0)),
+            0.0,
+        );
+        // Sign canonicalisation for w = 0.
+        assert_eq!(quaternion_from_matrix(&r), [0.0, 1.0, 0.0, 0.0]);
+        let r = matrix_from_quaternion([0.0, 0.0, -1.0, 0.0]);
+        assert_eq!(quaternion_from_matrix(&r), [0.0, 0.0, 1.0, 0.0]);
+    }
+
+    #[test]
+    fn quaternion_and_abc_of_hand_built_rotation_agree() {
+        // Hand-built: 120 deg about (1,1,1)/sqrt3 permutes axes x->y->z->x.
+        let perm = Matrix3::new(0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0);
+        let h = 0.5;
+        let q = [h, h, h, h];
+        let rq = rotation_from(OrientationConvention::Quaternion, &q).unwrap();
+        assert_mat_close(&rq, &perm, 1e-15);
+        // perm = Rz(90)*Ry(0)*Rx(90): check by hand above; extract and compare.
+        let abc = rotation_to(OrientationConvention::KukaAbc, &perm);
+        assert!(angle_diff_deg(abc[0], 90.0) < 1e-12, "{abc:?}");
+        assert!(angle_diff_deg(abc[1], 0.0) < 1e-12, "{abc:?}");
+        assert!(angle_diff_deg(abc[2], 90.0) < 1e-12, "{abc:?}");
+        let rabc = rotation_from(OrientationConvention::KukaAbc, &abc).unwrap();
+        assert_mat_close(&rabc, &rq, 1e-15);
+        let q_back = rotation_to(OrientationConvention::Quaternion, &rabc);
+        for (x, y) in q_back.iter().zip(q) {
+            assert!((x - y).abs() < 1e-15, "{q_back:?}");
+        }
+        // WPR of the same rotation is the reversed triple.
+        let wpr = rotation_to(OrientationConvention::FanucWpr, &perm);
+        assert!(angle_diff_deg(wpr[0], 90.0) < 1e-12, "{wpr:?}");
+        assert!(angle_diff_deg(wpr[1], 0.0) < 1e-12, "{wpr:?}");
+        assert!(angle_diff_deg(wpr[2], 90.0) < 1e-12, "{wpr:?}");
+    }
+
+    #[test]
+    fn quaternion_matches_nalgebra_for_a_generic_rotation() {
+        let axis = Unit::new_normalize(Vector3::new(0.3, -0.5, 0.8));
+        let uq = UnitQuaternion::from_axis_angle(&axis, 1.234);
+        let q = [uq.w, uq.i, uq.j, uq.k];
+        let r = rotation_from(OrientationConvention::Quaternion, &q).unwrap();
+        assert_mat_close(&r, &uq.to_rotation_matrix().into_inner(), 1e-15);
+    }
+
+    #[test]
+    fn matrix_is_row_major() {
+        let r = rz(90.0); // columns: x->y, y->-x
+        let v = rotation_to(OrientationConvention::Matrix, &r);
+        let expected = [0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0];
+        for (x, y) in v.iter().zip(expected) {
+            assert!((x - y).abs() < 1e-15, "{v:?}");
+        }
+        let back = rotation_from(OrientationConvention::Matrix, &expected).unwrap();
+        assert_mat_close(&back, &r, 1e-15);
+    }
+
+    #[test]
+    fn matrix_input_is_reorthonormalised() {
+        let r = rz(20.0) * ry(-40.0) * rx(75.0);
+        let mut v = rotation_to(OrientationConvention::Matrix, &r);
+        // Perturb by ~1e-7 (e.g. values printed with 7 decimals).
+        for (i, x) in v.iter_mut().enumerate() {
+            *x += 1e-7 * ((i as f64) * 1.7).sin();
+        }
+        let back = rotation_from(OrientationConvention::Matrix, &v).unwrap();
+        assert!(is_orthonormal(&back));
+        assert!(max_diff(&back, &r) < 1e-6);
+    }
+
+    #[test]
+    fn gimbal_lock_puts_everything_in_a_or_r() {
+        for b in [90.0, -90.0] {
+            for (a, c) in [(10.0, 20.0), (-170.0, 50.0), (0.0, -30.0)] {
+                let r = rz(a) * ry(b) * rx(c);
+                let abc = rotation_to(OrientationConvention::KukaAbc, &r);
+                assert_eq!(abc[2], 0.0, "{abc:?}");
+                assert!(angle_diff_deg(abc[1], b) < 1e-6, "{abc:?}");
+                // Rz(a)Ry(±90)Rx(c) = Rz(a ∓ c)Ry(±90)
+                let a_eff = if b > 0.0 { a - c } else { a + c };
+                assert!(angle_diff_deg(abc[0], a_eff) < 1e-6, "{abc:?} vs {a_eff}");
+                let back = rotation_from(OrientationConvention::KukaAbc, &abc).unwrap();
+                assert_mat_close(&back, &r, 1e-12);
+
+                let wpr = rotation_to(OrientationConvention::FanucWpr, &r);
+                assert_eq!(wpr[0], 0.0, "{wpr:?}");
+                assert!(angle_diff_deg(wpr[2], a_eff) < 1e-6, "{wpr:?}");
+                let back = rotation_from(OrientationConvention::FanucWpr, &wpr).unwrap();
+                assert_mat_close(&back, &r, 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn euler_output_range_is_half_open() {
+        // A = 180 must be reported as +180, never -180.
+        let r = rz(180.0);
+        let abc = rotation_to(OrientationConvention::KukaAbc, &r);
+        assert_eq!(abc, vec![180.0, 0.0, 0.0]);
+        let r = rx(-180.0);
+        let wpr = rotation_to(OrientationConvention::FanucWpr, &r);
+        assert_eq!(wpr, vec![180.0, 0.0, 0.0]);
+        // Identity gives exact (positive) zeros.
+        let abc = rotation_to(OrientationConvention::KukaAbc, &Matrix3::identity());
+        assert!(abc.iter().all(|v| *v == 0.0 && v.is_sign_positive()));
+    }
+
+    #[test]
+    fn rotation_angle_between_small_and_large() {
+        let i = Matrix3::identity();
+        assert_eq!(rotation_angle_between(&i, &i), 0.0);
+        // acos(trace) would return 0 or ~1e-8 for this; atan2 gets it right.
+        let tiny = 1e-10;
+        let r = Rotation3::from_axis_angle(&Vector3::y_axis(), tiny).into_inner();
+        let got = rotation_angle_between(&i, &r);
+        assert!((got - tiny).abs() < 1e-20, "{got:e}");
+        assert!((rotation_angle_between(&i, &rz(90.0)) - FRAC_PI_2).abs() < 1e-15);
+        assert!((rotation_angle_between(&i, &rx(180.0)) - PI).abs() < 1e-15);
+        // Relative: angle of aᵀb, independent of a common left factor.
+        let a = rz(40.0) * ry(10.0);
+        let b = a * rx(25.0);
+        assert!((rotation_angle_between(&a, &b) - 25f64.to_radians()).abs() < 1e-14);
+        assert!((rotation_angle_between(&b, &a) - 25f64.to_radians()).abs() < 1e-14);
+    }
+
+    // ---- error cases ------------------------------------------------------
+
+    #[test]
+    fn wrong_count_error() {
+        for conv in ALL {
+            let vals = vec![0.0; conv.n_values() + 1];
+            let err = rotation_from(conv, &vals).unwrap_err();
+            assert_eq!(
+                err,
+                OrientationError::WrongCount {
+                    convention: conv,
+                    expected: conv.n_values(),
+                    got: conv.n_values() + 1,
+                }
+            );
+        }
+        let msg = rotation_from(OrientationConvention::KukaAbc, &[1.0, 2.0])
+            .unwrap_err()
+            .to_string();
+        assert_eq!(msg, "kuka_abc orientation needs 3 values (a, b, c), got 2");
+    }
+
+    #[test]
+    fn not_finite_error() {
+        let err =
+            rotation_from(OrientationConvention::FanucWpr, &[0.0, f64::NAN, 0.0]).unwrap_err();
+        match &err {
+            OrientationError::NotFinite {
+                convention,
+                index,
+                column,
+                value,
+            } => {
+                assert_eq!(*convention, OrientationConvention::FanucWpr);
+                assert_eq!(*index, 1);
+                assert_eq!(*column, "p");
+                assert!(value.is_nan());
+            }
+            other => panic!("unexpected {other:?}"),
+        }
+        assert!(err.to_string().contains("'p'"), "{err}");
+        let err = rotation_from(
+            OrientationConvention::Quaternion,
+            &[1.0, 0.0, 0.0, f64::INFINITY],
+        )
+        .unwrap_err();
+        assert_eq!(
+            err,
+            OrientationError::NotFinite {
+                convention: OrientationConvention::Quaternion,
+                index: 3,
+                column: "qz",
+                value: f64::INFINITY,
+            }
+        );
+        let mut m = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
+        m[8] = f64::NEG_INFINITY;
+        assert!(matches!(
+            rotation_from(OrientationConvention::Matrix, &m),
+            Err(OrientationError::NotFinite { column: "r33", .. })
+        ));
+    }
+
+    #[test]
+    fn non_unit_quaternion_error_and_normalisation() {
+        let err =
+            rotation_from(OrientationConvention::Quaternion, &[1.2, 0.0, 0.0, 0.0]).unwrap_err();
+        assert_eq!(err, OrientationError::NonUnitQuaternion { norm: 1.2 });
+        assert!(
+            err.to_string()
+                .starts_with("quaternion (w,x,y,z) has norm 1.2000; expected a unit quaternion"),
+            "{err}"
+        );
+        assert!(matches!(
+            rotation_from(OrientationConvention::Quaternion, &[0.0; 4]),
+            Err(OrientationError::NonUnitQuaternion { norm }) if norm == 0.0
+        ));
+        // Within tolerance: normalised silently.
+        let s = 1.0 + 5e-4;
+        let q = [s * FRAC_1_SQRT_2, 0.0, 0.0, s * FRAC_1_SQRT_2];
+        let r = rotation_from(OrientationConvention::Quaternion, &q).unwrap();
+        assert!(is_orthonormal(&r));
+        assert_mat_close(&r, &rz(90.0), 1e-15);
+    }
+
+    #[test]
+    fn not_a_rotation_errors() {
+        // Not orthonormal (scaled).
+        let scaled = [1.01, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
+        let err = rotation_from(OrientationConvention::Matrix, &scaled).unwrap_err();
+        match &err {
+            OrientationError::NotARotation { detail } => {
+                assert!(detail.contains("orthonormal"), "{detail}")
+            }
+            other => panic!("unexpected {other:?}"),
+        }
+        // Reflection.
+        let mirror = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, -1.0];
+        let err = rotation_from(OrientationConvention::Matrix, &mirror).unwrap_err();
+        match &err {
+            OrientationError::NotARotation { detail } => {
+                assert!(detail.contains("determinant is -1.0000"), "{detail}")
+            }
+            other => panic!("unexpected {other:?}"),
+        }
+        assert!(err.to_string().starts_with("matrix is not a rotation:"));
+        // Column-major input of a rotation is still a rotation (its
+        // transpose), so the only thing we can catch is non-rotations.
+        let zeros = [0.0; 9];
+        assert!(matches!(
+            rotation_from(OrientationConvention::Matrix, &zeros),
+            Err(OrientationError::NotARotation { .. })
+        ));
+    }
+
+    // ---- property tests ---------------------------------------------------
+
+    /// Uniformly random rotation from a normalised 4-vector.
+    fn arb_rotation() -> impl Strategy<Value = Matrix3<f64>> {
+        prop::array::uniform4(-1.0f64..1.0)
+            .prop_filter("non-degenerate", |q| {
+                q.iter().map(|v| v * v).sum::<f64>() > 1e-3
+            })
+            .prop_map(|q| {
+                let uq = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+                    q[0], q[1], q[2], q[3],
+                ));
+                uq.to_rotation_matrix().into_inner()
+            })
+    }
+
+    /// Rotations at or within a hair of gimbal lock: B = ±90 ± δ (degrees).
+    fn arb_near_gimbal() -> impl Strategy<Value = Matrix3<f64>> {
+        let offsets = prop::sample::select(vec![
+            0.0, 1e-12, -1e-12, 1e-9, -1e-9, 1e-7, -1e-7, 1e-4, -1e-4,
+        ]);
+        (-180.0f64..180.0, prop::bool::ANY, offsets, -180.0f64..180.0).prop_map(|(a, pos, d, c)| {
+            let b = if pos { 90.0 } else { -90.0 } + d;
+            rz(a) * ry(b) * rx(c)
+        })
+    }
+
+    /// Euler-angle triples away from gimbal lock, in the output range.
+    fn arb_regular_angles() -> impl Strategy<Value = [f64; 3]> {
+        (-179.9f64..180.0, -89.0f64..89.0, -179.9f64..180.0).prop_map(|(a, b, c)| [a, b, c])
+    }
+
+    fn check_round_trip(r: &Matrix3<f64>) -> Result<(), TestCaseError> {
+        for conv in ALL {
+            let vals = rotation_to(conv, r);
+            prop_assert_eq!(vals.len(), conv.n_values());
+            let back = rotation_from(conv, &vals)
+                .map_err(|e| TestCaseError::fail(format!("{conv}: {e}")))?;
+            let d = max_diff(&back, r);
+            prop_assert!(d < 1e-12, "{}: diff {:e}, values {:?}", conv, d, vals);
+            prop_assert!(rotation_angle_between(&back, r) < 1e-12);
+            match conv {
+                OrientationConvention::Quaternion => {
+                    prop_assert!(vals[0] >= 0.0, "w < 0: {:?}", vals);
+                    let n: f64 = vals.iter().map(|v| v * v).sum::<f64>().sqrt();
+                    prop_assert!((n - 1.0).abs() < 1e-15);
+                }
+                OrientationConvention::KukaAbc | OrientationConvention::FanucWpr => {
+                    for v in &vals {
+                        prop_assert!(*v > -180.0 && *v <= 180.0, "{:?}", vals);
+                    }
+                    prop_assert!(vals[1].abs() <= 90.0, "{:?}", vals);
+                }
+                OrientationConvention::Matrix => {}
+            }
+        }
+        Ok(())
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(512))]
+
+        #[test]
+        fn round_trip_random_rotations(r in arb_rotation()) {
+            check_round_trip(&r)?;
+        }
+
+        #[test]
+        fn round_trip_near_gimbal(r in arb_near_gimbal()) {
+            check_round_trip(&r)?;
+        }
+
+        #[test]
+        fn quaternion_building_blocks_round_trip(r in arb_rotation()) {
+            let q = quaternion_from_matrix(&r);
+            prop_assert!(max_diff(&matrix_from_quaternion(q), &r) < 1e-14);
+            // Agrees with nalgebra up to sign.
+            let uq = UnitQuaternion::from_matrix(&r);
+            let s = if uq.w < 0.0 { -1.0 } else { 1.0 };
+            let n = [uq.w, uq.i, uq.j, uq.k];
+            for k in 0..4 {
+                prop_assert!((q[k] - s * n[k]).abs() < 1e-12, "{:?} vs {:?}", q, n);
+            }
+        }
+
+        #[test]
+        fn euler_angles_round_trip_away_from_gimbal(abc in arb_regular_angles()) {
+            let r = rotation_from(OrientationConvention::KukaAbc, &abc).unwrap();
+            prop_assert!(max_diff(&r, &(rz(abc[0]) * ry(abc[1]) * rx(abc[2]))) < 1e-14);
+            let back = rotation_to(OrientationConvention::KukaAbc, &r);
+            for k in 0..3 {
+                prop_assert!(angle_diff_deg(back[k], abc[k]) < 1e-9, "{:?} vs {:?}", back, abc);
+            }
+            let wpr = [abc[2], abc[1], abc[0]];
+            let rf = rotation_from(OrientationConvention::FanucWpr, &wpr).unwrap();
+            prop_assert!(max_diff(&rf, &r) < 1e-15);
+            let back = rotation_to(OrientationConvention::FanucWpr, &rf);
+            for k in 0..3 {
+                prop_assert!(angle_diff_deg(back[k], wpr[k]) < 1e-9, "{:?} vs {:?}", back, wpr);
+            }
+        }
+
+        #[test]
+        fn rotation_angle_matches_quaternion_angle(a in arb_rotation(), b in arb_rotation()) {
+            let theta = rotation_angle_between(&a, &b);
+            prop_assert!((0.0..=PI).contains(&theta));
+            let q = quaternion_from_matrix(&(a.transpose() * b));
+            let expected = 2.0 * q[1..].iter().map(|v| v * v).sum::<f64>().sqrt().atan2(q[0]);
+            prop_assert!((theta - expected).abs() < 1e-12, "{} vs {}", theta, expected);
+            prop_assert!((rotation_angle_between(&b, &a) - theta).abs() < 1e-12);
+        }
+    }
+}

@@ -1,0 +1,300 @@
+//! One parameter vector for every optimiser (least squares, TLBO, …).
+//!
+//! A `ParamId` names one scalar of a `RobotModel`; `ParamLayout` lists the
+//! parameters a model has, in a fixed order (base, links in chain order, tool,
+//! closed loop, compliance). Optimisers work on `Vec<f64>` values plus a mask of
+//! which entries are free. Units are SI: lengths m, angles rad, compliance
+//! rad/(N·m). Names follow the seed's tables: `alpha0 a0 beta0 b0 d1 theta1`,
+//! `alpha1 a1 d2 theta2`, `alpha2 a2 beta2 d3 theta3`, …, `tool_x`, `l4`, `c2`.
+
+use super::robot::RobotModel;
+use serde::{Deserialize, Serialize};
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum ParamKind {
+    Alpha,
+    A,
+    Beta,
+    B,
+    D,
+    Theta,
+    ToolX,
+    ToolY,
+    ToolZ,
+    ToolRx,
+    ToolRy,
+    ToolRz,
+    LoopL3,
+    LoopL4,
+    LoopL5,
+    Compliance,
+}
+
+/// Physical unit class of a parameter (for display and scaling).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ParamUnit {
+    Length,
+    Angle,
+    Compliance,
+}
+
+/// One scalar parameter: its kind and the 0-based link it belongs to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct ParamId {
+    pub kind: ParamKind,
+    pub link: usize,
+}
+
+impl ParamId {
+    pub const fn new(kind: ParamKind, link: usize) -> Self {
+        ParamId { kind, link }
+    }
+
+    pub fn unit(&self) -> ParamUnit {
+        use ParamKind::*;
+        match self.kind {
+            Alpha | Beta | Theta | ToolRx | ToolRy | ToolRz => ParamUnit::Angle,
+            Compliance => ParamUnit::Compliance,
+            _ => ParamUnit::Length,
+        }
+    }
+
+    /// Whether the parameter is geometric (everything but compliance).
+    pub fn is_geometric(&self) -> bool {
+        self.kind != ParamKind::Compliance
+    }
+
+    /// The seed's name of the parameter.
+    pub fn name(&self) -> String {
+        use ParamKind::*;
+        let k = self.link;
+        match self.kind {
+            Alpha => format!("alpha{k}"),
+            A => format!("a{k}"),
+            Beta => format!("beta{k}"),
+            B => format!("b{k}"),
+            D => format!("d{}", k + 1),
+            Theta => format!("theta{}", k + 1),
+            ToolX => "tool_x".into(),
+            ToolY => "tool_y".into(),
+            ToolZ => "tool_z".into(),
+            ToolRx => "tool_rx".into(),
+            ToolRy => "tool_ry".into(),
+            ToolRz => "tool_rz".into(),
+            LoopL3 => "l3".into(),
+            LoopL4 => "l4".into(),
+            LoopL5 => "l5".into(),
+            Compliance => format!("c{}", k + 1),
+        }
+    }
+
+    /// Parses a name produced by [`ParamId::name`].
+    pub fn parse(name: &str) -> Option<ParamId> {
+        use ParamKind::*;
+        let fixed = [
+            ("tool_x", ToolX),
+            ("tool_y", ToolY),
+            ("tool_z", ToolZ),
+            ("tool_rx", ToolRx),
+            ("tool_ry", ToolRy),
+            ("tool_rz", ToolRz),
+            ("l3", LoopL3),
+            ("l4", LoopL4),
+            ("l5", LoopL5),
+        ];
+        if let Some((_, k)) = fixed.iter().find(|(n, _)| *n == name) {
+            return Some(ParamId::new(*k, 0));
+        }
+        let split = name.find(|c: char| c.is_ascii_digit())?;
+        let (prefix, num) = name.split_at(split);
+        let n: usize = num.parse().ok()?;
+        let (kind, link) = match prefix {
+            "alpha" => (Alpha, n),
+            "a" => (A, n),
+            "beta" => (Beta, n),
+            "b" => (B, n),
+            "d" if n >= 1 => (D, n - 1),
+            "theta" if n >= 1 => (Theta, n - 1),
+            "c" if n >= 1 => (Compliance, n - 1),
+            _ => return None,
+        };
+        Some(ParamId::new(kind, link))
+    }
+}
+
+/// The ordered list of parameters of a model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParamLayout {
+    pub ids: Vec<ParamId>,
+}
+
+impl ParamLayout {
+    /// Every parameter of `model`: geometry, tool (6), loop (3) and compliance (N).
+    pub fn full(model: &RobotModel) -> Self {
+        let mut ids = Self::geometric(model).ids;
+        ids.extend((0..model.dof()).map(|k| ParamId::new(ParamKind::Compliance, k)));
+        ParamLayout { ids }
+    }
+
+    /// Geometric parameters only (no compliance).
+    pub fn geometric(model: &RobotModel) -> Self {
+        use ParamKind::*;
+        let mut ids = Vec::new();
+        for (k, l) in model.links.iter().enumerate() {
+            if k == 0 {
+                for kind in [A, B, D, Alpha, Beta, Theta] {
+                    ids.push(ParamId::new(kind, 0));
+                }
+            } else {
+                ids.push(ParamId::new(Alpha, k));
+                ids.push(ParamId::new(A, k));
+                if l.parallel {
+                    ids.push(ParamId::new(Beta, k));
+                }
+                ids.push(ParamId::new(D, k));
+                ids.push(ParamId::new(Theta, k));
+            }
+        }
+        for kind in [ToolX, ToolY, ToolZ, ToolRx, ToolRy, ToolRz] {
+            ids.push(ParamId::new(kind, 0));
+        }
+        if model.closed_loop.is_some() {
+            for kind in [LoopL3, LoopL4, LoopL5] {
+                ids.push(ParamId::new(kind, 0));
+            }
+        }
+        ParamLayout { ids }
+    }
+
+    pub fn len(&self) -> usize {
+        self.ids.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.ids.is_empty()
+    }
+
+    pub fn index_of(&self, id: ParamId) -> Option<usize> {
+        self.ids.iter().position(|x| *x == id)
+    }
+
+    pub fn names(&self) -> Vec<String> {
+        self.ids.iter().map(|i| i.name()).collect()
+    }
+
+    /// Current values of the listed parameters.
+    pub fn values(&self, model: &RobotModel) -> Vec<f64> {
+        self.ids.iter().map(|id| get(model, *id)).collect()
+    }
+
+    /// Writes `values` into `model`.
+    pub fn apply(&self, model: &mut RobotModel, values: &[f64]) {
+        for (id, v) in self.ids.iter().zip(values) {
+            set(model, *id, *v);
+        }
+    }
+}
+
+fn slot(model: &mut RobotModel, id: ParamId) -> &mut f64 {
+    use ParamKind::*;
+    match id.kind {
+        Alpha => &mut model.links[id.link].alpha,
+        A => &mut model.links[id.link].a,
+        Beta => &mut model.links[id.link].beta,
+        B => &mut model.links[id.link].b,
+        D => &mut model.links[id.link].d,
+        Theta => &mut model.links[id.link].theta,
+        ToolX => &mut model.tool.p.x,
+        ToolY => &mut model.tool.p.y,
+        ToolZ => &mut model.tool.p.z,
+        ToolRx => &mut model.tool.rpy[0],
+        ToolRy => &mut model.tool.rpy[1],
+        ToolRz => &mut model.tool.rpy[2],
+        LoopL3 => {
+            &mut model
+                .closed_loop
+                .as_mut()
+                .expect("model has no closed loop")
+                .l3
+        }
+        LoopL4 => {
+            &mut model
+                .closed_loop
+                .as_mut()
+                .expect("model has no closed loop")
+                .l4
+        }
+        LoopL5 => {
+            &mut model
+                .closed_loop
+                .as_mut()
+                .expect("model has no closed loop")
+                .l5
+        }
+        Compliance => &mut model.links[id.link].compliance,
+    }
+}
+
+/// Value of one parameter (SI).
+pub fn get(model: &RobotModel, id: ParamId) -> f64 {
+    let mut m = ModelRef(model);
+    m.get(id)
+}
+
+/// Sets one parameter (SI).
+pub fn set(model: &mut RobotModel, id: ParamId, value: f64) {
+    *slot(model, id) = value;
+}
+
+struct ModelRef<'a>(&'a RobotModel);
+
+impl ModelRef<'_> {
+    fn get(&mut self, id: ParamId) -> f64 {
+        use ParamKind::*;
+        let m = self.0;
+        match id.kind {
+            Alpha => m.links[id.link].alpha,
+            A => m.links[id.link].a,
+            Beta => m.links[id.link].beta,
+            B => m.links[id.link].b,
+            D => m.links[id.link].d,
+            Theta => m.links[id.link].theta,
+            ToolX => m.tool.p.x,
+            ToolY => m.tool.p.y,
+            ToolZ => m.tool.p.z,
+            ToolRx => m.tool.rpy[0],
+            ToolRy => m.tool.rpy[1],
+            ToolRz => m.tool.rpy[2],
+            LoopL3 => m.closed_loop.as_ref().map_or(0.0, |c| c.l3),
+            LoopL4 => m.closed_loop.as_ref().map_or(0.0, |c| c.l4),
+            LoopL5 => m.closed_loop.as_ref().map_or(0.0, |c| c.l5),
+            Compliance => m.links[id.link].compliance,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip() {
+        use ParamKind::*;
+        for id in [
+            ParamId::new(Alpha, 0),
+            ParamId::new(A, 3),
+            ParamId::new(Beta, 2),
+            ParamId::new(B, 0),
+            ParamId::new(D, 0),
+            ParamId::new(Theta, 5),
+            ParamId::new(ToolRz, 0),
+            ParamId::new(LoopL4, 0),
+            ParamId::new(Compliance, 1),
+        ] {
+            assert_eq!(ParamId::parse(&id.name()), Some(id), "{}", id.name());
+        }
+        assert_eq!(ParamId::new(D, 0).name(), "d1");
+        assert_eq!(ParamId::new(Alpha, 2).name(), "alpha2");
+        assert_eq!(ParamId::parse("zeta3"), None);
+    }
+}
