@@ -1,0 +1,1 @@
+//! The measurement CSV format (DESIGN "Measurement CSV"); see `parse` and `write`.

@@ -1,0 +1,108 @@
+//! Measurements: joint readings paired with measured TCP positions (and
+//! optionally orientations), as uploaded by a cell engineer.
+//!
+//! Two forms:
+//! - [`MeasuredPose`]: boundary units of the CSV format (controller joint readings
+//!   in degrees, positions in millimetres in the measurement frame, optional
+//!   orientation as fixed-axis XYZ angles `rx, ry, rz` in degrees, i.e.
+//!   `R = Rz(rz)·Ry(ry)·Rx(rx)`).
+//! - [`Measurement`]: SI form used by the numerical core (model-convention joint
+//!   values in radians after the controller's sign/zero conversion, metres).
+
+use crate::model::pose::rpy_matrix;
+use crate::model::RobotModel;
+use nalgebra::{Matrix3, Vector3};
+use serde::{Deserialize, Serialize};
+
+pub mod csv;
+
+/// Role of a measurement in the calibration (DESIGN "Data roles").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SetRole {
+    /// Q1: identifies the model-based parameters.
+    Identification,
+    /// Q2: trains the compensator.
+    Training,
+    /// Q3: validates; never used for fitting.
+    Validation,
+}
+
+impl SetRole {
+    pub fn parse(s: &str) -> Option<SetRole> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "identification" | "identify" | "q1" => Some(SetRole::Identification),
+            "training" | "train" | "q2" => Some(SetRole::Training),
+            "validation" | "validate" | "q3" => Some(SetRole::Validation),
+            _ => None,
+        }
+    }
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            SetRole::Identification => "identification",
+            SetRole::Training => "training",
+            SetRole::Validation => "validation",
+        }
+    }
+}
+
+/// One measured pose in boundary units (mm, deg), as in the CSV.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MeasuredPose {
+    /// Controller joint readings [deg].
+    pub q_deg: Vec<f64>,
+    /// Measured TCP position in the measurement frame [mm].
+    pub xyz_mm: [f64; 3],
+    /// Measured orientation, fixed-axis XYZ `[rx, ry, rz]` [deg].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rpy_deg: Option<[f64; 3]>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub payload_kg: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub temperature_c: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub set: Option<SetRole>,
+}
+
+/// One measured pose in SI units, ready for identification.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Measurement {
+    /// Model-convention joint values [rad].
+    pub q: Vec<f64>,
+    /// Measured TCP position in the measurement frame [m].
+    pub position: Vector3<f64>,
+    /// Measured TCP orientation in the measurement frame, when available.
+    pub orientation: Option<Matrix3<f64>>,
+    /// Payload mass during the measurement [kg].
+    pub payload_mass: f64,
+    /// Measurement session (tracker placement) index; 0 for a single session.
+    pub session: usize,
+}
+
+impl MeasuredPose {
+    /// Converts to SI with the model's controller conventions; `default_payload`
+    /// applies when the row gives no payload.
+    pub fn to_measurement(&self, model: &RobotModel, default_payload: f64) -> Measurement {
+        let q_ctrl: Vec<f64> = self.q_deg.iter().map(|d| d.to_radians()).collect();
+        Measurement {
+            q: model.joints_from_controller(&q_ctrl),
+            position: Vector3::new(self.xyz_mm[0], self.xyz_mm[1], self.xyz_mm[2]) * 1e-3,
+            orientation: self.rpy_deg.map(|r| {
+                rpy_matrix(r[0].to_radians(), r[1].to_radians(), r[2].to_radians())
+            }),
+            payload_mass: self.payload_kg.unwrap_or(default_payload),
+            session: 0,
+        }
+    }
+}
+
+/// Converts rows to SI measurements.
+pub fn to_measurements(
+    model: &RobotModel,
+    rows: &[MeasuredPose],
+    default_payload: f64,
+) -> Vec<Measurement> {
+    rows.iter()
+        .map(|r| r.to_measurement(model, default_payload))
+        .collect()
+}
