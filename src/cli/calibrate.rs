@@ -1,10 +1,303 @@
-//! `robocal calibrate`.
+//! `robocal calibrate`: identify calibrated models from measurement CSVs and
+//! print the comparison of methods (like the seed's Tables 2.5/2.6) with the
+//! identifiability report, or the same as JSON.
 
+use crate::identify::{calibrate, CalibrationOptions, CalibrationReport, Method};
+use crate::measure::{self, csv, SetRole};
+use crate::model::RobotModel;
+use anyhow::{bail, Context};
 use clap::Args;
+use std::fmt::Write as _;
 
 #[derive(Debug, Args)]
-pub struct CalibrateArgs {}
+pub struct CalibrateArgs {
+    /// Robot model: a preset name (ys100, hh800, ur5, ur10) or a model JSON file.
+    #[arg(long)]
+    pub model: String,
+    /// Identification measurements (CSV). Rows whose `set` column says
+    /// validation are moved to the validation set.
+    #[arg(long)]
+    pub identify: String,
+    /// Validation measurements (CSV), never used for fitting.
+    #[arg(long)]
+    pub validate: Option<String>,
+    /// Methods to run and compare, comma-separated: km, skcm, skcm-tlbo.
+    #[arg(long, default_value = "km,skcm,skcm-tlbo")]
+    pub method: String,
+    /// Payload mass [kg] for rows without a payload_kg column (default: the model's payload).
+    #[arg(long)]
+    pub payload_kg: Option<f64>,
+    /// Random seed of the TLBO search.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// TLBO population and generations.
+    #[arg(long, default_value_t = 50)]
+    pub population: usize,
+    #[arg(long, default_value_t = 100)]
+    pub generations: usize,
+    /// Keep the measurement frame as given (data already in the robot base frame).
+    #[arg(long)]
+    pub no_register: bool,
+    /// Tracker-data files with x_dif columns: measured = target + dif (plus) or − dif (minus).
+    #[arg(long, default_value = "plus")]
+    pub dif_sign: String,
+    /// Print the full report as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// Write the calibrated model of the best method (or of --save-method) to this file.
+    #[arg(long)]
+    pub save: Option<String>,
+    /// Method whose model --save writes (default: best validation mean).
+    #[arg(long)]
+    pub save_method: Option<String>,
+}
 
-pub fn run(_args: CalibrateArgs) -> anyhow::Result<()> {
-    anyhow::bail!("`robocal calibrate` is not available in this build yet")
+fn read_rows(path: &str, dif: csv::DifSign) -> anyhow::Result<Vec<measure::MeasuredPose>> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {path}"))?;
+    csv::parse_with(&text, dif).with_context(|| path.to_string())
+}
+
+pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
+    let model = crate::cli::load_model(&a.model)?;
+    let methods = Method::parse_list(&a.method).map_err(anyhow::Error::msg)?;
+    let dif = match a.dif_sign.as_str() {
+        "plus" => csv::DifSign::Plus,
+        "minus" => csv::DifSign::Minus,
+        other => bail!("--dif-sign must be plus or minus, got {other}"),
+    };
+    if let Some(p) = a.payload_kg {
+        if !(p.is_finite() && p >= 0.0) {
+            bail!("--payload-kg must be a non-negative number, got {p}");
+        }
+    }
+    let payload = a.payload_kg.unwrap_or(model.payload.mass);
+    let rows = read_rows(&a.identify, dif)?;
+    csv::check_joint_count(&rows, model.dof()).with_context(|| a.identify.clone())?;
+    let training = rows
+        .iter()
+        .filter(|r| r.set == Some(SetRole::Training))
+        .count();
+    if training > 0 && !a.json {
+        eprintln!(
+            "note: {training} rows marked `training` are for compensators and are not used here"
+        );
+    }
+    let (ident_rows, mut valid_rows): (Vec<_>, Vec<_>) = rows
+        .into_iter()
+        .filter(|r| r.set != Some(SetRole::Training))
+        .partition(|r| r.set != Some(SetRole::Validation));
+    if let Some(v) = &a.validate {
+        let more = read_rows(v, dif)?;
+        csv::check_joint_count(&more, model.dof()).with_context(|| v.clone())?;
+        valid_rows.extend(more);
+    }
+    let ident = measure::to_measurements(&model, &ident_rows, payload);
+    let valid = measure::to_measurements(&model, &valid_rows, payload);
+    let opts = CalibrationOptions {
+        methods,
+        register: !a.no_register,
+        tlbo: crate::identify::TlboSettings {
+            population: a.population,
+            generations: a.generations,
+            seed: a.seed,
+        },
+        ..Default::default()
+    };
+    let verbose = !a.json;
+    let report = calibrate(&model, &ident, &valid, &opts, &|p| {
+        if verbose && p.iteration == 0 {
+            eprintln!("[{:5.1}%] {}", p.percent, p.phase);
+        }
+        true
+    })?;
+    if let Some(path) = &a.save {
+        save_model(&model, &report, a.save_method.as_deref(), payload, path)?;
+    }
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print!("{}", render_report(&model, &report));
+    }
+    Ok(())
+}
+
+fn save_model(
+    nominal: &RobotModel,
+    report: &CalibrationReport,
+    method: Option<&str>,
+    payload: f64,
+    path: &str,
+) -> anyhow::Result<()> {
+    let chosen = match method {
+        Some(m) => {
+            let m = Method::parse(m).with_context(|| format!("unknown --save-method {m}"))?;
+            report
+                .methods
+                .get(m.name())
+                .with_context(|| format!("--save-method {} was not run", m.name()))?
+        }
+        None => report.best_method().context("no method ran")?,
+    };
+    // The calibrated model file read by `robocal solve` (format robocal-calibrated-model/1).
+    let file = serde_json::json!({
+        "format": "robocal-calibrated-model/1",
+        "robot": nominal.name,
+        "method": chosen.method.name(),
+        "model": crate::model::ModelDescription::from_model(&chosen.calibrated),
+        "nominal": crate::model::ModelDescription::from_model(nominal),
+        "cell_from_base": crate::identify::calibrate::PoseMmDeg::from_pose(&report.tracker_to_base.inverse()),
+        "payload_kg": payload,
+    });
+    std::fs::write(path, serde_json::to_string_pretty(&file)?)
+        .with_context(|| format!("cannot write {path}"))?;
+    eprintln!("saved the {} model to {path}", chosen.method.name());
+    Ok(())
+}
+
+fn method_label(name: &str) -> &str {
+    match name {
+        "km" => "KM",
+        "skcm" => "SKCM",
+        "skcm-tlbo" => "SKCM-C (TLBO)",
+        other => other,
+    }
+}
+
+/// The text report: accuracy table, identifiability, parameters, stiffness.
+pub fn render_report(nominal: &RobotModel, r: &CalibrationReport) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "robot {}: {} identification poses, {} validation poses",
+        r.robot, r.identification_poses, r.validation_poses
+    );
+    for reg in &r.registration {
+        let t = &reg.tracker_to_base;
+        let _ = writeln!(
+            s,
+            "registration (session {}): tracker->base xyz [{:.3}, {:.3}, {:.3}] mm, rpy [{:.4}, {:.4}, {:.4}] deg, nominal RMS {:.3} mm",
+            reg.session, t.xyz_mm[0], t.xyz_mm[1], t.xyz_mm[2], t.rpy_deg[0], t.rpy_deg[1], t.rpy_deg[2], reg.rms_mm
+        );
+    }
+    let _ = writeln!(s, "\nAbsolute position accuracy (mm)");
+    let _ = writeln!(
+        s,
+        "{:<22} {:>8} {:>8} {:>8} {:>8} {:>8}   {:>8} {:>8} {:>8} {:>8} {:>8}",
+        "", "id mean", "max", "std", "rms", "p95", "val mean", "max", "std", "rms", "p95"
+    );
+    let mut line = |label: &str,
+                    id: &crate::identify::ErrorStats,
+                    va: Option<&crate::identify::ErrorStats>| {
+        let _ = write!(
+            s,
+            "{:<22} {:>8.4} {:>8.4} {:>8.4} {:>8.4} {:>8.4}",
+            label, id.mean_mm, id.max_mm, id.std_mm, id.rms_mm, id.p95_mm
+        );
+        if let Some(v) = va {
+            let _ = write!(
+                s,
+                "   {:>8.4} {:>8.4} {:>8.4} {:>8.4} {:>8.4}",
+                v.mean_mm, v.max_mm, v.std_mm, v.rms_mm, v.p95_mm
+            );
+        }
+        let _ = writeln!(s);
+    };
+    line(
+        "Nominal robot model",
+        &r.nominal.identification.stats,
+        r.nominal.validation.as_ref().map(|v| &v.stats),
+    );
+    for (name, m) in &r.methods {
+        line(
+            method_label(name),
+            &m.identification.stats,
+            m.validation.as_ref().map(|v| &v.stats),
+        );
+    }
+    let id = &r.identifiability;
+    let _ = writeln!(
+        s,
+        "\nIdentifiability: {} parameters kept of {} candidates (rank {}), condition number {:.2}, observability O1 {:.4}",
+        id.kept.len(), id.candidates, id.rank, id.condition_number, id.observability_o1
+    );
+    for d in &id.dropped {
+        if d.depends_on.is_empty() {
+            let _ = writeln!(s, "  dropped {:<8} {}", d.name, d.reason);
+        } else {
+            let _ = writeln!(
+                s,
+                "  dropped {:<8} {} ({})",
+                d.name,
+                d.reason,
+                d.depends_on.join(", ")
+            );
+        }
+    }
+    for p in &id.correlated_pairs {
+        let _ = writeln!(s, "  correlated {} ~ {}: {:+.3}", p.a, p.b, p.correlation);
+    }
+    // Parameter table across methods.
+    let names: Vec<&str> = r.methods.keys().map(|k| k.as_str()).collect();
+    let _ = write!(
+        s,
+        "\nIdentified parameters (mm, deg, rad/(N·m))\n{:<10} {:>14}",
+        "name", "nominal"
+    );
+    for n in &names {
+        let _ = write!(s, " {:>14}", method_label(n));
+    }
+    let _ = writeln!(s);
+    let mut all: Vec<String> = Vec::new();
+    for m in r.methods.values() {
+        for p in &m.parameters {
+            if !all.contains(&p.name) {
+                all.push(p.name.clone());
+            }
+        }
+    }
+    for pname in &all {
+        let nominal_v = r
+            .methods
+            .values()
+            .flat_map(|m| &m.parameters)
+            .find(|p| &p.name == pname)
+            .map(|p| p.nominal)
+            .unwrap_or(0.0);
+        let _ = write!(s, "{:<10} {:>14.6}", pname, nominal_v);
+        for n in &names {
+            match r.methods[*n].parameters.iter().find(|p| &p.name == pname) {
+                Some(p) => {
+                    let _ = write!(s, " {:>14.6e}", p.value);
+                }
+                None => {
+                    let _ = write!(s, " {:>14}", "-");
+                }
+            }
+        }
+        let _ = writeln!(s);
+    }
+    let _ = writeln!(s, "\nJoint stiffness (N·m/rad)");
+    for (n, m) in &r.methods {
+        if m.stiffness_nm_per_rad.iter().any(|k| k.is_some()) {
+            let ks: Vec<String> = m
+                .stiffness_nm_per_rad
+                .iter()
+                .enumerate()
+                .filter_map(|(k, v)| v.map(|v| format!("K{}={:.4e}", k + 1, v)))
+                .collect();
+            let _ = writeln!(s, "  {:<14} {}", method_label(n), ks.join("  "));
+        }
+    }
+    for (n, m) in &r.methods {
+        let _ = writeln!(
+            s,
+            "solver {:<14} converged={} iterations={} ({})",
+            method_label(n),
+            m.solver.converged,
+            m.solver.iterations,
+            m.solver.reason
+        );
+    }
+    let _ = nominal;
+    s
 }

@@ -1,1 +1,258 @@
-//! compensate
+//! The compensated model (DESIGN "Compensated model and false targets", seed
+//! eq. 2.1): calibrated geometry, joint compliance under the given payload and an
+//! optional learned residual compensator.
+//!
+//! Predicted TCP pose of model-convention joints `q` [rad]:
+//!
+//! - `τ = τ(q)`: gravity torques [N·m] of the *calibrated* model at the commanded
+//!   configuration `q`, with payload mass `payload_kg` (its centre of mass is the
+//!   calibrated model's payload CoM), eqs. 3.7–3.9;
+//! - `P_base(q) = FK_cal(q + c∘τ)` with the residual `NN(q, τ)` [m] of the
+//!   compensator added to the position (base frame); the orientation is the
+//!   geometric part's;
+//! - `P_cell(q) = cell_from_base · P_base(q)`.
+//!
+//! Frames: the *registered base frame* is the calibrated model's base frame;
+//! `cell_from_base` maps it into the measurement (cell / tracker) frame in which
+//! the calibration data were measured. The *nominal* model is what the robot
+//! controller knows; its base frame is the controller's base frame, in which
+//! false targets are expressed.
+//!
+//! Units: SI inside (m, rad, kg, N·m); the file format in [`file`] uses mm/deg.
+
+use crate::kinematics::{chain, fk, geometric_jacobian, gravity_torques_of, KinematicsError};
+use crate::model::{ModelError, Pose, RobotModel};
+use nalgebra::{DMatrix, Vector3};
+use std::sync::Arc;
+
+pub mod file;
+pub mod synthetic;
+
+pub use file::{
+    load_compensated, parse_compensated, CalibratedModelFile, PoseDescription,
+    CALIBRATED_MODEL_FORMAT,
+};
+pub use synthetic::{synthetic_calibration, SyntheticErrors};
+
+/// A learned residual model: what the geometric and compliance model leave.
+///
+/// `residual` returns the position correction [m] in the registered base frame,
+/// to be added to `FK_cal(q + c∘τ)`. `q` are model-convention joint values
+/// [rad] (commanded), `tau` the gravity torques [N·m] at `q` with the model's
+/// payload. Implementations must be cheap and deterministic: the IK calls them
+/// once per iteration.
+pub trait Compensator: Send + Sync {
+    fn residual(&self, q: &[f64], tau: &[f64]) -> Vector3<f64>;
+    fn name(&self) -> &str;
+}
+
+/// Errors of the compensated model and its files.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CompensateError {
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    #[error(transparent)]
+    Kinematics(#[from] KinematicsError),
+    #[error("{path}: {reason}")]
+    Io { path: String, reason: String },
+    #[error("calibrated model file: {0}")]
+    Format(String),
+}
+
+/// Calibrated + compliant + compensated model with its frames (see module docs).
+#[derive(Clone)]
+pub struct CompensatedModel {
+    /// Identified model: geometry and compliance, SI; maps joints to the
+    /// registered base frame.
+    pub calibrated: RobotModel,
+    /// The controller's nominal model (false targets, joint conventions, limits).
+    pub nominal: RobotModel,
+    /// Registered base frame → measurement (cell / tracker) frame.
+    pub cell_from_base: Pose,
+    /// Payload mass [kg] used for the gravity torques.
+    pub payload_kg: f64,
+    /// Optional residual compensator (identity when `None`).
+    pub compensator: Option<Arc<dyn Compensator>>,
+}
+
+impl std::fmt::Debug for CompensatedModel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("CompensatedModel")
+            .field("calibrated", &self.calibrated)
+            .field("nominal", &self.nominal)
+            .field("cell_from_base", &self.cell_from_base)
+            .field("payload_kg", &self.payload_kg)
+            .field(
+                "compensator",
+                &self.compensator.as_ref().map(|c| c.name().to_string()),
+            )
+            .finish()
+    }
+}
+
+/// Predicted pose with the quantities the IK reuses.
+#[derive(Debug, Clone)]
+pub struct Prediction {
+    /// Predicted TCP pose in the registered base frame.
+    pub pose: Pose,
+    /// Gravity torques at the commanded joints [N·m].
+    pub tau: Vec<f64>,
+    /// Deflected joints `q + c∘τ` [rad].
+    pub deflected: Vec<f64>,
+}
+
+impl CompensatedModel {
+    /// A model whose calibrated geometry is the nominal one: identity frame, the
+    /// model's default payload, no compensator.
+    pub fn from_nominal(model: RobotModel) -> Self {
+        let payload_kg = model.payload.mass;
+        CompensatedModel {
+            calibrated: model.clone(),
+            nominal: model,
+            cell_from_base: Pose::identity(),
+            payload_kg,
+            compensator: None,
+        }
+    }
+
+    /// Number of active joints.
+    pub fn dof(&self) -> usize {
+        self.calibrated.dof()
+    }
+
+    /// Gravity torques [N·m] of the calibrated model at `q` with `payload_kg`.
+    pub fn torques(&self, q: &[f64]) -> Result<Vec<f64>, KinematicsError> {
+        let c = chain(&self.calibrated, q)?;
+        Ok(gravity_torques_of(&self.calibrated, &c, self.payload_kg))
+    }
+
+    fn deflect(&self, q: &[f64], tau: &[f64]) -> Vec<f64> {
+        q.iter()
+            .zip(tau)
+            .zip(&self.calibrated.links)
+            .map(|((q, t), l)| q + l.compliance * t)
+            .collect()
+    }
+
+    /// Full prediction in the registered base frame.
+    pub fn predict_detailed(&self, q: &[f64]) -> Result<Prediction, KinematicsError> {
+        let m = &self.calibrated;
+        let needs_tau = m.has_compliance() || self.compensator.is_some();
+        let tau = if needs_tau {
+            self.torques(q)?
+        } else {
+            vec![0.0; m.dof()]
+        };
+        let deflected = if m.has_compliance() {
+            self.deflect(q, &tau)
+        } else {
+            q.to_vec()
+        };
+        let mut pose = fk(m, &deflected)?;
+        if let Some(c) = &self.compensator {
+            pose.p += c.residual(q, &tau);
+        }
+        Ok(Prediction {
+            pose,
+            tau,
+            deflected,
+        })
+    }
+
+    /// Predicted TCP pose in the registered base frame.
+    pub fn predict_base(&self, q: &[f64]) -> Result<Pose, KinematicsError> {
+        Ok(self.predict_detailed(q)?.pose)
+    }
+
+    /// Predicted TCP pose in the measurement (cell) frame.
+    pub fn predict(&self, q: &[f64]) -> Result<Pose, KinematicsError> {
+        Ok(self.cell_from_base.compose(&self.predict_base(q)?))
+    }
+
+    /// Predicted pose (registered base frame) and its quasi-Newton Jacobian
+    /// (6×N, rows `[v; ω]`, base frame): the geometric Jacobian of the
+    /// calibrated chain at the deflected joints, neglecting `∂τ/∂q` and the
+    /// compensator's own derivative (both small against the arm's lever arms).
+    pub fn predict_base_with_jacobian(
+        &self,
+        q: &[f64],
+    ) -> Result<(Pose, DMatrix<f64>), KinematicsError> {
+        let m = &self.calibrated;
+        let c0 = chain(m, q)?;
+        let needs_tau = m.has_compliance() || self.compensator.is_some();
+        let tau = if needs_tau {
+            gravity_torques_of(m, &c0, self.payload_kg)
+        } else {
+            Vec::new()
+        };
+        let (mut pose, jac) = if m.has_compliance() {
+            let c1 = chain(m, &self.deflect(q, &tau))?;
+            (c1.tcp, geometric_jacobian(m, &c1))
+        } else {
+            (c0.tcp, geometric_jacobian(m, &c0))
+        };
+        if let Some(c) = &self.compensator {
+            pose.p += c.residual(q, &tau);
+        }
+        Ok((pose, jac))
+    }
+
+    /// The false target: the nominal model's TCP pose at `q`, in the
+    /// controller's nominal base frame.
+    pub fn false_target(&self, q: &[f64]) -> Result<Pose, KinematicsError> {
+        fk(&self.nominal, q)
+    }
+
+    /// Maps a pose given in the measurement (cell) frame into the registered base frame.
+    pub fn cell_to_base(&self, cell: &Pose) -> Pose {
+        self.cell_from_base.inverse().compose(cell)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kinematics::deflected_joints;
+    use crate::model::preset;
+
+    struct Constant(Vector3<f64>);
+    impl Compensator for Constant {
+        fn residual(&self, _q: &[f64], _tau: &[f64]) -> Vector3<f64> {
+            self.0
+        }
+        fn name(&self) -> &str {
+            "constant"
+        }
+    }
+
+    #[test]
+    fn predict_is_fk_of_deflected_joints_plus_residual_in_cell_frame() {
+        let mut cal = preset("ys100").unwrap();
+        for l in cal.links.iter_mut().skip(1).take(4) {
+            l.compliance = 1e-6;
+        }
+        let mut frame = Pose::identity();
+        frame.tr_y(-3.24);
+        frame.rot_z(0.3);
+        let m = CompensatedModel {
+            calibrated: cal.clone(),
+            nominal: preset("ys100").unwrap(),
+            cell_from_base: frame,
+            payload_kg: 80.0,
+            compensator: Some(Arc::new(Constant(Vector3::new(1e-4, -2e-4, 3e-4)))),
+        };
+        let q = [0.2, 1.3, -0.4, 0.5, 0.9, -1.0];
+        let qd = deflected_joints(&cal, &q, 80.0).unwrap();
+        let mut expect = fk(&cal, &qd).unwrap();
+        expect.p += Vector3::new(1e-4, -2e-4, 3e-4);
+        let base = m.predict_base(&q).unwrap();
+        assert!((base.p - expect.p).norm() < 1e-14);
+        assert!((base.r - expect.r).norm() < 1e-14);
+        let cell = m.predict(&q).unwrap();
+        let e = frame.compose(&expect);
+        assert!((cell.p - e.p).norm() < 1e-12);
+        let (pj, _) = m.predict_base_with_jacobian(&q).unwrap();
+        assert!((pj.p - expect.p).norm() < 1e-14);
+        assert!(format!("{m:?}").contains("constant"));
+    }
+}

@@ -1,1 +1,840 @@
-//! The measurement CSV format (DESIGN "Measurement CSV"); see `parse` and `write`.
+//! The measurement CSV format (DESIGN "Measurement CSV"); see [`parse`] and [`write`].
+//!
+//! Canonical layout (what [`write`] produces):
+//!
+//! ```text
+//! # comments start with '#', anywhere; blank lines are ignored
+//! q1,q2,q3,q4,q5,q6,x,y,z,rx,ry,rz,payload_kg,temperature_c,set
+//! 10,95,-20,0,30,0,1523.2,12.5,980.1,,,,110,21.5,identification
+//! ```
+//!
+//! - `q1..qN`: controller joint readings [deg], N = 2..7, contiguous.
+//! - `x, y, z`: measured TCP position in the measurement (tracker) frame [mm].
+//! - `rx, ry, rz` (optional, all three or none): measured orientation as fixed-axis
+//!   XYZ angles [deg], `R = Rz(rz)·Ry(ry)·Rx(rx)`.
+//! - `payload_kg`, `temperature_c`, `set` (optional). `set` is `identification`,
+//!   `training` or `validation` (also `q1`, `q2`, `q3`).
+//!
+//! Columns are found by name (case-insensitive, any order). In optional columns an
+//! empty field means "not given" for that row (the orientation needs all three
+//! fields or none). Unknown and duplicate columns are rejected.
+//!
+//! **Real-data layout** (`shared/data/ur5-wam-laser-tracker`): `step_order`,
+//! `x_t,y_t,z_t` (nominal target [mm]), `x_dif,y_dif,z_dif` [mm] and
+//! `joint_1..joint_N` [deg]. The sign of `dif` is not documented by the data's
+//! authors; the working assumption (it fits gravity sag) is
+//! `measured = x_t + dif` ([`DifSign::Plus`], what [`parse`] uses);
+//! [`parse_with`] with [`DifSign::Minus`] flips it. `step_order` is accepted and
+//! ignored; `joint_i` is an alias of `qi`.
+//!
+//! Unit sanity checks (the file is rejected, naming the line/column):
+//! - a joint reading with |q| > 720° "looks like wrong units" (encoder counts,
+//!   millidegrees, …);
+//! - every position coordinate of the whole file within ±5 "looks like metres,
+//!   expected millimetres".
+//!
+//! Radians given as degrees cannot be told apart from a small-angle degree file
+//! reliably, so that case is not checked.
+
+use super::{MeasuredPose, SetRole};
+use std::fmt::Write as _;
+
+/// Maximum joint count of a CSV row.
+pub const MAX_JOINTS: usize = 7;
+/// Minimum joint count of a CSV row.
+pub const MIN_JOINTS: usize = 2;
+/// A joint reading beyond this magnitude [deg] is rejected as wrong units.
+pub const MAX_JOINT_DEG: f64 = 720.0;
+/// If every position coordinate of the file is below this magnitude [mm], the
+/// file is rejected as metres.
+pub const METRES_SUSPECT_MM: f64 = 5.0;
+
+const ACCEPTED: &str = "q1..q7 (alias joint_1..joint_7), x, y, z, rx, ry, rz, payload_kg, \
+temperature_c, set; real-data layout: x_t, y_t, z_t, x_dif, y_dif, z_dif, step_order";
+
+/// Sign of the `*_dif` columns of the real-data layout.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum DifSign {
+    /// `measured = target + dif` (working assumption; fits gravity sag).
+    #[default]
+    Plus,
+    /// `measured = target − dif`.
+    Minus,
+}
+
+impl DifSign {
+    fn factor(self) -> f64 {
+        match self {
+            DifSign::Plus => 1.0,
+            DifSign::Minus => -1.0,
+        }
+    }
+}
+
+/// An error in a measurement CSV, with the 1-based line number and column name
+/// where they apply.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CsvError {
+    #[error("the CSV file is empty: no header row")]
+    Empty,
+    #[error("no data rows after the header on line {header_line}")]
+    NoDataRows { header_line: usize },
+    #[error("line {line}: missing column `{column}`")]
+    MissingColumn { line: usize, column: String },
+    #[error("line {line}: unknown column `{column}`; accepted columns: {accepted}")]
+    UnknownColumn {
+        line: usize,
+        column: String,
+        accepted: String,
+    },
+    #[error("line {line}: duplicate column `{column}` (column `{previous}` already given)")]
+    DuplicateColumn {
+        line: usize,
+        column: String,
+        previous: String,
+    },
+    #[error("line {line}: conflicting columns `{first}` and `{second}` (use one position layout: x,y,z or x_t,y_t,z_t + x_dif,y_dif,z_dif)")]
+    ConflictingColumns {
+        line: usize,
+        first: String,
+        second: String,
+    },
+    #[error("line {line}: joint columns must be q1..qN with {min} <= N <= {max}, found {found}")]
+    JointColumns {
+        line: usize,
+        found: String,
+        min: usize,
+        max: usize,
+    },
+    #[error("line {line}: expected {expected} fields, got {got}")]
+    FieldCount {
+        line: usize,
+        expected: usize,
+        got: usize,
+    },
+    #[error("line {line}, column `{column}`: `{value}` is not a number")]
+    NotNumeric {
+        line: usize,
+        column: String,
+        value: String,
+    },
+    #[error("line {line}, column `{column}`: `{value}` is not a finite number")]
+    NotFinite {
+        line: usize,
+        column: String,
+        value: String,
+    },
+    #[error("line {line}, column `set`: unknown set `{value}` (expected identification, training, validation or q1, q2, q3)")]
+    UnknownSet { line: usize, value: String },
+    #[error("line {line}, columns rx, ry, rz: give all three orientation angles or none")]
+    PartialOrientation { line: usize },
+    #[error("line {line}, column `{column}`: {value} deg looks like wrong units (|q| > {max} deg; joint readings must be in degrees)", max = MAX_JOINT_DEG)]
+    JointUnits {
+        line: usize,
+        column: String,
+        value: f64,
+    },
+    #[error("every position coordinate is within ±{limit} mm: looks like metres, expected millimetres", limit = METRES_SUSPECT_MM)]
+    PositionUnits,
+    #[error("row {row}: {got} joint values, but the model has {expected} joints")]
+    JointCount {
+        row: usize,
+        expected: usize,
+        got: usize,
+    },
+}
+
+/// What one header column means.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Col {
+    Joint(usize),
+    Pos(usize),
+    Rot(usize),
+    Payload,
+    Temperature,
+    Set,
+    Target(usize),
+    Dif(usize),
+    StepOrder,
+}
+
+fn classify(name: &str) -> Option<Col> {
+    let fixed = match name {
+        "x" => Some(Col::Pos(0)),
+        "y" => Some(Col::Pos(1)),
+        "z" => Some(Col::Pos(2)),
+        "rx" => Some(Col::Rot(0)),
+        "ry" => Some(Col::Rot(1)),
+        "rz" => Some(Col::Rot(2)),
+        "payload_kg" => Some(Col::Payload),
+        "temperature_c" => Some(Col::Temperature),
+        "set" => Some(Col::Set),
+        "x_t" => Some(Col::Target(0)),
+        "y_t" => Some(Col::Target(1)),
+        "z_t" => Some(Col::Target(2)),
+        "x_dif" => Some(Col::Dif(0)),
+        "y_dif" => Some(Col::Dif(1)),
+        "z_dif" => Some(Col::Dif(2)),
+        "step_order" => Some(Col::StepOrder),
+        _ => None,
+    };
+    if fixed.is_some() {
+        return fixed;
+    }
+    let num = name
+        .strip_prefix("joint_")
+        .or_else(|| name.strip_prefix('q'))?;
+    if num.is_empty() || !num.bytes().all(|b| b.is_ascii_digit()) || num.starts_with('0') {
+        return None;
+    }
+    num.parse::<usize>().ok().map(Col::Joint)
+}
+
+fn canonical_name(c: Col) -> String {
+    const XYZ: [&str; 3] = ["x", "y", "z"];
+    match c {
+        Col::Joint(i) => format!("q{i}"),
+        Col::Pos(i) => XYZ[i].to_string(),
+        Col::Rot(i) => format!("r{}", XYZ[i]),
+        Col::Payload => "payload_kg".into(),
+        Col::Temperature => "temperature_c".into(),
+        Col::Set => "set".into(),
+        Col::Target(i) => format!("{}_t", XYZ[i]),
+        Col::Dif(i) => format!("{}_dif", XYZ[i]),
+        Col::StepOrder => "step_order".into(),
+    }
+}
+
+/// Column indices of the recognised header.
+struct Header {
+    line: usize,
+    names: Vec<String>,
+    joints: Vec<usize>,
+    /// Canonical `x,y,z` or the real-data `(target, dif)` triples.
+    position: PositionCols,
+    rot: Option<[usize; 3]>,
+    payload: Option<usize>,
+    temperature: Option<usize>,
+    set: Option<usize>,
+}
+
+enum PositionCols {
+    Measured([usize; 3]),
+    TargetPlusDif([usize; 3], [usize; 3]),
+}
+
+fn split_fields(line: &str) -> Vec<&str> {
+    line.split(',')
+        .map(|f| {
+            let f = f.trim();
+            f.strip_prefix('"')
+                .and_then(|g| g.strip_suffix('"'))
+                .unwrap_or(f)
+                .trim()
+        })
+        .collect()
+}
+
+fn parse_header(line: usize, text: &str) -> Result<Header, CsvError> {
+    let names: Vec<String> = split_fields(text)
+        .iter()
+        .map(|s| s.to_ascii_lowercase())
+        .collect();
+    let mut cols: Vec<(Col, usize)> = Vec::new();
+    for (i, name) in names.iter().enumerate() {
+        let col = classify(name).ok_or_else(|| CsvError::UnknownColumn {
+            line,
+            column: name.clone(),
+            accepted: ACCEPTED.into(),
+        })?;
+        if let Some((_, j)) = cols.iter().find(|(c, _)| *c == col) {
+            return Err(CsvError::DuplicateColumn {
+                line,
+                column: name.clone(),
+                previous: names[*j].clone(),
+            });
+        }
+        cols.push((col, i));
+    }
+    let find = |c: Col| cols.iter().find(|(x, _)| *x == c).map(|(_, i)| *i);
+    let missing = |c: Col| CsvError::MissingColumn {
+        line,
+        column: canonical_name(c),
+    };
+
+    // Joints: q1..qN contiguous, 2 <= N <= 7.
+    let mut idx: Vec<usize> = cols
+        .iter()
+        .filter_map(|(c, _)| match c {
+            Col::Joint(i) => Some(*i),
+            _ => None,
+        })
+        .collect();
+    idx.sort_unstable();
+    let n = idx.last().copied().unwrap_or(0);
+    if n == 0 {
+        return Err(missing(Col::Joint(1)));
+    }
+    let found = || {
+        idx.iter()
+            .map(|i| format!("q{i}"))
+            .collect::<Vec<_>>()
+            .join(",")
+    };
+    if !(MIN_JOINTS..=MAX_JOINTS).contains(&n) {
+        return Err(CsvError::JointColumns {
+            line,
+            found: found(),
+            min: MIN_JOINTS,
+            max: MAX_JOINTS,
+        });
+    }
+    let mut joints = Vec::with_capacity(n);
+    for i in 1..=n {
+        joints.push(find(Col::Joint(i)).ok_or_else(|| missing(Col::Joint(i)))?);
+    }
+
+    // Position: canonical or real-data layout, not both.
+    let any_pos = (0..3).find_map(|i| find(Col::Pos(i)).map(|c| (i, c)));
+    let any_real = (0..3)
+        .flat_map(|i| [Col::Target(i), Col::Dif(i)])
+        .find_map(|c| find(c).map(|j| (c, j)));
+    let position = match (any_pos, any_real) {
+        (Some((_, a)), Some((_, b))) => {
+            return Err(CsvError::ConflictingColumns {
+                line,
+                first: names[a.min(b)].clone(),
+                second: names[a.max(b)].clone(),
+            })
+        }
+        (None, Some(_)) => {
+            let mut t = [0; 3];
+            let mut d = [0; 3];
+            for i in 0..3 {
+                t[i] = find(Col::Target(i)).ok_or_else(|| missing(Col::Target(i)))?;
+                d[i] = find(Col::Dif(i)).ok_or_else(|| missing(Col::Dif(i)))?;
+            }
+            PositionCols::TargetPlusDif(t, d)
+        }
+        _ => {
+            let mut p = [0; 3];
+            for (i, slot) in p.iter_mut().enumerate() {
+                *slot = find(Col::Pos(i)).ok_or_else(|| missing(Col::Pos(i)))?;
+            }
+            PositionCols::Measured(p)
+        }
+    };
+
+    let rot = if (0..3).any(|i| find(Col::Rot(i)).is_some()) {
+        let mut r = [0; 3];
+        for (i, slot) in r.iter_mut().enumerate() {
+            *slot = find(Col::Rot(i)).ok_or_else(|| missing(Col::Rot(i)))?;
+        }
+        Some(r)
+    } else {
+        None
+    };
+
+    Ok(Header {
+        line,
+        joints,
+        position,
+        rot,
+        payload: find(Col::Payload),
+        temperature: find(Col::Temperature),
+        set: find(Col::Set),
+        names,
+    })
+}
+
+/// Parses one numeric field; `None` for an empty field.
+fn number(line: usize, column: &str, s: &str) -> Result<Option<f64>, CsvError> {
+    if s.is_empty() {
+        return Ok(None);
+    }
+    let v: f64 = s.parse().map_err(|_| CsvError::NotNumeric {
+        line,
+        column: column.to_string(),
+        value: s.to_string(),
+    })?;
+    if !v.is_finite() {
+        return Err(CsvError::NotFinite {
+            line,
+            column: column.to_string(),
+            value: s.to_string(),
+        });
+    }
+    Ok(Some(v))
+}
+
+fn required(line: usize, column: &str, s: &str) -> Result<f64, CsvError> {
+    number(line, column, s)?.ok_or_else(|| CsvError::NotNumeric {
+        line,
+        column: column.to_string(),
+        value: String::new(),
+    })
+}
+
+impl Header {
+    fn row(&self, line: usize, fields: &[&str], sign: DifSign) -> Result<MeasuredPose, CsvError> {
+        if fields.len() != self.names.len() {
+            return Err(CsvError::FieldCount {
+                line,
+                expected: self.names.len(),
+                got: fields.len(),
+            });
+        }
+        let req = |c: usize| required(line, &self.names[c], fields[c]);
+        let opt = |c: usize| number(line, &self.names[c], fields[c]);
+
+        let mut q_deg = Vec::with_capacity(self.joints.len());
+        for &c in &self.joints {
+            let v = req(c)?;
+            if v.abs() > MAX_JOINT_DEG {
+                return Err(CsvError::JointUnits {
+                    line,
+                    column: self.names[c].clone(),
+                    value: v,
+                });
+            }
+            q_deg.push(v);
+        }
+        let mut xyz_mm = [0.0; 3];
+        match &self.position {
+            PositionCols::Measured(p) => {
+                for (x, &c) in xyz_mm.iter_mut().zip(p) {
+                    *x = req(c)?;
+                }
+            }
+            PositionCols::TargetPlusDif(t, d) => {
+                for i in 0..3 {
+                    xyz_mm[i] = req(t[i])? + sign.factor() * req(d[i])?;
+                }
+            }
+        }
+        let rpy_deg = match &self.rot {
+            None => None,
+            Some(r) => {
+                let v = [opt(r[0])?, opt(r[1])?, opt(r[2])?];
+                match v {
+                    [Some(a), Some(b), Some(c)] => Some([a, b, c]),
+                    [None, None, None] => None,
+                    _ => return Err(CsvError::PartialOrientation { line }),
+                }
+            }
+        };
+        let payload_kg = self.payload.map(opt).transpose()?.flatten();
+        let temperature_c = self.temperature.map(opt).transpose()?.flatten();
+        let set = match self.set {
+            Some(c) if !fields[c].is_empty() => Some(SetRole::parse(fields[c]).ok_or_else(
+                || CsvError::UnknownSet {
+                    line,
+                    value: fields[c].to_string(),
+                },
+            )?),
+            _ => None,
+        };
+        Ok(MeasuredPose {
+            q_deg,
+            xyz_mm,
+            rpy_deg,
+            payload_kg,
+            temperature_c,
+            set,
+        })
+    }
+}
+
+/// Parses a measurement CSV (either layout; real-data `dif` added: [`DifSign::Plus`]).
+pub fn parse(text: &str) -> Result<Vec<MeasuredPose>, CsvError> {
+    parse_with(text, DifSign::Plus)
+}
+
+/// Parses a measurement CSV with an explicit sign for the real-data `*_dif` columns.
+pub fn parse_with(text: &str, dif: DifSign) -> Result<Vec<MeasuredPose>, CsvError> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.trim()))
+        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
+    let (hline, htext) = lines.next().ok_or(CsvError::Empty)?;
+    let header = parse_header(hline, htext)?;
+    let mut rows = Vec::new();
+    for (line, l) in lines {
+        rows.push(header.row(line, &split_fields(l), dif)?);
+    }
+    if rows.is_empty() {
+        return Err(CsvError::NoDataRows {
+            header_line: header.line,
+        });
+    }
+    let all_small = rows
+        .iter()
+        .all(|r| r.xyz_mm.iter().all(|v| v.abs() < METRES_SUSPECT_MM));
+    if all_small {
+        return Err(CsvError::PositionUnits);
+    }
+    Ok(rows)
+}
+
+/// Checks that every row has `dof` joint values.
+pub fn check_joint_count(rows: &[MeasuredPose], dof: usize) -> Result<(), CsvError> {
+    match rows.iter().position(|r| r.q_deg.len() != dof) {
+        None => Ok(()),
+        Some(i) => Err(CsvError::JointCount {
+            row: i + 1,
+            expected: dof,
+            got: rows[i].q_deg.len(),
+        }),
+    }
+}
+
+/// Shortest text that parses back to exactly `x` (plain decimal, or exponent
+/// notation when the decimal would be long, e.g. `1e-17`).
+fn num(x: f64) -> String {
+    let s = x.to_string();
+    if s.len() > 24 {
+        format!("{x:e}")
+    } else {
+        s
+    }
+}
+
+/// Writes rows in the canonical layout
+/// `q1..qN,x,y,z[,rx,ry,rz][,payload_kg][,temperature_c][,set]`.
+///
+/// N is the largest joint count among the rows (rows are expected to agree); an
+/// optional column is written when any row has it, rows without it get an empty
+/// field. Numbers use Rust's shortest exact representation, so
+/// `parse(&write(rows)) == rows` bit for bit (for rows that pass the unit checks).
+pub fn write(rows: &[MeasuredPose]) -> String {
+    let n = rows.iter().map(|r| r.q_deg.len()).max().unwrap_or(0);
+    let rot = rows.iter().any(|r| r.rpy_deg.is_some());
+    let payload = rows.iter().any(|r| r.payload_kg.is_some());
+    let temp = rows.iter().any(|r| r.temperature_c.is_some());
+    let set = rows.iter().any(|r| r.set.is_some());
+
+    let mut header: Vec<String> = (1..=n).map(|i| format!("q{i}")).collect();
+    header.extend(["x", "y", "z"].map(String::from));
+    if rot {
+        header.extend(["rx", "ry", "rz"].map(String::from));
+    }
+    if payload {
+        header.push("payload_kg".into());
+    }
+    if temp {
+        header.push("temperature_c".into());
+    }
+    if set {
+        header.push("set".into());
+    }
+    let mut out = header.join(",");
+    out.push('\n');
+
+    let opt = |v: Option<f64>| v.map(num).unwrap_or_default();
+    for r in rows {
+        let mut f: Vec<String> = (0..n)
+            .map(|i| r.q_deg.get(i).copied().map(num).unwrap_or_default())
+            .collect();
+        f.extend(r.xyz_mm.iter().copied().map(num));
+        if rot {
+            match r.rpy_deg {
+                Some(a) => f.extend(a.iter().copied().map(num)),
+                None => f.extend([String::new(), String::new(), String::new()]),
+            }
+        }
+        if payload {
+            f.push(opt(r.payload_kg));
+        }
+        if temp {
+            f.push(opt(r.temperature_c));
+        }
+        if set {
+            f.push(r.set.map(|s| s.as_str().to_string()).unwrap_or_default());
+        }
+        let _ = writeln!(out, "{}", f.join(","));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(q: &[f64], xyz: [f64; 3]) -> MeasuredPose {
+        MeasuredPose {
+            q_deg: q.to_vec(),
+            xyz_mm: xyz,
+            rpy_deg: None,
+            payload_kg: None,
+            temperature_c: None,
+            set: None,
+        }
+    }
+
+    #[test]
+    fn round_trip_is_exact() {
+        let mut rows = vec![
+            row(
+                &[
+                    0.1,
+                    -45.123456789012345,
+                    1e-17,
+                    179.99999999999997,
+                    -0.0,
+                    3e-300,
+                ],
+                [1523.2000000000003, -1.0 / 3.0, 980.0],
+            ),
+            row(
+                &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0],
+                [std::f64::consts::PI * 100.0, 2.5e-9, -1e3],
+            ),
+            row(&[-719.0, 0.5, 0.25, 0.125, 7.0, 8.0], [10.0, 20.0, 30.0]),
+        ];
+        rows[0].rpy_deg = Some([0.1, 89.99999999999999, -179.5]);
+        rows[0].payload_kg = Some(110.0);
+        rows[1].temperature_c = Some(21.123456789);
+        rows[0].set = Some(SetRole::Identification);
+        rows[2].set = Some(SetRole::Validation);
+        let text = write(&rows);
+        assert!(text.starts_with("q1,q2,q3,q4,q5,q6,x,y,z,rx,ry,rz,payload_kg,temperature_c,set\n"));
+        let back = parse(&text).unwrap();
+        assert_eq!(back, rows);
+        for (a, b) in back.iter().zip(&rows) {
+            for (x, y) in a.q_deg.iter().zip(&b.q_deg) {
+                assert_eq!(x.to_bits(), y.to_bits());
+            }
+        }
+        // Minimal layout: no optional columns.
+        let plain = vec![row(&[1.0, 2.0], [100.0, 0.0, 0.0])];
+        let text = write(&plain);
+        assert_eq!(text, "q1,q2,x,y,z\n1,2,100,0,0\n");
+        assert_eq!(parse(&text).unwrap(), plain);
+    }
+
+    #[test]
+    fn comments_blank_lines_case_and_order() {
+        let text = "\u{feff}# exported by a tracker\n\n  # another comment\n\
+                    SET, Z ,y,X,Q2,q1,Payload_KG\r\n\
+                    # comment between rows\n\
+                    q2, 3.5, 2, 1, 20, 10, 5\r\n\
+                    \n\
+                    Training,6,5,4,40,30,\n";
+        let rows = parse(text).unwrap();
+        assert_eq!(rows.len(), 2);
+        assert_eq!(rows[0].q_deg, vec![10.0, 20.0]);
+        assert_eq!(rows[0].xyz_mm, [1.0, 2.0, 3.5]);
+        assert_eq!(rows[0].set, Some(SetRole::Training));
+        assert_eq!(rows[0].payload_kg, Some(5.0));
+        assert_eq!(rows[1].q_deg, vec![30.0, 40.0]);
+        assert_eq!(rows[1].xyz_mm, [4.0, 5.0, 6.0]);
+        assert_eq!(rows[1].payload_kg, None);
+        assert_eq!(rows[1].set, Some(SetRole::Training));
+    }
+
+    #[test]
+    fn real_data_layout_and_dif_sign() {
+        let text = "step_order,x_t,y_t,z_t,x_dif,y_dif,z_dif,joint_1,joint_2,joint_3\n\
+                    0,100,200,300,1,-2,0.5,10,20,30\n";
+        let plus = parse(text).unwrap();
+        assert_eq!(plus[0].xyz_mm, [101.0, 198.0, 300.5]);
+        assert_eq!(plus[0].q_deg, vec![10.0, 20.0, 30.0]);
+        let minus = parse_with(text, DifSign::Minus).unwrap();
+        assert_eq!(minus[0].xyz_mm, [99.0, 202.0, 299.5]);
+    }
+
+    fn err(text: &str) -> CsvError {
+        parse(text).unwrap_err()
+    }
+
+    #[test]
+    fn errors_name_line_and_column() {
+        assert_eq!(err(""), CsvError::Empty);
+        assert_eq!(err("# only a comment\n\n"), CsvError::Empty);
+        assert_eq!(
+            err("# c\nq1,q2,x,y,z\n# nothing\n"),
+            CsvError::NoDataRows { header_line: 2 }
+        );
+        assert_eq!(
+            err("q1,q2,x,y\n1,2,100,0\n"),
+            CsvError::MissingColumn {
+                line: 1,
+                column: "z".into()
+            }
+        );
+        assert_eq!(
+            err("q1,q3,x,y,z\n1,2,100,0,0\n"),
+            CsvError::MissingColumn {
+                line: 1,
+                column: "q2".into()
+            }
+        );
+        assert_eq!(
+            err("x,y,z\n100,0,0\n"),
+            CsvError::MissingColumn {
+                line: 1,
+                column: "q1".into()
+            }
+        );
+        assert!(matches!(
+            err("q1,x,y,z\n1,100,0,0\n"),
+            CsvError::JointColumns { line: 1, .. }
+        ));
+        assert!(matches!(
+            err("q1,q2,q3,q4,q5,q6,q7,q8,x,y,z\n1,2,3,4,5,6,7,8,100,0,0\n"),
+            CsvError::JointColumns { line: 1, .. }
+        ));
+        let e = err("q1,q2,x,y,z,speed\n1,2,100,0,0,3\n");
+        assert!(
+            matches!(&e, CsvError::UnknownColumn { line: 1, column, .. } if column == "speed"),
+            "{e}"
+        );
+        assert!(e.to_string().contains("payload_kg"), "{e}");
+        assert!(matches!(
+            err("q1,q2,x,y,z,X\n1,2,100,0,0,1\n"),
+            CsvError::DuplicateColumn { line: 1, .. }
+        ));
+        let e = err("q1,q2,joint_1,x,y,z\n1,2,1,100,0,0\n");
+        assert!(
+            matches!(e, CsvError::DuplicateColumn { line: 1, .. }),
+            "{e}"
+        );
+        assert!(e.to_string().contains("joint_1"), "{e}");
+        assert!(matches!(
+            err("q1,q2,x,y,z,x_t\n1,2,100,0,0,1\n"),
+            CsvError::ConflictingColumns { line: 1, .. }
+        ));
+        assert_eq!(
+            err("q1,q2,x_t,y_t,z_t,x_dif,y_dif\n1,2,100,0,0,1,1\n"),
+            CsvError::MissingColumn {
+                line: 1,
+                column: "z_dif".into()
+            }
+        );
+        assert_eq!(
+            err("q1,q2,x,y,z,rx,ry\n1,2,100,0,0,1,1\n"),
+            CsvError::MissingColumn {
+                line: 1,
+                column: "rz".into()
+            }
+        );
+        assert_eq!(
+            err("q1,q2,x,y,z\n1,2,100,0,0\n\n1,2,100,0\n"),
+            CsvError::FieldCount {
+                line: 4,
+                expected: 5,
+                got: 4
+            }
+        );
+        assert_eq!(
+            err("q1,q2,x,y,z\n1,2,100,0,0\n1,abc,100,0,0\n"),
+            CsvError::NotNumeric {
+                line: 3,
+                column: "q2".into(),
+                value: "abc".into()
+            }
+        );
+        assert_eq!(
+            err("q1,q2,x,y,z\n1,2,,0,0\n"),
+            CsvError::NotNumeric {
+                line: 2,
+                column: "x".into(),
+                value: "".into()
+            }
+        );
+        for bad in ["NaN", "inf", "-infinity"] {
+            assert_eq!(
+                err(&format!("q1,q2,x,y,z\n1,2,100,{bad},0\n")),
+                CsvError::NotFinite {
+                    line: 2,
+                    column: "y".into(),
+                    value: bad.into()
+                }
+            );
+        }
+        assert_eq!(
+            err("q1,q2,x,y,z,set\n1,2,100,0,0,calibration\n"),
+            CsvError::UnknownSet {
+                line: 2,
+                value: "calibration".into()
+            }
+        );
+        assert_eq!(
+            err("q1,q2,x,y,z,rx,ry,rz\n1,2,100,0,0,1,,3\n"),
+            CsvError::PartialOrientation { line: 2 }
+        );
+        assert_eq!(
+            err("q1,q2,x,y,z\n1,2,100,0,0\n1,36000,100,0,0\n"),
+            CsvError::JointUnits {
+                line: 3,
+                column: "q2".into(),
+                value: 36000.0
+            }
+        );
+        assert_eq!(
+            err("q1,q2,x,y,z\n1,2,1.2,0.3,0.9\n3,4,-1.1,2.5,0.2\n"),
+            CsvError::PositionUnits
+        );
+        // One millimetre-sized row is enough to pass the metres check.
+        assert!(parse("q1,q2,x,y,z\n1,2,1.2,0.3,0.9\n3,4,-1.1,250,0.2\n").is_ok());
+    }
+
+    #[test]
+    fn joint_count_check() {
+        let rows = vec![
+            row(&[1.0; 6], [100.0, 0.0, 0.0]),
+            row(&[1.0; 7], [100.0, 0.0, 0.0]),
+        ];
+        assert_eq!(check_joint_count(&rows[..1], 6), Ok(()));
+        assert_eq!(
+            check_joint_count(&rows, 6),
+            Err(CsvError::JointCount {
+                row: 2,
+                expected: 6,
+                got: 7
+            })
+        );
+    }
+
+    /// The real UR5/WAM laser-tracker files (shared/data). Skipped, with a note,
+    /// when the data directory is not next to the checkout.
+    #[test]
+    fn real_ur5_wam_files_parse() {
+        let dir = std::env::var("ROBOCAL_DATA_DIR")
+            .map(std::path::PathBuf::from)
+            .unwrap_or_else(|_| {
+                std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                    .join("../shared/data/ur5-wam-laser-tracker")
+            });
+        if !dir.exists() {
+            eprintln!("skipping: {} not found", dir.display());
+            return;
+        }
+        for (file, n, dof) in [
+            ("UR5/3D_UR5_uncalibrated_grid_cleaned.csv", 1000, 6),
+            ("UR5/3D_UR5_uncalibrated_random_cleaned.csv", 20, 6),
+            ("WAM/3D_WAM_uncalibrated_grid_cleaned.csv", 216, 7),
+            ("WAM/3D_WAM_uncalibrated_random_cleaned.csv", 20, 7),
+        ] {
+            let text = std::fs::read_to_string(dir.join(file)).unwrap();
+            let rows = parse(&text).unwrap_or_else(|e| panic!("{file}: {e}"));
+            assert_eq!(rows.len(), n, "{file}");
+            check_joint_count(&rows, dof).unwrap();
+            let minus = parse_with(&text, DifSign::Minus).unwrap();
+            // The two readings differ by exactly 2·dif.
+            let d = (rows[0].xyz_mm[2] - minus[0].xyz_mm[2]).abs();
+            assert!(d > 0.0, "{file}");
+            assert!(rows.iter().all(|r| r.set.is_none() && r.rpy_deg.is_none()));
+            // Round trip through the canonical layout.
+            assert_eq!(parse(&write(&rows)).unwrap(), rows, "{file}");
+        }
+        // First UR5 grid row: measured = x_t + x_dif.
+        let text =
+            std::fs::read_to_string(dir.join("UR5/3D_UR5_uncalibrated_grid_cleaned.csv")).unwrap();
+        let r = &parse(&text).unwrap()[0];
+        assert_eq!(r.xyz_mm[0], -430.32784075885013 + -2.144122241149887);
+        assert_eq!(r.q_deg[0], -22.933297010882566);
+    }
+}

@@ -87,9 +87,9 @@ impl MeasuredPose {
         Measurement {
             q: model.joints_from_controller(&q_ctrl),
             position: Vector3::new(self.xyz_mm[0], self.xyz_mm[1], self.xyz_mm[2]) * 1e-3,
-            orientation: self.rpy_deg.map(|r| {
-                rpy_matrix(r[0].to_radians(), r[1].to_radians(), r[2].to_radians())
-            }),
+            orientation: self
+                .rpy_deg
+                .map(|r| rpy_matrix(r[0].to_radians(), r[1].to_radians(), r[2].to_radians())),
             payload_mass: self.payload_kg.unwrap_or(default_payload),
             session: 0,
         }

@@ -1,0 +1,456 @@
+//! Iterative least squares for KM (seed §2.2, eqs. 2.3–2.4) and SKCM (§2.3,
+//! eq. 2.8; closed loop eq. 4.17): Levenberg–Marquardt on the stacked
+//! identification Jacobian with column scaling.
+//!
+//! Model of one measurement (eq. 2.1 without ΔP_extra), in the registered base
+//! frame of session s: `p = E_s · FK(φ, q + c∘τ(q))`, where τ are the gravity
+//! torques at the commanded joints with the measured payload, `E_s` a rigid
+//! correction of session s's frame (identity for session 0, whose frame the base
+//! parameters absorb). Residuals in metres; orientation residuals (rotation
+//! vector, rad) are weighted by `orientation_weight` [m/rad]. Jacobian columns
+//! come from `kinematics::jacobian` (eq. 4.9 + chain rule + `J_θ·diag(τ)`), with
+//! τ held fixed within an iteration.
+
+use crate::kinematics::{chain, gravity_torques_of, jacobian::fill_identification_rows};
+use crate::measure::Measurement;
+use crate::model::pose::{rotation_log, Pose};
+use crate::model::{ParamId, ParamKind, ParamLayout, RobotModel};
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// Levenberg–Marquardt settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LmSettings {
+    /// Maximum number of accepted or rejected iterations.
+    pub max_iterations: usize,
+    /// Converged when the relative cost decrease of an accepted step is below this.
+    pub cost_tolerance: f64,
+    /// Converged when the scaled step norm is below this (scaled parameters are
+    /// dimensionless: each column of the Jacobian has unit norm at the start).
+    pub step_tolerance: f64,
+    /// Initial damping (scaled problem).
+    pub initial_lambda: f64,
+    /// Weight of orientation residuals [m/rad].
+    pub orientation_weight: f64,
+}
+
+impl Default for LmSettings {
+    fn default() -> Self {
+        LmSettings {
+            max_iterations: 100,
+            cost_tolerance: 1e-10,
+            step_tolerance: 1e-10,
+            initial_lambda: 1e-6,
+            orientation_weight: 1.0,
+        }
+    }
+}
+
+/// How a least-squares run ended (non-convergence is data, not an error).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LmReport {
+    pub converged: bool,
+    pub iterations: usize,
+    pub reason: String,
+    /// RMS of the residual vector before and after [mm].
+    pub initial_rms_mm: f64,
+    pub final_rms_mm: f64,
+}
+
+/// Result of a fit.
+#[derive(Debug, Clone)]
+pub struct Fit {
+    pub model: RobotModel,
+    /// Frame corrections `E_s` per session (identity for session 0).
+    pub session_frames: Vec<Pose>,
+    pub report: LmReport,
+    /// Covariance of the fitted parameters (same order as `ids`) in SI units,
+    /// `σ²(JᵀJ)⁻¹` with `σ²` = residual sum of squares / (rows − parameters).
+    pub covariance: Option<DMatrix<f64>>,
+}
+
+/// A fit was stopped by the caller.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Cancelled;
+
+/// Number of residual rows of a data set.
+pub fn residual_rows(data: &[Measurement]) -> usize {
+    data.iter()
+        .map(|m| if m.orientation.is_some() { 6 } else { 3 })
+        .sum()
+}
+
+/// Predicted TCP position and rotation of one measurement in its session frame.
+pub fn predict(model: &RobotModel, m: &Measurement) -> Option<(Vector3<f64>, Matrix3<f64>)> {
+    let q = crate::kinematics::deflected_joints(model, &m.q, m.payload_mass).ok()?;
+    let p = crate::kinematics::fk(model, &q).ok()?;
+    Some((p.p, p.r))
+}
+
+/// Position error norms [mm] of a model on a data set (session frames applied).
+pub fn position_errors_mm(model: &RobotModel, frames: &[Pose], data: &[Measurement]) -> Vec<f64> {
+    data.iter()
+        .map(|m| match predict(model, m) {
+            Some((p, _)) => {
+                let e = frames.get(m.session).copied().unwrap_or_default();
+                (m.position - e.transform_point(&p)).norm() * 1e3
+            }
+            None => f64::INFINITY,
+        })
+        .collect()
+}
+
+/// A frozen-Jacobian least-squares solver (the chord form of eq. 2.4 / 7.8):
+/// the scaled normal matrix is factorised once at a reference model and reused
+/// for repeated updates `Δφ = (JᵀJ)⁻¹Jᵀ ΔP` from nearby starting points.
+pub struct FrozenSolver {
+    ids: Vec<ParamId>,
+    frames: Vec<Pose>,
+    scale: DVector<f64>,
+    chol: nalgebra::Cholesky<f64, nalgebra::Dyn>,
+    js: DMatrix<f64>,
+}
+
+impl FrozenSolver {
+    /// Factorises the Jacobian of `ids` at `model` (session frames held fixed).
+    pub fn new(
+        model: &RobotModel,
+        frames: &[Pose],
+        ids: &[ParamId],
+        data: &[Measurement],
+        settings: &LmSettings,
+    ) -> Option<FrozenSolver> {
+        let ev = evaluate(model, &frames[..1], ids, data, settings, true)?;
+        let mut js = ev.j?;
+        let scale = DVector::from_iterator(
+            js.ncols(),
+            js.column_iter().map(|c| {
+                let n = c.norm();
+                if n > 0.0 {
+                    1.0 / n
+                } else {
+                    1.0
+                }
+            }),
+        );
+        for (c, s) in scale.iter().enumerate() {
+            js.column_mut(c).scale_mut(*s);
+        }
+        let chol = js.tr_mul(&js).cholesky()?;
+        Some(FrozenSolver {
+            ids: ids.to_vec(),
+            frames: frames.to_vec(),
+            scale,
+            chol,
+            js,
+        })
+    }
+
+    /// Iterates from `start` until the cost stops decreasing by more than
+    /// `rel_tol` (relative) or `max_iterations`; returns the model and its
+    /// position error norms [mm].
+    pub fn solve(
+        &self,
+        start: &RobotModel,
+        data: &[Measurement],
+        settings: &LmSettings,
+        max_iterations: usize,
+        rel_tol: f64,
+    ) -> Option<(RobotModel, Vec<f64>)> {
+        let layout = ParamLayout {
+            ids: self.ids.clone(),
+        };
+        let mut model = start.clone();
+        let frames0 = &self.frames[..1];
+        let mut r = evaluate(&model, frames0, &self.ids, data, settings, false)?.r;
+        let mut cost = r.norm_squared();
+        for _ in 0..max_iterations {
+            let g = self.js.tr_mul(&r);
+            let delta = self.chol.solve(&g).component_mul(&self.scale);
+            let x = layout.values(&model);
+            let (m2, _) = apply_step(&model, frames0, &layout, &x, &delta);
+            let Some(e2) = evaluate(&m2, frames0, &self.ids, data, settings, false) else {
+                break;
+            };
+            let c2 = e2.r.norm_squared();
+            if c2 >= cost {
+                break;
+            }
+            let rel = (cost - c2) / cost.max(f64::MIN_POSITIVE);
+            model = m2;
+            r = e2.r;
+            cost = c2;
+            if rel < rel_tol {
+                break;
+            }
+        }
+        let errors = position_errors_mm(&model, &self.frames, data);
+        Some((model, errors))
+    }
+}
+
+struct Eval {
+    r: DVector<f64>,
+    j: Option<DMatrix<f64>>,
+}
+
+/// Residuals (and optionally the Jacobian of the prediction) at the current model.
+fn evaluate(
+    model: &RobotModel,
+    frames: &[Pose],
+    ids: &[ParamId],
+    data: &[Measurement],
+    settings: &LmSettings,
+    with_jacobian: bool,
+) -> Option<Eval> {
+    let rows = residual_rows(data);
+    let n_sess = frames.len().saturating_sub(1) * 6;
+    let cols = ids.len() + n_sess;
+    let mut r = DVector::zeros(rows);
+    let mut j = if with_jacobian {
+        Some(DMatrix::zeros(rows, cols))
+    } else {
+        None
+    };
+    let needs_tau = model.has_compliance() || ids.iter().any(|i| i.kind == ParamKind::Compliance);
+    let w = settings.orientation_weight;
+    let mut local = DMatrix::zeros(6, ids.len());
+    let mut row = 0;
+    for m in data {
+        let (q_eff, tau) = if needs_tau {
+            let c0 = chain(model, &m.q).ok()?;
+            let tau = gravity_torques_of(model, &c0, m.payload_mass);
+            let q: Vec<f64> =
+                m.q.iter()
+                    .zip(&tau)
+                    .zip(&model.links)
+                    .map(|((q, t), l)| q + l.compliance * t)
+                    .collect();
+            (q, tau)
+        } else {
+            (m.q.clone(), Vec::new())
+        };
+        let c = chain(model, &q_eff).ok()?;
+        let e = frames.get(m.session).copied().unwrap_or_default();
+        let pred = e.transform_point(&c.tcp.p);
+        let dp = m.position - pred;
+        r[row] = dp.x;
+        r[row + 1] = dp.y;
+        r[row + 2] = dp.z;
+        let orient = m.orientation.is_some();
+        if let Some(rm) = &m.orientation {
+            let dr = rotation_log(&(rm * (e.r * c.tcp.r).transpose())) * w;
+            r[row + 3] = dr.x;
+            r[row + 4] = dr.y;
+            r[row + 5] = dr.z;
+        }
+        if let Some(j) = j.as_mut() {
+            fill_identification_rows(model, &c, ids, &tau, orient, &mut local, 0);
+            for col in 0..ids.len() {
+                let v = e.r * Vector3::new(local[(0, col)], local[(1, col)], local[(2, col)]);
+                j[(row, col)] = v.x;
+                j[(row + 1, col)] = v.y;
+                j[(row + 2, col)] = v.z;
+                if orient {
+                    let om =
+                        e.r * Vector3::new(local[(3, col)], local[(4, col)], local[(5, col)]) * w;
+                    j[(row + 3, col)] = om.x;
+                    j[(row + 4, col)] = om.y;
+                    j[(row + 5, col)] = om.z;
+                }
+            }
+            if m.session > 0 {
+                let base = ids.len() + (m.session - 1) * 6;
+                for k in 0..3 {
+                    j[(row + k, base + k)] = 1.0;
+                    let ek = Vector3::ith(k, 1.0);
+                    let v = ek.cross(&pred);
+                    j[(row, base + 3 + k)] = v.x;
+                    j[(row + 1, base + 3 + k)] = v.y;
+                    j[(row + 2, base + 3 + k)] = v.z;
+                    if orient {
+                        j[(row + 3 + k, base + 3 + k)] = w;
+                    }
+                }
+            }
+        }
+        row += if orient { 6 } else { 3 };
+    }
+    Some(Eval { r, j })
+}
+
+fn apply_step(
+    model: &RobotModel,
+    frames: &[Pose],
+    layout: &ParamLayout,
+    x: &[f64],
+    delta: &DVector<f64>,
+) -> (RobotModel, Vec<Pose>) {
+    let mut m = model.clone();
+    let v: Vec<f64> = x.iter().zip(delta.iter()).map(|(a, d)| a + d).collect();
+    layout.apply(&mut m, &v);
+    let mut f = frames.to_vec();
+    let n = layout.len();
+    for (s, frame) in f.iter_mut().enumerate().skip(1) {
+        let b = n + (s - 1) * 6;
+        let dt = Vector3::new(delta[b], delta[b + 1], delta[b + 2]);
+        let dw = Vector3::new(delta[b + 3], delta[b + 4], delta[b + 5]);
+        let rot = nalgebra::Rotation3::from_scaled_axis(dw);
+        *frame = Pose::new(rot.matrix() * frame.r, rot.matrix() * frame.p + dt);
+    }
+    (m, f)
+}
+
+/// Fits the parameters `ids` (and the frames of sessions ≥ 1) to `data` by
+/// Levenberg–Marquardt, starting from `start`. `progress(iteration, rms_mm)`
+/// returns false to cancel.
+pub fn fit(
+    start: &RobotModel,
+    ids: &[ParamId],
+    data: &[Measurement],
+    sessions: usize,
+    settings: &LmSettings,
+    progress: &mut dyn FnMut(usize, f64) -> bool,
+) -> Result<Fit, Cancelled> {
+    let layout = ParamLayout { ids: ids.to_vec() };
+    let mut model = start.clone();
+    let mut frames = vec![Pose::identity(); sessions.max(1)];
+    let rows = residual_rows(data);
+    let rms_mm = |c: f64| (c / rows.max(1) as f64).sqrt() * 1e3;
+    let Some(mut ev) = evaluate(&model, &frames, ids, data, settings, true) else {
+        return Ok(Fit {
+            model,
+            session_frames: frames,
+            report: LmReport {
+                converged: false,
+                iterations: 0,
+                reason: "the starting model cannot be evaluated at some measured joints (closed loop does not close)".into(),
+                initial_rms_mm: f64::INFINITY,
+                final_rms_mm: f64::INFINITY,
+            },
+            covariance: None,
+        });
+    };
+    let mut cost = ev.r.norm_squared();
+    let initial = rms_mm(cost);
+    let ncols = ev.j.as_ref().map_or(0, |j| j.ncols());
+    // Column scaling, fixed from the first Jacobian.
+    let scale: DVector<f64> = {
+        let j = ev.j.as_ref().unwrap();
+        DVector::from_iterator(
+            ncols,
+            j.column_iter().map(|c| {
+                let n = c.norm();
+                if n > 0.0 {
+                    1.0 / n
+                } else {
+                    1.0
+                }
+            }),
+        )
+    };
+    let mut lambda = settings.initial_lambda;
+    let mut iterations = 0;
+    let mut converged = false;
+    let mut reason = String::from("maximum iterations reached");
+    if rows < ncols {
+        reason = format!("underdetermined: {rows} residuals for {ncols} unknowns");
+    }
+    while iterations < settings.max_iterations {
+        if !progress(iterations, rms_mm(cost)) {
+            return Err(Cancelled);
+        }
+        let mut js = ev.j.as_ref().expect("jacobian evaluated").clone();
+        for (c, s) in scale.iter().enumerate() {
+            js.column_mut(c).scale_mut(*s);
+        }
+        let a = js.tr_mul(&js);
+        let g = js.tr_mul(&ev.r);
+        let x = layout.values(&model);
+        let mut accepted = None;
+        while lambda < 1e12 {
+            iterations += 1;
+            let mut damped = a.clone();
+            for i in 0..ncols {
+                damped[(i, i)] += lambda * (1.0 + a[(i, i)]);
+            }
+            let Some(chol) = damped.cholesky() else {
+                lambda *= 10.0;
+                continue;
+            };
+            let ds = chol.solve(&g);
+            let delta = ds.component_mul(&scale);
+            let (m2, f2) = apply_step(&model, &frames, &layout, &x, &delta);
+            match evaluate(&m2, &f2, ids, data, settings, false) {
+                Some(e2) if e2.r.norm_squared() < cost => {
+                    accepted = Some((m2, f2, e2.r.norm_squared(), ds.norm()));
+                    lambda = (lambda / 10.0).max(1e-15);
+                    break;
+                }
+                _ => {
+                    lambda *= 10.0;
+                }
+            }
+            if iterations >= settings.max_iterations {
+                break;
+            }
+        }
+        let Some((m2, f2, c2, step)) = accepted else {
+            converged = true;
+            reason = "no step reduces the cost further (local minimum)".into();
+            break;
+        };
+        let rel = (cost - c2) / cost.max(f64::MIN_POSITIVE);
+        model = m2;
+        frames = f2;
+        cost = c2;
+        ev = match evaluate(&model, &frames, ids, data, settings, true) {
+            Some(e) => e,
+            None => {
+                reason = "model left the closed loop's assembly range".into();
+                break;
+            }
+        };
+        if rel < settings.cost_tolerance {
+            converged = true;
+            reason = format!("relative cost decrease {rel:.1e} below tolerance");
+            break;
+        }
+        if step < settings.step_tolerance {
+            converged = true;
+            reason = format!("scaled step {step:.1e} below tolerance");
+            break;
+        }
+    }
+    let covariance = ev.j.as_ref().and_then(|j| {
+        let dof = rows as f64 - ncols as f64;
+        if dof <= 0.0 {
+            return None;
+        }
+        let mut js = j.clone();
+        for (c, s) in scale.iter().enumerate() {
+            js.column_mut(c).scale_mut(*s);
+        }
+        let inv = js.tr_mul(&js).try_inverse()?;
+        let sigma2 = cost / dof;
+        let mut cov = DMatrix::zeros(ids.len(), ids.len());
+        for a in 0..ids.len() {
+            for b in 0..ids.len() {
+                cov[(a, b)] = inv[(a, b)] * scale[a] * scale[b] * sigma2;
+            }
+        }
+        Some(cov)
+    });
+    Ok(Fit {
+        model,
+        session_frames: frames,
+        report: LmReport {
+            converged,
+            iterations,
+            reason,
+            initial_rms_mm: initial,
+            final_rms_mm: rms_mm(cost),
+        },
+        covariance,
+    })
+}

@@ -1,0 +1,73 @@
+//! Error statistics of a pose set (DESIGN "Data roles"): mean, maximum, standard
+//! deviation, RMS and 95th percentile of the position-error norm, in millimetres.
+
+use serde::{Deserialize, Serialize};
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ErrorStats {
+    pub n: usize,
+    pub mean_mm: f64,
+    pub max_mm: f64,
+    /// Sample standard deviation (n − 1), as MATLAB's `std`.
+    pub std_mm: f64,
+    pub rms_mm: f64,
+    /// 95th percentile, linear interpolation between closest ranks.
+    pub p95_mm: f64,
+}
+
+impl ErrorStats {
+    /// Statistics of error norms given in millimetres.
+    pub fn from_errors_mm(e: &[f64]) -> ErrorStats {
+        let n = e.len();
+        if n == 0 {
+            return ErrorStats {
+                n,
+                mean_mm: 0.0,
+                max_mm: 0.0,
+                std_mm: 0.0,
+                rms_mm: 0.0,
+                p95_mm: 0.0,
+            };
+        }
+        let nf = n as f64;
+        let mean = e.iter().sum::<f64>() / nf;
+        let max = e.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+        let var = if n > 1 {
+            e.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (nf - 1.0)
+        } else {
+            0.0
+        };
+        let rms = (e.iter().map(|x| x * x).sum::<f64>() / nf).sqrt();
+        let mut s = e.to_vec();
+        s.sort_by(|a, b| a.total_cmp(b));
+        let pos = 0.95 * (nf - 1.0);
+        let lo = pos.floor() as usize;
+        let hi = (lo + 1).min(n - 1);
+        let p95 = s[lo] + (s[hi] - s[lo]) * (pos - lo as f64);
+        ErrorStats {
+            n,
+            mean_mm: mean,
+            max_mm: max,
+            std_mm: var.sqrt(),
+            rms_mm: rms,
+            p95_mm: p95,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn closed_form_values() {
+        let s = ErrorStats::from_errors_mm(&[1.0, 2.0, 3.0, 4.0]);
+        assert_eq!(s.n, 4);
+        assert!((s.mean_mm - 2.5).abs() < 1e-15);
+        assert_eq!(s.max_mm, 4.0);
+        assert!((s.std_mm - (5.0f64 / 3.0).sqrt()).abs() < 1e-15);
+        assert!((s.rms_mm - 7.5f64.sqrt()).abs() < 1e-15);
+        // 0.95·3 = 2.85 → 3 + 0.85·1
+        assert!((s.p95_mm - 3.85).abs() < 1e-12);
+    }
+}
