@@ -1,10 +1,140 @@
-//! `robocal serve`.
+//! `robocal serve`: the HTTP service.
+//!
+//! Configuration (flags override the environment):
+//! - `--bind ADDR` / `ROBOCAL_BIND`: listen address, default `127.0.0.1:8080`
+//!   (loopback; bind `0.0.0.0:8080` explicitly to serve the network);
+//! - `--database-url URL` / `DATABASE_URL`: default `sqlite://robocal.db?mode=rwc`,
+//!   created in the working directory on first start;
+//! - `ROBOCAL_API_KEYS`: comma-separated bearer keys for writes (none: writes
+//!   are open; reads are always open);
+//! - `--workers N` / `ROBOCAL_WORKERS`: calibration jobs run at once, default 1;
+//! - `RUST_LOG`: log filter, default `info`.
+//!
+//! Start-up: open the database, apply the migrations, mark jobs that a previous
+//! process left queued or running as failed ("interrupted by a restart"), then
+//! serve until SIGINT/SIGTERM.
 
+use crate::db::{Db, DEFAULT_DATABASE_URL};
+use crate::http::{app, AppState, ServiceConfig};
+use anyhow::Context;
 use clap::Args;
+use std::net::SocketAddr;
 
 #[derive(Debug, Args)]
-pub struct ServeArgs {}
+pub struct ServeArgs {
+    /// Listen address (loopback by default).
+    #[arg(long, env = "ROBOCAL_BIND", default_value = "127.0.0.1:8080")]
+    pub bind: String,
+    /// SQLite database URL or file path.
+    #[arg(long, env = "DATABASE_URL", default_value = DEFAULT_DATABASE_URL)]
+    pub database_url: String,
+    /// Calibration jobs that run at the same time.
+    #[arg(long, env = "ROBOCAL_WORKERS", default_value_t = 1)]
+    pub workers: usize,
+    /// Solve batches (above 16 targets) that run at the same time.
+    #[arg(long, env = "ROBOCAL_SOLVE_WORKERS", default_value_t = 2)]
+    pub solve_workers: usize,
+}
 
-pub fn run(_args: ServeArgs) -> anyhow::Result<()> {
-    anyhow::bail!("`robocal serve` is not available in this build yet")
+/// Reads `ROBOCAL_API_KEYS` (comma-separated; blanks ignored).
+pub fn api_keys_from_env() -> Vec<String> {
+    std::env::var("ROBOCAL_API_KEYS")
+        .unwrap_or_default()
+        .split(',')
+        .map(str::trim)
+        .filter(|k| !k.is_empty())
+        .map(String::from)
+        .collect()
+}
+
+fn init_tracing() {
+    let filter = tracing_subscriber::EnvFilter::try_from_default_env()
+        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info"));
+    let _ = tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr)
+        .with_ansi(std::io::IsTerminal::is_terminal(&std::io::stderr()))
+        .with_target(false)
+        .try_init();
+}
+
+pub fn run(args: ServeArgs) -> anyhow::Result<()> {
+    init_tracing();
+    if args.workers == 0 {
+        anyhow::bail!("--workers must be at least 1");
+    }
+    let addr: SocketAddr = args.bind.parse().with_context(|| {
+        format!(
+            "--bind {}: expected HOST:PORT, e.g. 127.0.0.1:8080",
+            args.bind
+        )
+    })?;
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .enable_all()
+        .thread_name("robocal-http")
+        .build()
+        .context("cannot start the async runtime")?;
+    let result = runtime.block_on(serve(addr, args));
+    // A calibration still running on the blocking pool is not waited for; the
+    // next start reports it as interrupted.
+    runtime.shutdown_timeout(std::time::Duration::from_secs(2));
+    result
+}
+
+async fn serve(addr: SocketAddr, args: ServeArgs) -> anyhow::Result<()> {
+    let db = Db::connect(&args.database_url)
+        .await
+        .with_context(|| format!("cannot open the database {}", args.database_url))?;
+    let interrupted = db.fail_interrupted_jobs().await?;
+    if !interrupted.is_empty() {
+        tracing::warn!(jobs = ?interrupted, "marked calibrations interrupted by a restart as failed");
+    }
+    let keys = api_keys_from_env();
+    let config = ServiceConfig {
+        api_keys: keys.clone(),
+        workers: args.workers,
+        solve_workers: args.solve_workers.max(1),
+        ..ServiceConfig::default()
+    };
+    let state = AppState::new(db, config);
+    let listener = tokio::net::TcpListener::bind(addr)
+        .await
+        .with_context(|| format!("cannot listen on {addr}"))?;
+    let local = listener.local_addr()?;
+    tracing::info!(
+        "robocal {} listening on http://{local} (database {}, {} calibration worker(s), API keys {})",
+        env!("CARGO_PKG_VERSION"),
+        args.database_url,
+        args.workers,
+        if keys.is_empty() {
+            "off: writes are open".to_string()
+        } else {
+            format!("on: {} key(s)", keys.len())
+        }
+    );
+    axum::serve(listener, app(state))
+        .with_graceful_shutdown(shutdown())
+        .await
+        .context("server error")?;
+    tracing::info!("stopped");
+    Ok(())
+}
+
+async fn shutdown() {
+    let ctrl_c = async {
+        let _ = tokio::signal::ctrl_c().await;
+    };
+    #[cfg(unix)]
+    let term = async {
+        if let Ok(mut s) = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())
+        {
+            s.recv().await;
+        }
+    };
+    #[cfg(not(unix))]
+    let term = std::future::pending::<()>();
+    tokio::select! {
+        _ = ctrl_c => {},
+        _ = term => {},
+    }
 }

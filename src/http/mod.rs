@@ -1,1 +1,417 @@
-//! http
+//! The HTTP API (axum): routes under `/v1`, JSON in millimetres and degrees,
+//! errors as `application/problem+json`, described by `openapi.yaml`.
+//!
+//! - [`app`] builds the router over an [`AppState`] (database, API keys,
+//!   bounded job workers, solver caches); tests drive it in-process.
+//! - Writes (POST, PUT, PATCH, DELETE) need `Authorization: Bearer <key>` when
+//!   API keys are configured; reads (GET, HEAD) are open, so dashboards and
+//!   CAM clients can read without a key. Keys are never logged.
+//! - CPU-heavy work runs off the async runtime: calibrations on a pool of
+//!   `workers` blocking tasks, solve batches above [`INLINE_SOLVE_MAX`] targets
+//!   on the blocking pool (rayon inside), bounded by a semaphore.
+//! - Bodies are limited to [`BODY_LIMIT_BYTES`].
+
+use crate::db::Db;
+use crate::ik::IkSolver;
+use axum::extract::{DefaultBodyLimit, Request, State};
+use axum::http::{header, Method, StatusCode};
+use axum::middleware::{self, Next};
+use axum::response::{IntoResponse, Response};
+use axum::routing::{get, post};
+use axum::Router;
+use std::collections::HashMap;
+use std::sync::atomic::AtomicBool;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+use tokio::sync::Semaphore;
+
+pub mod calibrations;
+pub mod error;
+pub mod report_page;
+pub mod robots;
+pub mod sets;
+pub mod solve;
+pub mod versions;
+
+pub use error::{ApiError, ApiJson, ApiPath, ApiQuery, Problem, PROBLEM_JSON};
+
+/// Largest accepted request body (measurement uploads, solve batches).
+pub const BODY_LIMIT_BYTES: usize = 16 * 1024 * 1024;
+
+/// Solve batches up to this many targets run inline on the async runtime
+/// (a few hundred microseconds at most); larger ones go to the blocking pool.
+pub const INLINE_SOLVE_MAX: usize = 16;
+
+/// The text of `openapi.yaml`, served at `/openapi.yaml`.
+pub const OPENAPI_YAML: &str = include_str!("../../openapi.yaml");
+
+/// Every route of the router as (method, path template). A test checks that
+/// each one is in `openapi.yaml` and that the spec has no others.
+pub const ROUTES: &[(&str, &str)] = &[
+    ("GET", "/healthz"),
+    ("GET", "/openapi.yaml"),
+    ("GET", "/v1/presets"),
+    ("GET", "/v1/robots"),
+    ("POST", "/v1/robots"),
+    ("GET", "/v1/robots/{id}"),
+    ("PATCH", "/v1/robots/{id}"),
+    ("DELETE", "/v1/robots/{id}"),
+    ("GET", "/v1/robots/{id}/measurement-sets"),
+    ("POST", "/v1/robots/{id}/measurement-sets"),
+    ("GET", "/v1/robots/{id}/measurement-sets/{sid}"),
+    ("DELETE", "/v1/robots/{id}/measurement-sets/{sid}"),
+    ("GET", "/v1/robots/{id}/measurement-sets/{sid}/original"),
+    ("GET", "/v1/robots/{id}/calibrations"),
+    ("POST", "/v1/robots/{id}/calibrations"),
+    ("GET", "/v1/robots/{id}/calibrations/{cid}"),
+    ("POST", "/v1/robots/{id}/calibrations/{cid}/cancel"),
+    ("GET", "/v1/robots/{id}/calibrations/{cid}/result"),
+    ("GET", "/v1/robots/{id}/calibrations/{cid}/report"),
+    ("GET", "/v1/robots/{id}/versions"),
+    ("POST", "/v1/robots/{id}/versions/rollback"),
+    ("GET", "/v1/robots/{id}/versions/{version}"),
+    ("POST", "/v1/robots/{id}/versions/{version}/activate"),
+    ("GET", "/v1/robots/{id}/versions/{version}/model.json"),
+    ("POST", "/v1/robots/{id}/solve"),
+];
+
+/// Service settings that are not the database.
+#[derive(Clone)]
+pub struct ServiceConfig {
+    /// Accepted API keys; empty: writes are open.
+    pub api_keys: Vec<String>,
+    /// Calibration jobs that run at the same time.
+    pub workers: usize,
+    /// Large solve batches that run at the same time.
+    pub solve_workers: usize,
+    /// Shortest interval between two progress writes of a job.
+    pub progress_interval: Duration,
+}
+
+/// Keys are redacted: a config printed by mistake leaks nothing.
+impl std::fmt::Debug for ServiceConfig {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ServiceConfig")
+            .field(
+                "api_keys",
+                &format_args!("[{} redacted]", self.api_keys.len()),
+            )
+            .field("workers", &self.workers)
+            .field("solve_workers", &self.solve_workers)
+            .field("progress_interval", &self.progress_interval)
+            .finish()
+    }
+}
+
+impl Default for ServiceConfig {
+    fn default() -> Self {
+        ServiceConfig {
+            api_keys: Vec::new(),
+            workers: 1,
+            solve_workers: 2,
+            progress_interval: Duration::from_millis(250),
+        }
+    }
+}
+
+/// The active model version of a robot, as the solve endpoint needs it.
+#[derive(Debug, Clone)]
+pub struct RobotContext {
+    pub robot_id: i64,
+    pub name: String,
+    pub model_json: String,
+    pub dof: usize,
+    /// (row id, version number, method) of the active version.
+    pub active: Option<(i64, i64, String)>,
+}
+
+/// Cache key of a prepared solver: robot, version row (None: nominal model),
+/// payload override bits.
+type SolverKey = (i64, Option<i64>, Option<u64>);
+
+/// Shared state of the service.
+#[derive(Clone)]
+pub struct AppState {
+    inner: Arc<Inner>,
+}
+
+struct Inner {
+    db: Db,
+    config: ServiceConfig,
+    calibration_slots: Arc<Semaphore>,
+    solve_slots: Arc<Semaphore>,
+    cancel_flags: Mutex<HashMap<i64, Arc<AtomicBool>>>,
+    robots: Mutex<HashMap<i64, Arc<RobotContext>>>,
+    solvers: Mutex<HashMap<SolverKey, Arc<IkSolver>>>,
+}
+
+/// Prepared solvers kept in memory (model versions are immutable).
+const SOLVER_CACHE_MAX: usize = 64;
+
+impl AppState {
+    pub fn new(db: Db, config: ServiceConfig) -> Self {
+        let workers = config.workers.max(1);
+        let solve_workers = config.solve_workers.max(1);
+        AppState {
+            inner: Arc::new(Inner {
+                db,
+                calibration_slots: Arc::new(Semaphore::new(workers)),
+                solve_slots: Arc::new(Semaphore::new(solve_workers)),
+                config,
+                cancel_flags: Mutex::new(HashMap::new()),
+                robots: Mutex::new(HashMap::new()),
+                solvers: Mutex::new(HashMap::new()),
+            }),
+        }
+    }
+
+    pub fn db(&self) -> &Db {
+        &self.inner.db
+    }
+
+    pub fn config(&self) -> &ServiceConfig {
+        &self.inner.config
+    }
+
+    pub(crate) fn calibration_slots(&self) -> Arc<Semaphore> {
+        self.inner.calibration_slots.clone()
+    }
+
+    pub(crate) fn solve_slots(&self) -> Arc<Semaphore> {
+        self.inner.solve_slots.clone()
+    }
+
+    pub(crate) fn cancel_flag(&self, job: i64) -> Arc<AtomicBool> {
+        lock(&self.inner.cancel_flags)
+            .entry(job)
+            .or_insert_with(|| Arc::new(AtomicBool::new(false)))
+            .clone()
+    }
+
+    pub(crate) fn existing_cancel_flag(&self, job: i64) -> Option<Arc<AtomicBool>> {
+        lock(&self.inner.cancel_flags).get(&job).cloned()
+    }
+
+    pub(crate) fn drop_cancel_flag(&self, job: i64) {
+        lock(&self.inner.cancel_flags).remove(&job);
+    }
+
+    /// Forgets what is cached about a robot (after its versions changed or it was deleted).
+    pub(crate) fn invalidate_robot(&self, robot_id: i64) {
+        lock(&self.inner.robots).remove(&robot_id);
+        lock(&self.inner.solvers).retain(|k, _| k.0 != robot_id);
+    }
+
+    /// The robot and its active version, cached.
+    pub(crate) async fn robot_context(&self, robot_id: i64) -> Result<Arc<RobotContext>, ApiError> {
+        if let Some(c) = lock(&self.inner.robots).get(&robot_id) {
+            return Ok(c.clone());
+        }
+        let robot = self
+            .db()
+            .robot(robot_id)
+            .await?
+            .ok_or_else(|| robots::robot_not_found(robot_id))?;
+        let active = self
+            .db()
+            .active_version(robot_id)
+            .await?
+            .map(|v| (v.id, v.version, v.method));
+        let ctx = Arc::new(RobotContext {
+            robot_id,
+            name: robot.name,
+            model_json: robot.model_json,
+            dof: robot.dof as usize,
+            active,
+        });
+        lock(&self.inner.robots).insert(robot_id, ctx.clone());
+        Ok(ctx)
+    }
+
+    pub(crate) fn cached_solver(&self, key: &SolverKey) -> Option<Arc<IkSolver>> {
+        lock(&self.inner.solvers).get(key).cloned()
+    }
+
+    pub(crate) fn cache_solver(&self, key: SolverKey, solver: Arc<IkSolver>) {
+        let mut cache = lock(&self.inner.solvers);
+        if cache.len() >= SOLVER_CACHE_MAX {
+            cache.clear();
+        }
+        cache.insert(key, solver);
+    }
+}
+
+/// Locks a mutex, recovering from poisoning (the guarded maps stay consistent).
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// The router of the service.
+pub fn app(state: AppState) -> Router {
+    let v1 = Router::new()
+        .route("/presets", get(robots::list_presets))
+        .route("/robots", get(robots::list).post(robots::create))
+        .route(
+            "/robots/{id}",
+            get(robots::get_one)
+                .patch(robots::update)
+                .delete(robots::delete),
+        )
+        .route(
+            "/robots/{id}/measurement-sets",
+            get(sets::list).post(sets::upload),
+        )
+        .route(
+            "/robots/{id}/measurement-sets/{sid}",
+            get(sets::get_one).delete(sets::delete),
+        )
+        .route(
+            "/robots/{id}/measurement-sets/{sid}/original",
+            get(sets::original),
+        )
+        .route(
+            "/robots/{id}/calibrations",
+            get(calibrations::list).post(calibrations::start),
+        )
+        .route(
+            "/robots/{id}/calibrations/{cid}",
+            get(calibrations::get_one),
+        )
+        .route(
+            "/robots/{id}/calibrations/{cid}/cancel",
+            post(calibrations::cancel),
+        )
+        .route(
+            "/robots/{id}/calibrations/{cid}/result",
+            get(calibrations::result),
+        )
+        .route(
+            "/robots/{id}/calibrations/{cid}/report",
+            get(calibrations::report),
+        )
+        .route("/robots/{id}/versions", get(versions::list))
+        .route("/robots/{id}/versions/rollback", post(versions::rollback))
+        .route("/robots/{id}/versions/{version}", get(versions::get_one))
+        .route(
+            "/robots/{id}/versions/{version}/activate",
+            post(versions::activate),
+        )
+        .route(
+            "/robots/{id}/versions/{version}/model.json",
+            get(versions::download),
+        )
+        .route("/robots/{id}/solve", post(solve::solve));
+    Router::new()
+        .route("/healthz", get(healthz))
+        .route("/openapi.yaml", get(openapi))
+        .nest("/v1", v1)
+        .fallback(not_found)
+        .method_not_allowed_fallback(method_not_allowed)
+        .layer(middleware::from_fn_with_state(state.clone(), auth))
+        .layer(DefaultBodyLimit::max(BODY_LIMIT_BYTES))
+        .layer(middleware::from_fn(catch_panics))
+        .layer(middleware::from_fn(log_requests))
+        .with_state(state)
+}
+
+async fn healthz(State(state): State<AppState>) -> Result<Response, ApiError> {
+    sqlx::query("SELECT 1")
+        .execute(state.db().pool())
+        .await
+        .map_err(|e| ApiError::Unavailable(format!("database unavailable: {e}")))?;
+    Ok(axum::Json(serde_json::json!({
+        "status": "ok",
+        "version": env!("CARGO_PKG_VERSION"),
+    }))
+    .into_response())
+}
+
+async fn openapi() -> Response {
+    (
+        [(header::CONTENT_TYPE, "application/yaml; charset=utf-8")],
+        OPENAPI_YAML,
+    )
+        .into_response()
+}
+
+async fn not_found(req: Request) -> ApiError {
+    ApiError::NotFound(format!(
+        "no route for {} {}; the routes are listed in /openapi.yaml",
+        req.method(),
+        req.uri().path()
+    ))
+}
+
+async fn method_not_allowed(req: Request) -> ApiError {
+    ApiError::MethodNotAllowed(format!(
+        "{} is not allowed on {}; see /openapi.yaml for the methods of this route",
+        req.method(),
+        req.uri().path()
+    ))
+}
+
+/// Writes need a bearer key when keys are configured.
+async fn auth(State(state): State<AppState>, req: Request, next: Next) -> Response {
+    let keys = &state.config().api_keys;
+    let read = matches!(*req.method(), Method::GET | Method::HEAD | Method::OPTIONS);
+    if keys.is_empty() || read {
+        return next.run(req).await;
+    }
+    let presented = req
+        .headers()
+        .get(header::AUTHORIZATION)
+        .and_then(|v| v.to_str().ok())
+        .and_then(|v| {
+            v.strip_prefix("Bearer ")
+                .or_else(|| v.strip_prefix("bearer "))
+        })
+        .map(str::trim);
+    match presented {
+        None => ApiError::Unauthorized(
+            "this operation needs an API key: send `Authorization: Bearer <key>`".into(),
+        )
+        .into_response(),
+        Some(k)
+            if keys
+                .iter()
+                .any(|key| constant_time_eq(key.as_bytes(), k.as_bytes())) =>
+        {
+            next.run(req).await
+        }
+        Some(_) => ApiError::Unauthorized("the API key is not valid".into()).into_response(),
+    }
+}
+
+/// Compares without an early exit on the first differing byte.
+fn constant_time_eq(a: &[u8], b: &[u8]) -> bool {
+    if a.len() != b.len() {
+        return false;
+    }
+    a.iter().zip(b).fold(0u8, |acc, (x, y)| acc | (x ^ y)) == 0
+}
+
+/// A handler that panics answers a problem+json 500 instead of dropping the connection.
+async fn catch_panics(req: Request, next: Next) -> Response {
+    match tokio::spawn(next.run(req)).await {
+        Ok(res) => res,
+        Err(e) => ApiError::Internal(format!("request handler failed: {e}")).into_response(),
+    }
+}
+
+/// Logs method, path, status and duration (never headers: they may hold keys).
+async fn log_requests(req: Request, next: Next) -> Response {
+    let method = req.method().clone();
+    let path = req.uri().path().to_string();
+    let start = Instant::now();
+    let res = next.run(req).await;
+    let status = res.status();
+    let ms = start.elapsed().as_secs_f64() * 1e3;
+    if status.is_server_error() {
+        tracing::warn!(%method, %path, status = status.as_u16(), ms, "request failed");
+    } else if status == StatusCode::UNAUTHORIZED || status.is_client_error() {
+        tracing::info!(%method, %path, status = status.as_u16(), ms, "request rejected");
+    } else {
+        tracing::debug!(%method, %path, status = status.as_u16(), ms, "request");
+    }
+    res
+}

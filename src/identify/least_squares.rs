@@ -100,6 +100,21 @@ pub fn position_errors_mm(model: &RobotModel, frames: &[Pose], data: &[Measureme
         .collect()
 }
 
+/// Column scaling `1/‖J_j‖` (1 for an all-zero column).
+fn column_scale(j: &DMatrix<f64>) -> DVector<f64> {
+    DVector::from_iterator(
+        j.ncols(),
+        j.column_iter().map(|c| {
+            let n = c.norm();
+            if n > 0.0 {
+                1.0 / n
+            } else {
+                1.0
+            }
+        }),
+    )
+}
+
 /// A frozen-Jacobian least-squares solver (the chord form of eq. 2.4 / 7.8):
 /// the scaled normal matrix is factorised once at a reference model and reused
 /// for repeated updates `Δφ = (JᵀJ)⁻¹Jᵀ ΔP` from nearby starting points.
@@ -122,17 +137,7 @@ impl FrozenSolver {
     ) -> Option<FrozenSolver> {
         let ev = evaluate(model, &frames[..1], ids, data, settings, true)?;
         let mut js = ev.j?;
-        let scale = DVector::from_iterator(
-            js.ncols(),
-            js.column_iter().map(|c| {
-                let n = c.norm();
-                if n > 0.0 {
-                    1.0 / n
-                } else {
-                    1.0
-                }
-            }),
-        );
+        let scale = column_scale(&js);
         for (c, s) in scale.iter().enumerate() {
             js.column_mut(c).scale_mut(*s);
         }
@@ -335,20 +340,7 @@ pub fn fit(
     let initial = rms_mm(cost);
     let ncols = ev.j.as_ref().map_or(0, |j| j.ncols());
     // Column scaling, fixed from the first Jacobian.
-    let scale: DVector<f64> = {
-        let j = ev.j.as_ref().unwrap();
-        DVector::from_iterator(
-            ncols,
-            j.column_iter().map(|c| {
-                let n = c.norm();
-                if n > 0.0 {
-                    1.0 / n
-                } else {
-                    1.0
-                }
-            }),
-        )
-    };
+    let scale = column_scale(ev.j.as_ref().expect("jacobian evaluated"));
     let mut lambda = settings.initial_lambda;
     let mut iterations = 0;
     let mut converged = false;

@@ -155,7 +155,10 @@ mod tests {
             assert_eq!(Configuration::parse(&i.to_string()).unwrap(), *c);
         }
         let c = Configuration::parse("Back, no-flip").unwrap();
-        assert_eq!(c, Configuration::new(Shoulder::Back, Elbow::Up, Wrist::NoFlip));
+        assert_eq!(
+            c,
+            Configuration::new(Shoulder::Back, Elbow::Up, Wrist::NoFlip)
+        );
         assert!(Configuration::parse("sideways").is_err());
         assert!(Configuration::parse("9").is_err());
     }

@@ -1,1 +1,23 @@
-//! ik
+//! Inverse kinematics on the calibrated, compensated model, and false targets
+//! (DESIGN "Compensated model and false targets").
+//!
+//! - [`analytic`]: closed-form IK of the nominal model (spherical wrist and
+//!   UR-style three parallel axes), all branches with configuration flags: the seed.
+//! - [`solver`]: damped Newton on `CompensatedModel::predict = target` from that
+//!   seed (branch, joint seed, limits, per-target result and failure reason).
+//! - [`batch`]: parallel batches and path mode.
+//! - [`targets`]: boundary targets (mm, degrees, orientation conventions), joint
+//!   commands in the controller convention and false targets `FK_nominal(q_cmd)`.
+//!
+//! Units: SI inside (m, rad); mm and degrees at the boundary (`targets`).
+
+pub mod analytic;
+pub mod batch;
+pub mod config;
+pub mod solver;
+pub mod targets;
+
+pub use analytic::{AnalyticError, AnalyticIk, AnalyticSolution, Structure};
+pub use config::{Configuration, Elbow, Shoulder, Wrist};
+pub use solver::{FailureReason, Goal, IkSettings, IkSolution, IkSolver, Refined, SolveOptions};
+pub use targets::{FalseTarget, JointJump, TargetFrame, TargetInput, TargetResult};

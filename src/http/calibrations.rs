@@ -1,0 +1,644 @@
+//! `/v1/robots/{id}/calibrations`: start a job on chosen measurement sets with
+//! one or more methods, poll its progress, cancel it, read the result and the
+//! HTML report.
+//!
+//! Jobs: the rows of the chosen sets are read when the job is queued (later
+//! changes to the sets do not affect it). A job waits for one of the
+//! `--workers` slots, then runs `identify::calibrate` on the blocking pool.
+//! Progress (phase, iteration, percent) goes to the database at most every
+//! `progress_interval`; cancellation sets a flag that the progress callback
+//! reads. A successful job stores its report and **one model version per
+//! method**, so any method's model can be activated later; the best method (by
+//! validation mean, identification mean without validation) is activated only
+//! when the robot has no active version yet: a recalibration never changes
+//! what the cell uses without an explicit `activate`.
+
+use super::robots::robot_not_found;
+use super::sets::MAX_SETS;
+use super::{ApiError, ApiJson, ApiPath, AppState};
+use crate::compensate::{CalibratedModelFile, CompensatedModel};
+use crate::db::{CalibrationRow, NewCalibration, NewVersion};
+use crate::identify::{
+    calibrate, CalibrationError, CalibrationOptions, CalibrationReport, Method, Progress,
+};
+use crate::measure::Measurement;
+use crate::model::RobotModel;
+use axum::extract::State;
+use axum::http::{header, StatusCode};
+use axum::response::{Html, IntoResponse, Response};
+use serde::{Deserialize, Serialize};
+use serde_json::{json, Value};
+use std::sync::atomic::Ordering;
+use std::time::Duration;
+use tokio::sync::watch;
+
+/// Methods run when the request names none.
+pub const DEFAULT_METHODS: [&str; 2] = ["km", "skcm"];
+
+fn calibration_not_found(robot: i64, id: i64) -> ApiError {
+    ApiError::NotFound(format!(
+        "calibration {id} of robot {robot} does not exist; list them with GET /v1/robots/{robot}/calibrations"
+    ))
+}
+
+/// `POST /v1/robots/{id}/calibrations` body.
+#[derive(Debug, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct StartCalibration {
+    /// Methods to run and compare: km, skcm, skcm-tlbo. Default km, skcm.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub methods: Option<Vec<String>>,
+    /// Sets that identify the model (default: every set with role identification).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub identification_set_ids: Option<Vec<i64>>,
+    /// Sets that validate it (default: every set with role validation).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub validation_set_ids: Option<Vec<i64>>,
+    /// Seed of every random choice (TLBO).
+    #[serde(default)]
+    pub seed: u64,
+    /// TLBO population (skcm-tlbo), default 50.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub population: Option<usize>,
+    /// TLBO generations (skcm-tlbo), default 100.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub generations: Option<usize>,
+    /// Levenberg–Marquardt iteration limit, default 100.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_iterations: Option<usize>,
+    /// Register the tracker frame in closed form first (default true).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub register: Option<bool>,
+    /// Payload [kg] for rows and sets that give none (default: the model's payload).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub payload_kg: Option<f64>,
+}
+
+/// A calibration job as the API returns it.
+#[derive(Debug, Serialize)]
+pub struct Calibration {
+    pub id: i64,
+    pub robot_id: i64,
+    pub status: String,
+    pub progress: JobProgress,
+    pub cancel_requested: bool,
+    pub methods: Value,
+    pub identification_set_ids: Value,
+    pub validation_set_ids: Value,
+    pub options: Value,
+    pub error: Option<String>,
+    pub best_method: Option<String>,
+    pub created_at: String,
+    pub started_at: Option<String>,
+    pub finished_at: Option<String>,
+    pub updated_at: String,
+    pub links: Value,
+}
+
+#[derive(Debug, Serialize)]
+pub struct JobProgress {
+    pub phase: Option<String>,
+    pub iteration: i64,
+    pub percent: f64,
+}
+
+impl Calibration {
+    pub fn from_row(r: CalibrationRow) -> Self {
+        let base = format!("/v1/robots/{}/calibrations/{}", r.robot_id, r.id);
+        let parse = |s: &str| serde_json::from_str(s).unwrap_or(Value::Null);
+        Calibration {
+            links: json!({
+                "self": base,
+                "cancel": format!("{base}/cancel"),
+                "result": format!("{base}/result"),
+                "report": format!("{base}/report"),
+            }),
+            id: r.id,
+            robot_id: r.robot_id,
+            status: r.status,
+            progress: JobProgress {
+                phase: r.phase,
+                iteration: r.iteration,
+                percent: r.percent,
+            },
+            cancel_requested: r.cancel_requested,
+            methods: parse(&r.methods),
+            identification_set_ids: parse(&r.identification_set_ids),
+            validation_set_ids: parse(&r.validation_set_ids),
+            options: parse(&r.options),
+            error: r.error,
+            best_method: r.best_method,
+            created_at: r.created_at,
+            started_at: r.started_at,
+            finished_at: r.finished_at,
+            updated_at: r.updated_at,
+        }
+    }
+}
+
+/// Everything a queued job needs; the rows are read when it is queued.
+struct Job {
+    id: i64,
+    robot_id: i64,
+    robot_name: String,
+    nominal: RobotModel,
+    ident: Vec<Measurement>,
+    valid: Vec<Measurement>,
+    opts: CalibrationOptions,
+    payload_kg: f64,
+}
+
+fn check_count(what: &str, v: Option<usize>, lo: usize, hi: usize) -> Result<(), ApiError> {
+    match v {
+        Some(n) if n < lo || n > hi => Err(ApiError::invalid(format!(
+            "`{what}` must be between {lo} and {hi}, got {n}"
+        ))),
+        _ => Ok(()),
+    }
+}
+
+pub async fn start(
+    State(state): State<AppState>,
+    ApiPath(robot_id): ApiPath<i64>,
+    ApiJson(req): ApiJson<StartCalibration>,
+) -> Result<Response, ApiError> {
+    let robot = state
+        .db()
+        .robot(robot_id)
+        .await?
+        .ok_or_else(|| robot_not_found(robot_id))?;
+    let nominal = RobotModel::from_json(&robot.model_json)
+        .map_err(|e| ApiError::Internal(format!("stored model of robot {robot_id}: {e}")))?;
+
+    let method_list = match &req.methods {
+        Some(m) if m.is_empty() => {
+            return Err(ApiError::invalid(
+                "`methods` is empty; give one or more of km, skcm, skcm-tlbo",
+            ))
+        }
+        Some(m) => m.join(","),
+        None => DEFAULT_METHODS.join(","),
+    };
+    let methods = Method::parse_list(&method_list).map_err(ApiError::invalid)?;
+    check_count("population", req.population, 2, 1000)?;
+    check_count("generations", req.generations, 1, 1_000_000)?;
+    check_count("max_iterations", req.max_iterations, 1, 10_000)?;
+    if let Some(p) = req.payload_kg {
+        if !(p.is_finite() && p >= 0.0) {
+            return Err(ApiError::invalid(format!(
+                "`payload_kg` must be a non-negative number of kilograms, got {p}"
+            )));
+        }
+    }
+
+    // The sets: named, or every set of the robot with the matching role.
+    let all_sets = state.db().sets(robot_id).await?;
+    let pick = |ids: &Option<Vec<i64>>, role: &str, field: &str| -> Result<Vec<_>, ApiError> {
+        match ids {
+            None => Ok(all_sets
+                .iter()
+                .filter(|s| s.role == role)
+                .cloned()
+                .collect()),
+            Some(ids) => {
+                if ids.len() > MAX_SETS {
+                    return Err(ApiError::invalid(format!(
+                        "`{field}` lists {} sets; at most {MAX_SETS}",
+                        ids.len()
+                    )));
+                }
+                let mut out: Vec<crate::db::SetRow> = Vec::new();
+                for id in ids {
+                    let s = all_sets.iter().find(|s| s.id == *id).ok_or_else(|| {
+                        ApiError::invalid(format!(
+                            "`{field}`: measurement set {id} does not exist for robot {robot_id}"
+                        ))
+                    })?;
+                    if !out.iter().any(|o| o.id == s.id) {
+                        out.push(s.clone());
+                    }
+                }
+                Ok(out)
+            }
+        }
+    };
+    let ident_sets = pick(
+        &req.identification_set_ids,
+        "identification",
+        "identification_set_ids",
+    )?;
+    let valid_sets = pick(&req.validation_set_ids, "validation", "validation_set_ids")?;
+    if ident_sets.is_empty() {
+        return Err(ApiError::invalid(format!(
+            "no identification set: upload one with role identification (POST /v1/robots/{robot_id}/measurement-sets) or list its id in `identification_set_ids`"
+        )));
+    }
+    if let Some(s) = valid_sets
+        .iter()
+        .find(|v| ident_sets.iter().any(|i| i.id == v.id))
+    {
+        return Err(ApiError::invalid(format!(
+            "measurement set {} is listed for both identification and validation; validation data must never be used for fitting",
+            s.id
+        )));
+    }
+    // Tracker sessions: identification sessions in order of first appearance.
+    let mut sessions: Vec<String> = Vec::new();
+    for s in &ident_sets {
+        if !sessions.contains(&s.session) {
+            sessions.push(s.session.clone());
+        }
+    }
+    if let Some(v) = valid_sets.iter().find(|v| !sessions.contains(&v.session)) {
+        return Err(ApiError::invalid(format!(
+            "validation set {} was measured in tracker session `{}`, which no identification set has, so its frame cannot be registered; measure identification poses in that session too",
+            v.id, v.session
+        )));
+    }
+    let default_payload = req.payload_kg.unwrap_or(nominal.payload.mass);
+    let load = |sets: &[crate::db::SetRow]| {
+        let state = state.clone();
+        let sets = sets.to_vec();
+        let sessions = sessions.clone();
+        let nominal = nominal.clone();
+        async move {
+            let mut out = Vec::new();
+            for s in &sets {
+                let rows = super::sets::load_rows(&state, robot_id, s.id).await?;
+                let session = sessions.iter().position(|x| *x == s.session).unwrap_or(0);
+                let payload = s.payload_kg.unwrap_or(default_payload);
+                for r in &rows {
+                    let mut m = r.to_measurement(&nominal, payload);
+                    m.session = session;
+                    out.push(m);
+                }
+            }
+            Ok::<_, ApiError>(out)
+        }
+    };
+    let ident = load(&ident_sets).await?;
+    let valid = load(&valid_sets).await?;
+
+    let defaults = CalibrationOptions::default();
+    let opts = CalibrationOptions {
+        methods: methods.clone(),
+        register: req.register.unwrap_or(true),
+        lm: crate::identify::LmSettings {
+            max_iterations: req.max_iterations.unwrap_or(defaults.lm.max_iterations),
+            ..defaults.lm.clone()
+        },
+        tlbo: crate::identify::TlboSettings {
+            population: req.population.unwrap_or(defaults.tlbo.population),
+            generations: req.generations.unwrap_or(defaults.tlbo.generations),
+            seed: req.seed,
+        },
+        ..defaults
+    };
+    let method_names: Vec<&str> = methods.iter().map(|m| m.name()).collect();
+    let ident_ids: Vec<i64> = ident_sets.iter().map(|s| s.id).collect();
+    let valid_ids: Vec<i64> = valid_sets.iter().map(|s| s.id).collect();
+    let options = json!({
+        "seed": req.seed,
+        "population": opts.tlbo.population,
+        "generations": opts.tlbo.generations,
+        "max_iterations": opts.lm.max_iterations,
+        "register": opts.register,
+        "payload_kg": default_payload,
+    });
+    let row = state
+        .db()
+        .insert_calibration(&NewCalibration {
+            robot_id,
+            methods: &serde_json::to_string(&method_names).unwrap_or_default(),
+            identification_set_ids: &serde_json::to_string(&ident_ids).unwrap_or_default(),
+            validation_set_ids: &serde_json::to_string(&valid_ids).unwrap_or_default(),
+            options: &options.to_string(),
+        })
+        .await?;
+    let job = Job {
+        id: row.id,
+        robot_id,
+        robot_name: robot.name.clone(),
+        nominal,
+        ident,
+        valid,
+        opts,
+        payload_kg: default_payload,
+    };
+    state.cancel_flag(job.id);
+    tokio::spawn(run_job(state.clone(), job));
+    let location = format!("/v1/robots/{robot_id}/calibrations/{}", row.id);
+    Ok((
+        StatusCode::ACCEPTED,
+        [(header::LOCATION, location)],
+        axum::Json(Calibration::from_row(row)),
+    )
+        .into_response())
+}
+
+/// Writes progress to the database, at most once per `interval`.
+async fn write_progress(
+    state: AppState,
+    id: i64,
+    mut rx: watch::Receiver<Option<Progress>>,
+    interval: Duration,
+) {
+    while rx.changed().await.is_ok() {
+        let p = rx.borrow_and_update().clone();
+        if let Some(p) = p {
+            let pct = if p.percent.is_finite() {
+                p.percent.clamp(0.0, 100.0)
+            } else {
+                0.0
+            };
+            if let Err(e) = state
+                .db()
+                .update_progress(id, &p.phase, p.iteration as i64, pct)
+                .await
+            {
+                tracing::warn!(job = id, error = %e, "cannot store job progress");
+            }
+        }
+        tokio::time::sleep(interval).await;
+    }
+}
+
+async fn run_job(state: AppState, job: Job) {
+    let id = job.id;
+    let robot_id = job.robot_id;
+    let cancel = state.cancel_flag(id);
+    let slots = state.calibration_slots();
+    let Ok(_permit) = slots.acquire_owned().await else {
+        return;
+    };
+    match state.db().start_calibration(id).await {
+        Ok(true) => {}
+        Ok(false) => {
+            // Cancelled while queued, or its robot was deleted.
+            state.drop_cancel_flag(id);
+            return;
+        }
+        Err(e) => {
+            tracing::error!(job = id, error = %e, "cannot start calibration");
+            state.drop_cancel_flag(id);
+            return;
+        }
+    }
+    tracing::info!(job = id, robot = robot_id, "calibration started");
+    let (tx, rx) = watch::channel(None::<Progress>);
+    let writer = tokio::spawn(write_progress(
+        state.clone(),
+        id,
+        rx,
+        state.config().progress_interval,
+    ));
+    let flag = cancel.clone();
+    let Job {
+        robot_name,
+        nominal,
+        ident,
+        valid,
+        opts,
+        payload_kg,
+        ..
+    } = job;
+    let outcome = tokio::task::spawn_blocking(move || {
+        let report = calibrate(&nominal, &ident, &valid, &opts, &|p: &Progress| {
+            tx.send_replace(Some(p.clone()));
+            !flag.load(Ordering::SeqCst)
+        });
+        drop(tx);
+        report.map(|r| {
+            let versions = versions_of(&r, &nominal, &robot_name, &opts, payload_kg);
+            (r, versions)
+        })
+    })
+    .await;
+    let _ = writer.await;
+    let db = state.db();
+    let stored = match outcome {
+        Ok(Ok((report, versions))) => match versions {
+            Ok(versions) => {
+                let best = report
+                    .best_method()
+                    .map(|m| m.method.name().to_string())
+                    .unwrap_or_default();
+                match serde_json::to_string(&report) {
+                    Ok(text) => db
+                        .finish_calibration_success(robot_id, id, &text, &best, &versions)
+                        .await
+                        .map(|v| {
+                            tracing::info!(job = id, robot = robot_id, best = %best, versions = v.len(), "calibration succeeded");
+                        }),
+                    Err(e) => {
+                        db.finish_calibration_error(id, "failed", &format!("internal error: {e}"))
+                            .await
+                    }
+                }
+            }
+            Err(e) => db.finish_calibration_error(id, "failed", &e).await,
+        },
+        Ok(Err(CalibrationError::Cancelled)) => {
+            tracing::info!(job = id, "calibration cancelled");
+            db.finish_calibration_error(id, "cancelled", "cancelled by request")
+                .await
+        }
+        Ok(Err(e)) => {
+            tracing::info!(job = id, error = %e, "calibration failed");
+            db.finish_calibration_error(id, "failed", &e.to_string())
+                .await
+        }
+        Err(e) => {
+            tracing::error!(job = id, error = %e, "calibration task panicked");
+            db.finish_calibration_error(id, "failed", "internal error in the calibration")
+                .await
+        }
+    };
+    if let Err(e) = stored {
+        tracing::error!(job = id, error = %e, "cannot store the calibration outcome");
+    }
+    state.drop_cancel_flag(id);
+    state.invalidate_robot(robot_id);
+}
+
+/// One calibrated model file per method, in the order the methods ran.
+fn versions_of(
+    r: &CalibrationReport,
+    nominal: &RobotModel,
+    robot_name: &str,
+    opts: &CalibrationOptions,
+    payload_kg: f64,
+) -> Result<Vec<NewVersion>, String> {
+    let cell_from_base = r.tracker_to_base.inverse();
+    let mut out = Vec::new();
+    for method in &opts.methods {
+        let Some(m) = r.methods.get(method.name()) else {
+            continue;
+        };
+        let cm = CompensatedModel {
+            calibrated: m.calibrated.clone(),
+            nominal: nominal.clone(),
+            cell_from_base,
+            payload_kg,
+            compensator: None,
+        };
+        let file = CalibratedModelFile::from_compensated(&cm, robot_name, method.name());
+        // The stored file must load back (it is what solve uses).
+        file.to_compensated()
+            .map_err(|e| format!("the {} model does not load back: {e}", method.name()))?;
+        let stats = json!({
+            "identification": m.identification.stats,
+            "validation": m.validation.as_ref().map(|v| &v.stats),
+        });
+        out.push(NewVersion {
+            method: method.name().to_string(),
+            model_json: file.to_json(),
+            stats_json: stats.to_string(),
+        });
+    }
+    Ok(out)
+}
+
+pub async fn list(
+    State(state): State<AppState>,
+    ApiPath(robot_id): ApiPath<i64>,
+) -> Result<Response, ApiError> {
+    if state.db().robot(robot_id).await?.is_none() {
+        return Err(robot_not_found(robot_id));
+    }
+    let jobs: Vec<Calibration> = state
+        .db()
+        .calibrations(robot_id)
+        .await?
+        .into_iter()
+        .map(Calibration::from_row)
+        .collect();
+    Ok(axum::Json(json!({ "calibrations": jobs })).into_response())
+}
+
+async fn load(state: &AppState, robot_id: i64, id: i64) -> Result<CalibrationRow, ApiError> {
+    state
+        .db()
+        .calibration(robot_id, id)
+        .await?
+        .ok_or_else(|| calibration_not_found(robot_id, id))
+}
+
+pub async fn get_one(
+    State(state): State<AppState>,
+    ApiPath((robot_id, id)): ApiPath<(i64, i64)>,
+) -> Result<Response, ApiError> {
+    let row = load(&state, robot_id, id).await?;
+    Ok(axum::Json(Calibration::from_row(row)).into_response())
+}
+
+pub async fn cancel(
+    State(state): State<AppState>,
+    ApiPath((robot_id, id)): ApiPath<(i64, i64)>,
+) -> Result<Response, ApiError> {
+    let row = load(&state, robot_id, id).await?;
+    if !matches!(row.status.as_str(), "queued" | "running") {
+        return Err(ApiError::Conflict(format!(
+            "calibration {id} is already {}; only queued or running jobs can be cancelled",
+            row.status
+        )));
+    }
+    if let Some(flag) = state.existing_cancel_flag(id) {
+        flag.store(true, Ordering::SeqCst);
+    }
+    let row = state
+        .db()
+        .request_cancel(robot_id, id)
+        .await?
+        .ok_or_else(|| calibration_not_found(robot_id, id))?;
+    Ok((StatusCode::ACCEPTED, axum::Json(Calibration::from_row(row))).into_response())
+}
+
+/// The report of a succeeded calibration, or a 409 that says what to wait for.
+async fn succeeded_report(
+    state: &AppState,
+    robot_id: i64,
+    id: i64,
+) -> Result<(CalibrationRow, Value), ApiError> {
+    let row = load(state, robot_id, id).await?;
+    match row.status.as_str() {
+        "succeeded" => {}
+        "queued" | "running" => {
+            return Err(ApiError::Conflict(format!(
+                "calibration {id} is {} ({:.0}%); poll GET /v1/robots/{robot_id}/calibrations/{id} until its status is succeeded",
+                row.status, row.percent
+            )))
+        }
+        other => {
+            return Err(ApiError::Conflict(format!(
+                "calibration {id} {other}: {}; it has no result",
+                row.error.as_deref().unwrap_or("no reason recorded")
+            )))
+        }
+    }
+    let text = state.db().calibration_report(id).await?.ok_or_else(|| {
+        ApiError::Internal(format!("calibration {id} succeeded without a report"))
+    })?;
+    let report: Value = serde_json::from_str(&text)
+        .map_err(|e| ApiError::Internal(format!("stored report of calibration {id}: {e}")))?;
+    Ok((row, report))
+}
+
+pub async fn result(
+    State(state): State<AppState>,
+    ApiPath((robot_id, id)): ApiPath<(i64, i64)>,
+) -> Result<Response, ApiError> {
+    let (row, report) = succeeded_report(&state, robot_id, id).await?;
+    let versions: Vec<Value> = state
+        .db()
+        .versions(robot_id)
+        .await?
+        .into_iter()
+        .filter(|v| v.calibration_id == Some(id))
+        .map(|v| json!({ "version": v.version, "method": v.method, "active": v.active }))
+        .collect();
+    // Mean and max position errors per method and set (mm), nominal first.
+    let line = |method: &str, part: &Value| {
+        let stat = |set: &str, key: &str| part[set][key].as_f64();
+        json!({
+            "method": method,
+            "identification_mean_mm": stat("identification", "mean_mm"),
+            "identification_max_mm": stat("identification", "max_mm"),
+            "validation_mean_mm": stat("validation", "mean_mm"),
+            "validation_max_mm": stat("validation", "max_mm"),
+        })
+    };
+    let mut summary = vec![line("nominal", &report["nominal"])];
+    if let Some(methods) = report["methods"].as_object() {
+        summary.extend(methods.iter().map(|(m, r)| line(m, r)));
+    }
+    Ok(axum::Json(json!({
+        "calibration_id": id,
+        "robot_id": robot_id,
+        "best_method": row.best_method,
+        "summary": summary,
+        "versions": versions,
+        "report": report,
+    }))
+    .into_response())
+}
+
+pub async fn report(
+    State(state): State<AppState>,
+    ApiPath((robot_id, id)): ApiPath<(i64, i64)>,
+) -> Result<Response, ApiError> {
+    let (_, report) = succeeded_report(&state, robot_id, id).await?;
+    let name = state
+        .db()
+        .robot(robot_id)
+        .await?
+        .map(|r| r.name)
+        .unwrap_or_default();
+    let title = format!("Calibration {id} of robot {robot_id} ({name})");
+    let html = tokio::task::spawn_blocking(move || {
+        super::report_page::render_report_page(&title, &report)
+    })
+    .await
+    .map_err(|e| ApiError::Internal(format!("report page: {e}")))?;
+    Ok(Html(html).into_response())
+}

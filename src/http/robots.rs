@@ -1,0 +1,234 @@
+//! `/v1/robots`: create from a preset or a model JSON, list, get, update name
+//! and metadata, delete (with its measurement sets, calibrations and versions).
+
+use super::{ApiError, ApiJson, ApiPath, AppState};
+use crate::db::{NewRobot, RobotRow};
+use crate::model::presets::{preset_description, PRESETS};
+use crate::model::RobotModel;
+use axum::extract::State;
+use axum::http::{header, StatusCode};
+use axum::response::{IntoResponse, Response};
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+
+/// Longest accepted robot or set name.
+pub const NAME_MAX: usize = 200;
+
+pub(crate) fn robot_not_found(id: i64) -> ApiError {
+    ApiError::NotFound(format!(
+        "robot {id} does not exist; list robots with GET /v1/robots"
+    ))
+}
+
+/// `POST /v1/robots` body.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CreateRobot {
+    pub name: Option<String>,
+    pub preset: Option<String>,
+    pub model: Option<Value>,
+    #[serde(default)]
+    pub metadata: Option<Value>,
+}
+
+/// `PATCH /v1/robots/{id}` body.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct UpdateRobot {
+    pub name: Option<String>,
+    pub metadata: Option<Value>,
+}
+
+/// A robot as the API returns it.
+#[derive(Debug, Serialize)]
+pub struct Robot {
+    pub id: i64,
+    pub name: String,
+    pub preset: Option<String>,
+    pub dof: i64,
+    pub metadata: Value,
+    pub active_version: Option<i64>,
+    pub created_at: String,
+    pub updated_at: String,
+    /// The nominal model description (single-robot responses only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub model: Option<Value>,
+}
+
+impl Robot {
+    pub fn from_row(r: RobotRow, with_model: bool) -> Robot {
+        Robot {
+            id: r.id,
+            name: r.name,
+            preset: r.preset,
+            dof: r.dof,
+            metadata: serde_json::from_str(&r.metadata).unwrap_or(Value::Null),
+            active_version: r.active_version,
+            created_at: r.created_at,
+            updated_at: r.updated_at,
+            model: with_model
+                .then(|| serde_json::from_str(&r.model_json).ok())
+                .flatten(),
+        }
+    }
+}
+
+pub(crate) fn check_name(name: &str, what: &str) -> Result<(), ApiError> {
+    if name.trim().is_empty() {
+        return Err(ApiError::invalid(format!("{what} must not be empty")));
+    }
+    if name.chars().count() > NAME_MAX {
+        return Err(ApiError::invalid(format!(
+            "{what} is longer than {NAME_MAX} characters"
+        )));
+    }
+    Ok(())
+}
+
+fn check_metadata(m: &Value) -> Result<String, ApiError> {
+    if !m.is_object() {
+        return Err(ApiError::invalid(
+            "`metadata` must be a JSON object, e.g. {\"cell\": \"A3\"}",
+        ));
+    }
+    Ok(m.to_string())
+}
+
+pub async fn list_presets() -> Result<Response, ApiError> {
+    let presets: Vec<Value> = PRESETS
+        .iter()
+        .map(|name| {
+            let d = preset_description(name).map_err(|e| ApiError::Internal(e.to_string()))?;
+            Ok(serde_json::json!({
+                "name": name,
+                "dof": d.joints.len(),
+                "payload_kg": d.payload.mass_kg,
+            }))
+        })
+        .collect::<Result<_, ApiError>>()?;
+    Ok(axum::Json(serde_json::json!({ "presets": presets })).into_response())
+}
+
+pub async fn create(
+    State(state): State<AppState>,
+    ApiJson(body): ApiJson<CreateRobot>,
+) -> Result<Response, ApiError> {
+    let (model, preset): (RobotModel, Option<String>) = match (&body.preset, &body.model) {
+        (Some(_), Some(_)) => {
+            return Err(ApiError::invalid(
+                "give either `preset` or `model`, not both",
+            ))
+        }
+        (None, None) => {
+            return Err(ApiError::invalid(format!(
+                "give `preset` (one of {}) or `model` (a model JSON object)",
+                PRESETS.join(", ")
+            )))
+        }
+        (Some(p), None) => {
+            let name = p.trim().to_ascii_lowercase();
+            (
+                crate::model::preset(&name).map_err(ApiError::invalid)?,
+                Some(name),
+            )
+        }
+        (None, Some(m)) => {
+            if !m.is_object() {
+                return Err(ApiError::invalid(
+                    "`model` must be a model JSON object (see the README's Model JSON)",
+                ));
+            }
+            (
+                RobotModel::from_json(&m.to_string()).map_err(ApiError::invalid)?,
+                None,
+            )
+        }
+    };
+    let name = body.name.clone().unwrap_or_else(|| model.name.clone());
+    check_name(&name, "`name`")?;
+    let metadata = match &body.metadata {
+        Some(m) => check_metadata(m)?,
+        None => "{}".to_string(),
+    };
+    let model_json = model.to_json();
+    let row = state
+        .db()
+        .insert_robot(&NewRobot {
+            name: &name,
+            preset: preset.as_deref(),
+            model_json: &model_json,
+            dof: model.dof() as i64,
+            metadata: &metadata,
+        })
+        .await?;
+    let location = format!("/v1/robots/{}", row.id);
+    Ok((
+        StatusCode::CREATED,
+        [(header::LOCATION, location)],
+        axum::Json(Robot::from_row(row, true)),
+    )
+        .into_response())
+}
+
+pub async fn list(State(state): State<AppState>) -> Result<Response, ApiError> {
+    let robots: Vec<Robot> = state
+        .db()
+        .robots()
+        .await?
+        .into_iter()
+        .map(|r| Robot::from_row(r, false))
+        .collect();
+    Ok(axum::Json(serde_json::json!({ "robots": robots })).into_response())
+}
+
+pub async fn get_one(
+    State(state): State<AppState>,
+    ApiPath(id): ApiPath<i64>,
+) -> Result<Response, ApiError> {
+    let row = state
+        .db()
+        .robot(id)
+        .await?
+        .ok_or_else(|| robot_not_found(id))?;
+    Ok(axum::Json(Robot::from_row(row, true)).into_response())
+}
+
+pub async fn update(
+    State(state): State<AppState>,
+    ApiPath(id): ApiPath<i64>,
+    ApiJson(body): ApiJson<UpdateRobot>,
+) -> Result<Response, ApiError> {
+    if let Some(n) = &body.name {
+        check_name(n, "`name`")?;
+    }
+    let metadata = body.metadata.as_ref().map(check_metadata).transpose()?;
+    if body.name.is_none() && metadata.is_none() {
+        return Err(ApiError::invalid(
+            "nothing to update: give `name` and/or `metadata` (the model of a robot cannot change; create a new robot instead)",
+        ));
+    }
+    let row = state
+        .db()
+        .update_robot(id, body.name.as_deref(), metadata.as_deref())
+        .await?
+        .ok_or_else(|| robot_not_found(id))?;
+    state.invalidate_robot(id);
+    Ok(axum::Json(Robot::from_row(row, true)).into_response())
+}
+
+pub async fn delete(
+    State(state): State<AppState>,
+    ApiPath(id): ApiPath<i64>,
+) -> Result<Response, ApiError> {
+    // Stop its running jobs first; they find their row gone when they finish.
+    for c in state.db().calibrations(id).await? {
+        if let Some(flag) = state.existing_cancel_flag(c.id) {
+            flag.store(true, std::sync::atomic::Ordering::SeqCst);
+        }
+    }
+    if !state.db().delete_robot(id).await? {
+        return Err(robot_not_found(id));
+    }
+    state.invalidate_robot(id);
+    Ok(StatusCode::NO_CONTENT.into_response())
+}

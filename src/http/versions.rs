@@ -1,0 +1,158 @@
+//! `/v1/robots/{id}/versions`: the calibrated models of a robot. List, get,
+//! activate, roll back to the previously active version, download the model
+//! file (`robocal-calibrated-model/1`, loadable by `robocal solve --model`).
+
+use super::robots::robot_not_found;
+use super::{ApiError, ApiPath, AppState};
+use crate::db::{Rollback, VersionRow};
+use axum::extract::State;
+use axum::http::header;
+use axum::response::{IntoResponse, Response};
+use serde::Serialize;
+use serde_json::{json, Value};
+
+fn version_not_found(robot: i64, v: i64) -> ApiError {
+    ApiError::NotFound(format!(
+        "robot {robot} has no model version {v}; list them with GET /v1/robots/{robot}/versions"
+    ))
+}
+
+/// A model version as the API returns it.
+#[derive(Debug, Serialize)]
+pub struct ModelVersion {
+    pub version: i64,
+    pub robot_id: i64,
+    pub calibration_id: Option<i64>,
+    pub method: String,
+    pub active: bool,
+    pub stats: Value,
+    pub created_at: String,
+    pub links: Value,
+}
+
+impl ModelVersion {
+    pub fn from_row(v: VersionRow) -> Self {
+        let base = format!("/v1/robots/{}/versions/{}", v.robot_id, v.version);
+        ModelVersion {
+            links: json!({
+                "self": base,
+                "activate": format!("{base}/activate"),
+                "model": format!("{base}/model.json"),
+            }),
+            version: v.version,
+            robot_id: v.robot_id,
+            calibration_id: v.calibration_id,
+            method: v.method,
+            active: v.active,
+            stats: serde_json::from_str(&v.stats_json).unwrap_or(Value::Null),
+            created_at: v.created_at,
+        }
+    }
+}
+
+async fn robot_exists(state: &AppState, robot_id: i64) -> Result<(), ApiError> {
+    match state.db().robot(robot_id).await? {
+        Some(_) => Ok(()),
+        None => Err(robot_not_found(robot_id)),
+    }
+}
+
+pub async fn list(
+    State(state): State<AppState>,
+    ApiPath(robot_id): ApiPath<i64>,
+) -> Result<Response, ApiError> {
+    robot_exists(&state, robot_id).await?;
+    let versions: Vec<ModelVersion> = state
+        .db()
+        .versions(robot_id)
+        .await?
+        .into_iter()
+        .map(ModelVersion::from_row)
+        .collect();
+    let active = versions.iter().find(|v| v.active).map(|v| v.version);
+    Ok(axum::Json(json!({ "active_version": active, "versions": versions })).into_response())
+}
+
+async fn load(state: &AppState, robot_id: i64, v: i64) -> Result<VersionRow, ApiError> {
+    match state.db().version(robot_id, v).await? {
+        Some(row) => Ok(row),
+        None => {
+            robot_exists(state, robot_id).await?;
+            Err(version_not_found(robot_id, v))
+        }
+    }
+}
+
+pub async fn get_one(
+    State(state): State<AppState>,
+    ApiPath((robot_id, v)): ApiPath<(i64, i64)>,
+) -> Result<Response, ApiError> {
+    let row = load(&state, robot_id, v).await?;
+    let model_text = state
+        .db()
+        .version_model(row.id)
+        .await?
+        .ok_or_else(|| version_not_found(robot_id, v))?;
+    let mut out = serde_json::to_value(ModelVersion::from_row(row))
+        .map_err(|e| ApiError::Internal(e.to_string()))?;
+    out["model"] = serde_json::from_str(&model_text)
+        .map_err(|e| ApiError::Internal(format!("stored model of version {v}: {e}")))?;
+    Ok(axum::Json(out).into_response())
+}
+
+pub async fn download(
+    State(state): State<AppState>,
+    ApiPath((robot_id, v)): ApiPath<(i64, i64)>,
+) -> Result<Response, ApiError> {
+    let row = load(&state, robot_id, v).await?;
+    let text = state
+        .db()
+        .version_model(row.id)
+        .await?
+        .ok_or_else(|| version_not_found(robot_id, v))?;
+    let disposition = format!(
+        "attachment; filename=\"robot-{robot_id}-v{v}-{}.json\"",
+        row.method
+    );
+    Ok((
+        [
+            (header::CONTENT_TYPE, "application/json".to_string()),
+            (header::CONTENT_DISPOSITION, disposition),
+        ],
+        text,
+    )
+        .into_response())
+}
+
+pub async fn activate(
+    State(state): State<AppState>,
+    ApiPath((robot_id, v)): ApiPath<(i64, i64)>,
+) -> Result<Response, ApiError> {
+    let row = match state.db().activate(robot_id, v).await? {
+        Some(row) => row,
+        None => {
+            robot_exists(&state, robot_id).await?;
+            return Err(version_not_found(robot_id, v));
+        }
+    };
+    state.invalidate_robot(robot_id);
+    tracing::info!(robot = robot_id, version = v, "model version activated");
+    Ok(axum::Json(ModelVersion::from_row(row)).into_response())
+}
+
+pub async fn rollback(
+    State(state): State<AppState>,
+    ApiPath(robot_id): ApiPath<i64>,
+) -> Result<Response, ApiError> {
+    robot_exists(&state, robot_id).await?;
+    match state.db().rollback(robot_id).await? {
+        Rollback::Done(row) => {
+            state.invalidate_robot(robot_id);
+            tracing::info!(robot = robot_id, version = row.version, "rolled back");
+            Ok(axum::Json(ModelVersion::from_row(row)).into_response())
+        }
+        Rollback::NothingToRollBack => Err(ApiError::Conflict(format!(
+            "robot {robot_id} has no earlier active version to roll back to; activate a version with POST /v1/robots/{robot_id}/versions/{{version}}/activate"
+        ))),
+    }
+}

@@ -1,0 +1,805 @@
+//! Closed-form inverse kinematics of the *nominal* model, used as the seed of
+//! the calibrated solve. All branches (up to 8) with their configuration flags.
+//!
+//! Frames and units: the target is the TCP pose in the model's base frame
+//! (metres, radians); solutions are model-convention joint values
+//! `q = θ − θ_offset` [rad] (controller conventions are applied elsewhere).
+//!
+//! Chain (Craig's modified DH, see `model::robot`), 0-based links `k = 0..5`:
+//! the constant base `B = Tr(a0,b0,d0)·Rx(α0)·Ry(β0)` precedes `Rz(θ0)`; link k
+//! is `Rx(α_k)·Tx(a_k)·Tz(d_k)·Rz(θ_k)`; the tool follows the flange. Base and
+//! tool are removed first (`T = B⁻¹·T_tcp·T_tool⁻¹`, the flange in frame 0′).
+//!
+//! Two structures are solved in closed form, with arbitrary offsets
+//! (`a0 b0 d0 α0 β0`, `a1 d1`, `a2 d2`, `a3 d3`, `d5`, θ offsets, tool):
+//!
+//! - **Spherical wrist** (YS100, HH800 open chain, KUKA/ABB/Fanuc-like):
+//!   axes 2 ∥ 3 (α2 = 0), axes 4, 5, 6 meet at the wrist centre
+//!   (`a4 = d4 = a5 = 0`, α4, α5 ≠ 0). The wrist centre `W = p − d5·z` lies at a
+//!   fixed offset `c_n = d1 + d2 + d3·cos α3` along the arm-plane normal
+//!   `n = Rz(θ0)·Rx(α1)·e_z`, which gives θ0 (two shoulder solutions); a planar
+//!   2R problem in link 1's frame gives θ1, θ2 (two elbow solutions); the wrist
+//!   rotation `Rz(θ3)·Rx(α4)·Rz(θ4)·Rx(α5)·Rz(θ5)` gives θ3, θ4, θ5 (two wrist
+//!   solutions) for any α4, α5.
+//! - **Three parallel axes** (UR-style: axes 2 ∥ 3 ∥ 4, `a5 = 0`): the point
+//!   `O4 = p − d5·z` has the fixed normal offset `d1 + d2 + d3 + d4·cos α4`, giving
+//!   θ0; `n·z5` gives θ4; `n` seen from the flange gives θ5; then frame 3 is
+//!   known and a planar 2R problem gives θ1, θ2 and θ3 (the UR closed form,
+//!   generalised to modified DH with offsets).
+//!
+//! Closed loop (HH800): the open chain is solved with the passive angle θ3p as
+//! the joint, then the crank motor angle is recovered from the loop closure
+//! (circle intersection, checked and polished against `solve_loop`).
+//!
+//! Hayati β ≠ 0, 7-joint arms and other geometries are not supported here
+//! (`AnalyticError::Unsupported`). A model that is only slightly off a solvable
+//! structure (a calibrated model used as the nominal one) can be seeded from
+//! its [`closed_form_proxy`]; otherwise the solver seeds numerically.
+//!
+//! Configuration flags: see `ik::config`. At a singularity (wrist: joint 5 at
+//! 0/π; shoulder: wrist point on axis 1) the free angle is taken from the hint.
+
+use super::config::{Configuration, Elbow, Shoulder, Wrist};
+use crate::kinematics::chain::tool_pose;
+use crate::kinematics::loop_closure::solve_loop;
+use crate::model::{Pose, RobotModel};
+use nalgebra::{Matrix3, Vector2, Vector3};
+use serde::{Deserialize, Serialize};
+use std::f64::consts::{PI, TAU};
+
+/// Tolerance on lengths that must vanish for a structure [m].
+const LEN_TOL: f64 = 1e-9;
+/// Tolerance on the sine of twists that must vanish.
+const SIN_TOL: f64 = 1e-9;
+/// Below this, a sine is treated as zero (singular branch).
+const SINGULAR: f64 = 1e-12;
+/// Reach tolerance of the strict solve (on cosines / sines).
+pub const STRICT_MARGIN: f64 = 1e-9;
+/// Elbow angle away from the stretched singularity of clamped seeds [rad].
+const CLAMPED_ELBOW: f64 = 0.01;
+
+/// The closed-form structure of a model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Structure {
+    SphericalWrist,
+    ThreeParallel,
+}
+
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum AnalyticError {
+    #[error("no closed-form inverse kinematics for this model: {0}")]
+    Unsupported(String),
+}
+
+/// One closed-form branch.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AnalyticSolution {
+    /// Model-convention joint values [rad], wrapped by 2π into the limits when
+    /// possible (nearest the hint, or the middle of the range).
+    pub q: Vec<f64>,
+    pub configuration: Configuration,
+    /// All joints within their limits.
+    pub within_limits: bool,
+    /// A free angle was taken from the hint (wrist or shoulder singularity).
+    pub singular: bool,
+    /// The target lies (slightly) outside the reach and the branch was clamped
+    /// to the boundary (only with a margin larger than [`STRICT_MARGIN`]).
+    pub clamped: bool,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct LoopGeom {
+    passive: usize,
+    sp: f64,
+    l3: f64,
+    l4: f64,
+    l5: f64,
+    xi: f64,
+}
+
+/// Closed-form IK of one nominal model (precomputed constants).
+#[derive(Debug, Clone)]
+pub struct AnalyticIk {
+    structure: Structure,
+    base_inv: Pose,
+    tool_inv: Pose,
+    alpha: [f64; 6],
+    a: [f64; 6],
+    d: [f64; 6],
+    offset: [f64; 6],
+    limits: [[f64; 2]; 6],
+    /// Offset of the wrist point along the arm-plane normal [m].
+    c_n: f64,
+    /// Wrist point in frame 2 (spherical: `Rx(α3)·(a3, 0, d3)`; UR: `(a3, 0, d3)`).
+    wp2: Vector3<f64>,
+    /// Planar second link length and angle.
+    l2: f64,
+    psi: f64,
+    loop_geom: Option<LoopGeom>,
+}
+
+fn wrap(x: f64) -> f64 {
+    let y = x.rem_euclid(TAU);
+    if y > PI {
+        y - TAU
+    } else {
+        y
+    }
+}
+
+fn finite_pose(p: &Pose) -> bool {
+    p.p.iter().all(|v| v.is_finite()) && p.r.iter().all(|v| v.is_finite())
+}
+
+impl AnalyticIk {
+    /// Detects the structure of `model` and precomputes its constants.
+    pub fn new(model: &RobotModel) -> Result<Self, AnalyticError> {
+        let unsupported = |s: String| Err(AnalyticError::Unsupported(s));
+        if model.dof() != 6 {
+            return unsupported(format!("{} joints (closed form needs 6)", model.dof()));
+        }
+        let l = &model.links;
+        for (k, link) in l.iter().enumerate().skip(1) {
+            if link.parallel && link.beta.abs() > SIN_TOL {
+                return unsupported(format!("Hayati twist β on joint {}", k + 1));
+            }
+        }
+        let sa = |k: usize| l[k].alpha.sin();
+        let ca = |k: usize| l[k].alpha.cos();
+        if sa(1).abs() < 1e-6 {
+            return unsupported("axes 1 and 2 are parallel".into());
+        }
+        if !(sa(2).abs() < SIN_TOL && ca(2) > 0.0) {
+            return unsupported("axes 2 and 3 are not parallel (α2 ≠ 0)".into());
+        }
+        if sa(4).abs() < 1e-6 || sa(5).abs() < 1e-6 {
+            return unsupported("wrist axes 4-5 or 5-6 are parallel".into());
+        }
+        if l[5].a.abs() > LEN_TOL {
+            return unsupported("axis 6 does not meet axis 5 (a5 ≠ 0)".into());
+        }
+        if l[2].a.abs() < LEN_TOL {
+            return unsupported("no upper-arm length (a2 = 0)".into());
+        }
+        let (structure, wp2, c_n) = if l[4].a.abs() < LEN_TOL && l[4].d.abs() < LEN_TOL {
+            let wp2 = Vector3::new(l[3].a, -sa(3) * l[3].d, ca(3) * l[3].d);
+            (
+                Structure::SphericalWrist,
+                wp2,
+                l[1].d + l[2].d * ca(2) + wp2.z,
+            )
+        } else if sa(3).abs() < SIN_TOL && ca(3) > 0.0 {
+            let wp2 = Vector3::new(l[3].a, 0.0, l[3].d);
+            (
+                Structure::ThreeParallel,
+                wp2,
+                l[1].d + l[2].d + l[3].d + l[4].d * ca(4),
+            )
+        } else {
+            return unsupported(
+                "neither a spherical wrist (a4 = d4 = a5 = 0) nor three parallel axes".into(),
+            );
+        };
+        let l2 = wp2.x.hypot(wp2.y);
+        if l2 < LEN_TOL {
+            return unsupported("no forearm length".into());
+        }
+        let b = &l[0];
+        let mut base = Pose::identity();
+        base.tr_x(b.a);
+        base.tr_y(b.b);
+        base.tr_z(b.d);
+        base.rot_x(b.alpha);
+        base.rot_y(b.beta);
+        let loop_geom = model.closed_loop.as_ref().map(|c| LoopGeom {
+            passive: c.passive,
+            sp: l[c.passive].a,
+            l3: c.l3,
+            l4: c.l4,
+            l5: c.l5,
+            xi: c.xi,
+        });
+        Ok(AnalyticIk {
+            structure,
+            base_inv: base.inverse(),
+            tool_inv: tool_pose(model).inverse(),
+            alpha: std::array::from_fn(|k| l[k].alpha),
+            a: std::array::from_fn(|k| l[k].a),
+            d: std::array::from_fn(|k| l[k].d),
+            offset: std::array::from_fn(|k| l[k].theta),
+            limits: std::array::from_fn(|k| l[k].limits),
+            c_n,
+            wp2,
+            l2,
+            psi: wp2.y.atan2(wp2.x),
+            loop_geom,
+        })
+    }
+
+    pub fn structure(&self) -> Structure {
+        self.structure
+    }
+
+    /// All branches reaching `tcp` (base frame) exactly; `hint` (model
+    /// convention, rad) picks 2π representatives and free angles at singularities.
+    pub fn solve(&self, tcp: &Pose, hint: Option<&[f64]>) -> Vec<AnalyticSolution> {
+        self.solve_with_margin(tcp, hint, STRICT_MARGIN)
+    }
+
+    /// Like [`AnalyticIk::solve`], but targets up to `margin` (on the cosines
+    /// and sines of the reach equations) outside the reach give clamped
+    /// boundary branches, flagged `clamped` (seeds for a calibrated solve).
+    pub fn solve_with_margin(
+        &self,
+        tcp: &Pose,
+        hint: Option<&[f64]>,
+        margin: f64,
+    ) -> Vec<AnalyticSolution> {
+        self.solve_impl(tcp, hint, margin, None)
+    }
+
+    /// One branch only (see [`AnalyticIk::solve_with_margin`]).
+    pub fn solve_branch(
+        &self,
+        tcp: &Pose,
+        configuration: Configuration,
+        hint: Option<&[f64]>,
+        margin: f64,
+    ) -> Option<AnalyticSolution> {
+        self.solve_impl(tcp, hint, margin, Some(configuration))
+            .pop()
+    }
+
+    fn solve_impl(
+        &self,
+        tcp: &Pose,
+        hint: Option<&[f64]>,
+        margin: f64,
+        only: Option<Configuration>,
+    ) -> Vec<AnalyticSolution> {
+        let mut out = Vec::with_capacity(8);
+        if !finite_pose(tcp) {
+            return out;
+        }
+        let reference = self.reference(hint);
+        let hint_theta = self
+            .chain_angles(&reference)
+            .unwrap_or_else(|| std::array::from_fn(|k| reference[k] + self.offset[k]));
+        let tb = self.base_inv.compose(&tcp.compose(&self.tool_inv));
+        let ctx = Ctx {
+            reference: &reference,
+            hint: &hint_theta,
+            margin,
+            only,
+        };
+        match self.structure {
+            Structure::SphericalWrist => self.solve_spherical(&tb, &ctx, &mut out),
+            Structure::ThreeParallel => self.solve_three_parallel(&tb, &ctx, &mut out),
+        }
+        out
+    }
+
+    /// The configuration flags of any joint vector (model convention, rad);
+    /// `None` when the closed loop cannot close.
+    pub fn configuration(&self, q: &[f64]) -> Option<Configuration> {
+        if q.len() != 6 {
+            return None;
+        }
+        let t = self.chain_angles(q)?;
+        let mut f = Pose::identity();
+        f.rot_x(self.alpha[1]);
+        f.tr_x(self.a[1]);
+        f.tr_z(self.d[1]);
+        f.rot_z(t[1]);
+        f.rot_x(self.alpha[2]);
+        f.tr_x(self.a[2]);
+        f.tr_z(self.d[2]);
+        f.rot_z(t[2]);
+        let wp = match self.structure {
+            Structure::SphericalWrist => f.transform_point(&self.wp2),
+            Structure::ThreeParallel => {
+                f.rot_x(self.alpha[3]);
+                f.tr_x(self.a[3]);
+                f.tr_z(self.d[3]);
+                f.rot_z(t[3]);
+                f.rot_x(self.alpha[4]);
+                f.tr_x(self.a[4]);
+                f.tr_z(self.d[4]);
+                f.p
+            }
+        };
+        let shoulder = if wp.x >= 0.0 {
+            Shoulder::Front
+        } else {
+            Shoulder::Back
+        };
+        let (plus, minus) = self.elbow_flags();
+        let elbow = if (t[2] + self.psi).sin() >= 0.0 {
+            plus
+        } else {
+            minus
+        };
+        let wrist = if t[4].sin() >= 0.0 {
+            Wrist::NoFlip
+        } else {
+            Wrist::Flip
+        };
+        Some(Configuration::new(shoulder, elbow, wrist))
+    }
+
+    /// Joint limits [rad] of the nominal model.
+    pub fn limits(&self) -> &[[f64; 2]; 6] {
+        &self.limits
+    }
+
+    /// The middle of each joint range (0 for ranges of 2π or more).
+    pub fn mid_range(&self) -> [f64; 6] {
+        std::array::from_fn(|k| {
+            let [lo, hi] = self.limits[k];
+            if hi - lo >= TAU {
+                0.0f64.clamp(lo, hi)
+            } else {
+                0.5 * (lo + hi)
+            }
+        })
+    }
+
+    fn reference(&self, hint: Option<&[f64]>) -> [f64; 6] {
+        match hint {
+            Some(h) if h.len() == 6 && h.iter().all(|v| v.is_finite()) => {
+                std::array::from_fn(|k| h[k])
+            }
+            _ => self.mid_range(),
+        }
+    }
+
+    /// Chain angles θ (passive angle at the loop joint).
+    fn chain_angles(&self, q: &[f64]) -> Option<[f64; 6]> {
+        let mut t: [f64; 6] = std::array::from_fn(|k| q[k] + self.offset[k]);
+        if let Some(g) = &self.loop_geom {
+            let p = g.passive;
+            t[p] = solve_loop(t[p - 1], t[p], g.sp, g.l3, g.l4, g.l5, g.xi)
+                .ok()?
+                .passive;
+        }
+        Some(t)
+    }
+
+    /// Elbow flags of the `+acos` and `−acos` planar solutions.
+    fn elbow_flags(&self) -> (Elbow, Elbow) {
+        if -self.alpha[1].sin() * self.a[2] > 0.0 {
+            (Elbow::Up, Elbow::Down)
+        } else {
+            (Elbow::Down, Elbow::Up)
+        }
+    }
+
+    /// θ0 solutions for a wrist point `w` in frame 0′: `(θ0, shoulder)`, and
+    /// whether clamped / singular.
+    fn shoulder_angles(&self, w: &Vector3<f64>, ctx: &Ctx) -> Option<ShoulderSolutions> {
+        let (sa, ca) = self.alpha[1].sin_cos();
+        let rho = w.x.hypot(w.y);
+        let rhs = self.c_n - ca * w.z;
+        if rho < 1e-9 {
+            let h = ctx.hint[0];
+            return Some((
+                [(h, Shoulder::Front), (h + PI, Shoulder::Back)],
+                false,
+                true,
+            ));
+        }
+        let k = rhs / (sa * rho);
+        if k.abs() > 1.0 + ctx.margin {
+            return None;
+        }
+        let clamped = k.abs() > 1.0;
+        let s = k.clamp(-1.0, 1.0).asin();
+        let phi = w.y.atan2(w.x);
+        Some((
+            [(phi + s, Shoulder::Front), (phi + PI - s, Shoulder::Back)],
+            clamped,
+            false,
+        ))
+    }
+
+    /// Frame 1′ (before Rz(θ1)) in frame 0′.
+    fn frame1(&self, t0: f64) -> Pose {
+        let mut f = Pose::identity();
+        f.rot_z(t0);
+        f.rot_x(self.alpha[1]);
+        f.tr_x(self.a[1]);
+        f.tr_z(self.d[1]);
+        f
+    }
+
+    /// Planar 2R: the wrist point at `(px, py)` in frame 1′. Returns
+    /// `(θ1, θ2, elbow)` for `±acos`, and whether clamped.
+    fn planar(&self, px: f64, py: f64, ctx: &Ctx) -> Option<PlanarSolutions> {
+        let (a2, l2) = (self.a[2], self.l2);
+        let c = (px * px + py * py - a2 * a2 - l2 * l2) / (2.0 * a2 * l2);
+        if c.abs() > 1.0 + ctx.margin {
+            return None;
+        }
+        let clamped = c.abs() > 1.0;
+        let mut g = c.clamp(-1.0, 1.0).acos();
+        if clamped && ctx.margin > STRICT_MARGIN {
+            // Seeds beyond the reach: start just off the stretched (folded)
+            // singularity, on the side of each elbow branch.
+            g = if c > 0.0 {
+                CLAMPED_ELBOW
+            } else {
+                PI - CLAMPED_ELBOW
+            };
+        }
+        let (plus, minus) = self.elbow_flags();
+        let base = py.atan2(px);
+        let one = |phi2: f64, e: Elbow| {
+            let t1 = base - (l2 * phi2.sin()).atan2(a2 + l2 * phi2.cos());
+            (t1, phi2 - self.psi, e)
+        };
+        Some(([one(g, plus), one(-g, minus)], clamped))
+    }
+
+    /// Wrist angles from `M = Rz(θ3)·Rx(α4)·Rz(θ4)·Rx(α5)·Rz(θ5)`.
+    fn wrist(&self, m: &Matrix3<f64>, ctx: &Ctx) -> Option<WristSolutions> {
+        let (s4, c4) = self.alpha[4].sin_cos();
+        let (s5, c5) = self.alpha[5].sin_cos();
+        let ct = (c4 * c5 - m[(2, 2)]) / (s4 * s5);
+        if ct.abs() > 1.0 + ctx.margin.max(1e-9) {
+            return None;
+        }
+        let g = ct.clamp(-1.0, 1.0).acos();
+        let one = |t4: f64, w: Wrist| {
+            let (st, ctt) = t4.sin_cos();
+            let (x, y) = (s5 * st, -c4 * s5 * ctt - s4 * c5);
+            if x.hypot(y) < SINGULAR {
+                let t3 = ctx.hint[3];
+                let mut r = Pose::identity();
+                r.rot_z(t3);
+                r.rot_x(self.alpha[4]);
+                r.rot_z(t4);
+                r.rot_x(self.alpha[5]);
+                let n = r.r.transpose() * m;
+                (t3, t4, n[(1, 0)].atan2(n[(0, 0)]), w, true)
+            } else {
+                let t3 = m[(1, 2)].atan2(m[(0, 2)]) - y.atan2(x);
+                let (xp, yp) = (s4 * st, s4 * ctt * c5 + c4 * s5);
+                let t5 = yp.atan2(xp) - m[(2, 1)].atan2(m[(2, 0)]);
+                (t3, t4, t5, w, false)
+            }
+        };
+        Some([one(g, Wrist::NoFlip), one(-g, Wrist::Flip)])
+    }
+
+    fn solve_spherical(&self, tb: &Pose, ctx: &Ctx, out: &mut Vec<AnalyticSolution>) {
+        let w = tb.p - tb.z_axis() * self.d[5];
+        let Some((shoulders, clamp0, sing0)) = self.shoulder_angles(&w, ctx) else {
+            return;
+        };
+        for (t0, sh) in shoulders {
+            if ctx.only.is_some_and(|c| c.shoulder != sh) {
+                continue;
+            }
+            let f1 = self.frame1(t0);
+            let w1 = f1.r.transpose() * (w - f1.p);
+            let Some((elbows, clamp1)) = self.planar(w1.x, w1.y, ctx) else {
+                continue;
+            };
+            for (t1, t2, el) in elbows {
+                if ctx.only.is_some_and(|c| c.elbow != el) {
+                    continue;
+                }
+                let mut f3 = f1;
+                f3.rot_z(t1);
+                f3.rot_x(self.alpha[2]);
+                f3.rot_z(t2);
+                f3.rot_x(self.alpha[3]);
+                let m = f3.r.transpose() * tb.r;
+                let Some(wrists) = self.wrist(&m, ctx) else {
+                    continue;
+                };
+                for (t3, t4, t5, wr, sing) in wrists {
+                    if ctx.only.is_some_and(|c| c.wrist != wr) {
+                        continue;
+                    }
+                    self.finish(
+                        [t0, t1, t2, t3, t4, t5],
+                        Configuration::new(sh, el, wr),
+                        sing0 || sing,
+                        clamp0 || clamp1,
+                        ctx,
+                        out,
+                    );
+                }
+            }
+        }
+    }
+
+    fn link_pose(&self, k: usize, theta: f64) -> Pose {
+        let mut f = Pose::identity();
+        f.rot_x(self.alpha[k]);
+        f.tr_x(self.a[k]);
+        f.tr_z(self.d[k]);
+        f.rot_z(theta);
+        f
+    }
+
+    fn solve_three_parallel(&self, tb: &Pose, ctx: &Ctx, out: &mut Vec<AnalyticSolution>) {
+        let z5 = tb.z_axis();
+        let o4 = tb.p - z5 * self.d[5];
+        let Some((shoulders, clamp0, sing0)) = self.shoulder_angles(&o4, ctx) else {
+            return;
+        };
+        let (sa1, ca1) = self.alpha[1].sin_cos();
+        let (s4, c4) = self.alpha[4].sin_cos();
+        let (s5, c5) = self.alpha[5].sin_cos();
+        for (t0, sh) in shoulders {
+            if ctx.only.is_some_and(|c| c.shoulder != sh) {
+                continue;
+            }
+            let (st0, ct0) = t0.sin_cos();
+            let n = Vector3::new(sa1 * st0, -sa1 * ct0, ca1);
+            let ct = (c4 * c5 - n.dot(&z5)) / (s4 * s5);
+            if ct.abs() > 1.0 + ctx.margin.max(1e-9) {
+                continue;
+            }
+            let g = ct.clamp(-1.0, 1.0).acos();
+            let n5 = tb.r.transpose() * n;
+            let f1_inv = self.frame1(t0).inverse();
+            for (t4, wr) in [(g, Wrist::NoFlip), (-g, Wrist::Flip)] {
+                if ctx.only.is_some_and(|c| c.wrist != wr) {
+                    continue;
+                }
+                let (st4, ct4) = t4.sin_cos();
+                let n4 = Vector3::new(s4 * st4, s4 * ct4, c4);
+                let v = Vector2::new(n4.x, c5 * n4.y + s5 * n4.z);
+                let (t5, sing) = if v.norm() < SINGULAR {
+                    (ctx.hint[5], true)
+                } else {
+                    (v.y.atan2(v.x) - n5.y.atan2(n5.x), false)
+                };
+                let f3 = tb
+                    .compose(&self.link_pose(5, t5).inverse())
+                    .compose(&self.link_pose(4, t4).inverse());
+                let f = f1_inv.compose(&f3);
+                let Some((elbows, clamp1)) = self.planar(f.p.x, f.p.y, ctx) else {
+                    continue;
+                };
+                let total = f.r[(1, 0)].atan2(f.r[(0, 0)]);
+                for (t1, t2, el) in elbows {
+                    if ctx.only.is_some_and(|c| c.elbow != el) {
+                        continue;
+                    }
+                    self.finish(
+                        [t0, t1, t2, total - t1 - t2, t4, t5],
+                        Configuration::new(sh, el, wr),
+                        sing0 || sing,
+                        clamp0 || clamp1,
+                        ctx,
+                        out,
+                    );
+                }
+            }
+        }
+    }
+
+    /// Chain angles → model-convention joints (loop motor, 2π wrapping, limits).
+    fn finish(
+        &self,
+        theta: [f64; 6],
+        configuration: Configuration,
+        singular: bool,
+        clamped: bool,
+        ctx: &Ctx,
+        out: &mut Vec<AnalyticSolution>,
+    ) {
+        let mut t = theta;
+        if let Some(g) = &self.loop_geom {
+            match motor_from_passive(t[g.passive - 1], t[g.passive], g) {
+                Some(m) => t[g.passive] = m,
+                None => return,
+            }
+        }
+        let mut within_limits = true;
+        let q = (0..6)
+            .map(|k| {
+                let (v, ok) = wrap_into(
+                    wrap(t[k] - self.offset[k]),
+                    self.limits[k],
+                    ctx.reference[k],
+                );
+                within_limits &= ok;
+                v
+            })
+            .collect();
+        out.push(AnalyticSolution {
+            q,
+            configuration,
+            within_limits,
+            singular,
+            clamped,
+        });
+    }
+}
+
+/// `(θ0, shoulder)` pairs, clamped, singular.
+type ShoulderSolutions = ([(f64, Shoulder); 2], bool, bool);
+/// `(θ1, θ2, elbow)` pairs, clamped.
+type PlanarSolutions = ([(f64, f64, Elbow); 2], bool);
+/// `(θ3, θ4, θ5, wrist, singular)` pairs.
+type WristSolutions = [(f64, f64, f64, Wrist, bool); 2];
+
+/// Largest deviation [rad] of a twist snapped to 0 by [`closed_form_proxy`].
+pub const PROXY_MAX_TWIST: f64 = 0.05;
+/// Largest offset [m] snapped to 0 by [`closed_form_proxy`].
+pub const PROXY_MAX_OFFSET: f64 = 0.01;
+
+/// A model of a closed-form structure close to `model`, for seeding only: the
+/// Hayati twists β are dropped, twists α2 and α3 within [`PROXY_MAX_TWIST`] of
+/// 0 and wrist offsets a4, d4, a5 within [`PROXY_MAX_OFFSET`] are set to 0 (as
+/// when a calibrated model serves as the nominal one). `None` when the model
+/// is farther from a solvable structure.
+pub fn closed_form_proxy(model: &RobotModel) -> Option<(RobotModel, AnalyticIk)> {
+    if model.dof() != 6 {
+        return None;
+    }
+    let mut p = model.clone();
+    for (k, l) in p.links.iter_mut().enumerate().skip(1) {
+        if l.parallel {
+            l.beta = 0.0;
+        }
+        if (k == 2 || k == 3) && l.alpha.abs() < PROXY_MAX_TWIST {
+            l.alpha = 0.0;
+        }
+    }
+    let snap = |v: &mut f64| {
+        if v.abs() < PROXY_MAX_OFFSET {
+            *v = 0.0;
+        }
+    };
+    snap(&mut p.links[4].a);
+    snap(&mut p.links[4].d);
+    snap(&mut p.links[5].a);
+    let a = AnalyticIk::new(&p).ok()?;
+    Some((p, a))
+}
+
+/// Per-call context of a solve.
+struct Ctx<'a> {
+    reference: &'a [f64; 6],
+    hint: &'a [f64; 6],
+    margin: f64,
+    /// Compute this branch only.
+    only: Option<Configuration>,
+}
+
+/// The 2π representative of `x` within `limits` nearest `reference`, or the
+/// nearest to `reference` overall (flagged false) when none is within limits.
+pub(crate) fn wrap_into(x: f64, limits: [f64; 2], reference: f64) -> (f64, bool) {
+    let tol = 1e-12;
+    let inside = |v: f64| v >= limits[0] - tol && v <= limits[1] + tol;
+    let nearest = x + ((reference - x) / TAU).round() * TAU;
+    if inside(nearest) {
+        return (nearest, true);
+    }
+    // The next representatives on either side, nearer one first.
+    let (a, b) = if nearest < reference {
+        (nearest + TAU, nearest - TAU)
+    } else {
+        (nearest - TAU, nearest + TAU)
+    };
+    for v in [a, b] {
+        if inside(v) {
+            return (v, true);
+        }
+    }
+    (nearest, false)
+}
+
+/// Crank motor angle θ3′ that gives the passive angle `passive` for the driver
+/// angle `driver` (inverse of `solve_loop`, same branch).
+fn motor_from_passive(driver: f64, passive: f64, g: &LoopGeom) -> Option<f64> {
+    let e = |a: f64| Vector2::new(a.cos(), a.sin());
+    let phi = passive + driver + g.xi;
+    let r = e(driver) * g.sp + e(phi) * g.l3;
+    let dist = r.norm();
+    if dist < 1e-12 {
+        return None;
+    }
+    let along = (g.l5 * g.l5 - g.l4 * g.l4 + dist * dist) / (2.0 * dist);
+    let h2 = g.l5 * g.l5 - along * along;
+    if h2 < 0.0 {
+        return None;
+    }
+    let unit = r / dist;
+    let perp = Vector2::new(-unit.y, unit.x);
+    let fwd = |m: f64| solve_loop(driver, m, g.sp, g.l3, g.l4, g.l5, g.xi).ok();
+    for sgn in [1.0, -1.0] {
+        let qp = unit * along + perp * (sgn * h2.sqrt());
+        let mut m = qp.y.atan2(qp.x);
+        let Some(sol) = fwd(m) else { continue };
+        if wrap(sol.passive - passive).abs() > 1e-6 {
+            continue;
+        }
+        // Polish against the forward loop solution.
+        let mut s = sol;
+        for _ in 0..3 {
+            let err = wrap(s.passive - passive);
+            if err.abs() < 1e-15 || s.partials.d_motor.abs() < 1e-12 {
+                break;
+            }
+            m -= err / s.partials.d_motor;
+            match fwd(m) {
+                Some(n) => s = n,
+                None => return None,
+            }
+        }
+        return Some(m);
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kinematics::fk;
+    use crate::model::preset;
+
+    #[test]
+    fn structures_are_detected() {
+        assert_eq!(
+            AnalyticIk::new(&preset("ys100").unwrap())
+                .unwrap()
+                .structure(),
+            Structure::SphericalWrist
+        );
+        assert_eq!(
+            AnalyticIk::new(&preset("hh800").unwrap())
+                .unwrap()
+                .structure(),
+            Structure::SphericalWrist
+        );
+        assert_eq!(
+            AnalyticIk::new(&preset("ur5").unwrap())
+                .unwrap()
+                .structure(),
+            Structure::ThreeParallel
+        );
+        let mut m = preset("ys100").unwrap();
+        m.links[4].a = 0.01;
+        assert!(AnalyticIk::new(&m).is_err());
+    }
+
+    #[test]
+    fn wrap_into_prefers_limits_then_reference() {
+        assert_eq!(wrap_into(3.0, [-PI, PI], 0.0), (3.0, true));
+        let (v, ok) = wrap_into(3.0, [-2.0 * TAU, 2.0 * TAU], -3.0);
+        assert!(ok && (v - (3.0 - TAU)).abs() < 1e-12);
+        let (_, ok) = wrap_into(3.0, [-1.0, 1.0], 0.0);
+        assert!(!ok);
+    }
+
+    #[test]
+    fn every_branch_maps_back_on_the_presets() {
+        for name in ["ys100", "hh800", "ur10"] {
+            let m = preset(name).unwrap();
+            let ik = AnalyticIk::new(&m).unwrap();
+            let q = [0.3, 1.45, 0.2, 0.4, 0.7, -0.6];
+            let t = fk(&m, &q).unwrap();
+            let sols = ik.solve(&t, None);
+            assert!(sols.len() >= 2, "{name}: {}", sols.len());
+            let mut found = false;
+            for s in &sols {
+                let p = fk(&m, &s.q).unwrap();
+                assert!((p.p - t.p).norm() < 1e-9, "{name} {:?}", s.configuration);
+                assert!((p.r - t.r).norm() < 1e-9, "{name}");
+                assert_eq!(ik.configuration(&s.q), Some(s.configuration), "{name}");
+                if s.q.iter().zip(&q).all(|(a, b)| wrap(a - b).abs() < 1e-7) {
+                    found = true;
+                }
+            }
+            assert!(found, "{name}: original branch missing");
+        }
+    }
+}

@@ -1,0 +1,908 @@
+//! Calibrated inverse kinematics: damped Newton (Levenberg–Marquardt) on the
+//! compensated model's prediction, seeded by the nominal closed form.
+//!
+//! Solves `P_base(q) = target` where `P_base` is `CompensatedModel::predict_base`
+//! (calibrated geometry at the deflected joints `q + c∘τ(q)`, plus the
+//! compensator residual). Frames: the target is given in the measurement (cell)
+//! frame or the registered base frame (`TargetFrame`), and converted to the
+//! registered base frame. Units: SI inside (m, rad); residuals are reported in
+//! mm and rad.
+//!
+//! Error vector (base frame): `e = [p* − p(q); L·log(R*·R(q)ᵀ)]`, with `L` the
+//! orientation length of `IkSettings` (1 m). Step: `Δq = J_wᵀ (J_w J_wᵀ + λ² I)⁻¹ e`
+//! with `J_w` the weighted quasi-Newton Jacobian (geometric Jacobian of the
+//! calibrated chain at the deflected joints; `∂τ/∂q` and the compensator's
+//! derivative are neglected, which leaves a linear convergence factor of about
+//! `‖c·∂τ/∂q‖` ≈ 1e-3–1e-2). The same formula gives the minimum-norm step for
+//! position-only targets (3 rows). The damping `μ = λ²` follows the gain ratio
+//! of each step (Nielsen's rule); a step that does not lower `‖e‖²` is
+//! discarded and μ grows, so steps stay damped near singularities (wrist:
+//! joint 5 at 0; stretched elbow; wrist point on axis 1). Steps are capped to
+//! `max_step_rad` and projected onto the joint limits (after trying the 2π
+//! equivalent for joints with a range of 2π or more).
+//!
+//! Seeds: the closed-form branches of the nominal model (or of its closed-form
+//! proxy, `analytic::closed_form_proxy`) for the target in the base frame,
+//! ordered by the requested branch, by the distance to
+//! a joint seed, or (default) by the distance to the middle of the joint ranges,
+//! within-limit branches first. Each branch seed is first *corrected*: the
+//! closed form is re-solved in the same branch for `T·P(q)⁻¹·FK_nom(q)` (the
+//! target moved by the calibrated model's deviation at the seed), which removes
+//! most of the nominal/calibrated difference exactly, including near
+//! singularities where it maps to large joint changes; then damped Newton runs
+//! from the corrected seed, and from the plain one if that fails. A last long
+//! run starts from the best attempt when it ended within 1 cm. Targets without
+//! a closed-form branch within the reach margin, position-only targets and
+//! models without a closed form use a deterministic multi-start (the joint seed,
+//! the middle of the ranges, then Halton points within the limits). Targets
+//! beyond the reach bound (sum of link lengths and offsets plus the tool) fail
+//! at once as unreachable.
+//!
+//! Failure reasons: `InvalidTarget` (non-finite values, non-rotation, bad
+//! seed); `Unreachable` (beyond the reach bound, or no closed-form branch even
+//! with the margin and no calibrated solution found); `OutOfLimits` (branches
+//! exist but only outside the limits, or the iteration stalled on a limit);
+//! `Singular` (stalled where the weighted Jacobian's smallest singular value is
+//! below `singular_threshold`, or converged into another branch than the
+//! requested one); `DidNotConverge` otherwise.
+
+use super::analytic::{closed_form_proxy, AnalyticIk, AnalyticSolution};
+use super::config::Configuration;
+use super::targets::TargetFrame;
+use crate::compensate::CompensatedModel;
+use crate::model::pose::rotation_log;
+use crate::model::{Pose, RobotModel};
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// Slack on the reach bound (compensator residuals, loop geometry) [m].
+const REACH_SLACK_M: f64 = 0.05;
+
+/// The last-resort long run only starts from attempts closer than this [m].
+const LAST_RESORT_MAX_M: f64 = 0.01;
+
+/// Numerical settings of the solver.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct IkSettings {
+    /// Convergence: position residual below this [m]. Default 1e-7 m (1e-4 mm).
+    pub position_tolerance_m: f64,
+    /// Convergence: orientation residual below this [rad]. Default 1e-7 rad.
+    pub orientation_tolerance_rad: f64,
+    /// Maximum evaluations of the prediction per seed (accepted and rejected
+    /// steps). Default 60.
+    pub max_iterations: usize,
+    /// Length [m] weighting orientation against position errors. Default 1 m.
+    pub orientation_length_m: f64,
+    /// Initial damping λ [m]. Default 1e-6 m.
+    pub initial_damping: f64,
+    /// Largest joint step per iteration [rad]. Default 0.3 rad.
+    pub max_step_rad: f64,
+    /// How far (on the cosines of the reach equations) outside the nominal
+    /// reach a target still gets clamped closed-form seeds. Default 0.05.
+    pub seed_reach_margin: f64,
+    /// Seeds outside the joint limits by at most this [rad] are still tried,
+    /// after the in-limit ones (the calibrated solution may be inside). Default 0.1 rad.
+    pub seed_limit_slack_rad: f64,
+    /// A failing target whose weighted Jacobian has a smallest singular value
+    /// below this [m] is reported singular. Default 1e-4 m.
+    pub singular_threshold: f64,
+    /// Seeds tried per target before giving up. Default 8.
+    pub max_attempts: usize,
+    /// Budget of the last-resort run from the best attempt, in multiples of
+    /// `max_iterations`. Default 5.
+    pub final_iterations_factor: usize,
+    /// Closed-form seed corrections: the nominal closed form is re-solved for
+    /// `T·P(q)⁻¹·FK_nom(q)` (the target moved by the calibrated model's
+    /// deviation at the current seed), in the seed's branch. Default 1.
+    pub seed_corrections: usize,
+    /// Starts of the multi-start seeding of models without a closed form. Default 24.
+    pub numeric_starts: usize,
+    /// Multi-start seeds added when the closed form has no branch for a target
+    /// within the reach bound. Default 8.
+    pub numeric_fallback_starts: usize,
+    /// Path mode: joint jumps above this are reported [rad]. Default 30°.
+    pub jump_threshold_rad: f64,
+    /// Worker threads of a batch; 0 uses rayon's global pool. Default 0.
+    pub threads: usize,
+}
+
+impl Default for IkSettings {
+    fn default() -> Self {
+        IkSettings {
+            position_tolerance_m: 1e-7,
+            orientation_tolerance_rad: 1e-7,
+            max_iterations: 60,
+            orientation_length_m: 1.0,
+            initial_damping: 1e-6,
+            max_step_rad: 0.3,
+            seed_reach_margin: 0.05,
+            seed_limit_slack_rad: 0.1,
+            singular_threshold: 1e-4,
+            max_attempts: 8,
+            seed_corrections: 1,
+            final_iterations_factor: 5,
+            numeric_starts: 24,
+            numeric_fallback_starts: 8,
+            jump_threshold_rad: 30f64.to_radians(),
+            threads: 0,
+        }
+    }
+}
+
+/// Per-call options.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct SolveOptions {
+    /// Frame of the targets (cell by default).
+    pub frame: TargetFrame,
+    /// Solve the position only (the orientation, when given, only guides the seed).
+    pub position_only: bool,
+    /// Required configuration branch.
+    pub branch: Option<Configuration>,
+    /// Joint seed (model convention, rad): the branch nearest it is preferred.
+    pub seed: Option<Vec<f64>>,
+}
+
+/// Why a target has no solution.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, thiserror::Error)]
+#[serde(tag = "kind", content = "detail", rename_all = "snake_case")]
+pub enum FailureReason {
+    #[error("target is out of reach")]
+    Unreachable,
+    #[error("the target is only reachable outside the joint limits")]
+    OutOfLimits,
+    #[error("singular configuration: the solver could not reach the target")]
+    Singular,
+    #[error("the solver did not converge")]
+    DidNotConverge,
+    #[error("invalid target: {0}")]
+    InvalidTarget(String),
+}
+
+impl FailureReason {
+    /// Short machine-readable code.
+    pub fn code(&self) -> &'static str {
+        match self {
+            FailureReason::Unreachable => "unreachable",
+            FailureReason::OutOfLimits => "out_of_limits",
+            FailureReason::Singular => "singular",
+            FailureReason::DidNotConverge => "did_not_converge",
+            FailureReason::InvalidTarget(_) => "invalid_target",
+        }
+    }
+}
+
+/// Result for one target.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct IkSolution {
+    /// Residuals within the tolerances and joints within limits.
+    pub converged: bool,
+    /// Model-convention joint commands [rad]; the best attempt when not
+    /// converged (do not command those), empty for invalid targets.
+    pub q: Vec<f64>,
+    /// `|p(q) − p*|` [mm] (NaN for invalid targets).
+    pub position_residual_mm: f64,
+    /// Rotation angle between `R(q)` and `R*` [rad] (NaN without a target orientation).
+    pub orientation_residual_rad: f64,
+    /// Evaluations of the prediction, summed over the attempts.
+    pub iterations: usize,
+    /// Configuration of `q` (None for models without a closed form).
+    pub branch: Option<Configuration>,
+    pub reason: Option<FailureReason>,
+}
+
+impl IkSolution {
+    pub fn invalid(reason: String) -> Self {
+        IkSolution {
+            converged: false,
+            q: Vec::new(),
+            position_residual_mm: f64::NAN,
+            orientation_residual_rad: f64::NAN,
+            iterations: 0,
+            branch: None,
+            reason: Some(FailureReason::InvalidTarget(reason)),
+        }
+    }
+}
+
+/// A target: position and, unless position-only, orientation (in the options' frame, SI).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Goal {
+    pub position: Vector3<f64>,
+    pub rotation: Option<Matrix3<f64>>,
+}
+
+impl From<&Pose> for Goal {
+    fn from(p: &Pose) -> Self {
+        Goal {
+            position: p.p,
+            rotation: Some(p.r),
+        }
+    }
+}
+
+/// Outcome of one damped Newton run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Refined {
+    pub q: Vec<f64>,
+    pub converged: bool,
+    pub position_residual_m: f64,
+    pub orientation_residual_rad: f64,
+    pub iterations: usize,
+    /// A joint ended on a limit the unconstrained step wanted to cross.
+    pub at_limit: bool,
+    /// Smallest singular value of the weighted Jacobian [m] (computed only when
+    /// not converged; NaN otherwise).
+    pub sigma_min: f64,
+    /// The prediction failed (e.g. the closed loop cannot close).
+    pub failed_evaluation: bool,
+}
+
+/// The calibrated IK solver of one compensated model.
+#[derive(Debug, Clone)]
+pub struct IkSolver {
+    model: CompensatedModel,
+    analytic: Option<AnalyticIk>,
+    analytic_error: Option<String>,
+    settings: IkSettings,
+    base_from_cell: Pose,
+    limits: Vec<[f64; 2]>,
+    /// Upper bound of the TCP distance from the base origin [m].
+    reach: f64,
+    /// The model the closed form solves (the nominal model or its proxy).
+    seed_model: RobotModel,
+}
+
+struct Eval {
+    pose: Pose,
+    jac: DMatrix<f64>,
+}
+
+/// Radical inverse in base `b` (Halton sequences).
+fn halton(mut i: usize, b: usize) -> f64 {
+    let (mut f, mut r) = (1.0, 0.0);
+    while i > 0 {
+        f /= b as f64;
+        r += f * (i % b) as f64;
+        i /= b;
+    }
+    r
+}
+
+impl IkSolver {
+    /// A solver for `model`. The closed form is built from the nominal model,
+    /// or from its closed-form proxy (`analytic::closed_form_proxy`) when the
+    /// nominal model is only nearly of a solvable structure; otherwise the
+    /// solver seeds numerically.
+    pub fn new(model: CompensatedModel, settings: IkSettings) -> Self {
+        let mut seed_model = model.nominal.clone();
+        let (analytic, analytic_error) = if model.nominal.dof() != model.calibrated.dof() {
+            (
+                None,
+                Some("nominal and calibrated joint counts differ".to_string()),
+            )
+        } else {
+            match AnalyticIk::new(&model.nominal) {
+                Ok(a) => (Some(a), None),
+                Err(e) => match closed_form_proxy(&model.nominal) {
+                    Some((proxy, a)) => {
+                        seed_model = proxy;
+                        (Some(a), None)
+                    }
+                    None => (None, Some(e.to_string())),
+                },
+            }
+        };
+        let limits = model.nominal.links.iter().map(|l| l.limits).collect();
+        let reach = model
+            .calibrated
+            .links
+            .iter()
+            .map(|l| l.a.abs() + l.b.abs() + l.d.abs())
+            .sum::<f64>()
+            + model.calibrated.tool.p.norm()
+            + REACH_SLACK_M;
+        IkSolver {
+            seed_model,
+            reach,
+            base_from_cell: model.cell_from_base.inverse(),
+            model,
+            analytic,
+            analytic_error,
+            settings,
+            limits,
+        }
+    }
+
+    pub fn model(&self) -> &CompensatedModel {
+        &self.model
+    }
+
+    pub fn settings(&self) -> &IkSettings {
+        &self.settings
+    }
+
+    /// The closed form of the nominal model (or of its proxy), if any.
+    pub fn analytic(&self) -> Option<&AnalyticIk> {
+        self.analytic.as_ref()
+    }
+
+    /// Why the model has no closed form (then seeds are numerical).
+    pub fn analytic_error(&self) -> Option<&str> {
+        self.analytic_error.as_deref()
+    }
+
+    /// Joint limits used by the solver [rad] (the nominal model's: the controller's).
+    pub fn limits(&self) -> &[[f64; 2]] {
+        &self.limits
+    }
+
+    /// Configuration flags of joints `q`.
+    pub fn configuration(&self, q: &[f64]) -> Option<Configuration> {
+        self.analytic.as_ref().and_then(|a| a.configuration(q))
+    }
+
+    /// Maps a goal from `frame` into the registered base frame.
+    pub fn goal_to_base(&self, goal: &Goal, frame: TargetFrame) -> Goal {
+        match frame {
+            TargetFrame::Base => *goal,
+            TargetFrame::Cell => Goal {
+                position: self.base_from_cell.transform_point(&goal.position),
+                rotation: goal.rotation.map(|r| self.base_from_cell.r * r),
+            },
+        }
+    }
+
+    /// Solves one pose target given in `options.frame`.
+    pub fn solve(&self, target: &Pose, options: &SolveOptions) -> IkSolution {
+        self.solve_goal(&Goal::from(target), options)
+    }
+
+    /// Solves one goal given in `options.frame`.
+    pub fn solve_goal(&self, goal: &Goal, options: &SolveOptions) -> IkSolution {
+        if let Err(msg) = self.validate(goal, options) {
+            return IkSolution::invalid(msg);
+        }
+        let g = self.goal_to_base(goal, options.frame);
+        self.solve_base(&g, options)
+    }
+
+    pub(crate) fn validate(&self, goal: &Goal, options: &SolveOptions) -> Result<(), String> {
+        if !goal.position.iter().all(|v| v.is_finite()) {
+            return Err("position is not finite".into());
+        }
+        match &goal.rotation {
+            None if !options.position_only => {
+                return Err("no orientation given (required unless position-only)".into())
+            }
+            Some(r) if !r.iter().all(|v| v.is_finite()) => {
+                return Err("orientation is not finite".into())
+            }
+            Some(r) if (r.transpose() * r - Matrix3::identity()).amax() > 1e-6 => {
+                return Err("orientation matrix is not a rotation".into())
+            }
+            _ => {}
+        }
+        if let Some(s) = &options.seed {
+            if s.len() != self.model.dof() || !s.iter().all(|v| v.is_finite()) {
+                return Err(format!(
+                    "joint seed needs {} finite values, got {}",
+                    self.model.dof(),
+                    s.len()
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether a goal in the base frame is within the reach bound (the sum of
+    /// the calibrated link lengths and offsets, the tool offset and 5 cm).
+    pub fn within_reach(&self, goal: &Goal) -> bool {
+        goal.position.norm() <= self.reach
+    }
+
+    /// Solves one goal in the registered base frame.
+    pub fn solve_base(&self, goal: &Goal, options: &SolveOptions) -> IkSolution {
+        if let Err(msg) = self.validate(goal, options) {
+            return IkSolution::invalid(msg);
+        }
+        let position_only = options.position_only || goal.rotation.is_none();
+        if !self.within_reach(goal) {
+            return IkSolution {
+                converged: false,
+                q: Vec::new(),
+                position_residual_mm: (goal.position.norm() - self.reach) * 1e3,
+                orientation_residual_rad: f64::NAN,
+                iterations: 0,
+                branch: None,
+                reason: Some(FailureReason::Unreachable),
+            };
+        }
+        let seeds = self.seeds(goal, options);
+        let mut total_iters = 0;
+        let mut best: Option<Refined> = None;
+        let branch_ok = |q: &[f64]| match (options.branch, self.configuration(q)) {
+            (Some(want), Some(got)) => want == got,
+            _ => true,
+        };
+        let consider = |r: Refined, best: &mut Option<Refined>| {
+            let better = best.as_ref().is_none_or(|b| {
+                (r.converged && !b.converged)
+                    || (r.converged == b.converged
+                        && r.position_residual_m + r.orientation_residual_rad
+                            < b.position_residual_m + b.orientation_residual_rad)
+            });
+            if better {
+                *best = Some(r);
+            }
+        };
+        for seed in seeds.list.iter().take(seeds.max_attempts.max(1)) {
+            // The corrected closed-form seed first, then the plain one.
+            let mut starts = Vec::with_capacity(2);
+            if let (Some(a), Some(c)) = (&self.analytic, seed.configuration) {
+                let (q, n) = self.corrected_seed(a, &seeds.target, &seed.q, c);
+                total_iters += n;
+                if q.iter().zip(&seed.q).any(|(x, y)| (x - y).abs() > 1e-9) {
+                    starts.push(q);
+                }
+            }
+            starts.push(seed.q.clone());
+            for q0 in starts {
+                let r = self.refine(goal, &q0, position_only);
+                total_iters += r.iterations;
+                if r.converged && branch_ok(&r.q) {
+                    return self.solution(goal, r, total_iters, None);
+                }
+                consider(r, &mut best);
+            }
+        }
+        // Last resort: a long run from the best end point (slow progress along
+        // the curved valleys of near-singular configurations; not for targets
+        // that are centimetres away).
+        if let Some(b) = best.as_ref().filter(|b| {
+            !b.converged && !b.failed_evaluation && b.position_residual_m < LAST_RESORT_MAX_M
+        }) {
+            let r = self.refine_with(
+                goal,
+                &b.q.clone(),
+                position_only,
+                self.settings.max_iterations * self.settings.final_iterations_factor,
+            );
+            total_iters += r.iterations;
+            if r.converged && branch_ok(&r.q) {
+                return self.solution(goal, r, total_iters, None);
+            }
+            consider(r, &mut best);
+        }
+        let reason = match &best {
+            None if seeds.any_out_of_limits => FailureReason::OutOfLimits,
+            None => FailureReason::Unreachable,
+            // Converged, but into another branch than the requested one: the
+            // target sits on a branch boundary (wrist, elbow or shoulder singularity).
+            Some(b) if b.converged => FailureReason::Singular,
+            Some(b) => {
+                if b.at_limit || (seeds.all_out_of_limits && !seeds.all_clamped) {
+                    FailureReason::OutOfLimits
+                } else if seeds.all_clamped && seeds.from_closed_form {
+                    FailureReason::Unreachable
+                } else if b.sigma_min < self.settings.singular_threshold {
+                    FailureReason::Singular
+                } else {
+                    FailureReason::DidNotConverge
+                }
+            }
+        };
+        match best {
+            Some(b) => self.solution(goal, b, total_iters, Some(reason)),
+            None => IkSolution {
+                converged: false,
+                q: Vec::new(),
+                position_residual_mm: f64::NAN,
+                orientation_residual_rad: f64::NAN,
+                iterations: 0,
+                branch: None,
+                reason: Some(reason),
+            },
+        }
+    }
+
+    pub(crate) fn solution(
+        &self,
+        goal: &Goal,
+        r: Refined,
+        iterations: usize,
+        reason: Option<FailureReason>,
+    ) -> IkSolution {
+        let orientation_residual_rad = if goal.rotation.is_some() {
+            r.orientation_residual_rad
+        } else {
+            f64::NAN
+        };
+        IkSolution {
+            converged: reason.is_none(),
+            branch: self.configuration(&r.q),
+            position_residual_mm: r.position_residual_m * 1e3,
+            orientation_residual_rad,
+            iterations,
+            q: r.q,
+            reason,
+        }
+    }
+
+    /// Ordered seeds for a goal in the base frame.
+    fn seeds(&self, goal: &Goal, options: &SolveOptions) -> Seeds {
+        let Some(analytic) = &self.analytic else {
+            return self.numeric_seeds(options);
+        };
+        let hint = options.seed.as_deref();
+        let reference: Vec<f64> = match hint {
+            Some(h) => h.to_vec(),
+            None => analytic.mid_range().to_vec(),
+        };
+        // Orientation for the closed form: the goal's, or the predicted one at the reference.
+        let rotation = goal.rotation.unwrap_or_else(|| {
+            self.model
+                .predict_base(&reference)
+                .map(|p| p.r)
+                .unwrap_or_else(|_| Matrix3::identity())
+        });
+        let target = Pose::new(rotation, goal.position);
+        let sols = analytic.solve_with_margin(&target, hint, self.settings.seed_reach_margin);
+        let mut cands: Vec<(AnalyticSolution, f64, f64)> = sols
+            .into_iter()
+            .filter(|s| options.branch.is_none_or(|b| b == s.configuration))
+            .map(|s| {
+                let violation = self.limit_violation(&s.q);
+                let dist: f64 =
+                    s.q.iter()
+                        .zip(&reference)
+                        .map(|(a, b)| (a - b).powi(2))
+                        .sum();
+                (s, violation, dist)
+            })
+            .collect();
+        let slack = self.settings.seed_limit_slack_rad;
+        cands.sort_by(|a, b| {
+            let ka = (a.1 > 0.0, a.0.clamped);
+            let kb = (b.1 > 0.0, b.0.clamped);
+            ka.cmp(&kb).then(a.2.total_cmp(&b.2))
+        });
+        let any_out_of_limits = cands.iter().any(|c| c.1 > slack);
+        let all_out_of_limits = !cands.is_empty() && cands.iter().all(|c| c.1 > slack);
+        let all_clamped = cands.iter().all(|c| c.0.clamped);
+        // In-limit branches first; slightly out-of-limit ones after them (the
+        // projected iteration may still find an in-limit calibrated solution).
+        let mut list: Vec<Seed> = cands
+            .iter()
+            .filter(|c| c.1 <= slack)
+            .map(|c| Seed {
+                q: c.0.q.clone(),
+                configuration: Some(c.0.configuration),
+            })
+            .collect();
+        // Position-only goals and targets without closed-form seeds also start
+        // from the joint seed itself.
+        if let Some(h) = hint {
+            if list.is_empty() || goal.rotation.is_none() || options.position_only {
+                let at = usize::from(!list.is_empty());
+                list.insert(
+                    at,
+                    Seed {
+                        q: self.clamp_to_limits(h),
+                        configuration: None,
+                    },
+                );
+            }
+        }
+        let mut max_attempts = self.settings.max_attempts;
+        if cands.is_empty() || goal.rotation.is_none() || options.position_only {
+            // Nothing from the closed form even with the margin (beyond the
+            // nominal reach, or a double singularity), or a position-only goal
+            // whose preferred orientation may be out of reach: multi-start on
+            // the calibrated model lets it have its say.
+            let extra = self.numeric_list(options, self.settings.numeric_fallback_starts);
+            max_attempts = list.len().min(self.settings.max_attempts) + extra.len();
+            list.truncate(self.settings.max_attempts);
+            list.extend(extra);
+        }
+        Seeds {
+            target,
+            list,
+            max_attempts,
+            any_out_of_limits,
+            all_out_of_limits,
+            all_clamped,
+            from_closed_form: true,
+        }
+    }
+
+    fn numeric_seeds(&self, options: &SolveOptions) -> Seeds {
+        let list = self.numeric_list(options, self.settings.numeric_starts);
+        Seeds {
+            target: Pose::identity(),
+            max_attempts: list.len(),
+            list,
+            any_out_of_limits: false,
+            all_out_of_limits: false,
+            all_clamped: false,
+            from_closed_form: false,
+        }
+    }
+
+    /// Multi-start seeds: the joint seed, the middle of the ranges, then
+    /// `count` Halton points within the limits (capped to ±π).
+    fn numeric_list(&self, options: &SolveOptions, count: usize) -> Vec<Seed> {
+        let n = self.model.dof();
+        let mut list = Vec::new();
+        if let Some(s) = &options.seed {
+            list.push(self.clamp_to_limits(s));
+        }
+        let span = |k: usize| {
+            let [lo, hi] = self.limits[k];
+            (lo.max(-std::f64::consts::PI), hi.min(std::f64::consts::PI))
+        };
+        list.push(
+            (0..n)
+                .map(|k| {
+                    let (lo, hi) = span(k);
+                    0.5 * (lo + hi)
+                })
+                .collect(),
+        );
+        const PRIMES: [usize; 8] = [2, 3, 5, 7, 11, 13, 17, 19];
+        for i in 1..=count {
+            list.push(
+                (0..n)
+                    .map(|k| {
+                        let (lo, hi) = span(k);
+                        lo + (hi - lo) * halton(i, PRIMES[k % PRIMES.len()])
+                    })
+                    .collect(),
+            );
+        }
+        list.into_iter()
+            .map(|q| Seed {
+                q,
+                configuration: None,
+            })
+            .collect()
+    }
+
+    fn limit_violation(&self, q: &[f64]) -> f64 {
+        q.iter()
+            .zip(&self.limits)
+            .map(|(v, l)| (l[0] - v).max(v - l[1]).max(0.0))
+            .fold(0.0, f64::max)
+    }
+
+    fn clamp_to_limits(&self, q: &[f64]) -> Vec<f64> {
+        q.iter()
+            .zip(&self.limits)
+            .map(|(v, l)| v.clamp(l[0], l[1]))
+            .collect()
+    }
+
+    /// Re-solves the closed form for the target moved by the calibrated
+    /// model's deviation at the seed, in the seed's branch (see
+    /// `IkSettings::seed_corrections`). Returns the seed and the evaluations used.
+    fn corrected_seed(
+        &self,
+        analytic: &AnalyticIk,
+        target: &Pose,
+        q0: &[f64],
+        configuration: Configuration,
+    ) -> (Vec<f64>, usize) {
+        let mut q = q0.to_vec();
+        let mut evaluations = 0;
+        for _ in 0..self.settings.seed_corrections {
+            let (Ok(p), Ok(n)) = (
+                self.model.predict_base(&q),
+                crate::kinematics::fk(&self.seed_model, &q),
+            ) else {
+                break;
+            };
+            evaluations += 1;
+            let moved = target.compose(&p.inverse()).compose(&n);
+            let best = analytic.solve_branch(
+                &moved,
+                configuration,
+                Some(&q),
+                self.settings.seed_reach_margin,
+            );
+            match best {
+                Some(s) => q = s.q,
+                None => break,
+            }
+        }
+        (q, evaluations)
+    }
+
+    /// Projects a trial joint value onto the limits, first trying the 2π
+    /// equivalent (revolute joints with a range of 2π or more).
+    fn project(x: f64, l: [f64; 2]) -> (f64, bool) {
+        let tau = std::f64::consts::TAU;
+        let x = if x < l[0] && x + tau <= l[1] {
+            x + tau
+        } else if x > l[1] && x - tau >= l[0] {
+            x - tau
+        } else {
+            x
+        };
+        (x.clamp(l[0], l[1]), x < l[0] || x > l[1])
+    }
+
+    fn evaluate(&self, q: &[f64]) -> Option<Eval> {
+        let (pose, jac) = self.model.predict_base_with_jacobian(q).ok()?;
+        Some(Eval { pose, jac })
+    }
+
+    /// Weighted error vector and the unweighted residual norms.
+    fn error(&self, goal: &Goal, pose: &Pose, position_only: bool) -> (DVector<f64>, f64, f64) {
+        let ep = goal.position - pose.p;
+        let er = goal
+            .rotation
+            .map(|r| rotation_log(&(r * pose.r.transpose())))
+            .unwrap_or_else(Vector3::zeros);
+        let e = if position_only {
+            DVector::from_column_slice(ep.as_slice())
+        } else {
+            let l = self.settings.orientation_length_m;
+            DVector::from_iterator(6, ep.iter().copied().chain(er.iter().map(|v| v * l)))
+        };
+        (e, ep.norm(), er.norm())
+    }
+
+    fn weighted_jacobian(&self, jac: &DMatrix<f64>, position_only: bool) -> DMatrix<f64> {
+        if position_only {
+            jac.rows(0, 3).into_owned()
+        } else {
+            let mut j = jac.clone();
+            let l = self.settings.orientation_length_m;
+            j.rows_mut(3, 3).scale_mut(l);
+            j
+        }
+    }
+
+    fn done(&self, pos: f64, rot: f64, position_only: bool) -> bool {
+        pos < self.settings.position_tolerance_m
+            && (position_only || rot < self.settings.orientation_tolerance_rad)
+    }
+
+    /// Damped Newton from `q0` (model convention, rad) towards a goal in the
+    /// base frame.
+    pub fn refine(&self, goal: &Goal, q0: &[f64], position_only: bool) -> Refined {
+        self.refine_with(goal, q0, position_only, self.settings.max_iterations)
+    }
+
+    /// [`IkSolver::refine`] with an explicit evaluation budget.
+    pub fn refine_with(
+        &self,
+        goal: &Goal,
+        q0: &[f64],
+        position_only: bool,
+        max_iterations: usize,
+    ) -> Refined {
+        let s = &self.settings;
+        let mut q = self.clamp_to_limits(q0);
+        let fail = |q: Vec<f64>, iterations| Refined {
+            q,
+            converged: false,
+            position_residual_m: f64::INFINITY,
+            orientation_residual_rad: f64::INFINITY,
+            iterations,
+            at_limit: false,
+            sigma_min: f64::NAN,
+            failed_evaluation: true,
+        };
+        let Some(mut ev) = self.evaluate(&q) else {
+            return fail(q, 1);
+        };
+        let (mut e, mut pos, mut rot) = self.error(goal, &ev.pose, position_only);
+        let mut cost = e.norm_squared();
+        // Damping μ = λ² [m²], updated from the gain ratio (Nielsen).
+        let mut mu = s.initial_damping * s.initial_damping;
+        let mut nu = 2.0;
+        let mut iterations = 1;
+        let mut at_limit = false;
+        let m = e.len();
+        while !self.done(pos, rot, position_only) && iterations < max_iterations {
+            let jw = self.weighted_jacobian(&ev.jac, position_only);
+            let mut a = &jw * jw.transpose();
+            for i in 0..m {
+                a[(i, i)] += mu;
+            }
+            let Some(chol) = a.cholesky() else {
+                mu = (mu * nu).max(1e-18);
+                nu *= 2.0;
+                iterations += 1;
+                continue;
+            };
+            let mut dq = jw.transpose() * chol.solve(&e);
+            let step = dq.amax();
+            if step > s.max_step_rad {
+                dq *= s.max_step_rad / step;
+            }
+            if !dq.iter().all(|v| v.is_finite()) {
+                break;
+            }
+            let mut clamped = false;
+            let trial: Vec<f64> = q
+                .iter()
+                .zip(dq.iter())
+                .zip(&self.limits)
+                .map(|((v, d), l)| {
+                    let (x, c) = Self::project(v + d, *l);
+                    clamped |= c;
+                    x
+                })
+                .collect();
+            iterations += 1;
+            at_limit = clamped;
+            let Some(ev_t) = self.evaluate(&trial) else {
+                mu = (mu * nu).max(1e-18);
+                nu *= 2.0;
+                continue;
+            };
+            let (e_t, pos_t, rot_t) = self.error(goal, &ev_t.pose, position_only);
+            let cost_t = e_t.norm_squared();
+            if cost_t < cost {
+                let jd = &jw * &dq;
+                let predicted = 2.0 * jd.dot(&e) - jd.norm_squared();
+                let rho = if predicted > 0.0 {
+                    (cost - cost_t) / predicted
+                } else {
+                    1.0
+                };
+                mu *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
+                mu = mu.max(1e-30);
+                nu = 2.0;
+                q = trial;
+                ev = ev_t;
+                e = e_t;
+                cost = cost_t;
+                pos = pos_t;
+                rot = rot_t;
+            } else {
+                mu = (mu * nu).max(1e-18);
+                nu *= 2.0;
+                if mu > 1e8 {
+                    break;
+                }
+            }
+        }
+        let converged = self.done(pos, rot, position_only);
+        let sigma_min = if converged {
+            f64::NAN
+        } else {
+            let jw = self.weighted_jacobian(&ev.jac, position_only);
+            jw.singular_values().min()
+        };
+        Refined {
+            q,
+            converged,
+            position_residual_m: pos,
+            orientation_residual_rad: rot,
+            iterations,
+            at_limit: at_limit && !converged,
+            sigma_min,
+            failed_evaluation: false,
+        }
+    }
+}
+
+struct Seed {
+    q: Vec<f64>,
+    /// Closed-form branch of the seed (enables the seed corrections).
+    configuration: Option<Configuration>,
+}
+
+struct Seeds {
+    /// The pose the closed form was solved for (base frame).
+    target: Pose,
+    list: Vec<Seed>,
+    /// How many of `list` to try.
+    max_attempts: usize,
+    any_out_of_limits: bool,
+    all_out_of_limits: bool,
+    all_clamped: bool,
+    from_closed_form: bool,
+}
