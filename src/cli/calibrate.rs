@@ -138,18 +138,19 @@ fn save_model(
         }
         None => report.best_method().context("no method ran")?,
     };
-    // The calibrated model file read by `robocal solve` (format robocal-calibrated-model/1).
-    let file = serde_json::json!({
-        "format": "robocal-calibrated-model/1",
-        "robot": nominal.name,
-        "method": chosen.method.name(),
-        "model": crate::model::ModelDescription::from_model(&chosen.calibrated),
-        "nominal": crate::model::ModelDescription::from_model(nominal),
-        "cell_from_base": crate::identify::calibrate::PoseMmDeg::from_pose(&report.tracker_to_base.inverse()),
-        "payload_kg": payload,
-    });
-    std::fs::write(path, serde_json::to_string_pretty(&file)?)
-        .with_context(|| format!("cannot write {path}"))?;
+    let model = crate::compensate::CompensatedModel {
+        calibrated: chosen.calibrated.clone(),
+        nominal: nominal.clone(),
+        cell_from_base: report.tracker_to_base.inverse(),
+        payload_kg: payload,
+        compensator: None,
+    };
+    let file = crate::compensate::CalibratedModelFile::from_compensated(
+        &model,
+        &nominal.name,
+        chosen.method.name(),
+    );
+    file.save(std::path::Path::new(path))?;
     eprintln!("saved the {} model to {path}", chosen.method.name());
     Ok(())
 }

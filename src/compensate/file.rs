@@ -21,51 +21,13 @@
 //! A learned compensator is not stored in this version of the format.
 
 use super::{CompensateError, CompensatedModel};
-use crate::model::description::matrix_to_rpy;
-use crate::model::pose::rpy_matrix;
-use crate::model::{preset, ModelDescription, Pose, RobotModel};
-use nalgebra::Vector3;
+use crate::model::{preset, ModelDescription, RobotModel};
 use serde::{Deserialize, Serialize};
 
 /// The `format` value of a calibrated model file.
 pub const CALIBRATED_MODEL_FORMAT: &str = "robocal-calibrated-model/1";
 
-/// A rigid transform in boundary units: translation [mm] and fixed-axis XYZ
-/// angles `[rx, ry, rz]` [deg], `R = Rz(rz)·Ry(ry)·Rx(rx)`.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PoseDescription {
-    pub xyz_mm: [f64; 3],
-    pub rpy_deg: [f64; 3],
-}
-
-impl PoseDescription {
-    pub fn from_pose(p: &Pose) -> Self {
-        PoseDescription {
-            xyz_mm: [p.p.x * 1e3, p.p.y * 1e3, p.p.z * 1e3],
-            rpy_deg: matrix_to_rpy(&p.r).map(f64::to_degrees),
-        }
-    }
-
-    /// The SI pose; every value must be finite.
-    pub fn to_pose(&self) -> Result<Pose, CompensateError> {
-        if self
-            .xyz_mm
-            .iter()
-            .chain(&self.rpy_deg)
-            .any(|v| !v.is_finite())
-        {
-            return Err(CompensateError::Format(
-                "cell_from_base values must be finite numbers".into(),
-            ));
-        }
-        let [rx, ry, rz] = self.rpy_deg.map(f64::to_radians);
-        Ok(Pose::new(
-            rpy_matrix(rx, ry, rz),
-            Vector3::from(self.xyz_mm) * 1e-3,
-        ))
-    }
-}
+pub use crate::model::description::PoseDescription;
 
 /// The on-disk calibrated model (see module docs).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -127,7 +89,9 @@ impl CalibratedModelFile {
         Ok(CompensatedModel {
             calibrated,
             nominal,
-            cell_from_base: self.cell_from_base.to_pose()?,
+            cell_from_base: self.cell_from_base.to_pose().ok_or_else(|| {
+                CompensateError::Format("cell_from_base values must be finite numbers".into())
+            })?,
             payload_kg: self.payload_kg,
             compensator: None,
         })

@@ -22,7 +22,7 @@ use super::stats::ErrorStats;
 use super::tlbo::{self, TlboSettings};
 use crate::kinematics::{chain, deflected_joints, fk, gravity_torques_of, KinematicsError};
 use crate::measure::Measurement;
-use crate::model::description::matrix_to_rpy;
+use crate::model::description::PoseDescription;
 use crate::model::params::ParamUnit;
 use crate::model::pose::Pose;
 use crate::model::{ModelDescription, ParamId, ParamKind, ParamLayout, RobotModel};
@@ -233,38 +233,12 @@ pub struct MethodReport {
     pub calibrated: RobotModel,
 }
 
-/// A pose in mm/deg (`R = Rz·Ry·Rx` of `rpy_deg`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct PoseMmDeg {
-    pub xyz_mm: [f64; 3],
-    pub rpy_deg: [f64; 3],
-}
-
-impl PoseMmDeg {
-    pub fn from_pose(p: &Pose) -> Self {
-        PoseMmDeg {
-            xyz_mm: [p.p.x * 1e3, p.p.y * 1e3, p.p.z * 1e3],
-            rpy_deg: matrix_to_rpy(&p.r).map(f64::to_degrees),
-        }
-    }
-    pub fn to_pose(&self) -> Pose {
-        Pose::new(
-            crate::model::pose::rpy_matrix(
-                self.rpy_deg[0].to_radians(),
-                self.rpy_deg[1].to_radians(),
-                self.rpy_deg[2].to_radians(),
-            ),
-            Vector3::new(self.xyz_mm[0], self.xyz_mm[1], self.xyz_mm[2]) * 1e-3,
-        )
-    }
-}
-
 /// Registration of each measurement session.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SessionRegistration {
     pub session: usize,
     /// Tracker → registered base frame (`x_base = R·x_tracker + t`).
-    pub tracker_to_base: PoseMmDeg,
+    pub tracker_to_base: PoseDescription,
     /// RMS distance of the nominal model after the registration [mm].
     pub rms_mm: f64,
 }
@@ -543,7 +517,7 @@ pub fn calibrate(
             *reg = r.tracker_to_base;
             reg_reports.push(SessionRegistration {
                 session: s,
-                tracker_to_base: PoseMmDeg::from_pose(&r.tracker_to_base),
+                tracker_to_base: PoseDescription::from_pose(&r.tracker_to_base),
                 rms_mm: r.rms * 1e3,
             });
         }

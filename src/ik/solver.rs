@@ -579,11 +579,17 @@ impl IkSolver {
                 configuration: Some(c.0.configuration),
             })
             .collect();
+        let in_limit_seeds = list.len();
+        // Then the out-of-limit branches, clamped into the limits.
+        list.extend(cands.iter().filter(|c| c.1 > slack).map(|c| Seed {
+            q: self.clamp_to_limits(&c.0.q),
+            configuration: None,
+        }));
         // Position-only goals and targets without closed-form seeds also start
         // from the joint seed itself.
         if let Some(h) = hint {
-            if list.is_empty() || goal.rotation.is_none() || options.position_only {
-                let at = usize::from(!list.is_empty());
+            if in_limit_seeds == 0 || goal.rotation.is_none() || options.position_only {
+                let at = usize::from(in_limit_seeds > 0);
                 list.insert(
                     at,
                     Seed {
@@ -594,9 +600,9 @@ impl IkSolver {
             }
         }
         let mut max_attempts = self.settings.max_attempts;
-        if cands.is_empty() || goal.rotation.is_none() || options.position_only {
-            // Nothing from the closed form even with the margin (beyond the
-            // nominal reach, or a double singularity), or a position-only goal
+        if in_limit_seeds == 0 || goal.rotation.is_none() || options.position_only {
+            // No in-limit closed-form seed (beyond the nominal reach, a branch the
+            // nominal model cannot assemble, a double singularity), or a position-only goal
             // whose preferred orientation may be out of reach: multi-start on
             // the calibrated model lets it have its say.
             let extra = self.numeric_list(options, self.settings.numeric_fallback_starts);

@@ -798,8 +798,8 @@ mod tests {
         );
     }
 
-    /// The real UR5/WAM laser-tracker files (shared/data). Skipped, with a note,
-    /// when the data directory is not next to the checkout.
+    /// The real UR5/WAM laser-tracker files (shared/data beside the checkout, or
+    /// `ROBOCAL_DATA_DIR`).
     #[test]
     fn real_ur5_wam_files_parse() {
         let dir = std::env::var("ROBOCAL_DATA_DIR")
@@ -808,10 +808,11 @@ mod tests {
                 std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
                     .join("../shared/data/ur5-wam-laser-tracker")
             });
-        if !dir.exists() {
-            eprintln!("skipping: {} not found", dir.display());
-            return;
-        }
+        assert!(
+            dir.exists(),
+            "real data not found at {} (set ROBOCAL_DATA_DIR)",
+            dir.display()
+        );
         for (file, n, dof) in [
             ("UR5/3D_UR5_uncalibrated_grid_cleaned.csv", 1000, 6),
             ("UR5/3D_UR5_uncalibrated_random_cleaned.csv", 20, 6),

@@ -424,6 +424,41 @@ impl ModelDescription {
     }
 }
 
+/// A rigid transform in boundary units: translation [mm] and fixed-axis XYZ
+/// angles `[rx, ry, rz]` [deg], `R = Rz(rz)·Ry(ry)·Rx(rx)`.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PoseDescription {
+    pub xyz_mm: [f64; 3],
+    pub rpy_deg: [f64; 3],
+}
+
+impl PoseDescription {
+    pub fn from_pose(p: &Pose) -> Self {
+        PoseDescription {
+            xyz_mm: [p.p.x / MM, p.p.y / MM, p.p.z / MM],
+            rpy_deg: matrix_to_rpy(&p.r).map(f64::to_degrees),
+        }
+    }
+
+    /// The SI pose, or `None` when a value is not finite.
+    pub fn to_pose(&self) -> Option<Pose> {
+        if self
+            .xyz_mm
+            .iter()
+            .chain(&self.rpy_deg)
+            .any(|v| !v.is_finite())
+        {
+            return None;
+        }
+        let [rx, ry, rz] = self.rpy_deg.map(f64::to_radians);
+        Some(Pose::new(
+            rpy_matrix(rx, ry, rz),
+            Vector3::from(self.xyz_mm) * MM,
+        ))
+    }
+}
+
 /// Fixed-axis XYZ angles `[rx, ry, rz]` with `R = Rz·Ry·Rx` (rad).
 pub fn matrix_to_rpy(r: &Matrix3<f64>) -> [f64; 3] {
     let ry = (-r[(2, 0)]).clamp(-1.0, 1.0).asin();
