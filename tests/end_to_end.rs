@@ -5,7 +5,7 @@
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal::compensate::CompensatedModel;
-use robocal::identify::pose_selection::select_d_optimal;
+use robocal::identify::pose_selection::choose_d_optimal;
 use robocal::identify::{calibrate, CalibrationOptions, Method};
 use robocal::ik::{IkSettings, IkSolver, SolveOptions};
 use robocal::measure;
@@ -24,10 +24,7 @@ fn solved_commands_reach_the_targets_on_the_true_robot() {
 
     // Measure, calibrate (SKCM).
     let candidates = random_configurations(&nominal, 500, &mut rng);
-    let q_id: Vec<Vec<f64>> = select_d_optimal(&nominal, &candidates, 30, payload, true)
-        .into_iter()
-        .map(|i| candidates[i].clone())
-        .collect();
+    let q_id = choose_d_optimal(&nominal, &candidates, 30, payload, true);
     let q_va = random_configurations(&nominal, 45, &mut rng);
     let id = measure::to_measurements(
         &nominal,

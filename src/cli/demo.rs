@@ -6,7 +6,7 @@
 //! with the 110 kg payload; KM, SKCM and SKCM-C by TLBO are compared as in
 //! Table 7.5 and the identified stiffness is printed next to the truth.
 
-use crate::identify::pose_selection::select_d_optimal;
+use crate::identify::pose_selection::choose_d_optimal;
 use crate::identify::{calibrate, CalibrationOptions, CalibrationReport, Method};
 use crate::measure;
 use crate::model::{preset, RobotModel};
@@ -49,10 +49,7 @@ pub fn ys100_simulation(
     // 30 identification poses chosen for D-optimality among 500 random ones that
     // cover the workspace; 45 validation poses drawn at random.
     let candidates = random_configurations(&nominal, 500, &mut rng);
-    let q_id: Vec<Vec<f64>> = select_d_optimal(&nominal, &candidates, 30, payload, true)
-        .into_iter()
-        .map(|i| candidates[i].clone())
-        .collect();
+    let q_id = choose_d_optimal(&nominal, &candidates, 30, payload, true);
     let q_va = random_configurations(&nominal, 45, &mut rng);
     let rows_id = truth.measure(&q_id, Some(payload), None, &mut rng)?;
     let rows_va = truth.measure(&q_va, Some(payload), None, &mut rng)?;

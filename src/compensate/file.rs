@@ -154,6 +154,7 @@ pub fn load_compensated(arg: &str) -> Result<CompensatedModel, CompensateError> 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::Pose;
 
     #[test]
     fn file_round_trip_keeps_model_frame_and_payload() {

@@ -94,3 +94,17 @@ pub fn select_d_optimal(
     }
     chosen
 }
+
+/// The `n` D-optimal configurations themselves (see [`select_d_optimal`]).
+pub fn choose_d_optimal(
+    model: &RobotModel,
+    candidates: &[Vec<f64>],
+    n: usize,
+    payload_kg: f64,
+    with_compliance: bool,
+) -> Vec<Vec<f64>> {
+    select_d_optimal(model, candidates, n, payload_kg, with_compliance)
+        .into_iter()
+        .map(|i| candidates[i].clone())
+        .collect()
+}
