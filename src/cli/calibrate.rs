@@ -116,7 +116,7 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
-        print!("{}", render_report(&model, &report));
+        print!("{}", render_report(&report));
     }
     Ok(())
 }
@@ -165,7 +165,7 @@ fn method_label(name: &str) -> &str {
 }
 
 /// The text report: accuracy table, identifiability, parameters, stiffness.
-pub fn render_report(nominal: &RobotModel, r: &CalibrationReport) -> String {
+pub fn render_report(r: &CalibrationReport) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -299,6 +299,5 @@ pub fn render_report(nominal: &RobotModel, r: &CalibrationReport) -> String {
             m.solver.reason
         );
     }
-    let _ = nominal;
     s
 }

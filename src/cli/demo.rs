@@ -142,9 +142,6 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
         }
     }
     println!();
-    print!(
-        "{}",
-        crate::cli::calibrate::render_report(&study.nominal, r)
-    );
+    print!("{}", crate::cli::calibrate::render_report(r));
     Ok(())
 }

@@ -39,6 +39,20 @@ pub struct TlboResult {
     pub evaluations: usize,
 }
 
+/// Greedy acceptance of both phases: `x` replaces the learner when it costs less.
+fn accept_if_better(
+    cost: &mut dyn FnMut(&[f64]) -> f64,
+    x: Vec<f64>,
+    learner: &mut Vec<f64>,
+    fitness: &mut f64,
+) {
+    let f = cost(&x);
+    if f < *fitness {
+        *learner = x;
+        *fitness = f;
+    }
+}
+
 /// Minimises `cost` over the box `[lo, hi]`. `progress(generation, best)` returns
 /// false to stop early; the best so far is returned.
 pub fn minimise(
@@ -81,12 +95,8 @@ pub fn minimise(
                 .map(|i| pop[k][i] + rng.gen::<f64>() * (teacher[i] - tf * mean[i]))
                 .collect();
             clamp(&mut x);
-            let f = cost(&x);
             evaluations += 1;
-            if f < fit[k] {
-                pop[k] = x;
-                fit[k] = f;
-            }
+            accept_if_better(cost, x, &mut pop[k], &mut fit[k]);
         }
         // Learner phase (eq. 7.12).
         for k in 0..np {
@@ -106,12 +116,8 @@ pub fn minimise(
                 })
                 .collect();
             clamp(&mut x);
-            let f = cost(&x);
             evaluations += 1;
-            if f < fit[k] {
-                pop[k] = x;
-                fit[k] = f;
-            }
+            accept_if_better(cost, x, &mut pop[k], &mut fit[k]);
         }
         let b = best_of(&fit);
         history.push(fit[b]);

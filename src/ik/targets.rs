@@ -204,12 +204,7 @@ impl IkSolver {
         targets: &[TargetInput],
         options: &super::SolveOptions,
     ) -> Vec<TargetResult> {
-        let parsed: Vec<Result<(Goal, Option<OrientationConvention>), String>> =
-            targets.iter().map(TargetInput::to_goal).collect();
-        let goals: Vec<Result<Goal, String>> = parsed
-            .iter()
-            .map(|p| p.as_ref().map(|(g, _)| *g).map_err(Clone::clone))
-            .collect();
+        let (parsed, goals) = parse_targets(targets);
         let sols = self.solve_batch_checked(&goals, options);
         sols.into_iter()
             .enumerate()
@@ -226,12 +221,7 @@ impl IkSolver {
         targets: &[TargetInput],
         options: &super::SolveOptions,
     ) -> Vec<TargetResult> {
-        let parsed: Vec<Result<(Goal, Option<OrientationConvention>), String>> =
-            targets.iter().map(TargetInput::to_goal).collect();
-        let goals: Vec<Result<Goal, String>> = parsed
-            .iter()
-            .map(|p| p.as_ref().map(|(g, _)| *g).map_err(Clone::clone))
-            .collect();
+        let (parsed, goals) = parse_targets(targets);
         let steps = self.solve_path_checked(&goals, options);
         steps
             .into_iter()
@@ -242,4 +232,16 @@ impl IkSolver {
             })
             .collect()
     }
+}
+
+type ParsedTarget = Result<(Goal, Option<OrientationConvention>), String>;
+
+/// Parses boundary targets into goals (keeping each target's convention).
+fn parse_targets(targets: &[TargetInput]) -> (Vec<ParsedTarget>, Vec<Result<Goal, String>>) {
+    let parsed: Vec<ParsedTarget> = targets.iter().map(TargetInput::to_goal).collect();
+    let goals = parsed
+        .iter()
+        .map(|p| p.as_ref().map(|(g, _)| *g).map_err(Clone::clone))
+        .collect();
+    (parsed, goals)
 }
