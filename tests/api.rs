@@ -168,6 +168,7 @@ async fn setup_with(keys: &[&str], workers: usize) -> TestApp {
             workers,
             solve_workers: 2,
             progress_interval: Duration::from_millis(20),
+            ..ServiceConfig::default()
         },
     );
     TestApp {
@@ -839,7 +840,7 @@ async fn job_progress_and_cancellation() {
         .post_json(
             "/v1/robots/{id}/calibrations",
             &[&rid],
-            json!({ "methods": ["skcm-tlbo"], "generations": 1000000, "population": 20 }),
+            json!({ "methods": ["skcm-tlbo"], "generations": 10000, "population": 20 }),
         )
         .await;
     assert_eq!(r.status, StatusCode::ACCEPTED, "{}", r.text());
@@ -1030,7 +1031,7 @@ async fn bad_input_gives_problem_json() {
     )
     .await;
     assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY);
-    assert!(r.detail().contains("known presets"), "{}", r.detail());
+    assert!(r.detail().contains("the presets are"), "{}", r.detail());
     // Invalid model JSON: the field is named.
     let r = post("/v1/robots", vec![], "application/json",
         r#"{"model": {"joints": [{"alpha_deg": 0, "a_mm": 0, "d_mm": 1, "limits_deg": [90, -90]}, {"alpha_deg": 90, "a_mm": 1, "d_mm": 0}]}}"#).await;

@@ -26,7 +26,13 @@ struct Server {
 impl Server {
     fn start(db: &Path) -> Server {
         let mut child = Command::new(env!("CARGO_BIN_EXE_robocal"))
-            .args(["serve", "--bind", "127.0.0.1:0"])
+            .args([
+                "serve",
+                "--bind",
+                "127.0.0.1:0",
+                "--max-tlbo-evaluations",
+                "100000000",
+            ])
             .env(
                 "DATABASE_URL",
                 format!("sqlite://{}?mode=rwc", db.display()),

@@ -8,6 +8,10 @@
 //! - `ROBOCAL_API_KEYS`: comma-separated bearer keys for writes (none: writes
 //!   are open; reads are always open);
 //! - `--workers N` / `ROBOCAL_WORKERS`: calibration jobs run at once, default 1;
+//! - limits and queues (`--max-queued-jobs`, `--max-queued-solves`,
+//!   `--body-limit`, `--metadata-limit`, `--max-poses-per-set`,
+//!   `--max-targets`, `--max-tlbo-evaluations`, `--job-time-limit`,
+//!   `--page-max`, each with a `ROBOCAL_…` variable; see [`crate::http::limits`]);
 //! - `RUST_LOG`: log filter, default `info`.
 //!
 //! Start-up: open the database, apply the migrations, mark jobs that a previous
@@ -15,7 +19,7 @@
 //! serve until SIGINT/SIGTERM.
 
 use crate::db::{Db, DEFAULT_DATABASE_URL};
-use crate::http::{app, AppState, ServiceConfig};
+use crate::http::{app, AppState, Limits, ServiceConfig, ServiceListener};
 use anyhow::Context;
 use clap::Args;
 use std::net::SocketAddr;
@@ -31,9 +35,65 @@ pub struct ServeArgs {
     /// Calibration jobs that run at the same time.
     #[arg(long, env = "ROBOCAL_WORKERS", default_value_t = 1)]
     pub workers: usize,
-    /// Solve batches (above 16 targets) that run at the same time.
+    /// Solve batches (above 64 targets) that run at the same time.
     #[arg(long, env = "ROBOCAL_SOLVE_WORKERS", default_value_t = 2)]
     pub solve_workers: usize,
+    /// Calibration jobs that may wait for a worker; more get 429 + Retry-After.
+    #[arg(long, env = "ROBOCAL_MAX_QUEUED_JOBS", default_value_t = Limits::default().queued_jobs)]
+    pub max_queued_jobs: usize,
+    /// Large solve batches that may wait for a solve worker; more get 429 + Retry-After.
+    #[arg(long, env = "ROBOCAL_MAX_QUEUED_SOLVES", default_value_t = Limits::default().queued_solves)]
+    pub max_queued_solves: usize,
+    /// Largest request body in bytes (413 above).
+    #[arg(long, env = "ROBOCAL_BODY_LIMIT", default_value_t = Limits::default().body_bytes)]
+    pub body_limit: usize,
+    /// Largest robot `metadata` object in bytes, as JSON (422 above).
+    #[arg(long, env = "ROBOCAL_METADATA_LIMIT", default_value_t = Limits::default().metadata_bytes)]
+    pub metadata_limit: usize,
+    /// Most rows in one measurement set (422 above).
+    #[arg(long, env = "ROBOCAL_MAX_POSES_PER_SET", default_value_t = Limits::default().poses_per_set)]
+    pub max_poses_per_set: usize,
+    /// Most targets in one solve request (422 above).
+    #[arg(long, env = "ROBOCAL_MAX_TARGETS", default_value_t = Limits::default().targets_per_request)]
+    pub max_targets: usize,
+    /// Largest TLBO population × generations of one job (422 above).
+    #[arg(long, env = "ROBOCAL_MAX_TLBO_EVALUATIONS", default_value_t = Limits::default().tlbo_evaluations)]
+    pub max_tlbo_evaluations: u64,
+    /// Wall-clock budget of one calibration job in seconds; the job fails when it runs longer.
+    #[arg(long, env = "ROBOCAL_JOB_TIME_LIMIT", default_value_t = Limits::default().job_time.as_secs())]
+    pub job_time_limit: u64,
+    /// Largest page of a list (`limit`).
+    #[arg(long, env = "ROBOCAL_PAGE_MAX", default_value_t = Limits::default().page_max)]
+    pub page_max: usize,
+}
+
+impl ServeArgs {
+    /// The limits these flags set.
+    pub fn limits(&self) -> anyhow::Result<Limits> {
+        let positive = [
+            ("--body-limit", self.body_limit as u64),
+            ("--metadata-limit", self.metadata_limit as u64),
+            ("--max-poses-per-set", self.max_poses_per_set as u64),
+            ("--max-targets", self.max_targets as u64),
+            ("--max-tlbo-evaluations", self.max_tlbo_evaluations),
+            ("--job-time-limit", self.job_time_limit),
+            ("--page-max", self.page_max as u64),
+        ];
+        if let Some((flag, _)) = positive.iter().find(|(_, v)| *v == 0) {
+            anyhow::bail!("{flag} must be at least 1");
+        }
+        Ok(Limits {
+            body_bytes: self.body_limit,
+            metadata_bytes: self.metadata_limit,
+            poses_per_set: self.max_poses_per_set,
+            targets_per_request: self.max_targets,
+            queued_jobs: self.max_queued_jobs,
+            tlbo_evaluations: self.max_tlbo_evaluations,
+            job_time: std::time::Duration::from_secs(self.job_time_limit),
+            queued_solves: self.max_queued_solves,
+            page_max: self.page_max,
+        })
+    }
 }
 
 /// Reads `ROBOCAL_API_KEYS` (comma-separated; blanks ignored).
@@ -63,6 +123,7 @@ pub fn run(args: ServeArgs) -> anyhow::Result<()> {
     if args.workers == 0 {
         anyhow::bail!("--workers must be at least 1");
     }
+    args.limits()?;
     let addr: SocketAddr = args.bind.parse().with_context(|| {
         format!(
             "--bind {}: expected HOST:PORT, e.g. 127.0.0.1:8080",
@@ -94,6 +155,7 @@ async fn serve(addr: SocketAddr, args: ServeArgs) -> anyhow::Result<()> {
         api_keys: keys.clone(),
         workers: args.workers,
         solve_workers: args.solve_workers.max(1),
+        limits: args.limits()?,
         ..ServiceConfig::default()
     };
     let state = AppState::new(db, config);
@@ -112,7 +174,7 @@ async fn serve(addr: SocketAddr, args: ServeArgs) -> anyhow::Result<()> {
             format!("on: {} key(s)", keys.len())
         }
     );
-    axum::serve(listener, app(state))
+    axum::serve(ServiceListener::new(listener), app(state))
         .with_graceful_shutdown(shutdown())
         .await
         .context("server error")?;

@@ -5,7 +5,10 @@
 //!   survives a crash of the process and of the machine), foreign keys on,
 //!   a busy timeout so concurrent writers wait instead of failing.
 //! - Every write runs in one `BEGIN IMMEDIATE` transaction: a crash at any point
-//!   leaves either all of it or none of it.
+//!   leaves either all of it or none of it. A write that belongs to a robot
+//!   checks inside its transaction that the robot still exists (and returns
+//!   `None` when not), so a concurrent delete gives a clean "not found", never
+//!   a foreign-key failure.
 //! - Schema: `migrations/` (numbered, commented), applied at start-up by
 //!   [`Db::connect`].
 //! - JSON columns hold boundary units (mm/deg) exactly as the API returns them.
@@ -124,10 +127,25 @@ impl Db {
             .ok_or_else(|| DbError::Protocol("inserted robot vanished".into()))
     }
 
-    pub async fn robots(&self) -> Result<Vec<RobotRow>, DbError> {
-        sqlx::query_as::<_, RobotRow>(&format!("{ROBOT_SELECT} ORDER BY r.id"))
-            .fetch_all(&self.pool)
-            .await
+    /// One page of robots by id, and how many there are.
+    pub async fn robots_page(
+        &self,
+        limit: i64,
+        offset: i64,
+    ) -> Result<(Vec<RobotRow>, i64), DbError> {
+        let mut tx = self.pool.begin().await?;
+        let rows = sqlx::query_as::<_, RobotRow>(&format!(
+            "{ROBOT_SELECT} ORDER BY r.id LIMIT ? OFFSET ?"
+        ))
+        .bind(limit)
+        .bind(offset)
+        .fetch_all(&mut *tx)
+        .await?;
+        let total = sqlx::query_scalar("SELECT COUNT(*) FROM robots")
+            .fetch_one(&mut *tx)
+            .await?;
+        tx.commit().await?;
+        Ok((rows, total))
     }
 
     pub async fn robot(&self, id: i64) -> Result<Option<RobotRow>, DbError> {
@@ -176,8 +194,13 @@ impl Db {
 
     // ------------------------------------------------------- measurement sets
 
-    pub async fn insert_set(&self, s: &NewSet<'_>) -> Result<SetRow, DbError> {
+    /// Stores a set; `None` when its robot does not exist (any more).
+    pub async fn insert_set(&self, s: &NewSet<'_>) -> Result<Option<SetRow>, DbError> {
         let mut tx = self.write().await?;
+        if !robot_exists_in(&mut tx, s.robot_id).await? {
+            tx.rollback().await?;
+            return Ok(None);
+        }
         let id: i64 = sqlx::query_scalar(
             "INSERT INTO measurement_sets (robot_id, name, role, session, payload_kg, length_unit, \
              angle_unit, format, original, rows_json, row_count, dof) \
@@ -197,10 +220,36 @@ impl Db {
         .bind(s.dof)
         .fetch_one(&mut *tx)
         .await?;
+        let row = sqlx::query_as::<_, SetRow>(&format!("{SET_SELECT} WHERE id = ?"))
+            .bind(id)
+            .fetch_one(&mut *tx)
+            .await?;
         tx.commit().await?;
-        self.set(s.robot_id, id)
-            .await?
-            .ok_or_else(|| DbError::Protocol("inserted measurement set vanished".into()))
+        Ok(Some(row))
+    }
+
+    /// One page of a robot's sets by id, and how many it has.
+    pub async fn sets_page(
+        &self,
+        robot_id: i64,
+        limit: i64,
+        offset: i64,
+    ) -> Result<(Vec<SetRow>, i64), DbError> {
+        let mut tx = self.pool.begin().await?;
+        let rows = sqlx::query_as::<_, SetRow>(&format!(
+            "{SET_SELECT} WHERE robot_id = ? ORDER BY id LIMIT ? OFFSET ?"
+        ))
+        .bind(robot_id)
+        .bind(limit)
+        .bind(offset)
+        .fetch_all(&mut *tx)
+        .await?;
+        let total = sqlx::query_scalar("SELECT COUNT(*) FROM measurement_sets WHERE robot_id = ?")
+            .bind(robot_id)
+            .fetch_one(&mut *tx)
+            .await?;
+        tx.commit().await?;
+        Ok((rows, total))
     }
 
     pub async fn sets(&self, robot_id: i64) -> Result<Vec<SetRow>, DbError> {
@@ -257,11 +306,16 @@ impl Db {
 
     // ----------------------------------------------------------- calibrations
 
+    /// Queues a calibration; `None` when its robot does not exist (any more).
     pub async fn insert_calibration(
         &self,
         c: &NewCalibration<'_>,
-    ) -> Result<CalibrationRow, DbError> {
+    ) -> Result<Option<CalibrationRow>, DbError> {
         let mut tx = self.write().await?;
+        if !robot_exists_in(&mut tx, c.robot_id).await? {
+            tx.rollback().await?;
+            return Ok(None);
+        }
         let id: i64 = sqlx::query_scalar(
             "INSERT INTO calibrations (robot_id, status, methods, identification_set_ids, \
              validation_set_ids, options) VALUES (?, 'queued', ?, ?, ?, ?) RETURNING id",
@@ -273,10 +327,36 @@ impl Db {
         .bind(c.options)
         .fetch_one(&mut *tx)
         .await?;
+        let row = sqlx::query_as::<_, CalibrationRow>(&format!("{CAL_SELECT} WHERE id = ?"))
+            .bind(id)
+            .fetch_one(&mut *tx)
+            .await?;
         tx.commit().await?;
-        self.calibration(c.robot_id, id)
-            .await?
-            .ok_or_else(|| DbError::Protocol("inserted calibration vanished".into()))
+        Ok(Some(row))
+    }
+
+    /// One page of a robot's calibrations by id, and how many it has.
+    pub async fn calibrations_page(
+        &self,
+        robot_id: i64,
+        limit: i64,
+        offset: i64,
+    ) -> Result<(Vec<CalibrationRow>, i64), DbError> {
+        let mut tx = self.pool.begin().await?;
+        let rows = sqlx::query_as::<_, CalibrationRow>(&format!(
+            "{CAL_SELECT} WHERE robot_id = ? ORDER BY id LIMIT ? OFFSET ?"
+        ))
+        .bind(robot_id)
+        .bind(limit)
+        .bind(offset)
+        .fetch_all(&mut *tx)
+        .await?;
+        let total = sqlx::query_scalar("SELECT COUNT(*) FROM calibrations WHERE robot_id = ?")
+            .bind(robot_id)
+            .fetch_one(&mut *tx)
+            .await?;
+        tx.commit().await?;
+        Ok((rows, total))
     }
 
     pub async fn calibrations(&self, robot_id: i64) -> Result<Vec<CalibrationRow>, DbError> {
@@ -472,6 +552,30 @@ impl Db {
 
     // --------------------------------------------------------- model versions
 
+    /// One page of a robot's versions by number, and how many it has.
+    pub async fn versions_page(
+        &self,
+        robot_id: i64,
+        limit: i64,
+        offset: i64,
+    ) -> Result<(Vec<VersionRow>, i64), DbError> {
+        let mut tx = self.pool.begin().await?;
+        let rows = sqlx::query_as::<_, VersionRow>(&format!(
+            "{VERSION_SELECT} WHERE robot_id = ? ORDER BY version LIMIT ? OFFSET ?"
+        ))
+        .bind(robot_id)
+        .bind(limit)
+        .bind(offset)
+        .fetch_all(&mut *tx)
+        .await?;
+        let total = sqlx::query_scalar("SELECT COUNT(*) FROM model_versions WHERE robot_id = ?")
+            .bind(robot_id)
+            .fetch_one(&mut *tx)
+            .await?;
+        tx.commit().await?;
+        Ok((rows, total))
+    }
+
     pub async fn versions(&self, robot_id: i64) -> Result<Vec<VersionRow>, DbError> {
         sqlx::query_as::<_, VersionRow>(&format!(
             "{VERSION_SELECT} WHERE robot_id = ? ORDER BY version"
@@ -568,6 +672,16 @@ impl Db {
             None => Rollback::NothingToRollBack,
         })
     }
+}
+
+async fn robot_exists_in(
+    tx: &mut Transaction<'static, Sqlite>,
+    robot_id: i64,
+) -> Result<bool, DbError> {
+    sqlx::query_scalar("SELECT EXISTS (SELECT 1 FROM robots WHERE id = ?)")
+        .bind(robot_id)
+        .fetch_one(&mut **tx)
+        .await
 }
 
 /// Outcome of [`Db::rollback`].

@@ -13,9 +13,10 @@
 //! when the robot has no active version yet: a recalibration never changes
 //! what the cell uses without an explicit `activate`.
 
+use super::input::{check_payload, page_fields, present, PageQuery};
 use super::robots::robot_not_found;
 use super::sets::MAX_SETS;
-use super::{ApiError, ApiJson, ApiPath, AppState};
+use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState, Ticket};
 use crate::compensate::{CalibratedModelFile, CompensatedModel};
 use crate::db::{CalibrationRow, NewCalibration, NewVersion};
 use crate::identify::{
@@ -28,7 +29,8 @@ use axum::http::{header, StatusCode};
 use axum::response::{Html, IntoResponse, Response};
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
-use std::sync::atomic::Ordering;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::Duration;
 use tokio::sync::watch;
 
@@ -46,31 +48,63 @@ fn calibration_not_found(robot: i64, id: i64) -> ApiError {
 #[serde(deny_unknown_fields)]
 pub struct StartCalibration {
     /// Methods to run and compare: km, skcm, skcm-tlbo. Default km, skcm.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        deserialize_with = "present",
+        skip_serializing_if = "Option::is_none"
+    )]
     pub methods: Option<Vec<String>>,
     /// Sets that identify the model (default: every set with role identification).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        deserialize_with = "present",
+        skip_serializing_if = "Option::is_none"
+    )]
     pub identification_set_ids: Option<Vec<i64>>,
     /// Sets that validate it (default: every set with role validation).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        deserialize_with = "present",
+        skip_serializing_if = "Option::is_none"
+    )]
     pub validation_set_ids: Option<Vec<i64>>,
     /// Seed of every random choice (TLBO).
     #[serde(default)]
     pub seed: u64,
     /// TLBO population (skcm-tlbo), default 50.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        deserialize_with = "present",
+        skip_serializing_if = "Option::is_none"
+    )]
     pub population: Option<usize>,
     /// TLBO generations (skcm-tlbo), default 100.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        deserialize_with = "present",
+        skip_serializing_if = "Option::is_none"
+    )]
     pub generations: Option<usize>,
     /// Levenberg–Marquardt iteration limit, default 100.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        deserialize_with = "present",
+        skip_serializing_if = "Option::is_none"
+    )]
     pub max_iterations: Option<usize>,
     /// Register the tracker frame in closed form first (default true).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        deserialize_with = "present",
+        skip_serializing_if = "Option::is_none"
+    )]
     pub register: Option<bool>,
     /// Payload [kg] for rows and sets that give none (default: the model's payload).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        deserialize_with = "present",
+        skip_serializing_if = "Option::is_none"
+    )]
     pub payload_kg: Option<f64>,
 }
 
@@ -146,6 +180,8 @@ struct Job {
     valid: Vec<Measurement>,
     opts: CalibrationOptions,
     payload_kg: f64,
+    /// Its place in the job queue, released when the job ends.
+    ticket: Ticket,
 }
 
 fn check_count(what: &str, v: Option<usize>, lo: usize, hi: usize) -> Result<(), ApiError> {
@@ -169,6 +205,7 @@ pub async fn start(
         .ok_or_else(|| robot_not_found(robot_id))?;
     let nominal = RobotModel::from_json(&robot.model_json)
         .map_err(|e| ApiError::Internal(format!("stored model of robot {robot_id}: {e}")))?;
+    let limits = state.limits().clone();
 
     let method_list = match &req.methods {
         Some(m) if m.is_empty() => {
@@ -184,12 +221,19 @@ pub async fn start(
     check_count("generations", req.generations, 1, 1_000_000)?;
     check_count("max_iterations", req.max_iterations, 1, 10_000)?;
     if let Some(p) = req.payload_kg {
-        if !(p.is_finite() && p >= 0.0) {
-            return Err(ApiError::invalid(format!(
-                "`payload_kg` must be a non-negative number of kilograms, got {p}"
-            )));
-        }
+        check_payload("`payload_kg`", p)?;
     }
+    let defaults = CalibrationOptions::default();
+    let population = req.population.unwrap_or(defaults.tlbo.population);
+    let generations = req.generations.unwrap_or(defaults.tlbo.generations);
+    let evaluations = (population as u64).saturating_mul(generations as u64);
+    if methods.contains(&Method::SkcmTlbo) && evaluations > limits.tlbo_evaluations {
+        return Err(ApiError::invalid(format!(
+            "population × generations = {population} × {generations} = {evaluations} TLBO candidates; at most {} per job (`--max-tlbo-evaluations`)",
+            limits.tlbo_evaluations
+        )));
+    }
+    let ticket = state.admit_job()?;
 
     // The sets: named, or every set of the robot with the matching role.
     let all_sets = state.db().sets(robot_id).await?;
@@ -279,7 +323,6 @@ pub async fn start(
     let ident = load(&ident_sets).await?;
     let valid = load(&valid_sets).await?;
 
-    let defaults = CalibrationOptions::default();
     let opts = CalibrationOptions {
         methods: methods.clone(),
         register: req.register.unwrap_or(true),
@@ -288,8 +331,8 @@ pub async fn start(
             ..defaults.lm.clone()
         },
         tlbo: crate::identify::TlboSettings {
-            population: req.population.unwrap_or(defaults.tlbo.population),
-            generations: req.generations.unwrap_or(defaults.tlbo.generations),
+            population,
+            generations,
             seed: req.seed,
         },
         ..defaults
@@ -314,7 +357,8 @@ pub async fn start(
             validation_set_ids: &serde_json::to_string(&valid_ids).unwrap_or_default(),
             options: &options.to_string(),
         })
-        .await?;
+        .await?
+        .ok_or_else(|| robot_not_found(robot_id))?;
     let job = Job {
         id: row.id,
         robot_id,
@@ -324,6 +368,7 @@ pub async fn start(
         valid,
         opts,
         payload_kg: default_payload,
+        ticket,
     };
     state.cancel_flag(job.id);
     tokio::spawn(run_job(state.clone(), job));
@@ -400,11 +445,22 @@ async fn run_job(state: AppState, job: Job) {
         valid,
         opts,
         payload_kg,
+        ticket: _ticket,
         ..
     } = job;
+    // The job's wall-clock budget: past it the job stops like a cancellation
+    // and is reported as failed.
+    let budget = state.limits().job_time;
+    let deadline = std::time::Instant::now() + budget;
+    let over_budget = Arc::new(AtomicBool::new(false));
+    let over = over_budget.clone();
     let outcome = tokio::task::spawn_blocking(move || {
         let report = calibrate(&nominal, &ident, &valid, &opts, &|p: &Progress| {
             tx.send_replace(Some(p.clone()));
+            if std::time::Instant::now() > deadline {
+                over.store(true, Ordering::SeqCst);
+                return false;
+            }
             !flag.load(Ordering::SeqCst)
         });
         drop(tx);
@@ -438,6 +494,18 @@ async fn run_job(state: AppState, job: Job) {
             }
             Err(e) => db.finish_calibration_error(id, "failed", &e).await,
         },
+        Ok(Err(CalibrationError::Cancelled)) if over_budget.load(Ordering::SeqCst) => {
+            tracing::info!(job = id, "calibration stopped at its time budget");
+            db.finish_calibration_error(
+                id,
+                "failed",
+                &format!(
+                    "stopped after the job time budget of {} s (`--job-time-limit`); use fewer poses, generations or a smaller population",
+                    budget.as_secs()
+                ),
+            )
+            .await
+        }
         Ok(Err(CalibrationError::Cancelled)) => {
             tracing::info!(job = id, "calibration cancelled");
             db.finish_calibration_error(id, "cancelled", "cancelled by request")
@@ -502,18 +570,21 @@ fn versions_of(
 pub async fn list(
     State(state): State<AppState>,
     ApiPath(robot_id): ApiPath<i64>,
+    ApiQuery(page): ApiQuery<PageQuery>,
 ) -> Result<Response, ApiError> {
+    let page = page.check(state.limits().page_max)?;
     if state.db().robot(robot_id).await?.is_none() {
         return Err(robot_not_found(robot_id));
     }
-    let jobs: Vec<Calibration> = state
+    let (rows, total) = state
         .db()
-        .calibrations(robot_id)
-        .await?
-        .into_iter()
-        .map(Calibration::from_row)
-        .collect();
-    Ok(axum::Json(json!({ "calibrations": jobs })).into_response())
+        .calibrations_page(robot_id, page.limit, page.offset)
+        .await?;
+    let jobs: Vec<Calibration> = rows.into_iter().map(Calibration::from_row).collect();
+    let mut out = page_fields(page, total);
+    out["calibrations"] =
+        serde_json::to_value(jobs).map_err(|e| ApiError::Internal(e.to_string()))?;
+    Ok(axum::Json(out).into_response())
 }
 
 async fn load(state: &AppState, robot_id: i64, id: i64) -> Result<CalibrationRow, ApiError> {

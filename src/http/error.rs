@@ -6,7 +6,7 @@
 //! 4xx details say what to fix. Database and internal errors are logged with
 //! their cause and returned as a generic 500 without it.
 
-use axum::extract::rejection::{BytesRejection, JsonRejection, PathRejection, QueryRejection};
+use axum::extract::rejection::{BytesRejection, PathRejection, QueryRejection};
 use axum::extract::{FromRequest, FromRequestParts, Request};
 use axum::http::request::Parts;
 use axum::http::{header, HeaderValue, StatusCode};
@@ -41,12 +41,22 @@ pub enum ApiError {
     /// 415: the body's content type is not accepted here.
     #[error("{0}")]
     UnsupportedMediaType(String),
+    /// 414: the URL is too long (answered for the HTTP parser, see `listener`).
+    #[error("{0}")]
+    UriTooLong(String),
     /// 422: well-formed but invalid content (unknown preset, bad CSV line, ...).
     #[error("{0}")]
     Unprocessable(String),
-    /// 503: the service is overloaded or shutting down.
+    /// 431: the request head is too large (answered for the HTTP parser).
+    #[error("{0}")]
+    HeadersTooLarge(String),
+    /// 503: the database is unavailable or the service is shutting down.
     #[error("{0}")]
     Unavailable(String),
+    /// 429 with `Retry-After`: the service is saturated (job or solve queue
+    /// full); the client should send this work again later.
+    #[error("{detail}")]
+    Busy { detail: String, retry_after_s: u32 },
     /// 500: logged with its cause; the client sees a generic message.
     #[error("internal error: {0}")]
     Internal(String),
@@ -72,8 +82,11 @@ impl ApiError {
             ApiError::Conflict(_) => StatusCode::CONFLICT,
             ApiError::PayloadTooLarge(_) => StatusCode::PAYLOAD_TOO_LARGE,
             ApiError::UnsupportedMediaType(_) => StatusCode::UNSUPPORTED_MEDIA_TYPE,
+            ApiError::UriTooLong(_) => StatusCode::URI_TOO_LONG,
             ApiError::Unprocessable(_) => StatusCode::UNPROCESSABLE_ENTITY,
+            ApiError::HeadersTooLarge(_) => StatusCode::REQUEST_HEADER_FIELDS_TOO_LARGE,
             ApiError::Unavailable(_) => StatusCode::SERVICE_UNAVAILABLE,
+            ApiError::Busy { .. } => StatusCode::TOO_MANY_REQUESTS,
             ApiError::Internal(_) => StatusCode::INTERNAL_SERVER_ERROR,
         }
     }
@@ -88,8 +101,11 @@ impl ApiError {
             ApiError::Conflict(_) => "conflict",
             ApiError::PayloadTooLarge(_) => "payload-too-large",
             ApiError::UnsupportedMediaType(_) => "unsupported-media-type",
+            ApiError::UriTooLong(_) => "uri-too-long",
             ApiError::Unprocessable(_) => "invalid-input",
+            ApiError::HeadersTooLarge(_) => "headers-too-large",
             ApiError::Unavailable(_) => "unavailable",
+            ApiError::Busy { .. } => "busy",
             ApiError::Internal(_) => "internal",
         }
     }
@@ -129,6 +145,10 @@ impl IntoResponse for ApiError {
         let mut res = (status, body).into_response();
         res.headers_mut()
             .insert(header::CONTENT_TYPE, HeaderValue::from_static(PROBLEM_JSON));
+        if let ApiError::Busy { retry_after_s, .. } = &self {
+            res.headers_mut()
+                .insert(header::RETRY_AFTER, HeaderValue::from(*retry_after_s));
+        }
         if status == StatusCode::UNAUTHORIZED {
             res.headers_mut().insert(
                 header::WWW_AUTHENTICATE,
@@ -141,34 +161,22 @@ impl IntoResponse for ApiError {
 
 impl From<sqlx::Error> for ApiError {
     fn from(e: sqlx::Error) -> Self {
-        ApiError::Internal(format!("database: {e}"))
-    }
-}
-
-impl From<JsonRejection> for ApiError {
-    fn from(r: JsonRejection) -> Self {
-        match r {
-            JsonRejection::JsonDataError(e) => {
-                ApiError::Unprocessable(format!("invalid request body: {}", e.body_text()))
-            }
-            JsonRejection::JsonSyntaxError(e) => {
-                ApiError::BadRequest(format!("malformed JSON: {}", e.body_text()))
-            }
-            JsonRejection::MissingJsonContentType(_) => ApiError::UnsupportedMediaType(
-                "expected a JSON body with `Content-Type: application/json`".into(),
+        match &e {
+            // Writes check their parent inside their transaction; this is the
+            // last line of defence should one be missed.
+            sqlx::Error::Database(d) if d.is_foreign_key_violation() => ApiError::Conflict(
+                "the resource this write belongs to was deleted meanwhile".into(),
             ),
-            JsonRejection::BytesRejection(e) => bytes_rejection(e),
-            other => ApiError::BadRequest(other.body_text()),
+            _ => ApiError::Internal(format!("database: {e}")),
         }
     }
 }
 
 fn bytes_rejection(e: BytesRejection) -> ApiError {
     if e.status() == StatusCode::PAYLOAD_TOO_LARGE {
-        ApiError::PayloadTooLarge(format!(
-            "the request body is larger than the limit of {} MiB",
-            super::BODY_LIMIT_BYTES / (1024 * 1024)
-        ))
+        ApiError::PayloadTooLarge(
+            "the request body is larger than the service's limit (`--body-limit`, default 16 MiB); split the upload or the batch".into(),
+        )
     } else {
         ApiError::BadRequest(format!("cannot read the request body: {}", e.body_text()))
     }
@@ -195,7 +203,23 @@ impl From<QueryRejection> for ApiError {
     }
 }
 
-/// `axum::Json` whose rejections are problem documents.
+/// Whether the request declares a JSON body (`application/json` or `*/*+json`).
+pub fn json_content_type(headers: &axum::http::HeaderMap) -> bool {
+    let Some(ct) = headers
+        .get(header::CONTENT_TYPE)
+        .and_then(|v| v.to_str().ok())
+    else {
+        return false;
+    };
+    let essence = ct.split(';').next().unwrap_or("").trim();
+    essence.eq_ignore_ascii_case("application/json")
+        || essence
+            .rsplit_once('+')
+            .is_some_and(|(t, suffix)| t.contains('/') && suffix.eq_ignore_ascii_case("json"))
+}
+
+/// A JSON object body (arrays and scalars are refused) whose rejections are
+/// problem documents.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct ApiJson<T>(pub T);
 
@@ -207,8 +231,13 @@ where
     type Rejection = ApiError;
 
     async fn from_request(req: Request, state: &S) -> Result<Self, Self::Rejection> {
-        let axum::Json(v) = axum::Json::<T>::from_request(req, state).await?;
-        Ok(ApiJson(v))
+        if !json_content_type(req.headers()) {
+            return Err(ApiError::UnsupportedMediaType(
+                "expected a JSON body with `Content-Type: application/json`".into(),
+            ));
+        }
+        let bytes = axum::body::Bytes::from_request(req, state).await?;
+        super::input::from_json_object(&bytes).map(ApiJson)
     }
 }
 

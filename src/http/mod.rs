@@ -7,9 +7,11 @@
 //!   API keys are configured; reads (GET, HEAD) are open, so dashboards and
 //!   CAM clients can read without a key. Keys are never logged.
 //! - CPU-heavy work runs off the async runtime: calibrations on a pool of
-//!   `workers` blocking tasks, solve batches above [`INLINE_SOLVE_MAX`] targets
-//!   on the blocking pool (rayon inside), bounded by a semaphore.
-//! - Bodies are limited to [`BODY_LIMIT_BYTES`].
+//!   `workers` blocking tasks, solve batches above [`SMALL_SOLVE_MAX`] targets
+//!   on the blocking pool (rayon inside), bounded by a semaphore. Both queues
+//!   are bounded: when full, the service answers 429 with `Retry-After`
+//!   ([`limits`]).
+//! - Request sizes, list pages and job budgets are limited by [`Limits`].
 
 use crate::db::Db;
 use crate::ik::IkSolver;
@@ -27,6 +29,9 @@ use tokio::sync::Semaphore;
 
 pub mod calibrations;
 pub mod error;
+pub mod input;
+pub mod limits;
+pub mod listener;
 pub mod report_page;
 pub mod robots;
 pub mod sets;
@@ -34,13 +39,11 @@ pub mod solve;
 pub mod versions;
 
 pub use error::{ApiError, ApiJson, ApiPath, ApiQuery, Problem, PROBLEM_JSON};
+pub use limits::{Admission, Limits, Ticket, PAYLOAD_MAX_KG, SMALL_SOLVE_MAX};
+pub use listener::ServiceListener;
 
-/// Largest accepted request body (measurement uploads, solve batches).
+/// Default largest request body (measurement uploads, solve batches).
 pub const BODY_LIMIT_BYTES: usize = 16 * 1024 * 1024;
-
-/// Solve batches up to this many targets run inline on the async runtime
-/// (a few hundred microseconds at most); larger ones go to the blocking pool.
-pub const INLINE_SOLVE_MAX: usize = 16;
 
 /// The text of `openapi.yaml`, served at `/openapi.yaml`.
 pub const OPENAPI_YAML: &str = include_str!("../../openapi.yaml");
@@ -86,6 +89,8 @@ pub struct ServiceConfig {
     pub solve_workers: usize,
     /// Shortest interval between two progress writes of a job.
     pub progress_interval: Duration,
+    /// Sizes, queues and budgets.
+    pub limits: Limits,
 }
 
 /// Keys are redacted: a config printed by mistake leaks nothing.
@@ -99,6 +104,7 @@ impl std::fmt::Debug for ServiceConfig {
             .field("workers", &self.workers)
             .field("solve_workers", &self.solve_workers)
             .field("progress_interval", &self.progress_interval)
+            .field("limits", &self.limits)
             .finish()
     }
 }
@@ -110,6 +116,7 @@ impl Default for ServiceConfig {
             workers: 1,
             solve_workers: 2,
             progress_interval: Duration::from_millis(250),
+            limits: Limits::default(),
         }
     }
 }
@@ -140,6 +147,10 @@ struct Inner {
     config: ServiceConfig,
     calibration_slots: Arc<Semaphore>,
     solve_slots: Arc<Semaphore>,
+    /// Calibration jobs running or waiting (workers + queued_jobs).
+    job_gate: Arc<Admission>,
+    /// Large solve batches running or waiting (solve_workers + queued_solves).
+    solve_gate: Arc<Admission>,
     cancel_flags: Mutex<HashMap<i64, Arc<AtomicBool>>>,
     robots: Mutex<HashMap<i64, Arc<RobotContext>>>,
     solvers: Mutex<HashMap<SolverKey, Arc<IkSolver>>>,
@@ -157,6 +168,8 @@ impl AppState {
                 db,
                 calibration_slots: Arc::new(Semaphore::new(workers)),
                 solve_slots: Arc::new(Semaphore::new(solve_workers)),
+                job_gate: Admission::new(workers + config.limits.queued_jobs),
+                solve_gate: Admission::new(solve_workers + config.limits.queued_solves),
                 config,
                 cancel_flags: Mutex::new(HashMap::new()),
                 robots: Mutex::new(HashMap::new()),
@@ -179,6 +192,39 @@ impl AppState {
 
     pub(crate) fn solve_slots(&self) -> Arc<Semaphore> {
         self.inner.solve_slots.clone()
+    }
+
+    pub fn limits(&self) -> &Limits {
+        &self.inner.config.limits
+    }
+
+    /// A place for a calibration job, or 429 with `Retry-After` when
+    /// `workers + queued_jobs` jobs are already running or waiting.
+    pub(crate) fn admit_job(&self) -> Result<Ticket, ApiError> {
+        let gate = &self.inner.job_gate;
+        gate.try_admit().ok_or_else(|| ApiError::Busy {
+            detail: format!(
+                "{} calibration jobs are running or queued, the most this service takes (--workers {} + --max-queued-jobs {}); retry later or cancel a job",
+                gate.in_flight(),
+                self.config().workers.max(1),
+                self.limits().queued_jobs
+            ),
+            retry_after_s: 10,
+        })
+    }
+
+    /// A place for a large solve batch, or 429 with `Retry-After`.
+    pub(crate) fn admit_solve(&self) -> Result<Ticket, ApiError> {
+        let gate = &self.inner.solve_gate;
+        gate.try_admit().ok_or_else(|| ApiError::Busy {
+            detail: format!(
+                "{} large solve batches are running or queued, the most this service takes (--solve-workers {} + --max-queued-solves {}); retry later, or send batches of at most {SMALL_SOLVE_MAX} targets, which are never queued",
+                gate.in_flight(),
+                self.config().solve_workers.max(1),
+                self.limits().queued_solves
+            ),
+            retry_after_s: 1,
+        })
     }
 
     pub(crate) fn cancel_flag(&self, job: i64) -> Arc<AtomicBool> {
@@ -308,7 +354,7 @@ pub fn app(state: AppState) -> Router {
         .fallback(not_found)
         .method_not_allowed_fallback(method_not_allowed)
         .layer(middleware::from_fn_with_state(state.clone(), auth))
-        .layer(DefaultBodyLimit::max(BODY_LIMIT_BYTES))
+        .layer(DefaultBodyLimit::max(state.limits().body_bytes))
         .layer(middleware::from_fn(catch_panics))
         .layer(middleware::from_fn(log_requests))
         .with_state(state)
@@ -361,11 +407,7 @@ async fn auth(State(state): State<AppState>, req: Request, next: Next) -> Respon
         .headers()
         .get(header::AUTHORIZATION)
         .and_then(|v| v.to_str().ok())
-        .and_then(|v| {
-            v.strip_prefix("Bearer ")
-                .or_else(|| v.strip_prefix("bearer "))
-        })
-        .map(str::trim);
+        .and_then(bearer_token);
     match presented {
         None => ApiError::Unauthorized(
             "this operation needs an API key: send `Authorization: Bearer <key>`".into(),
@@ -380,6 +422,16 @@ async fn auth(State(state): State<AppState>, req: Request, next: Next) -> Respon
         }
         Some(_) => ApiError::Unauthorized("the API key is not valid".into()).into_response(),
     }
+}
+
+/// The token of `Authorization: Bearer <token>`; the scheme is
+/// case-insensitive (RFC 9110 §11.1), followed by one or more spaces.
+fn bearer_token(value: &str) -> Option<&str> {
+    let (scheme, rest) = value.split_once(' ')?;
+    scheme
+        .eq_ignore_ascii_case("bearer")
+        .then(|| rest.trim_matches(' '))
+        .filter(|t| !t.is_empty())
 }
 
 /// Compares without an early exit on the first differing byte.
@@ -414,4 +466,17 @@ async fn log_requests(req: Request, next: Next) -> Response {
         tracing::debug!(%method, %path, status = status.as_u16(), ms, "request");
     }
     res
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn bearer_scheme_is_case_insensitive() {
+        for v in ["Bearer k1", "bearer k1", "BEARER k1", "bEaReR   k1"] {
+            assert_eq!(super::bearer_token(v), Some("k1"), "{v}");
+        }
+        for v in ["Basic k1", "Bearerk1", "Bearer ", "k1", ""] {
+            assert_eq!(super::bearer_token(v), None, "{v}");
+        }
+    }
 }

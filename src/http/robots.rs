@@ -1,7 +1,8 @@
 //! `/v1/robots`: create from a preset or a model JSON, list, get, update name
 //! and metadata, delete (with its measurement sets, calibrations and versions).
 
-use super::{ApiError, ApiJson, ApiPath, AppState};
+use super::input::{check_payload, page_fields, present, PageQuery};
+use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState};
 use crate::db::{NewRobot, RobotRow};
 use crate::model::presets::{preset_description, PRESETS};
 use crate::model::RobotModel;
@@ -9,10 +10,9 @@ use axum::extract::State;
 use axum::http::{header, StatusCode};
 use axum::response::{IntoResponse, Response};
 use serde::{Deserialize, Serialize};
-use serde_json::Value;
+use serde_json::{Map, Value};
 
-/// Longest accepted robot or set name.
-pub const NAME_MAX: usize = 200;
+pub(crate) use super::input::check_name;
 
 pub(crate) fn robot_not_found(id: i64) -> ApiError {
     ApiError::NotFound(format!(
@@ -20,23 +20,29 @@ pub(crate) fn robot_not_found(id: i64) -> ApiError {
     ))
 }
 
-/// `POST /v1/robots` body.
+/// `POST /v1/robots` body: exactly one of `preset` and `model`; no field may
+/// be `null`.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CreateRobot {
+    #[serde(default, deserialize_with = "present")]
     pub name: Option<String>,
+    #[serde(default, deserialize_with = "present")]
     pub preset: Option<String>,
-    pub model: Option<Value>,
-    #[serde(default)]
-    pub metadata: Option<Value>,
+    #[serde(default, deserialize_with = "present")]
+    pub model: Option<Map<String, Value>>,
+    #[serde(default, deserialize_with = "present")]
+    pub metadata: Option<Map<String, Value>>,
 }
 
-/// `PATCH /v1/robots/{id}` body.
+/// `PATCH /v1/robots/{id}` body (no field may be `null`).
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct UpdateRobot {
+    #[serde(default, deserialize_with = "present")]
     pub name: Option<String>,
-    pub metadata: Option<Value>,
+    #[serde(default, deserialize_with = "present")]
+    pub metadata: Option<Map<String, Value>>,
 }
 
 /// A robot as the API returns it.
@@ -73,25 +79,16 @@ impl Robot {
     }
 }
 
-pub(crate) fn check_name(name: &str, what: &str) -> Result<(), ApiError> {
-    if name.trim().is_empty() {
-        return Err(ApiError::invalid(format!("{what} must not be empty")));
-    }
-    if name.chars().count() > NAME_MAX {
+/// The metadata object as stored, within the size limit.
+fn check_metadata(m: &Map<String, Value>, max_bytes: usize) -> Result<String, ApiError> {
+    let text = serde_json::to_string(m).map_err(|e| ApiError::Internal(e.to_string()))?;
+    if text.len() > max_bytes {
         return Err(ApiError::invalid(format!(
-            "{what} is longer than {NAME_MAX} characters"
+            "`metadata` is {} bytes as JSON; at most {max_bytes} (`--metadata-limit`): keep files and large data elsewhere and put a reference here",
+            text.len()
         )));
     }
-    Ok(())
-}
-
-fn check_metadata(m: &Value) -> Result<String, ApiError> {
-    if !m.is_object() {
-        return Err(ApiError::invalid(
-            "`metadata` must be a JSON object, e.g. {\"cell\": \"A3\"}",
-        ));
-    }
-    Ok(m.to_string())
+    Ok(text)
 }
 
 pub async fn list_presets() -> Result<Response, ApiError> {
@@ -126,28 +123,28 @@ pub async fn create(
             )))
         }
         (Some(p), None) => {
-            let name = p.trim().to_ascii_lowercase();
+            if !PRESETS.contains(&p.as_str()) {
+                return Err(ApiError::invalid(format!(
+                    "unknown preset `{p}`; the presets are {} (GET /v1/presets)",
+                    PRESETS.join(", ")
+                )));
+            }
             (
-                crate::model::preset(&name).map_err(ApiError::invalid)?,
-                Some(name),
+                crate::model::preset(p).map_err(ApiError::invalid)?,
+                Some(p.clone()),
             )
         }
         (None, Some(m)) => {
-            if !m.is_object() {
-                return Err(ApiError::invalid(
-                    "`model` must be a model JSON object (see the README's Model JSON)",
-                ));
-            }
-            (
-                RobotModel::from_json(&m.to_string()).map_err(ApiError::invalid)?,
-                None,
-            )
+            let text = serde_json::to_string(m).map_err(|e| ApiError::Internal(e.to_string()))?;
+            let model = RobotModel::from_json(&text).map_err(ApiError::invalid)?;
+            check_payload("model field 'payload.mass_kg'", model.payload.mass)?;
+            (model, None)
         }
     };
     let name = body.name.clone().unwrap_or_else(|| model.name.clone());
     check_name(&name, "`name`")?;
     let metadata = match &body.metadata {
-        Some(m) => check_metadata(m)?,
+        Some(m) => check_metadata(m, state.limits().metadata_bytes)?,
         None => "{}".to_string(),
     };
     let model_json = model.to_json();
@@ -170,15 +167,19 @@ pub async fn create(
         .into_response())
 }
 
-pub async fn list(State(state): State<AppState>) -> Result<Response, ApiError> {
-    let robots: Vec<Robot> = state
-        .db()
-        .robots()
-        .await?
+pub async fn list(
+    State(state): State<AppState>,
+    ApiQuery(page): ApiQuery<PageQuery>,
+) -> Result<Response, ApiError> {
+    let page = page.check(state.limits().page_max)?;
+    let (rows, total) = state.db().robots_page(page.limit, page.offset).await?;
+    let robots: Vec<Robot> = rows
         .into_iter()
         .map(|r| Robot::from_row(r, false))
         .collect();
-    Ok(axum::Json(serde_json::json!({ "robots": robots })).into_response())
+    let mut out = page_fields(page, total);
+    out["robots"] = serde_json::to_value(robots).map_err(|e| ApiError::Internal(e.to_string()))?;
+    Ok(axum::Json(out).into_response())
 }
 
 pub async fn get_one(
@@ -201,7 +202,11 @@ pub async fn update(
     if let Some(n) = &body.name {
         check_name(n, "`name`")?;
     }
-    let metadata = body.metadata.as_ref().map(check_metadata).transpose()?;
+    let metadata = body
+        .metadata
+        .as_ref()
+        .map(|m| check_metadata(m, state.limits().metadata_bytes))
+        .transpose()?;
     if body.name.is_none() && metadata.is_none() {
         return Err(ApiError::invalid(
             "nothing to update: give `name` and/or `metadata` (the model of a robot cannot change; create a new robot instead)",

@@ -6,7 +6,10 @@
 //! millimetres and degrees when they are stored; the upload itself is kept
 //! verbatim and served by `GET .../original`.
 
-use super::robots::{check_name, robot_not_found};
+use super::input::{
+    check_name, check_payload, from_json_object, objects, page_fields, present, PageQuery,
+};
+use super::robots::robot_not_found;
 use super::{ApiError, ApiPath, ApiQuery, AppState};
 use crate::db::{NewSet, SetRow};
 use crate::measure::csv::{self, CsvError};
@@ -60,16 +63,23 @@ pub struct RowInput {
     pub set: Option<SetRole>,
 }
 
-/// A JSON upload.
+/// A JSON upload (optional fields may be left out, not `null`).
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct JsonUpload {
+    #[serde(default, deserialize_with = "present")]
     pub name: Option<String>,
+    #[serde(default, deserialize_with = "present")]
     pub role: Option<String>,
+    #[serde(default, deserialize_with = "present")]
     pub session: Option<String>,
+    #[serde(default, deserialize_with = "present")]
     pub payload_kg: Option<f64>,
+    #[serde(default, deserialize_with = "present")]
     pub length_unit: Option<String>,
+    #[serde(default, deserialize_with = "present")]
     pub angle_unit: Option<String>,
+    #[serde(deserialize_with = "objects")]
     pub rows: Vec<RowInput>,
 }
 
@@ -172,11 +182,7 @@ fn check_params(p: &SetParams) -> Result<Checked, ApiError> {
         check_name(n, "`name`")?;
     }
     if let Some(m) = p.payload_kg {
-        if !(m.is_finite() && m >= 0.0) {
-            return Err(ApiError::invalid(format!(
-                "`payload_kg` must be a non-negative number of kilograms, got {m}"
-            )));
-        }
+        check_payload("`payload_kg`", m)?;
     }
     let length = match p.length_unit.as_deref().unwrap_or("mm") {
         "mm" => Length::Mm,
@@ -299,11 +305,7 @@ fn json_rows(rows: Vec<RowInput>, c: &Checked) -> Result<Vec<MeasuredPose>, ApiE
             return Err(bad("orientation `rpy`"));
         }
         if let Some(p) = r.payload_kg {
-            if !(p.is_finite() && p >= 0.0) {
-                return Err(ApiError::invalid(format!(
-                    "row {n}: `payload_kg` must be a non-negative number, got {p}"
-                )));
-            }
+            check_payload(&format!("row {n}: `payload_kg`"), p)?;
         }
         if r.temperature_c.is_some_and(|t| !t.is_finite()) {
             return Err(bad("`temperature_c`"));
@@ -332,11 +334,20 @@ fn json_rows(rows: Vec<RowInput>, c: &Checked) -> Result<Vec<MeasuredPose>, ApiE
     Ok(out)
 }
 
-fn check_rows(rows: &[MeasuredPose], dof: usize) -> Result<(), ApiError> {
+fn check_rows(rows: &[MeasuredPose], dof: usize, max_rows: usize) -> Result<(), ApiError> {
+    if rows.len() > max_rows {
+        return Err(ApiError::invalid(format!(
+            "{} rows in one set; at most {max_rows} (`--max-poses-per-set`): split the upload",
+            rows.len()
+        )));
+    }
     csv::check_joint_count(rows, dof).map_err(|e| {
         ApiError::invalid(format!("{e} (the robot has {dof} joints: send q1..q{dof})"))
     })?;
     for (i, r) in rows.iter().enumerate() {
+        if let Some(p) = r.payload_kg {
+            check_payload(&format!("row {}: `payload_kg`", i + 1), p)?;
+        }
         if let Some((k, v)) = r
             .q_deg
             .iter()
@@ -394,6 +405,7 @@ pub async fn upload(
         .await?
         .ok_or_else(|| robot_not_found(robot_id))?;
     let dof = robot.dof as usize;
+    let max_rows = state.limits().poses_per_set;
     let text = String::from_utf8(body.to_vec())
         .map_err(|_| ApiError::invalid("the upload is not UTF-8 text"))?;
 
@@ -408,7 +420,7 @@ pub async fn upload(
             if c.angle == Angle::Rad {
                 to_degrees(&mut rows);
             }
-            check_rows(&rows, dof)?;
+            check_rows(&rows, dof, max_rows)?;
             Ok((c, rows, "csv", text))
         } else {
             if query.name.is_some()
@@ -422,16 +434,10 @@ pub async fn upload(
                     "for JSON uploads give name, role, session, payload_kg and units in the body, not the query string",
                 ));
             }
-            let up: JsonUpload = serde_json::from_str(&text).map_err(|e| {
-                if e.is_syntax() || e.is_eof() {
-                    ApiError::BadRequest(format!("malformed JSON: {e}"))
-                } else {
-                    ApiError::invalid(format!("invalid request body: {e}"))
-                }
-            })?;
+            let up: JsonUpload = from_json_object(text.as_bytes())?;
             let c = check_params(&up.params())?;
             let rows = json_rows(up.rows, &c)?;
-            check_rows(&rows, dof)?;
+            check_rows(&rows, dof, max_rows)?;
             Ok((c, rows, "json", text))
         }
     })
@@ -469,11 +475,8 @@ pub async fn upload(
             row_count: rows.len() as i64,
             dof: dof as i64,
         })
-        .await
-        .map_err(|e| match &e {
-            sqlx::Error::Database(d) if d.is_foreign_key_violation() => robot_not_found(robot_id),
-            _ => e.into(),
-        })?;
+        .await?
+        .ok_or_else(|| robot_not_found(robot_id))?;
     let location = format!("/v1/robots/{robot_id}/measurement-sets/{}", row.id);
     Ok((
         StatusCode::CREATED,
@@ -486,18 +489,24 @@ pub async fn upload(
 pub async fn list(
     State(state): State<AppState>,
     ApiPath(robot_id): ApiPath<i64>,
+    ApiQuery(page): ApiQuery<PageQuery>,
 ) -> Result<Response, ApiError> {
+    let page = page.check(state.limits().page_max)?;
     if state.db().robot(robot_id).await?.is_none() {
         return Err(robot_not_found(robot_id));
     }
-    let sets: Vec<MeasurementSet> = state
+    let (rows, total) = state
         .db()
-        .sets(robot_id)
-        .await?
+        .sets_page(robot_id, page.limit, page.offset)
+        .await?;
+    let sets: Vec<MeasurementSet> = rows
         .into_iter()
         .map(|r| MeasurementSet::from_row(r, None))
         .collect();
-    Ok(axum::Json(serde_json::json!({ "measurement_sets": sets })).into_response())
+    let mut out = page_fields(page, total);
+    out["measurement_sets"] =
+        serde_json::to_value(sets).map_err(|e| ApiError::Internal(e.to_string()))?;
+    Ok(axum::Json(out).into_response())
 }
 
 /// Loads the parsed rows of a set.

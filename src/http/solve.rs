@@ -14,7 +14,8 @@
 //! change once written. Small batches are solved inline; larger ones on the
 //! blocking pool (parallel inside), at most `solve_workers` at a time.
 
-use super::{ApiError, ApiJson, ApiPath, AppState, INLINE_SOLVE_MAX};
+use super::input::{check_payload, object_or_null, objects, present};
+use super::{ApiError, ApiJson, ApiPath, AppState, SMALL_SOLVE_MAX};
 use crate::compensate::{CalibratedModelFile, CompensatedModel};
 use crate::ik::{
     Configuration, IkSettings, IkSolver, JointJump, SolveOptions, TargetFrame, TargetInput,
@@ -29,8 +30,45 @@ use serde_json::Value;
 use std::sync::Arc;
 use std::time::Instant;
 
-/// Most targets in one request.
-pub const MAX_TARGETS: usize = 100_000;
+/// Names of the orientation conventions as `openapi.yaml` lists them
+/// (canonical names and aliases, lower case).
+pub const CONVENTION_NAMES: [&str; 12] = [
+    "quaternion",
+    "quat",
+    "wxyz",
+    "abb",
+    "kuka_abc",
+    "abc",
+    "kuka",
+    "fanuc_wpr",
+    "wpr",
+    "fanuc",
+    "matrix",
+    "rotation_matrix",
+];
+
+/// A convention name exactly as listed in the spec.
+fn convention(name: &str, what: &str) -> Result<OrientationConvention, ApiError> {
+    if !CONVENTION_NAMES.contains(&name) {
+        return Err(ApiError::invalid(format!(
+            "{what}: unknown orientation convention `{name}`; use one of {}",
+            CONVENTION_NAMES.join(", ")
+        )));
+    }
+    OrientationConvention::from_name(name).map_err(|e| ApiError::invalid(format!("{what}: {e}")))
+}
+
+/// Words of a branch as the spec's pattern allows them: an index `0`..`7`, or
+/// flags from front|back, up|down, noflip|no-flip|flip joined by single `,`,
+/// `-`, `/` or spaces, lower case.
+fn branch_syntax_ok(text: &str) -> bool {
+    if text.len() == 1 && matches!(text.as_bytes()[0], b'0'..=b'7') {
+        return true;
+    }
+    let t = text.replace("no-flip", "noflip");
+    t.split([',', '-', '/', ' '])
+        .all(|w| matches!(w, "front" | "back" | "up" | "down" | "noflip" | "flip"))
+}
 
 /// Which model to solve with.
 #[derive(Debug, Clone, Deserialize)]
@@ -43,6 +81,7 @@ pub enum VersionSelector {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OrientationIn {
+    #[serde(default, deserialize_with = "present")]
     pub convention: Option<String>,
     pub values: Vec<f64>,
 }
@@ -55,7 +94,7 @@ pub struct TargetIn {
     pub x: f64,
     pub y: f64,
     pub z: f64,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "object_or_null")]
     pub orientation: Option<OrientationIn>,
 }
 
@@ -63,26 +102,27 @@ pub struct TargetIn {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SolveRequest {
+    #[serde(deserialize_with = "objects")]
     pub targets: Vec<TargetIn>,
     /// Orientation convention of targets that do not name one; also the
     /// convention of false targets of position-only targets.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "present")]
     pub convention: Option<String>,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "present")]
     pub payload_kg: Option<f64>,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "present")]
     pub branch: Option<String>,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "present")]
     pub seed_deg: Option<Vec<f64>>,
     #[serde(default)]
     pub path: bool,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "present")]
     pub frame: Option<String>,
     #[serde(default)]
     pub position_only: bool,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "present")]
     pub version: Option<VersionSelector>,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "present")]
     pub jump_deg: Option<f64>,
 }
 
@@ -173,8 +213,7 @@ fn target_id(i: usize, id: &Option<Value>) -> Result<String, ApiError> {
 
 fn to_inputs(req: &SolveRequest) -> Result<Vec<TargetInput>, ApiError> {
     if let Some(c) = &req.convention {
-        OrientationConvention::from_name(c)
-            .map_err(|e| ApiError::invalid(format!("`convention`: {e}")))?;
+        convention(c, "`convention`")?;
     }
     req.targets
         .iter()
@@ -184,6 +223,9 @@ fn to_inputs(req: &SolveRequest) -> Result<Vec<TargetInput>, ApiError> {
             let (convention, orientation) = match &t.orientation {
                 None => (None, Vec::new()),
                 Some(o) => {
+                    if let Some(c) = &o.convention {
+                        convention(c, &format!("target `{id}`: `orientation.convention`"))?;
+                    }
                     let conv = o.convention.clone().or_else(|| req.convention.clone());
                     let Some(conv) = conv else {
                         return Err(ApiError::invalid(format!(
@@ -224,15 +266,20 @@ async fn prepare(
                 "robot {robot_id} has no active model version: run a calibration (POST /v1/robots/{robot_id}/calibrations), activate a version, name one with \"version\": N, or solve with the nominal model with \"version\": \"nominal\""
             ))
         })?),
-        Some(VersionSelector::Name(n)) if n.eq_ignore_ascii_case("active") => {
+        Some(VersionSelector::Name(n)) if n == "active" => {
             Some(ctx.active.clone().ok_or_else(|| {
                 ApiError::Conflict(format!("robot {robot_id} has no active model version"))
             })?)
         }
-        Some(VersionSelector::Name(n)) if n.eq_ignore_ascii_case("nominal") => None,
+        Some(VersionSelector::Name(n)) if n == "nominal" => None,
         Some(VersionSelector::Name(n)) => {
             return Err(ApiError::invalid(format!(
                 "`version` must be a version number, \"active\" or \"nominal\", got \"{n}\""
+            )))
+        }
+        Some(VersionSelector::Number(v)) if *v < 1 => {
+            return Err(ApiError::invalid(format!(
+                "`version` numbers start at 1, got {v}"
             )))
         }
         Some(VersionSelector::Number(v)) => {
@@ -339,18 +386,15 @@ pub async fn solve(
             "`targets` is empty: send at least one target",
         ));
     }
-    if req.targets.len() > MAX_TARGETS {
+    let max_targets = state.limits().targets_per_request;
+    if req.targets.len() > max_targets {
         return Err(ApiError::invalid(format!(
-            "{} targets in one request; at most {MAX_TARGETS} (split the batch)",
+            "{} targets in one request; at most {max_targets} (`--max-targets`): split the batch",
             req.targets.len()
         )));
     }
     if let Some(p) = req.payload_kg {
-        if !(p.is_finite() && p >= 0.0) {
-            return Err(ApiError::invalid(format!(
-                "`payload_kg` must be a non-negative number of kilograms, got {p}"
-            )));
-        }
+        check_payload("`payload_kg`", p)?;
     }
     if let Some(j) = req.jump_deg {
         if !(j.is_finite() && j > 0.0) {
@@ -359,12 +403,22 @@ pub async fn solve(
             ));
         }
     }
-    let frame: TargetFrame = match &req.frame {
-        None => TargetFrame::Cell,
-        Some(f) => f
-            .parse()
-            .map_err(|e: String| ApiError::invalid(format!("`frame`: {e}")))?,
+    let frame: TargetFrame = match req.frame.as_deref() {
+        None | Some("cell") => TargetFrame::Cell,
+        Some("base") => TargetFrame::Base,
+        Some(f) => {
+            return Err(ApiError::invalid(format!(
+                "`frame` must be cell or base, got `{f}`"
+            )))
+        }
     };
+    if let Some(b) = &req.branch {
+        if !branch_syntax_ok(b) {
+            return Err(ApiError::invalid(format!(
+                "`branch`: `{b}` is not a branch; give an index 0..7 or flags front|back, up|down, noflip|flip in lower case joined by `,`, e.g. front,up,noflip"
+            )));
+        }
+    }
     let branch = req
         .branch
         .as_deref()
@@ -380,9 +434,8 @@ pub async fn solve(
     let default_conv = req
         .convention
         .as_deref()
-        .map(OrientationConvention::from_name)
-        .transpose()
-        .map_err(|e| ApiError::invalid(format!("`convention`: {e}")))?
+        .map(|c| convention(c, "`convention`"))
+        .transpose()?
         .unwrap_or(OrientationConvention::Quaternion);
 
     let prepared = prepare(&state, robot_id, &req).await?;
@@ -409,13 +462,16 @@ pub async fn solve(
     };
     let payload_kg = solver.model().payload_kg;
     let path = req.path;
-    let results = if inputs.len() <= INLINE_SOLVE_MAX {
+    let results = if inputs.len() <= SMALL_SOLVE_MAX {
         if path {
             solver.solve_targets_path(&inputs, &options)
         } else {
             solve_inline(&solver, &inputs, &options, default_conv)
         }
     } else {
+        // Large batches queue for a solve worker; a full queue is refused
+        // at once (429 + Retry-After) instead of waiting silently.
+        let ticket = state.admit_solve()?;
         let permit = state
             .solve_slots()
             .acquire_owned()
@@ -423,6 +479,7 @@ pub async fn solve(
             .map_err(|_| ApiError::Unavailable("the service is shutting down".into()))?;
         let results = tokio::task::spawn_blocking(move || {
             let _permit = permit;
+            let _ticket = ticket;
             if path {
                 solver.solve_targets_path(&inputs, &options)
             } else {

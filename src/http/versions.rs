@@ -2,8 +2,9 @@
 //! activate, roll back to the previously active version, download the model
 //! file (`robocal-calibrated-model/1`, loadable by `robocal solve --model`).
 
+use super::input::{page_fields, PageQuery};
 use super::robots::robot_not_found;
-use super::{ApiError, ApiPath, AppState};
+use super::{ApiError, ApiPath, ApiQuery, AppState};
 use crate::db::{Rollback, VersionRow};
 use axum::extract::State;
 use axum::http::header;
@@ -60,17 +61,24 @@ async fn robot_exists(state: &AppState, robot_id: i64) -> Result<(), ApiError> {
 pub async fn list(
     State(state): State<AppState>,
     ApiPath(robot_id): ApiPath<i64>,
+    ApiQuery(page): ApiQuery<PageQuery>,
 ) -> Result<Response, ApiError> {
-    robot_exists(&state, robot_id).await?;
-    let versions: Vec<ModelVersion> = state
+    let page = page.check(state.limits().page_max)?;
+    let robot = state
         .db()
-        .versions(robot_id)
+        .robot(robot_id)
         .await?
-        .into_iter()
-        .map(ModelVersion::from_row)
-        .collect();
-    let active = versions.iter().find(|v| v.active).map(|v| v.version);
-    Ok(axum::Json(json!({ "active_version": active, "versions": versions })).into_response())
+        .ok_or_else(|| robot_not_found(robot_id))?;
+    let (rows, total) = state
+        .db()
+        .versions_page(robot_id, page.limit, page.offset)
+        .await?;
+    let versions: Vec<ModelVersion> = rows.into_iter().map(ModelVersion::from_row).collect();
+    let mut out = page_fields(page, total);
+    out["active_version"] = json!(robot.active_version);
+    out["versions"] =
+        serde_json::to_value(versions).map_err(|e| ApiError::Internal(e.to_string()))?;
+    Ok(axum::Json(out).into_response())
 }
 
 async fn load(state: &AppState, robot_id: i64, v: i64) -> Result<VersionRow, ApiError> {
@@ -151,8 +159,12 @@ pub async fn rollback(
             tracing::info!(robot = robot_id, version = row.version, "rolled back");
             Ok(axum::Json(ModelVersion::from_row(row)).into_response())
         }
-        Rollback::NothingToRollBack => Err(ApiError::Conflict(format!(
+        Rollback::NothingToRollBack => {
+            // Deleted meanwhile: say so rather than "nothing to roll back".
+            robot_exists(&state, robot_id).await?;
+            Err(ApiError::Conflict(format!(
             "robot {robot_id} has no earlier active version to roll back to; activate a version with POST /v1/robots/{robot_id}/versions/{{version}}/activate"
-        ))),
+        )))
+        }
     }
 }

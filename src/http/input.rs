@@ -1,0 +1,284 @@
+//! Request input rules shared by the routes, written to match `openapi.yaml`
+//! exactly, so that the server refuses what the spec refuses and accepts what
+//! it allows:
+//!
+//! - bodies and nested records are JSON objects only ([`from_json_object`],
+//!   [`objects`], [`object_or_null`]); serde would otherwise read a struct from
+//!   an array of its fields;
+//! - an optional field may be left out, but `null` is refused unless the spec
+//!   says the field is nullable ([`present`]);
+//! - names ([`check_name`]), payloads ([`check_payload`]) and list paging
+//!   ([`Page`]).
+
+use super::limits::{PAGE_DEFAULT, PAYLOAD_MAX_KG};
+use super::ApiError;
+use serde::de::{DeserializeOwned, Deserializer, MapAccess, Visitor};
+use serde::Deserialize;
+use std::fmt;
+use std::marker::PhantomData;
+
+/// Longest accepted robot, set or session name (characters).
+pub const NAME_MAX: usize = 200;
+
+/// Parses a JSON object body: 400 when it is not JSON, 422 when it is JSON of
+/// the wrong shape (an array, a scalar, a wrong field).
+pub fn from_json_object<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, ApiError> {
+    let first = bytes.iter().find(|b| !b.is_ascii_whitespace());
+    if first != Some(&b'{') {
+        return Err(
+            match serde_json::from_slice::<serde::de::IgnoredAny>(bytes) {
+                Ok(_) => ApiError::invalid("the request body must be a JSON object"),
+                Err(e) => ApiError::BadRequest(format!("malformed JSON: {e}")),
+            },
+        );
+    }
+    serde_json::from_slice::<T>(bytes).map_err(|e| {
+        if e.is_data() {
+            ApiError::invalid(format!("invalid request body: {e}"))
+        } else {
+            ApiError::BadRequest(format!("malformed JSON: {e}"))
+        }
+    })
+}
+
+/// A record that must be a JSON object (not an array of its fields).
+struct Obj<T>(T);
+
+impl<'de, T: Deserialize<'de>> Deserialize<'de> for Obj<T> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V<T>(PhantomData<T>);
+        impl<'de, T: Deserialize<'de>> Visitor<'de> for V<T> {
+            type Value = T;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a JSON object")
+            }
+            fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<T, A::Error> {
+                T::deserialize(serde::de::value::MapAccessDeserializer::new(map))
+            }
+        }
+        d.deserialize_map(V(PhantomData)).map(Obj)
+    }
+}
+
+/// `deserialize_with` for a list of records that must each be a JSON object.
+pub fn objects<'de, D, T>(d: D) -> Result<Vec<T>, D::Error>
+where
+    D: Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    Ok(Vec::<Obj<T>>::deserialize(d)?
+        .into_iter()
+        .map(|o| o.0)
+        .collect())
+}
+
+/// `deserialize_with` for a nullable record that must be a JSON object.
+pub fn object_or_null<'de, D, T>(d: D) -> Result<Option<T>, D::Error>
+where
+    D: Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    Ok(Option::<Obj<T>>::deserialize(d)?.map(|o| o.0))
+}
+
+/// `deserialize_with` (with `#[serde(default)]`) for an optional field that
+/// may be left out but not be `null`.
+pub fn present<'de, D, T>(d: D) -> Result<Option<T>, D::Error>
+where
+    D: Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    T::deserialize(d).map(Some)
+}
+
+/// Whitespace as `openapi.yaml` counts it for names: a name needs one
+/// character that is not a space, tab or line break (pattern `[^ \t\r\n]`).
+fn blank(name: &str) -> bool {
+    name.chars().all(|c| matches!(c, ' ' | '\t' | '\r' | '\n'))
+}
+
+/// A name: 1 to [`NAME_MAX`] characters, not only blanks.
+pub fn check_name(name: &str, what: &str) -> Result<(), ApiError> {
+    if name.is_empty() || blank(name) {
+        return Err(ApiError::invalid(format!(
+            "{what} must not be empty or blank"
+        )));
+    }
+    if name.chars().count() > NAME_MAX {
+        return Err(ApiError::invalid(format!(
+            "{what} is longer than {NAME_MAX} characters"
+        )));
+    }
+    Ok(())
+}
+
+/// A payload in kilograms: finite, 0 to [`PAYLOAD_MAX_KG`].
+pub fn check_payload(what: &str, kg: f64) -> Result<(), ApiError> {
+    if !(kg.is_finite() && (0.0..=PAYLOAD_MAX_KG).contains(&kg)) {
+        return Err(ApiError::invalid(format!(
+            "{what} must be between 0 and {PAYLOAD_MAX_KG} kg, got {kg}"
+        )));
+    }
+    Ok(())
+}
+
+/// `?limit=&offset=` of a list.
+#[derive(Debug, Clone, Copy, Default, Deserialize)]
+pub struct PageQuery {
+    pub limit: Option<u64>,
+    pub offset: Option<u64>,
+}
+
+/// A checked page: at most `limit` items from `offset` (0-based).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Page {
+    pub limit: i64,
+    pub offset: i64,
+}
+
+impl PageQuery {
+    pub fn check(self, page_max: usize) -> Result<Page, ApiError> {
+        let limit = self.limit.unwrap_or(PAGE_DEFAULT.min(page_max) as u64);
+        if limit == 0 || limit > page_max as u64 {
+            return Err(ApiError::BadRequest(format!(
+                "`limit` must be between 1 and {page_max}, got {limit}"
+            )));
+        }
+        let offset = self.offset.unwrap_or(0);
+        let offset = i64::try_from(offset)
+            .map_err(|_| ApiError::BadRequest(format!("`offset` must be at most {}", i64::MAX)))?;
+        Ok(Page {
+            limit: limit as i64,
+            offset,
+        })
+    }
+}
+
+/// The paging fields of a list response.
+pub fn page_fields(page: Page, total: i64) -> serde_json::Value {
+    let next = page.offset.saturating_add(page.limit);
+    serde_json::json!({
+        "total": total,
+        "limit": page.limit,
+        "offset": page.offset,
+        "next_offset": (next < total).then_some(next),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    #[derive(Debug, Deserialize, PartialEq)]
+    #[serde(deny_unknown_fields)]
+    struct Inner {
+        a: f64,
+    }
+
+    #[derive(Debug, Deserialize, PartialEq)]
+    #[serde(deny_unknown_fields)]
+    struct Outer {
+        #[serde(default, deserialize_with = "present")]
+        name: Option<String>,
+        #[serde(deserialize_with = "objects")]
+        items: Vec<Inner>,
+        #[serde(default, deserialize_with = "object_or_null")]
+        one: Option<Inner>,
+    }
+
+    fn parse(v: serde_json::Value) -> Result<Outer, ApiError> {
+        from_json_object(v.to_string().as_bytes())
+    }
+
+    #[test]
+    fn objects_only_and_no_nulls_where_not_nullable() {
+        let ok = parse(json!({"items": [{"a": 1.0}], "one": null})).unwrap();
+        assert_eq!(ok.items, vec![Inner { a: 1.0 }]);
+        assert_eq!(ok.name, None);
+        assert!(parse(json!({"items": [], "one": {"a": 2.0}}))
+            .unwrap()
+            .one
+            .is_some());
+        // serde alone would read these structs from arrays of their fields.
+        for bad in [
+            json!([[], null]),
+            json!({"items": [[1.0]]}),
+            json!({"items": [], "one": [2.0]}),
+            json!({"items": [], "name": null}),
+        ] {
+            let e = parse(bad.clone()).unwrap_err();
+            assert!(matches!(e, ApiError::Unprocessable(_)), "{bad}: {e:?}");
+        }
+        assert!(matches!(
+            from_json_object::<Outer>(b"{\"items\": ["),
+            Err(ApiError::BadRequest(_))
+        ));
+        assert!(matches!(
+            from_json_object::<Outer>(b""),
+            Err(ApiError::BadRequest(_))
+        ));
+    }
+
+    #[test]
+    fn names_and_payloads() {
+        assert!(check_name("a", "n").is_ok());
+        assert!(check_name("\u{3000}", "n").is_ok());
+        for bad in ["", " ", "\t\r\n "] {
+            assert!(check_name(bad, "n").is_err(), "{bad:?}");
+        }
+        assert!(check_name(&"x".repeat(NAME_MAX), "n").is_ok());
+        assert!(check_name(&"é".repeat(NAME_MAX + 1), "n").is_err());
+        assert!(check_payload("p", 0.0).is_ok());
+        assert!(check_payload("p", PAYLOAD_MAX_KG).is_ok());
+        for bad in [-1e-9, 10_000.5, 1e308, f64::NAN, f64::INFINITY] {
+            assert!(check_payload("p", bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn paging() {
+        let p = PageQuery::default().check(1000).unwrap();
+        assert_eq!(
+            p,
+            Page {
+                limit: 100,
+                offset: 0
+            }
+        );
+        assert!(PageQuery {
+            limit: Some(0),
+            offset: None
+        }
+        .check(1000)
+        .is_err());
+        assert!(PageQuery {
+            limit: Some(1001),
+            offset: None
+        }
+        .check(1000)
+        .is_err());
+        assert!(PageQuery {
+            limit: None,
+            offset: Some(u64::MAX)
+        }
+        .check(1000)
+        .is_err());
+        let f = page_fields(
+            Page {
+                limit: 2,
+                offset: 2,
+            },
+            5,
+        );
+        assert_eq!(f["next_offset"], 4);
+        let f = page_fields(
+            Page {
+                limit: 2,
+                offset: 4,
+            },
+            5,
+        );
+        assert!(f["next_offset"].is_null());
+    }
+}
