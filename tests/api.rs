@@ -1135,7 +1135,7 @@ async fn bad_input_gives_problem_json() {
         "{}",
     )
     .await;
-    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY);
+    assert_eq!(r.status, StatusCode::CONFLICT);
     assert!(
         r.detail().contains("no identification set"),
         "{}",
@@ -1148,7 +1148,7 @@ async fn bad_input_gives_problem_json() {
         r#"{"identification_set_ids": [99]}"#,
     )
     .await;
-    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY);
+    assert_eq!(r.status, StatusCode::CONFLICT);
     assert!(r.detail().contains("set 99"));
     // Solve requests.
     let r = post("/v1/robots/{id}/solve", vec![rid.clone()], "application/json",
@@ -1161,8 +1161,11 @@ async fn bad_input_gives_problem_json() {
     );
     let r = post("/v1/robots/{id}/solve", vec![rid.clone()], "application/json",
         r#"{"version":"nominal","targets":[{"x":500,"y":0,"z":500,"orientation":{"values":[1,0,0,0]}}]}"#).await;
-    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY);
-    assert!(r.detail().contains("convention"), "{}", r.detail());
+    // An orientation without a convention fails its target alone.
+    assert_eq!(r.status, StatusCode::OK);
+    let res = &r.json()["results"][0];
+    assert_eq!(res["reason"]["code"], "invalid_target", "{res}");
+    assert!(res["reason"]["message"].as_str().unwrap().contains("convention"));
     let r = post(
         "/v1/robots/{id}/solve",
         vec![rid.clone()],
@@ -1186,7 +1189,8 @@ async fn bad_input_gives_problem_json() {
         r#"{"version":7,"targets":[{"x":500,"y":0,"z":500}]}"#,
     )
     .await;
-    assert_eq!(r.status, StatusCode::NOT_FOUND);
+    assert_eq!(r.status, StatusCode::CONFLICT);
+    assert!(r.detail().contains("no model version 7"));
     let r = post(
         "/v1/robots/{id}/solve",
         vec![rid.clone()],

@@ -26,13 +26,7 @@ struct Server {
 impl Server {
     fn start(db: &Path) -> Server {
         let mut child = Command::new(env!("CARGO_BIN_EXE_robocal"))
-            .args([
-                "serve",
-                "--bind",
-                "127.0.0.1:0",
-                "--max-tlbo-evaluations",
-                "100000000",
-            ])
+            .args(["serve", "--bind", "127.0.0.1:0"])
             .env(
                 "DATABASE_URL",
                 format!("sqlite://{}?mode=rwc", db.display()),

@@ -10,7 +10,7 @@
 //! - `--workers N` / `ROBOCAL_WORKERS`: calibration jobs run at once, default 1;
 //! - limits and queues (`--max-queued-jobs`, `--max-queued-solves`,
 //!   `--body-limit`, `--metadata-limit`, `--max-poses-per-set`,
-//!   `--max-targets`, `--max-tlbo-evaluations`, `--job-time-limit`,
+//!   `--max-targets`, `--job-time-limit`,
 //!   `--page-max`, each with a `ROBOCAL_…` variable; see [`crate::http::limits`]);
 //! - `RUST_LOG`: log filter, default `info`.
 //!
@@ -56,9 +56,6 @@ pub struct ServeArgs {
     /// Most targets in one solve request (422 above).
     #[arg(long, env = "ROBOCAL_MAX_TARGETS", default_value_t = Limits::default().targets_per_request)]
     pub max_targets: usize,
-    /// Largest TLBO population × generations of one job (422 above).
-    #[arg(long, env = "ROBOCAL_MAX_TLBO_EVALUATIONS", default_value_t = Limits::default().tlbo_evaluations)]
-    pub max_tlbo_evaluations: u64,
     /// Wall-clock budget of one calibration job in seconds; the job fails when it runs longer.
     #[arg(long, env = "ROBOCAL_JOB_TIME_LIMIT", default_value_t = Limits::default().job_time.as_secs())]
     pub job_time_limit: u64,
@@ -75,7 +72,6 @@ impl ServeArgs {
             ("--metadata-limit", self.metadata_limit as u64),
             ("--max-poses-per-set", self.max_poses_per_set as u64),
             ("--max-targets", self.max_targets as u64),
-            ("--max-tlbo-evaluations", self.max_tlbo_evaluations),
             ("--job-time-limit", self.job_time_limit),
             ("--page-max", self.page_max as u64),
         ];
@@ -88,7 +84,6 @@ impl ServeArgs {
             poses_per_set: self.max_poses_per_set,
             targets_per_request: self.max_targets,
             queued_jobs: self.max_queued_jobs,
-            tlbo_evaluations: self.max_tlbo_evaluations,
             job_time: std::time::Duration::from_secs(self.job_time_limit),
             queued_solves: self.max_queued_solves,
             page_max: self.page_max,

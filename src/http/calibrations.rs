@@ -13,7 +13,7 @@
 //! when the robot has no active version yet: a recalibration never changes
 //! what the cell uses without an explicit `activate`.
 
-use super::input::{check_payload, page_fields, present, PageQuery};
+use super::input::{check_payload, int, page_fields, present, present_int, present_ints, PageQuery};
 use super::robots::robot_not_found;
 use super::sets::MAX_SETS;
 use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState, Ticket};
@@ -57,38 +57,38 @@ pub struct StartCalibration {
     /// Sets that identify the model (default: every set with role identification).
     #[serde(
         default,
-        deserialize_with = "present",
+        deserialize_with = "present_ints",
         skip_serializing_if = "Option::is_none"
     )]
     pub identification_set_ids: Option<Vec<i64>>,
     /// Sets that validate it (default: every set with role validation).
     #[serde(
         default,
-        deserialize_with = "present",
+        deserialize_with = "present_ints",
         skip_serializing_if = "Option::is_none"
     )]
     pub validation_set_ids: Option<Vec<i64>>,
     /// Seed of every random choice (TLBO).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "int")]
     pub seed: u64,
     /// TLBO population (skcm-tlbo), default 50.
     #[serde(
         default,
-        deserialize_with = "present",
+        deserialize_with = "present_int",
         skip_serializing_if = "Option::is_none"
     )]
     pub population: Option<usize>,
     /// TLBO generations (skcm-tlbo), default 100.
     #[serde(
         default,
-        deserialize_with = "present",
+        deserialize_with = "present_int",
         skip_serializing_if = "Option::is_none"
     )]
     pub generations: Option<usize>,
     /// Levenberg–Marquardt iteration limit, default 100.
     #[serde(
         default,
-        deserialize_with = "present",
+        deserialize_with = "present_int",
         skip_serializing_if = "Option::is_none"
     )]
     pub max_iterations: Option<usize>,
@@ -205,7 +205,6 @@ pub async fn start(
         .ok_or_else(|| robot_not_found(robot_id))?;
     let nominal = RobotModel::from_json(&robot.model_json)
         .map_err(|e| ApiError::Internal(format!("stored model of robot {robot_id}: {e}")))?;
-    let limits = state.limits().clone();
 
     let method_list = match &req.methods {
         Some(m) if m.is_empty() => {
@@ -226,13 +225,6 @@ pub async fn start(
     let defaults = CalibrationOptions::default();
     let population = req.population.unwrap_or(defaults.tlbo.population);
     let generations = req.generations.unwrap_or(defaults.tlbo.generations);
-    let evaluations = (population as u64).saturating_mul(generations as u64);
-    if methods.contains(&Method::SkcmTlbo) && evaluations > limits.tlbo_evaluations {
-        return Err(ApiError::invalid(format!(
-            "population × generations = {population} × {generations} = {evaluations} TLBO candidates; at most {} per job (`--max-tlbo-evaluations`)",
-            limits.tlbo_evaluations
-        )));
-    }
     let ticket = state.admit_job()?;
 
     // The sets: named, or every set of the robot with the matching role.
@@ -253,9 +245,11 @@ pub async fn start(
                 }
                 let mut out: Vec<crate::db::SetRow> = Vec::new();
                 for id in ids {
+                    // A reference in the body to a set the robot does not
+                    // have (yet): a conflict with its state, not a missing URL.
                     let s = all_sets.iter().find(|s| s.id == *id).ok_or_else(|| {
-                        ApiError::invalid(format!(
-                            "`{field}`: measurement set {id} does not exist for robot {robot_id}"
+                        ApiError::Conflict(format!(
+                            "`{field}`: measurement set {id} does not exist for robot {robot_id}; list them with GET /v1/robots/{robot_id}/measurement-sets"
                         ))
                     })?;
                     if !out.iter().any(|o| o.id == s.id) {
@@ -273,7 +267,8 @@ pub async fn start(
     )?;
     let valid_sets = pick(&req.validation_set_ids, "validation", "validation_set_ids")?;
     if ident_sets.is_empty() {
-        return Err(ApiError::invalid(format!(
+        // The robot's data, not the request, is missing: a state conflict.
+        return Err(ApiError::Conflict(format!(
             "no identification set: upload one with role identification (POST /v1/robots/{robot_id}/measurement-sets) or list its id in `identification_set_ids`"
         )));
     }
@@ -294,7 +289,8 @@ pub async fn start(
         }
     }
     if let Some(v) = valid_sets.iter().find(|v| !sessions.contains(&v.session)) {
-        return Err(ApiError::invalid(format!(
+        // A property of the stored sets: a state conflict.
+        return Err(ApiError::Conflict(format!(
             "validation set {} was measured in tracker session `{}`, which no identification set has, so its frame cannot be registered; measure identification poses in that session too",
             v.id, v.session
         )));

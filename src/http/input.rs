@@ -91,6 +91,79 @@ where
     T::deserialize(d).map(Some)
 }
 
+/// An integer as JSON Schema counts them: `3` and `3.0` alike (serde's integer
+/// types refuse `3.0`), within the range of `T`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Int<T>(pub T);
+
+impl<'de, T: TryFrom<i128>> Deserialize<'de> for Int<T> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V<T>(PhantomData<T>);
+        impl<T: TryFrom<i128>> V<T> {
+            fn make<E: serde::de::Error>(v: i128) -> Result<Int<T>, E> {
+                T::try_from(v)
+                    .map(Int)
+                    .map_err(|_| E::custom(format!("integer {v} is out of range")))
+            }
+        }
+        impl<'de, T: TryFrom<i128>> Visitor<'de> for V<T> {
+            type Value = Int<T>;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("an integer")
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Int<T>, E> {
+                Self::make(v.into())
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Int<T>, E> {
+                Self::make(v.into())
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<Int<T>, E> {
+                // |v| < 2^100 converts exactly; larger is out of every range here.
+                if v.is_finite() && v.fract() == 0.0 && v.abs() < 1e30 {
+                    Self::make(v as i128)
+                } else {
+                    Err(E::custom(format!("{v} is not an integer in range")))
+                }
+            }
+        }
+        d.deserialize_any(V(PhantomData))
+    }
+}
+
+/// `deserialize_with` for an integer field (see [`Int`]).
+pub fn int<'de, D, T>(d: D) -> Result<T, D::Error>
+where
+    D: Deserializer<'de>,
+    T: TryFrom<i128>,
+{
+    Int::<T>::deserialize(d).map(|i| i.0)
+}
+
+/// `deserialize_with` (with `#[serde(default)]`) for an optional integer that
+/// may be left out but not be `null`.
+pub fn present_int<'de, D, T>(d: D) -> Result<Option<T>, D::Error>
+where
+    D: Deserializer<'de>,
+    T: TryFrom<i128>,
+{
+    int(d).map(Some)
+}
+
+/// `deserialize_with` (with `#[serde(default)]`) for an optional list of
+/// integers that may be left out but not be `null`.
+pub fn present_ints<'de, D, T>(d: D) -> Result<Option<Vec<T>>, D::Error>
+where
+    D: Deserializer<'de>,
+    T: TryFrom<i128>,
+{
+    Ok(Some(
+        Vec::<Int<T>>::deserialize(d)?
+            .into_iter()
+            .map(|i| i.0)
+            .collect(),
+    ))
+}
+
 /// Whitespace as `openapi.yaml` counts it for names: a name needs one
 /// character that is not a space, tab or line break (pattern `[^ \t\r\n]`).
 fn blank(name: &str) -> bool {
@@ -218,6 +291,31 @@ mod tests {
             from_json_object::<Outer>(b""),
             Err(ApiError::BadRequest(_))
         ));
+    }
+
+    #[derive(Debug, Deserialize)]
+    struct Ints {
+        #[serde(deserialize_with = "int")]
+        a: u8,
+        #[serde(default, deserialize_with = "present_ints")]
+        b: Option<Vec<i64>>,
+    }
+
+    #[test]
+    fn integers_as_json_schema_counts_them() {
+        let v: Ints = serde_json::from_str(r#"{"a": 7.0, "b": [1, -2.0, 3e2]}"#).unwrap();
+        assert_eq!(v.a, 7);
+        assert_eq!(v.b, Some(vec![1, -2, 300]));
+        for bad in [
+            r#"{"a": 7.5}"#,
+            r#"{"a": 256}"#,
+            r#"{"a": -1}"#,
+            r#"{"a": "7"}"#,
+            r#"{"a": 1, "b": null}"#,
+            r#"{"a": 1, "b": [1e300]}"#,
+        ] {
+            assert!(serde_json::from_str::<Ints>(bad).is_err(), "{bad}");
+        }
     }
 
     #[test]

@@ -43,8 +43,6 @@ pub struct Limits {
     pub targets_per_request: usize,
     /// Calibration jobs that may wait for a worker.
     pub queued_jobs: usize,
-    /// Largest TLBO population × generations of one job.
-    pub tlbo_evaluations: u64,
     /// Wall-clock budget of one calibration job; it fails when exceeded.
     pub job_time: Duration,
     /// Large solve batches that may wait for a solve worker.
@@ -61,8 +59,7 @@ impl Default for Limits {
             poses_per_set: 100_000,
             targets_per_request: 100_000,
             queued_jobs: 8,
-            tlbo_evaluations: 200_000,
-            job_time: Duration::from_secs(3600),
+            job_time: Duration::from_secs(1800),
             queued_solves: 4,
             page_max: 1000,
         }

@@ -14,7 +14,7 @@
 //! change once written. Small batches are solved inline; larger ones on the
 //! blocking pool (parallel inside), at most `solve_workers` at a time.
 
-use super::input::{check_payload, object_or_null, objects, present};
+use super::input::{check_payload, object_or_null, objects, present, Int};
 use super::{ApiError, ApiJson, ApiPath, AppState, SMALL_SOLVE_MAX};
 use crate::compensate::{CalibratedModelFile, CompensatedModel};
 use crate::ik::{
@@ -74,7 +74,7 @@ fn branch_syntax_ok(text: &str) -> bool {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(untagged)]
 pub enum VersionSelector {
-    Number(i64),
+    Number(Int<i64>),
     Name(String),
 }
 
@@ -226,13 +226,9 @@ fn to_inputs(req: &SolveRequest) -> Result<Vec<TargetInput>, ApiError> {
                     if let Some(c) = &o.convention {
                         convention(c, &format!("target `{id}`: `orientation.convention`"))?;
                     }
+                    // Without a convention the target fails alone (invalid_target).
                     let conv = o.convention.clone().or_else(|| req.convention.clone());
-                    let Some(conv) = conv else {
-                        return Err(ApiError::invalid(format!(
-                            "target `{id}`: the orientation has no convention; set `convention` on the request or on the target (quaternion, kuka_abc, fanuc_wpr, matrix)"
-                        )));
-                    };
-                    (Some(conv), o.values.clone())
+                    (conv, o.values.clone())
                 }
             };
             Ok(TargetInput {
@@ -277,14 +273,16 @@ async fn prepare(
                 "`version` must be a version number, \"active\" or \"nominal\", got \"{n}\""
             )))
         }
-        Some(VersionSelector::Number(v)) if *v < 1 => {
+        Some(VersionSelector::Number(Int(v))) if *v < 1 => {
             return Err(ApiError::invalid(format!(
                 "`version` numbers start at 1, got {v}"
             )))
         }
-        Some(VersionSelector::Number(v)) => {
+        Some(VersionSelector::Number(Int(v))) => {
+            // A version the robot does not have (yet): a conflict with its
+            // state, not a missing URL.
             let row = state.db().version(robot_id, *v).await?.ok_or_else(|| {
-                ApiError::NotFound(format!(
+                ApiError::Conflict(format!(
                     "robot {robot_id} has no model version {v}; list them with GET /v1/robots/{robot_id}/versions"
                 ))
             })?;
