@@ -13,7 +13,9 @@
 //! when the robot has no active version yet: a recalibration never changes
 //! what the cell uses without an explicit `activate`.
 
-use super::input::{check_payload, int, page_fields, present, present_int, present_ints, PageQuery};
+use super::input::{
+    check_payload, int, page_fields, present, present_int, present_ints, PageQuery,
+};
 use super::robots::robot_not_found;
 use super::sets::MAX_SETS;
 use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState, Ticket};
