@@ -24,14 +24,14 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal::compensate::CalibratedModelFile;
 use robocal::db::Db;
+use robocal::http::client::Conn;
 use robocal::http::{app, AppState, ServiceConfig};
 use robocal::measure::csv;
 use robocal::model::orientation::{rotation_to, OrientationConvention};
 use robocal::model::preset;
 use robocal::sim::{try_random_configurations, ys100_table_7_1, PoseFilter, TrueRobot};
 use serde_json::{json, Value};
-use std::io::{BufRead, BufReader, Read, Write};
-use std::net::{SocketAddr, TcpStream, ToSocketAddrs};
+use std::net::{SocketAddr, ToSocketAddrs};
 use std::time::{Duration, Instant};
 
 struct Args {
@@ -84,104 +84,6 @@ fn parse_args() -> anyhow::Result<Args> {
         );
     }
     Ok(a)
-}
-
-/// A keep-alive HTTP/1.1 connection.
-struct Conn {
-    addr: SocketAddr,
-    reader: BufReader<TcpStream>,
-    writer: TcpStream,
-}
-
-impl Conn {
-    fn open(addr: SocketAddr) -> anyhow::Result<Conn> {
-        let s = TcpStream::connect(addr)?;
-        s.set_nodelay(true)?;
-        s.set_read_timeout(Some(Duration::from_secs(60)))?;
-        Ok(Conn {
-            addr,
-            reader: BufReader::new(s.try_clone()?),
-            writer: s,
-        })
-    }
-
-    /// Sends a request and returns (status, body).
-    fn request(
-        &mut self,
-        method: &str,
-        path: &str,
-        body: Option<(&str, &[u8])>,
-    ) -> anyhow::Result<(u16, Vec<u8>)> {
-        let mut head = format!("{method} {path} HTTP/1.1\r\nHost: {}\r\n", self.addr);
-        match body {
-            Some((ct, b)) => head.push_str(&format!(
-                "Content-Type: {ct}\r\nContent-Length: {}\r\n\r\n",
-                b.len()
-            )),
-            None => head.push_str("Content-Length: 0\r\n\r\n"),
-        }
-        let mut msg = head.into_bytes();
-        if let Some((_, b)) = body {
-            msg.extend_from_slice(b);
-        }
-        self.writer.write_all(&msg)?;
-        let mut line = String::new();
-        self.reader.read_line(&mut line)?;
-        let status: u16 = line
-            .split_whitespace()
-            .nth(1)
-            .and_then(|s| s.parse().ok())
-            .with_context(|| format!("bad status line {line:?}"))?;
-        let mut len = 0usize;
-        let mut chunked = false;
-        loop {
-            line.clear();
-            self.reader.read_line(&mut line)?;
-            let l = line.trim_end();
-            if l.is_empty() {
-                break;
-            }
-            let lower = l.to_ascii_lowercase();
-            if let Some(v) = lower.strip_prefix("content-length:") {
-                len = v.trim().parse()?;
-            }
-            if lower.starts_with("transfer-encoding:") && lower.contains("chunked") {
-                chunked = true;
-            }
-        }
-        let mut out = Vec::new();
-        if chunked {
-            loop {
-                line.clear();
-                self.reader.read_line(&mut line)?;
-                let n = usize::from_str_radix(line.trim(), 16)?;
-                let mut chunk = vec![0; n + 2];
-                self.reader.read_exact(&mut chunk)?;
-                if n == 0 {
-                    break;
-                }
-                out.extend_from_slice(&chunk[..n]);
-            }
-        } else {
-            out.resize(len, 0);
-            self.reader.read_exact(&mut out)?;
-        }
-        Ok((status, out))
-    }
-
-    fn json(&mut self, method: &str, path: &str, body: Option<Value>) -> anyhow::Result<Value> {
-        let text = body.map(|b| b.to_string());
-        let (status, bytes) = self.request(
-            method,
-            path,
-            text.as_deref().map(|t| ("application/json", t.as_bytes())),
-        )?;
-        let v: Value = serde_json::from_slice(&bytes).unwrap_or(Value::Null);
-        if status >= 400 {
-            bail!("{method} {path}: {status} {v}");
-        }
-        Ok(v)
-    }
 }
 
 fn loopback(url: &str) -> anyhow::Result<SocketAddr> {

@@ -28,6 +28,7 @@ use std::time::{Duration, Instant};
 use tokio::sync::Semaphore;
 
 pub mod calibrations;
+pub mod client;
 pub mod error;
 pub mod input;
 pub mod limits;

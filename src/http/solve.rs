@@ -241,6 +241,97 @@ fn to_inputs(req: &SolveRequest) -> Result<Vec<TargetInput>, ApiError> {
         .collect()
 }
 
+/// A solve request after its checks: what every target needs.
+pub struct CheckedRequest {
+    pub inputs: Vec<TargetInput>,
+    pub frame: TargetFrame,
+    pub branch: Option<Configuration>,
+    pub default_conv: OrientationConvention,
+}
+
+/// Every check of a solve request that does not need the robot (422 on
+/// failure, naming the field).
+pub fn check_request(req: &SolveRequest, max_targets: usize) -> Result<CheckedRequest, ApiError> {
+    if req.targets.is_empty() {
+        return Err(ApiError::invalid(
+            "`targets` is empty: send at least one target",
+        ));
+    }
+    if req.targets.len() > max_targets {
+        return Err(ApiError::invalid(format!(
+            "{} targets in one request; at most {max_targets} (`--max-targets`): split the batch",
+            req.targets.len()
+        )));
+    }
+    if let Some(p) = req.payload_kg {
+        check_payload("`payload_kg`", p)?;
+    }
+    if let Some(j) = req.jump_deg {
+        if !(j.is_finite() && j > 0.0) {
+            return Err(ApiError::invalid(
+                "`jump_deg` must be a positive number of degrees",
+            ));
+        }
+    }
+    let frame: TargetFrame = match req.frame.as_deref() {
+        None | Some("cell") => TargetFrame::Cell,
+        Some("base") => TargetFrame::Base,
+        Some(f) => {
+            return Err(ApiError::invalid(format!(
+                "`frame` must be cell or base, got `{f}`"
+            )))
+        }
+    };
+    if let Some(b) = &req.branch {
+        if !branch_syntax_ok(b) {
+            return Err(ApiError::invalid(format!(
+                "`branch`: `{b}` is not a branch; give an index 0..7 or flags front|back, up|down, noflip|flip in lower case joined by `,`, e.g. front,up,noflip"
+            )));
+        }
+    }
+    let branch = req
+        .branch
+        .as_deref()
+        .map(Configuration::parse)
+        .transpose()
+        .map_err(|e| ApiError::invalid(format!("`branch`: {e}")))?;
+    if req.seed_deg.is_some() && branch.is_some() {
+        return Err(ApiError::invalid(
+            "give either `branch` or `seed_deg`, not both",
+        ));
+    }
+    let inputs = to_inputs(req)?;
+    let default_conv = req
+        .convention
+        .as_deref()
+        .map(|c| convention(c, "`convention`"))
+        .transpose()?
+        .unwrap_or(OrientationConvention::Quaternion);
+    Ok(CheckedRequest {
+        inputs,
+        frame,
+        branch,
+        default_conv,
+    })
+}
+
+/// The joint seed of a request in the solver's joint convention, checked
+/// against the robot's joint count.
+pub fn seed_joints(req: &SolveRequest, solver: &IkSolver) -> Result<Option<Vec<f64>>, ApiError> {
+    let Some(s) = &req.seed_deg else {
+        return Ok(None);
+    };
+    let dof = solver.model().dof();
+    if s.len() != dof || s.iter().any(|v| !v.is_finite()) {
+        return Err(ApiError::invalid(format!(
+            "`seed_deg` needs {dof} finite joint values (controller convention, degrees), got {}",
+            s.len()
+        )));
+    }
+    let rad: Vec<f64> = s.iter().map(|d| d.to_radians()).collect();
+    Ok(Some(solver.model().nominal.joints_from_controller(&rad)))
+}
+
 /// The prepared solver and what it is.
 struct Prepared {
     solver: Arc<IkSolver>,
@@ -339,7 +430,7 @@ async fn prepare(
 }
 
 /// Solves small batches without leaving the calling thread.
-fn solve_inline(
+pub fn solve_inline(
     solver: &IkSolver,
     targets: &[TargetInput],
     options: &SolveOptions,
@@ -379,79 +470,16 @@ pub async fn solve(
     ApiJson(req): ApiJson<SolveRequest>,
 ) -> Result<Response, ApiError> {
     let start = Instant::now();
-    if req.targets.is_empty() {
-        return Err(ApiError::invalid(
-            "`targets` is empty: send at least one target",
-        ));
-    }
-    let max_targets = state.limits().targets_per_request;
-    if req.targets.len() > max_targets {
-        return Err(ApiError::invalid(format!(
-            "{} targets in one request; at most {max_targets} (`--max-targets`): split the batch",
-            req.targets.len()
-        )));
-    }
-    if let Some(p) = req.payload_kg {
-        check_payload("`payload_kg`", p)?;
-    }
-    if let Some(j) = req.jump_deg {
-        if !(j.is_finite() && j > 0.0) {
-            return Err(ApiError::invalid(
-                "`jump_deg` must be a positive number of degrees",
-            ));
-        }
-    }
-    let frame: TargetFrame = match req.frame.as_deref() {
-        None | Some("cell") => TargetFrame::Cell,
-        Some("base") => TargetFrame::Base,
-        Some(f) => {
-            return Err(ApiError::invalid(format!(
-                "`frame` must be cell or base, got `{f}`"
-            )))
-        }
-    };
-    if let Some(b) = &req.branch {
-        if !branch_syntax_ok(b) {
-            return Err(ApiError::invalid(format!(
-                "`branch`: `{b}` is not a branch; give an index 0..7 or flags front|back, up|down, noflip|flip in lower case joined by `,`, e.g. front,up,noflip"
-            )));
-        }
-    }
-    let branch = req
-        .branch
-        .as_deref()
-        .map(Configuration::parse)
-        .transpose()
-        .map_err(|e| ApiError::invalid(format!("`branch`: {e}")))?;
-    if req.seed_deg.is_some() && branch.is_some() {
-        return Err(ApiError::invalid(
-            "give either `branch` or `seed_deg`, not both",
-        ));
-    }
-    let inputs = to_inputs(&req)?;
-    let default_conv = req
-        .convention
-        .as_deref()
-        .map(|c| convention(c, "`convention`"))
-        .transpose()?
-        .unwrap_or(OrientationConvention::Quaternion);
+    let CheckedRequest {
+        inputs,
+        frame,
+        branch,
+        default_conv,
+    } = check_request(&req, state.limits().targets_per_request)?;
 
     let prepared = prepare(&state, robot_id, &req).await?;
     let solver = prepared.solver.clone();
-    let seed = match &req.seed_deg {
-        None => None,
-        Some(s) => {
-            let dof = solver.model().dof();
-            if s.len() != dof || s.iter().any(|v| !v.is_finite()) {
-                return Err(ApiError::invalid(format!(
-                    "`seed_deg` needs {dof} finite joint values (controller convention, degrees), got {}",
-                    s.len()
-                )));
-            }
-            let rad: Vec<f64> = s.iter().map(|d| d.to_radians()).collect();
-            Some(solver.model().nominal.joints_from_controller(&rad))
-        }
-    };
+    let seed = seed_joints(&req, &solver)?;
     let options = SolveOptions {
         frame,
         position_only: req.position_only,

@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Bounded fuzzing of the parsers with cargo-fuzz (libFuzzer) on the stable
+# toolchain (`--sanitizer none`: coverage-guided, no sanitizer; the code under
+# test is safe Rust, so what is looked for is panics, overflows caught by debug
+# assertions, hangs and broken round trips).
+#
+#   scripts/fuzz.sh [SECONDS_PER_TARGET]     (default 60)
+#
+# Targets (fuzz/fuzz_targets/): measurement_csv, targets_csv, model_json,
+# solve_request. Each run starts from the seeds in fuzz/seeds/<target>/ with a
+# fixed libFuzzer seed and writes new inputs to a temporary corpus, so the
+# repository is not changed. A crash leaves its input in
+# fuzz/artifacts/<target>/ and fails the script; turn it into a regression
+# test in tests/fuzz_regressions.rs.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+SECS=${1:-60}
+VERSION=0.13.2
+if ! cargo fuzz --version 2>/dev/null | grep -q "$VERSION"; then
+    cargo install cargo-fuzz --locked --version "$VERSION"
+fi
+cd fuzz
+cargo fuzz build --sanitizer none
+status=0
+for target in measurement_csv targets_csv model_json solve_request; do
+    corpus=$(mktemp -d)
+    log=$(mktemp)
+    code=0
+    cargo fuzz run --sanitizer none "$target" "$corpus" "seeds/$target" -- \
+        -max_total_time="$SECS" -seed=1 -timeout=10 -rss_limit_mb=2048 \
+        -max_len=8192 -print_final_stats=1 >"$log" 2>&1 || code=$?
+    runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log")
+    new=$(sed -n 's/^stat::new_units_added: *//p' "$log")
+    if [ "$code" -ne 0 ]; then
+        tail -40 "$log" >&2
+        echo "fuzz: $target FAILED after ${runs:-?} runs; the input is in fuzz/artifacts/$target/" >&2
+        status=1
+    else
+        echo "fuzz: $target: ${runs:-?} inputs in ${SECS} s, ${new:-?} new coverage units, no failure"
+    fi
+    rm -rf "$corpus" "$log"
+done
+exit $status
