@@ -42,6 +42,8 @@ struct Args {
     batches: usize,
     batch_size: usize,
     server_threads: usize,
+    /// Write the request bodies (single.json, batch.json) here and stop.
+    write_bodies: Option<std::path::PathBuf>,
 }
 
 fn parse_args() -> anyhow::Result<Args> {
@@ -53,6 +55,7 @@ fn parse_args() -> anyhow::Result<Args> {
         batches: 50,
         batch_size: 1000,
         server_threads: 2,
+        write_bodies: None,
     };
     let mut it = std::env::args().skip(1);
     while let Some(flag) = it.next() {
@@ -65,10 +68,12 @@ fn parse_args() -> anyhow::Result<Args> {
             "--batches" => a.batches = val()?.parse()?,
             "--batch-size" => a.batch_size = val()?.parse()?,
             "--server-threads" => a.server_threads = val()?.parse()?,
+            "--write-bodies" => a.write_bodies = Some(val()?.into()),
             "-h" | "--help" => {
                 println!(
                     "robocal-load [--url http://127.0.0.1:8080 --robot ID] [--connections 4] \
-                     [--single 20000] [--batches 50] [--batch-size 1000] [--server-threads 2]"
+                     [--single 20000] [--batches 50] [--batch-size 1000] [--server-threads 2] \
+                     [--write-bodies DIR]"
                 );
                 std::process::exit(0);
             }
@@ -272,6 +277,17 @@ fn main() -> anyhow::Result<()> {
     let batch = json!({ "convention": "kuka_abc", "targets": &pool[..args.batch_size] })
         .to_string()
         .into_bytes();
+    if let Some(dir) = &args.write_bodies {
+        // For an outside load generator (wrk): one single-target body and one batch.
+        std::fs::create_dir_all(dir)?;
+        std::fs::write(dir.join("single.json"), &singles[0])?;
+        std::fs::write(dir.join("batch.json"), &batch)?;
+        println!(
+            "robocal-load: wrote {}/single.json and batch.json for robot {robot}",
+            dir.display()
+        );
+        return Ok(());
+    }
     println!(
         "robocal-load: {addr}, robot {robot}, {} cores, {} client connections",
         std::thread::available_parallelism().map_or(0, |n| n.get()),

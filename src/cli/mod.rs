@@ -1,7 +1,8 @@
-//! The `robocal` command line: simulate, calibrate, demo, solve, serve.
+//! The `robocal` command line: simulate, calibrate, demo, solve, serve, bench.
 
 use clap::{Parser, Subcommand};
 
+pub mod bench;
 pub mod calibrate;
 pub mod demo;
 pub mod serve;
@@ -31,6 +32,8 @@ pub enum Command {
     Solve(solve::SolveArgs),
     /// Run the HTTP service.
     Serve(serve::ServeArgs),
+    /// Time robocal's side of the peer benchmark (KM, IK), as JSON.
+    Bench(bench::BenchArgs),
 }
 
 /// Runs the parsed command line.
@@ -41,6 +44,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Demo(a) => demo::run(a),
         Command::Solve(a) => solve::run(a),
         Command::Serve(a) => serve::run(a),
+        Command::Bench(a) => bench::run(a),
     }
 }
 

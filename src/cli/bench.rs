@@ -1,0 +1,269 @@
+//! `robocal bench`: in-process timings of robocal's side of the peer
+//! benchmark (`scripts/peer_bench.py`), printed as JSON.
+//!
+//! - `bench km`: KM (seed §2.2, eqs. 2.3–2.4) on an identification CSV, the
+//!   validation error of the fitted model, and the wall time of the whole
+//!   `identify::calibrate` call (registration, identifiability, KM), repeated.
+//! - `bench ik`: inverse kinematics of target poses (CSV `x,y,z` in mm and
+//!   `qw,qx,qy,qz`, in the robot's base frame) on a model (preset, model JSON
+//!   or calibrated model file), each solve timed alone; the accuracy of each
+//!   solution is measured independently by forward kinematics of the returned
+//!   joints (position error in mm, rotation angle in rad).
+//!
+//! Times are wall-clock on the calling thread (pin with `taskset -c 0`).
+
+use crate::compensate::{CalibratedModelFile, CompensatedModel};
+use crate::identify::{calibrate, CalibrationOptions, Method};
+use crate::ik::{Goal, IkSettings, IkSolver, SolveOptions, TargetFrame};
+use crate::measure::{self, csv};
+use anyhow::{bail, Context};
+use clap::{Args, Subcommand};
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use serde_json::json;
+use std::time::Instant;
+
+#[derive(Debug, Args)]
+pub struct BenchArgs {
+    #[command(subcommand)]
+    pub what: BenchCommand,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum BenchCommand {
+    /// KM calibration: validation accuracy and time per calibration.
+    Km(KmArgs),
+    /// Inverse kinematics: solve rate, accuracy and time per target.
+    Ik(IkArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct KmArgs {
+    /// Preset name or model JSON file.
+    #[arg(long)]
+    pub model: String,
+    /// Identification measurement CSV.
+    #[arg(long)]
+    pub identify: String,
+    /// Validation measurement CSV.
+    #[arg(long)]
+    pub validate: String,
+    /// Sign of `*_dif` columns (real-data layout): plus or minus.
+    #[arg(long, default_value = "plus")]
+    pub dif_sign: String,
+    /// Calibrations to time.
+    #[arg(long, default_value_t = 10)]
+    pub repeat: usize,
+}
+
+#[derive(Debug, Args)]
+pub struct IkArgs {
+    /// Preset name or model JSON file (the nominal model).
+    #[arg(long)]
+    pub model: String,
+    /// A calibrated model file (`robocal calibrate --save`) to solve on instead.
+    #[arg(long)]
+    pub calibrated: Option<String>,
+    /// Targets CSV: x,y,z (mm), qw,qx,qy,qz, in the base frame.
+    #[arg(long)]
+    pub targets: String,
+    /// Position tolerance (mm).
+    #[arg(long, default_value_t = 1e-4)]
+    pub position_tolerance_mm: f64,
+    /// Orientation tolerance (rad).
+    #[arg(long, default_value_t = 1e-7)]
+    pub orientation_tolerance_rad: f64,
+    /// Passes over the targets.
+    #[arg(long, default_value_t = 5)]
+    pub repeat: usize,
+    /// Write the solutions here (CSV: converged, q1..qN in model radians), for
+    /// checking them with another implementation's forward kinematics.
+    #[arg(long)]
+    pub joints_out: Option<String>,
+}
+
+pub fn run(a: BenchArgs) -> anyhow::Result<()> {
+    let out = match a.what {
+        BenchCommand::Km(k) => km(&k)?,
+        BenchCommand::Ik(i) => ik(&i)?,
+    };
+    println!("{}", serde_json::to_string_pretty(&out)?);
+    Ok(())
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n == 0 {
+        f64::NAN
+    } else if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+fn km(a: &KmArgs) -> anyhow::Result<serde_json::Value> {
+    let model = crate::cli::load_model(&a.model)?;
+    let dif = match a.dif_sign.as_str() {
+        "plus" => csv::DifSign::Plus,
+        "minus" => csv::DifSign::Minus,
+        other => bail!("--dif-sign must be plus or minus, got {other}"),
+    };
+    let read = |p: &str| -> anyhow::Result<_> {
+        let text = std::fs::read_to_string(p).with_context(|| format!("cannot read {p}"))?;
+        csv::parse_with(&text, dif).with_context(|| p.to_string())
+    };
+    let payload = model.payload.mass;
+    let ident = measure::to_measurements(&model, &read(&a.identify)?, payload);
+    let valid = measure::to_measurements(&model, &read(&a.validate)?, payload);
+    let opts = CalibrationOptions {
+        methods: vec![Method::Km],
+        ..Default::default()
+    };
+    let mut times = Vec::new();
+    let mut last = None;
+    for _ in 0..a.repeat.max(1) {
+        let t = Instant::now();
+        let r = calibrate(&model, &ident, &valid, &opts, &|_| true)?;
+        times.push(t.elapsed().as_secs_f64() * 1e3);
+        last = Some(r);
+    }
+    let r = last.expect("at least one run");
+    let m = r.methods.get("km").context("KM did not run")?;
+    let v = m.validation.as_ref().context("no validation")?;
+    Ok(json!({
+        "bench": "km",
+        "model": a.model,
+        "identification_poses": ident.len(),
+        "validation_poses": valid.len(),
+        "nominal_validation_mean_mm": r.nominal.validation.as_ref().map(|v| v.stats.mean_mm),
+        "validation_mean_mm": v.stats.mean_mm,
+        "validation_max_mm": v.stats.max_mm,
+        "identification_mean_mm": m.identification.stats.mean_mm,
+        "parameters": m.parameters.len(),
+        "converged": m.solver.converged,
+        "iterations": m.solver.iterations,
+        "repeats": times.len(),
+        "time_ms_median": median(times.clone()),
+        "time_ms_min": times.iter().copied().fold(f64::INFINITY, f64::min),
+    }))
+}
+
+/// Target poses of a CSV with columns x,y,z,qw,qx,qy,qz (any order).
+fn read_pose_targets(path: &str) -> anyhow::Result<Vec<Goal>> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {path}"))?;
+    let mut lines = text
+        .lines()
+        .filter(|l| !l.trim().is_empty() && !l.starts_with('#'));
+    let header: Vec<String> = lines
+        .next()
+        .context("empty targets file")?
+        .split(',')
+        .map(|c| c.trim().to_ascii_lowercase())
+        .collect();
+    let col = |n: &str| {
+        header
+            .iter()
+            .position(|c| c == n)
+            .with_context(|| format!("{path}: no column {n}"))
+    };
+    let idx = [
+        col("x")?,
+        col("y")?,
+        col("z")?,
+        col("qw")?,
+        col("qx")?,
+        col("qy")?,
+        col("qz")?,
+    ];
+    lines
+        .enumerate()
+        .map(|(i, l)| {
+            let f: Vec<f64> = l
+                .split(',')
+                .map(|v| v.trim().parse::<f64>())
+                .collect::<Result<_, _>>()
+                .with_context(|| format!("{path}: line {}", i + 2))?;
+            let g = |k: usize| f.get(idx[k]).copied().context("short line");
+            let q = UnitQuaternion::from_quaternion(Quaternion::new(g(3)?, g(4)?, g(5)?, g(6)?));
+            Ok(Goal {
+                position: Vector3::new(g(0)?, g(1)?, g(2)?) * 1e-3,
+                rotation: Some(*q.to_rotation_matrix().matrix()),
+            })
+        })
+        .collect()
+}
+
+fn ik(a: &IkArgs) -> anyhow::Result<serde_json::Value> {
+    let nominal = crate::cli::load_model(&a.model)?;
+    let model = match &a.calibrated {
+        None => CompensatedModel::from_nominal(nominal),
+        Some(p) => {
+            let text = std::fs::read_to_string(p).with_context(|| format!("cannot read {p}"))?;
+            CalibratedModelFile::from_json(&text)
+                .and_then(|f| f.to_compensated())
+                .map_err(|e| anyhow::anyhow!("{p}: {e}"))?
+        }
+    };
+    let settings = IkSettings {
+        position_tolerance_m: a.position_tolerance_mm * 1e-3,
+        orientation_tolerance_rad: a.orientation_tolerance_rad,
+        ..IkSettings::default()
+    };
+    let solver = IkSolver::new(model, settings);
+    let goals = read_pose_targets(&a.targets)?;
+    let options = SolveOptions {
+        frame: TargetFrame::Base,
+        ..SolveOptions::default()
+    };
+    let mut times = Vec::with_capacity(goals.len() * a.repeat.max(1));
+    let mut solutions = Vec::new();
+    for pass in 0..a.repeat.max(1) {
+        for g in &goals {
+            let t = Instant::now();
+            let s = solver.solve_goal(g, &options);
+            times.push(t.elapsed().as_secs_f64() * 1e6);
+            if pass == 0 {
+                solutions.push(s);
+            }
+        }
+    }
+    if let Some(path) = &a.joints_out {
+        let mut out = String::new();
+        for s in &solutions {
+            let q: Vec<String> = s.q.iter().map(|v| v.to_string()).collect();
+            out.push_str(&format!("{},{}\n", u8::from(s.converged), q.join(",")));
+        }
+        std::fs::write(path, out).with_context(|| format!("cannot write {path}"))?;
+    }
+    // Accuracy by forward kinematics of the returned joints, not the solver's residual.
+    let (mut solved, mut max_p, mut max_r, mut sum_p) = (0, 0.0f64, 0.0f64, 0.0);
+    for (g, s) in goals.iter().zip(&solutions) {
+        if !s.converged {
+            continue;
+        }
+        solved += 1;
+        let pose = solver.model().predict_base(&s.q)?;
+        let dp = (pose.p - g.position).norm() * 1e3;
+        let r = g.rotation.expect("pose targets");
+        let dr = nalgebra::Rotation3::from_matrix_unchecked(pose.r.transpose() * r).angle();
+        max_p = max_p.max(dp);
+        max_r = max_r.max(dr);
+        sum_p += dp;
+    }
+    Ok(json!({
+        "bench": "ik",
+        "model": a.calibrated.clone().unwrap_or_else(|| a.model.clone()),
+        "targets": goals.len(),
+        "solved": solved,
+        "solve_rate": solved as f64 / goals.len().max(1) as f64,
+        "position_tolerance_mm": a.position_tolerance_mm,
+        "orientation_tolerance_rad": a.orientation_tolerance_rad,
+        "mean_position_error_mm": sum_p / solved.max(1) as f64,
+        "max_position_error_mm": max_p,
+        "max_orientation_error_rad": max_r,
+        "repeats": a.repeat.max(1),
+        "time_us_median": median(times.clone()),
+        "time_us_mean": times.iter().sum::<f64>() / times.len().max(1) as f64,
+    }))
+}
