@@ -133,17 +133,39 @@ impl Db {
         limit: i64,
         offset: i64,
     ) -> Result<(Vec<RobotRow>, i64), DbError> {
+        self.page(
+            &format!("{ROBOT_SELECT} ORDER BY r.id LIMIT ? OFFSET ?"),
+            "SELECT COUNT(*) FROM robots",
+            None,
+            limit,
+            offset,
+        )
+        .await
+    }
+
+    /// One page of a list query (`… LIMIT ? OFFSET ?`, with a leading
+    /// `robot_id = ?` parameter when `robot_id` is given) and the count of the
+    /// whole list, read in one transaction so both agree.
+    async fn page<T>(
+        &self,
+        list_sql: &str,
+        count_sql: &str,
+        robot_id: Option<i64>,
+        limit: i64,
+        offset: i64,
+    ) -> Result<(Vec<T>, i64), DbError>
+    where
+        T: for<'r> FromRow<'r, sqlx::sqlite::SqliteRow> + Send + Unpin,
+    {
         let mut tx = self.pool.begin().await?;
-        let rows = sqlx::query_as::<_, RobotRow>(&format!(
-            "{ROBOT_SELECT} ORDER BY r.id LIMIT ? OFFSET ?"
-        ))
-        .bind(limit)
-        .bind(offset)
-        .fetch_all(&mut *tx)
-        .await?;
-        let total = sqlx::query_scalar("SELECT COUNT(*) FROM robots")
-            .fetch_one(&mut *tx)
-            .await?;
+        let mut list = sqlx::query_as::<_, T>(list_sql);
+        let mut count = sqlx::query_scalar::<_, i64>(count_sql);
+        if let Some(id) = robot_id {
+            list = list.bind(id);
+            count = count.bind(id);
+        }
+        let rows = list.bind(limit).bind(offset).fetch_all(&mut *tx).await?;
+        let total = count.fetch_one(&mut *tx).await?;
         tx.commit().await?;
         Ok((rows, total))
     }
@@ -235,21 +257,14 @@ impl Db {
         limit: i64,
         offset: i64,
     ) -> Result<(Vec<SetRow>, i64), DbError> {
-        let mut tx = self.pool.begin().await?;
-        let rows = sqlx::query_as::<_, SetRow>(&format!(
-            "{SET_SELECT} WHERE robot_id = ? ORDER BY id LIMIT ? OFFSET ?"
-        ))
-        .bind(robot_id)
-        .bind(limit)
-        .bind(offset)
-        .fetch_all(&mut *tx)
-        .await?;
-        let total = sqlx::query_scalar("SELECT COUNT(*) FROM measurement_sets WHERE robot_id = ?")
-            .bind(robot_id)
-            .fetch_one(&mut *tx)
-            .await?;
-        tx.commit().await?;
-        Ok((rows, total))
+        self.page(
+            &format!("{SET_SELECT} WHERE robot_id = ? ORDER BY id LIMIT ? OFFSET ?"),
+            "SELECT COUNT(*) FROM measurement_sets WHERE robot_id = ?",
+            Some(robot_id),
+            limit,
+            offset,
+        )
+        .await
     }
 
     pub async fn sets(&self, robot_id: i64) -> Result<Vec<SetRow>, DbError> {
@@ -342,21 +357,14 @@ impl Db {
         limit: i64,
         offset: i64,
     ) -> Result<(Vec<CalibrationRow>, i64), DbError> {
-        let mut tx = self.pool.begin().await?;
-        let rows = sqlx::query_as::<_, CalibrationRow>(&format!(
-            "{CAL_SELECT} WHERE robot_id = ? ORDER BY id LIMIT ? OFFSET ?"
-        ))
-        .bind(robot_id)
-        .bind(limit)
-        .bind(offset)
-        .fetch_all(&mut *tx)
-        .await?;
-        let total = sqlx::query_scalar("SELECT COUNT(*) FROM calibrations WHERE robot_id = ?")
-            .bind(robot_id)
-            .fetch_one(&mut *tx)
-            .await?;
-        tx.commit().await?;
-        Ok((rows, total))
+        self.page(
+            &format!("{CAL_SELECT} WHERE robot_id = ? ORDER BY id LIMIT ? OFFSET ?"),
+            "SELECT COUNT(*) FROM calibrations WHERE robot_id = ?",
+            Some(robot_id),
+            limit,
+            offset,
+        )
+        .await
     }
 
     pub async fn calibrations(&self, robot_id: i64) -> Result<Vec<CalibrationRow>, DbError> {
@@ -559,21 +567,14 @@ impl Db {
         limit: i64,
         offset: i64,
     ) -> Result<(Vec<VersionRow>, i64), DbError> {
-        let mut tx = self.pool.begin().await?;
-        let rows = sqlx::query_as::<_, VersionRow>(&format!(
-            "{VERSION_SELECT} WHERE robot_id = ? ORDER BY version LIMIT ? OFFSET ?"
-        ))
-        .bind(robot_id)
-        .bind(limit)
-        .bind(offset)
-        .fetch_all(&mut *tx)
-        .await?;
-        let total = sqlx::query_scalar("SELECT COUNT(*) FROM model_versions WHERE robot_id = ?")
-            .bind(robot_id)
-            .fetch_one(&mut *tx)
-            .await?;
-        tx.commit().await?;
-        Ok((rows, total))
+        self.page(
+            &format!("{VERSION_SELECT} WHERE robot_id = ? ORDER BY version LIMIT ? OFFSET ?"),
+            "SELECT COUNT(*) FROM model_versions WHERE robot_id = ?",
+            Some(robot_id),
+            limit,
+            offset,
+        )
+        .await
     }
 
     pub async fn versions(&self, robot_id: i64) -> Result<Vec<VersionRow>, DbError> {
