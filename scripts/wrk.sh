@@ -39,7 +39,19 @@ function response(status, headers, body)
   if status ~= 200 then error("status " .. status) end
 end
 LUA
-echo "== single-target solves: wrk -t2 -c16 -d$DURATION"
-BODY="$WORK/single.json" wrk -t2 -c16 -d"$DURATION" --latency -s "$WORK/post.lua" "http://$ADDR/v1/robots/1/solve"
-echo "== 1000-target batches, one at a time: wrk -t1 -c1 -d$DURATION"
-BODY="$WORK/batch.json" wrk -t1 -c1 -d"$DURATION" --latency -s "$WORK/post.lua" "http://$ADDR/v1/robots/1/solve"
+# Server CPU time (user + system) per request: independent of what else runs
+# on the machine, unlike requests/s.
+cpu_ticks() { awk '{print $14 + $15}' "/proc/$SERVER_PID/stat"; }
+run() {
+    local label=$1 body=$2; shift 2
+    echo "== $label: wrk $*"
+    local before out requests
+    before=$(cpu_ticks)
+    out=$(BODY="$body" wrk "$@" --latency -s "$WORK/post.lua" "http://$ADDR/v1/robots/1/solve")
+    echo "$out"
+    requests=$(echo "$out" | awk '/requests in/ {print $1}')
+    awk -v t="$(( $(cpu_ticks) - before ))" -v hz="$(getconf CLK_TCK)" -v n="$requests" \
+        'BEGIN { printf "server CPU per request: %.1f us (%d requests)\n", t / hz / n * 1e6, n }'
+}
+run "single-target solves" "$WORK/single.json" -t2 -c16 -d"$DURATION"
+run "1000-target batches, one at a time" "$WORK/batch.json" -t1 -c1 -d"$DURATION"
