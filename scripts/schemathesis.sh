@@ -52,7 +52,7 @@ ROBOCAL_API_KEYS=ci-key-1,ci-key-2 RUST_LOG=warn,robocal::cli::serve=info "$BIN"
 SERVER_PID=$!
 ADDR=
 for _ in $(seq 1 300); do
-    ADDR=$(sed -n 's/.*listening on http:\/\/\([0-9.:]*\).*/\1/p' "$WORK/server.log" 2>/dev/null | head -1)
+    ADDR=$(sed -n 's/.*listening on http:\/\/\([0-9.:]*\).*/\1/p' "$WORK/server.log" 2>/dev/null | head -1 || true)
     [ -n "$ADDR" ] && break
     kill -0 "$SERVER_PID" 2>/dev/null || { echo "schemathesis.sh: the server exited" >&2; exit 1; }
     sleep 0.1

@@ -23,7 +23,7 @@ RUST_LOG=warn,robocal::cli::serve=info target/release/robocal serve --bind 127.0
     --database-url "sqlite://$WORK/wrk.db?mode=rwc" 2> "$WORK/server.log" &
 SERVER_PID=$!
 for _ in $(seq 1 100); do
-    ADDR=$(sed -n 's/.*listening on http:\/\/\([0-9.:]*\).*/\1/p' "$WORK/server.log" | head -1)
+    ADDR=$(sed -n 's/.*listening on http:\/\/\([0-9.:]*\).*/\1/p' "$WORK/server.log" 2>/dev/null | head -1 || true)
     [ -n "$ADDR" ] && break
     sleep 0.1
 done
