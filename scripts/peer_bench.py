@@ -3,14 +3,15 @@
     scripts/peer_bench.sh                 (one command: venv, release build, this script)
     python scripts/peer_bench.py --robocal target/release/robocal
 
-KM (kinematic calibration, least squares on all geometric parameters) on the
-real UR5 laser-tracker grid (1000 poses), validated on its 20 random poses:
-  - reference A: pybotics' kinematic chain (the UR5's standard DH regrouped
-    into pybotics' modified DH exactly), fitted with scipy.optimize
-    least_squares (LM); forward kinematics pose by pose, as pybotics does;
-  - reference B: the same model with vectorised numpy forward kinematics and
-    scipy least_squares (LM) — the fastest plain-Python reference;
-  - robocal: `robocal bench km` (registration, identifiability, KM).
+KM (kinematic calibration, least squares on the identifiable geometric
+parameters) on the real UR5 laser-tracker grid (1000 poses), validated on its
+20 random poses:
+  - reference: the UR5's standard DH with vectorised numpy forward kinematics,
+    fitted with scipy.optimize.least_squares (LM) on 25 parameters: a, alpha,
+    theta offset of joints 1-5, d of joints 4 and 5, the tool position, and the
+    base frame's translation and tilt (rotations about x and y) — d1, d2, d3,
+    a6, alpha6, d6, theta6 and the base's rotation about z depend on these;
+  - robocal: `robocal bench km` (registration, identifiability by SVD, KM).
 Accuracy is the mean position error on the 20 validation poses; time is the
 median wall time of a whole fit.
 
@@ -72,74 +73,36 @@ def fk_std(q, a, d, alpha, theta, tool):
     return (T[:, :3, :3] @ tool + T[:, :3, 3])
 
 
+# Free parameters (indices into a, d, alpha, theta offset: 6 each) and the tool.
+FREE_A, FREE_D, FREE_AL, FREE_TH = [0, 1, 2, 3, 4], [3, 4], [0, 1, 2, 3, 4], [0, 1, 2, 3, 4]
+N_CHAIN = len(FREE_A) + len(FREE_D) + len(FREE_AL) + len(FREE_TH) + 3
+N_FREE = N_CHAIN + 5  # + base translation (3) and tilt about x, y (2)
+
+
 def unpack(x):
-    da, dd, dal, dth = x[0:6], x[6:12], x[12:18], x[18:24]
-    tool = x[24:27]
-    base_t, base_r = x[27:30], x[30:33]
-    return A + da, D + dd, ALPHA + dal, dth, tool, base_t, base_r
-
-
-def rot(r):
-    from scipy.spatial.transform import Rotation
-    return Rotation.from_rotvec(r).as_matrix()
+    a, d, al, th = A.copy(), D.copy(), ALPHA.copy(), np.zeros(6)
+    k = 0
+    for arr, idx in ((a, FREE_A), (d, FREE_D), (al, FREE_AL), (th, FREE_TH)):
+        arr[idx] += x[k:k + len(idx)]
+        k += len(idx)
+    return a, d, al, th, x[k:k + 3]
 
 
 def residual_vec(x, q, p):
-    a, d, al, th, tool, bt, br = unpack(x)
-    pred = fk_std(q, a, d, al, th, tool) @ rot(br).T + bt
-    return (pred - p).ravel()
+    from scipy.spatial.transform import Rotation
+    a, d, al, th, tool = unpack(x)
+    base_r = Rotation.from_rotvec([x[N_CHAIN + 3], x[N_CHAIN + 4], 0.0]).as_matrix()
+    return (fk_std(q, a, d, al, th, tool) @ base_r.T + x[N_CHAIN:N_CHAIN + 3] - p).ravel()
 
 
 def x0():
-    x = np.zeros(33)
-    x[24:27] = [0.0, 0.0, 31.0]  # nominal TCP offset of the data (README)
+    x = np.zeros(N_FREE)
+    x[N_CHAIN - 3:N_CHAIN] = [0.0, 0.0, 31.0]  # nominal TCP offset of the data (README)
     return x
 
 
 def fit_vectorised(q, p):
     return least_squares(residual_vec, x0(), args=(q, p), method="lm", x_scale="jac").x
-
-
-# ----------------------------------------------------------------- pybotics
-
-def pybotics_robot():
-    from pybotics.kinematic_chain import MDHKinematicChain
-    from pybotics.robot import Robot
-    from pybotics.tool import Tool
-    # Standard DH regrouped exactly: Tx(a)Rx(alpha) = Rx(alpha)Tx(a), so MDH row i
-    # takes (alpha_{i-1}, a_{i-1}) of standard row i-1 and (theta_i, d_i).
-    rows = []
-    for i in range(6):
-        al, a = (ALPHA[i - 1], A[i - 1]) if i > 0 else (0.0, 0.0)
-        rows.append([al, a, 0.0, D[i]])
-    robot = Robot(MDHKinematicChain(np.array(rows)), tool=Tool())
-    robot.joint_limits = np.array([[-2 * np.pi] * 6, [2 * np.pi] * 6])
-    return robot
-
-
-def fit_pybotics(q, p):
-    robot = pybotics_robot()
-    nominal = robot.kinematic_chain.vector.copy()
-    # Parameters: 24 MDH values, tool position, base translation and rotation.
-
-    def residual(x):
-        robot.kinematic_chain.vector = nominal + x[:24]
-        robot.tool.position = x[24:27]
-        R, t = rot(x[30:33]), x[27:30]
-        pred = np.array([robot.fk(qi)[:3, 3] for qi in q])
-        return (pred @ R.T + t - p).ravel()
-
-    x = np.zeros(33)
-    x[24:27] = [0.0, 0.0, 31.0]
-    res = least_squares(residual, x, method="lm", x_scale="jac")
-
-    def predict(qs):
-        robot.kinematic_chain.vector = nominal + res.x[:24]
-        robot.tool.position = res.x[24:27]
-        R, t = rot(res.x[30:33]), res.x[27:30]
-        return np.array([robot.fk(qi)[:3, 3] for qi in qs]) @ R.T + t
-
-    return predict
 
 
 def timed(f, repeat):
@@ -159,10 +122,7 @@ def km_bench(robocal, repeat):
     out = {}
     x, t = timed(lambda: fit_vectorised(qi, pi), repeat)
     err = np.linalg.norm(residual_vec(x, qv, pv).reshape(-1, 3), axis=1)
-    out["scipy_vectorised"] = {"validation_mean_mm": float(err.mean()), "time_s": t}
-    predict, t = timed(lambda: fit_pybotics(qi, pi), 1)
-    err = np.linalg.norm(predict(qv) - pv, axis=1)
-    out["pybotics_scipy"] = {"validation_mean_mm": float(err.mean()), "time_s": t}
+    out["scipy_least_squares"] = {"validation_mean_mm": float(err.mean()), "time_s": t}
     r = json.loads(subprocess.check_output([
         robocal, "bench", "km", "--model", "ur5", "--identify", grid, "--validate", rand,
         "--repeat", str(max(repeat, 10))]))
@@ -239,7 +199,7 @@ def main():
         r = km["robocal"]
         print("KM on the real UR5 grid (1000 poses), validated on 20 random poses")
         print(f"{'':24}{'val. mean mm':>14}{'time':>12}{'robocal faster':>16}{'accuracy ratio':>16}")
-        for name in ("pybotics_scipy", "scipy_vectorised", "robocal"):
+        for name in ("scipy_least_squares", "robocal"):
             v = km[name]
             print(f"{name:24}{v['validation_mean_mm']:14.4f}{v['time_s'] * 1e3:10.1f}ms"
                   f"{v['time_s'] / r['time_s']:15.0f}x{v['validation_mean_mm'] / r['validation_mean_mm']:16.4f}",
