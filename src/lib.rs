@@ -2,16 +2,12 @@
 //!
 //! Flow: measure (`measure`, `sim`) → calibrate (`identify`) → store (`db`) →
 //! solve (`compensate`, `ik`), served over HTTP (`http`) and the command line (`cli`).
-//! The numerical core (`model`, `kinematics`, `identify`, `compensate`, `ik`, `sim`)
-//! never touches HTTP, the database or the async runtime.
+//! The numerical core lives in the `robocal-core` crate (re-exported here under
+//! the same module names), whose dependency tree has no HTTP, database, async
+//! runtime or command-line crates.
+
+pub use robocal_core::{compensate, identify, ik, kinematics, measure, model, sim};
 
 pub mod cli;
-pub mod compensate;
 pub mod db;
 pub mod http;
-pub mod identify;
-pub mod ik;
-pub mod kinematics;
-pub mod measure;
-pub mod model;
-pub mod sim;

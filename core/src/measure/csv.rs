@@ -806,7 +806,7 @@ mod tests {
             .map(std::path::PathBuf::from)
             .unwrap_or_else(|_| {
                 std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-                    .join("../shared/data/ur5-wam-laser-tracker")
+                    .join("../../shared/data/ur5-wam-laser-tracker")
             });
         assert!(
             dir.exists(),

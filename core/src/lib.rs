@@ -1,0 +1,14 @@
+//! robocal-core: the numerical core of robocal.
+//!
+//! Flow: measure (`measure`, `sim`) → calibrate (`identify`) → solve
+//! (`compensate`, `ik`). Every function takes the model and the joint values as
+//! arguments; there is no hidden mutable chain state, and nothing here touches
+//! HTTP, a database, the async runtime or the file system.
+
+pub mod compensate;
+pub mod identify;
+pub mod ik;
+pub mod kinematics;
+pub mod measure;
+pub mod model;
+pub mod sim;
