@@ -231,6 +231,12 @@ pub async fn start(
 
     // The sets: named, or every set of the robot with the matching role.
     let all_sets = state.db().sets(robot_id).await?;
+    // A delete of the robot may have run between the robot lookup and the set
+    // list (the cascade removes its sets): the robot still existing now means
+    // it existed when the sets were read, so the list is that robot's.
+    if state.db().robot(robot_id).await?.is_none() {
+        return Err(robot_not_found(robot_id));
+    }
     let pick = |ids: &Option<Vec<i64>>, role: &str, field: &str| -> Result<Vec<_>, ApiError> {
         match ids {
             None => Ok(all_sets
