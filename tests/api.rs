@@ -1860,10 +1860,10 @@ async fn writes_racing_a_robot_delete_never_fail_with_500() {
     let db = t.state.db();
     let missing = robocal::db::NewCalibration {
         robot_id: 999_999,
-        methods: "[\"km\"]",
-        identification_set_ids: "[]",
-        validation_set_ids: "[]",
-        options: "{}",
+        methods: &["km".to_string()],
+        identification_set_ids: &[],
+        validation_set_ids: &[],
+        options: &json!({}),
     };
     assert!(db.insert_calibration(&missing).await.unwrap().is_none());
     assert!(db

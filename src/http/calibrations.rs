@@ -20,7 +20,7 @@ use super::robots::robot_not_found;
 use super::sets::MAX_SETS;
 use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState, Ticket};
 use crate::compensate::{CalibratedModelFile, CompensatedModel};
-use crate::db::{CalibrationRow, NewCalibration, NewVersion};
+use crate::db::{CalibrationRow, JobStatus, NewCalibration, NewVersion, StoredRole};
 use crate::identify::{
     calibrate, CalibrationError, CalibrationOptions, CalibrationReport, Method, Progress,
 };
@@ -115,12 +115,12 @@ pub struct StartCalibration {
 pub struct Calibration {
     pub id: i64,
     pub robot_id: i64,
-    pub status: String,
+    pub status: JobStatus,
     pub progress: JobProgress,
     pub cancel_requested: bool,
-    pub methods: Value,
-    pub identification_set_ids: Value,
-    pub validation_set_ids: Value,
+    pub methods: Vec<String>,
+    pub identification_set_ids: Vec<i64>,
+    pub validation_set_ids: Vec<i64>,
     pub options: Value,
     pub error: Option<String>,
     pub best_method: Option<String>,
@@ -141,7 +141,6 @@ pub struct JobProgress {
 impl Calibration {
     pub fn from_row(r: CalibrationRow) -> Self {
         let base = format!("/v1/robots/{}/calibrations/{}", r.robot_id, r.id);
-        let parse = |s: &str| serde_json::from_str(s).unwrap_or(Value::Null);
         Calibration {
             links: json!({
                 "self": base,
@@ -158,10 +157,10 @@ impl Calibration {
                 percent: r.percent,
             },
             cancel_requested: r.cancel_requested,
-            methods: parse(&r.methods),
-            identification_set_ids: parse(&r.identification_set_ids),
-            validation_set_ids: parse(&r.validation_set_ids),
-            options: parse(&r.options),
+            methods: r.methods.0,
+            identification_set_ids: r.identification_set_ids.0,
+            validation_set_ids: r.validation_set_ids.0,
+            options: r.options.0,
             error: r.error,
             best_method: r.best_method,
             created_at: r.created_at,
@@ -237,7 +236,10 @@ pub async fn start(
     if state.db().robot(robot_id).await?.is_none() {
         return Err(robot_not_found(robot_id));
     }
-    let pick = |ids: &Option<Vec<i64>>, role: &str, field: &str| -> Result<Vec<_>, ApiError> {
+    let pick = |ids: &Option<Vec<i64>>,
+                role: StoredRole,
+                field: &str|
+     -> Result<Vec<_>, ApiError> {
         match ids {
             None => Ok(all_sets
                 .iter()
@@ -270,10 +272,14 @@ pub async fn start(
     };
     let ident_sets = pick(
         &req.identification_set_ids,
-        "identification",
+        StoredRole::Identification,
         "identification_set_ids",
     )?;
-    let valid_sets = pick(&req.validation_set_ids, "validation", "validation_set_ids")?;
+    let valid_sets = pick(
+        &req.validation_set_ids,
+        StoredRole::Validation,
+        "validation_set_ids",
+    )?;
     if ident_sets.is_empty() {
         // The robot's data, not the request, is missing: a state conflict.
         return Err(ApiError::Conflict(format!(
@@ -341,7 +347,7 @@ pub async fn start(
         },
         ..defaults
     };
-    let method_names: Vec<&str> = methods.iter().map(|m| m.name()).collect();
+    let method_names: Vec<String> = methods.iter().map(|m| m.name().to_string()).collect();
     let ident_ids: Vec<i64> = ident_sets.iter().map(|s| s.id).collect();
     let valid_ids: Vec<i64> = valid_sets.iter().map(|s| s.id).collect();
     let options = json!({
@@ -356,10 +362,10 @@ pub async fn start(
         .db()
         .insert_calibration(&NewCalibration {
             robot_id,
-            methods: &serde_json::to_string(&method_names).unwrap_or_default(),
-            identification_set_ids: &serde_json::to_string(&ident_ids).unwrap_or_default(),
-            validation_set_ids: &serde_json::to_string(&valid_ids).unwrap_or_default(),
-            options: &options.to_string(),
+            methods: &method_names,
+            identification_set_ids: &ident_ids,
+            validation_set_ids: &valid_ids,
+            options: &options,
         })
         .await?
         .ok_or_else(|| robot_not_found(robot_id))?;
@@ -491,18 +497,18 @@ async fn run_job(state: AppState, job: Job) {
                             tracing::info!(job = id, robot = robot_id, best = %best, versions = v.len(), "calibration succeeded");
                         }),
                     Err(e) => {
-                        db.finish_calibration_error(id, "failed", &format!("internal error: {e}"))
+                        db.finish_calibration_error(id, JobStatus::Failed, &format!("internal error: {e}"))
                             .await
                     }
                 }
             }
-            Err(e) => db.finish_calibration_error(id, "failed", &e).await,
+            Err(e) => db.finish_calibration_error(id, JobStatus::Failed, &e).await,
         },
         Ok(Err(CalibrationError::Cancelled)) if over_budget.load(Ordering::SeqCst) => {
             tracing::info!(job = id, "calibration stopped at its time budget");
             db.finish_calibration_error(
                 id,
-                "failed",
+                JobStatus::Failed,
                 &format!(
                     "stopped after the job time budget of {} s (`--job-time-limit`); use fewer poses, generations or a smaller population",
                     budget.as_secs()
@@ -512,17 +518,17 @@ async fn run_job(state: AppState, job: Job) {
         }
         Ok(Err(CalibrationError::Cancelled)) => {
             tracing::info!(job = id, "calibration cancelled");
-            db.finish_calibration_error(id, "cancelled", "cancelled by request")
+            db.finish_calibration_error(id, JobStatus::Cancelled, "cancelled by request")
                 .await
         }
         Ok(Err(e)) => {
             tracing::info!(job = id, error = %e, "calibration failed");
-            db.finish_calibration_error(id, "failed", &e.to_string())
+            db.finish_calibration_error(id, JobStatus::Failed, &e.to_string())
                 .await
         }
         Err(e) => {
             tracing::error!(job = id, error = %e, "calibration task panicked");
-            db.finish_calibration_error(id, "failed", "internal error in the calibration")
+            db.finish_calibration_error(id, JobStatus::Failed, "internal error in the calibration")
                 .await
         }
     };
@@ -565,7 +571,7 @@ fn versions_of(
         out.push(NewVersion {
             method: method.name().to_string(),
             model_json: file.to_json(),
-            stats_json: stats.to_string(),
+            stats,
         });
     }
     Ok(out)
@@ -612,7 +618,7 @@ pub async fn cancel(
     ApiPath((robot_id, id)): ApiPath<(i64, i64)>,
 ) -> Result<Response, ApiError> {
     let row = load(&state, robot_id, id).await?;
-    if !matches!(row.status.as_str(), "queued" | "running") {
+    if !row.status.is_active() {
         return Err(ApiError::Conflict(format!(
             "calibration {id} is already {}; only queued or running jobs can be cancelled",
             row.status
@@ -636,9 +642,9 @@ async fn succeeded_report(
     id: i64,
 ) -> Result<(CalibrationRow, Value), ApiError> {
     let row = load(state, robot_id, id).await?;
-    match row.status.as_str() {
-        "succeeded" => {}
-        "queued" | "running" => {
+    match row.status {
+        JobStatus::Succeeded => {}
+        JobStatus::Queued | JobStatus::Running => {
             return Err(ApiError::Conflict(format!(
                 "calibration {id} is {} ({:.0}%); poll GET /v1/robots/{robot_id}/calibrations/{id} until its status is succeeded",
                 row.status, row.percent

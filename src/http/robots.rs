@@ -68,7 +68,7 @@ impl Robot {
             name: r.name,
             preset: r.preset,
             dof: r.dof,
-            metadata: serde_json::from_str(&r.metadata).unwrap_or(Value::Null),
+            metadata: Value::Object(r.metadata.0),
             active_version: r.active_version,
             created_at: r.created_at,
             updated_at: r.updated_at,
@@ -80,7 +80,10 @@ impl Robot {
 }
 
 /// The metadata object as stored, within the size limit.
-fn check_metadata(m: &Map<String, Value>, max_bytes: usize) -> Result<String, ApiError> {
+fn check_metadata<'m>(
+    m: &'m Map<String, Value>,
+    max_bytes: usize,
+) -> Result<&'m Map<String, Value>, ApiError> {
     let text = serde_json::to_string(m).map_err(|e| ApiError::Internal(e.to_string()))?;
     if text.len() > max_bytes {
         return Err(ApiError::invalid(format!(
@@ -88,7 +91,7 @@ fn check_metadata(m: &Map<String, Value>, max_bytes: usize) -> Result<String, Ap
             text.len()
         )));
     }
-    Ok(text)
+    Ok(m)
 }
 
 pub async fn list_presets() -> Result<Response, ApiError> {
@@ -143,9 +146,10 @@ pub async fn create(
     };
     let name = body.name.clone().unwrap_or_else(|| model.name.clone());
     check_name(&name, "`name`")?;
+    let empty = Map::new();
     let metadata = match &body.metadata {
         Some(m) => check_metadata(m, state.limits().metadata_bytes)?,
-        None => "{}".to_string(),
+        None => &empty,
     };
     let model_json = model.to_json();
     let row = state
@@ -155,7 +159,7 @@ pub async fn create(
             preset: preset.as_deref(),
             model_json: &model_json,
             dof: model.dof() as i64,
-            metadata: &metadata,
+            metadata,
         })
         .await?;
     let location = format!("/v1/robots/{}", row.id);
@@ -214,7 +218,7 @@ pub async fn update(
     }
     let row = state
         .db()
-        .update_robot(id, body.name.as_deref(), metadata.as_deref())
+        .update_robot(id, body.name.as_deref(), metadata)
         .await?
         .ok_or_else(|| robot_not_found(id))?;
     state.invalidate_robot(id);

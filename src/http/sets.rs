@@ -11,7 +11,7 @@ use super::input::{
 };
 use super::robots::robot_not_found;
 use super::{ApiError, ApiPath, ApiQuery, AppState};
-use crate::db::{NewSet, SetRow};
+use crate::db::{AngleUnit, LengthUnit, NewSet, SetFormat, SetRow};
 use crate::measure::csv::{self, CsvError};
 use crate::measure::{MeasuredPose, SetRole};
 use axum::body::Bytes;
@@ -127,14 +127,14 @@ impl MeasurementSet {
             id: r.id,
             robot_id: r.robot_id,
             name: r.name,
-            role: r.role,
+            role: SetRole::from(r.role).as_str().to_string(),
             session: r.session,
             payload_kg: r.payload_kg,
             units: Units {
-                length: r.length_unit,
-                angle: r.angle_unit,
+                length: r.length_unit.as_str().to_string(),
+                angle: r.angle_unit.as_str().to_string(),
             },
-            format: r.format,
+            format: r.format.as_str().to_string(),
             row_count: r.row_count,
             dof: r.dof,
             created_at: r.created_at,
@@ -143,17 +143,8 @@ impl MeasurementSet {
     }
 }
 
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Length {
-    Mm,
-    M,
-}
-
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Angle {
-    Deg,
-    Rad,
-}
+type Length = LengthUnit;
+type Angle = AngleUnit;
 
 struct Checked {
     name: String,
@@ -421,7 +412,7 @@ pub async fn upload(
                 to_degrees(&mut rows);
             }
             check_rows(&rows, dof, max_rows)?;
-            Ok((c, rows, "csv", text))
+            Ok((c, rows, SetFormat::Csv, text))
         } else {
             if query.name.is_some()
                 || query.role.is_some()
@@ -438,7 +429,7 @@ pub async fn upload(
             let c = check_params(&up.params())?;
             let rows = json_rows(up.rows, &c)?;
             check_rows(&rows, dof, max_rows)?;
-            Ok((c, rows, "json", text))
+            Ok((c, rows, SetFormat::Json, text))
         }
     })
     .await
@@ -458,20 +449,19 @@ pub async fn upload(
     } else {
         c.name.clone()
     };
-    let rows_json = serde_json::to_string(&rows).map_err(|e| ApiError::Internal(e.to_string()))?;
     let row = state
         .db()
         .insert_set(&NewSet {
             robot_id,
             name: &name,
-            role: role.as_str(),
+            role: role.into(),
             session: &c.session,
             payload_kg: c.payload_kg,
-            length_unit: if c.length == Length::M { "m" } else { "mm" },
-            angle_unit: if c.angle == Angle::Rad { "rad" } else { "deg" },
+            length_unit: c.length,
+            angle_unit: c.angle,
             format,
             original: &original,
-            rows_json: &rows_json,
+            rows: &rows,
             row_count: rows.len() as i64,
             dof: dof as i64,
         })
@@ -515,13 +505,11 @@ pub(crate) async fn load_rows(
     robot_id: i64,
     set_id: i64,
 ) -> Result<Vec<MeasuredPose>, ApiError> {
-    let text = state
+    state
         .db()
         .set_rows(robot_id, set_id)
         .await?
-        .ok_or_else(|| set_not_found(robot_id, set_id))?;
-    serde_json::from_str(&text)
-        .map_err(|e| ApiError::Internal(format!("stored rows of set {set_id}: {e}")))
+        .ok_or_else(|| set_not_found(robot_id, set_id))
 }
 
 pub async fn get_one(
@@ -546,7 +534,7 @@ pub async fn original(
         .set_original(robot_id, set_id)
         .await?
         .ok_or_else(|| set_not_found(robot_id, set_id))?;
-    let ct = if format == "csv" {
+    let ct = if format == SetFormat::Csv {
         "text/csv; charset=utf-8"
     } else {
         "application/json"

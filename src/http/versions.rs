@@ -45,7 +45,7 @@ impl ModelVersion {
             calibration_id: v.calibration_id,
             method: v.method,
             active: v.active,
-            stats: serde_json::from_str(&v.stats_json).unwrap_or(Value::Null),
+            stats: v.stats.0,
             created_at: v.created_at,
         }
     }

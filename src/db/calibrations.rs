@@ -1,0 +1,356 @@
+//! Calibration jobs: queue, progress, cancellation and their reports.
+
+use super::versions::{activate_in, NewVersion};
+use super::{robot_exists_in, Db, DbError, Json};
+use serde_json::Value;
+use sqlx::FromRow;
+
+/// State of a calibration job.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, sqlx::Type, serde::Serialize)]
+#[sqlx(rename_all = "lowercase")]
+#[serde(rename_all = "lowercase")]
+pub enum JobStatus {
+    Queued,
+    Running,
+    Succeeded,
+    Failed,
+    Cancelled,
+}
+
+impl std::fmt::Display for JobStatus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl JobStatus {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            JobStatus::Queued => "queued",
+            JobStatus::Running => "running",
+            JobStatus::Succeeded => "succeeded",
+            JobStatus::Failed => "failed",
+            JobStatus::Cancelled => "cancelled",
+        }
+    }
+
+    /// Queued or running.
+    pub fn is_active(self) -> bool {
+        matches!(self, JobStatus::Queued | JobStatus::Running)
+    }
+}
+
+impl Db {
+    /// Marks jobs that a previous process left queued or running as failed.
+    /// Returns their ids.
+    pub async fn fail_interrupted_jobs(&self) -> Result<Vec<i64>, DbError> {
+        let mut tx = self.write().await?;
+        let ids: Vec<i64> = sqlx::query_scalar(
+            "SELECT id FROM calibrations WHERE status IN ('queued', 'running') ORDER BY id",
+        )
+        .fetch_all(&mut *tx)
+        .await?;
+        sqlx::query(concat!(
+            "UPDATE calibrations SET status = 'failed', error = 'interrupted by a restart', \
+             finished_at = ",
+            now!(),
+            ", \
+             updated_at = ",
+            now!(),
+            " \
+             WHERE status IN ('queued', 'running')"
+        ))
+        .execute(&mut *tx)
+        .await?;
+        tx.commit().await?;
+        Ok(ids)
+    }
+
+    /// Queues a calibration; `None` when its robot does not exist (any more).
+    pub async fn insert_calibration(
+        &self,
+        c: &NewCalibration<'_>,
+    ) -> Result<Option<CalibrationRow>, DbError> {
+        let mut tx = self.write().await?;
+        if !robot_exists_in(&mut tx, c.robot_id).await? {
+            tx.rollback().await?;
+            return Ok(None);
+        }
+        let id: i64 = sqlx::query_scalar(
+            "INSERT INTO calibrations (robot_id, status, methods, identification_set_ids, \
+             validation_set_ids, options) VALUES (?, 'queued', ?, ?, ?, ?) RETURNING id",
+        )
+        .bind(c.robot_id)
+        .bind(Json(c.methods))
+        .bind(Json(c.identification_set_ids))
+        .bind(Json(c.validation_set_ids))
+        .bind(Json(c.options))
+        .fetch_one(&mut *tx)
+        .await?;
+        let row = sqlx::query_as::<_, CalibrationRow>(&format!("{CAL_SELECT} WHERE id = ?"))
+            .bind(id)
+            .fetch_one(&mut *tx)
+            .await?;
+        tx.commit().await?;
+        Ok(Some(row))
+    }
+
+    /// One page of a robot's calibrations by id, and how many it has.
+    pub async fn calibrations_page(
+        &self,
+        robot_id: i64,
+        limit: i64,
+        offset: i64,
+    ) -> Result<(Vec<CalibrationRow>, i64), DbError> {
+        self.page(
+            &format!("{CAL_SELECT} WHERE robot_id = ? ORDER BY id LIMIT ? OFFSET ?"),
+            "SELECT COUNT(*) FROM calibrations WHERE robot_id = ?",
+            Some(robot_id),
+            limit,
+            offset,
+        )
+        .await
+    }
+
+    pub async fn calibrations(&self, robot_id: i64) -> Result<Vec<CalibrationRow>, DbError> {
+        sqlx::query_as::<_, CalibrationRow>(&format!("{CAL_SELECT} WHERE robot_id = ? ORDER BY id"))
+            .bind(robot_id)
+            .fetch_all(&self.pool)
+            .await
+    }
+
+    pub async fn calibration(
+        &self,
+        robot_id: i64,
+        id: i64,
+    ) -> Result<Option<CalibrationRow>, DbError> {
+        sqlx::query_as::<_, CalibrationRow>(&format!("{CAL_SELECT} WHERE robot_id = ? AND id = ?"))
+            .bind(robot_id)
+            .bind(id)
+            .fetch_optional(&self.pool)
+            .await
+    }
+
+    /// The stored report JSON of a calibration.
+    pub async fn calibration_report(&self, id: i64) -> Result<Option<String>, DbError> {
+        Ok(
+            sqlx::query_scalar::<_, Option<String>>("SELECT report FROM calibrations WHERE id = ?")
+                .bind(id)
+                .fetch_optional(&self.pool)
+                .await?
+                .flatten(),
+        )
+    }
+
+    /// queued → running; false when the job is no longer queued (cancelled).
+    pub async fn start_calibration(&self, id: i64) -> Result<bool, DbError> {
+        let mut tx = self.write().await?;
+        let n = sqlx::query(concat!(
+            "UPDATE calibrations SET status = 'running', phase = 'starting', \
+             started_at = ",
+            now!(),
+            ", \
+             updated_at = ",
+            now!(),
+            " \
+             WHERE id = ? AND status = 'queued' AND cancel_requested = 0"
+        ))
+        .bind(id)
+        .execute(&mut *tx)
+        .await?
+        .rows_affected();
+        tx.commit().await?;
+        Ok(n > 0)
+    }
+
+    /// Progress of a running job.
+    pub async fn update_progress(
+        &self,
+        id: i64,
+        phase: &str,
+        iteration: i64,
+        percent: f64,
+    ) -> Result<(), DbError> {
+        let mut tx = self.write().await?;
+        sqlx::query(concat!(
+            "UPDATE calibrations SET phase = ?, iteration = ?, percent = ?, \
+             updated_at = ",
+            now!(),
+            " WHERE id = ? AND status = 'running'"
+        ))
+        .bind(phase)
+        .bind(iteration)
+        .bind(percent)
+        .bind(id)
+        .execute(&mut *tx)
+        .await?;
+        tx.commit().await?;
+        Ok(())
+    }
+
+    /// Requests cancellation. A queued job is cancelled at once; a running one
+    /// is flagged (the worker stops at its next progress check). Returns the
+    /// row after the change, or `None` when missing.
+    pub async fn request_cancel(
+        &self,
+        robot_id: i64,
+        id: i64,
+    ) -> Result<Option<CalibrationRow>, DbError> {
+        let mut tx = self.write().await?;
+        sqlx::query(concat!(
+            "UPDATE calibrations SET status = 'cancelled', cancel_requested = 1, \
+             error = 'cancelled by request', finished_at = ",
+            now!(),
+            ", \
+             updated_at = ",
+            now!(),
+            " \
+             WHERE robot_id = ? AND id = ? AND status = 'queued'"
+        ))
+        .bind(robot_id)
+        .bind(id)
+        .execute(&mut *tx)
+        .await?;
+        sqlx::query(concat!(
+            "UPDATE calibrations SET cancel_requested = 1, \
+             updated_at = ",
+            now!(),
+            " \
+             WHERE robot_id = ? AND id = ? AND status = 'running'"
+        ))
+        .bind(robot_id)
+        .bind(id)
+        .execute(&mut *tx)
+        .await?;
+        tx.commit().await?;
+        self.calibration(robot_id, id).await
+    }
+
+    /// Ends a job without a result (failed or cancelled).
+    pub async fn finish_calibration_error(
+        &self,
+        id: i64,
+        status: JobStatus,
+        error: &str,
+    ) -> Result<(), DbError> {
+        let mut tx = self.write().await?;
+        sqlx::query(concat!(
+            "UPDATE calibrations SET status = ?, error = ?, \
+             finished_at = ",
+            now!(),
+            ", \
+             updated_at = ",
+            now!(),
+            " \
+             WHERE id = ? AND status IN ('queued', 'running')"
+        ))
+        .bind(status)
+        .bind(error)
+        .bind(id)
+        .execute(&mut *tx)
+        .await?;
+        tx.commit().await?;
+        Ok(())
+    }
+
+    /// Stores a successful calibration in one transaction: the report, one
+    /// model version per method (in the given order), and the activation of
+    /// `activate_method`'s version when the robot has no active version.
+    /// Returns the created versions as (method, version number).
+    pub async fn finish_calibration_success(
+        &self,
+        robot_id: i64,
+        id: i64,
+        report_json: &str,
+        best_method: &str,
+        versions: &[NewVersion],
+    ) -> Result<Vec<(String, i64)>, DbError> {
+        let mut tx = self.write().await?;
+        let n = sqlx::query(
+            concat!("UPDATE calibrations SET status = 'succeeded', report = ?, best_method = ?, phase = 'done', \
+             percent = 100, finished_at = ", now!(), ", \
+             updated_at = ", now!(), " \
+             WHERE id = ? AND status = 'running'"),
+        )
+        .bind(report_json)
+        .bind(best_method)
+        .bind(id)
+        .execute(&mut *tx)
+        .await?
+        .rows_affected();
+        if n == 0 {
+            // Deleted with its robot meanwhile, or no longer running.
+            tx.rollback().await?;
+            return Ok(Vec::new());
+        }
+        let mut next: i64 = sqlx::query_scalar(
+            "SELECT COALESCE(MAX(version), 0) + 1 FROM model_versions WHERE robot_id = ?",
+        )
+        .bind(robot_id)
+        .fetch_one(&mut *tx)
+        .await?;
+        let has_active: bool = sqlx::query_scalar(
+            "SELECT EXISTS (SELECT 1 FROM model_versions WHERE robot_id = ? AND active = 1)",
+        )
+        .bind(robot_id)
+        .fetch_one(&mut *tx)
+        .await?;
+        let mut out = Vec::new();
+        for v in versions {
+            let vid: i64 = sqlx::query_scalar(
+                "INSERT INTO model_versions (robot_id, version, calibration_id, method, model_json, \
+                 stats_json) VALUES (?, ?, ?, ?, ?, ?) RETURNING id",
+            )
+            .bind(robot_id)
+            .bind(next)
+            .bind(id)
+            .bind(&v.method)
+            .bind(&v.model_json)
+            .bind(Json(&v.stats))
+            .fetch_one(&mut *tx)
+            .await?;
+            if !has_active && v.method == best_method {
+                activate_in(&mut tx, robot_id, vid).await?;
+            }
+            out.push((v.method.clone(), next));
+            next += 1;
+        }
+        tx.commit().await?;
+        Ok(out)
+    }
+}
+
+const CAL_SELECT: &str = "SELECT id, robot_id, status, phase, iteration, percent, \
+    cancel_requested, methods, identification_set_ids, validation_set_ids, options, error, \
+    best_method, created_at, started_at, finished_at, updated_at FROM calibrations";
+
+/// A calibration job to insert (JSON texts).
+#[derive(Debug)]
+pub struct NewCalibration<'a> {
+    pub robot_id: i64,
+    pub methods: &'a [String],
+    pub identification_set_ids: &'a [i64],
+    pub validation_set_ids: &'a [i64],
+    pub options: &'a Value,
+}
+
+#[derive(Debug, Clone, FromRow)]
+pub struct CalibrationRow {
+    pub id: i64,
+    pub robot_id: i64,
+    pub status: JobStatus,
+    pub phase: Option<String>,
+    pub iteration: i64,
+    pub percent: f64,
+    pub cancel_requested: bool,
+    pub methods: Json<Vec<String>>,
+    pub identification_set_ids: Json<Vec<i64>>,
+    pub validation_set_ids: Json<Vec<i64>>,
+    pub options: Json<Value>,
+    pub error: Option<String>,
+    pub best_method: Option<String>,
+    pub created_at: String,
+    pub started_at: Option<String>,
+    pub finished_at: Option<String>,
+    pub updated_at: String,
+}

@@ -1,0 +1,115 @@
+//! Robots: the cell's robots and their nominal models.
+
+use super::{Db, DbError, Json};
+use serde_json::{Map, Value};
+use sqlx::FromRow;
+
+impl Db {
+    pub async fn insert_robot(&self, r: &NewRobot<'_>) -> Result<RobotRow, DbError> {
+        let mut tx = self.write().await?;
+        let id: i64 = sqlx::query_scalar(
+            "INSERT INTO robots (name, preset, model_json, dof, metadata) VALUES (?, ?, ?, ?, ?) RETURNING id",
+        )
+        .bind(r.name)
+        .bind(r.preset)
+        .bind(r.model_json)
+        .bind(r.dof)
+        .bind(Json(r.metadata))
+        .fetch_one(&mut *tx)
+        .await?;
+        tx.commit().await?;
+        self.robot(id)
+            .await?
+            .ok_or_else(|| DbError::Protocol("inserted robot vanished".into()))
+    }
+
+    /// One page of robots by id, and how many there are.
+    pub async fn robots_page(
+        &self,
+        limit: i64,
+        offset: i64,
+    ) -> Result<(Vec<RobotRow>, i64), DbError> {
+        self.page(
+            &format!("{ROBOT_SELECT} ORDER BY r.id LIMIT ? OFFSET ?"),
+            "SELECT COUNT(*) FROM robots",
+            None,
+            limit,
+            offset,
+        )
+        .await
+    }
+
+    pub async fn robot(&self, id: i64) -> Result<Option<RobotRow>, DbError> {
+        sqlx::query_as::<_, RobotRow>(&format!("{ROBOT_SELECT} WHERE r.id = ?"))
+            .bind(id)
+            .fetch_optional(&self.pool)
+            .await
+    }
+
+    /// Updates name and/or metadata; `None` when the robot does not exist.
+    pub async fn update_robot(
+        &self,
+        id: i64,
+        name: Option<&str>,
+        metadata: Option<&Map<String, Value>>,
+    ) -> Result<Option<RobotRow>, DbError> {
+        let mut tx = self.write().await?;
+        let n = sqlx::query(concat!(
+            "UPDATE robots SET name = COALESCE(?, name), metadata = COALESCE(?, metadata), \
+             updated_at = ",
+            now!(),
+            " WHERE id = ?"
+        ))
+        .bind(name)
+        .bind(metadata.map(Json))
+        .bind(id)
+        .execute(&mut *tx)
+        .await?
+        .rows_affected();
+        tx.commit().await?;
+        if n == 0 {
+            return Ok(None);
+        }
+        self.robot(id).await
+    }
+
+    /// Deletes a robot and everything that belongs to it; false when missing.
+    pub async fn delete_robot(&self, id: i64) -> Result<bool, DbError> {
+        let mut tx = self.write().await?;
+        let n = sqlx::query("DELETE FROM robots WHERE id = ?")
+            .bind(id)
+            .execute(&mut *tx)
+            .await?
+            .rows_affected();
+        tx.commit().await?;
+        Ok(n > 0)
+    }
+}
+
+const ROBOT_SELECT: &str = "SELECT r.id, r.name, r.preset, r.model_json, r.dof, r.metadata, \
+    r.created_at, r.updated_at, \
+    (SELECT v.version FROM model_versions v WHERE v.robot_id = r.id AND v.active = 1) AS active_version \
+    FROM robots r";
+
+/// A robot to insert.
+#[derive(Debug)]
+pub struct NewRobot<'a> {
+    pub name: &'a str,
+    pub preset: Option<&'a str>,
+    pub model_json: &'a str,
+    pub dof: i64,
+    pub metadata: &'a Map<String, Value>,
+}
+
+#[derive(Debug, Clone, FromRow)]
+pub struct RobotRow {
+    pub id: i64,
+    pub name: String,
+    pub preset: Option<String>,
+    pub model_json: String,
+    pub dof: i64,
+    pub metadata: Json<Map<String, Value>>,
+    pub created_at: String,
+    pub updated_at: String,
+    pub active_version: Option<i64>,
+}

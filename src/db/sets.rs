@@ -1,0 +1,233 @@
+//! Measurement sets: the uploads as received and their parsed rows.
+
+use super::{robot_exists_in, Db, DbError, Json};
+use crate::measure::{MeasuredPose, SetRole};
+use sqlx::{FromRow, Row};
+
+/// Data role of a set as stored (DESIGN "Data roles").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, sqlx::Type)]
+#[sqlx(rename_all = "lowercase")]
+pub enum StoredRole {
+    Identification,
+    Training,
+    Validation,
+}
+
+impl From<SetRole> for StoredRole {
+    fn from(r: SetRole) -> Self {
+        match r {
+            SetRole::Identification => StoredRole::Identification,
+            SetRole::Training => StoredRole::Training,
+            SetRole::Validation => StoredRole::Validation,
+        }
+    }
+}
+
+impl From<StoredRole> for SetRole {
+    fn from(r: StoredRole) -> Self {
+        match r {
+            StoredRole::Identification => SetRole::Identification,
+            StoredRole::Training => SetRole::Training,
+            StoredRole::Validation => SetRole::Validation,
+        }
+    }
+}
+
+/// Declared length unit of an upload.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, sqlx::Type)]
+#[sqlx(rename_all = "lowercase")]
+pub enum LengthUnit {
+    Mm,
+    M,
+}
+
+/// Declared angle unit of an upload.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, sqlx::Type)]
+#[sqlx(rename_all = "lowercase")]
+pub enum AngleUnit {
+    Deg,
+    Rad,
+}
+
+/// Format of the upload as received.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, sqlx::Type)]
+#[sqlx(rename_all = "lowercase")]
+pub enum SetFormat {
+    Csv,
+    Json,
+}
+
+impl LengthUnit {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            LengthUnit::Mm => "mm",
+            LengthUnit::M => "m",
+        }
+    }
+}
+
+impl AngleUnit {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            AngleUnit::Deg => "deg",
+            AngleUnit::Rad => "rad",
+        }
+    }
+}
+
+impl SetFormat {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            SetFormat::Csv => "csv",
+            SetFormat::Json => "json",
+        }
+    }
+}
+
+impl Db {
+    /// Stores a set; `None` when its robot does not exist (any more).
+    pub async fn insert_set(&self, s: &NewSet<'_>) -> Result<Option<SetRow>, DbError> {
+        let mut tx = self.write().await?;
+        if !robot_exists_in(&mut tx, s.robot_id).await? {
+            tx.rollback().await?;
+            return Ok(None);
+        }
+        let id: i64 = sqlx::query_scalar(
+            "INSERT INTO measurement_sets (robot_id, name, role, session, payload_kg, length_unit, \
+             angle_unit, format, original, rows_json, row_count, dof) \
+             VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?) RETURNING id",
+        )
+        .bind(s.robot_id)
+        .bind(s.name)
+        .bind(s.role)
+        .bind(s.session)
+        .bind(s.payload_kg)
+        .bind(s.length_unit)
+        .bind(s.angle_unit)
+        .bind(s.format)
+        .bind(s.original)
+        .bind(Json(s.rows))
+        .bind(s.row_count)
+        .bind(s.dof)
+        .fetch_one(&mut *tx)
+        .await?;
+        let row = sqlx::query_as::<_, SetRow>(&format!("{SET_SELECT} WHERE id = ?"))
+            .bind(id)
+            .fetch_one(&mut *tx)
+            .await?;
+        tx.commit().await?;
+        Ok(Some(row))
+    }
+
+    /// One page of a robot's sets by id, and how many it has.
+    pub async fn sets_page(
+        &self,
+        robot_id: i64,
+        limit: i64,
+        offset: i64,
+    ) -> Result<(Vec<SetRow>, i64), DbError> {
+        self.page(
+            &format!("{SET_SELECT} WHERE robot_id = ? ORDER BY id LIMIT ? OFFSET ?"),
+            "SELECT COUNT(*) FROM measurement_sets WHERE robot_id = ?",
+            Some(robot_id),
+            limit,
+            offset,
+        )
+        .await
+    }
+
+    pub async fn sets(&self, robot_id: i64) -> Result<Vec<SetRow>, DbError> {
+        sqlx::query_as::<_, SetRow>(&format!("{SET_SELECT} WHERE robot_id = ? ORDER BY id"))
+            .bind(robot_id)
+            .fetch_all(&self.pool)
+            .await
+    }
+
+    pub async fn set(&self, robot_id: i64, id: i64) -> Result<Option<SetRow>, DbError> {
+        sqlx::query_as::<_, SetRow>(&format!("{SET_SELECT} WHERE robot_id = ? AND id = ?"))
+            .bind(robot_id)
+            .bind(id)
+            .fetch_optional(&self.pool)
+            .await
+    }
+
+    /// The parsed rows of a set (mm/deg).
+    pub async fn set_rows(
+        &self,
+        robot_id: i64,
+        id: i64,
+    ) -> Result<Option<Vec<MeasuredPose>>, DbError> {
+        let rows: Option<Json<Vec<MeasuredPose>>> = sqlx::query_scalar(
+            "SELECT rows_json FROM measurement_sets WHERE robot_id = ? AND id = ?",
+        )
+        .bind(robot_id)
+        .bind(id)
+        .fetch_optional(&self.pool)
+        .await?;
+        Ok(rows.map(|r| r.0))
+    }
+
+    /// The upload as received: (format, text).
+    pub async fn set_original(
+        &self,
+        robot_id: i64,
+        id: i64,
+    ) -> Result<Option<(SetFormat, String)>, DbError> {
+        let row = sqlx::query(
+            "SELECT format, original FROM measurement_sets WHERE robot_id = ? AND id = ?",
+        )
+        .bind(robot_id)
+        .bind(id)
+        .fetch_optional(&self.pool)
+        .await?;
+        row.map(|r| Ok((r.try_get(0)?, r.try_get(1)?))).transpose()
+    }
+
+    pub async fn delete_set(&self, robot_id: i64, id: i64) -> Result<bool, DbError> {
+        let mut tx = self.write().await?;
+        let n = sqlx::query("DELETE FROM measurement_sets WHERE robot_id = ? AND id = ?")
+            .bind(robot_id)
+            .bind(id)
+            .execute(&mut *tx)
+            .await?
+            .rows_affected();
+        tx.commit().await?;
+        Ok(n > 0)
+    }
+}
+
+const SET_SELECT: &str = "SELECT id, robot_id, name, role, session, payload_kg, length_unit, \
+    angle_unit, format, row_count, dof, created_at FROM measurement_sets";
+
+/// A measurement set to insert.
+#[derive(Debug)]
+pub struct NewSet<'a> {
+    pub robot_id: i64,
+    pub name: &'a str,
+    pub role: StoredRole,
+    pub session: &'a str,
+    pub payload_kg: Option<f64>,
+    pub length_unit: LengthUnit,
+    pub angle_unit: AngleUnit,
+    pub format: SetFormat,
+    pub original: &'a str,
+    pub rows: &'a [MeasuredPose],
+    pub row_count: i64,
+    pub dof: i64,
+}
+
+#[derive(Debug, Clone, FromRow)]
+pub struct SetRow {
+    pub id: i64,
+    pub robot_id: i64,
+    pub name: String,
+    pub role: StoredRole,
+    pub session: String,
+    pub payload_kg: Option<f64>,
+    pub length_unit: LengthUnit,
+    pub angle_unit: AngleUnit,
+    pub format: SetFormat,
+    pub row_count: i64,
+    pub dof: i64,
+    pub created_at: String,
+}
