@@ -80,10 +80,10 @@ impl Robot {
 }
 
 /// The metadata object as stored, within the size limit.
-fn check_metadata<'m>(
-    m: &'m Map<String, Value>,
+fn check_metadata(
+    m: &Map<String, Value>,
     max_bytes: usize,
-) -> Result<&'m Map<String, Value>, ApiError> {
+) -> Result<&Map<String, Value>, ApiError> {
     let text = serde_json::to_string(m).map_err(|e| ApiError::Internal(e.to_string()))?;
     if text.len() > max_bytes {
         return Err(ApiError::invalid(format!(
