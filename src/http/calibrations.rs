@@ -723,3 +723,29 @@ pub async fn report(
     .map_err(|e| ApiError::Internal(format!("report page: {e}")))?;
     Ok(Html(html).into_response())
 }
+
+/// The routes of calibration jobs.
+pub fn routes() -> Vec<super::Route> {
+    use super::route;
+    use axum::http::Method;
+    vec![
+        route(Method::GET, "/v1/robots/{id}/calibrations", list),
+        route(Method::POST, "/v1/robots/{id}/calibrations", start),
+        route(Method::GET, "/v1/robots/{id}/calibrations/{cid}", get_one),
+        route(
+            Method::POST,
+            "/v1/robots/{id}/calibrations/{cid}/cancel",
+            cancel,
+        ),
+        route(
+            Method::GET,
+            "/v1/robots/{id}/calibrations/{cid}/result",
+            result,
+        ),
+        route(
+            Method::GET,
+            "/v1/robots/{id}/calibrations/{cid}/report",
+            report,
+        ),
+    ]
+}

@@ -16,17 +16,20 @@
 use crate::db::Db;
 use crate::ik::IkSolver;
 use axum::extract::{DefaultBodyLimit, Request, State};
-use axum::http::{header, Method, StatusCode};
+use axum::handler::Handler;
+use axum::http::{header, Method};
 use axum::middleware::{self, Next};
 use axum::response::{IntoResponse, Response};
-use axum::routing::{get, post};
+use axum::routing::{on, MethodFilter, MethodRouter};
 use axum::Router;
 use std::collections::HashMap;
-use std::future::Future;
 use std::sync::atomic::AtomicBool;
 use std::sync::{Arc, Mutex};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 use tokio::sync::Semaphore;
+use tower_http::catch_panic::CatchPanicLayer;
+use tower_http::trace::{DefaultMakeSpan, DefaultOnFailure, DefaultOnResponse, TraceLayer};
+use tracing::Level;
 
 pub mod calibrations;
 pub mod client;
@@ -50,35 +53,48 @@ pub const BODY_LIMIT_BYTES: usize = 16 * 1024 * 1024;
 /// The text of `openapi.yaml`, served at `/openapi.yaml`.
 pub const OPENAPI_YAML: &str = include_str!("../../openapi.yaml");
 
-/// Every route of the router as (method, path template). A test checks that
-/// each one is in `openapi.yaml` and that the spec has no others.
-pub const ROUTES: &[(&str, &str)] = &[
-    ("GET", "/healthz"),
-    ("GET", "/openapi.yaml"),
-    ("GET", "/v1/presets"),
-    ("GET", "/v1/robots"),
-    ("POST", "/v1/robots"),
-    ("GET", "/v1/robots/{id}"),
-    ("PATCH", "/v1/robots/{id}"),
-    ("DELETE", "/v1/robots/{id}"),
-    ("GET", "/v1/robots/{id}/measurement-sets"),
-    ("POST", "/v1/robots/{id}/measurement-sets"),
-    ("GET", "/v1/robots/{id}/measurement-sets/{sid}"),
-    ("DELETE", "/v1/robots/{id}/measurement-sets/{sid}"),
-    ("GET", "/v1/robots/{id}/measurement-sets/{sid}/original"),
-    ("GET", "/v1/robots/{id}/calibrations"),
-    ("POST", "/v1/robots/{id}/calibrations"),
-    ("GET", "/v1/robots/{id}/calibrations/{cid}"),
-    ("POST", "/v1/robots/{id}/calibrations/{cid}/cancel"),
-    ("GET", "/v1/robots/{id}/calibrations/{cid}/result"),
-    ("GET", "/v1/robots/{id}/calibrations/{cid}/report"),
-    ("GET", "/v1/robots/{id}/versions"),
-    ("POST", "/v1/robots/{id}/versions/rollback"),
-    ("GET", "/v1/robots/{id}/versions/{version}"),
-    ("POST", "/v1/robots/{id}/versions/{version}/activate"),
-    ("GET", "/v1/robots/{id}/versions/{version}/model.json"),
-    ("POST", "/v1/robots/{id}/solve"),
-];
+/// One route of the service: method, path template and handler. Each
+/// resource module lists its own in `routes()`; [`app`] builds the router from
+/// them and [`route_table`] reports the same list (a test checks it against
+/// `openapi.yaml`), so no list of routes is kept by hand beside the router.
+pub struct Route {
+    pub method: Method,
+    pub path: &'static str,
+    handler: MethodRouter<AppState>,
+}
+
+/// A route for one method of a path.
+pub(crate) fn route<H, T>(method: Method, path: &'static str, handler: H) -> Route
+where
+    H: Handler<T, AppState>,
+    T: 'static,
+{
+    let filter = MethodFilter::try_from(method.clone()).expect("a standard HTTP method");
+    Route {
+        method,
+        path,
+        handler: on(filter, handler),
+    }
+}
+
+/// Every route of the service, resource by resource.
+fn routes() -> Vec<Route> {
+    let mut all = vec![
+        route(Method::GET, "/healthz", healthz),
+        route(Method::GET, "/openapi.yaml", openapi),
+    ];
+    all.extend(robots::routes());
+    all.extend(sets::routes());
+    all.extend(calibrations::routes());
+    all.extend(versions::routes());
+    all.extend(solve::routes());
+    all
+}
+
+/// (method, path template) of every route the router serves.
+pub fn route_table() -> Vec<(Method, &'static str)> {
+    routes().into_iter().map(|r| (r.method, r.path)).collect()
+}
 
 /// Service settings that are not the database.
 #[derive(Clone)]
@@ -296,69 +312,25 @@ fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
 
 /// The router of the service.
 pub fn app(state: AppState) -> Router {
-    let v1 = Router::new()
-        .route("/presets", get(robots::list_presets))
-        .route("/robots", get(robots::list).post(robots::create))
-        .route(
-            "/robots/{id}",
-            get(robots::get_one)
-                .patch(robots::update)
-                .delete(robots::delete),
-        )
-        .route(
-            "/robots/{id}/measurement-sets",
-            get(sets::list).post(sets::upload),
-        )
-        .route(
-            "/robots/{id}/measurement-sets/{sid}",
-            get(sets::get_one).delete(sets::delete),
-        )
-        .route(
-            "/robots/{id}/measurement-sets/{sid}/original",
-            get(sets::original),
-        )
-        .route(
-            "/robots/{id}/calibrations",
-            get(calibrations::list).post(calibrations::start),
-        )
-        .route(
-            "/robots/{id}/calibrations/{cid}",
-            get(calibrations::get_one),
-        )
-        .route(
-            "/robots/{id}/calibrations/{cid}/cancel",
-            post(calibrations::cancel),
-        )
-        .route(
-            "/robots/{id}/calibrations/{cid}/result",
-            get(calibrations::result),
-        )
-        .route(
-            "/robots/{id}/calibrations/{cid}/report",
-            get(calibrations::report),
-        )
-        .route("/robots/{id}/versions", get(versions::list))
-        .route("/robots/{id}/versions/rollback", post(versions::rollback))
-        .route("/robots/{id}/versions/{version}", get(versions::get_one))
-        .route(
-            "/robots/{id}/versions/{version}/activate",
-            post(versions::activate),
-        )
-        .route(
-            "/robots/{id}/versions/{version}/model.json",
-            get(versions::download),
-        )
-        .route("/robots/{id}/solve", post(solve::solve));
-    Router::new()
-        .route("/healthz", get(healthz))
-        .route("/openapi.yaml", get(openapi))
-        .nest("/v1", v1)
+    let mut router = Router::new();
+    for r in routes() {
+        // Routes of one path with different methods merge into one.
+        router = router.route(r.path, r.handler);
+    }
+    router
         .fallback(not_found)
         .method_not_allowed_fallback(method_not_allowed)
         .layer(middleware::from_fn_with_state(state.clone(), auth))
         .layer(DefaultBodyLimit::max(state.limits().body_bytes))
-        .layer(middleware::from_fn(catch_panics))
-        .layer(middleware::from_fn(log_requests))
+        .layer(CatchPanicLayer::custom(panic_response))
+        .layer(
+            // Method, path, status and latency; never headers (they may hold keys).
+            TraceLayer::new_for_http()
+                .make_span_with(DefaultMakeSpan::new().level(Level::DEBUG))
+                .on_request(())
+                .on_response(DefaultOnResponse::new().level(Level::DEBUG))
+                .on_failure(DefaultOnFailure::new().level(Level::WARN)),
+        )
         .with_state(state)
 }
 
@@ -445,49 +417,47 @@ fn constant_time_eq(a: &[u8], b: &[u8]) -> bool {
 }
 
 /// A handler that panics answers a problem+json 500 instead of dropping the
-/// connection. The handler's future is polled in place under `catch_unwind`
-/// (spawning a task per request for this cost measurable throughput).
-async fn catch_panics(req: Request, next: Next) -> Response {
-    let mut fut = Box::pin(next.run(req));
-    std::future::poll_fn(move |cx| {
-        match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| fut.as_mut().poll(cx))) {
-            Ok(poll) => poll,
-            Err(panic) => {
-                let what = panic
-                    .downcast_ref::<&str>()
-                    .map(|s| s.to_string())
-                    .or_else(|| panic.downcast_ref::<String>().cloned())
-                    .unwrap_or_default();
-                std::task::Poll::Ready(
-                    ApiError::Internal(format!("request handler panicked: {what}")).into_response(),
-                )
-            }
-        }
-    })
-    .await
-}
-
-/// Logs method, path, status and duration (never headers: they may hold keys).
-async fn log_requests(req: Request, next: Next) -> Response {
-    let method = req.method().clone();
-    let uri = req.uri().clone();
-    let start = Instant::now();
-    let res = next.run(req).await;
-    let status = res.status();
-    let ms = start.elapsed().as_secs_f64() * 1e3;
-    let path = uri.path();
-    if status.is_server_error() {
-        tracing::warn!(%method, %path, status = status.as_u16(), ms, "request failed");
-    } else if status == StatusCode::UNAUTHORIZED || status.is_client_error() {
-        tracing::info!(%method, %path, status = status.as_u16(), ms, "request rejected");
-    } else {
-        tracing::debug!(%method, %path, status = status.as_u16(), ms, "request");
-    }
-    res
+/// connection (the panic message is logged, not sent).
+fn panic_response(panic: Box<dyn std::any::Any + Send + 'static>) -> Response {
+    let what = panic
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| panic.downcast_ref::<String>().cloned())
+        .unwrap_or_default();
+    ApiError::Internal(format!("request handler panicked: {what}")).into_response()
 }
 
 #[cfg(test)]
 mod tests {
+    use axum::body::Body;
+    use axum::http::{Request, StatusCode};
+    use tower::ServiceExt;
+
+    /// A panicking handler answers a problem+json 500 without the panic text.
+    #[tokio::test]
+    async fn a_panic_becomes_a_problem_500() {
+        async fn boom() -> &'static str {
+            panic!("secret detail")
+        }
+        let app = axum::Router::new()
+            .route("/boom", axum::routing::get(boom))
+            .layer(tower_http::catch_panic::CatchPanicLayer::custom(
+                super::panic_response,
+            ));
+        let res = app
+            .oneshot(Request::get("/boom").body(Body::empty()).unwrap())
+            .await
+            .unwrap();
+        assert_eq!(res.status(), StatusCode::INTERNAL_SERVER_ERROR);
+        assert_eq!(res.headers()["content-type"], super::error::PROBLEM_JSON);
+        let body = axum::body::to_bytes(res.into_body(), 1 << 16)
+            .await
+            .unwrap();
+        let text = String::from_utf8(body.to_vec()).unwrap();
+        assert!(text.contains("\"status\":500"), "{text}");
+        assert!(!text.contains("secret detail"), "{text}");
+    }
+
     #[test]
     fn bearer_scheme_is_case_insensitive() {
         for v in ["Bearer k1", "bearer k1", "BEARER k1", "bEaReR   k1"] {

@@ -241,3 +241,17 @@ pub async fn delete(
     state.invalidate_robot(id);
     Ok(StatusCode::NO_CONTENT.into_response())
 }
+
+/// The routes of robots and presets.
+pub fn routes() -> Vec<super::Route> {
+    use super::route;
+    use axum::http::Method;
+    vec![
+        route(Method::GET, "/v1/presets", list_presets),
+        route(Method::GET, "/v1/robots", list),
+        route(Method::POST, "/v1/robots", create),
+        route(Method::GET, "/v1/robots/{id}", get_one),
+        route(Method::PATCH, "/v1/robots/{id}", update),
+        route(Method::DELETE, "/v1/robots/{id}", delete),
+    ]
+}

@@ -552,6 +552,32 @@ pub async fn delete(
     Ok(StatusCode::NO_CONTENT.into_response())
 }
 
+/// The routes of measurement sets.
+pub fn routes() -> Vec<super::Route> {
+    use super::route;
+    use axum::http::Method;
+    const SETS: &str = "/v1/robots/{id}/measurement-sets";
+    vec![
+        route(Method::GET, SETS, list),
+        route(Method::POST, SETS, upload),
+        route(
+            Method::GET,
+            "/v1/robots/{id}/measurement-sets/{sid}",
+            get_one,
+        ),
+        route(
+            Method::DELETE,
+            "/v1/robots/{id}/measurement-sets/{sid}",
+            delete,
+        ),
+        route(
+            Method::GET,
+            "/v1/robots/{id}/measurement-sets/{sid}/original",
+            original,
+        ),
+    ]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

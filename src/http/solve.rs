@@ -548,3 +548,12 @@ pub async fn solve(
     };
     Ok(axum::Json(resp).into_response())
 }
+
+/// The route of the solve endpoint.
+pub fn routes() -> Vec<super::Route> {
+    vec![super::route(
+        axum::http::Method::POST,
+        "/v1/robots/{id}/solve",
+        solve,
+    )]
+}

@@ -168,3 +168,24 @@ pub async fn rollback(
         }
     }
 }
+
+/// The routes of model versions.
+pub fn routes() -> Vec<super::Route> {
+    use super::route;
+    use axum::http::Method;
+    vec![
+        route(Method::GET, "/v1/robots/{id}/versions", list),
+        route(Method::POST, "/v1/robots/{id}/versions/rollback", rollback),
+        route(Method::GET, "/v1/robots/{id}/versions/{version}", get_one),
+        route(
+            Method::POST,
+            "/v1/robots/{id}/versions/{version}/activate",
+            activate,
+        ),
+        route(
+            Method::GET,
+            "/v1/robots/{id}/versions/{version}/model.json",
+            download,
+        ),
+    ]
+}
