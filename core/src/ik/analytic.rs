@@ -86,6 +86,12 @@ pub struct AnalyticSolution {
     /// The target lies (slightly) outside the reach and the branch was clamped
     /// to the boundary (only with a margin larger than [`STRICT_MARGIN`]).
     pub clamped: bool,
+    /// Signed distance [m] of the wrist point outside this branch's workspace.
+    /// Outside: the distance it lies inside the shoulder-offset cylinder about
+    /// axis 1 plus the distance outside the elbow's reachable annulus
+    /// `[|a2 − l2|, a2 + l2]`; inside: minus the distance to the nearer of the
+    /// two boundaries. See [`AnalyticIk::reach_excess`].
+    pub reach_excess_m: f64,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -251,6 +257,16 @@ impl AnalyticIk {
             .pop()
     }
 
+    /// Signed distance [m] of the wrist point of `tcp` (base frame) outside
+    /// the nominal workspace for this orientation: the smallest
+    /// [`AnalyticSolution::reach_excess_m`] over all branches, ≤ 0 when a
+    /// branch reaches it. Infinite for a non-finite pose. Joint limits are not
+    /// considered. A reach test for the calibrated model compares it with the
+    /// calibrated model's largest deviation from this one.
+    pub fn reach_excess(&self, tcp: &Pose) -> f64 {
+        self.solve_impl_excess(tcp, None, f64::INFINITY, None).1
+    }
+
     fn solve_impl(
         &self,
         tcp: &Pose,
@@ -258,9 +274,19 @@ impl AnalyticIk {
         margin: f64,
         only: Option<Configuration>,
     ) -> Vec<AnalyticSolution> {
+        self.solve_impl_excess(tcp, hint, margin, only).0
+    }
+
+    fn solve_impl_excess(
+        &self,
+        tcp: &Pose,
+        hint: Option<&[f64]>,
+        margin: f64,
+        only: Option<Configuration>,
+    ) -> (Vec<AnalyticSolution>, f64) {
         let mut out = Vec::with_capacity(8);
         if !finite_pose(tcp) {
-            return out;
+            return (out, f64::INFINITY);
         }
         let reference = self.reference(hint);
         let hint_theta = self
@@ -272,12 +298,13 @@ impl AnalyticIk {
             hint: &hint_theta,
             margin,
             only,
+            min_excess: std::cell::Cell::new(f64::INFINITY),
         };
         match self.structure {
             Structure::SphericalWrist => self.solve_spherical(&tb, &ctx, &mut out),
             Structure::ThreeParallel => self.solve_three_parallel(&tb, &ctx, &mut out),
         }
-        out
+        (out, ctx.min_excess.get())
     }
 
     /// The configuration flags of any joint vector (model convention, rad);
@@ -375,18 +402,22 @@ impl AnalyticIk {
         }
     }
 
-    /// θ0 solutions for a wrist point `w` in frame 0′: `(θ0, shoulder)`, and
-    /// whether clamped / singular.
+    /// θ0 solutions for a wrist point `w` in frame 0′: `(θ0, shoulder)`,
+    /// whether clamped / singular, and the signed reach excess [m] (how far `w`
+    /// lies inside the cylinder of radius `|c_n − cos α1·w_z| / |sin α1|` about
+    /// axis 1 that the offset along the arm-plane normal forbids; negative outside it).
     fn shoulder_angles(&self, w: &Vector3<f64>, ctx: &Ctx) -> Option<ShoulderSolutions> {
         let (sa, ca) = self.alpha[1].sin_cos();
         let rho = w.x.hypot(w.y);
         let rhs = self.c_n - ca * w.z;
+        let excess = rhs.abs() / sa.abs() - rho;
         if rho < 1e-9 {
             let h = ctx.hint[0];
             return Some((
                 [(h, Shoulder::Front), (h + PI, Shoulder::Back)],
                 false,
                 true,
+                excess,
             ));
         }
         let k = rhs / (sa * rho);
@@ -400,6 +431,7 @@ impl AnalyticIk {
             [(phi + s, Shoulder::Front), (phi + PI - s, Shoulder::Back)],
             clamped,
             false,
+            excess,
         ))
     }
 
@@ -414,9 +446,13 @@ impl AnalyticIk {
     }
 
     /// Planar 2R: the wrist point at `(px, py)` in frame 1′. Returns
-    /// `(θ1, θ2, elbow)` for `±acos`, and whether clamped.
+    /// `(θ1, θ2, elbow)` for `±acos`, whether clamped, and the signed reach
+    /// excess [m] (distance of the point outside the annulus
+    /// `[|a2 − l2|, a2 + l2]`, negative inside).
     fn planar(&self, px: f64, py: f64, ctx: &Ctx) -> Option<PlanarSolutions> {
         let (a2, l2) = (self.a[2], self.l2);
+        let r = px.hypot(py);
+        let excess = (r - (a2.abs() + l2)).max((a2.abs() - l2).abs() - r);
         let c = (px * px + py * py - a2 * a2 - l2 * l2) / (2.0 * a2 * l2);
         if c.abs() > 1.0 + ctx.margin {
             return None;
@@ -438,7 +474,7 @@ impl AnalyticIk {
             let t1 = base - (l2 * phi2.sin()).atan2(a2 + l2 * phi2.cos());
             (t1, phi2 - self.psi, e)
         };
-        Some(([one(g, plus), one(-g, minus)], clamped))
+        Some(([one(g, plus), one(-g, minus)], clamped, excess))
     }
 
     /// Wrist angles from `M = Rz(θ3)·Rx(α4)·Rz(θ4)·Rx(α5)·Rz(θ5)`.
@@ -474,7 +510,7 @@ impl AnalyticIk {
 
     fn solve_spherical(&self, tb: &Pose, ctx: &Ctx, out: &mut Vec<AnalyticSolution>) {
         let w = tb.p - tb.z_axis() * self.d[5];
-        let Some((shoulders, clamp0, sing0)) = self.shoulder_angles(&w, ctx) else {
+        let Some((shoulders, clamp0, sing0, excess0)) = self.shoulder_angles(&w, ctx) else {
             return;
         };
         for (t0, sh) in shoulders {
@@ -483,7 +519,7 @@ impl AnalyticIk {
             }
             let f1 = self.frame1(t0);
             let w1 = f1.r.transpose() * (w - f1.p);
-            let Some((elbows, clamp1)) = self.planar(w1.x, w1.y, ctx) else {
+            let Some((elbows, clamp1, excess1)) = self.planar(w1.x, w1.y, ctx) else {
                 continue;
             };
             for (t1, t2, el) in elbows {
@@ -507,7 +543,10 @@ impl AnalyticIk {
                         [t0, t1, t2, t3, t4, t5],
                         Configuration::new(sh, el, wr),
                         sing0 || sing,
-                        clamp0 || clamp1,
+                        Reach {
+                            clamped: clamp0 || clamp1,
+                            excess_m: signed_excess(excess0, excess1),
+                        },
                         ctx,
                         out,
                     );
@@ -528,7 +567,7 @@ impl AnalyticIk {
     fn solve_three_parallel(&self, tb: &Pose, ctx: &Ctx, out: &mut Vec<AnalyticSolution>) {
         let z5 = tb.z_axis();
         let o4 = tb.p - z5 * self.d[5];
-        let Some((shoulders, clamp0, sing0)) = self.shoulder_angles(&o4, ctx) else {
+        let Some((shoulders, clamp0, sing0, excess0)) = self.shoulder_angles(&o4, ctx) else {
             return;
         };
         let (sa1, ca1) = self.alpha[1].sin_cos();
@@ -563,7 +602,7 @@ impl AnalyticIk {
                     .compose(&self.link_pose(5, t5).inverse())
                     .compose(&self.link_pose(4, t4).inverse());
                 let f = f1_inv.compose(&f3);
-                let Some((elbows, clamp1)) = self.planar(f.p.x, f.p.y, ctx) else {
+                let Some((elbows, clamp1, excess1)) = self.planar(f.p.x, f.p.y, ctx) else {
                     continue;
                 };
                 let total = f.r[(1, 0)].atan2(f.r[(0, 0)]);
@@ -575,7 +614,10 @@ impl AnalyticIk {
                         [t0, t1, t2, total - t1 - t2, t4, t5],
                         Configuration::new(sh, el, wr),
                         sing0 || sing,
-                        clamp0 || clamp1,
+                        Reach {
+                            clamped: clamp0 || clamp1,
+                            excess_m: signed_excess(excess0, excess1),
+                        },
                         ctx,
                         out,
                     );
@@ -590,10 +632,11 @@ impl AnalyticIk {
         theta: [f64; 6],
         configuration: Configuration,
         singular: bool,
-        clamped: bool,
+        reach: Reach,
         ctx: &Ctx,
         out: &mut Vec<AnalyticSolution>,
     ) {
+        ctx.min_excess.set(ctx.min_excess.get().min(reach.excess_m));
         let mut t = theta;
         if let Some(g) = &self.loop_geom {
             match motor_from_passive(t[g.passive - 1], t[g.passive], g) {
@@ -618,15 +661,35 @@ impl AnalyticIk {
             configuration,
             within_limits,
             singular,
-            clamped,
+            clamped: reach.clamped,
+            reach_excess_m: reach.excess_m,
         });
     }
 }
 
-/// `(θ0, shoulder)` pairs, clamped, singular.
-type ShoulderSolutions = ([(f64, Shoulder); 2], bool, bool);
-/// `(θ1, θ2, elbow)` pairs, clamped.
-type PlanarSolutions = ([(f64, f64, Elbow); 2], bool);
+/// `(θ0, shoulder)` pairs, clamped, singular, reach excess [m].
+type ShoulderSolutions = ([(f64, Shoulder); 2], bool, bool, f64);
+/// `(θ1, θ2, elbow)` pairs, clamped, reach excess [m].
+type PlanarSolutions = ([(f64, f64, Elbow); 2], bool, f64);
+
+/// Signed workspace excess of two conditions with signed excesses `a`, `b`:
+/// the sum of the violated parts when one is violated, else the larger (the
+/// distance to the nearer boundary, negated).
+fn signed_excess(a: f64, b: f64) -> f64 {
+    if a > 0.0 || b > 0.0 {
+        a.max(0.0) + b.max(0.0)
+    } else {
+        a.max(b)
+    }
+}
+
+/// Whether a branch was clamped to the workspace boundary, and how far [m]
+/// its wrist point lies outside.
+#[derive(Debug, Clone, Copy)]
+struct Reach {
+    clamped: bool,
+    excess_m: f64,
+}
 /// `(θ3, θ4, θ5, wrist, singular)` pairs.
 type WristSolutions = [(f64, f64, f64, Wrist, bool); 2];
 
@@ -672,6 +735,9 @@ struct Ctx<'a> {
     margin: f64,
     /// Compute this branch only.
     only: Option<Configuration>,
+    /// Smallest reach excess [m] of the branches met so far (also those the
+    /// closed loop then rejects).
+    min_excess: std::cell::Cell<f64>,
 }
 
 /// The 2π representative of `x` within `limits` nearest `reference`, or the

@@ -34,17 +34,32 @@
 //! run starts from the best attempt when it ended within 1 cm. Targets without
 //! a closed-form branch within the reach margin, position-only targets and
 //! models without a closed form use a deterministic multi-start (the joint seed,
-//! the middle of the ranges, then Halton points within the limits). Targets
-//! beyond the reach bound (sum of link lengths and offsets plus the tool) fail
-//! at once as unreachable.
+//! the middle of the ranges, then Halton points within the limits).
+//!
+//! Reach test (targets with an orientation): the closed form gives the signed
+//! distance `e` of the target's wrist point outside the nominal workspace
+//! (`AnalyticIk::reach_excess`). With `m` the reach margin
+//! (`IkSolver::reach_margin_m`, twice the sampled calibrated-vs-nominal
+//! wrist-point deviation plus 5 mm): `e > m` fails at once (no evaluation);
+//! `e > −m` (near the boundary, either side) runs the corrected test — the
+//! target moved by the calibrated model's deviation at each closed-form
+//! branch within the margin, re-solved up to 4 times (one evaluation each)
+//! until one branch reaches it — and a corrected excess above 0.1 mm fails as
+//! unreachable. Cruder, for every target: beyond the sum of link lengths and
+//! offsets plus the tool.
 //!
 //! Failure reasons: `InvalidTarget` (non-finite values, non-rotation, bad
-//! seed); `Unreachable` (beyond the reach bound, or no closed-form branch even
-//! with the margin and no calibrated solution found); `OutOfLimits` (branches
-//! exist but only outside the limits, or the iteration stalled on a limit);
-//! `Singular` (stalled where the weighted Jacobian's smallest singular value is
-//! below `singular_threshold`, or converged into another branch than the
-//! requested one); `DidNotConverge` otherwise.
+//! seed); `Unreachable` (the reach test, or beyond the nominal or corrected
+//! workspace and no calibrated solution found, or no closed-form branch even
+//! with the margin); with a required branch (`SolveOptions::branch`, or path
+//! mode's kept branch) every other failure is `BranchUnavailable`, naming the
+//! branch (exists only outside the limits, stalled on a limit or at a
+//! singular configuration, converged only into other branches), with the
+//! branches that do reach the target; without one, `OutOfLimits` (branches
+//! exist but only outside the limits, or the iteration stalled on a limit),
+//! `Singular` (stalled inside the workspace where the weighted Jacobian's
+//! smallest singular value is below `singular_threshold`), `DidNotConverge`
+//! otherwise. A required branch is never replaced by another.
 
 use super::analytic::{closed_form_proxy, AnalyticIk, AnalyticSolution};
 use super::config::Configuration;
@@ -60,6 +75,39 @@ const REACH_SLACK_M: f64 = 0.05;
 
 /// The last-resort long run only starts from attempts closer than this [m].
 const LAST_RESORT_MAX_M: f64 = 0.01;
+
+/// Safety factor on the sampled calibrated-vs-nominal deviation of the reach test.
+const REACH_MARGIN_FACTOR: f64 = 2.0;
+/// Floor added to the reach test's margin [m] (unsampled deviations, compensator).
+const REACH_MARGIN_FLOOR_M: f64 = 0.005;
+/// Fixed-point steps of the corrected reach test per branch.
+const CORRECTED_REACH_STEPS: usize = 4;
+/// The corrected reach test's iteration stops when the excess changes less than this [m].
+const CORRECTED_REACH_CONVERGED_M: f64 = 2e-6;
+/// A target whose corrected reach excess is above this [m] is unreachable.
+const CORRECTED_REACH_TOLERANCE_M: f64 = 0.0001;
+/// Joint samples of the deviation estimate of the reach test.
+const REACH_SAMPLES: usize = 64;
+
+/// Largest deviation [m] of the calibrated prediction's wrist point from the
+/// seed model's over `REACH_SAMPLES` Halton points within the limits (capped
+/// to ±π): `|Δp| + |ΔR|·(|tool| + |d_N|)` with `|ΔR|` the rotation angle.
+fn wrist_deviation(model: &CompensatedModel, seed_model: &RobotModel, limits: &[[f64; 2]]) -> f64 {
+    let lever = seed_model.tool.p.norm() + seed_model.links.last().map_or(0.0, |l| l.d.abs());
+    let mut worst: f64 = 0.0;
+    for i in 1..=REACH_SAMPLES {
+        let q = halton_joints(limits, i);
+        let (Ok(p), Ok(n)) = (
+            model.predict_base(&q),
+            crate::kinematics::fk(seed_model, &q),
+        ) else {
+            continue;
+        };
+        let d = (p.p - n.p).norm() + rotation_log(&(p.r * n.r.transpose())).norm() * lever;
+        worst = worst.max(d);
+    }
+    worst
+}
 
 /// Numerical settings of the solver.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -104,6 +152,10 @@ pub struct IkSettings {
     pub jump_threshold_rad: f64,
     /// Worker threads of a batch; 0 uses rayon's global pool. Default 0.
     pub threads: usize,
+    /// The reach test (see [`IkSolver::reach_margin_m`]): targets beyond the
+    /// workspace fail as `Unreachable` before the iteration. Default true;
+    /// off, they go through every seed (a brute-force check of the test).
+    pub reach_test: bool,
 }
 
 impl Default for IkSettings {
@@ -125,6 +177,7 @@ impl Default for IkSettings {
             numeric_fallback_starts: 8,
             jump_threshold_rad: 30f64.to_radians(),
             threads: 0,
+            reach_test: true,
         }
     }
 }
@@ -156,6 +209,45 @@ pub enum FailureReason {
     DidNotConverge,
     #[error("invalid target: {0}")]
     InvalidTarget(String),
+    /// A configuration branch was required (requested, or kept by path mode)
+    /// and the target has no solution in it.
+    #[error("{}", branch_message(requested, *out_of_limits, *singular, reachable))]
+    BranchUnavailable {
+        /// The required branch.
+        requested: Configuration,
+        /// The branch exists, but only outside the joint limits (or the
+        /// iteration in it stalled on a limit).
+        out_of_limits: bool,
+        /// The iteration in the branch stalled at a singular configuration.
+        singular: bool,
+        /// Branches of the nominal closed form that reach the target within
+        /// the limits (empty when unknown).
+        reachable: Vec<Configuration>,
+    },
+}
+
+fn branch_message(
+    requested: &Configuration,
+    out_of_limits: bool,
+    singular: bool,
+    reachable: &[Configuration],
+) -> String {
+    let mut m = format!("not reachable in the required branch {requested}");
+    if out_of_limits {
+        m.push_str(" within the joint limits");
+    }
+    if singular {
+        m.push_str(": the solver stalled at a singular configuration in it");
+    }
+    let others: Vec<String> = reachable
+        .iter()
+        .filter(|c| *c != requested)
+        .map(|c| c.to_string())
+        .collect();
+    if !others.is_empty() {
+        m.push_str(&format!("; reachable in {}", others.join(", ")));
+    }
+    m
 }
 
 impl FailureReason {
@@ -167,6 +259,7 @@ impl FailureReason {
             FailureReason::Singular => "singular",
             FailureReason::DidNotConverge => "did_not_converge",
             FailureReason::InvalidTarget(_) => "invalid_target",
+            FailureReason::BranchUnavailable { .. } => "branch_unavailable",
         }
     }
 }
@@ -248,6 +341,9 @@ pub struct IkSolver {
     limits: Vec<[f64; 2]>,
     /// Upper bound of the TCP distance from the base origin [m].
     reach: f64,
+    /// Largest nominal-workspace excess [m] of the wrist point that a target
+    /// of the calibrated model may have (see [`IkSolver::reach_margin_m`]).
+    reach_margin_m: f64,
     /// The model the closed form solves (the nominal model or its proxy).
     seed_model: RobotModel,
 }
@@ -266,6 +362,24 @@ fn halton(mut i: usize, b: usize) -> f64 {
         i /= b;
     }
     r
+}
+
+/// A joint range capped to ±π: `(lo, hi)`.
+fn capped_span(l: [f64; 2]) -> (f64, f64) {
+    (l[0].max(-std::f64::consts::PI), l[1].min(std::f64::consts::PI))
+}
+
+/// The `i`-th Halton point within the limits (capped to ±π), one prime base per joint.
+fn halton_joints(limits: &[[f64; 2]], i: usize) -> Vec<f64> {
+    const PRIMES: [usize; 8] = [2, 3, 5, 7, 11, 13, 17, 19];
+    limits
+        .iter()
+        .enumerate()
+        .map(|(k, l)| {
+            let (lo, hi) = capped_span(*l);
+            lo + (hi - lo) * halton(i, PRIMES[k % PRIMES.len()])
+        })
+        .collect()
 }
 
 impl IkSolver {
@@ -292,7 +406,7 @@ impl IkSolver {
                 },
             }
         };
-        let limits = model.nominal.links.iter().map(|l| l.limits).collect();
+        let limits: Vec<[f64; 2]> = model.nominal.links.iter().map(|l| l.limits).collect();
         let reach = model
             .calibrated
             .links
@@ -301,9 +415,16 @@ impl IkSolver {
             .sum::<f64>()
             + model.calibrated.tool.p.norm()
             + REACH_SLACK_M;
+        let reach_margin_m = if analytic.is_some() {
+            REACH_MARGIN_FACTOR * wrist_deviation(&model, &seed_model, &limits)
+                + REACH_MARGIN_FLOOR_M
+        } else {
+            f64::INFINITY
+        };
         IkSolver {
             seed_model,
             reach,
+            reach_margin_m,
             base_from_cell: model.cell_from_base.inverse(),
             model,
             analytic,
@@ -329,6 +450,20 @@ impl IkSolver {
     /// Why the model has no closed form (then seeds are numerical).
     pub fn analytic_error(&self) -> Option<&str> {
         self.analytic_error.as_deref()
+    }
+
+    /// The reach test's margin [m]: a target whose wrist point lies farther
+    /// than this outside the nominal closed form's workspace
+    /// ([`AnalyticIk::reach_excess`]) fails as `Unreachable` without an
+    /// evaluation of the calibrated model. It is
+    /// `REACH_MARGIN_FACTOR · δ + REACH_MARGIN_FLOOR_M`, with `δ` the largest
+    /// deviation of the calibrated prediction's wrist point from the seed
+    /// model's over 64 Halton joint samples (`|Δp| + |ΔR|·(|tool| + |d6|)`):
+    /// a target the calibrated model reaches at `q*` has its wrist point
+    /// within `δ(q*)` of the nominal wrist point at `q*`, which is inside the
+    /// workspace. Infinite for models without a closed form.
+    pub fn reach_margin_m(&self) -> f64 {
+        self.reach_margin_m
     }
 
     /// Joint limits used by the solver [rad] (the nominal model's: the controller's).
@@ -418,7 +553,46 @@ impl IkSolver {
             };
         }
         let seeds = self.seeds(goal, options);
+        let fail = |reason: FailureReason| IkSolution {
+            converged: false,
+            q: Vec::new(),
+            position_residual_mm: f64::NAN,
+            orientation_residual_rad: f64::NAN,
+            iterations: 0,
+            branch: None,
+            reason: Some(reason),
+        };
+        // The reach test: beyond the nominal workspace by more than the
+        // calibrated model can deviate from it.
+        let reach_test = self.settings.reach_test;
+        if reach_test && seeds.reach_excess_m > self.reach_margin_m {
+            return fail(FailureReason::Unreachable);
+        }
+        if let (Some(requested), true) = (options.branch, seeds.branch_out_of_limits) {
+            return fail(FailureReason::BranchUnavailable {
+                requested,
+                out_of_limits: true,
+                singular: false,
+                reachable: seeds.reachable.clone(),
+            });
+        }
         let mut total_iters = 0;
+        // Within the margin of the nominal workspace's boundary (either side):
+        // the same test with the target moved by the calibrated model's own
+        // deviation at the boundary.
+        let mut corrected_excess = f64::NEG_INFINITY;
+        if reach_test && seeds.reach_excess_m > -self.reach_margin_m {
+            let (excess, n) =
+                self.corrected_reach_excess(&seeds.target, options.seed.as_deref());
+            total_iters += n;
+            corrected_excess = excess;
+            if excess > CORRECTED_REACH_TOLERANCE_M {
+                return IkSolution {
+                    iterations: total_iters,
+                    ..fail(FailureReason::Unreachable)
+                };
+            }
+        }
         let mut best: Option<Refined> = None;
         let branch_ok = |q: &[f64]| match (options.branch, self.configuration(q)) {
             (Some(want), Some(got)) => want == got,
@@ -473,13 +647,28 @@ impl IkSolver {
             }
             consider(r, &mut best);
         }
-        let reason = match &best {
-            None if seeds.any_out_of_limits => FailureReason::OutOfLimits,
-            None => FailureReason::Unreachable,
-            // Converged, but into another branch than the requested one: the
-            // target sits on a branch boundary (wrist, elbow or shoulder singularity).
-            Some(b) if b.converged => FailureReason::Singular,
-            Some(b) => {
+        let reason = match (&best, options.branch) {
+            (None, _) if seeds.any_out_of_limits => FailureReason::OutOfLimits,
+            (None, _) => FailureReason::Unreachable,
+            (Some(b), _)
+                if (seeds.reach_excess_m > 0.0 || corrected_excess > 0.0) && !b.converged =>
+            {
+                // Beyond the (corrected) workspace, and the calibrated model
+                // did not get there either.
+                FailureReason::Unreachable
+            }
+            // A required branch: the failure names it. `b` converged only
+            // when it is in another branch.
+            (Some(b), Some(requested)) => FailureReason::BranchUnavailable {
+                requested,
+                out_of_limits: (!b.converged && b.at_limit)
+                    || (seeds.branch_exists && !seeds.reachable.contains(&requested)),
+                singular: !b.converged
+                    && !b.at_limit
+                    && b.sigma_min < self.settings.singular_threshold,
+                reachable: seeds.reachable.clone(),
+            },
+            (Some(b), None) => {
                 if b.at_limit || (seeds.all_out_of_limits && !seeds.all_clamped) {
                     FailureReason::OutOfLimits
                 } else if seeds.all_clamped && seeds.from_closed_form {
@@ -492,15 +681,18 @@ impl IkSolver {
             }
         };
         match best {
-            Some(b) => self.solution(goal, b, total_iters, Some(reason)),
+            Some(b) => {
+                let branch_failed = matches!(reason, FailureReason::BranchUnavailable { .. });
+                let mut s = self.solution(goal, b, total_iters, Some(reason));
+                if branch_failed {
+                    // The best attempt is in another branch: do not show it as the answer's.
+                    s.branch = None;
+                }
+                s
+            }
             None => IkSolution {
-                converged: false,
-                q: Vec::new(),
-                position_residual_mm: f64::NAN,
-                orientation_residual_rad: f64::NAN,
-                iterations: 0,
-                branch: None,
-                reason: Some(reason),
+                iterations: total_iters,
+                ..fail(reason)
             },
         }
     }
@@ -547,6 +739,36 @@ impl IkSolver {
         });
         let target = Pose::new(rotation, goal.position);
         let sols = analytic.solve_with_margin(&target, hint, self.settings.seed_reach_margin);
+        let slack = self.settings.seed_limit_slack_rad;
+        // The reach test needs the target's own orientation; any unclamped
+        // branch means the wrist point is inside the nominal workspace.
+        let oriented = goal.rotation.is_some() && !options.position_only;
+        let reach_excess_m = if !oriented {
+            f64::NEG_INFINITY
+        } else if sols.is_empty() {
+            analytic.reach_excess(&target)
+        } else {
+            sols.iter().map(|s| s.reach_excess_m).fold(f64::INFINITY, f64::min)
+        };
+        // Strictly within the limits (the seeds allow the slack).
+        let reachable: Vec<Configuration> = sols
+            .iter()
+            .filter(|s| !s.clamped && self.limit_violation(&s.q) <= 1e-9)
+            .map(|s| s.configuration)
+            .collect();
+        let branch_exists = options
+            .branch
+            .is_some_and(|b| sols.iter().any(|s| !s.clamped && s.configuration == b));
+        // The required branch exists in the closed form, but only outside the limits.
+        let branch_out_of_limits = oriented
+            && options.branch.is_some_and(|b| {
+                let mine: Vec<&AnalyticSolution> =
+                    sols.iter().filter(|s| s.configuration == b).collect();
+                !mine.is_empty()
+                    && mine
+                        .iter()
+                        .all(|s| !s.clamped && self.limit_violation(&s.q) > slack)
+            });
         let mut cands: Vec<(AnalyticSolution, f64, f64)> = sols
             .into_iter()
             .filter(|s| options.branch.is_none_or(|b| b == s.configuration))
@@ -560,7 +782,6 @@ impl IkSolver {
                 (s, violation, dist)
             })
             .collect();
-        let slack = self.settings.seed_limit_slack_rad;
         cands.sort_by(|a, b| {
             let ka = (a.1 > 0.0, a.0.clamped);
             let kb = (b.1 > 0.0, b.0.clamped);
@@ -618,6 +839,10 @@ impl IkSolver {
             all_out_of_limits,
             all_clamped,
             from_closed_form: true,
+            reach_excess_m,
+            reachable,
+            branch_out_of_limits,
+            branch_exists,
         }
     }
 
@@ -631,39 +856,31 @@ impl IkSolver {
             all_out_of_limits: false,
             all_clamped: false,
             from_closed_form: false,
+            reach_excess_m: f64::NEG_INFINITY,
+            reachable: Vec::new(),
+            branch_out_of_limits: false,
+            branch_exists: false,
         }
     }
 
     /// Multi-start seeds: the joint seed, the middle of the ranges, then
     /// `count` Halton points within the limits (capped to ±π).
     fn numeric_list(&self, options: &SolveOptions, count: usize) -> Vec<Seed> {
-        let n = self.model.dof();
         let mut list = Vec::new();
         if let Some(s) = &options.seed {
             list.push(self.clamp_to_limits(s));
         }
-        let span = |k: usize| {
-            let [lo, hi] = self.limits[k];
-            (lo.max(-std::f64::consts::PI), hi.min(std::f64::consts::PI))
-        };
         list.push(
-            (0..n)
-                .map(|k| {
-                    let (lo, hi) = span(k);
+            self.limits
+                .iter()
+                .map(|l| {
+                    let (lo, hi) = capped_span(*l);
                     0.5 * (lo + hi)
                 })
                 .collect(),
         );
-        const PRIMES: [usize; 8] = [2, 3, 5, 7, 11, 13, 17, 19];
         for i in 1..=count {
-            list.push(
-                (0..n)
-                    .map(|k| {
-                        let (lo, hi) = span(k);
-                        lo + (hi - lo) * halton(i, PRIMES[k % PRIMES.len()])
-                    })
-                    .collect(),
-            );
+            list.push(halton_joints(&self.limits, i));
         }
         list.into_iter()
             .map(|q| Seed {
@@ -685,6 +902,59 @@ impl IkSolver {
             .zip(&self.limits)
             .map(|(v, l)| v.clamp(l[0], l[1]))
             .collect()
+    }
+
+    /// The calibrated model's reach excess [m]: the closed form's branch `q`
+    /// (clamped to the workspace boundary when outside, limits ignored) is
+    /// moved by the calibrated model's deviation there, as in the seed
+    /// corrections — the target becomes `T·P(q)⁻¹·FK_nom(q)` — and the branch
+    /// is re-solved for the moved target, up to `CORRECTED_REACH_STEPS` times
+    /// or until the excess changes by less than `CORRECTED_REACH_CONVERGED_M`
+    /// (a fixed-point iteration onto the calibrated workspace). Branches are
+    /// taken nearest the workspace first, only those within the reach margin,
+    /// until one reaches the target. Returns the smallest excess (−∞ without
+    /// branches) and the evaluations used.
+    fn corrected_reach_excess(&self, target: &Pose, hint: Option<&[f64]>) -> (f64, usize) {
+        let Some(analytic) = &self.analytic else {
+            return (0.0, 0);
+        };
+        let mut branches = analytic.solve_with_margin(target, hint, f64::INFINITY);
+        branches.sort_by(|a, b| a.reach_excess_m.total_cmp(&b.reach_excess_m));
+        let mut best = f64::INFINITY;
+        let mut evaluations = 0;
+        for branch in branches
+            .iter()
+            .filter(|b| b.reach_excess_m <= self.reach_margin_m)
+        {
+            let mut q = branch.q.clone();
+            let mut excess = branch.reach_excess_m;
+            for _ in 0..CORRECTED_REACH_STEPS {
+                let (Ok(p), Ok(n)) = (
+                    self.model.predict_base(&q),
+                    crate::kinematics::fk(&self.seed_model, &q),
+                ) else {
+                    break;
+                };
+                evaluations += 1;
+                let moved = target.compose(&p.inverse()).compose(&n);
+                let Some(next) =
+                    analytic.solve_branch(&moved, branch.configuration, Some(&q), f64::INFINITY)
+                else {
+                    break;
+                };
+                let change = (next.reach_excess_m - excess).abs();
+                excess = next.reach_excess_m;
+                q = next.q;
+                if change < CORRECTED_REACH_CONVERGED_M {
+                    break;
+                }
+            }
+            best = best.min(excess);
+            if best <= 0.0 {
+                break;
+            }
+        }
+        (if best.is_finite() { best } else { f64::NEG_INFINITY }, evaluations)
     }
 
     /// Re-solves the closed form for the target moved by the calibrated
@@ -911,4 +1181,14 @@ struct Seeds {
     all_out_of_limits: bool,
     all_clamped: bool,
     from_closed_form: bool,
+    /// Signed distance [m] of the wrist point outside the nominal workspace
+    /// ([`AnalyticIk::reach_excess`]); −∞ when the target's orientation is
+    /// free (no reach test).
+    reach_excess_m: f64,
+    /// Closed-form branches reaching the target within the limits (slack included).
+    reachable: Vec<Configuration>,
+    /// The required branch exists only outside the limits (beyond the slack).
+    branch_out_of_limits: bool,
+    /// The required branch reaches the target in the closed form (limits aside).
+    branch_exists: bool,
 }
