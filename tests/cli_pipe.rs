@@ -43,16 +43,24 @@ fn solve_and_calibrate_end_quietly_when_the_reader_is_gone() {
     }
     std::fs::write(&targets, text).unwrap();
     let mut solve = robocal();
-    solve.args(["solve", "--model", "ur5", "--targets"]).arg(&targets);
+    solve
+        .args(["solve", "--model", "ur5", "--targets"])
+        .arg(&targets);
     run_with_closed_stdout(solve);
 
     let sim = robocal()
-        .args(["simulate", "--preset", "ys100", "--poses", "30", "--seed", "1"])
+        .args([
+            "simulate", "--preset", "ys100", "--poses", "30", "--seed", "1",
+        ])
         .arg("--out")
         .arg(dir.path().join("m.csv"))
         .output()
         .unwrap();
-    assert!(sim.status.success(), "{}", String::from_utf8_lossy(&sim.stderr));
+    assert!(
+        sim.status.success(),
+        "{}",
+        String::from_utf8_lossy(&sim.stderr)
+    );
     let mut cal = robocal();
     cal.args(["calibrate", "--model", "ys100", "--method", "km", "--json"])
         .arg("--identify")

@@ -960,7 +960,10 @@ fn a_required_branch_is_returned_or_named_in_the_failure() {
             let reason = s.reason.clone().unwrap();
             assert_eq!(reason.code(), "branch_unavailable", "{reason}");
             assert!(reason.to_string().contains("front-down-noflip"), "{reason}");
-            assert_ne!(s.branch, Some(Configuration::parse("front,up,noflip").unwrap()));
+            assert_ne!(
+                s.branch,
+                Some(Configuration::parse("front,up,noflip").unwrap())
+            );
             named += 1;
         }
     }

@@ -366,7 +366,10 @@ fn halton(mut i: usize, b: usize) -> f64 {
 
 /// A joint range capped to ±π: `(lo, hi)`.
 fn capped_span(l: [f64; 2]) -> (f64, f64) {
-    (l[0].max(-std::f64::consts::PI), l[1].min(std::f64::consts::PI))
+    (
+        l[0].max(-std::f64::consts::PI),
+        l[1].min(std::f64::consts::PI),
+    )
 }
 
 /// The `i`-th Halton point within the limits (capped to ±π), one prime base per joint.
@@ -582,8 +585,7 @@ impl IkSolver {
         // deviation at the boundary.
         let mut corrected_excess = f64::NEG_INFINITY;
         if reach_test && seeds.reach_excess_m > -self.reach_margin_m {
-            let (excess, n) =
-                self.corrected_reach_excess(&seeds.target, options.seed.as_deref());
+            let (excess, n) = self.corrected_reach_excess(&seeds.target, options.seed.as_deref());
             total_iters += n;
             corrected_excess = excess;
             if excess > CORRECTED_REACH_TOLERANCE_M {
@@ -748,7 +750,9 @@ impl IkSolver {
         } else if sols.is_empty() {
             analytic.reach_excess(&target)
         } else {
-            sols.iter().map(|s| s.reach_excess_m).fold(f64::INFINITY, f64::min)
+            sols.iter()
+                .map(|s| s.reach_excess_m)
+                .fold(f64::INFINITY, f64::min)
         };
         // Strictly within the limits (the seeds allow the slack).
         let reachable: Vec<Configuration> = sols
@@ -954,7 +958,14 @@ impl IkSolver {
                 break;
             }
         }
-        (if best.is_finite() { best } else { f64::NEG_INFINITY }, evaluations)
+        (
+            if best.is_finite() {
+                best
+            } else {
+                f64::NEG_INFINITY
+            },
+            evaluations,
+        )
     }
 
     /// Re-solves the closed form for the target moved by the calibrated
