@@ -933,14 +933,10 @@ impl IkSolver {
             let mut q = branch.q.clone();
             let mut excess = branch.reach_excess_m;
             for _ in 0..CORRECTED_REACH_STEPS {
-                let (Ok(p), Ok(n)) = (
-                    self.model.predict_base(&q),
-                    crate::kinematics::fk(&self.seed_model, &q),
-                ) else {
+                let Some(moved) = self.moved_target(target, &q) else {
                     break;
                 };
                 evaluations += 1;
-                let moved = target.compose(&p.inverse()).compose(&n);
                 let Some(next) =
                     analytic.solve_branch(&moved, branch.configuration, Some(&q), f64::INFINITY)
                 else {
@@ -968,6 +964,14 @@ impl IkSolver {
         )
     }
 
+    /// The target moved by the calibrated model's deviation from the seed
+    /// model at `q`: `T·P(q)⁻¹·FK_nom(q)` (one evaluation of the prediction).
+    fn moved_target(&self, target: &Pose, q: &[f64]) -> Option<Pose> {
+        let p = self.model.predict_base(q).ok()?;
+        let n = crate::kinematics::fk(&self.seed_model, q).ok()?;
+        Some(target.compose(&p.inverse()).compose(&n))
+    }
+
     /// Re-solves the closed form for the target moved by the calibrated
     /// model's deviation at the seed, in the seed's branch (see
     /// `IkSettings::seed_corrections`). Returns the seed and the evaluations used.
@@ -981,14 +985,10 @@ impl IkSolver {
         let mut q = q0.to_vec();
         let mut evaluations = 0;
         for _ in 0..self.settings.seed_corrections {
-            let (Ok(p), Ok(n)) = (
-                self.model.predict_base(&q),
-                crate::kinematics::fk(&self.seed_model, &q),
-            ) else {
+            let Some(moved) = self.moved_target(target, &q) else {
                 break;
             };
             evaluations += 1;
-            let moved = target.compose(&p.inverse()).compose(&n);
             let best = analytic.solve_branch(
                 &moved,
                 configuration,
