@@ -155,7 +155,7 @@ fn identification_jacobian_matches_finite_differences() {
             // Geometry acts at the deflected joints; compliance columns through the deflection.
             let qd = deflected_joints(&m, &q, m.payload.mass).unwrap();
             let c = chain(&m, &qd).unwrap();
-            let j = identification_jacobian(&m, &c, &layout.ids, &tau, true);
+            let j = identification_jacobian(&m, &c, &layout.ids, &tau, m.payload.mass, true);
             let v0 = layout.values(&m);
             for (col, id) in layout.ids.iter().enumerate() {
                 // Compliance steps move the joint by about 1e-6 rad.

@@ -21,7 +21,7 @@ pub struct CalibrateArgs {
     /// Validation measurements (CSV), never used for fitting.
     #[arg(long)]
     pub validate: Option<String>,
-    /// Methods to run and compare, comma-separated: km, skcm, skcm-tlbo.
+    /// Methods to run and compare, comma-separated: km, skcm, skcm-tlbo, skcm-payload.
     #[arg(long, default_value = "km,skcm,skcm-tlbo")]
     pub method: String,
     /// Payload mass [kg] for rows without a payload_kg column (default: the model's payload).
@@ -131,10 +131,13 @@ fn save_model(
     let chosen = match method {
         Some(m) => {
             let m = Method::parse(m).with_context(|| format!("unknown --save-method {m}"))?;
-            report
-                .methods
-                .get(m.name())
-                .with_context(|| format!("--save-method {} was not run", m.name()))?
+            match report.methods.get(m.name()) {
+                Some(r) => r,
+                None => match report.failed.iter().find(|f| f.method == m) {
+                    Some(f) => bail!("--save-method {} failed: {}", m.name(), f.reason),
+                    None => bail!("--save-method {} was not run", m.name()),
+                },
+            }
         }
         None => report.best_method().context("no method ran")?,
     };
@@ -160,6 +163,7 @@ fn method_label(name: &str) -> &str {
         "km" => "KM",
         "skcm" => "SKCM",
         "skcm-tlbo" => "SKCM-C (TLBO)",
+        "skcm-payload" => "SKCM-payload",
         other => other,
     }
 }
@@ -292,12 +296,27 @@ pub fn render_report(r: &CalibrationReport) -> String {
     for (n, m) in &r.methods {
         let _ = writeln!(
             s,
-            "solver {:<14} converged={} iterations={} ({})",
+            "solver {:<14} converged={} iterations={} reason={} ({})",
             method_label(n),
             m.solver.converged,
             m.solver.iterations,
-            m.solver.reason
+            m.solver.reason.code(),
+            m.solver.detail
         );
+    }
+    if r.methods.values().any(|m| !m.warnings.is_empty()) {
+        let _ = writeln!(s, "\nWarnings");
+        for (n, m) in &r.methods {
+            for w in &m.warnings {
+                let _ = writeln!(s, "  {:<14} {}", method_label(n), w.message);
+            }
+        }
+    }
+    if !r.failed.is_empty() {
+        let _ = writeln!(s, "\nFailed methods (the others above are complete)");
+        for f in &r.failed {
+            let _ = writeln!(s, "  {:<14} {}", method_label(f.method.name()), f.reason);
+        }
     }
     s
 }

@@ -22,7 +22,8 @@ use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState, Ticket};
 use crate::compensate::{CalibratedModelFile, CompensatedModel};
 use crate::db::{CalibrationRow, JobStatus, NewCalibration, NewVersion, StoredRole};
 use crate::identify::{
-    calibrate, CalibrationError, CalibrationOptions, CalibrationReport, Method, Progress,
+    calibrate, CalibrationError, CalibrationOptions, CalibrationReport, FailedMethod, Method,
+    Progress,
 };
 use crate::measure::Measurement;
 use crate::model::RobotModel;
@@ -474,36 +475,42 @@ async fn run_job(state: AppState, job: Job) {
             !flag.load(Ordering::SeqCst)
         });
         drop(tx);
-        report.map(|r| {
-            let versions = versions_of(&r, &nominal, &robot_name, &opts, payload_kg);
-            (r, versions)
+        report.and_then(|mut r| {
+            let versions = versions_of(&mut r, &nominal, &robot_name, &opts, payload_kg);
+            if versions.is_empty() {
+                return Err(CalibrationError::AllMethodsFailed {
+                    failed: r.failed.clone(),
+                });
+            }
+            Ok((r, versions))
         })
     })
     .await;
     let _ = writer.await;
     let db = state.db();
     let stored = match outcome {
-        Ok(Ok((report, versions))) => match versions {
-            Ok(versions) => {
-                let best = report
-                    .best_method()
-                    .map(|m| m.method.name().to_string())
-                    .unwrap_or_default();
-                match serde_json::to_string(&report) {
-                    Ok(text) => db
-                        .finish_calibration_success(robot_id, id, &text, &best, &versions)
-                        .await
-                        .map(|v| {
-                            tracing::info!(job = id, robot = robot_id, best = %best, versions = v.len(), "calibration succeeded");
-                        }),
-                    Err(e) => {
-                        db.finish_calibration_error(id, JobStatus::Failed, &format!("internal error: {e}"))
-                            .await
-                    }
+        Ok(Ok((report, versions))) => {
+            let best = report
+                .best_method()
+                .map(|m| m.method.name().to_string())
+                .unwrap_or_default();
+            match serde_json::to_string(&report) {
+                Ok(text) => db
+                    .finish_calibration_success(robot_id, id, &text, &best, &versions)
+                    .await
+                    .map(|v| {
+                        tracing::info!(job = id, robot = robot_id, best = %best, versions = v.len(), failed = report.failed.len(), "calibration succeeded");
+                    }),
+                Err(e) => {
+                    db.finish_calibration_error(
+                        id,
+                        JobStatus::Failed,
+                        &format!("internal error: {e}"),
+                    )
+                    .await
                 }
             }
-            Err(e) => db.finish_calibration_error(id, JobStatus::Failed, &e).await,
-        },
+        }
         Ok(Err(CalibrationError::Cancelled)) if over_budget.load(Ordering::SeqCst) => {
             tracing::info!(job = id, "calibration stopped at its time budget");
             db.finish_calibration_error(
@@ -539,14 +546,16 @@ async fn run_job(state: AppState, job: Job) {
     state.invalidate_robot(robot_id);
 }
 
-/// One calibrated model file per method, in the order the methods ran.
+/// One calibrated model file per method, in the order the methods ran. A
+/// method whose file does not load back (what solve would use) moves from the
+/// report's methods to its failed list; the others are stored.
 fn versions_of(
-    r: &CalibrationReport,
+    r: &mut CalibrationReport,
     nominal: &RobotModel,
     robot_name: &str,
     opts: &CalibrationOptions,
     payload_kg: f64,
-) -> Result<Vec<NewVersion>, String> {
+) -> Vec<NewVersion> {
     let cell_from_base = r.tracker_to_base.inverse();
     let mut out = Vec::new();
     for method in &opts.methods {
@@ -561,9 +570,14 @@ fn versions_of(
             compensator: None,
         };
         let file = CalibratedModelFile::from_compensated(&cm, robot_name, method.name());
-        // The stored file must load back (it is what solve uses).
-        file.to_compensated()
-            .map_err(|e| format!("the {} model does not load back: {e}", method.name()))?;
+        if let Err(e) = file.to_compensated() {
+            r.methods.remove(method.name());
+            r.failed.push(FailedMethod {
+                method: *method,
+                reason: format!("the {} model does not load back: {e}", method.name()),
+            });
+            continue;
+        }
         let stats = json!({
             "identification": m.identification.stats,
             "validation": m.validation.as_ref().map(|v| &v.stats),
@@ -574,7 +588,7 @@ fn versions_of(
             stats,
         });
     }
-    Ok(out)
+    out
 }
 
 pub async fn list(

@@ -93,6 +93,7 @@ pub fn render_report_page(title: &str, report: &Value) -> String {
         statistics(&mut d, report, &methods);
         error_charts(&mut d, report, &methods);
         solvers(&mut d, &methods);
+        warnings_and_failures(&mut d, report, &methods);
         identifiability(&mut d, report, &methods);
         parameters(&mut d, &methods);
         stiffness(&mut d, &methods);
@@ -137,6 +138,7 @@ fn method_label(key: &str) -> String {
         "km" => "KM".into(),
         "skcm" => "SKCM".into(),
         "skcm-tlbo" => "SKCM-C (TLBO)".into(),
+        "skcm-payload" => "SKCM-payload".into(),
         other => other.to_string(),
     }
 }
@@ -659,6 +661,37 @@ fn error_charts(d: &mut Doc, report: &Value, methods: &[MethodView]) {
     );
 }
 
+/// Warnings per method and the methods that failed, with their reasons.
+fn warnings_and_failures(d: &mut Doc, report: &Value, methods: &[MethodView]) {
+    let failed = arr(report, "failed");
+    let any_warning = methods.iter().any(|m| !arr(m.v, "warnings").is_empty());
+    if failed.is_empty() && !any_warning {
+        return;
+    }
+    d.out
+        .push_str("<section>\n<h2>Warnings and failed methods</h2>\n<ul>\n");
+    for m in methods {
+        for w in arr(m.v, "warnings") {
+            let _ = writeln!(
+                d.out,
+                "<li><strong>{}</strong>: {}</li>",
+                escape_html(&m.label),
+                escape_html(&text(w.get("message")).unwrap_or_else(|| "—".into()))
+            );
+        }
+    }
+    for f in failed {
+        let name = text(f.get("method")).unwrap_or_else(|| "—".into());
+        let _ = writeln!(
+            d.out,
+            "<li><strong>{}</strong> <span class=\"bad\">failed</span>: {}</li>",
+            escape_html(&method_label(&name)),
+            escape_html(&text(f.get("reason")).unwrap_or_else(|| "—".into()))
+        );
+    }
+    d.out.push_str("</ul>\n</section>\n");
+}
+
 fn solvers(d: &mut Doc, methods: &[MethodView]) {
     if methods.is_empty() {
         return;
@@ -687,7 +720,9 @@ fn solvers(d: &mut Doc, methods: &[MethodView]) {
             count(s, "iterations"),
             cell_num(f(s, "initial_rms_mm"), 4),
             cell_num(f(s, "final_rms_mm"), 4),
-            text(s.get("reason")).map_or_else(|| "—".into(), |r| escape_html(&r)),
+            text(s.get("detail"))
+                .or_else(|| text(s.get("reason")))
+                .map_or_else(|| "—".into(), |r| escape_html(&r)),
         );
     }
     d.out.push_str("</tbody></table>\n");

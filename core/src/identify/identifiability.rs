@@ -5,7 +5,10 @@
 //! each column is scaled to unit norm, the numerical rank comes from the SVD,
 //! and parameters are then taken greedily in a preference order (a pivoted
 //! Gram–Schmidt QR): a column whose component orthogonal to the columns already
-//! kept is below `dependency_tolerance` is dependent and dropped. The order
+//! kept is below `dependency_tolerance` is dependent and dropped, and one below
+//! `near_dependency_tolerance` (default 1e-3, i.e. a multiple correlation with
+//! the kept columns above 0.9999995) is nearly dependent and dropped too: its σ
+//! would be over 1000× that of an independent column. The order
 //! prefers the parameters nearest the tool, which reproduces the seed's choices
 //! (§2.2: keep d3 over d2, the tool's z over d6, the tool's x, y over θ6).
 //!
@@ -30,6 +33,17 @@ pub struct IdentifiabilitySettings {
     pub dependency_tolerance: f64,
     /// |correlation| above which a pair is reported as strongly correlated.
     pub correlation_threshold: f64,
+    /// Near-dependence: a column whose independent part (relative residual after
+    /// projection on the kept ones, `√(1 − R²)` with R the multiple correlation)
+    /// is below this is fixed at nominal. Its σ would be at least `1/tol` times
+    /// what the same column alone would give, and it would raise the condition
+    /// number by about that factor.
+    #[serde(default = "default_near_dependency_tolerance")]
+    pub near_dependency_tolerance: f64,
+}
+
+fn default_near_dependency_tolerance() -> f64 {
+    1e-3
 }
 
 impl Default for IdentifiabilitySettings {
@@ -38,14 +52,31 @@ impl Default for IdentifiabilitySettings {
             zero_column_tolerance: 1e-9,
             dependency_tolerance: 1e-6,
             correlation_threshold: 0.95,
+            near_dependency_tolerance: default_near_dependency_tolerance(),
         }
     }
+}
+
+/// Why a parameter is not identified.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DropKind {
+    /// Fixed by design (e.g. the loop's scale).
+    Fixed,
+    /// Its column is zero: no effect on the measured quantities.
+    NoEffect,
+    /// Linearly dependent on kept parameters (numerically exact).
+    Dependent,
+    /// Nearly dependent: its independent part is below
+    /// `near_dependency_tolerance`.
+    NearlyDependent,
 }
 
 /// A parameter that is not identified, and why.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DroppedParam {
     pub name: String,
+    pub kind: DropKind,
     pub reason: String,
     /// Kept parameters it is (linearly) dependent on.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -83,6 +114,16 @@ pub struct IdentifiabilityReport {
     pub correlated_pairs: Vec<CorrelatedPair>,
 }
 
+impl IdentifiabilityReport {
+    /// Number of parameters dropped as nearly (not exactly) dependent.
+    pub fn near_dependent(&self) -> usize {
+        self.dropped
+            .iter()
+            .filter(|d| d.kind == DropKind::NearlyDependent)
+            .count()
+    }
+}
+
 /// Preference rank: lower is considered first (kept when dependent). Tool first,
 /// then links from the tip to the base, loop lengths, compliance last.
 fn preference(id: &ParamId, n: usize) -> (usize, usize, usize) {
@@ -100,6 +141,7 @@ fn preference(id: &ParamId, n: usize) -> (usize, usize, usize) {
         ToolX | ToolY | ToolZ | ToolRx | ToolRy | ToolRz => (0, 0, id.kind as usize),
         LoopL3 | LoopL4 | LoopL5 => (1, 0, id.kind as usize),
         Compliance => (3, id.link, 0),
+        PayloadX | PayloadY | PayloadZ => (4, 0, id.kind as usize),
         k => (2, n - id.link, within(k)),
     }
 }
@@ -128,6 +170,7 @@ pub fn analyse(
         .iter()
         .map(|(id, why)| DroppedParam {
             name: id.name(),
+            kind: DropKind::Fixed,
             reason: why.clone(),
             depends_on: vec![],
         })
@@ -142,6 +185,7 @@ pub fn analyse(
             };
             dropped.push(DroppedParam {
                 name: id.name(),
+                kind: DropKind::NoEffect,
                 reason,
                 depends_on: vec![],
             });
@@ -176,7 +220,7 @@ pub fn analyse(
             }
         }
         let res = v.norm();
-        if res > settings.dependency_tolerance {
+        if res > settings.dependency_tolerance && res >= settings.near_dependency_tolerance {
             basis.push(v / res);
             kept_local.push(k);
         } else {
@@ -198,9 +242,25 @@ pub fn analyse(
                 .filter(|(_, c)| c.abs() > 0.1 * cmax)
                 .map(|(&kk, _)| candidates[live[kk]].name())
                 .collect::<Vec<_>>();
+            let (kind, reason) = if res <= settings.dependency_tolerance {
+                (
+                    DropKind::Dependent,
+                    "linearly dependent on kept parameters".to_string(),
+                )
+            } else {
+                (
+                    DropKind::NearlyDependent,
+                    format!(
+                        "nearly dependent on kept parameters: only {res:.1e} of its scaled column is independent of them (threshold {:.0e}), so its σ would be some {:.0}× larger; fixed at nominal",
+                        settings.near_dependency_tolerance,
+                        1.0 / res
+                    ),
+                )
+            };
             dropped.push(DroppedParam {
                 name: candidates[live[k]].name(),
-                reason: "linearly dependent on kept parameters".into(),
+                kind,
+                reason,
                 depends_on,
             });
         }
@@ -252,7 +312,7 @@ pub fn uncertainty(
     let std_devs = ids
         .iter()
         .zip(&sd)
-        .map(|(id, s)| (id.name(), super::calibrate::to_display(id, *s)))
+        .map(|(id, s)| (id.name(), super::report::to_display(id, *s)))
         .collect();
     let mut pairs = Vec::new();
     for a in 0..ids.len() {

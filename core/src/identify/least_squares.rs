@@ -32,6 +32,14 @@ pub struct LmSettings {
     pub initial_lambda: f64,
     /// Weight of orientation residuals [m/rad].
     pub orientation_weight: f64,
+    /// Converged when no step reduces the cost and the projected scaled
+    /// gradient (largest |cosine| residual–column) is below this.
+    #[serde(default = "default_gradient_tolerance")]
+    pub gradient_tolerance: f64,
+}
+
+fn default_gradient_tolerance() -> f64 {
+    1e-6
 }
 
 impl Default for LmSettings {
@@ -42,6 +50,58 @@ impl Default for LmSettings {
             step_tolerance: 1e-10,
             initial_lambda: 1e-6,
             orientation_weight: 1.0,
+            gradient_tolerance: default_gradient_tolerance(),
+        }
+    }
+}
+
+/// Why a least-squares run stopped. Only the first three are convergence tests
+/// that passed; every other reason leaves `converged = false`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StopReason {
+    /// An accepted step decreased the cost by less than `cost_tolerance` (relative).
+    CostTolerance,
+    /// An accepted step was shorter than `step_tolerance` (scaled).
+    StepTolerance,
+    /// No trial step reduced the cost and the projected scaled gradient (the
+    /// largest cosine between the residual and a free column) is below
+    /// `gradient_tolerance`: a (bound-constrained) minimum.
+    GradientTolerance,
+    /// The iteration budget ran out (accepted and rejected steps both count).
+    MaxIterations,
+    /// No trial step reduced the cost although the gradient is not small
+    /// (damping exhausted): not a minimum that a test confirmed.
+    NoDescent,
+    /// Trial models could not be evaluated (e.g. a closed loop that does not
+    /// close), or the accepted model left the loop's assembly range.
+    EvaluationFailed,
+    /// Fewer residuals than unknowns.
+    Underdetermined,
+    /// The starting model cannot be evaluated at some measured joints.
+    StartNotEvaluable,
+}
+
+impl StopReason {
+    /// Whether this reason is a passed convergence test.
+    pub fn converged(&self) -> bool {
+        matches!(
+            self,
+            StopReason::CostTolerance | StopReason::StepTolerance | StopReason::GradientTolerance
+        )
+    }
+
+    /// The snake_case code used in JSON.
+    pub fn code(&self) -> &'static str {
+        match self {
+            StopReason::CostTolerance => "cost_tolerance",
+            StopReason::StepTolerance => "step_tolerance",
+            StopReason::GradientTolerance => "gradient_tolerance",
+            StopReason::MaxIterations => "max_iterations",
+            StopReason::NoDescent => "no_descent",
+            StopReason::EvaluationFailed => "evaluation_failed",
+            StopReason::Underdetermined => "underdetermined",
+            StopReason::StartNotEvaluable => "start_not_evaluable",
         }
     }
 }
@@ -49,9 +109,15 @@ impl Default for LmSettings {
 /// How a least-squares run ended (non-convergence is data, not an error).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LmReport {
+    /// True only when `reason` is a passed convergence test.
     pub converged: bool,
     pub iterations: usize,
-    pub reason: String,
+    pub reason: StopReason,
+    /// The reason in words, with the figures of the test.
+    pub detail: String,
+    /// Projected scaled gradient at the end: the largest |cosine| between the
+    /// residual vector and a free Jacobian column (0 at an exact minimum).
+    pub gradient: f64,
     /// RMS of the residual vector before and after [mm].
     pub initial_rms_mm: f64,
     pub final_rms_mm: f64,
@@ -66,7 +132,21 @@ pub struct Fit {
     pub report: LmReport,
     /// Covariance of the fitted parameters (same order as `ids`) in SI units,
     /// `σ²(JᵀJ)⁻¹` with `σ²` = residual sum of squares / (rows − parameters).
+    /// Parameters held at a bound have zero rows and columns.
     pub covariance: Option<DMatrix<f64>>,
+    /// Per parameter of `ids`: held at its lower bound at the end (the
+    /// unconstrained fit would move it below; see [`lower_bound`]).
+    pub at_bound: Vec<bool>,
+}
+
+/// Lower bound of a parameter: compliance is admissible only when `c ≥ 0`
+/// (a joint cannot move against the torque that loads it); everything else is free.
+pub fn lower_bound(id: &ParamId) -> f64 {
+    if id.kind == ParamKind::Compliance {
+        0.0
+    } else {
+        f64::NEG_INFINITY
+    }
 }
 
 /// A fit was stopped by the caller.
@@ -116,8 +196,10 @@ fn column_scale(j: &DMatrix<f64>) -> DVector<f64> {
 }
 
 /// A frozen-Jacobian least-squares solver (the chord form of eq. 2.4 / 7.8):
-/// the scaled normal matrix is factorised once at a reference model and reused
-/// for repeated updates `Δφ = (JᵀJ)⁻¹Jᵀ ΔP` from nearby starting points.
+/// the scaled normal matrix of `ids` and of every session frame ≥ 1 is
+/// factorised once at a reference model and reused for repeated updates
+/// `Δφ = (JᵀJ)⁻¹Jᵀ ΔP` from nearby starting points. The result depends only on
+/// the starting point: the factorisation never changes after `new`.
 pub struct FrozenSolver {
     ids: Vec<ParamId>,
     frames: Vec<Pose>,
@@ -127,7 +209,8 @@ pub struct FrozenSolver {
 }
 
 impl FrozenSolver {
-    /// Factorises the Jacobian of `ids` at `model` (session frames held fixed).
+    /// Factorises the Jacobian of `ids` and of the session frames at `model`
+    /// with session frames `frames` (one per session, identity for session 0).
     pub fn new(
         model: &RobotModel,
         frames: &[Pose],
@@ -135,7 +218,7 @@ impl FrozenSolver {
         data: &[Measurement],
         settings: &LmSettings,
     ) -> Option<FrozenSolver> {
-        let ev = evaluate(model, &frames[..1], ids, data, settings, true)?;
+        let ev = evaluate(model, frames, ids, data, settings, true)?;
         let mut js = ev.j?;
         let scale = column_scale(&js);
         for (c, s) in scale.iter().enumerate() {
@@ -151,9 +234,9 @@ impl FrozenSolver {
         })
     }
 
-    /// Iterates from `start` until the cost stops decreasing by more than
-    /// `rel_tol` (relative) or `max_iterations`; returns the model and its
-    /// position error norms [mm].
+    /// Iterates from `start` (with the reference session frames) until the cost
+    /// stops decreasing by more than `rel_tol` (relative) or `max_iterations`;
+    /// returns the model, the session frames and the position error norms [mm].
     pub fn solve(
         &self,
         start: &RobotModel,
@@ -161,20 +244,20 @@ impl FrozenSolver {
         settings: &LmSettings,
         max_iterations: usize,
         rel_tol: f64,
-    ) -> Option<(RobotModel, Vec<f64>)> {
+    ) -> Option<(RobotModel, Vec<Pose>, Vec<f64>)> {
         let layout = ParamLayout {
             ids: self.ids.clone(),
         };
         let mut model = start.clone();
-        let frames0 = &self.frames[..1];
-        let mut r = evaluate(&model, frames0, &self.ids, data, settings, false)?.r;
+        let mut frames = self.frames.clone();
+        let mut r = evaluate(&model, &frames, &self.ids, data, settings, false)?.r;
         let mut cost = r.norm_squared();
         for _ in 0..max_iterations {
             let g = self.js.tr_mul(&r);
             let delta = self.chol.solve(&g).component_mul(&self.scale);
             let x = layout.values(&model);
-            let (m2, _) = apply_step(&model, frames0, &layout, &x, &delta);
-            let Some(e2) = evaluate(&m2, frames0, &self.ids, data, settings, false) else {
+            let (m2, f2) = apply_step(&model, &frames, &layout, &x, &delta);
+            let Some(e2) = evaluate(&m2, &f2, &self.ids, data, settings, false) else {
                 break;
             };
             let c2 = e2.r.norm_squared();
@@ -183,14 +266,15 @@ impl FrozenSolver {
             }
             let rel = (cost - c2) / cost.max(f64::MIN_POSITIVE);
             model = m2;
+            frames = f2;
             r = e2.r;
             cost = c2;
             if rel < rel_tol {
                 break;
             }
         }
-        let errors = position_errors_mm(&model, &self.frames, data);
-        Some((model, errors))
+        let errors = position_errors_mm(&model, &frames, data);
+        Some((model, frames, errors))
     }
 }
 
@@ -217,7 +301,10 @@ fn evaluate(
     } else {
         None
     };
-    let needs_tau = model.has_compliance() || ids.iter().any(|i| i.kind == ParamKind::Compliance);
+    let needs_tau = model.has_compliance()
+        || ids
+            .iter()
+            .any(|i| i.kind == ParamKind::Compliance || i.is_payload());
     let w = settings.orientation_weight;
     let mut local = DMatrix::zeros(6, ids.len());
     let mut row = 0;
@@ -250,7 +337,7 @@ fn evaluate(
             r[row + 5] = dr.z;
         }
         if let Some(j) = j.as_mut() {
-            fill_identification_rows(model, &c, ids, &tau, orient, &mut local, 0);
+            fill_identification_rows(model, &c, ids, &tau, m.payload_mass, orient, &mut local, 0);
             for col in 0..ids.len() {
                 let v = e.r * Vector3::new(local[(0, col)], local[(1, col)], local[(2, col)]);
                 j[(row, col)] = v.x;
@@ -306,9 +393,33 @@ fn apply_step(
     (m, f)
 }
 
+/// Largest |cosine| between the residual and a free scaled column: the
+/// first-order optimality measure of the scaled, bound-constrained problem.
+fn gradient_measure(js: &DMatrix<f64>, g: &DVector<f64>, r_norm: f64, active: &[bool]) -> f64 {
+    if r_norm == 0.0 {
+        return 0.0;
+    }
+    (0..g.len())
+        .filter(|&i| !active.get(i).copied().unwrap_or(false))
+        .map(|i| {
+            let n = js.column(i).norm();
+            if n > 0.0 {
+                g[i].abs() / (n * r_norm)
+            } else {
+                0.0
+            }
+        })
+        .fold(0.0, f64::max)
+}
+
 /// Fits the parameters `ids` (and the frames of sessions ≥ 1) to `data` by
 /// Levenberg–Marquardt, starting from `start`. `progress(iteration, rms_mm)`
 /// returns false to cancel.
+///
+/// Bounds ([`lower_bound`]): a projected LM. A parameter at its bound whose
+/// gradient points below it is held (active) for the step; a free parameter
+/// that would cross its bound is projected onto it. When no bound is active,
+/// this is the seed's unconstrained LM exactly.
 pub fn fit(
     start: &RobotModel,
     ids: &[ParamId],
@@ -318,7 +429,17 @@ pub fn fit(
     progress: &mut dyn FnMut(usize, f64) -> bool,
 ) -> Result<Fit, Cancelled> {
     let layout = ParamLayout { ids: ids.to_vec() };
+    let lower: Vec<f64> = ids.iter().map(lower_bound).collect();
     let mut model = start.clone();
+    {
+        let x: Vec<f64> = layout
+            .values(&model)
+            .iter()
+            .zip(&lower)
+            .map(|(v, lo)| v.max(*lo))
+            .collect();
+        layout.apply(&mut model, &x);
+    }
     let mut frames = vec![Pose::identity(); sessions.max(1)];
     let rows = residual_rows(data);
     let rms_mm = |c: f64| (c / rows.max(1) as f64).sqrt() * 1e3;
@@ -329,11 +450,14 @@ pub fn fit(
             report: LmReport {
                 converged: false,
                 iterations: 0,
-                reason: "the starting model cannot be evaluated at some measured joints (closed loop does not close)".into(),
+                reason: StopReason::StartNotEvaluable,
+                detail: "the starting model cannot be evaluated at some measured joints (closed loop does not close)".into(),
+                gradient: f64::NAN,
                 initial_rms_mm: f64::INFINITY,
                 final_rms_mm: f64::INFINITY,
             },
             covariance: None,
+            at_bound: vec![false; ids.len()],
         });
     };
     let mut cost = ev.r.norm_squared();
@@ -341,55 +465,107 @@ pub fn fit(
     let ncols = ev.j.as_ref().map_or(0, |j| j.ncols());
     // Column scaling, fixed from the first Jacobian.
     let scale = column_scale(ev.j.as_ref().expect("jacobian evaluated"));
-    let mut lambda = settings.initial_lambda;
-    let mut iterations = 0;
-    let mut converged = false;
-    let mut reason = String::from("maximum iterations reached");
-    if rows < ncols {
-        reason = format!("underdetermined: {rows} residuals for {ncols} unknowns");
-    }
-    while iterations < settings.max_iterations {
-        if !progress(iterations, rms_mm(cost)) {
-            return Err(Cancelled);
-        }
+    let scaled = |ev: &Eval| {
         let mut js = ev.j.as_ref().expect("jacobian evaluated").clone();
         for (c, s) in scale.iter().enumerate() {
             js.column_mut(c).scale_mut(*s);
         }
+        js
+    };
+    let mut lambda = settings.initial_lambda;
+    let mut iterations = 0;
+    let mut reason = StopReason::MaxIterations;
+    let mut detail = format!(
+        "iteration budget of {} used up before a convergence test passed",
+        settings.max_iterations
+    );
+    let mut active = vec![false; ncols];
+    let mut gradient = f64::NAN;
+    if rows < ncols {
+        reason = StopReason::Underdetermined;
+        detail = format!("underdetermined: {rows} residuals for {ncols} unknowns");
+    }
+    while rows >= ncols && iterations < settings.max_iterations {
+        if !progress(iterations, rms_mm(cost)) {
+            return Err(Cancelled);
+        }
+        let js = scaled(&ev);
         let a = js.tr_mul(&js);
         let g = js.tr_mul(&ev.r);
         let x = layout.values(&model);
+        // Active bounds: at the bound with the descent direction (+g) below it.
+        for i in 0..ncols {
+            active[i] = i < ids.len() && x[i] <= lower[i] && g[i] < 0.0;
+        }
+        gradient = gradient_measure(&js, &g, cost.sqrt(), &active);
         let mut accepted = None;
-        while lambda < 1e12 {
+        let mut evaluations_failed = 0;
+        let mut trials = 0;
+        while lambda < 1e12 && iterations < settings.max_iterations {
             iterations += 1;
+            trials += 1;
             let mut damped = a.clone();
+            let mut rhs = g.clone();
             for i in 0..ncols {
                 damped[(i, i)] += lambda * (1.0 + a[(i, i)]);
+                if active[i] {
+                    damped.row_mut(i).fill(0.0);
+                    damped.column_mut(i).fill(0.0);
+                    damped[(i, i)] = 1.0;
+                    rhs[i] = 0.0;
+                }
             }
             let Some(chol) = damped.cholesky() else {
                 lambda *= 10.0;
                 continue;
             };
-            let ds = chol.solve(&g);
-            let delta = ds.component_mul(&scale);
+            let mut delta = chol.solve(&rhs).component_mul(&scale);
+            // Projection onto the bounds.
+            for i in 0..ids.len() {
+                if x[i] + delta[i] < lower[i] {
+                    delta[i] = lower[i] - x[i];
+                }
+            }
+            let step = delta.component_div(&scale).norm();
             let (m2, f2) = apply_step(&model, &frames, &layout, &x, &delta);
             match evaluate(&m2, &f2, ids, data, settings, false) {
                 Some(e2) if e2.r.norm_squared() < cost => {
-                    accepted = Some((m2, f2, e2.r.norm_squared(), ds.norm()));
+                    accepted = Some((m2, f2, e2.r.norm_squared(), step));
                     lambda = (lambda / 10.0).max(1e-15);
                     break;
                 }
-                _ => {
+                Some(_) => lambda *= 10.0,
+                None => {
+                    evaluations_failed += 1;
                     lambda *= 10.0;
                 }
             }
-            if iterations >= settings.max_iterations {
-                break;
-            }
         }
         let Some((m2, f2, c2, step)) = accepted else {
-            converged = true;
-            reason = "no step reduces the cost further (local minimum)".into();
+            if gradient <= settings.gradient_tolerance {
+                reason = StopReason::GradientTolerance;
+                detail = format!(
+                    "no step reduces the cost and the projected scaled gradient {gradient:.1e} is below {:.0e}",
+                    settings.gradient_tolerance
+                );
+            } else if iterations >= settings.max_iterations && lambda < 1e12 {
+                reason = StopReason::MaxIterations;
+                detail = format!(
+                    "iteration budget of {} used up during rejected steps (scaled gradient {gradient:.1e})",
+                    settings.max_iterations
+                );
+            } else if evaluations_failed == trials && trials > 0 {
+                reason = StopReason::EvaluationFailed;
+                detail = format!(
+                    "none of {trials} trial steps could be evaluated (closed loop does not close)"
+                );
+            } else {
+                reason = StopReason::NoDescent;
+                detail = format!(
+                    "no step reduces the cost, but the scaled gradient {gradient:.1e} is above {:.0e}: not a confirmed minimum",
+                    settings.gradient_tolerance
+                );
+            }
             break;
         };
         let rel = (cost - c2) / cost.max(f64::MIN_POSITIVE);
@@ -399,36 +575,65 @@ pub fn fit(
         ev = match evaluate(&model, &frames, ids, data, settings, true) {
             Some(e) => e,
             None => {
-                reason = "model left the closed loop's assembly range".into();
+                reason = StopReason::EvaluationFailed;
+                detail = "the model left the closed loop's assembly range".into();
                 break;
             }
         };
         if rel < settings.cost_tolerance {
-            converged = true;
-            reason = format!("relative cost decrease {rel:.1e} below tolerance");
+            reason = StopReason::CostTolerance;
+            detail = format!(
+                "relative cost decrease {rel:.1e} below {:.0e}",
+                settings.cost_tolerance
+            );
             break;
         }
         if step < settings.step_tolerance {
-            converged = true;
-            reason = format!("scaled step {step:.1e} below tolerance");
+            reason = StopReason::StepTolerance;
+            detail = format!(
+                "scaled step {step:.1e} below {:.0e}",
+                settings.step_tolerance
+            );
             break;
         }
     }
-    let covariance = ev.j.as_ref().and_then(|j| {
-        let dof = rows as f64 - ncols as f64;
+    // Final bound state and gradient at the returned model.
+    let at_bound: Vec<bool> =
+        ev.j.as_ref()
+            .map(|_| {
+                let js = scaled(&ev);
+                let g = js.tr_mul(&ev.r);
+                let x = layout.values(&model);
+                for i in 0..ncols {
+                    active[i] = i < ids.len() && x[i] <= lower[i] && g[i] < 0.0;
+                }
+                gradient = gradient_measure(&js, &g, cost.sqrt(), &active);
+                active[..ids.len()].to_vec()
+            })
+            .unwrap_or_else(|| vec![false; ids.len()]);
+    let covariance = ev.j.as_ref().and_then(|_| {
+        let free = ncols - active.iter().filter(|a| **a).count();
+        let dof = rows as f64 - free as f64;
         if dof <= 0.0 {
             return None;
         }
-        let mut js = j.clone();
-        for (c, s) in scale.iter().enumerate() {
-            js.column_mut(c).scale_mut(*s);
+        let js = scaled(&ev);
+        let mut a = js.tr_mul(&js);
+        for i in 0..ncols {
+            if active[i] {
+                a.row_mut(i).fill(0.0);
+                a.column_mut(i).fill(0.0);
+                a[(i, i)] = 1.0;
+            }
         }
-        let inv = js.tr_mul(&js).try_inverse()?;
+        let inv = a.try_inverse()?;
         let sigma2 = cost / dof;
         let mut cov = DMatrix::zeros(ids.len(), ids.len());
         for a in 0..ids.len() {
             for b in 0..ids.len() {
-                cov[(a, b)] = inv[(a, b)] * scale[a] * scale[b] * sigma2;
+                if !active[a] && !active[b] {
+                    cov[(a, b)] = inv[(a, b)] * scale[a] * scale[b] * sigma2;
+                }
             }
         }
         Some(cov)
@@ -437,12 +642,15 @@ pub fn fit(
         model,
         session_frames: frames,
         report: LmReport {
-            converged,
+            converged: reason.converged(),
             iterations,
             reason,
+            detail,
+            gradient,
             initial_rms_mm: initial,
             final_rms_mm: rms_mm(cost),
         },
         covariance,
+        at_bound,
     })
 }

@@ -37,7 +37,10 @@ pub fn select_d_optimal(
     for (i, q) in candidates.iter().enumerate() {
         if let Ok(c) = chain(model, q) {
             let tau = gravity_torques_of(model, &c, payload_kg);
-            blocks.push((i, identification_jacobian(model, &c, &ids, &tau, false)));
+            blocks.push((
+                i,
+                identification_jacobian(model, &c, &ids, &tau, payload_kg, false),
+            ));
         }
     }
     let p = ids.len();

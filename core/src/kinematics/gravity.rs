@@ -32,13 +32,41 @@ pub fn gravity_torques_of(model: &RobotModel, chain: &Chain, payload_mass: f64) 
         let moment = (s_sum - f.p * m_sum).cross(&g);
         tau_chain[k] = f.z_axis().dot(&moment);
     }
+    map_loop_torques(model, chain, &mut tau_chain);
+    tau_chain
+}
+
+/// Maps the open-chain torque on a closed loop's passive joint to the driver
+/// and the crank motor by virtual work (`τ_a = (∂θ3p/∂θ_a)·τ_3p`).
+fn map_loop_torques(model: &RobotModel, chain: &Chain, tau_chain: &mut [f64]) {
     if let (Some(cl), Some(lp)) = (&model.closed_loop, &chain.loop_partials) {
         let k = cl.passive;
         let t = tau_chain[k];
         tau_chain[k - 1] += lp.d_driver * t;
         tau_chain[k] = lp.d_motor * t;
     }
-    tau_chain
+}
+
+/// Partial derivatives of the active joint torques with respect to the payload's
+/// centre of mass in the tool frame, `∂τ/∂com_j` [N·m/m] for j = x, y, z.
+/// The torque is linear in the CoM: `∂τ_i/∂com_j = M · z_i · ((R_tcp e_j) × g)`
+/// (from `τ_i = z_i · ((S_i − M_i·o_i) × g)` with `S ∋ M·(p_tcp + R_tcp·com)`).
+pub fn payload_com_torque_partials(
+    model: &RobotModel,
+    chain: &Chain,
+    payload_mass: f64,
+) -> [Vec<f64>; 3] {
+    let n = model.dof();
+    let g = model.gravity;
+    std::array::from_fn(|j| {
+        let arm = chain.tcp.r * Vector3::ith(j, 1.0) * payload_mass;
+        let moment = arm.cross(&g);
+        let mut tau: Vec<f64> = (0..n)
+            .map(|k| chain.links[k].frame.z_axis().dot(&moment))
+            .collect();
+        map_loop_torques(model, chain, &mut tau);
+        tau
+    })
 }
 
 /// Gravity torques [N·m] at the active joints `q` (model convention, rad).

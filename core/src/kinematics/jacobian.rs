@@ -9,6 +9,10 @@
 //!   contributes `[u × (p − o); u]`; one that translates it along `u`
 //!   contributes `[u; 0]`. The torque τ is held fixed (computed at the commanded
 //!   configuration), as in the seed's iterative SKCM.
+//! - Payload CoM columns (`skcm-payload`, beyond the seed): the deflection
+//!   `c∘τ` depends on the payload's centre of mass r (tool frame) through
+//!   `∂τ_i/∂r_j = M·z_i·((R_tcp e_j) × g)`, so the column is
+//!   `Σ_k c_k·(∂τ_k/∂r_j)·[z_k × (p − o_k); z_k]` (exact: τ is linear in r).
 
 use super::chain::Chain;
 use crate::model::params::{ParamId, ParamKind};
@@ -72,13 +76,33 @@ fn loop_col(model: &RobotModel, chain: &Chain, d: impl Fn(&super::LoopPartials) 
     }
 }
 
+/// Column of a payload CoM coordinate j: the joints deflect by `c∘τ`, and τ
+/// depends on the CoM, so the TCP moves by `Σ_k c_k·(∂τ_k/∂com_j)·J_k`.
+fn payload_col(model: &RobotModel, chain: &Chain, j: usize, payload_mass: f64) -> Col {
+    if payload_mass == 0.0 || !model.has_compliance() {
+        return (Vector3::zeros(), Vector3::zeros());
+    }
+    let dtau = &super::gravity::payload_com_torque_partials(model, chain, payload_mass)[j];
+    (0..model.dof()).fold((Vector3::zeros(), Vector3::zeros()), |acc, k| {
+        add(
+            acc,
+            scale(
+                active_col(model, chain, k),
+                model.links[k].compliance * dtau[k],
+            ),
+        )
+    })
+}
+
 /// Column of one parameter. `tau` are the active joint torques [N·m] used by
-/// compliance columns.
+/// compliance columns; `payload_mass` [kg] is the payload of the pose (payload
+/// CoM columns).
 pub fn param_column(
     model: &RobotModel,
     chain: &Chain,
     id: ParamId,
     tau: &[f64],
+    payload_mass: f64,
 ) -> (Vector3<f64>, Vector3<f64>) {
     use ParamKind::*;
     let p = &chain.tcp.p;
@@ -127,22 +151,27 @@ pub fn param_column(
             active_col(model, chain, k),
             tau.get(k).copied().unwrap_or(0.0),
         ),
+        PayloadX => payload_col(model, chain, 0, payload_mass),
+        PayloadY => payload_col(model, chain, 1, payload_mass),
+        PayloadZ => payload_col(model, chain, 2, payload_mass),
     }
 }
 
 /// Writes the identification Jacobian rows of one pose into `out`, starting at
 /// row `row0`: 3 position rows, then 3 orientation rows when `orientation`.
+#[allow(clippy::too_many_arguments)]
 pub fn fill_identification_rows(
     model: &RobotModel,
     chain: &Chain,
     ids: &[ParamId],
     tau: &[f64],
+    payload_mass: f64,
     orientation: bool,
     out: &mut DMatrix<f64>,
     row0: usize,
 ) {
     for (c, id) in ids.iter().enumerate() {
-        let (v, w) = param_column(model, chain, *id, tau);
+        let (v, w) = param_column(model, chain, *id, tau, payload_mass);
         out[(row0, c)] = v.x;
         out[(row0 + 1, c)] = v.y;
         out[(row0 + 2, c)] = v.z;
@@ -160,10 +189,11 @@ pub fn identification_jacobian(
     chain: &Chain,
     ids: &[ParamId],
     tau: &[f64],
+    payload_mass: f64,
     orientation: bool,
 ) -> DMatrix<f64> {
     let rows = if orientation { 6 } else { 3 };
     let mut j = DMatrix::zeros(rows, ids.len());
-    fill_identification_rows(model, chain, ids, tau, orientation, &mut j, 0);
+    fill_identification_rows(model, chain, ids, tau, payload_mass, orientation, &mut j, 0);
     j
 }

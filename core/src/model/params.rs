@@ -28,6 +28,10 @@ pub enum ParamKind {
     LoopL4,
     LoopL5,
     Compliance,
+    /// Payload centre of mass in the tool frame, x, y, z (for `skcm-payload`).
+    PayloadX,
+    PayloadY,
+    PayloadZ,
 }
 
 /// Physical unit class of a parameter (for display and scaling).
@@ -59,9 +63,20 @@ impl ParamId {
         }
     }
 
-    /// Whether the parameter is geometric (everything but compliance).
+    /// Whether the parameter is geometric (everything but compliance and payload).
     pub fn is_geometric(&self) -> bool {
-        self.kind != ParamKind::Compliance
+        !matches!(
+            self.kind,
+            ParamKind::Compliance | ParamKind::PayloadX | ParamKind::PayloadY | ParamKind::PayloadZ
+        )
+    }
+
+    /// Whether the parameter is one coordinate of the payload's centre of mass.
+    pub fn is_payload(&self) -> bool {
+        matches!(
+            self.kind,
+            ParamKind::PayloadX | ParamKind::PayloadY | ParamKind::PayloadZ
+        )
     }
 
     /// The seed's name of the parameter.
@@ -85,6 +100,9 @@ impl ParamId {
             LoopL4 => "l4".into(),
             LoopL5 => "l5".into(),
             Compliance => format!("c{}", k + 1),
+            PayloadX => "payload_x".into(),
+            PayloadY => "payload_y".into(),
+            PayloadZ => "payload_z".into(),
         }
     }
 
@@ -101,6 +119,9 @@ impl ParamId {
             ("l3", LoopL3),
             ("l4", LoopL4),
             ("l5", LoopL5),
+            ("payload_x", PayloadX),
+            ("payload_y", PayloadY),
+            ("payload_z", PayloadZ),
         ];
         if let Some((_, k)) = fixed.iter().find(|(n, _)| *n == name) {
             return Some(ParamId::new(*k, 0));
@@ -232,6 +253,9 @@ fn slot(model: &mut RobotModel, id: ParamId) -> &mut f64 {
                 .l5
         }
         Compliance => &mut model.links[id.link].compliance,
+        PayloadX => &mut model.payload.com.x,
+        PayloadY => &mut model.payload.com.y,
+        PayloadZ => &mut model.payload.com.z,
     }
 }
 
@@ -269,6 +293,9 @@ impl ModelRef<'_> {
             LoopL4 => m.closed_loop.as_ref().map_or(0.0, |c| c.l4),
             LoopL5 => m.closed_loop.as_ref().map_or(0.0, |c| c.l5),
             Compliance => m.links[id.link].compliance,
+            PayloadX => m.payload.com.x,
+            PayloadY => m.payload.com.y,
+            PayloadZ => m.payload.com.z,
         }
     }
 }
@@ -290,6 +317,7 @@ mod tests {
             ParamId::new(ToolRz, 0),
             ParamId::new(LoopL4, 0),
             ParamId::new(Compliance, 1),
+            ParamId::new(PayloadY, 0),
         ] {
             assert_eq!(ParamId::parse(&id.name()), Some(id), "{}", id.name());
         }

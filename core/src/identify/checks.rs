@@ -1,0 +1,235 @@
+//! Checks before and around a calibration: input sanity per measurement, the
+//! parameters fixed by design, the rank a good pose set of this robot reaches
+//! (to tell "too few / too similar poses" from a dependent parameter), and
+//! whether gravity loads the joints at all (compliance methods need link
+//! masses or a payload).
+//!
+//! Units: SI (m, rad, kg, N·m).
+
+use super::least_squares;
+use super::registration::RegistrationError;
+use super::report::FailedMethod;
+use crate::kinematics::{chain, fk, gravity_torques_of, KinematicsError};
+use crate::measure::Measurement;
+use crate::model::{ParamId, ParamKind, RobotModel};
+use nalgebra::{DMatrix, Vector3};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// Why a calibration cannot run.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CalibrationError {
+    #[error("the identification set is empty")]
+    NoData,
+    #[error(
+        "{set} measurement {index}: expected {expected} joint values for this robot, got {got}"
+    )]
+    JointCount {
+        set: &'static str,
+        index: usize,
+        expected: usize,
+        got: usize,
+    },
+    #[error("{set} measurement {index}: {what} is not a finite number")]
+    NotFinite {
+        set: &'static str,
+        index: usize,
+        what: &'static str,
+    },
+    #[error("too few poses: {poses} poses give {rows} equations, but this robot has {params} identifiable parameters; measure at least {needed} poses (3 to 5 times that is better)")]
+    TooFewPoses {
+        poses: usize,
+        rows: usize,
+        params: usize,
+        needed: usize,
+    },
+    #[error("singular pose set: the poses excite only {rank} of the robot's {generic_rank} identifiable parameter combinations{detail}; measure poses that move every joint across its range")]
+    SingularPoses {
+        rank: usize,
+        generic_rank: usize,
+        detail: String,
+    },
+    #[error("registration of session {session}: {source}")]
+    Registration {
+        session: usize,
+        source: RegistrationError,
+    },
+    #[error("the measurements do not fit the model: RMS {rms_mm:.1} mm after registering the tracker frame (limit {limit_mm:.0} mm); check units (positions in mm, joints in degrees), joint order and signs, and the model")]
+    Inconsistent { rms_mm: f64, limit_mm: f64 },
+    #[error("{set} measurement {index}: {source}")]
+    Kinematics {
+        set: &'static str,
+        index: usize,
+        source: KinematicsError,
+    },
+    #[error("calibration cancelled")]
+    Cancelled,
+    #[error("no method succeeded: {}", failed.iter().map(|f| format!("{}: {}", f.method.name(), f.reason)).collect::<Vec<_>>().join("; "))]
+    AllMethodsFailed { failed: Vec<FailedMethod> },
+}
+
+pub(crate) fn check_set(
+    model: &RobotModel,
+    data: &[Measurement],
+    set: &'static str,
+) -> Result<(), CalibrationError> {
+    for (index, m) in data.iter().enumerate() {
+        if m.q.len() != model.dof() {
+            return Err(CalibrationError::JointCount {
+                set,
+                index,
+                expected: model.dof(),
+                got: m.q.len(),
+            });
+        }
+        if m.q.iter().any(|x| !x.is_finite()) {
+            return Err(CalibrationError::NotFinite {
+                set,
+                index,
+                what: "a joint value",
+            });
+        }
+        if m.position.iter().any(|x| !x.is_finite()) {
+            return Err(CalibrationError::NotFinite {
+                set,
+                index,
+                what: "the measured position",
+            });
+        }
+        if !m.payload_mass.is_finite() || m.payload_mass < 0.0 {
+            return Err(CalibrationError::NotFinite {
+                set,
+                index,
+                what: "the payload mass",
+            });
+        }
+        if let Some(r) = &m.orientation {
+            if r.iter().any(|x| !x.is_finite()) {
+                return Err(CalibrationError::NotFinite {
+                    set,
+                    index,
+                    what: "the measured orientation",
+                });
+            }
+        }
+        fk(model, &m.q).map_err(|source| CalibrationError::Kinematics { set, index, source })?;
+    }
+    Ok(())
+}
+
+/// Stacked identification Jacobian of `ids` over `data` at `model` (positions only
+/// or with orientation rows where measured).
+pub(crate) fn stacked_jacobian(
+    model: &RobotModel,
+    ids: &[ParamId],
+    data: &[Measurement],
+) -> DMatrix<f64> {
+    let rows = least_squares::residual_rows(data);
+    let mut j = DMatrix::zeros(rows, ids.len());
+    let mut row = 0;
+    for m in data {
+        let c0 = chain(model, &m.q).expect("checked");
+        let tau = gravity_torques_of(model, &c0, m.payload_mass);
+        let orient = m.orientation.is_some();
+        crate::kinematics::jacobian::fill_identification_rows(
+            model,
+            &c0,
+            ids,
+            &tau,
+            m.payload_mass,
+            orient,
+            &mut j,
+            row,
+        );
+        row += if orient { 6 } else { 3 };
+    }
+    j
+}
+
+/// Parameters that are fixed by design, with the reason.
+pub(crate) fn fixed_params(model: &RobotModel) -> Vec<(ParamId, String)> {
+    let mut v = Vec::new();
+    if model.closed_loop.is_some() {
+        v.push((
+            ParamId::new(ParamKind::LoopL3, 0),
+            "fixed: sets the closed loop's scale (seed §4.3)".to_string(),
+        ));
+    }
+    v
+}
+
+/// Rank of the geometric identification Jacobian for well-spread random poses:
+/// what a good pose set of this robot can identify.
+pub(crate) fn generic_rank(model: &RobotModel, ids: &[ParamId], orientation: bool) -> usize {
+    let mut rng = ChaCha8Rng::seed_from_u64(0x5eed);
+    let mut data = Vec::new();
+    let mut tries = 0;
+    while data.len() < 60 && tries < 10_000 {
+        tries += 1;
+        let q: Vec<f64> = model
+            .links
+            .iter()
+            .map(|l| rng.gen_range(l.limits[0].max(-3.1)..l.limits[1].min(3.1)))
+            .collect();
+        if fk(model, &q).is_ok() {
+            data.push(Measurement {
+                q,
+                position: Vector3::zeros(),
+                orientation: orientation.then(nalgebra::Matrix3::identity),
+                payload_mass: model.payload.mass,
+                session: 0,
+            });
+        }
+    }
+    let j = stacked_jacobian(model, ids, &data);
+    let norms: Vec<f64> = j.column_iter().map(|c| c.norm()).collect();
+    let max = norms.iter().cloned().fold(0.0, f64::max);
+    let live: Vec<usize> = (0..ids.len()).filter(|&c| norms[c] > 1e-9 * max).collect();
+    let mut js = DMatrix::zeros(j.nrows(), live.len());
+    for (k, &c) in live.iter().enumerate() {
+        js.set_column(k, &(j.column(c) / norms[c]));
+    }
+    let sv = js.svd(false, false).singular_values;
+    let smax = sv.max();
+    sv.iter().filter(|s| **s > smax * 1e-9).count()
+}
+
+pub(crate) fn joint_range_detail(model: &RobotModel, data: &[Measurement]) -> String {
+    let mut still = Vec::new();
+    for k in 0..model.dof() {
+        let (lo, hi) = data
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), m| {
+                (a.min(m.q[k]), b.max(m.q[k]))
+            });
+        if (hi - lo).to_degrees() < 5.0 {
+            still.push(format!(
+                "J{} moves only {:.2} deg",
+                k + 1,
+                (hi - lo).to_degrees()
+            ));
+        }
+    }
+    if still.is_empty() {
+        String::new()
+    } else {
+        format!(" ({})", still.join(", "))
+    }
+}
+
+/// Why the compliance methods cannot run on this model and data, if they cannot:
+/// with no link mass and no payload, gravity puts no torque on any joint.
+pub(crate) fn gravity_problem(model: &RobotModel, data: &[Measurement]) -> Option<String> {
+    let link_mass: f64 = model.links.iter().map(|l| l.mass).sum();
+    let payload = data.iter().any(|m| m.payload_mass > 0.0);
+    (link_mass <= 0.0 && !payload).then(|| {
+        "the model has no link masses and the measurements carry no payload, so gravity puts no torque on any joint and no compliance can be identified; add link masses (`mass_kg`, `com_mm`) to the model or a payload (`payload_kg`), or use km".to_string()
+    })
+}
+
+/// Why `skcm-payload` cannot identify the payload's centre of mass, if it cannot.
+pub(crate) fn payload_problem(data: &[Measurement]) -> Option<String> {
+    (!data.iter().any(|m| m.payload_mass > 0.0)).then(|| {
+        "no identification pose carries a payload (payload_kg is 0 everywhere), so its centre of mass has no effect; give the payload mass (`payload_kg`) or use skcm".to_string()
+    })
+}

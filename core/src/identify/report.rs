@@ -1,0 +1,197 @@
+//! What a calibration reports: errors per set, identified parameters with σ,
+//! stiffness, solver reports, warnings for implausible results, and the
+//! methods that failed with their reasons (a failed method never hides the
+//! ones that worked).
+//!
+//! Units: millimetres, degrees, rad/(N·m) and N·m/rad (display units); the
+//! calibrated `RobotModel` inside stays SI.
+
+use super::identifiability::IdentifiabilityReport;
+use super::least_squares::LmReport;
+use super::options::Method;
+use super::stats::ErrorStats;
+use crate::model::description::PoseDescription;
+use crate::model::params::ParamUnit;
+use crate::model::pose::Pose;
+use crate::model::{ModelDescription, ParamId, RobotModel};
+use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// Errors of one set: statistics plus the per-pose error norms (mm).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SetErrors {
+    #[serde(flatten)]
+    pub stats: ErrorStats,
+    pub errors_mm: Vec<f64>,
+}
+
+impl SetErrors {
+    pub fn new(errors_mm: Vec<f64>) -> Self {
+        SetErrors {
+            stats: ErrorStats::from_errors_mm(&errors_mm),
+            errors_mm,
+        }
+    }
+}
+
+/// One identified parameter in display units (mm, deg or rad/(N·m)).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ParamEstimate {
+    pub name: String,
+    pub unit: String,
+    pub nominal: f64,
+    pub value: f64,
+    pub std: Option<f64>,
+}
+
+/// TLBO summary of SKCM-C.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TlboSummary {
+    pub population: usize,
+    pub generations: usize,
+    pub evaluations: usize,
+    /// Best eq. 7.10 cost [mm²] after each generation.
+    pub history: Vec<f64>,
+}
+
+/// Result of one method.
+#[derive(Debug, Clone, Serialize)]
+pub struct MethodReport {
+    pub method: Method,
+    pub solver: LmReport,
+    pub identification: SetErrors,
+    pub validation: Option<SetErrors>,
+    pub parameters: Vec<ParamEstimate>,
+    /// Identified joint stiffness 1/c [N·m/rad] (None: not identified / rigid).
+    pub stiffness_nm_per_rad: Vec<Option<f64>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tlbo: Option<TlboSummary>,
+    /// Physically implausible or doubtful results (the figures stay reported).
+    pub warnings: Vec<MethodWarning>,
+    /// The calibrated model in the registered base frame (mm/deg).
+    pub model: ModelDescription,
+    #[serde(skip)]
+    pub calibrated: RobotModel,
+}
+
+/// Kind of a method warning.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum WarningKind {
+    /// The solver stopped without a passed convergence test.
+    NotConverged,
+    /// A compliance is held at its bound c = 0: the unconstrained fit wanted a
+    /// negative compliance.
+    ComplianceAtBound,
+    /// An identified stiffness 1/c lies outside the plausible range.
+    StiffnessImplausible,
+    /// A parameter the method considered is not identifiable from these poses
+    /// and stays at its nominal value.
+    ParameterNotIdentifiable,
+}
+
+/// A warning about one method's result.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MethodWarning {
+    pub kind: WarningKind,
+    /// Joint number (1-based) the warning is about.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub joint: Option<usize>,
+    pub message: String,
+}
+
+/// A method that did not deliver a model, and why.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FailedMethod {
+    pub method: Method,
+    pub reason: String,
+}
+
+/// Registration of each measurement session.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SessionRegistration {
+    pub session: usize,
+    /// Tracker → registered base frame (`x_base = R·x_tracker + t`).
+    pub tracker_to_base: PoseDescription,
+    /// RMS distance of the nominal model after the registration [mm].
+    pub rms_mm: f64,
+}
+
+/// Nominal-model errors (before calibration) in the registered frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct NominalErrors {
+    pub identification: SetErrors,
+    pub validation: Option<SetErrors>,
+}
+
+/// Everything a calibration found.
+#[derive(Debug, Clone, Serialize)]
+pub struct CalibrationReport {
+    pub robot: String,
+    pub identification_poses: usize,
+    pub validation_poses: usize,
+    pub registration: Vec<SessionRegistration>,
+    pub identifiability: IdentifiabilityReport,
+    pub nominal: NominalErrors,
+    pub methods: BTreeMap<String, MethodReport>,
+    /// Methods that failed, with their reasons (the others are still reported).
+    pub failed: Vec<FailedMethod>,
+    /// Tracker → registered base frame of session 0.
+    #[serde(skip)]
+    pub tracker_to_base: Pose,
+}
+
+impl CalibrationReport {
+    /// The best method by validation mean (identification mean without validation).
+    pub fn best_method(&self) -> Option<&MethodReport> {
+        self.methods.values().min_by(|a, b| {
+            let key = |m: &MethodReport| {
+                m.validation
+                    .as_ref()
+                    .map_or(m.identification.stats.mean_mm, |v| v.stats.mean_mm)
+            };
+            key(a).total_cmp(&key(b))
+        })
+    }
+}
+
+/// Converts an SI parameter value to display units.
+pub fn to_display(id: &ParamId, v: f64) -> f64 {
+    match id.unit() {
+        ParamUnit::Length => v * 1e3,
+        ParamUnit::Angle => v.to_degrees(),
+        ParamUnit::Compliance => v,
+    }
+}
+
+pub(crate) fn unit_name(id: &ParamId) -> &'static str {
+    match id.unit() {
+        ParamUnit::Length => "mm",
+        ParamUnit::Angle => "deg",
+        ParamUnit::Compliance => "rad/(N·m)",
+    }
+}
+
+/// Identified parameters in display units; σ from the covariance (none for a
+/// parameter held at a bound).
+pub(crate) fn estimates(
+    nominal: &RobotModel,
+    fitted: &RobotModel,
+    ids: &[ParamId],
+    cov: Option<&DMatrix<f64>>,
+    at_bound: &[bool],
+) -> Vec<ParamEstimate> {
+    ids.iter()
+        .enumerate()
+        .map(|(i, id)| ParamEstimate {
+            name: id.name(),
+            unit: unit_name(id).into(),
+            nominal: to_display(id, crate::model::params::get(nominal, *id)),
+            value: to_display(id, crate::model::params::get(fitted, *id)),
+            std: cov
+                .filter(|c| i < c.nrows() && !at_bound.get(i).copied().unwrap_or(false))
+                .map(|c| to_display(id, c[(i, i)].max(0.0).sqrt())),
+        })
+        .collect()
+}
