@@ -283,3 +283,66 @@ fn skcm_payload_with_link_masses_off_stays_at_the_floor() {
     assert!(skcm > 3.0 * floor, "SKCM {skcm} mm");
     assert!(payload <= 1.3 * floor, "SKCM-payload {payload} mm");
 }
+
+/// SKCM-C (TLBO) with the identification poses measured from two tracker
+/// placements is as accurate as with one: the inner fit and the cost use
+/// every session's frame.
+#[test]
+fn two_session_skcm_c_is_as_accurate_as_one() {
+    use robocal::identify::TlboSettings;
+    use robocal::sim::tracker_frame;
+    let nominal = preset("ys100").unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(41);
+    let mut tm = perturb_geometry(&nominal, &ErrorMagnitudes::from_mm_deg(1.0, 0.1), &mut rng);
+    let stiffness = [0.0, 1.5e6, 1.0e6, 1.2e6, 1.0e6, 0.0];
+    for (l, k) in tm.links.iter_mut().zip(stiffness) {
+        l.compliance = if k > 0.0 { 1.0 / k } else { 0.0 };
+    }
+    let frames = [
+        tracker_frame(2.0, -1.0, 30.0, [2200.0, 300.0, -200.0]),
+        tracker_frame(-4.0, 3.0, -110.0, [-800.0, 2600.0, 150.0]),
+    ];
+    let qs_id = random_configurations(&nominal, 60, &mut rng);
+    let qs_va = random_configurations(&nominal, 40, &mut rng);
+    let p = nominal.payload.mass;
+    let mut noise = ChaCha8Rng::seed_from_u64(5);
+    let mut measure = |qs: &[Vec<f64>], session: usize| {
+        let mut truth = TrueRobot::new(tm.clone());
+        truth.tracker_from_base = frames[session];
+        truth.noise_mm = 0.01;
+        let rows = truth.measure(qs, Some(p), None, &mut noise).unwrap();
+        let mut m = measure::to_measurements(&nominal, &rows, p);
+        for x in m.iter_mut() {
+            x.session = session;
+        }
+        m
+    };
+    let one_id = measure(&qs_id, 0);
+    let one_va = measure(&qs_va, 0);
+    let mut two_id = measure(&qs_id[..30], 0);
+    two_id.extend(measure(&qs_id[30..], 1));
+    let mut two_va = measure(&qs_va[..20], 0);
+    two_va.extend(measure(&qs_va[20..], 1));
+    let o = || CalibrationOptions {
+        methods: vec![Method::SkcmTlbo],
+        tlbo: TlboSettings {
+            population: 20,
+            generations: 30,
+            seed: 1,
+        },
+        ..Default::default()
+    };
+    let v = |r: &CalibrationReport| {
+        r.methods["skcm-tlbo"]
+            .validation
+            .as_ref()
+            .unwrap()
+            .stats
+            .mean_mm
+    };
+    let one = v(&run_with(&nominal, &one_id, &one_va, o()).unwrap());
+    let two = v(&run_with(&nominal, &two_id, &two_va, o()).unwrap());
+    eprintln!("SKCM-C one session {one:.4} mm, two sessions {two:.4} mm");
+    assert!(one < 0.03, "one session {one} mm");
+    assert!(two <= 1.15 * one, "two sessions {two} mm vs one {one} mm");
+}

@@ -31,10 +31,13 @@
 //! - a joint reading with |q| > 720° "looks like wrong units" (encoder counts,
 //!   millidegrees, …);
 //! - every position coordinate of the whole file within ±5 "looks like metres,
-//!   expected millimetres".
+//!   expected millimetres";
+//! - a position coordinate beyond ±100 m, or a `payload_kg` outside
+//!   0..10,000 kg, is rejected naming line and column.
 //!
 //! Radians given as degrees cannot be told apart from a small-angle degree file
-//! reliably, so that case is not checked.
+//! reliably, so that case is not checked. Values in messages are short
+//! (scientific notation for large magnitudes, long fields cut).
 
 use super::{MeasuredPose, SetRole};
 use std::fmt::Write as _;
@@ -48,6 +51,29 @@ pub const MAX_JOINT_DEG: f64 = 720.0;
 /// If every position coordinate of the file is below this magnitude [mm], the
 /// file is rejected as metres.
 pub const METRES_SUSPECT_MM: f64 = 5.0;
+/// Largest accepted magnitude of a position coordinate [mm] (100 m).
+pub const MAX_POSITION_MM: f64 = 100_000.0;
+/// Largest accepted payload [kg].
+pub const MAX_PAYLOAD_KG: f64 = 10_000.0;
+
+/// A number for a message: plain when moderate, scientific otherwise (never
+/// hundreds of digits).
+pub fn short_number(v: f64) -> String {
+    if v != 0.0 && !(1e-3..1e6).contains(&v.abs()) {
+        format!("{v:.3e}")
+    } else {
+        format!("{}", (v * 1e6).round() / 1e6)
+    }
+}
+
+/// A field for a message, cut to 40 characters.
+fn short_text(s: &str) -> String {
+    if s.chars().count() > 40 {
+        format!("{}…", s.chars().take(40).collect::<String>())
+    } else {
+        s.to_string()
+    }
+}
 
 const ACCEPTED: &str = "q1..q7 (alias joint_1..joint_7), x, y, z, rx, ry, rz, payload_kg, \
 temperature_c, set; real-data layout: x_t, y_t, z_t, x_dif, y_dif, z_dif, step_order";
@@ -112,13 +138,19 @@ pub enum CsvError {
         expected: usize,
         got: usize,
     },
-    #[error("line {line}, column `{column}`: `{value}` is not a number")]
+    #[error(
+        "line {line}, column `{column}`: `{}` is not a number",
+        short_text(value)
+    )]
     NotNumeric {
         line: usize,
         column: String,
         value: String,
     },
-    #[error("line {line}, column `{column}`: `{value}` is not a finite number")]
+    #[error(
+        "line {line}, column `{column}`: `{}` is not a finite number",
+        short_text(value)
+    )]
     NotFinite {
         line: usize,
         column: String,
@@ -128,11 +160,19 @@ pub enum CsvError {
     UnknownSet { line: usize, value: String },
     #[error("line {line}, columns rx, ry, rz: give all three orientation angles or none")]
     PartialOrientation { line: usize },
-    #[error("line {line}, column `{column}`: {value} deg looks like wrong units (|q| > {max} deg; joint readings must be in degrees)", max = MAX_JOINT_DEG)]
+    #[error("line {line}, column `{column}`: {} deg looks like wrong units (|q| > {max} deg; joint readings must be in degrees)", short_number(*value), max = MAX_JOINT_DEG)]
     JointUnits {
         line: usize,
         column: String,
         value: f64,
+    },
+    #[error("line {line}, column `{column}`: {} {unit} is outside {range}", short_number(*value))]
+    OutOfRange {
+        line: usize,
+        column: String,
+        value: f64,
+        unit: &'static str,
+        range: &'static str,
     },
     #[error("every position coordinate is within ±{limit} mm: looks like metres, expected millimetres", limit = METRES_SUSPECT_MM)]
     PositionUnits,
@@ -412,6 +452,21 @@ impl Header {
                 }
             }
         }
+        let position_cols = match &self.position {
+            PositionCols::Measured(p) => *p,
+            PositionCols::TargetPlusDif(t, _) => *t,
+        };
+        for (x, &c) in xyz_mm.iter().zip(&position_cols) {
+            if x.abs() > MAX_POSITION_MM {
+                return Err(CsvError::OutOfRange {
+                    line,
+                    column: self.names[c].clone(),
+                    value: *x,
+                    unit: "mm",
+                    range: "±100 m (positions are in millimetres)",
+                });
+            }
+        }
         let rpy_deg = match &self.rot {
             None => None,
             Some(r) => {
@@ -424,6 +479,17 @@ impl Header {
             }
         };
         let payload_kg = self.payload.map(opt).transpose()?.flatten();
+        if let (Some(kg), Some(c)) = (payload_kg, self.payload) {
+            if !(0.0..=MAX_PAYLOAD_KG).contains(&kg) {
+                return Err(CsvError::OutOfRange {
+                    line,
+                    column: self.names[c].clone(),
+                    value: kg,
+                    unit: "kg",
+                    range: "0..10000 kg",
+                });
+            }
+        }
         let temperature_c = self.temperature.map(opt).transpose()?.flatten();
         let set = match self.set {
             Some(c) if !fields[c].is_empty() => Some(SetRole::parse(fields[c]).ok_or_else(
@@ -837,5 +903,50 @@ mod tests {
         let r = &parse(&text).unwrap()[0];
         assert_eq!(r.xyz_mm[0], -430.32784075885013 + -2.144122241149887);
         assert_eq!(r.q_deg[0], -22.933297010882566);
+    }
+}
+
+#[cfg(test)]
+mod bounds_tests {
+    use super::*;
+
+    fn err(text: &str) -> String {
+        parse(text).unwrap_err().to_string()
+    }
+
+    /// Positions beyond ±100 m, payloads outside 0..10,000 kg and absurd joint
+    /// values are rejected with a short message naming line and column.
+    #[test]
+    fn out_of_range_values_give_short_messages() {
+        let head = "q1,q2,q3,q4,q5,q6,x,y,z,payload_kg\n";
+        let ok = "0,0,0,0,0,0,1000,200,300,5\n";
+        let e = err(&format!("{head}{ok}0,0,0,0,0,0,1e300,200,300,5\n"));
+        assert!(
+            e.starts_with("line 3, column `x`: 1.000e300 mm is outside ±100 m"),
+            "{e}"
+        );
+        assert!(e.len() < 120, "{e}");
+        let e = err(&format!("{head}{ok}0,0,0,0,0,0,1000,-100001,300,5\n"));
+        assert!(e.contains("line 3, column `y`"), "{e}");
+        for bad in ["-1", "10000.5", "1e308"] {
+            let e = err(&format!("{head}0,0,0,0,0,0,1000,200,300,{bad}\n"));
+            assert!(
+                e.starts_with("line 2, column `payload_kg`") && e.contains("0..10000 kg"),
+                "{e}"
+            );
+            assert!(e.len() < 120, "{e}");
+        }
+        assert!(parse(&format!("{head}0,0,0,0,0,0,1000,200,300,10000\n")).is_ok());
+        let e = err(&format!("{head}1e300,0,0,0,0,0,1000,200,300,5\n"));
+        assert!(
+            e.contains("column `q1`: 1.000e300 deg") && e.len() < 160,
+            "{e}"
+        );
+        let long = "9".repeat(400) + "x";
+        let e = err(&format!("{head}0,0,0,0,0,0,{long},200,300,5\n"));
+        assert!(e.len() < 160, "{e}");
+        // The real-data layout names the target column.
+        let e = err("x_t,y_t,z_t,x_dif,y_dif,z_dif,joint_1,joint_2\n2e5,0,0,0,0,0,0,0\n");
+        assert!(e.contains("column `x_t`"), "{e}");
     }
 }
