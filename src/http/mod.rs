@@ -33,6 +33,7 @@ use tracing::Level;
 
 pub mod calibrations;
 pub mod client;
+pub mod console;
 pub mod error;
 pub mod input;
 pub mod limits;
@@ -310,10 +311,10 @@ fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-/// The router of the service.
+/// The router of the service: the JSON API and the web console.
 pub fn app(state: AppState) -> Router {
     let mut router = Router::new();
-    for r in routes() {
+    for r in routes().into_iter().chain(console::routes()) {
         // Routes of one path with different methods merge into one.
         router = router.route(r.path, r.handler);
     }

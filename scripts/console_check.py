@@ -1,0 +1,184 @@
+#!/usr/bin/env python3
+"""Drives the web console in a real browser through the whole flow and saves a
+screenshot of each step:
+
+  create robot -> upload measurements -> calibrate (live progress) -> report
+  -> activate a version -> solve a targets CSV
+
+against a real `robocal serve` with API keys on a temporary database, using
+Debian's Chromium and chromedriver through Selenium.
+
+    scripts/console_check.sh [path/to/robocal]     (installs what it needs)
+    python3 scripts/console_check.py --robocal target/debug/robocal --out DIR
+
+Data: the real UR5 laser-tracker set in ../shared/data (grid for
+identification, the 20 random poses for validation). Exits non-zero on the
+first step that does not behave.
+"""
+import argparse
+import os
+import pathlib
+import shutil
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+
+from selenium import webdriver
+from selenium.webdriver.chrome.options import Options
+from selenium.webdriver.chrome.service import Service
+from selenium.webdriver.common.by import By
+from selenium.webdriver.support import expected_conditions as EC
+from selenium.webdriver.support.ui import Select, WebDriverWait
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+DATA = pathlib.Path(os.environ.get(
+    "ROBOCAL_DATA_DIR", ROOT.parent / "shared/data/ur5-wam-laser-tracker"))
+KEY = "console-check-key"
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def wait_http(url, seconds=60):
+    import urllib.request
+    end = time.time() + seconds
+    while time.time() < end:
+        try:
+            with urllib.request.urlopen(url, timeout=2) as r:
+                if r.status == 200:
+                    return
+        except Exception:
+            time.sleep(0.2)
+    raise SystemExit(f"the service did not answer {url} within {seconds} s")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--robocal", default=str(ROOT / "target/debug/robocal"))
+    ap.add_argument("--out", default=str(ROOT / "target/console-check"))
+    ap.add_argument("--chromium", default=shutil.which("chromium") or "/usr/bin/chromium")
+    ap.add_argument("--chromedriver", default=shutil.which("chromedriver") or "/usr/bin/chromedriver")
+    args = ap.parse_args()
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    grid = DATA / "UR5/3D_UR5_uncalibrated_grid_cleaned.csv"
+    random = DATA / "UR5/3D_UR5_uncalibrated_random_cleaned.csv"
+    for f in (grid, random):
+        if not f.exists():
+            raise SystemExit(f"data not found: {f} (set ROBOCAL_DATA_DIR)")
+
+    work = tempfile.mkdtemp(prefix="robocal-console-")
+    port = free_port()
+    base = f"http://127.0.0.1:{port}"
+    env = dict(os.environ, DATABASE_URL=f"sqlite://{work}/console.db?mode=rwc",
+               ROBOCAL_API_KEYS=KEY, RUST_LOG="warn")
+    server = subprocess.Popen([args.robocal, "serve", "--bind", f"127.0.0.1:{port}"],
+                              env=env, stdout=open(f"{work}/server.log", "w"),
+                              stderr=subprocess.STDOUT)
+    opts = Options()
+    opts.binary_location = args.chromium
+    for a in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage",
+              "--window-size=1400,1000"):
+        opts.add_argument(a)
+    driver = None
+    step = 0
+
+    def shot(name, section=None):
+        nonlocal step
+        step += 1
+        if section is not None:
+            driver.execute_script(
+                "arguments[0].scrollIntoView()", driver.find_element(By.ID, section))
+        path = out / f"{step:02d}-{name}.png"
+        driver.save_screenshot(str(path))
+        print(f"console_check: step {step} {name}: ok ({path})")
+
+    try:
+        wait_http(f"{base}/healthz")
+        driver = webdriver.Chrome(service=Service(args.chromedriver), options=opts)
+        wait = WebDriverWait(driver, 120)
+
+        # 1. Start page, key, create a robot from the UR5 preset.
+        driver.get(f"{base}/ui")
+        key = driver.find_element(By.ID, "api-key")
+        key.send_keys(KEY)
+        key.send_keys("\t")
+        form = driver.find_element(By.ID, "create-robot")
+        form.find_element(By.NAME, "name").send_keys("UR5 cell 1")
+        Select(form.find_element(By.NAME, "preset")).select_by_value("ur5")
+        shot("robots")
+        form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+        wait.until(EC.url_contains("/ui/robots/"))
+        wait.until(EC.presence_of_element_located((By.ID, "upload")))
+        shot("robot-created")
+
+        # 2. Upload the grid (identification) and the random poses (validation).
+        for n, (path, role) in enumerate(((grid, "identification"), (random, "validation"))):
+            form = driver.find_element(By.ID, "upload")
+            form.find_element(By.NAME, "file").send_keys(str(path))
+            Select(form.find_element(By.NAME, "role")).select_by_value(role)
+            form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+            # The page reloads when the upload is stored.
+            wait.until(EC.staleness_of(form))
+            wait.until(lambda d: len(d.find_elements(By.CSS_SELECTOR, "#sets tbody tr")) == n + 1)
+        rows = driver.find_elements(By.CSS_SELECTOR, "#sets tbody tr")
+        assert len(rows) == 2, f"expected 2 sets, the page lists {len(rows)}"
+        shot("uploaded", "sets")
+
+        # 3. Calibrate with KM only; watch the job until it succeeds.
+        form = driver.find_element(By.ID, "calibrate")
+        for box in form.find_elements(By.NAME, "method"):
+            if box.is_selected() != (box.get_attribute("value") == "km"):
+                box.click()
+        form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+        wait.until(EC.staleness_of(form))
+        wait.until(EC.presence_of_element_located((By.CSS_SELECTOR, "#calibrations tbody tr")))
+        shot("calibration-started", "calibrations")
+        wait.until(lambda d: d.find_element(By.CSS_SELECTOR, "#calibrations tbody tr .status").text
+                   in ("succeeded", "failed", "cancelled"))
+        status = driver.find_element(By.CSS_SELECTOR, "#calibrations tbody tr .status").text
+        assert status == "succeeded", f"the calibration ended {status}"
+        shot("calibration-done", "calibrations")
+
+        # 4. The report.
+        robot_url = driver.current_url
+        driver.find_element(By.LINK_TEXT, "report").click()
+        wait.until(EC.presence_of_element_located((By.TAG_NAME, "h1")))
+        assert "KM" in driver.page_source, "the report does not show the KM method"
+        shot("report")
+        driver.get(robot_url)
+
+        # 5. Versions: the first calibration activated its best; roll back is
+        # refused with one activation only, so activate explicitly.
+        wait.until(EC.presence_of_element_located((By.CSS_SELECTOR, "#versions tbody tr")))
+        assert driver.find_elements(By.CSS_SELECTOR, "#versions tr.active"), "no active version"
+        shot("versions", "versions")
+
+        # 6. Solve two targets (positions of two measured poses).
+        form = driver.find_element(By.ID, "solve-form")
+        form.find_element(By.NAME, "targets").send_keys(
+            "id,x,y,z\np1,-495.48,-261.22,359.40\np2,-496.56,-303.74,389.15\n")
+        form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+        wait.until(lambda d: d.find_element(By.ID, "solve-result").is_displayed()
+                   or "bad" in d.find_element(By.ID, "message").get_attribute("class"))
+        result = driver.find_element(By.ID, "solve-result").text
+        message = driver.find_element(By.ID, "message").text
+        assert result.count("\n") >= 2 and "p1" in result and "p2" in result, \
+            f"solve answer: {result!r} message: {message!r}"
+        assert ",ok," in result, f"no target solved: {result!r}"
+        shot("solved", "solve")
+        print(f"console_check: the whole flow passed; screenshots in {out}")
+    finally:
+        if driver is not None:
+            driver.quit()
+        server.terminate()
+        server.wait(timeout=30)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# Installs Debian's Chromium and chromedriver (when missing) and Selenium in a
+# virtual environment, then drives the web console through the whole flow in
+# headless Chromium (scripts/console_check.py). Screenshots: target/console-check/.
+#
+#   scripts/console_check.sh [path/to/robocal]    (default target/debug/robocal)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+BIN=${1:-target/debug/robocal}
+SELENIUM_VERSION=4.51.0
+if ! command -v chromium >/dev/null || ! command -v chromedriver >/dev/null; then
+    SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO=sudo
+    $SUDO apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq chromium chromium-driver >/dev/null
+fi
+VENV=target/console-venv
+if [ ! -x "$VENV/bin/python" ]; then
+    python3 -m venv "$VENV"
+fi
+"$VENV/bin/pip" install -q "selenium==$SELENIUM_VERSION"
+"$VENV/bin/python" scripts/console_check.py --robocal "$BIN" --out target/console-check

@@ -1,0 +1,51 @@
+//! The web console: server-rendered pages (maud, escaping by default) for the
+//! whole flow — robots, measurement uploads, calibration jobs with live
+//! progress, reports, model versions with activate and rollback, and solving a
+//! targets CSV. The pages read the store directly; every write is made by the
+//! page's own script through the REST API (`/v1`), so the console obeys the
+//! same API keys, limits and validation as any client. No external assets:
+//! the style sheet and the script are inlined.
+//!
+//! Routes: `GET /ui` (robots), `GET /ui/robots/{id}` (one robot). They are
+//! HTML, not part of the JSON API, so `openapi.yaml` does not list them.
+
+mod pages;
+
+use super::robots::robot_not_found;
+use super::{route, ApiError, ApiPath, AppState, Route};
+use axum::extract::State;
+use axum::http::Method;
+use axum::response::{Html, IntoResponse, Response};
+
+/// Robots listed on the start page.
+const ROBOTS_SHOWN: i64 = 500;
+
+/// The routes of the console.
+pub fn routes() -> Vec<Route> {
+    vec![
+        route(Method::GET, "/ui", robots_page),
+        route(Method::GET, "/ui/robots/{id}", robot_page),
+    ]
+}
+
+async fn robots_page(State(state): State<AppState>) -> Result<Response, ApiError> {
+    let (robots, total) = state.db().robots_page(ROBOTS_SHOWN, 0).await?;
+    let keys = !state.config().api_keys.is_empty();
+    Ok(Html(pages::robots(&robots, total, keys).into_string()).into_response())
+}
+
+async fn robot_page(
+    State(state): State<AppState>,
+    ApiPath(id): ApiPath<i64>,
+) -> Result<Response, ApiError> {
+    let db = state.db();
+    let robot = db.robot(id).await?.ok_or_else(|| robot_not_found(id))?;
+    let view = pages::RobotView {
+        sets: db.sets(id).await?,
+        calibrations: db.calibrations(id).await?,
+        versions: db.versions(id).await?,
+        keys: !state.config().api_keys.is_empty(),
+        robot,
+    };
+    Ok(Html(pages::robot(&view).into_string()).into_response())
+}

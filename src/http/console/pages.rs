@@ -1,0 +1,275 @@
+//! The console's pages as maud templates (every interpolated value is
+//! HTML-escaped by maud).
+
+use crate::db::{CalibrationRow, JobStatus, RobotRow, SetRow, VersionRow};
+use crate::identify::Method;
+use crate::measure::SetRole;
+use crate::model::orientation::OrientationConvention;
+use crate::model::presets::PRESETS;
+use maud::{html, Markup, PreEscaped, DOCTYPE};
+
+const SCRIPT: &str = include_str!("console.js");
+const STYLE: &str = include_str!("console.css");
+
+/// Everything the robot page shows.
+pub struct RobotView {
+    pub robot: RobotRow,
+    pub sets: Vec<SetRow>,
+    pub calibrations: Vec<CalibrationRow>,
+    pub versions: Vec<VersionRow>,
+    pub keys: bool,
+}
+
+fn layout(title: &str, keys: bool, body: Markup) -> Markup {
+    html! {
+        (DOCTYPE)
+        html lang="en" {
+            head {
+                meta charset="utf-8";
+                meta name="viewport" content="width=device-width, initial-scale=1";
+                title { (title) " — robocal" }
+                style { (PreEscaped(STYLE)) }
+            }
+            body {
+                header {
+                    a.brand href="/ui" { "robocal" }
+                    span.sub { "console" }
+                    @if keys {
+                        label.key {
+                            "API key "
+                            input #api-key type="password" autocomplete="off"
+                                placeholder="needed for changes";
+                        }
+                    }
+                }
+                main {
+                    div #message .msg hidden {}
+                    (body)
+                }
+                footer {
+                    "REST API: " a href="/openapi.yaml" { "/openapi.yaml" }
+                }
+                script { (PreEscaped(SCRIPT)) }
+            }
+        }
+    }
+}
+
+/// The start page: robots and a form to add one.
+pub fn robots(robots: &[RobotRow], total: i64, keys: bool) -> Markup {
+    layout(
+        "Robots",
+        keys,
+        html! {
+            h1 { "Robots" }
+            @if robots.is_empty() {
+                p.empty { "No robot yet: add one below." }
+            } @else {
+                table #robots {
+                    thead { tr { th { "Id" } th { "Name" } th { "Model" } th { "Axes" } th { "Active version" } th { "Created" } } }
+                    tbody {
+                        @for r in robots {
+                            tr {
+                                td { (r.id) }
+                                td { a href={ "/ui/robots/" (r.id) } { (r.name) } }
+                                td { (r.preset.as_deref().unwrap_or("custom model")) }
+                                td { (r.dof) }
+                                td { @match r.active_version { Some(v) => { "v" (v) }, None => { "nominal" } } }
+                                td { (r.created_at) }
+                            }
+                        }
+                    }
+                }
+                @if total > robots.len() as i64 {
+                    p.note { "Showing " (robots.len()) " of " (total) " robots." }
+                }
+            }
+            section {
+                h2 { "Add a robot" }
+                form #create-robot data-action="create-robot" {
+                    label { "Name " input name="name" placeholder="e.g. cell 3 robot"; }
+                    label { "Preset "
+                        select name="preset" {
+                            @for p in PRESETS { option value=(p) { (p) } }
+                        }
+                    }
+                    label.wide { "or a model description (JSON, mm/deg; replaces the preset) "
+                        textarea name="model" rows="4" placeholder="{\"name\": ..., \"joints\": [...]}" {}
+                    }
+                    button type="submit" { "Create robot" }
+                }
+            }
+        },
+    )
+}
+
+fn job_active(s: JobStatus) -> bool {
+    s.is_active()
+}
+
+fn validation_mean(v: &VersionRow) -> Option<f64> {
+    v.stats.0.get("validation")?.get("mean_mm")?.as_f64()
+}
+
+/// One robot: sets, calibrations, versions, solve.
+pub fn robot(v: &RobotView) -> Markup {
+    let r = &v.robot;
+    let id = r.id;
+    layout(
+        &r.name,
+        v.keys,
+        html! {
+            p.crumbs { a href="/ui" { "Robots" } " / " (r.name) }
+            h1 { (r.name) }
+            p.note {
+                "Robot " (id) " · " (r.preset.as_deref().unwrap_or("custom model")) " · " (r.dof) " axes · "
+                @match r.active_version { Some(a) => { "active model version " (a) }, None => { "no calibrated version yet (solves use the nominal model)" } }
+            }
+
+            section #sets {
+                h2 { "Measurement sets" }
+                @if v.sets.is_empty() {
+                    p.empty { "No measurements yet: upload a laser-tracker CSV below." }
+                } @else {
+                    table {
+                        thead { tr { th { "Id" } th { "Name" } th { "Role" } th { "Session" } th { "Poses" } th { "Payload [kg]" } th { "Uploaded" } th {} } }
+                        tbody {
+                            @for s in &v.sets {
+                                tr {
+                                    td { (s.id) } td { (s.name) } td { (SetRole::from(s.role).as_str()) } td { (s.session) }
+                                    td { (s.row_count) }
+                                    td { @if let Some(p) = s.payload_kg { (p) } @else { "—" } }
+                                    td { (s.created_at) }
+                                    td { a href={ "/v1/robots/" (id) "/measurement-sets/" (s.id) "/original" } { "original" } }
+                                }
+                            }
+                        }
+                    }
+                }
+                form #upload data-action="upload" data-robot=(id) {
+                    label.wide { "CSV file " input type="file" name="file" accept=".csv,text/csv"; }
+                    label { "Role "
+                        select name="role" {
+                            option value="identification" { "identification" }
+                            option value="validation" { "validation" }
+                            option value="training" { "training" }
+                        }
+                    }
+                    label { "Name " input name="name"; }
+                    label { "Tracker session " input name="session" placeholder="default"; }
+                    label { "Payload [kg] " input name="payload_kg" type="number" step="any" min="0"; }
+                    label { "Lengths "
+                        select name="length_unit" { option value="mm" { "mm" } option value="m" { "m" } }
+                    }
+                    label { "Angles "
+                        select name="angle_unit" { option value="deg" { "deg" } option value="rad" { "rad" } }
+                    }
+                    button type="submit" { "Upload" }
+                }
+            }
+
+            section #calibrations {
+                h2 { "Calibrations" }
+                @if v.calibrations.is_empty() {
+                    p.empty { "No calibration yet." }
+                } @else {
+                    table {
+                        thead { tr { th { "Id" } th { "Methods" } th { "Status" } th { "Phase" } th { "Progress" } th { "Best" } th { "Created" } th {} } }
+                        tbody {
+                            @for c in v.calibrations.iter().rev() {
+                                @let url = format!("/v1/robots/{id}/calibrations/{}", c.id);
+                                tr data-job=(url) data-active=(job_active(c.status)) {
+                                    td { (c.id) }
+                                    td { (c.methods.0.join(", ")) }
+                                    td.status { (c.status.as_str()) }
+                                    td.phase { (c.phase.as_deref().unwrap_or("")) }
+                                    td { progress max="100" value=(c.percent) {} " " span.percent { (format!("{:.0} %", c.percent)) } }
+                                    td { (c.best_method.as_deref().unwrap_or("—")) }
+                                    td { (c.created_at) }
+                                    td {
+                                        @if c.status == JobStatus::Succeeded {
+                                            a href={ (url) "/report" } { "report" } " · "
+                                            a href={ (url) "/result" } { "result" }
+                                        } @else if job_active(c.status) {
+                                            button.small data-post={ (url) "/cancel" } { "Cancel" }
+                                        } @else if let Some(e) = &c.error {
+                                            span.bad { (e) }
+                                        }
+                                    }
+                                }
+                            }
+                        }
+                    }
+                }
+                form #calibrate data-action="calibrate" data-robot=(id) {
+                    fieldset {
+                        legend { "Methods" }
+                        @for m in Method::ALL {
+                            label.check {
+                                input type="checkbox" name="method" value=(m.name())
+                                    checked[matches!(m.name(), "km" | "skcm")];
+                                " " (m.name())
+                            }
+                        }
+                    }
+                    label { "Seed " input name="seed" type="number" min="0" step="1" placeholder="1"; }
+                    label { "Payload [kg] " input name="payload_kg" type="number" step="any" min="0" placeholder="model's"; }
+                    button type="submit" { "Start calibration" }
+                }
+            }
+
+            section #versions {
+                h2 { "Model versions" }
+                @if v.versions.is_empty() {
+                    p.empty { "No model version yet: a successful calibration creates one per method." }
+                } @else {
+                    table {
+                        thead { tr { th { "Version" } th { "Method" } th { "Calibration" } th { "Validation mean [mm]" } th { "Created" } th {} } }
+                        tbody {
+                            @for ver in v.versions.iter().rev() {
+                                tr.active[ver.active] {
+                                    td { "v" (ver.version) @if ver.active { " " span.tag { "active" } } }
+                                    td { (ver.method) }
+                                    td { @if let Some(c) = ver.calibration_id { (c) } @else { "—" } }
+                                    td { @if let Some(m) = validation_mean(ver) { (format!("{m:.4}")) } @else { "—" } }
+                                    td { (ver.created_at) }
+                                    td {
+                                        a href={ "/v1/robots/" (id) "/versions/" (ver.version) "/model.json" } { "model.json" }
+                                        @if !ver.active {
+                                            " " button.small data-post={ "/v1/robots/" (id) "/versions/" (ver.version) "/activate" } { "Activate" }
+                                        }
+                                    }
+                                }
+                            }
+                        }
+                    }
+                    p { button.small #rollback data-post={ "/v1/robots/" (id) "/versions/rollback" } { "Roll back to the previous active version" } }
+                }
+            }
+
+            section #solve {
+                h2 { "Solve targets" }
+                p.note { "A targets CSV (id,x,y,z and an orientation in the chosen convention, mm/deg); the answer is the joint commands and false targets as CSV." }
+                form #solve-form data-action="solve" data-robot=(id) {
+                    label.wide { "Targets file " input type="file" name="file" accept=".csv,text/csv"; }
+                    label.wide { "or paste the CSV " textarea name="targets" rows="4" placeholder="id,x,y,z\np1,600,0,800" {} }
+                    label { "Orientation convention "
+                        select name="convention" {
+                            @for c in OrientationConvention::ALL { option value=(c.name()) { (c.name()) } }
+                        }
+                    }
+                    label { "Model "
+                        select name="version" {
+                            option value="active" { "active version" }
+                            option value="nominal" { "nominal" }
+                            @for ver in &v.versions { option value=(ver.version) { "v" (ver.version) " (" (ver.method) ")" } }
+                        }
+                    }
+                    button type="submit" { "Solve" }
+                }
+                a #solve-download download="solved.csv" hidden { "Download the answer (CSV)" }
+                pre #solve-result hidden {}
+            }
+        },
+    )
+}
