@@ -6,6 +6,7 @@
 //! HTTP, a database, the async runtime or the file system.
 
 pub mod compensate;
+pub mod export;
 pub mod identify;
 pub mod ik;
 pub mod kinematics;

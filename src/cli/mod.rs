@@ -5,6 +5,7 @@ use clap::{Parser, Subcommand};
 pub mod bench;
 pub mod calibrate;
 pub mod demo;
+pub mod export;
 pub mod serve;
 pub mod simulate;
 pub mod solve;
@@ -30,6 +31,8 @@ pub enum Command {
     Demo(demo::DemoArgs),
     /// Solve target poses into joint commands and false targets.
     Solve(solve::SolveArgs),
+    /// Export the (calibrated) geometric model: URDF, standard/modified DH CSV, JSON.
+    Export(export::ExportArgs),
     /// Run the HTTP service.
     Serve(serve::ServeArgs),
     /// Time robocal's side of the peer benchmark (KM, IK), as JSON.
@@ -43,6 +46,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Calibrate(a) => calibrate::run(a),
         Command::Demo(a) => demo::run(a),
         Command::Solve(a) => solve::run(a),
+        Command::Export(a) => export::run(a),
         Command::Serve(a) => serve::run(a),
         Command::Bench(a) => bench::run(a),
     }

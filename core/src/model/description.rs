@@ -459,18 +459,10 @@ impl PoseDescription {
     }
 }
 
-/// Fixed-axis XYZ angles `[rx, ry, rz]` with `R = Rz·Ry·Rx` (rad).
+/// Fixed-axis XYZ angles `[rx, ry, rz]` with `R = Rz·Ry·Rx` (rad):
+/// [`super::orientation::fixed_xyz_angles`] (its gimbal-lock rule: `rx = 0`).
 pub fn matrix_to_rpy(r: &Matrix3<f64>) -> [f64; 3] {
-    let ry = (-r[(2, 0)]).clamp(-1.0, 1.0).asin();
-    if r[(2, 0)].abs() < 1.0 - 1e-12 {
-        let rx = r[(2, 1)].atan2(r[(2, 2)]);
-        let rz = r[(1, 0)].atan2(r[(0, 0)]);
-        [rx, ry, rz]
-    } else {
-        // Gimbal lock: put everything into rz.
-        let rz = (-r[(0, 1)]).atan2(r[(1, 1)]);
-        [0.0, ry, rz]
-    }
+    super::orientation::fixed_xyz_angles(r)
 }
 
 impl RobotModel {

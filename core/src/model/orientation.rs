@@ -274,20 +274,27 @@ pub fn rotation_angle_between(a: &Matrix3<f64>, b: &Matrix3<f64>) -> f64 {
 
 /// `Rz(a)·Ry(b)·Rx(c)` with angles in radians.
 fn rz_ry_rx(a: f64, b: f64, c: f64) -> Matrix3<f64> {
-    let (sa, ca) = a.sin_cos();
-    let (sb, cb) = b.sin_cos();
-    let (sc, cc) = c.sin_cos();
-    Matrix3::new(
-        ca * cb,
-        ca * sb * sc - sa * cc,
-        ca * sb * cc + sa * sc,
-        sa * cb,
-        sa * sb * sc + ca * cc,
-        sa * sb * cc - ca * sc,
-        -sb,
-        cb * sc,
-        cb * cc,
-    )
+    fixed_xyz_matrix(c, b, a)
+}
+
+/// The one fixed-axis XYZ rotation of robocal (KUKA ABC, Fanuc WPR, URDF
+/// roll-pitch-yaw, the model files' `rpy`, the measurement CSV's
+/// `rx_deg, ry_deg, rz_deg`): `R = Rz(rz)·Ry(ry)·Rx(rx)`, radians, built on
+/// nalgebra's rotations (`Rotation3::from_euler_angles(roll, pitch, yaw)` is
+/// exactly this product).
+pub fn fixed_xyz_matrix(rx: f64, ry: f64, rz: f64) -> Matrix3<f64> {
+    nalgebra::Rotation3::from_euler_angles(rx, ry, rz).into_inner()
+}
+
+/// Inverse of [`fixed_xyz_matrix`]: `[rx, ry, rz]` in radians with `ry` in
+/// `[-π/2, π/2]` and `rx, rz` in `(-π, π]`. The gimbal-lock rule (the only
+/// one in robocal): when `cos(ry) < GIMBAL_COS_THRESHOLD` (`ry` within about
+/// 6e-12° of ±90°), `rx = 0` and the whole rotation about the vertical goes
+/// into `rz`. Accurate to rounding arbitrarily close to the lock (see
+/// `rz_ry_rx_angles`).
+pub fn fixed_xyz_angles(r: &Matrix3<f64>) -> [f64; 3] {
+    let (a, b, c) = rz_ry_rx_angles(r);
+    [c, b, a]
 }
 
 /// Inverse of [`rz_ry_rx`]: `(a, b, c)` in radians with `b ∈ [-π/2, π/2]`.

@@ -120,13 +120,10 @@ impl Pose {
     }
 }
 
-/// Rotation `Rz(rz) · Ry(ry) · Rx(rx)` (fixed-axis XYZ), angles in radians.
+/// Rotation `Rz(rz) · Ry(ry) · Rx(rx)` (fixed-axis XYZ), angles in radians:
+/// [`super::orientation::fixed_xyz_matrix`].
 pub fn rpy_matrix(rx: f64, ry: f64, rz: f64) -> Matrix3<f64> {
-    let mut p = Pose::identity();
-    p.rot_z(rz);
-    p.rot_y(ry);
-    p.rot_x(rx);
-    p.r
+    super::orientation::fixed_xyz_matrix(rx, ry, rz)
 }
 
 /// Rotation vector (axis · angle, rad) of `r`, robust near 0 and π.
