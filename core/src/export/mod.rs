@@ -35,6 +35,7 @@
 //! is not a joint reading): those exports fail with a message.
 
 use crate::compensate::{CalibratedModelFile, CompensatedModel};
+use crate::kinematics::chain::{base_constant, tool_pose};
 use crate::model::orientation::fixed_xyz_angles;
 use crate::model::{Pose, RobotModel};
 use std::fmt::Write as _;
@@ -156,11 +157,7 @@ fn joint_origin(m: &RobotModel, k: usize) -> Pose {
     let l = &m.links[k];
     let mut p = Pose::identity();
     if k == 0 {
-        p.tr_x(l.a);
-        p.tr_y(l.b);
-        p.tr_z(l.d);
-        p.rot_x(l.alpha);
-        p.rot_y(l.beta);
+        p = base_constant(l);
     } else {
         p.rot_x(l.alpha);
         p.tr_x(l.a);
@@ -233,7 +230,7 @@ fn urdf(model: &CompensatedModel, source: &ExportSource) -> Result<String, Expor
     let _ = writeln!(
         s,
         "  <joint name=\"tcp_joint\" type=\"fixed\">\n    <parent link=\"{parent}\"/>\n    <child link=\"tcp\"/>\n    <origin {}/>\n  </joint>",
-        xyz_rpy(&crate::kinematics::chain::tool_pose(m))
+        xyz_rpy(&tool_pose(m))
     );
     let _ = writeln!(s, "  <link name=\"tcp\"/>");
     let _ = writeln!(s, "</robot>");
@@ -310,13 +307,7 @@ fn dh_csv(
         transform_cells(&model.cell_from_base)
     );
     // The base link's constant part is the base transform; joint 1 keeps θ0.
-    let l0 = &m.links[0];
-    let mut base = Pose::identity();
-    base.tr_x(l0.a);
-    base.tr_y(l0.b);
-    base.tr_z(l0.d);
-    base.rot_x(l0.alpha);
-    base.rot_y(l0.beta);
+    let base = base_constant(&m.links[0]);
     let _ = writeln!(s, "base{blank_joint},{}", transform_cells(&base));
     for k in 0..n {
         let l = &m.links[k];
@@ -358,11 +349,7 @@ fn dh_csv(
             l.limits[1].to_degrees()
         );
     }
-    let _ = writeln!(
-        s,
-        "tool{blank_joint},{}",
-        transform_cells(&crate::kinematics::chain::tool_pose(m))
-    );
+    let _ = writeln!(s, "tool{blank_joint},{}", transform_cells(&tool_pose(m)));
     Ok(s)
 }
 

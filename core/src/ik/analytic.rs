@@ -191,13 +191,7 @@ impl AnalyticIk {
         if l2 < LEN_TOL {
             return unsupported("no forearm length".into());
         }
-        let b = &l[0];
-        let mut base = Pose::identity();
-        base.tr_x(b.a);
-        base.tr_y(b.b);
-        base.tr_z(b.d);
-        base.rot_x(b.alpha);
-        base.rot_y(b.beta);
+        let base = crate::kinematics::chain::base_constant(&l[0]);
         let loop_geom = model.closed_loop.as_ref().map(|c| LoopGeom {
             passive: c.passive,
             sp: l[c.passive].a,

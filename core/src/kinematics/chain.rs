@@ -125,6 +125,18 @@ fn link_step(k: usize, l: &Link, angle: f64, pose: &mut Pose) -> LinkFrames {
     }
 }
 
+/// The constant part of the base link (eq. 4.3 without `Rot(z,θ1)`):
+/// `Tr(x,a0)·Tr(y,b0)·Tr(z,d1)·Rot(x,α0)·Rot(y,β0)`.
+pub fn base_constant(l: &Link) -> Pose {
+    let mut p = Pose::identity();
+    p.tr_x(l.a);
+    p.tr_y(l.b);
+    p.tr_z(l.d);
+    p.rot_x(l.alpha);
+    p.rot_y(l.beta);
+    p
+}
+
 /// The tool transform of the model.
 pub fn tool_pose(model: &RobotModel) -> Pose {
     let t = &model.tool;
