@@ -11,3 +11,4 @@ pub use robocal_core::{compensate, export, identify, ik, kinematics, measure, mo
 pub mod cli;
 pub mod db;
 pub mod http;
+pub mod service;

@@ -171,6 +171,26 @@ impl From<sqlx::Error> for ApiError {
     }
 }
 
+impl From<crate::service::ServiceError> for ApiError {
+    fn from(e: crate::service::ServiceError) -> Self {
+        use crate::service::ServiceError as S;
+        match e {
+            S::Invalid(m) => ApiError::Unprocessable(m),
+            S::NotFound(m) => ApiError::NotFound(m),
+            S::Conflict(m) => ApiError::Conflict(m),
+            S::Busy {
+                detail,
+                retry_after_s,
+            } => ApiError::Busy {
+                detail,
+                retry_after_s,
+            },
+            S::Db(e) => ApiError::from(e),
+            S::Internal(m) => ApiError::Internal(m),
+        }
+    }
+}
+
 fn bytes_rejection(e: BytesRejection) -> ApiError {
     if e.status() == StatusCode::PAYLOAD_TOO_LARGE {
         ApiError::PayloadTooLarge(

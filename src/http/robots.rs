@@ -15,9 +15,7 @@ use serde_json::{Map, Value};
 pub(crate) use super::input::check_name;
 
 pub(crate) fn robot_not_found(id: i64) -> ApiError {
-    ApiError::NotFound(format!(
-        "robot {id} does not exist; list robots with GET /v1/robots"
-    ))
+    crate::service::ServiceError::robot_not_found(id).into()
 }
 
 /// `POST /v1/robots` body: exactly one of `preset` and `model`; no field may

@@ -1,0 +1,447 @@
+//! Calibration jobs: which sets a job uses, their tracker sessions, the job
+//! runner and its progress, and the model versions a job stores.
+//!
+//! The rows of the chosen sets are read when the job is queued (later changes
+//! to the sets do not affect it). A job waits for one of the `--workers`
+//! slots, then runs `identify::calibrate` on the blocking pool. Progress
+//! (phase, iteration, percent) goes to the store at most every
+//! `progress_interval`; cancellation sets a flag that the progress callback
+//! reads, as does the job's time budget. A successful job stores its report and
+//! **one model version per method** that succeeded (a method that failed is
+//! listed with its reason; the others are kept); the best method (by
+//! validation mean, identification mean without validation) is activated only
+//! when the robot has no active version yet.
+
+use super::{AppState, ServiceError};
+use crate::compensate::{CalibratedModelFile, CompensatedModel};
+use crate::db::{CalibrationRow, JobStatus, NewCalibration, NewVersion, SetRow, StoredRole};
+use crate::http::limits::Ticket;
+use crate::identify::{
+    calibrate, CalibrationError, CalibrationOptions, CalibrationReport, FailedMethod, LmSettings,
+    Method, Progress, TlboSettings,
+};
+use crate::measure::Measurement;
+use crate::model::RobotModel;
+use serde_json::json;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Duration;
+use tokio::sync::watch;
+
+/// Most sets one job may name per role.
+pub const MAX_SETS: usize = crate::http::sets::MAX_SETS;
+
+/// A calibration to start: methods, data and solver settings, checked by the caller.
+#[derive(Debug, Clone)]
+pub struct StartCommand {
+    pub methods: Vec<Method>,
+    /// Sets that identify the model; `None`: every set with role identification.
+    pub identification_set_ids: Option<Vec<i64>>,
+    /// Sets that validate; `None`: every set with role validation.
+    pub validation_set_ids: Option<Vec<i64>>,
+    /// Register the tracker frame per session before fitting.
+    pub register: bool,
+    pub max_iterations: usize,
+    pub population: usize,
+    pub generations: usize,
+    /// Seed of the randomised methods.
+    pub seed: u64,
+    /// Payload for sets that declare none (default: the model's).
+    pub payload_kg: Option<f64>,
+}
+
+fn set_vanished(robot_id: i64, set_id: i64) -> ServiceError {
+    ServiceError::Conflict(format!(
+        "measurement set {set_id} of robot {robot_id} was deleted while the job was being queued"
+    ))
+}
+
+/// Queues a calibration of a robot and starts its job; returns the queued job.
+pub async fn start(
+    state: &AppState,
+    robot_id: i64,
+    cmd: StartCommand,
+) -> Result<CalibrationRow, ServiceError> {
+    let robot = state
+        .db()
+        .robot(robot_id)
+        .await?
+        .ok_or_else(|| ServiceError::robot_not_found(robot_id))?;
+    let nominal = RobotModel::from_json(&robot.model_json)
+        .map_err(|e| ServiceError::Internal(format!("stored model of robot {robot_id}: {e}")))?;
+    let ticket = state.admit_job()?;
+
+    // The sets: named, or every set of the robot with the matching role.
+    let all_sets = state.db().sets(robot_id).await?;
+    // A delete of the robot may have run between the robot lookup and the set
+    // list (the cascade removes its sets): the robot still existing now means
+    // it existed when the sets were read, so the list is that robot's.
+    if state.db().robot(robot_id).await?.is_none() {
+        return Err(ServiceError::robot_not_found(robot_id));
+    }
+    let pick = |ids: &Option<Vec<i64>>,
+                role: StoredRole,
+                field: &str|
+     -> Result<Vec<_>, ServiceError> {
+        match ids {
+            None => Ok(all_sets
+                .iter()
+                .filter(|s| s.role == role)
+                .cloned()
+                .collect()),
+            Some(ids) => {
+                if ids.len() > MAX_SETS {
+                    return Err(ServiceError::Invalid(format!(
+                        "`{field}` lists {} sets; at most {MAX_SETS}",
+                        ids.len()
+                    )));
+                }
+                let mut out: Vec<SetRow> = Vec::new();
+                for id in ids {
+                    // A reference in the body to a set the robot does not
+                    // have (yet): a conflict with its state, not a missing URL.
+                    let s = all_sets.iter().find(|s| s.id == *id).ok_or_else(|| {
+                        ServiceError::Conflict(format!(
+                            "`{field}`: measurement set {id} does not exist for robot {robot_id}; list them with GET /v1/robots/{robot_id}/measurement-sets"
+                        ))
+                    })?;
+                    if !out.iter().any(|o| o.id == s.id) {
+                        out.push(s.clone());
+                    }
+                }
+                Ok(out)
+            }
+        }
+    };
+    let ident_sets = pick(
+        &cmd.identification_set_ids,
+        StoredRole::Identification,
+        "identification_set_ids",
+    )?;
+    let valid_sets = pick(
+        &cmd.validation_set_ids,
+        StoredRole::Validation,
+        "validation_set_ids",
+    )?;
+    if ident_sets.is_empty() {
+        // The robot's data, not the request, is missing: a state conflict.
+        return Err(ServiceError::Conflict(format!(
+            "no identification set: upload one with role identification (POST /v1/robots/{robot_id}/measurement-sets) or list its id in `identification_set_ids`"
+        )));
+    }
+    if let Some(s) = valid_sets
+        .iter()
+        .find(|v| ident_sets.iter().any(|i| i.id == v.id))
+    {
+        return Err(ServiceError::Invalid(format!(
+            "measurement set {} is listed for both identification and validation; validation data must never be used for fitting",
+            s.id
+        )));
+    }
+    // Tracker sessions: identification sessions in order of first appearance.
+    let mut sessions: Vec<String> = Vec::new();
+    for s in &ident_sets {
+        if !sessions.contains(&s.session) {
+            sessions.push(s.session.clone());
+        }
+    }
+    if let Some(v) = valid_sets.iter().find(|v| !sessions.contains(&v.session)) {
+        // A property of the stored sets: a state conflict.
+        return Err(ServiceError::Conflict(format!(
+            "validation set {} was measured in tracker session `{}`, which no identification set has, so its frame cannot be registered; measure identification poses in that session too",
+            v.id, v.session
+        )));
+    }
+    let default_payload = cmd.payload_kg.unwrap_or(nominal.payload.mass);
+    let load = |sets: &[SetRow]| {
+        let state = state.clone();
+        let sets = sets.to_vec();
+        let sessions = sessions.clone();
+        let nominal = nominal.clone();
+        async move {
+            let mut out = Vec::new();
+            for s in &sets {
+                let rows = state
+                    .db()
+                    .set_rows(robot_id, s.id)
+                    .await?
+                    .ok_or_else(|| set_vanished(robot_id, s.id))?;
+                let session = sessions.iter().position(|x| *x == s.session).unwrap_or(0);
+                let payload = s.payload_kg.unwrap_or(default_payload);
+                for r in &rows {
+                    let mut m = r.to_measurement(&nominal, payload);
+                    m.session = session;
+                    out.push(m);
+                }
+            }
+            Ok::<_, ServiceError>(out)
+        }
+    };
+    let ident = load(&ident_sets).await?;
+    let valid = load(&valid_sets).await?;
+
+    let defaults = CalibrationOptions::default();
+    let opts = CalibrationOptions {
+        methods: cmd.methods.clone(),
+        register: cmd.register,
+        lm: LmSettings {
+            max_iterations: cmd.max_iterations,
+            ..defaults.lm.clone()
+        },
+        tlbo: TlboSettings {
+            population: cmd.population,
+            generations: cmd.generations,
+            seed: cmd.seed,
+        },
+        ..defaults
+    };
+    let method_names: Vec<String> = cmd.methods.iter().map(|m| m.name().to_string()).collect();
+    let ident_ids: Vec<i64> = ident_sets.iter().map(|s| s.id).collect();
+    let valid_ids: Vec<i64> = valid_sets.iter().map(|s| s.id).collect();
+    let options = json!({
+        "seed": cmd.seed,
+        "population": opts.tlbo.population,
+        "generations": opts.tlbo.generations,
+        "max_iterations": opts.lm.max_iterations,
+        "register": opts.register,
+        "payload_kg": default_payload,
+    });
+    let row = state
+        .db()
+        .insert_calibration(&NewCalibration {
+            robot_id,
+            methods: &method_names,
+            identification_set_ids: &ident_ids,
+            validation_set_ids: &valid_ids,
+            options: &options,
+        })
+        .await?
+        .ok_or_else(|| ServiceError::robot_not_found(robot_id))?;
+    let job = Job {
+        id: row.id,
+        robot_id,
+        robot_name: robot.name.clone(),
+        nominal,
+        ident,
+        valid,
+        opts,
+        payload_kg: default_payload,
+        ticket,
+    };
+    state.cancel_flag(job.id);
+    tokio::spawn(run_job(state.clone(), job));
+    Ok(row)
+}
+
+/// Everything a queued job needs; the rows are read when it is queued.
+struct Job {
+    id: i64,
+    robot_id: i64,
+    robot_name: String,
+    nominal: RobotModel,
+    ident: Vec<Measurement>,
+    valid: Vec<Measurement>,
+    opts: CalibrationOptions,
+    payload_kg: f64,
+    /// Its place in the job queue, released when the job ends.
+    ticket: Ticket,
+}
+
+/// Writes progress to the database, at most once per `interval`.
+async fn write_progress(
+    state: AppState,
+    id: i64,
+    mut rx: watch::Receiver<Option<Progress>>,
+    interval: Duration,
+) {
+    while rx.changed().await.is_ok() {
+        let p = rx.borrow_and_update().clone();
+        if let Some(p) = p {
+            let pct = if p.percent.is_finite() {
+                p.percent.clamp(0.0, 100.0)
+            } else {
+                0.0
+            };
+            if let Err(e) = state
+                .db()
+                .update_progress(id, &p.phase, p.iteration as i64, pct)
+                .await
+            {
+                tracing::warn!(job = id, error = %e, "cannot store job progress");
+            }
+        }
+        tokio::time::sleep(interval).await;
+    }
+}
+
+async fn run_job(state: AppState, job: Job) {
+    let id = job.id;
+    let robot_id = job.robot_id;
+    let cancel = state.cancel_flag(id);
+    let slots = state.calibration_slots();
+    let Ok(_permit) = slots.acquire_owned().await else {
+        return;
+    };
+    match state.db().start_calibration(id).await {
+        Ok(true) => {}
+        Ok(false) => {
+            // Cancelled while queued, or its robot was deleted.
+            state.drop_cancel_flag(id);
+            return;
+        }
+        Err(e) => {
+            tracing::error!(job = id, error = %e, "cannot start calibration");
+            state.drop_cancel_flag(id);
+            return;
+        }
+    }
+    tracing::info!(job = id, robot = robot_id, "calibration started");
+    let (tx, rx) = watch::channel(None::<Progress>);
+    let writer = tokio::spawn(write_progress(
+        state.clone(),
+        id,
+        rx,
+        state.config().progress_interval,
+    ));
+    let flag = cancel.clone();
+    let Job {
+        robot_name,
+        nominal,
+        ident,
+        valid,
+        opts,
+        payload_kg,
+        ticket: _ticket,
+        ..
+    } = job;
+    // The job's wall-clock budget: past it the job stops like a cancellation
+    // and is reported as failed.
+    let budget = state.limits().job_time;
+    let deadline = std::time::Instant::now() + budget;
+    let over_budget = Arc::new(AtomicBool::new(false));
+    let over = over_budget.clone();
+    let outcome = tokio::task::spawn_blocking(move || {
+        let report = calibrate(&nominal, &ident, &valid, &opts, &|p: &Progress| {
+            tx.send_replace(Some(p.clone()));
+            if std::time::Instant::now() > deadline {
+                over.store(true, Ordering::SeqCst);
+                return false;
+            }
+            !flag.load(Ordering::SeqCst)
+        });
+        drop(tx);
+        report.and_then(|mut r| {
+            let versions = versions_of(&mut r, &nominal, &robot_name, &opts, payload_kg);
+            if versions.is_empty() {
+                return Err(CalibrationError::AllMethodsFailed {
+                    failed: r.failed.clone(),
+                });
+            }
+            Ok((r, versions))
+        })
+    })
+    .await;
+    let _ = writer.await;
+    let db = state.db();
+    let stored = match outcome {
+        Ok(Ok((report, versions))) => {
+            let best = report
+                .best_method()
+                .map(|m| m.method.name().to_string())
+                .unwrap_or_default();
+            match serde_json::to_string(&report) {
+                Ok(text) => db
+                    .finish_calibration_success(robot_id, id, &text, &best, &versions)
+                    .await
+                    .map(|v| {
+                        tracing::info!(job = id, robot = robot_id, best = %best, versions = v.len(), failed = report.failed.len(), "calibration succeeded");
+                    }),
+                Err(e) => {
+                    db.finish_calibration_error(
+                        id,
+                        JobStatus::Failed,
+                        &format!("internal error: {e}"),
+                    )
+                    .await
+                }
+            }
+        }
+        Ok(Err(CalibrationError::Cancelled)) if over_budget.load(Ordering::SeqCst) => {
+            tracing::info!(job = id, "calibration stopped at its time budget");
+            db.finish_calibration_error(
+                id,
+                JobStatus::Failed,
+                &format!(
+                    "stopped after the job time budget of {} s (`--job-time-limit`); use fewer poses, generations or a smaller population",
+                    budget.as_secs()
+                ),
+            )
+            .await
+        }
+        Ok(Err(CalibrationError::Cancelled)) => {
+            tracing::info!(job = id, "calibration cancelled");
+            db.finish_calibration_error(id, JobStatus::Cancelled, "cancelled by request")
+                .await
+        }
+        Ok(Err(e)) => {
+            tracing::info!(job = id, error = %e, "calibration failed");
+            db.finish_calibration_error(id, JobStatus::Failed, &e.to_string())
+                .await
+        }
+        Err(e) => {
+            tracing::error!(job = id, error = %e, "calibration task panicked");
+            db.finish_calibration_error(id, JobStatus::Failed, "internal error in the calibration")
+                .await
+        }
+    };
+    if let Err(e) = stored {
+        tracing::error!(job = id, error = %e, "cannot store the calibration outcome");
+    }
+    state.drop_cancel_flag(id);
+    state.invalidate_robot(robot_id);
+}
+
+/// One calibrated model file per method, in the order the methods ran. A
+/// method whose file does not load back (what solve would use) moves from the
+/// report's methods to its failed list; the others are stored.
+fn versions_of(
+    r: &mut CalibrationReport,
+    nominal: &RobotModel,
+    robot_name: &str,
+    opts: &CalibrationOptions,
+    payload_kg: f64,
+) -> Vec<NewVersion> {
+    let cell_from_base = r.tracker_to_base.inverse();
+    let mut out = Vec::new();
+    for method in &opts.methods {
+        let Some(m) = r.methods.get(method.name()) else {
+            continue;
+        };
+        let cm = CompensatedModel {
+            calibrated: m.calibrated.clone(),
+            nominal: nominal.clone(),
+            cell_from_base,
+            payload_kg,
+            compensator: None,
+        };
+        let file = CalibratedModelFile::from_compensated(&cm, robot_name, method.name());
+        if let Err(e) = file.to_compensated() {
+            r.methods.remove(method.name());
+            r.failed.push(FailedMethod {
+                method: *method,
+                reason: format!("the {} model does not load back: {e}", method.name()),
+            });
+            continue;
+        }
+        let stats = json!({
+            "identification": m.identification.stats,
+            "validation": m.validation.as_ref().map(|v| &v.stats),
+        });
+        out.push(NewVersion {
+            method: method.name().to_string(),
+            model_json: file.to_json(),
+            stats,
+        });
+    }
+    out
+}

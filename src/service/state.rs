@@ -1,0 +1,230 @@
+//! Shared state of the service: the store, settings, the bounded job and
+//! solve queues, cancellation flags and the caches of robots and prepared
+//! solvers.
+
+use super::ServiceError;
+use crate::db::Db;
+use crate::http::limits::{Admission, Limits, Ticket, SMALL_SOLVE_MAX};
+use crate::ik::IkSolver;
+use std::collections::HashMap;
+use std::sync::atomic::AtomicBool;
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+use tokio::sync::Semaphore;
+
+/// Service settings that are not the database.
+#[derive(Clone)]
+pub struct ServiceConfig {
+    /// Accepted API keys; empty: writes are open.
+    pub api_keys: Vec<String>,
+    /// Calibration jobs that run at the same time.
+    pub workers: usize,
+    /// Large solve batches that run at the same time.
+    pub solve_workers: usize,
+    /// Shortest interval between two progress writes of a job.
+    pub progress_interval: Duration,
+    /// Sizes, queues and budgets.
+    pub limits: Limits,
+}
+
+/// Keys are redacted: a config printed by mistake leaks nothing.
+impl std::fmt::Debug for ServiceConfig {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ServiceConfig")
+            .field(
+                "api_keys",
+                &format_args!("[{} redacted]", self.api_keys.len()),
+            )
+            .field("workers", &self.workers)
+            .field("solve_workers", &self.solve_workers)
+            .field("progress_interval", &self.progress_interval)
+            .field("limits", &self.limits)
+            .finish()
+    }
+}
+
+impl Default for ServiceConfig {
+    fn default() -> Self {
+        ServiceConfig {
+            api_keys: Vec::new(),
+            workers: 1,
+            solve_workers: 2,
+            progress_interval: Duration::from_millis(250),
+            limits: Limits::default(),
+        }
+    }
+}
+
+/// The active model version of a robot, as the solve endpoint needs it.
+#[derive(Debug, Clone)]
+pub struct RobotContext {
+    pub robot_id: i64,
+    pub name: String,
+    pub model_json: String,
+    pub dof: usize,
+    /// (row id, version number, method) of the active version.
+    pub active: Option<(i64, i64, String)>,
+}
+
+/// Cache key of a prepared solver: robot, version row (None: nominal model),
+/// payload override bits.
+type SolverKey = (i64, Option<i64>, Option<u64>);
+
+/// Shared state of the service.
+#[derive(Clone)]
+pub struct AppState {
+    inner: Arc<Inner>,
+}
+
+struct Inner {
+    db: Db,
+    config: ServiceConfig,
+    calibration_slots: Arc<Semaphore>,
+    solve_slots: Arc<Semaphore>,
+    /// Calibration jobs running or waiting (workers + queued_jobs).
+    job_gate: Arc<Admission>,
+    /// Large solve batches running or waiting (solve_workers + queued_solves).
+    solve_gate: Arc<Admission>,
+    cancel_flags: Mutex<HashMap<i64, Arc<AtomicBool>>>,
+    robots: Mutex<HashMap<i64, Arc<RobotContext>>>,
+    solvers: Mutex<HashMap<SolverKey, Arc<IkSolver>>>,
+}
+
+/// Prepared solvers kept in memory (model versions are immutable).
+const SOLVER_CACHE_MAX: usize = 64;
+
+impl AppState {
+    pub fn new(db: Db, config: ServiceConfig) -> Self {
+        let workers = config.workers.max(1);
+        let solve_workers = config.solve_workers.max(1);
+        AppState {
+            inner: Arc::new(Inner {
+                db,
+                calibration_slots: Arc::new(Semaphore::new(workers)),
+                solve_slots: Arc::new(Semaphore::new(solve_workers)),
+                job_gate: Admission::new(workers + config.limits.queued_jobs),
+                solve_gate: Admission::new(solve_workers + config.limits.queued_solves),
+                config,
+                cancel_flags: Mutex::new(HashMap::new()),
+                robots: Mutex::new(HashMap::new()),
+                solvers: Mutex::new(HashMap::new()),
+            }),
+        }
+    }
+
+    pub fn db(&self) -> &Db {
+        &self.inner.db
+    }
+
+    pub fn config(&self) -> &ServiceConfig {
+        &self.inner.config
+    }
+
+    pub(crate) fn calibration_slots(&self) -> Arc<Semaphore> {
+        self.inner.calibration_slots.clone()
+    }
+
+    pub(crate) fn solve_slots(&self) -> Arc<Semaphore> {
+        self.inner.solve_slots.clone()
+    }
+
+    pub fn limits(&self) -> &Limits {
+        &self.inner.config.limits
+    }
+
+    /// A place for a calibration job, or 429 with `Retry-After` when
+    /// `workers + queued_jobs` jobs are already running or waiting.
+    pub(crate) fn admit_job(&self) -> Result<Ticket, ServiceError> {
+        let gate = &self.inner.job_gate;
+        gate.try_admit().ok_or_else(|| ServiceError::Busy {
+            detail: format!(
+                "{} calibration jobs are running or queued, the most this service takes (--workers {} + --max-queued-jobs {}); retry later or cancel a job",
+                gate.in_flight(),
+                self.config().workers.max(1),
+                self.limits().queued_jobs
+            ),
+            retry_after_s: 10,
+        })
+    }
+
+    /// A place for a large solve batch, or 429 with `Retry-After`.
+    pub(crate) fn admit_solve(&self) -> Result<Ticket, ServiceError> {
+        let gate = &self.inner.solve_gate;
+        gate.try_admit().ok_or_else(|| ServiceError::Busy {
+            detail: format!(
+                "{} large solve batches are running or queued, the most this service takes (--solve-workers {} + --max-queued-solves {}); retry later, or send batches of at most {SMALL_SOLVE_MAX} targets, which are never queued",
+                gate.in_flight(),
+                self.config().solve_workers.max(1),
+                self.limits().queued_solves
+            ),
+            retry_after_s: 1,
+        })
+    }
+
+    pub(crate) fn cancel_flag(&self, job: i64) -> Arc<AtomicBool> {
+        lock(&self.inner.cancel_flags)
+            .entry(job)
+            .or_insert_with(|| Arc::new(AtomicBool::new(false)))
+            .clone()
+    }
+
+    pub(crate) fn existing_cancel_flag(&self, job: i64) -> Option<Arc<AtomicBool>> {
+        lock(&self.inner.cancel_flags).get(&job).cloned()
+    }
+
+    pub(crate) fn drop_cancel_flag(&self, job: i64) {
+        lock(&self.inner.cancel_flags).remove(&job);
+    }
+
+    /// Forgets what is cached about a robot (after its versions changed or it was deleted).
+    pub(crate) fn invalidate_robot(&self, robot_id: i64) {
+        lock(&self.inner.robots).remove(&robot_id);
+        lock(&self.inner.solvers).retain(|k, _| k.0 != robot_id);
+    }
+
+    /// The robot and its active version, cached.
+    pub(crate) async fn robot_context(
+        &self,
+        robot_id: i64,
+    ) -> Result<Arc<RobotContext>, ServiceError> {
+        if let Some(c) = lock(&self.inner.robots).get(&robot_id) {
+            return Ok(c.clone());
+        }
+        let robot = self
+            .db()
+            .robot(robot_id)
+            .await?
+            .ok_or_else(|| ServiceError::robot_not_found(robot_id))?;
+        let active = self
+            .db()
+            .active_version(robot_id)
+            .await?
+            .map(|v| (v.id, v.version, v.method));
+        let ctx = Arc::new(RobotContext {
+            robot_id,
+            name: robot.name,
+            model_json: robot.model_json,
+            dof: robot.dof as usize,
+            active,
+        });
+        lock(&self.inner.robots).insert(robot_id, ctx.clone());
+        Ok(ctx)
+    }
+
+    pub(crate) fn cached_solver(&self, key: &SolverKey) -> Option<Arc<IkSolver>> {
+        lock(&self.inner.solvers).get(key).cloned()
+    }
+
+    pub(crate) fn cache_solver(&self, key: SolverKey, solver: Arc<IkSolver>) {
+        let mut cache = lock(&self.inner.solvers);
+        if cache.len() >= SOLVER_CACHE_MAX {
+            cache.clear();
+        }
+        cache.insert(key, solver);
+    }
+}
+
+/// Locks a mutex, recovering from poisoning (the guarded maps stay consistent).
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
+}
