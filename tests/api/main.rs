@@ -1,0 +1,16 @@
+//! The HTTP API against a real SQLite file in a temporary directory, driven
+//! in-process through the router (`tower::ServiceExt::oneshot`).
+//!
+//! Every response is checked against `openapi.yaml`: its status must be
+//! documented for the route and method, and a JSON body must validate against
+//! the documented schema (JSON Schema 2020-12, via `jsonschema`).
+//!
+//! One file per theme: `contract` (routes, spec, bad input, keys, paging),
+//! `flow` (the quickstart end to end), `sets` (uploads), `jobs` (progress,
+//! cancellation, saturation, races); the harness is `support`.
+
+mod contract;
+mod flow;
+mod jobs;
+mod sets;
+mod support;

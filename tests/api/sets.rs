@@ -1,0 +1,190 @@
+use crate::support::*;
+use axum::http::StatusCode;
+use robocal::measure::{csv, MeasuredPose, SetRole};
+use robocal::model::preset;
+use serde_json::{json, Value};
+
+#[tokio::test]
+async fn csv_and_json_uploads_are_stored_losslessly() {
+    let t = setup().await;
+    let robot = t.create_robot("ys100").await;
+    let rid = robot.to_string();
+
+    // CSV: rows read back bit for bit; the original text verbatim.
+    let text = simulated_csv(3, 25);
+    let set = t.upload_csv(robot, &text, "?session=tracker-A").await;
+    assert_eq!(set["role"], "identification");
+    assert_eq!(set["session"], "tracker-A");
+    assert_eq!(set["format"], "csv");
+    let sid = set["id"].as_i64().unwrap().to_string();
+    let r = t
+        .get("/v1/robots/{id}/measurement-sets/{sid}", &[&rid, &sid])
+        .await;
+    let rows: Vec<MeasuredPose> = serde_json::from_value(r.json()["rows"].clone()).unwrap();
+    assert_eq!(rows, csv::parse(&text).unwrap());
+    let r = t
+        .get(
+            "/v1/robots/{id}/measurement-sets/{sid}/original",
+            &[&rid, &sid],
+        )
+        .await;
+    assert!(r.content_type.starts_with("text/csv"));
+    assert_eq!(r.text(), text);
+
+    // JSON: every optional field, role taken from the rows' common `set`.
+    let mut rows = simulated_rows(4, 10, Some(SetRole::Validation));
+    rows[0].rpy_deg = Some([1.5, -2.25, 179.0]);
+    rows[1].temperature_c = Some(21.5);
+    rows[2].payload_kg = Some(55.5);
+    let body = json!({ "name": "q3", "payload_kg": 110.0, "rows": rows });
+    let r = t
+        .post_json("/v1/robots/{id}/measurement-sets", &[&rid], body.clone())
+        .await;
+    assert_eq!(r.status, StatusCode::CREATED, "{}", r.text());
+    assert_eq!(r.json()["role"], "validation");
+    assert_eq!(r.json()["format"], "json");
+    let sid2 = r.json()["id"].as_i64().unwrap().to_string();
+    let r = t
+        .get("/v1/robots/{id}/measurement-sets/{sid}", &[&rid, &sid2])
+        .await;
+    let back: Vec<MeasuredPose> = serde_json::from_value(r.json()["rows"].clone()).unwrap();
+    assert_eq!(back, rows);
+
+    // Declared units: metres and radians are converted to mm and deg.
+    let si: Vec<Value> = rows
+        .iter()
+        .map(|r| {
+            json!({ "q": r.q_deg.iter().map(|d| d.to_radians()).collect::<Vec<_>>(),
+                    "xyz": r.xyz_mm.map(|v| v / 1e3) })
+        })
+        .collect();
+    let r = t
+        .post_json(
+            "/v1/robots/{id}/measurement-sets",
+            &[&rid],
+            json!({ "length_unit": "m", "angle_unit": "rad", "rows": si }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::CREATED, "{}", r.text());
+    assert_eq!(r.json()["units"]["length"], "m");
+    let sid3 = r.json()["id"].as_i64().unwrap().to_string();
+    let r = t
+        .get("/v1/robots/{id}/measurement-sets/{sid}", &[&rid, &sid3])
+        .await;
+    let conv: Vec<MeasuredPose> = serde_json::from_value(r.json()["rows"].clone()).unwrap();
+    for (a, b) in conv.iter().zip(&rows) {
+        assert!((a.xyz_mm[0] - b.xyz_mm[0]).abs() < 1e-9);
+        assert!((a.q_deg[1] - b.q_deg[1]).abs() < 1e-9);
+    }
+    // A CSV in metres.
+    let metres =
+        "q1,q2,q3,q4,q5,q6,x,y,z\n0,90,0,0,0,0,1.5,-3.2,1.1\n10,80,5,0,20,0,1.4,-3.1,1.2\n";
+    let set = t
+        .upload_csv(robot, metres, "?length_unit=m&role=training")
+        .await;
+    let sid4 = set["id"].as_i64().unwrap().to_string();
+    let r = t
+        .get("/v1/robots/{id}/measurement-sets/{sid}", &[&rid, &sid4])
+        .await;
+    assert_eq!(
+        r.json()["rows"][0]["xyz_mm"],
+        json!([1500.0, -3200.0, 1100.0])
+    );
+
+    // List, delete.
+    let r = t.get("/v1/robots/{id}/measurement-sets", &[&rid]).await;
+    assert_eq!(r.json()["measurement_sets"].as_array().unwrap().len(), 4);
+    assert!(r.json()["measurement_sets"][0].get("rows").is_none());
+    let r = t
+        .send(
+            "DELETE",
+            "/v1/robots/{id}/measurement-sets/{sid}",
+            &[&rid, &sid],
+            "",
+            None,
+            vec![],
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::NO_CONTENT);
+    let r = t
+        .get("/v1/robots/{id}/measurement-sets/{sid}", &[&rid, &sid])
+        .await;
+    assert_eq!(r.status, StatusCode::NOT_FOUND);
+    assert!(r.detail().contains("measurement set"));
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn payloads_beyond_10_tonnes_are_refused_before_any_work() {
+    let t = setup().await;
+    let robot = t.create_robot("ys100").await;
+    let rid = robot.to_string();
+    t.upload_csv(robot, &simulated_csv(5, 30), "?role=identification")
+        .await;
+    // The calibration that used to panic the worker.
+    for p in ["1e308", "1e200", "10000.5", "-1"] {
+        let r = t
+            .send(
+                "POST",
+                "/v1/robots/{id}/calibrations",
+                &[&rid],
+                "",
+                Some("application/json"),
+                format!(r#"{{"methods": ["km"], "payload_kg": {p}}}"#).into_bytes(),
+            )
+            .await;
+        assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{p}");
+        assert!(r.detail().contains("payload_kg"), "{}", r.detail());
+    }
+    let r = t.get("/v1/robots/{id}/calibrations", &[&rid]).await;
+    assert_eq!(r.json()["total"], 0, "no job was queued");
+    // Uploads: the query, a JSON row, a CSV column.
+    let r = t
+        .send(
+            "POST",
+            "/v1/robots/{id}/measurement-sets",
+            &[&rid],
+            "?payload_kg=1e308",
+            Some("text/csv"),
+            simulated_csv(6, 30).into_bytes(),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY);
+    let mut rows = simulated_rows(7, 30, None);
+    rows[3].payload_kg = Some(1e308);
+    let r = t
+        .post_json(
+            "/v1/robots/{id}/measurement-sets",
+            &[&rid],
+            json!({ "rows": rows.iter().map(|r| json!({"q": r.q_deg, "xyz": r.xyz_mm, "payload_kg": r.payload_kg})).collect::<Vec<_>>() }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY);
+    assert!(r.detail().contains("row 4"), "{}", r.detail());
+    let csv_text = csv::write(&rows);
+    let r = t
+        .send(
+            "POST",
+            "/v1/robots/{id}/measurement-sets",
+            &[&rid],
+            "",
+            Some("text/csv"),
+            csv_text.into_bytes(),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+    // Solve and robot models.
+    let r = t
+        .post_json(
+            "/v1/robots/{id}/solve",
+            &[&rid],
+            json!({"version": "nominal", "payload_kg": 1e308, "targets": [{"x": 1500, "y": 0, "z": 1200}]}),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY);
+    let mut model: Value = serde_json::from_str(&preset("ys100").unwrap().to_json()).unwrap();
+    model["payload"]["mass_kg"] = json!(1e308);
+    let r = t
+        .post_json("/v1/robots", &[], json!({ "model": model }))
+        .await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+}

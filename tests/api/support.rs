@@ -1,0 +1,387 @@
+//! The test harness: the router on a temporary SQLite file, requests, and
+//! every response checked against `openapi.yaml`; simulated measurements.
+#![allow(dead_code)]
+
+use axum::body::Body;
+use axum::http::{header, Request, StatusCode};
+use axum::Router;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use robocal::db::Db;
+use robocal::http::{app, AppState, ServiceConfig, OPENAPI_YAML};
+use robocal::measure::{csv, MeasuredPose, SetRole};
+use robocal::model::preset;
+use robocal::sim::{
+    tracker_frame, try_random_configurations, ys100_table_7_1, PoseFilter, TrueRobot,
+};
+use serde_json::{json, Value};
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+use tower::ServiceExt;
+
+pub(crate) struct Spec {
+    pub(crate) doc: Value,
+    pub(crate) validators: Mutex<HashMap<String, Arc<jsonschema::Validator>>>,
+}
+
+impl Spec {
+    pub(crate) fn load() -> Spec {
+        let yaml: serde_yaml::Value =
+            serde_yaml::from_str(OPENAPI_YAML).expect("openapi.yaml parses");
+        let doc: Value = serde_json::to_value(yaml).expect("openapi.yaml is JSON-compatible");
+        Spec {
+            doc,
+            validators: Mutex::new(HashMap::new()),
+        }
+    }
+
+    pub(crate) fn deref<'a>(&'a self, v: &'a Value) -> &'a Value {
+        match v.get("$ref").and_then(Value::as_str) {
+            Some(r) => self
+                .doc
+                .pointer(r.trim_start_matches('#'))
+                .unwrap_or_else(|| panic!("dangling $ref {r}")),
+            None => v,
+        }
+    }
+
+    pub(crate) fn validator(&self, schema: &Value) -> Arc<jsonschema::Validator> {
+        let key = schema.to_string();
+        if let Some(v) = self.validators.lock().unwrap().get(&key) {
+            return v.clone();
+        }
+        let mut root = json!({
+            "$schema": "https://json-schema.org/draft/2020-12/schema",
+            "components": self.doc["components"].clone(),
+        });
+        for (k, v) in schema.as_object().expect("schema is an object") {
+            root[k] = v.clone();
+        }
+        let v = Arc::new(jsonschema::validator_for(&root).expect("schema compiles"));
+        self.validators.lock().unwrap().insert(key, v.clone());
+        v
+    }
+
+    /// Validates `value` against component schema `name`.
+    pub(crate) fn validate_component(&self, name: &str, value: &Value) {
+        let schema = json!({ "$ref": format!("#/components/schemas/{name}") });
+        self.validate(&schema, value, name);
+    }
+
+    pub(crate) fn validate(&self, schema: &Value, value: &Value, what: &str) {
+        let v = self.validator(schema);
+        let errors: Vec<String> = v
+            .iter_errors(value)
+            .map(|e| format!("{} at {}", e, e.instance_path))
+            .collect();
+        assert!(
+            errors.is_empty(),
+            "{what}: response does not match openapi.yaml:\n{}\n{}",
+            errors.join("\n"),
+            serde_json::to_string_pretty(value).unwrap()
+        );
+    }
+
+    /// Checks a response against the documented responses of `method template`.
+    pub(crate) fn check(
+        &self,
+        method: &str,
+        template: &str,
+        status: u16,
+        content_type: &str,
+        body: &[u8],
+    ) {
+        let op = &self.doc["paths"][template][method.to_ascii_lowercase()];
+        assert!(op.is_object(), "{method} {template} is not in openapi.yaml");
+        let resp = op["responses"]
+            .get(status.to_string())
+            .unwrap_or_else(|| panic!("{method} {template}: status {status} is not documented"));
+        let resp = self.deref(resp);
+        let ct = content_type.split(';').next().unwrap_or("").trim();
+        if status == 204 {
+            assert!(body.is_empty());
+            return;
+        }
+        let media = &resp["content"][ct];
+        assert!(
+            media.is_object(),
+            "{method} {template} {status}: content type {ct} is not documented"
+        );
+        if ct.ends_with("json") {
+            let value: Value = serde_json::from_slice(body).expect("JSON body");
+            self.validate(
+                &media["schema"],
+                &value,
+                &format!("{method} {template} {status}"),
+            );
+        }
+    }
+}
+
+pub(crate) struct TestApp {
+    pub(crate) router: Router,
+    pub(crate) state: AppState,
+    pub(crate) spec: Arc<Spec>,
+    pub(crate) _dir: tempfile::TempDir,
+    pub(crate) key: Option<String>,
+}
+
+#[derive(Debug)]
+pub(crate) struct Resp {
+    pub(crate) status: StatusCode,
+    pub(crate) content_type: String,
+    pub(crate) headers: axum::http::HeaderMap,
+    pub(crate) body: Vec<u8>,
+}
+
+impl Resp {
+    pub(crate) fn json(&self) -> Value {
+        serde_json::from_slice(&self.body)
+            .unwrap_or_else(|e| panic!("not JSON ({e}): {}", String::from_utf8_lossy(&self.body)))
+    }
+    pub(crate) fn text(&self) -> String {
+        String::from_utf8(self.body.clone()).unwrap()
+    }
+    pub(crate) fn detail(&self) -> String {
+        assert_eq!(
+            self.content_type,
+            "application/problem+json",
+            "{:?}",
+            self.text()
+        );
+        let p = self.json();
+        assert_eq!(p["status"].as_u64(), Some(self.status.as_u16() as u64));
+        p["detail"].as_str().unwrap().to_string()
+    }
+}
+
+pub(crate) async fn setup_with(keys: &[&str], workers: usize) -> TestApp {
+    setup_config(ServiceConfig {
+        api_keys: keys.iter().map(|k| k.to_string()).collect(),
+        workers,
+        solve_workers: 2,
+        progress_interval: Duration::from_millis(20),
+        ..ServiceConfig::default()
+    })
+    .await
+}
+
+pub(crate) async fn setup_config(config: ServiceConfig) -> TestApp {
+    let dir = tempfile::tempdir().unwrap();
+    let url = format!("sqlite://{}?mode=rwc", dir.path().join("api.db").display());
+    let db = Db::connect(&url).await.unwrap();
+    let keys = config.api_keys.clone();
+    let state = AppState::new(db, config);
+    TestApp {
+        router: app(state.clone()),
+        state,
+        spec: Arc::new(Spec::load()),
+        _dir: dir,
+        key: keys.first().cloned(),
+    }
+}
+
+pub(crate) async fn setup() -> TestApp {
+    setup_with(&[], 1).await
+}
+
+pub(crate) fn fill(template: &str, args: &[&str]) -> String {
+    let mut out = template.to_string();
+    for a in args {
+        let start = out.find('{').expect("more args than parameters");
+        let end = start + out[start..].find('}').unwrap();
+        out.replace_range(start..=end, a);
+    }
+    assert!(!out.contains('{'), "missing path arguments for {template}");
+    out
+}
+
+impl TestApp {
+    /// Sends a request to `template` filled with `args` (+ `query`), checks
+    /// the response against the spec and returns it.
+    pub(crate) async fn send(
+        &self,
+        method: &str,
+        template: &str,
+        args: &[&str],
+        query: &str,
+        content_type: Option<&str>,
+        body: Vec<u8>,
+    ) -> Resp {
+        let uri = fill(template, args) + query;
+        let resp = self
+            .raw(method, &uri, content_type, body, self.key.as_deref())
+            .await;
+        self.spec.check(
+            method,
+            template,
+            resp.status.as_u16(),
+            &resp.content_type,
+            &resp.body,
+        );
+        resp
+    }
+
+    pub(crate) async fn raw(
+        &self,
+        method: &str,
+        uri: &str,
+        content_type: Option<&str>,
+        body: Vec<u8>,
+        key: Option<&str>,
+    ) -> Resp {
+        let mut req = Request::builder().method(method).uri(uri);
+        if let Some(ct) = content_type {
+            req = req.header(header::CONTENT_TYPE, ct);
+        }
+        if let Some(k) = key {
+            req = req.header(header::AUTHORIZATION, format!("Bearer {k}"));
+        }
+        let res = self
+            .router
+            .clone()
+            .oneshot(req.body(Body::from(body)).unwrap())
+            .await
+            .unwrap();
+        let status = res.status();
+        let headers = res.headers().clone();
+        let content_type = headers
+            .get(header::CONTENT_TYPE)
+            .map(|v| v.to_str().unwrap().to_string())
+            .unwrap_or_default();
+        let body = axum::body::to_bytes(res.into_body(), usize::MAX)
+            .await
+            .unwrap()
+            .to_vec();
+        if status.is_client_error() || status.is_server_error() {
+            assert_eq!(content_type, "application/problem+json", "{method} {uri}");
+            self.spec
+                .validate_component("Problem", &serde_json::from_slice(&body).unwrap());
+        }
+        Resp {
+            status,
+            content_type,
+            headers,
+            body,
+        }
+    }
+
+    pub(crate) async fn get(&self, template: &str, args: &[&str]) -> Resp {
+        self.send("GET", template, args, "", None, Vec::new()).await
+    }
+
+    pub(crate) async fn post_json(&self, template: &str, args: &[&str], body: Value) -> Resp {
+        self.send(
+            "POST",
+            template,
+            args,
+            "",
+            Some("application/json"),
+            body.to_string().into_bytes(),
+        )
+        .await
+    }
+
+    pub(crate) async fn create_robot(&self, preset: &str) -> i64 {
+        let r = self
+            .post_json(
+                "/v1/robots",
+                &[],
+                json!({ "preset": preset, "name": "cell-3" }),
+            )
+            .await;
+        assert_eq!(r.status, StatusCode::CREATED, "{}", r.text());
+        r.json()["id"].as_i64().unwrap()
+    }
+
+    pub(crate) async fn upload_csv(&self, robot: i64, text: &str, query: &str) -> Value {
+        let r = self
+            .send(
+                "POST",
+                "/v1/robots/{id}/measurement-sets",
+                &[&robot.to_string()],
+                query,
+                Some("text/csv"),
+                text.as_bytes().to_vec(),
+            )
+            .await;
+        assert_eq!(r.status, StatusCode::CREATED, "{}", r.text());
+        r.json()
+    }
+
+    /// Polls a job until it reaches one of `states`.
+    pub(crate) async fn wait_for(
+        &self,
+        robot: i64,
+        job: i64,
+        states: &[&str],
+        timeout: Duration,
+    ) -> Value {
+        let start = Instant::now();
+        loop {
+            let r = self
+                .get(
+                    "/v1/robots/{id}/calibrations/{cid}",
+                    &[&robot.to_string(), &job.to_string()],
+                )
+                .await;
+            assert_eq!(r.status, StatusCode::OK);
+            let j = r.json();
+            if states.contains(&j["status"].as_str().unwrap()) {
+                return j;
+            }
+            assert!(
+                start.elapsed() < timeout,
+                "job {job} still {} after {timeout:?}: {j}",
+                j["status"]
+            );
+            tokio::time::sleep(Duration::from_millis(25)).await;
+        }
+    }
+}
+
+/// The simulated YS100 of the seed's §7.4 (Table 7.1 + 7.2), measured by a
+/// tracker 3.24 m away and turned 90°.
+pub(crate) fn truth() -> TrueRobot {
+    let mut t = TrueRobot::new(ys100_table_7_1());
+    t.tracker_from_base = tracker_frame(0.0, 0.0, 90.0, [500.0, -3240.0, 0.0]);
+    t.noise_mm = 0.01;
+    t
+}
+
+pub(crate) fn simulated_rows(seed: u64, n: usize, set: Option<SetRole>) -> Vec<MeasuredPose> {
+    let t = truth();
+    let nominal = preset("ys100").unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let qs = try_random_configurations(&nominal, n, &PoseFilter::default(), &mut rng, |q| {
+        t.true_position(q, Some(110.0)).is_ok()
+    })
+    .unwrap();
+    t.measure(&qs, Some(110.0), set, &mut rng).unwrap()
+}
+
+pub(crate) fn simulated_csv(seed: u64, n: usize) -> String {
+    format!(
+        "# simulated YS100\n{}",
+        csv::write(&simulated_rows(seed, n, None))
+    )
+}
+
+/// Parses a server timestamp (UTC, RFC 3339 with milliseconds) into seconds
+/// since an arbitrary epoch that is the same for every timestamp of one day.
+pub(crate) fn seconds_of_day(ts: &str) -> f64 {
+    let t = ts.split('T').nth(1).unwrap().trim_end_matches('Z');
+    let mut parts = t.split(':');
+    let h: f64 = parts.next().unwrap().parse().unwrap();
+    let m: f64 = parts.next().unwrap().parse().unwrap();
+    let s: f64 = parts.next().unwrap().parse().unwrap();
+    let day: f64 = ts[8..10].parse().unwrap();
+    ((day * 24.0 + h) * 60.0 + m) * 60.0 + s
+}
+
+pub(crate) fn targets_small() -> Vec<Value> {
+    (0..20)
+        .map(|i| json!({"x": 1500.0, "y": i as f64 * 10.0, "z": 1200.0}))
+        .collect()
+}
