@@ -12,7 +12,9 @@
 //! - `x, y, z`: TCP position [mm] in the measurement (cell) frame, or in the
 //!   registered base frame with `--frame base`;
 //! - the orientation columns of exactly one convention, angles in degrees:
-//!   `qw,qx,qy,qz` (quaternion, ABB) | `a,b,c` (KUKA, `Rz(A)·Ry(B)·Rx(C)`) |
+//!   `qw,qx,qy,qz` (quaternion) | `q1,q2,q3,q4` (ABB, q1 scalar) |
+//!   `ur_rx_rad,ur_ry_rad,ur_rz_rad` (UR rotation vector, radians) |
+//!   `a,b,c` (KUKA, `Rz(A)·Ry(B)·Rx(C)`) |
 //!   `w,p,r` (Fanuc, `Rz(R)·Ry(P)·Rx(W)`) | `r11..r33` (row-major matrix).
 //!   With `--position-only` they may be omitted (or left empty in a row).
 //!
@@ -43,7 +45,8 @@ pub struct SolveArgs {
     #[arg(long)]
     pub model: String,
     /// Targets CSV: optional `id`, `x,y,z` [mm] and the orientation columns of
-    /// one convention, angles in degrees: `qw,qx,qy,qz` (quaternion) | `a,b,c`
+    /// one convention, angles in degrees: `qw,qx,qy,qz` (quaternion) |
+    /// `q1,q2,q3,q4` (ABB) | `ur_rx_rad,ur_ry_rad,ur_rz_rad` (UR, radians) | `a,b,c`
     /// (KUKA) | `w,p,r` (Fanuc) | `r11..r33` (matrix); `#` starts a comment line.
     #[arg(long)]
     pub targets: String,
@@ -125,7 +128,7 @@ pub fn parse_targets_csv(text: &str) -> anyhow::Result<TargetsCsv> {
     if let Some(c) = cols.iter().find(|c| !known(c)) {
         bail!(
             "line {hline}: unknown column `{c}`; expected id, x, y, z and the orientation \
-             columns of one convention: qw,qx,qy,qz | a,b,c | w,p,r | r11..r33"
+             columns of one convention: qw,qx,qy,qz | q1,q2,q3,q4 | a,b,c | w,p,r | ur_rx_rad,ur_ry_rad,ur_rz_rad | r11..r33"
         );
     }
     let xyz: Vec<usize> = ["x", "y", "z"]
@@ -277,7 +280,7 @@ pub fn solve_to_string(a: &SolveArgs) -> anyhow::Result<String> {
     let csv = parse_targets_csv(&text).with_context(|| a.targets.clone())?;
     if csv.convention.is_none() && !a.position_only {
         bail!(
-            "{}: no orientation columns (qw,qx,qy,qz | a,b,c | w,p,r | r11..r33); add them or pass --position-only",
+            "{}: no orientation columns (qw,qx,qy,qz | q1,q2,q3,q4 | a,b,c | w,p,r | ur_rx_rad,ur_ry_rad,ur_rz_rad | r11..r33); add them or pass --position-only",
             a.targets
         );
     }

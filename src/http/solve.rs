@@ -32,17 +32,22 @@ use std::time::Instant;
 
 /// Names of the orientation conventions as `openapi.yaml` lists them
 /// (canonical names and aliases, lower case).
-pub const CONVENTION_NAMES: [&str; 12] = [
+pub const CONVENTION_NAMES: [&str; 17] = [
     "quaternion",
     "quat",
     "wxyz",
     "abb",
+    "abb_q1q4",
+    "q1q4",
     "kuka_abc",
     "abc",
     "kuka",
     "fanuc_wpr",
     "wpr",
     "fanuc",
+    "ur_rotvec",
+    "rotvec",
+    "rotation_vector",
     "matrix",
     "rotation_matrix",
 ];

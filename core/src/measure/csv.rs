@@ -11,7 +11,9 @@
 //! - `q1..qN`: controller joint readings [deg], N = 2..7, contiguous.
 //! - `x, y, z`: measured TCP position in the measurement (tracker) frame [mm].
 //! - `rx, ry, rz` (optional, all three or none): measured orientation as fixed-axis
-//!   XYZ angles [deg], `R = Rz(rz)·Ry(ry)·Rx(rx)`.
+//!   XYZ angles in DEGREES, `R = Rz(rz)·Ry(ry)·Rx(rx)` — not a rotation vector
+//!   (a UR controller's `rx, ry, rz`). The explicit names `rx_deg, ry_deg,
+//!   rz_deg` are accepted for the same columns and say so in the file.
 //! - `payload_kg`, `temperature_c`, `set` (optional). `set` is `identification`,
 //!   `training` or `validation` (also `q1`, `q2`, `q3`).
 //!
@@ -75,7 +77,9 @@ fn short_text(s: &str) -> String {
     }
 }
 
-const ACCEPTED: &str = "q1..q7 (alias joint_1..joint_7), x, y, z, rx, ry, rz, payload_kg, \
+const ACCEPTED: &str =
+    "q1..q7 (alias joint_1..joint_7), x, y, z, rx, ry, rz (fixed-axis XYZ degrees, \
+alias rx_deg, ry_deg, rz_deg), payload_kg, \
 temperature_c, set; real-data layout: x_t, y_t, z_t, x_dif, y_dif, z_dif, step_order";
 
 /// Sign of the `*_dif` columns of the real-data layout.
@@ -203,9 +207,9 @@ fn classify(name: &str) -> Option<Col> {
         "x" => Some(Col::Pos(0)),
         "y" => Some(Col::Pos(1)),
         "z" => Some(Col::Pos(2)),
-        "rx" => Some(Col::Rot(0)),
-        "ry" => Some(Col::Rot(1)),
-        "rz" => Some(Col::Rot(2)),
+        "rx" | "rx_deg" => Some(Col::Rot(0)),
+        "ry" | "ry_deg" => Some(Col::Rot(1)),
+        "rz" | "rz_deg" => Some(Col::Rot(2)),
         "payload_kg" => Some(Col::Payload),
         "temperature_c" => Some(Col::Temperature),
         "set" => Some(Col::Set),
@@ -678,6 +682,15 @@ mod tests {
         let text = write(&plain);
         assert_eq!(text, "q1,q2,x,y,z\n1,2,100,0,0\n");
         assert_eq!(parse(&text).unwrap(), plain);
+    }
+
+    #[test]
+    fn orientation_columns_may_say_degrees() {
+        let plain = parse("q1,q2,x,y,z,rx,ry,rz\n1,2,100,0,0,10,20,30\n").unwrap();
+        let named = parse("q1,q2,x,y,z,rx_deg,ry_deg,rz_deg\n1,2,100,0,0,10,20,30\n").unwrap();
+        assert_eq!(plain, named);
+        assert_eq!(named[0].rpy_deg, Some([10.0, 20.0, 30.0]));
+        assert!(parse("q1,q2,x,y,z,rx,ry_deg,rx_deg\n1,2,100,0,0,10,20,30\n").is_err());
     }
 
     #[test]

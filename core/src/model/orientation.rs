@@ -18,6 +18,21 @@
 //!   about x and applied first. Numerically the same matrix as KUKA with
 //!   `A = R`, `B = P`, `C = W`.
 //! * Matrix: nine values in **row-major** order `r11 r12 r13 r21 ... r33`.
+//! * UR rotation vector (`ur_rotvec`, columns `ur_rx_rad, ur_ry_rad,
+//!   ur_rz_rad`): axis · angle in **RADIANS**, as Universal Robots controllers
+//!   write `p[x, y, z, rx, ry, rz]` — the one exception to "degrees", stated in
+//!   its name and column names. Returned with angle ≤ π.
+//! * ABB `q1..q4` (`abb_q1q4`, columns `q1, q2, q3, q4`): the same unit
+//!   quaternion as `quaternion`, with ABB's naming: `q1` is the scalar part.
+//!
+//! | name | values | rotation |
+//! |---|---|---|
+//! | `quaternion` | `qw, qx, qy, qz` | Hamilton, scalar first |
+//! | `abb_q1q4` | `q1, q2, q3, q4` | Hamilton, `q1` scalar |
+//! | `kuka_abc` | `a, b, c` [deg] | `Rz(A)·Ry(B)·Rx(C)` |
+//! | `fanuc_wpr` | `w, p, r` [deg] | `Rz(R)·Ry(P)·Rx(W)` |
+//! | `ur_rotvec` | `ur_rx_rad, ur_ry_rad, ur_rz_rad` [rad] | `exp([r]×)`, angle `|r|` about `r/|r|` |
+//! | `matrix` | `r11 … r33` | row-major |
 //!
 //! Euler angles returned by [`rotation_to`] lie in `(-180, 180]`, with the
 //! middle angle (B or P) in `[-90, 90]`. At gimbal lock (B or P = ±90°) the
@@ -58,22 +73,30 @@ pub enum OrientationConvention {
     FanucWpr,
     /// Full rotation matrix, nine values, row-major.
     Matrix,
+    /// Universal Robots rotation vector `rx, ry, rz`: axis · angle in radians.
+    UrRotvec,
+    /// ABB quaternion `q1, q2, q3, q4` (`q1` the scalar part).
+    AbbQ1q4,
 }
 
 impl OrientationConvention {
     /// All conventions, in declaration order.
-    pub const ALL: [OrientationConvention; 4] = [
+    pub const ALL: [OrientationConvention; 6] = [
         OrientationConvention::Quaternion,
         OrientationConvention::KukaAbc,
         OrientationConvention::FanucWpr,
         OrientationConvention::Matrix,
+        OrientationConvention::UrRotvec,
+        OrientationConvention::AbbQ1q4,
     ];
 
     /// Number of values that make up one orientation in this convention.
     pub fn n_values(self) -> usize {
         match self {
-            OrientationConvention::Quaternion => 4,
-            OrientationConvention::KukaAbc | OrientationConvention::FanucWpr => 3,
+            OrientationConvention::Quaternion | OrientationConvention::AbbQ1q4 => 4,
+            OrientationConvention::KukaAbc
+            | OrientationConvention::FanucWpr
+            | OrientationConvention::UrRotvec => 3,
             OrientationConvention::Matrix => 9,
         }
     }
@@ -85,6 +108,8 @@ impl OrientationConvention {
             OrientationConvention::KukaAbc => "kuka_abc",
             OrientationConvention::FanucWpr => "fanuc_wpr",
             OrientationConvention::Matrix => "matrix",
+            OrientationConvention::UrRotvec => "ur_rotvec",
+            OrientationConvention::AbbQ1q4 => "abb_q1q4",
         }
     }
 
@@ -92,7 +117,8 @@ impl OrientationConvention {
     /// whitespace and treating `-` and spaces like `_`.
     ///
     /// Accepted: `quaternion | quat | wxyz | abb`, `kuka_abc | abc | kuka`,
-    /// `fanuc_wpr | wpr | fanuc`, `matrix | rotation_matrix`.
+    /// `fanuc_wpr | wpr | fanuc`, `matrix | rotation_matrix`,
+    /// `ur_rotvec | rotvec | rotation_vector`, `abb_q1q4 | q1q4`.
     pub fn from_name(name: &str) -> Result<Self, OrientationError> {
         let key: String = name
             .trim()
@@ -107,6 +133,8 @@ impl OrientationConvention {
             "kuka_abc" | "abc" | "kuka" => Ok(OrientationConvention::KukaAbc),
             "fanuc_wpr" | "wpr" | "fanuc" => Ok(OrientationConvention::FanucWpr),
             "matrix" | "rotation_matrix" => Ok(OrientationConvention::Matrix),
+            "ur_rotvec" | "rotvec" | "rotation_vector" => Ok(OrientationConvention::UrRotvec),
+            "abb_q1q4" | "q1q4" => Ok(OrientationConvention::AbbQ1q4),
             _ => Err(OrientationError::UnknownConvention {
                 name: name.to_string(),
             }),
@@ -122,6 +150,8 @@ impl OrientationConvention {
             OrientationConvention::Matrix => &[
                 "r11", "r12", "r13", "r21", "r22", "r23", "r31", "r32", "r33",
             ],
+            OrientationConvention::UrRotvec => &["ur_rx_rad", "ur_ry_rad", "ur_rz_rad"],
+            OrientationConvention::AbbQ1q4 => &["q1", "q2", "q3", "q4"],
         }
     }
 }
@@ -145,7 +175,8 @@ impl FromStr for OrientationConvention {
 pub enum OrientationError {
     #[error(
         "unknown orientation convention '{name}'; expected one of: quaternion (aliases quat, \
-         wxyz, abb), kuka_abc (abc, kuka), fanuc_wpr (wpr, fanuc), matrix (rotation_matrix)"
+         wxyz, abb), kuka_abc (abc, kuka), fanuc_wpr (wpr, fanuc), matrix (rotation_matrix), \
+         ur_rotvec (rotvec, rotation_vector; radians), abb_q1q4 (q1q4)"
     )]
     UnknownConvention { name: String },
 
@@ -404,7 +435,7 @@ pub fn rotation_from(
         });
     }
     match conv {
-        OrientationConvention::Quaternion => {
+        OrientationConvention::Quaternion | OrientationConvention::AbbQ1q4 => {
             let q = [values[0], values[1], values[2], values[3]];
             let norm = q.iter().map(|v| v * v).sum::<f64>().sqrt();
             if (norm - 1.0).abs() > QUATERNION_NORM_TOLERANCE {
@@ -412,6 +443,10 @@ pub fn rotation_from(
             }
             Ok(matrix_from_quaternion(q))
         }
+        OrientationConvention::UrRotvec => Ok(nalgebra::Rotation3::from_scaled_axis(Vector3::new(
+            values[0], values[1], values[2],
+        ))
+        .into_inner()),
         OrientationConvention::KukaAbc => Ok(rz_ry_rx(
             values[0].to_radians(),
             values[1].to_radians(),
@@ -456,7 +491,13 @@ pub fn rotation_from(
 /// W (Fanuc) is 0. Quaternions have `w >= 0`. Matrices are row-major.
 pub fn rotation_to(conv: OrientationConvention, r: &Matrix3<f64>) -> Vec<f64> {
     match conv {
-        OrientationConvention::Quaternion => quaternion_from_matrix(r).to_vec(),
+        OrientationConvention::Quaternion | OrientationConvention::AbbQ1q4 => {
+            quaternion_from_matrix(r).to_vec()
+        }
+        OrientationConvention::UrRotvec => crate::model::pose::rotation_log(r)
+            .iter()
+            .map(|v| v + 0.0)
+            .collect(),
         OrientationConvention::KukaAbc => {
             let (a, b, c) = rz_ry_rx_angles(r);
             vec![wrap_degrees(a), middle_degrees(b), wrap_degrees(c)]
@@ -478,7 +519,7 @@ mod tests {
     use proptest::prelude::*;
     use std::f64::consts::{FRAC_1_SQRT_2, FRAC_PI_2, PI};
 
-    const ALL: [OrientationConvention; 4] = OrientationConvention::ALL;
+    const ALL: [OrientationConvention; 6] = OrientationConvention::ALL;
 
     /// Independent reference: elementary rotations from nalgebra, degrees.
     fn rx(deg: f64) -> Matrix3<f64> {
@@ -519,7 +560,7 @@ mod tests {
 
     #[test]
     fn n_values_and_column_names_agree() {
-        let expected = [4, 3, 3, 9];
+        let expected = [4, 3, 3, 9, 3, 4];
         for (conv, n) in ALL.into_iter().zip(expected) {
             assert_eq!(conv.n_values(), n);
             assert_eq!(conv.column_names().len(), n);
@@ -639,6 +680,48 @@ mod tests {
         let (w, p, rr) = (-45.0, 33.0, 170.0);
         let r = rotation_from(OrientationConvention::FanucWpr, &[w, p, rr]).unwrap();
         assert_mat_close(&r, &(rz(rr) * ry(p) * rx(w)), 1e-15);
+    }
+
+    #[test]
+    fn ur_rotvec_is_axis_times_angle_in_radians() {
+        let r = rotation_from(OrientationConvention::UrRotvec, &[0.0, 0.0, FRAC_PI_2]).unwrap();
+        assert_mat_close(&r, &rz(90.0), 1e-15);
+        // 120° about (1,1,1)/√3 permutes the axes x → y → z → x.
+        let a = 2.0 * PI / 3.0 / 3f64.sqrt();
+        let r = rotation_from(OrientationConvention::UrRotvec, &[a, a, a]).unwrap();
+        let perm = Matrix3::new(0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0);
+        assert_mat_close(&r, &perm, 1e-15);
+        let back = rotation_to(OrientationConvention::UrRotvec, &perm);
+        for v in back {
+            assert!((v - a).abs() < 1e-15, "{v}");
+        }
+        // Names that cannot be read as degrees or as another convention.
+        assert_eq!(
+            OrientationConvention::UrRotvec.column_names(),
+            &["ur_rx_rad", "ur_ry_rad", "ur_rz_rad"]
+        );
+        assert_eq!(
+            OrientationConvention::from_name("rotvec"),
+            Ok(OrientationConvention::UrRotvec)
+        );
+    }
+
+    #[test]
+    fn abb_q1q4_is_the_scalar_first_quaternion() {
+        let q = [FRAC_1_SQRT_2, 0.0, 0.0, FRAC_1_SQRT_2];
+        let r = rotation_from(OrientationConvention::AbbQ1q4, &q).unwrap();
+        assert_mat_close(&r, &rz(90.0), 1e-15);
+        assert_eq!(
+            OrientationConvention::AbbQ1q4.column_names(),
+            &["q1", "q2", "q3", "q4"]
+        );
+        // Every name and column is unique across conventions.
+        let mut names: Vec<&str> = ALL.iter().map(|c| c.name()).collect();
+        names.extend(ALL.iter().flat_map(|c| c.column_names().iter().copied()));
+        let n = names.len();
+        names.sort();
+        names.dedup();
+        assert_eq!(names.len(), n);
     }
 
     #[test]
@@ -935,7 +1018,18 @@ mod tests {
             prop_assert!(d < 1e-12, "{}: diff {:e}, values {:?}", conv, d, vals);
             prop_assert!(rotation_angle_between(&back, r) < 1e-12);
             match conv {
-                OrientationConvention::Quaternion => {
+                OrientationConvention::UrRotvec => {
+                    let angle = vals.iter().map(|v| v * v).sum::<f64>().sqrt();
+                    prop_assert!(angle <= PI + 1e-12, "{:?}", vals);
+                    // Against nalgebra's own rotation vector (up to the sign at π).
+                    let n = nalgebra::Rotation3::from_matrix_unchecked(*r).scaled_axis();
+                    if angle < PI - 1e-6 {
+                        for k in 0..3 {
+                            prop_assert!((vals[k] - n[k]).abs() < 1e-9, "{:?} vs {}", vals, n);
+                        }
+                    }
+                }
+                OrientationConvention::Quaternion | OrientationConvention::AbbQ1q4 => {
                     prop_assert!(vals[0] >= 0.0, "w < 0: {:?}", vals);
                     let n: f64 = vals.iter().map(|v| v * v).sum::<f64>().sqrt();
                     prop_assert!((n - 1.0).abs() < 1e-15);
