@@ -346,3 +346,94 @@ fn two_session_skcm_c_is_as_accurate_as_one() {
     assert!(one < 0.03, "one session {one} mm");
     assert!(two <= 1.15 * one, "two sessions {two} mm vs one {one} mm");
 }
+
+/// The command line takes several measurement files (one tracker session
+/// each) or one file with a `session` column, as the service takes sets with
+/// sessions; both give the same calibration.
+#[test]
+fn cli_takes_several_files_or_a_session_column() {
+    use robocal::sim::tracker_frame;
+    let nominal = preset("ys100").unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(12);
+    let tm = perturb_geometry(&nominal, &ErrorMagnitudes::from_mm_deg(1.0, 0.1), &mut rng);
+    let dir = tempfile::tempdir().unwrap();
+    let mut combined_id = Vec::new();
+    let mut combined_va = Vec::new();
+    for (s, frame) in [
+        tracker_frame(5.0, 2.0, 80.0, [2000.0, 100.0, -300.0]),
+        tracker_frame(-3.0, 1.0, -20.0, [-500.0, 2500.0, 0.0]),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let mut truth = TrueRobot::new(tm.clone());
+        truth.tracker_from_base = frame;
+        truth.noise_mm = 0.005;
+        let p = Some(nominal.payload.mass);
+        let id = truth
+            .measure(
+                &random_configurations(&nominal, 30, &mut rng),
+                p,
+                None,
+                &mut rng,
+            )
+            .unwrap();
+        let va = truth
+            .measure(
+                &random_configurations(&nominal, 20, &mut rng),
+                p,
+                None,
+                &mut rng,
+            )
+            .unwrap();
+        std::fs::write(dir.path().join(format!("id{s}.csv")), csv::write(&id)).unwrap();
+        std::fs::write(dir.path().join(format!("va{s}.csv")), csv::write(&va)).unwrap();
+        let tag = |rows: Vec<measure::MeasuredPose>| {
+            rows.into_iter().map(move |mut r| {
+                r.session = Some(["A", "B"][s].to_string());
+                r
+            })
+        };
+        combined_id.extend(tag(id));
+        combined_va.extend(tag(va));
+    }
+    std::fs::write(dir.path().join("id.csv"), csv::write(&combined_id)).unwrap();
+    std::fs::write(dir.path().join("va.csv"), csv::write(&combined_va)).unwrap();
+    let run = |identify: &str, validate: &str| -> serde_json::Value {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_robocal"))
+            .current_dir(dir.path())
+            .args([
+                "calibrate",
+                "--model",
+                "ys100",
+                "--identify",
+                identify,
+                "--validate",
+                validate,
+                "--method",
+                "km",
+                "--json",
+            ])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    let files = run("id0.csv,id1.csv", "va0.csv,va1.csv");
+    let column = run("id.csv", "va.csv");
+    for r in [&files, &column] {
+        assert_eq!(r["registration"].as_array().unwrap().len(), 2);
+        let v = r["methods"]["km"]["validation"]["mean_mm"]
+            .as_f64()
+            .unwrap();
+        assert!(v < 0.015, "validation mean {v}");
+    }
+    assert_eq!(
+        files["methods"]["km"]["validation"]["mean_mm"],
+        column["methods"]["km"]["validation"]["mean_mm"]
+    );
+}

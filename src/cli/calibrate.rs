@@ -14,13 +14,17 @@ pub struct CalibrateArgs {
     /// Robot model: a preset name (ys100, hh800, ur5, ur10) or a model JSON file.
     #[arg(long)]
     pub model: String,
-    /// Identification measurements (CSV). Rows whose `set` column says
+    /// Identification measurements (CSV), one or more files (repeat the option
+    /// or separate with commas). Each file is its own tracker session unless
+    /// its rows carry a `session` column. Rows whose `set` column says
     /// validation are moved to the validation set.
-    #[arg(long)]
-    pub identify: String,
-    /// Validation measurements (CSV), never used for fitting.
-    #[arg(long)]
-    pub validate: Option<String>,
+    #[arg(long, required = true, num_args = 1.., value_delimiter = ',')]
+    pub identify: Vec<String>,
+    /// Validation measurements (CSV), never used for fitting. With as many
+    /// files as --identify, the N-th belongs to the N-th file's session;
+    /// otherwise to the first session (a `session` column overrides both).
+    #[arg(long, num_args = 1.., value_delimiter = ',')]
+    pub validate: Vec<String>,
     /// Methods to run and compare, comma-separated: km, skcm, skcm-tlbo, skcm-payload.
     #[arg(long, default_value = "km,skcm,skcm-tlbo")]
     pub method: String,
@@ -71,28 +75,60 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         }
     }
     let payload = a.payload_kg.unwrap_or(model.payload.mass);
-    let rows = read_rows(&a.identify, dif)?;
-    csv::check_joint_count(&rows, model.dof()).with_context(|| a.identify.clone())?;
-    let training = rows
-        .iter()
-        .filter(|r| r.set == Some(SetRole::Training))
-        .count();
+    // Rows with their tracker-session label: the `session` column, else the file's.
+    let label = |file: usize| format!("file {}", file + 1);
+    let mut ident_rows: Vec<(String, measure::MeasuredPose)> = Vec::new();
+    let mut valid_rows: Vec<(String, measure::MeasuredPose)> = Vec::new();
+    let mut training = 0;
+    for (i, path) in a.identify.iter().enumerate() {
+        let rows = read_rows(path, dif)?;
+        csv::check_joint_count(&rows, model.dof()).with_context(|| path.clone())?;
+        for r in rows {
+            let s = r.session.clone().unwrap_or_else(|| label(i));
+            match r.set {
+                Some(SetRole::Training) => training += 1,
+                Some(SetRole::Validation) => valid_rows.push((s, r)),
+                _ => ident_rows.push((s, r)),
+            }
+        }
+    }
     if training > 0 && !a.json {
         eprintln!(
             "note: {training} rows marked `training` are for compensators and are not used here"
         );
     }
-    let (ident_rows, mut valid_rows): (Vec<_>, Vec<_>) = rows
-        .into_iter()
-        .filter(|r| r.set != Some(SetRole::Training))
-        .partition(|r| r.set != Some(SetRole::Validation));
-    if let Some(v) = &a.validate {
-        let more = read_rows(v, dif)?;
-        csv::check_joint_count(&more, model.dof()).with_context(|| v.clone())?;
-        valid_rows.extend(more);
+    let same_count = a.validate.len() == a.identify.len();
+    for (j, path) in a.validate.iter().enumerate() {
+        let more = read_rows(path, dif)?;
+        csv::check_joint_count(&more, model.dof()).with_context(|| path.clone())?;
+        let own = label(if same_count { j } else { 0 });
+        valid_rows.extend(
+            more.into_iter()
+                .map(|r| (r.session.clone().unwrap_or_else(|| own.clone()), r)),
+        );
     }
-    let ident = measure::to_measurements(&model, &ident_rows, payload);
-    let valid = measure::to_measurements(&model, &valid_rows, payload);
+    let mut sessions: Vec<String> = Vec::new();
+    for (s, _) in &ident_rows {
+        if !sessions.contains(s) {
+            sessions.push(s.clone());
+        }
+    }
+    if let Some((s, _)) = valid_rows.iter().find(|(s, _)| !sessions.contains(s)) {
+        bail!(
+            "validation rows of tracker session `{s}` have no identification rows in that session, so its frame cannot be registered; measure identification poses in that session too"
+        );
+    }
+    let to_si = |rows: &[(String, measure::MeasuredPose)]| -> Vec<measure::Measurement> {
+        rows.iter()
+            .map(|(s, r)| {
+                let mut m = r.to_measurement(&model, payload);
+                m.session = sessions.iter().position(|x| x == s).unwrap_or(0);
+                m
+            })
+            .collect()
+    };
+    let ident = to_si(&ident_rows);
+    let valid = to_si(&valid_rows);
     let opts = CalibrationOptions {
         methods,
         register: !a.no_register,

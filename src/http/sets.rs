@@ -308,6 +308,7 @@ fn json_rows(rows: Vec<RowInput>, c: &Checked) -> Result<Vec<MeasuredPose>, ApiE
             payload_kg: r.payload_kg,
             temperature_c: r.temperature_c,
             set: r.set,
+            session: None,
         });
     }
     if c.angle == Angle::Rad {
@@ -410,6 +411,18 @@ pub async fn upload(
             };
             if c.angle == Angle::Rad {
                 to_degrees(&mut rows);
+            }
+            // A set is one tracker session: a `session` column must agree.
+            if let Some((i, s)) = rows
+                .iter()
+                .enumerate()
+                .find_map(|(i, r)| r.session.as_ref().filter(|s| **s != c.session).map(|s| (i, s)))
+            {
+                return Err(ApiError::invalid(format!(
+                    "row {}: the `session` column says `{s}` but this set's session is `{}`; upload each tracker session as its own set (`?session=`)",
+                    i + 1,
+                    c.session
+                )));
             }
             check_rows(&rows, dof, max_rows)?;
             Ok((c, rows, SetFormat::Csv, text))

@@ -14,6 +14,8 @@
 //!   XYZ angles in DEGREES, `R = Rz(rz)·Ry(ry)·Rx(rx)` — not a rotation vector
 //!   (a UR controller's `rx, ry, rz`). The explicit names `rx_deg, ry_deg,
 //!   rz_deg` are accepted for the same columns and say so in the file.
+//! - `session` (optional): a tracker-session label per row (e.g. `A`, `B`);
+//!   rows with different labels get their own frame registration.
 //! - `payload_kg`, `temperature_c`, `set` (optional). `set` is `identification`,
 //!   `training` or `validation` (also `q1`, `q2`, `q3`).
 //!
@@ -80,7 +82,7 @@ fn short_text(s: &str) -> String {
 const ACCEPTED: &str =
     "q1..q7 (alias joint_1..joint_7), x, y, z, rx, ry, rz (fixed-axis XYZ degrees, \
 alias rx_deg, ry_deg, rz_deg), payload_kg, \
-temperature_c, set; real-data layout: x_t, y_t, z_t, x_dif, y_dif, z_dif, step_order";
+temperature_c, set, session; real-data layout: x_t, y_t, z_t, x_dif, y_dif, z_dif, step_order";
 
 /// Sign of the `*_dif` columns of the real-data layout.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -162,6 +164,8 @@ pub enum CsvError {
     },
     #[error("line {line}, column `set`: unknown set `{value}` (expected identification, training, validation or q1, q2, q3)")]
     UnknownSet { line: usize, value: String },
+    #[error("line {line}, column `session`: `{value}` is not a session label (at most 64 characters, no control characters)")]
+    BadSession { line: usize, value: String },
     #[error("line {line}, columns rx, ry, rz: give all three orientation angles or none")]
     PartialOrientation { line: usize },
     #[error("line {line}, column `{column}`: {} deg looks like wrong units (|q| > {max} deg; joint readings must be in degrees)", short_number(*value), max = MAX_JOINT_DEG)]
@@ -197,6 +201,7 @@ enum Col {
     Payload,
     Temperature,
     Set,
+    Session,
     Target(usize),
     Dif(usize),
     StepOrder,
@@ -213,6 +218,7 @@ fn classify(name: &str) -> Option<Col> {
         "payload_kg" => Some(Col::Payload),
         "temperature_c" => Some(Col::Temperature),
         "set" => Some(Col::Set),
+        "session" => Some(Col::Session),
         "x_t" => Some(Col::Target(0)),
         "y_t" => Some(Col::Target(1)),
         "z_t" => Some(Col::Target(2)),
@@ -243,6 +249,7 @@ fn canonical_name(c: Col) -> String {
         Col::Payload => "payload_kg".into(),
         Col::Temperature => "temperature_c".into(),
         Col::Set => "set".into(),
+        Col::Session => "session".into(),
         Col::Target(i) => format!("{}_t", XYZ[i]),
         Col::Dif(i) => format!("{}_dif", XYZ[i]),
         Col::StepOrder => "step_order".into(),
@@ -260,6 +267,7 @@ struct Header {
     payload: Option<usize>,
     temperature: Option<usize>,
     set: Option<usize>,
+    session: Option<usize>,
 }
 
 enum PositionCols {
@@ -387,6 +395,7 @@ fn parse_header(line: usize, text: &str) -> Result<Header, CsvError> {
         payload: find(Col::Payload),
         temperature: find(Col::Temperature),
         set: find(Col::Set),
+        session: find(Col::Session),
         names,
     })
 }
@@ -504,6 +513,19 @@ impl Header {
             )?),
             _ => None,
         };
+        let session = match self.session {
+            Some(c) if !fields[c].is_empty() => {
+                let v = fields[c];
+                if v.chars().count() > 64 || v.chars().any(|ch| ch.is_control()) {
+                    return Err(CsvError::BadSession {
+                        line,
+                        value: short_text(v),
+                    });
+                }
+                Some(v.to_string())
+            }
+            _ => None,
+        };
         Ok(MeasuredPose {
             q_deg,
             xyz_mm,
@@ -511,6 +533,7 @@ impl Header {
             payload_kg,
             temperature_c,
             set,
+            session,
         })
     }
 }
@@ -572,7 +595,7 @@ fn num(x: f64) -> String {
 }
 
 /// Writes rows in the canonical layout
-/// `q1..qN,x,y,z[,rx,ry,rz][,payload_kg][,temperature_c][,set]`.
+/// `q1..qN,x,y,z[,rx,ry,rz][,payload_kg][,temperature_c][,set][,session]`.
 ///
 /// N is the largest joint count among the rows (rows are expected to agree); an
 /// optional column is written when any row has it, rows without it get an empty
@@ -584,6 +607,7 @@ pub fn write(rows: &[MeasuredPose]) -> String {
     let payload = rows.iter().any(|r| r.payload_kg.is_some());
     let temp = rows.iter().any(|r| r.temperature_c.is_some());
     let set = rows.iter().any(|r| r.set.is_some());
+    let session = rows.iter().any(|r| r.session.is_some());
 
     let mut header: Vec<String> = (1..=n).map(|i| format!("q{i}")).collect();
     header.extend(["x", "y", "z"].map(String::from));
@@ -598,6 +622,9 @@ pub fn write(rows: &[MeasuredPose]) -> String {
     }
     if set {
         header.push("set".into());
+    }
+    if session {
+        header.push("session".into());
     }
     let mut out = header.join(",");
     out.push('\n');
@@ -623,6 +650,9 @@ pub fn write(rows: &[MeasuredPose]) -> String {
         if set {
             f.push(r.set.map(|s| s.as_str().to_string()).unwrap_or_default());
         }
+        if session {
+            f.push(r.session.clone().unwrap_or_default());
+        }
         let _ = writeln!(out, "{}", f.join(","));
     }
     out
@@ -640,6 +670,7 @@ mod tests {
             payload_kg: None,
             temperature_c: None,
             set: None,
+            session: None,
         }
     }
 

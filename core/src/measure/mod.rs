@@ -62,6 +62,9 @@ pub struct MeasuredPose {
     pub temperature_c: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub set: Option<SetRole>,
+    /// Tracker-session label (CSV `session` column), when given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub session: Option<String>,
 }
 
 /// One measured pose in SI units, ready for identification.

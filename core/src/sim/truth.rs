@@ -280,6 +280,7 @@ impl TrueRobot {
                     payload_kg,
                     temperature_c: None,
                     set,
+                    session: None,
                 })
             })
             .collect()
