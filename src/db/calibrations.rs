@@ -5,6 +5,23 @@ use super::{robot_exists_in, Db, DbError, Json};
 use serde_json::Value;
 use sqlx::FromRow;
 
+/// What a succeeded job reached, in millimetres (stored with the job).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct JobSummary {
+    /// The method with the lowest mean error on `judged_on`.
+    pub best_method: String,
+    /// `validation` when the job had validation poses, else `identification`.
+    pub judged_on: String,
+    pub mean_mm: f64,
+    pub max_mm: f64,
+    /// The nominal model's mean error on the same poses, after registration.
+    pub nominal_mean_mm: f64,
+    /// Every method's warnings, as "method: message".
+    pub warnings: Vec<String>,
+    /// Methods that failed, as "method: reason"; the others were kept.
+    pub failed_methods: Vec<String>,
+}
+
 /// State of a calibration job.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, sqlx::Type, serde::Serialize)]
 #[sqlx(rename_all = "lowercase")]
@@ -263,17 +280,19 @@ impl Db {
         id: i64,
         report_json: &str,
         best_method: &str,
+        summary: &JobSummary,
         versions: &[NewVersion],
     ) -> Result<Vec<(String, i64)>, DbError> {
         let mut tx = self.write().await?;
         let n = sqlx::query(
-            concat!("UPDATE calibrations SET status = 'succeeded', report = ?, best_method = ?, phase = 'done', \
+            concat!("UPDATE calibrations SET status = 'succeeded', report = ?, best_method = ?, summary = ?, phase = 'done', \
              percent = 100, finished_at = ", now!(), ", \
              updated_at = ", now!(), " \
              WHERE id = ? AND status = 'running'"),
         )
         .bind(report_json)
         .bind(best_method)
+        .bind(Json(summary))
         .bind(id)
         .execute(&mut *tx)
         .await?
@@ -322,7 +341,7 @@ impl Db {
 
 const CAL_SELECT: &str = "SELECT id, robot_id, status, phase, iteration, percent, \
     cancel_requested, methods, identification_set_ids, validation_set_ids, options, error, \
-    best_method, created_at, started_at, finished_at, updated_at FROM calibrations";
+    best_method, summary, created_at, started_at, finished_at, updated_at FROM calibrations";
 
 /// A calibration job to insert (JSON texts).
 #[derive(Debug)]
@@ -349,6 +368,8 @@ pub struct CalibrationRow {
     pub options: Json<Value>,
     pub error: Option<String>,
     pub best_method: Option<String>,
+    /// Set when the job succeeded.
+    pub summary: Option<Json<JobSummary>>,
     pub created_at: String,
     pub started_at: Option<String>,
     pub finished_at: Option<String>,

@@ -43,7 +43,7 @@ mod robots;
 mod sets;
 mod versions;
 
-pub use calibrations::{CalibrationRow, JobStatus, NewCalibration};
+pub use calibrations::{CalibrationRow, JobStatus, JobSummary, NewCalibration};
 pub use robots::{NewRobot, RobotRow};
 pub use sets::{AngleUnit, LengthUnit, NewSet, SetFormat, SetRow, StoredRole};
 pub use versions::{NewVersion, Rollback, VersionRow};

@@ -11,7 +11,7 @@ use super::input::{
 };
 use super::robots::robot_not_found;
 use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState};
-use crate::db::{CalibrationRow, JobStatus};
+use crate::db::{CalibrationRow, JobStatus, JobSummary};
 use crate::identify::{CalibrationOptions, Method};
 use crate::service::{self, calibrations::StartCommand};
 use axum::extract::State;
@@ -109,6 +109,8 @@ pub struct Calibration {
     pub options: Value,
     pub error: Option<String>,
     pub best_method: Option<String>,
+    /// What the job reached (set when it succeeded).
+    pub summary: Option<JobSummary>,
     pub created_at: String,
     pub started_at: Option<String>,
     pub finished_at: Option<String>,
@@ -148,6 +150,7 @@ impl Calibration {
             options: r.options.0,
             error: r.error,
             best_method: r.best_method,
+            summary: r.summary.map(|s| s.0),
             created_at: r.created_at,
             started_at: r.started_at,
             finished_at: r.finished_at,

@@ -14,7 +14,9 @@
 
 use super::{AppState, ServiceError};
 use crate::compensate::{CalibratedModelFile, CompensatedModel};
-use crate::db::{CalibrationRow, JobStatus, NewCalibration, NewVersion, SetRow, StoredRole};
+use crate::db::{
+    CalibrationRow, JobStatus, JobSummary, NewCalibration, NewVersion, SetRow, StoredRole,
+};
 use crate::http::limits::Ticket;
 use crate::identify::{
     calibrate, CalibrationError, CalibrationOptions, CalibrationReport, FailedMethod, LmSettings,
@@ -51,8 +53,9 @@ pub struct StartCommand {
 }
 
 fn set_vanished(robot_id: i64, set_id: i64) -> ServiceError {
-    ServiceError::Conflict(format!(
-        "measurement set {set_id} of robot {robot_id} was deleted while the job was being queued"
+    // Deleted meanwhile (alone, or with its robot): the set is not found.
+    ServiceError::NotFound(format!(
+        "measurement set {set_id} of robot {robot_id} does not exist (deleted while the job was being queued)"
     ))
 }
 
@@ -345,13 +348,11 @@ async fn run_job(state: AppState, job: Job) {
     let db = state.db();
     let stored = match outcome {
         Ok(Ok((report, versions))) => {
-            let best = report
-                .best_method()
-                .map(|m| m.method.name().to_string())
-                .unwrap_or_default();
+            let summary = summary_of(&report);
+            let best = summary.best_method.clone();
             match serde_json::to_string(&report) {
                 Ok(text) => db
-                    .finish_calibration_success(robot_id, id, &text, &best, &versions)
+                    .finish_calibration_success(robot_id, id, &text, &best, &summary, &versions)
                     .await
                     .map(|v| {
                         tracing::info!(job = id, robot = robot_id, best = %best, versions = v.len(), failed = report.failed.len(), "calibration succeeded");
@@ -399,6 +400,47 @@ async fn run_job(state: AppState, job: Job) {
     }
     state.drop_cancel_flag(id);
     state.invalidate_robot(robot_id);
+}
+
+/// The summary of a report: the best method by validation mean (by
+/// identification mean when there are no validation poses), its errors next
+/// to the nominal model's on the same poses, every warning and failed method.
+pub fn summary_of(r: &CalibrationReport) -> JobSummary {
+    let best = r.best_method();
+    let validated = best.is_some_and(|m| m.validation.is_some());
+    let (set, nominal) = match best {
+        Some(m) if validated => (m.validation.as_ref(), r.nominal.validation.as_ref()),
+        Some(m) => (Some(&m.identification), Some(&r.nominal.identification)),
+        None => (None, None),
+    };
+    JobSummary {
+        best_method: best
+            .map(|m| m.method.name().to_string())
+            .unwrap_or_default(),
+        judged_on: if validated {
+            "validation"
+        } else {
+            "identification"
+        }
+        .to_string(),
+        mean_mm: set.map_or(f64::NAN, |s| s.stats.mean_mm),
+        max_mm: set.map_or(f64::NAN, |s| s.stats.max_mm),
+        nominal_mean_mm: nominal.map_or(f64::NAN, |s| s.stats.mean_mm),
+        warnings: r
+            .methods
+            .iter()
+            .flat_map(|(name, m)| {
+                m.warnings
+                    .iter()
+                    .map(move |w| format!("{name}: {}", w.message))
+            })
+            .collect(),
+        failed_methods: r
+            .failed
+            .iter()
+            .map(|f| format!("{}: {}", f.method.name(), f.reason))
+            .collect(),
+    }
 }
 
 /// One calibrated model file per method, in the order the methods ran. A

@@ -85,6 +85,17 @@ async fn quickstart_flow_calibrate_version_and_solve() {
         .unwrap();
     assert!(skcm_val < 0.1, "skcm validation mean {skcm_val} mm");
     assert!(km_val < nominal_val && skcm_val < km_val);
+    // The job's status carries the summary of the same figures.
+    let summary = &done["summary"];
+    assert_eq!(summary["best_method"], "skcm", "{summary}");
+    assert_eq!(summary["judged_on"], "validation");
+    assert_eq!(summary["mean_mm"].as_f64(), Some(skcm_val));
+    assert_eq!(
+        summary["max_mm"],
+        res["report"]["methods"]["skcm"]["validation"]["max_mm"]
+    );
+    assert_eq!(summary["nominal_mean_mm"].as_f64(), Some(nominal_val));
+    assert!(summary["failed_methods"].as_array().unwrap().is_empty());
     assert_eq!(res["versions"].as_array().unwrap().len(), 2);
     assert_eq!(res["summary"][0]["method"], "nominal");
     assert_eq!(res["summary"].as_array().unwrap().len(), 3);

@@ -184,7 +184,19 @@ pub fn robot(v: &RobotView) -> Markup {
                                     td.status { (c.status.as_str()) }
                                     td.phase { (c.phase.as_deref().unwrap_or("")) }
                                     td { progress max="100" value=(c.percent) {} " " span.percent { (format!("{:.0} %", c.percent)) } }
-                                    td { (c.best_method.as_deref().unwrap_or("—")) }
+                                    td {
+                                        (c.best_method.as_deref().unwrap_or("—"))
+                                        @if let Some(sum) = &c.summary {
+                                            br;
+                                            span.note { (format!("{:.4} mm mean on {} (nominal {:.3})", sum.0.mean_mm, sum.0.judged_on, sum.0.nominal_mean_mm)) }
+                                            @if !sum.0.warnings.is_empty() || !sum.0.failed_methods.is_empty() {
+                                                br;
+                                                span.bad title=(sum.0.warnings.iter().chain(&sum.0.failed_methods).cloned().collect::<Vec<_>>().join("\n")) {
+                                                    (sum.0.warnings.len()) " warnings, " (sum.0.failed_methods.len()) " failed methods"
+                                                }
+                                            }
+                                        }
+                                    }
                                     td { (c.created_at) }
                                     td {
                                         @if c.status == JobStatus::Succeeded {
