@@ -1,11 +1,15 @@
 //! `/v1/robots/{id}/versions`: the calibrated models of a robot. List, get,
 //! activate, roll back to the previously active version, download the model
-//! file (`robocal-calibrated-model/1`, loadable by `robocal solve --model`).
+//! file (`robocal-calibrated-model/1`, loadable by `robocal solve --model`),
+//! export it for other tools (`export?format=urdf|dh-csv|mdh-csv|json`, the
+//! text of `crate::export`).
 
 use super::input::{page_fields, PageQuery};
 use super::robots::robot_not_found;
 use super::{ApiError, ApiPath, ApiQuery, AppState};
+use crate::compensate::CalibratedModelFile;
 use crate::db::{Rollback, VersionRow};
+use crate::export::{export, ExportFormat, ExportSource};
 use axum::extract::State;
 use axum::http::header;
 use axum::response::{IntoResponse, Response};
@@ -132,6 +136,52 @@ pub async fn download(
         .into_response())
 }
 
+/// `?format=` of an export.
+#[derive(Debug, Clone, serde::Deserialize)]
+pub struct ExportQuery {
+    pub format: String,
+}
+
+pub async fn export_version(
+    State(state): State<AppState>,
+    ApiPath((robot_id, v)): ApiPath<(i64, i64)>,
+    ApiQuery(q): ApiQuery<ExportQuery>,
+) -> Result<Response, ApiError> {
+    let format: ExportFormat = q
+        .format
+        .parse()
+        .map_err(|e: crate::export::ExportError| ApiError::BadRequest(e.to_string()))?;
+    let row = load(&state, robot_id, v).await?;
+    let text = state
+        .db()
+        .version_model(row.id)
+        .await?
+        .ok_or_else(|| version_not_found(robot_id, v))?;
+    let file = CalibratedModelFile::from_json(&text)
+        .map_err(|e| ApiError::Internal(format!("stored model of version {v}: {e}")))?;
+    let model = file
+        .to_compensated()
+        .map_err(|e| ApiError::Internal(format!("stored model of version {v}: {e}")))?;
+    let source = ExportSource {
+        robot: &file.robot,
+        method: &row.method,
+    };
+    let out = export(&model, &source, format).map_err(|e| ApiError::invalid(e.to_string()))?;
+    let disposition = format!(
+        "attachment; filename=\"robot-{robot_id}-v{v}-{}.{}\"",
+        row.method,
+        format.extension()
+    );
+    Ok((
+        [
+            (header::CONTENT_TYPE, format.content_type().to_string()),
+            (header::CONTENT_DISPOSITION, disposition),
+        ],
+        out,
+    )
+        .into_response())
+}
+
 pub async fn activate(
     State(state): State<AppState>,
     ApiPath((robot_id, v)): ApiPath<(i64, i64)>,
@@ -186,6 +236,11 @@ pub fn routes() -> Vec<super::Route> {
             Method::GET,
             "/v1/robots/{id}/versions/{version}/model.json",
             download,
+        ),
+        route(
+            Method::GET,
+            "/v1/robots/{id}/versions/{version}/export",
+            export_version,
         ),
     ]
 }

@@ -194,6 +194,55 @@ async fn quickstart_flow_calibrate_version_and_solve() {
     let file = CalibratedModelFile::from_json(&r.text()).unwrap();
     let model = file.to_compensated().unwrap();
 
+    // Exports of the version: the same text as the core's export of that file.
+    let v = skcm_v.to_string();
+    let export_path = "/v1/robots/{id}/versions/{version}/export";
+    for (format, ctype) in [
+        ("urdf", "application/xml"),
+        ("mdh-csv", "text/csv"),
+        ("json", "application/json"),
+    ] {
+        let r = t
+            .send(
+                "GET",
+                export_path,
+                &[&rid, &v],
+                &format!("?format={format}"),
+                None,
+                vec![],
+            )
+            .await;
+        assert_eq!(r.status, StatusCode::OK, "{format}: {}", r.text());
+        assert_eq!(r.content_type, ctype);
+        let source = robocal::export::ExportSource {
+            robot: &file.robot,
+            method: "skcm",
+        };
+        let want = robocal::export::export(&model, &source, format.parse().unwrap()).unwrap();
+        assert_eq!(r.text(), want, "{format}");
+    }
+    // Standard DH: exact, or refused naming the Hayati twists.
+    let r = t
+        .send(
+            "GET",
+            export_path,
+            &[&rid, &v],
+            "?format=dh-csv",
+            None,
+            vec![],
+        )
+        .await;
+    assert!(
+        r.status == StatusCode::OK
+            || (r.status == StatusCode::UNPROCESSABLE_ENTITY && r.text().contains("Hayati")),
+        "{}",
+        r.text()
+    );
+    let r = t
+        .send("GET", export_path, &[&rid, &v], "?format=sdf", None, vec![])
+        .await;
+    assert_eq!(r.status, StatusCode::BAD_REQUEST, "{}", r.text());
+
     // Solve: targets that the calibrated model reaches at known joints.
     let nominal = preset("ys100").unwrap();
     let truth = truth();
