@@ -95,6 +95,21 @@ async fn load(state: &AppState, robot_id: i64, v: i64) -> Result<VersionRow, Api
     }
 }
 
+/// A version and its stored model file text.
+async fn load_with_model(
+    state: &AppState,
+    robot_id: i64,
+    v: i64,
+) -> Result<(VersionRow, String), ApiError> {
+    let row = load(state, robot_id, v).await?;
+    let text = state
+        .db()
+        .version_model(row.id)
+        .await?
+        .ok_or_else(|| version_not_found(robot_id, v))?;
+    Ok((row, text))
+}
+
 pub async fn get_one(
     State(state): State<AppState>,
     ApiPath((robot_id, v)): ApiPath<(i64, i64)>,
@@ -116,12 +131,7 @@ pub async fn download(
     State(state): State<AppState>,
     ApiPath((robot_id, v)): ApiPath<(i64, i64)>,
 ) -> Result<Response, ApiError> {
-    let row = load(&state, robot_id, v).await?;
-    let text = state
-        .db()
-        .version_model(row.id)
-        .await?
-        .ok_or_else(|| version_not_found(robot_id, v))?;
+    let (row, text) = load_with_model(&state, robot_id, v).await?;
     let disposition = format!(
         "attachment; filename=\"robot-{robot_id}-v{v}-{}.json\"",
         row.method
@@ -151,12 +161,7 @@ pub async fn export_version(
         .format
         .parse()
         .map_err(|e: crate::export::ExportError| ApiError::BadRequest(e.to_string()))?;
-    let row = load(&state, robot_id, v).await?;
-    let text = state
-        .db()
-        .version_model(row.id)
-        .await?
-        .ok_or_else(|| version_not_found(robot_id, v))?;
+    let (row, text) = load_with_model(&state, robot_id, v).await?;
     let file = CalibratedModelFile::from_json(&text)
         .map_err(|e| ApiError::Internal(format!("stored model of version {v}: {e}")))?;
     let model = file
