@@ -314,6 +314,22 @@ fn json_rows(rows: Vec<RowInput>, c: &Checked) -> Result<Vec<MeasuredPose>, ApiE
     if c.angle == Angle::Rad {
         to_degrees(&mut out);
     }
+    // The same bounds as the measurement CSV (after unit conversion).
+    for (i, r) in out.iter().enumerate() {
+        let n = i + 1;
+        if let Some(q) = r.q_deg.iter().find(|q| q.abs() > csv::MAX_JOINT_DEG) {
+            return Err(ApiError::invalid(format!(
+                "row {n}: joint value {q:.4e} deg is beyond ±{} deg: wrong units (encoder counts, or radians declared as degrees)?",
+                csv::MAX_JOINT_DEG
+            )));
+        }
+        if let Some(x) = r.xyz_mm.iter().find(|x| x.abs() > csv::MAX_POSITION_MM) {
+            return Err(ApiError::invalid(format!(
+                "row {n}: position coordinate {x:.4e} mm is beyond ±{} m of the tracker",
+                csv::MAX_POSITION_MM / 1e3
+            )));
+        }
+    }
     if out
         .iter()
         .all(|r| r.xyz_mm.iter().all(|v| v.abs() < csv::METRES_SUSPECT_MM))

@@ -283,6 +283,31 @@ fn bad_inputs() -> Vec<Bad> {
             S::UNPROCESSABLE_ENTITY,
             &[],
         ),
+        // JSON rows have the CSV's bounds.
+        bad(
+            "POST",
+            UPLOAD,
+            JSON,
+            r#"{"rows":[{"q":[0,90,0,0,0,0],"xyz":[1e9,0,0]}]}"#,
+            S::UNPROCESSABLE_ENTITY,
+            &["row 1", "beyond"],
+        ),
+        bad(
+            "POST",
+            UPLOAD,
+            JSON,
+            r#"{"rows":[{"q":[0,90,1e6,0,0,0],"xyz":[1500,0,1000]}]}"#,
+            S::UNPROCESSABLE_ENTITY,
+            &["row 1", "wrong units"],
+        ),
+        bad(
+            "POST",
+            UPLOAD,
+            JSON,
+            r#"{"rows":[{"q":[0,90,0,0,0,0],"xyz":[1500,0,1000],"payload_kg":20000}]}"#,
+            S::UNPROCESSABLE_ENTITY,
+            &["payload_kg"],
+        ),
         // Metadata must be an object.
         bad(
             "PATCH",
