@@ -82,7 +82,6 @@ async fn pages_render_the_store_and_escape_user_text() {
         "id=\"calibrations\"",
         "id=\"calibrate\"",
         "id=\"versions\"",
-        "id=\"solve-form\"",
     ] {
         assert!(html.contains(part), "robot page lacks {part}");
     }

@@ -69,24 +69,6 @@ const handlers = {
     await api("POST", `/v1/robots/${robot}/calibrations`, JSON.stringify(body), "application/json");
     location.reload();
   },
-  async solve(form) {
-    const robot = form.dataset.robot;
-    const text = await fileOrText(form, "file", "targets");
-    if (!text) throw new Error("choose a targets CSV file or paste its text");
-    const q = new URLSearchParams();
-    for (const k of ["convention", "version"]) {
-      const v = formValue(form, k);
-      if (v) q.set(k, v);
-    }
-    const r = await api("POST", `/v1/robots/${robot}/solve?${q}`, text, "text/csv", "text/csv");
-    const out = document.getElementById("solve-result");
-    out.textContent = r.text;
-    out.hidden = false;
-    const link = document.getElementById("solve-download");
-    link.href = URL.createObjectURL(new Blob([r.text], { type: "text/csv" }));
-    link.hidden = false;
-    show("solved; the answer is below", true);
-  },
 };
 
 document.addEventListener("submit", async (ev) => {

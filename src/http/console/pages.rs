@@ -4,7 +4,6 @@
 use crate::db::{CalibrationRow, JobStatus, RobotRow, SetRow, VersionRow};
 use crate::identify::Method;
 use crate::measure::SetRole;
-use crate::model::orientation::OrientationConvention;
 use crate::model::presets::PRESETS;
 use maud::{html, Markup, PreEscaped, DOCTYPE};
 
@@ -111,7 +110,7 @@ fn validation_mean(v: &VersionRow) -> Option<f64> {
     v.stats.0.get("validation")?.get("mean_mm")?.as_f64()
 }
 
-/// One robot: sets, calibrations, versions, solve.
+/// One robot: sets, calibrations, versions.
 pub fn robot(v: &RobotView) -> Markup {
     let r = &v.robot;
     let id = r.id;
@@ -259,29 +258,6 @@ pub fn robot(v: &RobotView) -> Markup {
                 }
             }
 
-            section #solve {
-                h2 { "Solve targets" }
-                p.note { "A targets CSV (id,x,y,z and an orientation in the chosen convention, mm/deg); the answer is the joint commands and false targets as CSV." }
-                form #solve-form data-action="solve" data-robot=(id) {
-                    label.wide { "Targets file " input type="file" name="file" accept=".csv,text/csv"; }
-                    label.wide { "or paste the CSV " textarea name="targets" rows="4" placeholder="id,x,y,z\np1,600,0,800" {} }
-                    label { "Orientation convention "
-                        select name="convention" {
-                            @for c in OrientationConvention::ALL { option value=(c.name()) { (c.name()) } }
-                        }
-                    }
-                    label { "Model "
-                        select name="version" {
-                            option value="active" { "active version" }
-                            option value="nominal" { "nominal" }
-                            @for ver in &v.versions { option value=(ver.version) { "v" (ver.version) " (" (ver.method) ")" } }
-                        }
-                    }
-                    button type="submit" { "Solve" }
-                }
-                a #solve-download download="solved.csv" hidden { "Download the answer (CSV)" }
-                pre #solve-result hidden {}
-            }
         },
     )
 }
