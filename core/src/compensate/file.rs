@@ -1,31 +1,42 @@
 //! The calibrated model file (`robocal calibrate --save cal.json`) and the model
 //! loader used by `robocal solve`.
 //!
-//! Format `robocal-calibrated-model/1`, boundary units millimetres and degrees:
+//! Format `robocal-calibrated-model/2`, boundary units millimetres and degrees
+//! (`/1` files, which have no compensator, still load):
 //!
 //! ```json
 //! {
-//!   "format": "robocal-calibrated-model/1",
+//!   "format": "robocal-calibrated-model/2",
 //!   "robot": "ys100",
 //!   "method": "skcm",
 //!   "model":   { ...model description, calibrated, includes compliance... },
 //!   "nominal": { ...model description of the controller's nominal model... },
 //!   "cell_from_base": { "xyz_mm": [0, -3240, 0], "rpy_deg": [0, 0, 90] },
-//!   "payload_kg": 110
+//!   "payload_kg": 110,
+//!   "compensator": { "kind": "mlp", ... }
 //! }
 //! ```
 //!
 //! `cell_from_base` maps the registered robot base frame into the measurement
 //! (cell / tracker) frame; its rotation is `Rz(rz)·Ry(ry)·Rx(rx)` with
 //! `rpy_deg = [rx, ry, rz]` (fixed-axis XYZ, as the tool of a model description).
-//! A learned compensator is not stored in this version of the format.
+//!
+//! `compensator` (optional, format 2) is the learned residual compensator,
+//! tagged by `kind`: `mlp` ([`Mlp`](super::Mlp): `dof`, `hidden`, `features`,
+//! flat `weights`, `input_norm`, `output_norm`) or `rbf` ([`Rbf`](super::Rbf):
+//! `dof`, `output_frame`, `input_norm`, `spread`, `centres`, `weights`). Its
+//! values are SI (inputs rad, kg, N·m; outputs m) as the network computes them.
+//! A file with an unknown `kind` is rejected.
 
-use super::{CompensateError, CompensatedModel};
+use super::{CompensateError, CompensatedModel, StoredCompensator};
 use crate::model::{preset, ModelDescription, RobotModel};
 use serde::{Deserialize, Serialize};
 
-/// The `format` value of a calibrated model file.
-pub const CALIBRATED_MODEL_FORMAT: &str = "robocal-calibrated-model/1";
+/// The `format` value of a calibrated model file written now.
+pub const CALIBRATED_MODEL_FORMAT: &str = "robocal-calibrated-model/2";
+
+/// Older formats that still load.
+pub const OLDER_FORMATS: [&str; 1] = ["robocal-calibrated-model/1"];
 
 pub use crate::model::description::PoseDescription;
 
@@ -47,10 +58,14 @@ pub struct CalibratedModelFile {
     pub cell_from_base: PoseDescription,
     /// Payload mass [kg] the model applies by default.
     pub payload_kg: f64,
+    /// Learned residual compensator (format 2).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compensator: Option<StoredCompensator>,
 }
 
 impl CalibratedModelFile {
-    /// The file contents of a compensated model (the compensator, if any, is not stored).
+    /// The file contents of a compensated model, with its compensator when it
+    /// has a stored form ([`Compensator::stored`](super::Compensator::stored)).
     pub fn from_compensated(m: &CompensatedModel, robot: &str, method: &str) -> Self {
         CalibratedModelFile {
             format: CALIBRATED_MODEL_FORMAT.to_string(),
@@ -60,16 +75,28 @@ impl CalibratedModelFile {
             nominal: ModelDescription::from_model(&m.nominal),
             cell_from_base: PoseDescription::from_pose(&m.cell_from_base),
             payload_kg: m.payload_kg,
+            compensator: m.compensator.as_ref().and_then(|c| c.stored()),
         }
     }
 
     /// Validates the file and builds the SI model.
     pub fn to_compensated(&self) -> Result<CompensatedModel, CompensateError> {
-        if self.format != CALIBRATED_MODEL_FORMAT {
+        let old = OLDER_FORMATS.contains(&self.format.as_str());
+        if self.format != CALIBRATED_MODEL_FORMAT && !old {
             return Err(CompensateError::Format(format!(
-                "unsupported format `{}` (expected `{CALIBRATED_MODEL_FORMAT}`)",
+                "unsupported format `{}` (expected `{CALIBRATED_MODEL_FORMAT}` or one of {OLDER_FORMATS:?})",
                 self.format
             )));
+        }
+        if old && self.compensator.is_some() {
+            return Err(CompensateError::Format(format!(
+                "format `{}` cannot carry a compensator; use `{CALIBRATED_MODEL_FORMAT}`",
+                self.format
+            )));
+        }
+        if let Some(c) = &self.compensator {
+            c.validate()
+                .map_err(|e| CompensateError::Format(format!("compensator: {e}")))?;
         }
         let calibrated = self.model.to_model()?;
         let nominal = self.nominal.to_model()?;
@@ -88,12 +115,22 @@ impl CalibratedModelFile {
         }
         Ok(CompensatedModel {
             calibrated,
+            compensator: match &self.compensator {
+                Some(c) if c.dof() != nominal.dof() => {
+                    return Err(CompensateError::Format(format!(
+                        "the compensator was trained for {} joints but the model has {}",
+                        c.dof(),
+                        nominal.dof()
+                    )))
+                }
+                Some(c) => Some(c.clone().into_arc()),
+                None => None,
+            },
             nominal,
             cell_from_base: self.cell_from_base.to_pose().ok_or_else(|| {
                 CompensateError::Format("cell_from_base values must be finite numbers".into())
             })?,
             payload_kg: self.payload_kg,
-            compensator: None,
         })
     }
 
@@ -195,5 +232,80 @@ mod tests {
         let mut f = CalibratedModelFile::from_compensated(&m, "ys100", "km");
         f.format = "robocal-calibrated-model/9".into();
         assert!(parse_compensated(&f.to_json()).is_err());
+    }
+
+    fn mlp_compensated() -> CompensatedModel {
+        use crate::compensate::{train, CompensatorSpec, LmTrainSettings, MlpSpec, Trainer};
+        use rand::SeedableRng;
+        let nominal = preset("ys100").unwrap();
+        let mut m = CompensatedModel::from_nominal(nominal.clone());
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(2);
+        let qs = crate::sim::random_configurations(&nominal, 40, &mut rng);
+        let samples: Vec<crate::compensate::Sample> = qs
+            .iter()
+            .map(|q| crate::compensate::Sample {
+                q: q.clone(),
+                tau: m.torques(q).unwrap(),
+                payload_kg: 110.0,
+                residual: nalgebra::Vector3::new(1e-4 * q[1].sin(), 2e-4 * q[2].cos(), 1e-5),
+            })
+            .collect();
+        let spec = CompensatorSpec::Mlp {
+            spec: MlpSpec::SMALL,
+            trainer: Trainer::Lm(LmTrainSettings {
+                max_epochs: 5,
+                ..Default::default()
+            }),
+        };
+        let (c, _) = train(&spec, &samples, &mut rng, &mut |_, _| true).unwrap();
+        m.compensator = Some(c.into_arc());
+        m
+    }
+
+    #[test]
+    fn compensator_round_trips_and_version_1_still_loads() {
+        let m = mlp_compensated();
+        let file = CalibratedModelFile::from_compensated(&m, "ys100", "skcm-nn");
+        assert_eq!(file.format, CALIBRATED_MODEL_FORMAT);
+        let text = file.to_json();
+        assert!(text.contains("\"kind\": \"mlp\""));
+        let back = parse_compensated(&text).unwrap();
+        let q = [0.1, 1.2, -0.3, 0.4, 0.5, -0.6];
+        // Bit for bit: the weights are printed with round-trip precision.
+        assert_eq!(m.predict(&q).unwrap().p, back.predict(&q).unwrap().p);
+        assert_ne!(
+            m.predict(&q).unwrap().p,
+            CompensatedModel {
+                compensator: None,
+                ..m.clone()
+            }
+            .predict(&q)
+            .unwrap()
+            .p
+        );
+        // A version-1 file (no compensator) loads as before.
+        let mut v1: serde_json::Value = serde_json::from_str(&text).unwrap();
+        v1["format"] = "robocal-calibrated-model/1".into();
+        v1.as_object_mut().unwrap().remove("compensator");
+        let old = parse_compensated(&v1.to_string()).unwrap();
+        assert!(old.compensator.is_none());
+    }
+
+    #[test]
+    fn unknown_or_broken_compensators_fail_loudly() {
+        let m = mlp_compensated();
+        let text = CalibratedModelFile::from_compensated(&m, "ys100", "skcm-nn").to_json();
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        v["compensator"]["kind"] = "gaussian-process".into();
+        let e = parse_compensated(&v.to_string()).unwrap_err().to_string();
+        assert!(e.contains("gaussian-process") && e.contains("mlp"), "{e}");
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        v["compensator"]["weights"].as_array_mut().unwrap().pop();
+        let e = parse_compensated(&v.to_string()).unwrap_err().to_string();
+        assert!(e.contains("weights"), "{e}");
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        v["format"] = "robocal-calibrated-model/1".into();
+        let e = parse_compensated(&v.to_string()).unwrap_err().to_string();
+        assert!(e.contains("cannot carry a compensator"), "{e}");
     }
 }

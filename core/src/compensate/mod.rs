@@ -21,18 +21,31 @@
 //! Units: SI inside (m, rad, kg, N·m); the file format in [`file`] uses mm/deg.
 
 use crate::kinematics::{chain, fk, geometric_jacobian, gravity_torques_of, KinematicsError};
+use crate::measure::Measurement;
 use crate::model::{ModelError, Pose, RobotModel};
-use nalgebra::{DMatrix, Vector3};
+use nalgebra::{DMatrix, Matrix3xX, Vector3};
+use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 
 pub mod file;
+pub mod mlp;
+pub mod rbf;
+pub mod select;
 pub mod synthetic;
+pub mod train;
 
 pub use file::{
     load_compensated, parse_compensated, CalibratedModelFile, PoseDescription,
     CALIBRATED_MODEL_FORMAT,
 };
+pub use mlp::{Features, Mlp, Normalisation};
+pub use rbf::{train_rbf, OutputFrame, Rbf, RbfReport, RbfSettings};
+pub use select::{choose, cross_validate, Choice, CvStats};
 pub use synthetic::{synthetic_calibration, SyntheticErrors};
+pub use train::{
+    train, CompensatorSpec, IwoSettings, LmTrainSettings, MlpSpec, TlboTrainSettings, TrainError,
+    TrainReport, Trainer,
+};
 
 /// A learned residual model: what the geometric and compliance model leave.
 ///
@@ -44,6 +57,70 @@ pub use synthetic::{synthetic_calibration, SyntheticErrors};
 pub trait Compensator: Send + Sync {
     fn residual(&self, q: &[f64], tau: &[f64]) -> Vector3<f64>;
     fn name(&self) -> &str;
+    /// The residual at a given payload mass [kg] (for compensators with a
+    /// payload input; the default ignores it).
+    fn residual_at(&self, q: &[f64], tau: &[f64], payload_kg: f64) -> Vector3<f64> {
+        let _ = payload_kg;
+        self.residual(q, tau)
+    }
+    /// `∂residual/∂q` [m/rad], 3×N, for the IK Jacobian; `None` when it is
+    /// negligible or unknown (the IK then treats the residual as locally constant).
+    fn jacobian_q(&self, q: &[f64], tau: &[f64], payload_kg: f64) -> Option<Matrix3xX<f64>> {
+        let _ = (q, tau, payload_kg);
+        None
+    }
+    /// The storable form for the model file; `None` for compensators that
+    /// cannot be stored (the file then carries no compensator).
+    fn stored(&self) -> Option<StoredCompensator> {
+        None
+    }
+}
+
+/// A compensator as the model file stores it, tagged by `kind`. An unknown kind
+/// fails to parse.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum StoredCompensator {
+    /// Joint-space MLP (SKCM-NN, SKCM-IWONN, SKCM-TLBONN).
+    Mlp(Mlp),
+    /// Torque-space RBF (KM-RBF).
+    Rbf(Rbf),
+}
+
+impl StoredCompensator {
+    pub fn validate(&self) -> Result<(), String> {
+        match self {
+            StoredCompensator::Mlp(m) => m.validate(),
+            StoredCompensator::Rbf(r) => r.validate(),
+        }
+    }
+
+    pub fn dof(&self) -> usize {
+        match self {
+            StoredCompensator::Mlp(m) => m.dof,
+            StoredCompensator::Rbf(r) => r.dof,
+        }
+    }
+
+    pub fn into_arc(self) -> Arc<dyn Compensator> {
+        match self {
+            StoredCompensator::Mlp(m) => Arc::new(m),
+            StoredCompensator::Rbf(r) => Arc::new(r),
+        }
+    }
+}
+
+/// One training sample of a compensator: commanded joints, gravity torques and
+/// payload of the pose, and the residual the model-based part leaves.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sample {
+    /// Model-convention joints [rad].
+    pub q: Vec<f64>,
+    /// Gravity torques of the calibrated model at `q` [N·m].
+    pub tau: Vec<f64>,
+    pub payload_kg: f64,
+    /// Measured minus predicted position [m], registered base frame.
+    pub residual: Vector3<f64>,
 }
 
 /// Errors of the compensated model and its files.
@@ -122,8 +199,36 @@ impl CompensatedModel {
 
     /// Gravity torques [N·m] of the calibrated model at `q` with `payload_kg`.
     pub fn torques(&self, q: &[f64]) -> Result<Vec<f64>, KinematicsError> {
+        self.torques_at(q, self.payload_kg)
+    }
+
+    /// Gravity torques [N·m] of the calibrated model at `q` with a given payload [kg].
+    pub fn torques_at(&self, q: &[f64], payload_kg: f64) -> Result<Vec<f64>, KinematicsError> {
         let c = chain(&self.calibrated, q)?;
-        Ok(gravity_torques_of(&self.calibrated, &c, self.payload_kg))
+        Ok(gravity_torques_of(&self.calibrated, &c, payload_kg))
+    }
+
+    /// Training samples of a compensator on top of this model (its own
+    /// compensator, if any, is ignored): residual = measured position mapped
+    /// into the registered base frame minus `FK_cal(q + c∘τ)`, each pose at its
+    /// own payload. Every measurement is taken to be in `cell_from_base`'s frame.
+    pub fn samples(&self, data: &[Measurement]) -> Result<Vec<Sample>, KinematicsError> {
+        let base_only = CompensatedModel {
+            compensator: None,
+            ..self.clone()
+        };
+        let to_base = self.cell_from_base.inverse();
+        data.iter()
+            .map(|m| {
+                let p = base_only.predict_detailed_at(&m.q, m.payload_mass)?;
+                Ok(Sample {
+                    q: m.q.clone(),
+                    tau: self.torques_at(&m.q, m.payload_mass)?,
+                    payload_kg: m.payload_mass,
+                    residual: to_base.transform_point(&m.position) - p.pose.p,
+                })
+            })
+            .collect()
     }
 
     fn deflect(&self, q: &[f64], tau: &[f64]) -> Vec<f64> {
@@ -136,10 +241,19 @@ impl CompensatedModel {
 
     /// Full prediction in the registered base frame.
     pub fn predict_detailed(&self, q: &[f64]) -> Result<Prediction, KinematicsError> {
+        self.predict_detailed_at(q, self.payload_kg)
+    }
+
+    /// Full prediction in the registered base frame with a given payload [kg].
+    pub fn predict_detailed_at(
+        &self,
+        q: &[f64],
+        payload_kg: f64,
+    ) -> Result<Prediction, KinematicsError> {
         let m = &self.calibrated;
         let needs_tau = m.has_compliance() || self.compensator.is_some();
         let tau = if needs_tau {
-            self.torques(q)?
+            self.torques_at(q, payload_kg)?
         } else {
             vec![0.0; m.dof()]
         };
@@ -150,7 +264,7 @@ impl CompensatedModel {
         };
         let mut pose = fk(m, &deflected)?;
         if let Some(c) = &self.compensator {
-            pose.p += c.residual(q, &tau);
+            pose.p += c.residual_at(q, &tau, payload_kg);
         }
         Ok(Prediction {
             pose,
@@ -171,9 +285,9 @@ impl CompensatedModel {
 
     /// Predicted pose (registered base frame) and its quasi-Newton Jacobian
     /// (6×N, rows `[v; ω]`, base frame): the geometric Jacobian of the
-    /// calibrated chain at the deflected joints, neglecting `∂τ/∂q` and the
-    /// compensator's own derivative (both small against the arm's lever arms:
-    /// relative size `‖c·∂τ/∂q‖` ≈ 1e-3).
+    /// calibrated chain at the deflected joints plus the compensator's
+    /// `∂NN/∂q` on the position rows (when it gives one), neglecting `∂τ/∂q`
+    /// (small against the arm's lever arms: relative size `‖c·∂τ/∂q‖` ≈ 1e-3).
     pub fn predict_base_with_jacobian(
         &self,
         q: &[f64],
@@ -186,14 +300,18 @@ impl CompensatedModel {
         } else {
             Vec::new()
         };
-        let (mut pose, jac) = if m.has_compliance() {
+        let (mut pose, mut jac) = if m.has_compliance() {
             let c1 = chain(m, &self.deflect(q, &tau))?;
             (c1.tcp, geometric_jacobian(m, &c1))
         } else {
             (c0.tcp, geometric_jacobian(m, &c0))
         };
         if let Some(c) = &self.compensator {
-            pose.p += c.residual(q, &tau);
+            pose.p += c.residual_at(q, &tau, self.payload_kg);
+            if let Some(d) = c.jacobian_q(q, &tau, self.payload_kg) {
+                let mut v = jac.rows_mut(0, 3);
+                v += d;
+            }
         }
         Ok((pose, jac))
     }
@@ -255,5 +373,57 @@ mod tests {
         let (pj, _) = m.predict_base_with_jacobian(&q).unwrap();
         assert!((pj.p - expect.p).norm() < 1e-14);
         assert!(format!("{m:?}").contains("constant"));
+    }
+
+    /// With a rigid calibrated model the position rows of the IK Jacobian are
+    /// exact, so they must equal central differences of the prediction,
+    /// compensator included.
+    #[test]
+    fn ik_jacobian_includes_the_compensator_derivative() {
+        use crate::compensate::mlp::Shape;
+        let nominal = preset("ur10").unwrap();
+        let features = Features {
+            sin_cos: true,
+            payload: false,
+        };
+        let shape = Shape {
+            inputs: features.count(6),
+            hidden: 8,
+            outputs: 3,
+        };
+        let weights: Vec<f64> = (0..shape.n_weights())
+            .map(|k| ((k as f64) * 0.7).sin())
+            .collect();
+        let net = Mlp {
+            dof: 6,
+            hidden: 8,
+            features,
+            weights,
+            input_norm: Normalisation {
+                centre: vec![0.1; shape.inputs],
+                scale: vec![0.5; shape.inputs],
+            },
+            output_norm: Normalisation {
+                centre: vec![0.0; 3],
+                scale: vec![2e3; 3],
+            },
+        };
+        let mut m = CompensatedModel::from_nominal(nominal);
+        m.compensator = Some(Arc::new(net));
+        let q = [0.3, -1.0, 1.2, -0.5, 0.8, 0.2];
+        let (_, jac) = m.predict_base_with_jacobian(&q).unwrap();
+        let mut plain = m.clone();
+        plain.compensator = None;
+        let (_, jac0) = plain.predict_base_with_jacobian(&q).unwrap();
+        assert!((jac.rows(0, 3) - jac0.rows(0, 3)).norm() > 1e-5);
+        let h = 1e-6;
+        for k in 0..6 {
+            let (mut qp, mut qm) = (q, q);
+            qp[k] += h;
+            qm[k] -= h;
+            let fd = (m.predict_base(&qp).unwrap().p - m.predict_base(&qm).unwrap().p) / (2.0 * h);
+            let col = jac.fixed_view::<3, 1>(0, k);
+            assert!((col - fd).norm() < 1e-7, "joint {k}: {col} vs {fd}");
+        }
     }
 }

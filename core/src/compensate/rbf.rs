@@ -1,0 +1,416 @@
+//! KM-RBF (seed ch. 3, eqs. 3.10–3.12): a radial basis network from the gravity
+//! torques to the position residual, grown greedily.
+//!
+//! Hidden unit `i`: `o_i = exp(−n²)`, `n = ‖w_i − p‖·b` (eqs. 3.10–3.11) with the
+//! input `p` the normalised gravity torques and one bias `b = √ln2 / spread` for
+//! all units (MATLAB `newrb`: a unit answers 0.5 at distance `spread`). Linear
+//! output layer with bias. Training (§3.2, as `newrb`): start with no unit; run
+//! the network, add a unit centred on the training input with the largest
+//! residual error, re-solve the linear layer by least squares (SVD), repeat up to
+//! `max_neurons` (40 in the seed). The spread and the number of units are chosen
+//! on a held-out part of the training set ([`RbfSettings`]); the network is then
+//! re-grown on all training samples with that spread and size.
+//!
+//! Inputs: the gravity torques τ [N·m] at the commanded joints, min–max
+//! normalised to `[−1, 1]` per joint over the training set (joints whose torque
+//! never changes, e.g. joint 1 of a floor robot, drop out). Outputs: the residual
+//! [m], in the registered base frame (`OutputFrame::Base`, the seed's choice)
+//! or turned by `−q1` about the base z axis (`OutputFrame::Joint1`): gravity
+//! torques do not see `q1`, while an error caused by them turns with the arm
+//! about joint 1, so a network of τ alone can only learn it in a frame that
+//! turns with joint 1 (exact for a floor or ceiling robot whose joint 1 axis is
+//! the base z axis). The derivative in `q` is that of the frame rotation; the
+//! torques' own dependence on `q` is neglected as in the IK's quasi-Newton
+//! Jacobian (see [`CompensatedModel::predict_base_with_jacobian`](super::CompensatedModel::predict_base_with_jacobian)).
+
+use super::mlp::Normalisation;
+use super::{Compensator, Sample};
+use nalgebra::{DMatrix, Matrix3, Matrix3xX, Vector3};
+use rand::seq::SliceRandom;
+use rand::Rng;
+use serde::{Deserialize, Serialize};
+
+/// Frame of the RBF outputs (module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum OutputFrame {
+    Base,
+    Joint1,
+}
+
+/// A trained RBF network (a [`Compensator`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Rbf {
+    pub dof: usize,
+    pub output_frame: OutputFrame,
+    pub input_norm: Normalisation,
+    /// Spread in normalised torque units.
+    pub spread: f64,
+    /// Centres, `dof` values each (normalised torques), flat.
+    pub centres: Vec<f64>,
+    /// Output weights, row-major `3 × (units + 1)`; the last column is the bias.
+    pub weights: Vec<f64>,
+}
+
+/// RBF training settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RbfSettings {
+    /// Maximum number of hidden units (seed: 40).
+    pub max_neurons: usize,
+    /// Candidate spreads [normalised torque units].
+    pub spreads: Vec<f64>,
+    /// Fraction of the training samples held out to choose spread and size.
+    pub holdout: f64,
+    pub output_frame: OutputFrame,
+}
+
+impl Default for RbfSettings {
+    fn default() -> Self {
+        RbfSettings {
+            max_neurons: 40,
+            spreads: vec![0.25, 0.5, 1.0, 2.0, 4.0],
+            holdout: 0.2,
+            output_frame: OutputFrame::Joint1,
+        }
+    }
+}
+
+/// What the RBF training chose.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RbfReport {
+    pub spread: f64,
+    pub neurons: usize,
+    /// Held-out RMS of the error norm [mm] of the chosen spread and size.
+    pub holdout_rms_mm: f64,
+}
+
+fn rot_z(a: f64) -> Matrix3<f64> {
+    let (s, c) = a.sin_cos();
+    Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
+}
+
+impl Rbf {
+    pub fn units(&self) -> usize {
+        self.centres.len() / self.dof.max(1)
+    }
+
+    pub fn validate(&self) -> Result<(), String> {
+        if self.dof == 0 || !self.centres.len().is_multiple_of(self.dof) {
+            return Err("rbf: centres must hold dof values per unit".into());
+        }
+        if self.weights.len() != 3 * (self.units() + 1) {
+            return Err(format!(
+                "rbf: {} output weights, {} units need {}",
+                self.weights.len(),
+                self.units(),
+                3 * (self.units() + 1)
+            ));
+        }
+        if !(self.spread.is_finite() && self.spread > 0.0) {
+            return Err("rbf: spread must be positive".into());
+        }
+        if self
+            .centres
+            .iter()
+            .chain(&self.weights)
+            .any(|v| !v.is_finite())
+        {
+            return Err("rbf: centres and weights must be finite".into());
+        }
+        self.input_norm.validate(self.dof, "rbf input", false)
+    }
+
+    /// Output in the network's own frame [m].
+    fn local(&self, tau: &[f64]) -> Vector3<f64> {
+        let mut p = tau.to_vec();
+        self.input_norm.apply(&mut p);
+        let b = std::f64::consts::LN_2.sqrt() / self.spread;
+        let k = self.units();
+        let mut y = Vector3::new(
+            self.weights[k],
+            self.weights[2 * k + 1],
+            self.weights[3 * k + 2],
+        );
+        for (i, c) in self.centres.chunks_exact(self.dof).enumerate() {
+            let d2: f64 = c.iter().zip(&p).map(|(a, b)| (a - b) * (a - b)).sum();
+            let o = (-d2 * b * b).exp();
+            for r in 0..3 {
+                y[r] += self.weights[r * (k + 1) + i] * o;
+            }
+        }
+        y
+    }
+
+    pub fn eval(&self, q: &[f64], tau: &[f64]) -> Vector3<f64> {
+        let y = self.local(tau);
+        match self.output_frame {
+            OutputFrame::Base => y,
+            OutputFrame::Joint1 => rot_z(q[0]) * y,
+        }
+    }
+}
+
+impl Compensator for Rbf {
+    fn residual(&self, q: &[f64], tau: &[f64]) -> Vector3<f64> {
+        self.eval(q, tau)
+    }
+    fn jacobian_q(&self, q: &[f64], tau: &[f64], _payload_kg: f64) -> Option<Matrix3xX<f64>> {
+        match self.output_frame {
+            OutputFrame::Base => None,
+            OutputFrame::Joint1 => {
+                let y = self.local(tau);
+                let (s, c) = q[0].sin_cos();
+                let mut j = Matrix3xX::zeros(q.len());
+                j[(0, 0)] = -s * y.x - c * y.y;
+                j[(1, 0)] = c * y.x - s * y.y;
+                Some(j)
+            }
+        }
+    }
+    fn name(&self) -> &str {
+        "rbf"
+    }
+    fn stored(&self) -> Option<super::StoredCompensator> {
+        Some(super::StoredCompensator::Rbf(self.clone()))
+    }
+}
+
+/// Targets of the RBF: residuals in its output frame [m].
+fn local_targets(samples: &[Sample], frame: OutputFrame) -> Vec<Vector3<f64>> {
+    samples
+        .iter()
+        .map(|s| match frame {
+            OutputFrame::Base => s.residual,
+            OutputFrame::Joint1 => rot_z(s.q[0]).transpose() * s.residual,
+        })
+        .collect()
+}
+
+/// Called after each growth step with (units, output weights, centre indices).
+type GrowStep<'a> = dyn FnMut(usize, &[f64], &[usize]) + 'a;
+
+/// Grows a network on `(inputs, targets)` (normalised torques, local residuals)
+/// and calls `each(units, weights, centres)` after every growth step (0 units
+/// first). Returns after `max_neurons` units or when every input is a centre.
+fn grow(
+    inputs: &[Vec<f64>],
+    targets: &[Vector3<f64>],
+    spread: f64,
+    max_neurons: usize,
+    each: &mut GrowStep,
+) {
+    let n = inputs.len();
+    let b2 = std::f64::consts::LN_2 / (spread * spread);
+    let mut centres: Vec<usize> = Vec::new();
+    let mut design = DMatrix::from_element(n, 1, 1.0);
+    let y = DMatrix::from_fn(n, 3, |i, r| targets[i][r]);
+    loop {
+        let k = centres.len();
+        let svd = design.clone().svd(true, true);
+        let w = match svd.solve(&y, 1e-12 * svd.singular_values.max()) {
+            Ok(w) => w,
+            Err(_) => return,
+        };
+        // Weights row-major 3 × (k + 1), bias last; design columns are units then bias.
+        let mut flat = vec![0.0; 3 * (k + 1)];
+        for r in 0..3 {
+            for c in 0..k {
+                flat[r * (k + 1) + c] = w[(c + 1, r)];
+            }
+            flat[r * (k + 1) + k] = w[(0, r)];
+        }
+        each(k, &flat, &centres);
+        if k >= max_neurons || k >= n {
+            return;
+        }
+        let fitted = &design * &w;
+        let worst = (0..n).filter(|i| !centres.contains(i)).max_by(|&a, &b| {
+            let ea = (y.row(a) - fitted.row(a)).norm_squared();
+            let eb = (y.row(b) - fitted.row(b)).norm_squared();
+            ea.total_cmp(&eb)
+        });
+        let Some(c) = worst else { return };
+        centres.push(c);
+        let col = DMatrix::from_fn(n, 1, |i, _| {
+            let d2: f64 = inputs[i]
+                .iter()
+                .zip(&inputs[c])
+                .map(|(a, b)| (a - b) * (a - b))
+                .sum();
+            (-d2 * b2).exp()
+        });
+        let cols = design.ncols();
+        design = design.insert_column(cols, 0.0);
+        design.set_column(cols, &col.column(0));
+    }
+}
+
+fn network(
+    dof: usize,
+    frame: OutputFrame,
+    norm: &Normalisation,
+    spread: f64,
+    inputs: &[Vec<f64>],
+    weights: &[f64],
+    centres: &[usize],
+) -> Rbf {
+    Rbf {
+        dof,
+        output_frame: frame,
+        input_norm: norm.clone(),
+        spread,
+        centres: centres.iter().flat_map(|&c| inputs[c].clone()).collect(),
+        weights: weights.to_vec(),
+    }
+}
+
+/// Trains an RBF network on `samples` (needs at least 5). The random generator
+/// only splits off the held-out part.
+pub fn train_rbf(
+    samples: &[Sample],
+    settings: &RbfSettings,
+    rng: &mut impl Rng,
+) -> Result<(Rbf, RbfReport), String> {
+    if samples.len() < 5 {
+        return Err(format!(
+            "the RBF needs at least 5 training poses, got {}",
+            samples.len()
+        ));
+    }
+    let dof = samples[0].tau.len();
+    let taus: Vec<Vec<f64>> = samples.iter().map(|s| s.tau.clone()).collect();
+    let norm = Normalisation::min_max(&taus, 0.0);
+    let inputs: Vec<Vec<f64>> = taus
+        .iter()
+        .map(|t| {
+            let mut t = t.clone();
+            norm.apply(&mut t);
+            t
+        })
+        .collect();
+    let frame = settings.output_frame;
+    let targets = local_targets(samples, frame);
+    let mut order: Vec<usize> = (0..samples.len()).collect();
+    order.shuffle(rng);
+    let n_hold =
+        ((samples.len() as f64 * settings.holdout).round() as usize).clamp(1, samples.len() - 2);
+    let (hold, fit) = order.split_at(n_hold);
+    let fit_in: Vec<Vec<f64>> = fit.iter().map(|&i| inputs[i].clone()).collect();
+    let fit_y: Vec<Vector3<f64>> = fit.iter().map(|&i| targets[i]).collect();
+    let mut best = (f64::INFINITY, settings.spreads[0], 0usize);
+    for &spread in &settings.spreads {
+        grow(
+            &fit_in,
+            &fit_y,
+            spread,
+            settings.max_neurons,
+            &mut |k, w, centres| {
+                let net = network(dof, OutputFrame::Base, &norm, spread, &fit_in, w, centres);
+                let mse = hold
+                    .iter()
+                    .map(|&i| (net.local(&samples[i].tau) - targets[i]).norm_squared())
+                    .sum::<f64>()
+                    / hold.len() as f64;
+                if mse < best.0 {
+                    best = (mse, spread, k);
+                }
+            },
+        );
+    }
+    let (mse, spread, neurons) = best;
+    let mut out = None;
+    grow(&inputs, &targets, spread, neurons, &mut |k, w, centres| {
+        if k == neurons {
+            out = Some(network(dof, frame, &norm, spread, &inputs, w, centres));
+        }
+    });
+    let net = out.ok_or("the RBF least-squares problem could not be solved")?;
+    Ok((
+        net,
+        RbfReport {
+            spread,
+            neurons,
+            holdout_rms_mm: mse.sqrt() * 1e3,
+        },
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+
+    fn sample(q0: f64, tau: [f64; 3], r: Vector3<f64>) -> Sample {
+        Sample {
+            q: vec![q0, 0.0, 0.0],
+            tau: tau.to_vec(),
+            payload_kg: 0.0,
+            residual: r,
+        }
+    }
+
+    /// A smooth function of the torques, turned with joint 1, is learned to a
+    /// small fraction of its size on unseen inputs.
+    #[test]
+    fn learns_a_smooth_torque_function_in_the_joint1_frame() {
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let f = |t: &[f64; 3]| {
+            Vector3::new(
+                1e-4 * (t[1] / 900.0).sin(),
+                5e-5 * (t[2] / 300.0) * (t[1] / 900.0),
+                -2e-4 * (t[1] / 900.0).powi(2),
+            )
+        };
+        let draw = |rng: &mut ChaCha8Rng| {
+            let t = [
+                0.0,
+                rng.gen_range(-2000.0..2000.0),
+                rng.gen_range(-600.0..600.0),
+            ];
+            let q0: f64 = rng.gen_range(-3.0..3.0);
+            sample(q0, t, rot_z(q0) * f(&t))
+        };
+        let train: Vec<Sample> = (0..300).map(|_| draw(&mut rng)).collect();
+        let test: Vec<Sample> = (0..100).map(|_| draw(&mut rng)).collect();
+        let (net, rep) = train_rbf(&train, &RbfSettings::default(), &mut rng).unwrap();
+        assert!(rep.neurons > 3 && rep.neurons <= 40, "{rep:?}");
+        net.validate().unwrap();
+        let (mut before, mut after) = (0.0, 0.0);
+        for s in &test {
+            before += s.residual.norm();
+            after += (s.residual - net.residual(&s.q, &s.tau)).norm();
+        }
+        assert!(after < 0.05 * before, "{after} vs {before}");
+        // The frame rotation's derivative matches finite differences.
+        let s = &test[0];
+        let j = net.jacobian_q(&s.q, &s.tau, 0.0).unwrap();
+        let h = 1e-6;
+        let mut qp = s.q.clone();
+        qp[0] += h;
+        let mut qm = s.q.clone();
+        qm[0] -= h;
+        let fd = (net.eval(&qp, &s.tau) - net.eval(&qm, &s.tau)) / (2.0 * h);
+        assert!((j.column(0) - fd).norm() < 1e-9 * (1.0 + fd.norm()));
+    }
+
+    /// Pure noise: the held-out choice keeps the network tiny.
+    #[test]
+    fn noise_gets_few_units() {
+        let mut rng = ChaCha8Rng::seed_from_u64(4);
+        let train: Vec<Sample> = (0..200)
+            .map(|_| {
+                let t = [0.0, rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0)];
+                let r = Vector3::new(
+                    rng.gen_range(-1e-5..1e-5),
+                    rng.gen_range(-1e-5..1e-5),
+                    rng.gen_range(-1e-5..1e-5),
+                );
+                sample(0.0, t, r)
+            })
+            .collect();
+        let (_, rep) = train_rbf(&train, &RbfSettings::default(), &mut rng).unwrap();
+        assert!(rep.neurons <= 5, "{rep:?}");
+    }
+}

@@ -1,0 +1,773 @@
+//! Training of the residual compensators on [`Sample`]s: the MLP of
+//! [`mlp`](super::mlp) by Levenberg–Marquardt backpropagation (seed ch. 4, the
+//! MATLAB toolbox default `trainlm`), by invasive weed optimisation (ch. 5,
+//! eqs. 5.6–5.10) or by TLBO (ch. 6, eqs. 6.10–6.11, the engine of
+//! [`identify::tlbo`](crate::identify::tlbo)), all over the same flat weight
+//! vector in normalised units; and the RBF of [`rbf`](super::rbf) (ch. 3).
+//!
+//! Loss per sample (eqs. 5.5 / 6.9): `E = (1/3)·Σ_o e_o²` with `e` the error of
+//! the normalised outputs. LM minimises `Σ E` on the fitting part and stops
+//! early on a held-out part (MATLAB `max_fail`); IWO minimises eq. 5.7,
+//! `mean(E) + 0.7·max(E)`; TLBO minimises `mean(E)` (eq. 6.9).
+//!
+//! Readings of the seed, stated here: eq. 5.10 draws `K` "between 0 and 1",
+//! which would only ever move weights upward; as in IWO's original
+//! formulation (Mehrabian & Lucas 2006) the offspring are spread normally,
+//! `K ~ N(0, 1)`, with the σ of eq. 5.6; the initial weeds are drawn as LM's
+//! initial network (Nguyen–Widrow, clamped to the bounds) rather than uniformly
+//! in `[−1.7, 1.7]`, which saturates the tansig units of normalised inputs and
+//! leaves σ ≤ 0.05 too little room. The seed gives no iteration counts for
+//! IWO and TLBO; the defaults below give both about 25 000 loss evaluations.
+//! Every random draw comes from the injected seeded generator; the result is
+//! bit-for-bit reproducible (parallel evaluation keeps a fixed reduction order).
+
+use super::mlp::{Features, Mlp, Normalisation, Shape};
+use super::rbf::{train_rbf, RbfReport, RbfSettings};
+use super::{Sample, StoredCompensator};
+use crate::identify::tlbo::{self, TlboSettings};
+use nalgebra::{DMatrix, DVector};
+use rand::seq::SliceRandom;
+use rand::Rng;
+use rand_distr::{Distribution, StandardNormal};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// Network size and inputs.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct MlpSpec {
+    pub hidden: usize,
+    pub features: Features,
+}
+
+impl MlpSpec {
+    /// The SKCM-NN network of ch. 4: 6-20-3 on the joint angles.
+    pub const SKCM_NN: MlpSpec = MlpSpec {
+        hidden: 20,
+        features: Features::JOINTS,
+    };
+    /// The IWO / TLBO network of ch. 5–6: 6-5-3 (53 weights) on the joint angles.
+    pub const SMALL: MlpSpec = MlpSpec {
+        hidden: 5,
+        features: Features::JOINTS,
+    };
+}
+
+/// Levenberg–Marquardt backpropagation (MATLAB `trainlm` defaults).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LmTrainSettings {
+    pub max_epochs: usize,
+    pub mu: f64,
+    pub mu_dec: f64,
+    pub mu_inc: f64,
+    pub mu_max: f64,
+    /// Fraction of the training samples held out for early stopping.
+    pub holdout: f64,
+    /// Stop after this many epochs in a row without a better held-out loss.
+    pub max_fail: usize,
+}
+
+impl Default for LmTrainSettings {
+    fn default() -> Self {
+        LmTrainSettings {
+            max_epochs: 300,
+            mu: 1e-3,
+            mu_dec: 0.1,
+            mu_inc: 10.0,
+            mu_max: 1e10,
+            holdout: 0.15,
+            max_fail: 6,
+        }
+    }
+}
+
+/// Invasive weed optimisation, seed ch. 5 hyperparameters.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct IwoSettings {
+    pub initial_population: usize,
+    pub max_population: usize,
+    pub seeds_min: usize,
+    pub seeds_max: usize,
+    pub sigma_initial: f64,
+    pub sigma_final: f64,
+    /// Nonlinear modulation index `n` of eq. 5.6.
+    pub exponent: f64,
+    /// Weights stay in `[−bound, bound]`.
+    pub bound: f64,
+    /// Weight of `max(E)` in eq. 5.7 (`mean` has weight 1).
+    pub max_weight: f64,
+    pub iterations: usize,
+}
+
+impl Default for IwoSettings {
+    fn default() -> Self {
+        IwoSettings {
+            initial_population: 10,
+            max_population: 50,
+            seeds_min: 0,
+            seeds_max: 5,
+            sigma_initial: 0.05,
+            sigma_final: 0.0005,
+            exponent: 2.0,
+            bound: 1.7,
+            max_weight: 0.7,
+            iterations: 200,
+        }
+    }
+}
+
+/// TLBO over the weights (ch. 6).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TlboTrainSettings {
+    pub population: usize,
+    pub generations: usize,
+    /// Weights stay in `[−bound, bound]` (the IWO bound of ch. 5).
+    pub bound: f64,
+}
+
+impl Default for TlboTrainSettings {
+    fn default() -> Self {
+        TlboTrainSettings {
+            population: 50,
+            generations: 250,
+            bound: 1.7,
+        }
+    }
+}
+
+/// How the MLP weights are found.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "trainer", rename_all = "kebab-case")]
+pub enum Trainer {
+    Lm(LmTrainSettings),
+    Iwo(IwoSettings),
+    Tlbo(TlboTrainSettings),
+}
+
+impl Trainer {
+    pub fn name(&self) -> &'static str {
+        match self {
+            Trainer::Lm(_) => "lm",
+            Trainer::Iwo(_) => "iwo",
+            Trainer::Tlbo(_) => "tlbo",
+        }
+    }
+}
+
+/// Which compensator to train.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum CompensatorSpec {
+    Mlp { spec: MlpSpec, trainer: Trainer },
+    Rbf(RbfSettings),
+}
+
+impl CompensatorSpec {
+    /// SKCM-NN: 6-20-3 by LM backpropagation.
+    pub fn skcm_nn() -> Self {
+        CompensatorSpec::Mlp {
+            spec: MlpSpec::SKCM_NN,
+            trainer: Trainer::Lm(LmTrainSettings::default()),
+        }
+    }
+    /// SKCM-IWONN: 6-5-3 by IWO.
+    pub fn skcm_iwonn() -> Self {
+        CompensatorSpec::Mlp {
+            spec: MlpSpec::SMALL,
+            trainer: Trainer::Iwo(IwoSettings::default()),
+        }
+    }
+    /// SKCM-TLBONN: 6-5-3 by TLBO.
+    pub fn skcm_tlbonn() -> Self {
+        CompensatorSpec::Mlp {
+            spec: MlpSpec::SMALL,
+            trainer: Trainer::Tlbo(TlboTrainSettings::default()),
+        }
+    }
+    /// KM-RBF's network.
+    pub fn km_rbf() -> Self {
+        CompensatorSpec::Rbf(RbfSettings::default())
+    }
+
+    pub fn label(&self) -> &'static str {
+        match self {
+            CompensatorSpec::Rbf(_) => "rbf",
+            CompensatorSpec::Mlp { trainer, .. } => match trainer {
+                Trainer::Lm(_) => "nn",
+                Trainer::Iwo(_) => "iwonn",
+                Trainer::Tlbo(_) => "tlbonn",
+            },
+        }
+    }
+}
+
+/// Why training failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum TrainError {
+    #[error("training cancelled")]
+    Cancelled,
+    #[error("{0}")]
+    Data(String),
+}
+
+/// What a training run did.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TrainReport {
+    /// `lm`, `iwo`, `tlbo` or `rbf`.
+    pub trainer: String,
+    pub samples: usize,
+    /// Epochs (LM), iterations (IWO) or generations (TLBO) run; RBF units.
+    pub epochs: usize,
+    pub evaluations: usize,
+    /// Final training loss (normalised units, see module docs).
+    pub loss: f64,
+    /// Why it stopped.
+    pub stop: String,
+    /// Training RMS of the residual error norm after compensation [mm].
+    pub rms_mm: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rbf: Option<RbfReport>,
+}
+
+/// Normalised training data in flat row-major arrays.
+struct Prepared {
+    shape: Shape,
+    x: Vec<f64>,
+    y: Vec<f64>,
+    input_norm: Normalisation,
+    output_norm: Normalisation,
+}
+
+impl Prepared {
+    fn new(samples: &[Sample], spec: &MlpSpec) -> Prepared {
+        let dof = samples[0].q.len();
+        let mut raw = Vec::with_capacity(samples.len());
+        for s in samples {
+            let mut f = Vec::new();
+            spec.features.write(&s.q, s.payload_kg, &mut f);
+            raw.push(f);
+        }
+        let outs: Vec<Vec<f64>> = samples
+            .iter()
+            .map(|s| s.residual.iter().copied().collect())
+            .collect();
+        let input_norm = Normalisation::min_max(&raw, 0.0);
+        let output_norm = Normalisation::min_max(&outs, 1.0);
+        let mut x = Vec::with_capacity(raw.len() * input_norm.len());
+        for mut r in raw {
+            input_norm.apply(&mut r);
+            x.extend(r);
+        }
+        let mut y = Vec::with_capacity(outs.len() * 3);
+        for mut r in outs {
+            output_norm.apply(&mut r);
+            y.extend(r);
+        }
+        Prepared {
+            shape: Shape {
+                inputs: spec.features.count(dof),
+                hidden: spec.hidden,
+                outputs: 3,
+            },
+            x,
+            y,
+            input_norm,
+            output_norm,
+        }
+    }
+
+    fn n(&self) -> usize {
+        self.y.len() / 3
+    }
+
+    fn xi(&self, i: usize) -> &[f64] {
+        let ni = self.shape.inputs;
+        &self.x[i * ni..(i + 1) * ni]
+    }
+
+    fn yi(&self, i: usize) -> &[f64] {
+        &self.y[3 * i..3 * i + 3]
+    }
+
+    /// Per-sample loss `E_i` of the samples `idx`.
+    fn sample_losses(&self, w: &[f64], idx: &[usize], out: &mut Vec<f64>) {
+        let s = self.shape;
+        let mut h = vec![0.0; s.hidden];
+        let mut y = [0.0; 3];
+        out.clear();
+        for &i in idx {
+            s.forward(w, self.xi(i), &mut h, &mut y);
+            let t = self.yi(i);
+            out.push(((y[0] - t[0]).powi(2) + (y[1] - t[1]).powi(2) + (y[2] - t[2]).powi(2)) / 3.0);
+        }
+    }
+
+    fn mean_loss(&self, w: &[f64], idx: &[usize]) -> f64 {
+        let mut e = Vec::with_capacity(idx.len());
+        self.sample_losses(w, idx, &mut e);
+        e.iter().sum::<f64>() / e.len().max(1) as f64
+    }
+
+    fn into_mlp(self, spec: &MlpSpec, dof: usize, weights: Vec<f64>) -> Mlp {
+        Mlp {
+            dof,
+            hidden: spec.hidden,
+            features: spec.features,
+            weights,
+            input_norm: self.input_norm,
+            output_norm: self.output_norm,
+        }
+    }
+}
+
+/// Nguyen–Widrow initialisation of the hidden layer (MATLAB `initnw`), output
+/// layer uniform in `[−0.5, 0.5]`.
+fn nguyen_widrow(shape: &Shape, rng: &mut impl Rng) -> Vec<f64> {
+    let (ni, nh) = (shape.inputs, shape.hidden);
+    let beta = 0.7 * (nh as f64).powf(1.0 / ni.max(1) as f64);
+    let mut w = vec![0.0; shape.n_weights()];
+    for j in 0..nh {
+        let row: Vec<f64> = (0..ni).map(|_| rng.gen_range(-1.0..1.0)).collect();
+        let norm = row.iter().map(|v| v * v).sum::<f64>().sqrt().max(1e-12);
+        for i in 0..ni {
+            w[j * ni + i] = beta * row[i] / norm;
+        }
+        w[nh * ni + j] = rng.gen_range(-beta..beta);
+    }
+    for v in w[nh * (ni + 1)..].iter_mut() {
+        *v = rng.gen_range(-0.5..0.5);
+    }
+    w
+}
+
+fn lm(
+    data: &Prepared,
+    settings: &LmTrainSettings,
+    rng: &mut impl Rng,
+    progress: &mut dyn FnMut(usize, f64) -> bool,
+) -> Result<(Vec<f64>, usize, usize, f64, String), TrainError> {
+    let n = data.n();
+    let shape = data.shape;
+    let nw = shape.n_weights();
+    let mut order: Vec<usize> = (0..n).collect();
+    order.shuffle(rng);
+    let n_hold = if n >= 10 {
+        ((n as f64 * settings.holdout).round() as usize).clamp(1, n / 2)
+    } else {
+        0
+    };
+    let (hold, fit) = order.split_at(n_hold);
+    let mut w = nguyen_widrow(&shape, rng);
+    let sse = |w: &[f64]| data.mean_loss(w, fit) * fit.len() as f64 * 3.0;
+    let mut cur = sse(&w);
+    let mut best_hold = if hold.is_empty() {
+        f64::INFINITY
+    } else {
+        data.mean_loss(&w, hold)
+    };
+    let mut best_w = w.clone();
+    let mut fails = 0;
+    let mut mu = settings.mu;
+    let mut evaluations = 1;
+    let mut stop = format!("{} epochs", settings.max_epochs);
+    let mut epochs = 0;
+    let rows = fit.len() * 3;
+    let mut jac = DMatrix::<f64>::zeros(rows, nw);
+    let mut res = DVector::<f64>::zeros(rows);
+    let mut h = vec![0.0; shape.hidden];
+    let mut y = [0.0; 3];
+    let mut jrow = vec![0.0; 3 * nw];
+    for epoch in 0..settings.max_epochs {
+        epochs = epoch + 1;
+        for (r, &i) in fit.iter().enumerate() {
+            let x = data.xi(i);
+            shape.forward(&w, x, &mut h, &mut y);
+            shape.weight_jacobian(&w, x, &h, &mut jrow);
+            let t = data.yi(i);
+            for o in 0..3 {
+                res[3 * r + o] = t[o] - y[o];
+                for k in 0..nw {
+                    jac[(3 * r + o, k)] = jrow[o * nw + k];
+                }
+            }
+        }
+        let jtj = jac.tr_mul(&jac);
+        let g = jac.tr_mul(&res);
+        if g.amax() < 1e-12 {
+            stop = "gradient below 1e-12".into();
+            break;
+        }
+        let mut improved = false;
+        while mu <= settings.mu_max {
+            let mut a = jtj.clone();
+            for k in 0..nw {
+                a[(k, k)] += mu;
+            }
+            if let Some(ch) = a.cholesky() {
+                let dw = ch.solve(&g);
+                let trial: Vec<f64> = w.iter().zip(dw.iter()).map(|(a, b)| a + b).collect();
+                evaluations += 1;
+                let s = sse(&trial);
+                if s < cur {
+                    w = trial;
+                    cur = s;
+                    mu *= settings.mu_dec;
+                    improved = true;
+                    break;
+                }
+            }
+            mu *= settings.mu_inc;
+        }
+        if !improved {
+            stop = format!("mu above {:e}", settings.mu_max);
+            break;
+        }
+        if !hold.is_empty() {
+            let v = data.mean_loss(&w, hold);
+            if v < best_hold {
+                best_hold = v;
+                best_w.clone_from(&w);
+                fails = 0;
+            } else {
+                fails += 1;
+                if fails >= settings.max_fail {
+                    stop = format!(
+                        "early stop: held-out loss not better for {} epochs",
+                        settings.max_fail
+                    );
+                    break;
+                }
+            }
+        } else {
+            best_w.clone_from(&w);
+        }
+        if !progress(epoch, cur / rows as f64) {
+            return Err(TrainError::Cancelled);
+        }
+    }
+    let loss = data.mean_loss(&best_w, fit);
+    Ok((best_w, epochs, evaluations, loss, stop))
+}
+
+/// Eq. 5.7 (`max_weight` = 0.7) or eq. 6.9 (`max_weight` = 0) on all samples.
+fn population_loss(data: &Prepared, all: &[usize], w: &[f64], max_weight: f64) -> f64 {
+    let mut e = Vec::with_capacity(all.len());
+    data.sample_losses(w, all, &mut e);
+    let mean = e.iter().sum::<f64>() / e.len().max(1) as f64;
+    if max_weight == 0.0 {
+        return mean;
+    }
+    mean + max_weight * e.iter().cloned().fold(0.0, f64::max)
+}
+
+fn iwo(
+    data: &Prepared,
+    s: &IwoSettings,
+    rng: &mut impl Rng,
+    progress: &mut dyn FnMut(usize, f64) -> bool,
+) -> Result<(Vec<f64>, usize, usize, f64, String), TrainError> {
+    let all: Vec<usize> = (0..data.n()).collect();
+    let loss = |w: &[f64]| population_loss(data, &all, w, s.max_weight);
+    let b = s.bound;
+    let mut pop: Vec<(Vec<f64>, f64)> = (0..s.initial_population.max(1))
+        .map(|_| {
+            let mut w = nguyen_widrow(&data.shape, rng);
+            w.iter_mut().for_each(|v| *v = v.clamp(-b, b));
+            w
+        })
+        .collect::<Vec<_>>()
+        .into_par_iter()
+        .map(|w| {
+            let l = loss(&w);
+            (w, l)
+        })
+        .collect();
+    let mut evaluations = pop.len();
+    let itmax = s.iterations.max(1) as f64;
+    for it in 0..s.iterations {
+        // Eq. 5.6.
+        let sigma = ((itmax - it as f64).powf(s.exponent) / itmax.powf(s.exponent))
+            * (s.sigma_initial - s.sigma_final)
+            + s.sigma_final;
+        let lmin = pop.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
+        let lmax = pop.iter().map(|p| p.1).fold(f64::NEG_INFINITY, f64::max);
+        let mut children = Vec::new();
+        for (x, l) in &pop {
+            // Eqs. 5.8–5.9.
+            let r = if lmax > lmin {
+                (l - lmax) / (lmin - lmax)
+            } else {
+                1.0
+            };
+            let seeds =
+                (s.seeds_min as f64 + (s.seeds_max - s.seeds_min) as f64 * r).floor() as usize;
+            for _ in 0..seeds {
+                // Eq. 5.10 with K ~ N(0, 1) (module docs), bounded.
+                let child: Vec<f64> = x
+                    .iter()
+                    .map(|v| {
+                        let k: f64 = StandardNormal.sample(rng);
+                        (v + sigma * k).clamp(-b, b)
+                    })
+                    .collect();
+                children.push(child);
+            }
+        }
+        evaluations += children.len();
+        let scored: Vec<(Vec<f64>, f64)> = children
+            .into_par_iter()
+            .map(|w| {
+                let l = loss(&w);
+                (w, l)
+            })
+            .collect();
+        pop.extend(scored);
+        // Ranking and selection: keep the best `max_population` (stable sort).
+        pop.sort_by(|a, b| a.1.total_cmp(&b.1));
+        pop.truncate(s.max_population.max(1));
+        if !progress(it, pop[0].1) {
+            return Err(TrainError::Cancelled);
+        }
+    }
+    let (w, l) = pop.swap_remove(0);
+    Ok((
+        w,
+        s.iterations,
+        evaluations,
+        l,
+        format!("{} iterations", s.iterations),
+    ))
+}
+
+fn tlbo_train(
+    data: &Prepared,
+    s: &TlboTrainSettings,
+    rng: &mut impl Rng,
+    progress: &mut dyn FnMut(usize, f64) -> bool,
+) -> Result<(Vec<f64>, usize, usize, f64, String), TrainError> {
+    let nw = data.shape.n_weights();
+    let all: Vec<usize> = (0..data.n()).collect();
+    let mut cost = |w: &[f64]| population_loss(data, &all, w, 0.0);
+    let lo = vec![-s.bound; nw];
+    let hi = vec![s.bound; nw];
+    let settings = TlboSettings {
+        population: s.population,
+        generations: s.generations,
+        seed: 0,
+    };
+    let mut cancelled = false;
+    let r = tlbo::minimise(&mut cost, &lo, &hi, &settings, rng, &mut |g, best| {
+        cancelled = !progress(g, best);
+        !cancelled
+    });
+    if cancelled {
+        return Err(TrainError::Cancelled);
+    }
+    let gens = r.history.len();
+    Ok((
+        r.best,
+        gens,
+        r.evaluations,
+        r.best_cost,
+        format!("{gens} generations"),
+    ))
+}
+
+fn training_rms_mm(c: &StoredCompensator, samples: &[Sample]) -> f64 {
+    let c = c.clone().into_arc();
+    let ss: f64 = samples
+        .iter()
+        .map(|s| (s.residual - c.residual_at(&s.q, &s.tau, s.payload_kg)).norm_squared())
+        .sum();
+    (ss / samples.len() as f64).sqrt() * 1e3
+}
+
+/// Trains a compensator on `samples`. `progress(epoch, loss)` is called after
+/// every epoch / iteration / generation and returns false to cancel.
+pub fn train(
+    spec: &CompensatorSpec,
+    samples: &[Sample],
+    rng: &mut impl Rng,
+    progress: &mut dyn FnMut(usize, f64) -> bool,
+) -> Result<(StoredCompensator, TrainReport), TrainError> {
+    if samples.len() < 5 {
+        return Err(TrainError::Data(format!(
+            "a compensator needs at least 5 training poses, got {}",
+            samples.len()
+        )));
+    }
+    let dof = samples[0].q.len();
+    if samples.iter().any(|s| {
+        s.q.len() != dof || s.tau.len() != dof || !s.residual.iter().all(|v| v.is_finite())
+    }) {
+        return Err(TrainError::Data(
+            "training samples must have the same number of joints and finite residuals".into(),
+        ));
+    }
+    match spec {
+        CompensatorSpec::Rbf(settings) => {
+            let (net, rep) = train_rbf(samples, settings, rng).map_err(TrainError::Data)?;
+            let stored = StoredCompensator::Rbf(net);
+            if !progress(rep.neurons, rep.holdout_rms_mm) {
+                return Err(TrainError::Cancelled);
+            }
+            Ok((
+                stored.clone(),
+                TrainReport {
+                    trainer: "rbf".into(),
+                    samples: samples.len(),
+                    epochs: rep.neurons,
+                    evaluations: rep.neurons,
+                    loss: rep.holdout_rms_mm,
+                    stop: format!(
+                        "{} units, spread {} chosen on held-out data",
+                        rep.neurons, rep.spread
+                    ),
+                    rms_mm: training_rms_mm(&stored, samples),
+                    rbf: Some(rep),
+                },
+            ))
+        }
+        CompensatorSpec::Mlp { spec: m, trainer } => {
+            if m.hidden == 0 {
+                return Err(TrainError::Data(
+                    "the MLP needs at least one hidden unit".into(),
+                ));
+            }
+            let data = Prepared::new(samples, m);
+            let (w, epochs, evaluations, loss, stop) = match trainer {
+                Trainer::Lm(s) => lm(&data, s, rng, progress)?,
+                Trainer::Iwo(s) => iwo(&data, s, rng, progress)?,
+                Trainer::Tlbo(s) => tlbo_train(&data, s, rng, progress)?,
+            };
+            let stored = StoredCompensator::Mlp(data.into_mlp(m, dof, w));
+            Ok((
+                stored.clone(),
+                TrainReport {
+                    trainer: trainer.name().into(),
+                    samples: samples.len(),
+                    epochs,
+                    evaluations,
+                    loss,
+                    stop,
+                    rms_mm: training_rms_mm(&stored, samples),
+                    rbf: None,
+                },
+            ))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Vector3;
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+
+    /// Samples of a smooth joint-space function (a few tenths of a mm).
+    fn smooth(n: usize, seed: u64) -> Vec<Sample> {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        (0..n)
+            .map(|_| {
+                let q: Vec<f64> = (0..6).map(|_| rng.gen_range(-2.0..2.0)).collect();
+                let r = Vector3::new(
+                    2e-4 * (0.8 * q[1]).sin() + 5e-5 * q[2],
+                    1e-4 * (q[1] + 0.5 * q[2]).cos(),
+                    -1.5e-4 * (0.6 * q[2]).sin() * (0.5 * q[1]).cos(),
+                );
+                Sample {
+                    tau: vec![0.0; 6],
+                    q,
+                    payload_kg: 10.0,
+                    residual: r,
+                }
+            })
+            .collect()
+    }
+
+    fn mean_error_mm(c: &StoredCompensator, s: &[Sample]) -> (f64, f64) {
+        let c = c.clone().into_arc();
+        let before = s.iter().map(|s| s.residual.norm()).sum::<f64>() / s.len() as f64;
+        let after = s
+            .iter()
+            .map(|s| (s.residual - c.residual(&s.q, &s.tau)).norm())
+            .sum::<f64>()
+            / s.len() as f64;
+        (before * 1e3, after * 1e3)
+    }
+
+    #[test]
+    fn every_trainer_learns_a_smooth_residual_and_repeats_bit_for_bit() {
+        let train_set = smooth(300, 1);
+        let test_set = smooth(200, 2);
+        let quick_iwo = IwoSettings {
+            iterations: 150,
+            ..Default::default()
+        };
+        let quick_tlbo = TlboTrainSettings {
+            generations: 120,
+            ..Default::default()
+        };
+        let cases = [
+            (CompensatorSpec::skcm_nn(), 0.1),
+            (
+                CompensatorSpec::Mlp {
+                    spec: MlpSpec::SMALL,
+                    trainer: Trainer::Iwo(quick_iwo),
+                },
+                0.7,
+            ),
+            (
+                CompensatorSpec::Mlp {
+                    spec: MlpSpec::SMALL,
+                    trainer: Trainer::Tlbo(quick_tlbo),
+                },
+                0.7,
+            ),
+        ];
+        for (spec, ratio) in cases {
+            let run = || {
+                let mut rng = ChaCha8Rng::seed_from_u64(7);
+                train(&spec, &train_set, &mut rng, &mut |_, _| true).unwrap()
+            };
+            let (a, rep) = run();
+            let (b, _) = run();
+            assert_eq!(a, b, "{} is not reproducible", spec.label());
+            let (before, after) = mean_error_mm(&a, &test_set);
+            eprintln!("{}: {before} -> {after} ({rep:?})", spec.label());
+            assert!(
+                after < ratio * before,
+                "{}: {after} mm after vs {before} mm before ({rep:?})",
+                spec.label()
+            );
+        }
+    }
+
+    #[test]
+    fn cancellation_stops_training() {
+        let s = smooth(50, 3);
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        for spec in [
+            CompensatorSpec::skcm_nn(),
+            CompensatorSpec::skcm_iwonn(),
+            CompensatorSpec::skcm_tlbonn(),
+        ] {
+            let mut calls = 0;
+            let r = train(&spec, &s, &mut rng, &mut |_, _| {
+                calls += 1;
+                calls < 3
+            });
+            assert_eq!(r.unwrap_err(), TrainError::Cancelled);
+            assert_eq!(calls, 3);
+        }
+        assert!(matches!(
+            train(
+                &CompensatorSpec::skcm_nn(),
+                &s[..3],
+                &mut rng,
+                &mut |_, _| true
+            ),
+            Err(TrainError::Data(_))
+        ));
+    }
+}
