@@ -41,7 +41,7 @@ pub use file::{
 pub use mlp::{Features, Mlp, Normalisation};
 pub use rbf::{train_rbf, OutputFrame, Rbf, RbfReport, RbfSettings};
 pub use select::{choose, cross_validate, Choice, CvStats};
-pub use synthetic::{synthetic_calibration, SyntheticErrors};
+pub use synthetic::{synthetic_calibration, unmodelled_truth, SyntheticErrors};
 pub use train::{
     train, CompensatorSpec, IwoSettings, LmTrainSettings, MlpSpec, TlboTrainSettings, TrainError,
     TrainReport, Trainer,

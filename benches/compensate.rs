@@ -1,0 +1,125 @@
+//! Compensator benchmarks (YS100; synthetic calibrated model of
+//! `SyntheticErrors::typical(1e-6)`, residuals a smooth joint-space function of
+//! a few tenths of a millimetre, the model's gravity torques):
+//!
+//! - `train_{50,1000}/{lm_6-20-3,iwo_6-5-3,tlbo_6-5-3,rbf}`: one training run
+//!   with the default settings (the seed's network sizes);
+//! - `predict/mlp_6-20-3_residual`: one residual of a trained 6-20-3 network;
+//! - `predict/mlp_6-20-3_residual_and_dq`: residual plus its 3×6 derivative;
+//! - `ik/solve_{plain,compensated}`: one calibrated IK solve without and with
+//!   the 6-20-3 compensator (cycling through 1000 targets).
+//!
+//! Trainer comparison over 20 seeds (final validation error and wall time):
+//! `cargo run --release --example compare_trainers`.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use nalgebra::Vector3;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use robocal::compensate::{
+    synthetic_calibration, train, CompensatedModel, Compensator, CompensatorSpec, Sample,
+    StoredCompensator, SyntheticErrors,
+};
+use robocal::ik::{Goal, IkSettings, IkSolver, SolveOptions};
+use robocal::model::preset;
+use robocal::sim::random_configurations;
+use std::hint::black_box;
+use std::sync::Arc;
+
+fn samples(cm: &CompensatedModel, n: usize, seed: u64) -> Vec<Sample> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    random_configurations(&cm.nominal, n, &mut rng)
+        .into_iter()
+        .map(|q| Sample {
+            tau: cm.torques(&q).unwrap(),
+            residual: Vector3::new(
+                2e-4 * (0.8 * q[1]).sin() + 5e-5 * q[2],
+                1e-4 * (q[1] + 0.5 * q[2]).cos() * q[0].cos(),
+                -1.5e-4 * (0.6 * q[2]).sin() * (0.5 * q[3]).cos(),
+            ),
+            q,
+            payload_kg: cm.payload_kg,
+        })
+        .collect()
+}
+
+fn fit(spec: &CompensatorSpec, s: &[Sample]) -> StoredCompensator {
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    train(spec, s, &mut rng, &mut |_, _| true).unwrap().0
+}
+
+fn bench(c: &mut Criterion) {
+    let cm = synthetic_calibration(
+        &preset("ys100").unwrap(),
+        &SyntheticErrors::typical(1e-6),
+        3,
+    );
+    let specs = [
+        ("lm_6-20-3", CompensatorSpec::skcm_nn()),
+        ("iwo_6-5-3", CompensatorSpec::skcm_iwonn()),
+        ("tlbo_6-5-3", CompensatorSpec::skcm_tlbonn()),
+        ("rbf", CompensatorSpec::km_rbf()),
+    ];
+    for n in [50, 1000] {
+        let s = samples(&cm, n, 2);
+        let mut g = c.benchmark_group(format!("train_{n}"));
+        g.sample_size(10);
+        for (name, spec) in &specs {
+            g.bench_function(*name, |b| b.iter(|| black_box(fit(spec, black_box(&s)))));
+        }
+        g.finish();
+    }
+
+    let s = samples(&cm, 1000, 2);
+    let net = fit(&CompensatorSpec::skcm_nn(), &s).into_arc();
+    let qs: Vec<Vec<f64>> = s.iter().map(|s| s.q.clone()).collect();
+    let tau = vec![0.0; 6];
+    let mut g = c.benchmark_group("predict");
+    let mut i = 0;
+    g.bench_function("mlp_6-20-3_residual", |b| {
+        b.iter(|| {
+            i = (i + 1) % qs.len();
+            black_box(net.residual(black_box(&qs[i]), &tau))
+        })
+    });
+    let mut i = 0;
+    g.bench_function("mlp_6-20-3_residual_and_dq", |b| {
+        b.iter(|| {
+            i = (i + 1) % qs.len();
+            let q = black_box(&qs[i]);
+            black_box((net.residual(q, &tau), net.jacobian_q(q, &tau, 110.0)))
+        })
+    });
+    g.finish();
+
+    let compensated = CompensatedModel {
+        compensator: Some(Arc::clone(&net)),
+        ..cm.clone()
+    };
+    let mut g = c.benchmark_group("ik");
+    let options = SolveOptions::default();
+    for (name, m) in [("solve_plain", &cm), ("solve_compensated", &compensated)] {
+        let solver = IkSolver::new(
+            m.clone(),
+            IkSettings {
+                threads: 1,
+                ..IkSettings::default()
+            },
+        );
+        let goals: Vec<Goal> = qs
+            .iter()
+            .map(|q| Goal::from(&m.predict(q).unwrap()))
+            .collect();
+        let mut i = 0;
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                i = (i + 1) % goals.len();
+                black_box(solver.solve_goal(black_box(&goals[i]), &options))
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -1,0 +1,90 @@
+//! TLBO vs IWO vs LM backpropagation over 20 seeds (issue 9): the YS100 study
+//! truth of `compensate::unmodelled_truth` (unmodelled effects on), 1000
+//! training poses identified by SKCM, 200 validation poses; each trainer runs
+//! with seeds 0–19 on the same residuals. Prints per trainer the validation
+//! mean error [mm] after compensation (mean, min, max over seeds) and the wall
+//! time per training run [s].
+//!
+//! Run: `cargo run --release --example compare_trainers [seeds]`
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use robocal::compensate::{
+    train, unmodelled_truth, CompensatedModel, CompensatorSpec, LmTrainSettings, MlpSpec, Trainer,
+};
+use robocal::identify::{calibrate, CalibrationOptions, Method};
+use robocal::measure::{self, Measurement};
+use robocal::model::preset;
+use robocal::sim::random_configurations;
+use std::time::Instant;
+
+fn main() {
+    let seeds: u64 = std::env::args()
+        .nth(1)
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(20);
+    let nominal = preset("ys100").unwrap();
+    let truth = unmodelled_truth(&nominal, true, 1);
+    let mut rng = ChaCha8Rng::seed_from_u64(101);
+    let payload = nominal.payload.mass;
+    let mut draw = |n| -> Vec<Measurement> {
+        let qs = random_configurations(&nominal, n, &mut rng);
+        let rows = truth.measure(&qs, Some(payload), None, &mut rng).unwrap();
+        measure::to_measurements(&nominal, &rows, payload)
+    };
+    let train_set = draw(1000);
+    let valid = draw(200);
+    let opts = CalibrationOptions {
+        methods: vec![Method::Skcm],
+        ..Default::default()
+    };
+    let r = calibrate(&nominal, &train_set, &valid, &opts, &|_| true).unwrap();
+    let base = CompensatedModel {
+        calibrated: r.methods["skcm"].calibrated.clone(),
+        nominal: nominal.clone(),
+        cell_from_base: r.tracker_to_base.inverse(),
+        payload_kg: payload,
+        compensator: None,
+    };
+    let samples = base.samples(&train_set).unwrap();
+    let vsamples = base.samples(&valid).unwrap();
+    let base_mean =
+        vsamples.iter().map(|s| s.residual.norm()).sum::<f64>() / vsamples.len() as f64 * 1e3;
+    println!("SKCM validation mean {base_mean:.4} mm (1000 training poses, 200 validation poses, {seeds} seeds)");
+    println!("| trainer | network | validation mean [mm] (mean / min / max over seeds) | wall time per run [s] |");
+    println!("|---|---|---|---|");
+    let lm_small = CompensatorSpec::Mlp {
+        spec: MlpSpec::SMALL,
+        trainer: Trainer::Lm(LmTrainSettings::default()),
+    };
+    for (name, net, spec) in [
+        ("LM backprop", "6-20-3", CompensatorSpec::skcm_nn()),
+        ("LM backprop", "6-5-3", lm_small),
+        ("IWO", "6-5-3", CompensatorSpec::skcm_iwonn()),
+        ("TLBO", "6-5-3", CompensatorSpec::skcm_tlbonn()),
+    ] {
+        let mut errs = Vec::new();
+        let mut secs = 0.0;
+        for seed in 0..seeds {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            let t0 = Instant::now();
+            let (c, _) = train(&spec, &samples, &mut rng, &mut |_, _| true).unwrap();
+            secs += t0.elapsed().as_secs_f64();
+            let c = c.into_arc();
+            let e = vsamples
+                .iter()
+                .map(|s| (s.residual - c.residual_at(&s.q, &s.tau, s.payload_kg)).norm())
+                .sum::<f64>()
+                / vsamples.len() as f64
+                * 1e3;
+            errs.push(e);
+        }
+        let mean = errs.iter().sum::<f64>() / errs.len() as f64;
+        let min = errs.iter().cloned().fold(f64::INFINITY, f64::min);
+        let max = errs.iter().cloned().fold(0.0, f64::max);
+        println!(
+            "| {name} | {net} | {mean:.4} / {min:.4} / {max:.4} | {:.3} |",
+            secs / seeds as f64
+        );
+    }
+}
