@@ -17,8 +17,8 @@ use nalgebra::Vector3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal::compensate::{
-    synthetic_calibration, train, CompensatedModel, Compensator, CompensatorSpec, Sample,
-    StoredCompensator, SyntheticErrors,
+    synthetic_calibration, train, CompensatedModel, CompensatorSpec, Sample, StoredCompensator,
+    SyntheticErrors,
 };
 use robocal::ik::{Goal, IkSettings, IkSolver, SolveOptions};
 use robocal::model::preset;

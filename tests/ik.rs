@@ -693,7 +693,7 @@ fn calibrated_model_file_round_trip_gives_the_same_solutions() {
     let mut cm = calibrated("hh800", 13);
     cm.payload_kg = 500.0;
     let file = CalibratedModelFile::from_compensated(&cm, "hh800", "skcm");
-    assert_eq!(file.format, "robocal-calibrated-model/1");
+    assert_eq!(file.format, "robocal-calibrated-model/2");
     let dir = std::env::temp_dir().join(format!("robocal-ik-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("cal.json");

@@ -1,6 +1,6 @@
 //! `/v1/robots/{id}/versions`: the calibrated models of a robot. List, get,
 //! activate, roll back to the previously active version, download the model
-//! file (`robocal-calibrated-model/1`, loadable by `robocal solve --model`),
+//! file (`robocal-calibrated-model/2`, loadable by `robocal solve --model`),
 //! export it for other tools (`export?format=urdf|dh-csv|mdh-csv|json`, the
 //! text of `crate::export`).
 

@@ -64,15 +64,32 @@ pub fn minimise(
     progress: &mut dyn FnMut(usize, f64) -> bool,
 ) -> TlboResult {
     let d = lo.len();
-    let np = settings.population.max(2);
+    let pop: Vec<Vec<f64>> = (0..settings.population.max(2))
+        .map(|_| (0..d).map(|i| rng.gen_range(lo[i]..=hi[i])).collect())
+        .collect();
+    minimise_from(cost, lo, hi, pop, settings, rng, progress)
+}
+
+/// As [`minimise`], from a given initial population (at least two learners,
+/// clamped to the box; `settings.population` is not used).
+pub fn minimise_from(
+    cost: &mut dyn FnMut(&[f64]) -> f64,
+    lo: &[f64],
+    hi: &[f64],
+    mut pop: Vec<Vec<f64>>,
+    settings: &TlboSettings,
+    rng: &mut impl Rng,
+    progress: &mut dyn FnMut(usize, f64) -> bool,
+) -> TlboResult {
+    let d = lo.len();
+    let np = pop.len();
+    assert!(np >= 2, "TLBO needs at least two learners");
     let clamp = |x: &mut Vec<f64>| {
         for i in 0..d {
             x[i] = x[i].clamp(lo[i], hi[i]);
         }
     };
-    let mut pop: Vec<Vec<f64>> = (0..np)
-        .map(|_| (0..d).map(|i| rng.gen_range(lo[i]..=hi[i])).collect())
-        .collect();
+    pop.iter_mut().for_each(clamp);
     let mut fit: Vec<f64> = pop.iter().map(|x| cost(x)).collect();
     let mut evaluations = np;
     let mut history = Vec::with_capacity(settings.generations);
