@@ -90,7 +90,8 @@ pub fn synthetic_calibration(
 }
 
 /// The simulated truth of the compensator study (tests/compensate.rs, the
-/// compensator benchmark and `examples/compare_trainers.rs`): `nominal` with
+/// compensator benchmark `core/benches/compensate.rs` and
+/// `core/examples/compare_trainers.rs`): `nominal` with
 /// uniform 1 mm / 0.1° geometric errors, the joint stiffness of the seed's
 /// Table 7.2 on joints 2–5, 0.01 mm tracker noise and a tracker frame 3.4 m
 /// from the base, turned by 30°. With `effects`, also what no model-based

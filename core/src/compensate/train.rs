@@ -20,7 +20,10 @@
 //! zero output weights (the null network, so training can only improve on
 //! "no compensation"), TLBO's learners with output weights in `[−0.05, 0.05]`
 //! (TLBO moves learners by their differences and needs diversity). LM counts
-//! the null network as the first early-stopping candidate. The seed gives no
+//! the null network as a final early-stopping candidate; IWO and TLBO hold out
+//! 15 % of the samples the same way and return the null network when their
+//! result does not beat it there (with nothing but noise to learn, a
+//! compensator should not add its own). The seed gives no
 //! iteration counts for
 //! IWO and TLBO; the defaults below give both about 25 000 loss evaluations.
 //! Every random draw comes from the injected seeded generator; the result is
@@ -113,6 +116,9 @@ pub struct IwoSettings {
     /// Weight of `max(E)` in eq. 5.7 (`mean` has weight 1).
     pub max_weight: f64,
     pub iterations: usize,
+    /// Fraction of the training samples held out to check the result against
+    /// the null network (module docs).
+    pub holdout: f64,
 }
 
 impl Default for IwoSettings {
@@ -128,6 +134,7 @@ impl Default for IwoSettings {
             bound: 1.7,
             max_weight: 0.7,
             iterations: 200,
+            holdout: 0.15,
         }
     }
 }
@@ -139,6 +146,9 @@ pub struct TlboTrainSettings {
     pub generations: usize,
     /// Weights stay in `[−bound, bound]` (the IWO bound of ch. 5).
     pub bound: f64,
+    /// Fraction of the training samples held out to check the result against
+    /// the null network (module docs).
+    pub holdout: f64,
 }
 
 impl Default for TlboTrainSettings {
@@ -147,6 +157,7 @@ impl Default for TlboTrainSettings {
             population: 50,
             generations: 250,
             bound: 1.7,
+            holdout: 0.15,
         }
     }
 }
@@ -385,6 +396,34 @@ fn null_network(data: &Prepared, w: &[f64]) -> Vec<f64> {
     z
 }
 
+/// Shuffled (held-out, fitting) sample indices; nothing is held out below 10 samples.
+fn split_holdout(n: usize, fraction: f64, rng: &mut impl Rng) -> (Vec<usize>, Vec<usize>) {
+    let mut order: Vec<usize> = (0..n).collect();
+    order.shuffle(rng);
+    let n_hold = if n >= 10 {
+        ((n as f64 * fraction).round() as usize).clamp(1, n / 2)
+    } else {
+        0
+    };
+    let fit = order.split_off(n_hold);
+    (order, fit)
+}
+
+/// The population methods' guard: the result must beat the null network on
+/// the held-out samples, else the null network is returned.
+fn null_guard(data: &Prepared, hold: &[usize], w: Vec<f64>, stop: &mut String) -> Vec<f64> {
+    if hold.is_empty() {
+        return w;
+    }
+    let null = null_network(data, &w);
+    if data.mean_loss(&null, hold) <= data.mean_loss(&w, hold) {
+        stop.push_str("; not better than the mean residual on the held-out part: null network");
+        null
+    } else {
+        w
+    }
+}
+
 fn lm(
     data: &Prepared,
     settings: &LmTrainSettings,
@@ -394,14 +433,8 @@ fn lm(
     let n = data.n();
     let shape = data.shape;
     let nw = shape.n_weights();
-    let mut order: Vec<usize> = (0..n).collect();
-    order.shuffle(rng);
-    let n_hold = if n >= 10 {
-        ((n as f64 * settings.holdout).round() as usize).clamp(1, n / 2)
-    } else {
-        0
-    };
-    let (hold, fit) = order.split_at(n_hold);
+    let (hold, fit) = split_holdout(n, settings.holdout, rng);
+    let (hold, fit) = (&hold[..], &fit[..]);
     let mut w = nguyen_widrow(&shape, rng);
     let sse = |w: &[f64]| data.mean_loss(w, fit) * fit.len() as f64 * 3.0;
     let mut cur = sse(&w);
@@ -520,8 +553,8 @@ fn iwo(
     rng: &mut impl Rng,
     progress: &mut dyn FnMut(usize, f64) -> bool,
 ) -> Result<(Vec<f64>, usize, usize, f64, String), TrainError> {
-    let all: Vec<usize> = (0..data.n()).collect();
-    let loss = |w: &[f64]| population_loss(data, &all, w, s.max_weight);
+    let (hold, fit) = split_holdout(data.n(), s.holdout, rng);
+    let loss = |w: &[f64]| population_loss(data, &fit, w, s.max_weight);
     let b = s.bound;
     let mut pop: Vec<(Vec<f64>, f64)> = (0..s.initial_population.max(1))
         .map(|_| initial_weights(data, 0.0, b, rng))
@@ -580,13 +613,9 @@ fn iwo(
         }
     }
     let (w, l) = pop.swap_remove(0);
-    Ok((
-        w,
-        s.iterations,
-        evaluations,
-        l,
-        format!("{} iterations", s.iterations),
-    ))
+    let mut stop = format!("{} iterations", s.iterations);
+    let w = null_guard(data, &hold, w, &mut stop);
+    Ok((w, s.iterations, evaluations, l, stop))
 }
 
 fn tlbo_train(
@@ -596,8 +625,8 @@ fn tlbo_train(
     progress: &mut dyn FnMut(usize, f64) -> bool,
 ) -> Result<(Vec<f64>, usize, usize, f64, String), TrainError> {
     let nw = data.shape.n_weights();
-    let all: Vec<usize> = (0..data.n()).collect();
-    let mut cost = |w: &[f64]| population_loss(data, &all, w, 0.0);
+    let (hold, fit) = split_holdout(data.n(), s.holdout, rng);
+    let mut cost = |w: &[f64]| population_loss(data, &fit, w, 0.0);
     let lo = vec![-s.bound; nw];
     let hi = vec![s.bound; nw];
     let settings = TlboSettings {
@@ -617,13 +646,9 @@ fn tlbo_train(
         return Err(TrainError::Cancelled);
     }
     let gens = r.history.len();
-    Ok((
-        r.best,
-        gens,
-        r.evaluations,
-        r.best_cost,
-        format!("{gens} generations"),
-    ))
+    let mut stop = format!("{gens} generations");
+    let w = null_guard(data, &hold, r.best, &mut stop);
+    Ok((w, gens, r.evaluations, r.best_cost, stop))
 }
 
 fn training_rms_mm(c: &StoredCompensator, samples: &[Sample]) -> f64 {

@@ -10,19 +10,19 @@
 //!   the 6-20-3 compensator (cycling through 1000 targets).
 //!
 //! Trainer comparison over 20 seeds (final validation error and wall time):
-//! `cargo run --release --example compare_trainers`.
+//! `cargo run --release -p robocal-core --example compare_trainers`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::Vector3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal::compensate::{
+use robocal_core::compensate::{
     synthetic_calibration, train, CompensatedModel, CompensatorSpec, Sample, StoredCompensator,
     SyntheticErrors,
 };
-use robocal::ik::{Goal, IkSettings, IkSolver, SolveOptions};
-use robocal::model::preset;
-use robocal::sim::random_configurations;
+use robocal_core::ik::{Goal, IkSettings, IkSolver, SolveOptions};
+use robocal_core::model::preset;
+use robocal_core::sim::random_configurations;
 use std::hint::black_box;
 use std::sync::Arc;
 

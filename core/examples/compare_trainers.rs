@@ -5,17 +5,17 @@
 //! mean error [mm] after compensation (mean, min, max over seeds) and the wall
 //! time per training run [s].
 //!
-//! Run: `cargo run --release --example compare_trainers [seeds]`
+//! Run: `cargo run --release -p robocal-core --example compare_trainers [seeds]`
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal::compensate::{
+use robocal_core::compensate::{
     train, unmodelled_truth, CompensatedModel, CompensatorSpec, LmTrainSettings, MlpSpec, Trainer,
 };
-use robocal::identify::{calibrate, CalibrationOptions, Method};
-use robocal::measure::{self, Measurement};
-use robocal::model::preset;
-use robocal::sim::random_configurations;
+use robocal_core::identify::{calibrate, CalibrationOptions, Method};
+use robocal_core::measure::{self, Measurement};
+use robocal_core::model::preset;
+use robocal_core::sim::random_configurations;
 use std::time::Instant;
 
 fn main() {
