@@ -29,7 +29,7 @@
 //!   `T_i = Rz(θ)·Tz(d)·Tx(a)·Rx(α)`. Exact regrouping of the modified chain
 //!   (`Rx(α)·Tx(a)` commute, so link k+1's `a, α` become joint k's); only
 //!   without Hayati twists β on the links after the base.
-//! - **JSON** (`json`): the calibrated model file (`robocal-calibrated-model/1`).
+//! - **JSON** (`json`): the calibrated model file (`robocal-calibrated-model/2`).
 //!
 //! Closed-loop models (HH800) have no URDF or DH form here (the passive angle
 //! is not a joint reading): those exports fail with a message.
