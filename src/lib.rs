@@ -1,7 +1,8 @@
 //! robocal: calibration of industrial robots and false targets for offline programming.
 //!
 //! Flow: measure (`measure`, `sim`) → calibrate (`identify`) → store (`db`) →
-//! solve (`compensate`, `ik`), served over HTTP (`http`) and the command line (`cli`).
+//! solve (`compensate`, `ik`), served over HTTP (`http`) and the command line (`cli`);
+//! `report` renders a stored calibration report as HTML.
 //! The numerical core lives in the `robocal-core` crate (re-exported here under
 //! the same module names), whose dependency tree has no HTTP, database, async
 //! runtime or command-line crates.
@@ -11,4 +12,5 @@ pub use robocal_core::{compensate, export, identify, ik, kinematics, measure, mo
 pub mod cli;
 pub mod db;
 pub mod http;
+pub mod report;
 pub mod service;

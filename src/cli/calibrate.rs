@@ -2,9 +2,12 @@
 //! print the comparison of methods (like the seed's Tables 2.5/2.6) with the
 //! identifiability report, or the same as JSON.
 
-use crate::identify::{calibrate, CalibrationOptions, CalibrationReport, Method};
+use crate::identify::{
+    calibrate, CalibrationOptions, CalibrationReport, Method, PoseSource, PoseSources,
+};
 use crate::measure::{self, csv, SetRole};
 use crate::model::RobotModel;
+use crate::report::method_label;
 use anyhow::{bail, Context};
 use clap::Args;
 use std::fmt::Write as _;
@@ -48,6 +51,9 @@ pub struct CalibrateArgs {
     /// Print the full report as JSON on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Write the report as one self-contained HTML page to this file.
+    #[arg(long)]
+    pub html: Option<String>,
     /// Write the calibrated model of the best method (or of --save-method) to this file.
     #[arg(long)]
     pub save: Option<String>,
@@ -79,16 +85,29 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     let label = |file: usize| format!("file {}", file + 1);
     let mut ident_rows: Vec<(String, measure::MeasuredPose)> = Vec::new();
     let mut valid_rows: Vec<(String, measure::MeasuredPose)> = Vec::new();
+    // Each pose's source (file name, 1-based data row, session) for the report.
+    let (mut ident_src, mut valid_src) = (Vec::new(), Vec::new());
+    let source = |path: &str, k: usize, session: &str| PoseSource {
+        set: file_name(path),
+        row: k + 1,
+        session: session.to_string(),
+    };
     let mut training = 0;
     for (i, path) in a.identify.iter().enumerate() {
         let rows = read_rows(path, dif)?;
         csv::check_joint_count(&rows, model.dof()).with_context(|| path.clone())?;
-        for r in rows {
+        for (k, r) in rows.into_iter().enumerate() {
             let s = r.session.clone().unwrap_or_else(|| label(i));
             match r.set {
                 Some(SetRole::Training) => training += 1,
-                Some(SetRole::Validation) => valid_rows.push((s, r)),
-                _ => ident_rows.push((s, r)),
+                Some(SetRole::Validation) => {
+                    valid_src.push(source(path, k, &s));
+                    valid_rows.push((s, r));
+                }
+                _ => {
+                    ident_src.push(source(path, k, &s));
+                    ident_rows.push((s, r));
+                }
             }
         }
     }
@@ -102,10 +121,11 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         let more = read_rows(path, dif)?;
         csv::check_joint_count(&more, model.dof()).with_context(|| path.clone())?;
         let own = label(if same_count { j } else { 0 });
-        valid_rows.extend(
-            more.into_iter()
-                .map(|r| (r.session.clone().unwrap_or_else(|| own.clone()), r)),
-        );
+        for (k, r) in more.into_iter().enumerate() {
+            let s = r.session.clone().unwrap_or_else(|| own.clone());
+            valid_src.push(source(path, k, &s));
+            valid_rows.push((s, r));
+        }
     }
     let mut sessions: Vec<String> = Vec::new();
     for (s, _) in &ident_rows {
@@ -140,12 +160,23 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         ..Default::default()
     };
     let verbose = !a.json;
-    let report = calibrate(&model, &ident, &valid, &opts, &|p| {
+    let mut report = calibrate(&model, &ident, &valid, &opts, &|p| {
         if verbose && p.iteration == 0 {
             eprintln!("[{:5.1}%] {}", p.percent, p.phase);
         }
         true
     })?;
+    report.pose_sources = PoseSources {
+        identification: ident_src,
+        validation: valid_src,
+    };
+    report.session_names = sessions.clone();
+    if let Some(path) = &a.html {
+        let files: Vec<String> = a.identify.iter().map(|p| file_name(p)).collect();
+        let title = format!("Calibration of {}", files.join(", "));
+        let html = crate::report::render_html(&title, &serde_json::to_value(&report)?);
+        std::fs::write(path, html).with_context(|| format!("cannot write {path}"))?;
+    }
     if let Some(path) = &a.save {
         save_model(&model, &report, a.save_method.as_deref(), payload, path)?;
     }
@@ -155,6 +186,12 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         print!("{}", render_report(&report));
     }
     Ok(())
+}
+
+fn file_name(path: &str) -> String {
+    std::path::Path::new(path)
+        .file_name()
+        .map_or_else(|| path.to_string(), |n| n.to_string_lossy().into_owned())
 }
 
 fn save_model(
@@ -192,16 +229,6 @@ fn save_model(
     file.save(std::path::Path::new(path))?;
     eprintln!("saved the {} model to {path}", chosen.method.name());
     Ok(())
-}
-
-fn method_label(name: &str) -> &str {
-    match name {
-        "km" => "KM",
-        "skcm" => "SKCM",
-        "skcm-tlbo" => "SKCM-C (TLBO)",
-        "skcm-payload" => "SKCM-payload",
-        other => other,
-    }
 }
 
 /// The text report: accuracy table, identifiability, parameters, stiffness.

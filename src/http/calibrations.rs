@@ -352,11 +352,9 @@ pub async fn report(
         .map(|r| r.name)
         .unwrap_or_default();
     let title = format!("Calibration {id} of robot {robot_id} ({name})");
-    let html = tokio::task::spawn_blocking(move || {
-        super::report_page::render_report_page(&title, &report)
-    })
-    .await
-    .map_err(|e| ApiError::Internal(format!("report page: {e}")))?;
+    let html = tokio::task::spawn_blocking(move || crate::report::render_html(&title, &report))
+        .await
+        .map_err(|e| ApiError::Internal(format!("report page: {e}")))?;
     Ok(Html(html).into_response())
 }
 

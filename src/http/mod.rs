@@ -31,7 +31,6 @@ pub mod error;
 pub mod input;
 pub mod limits;
 pub mod listener;
-pub mod report_page;
 pub mod robots;
 pub mod sets;
 pub mod solve;

@@ -19,12 +19,13 @@ use super::checks::{
     CalibrationError,
 };
 use super::identifiability::{self, IdentifiabilityReport};
-use super::least_squares::{self, Fit};
+use super::least_squares::Fit;
 use super::methods::{Context, MethodError, MethodFit};
 use super::options::{CalibrationOptions, Method, Progress};
 use super::registration::register;
 use super::report::{
-    CalibrationReport, FailedMethod, NominalErrors, SessionRegistration, SetErrors,
+    CalibrationReport, FailedMethod, NominalErrors, PoseSources, SessionRegistration, SetErrors,
+    REPORT_FORMAT_VERSION,
 };
 use crate::kinematics::{deflected_joints, fk};
 use crate::measure::Measurement;
@@ -208,14 +209,8 @@ pub fn calibrate(
     let reg = register_sessions(nominal, identification, validation, opts)?;
     let id_frames = vec![Pose::identity(); reg.sessions];
     let nominal_errors = NominalErrors {
-        identification: SetErrors::new(least_squares::position_errors_mm(
-            nominal, &id_frames, &reg.ident,
-        )),
-        validation: (!reg.valid.is_empty()).then(|| {
-            SetErrors::new(least_squares::position_errors_mm(
-                nominal, &id_frames, &reg.valid,
-            ))
-        }),
+        identification: SetErrors::of(nominal, &id_frames, &reg.ident),
+        validation: (!reg.valid.is_empty()).then(|| SetErrors::of(nominal, &id_frames, &reg.valid)),
     };
     let nominal_rms = nominal_errors.identification.stats.rms_mm;
     if nominal_rms > opts.max_nominal_rms_mm {
@@ -358,6 +353,7 @@ pub fn calibrate(
         return Err(CalibrationError::AllMethodsFailed { failed });
     }
     Ok(CalibrationReport {
+        format_version: REPORT_FORMAT_VERSION,
         robot: nominal.name.clone(),
         identification_poses: identification.len(),
         validation_poses: validation.len(),
@@ -366,6 +362,8 @@ pub fn calibrate(
         nominal: nominal_errors,
         methods,
         failed,
+        session_names: Vec::new(),
+        pose_sources: PoseSources::default(),
         tracker_to_base: reg.tracker_to_base[0],
     })
 }

@@ -25,7 +25,7 @@
 
 use super::checks::{payload_problem, stacked_jacobian};
 use super::identifiability::{self, DroppedParam};
-use super::least_squares::{self, fit, Cancelled, Fit, FrozenSolver};
+use super::least_squares::{fit, Cancelled, Fit, FrozenSolver};
 use super::options::{CalibrationOptions, Method};
 use super::report::{estimates, MethodReport, MethodWarning, SetErrors, TlboSummary, WarningKind};
 use super::tlbo;
@@ -249,15 +249,9 @@ impl Context<'_> {
                 method.name()
             ));
         }
-        let id_err =
-            least_squares::position_errors_mm(&fitted.model, &fitted.session_frames, self.ident);
-        let va_err = (!self.valid.is_empty()).then(|| {
-            SetErrors::new(least_squares::position_errors_mm(
-                &fitted.model,
-                &fitted.session_frames,
-                self.valid,
-            ))
-        });
+        let id_err = SetErrors::of(&fitted.model, &fitted.session_frames, self.ident);
+        let va_err = (!self.valid.is_empty())
+            .then(|| SetErrors::of(&fitted.model, &fitted.session_frames, self.valid));
         let mut warnings = Vec::new();
         if !fitted.report.converged {
             warnings.push(MethodWarning {
@@ -313,7 +307,7 @@ impl Context<'_> {
         Ok(MethodReport {
             method,
             solver: fitted.report.clone(),
-            identification: SetErrors::new(id_err),
+            identification: id_err,
             validation: va_err,
             parameters: estimates(
                 self.nominal,

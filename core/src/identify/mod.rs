@@ -26,8 +26,8 @@ pub use least_squares::{LmReport, LmSettings, StopReason};
 pub use options::{CalibrationOptions, Method, Progress};
 pub use registration::{register, Registration};
 pub use report::{
-    CalibrationReport, FailedMethod, MethodReport, MethodWarning, ParamEstimate, SetErrors,
-    WarningKind,
+    CalibrationReport, FailedMethod, MethodReport, MethodWarning, ParamEstimate, PoseSource,
+    PoseSources, SetErrors, WarningKind, REPORT_FORMAT_VERSION,
 };
 pub use stats::ErrorStats;
 pub use tlbo::TlboSettings;

@@ -10,6 +10,7 @@ use super::identifiability::IdentifiabilityReport;
 use super::least_squares::LmReport;
 use super::options::Method;
 use super::stats::ErrorStats;
+use crate::measure::Measurement;
 use crate::model::description::PoseDescription;
 use crate::model::params::ParamUnit;
 use crate::model::pose::Pose;
@@ -18,12 +19,24 @@ use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
-/// Errors of one set: statistics plus the per-pose error norms (mm).
+/// Version of the serialised [`CalibrationReport`]. 1: no version field, error
+/// norms only; 2: per-pose error vectors and positions, pose sources.
+pub const REPORT_FORMAT_VERSION: u32 = 2;
+
+/// Errors of one set: statistics plus the per-pose error norms (mm), and
+/// (format 2) the per-pose error vectors `measured − predicted` and the
+/// measured positions, both in the registered base frame of the pose's
+/// session [mm]. A pose the model cannot predict has a norm of infinity and
+/// no finite vector (`[NaN; 3]` serialises as nulls).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SetErrors {
     #[serde(flatten)]
     pub stats: ErrorStats,
     pub errors_mm: Vec<f64>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub errors_xyz_mm: Vec<[Option<f64>; 3]>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub positions_mm: Vec<[f64; 3]>,
 }
 
 impl SetErrors {
@@ -31,8 +44,58 @@ impl SetErrors {
         SetErrors {
             stats: ErrorStats::from_errors_mm(&errors_mm),
             errors_mm,
+            errors_xyz_mm: Vec::new(),
+            positions_mm: Vec::new(),
         }
     }
+
+    /// Errors of `model` on `data` with the session frames applied: norms,
+    /// vectors and measured positions (eq. 2.3's residual, in mm).
+    pub fn of(model: &RobotModel, frames: &[Pose], data: &[Measurement]) -> Self {
+        let mut xyz = Vec::with_capacity(data.len());
+        let mut norms = Vec::with_capacity(data.len());
+        for m in data {
+            match super::least_squares::predict(model, m) {
+                Some((p, _)) => {
+                    let e = frames.get(m.session).copied().unwrap_or_default();
+                    let d = (m.position - e.transform_point(&p)) * 1e3;
+                    norms.push(d.norm());
+                    xyz.push([Some(d.x), Some(d.y), Some(d.z)]);
+                }
+                None => {
+                    norms.push(f64::INFINITY);
+                    xyz.push([None; 3]);
+                }
+            }
+        }
+        SetErrors {
+            positions_mm: data
+                .iter()
+                .map(|m| [m.position.x * 1e3, m.position.y * 1e3, m.position.z * 1e3])
+                .collect(),
+            errors_xyz_mm: xyz,
+            ..SetErrors::new(norms)
+        }
+    }
+}
+
+/// Where a pose came from: its measurement set, the row (step) number in that
+/// upload (1-based data row) and the tracker session's name. Filled by the
+/// caller that knows the uploads; empty when unknown.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct PoseSource {
+    pub set: String,
+    pub row: usize,
+    pub session: String,
+}
+
+/// Pose sources of both sets, in the order of the report's per-pose vectors.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct PoseSources {
+    #[serde(default)]
+    pub identification: Vec<PoseSource>,
+    #[serde(default)]
+    pub validation: Vec<PoseSource>,
 }
 
 /// One identified parameter in display units (mm, deg or rad/(N·m)).
@@ -128,6 +191,8 @@ pub struct NominalErrors {
 /// Everything a calibration found.
 #[derive(Debug, Clone, Serialize)]
 pub struct CalibrationReport {
+    /// [`REPORT_FORMAT_VERSION`] of the writer.
+    pub format_version: u32,
     pub robot: String,
     pub identification_poses: usize,
     pub validation_poses: usize,
@@ -137,6 +202,12 @@ pub struct CalibrationReport {
     pub methods: BTreeMap<String, MethodReport>,
     /// Methods that failed, with their reasons (the others are still reported).
     pub failed: Vec<FailedMethod>,
+    /// Names of the tracker sessions by index (empty: unnamed).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub session_names: Vec<String>,
+    /// Where each pose came from (empty: unknown).
+    #[serde(skip_serializing_if = "PoseSources::is_empty")]
+    pub pose_sources: PoseSources,
     /// Tracker → registered base frame of session 0.
     #[serde(skip)]
     pub tracker_to_base: Pose,
@@ -153,6 +224,12 @@ impl CalibrationReport {
             };
             key(a).total_cmp(&key(b))
         })
+    }
+}
+
+impl PoseSources {
+    pub fn is_empty(&self) -> bool {
+        self.identification.is_empty() && self.validation.is_empty()
     }
 }
 

@@ -1,0 +1,220 @@
+//! The typed view of a stored calibration report: what the page reads from the
+//! JSON form of [`crate::identify::CalibrationReport`].
+//!
+//! Deserialisation is lenient on purpose: a stored report outlives the code
+//! that wrote it. Every field has a default, a non-finite number (written as
+//! `null`) reads as `None`, and a part that does not parse (e.g. an
+//! identifiability summary of another shape) is dropped, so the page shows
+//! what it can and says what is missing. The format version says which parts
+//! to expect: 1 (no `format_version` field) holds error norms only; 2 adds
+//! per-pose error vectors, positions, session names and pose sources.
+
+use crate::identify::identifiability::IdentifiabilityReport;
+use crate::identify::{
+    FailedMethod, LmReport, MethodWarning, ParamEstimate, PoseSources, REPORT_FORMAT_VERSION,
+};
+use serde::de::DeserializeOwned;
+use serde::{Deserialize, Deserializer};
+use std::collections::BTreeMap;
+
+/// A part that parses or is `None` (never an error for the whole report).
+fn lenient<'de, D: Deserializer<'de>, T: DeserializeOwned>(d: D) -> Result<Option<T>, D::Error> {
+    let v = serde_json::Value::deserialize(d)?;
+    Ok(serde_json::from_value(v).ok())
+}
+
+/// A list whose unparsable items are dropped.
+fn lenient_list<'de, D: Deserializer<'de>, T: DeserializeOwned>(d: D) -> Result<Vec<T>, D::Error> {
+    let v = serde_json::Value::deserialize(d)?;
+    Ok(match v {
+        serde_json::Value::Array(items) => items
+            .into_iter()
+            .filter_map(|i| serde_json::from_value(i).ok())
+            .collect(),
+        _ => Vec::new(),
+    })
+}
+
+fn version_one() -> u32 {
+    1
+}
+
+/// The report as the page reads it.
+#[derive(Debug, Clone, Default, Deserialize)]
+pub struct ReportView {
+    #[serde(default = "version_one")]
+    pub format_version: u32,
+    #[serde(default)]
+    pub robot: String,
+    #[serde(default)]
+    pub identification_poses: Option<usize>,
+    #[serde(default)]
+    pub validation_poses: Option<usize>,
+    #[serde(default, deserialize_with = "lenient_list")]
+    pub registration: Vec<RegistrationView>,
+    #[serde(default, deserialize_with = "lenient")]
+    pub identifiability: Option<IdentifiabilityReport>,
+    #[serde(default)]
+    pub nominal: SetsView,
+    #[serde(default)]
+    pub methods: BTreeMap<String, MethodView>,
+    #[serde(default, deserialize_with = "lenient_list")]
+    pub failed: Vec<FailedMethod>,
+    #[serde(default)]
+    pub session_names: Vec<String>,
+    #[serde(default, deserialize_with = "lenient")]
+    pub pose_sources: Option<PoseSources>,
+}
+
+/// Registration of one session (only the RMS is shown).
+#[derive(Debug, Clone, Deserialize)]
+pub struct RegistrationView {
+    pub session: usize,
+    #[serde(default)]
+    pub rms_mm: Option<f64>,
+}
+
+/// Errors of a model on the identification and validation sets.
+#[derive(Debug, Clone, Default, Deserialize)]
+pub struct SetsView {
+    #[serde(default)]
+    pub identification: Option<SetView>,
+    #[serde(default)]
+    pub validation: Option<SetView>,
+}
+
+/// Errors on one set; `None` entries are poses the model could not predict.
+#[derive(Debug, Clone, Default, Deserialize)]
+pub struct SetView {
+    #[serde(default)]
+    pub n: Option<usize>,
+    #[serde(default)]
+    pub mean_mm: Option<f64>,
+    #[serde(default)]
+    pub max_mm: Option<f64>,
+    #[serde(default)]
+    pub std_mm: Option<f64>,
+    #[serde(default)]
+    pub rms_mm: Option<f64>,
+    #[serde(default)]
+    pub p95_mm: Option<f64>,
+    #[serde(default)]
+    pub errors_mm: Vec<Option<f64>>,
+    #[serde(default)]
+    pub errors_xyz_mm: Vec<[Option<f64>; 3]>,
+    #[serde(default)]
+    pub positions_mm: Vec<[Option<f64>; 3]>,
+}
+
+impl SetView {
+    /// The finite error norms.
+    pub fn finite(&self) -> Vec<f64> {
+        self.errors_mm
+            .iter()
+            .flatten()
+            .copied()
+            .filter(|v| v.is_finite())
+            .collect()
+    }
+    /// Signed errors along one axis (0 = x), finite ones only.
+    pub fn axis(&self, k: usize) -> Vec<f64> {
+        self.errors_xyz_mm
+            .iter()
+            .filter_map(|v| v[k])
+            .filter(|v| v.is_finite())
+            .collect()
+    }
+}
+
+/// The result of one method.
+#[derive(Debug, Clone, Default, Deserialize)]
+pub struct MethodView {
+    #[serde(default, deserialize_with = "lenient")]
+    pub solver: Option<LmReport>,
+    #[serde(flatten)]
+    pub sets: SetsView,
+    #[serde(default, deserialize_with = "lenient_list")]
+    pub parameters: Vec<ParamEstimate>,
+    #[serde(default)]
+    pub stiffness_nm_per_rad: Vec<Option<f64>>,
+    #[serde(default, deserialize_with = "lenient")]
+    pub tlbo: Option<TlboView>,
+    #[serde(default, deserialize_with = "lenient_list")]
+    pub warnings: Vec<MethodWarning>,
+}
+
+/// TLBO convergence (cost per generation).
+#[derive(Debug, Clone, Deserialize)]
+pub struct TlboView {
+    #[serde(default)]
+    pub generations: Option<usize>,
+    #[serde(default)]
+    pub evaluations: Option<usize>,
+    #[serde(default)]
+    pub history: Vec<Option<f64>>,
+}
+
+/// How the page treats the report's format version.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// The current version: everything is expected.
+    Current,
+    /// An older version: parts it did not hold are said to be missing.
+    Older(u32),
+    /// A newer version than this program knows: shown as far as understood.
+    Newer(u32),
+}
+
+impl ReportView {
+    /// Reads a stored report.
+    pub fn from_json(v: &serde_json::Value) -> Result<ReportView, serde_json::Error> {
+        ReportView::deserialize(v)
+    }
+
+    pub fn format(&self) -> Format {
+        use std::cmp::Ordering::*;
+        match self.format_version.cmp(&REPORT_FORMAT_VERSION) {
+            Equal => Format::Current,
+            Less => Format::Older(self.format_version),
+            Greater => Format::Newer(self.format_version),
+        }
+    }
+
+    /// The methods in the seed's order (KM, SKCM, SKCM-C), then any other.
+    pub fn ordered_methods(&self) -> Vec<(&str, &MethodView)> {
+        let rank = |k: &str| match k {
+            "km" => 0,
+            "skcm" => 1,
+            "skcm-tlbo" => 2,
+            _ => 3,
+        };
+        let mut v: Vec<(&str, &MethodView)> =
+            self.methods.iter().map(|(k, m)| (k.as_str(), m)).collect();
+        v.sort_by(|a, b| rank(a.0).cmp(&rank(b.0)).then(a.0.cmp(b.0)));
+        v
+    }
+
+    /// The best method, as [`crate::identify::CalibrationReport::best_method`]:
+    /// smallest validation mean, identification mean without a validation set.
+    pub fn best(&self) -> Option<&str> {
+        self.methods
+            .iter()
+            .filter_map(|(k, m)| Some((k.as_str(), best_key(m)?)))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(k, _)| k)
+    }
+
+    /// The name of session `i` as the measurement sets name it.
+    pub fn session_name(&self, i: usize) -> String {
+        self.session_names
+            .get(i)
+            .cloned()
+            .unwrap_or_else(|| format!("session {}", i + 1))
+    }
+}
+
+/// The ranking key of "best": validation mean, else identification mean.
+pub fn best_key(m: &MethodView) -> Option<f64> {
+    let mean = |s: &Option<SetView>| s.as_ref().and_then(|s| s.mean_mm);
+    mean(&m.sets.validation).or_else(|| mean(&m.sets.identification))
+}
