@@ -354,6 +354,12 @@ pub fn outlier_limit(errors: &[f64]) -> Option<f64> {
 /// One row per pose of both sets; outliers of the best method flagged.
 pub fn pose_table(r: &ReportView, models: &[Model], best: Option<&str>) -> Markup {
     let best_model = models.iter().find(|m| Some(m.key) == best);
+    let n_ident = models
+        .iter()
+        .filter_map(|m| m.set("identification"))
+        .map(|s| s.errors_mm.len())
+        .max()
+        .unwrap_or(0);
     html! {
         section #poses {
             h2 { "Per-pose errors" }
@@ -370,12 +376,11 @@ pub fn pose_table(r: &ReportView, models: &[Model], best: Option<&str>) -> Marku
                         th { "flag" }
                     } }
                     tbody {
-                        @let mut k = 0usize;
                         @for (set, name) in SETS {
                             @let n = models.iter().filter_map(|m| m.set(set)).map(|s| s.errors_mm.len()).max().unwrap_or(0);
                             @let limit = best_model.and_then(|b| b.set(set)).and_then(|s| outlier_limit(&s.finite()));
                             @for i in 0..n {
-                                @let _ = { k += 1; };
+                                @let k = if set == "identification" { i + 1 } else { n_ident + i + 1 };
                                 @let src = source(r, set, i);
                                 @let e_best = best_model.and_then(|b| b.set(set)).and_then(|s| s.errors_mm.get(i).copied().flatten());
                                 @let out = matches!((e_best, limit), (Some(e), Some(l)) if e > l);
