@@ -20,7 +20,7 @@ use crate::db::{
 use crate::http::limits::Ticket;
 use crate::identify::{
     calibrate, CalibrationError, CalibrationOptions, CalibrationReport, FailedMethod, LmSettings,
-    Method, Progress, TlboSettings,
+    Method, PoseSource, PoseSources, Progress, TlboSettings,
 };
 use crate::measure::Measurement;
 use crate::model::RobotModel;
@@ -163,6 +163,7 @@ pub async fn start(
         let nominal = nominal.clone();
         async move {
             let mut out = Vec::new();
+            let mut sources = Vec::new();
             for s in &sets {
                 let rows = state
                     .db()
@@ -171,17 +172,27 @@ pub async fn start(
                     .ok_or_else(|| set_vanished(robot_id, s.id))?;
                 let session = sessions.iter().position(|x| *x == s.session).unwrap_or(0);
                 let payload = s.payload_kg.unwrap_or(default_payload);
-                for r in &rows {
+                for (i, r) in rows.iter().enumerate() {
                     let mut m = r.to_measurement(&nominal, payload);
                     m.session = session;
                     out.push(m);
+                    // Where the pose came from, for the report's per-pose table.
+                    sources.push(PoseSource {
+                        set: s.name.clone(),
+                        row: i + 1,
+                        session: s.session.clone(),
+                    });
                 }
             }
-            Ok::<_, ServiceError>(out)
+            Ok::<_, ServiceError>((out, sources))
         }
     };
-    let ident = load(&ident_sets).await?;
-    let valid = load(&valid_sets).await?;
+    let (ident, ident_sources) = load(&ident_sets).await?;
+    let (valid, valid_sources) = load(&valid_sets).await?;
+    let pose_sources = PoseSources {
+        identification: ident_sources,
+        validation: valid_sources,
+    };
 
     let defaults = CalibrationOptions::default();
     let opts = CalibrationOptions {
@@ -227,6 +238,8 @@ pub async fn start(
         nominal,
         ident,
         valid,
+        session_names: sessions,
+        pose_sources,
         opts,
         payload_kg: default_payload,
         ticket,
@@ -246,6 +259,10 @@ struct Job {
     valid: Vec<Measurement>,
     opts: CalibrationOptions,
     payload_kg: f64,
+    /// Tracker session names in the order of the measurements' session index.
+    session_names: Vec<String>,
+    /// Set, row and session of every identification and validation pose.
+    pose_sources: PoseSources,
     /// Its place in the job queue, released when the job ends.
     ticket: Ticket,
 }
@@ -313,6 +330,8 @@ async fn run_job(state: AppState, job: Job) {
         ident,
         valid,
         opts,
+        session_names,
+        pose_sources,
         payload_kg,
         ticket: _ticket,
         ..
@@ -334,6 +353,8 @@ async fn run_job(state: AppState, job: Job) {
         });
         drop(tx);
         report.and_then(|mut r| {
+            r.session_names = session_names;
+            r.pose_sources = pose_sources;
             let versions = versions_of(&mut r, &nominal, &robot_name, &opts, payload_kg);
             if versions.is_empty() {
                 return Err(CalibrationError::AllMethodsFailed {

@@ -96,6 +96,15 @@ async fn quickstart_flow_calibrate_version_and_solve() {
     );
     assert_eq!(summary["nominal_mean_mm"].as_f64(), Some(nominal_val));
     assert!(summary["failed_methods"].as_array().unwrap().is_empty());
+    // Every pose names its set, upload row and session for the report.
+    let sources = &res["report"]["pose_sources"];
+    let n_ident = res["report"]["identification_poses"].as_u64().unwrap() as usize;
+    assert_eq!(sources["identification"].as_array().unwrap().len(), n_ident);
+    assert_eq!(sources["identification"][0]["row"], 1, "{sources}");
+    assert!(!res["report"]["session_names"]
+        .as_array()
+        .unwrap()
+        .is_empty());
     assert_eq!(res["versions"].as_array().unwrap().len(), 2);
     assert_eq!(res["summary"][0]["method"], "nominal");
     assert_eq!(res["summary"].as_array().unwrap().len(), 3);
