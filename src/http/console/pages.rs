@@ -2,6 +2,7 @@
 //! HTML-escaped by maud).
 
 use crate::db::{CalibrationRow, JobStatus, RobotRow, SetRow, VersionRow};
+use crate::http::calibrations::DEFAULT_METHODS;
 use crate::identify::Method;
 use crate::measure::SetRole;
 use crate::model::presets::PRESETS;
@@ -218,7 +219,7 @@ pub fn robot(v: &RobotView) -> Markup {
                         @for m in Method::ALL {
                             label.check {
                                 input type="checkbox" name="method" value=(m.name())
-                                    checked[matches!(m.name(), "km" | "skcm")];
+                                    checked[DEFAULT_METHODS.contains(&m.name())];
                                 " " (m.name())
                             }
                         }
