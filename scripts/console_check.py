@@ -3,7 +3,7 @@
 screenshot of each step:
 
   create robot -> upload measurements -> calibrate (live progress) -> report
-  -> activate a version (solving a targets CSV from the console is not built yet)
+  -> versions (the best is active) -> solve a targets CSV into a CSV answer
 
 against a real `robocal serve` with API keys on a temporary database, using
 Debian's Chromium and chromedriver through Selenium.
@@ -158,6 +158,27 @@ def main():
         wait.until(EC.presence_of_element_located((By.CSS_SELECTOR, "#versions tbody tr")))
         assert driver.find_elements(By.CSS_SELECTOR, "#versions tr.active"), "no active version"
         shot("versions", "versions")
+
+        # 6. Solve: the first 10 nominal targets of the random set, position
+        # only, with the active version; the CSV answer is shown and offered.
+        import csv as csvmod
+        targets = pathlib.Path(work) / "targets.csv"
+        with open(random) as f, open(targets, "w") as g:
+            rows = list(csvmod.DictReader(f))[:10]
+            g.write("id,x,y,z\n")
+            for i, r in enumerate(rows):
+                g.write(f"t{i + 1},{r['x_t']},{r['y_t']},{r['z_t']}\n")
+        form = driver.find_element(By.ID, "solve")
+        form.find_element(By.NAME, "file").send_keys(str(targets))
+        form.find_element(By.NAME, "position_only").click()
+        form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+        wait.until(EC.visibility_of_element_located((By.ID, "solve-result")))
+        summary = driver.find_element(By.ID, "solve-summary").text
+        assert summary.startswith("10 of 10 targets solved"), f"solve: {summary}"
+        answer = driver.find_element(By.ID, "solve-csv").text.splitlines()
+        assert answer[0].startswith("id,status,reason,branch,j1_deg"), answer[0]
+        assert len(answer) == 11 and all(",ok," in l for l in answer[1:]), answer
+        shot("solved", "solve-section")
 
         print(f"console_check: the whole flow passed; screenshots in {out}")
     finally:

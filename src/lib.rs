@@ -7,7 +7,9 @@
 //! the same module names), whose dependency tree has no HTTP, database, async
 //! runtime or command-line crates.
 
-pub use robocal_core::{compensate, export, identify, ik, kinematics, measure, model, sim};
+pub use robocal_core::{
+    compensate, csv_text, export, identify, ik, kinematics, measure, model, sim,
+};
 
 pub mod cli;
 pub mod db;

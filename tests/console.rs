@@ -82,6 +82,8 @@ async fn pages_render_the_store_and_escape_user_text() {
         "id=\"calibrations\"",
         "id=\"calibrate\"",
         "id=\"versions\"",
+        "id=\"solve\"",
+        "data-action=\"solve\"",
     ] {
         assert!(html.contains(part), "robot page lacks {part}");
     }

@@ -12,7 +12,7 @@ use nalgebra::{Matrix3, Vector3};
 use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use robocal::cli::solve::{solve_to_string, SolveArgs};
+use robocal::cli::solve::{solve_to_string, OutputFormat, SolveArgs};
 use robocal::compensate::{
     load_compensated, parse_compensated, synthetic_calibration, CalibratedModelFile,
     CompensatedModel, Compensator, SyntheticErrors,
@@ -728,7 +728,10 @@ fn cli_args(model: &str, targets: &str) -> SolveArgs {
         position_only: false,
         jump_deg: 30.0,
         threads: 0,
-        json: true,
+        format: OutputFormat::Json,
+        json: false,
+        delimiter: None,
+        decimal: None,
     }
 }
 
@@ -780,9 +783,39 @@ fn cli_solves_a_targets_csv_into_json_and_table() {
     assert!(t[0]["position_residual_mm"].as_f64().unwrap() < 1e-3);
     assert_eq!(t[2]["reason"], "invalid_target");
     assert_eq!(t[3]["reason"], "unreachable");
+    // The same solve as CSV: one row per target, joints as in the JSON.
+    args.format = OutputFormat::Csv;
+    let text = solve_to_string(&args).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 5, "{text}");
+    let head: Vec<&str> = lines[0].split(',').collect();
+    assert_eq!(&head[..5], ["id", "status", "reason", "branch", "j1_deg"]);
+    let a_col = head.iter().position(|h| *h == "false_a").unwrap();
+    let row0: Vec<&str> = lines[1].split(',').collect();
+    assert_eq!(&row0[..2], ["t0", "ok"]);
+    for k in 0..6 {
+        let csv_deg: f64 = row0[4 + k].parse().unwrap();
+        let json_deg = t[0]["joints_deg"][k].as_f64().unwrap();
+        assert!(
+            (csv_deg - json_deg).abs() < 1e-6,
+            "joint {k}: {csv_deg} vs {json_deg}"
+        );
+    }
+    let ft_a: f64 = row0[a_col].parse().unwrap();
+    assert!((ft_a - t[0]["false_target"]["a"].as_f64().unwrap()).abs() < 1e-8);
+    assert!(
+        lines[3].starts_with("bad,failed,invalid_target,"),
+        "{}",
+        lines[3]
+    );
+    assert!(
+        lines[4].starts_with("far,failed,unreachable,"),
+        "{}",
+        lines[4]
+    );
     // Path mode and the table.
     args.path = true;
-    args.json = false;
+    args.format = OutputFormat::Table;
     args.branch = Some("front,up,noflip".into());
     let table = solve_to_string(&args).unwrap();
     assert!(table.contains("front-up-noflip"), "{table}");

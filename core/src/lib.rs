@@ -3,9 +3,11 @@
 //! Flow: measure (`measure`, `sim`) → calibrate (`identify`) → solve
 //! (`compensate`, `ik`). Every function takes the model and the joint values as
 //! arguments; there is no hidden mutable chain state, and nothing here touches
-//! HTTP, a database, the async runtime or the file system.
+//! HTTP, a database, the async runtime or the file system. `csv_text` reads the
+//! CSV texts of measurement and target files for both.
 
 pub mod compensate;
+pub mod csv_text;
 pub mod export;
 pub mod identify;
 pub mod ik;

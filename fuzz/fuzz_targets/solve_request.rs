@@ -5,8 +5,9 @@
 use libfuzzer_sys::fuzz_target;
 use robocal::compensate::CompensatedModel;
 use robocal::http::input::from_json_object;
-use robocal::http::solve::{check_request, seed_joints, solve_inline, SolveRequest};
-use robocal::ik::{IkSettings, IkSolver, SolveOptions};
+use robocal::http::solve::{json_command, SolveRequest};
+use robocal::ik::{IkSettings, IkSolver};
+use robocal::service::solve::{seed_joints, Targets};
 use std::sync::OnceLock;
 
 fn solver() -> &'static IkSolver {
@@ -21,23 +22,23 @@ fuzz_target!(|data: &[u8]| {
     let Ok(req) = from_json_object::<SolveRequest>(data) else {
         return;
     };
-    let Ok(checked) = check_request(&req, 100_000) else {
+    let Ok(mut cmd) = json_command(1, &req) else {
         return;
     };
-    let Ok(seed) = seed_joints(&req, solver()) else {
-        return;
+    if let Some(s) = &cmd.seed_deg {
+        let Ok(seed) = seed_joints(s, solver()) else {
+            return;
+        };
+        cmd.options.seed = Some(seed);
+    }
+    let Targets::Inputs(inputs) = &cmd.targets else {
+        panic!("a JSON request gives checked inputs");
     };
-    let options = SolveOptions {
-        frame: checked.frame,
-        position_only: req.position_only,
-        branch: checked.branch,
-        seed,
-    };
-    let first = &checked.inputs[..checked.inputs.len().min(8)];
-    let results = if req.path {
-        solver().solve_targets_path(first, &options)
+    let first = &inputs[..inputs.len().min(8)];
+    let results = if cmd.path {
+        solver().solve_targets_path(first, &cmd.options)
     } else {
-        solve_inline(solver(), first, &options, checked.default_conv)
+        solver().solve_targets_serial(first, &cmd.options)
     };
     assert_eq!(results.len(), first.len());
 });

@@ -11,7 +11,7 @@
 //! - limits and queues (`--max-queued-jobs`, `--max-queued-solves`,
 //!   `--body-limit`, `--metadata-limit`, `--max-poses-per-set`,
 //!   `--max-targets`, `--job-time-limit`,
-//!   `--page-max`, each with a `ROBOCAL_…` variable; see [`crate::http::limits`]);
+//!   `--page-max`, each with a `ROBOCAL_…` variable; see [`crate::service::limits`]);
 //! - `RUST_LOG`: log filter, default `info`.
 //!
 //! Start-up: open the database, apply the migrations, mark jobs that a previous

@@ -1,40 +1,31 @@
 //! `robocal solve`: target poses → joint commands and false targets.
 //!
-//! Targets CSV (`#` starts a comment line; blank lines are ignored; columns by
-//! name, case-insensitive, any order):
-//!
-//! ```text
-//! id,x,y,z,a,b,c
-//! p1,1500,-3240,1200,180,0,180
-//! ```
-//!
-//! - `id` (optional; default: the 1-based target number);
-//! - `x, y, z`: TCP position [mm] in the measurement (cell) frame, or in the
-//!   registered base frame with `--frame base`;
-//! - the orientation columns of exactly one convention, angles in degrees:
-//!   `qw,qx,qy,qz` (quaternion) | `q1,q2,q3,q4` (ABB, q1 scalar) |
-//!   `ur_rx_rad,ur_ry_rad,ur_rz_rad` (UR rotation vector, radians) |
-//!   `a,b,c` (KUKA, `Rz(A)·Ry(B)·Rx(C)`) |
-//!   `w,p,r` (Fanuc, `Rz(R)·Ry(P)·Rx(W)`) | `r11..r33` (row-major matrix).
-//!   With `--position-only` they may be omitted (or left empty in a row).
-//!
-//! A malformed row (a number that does not parse, NaN, a non-unit quaternion)
-//! fails alone with an `invalid_target` reason; header errors reject the file.
+//! The targets file is read by `ik::targets_csv` (the same parser as the
+//! service's `text/csv` solve): optional `id`, `x,y,z` [mm] in the measurement
+//! (cell) frame, or the registered base frame with `--frame base`, and the
+//! orientation columns of exactly one convention (see that module); `,`, `;`
+//! or tab delimited, decimal commas with `;` or tabs. With `--position-only`
+//! the orientation columns may be omitted (or left empty in a row). A
+//! malformed row fails alone with an `invalid_target` reason; header errors
+//! reject the file.
 //!
 //! Output per target: id, status, reason, configuration branch, joint commands
 //! (controller convention, degrees), position [mm] and orientation [rad]
 //! residuals of the compensated prediction, and the false target
 //! (`FK_nominal(q_cmd)`, controller base frame, mm, same orientation convention
-//! as the input), as a table or, with `--json`, as JSON.
+//! as the input), as a table (`--format table`, the default), CSV
+//! (`--format csv`, the columns of `ik::targets_csv::results_csv`) or JSON.
 
 use crate::compensate::load_compensated;
+use crate::csv_text::{parse_delimiter, Decimal, Dialect};
+use crate::ik::targets_csv::CONVENTION_COLUMNS;
 use crate::ik::{
-    Configuration, IkSettings, IkSolution, IkSolver, SolveOptions, TargetFrame, TargetInput,
+    parse_targets_csv, results_csv, Configuration, IkSettings, IkSolver, SolveOptions, TargetFrame,
     TargetResult,
 };
 use crate::model::orientation::OrientationConvention;
 use anyhow::{bail, Context};
-use clap::Args;
+use clap::{Args, ValueEnum};
 use serde_json::json;
 use std::fmt::Write as _;
 
@@ -77,154 +68,30 @@ pub struct SolveArgs {
     /// Worker threads (0: all cores).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
-    /// Print JSON instead of a table.
-    #[arg(long)]
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
+    pub format: OutputFormat,
+    /// Same as `--format json`.
+    #[arg(long, conflicts_with = "format")]
     pub json: bool,
+    /// Field delimiter of the targets file: `,`, `;` or `tab` (default: detected).
+    #[arg(long)]
+    pub delimiter: Option<String>,
+    /// Decimal separator of the targets file: `point` or `comma` (default:
+    /// detected; a comma needs `;` or tab delimiters).
+    #[arg(long)]
+    pub decimal: Option<String>,
 }
 
-/// One parsed CSV row: the target or why the row is invalid.
-#[derive(Debug, Clone, PartialEq)]
-pub struct TargetRow {
-    pub id: String,
-    pub target: Result<TargetInput, String>,
-}
-
-/// Targets parsed from a CSV text, with the orientation convention of the file.
-#[derive(Debug, Clone, PartialEq)]
-pub struct TargetsCsv {
-    pub convention: Option<OrientationConvention>,
-    pub rows: Vec<TargetRow>,
-}
-
-/// Parses a targets CSV (see the module docs).
-pub fn parse_targets_csv(text: &str) -> anyhow::Result<TargetsCsv> {
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .map(|(i, l)| (i + 1, l.trim()))
-        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-    let Some((hline, header)) = lines.next() else {
-        bail!("the targets file has no header row");
-    };
-    let cols: Vec<String> = header
-        .split(',')
-        .map(|c| c.trim().to_ascii_lowercase())
-        .collect();
-    let find = |name: &str| cols.iter().position(|c| c == name);
-    for (i, c) in cols.iter().enumerate() {
-        if cols[..i].contains(c) {
-            bail!("line {hline}: duplicate column `{c}`");
-        }
-    }
-    let known = |c: &str| {
-        c == "id"
-            || c == "x"
-            || c == "y"
-            || c == "z"
-            || OrientationConvention::ALL
-                .iter()
-                .any(|k| k.column_names().contains(&c))
-    };
-    if let Some(c) = cols.iter().find(|c| !known(c)) {
-        bail!(
-            "line {hline}: unknown column `{c}`; expected id, x, y, z and the orientation \
-             columns of one convention: qw,qx,qy,qz | q1,q2,q3,q4 | a,b,c | w,p,r | ur_rx_rad,ur_ry_rad,ur_rz_rad | r11..r33"
-        );
-    }
-    let xyz: Vec<usize> = ["x", "y", "z"]
-        .iter()
-        .map(|n| find(n).with_context(|| format!("line {hline}: missing column `{n}`")))
-        .collect::<anyhow::Result<_>>()?;
-    let present: Vec<OrientationConvention> = OrientationConvention::ALL
-        .into_iter()
-        .filter(|k| k.column_names().iter().any(|n| find(n).is_some()))
-        .collect();
-    let convention = match present.as_slice() {
-        [] => None,
-        [k] => Some(*k),
-        _ => bail!(
-            "line {hline}: orientation columns of several conventions ({}); use one",
-            present
-                .iter()
-                .map(|k| k.name())
-                .collect::<Vec<_>>()
-                .join(", ")
-        ),
-    };
-    let ori_idx: Vec<usize> = match convention {
-        None => Vec::new(),
-        Some(k) => k
-            .column_names()
-            .iter()
-            .map(|n| {
-                find(n).with_context(|| {
-                    format!(
-                        "line {hline}: {} orientation needs columns {}; `{n}` is missing",
-                        k.name(),
-                        k.column_names().join(", ")
-                    )
-                })
-            })
-            .collect::<anyhow::Result<_>>()?,
-    };
-    let id_idx = find("id");
-    let mut rows = Vec::new();
-    for (n, (lineno, line)) in lines.enumerate() {
-        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
-        let id = id_idx
-            .and_then(|i| cells.get(i))
-            .filter(|s| !s.is_empty())
-            .map(|s| s.to_string())
-            .unwrap_or_else(|| (n + 1).to_string());
-        let target = parse_row(&cells, &cols, &xyz, &ori_idx, convention)
-            .map(|mut t| {
-                t.id = Some(id.clone());
-                t
-            })
-            .map_err(|e| format!("line {lineno}: {e}"));
-        rows.push(TargetRow { id, target });
-    }
-    Ok(TargetsCsv { convention, rows })
-}
-
-fn parse_row(
-    cells: &[&str],
-    cols: &[String],
-    xyz: &[usize],
-    ori_idx: &[usize],
-    convention: Option<OrientationConvention>,
-) -> Result<TargetInput, String> {
-    if cells.len() != cols.len() {
-        return Err(format!(
-            "{} fields, the header has {}",
-            cells.len(),
-            cols.len()
-        ));
-    }
-    let num = |i: usize| -> Result<f64, String> {
-        cells[i]
-            .parse::<f64>()
-            .map_err(|_| format!("column `{}`: `{}` is not a number", cols[i], cells[i]))
-    };
-    let xyz_mm = [num(xyz[0])?, num(xyz[1])?, num(xyz[2])?];
-    let empty = ori_idx.iter().filter(|&&i| cells[i].is_empty()).count();
-    let (convention, orientation) = if ori_idx.is_empty() || empty == ori_idx.len() {
-        (None, Vec::new())
-    } else if empty > 0 {
-        return Err("some orientation fields are empty".into());
-    } else {
-        let values = ori_idx
-            .iter()
-            .map(|&i| num(i))
-            .collect::<Result<Vec<f64>, String>>()?;
-        (convention.map(|k| k.name().to_string()), values)
-    };
-    Ok(TargetInput {
-        id: None,
-        xyz_mm,
-        convention,
-        orientation,
-    })
+/// How `robocal solve` prints its results.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum OutputFormat {
+    /// Aligned columns with `#` comment lines (for people).
+    Table,
+    /// One header row and one row per target (for programs and spreadsheets).
+    Csv,
+    /// One JSON document.
+    Json,
 }
 
 fn parse_seed(text: &str) -> anyhow::Result<Vec<f64>> {
@@ -277,10 +144,28 @@ pub fn solve_to_string(a: &SolveArgs) -> anyhow::Result<String> {
     }
     let text = std::fs::read_to_string(&a.targets)
         .with_context(|| format!("cannot read targets file {}", a.targets))?;
-    let csv = parse_targets_csv(&text).with_context(|| a.targets.clone())?;
+    let dialect = Dialect {
+        delimiter: a
+            .delimiter
+            .as_deref()
+            .map(|d| {
+                parse_delimiter(d)
+                    .with_context(|| format!("--delimiter must be `,`, `;` or `tab`, got `{d}`"))
+            })
+            .transpose()?,
+        decimal: a
+            .decimal
+            .as_deref()
+            .map(|d| {
+                Decimal::parse(d)
+                    .with_context(|| format!("--decimal must be point or comma, got `{d}`"))
+            })
+            .transpose()?,
+    };
+    let csv = parse_targets_csv(&text, dialect).with_context(|| a.targets.clone())?;
     if csv.convention.is_none() && !a.position_only {
         bail!(
-            "{}: no orientation columns (qw,qx,qy,qz | q1,q2,q3,q4 | a,b,c | w,p,r | ur_rx_rad,ur_ry_rad,ur_rz_rad | r11..r33); add them or pass --position-only",
+            "{}: no orientation columns ({CONVENTION_COLUMNS}); add them or pass --position-only",
             a.targets
         );
     }
@@ -296,32 +181,9 @@ pub fn solve_to_string(a: &SolveArgs) -> anyhow::Result<String> {
         position_only: a.position_only,
         branch,
         seed,
+        false_target_convention: csv.convention,
     };
-    let valid: Vec<TargetInput> = csv
-        .rows
-        .iter()
-        .filter_map(|r| r.target.as_ref().ok().cloned())
-        .collect();
-    let mut solved = if a.path {
-        solver.solve_targets_path(&valid, &options)
-    } else {
-        solver.solve_targets(&valid, &options)
-    }
-    .into_iter();
-    let results: Vec<TargetResult> = csv
-        .rows
-        .iter()
-        .map(|r| match &r.target {
-            Ok(_) => solved.next().expect("one result per valid target"),
-            Err(msg) => TargetResult {
-                id: r.id.clone(),
-                solution: IkSolution::invalid(msg.clone()),
-                joints_deg: None,
-                false_target: None,
-                jump: None,
-            },
-        })
-        .collect();
+    let results: Vec<TargetResult> = csv.solve(&solver, &options, a.path);
     let conv = csv.convention.unwrap_or(OrientationConvention::Quaternion);
     let header = Header {
         model: &a.model,
@@ -332,10 +194,11 @@ pub fn solve_to_string(a: &SolveArgs) -> anyhow::Result<String> {
         position_only: a.position_only,
         closed_form: solver.analytic().is_some(),
     };
-    Ok(if a.json {
-        render_json(&header, &results)
-    } else {
-        render_table(&header, &results, solver.model().dof())
+    let format = if a.json { OutputFormat::Json } else { a.format };
+    Ok(match format {
+        OutputFormat::Json => render_json(&header, &results),
+        OutputFormat::Table => render_table(&header, &results, solver.model().dof()),
+        OutputFormat::Csv => results_csv(&results, solver.model().dof(), conv),
     })
 }
 
@@ -494,29 +357,4 @@ fn render_table(h: &Header, results: &[TargetResult], dof: usize) -> String {
 pub fn run(args: SolveArgs) -> anyhow::Result<()> {
     print!("{}", solve_to_string(&args)?);
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn csv_conventions_and_row_errors() {
-        let t = parse_targets_csv("# c\nid,x,y,z,qw,qx,qy,qz\np,1,2,3,1,0,0,0\nq,1,2,x,1,0,0,0\n")
-            .unwrap();
-        assert_eq!(t.convention, Some(OrientationConvention::Quaternion));
-        assert_eq!(t.rows.len(), 2);
-        assert!(t.rows[0].target.is_ok());
-        assert!(t.rows[1].target.as_ref().unwrap_err().contains("`z`"));
-        let t = parse_targets_csv("x,y,z,W,P,R\n1,2,3,0,0,0\n").unwrap();
-        assert_eq!(t.convention, Some(OrientationConvention::FanucWpr));
-        assert_eq!(t.rows[0].id, "1");
-        assert!(parse_targets_csv("x,y,z,a,b,c,w\n").is_err());
-        assert!(parse_targets_csv("x,y,z,a,b\n").is_err());
-        assert!(parse_targets_csv("x,y,z,rx\n").is_err());
-        assert!(parse_targets_csv("x,y\n").is_err());
-        assert!(parse_targets_csv("# only a comment\n").is_err());
-        let t = parse_targets_csv("x,y,z\n1,2,3\n").unwrap();
-        assert_eq!(t.convention, None);
-    }
 }

@@ -185,6 +185,7 @@ impl From<crate::service::ServiceError> for ApiError {
                 detail,
                 retry_after_s,
             },
+            S::Unavailable(m) => ApiError::Unavailable(m),
             S::Db(e) => ApiError::from(e),
             S::Internal(m) => ApiError::Internal(m),
         }
@@ -220,6 +221,22 @@ impl From<QueryRejection> for ApiError {
     fn from(r: QueryRejection) -> Self {
         ApiError::BadRequest(format!("invalid query string: {}", r.body_text()))
     }
+}
+
+/// The media type of the request body (`text/csv` of `text/csv; charset=…`),
+/// lower case; empty when none is declared.
+pub fn content_type(headers: &axum::http::HeaderMap) -> String {
+    headers
+        .get(header::CONTENT_TYPE)
+        .and_then(|v| v.to_str().ok())
+        .map(|v| {
+            v.split(';')
+                .next()
+                .unwrap_or("")
+                .trim()
+                .to_ascii_lowercase()
+        })
+        .unwrap_or_default()
 }
 
 /// Whether the request declares a JSON body (`application/json` or `*/*+json`).

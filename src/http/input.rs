@@ -10,8 +10,8 @@
 //! - names ([`check_name`]), payloads ([`check_payload`]) and list paging
 //!   ([`Page`]).
 
-use super::limits::{PAGE_DEFAULT, PAYLOAD_MAX_KG};
 use super::ApiError;
+use crate::service::limits::{PAGE_DEFAULT, PAYLOAD_MAX_KG};
 use serde::de::{DeserializeOwned, Deserializer, MapAccess, Visitor};
 use serde::Deserialize;
 use std::fmt;

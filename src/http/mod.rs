@@ -29,20 +29,19 @@ pub mod client;
 pub mod console;
 pub mod error;
 pub mod input;
-pub mod limits;
+
 pub mod listener;
 pub mod robots;
 pub mod sets;
 pub mod solve;
 pub mod versions;
 
+pub use crate::service::limits::{
+    Admission, Limits, Ticket, BODY_LIMIT_BYTES, PAYLOAD_MAX_KG, SMALL_SOLVE_MAX,
+};
 pub use crate::service::{AppState, RobotContext, ServiceConfig};
 pub use error::{ApiError, ApiJson, ApiPath, ApiQuery, Problem, PROBLEM_JSON};
-pub use limits::{Admission, Limits, Ticket, PAYLOAD_MAX_KG, SMALL_SOLVE_MAX};
 pub use listener::ServiceListener;
-
-/// Default largest request body (measurement uploads, solve batches).
-pub const BODY_LIMIT_BYTES: usize = 16 * 1024 * 1024;
 
 /// The text of `openapi.yaml`, served at `/openapi.yaml`.
 pub const OPENAPI_YAML: &str = include_str!("../../openapi.yaml");

@@ -6,14 +6,19 @@
 //! millimetres and degrees when they are stored; the upload itself is kept
 //! verbatim and served by `GET .../original`.
 
+use super::error::content_type;
 use super::input::{
     check_name, check_payload, from_json_object, objects, page_fields, present, PageQuery,
 };
 use super::robots::robot_not_found;
 use super::{ApiError, ApiPath, ApiQuery, AppState};
-use crate::db::{AngleUnit, LengthUnit, NewSet, SetFormat, SetRow};
-use crate::measure::csv::{self, CsvError};
+use crate::db::{AngleUnit, LengthUnit, SetFormat, SetRow};
+use crate::measure::csv::{self, DifSign, ReadOptions};
 use crate::measure::{MeasuredPose, SetRole};
+use crate::service::{
+    self,
+    sets::{NewSetCommand, SetContent},
+};
 use axum::body::Bytes;
 use axum::extract::rejection::BytesRejection;
 use axum::extract::State;
@@ -23,9 +28,6 @@ use serde::{Deserialize, Serialize};
 
 /// Most sets one calibration may use.
 pub const MAX_SETS: usize = 100;
-
-/// Largest joint reading accepted, in degrees (as the CSV parser).
-const MAX_JOINT_DEG: f64 = 720.0;
 
 pub(crate) fn set_not_found(robot: i64, id: i64) -> ApiError {
     ApiError::NotFound(format!(
@@ -43,6 +45,12 @@ pub struct SetParams {
     pub payload_kg: Option<f64>,
     pub length_unit: Option<String>,
     pub angle_unit: Option<String>,
+    /// CSV only: sign of the real-data `*_dif` columns (`plus` | `minus`).
+    pub dif_sign: Option<String>,
+    /// CSV only: `,`, `;` or `tab` (detected when absent).
+    pub delimiter: Option<String>,
+    /// CSV only: `point` or `comma` (detected when absent).
+    pub decimal: Option<String>,
 }
 
 /// One row of a JSON upload, in the declared units.
@@ -92,6 +100,7 @@ impl JsonUpload {
             payload_kg: self.payload_kg,
             length_unit: self.length_unit.clone(),
             angle_unit: self.angle_unit.clone(),
+            ..SetParams::default()
         }
     }
 }
@@ -203,78 +212,6 @@ fn check_params(p: &SetParams) -> Result<Checked, ApiError> {
     })
 }
 
-/// Position columns of both CSV layouts.
-const POSITION_COLUMNS: [&str; 9] = [
-    "x", "y", "z", "x_t", "y_t", "z_t", "x_dif", "y_dif", "z_dif",
-];
-
-/// Scales the position columns of a CSV text (metres → millimetres) before it
-/// is parsed; fields that are not numbers are left for the parser to report.
-fn scale_csv_positions(text: &str, factor: f64) -> String {
-    let mut out = String::with_capacity(text.len() + text.len() / 4);
-    let mut cols: Option<Vec<bool>> = None;
-    for line in text.lines() {
-        let t = line.trim();
-        if t.is_empty() || t.starts_with('#') {
-            out.push_str(line);
-            out.push('\n');
-            continue;
-        }
-        match &cols {
-            None => {
-                cols = Some(
-                    t.trim_start_matches('\u{feff}')
-                        .split(',')
-                        .map(|c| {
-                            let c = c.trim().trim_matches('"').trim().to_ascii_lowercase();
-                            POSITION_COLUMNS.contains(&c.as_str())
-                        })
-                        .collect(),
-                );
-                out.push_str(line);
-            }
-            Some(scale) => {
-                let fields: Vec<String> = t
-                    .split(',')
-                    .enumerate()
-                    .map(|(i, f)| {
-                        let v = f.trim().trim_matches('"').trim();
-                        match (scale.get(i), v.parse::<f64>()) {
-                            (Some(true), Ok(x)) if x.is_finite() => (x * factor).to_string(),
-                            _ => f.to_string(),
-                        }
-                    })
-                    .collect();
-                out.push_str(&fields.join(","));
-            }
-        }
-        out.push('\n');
-    }
-    out
-}
-
-fn csv_error(e: CsvError) -> ApiError {
-    let hint = match e {
-        CsvError::PositionUnits => "; if the file is in metres, upload it with ?length_unit=m",
-        _ => "",
-    };
-    ApiError::invalid(format!("measurement CSV: {e}{hint}"))
-}
-
-/// Converts angles to degrees in place.
-fn to_degrees(rows: &mut [MeasuredPose]) {
-    for r in rows {
-        for q in r.q_deg.iter_mut() {
-            *q = q.to_degrees();
-        }
-        if let Some(rpy) = r.rpy_deg.as_mut() {
-            for a in rpy.iter_mut() {
-                *a = a.to_degrees();
-            }
-        }
-    }
-}
-
 fn json_rows(rows: Vec<RowInput>, c: &Checked) -> Result<Vec<MeasuredPose>, ApiError> {
     if rows.is_empty() {
         return Err(ApiError::invalid(
@@ -312,7 +249,12 @@ fn json_rows(rows: Vec<RowInput>, c: &Checked) -> Result<Vec<MeasuredPose>, ApiE
         });
     }
     if c.angle == Angle::Rad {
-        to_degrees(&mut out);
+        for r in out.iter_mut() {
+            r.q_deg.iter_mut().for_each(|q| *q = q.to_degrees());
+            if let Some(rpy) = r.rpy_deg.as_mut() {
+                rpy.iter_mut().for_each(|a| *a = a.to_degrees());
+            }
+        }
     }
     // The same bounds as the measurement CSV (after unit conversion).
     for (i, r) in out.iter().enumerate() {
@@ -342,48 +284,23 @@ fn json_rows(rows: Vec<RowInput>, c: &Checked) -> Result<Vec<MeasuredPose>, ApiE
     Ok(out)
 }
 
-fn check_rows(rows: &[MeasuredPose], dof: usize, max_rows: usize) -> Result<(), ApiError> {
-    if rows.len() > max_rows {
-        return Err(ApiError::invalid(format!(
-            "{} rows in one set; at most {max_rows} (`--max-poses-per-set`): split the upload",
-            rows.len()
-        )));
-    }
-    csv::check_joint_count(rows, dof).map_err(|e| {
-        ApiError::invalid(format!("{e} (the robot has {dof} joints: send q1..q{dof})"))
-    })?;
-    for (i, r) in rows.iter().enumerate() {
-        if let Some(p) = r.payload_kg {
-            check_payload(&format!("row {}: `payload_kg`", i + 1), p)?;
-        }
-        if let Some((k, v)) = r
-            .q_deg
-            .iter()
-            .enumerate()
-            .find(|(_, v)| v.abs() > MAX_JOINT_DEG)
-        {
+/// The CSV reading options of an upload's query.
+fn read_options(q: &SetParams, c: &Checked) -> Result<ReadOptions, ApiError> {
+    let dif = match q.dif_sign.as_deref() {
+        None | Some("plus") => DifSign::Plus,
+        Some("minus") => DifSign::Minus,
+        Some(other) => {
             return Err(ApiError::invalid(format!(
-                "row {}: joint q{} = {v} deg is beyond ±{MAX_JOINT_DEG} deg; check the angle unit",
-                i + 1,
-                k + 1
-            )));
+                "`dif_sign` must be plus (measured = target + dif) or minus, got `{other}`"
+            )))
         }
-    }
-    Ok(())
-}
-
-fn content_type(headers: &HeaderMap) -> String {
-    headers
-        .get(header::CONTENT_TYPE)
-        .and_then(|v| v.to_str().ok())
-        .map(|v| {
-            v.split(';')
-                .next()
-                .unwrap_or("")
-                .trim()
-                .to_ascii_lowercase()
-        })
-        .unwrap_or_default()
+    };
+    Ok(ReadOptions {
+        dif,
+        dialect: super::solve::dialect(q.delimiter.as_deref(), q.decimal.as_deref())?,
+        metres: c.length == Length::M,
+        radians: c.angle == Angle::Rad,
+    })
 }
 
 pub async fn upload(
@@ -406,96 +323,54 @@ pub async fn upload(
             }
         )));
     }
-    let body = body?;
-    let robot = state
-        .db()
-        .robot(robot_id)
-        .await?
-        .ok_or_else(|| robot_not_found(robot_id))?;
-    let dof = robot.dof as usize;
-    let max_rows = state.limits().poses_per_set;
-    let text = String::from_utf8(body.to_vec())
+    let text = String::from_utf8(body?.to_vec())
         .map_err(|_| ApiError::invalid("the upload is not UTF-8 text"))?;
-
-    let parsed = tokio::task::spawn_blocking(move || -> Result<_, ApiError> {
-        if is_csv {
-            let c = check_params(&query)?;
-            let mut rows = if c.length == Length::M {
-                csv::parse(&scale_csv_positions(&text, 1e3)).map_err(csv_error)?
-            } else {
-                csv::parse(&text).map_err(csv_error)?
-            };
-            if c.angle == Angle::Rad {
-                to_degrees(&mut rows);
-            }
-            // A set is one tracker session: a `session` column must agree.
-            if let Some((i, s)) = rows
-                .iter()
-                .enumerate()
-                .find_map(|(i, r)| r.session.as_ref().filter(|s| **s != c.session).map(|s| (i, s)))
-            {
-                return Err(ApiError::invalid(format!(
-                    "row {}: the `session` column says `{s}` but this set's session is `{}`; upload each tracker session as its own set (`?session=`)",
-                    i + 1,
-                    c.session
-                )));
-            }
-            check_rows(&rows, dof, max_rows)?;
-            Ok((c, rows, SetFormat::Csv, text))
-        } else {
-            if query.name.is_some()
-                || query.role.is_some()
-                || query.session.is_some()
-                || query.payload_kg.is_some()
-                || query.length_unit.is_some()
-                || query.angle_unit.is_some()
-            {
-                return Err(ApiError::invalid(
-                    "for JSON uploads give name, role, session, payload_kg and units in the body, not the query string",
-                ));
-            }
-            let up: JsonUpload = from_json_object(text.as_bytes())?;
-            let c = check_params(&up.params())?;
-            let rows = json_rows(up.rows, &c)?;
-            check_rows(&rows, dof, max_rows)?;
-            Ok((c, rows, SetFormat::Json, text))
-        }
-    })
-    .await
-    .map_err(|e| ApiError::Internal(format!("upload parser: {e}")))??;
-    let (c, rows, format, original) = parsed;
-
-    // Role: declared, else the rows' common `set` value, else identification.
-    let role = c.role.unwrap_or_else(|| {
-        let first = rows[0].set;
-        match first {
-            Some(r) if rows.iter().all(|x| x.set == Some(r)) => r,
-            _ => SetRole::Identification,
-        }
-    });
-    let name = if c.name.is_empty() {
-        role.as_str().to_string()
+    let (c, content) = if is_csv {
+        let c = check_params(&query)?;
+        let read = read_options(&query, &c)?;
+        (c, SetContent::Csv { text, read })
     } else {
-        c.name.clone()
+        let SetParams {
+            name: None,
+            role: None,
+            session: None,
+            payload_kg: None,
+            length_unit: None,
+            angle_unit: None,
+            dif_sign: None,
+            delimiter: None,
+            decimal: None,
+        } = query
+        else {
+            return Err(ApiError::invalid(
+                "for JSON uploads give name, role, session, payload_kg and units in the body, not the query string (dif_sign, delimiter and decimal are for CSV uploads)",
+            ));
+        };
+        let up: JsonUpload = from_json_object(text.as_bytes())?;
+        let c = check_params(&up.params())?;
+        let rows = json_rows(up.rows, &c)?;
+        (
+            c,
+            SetContent::Rows {
+                rows,
+                original: text,
+            },
+        )
     };
-    let row = state
-        .db()
-        .insert_set(&NewSet {
+    let row = service::sets::upload(
+        &state,
+        NewSetCommand {
             robot_id,
-            name: &name,
-            role: role.into(),
-            session: &c.session,
+            name: c.name,
+            role: c.role,
+            session: c.session,
             payload_kg: c.payload_kg,
-            length_unit: c.length,
-            angle_unit: c.angle,
-            format,
-            original: &original,
-            rows: &rows,
-            row_count: rows.len() as i64,
-            dof: dof as i64,
-        })
-        .await?
-        .ok_or_else(|| robot_not_found(robot_id))?;
+            length: c.length,
+            angle: c.angle,
+            content,
+        },
+    )
+    .await?;
     let location = format!("/v1/robots/{robot_id}/measurement-sets/{}", row.id);
     Ok((
         StatusCode::CREATED,
@@ -605,16 +480,4 @@ pub fn routes() -> Vec<super::Route> {
             original,
         ),
     ]
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn metres_are_scaled_in_position_columns_only() {
-        let t = "# c\nq1,q2,x,y,z\n1.5,2,1.25,-0.5,2\n";
-        let s = scale_csv_positions(t, 1e3);
-        assert_eq!(s, "# c\nq1,q2,x,y,z\n1.5,2,1250,-500,2000\n");
-    }
 }

@@ -10,24 +10,32 @@
 //! controller's base frame, in the target's convention (quaternion for
 //! position-only targets unless `convention` is given).
 //!
-//! Prepared solvers are cached per (robot, version, payload): versions never
-//! change once written. Small batches are solved inline; larger ones on the
-//! blocking pool (parallel inside), at most `solve_workers` at a time.
+//! The same request as a targets CSV (`Content-Type: text/csv`, the file
+//! format of `robocal solve`, options in the query string) and the answer as
+//! CSV (`Accept: text/csv`, or by default for a CSV request; columns of
+//! `ik::targets_csv`, the model used in `X-Robocal-Version` /
+//! `X-Robocal-Method`). The handler turns either body into a
+//! `service::solve::SolveCommand`; the service picks the model and runs it.
 
-use super::input::{check_payload, object_or_null, objects, present, Int};
-use super::{ApiError, ApiJson, ApiPath, AppState, SMALL_SOLVE_MAX};
-use crate::compensate::{CalibratedModelFile, CompensatedModel};
+use super::error::{content_type, json_content_type};
+use super::input::{check_payload, from_json_object, object_or_null, objects, present, Int};
+use super::{ApiError, ApiPath, ApiQuery, AppState};
+use crate::csv_text::{parse_delimiter, Decimal, Dialect};
+use crate::ik::targets_csv::CONVENTION_COLUMNS;
 use crate::ik::{
-    Configuration, IkSettings, IkSolver, JointJump, SolveOptions, TargetFrame, TargetInput,
-    TargetResult,
+    parse_targets_csv, results_csv, Configuration, JointJump, SolveOptions, TargetFrame,
+    TargetInput, TargetResult,
 };
 use crate::model::orientation::OrientationConvention;
-use crate::model::RobotModel;
+use crate::service;
+use crate::service::solve::{ModelChoice, SolveCommand, Targets};
+use axum::body::Bytes;
+use axum::extract::rejection::BytesRejection;
 use axum::extract::State;
+use axum::http::{header, HeaderMap, HeaderName};
 use axum::response::{IntoResponse, Response};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
-use std::sync::Arc;
 use std::time::Instant;
 
 /// Names of the orientation conventions as `openapi.yaml` lists them
@@ -217,9 +225,6 @@ fn target_id(i: usize, id: &Option<Value>) -> Result<String, ApiError> {
 }
 
 fn to_inputs(req: &SolveRequest) -> Result<Vec<TargetInput>, ApiError> {
-    if let Some(c) = &req.convention {
-        convention(c, "`convention`")?;
-    }
     req.targets
         .iter()
         .enumerate()
@@ -246,39 +251,33 @@ fn to_inputs(req: &SolveRequest) -> Result<Vec<TargetInput>, ApiError> {
         .collect()
 }
 
-/// A solve request after its checks: what every target needs.
-pub struct CheckedRequest {
-    pub inputs: Vec<TargetInput>,
-    pub frame: TargetFrame,
-    pub branch: Option<Configuration>,
-    pub default_conv: OrientationConvention,
+/// The options both body formats share, before the targets.
+struct Common<'a> {
+    version: Option<&'a VersionSelector>,
+    payload_kg: Option<f64>,
+    jump_deg: Option<f64>,
+    frame: Option<&'a str>,
+    branch: Option<&'a str>,
+    seed_deg: Option<Vec<f64>>,
+    convention: Option<&'a str>,
+    position_only: bool,
+    path: bool,
 }
 
-/// Every check of a solve request that does not need the robot (422 on
-/// failure, naming the field).
-pub fn check_request(req: &SolveRequest, max_targets: usize) -> Result<CheckedRequest, ApiError> {
-    if req.targets.is_empty() {
-        return Err(ApiError::invalid(
-            "`targets` is empty: send at least one target",
-        ));
-    }
-    if req.targets.len() > max_targets {
-        return Err(ApiError::invalid(format!(
-            "{} targets in one request; at most {max_targets} (`--max-targets`): split the batch",
-            req.targets.len()
-        )));
-    }
-    if let Some(p) = req.payload_kg {
+/// Every check that does not need the robot (422 naming the field), as a
+/// service command with no targets yet.
+fn command(robot_id: i64, c: Common) -> Result<SolveCommand, ApiError> {
+    if let Some(p) = c.payload_kg {
         check_payload("`payload_kg`", p)?;
     }
-    if let Some(j) = req.jump_deg {
+    if let Some(j) = c.jump_deg {
         if !(j.is_finite() && j > 0.0) {
             return Err(ApiError::invalid(
                 "`jump_deg` must be a positive number of degrees",
             ));
         }
     }
-    let frame: TargetFrame = match req.frame.as_deref() {
+    let frame = match c.frame {
         None | Some("cell") => TargetFrame::Cell,
         Some("base") => TargetFrame::Base,
         Some(f) => {
@@ -287,264 +286,281 @@ pub fn check_request(req: &SolveRequest, max_targets: usize) -> Result<CheckedRe
             )))
         }
     };
-    if let Some(b) = &req.branch {
+    if let Some(b) = c.branch {
         if !branch_syntax_ok(b) {
             return Err(ApiError::invalid(format!(
                 "`branch`: `{b}` is not a branch; give an index 0..7 or flags front|back, up|down, noflip|flip in lower case joined by `,`, e.g. front,up,noflip"
             )));
         }
     }
-    let branch = req
+    let branch = c
         .branch
-        .as_deref()
         .map(Configuration::parse)
         .transpose()
         .map_err(|e| ApiError::invalid(format!("`branch`: {e}")))?;
-    if req.seed_deg.is_some() && branch.is_some() {
+    if c.seed_deg.is_some() && branch.is_some() {
         return Err(ApiError::invalid(
             "give either `branch` or `seed_deg`, not both",
         ));
     }
-    let inputs = to_inputs(req)?;
-    let default_conv = req
+    let false_target_convention = c
         .convention
-        .as_deref()
-        .map(|c| convention(c, "`convention`"))
-        .transpose()?
-        .unwrap_or(OrientationConvention::Quaternion);
-    Ok(CheckedRequest {
-        inputs,
-        frame,
-        branch,
-        default_conv,
-    })
-}
-
-/// The joint seed of a request in the solver's joint convention, checked
-/// against the robot's joint count.
-pub fn seed_joints(req: &SolveRequest, solver: &IkSolver) -> Result<Option<Vec<f64>>, ApiError> {
-    let Some(s) = &req.seed_deg else {
-        return Ok(None);
-    };
-    let dof = solver.model().dof();
-    if s.len() != dof || s.iter().any(|v| !v.is_finite()) {
-        return Err(ApiError::invalid(format!(
-            "`seed_deg` needs {dof} finite joint values (controller convention, degrees), got {}",
-            s.len()
-        )));
-    }
-    let rad: Vec<f64> = s.iter().map(|d| d.to_radians()).collect();
-    Ok(Some(solver.model().nominal.joints_from_controller(&rad)))
-}
-
-/// The prepared solver and what it is.
-struct Prepared {
-    solver: Arc<IkSolver>,
-    version: Option<i64>,
-    method: String,
-}
-
-async fn prepare(
-    state: &AppState,
-    robot_id: i64,
-    req: &SolveRequest,
-) -> Result<Prepared, ApiError> {
-    let ctx = state.robot_context(robot_id).await?;
-    let payload_bits = req.payload_kg.map(f64::to_bits);
-    // (version row id, version number, method); None: nominal.
-    let chosen: Option<(i64, i64, String)> = match &req.version {
-        None => Some(ctx.active.clone().ok_or_else(|| {
-            ApiError::Conflict(format!(
-                "robot {robot_id} has no active model version: run a calibration (POST /v1/robots/{robot_id}/calibrations), activate a version, name one with \"version\": N, or solve with the nominal model with \"version\": \"nominal\""
-            ))
-        })?),
-        Some(VersionSelector::Name(n)) if n == "active" => {
-            Some(ctx.active.clone().ok_or_else(|| {
-                ApiError::Conflict(format!("robot {robot_id} has no active model version"))
-            })?)
-        }
-        Some(VersionSelector::Name(n)) if n == "nominal" => None,
+        .map(|name| convention(name, "`convention`"))
+        .transpose()?;
+    let model = match c.version {
+        None => ModelChoice::Active,
+        Some(VersionSelector::Name(n)) if n == "active" => ModelChoice::Active,
+        Some(VersionSelector::Name(n)) if n == "nominal" => ModelChoice::Nominal,
         Some(VersionSelector::Name(n)) => {
             return Err(ApiError::invalid(format!(
                 "`version` must be a version number, \"active\" or \"nominal\", got \"{n}\""
             )))
         }
-        Some(VersionSelector::Number(Int(v))) if *v < 1 => {
-            return Err(ApiError::invalid(format!(
-                "`version` numbers start at 1, got {v}"
-            )))
-        }
-        Some(VersionSelector::Number(Int(v))) => {
-            // A version the robot does not have (yet): a conflict with its
-            // state, not a missing URL.
-            let row = state.db().version(robot_id, *v).await?.ok_or_else(|| {
-                ApiError::Conflict(format!(
-                    "robot {robot_id} has no model version {v}; list them with GET /v1/robots/{robot_id}/versions"
-                ))
-            })?;
-            Some((row.id, row.version, row.method))
-        }
+        Some(VersionSelector::Number(Int(v))) => ModelChoice::Version(*v),
     };
-    let key = (robot_id, chosen.as_ref().map(|c| c.0), payload_bits);
-    let custom_jump = req.jump_deg.is_some();
-    let (version, method) = match &chosen {
-        Some((_, v, m)) => (Some(*v), m.clone()),
-        None => (None, "nominal".to_string()),
-    };
-    if !custom_jump {
-        if let Some(solver) = state.cached_solver(&key) {
-            return Ok(Prepared {
-                solver,
-                version,
-                method,
-            });
-        }
-    }
-    let mut model = match &chosen {
-        Some((vid, v, _)) => {
-            let text = state.db().version_model(*vid).await?.ok_or_else(|| {
-                ApiError::NotFound(format!("robot {robot_id} has no model version {v}"))
-            })?;
-            CalibratedModelFile::from_json(&text)
-                .and_then(|f| f.to_compensated())
-                .map_err(|e| ApiError::Internal(format!("stored model version {v}: {e}")))?
-        }
-        None => {
-            let m = RobotModel::from_json(&ctx.model_json).map_err(|e| {
-                ApiError::Internal(format!("stored model of robot {robot_id}: {e}"))
-            })?;
-            CompensatedModel::from_nominal(m)
-        }
-    };
-    if let Some(p) = req.payload_kg {
-        model.payload_kg = p;
-    }
-    let mut settings = IkSettings::default();
-    if let Some(j) = req.jump_deg {
-        settings.jump_threshold_rad = j.to_radians();
-    }
-    let solver = Arc::new(IkSolver::new(model, settings));
-    if !custom_jump {
-        state.cache_solver(key, solver.clone());
-    }
-    Ok(Prepared {
-        solver,
-        version,
-        method,
+    Ok(SolveCommand {
+        robot_id,
+        model,
+        payload_kg: c.payload_kg,
+        jump_deg: c.jump_deg,
+        seed_deg: c.seed_deg,
+        options: SolveOptions {
+            frame,
+            position_only: c.position_only,
+            branch,
+            seed: None,
+            false_target_convention,
+        },
+        path: c.path,
+        targets: Targets::Inputs(Vec::new()),
     })
 }
 
-/// Solves small batches without leaving the calling thread.
-pub fn solve_inline(
-    solver: &IkSolver,
-    targets: &[TargetInput],
-    options: &SolveOptions,
-    default_conv: OrientationConvention,
-) -> Vec<TargetResult> {
-    targets
-        .iter()
-        .enumerate()
-        .map(|(i, t)| {
-            let id = t.id.clone().unwrap_or_else(|| (i + 1).to_string());
-            let (solution, conv) = match t.to_goal() {
-                Ok((goal, conv)) => (solver.solve_goal(&goal, options), conv),
-                Err(msg) => (crate::ik::IkSolution::invalid(msg), None),
-            };
-            let (joints_deg, false_target) = if solution.converged {
-                (
-                    Some(solver.controller_degrees(&solution.q)),
-                    solver.false_target(&solution.q, conv.unwrap_or(default_conv)),
-                )
-            } else {
-                (None, None)
-            };
-            TargetResult {
-                id,
-                solution,
-                joints_deg,
-                false_target,
-                jump: None,
-            }
+/// A JSON solve request as a service command.
+pub fn json_command(robot_id: i64, req: &SolveRequest) -> Result<SolveCommand, ApiError> {
+    if req.targets.is_empty() {
+        return Err(ApiError::invalid(
+            "`targets` is empty: send at least one target",
+        ));
+    }
+    let mut cmd = command(
+        robot_id,
+        Common {
+            version: req.version.as_ref(),
+            payload_kg: req.payload_kg,
+            jump_deg: req.jump_deg,
+            frame: req.frame.as_deref(),
+            branch: req.branch.as_deref(),
+            seed_deg: req.seed_deg.clone(),
+            convention: req.convention.as_deref(),
+            position_only: req.position_only,
+            path: req.path,
+        },
+    )?;
+    cmd.targets = Targets::Inputs(to_inputs(req)?);
+    Ok(cmd)
+}
+
+/// Query parameters of a `text/csv` solve (the JSON body's options).
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CsvSolveQuery {
+    pub version: Option<String>,
+    pub payload_kg: Option<f64>,
+    pub jump_deg: Option<f64>,
+    pub frame: Option<String>,
+    pub branch: Option<String>,
+    /// Controller joint seed [deg], comma-separated.
+    pub seed_deg: Option<String>,
+    pub convention: Option<String>,
+    pub position_only: Option<bool>,
+    pub path: Option<bool>,
+    /// `,`, `;` or `tab` (detected when absent).
+    pub delimiter: Option<String>,
+    /// `point` or `comma` (detected when absent).
+    pub decimal: Option<String>,
+}
+
+impl CsvSolveQuery {
+    fn is_empty(&self) -> bool {
+        self.version.is_none()
+            && self.payload_kg.is_none()
+            && self.jump_deg.is_none()
+            && self.frame.is_none()
+            && self.branch.is_none()
+            && self.seed_deg.is_none()
+            && self.convention.is_none()
+            && self.position_only.is_none()
+            && self.path.is_none()
+            && self.delimiter.is_none()
+            && self.decimal.is_none()
+    }
+}
+
+/// The delimiter and decimal separator a query declares.
+pub fn dialect(delimiter: Option<&str>, decimal: Option<&str>) -> Result<Dialect, ApiError> {
+    Ok(Dialect {
+        delimiter: delimiter
+            .map(|d| {
+                parse_delimiter(d).ok_or_else(|| {
+                    ApiError::invalid(format!("`delimiter` must be `,`, `;` or `tab`, got `{d}`"))
+                })
+            })
+            .transpose()?,
+        decimal: decimal
+            .map(|d| {
+                Decimal::parse(d).ok_or_else(|| {
+                    ApiError::invalid(format!("`decimal` must be point or comma, got `{d}`"))
+                })
+            })
+            .transpose()?,
+    })
+}
+
+/// A targets CSV and its query as a service command.
+pub fn csv_command(robot_id: i64, q: &CsvSolveQuery, text: &str) -> Result<SolveCommand, ApiError> {
+    let version = q.version.as_deref().map(|v| match v.parse::<i64>() {
+        Ok(n) => VersionSelector::Number(Int(n)),
+        Err(_) => VersionSelector::Name(v.to_string()),
+    });
+    let seed_deg = q
+        .seed_deg
+        .as_deref()
+        .map(|s| {
+            s.split(',')
+                .map(|v| {
+                    v.trim().parse::<f64>().map_err(|_| {
+                        ApiError::invalid(format!(
+                            "`seed_deg`: `{}` is not a number; give the joint values in degrees separated by commas",
+                            v.trim()
+                        ))
+                    })
+                })
+                .collect::<Result<Vec<f64>, ApiError>>()
         })
-        .collect()
+        .transpose()?;
+    let mut cmd = command(
+        robot_id,
+        Common {
+            version: version.as_ref(),
+            payload_kg: q.payload_kg,
+            jump_deg: q.jump_deg,
+            frame: q.frame.as_deref(),
+            branch: q.branch.as_deref(),
+            seed_deg,
+            convention: q.convention.as_deref(),
+            position_only: q.position_only.unwrap_or(false),
+            path: q.path.unwrap_or(false),
+        },
+    )?;
+    let d = dialect(q.delimiter.as_deref(), q.decimal.as_deref())?;
+    let csv =
+        parse_targets_csv(text, d).map_err(|e| ApiError::invalid(format!("targets CSV: {e}")))?;
+    if csv.convention.is_none() && !cmd.options.position_only {
+        return Err(ApiError::invalid(format!(
+            "targets CSV: no orientation columns ({CONVENTION_COLUMNS}); add them or solve with `position_only=true`"
+        )));
+    }
+    if csv.rows.is_empty() {
+        return Err(ApiError::invalid(
+            "targets CSV: no target rows after the header",
+        ));
+    }
+    // False targets of position-only rows in the file's convention.
+    if cmd.options.false_target_convention.is_none() {
+        cmd.options.false_target_convention = csv.convention;
+    }
+    cmd.targets = Targets::Csv(csv);
+    Ok(cmd)
+}
+
+fn is_csv_type(ct: &str) -> bool {
+    matches!(ct, "text/csv" | "application/csv")
+}
+
+/// Whether the answer is CSV: as `Accept` asks, else the request's format.
+fn wants_csv(headers: &HeaderMap, request_is_csv: bool) -> bool {
+    let accept = headers
+        .get(header::ACCEPT)
+        .and_then(|v| v.to_str().ok())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    let csv = accept.contains("text/csv");
+    let json = accept.contains("application/json");
+    match (csv, json) {
+        (true, false) => true,
+        (false, true) => false,
+        _ => request_is_csv,
+    }
 }
 
 pub async fn solve(
     State(state): State<AppState>,
     ApiPath(robot_id): ApiPath<i64>,
-    ApiJson(req): ApiJson<SolveRequest>,
+    ApiQuery(query): ApiQuery<CsvSolveQuery>,
+    headers: HeaderMap,
+    body: Result<Bytes, BytesRejection>,
 ) -> Result<Response, ApiError> {
     let start = Instant::now();
-    let CheckedRequest {
-        inputs,
-        frame,
-        branch,
-        default_conv,
-    } = check_request(&req, state.limits().targets_per_request)?;
-
-    let prepared = prepare(&state, robot_id, &req).await?;
-    let solver = prepared.solver.clone();
-    let seed = seed_joints(&req, &solver)?;
-    let options = SolveOptions {
-        frame,
-        position_only: req.position_only,
-        branch,
-        seed,
-    };
-    let payload_kg = solver.model().payload_kg;
-    let path = req.path;
-    let results = if inputs.len() <= SMALL_SOLVE_MAX {
-        if path {
-            solver.solve_targets_path(&inputs, &options)
-        } else {
-            solve_inline(&solver, &inputs, &options, default_conv)
-        }
-    } else {
-        // Large batches queue for a solve worker; a full queue is refused
-        // at once (429 + Retry-After) instead of waiting silently.
-        let ticket = state.admit_solve()?;
-        let permit = state
-            .solve_slots()
-            .acquire_owned()
-            .await
-            .map_err(|_| ApiError::Unavailable("the service is shutting down".into()))?;
-        let results = tokio::task::spawn_blocking(move || {
-            let _permit = permit;
-            let _ticket = ticket;
-            if path {
-                solver.solve_targets_path(&inputs, &options)
-            } else {
-                solver.solve_targets(&inputs, &options)
-            }
-        })
-        .await
-        .map_err(|e| ApiError::Internal(format!("solver task: {e}")))?;
-        results
-    };
-    // Position-only targets: false targets in the requested convention.
-    let mut out: Vec<TargetOut> = Vec::with_capacity(results.len());
-    for mut r in results {
-        if let (Some(ft), true) = (&r.false_target, req.convention.is_some()) {
-            if ft.convention != default_conv
-                && req
-                    .targets
-                    .get(out.len())
-                    .is_some_and(|t| t.orientation.is_none())
-            {
-                r.false_target = prepared.solver.false_target(&r.solution.q, default_conv);
-            }
-        }
-        out.push(TargetOut::from(r));
+    let ct = content_type(&headers);
+    let request_is_csv = is_csv_type(&ct);
+    if !request_is_csv && !json_content_type(&headers) {
+        return Err(ApiError::UnsupportedMediaType(
+            "send the targets as JSON (`Content-Type: application/json`) or as a targets CSV (`Content-Type: text/csv`, options in the query string)".into(),
+        ));
     }
-    let solved = out.iter().filter(|r| r.status == "ok").count();
+    let body = body?;
+    let cmd = if request_is_csv {
+        let text = std::str::from_utf8(&body)
+            .map_err(|_| ApiError::invalid("the targets CSV is not UTF-8 text"))?;
+        csv_command(robot_id, &query, text)?
+    } else {
+        if !query.is_empty() {
+            return Err(ApiError::invalid(
+                "for JSON solves give the options in the body, not the query string",
+            ));
+        }
+        let req: SolveRequest = from_json_object(&body)?;
+        json_command(robot_id, &req)?
+    };
+    let frame = cmd.options.frame;
+    let position_only = cmd.options.position_only;
+    let path = cmd.path;
+    let out_conv = cmd
+        .options
+        .false_target_convention
+        .unwrap_or(OrientationConvention::Quaternion);
+    let done = service::solve::solve(&state, cmd).await?;
+    let solved = done.results.iter().filter(|r| r.solution.converged).count();
+    if wants_csv(&headers, request_is_csv) {
+        let text = results_csv(&done.results, done.dof, out_conv);
+        let version = done
+            .version
+            .map(|v| v.to_string())
+            .unwrap_or_else(|| "nominal".into());
+        return Ok((
+            [
+                (header::CONTENT_TYPE, "text/csv; charset=utf-8".to_string()),
+                (HeaderName::from_static("x-robocal-version"), version),
+                (HeaderName::from_static("x-robocal-method"), done.method),
+                (
+                    HeaderName::from_static("x-robocal-solved"),
+                    format!("{solved}/{}", done.results.len()),
+                ),
+            ],
+            text,
+        )
+            .into_response());
+    }
+    let out: Vec<TargetOut> = done.results.into_iter().map(TargetOut::from).collect();
     let resp = SolveResponse {
         robot_id,
-        version: prepared.version,
-        method: prepared.method,
+        version: done.version,
+        method: done.method,
         frame: frame.to_string(),
-        payload_kg,
+        payload_kg: done.payload_kg,
         path,
-        position_only: req.position_only,
+        position_only,
         targets: out.len(),
         solved,
         failed: out.len() - solved,

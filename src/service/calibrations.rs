@@ -12,12 +12,12 @@
 //! validation mean, identification mean without validation) is activated only
 //! when the robot has no active version yet.
 
+use super::limits::Ticket;
 use super::{AppState, ServiceError};
 use crate::compensate::{CalibratedModelFile, CompensatedModel};
 use crate::db::{
     CalibrationRow, JobStatus, JobSummary, NewCalibration, NewVersion, SetRow, StoredRole,
 };
-use crate::http::limits::Ticket;
 use crate::identify::{
     calibrate, CalibrationError, CalibrationOptions, CalibrationReport, FailedMethod, LmSettings,
     Method, PoseSource, PoseSources, Progress, TlboSettings,

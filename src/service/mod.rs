@@ -1,10 +1,13 @@
 //! The service layer, between the HTTP handlers and the core and store: the
 //! shared state and caches ([`AppState`]), and the orchestration of work —
 //! calibration jobs (set selection, tracker sessions, the job runner and its
-//! progress, model versions). It takes domain commands, not HTTP bodies, and
+//! progress, model versions), measurement-set uploads and solves (model choice, solver cache, batches). It takes domain commands, not HTTP bodies, and
 //! answers with a typed [`ServiceError`] that the HTTP layer maps to a status.
 
 pub mod calibrations;
+pub mod limits;
+pub mod sets;
+pub mod solve;
 mod state;
 
 pub use state::{AppState, RobotContext, ServiceConfig};
@@ -26,6 +29,9 @@ pub enum ServiceError {
     /// The service is saturated; the same command may succeed later.
     #[error("{detail}")]
     Busy { detail: String, retry_after_s: u32 },
+    /// The service cannot take the command now (shutting down).
+    #[error("{0}")]
+    Unavailable(String),
     /// The store failed.
     #[error("database error: {0}")]
     Db(#[from] DbError),

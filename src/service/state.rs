@@ -2,9 +2,9 @@
 //! solve queues, cancellation flags and the caches of robots and prepared
 //! solvers.
 
+use super::limits::{Admission, Limits, Ticket, SMALL_SOLVE_MAX};
 use super::ServiceError;
 use crate::db::Db;
-use crate::http::limits::{Admission, Limits, Ticket, SMALL_SOLVE_MAX};
 use crate::ik::IkSolver;
 use std::collections::HashMap;
 use std::sync::atomic::AtomicBool;

@@ -6,11 +6,12 @@
 //! the documented schema (JSON Schema 2020-12, via `jsonschema`).
 //!
 //! One file per theme: `contract` (routes, spec, bad input, keys, paging),
-//! `flow` (the quickstart end to end), `sets` (uploads), `jobs` (progress,
+//! `flow` (the quickstart end to end), `sets` (uploads), `solve` (targets CSV in and out), `jobs` (progress,
 //! cancellation, saturation, races); the harness is `support`.
 
 mod contract;
 mod flow;
 mod jobs;
 mod sets;
+mod solve;
 mod support;

@@ -188,3 +188,75 @@ async fn payloads_beyond_10_tonnes_are_refused_before_any_work() {
         .await;
     assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
 }
+
+#[tokio::test]
+async fn locale_csv_and_dif_sign_uploads_read_like_the_canonical_file() {
+    let t = setup().await;
+    let robot = t.create_robot("ys100").await;
+    let rid = robot.to_string();
+    let rows_of = |set: &Value| {
+        let t = &t;
+        let rid = rid.clone();
+        let sid = set["id"].as_i64().unwrap().to_string();
+        async move {
+            let r = t
+                .get("/v1/robots/{id}/measurement-sets/{sid}", &[&rid, &sid])
+                .await;
+            serde_json::from_value::<Vec<MeasuredPose>>(r.json()["rows"].clone()).unwrap()
+        }
+    };
+
+    // `;`-separated with decimal commas (detected, and declared).
+    let text = simulated_csv(5, 8);
+    let semi: String = text
+        .lines()
+        .map(|l| l.replace(',', ";").replace('.', ","))
+        .collect::<Vec<_>>()
+        .join("\n");
+    for query in ["", "?delimiter=;&decimal=comma"] {
+        let set = t.upload_csv(robot, &semi, query).await;
+        assert_eq!(rows_of(&set).await, csv::parse(&text).unwrap(), "{query}");
+    }
+
+    // The real-data layout with the opposite `dif` sign.
+    let real = "joint_1,joint_2,joint_3,joint_4,joint_5,joint_6,x_t,y_t,z_t,x_dif,y_dif,z_dif\n\
+                10,80,-20,5,30,0,1500,100,1200,0.5,-0.25,1\n";
+    let plus = rows_of(&t.upload_csv(robot, real, "").await).await;
+    let minus = rows_of(&t.upload_csv(robot, real, "?dif_sign=minus").await).await;
+    assert_eq!(plus[0].xyz_mm, [1500.5, 99.75, 1201.0]);
+    assert_eq!(minus[0].xyz_mm, [1499.5, 100.25, 1199.0]);
+
+    // Bad options name themselves; CSV options are refused on JSON uploads.
+    for (query, expect) in [
+        ("?dif_sign=up", "dif_sign"),
+        ("?delimiter=|", "delimiter"),
+        ("?decimal=comma&delimiter=,", "decimal comma"),
+    ] {
+        let r = t
+            .send(
+                "POST",
+                "/v1/robots/{id}/measurement-sets",
+                &[&rid],
+                query,
+                Some("text/csv"),
+                text.clone().into_bytes(),
+            )
+            .await;
+        assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{query}");
+        assert!(r.detail().contains(expect), "{query}: {}", r.detail());
+    }
+    let r = t
+        .send(
+            "POST",
+            "/v1/robots/{id}/measurement-sets",
+            &[&rid],
+            "?dif_sign=minus",
+            Some("application/json"),
+            json!({"rows": simulated_rows(6, 3, None)})
+                .to_string()
+                .into_bytes(),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY);
+    assert!(r.detail().contains("CSV uploads"), "{}", r.detail());
+}

@@ -209,9 +209,27 @@ impl TestApp {
         content_type: Option<&str>,
         body: Vec<u8>,
     ) -> Resp {
+        let ct: Vec<(&str, &str)> = content_type
+            .map(|c| ("content-type", c))
+            .into_iter()
+            .collect();
+        self.send_with(method, template, args, query, &ct, body)
+            .await
+    }
+
+    /// `send` with extra request headers (e.g. `Accept`).
+    pub(crate) async fn send_with(
+        &self,
+        method: &str,
+        template: &str,
+        args: &[&str],
+        query: &str,
+        headers: &[(&str, &str)],
+        body: Vec<u8>,
+    ) -> Resp {
         let uri = fill(template, args) + query;
         let resp = self
-            .raw(method, &uri, content_type, body, self.key.as_deref())
+            .raw_with(method, &uri, headers, body, self.key.as_deref())
             .await;
         self.spec.check(
             method,
@@ -231,9 +249,24 @@ impl TestApp {
         body: Vec<u8>,
         key: Option<&str>,
     ) -> Resp {
+        let ct: Vec<(&str, &str)> = content_type
+            .map(|c| ("content-type", c))
+            .into_iter()
+            .collect();
+        self.raw_with(method, uri, &ct, body, key).await
+    }
+
+    pub(crate) async fn raw_with(
+        &self,
+        method: &str,
+        uri: &str,
+        headers: &[(&str, &str)],
+        body: Vec<u8>,
+        key: Option<&str>,
+    ) -> Resp {
         let mut req = Request::builder().method(method).uri(uri);
-        if let Some(ct) = content_type {
-            req = req.header(header::CONTENT_TYPE, ct);
+        for (name, value) in headers {
+            req = req.header(*name, *value);
         }
         if let Some(k) = key {
             req = req.header(header::AUTHORIZATION, format!("Bearer {k}"));

@@ -16,8 +16,10 @@ pub mod batch;
 pub mod config;
 pub mod solver;
 pub mod targets;
+pub mod targets_csv;
 
 pub use analytic::{AnalyticError, AnalyticIk, AnalyticSolution, Structure};
 pub use config::{Configuration, Elbow, Shoulder, Wrist};
 pub use solver::{FailureReason, Goal, IkSettings, IkSolution, IkSolver, Refined, SolveOptions};
 pub use targets::{FalseTarget, JointJump, TargetFrame, TargetInput, TargetResult};
+pub use targets_csv::{parse_targets_csv, results_csv, TargetRow, TargetsCsv, TargetsCsvError};

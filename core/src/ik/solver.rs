@@ -65,6 +65,7 @@ use super::analytic::{closed_form_proxy, AnalyticIk, AnalyticSolution};
 use super::config::Configuration;
 use super::targets::TargetFrame;
 use crate::compensate::CompensatedModel;
+use crate::model::orientation::OrientationConvention;
 use crate::model::pose::rotation_log;
 use crate::model::{Pose, RobotModel};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
@@ -193,6 +194,9 @@ pub struct SolveOptions {
     pub branch: Option<Configuration>,
     /// Joint seed (model convention, rad): the branch nearest it is preferred.
     pub seed: Option<Vec<f64>>,
+    /// Convention of the false targets of targets without an orientation
+    /// (quaternion when `None`); a target with an orientation gets its own.
+    pub false_target_convention: Option<OrientationConvention>,
 }
 
 /// Why a target has no solution.

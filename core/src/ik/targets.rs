@@ -173,6 +173,7 @@ impl IkSolver {
         index: usize,
         input: &TargetInput,
         conv: Option<OrientationConvention>,
+        options: &super::SolveOptions,
         solution: IkSolution,
         jump: Option<JointJump>,
     ) -> TargetResult {
@@ -182,7 +183,8 @@ impl IkSolver {
                 Some(self.controller_degrees(&solution.q)),
                 self.false_target(
                     &solution.q,
-                    conv.unwrap_or(OrientationConvention::Quaternion),
+                    conv.or(options.false_target_convention)
+                        .unwrap_or(OrientationConvention::Quaternion),
                 ),
             )
         } else {
@@ -210,7 +212,28 @@ impl IkSolver {
             .enumerate()
             .map(|(i, s)| {
                 let conv = parsed[i].as_ref().ok().and_then(|p| p.1);
-                self.target_result(i, &targets[i], conv, s, None)
+                self.target_result(i, &targets[i], conv, options, s, None)
+            })
+            .collect()
+    }
+
+    /// Solves boundary targets one after the other on the calling thread (for
+    /// small batches, where handing work to the thread pool costs more than
+    /// it saves).
+    pub fn solve_targets_serial(
+        &self,
+        targets: &[TargetInput],
+        options: &super::SolveOptions,
+    ) -> Vec<TargetResult> {
+        targets
+            .iter()
+            .enumerate()
+            .map(|(i, t)| {
+                let (solution, conv) = match t.to_goal() {
+                    Ok((goal, conv)) => (self.solve_goal(&goal, options), conv),
+                    Err(msg) => (IkSolution::invalid(msg), None),
+                };
+                self.target_result(i, t, conv, options, solution, None)
             })
             .collect()
     }
@@ -228,7 +251,7 @@ impl IkSolver {
             .enumerate()
             .map(|(i, (s, jump))| {
                 let conv = parsed[i].as_ref().ok().and_then(|p| p.1);
-                self.target_result(i, &targets[i], conv, s, jump)
+                self.target_result(i, &targets[i], conv, options, s, jump)
             })
             .collect()
     }

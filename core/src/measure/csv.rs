@@ -39,11 +39,21 @@
 //! - a position coordinate beyond ±100 m, or a `payload_kg` outside
 //!   0..10,000 kg, is rejected naming line and column.
 //!
+//! Fields may be separated by `,`, `;` or tabs, and with `;` or tabs numbers may
+//! use a decimal comma (`1523,2`), as tracker software in many locales writes
+//! them; both are detected from the text or declared ([`ReadOptions::dialect`],
+//! see `csv_text`). Quoted fields are read as CSV quotes them.
+//!
+//! A file in metres or radians is read with [`ReadOptions::metres`] /
+//! [`ReadOptions::radians`]: its positions and angles are converted to mm and
+//! degrees before the checks above.
+//!
 //! Radians given as degrees cannot be told apart from a small-angle degree file
 //! reliably, so that case is not checked. Values in messages are short
 //! (scientific notation for large magnitudes, long fields cut).
 
 use super::{MeasuredPose, SetRole};
+use crate::csv_text::{self, Dialect, TextError};
 use std::fmt::Write as _;
 
 /// Maximum joint count of a CSV row.
@@ -109,6 +119,8 @@ impl DifSign {
 pub enum CsvError {
     #[error("the CSV file is empty: no header row")]
     Empty,
+    #[error(transparent)]
+    Text(#[from] TextError),
     #[error("no data rows after the header on line {header_line}")]
     NoDataRows { header_line: usize },
     #[error("line {line}: missing column `{column}`")]
@@ -268,6 +280,10 @@ struct Header {
     temperature: Option<usize>,
     set: Option<usize>,
     session: Option<usize>,
+    /// How numbers and units are read (from [`ReadOptions`] and the text).
+    decimal_comma: bool,
+    metres: bool,
+    radians: bool,
 }
 
 enum PositionCols {
@@ -275,23 +291,8 @@ enum PositionCols {
     TargetPlusDif([usize; 3], [usize; 3]),
 }
 
-fn split_fields(line: &str) -> Vec<&str> {
-    line.split(',')
-        .map(|f| {
-            let f = f.trim();
-            f.strip_prefix('"')
-                .and_then(|g| g.strip_suffix('"'))
-                .unwrap_or(f)
-                .trim()
-        })
-        .collect()
-}
-
-fn parse_header(line: usize, text: &str) -> Result<Header, CsvError> {
-    let names: Vec<String> = split_fields(text)
-        .iter()
-        .map(|s| s.to_ascii_lowercase())
-        .collect();
+fn parse_header(line: usize, fields: &[String], opts: &ReadOptions) -> Result<Header, CsvError> {
+    let names: Vec<String> = fields.iter().map(|s| s.to_ascii_lowercase()).collect();
     let mut cols: Vec<(Col, usize)> = Vec::new();
     for (i, name) in names.iter().enumerate() {
         let col = classify(name).ok_or_else(|| CsvError::UnknownColumn {
@@ -397,15 +398,23 @@ fn parse_header(line: usize, text: &str) -> Result<Header, CsvError> {
         set: find(Col::Set),
         session: find(Col::Session),
         names,
+        decimal_comma: false,
+        metres: opts.metres,
+        radians: opts.radians,
     })
 }
 
 /// Parses one numeric field; `None` for an empty field.
-fn number(line: usize, column: &str, s: &str) -> Result<Option<f64>, CsvError> {
+fn number(
+    line: usize,
+    column: &str,
+    s: &str,
+    decimal_comma: bool,
+) -> Result<Option<f64>, CsvError> {
     if s.is_empty() {
         return Ok(None);
     }
-    let v: f64 = s.parse().map_err(|_| CsvError::NotNumeric {
+    let v: f64 = csv_text::parse_number(s, decimal_comma).ok_or_else(|| CsvError::NotNumeric {
         line,
         column: column.to_string(),
         value: s.to_string(),
@@ -420,8 +429,8 @@ fn number(line: usize, column: &str, s: &str) -> Result<Option<f64>, CsvError> {
     Ok(Some(v))
 }
 
-fn required(line: usize, column: &str, s: &str) -> Result<f64, CsvError> {
-    number(line, column, s)?.ok_or_else(|| CsvError::NotNumeric {
+fn required(line: usize, column: &str, s: &str, decimal_comma: bool) -> Result<f64, CsvError> {
+    number(line, column, s, decimal_comma)?.ok_or_else(|| CsvError::NotNumeric {
         line,
         column: column.to_string(),
         value: String::new(),
@@ -437,12 +446,15 @@ impl Header {
                 got: fields.len(),
             });
         }
-        let req = |c: usize| required(line, &self.names[c], fields[c]);
-        let opt = |c: usize| number(line, &self.names[c], fields[c]);
+        let dc = self.decimal_comma;
+        let req = |c: usize| required(line, &self.names[c], fields[c], dc);
+        let opt = |c: usize| number(line, &self.names[c], fields[c], dc);
+        let angle = |v: f64| if self.radians { v.to_degrees() } else { v };
+        let length = if self.metres { 1e3 } else { 1.0 };
 
         let mut q_deg = Vec::with_capacity(self.joints.len());
         for &c in &self.joints {
-            let v = req(c)?;
+            let v = angle(req(c)?);
             if v.abs() > MAX_JOINT_DEG {
                 return Err(CsvError::JointUnits {
                     line,
@@ -456,12 +468,12 @@ impl Header {
         match &self.position {
             PositionCols::Measured(p) => {
                 for (x, &c) in xyz_mm.iter_mut().zip(p) {
-                    *x = req(c)?;
+                    *x = length * req(c)?;
                 }
             }
             PositionCols::TargetPlusDif(t, d) => {
                 for i in 0..3 {
-                    xyz_mm[i] = req(t[i])? + sign.factor() * req(d[i])?;
+                    xyz_mm[i] = length * (req(t[i])? + sign.factor() * req(d[i])?);
                 }
             }
         }
@@ -485,7 +497,7 @@ impl Header {
             Some(r) => {
                 let v = [opt(r[0])?, opt(r[1])?, opt(r[2])?];
                 match v {
-                    [Some(a), Some(b), Some(c)] => Some([a, b, c]),
+                    [Some(a), Some(b), Some(c)] => Some([angle(a), angle(b), angle(c)]),
                     [None, None, None] => None,
                     _ => return Err(CsvError::PartialOrientation { line }),
                 }
@@ -538,24 +550,45 @@ impl Header {
     }
 }
 
+/// How a measurement CSV is read; the default reads the canonical file
+/// (mm, degrees, delimiter and decimal separator detected, `dif` added).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ReadOptions {
+    /// Sign of the real-data `*_dif` columns.
+    pub dif: DifSign,
+    /// Delimiter and decimal separator; `None` fields are detected.
+    pub dialect: Dialect,
+    /// Positions are in metres (converted to mm).
+    pub metres: bool,
+    /// Joint and orientation angles are in radians (converted to degrees).
+    pub radians: bool,
+}
+
 /// Parses a measurement CSV (either layout; real-data `dif` added: [`DifSign::Plus`]).
 pub fn parse(text: &str) -> Result<Vec<MeasuredPose>, CsvError> {
-    parse_with(text, DifSign::Plus)
+    parse_opts(text, &ReadOptions::default())
 }
 
 /// Parses a measurement CSV with an explicit sign for the real-data `*_dif` columns.
 pub fn parse_with(text: &str, dif: DifSign) -> Result<Vec<MeasuredPose>, CsvError> {
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .map(|(i, l)| (i + 1, l.trim()))
-        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-    let (hline, htext) = lines.next().ok_or(CsvError::Empty)?;
-    let header = parse_header(hline, htext)?;
-    let mut rows = Vec::new();
-    for (line, l) in lines {
-        rows.push(header.row(line, &split_fields(l), dif)?);
+    parse_opts(
+        text,
+        &ReadOptions {
+            dif,
+            ..ReadOptions::default()
+        },
+    )
+}
+
+/// Parses a measurement CSV read as `opts` says.
+pub fn parse_opts(text: &str, opts: &ReadOptions) -> Result<Vec<MeasuredPose>, CsvError> {
+    let table = csv_text::read(text, opts.dialect)?.ok_or(CsvError::Empty)?;
+    let mut header = parse_header(table.header_line, &table.header, opts)?;
+    header.decimal_comma = table.decimal_comma;
+    let mut rows = Vec::with_capacity(table.records.len());
+    for r in &table.records {
+        let fields: Vec<&str> = r.fields.iter().map(String::as_str).collect();
+        rows.push(header.row(r.line, &fields, opts.dif)?);
     }
     if rows.is_empty() {
         return Err(CsvError::NoDataRows {
@@ -992,5 +1025,44 @@ mod bounds_tests {
         // The real-data layout names the target column.
         let e = err("x_t,y_t,z_t,x_dif,y_dif,z_dif,joint_1,joint_2\n2e5,0,0,0,0,0,0,0\n");
         assert!(e.contains("column `x_t`"), "{e}");
+    }
+
+    #[test]
+    fn metres_radians_semicolons_and_decimal_commas_read_like_the_canonical_file() {
+        let canonical = parse("q1,q2,x,y,z,rx,ry,rz\n90,-45,1250,-500,2000,0,0,180\n").unwrap();
+        let opts = ReadOptions {
+            metres: true,
+            radians: true,
+            ..ReadOptions::default()
+        };
+        let text = format!(
+            "# tracker export\nq1;q2;x;y;z;rx;ry;rz\n{};{};1,25;-0,5;2;0;0;{}\n",
+            std::f64::consts::FRAC_PI_2.to_string().replace('.', ","),
+            (-std::f64::consts::FRAC_PI_4).to_string().replace('.', ","),
+            std::f64::consts::PI.to_string().replace('.', ",")
+        );
+        let rows = parse_opts(&text, &opts).unwrap();
+        assert_eq!(rows.len(), 1);
+        for (a, b) in rows[0].q_deg.iter().zip(&canonical[0].q_deg) {
+            assert!((a - b).abs() < 1e-12, "{a} vs {b}");
+        }
+        assert_eq!(rows[0].xyz_mm, canonical[0].xyz_mm);
+        let r = rows[0].rpy_deg.unwrap();
+        assert!((r[2] - 180.0).abs() < 1e-12);
+        // A decimal comma in a comma-separated file is a field count error,
+        // never a silently different number.
+        assert!(matches!(
+            parse("q1,q2,x,y,z\n1,5,2,3,4,5\n"),
+            Err(CsvError::FieldCount { .. })
+        ));
+    }
+
+    #[test]
+    fn dif_sign_minus_subtracts_the_deviation() {
+        let text = "joint_1,joint_2,x_t,y_t,z_t,x_dif,y_dif,z_dif\n1,2,100,200,300,0.5,-0.25,1\n";
+        let plus = parse_with(text, DifSign::Plus).unwrap();
+        let minus = parse_with(text, DifSign::Minus).unwrap();
+        assert_eq!(plus[0].xyz_mm, [100.5, 199.75, 301.0]);
+        assert_eq!(minus[0].xyz_mm, [99.5, 200.25, 299.0]);
     }
 }

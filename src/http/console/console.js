@@ -24,7 +24,7 @@ async function api(method, url, body, contentType, accept) {
     try { detail = JSON.parse(text).detail || text; } catch (e) { /* not JSON */ }
     throw new Error(res.status + ": " + detail);
   }
-  return { text, json: () => JSON.parse(text), type: res.headers.get("Content-Type") || "" };
+  return { text, json: () => JSON.parse(text), type: res.headers.get("Content-Type") || "", headers: res.headers };
 }
 
 function formValue(form, name) {
@@ -51,12 +51,33 @@ const handlers = {
     const text = await fileOrText(form, "file", "csv");
     if (!text) throw new Error("choose a CSV file or paste its text");
     const q = new URLSearchParams();
-    for (const k of ["name", "role", "session", "payload_kg", "length_unit", "angle_unit"]) {
+    for (const k of ["name", "role", "session", "payload_kg", "length_unit", "angle_unit", "decimal", "dif_sign"]) {
       const v = formValue(form, k);
       if (v) q.set(k, v);
     }
     await api("POST", `/v1/robots/${robot}/measurement-sets?${q}`, text, "text/csv");
     location.reload();
+  },
+  async solve(form) {
+    const robot = form.dataset.robot;
+    const text = await fileOrText(form, "file", "csv");
+    if (!text) throw new Error("choose a targets CSV file or paste its text");
+    const q = new URLSearchParams();
+    for (const k of ["version", "frame", "payload_kg", "branch"]) {
+      const v = formValue(form, k);
+      if (v) q.set(k, v);
+    }
+    if (form.elements["position_only"].checked) q.set("position_only", "true");
+    const r = await api("POST", `/v1/robots/${robot}/solve?${q}`, text, "text/csv", "text/csv");
+    // "solved/total" of the whole batch, from the answer's header.
+    const [solved, total] = (r.headers.get("X-Robocal-Solved") || "0/0").split("/");
+    const summary = `${solved} of ${total} targets solved (model: ${r.headers.get("X-Robocal-Version")}, ${r.headers.get("X-Robocal-Method")})`;
+    document.getElementById("solve-summary").textContent = summary;
+    document.getElementById("solve-csv").textContent = r.text;
+    const link = document.getElementById("solve-download");
+    link.href = URL.createObjectURL(new Blob([r.text], { type: "text/csv" }));
+    document.getElementById("solve-result").hidden = false;
+    show(summary, true);
   },
   async calibrate(form) {
     const robot = form.dataset.robot;

@@ -164,6 +164,19 @@ pub fn robot(v: &RobotView) -> Markup {
                     label { "Angles "
                         select name="angle_unit" { option value="deg" { "deg" } option value="rad" { "rad" } }
                     }
+                    label { "Decimal separator "
+                        select name="decimal" {
+                            option value="" { "detect" }
+                            option value="point" { "point (1500.25)" }
+                            option value="comma" { "comma (1500,25; fields split by ;)" }
+                        }
+                    }
+                    label { "dif columns "
+                        select name="dif_sign" {
+                            option value="plus" { "measured = target + dif" }
+                            option value="minus" { "measured = target − dif" }
+                        }
+                    }
                     button type="submit" { "Upload" }
                 }
             }
@@ -256,6 +269,36 @@ pub fn robot(v: &RobotView) -> Markup {
                         }
                     }
                     p { button.small #rollback data-post={ "/v1/robots/" (id) "/versions/rollback" } { "Roll back to the previous active version" } }
+                }
+            }
+
+            section #solve-section {
+                h2 { "Solve targets" }
+                p.note { "A targets CSV (id, x, y, z in mm and the orientation columns of one convention, e.g. a,b,c) in, joint commands and false targets out, as CSV." }
+                form #solve data-action="solve" data-robot=(id) {
+                    label.wide { "Targets CSV " input type="file" name="file" accept=".csv,text/csv"; }
+                    label.wide { "or paste it " textarea name="csv" rows="3" placeholder="id,x,y,z,a,b,c" {} }
+                    label { "Model "
+                        select name="version" {
+                            option value="active" { "active version" }
+                            @for ver in v.versions.iter().rev() {
+                                option value=(ver.version) { "v" (ver.version) " " (ver.method) }
+                            }
+                            option value="nominal" { "nominal model" }
+                        }
+                    }
+                    label { "Frame "
+                        select name="frame" { option value="cell" { "cell (tracker)" } option value="base" { "robot base" } }
+                    }
+                    label { "Payload [kg] " input name="payload_kg" type="number" step="any" min="0"; }
+                    label { "Branch " input name="branch" placeholder="e.g. front,up,noflip"; }
+                    label { input type="checkbox" name="position_only" value="true"; " position only" }
+                    button type="submit" { "Solve" }
+                }
+                div #solve-result hidden {
+                    p #solve-summary {}
+                    p { a #solve-download download="solution.csv" href="#" { "Download the CSV" } }
+                    pre #solve-csv {}
                 }
             }
 

@@ -27,6 +27,9 @@ pub const PAYLOAD_MAX_KG: f64 = 10_000.0;
 /// thread; larger ones go through the bounded solve queue.
 pub const SMALL_SOLVE_MAX: usize = 64;
 
+/// Default largest request body (measurement uploads, solve batches).
+pub const BODY_LIMIT_BYTES: usize = 16 * 1024 * 1024;
+
 /// Largest id or version number in a path (SQLite's integer range).
 pub const ID_MAX: i64 = i64::MAX;
 
@@ -54,7 +57,7 @@ pub struct Limits {
 impl Default for Limits {
     fn default() -> Self {
         Limits {
-            body_bytes: super::BODY_LIMIT_BYTES,
+            body_bytes: BODY_LIMIT_BYTES,
             metadata_bytes: 16 * 1024,
             poses_per_set: 100_000,
             targets_per_request: 100_000,

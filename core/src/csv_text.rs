@@ -1,0 +1,304 @@
+//! CSV text as robocal reads it: the one reader behind the measurement files
+//! (`measure::csv`) and the target files (`ik::targets_csv`), on the `csv`
+//! crate (quoted fields, record positions) with robocal's own rules on top:
+//!
+//! - a UTF-8 byte-order mark is ignored; lines whose first non-blank character
+//!   is `#` are comments; blank lines are ignored; fields are trimmed;
+//! - the first remaining line is the header;
+//! - the field delimiter is `,`, `;` or a tab: declared, or detected as the
+//!   one of the three that occurs most often in the header (ties go to `,`);
+//! - the decimal separator is `.`, or `,` when the delimiter is not `,`
+//!   (tracker software in many locales writes `1523,2;12,5;980,1`): declared,
+//!   or accepted in either form when the delimiter allows it;
+//! - every record keeps its 1-based line number for messages.
+//!
+//! Whether a record has as many fields as the header is for the caller to
+//! judge (it names the line and the counts).
+
+use std::borrow::Cow;
+
+/// The decimal separator of numeric fields.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Decimal {
+    /// `1523.2`.
+    Point,
+    /// `1523,2` (needs `;` or a tab as the delimiter).
+    Comma,
+}
+
+impl Decimal {
+    /// `point` / `.` or `comma` / `,`.
+    pub fn parse(text: &str) -> Option<Decimal> {
+        match text.trim().to_ascii_lowercase().as_str() {
+            "point" | "." | "dot" => Some(Decimal::Point),
+            "comma" | "," => Some(Decimal::Comma),
+            _ => None,
+        }
+    }
+}
+
+/// How to read a text: each `None` is detected.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Dialect {
+    /// `b','`, `b';'` or `b'\t'`.
+    pub delimiter: Option<u8>,
+    pub decimal: Option<Decimal>,
+}
+
+/// The delimiters robocal reads.
+pub const DELIMITERS: [u8; 3] = [b',', b';', b'\t'];
+
+/// A delimiter by name: `,` / `comma`, `;` / `semicolon`, `tab` / `\t`.
+pub fn parse_delimiter(text: &str) -> Option<u8> {
+    match text {
+        "," | "comma" => Some(b','),
+        ";" | "semicolon" => Some(b';'),
+        "\t" | "tab" | "\\t" => Some(b'\t'),
+        _ => None,
+    }
+}
+
+/// Why a text cannot be read as a table.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum TextError {
+    #[error("the delimiter must be `,`, `;` or a tab")]
+    BadDelimiter,
+    #[error("a decimal comma needs `;` or a tab as the field delimiter")]
+    CommaWithCommaDelimiter,
+    #[error("line {line}: {message}")]
+    Malformed { line: usize, message: String },
+}
+
+/// One record after the header.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Record {
+    /// 1-based line of the record in the text.
+    pub line: usize,
+    pub fields: Vec<String>,
+}
+
+/// A text read as a header and records.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Table {
+    pub delimiter: u8,
+    /// Whether numeric fields may use a decimal comma.
+    pub decimal_comma: bool,
+    pub header_line: usize,
+    /// Header names as written (trimmed).
+    pub header: Vec<String>,
+    pub records: Vec<Record>,
+}
+
+impl Table {
+    /// Parses a numeric field: `None` when it is not a number in the table's
+    /// decimal convention. Empty fields are the caller's business.
+    pub fn number(&self, field: &str) -> Option<f64> {
+        parse_number(field, self.decimal_comma)
+    }
+}
+
+/// A number with `.` or, when `decimal_comma`, `,` as the decimal separator
+/// (never both, and no digit grouping).
+pub fn parse_number(field: &str, decimal_comma: bool) -> Option<f64> {
+    let field = field.trim();
+    if decimal_comma && field.contains(',') {
+        if field.contains('.') || field.matches(',').count() > 1 {
+            return None;
+        }
+        return field.replace(',', ".").parse().ok();
+    }
+    field.parse().ok()
+}
+
+fn is_comment(line: &str) -> bool {
+    line.trim_start().starts_with('#')
+}
+
+/// The delimiter that occurs most often in the header line (outside quotes).
+fn detect_delimiter(header: &str) -> u8 {
+    let mut counts = [0usize; 3];
+    let mut quoted = false;
+    for b in header.bytes() {
+        if b == b'"' {
+            quoted = !quoted;
+        } else if !quoted {
+            if let Some(i) = DELIMITERS.iter().position(|&d| d == b) {
+                counts[i] += 1;
+            }
+        }
+    }
+    let best = (0..3).max_by_key(|&i| (counts[i], 3 - i)).unwrap_or(0);
+    if counts[best] == 0 {
+        b','
+    } else {
+        DELIMITERS[best]
+    }
+}
+
+/// Reads a text as a header and records; `Ok(None)` when it has no header
+/// line (empty, or only comments and blank lines).
+pub fn read(text: &str, dialect: Dialect) -> Result<Option<Table>, TextError> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    // Comment lines become blank lines, which the reader skips, so line
+    // numbers stay those of the text and a quote in a comment is harmless.
+    let text: Cow<str> = if text.lines().any(is_comment) {
+        let mut s = String::with_capacity(text.len());
+        for l in text.split_inclusive('\n') {
+            if is_comment(l) {
+                s.push_str(if l.ends_with("\r\n") {
+                    "\r\n"
+                } else if l.ends_with('\n') {
+                    "\n"
+                } else {
+                    ""
+                });
+            } else {
+                s.push_str(l);
+            }
+        }
+        Cow::Owned(s)
+    } else {
+        Cow::Borrowed(text)
+    };
+    let Some(header_text) = text.lines().find(|l| !l.trim().is_empty()) else {
+        return Ok(None);
+    };
+    let delimiter = match dialect.delimiter {
+        Some(d) if DELIMITERS.contains(&d) => d,
+        Some(_) => return Err(TextError::BadDelimiter),
+        None => detect_delimiter(header_text),
+    };
+    let decimal_comma = match dialect.decimal {
+        Some(Decimal::Comma) if delimiter == b',' => {
+            return Err(TextError::CommaWithCommaDelimiter)
+        }
+        Some(Decimal::Comma) => true,
+        Some(Decimal::Point) => false,
+        None => delimiter != b',',
+    };
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .delimiter(delimiter)
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes());
+    // Line numbers from byte offsets: a record's position is where the reader
+    // started looking for it, before the blank lines it skipped.
+    let line_starts: Vec<usize> = std::iter::once(0)
+        .chain(text.match_indices('\n').map(|(i, _)| i + 1))
+        .collect();
+    let lines: Vec<&str> = text.split('\n').collect();
+    let line_of = |byte: u64| {
+        let mut l = line_starts.partition_point(|&s| s as u64 <= byte);
+        while l < lines.len() && lines[l - 1].trim().is_empty() {
+            l += 1;
+        }
+        l
+    };
+    let mut header: Option<(usize, Vec<String>)> = None;
+    let mut records = Vec::new();
+    let mut record = csv::StringRecord::new();
+    loop {
+        let more = reader.read_record(&mut record).map_err(|e| {
+            let line = e.position().map_or(0, |p| line_of(p.byte()));
+            TextError::Malformed {
+                line,
+                message: e.to_string(),
+            }
+        })?;
+        if !more {
+            break;
+        }
+        if record.iter().all(str::is_empty) {
+            continue;
+        }
+        let line = record.position().map_or(0, |p| line_of(p.byte()));
+        let fields: Vec<String> = record.iter().map(str::to_string).collect();
+        if header.is_none() {
+            header = Some((line, fields));
+        } else {
+            records.push(Record { line, fields });
+        }
+    }
+    Ok(header.map(|(header_line, header)| Table {
+        delimiter,
+        decimal_comma,
+        header_line,
+        header,
+        records,
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn table(text: &str) -> Table {
+        read(text, Dialect::default()).unwrap().unwrap()
+    }
+
+    #[test]
+    fn comments_blank_lines_and_line_numbers() {
+        let t = table("\u{feff}# a \"quoted comment\n\n  # indented\nx,y\n\n1,2\n   \n# c\n3, 4\n");
+        assert_eq!(t.header_line, 4);
+        assert_eq!(t.header, ["x", "y"]);
+        assert_eq!(t.records.len(), 2);
+        assert_eq!(t.records[0].line, 6);
+        assert_eq!(t.records[1].line, 9);
+        assert_eq!(t.records[1].fields, ["3", "4"]);
+        assert!(read("# only\n\n", Dialect::default()).unwrap().is_none());
+    }
+
+    #[test]
+    fn quoted_fields_keep_their_delimiters() {
+        let t = table("id,x\n\"a,b\",1\n");
+        assert_eq!(t.records[0].fields, ["a,b", "1"]);
+    }
+
+    #[test]
+    fn semicolons_and_decimal_commas_are_detected() {
+        let t = table("x;y;z\n1523,25;-12,5;980\n");
+        assert_eq!(t.delimiter, b';');
+        assert!(t.decimal_comma);
+        let v: Vec<f64> = t.records[0]
+            .fields
+            .iter()
+            .map(|f| t.number(f).unwrap())
+            .collect();
+        assert_eq!(v, [1523.25, -12.5, 980.0]);
+        let t = table("x\ty\n1,5\t2.5\n");
+        assert_eq!(t.delimiter, b'\t');
+        assert_eq!(t.number("1,5"), Some(1.5));
+        // A comma-separated file never reads a decimal comma.
+        let t = table("x,y\n1.5,2\n");
+        assert!(!t.decimal_comma);
+        assert_eq!(t.number("1,5"), None);
+    }
+
+    #[test]
+    fn declared_dialects_win_and_contradictions_fail() {
+        let d = Dialect {
+            delimiter: Some(b';'),
+            decimal: Some(Decimal::Point),
+        };
+        let t = read("x,y;z\n1,5;2\n", d).unwrap().unwrap();
+        assert_eq!(t.header, ["x,y", "z"]);
+        assert_eq!(t.number("1,5"), None);
+        let bad = Dialect {
+            delimiter: Some(b','),
+            decimal: Some(Decimal::Comma),
+        };
+        assert_eq!(
+            read("x\n1\n", bad).unwrap_err(),
+            TextError::CommaWithCommaDelimiter
+        );
+    }
+
+    #[test]
+    fn grouped_or_mixed_separators_are_not_numbers() {
+        assert_eq!(parse_number("1.234,5", true), None);
+        assert_eq!(parse_number("1,234,5", true), None);
+        assert_eq!(parse_number("-0,25", true), Some(-0.25));
+        assert_eq!(parse_number("2e3", true), Some(2000.0));
+    }
+}

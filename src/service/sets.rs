@@ -1,0 +1,161 @@
+//! Measurement-set uploads: reading a measurement CSV off the async runtime
+//! (declared or detected delimiter and decimal separator, metres or radians
+//! converted to mm and degrees, the sign of the real-data `dif` columns),
+//! the checks that need the robot (joint count) or the service (rows per set),
+//! the set's role and name, and storing it with the upload kept verbatim.
+//!
+//! Units: rows are stored in mm and degrees (`MeasuredPose`), whatever the
+//! upload declared.
+
+use super::{AppState, ServiceError};
+use crate::db::{AngleUnit, LengthUnit, NewSet, SetFormat, SetRow};
+use crate::measure::csv::{self, CsvError, ReadOptions, MAX_JOINT_DEG, MAX_PAYLOAD_KG};
+use crate::measure::{MeasuredPose, SetRole};
+
+/// What the upload carries.
+#[derive(Debug, Clone)]
+pub enum SetContent {
+    /// A measurement CSV, read as `read` says (its units must agree with the
+    /// command's `length` and `angle`).
+    Csv { text: String, read: ReadOptions },
+    /// Rows already in mm and degrees, with the original JSON text.
+    Rows {
+        rows: Vec<MeasuredPose>,
+        original: String,
+    },
+}
+
+/// A measurement-set upload, in domain terms.
+#[derive(Debug, Clone)]
+pub struct NewSetCommand {
+    pub robot_id: i64,
+    /// Set name (empty: the role's name).
+    pub name: String,
+    /// Declared role; `None`: the rows' common `set` value, else identification.
+    pub role: Option<SetRole>,
+    pub session: String,
+    /// Payload of rows that carry none [kg].
+    pub payload_kg: Option<f64>,
+    pub length: LengthUnit,
+    pub angle: AngleUnit,
+    pub content: SetContent,
+}
+
+fn csv_error(e: CsvError) -> ServiceError {
+    let hint = match e {
+        CsvError::PositionUnits => "; if the file is in metres, upload it with ?length_unit=m",
+        _ => "",
+    };
+    ServiceError::Invalid(format!("measurement CSV: {e}{hint}"))
+}
+
+/// Reads a CSV upload; a set is one tracker session, so a `session` column
+/// must agree with the set's.
+fn read_csv(
+    text: &str,
+    read: &ReadOptions,
+    session: &str,
+) -> Result<Vec<MeasuredPose>, ServiceError> {
+    let rows = csv::parse_opts(text, read).map_err(csv_error)?;
+    if let Some((i, s)) = rows
+        .iter()
+        .enumerate()
+        .find_map(|(i, r)| r.session.as_ref().filter(|s| *s != session).map(|s| (i, s)))
+    {
+        return Err(ServiceError::Invalid(format!(
+            "row {}: the `session` column says `{s}` but this set's session is `{session}`; upload each tracker session as its own set (`?session=`)",
+            i + 1
+        )));
+    }
+    Ok(rows)
+}
+
+/// The checks that need the robot and the service's limits.
+fn check_rows(rows: &[MeasuredPose], dof: usize, max_rows: usize) -> Result<(), ServiceError> {
+    if rows.len() > max_rows {
+        return Err(ServiceError::Invalid(format!(
+            "{} rows in one set; at most {max_rows} (`--max-poses-per-set`): split the upload",
+            rows.len()
+        )));
+    }
+    csv::check_joint_count(rows, dof).map_err(|e| {
+        ServiceError::Invalid(format!("{e} (the robot has {dof} joints: send q1..q{dof})"))
+    })?;
+    for (i, r) in rows.iter().enumerate() {
+        if let Some(p) = r.payload_kg {
+            if !(p.is_finite() && (0.0..=MAX_PAYLOAD_KG).contains(&p)) {
+                return Err(ServiceError::Invalid(format!(
+                    "row {}: `payload_kg` must be between 0 and {MAX_PAYLOAD_KG} kg, got {p}",
+                    i + 1
+                )));
+            }
+        }
+        if let Some((k, v)) = r
+            .q_deg
+            .iter()
+            .enumerate()
+            .find(|(_, v)| v.abs() > MAX_JOINT_DEG)
+        {
+            return Err(ServiceError::Invalid(format!(
+                "row {}: joint q{} = {v} deg is beyond ±{MAX_JOINT_DEG} deg; check the angle unit",
+                i + 1,
+                k + 1
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Reads, checks and stores a measurement set.
+pub async fn upload(state: &AppState, cmd: NewSetCommand) -> Result<SetRow, ServiceError> {
+    let robot_id = cmd.robot_id;
+    let robot = state
+        .db()
+        .robot(robot_id)
+        .await?
+        .ok_or_else(|| ServiceError::robot_not_found(robot_id))?;
+    let dof = robot.dof as usize;
+    let max_rows = state.limits().poses_per_set;
+    let session = cmd.session.clone();
+    let (rows, format, original) = tokio::task::spawn_blocking(move || {
+        let (rows, format, original) = match cmd.content {
+            SetContent::Csv { text, read } => {
+                (read_csv(&text, &read, &session)?, SetFormat::Csv, text)
+            }
+            SetContent::Rows { rows, original } => (rows, SetFormat::Json, original),
+        };
+        check_rows(&rows, dof, max_rows)?;
+        Ok::<_, ServiceError>((rows, format, original))
+    })
+    .await
+    .map_err(|e| ServiceError::Internal(format!("upload parser: {e}")))??;
+
+    // Role: declared, else the rows' common `set` value, else identification.
+    let role = cmd.role.unwrap_or_else(|| match rows[0].set {
+        Some(r) if rows.iter().all(|x| x.set == Some(r)) => r,
+        _ => SetRole::Identification,
+    });
+    let name = if cmd.name.is_empty() {
+        role.as_str().to_string()
+    } else {
+        cmd.name
+    };
+    state
+        .db()
+        .insert_set(&NewSet {
+            robot_id,
+            name: &name,
+            role: role.into(),
+            session: &cmd.session,
+            payload_kg: cmd.payload_kg,
+            length_unit: cmd.length,
+            angle_unit: cmd.angle,
+            format,
+            original: &original,
+            rows: &rows,
+            row_count: rows.len() as i64,
+            dof: dof as i64,
+        })
+        .await?
+        .ok_or_else(|| ServiceError::robot_not_found(robot_id))
+}

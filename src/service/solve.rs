@@ -1,0 +1,236 @@
+//! Solve orchestration: which model a solve uses (the active version, a
+//! numbered one or the nominal model), the prepared-solver cache, the joint
+//! seed, and where the batch runs — inline for small batches, on the solve
+//! workers behind admission control for large ones (a full queue is refused at
+//! once with `Busy`, never a silent wait).
+//!
+//! Prepared solvers are cached per (robot, version row, payload override):
+//! versions never change once written. A custom jump threshold gets a fresh
+//! solver that is not cached.
+//!
+//! Units at this boundary: targets in mm and degrees (`TargetInput`), joint
+//! seeds and commands in the controller convention in degrees.
+
+use super::limits::SMALL_SOLVE_MAX;
+use super::{AppState, ServiceError};
+use crate::compensate::{CalibratedModelFile, CompensatedModel};
+use crate::ik::{IkSettings, IkSolver, SolveOptions, TargetInput, TargetResult, TargetsCsv};
+use crate::model::RobotModel;
+use std::sync::Arc;
+
+/// Which model to solve with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ModelChoice {
+    /// The robot's active version (a conflict when it has none).
+    #[default]
+    Active,
+    /// The robot's nominal (uncalibrated) model.
+    Nominal,
+    /// A version by number (≥ 1).
+    Version(i64),
+}
+
+/// The targets of a solve: checked inputs, or the rows of a targets file
+/// (invalid rows fail alone).
+#[derive(Debug, Clone)]
+pub enum Targets {
+    Inputs(Vec<TargetInput>),
+    Csv(TargetsCsv),
+}
+
+impl Targets {
+    pub fn len(&self) -> usize {
+        match self {
+            Targets::Inputs(t) => t.len(),
+            Targets::Csv(c) => c.rows.len(),
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    fn run(&self, solver: &IkSolver, options: &SolveOptions, path: bool) -> Vec<TargetResult> {
+        match self {
+            Targets::Inputs(t) if path => solver.solve_targets_path(t, options),
+            Targets::Inputs(t) if t.len() <= SMALL_SOLVE_MAX => {
+                solver.solve_targets_serial(t, options)
+            }
+            Targets::Inputs(t) => solver.solve_targets(t, options),
+            Targets::Csv(c) => c.solve(solver, options, path),
+        }
+    }
+}
+
+/// A solve, in domain terms.
+#[derive(Debug, Clone)]
+pub struct SolveCommand {
+    pub robot_id: i64,
+    pub model: ModelChoice,
+    /// Payload mass [kg] instead of the model's.
+    pub payload_kg: Option<f64>,
+    /// Path-mode joint jump threshold [deg] instead of the default.
+    pub jump_deg: Option<f64>,
+    /// Joint seed, controller convention [deg]; checked against the robot.
+    pub seed_deg: Option<Vec<f64>>,
+    /// Frame, branch, position-only and output convention (`seed` is set
+    /// from `seed_deg`).
+    pub options: SolveOptions,
+    pub path: bool,
+    pub targets: Targets,
+}
+
+/// What a solve produced.
+#[derive(Debug)]
+pub struct SolveOutcome {
+    /// Version number used (`None`: the nominal model).
+    pub version: Option<i64>,
+    /// Calibration method of that version, or `nominal`.
+    pub method: String,
+    pub payload_kg: f64,
+    pub dof: usize,
+    pub results: Vec<TargetResult>,
+}
+
+/// The model a solve uses: (version row id, version number, method), `None`
+/// for the nominal model.
+async fn choose_version(
+    state: &AppState,
+    robot_id: i64,
+    choice: ModelChoice,
+    active: Option<(i64, i64, String)>,
+) -> Result<Option<(i64, i64, String)>, ServiceError> {
+    match choice {
+        ModelChoice::Active => active.map(Some).ok_or_else(|| {
+            ServiceError::Conflict(format!(
+                "robot {robot_id} has no active model version: run a calibration (POST /v1/robots/{robot_id}/calibrations), activate a version, name one with \"version\": N, or solve with the nominal model with \"version\": \"nominal\""
+            ))
+        }),
+        ModelChoice::Nominal => Ok(None),
+        ModelChoice::Version(v) if v < 1 => Err(ServiceError::Invalid(format!(
+            "`version` numbers start at 1, got {v}"
+        ))),
+        ModelChoice::Version(v) => {
+            // A version the robot does not have (yet): a conflict with its
+            // state, not a missing URL.
+            let row = state.db().version(robot_id, v).await?.ok_or_else(|| {
+                ServiceError::Conflict(format!(
+                    "robot {robot_id} has no model version {v}; list them with GET /v1/robots/{robot_id}/versions"
+                ))
+            })?;
+            Ok(Some((row.id, row.version, row.method)))
+        }
+    }
+}
+
+/// The prepared solver of a command, from the cache when it can be.
+async fn prepare(
+    state: &AppState,
+    cmd: &SolveCommand,
+) -> Result<(Arc<IkSolver>, Option<i64>, String), ServiceError> {
+    let robot_id = cmd.robot_id;
+    let ctx = state.robot_context(robot_id).await?;
+    let chosen = choose_version(state, robot_id, cmd.model, ctx.active.clone()).await?;
+    let (version, method) = match &chosen {
+        Some((_, v, m)) => (Some(*v), m.clone()),
+        None => (None, "nominal".to_string()),
+    };
+    let key = (
+        robot_id,
+        chosen.as_ref().map(|c| c.0),
+        cmd.payload_kg.map(f64::to_bits),
+    );
+    let cacheable = cmd.jump_deg.is_none();
+    if cacheable {
+        if let Some(solver) = state.cached_solver(&key) {
+            return Ok((solver, version, method));
+        }
+    }
+    let mut model = match &chosen {
+        Some((vid, v, _)) => {
+            let text = state.db().version_model(*vid).await?.ok_or_else(|| {
+                ServiceError::NotFound(format!("robot {robot_id} has no model version {v}"))
+            })?;
+            CalibratedModelFile::from_json(&text)
+                .and_then(|f| f.to_compensated())
+                .map_err(|e| ServiceError::Internal(format!("stored model version {v}: {e}")))?
+        }
+        None => {
+            let m = RobotModel::from_json(&ctx.model_json).map_err(|e| {
+                ServiceError::Internal(format!("stored model of robot {robot_id}: {e}"))
+            })?;
+            CompensatedModel::from_nominal(m)
+        }
+    };
+    if let Some(p) = cmd.payload_kg {
+        model.payload_kg = p;
+    }
+    let mut settings = IkSettings::default();
+    if let Some(j) = cmd.jump_deg {
+        settings.jump_threshold_rad = j.to_radians();
+    }
+    let solver = Arc::new(IkSolver::new(model, settings));
+    if cacheable {
+        state.cache_solver(key, solver.clone());
+    }
+    Ok((solver, version, method))
+}
+
+/// The seed in the solver's joint convention, checked against the joint count.
+pub fn seed_joints(seed_deg: &[f64], solver: &IkSolver) -> Result<Vec<f64>, ServiceError> {
+    let dof = solver.model().dof();
+    if seed_deg.len() != dof || seed_deg.iter().any(|v| !v.is_finite()) {
+        return Err(ServiceError::Invalid(format!(
+            "`seed_deg` needs {dof} finite joint values (controller convention, degrees), got {}",
+            seed_deg.len()
+        )));
+    }
+    let rad: Vec<f64> = seed_deg.iter().map(|d| d.to_radians()).collect();
+    Ok(solver.model().nominal.joints_from_controller(&rad))
+}
+
+/// Solves a command's targets with the chosen model.
+pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutcome, ServiceError> {
+    let max = state.limits().targets_per_request;
+    if cmd.targets.is_empty() {
+        return Err(ServiceError::Invalid(
+            "no targets: send at least one target".into(),
+        ));
+    }
+    if cmd.targets.len() > max {
+        return Err(ServiceError::Invalid(format!(
+            "{} targets in one request; at most {max} (`--max-targets`): split the batch",
+            cmd.targets.len()
+        )));
+    }
+    let (solver, version, method) = prepare(state, &cmd).await?;
+    if let Some(s) = &cmd.seed_deg {
+        cmd.options.seed = Some(seed_joints(s, &solver)?);
+    }
+    let payload_kg = solver.model().payload_kg;
+    let dof = solver.model().dof();
+    let results = if cmd.targets.len() <= SMALL_SOLVE_MAX {
+        cmd.targets.run(&solver, &cmd.options, cmd.path)
+    } else {
+        let ticket = state.admit_solve()?;
+        let permit = state
+            .solve_slots()
+            .acquire_owned()
+            .await
+            .map_err(|_| ServiceError::Unavailable("the service is shutting down".into()))?;
+        tokio::task::spawn_blocking(move || {
+            let _permit = permit;
+            let _ticket = ticket;
+            cmd.targets.run(&solver, &cmd.options, cmd.path)
+        })
+        .await
+        .map_err(|e| ServiceError::Internal(format!("solver task: {e}")))?
+    };
+    Ok(SolveOutcome {
+        version,
+        method,
+        payload_kg,
+        dof,
+        results,
+    })
+}
