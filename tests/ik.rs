@@ -7,6 +7,9 @@
 //! converged to < 1e-3 mm and < 1e-6 rad, checked independently through
 //! `CompensatedModel::predict`, with a reason on every failure. They run 10,000
 //! targets per robot in both debug and release builds.
+//!
+//! Length: one file for the solver's acceptance suite (oracles, presets,
+//! failure reasons, the CLI), sharing its calibrated-model fixtures.
 
 use nalgebra::{Matrix3, Vector3};
 use proptest::prelude::*;

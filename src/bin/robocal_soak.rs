@@ -27,6 +27,9 @@
 //! ```text
 //! cargo run --release --bin robocal-soak -- --robocal target/release/robocal [--kills 10] [--seconds 120] [--clients 3] [--seed 1]
 //! ```
+//!
+//! Length: one self-contained program (load generator, killer, restart and the
+//! integrity checks after each crash), kept in one file so CI runs it as is.
 
 use anyhow::{bail, ensure, Context};
 use rand::{Rng, SeedableRng};

@@ -1,3 +1,8 @@
+//! The API contract: every route is in openapi.yaml and the spec has no other,
+//! the server refuses what the spec refuses (a table of bad inputs), API keys,
+//! paging and problem documents. Length: the checks share the spec walker and
+//! the bad-input table.
+
 use crate::support::*;
 use axum::body::Body;
 use axum::http::{header, Request, StatusCode};

@@ -10,6 +10,9 @@
 //! vector, rad) are weighted by `orientation_weight` [m/rad]. Jacobian columns
 //! come from `kinematics::jacobian` (eq. 4.9 + chain rule + `J_θ·diag(τ)`), with
 //! τ held fixed within an iteration.
+//!
+//! Length: the LM loop, its typed stop tests, the bounds and the frozen-Jacobian
+//! inner solver share their step and scaling code in one file.
 
 use crate::kinematics::{chain, gravity_torques_of, jacobian::fill_identification_rows};
 use crate::measure::Measurement;

@@ -38,6 +38,10 @@
 //!
 //! Configuration flags: see `ik::config`. At a singularity (wrist: joint 5 at
 //! 0/π; shoulder: wrist point on axis 1) the free angle is taken from the hint.
+//!
+//! Length: the three closed forms (spherical wrist, three parallel axes, the
+//! HH800 loop) share the frame, branch, reach and limit helpers in one file,
+//! so the branch conventions are written once.
 
 use super::config::{Configuration, Elbow, Shoulder, Wrist};
 use crate::kinematics::chain::tool_pose;
