@@ -21,6 +21,19 @@ configurations: roboticstoolbox-python's C++ `ik_LM` called on a prebuilt ETS
 (position 1e-4 mm, orientation 1e-7 rad). Every solution of both solvers is
 checked with roboticstoolbox's forward kinematics.
 
+KM on a simulated YS100 (the seed's §7.4 robot: Table 7.1 geometric errors,
+Table 7.2 compliance, 110 kg payload, 0.01 mm noise, tracker frame 2.5 m
+away), 50 identification and 30 validation poses from `robocal simulate`:
+  - reference: the YS100's modified DH (Craig, as `robocal export --format
+    mdh-csv` prints it) with vectorised numpy forward kinematics, fitted with
+    scipy.optimize.least_squares (LM) on the geometric parameters that are not
+    exactly redundant: a, alpha, d, theta offset of joints 2-5 (d2 dropped:
+    axes 2 and 3 are parallel, Hayati's beta of joint 3 instead), a, alpha of
+    joint 6, the tool position and the base frame's full pose (it absorbs
+    joint 1's parameters; d6 and theta6 fold into the tool);
+  - robocal: `robocal bench km`.
+Neither models compliance here (KM), so both carry the same gravity error.
+
 Times run on one core if the caller pins the process (`taskset -c 0`).
 Prints a table of ratios and writes target/peer-bench.json.
 """
@@ -131,6 +144,111 @@ def km_bench(robocal, repeat):
     return out
 
 
+# YS100 modified DH (mm, deg) as `robocal export --model ys100 --format mdh-csv`.
+YS_A = np.array([0.0, 320.0, 870.0, 200.0, 0.0, 0.0])
+YS_ALPHA = np.radians([0.0, 90.0, 0.0, 90.0, -90.0, 90.0])
+YS_D = np.array([0.0, 0.0, 0.0, 1030.0, 0.0, 185.0])
+YS_BASE_Z = 480.0
+YS_TOOL = np.array([200.0, 50.0, 500.0])
+# Free: a, alpha of joints 2-6; d of joints 3-5; theta of joints 2-5; beta 3.
+YS_FREE_A, YS_FREE_AL = [1, 2, 3, 4, 5], [1, 2, 3, 4, 5]
+YS_FREE_D, YS_FREE_TH = [2, 3, 4], [1, 2, 3, 4]
+YS_N_CHAIN = len(YS_FREE_A) + len(YS_FREE_AL) + len(YS_FREE_D) + len(YS_FREE_TH) + 1 + 3
+
+
+def fk_mdh(q, a, alpha, d, theta, beta, tool):
+    """Positions (N×3, mm) of the modified DH chain Rx(α)·Tx(a)·Ry(β)·Tz(d)·Rz(θ)."""
+    n = q.shape[0]
+    T = np.broadcast_to(np.eye(4), (n, 4, 4)).copy()
+    for i in range(6):
+        ca, sa = np.cos(alpha[i]), np.sin(alpha[i])
+        cb, sb = np.cos(beta[i]), np.sin(beta[i])
+        X = np.array([[1, 0, 0, a[i]], [0, ca, -sa, 0], [0, sa, ca, 0], [0, 0, 0, 1.0]])
+        B = np.array([[cb, 0, sb, 0], [0, 1, 0, 0], [-sb, 0, cb, 0], [0, 0, 0, 1.0]])
+        fixed = X @ B
+        fixed[:3, 3] += fixed[:3, 2] * d[i]
+        th = q[:, i] + theta[i]
+        ct, st = np.cos(th), np.sin(th)
+        Z = np.zeros((n, 4, 4))
+        Z[:, 0, 0], Z[:, 0, 1], Z[:, 1, 0], Z[:, 1, 1] = ct, -st, st, ct
+        Z[:, 2, 2], Z[:, 3, 3] = 1.0, 1.0
+        T = T @ (fixed @ Z)
+    return T[:, :3, :3] @ tool + T[:, :3, 3]
+
+
+def ys_residual(x, q, p):
+    from scipy.spatial.transform import Rotation
+    a, al, d, th, beta = YS_A.copy(), YS_ALPHA.copy(), YS_D.copy(), np.zeros(6), np.zeros(6)
+    k = 0
+    for arr, idx in ((a, YS_FREE_A), (al, YS_FREE_AL), (d, YS_FREE_D), (th, YS_FREE_TH)):
+        arr[idx] += x[k:k + len(idx)]
+        k += len(idx)
+    beta[2] = x[k]
+    tool = YS_TOOL + x[k + 1:k + 4]
+    base_r = Rotation.from_rotvec(x[YS_N_CHAIN + 3:YS_N_CHAIN + 6]).as_matrix()
+    base_t = np.array([0.0, 0.0, YS_BASE_Z]) + x[YS_N_CHAIN:YS_N_CHAIN + 3]
+    return (fk_mdh(q, a, al, d, th, beta, tool) @ base_r.T + base_t - p).ravel()
+
+
+def load_canonical(path):
+    """Joints (rad) and positions (mm) of a canonical measurement CSV."""
+    with open(path) as f:
+        lines = [l for l in f if l.strip() and not l.lstrip().startswith("#")]
+    raw = np.genfromtxt(lines, delimiter=",", names=True)
+    q = np.radians(np.stack([raw[f"q{i}"] for i in range(1, 7)], axis=1))
+    return q, np.stack([raw[c] for c in "xyz"], axis=1)
+
+
+def fit_ys(q, p):
+    """KM on the tracker data: the base frame starts from a closed-form
+    (Kabsch) registration of the nominal positions, as a tracker user would."""
+    nominal = ys_residual(np.zeros(YS_N_CHAIN + 6), q, np.zeros_like(p)).reshape(-1, 3)
+    cn, cp = nominal.mean(axis=0), p.mean(axis=0)
+    u, _, vt = np.linalg.svd((nominal - cn).T @ (p - cp))
+    dsign = np.sign(np.linalg.det(vt.T @ u.T))
+    r = vt.T @ np.diag([1.0, 1.0, dsign]) @ u.T
+    from scipy.spatial.transform import Rotation
+    x0 = np.zeros(YS_N_CHAIN + 6)
+    x0[YS_N_CHAIN + 3:] = Rotation.from_matrix(r).as_rotvec()
+    # p ≈ R·(fk + base_z) + t: the base translation in the fitted form.
+    x0[YS_N_CHAIN:YS_N_CHAIN + 3] = cp - r @ cn + r @ np.array([0.0, 0.0, YS_BASE_Z]) - np.array([0.0, 0.0, YS_BASE_Z])
+    return least_squares(ys_residual, x0, args=(q, p), method="lm", x_scale="jac").x
+
+
+def km_ys100_bench(robocal, repeat):
+    work = tempfile.mkdtemp(prefix="robocal-peer-")
+    files = {}
+    for name, seed, n in (("ident", 1, 50), ("valid", 2, 30)):
+        path = os.path.join(work, f"{name}.csv")
+        subprocess.check_call([
+            robocal, "simulate", "--preset", "ys100", "--poses", str(n), "--seed", str(seed),
+            "--tracker", "1,-2,30,2500,-1000,400", "--out", path],
+            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        files[name] = path
+    qi, pi = load_canonical(files["ident"])
+    qv, pv = load_canonical(files["valid"])
+    x, t = timed(lambda: fit_ys(qi, pi), repeat)
+    err = np.linalg.norm(ys_residual(x, qv, pv).reshape(-1, 3), axis=1)
+    out = {"scipy_least_squares": {"validation_mean_mm": float(err.mean()), "time_s": t}}
+    r = json.loads(subprocess.check_output([
+        robocal, "bench", "km", "--model", "ys100", "--identify", files["ident"],
+        "--validate", files["valid"], "--repeat", str(max(repeat, 10))]))
+    out["robocal"] = {"validation_mean_mm": r["validation_mean_mm"], "time_s": r["time_ms_median"] / 1e3,
+                      "converged": r["converged"]}
+    return out
+
+
+def print_km(title, km):
+    r = km["robocal"]
+    print(title)
+    print(f"{'':24}{'val. mean mm':>14}{'time':>12}{'robocal faster':>16}{'accuracy ratio':>16}")
+    for name in ("scipy_least_squares", "robocal"):
+        v = km[name]
+        print(f"{name:24}{v['validation_mean_mm']:14.4f}{v['time_s'] * 1e3:10.1f}ms"
+              f"{v['time_s'] / r['time_s']:15.0f}x{v['validation_mean_mm'] / r['validation_mean_mm']:16.4f}",
+              flush=True)
+
+
 def ik_bench(robocal, n, seed):
     import roboticstoolbox as rtb
     from spatialmath import SE3
@@ -191,20 +309,16 @@ def main():
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--ik-targets", type=int, default=1000)
     ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--only", choices=["km", "ik"], help="run one half only")
+    ap.add_argument("--only", choices=["km", "km-ys100", "ik"], help="run one part only")
     a = ap.parse_args()
     out = {}
-    if a.only != "ik":
-        km = out["km"] = km_bench(a.robocal, a.repeat)
-        r = km["robocal"]
-        print("KM on the real UR5 grid (1000 poses), validated on 20 random poses")
-        print(f"{'':24}{'val. mean mm':>14}{'time':>12}{'robocal faster':>16}{'accuracy ratio':>16}")
-        for name in ("scipy_least_squares", "robocal"):
-            v = km[name]
-            print(f"{name:24}{v['validation_mean_mm']:14.4f}{v['time_s'] * 1e3:10.1f}ms"
-                  f"{v['time_s'] / r['time_s']:15.0f}x{v['validation_mean_mm'] / r['validation_mean_mm']:16.4f}",
-                  flush=True)
-    if a.only == "km":
+    if a.only in (None, "km"):
+        out["km"] = km_bench(a.robocal, a.repeat)
+        print_km("KM on the real UR5 grid (1000 poses), validated on 20 random poses", out["km"])
+    if a.only in (None, "km-ys100"):
+        out["km_ys100"] = km_ys100_bench(a.robocal, a.repeat)
+        print_km("\nKM on a simulated YS100 (50 poses), validated on 30 other poses", out["km_ys100"])
+    if a.only in ("km", "km-ys100"):
         return write(out)
     ik = out["ik"] = ik_bench(a.robocal, a.ik_targets, a.seed)
     print(f"\nIK on the nominal UR5, {ik['targets']} random poses, tolerance 1e-4 mm / 1e-7 rad")
