@@ -189,6 +189,32 @@ async fn real_ur5_default_calibration_over_http() {
     }
 }
 
+/// Real UR5 over HTTP, SKCM-C (`skcm-tlbo`, compliance searched by TLBO with
+/// the geometry refitted for every candidate): succeeds with a version,
+/// admissible compliances, and no worse than KM + 3 % on the 20 random poses.
+#[tokio::test]
+async fn real_ur5_skcm_c_over_http() {
+    let app = App::new().await;
+    let robot = app.robot_with_data("ur5", "UR5").await;
+    let r = app
+        .calibrate(
+            robot,
+            json!({ "methods": ["km", "skcm-tlbo"], "population": 20, "generations": 20, "seed": 1 }),
+        )
+        .await;
+    assert_eq!(r["report"]["failed"], json!([]));
+    assert_eq!(
+        r["versions"].as_array().unwrap().len(),
+        2,
+        "{}",
+        r["versions"]
+    );
+    check_methods(&r);
+    let (km, skcm_c) = (val_mean(&r, "km"), val_mean(&r, "skcm-tlbo"));
+    eprintln!("real UR5 over HTTP: KM {km:.4} mm, SKCM-C {skcm_c:.4} mm on the 20 random poses");
+    assert!(skcm_c <= 1.03 * km, "SKCM-C {skcm_c} mm vs KM {km} mm");
+}
+
 /// Real WAM over HTTP with the shipped model file: km, skcm, skcm-tlbo and
 /// skcm-payload all succeed and deliver a version each; figures are printed.
 #[tokio::test]
