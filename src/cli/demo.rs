@@ -6,6 +6,7 @@
 //! with the 110 kg payload; KM, SKCM and SKCM-C by TLBO are compared as in
 //! Table 7.5 and the identified stiffness is printed next to the truth.
 
+use super::progress::ProgressPrinter;
 use crate::identify::pose_selection::choose_d_optimal;
 use crate::identify::{calibrate, CalibrationOptions, CalibrationReport, Method};
 use crate::measure;
@@ -72,13 +73,13 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     if a.name != "ys100-simulation" {
         bail!("unknown demo `{}` (available: ys100-simulation)", a.name);
     }
-    let quiet = a.json;
+    let progress = ProgressPrinter::stderr(!a.json);
     let study = ys100_simulation(a.seed, &|p| {
-        if !quiet && p.iteration == 0 {
-            eprintln!("[{:5.1}%] {}", p.percent, p.phase);
-        }
+        progress.update(p);
         true
-    })?;
+    });
+    progress.finish();
+    let study = study?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&study.report)?);
         return Ok(());

@@ -6,6 +6,7 @@ pub mod bench;
 pub mod calibrate;
 pub mod demo;
 pub mod export;
+pub mod progress;
 pub mod serve;
 pub mod simulate;
 pub mod solve;
