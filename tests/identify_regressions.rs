@@ -284,6 +284,70 @@ fn skcm_payload_with_link_masses_off_stays_at_the_floor() {
     assert!(payload <= 1.3 * floor, "SKCM-payload {payload} mm");
 }
 
+/// Beyond the seed: every pose carries 8 kg more than declared (an unknown
+/// gripper), measured with two payloads (declared 110 kg and 40 kg). The
+/// truth simply carries the heavier payloads; the rows declare the lighter
+/// ones. `skcm-payload` identifies the common mass offset with the CoM,
+/// comes back to the noise floor and finds the offset within 1 kg with its σ.
+#[test]
+fn skcm_payload_identifies_an_unknown_payload_mass() {
+    use robocal::sim::tracker_frame;
+    let nominal = preset("ys100").unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(78);
+    let mut tm = perturb_geometry(&nominal, &ErrorMagnitudes::from_mm_deg(1.0, 0.1), &mut rng);
+    let stiffness = [0.0, 1.5e6, 1.0e6, 1.2e6, 1.0e6, 0.0];
+    for (l, k) in tm.links.iter_mut().zip(stiffness) {
+        l.compliance = if k > 0.0 { 1.0 / k } else { 0.0 };
+    }
+    let mut truth = TrueRobot::new(tm);
+    truth.tracker_from_base = tracker_frame(3.0, -2.0, 120.0, [2500.0, -1800.0, 400.0]);
+    truth.noise_mm = 0.01;
+    let extra_kg = 8.0;
+    let set = |n: usize, declared: f64, rng: &mut ChaCha8Rng| {
+        let qs = random_configurations(&nominal, n, rng);
+        let mut rows = truth
+            .measure(&qs, Some(declared + extra_kg), None, rng)
+            .unwrap();
+        for r in rows.iter_mut() {
+            r.payload_kg = Some(declared);
+        }
+        measure::to_measurements(&nominal, &rows, declared)
+    };
+    let mut id = set(60, 110.0, &mut rng);
+    id.extend(set(60, 40.0, &mut rng));
+    let mut va = set(30, 110.0, &mut rng);
+    va.extend(set(30, 40.0, &mut rng));
+    let mut r = run_with(
+        &nominal,
+        &id,
+        &va,
+        opts(&[Method::Skcm, Method::SkcmPayload]),
+    )
+    .unwrap();
+    let v = |m: &str| r.methods[m].validation.as_ref().unwrap().stats.mean_mm;
+    let (skcm, payload) = (v("skcm"), v("skcm-payload"));
+    let m = r.methods.remove("skcm-payload").unwrap();
+    let offset = m.calibrated.payload.mass_offset;
+    let e = m
+        .parameters
+        .iter()
+        .find(|x| x.name == "payload_mass_offset")
+        .expect("the mass offset is reported");
+    eprintln!(
+        "payload 8 kg heavier than declared: SKCM {skcm:.4} mm, SKCM-payload {payload:.4} mm, offset {offset:.3} kg (σ {:?})",
+        e.std
+    );
+    let floor = noise_floor_mm();
+    assert!(payload <= 1.3 * floor, "SKCM-payload {payload} mm");
+    assert!(
+        payload < skcm,
+        "SKCM {skcm} mm vs SKCM-payload {payload} mm"
+    );
+    assert!((offset - extra_kg).abs() <= 1.0, "offset {offset} kg");
+    assert!(e.std.is_some_and(|s| s > 0.0 && s < 1.0), "{e:?}");
+    assert!(m.solver.converged, "{:?}", m.solver);
+}
+
 /// SKCM-C (TLBO) with the identification poses measured from two tracker
 /// placements is as accurate as with one: the inner fit and the cost use
 /// every session's frame.

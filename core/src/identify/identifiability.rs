@@ -141,7 +141,7 @@ fn preference(id: &ParamId, n: usize) -> (usize, usize, usize) {
         ToolX | ToolY | ToolZ | ToolRx | ToolRy | ToolRz => (0, 0, id.kind as usize),
         LoopL3 | LoopL4 | LoopL5 => (1, 0, id.kind as usize),
         Compliance => (3, id.link, 0),
-        PayloadX | PayloadY | PayloadZ => (4, 0, id.kind as usize),
+        PayloadX | PayloadY | PayloadZ | PayloadMass => (4, 0, id.kind as usize),
         k => (2, n - id.link, within(k)),
     }
 }

@@ -16,8 +16,14 @@
 //!   of mass r (tool frame) known. SKCM with a wrong r absorbs the wrong torques
 //!   into wrong compliances. This method starts from the SKCM fit and fits
 //!   geometry, compliance and r jointly: `p = FK(φ, q + c∘τ(q, M, r))`, with the
-//!   columns `Σ_k c_k·(∂τ_k/∂r_j)·J_k` (`kinematics::jacobian`). The mass M
-//!   stays as measured (`payload_kg` of each pose).
+//!   columns `Σ_k c_k·(∂τ_k/∂r_j)·J_k` (`kinematics::jacobian`). The mass is
+//!   each pose's `payload_kg` plus one offset ΔM common to all poses (an
+//!   unknown tool or adapter), fitted jointly with the column
+//!   `Σ_k c_k·(∂τ_k/∂M)·J_k`, when the poses carry at least two different
+//!   payload masses (with one, the offset trades off against the CoM along the
+//!   tool axis and stays at 0, reported as not identified); like every
+//!   candidate it is then kept only when the poses make it identifiable, and a
+//!   total mass below zero on any pose is a warning.
 //!
 //! After a fit: statistics per set, parameters with σ, stiffness 1/c, warnings
 //! (not converged, compliance held at c = 0, stiffness outside the plausible
@@ -182,14 +188,30 @@ impl Context<'_> {
                 "SKCM identified no compliance, so the payload's centre of mass has no effect on the measurements; use skcm or km".into(),
             ));
         }
-        // Which CoM coordinates the poses excite, at the SKCM compliance.
+        // Which payload parameters the poses excite, at the SKCM compliance.
         let base = self.with_compliance();
-        let payload = [
+        let mut masses: Vec<f64> = self.ident.iter().map(|m| m.payload_mass).collect();
+        masses.sort_by(f64::total_cmp);
+        masses.dedup_by(|a, b| (*a - *b).abs() < 1e-6);
+        let mut payload: Vec<ParamId> = [
             ParamKind::PayloadX,
             ParamKind::PayloadY,
             ParamKind::PayloadZ,
         ]
-        .map(|k| ParamId::new(k, 0));
+        .map(|k| ParamId::new(k, 0))
+        .to_vec();
+        let mass_offset = ParamId::new(ParamKind::PayloadMass, 0);
+        let mut single_mass = Vec::new();
+        if masses.len() >= 2 {
+            payload.push(mass_offset);
+        } else {
+            single_mass.push(DroppedParam {
+                name: mass_offset.name(),
+                kind: identifiability::DropKind::NearlyDependent,
+                reason: "every pose carries the same payload mass, so an unknown mass offset is not separable from the centre of mass along the tool axis; measure a set with a different payload to identify it".into(),
+                depends_on: vec!["payload_z".into()],
+            });
+        }
         let candidates: Vec<ParamId> = base.iter().chain(&payload).copied().collect();
         let j = stacked_jacobian(&skcm.model, &candidates, self.ident);
         let analysis = identifiability::analyse(
@@ -207,7 +229,7 @@ impl Context<'_> {
             .collect();
         if kept_payload.is_empty() {
             return Err(MethodError::Failed(
-                "the poses do not excite the payload's centre of mass (no coordinate is identifiable); measure poses that turn the tool through different orientations".into(),
+                "the poses do not excite the payload (neither its centre of mass nor its mass is identifiable); measure poses that turn the tool through different orientations".into(),
             ));
         }
         let not_identified = analysis
@@ -215,6 +237,7 @@ impl Context<'_> {
             .dropped
             .into_iter()
             .filter(|d| payload.iter().any(|p| p.name() == d.name))
+            .chain(single_mass)
             .collect();
         let ids: Vec<ParamId> = base.iter().chain(&kept_payload).copied().collect();
         let f = fit(
@@ -302,6 +325,24 @@ impl Context<'_> {
                 stiffness.push(Some(kk));
             } else {
                 stiffness.push(None);
+            }
+        }
+        let offset = fitted.model.payload.mass_offset;
+        if offset != 0.0 {
+            let lightest = self
+                .ident
+                .iter()
+                .chain(self.valid)
+                .map(|m| m.payload_mass)
+                .fold(f64::INFINITY, f64::min);
+            if lightest + offset < 0.0 {
+                warnings.push(MethodWarning {
+                    kind: WarningKind::PayloadImplausible,
+                    joint: None,
+                    message: format!(
+                        "the identified payload mass offset {offset:+.2} kg leaves a negative mass on poses declared with {lightest:.2} kg: the payload and compliance are not separable in these poses"
+                    ),
+                });
             }
         }
         Ok(MethodReport {

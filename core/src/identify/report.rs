@@ -152,6 +152,8 @@ pub enum WarningKind {
     /// A parameter the method considered is not identifiable from these poses
     /// and stays at its nominal value.
     ParameterNotIdentifiable,
+    /// The identified payload is physically implausible (a negative total mass).
+    PayloadImplausible,
 }
 
 /// A warning about one method's result.
@@ -238,7 +240,7 @@ pub fn to_display(id: &ParamId, v: f64) -> f64 {
     match id.unit() {
         ParamUnit::Length => v * 1e3,
         ParamUnit::Angle => v.to_degrees(),
-        ParamUnit::Compliance => v,
+        ParamUnit::Compliance | ParamUnit::Mass => v,
     }
 }
 
@@ -247,6 +249,7 @@ pub(crate) fn unit_name(id: &ParamId) -> &'static str {
         ParamUnit::Length => "mm",
         ParamUnit::Angle => "deg",
         ParamUnit::Compliance => "rad/(N·m)",
+        ParamUnit::Mass => "kg",
     }
 }
 

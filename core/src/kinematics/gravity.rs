@@ -17,11 +17,14 @@ use super::chain::{chain, Chain, KinematicsError};
 use crate::model::robot::RobotModel;
 use nalgebra::Vector3;
 
-/// Gravity torques [N·m] at the active joints for a computed chain.
+/// Gravity torques [N·m] at the active joints for a computed chain, with the
+/// declared payload `payload_mass` [kg] plus the model's identified
+/// `payload.mass_offset`.
 pub fn gravity_torques_of(model: &RobotModel, chain: &Chain, payload_mass: f64) -> Vec<f64> {
     let n = model.dof();
     let g = model.gravity;
     let mut tau_chain = vec![0.0; n];
+    let payload_mass = payload_mass + model.payload.mass_offset;
     let mut m_sum = payload_mass;
     let mut s_sum: Vector3<f64> = chain.tcp.transform_point(&model.payload.com) * payload_mass;
     for k in (0..n).rev() {
@@ -58,6 +61,7 @@ pub fn payload_com_torque_partials(
 ) -> [Vec<f64>; 3] {
     let n = model.dof();
     let g = model.gravity;
+    let payload_mass = payload_mass + model.payload.mass_offset;
     std::array::from_fn(|j| {
         let arm = chain.tcp.r * Vector3::ith(j, 1.0) * payload_mass;
         let moment = arm.cross(&g);
@@ -67,6 +71,23 @@ pub fn payload_com_torque_partials(
         map_loop_torques(model, chain, &mut tau);
         tau
     })
+}
+
+/// Partial derivatives of the active joint torques with respect to the
+/// payload's mass, `∂τ_i/∂M = z_i · ((c_p − o_i) × g)` [N·m/kg], with `c_p`
+/// the payload's centre of mass in the base frame (the mass offset of
+/// `skcm-payload`; independent of the mass itself).
+pub fn payload_mass_torque_partials(model: &RobotModel, chain: &Chain) -> Vec<f64> {
+    let g = model.gravity;
+    let c = chain.tcp.transform_point(&model.payload.com);
+    let mut tau: Vec<f64> = (0..model.dof())
+        .map(|k| {
+            let f = &chain.links[k].frame;
+            f.z_axis().dot(&(c - f.p).cross(&g))
+        })
+        .collect();
+    map_loop_torques(model, chain, &mut tau);
+    tau
 }
 
 /// Gravity torques [N·m] at the active joints `q` (model convention, rad).

@@ -79,10 +79,24 @@ fn loop_col(model: &RobotModel, chain: &Chain, d: impl Fn(&super::LoopPartials) 
 /// Column of a payload CoM coordinate j: the joints deflect by `c∘τ`, and τ
 /// depends on the CoM, so the TCP moves by `Σ_k c_k·(∂τ_k/∂com_j)·J_k`.
 fn payload_col(model: &RobotModel, chain: &Chain, j: usize, payload_mass: f64) -> Col {
-    if payload_mass == 0.0 || !model.has_compliance() {
+    if payload_mass + model.payload.mass_offset == 0.0 || !model.has_compliance() {
         return (Vector3::zeros(), Vector3::zeros());
     }
     let dtau = &super::gravity::payload_com_torque_partials(model, chain, payload_mass)[j];
+    deflection_col(model, chain, dtau)
+}
+
+/// Column of the payload mass offset: `Σ_k c_k·(∂τ_k/∂M)·J_k`.
+fn payload_mass_col(model: &RobotModel, chain: &Chain) -> Col {
+    if !model.has_compliance() {
+        return (Vector3::zeros(), Vector3::zeros());
+    }
+    let dtau = super::gravity::payload_mass_torque_partials(model, chain);
+    deflection_col(model, chain, &dtau)
+}
+
+/// The TCP motion `Σ_k c_k·Δτ_k·J_k` of torque changes `Δτ` through the compliances.
+fn deflection_col(model: &RobotModel, chain: &Chain, dtau: &[f64]) -> Col {
     (0..model.dof()).fold((Vector3::zeros(), Vector3::zeros()), |acc, k| {
         add(
             acc,
@@ -154,6 +168,7 @@ pub fn param_column(
         PayloadX => payload_col(model, chain, 0, payload_mass),
         PayloadY => payload_col(model, chain, 1, payload_mass),
         PayloadZ => payload_col(model, chain, 2, payload_mass),
+        PayloadMass => payload_mass_col(model, chain),
     }
 }
 
@@ -204,7 +219,7 @@ mod tests {
     use crate::kinematics::{chain, deflected_joints, fk, gravity_torques};
     use crate::model::preset;
 
-    /// Payload CoM columns against central finite differences of the full
+    /// Payload CoM and mass-offset columns against central finite differences of the full
     /// prediction `FK(q + c∘τ(q, M, r))`. The column takes ∂τ/∂r at the deflected
     /// chain (τ itself at the commanded one), a second-order difference of the
     /// size of the deflection (below 1e-5 rad here), hence the 1e-3 relative
@@ -229,6 +244,7 @@ mod tests {
                     ParamKind::PayloadX,
                     ParamKind::PayloadY,
                     ParamKind::PayloadZ,
+                    ParamKind::PayloadMass,
                 ]
                 .map(|k| ParamId::new(k, 0));
                 let j = identification_jacobian(&m, &c, &ids, &tau, mass, false);

@@ -120,6 +120,10 @@ pub struct PayloadDescription {
     /// Centre of mass in the tool frame.
     #[serde(default)]
     pub com_mm: [f64; 3],
+    /// Mass every pose carries beyond its declared payload (identified by
+    /// `skcm-payload`); left out when 0.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub mass_offset_kg: f64,
 }
 
 /// The JSON description of a robot model (mm/deg).
@@ -344,9 +348,17 @@ impl ModelDescription {
         if payload_mass < 0.0 {
             return Err(invalid("payload.mass_kg", "must not be negative"));
         }
+        let mass_offset = finite("payload.mass_offset_kg", self.payload.mass_offset_kg)?;
+        if mass_offset.abs() > 10_000.0 {
+            return Err(invalid(
+                "payload.mass_offset_kg",
+                "must be within ±10000 kg",
+            ));
+        }
         let payload = Payload {
             mass: payload_mass,
             com: finite3("payload.com_mm", self.payload.com_mm)? * MM,
+            mass_offset,
         };
         let gravity = finite3("gravity_mps2", self.gravity_mps2)?;
         if gravity.norm() > 100.0 {
@@ -417,6 +429,7 @@ impl ModelDescription {
                     m.payload.com.y / MM,
                     m.payload.com.z / MM,
                 ],
+                mass_offset_kg: m.payload.mass_offset,
             },
             gravity_mps2: [m.gravity.x, m.gravity.y, m.gravity.z],
             assumptions: m.assumptions.clone(),

@@ -32,6 +32,9 @@ pub enum ParamKind {
     PayloadX,
     PayloadY,
     PayloadZ,
+    /// Payload mass every pose carries beyond its declared payload [kg] (an
+    /// unknown tool or adapter; for `skcm-payload`).
+    PayloadMass,
 }
 
 /// Physical unit class of a parameter (for display and scaling).
@@ -40,6 +43,7 @@ pub enum ParamUnit {
     Length,
     Angle,
     Compliance,
+    Mass,
 }
 
 /// One scalar parameter: its kind and the 0-based link it belongs to.
@@ -59,6 +63,7 @@ impl ParamId {
         match self.kind {
             Alpha | Beta | Theta | ToolRx | ToolRy | ToolRz => ParamUnit::Angle,
             Compliance => ParamUnit::Compliance,
+            PayloadMass => ParamUnit::Mass,
             _ => ParamUnit::Length,
         }
     }
@@ -67,15 +72,23 @@ impl ParamId {
     pub fn is_geometric(&self) -> bool {
         !matches!(
             self.kind,
-            ParamKind::Compliance | ParamKind::PayloadX | ParamKind::PayloadY | ParamKind::PayloadZ
+            ParamKind::Compliance
+                | ParamKind::PayloadX
+                | ParamKind::PayloadY
+                | ParamKind::PayloadZ
+                | ParamKind::PayloadMass
         )
     }
 
-    /// Whether the parameter is one coordinate of the payload's centre of mass.
+    /// Whether the parameter is the payload's (a centre-of-mass coordinate or
+    /// the mass offset).
     pub fn is_payload(&self) -> bool {
         matches!(
             self.kind,
-            ParamKind::PayloadX | ParamKind::PayloadY | ParamKind::PayloadZ
+            ParamKind::PayloadX
+                | ParamKind::PayloadY
+                | ParamKind::PayloadZ
+                | ParamKind::PayloadMass
         )
     }
 
@@ -103,6 +116,7 @@ impl ParamId {
             PayloadX => "payload_x".into(),
             PayloadY => "payload_y".into(),
             PayloadZ => "payload_z".into(),
+            PayloadMass => "payload_mass_offset".into(),
         }
     }
 
@@ -122,6 +136,7 @@ impl ParamId {
             ("payload_x", PayloadX),
             ("payload_y", PayloadY),
             ("payload_z", PayloadZ),
+            ("payload_mass_offset", PayloadMass),
         ];
         if let Some((_, k)) = fixed.iter().find(|(n, _)| *n == name) {
             return Some(ParamId::new(*k, 0));
@@ -256,6 +271,7 @@ fn slot(model: &mut RobotModel, id: ParamId) -> &mut f64 {
         PayloadX => &mut model.payload.com.x,
         PayloadY => &mut model.payload.com.y,
         PayloadZ => &mut model.payload.com.z,
+        PayloadMass => &mut model.payload.mass_offset,
     }
 }
 
@@ -296,6 +312,7 @@ impl ModelRef<'_> {
             PayloadX => m.payload.com.x,
             PayloadY => m.payload.com.y,
             PayloadZ => m.payload.com.z,
+            PayloadMass => m.payload.mass_offset,
         }
     }
 }
@@ -318,6 +335,7 @@ mod tests {
             ParamId::new(LoopL4, 0),
             ParamId::new(Compliance, 1),
             ParamId::new(PayloadY, 0),
+            ParamId::new(PayloadMass, 0),
         ] {
             assert_eq!(ParamId::parse(&id.name()), Some(id), "{}", id.name());
         }

@@ -75,6 +75,7 @@ fn ys100() -> ModelDescription {
         payload: PayloadDescription {
             mass_kg: 110.0,
             com_mm: [-200.0, -50.0, -250.0],
+            ..PayloadDescription::default()
         },
         gravity_mps2: [0.0, 0.0, -G0],
         assumptions: vec![
@@ -121,6 +122,7 @@ fn hh800() -> ModelDescription {
         payload: PayloadDescription {
             mass_kg: 745.0,
             com_mm: [-200.0, -200.0, 100.0],
+            ..PayloadDescription::default()
         },
         gravity_mps2: [0.0, 0.0, -G0],
         assumptions: vec![

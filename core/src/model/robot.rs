@@ -127,6 +127,11 @@ pub struct Payload {
     pub mass: f64,
     /// Centre of mass in the tool frame [m].
     pub com: Vector3<f64>,
+    /// Mass every pose carries beyond its declared payload [kg] (identified by
+    /// `skcm-payload`; 0 unless identified): the gravity torques use the
+    /// declared payload plus this.
+    #[serde(default)]
+    pub mass_offset: f64,
 }
 
 impl Default for Payload {
@@ -134,6 +139,7 @@ impl Default for Payload {
         Payload {
             mass: 0.0,
             com: Vector3::zeros(),
+            mass_offset: 0.0,
         }
     }
 }

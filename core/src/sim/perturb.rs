@@ -67,7 +67,7 @@ pub fn perturb_geometry_with(
         let scale = match id.unit() {
             ParamUnit::Length => mag.length_m,
             ParamUnit::Angle => mag.angle_rad,
-            ParamUnit::Compliance => 0.0,
+            ParamUnit::Compliance | ParamUnit::Mass => 0.0,
         };
         let unit: f64 = match dist {
             ErrorDistribution::Uniform => rng.gen::<f64>() * 2.0 - 1.0,
