@@ -3,7 +3,8 @@
 //! identifiability report, or the same as JSON.
 
 use crate::identify::{
-    calibrate, CalibrationOptions, CalibrationReport, Method, PoseSource, PoseSources,
+    calibrate_with_training, CalibrationOptions, CalibrationReport, CompensatorOptions, Method,
+    PoseSource, PoseSources,
 };
 use crate::measure::{self, csv, SetRole};
 use crate::model::RobotModel;
@@ -20,7 +21,8 @@ pub struct CalibrateArgs {
     /// Identification measurements (CSV), one or more files (repeat the option
     /// or separate with commas). Each file is its own tracker session unless
     /// its rows carry a `session` column. Rows whose `set` column says
-    /// validation are moved to the validation set.
+    /// validation are moved to the validation set, rows that say training to
+    /// the compensator training pool.
     #[arg(long, required = true, num_args = 1.., value_delimiter = ',')]
     pub identify: Vec<String>,
     /// Validation measurements (CSV), never used for fitting. With as many
@@ -28,15 +30,28 @@ pub struct CalibrateArgs {
     /// otherwise to the first session (a `session` column overrides both).
     #[arg(long, num_args = 1.., value_delimiter = ',')]
     pub validate: Vec<String>,
-    /// Methods to run and compare, comma-separated: km, skcm, skcm-tlbo, skcm-payload.
+    /// Compensator training measurements (CSV, the Q2 pool), never used by the
+    /// model-based fit. Without them the compensators train on the
+    /// identification poses and are judged by k-fold cross-validation there.
+    /// Each row belongs to the session of its `session` column, else to the
+    /// first session.
+    #[arg(long, num_args = 1.., value_delimiter = ',')]
+    pub train: Vec<String>,
+    /// Methods to run and compare, comma-separated: km, skcm, skcm-tlbo,
+    /// skcm-payload, km-rbf, skcm-nn, skcm-iwonn, skcm-tlbonn, auto; `all` runs
+    /// every one and prints the comparison table (rows methods, columns sets).
     #[arg(long, default_value = "km,skcm,skcm-tlbo")]
     pub method: String,
     /// Payload mass [kg] for rows without a payload_kg column (default: the model's payload).
     #[arg(long)]
     pub payload_kg: Option<f64>,
-    /// Random seed of the TLBO search.
+    /// Random seed of the TLBO search and of the compensators' training.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// Folds of the compensators' cross-validation on the training pool
+    /// (0: none for the explicit methods; `auto` then uses 5).
+    #[arg(long, default_value_t = 5)]
+    pub cv_folds: usize,
     /// TLBO population and generations.
     #[arg(long, default_value_t = 50)]
     pub population: usize,
@@ -92,14 +107,17 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         row: k + 1,
         session: session.to_string(),
     };
-    let mut training = 0;
+    let (mut train_rows, mut train_src) = (Vec::new(), Vec::new());
     for (i, path) in a.identify.iter().enumerate() {
         let rows = read_rows(path, dif)?;
         csv::check_joint_count(&rows, model.dof()).with_context(|| path.clone())?;
         for (k, r) in rows.into_iter().enumerate() {
             let s = r.session.clone().unwrap_or_else(|| label(i));
             match r.set {
-                Some(SetRole::Training) => training += 1,
+                Some(SetRole::Training) => {
+                    train_src.push(source(path, k, &s));
+                    train_rows.push((s, r));
+                }
                 Some(SetRole::Validation) => {
                     valid_src.push(source(path, k, &s));
                     valid_rows.push((s, r));
@@ -111,10 +129,14 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
             }
         }
     }
-    if training > 0 && !a.json {
-        eprintln!(
-            "note: {training} rows marked `training` are for compensators and are not used here"
-        );
+    for path in &a.train {
+        let more = read_rows(path, dif)?;
+        csv::check_joint_count(&more, model.dof()).with_context(|| path.clone())?;
+        for (k, r) in more.into_iter().enumerate() {
+            let s = r.session.clone().unwrap_or_else(|| label(0));
+            train_src.push(source(path, k, &s));
+            train_rows.push((s, r));
+        }
     }
     let same_count = a.validate.len() == a.identify.len();
     for (j, path) in a.validate.iter().enumerate() {
@@ -138,6 +160,11 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
             "validation rows of tracker session `{s}` have no identification rows in that session, so its frame cannot be registered; measure identification poses in that session too"
         );
     }
+    if let Some((s, _)) = train_rows.iter().find(|(s, _)| !sessions.contains(s)) {
+        bail!(
+            "training rows of tracker session `{s}` have no identification rows in that session, so its frame cannot be registered; measure identification poses in that session too"
+        );
+    }
     let to_si = |rows: &[(String, measure::MeasuredPose)]| -> Vec<measure::Measurement> {
         rows.iter()
             .map(|(s, r)| {
@@ -149,6 +176,7 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     };
     let ident = to_si(&ident_rows);
     let valid = to_si(&valid_rows);
+    let training = to_si(&train_rows);
     let opts = CalibrationOptions {
         methods,
         register: !a.no_register,
@@ -157,10 +185,15 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
             generations: a.generations,
             seed: a.seed,
         },
+        compensator: CompensatorOptions {
+            seed: a.seed,
+            cv_folds: a.cv_folds,
+            ..Default::default()
+        },
         ..Default::default()
     };
     let verbose = !a.json;
-    let mut report = calibrate(&model, &ident, &valid, &opts, &|p| {
+    let mut report = calibrate_with_training(&model, &ident, &training, &valid, &opts, &|p| {
         if verbose && p.iteration == 0 {
             eprintln!("[{:5.1}%] {}", p.percent, p.phase);
         }
@@ -169,6 +202,7 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     report.pose_sources = PoseSources {
         identification: ident_src,
         validation: valid_src,
+        training: train_src,
     };
     report.session_names = sessions.clone();
     if let Some(path) = &a.html {
@@ -219,7 +253,7 @@ fn save_model(
         nominal: nominal.clone(),
         cell_from_base: report.tracker_to_base.inverse(),
         payload_kg: payload,
-        compensator: None,
+        compensator: chosen.stored_compensator.clone().map(|c| c.into_arc()),
     };
     let file = crate::compensate::CalibratedModelFile::from_compensated(
         &model,

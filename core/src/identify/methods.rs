@@ -64,6 +64,7 @@ pub(crate) struct Context<'a> {
 }
 
 /// A method's fit before it is reported.
+#[derive(Clone)]
 pub(crate) struct MethodFit {
     pub fit: Fit,
     pub ids: Vec<ParamId>,
@@ -320,7 +321,10 @@ impl Context<'_> {
             tlbo,
             warnings,
             model: description,
+            compensator: None,
+            auto: None,
             calibrated: fitted.model,
+            stored_compensator: None,
         })
     }
 }
