@@ -316,6 +316,8 @@ pub fn render_report(r: &CalibrationReport) -> String {
             m.validation.as_ref().map(|v| &v.stats),
         );
     }
+    let _ = write!(s, "{}", render_comparison(r));
+    let _ = write!(s, "{}", render_compensators(r));
     let id = &r.identifiability;
     let _ = writeln!(
         s,
@@ -413,6 +415,137 @@ pub fn render_report(r: &CalibrationReport) -> String {
         let _ = writeln!(s, "\nFailed methods (the others above are complete)");
         for f in &r.failed {
             let _ = writeln!(s, "  {:<14} {}", method_label(f.method.name()), f.reason);
+        }
+    }
+    s
+}
+
+/// The seed-style comparison (rows = methods, columns = sets, mean / max in mm),
+/// the compensator training pool between identification and validation.
+pub fn render_comparison(r: &CalibrationReport) -> String {
+    let mut s = String::new();
+    let training = r.training_poses > 0;
+    let validation = r.validation_poses > 0;
+    let _ = write!(
+        s,
+        "\nComparison, mean / max (mm)\n{:<22} {:>19}",
+        "", "identification (Q1)"
+    );
+    if training {
+        let _ = write!(s, " {:>19}", "training (Q2)");
+    }
+    if validation {
+        let _ = write!(s, " {:>19}", "validation (Q3)");
+    }
+    let _ = writeln!(s);
+    let cell = |e: Option<&crate::identify::ErrorStats>| match e {
+        Some(e) => format!("{:>9.4} / {:<7.4}", e.mean_mm, e.max_mm),
+        None => format!("{:>19}", "-"),
+    };
+    let _ = write!(
+        s,
+        "{:<22} {}",
+        "Nominal robot model",
+        cell(Some(&r.nominal.identification.stats))
+    );
+    if training {
+        let _ = write!(s, " {}", cell(None));
+    }
+    if validation {
+        let _ = write!(
+            s,
+            " {}",
+            cell(r.nominal.validation.as_ref().map(|v| &v.stats))
+        );
+    }
+    let _ = writeln!(s);
+    for (name, m) in &r.methods {
+        let _ = write!(
+            s,
+            "{:<22} {}",
+            method_label(name),
+            cell(Some(&m.identification.stats))
+        );
+        if training {
+            let _ = write!(s, " {}", cell(m.training.as_ref().map(|v| &v.stats)));
+        }
+        if validation {
+            let _ = write!(s, " {}", cell(m.validation.as_ref().map(|v| &v.stats)));
+        }
+        let _ = writeln!(s);
+    }
+    s
+}
+
+/// Each compensator: network, training, cross-validation and its effect on
+/// every set; `auto`'s choice and why.
+pub fn render_compensators(r: &CalibrationReport) -> String {
+    let mut s = String::new();
+    let with: Vec<_> = r
+        .methods
+        .iter()
+        .filter(|(_, m)| m.compensator.is_some() || m.auto.is_some())
+        .collect();
+    if with.is_empty() {
+        return s;
+    }
+    let _ = writeln!(s, "\nCompensators (mean / max in mm, base -> compensated)");
+    let pair = |b: &crate::identify::ErrorStats, c: &crate::identify::ErrorStats| {
+        format!(
+            "{:.4} -> {:.4} / {:.4} -> {:.4}",
+            b.mean_mm, c.mean_mm, b.max_mm, c.max_mm
+        )
+    };
+    for (name, m) in with {
+        if let Some(a) = &m.auto {
+            let _ = writeln!(
+                s,
+                "  {:<14} chose {}: {}",
+                method_label(name),
+                method_label(a.chosen.name()),
+                a.reason
+            );
+        }
+        let Some(c) = &m.compensator else {
+            continue;
+        };
+        let _ = writeln!(
+            s,
+            "  {:<14} {} on {}, {} units, over {}; trained by {} on {} {} poses: {} epochs / iterations / generations, {} loss evaluations, stopped: {}; training RMS {:.4} mm",
+            method_label(name),
+            c.kind,
+            c.inputs,
+            c.units,
+            method_label(c.base.name()),
+            c.training.trainer,
+            c.training_poses,
+            c.trained_on,
+            c.training.epochs,
+            c.training.evaluations,
+            c.training.stop,
+            c.training.rms_mm
+        );
+        if let Some(cv) = &c.cross_validation {
+            let _ = writeln!(
+                s,
+                "  {:<14} cross-validated ({} folds on the {} poses): {}",
+                "",
+                cv.folds,
+                c.trained_on,
+                pair(&cv.base, &cv.compensated)
+            );
+        }
+        let _ = writeln!(
+            s,
+            "  {:<14} identification: {}",
+            "",
+            pair(&c.base_identification, &m.identification.stats)
+        );
+        if let (Some(b), Some(t)) = (&c.base_training, &m.training) {
+            let _ = writeln!(s, "  {:<14} training:       {}", "", pair(b, &t.stats));
+        }
+        if let (Some(b), Some(v)) = (&c.base_validation, &m.validation) {
+            let _ = writeln!(s, "  {:<14} validation:     {}", "", pair(b, &v.stats));
         }
     }
     s

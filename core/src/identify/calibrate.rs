@@ -405,6 +405,9 @@ pub fn calibrate_with_training(
         let frames = mf.fit.session_frames.clone();
         match ctx.report(*method, mf) {
             Ok(mut r) => {
+                if !train_base.is_empty() {
+                    r.training = Some(SetErrors::of(&r.calibrated, &frames, &train_base));
+                }
                 if let Some((m, t)) = &h.compensator {
                     let base = m.base().expect("a compensator method");
                     compensate_report(

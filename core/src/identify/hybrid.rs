@@ -174,14 +174,10 @@ pub(crate) fn compensate_report(
     if !valid.is_empty() {
         report.validation = Some(SetErrors::of_compensated(&model, c, frames, valid));
     }
-    let (base_training_pool, training_pool) = if training.is_empty() {
-        (None, None)
-    } else {
-        (
-            Some(SetErrors::of(&model, frames, training).stats),
-            Some(SetErrors::of_compensated(&model, c, frames, training).stats),
-        )
-    };
+    let base_training = report.training.as_ref().map(|t| t.stats.clone());
+    if !training.is_empty() {
+        report.training = Some(SetErrors::of_compensated(&model, c, frames, training));
+    }
     let (kind, units, inputs) = inputs_of(&trained.stored);
     report.compensator = Some(CompensatorSummary {
         base,
@@ -203,8 +199,7 @@ pub(crate) fn compensate_report(
         cross_validation: trained.cv.clone(),
         base_identification,
         base_validation,
-        base_training_pool,
-        training_pool,
+        base_training,
     });
     report.stored_compensator = Some(trained.stored.clone());
 }

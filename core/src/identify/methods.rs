@@ -310,6 +310,7 @@ impl Context<'_> {
             solver: fitted.report.clone(),
             identification: id_err,
             validation: va_err,
+            training: None,
             parameters: estimates(
                 self.nominal,
                 &fitted.model,

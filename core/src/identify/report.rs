@@ -162,6 +162,9 @@ pub struct MethodReport {
     pub solver: LmReport,
     pub identification: SetErrors,
     pub validation: Option<SetErrors>,
+    /// Errors on the compensator training pool (Q2), when one was given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub training: Option<SetErrors>,
     pub parameters: Vec<ParamEstimate>,
     /// Identified joint stiffness 1/c [N·m/rad] (None: not identified / rigid).
     pub stiffness_nm_per_rad: Vec<Option<f64>>,
@@ -211,12 +214,9 @@ pub struct CompensatorSummary {
     pub base_identification: ErrorStats,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub base_validation: Option<ErrorStats>,
-    /// Base and compensated errors on the training pool, when it is a set of
-    /// its own [mm].
+    /// The base alone on the training pool, when it is a set of its own [mm].
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub base_training_pool: Option<ErrorStats>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub training_pool: Option<ErrorStats>,
+    pub base_training: Option<ErrorStats>,
 }
 
 /// One candidate `auto` weighed: cross-validated errors on the training pool
