@@ -248,7 +248,7 @@ impl CompensatorOptions {
     /// at most (for progress percentages).
     pub fn max_epochs(&self, method: Method) -> usize {
         match method {
-            Method::KmRbf => self.rbf.max_neurons,
+            Method::KmRbf => (self.rbf.max_neurons + 1) * (self.rbf.spreads.len() + 1),
             Method::SkcmNn => self.lm.max_epochs,
             Method::SkcmIwonn => self.iwo.iterations,
             Method::SkcmTlbonn => self.tlbo.generations,
