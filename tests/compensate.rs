@@ -353,6 +353,7 @@ fn base_failure_pool_choice_and_cancellation() {
         "{}",
         a.reason
     );
+    assert!(a.candidates.is_empty(), "{:?}", a.candidates);
     // Cancelled from the progress callback during SKCM-NN's training.
     let nominal = preset("ys100").unwrap();
     let ident = measure_truth(&t, &nominal, 60, &mut rng);

@@ -350,7 +350,7 @@ pub(crate) fn run_auto(
             o.auto_candidates
                 .iter()
                 .copied()
-                .filter(|m| m.base() == Some(*b))
+                .filter(|m| m.base() == Some(*b) && (gravity.is_none() || !m.uses_torques()))
                 .collect()
         })
         .collect();
