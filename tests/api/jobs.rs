@@ -575,3 +575,72 @@ async fn compensator_job_yields_a_version_whose_solve_uses_it() {
     }
     assert!(solved >= 7, "{s}");
 }
+
+/// Cancelling a job while a compensator trains (SKCM-NN by LM on 1000
+/// training poses, progress per epoch) ends it promptly.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn cancelling_a_compensator_job_during_training_takes_effect_quickly() {
+    use robocal::measure::SetRole;
+    let t = setup_with(&[], 1).await;
+    let robot = t.create_robot("ys100").await;
+    let rid = robot.to_string();
+    t.upload_csv(robot, &simulated_csv(5, 30), "?role=identification")
+        .await;
+    let training = format!(
+        "# simulated YS100, training\n{}",
+        robocal::measure::csv::write(&simulated_rows(6, 1000, Some(SetRole::Training)))
+    );
+    t.upload_csv(robot, &training, "?role=training").await;
+    let r = t
+        .post_json(
+            "/v1/robots/{id}/calibrations",
+            &[&rid],
+            json!({ "methods": ["skcm-nn"] }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::ACCEPTED, "{}", r.text());
+    let job = r.json()["id"].as_i64().unwrap();
+    let start = Instant::now();
+    loop {
+        let j = t
+            .get(
+                "/v1/robots/{id}/calibrations/{cid}",
+                &[&rid, &job.to_string()],
+            )
+            .await
+            .json();
+        // Past the base fit (the first 5 % of the method's span): training.
+        if j["progress"]["phase"] == "skcm-nn" && j["progress"]["percent"].as_f64() > Some(15.0) {
+            break;
+        }
+        assert!(start.elapsed() < Duration::from_secs(120), "{j}");
+        tokio::time::sleep(Duration::from_millis(10)).await;
+    }
+    let r = t
+        .send(
+            "POST",
+            "/v1/robots/{id}/calibrations/{cid}/cancel",
+            &[&rid, &job.to_string()],
+            "",
+            None,
+            vec![],
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::ACCEPTED);
+    let requested = seconds_of_day(r.json()["updated_at"].as_str().unwrap());
+    let j = t
+        .wait_for(
+            robot,
+            job,
+            &["cancelled", "failed", "succeeded"],
+            Duration::from_secs(60),
+        )
+        .await;
+    assert_eq!(j["status"], "cancelled", "{j}");
+    let ended = seconds_of_day(j["finished_at"].as_str().unwrap());
+    let latency = ended - requested;
+    assert!(
+        (0.0..5.0).contains(&latency),
+        "cancellation took {latency:.3} s"
+    );
+}
