@@ -138,3 +138,109 @@ fn errors_are_reported_not_panicked() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("unknown demo"));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A compensator method from the command line: `--train` is the training pool,
+/// the comparison table has its column, `--save` writes the compensator
+/// (format 2) and `solve --model` uses it: each solution lands on its target
+/// through the compensated prediction of the saved file.
+#[test]
+fn compensator_method_saves_and_solves() {
+    let dir = std::env::temp_dir().join(format!("robocal-cli-comp-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (set, n, seed) in [("identification", "40", "1"), ("training", "80", "2")] {
+        let a = robocal(
+            &[
+                "simulate",
+                "--poses",
+                n,
+                "--seed",
+                seed,
+                "--set",
+                set,
+                "--gear-error",
+                "0.01,1",
+                "--out",
+                &format!("{set}.csv"),
+            ],
+            &dir,
+        );
+        assert!(a.status.success(), "{}", String::from_utf8_lossy(&a.stderr));
+    }
+    let out = robocal(
+        &[
+            "calibrate",
+            "--model",
+            "ys100",
+            "--identify",
+            "identification.csv",
+            "--train",
+            "training.csv",
+            "--method",
+            "skcm,skcm-nn",
+            "--cv-folds",
+            "0",
+            "--save",
+            "cal.json",
+            "--save-method",
+            "skcm-nn",
+        ],
+        &dir,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("training (Q2)") && text.contains("Compensators"),
+        "{text}"
+    );
+    assert!(text.contains("on 80 training poses"), "{text}");
+    let file = std::fs::read_to_string(dir.join("cal.json")).unwrap();
+    let model = robocal::compensate::parse_compensated(&file).unwrap();
+    assert!(model.compensator.is_some());
+    let nominal = robocal::model::preset("ys100").unwrap();
+    let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(9);
+    let qs = robocal::sim::random_configurations(&nominal, 5, &mut rng);
+    let mut targets = String::from("id,x,y,z\n");
+    let mut want = Vec::new();
+    for (i, q) in qs.iter().enumerate() {
+        let p = model.predict(q).unwrap().p * 1e3;
+        targets.push_str(&format!("t{i},{},{},{}\n", p.x, p.y, p.z));
+        want.push(p);
+    }
+    std::fs::write(dir.join("targets.csv"), targets).unwrap();
+    let out = robocal(
+        &[
+            "solve",
+            "--model",
+            "cal.json",
+            "--targets",
+            "targets.csv",
+            "--position-only",
+            "--json",
+        ],
+        &dir,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let results = v["targets"].as_array().unwrap_or_else(|| panic!("{v}"));
+    assert_eq!(results.len(), 5);
+    assert!(v["solved"].as_u64() >= Some(4), "{v}");
+    for (r, p) in results.iter().zip(&want) {
+        if r["status"] != "ok" {
+            continue;
+        }
+        let deg: Vec<f64> = serde_json::from_value(r["joints_deg"].clone()).unwrap();
+        let q =
+            nominal.joints_from_controller(&deg.iter().map(|d| d.to_radians()).collect::<Vec<_>>());
+        let reached = model.predict(&q).unwrap().p * 1e3;
+        assert!((reached - p).norm() < 1e-3, "{} mm", (reached - p).norm());
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

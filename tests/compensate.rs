@@ -9,19 +9,25 @@
 //! every joint, 0.01 mm tracker noise, and a tracker frame 3.4 m from the base,
 //! turned by 30°. The calibration knows the preset's masses and none of the
 //! other effects.
+//!
+//! Everything runs through the identification pipeline
+//! (`identify::calibrate_with_training`) with the three data roles: 100
+//! identification poses fit the base, the training pool trains the
+//! compensator, 200 validation poses judge; each figure is recomputed through
+//! `CompensatedModel::predict` from the model the report delivers.
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal::compensate::{
-    choose, cross_validate, train, unmodelled_truth, CompensatedModel, Compensator,
-    CompensatorSpec, CvStats, Sample, StoredCompensator,
+use robocal::compensate::{unmodelled_truth, CompensatedModel, CompensatorSpec, StoredCompensator};
+use robocal::identify::{
+    calibrate, calibrate_with_training, CalibrationOptions, CalibrationReport, CompensatorOptions,
+    ErrorStats, Method,
 };
-use robocal::identify::{calibrate, CalibrationOptions, CalibrationReport, ErrorStats, Method};
 use robocal::ik::{Goal, IkSettings, IkSolver, SolveOptions};
 use robocal::measure::{self, csv, Measurement};
 use robocal::model::{preset, ModelDescription, RobotModel};
 use robocal::sim::{random_configurations, TrueRobot};
-use std::sync::{Arc, OnceLock};
+use std::sync::OnceLock;
 
 fn measure_truth(
     t: &TrueRobot,
@@ -58,18 +64,6 @@ fn errors(m: &CompensatedModel, data: &[Measurement]) -> ErrorStats {
     ErrorStats::from_errors_mm(&e)
 }
 
-fn with(m: &CompensatedModel, c: &StoredCompensator) -> CompensatedModel {
-    CompensatedModel {
-        compensator: Some(c.clone().into_arc()),
-        ..m.clone()
-    }
-}
-
-fn fit(spec: &CompensatorSpec, samples: &[Sample], seed: u64) -> StoredCompensator {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    train(spec, samples, &mut rng, &mut |_, _| true).unwrap().0
-}
-
 /// (method name, base, compensator spec) of the seed's hybrid methods.
 fn hybrids() -> Vec<(&'static str, &'static str, CompensatorSpec)> {
     vec![
@@ -80,60 +74,95 @@ fn hybrids() -> Vec<(&'static str, &'static str, CompensatorSpec)> {
     ]
 }
 
+const BASES_AND_COMPENSATORS: [Method; 6] = [
+    Method::Km,
+    Method::Skcm,
+    Method::KmRbf,
+    Method::SkcmNn,
+    Method::SkcmIwonn,
+    Method::SkcmTlbonn,
+];
+
+/// A calibration through the pipeline with the three data roles: 100
+/// identification poses (Q1), `n_train` training poses (Q2), 200 validation
+/// poses (Q3), all of the same simulated truth.
 struct Study {
     nominal: RobotModel,
+    train: Vec<Measurement>,
     valid: Vec<Measurement>,
-    bases: Vec<(&'static str, CompensatedModel)>,
-    /// (method, base, trained compensator)
-    trained: Vec<(&'static str, &'static str, StoredCompensator)>,
-    samples: Vec<(&'static str, Vec<Sample>)>,
+    report: CalibrationReport,
 }
 
-fn study(n_train: usize, effects: bool, seed: u64) -> Study {
+fn options(methods: &[Method], seed: u64, cv_folds: usize) -> CalibrationOptions {
+    CalibrationOptions {
+        methods: methods.to_vec(),
+        compensator: CompensatorOptions {
+            seed,
+            cv_folds,
+            ..Default::default()
+        },
+        ..Default::default()
+    }
+}
+
+fn study(n_train: usize, effects: bool, seed: u64, methods: &[Method], cv_folds: usize) -> Study {
     let nominal = preset("ys100").unwrap();
     let t = unmodelled_truth(&nominal, effects, seed);
     let mut rng = ChaCha8Rng::seed_from_u64(seed + 100);
-    let train_set = measure_truth(&t, &nominal, n_train, &mut rng);
+    let ident = measure_truth(&t, &nominal, 100, &mut rng);
+    let train = measure_truth(&t, &nominal, n_train, &mut rng);
     let valid = measure_truth(&t, &nominal, 200, &mut rng);
-    let opts = CalibrationOptions {
-        methods: vec![Method::Km, Method::Skcm],
-        ..Default::default()
-    };
-    let r = calibrate(&nominal, &train_set, &valid, &opts, &|_| true).unwrap();
-    let bases: Vec<_> = ["km", "skcm"]
-        .into_iter()
-        .map(|m| (m, base(&nominal, &r, m)))
-        .collect();
-    let samples: Vec<_> = bases
-        .iter()
-        .map(|(m, b)| (*m, b.samples(&train_set).unwrap()))
-        .collect();
-    let trained = hybrids()
-        .into_iter()
-        .map(|(name, b, spec)| {
-            let s = &samples.iter().find(|x| x.0 == b).unwrap().1;
-            (name, b, fit(&spec, s, seed))
-        })
-        .collect();
+    let opts = options(methods, seed, cv_folds);
+    let report =
+        calibrate_with_training(&nominal, &ident, &train, &valid, &opts, &|_| true).unwrap();
     Study {
         nominal,
+        train,
         valid,
-        bases,
-        trained,
-        samples,
+        report,
     }
 }
 
 impl Study {
-    fn base(&self, name: &str) -> &CompensatedModel {
-        &self.bases.iter().find(|b| b.0 == name).unwrap().1
+    /// The model a method delivers, rebuilt from the report as its model file
+    /// would be (measurement frame, compensator included).
+    fn model(&self, method: &str) -> CompensatedModel {
+        let m = &self.report.methods[method];
+        CompensatedModel {
+            compensator: m.stored_compensator.clone().map(|c| c.into_arc()),
+            ..base(&self.nominal, &self.report, method)
+        }
+    }
+
+    /// Validation errors of a method recomputed through
+    /// `CompensatedModel::predict` (not the pipeline's own statistics), after
+    /// checking that the two agree.
+    fn validation(&self, method: &str) -> ErrorStats {
+        let e = errors(&self.model(method), &self.valid);
+        let r = &self.report.methods[method]
+            .validation
+            .as_ref()
+            .unwrap()
+            .stats;
+        assert!(
+            (e.mean_mm - r.mean_mm).abs() < 1e-6 && (e.max_mm - r.max_mm).abs() < 1e-6,
+            "{method}: report {r:?} vs recomputed {e:?}"
+        );
+        e
+    }
+
+    fn compensator(&self, method: &str) -> &StoredCompensator {
+        self.report.methods[method]
+            .stored_compensator
+            .as_ref()
+            .unwrap_or_else(|| panic!("{method} has no compensator"))
     }
 }
 
 static THOUSAND: OnceLock<Study> = OnceLock::new();
 
 fn thousand() -> &'static Study {
-    THOUSAND.get_or_init(|| study(1000, true, 1))
+    THOUSAND.get_or_init(|| study(1000, true, 1, &BASES_AND_COMPENSATORS, 0))
 }
 
 /// 1000 training poses: KM-RBF and SKCM-NN lower the validation mean by ≥ 15 %
@@ -142,9 +171,13 @@ fn thousand() -> &'static Study {
 fn thousand_poses_every_compensator_beats_its_base() {
     let s = thousand();
     let mut best_gain: f64 = 0.0;
-    for (method, b, c) in &s.trained {
-        let base = errors(s.base(b), &s.valid);
-        let comp = errors(&with(s.base(b), c), &s.valid);
+    for (method, b, _) in hybrids() {
+        let c = s.report.methods[method].compensator.as_ref().unwrap();
+        assert_eq!(c.trained_on, "training");
+        assert_eq!(c.training_poses, 1000);
+        assert_eq!(c.base.name(), b);
+        let base = s.validation(b);
+        let comp = s.validation(method);
         let gain = 1.0 - comp.mean_mm / base.mean_mm;
         eprintln!(
             "{method}: validation mean {:.4} -> {:.4} mm ({:.1} %), max {:.4} -> {:.4} mm",
@@ -164,22 +197,25 @@ fn thousand_poses_every_compensator_beats_its_base() {
     assert!(best_gain >= 0.35, "best gain {:.1} %", best_gain * 100.0);
 }
 
-/// Same seed, same weights, bit for bit (IWO evaluates its offspring in
-/// parallel; the unit tests repeat every trainer on a smaller set).
+/// Same seed, same weights, bit for bit: the pipeline run again on the same
+/// data (IWO evaluates its offspring in parallel; the unit tests repeat every
+/// trainer on a smaller set).
 #[test]
 fn training_is_deterministic() {
     let s = thousand();
-    let samples = &s.samples.iter().find(|x| x.0 == "skcm").unwrap().1;
-    for (method, spec_seed) in [("skcm-iwonn", 1), ("km-rbf", 1)] {
-        let spec = hybrids().into_iter().find(|h| h.0 == method).unwrap().2;
-        let samples = if method == "km-rbf" {
-            &s.samples.iter().find(|x| x.0 == "km").unwrap().1
-        } else {
-            samples
-        };
-        let again = fit(&spec, samples, spec_seed);
-        let first = &s.trained.iter().find(|t| t.0 == method).unwrap().2;
-        assert_eq!(&again, first, "{method}");
+    let nominal = &s.nominal;
+    let t = unmodelled_truth(nominal, true, 1);
+    let mut rng = ChaCha8Rng::seed_from_u64(101);
+    let ident = measure_truth(&t, nominal, 100, &mut rng);
+    let opts = options(&[Method::KmRbf, Method::SkcmIwonn], 1, 0);
+    let again =
+        calibrate_with_training(nominal, &ident, &s.train, &s.valid, &opts, &|_| true).unwrap();
+    for method in ["km-rbf", "skcm-iwonn"] {
+        assert_eq!(
+            again.methods[method].stored_compensator.as_ref(),
+            Some(s.compensator(method)),
+            "{method}"
+        );
     }
 }
 
@@ -189,9 +225,8 @@ fn training_is_deterministic() {
 #[test]
 fn compensated_ik_solves_10000_targets() {
     let s = thousand();
-    let nn = &s.trained.iter().find(|t| t.0 == "skcm-nn").unwrap().2;
-    let plain = s.base("skcm").clone();
-    let comp = with(&plain, nn);
+    let plain = s.model("skcm");
+    let comp = s.model("skcm-nn");
     let mut rng = ChaCha8Rng::seed_from_u64(5);
     let qs = random_configurations(&s.nominal, 10_000, &mut rng);
     let mut rates = Vec::new();
@@ -228,70 +263,36 @@ fn compensated_ik_solves_10000_targets() {
     );
 }
 
-/// `auto` for one base: 5-fold cross-validation of each candidate on the
-/// training pool, then [`choose`]; returns the chosen compensator (trained on
-/// the whole pool) or `None`, and the cross-validations.
-fn auto(
-    samples: &[Sample],
-    candidates: &[(&str, CompensatorSpec)],
-    seed: u64,
-) -> (Option<StoredCompensator>, Vec<(String, CvStats)>) {
-    let cvs: Vec<(String, CvStats)> = candidates
-        .iter()
-        .map(|(name, spec)| {
-            let mut rng = ChaCha8Rng::seed_from_u64(seed);
-            let cv = cross_validate(samples, 5, &mut rng, |train_set| {
-                Ok::<_, ()>(fit(spec, train_set, seed).into_arc() as Arc<dyn Compensator>)
-            })
-            .unwrap();
-            (name.to_string(), cv)
-        })
-        .collect();
-    let choice = choose(&cvs, 0.05);
-    eprintln!("auto: {}", choice.reason);
-    let chosen = choice.chosen.map(|name| {
-        let spec = &candidates.iter().find(|c| c.0 == name).unwrap().1;
-        fit(spec, samples, seed)
-    });
-    (chosen, cvs)
-}
-
-/// 50 training poses: `auto` is never worse than its base by more than 2 % on
-/// the validation mean or max, although a plain network may well be.
+/// 50 training poses: `auto` is never worse than its base method by more than
+/// 2 % on the validation mean or max, although a plain network may well be.
 #[test]
 fn fifty_poses_auto_falls_back_to_the_base() {
-    let s = study(50, true, 2);
-    for (b, cands) in [
-        ("km", vec![("km-rbf", CompensatorSpec::km_rbf())]),
-        (
-            "skcm",
-            vec![
-                ("skcm-nn", CompensatorSpec::skcm_nn()),
-                ("skcm-iwonn", CompensatorSpec::skcm_iwonn()),
-                ("skcm-tlbonn", CompensatorSpec::skcm_tlbonn()),
-            ],
-        ),
-    ] {
-        let samples = &s.samples.iter().find(|x| x.0 == b).unwrap().1;
-        let base = errors(s.base(b), &s.valid);
-        for (method, bb, c) in &s.trained {
-            if *bb == b {
-                let e = errors(&with(s.base(b), c), &s.valid);
-                eprintln!(
-                    "{method} on 50 poses: validation mean {:.4} vs base {:.4} mm",
-                    e.mean_mm, base.mean_mm
-                );
-            }
-        }
-        let (chosen, _) = auto(samples, &cands, 2);
-        let got = match &chosen {
-            Some(c) => errors(&with(s.base(b), c), &s.valid),
-            None => base.clone(),
-        };
-        assert!(
-            got.mean_mm <= 1.02 * base.mean_mm && got.max_mm <= 1.02 * base.max_mm,
-            "auto on {b}: {got:?} vs base {base:?}"
+    let mut methods = BASES_AND_COMPENSATORS.to_vec();
+    methods.push(Method::Auto);
+    let s = study(50, true, 2, &methods, 5);
+    for (method, b, _) in hybrids() {
+        let e = s.validation(method);
+        let base = s.validation(b);
+        eprintln!(
+            "{method} on 50 poses: validation mean {:.4} vs base {:.4} mm, max {:.4} vs {:.4} mm",
+            e.mean_mm, base.mean_mm, e.max_mm, base.max_mm
         );
+    }
+    let auto = &s.report.methods["auto"];
+    let a = auto.auto.as_ref().unwrap();
+    eprintln!("auto: {}", a.reason);
+    let base = a.chosen.base().unwrap_or(a.chosen).name();
+    let got = s.validation("auto");
+    let want = s.validation(base);
+    assert!(
+        got.mean_mm <= 1.02 * want.mean_mm && got.max_mm <= 1.02 * want.max_mm,
+        "auto ({}) {got:?} vs its base {base} {want:?}",
+        a.chosen.name()
+    );
+    // Every candidate was cross-validated on the 50 training poses.
+    assert_eq!(a.candidates.len(), 4, "{:?}", a.candidates);
+    for c in &a.candidates {
+        assert_eq!(c.cross_validation.as_ref().unwrap().compensated.n, 50);
     }
 }
 
@@ -299,10 +300,10 @@ fn fifty_poses_auto_falls_back_to_the_base() {
 /// compensator makes the validation mean or max worse by more than 5 %.
 #[test]
 fn effects_off_no_compensator_hurts() {
-    let s = study(300, false, 3);
-    for (method, b, c) in &s.trained {
-        let base = errors(s.base(b), &s.valid);
-        let comp = errors(&with(s.base(b), c), &s.valid);
+    let s = study(300, false, 3, &BASES_AND_COMPENSATORS, 0);
+    for (method, b, _) in hybrids() {
+        let base = s.validation(b);
+        let comp = s.validation(method);
         eprintln!(
             "{method}, effects off: mean {:.4} -> {:.4}, max {:.4} -> {:.4} mm",
             base.mean_mm, comp.mean_mm, base.max_mm, comp.max_mm
@@ -314,11 +315,82 @@ fn effects_off_no_compensator_hurts() {
     }
 }
 
-fn real(path: &str) -> Vec<measure::MeasuredPose> {
-    let p = format!(
-        "{}/../shared/data/ur5-wam-laser-tracker/{path}",
-        env!("CARGO_MANIFEST_DIR")
+/// A compensator method whose base fails fails on its own (with the reason),
+/// the others are delivered; without a training pool the compensator trains
+/// on the identification poses; cancelling during training cancels the
+/// calibration.
+#[test]
+fn base_failure_pool_choice_and_cancellation() {
+    let mut nominal = preset("ys100").unwrap();
+    let t = unmodelled_truth(&nominal, true, 4);
+    let mut rng = ChaCha8Rng::seed_from_u64(104);
+    let ident = measure_truth(&t, &nominal, 60, &mut rng);
+    // A model without masses: SKCM (and so SKCM-NN) and the torque RBF cannot run.
+    for l in nominal.links.iter_mut() {
+        l.mass = 0.0;
+    }
+    nominal.payload.mass = 0.0;
+    let ident: Vec<Measurement> = ident
+        .into_iter()
+        .map(|m| Measurement {
+            payload_mass: 0.0,
+            ..m
+        })
+        .collect();
+    let opts = options(&[Method::Km, Method::SkcmNn, Method::KmRbf], 1, 0);
+    let r = calibrate(&nominal, &ident, &[], &opts, &|_| true).unwrap();
+    assert!(r.methods.contains_key("km"));
+    let failed: Vec<&str> = r.failed.iter().map(|f| f.method.name()).collect();
+    assert_eq!(failed, ["skcm-nn", "km-rbf"], "{:?}", r.failed);
+    assert!(r.failed.iter().all(|f| f.reason.contains("torque")));
+    // Compensator on KM, trained on the identification pool (no Q2) by auto.
+    let opts = options(&[Method::Auto], 1, 3);
+    let r = calibrate(&nominal, &ident, &[], &opts, &|_| true).unwrap();
+    let a = r.methods["auto"].auto.as_ref().unwrap();
+    assert_eq!(a.chosen, Method::Km, "{}", a.reason);
+    assert!(
+        a.reason.contains("skcm and km-rbf not tried"),
+        "{}",
+        a.reason
     );
+    assert!(a.candidates.is_empty(), "{:?}", a.candidates);
+    // Cancelled from the progress callback during SKCM-NN's training.
+    let nominal = preset("ys100").unwrap();
+    let ident = measure_truth(&t, &nominal, 60, &mut rng);
+    let opts = options(&[Method::SkcmNn], 1, 0);
+    let seen = std::sync::atomic::AtomicUsize::new(0);
+    let r = calibrate(&nominal, &ident, &[], &opts, &|p| {
+        if p.phase == "skcm-nn" && p.percent > 12.0 {
+            seen.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+            return false;
+        }
+        true
+    });
+    assert!(matches!(
+        r,
+        Err(robocal::identify::CalibrationError::Cancelled)
+    ));
+    assert_eq!(seen.load(std::sync::atomic::Ordering::SeqCst), 1);
+    // Without Q2 the compensator says it trained on the identification poses.
+    let r = calibrate(&nominal, &ident, &[], &opts, &|_| true).unwrap();
+    let c = r.methods["skcm-nn"].compensator.as_ref().unwrap();
+    assert_eq!(
+        (c.trained_on.as_str(), c.training_poses),
+        ("identification", 60)
+    );
+}
+
+/// The shared data directory: `../shared` next to the repository, or one
+/// level further up (a worktree in a subdirectory).
+fn real(path: &str) -> Vec<measure::MeasuredPose> {
+    let root = env!("CARGO_MANIFEST_DIR");
+    let p = [
+        format!("{root}/../shared/data/ur5-wam-laser-tracker/{path}"),
+        format!("{root}/../../shared/data/ur5-wam-laser-tracker/{path}"),
+    ]
+    .into_iter()
+    .find(|p| std::path::Path::new(p).exists())
+    .unwrap_or_else(|| panic!("{path}: the laser-tracker data is not in ../shared/data"));
     csv::parse_with(&std::fs::read_to_string(p).unwrap(), csv::DifSign::Plus).unwrap()
 }
 
@@ -344,66 +416,59 @@ fn wam() -> RobotModel {
     RobotModel::from_json(&desc.to_string()).unwrap()
 }
 
-/// Real data, grid for identification and training, the 20 random poses for
-/// validation: `auto` on top of KM is never worse than KM on the mean. The
-/// published hybrid (MDH + graph neural network) reaches UR5 0.155 mm and
-/// WAM 2.92 mm mean on the same 20 poses.
+/// Real data through the pipeline: the grid identifies the base and, with no
+/// training pool, trains the compensators (judged by 5-fold cross-validation
+/// inside it); the 20 random poses validate. `auto` is never worse than KM on
+/// the mean. Every method's figures are printed beside the published hybrid
+/// (MDH + graph neural network) on the same 20 poses: UR5 0.155 mm, WAM 2.92 mm.
 #[test]
 fn real_data_auto_never_worse_than_km() {
-    for (name, model, grid, random) in [
+    for (name, model, grid, random, published) in [
         (
             "UR5",
             ur5(),
             "UR5/3D_UR5_uncalibrated_grid_cleaned.csv",
             "UR5/3D_UR5_uncalibrated_random_cleaned.csv",
+            0.155,
         ),
         (
             "WAM",
             wam(),
             "WAM/3D_WAM_uncalibrated_grid_cleaned.csv",
             "WAM/3D_WAM_uncalibrated_random_cleaned.csv",
+            2.92,
         ),
     ] {
-        let train_set = measure::to_measurements(&model, &real(grid), 0.0);
+        let ident = measure::to_measurements(&model, &real(grid), 0.0);
         let valid = measure::to_measurements(&model, &real(random), 0.0);
-        let opts = CalibrationOptions {
-            methods: vec![Method::Km],
-            ..Default::default()
-        };
-        let r = calibrate(&model, &train_set, &valid, &opts, &|_| true).unwrap();
-        let km = base(&model, &r, "km");
-        let samples = km.samples(&train_set).unwrap();
-        let km_err = errors(&km, &valid);
-        let mut cands = vec![
-            ("km-nn", CompensatorSpec::skcm_nn()),
-            ("km-iwonn", CompensatorSpec::skcm_iwonn()),
-            ("km-tlbonn", CompensatorSpec::skcm_tlbonn()),
-        ];
-        if model.links.iter().any(|l| l.mass > 0.0) {
-            cands.push(("km-rbf", CompensatorSpec::km_rbf()));
-        }
-        for (method, spec) in &cands {
-            let e = errors(&with(&km, &fit(spec, &samples, 1)), &valid);
+        let mut methods = BASES_AND_COMPENSATORS.to_vec();
+        methods.push(Method::Auto);
+        let opts = options(&methods, 1, 5);
+        let r = calibrate(&model, &ident, &valid, &opts, &|_| true).unwrap();
+        for (m, rep) in &r.methods {
+            let v = &rep.validation.as_ref().unwrap().stats;
             eprintln!(
-                "{name} {method}: random-20 mean {:.4} mm, max {:.4} mm (KM {:.4} / {:.4})",
-                e.mean_mm, e.max_mm, km_err.mean_mm, km_err.max_mm
+                "{name} {m}: random-20 mean {:.4} mm, max {:.4} mm (published hybrid {published} mm mean)",
+                v.mean_mm, v.max_mm
             );
         }
-        let (chosen, _) = auto(&samples, &cands, 1);
-        let got = match &chosen {
-            Some(c) => errors(&with(&km, c), &valid),
-            None => km_err.clone(),
-        };
+        for f in &r.failed {
+            eprintln!("{name} {} failed: {}", f.method.name(), f.reason);
+        }
+        let km = &r.methods["km"].validation.as_ref().unwrap().stats;
+        let auto = &r.methods["auto"];
+        let got = &auto.validation.as_ref().unwrap().stats;
+        eprintln!("{name} auto: {}", auto.auto.as_ref().unwrap().reason);
         eprintln!(
             "{name} auto: {:.4} / {:.4} mm; KM {:.4} / {:.4} mm",
-            got.mean_mm, got.max_mm, km_err.mean_mm, km_err.max_mm
+            got.mean_mm, got.max_mm, km.mean_mm, km.max_mm
         );
         // The issue asks for "never worse on mean or max"; on the UR5 the
         // cross-validated choice can lower the mean and still raise the max of
         // the 20 random poses (README, "Compensators"): only the mean is held.
         assert!(
-            got.mean_mm <= km_err.mean_mm,
-            "{name}: auto {got:?} vs KM {km_err:?}"
+            got.mean_mm <= km.mean_mm,
+            "{name}: auto {got:?} vs KM {km:?}"
         );
     }
 }

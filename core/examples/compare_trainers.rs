@@ -58,7 +58,11 @@ fn main() {
         trainer: Trainer::Lm(LmTrainSettings::default()),
     };
     for (name, net, spec) in [
-        ("LM backprop", "6-20-3", CompensatorSpec::skcm_nn()),
+        (
+            "LM backprop",
+            "18-20-3 (q, sin q, cos q)",
+            CompensatorSpec::skcm_nn(),
+        ),
         ("LM backprop", "6-5-3", lm_small),
         ("IWO", "6-5-3", CompensatorSpec::skcm_iwonn()),
         ("TLBO", "6-5-3", CompensatorSpec::skcm_tlbonn()),

@@ -3,7 +3,8 @@
 //! identifiability report, or the same as JSON.
 
 use crate::identify::{
-    calibrate, CalibrationOptions, CalibrationReport, Method, PoseSource, PoseSources,
+    calibrate_with_training, CalibrationOptions, CalibrationReport, CompensatorOptions, Method,
+    PoseSource, PoseSources,
 };
 use crate::measure::{self, csv, SetRole};
 use crate::model::RobotModel;
@@ -20,7 +21,8 @@ pub struct CalibrateArgs {
     /// Identification measurements (CSV), one or more files (repeat the option
     /// or separate with commas). Each file is its own tracker session unless
     /// its rows carry a `session` column. Rows whose `set` column says
-    /// validation are moved to the validation set.
+    /// validation are moved to the validation set, rows that say training to
+    /// the compensator training pool.
     #[arg(long, required = true, num_args = 1.., value_delimiter = ',')]
     pub identify: Vec<String>,
     /// Validation measurements (CSV), never used for fitting. With as many
@@ -28,15 +30,28 @@ pub struct CalibrateArgs {
     /// otherwise to the first session (a `session` column overrides both).
     #[arg(long, num_args = 1.., value_delimiter = ',')]
     pub validate: Vec<String>,
-    /// Methods to run and compare, comma-separated: km, skcm, skcm-tlbo, skcm-payload.
+    /// Compensator training measurements (CSV, the Q2 pool), never used by the
+    /// model-based fit. Without them the compensators train on the
+    /// identification poses and are judged by k-fold cross-validation there.
+    /// Each row belongs to the session of its `session` column, else to the
+    /// first session.
+    #[arg(long, num_args = 1.., value_delimiter = ',')]
+    pub train: Vec<String>,
+    /// Methods to run and compare, comma-separated: km, skcm, skcm-tlbo,
+    /// skcm-payload, km-rbf, skcm-nn, skcm-iwonn, skcm-tlbonn, auto; `all` runs
+    /// every one and prints the comparison table (rows methods, columns sets).
     #[arg(long, default_value = "km,skcm,skcm-tlbo")]
     pub method: String,
     /// Payload mass [kg] for rows without a payload_kg column (default: the model's payload).
     #[arg(long)]
     pub payload_kg: Option<f64>,
-    /// Random seed of the TLBO search.
+    /// Random seed of the TLBO search and of the compensators' training.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// Folds of the compensators' cross-validation on the training pool
+    /// (0: none for the explicit methods; `auto` then uses 5).
+    #[arg(long, default_value_t = 5)]
+    pub cv_folds: usize,
     /// TLBO population and generations.
     #[arg(long, default_value_t = 50)]
     pub population: usize,
@@ -92,14 +107,17 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         row: k + 1,
         session: session.to_string(),
     };
-    let mut training = 0;
+    let (mut train_rows, mut train_src) = (Vec::new(), Vec::new());
     for (i, path) in a.identify.iter().enumerate() {
         let rows = read_rows(path, dif)?;
         csv::check_joint_count(&rows, model.dof()).with_context(|| path.clone())?;
         for (k, r) in rows.into_iter().enumerate() {
             let s = r.session.clone().unwrap_or_else(|| label(i));
             match r.set {
-                Some(SetRole::Training) => training += 1,
+                Some(SetRole::Training) => {
+                    train_src.push(source(path, k, &s));
+                    train_rows.push((s, r));
+                }
                 Some(SetRole::Validation) => {
                     valid_src.push(source(path, k, &s));
                     valid_rows.push((s, r));
@@ -111,10 +129,14 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
             }
         }
     }
-    if training > 0 && !a.json {
-        eprintln!(
-            "note: {training} rows marked `training` are for compensators and are not used here"
-        );
+    for path in &a.train {
+        let more = read_rows(path, dif)?;
+        csv::check_joint_count(&more, model.dof()).with_context(|| path.clone())?;
+        for (k, r) in more.into_iter().enumerate() {
+            let s = r.session.clone().unwrap_or_else(|| label(0));
+            train_src.push(source(path, k, &s));
+            train_rows.push((s, r));
+        }
     }
     let same_count = a.validate.len() == a.identify.len();
     for (j, path) in a.validate.iter().enumerate() {
@@ -138,6 +160,11 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
             "validation rows of tracker session `{s}` have no identification rows in that session, so its frame cannot be registered; measure identification poses in that session too"
         );
     }
+    if let Some((s, _)) = train_rows.iter().find(|(s, _)| !sessions.contains(s)) {
+        bail!(
+            "training rows of tracker session `{s}` have no identification rows in that session, so its frame cannot be registered; measure identification poses in that session too"
+        );
+    }
     let to_si = |rows: &[(String, measure::MeasuredPose)]| -> Vec<measure::Measurement> {
         rows.iter()
             .map(|(s, r)| {
@@ -149,6 +176,7 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     };
     let ident = to_si(&ident_rows);
     let valid = to_si(&valid_rows);
+    let training = to_si(&train_rows);
     let opts = CalibrationOptions {
         methods,
         register: !a.no_register,
@@ -157,10 +185,15 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
             generations: a.generations,
             seed: a.seed,
         },
+        compensator: CompensatorOptions {
+            seed: a.seed,
+            cv_folds: a.cv_folds,
+            ..Default::default()
+        },
         ..Default::default()
     };
     let verbose = !a.json;
-    let mut report = calibrate(&model, &ident, &valid, &opts, &|p| {
+    let mut report = calibrate_with_training(&model, &ident, &training, &valid, &opts, &|p| {
         if verbose && p.iteration == 0 {
             eprintln!("[{:5.1}%] {}", p.percent, p.phase);
         }
@@ -169,6 +202,7 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     report.pose_sources = PoseSources {
         identification: ident_src,
         validation: valid_src,
+        training: train_src,
     };
     report.session_names = sessions.clone();
     if let Some(path) = &a.html {
@@ -219,7 +253,7 @@ fn save_model(
         nominal: nominal.clone(),
         cell_from_base: report.tracker_to_base.inverse(),
         payload_kg: payload,
-        compensator: None,
+        compensator: chosen.stored_compensator.clone().map(|c| c.into_arc()),
     };
     let file = crate::compensate::CalibratedModelFile::from_compensated(
         &model,
@@ -282,6 +316,8 @@ pub fn render_report(r: &CalibrationReport) -> String {
             m.validation.as_ref().map(|v| &v.stats),
         );
     }
+    let _ = write!(s, "{}", render_comparison(r));
+    let _ = write!(s, "{}", render_compensators(r));
     let id = &r.identifiability;
     let _ = writeln!(
         s,
@@ -379,6 +415,137 @@ pub fn render_report(r: &CalibrationReport) -> String {
         let _ = writeln!(s, "\nFailed methods (the others above are complete)");
         for f in &r.failed {
             let _ = writeln!(s, "  {:<14} {}", method_label(f.method.name()), f.reason);
+        }
+    }
+    s
+}
+
+/// The seed-style comparison (rows = methods, columns = sets, mean / max in mm),
+/// the compensator training pool between identification and validation.
+pub fn render_comparison(r: &CalibrationReport) -> String {
+    let mut s = String::new();
+    let training = r.training_poses > 0;
+    let validation = r.validation_poses > 0;
+    let _ = write!(
+        s,
+        "\nComparison, mean / max (mm)\n{:<22} {:>19}",
+        "", "identification (Q1)"
+    );
+    if training {
+        let _ = write!(s, " {:>19}", "training (Q2)");
+    }
+    if validation {
+        let _ = write!(s, " {:>19}", "validation (Q3)");
+    }
+    let _ = writeln!(s);
+    let cell = |e: Option<&crate::identify::ErrorStats>| match e {
+        Some(e) => format!("{:>9.4} / {:<7.4}", e.mean_mm, e.max_mm),
+        None => format!("{:>19}", "-"),
+    };
+    let _ = write!(
+        s,
+        "{:<22} {}",
+        "Nominal robot model",
+        cell(Some(&r.nominal.identification.stats))
+    );
+    if training {
+        let _ = write!(s, " {}", cell(None));
+    }
+    if validation {
+        let _ = write!(
+            s,
+            " {}",
+            cell(r.nominal.validation.as_ref().map(|v| &v.stats))
+        );
+    }
+    let _ = writeln!(s);
+    for (name, m) in &r.methods {
+        let _ = write!(
+            s,
+            "{:<22} {}",
+            method_label(name),
+            cell(Some(&m.identification.stats))
+        );
+        if training {
+            let _ = write!(s, " {}", cell(m.training.as_ref().map(|v| &v.stats)));
+        }
+        if validation {
+            let _ = write!(s, " {}", cell(m.validation.as_ref().map(|v| &v.stats)));
+        }
+        let _ = writeln!(s);
+    }
+    s
+}
+
+/// Each compensator: network, training, cross-validation and its effect on
+/// every set; `auto`'s choice and why.
+pub fn render_compensators(r: &CalibrationReport) -> String {
+    let mut s = String::new();
+    let with: Vec<_> = r
+        .methods
+        .iter()
+        .filter(|(_, m)| m.compensator.is_some() || m.auto.is_some())
+        .collect();
+    if with.is_empty() {
+        return s;
+    }
+    let _ = writeln!(s, "\nCompensators (mean / max in mm, base -> compensated)");
+    let pair = |b: &crate::identify::ErrorStats, c: &crate::identify::ErrorStats| {
+        format!(
+            "{:.4} -> {:.4} / {:.4} -> {:.4}",
+            b.mean_mm, c.mean_mm, b.max_mm, c.max_mm
+        )
+    };
+    for (name, m) in with {
+        if let Some(a) = &m.auto {
+            let _ = writeln!(
+                s,
+                "  {:<14} chose {}: {}",
+                method_label(name),
+                method_label(a.chosen.name()),
+                a.reason
+            );
+        }
+        let Some(c) = &m.compensator else {
+            continue;
+        };
+        let _ = writeln!(
+            s,
+            "  {:<14} {} on {}, {} units, over {}; trained by {} on {} {} poses: {} epochs / iterations / generations, {} loss evaluations, stopped: {}; training RMS {:.4} mm",
+            method_label(name),
+            c.kind,
+            c.inputs,
+            c.units,
+            method_label(c.base.name()),
+            c.training.trainer,
+            c.training_poses,
+            c.trained_on,
+            c.training.epochs,
+            c.training.evaluations,
+            c.training.stop,
+            c.training.rms_mm
+        );
+        if let Some(cv) = &c.cross_validation {
+            let _ = writeln!(
+                s,
+                "  {:<14} cross-validated ({} folds on the {} poses): {}",
+                "",
+                cv.folds,
+                c.trained_on,
+                pair(&cv.base, &cv.compensated)
+            );
+        }
+        let _ = writeln!(
+            s,
+            "  {:<14} identification: {}",
+            "",
+            pair(&c.base_identification, &m.identification.stats)
+        );
+        if let (Some(b), Some(t)) = (&c.base_training, &m.training) {
+            let _ = writeln!(s, "  {:<14} training:       {}", "", pair(b, &t.stats));
+        }
+        if let (Some(b), Some(v)) = (&c.base_validation, &m.validation) {
+            let _ = writeln!(s, "  {:<14} validation:     {}", "", pair(b, &v.stats));
         }
     }
     s

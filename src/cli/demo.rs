@@ -57,7 +57,7 @@ pub fn ys100_simulation(
     let ident = measure::to_measurements(&nominal, &rows_id, payload);
     let valid = measure::to_measurements(&nominal, &rows_va, payload);
     let mut opts = CalibrationOptions {
-        methods: Method::ALL.to_vec(),
+        methods: Method::MODEL_BASED.to_vec(),
         ..Default::default()
     };
     opts.tlbo.seed = seed;

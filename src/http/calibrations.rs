@@ -34,7 +34,8 @@ fn calibration_not_found(robot: i64, id: i64) -> ApiError {
 #[derive(Debug, Default, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct StartCalibration {
-    /// Methods to run and compare: km, skcm, skcm-tlbo. Default km, skcm.
+    /// Methods to run and compare (see [`Method::parse`]; `all` for every one).
+    /// Default km, skcm.
     #[serde(
         default,
         deserialize_with = "present",
@@ -55,7 +56,15 @@ pub struct StartCalibration {
         skip_serializing_if = "Option::is_none"
     )]
     pub validation_set_ids: Option<Vec<i64>>,
-    /// Seed of every random choice (TLBO).
+    /// Sets that train the compensators (default: every set with role
+    /// training; none: the compensators train on the identification sets).
+    #[serde(
+        default,
+        deserialize_with = "present_ints",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub training_set_ids: Option<Vec<i64>>,
+    /// Seed of every random choice (TLBO, compensator training).
     #[serde(default, deserialize_with = "int")]
     pub seed: u64,
     /// TLBO population (skcm-tlbo), default 50.
@@ -176,7 +185,7 @@ pub async fn start(
     let method_list = match &req.methods {
         Some(m) if m.is_empty() => {
             return Err(ApiError::invalid(
-                "`methods` is empty; give one or more of km, skcm, skcm-tlbo",
+                "`methods` is empty; give one or more of km, skcm, skcm-tlbo, skcm-payload, km-rbf, skcm-nn, skcm-iwonn, skcm-tlbonn, auto",
             ))
         }
         Some(m) => m.join(","),
@@ -196,6 +205,7 @@ pub async fn start(
         methods,
         identification_set_ids: req.identification_set_ids.clone(),
         validation_set_ids: req.validation_set_ids.clone(),
+        training_set_ids: req.training_set_ids.clone(),
         register: req.register.unwrap_or(true),
         max_iterations: req.max_iterations.unwrap_or(defaults.lm.max_iterations),
         population,

@@ -9,6 +9,11 @@ pub fn method_label(key: &str) -> &str {
         "skcm" => "SKCM",
         "skcm-tlbo" => "SKCM-C (TLBO)",
         "skcm-payload" => "SKCM-payload",
+        "km-rbf" => "KM-RBF",
+        "skcm-nn" => "SKCM-NN",
+        "skcm-iwonn" => "SKCM-IWONN",
+        "skcm-tlbonn" => "SKCM-TLBONN",
+        "auto" => "auto",
         other => other,
     }
 }
@@ -69,6 +74,7 @@ mod tests {
         assert_eq!(num(f64::INFINITY, 3), "—");
         assert_eq!(param(-0.00001, "mm"), "0.0000");
         assert_eq!(method_label("skcm-tlbo"), "SKCM-C (TLBO)");
+        assert_eq!(method_label("skcm-tlbonn"), "SKCM-TLBONN");
         assert_eq!(method_label("new"), "new");
     }
 }

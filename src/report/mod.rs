@@ -61,6 +61,7 @@ pub fn render_html(title: &str, report: &serde_json::Value) -> String {
                 (page::header(title, r, &models))
                 (page::alerts(r))
                 (page::statistics(&models, best))
+                (page::compensators(&models))
                 (page::histograms(&models))
                 (page::per_axis(&models, best))
                 (page::positions(r, &models, best))

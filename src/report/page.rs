@@ -474,3 +474,68 @@ pub fn parameters(r: &ReportView, models: &[Model]) -> Markup {
         }
     }
 }
+
+/// The learned compensators: what each is, how it was trained, and its effect
+/// on every set (base → compensated), with `auto`'s choice.
+pub fn compensators(models: &[Model]) -> Markup {
+    let shown: Vec<(&Model, &MethodView)> = models
+        .iter()
+        .filter_map(|m| Some((m, m.method?)))
+        .filter(|(_, v)| v.compensator.is_some() || v.auto.is_some())
+        .collect();
+    if shown.is_empty() {
+        return html! {};
+    }
+    let gain = |b: Option<f64>, c: Option<f64>| match (b, c) {
+        (Some(b), Some(c)) if b > 0.0 => format!("{:+.1} %", 100.0 * (c - b) / b),
+        _ => "—".into(),
+    };
+    html! {
+        section #compensators {
+            h2 { "Compensators" }
+            p.note { "Each compensator learns what its model-based base leaves: base → compensated, "
+                "mean and max position error [mm]. Cross-validated figures are out-of-fold predictions "
+                "on the training pool." }
+            @for (m, v) in &shown {
+                h3 { (m.label) }
+                @if let Some(a) = &v.auto {
+                    p { strong { "Chose " (method_label(&a.chosen)) ": " } (a.reason) }
+                }
+                @if let Some(c) = &v.compensator {
+                    p { (c.kind) " on " (c.inputs) ", " (c.units.map_or("—".into(), |u| u.to_string()))
+                        " units, over " (method_label(&c.base)) "; trained by " (c.training.trainer)
+                        " on " (c.training_poses.map_or("—".into(), |n| n.to_string())) " "
+                        (c.trained_on) " poses, " (c.training.epochs.map_or("—".into(), |n| n.to_string()))
+                        " epochs / iterations / generations; stopped: " (c.training.stop) }
+                    table {
+                        thead { tr { th { "Set" } th.n { "base mean" } th.n { "mean" } th.n { "change" }
+                            th.n { "base max" } th.n { "max" } th.n { "change" } } }
+                        tbody {
+                            @let rows = [
+                                ("Cross-validated (training pool)", c.cross_validation.as_ref().map(|cv| (&cv.base, &cv.compensated))),
+                            ];
+                            @for (name, pair) in rows {
+                                @if let Some((b, a)) = pair {
+                                    tr { td { (name) }
+                                        td.n { (opt(b.mean_mm, 4)) } td.n { (opt(a.mean_mm, 4)) } td.n { (gain(b.mean_mm, a.mean_mm)) }
+                                        td.n { (opt(b.max_mm, 4)) } td.n { (opt(a.max_mm, 4)) } td.n { (gain(b.max_mm, a.max_mm)) } }
+                                }
+                            }
+                            @for (name, b, a) in [
+                                ("Identification", c.base_identification.as_ref(), v.sets.identification.as_ref()),
+                                ("Training", c.base_training.as_ref(), v.training.as_ref()),
+                                ("Validation", c.base_validation.as_ref(), v.sets.validation.as_ref()),
+                            ] {
+                                @if let (Some(b), Some(a)) = (b, a) {
+                                    tr { td { (name) }
+                                        td.n { (opt(b.mean_mm, 4)) } td.n { (opt(a.mean_mm, 4)) } td.n { (gain(b.mean_mm, a.mean_mm)) }
+                                        td.n { (opt(b.max_mm, 4)) } td.n { (opt(a.max_mm, 4)) } td.n { (gain(b.max_mm, a.max_mm)) } }
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}

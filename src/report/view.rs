@@ -7,7 +7,8 @@
 //! identifiability summary of another shape) is dropped, so the page shows
 //! what it can and says what is missing. The format version says which parts
 //! to expect: 1 (no `format_version` field) holds error norms only; 2 adds
-//! per-pose error vectors, positions, session names and pose sources.
+//! per-pose error vectors, positions, session names and pose sources; 3 the
+//! compensator training pool, the compensators and `auto`'s choice.
 
 use crate::identify::identifiability::IdentifiabilityReport;
 use crate::identify::{
@@ -141,6 +142,80 @@ pub struct MethodView {
     pub tlbo: Option<TlboView>,
     #[serde(default, deserialize_with = "lenient_list")]
     pub warnings: Vec<MethodWarning>,
+    /// Errors on the compensator training pool (format 3).
+    #[serde(default, deserialize_with = "lenient")]
+    pub training: Option<SetView>,
+    #[serde(default, deserialize_with = "lenient")]
+    pub compensator: Option<CompensatorView>,
+    #[serde(default, deserialize_with = "lenient")]
+    pub auto: Option<AutoView>,
+}
+
+/// Statistics only (mm).
+#[derive(Debug, Clone, Default, Deserialize)]
+pub struct StatsView {
+    #[serde(default)]
+    pub mean_mm: Option<f64>,
+    #[serde(default)]
+    pub max_mm: Option<f64>,
+}
+
+/// Cross-validated errors of the base and the compensated model.
+#[derive(Debug, Clone, Default, Deserialize)]
+pub struct CvView {
+    #[serde(default)]
+    pub folds: Option<usize>,
+    #[serde(default)]
+    pub base: StatsView,
+    #[serde(default)]
+    pub compensated: StatsView,
+}
+
+/// The training run of a compensator.
+#[derive(Debug, Clone, Default, Deserialize)]
+pub struct TrainView {
+    #[serde(default)]
+    pub trainer: String,
+    #[serde(default)]
+    pub epochs: Option<usize>,
+    #[serde(default)]
+    pub stop: String,
+}
+
+/// A compensator method's network, training and base errors (format 3).
+#[derive(Debug, Clone, Default, Deserialize)]
+pub struct CompensatorView {
+    #[serde(default)]
+    pub base: String,
+    #[serde(default)]
+    pub kind: String,
+    #[serde(default)]
+    pub units: Option<usize>,
+    #[serde(default)]
+    pub inputs: String,
+    #[serde(default)]
+    pub training: TrainView,
+    #[serde(default)]
+    pub trained_on: String,
+    #[serde(default)]
+    pub training_poses: Option<usize>,
+    #[serde(default, deserialize_with = "lenient")]
+    pub cross_validation: Option<CvView>,
+    #[serde(default)]
+    pub base_identification: Option<StatsView>,
+    #[serde(default)]
+    pub base_validation: Option<StatsView>,
+    #[serde(default)]
+    pub base_training: Option<StatsView>,
+}
+
+/// What `auto` chose and why.
+#[derive(Debug, Clone, Default, Deserialize)]
+pub struct AutoView {
+    #[serde(default)]
+    pub chosen: String,
+    #[serde(default)]
+    pub reason: String,
 }
 
 /// TLBO convergence (cost per generation).

@@ -6,7 +6,11 @@
 //! slots, then runs `identify::calibrate` on the blocking pool. Progress
 //! (phase, iteration, percent) goes to the store at most every
 //! `progress_interval`; cancellation sets a flag that the progress callback
-//! reads, as does the job's time budget. A successful job stores its report and
+//! reads (after every LM iteration, TLBO generation and compensator training
+//! epoch / iteration / generation), as does the job's time budget. Sets with
+//! role `training` (or those named in `training_set_ids`) train the
+//! compensator methods; a model version of a compensator method stores its
+//! compensator (model file format 2). A successful job stores its report and
 //! **one model version per method** that succeeded (a method that failed is
 //! listed with its reason; the others are kept); the best method (by
 //! validation mean, identification mean without validation) is activated only
@@ -19,8 +23,9 @@ use crate::db::{
     CalibrationRow, JobStatus, JobSummary, NewCalibration, NewVersion, SetRow, StoredRole,
 };
 use crate::identify::{
-    calibrate, CalibrationError, CalibrationOptions, CalibrationReport, FailedMethod, LmSettings,
-    Method, PoseSource, PoseSources, Progress, TlboSettings,
+    calibrate_with_training, CalibrationError, CalibrationOptions, CalibrationReport,
+    CompensatorOptions, FailedMethod, LmSettings, Method, PoseSource, PoseSources, Progress,
+    TlboSettings,
 };
 use crate::measure::Measurement;
 use crate::model::RobotModel;
@@ -41,6 +46,9 @@ pub struct StartCommand {
     pub identification_set_ids: Option<Vec<i64>>,
     /// Sets that validate; `None`: every set with role validation.
     pub validation_set_ids: Option<Vec<i64>>,
+    /// Sets that train the compensators (Q2); `None`: every set with role
+    /// training. Without any, compensators train on the identification sets.
+    pub training_set_ids: Option<Vec<i64>>,
     /// Register the tracker frame per session before fitting.
     pub register: bool,
     pub max_iterations: usize,
@@ -126,6 +134,11 @@ pub async fn start(
         StoredRole::Validation,
         "validation_set_ids",
     )?;
+    let train_sets = pick(
+        &cmd.training_set_ids,
+        StoredRole::Training,
+        "training_set_ids",
+    )?;
     if ident_sets.is_empty() {
         // The robot's data, not the request, is missing: a state conflict.
         return Err(ServiceError::Conflict(format!(
@@ -141,6 +154,14 @@ pub async fn start(
             s.id
         )));
     }
+    if let Some(s) = train_sets.iter().find(|t| {
+        ident_sets.iter().any(|i| i.id == t.id) || valid_sets.iter().any(|v| v.id == t.id)
+    }) {
+        return Err(ServiceError::Invalid(format!(
+            "measurement set {} is listed for training and for identification or validation; each set plays one role",
+            s.id
+        )));
+    }
     // Tracker sessions: identification sessions in order of first appearance.
     let mut sessions: Vec<String> = Vec::new();
     for s in &ident_sets {
@@ -153,6 +174,12 @@ pub async fn start(
         return Err(ServiceError::Conflict(format!(
             "validation set {} was measured in tracker session `{}`, which no identification set has, so its frame cannot be registered; measure identification poses in that session too",
             v.id, v.session
+        )));
+    }
+    if let Some(t) = train_sets.iter().find(|t| !sessions.contains(&t.session)) {
+        return Err(ServiceError::Conflict(format!(
+            "training set {} was measured in tracker session `{}`, which no identification set has, so its frame cannot be registered; measure identification poses in that session too",
+            t.id, t.session
         )));
     }
     let default_payload = cmd.payload_kg.unwrap_or(nominal.payload.mass);
@@ -189,9 +216,11 @@ pub async fn start(
     };
     let (ident, ident_sources) = load(&ident_sets).await?;
     let (valid, valid_sources) = load(&valid_sets).await?;
+    let (training, train_sources) = load(&train_sets).await?;
     let pose_sources = PoseSources {
         identification: ident_sources,
         validation: valid_sources,
+        training: train_sources,
     };
 
     let defaults = CalibrationOptions::default();
@@ -207,12 +236,18 @@ pub async fn start(
             generations: cmd.generations,
             seed: cmd.seed,
         },
+        compensator: CompensatorOptions {
+            seed: cmd.seed,
+            ..defaults.compensator.clone()
+        },
         ..defaults
     };
     let method_names: Vec<String> = cmd.methods.iter().map(|m| m.name().to_string()).collect();
     let ident_ids: Vec<i64> = ident_sets.iter().map(|s| s.id).collect();
     let valid_ids: Vec<i64> = valid_sets.iter().map(|s| s.id).collect();
+    let train_ids: Vec<i64> = train_sets.iter().map(|s| s.id).collect();
     let options = json!({
+        "training_set_ids": train_ids,
         "seed": cmd.seed,
         "population": opts.tlbo.population,
         "generations": opts.tlbo.generations,
@@ -238,6 +273,7 @@ pub async fn start(
         nominal,
         ident,
         valid,
+        training,
         session_names: sessions,
         pose_sources,
         opts,
@@ -257,6 +293,8 @@ struct Job {
     nominal: RobotModel,
     ident: Vec<Measurement>,
     valid: Vec<Measurement>,
+    /// Compensator training poses (Q2).
+    training: Vec<Measurement>,
     opts: CalibrationOptions,
     payload_kg: f64,
     /// Tracker session names in the order of the measurements' session index.
@@ -329,6 +367,7 @@ async fn run_job(state: AppState, job: Job) {
         nominal,
         ident,
         valid,
+        training,
         opts,
         session_names,
         pose_sources,
@@ -343,14 +382,21 @@ async fn run_job(state: AppState, job: Job) {
     let over_budget = Arc::new(AtomicBool::new(false));
     let over = over_budget.clone();
     let outcome = tokio::task::spawn_blocking(move || {
-        let report = calibrate(&nominal, &ident, &valid, &opts, &|p: &Progress| {
-            tx.send_replace(Some(p.clone()));
-            if std::time::Instant::now() > deadline {
-                over.store(true, Ordering::SeqCst);
-                return false;
-            }
-            !flag.load(Ordering::SeqCst)
-        });
+        let report = calibrate_with_training(
+            &nominal,
+            &ident,
+            &training,
+            &valid,
+            &opts,
+            &|p: &Progress| {
+                tx.send_replace(Some(p.clone()));
+                if std::time::Instant::now() > deadline {
+                    over.store(true, Ordering::SeqCst);
+                    return false;
+                }
+                !flag.load(Ordering::SeqCst)
+            },
+        );
         drop(tx);
         report.and_then(|mut r| {
             r.session_names = session_names;
@@ -485,7 +531,7 @@ fn versions_of(
             nominal: nominal.clone(),
             cell_from_base,
             payload_kg,
-            compensator: None,
+            compensator: m.stored_compensator.clone().map(|c| c.into_arc()),
         };
         let file = CalibratedModelFile::from_compensated(&cm, robot_name, method.name());
         if let Err(e) = file.to_compensated() {

@@ -426,3 +426,221 @@ async fn writes_racing_a_robot_delete_never_fail_with_500() {
     assert_eq!(db.integrity_check().await.unwrap(), "ok");
     eprintln!("race outcomes (calibrate, upload, rename, delete): {outcomes:?}");
 }
+
+/// A job with a compensator method: the training set (role `training`) trains
+/// it, the report says so, its model version stores the compensator, and
+/// solve over HTTP uses it (each answer checked through the compensated
+/// prediction of the downloaded file).
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn compensator_job_yields_a_version_whose_solve_uses_it() {
+    use rand::SeedableRng;
+    use robocal::compensate::CalibratedModelFile;
+    use robocal::measure::SetRole;
+    let t = setup_with(&[], 1).await;
+    let robot = t.create_robot("ys100").await;
+    let rid = robot.to_string();
+    t.upload_csv(robot, &simulated_csv(11, 40), "?role=identification")
+        .await;
+    let training = format!(
+        "# simulated YS100, training\n{}",
+        robocal::measure::csv::write(&simulated_rows(12, 60, Some(SetRole::Training)))
+    );
+    t.upload_csv(robot, &training, "?role=training").await;
+    t.upload_csv(robot, &simulated_csv(13, 20), "?role=validation")
+        .await;
+    let r = t
+        .post_json(
+            "/v1/robots/{id}/calibrations",
+            &[&rid],
+            json!({ "methods": ["skcm", "skcm-nn"], "seed": 3 }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::ACCEPTED, "{}", r.text());
+    let job = r.json()["id"].as_i64().unwrap();
+    assert_eq!(
+        r.json()["options"]["training_set_ids"]
+            .as_array()
+            .map(Vec::len),
+        Some(1)
+    );
+    let done = t
+        .wait_for(
+            robot,
+            job,
+            &["succeeded", "failed", "cancelled"],
+            Duration::from_secs(300),
+        )
+        .await;
+    assert_eq!(done["status"], "succeeded", "{done}");
+    let res = t
+        .get(
+            "/v1/robots/{id}/calibrations/{cid}/result",
+            &[&rid, &job.to_string()],
+        )
+        .await
+        .json();
+    let report = &res["report"];
+    assert_eq!(report["training_poses"], 60);
+    assert_eq!(
+        report["pose_sources"]["training"].as_array().map(Vec::len),
+        Some(60)
+    );
+    let nn = &report["methods"]["skcm-nn"];
+    let c = &nn["compensator"];
+    assert_eq!(c["trained_on"], "training", "{c}");
+    assert_eq!(c["training_poses"], 60);
+    assert_eq!(c["base"], "skcm");
+    assert_eq!(c["kind"], "mlp");
+    assert_eq!(c["training"]["trainer"], "lm");
+    assert_eq!(c["cross_validation"]["folds"], 5);
+    // Its base statistics are SKCM's own figures on the same poses.
+    assert_eq!(
+        c["base_validation"]["mean_mm"],
+        report["methods"]["skcm"]["validation"]["mean_mm"]
+    );
+    assert!(nn["training"]["mean_mm"].is_number());
+    let versions = res["versions"].as_array().unwrap();
+    assert_eq!(versions.len(), 2);
+    let nn_v = versions
+        .iter()
+        .find(|v| v["method"] == "skcm-nn")
+        .unwrap_or_else(|| panic!("{versions:?}"))["version"]
+        .as_i64()
+        .unwrap();
+    let r = t
+        .send(
+            "POST",
+            "/v1/robots/{id}/versions/{version}/activate",
+            &[&rid, &nn_v.to_string()],
+            "",
+            None,
+            vec![],
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let text = t
+        .get(
+            "/v1/robots/{id}/versions/{version}/model.json",
+            &[&rid, &nn_v.to_string()],
+        )
+        .await
+        .text();
+    let file = CalibratedModelFile::from_json(&text).unwrap();
+    assert_eq!(file.format, "robocal-calibrated-model/2");
+    assert!(
+        file.compensator.is_some(),
+        "the version lost its compensator"
+    );
+    let model = file.to_compensated().unwrap();
+    let nominal = robocal::model::preset("ys100").unwrap();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(21);
+    let qs = robocal::sim::random_configurations(&nominal, 8, &mut rng);
+    let targets: Vec<Value> = qs
+        .iter()
+        .map(|q| {
+            let p = model.predict(q).unwrap().p * 1e3;
+            json!({ "x": p.x, "y": p.y, "z": p.z })
+        })
+        .collect();
+    let r = t
+        .post_json(
+            "/v1/robots/{id}/solve",
+            &[&rid],
+            json!({ "targets": targets, "position_only": true }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let s = r.json();
+    assert_eq!(s["method"], "skcm-nn");
+    let mut solved = 0;
+    for (res, tgt) in s["results"].as_array().unwrap().iter().zip(&targets) {
+        if res["status"] != "ok" {
+            continue;
+        }
+        solved += 1;
+        let joints: Vec<f64> = serde_json::from_value(res["joints_deg"].clone()).unwrap();
+        let q = nominal
+            .joints_from_controller(&joints.iter().map(|d| d.to_radians()).collect::<Vec<_>>());
+        let reached = model.predict(&q).unwrap().p * 1e3;
+        let want = nalgebra::Vector3::new(
+            tgt["x"].as_f64().unwrap(),
+            tgt["y"].as_f64().unwrap(),
+            tgt["z"].as_f64().unwrap(),
+        );
+        assert!(
+            (reached - want).norm() < 1e-3,
+            "compensated prediction misses by {} mm",
+            (reached - want).norm()
+        );
+    }
+    assert!(solved >= 7, "{s}");
+}
+
+/// Cancelling a job while a compensator trains (SKCM-NN by LM on 1000
+/// training poses, progress per epoch) ends it promptly.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn cancelling_a_compensator_job_during_training_takes_effect_quickly() {
+    use robocal::measure::SetRole;
+    let t = setup_with(&[], 1).await;
+    let robot = t.create_robot("ys100").await;
+    let rid = robot.to_string();
+    t.upload_csv(robot, &simulated_csv(5, 30), "?role=identification")
+        .await;
+    let training = format!(
+        "# simulated YS100, training\n{}",
+        robocal::measure::csv::write(&simulated_rows(6, 1000, Some(SetRole::Training)))
+    );
+    t.upload_csv(robot, &training, "?role=training").await;
+    let r = t
+        .post_json(
+            "/v1/robots/{id}/calibrations",
+            &[&rid],
+            json!({ "methods": ["skcm-nn"] }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::ACCEPTED, "{}", r.text());
+    let job = r.json()["id"].as_i64().unwrap();
+    let start = Instant::now();
+    loop {
+        let j = t
+            .get(
+                "/v1/robots/{id}/calibrations/{cid}",
+                &[&rid, &job.to_string()],
+            )
+            .await
+            .json();
+        // Past the base fit (the first 5 % of the method's span): training.
+        if j["progress"]["phase"] == "skcm-nn" && j["progress"]["percent"].as_f64() > Some(15.0) {
+            break;
+        }
+        assert!(start.elapsed() < Duration::from_secs(120), "{j}");
+        tokio::time::sleep(Duration::from_millis(10)).await;
+    }
+    let r = t
+        .send(
+            "POST",
+            "/v1/robots/{id}/calibrations/{cid}/cancel",
+            &[&rid, &job.to_string()],
+            "",
+            None,
+            vec![],
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::ACCEPTED);
+    let requested = seconds_of_day(r.json()["updated_at"].as_str().unwrap());
+    let j = t
+        .wait_for(
+            robot,
+            job,
+            &["cancelled", "failed", "succeeded"],
+            Duration::from_secs(60),
+        )
+        .await;
+    assert_eq!(j["status"], "cancelled", "{j}");
+    let ended = seconds_of_day(j["finished_at"].as_str().unwrap());
+    let latency = ended - requested;
+    assert!(
+        (0.0..5.0).contains(&latency),
+        "cancellation took {latency:.3} s"
+    );
+}

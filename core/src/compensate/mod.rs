@@ -39,7 +39,7 @@ pub use file::{
     CALIBRATED_MODEL_FORMAT,
 };
 pub use mlp::{Features, Mlp, Normalisation};
-pub use rbf::{train_rbf, OutputFrame, Rbf, RbfReport, RbfSettings};
+pub use rbf::{train_rbf, train_rbf_with_progress, OutputFrame, Rbf, RbfReport, RbfSettings};
 pub use select::{choose, cross_validate, Choice, CvStats};
 pub use synthetic::{synthetic_calibration, unmodelled_truth, SyntheticErrors};
 pub use train::{

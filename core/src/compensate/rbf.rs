@@ -188,7 +188,7 @@ fn local_targets(samples: &[Sample], frame: OutputFrame) -> Vec<Vector3<f64>> {
 }
 
 /// Called after each growth step with (units, output weights, centre indices).
-type GrowStep<'a> = dyn FnMut(usize, &[f64], &[usize]) + 'a;
+type GrowStep<'a> = dyn FnMut(usize, &[f64], &[usize]) -> bool + 'a;
 
 /// Grows a network on `(inputs, targets)` (normalised torques, local residuals)
 /// and calls `each(units, weights, centres)` after every growth step (0 units
@@ -220,8 +220,7 @@ fn grow(
             }
             flat[r * (k + 1) + k] = w[(0, r)];
         }
-        each(k, &flat, &centres);
-        if k >= max_neurons || k >= n {
+        if !each(k, &flat, &centres) || k >= max_neurons || k >= n {
             return;
         }
         let fitted = &design * &w;
@@ -272,6 +271,20 @@ pub fn train_rbf(
     settings: &RbfSettings,
     rng: &mut impl Rng,
 ) -> Result<(Rbf, RbfReport), String> {
+    train_rbf_with_progress(samples, settings, rng, &mut |_, _| true)
+        .map(|r| r.expect("never cancelled"))
+}
+
+/// [`train_rbf`] with `progress(step, held-out RMS [mm])` after every unit
+/// added, `step` counting the units of every candidate spread and then of the
+/// final network (at most `max_neurons + 1` per spread and once more); it
+/// returns false to cancel, which gives `Ok(None)`.
+pub fn train_rbf_with_progress(
+    samples: &[Sample],
+    settings: &RbfSettings,
+    rng: &mut impl Rng,
+    progress: &mut dyn FnMut(usize, f64) -> bool,
+) -> Result<Option<(Rbf, RbfReport)>, String> {
     if samples.len() < 5 {
         return Err(format!(
             "the RBF needs at least 5 training poses, got {}",
@@ -299,6 +312,8 @@ pub fn train_rbf(
     let fit_in: Vec<Vec<f64>> = fit.iter().map(|&i| inputs[i].clone()).collect();
     let fit_y: Vec<Vector3<f64>> = fit.iter().map(|&i| targets[i]).collect();
     let mut best = (f64::INFINITY, settings.spreads[0], 0usize);
+    let mut go = true;
+    let mut step = 0usize;
     for &spread in &settings.spreads {
         grow(
             &fit_in,
@@ -315,8 +330,14 @@ pub fn train_rbf(
                 if mse < best.0 {
                     best = (mse, spread, k);
                 }
+                step += 1;
+                go = progress(step, mse.sqrt() * 1e3);
+                go
             },
         );
+        if !go {
+            return Ok(None);
+        }
     }
     let (mse, spread, neurons) = best;
     let mut out = None;
@@ -324,16 +345,22 @@ pub fn train_rbf(
         if k == neurons {
             out = Some(network(dof, frame, &norm, spread, &inputs, w, centres));
         }
+        step += 1;
+        go = progress(step, mse.sqrt() * 1e3);
+        go
     });
+    if !go {
+        return Ok(None);
+    }
     let net = out.ok_or("the RBF least-squares problem could not be solved")?;
-    Ok((
+    Ok(Some((
         net,
         RbfReport {
             spread,
             neurons,
             holdout_rms_mm: mse.sqrt() * 1e3,
         },
-    ))
+    )))
 }
 
 #[cfg(test)]

@@ -21,16 +21,19 @@
 //! "no compensation"), TLBO's learners with output weights in `[−0.05, 0.05]`
 //! (TLBO moves learners by their differences and needs diversity). LM counts
 //! the null network as a final early-stopping candidate; IWO and TLBO hold out
-//! 15 % of the samples the same way and return the null network when their
-//! result does not beat it there (with nothing but noise to learn, a
-//! compensator should not add its own). The seed gives no
+//! 15 % of the samples the same way and return the null network unless their
+//! result beats it there significantly: the mean of the paired per-sample loss
+//! gains must exceed twice its standard error (with nothing but noise to
+//! learn, a compensator should not add its own; IWO's mean + 0.7·max loss
+//! otherwise buys small chance gains on the held-out mean that do not carry
+//! over to new poses). The seed gives no
 //! iteration counts for
 //! IWO and TLBO; the defaults below give both about 25 000 loss evaluations.
 //! Every random draw comes from the injected seeded generator; the result is
 //! bit-for-bit reproducible (parallel evaluation keeps a fixed reduction order).
 
 use super::mlp::{Features, Mlp, Normalisation, Shape};
-use super::rbf::{train_rbf, RbfReport, RbfSettings};
+use super::rbf::{train_rbf_with_progress, RbfReport, RbfSettings};
 use super::{Sample, StoredCompensator};
 use crate::identify::tlbo::{self, TlboSettings};
 use nalgebra::{DMatrix, DVector};
@@ -416,13 +419,33 @@ fn null_guard(data: &Prepared, hold: &[usize], w: Vec<f64>, stop: &mut String) -
         return w;
     }
     let null = null_network(data, &w);
-    if data.mean_loss(&null, hold) <= data.mean_loss(&w, hold) {
-        stop.push_str("; not better than the mean residual on the held-out part: null network");
+    let (mut a, mut b) = (Vec::new(), Vec::new());
+    data.sample_losses(&null, hold, &mut a);
+    data.sample_losses(&w, hold, &mut b);
+    // Paired per-sample gains of the network over the null network on the
+    // held-out part; kept only when their mean exceeds twice its standard
+    // error (module docs).
+    let d: Vec<f64> = a.iter().zip(&b).map(|(x, y)| x - y).collect();
+    let n = d.len() as f64;
+    let mean = d.iter().sum::<f64>() / n;
+    let se = if d.len() > 1 {
+        (d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt()
+    } else {
+        0.0
+    };
+    if mean <= GUARD_STANDARD_ERRORS * se {
+        stop.push_str(&format!(
+            "; not better than the mean residual on the held-out part by {GUARD_STANDARD_ERRORS} standard errors: null network"
+        ));
         null
     } else {
         w
     }
 }
+
+/// Standard errors by which an IWO or TLBO network must beat the null network
+/// on the held-out samples (module docs).
+const GUARD_STANDARD_ERRORS: f64 = 2.0;
 
 fn lm(
     data: &Prepared,
@@ -684,11 +707,10 @@ pub fn train(
     }
     match spec {
         CompensatorSpec::Rbf(settings) => {
-            let (net, rep) = train_rbf(samples, settings, rng).map_err(TrainError::Data)?;
+            let (net, rep) = train_rbf_with_progress(samples, settings, rng, progress)
+                .map_err(TrainError::Data)?
+                .ok_or(TrainError::Cancelled)?;
             let stored = StoredCompensator::Rbf(net);
-            if !progress(rep.neurons, rep.holdout_rms_mm) {
-                return Err(TrainError::Cancelled);
-            }
             Ok((
                 stored.clone(),
                 TrainReport {

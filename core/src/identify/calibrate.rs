@@ -1,5 +1,6 @@
 //! The calibration pipeline in phases: checks → registration → nominal errors
-//! → identifiability → methods (each on its own, `methods`) → report.
+//! → identifiability → methods (each on its own, `methods`; compensators and
+//! `auto` in `hybrid`) → report.
 //!
 //! Frames: measured positions arrive in the measurement (tracker) frame of their
 //! session; each session is registered in closed form onto the nominal model's
@@ -18,8 +19,8 @@ use super::checks::{
     check_set, fixed_params, generic_rank, gravity_problem, joint_range_detail, stacked_jacobian,
     CalibrationError,
 };
+use super::hybrid::{compensate_report, run_auto, run_compensated, Cache, Hybrid};
 use super::identifiability::{self, IdentifiabilityReport};
-use super::least_squares::Fit;
 use super::methods::{Context, MethodError, MethodFit};
 use super::options::{CalibrationOptions, Method, Progress};
 use super::registration::register;
@@ -77,10 +78,28 @@ fn register_sessions(
             });
         }
     }
-    let to_base = |data: &[Measurement]| -> Vec<Measurement> {
+    let mut r = Registered {
+        ident: Vec::new(),
+        valid: Vec::new(),
+        sessions,
+        tracker_to_base: regs,
+        reports,
+    };
+    r.ident = r.to_base(identification);
+    r.valid = r.to_base(validation);
+    Ok(r)
+}
+
+impl Registered {
+    /// Measurements mapped into the registered base frame of their session.
+    fn to_base(&self, data: &[Measurement]) -> Vec<Measurement> {
         data.iter()
             .map(|m| {
-                let t = regs.get(m.session).copied().unwrap_or_default();
+                let t = self
+                    .tracker_to_base
+                    .get(m.session)
+                    .copied()
+                    .unwrap_or_default();
                 Measurement {
                     position: t.transform_point(&m.position),
                     orientation: m.orientation.map(|r| t.r * r),
@@ -88,14 +107,7 @@ fn register_sessions(
                 }
             })
             .collect()
-    };
-    Ok(Registered {
-        ident: to_base(identification),
-        valid: to_base(validation),
-        sessions,
-        tracker_to_base: regs,
-        reports,
-    })
+    }
 }
 
 /// The kept geometric and compliance parameters and the identifiability report.
@@ -175,15 +187,35 @@ fn identifiability_phase(
 fn weight(m: Method) -> f64 {
     match m {
         Method::SkcmTlbo => 8.0,
-        Method::SkcmPayload => 2.0,
+        Method::SkcmPayload | Method::KmRbf => 2.0,
+        Method::SkcmNn | Method::SkcmIwonn | Method::SkcmTlbonn => 6.0,
+        Method::Auto => 12.0,
         _ => 1.0,
     }
 }
 
-/// Runs the calibration. `progress` returns false to cancel.
+/// Runs the calibration without a compensator training pool. `progress`
+/// returns false to cancel.
 pub fn calibrate(
     nominal: &RobotModel,
     identification: &[Measurement],
+    validation: &[Measurement],
+    opts: &CalibrationOptions,
+    progress: &dyn Fn(&Progress) -> bool,
+) -> Result<CalibrationReport, CalibrationError> {
+    calibrate_with_training(nominal, identification, &[], validation, opts, progress)
+}
+
+/// Runs the calibration with the data roles of DESIGN "Data roles": Q1
+/// `identification` fits the model-based part, Q2 `training` trains the
+/// compensators (empty: they train on Q1 and are judged by k-fold
+/// cross-validation inside it), Q3 `validation` is never fitted. Training
+/// poses must come from tracker sessions that have identification poses.
+/// `progress` returns false to cancel.
+pub fn calibrate_with_training(
+    nominal: &RobotModel,
+    identification: &[Measurement],
+    training: &[Measurement],
     validation: &[Measurement],
     opts: &CalibrationOptions,
     progress: &dyn Fn(&Progress) -> bool,
@@ -204,9 +236,22 @@ pub fn calibrate(
         return Err(CalibrationError::NoData);
     }
     check_set(nominal, identification, "identification")?;
+    check_set(nominal, training, "training")?;
     check_set(nominal, validation, "validation")?;
+    if let Some((index, m)) = training
+        .iter()
+        .enumerate()
+        .find(|(_, m)| !identification.iter().any(|i| i.session == m.session))
+    {
+        return Err(CalibrationError::UnregisteredSession {
+            set: "training",
+            index,
+            session: m.session,
+        });
+    }
     say("registration", 0, 0.0, None)?;
     let reg = register_sessions(nominal, identification, validation, opts)?;
+    let train_base = reg.to_base(training);
     let id_frames = vec![Pose::identity(); reg.sessions];
     let nominal_errors = NominalErrors {
         identification: SetErrors::of(nominal, &id_frames, &reg.ident),
@@ -220,12 +265,12 @@ pub fn calibrate(
         });
     }
 
-    // Compliance methods fail fast when gravity loads no joint.
+    // Methods that need gravity torques fail fast when gravity loads no joint.
     let mut failed: Vec<FailedMethod> = Vec::new();
     let gravity = gravity_problem(nominal, &reg.ident);
     let mut to_run: Vec<Method> = Vec::new();
     for m in &opts.methods {
-        match (&gravity, m.uses_compliance()) {
+        match (&gravity, m.uses_torques()) {
             (Some(why), true) => failed.push(FailedMethod {
                 method: *m,
                 reason: why.clone(),
@@ -238,7 +283,9 @@ pub fn calibrate(
     }
 
     say("identifiability", 0, 5.0, None)?;
-    let with_compliance = to_run.iter().any(|m| m.uses_compliance());
+    let with_compliance = to_run
+        .iter()
+        .any(|m| m.uses_compliance() || (*m == Method::Auto && gravity.is_none()));
     let idf = identifiability_phase(nominal, &reg, with_compliance, opts)?;
     let mut ident_report = idf.report;
     let mut start = nominal.clone();
@@ -255,12 +302,17 @@ pub fn calibrate(
         kept_c: idf.kept_c,
         opts,
     };
+    // The compensators' training pool: Q2, else Q1.
+    let (pool, pool_name): (&[Measurement], &str) = if train_base.is_empty() {
+        (&reg.ident, "identification")
+    } else {
+        (&train_base, "training")
+    };
 
     let total: f64 = to_run.iter().map(|m| weight(*m)).sum();
     let mut done = 0.0;
     let mut methods = BTreeMap::new();
-    let mut km_fit: Option<Fit> = None;
-    let mut skcm_fit: Option<Fit> = None;
+    let mut cache = Cache::default();
     for method in &to_run {
         let span = 90.0 * weight(*method) / total;
         let base_pct = 10.0 + 90.0 * done / total;
@@ -274,21 +326,23 @@ pub fn calibrate(
                 rms_mm: Some(rms),
             })
         };
-        let outcome: Result<MethodFit, MethodError> = match method {
-            Method::Km => ctx.km(&mut lm_progress).map_err(Into::into).map(|f| {
-                km_fit = Some(f.clone());
-                MethodFit {
-                    ids: ctx.kept_geo.clone(),
-                    fit: f,
-                    tlbo: None,
-                    not_identified: vec![],
-                }
-            }),
-            Method::Skcm => ctx.skcm(&mut lm_progress).inspect(|mf| {
-                skcm_fit = Some(mf.fit.clone());
-            }),
+        let mut frac_progress = |f: f64, it: usize, loss: Option<f64>| {
+            progress(&Progress {
+                phase: name.to_string(),
+                iteration: it,
+                percent: base_pct + span * f.clamp(0.0, 1.0),
+                rms_mm: loss,
+            })
+        };
+        let plain = |mf: MethodFit| Hybrid {
+            base: mf,
+            compensator: None,
+            auto: None,
+        };
+        let outcome: Result<Hybrid, MethodError> = match method {
+            Method::Km | Method::Skcm => cache.base_fit(&ctx, *method, &mut lm_progress).map(plain),
             Method::SkcmTlbo => {
-                let warm = match &km_fit {
+                let warm = match &cache.km {
                     Some(f) => f.clone(),
                     None => ctx
                         .km(&mut |_, _| true)
@@ -303,18 +357,27 @@ pub fn calibrate(
                         rms_mm: Some(best.sqrt()),
                     })
                 })
+                .map(plain)
             }
-            Method::SkcmPayload => {
-                let skcm = match &skcm_fit {
-                    Some(f) => Ok(f.clone()),
-                    None => ctx.skcm(&mut |_, _| true).map(|mf| mf.fit),
-                };
-                skcm.and_then(|s| ctx.skcm_payload(&s, &mut lm_progress))
+            Method::SkcmPayload => cache
+                .base_fit(&ctx, Method::Skcm, &mut |_, _| true)
+                .and_then(|s| ctx.skcm_payload(&s.fit, &mut lm_progress))
+                .map(plain),
+            Method::KmRbf | Method::SkcmNn | Method::SkcmIwonn | Method::SkcmTlbonn => {
+                run_compensated(&ctx, &mut cache, *method, pool, &mut frac_progress)
             }
+            Method::Auto => run_auto(
+                &ctx,
+                &mut cache,
+                pool,
+                pool_name,
+                gravity.as_deref(),
+                &mut frac_progress,
+            ),
         };
         done += weight(*method);
-        let mf = match outcome {
-            Ok(mf) => mf,
+        let h = match outcome {
+            Ok(h) => h,
             Err(MethodError::Cancelled) => return Err(CalibrationError::Cancelled),
             Err(MethodError::Failed(reason)) => {
                 failed.push(FailedMethod {
@@ -325,6 +388,7 @@ pub fn calibrate(
                 continue;
             }
         };
+        let mf = h.base;
         let uncertainty_source =
             *method == Method::Skcm || (*method == Method::Km && !to_run.contains(&Method::Skcm));
         if uncertainty_source {
@@ -338,8 +402,25 @@ pub fn calibrate(
                 ident_report.correlated_pairs = pairs;
             }
         }
+        let frames = mf.fit.session_frames.clone();
         match ctx.report(*method, mf) {
-            Ok(r) => {
+            Ok(mut r) => {
+                if !train_base.is_empty() {
+                    r.training = Some(SetErrors::of(&r.calibrated, &frames, &train_base));
+                }
+                if let Some((m, t)) = &h.compensator {
+                    let base = m.base().expect("a compensator method");
+                    compensate_report(
+                        &mut r,
+                        base,
+                        &frames,
+                        t,
+                        &reg.ident,
+                        &train_base,
+                        &reg.valid,
+                    );
+                }
+                r.auto = h.auto;
                 methods.insert(name.to_string(), r);
             }
             Err(reason) => failed.push(FailedMethod {
@@ -357,6 +438,7 @@ pub fn calibrate(
         robot: nominal.name.clone(),
         identification_poses: identification.len(),
         validation_poses: validation.len(),
+        training_poses: training.len(),
         registration: reg.reports,
         identifiability: ident_report,
         nominal: nominal_errors,

@@ -62,6 +62,12 @@ pub enum CalibrationError {
         index: usize,
         source: KinematicsError,
     },
+    #[error("{set} measurement {index}: its tracker session has no identification poses, so its frame cannot be registered; measure identification poses in that session too")]
+    UnregisteredSession {
+        set: &'static str,
+        index: usize,
+        session: usize,
+    },
     #[error("calibration cancelled")]
     Cancelled,
     #[error("no method succeeded: {}", failed.iter().map(|f| format!("{}: {}", f.method.name(), f.reason)).collect::<Vec<_>>().join("; "))]

@@ -70,6 +70,7 @@ pub(crate) struct Context<'a> {
 }
 
 /// A method's fit before it is reported.
+#[derive(Clone)]
 pub(crate) struct MethodFit {
     pub fit: Fit,
     pub ids: Vec<ParamId>,
@@ -350,6 +351,7 @@ impl Context<'_> {
             solver: fitted.report.clone(),
             identification: id_err,
             validation: va_err,
+            training: None,
             parameters: estimates(
                 self.nominal,
                 &fitted.model,
@@ -361,7 +363,10 @@ impl Context<'_> {
             tlbo,
             warnings,
             model: description,
+            compensator: None,
+            auto: None,
             calibrated: fitted.model,
+            stored_compensator: None,
         })
     }
 }

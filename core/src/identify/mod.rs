@@ -2,13 +2,15 @@
 //! analysis, and the model-based methods of the seed: KM (§2.2, eqs. 2.3–2.4),
 //! SKCM (§2.3, eq. 2.8; closed loop eq. 4.17) and SKCM-C by TLBO (ch. 7,
 //! eqs. 7.7–7.12), and SKCM with the payload's centre of mass (beyond the
-//! seed). Statistics per set follow DESIGN "Data roles".
+//! seed); the compensator methods KM-RBF, SKCM-NN, SKCM-IWONN, SKCM-TLBONN
+//! (ch. 3–6) and `auto` on top of them (`hybrid`). Statistics per set follow DESIGN "Data roles".
 //!
 //! Units: SI inside; reports speak millimetres and degrees (compliance in
 //! rad/(N·m), stiffness in N·m/rad).
 
 pub mod calibrate;
 pub mod checks;
+mod hybrid;
 pub mod identifiability;
 pub mod least_squares;
 pub mod methods;
@@ -19,15 +21,16 @@ pub mod report;
 pub mod stats;
 pub mod tlbo;
 
-pub use calibrate::calibrate;
+pub use calibrate::{calibrate, calibrate_with_training};
 pub use checks::CalibrationError;
 pub use identifiability::{DropKind, IdentifiabilityReport, IdentifiabilitySettings};
 pub use least_squares::{LmReport, LmSettings, StopReason};
-pub use options::{CalibrationOptions, Method, Progress};
+pub use options::{CalibrationOptions, CompensatorOptions, Method, Progress};
 pub use registration::{register, Registration};
 pub use report::{
-    CalibrationReport, FailedMethod, MethodReport, MethodWarning, ParamEstimate, PoseSource,
-    PoseSources, SetErrors, WarningKind, REPORT_FORMAT_VERSION,
+    AutoCandidate, AutoSummary, CalibrationReport, CompensatorSummary, FailedMethod, MethodReport,
+    MethodWarning, ParamEstimate, PoseSource, PoseSources, SetErrors, WarningKind,
+    REPORT_FORMAT_VERSION,
 };
 pub use stats::ErrorStats;
 pub use tlbo::TlboSettings;

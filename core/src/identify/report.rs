@@ -10,18 +10,21 @@ use super::identifiability::IdentifiabilityReport;
 use super::least_squares::LmReport;
 use super::options::Method;
 use super::stats::ErrorStats;
+use crate::compensate::{Compensator, CvStats, StoredCompensator, TrainReport};
 use crate::measure::Measurement;
 use crate::model::description::PoseDescription;
 use crate::model::params::ParamUnit;
 use crate::model::pose::Pose;
 use crate::model::{ModelDescription, ParamId, RobotModel};
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, Vector3};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
 /// Version of the serialised [`CalibrationReport`]. 1: no version field, error
-/// norms only; 2: per-pose error vectors and positions, pose sources.
-pub const REPORT_FORMAT_VERSION: u32 = 2;
+/// norms only; 2: per-pose error vectors and positions, pose sources; 3: the
+/// compensator training pool (`training_poses`, `pose_sources.training`), the
+/// compensator summary of each compensator method and `auto`'s choice.
+pub const REPORT_FORMAT_VERSION: u32 = 3;
 
 /// Errors of one set: statistics plus the per-pose error norms (mm), and
 /// (format 2) the per-pose error vectors `measured − predicted` and the
@@ -52,11 +55,24 @@ impl SetErrors {
     /// Errors of `model` on `data` with the session frames applied: norms,
     /// vectors and measured positions (eq. 2.3's residual, in mm).
     pub fn of(model: &RobotModel, frames: &[Pose], data: &[Measurement]) -> Self {
+        Self::of_compensated(model, None, frames, data)
+    }
+
+    /// [`SetErrors::of`] through the compensated prediction
+    /// `FK(q + c∘τ) + NN(q, τ)` (registered base frame, then the session frame),
+    /// τ the gravity torques of `model` at the commanded joints with the pose's
+    /// payload.
+    pub fn of_compensated(
+        model: &RobotModel,
+        compensator: Option<&dyn Compensator>,
+        frames: &[Pose],
+        data: &[Measurement],
+    ) -> Self {
         let mut xyz = Vec::with_capacity(data.len());
         let mut norms = Vec::with_capacity(data.len());
         for m in data {
-            match super::least_squares::predict(model, m) {
-                Some((p, _)) => {
+            match predict_compensated(model, compensator, m) {
+                Some(p) => {
                     let e = frames.get(m.session).copied().unwrap_or_default();
                     let d = (m.position - e.transform_point(&p)) * 1e3;
                     norms.push(d.norm());
@@ -79,6 +95,24 @@ impl SetErrors {
     }
 }
 
+/// Predicted position [m] in the registered base frame, with the compensator's
+/// residual when there is one; `None` when the model cannot predict the pose.
+pub(crate) fn predict_compensated(
+    model: &RobotModel,
+    compensator: Option<&dyn Compensator>,
+    m: &Measurement,
+) -> Option<Vector3<f64>> {
+    let (p, _) = super::least_squares::predict(model, m)?;
+    match compensator {
+        None => Some(p),
+        Some(c) => {
+            let ch = crate::kinematics::chain(model, &m.q).ok()?;
+            let tau = crate::kinematics::gravity_torques_of(model, &ch, m.payload_mass);
+            Some(p + c.residual_at(&m.q, &tau, m.payload_mass))
+        }
+    }
+}
+
 /// Where a pose came from: its measurement set, the row (step) number in that
 /// upload (1-based data row) and the tracker session's name. Filled by the
 /// caller that knows the uploads; empty when unknown.
@@ -89,13 +123,16 @@ pub struct PoseSource {
     pub session: String,
 }
 
-/// Pose sources of both sets, in the order of the report's per-pose vectors.
+/// Pose sources of the sets, in the order of the report's per-pose vectors.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct PoseSources {
     #[serde(default)]
     pub identification: Vec<PoseSource>,
     #[serde(default)]
     pub validation: Vec<PoseSource>,
+    /// The compensator training pool (Q2), when one was given.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub training: Vec<PoseSource>,
 }
 
 /// One identified parameter in display units (mm, deg or rad/(N·m)).
@@ -125,6 +162,9 @@ pub struct MethodReport {
     pub solver: LmReport,
     pub identification: SetErrors,
     pub validation: Option<SetErrors>,
+    /// Errors on the compensator training pool (Q2), when one was given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub training: Option<SetErrors>,
     pub parameters: Vec<ParamEstimate>,
     /// Identified joint stiffness 1/c [N·m/rad] (None: not identified / rigid).
     pub stiffness_nm_per_rad: Vec<Option<f64>>,
@@ -134,8 +174,70 @@ pub struct MethodReport {
     pub warnings: Vec<MethodWarning>,
     /// The calibrated model in the registered base frame (mm/deg).
     pub model: ModelDescription,
+    /// The learned compensator of a compensator method (or of `auto`'s choice):
+    /// what it is, how it was trained, on which poses, and its effect per set.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub compensator: Option<CompensatorSummary>,
+    /// What `auto` compared and why it chose what it did.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub auto: Option<AutoSummary>,
     #[serde(skip)]
     pub calibrated: RobotModel,
+    /// The trained compensator (the model file stores it).
+    #[serde(skip)]
+    pub stored_compensator: Option<StoredCompensator>,
+}
+
+/// A compensator method's network, its training and its effect: the base
+/// model's statistics next to the compensated ones on every set.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CompensatorSummary {
+    /// The model-based method under it (`km` or `skcm`).
+    pub base: Method,
+    /// `mlp` or `rbf`.
+    pub kind: String,
+    /// Hidden units (MLP) or radial units (RBF).
+    pub units: usize,
+    /// Inputs of the network (e.g. `q, sin q, cos q` or `gravity torques`).
+    pub inputs: String,
+    /// The training run on the whole pool: trainer, epochs / iterations /
+    /// generations, evaluations, why it stopped, training RMS.
+    pub training: TrainReport,
+    /// Which poses trained it: `training` (the Q2 pool) or `identification`
+    /// (no training pool given; judged by k-fold cross-validation inside it).
+    pub trained_on: String,
+    pub training_poses: usize,
+    /// k-fold cross-validation on the training pool (none when switched off).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cross_validation: Option<CvStats>,
+    /// The base alone on the identification and validation sets [mm].
+    pub base_identification: ErrorStats,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub base_validation: Option<ErrorStats>,
+    /// The base alone on the training pool, when it is a set of its own [mm].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub base_training: Option<ErrorStats>,
+}
+
+/// One candidate `auto` weighed: cross-validated errors on the training pool
+/// [mm] of the base alone and with the compensator.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AutoCandidate {
+    pub method: Method,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cross_validation: Option<CvStats>,
+    /// Why it was not available (training failed, base failed).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub failed: Option<String>,
+}
+
+/// The choice of `auto`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AutoSummary {
+    /// The method whose model `auto` delivers (a base or a compensator method).
+    pub chosen: Method,
+    pub reason: String,
+    pub candidates: Vec<AutoCandidate>,
 }
 
 /// Kind of a method warning.
@@ -198,6 +300,10 @@ pub struct CalibrationReport {
     pub robot: String,
     pub identification_poses: usize,
     pub validation_poses: usize,
+    /// Poses of the compensator training pool (Q2; 0: none given, compensators
+    /// train on the identification poses).
+    #[serde(default)]
+    pub training_poses: usize,
     pub registration: Vec<SessionRegistration>,
     pub identifiability: IdentifiabilityReport,
     pub nominal: NominalErrors,
@@ -231,7 +337,7 @@ impl CalibrationReport {
 
 impl PoseSources {
     pub fn is_empty(&self) -> bool {
-        self.identification.is_empty() && self.validation.is_empty()
+        self.identification.is_empty() && self.validation.is_empty() && self.training.is_empty()
     }
 }
 
