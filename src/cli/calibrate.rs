@@ -2,6 +2,7 @@
 //! print the comparison of methods (like the seed's Tables 2.5/2.6) with the
 //! identifiability report, or the same as JSON.
 
+use super::progress::ProgressPrinter;
 use crate::identify::{
     calibrate_with_training, CalibrationOptions, CalibrationReport, CompensatorOptions, Method,
     PoseSource, PoseSources,
@@ -192,13 +193,13 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         },
         ..Default::default()
     };
-    let verbose = !a.json;
-    let mut report = calibrate_with_training(&model, &ident, &training, &valid, &opts, &|p| {
-        if verbose && p.iteration == 0 {
-            eprintln!("[{:5.1}%] {}", p.percent, p.phase);
-        }
+    let progress = ProgressPrinter::stderr(!a.json);
+    let report = calibrate_with_training(&model, &ident, &training, &valid, &opts, &|p| {
+        progress.update(p);
         true
-    })?;
+    });
+    progress.finish();
+    let mut report = report?;
     report.pose_sources = PoseSources {
         identification: ident_src,
         validation: valid_src,
@@ -266,6 +267,17 @@ fn save_model(
 }
 
 /// The text report: accuracy table, identifiability, parameters, stiffness.
+/// A parameter value in its display unit, one format per unit: lengths and
+/// angles with 6 decimals (0.001 µm, 1e-6 deg), compliances in scientific
+/// notation, masses with 3 decimals.
+fn param_number(v: f64, unit: &str) -> String {
+    match unit {
+        "rad/(N·m)" => format!("{v:.4e}"),
+        "kg" => format!("{v:.3}"),
+        _ => format!("{v:.6}"),
+    }
+}
+
 pub fn render_report(r: &CalibrationReport) -> String {
     let mut s = String::new();
     let _ = writeln!(
@@ -367,11 +379,18 @@ pub fn render_report(r: &CalibrationReport) -> String {
             .find(|p| &p.name == pname)
             .map(|p| p.nominal)
             .unwrap_or(0.0);
-        let _ = write!(s, "{:<10} {:>14.6}", pname, nominal_v);
+        let unit = r
+            .methods
+            .values()
+            .flat_map(|m| &m.parameters)
+            .find(|p| &p.name == pname)
+            .map(|p| p.unit.as_str())
+            .unwrap_or("");
+        let _ = write!(s, "{:<10} {:>14}", pname, param_number(nominal_v, unit));
         for n in &names {
             match r.methods[*n].parameters.iter().find(|p| &p.name == pname) {
                 Some(p) => {
-                    let _ = write!(s, " {:>14.6e}", p.value);
+                    let _ = write!(s, " {:>14}", param_number(p.value, unit));
                 }
                 None => {
                     let _ = write!(s, " {:>14}", "-");
@@ -380,7 +399,13 @@ pub fn render_report(r: &CalibrationReport) -> String {
         }
         let _ = writeln!(s);
     }
-    let _ = writeln!(s, "\nJoint stiffness (N·m/rad)");
+    let any_stiffness = r
+        .methods
+        .values()
+        .any(|m| m.stiffness_nm_per_rad.iter().any(|k| k.is_some()));
+    if any_stiffness {
+        let _ = writeln!(s, "\nJoint stiffness (N·m/rad)");
+    }
     for (n, m) in &r.methods {
         if m.stiffness_nm_per_rad.iter().any(|k| k.is_some()) {
             let ks: Vec<String> = m
