@@ -316,6 +316,70 @@ impl TestApp {
         .await
     }
 
+    /// A `POST` without a body (cancel, activate, rollback).
+    pub(crate) async fn post_empty(&self, template: &str, args: &[&str]) -> Resp {
+        self.send("POST", template, args, "", None, Vec::new())
+            .await
+    }
+
+    /// Starts a calibration job of robot `rid` with `body`.
+    pub(crate) async fn start_job(&self, rid: &str, body: Value) -> Resp {
+        self.post_json("/v1/robots/{id}/calibrations", &[rid], body)
+            .await
+    }
+
+    /// `GET` of job `job` of robot `rid`.
+    pub(crate) async fn job(&self, rid: &str, job: i64) -> Resp {
+        self.get(
+            "/v1/robots/{id}/calibrations/{cid}",
+            &[rid, &job.to_string()],
+        )
+        .await
+    }
+
+    /// Requests cancellation of job `job` of robot `rid`.
+    pub(crate) async fn cancel_job(&self, rid: &str, job: i64) -> Resp {
+        self.post_empty(
+            "/v1/robots/{id}/calibrations/{cid}/cancel",
+            &[rid, &job.to_string()],
+        )
+        .await
+    }
+
+    /// Polls job `job` of robot `rid` until it reports phase `phase` at
+    /// iteration `min_iteration` or later (at most 120 s); the job then.
+    pub(crate) async fn wait_for_progress(
+        &self,
+        rid: &str,
+        job: i64,
+        phase: &str,
+        min_iteration: i64,
+    ) -> Value {
+        let start = Instant::now();
+        loop {
+            let j = self.job(rid, job).await.json();
+            if j["progress"]["phase"] == phase
+                && j["progress"]["iteration"].as_i64() >= Some(min_iteration)
+            {
+                return j;
+            }
+            assert!(
+                start.elapsed() < Duration::from_secs(120),
+                "no progress: {j}"
+            );
+            tokio::time::sleep(Duration::from_millis(10)).await;
+        }
+    }
+
+    /// A YS100 with one simulated identification set (seed 5, 30 poses):
+    /// its id, as a number and as text.
+    pub(crate) async fn robot_with_identification_set(&self) -> (i64, String) {
+        let robot = self.create_robot("ys100").await;
+        self.upload_csv(robot, &simulated_csv(5, 30), "?role=identification")
+            .await;
+        (robot, robot.to_string())
+    }
+
     pub(crate) async fn create_robot(&self, preset: &str) -> i64 {
         let r = self
             .post_json(
