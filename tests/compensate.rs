@@ -10,6 +10,9 @@
 //! turned by 30°. The calibration knows the preset's masses and none of the
 //! other effects.
 
+mod common;
+
+use common::{measure_truth, real_with};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal::compensate::{
@@ -20,20 +23,8 @@ use robocal::identify::{calibrate, CalibrationOptions, CalibrationReport, ErrorS
 use robocal::ik::{Goal, IkSettings, IkSolver, SolveOptions};
 use robocal::measure::{self, csv, Measurement};
 use robocal::model::{preset, ModelDescription, RobotModel};
-use robocal::sim::{random_configurations, TrueRobot};
+use robocal::sim::random_configurations;
 use std::sync::{Arc, OnceLock};
-
-fn measure_truth(
-    t: &TrueRobot,
-    nominal: &RobotModel,
-    n: usize,
-    rng: &mut ChaCha8Rng,
-) -> Vec<Measurement> {
-    let qs = random_configurations(nominal, n, rng);
-    let payload = nominal.payload.mass;
-    let rows = t.measure(&qs, Some(payload), None, rng).unwrap();
-    measure::to_measurements(nominal, &rows, payload)
-}
 
 /// The base model of a calibrated method, in the measurement frame.
 fn base(nominal: &RobotModel, r: &CalibrationReport, method: &str) -> CompensatedModel {
@@ -315,11 +306,7 @@ fn effects_off_no_compensator_hurts() {
 }
 
 fn real(path: &str) -> Vec<measure::MeasuredPose> {
-    let p = format!(
-        "{}/../shared/data/ur5-wam-laser-tracker/{path}",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    csv::parse_with(&std::fs::read_to_string(p).unwrap(), csv::DifSign::Plus).unwrap()
+    real_with(path, csv::DifSign::Plus)
 }
 
 fn ur5() -> RobotModel {

@@ -2,6 +2,8 @@
 //! shipped model files (models/ur5.json, models/wam.json), over HTTP and the
 //! command line, as a new user runs them.
 
+mod common;
+
 use axum::body::Body;
 use axum::http::{header, Request, StatusCode};
 use axum::Router;
@@ -11,18 +13,10 @@ use serde_json::{json, Value};
 use std::time::{Duration, Instant};
 use tower::ServiceExt;
 
-const ROOT: &str = env!("CARGO_MANIFEST_DIR");
-
-fn data(path: &str) -> String {
-    std::fs::read_to_string(format!(
-        "{ROOT}/../shared/data/ur5-wam-laser-tracker/{path}"
-    ))
-    .unwrap()
-}
+use common::{data, model_text, robocal_json, ROOT};
 
 fn model_file(name: &str) -> Value {
-    serde_json::from_str(&std::fs::read_to_string(format!("{ROOT}/models/{name}.json")).unwrap())
-        .unwrap()
+    serde_json::from_str(&model_text(name)).unwrap()
 }
 
 struct App {
@@ -228,10 +222,10 @@ async fn real_wam_all_methods_over_http() {
 /// The README's real-data commands run as written (from the repository root).
 #[test]
 fn real_data_cli_commands_run_as_written() {
-    let run = |model: &str, dir: &str, methods: &str| {
-        let out = std::process::Command::new(env!("CARGO_BIN_EXE_robocal"))
-            .current_dir(ROOT)
-            .args([
+    let run = |model: &str, dir: &str, methods: &str| -> Value {
+        robocal_json(
+            std::path::Path::new(ROOT),
+            &[
                 "calibrate",
                 "--model",
                 &format!("models/{model}.json"),
@@ -246,16 +240,8 @@ fn real_data_cli_commands_run_as_written() {
                 "--generations",
                 "20",
                 "--json",
-            ])
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let v: Value = serde_json::from_slice(&out.stdout).unwrap();
-        v
+            ],
+        )
     };
     let ur5 = run("ur5", "UR5", "km");
     let km = ur5["methods"]["km"]["validation"]["mean_mm"]
