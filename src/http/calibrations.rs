@@ -7,7 +7,7 @@
 //! [`crate::service::calibrations`].
 
 use super::input::{check_payload, int, page_body, present, present_int, present_ints, PageQuery};
-use super::robots::load_robot;
+use super::robots::robot_list_page;
 use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState};
 use crate::db::{CalibrationRow, JobStatus, JobSummary};
 use crate::identify::{CalibrationOptions, Method};
@@ -127,12 +127,14 @@ impl Calibration {
     pub fn from_row(r: CalibrationRow) -> Self {
         let base = format!("/v1/robots/{}/calibrations/{}", r.robot_id, r.id);
         Calibration {
-            links: json!({
-                "self": base,
-                "cancel": format!("{base}/cancel"),
-                "result": format!("{base}/result"),
-                "report": format!("{base}/report"),
-            }),
+            links: super::links(
+                &base,
+                &[
+                    ("cancel", "/cancel"),
+                    ("result", "/result"),
+                    ("report", "/report"),
+                ],
+            ),
             id: r.id,
             robot_id: r.robot_id,
             status: r.status,
@@ -215,8 +217,7 @@ pub async fn list(
     ApiPath(robot_id): ApiPath<i64>,
     ApiQuery(page): ApiQuery<PageQuery>,
 ) -> Result<Response, ApiError> {
-    let page = page.check(state.limits().page_max)?;
-    load_robot(&state, robot_id).await?;
+    let (page, _) = robot_list_page(&state, robot_id, page).await?;
     let (rows, total) = state
         .db()
         .calibrations_page(robot_id, page.limit, page.offset)

@@ -97,6 +97,17 @@ where
     route(Method::DELETE, path, handler)
 }
 
+/// The `links` of a resource at `base`: `self`, and each other relation at
+/// `base` followed by its suffix.
+pub(crate) fn links(base: &str, relations: &[(&str, &str)]) -> serde_json::Value {
+    let mut out = serde_json::Map::new();
+    out.insert("self".into(), base.into());
+    for (rel, suffix) in relations {
+        out.insert((*rel).into(), format!("{base}{suffix}").into());
+    }
+    out.into()
+}
+
 /// The answer to a request that made a resource: `status` (201 Created, 202
 /// Accepted), `Location: location` and the resource as JSON.
 pub(crate) fn located<B: serde::Serialize>(

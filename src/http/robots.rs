@@ -1,7 +1,7 @@
 //! `/v1/robots`: create from a preset or a model JSON, list, get, update name
 //! and metadata, delete (with its measurement sets, calibrations and versions).
 
-use super::input::{check_payload, page_body, present, PageQuery};
+use super::input::{check_payload, page_body, present, Page, PageQuery};
 use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState};
 use crate::db::{NewRobot, RobotRow};
 use crate::model::presets::{preset_description, PRESETS};
@@ -16,6 +16,17 @@ pub(crate) use super::input::check_name;
 
 pub(crate) fn robot_not_found(id: i64) -> ApiError {
     crate::service::ServiceError::robot_not_found(id).into()
+}
+
+/// The checked page of a list that belongs to robot `id`, and the robot
+/// (404 when missing; a bad page is refused first).
+pub(crate) async fn robot_list_page(
+    state: &AppState,
+    id: i64,
+    page: PageQuery,
+) -> Result<(Page, RobotRow), ApiError> {
+    let page = page.check(state.limits().page_max)?;
+    Ok((page, load_robot(state, id).await?))
 }
 
 /// The stored robot `id`, or 404.

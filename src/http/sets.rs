@@ -10,7 +10,7 @@ use super::error::content_type;
 use super::input::{
     check_name, check_payload, from_json_object, objects, page_body, present, PageQuery,
 };
-use super::robots::load_robot;
+use super::robots::robot_list_page;
 use super::{ApiError, ApiPath, ApiQuery, AppState};
 use crate::db::{AngleUnit, LengthUnit, SetFormat, SetRow};
 use crate::measure::csv::{self, DifSign, ReadOptions};
@@ -384,8 +384,7 @@ pub async fn list(
     ApiPath(robot_id): ApiPath<i64>,
     ApiQuery(page): ApiQuery<PageQuery>,
 ) -> Result<Response, ApiError> {
-    let page = page.check(state.limits().page_max)?;
-    load_robot(&state, robot_id).await?;
+    let (page, _) = robot_list_page(&state, robot_id, page).await?;
     let (rows, total) = state
         .db()
         .sets_page(robot_id, page.limit, page.offset)

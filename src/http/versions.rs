@@ -5,7 +5,7 @@
 //! text of `crate::export`).
 
 use super::input::{page_body, PageQuery};
-use super::robots::load_robot;
+use super::robots::{load_robot, robot_list_page};
 use super::{ApiError, ApiPath, ApiQuery, AppState};
 use crate::compensate::CalibratedModelFile;
 use crate::db::{Rollback, VersionRow};
@@ -39,11 +39,10 @@ impl ModelVersion {
     pub fn from_row(v: VersionRow) -> Self {
         let base = format!("/v1/robots/{}/versions/{}", v.robot_id, v.version);
         ModelVersion {
-            links: json!({
-                "self": base,
-                "activate": format!("{base}/activate"),
-                "model": format!("{base}/model.json"),
-            }),
+            links: super::links(
+                &base,
+                &[("activate", "/activate"), ("model", "/model.json")],
+            ),
             version: v.version,
             robot_id: v.robot_id,
             calibration_id: v.calibration_id,
@@ -60,8 +59,7 @@ pub async fn list(
     ApiPath(robot_id): ApiPath<i64>,
     ApiQuery(page): ApiQuery<PageQuery>,
 ) -> Result<Response, ApiError> {
-    let page = page.check(state.limits().page_max)?;
-    let robot = load_robot(&state, robot_id).await?;
+    let (page, robot) = robot_list_page(&state, robot_id, page).await?;
     let (rows, total) = state
         .db()
         .versions_page(robot_id, page.limit, page.offset)
