@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{measure_truth, opts, real_with, run_with};
+use common::{measure_truth, opts, real_with, run_with, two_tracker_sessions};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal::identify::{
@@ -299,23 +299,13 @@ fn bad_input_gives_a_clear_error() {
 /// parameters are shared and recovered to the noise level.
 #[test]
 fn two_tracker_sessions_share_the_robot_parameters() {
-    let nominal = preset("ys100").unwrap();
-    let mut rng = ChaCha8Rng::seed_from_u64(12);
-    let tm = perturb_geometry(&nominal, &ErrorMagnitudes::from_mm_deg(1.0, 0.1), &mut rng);
+    let (nominal, sessions) = two_tracker_sessions();
+    let payload = nominal.payload.mass;
     let mut all = Vec::new();
     let mut valid = Vec::new();
-    for (s, frame) in [
-        tracker_frame(5.0, 2.0, 80.0, [2000.0, 100.0, -300.0]),
-        tracker_frame(-3.0, 1.0, -20.0, [-500.0, 2500.0, 0.0]),
-    ]
-    .into_iter()
-    .enumerate()
-    {
-        let mut truth = TrueRobot::new(tm.clone());
-        truth.tracker_from_base = frame;
-        truth.noise_mm = 0.005;
-        let mut id = measure_truth(&truth, &nominal, 30, &mut rng);
-        let mut va = measure_truth(&truth, &nominal, 20, &mut rng);
+    for (s, (id, va)) in sessions.into_iter().enumerate() {
+        let mut id = measure::to_measurements(&nominal, &id, payload);
+        let mut va = measure::to_measurements(&nominal, &va, payload);
         for m in id.iter_mut().chain(va.iter_mut()) {
             m.session = s;
         }

@@ -3,7 +3,9 @@
 
 mod common;
 
-use common::{measure_truth, opts, real, robocal_json, run_with, shipped_model};
+use common::{
+    measure_truth, opts, real, robocal_json, run_with, shipped_model, two_tracker_sessions,
+};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal::identify::{
@@ -314,40 +316,11 @@ fn two_session_skcm_c_is_as_accurate_as_one() {
 /// sessions; both give the same calibration.
 #[test]
 fn cli_takes_several_files_or_a_session_column() {
-    use robocal::sim::tracker_frame;
-    let nominal = preset("ys100").unwrap();
-    let mut rng = ChaCha8Rng::seed_from_u64(12);
-    let tm = perturb_geometry(&nominal, &ErrorMagnitudes::from_mm_deg(1.0, 0.1), &mut rng);
+    let (_, sessions) = two_tracker_sessions();
     let dir = tempfile::tempdir().unwrap();
     let mut combined_id = Vec::new();
     let mut combined_va = Vec::new();
-    for (s, frame) in [
-        tracker_frame(5.0, 2.0, 80.0, [2000.0, 100.0, -300.0]),
-        tracker_frame(-3.0, 1.0, -20.0, [-500.0, 2500.0, 0.0]),
-    ]
-    .into_iter()
-    .enumerate()
-    {
-        let mut truth = TrueRobot::new(tm.clone());
-        truth.tracker_from_base = frame;
-        truth.noise_mm = 0.005;
-        let p = Some(nominal.payload.mass);
-        let id = truth
-            .measure(
-                &random_configurations(&nominal, 30, &mut rng),
-                p,
-                None,
-                &mut rng,
-            )
-            .unwrap();
-        let va = truth
-            .measure(
-                &random_configurations(&nominal, 20, &mut rng),
-                p,
-                None,
-                &mut rng,
-            )
-            .unwrap();
+    for (s, (id, va)) in sessions.into_iter().enumerate() {
         std::fs::write(dir.path().join(format!("id{s}.csv")), csv::write(&id)).unwrap();
         std::fs::write(dir.path().join(format!("va{s}.csv")), csv::write(&va)).unwrap();
         let tag = |rows: Vec<measure::MeasuredPose>| {

@@ -7,13 +7,11 @@ mod common;
 use axum::body::Body;
 use axum::http::{header, Request, StatusCode};
 use axum::Router;
-use robocal::db::Db;
-use robocal::http::{app, AppState, ServiceConfig};
+use robocal::http::ServiceConfig;
 use serde_json::{json, Value};
 use std::time::{Duration, Instant};
-use tower::ServiceExt;
 
-use common::{data, model_text, robocal_json, ROOT};
+use common::{data, model_text, oneshot, robocal_json, service, ROOT};
 
 fn model_file(name: &str) -> Value {
     serde_json::from_str(&model_text(name)).unwrap()
@@ -26,20 +24,12 @@ struct App {
 
 impl App {
     async fn new() -> App {
-        let dir = tempfile::tempdir().unwrap();
-        let url = format!("sqlite://{}?mode=rwc", dir.path().join("real.db").display());
-        let db = Db::connect(&url).await.unwrap();
-        let state = AppState::new(
-            db,
-            ServiceConfig {
-                progress_interval: Duration::from_millis(50),
-                ..ServiceConfig::default()
-            },
-        );
-        App {
-            router: app(state),
-            _dir: dir,
-        }
+        let (router, _, dir) = service(ServiceConfig {
+            progress_interval: Duration::from_millis(50),
+            ..ServiceConfig::default()
+        })
+        .await;
+        App { router, _dir: dir }
     }
 
     async fn call(&self, method: &str, uri: &str, ct: Option<&str>, body: Vec<u8>) -> (u16, Value) {
@@ -47,18 +37,9 @@ impl App {
         if let Some(ct) = ct {
             req = req.header(header::CONTENT_TYPE, ct);
         }
-        let res = self
-            .router
-            .clone()
-            .oneshot(req.body(Body::from(body)).unwrap())
-            .await
-            .unwrap();
-        let status = res.status().as_u16();
-        let bytes = axum::body::to_bytes(res.into_body(), usize::MAX)
-            .await
-            .unwrap();
+        let (status, _, bytes) = oneshot(&self.router, req.body(Body::from(body)).unwrap()).await;
         let v = serde_json::from_slice(&bytes).unwrap_or(Value::Null);
-        (status, v)
+        (status.as_u16(), v)
     }
 
     async fn post(&self, uri: &str, body: Value) -> (u16, Value) {

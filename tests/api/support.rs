@@ -2,13 +2,13 @@
 //! every response checked against `openapi.yaml`; simulated measurements.
 #![allow(dead_code)]
 
+use crate::common::{oneshot, service};
 use axum::body::Body;
 use axum::http::{header, Request, StatusCode};
 use axum::Router;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal::db::Db;
-use robocal::http::{app, AppState, ServiceConfig, OPENAPI_YAML};
+use robocal::http::{AppState, ServiceConfig, OPENAPI_YAML};
 use robocal::measure::{csv, MeasuredPose, SetRole};
 use robocal::model::preset;
 use robocal::sim::{
@@ -18,7 +18,6 @@ use serde_json::{json, Value};
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
-use tower::ServiceExt;
 
 pub(crate) struct Spec {
     pub(crate) doc: Value,
@@ -168,13 +167,10 @@ pub(crate) async fn setup_with(keys: &[&str], workers: usize) -> TestApp {
 }
 
 pub(crate) async fn setup_config(config: ServiceConfig) -> TestApp {
-    let dir = tempfile::tempdir().unwrap();
-    let url = format!("sqlite://{}?mode=rwc", dir.path().join("api.db").display());
-    let db = Db::connect(&url).await.unwrap();
     let keys = config.api_keys.clone();
-    let state = AppState::new(db, config);
+    let (router, state, dir) = service(config).await;
     TestApp {
-        router: app(state.clone()),
+        router,
         state,
         spec: Arc::new(Spec::load()),
         _dir: dir,
@@ -271,22 +267,12 @@ impl TestApp {
         if let Some(k) = key {
             req = req.header(header::AUTHORIZATION, format!("Bearer {k}"));
         }
-        let res = self
-            .router
-            .clone()
-            .oneshot(req.body(Body::from(body)).unwrap())
-            .await
-            .unwrap();
-        let status = res.status();
-        let headers = res.headers().clone();
+        let (status, headers, body) =
+            oneshot(&self.router, req.body(Body::from(body)).unwrap()).await;
         let content_type = headers
             .get(header::CONTENT_TYPE)
             .map(|v| v.to_str().unwrap().to_string())
             .unwrap_or_default();
-        let body = axum::body::to_bytes(res.into_body(), usize::MAX)
-            .await
-            .unwrap()
-            .to_vec();
         if status.is_client_error() || status.is_server_error() {
             assert_eq!(content_type, "application/problem+json", "{method} {uri}");
             self.spec
