@@ -1,6 +1,9 @@
 //! Identification checked against simulated ground truth and real laser-tracker
 //! data (../shared/data/ur5-wam-laser-tracker).
 
+mod common;
+
+use common::{measure_truth, opts, real_with, run_with, two_tracker_sessions};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal::identify::{
@@ -12,29 +15,13 @@ use robocal::sim::{
     perturb_geometry, random_configurations, tracker_frame, ErrorMagnitudes, TrueRobot,
 };
 
-fn measure_truth(
-    truth: &TrueRobot,
-    nominal: &RobotModel,
-    n: usize,
-    rng: &mut ChaCha8Rng,
-) -> Vec<Measurement> {
-    let qs = random_configurations(nominal, n, rng);
-    let payload = nominal.payload.mass;
-    let rows = truth.measure(&qs, Some(payload), None, rng).unwrap();
-    measure::to_measurements(nominal, &rows, payload)
-}
-
 fn run(
     nominal: &RobotModel,
     id: &[Measurement],
     va: &[Measurement],
     methods: &[Method],
 ) -> CalibrationReport {
-    let opts = CalibrationOptions {
-        methods: methods.to_vec(),
-        ..Default::default()
-    };
-    calibrate(nominal, id, va, &opts, &|_| true).unwrap()
+    run_with(nominal, id, va, opts(methods)).unwrap()
 }
 
 fn val_mean(r: &CalibrationReport, m: &str) -> f64 {
@@ -151,14 +138,6 @@ fn tracker_frame_is_registered_away() {
     assert!((reg.xyz_mm[1].abs() - 0.0).abs() > 100.0, "{reg:?}");
 }
 
-fn real(path: &str, sign: csv::DifSign) -> Vec<measure::MeasuredPose> {
-    let p = format!(
-        "{}/../shared/data/ur5-wam-laser-tracker/{path}",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    csv::parse_with(&std::fs::read_to_string(p).unwrap(), sign).unwrap()
-}
-
 /// Real data: KM on the UR5 grid brings the 20 random poses from 2.57 mm mean to
 /// about 0.10 mm (data README), with either sign of the difference columns.
 #[test]
@@ -173,12 +152,12 @@ fn ur5_real_data_km() {
     for sign in [csv::DifSign::Plus, csv::DifSign::Minus] {
         let grid = measure::to_measurements(
             &model,
-            &real("UR5/3D_UR5_uncalibrated_grid_cleaned.csv", sign),
+            &real_with("UR5/3D_UR5_uncalibrated_grid_cleaned.csv", sign),
             0.0,
         );
         let test = measure::to_measurements(
             &model,
-            &real("UR5/3D_UR5_uncalibrated_random_cleaned.csv", sign),
+            &real_with("UR5/3D_UR5_uncalibrated_random_cleaned.csv", sign),
             0.0,
         );
         // Before calibration, in the base frame as recorded: ~2.57 mm.
@@ -320,23 +299,13 @@ fn bad_input_gives_a_clear_error() {
 /// parameters are shared and recovered to the noise level.
 #[test]
 fn two_tracker_sessions_share_the_robot_parameters() {
-    let nominal = preset("ys100").unwrap();
-    let mut rng = ChaCha8Rng::seed_from_u64(12);
-    let tm = perturb_geometry(&nominal, &ErrorMagnitudes::from_mm_deg(1.0, 0.1), &mut rng);
+    let (nominal, sessions) = two_tracker_sessions();
+    let payload = nominal.payload.mass;
     let mut all = Vec::new();
     let mut valid = Vec::new();
-    for (s, frame) in [
-        tracker_frame(5.0, 2.0, 80.0, [2000.0, 100.0, -300.0]),
-        tracker_frame(-3.0, 1.0, -20.0, [-500.0, 2500.0, 0.0]),
-    ]
-    .into_iter()
-    .enumerate()
-    {
-        let mut truth = TrueRobot::new(tm.clone());
-        truth.tracker_from_base = frame;
-        truth.noise_mm = 0.005;
-        let mut id = measure_truth(&truth, &nominal, 30, &mut rng);
-        let mut va = measure_truth(&truth, &nominal, 20, &mut rng);
+    for (s, (id, va)) in sessions.into_iter().enumerate() {
+        let mut id = measure::to_measurements(&nominal, &id, payload);
+        let mut va = measure::to_measurements(&nominal, &va, payload);
         for m in id.iter_mut().chain(va.iter_mut()) {
             m.session = s;
         }

@@ -1,43 +1,20 @@
 //! Regression tests of issue 7: admissible compliance, honest solver reports,
 //! per-method failure, near-dependent parameters on the real UR5 data.
 
+mod common;
+
+use common::{
+    measure_truth, opts, real, robocal_json, run_with, shipped_model, two_tracker_sessions,
+};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal::identify::{
-    calibrate, CalibrationError, CalibrationOptions, CalibrationReport, DropKind, LmSettings,
-    Method, StopReason, WarningKind,
+    CalibrationError, CalibrationOptions, CalibrationReport, DropKind, LmSettings, Method,
+    StopReason, WarningKind,
 };
-use robocal::measure::{self, csv, Measurement};
-use robocal::model::{preset, RobotModel};
+use robocal::measure::{self, csv};
+use robocal::model::preset;
 use robocal::sim::{perturb_geometry, random_configurations, ErrorMagnitudes, TrueRobot};
-
-fn measure_truth(
-    truth: &TrueRobot,
-    nominal: &RobotModel,
-    n: usize,
-    rng: &mut ChaCha8Rng,
-) -> Vec<Measurement> {
-    let qs = random_configurations(nominal, n, rng);
-    let payload = nominal.payload.mass;
-    let rows = truth.measure(&qs, Some(payload), None, rng).unwrap();
-    measure::to_measurements(nominal, &rows, payload)
-}
-
-fn run_with(
-    nominal: &RobotModel,
-    id: &[Measurement],
-    va: &[Measurement],
-    opts: CalibrationOptions,
-) -> Result<CalibrationReport, CalibrationError> {
-    calibrate(nominal, id, va, &opts, &|_| true)
-}
-
-fn opts(methods: &[Method]) -> CalibrationOptions {
-    CalibrationOptions {
-        methods: methods.to_vec(),
-        ..Default::default()
-    }
-}
 
 /// A truth whose joint 3 deflects *against* its gravity torque (an effect no
 /// admissible compliance has): SKCM keeps every c ≥ 0, says c3 is held at its
@@ -150,19 +127,6 @@ fn compliance_methods_fail_fast_without_masses() {
         matches!(e, CalibrationError::AllMethodsFailed { .. }),
         "{e}"
     );
-}
-
-fn real(path: &str) -> Vec<measure::MeasuredPose> {
-    let p = format!(
-        "{}/../shared/data/ur5-wam-laser-tracker/{path}",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    csv::parse(&std::fs::read_to_string(p).unwrap()).unwrap()
-}
-
-pub fn shipped_model(name: &str) -> RobotModel {
-    let p = format!("{}/models/{name}.json", env!("CARGO_MANIFEST_DIR"));
-    RobotModel::from_json(&std::fs::read_to_string(p).unwrap()).unwrap()
 }
 
 /// The shipped UR5 model carries the data's TCP offset (z = 31 mm), which
@@ -416,40 +380,11 @@ fn two_session_skcm_c_is_as_accurate_as_one() {
 /// sessions; both give the same calibration.
 #[test]
 fn cli_takes_several_files_or_a_session_column() {
-    use robocal::sim::tracker_frame;
-    let nominal = preset("ys100").unwrap();
-    let mut rng = ChaCha8Rng::seed_from_u64(12);
-    let tm = perturb_geometry(&nominal, &ErrorMagnitudes::from_mm_deg(1.0, 0.1), &mut rng);
+    let (_, sessions) = two_tracker_sessions();
     let dir = tempfile::tempdir().unwrap();
     let mut combined_id = Vec::new();
     let mut combined_va = Vec::new();
-    for (s, frame) in [
-        tracker_frame(5.0, 2.0, 80.0, [2000.0, 100.0, -300.0]),
-        tracker_frame(-3.0, 1.0, -20.0, [-500.0, 2500.0, 0.0]),
-    ]
-    .into_iter()
-    .enumerate()
-    {
-        let mut truth = TrueRobot::new(tm.clone());
-        truth.tracker_from_base = frame;
-        truth.noise_mm = 0.005;
-        let p = Some(nominal.payload.mass);
-        let id = truth
-            .measure(
-                &random_configurations(&nominal, 30, &mut rng),
-                p,
-                None,
-                &mut rng,
-            )
-            .unwrap();
-        let va = truth
-            .measure(
-                &random_configurations(&nominal, 20, &mut rng),
-                p,
-                None,
-                &mut rng,
-            )
-            .unwrap();
+    for (s, (id, va)) in sessions.into_iter().enumerate() {
         std::fs::write(dir.path().join(format!("id{s}.csv")), csv::write(&id)).unwrap();
         std::fs::write(dir.path().join(format!("va{s}.csv")), csv::write(&va)).unwrap();
         let tag = |rows: Vec<measure::MeasuredPose>| {
@@ -464,9 +399,9 @@ fn cli_takes_several_files_or_a_session_column() {
     std::fs::write(dir.path().join("id.csv"), csv::write(&combined_id)).unwrap();
     std::fs::write(dir.path().join("va.csv"), csv::write(&combined_va)).unwrap();
     let run = |identify: &str, validate: &str| -> serde_json::Value {
-        let out = std::process::Command::new(env!("CARGO_BIN_EXE_robocal"))
-            .current_dir(dir.path())
-            .args([
+        robocal_json(
+            dir.path(),
+            &[
                 "calibrate",
                 "--model",
                 "ys100",
@@ -477,15 +412,8 @@ fn cli_takes_several_files_or_a_session_column() {
                 "--method",
                 "km",
                 "--json",
-            ])
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        serde_json::from_slice(&out.stdout).unwrap()
+            ],
+        )
     };
     let files = run("id0.csv,id1.csv", "va0.csv,va1.csv");
     let column = run("id.csv", "va.csv");

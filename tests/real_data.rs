@@ -2,27 +2,19 @@
 //! shipped model files (models/ur5.json, models/wam.json), over HTTP and the
 //! command line, as a new user runs them.
 
+mod common;
+
 use axum::body::Body;
 use axum::http::{header, Request, StatusCode};
 use axum::Router;
-use robocal::db::Db;
-use robocal::http::{app, AppState, ServiceConfig};
+use robocal::http::ServiceConfig;
 use serde_json::{json, Value};
 use std::time::{Duration, Instant};
-use tower::ServiceExt;
 
-const ROOT: &str = env!("CARGO_MANIFEST_DIR");
-
-fn data(path: &str) -> String {
-    std::fs::read_to_string(format!(
-        "{ROOT}/../shared/data/ur5-wam-laser-tracker/{path}"
-    ))
-    .unwrap()
-}
+use common::{data, model_text, oneshot, robocal_json, service, ROOT};
 
 fn model_file(name: &str) -> Value {
-    serde_json::from_str(&std::fs::read_to_string(format!("{ROOT}/models/{name}.json")).unwrap())
-        .unwrap()
+    serde_json::from_str(&model_text(name)).unwrap()
 }
 
 struct App {
@@ -32,20 +24,12 @@ struct App {
 
 impl App {
     async fn new() -> App {
-        let dir = tempfile::tempdir().unwrap();
-        let url = format!("sqlite://{}?mode=rwc", dir.path().join("real.db").display());
-        let db = Db::connect(&url).await.unwrap();
-        let state = AppState::new(
-            db,
-            ServiceConfig {
-                progress_interval: Duration::from_millis(50),
-                ..ServiceConfig::default()
-            },
-        );
-        App {
-            router: app(state),
-            _dir: dir,
-        }
+        let (router, _, dir) = service(ServiceConfig {
+            progress_interval: Duration::from_millis(50),
+            ..ServiceConfig::default()
+        })
+        .await;
+        App { router, _dir: dir }
     }
 
     async fn call(&self, method: &str, uri: &str, ct: Option<&str>, body: Vec<u8>) -> (u16, Value) {
@@ -53,18 +37,9 @@ impl App {
         if let Some(ct) = ct {
             req = req.header(header::CONTENT_TYPE, ct);
         }
-        let res = self
-            .router
-            .clone()
-            .oneshot(req.body(Body::from(body)).unwrap())
-            .await
-            .unwrap();
-        let status = res.status().as_u16();
-        let bytes = axum::body::to_bytes(res.into_body(), usize::MAX)
-            .await
-            .unwrap();
+        let (status, _, bytes) = oneshot(&self.router, req.body(Body::from(body)).unwrap()).await;
         let v = serde_json::from_slice(&bytes).unwrap_or(Value::Null);
-        (status, v)
+        (status.as_u16(), v)
     }
 
     async fn post(&self, uri: &str, body: Value) -> (u16, Value) {
@@ -254,10 +229,10 @@ async fn real_wam_all_methods_over_http() {
 /// The README's real-data commands run as written (from the repository root).
 #[test]
 fn real_data_cli_commands_run_as_written() {
-    let run = |model: &str, dir: &str, methods: &str| {
-        let out = std::process::Command::new(env!("CARGO_BIN_EXE_robocal"))
-            .current_dir(ROOT)
-            .args([
+    let run = |model: &str, dir: &str, methods: &str| -> Value {
+        robocal_json(
+            std::path::Path::new(ROOT),
+            &[
                 "calibrate",
                 "--model",
                 &format!("models/{model}.json"),
@@ -272,16 +247,8 @@ fn real_data_cli_commands_run_as_written() {
                 "--generations",
                 "20",
                 "--json",
-            ])
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let v: Value = serde_json::from_slice(&out.stdout).unwrap();
-        v
+            ],
+        )
     };
     let ur5 = run("ur5", "UR5", "km");
     let km = ur5["methods"]["km"]["validation"]["mean_mm"]

@@ -1,9 +1,16 @@
 //! Calibration jobs: queue, progress, cancellation and their reports.
 
 use super::versions::{activate_in, NewVersion};
-use super::{robot_exists_in, Db, DbError, Json};
+use super::{commit_inserted, Db, DbError, Json};
 use serde_json::Value;
 use sqlx::FromRow;
+
+/// The SQL assignments that stamp a job as ended now.
+macro_rules! finished_now {
+    () => {
+        concat!("finished_at = ", now!(), ", updated_at = ", now!())
+    };
+}
 
 /// What a succeeded job reached, in millimetres (stored with the job).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -68,14 +75,9 @@ impl Db {
         .fetch_all(&mut *tx)
         .await?;
         sqlx::query(concat!(
-            "UPDATE calibrations SET status = 'failed', error = 'interrupted by a restart', \
-             finished_at = ",
-            now!(),
-            ", \
-             updated_at = ",
-            now!(),
-            " \
-             WHERE status IN ('queued', 'running')"
+            "UPDATE calibrations SET status = 'failed', error = 'interrupted by a restart', ",
+            finished_now!(),
+            " WHERE status IN ('queued', 'running')"
         ))
         .execute(&mut *tx)
         .await?;
@@ -88,11 +90,9 @@ impl Db {
         &self,
         c: &NewCalibration<'_>,
     ) -> Result<Option<CalibrationRow>, DbError> {
-        let mut tx = self.write().await?;
-        if !robot_exists_in(&mut tx, c.robot_id).await? {
-            tx.rollback().await?;
+        let Some(mut tx) = self.write_for_robot(c.robot_id).await? else {
             return Ok(None);
-        }
+        };
         let id: i64 = sqlx::query_scalar(
             "INSERT INTO calibrations (robot_id, status, methods, identification_set_ids, \
              validation_set_ids, options) VALUES (?, 'queued', ?, ?, ?, ?) RETURNING id",
@@ -104,12 +104,7 @@ impl Db {
         .bind(Json(c.options))
         .fetch_one(&mut *tx)
         .await?;
-        let row = sqlx::query_as::<_, CalibrationRow>(&format!("{CAL_SELECT} WHERE id = ?"))
-            .bind(id)
-            .fetch_one(&mut *tx)
-            .await?;
-        tx.commit().await?;
-        Ok(Some(row))
+        commit_inserted(tx, CAL_SELECT, "id", id).await.map(Some)
     }
 
     /// One page of a robot's calibrations by id, and how many it has.
@@ -119,21 +114,12 @@ impl Db {
         limit: i64,
         offset: i64,
     ) -> Result<(Vec<CalibrationRow>, i64), DbError> {
-        self.page(
-            &format!("{CAL_SELECT} WHERE robot_id = ? ORDER BY id LIMIT ? OFFSET ?"),
-            "SELECT COUNT(*) FROM calibrations WHERE robot_id = ?",
-            Some(robot_id),
-            limit,
-            offset,
-        )
-        .await
+        self.robot_page(CAL_SELECT, "calibrations", "id", robot_id, limit, offset)
+            .await
     }
 
     pub async fn calibrations(&self, robot_id: i64) -> Result<Vec<CalibrationRow>, DbError> {
-        sqlx::query_as::<_, CalibrationRow>(&format!("{CAL_SELECT} WHERE robot_id = ? ORDER BY id"))
-            .bind(robot_id)
-            .fetch_all(&self.pool)
-            .await
+        self.robot_rows(CAL_SELECT, "id", robot_id).await
     }
 
     pub async fn calibration(
@@ -141,11 +127,7 @@ impl Db {
         robot_id: i64,
         id: i64,
     ) -> Result<Option<CalibrationRow>, DbError> {
-        sqlx::query_as::<_, CalibrationRow>(&format!("{CAL_SELECT} WHERE robot_id = ? AND id = ?"))
-            .bind(robot_id)
-            .bind(id)
-            .fetch_optional(&self.pool)
-            .await
+        self.robot_row(CAL_SELECT, "id", robot_id, id).await
     }
 
     /// The stored report JSON of a calibration.
@@ -161,23 +143,15 @@ impl Db {
 
     /// queued → running; false when the job is no longer queued (cancelled).
     pub async fn start_calibration(&self, id: i64) -> Result<bool, DbError> {
-        let mut tx = self.write().await?;
-        let n = sqlx::query(concat!(
-            "UPDATE calibrations SET status = 'running', phase = 'starting', \
-             started_at = ",
+        let start = sqlx::query(concat!(
+            "UPDATE calibrations SET status = 'running', phase = 'starting', started_at = ",
             now!(),
-            ", \
-             updated_at = ",
+            ", updated_at = ",
             now!(),
-            " \
-             WHERE id = ? AND status = 'queued' AND cancel_requested = 0"
+            " WHERE id = ? AND status = 'queued' AND cancel_requested = 0"
         ))
-        .bind(id)
-        .execute(&mut *tx)
-        .await?
-        .rows_affected();
-        tx.commit().await?;
-        Ok(n > 0)
+        .bind(id);
+        Ok(self.write_one(start).await? > 0)
     }
 
     /// Progress of a running job.
@@ -188,20 +162,16 @@ impl Db {
         iteration: i64,
         percent: f64,
     ) -> Result<(), DbError> {
-        let mut tx = self.write().await?;
-        sqlx::query(concat!(
-            "UPDATE calibrations SET phase = ?, iteration = ?, percent = ?, \
-             updated_at = ",
+        let progress = sqlx::query(concat!(
+            "UPDATE calibrations SET phase = ?, iteration = ?, percent = ?, updated_at = ",
             now!(),
             " WHERE id = ? AND status = 'running'"
         ))
         .bind(phase)
         .bind(iteration)
         .bind(percent)
-        .bind(id)
-        .execute(&mut *tx)
-        .await?;
-        tx.commit().await?;
+        .bind(id);
+        self.write_one(progress).await?;
         Ok(())
     }
 
@@ -216,24 +186,18 @@ impl Db {
         let mut tx = self.write().await?;
         sqlx::query(concat!(
             "UPDATE calibrations SET status = 'cancelled', cancel_requested = 1, \
-             error = 'cancelled by request', finished_at = ",
-            now!(),
-            ", \
-             updated_at = ",
-            now!(),
-            " \
-             WHERE robot_id = ? AND id = ? AND status = 'queued'"
+             error = 'cancelled by request', ",
+            finished_now!(),
+            " WHERE robot_id = ? AND id = ? AND status = 'queued'"
         ))
         .bind(robot_id)
         .bind(id)
         .execute(&mut *tx)
         .await?;
         sqlx::query(concat!(
-            "UPDATE calibrations SET cancel_requested = 1, \
-             updated_at = ",
+            "UPDATE calibrations SET cancel_requested = 1, updated_at = ",
             now!(),
-            " \
-             WHERE robot_id = ? AND id = ? AND status = 'running'"
+            " WHERE robot_id = ? AND id = ? AND status = 'running'"
         ))
         .bind(robot_id)
         .bind(id)
@@ -250,23 +214,15 @@ impl Db {
         status: JobStatus,
         error: &str,
     ) -> Result<(), DbError> {
-        let mut tx = self.write().await?;
-        sqlx::query(concat!(
-            "UPDATE calibrations SET status = ?, error = ?, \
-             finished_at = ",
-            now!(),
-            ", \
-             updated_at = ",
-            now!(),
-            " \
-             WHERE id = ? AND status IN ('queued', 'running')"
+        let end = sqlx::query(concat!(
+            "UPDATE calibrations SET status = ?, error = ?, ",
+            finished_now!(),
+            " WHERE id = ? AND status IN ('queued', 'running')"
         ))
         .bind(status)
         .bind(error)
-        .bind(id)
-        .execute(&mut *tx)
-        .await?;
-        tx.commit().await?;
+        .bind(id);
+        self.write_one(end).await?;
         Ok(())
     }
 
@@ -284,12 +240,12 @@ impl Db {
         versions: &[NewVersion],
     ) -> Result<Vec<(String, i64)>, DbError> {
         let mut tx = self.write().await?;
-        let n = sqlx::query(
-            concat!("UPDATE calibrations SET status = 'succeeded', report = ?, best_method = ?, summary = ?, phase = 'done', \
-             percent = 100, finished_at = ", now!(), ", \
-             updated_at = ", now!(), " \
-             WHERE id = ? AND status = 'running'"),
-        )
+        let n = sqlx::query(concat!(
+            "UPDATE calibrations SET status = 'succeeded', report = ?, best_method = ?, \
+                 summary = ?, phase = 'done', percent = 100, ",
+            finished_now!(),
+            " WHERE id = ? AND status = 'running'"
+        ))
         .bind(report_json)
         .bind(best_method)
         .bind(Json(summary))

@@ -21,8 +21,10 @@
 //!
 //! The service is the only writer: run one `robocal serve` per database file.
 
+use sqlx::query::Query;
 use sqlx::sqlite::{
-    SqliteConnectOptions, SqliteJournalMode, SqlitePool, SqlitePoolOptions, SqliteSynchronous,
+    SqliteArguments, SqliteConnectOptions, SqliteJournalMode, SqlitePool, SqlitePoolOptions,
+    SqliteRow, SqliteSynchronous,
 };
 use sqlx::{FromRow, Row, Sqlite, Transaction};
 use std::str::FromStr;
@@ -121,7 +123,7 @@ impl Db {
         offset: i64,
     ) -> Result<(Vec<T>, i64), DbError>
     where
-        T: for<'r> FromRow<'r, sqlx::sqlite::SqliteRow> + Send + Unpin,
+        T: for<'r> FromRow<'r, SqliteRow> + Send + Unpin,
     {
         let mut tx = self.pool.begin().await?;
         let mut list = sqlx::query_as::<_, T>(list_sql);
@@ -135,9 +137,111 @@ impl Db {
         tx.commit().await?;
         Ok((rows, total))
     }
+
+    /// One page of a robot's rows: `{select} WHERE robot_id = ? ORDER BY
+    /// {order_by}` and the count of that robot's rows in `table`.
+    pub(super) async fn robot_page<T>(
+        &self,
+        select: &str,
+        table: &str,
+        order_by: &str,
+        robot_id: i64,
+        limit: i64,
+        offset: i64,
+    ) -> Result<(Vec<T>, i64), DbError>
+    where
+        T: for<'r> FromRow<'r, SqliteRow> + Send + Unpin,
+    {
+        self.page(
+            &format!("{select} WHERE robot_id = ? ORDER BY {order_by} LIMIT ? OFFSET ?"),
+            &format!("SELECT COUNT(*) FROM {table} WHERE robot_id = ?"),
+            Some(robot_id),
+            limit,
+            offset,
+        )
+        .await
+    }
+
+    /// All rows of a robot: `{select} WHERE robot_id = ? ORDER BY {order_by}`.
+    pub(super) async fn robot_rows<T>(
+        &self,
+        select: &str,
+        order_by: &str,
+        robot_id: i64,
+    ) -> Result<Vec<T>, DbError>
+    where
+        T: for<'r> FromRow<'r, SqliteRow> + Send + Unpin,
+    {
+        sqlx::query_as::<_, T>(&format!("{select} WHERE robot_id = ? ORDER BY {order_by}"))
+            .bind(robot_id)
+            .fetch_all(&self.pool)
+            .await
+    }
+
+    /// One row of a robot: `{select} WHERE robot_id = ? AND {key} = ?`.
+    pub(super) async fn robot_row<T>(
+        &self,
+        select: &str,
+        key: &str,
+        robot_id: i64,
+        value: i64,
+    ) -> Result<Option<T>, DbError>
+    where
+        T: for<'r> FromRow<'r, SqliteRow> + Send + Unpin,
+    {
+        sqlx::query_as::<_, T>(&format!("{select} WHERE robot_id = ? AND {key} = ?"))
+            .bind(robot_id)
+            .bind(value)
+            .fetch_optional(&self.pool)
+            .await
+    }
+
+    /// Runs one statement in its own write transaction; the rows it changed.
+    pub(super) async fn write_one<'q>(
+        &self,
+        statement: Query<'q, Sqlite, SqliteArguments<'q>>,
+    ) -> Result<u64, DbError> {
+        let mut tx = self.write().await?;
+        let n = statement.execute(&mut *tx).await?.rows_affected();
+        tx.commit().await?;
+        Ok(n)
+    }
+
+    /// Starts a write transaction for a write that belongs to a robot; `None`
+    /// (rolled back) when the robot does not exist (any more).
+    pub(super) async fn write_for_robot(
+        &self,
+        robot_id: i64,
+    ) -> Result<Option<Transaction<'static, Sqlite>>, DbError> {
+        let mut tx = self.write().await?;
+        if !robot_exists_in(&mut tx, robot_id).await? {
+            tx.rollback().await?;
+            return Ok(None);
+        }
+        Ok(Some(tx))
+    }
 }
 
-pub(crate) async fn robot_exists_in(
+/// Reads back the row `{select} WHERE {id_column} = ?` just inserted in `tx`
+/// and commits, so the caller gets the row as stored (defaults, timestamps).
+pub(super) async fn commit_inserted<T>(
+    mut tx: Transaction<'static, Sqlite>,
+    select: &str,
+    id_column: &str,
+    id: i64,
+) -> Result<T, DbError>
+where
+    T: for<'r> FromRow<'r, SqliteRow> + Send + Unpin,
+{
+    let row = sqlx::query_as::<_, T>(&format!("{select} WHERE {id_column} = ?"))
+        .bind(id)
+        .fetch_one(&mut *tx)
+        .await?;
+    tx.commit().await?;
+    Ok(row)
+}
+
+async fn robot_exists_in(
     tx: &mut Transaction<'static, Sqlite>,
     robot_id: i64,
 ) -> Result<bool, DbError> {

@@ -1,6 +1,6 @@
 //! Robots: the cell's robots and their nominal models.
 
-use super::{Db, DbError, Json};
+use super::{commit_inserted, Db, DbError, Json};
 use serde_json::{Map, Value};
 use sqlx::FromRow;
 
@@ -17,10 +17,7 @@ impl Db {
         .bind(Json(r.metadata))
         .fetch_one(&mut *tx)
         .await?;
-        tx.commit().await?;
-        self.robot(id)
-            .await?
-            .ok_or_else(|| DbError::Protocol("inserted robot vanished".into()))
+        commit_inserted(tx, ROBOT_SELECT, "r.id", id).await
     }
 
     /// One page of robots by id, and how many there are.
@@ -53,8 +50,7 @@ impl Db {
         name: Option<&str>,
         metadata: Option<&Map<String, Value>>,
     ) -> Result<Option<RobotRow>, DbError> {
-        let mut tx = self.write().await?;
-        let n = sqlx::query(concat!(
+        let update = sqlx::query(concat!(
             "UPDATE robots SET name = COALESCE(?, name), metadata = COALESCE(?, metadata), \
              updated_at = ",
             now!(),
@@ -62,12 +58,8 @@ impl Db {
         ))
         .bind(name)
         .bind(metadata.map(Json))
-        .bind(id)
-        .execute(&mut *tx)
-        .await?
-        .rows_affected();
-        tx.commit().await?;
-        if n == 0 {
+        .bind(id);
+        if self.write_one(update).await? == 0 {
             return Ok(None);
         }
         self.robot(id).await
@@ -75,14 +67,8 @@ impl Db {
 
     /// Deletes a robot and everything that belongs to it; false when missing.
     pub async fn delete_robot(&self, id: i64) -> Result<bool, DbError> {
-        let mut tx = self.write().await?;
-        let n = sqlx::query("DELETE FROM robots WHERE id = ?")
-            .bind(id)
-            .execute(&mut *tx)
-            .await?
-            .rows_affected();
-        tx.commit().await?;
-        Ok(n > 0)
+        let delete = sqlx::query("DELETE FROM robots WHERE id = ?").bind(id);
+        Ok(self.write_one(delete).await? > 0)
     }
 }
 

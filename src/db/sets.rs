@@ -1,6 +1,6 @@
 //! Measurement sets: the uploads as received and their parsed rows.
 
-use super::{robot_exists_in, Db, DbError, Json};
+use super::{commit_inserted, Db, DbError, Json};
 use crate::measure::{MeasuredPose, SetRole};
 use sqlx::{FromRow, Row};
 
@@ -87,11 +87,9 @@ impl SetFormat {
 impl Db {
     /// Stores a set; `None` when its robot does not exist (any more).
     pub async fn insert_set(&self, s: &NewSet<'_>) -> Result<Option<SetRow>, DbError> {
-        let mut tx = self.write().await?;
-        if !robot_exists_in(&mut tx, s.robot_id).await? {
-            tx.rollback().await?;
+        let Some(mut tx) = self.write_for_robot(s.robot_id).await? else {
             return Ok(None);
-        }
+        };
         let id: i64 = sqlx::query_scalar(
             "INSERT INTO measurement_sets (robot_id, name, role, session, payload_kg, length_unit, \
              angle_unit, format, original, rows_json, row_count, dof) \
@@ -111,12 +109,7 @@ impl Db {
         .bind(s.dof)
         .fetch_one(&mut *tx)
         .await?;
-        let row = sqlx::query_as::<_, SetRow>(&format!("{SET_SELECT} WHERE id = ?"))
-            .bind(id)
-            .fetch_one(&mut *tx)
-            .await?;
-        tx.commit().await?;
-        Ok(Some(row))
+        commit_inserted(tx, SET_SELECT, "id", id).await.map(Some)
     }
 
     /// One page of a robot's sets by id, and how many it has.
@@ -126,10 +119,11 @@ impl Db {
         limit: i64,
         offset: i64,
     ) -> Result<(Vec<SetRow>, i64), DbError> {
-        self.page(
-            &format!("{SET_SELECT} WHERE robot_id = ? ORDER BY id LIMIT ? OFFSET ?"),
-            "SELECT COUNT(*) FROM measurement_sets WHERE robot_id = ?",
-            Some(robot_id),
+        self.robot_page(
+            SET_SELECT,
+            "measurement_sets",
+            "id",
+            robot_id,
             limit,
             offset,
         )
@@ -137,18 +131,11 @@ impl Db {
     }
 
     pub async fn sets(&self, robot_id: i64) -> Result<Vec<SetRow>, DbError> {
-        sqlx::query_as::<_, SetRow>(&format!("{SET_SELECT} WHERE robot_id = ? ORDER BY id"))
-            .bind(robot_id)
-            .fetch_all(&self.pool)
-            .await
+        self.robot_rows(SET_SELECT, "id", robot_id).await
     }
 
     pub async fn set(&self, robot_id: i64, id: i64) -> Result<Option<SetRow>, DbError> {
-        sqlx::query_as::<_, SetRow>(&format!("{SET_SELECT} WHERE robot_id = ? AND id = ?"))
-            .bind(robot_id)
-            .bind(id)
-            .fetch_optional(&self.pool)
-            .await
+        self.robot_row(SET_SELECT, "id", robot_id, id).await
     }
 
     /// The parsed rows of a set (mm/deg).
@@ -184,15 +171,10 @@ impl Db {
     }
 
     pub async fn delete_set(&self, robot_id: i64, id: i64) -> Result<bool, DbError> {
-        let mut tx = self.write().await?;
-        let n = sqlx::query("DELETE FROM measurement_sets WHERE robot_id = ? AND id = ?")
+        let delete = sqlx::query("DELETE FROM measurement_sets WHERE robot_id = ? AND id = ?")
             .bind(robot_id)
-            .bind(id)
-            .execute(&mut *tx)
-            .await?
-            .rows_affected();
-        tx.commit().await?;
-        Ok(n > 0)
+            .bind(id);
+        Ok(self.write_one(delete).await? > 0)
     }
 }
 

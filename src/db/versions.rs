@@ -13,10 +13,11 @@ impl Db {
         limit: i64,
         offset: i64,
     ) -> Result<(Vec<VersionRow>, i64), DbError> {
-        self.page(
-            &format!("{VERSION_SELECT} WHERE robot_id = ? ORDER BY version LIMIT ? OFFSET ?"),
-            "SELECT COUNT(*) FROM model_versions WHERE robot_id = ?",
-            Some(robot_id),
+        self.robot_page(
+            VERSION_SELECT,
+            "model_versions",
+            "version",
+            robot_id,
             limit,
             offset,
         )
@@ -24,12 +25,7 @@ impl Db {
     }
 
     pub async fn versions(&self, robot_id: i64) -> Result<Vec<VersionRow>, DbError> {
-        sqlx::query_as::<_, VersionRow>(&format!(
-            "{VERSION_SELECT} WHERE robot_id = ? ORDER BY version"
-        ))
-        .bind(robot_id)
-        .fetch_all(&self.pool)
-        .await
+        self.robot_rows(VERSION_SELECT, "version", robot_id).await
     }
 
     pub async fn version(
@@ -37,13 +33,8 @@ impl Db {
         robot_id: i64,
         version: i64,
     ) -> Result<Option<VersionRow>, DbError> {
-        sqlx::query_as::<_, VersionRow>(&format!(
-            "{VERSION_SELECT} WHERE robot_id = ? AND version = ?"
-        ))
-        .bind(robot_id)
-        .bind(version)
-        .fetch_optional(&self.pool)
-        .await
+        self.robot_row(VERSION_SELECT, "version", robot_id, version)
+            .await
     }
 
     pub async fn active_version(&self, robot_id: i64) -> Result<Option<VersionRow>, DbError> {

@@ -6,16 +6,14 @@
 //! selection, sessions, the runner, progress, model versions) is
 //! [`crate::service::calibrations`].
 
-use super::input::{
-    check_payload, int, page_fields, present, present_int, present_ints, PageQuery,
-};
-use super::robots::robot_not_found;
+use super::input::{check_payload, int, page_body, present, present_int, present_ints, PageQuery};
+use super::robots::robot_list_page;
 use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState};
 use crate::db::{CalibrationRow, JobStatus, JobSummary};
 use crate::identify::{CalibrationOptions, Method};
 use crate::service::{self, calibrations::StartCommand};
 use axum::extract::State;
-use axum::http::{header, StatusCode};
+use axum::http::StatusCode;
 use axum::response::{Html, IntoResponse, Response};
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
@@ -138,12 +136,14 @@ impl Calibration {
     pub fn from_row(r: CalibrationRow) -> Self {
         let base = format!("/v1/robots/{}/calibrations/{}", r.robot_id, r.id);
         Calibration {
-            links: json!({
-                "self": base,
-                "cancel": format!("{base}/cancel"),
-                "result": format!("{base}/result"),
-                "report": format!("{base}/report"),
-            }),
+            links: super::links(
+                &base,
+                &[
+                    ("cancel", "/cancel"),
+                    ("result", "/result"),
+                    ("report", "/report"),
+                ],
+            ),
             id: r.id,
             robot_id: r.robot_id,
             status: r.status,
@@ -215,12 +215,11 @@ pub async fn start(
     };
     let row = service::calibrations::start(&state, robot_id, cmd).await?;
     let location = format!("/v1/robots/{robot_id}/calibrations/{}", row.id);
-    Ok((
+    Ok(super::located(
         StatusCode::ACCEPTED,
-        [(header::LOCATION, location)],
-        axum::Json(Calibration::from_row(row)),
-    )
-        .into_response())
+        location,
+        Calibration::from_row(row),
+    ))
 }
 
 pub async fn list(
@@ -228,19 +227,13 @@ pub async fn list(
     ApiPath(robot_id): ApiPath<i64>,
     ApiQuery(page): ApiQuery<PageQuery>,
 ) -> Result<Response, ApiError> {
-    let page = page.check(state.limits().page_max)?;
-    if state.db().robot(robot_id).await?.is_none() {
-        return Err(robot_not_found(robot_id));
-    }
+    let (page, _) = robot_list_page(&state, robot_id, page).await?;
     let (rows, total) = state
         .db()
         .calibrations_page(robot_id, page.limit, page.offset)
         .await?;
     let jobs: Vec<Calibration> = rows.into_iter().map(Calibration::from_row).collect();
-    let mut out = page_fields(page, total);
-    out["calibrations"] =
-        serde_json::to_value(jobs).map_err(|e| ApiError::Internal(e.to_string()))?;
-    Ok(axum::Json(out).into_response())
+    Ok(axum::Json(page_body(page, total, "calibrations", jobs)?).into_response())
 }
 
 async fn load(state: &AppState, robot_id: i64, id: i64) -> Result<CalibrationRow, ApiError> {
@@ -370,26 +363,13 @@ pub async fn report(
 
 /// The routes of calibration jobs.
 pub fn routes() -> Vec<super::Route> {
-    use super::route;
-    use axum::http::Method;
+    use super::{get, post};
     vec![
-        route(Method::GET, "/v1/robots/{id}/calibrations", list),
-        route(Method::POST, "/v1/robots/{id}/calibrations", start),
-        route(Method::GET, "/v1/robots/{id}/calibrations/{cid}", get_one),
-        route(
-            Method::POST,
-            "/v1/robots/{id}/calibrations/{cid}/cancel",
-            cancel,
-        ),
-        route(
-            Method::GET,
-            "/v1/robots/{id}/calibrations/{cid}/result",
-            result,
-        ),
-        route(
-            Method::GET,
-            "/v1/robots/{id}/calibrations/{cid}/report",
-            report,
-        ),
+        get("/v1/robots/{id}/calibrations", list),
+        post("/v1/robots/{id}/calibrations", start),
+        get("/v1/robots/{id}/calibrations/{cid}", get_one),
+        post("/v1/robots/{id}/calibrations/{cid}/cancel", cancel),
+        get("/v1/robots/{id}/calibrations/{cid}/result", result),
+        get("/v1/robots/{id}/calibrations/{cid}/report", report),
     ]
 }

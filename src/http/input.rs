@@ -238,6 +238,18 @@ pub fn page_fields(page: Page, total: i64) -> serde_json::Value {
     })
 }
 
+/// A list response: the paging fields and the page's items under `key`.
+pub fn page_body<T: serde::Serialize>(
+    page: Page,
+    total: i64,
+    key: &str,
+    items: T,
+) -> Result<serde_json::Value, ApiError> {
+    let mut out = page_fields(page, total);
+    out[key] = serde_json::to_value(items).map_err(|e| ApiError::Internal(e.to_string()))?;
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -70,12 +70,57 @@ where
     }
 }
 
+/// A `GET` route.
+pub(crate) fn get<H, T>(path: &'static str, handler: H) -> Route
+where
+    H: Handler<T, AppState>,
+    T: 'static,
+{
+    route(Method::GET, path, handler)
+}
+
+/// A `POST` route.
+pub(crate) fn post<H, T>(path: &'static str, handler: H) -> Route
+where
+    H: Handler<T, AppState>,
+    T: 'static,
+{
+    route(Method::POST, path, handler)
+}
+
+/// A `DELETE` route.
+pub(crate) fn delete<H, T>(path: &'static str, handler: H) -> Route
+where
+    H: Handler<T, AppState>,
+    T: 'static,
+{
+    route(Method::DELETE, path, handler)
+}
+
+/// The `links` of a resource at `base`: `self`, and each other relation at
+/// `base` followed by its suffix.
+pub(crate) fn links(base: &str, relations: &[(&str, &str)]) -> serde_json::Value {
+    let mut out = serde_json::Map::new();
+    out.insert("self".into(), base.into());
+    for (rel, suffix) in relations {
+        out.insert((*rel).into(), format!("{base}{suffix}").into());
+    }
+    out.into()
+}
+
+/// The answer to a request that made a resource: `status` (201 Created, 202
+/// Accepted), `Location: location` and the resource as JSON.
+pub(crate) fn located<B: serde::Serialize>(
+    status: axum::http::StatusCode,
+    location: String,
+    body: B,
+) -> Response {
+    (status, [(header::LOCATION, location)], axum::Json(body)).into_response()
+}
+
 /// Every route of the service, resource by resource.
 fn routes() -> Vec<Route> {
-    let mut all = vec![
-        route(Method::GET, "/healthz", healthz),
-        route(Method::GET, "/openapi.yaml", openapi),
-    ];
+    let mut all = vec![get("/healthz", healthz), get("/openapi.yaml", openapi)];
     all.extend(robots::routes());
     all.extend(sets::routes());
     all.extend(calibrations::routes());

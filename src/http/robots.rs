@@ -1,13 +1,13 @@
 //! `/v1/robots`: create from a preset or a model JSON, list, get, update name
 //! and metadata, delete (with its measurement sets, calibrations and versions).
 
-use super::input::{check_payload, page_fields, present, PageQuery};
+use super::input::{check_payload, page_body, present, Page, PageQuery};
 use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState};
 use crate::db::{NewRobot, RobotRow};
 use crate::model::presets::{preset_description, PRESETS};
 use crate::model::RobotModel;
 use axum::extract::State;
-use axum::http::{header, StatusCode};
+use axum::http::StatusCode;
 use axum::response::{IntoResponse, Response};
 use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
@@ -16,6 +16,26 @@ pub(crate) use super::input::check_name;
 
 pub(crate) fn robot_not_found(id: i64) -> ApiError {
     crate::service::ServiceError::robot_not_found(id).into()
+}
+
+/// The checked page of a list that belongs to robot `id`, and the robot
+/// (404 when missing; a bad page is refused first).
+pub(crate) async fn robot_list_page(
+    state: &AppState,
+    id: i64,
+    page: PageQuery,
+) -> Result<(Page, RobotRow), ApiError> {
+    let page = page.check(state.limits().page_max)?;
+    Ok((page, load_robot(state, id).await?))
+}
+
+/// The stored robot `id`, or 404.
+pub(crate) async fn load_robot(state: &AppState, id: i64) -> Result<RobotRow, ApiError> {
+    state
+        .db()
+        .robot(id)
+        .await?
+        .ok_or_else(|| robot_not_found(id))
 }
 
 /// `POST /v1/robots` body: exactly one of `preset` and `model`; no field may
@@ -161,12 +181,11 @@ pub async fn create(
         })
         .await?;
     let location = format!("/v1/robots/{}", row.id);
-    Ok((
+    Ok(super::located(
         StatusCode::CREATED,
-        [(header::LOCATION, location)],
-        axum::Json(Robot::from_row(row, true)),
-    )
-        .into_response())
+        location,
+        Robot::from_row(row, true),
+    ))
 }
 
 pub async fn list(
@@ -179,20 +198,14 @@ pub async fn list(
         .into_iter()
         .map(|r| Robot::from_row(r, false))
         .collect();
-    let mut out = page_fields(page, total);
-    out["robots"] = serde_json::to_value(robots).map_err(|e| ApiError::Internal(e.to_string()))?;
-    Ok(axum::Json(out).into_response())
+    Ok(axum::Json(page_body(page, total, "robots", robots)?).into_response())
 }
 
 pub async fn get_one(
     State(state): State<AppState>,
     ApiPath(id): ApiPath<i64>,
 ) -> Result<Response, ApiError> {
-    let row = state
-        .db()
-        .robot(id)
-        .await?
-        .ok_or_else(|| robot_not_found(id))?;
+    let row = load_robot(&state, id).await?;
     Ok(axum::Json(Robot::from_row(row, true)).into_response())
 }
 
@@ -242,14 +255,13 @@ pub async fn delete(
 
 /// The routes of robots and presets.
 pub fn routes() -> Vec<super::Route> {
-    use super::route;
-    use axum::http::Method;
+    use super::{get, post, route};
     vec![
-        route(Method::GET, "/v1/presets", list_presets),
-        route(Method::GET, "/v1/robots", list),
-        route(Method::POST, "/v1/robots", create),
-        route(Method::GET, "/v1/robots/{id}", get_one),
-        route(Method::PATCH, "/v1/robots/{id}", update),
-        route(Method::DELETE, "/v1/robots/{id}", delete),
+        get("/v1/presets", list_presets),
+        get("/v1/robots", list),
+        post("/v1/robots", create),
+        get("/v1/robots/{id}", get_one),
+        route(axum::http::Method::PATCH, "/v1/robots/{id}", update),
+        super::delete("/v1/robots/{id}", delete),
     ]
 }

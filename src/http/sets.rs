@@ -8,9 +8,9 @@
 
 use super::error::content_type;
 use super::input::{
-    check_name, check_payload, from_json_object, objects, page_fields, present, PageQuery,
+    check_name, check_payload, from_json_object, objects, page_body, present, PageQuery,
 };
-use super::robots::robot_not_found;
+use super::robots::robot_list_page;
 use super::{ApiError, ApiPath, ApiQuery, AppState};
 use crate::db::{AngleUnit, LengthUnit, SetFormat, SetRow};
 use crate::measure::csv::{self, DifSign, ReadOptions};
@@ -372,12 +372,11 @@ pub async fn upload(
     )
     .await?;
     let location = format!("/v1/robots/{robot_id}/measurement-sets/{}", row.id);
-    Ok((
+    Ok(super::located(
         StatusCode::CREATED,
-        [(header::LOCATION, location)],
-        axum::Json(MeasurementSet::from_row(row, None)),
-    )
-        .into_response())
+        location,
+        MeasurementSet::from_row(row, None),
+    ))
 }
 
 pub async fn list(
@@ -385,10 +384,7 @@ pub async fn list(
     ApiPath(robot_id): ApiPath<i64>,
     ApiQuery(page): ApiQuery<PageQuery>,
 ) -> Result<Response, ApiError> {
-    let page = page.check(state.limits().page_max)?;
-    if state.db().robot(robot_id).await?.is_none() {
-        return Err(robot_not_found(robot_id));
-    }
+    let (page, _) = robot_list_page(&state, robot_id, page).await?;
     let (rows, total) = state
         .db()
         .sets_page(robot_id, page.limit, page.offset)
@@ -397,10 +393,7 @@ pub async fn list(
         .into_iter()
         .map(|r| MeasurementSet::from_row(r, None))
         .collect();
-    let mut out = page_fields(page, total);
-    out["measurement_sets"] =
-        serde_json::to_value(sets).map_err(|e| ApiError::Internal(e.to_string()))?;
-    Ok(axum::Json(out).into_response())
+    Ok(axum::Json(page_body(page, total, "measurement_sets", sets)?).into_response())
 }
 
 /// Loads the parsed rows of a set.
@@ -458,26 +451,14 @@ pub async fn delete(
 
 /// The routes of measurement sets.
 pub fn routes() -> Vec<super::Route> {
-    use super::route;
-    use axum::http::Method;
+    use super::{get, post};
     const SETS: &str = "/v1/robots/{id}/measurement-sets";
+    const SET: &str = "/v1/robots/{id}/measurement-sets/{sid}";
     vec![
-        route(Method::GET, SETS, list),
-        route(Method::POST, SETS, upload),
-        route(
-            Method::GET,
-            "/v1/robots/{id}/measurement-sets/{sid}",
-            get_one,
-        ),
-        route(
-            Method::DELETE,
-            "/v1/robots/{id}/measurement-sets/{sid}",
-            delete,
-        ),
-        route(
-            Method::GET,
-            "/v1/robots/{id}/measurement-sets/{sid}/original",
-            original,
-        ),
+        get(SETS, list),
+        post(SETS, upload),
+        get(SET, get_one),
+        super::delete(SET, delete),
+        get("/v1/robots/{id}/measurement-sets/{sid}/original", original),
     ]
 }

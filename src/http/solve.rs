@@ -572,9 +572,5 @@ pub async fn solve(
 
 /// The route of the solve endpoint.
 pub fn routes() -> Vec<super::Route> {
-    vec![super::route(
-        axum::http::Method::POST,
-        "/v1/robots/{id}/solve",
-        solve,
-    )]
+    vec![super::post("/v1/robots/{id}/solve", solve)]
 }

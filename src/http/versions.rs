@@ -4,8 +4,8 @@
 //! export it for other tools (`export?format=urdf|dh-csv|mdh-csv|json`, the
 //! text of `crate::export`).
 
-use super::input::{page_fields, PageQuery};
-use super::robots::robot_not_found;
+use super::input::{page_body, PageQuery};
+use super::robots::{load_robot, robot_list_page};
 use super::{ApiError, ApiPath, ApiQuery, AppState};
 use crate::compensate::CalibratedModelFile;
 use crate::db::{Rollback, VersionRow};
@@ -39,11 +39,10 @@ impl ModelVersion {
     pub fn from_row(v: VersionRow) -> Self {
         let base = format!("/v1/robots/{}/versions/{}", v.robot_id, v.version);
         ModelVersion {
-            links: json!({
-                "self": base,
-                "activate": format!("{base}/activate"),
-                "model": format!("{base}/model.json"),
-            }),
+            links: super::links(
+                &base,
+                &[("activate", "/activate"), ("model", "/model.json")],
+            ),
             version: v.version,
             robot_id: v.robot_id,
             calibration_id: v.calibration_id,
@@ -55,33 +54,19 @@ impl ModelVersion {
     }
 }
 
-async fn robot_exists(state: &AppState, robot_id: i64) -> Result<(), ApiError> {
-    match state.db().robot(robot_id).await? {
-        Some(_) => Ok(()),
-        None => Err(robot_not_found(robot_id)),
-    }
-}
-
 pub async fn list(
     State(state): State<AppState>,
     ApiPath(robot_id): ApiPath<i64>,
     ApiQuery(page): ApiQuery<PageQuery>,
 ) -> Result<Response, ApiError> {
-    let page = page.check(state.limits().page_max)?;
-    let robot = state
-        .db()
-        .robot(robot_id)
-        .await?
-        .ok_or_else(|| robot_not_found(robot_id))?;
+    let (page, robot) = robot_list_page(&state, robot_id, page).await?;
     let (rows, total) = state
         .db()
         .versions_page(robot_id, page.limit, page.offset)
         .await?;
     let versions: Vec<ModelVersion> = rows.into_iter().map(ModelVersion::from_row).collect();
-    let mut out = page_fields(page, total);
+    let mut out = page_body(page, total, "versions", versions)?;
     out["active_version"] = json!(robot.active_version);
-    out["versions"] =
-        serde_json::to_value(versions).map_err(|e| ApiError::Internal(e.to_string()))?;
     Ok(axum::Json(out).into_response())
 }
 
@@ -89,7 +74,7 @@ async fn load(state: &AppState, robot_id: i64, v: i64) -> Result<VersionRow, Api
     match state.db().version(robot_id, v).await? {
         Some(row) => Ok(row),
         None => {
-            robot_exists(state, robot_id).await?;
+            load_robot(state, robot_id).await?;
             Err(version_not_found(robot_id, v))
         }
     }
@@ -194,7 +179,7 @@ pub async fn activate(
     let row = match state.db().activate(robot_id, v).await? {
         Some(row) => row,
         None => {
-            robot_exists(&state, robot_id).await?;
+            load_robot(&state, robot_id).await?;
             return Err(version_not_found(robot_id, v));
         }
     };
@@ -207,7 +192,7 @@ pub async fn rollback(
     State(state): State<AppState>,
     ApiPath(robot_id): ApiPath<i64>,
 ) -> Result<Response, ApiError> {
-    robot_exists(&state, robot_id).await?;
+    load_robot(&state, robot_id).await?;
     match state.db().rollback(robot_id).await? {
         Rollback::Done(row) => {
             state.invalidate_robot(robot_id);
@@ -216,7 +201,7 @@ pub async fn rollback(
         }
         Rollback::NothingToRollBack => {
             // Deleted meanwhile: say so rather than "nothing to roll back".
-            robot_exists(&state, robot_id).await?;
+            load_robot(&state, robot_id).await?;
             Err(ApiError::Conflict(format!(
             "robot {robot_id} has no earlier active version to roll back to; activate a version with POST /v1/robots/{robot_id}/versions/{{version}}/activate"
         )))
@@ -226,26 +211,13 @@ pub async fn rollback(
 
 /// The routes of model versions.
 pub fn routes() -> Vec<super::Route> {
-    use super::route;
-    use axum::http::Method;
+    use super::{get, post};
     vec![
-        route(Method::GET, "/v1/robots/{id}/versions", list),
-        route(Method::POST, "/v1/robots/{id}/versions/rollback", rollback),
-        route(Method::GET, "/v1/robots/{id}/versions/{version}", get_one),
-        route(
-            Method::POST,
-            "/v1/robots/{id}/versions/{version}/activate",
-            activate,
-        ),
-        route(
-            Method::GET,
-            "/v1/robots/{id}/versions/{version}/model.json",
-            download,
-        ),
-        route(
-            Method::GET,
-            "/v1/robots/{id}/versions/{version}/export",
-            export_version,
-        ),
+        get("/v1/robots/{id}/versions", list),
+        post("/v1/robots/{id}/versions/rollback", rollback),
+        get("/v1/robots/{id}/versions/{version}", get_one),
+        post("/v1/robots/{id}/versions/{version}/activate", activate),
+        get("/v1/robots/{id}/versions/{version}/model.json", download),
+        get("/v1/robots/{id}/versions/{version}/export", export_version),
     ]
 }

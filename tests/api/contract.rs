@@ -413,38 +413,23 @@ async fn api_keys_guard_writes_only_when_configured() {
     // Keys on.
     let t = setup_with(&["s3cret", "other"], 1).await;
     let body = br#"{"preset": "ur10"}"#.to_vec();
-    let r = t
-        .raw(
+    let create = |key: Option<&'static str>| {
+        t.raw(
             "POST",
             "/v1/robots",
             Some("application/json"),
             body.clone(),
-            None,
+            key,
         )
-        .await;
+    };
+    let r = create(None).await;
     assert_eq!(r.status, StatusCode::UNAUTHORIZED);
     assert!(r.headers.contains_key(header::WWW_AUTHENTICATE));
     assert!(r.detail().contains("Bearer"));
-    let r = t
-        .raw(
-            "POST",
-            "/v1/robots",
-            Some("application/json"),
-            body.clone(),
-            Some("wrong"),
-        )
-        .await;
+    let r = create(Some("wrong")).await;
     assert_eq!(r.status, StatusCode::UNAUTHORIZED);
     assert!(!r.text().contains("s3cret"));
-    let r = t
-        .raw(
-            "POST",
-            "/v1/robots",
-            Some("application/json"),
-            body.clone(),
-            Some("other"),
-        )
-        .await;
+    let r = create(Some("other")).await;
     assert_eq!(r.status, StatusCode::CREATED);
     let id = r.json()["id"].as_i64().unwrap();
     // Reads are open.

@@ -39,9 +39,8 @@ async fn quickstart_flow_calibrate_version_and_solve() {
 
     // Calibrate km + skcm.
     let r = t
-        .post_json(
-            "/v1/robots/{id}/calibrations",
-            &[&rid],
+        .start_job(
+            &rid,
             json!({ "methods": ["km", "skcm"], "identification_set_ids": [q1["id"]],
                     "validation_set_ids": [q3["id"]], "seed": 1 }),
         )
@@ -145,25 +144,14 @@ async fn quickstart_flow_calibrate_version_and_solve() {
 
     // Nothing to roll back to yet.
     let r = t
-        .send(
-            "POST",
-            "/v1/robots/{id}/versions/rollback",
-            &[&rid],
-            "",
-            None,
-            vec![],
-        )
+        .post_empty("/v1/robots/{id}/versions/rollback", &[&rid])
         .await;
     assert_eq!(r.status, StatusCode::CONFLICT);
     // Activate km, then roll back to skcm.
     let r = t
-        .send(
-            "POST",
+        .post_empty(
             "/v1/robots/{id}/versions/{version}/activate",
             &[&rid, &km_v.to_string()],
-            "",
-            None,
-            vec![],
         )
         .await;
     assert_eq!(r.status, StatusCode::OK);
@@ -173,14 +161,7 @@ async fn quickstart_flow_calibrate_version_and_solve() {
         Some(km_v)
     );
     let r = t
-        .send(
-            "POST",
-            "/v1/robots/{id}/versions/rollback",
-            &[&rid],
-            "",
-            None,
-            vec![],
-        )
+        .post_empty("/v1/robots/{id}/versions/rollback", &[&rid])
         .await;
     assert_eq!(r.status, StatusCode::OK);
     assert_eq!(r.json()["version"].as_i64(), Some(skcm_v));

@@ -10,15 +10,11 @@ use tower::ServiceExt;
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn job_progress_and_cancellation() {
     let t = setup_with(&[], 1).await;
-    let robot = t.create_robot("ys100").await;
-    let rid = robot.to_string();
-    t.upload_csv(robot, &simulated_csv(5, 30), "?role=identification")
-        .await;
+    let (robot, rid) = t.robot_with_identification_set().await;
     // A long TLBO run: progress is reported, then it is cancelled.
     let r = t
-        .post_json(
-            "/v1/robots/{id}/calibrations",
-            &[&rid],
+        .start_job(
+            &rid,
             json!({ "methods": ["skcm-tlbo"], "generations": 10000, "population": 20 }),
         )
         .await;
@@ -26,52 +22,15 @@ async fn job_progress_and_cancellation() {
     assert_eq!(r.json()["status"], "queued");
     let long = r.json()["id"].as_i64().unwrap();
     // A second job waits for the single worker; cancelling it is immediate.
-    let r = t
-        .post_json(
-            "/v1/robots/{id}/calibrations",
-            &[&rid],
-            json!({ "methods": ["km"] }),
-        )
-        .await;
+    let r = t.start_job(&rid, json!({ "methods": ["km"] })).await;
     let queued = r.json()["id"].as_i64().unwrap();
 
-    let start = Instant::now();
-    let running = loop {
-        let j = t
-            .get(
-                "/v1/robots/{id}/calibrations/{cid}",
-                &[&rid, &long.to_string()],
-            )
-            .await
-            .json();
-        if j["progress"]["phase"] == "skcm-tlbo" && j["progress"]["iteration"].as_i64() > Some(1) {
-            break j;
-        }
-        assert!(
-            start.elapsed() < Duration::from_secs(120),
-            "no progress: {j}"
-        );
-        tokio::time::sleep(Duration::from_millis(20)).await;
-    };
+    let running = t.wait_for_progress(&rid, long, "skcm-tlbo", 2).await;
     assert_eq!(running["status"], "running");
     assert!(running["progress"]["percent"].as_f64().unwrap() > 10.0);
-    let r = t
-        .get(
-            "/v1/robots/{id}/calibrations/{cid}",
-            &[&rid, &queued.to_string()],
-        )
-        .await;
+    let r = t.job(&rid, queued).await;
     assert_eq!(r.json()["status"], "queued");
-    let r = t
-        .send(
-            "POST",
-            "/v1/robots/{id}/calibrations/{cid}/cancel",
-            &[&rid, &queued.to_string()],
-            "",
-            None,
-            vec![],
-        )
-        .await;
+    let r = t.cancel_job(&rid, queued).await;
     assert_eq!(r.status, StatusCode::ACCEPTED);
     assert_eq!(r.json()["status"], "cancelled");
 
@@ -85,16 +44,7 @@ async fn job_progress_and_cancellation() {
     assert_eq!(r.status, StatusCode::CONFLICT);
     assert!(r.detail().contains("running"));
 
-    let r = t
-        .send(
-            "POST",
-            "/v1/robots/{id}/calibrations/{cid}/cancel",
-            &[&rid, &long.to_string()],
-            "",
-            None,
-            vec![],
-        )
-        .await;
+    let r = t.cancel_job(&rid, long).await;
     assert_eq!(r.status, StatusCode::ACCEPTED);
     assert_eq!(r.json()["cancel_requested"], true);
     let j = t
@@ -108,16 +58,7 @@ async fn job_progress_and_cancellation() {
     assert_eq!(j["status"], "cancelled", "{j}");
     assert!(j["finished_at"].is_string());
     // Cancelling twice: conflict.
-    let r = t
-        .send(
-            "POST",
-            "/v1/robots/{id}/calibrations/{cid}/cancel",
-            &[&rid, &long.to_string()],
-            "",
-            None,
-            vec![],
-        )
-        .await;
+    let r = t.cancel_job(&rid, long).await;
     assert_eq!(r.status, StatusCode::CONFLICT);
     let r = t
         .get(
@@ -141,9 +82,8 @@ async fn job_progress_and_cancellation() {
         .json();
     let tiny = sets["measurement_sets"][1]["id"].clone();
     let r = t
-        .post_json(
-            "/v1/robots/{id}/calibrations",
-            &[&rid],
+        .start_job(
+            &rid,
             json!({ "methods": ["km"], "identification_set_ids": [tiny] }),
         )
         .await;
@@ -177,25 +117,16 @@ async fn saturation_answers_429_with_retry_after() {
         ..ServiceConfig::default()
     })
     .await;
-    let robot = t.create_robot("ys100").await;
-    let rid = robot.to_string();
-    t.upload_csv(robot, &simulated_csv(5, 30), "?role=identification")
-        .await;
+    let (robot, rid) = t.robot_with_identification_set().await;
     let long = json!({ "methods": ["skcm-tlbo"], "generations": 100000, "population": 20 });
-    let r = t
-        .post_json("/v1/robots/{id}/calibrations", &[&rid], long.clone())
-        .await;
+    let r = t.start_job(&rid, long.clone()).await;
     assert_eq!(r.status, StatusCode::ACCEPTED);
     let running = r.json()["id"].as_i64().unwrap();
-    let r = t
-        .post_json("/v1/robots/{id}/calibrations", &[&rid], long.clone())
-        .await;
+    let r = t.start_job(&rid, long.clone()).await;
     assert_eq!(r.status, StatusCode::ACCEPTED);
     let queued = r.json()["id"].as_i64().unwrap();
     // One worker + one queued place: the third job is refused at once.
-    let r = t
-        .post_json("/v1/robots/{id}/calibrations", &[&rid], long.clone())
-        .await;
+    let r = t.start_job(&rid, long.clone()).await;
     assert_eq!(r.status, StatusCode::TOO_MANY_REQUESTS, "{}", r.text());
     assert!(
         r.headers[header::RETRY_AFTER]
@@ -208,16 +139,7 @@ async fn saturation_answers_429_with_retry_after() {
     assert!(r.detail().contains("--max-queued-jobs"), "{}", r.detail());
     // Cancelling frees the places.
     for job in [queued, running] {
-        let r = t
-            .send(
-                "POST",
-                "/v1/robots/{id}/calibrations/{cid}/cancel",
-                &[&rid, &job.to_string()],
-                "",
-                None,
-                vec![],
-            )
-            .await;
+        let r = t.cancel_job(&rid, job).await;
         assert_eq!(r.status, StatusCode::ACCEPTED);
         t.wait_for(robot, job, &["cancelled"], Duration::from_secs(60))
             .await;
@@ -227,13 +149,7 @@ async fn saturation_answers_429_with_retry_after() {
     let mut admitted = false;
     let deadline = Instant::now() + Duration::from_secs(30);
     while Instant::now() < deadline {
-        let r = t
-            .post_json(
-                "/v1/robots/{id}/calibrations",
-                &[&rid],
-                json!({"methods": ["km"]}),
-            )
-            .await;
+        let r = t.start_job(&rid, json!({"methods": ["km"]})).await;
         if r.status == StatusCode::ACCEPTED {
             admitted = true;
             break;
@@ -297,43 +213,16 @@ async fn saturation_answers_429_with_retry_after() {
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn cancelling_a_big_tlbo_job_takes_effect_quickly() {
     let t = setup_with(&[], 1).await;
-    let robot = t.create_robot("ys100").await;
-    let rid = robot.to_string();
-    t.upload_csv(robot, &simulated_csv(5, 30), "?role=identification")
-        .await;
+    let (robot, rid) = t.robot_with_identification_set().await;
     let r = t
-        .post_json(
-            "/v1/robots/{id}/calibrations",
-            &[&rid],
+        .start_job(
+            &rid,
             json!({ "methods": ["skcm-tlbo"], "generations": 100000, "population": 200 }),
         )
         .await;
     let job = r.json()["id"].as_i64().unwrap();
-    let start = Instant::now();
-    loop {
-        let j = t
-            .get(
-                "/v1/robots/{id}/calibrations/{cid}",
-                &[&rid, &job.to_string()],
-            )
-            .await
-            .json();
-        if j["progress"]["phase"] == "skcm-tlbo" && j["progress"]["iteration"].as_i64() >= Some(1) {
-            break;
-        }
-        assert!(start.elapsed() < Duration::from_secs(120), "{j}");
-        tokio::time::sleep(Duration::from_millis(10)).await;
-    }
-    let r = t
-        .send(
-            "POST",
-            "/v1/robots/{id}/calibrations/{cid}/cancel",
-            &[&rid, &job.to_string()],
-            "",
-            None,
-            vec![],
-        )
-        .await;
+    t.wait_for_progress(&rid, job, "skcm-tlbo", 1).await;
+    let r = t.cancel_job(&rid, job).await;
     assert_eq!(r.status, StatusCode::ACCEPTED);
     let requested = seconds_of_day(r.json()["updated_at"].as_str().unwrap());
     let j = t

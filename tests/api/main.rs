@@ -9,6 +9,8 @@
 //! `flow` (the quickstart end to end), `sets` (uploads), `solve` (targets CSV in and out), `jobs` (progress,
 //! cancellation, saturation, races); the harness is `support`.
 
+#[path = "../common/mod.rs"]
+mod common;
 mod contract;
 mod flow;
 mod jobs;

@@ -116,10 +116,7 @@ async fn csv_and_json_uploads_are_stored_losslessly() {
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn payloads_beyond_10_tonnes_are_refused_before_any_work() {
     let t = setup().await;
-    let robot = t.create_robot("ys100").await;
-    let rid = robot.to_string();
-    t.upload_csv(robot, &simulated_csv(5, 30), "?role=identification")
-        .await;
+    let (_, rid) = t.robot_with_identification_set().await;
     // The calibration that used to panic the worker.
     for p in ["1e308", "1e200", "10000.5", "-1"] {
         let r = t

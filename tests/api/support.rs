@@ -2,13 +2,13 @@
 //! every response checked against `openapi.yaml`; simulated measurements.
 #![allow(dead_code)]
 
+use crate::common::{oneshot, service};
 use axum::body::Body;
 use axum::http::{header, Request, StatusCode};
 use axum::Router;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal::db::Db;
-use robocal::http::{app, AppState, ServiceConfig, OPENAPI_YAML};
+use robocal::http::{AppState, ServiceConfig, OPENAPI_YAML};
 use robocal::measure::{csv, MeasuredPose, SetRole};
 use robocal::model::preset;
 use robocal::sim::{
@@ -18,7 +18,6 @@ use serde_json::{json, Value};
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
-use tower::ServiceExt;
 
 pub(crate) struct Spec {
     pub(crate) doc: Value,
@@ -168,13 +167,10 @@ pub(crate) async fn setup_with(keys: &[&str], workers: usize) -> TestApp {
 }
 
 pub(crate) async fn setup_config(config: ServiceConfig) -> TestApp {
-    let dir = tempfile::tempdir().unwrap();
-    let url = format!("sqlite://{}?mode=rwc", dir.path().join("api.db").display());
-    let db = Db::connect(&url).await.unwrap();
     let keys = config.api_keys.clone();
-    let state = AppState::new(db, config);
+    let (router, state, dir) = service(config).await;
     TestApp {
-        router: app(state.clone()),
+        router,
         state,
         spec: Arc::new(Spec::load()),
         _dir: dir,
@@ -271,22 +267,12 @@ impl TestApp {
         if let Some(k) = key {
             req = req.header(header::AUTHORIZATION, format!("Bearer {k}"));
         }
-        let res = self
-            .router
-            .clone()
-            .oneshot(req.body(Body::from(body)).unwrap())
-            .await
-            .unwrap();
-        let status = res.status();
-        let headers = res.headers().clone();
+        let (status, headers, body) =
+            oneshot(&self.router, req.body(Body::from(body)).unwrap()).await;
         let content_type = headers
             .get(header::CONTENT_TYPE)
             .map(|v| v.to_str().unwrap().to_string())
             .unwrap_or_default();
-        let body = axum::body::to_bytes(res.into_body(), usize::MAX)
-            .await
-            .unwrap()
-            .to_vec();
         if status.is_client_error() || status.is_server_error() {
             assert_eq!(content_type, "application/problem+json", "{method} {uri}");
             self.spec
@@ -314,6 +300,70 @@ impl TestApp {
             body.to_string().into_bytes(),
         )
         .await
+    }
+
+    /// A `POST` without a body (cancel, activate, rollback).
+    pub(crate) async fn post_empty(&self, template: &str, args: &[&str]) -> Resp {
+        self.send("POST", template, args, "", None, Vec::new())
+            .await
+    }
+
+    /// Starts a calibration job of robot `rid` with `body`.
+    pub(crate) async fn start_job(&self, rid: &str, body: Value) -> Resp {
+        self.post_json("/v1/robots/{id}/calibrations", &[rid], body)
+            .await
+    }
+
+    /// `GET` of job `job` of robot `rid`.
+    pub(crate) async fn job(&self, rid: &str, job: i64) -> Resp {
+        self.get(
+            "/v1/robots/{id}/calibrations/{cid}",
+            &[rid, &job.to_string()],
+        )
+        .await
+    }
+
+    /// Requests cancellation of job `job` of robot `rid`.
+    pub(crate) async fn cancel_job(&self, rid: &str, job: i64) -> Resp {
+        self.post_empty(
+            "/v1/robots/{id}/calibrations/{cid}/cancel",
+            &[rid, &job.to_string()],
+        )
+        .await
+    }
+
+    /// Polls job `job` of robot `rid` until it reports phase `phase` at
+    /// iteration `min_iteration` or later (at most 120 s); the job then.
+    pub(crate) async fn wait_for_progress(
+        &self,
+        rid: &str,
+        job: i64,
+        phase: &str,
+        min_iteration: i64,
+    ) -> Value {
+        let start = Instant::now();
+        loop {
+            let j = self.job(rid, job).await.json();
+            if j["progress"]["phase"] == phase
+                && j["progress"]["iteration"].as_i64() >= Some(min_iteration)
+            {
+                return j;
+            }
+            assert!(
+                start.elapsed() < Duration::from_secs(120),
+                "no progress: {j}"
+            );
+            tokio::time::sleep(Duration::from_millis(10)).await;
+        }
+    }
+
+    /// A YS100 with one simulated identification set (seed 5, 30 poses):
+    /// its id, as a number and as text.
+    pub(crate) async fn robot_with_identification_set(&self) -> (i64, String) {
+        let robot = self.create_robot("ys100").await;
+        self.upload_csv(robot, &simulated_csv(5, 30), "?role=identification")
+            .await;
+        (robot, robot.to_string())
     }
 
     pub(crate) async fn create_robot(&self, preset: &str) -> i64 {

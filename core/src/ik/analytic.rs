@@ -541,10 +541,7 @@ impl AnalyticIk {
                         [t0, t1, t2, t3, t4, t5],
                         Configuration::new(sh, el, wr),
                         sing0 || sing,
-                        Reach {
-                            clamped: clamp0 || clamp1,
-                            excess_m: signed_excess(excess0, excess1),
-                        },
+                        Reach::of(clamp0, clamp1, excess0, excess1),
                         ctx,
                         out,
                     );
@@ -612,10 +609,7 @@ impl AnalyticIk {
                         [t0, t1, t2, total - t1 - t2, t4, t5],
                         Configuration::new(sh, el, wr),
                         sing0 || sing,
-                        Reach {
-                            clamped: clamp0 || clamp1,
-                            excess_m: signed_excess(excess0, excess1),
-                        },
+                        Reach::of(clamp0, clamp1, excess0, excess1),
                         ctx,
                         out,
                     );
@@ -687,6 +681,16 @@ fn signed_excess(a: f64, b: f64) -> f64 {
 struct Reach {
     clamped: bool,
     excess_m: f64,
+}
+
+impl Reach {
+    /// The reach of a branch from its shoulder (0) and planar (1) steps.
+    fn of(clamp0: bool, clamp1: bool, excess0: f64, excess1: f64) -> Reach {
+        Reach {
+            clamped: clamp0 || clamp1,
+            excess_m: signed_excess(excess0, excess1),
+        }
+    }
 }
 /// `(θ3, θ4, θ5, wrist, singular)` pairs.
 type WristSolutions = [(f64, f64, f64, Wrist, bool); 2];

@@ -269,6 +269,11 @@ pub struct IkSolution {
 
 impl IkSolution {
     pub fn invalid(reason: String) -> Self {
+        IkSolution::failed(FailureReason::InvalidTarget(reason))
+    }
+
+    /// A solution that failed before any iteration: no joints, NaN residuals.
+    fn failed(reason: FailureReason) -> Self {
         IkSolution {
             converged: false,
             q: Vec::new(),
@@ -276,7 +281,7 @@ impl IkSolution {
             orientation_residual_rad: f64::NAN,
             iterations: 0,
             branch: None,
-            reason: Some(FailureReason::InvalidTarget(reason)),
+            reason: Some(reason),
         }
     }
 }
@@ -503,15 +508,7 @@ impl IkSolver {
             };
         }
         let seeds = self.seeds(goal, options);
-        let fail = |reason: FailureReason| IkSolution {
-            converged: false,
-            q: Vec::new(),
-            position_residual_mm: f64::NAN,
-            orientation_residual_rad: f64::NAN,
-            iterations: 0,
-            branch: None,
-            reason: Some(reason),
-        };
+        let fail = IkSolution::failed;
         // The reach test: beyond the nominal workspace by more than the
         // calibrated model can deviate from it.
         let reach_test = self.settings.reach_test;

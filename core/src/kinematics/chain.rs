@@ -91,21 +91,14 @@ fn chain_angles(
 #[inline]
 fn link_step(k: usize, l: &Link, angle: f64, pose: &mut Pose) -> LinkFrames {
     let start = *pose;
-    if k == 0 {
+    let (after_a, after_beta) = if k == 0 {
         pose.tr_x(l.a);
         pose.tr_y(l.b);
         pose.tr_z(l.d);
         pose.rot_x(l.alpha);
         let after_a = *pose;
         pose.rot_y(l.beta);
-        let after_beta = *pose;
-        pose.rot_z(angle);
-        LinkFrames {
-            start,
-            after_a,
-            after_beta,
-            frame: *pose,
-        }
+        (after_a, *pose)
     } else {
         pose.rot_x(l.alpha);
         pose.tr_x(l.a);
@@ -115,13 +108,14 @@ fn link_step(k: usize, l: &Link, angle: f64, pose: &mut Pose) -> LinkFrames {
         }
         let after_beta = *pose;
         pose.tr_z(l.d);
-        pose.rot_z(angle);
-        LinkFrames {
-            start,
-            after_a,
-            after_beta,
-            frame: *pose,
-        }
+        (after_a, after_beta)
+    };
+    pose.rot_z(angle);
+    LinkFrames {
+        start,
+        after_a,
+        after_beta,
+        frame: *pose,
     }
 }
 
