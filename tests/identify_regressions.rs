@@ -12,8 +12,8 @@ use robocal::identify::{
     CalibrationError, CalibrationOptions, CalibrationReport, DropKind, LmSettings, Method,
     StopReason, WarningKind,
 };
-use robocal::measure::{self, csv};
-use robocal::model::preset;
+use robocal::measure::{self, csv, Measurement};
+use robocal::model::{preset, RobotModel};
 use robocal::sim::{perturb_geometry, random_configurations, ErrorMagnitudes, TrueRobot};
 
 /// A truth whose joint 3 deflects *against* its gravity torque (an effect no
@@ -172,6 +172,29 @@ fn ur5_with_tcp_offset_drops_nearly_dependent_wrist_parameters() {
     assert!(skcm <= km * 1.03, "SKCM {skcm} mm vs KM {km} mm");
 }
 
+/// A YS100 truth: geometric errors (1 mm, 0.1°) and the seed's Table 7.2
+/// stiffness (K2..K5; joints 1 and 6 rigid).
+fn table_7_2_truth(nominal: &RobotModel, rng: &mut ChaCha8Rng) -> RobotModel {
+    let mut tm = perturb_geometry(nominal, &ErrorMagnitudes::from_mm_deg(1.0, 0.1), rng);
+    let stiffness = [0.0, 1.5e6, 1.0e6, 1.2e6, 1.0e6, 0.0];
+    for (l, k) in tm.links.iter_mut().zip(stiffness) {
+        l.compliance = if k > 0.0 { 1.0 / k } else { 0.0 };
+    }
+    tm
+}
+
+/// Validation means of SKCM and SKCM-payload and the SKCM-payload report.
+fn skcm_and_payload(
+    nominal: &RobotModel,
+    id: &[Measurement],
+    va: &[Measurement],
+) -> (f64, f64, robocal::identify::MethodReport) {
+    let mut r = run_with(nominal, id, va, opts(&[Method::Skcm, Method::SkcmPayload])).unwrap();
+    let v = |m: &str| r.methods[m].validation.as_ref().unwrap().stats.mean_mm;
+    let (skcm, payload) = (v("skcm"), v("skcm-payload"));
+    (skcm, payload, r.methods.remove("skcm-payload").unwrap())
+}
+
 /// Validation means of SKCM and SKCM-payload, the CoM error [mm] and the
 /// SKCM-payload report, for a truth whose payload CoM is 250 mm from the
 /// model's and whose link masses are `mass_factor` times the model's.
@@ -179,12 +202,7 @@ fn payload_case(mass_factor: f64) -> (f64, f64, f64, robocal::identify::MethodRe
     use robocal::sim::tracker_frame;
     let nominal = preset("ys100").unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(77);
-    let mut tm = perturb_geometry(&nominal, &ErrorMagnitudes::from_mm_deg(1.0, 0.1), &mut rng);
-    // Seed Table 7.2: K2..K5; joints 1 and 6 rigid.
-    let stiffness = [0.0, 1.5e6, 1.0e6, 1.2e6, 1.0e6, 0.0];
-    for (l, k) in tm.links.iter_mut().zip(stiffness) {
-        l.compliance = if k > 0.0 { 1.0 / k } else { 0.0 };
-    }
+    let mut tm = table_7_2_truth(&nominal, &mut rng);
     // The payload's CoM 150 mm along x and 200 mm along z of the tool frame.
     tm.payload.com = nominal.payload.com + nalgebra::Vector3::new(0.15, 0.0, 0.2);
     for l in tm.links.iter_mut() {
@@ -195,16 +213,7 @@ fn payload_case(mass_factor: f64) -> (f64, f64, f64, robocal::identify::MethodRe
     truth.noise_mm = 0.01;
     let id = measure_truth(&truth, &nominal, 80, &mut rng);
     let va = measure_truth(&truth, &nominal, 40, &mut rng);
-    let mut r = run_with(
-        &nominal,
-        &id,
-        &va,
-        opts(&[Method::Skcm, Method::SkcmPayload]),
-    )
-    .unwrap();
-    let v = |m: &str| r.methods[m].validation.as_ref().unwrap().stats.mean_mm;
-    let (skcm, payload) = (v("skcm"), v("skcm-payload"));
-    let m = r.methods.remove("skcm-payload").unwrap();
+    let (skcm, payload, m) = skcm_and_payload(&nominal, &id, &va);
     let err_mm = (m.calibrated.payload.com - tm.payload.com).norm() * 1e3;
     eprintln!(
         "link masses x{mass_factor}: SKCM {skcm:.4} mm, SKCM-payload {payload:.4} mm, CoM error {err_mm:.2} mm"
@@ -258,11 +267,7 @@ fn skcm_payload_identifies_an_unknown_payload_mass() {
     use robocal::sim::tracker_frame;
     let nominal = preset("ys100").unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(78);
-    let mut tm = perturb_geometry(&nominal, &ErrorMagnitudes::from_mm_deg(1.0, 0.1), &mut rng);
-    let stiffness = [0.0, 1.5e6, 1.0e6, 1.2e6, 1.0e6, 0.0];
-    for (l, k) in tm.links.iter_mut().zip(stiffness) {
-        l.compliance = if k > 0.0 { 1.0 / k } else { 0.0 };
-    }
+    let tm = table_7_2_truth(&nominal, &mut rng);
     let mut truth = TrueRobot::new(tm);
     truth.tracker_from_base = tracker_frame(3.0, -2.0, 120.0, [2500.0, -1800.0, 400.0]);
     truth.noise_mm = 0.01;
@@ -281,16 +286,7 @@ fn skcm_payload_identifies_an_unknown_payload_mass() {
     id.extend(set(60, 40.0, &mut rng));
     let mut va = set(30, 110.0, &mut rng);
     va.extend(set(30, 40.0, &mut rng));
-    let mut r = run_with(
-        &nominal,
-        &id,
-        &va,
-        opts(&[Method::Skcm, Method::SkcmPayload]),
-    )
-    .unwrap();
-    let v = |m: &str| r.methods[m].validation.as_ref().unwrap().stats.mean_mm;
-    let (skcm, payload) = (v("skcm"), v("skcm-payload"));
-    let m = r.methods.remove("skcm-payload").unwrap();
+    let (skcm, payload, m) = skcm_and_payload(&nominal, &id, &va);
     let offset = m.calibrated.payload.mass_offset;
     let e = m
         .parameters
@@ -321,11 +317,7 @@ fn two_session_skcm_c_is_as_accurate_as_one() {
     use robocal::sim::tracker_frame;
     let nominal = preset("ys100").unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(41);
-    let mut tm = perturb_geometry(&nominal, &ErrorMagnitudes::from_mm_deg(1.0, 0.1), &mut rng);
-    let stiffness = [0.0, 1.5e6, 1.0e6, 1.2e6, 1.0e6, 0.0];
-    for (l, k) in tm.links.iter_mut().zip(stiffness) {
-        l.compliance = if k > 0.0 { 1.0 / k } else { 0.0 };
-    }
+    let tm = table_7_2_truth(&nominal, &mut rng);
     let frames = [
         tracker_frame(2.0, -1.0, 30.0, [2200.0, 300.0, -200.0]),
         tracker_frame(-4.0, 3.0, -110.0, [-800.0, 2600.0, 150.0]),

@@ -129,6 +129,19 @@ fn check_methods(result: &Value) {
     }
 }
 
+/// No method failed, each gave one of the `versions` versions, and every
+/// model is admissible with an honest solver report.
+fn all_delivered(result: &Value, versions: usize) {
+    assert_eq!(result["report"]["failed"], json!([]));
+    assert_eq!(
+        result["versions"].as_array().unwrap().len(),
+        versions,
+        "{}",
+        result["versions"]
+    );
+    check_methods(result);
+}
+
 /// Real UR5 over HTTP with the default request `{}` (km + skcm): succeeds,
 /// every method gives a version, KM reaches ≤ 0.105 mm mean on the 20 random
 /// poses, SKCM no worse than KM + 3 %, all compliances ≥ 0, solvers honest.
@@ -177,14 +190,7 @@ async fn real_ur5_skcm_c_over_http() {
             json!({ "methods": ["km", "skcm-tlbo"], "population": 20, "generations": 20, "seed": 1 }),
         )
         .await;
-    assert_eq!(r["report"]["failed"], json!([]));
-    assert_eq!(
-        r["versions"].as_array().unwrap().len(),
-        2,
-        "{}",
-        r["versions"]
-    );
-    check_methods(&r);
+    all_delivered(&r, 2);
     let (km, skcm_c) = (val_mean(&r, "km"), val_mean(&r, "skcm-tlbo"));
     eprintln!("real UR5 over HTTP: KM {km:.4} mm, SKCM-C {skcm_c:.4} mm on the 20 random poses");
     assert!(skcm_c <= 1.03 * km, "SKCM-C {skcm_c} mm vs KM {km} mm");
@@ -206,14 +212,7 @@ async fn real_wam_all_methods_over_http() {
             }),
         )
         .await;
-    assert_eq!(r["report"]["failed"], json!([]));
-    assert_eq!(
-        r["versions"].as_array().unwrap().len(),
-        4,
-        "{}",
-        r["versions"]
-    );
-    check_methods(&r);
+    all_delivered(&r, 4);
     let nominal = r["report"]["nominal"]["validation"]["mean_mm"]
         .as_f64()
         .unwrap();

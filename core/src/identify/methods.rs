@@ -85,14 +85,7 @@ impl Context<'_> {
     }
 
     pub fn km(&self, progress: &mut dyn FnMut(usize, f64) -> bool) -> Result<Fit, Cancelled> {
-        fit(
-            &self.start,
-            &self.kept_geo,
-            self.ident,
-            self.sessions,
-            &self.opts.lm,
-            progress,
-        )
+        self.fit_from(&self.start, &self.kept_geo, progress)
     }
 
     fn require_compliance(&self) -> Result<(), MethodError> {
@@ -104,20 +97,31 @@ impl Context<'_> {
         Ok(())
     }
 
+    /// LM on `ids` from `start` with the identification poses and every
+    /// tracker session (`least_squares::fit`).
+    fn fit_from(
+        &self,
+        start: &RobotModel,
+        ids: &[ParamId],
+        progress: &mut dyn FnMut(usize, f64) -> bool,
+    ) -> Result<Fit, Cancelled> {
+        fit(
+            start,
+            ids,
+            self.ident,
+            self.sessions,
+            &self.opts.lm,
+            progress,
+        )
+    }
+
     pub fn skcm(
         &self,
         progress: &mut dyn FnMut(usize, f64) -> bool,
     ) -> Result<MethodFit, MethodError> {
         self.require_compliance()?;
         let ids = self.with_compliance();
-        let f = fit(
-            &self.start,
-            &ids,
-            self.ident,
-            self.sessions,
-            &self.opts.lm,
-            progress,
-        )?;
+        let f = self.fit_from(&self.start, &ids, progress)?;
         Ok(MethodFit {
             fit: f,
             ids,
@@ -153,14 +157,7 @@ impl Context<'_> {
             return Err(MethodError::Cancelled);
         }
         let start = cost.with_c(&result.best);
-        let f = fit(
-            &start,
-            &self.kept_geo,
-            self.ident,
-            self.sessions,
-            &self.opts.lm,
-            &mut |_, _| true,
-        )?;
+        let f = self.fit_from(&start, &self.kept_geo, &mut |_, _| true)?;
         Ok(MethodFit {
             fit: f,
             ids: self.with_compliance(),
@@ -241,14 +238,7 @@ impl Context<'_> {
             .chain(single_mass)
             .collect();
         let ids: Vec<ParamId> = base.iter().chain(&kept_payload).copied().collect();
-        let f = fit(
-            &skcm.model,
-            &ids,
-            self.ident,
-            self.sessions,
-            &self.opts.lm,
-            progress,
-        )?;
+        let f = self.fit_from(&skcm.model, &ids, progress)?;
         Ok(MethodFit {
             fit: f,
             ids,
