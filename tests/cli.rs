@@ -1,5 +1,8 @@
 //! The command line end to end: simulate → calibrate (table and JSON), and errors.
 
+mod common;
+
+use common::robocal_json;
 use std::process::Command;
 
 fn robocal(args: &[&str], dir: &std::path::Path) -> std::process::Output {
@@ -38,7 +41,8 @@ fn simulate_then_calibrate_json_is_scriptable() {
         &dir,
     );
     assert!(b.status.success());
-    let out = robocal(
+    let v = robocal_json(
+        &dir,
         &[
             "calibrate",
             "--model",
@@ -53,14 +57,7 @@ fn simulate_then_calibrate_json_is_scriptable() {
             "--save",
             "cal.json",
         ],
-        &dir,
     );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let km = v["methods"]["km"]["validation"]["mean_mm"]
         .as_f64()
         .unwrap();
@@ -211,7 +208,8 @@ fn compensator_method_saves_and_solves() {
         want.push(p);
     }
     std::fs::write(dir.join("targets.csv"), targets).unwrap();
-    let out = robocal(
+    let v = robocal_json(
+        &dir,
         &[
             "solve",
             "--model",
@@ -221,14 +219,7 @@ fn compensator_method_saves_and_solves() {
             "--position-only",
             "--json",
         ],
-        &dir,
     );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let results = v["targets"].as_array().unwrap_or_else(|| panic!("{v}"));
     assert_eq!(results.len(), 5);
     assert!(v["solved"].as_u64() >= Some(4), "{v}");

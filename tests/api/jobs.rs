@@ -222,20 +222,7 @@ async fn cancelling_a_big_tlbo_job_takes_effect_quickly() {
         .await;
     let job = r.json()["id"].as_i64().unwrap();
     t.wait_for_progress(&rid, job, "skcm-tlbo", 1).await;
-    let r = t.cancel_job(&rid, job).await;
-    assert_eq!(r.status, StatusCode::ACCEPTED);
-    let requested = seconds_of_day(r.json()["updated_at"].as_str().unwrap());
-    let j = t
-        .wait_for(
-            robot,
-            job,
-            &["cancelled", "failed", "succeeded"],
-            Duration::from_secs(60),
-        )
-        .await;
-    assert_eq!(j["status"], "cancelled", "{j}");
-    let ended = seconds_of_day(j["finished_at"].as_str().unwrap());
-    let latency = ended - requested;
+    let latency = t.cancel_latency(robot, job).await;
     assert!(
         (0.0..5.0).contains(&latency),
         "cancellation took {latency:.3} s"
@@ -505,29 +492,7 @@ async fn cancelling_a_compensator_job_during_training_takes_effect_quickly() {
         assert!(start.elapsed() < Duration::from_secs(120), "{j}");
         tokio::time::sleep(Duration::from_millis(10)).await;
     }
-    let r = t
-        .send(
-            "POST",
-            "/v1/robots/{id}/calibrations/{cid}/cancel",
-            &[&rid, &job.to_string()],
-            "",
-            None,
-            vec![],
-        )
-        .await;
-    assert_eq!(r.status, StatusCode::ACCEPTED);
-    let requested = seconds_of_day(r.json()["updated_at"].as_str().unwrap());
-    let j = t
-        .wait_for(
-            robot,
-            job,
-            &["cancelled", "failed", "succeeded"],
-            Duration::from_secs(60),
-        )
-        .await;
-    assert_eq!(j["status"], "cancelled", "{j}");
-    let ended = seconds_of_day(j["finished_at"].as_str().unwrap());
-    let latency = ended - requested;
+    let latency = t.cancel_latency(robot, job).await;
     assert!(
         (0.0..5.0).contains(&latency),
         "cancellation took {latency:.3} s"

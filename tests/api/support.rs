@@ -332,6 +332,25 @@ impl TestApp {
         .await
     }
 
+    /// Cancels the running job `job` of robot `robot` and returns the seconds
+    /// from the cancel answer to the job's end, by the job's own timestamps;
+    /// the job must end `cancelled`.
+    pub(crate) async fn cancel_latency(&self, robot: i64, job: i64) -> f64 {
+        let r = self.cancel_job(&robot.to_string(), job).await;
+        assert_eq!(r.status, StatusCode::ACCEPTED);
+        let requested = seconds_of_day(r.json()["updated_at"].as_str().unwrap());
+        let j = self
+            .wait_for(
+                robot,
+                job,
+                &["cancelled", "failed", "succeeded"],
+                Duration::from_secs(60),
+            )
+            .await;
+        assert_eq!(j["status"], "cancelled", "{j}");
+        seconds_of_day(j["finished_at"].as_str().unwrap()) - requested
+    }
+
     /// Polls job `job` of robot `rid` until it reports phase `phase` at
     /// iteration `min_iteration` or later (at most 120 s); the job then.
     pub(crate) async fn wait_for_progress(
