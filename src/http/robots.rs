@@ -127,11 +127,10 @@ pub async fn list_presets() -> Result<Response, ApiError> {
     Ok(axum::Json(serde_json::json!({ "presets": presets })).into_response())
 }
 
-pub async fn create(
-    State(state): State<AppState>,
-    ApiJson(body): ApiJson<CreateRobot>,
-) -> Result<Response, ApiError> {
-    let (model, preset): (RobotModel, Option<String>) = match (&body.preset, &body.model) {
+/// The robot model of a create request: a preset by name, or a model JSON
+/// object (422 naming what is wrong); with the preset's name.
+fn requested_model(body: &CreateRobot) -> Result<(RobotModel, Option<String>), ApiError> {
+    Ok(match (&body.preset, &body.model) {
         (Some(_), Some(_)) => {
             return Err(ApiError::invalid(
                 "give either `preset` or `model`, not both",
@@ -161,7 +160,14 @@ pub async fn create(
             check_payload("model field 'payload.mass_kg'", model.payload.mass)?;
             (model, None)
         }
-    };
+    })
+}
+
+pub async fn create(
+    State(state): State<AppState>,
+    ApiJson(body): ApiJson<CreateRobot>,
+) -> Result<Response, ApiError> {
+    let (model, preset) = requested_model(&body)?;
     let name = body.name.clone().unwrap_or_else(|| model.name.clone());
     check_name(&name, "`name`")?;
     let empty = Map::new();

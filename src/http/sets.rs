@@ -303,31 +303,17 @@ fn read_options(q: &SetParams, c: &Checked) -> Result<ReadOptions, ApiError> {
     })
 }
 
-pub async fn upload(
-    State(state): State<AppState>,
-    ApiPath(robot_id): ApiPath<i64>,
-    ApiQuery(query): ApiQuery<SetParams>,
-    headers: HeaderMap,
-    body: Result<Bytes, BytesRejection>,
-) -> Result<Response, ApiError> {
-    let ct = content_type(&headers);
-    let is_csv = matches!(ct.as_str(), "text/csv" | "application/csv" | "text/plain");
-    let is_json = ct == "application/json" || ct.ends_with("+json");
-    if !is_csv && !is_json {
-        return Err(ApiError::UnsupportedMediaType(format!(
-            "upload the measurement CSV as `Content-Type: text/csv` or rows as `application/json`{}",
-            if ct.is_empty() {
-                String::new()
-            } else {
-                format!(", not `{ct}`")
-            }
-        )));
-    }
-    let text = String::from_utf8(body?.to_vec())
-        .map_err(|_| ApiError::invalid("the upload is not UTF-8 text"))?;
+/// The upload's body as a service command: a CSV with its query options, or
+/// JSON rows with their metadata in the body (422 naming what is wrong).
+fn upload_command(
+    robot_id: i64,
+    query: &SetParams,
+    is_csv: bool,
+    text: String,
+) -> Result<NewSetCommand, ApiError> {
     let (c, content) = if is_csv {
-        let c = check_params(&query)?;
-        let read = read_options(&query, &c)?;
+        let c = check_params(query)?;
+        let read = read_options(query, &c)?;
         (c, SetContent::Csv { text, read })
     } else {
         let SetParams {
@@ -349,28 +335,51 @@ pub async fn upload(
         let up: JsonUpload = from_json_object(text.as_bytes())?;
         let c = check_params(&up.params())?;
         let rows = json_rows(up.rows, &c)?;
-        (
-            c,
-            SetContent::Rows {
-                rows,
-                original: text,
-            },
-        )
+        let original = text;
+        (c, SetContent::Rows { rows, original })
     };
-    let row = service::sets::upload(
-        &state,
-        NewSetCommand {
-            robot_id,
-            name: c.name,
-            role: c.role,
-            session: c.session,
-            payload_kg: c.payload_kg,
-            length: c.length,
-            angle: c.angle,
-            content,
-        },
-    )
-    .await?;
+    Ok(NewSetCommand {
+        robot_id,
+        name: c.name,
+        role: c.role,
+        session: c.session,
+        payload_kg: c.payload_kg,
+        length: c.length,
+        angle: c.angle,
+        content,
+    })
+}
+
+/// Whether the upload is a CSV (else JSON rows); 415 for other media types.
+fn upload_is_csv(headers: &HeaderMap) -> Result<bool, ApiError> {
+    let ct = content_type(headers);
+    let is_csv = matches!(ct.as_str(), "text/csv" | "application/csv" | "text/plain");
+    let is_json = ct == "application/json" || ct.ends_with("+json");
+    if !is_csv && !is_json {
+        let not = if ct.is_empty() {
+            String::new()
+        } else {
+            format!(", not `{ct}`")
+        };
+        return Err(ApiError::UnsupportedMediaType(format!(
+            "upload the measurement CSV as `Content-Type: text/csv` or rows as `application/json`{not}"
+        )));
+    }
+    Ok(is_csv)
+}
+
+pub async fn upload(
+    State(state): State<AppState>,
+    ApiPath(robot_id): ApiPath<i64>,
+    ApiQuery(query): ApiQuery<SetParams>,
+    headers: HeaderMap,
+    body: Result<Bytes, BytesRejection>,
+) -> Result<Response, ApiError> {
+    let is_csv = upload_is_csv(&headers)?;
+    let text = String::from_utf8(body?.to_vec())
+        .map_err(|_| ApiError::invalid("the upload is not UTF-8 text"))?;
+    let cmd = upload_command(robot_id, &query, is_csv, text)?;
+    let row = service::sets::upload(&state, cmd).await?;
     let location = format!("/v1/robots/{robot_id}/measurement-sets/{}", row.id);
     Ok(super::located(
         StatusCode::CREATED,

@@ -28,7 +28,7 @@ use crate::ik::{
 };
 use crate::model::orientation::OrientationConvention;
 use crate::service;
-use crate::service::solve::{ModelChoice, SolveCommand, Targets};
+use crate::service::solve::{ModelChoice, SolveCommand, SolveOutcome, Targets};
 use axum::body::Bytes;
 use axum::extract::rejection::BytesRejection;
 use axum::extract::State;
@@ -494,6 +494,52 @@ fn wants_csv(headers: &HeaderMap, request_is_csv: bool) -> bool {
     }
 }
 
+/// The request body as a service command (JSON with its options in the body,
+/// or a targets CSV with its options in the query).
+fn solve_command(
+    robot_id: i64,
+    query: &CsvSolveQuery,
+    request_is_csv: bool,
+    body: &[u8],
+) -> Result<SolveCommand, ApiError> {
+    if request_is_csv {
+        let text = std::str::from_utf8(body)
+            .map_err(|_| ApiError::invalid("the targets CSV is not UTF-8 text"))?;
+        return csv_command(robot_id, query, text);
+    }
+    if !query.is_empty() {
+        return Err(ApiError::invalid(
+            "for JSON solves give the options in the body, not the query string",
+        ));
+    }
+    let req: SolveRequest = from_json_object(body)?;
+    json_command(robot_id, &req)
+}
+
+/// A solve's answer as CSV, the model used in `X-Robocal-*` headers.
+fn csv_answer(done: &SolveOutcome, conv: OrientationConvention, solved: usize) -> Response {
+    let version = done
+        .version
+        .map(|v| v.to_string())
+        .unwrap_or_else(|| "nominal".into());
+    (
+        [
+            (header::CONTENT_TYPE, "text/csv; charset=utf-8".to_string()),
+            (HeaderName::from_static("x-robocal-version"), version),
+            (
+                HeaderName::from_static("x-robocal-method"),
+                done.method.clone(),
+            ),
+            (
+                HeaderName::from_static("x-robocal-solved"),
+                format!("{solved}/{}", done.results.len()),
+            ),
+        ],
+        results_csv(&done.results, done.dof, conv),
+    )
+        .into_response()
+}
+
 pub async fn solve(
     State(state): State<AppState>,
     ApiPath(robot_id): ApiPath<i64>,
@@ -502,30 +548,14 @@ pub async fn solve(
     body: Result<Bytes, BytesRejection>,
 ) -> Result<Response, ApiError> {
     let start = Instant::now();
-    let ct = content_type(&headers);
-    let request_is_csv = is_csv_type(&ct);
+    let request_is_csv = is_csv_type(&content_type(&headers));
     if !request_is_csv && !json_content_type(&headers) {
         return Err(ApiError::UnsupportedMediaType(
             "send the targets as JSON (`Content-Type: application/json`) or as a targets CSV (`Content-Type: text/csv`, options in the query string)".into(),
         ));
     }
-    let body = body?;
-    let cmd = if request_is_csv {
-        let text = std::str::from_utf8(&body)
-            .map_err(|_| ApiError::invalid("the targets CSV is not UTF-8 text"))?;
-        csv_command(robot_id, &query, text)?
-    } else {
-        if !query.is_empty() {
-            return Err(ApiError::invalid(
-                "for JSON solves give the options in the body, not the query string",
-            ));
-        }
-        let req: SolveRequest = from_json_object(&body)?;
-        json_command(robot_id, &req)?
-    };
-    let frame = cmd.options.frame;
-    let position_only = cmd.options.position_only;
-    let path = cmd.path;
+    let cmd = solve_command(robot_id, &query, request_is_csv, &body?)?;
+    let (frame, position_only, path) = (cmd.options.frame, cmd.options.position_only, cmd.path);
     let out_conv = cmd
         .options
         .false_target_convention
@@ -533,27 +563,10 @@ pub async fn solve(
     let done = service::solve::solve(&state, cmd).await?;
     let solved = done.results.iter().filter(|r| r.solution.converged).count();
     if wants_csv(&headers, request_is_csv) {
-        let text = results_csv(&done.results, done.dof, out_conv);
-        let version = done
-            .version
-            .map(|v| v.to_string())
-            .unwrap_or_else(|| "nominal".into());
-        return Ok((
-            [
-                (header::CONTENT_TYPE, "text/csv; charset=utf-8".to_string()),
-                (HeaderName::from_static("x-robocal-version"), version),
-                (HeaderName::from_static("x-robocal-method"), done.method),
-                (
-                    HeaderName::from_static("x-robocal-solved"),
-                    format!("{solved}/{}", done.results.len()),
-                ),
-            ],
-            text,
-        )
-            .into_response());
+        return Ok(csv_answer(&done, out_conv, solved));
     }
     let out: Vec<TargetOut> = done.results.into_iter().map(TargetOut::from).collect();
-    let resp = SolveResponse {
+    Ok(axum::Json(SolveResponse {
         robot_id,
         version: done.version,
         method: done.method,
@@ -566,8 +579,8 @@ pub async fn solve(
         failed: out.len() - solved,
         elapsed_ms: start.elapsed().as_secs_f64() * 1e3,
         results: out,
-    };
-    Ok(axum::Json(resp).into_response())
+    })
+    .into_response())
 }
 
 /// The route of the solve endpoint.
