@@ -15,6 +15,9 @@
 //! listed with its reason; the others are kept); the best method (by
 //! validation mean, identification mean without validation) is activated only
 //! when the robot has no active version yet.
+//!
+//! Length: the phases of a job (set selection, loading, running, storing
+//! versions and the summary) are kept together, each in its own function.
 
 use super::limits::Ticket;
 use super::{AppState, ServiceError};
@@ -67,164 +70,161 @@ fn set_vanished(robot_id: i64, set_id: i64) -> ServiceError {
     ))
 }
 
-/// Queues a calibration of a robot and starts its job; returns the queued job.
-pub async fn start(
-    state: &AppState,
+/// A set list of the command (`ids`), or every set of the robot with `role`.
+fn pick_sets(
+    all_sets: &[SetRow],
+    ids: &Option<Vec<i64>>,
+    role: StoredRole,
+    field: &str,
     robot_id: i64,
-    cmd: StartCommand,
-) -> Result<CalibrationRow, ServiceError> {
-    let robot = state
-        .db()
-        .robot(robot_id)
-        .await?
-        .ok_or_else(|| ServiceError::robot_not_found(robot_id))?;
-    let nominal = RobotModel::from_json(&robot.model_json)
-        .map_err(|e| ServiceError::Internal(format!("stored model of robot {robot_id}: {e}")))?;
-    let ticket = state.admit_job()?;
-
-    // The sets: named, or every set of the robot with the matching role.
-    let all_sets = state.db().sets(robot_id).await?;
-    // A delete of the robot may have run between the robot lookup and the set
-    // list (the cascade removes its sets): the robot still existing now means
-    // it existed when the sets were read, so the list is that robot's.
-    if state.db().robot(robot_id).await?.is_none() {
-        return Err(ServiceError::robot_not_found(robot_id));
-    }
-    let pick = |ids: &Option<Vec<i64>>,
-                role: StoredRole,
-                field: &str|
-     -> Result<Vec<_>, ServiceError> {
-        match ids {
-            None => Ok(all_sets
-                .iter()
-                .filter(|s| s.role == role)
-                .cloned()
-                .collect()),
-            Some(ids) => {
-                if ids.len() > MAX_SETS {
-                    return Err(ServiceError::Invalid(format!(
-                        "`{field}` lists {} sets; at most {MAX_SETS}",
-                        ids.len()
-                    )));
-                }
-                let mut out: Vec<SetRow> = Vec::new();
-                for id in ids {
-                    // A reference in the body to a set the robot does not
-                    // have (yet): a conflict with its state, not a missing URL.
-                    let s = all_sets.iter().find(|s| s.id == *id).ok_or_else(|| {
-                        ServiceError::Conflict(format!(
-                            "`{field}`: measurement set {id} does not exist for robot {robot_id}; list them with GET /v1/robots/{robot_id}/measurement-sets"
-                        ))
-                    })?;
-                    if !out.iter().any(|o| o.id == s.id) {
-                        out.push(s.clone());
-                    }
-                }
-                Ok(out)
-            }
-        }
+) -> Result<Vec<SetRow>, ServiceError> {
+    let Some(ids) = ids else {
+        return Ok(all_sets
+            .iter()
+            .filter(|s| s.role == role)
+            .cloned()
+            .collect());
     };
-    let ident_sets = pick(
-        &cmd.identification_set_ids,
-        StoredRole::Identification,
+    if ids.len() > MAX_SETS {
+        return Err(ServiceError::Invalid(format!(
+            "`{field}` lists {} sets; at most {MAX_SETS}",
+            ids.len()
+        )));
+    }
+    let mut out: Vec<SetRow> = Vec::new();
+    for id in ids {
+        // A reference in the body to a set the robot does not have (yet): a
+        // conflict with its state, not a missing URL.
+        let s = all_sets.iter().find(|s| s.id == *id).ok_or_else(|| {
+            ServiceError::Conflict(format!(
+                "`{field}`: measurement set {id} does not exist for robot {robot_id}; list them with GET /v1/robots/{robot_id}/measurement-sets"
+            ))
+        })?;
+        if !out.iter().any(|o| o.id == s.id) {
+            out.push(s.clone());
+        }
+    }
+    Ok(out)
+}
+
+/// The sets of a job by role (Q1, Q3, Q2).
+struct SelectedSets {
+    ident: Vec<SetRow>,
+    valid: Vec<SetRow>,
+    train: Vec<SetRow>,
+}
+
+/// The sets of a command, each in one role, with at least one identification set.
+fn select_sets(
+    all_sets: &[SetRow],
+    cmd: &StartCommand,
+    robot_id: i64,
+) -> Result<SelectedSets, ServiceError> {
+    use StoredRole::{Identification, Training, Validation};
+    let ids = &cmd.identification_set_ids;
+    let ident = pick_sets(
+        all_sets,
+        ids,
+        Identification,
         "identification_set_ids",
+        robot_id,
     )?;
-    let valid_sets = pick(
-        &cmd.validation_set_ids,
-        StoredRole::Validation,
-        "validation_set_ids",
-    )?;
-    let train_sets = pick(
+    let ids = &cmd.validation_set_ids;
+    let valid = pick_sets(all_sets, ids, Validation, "validation_set_ids", robot_id)?;
+    let train = pick_sets(
+        all_sets,
         &cmd.training_set_ids,
-        StoredRole::Training,
+        Training,
         "training_set_ids",
+        robot_id,
     )?;
-    if ident_sets.is_empty() {
+    if ident.is_empty() {
         // The robot's data, not the request, is missing: a state conflict.
         return Err(ServiceError::Conflict(format!(
             "no identification set: upload one with role identification (POST /v1/robots/{robot_id}/measurement-sets) or list its id in `identification_set_ids`"
         )));
     }
-    if let Some(s) = valid_sets
-        .iter()
-        .find(|v| ident_sets.iter().any(|i| i.id == v.id))
-    {
+    if let Some(s) = valid.iter().find(|v| ident.iter().any(|i| i.id == v.id)) {
         return Err(ServiceError::Invalid(format!(
             "measurement set {} is listed for both identification and validation; validation data must never be used for fitting",
             s.id
         )));
     }
-    if let Some(s) = train_sets.iter().find(|t| {
-        ident_sets.iter().any(|i| i.id == t.id) || valid_sets.iter().any(|v| v.id == t.id)
-    }) {
+    if let Some(s) = train
+        .iter()
+        .find(|t| ident.iter().any(|i| i.id == t.id) || valid.iter().any(|v| v.id == t.id))
+    {
         return Err(ServiceError::Invalid(format!(
             "measurement set {} is listed for training and for identification or validation; each set plays one role",
             s.id
         )));
     }
-    // Tracker sessions: identification sessions in order of first appearance.
+    Ok(SelectedSets {
+        ident,
+        valid,
+        train,
+    })
+}
+
+/// Tracker sessions: the identification sets' sessions in order of first
+/// appearance; a validation or training set of another session cannot be
+/// registered (a state conflict).
+fn sessions_of(sets: &SelectedSets) -> Result<Vec<String>, ServiceError> {
     let mut sessions: Vec<String> = Vec::new();
-    for s in &ident_sets {
+    for s in &sets.ident {
         if !sessions.contains(&s.session) {
             sessions.push(s.session.clone());
         }
     }
-    if let Some(v) = valid_sets.iter().find(|v| !sessions.contains(&v.session)) {
-        // A property of the stored sets: a state conflict.
-        return Err(ServiceError::Conflict(format!(
-            "validation set {} was measured in tracker session `{}`, which no identification set has, so its frame cannot be registered; measure identification poses in that session too",
-            v.id, v.session
-        )));
-    }
-    if let Some(t) = train_sets.iter().find(|t| !sessions.contains(&t.session)) {
-        return Err(ServiceError::Conflict(format!(
-            "training set {} was measured in tracker session `{}`, which no identification set has, so its frame cannot be registered; measure identification poses in that session too",
-            t.id, t.session
-        )));
-    }
-    let default_payload = cmd.payload_kg.unwrap_or(nominal.payload.mass);
-    let load = |sets: &[SetRow]| {
-        let state = state.clone();
-        let sets = sets.to_vec();
-        let sessions = sessions.clone();
-        let nominal = nominal.clone();
-        async move {
-            let mut out = Vec::new();
-            let mut sources = Vec::new();
-            for s in &sets {
-                let rows = state
-                    .db()
-                    .set_rows(robot_id, s.id)
-                    .await?
-                    .ok_or_else(|| set_vanished(robot_id, s.id))?;
-                let session = sessions.iter().position(|x| *x == s.session).unwrap_or(0);
-                let payload = s.payload_kg.unwrap_or(default_payload);
-                for (i, r) in rows.iter().enumerate() {
-                    let mut m = r.to_measurement(&nominal, payload);
-                    m.session = session;
-                    out.push(m);
-                    // Where the pose came from, for the report's per-pose table.
-                    sources.push(PoseSource {
-                        set: s.name.clone(),
-                        row: i + 1,
-                        session: s.session.clone(),
-                    });
-                }
-            }
-            Ok::<_, ServiceError>((out, sources))
+    for (what, list) in [("validation", &sets.valid), ("training", &sets.train)] {
+        if let Some(v) = list.iter().find(|v| !sessions.contains(&v.session)) {
+            return Err(ServiceError::Conflict(format!(
+                "{what} set {} was measured in tracker session `{}`, which no identification set has, so its frame cannot be registered; measure identification poses in that session too",
+                v.id, v.session
+            )));
         }
-    };
-    let (ident, ident_sources) = load(&ident_sets).await?;
-    let (valid, valid_sources) = load(&valid_sets).await?;
-    let (training, train_sources) = load(&train_sets).await?;
-    let pose_sources = PoseSources {
-        identification: ident_sources,
-        validation: valid_sources,
-        training: train_sources,
-    };
+    }
+    Ok(sessions)
+}
 
+/// The poses of `sets` (SI, session indices into `sessions`) and where each
+/// came from, for the report's per-pose table.
+async fn load_sets(
+    state: &AppState,
+    robot_id: i64,
+    sets: &[SetRow],
+    sessions: &[String],
+    nominal: &RobotModel,
+    default_payload: f64,
+) -> Result<(Vec<Measurement>, Vec<PoseSource>), ServiceError> {
+    let mut out = Vec::new();
+    let mut sources = Vec::new();
+    for s in sets {
+        let rows = state
+            .db()
+            .set_rows(robot_id, s.id)
+            .await?
+            .ok_or_else(|| set_vanished(robot_id, s.id))?;
+        let session = sessions.iter().position(|x| *x == s.session).unwrap_or(0);
+        let payload = s.payload_kg.unwrap_or(default_payload);
+        for (i, r) in rows.iter().enumerate() {
+            let mut m = r.to_measurement(nominal, payload);
+            m.session = session;
+            out.push(m);
+            sources.push(PoseSource {
+                set: s.name.clone(),
+                row: i + 1,
+                session: s.session.clone(),
+            });
+        }
+    }
+    Ok((out, sources))
+}
+
+/// The calibration options of a command.
+fn calibration_options(cmd: &StartCommand) -> CalibrationOptions {
     let defaults = CalibrationOptions::default();
-    let opts = CalibrationOptions {
+    CalibrationOptions {
         methods: cmd.methods.clone(),
         register: cmd.register,
         lm: LmSettings {
@@ -241,13 +241,72 @@ pub async fn start(
             ..defaults.compensator.clone()
         },
         ..defaults
+    }
+}
+
+/// Queues a calibration of a robot and starts its job; returns the queued job.
+pub async fn start(
+    state: &AppState,
+    robot_id: i64,
+    cmd: StartCommand,
+) -> Result<CalibrationRow, ServiceError> {
+    let robot = state
+        .db()
+        .robot(robot_id)
+        .await?
+        .ok_or_else(|| ServiceError::robot_not_found(robot_id))?;
+    let nominal = RobotModel::from_json(&robot.model_json)
+        .map_err(|e| ServiceError::Internal(format!("stored model of robot {robot_id}: {e}")))?;
+    let ticket = state.admit_job()?;
+
+    let all_sets = state.db().sets(robot_id).await?;
+    // A delete of the robot may have run between the robot lookup and the set
+    // list (the cascade removes its sets): the robot still existing now means
+    // it existed when the sets were read, so the list is that robot's.
+    if state.db().robot(robot_id).await?.is_none() {
+        return Err(ServiceError::robot_not_found(robot_id));
+    }
+    let sets = select_sets(&all_sets, &cmd, robot_id)?;
+    let sessions = sessions_of(&sets)?;
+    let default_payload = cmd.payload_kg.unwrap_or(nominal.payload.mass);
+    let (ident, ident_sources) = load_sets(
+        state,
+        robot_id,
+        &sets.ident,
+        &sessions,
+        &nominal,
+        default_payload,
+    )
+    .await?;
+    let (valid, valid_sources) = load_sets(
+        state,
+        robot_id,
+        &sets.valid,
+        &sessions,
+        &nominal,
+        default_payload,
+    )
+    .await?;
+    let (training, train_sources) = load_sets(
+        state,
+        robot_id,
+        &sets.train,
+        &sessions,
+        &nominal,
+        default_payload,
+    )
+    .await?;
+    let pose_sources = PoseSources {
+        identification: ident_sources,
+        validation: valid_sources,
+        training: train_sources,
     };
+
+    let opts = calibration_options(&cmd);
     let method_names: Vec<String> = cmd.methods.iter().map(|m| m.name().to_string()).collect();
-    let ident_ids: Vec<i64> = ident_sets.iter().map(|s| s.id).collect();
-    let valid_ids: Vec<i64> = valid_sets.iter().map(|s| s.id).collect();
-    let train_ids: Vec<i64> = train_sets.iter().map(|s| s.id).collect();
+    let ids = |list: &[SetRow]| list.iter().map(|s| s.id).collect::<Vec<i64>>();
     let options = json!({
-        "training_set_ids": train_ids,
+        "training_set_ids": ids(&sets.train),
         "seed": cmd.seed,
         "population": opts.tlbo.population,
         "generations": opts.tlbo.generations,
@@ -260,8 +319,8 @@ pub async fn start(
         .insert_calibration(&NewCalibration {
             robot_id,
             methods: &method_names,
-            identification_set_ids: &ident_ids,
-            validation_set_ids: &valid_ids,
+            identification_set_ids: &ids(&sets.ident),
+            validation_set_ids: &ids(&sets.valid),
             options: &options,
         })
         .await?
