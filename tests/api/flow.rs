@@ -119,6 +119,25 @@ async fn quickstart_flow_calibrate_version_and_solve() {
     assert!(r.content_type.starts_with("text/html"));
     let html = r.text();
     assert!(html.contains("<svg") && html.contains("cell-3"));
+    // The report's sections over HTTP, self-contained: histograms, per-axis
+    // errors, errors by position, the per-pose table (one row per pose).
+    for id in ["histograms", "per-axis", "positions", "poses", "statistics"] {
+        assert!(
+            html.contains(&format!(" id=\"{id}\"")),
+            "section {id} missing"
+        );
+    }
+    let lower = html.to_lowercase();
+    for external in ["src=\"http", "href=\"http", "<link", "@import"] {
+        assert!(!lower.contains(external), "external reference `{external}`");
+    }
+    let poses = &html[html.find(" id=\"poses\"").unwrap()..];
+    let poses = &poses[..poses.find("</section>").unwrap()];
+    assert_eq!(
+        poses.matches("<tr").count(),
+        1 + 30 + 20,
+        "header + 30 + 20 poses"
+    );
 
     // Versions: one per method; the best is active (the robot had none).
     let r = t.get("/v1/robots/{id}/versions", &[&rid]).await;
