@@ -4,7 +4,7 @@
 //! kinematics to 1e-6 mm; the command line writes every format.
 
 use robocal::cli::export::{export_to_string, ExportArgs};
-use robocal::compensate::load_compensated;
+use robocal::cli::model_files::load_compensated;
 use robocal::kinematics::fk;
 
 const CALIBRATED: &str = "tests/golden/ur5_km_calibrated.json";

@@ -15,10 +15,11 @@ use nalgebra::{Matrix3, Vector3};
 use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use robocal::cli::model_files::{load_compensated, save_model_file};
 use robocal::cli::solve::{solve_to_string, OutputFormat, SolveArgs};
 use robocal::compensate::{
-    load_compensated, parse_compensated, synthetic_calibration, CalibratedModelFile,
-    CompensatedModel, Compensator, SyntheticErrors,
+    parse_compensated, synthetic_calibration, CalibratedModelFile, CompensatedModel, Compensator,
+    SyntheticErrors,
 };
 use robocal::ik::{
     AnalyticIk, Configuration, FailureReason, Goal, IkSettings, IkSolver, SolveOptions,
@@ -700,7 +701,7 @@ fn calibrated_model_file_round_trip_gives_the_same_solutions() {
     let dir = std::env::temp_dir().join(format!("robocal-ik-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("cal.json");
-    file.save(&path).unwrap();
+    save_model_file(&file, &path).unwrap();
     let back = load_compensated(path.to_str().unwrap()).unwrap();
     assert_eq!(back.payload_kg, 500.0);
     assert!(back.calibrated.has_compliance());
@@ -744,9 +745,11 @@ fn cli_solves_a_targets_csv_into_json_and_table() {
     let dir = std::env::temp_dir().join(format!("robocal-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let model = dir.join("cal.json");
-    CalibratedModelFile::from_compensated(&cm, "ys100", "skcm")
-        .save(&model)
-        .unwrap();
+    save_model_file(
+        &CalibratedModelFile::from_compensated(&cm, "ys100", "skcm"),
+        &model,
+    )
+    .unwrap();
     let mut csv = String::from("# targets in the tracker frame\nid,x,y,z,a,b,c\n");
     let qs = [
         [0.1, 1.3, -0.2, 0.3, 0.8, 0.1],

@@ -261,7 +261,7 @@ fn save_model(
         &nominal.name,
         chosen.method.name(),
     );
-    file.save(std::path::Path::new(path))?;
+    super::model_files::save_model_file(&file, std::path::Path::new(path))?;
     eprintln!("saved the {} model to {path}", chosen.method.name());
     Ok(())
 }

@@ -2,7 +2,7 @@
 //! standard-DH or modified-DH CSV, or robocal's JSON (`crate::export` makes the
 //! text; this command reads the model and writes the file or stdout).
 
-use crate::compensate::load_compensated;
+use super::model_files::load_compensated;
 use crate::export::{export, ExportFormat, ExportSource};
 use anyhow::Context;
 use clap::Args;

@@ -6,6 +6,7 @@ pub mod bench;
 pub mod calibrate;
 pub mod demo;
 pub mod export;
+pub mod model_files;
 pub mod progress;
 pub mod serve;
 pub mod simulate;

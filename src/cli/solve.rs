@@ -16,7 +16,7 @@
 //! as the input), as a table (`--format table`, the default), CSV
 //! (`--format csv`, the columns of `ik::targets_csv::results_csv`) or JSON.
 
-use crate::compensate::load_compensated;
+use super::model_files::load_compensated;
 use crate::csv_text::{parse_delimiter, Decimal, Dialect};
 use crate::ik::targets_csv::CONVENTION_COLUMNS;
 use crate::ik::{

@@ -29,7 +29,7 @@
 //! A file with an unknown `kind` is rejected.
 
 use super::{CompensateError, CompensatedModel, StoredCompensator};
-use crate::model::{preset, ModelDescription, RobotModel};
+use crate::model::{ModelDescription, RobotModel};
 use serde::{Deserialize, Serialize};
 
 /// The `format` value of a calibrated model file written now.
@@ -141,14 +141,6 @@ impl CalibratedModelFile {
     pub fn from_json(text: &str) -> Result<Self, CompensateError> {
         serde_json::from_str(text).map_err(|e| CompensateError::Format(e.to_string()))
     }
-
-    /// Writes the file as pretty JSON.
-    pub fn save(&self, path: &std::path::Path) -> Result<(), CompensateError> {
-        std::fs::write(path, self.to_json() + "\n").map_err(|e| CompensateError::Io {
-            path: path.display().to_string(),
-            reason: e.to_string(),
-        })
-    }
 }
 
 /// Parses either a calibrated model file or a plain model description. A plain
@@ -163,35 +155,10 @@ pub fn parse_compensated(text: &str) -> Result<CompensatedModel, CompensateError
     }
 }
 
-/// Loads a calibrated model file, a model JSON file or a preset name.
-pub fn load_compensated(arg: &str) -> Result<CompensatedModel, CompensateError> {
-    let path = std::path::Path::new(arg);
-    if path.exists() {
-        let text = std::fs::read_to_string(path).map_err(|e| CompensateError::Io {
-            path: arg.to_string(),
-            reason: e.to_string(),
-        })?;
-        parse_compensated(&text).map_err(|e| match e {
-            CompensateError::Io { .. } => e,
-            other => CompensateError::Io {
-                path: arg.to_string(),
-                reason: other.to_string(),
-            },
-        })
-    } else if arg.ends_with(".json") {
-        Err(CompensateError::Io {
-            path: arg.to_string(),
-            reason: "file does not exist".into(),
-        })
-    } else {
-        Ok(CompensatedModel::from_nominal(preset(arg)?))
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::Pose;
+    use crate::model::{preset, Pose};
 
     #[test]
     fn file_round_trip_keeps_model_frame_and_payload() {
@@ -221,14 +188,12 @@ mod tests {
     }
 
     #[test]
-    fn plain_models_and_presets_load_as_nominal() {
-        let m = load_compensated("ur10").unwrap();
-        assert_eq!(m.calibrated, m.nominal);
-        assert_eq!(m.cell_from_base, Pose::identity());
+    fn plain_models_load_as_nominal() {
         let text = preset("ys100").unwrap().to_json();
         let m = parse_compensated(&text).unwrap();
+        assert_eq!(m.calibrated, m.nominal);
+        assert_eq!(m.cell_from_base, Pose::identity());
         assert_eq!(m.payload_kg, 110.0);
-        assert!(load_compensated("missing.json").is_err());
         let mut f = CalibratedModelFile::from_compensated(&m, "ys100", "km");
         f.format = "robocal-calibrated-model/9".into();
         assert!(parse_compensated(&f.to_json()).is_err());

@@ -34,10 +34,7 @@ pub mod select;
 pub mod synthetic;
 pub mod train;
 
-pub use file::{
-    load_compensated, parse_compensated, CalibratedModelFile, PoseDescription,
-    CALIBRATED_MODEL_FORMAT,
-};
+pub use file::{parse_compensated, CalibratedModelFile, PoseDescription, CALIBRATED_MODEL_FORMAT};
 pub use mlp::{Features, Mlp, Normalisation};
 pub use rbf::{train_rbf, train_rbf_with_progress, OutputFrame, Rbf, RbfReport, RbfSettings};
 pub use select::{choose, cross_validate, Choice, CvStats};

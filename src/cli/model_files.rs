@@ -1,0 +1,59 @@
+//! Model files on disk, for the command line (the core parses and writes
+//! their text; reading and writing files happens here): a calibrated model
+//! file (`robocal calibrate --save`), a model JSON file, or a preset name.
+
+use crate::compensate::{
+    parse_compensated, CalibratedModelFile, CompensateError, CompensatedModel,
+};
+use crate::model::preset;
+use std::path::Path;
+
+/// Loads a calibrated model file, a model JSON file or a preset name.
+pub fn load_compensated(arg: &str) -> Result<CompensatedModel, CompensateError> {
+    let path = Path::new(arg);
+    if path.exists() {
+        let io = |reason: String| CompensateError::Io {
+            path: arg.to_string(),
+            reason,
+        };
+        let text = std::fs::read_to_string(path).map_err(|e| io(e.to_string()))?;
+        parse_compensated(&text).map_err(|e| match e {
+            CompensateError::Io { .. } => e,
+            other => io(other.to_string()),
+        })
+    } else if arg.ends_with(".json") {
+        Err(CompensateError::Io {
+            path: arg.to_string(),
+            reason: "file does not exist".into(),
+        })
+    } else {
+        Ok(CompensatedModel::from_nominal(preset(arg)?))
+    }
+}
+
+/// Writes a calibrated model file as pretty JSON.
+pub fn save_model_file(file: &CalibratedModelFile, path: &Path) -> Result<(), CompensateError> {
+    std::fs::write(path, file.to_json() + "\n").map_err(|e| CompensateError::Io {
+        path: path.display().to_string(),
+        reason: e.to_string(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn presets_and_files_load_and_missing_files_fail() {
+        let m = load_compensated("ur10").unwrap();
+        assert_eq!(m.calibrated, m.nominal);
+        assert!(load_compensated("missing.json").is_err());
+        assert!(load_compensated("no-such-preset").is_err());
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("cal.json");
+        let file = CalibratedModelFile::from_compensated(&m, "ur10", "km");
+        save_model_file(&file, &path).unwrap();
+        let back = load_compensated(path.to_str().unwrap()).unwrap();
+        assert_eq!(back.calibrated, m.calibrated);
+    }
+}
