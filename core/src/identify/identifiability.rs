@@ -312,7 +312,7 @@ pub fn uncertainty(
     let std_devs = ids
         .iter()
         .zip(&sd)
-        .map(|(id, s)| (id.name(), super::report::to_display(id, *s)))
+        .map(|(id, s)| (id.name(), id.to_display(*s)))
         .collect();
     let mut pairs = Vec::new();
     for a in 0..ids.len() {

@@ -13,7 +13,6 @@ use super::stats::ErrorStats;
 use crate::compensate::{Compensator, CvStats, StoredCompensator, TrainReport};
 use crate::measure::Measurement;
 use crate::model::description::PoseDescription;
-use crate::model::params::ParamUnit;
 use crate::model::pose::Pose;
 use crate::model::{ModelDescription, ParamId, RobotModel};
 use nalgebra::{DMatrix, Vector3};
@@ -341,24 +340,6 @@ impl PoseSources {
     }
 }
 
-/// Converts an SI parameter value to display units.
-pub fn to_display(id: &ParamId, v: f64) -> f64 {
-    match id.unit() {
-        ParamUnit::Length => v * 1e3,
-        ParamUnit::Angle => v.to_degrees(),
-        ParamUnit::Compliance | ParamUnit::Mass => v,
-    }
-}
-
-pub(crate) fn unit_name(id: &ParamId) -> &'static str {
-    match id.unit() {
-        ParamUnit::Length => "mm",
-        ParamUnit::Angle => "deg",
-        ParamUnit::Compliance => "rad/(N·m)",
-        ParamUnit::Mass => "kg",
-    }
-}
-
 /// Identified parameters in display units; σ from the covariance (none for a
 /// parameter held at a bound).
 pub(crate) fn estimates(
@@ -372,12 +353,12 @@ pub(crate) fn estimates(
         .enumerate()
         .map(|(i, id)| ParamEstimate {
             name: id.name(),
-            unit: unit_name(id).into(),
-            nominal: to_display(id, crate::model::params::get(nominal, *id)),
-            value: to_display(id, crate::model::params::get(fitted, *id)),
+            unit: id.unit_name().into(),
+            nominal: id.to_display(crate::model::params::get(nominal, *id)),
+            value: id.to_display(crate::model::params::get(fitted, *id)),
             std: cov
                 .filter(|c| i < c.nrows() && !at_bound.get(i).copied().unwrap_or(false))
-                .map(|c| to_display(id, c[(i, i)].max(0.0).sqrt())),
+                .map(|c| id.to_display(c[(i, i)].max(0.0).sqrt())),
         })
         .collect()
 }

@@ -67,13 +67,14 @@
 
 use super::analytic::{closed_form_proxy, AnalyticIk, AnalyticSolution};
 use super::config::Configuration;
-use super::targets::TargetFrame;
 use crate::compensate::CompensatedModel;
 use crate::model::orientation::OrientationConvention;
 use crate::model::pose::rotation_log;
 use crate::model::{Pose, RobotModel};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::str::FromStr;
 
 mod newton;
 mod reach;
@@ -89,6 +90,37 @@ const REACH_SLACK_M: f64 = 0.05;
 
 /// The last-resort long run only starts from attempts closer than this [m].
 const LAST_RESORT_MAX_M: f64 = 0.01;
+
+/// Frame of the targets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TargetFrame {
+    /// The calibrated model's measurement (cell / tracker) frame.
+    #[default]
+    Cell,
+    /// The registered robot base frame.
+    Base,
+}
+
+impl FromStr for TargetFrame {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "cell" | "measurement" | "tracker" => Ok(TargetFrame::Cell),
+            "base" | "robot" => Ok(TargetFrame::Base),
+            other => Err(format!("unknown target frame `{other}` (use cell or base)")),
+        }
+    }
+}
+
+impl fmt::Display for TargetFrame {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            TargetFrame::Cell => "cell",
+            TargetFrame::Base => "base",
+        })
+    }
+}
 
 /// Numerical settings of the solver.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

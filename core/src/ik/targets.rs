@@ -13,43 +13,11 @@
 //!   the controller's nominal base frame, in the caller's orientation
 //!   convention (quaternion when the target had no orientation).
 
+pub use super::solver::TargetFrame;
 use super::solver::{Goal, IkSolution, IkSolver};
 use crate::model::orientation::{rotation_from, rotation_to, OrientationConvention};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
-use std::fmt;
-use std::str::FromStr;
-
-/// Frame of the targets.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum TargetFrame {
-    /// The calibrated model's measurement (cell / tracker) frame.
-    #[default]
-    Cell,
-    /// The registered robot base frame.
-    Base,
-}
-
-impl FromStr for TargetFrame {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s.trim().to_ascii_lowercase().as_str() {
-            "cell" | "measurement" | "tracker" => Ok(TargetFrame::Cell),
-            "base" | "robot" => Ok(TargetFrame::Base),
-            other => Err(format!("unknown target frame `{other}` (use cell or base)")),
-        }
-    }
-}
-
-impl fmt::Display for TargetFrame {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            TargetFrame::Cell => "cell",
-            TargetFrame::Base => "base",
-        })
-    }
-}
 
 /// One target as a caller sends it (boundary units).
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]

@@ -494,10 +494,7 @@ pub fn rotation_to(conv: OrientationConvention, r: &Matrix3<f64>) -> Vec<f64> {
         OrientationConvention::Quaternion | OrientationConvention::AbbQ1q4 => {
             quaternion_from_matrix(r).to_vec()
         }
-        OrientationConvention::UrRotvec => crate::model::pose::rotation_log(r)
-            .iter()
-            .map(|v| v + 0.0)
-            .collect(),
+        OrientationConvention::UrRotvec => rotation_log(r).iter().map(|v| v + 0.0).collect(),
         OrientationConvention::KukaAbc => {
             let (a, b, c) = rz_ry_rx_angles(r);
             vec![wrap_degrees(a), middle_degrees(b), wrap_degrees(c)]
@@ -509,6 +506,27 @@ pub fn rotation_to(conv: OrientationConvention, r: &Matrix3<f64>) -> Vec<f64> {
         OrientationConvention::Matrix => (0..3)
             .flat_map(|i| (0..3).map(move |j| r[(i, j)]))
             .collect(),
+    }
+}
+
+/// Rotation vector (axis · angle, rad) of `r`, robust near 0 and π.
+pub fn rotation_log(r: &Matrix3<f64>) -> Vector3<f64> {
+    // sinθ·axis from the skew part, cosθ from the trace: accurate for small angles.
+    let s = Vector3::new(
+        r[(2, 1)] - r[(1, 2)],
+        r[(0, 2)] - r[(2, 0)],
+        r[(1, 0)] - r[(0, 1)],
+    ) * 0.5;
+    let c = 0.5 * (r.trace() - 1.0);
+    if c > -0.9 {
+        let sn = s.norm();
+        let theta = sn.atan2(c);
+        if sn < 1e-300 {
+            return Vector3::zeros();
+        }
+        s * (theta / sn)
+    } else {
+        nalgebra::Rotation3::from_matrix_unchecked(*r).scaled_axis()
     }
 }
 

@@ -68,6 +68,26 @@ impl ParamId {
         }
     }
 
+    /// An SI value of the parameter in display units (mm, deg; compliance
+    /// and mass as they are).
+    pub fn to_display(&self, v: f64) -> f64 {
+        match self.unit() {
+            ParamUnit::Length => v * 1e3,
+            ParamUnit::Angle => v.to_degrees(),
+            ParamUnit::Compliance | ParamUnit::Mass => v,
+        }
+    }
+
+    /// The display unit's name.
+    pub fn unit_name(&self) -> &'static str {
+        match self.unit() {
+            ParamUnit::Length => "mm",
+            ParamUnit::Angle => "deg",
+            ParamUnit::Compliance => "rad/(N·m)",
+            ParamUnit::Mass => "kg",
+        }
+    }
+
     /// Whether the parameter is geometric (everything but compliance and payload).
     pub fn is_geometric(&self) -> bool {
         !matches!(

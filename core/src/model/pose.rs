@@ -6,6 +6,7 @@
 //! … are those of the seed's eq. 4.1 (Craig's modified DH) and are applied by
 //! post-multiplication, which keeps forward kinematics allocation-free.
 
+pub use super::orientation::rotation_log;
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -124,27 +125,6 @@ impl Pose {
 /// [`super::orientation::fixed_xyz_matrix`].
 pub fn rpy_matrix(rx: f64, ry: f64, rz: f64) -> Matrix3<f64> {
     super::orientation::fixed_xyz_matrix(rx, ry, rz)
-}
-
-/// Rotation vector (axis · angle, rad) of `r`, robust near 0 and π.
-pub fn rotation_log(r: &Matrix3<f64>) -> Vector3<f64> {
-    // sinθ·axis from the skew part, cosθ from the trace: accurate for small angles.
-    let s = Vector3::new(
-        r[(2, 1)] - r[(1, 2)],
-        r[(0, 2)] - r[(2, 0)],
-        r[(1, 0)] - r[(0, 1)],
-    ) * 0.5;
-    let c = 0.5 * (r.trace() - 1.0);
-    if c > -0.9 {
-        let sn = s.norm();
-        let theta = sn.atan2(c);
-        if sn < 1e-300 {
-            return Vector3::zeros();
-        }
-        s * (theta / sn)
-    } else {
-        nalgebra::Rotation3::from_matrix_unchecked(*r).scaled_axis()
-    }
 }
 
 #[cfg(test)]
