@@ -354,6 +354,9 @@ fn base_failure_pool_choice_and_cancellation() {
         a.reason
     );
     assert!(a.candidates.is_empty(), "{:?}", a.candidates);
+    // Its model file names the method it delivers.
+    assert_eq!(r.methods["auto"].model_file_method(), "auto: km");
+    assert_eq!(r.methods["auto"].method.name(), "auto");
     // Cancelled from the progress callback during SKCM-NN's training.
     let nominal = preset("ys100").unwrap();
     let ident = measure_truth(&t, &nominal, 60, &mut rng);

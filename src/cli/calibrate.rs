@@ -256,13 +256,11 @@ fn save_model(
         payload_kg: payload,
         compensator: chosen.stored_compensator.clone().map(|c| c.into_arc()),
     };
-    let file = crate::compensate::CalibratedModelFile::from_compensated(
-        &model,
-        &nominal.name,
-        chosen.method.name(),
-    );
+    let label = chosen.model_file_method();
+    let file =
+        crate::compensate::CalibratedModelFile::from_compensated(&model, &nominal.name, &label);
     super::model_files::save_model_file(&file, std::path::Path::new(path))?;
-    eprintln!("saved the {} model to {path}", chosen.method.name());
+    eprintln!("saved the {label} model to {path}");
     Ok(())
 }
 

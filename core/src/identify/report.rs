@@ -187,6 +187,17 @@ pub struct MethodReport {
     pub stored_compensator: Option<StoredCompensator>,
 }
 
+impl MethodReport {
+    /// The method a model file of this result names: the method itself, or
+    /// for `auto` the method it chose (`auto: skcm-nn`).
+    pub fn model_file_method(&self) -> String {
+        match &self.auto {
+            Some(a) => format!("{}: {}", self.method.name(), a.chosen.name()),
+            None => self.method.name().to_string(),
+        }
+    }
+}
+
 /// A compensator method's network, its training and its effect: the base
 /// model's statistics next to the compensated ones on every set.
 #[derive(Debug, Clone, PartialEq, Serialize)]
