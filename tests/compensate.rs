@@ -16,6 +16,9 @@
 //! compensator, 200 validation poses judge; each figure is recomputed through
 //! `CompensatedModel::predict` from the model the report delivers.
 
+mod common;
+
+use common::{measure_truth, real};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal::compensate::{unmodelled_truth, CompensatedModel, CompensatorSpec, StoredCompensator};
@@ -24,22 +27,10 @@ use robocal::identify::{
     ErrorStats, Method,
 };
 use robocal::ik::{Goal, IkSettings, IkSolver, SolveOptions};
-use robocal::measure::{self, csv, Measurement};
+use robocal::measure::{self, Measurement};
 use robocal::model::{preset, ModelDescription, RobotModel};
-use robocal::sim::{random_configurations, TrueRobot};
+use robocal::sim::random_configurations;
 use std::sync::OnceLock;
-
-fn measure_truth(
-    t: &TrueRobot,
-    nominal: &RobotModel,
-    n: usize,
-    rng: &mut ChaCha8Rng,
-) -> Vec<Measurement> {
-    let qs = random_configurations(nominal, n, rng);
-    let payload = nominal.payload.mass;
-    let rows = t.measure(&qs, Some(payload), None, rng).unwrap();
-    measure::to_measurements(nominal, &rows, payload)
-}
 
 /// The base model of a calibrated method, in the measurement frame.
 fn base(nominal: &RobotModel, r: &CalibrationReport, method: &str) -> CompensatedModel {
@@ -381,20 +372,6 @@ fn base_failure_pool_choice_and_cancellation() {
         (c.trained_on.as_str(), c.training_poses),
         ("identification", 60)
     );
-}
-
-/// The shared data directory: `../shared` next to the repository, or one
-/// level further up (a worktree in a subdirectory).
-fn real(path: &str) -> Vec<measure::MeasuredPose> {
-    let root = env!("CARGO_MANIFEST_DIR");
-    let p = [
-        format!("{root}/../shared/data/ur5-wam-laser-tracker/{path}"),
-        format!("{root}/../../shared/data/ur5-wam-laser-tracker/{path}"),
-    ]
-    .into_iter()
-    .find(|p| std::path::Path::new(p).exists())
-    .unwrap_or_else(|| panic!("{path}: the laser-tracker data is not in ../shared/data"));
-    csv::parse_with(&std::fs::read_to_string(p).unwrap(), csv::DifSign::Plus).unwrap()
 }
 
 fn ur5() -> RobotModel {

@@ -110,6 +110,38 @@ pub fn parse_number(field: &str, decimal_comma: bool) -> Option<f64> {
     field.parse().ok()
 }
 
+/// A field for a message: cut to 40 characters (never a whole long line).
+pub fn short_text(s: &str) -> String {
+    if s.chars().count() > 40 {
+        format!("{}…", s.chars().take(40).collect::<String>())
+    } else {
+        s.to_string()
+    }
+}
+
+/// Delimiter and decimal separator by name (`,` / `;` / `tab`, `point` /
+/// `comma`), each `None` to detect; the error names the bad value.
+pub fn dialect_from_names(
+    delimiter: Option<&str>,
+    decimal: Option<&str>,
+) -> Result<Dialect, String> {
+    Ok(Dialect {
+        delimiter: delimiter
+            .map(|d| {
+                parse_delimiter(d)
+                    .ok_or_else(|| format!("the delimiter must be `,`, `;` or `tab`, got `{d}`"))
+            })
+            .transpose()?,
+        decimal: decimal
+            .map(|d| {
+                Decimal::parse(d).ok_or_else(|| {
+                    format!("the decimal separator must be point or comma, got `{d}`")
+                })
+            })
+            .transpose()?,
+    })
+}
+
 fn is_comment(line: &str) -> bool {
     line.trim_start().starts_with('#')
 }

@@ -17,7 +17,7 @@
 //! (`--format csv`, the columns of `ik::targets_csv::results_csv`) or JSON.
 
 use super::model_files::load_compensated;
-use crate::csv_text::{parse_delimiter, Decimal, Dialect};
+use crate::csv_text::dialect_from_names;
 use crate::ik::targets_csv::CONVENTION_COLUMNS;
 use crate::ik::{
     parse_targets_csv, results_csv, Configuration, IkSettings, IkSolver, SolveOptions, TargetFrame,
@@ -144,24 +144,8 @@ pub fn solve_to_string(a: &SolveArgs) -> anyhow::Result<String> {
     }
     let text = std::fs::read_to_string(&a.targets)
         .with_context(|| format!("cannot read targets file {}", a.targets))?;
-    let dialect = Dialect {
-        delimiter: a
-            .delimiter
-            .as_deref()
-            .map(|d| {
-                parse_delimiter(d)
-                    .with_context(|| format!("--delimiter must be `,`, `;` or `tab`, got `{d}`"))
-            })
-            .transpose()?,
-        decimal: a
-            .decimal
-            .as_deref()
-            .map(|d| {
-                Decimal::parse(d)
-                    .with_context(|| format!("--decimal must be point or comma, got `{d}`"))
-            })
-            .transpose()?,
-    };
+    let dialect = dialect_from_names(a.delimiter.as_deref(), a.decimal.as_deref())
+        .map_err(anyhow::Error::msg)?;
     let csv = parse_targets_csv(&text, dialect).with_context(|| a.targets.clone())?;
     if csv.convention.is_none() && !a.position_only {
         bail!(

@@ -6,7 +6,7 @@
 //! millimetres and degrees when they are stored; the upload itself is kept
 //! verbatim and served by `GET .../original`.
 
-use super::error::content_type;
+use super::error::{content_type, json_content_type};
 use super::input::{
     check_name, check_payload, from_json_object, objects, page_body, present, PageQuery,
 };
@@ -354,7 +354,7 @@ fn upload_command(
 fn upload_is_csv(headers: &HeaderMap) -> Result<bool, ApiError> {
     let ct = content_type(headers);
     let is_csv = matches!(ct.as_str(), "text/csv" | "application/csv" | "text/plain");
-    let is_json = ct == "application/json" || ct.ends_with("+json");
+    let is_json = json_content_type(headers);
     if !is_csv && !is_json {
         let not = if ct.is_empty() {
             String::new()

@@ -20,7 +20,7 @@
 use super::error::{content_type, json_content_type};
 use super::input::{check_payload, from_json_object, object_or_null, objects, present, Int};
 use super::{ApiError, ApiPath, ApiQuery, AppState};
-use crate::csv_text::{parse_delimiter, Decimal, Dialect};
+use crate::csv_text::{dialect_from_names, Dialect};
 use crate::ik::targets_csv::CONVENTION_COLUMNS;
 use crate::ik::{
     parse_targets_csv, results_csv, Configuration, JointJump, SolveOptions, TargetFrame,
@@ -399,22 +399,7 @@ impl CsvSolveQuery {
 
 /// The delimiter and decimal separator a query declares.
 pub fn dialect(delimiter: Option<&str>, decimal: Option<&str>) -> Result<Dialect, ApiError> {
-    Ok(Dialect {
-        delimiter: delimiter
-            .map(|d| {
-                parse_delimiter(d).ok_or_else(|| {
-                    ApiError::invalid(format!("`delimiter` must be `,`, `;` or `tab`, got `{d}`"))
-                })
-            })
-            .transpose()?,
-        decimal: decimal
-            .map(|d| {
-                Decimal::parse(d).ok_or_else(|| {
-                    ApiError::invalid(format!("`decimal` must be point or comma, got `{d}`"))
-                })
-            })
-            .transpose()?,
-    })
+    dialect_from_names(delimiter, decimal).map_err(ApiError::invalid)
 }
 
 /// A targets CSV and its query as a service command.

@@ -22,7 +22,7 @@ pub mod view;
 pub use format::method_label;
 pub use view::ReportView;
 
-use maud::{html, PreEscaped, DOCTYPE};
+use maud::{html, Markup, PreEscaped, DOCTYPE};
 
 const STYLE: &str = include_str!("report.css");
 const SCRIPT: &str = include_str!("sort.js");
@@ -76,12 +76,7 @@ pub fn render_html(title: &str, report: &serde_json::Value) -> String {
     html! {
         (DOCTYPE)
         html lang="en" {
-            head {
-                meta charset="utf-8";
-                meta name="viewport" content="width=device-width, initial-scale=1";
-                title { (title) }
-                style { (PreEscaped(STYLE)) }
-            }
+            (page_head(title, STYLE))
             body {
                 main {
                     @if heading { header.top { p.kicker { "robocal · calibration report" } h1 { (title) } } }
@@ -93,4 +88,17 @@ pub fn render_html(title: &str, report: &serde_json::Value) -> String {
         }
     }
     .into_string()
+}
+
+/// The `<head>` of robocal's self-contained pages (the report, the web
+/// console): charset, viewport, title and the page's inline style sheet.
+pub fn page_head(title: &str, style: &str) -> Markup {
+    html! {
+        head {
+            meta charset="utf-8";
+            meta name="viewport" content="width=device-width, initial-scale=1";
+            title { (title) }
+            style { (PreEscaped(style)) }
+        }
+    }
 }

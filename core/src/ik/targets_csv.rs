@@ -34,7 +34,7 @@
 
 use super::solver::{IkSolution, IkSolver, SolveOptions};
 use super::targets::{TargetInput, TargetResult};
-use crate::csv_text::{self, Dialect, TextError};
+use crate::csv_text::{self, short_text, Dialect, TextError};
 use crate::model::orientation::{rotation_from, rotation_to, OrientationConvention};
 
 /// One row of a targets file: the target, or why the row is invalid.
@@ -202,7 +202,7 @@ fn parse_row(
             format!(
                 "column `{}`: `{}` is not a number",
                 cols[i],
-                short(cells[i])
+                short_text(cells[i])
             )
         })
     };
@@ -225,15 +225,6 @@ fn parse_row(
         convention,
         orientation,
     })
-}
-
-/// A field cut for a message.
-fn short(s: &str) -> String {
-    if s.chars().count() > 40 {
-        format!("{}…", s.chars().take(40).collect::<String>())
-    } else {
-        s.to_string()
-    }
 }
 
 impl TargetsCsv {

@@ -57,7 +57,7 @@
 //! in `csv/tests.rs`.
 
 use super::{MeasuredPose, SetRole};
-use crate::csv_text::{self, Dialect, TextError};
+use crate::csv_text::{self, short_text, Dialect, TextError};
 use std::fmt::Write as _;
 
 /// Maximum joint count of a CSV row.
@@ -81,15 +81,6 @@ pub fn short_number(v: f64) -> String {
         format!("{v:.3e}")
     } else {
         format!("{}", (v * 1e6).round() / 1e6)
-    }
-}
-
-/// A field for a message, cut to 40 characters.
-fn short_text(s: &str) -> String {
-    if s.chars().count() > 40 {
-        format!("{}…", s.chars().take(40).collect::<String>())
-    } else {
-        s.to_string()
     }
 }
 

@@ -6,6 +6,7 @@ use crate::http::calibrations::DEFAULT_METHODS;
 use crate::identify::Method;
 use crate::measure::SetRole;
 use crate::model::presets::PRESETS;
+use crate::report::page_head;
 use maud::{html, Markup, PreEscaped, DOCTYPE};
 
 const SCRIPT: &str = include_str!("console.js");
@@ -24,12 +25,7 @@ fn layout(title: &str, keys: bool, body: Markup) -> Markup {
     html! {
         (DOCTYPE)
         html lang="en" {
-            head {
-                meta charset="utf-8";
-                meta name="viewport" content="width=device-width, initial-scale=1";
-                title { (title) " — robocal" }
-                style { (PreEscaped(STYLE)) }
-            }
+            (page_head(&format!("{title} — robocal"), STYLE))
             body {
                 header {
                     a.brand href="/ui" { "robocal" }
