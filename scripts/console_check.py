@@ -27,6 +27,7 @@ import time
 
 from selenium import webdriver
 from selenium.webdriver.chrome.options import Options
+from selenium.common.exceptions import StaleElementReferenceException, WebDriverException
 from selenium.webdriver.chrome.service import Service
 from selenium.webdriver.common.by import By
 from selenium.webdriver.support import expected_conditions as EC
@@ -36,6 +37,20 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 DATA = pathlib.Path(os.environ.get(
     "ROBOCAL_DATA_DIR", ROOT.parent / "shared/data/ur5-wam-laser-tracker"))
 KEY = "console-check-key"
+
+
+def replaced(element):
+    """Wait condition: `element` left the document (the page reloaded).
+    Chromium sometimes answers a query on a node of the unloaded page with a
+    generic inspector error instead of a stale-element error; both mean the
+    node is gone."""
+    def gone(_driver):
+        try:
+            element.is_enabled()
+            return False
+        except (StaleElementReferenceException, WebDriverException):
+            return True
+    return gone
 
 
 def free_port():
@@ -124,7 +139,7 @@ def main():
             Select(form.find_element(By.NAME, "role")).select_by_value(role)
             form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
             # The page reloads when the upload is stored.
-            wait.until(EC.staleness_of(form))
+            wait.until(replaced(form))
             wait.until(lambda d: len(d.find_elements(By.CSS_SELECTOR, "#sets tbody tr")) == n + 1)
         rows = driver.find_elements(By.CSS_SELECTOR, "#sets tbody tr")
         assert len(rows) == 2, f"expected 2 sets, the page lists {len(rows)}"
@@ -136,7 +151,7 @@ def main():
             if box.is_selected() != (box.get_attribute("value") == "km"):
                 box.click()
         form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
-        wait.until(EC.staleness_of(form))
+        wait.until(replaced(form))
         wait.until(EC.presence_of_element_located((By.CSS_SELECTOR, "#calibrations tbody tr")))
         shot("calibration-started", "calibrations")
         wait.until(lambda d: d.find_element(By.CSS_SELECTOR, "#calibrations tbody tr .status").text
