@@ -18,7 +18,7 @@
 
 mod common;
 
-use common::{measure_truth, real};
+use common::{measure_truth, real, shipped_model};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal::compensate::{unmodelled_truth, CompensatedModel, CompensatorSpec, StoredCompensator};
@@ -28,7 +28,7 @@ use robocal::identify::{
 };
 use robocal::ik::{Goal, IkSettings, IkSolver, SolveOptions};
 use robocal::measure::{self, Measurement};
-use robocal::model::{preset, ModelDescription, RobotModel};
+use robocal::model::{preset, RobotModel};
 use robocal::sim::random_configurations;
 use std::sync::OnceLock;
 
@@ -156,8 +156,8 @@ fn thousand() -> &'static Study {
     THOUSAND.get_or_init(|| study(1000, true, 1, &BASES_AND_COMPENSATORS, 0))
 }
 
-/// 1000 training poses: KM-RBF and SKCM-NN lower the validation mean by ≥ 15 %
-/// against their bases, the best compensator by ≥ 35 %.
+/// 1000 training poses: KM-RBF, SKCM-NN and SKCM-TLBONN lower the validation
+/// mean by ≥ 15 % against their bases, the best compensator by ≥ 35 %.
 #[test]
 fn thousand_poses_every_compensator_beats_its_base() {
     let s = thousand();
@@ -178,9 +178,10 @@ fn thousand_poses_every_compensator_beats_its_base() {
             base.max_mm,
             comp.max_mm
         );
-        // IWO and TLBO on the seed's 6-5-3 network do not reach the issue's
-        // 15 % here (see README, "Compensators"); they are reported, not held to it.
-        if !method.ends_with("iwonn") && !method.ends_with("tlbonn") {
+        // IWO with the seed's loss (eq. 5.7, mean + 0.7·max over 850 fitting
+        // poses) does not reach the issue's 15 % here (README, "Compensators");
+        // it is reported, not held to it.
+        if !method.ends_with("iwonn") {
             assert!(gain >= 0.15, "{method}: only {:.1} % better", gain * 100.0);
         }
         best_gain = best_gain.max(gain);
@@ -374,46 +375,25 @@ fn base_failure_pool_choice_and_cancellation() {
     );
 }
 
-fn ur5() -> RobotModel {
-    let mut desc = ModelDescription::from_model(&preset("ur5").unwrap());
-    desc.tool.xyz_mm = [0.0, 0.09, 31.0];
-    desc.to_model().unwrap()
-}
-
-/// The WAM from the data's README: standard DH, TCP (0, 0, 44) mm; no masses
-/// (the torque-based RBF then has nothing to work with and is not offered).
-fn wam() -> RobotModel {
-    let a = [0.0, 0.0, 45.0, -45.0, 0.0, 0.0, 0.0];
-    let d = [0.0, 0.0, 550.0, 0.0, 300.0, 0.0, 60.0];
-    let alpha = [-90.0, 90.0, -90.0, 90.0, -90.0, 90.0, 0.0];
-    let joints: Vec<serde_json::Value> = (0..7)
-        .map(|k| serde_json::json!({"a_mm": a[k], "d_mm": d[k], "alpha_deg": alpha[k], "limits_deg": [-360, 360]}))
-        .collect();
-    let desc = serde_json::json!({
-        "name": "wam", "convention": "standard", "joints": joints,
-        "tool": {"xyz_mm": [0, 0, 44]}
-    });
-    RobotModel::from_json(&desc.to_string()).unwrap()
-}
-
-/// Real data through the pipeline: the grid identifies the base and, with no
-/// training pool, trains the compensators (judged by 5-fold cross-validation
-/// inside it); the 20 random poses validate. `auto` is never worse than KM on
-/// the mean. Every method's figures are printed beside the published hybrid
+/// Real data through the pipeline with the shipped model files (link masses
+/// and centres of mass, so SKCM and the torque-based RBF can run): the grid
+/// identifies the base and, with no training pool, trains the compensators
+/// (judged by 5-fold cross-validation inside it); the 20 random poses
+/// validate. `auto` is never worse than KM on mean or max. Every method's figures are printed beside the published hybrid
 /// (MDH + graph neural network) on the same 20 poses: UR5 0.155 mm, WAM 2.92 mm.
 #[test]
 fn real_data_auto_never_worse_than_km() {
     for (name, model, grid, random, published) in [
         (
             "UR5",
-            ur5(),
+            shipped_model("ur5"),
             "UR5/3D_UR5_uncalibrated_grid_cleaned.csv",
             "UR5/3D_UR5_uncalibrated_random_cleaned.csv",
             0.155,
         ),
         (
             "WAM",
-            wam(),
+            shipped_model("wam"),
             "WAM/3D_WAM_uncalibrated_grid_cleaned.csv",
             "WAM/3D_WAM_uncalibrated_random_cleaned.csv",
             2.92,
@@ -443,11 +423,12 @@ fn real_data_auto_never_worse_than_km() {
             "{name} auto: {:.4} / {:.4} mm; KM {:.4} / {:.4} mm",
             got.mean_mm, got.max_mm, km.mean_mm, km.max_mm
         );
-        // The issue asks for "never worse on mean or max"; on the UR5 the
-        // cross-validated choice can lower the mean and still raise the max of
-        // the 20 random poses (README, "Compensators"): only the mean is held.
+        // "Never worse" at the resolution of the reported figures (0.1 µm,
+        // four decimals in mm): on the UR5 auto's and KM's max share their
+        // worst pose and differ by nanometres.
+        let resolution_mm = 1e-4;
         assert!(
-            got.mean_mm <= km.mean_mm,
+            got.mean_mm <= km.mean_mm + resolution_mm && got.max_mm <= km.max_mm + resolution_mm,
             "{name}: auto {got:?} vs KM {km:?}"
         );
     }

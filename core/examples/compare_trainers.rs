@@ -6,11 +6,14 @@
 //! time per training run [s].
 //!
 //! Run: `cargo run --release -p robocal-core --example compare_trainers [seeds]`
+//! (release: the population trainers of the 18-40-3 network take minutes per
+//! seed in the dev profile).
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal_core::compensate::{
-    train, unmodelled_truth, CompensatedModel, CompensatorSpec, LmTrainSettings, MlpSpec, Trainer,
+    train, unmodelled_truth, CompensatedModel, CompensatorSpec, IwoSettings, LmTrainSettings,
+    MlpSpec, OutputLayer, TlboTrainSettings, Trainer,
 };
 use robocal_core::identify::{calibrate, CalibrationOptions, Method};
 use robocal_core::measure::{self, Measurement};
@@ -57,15 +60,55 @@ fn main() {
         spec: MlpSpec::SMALL,
         trainer: Trainer::Lm(LmTrainSettings::default()),
     };
+    let searched = |trainer| CompensatorSpec::Mlp {
+        spec: MlpSpec::SMALL,
+        trainer,
+    };
+    let iwo_mean_only = CompensatorSpec::Mlp {
+        spec: MlpSpec::POPULATION,
+        trainer: Trainer::Iwo(IwoSettings {
+            max_weight: 0.0,
+            ..Default::default()
+        }),
+    };
     for (name, net, spec) in [
         (
-            "LM backprop",
+            "LM backprop (SKCM-NN)",
             "18-20-3 (q, sin q, cos q)",
             CompensatorSpec::skcm_nn(),
         ),
         ("LM backprop", "6-5-3", lm_small),
-        ("IWO", "6-5-3", CompensatorSpec::skcm_iwonn()),
-        ("TLBO", "6-5-3", CompensatorSpec::skcm_tlbonn()),
+        (
+            "IWO (SKCM-IWONN)",
+            "18-40-3, output layer by least squares",
+            CompensatorSpec::skcm_iwonn(),
+        ),
+        (
+            "TLBO (SKCM-TLBONN)",
+            "18-40-3, output layer by least squares",
+            CompensatorSpec::skcm_tlbonn(),
+        ),
+        (
+            "IWO, loss mean(E) instead of eq. 5.7",
+            "18-40-3, output layer by least squares",
+            iwo_mean_only,
+        ),
+        (
+            "IWO, every weight searched",
+            "6-5-3 (the seed's)",
+            searched(Trainer::Iwo(IwoSettings {
+                output_layer: OutputLayer::Searched,
+                ..Default::default()
+            })),
+        ),
+        (
+            "TLBO, every weight searched",
+            "6-5-3 (the seed's)",
+            searched(Trainer::Tlbo(TlboTrainSettings {
+                output_layer: OutputLayer::Searched,
+                ..Default::default()
+            })),
+        ),
     ] {
         let mut errs = Vec::new();
         let mut secs = 0.0;

@@ -40,8 +40,8 @@ pub use rbf::{train_rbf, train_rbf_with_progress, OutputFrame, Rbf, RbfReport, R
 pub use select::{choose, cross_validate, Choice, CvStats};
 pub use synthetic::{synthetic_calibration, unmodelled_truth, SyntheticErrors};
 pub use train::{
-    train, CompensatorSpec, IwoSettings, LmTrainSettings, MlpSpec, TlboTrainSettings, TrainError,
-    TrainReport, Trainer,
+    train, CompensatorSpec, IwoSettings, LmTrainSettings, MlpSpec, OutputLayer, TlboTrainSettings,
+    TrainError, TrainReport, Trainer,
 };
 
 /// A learned residual model: what the geometric and compliance model leave.

@@ -199,7 +199,7 @@ pub struct CompensatorOptions {
     /// Network of SKCM-NN.
     pub nn: MlpSpec,
     pub lm: LmTrainSettings,
-    /// Network of SKCM-IWONN and SKCM-TLBONN (the seed's 6-5-3).
+    /// Network of SKCM-IWONN and SKCM-TLBONN (`MlpSpec::POPULATION`).
     pub small: MlpSpec,
     pub iwo: IwoSettings,
     pub tlbo: TlboTrainSettings,
@@ -216,7 +216,7 @@ impl Default for CompensatorOptions {
             rbf: RbfSettings::default(),
             nn: MlpSpec::SKCM_NN,
             lm: LmTrainSettings::default(),
-            small: MlpSpec::SMALL,
+            small: MlpSpec::POPULATION,
             iwo: IwoSettings::default(),
             tlbo: TlboTrainSettings::default(),
         }
