@@ -195,7 +195,9 @@ pub(crate) fn generic_rank(model: &RobotModel, ids: &[ParamId], orientation: boo
     for (k, &c) in live.iter().enumerate() {
         js.set_column(k, &(j.column(c) / norms[c]));
     }
-    let sv = js.svd(false, false).singular_values;
+    let sv = super::identifiability::triangular_factor(js)
+        .svd(false, false)
+        .singular_values;
     let smax = sv.max();
     sv.iter().filter(|s| **s > smax * 1e-9).count()
 }

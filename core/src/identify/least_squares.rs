@@ -77,7 +77,7 @@ pub enum StopReason {
     /// (damping exhausted): not a minimum that a test confirmed.
     NoDescent,
     /// Trial models could not be evaluated (e.g. a closed loop that does not
-    /// close), or the accepted model left the loop's assembly range.
+    /// close).
     EvaluationFailed,
     /// Fewer residuals than unknowns.
     Underdetermined,
@@ -198,6 +198,29 @@ fn column_scale(j: &DMatrix<f64>) -> DVector<f64> {
     )
 }
 
+/// Scales the columns of `j` by `scale` in place.
+fn scale_columns(j: &mut DMatrix<f64>, scale: &DVector<f64>) {
+    for (c, s) in scale.iter().enumerate() {
+        j.column_mut(c).scale_mut(*s);
+    }
+}
+
+/// `jᵀj`, each entry the same column dot product as `j.tr_mul(j)` computes,
+/// but the lower triangle only, mirrored (half the work).
+fn gram(j: &DMatrix<f64>) -> DMatrix<f64> {
+    let n = j.ncols();
+    let mut a = DMatrix::zeros(n, n);
+    for i in 0..n {
+        let ci = j.column(i);
+        for k in 0..=i {
+            let d = ci.dot(&j.column(k));
+            a[(i, k)] = d;
+            a[(k, i)] = d;
+        }
+    }
+    a
+}
+
 /// A frozen-Jacobian least-squares solver (the chord form of eq. 2.4 / 7.8):
 /// the scaled normal matrix of `ids` and of every session frame ≥ 1 is
 /// factorised once at a reference model and reused for repeated updates
@@ -224,10 +247,8 @@ impl FrozenSolver {
         let ev = evaluate(model, frames, ids, data, settings, true)?;
         let mut js = ev.j?;
         let scale = column_scale(&js);
-        for (c, s) in scale.iter().enumerate() {
-            js.column_mut(c).scale_mut(*s);
-        }
-        let chol = js.tr_mul(&js).cholesky()?;
+        scale_columns(&mut js, &scale);
+        let chol = gram(&js).cholesky()?;
         Some(FrozenSolver {
             ids: ids.to_vec(),
             frames: frames.to_vec(),
@@ -466,15 +487,15 @@ pub fn fit(
     let mut cost = ev.r.norm_squared();
     let initial = rms_mm(cost);
     let ncols = ev.j.as_ref().map_or(0, |j| j.ncols());
-    // Column scaling, fixed from the first Jacobian.
+    // Column scaling, fixed from the first Jacobian; every evaluation's
+    // Jacobian is scaled in place as it arrives (`scaled`).
     let scale = column_scale(ev.j.as_ref().expect("jacobian evaluated"));
-    let scaled = |ev: &Eval| {
-        let mut js = ev.j.as_ref().expect("jacobian evaluated").clone();
-        for (c, s) in scale.iter().enumerate() {
-            js.column_mut(c).scale_mut(*s);
+    let scaled = |ev: &mut Eval| {
+        if let Some(j) = ev.j.as_mut() {
+            scale_columns(j, &scale);
         }
-        js
     };
+    scaled(&mut ev);
     let mut lambda = settings.initial_lambda;
     let mut iterations = 0;
     let mut reason = StopReason::MaxIterations;
@@ -492,15 +513,15 @@ pub fn fit(
         if !progress(iterations, rms_mm(cost)) {
             return Err(Cancelled);
         }
-        let js = scaled(&ev);
-        let a = js.tr_mul(&js);
+        let js = ev.j.as_ref().expect("jacobian evaluated");
+        let a = gram(js);
         let g = js.tr_mul(&ev.r);
         let x = layout.values(&model);
         // Active bounds: at the bound with the descent direction (+g) below it.
         for i in 0..ncols {
             active[i] = i < ids.len() && x[i] <= lower[i] && g[i] < 0.0;
         }
-        gradient = gradient_measure(&js, &g, cost.sqrt(), &active);
+        gradient = gradient_measure(js, &g, cost.sqrt(), &active);
         let mut accepted = None;
         let mut evaluations_failed = 0;
         let mut trials = 0;
@@ -531,9 +552,12 @@ pub fn fit(
             }
             let step = delta.component_div(&scale).norm();
             let (m2, f2) = apply_step(&model, &frames, &layout, &x, &delta);
-            match evaluate(&m2, &f2, ids, data, settings, false) {
+            // With the Jacobian: an accepted trial is the next iterate, whose
+            // Jacobian is needed next (one forward-kinematics pass per trial).
+            match evaluate(&m2, &f2, ids, data, settings, true) {
                 Some(e2) if e2.r.norm_squared() < cost => {
-                    accepted = Some((m2, f2, e2.r.norm_squared(), step));
+                    let c2 = e2.r.norm_squared();
+                    accepted = Some((m2, f2, e2, c2, step));
                     lambda = (lambda / 10.0).max(1e-15);
                     break;
                 }
@@ -544,7 +568,7 @@ pub fn fit(
                 }
             }
         }
-        let Some((m2, f2, c2, step)) = accepted else {
+        let Some((m2, f2, e2, c2, step)) = accepted else {
             if gradient <= settings.gradient_tolerance {
                 reason = StopReason::GradientTolerance;
                 detail = format!(
@@ -575,14 +599,8 @@ pub fn fit(
         model = m2;
         frames = f2;
         cost = c2;
-        ev = match evaluate(&model, &frames, ids, data, settings, true) {
-            Some(e) => e,
-            None => {
-                reason = StopReason::EvaluationFailed;
-                detail = "the model left the closed loop's assembly range".into();
-                break;
-            }
-        };
+        ev = e2;
+        scaled(&mut ev);
         if rel < settings.cost_tolerance {
             reason = StopReason::CostTolerance;
             detail = format!(
@@ -603,25 +621,23 @@ pub fn fit(
     // Final bound state and gradient at the returned model.
     let at_bound: Vec<bool> =
         ev.j.as_ref()
-            .map(|_| {
-                let js = scaled(&ev);
+            .map(|js| {
                 let g = js.tr_mul(&ev.r);
                 let x = layout.values(&model);
                 for i in 0..ncols {
                     active[i] = i < ids.len() && x[i] <= lower[i] && g[i] < 0.0;
                 }
-                gradient = gradient_measure(&js, &g, cost.sqrt(), &active);
+                gradient = gradient_measure(js, &g, cost.sqrt(), &active);
                 active[..ids.len()].to_vec()
             })
             .unwrap_or_else(|| vec![false; ids.len()]);
-    let covariance = ev.j.as_ref().and_then(|_| {
+    let covariance = ev.j.as_ref().and_then(|js| {
         let free = ncols - active.iter().filter(|a| **a).count();
         let dof = rows as f64 - free as f64;
         if dof <= 0.0 {
             return None;
         }
-        let js = scaled(&ev);
-        let mut a = js.tr_mul(&js);
+        let mut a = gram(js);
         for i in 0..ncols {
             if active[i] {
                 a.row_mut(i).fill(0.0);
