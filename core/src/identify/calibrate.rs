@@ -16,7 +16,7 @@
 //! the calibration an error.
 
 use super::checks::{
-    check_set, fixed_params, generic_rank, gravity_problem, joint_range_detail, stacked_jacobian,
+    check_set, fixed_params, generic_rank, gravity_problem, joint_range_detail, stacked_factor,
     CalibrationError,
 };
 use super::hybrid::{compensate_report, run_auto, run_compensated, Cache, Hybrid};
@@ -134,10 +134,11 @@ fn identifiability_phase(
     if with_compliance {
         candidates.extend((0..nominal.dof()).map(|k| ParamId::new(ParamKind::Compliance, k)));
     }
-    let j = stacked_jacobian(nominal, &candidates, ident);
-    let analysis = identifiability::analyse(
+    let (j, rows) = stacked_factor(nominal, &candidates, ident);
+    let analysis = identifiability::analyse_factor(
         nominal,
         &j,
+        rows,
         &candidates,
         &fixed,
         ident.len(),
@@ -148,7 +149,6 @@ fn identifiability_phase(
     let any_orientation = ident.iter().any(|m| m.orientation.is_some());
     let per_pose = if any_orientation { 6 } else { 3 };
     let gen_rank = generic_rank(nominal, &geometric, any_orientation);
-    let rows = j.nrows();
     // Near-dependent parameters are dropped on purpose; only a shortfall in
     // exact rank means the poses are too few or too alike.
     let near = analysis.report.near_dependent();

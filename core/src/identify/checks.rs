@@ -132,10 +132,16 @@ pub(crate) fn stacked_jacobian(
 ) -> DMatrix<f64> {
     let rows = least_squares::residual_rows(data);
     let mut j = DMatrix::zeros(rows, ids.len());
+    // Only compliance columns use the torques.
+    let needs_tau = ids.iter().any(|i| i.kind == ParamKind::Compliance);
     let mut row = 0;
     for m in data {
         let c0 = chain(model, &m.q).expect("checked");
-        let tau = gravity_torques_of(model, &c0, m.payload_mass);
+        let tau = if needs_tau {
+            gravity_torques_of(model, &c0, m.payload_mass)
+        } else {
+            Vec::new()
+        };
         let orient = m.orientation.is_some();
         crate::kinematics::jacobian::fill_identification_rows(
             model,
@@ -150,6 +156,35 @@ pub(crate) fn stacked_jacobian(
         row += if orient { 6 } else { 3 };
     }
     j
+}
+
+/// Poses per block of [`stacked_factor`]: a block's rows and the factor so far
+/// (some 100 KB) stay in cache while the block is reduced.
+const FACTOR_BLOCK_POSES: usize = 100;
+
+/// The triangular factor R of the stacked identification Jacobian J of
+/// [`stacked_jacobian`] (`RᵀR = JᵀJ`, at most `ids.len()` rows, see
+/// `identifiability::triangular_factor`) and J's row count, built block by
+/// block: R of `[R_so_far; next block of rows]` is R of all rows so far
+/// (`[R; B] = diag(Q, I)·[Q_so_farᵀ·J_so_far; B]`). J itself (thousands of
+/// rows) is never formed.
+pub(crate) fn stacked_factor(
+    model: &RobotModel,
+    ids: &[ParamId],
+    data: &[Measurement],
+) -> (DMatrix<f64>, usize) {
+    let n = ids.len();
+    let mut r = DMatrix::zeros(0, n);
+    let mut rows = 0;
+    for block in data.chunks(FACTOR_BLOCK_POSES) {
+        let b = stacked_jacobian(model, ids, block);
+        rows += b.nrows();
+        let mut s = DMatrix::zeros(r.nrows() + b.nrows(), n);
+        s.rows_mut(0, r.nrows()).copy_from(&r);
+        s.rows_mut(r.nrows(), b.nrows()).copy_from(&b);
+        r = super::identifiability::triangular_factor(s);
+    }
+    (r, rows)
 }
 
 /// Parameters that are fixed by design, with the reason.

@@ -18,10 +18,12 @@
 //! (`(σ1⋯σL)^(1/L)/√m`, m poses), and (after a fit) standard deviations and
 //! strongly correlated pairs.
 //!
-//! Computation: the scaled matrix (rows × candidates, thousands of rows) is
-//! reduced once to the triangular factor R of its QR (`triangular_factor`);
-//! the SVDs, the Gram–Schmidt pass and the dependency least squares then run
-//! on R's columns, which have the same singular values and inner products.
+//! Computation: the Jacobian (rows × candidates, thousands of rows) is
+//! reduced to the triangular factor R of its QR (`triangular_factor`; the
+//! calibration builds R block by block, `checks::stacked_factor`, without
+//! forming the Jacobian); column norms, the SVDs, the Gram–Schmidt pass and the
+//! dependency least squares then run on R's columns, which have the same
+//! singular values and inner products.
 
 use crate::model::{ParamId, ParamKind, RobotModel};
 use nalgebra::{DMatrix, DVector};
@@ -158,14 +160,16 @@ pub struct Analysis {
     pub report: IdentifiabilityReport,
 }
 
-/// The upper-triangular factor R of the Householder QR `js = Q·R` (min(rows,
-/// cols) × cols). Q has orthonormal columns, so R has the singular values of
-/// `js` (to rounding of the order ε‖js‖, as the SVD of `js` itself) and the same
-/// inner products between columns: the rank, the Gram–Schmidt residuals, the
-/// dependencies and the condition number all follow from R's short columns.
-/// One QR of the rows × cols matrix replaces an SVD of it for each of these
-/// (several for a robot with dependent candidates), the bulk of the analysis's
-/// time on a large pose set.
+/// The upper-triangular factor R of the Householder QR `j = Q·R` (min(rows,
+/// cols) × cols; `j` itself when it has no more rows than columns). Q has
+/// orthonormal columns, so R has the singular values of `j` (to rounding of
+/// the order ε‖j‖ per column, as the SVD of `j` itself) and the same inner
+/// products between columns, hence the same column norms and, scaled, the
+/// same scaled columns' inner products (`j·D = Q·(R·D)`): the rank, the
+/// Gram–Schmidt residuals, the dependencies and the condition number all
+/// follow from R's short columns. One QR replaces an SVD of the rows × cols
+/// matrix for each of these (several for a robot with dependent candidates),
+/// the bulk of the analysis's time on a large pose set.
 pub(crate) fn triangular_factor(js: DMatrix<f64>) -> DMatrix<f64> {
     if js.ncols() == 0 || js.nrows() <= js.ncols() {
         return js;
@@ -183,19 +187,22 @@ pub fn analyse(
     poses: usize,
     settings: &IdentifiabilitySettings,
 ) -> Analysis {
-    analyse_with(model, j, candidates, fixed, poses, settings, true)
+    let f = triangular_factor(j.clone());
+    analyse_factor(model, &f, j.nrows(), candidates, fixed, poses, settings)
 }
 
-/// [`analyse`], on R's columns when `reduce` (the fast path), else on the
-/// scaled rows × candidates matrix itself (the general path the tests compare with).
-fn analyse_with(
+/// [`analyse`] from a factor `f` of the Jacobian: any matrix with the
+/// Jacobian's column inner products (`fᵀf = jᵀj`), such as its triangular
+/// factor (`triangular_factor`, `checks::stacked_factor`: the fast path) or the
+/// `rows` × candidates Jacobian itself (the general path).
+pub(crate) fn analyse_factor(
     model: &RobotModel,
     j: &DMatrix<f64>,
+    rows: usize,
     candidates: &[ParamId],
     fixed: &[(ParamId, String)],
     poses: usize,
     settings: &IdentifiabilitySettings,
-    reduce: bool,
 ) -> Analysis {
     let n = model.dof();
     let norms: Vec<f64> = j.column_iter().map(|c| c.norm()).collect();
@@ -227,14 +234,12 @@ fn analyse_with(
             live.push(c);
         }
     }
-    // Scaled candidate matrix, reduced to its triangular factor (see
-    // `triangular_factor`), and its rank.
-    let rows = j.nrows();
-    let mut js = DMatrix::zeros(rows, live.len());
+    // Scaled candidate matrix (of the factor's short columns on the fast
+    // path) and its rank.
+    let mut rf = DMatrix::zeros(j.nrows(), live.len());
     for (k, &c) in live.iter().enumerate() {
-        js.set_column(k, &(j.column(c) / norms[c]));
+        rf.set_column(k, &(j.column(c) / norms[c]));
     }
-    let rf = if reduce { triangular_factor(js) } else { js };
     let rank = if live.is_empty() {
         0
     } else {
@@ -371,7 +376,7 @@ pub fn uncertainty(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::identify::checks::stacked_jacobian;
+    use crate::identify::checks::{stacked_factor, stacked_jacobian};
     use crate::measure::{to_measurements, Measurement};
     use crate::model::{preset, ParamLayout};
     use crate::sim::{perturb_geometry, random_configurations, ErrorMagnitudes, TrueRobot};
@@ -390,13 +395,13 @@ mod tests {
         (nominal, m)
     }
 
-    /// The fast path (everything on the QR's triangular factor) against the
-    /// general path (SVDs and Gram–Schmidt on the full scaled matrix): the same
-    /// rank, kept and dropped parameters with the same reasons and
-    /// dependencies, and the same condition number and O1 to rounding. Open
-    /// chains with dependent parameters (UR5, YS100 with compliance), a closed
-    /// loop (HH800), and a pose set with fewer rows than candidates (the
-    /// general path is taken as is).
+    /// The fast path (everything on the triangular factor built block by
+    /// block) against the general path (SVDs and Gram–Schmidt on the full
+    /// scaled matrix): the same rank, kept and dropped parameters with the
+    /// same reasons and dependencies, and the same condition number and O1 to
+    /// rounding. Open chains with dependent parameters and columns without
+    /// effect (UR5, YS100 with compliance), a closed loop (HH800), several
+    /// blocks (300 poses), and a pose set with fewer rows than candidates.
     #[test]
     fn triangular_factor_path_matches_the_full_matrix() {
         for (name, poses) in [("ur5", 300), ("ys100", 200), ("hh800", 150), ("ys100", 8)] {
@@ -404,9 +409,16 @@ mod tests {
             let mut ids = ParamLayout::geometric(&nominal).ids;
             ids.extend((0..nominal.dof()).map(|k| ParamId::new(ParamKind::Compliance, k)));
             let j = stacked_jacobian(&nominal, &ids, &ident);
+            let (f, rows) = stacked_factor(&nominal, &ids, &ident);
+            assert_eq!((rows, f.ncols()), j.shape());
+            assert!(f.nrows() <= f.ncols() && f.nrows() <= rows);
             let s = IdentifiabilitySettings::default();
-            let fast = analyse_with(&nominal, &j, &ids, &[], ident.len(), &s, true);
-            let full = analyse_with(&nominal, &j, &ids, &[], ident.len(), &s, false);
+            let n = ident.len();
+            let fast = analyse_factor(&nominal, &f, rows, &ids, &[], n, &s);
+            let full = analyse_factor(&nominal, &j, rows, &ids, &[], n, &s);
+            // The public entry point: one QR of the whole matrix.
+            let whole = analyse(&nominal, &j, &ids, &[], n, &s);
+            assert_eq!(whole.report.kept, full.report.kept, "{name}");
             let (a, b) = (&fast.report, &full.report);
             assert_eq!(fast.kept, full.kept, "{name}");
             assert_eq!(a.rank, b.rank, "{name}");

@@ -317,36 +317,67 @@ fn evaluate(
     with_jacobian: bool,
 ) -> Option<Eval> {
     let rows = residual_rows(data);
-    let n_sess = frames.len().saturating_sub(1) * 6;
-    let cols = ids.len() + n_sess;
+    let cols = ids.len() + frames.len().saturating_sub(1) * 6;
     let mut r = DVector::zeros(rows);
-    let mut j = if with_jacobian {
-        Some(DMatrix::zeros(rows, cols))
-    } else {
-        None
+    let mut j = with_jacobian.then(|| DMatrix::zeros(rows, cols));
+    let sink = match j.as_mut() {
+        Some(j) => Rows::Full(j),
+        None => Rows::Skip,
     };
+    evaluate_into(model, frames, ids, data, settings, &mut r, sink).then_some(Eval { r, j })
+}
+
+/// Where [`evaluate_into`] puts the Jacobian rows of each pose.
+enum Rows<'a> {
+    Skip,
+    /// Into the rows × columns Jacobian (every entry overwritten, so the LM
+    /// loop reuses two buffers instead of allocating one per evaluation).
+    Full(&'a mut DMatrix<f64>),
+}
+
+/// [`evaluate`] into `r` (rows) and `rows`. False when some pose cannot be
+/// evaluated (the outputs are then garbage).
+fn evaluate_into(
+    model: &RobotModel,
+    frames: &[Pose],
+    ids: &[ParamId],
+    data: &[Measurement],
+    settings: &LmSettings,
+    r: &mut DVector<f64>,
+    mut rows: Rows,
+) -> bool {
     let needs_tau = model.has_compliance()
         || ids
             .iter()
             .any(|i| i.kind == ParamKind::Compliance || i.is_payload());
     let w = settings.orientation_weight;
+    let cols = ids.len() + frames.len().saturating_sub(1) * 6;
     let mut local = DMatrix::zeros(6, ids.len());
+    // The pose's rows of the Jacobian, session-frame columns included.
+    let mut pose_rows = DMatrix::zeros(6, cols);
+    let mut q_eff = Vec::new();
+    let mut tau = Vec::new();
     let mut row = 0;
     for m in data {
-        let (q_eff, tau) = if needs_tau {
-            let c0 = chain(model, &m.q).ok()?;
-            let tau = gravity_torques_of(model, &c0, m.payload_mass);
-            let q: Vec<f64> =
+        let q: &[f64] = if needs_tau {
+            let Ok(c0) = chain(model, &m.q) else {
+                return false;
+            };
+            tau = gravity_torques_of(model, &c0, m.payload_mass);
+            q_eff.clear();
+            q_eff.extend(
                 m.q.iter()
                     .zip(&tau)
                     .zip(&model.links)
-                    .map(|((q, t), l)| q + l.compliance * t)
-                    .collect();
-            (q, tau)
+                    .map(|((q, t), l)| q + l.compliance * t),
+            );
+            &q_eff
         } else {
-            (m.q.clone(), Vec::new())
+            &m.q
         };
-        let c = chain(model, &q_eff).ok()?;
+        let Ok(c) = chain(model, q) else {
+            return false;
+        };
         let e = frames.get(m.session).copied().unwrap_or_default();
         let pred = e.transform_point(&c.tcp.p);
         let dp = m.position - pred;
@@ -360,39 +391,50 @@ fn evaluate(
             r[row + 4] = dr.y;
             r[row + 5] = dr.z;
         }
-        if let Some(j) = j.as_mut() {
+        let n_rows = if orient { 6 } else { 3 };
+        if !matches!(rows, Rows::Skip) {
+            let j = &mut pose_rows;
             fill_identification_rows(model, &c, ids, &tau, m.payload_mass, orient, &mut local, 0);
             for col in 0..ids.len() {
                 let v = e.r * Vector3::new(local[(0, col)], local[(1, col)], local[(2, col)]);
-                j[(row, col)] = v.x;
-                j[(row + 1, col)] = v.y;
-                j[(row + 2, col)] = v.z;
+                j[(0, col)] = v.x;
+                j[(1, col)] = v.y;
+                j[(2, col)] = v.z;
                 if orient {
                     let om =
                         e.r * Vector3::new(local[(3, col)], local[(4, col)], local[(5, col)]) * w;
-                    j[(row + 3, col)] = om.x;
-                    j[(row + 4, col)] = om.y;
-                    j[(row + 5, col)] = om.z;
+                    j[(3, col)] = om.x;
+                    j[(4, col)] = om.y;
+                    j[(5, col)] = om.z;
                 }
+            }
+            if cols > ids.len() {
+                j.columns_mut(ids.len(), cols - ids.len()).fill(0.0);
             }
             if m.session > 0 {
                 let base = ids.len() + (m.session - 1) * 6;
                 for k in 0..3 {
-                    j[(row + k, base + k)] = 1.0;
+                    j[(k, base + k)] = 1.0;
                     let ek = Vector3::ith(k, 1.0);
                     let v = ek.cross(&pred);
-                    j[(row, base + 3 + k)] = v.x;
-                    j[(row + 1, base + 3 + k)] = v.y;
-                    j[(row + 2, base + 3 + k)] = v.z;
+                    j[(0, base + 3 + k)] = v.x;
+                    j[(1, base + 3 + k)] = v.y;
+                    j[(2, base + 3 + k)] = v.z;
                     if orient {
-                        j[(row + 3 + k, base + 3 + k)] = w;
+                        j[(3 + k, base + 3 + k)] = w;
                     }
                 }
             }
+            match &mut rows {
+                Rows::Skip => {}
+                Rows::Full(full) => full
+                    .view_mut((row, 0), (n_rows, cols))
+                    .copy_from(&j.rows(0, n_rows)),
+            }
         }
-        row += if orient { 6 } else { 3 };
+        row += n_rows;
     }
-    Some(Eval { r, j })
+    true
 }
 
 fn apply_step(
@@ -467,7 +509,20 @@ pub fn fit(
     let mut frames = vec![Pose::identity(); sessions.max(1)];
     let rows = residual_rows(data);
     let rms_mm = |c: f64| (c / rows.max(1) as f64).sqrt() * 1e3;
-    let Some(mut ev) = evaluate(&model, &frames, ids, data, settings, true) else {
+    let ncols = ids.len() + (frames.len() - 1) * 6;
+    // The current point and the trial buffers (residuals, Jacobian), swapped
+    // when a trial is accepted.
+    let mut ev = (DVector::zeros(rows), DMatrix::zeros(rows, ncols));
+    let mut trial = (DVector::zeros(rows), DMatrix::zeros(rows, ncols));
+    if !evaluate_into(
+        &model,
+        &frames,
+        ids,
+        data,
+        settings,
+        &mut ev.0,
+        Rows::Full(&mut ev.1),
+    ) {
         return Ok(Fit {
             model,
             session_frames: frames,
@@ -484,18 +539,12 @@ pub fn fit(
             at_bound: vec![false; ids.len()],
         });
     };
-    let mut cost = ev.r.norm_squared();
+    let mut cost = ev.0.norm_squared();
     let initial = rms_mm(cost);
-    let ncols = ev.j.as_ref().map_or(0, |j| j.ncols());
-    // Column scaling, fixed from the first Jacobian; every evaluation's
-    // Jacobian is scaled in place as it arrives (`scaled`).
-    let scale = column_scale(ev.j.as_ref().expect("jacobian evaluated"));
-    let scaled = |ev: &mut Eval| {
-        if let Some(j) = ev.j.as_mut() {
-            scale_columns(j, &scale);
-        }
-    };
-    scaled(&mut ev);
+    // Column scaling, fixed from the first Jacobian; every accepted
+    // evaluation's Jacobian is scaled in place.
+    let scale = column_scale(&ev.1);
+    scale_columns(&mut ev.1, &scale);
     let mut lambda = settings.initial_lambda;
     let mut iterations = 0;
     let mut reason = StopReason::MaxIterations;
@@ -504,7 +553,7 @@ pub fn fit(
         settings.max_iterations
     );
     let mut active = vec![false; ncols];
-    let mut gradient = f64::NAN;
+    let mut gradient: f64;
     if rows < ncols {
         reason = StopReason::Underdetermined;
         detail = format!("underdetermined: {rows} residuals for {ncols} unknowns");
@@ -513,9 +562,9 @@ pub fn fit(
         if !progress(iterations, rms_mm(cost)) {
             return Err(Cancelled);
         }
-        let js = ev.j.as_ref().expect("jacobian evaluated");
+        let js = &ev.1;
         let a = gram(js);
-        let g = js.tr_mul(&ev.r);
+        let g = js.tr_mul(&ev.0);
         let x = layout.values(&model);
         // Active bounds: at the bound with the descent direction (+g) below it.
         for i in 0..ncols {
@@ -554,21 +603,28 @@ pub fn fit(
             let (m2, f2) = apply_step(&model, &frames, &layout, &x, &delta);
             // With the Jacobian: an accepted trial is the next iterate, whose
             // Jacobian is needed next (one forward-kinematics pass per trial).
-            match evaluate(&m2, &f2, ids, data, settings, true) {
-                Some(e2) if e2.r.norm_squared() < cost => {
-                    let c2 = e2.r.norm_squared();
-                    accepted = Some((m2, f2, e2, c2, step));
-                    lambda = (lambda / 10.0).max(1e-15);
-                    break;
-                }
-                Some(_) => lambda *= 10.0,
-                None => {
-                    evaluations_failed += 1;
-                    lambda *= 10.0;
-                }
+            if !evaluate_into(
+                &m2,
+                &f2,
+                ids,
+                data,
+                settings,
+                &mut trial.0,
+                Rows::Full(&mut trial.1),
+            ) {
+                evaluations_failed += 1;
+                lambda *= 10.0;
+                continue;
             }
+            let c2 = trial.0.norm_squared();
+            if c2 < cost {
+                accepted = Some((m2, f2, c2, step));
+                lambda = (lambda / 10.0).max(1e-15);
+                break;
+            }
+            lambda *= 10.0;
         }
-        let Some((m2, f2, e2, c2, step)) = accepted else {
+        let Some((m2, f2, c2, step)) = accepted else {
             if gradient <= settings.gradient_tolerance {
                 reason = StopReason::GradientTolerance;
                 detail = format!(
@@ -599,8 +655,8 @@ pub fn fit(
         model = m2;
         frames = f2;
         cost = c2;
-        ev = e2;
-        scaled(&mut ev);
+        std::mem::swap(&mut ev, &mut trial);
+        scale_columns(&mut ev.1, &scale);
         if rel < settings.cost_tolerance {
             reason = StopReason::CostTolerance;
             detail = format!(
@@ -619,19 +675,15 @@ pub fn fit(
         }
     }
     // Final bound state and gradient at the returned model.
-    let at_bound: Vec<bool> =
-        ev.j.as_ref()
-            .map(|js| {
-                let g = js.tr_mul(&ev.r);
-                let x = layout.values(&model);
-                for i in 0..ncols {
-                    active[i] = i < ids.len() && x[i] <= lower[i] && g[i] < 0.0;
-                }
-                gradient = gradient_measure(js, &g, cost.sqrt(), &active);
-                active[..ids.len()].to_vec()
-            })
-            .unwrap_or_else(|| vec![false; ids.len()]);
-    let covariance = ev.j.as_ref().and_then(|js| {
+    let js = &ev.1;
+    let g = js.tr_mul(&ev.0);
+    let x = layout.values(&model);
+    for i in 0..ncols {
+        active[i] = i < ids.len() && x[i] <= lower[i] && g[i] < 0.0;
+    }
+    gradient = gradient_measure(js, &g, cost.sqrt(), &active);
+    let at_bound = active[..ids.len()].to_vec();
+    let covariance = (|| {
         let free = ncols - active.iter().filter(|a| **a).count();
         let dof = rows as f64 - free as f64;
         if dof <= 0.0 {
@@ -656,7 +708,7 @@ pub fn fit(
             }
         }
         Some(cov)
-    });
+    })();
     Ok(Fit {
         model,
         session_frames: frames,

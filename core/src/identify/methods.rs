@@ -29,7 +29,7 @@
 //! (not converged, compliance held at c = 0, stiffness outside the plausible
 //! range), and the model must load back from its JSON description.
 
-use super::checks::{payload_problem, stacked_jacobian};
+use super::checks::{payload_problem, stacked_factor};
 use super::identifiability::{self, DroppedParam};
 use super::least_squares::{fit, Cancelled, Fit, FrozenSolver};
 use super::options::{CalibrationOptions, Method};
@@ -211,10 +211,11 @@ impl Context<'_> {
             });
         }
         let candidates: Vec<ParamId> = base.iter().chain(&payload).copied().collect();
-        let j = stacked_jacobian(&skcm.model, &candidates, self.ident);
-        let analysis = identifiability::analyse(
+        let (j, rows) = stacked_factor(&skcm.model, &candidates, self.ident);
+        let analysis = identifiability::analyse_factor(
             &skcm.model,
             &j,
+            rows,
             &candidates,
             &[],
             self.ident.len(),
@@ -452,6 +453,7 @@ impl<'a> SkcmCCost<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::identify::checks::stacked_jacobian;
     use crate::measure::to_measurements;
     use crate::model::preset;
     use crate::model::ParamLayout;
