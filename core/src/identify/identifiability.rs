@@ -409,7 +409,7 @@ mod tests {
             let mut ids = ParamLayout::geometric(&nominal).ids;
             ids.extend((0..nominal.dof()).map(|k| ParamId::new(ParamKind::Compliance, k)));
             let j = stacked_jacobian(&nominal, &ids, &ident);
-            let (f, rows) = stacked_factor(&nominal, &ids, &ident);
+            let (f, rows) = stacked_factor(&nominal, &ids, &ident, None);
             assert_eq!((rows, f.ncols()), j.shape());
             assert!(f.nrows() <= f.ncols() && f.nrows() <= rows);
             let s = IdentifiabilitySettings::default();

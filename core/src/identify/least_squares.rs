@@ -14,7 +14,7 @@
 //! Length: the LM loop, its typed stop tests, the bounds and the frozen-Jacobian
 //! inner solver share their step and scaling code in one file.
 
-use crate::kinematics::{chain, gravity_torques_of, jacobian::fill_identification_rows};
+use crate::kinematics::{chain, gravity_torques_of, jacobian::fill_identification_rows, Chain};
 use crate::measure::Measurement;
 use crate::model::pose::{rotation_log, Pose};
 use crate::model::{ParamId, ParamKind, ParamLayout, RobotModel};
@@ -140,6 +140,10 @@ pub struct Fit {
     /// Per parameter of `ids`: held at its lower bound at the end (the
     /// unconstrained fit would move it below; see [`lower_bound`]).
     pub at_bound: Vec<bool>,
+    /// The residual vector at the returned model and session frames (measured
+    /// minus predicted, m; weighted rotation vectors on orientation rows),
+    /// `None` when the start could not be evaluated.
+    pub residuals: Option<DVector<f64>>,
 }
 
 /// Lower bound of a parameter: compliance is admissible only when `c ≥ 0`
@@ -324,7 +328,7 @@ fn evaluate(
         Some(j) => Rows::Full(j),
         None => Rows::Skip,
     };
-    evaluate_into(model, frames, ids, data, settings, &mut r, sink).then_some(Eval { r, j })
+    evaluate_into(model, frames, ids, data, settings, &mut r, sink, None).then_some(Eval { r, j })
 }
 
 /// Where [`evaluate_into`] puts the Jacobian rows of each pose.
@@ -336,7 +340,10 @@ enum Rows<'a> {
 }
 
 /// [`evaluate`] into `r` (rows) and `rows`. False when some pose cannot be
-/// evaluated (the outputs are then garbage).
+/// evaluated (the outputs are then garbage). `chains`: the forward kinematics
+/// of `data` at the commanded joints on `model`'s geometry, used where the
+/// joints are not deflected (no torques needed).
+#[allow(clippy::too_many_arguments)]
 fn evaluate_into(
     model: &RobotModel,
     frames: &[Pose],
@@ -345,6 +352,7 @@ fn evaluate_into(
     settings: &LmSettings,
     r: &mut DVector<f64>,
     mut rows: Rows,
+    chains: Option<&[Chain]>,
 ) -> bool {
     let needs_tau = model.has_compliance()
         || ids
@@ -358,7 +366,12 @@ fn evaluate_into(
     let mut q_eff = Vec::new();
     let mut tau = Vec::new();
     let mut row = 0;
-    for m in data {
+    for (i, m) in data.iter().enumerate() {
+        let known = if needs_tau {
+            None
+        } else {
+            chains.map(|c| &c[i])
+        };
         let q: &[f64] = if needs_tau {
             let Ok(c0) = chain(model, &m.q) else {
                 return false;
@@ -375,8 +388,16 @@ fn evaluate_into(
         } else {
             &m.q
         };
-        let Ok(c) = chain(model, q) else {
-            return false;
+        let owned;
+        let c = match known {
+            Some(c) => c,
+            None => {
+                let Ok(c) = chain(model, q) else {
+                    return false;
+                };
+                owned = c;
+                &owned
+            }
         };
         let e = frames.get(m.session).copied().unwrap_or_default();
         let pred = e.transform_point(&c.tcp.p);
@@ -394,7 +415,7 @@ fn evaluate_into(
         let n_rows = if orient { 6 } else { 3 };
         if !matches!(rows, Rows::Skip) {
             let j = &mut pose_rows;
-            fill_identification_rows(model, &c, ids, &tau, m.payload_mass, orient, &mut local, 0);
+            fill_identification_rows(model, c, ids, &tau, m.payload_mass, orient, &mut local, 0);
             for col in 0..ids.len() {
                 let v = e.r * Vector3::new(local[(0, col)], local[(1, col)], local[(2, col)]);
                 j[(0, col)] = v.x;
@@ -494,6 +515,22 @@ pub fn fit(
     settings: &LmSettings,
     progress: &mut dyn FnMut(usize, f64) -> bool,
 ) -> Result<Fit, Cancelled> {
+    fit_with_start_chains(start, ids, data, sessions, settings, None, progress)
+}
+
+/// [`fit`], with the forward kinematics of `data` at the commanded joints on
+/// `start`'s geometry when already known (`start_chains[i]` of `data[i]`; the
+/// first evaluation then skips its forward kinematics where no joint is
+/// deflected).
+pub(crate) fn fit_with_start_chains(
+    start: &RobotModel,
+    ids: &[ParamId],
+    data: &[Measurement],
+    sessions: usize,
+    settings: &LmSettings,
+    start_chains: Option<&[Chain]>,
+    progress: &mut dyn FnMut(usize, f64) -> bool,
+) -> Result<Fit, Cancelled> {
     let layout = ParamLayout { ids: ids.to_vec() };
     let lower: Vec<f64> = ids.iter().map(lower_bound).collect();
     let mut model = start.clone();
@@ -522,6 +559,7 @@ pub fn fit(
         settings,
         &mut ev.0,
         Rows::Full(&mut ev.1),
+        start_chains,
     ) {
         return Ok(Fit {
             model,
@@ -537,6 +575,7 @@ pub fn fit(
             },
             covariance: None,
             at_bound: vec![false; ids.len()],
+            residuals: None,
         });
     };
     let mut cost = ev.0.norm_squared();
@@ -611,6 +650,7 @@ pub fn fit(
                 settings,
                 &mut trial.0,
                 Rows::Full(&mut trial.1),
+                None,
             ) {
                 evaluations_failed += 1;
                 lambda *= 10.0;
@@ -723,5 +763,6 @@ pub fn fit(
         },
         covariance,
         at_bound,
+        residuals: Some(ev.0),
     })
 }
