@@ -9,14 +9,17 @@
 //! parameters absorb). Residuals in metres; orientation residuals (rotation
 //! vector, rad) are weighted by `orientation_weight` [m/rad]. Jacobian columns
 //! come from `kinematics::jacobian` (eq. 4.9 + chain rule + `J_θ·diag(τ)`), with
-//! τ held fixed within an iteration.
+//! τ held fixed within an iteration. The residuals, Jacobian rows and `JᵀJ` of
+//! a data set are computed in `evaluate`.
 //!
-//! Length: the LM loop, its typed stop tests, the bounds and the frozen-Jacobian
-//! inner solver share their step and scaling code in one file.
+//! Cost per LM iteration: one forward-kinematics pass per trial step (a trial
+//! is evaluated with its Jacobian, so an accepted one is not evaluated again),
+//! into two residual/Jacobian buffers swapped on acceptance.
 
-use crate::kinematics::{chain, gravity_torques_of, jacobian::fill_identification_rows, Chain};
+use super::evaluate::{column_scale, evaluate, evaluate_into, gram, scale_columns, Rows};
+use crate::kinematics::Chain;
 use crate::measure::Measurement;
-use crate::model::pose::{rotation_log, Pose};
+use crate::model::pose::Pose;
 use crate::model::{ParamId, ParamKind, ParamLayout, RobotModel};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
@@ -187,44 +190,6 @@ pub fn position_errors_mm(model: &RobotModel, frames: &[Pose], data: &[Measureme
         .collect()
 }
 
-/// Column scaling `1/‖J_j‖` (1 for an all-zero column).
-fn column_scale(j: &DMatrix<f64>) -> DVector<f64> {
-    DVector::from_iterator(
-        j.ncols(),
-        j.column_iter().map(|c| {
-            let n = c.norm();
-            if n > 0.0 {
-                1.0 / n
-            } else {
-                1.0
-            }
-        }),
-    )
-}
-
-/// Scales the columns of `j` by `scale` in place.
-fn scale_columns(j: &mut DMatrix<f64>, scale: &DVector<f64>) {
-    for (c, s) in scale.iter().enumerate() {
-        j.column_mut(c).scale_mut(*s);
-    }
-}
-
-/// `jᵀj`, each entry the same column dot product as `j.tr_mul(j)` computes,
-/// but the lower triangle only, mirrored (half the work).
-fn gram(j: &DMatrix<f64>) -> DMatrix<f64> {
-    let n = j.ncols();
-    let mut a = DMatrix::zeros(n, n);
-    for i in 0..n {
-        let ci = j.column(i);
-        for k in 0..=i {
-            let d = ci.dot(&j.column(k));
-            a[(i, k)] = d;
-            a[(k, i)] = d;
-        }
-    }
-    a
-}
-
 /// A frozen-Jacobian least-squares solver (the chord form of eq. 2.4 / 7.8):
 /// the scaled normal matrix of `ids` and of every session frame ≥ 1 is
 /// factorised once at a reference model and reused for repeated updates
@@ -304,158 +269,6 @@ impl FrozenSolver {
         let errors = position_errors_mm(&model, &frames, data);
         Some((model, frames, errors))
     }
-}
-
-struct Eval {
-    r: DVector<f64>,
-    j: Option<DMatrix<f64>>,
-}
-
-/// Residuals (and optionally the Jacobian of the prediction) at the current model.
-fn evaluate(
-    model: &RobotModel,
-    frames: &[Pose],
-    ids: &[ParamId],
-    data: &[Measurement],
-    settings: &LmSettings,
-    with_jacobian: bool,
-) -> Option<Eval> {
-    let rows = residual_rows(data);
-    let cols = ids.len() + frames.len().saturating_sub(1) * 6;
-    let mut r = DVector::zeros(rows);
-    let mut j = with_jacobian.then(|| DMatrix::zeros(rows, cols));
-    let sink = match j.as_mut() {
-        Some(j) => Rows::Full(j),
-        None => Rows::Skip,
-    };
-    evaluate_into(model, frames, ids, data, settings, &mut r, sink, None).then_some(Eval { r, j })
-}
-
-/// Where [`evaluate_into`] puts the Jacobian rows of each pose.
-enum Rows<'a> {
-    Skip,
-    /// Into the rows × columns Jacobian (every entry overwritten, so the LM
-    /// loop reuses two buffers instead of allocating one per evaluation).
-    Full(&'a mut DMatrix<f64>),
-}
-
-/// [`evaluate`] into `r` (rows) and `rows`. False when some pose cannot be
-/// evaluated (the outputs are then garbage). `chains`: the forward kinematics
-/// of `data` at the commanded joints on `model`'s geometry, used where the
-/// joints are not deflected (no torques needed).
-#[allow(clippy::too_many_arguments)]
-fn evaluate_into(
-    model: &RobotModel,
-    frames: &[Pose],
-    ids: &[ParamId],
-    data: &[Measurement],
-    settings: &LmSettings,
-    r: &mut DVector<f64>,
-    mut rows: Rows,
-    chains: Option<&[Chain]>,
-) -> bool {
-    let needs_tau = model.has_compliance()
-        || ids
-            .iter()
-            .any(|i| i.kind == ParamKind::Compliance || i.is_payload());
-    let w = settings.orientation_weight;
-    let cols = ids.len() + frames.len().saturating_sub(1) * 6;
-    let mut local = DMatrix::zeros(6, ids.len());
-    // The pose's rows of the Jacobian, session-frame columns included.
-    let mut pose_rows = DMatrix::zeros(6, cols);
-    let mut q_eff = Vec::new();
-    let mut tau = Vec::new();
-    let mut row = 0;
-    for (i, m) in data.iter().enumerate() {
-        let known = if needs_tau {
-            None
-        } else {
-            chains.map(|c| &c[i])
-        };
-        let q: &[f64] = if needs_tau {
-            let Ok(c0) = chain(model, &m.q) else {
-                return false;
-            };
-            tau = gravity_torques_of(model, &c0, m.payload_mass);
-            q_eff.clear();
-            q_eff.extend(
-                m.q.iter()
-                    .zip(&tau)
-                    .zip(&model.links)
-                    .map(|((q, t), l)| q + l.compliance * t),
-            );
-            &q_eff
-        } else {
-            &m.q
-        };
-        let owned;
-        let c = match known {
-            Some(c) => c,
-            None => {
-                let Ok(c) = chain(model, q) else {
-                    return false;
-                };
-                owned = c;
-                &owned
-            }
-        };
-        let e = frames.get(m.session).copied().unwrap_or_default();
-        let pred = e.transform_point(&c.tcp.p);
-        let dp = m.position - pred;
-        r[row] = dp.x;
-        r[row + 1] = dp.y;
-        r[row + 2] = dp.z;
-        let orient = m.orientation.is_some();
-        if let Some(rm) = &m.orientation {
-            let dr = rotation_log(&(rm * (e.r * c.tcp.r).transpose())) * w;
-            r[row + 3] = dr.x;
-            r[row + 4] = dr.y;
-            r[row + 5] = dr.z;
-        }
-        let n_rows = if orient { 6 } else { 3 };
-        if !matches!(rows, Rows::Skip) {
-            let j = &mut pose_rows;
-            fill_identification_rows(model, c, ids, &tau, m.payload_mass, orient, &mut local, 0);
-            for col in 0..ids.len() {
-                let v = e.r * Vector3::new(local[(0, col)], local[(1, col)], local[(2, col)]);
-                j[(0, col)] = v.x;
-                j[(1, col)] = v.y;
-                j[(2, col)] = v.z;
-                if orient {
-                    let om =
-                        e.r * Vector3::new(local[(3, col)], local[(4, col)], local[(5, col)]) * w;
-                    j[(3, col)] = om.x;
-                    j[(4, col)] = om.y;
-                    j[(5, col)] = om.z;
-                }
-            }
-            if cols > ids.len() {
-                j.columns_mut(ids.len(), cols - ids.len()).fill(0.0);
-            }
-            if m.session > 0 {
-                let base = ids.len() + (m.session - 1) * 6;
-                for k in 0..3 {
-                    j[(k, base + k)] = 1.0;
-                    let ek = Vector3::ith(k, 1.0);
-                    let v = ek.cross(&pred);
-                    j[(0, base + 3 + k)] = v.x;
-                    j[(1, base + 3 + k)] = v.y;
-                    j[(2, base + 3 + k)] = v.z;
-                    if orient {
-                        j[(3 + k, base + 3 + k)] = w;
-                    }
-                }
-            }
-            match &mut rows {
-                Rows::Skip => {}
-                Rows::Full(full) => full
-                    .view_mut((row, 0), (n_rows, cols))
-                    .copy_from(&j.rows(0, n_rows)),
-            }
-        }
-        row += n_rows;
-    }
-    true
 }
 
 fn apply_step(
