@@ -78,23 +78,14 @@ pub(crate) fn evaluate(
     let cols = ids.len() + frames.len().saturating_sub(1) * 6;
     let mut r = DVector::zeros(rows);
     let mut j = with_jacobian.then(|| DMatrix::zeros(rows, cols));
-    let sink = match j.as_mut() {
-        Some(j) => Rows::Full(j),
-        None => Rows::Skip,
-    };
-    evaluate_into(model, frames, ids, data, settings, &mut r, sink, None).then_some(Eval { r, j })
+    evaluate_into(model, frames, ids, data, settings, &mut r, j.as_mut(), None)
+        .then_some(Eval { r, j })
 }
 
-/// Where [`evaluate_into`] puts the Jacobian rows of each pose.
-pub(crate) enum Rows<'a> {
-    Skip,
-    /// Into the rows × columns Jacobian (every entry overwritten, so the LM
-    /// loop reuses two buffers instead of allocating one per evaluation).
-    Full(&'a mut DMatrix<f64>),
-}
-
-/// [`evaluate`] into `r` (rows) and `rows`. False when some pose cannot be
-/// evaluated (the outputs are then garbage). `chains`: the forward kinematics
+/// [`evaluate`] into `r` (rows) and, when given, the rows × columns Jacobian
+/// `j` (every entry overwritten, so the LM loop reuses two buffers instead of
+/// allocating one per evaluation). False when some pose cannot be evaluated
+/// (the outputs are then garbage). `chains`: the forward kinematics
 /// of `data` at the commanded joints on `model`'s geometry, used where the
 /// joints are not deflected (no torques needed).
 #[allow(clippy::too_many_arguments)]
@@ -105,7 +96,7 @@ pub(crate) fn evaluate_into(
     data: &[Measurement],
     settings: &LmSettings,
     r: &mut DVector<f64>,
-    mut rows: Rows,
+    mut j: Option<&mut DMatrix<f64>>,
     chains: Option<&[Chain]>,
 ) -> bool {
     let needs_tau = model.has_compliance()
@@ -113,10 +104,13 @@ pub(crate) fn evaluate_into(
             .iter()
             .any(|i| i.kind == ParamKind::Compliance || i.is_payload());
     let w = settings.orientation_weight;
-    let cols = ids.len() + frames.len().saturating_sub(1) * 6;
+    if let Some(j) = j.as_mut() {
+        // Session-frame columns: zero except the entries written below.
+        for c in ids.len()..j.ncols() {
+            j.column_mut(c).fill(0.0);
+        }
+    }
     let mut local = DMatrix::zeros(6, ids.len());
-    // The pose's rows of the Jacobian, session-frame columns included.
-    let mut pose_rows = DMatrix::zeros(6, cols);
     let mut q_eff = Vec::new();
     let mut tau = Vec::new();
     let mut row = 0;
@@ -167,44 +161,34 @@ pub(crate) fn evaluate_into(
             r[row + 5] = dr.z;
         }
         let n_rows = if orient { 6 } else { 3 };
-        if !matches!(rows, Rows::Skip) {
-            let j = &mut pose_rows;
+        if let Some(j) = j.as_mut() {
             fill_identification_rows(model, c, ids, &tau, m.payload_mass, orient, &mut local, 0);
             for col in 0..ids.len() {
                 let v = e.r * Vector3::new(local[(0, col)], local[(1, col)], local[(2, col)]);
-                j[(0, col)] = v.x;
-                j[(1, col)] = v.y;
-                j[(2, col)] = v.z;
+                j[(row, col)] = v.x;
+                j[(row + 1, col)] = v.y;
+                j[(row + 2, col)] = v.z;
                 if orient {
                     let om =
                         e.r * Vector3::new(local[(3, col)], local[(4, col)], local[(5, col)]) * w;
-                    j[(3, col)] = om.x;
-                    j[(4, col)] = om.y;
-                    j[(5, col)] = om.z;
+                    j[(row + 3, col)] = om.x;
+                    j[(row + 4, col)] = om.y;
+                    j[(row + 5, col)] = om.z;
                 }
-            }
-            if cols > ids.len() {
-                j.columns_mut(ids.len(), cols - ids.len()).fill(0.0);
             }
             if m.session > 0 {
                 let base = ids.len() + (m.session - 1) * 6;
                 for k in 0..3 {
-                    j[(k, base + k)] = 1.0;
+                    j[(row + k, base + k)] = 1.0;
                     let ek = Vector3::ith(k, 1.0);
                     let v = ek.cross(&pred);
-                    j[(0, base + 3 + k)] = v.x;
-                    j[(1, base + 3 + k)] = v.y;
-                    j[(2, base + 3 + k)] = v.z;
+                    j[(row, base + 3 + k)] = v.x;
+                    j[(row + 1, base + 3 + k)] = v.y;
+                    j[(row + 2, base + 3 + k)] = v.z;
                     if orient {
-                        j[(3 + k, base + 3 + k)] = w;
+                        j[(row + 3 + k, base + 3 + k)] = w;
                     }
                 }
-            }
-            match &mut rows {
-                Rows::Skip => {}
-                Rows::Full(full) => full
-                    .view_mut((row, 0), (n_rows, cols))
-                    .copy_from(&j.rows(0, n_rows)),
             }
         }
         row += n_rows;

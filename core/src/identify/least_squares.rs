@@ -16,7 +16,7 @@
 //! is evaluated with its Jacobian, so an accepted one is not evaluated again),
 //! into two residual/Jacobian buffers swapped on acceptance.
 
-use super::evaluate::{column_scale, evaluate, evaluate_into, gram, scale_columns, Rows};
+use super::evaluate::{column_scale, evaluate, evaluate_into, gram, scale_columns};
 use crate::kinematics::Chain;
 use crate::measure::Measurement;
 use crate::model::pose::Pose;
@@ -371,7 +371,7 @@ pub(crate) fn fit_with_start_chains(
         data,
         settings,
         &mut ev.0,
-        Rows::Full(&mut ev.1),
+        Some(&mut ev.1),
         start_chains,
     ) {
         return Ok(Fit {
@@ -462,7 +462,7 @@ pub(crate) fn fit_with_start_chains(
                 data,
                 settings,
                 &mut trial.0,
-                Rows::Full(&mut trial.1),
+                Some(&mut trial.1),
                 None,
             ) {
                 evaluations_failed += 1;
