@@ -10,6 +10,10 @@
 //! sessions ≥ 1 get their own frame correction. Units: SI inside, mm/deg in the
 //! report.
 //!
+//! The identification poses' forward kinematics at the nominal model are
+//! computed once, by the checks, and shared by the registration, the nominal
+//! errors, the identifiability factor and the first evaluation of KM and SKCM.
+//!
 //! A method that fails (compliance on a model without masses, a model that
 //! does not load back, …) is listed in `CalibrationReport::failed` with its
 //! reason; the others are reported as usual. Only when every method fails is
