@@ -10,17 +10,22 @@
 //! sessions ≥ 1 get their own frame correction. Units: SI inside, mm/deg in the
 //! report.
 //!
+//! The identification poses' forward kinematics at the nominal model are
+//! computed once, by the checks, and shared by the registration, the nominal
+//! errors, the identifiability factor and the first evaluation of KM and SKCM.
+//!
 //! A method that fails (compliance on a model without masses, a model that
 //! does not load back, …) is listed in `CalibrationReport::failed` with its
 //! reason; the others are reported as usual. Only when every method fails is
 //! the calibration an error.
 
 use super::checks::{
-    check_set, fixed_params, generic_rank, gravity_problem, joint_range_detail, stacked_jacobian,
-    CalibrationError,
+    check_set, checked_chains, fixed_params, generic_rank, gravity_problem, joint_range_detail,
+    stacked_factor, CalibrationError,
 };
 use super::hybrid::{compensate_report, run_auto, run_compensated, Cache, Hybrid};
 use super::identifiability::{self, IdentifiabilityReport};
+use super::least_squares::predict;
 use super::methods::{Context, MethodError, MethodFit};
 use super::options::{CalibrationOptions, Method, Progress};
 use super::registration::register;
@@ -28,7 +33,7 @@ use super::report::{
     CalibrationReport, FailedMethod, NominalErrors, PoseSources, SessionRegistration, SetErrors,
     REPORT_FORMAT_VERSION,
 };
-use crate::kinematics::{deflected_joints, fk};
+use crate::kinematics::Chain;
 use crate::measure::Measurement;
 use crate::model::description::PoseDescription;
 use crate::model::pose::Pose;
@@ -45,10 +50,11 @@ struct Registered {
     reports: Vec<SessionRegistration>,
 }
 
-/// Registration per session onto the nominal TCP positions.
+/// Registration per session onto the nominal TCP positions `predicted` (one
+/// per identification measurement, [`nominal_predictions`]).
 fn register_sessions(
-    nominal: &RobotModel,
     identification: &[Measurement],
+    predicted: &[Option<Vector3<f64>>],
     validation: &[Measurement],
     opts: &CalibrationOptions,
 ) -> Result<Registered, CalibrationError> {
@@ -59,11 +65,9 @@ fn register_sessions(
         for (s, reg) in regs.iter_mut().enumerate() {
             let (y, x): (Vec<Vector3<f64>>, Vec<Vector3<f64>>) = identification
                 .iter()
-                .filter(|m| m.session == s)
-                .map(|m| {
-                    let q = deflected_joints(nominal, &m.q, m.payload_mass).expect("checked");
-                    (m.position, fk(nominal, &q).expect("checked").p)
-                })
+                .zip(predicted)
+                .filter(|(m, _)| m.session == s)
+                .map(|(m, p)| (m.position, p.expect("checked")))
                 .unzip();
             if y.is_empty() {
                 continue;
@@ -110,6 +114,24 @@ impl Registered {
     }
 }
 
+/// The nominal model's TCP positions at the (deflected) joints of `data`
+/// (`least_squares::predict`), from the forward kinematics `chains` of `data`
+/// at the commanded joints when the model has no compliance (the joints are
+/// then not deflected: the same numbers without a second pass).
+fn nominal_predictions(
+    nominal: &RobotModel,
+    data: &[Measurement],
+    chains: &[Chain],
+) -> Vec<Option<Vector3<f64>>> {
+    if nominal.has_compliance() {
+        data.iter()
+            .map(|m| predict(nominal, m).map(|(p, _)| p))
+            .collect()
+    } else {
+        chains.iter().map(|c| Some(c.tcp.p)).collect()
+    }
+}
+
 /// The kept geometric and compliance parameters and the identifiability report.
 struct Identifiable {
     kept_geo: Vec<ParamId>,
@@ -120,6 +142,7 @@ struct Identifiable {
 fn identifiability_phase(
     nominal: &RobotModel,
     reg: &Registered,
+    chains: &[Chain],
     with_compliance: bool,
     opts: &CalibrationOptions,
 ) -> Result<Identifiable, CalibrationError> {
@@ -134,10 +157,11 @@ fn identifiability_phase(
     if with_compliance {
         candidates.extend((0..nominal.dof()).map(|k| ParamId::new(ParamKind::Compliance, k)));
     }
-    let j = stacked_jacobian(nominal, &candidates, ident);
-    let analysis = identifiability::analyse(
+    let (j, rows) = stacked_factor(nominal, &candidates, ident, Some(chains));
+    let analysis = identifiability::analyse_factor(
         nominal,
         &j,
+        rows,
         &candidates,
         &fixed,
         ident.len(),
@@ -148,7 +172,6 @@ fn identifiability_phase(
     let any_orientation = ident.iter().any(|m| m.orientation.is_some());
     let per_pose = if any_orientation { 6 } else { 3 };
     let gen_rank = generic_rank(nominal, &geometric, any_orientation);
-    let rows = j.nrows();
     // Near-dependent parameters are dropped on purpose; only a shortfall in
     // exact rank means the poses are too few or too alike.
     let near = analysis.report.near_dependent();
@@ -235,7 +258,10 @@ pub fn calibrate_with_training(
     if identification.is_empty() {
         return Err(CalibrationError::NoData);
     }
-    check_set(nominal, identification, "identification")?;
+    // The nominal forward kinematics of the identification poses, shared by
+    // the checks, the registration, the nominal errors, the identifiability
+    // Jacobian and the first evaluation of the fits.
+    let chains = checked_chains(nominal, identification, "identification")?;
     check_set(nominal, training, "training")?;
     check_set(nominal, validation, "validation")?;
     if let Some((index, m)) = training
@@ -250,11 +276,16 @@ pub fn calibrate_with_training(
         });
     }
     say("registration", 0, 0.0, None)?;
-    let reg = register_sessions(nominal, identification, validation, opts)?;
+    let predicted = nominal_predictions(nominal, identification, &chains);
+    let reg = register_sessions(identification, &predicted, validation, opts)?;
     let train_base = reg.to_base(training);
     let id_frames = vec![Pose::identity(); reg.sessions];
     let nominal_errors = NominalErrors {
-        identification: SetErrors::of(nominal, &id_frames, &reg.ident),
+        identification: SetErrors::from_predictions(
+            &id_frames,
+            &reg.ident,
+            predicted.iter().copied(),
+        ),
         validation: (!reg.valid.is_empty()).then(|| SetErrors::of(nominal, &id_frames, &reg.valid)),
     };
     let nominal_rms = nominal_errors.identification.stats.rms_mm;
@@ -286,7 +317,7 @@ pub fn calibrate_with_training(
     let with_compliance = to_run
         .iter()
         .any(|m| m.uses_compliance() || (*m == Method::Auto && gravity.is_none()));
-    let idf = identifiability_phase(nominal, &reg, with_compliance, opts)?;
+    let idf = identifiability_phase(nominal, &reg, &chains, with_compliance, opts)?;
     let mut ident_report = idf.report;
     let mut start = nominal.clone();
     for l in start.links.iter_mut() {
@@ -296,6 +327,7 @@ pub fn calibrate_with_training(
         nominal,
         start,
         ident: &reg.ident,
+        ident_chains: &chains,
         valid: &reg.valid,
         sessions: reg.sessions,
         kept_geo: idf.kept_geo,

@@ -9,7 +9,7 @@
 use super::least_squares;
 use super::registration::RegistrationError;
 use super::report::FailedMethod;
-use crate::kinematics::{chain, fk, gravity_torques_of, KinematicsError};
+use crate::kinematics::{chain, fk, gravity_torques_of, Chain, KinematicsError};
 use crate::measure::Measurement;
 use crate::model::{ParamId, ParamKind, RobotModel};
 use nalgebra::{DMatrix, Vector3};
@@ -80,45 +80,73 @@ pub(crate) fn check_set(
     set: &'static str,
 ) -> Result<(), CalibrationError> {
     for (index, m) in data.iter().enumerate() {
-        if m.q.len() != model.dof() {
-            return Err(CalibrationError::JointCount {
-                set,
-                index,
-                expected: model.dof(),
-                got: m.q.len(),
-            });
-        }
-        if m.q.iter().any(|x| !x.is_finite()) {
-            return Err(CalibrationError::NotFinite {
-                set,
-                index,
-                what: "a joint value",
-            });
-        }
-        if m.position.iter().any(|x| !x.is_finite()) {
-            return Err(CalibrationError::NotFinite {
-                set,
-                index,
-                what: "the measured position",
-            });
-        }
-        if !m.payload_mass.is_finite() || m.payload_mass < 0.0 {
-            return Err(CalibrationError::NotFinite {
-                set,
-                index,
-                what: "the payload mass",
-            });
-        }
-        if let Some(r) = &m.orientation {
-            if r.iter().any(|x| !x.is_finite()) {
-                return Err(CalibrationError::NotFinite {
-                    set,
-                    index,
-                    what: "the measured orientation",
-                });
-            }
-        }
+        check_inputs(model, m, set, index)?;
         fk(model, &m.q).map_err(|source| CalibrationError::Kinematics { set, index, source })?;
+    }
+    Ok(())
+}
+
+/// [`check_set`], keeping the forward kinematics of each measurement at its
+/// commanded joints (`chain` is `fk` with every frame kept: the same numbers),
+/// for the later phases that need them at `model`.
+pub(crate) fn checked_chains(
+    model: &RobotModel,
+    data: &[Measurement],
+    set: &'static str,
+) -> Result<Vec<Chain>, CalibrationError> {
+    data.iter()
+        .enumerate()
+        .map(|(index, m)| {
+            check_inputs(model, m, set, index)?;
+            chain(model, &m.q).map_err(|source| CalibrationError::Kinematics { set, index, source })
+        })
+        .collect()
+}
+
+/// The checks of one measurement before its forward kinematics.
+fn check_inputs(
+    model: &RobotModel,
+    m: &Measurement,
+    set: &'static str,
+    index: usize,
+) -> Result<(), CalibrationError> {
+    if m.q.len() != model.dof() {
+        return Err(CalibrationError::JointCount {
+            set,
+            index,
+            expected: model.dof(),
+            got: m.q.len(),
+        });
+    }
+    if m.q.iter().any(|x| !x.is_finite()) {
+        return Err(CalibrationError::NotFinite {
+            set,
+            index,
+            what: "a joint value",
+        });
+    }
+    if m.position.iter().any(|x| !x.is_finite()) {
+        return Err(CalibrationError::NotFinite {
+            set,
+            index,
+            what: "the measured position",
+        });
+    }
+    if !m.payload_mass.is_finite() || m.payload_mass < 0.0 {
+        return Err(CalibrationError::NotFinite {
+            set,
+            index,
+            what: "the payload mass",
+        });
+    }
+    if let Some(r) = &m.orientation {
+        if r.iter().any(|x| !x.is_finite()) {
+            return Err(CalibrationError::NotFinite {
+                set,
+                index,
+                what: "the measured orientation",
+            });
+        }
     }
     Ok(())
 }
@@ -130,16 +158,40 @@ pub(crate) fn stacked_jacobian(
     ids: &[ParamId],
     data: &[Measurement],
 ) -> DMatrix<f64> {
+    stacked_jacobian_of(model, ids, data, None)
+}
+
+/// [`stacked_jacobian`] with the forward kinematics of `data` at `model` when
+/// already computed (`chains[i]` of `data[i]` at its commanded joints).
+fn stacked_jacobian_of(
+    model: &RobotModel,
+    ids: &[ParamId],
+    data: &[Measurement],
+    chains: Option<&[Chain]>,
+) -> DMatrix<f64> {
     let rows = least_squares::residual_rows(data);
     let mut j = DMatrix::zeros(rows, ids.len());
+    // Only compliance columns use the torques.
+    let needs_tau = ids.iter().any(|i| i.kind == ParamKind::Compliance);
     let mut row = 0;
-    for m in data {
-        let c0 = chain(model, &m.q).expect("checked");
-        let tau = gravity_torques_of(model, &c0, m.payload_mass);
+    for (i, m) in data.iter().enumerate() {
+        let owned;
+        let c0 = match chains {
+            Some(c) => &c[i],
+            None => {
+                owned = chain(model, &m.q).expect("checked");
+                &owned
+            }
+        };
+        let tau = if needs_tau {
+            gravity_torques_of(model, c0, m.payload_mass)
+        } else {
+            Vec::new()
+        };
         let orient = m.orientation.is_some();
         crate::kinematics::jacobian::fill_identification_rows(
             model,
-            &c0,
+            c0,
             ids,
             &tau,
             m.payload_mass,
@@ -150,6 +202,43 @@ pub(crate) fn stacked_jacobian(
         row += if orient { 6 } else { 3 };
     }
     j
+}
+
+/// Poses per block of [`stacked_factor`]: a block's rows and the factor so far
+/// (some 100 KB) stay in cache while the block is reduced.
+const FACTOR_BLOCK_POSES: usize = 100;
+
+/// The triangular factor R of the stacked identification Jacobian J of
+/// [`stacked_jacobian`] (`RᵀR = JᵀJ`, at most `ids.len()` rows, see
+/// `identifiability::triangular_factor`) and J's row count, built block by
+/// block: R of `[R_so_far; next block of rows]` is R of all rows so far
+/// (`[R; B] = diag(Q, I)·[Q_so_farᵀ·J_so_far; B]`). J itself (thousands of
+/// rows) is never formed. `chains`: the forward kinematics of `data` at
+/// `model` when already computed (as in [`stacked_jacobian_of`]).
+pub(crate) fn stacked_factor(
+    model: &RobotModel,
+    ids: &[ParamId],
+    data: &[Measurement],
+    chains: Option<&[Chain]>,
+) -> (DMatrix<f64>, usize) {
+    let n = ids.len();
+    let mut r = DMatrix::zeros(0, n);
+    let mut rows = 0;
+    for (k, block) in data.chunks(FACTOR_BLOCK_POSES).enumerate() {
+        let from = k * FACTOR_BLOCK_POSES;
+        let b = stacked_jacobian_of(
+            model,
+            ids,
+            block,
+            chains.map(|c| &c[from..from + block.len()]),
+        );
+        rows += b.nrows();
+        let mut s = DMatrix::zeros(r.nrows() + b.nrows(), n);
+        s.rows_mut(0, r.nrows()).copy_from(&r);
+        s.rows_mut(r.nrows(), b.nrows()).copy_from(&b);
+        r = super::identifiability::triangular_factor(s);
+    }
+    (r, rows)
 }
 
 /// Parameters that are fixed by design, with the reason.
@@ -195,7 +284,9 @@ pub(crate) fn generic_rank(model: &RobotModel, ids: &[ParamId], orientation: boo
     for (k, &c) in live.iter().enumerate() {
         js.set_column(k, &(j.column(c) / norms[c]));
     }
-    let sv = js.svd(false, false).singular_values;
+    let sv = super::identifiability::triangular_factor(js)
+        .svd(false, false)
+        .singular_values;
     let smax = sv.max();
     sv.iter().filter(|s| **s > smax * 1e-9).count()
 }

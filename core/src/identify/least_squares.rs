@@ -9,14 +9,17 @@
 //! parameters absorb). Residuals in metres; orientation residuals (rotation
 //! vector, rad) are weighted by `orientation_weight` [m/rad]. Jacobian columns
 //! come from `kinematics::jacobian` (eq. 4.9 + chain rule + `J_θ·diag(τ)`), with
-//! τ held fixed within an iteration.
+//! τ held fixed within an iteration. The residuals, Jacobian rows and `JᵀJ` of
+//! a data set are computed in `evaluate`.
 //!
-//! Length: the LM loop, its typed stop tests, the bounds and the frozen-Jacobian
-//! inner solver share their step and scaling code in one file.
+//! Cost per LM iteration: one forward-kinematics pass per trial step (a trial
+//! is evaluated with its Jacobian, so an accepted one is not evaluated again),
+//! into two residual/Jacobian buffers swapped on acceptance.
 
-use crate::kinematics::{chain, gravity_torques_of, jacobian::fill_identification_rows};
+use super::evaluate::{column_scale, evaluate, evaluate_into, gram, scale_columns};
+use crate::kinematics::Chain;
 use crate::measure::Measurement;
-use crate::model::pose::{rotation_log, Pose};
+use crate::model::pose::Pose;
 use crate::model::{ParamId, ParamKind, ParamLayout, RobotModel};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
@@ -77,7 +80,7 @@ pub enum StopReason {
     /// (damping exhausted): not a minimum that a test confirmed.
     NoDescent,
     /// Trial models could not be evaluated (e.g. a closed loop that does not
-    /// close), or the accepted model left the loop's assembly range.
+    /// close).
     EvaluationFailed,
     /// Fewer residuals than unknowns.
     Underdetermined,
@@ -140,6 +143,10 @@ pub struct Fit {
     /// Per parameter of `ids`: held at its lower bound at the end (the
     /// unconstrained fit would move it below; see [`lower_bound`]).
     pub at_bound: Vec<bool>,
+    /// The residual vector at the returned model and session frames (measured
+    /// minus predicted, m; weighted rotation vectors on orientation rows),
+    /// `None` when the start could not be evaluated.
+    pub residuals: Option<DVector<f64>>,
 }
 
 /// Lower bound of a parameter: compliance is admissible only when `c ≥ 0`
@@ -183,21 +190,6 @@ pub fn position_errors_mm(model: &RobotModel, frames: &[Pose], data: &[Measureme
         .collect()
 }
 
-/// Column scaling `1/‖J_j‖` (1 for an all-zero column).
-fn column_scale(j: &DMatrix<f64>) -> DVector<f64> {
-    DVector::from_iterator(
-        j.ncols(),
-        j.column_iter().map(|c| {
-            let n = c.norm();
-            if n > 0.0 {
-                1.0 / n
-            } else {
-                1.0
-            }
-        }),
-    )
-}
-
 /// A frozen-Jacobian least-squares solver (the chord form of eq. 2.4 / 7.8):
 /// the scaled normal matrix of `ids` and of every session frame ≥ 1 is
 /// factorised once at a reference model and reused for repeated updates
@@ -224,10 +216,8 @@ impl FrozenSolver {
         let ev = evaluate(model, frames, ids, data, settings, true)?;
         let mut js = ev.j?;
         let scale = column_scale(&js);
-        for (c, s) in scale.iter().enumerate() {
-            js.column_mut(c).scale_mut(*s);
-        }
-        let chol = js.tr_mul(&js).cholesky()?;
+        scale_columns(&mut js, &scale);
+        let chol = gram(&js).cholesky()?;
         Some(FrozenSolver {
             ids: ids.to_vec(),
             frames: frames.to_vec(),
@@ -279,99 +269,6 @@ impl FrozenSolver {
         let errors = position_errors_mm(&model, &frames, data);
         Some((model, frames, errors))
     }
-}
-
-struct Eval {
-    r: DVector<f64>,
-    j: Option<DMatrix<f64>>,
-}
-
-/// Residuals (and optionally the Jacobian of the prediction) at the current model.
-fn evaluate(
-    model: &RobotModel,
-    frames: &[Pose],
-    ids: &[ParamId],
-    data: &[Measurement],
-    settings: &LmSettings,
-    with_jacobian: bool,
-) -> Option<Eval> {
-    let rows = residual_rows(data);
-    let n_sess = frames.len().saturating_sub(1) * 6;
-    let cols = ids.len() + n_sess;
-    let mut r = DVector::zeros(rows);
-    let mut j = if with_jacobian {
-        Some(DMatrix::zeros(rows, cols))
-    } else {
-        None
-    };
-    let needs_tau = model.has_compliance()
-        || ids
-            .iter()
-            .any(|i| i.kind == ParamKind::Compliance || i.is_payload());
-    let w = settings.orientation_weight;
-    let mut local = DMatrix::zeros(6, ids.len());
-    let mut row = 0;
-    for m in data {
-        let (q_eff, tau) = if needs_tau {
-            let c0 = chain(model, &m.q).ok()?;
-            let tau = gravity_torques_of(model, &c0, m.payload_mass);
-            let q: Vec<f64> =
-                m.q.iter()
-                    .zip(&tau)
-                    .zip(&model.links)
-                    .map(|((q, t), l)| q + l.compliance * t)
-                    .collect();
-            (q, tau)
-        } else {
-            (m.q.clone(), Vec::new())
-        };
-        let c = chain(model, &q_eff).ok()?;
-        let e = frames.get(m.session).copied().unwrap_or_default();
-        let pred = e.transform_point(&c.tcp.p);
-        let dp = m.position - pred;
-        r[row] = dp.x;
-        r[row + 1] = dp.y;
-        r[row + 2] = dp.z;
-        let orient = m.orientation.is_some();
-        if let Some(rm) = &m.orientation {
-            let dr = rotation_log(&(rm * (e.r * c.tcp.r).transpose())) * w;
-            r[row + 3] = dr.x;
-            r[row + 4] = dr.y;
-            r[row + 5] = dr.z;
-        }
-        if let Some(j) = j.as_mut() {
-            fill_identification_rows(model, &c, ids, &tau, m.payload_mass, orient, &mut local, 0);
-            for col in 0..ids.len() {
-                let v = e.r * Vector3::new(local[(0, col)], local[(1, col)], local[(2, col)]);
-                j[(row, col)] = v.x;
-                j[(row + 1, col)] = v.y;
-                j[(row + 2, col)] = v.z;
-                if orient {
-                    let om =
-                        e.r * Vector3::new(local[(3, col)], local[(4, col)], local[(5, col)]) * w;
-                    j[(row + 3, col)] = om.x;
-                    j[(row + 4, col)] = om.y;
-                    j[(row + 5, col)] = om.z;
-                }
-            }
-            if m.session > 0 {
-                let base = ids.len() + (m.session - 1) * 6;
-                for k in 0..3 {
-                    j[(row + k, base + k)] = 1.0;
-                    let ek = Vector3::ith(k, 1.0);
-                    let v = ek.cross(&pred);
-                    j[(row, base + 3 + k)] = v.x;
-                    j[(row + 1, base + 3 + k)] = v.y;
-                    j[(row + 2, base + 3 + k)] = v.z;
-                    if orient {
-                        j[(row + 3 + k, base + 3 + k)] = w;
-                    }
-                }
-            }
-        }
-        row += if orient { 6 } else { 3 };
-    }
-    Some(Eval { r, j })
 }
 
 fn apply_step(
@@ -431,6 +328,22 @@ pub fn fit(
     settings: &LmSettings,
     progress: &mut dyn FnMut(usize, f64) -> bool,
 ) -> Result<Fit, Cancelled> {
+    fit_with_start_chains(start, ids, data, sessions, settings, None, progress)
+}
+
+/// [`fit`], with the forward kinematics of `data` at the commanded joints on
+/// `start`'s geometry when already known (`start_chains[i]` of `data[i]`; the
+/// first evaluation then skips its forward kinematics where no joint is
+/// deflected).
+pub(crate) fn fit_with_start_chains(
+    start: &RobotModel,
+    ids: &[ParamId],
+    data: &[Measurement],
+    sessions: usize,
+    settings: &LmSettings,
+    start_chains: Option<&[Chain]>,
+    progress: &mut dyn FnMut(usize, f64) -> bool,
+) -> Result<Fit, Cancelled> {
     let layout = ParamLayout { ids: ids.to_vec() };
     let lower: Vec<f64> = ids.iter().map(lower_bound).collect();
     let mut model = start.clone();
@@ -446,7 +359,21 @@ pub fn fit(
     let mut frames = vec![Pose::identity(); sessions.max(1)];
     let rows = residual_rows(data);
     let rms_mm = |c: f64| (c / rows.max(1) as f64).sqrt() * 1e3;
-    let Some(mut ev) = evaluate(&model, &frames, ids, data, settings, true) else {
+    let ncols = ids.len() + (frames.len() - 1) * 6;
+    // The current point and the trial buffers (residuals, Jacobian), swapped
+    // when a trial is accepted.
+    let mut ev = (DVector::zeros(rows), DMatrix::zeros(rows, ncols));
+    let mut trial = (DVector::zeros(rows), DMatrix::zeros(rows, ncols));
+    if !evaluate_into(
+        &model,
+        &frames,
+        ids,
+        data,
+        settings,
+        &mut ev.0,
+        Some(&mut ev.1),
+        start_chains,
+    ) {
         return Ok(Fit {
             model,
             session_frames: frames,
@@ -461,20 +388,15 @@ pub fn fit(
             },
             covariance: None,
             at_bound: vec![false; ids.len()],
+            residuals: None,
         });
     };
-    let mut cost = ev.r.norm_squared();
+    let mut cost = ev.0.norm_squared();
     let initial = rms_mm(cost);
-    let ncols = ev.j.as_ref().map_or(0, |j| j.ncols());
-    // Column scaling, fixed from the first Jacobian.
-    let scale = column_scale(ev.j.as_ref().expect("jacobian evaluated"));
-    let scaled = |ev: &Eval| {
-        let mut js = ev.j.as_ref().expect("jacobian evaluated").clone();
-        for (c, s) in scale.iter().enumerate() {
-            js.column_mut(c).scale_mut(*s);
-        }
-        js
-    };
+    // Column scaling, fixed from the first Jacobian; every accepted
+    // evaluation's Jacobian is scaled in place.
+    let scale = column_scale(&ev.1);
+    scale_columns(&mut ev.1, &scale);
     let mut lambda = settings.initial_lambda;
     let mut iterations = 0;
     let mut reason = StopReason::MaxIterations;
@@ -483,7 +405,7 @@ pub fn fit(
         settings.max_iterations
     );
     let mut active = vec![false; ncols];
-    let mut gradient = f64::NAN;
+    let mut gradient: f64;
     if rows < ncols {
         reason = StopReason::Underdetermined;
         detail = format!("underdetermined: {rows} residuals for {ncols} unknowns");
@@ -492,15 +414,15 @@ pub fn fit(
         if !progress(iterations, rms_mm(cost)) {
             return Err(Cancelled);
         }
-        let js = scaled(&ev);
-        let a = js.tr_mul(&js);
-        let g = js.tr_mul(&ev.r);
+        let js = &ev.1;
+        let a = gram(js);
+        let g = js.tr_mul(&ev.0);
         let x = layout.values(&model);
         // Active bounds: at the bound with the descent direction (+g) below it.
         for i in 0..ncols {
             active[i] = i < ids.len() && x[i] <= lower[i] && g[i] < 0.0;
         }
-        gradient = gradient_measure(&js, &g, cost.sqrt(), &active);
+        gradient = gradient_measure(js, &g, cost.sqrt(), &active);
         let mut accepted = None;
         let mut evaluations_failed = 0;
         let mut trials = 0;
@@ -531,18 +453,29 @@ pub fn fit(
             }
             let step = delta.component_div(&scale).norm();
             let (m2, f2) = apply_step(&model, &frames, &layout, &x, &delta);
-            match evaluate(&m2, &f2, ids, data, settings, false) {
-                Some(e2) if e2.r.norm_squared() < cost => {
-                    accepted = Some((m2, f2, e2.r.norm_squared(), step));
-                    lambda = (lambda / 10.0).max(1e-15);
-                    break;
-                }
-                Some(_) => lambda *= 10.0,
-                None => {
-                    evaluations_failed += 1;
-                    lambda *= 10.0;
-                }
+            // With the Jacobian: an accepted trial is the next iterate, whose
+            // Jacobian is needed next (one forward-kinematics pass per trial).
+            if !evaluate_into(
+                &m2,
+                &f2,
+                ids,
+                data,
+                settings,
+                &mut trial.0,
+                Some(&mut trial.1),
+                None,
+            ) {
+                evaluations_failed += 1;
+                lambda *= 10.0;
+                continue;
             }
+            let c2 = trial.0.norm_squared();
+            if c2 < cost {
+                accepted = Some((m2, f2, c2, step));
+                lambda = (lambda / 10.0).max(1e-15);
+                break;
+            }
+            lambda *= 10.0;
         }
         let Some((m2, f2, c2, step)) = accepted else {
             if gradient <= settings.gradient_tolerance {
@@ -575,14 +508,8 @@ pub fn fit(
         model = m2;
         frames = f2;
         cost = c2;
-        ev = match evaluate(&model, &frames, ids, data, settings, true) {
-            Some(e) => e,
-            None => {
-                reason = StopReason::EvaluationFailed;
-                detail = "the model left the closed loop's assembly range".into();
-                break;
-            }
-        };
+        std::mem::swap(&mut ev, &mut trial);
+        scale_columns(&mut ev.1, &scale);
         if rel < settings.cost_tolerance {
             reason = StopReason::CostTolerance;
             detail = format!(
@@ -601,27 +528,21 @@ pub fn fit(
         }
     }
     // Final bound state and gradient at the returned model.
-    let at_bound: Vec<bool> =
-        ev.j.as_ref()
-            .map(|_| {
-                let js = scaled(&ev);
-                let g = js.tr_mul(&ev.r);
-                let x = layout.values(&model);
-                for i in 0..ncols {
-                    active[i] = i < ids.len() && x[i] <= lower[i] && g[i] < 0.0;
-                }
-                gradient = gradient_measure(&js, &g, cost.sqrt(), &active);
-                active[..ids.len()].to_vec()
-            })
-            .unwrap_or_else(|| vec![false; ids.len()]);
-    let covariance = ev.j.as_ref().and_then(|_| {
+    let js = &ev.1;
+    let g = js.tr_mul(&ev.0);
+    let x = layout.values(&model);
+    for i in 0..ncols {
+        active[i] = i < ids.len() && x[i] <= lower[i] && g[i] < 0.0;
+    }
+    gradient = gradient_measure(js, &g, cost.sqrt(), &active);
+    let at_bound = active[..ids.len()].to_vec();
+    let covariance = (|| {
         let free = ncols - active.iter().filter(|a| **a).count();
         let dof = rows as f64 - free as f64;
         if dof <= 0.0 {
             return None;
         }
-        let js = scaled(&ev);
-        let mut a = js.tr_mul(&js);
+        let mut a = gram(js);
         for i in 0..ncols {
             if active[i] {
                 a.row_mut(i).fill(0.0);
@@ -640,7 +561,7 @@ pub fn fit(
             }
         }
         Some(cov)
-    });
+    })();
     Ok(Fit {
         model,
         session_frames: frames,
@@ -655,5 +576,6 @@ pub fn fit(
         },
         covariance,
         at_bound,
+        residuals: Some(ev.0),
     })
 }

@@ -29,13 +29,15 @@
 //! (not converged, compliance held at c = 0, stiffness outside the plausible
 //! range), and the model must load back from its JSON description.
 
-use super::checks::{payload_problem, stacked_jacobian};
+use super::checks::{payload_problem, stacked_factor};
 use super::identifiability::{self, DroppedParam};
-use super::least_squares::{fit, Cancelled, Fit, FrozenSolver};
+use super::least_squares::{
+    fit, fit_with_start_chains, residual_rows, Cancelled, Fit, FrozenSolver,
+};
 use super::options::{CalibrationOptions, Method};
 use super::report::{estimates, MethodReport, MethodWarning, SetErrors, TlboSummary, WarningKind};
 use super::tlbo;
-use crate::kinematics::{chain, gravity_torques_of};
+use crate::kinematics::{chain, gravity_torques_of, Chain};
 use crate::measure::Measurement;
 use crate::model::pose::Pose;
 use crate::model::{ModelDescription, ParamId, ParamKind, RobotModel};
@@ -62,6 +64,9 @@ pub(crate) struct Context<'a> {
     pub start: RobotModel,
     /// Identification and validation data in the registered base frame.
     pub ident: &'a [Measurement],
+    /// Forward kinematics of `ident` at its commanded joints on the nominal
+    /// geometry (that of `start`), for the first evaluation of a fit from `start`.
+    pub ident_chains: &'a [Chain],
     pub valid: &'a [Measurement],
     pub sessions: usize,
     pub kept_geo: Vec<ParamId>,
@@ -85,7 +90,25 @@ impl Context<'_> {
     }
 
     pub fn km(&self, progress: &mut dyn FnMut(usize, f64) -> bool) -> Result<Fit, Cancelled> {
-        self.fit_from(&self.start, &self.kept_geo, progress)
+        self.fit_from_start(&self.kept_geo, progress)
+    }
+
+    /// [`Context::fit_from`] `start`, whose forward kinematics at the
+    /// identification poses are known.
+    fn fit_from_start(
+        &self,
+        ids: &[ParamId],
+        progress: &mut dyn FnMut(usize, f64) -> bool,
+    ) -> Result<Fit, Cancelled> {
+        fit_with_start_chains(
+            &self.start,
+            ids,
+            self.ident,
+            self.sessions,
+            &self.opts.lm,
+            Some(self.ident_chains),
+            progress,
+        )
     }
 
     fn require_compliance(&self) -> Result<(), MethodError> {
@@ -121,7 +144,7 @@ impl Context<'_> {
     ) -> Result<MethodFit, MethodError> {
         self.require_compliance()?;
         let ids = self.with_compliance();
-        let f = self.fit_from(&self.start, &ids, progress)?;
+        let f = self.fit_from_start(&ids, progress)?;
         Ok(MethodFit {
             fit: f,
             ids,
@@ -211,10 +234,11 @@ impl Context<'_> {
             });
         }
         let candidates: Vec<ParamId> = base.iter().chain(&payload).copied().collect();
-        let j = stacked_jacobian(&skcm.model, &candidates, self.ident);
-        let analysis = identifiability::analyse(
+        let (j, rows) = stacked_factor(&skcm.model, &candidates, self.ident, None);
+        let analysis = identifiability::analyse_factor(
             &skcm.model,
             &j,
+            rows,
             &candidates,
             &[],
             self.ident.len(),
@@ -263,7 +287,13 @@ impl Context<'_> {
                 method.name()
             ));
         }
-        let id_err = SetErrors::of(&fitted.model, &fitted.session_frames, self.ident);
+        // The fit's last residuals are those of the identification set.
+        let id_err = match &fitted.residuals {
+            Some(r) if r.len() == residual_rows(self.ident) => {
+                SetErrors::from_residual_vector(self.ident, r)
+            }
+            _ => SetErrors::of(&fitted.model, &fitted.session_frames, self.ident),
+        };
         let va_err = (!self.valid.is_empty())
             .then(|| SetErrors::of(&fitted.model, &fitted.session_frames, self.valid));
         let mut warnings = Vec::new();
@@ -452,6 +482,7 @@ impl<'a> SkcmCCost<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::identify::checks::stacked_jacobian;
     use crate::measure::to_measurements;
     use crate::model::preset;
     use crate::model::ParamLayout;

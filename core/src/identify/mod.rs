@@ -10,6 +10,7 @@
 
 pub mod calibrate;
 pub mod checks;
+mod evaluate;
 mod hybrid;
 pub mod identifiability;
 pub mod least_squares;

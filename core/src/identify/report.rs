@@ -15,7 +15,7 @@ use crate::measure::Measurement;
 use crate::model::description::PoseDescription;
 use crate::model::pose::Pose;
 use crate::model::{ModelDescription, ParamId, RobotModel};
-use nalgebra::{DMatrix, Vector3};
+use nalgebra::{DMatrix, DVector, Vector3};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -67,13 +67,60 @@ impl SetErrors {
         frames: &[Pose],
         data: &[Measurement],
     ) -> Self {
+        Self::from_predictions(
+            frames,
+            data,
+            data.iter()
+                .map(|m| predict_compensated(model, compensator, m)),
+        )
+    }
+
+    /// [`SetErrors::of`] from the predicted positions [m] of `data` in the
+    /// registered base frame (`None`: the model cannot predict the pose), one
+    /// per measurement in order.
+    pub(crate) fn from_predictions(
+        frames: &[Pose],
+        data: &[Measurement],
+        predictions: impl Iterator<Item = Option<Vector3<f64>>>,
+    ) -> Self {
+        Self::from_residuals(
+            data,
+            data.iter().zip(predictions).map(|(m, p)| {
+                p.map(|p| {
+                    let e = frames.get(m.session).copied().unwrap_or_default();
+                    m.position - e.transform_point(&p)
+                })
+            }),
+        )
+    }
+
+    /// [`SetErrors::of`] from the fitted model's residual vector on `data`
+    /// (`least_squares::Fit::residuals`: measured minus predicted, the same
+    /// numbers [`SetErrors::of`] computes again; orientation rows skipped).
+    pub(crate) fn from_residual_vector(data: &[Measurement], r: &DVector<f64>) -> Self {
+        let mut row = 0;
+        Self::from_residuals(
+            data,
+            data.iter().map(|m| {
+                let d = Vector3::new(r[row], r[row + 1], r[row + 2]);
+                row += if m.orientation.is_some() { 6 } else { 3 };
+                Some(d)
+            }),
+        )
+    }
+
+    /// The set's errors from the position residuals [m] (measured minus
+    /// predicted, in the session frame; `None`: not predictable) of `data`.
+    fn from_residuals(
+        data: &[Measurement],
+        residuals: impl Iterator<Item = Option<Vector3<f64>>>,
+    ) -> Self {
         let mut xyz = Vec::with_capacity(data.len());
         let mut norms = Vec::with_capacity(data.len());
-        for m in data {
-            match predict_compensated(model, compensator, m) {
-                Some(p) => {
-                    let e = frames.get(m.session).copied().unwrap_or_default();
-                    let d = (m.position - e.transform_point(&p)) * 1e3;
+        for r in residuals {
+            match r {
+                Some(r) => {
+                    let d = r * 1e3;
                     norms.push(d.norm());
                     xyz.push([Some(d.x), Some(d.y), Some(d.z)]);
                 }

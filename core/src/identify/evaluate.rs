@@ -1,0 +1,234 @@
+//! The measurement model over a data set for the least-squares fits
+//! (`least_squares`): residuals and Jacobian rows per pose, and the normal
+//! matrix `JᵀJ`.
+//!
+//! Model of one measurement (seed eq. 2.1 without ΔP_extra), in the registered
+//! base frame of session s: `p = E_s · FK(φ, q + c∘τ(q))`, τ the gravity
+//! torques at the commanded joints with the measured payload, `E_s` the rigid
+//! correction of session s's frame (identity for session 0). Residuals
+//! (measured − predicted) in metres, 3 rows per pose, plus 3 orientation rows
+//! (rotation vector [rad] × `orientation_weight` [m/rad]) where measured.
+//! Jacobian rows of the prediction: the identification columns of
+//! `kinematics::jacobian` (eq. 4.9 + chain rule + `J_θ·diag(τ)`) rotated into
+//! the session frame, then 6 columns per session ≥ 1 (translation, small
+//! rotation of `E_s`); τ held fixed within an evaluation.
+
+use super::least_squares::{residual_rows, LmSettings};
+use crate::kinematics::{chain, gravity_torques_of, jacobian::fill_identification_rows, Chain};
+use crate::measure::Measurement;
+use crate::model::pose::{rotation_log, Pose};
+use crate::model::{ParamId, ParamKind, RobotModel};
+use nalgebra::{DMatrix, DVector, Vector3};
+
+/// Column scaling `1/‖J_j‖` (1 for an all-zero column).
+pub(crate) fn column_scale(j: &DMatrix<f64>) -> DVector<f64> {
+    DVector::from_iterator(
+        j.ncols(),
+        j.column_iter().map(|c| {
+            let n = c.norm();
+            if n > 0.0 {
+                1.0 / n
+            } else {
+                1.0
+            }
+        }),
+    )
+}
+
+/// Scales the columns of `j` by `scale` in place.
+pub(crate) fn scale_columns(j: &mut DMatrix<f64>, scale: &DVector<f64>) {
+    for (c, s) in scale.iter().enumerate() {
+        j.column_mut(c).scale_mut(*s);
+    }
+}
+
+/// `jᵀj`, each entry the same column dot product as `j.tr_mul(j)` computes
+/// (bit for bit), but the lower triangle only, mirrored (half the work). A
+/// kernel taking four columns by four was measured slower (the baseline
+/// x86-64 target has too few vector registers for its partial sums).
+pub(crate) fn gram(j: &DMatrix<f64>) -> DMatrix<f64> {
+    let n = j.ncols();
+    let mut a = DMatrix::zeros(n, n);
+    for i in 0..n {
+        let ci = j.column(i);
+        for k in 0..=i {
+            let d = ci.dot(&j.column(k));
+            a[(i, k)] = d;
+            a[(k, i)] = d;
+        }
+    }
+    a
+}
+
+pub(crate) struct Eval {
+    pub r: DVector<f64>,
+    pub j: Option<DMatrix<f64>>,
+}
+
+/// Residuals (and optionally the Jacobian of the prediction) at the current model.
+pub(crate) fn evaluate(
+    model: &RobotModel,
+    frames: &[Pose],
+    ids: &[ParamId],
+    data: &[Measurement],
+    settings: &LmSettings,
+    with_jacobian: bool,
+) -> Option<Eval> {
+    let rows = residual_rows(data);
+    let cols = ids.len() + frames.len().saturating_sub(1) * 6;
+    let mut r = DVector::zeros(rows);
+    let mut j = with_jacobian.then(|| DMatrix::zeros(rows, cols));
+    evaluate_into(model, frames, ids, data, settings, &mut r, j.as_mut(), None)
+        .then_some(Eval { r, j })
+}
+
+/// [`evaluate`] into `r` (rows) and, when given, the rows × columns Jacobian
+/// `j` (every entry overwritten, so the LM loop reuses two buffers instead of
+/// allocating one per evaluation). False when some pose cannot be evaluated
+/// (the outputs are then garbage). `chains`: the forward kinematics
+/// of `data` at the commanded joints on `model`'s geometry, used where the
+/// joints are not deflected (no torques needed).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn evaluate_into(
+    model: &RobotModel,
+    frames: &[Pose],
+    ids: &[ParamId],
+    data: &[Measurement],
+    settings: &LmSettings,
+    r: &mut DVector<f64>,
+    mut j: Option<&mut DMatrix<f64>>,
+    chains: Option<&[Chain]>,
+) -> bool {
+    let needs_tau = model.has_compliance()
+        || ids
+            .iter()
+            .any(|i| i.kind == ParamKind::Compliance || i.is_payload());
+    let w = settings.orientation_weight;
+    if let Some(j) = j.as_mut() {
+        // Session-frame columns: zero except the entries written below.
+        for c in ids.len()..j.ncols() {
+            j.column_mut(c).fill(0.0);
+        }
+    }
+    let mut local = DMatrix::zeros(6, ids.len());
+    let mut q_eff = Vec::new();
+    let mut tau = Vec::new();
+    let mut row = 0;
+    for (i, m) in data.iter().enumerate() {
+        let known = if needs_tau {
+            None
+        } else {
+            chains.map(|c| &c[i])
+        };
+        let q: &[f64] = if needs_tau {
+            let Ok(c0) = chain(model, &m.q) else {
+                return false;
+            };
+            tau = gravity_torques_of(model, &c0, m.payload_mass);
+            q_eff.clear();
+            q_eff.extend(
+                m.q.iter()
+                    .zip(&tau)
+                    .zip(&model.links)
+                    .map(|((q, t), l)| q + l.compliance * t),
+            );
+            &q_eff
+        } else {
+            &m.q
+        };
+        let owned;
+        let c = match known {
+            Some(c) => c,
+            None => {
+                let Ok(c) = chain(model, q) else {
+                    return false;
+                };
+                owned = c;
+                &owned
+            }
+        };
+        let e = frames.get(m.session).copied().unwrap_or_default();
+        let pred = e.transform_point(&c.tcp.p);
+        let dp = m.position - pred;
+        r[row] = dp.x;
+        r[row + 1] = dp.y;
+        r[row + 2] = dp.z;
+        let orient = m.orientation.is_some();
+        if let Some(rm) = &m.orientation {
+            let dr = rotation_log(&(rm * (e.r * c.tcp.r).transpose())) * w;
+            r[row + 3] = dr.x;
+            r[row + 4] = dr.y;
+            r[row + 5] = dr.z;
+        }
+        let n_rows = if orient { 6 } else { 3 };
+        if let Some(j) = j.as_mut() {
+            fill_identification_rows(model, c, ids, &tau, m.payload_mass, orient, &mut local, 0);
+            for col in 0..ids.len() {
+                let v = e.r * Vector3::new(local[(0, col)], local[(1, col)], local[(2, col)]);
+                j[(row, col)] = v.x;
+                j[(row + 1, col)] = v.y;
+                j[(row + 2, col)] = v.z;
+                if orient {
+                    let om =
+                        e.r * Vector3::new(local[(3, col)], local[(4, col)], local[(5, col)]) * w;
+                    j[(row + 3, col)] = om.x;
+                    j[(row + 4, col)] = om.y;
+                    j[(row + 5, col)] = om.z;
+                }
+            }
+            if m.session > 0 {
+                let base = ids.len() + (m.session - 1) * 6;
+                for k in 0..3 {
+                    j[(row + k, base + k)] = 1.0;
+                    let ek = Vector3::ith(k, 1.0);
+                    let v = ek.cross(&pred);
+                    j[(row, base + 3 + k)] = v.x;
+                    j[(row + 1, base + 3 + k)] = v.y;
+                    j[(row + 2, base + 3 + k)] = v.z;
+                    if orient {
+                        j[(row + 3 + k, base + 3 + k)] = w;
+                    }
+                }
+            }
+        }
+        row += n_rows;
+    }
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// The lower-triangle Gram matrix is `j.tr_mul(j)` bit for bit (the fits'
+    /// numbers do not change with it): several shapes, a zero column, mixed
+    /// magnitudes.
+    #[test]
+    fn gram_equals_nalgebra_tr_mul_bit_for_bit() {
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        for (m, n) in [
+            (3000, 25),
+            (3003, 34),
+            (7, 3),
+            (16, 1),
+            (9, 0),
+            (45, 8),
+            (1, 5),
+        ] {
+            let mut j = DMatrix::from_fn(m, n, |_, c| {
+                rng.gen_range(-1.0..1.0) * 10f64.powi(c as i32 % 7 - 3)
+            });
+            if n > 2 {
+                j.column_mut(2).fill(0.0);
+            }
+            let a = gram(&j);
+            let b = j.tr_mul(&j);
+            assert_eq!(a.shape(), b.shape());
+            for (x, y) in a.iter().zip(b.iter()) {
+                assert_eq!(x.to_bits(), y.to_bits(), "{m}×{n}: {x} vs {y}");
+            }
+        }
+    }
+}
