@@ -78,8 +78,9 @@ impl Features {
     }
 }
 
-/// Layer widths up to this use stack buffers in [`Mlp::eval_with_jacobian`].
-const STACK_WIDTH: usize = 64;
+/// Layer widths up to this use stack buffers in [`Mlp::eval_with_jacobian`]
+/// (wider layers the heap).
+const STACK_WIDTH: usize = 32;
 
 /// A slice of `n` zeros: `stack` when it is long enough, else `heap`.
 fn scratch<'a, const S: usize>(
@@ -305,9 +306,20 @@ impl Mlp {
         }
     }
 
-    /// Residual [m] at joints `q` and payload [kg].
+    /// Residual [m] at joints `q` and payload [kg] (the forward pass of
+    /// [`Mlp::eval_with_jacobian`] alone).
     pub fn eval(&self, q: &[f64], payload_kg: f64) -> Vector3<f64> {
-        self.eval_with_jacobian(q, payload_kg, None)
+        let s = self.shape();
+        let (mut xs, mut xh) = ([0.0; STACK_WIDTH], Vec::new());
+        let x = scratch(&mut xs, &mut xh, s.inputs);
+        self.features.write_into(q, payload_kg, x);
+        self.input_norm.apply(x);
+        let (mut hs, mut hh) = ([0.0; STACK_WIDTH], Vec::new());
+        let h = scratch(&mut hs, &mut hh, s.hidden);
+        let mut y = [0.0; 3];
+        s.forward(&self.weights, x, h, &mut y);
+        self.output_norm.invert(&mut y);
+        Vector3::new(y[0], y[1], y[2])
     }
 
     /// `∂residual/∂q` [m/rad], 3×dof.
@@ -319,7 +331,7 @@ impl Mlp {
 
     /// Residual [m] at joints `q` and payload [kg] and, when `dq` is given
     /// (`dof` columns), `∂residual/∂q` [m/rad] into it: one forward pass, no
-    /// allocation for layers up to 64 wide (the IK calls it once per
+    /// allocation for layers up to 32 wide (the IK calls it once per
     /// evaluation). The derivative is the module docs' chain rule.
     pub fn eval_with_jacobian(
         &self,
@@ -328,16 +340,13 @@ impl Mlp {
         dq: Option<&mut [Vector3<f64>]>,
     ) -> Vector3<f64> {
         let s = self.shape();
+        // The raw features (kept for the derivative's sin q and cos q), then normalised.
+        let (mut raw_s, mut raw_h) = ([0.0; STACK_WIDTH], Vec::new());
+        let raw = scratch(&mut raw_s, &mut raw_h, s.inputs);
+        self.features.write_into(q, payload_kg, raw);
         let (mut xs, mut xh) = ([0.0; STACK_WIDTH], Vec::new());
         let x = scratch(&mut xs, &mut xh, s.inputs);
-        self.features.write_into(q, payload_kg, x);
-        // The raw sin q and cos q features, for the derivative.
-        let n = self.dof;
-        let (mut trig_s, mut trig_h) = ([0.0; STACK_WIDTH], Vec::new());
-        let trig = scratch(&mut trig_s, &mut trig_h, 2 * n);
-        if self.features.sin_cos && dq.is_some() {
-            trig.copy_from_slice(&x[n..3 * n]);
-        }
+        x.copy_from_slice(raw);
         self.input_norm.apply(x);
         let (mut hs, mut hh) = ([0.0; STACK_WIDTH], Vec::new());
         let h = scratch(&mut hs, &mut hh, s.hidden);
@@ -349,14 +358,16 @@ impl Mlp {
             let dx = scratch(&mut ds, &mut dh, 3 * s.inputs);
             s.input_jacobian(&self.weights, h, dx);
             let sc = &self.input_norm.scale;
+            let n = self.dof;
             for o in 0..3 {
                 let so = 1.0 / self.output_norm.scale[o];
                 let row = &dx[o * s.inputs..(o + 1) * s.inputs];
                 for (k, col) in out.iter_mut().enumerate().take(n) {
                     let mut d = row[k] * sc[k];
                     if self.features.sin_cos {
-                        d += row[n + k] * sc[n + k] * trig[n + k];
-                        d -= row[2 * n + k] * sc[2 * n + k] * trig[k];
+                        // ∂ sin q/∂q = cos q (raw[2n + k]), ∂ cos q/∂q = −sin q (raw[n + k]).
+                        d += row[n + k] * sc[n + k] * raw[2 * n + k];
+                        d -= row[2 * n + k] * sc[2 * n + k] * raw[n + k];
                     }
                     col[o] = d * so;
                 }

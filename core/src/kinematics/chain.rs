@@ -113,7 +113,7 @@ impl LinkTrig {
 }
 
 /// `pose · Rot(x, α)` from `(sin α, cos α)` (as [`Pose::rot_x`]).
-#[inline]
+#[inline(always)]
 pub(crate) fn rot_x_sc(pose: &mut Pose, (s, c): (f64, f64)) {
     let c1 = pose.r.column(1).into_owned();
     let c2 = pose.r.column(2).into_owned();
@@ -122,12 +122,21 @@ pub(crate) fn rot_x_sc(pose: &mut Pose, (s, c): (f64, f64)) {
 }
 
 /// `pose · Rot(y, β)` from `(sin β, cos β)` (as [`Pose::rot_y`]).
-#[inline]
+#[inline(always)]
 pub(crate) fn rot_y_sc(pose: &mut Pose, (s, c): (f64, f64)) {
     let c0 = pose.r.column(0).into_owned();
     let c2 = pose.r.column(2).into_owned();
     pose.r.set_column(0, &(c0 * c - c2 * s));
     pose.r.set_column(2, &(c0 * s + c2 * c));
+}
+
+/// `pose · Rot(z, θ)` from `(sin θ, cos θ)` (as [`Pose::rot_z`]).
+#[inline(always)]
+pub(crate) fn rot_z_sc(pose: &mut Pose, (s, c): (f64, f64)) {
+    let c0 = pose.r.column(0).into_owned();
+    let c1 = pose.r.column(1).into_owned();
+    pose.r.set_column(0, &(c0 * c + c1 * s));
+    pose.r.set_column(1, &(c1 * c - c0 * s));
 }
 
 /// Applies the constant part of link `k` to `pose`, everything before
@@ -160,6 +169,17 @@ pub(crate) fn link_constant_step(
         pose.tr_z(l.d);
         (after_a, after_beta)
     }
+}
+
+/// [`link_constant_step`] for a link `k > 0`, without the intermediate frames.
+#[inline(always)]
+pub(crate) fn link_constant_apply(l: &Link, t: &LinkTrig, pose: &mut Pose) {
+    rot_x_sc(pose, t.alpha);
+    pose.p += pose.r.column(0) * l.a;
+    if l.parallel {
+        rot_y_sc(pose, t.beta);
+    }
+    pose.p += pose.r.column(2) * l.d;
 }
 
 /// Applies one link's transform to `pose` (frame k−1 → frame k).

@@ -16,7 +16,8 @@
 //! kept, in a caller's buffer: no allocation per call.
 
 use super::chain::{
-    chain_angles, check_q, link_constant_step, tool_pose, KinematicsError, LinkTrig,
+    chain_angles, check_q, link_constant_apply, link_constant_step, rot_z_sc, tool_pose,
+    KinematicsError, LinkTrig,
 };
 use super::gravity::gravity_torques_into;
 use super::loop_closure::LoopPartials;
@@ -118,9 +119,9 @@ impl PreparedChain {
         let mut pose = self.base;
         for (k, (l, t)) in m.links.iter().zip(&self.trig).enumerate() {
             if k > 0 {
-                link_constant_step(k, l, t, &mut pose);
+                link_constant_apply(l, t, &mut pose);
             }
-            pose.rot_z(angles[k]);
+            rot_z_sc(&mut pose, angles[k].sin_cos());
             visit(k, &pose);
         }
         Ok((pose, loop_partials))
