@@ -2,6 +2,14 @@
 //! step, the error vector and the weighted Jacobian of the parent module's
 //! header, with Nielsen's damping rule and projection onto the joint limits.
 //! Frames: base frame; units: m, rad.
+//!
+//! One generic iteration (`refine_in`): six-joint models run it on
+//! fixed-size (stack) matrices, others on dynamic ones (compared in the tests).
+//! The step's system `J_w J_wᵀ + λ² I` is always 6×6: a position-only goal has
+//! zero orientation rows in `J_w` and `e` and a unit diagonal there, which
+//! decouples them (their solution is 0), so the step is the 3-row
+//! minimum-norm step of the parent module's header. The prediction and its
+//! Jacobian come from the prepared model (`solver/eval.rs`).
 
 use super::*;
 use nalgebra::{
@@ -215,6 +223,52 @@ impl IkSolver {
             at_limit: at_limit && !converged,
             sigma_min,
             failed_evaluation: false,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::compensate::{synthetic_calibration, SyntheticErrors};
+    use crate::model::preset;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// The fixed-size iteration (six joints) against the dynamic-size one on
+    /// random targets of YS100, UR10 and the HH800 loop, calibrated (Hayati β,
+    /// compliance under the payload), full-pose and position-only goals.
+    #[test]
+    fn fixed_size_iteration_equals_the_dynamic_one() {
+        let mut rng = ChaCha8Rng::seed_from_u64(31);
+        for name in ["ys100", "ur10", "hh800"] {
+            let nominal = preset(name).unwrap();
+            let cm = synthetic_calibration(&nominal, &SyntheticErrors::typical(1e-6), 11);
+            assert!(cm.calibrated.has_compliance());
+            let solver = IkSolver::new(cm.clone(), IkSettings::default());
+            let mut converged = 0;
+            for i in 0..30 {
+                let q: Vec<f64> = nominal
+                    .links
+                    .iter()
+                    .map(|l| rng.gen_range(l.limits[0]..l.limits[1]))
+                    .collect();
+                let Ok(p) = cm.predict_base(&q) else { continue };
+                let goal = Goal::from(&p);
+                let q0: Vec<f64> = q.iter().map(|v| v + rng.gen_range(-0.05..0.05)).collect();
+                let q0 = solver.clamp_to_limits(&q0);
+                let position_only = i % 3 == 0;
+                let a = solver.refine_in(U6, &goal, q0.clone(), position_only, 60);
+                let b = solver.refine_in(Dyn(6), &goal, q0, position_only, 60);
+                assert_eq!(a.converged, b.converged, "{name} {i}");
+                assert_eq!(a.iterations, b.iterations, "{name} {i}");
+                for (x, y) in a.q.iter().zip(&b.q) {
+                    assert!((x - y).abs() <= 1e-12, "{name} {i}: {x} vs {y}");
+                }
+                assert!((a.position_residual_m - b.position_residual_m).abs() <= 1e-12);
+                converged += usize::from(a.converged);
+            }
+            assert!(converged >= 20, "{name}: {converged} of 30 converged");
         }
     }
 }
