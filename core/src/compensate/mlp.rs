@@ -59,6 +59,41 @@ impl Features {
             out.push(payload_kg);
         }
     }
+
+    /// [`Features::write`] into a slice of `count(q.len())` values.
+    pub fn write_into(&self, q: &[f64], payload_kg: f64, out: &mut [f64]) {
+        let n = q.len();
+        out[..n].copy_from_slice(q);
+        let mut end = n;
+        if self.sin_cos {
+            for (k, x) in q.iter().enumerate() {
+                out[n + k] = x.sin();
+                out[2 * n + k] = x.cos();
+            }
+            end = 3 * n;
+        }
+        if self.payload {
+            out[end] = payload_kg;
+        }
+    }
+}
+
+/// Layer widths up to this use stack buffers in [`Mlp::eval_with_jacobian`]
+/// (wider layers the heap).
+const STACK_WIDTH: usize = 32;
+
+/// A slice of `n` zeros: `stack` when it is long enough, else `heap`.
+fn scratch<'a, const S: usize>(
+    stack: &'a mut [f64; S],
+    heap: &'a mut Vec<f64>,
+    n: usize,
+) -> &'a mut [f64] {
+    if n <= S {
+        &mut stack[..n]
+    } else {
+        heap.resize(n, 0.0);
+        heap
+    }
 }
 
 /// Affine normalisation `x_n = (x − centre)·scale` per column.
@@ -271,56 +306,74 @@ impl Mlp {
         }
     }
 
-    fn normalised_input(&self, q: &[f64], payload_kg: f64) -> Vec<f64> {
-        let mut x = Vec::with_capacity(self.input_norm.len());
-        self.features.write(q, payload_kg, &mut x);
-        self.input_norm.apply(&mut x);
-        x
-    }
-
-    /// Residual [m] at joints `q` and payload [kg].
+    /// Residual [m] at joints `q` and payload [kg] (the forward pass of
+    /// [`Mlp::eval_with_jacobian`] alone).
     pub fn eval(&self, q: &[f64], payload_kg: f64) -> Vector3<f64> {
         let s = self.shape();
-        let x = self.normalised_input(q, payload_kg);
-        let mut h = [0.0; 64];
-        let mut hv;
-        let h: &mut [f64] = if s.hidden <= h.len() {
-            &mut h[..s.hidden]
-        } else {
-            hv = vec![0.0; s.hidden];
-            &mut hv
-        };
+        let (mut xs, mut xh) = ([0.0; STACK_WIDTH], Vec::new());
+        let x = scratch(&mut xs, &mut xh, s.inputs);
+        self.features.write_into(q, payload_kg, x);
+        self.input_norm.apply(x);
+        let (mut hs, mut hh) = ([0.0; STACK_WIDTH], Vec::new());
+        let h = scratch(&mut hs, &mut hh, s.hidden);
         let mut y = [0.0; 3];
-        s.forward(&self.weights, &x, h, &mut y);
+        s.forward(&self.weights, x, h, &mut y);
         self.output_norm.invert(&mut y);
         Vector3::new(y[0], y[1], y[2])
     }
 
     /// `∂residual/∂q` [m/rad], 3×dof.
     pub fn jacobian(&self, q: &[f64], payload_kg: f64) -> Matrix3xX<f64> {
+        let mut cols = vec![Vector3::zeros(); self.dof];
+        self.eval_with_jacobian(q, payload_kg, Some(&mut cols));
+        Matrix3xX::from_columns(&cols)
+    }
+
+    /// Residual [m] at joints `q` and payload [kg] and, when `dq` is given
+    /// (`dof` columns), `∂residual/∂q` [m/rad] into it: one forward pass, no
+    /// allocation for layers up to 32 wide (the IK calls it once per
+    /// evaluation). The derivative is the module docs' chain rule.
+    pub fn eval_with_jacobian(
+        &self,
+        q: &[f64],
+        payload_kg: f64,
+        dq: Option<&mut [Vector3<f64>]>,
+    ) -> Vector3<f64> {
         let s = self.shape();
-        let x = self.normalised_input(q, payload_kg);
-        let mut h = vec![0.0; s.hidden];
+        // The raw features (kept for the derivative's sin q and cos q), then normalised.
+        let (mut raw_s, mut raw_h) = ([0.0; STACK_WIDTH], Vec::new());
+        let raw = scratch(&mut raw_s, &mut raw_h, s.inputs);
+        self.features.write_into(q, payload_kg, raw);
+        let (mut xs, mut xh) = ([0.0; STACK_WIDTH], Vec::new());
+        let x = scratch(&mut xs, &mut xh, s.inputs);
+        x.copy_from_slice(raw);
+        self.input_norm.apply(x);
+        let (mut hs, mut hh) = ([0.0; STACK_WIDTH], Vec::new());
+        let h = scratch(&mut hs, &mut hh, s.hidden);
         let mut y = [0.0; 3];
-        s.forward(&self.weights, &x, &mut h, &mut y);
-        let mut dx = vec![0.0; 3 * s.inputs];
-        s.input_jacobian(&self.weights, &h, &mut dx);
-        let n = self.dof;
-        let mut out = Matrix3xX::zeros(n);
-        let sc = &self.input_norm.scale;
-        for o in 0..3 {
-            let so = 1.0 / self.output_norm.scale[o];
-            let row = &dx[o * s.inputs..(o + 1) * s.inputs];
-            for k in 0..n {
-                let mut d = row[k] * sc[k];
-                if self.features.sin_cos {
-                    d += row[n + k] * sc[n + k] * q[k].cos();
-                    d -= row[2 * n + k] * sc[2 * n + k] * q[k].sin();
+        s.forward(&self.weights, x, h, &mut y);
+        self.output_norm.invert(&mut y);
+        if let Some(out) = dq {
+            let (mut ds, mut dh) = ([0.0; 3 * STACK_WIDTH], Vec::new());
+            let dx = scratch(&mut ds, &mut dh, 3 * s.inputs);
+            s.input_jacobian(&self.weights, h, dx);
+            let sc = &self.input_norm.scale;
+            let n = self.dof;
+            for o in 0..3 {
+                let so = 1.0 / self.output_norm.scale[o];
+                let row = &dx[o * s.inputs..(o + 1) * s.inputs];
+                for (k, col) in out.iter_mut().enumerate().take(n) {
+                    let mut d = row[k] * sc[k];
+                    if self.features.sin_cos {
+                        // ∂ sin q/∂q = cos q (raw[2n + k]), ∂ cos q/∂q = −sin q (raw[n + k]).
+                        d += row[n + k] * sc[n + k] * raw[2 * n + k];
+                        d -= row[2 * n + k] * sc[2 * n + k] * raw[n + k];
+                    }
+                    col[o] = d * so;
                 }
-                out[(o, k)] = d * so;
             }
         }
-        out
+        Vector3::new(y[0], y[1], y[2])
     }
 }
 
@@ -333,6 +386,15 @@ impl Compensator for Mlp {
     }
     fn jacobian_q(&self, q: &[f64], _tau: &[f64], payload_kg: f64) -> Option<Matrix3xX<f64>> {
         Some(self.jacobian(q, payload_kg))
+    }
+    fn residual_and_jacobian(
+        &self,
+        q: &[f64],
+        _tau: &[f64],
+        payload_kg: f64,
+        dq: &mut [Vector3<f64>],
+    ) -> (Vector3<f64>, bool) {
+        (self.eval_with_jacobian(q, payload_kg, Some(dq)), true)
     }
     fn name(&self) -> &str {
         "mlp"

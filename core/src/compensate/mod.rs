@@ -66,6 +66,29 @@ pub trait Compensator: Send + Sync {
         let _ = (q, tau, payload_kg);
         None
     }
+    /// [`Compensator::residual_at`] and [`Compensator::jacobian_q`] in one
+    /// call, the derivative's columns into `dq` (N values): returns the
+    /// residual and whether `dq` was written. The IK calls it once per
+    /// evaluation; implementations that share work between the two (one
+    /// forward pass of a network) override it.
+    fn residual_and_jacobian(
+        &self,
+        q: &[f64],
+        tau: &[f64],
+        payload_kg: f64,
+        dq: &mut [Vector3<f64>],
+    ) -> (Vector3<f64>, bool) {
+        let r = self.residual_at(q, tau, payload_kg);
+        match self.jacobian_q(q, tau, payload_kg) {
+            Some(d) => {
+                for (k, c) in dq.iter_mut().enumerate().take(d.ncols()) {
+                    *c = d.column(k).into_owned();
+                }
+                (r, true)
+            }
+            None => (r, false),
+        }
+    }
     /// The storable form for the model file; `None` for compensators that
     /// cannot be stored (the file then carries no compensator).
     fn stored(&self) -> Option<StoredCompensator> {

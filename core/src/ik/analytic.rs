@@ -44,7 +44,7 @@
 //! so the branch conventions are written once.
 
 use super::config::{Configuration, Elbow, Shoulder, Wrist};
-use crate::kinematics::chain::tool_pose;
+use crate::kinematics::chain::{rot_x_sc, tool_pose};
 use crate::kinematics::loop_closure::solve_loop;
 use crate::model::{Pose, RobotModel};
 use nalgebra::{Matrix3, Vector2, Vector3};
@@ -114,7 +114,8 @@ pub struct AnalyticIk {
     structure: Structure,
     base_inv: Pose,
     tool_inv: Pose,
-    alpha: [f64; 6],
+    /// `(sin α_k, cos α_k)` of the twists, computed once.
+    alpha_sc: [(f64, f64); 6],
     a: [f64; 6],
     d: [f64; 6],
     offset: [f64; 6],
@@ -208,7 +209,7 @@ impl AnalyticIk {
             structure,
             base_inv: base.inverse(),
             tool_inv: tool_pose(model).inverse(),
-            alpha: std::array::from_fn(|k| l[k].alpha),
+            alpha_sc: std::array::from_fn(|k| l[k].alpha.sin_cos()),
             a: std::array::from_fn(|k| l[k].a),
             d: std::array::from_fn(|k| l[k].d),
             offset: std::array::from_fn(|k| l[k].theta),
@@ -313,22 +314,22 @@ impl AnalyticIk {
         }
         let t = self.chain_angles(q)?;
         let mut f = Pose::identity();
-        f.rot_x(self.alpha[1]);
+        rot_x_sc(&mut f, self.alpha_sc[1]);
         f.tr_x(self.a[1]);
         f.tr_z(self.d[1]);
         f.rot_z(t[1]);
-        f.rot_x(self.alpha[2]);
+        rot_x_sc(&mut f, self.alpha_sc[2]);
         f.tr_x(self.a[2]);
         f.tr_z(self.d[2]);
         f.rot_z(t[2]);
         let wp = match self.structure {
             Structure::SphericalWrist => f.transform_point(&self.wp2),
             Structure::ThreeParallel => {
-                f.rot_x(self.alpha[3]);
+                rot_x_sc(&mut f, self.alpha_sc[3]);
                 f.tr_x(self.a[3]);
                 f.tr_z(self.d[3]);
                 f.rot_z(t[3]);
-                f.rot_x(self.alpha[4]);
+                rot_x_sc(&mut f, self.alpha_sc[4]);
                 f.tr_x(self.a[4]);
                 f.tr_z(self.d[4]);
                 f.p
@@ -393,7 +394,7 @@ impl AnalyticIk {
 
     /// Elbow flags of the `+acos` and `−acos` planar solutions.
     fn elbow_flags(&self) -> (Elbow, Elbow) {
-        if -self.alpha[1].sin() * self.a[2] > 0.0 {
+        if -self.alpha_sc[1].0 * self.a[2] > 0.0 {
             (Elbow::Up, Elbow::Down)
         } else {
             (Elbow::Down, Elbow::Up)
@@ -405,7 +406,7 @@ impl AnalyticIk {
     /// lies inside the cylinder of radius `|c_n − cos α1·w_z| / |sin α1|` about
     /// axis 1 that the offset along the arm-plane normal forbids; negative outside it).
     fn shoulder_angles(&self, w: &Vector3<f64>, ctx: &Ctx) -> Option<ShoulderSolutions> {
-        let (sa, ca) = self.alpha[1].sin_cos();
+        let (sa, ca) = self.alpha_sc[1];
         let rho = w.x.hypot(w.y);
         let rhs = self.c_n - ca * w.z;
         let excess = rhs.abs() / sa.abs() - rho;
@@ -437,7 +438,7 @@ impl AnalyticIk {
     fn frame1(&self, t0: f64) -> Pose {
         let mut f = Pose::identity();
         f.rot_z(t0);
-        f.rot_x(self.alpha[1]);
+        rot_x_sc(&mut f, self.alpha_sc[1]);
         f.tr_x(self.a[1]);
         f.tr_z(self.d[1]);
         f
@@ -469,39 +470,49 @@ impl AnalyticIk {
         let (plus, minus) = self.elbow_flags();
         let base = py.atan2(px);
         let one = |phi2: f64, e: Elbow| {
+            if ctx.only.is_some_and(|c| c.elbow != e) {
+                // Not asked for (the callers skip it).
+                return (f64::NAN, f64::NAN, e);
+            }
             let t1 = base - (l2 * phi2.sin()).atan2(a2 + l2 * phi2.cos());
             (t1, phi2 - self.psi, e)
         };
         Some(([one(g, plus), one(-g, minus)], clamped, excess))
     }
 
-    /// Wrist angles from `M = Rz(θ3)·Rx(α4)·Rz(θ4)·Rx(α5)·Rz(θ5)`.
+    /// Wrist angles from `M = Rz(θ3)·Rx(α4)·Rz(θ4)·Rx(α5)·Rz(θ5)`; only the
+    /// branch `ctx.only` asks for is computed (`None` in the other's place).
     fn wrist(&self, m: &Matrix3<f64>, ctx: &Ctx) -> Option<WristSolutions> {
-        let (s4, c4) = self.alpha[4].sin_cos();
-        let (s5, c5) = self.alpha[5].sin_cos();
+        let (s4, c4) = self.alpha_sc[4];
+        let (s5, c5) = self.alpha_sc[5];
         let ct = (c4 * c5 - m[(2, 2)]) / (s4 * s5);
         if ct.abs() > 1.0 + ctx.margin.max(1e-9) {
             return None;
         }
         let g = ct.clamp(-1.0, 1.0).acos();
+        // The directions of M's third column and third row (the same for both branches).
+        let (col, row) = (m[(1, 2)].atan2(m[(0, 2)]), m[(2, 1)].atan2(m[(2, 0)]));
         let one = |t4: f64, w: Wrist| {
+            if ctx.only.is_some_and(|c| c.wrist != w) {
+                return None;
+            }
             let (st, ctt) = t4.sin_cos();
             let (x, y) = (s5 * st, -c4 * s5 * ctt - s4 * c5);
-            if x.hypot(y) < SINGULAR {
+            Some(if x.hypot(y) < SINGULAR {
                 let t3 = ctx.hint[3];
                 let mut r = Pose::identity();
                 r.rot_z(t3);
-                r.rot_x(self.alpha[4]);
+                rot_x_sc(&mut r, self.alpha_sc[4]);
                 r.rot_z(t4);
-                r.rot_x(self.alpha[5]);
+                rot_x_sc(&mut r, self.alpha_sc[5]);
                 let n = r.r.transpose() * m;
                 (t3, t4, n[(1, 0)].atan2(n[(0, 0)]), w, true)
             } else {
-                let t3 = m[(1, 2)].atan2(m[(0, 2)]) - y.atan2(x);
+                let t3 = col - y.atan2(x);
                 let (xp, yp) = (s4 * st, s4 * ctt * c5 + c4 * s5);
-                let t5 = yp.atan2(xp) - m[(2, 1)].atan2(m[(2, 0)]);
+                let t5 = yp.atan2(xp) - row;
                 (t3, t4, t5, w, false)
-            }
+            })
         };
         Some([one(g, Wrist::NoFlip), one(-g, Wrist::Flip)])
     }
@@ -526,17 +537,14 @@ impl AnalyticIk {
                 }
                 let mut f3 = f1;
                 f3.rot_z(t1);
-                f3.rot_x(self.alpha[2]);
+                rot_x_sc(&mut f3, self.alpha_sc[2]);
                 f3.rot_z(t2);
-                f3.rot_x(self.alpha[3]);
+                rot_x_sc(&mut f3, self.alpha_sc[3]);
                 let m = f3.r.transpose() * tb.r;
                 let Some(wrists) = self.wrist(&m, ctx) else {
                     continue;
                 };
-                for (t3, t4, t5, wr, sing) in wrists {
-                    if ctx.only.is_some_and(|c| c.wrist != wr) {
-                        continue;
-                    }
+                for (t3, t4, t5, wr, sing) in wrists.into_iter().flatten() {
                     self.finish(
                         [t0, t1, t2, t3, t4, t5],
                         Configuration::new(sh, el, wr),
@@ -552,7 +560,7 @@ impl AnalyticIk {
 
     fn link_pose(&self, k: usize, theta: f64) -> Pose {
         let mut f = Pose::identity();
-        f.rot_x(self.alpha[k]);
+        rot_x_sc(&mut f, self.alpha_sc[k]);
         f.tr_x(self.a[k]);
         f.tr_z(self.d[k]);
         f.rot_z(theta);
@@ -565,9 +573,9 @@ impl AnalyticIk {
         let Some((shoulders, clamp0, sing0, excess0)) = self.shoulder_angles(&o4, ctx) else {
             return;
         };
-        let (sa1, ca1) = self.alpha[1].sin_cos();
-        let (s4, c4) = self.alpha[4].sin_cos();
-        let (s5, c5) = self.alpha[5].sin_cos();
+        let (sa1, ca1) = self.alpha_sc[1];
+        let (s4, c4) = self.alpha_sc[4];
+        let (s5, c5) = self.alpha_sc[5];
         for (t0, sh) in shoulders {
             if ctx.only.is_some_and(|c| c.shoulder != sh) {
                 continue;
@@ -692,8 +700,8 @@ impl Reach {
         }
     }
 }
-/// `(θ3, θ4, θ5, wrist, singular)` pairs.
-type WristSolutions = [(f64, f64, f64, Wrist, bool); 2];
+/// `(θ3, θ4, θ5, wrist, singular)` pairs (`None`: not asked for).
+type WristSolutions = [Option<(f64, f64, f64, Wrist, bool)>; 2];
 
 /// Largest deviation [rad] of a twist snapped to 0 by [`closed_form_proxy`].
 pub const PROXY_MAX_TWIST: f64 = 0.05;

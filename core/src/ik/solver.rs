@@ -71,14 +71,17 @@ use crate::compensate::CompensatedModel;
 use crate::model::orientation::OrientationConvention;
 use crate::model::pose::rotation_log;
 use crate::model::{Pose, RobotModel};
-use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+use nalgebra::{DMatrix, Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::str::FromStr;
 
+mod eval;
 mod newton;
 mod reach;
 mod seeds;
+
+use eval::PreparedModel;
 
 use reach::{
     wrist_deviation, CORRECTED_REACH_TOLERANCE_M, REACH_MARGIN_FACTOR, REACH_MARGIN_FLOOR_M,
@@ -365,8 +368,9 @@ pub struct IkSolver {
     /// Largest nominal-workspace excess [m] of the wrist point that a target
     /// of the calibrated model may have (see [`IkSolver::reach_margin_m`]).
     reach_margin_m: f64,
-    /// The model the closed form solves (the nominal model or its proxy).
-    seed_model: RobotModel,
+    /// `model` and the model the closed form solves (the nominal model or its
+    /// proxy), prepared for the iteration (constants once).
+    prepared: PreparedModel,
 }
 
 impl IkSolver {
@@ -409,7 +413,7 @@ impl IkSolver {
             f64::INFINITY
         };
         IkSolver {
-            seed_model,
+            prepared: PreparedModel::new(&model, &seed_model),
             reach,
             reach_margin_m,
             base_from_cell: model.cell_from_base.inverse(),

@@ -48,7 +48,7 @@ pub struct Chain {
     pub loop_partials: Option<LoopPartials>,
 }
 
-fn check_q(model: &RobotModel, q: &[f64]) -> Result<(), KinematicsError> {
+pub(crate) fn check_q(model: &RobotModel, q: &[f64]) -> Result<(), KinematicsError> {
     if q.len() != model.dof() {
         return Err(KinematicsError::DimensionMismatch {
             expected: model.dof(),
@@ -62,7 +62,7 @@ fn check_q(model: &RobotModel, q: &[f64]) -> Result<(), KinematicsError> {
 }
 
 /// Chain joint angles for active joints `q`, with loop partials.
-fn chain_angles(
+pub(crate) fn chain_angles(
     model: &RobotModel,
     q: &[f64],
     out: &mut [f64],
@@ -87,29 +87,106 @@ fn chain_angles(
     Ok(None)
 }
 
-/// Applies one link's transform to `pose` (frame k−1 → frame k).
+/// Sines and cosines of a link's constant twists α and β (computed once per
+/// model by [`super::prepared::PreparedChain`], per call by [`chain`] and [`fk`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct LinkTrig {
+    /// `(sin α, cos α)`.
+    pub alpha: (f64, f64),
+    /// `(sin β, cos β)`.
+    pub beta: (f64, f64),
+}
+
+impl LinkTrig {
+    /// The twists of link `k` (β only where it is used: the base link and
+    /// parallel links).
+    pub(crate) fn of(k: usize, l: &Link) -> Self {
+        LinkTrig {
+            alpha: l.alpha.sin_cos(),
+            beta: if k == 0 || l.parallel {
+                l.beta.sin_cos()
+            } else {
+                (0.0, 1.0)
+            },
+        }
+    }
+}
+
+/// `pose · Rot(x, α)` from `(sin α, cos α)` (as [`Pose::rot_x`]).
+#[inline(always)]
+pub(crate) fn rot_x_sc(pose: &mut Pose, (s, c): (f64, f64)) {
+    let c1 = pose.r.column(1).into_owned();
+    let c2 = pose.r.column(2).into_owned();
+    pose.r.set_column(1, &(c1 * c + c2 * s));
+    pose.r.set_column(2, &(c2 * c - c1 * s));
+}
+
+/// `pose · Rot(y, β)` from `(sin β, cos β)` (as [`Pose::rot_y`]).
+#[inline(always)]
+pub(crate) fn rot_y_sc(pose: &mut Pose, (s, c): (f64, f64)) {
+    let c0 = pose.r.column(0).into_owned();
+    let c2 = pose.r.column(2).into_owned();
+    pose.r.set_column(0, &(c0 * c - c2 * s));
+    pose.r.set_column(2, &(c0 * s + c2 * c));
+}
+
+/// `pose · Rot(z, θ)` from `(sin θ, cos θ)` (as [`Pose::rot_z`]).
+#[inline(always)]
+pub(crate) fn rot_z_sc(pose: &mut Pose, (s, c): (f64, f64)) {
+    let c0 = pose.r.column(0).into_owned();
+    let c1 = pose.r.column(1).into_owned();
+    pose.r.set_column(0, &(c0 * c + c1 * s));
+    pose.r.set_column(1, &(c1 * c - c0 * s));
+}
+
+/// Applies the constant part of link `k` to `pose`, everything before
+/// `Rot(z,θ)`: `Tr(x,a0)·Tr(y,b0)·Tr(z,d1)·Rot(x,α0)·Rot(y,β0)` for the base
+/// link, `Rot(x,α)·Tr(x,a)·[Rot(y,β)]·Tr(z,d)` for the others. Returns the
+/// frames `after_a` and `after_beta` of [`LinkFrames`].
 #[inline]
-fn link_step(k: usize, l: &Link, angle: f64, pose: &mut Pose) -> LinkFrames {
-    let start = *pose;
-    let (after_a, after_beta) = if k == 0 {
+pub(crate) fn link_constant_step(
+    k: usize,
+    l: &Link,
+    t: &LinkTrig,
+    pose: &mut Pose,
+) -> (Pose, Pose) {
+    if k == 0 {
         pose.tr_x(l.a);
         pose.tr_y(l.b);
         pose.tr_z(l.d);
-        pose.rot_x(l.alpha);
+        rot_x_sc(pose, t.alpha);
         let after_a = *pose;
-        pose.rot_y(l.beta);
+        rot_y_sc(pose, t.beta);
         (after_a, *pose)
     } else {
-        pose.rot_x(l.alpha);
+        rot_x_sc(pose, t.alpha);
         pose.tr_x(l.a);
         let after_a = *pose;
         if l.parallel {
-            pose.rot_y(l.beta);
+            rot_y_sc(pose, t.beta);
         }
         let after_beta = *pose;
         pose.tr_z(l.d);
         (after_a, after_beta)
-    };
+    }
+}
+
+/// [`link_constant_step`] for a link `k > 0`, without the intermediate frames.
+#[inline(always)]
+pub(crate) fn link_constant_apply(l: &Link, t: &LinkTrig, pose: &mut Pose) {
+    rot_x_sc(pose, t.alpha);
+    pose.p += pose.r.column(0) * l.a;
+    if l.parallel {
+        rot_y_sc(pose, t.beta);
+    }
+    pose.p += pose.r.column(2) * l.d;
+}
+
+/// Applies one link's transform to `pose` (frame k−1 → frame k).
+#[inline]
+fn link_step(k: usize, l: &Link, angle: f64, pose: &mut Pose) -> LinkFrames {
+    let start = *pose;
+    let (after_a, after_beta) = link_constant_step(k, l, &LinkTrig::of(k, l), pose);
     pose.rot_z(angle);
     LinkFrames {
         start,

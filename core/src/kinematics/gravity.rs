@@ -14,6 +14,8 @@
 //! `Δθ = c ∘ τ` at the commanded configuration, with the given payload mass.
 
 use super::chain::{chain, Chain, KinematicsError};
+use super::loop_closure::LoopPartials;
+use crate::model::pose::Pose;
 use crate::model::robot::RobotModel;
 use nalgebra::Vector3;
 
@@ -21,28 +23,56 @@ use nalgebra::Vector3;
 /// declared payload `payload_mass` [kg] plus the model's identified
 /// `payload.mass_offset`.
 pub fn gravity_torques_of(model: &RobotModel, chain: &Chain, payload_mass: f64) -> Vec<f64> {
+    let mut tau = vec![0.0; model.dof()];
+    gravity_torques_into(
+        model,
+        |k| &chain.links[k].frame,
+        &chain.tcp,
+        chain.loop_partials.as_ref(),
+        payload_mass,
+        &mut tau,
+    );
+    tau
+}
+
+/// [`gravity_torques_of`] from the link frames `frame(k)` (frame k in the base
+/// frame), the TCP pose and the loop partials, into `tau` (N values).
+pub(crate) fn gravity_torques_into<'a>(
+    model: &RobotModel,
+    frame: impl Fn(usize) -> &'a Pose,
+    tcp: &Pose,
+    loop_partials: Option<&LoopPartials>,
+    payload_mass: f64,
+    tau: &mut [f64],
+) {
     let n = model.dof();
     let g = model.gravity;
-    let mut tau_chain = vec![0.0; n];
     let payload_mass = payload_mass + model.payload.mass_offset;
     let mut m_sum = payload_mass;
-    let mut s_sum: Vector3<f64> = chain.tcp.transform_point(&model.payload.com) * payload_mass;
+    let mut s_sum: Vector3<f64> = tcp.transform_point(&model.payload.com) * payload_mass;
     for k in (0..n).rev() {
-        let f = &chain.links[k].frame;
+        let f = frame(k);
         let l = &model.links[k];
         m_sum += l.mass;
         s_sum += f.transform_point(&l.com) * l.mass;
         let moment = (s_sum - f.p * m_sum).cross(&g);
-        tau_chain[k] = f.z_axis().dot(&moment);
+        tau[k] = f.z_axis().dot(&moment);
     }
-    map_loop_torques(model, chain, &mut tau_chain);
-    tau_chain
+    map_loop_partials(model, loop_partials, tau);
 }
 
 /// Maps the open-chain torque on a closed loop's passive joint to the driver
 /// and the crank motor by virtual work (`τ_a = (∂θ3p/∂θ_a)·τ_3p`).
 fn map_loop_torques(model: &RobotModel, chain: &Chain, tau_chain: &mut [f64]) {
-    if let (Some(cl), Some(lp)) = (&model.closed_loop, &chain.loop_partials) {
+    map_loop_partials(model, chain.loop_partials.as_ref(), tau_chain);
+}
+
+fn map_loop_partials(
+    model: &RobotModel,
+    loop_partials: Option<&LoopPartials>,
+    tau_chain: &mut [f64],
+) {
+    if let (Some(cl), Some(lp)) = (&model.closed_loop, loop_partials) {
         let k = cl.passive;
         let t = tau_chain[k];
         tau_chain[k - 1] += lp.d_driver * t;

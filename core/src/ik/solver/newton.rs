@@ -2,13 +2,22 @@
 //! step, the error vector and the weighted Jacobian of the parent module's
 //! header, with Nielsen's damping rule and projection onto the joint limits.
 //! Frames: base frame; units: m, rad.
+//!
+//! One generic iteration (`refine_in`): six-joint models run it on
+//! fixed-size (stack) matrices, others on dynamic ones (compared in the tests).
+//! The step's system `J_w J_wᵀ + λ² I` is always 6×6: a position-only goal has
+//! zero orientation rows in `J_w` and `e` and a unit diagonal there, which
+//! decouples them (their solution is 0), so the step is the 3-row
+//! minimum-norm step of the parent module's header. The prediction and its
+//! Jacobian come from the prepared model (`solver/eval.rs`).
 
 use super::*;
+use nalgebra::{
+    allocator::Allocator, DefaultAllocator, Dim, Dyn, Matrix6, OMatrix, OVector, Vector6, U1, U6,
+};
 
-pub(super) struct Eval {
-    pub(super) pose: Pose,
-    pub(super) jac: DMatrix<f64>,
-}
+/// Quasi-Newton Jacobian of `N` joints (rows `[v; ω]`).
+type Jac<D> = OMatrix<f64, U6, D>;
 
 impl IkSolver {
     /// Projects a trial joint value onto the limits, first trying the 2π
@@ -25,45 +34,43 @@ impl IkSolver {
         (x.clamp(l[0], l[1]), x < l[0] || x > l[1])
     }
 
-    pub(super) fn evaluate(&self, q: &[f64]) -> Option<Eval> {
-        let (pose, jac) = self.model.predict_base_with_jacobian(q).ok()?;
-        Some(Eval { pose, jac })
-    }
-
-    /// Weighted error vector and the unweighted residual norms.
+    /// Weighted error vector `[p* − p; L·log(R*·Rᵀ)]` (orientation rows 0 for
+    /// position-only goals) and the unweighted residual norms.
     pub(super) fn error(
         &self,
         goal: &Goal,
         pose: &Pose,
         position_only: bool,
-    ) -> (DVector<f64>, f64, f64) {
+    ) -> (Vector6<f64>, f64, f64) {
         let ep = goal.position - pose.p;
         let er = goal
             .rotation
             .map(|r| rotation_log(&(r * pose.r.transpose())))
             .unwrap_or_else(Vector3::zeros);
+        let l = self.settings.orientation_length_m;
         let e = if position_only {
-            DVector::from_column_slice(ep.as_slice())
+            Vector6::new(ep.x, ep.y, ep.z, 0.0, 0.0, 0.0)
         } else {
-            let l = self.settings.orientation_length_m;
-            DVector::from_iterator(6, ep.iter().copied().chain(er.iter().map(|v| v * l)))
+            Vector6::new(ep.x, ep.y, ep.z, er.x * l, er.y * l, er.z * l)
         };
         (e, ep.norm(), er.norm())
     }
 
-    pub(super) fn weighted_jacobian(
-        &self,
-        jac: &DMatrix<f64>,
-        position_only: bool,
-    ) -> DMatrix<f64> {
-        if position_only {
-            jac.rows(0, 3).into_owned()
+    /// The weighted Jacobian: orientation rows times `L`, or 0 for
+    /// position-only goals (which then decouple from the position rows in the
+    /// step's 6×6 system).
+    fn weighted_jacobian<D: Dim>(&self, jac: &Jac<D>, position_only: bool) -> Jac<D>
+    where
+        DefaultAllocator: Allocator<U6, D>,
+    {
+        let mut j = jac.clone();
+        let l = if position_only {
+            0.0
         } else {
-            let mut j = jac.clone();
-            let l = self.settings.orientation_length_m;
-            j.rows_mut(3, 3).scale_mut(l);
-            j
-        }
+            self.settings.orientation_length_m
+        };
+        j.fixed_rows_mut::<3>(3).scale_mut(l);
+        j
     }
 
     pub(super) fn done(&self, pos: f64, rot: f64, position_only: bool) -> bool {
@@ -85,8 +92,29 @@ impl IkSolver {
         position_only: bool,
         max_iterations: usize,
     ) -> Refined {
+        let q = self.clamp_to_limits(q0);
+        // Six joints on the stack (fixed-size matrices), others on the heap:
+        // the same iteration.
+        if q.len() == 6 {
+            self.refine_in(U6, goal, q, position_only, max_iterations)
+        } else {
+            self.refine_in(Dyn(q.len()), goal, q, position_only, max_iterations)
+        }
+    }
+
+    /// The damped Newton iteration for `d` joints.
+    pub(super) fn refine_in<D: Dim>(
+        &self,
+        d: D,
+        goal: &Goal,
+        q_start: Vec<f64>,
+        position_only: bool,
+        max_iterations: usize,
+    ) -> Refined
+    where
+        DefaultAllocator: Allocator<U6, D> + Allocator<D> + Allocator<D, U6>,
+    {
         let s = &self.settings;
-        let mut q = self.clamp_to_limits(q0);
         let fail = |q: Vec<f64>, iterations| Refined {
             q,
             converged: false,
@@ -97,22 +125,27 @@ impl IkSolver {
             sigma_min: f64::NAN,
             failed_evaluation: true,
         };
-        let Some(mut ev) = self.evaluate(&q) else {
-            return fail(q, 1);
+        let mut jac = Jac::<D>::zeros_generic(U6, d);
+        let Some(pose) = self.prepared.predict_with_jacobian(&q_start, &mut jac) else {
+            return fail(q_start, 1);
         };
-        let (mut e, mut pos, mut rot) = self.error(goal, &ev.pose, position_only);
+        let mut q = OVector::<f64, D>::from_column_slice_generic(d, U1, &q_start);
+        let mut jac_t = jac.clone();
+        let (mut e, mut pos, mut rot) = self.error(goal, &pose, position_only);
         let mut cost = e.norm_squared();
         // Damping μ = λ² [m²], updated from the gain ratio (Nielsen).
         let mut mu = s.initial_damping * s.initial_damping;
         let mut nu = 2.0;
         let mut iterations = 1;
         let mut at_limit = false;
-        let m = e.len();
+        // Rows of the system: the orientation rows of position-only goals are
+        // zero and get a unit diagonal (their step component is 0).
+        let m = if position_only { 3 } else { 6 };
         while !self.done(pos, rot, position_only) && iterations < max_iterations {
-            let jw = self.weighted_jacobian(&ev.jac, position_only);
-            let mut a = &jw * jw.transpose();
-            for i in 0..m {
-                a[(i, i)] += mu;
+            let jw = self.weighted_jacobian(&jac, position_only);
+            let mut a: Matrix6<f64> = &jw * jw.transpose();
+            for i in 0..6 {
+                a[(i, i)] += if i < m { mu } else { 1.0 };
             }
             let Some(chol) = a.cholesky() else {
                 mu = (mu * nu).max(1e-18);
@@ -120,7 +153,7 @@ impl IkSolver {
                 iterations += 1;
                 continue;
             };
-            let mut dq = jw.transpose() * chol.solve(&e);
+            let mut dq: OVector<f64, D> = jw.transpose() * chol.solve(&e);
             let step = dq.amax();
             if step > s.max_step_rad {
                 dq *= s.max_step_rad / step;
@@ -129,27 +162,26 @@ impl IkSolver {
                 break;
             }
             let mut clamped = false;
-            let trial: Vec<f64> = q
-                .iter()
-                .zip(dq.iter())
-                .zip(&self.limits)
-                .map(|((v, d), l)| {
-                    let (x, c) = Self::project(v + d, *l);
-                    clamped |= c;
-                    x
-                })
-                .collect();
+            let mut trial = q.clone();
+            for ((t, d), l) in trial.iter_mut().zip(dq.iter()).zip(&self.limits) {
+                let (x, c) = Self::project(*t + d, *l);
+                clamped |= c;
+                *t = x;
+            }
             iterations += 1;
             at_limit = clamped;
-            let Some(ev_t) = self.evaluate(&trial) else {
+            let Some(pose_t) = self
+                .prepared
+                .predict_with_jacobian(trial.as_slice(), &mut jac_t)
+            else {
                 mu = (mu * nu).max(1e-18);
                 nu *= 2.0;
                 continue;
             };
-            let (e_t, pos_t, rot_t) = self.error(goal, &ev_t.pose, position_only);
+            let (e_t, pos_t, rot_t) = self.error(goal, &pose_t, position_only);
             let cost_t = e_t.norm_squared();
             if cost_t < cost {
-                let jd = &jw * &dq;
+                let jd: Vector6<f64> = &jw * &dq;
                 let predicted = 2.0 * jd.dot(&e) - jd.norm_squared();
                 let rho = if predicted > 0.0 {
                     (cost - cost_t) / predicted
@@ -160,7 +192,7 @@ impl IkSolver {
                 mu = mu.max(1e-30);
                 nu = 2.0;
                 q = trial;
-                ev = ev_t;
+                std::mem::swap(&mut jac, &mut jac_t);
                 e = e_t;
                 cost = cost_t;
                 pos = pos_t;
@@ -177,11 +209,13 @@ impl IkSolver {
         let sigma_min = if converged {
             f64::NAN
         } else {
-            let jw = self.weighted_jacobian(&ev.jac, position_only);
-            jw.singular_values().min()
+            let jw = self.weighted_jacobian(&jac, position_only);
+            DMatrix::from_fn(m, jw.ncols(), |i, j| jw[(i, j)])
+                .singular_values()
+                .min()
         };
         Refined {
-            q,
+            q: q.as_slice().to_vec(),
             converged,
             position_residual_m: pos,
             orientation_residual_rad: rot,
@@ -189,6 +223,52 @@ impl IkSolver {
             at_limit: at_limit && !converged,
             sigma_min,
             failed_evaluation: false,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::compensate::{synthetic_calibration, SyntheticErrors};
+    use crate::model::preset;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// The fixed-size iteration (six joints) against the dynamic-size one on
+    /// random targets of YS100, UR10 and the HH800 loop, calibrated (Hayati β,
+    /// compliance under the payload), full-pose and position-only goals.
+    #[test]
+    fn fixed_size_iteration_equals_the_dynamic_one() {
+        let mut rng = ChaCha8Rng::seed_from_u64(31);
+        for name in ["ys100", "ur10", "hh800"] {
+            let nominal = preset(name).unwrap();
+            let cm = synthetic_calibration(&nominal, &SyntheticErrors::typical(1e-6), 11);
+            assert!(cm.calibrated.has_compliance());
+            let solver = IkSolver::new(cm.clone(), IkSettings::default());
+            let mut converged = 0;
+            for i in 0..30 {
+                let q: Vec<f64> = nominal
+                    .links
+                    .iter()
+                    .map(|l| rng.gen_range(l.limits[0]..l.limits[1]))
+                    .collect();
+                let Ok(p) = cm.predict_base(&q) else { continue };
+                let goal = Goal::from(&p);
+                let q0: Vec<f64> = q.iter().map(|v| v + rng.gen_range(-0.05..0.05)).collect();
+                let q0 = solver.clamp_to_limits(&q0);
+                let position_only = i % 3 == 0;
+                let a = solver.refine_in(U6, &goal, q0.clone(), position_only, 60);
+                let b = solver.refine_in(Dyn(6), &goal, q0, position_only, 60);
+                assert_eq!(a.converged, b.converged, "{name} {i}");
+                assert_eq!(a.iterations, b.iterations, "{name} {i}");
+                for (x, y) in a.q.iter().zip(&b.q) {
+                    assert!((x - y).abs() <= 1e-12, "{name} {i}: {x} vs {y}");
+                }
+                assert!((a.position_residual_m - b.position_residual_m).abs() <= 1e-12);
+                converged += usize::from(a.converged);
+            }
+            assert!(converged >= 20, "{name}: {converged} of 30 converged");
         }
     }
 }

@@ -106,8 +106,8 @@ impl IkSolver {
     /// The target moved by the calibrated model's deviation from the seed
     /// model at `q`: `T·P(q)⁻¹·FK_nom(q)` (one evaluation of the prediction).
     pub(super) fn moved_target(&self, target: &Pose, q: &[f64]) -> Option<Pose> {
-        let p = self.model.predict_base(q).ok()?;
-        let n = crate::kinematics::fk(&self.seed_model, q).ok()?;
+        let p = self.prepared.predict_base(q)?;
+        let n = self.prepared.seed_fk(q)?;
         Some(target.compose(&p.inverse()).compose(&n))
     }
 }
