@@ -2,12 +2,14 @@
 //! `SyntheticErrors::typical(1e-6)`, residuals a smooth joint-space function of
 //! a few tenths of a millimetre, the model's gravity torques):
 //!
-//! - `train_{50,1000}/{lm_6-20-3,iwo_6-5-3,tlbo_6-5-3,rbf}`: one training run
-//!   with the default settings (the seed's network sizes);
-//! - `predict/mlp_6-20-3_residual`: one residual of a trained 6-20-3 network;
-//! - `predict/mlp_6-20-3_residual_and_dq`: residual plus its 3×6 derivative;
+//! - `train_{50,1000}/{lm_18-20-3,iwo_18-40-3,tlbo_18-40-3,rbf}`: one training
+//!   run of each method's compensator with the default settings (SKCM-NN,
+//!   SKCM-IWONN, SKCM-TLBONN, KM-RBF);
+//! - `predict/mlp_18-20-3_residual`: one residual of the trained SKCM-NN
+//!   network (18-20-3: q, sin q, cos q);
+//! - `predict/mlp_18-20-3_residual_and_dq`: residual plus its 3×6 derivative;
 //! - `ik/solve_{plain,compensated}`: one calibrated IK solve without and with
-//!   the 6-20-3 compensator (cycling through 1000 targets).
+//!   the 18-20-3 compensator (cycling through 1000 targets).
 //!
 //! Trainer comparison over 20 seeds (final validation error and wall time):
 //! `cargo run --release -p robocal-core --example compare_trainers`.
@@ -55,9 +57,9 @@ fn bench(c: &mut Criterion) {
         3,
     );
     let specs = [
-        ("lm_6-20-3", CompensatorSpec::skcm_nn()),
-        ("iwo_6-5-3", CompensatorSpec::skcm_iwonn()),
-        ("tlbo_6-5-3", CompensatorSpec::skcm_tlbonn()),
+        ("lm_18-20-3", CompensatorSpec::skcm_nn()),
+        ("iwo_18-40-3", CompensatorSpec::skcm_iwonn()),
+        ("tlbo_18-40-3", CompensatorSpec::skcm_tlbonn()),
         ("rbf", CompensatorSpec::km_rbf()),
     ];
     for n in [50, 1000] {
@@ -76,14 +78,14 @@ fn bench(c: &mut Criterion) {
     let tau = vec![0.0; 6];
     let mut g = c.benchmark_group("predict");
     let mut i = 0;
-    g.bench_function("mlp_6-20-3_residual", |b| {
+    g.bench_function("mlp_18-20-3_residual", |b| {
         b.iter(|| {
             i = (i + 1) % qs.len();
             black_box(net.residual(black_box(&qs[i]), &tau))
         })
     });
     let mut i = 0;
-    g.bench_function("mlp_6-20-3_residual_and_dq", |b| {
+    g.bench_function("mlp_18-20-3_residual_and_dq", |b| {
         b.iter(|| {
             i = (i + 1) % qs.len();
             let q = black_box(&qs[i]);
