@@ -284,7 +284,12 @@ def ik_bench(robocal, n, seed):
     t = time.perf_counter()
     sols = [ets.ik_LM(T, q0=q0, tol=tol, ilimit=100, slimit=100) for T, q0 in zip(Ts, q0s)]
     rtb_us = (time.perf_counter() - t) / n * 1e6
-    ok = [check(s[0], T) for s, T in zip(sols, Ts) if s[1]]
+    # roboticstoolbox answers an IKSolution (q, success, ...); older numpy
+    # builds of it answered a plain tuple.
+    def unpack(s):
+        return (s.q, bool(s.success)) if hasattr(s, "success") else (s[0], bool(s[1]))
+
+    ok = [check(q, T) for (q, good), T in ((unpack(s), T) for s, T in zip(sols, Ts)) if good]
     rtb = {"solve_rate": len(ok) / n, "time_us_mean": rtb_us,
            "max_position_error_mm": max(o[0] for o in ok), "max_orientation_error_rad": max(o[1] for o in ok)}
     joints = os.path.join(tmp, "joints.csv")
