@@ -39,6 +39,10 @@
 //! IWO and TLBO; the defaults below give both about 25 000 loss evaluations.
 //! Every random draw comes from the injected seeded generator; the result is
 //! bit-for-bit reproducible (parallel evaluation keeps a fixed reduction order).
+//!
+//! Length: the four trainers share the data preparation, the null network and
+//! its guard, and the least-squares output layer; split apart they would each
+//! need those private helpers. About a sixth of the file is unit tests.
 
 use super::mlp::{Features, Mlp, Normalisation, Shape};
 use super::rbf::{train_rbf_with_progress, RbfReport, RbfSettings};

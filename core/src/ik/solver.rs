@@ -63,7 +63,11 @@
 //!
 //! Layout: this file holds the settings, the result types and the per-target
 //! strategy (`solve_base`); the seeds, the reach test and the damped Newton
-//! iteration are in `solver/seeds.rs`, `solver/reach.rs` and `solver/newton.rs`.
+//! iteration are in `solver/seeds.rs`, `solver/reach.rs` and `solver/newton.rs`. The
+//! model evaluation (pose and Jacobian of the compensated model in one pass) is
+//! `solver/eval.rs`. Length: the per-target strategy reads as one sequence
+//! (reach, branches, seeds, refinement, the failure reason) and about 250
+//! lines are its settings and result types with their documentation.
 
 use super::analytic::{closed_form_proxy, AnalyticIk, AnalyticSolution};
 use super::config::Configuration;
