@@ -13,7 +13,6 @@
 //! the session frame, then 6 columns per session ≥ 1 (translation, small
 //! rotation of `E_s`); τ held fixed within an evaluation.
 
-use super::least_squares::{residual_rows, LmSettings};
 use crate::kinematics::{chain, gravity_torques_of, jacobian::fill_identification_rows, Chain};
 use crate::measure::Measurement;
 use crate::model::pose::{rotation_log, Pose};
@@ -65,21 +64,37 @@ pub(crate) struct Eval {
     pub j: Option<DMatrix<f64>>,
 }
 
+/// Number of residual rows of a data set.
+pub fn residual_rows(data: &[Measurement]) -> usize {
+    data.iter()
+        .map(|m| if m.orientation.is_some() { 6 } else { 3 })
+        .sum()
+}
+
 /// Residuals (and optionally the Jacobian of the prediction) at the current model.
 pub(crate) fn evaluate(
     model: &RobotModel,
     frames: &[Pose],
     ids: &[ParamId],
     data: &[Measurement],
-    settings: &LmSettings,
+    orientation_weight: f64,
     with_jacobian: bool,
 ) -> Option<Eval> {
     let rows = residual_rows(data);
     let cols = ids.len() + frames.len().saturating_sub(1) * 6;
     let mut r = DVector::zeros(rows);
     let mut j = with_jacobian.then(|| DMatrix::zeros(rows, cols));
-    evaluate_into(model, frames, ids, data, settings, &mut r, j.as_mut(), None)
-        .then_some(Eval { r, j })
+    evaluate_into(
+        model,
+        frames,
+        ids,
+        data,
+        orientation_weight,
+        &mut r,
+        j.as_mut(),
+        None,
+    )
+    .then_some(Eval { r, j })
 }
 
 /// [`evaluate`] into `r` (rows) and, when given, the rows × columns Jacobian
@@ -94,7 +109,7 @@ pub(crate) fn evaluate_into(
     frames: &[Pose],
     ids: &[ParamId],
     data: &[Measurement],
-    settings: &LmSettings,
+    orientation_weight: f64,
     r: &mut DVector<f64>,
     mut j: Option<&mut DMatrix<f64>>,
     chains: Option<&[Chain]>,
@@ -103,7 +118,7 @@ pub(crate) fn evaluate_into(
         || ids
             .iter()
             .any(|i| i.kind == ParamKind::Compliance || i.is_payload());
-    let w = settings.orientation_weight;
+    let w = orientation_weight;
     if let Some(j) = j.as_mut() {
         // Session-frame columns: zero except the entries written below.
         for c in ids.len()..j.ncols() {

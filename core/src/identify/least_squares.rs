@@ -16,6 +16,7 @@
 //! is evaluated with its Jacobian, so an accepted one is not evaluated again),
 //! into two residual/Jacobian buffers swapped on acceptance.
 
+pub use super::evaluate::residual_rows;
 use super::evaluate::{column_scale, evaluate, evaluate_into, gram, scale_columns};
 use crate::kinematics::Chain;
 use crate::measure::Measurement;
@@ -163,13 +164,6 @@ pub fn lower_bound(id: &ParamId) -> f64 {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Cancelled;
 
-/// Number of residual rows of a data set.
-pub fn residual_rows(data: &[Measurement]) -> usize {
-    data.iter()
-        .map(|m| if m.orientation.is_some() { 6 } else { 3 })
-        .sum()
-}
-
 /// Predicted TCP position and rotation of one measurement in its session frame.
 pub fn predict(model: &RobotModel, m: &Measurement) -> Option<(Vector3<f64>, Matrix3<f64>)> {
     let q = crate::kinematics::deflected_joints(model, &m.q, m.payload_mass).ok()?;
@@ -213,7 +207,7 @@ impl FrozenSolver {
         data: &[Measurement],
         settings: &LmSettings,
     ) -> Option<FrozenSolver> {
-        let ev = evaluate(model, frames, ids, data, settings, true)?;
+        let ev = evaluate(model, frames, ids, data, settings.orientation_weight, true)?;
         let mut js = ev.j?;
         let scale = column_scale(&js);
         scale_columns(&mut js, &scale);
@@ -243,14 +237,29 @@ impl FrozenSolver {
         };
         let mut model = start.clone();
         let mut frames = self.frames.clone();
-        let mut r = evaluate(&model, &frames, &self.ids, data, settings, false)?.r;
+        let mut r = evaluate(
+            &model,
+            &frames,
+            &self.ids,
+            data,
+            settings.orientation_weight,
+            false,
+        )?
+        .r;
         let mut cost = r.norm_squared();
         for _ in 0..max_iterations {
             let g = self.js.tr_mul(&r);
             let delta = self.chol.solve(&g).component_mul(&self.scale);
             let x = layout.values(&model);
             let (m2, f2) = apply_step(&model, &frames, &layout, &x, &delta);
-            let Some(e2) = evaluate(&m2, &f2, &self.ids, data, settings, false) else {
+            let Some(e2) = evaluate(
+                &m2,
+                &f2,
+                &self.ids,
+                data,
+                settings.orientation_weight,
+                false,
+            ) else {
                 break;
             };
             let c2 = e2.r.norm_squared();
@@ -369,7 +378,7 @@ pub(crate) fn fit_with_start_chains(
         &frames,
         ids,
         data,
-        settings,
+        settings.orientation_weight,
         &mut ev.0,
         Some(&mut ev.1),
         start_chains,
@@ -460,7 +469,7 @@ pub(crate) fn fit_with_start_chains(
                 &f2,
                 ids,
                 data,
-                settings,
+                settings.orientation_weight,
                 &mut trial.0,
                 Some(&mut trial.1),
                 None,
