@@ -526,7 +526,25 @@ pub fn rotation_log(r: &Matrix3<f64>) -> Vector3<f64> {
         }
         s * (theta / sn)
     } else {
-        nalgebra::Rotation3::from_matrix_unchecked(*r).scaled_axis()
+        // Near π the skew part vanishes; the axis comes from the symmetric
+        // part, (R + Rᵀ)/2 − cosθ·I = (1 − cosθ)·a·aᵀ, by its largest diagonal
+        // entry, and its sign from the skew part where that has one
+        // (nalgebra's `scaled_axis` answers zero at exactly π).
+        let b = (r + r.transpose()) * 0.5 - Matrix3::identity() * c;
+        let k = (0..3)
+            .max_by(|&i, &j| b[(i, i)].total_cmp(&b[(j, j)]))
+            .unwrap_or(0);
+        let one_minus_c = 1.0 - c;
+        let ak = (b[(k, k)] / one_minus_c).max(0.0).sqrt();
+        if ak == 0.0 {
+            return Vector3::zeros();
+        }
+        let mut a = b.column(k) / (one_minus_c * ak);
+        a /= a.norm();
+        if a.dot(&s) < 0.0 {
+            a = -a;
+        }
+        a * s.norm().atan2(c)
     }
 }
 

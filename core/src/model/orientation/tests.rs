@@ -580,3 +580,31 @@ proptest! {
         prop_assert!((rotation_angle_between(&b, &a) - theta).abs() < 1e-12);
     }
 }
+
+/// Half turns: the skew part of R vanishes, so the axis must come from the
+/// symmetric part. Each half turn's logarithm has length π and rebuilds R
+/// (regression: a half turn about z, diag(−1, −1, 1), gave the zero vector).
+#[test]
+fn rotation_log_of_half_turns() {
+    let axes = [
+        Vector3::x(),
+        Vector3::y(),
+        Vector3::z(),
+        Vector3::new(1.0, 1.0, 0.0),
+        Vector3::new(-1.0, 2.0, 3.0),
+        Vector3::new(0.3, -0.2, -0.9),
+    ];
+    for axis in axes {
+        for angle in [PI, PI - 1e-9, PI - 1e-4, PI - 0.3] {
+            let a = Unit::new_normalize(axis);
+            let r = *Rotation3::from_axis_angle(&a, angle).matrix();
+            let v = rotation_log(&r);
+            assert!((v.norm() - angle).abs() < 1e-9, "{axis:?} {angle}: {v:?}");
+            let back = *Rotation3::new(v).matrix();
+            assert_mat_close(&back, &r, 1e-12);
+            if angle < PI {
+                assert_vec_close(&v, &(a.into_inner() * angle), 1e-9);
+            }
+        }
+    }
+}
