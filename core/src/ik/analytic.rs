@@ -44,7 +44,7 @@
 //! so the branch conventions are written once.
 
 use super::config::{Configuration, Elbow, Shoulder, Wrist};
-use crate::kinematics::chain::{rot_x_sc, tool_pose};
+use crate::kinematics::chain::tool_pose;
 use crate::kinematics::loop_closure::solve_loop;
 use crate::model::{Pose, RobotModel};
 use nalgebra::{Matrix3, Vector2, Vector3};
@@ -314,22 +314,22 @@ impl AnalyticIk {
         }
         let t = self.chain_angles(q)?;
         let mut f = Pose::identity();
-        rot_x_sc(&mut f, self.alpha_sc[1]);
+        f.rot_x_sc(self.alpha_sc[1]);
         f.tr_x(self.a[1]);
         f.tr_z(self.d[1]);
         f.rot_z(t[1]);
-        rot_x_sc(&mut f, self.alpha_sc[2]);
+        f.rot_x_sc(self.alpha_sc[2]);
         f.tr_x(self.a[2]);
         f.tr_z(self.d[2]);
         f.rot_z(t[2]);
         let wp = match self.structure {
             Structure::SphericalWrist => f.transform_point(&self.wp2),
             Structure::ThreeParallel => {
-                rot_x_sc(&mut f, self.alpha_sc[3]);
+                f.rot_x_sc(self.alpha_sc[3]);
                 f.tr_x(self.a[3]);
                 f.tr_z(self.d[3]);
                 f.rot_z(t[3]);
-                rot_x_sc(&mut f, self.alpha_sc[4]);
+                f.rot_x_sc(self.alpha_sc[4]);
                 f.tr_x(self.a[4]);
                 f.tr_z(self.d[4]);
                 f.p
@@ -438,7 +438,7 @@ impl AnalyticIk {
     fn frame1(&self, t0: f64) -> Pose {
         let mut f = Pose::identity();
         f.rot_z(t0);
-        rot_x_sc(&mut f, self.alpha_sc[1]);
+        f.rot_x_sc(self.alpha_sc[1]);
         f.tr_x(self.a[1]);
         f.tr_z(self.d[1]);
         f
@@ -502,9 +502,9 @@ impl AnalyticIk {
                 let t3 = ctx.hint[3];
                 let mut r = Pose::identity();
                 r.rot_z(t3);
-                rot_x_sc(&mut r, self.alpha_sc[4]);
+                r.rot_x_sc(self.alpha_sc[4]);
                 r.rot_z(t4);
-                rot_x_sc(&mut r, self.alpha_sc[5]);
+                r.rot_x_sc(self.alpha_sc[5]);
                 let n = r.r.transpose() * m;
                 (t3, t4, n[(1, 0)].atan2(n[(0, 0)]), w, true)
             } else {
@@ -537,9 +537,9 @@ impl AnalyticIk {
                 }
                 let mut f3 = f1;
                 f3.rot_z(t1);
-                rot_x_sc(&mut f3, self.alpha_sc[2]);
+                f3.rot_x_sc(self.alpha_sc[2]);
                 f3.rot_z(t2);
-                rot_x_sc(&mut f3, self.alpha_sc[3]);
+                f3.rot_x_sc(self.alpha_sc[3]);
                 let m = f3.r.transpose() * tb.r;
                 let Some(wrists) = self.wrist(&m, ctx) else {
                     continue;
@@ -560,7 +560,7 @@ impl AnalyticIk {
 
     fn link_pose(&self, k: usize, theta: f64) -> Pose {
         let mut f = Pose::identity();
-        rot_x_sc(&mut f, self.alpha_sc[k]);
+        f.rot_x_sc(self.alpha_sc[k]);
         f.tr_x(self.a[k]);
         f.tr_z(self.d[k]);
         f.rot_z(theta);

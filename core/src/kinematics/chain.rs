@@ -112,33 +112,6 @@ impl LinkTrig {
     }
 }
 
-/// `pose · Rot(x, α)` from `(sin α, cos α)` (as [`Pose::rot_x`]).
-#[inline(always)]
-pub(crate) fn rot_x_sc(pose: &mut Pose, (s, c): (f64, f64)) {
-    let c1 = pose.r.column(1).into_owned();
-    let c2 = pose.r.column(2).into_owned();
-    pose.r.set_column(1, &(c1 * c + c2 * s));
-    pose.r.set_column(2, &(c2 * c - c1 * s));
-}
-
-/// `pose · Rot(y, β)` from `(sin β, cos β)` (as [`Pose::rot_y`]).
-#[inline(always)]
-pub(crate) fn rot_y_sc(pose: &mut Pose, (s, c): (f64, f64)) {
-    let c0 = pose.r.column(0).into_owned();
-    let c2 = pose.r.column(2).into_owned();
-    pose.r.set_column(0, &(c0 * c - c2 * s));
-    pose.r.set_column(2, &(c0 * s + c2 * c));
-}
-
-/// `pose · Rot(z, θ)` from `(sin θ, cos θ)` (as [`Pose::rot_z`]).
-#[inline(always)]
-pub(crate) fn rot_z_sc(pose: &mut Pose, (s, c): (f64, f64)) {
-    let c0 = pose.r.column(0).into_owned();
-    let c1 = pose.r.column(1).into_owned();
-    pose.r.set_column(0, &(c0 * c + c1 * s));
-    pose.r.set_column(1, &(c1 * c - c0 * s));
-}
-
 /// Applies the constant part of link `k` to `pose`, everything before
 /// `Rot(z,θ)`: `Tr(x,a0)·Tr(y,b0)·Tr(z,d1)·Rot(x,α0)·Rot(y,β0)` for the base
 /// link, `Rot(x,α)·Tr(x,a)·[Rot(y,β)]·Tr(z,d)` for the others. Returns the
@@ -154,16 +127,16 @@ pub(crate) fn link_constant_step(
         pose.tr_x(l.a);
         pose.tr_y(l.b);
         pose.tr_z(l.d);
-        rot_x_sc(pose, t.alpha);
+        pose.rot_x_sc(t.alpha);
         let after_a = *pose;
-        rot_y_sc(pose, t.beta);
+        pose.rot_y_sc(t.beta);
         (after_a, *pose)
     } else {
-        rot_x_sc(pose, t.alpha);
+        pose.rot_x_sc(t.alpha);
         pose.tr_x(l.a);
         let after_a = *pose;
         if l.parallel {
-            rot_y_sc(pose, t.beta);
+            pose.rot_y_sc(t.beta);
         }
         let after_beta = *pose;
         pose.tr_z(l.d);
@@ -174,10 +147,10 @@ pub(crate) fn link_constant_step(
 /// [`link_constant_step`] for a link `k > 0`, without the intermediate frames.
 #[inline(always)]
 pub(crate) fn link_constant_apply(l: &Link, t: &LinkTrig, pose: &mut Pose) {
-    rot_x_sc(pose, t.alpha);
+    pose.rot_x_sc(t.alpha);
     pose.p += pose.r.column(0) * l.a;
     if l.parallel {
-        rot_y_sc(pose, t.beta);
+        pose.rot_y_sc(t.beta);
     }
     pose.p += pose.r.column(2) * l.d;
 }

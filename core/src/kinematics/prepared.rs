@@ -16,8 +16,8 @@
 //! kept, in a caller's buffer: no allocation per call.
 
 use super::chain::{
-    chain_angles, check_q, link_constant_apply, link_constant_step, rot_z_sc, tool_pose,
-    KinematicsError, LinkTrig,
+    chain_angles, check_q, link_constant_apply, link_constant_step, tool_pose, KinematicsError,
+    LinkTrig,
 };
 use super::gravity::gravity_torques_into;
 use super::loop_closure::LoopPartials;
@@ -121,7 +121,7 @@ impl PreparedChain {
             if k > 0 {
                 link_constant_apply(l, t, &mut pose);
             }
-            rot_z_sc(&mut pose, angles[k].sin_cos());
+            pose.rot_z_sc(angles[k].sin_cos());
             visit(k, &pose);
         }
         Ok((pose, loop_partials))

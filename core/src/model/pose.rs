@@ -77,7 +77,13 @@ impl Pose {
 
     /// `self · Rot(x, angle)`.
     pub fn rot_x(&mut self, angle: f64) {
-        let (s, c) = angle.sin_cos();
+        self.rot_x_sc(angle.sin_cos());
+    }
+
+    /// `self · Rot(x, α)` from `(sin α, cos α)`, for callers that keep the
+    /// sines and cosines of constant angles.
+    #[inline(always)]
+    pub fn rot_x_sc(&mut self, (s, c): (f64, f64)) {
         let c1 = self.r.column(1).into_owned();
         let c2 = self.r.column(2).into_owned();
         self.r.set_column(1, &(c1 * c + c2 * s));
@@ -86,7 +92,12 @@ impl Pose {
 
     /// `self · Rot(y, angle)`.
     pub fn rot_y(&mut self, angle: f64) {
-        let (s, c) = angle.sin_cos();
+        self.rot_y_sc(angle.sin_cos());
+    }
+
+    /// `self · Rot(y, β)` from `(sin β, cos β)`.
+    #[inline(always)]
+    pub fn rot_y_sc(&mut self, (s, c): (f64, f64)) {
         let c0 = self.r.column(0).into_owned();
         let c2 = self.r.column(2).into_owned();
         self.r.set_column(0, &(c0 * c - c2 * s));
@@ -95,7 +106,12 @@ impl Pose {
 
     /// `self · Rot(z, angle)`.
     pub fn rot_z(&mut self, angle: f64) {
-        let (s, c) = angle.sin_cos();
+        self.rot_z_sc(angle.sin_cos());
+    }
+
+    /// `self · Rot(z, θ)` from `(sin θ, cos θ)`.
+    #[inline(always)]
+    pub fn rot_z_sc(&mut self, (s, c): (f64, f64)) {
         let c0 = self.r.column(0).into_owned();
         let c1 = self.r.column(1).into_owned();
         self.r.set_column(0, &(c0 * c + c1 * s));
