@@ -46,6 +46,7 @@
 use super::config::{Configuration, Elbow, Shoulder, Wrist};
 use crate::kinematics::chain::tool_pose;
 use crate::kinematics::loop_closure::solve_loop;
+use crate::model::pose::sin_cos;
 use crate::model::{Pose, RobotModel};
 use nalgebra::{Matrix3, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
@@ -81,7 +82,7 @@ pub enum AnalyticError {
 pub struct AnalyticSolution {
     /// Model-convention joint values [rad], wrapped by 2π into the limits when
     /// possible (nearest the hint, or the middle of the range).
-    pub q: Vec<f64>,
+    pub q: [f64; 6],
     pub configuration: Configuration,
     /// All joints within their limits.
     pub within_limits: bool,
@@ -130,12 +131,40 @@ pub struct AnalyticIk {
     loop_geom: Option<LoopGeom>,
 }
 
+/// `x` wrapped into `(−π, π]`. The closed form's angles are sums of a few
+/// `atan2`/`acos` values, so whole turns are subtracted directly; `fmod`
+/// (`rem_euclid`) is kept for the rare large argument (it is the slowest
+/// step of the closed form otherwise).
 fn wrap(x: f64) -> f64 {
-    let y = x.rem_euclid(TAU);
-    if y > PI {
-        y - TAU
+    if !x.is_finite() {
+        return f64::NAN;
+    }
+    let mut y = if x.abs() > 8.0 * TAU {
+        x.rem_euclid(TAU)
     } else {
-        y
+        x
+    };
+    while y > PI {
+        y -= TAU;
+    }
+    while y <= -PI {
+        y += TAU;
+    }
+    y
+}
+
+/// `x.round()` (half away from zero) without the library call that
+/// `f64::round` becomes on baseline x86-64 (no SSE4.1): exact for
+/// `|x| < 2^52`, where a float's integer part fits an `i64`.
+fn round_turns(x: f64) -> f64 {
+    if x.is_nan() || x.abs() >= 4.5e15 {
+        return x.round();
+    }
+    let t = x as i64 as f64;
+    if (x - t).abs() >= 0.5 {
+        t + 1f64.copysign(x)
+    } else {
+        t
     }
 }
 
@@ -496,7 +525,7 @@ impl AnalyticIk {
             if ctx.only.is_some_and(|c| c.wrist != w) {
                 return None;
             }
-            let (st, ctt) = t4.sin_cos();
+            let (st, ctt) = sin_cos(t4);
             let (x, y) = (s5 * st, -c4 * s5 * ctt - s4 * c5);
             Some(if x.hypot(y) < SINGULAR {
                 let t3 = ctx.hint[3];
@@ -580,7 +609,7 @@ impl AnalyticIk {
             if ctx.only.is_some_and(|c| c.shoulder != sh) {
                 continue;
             }
-            let (st0, ct0) = t0.sin_cos();
+            let (st0, ct0) = sin_cos(t0);
             let n = Vector3::new(sa1 * st0, -sa1 * ct0, ca1);
             let ct = (c4 * c5 - n.dot(&z5)) / (s4 * s5);
             if ct.abs() > 1.0 + ctx.margin.max(1e-9) {
@@ -593,7 +622,7 @@ impl AnalyticIk {
                 if ctx.only.is_some_and(|c| c.wrist != wr) {
                     continue;
                 }
-                let (st4, ct4) = t4.sin_cos();
+                let (st4, ct4) = sin_cos(t4);
                 let n4 = Vector3::new(s4 * st4, s4 * ct4, c4);
                 let v = Vector2::new(n4.x, c5 * n4.y + s5 * n4.z);
                 let (t5, sing) = if v.norm() < SINGULAR {
@@ -645,17 +674,13 @@ impl AnalyticIk {
             }
         }
         let mut within_limits = true;
-        let q = (0..6)
-            .map(|k| {
-                let (v, ok) = wrap_into(
-                    wrap(t[k] - self.offset[k]),
-                    self.limits[k],
-                    ctx.reference[k],
-                );
-                within_limits &= ok;
-                v
-            })
-            .collect();
+        // The representative within the limits nearest the reference (which
+        // turn `t − offset` is on does not matter).
+        let q = std::array::from_fn(|k| {
+            let (v, ok) = wrap_into(t[k] - self.offset[k], self.limits[k], ctx.reference[k]);
+            within_limits &= ok;
+            v
+        });
         out.push(AnalyticSolution {
             q,
             configuration,
@@ -755,7 +780,7 @@ struct Ctx<'a> {
 pub(crate) fn wrap_into(x: f64, limits: [f64; 2], reference: f64) -> (f64, bool) {
     let tol = 1e-12;
     let inside = |v: f64| v >= limits[0] - tol && v <= limits[1] + tol;
-    let nearest = x + ((reference - x) / TAU).round() * TAU;
+    let nearest = x + round_turns((reference - x) / TAU) * TAU;
     if inside(nearest) {
         return (nearest, true);
     }
@@ -845,6 +870,49 @@ mod tests {
         let mut m = preset("ys100").unwrap();
         m.links[4].a = 0.01;
         assert!(AnalyticIk::new(&m).is_err());
+    }
+
+    #[test]
+    fn wrap_and_round_turns_match_the_library_functions() {
+        let reference = |x: f64| {
+            let y = x.rem_euclid(TAU);
+            if y > PI {
+                y - TAU
+            } else {
+                y
+            }
+        };
+        let mut xs = vec![
+            0.0,
+            -0.0,
+            PI,
+            -PI,
+            TAU,
+            -TAU,
+            3.0 * PI,
+            -3.0 * PI,
+            0.5,
+            -0.5,
+            1.5,
+            -2.5,
+        ];
+        xs.extend((0..20_000).map(|k| (k as f64 - 10_000.0) * 0.0123));
+        xs.extend([1e3, -1e3 - 0.25, 4.4e15 + 0.5, 1e17, -1e17]);
+        for x in xs {
+            let (a, b) = (wrap(x), reference(x));
+            assert!(a > -PI && a <= PI, "wrap({x}) = {a}");
+            // The same angle up to rounding, and the same representative.
+            assert!(
+                (a - b).abs() <= 1e-12 * x.abs().max(1.0),
+                "wrap({x}) = {a}, fmod gives {b}"
+            );
+            assert_eq!(round_turns(x), x.round(), "round_turns({x})");
+        }
+        assert!(wrap(f64::INFINITY).is_nan() && wrap(f64::NAN).is_nan());
+        assert!(round_turns(f64::NAN).is_nan());
+        assert_eq!(round_turns(0.49999999999999994), 0.0);
+        assert_eq!(round_turns(-0.5), -1.0);
+        assert_eq!(round_turns(2.5), 3.0);
     }
 
     #[test]

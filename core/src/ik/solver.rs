@@ -30,8 +30,12 @@
 //! target moved by the calibrated model's deviation at the seed), which removes
 //! most of the nominal/calibrated difference exactly, including near
 //! singularities where it maps to large joint changes; then damped Newton runs
-//! from the corrected seed, and from the plain one if that fails. A last long
-//! run starts from the best attempt when it ended within 1 cm. Targets without
+//! from the corrected seed, and from the plain one if that fails. A seed whose
+//! corrected target lies outside its branch's nominal workspace (the branch
+//! most likely cannot reach it: a damped Newton run there stalls for tens of
+//! evaluations at the boundary) waits until the other seeds have been tried.
+//! A last long run starts from the best attempt when it ended within 1 cm.
+//! Targets without
 //! a closed-form branch within the reach margin, position-only targets and
 //! models without a closed form use a deterministic multi-start (the joint seed,
 //! the middle of the ranges, then Halton points within the limits).
@@ -41,7 +45,9 @@
 //! (`AnalyticIk::reach_excess`). With `m` the reach margin
 //! (`IkSolver::reach_margin_m`, twice the sampled calibrated-vs-nominal
 //! wrist-point deviation plus 5 mm): `e > m` fails at once (no evaluation);
-//! `e > −m` (near the boundary, either side) runs the corrected test — the
+//! `e > −m` (near the boundary, either side) runs the corrected test (for
+//! `e > 0` before any seed; for `e ≤ 0` only once the seeds whose branches
+//! reach the target have failed, since a converged solution proves reach) — the
 //! target moved by the calibrated model's deviation at each closed-form
 //! branch within the margin, re-solved up to 4 times (one evaluation each)
 //! until one branch reaches it — and a corrected excess above 0.1 mm fails as
@@ -566,17 +572,24 @@ impl IkSolver {
         let mut total_iters = 0;
         // Within the margin of the nominal workspace's boundary (either side):
         // the same test with the target moved by the calibrated model's own
-        // deviation at the boundary.
+        // deviation at the boundary. Beyond the boundary it runs first; inside
+        // it, only once the seeds whose branch reaches the target have failed
+        // (a converged solution needs no reach test).
         let mut corrected_excess = f64::NEG_INFINITY;
-        if reach_test && seeds.reach_excess_m > -self.reach_margin_m {
+        let mut reach_pending = reach_test && seeds.reach_excess_m > -self.reach_margin_m;
+        let mut corrected_reach = |total_iters: &mut usize| -> Option<IkSolution> {
             let (excess, n) = self.corrected_reach_excess(&seeds.target, options.seed.as_deref());
-            total_iters += n;
+            *total_iters += n;
             corrected_excess = excess;
-            if excess > CORRECTED_REACH_TOLERANCE_M {
-                return IkSolution {
-                    iterations: total_iters,
-                    ..fail(FailureReason::Unreachable)
-                };
+            (excess > CORRECTED_REACH_TOLERANCE_M).then(|| IkSolution {
+                iterations: *total_iters,
+                ..fail(FailureReason::Unreachable)
+            })
+        };
+        if reach_pending && seeds.reach_excess_m > 0.0 {
+            reach_pending = false;
+            if let Some(unreachable) = corrected_reach(&mut total_iters) {
+                return unreachable;
             }
         }
         let mut best: Option<Refined> = None;
@@ -595,17 +608,33 @@ impl IkSolver {
                 *best = Some(r);
             }
         };
-        for seed in seeds.list.iter().take(seeds.max_attempts.max(1)) {
+        // Seeds whose corrected target lies beyond their branch's reach wait
+        // until the other seeds have been tried (a damped Newton run that
+        // cannot reach stalls for tens of evaluations at the boundary).
+        let mut deferred: Vec<Vec<Vec<f64>>> = Vec::new();
+        let seeds_now = seeds.list.iter().take(seeds.max_attempts.max(1));
+        for seed in seeds_now {
             // The corrected closed-form seed first, then the plain one.
             let mut starts = Vec::with_capacity(2);
+            let mut beyond_reach = false;
             if let (Some(a), Some(c)) = (&self.analytic, seed.configuration) {
-                let (q, n) = self.corrected_seed(a, &seeds.target, &seed.q, c);
-                total_iters += n;
-                if q.iter().zip(&seed.q).any(|(x, y)| (x - y).abs() > 1e-9) {
-                    starts.push(q);
+                let corrected = self.corrected_seed(a, &seeds.target, seed, c);
+                total_iters += corrected.evaluations;
+                beyond_reach = corrected.beyond_reach;
+                if corrected
+                    .q
+                    .iter()
+                    .zip(&seed.q)
+                    .any(|(x, y)| (x - y).abs() > 1e-9)
+                {
+                    starts.push(corrected.q);
                 }
             }
             starts.push(seed.q.clone());
+            if beyond_reach {
+                deferred.push(starts);
+                continue;
+            }
             for q0 in starts {
                 let r = self.refine(goal, &q0, position_only);
                 total_iters += r.iterations;
@@ -614,6 +643,19 @@ impl IkSolver {
                 }
                 consider(r, &mut best);
             }
+        }
+        if reach_pending {
+            if let Some(unreachable) = corrected_reach(&mut total_iters) {
+                return unreachable;
+            }
+        }
+        for q0 in deferred.into_iter().flatten() {
+            let r = self.refine(goal, &q0, position_only);
+            total_iters += r.iterations;
+            if r.converged && branch_ok(&r.q) {
+                return self.solution(goal, r, total_iters, None);
+            }
+            consider(r, &mut best);
         }
         // Last resort: a long run from the best end point (slow progress along
         // the curved valleys of near-singular configurations; not for targets

@@ -21,7 +21,7 @@ use super::chain::{
 };
 use super::gravity::gravity_torques_into;
 use super::loop_closure::LoopPartials;
-use crate::model::pose::Pose;
+use crate::model::pose::{sin_cos, Pose};
 use crate::model::robot::RobotModel;
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, Vector3, U6};
 
@@ -121,7 +121,7 @@ impl PreparedChain {
             if k > 0 {
                 link_constant_apply(l, t, &mut pose);
             }
-            pose.rot_z_sc(angles[k].sin_cos());
+            pose.rot_z_sc(sin_cos(angles[k]));
             visit(k, &pose);
         }
         Ok((pose, loop_partials))

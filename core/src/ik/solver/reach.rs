@@ -69,10 +69,10 @@ impl IkSolver {
             .iter()
             .filter(|b| b.reach_excess_m <= self.reach_margin_m)
         {
-            let mut q = branch.q.clone();
+            let mut q = branch.q;
             let mut excess = branch.reach_excess_m;
             for _ in 0..CORRECTED_REACH_STEPS {
-                let Some(moved) = self.moved_target(target, &q) else {
+                let Some(moved) = self.moved_target(target, &q, None) else {
                     break;
                 };
                 evaluations += 1;
@@ -105,9 +105,19 @@ impl IkSolver {
 
     /// The target moved by the calibrated model's deviation from the seed
     /// model at `q`: `T·P(q)⁻¹·FK_nom(q)` (one evaluation of the prediction).
-    pub(super) fn moved_target(&self, target: &Pose, q: &[f64]) -> Option<Pose> {
+    /// `seed_pose` is `FK_nom(q)` when the caller knows it (a closed-form
+    /// solution of `T` itself).
+    pub(super) fn moved_target(
+        &self,
+        target: &Pose,
+        q: &[f64],
+        seed_pose: Option<&Pose>,
+    ) -> Option<Pose> {
         let p = self.prepared.predict_base(q)?;
-        let n = self.prepared.seed_fk(q)?;
+        let n = match seed_pose {
+            Some(n) => *n,
+            None => self.prepared.seed_fk(q)?,
+        };
         Some(target.compose(&p.inverse()).compose(&n))
     }
 }

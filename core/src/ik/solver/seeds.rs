@@ -117,8 +117,9 @@ impl IkSolver {
             .iter()
             .filter(|c| c.1 <= slack)
             .map(|c| Seed {
-                q: c.0.q.clone(),
+                q: c.0.q.to_vec(),
                 configuration: Some(c.0.configuration),
+                on_target: !c.0.clamped,
             })
             .collect();
         let in_limit_seeds = list.len();
@@ -126,6 +127,7 @@ impl IkSolver {
         list.extend(cands.iter().filter(|c| c.1 > slack).map(|c| Seed {
             q: self.clamp_to_limits(&c.0.q),
             configuration: None,
+            on_target: false,
         }));
         // Position-only goals and targets without closed-form seeds also start
         // from the joint seed itself.
@@ -137,6 +139,7 @@ impl IkSolver {
                     Seed {
                         q: self.clamp_to_limits(h),
                         configuration: None,
+                        on_target: false,
                     },
                 );
             }
@@ -207,6 +210,7 @@ impl IkSolver {
             .map(|q| Seed {
                 q,
                 configuration: None,
+                on_target: false,
             })
             .collect()
     }
@@ -227,40 +231,68 @@ impl IkSolver {
 
     /// Re-solves the closed form for the target moved by the calibrated
     /// model's deviation at the seed, in the seed's branch (see
-    /// `IkSettings::seed_corrections`). Returns the seed and the evaluations used.
+    /// `IkSettings::seed_corrections`).
     pub(super) fn corrected_seed(
         &self,
         analytic: &AnalyticIk,
         target: &Pose,
-        q0: &[f64],
+        seed: &Seed,
         configuration: Configuration,
-    ) -> (Vec<f64>, usize) {
-        let mut q = q0.to_vec();
-        let mut evaluations = 0;
-        for _ in 0..self.settings.seed_corrections {
-            let Some(moved) = self.moved_target(target, &q) else {
+    ) -> CorrectedSeed {
+        let mut out = CorrectedSeed {
+            q: seed.q.clone(),
+            evaluations: 0,
+            beyond_reach: false,
+        };
+        for k in 0..self.settings.seed_corrections {
+            // An unclamped closed-form branch is where the seed model reaches the target.
+            let seed_pose = (k == 0 && seed.on_target).then_some(target);
+            let Some(moved) = self.moved_target(target, &out.q, seed_pose) else {
                 break;
             };
-            evaluations += 1;
+            out.evaluations += 1;
             let best = analytic.solve_branch(
                 &moved,
                 configuration,
-                Some(&q),
+                Some(&out.q),
                 self.settings.seed_reach_margin,
             );
             match best {
-                Some(s) => q = s.q,
-                None => break,
+                Some(s) => {
+                    out.beyond_reach = s.reach_excess_m > 0.0;
+                    out.q.copy_from_slice(&s.q);
+                }
+                None => {
+                    // Beyond even the seed margin in this branch.
+                    out.beyond_reach = true;
+                    break;
+                }
             }
         }
-        (q, evaluations)
+        out
     }
+}
+
+/// A closed-form seed after `IkSettings::seed_corrections`.
+pub(super) struct CorrectedSeed {
+    pub(super) q: Vec<f64>,
+    /// Evaluations of the prediction used.
+    pub(super) evaluations: usize,
+    /// The moved target lies outside the nominal workspace of the seed's
+    /// branch (its wrist point beyond the arm's reach in that shoulder and
+    /// elbow configuration): the calibrated model most likely cannot reach
+    /// the target in this branch either, so the solver tries it after the
+    /// others.
+    pub(super) beyond_reach: bool,
 }
 
 pub(super) struct Seed {
     pub(super) q: Vec<f64>,
     /// Closed-form branch of the seed (enables the seed corrections).
     pub(super) configuration: Option<Configuration>,
+    /// The seed model's forward kinematics at `q` is the target (an
+    /// unclamped closed-form branch), up to rounding.
+    pub(super) on_target: bool,
 }
 
 pub(super) struct Seeds {
