@@ -189,11 +189,34 @@ impl Shape {
 
     /// Forward pass in normalised units: fills the hidden activations `h`
     /// (`hidden` values) and the outputs `y` (`outputs` values).
+    ///
+    /// Each hidden unit's sum runs over the inputs in order, starting from its
+    /// bias; four units are summed side by side, which only interleaves four
+    /// independent chains of additions (the same values bit for bit as one
+    /// unit at a time, about 4× fewer cycles of addition latency).
     #[inline]
     pub fn forward(&self, w: &[f64], x: &[f64], h: &mut [f64], y: &mut [f64]) {
         let (ob1, ow2, ob2) = self.offsets();
         let ni = self.inputs;
-        for (j, hj) in h.iter_mut().enumerate().take(self.hidden) {
+        let x = &x[..ni];
+        let quads = self.hidden / 4;
+        for (q, rows) in w[..4 * quads * ni].chunks_exact(4 * ni).enumerate() {
+            let j = 4 * q;
+            let (r0, rest) = rows.split_at(ni);
+            let (r1, rest) = rest.split_at(ni);
+            let (r2, r3) = rest.split_at(ni);
+            let mut a = [w[ob1 + j], w[ob1 + j + 1], w[ob1 + j + 2], w[ob1 + j + 3]];
+            for ((((xi, w0), w1), w2), w3) in x.iter().zip(r0).zip(r1).zip(r2).zip(r3) {
+                a[0] += w0 * xi;
+                a[1] += w1 * xi;
+                a[2] += w2 * xi;
+                a[3] += w3 * xi;
+            }
+            for (k, ak) in a.iter().enumerate() {
+                h[j + k] = ak.tanh();
+            }
+        }
+        for (j, hj) in h.iter_mut().enumerate().take(self.hidden).skip(4 * quads) {
             let row = &w[j * ni..(j + 1) * ni];
             let mut a = w[ob1 + j];
             for (wi, xi) in row.iter().zip(x) {
@@ -231,22 +254,6 @@ impl Shape {
                 row[ow2 + o * nh + j] = h[j];
             }
             row[ob2 + o] = 1.0;
-        }
-    }
-
-    /// `∂y_o/∂x_i` (row-major, `outputs × inputs`) after [`Shape::forward`].
-    pub fn input_jacobian(&self, w: &[f64], h: &[f64], jac: &mut [f64]) {
-        let (_, ow2, _) = self.offsets();
-        let (ni, nh) = (self.inputs, self.hidden);
-        jac.fill(0.0);
-        for j in 0..nh {
-            let d = 1.0 - h[j] * h[j];
-            for o in 0..self.outputs {
-                let g = w[ow2 + o * nh + j] * d;
-                for i in 0..ni {
-                    jac[o * ni + i] += g * w[j * ni + i];
-                }
-            }
         }
     }
 }
@@ -354,22 +361,48 @@ impl Mlp {
         s.forward(&self.weights, x, h, &mut y);
         self.output_norm.invert(&mut y);
         if let Some(out) = dq {
-            let (mut ds, mut dh) = ([0.0; 3 * STACK_WIDTH], Vec::new());
-            let dx = scratch(&mut ds, &mut dh, 3 * s.inputs);
-            s.input_jacobian(&self.weights, h, dx);
-            let sc = &self.input_norm.scale;
+            // ∂x_i/∂q_k of the normalised features, three per joint: q_k
+            // itself, sin q_k (∂ = cos q_k, raw[2n + k]) and cos q_k
+            // (∂ = −sin q_k, raw[n + k]).
             let n = self.dof;
-            for o in 0..3 {
-                let so = 1.0 / self.output_norm.scale[o];
-                let row = &dx[o * s.inputs..(o + 1) * s.inputs];
-                for (k, col) in out.iter_mut().enumerate().take(n) {
-                    let mut d = row[k] * sc[k];
+            let sc = &self.input_norm.scale;
+            let mut dfdq = [[0.0; 3]; STACK_WIDTH];
+            let mut dfdq_h = Vec::new();
+            let dfdq: &mut [[f64; 3]] = if n <= STACK_WIDTH {
+                &mut dfdq[..n]
+            } else {
+                dfdq_h.resize(n, [0.0; 3]);
+                &mut dfdq_h
+            };
+            for (k, d) in dfdq.iter_mut().enumerate() {
+                d[0] = sc[k];
+                if self.features.sin_cos {
+                    d[1] = sc[n + k] * raw[2 * n + k];
+                    d[2] = -sc[2 * n + k] * raw[n + k];
+                }
+            }
+            // ∂y/∂q_k = Σ_j W2[·, j]·(1 − h_j²)·Σ_i W1[j, i]·∂x_i/∂q_k.
+            let (ni, nh) = (s.inputs, s.hidden);
+            let (_, ow2, _) = s.offsets();
+            let w = &self.weights;
+            for c in out.iter_mut().take(n) {
+                *c = Vector3::zeros();
+            }
+            for (j, hj) in h.iter().enumerate() {
+                let d = 1.0 - hj * hj;
+                let g = Vector3::new(w[ow2 + j], w[ow2 + nh + j], w[ow2 + 2 * nh + j]) * d;
+                let row = &w[j * ni..(j + 1) * ni];
+                for (k, (c, f)) in out.iter_mut().zip(dfdq.iter()).enumerate() {
+                    let mut a = row[k] * f[0];
                     if self.features.sin_cos {
-                        // ∂ sin q/∂q = cos q (raw[2n + k]), ∂ cos q/∂q = −sin q (raw[n + k]).
-                        d += row[n + k] * sc[n + k] * raw[2 * n + k];
-                        d -= row[2 * n + k] * sc[2 * n + k] * raw[n + k];
+                        a += row[n + k] * f[1] + row[2 * n + k] * f[2];
                     }
-                    col[o] = d * so;
+                    *c += g * a;
+                }
+            }
+            for c in out.iter_mut().take(n) {
+                for (o, v) in c.iter_mut().enumerate() {
+                    *v /= self.output_norm.scale[o];
                 }
             }
         }

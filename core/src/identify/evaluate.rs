@@ -13,7 +13,8 @@
 //! the session frame, then 6 columns per session ≥ 1 (translation, small
 //! rotation of `E_s`); τ held fixed within an evaluation.
 
-use crate::kinematics::{chain, gravity_torques_of, jacobian::fill_identification_rows, Chain};
+use crate::kinematics::chain::{chain_with, ChainConstants};
+use crate::kinematics::{gravity_torques_of, jacobian::fill_identification_rows, Chain};
 use crate::measure::Measurement;
 use crate::model::pose::{rotation_log, Pose};
 use crate::model::{ParamId, ParamKind, RobotModel};
@@ -125,6 +126,7 @@ pub(crate) fn evaluate_into(
             j.column_mut(c).fill(0.0);
         }
     }
+    let constants = ChainConstants::of(model);
     let mut local = DMatrix::zeros(6, ids.len());
     let mut q_eff = Vec::new();
     let mut tau = Vec::new();
@@ -136,7 +138,7 @@ pub(crate) fn evaluate_into(
             chains.map(|c| &c[i])
         };
         let q: &[f64] = if needs_tau {
-            let Ok(c0) = chain(model, &m.q) else {
+            let Ok(c0) = chain_with(model, &constants, &m.q) else {
                 return false;
             };
             tau = gravity_torques_of(model, &c0, m.payload_mass);
@@ -155,7 +157,7 @@ pub(crate) fn evaluate_into(
         let c = match known {
             Some(c) => c,
             None => {
-                let Ok(c) = chain(model, q) else {
+                let Ok(c) = chain_with(model, &constants, q) else {
                     return false;
                 };
                 owned = c;

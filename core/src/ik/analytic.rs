@@ -46,7 +46,7 @@
 use super::config::{Configuration, Elbow, Shoulder, Wrist};
 use crate::kinematics::chain::tool_pose;
 use crate::kinematics::loop_closure::solve_loop;
-use crate::model::pose::sin_cos;
+use crate::kinematics::prepared::sin_cos;
 use crate::model::{Pose, RobotModel};
 use nalgebra::{Matrix3, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
@@ -466,7 +466,7 @@ impl AnalyticIk {
     /// Frame 1′ (before Rz(θ1)) in frame 0′.
     fn frame1(&self, t0: f64) -> Pose {
         let mut f = Pose::identity();
-        f.rot_z(t0);
+        f.rot_z_sc(sin_cos(t0));
         f.rot_x_sc(self.alpha_sc[1]);
         f.tr_x(self.a[1]);
         f.tr_z(self.d[1]);
@@ -565,9 +565,9 @@ impl AnalyticIk {
                     continue;
                 }
                 let mut f3 = f1;
-                f3.rot_z(t1);
+                f3.rot_z_sc(sin_cos(t1));
                 f3.rot_x_sc(self.alpha_sc[2]);
-                f3.rot_z(t2);
+                f3.rot_z_sc(sin_cos(t2));
                 f3.rot_x_sc(self.alpha_sc[3]);
                 let m = f3.r.transpose() * tb.r;
                 let Some(wrists) = self.wrist(&m, ctx) else {
@@ -592,7 +592,7 @@ impl AnalyticIk {
         f.rot_x_sc(self.alpha_sc[k]);
         f.tr_x(self.a[k]);
         f.tr_z(self.d[k]);
-        f.rot_z(theta);
+        f.rot_z_sc(sin_cos(theta));
         f
     }
 

@@ -11,9 +11,10 @@
 //! Error vector (base frame): `e = [p* − p(q); L·log(R*·R(q)ᵀ)]`, with `L` the
 //! orientation length of `IkSettings` (1 m). Step: `Δq = J_wᵀ (J_w J_wᵀ + λ² I)⁻¹ e`
 //! with `J_w` the weighted quasi-Newton Jacobian (geometric Jacobian of the
-//! calibrated chain at the deflected joints; `∂τ/∂q` and the compensator's
-//! derivative are neglected, which leaves a linear convergence factor of about
-//! `‖c·∂τ/∂q‖` ≈ 1e-3–1e-2). The same formula gives the minimum-norm step for
+//! calibrated chain at the deflected joints plus the compensator's `∂NN/∂q`,
+//! taken at the start of each damped Newton run and kept for its trial steps
+//! (a chord: it is about 1e-4 of the chain's); `∂τ/∂q` is neglected, which
+//! leaves a linear convergence factor of about `‖c·∂τ/∂q‖` ≈ 1e-3–1e-2). The same formula gives the minimum-norm step for
 //! position-only targets (3 rows). The damping `μ = λ²` follows the gain ratio
 //! of each step (Nielsen's rule); a step that does not lower `‖e‖²` is
 //! discarded and μ grows, so steps stay damped near singularities (wrist:
@@ -495,9 +496,8 @@ impl IkSolver {
 
     /// Solves one goal given in `options.frame`.
     pub fn solve_goal(&self, goal: &Goal, options: &SolveOptions) -> IkSolution {
-        if let Err(msg) = self.validate(goal, options) {
-            return IkSolution::invalid(msg);
-        }
+        // `solve_base` validates: a rigid change of frame keeps a goal finite
+        // (or not) and a rotation a rotation.
         let g = self.goal_to_base(goal, options.frame);
         self.solve_base(&g, options)
     }

@@ -155,11 +155,36 @@ pub(crate) fn link_constant_apply(l: &Link, t: &LinkTrig, pose: &mut Pose) {
     pose.p += pose.r.column(2) * l.d;
 }
 
+/// The parts of [`chain`] and [`fk`] that depend on the model alone: the
+/// links' twist trigonometry and the tool transform. Callers that evaluate
+/// one model at many joint vectors (the identification's measurement model)
+/// compute them once and call [`chain_with`]; the results are the same bit
+/// for bit.
+#[derive(Debug, Clone)]
+pub(crate) struct ChainConstants {
+    trig: Vec<LinkTrig>,
+    tool: Pose,
+}
+
+impl ChainConstants {
+    pub(crate) fn of(model: &RobotModel) -> Self {
+        ChainConstants {
+            trig: model
+                .links
+                .iter()
+                .enumerate()
+                .map(|(k, l)| LinkTrig::of(k, l))
+                .collect(),
+            tool: tool_pose(model),
+        }
+    }
+}
+
 /// Applies one link's transform to `pose` (frame k−1 → frame k).
 #[inline]
-fn link_step(k: usize, l: &Link, angle: f64, pose: &mut Pose) -> LinkFrames {
+fn link_step(k: usize, l: &Link, t: &LinkTrig, angle: f64, pose: &mut Pose) -> LinkFrames {
     let start = *pose;
-    let (after_a, after_beta) = link_constant_step(k, l, &LinkTrig::of(k, l), pose);
+    let (after_a, after_beta) = link_constant_step(k, l, t, pose);
     pose.rot_z(angle);
     LinkFrames {
         start,
@@ -189,6 +214,16 @@ pub fn tool_pose(model: &RobotModel) -> Pose {
 
 /// Forward kinematics with every intermediate frame.
 pub fn chain(model: &RobotModel, q: &[f64]) -> Result<Chain, KinematicsError> {
+    chain_with(model, &ChainConstants::of(model), q)
+}
+
+/// [`chain`] with the model's constants computed by the caller
+/// (`ChainConstants::of(model)`).
+pub(crate) fn chain_with(
+    model: &RobotModel,
+    constants: &ChainConstants,
+    q: &[f64],
+) -> Result<Chain, KinematicsError> {
     check_q(model, q)?;
     let n = model.dof();
     let mut angles = vec![0.0; n];
@@ -198,10 +233,11 @@ pub fn chain(model: &RobotModel, q: &[f64]) -> Result<Chain, KinematicsError> {
         .links
         .iter()
         .enumerate()
-        .map(|(k, l)| link_step(k, l, angles[k], &mut pose))
+        .zip(&constants.trig)
+        .map(|((k, l), t)| link_step(k, l, t, angles[k], &mut pose))
         .collect();
     let flange = pose;
-    let tcp = flange.compose(&tool_pose(model));
+    let tcp = flange.compose(&constants.tool);
     Ok(Chain {
         links,
         angles,
@@ -226,7 +262,7 @@ pub fn fk(model: &RobotModel, q: &[f64]) -> Result<Pose, KinematicsError> {
     chain_angles(model, q, angles)?;
     let mut pose = Pose::identity();
     for (k, l) in model.links.iter().enumerate() {
-        link_step(k, l, angles[k], &mut pose);
+        link_step(k, l, &LinkTrig::of(k, l), angles[k], &mut pose);
     }
     Ok(pose.compose(&tool_pose(model)))
 }

@@ -10,18 +10,6 @@ pub use super::orientation::rotation_log;
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
-/// `(sin x, cos x)` [x in rad], for every joint angle of the kinematics.
-///
-/// The `libm` crate's `sincos` (musl's algorithm; error below 1 ulp, as the
-/// standard library's) rather than `f64::sin_cos`, for speed: on x86-64 Linux
-/// the standard one calls glibc's `sincos`, which saves and restores the
-/// floating-point rounding mode on every call, and forward kinematics calls it
-/// once per joint and evaluation (`cargo bench --bench ik` measures the IK).
-#[inline]
-pub fn sin_cos(x: f64) -> (f64, f64) {
-    libm::sincos(x)
-}
-
 /// A rigid transform `x_parent = r · x_child + p` (SI units).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Pose {
@@ -89,7 +77,7 @@ impl Pose {
 
     /// `self · Rot(x, angle)`.
     pub fn rot_x(&mut self, angle: f64) {
-        self.rot_x_sc(sin_cos(angle));
+        self.rot_x_sc(angle.sin_cos());
     }
 
     /// `self · Rot(x, α)` from `(sin α, cos α)`, for callers that keep the
@@ -104,7 +92,7 @@ impl Pose {
 
     /// `self · Rot(y, angle)`.
     pub fn rot_y(&mut self, angle: f64) {
-        self.rot_y_sc(sin_cos(angle));
+        self.rot_y_sc(angle.sin_cos());
     }
 
     /// `self · Rot(y, β)` from `(sin β, cos β)`.
@@ -118,7 +106,7 @@ impl Pose {
 
     /// `self · Rot(z, angle)`.
     pub fn rot_z(&mut self, angle: f64) {
-        self.rot_z_sc(sin_cos(angle));
+        self.rot_z_sc(angle.sin_cos());
     }
 
     /// `self · Rot(z, θ)` from `(sin θ, cos θ)`.

@@ -10,7 +10,8 @@
 //! frame [m]; quasi-Newton Jacobian 6×N, rows `[v; ω]`: the geometric Jacobian
 //! of the calibrated chain at the deflected joints plus the compensator's
 //! `∂NN/∂q` on the position rows, `∂τ/∂q` neglected), compared in the tests
-//! below; [`PreparedModel::seed_fk`] is the seed model's forward kinematics.
+//! below; [`PreparedModel::predict_with_chord`] takes `∂NN/∂q` from an earlier
+//! evaluation; [`PreparedModel::seed_fk`] is the seed model's forward kinematics.
 //! Joints in the model convention [rad], torques N·m, payload kg.
 
 use crate::compensate::{CompensatedModel, Compensator};
@@ -19,6 +20,52 @@ use crate::kinematics::LoopPartials;
 use crate::model::{Pose, RobotModel};
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, Vector3, U6};
 use std::sync::Arc;
+
+/// The compensator's `∂NN/∂q` [m/rad] at one point (position rows of the
+/// IK Jacobian), kept on the stack for up to `STACK_DOF` joints.
+pub(crate) struct NnDerivative {
+    stack: [Vector3<f64>; STACK_DOF],
+    heap: Vec<Vector3<f64>>,
+    n: usize,
+    /// The compensator wrote a derivative (false: none, or no compensator).
+    written: bool,
+}
+
+impl NnDerivative {
+    pub(crate) fn new() -> Self {
+        NnDerivative {
+            stack: [Vector3::zeros(); STACK_DOF],
+            heap: Vec::new(),
+            n: 0,
+            written: false,
+        }
+    }
+
+    fn columns(&mut self, n: usize) -> &mut [Vector3<f64>] {
+        self.n = n;
+        stack_or_heap(&mut self.stack, &mut self.heap, n, Vector3::zeros())
+    }
+
+    /// `jac[0..3, k] += ∂NN/∂q_k` when a derivative was written.
+    fn add_to<D: Dim>(&self, jac: &mut OMatrix<f64, U6, D>)
+    where
+        DefaultAllocator: Allocator<U6, D>,
+    {
+        if !self.written {
+            return;
+        }
+        let cols = if self.n <= STACK_DOF {
+            &self.stack[..self.n]
+        } else {
+            &self.heap[..]
+        };
+        for (k, d) in cols.iter().enumerate() {
+            for i in 0..3 {
+                jac[(i, k)] += d[i];
+            }
+        }
+    }
+}
 
 /// A compensated model prepared for repeated evaluation (see the module docs).
 #[derive(Clone)]
@@ -75,18 +122,19 @@ impl PreparedModel {
     }
 
     /// `CompensatedModel::predict_base_with_jacobian`, the Jacobian into `jac`.
+    /// The compensator's `∂NN/∂q` (when it has one) is also written into
+    /// `nn_dq` (N columns) for [`PreparedModel::predict_with_chord`].
     pub(crate) fn predict_with_jacobian<D: Dim>(
         &self,
         q: &[f64],
         jac: &mut OMatrix<f64, U6, D>,
+        nn_dq: &mut NnDerivative,
     ) -> Option<Pose>
     where
         DefaultAllocator: Allocator<U6, D>,
     {
         let chain = &self.calibrated;
-        let n = q.len();
-        let (mut dq_s, mut dq_h) = ([Vector3::new(0.0, 0.0, 0.0); STACK_DOF], Vec::new());
-        let dq = stack_or_heap(&mut dq_s, &mut dq_h, n, Vector3::new(0.0, 0.0, 0.0));
+        let dq = nn_dq.columns(q.len());
         let mut with_dq = false;
         let pose = self.predict(
             q,
@@ -97,13 +145,33 @@ impl PreparedModel {
                 r
             },
         )?;
-        if with_dq {
-            for (k, d) in dq.iter().enumerate() {
-                for i in 0..3 {
-                    jac[(i, k)] += d[i];
-                }
-            }
-        }
+        nn_dq.written = with_dq;
+        nn_dq.add_to(jac);
+        Some(pose)
+    }
+
+    /// [`PreparedModel::predict_with_jacobian`] with the compensator's
+    /// derivative taken from `nn_dq` (computed at an earlier point: a chord)
+    /// instead of at `q`: the residual itself is exact, only its derivative in
+    /// the Jacobian is older. The damped Newton iteration uses it for its
+    /// trial steps, where `∂NN/∂q` (about 1e-4 of the chain's Jacobian) changes
+    /// negligibly and costs about a third of the network's evaluation.
+    pub(crate) fn predict_with_chord<D: Dim>(
+        &self,
+        q: &[f64],
+        jac: &mut OMatrix<f64, U6, D>,
+        nn_dq: &NnDerivative,
+    ) -> Option<Pose>
+    where
+        DefaultAllocator: Allocator<U6, D>,
+    {
+        let chain = &self.calibrated;
+        let pose = self.predict(
+            q,
+            |frames, tcp, lp| chain.jacobian_into(frames, tcp, lp, jac),
+            |c, q, tau, payload| c.residual_at(q, tau, payload),
+        )?;
+        nn_dq.add_to(jac);
         Some(pose)
     }
 
@@ -228,12 +296,20 @@ mod tests {
                 assert!((base.p - expect.p).amax() <= 1e-12, "{name}");
                 assert!((base.r - expect.r).amax() <= 1e-12, "{name}");
                 let mut j = OMatrix::<f64, U6, Dyn>::zeros(6);
-                let pj = p.predict_with_jacobian(&q, &mut j).unwrap();
+                let pj = p
+                    .predict_with_jacobian(&q, &mut j, &mut NnDerivative::new())
+                    .unwrap();
                 assert!((pj.p - pose.p).amax() <= 1e-12, "{name}");
                 assert!((pj.r - pose.r).amax() <= 1e-12, "{name}");
                 assert!((j - &jac).amax() <= 1e-12, "{name}");
                 let mut j6 = nalgebra::Matrix6::zeros();
-                p.predict_with_jacobian(&q, &mut j6).unwrap();
+                let mut nn = NnDerivative::new();
+                p.predict_with_jacobian(&q, &mut j6, &mut nn).unwrap();
+                // The chord with the derivative of the same point is the same Jacobian.
+                let mut jc = nalgebra::Matrix6::zeros();
+                let pc = p.predict_with_chord(&q, &mut jc, &nn).unwrap();
+                assert!((pc.p - pose.p).amax() <= 1e-12, "{name}");
+                assert!((jc - &jac).amax() <= 1e-12, "{name}");
                 assert!((j6 - &jac).amax() <= 1e-12, "{name}");
                 let n = p.seed_fk(&q).unwrap();
                 let e = fk(&m.nominal, &q).unwrap();

@@ -11,6 +11,7 @@
 //! minimum-norm step of the parent module's header. The prediction and its
 //! Jacobian come from the prepared model (`solver/eval.rs`).
 
+use super::eval::NnDerivative;
 use super::*;
 use nalgebra::{
     allocator::Allocator, DefaultAllocator, Dim, Dyn, Matrix6, OMatrix, OVector, Vector6, U1, U6,
@@ -126,7 +127,12 @@ impl IkSolver {
             failed_evaluation: true,
         };
         let mut jac = Jac::<D>::zeros_generic(U6, d);
-        let Some(pose) = self.prepared.predict_with_jacobian(&q_start, &mut jac) else {
+        // The compensator's derivative at the start: a chord for the trial steps.
+        let mut nn_dq = NnDerivative::new();
+        let Some(pose) = self
+            .prepared
+            .predict_with_jacobian(&q_start, &mut jac, &mut nn_dq)
+        else {
             return fail(q_start, 1);
         };
         let mut q = OVector::<f64, D>::from_column_slice_generic(d, U1, &q_start);
@@ -170,9 +176,9 @@ impl IkSolver {
             }
             iterations += 1;
             at_limit = clamped;
-            let Some(pose_t) = self
-                .prepared
-                .predict_with_jacobian(trial.as_slice(), &mut jac_t)
+            let Some(pose_t) =
+                self.prepared
+                    .predict_with_chord(trial.as_slice(), &mut jac_t, &nn_dq)
             else {
                 mu = (mu * nu).max(1e-18);
                 nu *= 2.0;
