@@ -7,7 +7,10 @@
 //!
 //! Run: `cargo run --release -p robocal-core --example compare_trainers [seeds]`
 //! (release: the population trainers of the 18-40-3 network take minutes per
-//! seed in the dev profile).
+//! seed in the dev profile). `COMPARE_TRAINERS=iwo,tlbo` runs only the
+//! trainers whose name contains one of the comma-separated words
+//! (case-insensitive); `COMPARE_PER_SEED=1` also prints, per seed, the
+//! validation mean, its gain against SKCM and the training run's stop reason.
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -26,6 +29,17 @@ fn main() {
         .nth(1)
         .and_then(|s| s.parse().ok())
         .unwrap_or(20);
+    let filter: Vec<String> = std::env::var("COMPARE_TRAINERS")
+        .unwrap_or_default()
+        .split(',')
+        .map(|w| w.trim().to_lowercase())
+        .filter(|w| !w.is_empty())
+        .collect();
+    let selected = |name: &str| {
+        let name = name.to_lowercase();
+        filter.is_empty() || filter.iter().any(|w| name.contains(w.as_str()))
+    };
+    let per_seed = std::env::var("COMPARE_PER_SEED").is_ok_and(|v| v == "1");
     let nominal = preset("ys100").unwrap();
     let truth = unmodelled_truth(&nominal, true, 1);
     let mut rng = ChaCha8Rng::seed_from_u64(101);
@@ -110,12 +124,15 @@ fn main() {
             })),
         ),
     ] {
+        if !selected(name) {
+            continue;
+        }
         let mut errs = Vec::new();
         let mut secs = 0.0;
         for seed in 0..seeds {
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
             let t0 = Instant::now();
-            let (c, _) = train(&spec, &samples, &mut rng, &mut |_, _| true).unwrap();
+            let (c, rep) = train(&spec, &samples, &mut rng, &mut |_, _| true).unwrap();
             secs += t0.elapsed().as_secs_f64();
             let c = c.into_arc();
             let e = vsamples
@@ -124,6 +141,15 @@ fn main() {
                 .sum::<f64>()
                 / vsamples.len() as f64
                 * 1e3;
+            if per_seed {
+                println!(
+                    "  seed {seed}: {e:.4} mm, gain {:.1} %, loss {:.4e}, {} evaluations, {}",
+                    (1.0 - e / base_mean) * 100.0,
+                    rep.loss,
+                    rep.evaluations,
+                    rep.stop
+                );
+            }
             errs.push(e);
         }
         let mean = errs.iter().sum::<f64>() / errs.len() as f64;
