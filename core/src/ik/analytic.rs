@@ -780,7 +780,9 @@ struct Ctx<'a> {
 pub(crate) fn wrap_into(x: f64, limits: [f64; 2], reference: f64) -> (f64, bool) {
     let tol = 1e-12;
     let inside = |v: f64| v >= limits[0] - tol && v <= limits[1] + tol;
-    let nearest = x + round_turns((reference - x) / TAU) * TAU;
+    // Multiplying by 1/2π (not dividing): the turn count only decides
+    // between representatives, and a division costs as much as the rest.
+    let nearest = x + round_turns((reference - x) * (1.0 / TAU)) * TAU;
     if inside(nearest) {
         return (nearest, true);
     }
