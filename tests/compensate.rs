@@ -221,7 +221,7 @@ fn compensated_ik_solves_10000_targets() {
     let comp = s.model("skcm-nn");
     let mut rng = ChaCha8Rng::seed_from_u64(5);
     let qs = random_configurations(&s.nominal, 10_000, &mut rng);
-    let mut rates = Vec::new();
+    let (mut rates, mut evaluations) = (Vec::new(), Vec::new());
     for m in [&plain, &comp] {
         let solver = IkSolver::new(m.clone(), IkSettings::default());
         let goals: Vec<Goal> = qs
@@ -244,10 +244,11 @@ fn compensated_ik_solves_10000_targets() {
             }
         }
         rates.push(ok as f64 / goals.len() as f64);
+        evaluations.push(sols.iter().map(|s| s.iterations).sum::<usize>());
     }
     eprintln!(
-        "IK success: uncompensated {:.4}, compensated {:.4}",
-        rates[0], rates[1]
+        "IK success: uncompensated {:.4}, compensated {:.4}; evaluations {} and {}",
+        rates[0], rates[1], evaluations[0], evaluations[1]
     );
     assert!(
         rates[1] >= 0.999 && rates[1] >= rates[0] - 0.0005,
