@@ -83,15 +83,15 @@ impl Features {
 const STACK_WIDTH: usize = 32;
 
 /// A slice of `n` zeros: `stack` when it is long enough, else `heap`.
-fn scratch<'a, const S: usize>(
-    stack: &'a mut [f64; S],
-    heap: &'a mut Vec<f64>,
+fn scratch<'a, T: Copy + Default, const S: usize>(
+    stack: &'a mut [T; S],
+    heap: &'a mut Vec<T>,
     n: usize,
-) -> &'a mut [f64] {
+) -> &'a mut [T] {
     if n <= S {
         &mut stack[..n]
     } else {
-        heap.resize(n, 0.0);
+        heap.resize(n, T::default());
         heap
     }
 }
@@ -366,14 +366,8 @@ impl Mlp {
             // (∂ = −sin q_k, raw[n + k]).
             let n = self.dof;
             let sc = &self.input_norm.scale;
-            let mut dfdq = [[0.0; 3]; STACK_WIDTH];
-            let mut dfdq_h = Vec::new();
-            let dfdq: &mut [[f64; 3]] = if n <= STACK_WIDTH {
-                &mut dfdq[..n]
-            } else {
-                dfdq_h.resize(n, [0.0; 3]);
-                &mut dfdq_h
-            };
+            let (mut dfdq_s, mut dfdq_h) = ([[0.0; 3]; STACK_WIDTH], Vec::new());
+            let dfdq = scratch(&mut dfdq_s, &mut dfdq_h, n);
             for (k, d) in dfdq.iter_mut().enumerate() {
                 d[0] = sc[k];
                 if self.features.sin_cos {

@@ -131,26 +131,14 @@ pub struct AnalyticIk {
     loop_geom: Option<LoopGeom>,
 }
 
-/// `x` wrapped into `(−π, π]`. The closed form's angles are sums of a few
-/// `atan2`/`acos` values, so whole turns are subtracted directly; `fmod`
-/// (`rem_euclid`) is kept for the rare large argument (it is the slowest
-/// step of the closed form otherwise).
+/// `x` wrapped into `(−π, π]`.
 fn wrap(x: f64) -> f64 {
-    if !x.is_finite() {
-        return f64::NAN;
-    }
-    let mut y = if x.abs() > 8.0 * TAU {
-        x.rem_euclid(TAU)
+    let y = x.rem_euclid(TAU);
+    if y > PI {
+        y - TAU
     } else {
-        x
-    };
-    while y > PI {
-        y -= TAU;
+        y
     }
-    while y <= -PI {
-        y += TAU;
-    }
-    y
 }
 
 /// `x.round()` (half away from zero) without the library call that

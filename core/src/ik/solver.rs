@@ -597,7 +597,20 @@ impl IkSolver {
             (Some(want), Some(got)) => want == got,
             _ => true,
         };
-        let consider = |r: Refined, best: &mut Option<Refined>| {
+        // One damped Newton run of `budget` evaluations from `q0`: the
+        // solution when it converges in an acceptable branch, otherwise kept
+        // in `best` when it is the best attempt so far.
+        let max_iterations = self.settings.max_iterations;
+        let attempt = |q0: &[f64],
+                       budget: usize,
+                       total_iters: &mut usize,
+                       best: &mut Option<Refined>|
+         -> Option<IkSolution> {
+            let r = self.refine_with(goal, q0, position_only, budget);
+            *total_iters += r.iterations;
+            if r.converged && branch_ok(&r.q) {
+                return Some(self.solution(goal, r, *total_iters, None));
+            }
             let better = best.as_ref().is_none_or(|b| {
                 (r.converged && !b.converged)
                     || (r.converged == b.converged
@@ -607,6 +620,7 @@ impl IkSolver {
             if better {
                 *best = Some(r);
             }
+            None
         };
         // Seeds whose corrected target lies beyond their branch's reach wait
         // until the other seeds have been tried (a damped Newton run that
@@ -636,12 +650,9 @@ impl IkSolver {
                 continue;
             }
             for q0 in starts {
-                let r = self.refine(goal, &q0, position_only);
-                total_iters += r.iterations;
-                if r.converged && branch_ok(&r.q) {
-                    return self.solution(goal, r, total_iters, None);
+                if let Some(s) = attempt(&q0, max_iterations, &mut total_iters, &mut best) {
+                    return s;
                 }
-                consider(r, &mut best);
             }
         }
         if reach_pending {
@@ -650,30 +661,24 @@ impl IkSolver {
             }
         }
         for q0 in deferred.into_iter().flatten() {
-            let r = self.refine(goal, &q0, position_only);
-            total_iters += r.iterations;
-            if r.converged && branch_ok(&r.q) {
-                return self.solution(goal, r, total_iters, None);
+            if let Some(s) = attempt(&q0, max_iterations, &mut total_iters, &mut best) {
+                return s;
             }
-            consider(r, &mut best);
         }
         // Last resort: a long run from the best end point (slow progress along
         // the curved valleys of near-singular configurations; not for targets
         // that are centimetres away).
-        if let Some(b) = best.as_ref().filter(|b| {
-            !b.converged && !b.failed_evaluation && b.position_residual_m < LAST_RESORT_MAX_M
-        }) {
-            let r = self.refine_with(
-                goal,
-                &b.q.clone(),
-                position_only,
-                self.settings.max_iterations * self.settings.final_iterations_factor,
-            );
-            total_iters += r.iterations;
-            if r.converged && branch_ok(&r.q) {
-                return self.solution(goal, r, total_iters, None);
+        if let Some(q0) = best
+            .as_ref()
+            .filter(|b| {
+                !b.converged && !b.failed_evaluation && b.position_residual_m < LAST_RESORT_MAX_M
+            })
+            .map(|b| b.q.clone())
+        {
+            let budget = max_iterations * self.settings.final_iterations_factor;
+            if let Some(s) = attempt(&q0, budget, &mut total_iters, &mut best) {
+                return s;
             }
-            consider(r, &mut best);
         }
         let reason = match (&best, options.branch) {
             (None, _) if seeds.any_out_of_limits => FailureReason::OutOfLimits,

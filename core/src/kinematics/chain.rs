@@ -162,8 +162,8 @@ pub(crate) fn link_constant_apply(l: &Link, t: &LinkTrig, pose: &mut Pose) {
 /// for bit.
 #[derive(Debug, Clone)]
 pub(crate) struct ChainConstants {
-    trig: Vec<LinkTrig>,
-    tool: Pose,
+    pub(crate) trig: Vec<LinkTrig>,
+    pub(crate) tool: Pose,
 }
 
 impl ChainConstants {

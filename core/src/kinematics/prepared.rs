@@ -16,8 +16,7 @@
 //! kept, in a caller's buffer: no allocation per call.
 
 use super::chain::{
-    chain_angles, check_q, link_constant_apply, link_constant_step, tool_pose, KinematicsError,
-    LinkTrig,
+    chain_angles, check_q, link_constant_apply, link_constant_step, ChainConstants, KinematicsError,
 };
 use super::gravity::gravity_torques_into;
 use super::loop_closure::LoopPartials;
@@ -65,28 +64,22 @@ pub fn stack_or_heap<'a, T: Copy>(
 #[derive(Debug, Clone)]
 pub struct PreparedChain {
     model: RobotModel,
-    trig: Vec<LinkTrig>,
+    /// The twists' trigonometry and the tool transform (as [`super::chain::chain_with`] uses them).
+    constants: ChainConstants,
     /// Constant part of the base link, `Tr(x,a0)·Tr(y,b0)·Tr(z,d1)·Rot(x,α0)·Rot(y,β0)`.
     base: Pose,
-    tool: Pose,
 }
 
 impl PreparedChain {
     pub fn new(model: &RobotModel) -> Self {
-        let trig: Vec<LinkTrig> = model
-            .links
-            .iter()
-            .enumerate()
-            .map(|(k, l)| LinkTrig::of(k, l))
-            .collect();
+        let constants = ChainConstants::of(model);
         let mut base = Pose::identity();
-        if let (Some(l), Some(t)) = (model.links.first(), trig.first()) {
+        if let (Some(l), Some(t)) = (model.links.first(), constants.trig.first()) {
             link_constant_step(0, l, t, &mut base);
         }
         PreparedChain {
-            trig,
+            constants,
             base,
-            tool: tool_pose(model),
             model: model.clone(),
         }
     }
@@ -108,14 +101,14 @@ impl PreparedChain {
     ) -> Result<(Pose, Option<LoopPartials>), KinematicsError> {
         let flange_and_partials = self.walk(q, |k, p| frames[k] = *p)?;
         Ok((
-            flange_and_partials.0.compose(&self.tool),
+            flange_and_partials.0.compose(&self.constants.tool),
             flange_and_partials.1,
         ))
     }
 
     /// The TCP pose (as [`super::chain::fk`]).
     pub fn fk(&self, q: &[f64]) -> Result<Pose, KinematicsError> {
-        Ok(self.walk(q, |_, _| {})?.0.compose(&self.tool))
+        Ok(self.walk(q, |_, _| {})?.0.compose(&self.constants.tool))
     }
 
     /// Walks the chain: `visit(k, frame k)` for every link; returns the flange
@@ -133,7 +126,7 @@ impl PreparedChain {
         let angles = stack_or_heap(&mut buf, &mut heap, n, 0.0);
         let loop_partials = chain_angles(m, q, angles)?;
         let mut pose = self.base;
-        for (k, (l, t)) in m.links.iter().zip(&self.trig).enumerate() {
+        for (k, (l, t)) in m.links.iter().zip(&self.constants.trig).enumerate() {
             if k > 0 {
                 link_constant_apply(l, t, &mut pose);
             }
