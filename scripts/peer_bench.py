@@ -13,7 +13,9 @@ parameters) on the real UR5 laser-tracker grid (1000 poses), validated on its
     a6, alpha6, d6, theta6 and the base's rotation about z depend on these;
   - robocal: `robocal bench km` (registration, identifiability by SVD, KM).
 Accuracy is the mean position error on the 20 validation poses; time is the
-median wall time of a whole fit.
+median wall time of a whole fit: over --repeat runs for scipy (default 3, a
+fit takes seconds), over at least 30 for robocal (a fit takes milliseconds,
+and a median of few runs moves with the machine's noise).
 
 IK on the nominal UR5 (robocal's preset geometry), 1000 poses of random joint
 configurations: roboticstoolbox-python's C++ `ik_LM` called on a prebuilt ETS
@@ -138,7 +140,7 @@ def km_bench(robocal, repeat):
     out["scipy_least_squares"] = {"validation_mean_mm": float(err.mean()), "time_s": t}
     r = json.loads(subprocess.check_output([
         robocal, "bench", "km", "--model", "ur5", "--identify", grid, "--validate", rand,
-        "--repeat", str(max(repeat, 10))]))
+        "--repeat", str(max(repeat, 30))]))
     out["robocal"] = {"validation_mean_mm": r["validation_mean_mm"], "time_s": r["time_ms_median"] / 1e3,
                       "converged": r["converged"]}
     return out
@@ -232,7 +234,7 @@ def km_ys100_bench(robocal, repeat):
     out = {"scipy_least_squares": {"validation_mean_mm": float(err.mean()), "time_s": t}}
     r = json.loads(subprocess.check_output([
         robocal, "bench", "km", "--model", "ys100", "--identify", files["ident"],
-        "--validate", files["valid"], "--repeat", str(max(repeat, 10))]))
+        "--validate", files["valid"], "--repeat", str(max(repeat, 30))]))
     out["robocal"] = {"validation_mean_mm": r["validation_mean_mm"], "time_s": r["time_ms_median"] / 1e3,
                       "converged": r["converged"]}
     return out

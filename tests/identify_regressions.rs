@@ -294,8 +294,8 @@ fn skcm_payload_identifies_an_unknown_payload_mass() {
         .find(|x| x.name == "payload_mass_offset")
         .expect("the mass offset is reported");
     eprintln!(
-        "payload 8 kg heavier than declared: SKCM {skcm:.4} mm, SKCM-payload {payload:.4} mm, offset {offset:.3} kg (σ {:?})",
-        e.std
+        "payload 8 kg heavier than declared: SKCM {skcm:.4} mm, SKCM-payload {payload:.4} mm, offset {offset:.3} kg (σ {:?}); solver: {} (gradient {:.1e})",
+        e.std, m.solver.detail, m.solver.gradient
     );
     let floor = noise_floor_mm();
     assert!(payload <= 1.3 * floor, "SKCM-payload {payload} mm");

@@ -122,7 +122,13 @@ fn check_methods(result: &Value) {
         let converged = m["solver"]["converged"].as_bool().unwrap();
         assert_eq!(
             converged,
-            ["cost_tolerance", "step_tolerance", "gradient_tolerance"].contains(&reason),
+            [
+                "cost_tolerance",
+                "step_tolerance",
+                "gradient_tolerance",
+                "predicted_cost_tolerance"
+            ]
+            .contains(&reason),
             "{name}: {}",
             m["solver"]
         );

@@ -9,6 +9,7 @@
 use super::least_squares;
 use super::registration::RegistrationError;
 use super::report::FailedMethod;
+use crate::kinematics::chain::{chain_with, ChainConstants};
 use crate::kinematics::{chain, fk, gravity_torques_of, Chain, KinematicsError};
 use crate::measure::Measurement;
 use crate::model::{ParamId, ParamKind, RobotModel};
@@ -94,11 +95,16 @@ pub(crate) fn checked_chains(
     data: &[Measurement],
     set: &'static str,
 ) -> Result<Vec<Chain>, CalibrationError> {
+    let constants = ChainConstants::of(model);
     data.iter()
         .enumerate()
         .map(|(index, m)| {
             check_inputs(model, m, set, index)?;
-            chain(model, &m.q).map_err(|source| CalibrationError::Kinematics { set, index, source })
+            chain_with(model, &constants, &m.q).map_err(|source| CalibrationError::Kinematics {
+                set,
+                index,
+                source,
+            })
         })
         .collect()
 }
@@ -205,8 +211,9 @@ fn stacked_jacobian_of(
 }
 
 /// Poses per block of [`stacked_factor`]: a block's rows and the factor so far
-/// (some 100 KB) stay in cache while the block is reduced.
-const FACTOR_BLOCK_POSES: usize = 100;
+/// (some 200 KB for 34 candidate columns) stay in cache while the block is
+/// reduced (1000 poses per block measured slower, 100 a little slower).
+const FACTOR_BLOCK_POSES: usize = 250;
 
 /// The triangular factor R of the stacked identification Jacobian J of
 /// [`stacked_jacobian`] (`RᵀR = JᵀJ`, at most `ids.len()` rows, see

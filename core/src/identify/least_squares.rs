@@ -77,8 +77,15 @@ pub enum StopReason {
     GradientTolerance,
     /// The iteration budget ran out (accepted and rejected steps both count).
     MaxIterations,
+    /// No trial step reduced the cost, and the decrease the linear model
+    /// predicts for the trials (at most, over this iteration's damping values)
+    /// is below `cost_tolerance` (relative): what is left to gain is below
+    /// the cost test, within the rounding of the cost itself. The same test
+    /// as [`StopReason::CostTolerance`], on the predicted decrease.
+    PredictedCostTolerance,
     /// No trial step reduced the cost although the gradient is not small
-    /// (damping exhausted): not a minimum that a test confirmed.
+    /// and the predicted decrease is above `cost_tolerance` (damping
+    /// exhausted): not a minimum that a test confirmed.
     NoDescent,
     /// Trial models could not be evaluated (e.g. a closed loop that does not
     /// close).
@@ -94,7 +101,10 @@ impl StopReason {
     pub fn converged(&self) -> bool {
         matches!(
             self,
-            StopReason::CostTolerance | StopReason::StepTolerance | StopReason::GradientTolerance
+            StopReason::CostTolerance
+                | StopReason::StepTolerance
+                | StopReason::GradientTolerance
+                | StopReason::PredictedCostTolerance
         )
     }
 
@@ -104,6 +114,7 @@ impl StopReason {
             StopReason::CostTolerance => "cost_tolerance",
             StopReason::StepTolerance => "step_tolerance",
             StopReason::GradientTolerance => "gradient_tolerance",
+            StopReason::PredictedCostTolerance => "predicted_cost_tolerance",
             StopReason::MaxIterations => "max_iterations",
             StopReason::NoDescent => "no_descent",
             StopReason::EvaluationFailed => "evaluation_failed",
@@ -304,6 +315,75 @@ fn apply_step(
 
 /// Largest |cosine| between the residual and a free scaled column: the
 /// first-order optimality measure of the scaled, bound-constrained problem.
+/// The state of an LM iteration none of whose trial steps reduced the cost.
+struct Stall {
+    /// Projected scaled gradient ([`gradient_measure`]).
+    gradient: f64,
+    /// Largest relative decrease the linear model predicts for an evaluated
+    /// trial (−∞ when none could be evaluated).
+    predicted: f64,
+    /// The iteration budget ran out while the damping was still usable.
+    budget_used: bool,
+    trials: usize,
+    evaluations_failed: usize,
+}
+
+/// Why the LM stops when no trial step reduced the cost: a minimum confirmed
+/// by the gradient or by the predicted decrease, or the reason it is not.
+fn stall_reason(s: &Stall, settings: &LmSettings) -> (StopReason, String) {
+    let Stall {
+        gradient,
+        predicted,
+        trials,
+        ..
+    } = *s;
+    if gradient <= settings.gradient_tolerance {
+        (
+            StopReason::GradientTolerance,
+            format!(
+                "no step reduces the cost and the projected scaled gradient {gradient:.1e} is below {:.0e}",
+                settings.gradient_tolerance
+            ),
+        )
+    } else if (0.0..=settings.cost_tolerance).contains(&predicted) {
+        (
+            StopReason::PredictedCostTolerance,
+            format!(
+                "no step reduces the cost; the largest relative decrease the linear model predicts, {predicted:.1e}, is below {:.0e} (scaled gradient {gradient:.1e})",
+                settings.cost_tolerance
+            ),
+        )
+    } else if s.budget_used {
+        (
+            StopReason::MaxIterations,
+            format!(
+                "iteration budget of {} used up during rejected steps (scaled gradient {gradient:.1e})",
+                settings.max_iterations
+            ),
+        )
+    } else if s.evaluations_failed == trials && trials > 0 {
+        (
+            StopReason::EvaluationFailed,
+            format!("none of {trials} trial steps could be evaluated (closed loop does not close)"),
+        )
+    } else {
+        (
+            StopReason::NoDescent,
+            format!(
+                "no step reduces the cost, but the scaled gradient {gradient:.1e} is above {:.0e} and the predicted relative decrease {predicted:.1e} above {:.0e}: not a confirmed minimum",
+                settings.gradient_tolerance, settings.cost_tolerance
+            ),
+        )
+    }
+}
+
+/// The decrease of the squared residual norm that the linear model predicts
+/// for the scaled step `d`: `‖r‖² − ‖r − J·d‖² = 2·dᵀg − dᵀA·d`, with
+/// `A = JᵀJ` and `g = Jᵀr` of the scaled Jacobian.
+fn predicted_decrease(a: &DMatrix<f64>, g: &DVector<f64>, d: &DVector<f64>) -> f64 {
+    2.0 * d.dot(g) - (a * d).dot(d)
+}
+
 fn gradient_measure(js: &DMatrix<f64>, g: &DVector<f64>, r_norm: f64, active: &[bool]) -> f64 {
     if r_norm == 0.0 {
         return 0.0;
@@ -435,6 +515,8 @@ pub(crate) fn fit_with_start_chains(
         let mut accepted = None;
         let mut evaluations_failed = 0;
         let mut trials = 0;
+        // Largest relative cost decrease the linear model predicts for a trial.
+        let mut predicted = f64::NEG_INFINITY;
         while lambda < 1e12 && iterations < settings.max_iterations {
             iterations += 1;
             trials += 1;
@@ -460,7 +542,8 @@ pub(crate) fn fit_with_start_chains(
                     delta[i] = lower[i] - x[i];
                 }
             }
-            let step = delta.component_div(&scale).norm();
+            let scaled = delta.component_div(&scale);
+            let step = scaled.norm();
             let (m2, f2) = apply_step(&model, &frames, &layout, &x, &delta);
             // With the Jacobian: an accepted trial is the next iterate, whose
             // Jacobian is needed next (one forward-kinematics pass per trial).
@@ -479,6 +562,9 @@ pub(crate) fn fit_with_start_chains(
                 continue;
             }
             let c2 = trial.0.norm_squared();
+            // Over evaluated trials only: a step that cannot be evaluated
+            // says nothing about what is left to gain.
+            predicted = predicted.max(predicted_decrease(&a, &g, &scaled) / cost);
             if c2 < cost {
                 accepted = Some((m2, f2, c2, step));
                 lambda = (lambda / 10.0).max(1e-15);
@@ -487,30 +573,16 @@ pub(crate) fn fit_with_start_chains(
             lambda *= 10.0;
         }
         let Some((m2, f2, c2, step)) = accepted else {
-            if gradient <= settings.gradient_tolerance {
-                reason = StopReason::GradientTolerance;
-                detail = format!(
-                    "no step reduces the cost and the projected scaled gradient {gradient:.1e} is below {:.0e}",
-                    settings.gradient_tolerance
-                );
-            } else if iterations >= settings.max_iterations && lambda < 1e12 {
-                reason = StopReason::MaxIterations;
-                detail = format!(
-                    "iteration budget of {} used up during rejected steps (scaled gradient {gradient:.1e})",
-                    settings.max_iterations
-                );
-            } else if evaluations_failed == trials && trials > 0 {
-                reason = StopReason::EvaluationFailed;
-                detail = format!(
-                    "none of {trials} trial steps could be evaluated (closed loop does not close)"
-                );
-            } else {
-                reason = StopReason::NoDescent;
-                detail = format!(
-                    "no step reduces the cost, but the scaled gradient {gradient:.1e} is above {:.0e}: not a confirmed minimum",
-                    settings.gradient_tolerance
-                );
-            }
+            (reason, detail) = stall_reason(
+                &Stall {
+                    gradient,
+                    predicted,
+                    budget_used: iterations >= settings.max_iterations && lambda < 1e12,
+                    trials,
+                    evaluations_failed,
+                },
+                settings,
+            );
             break;
         };
         let rel = (cost - c2) / cost.max(f64::MIN_POSITIVE);
@@ -587,4 +659,76 @@ pub(crate) fn fit_with_start_chains(
         at_bound,
         residuals: Some(ev.0),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// The predicted decrease against its definition `‖r‖² − ‖r − J·d‖²`,
+    /// computed directly, on random tall systems and steps.
+    #[test]
+    fn predicted_decrease_is_the_linear_models_decrease() {
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        for (m, n) in [(30, 4), (300, 25), (7, 7)] {
+            let j = DMatrix::from_fn(m, n, |_, _| rng.gen_range(-1.0..1.0));
+            let r = DVector::from_fn(m, |_, _| rng.gen_range(-1.0..1.0));
+            let d = DVector::from_fn(n, |_, _| rng.gen_range(-0.5..0.5));
+            let direct = r.norm_squared() - (&r - &j * &d).norm_squared();
+            let p = predicted_decrease(&j.tr_mul(&j), &j.tr_mul(&r), &d);
+            assert!(
+                (p - direct).abs() <= 1e-12 * r.norm_squared(),
+                "{p} vs {direct}"
+            );
+        }
+    }
+
+    fn stall(gradient: f64, predicted: f64) -> Stall {
+        Stall {
+            gradient,
+            predicted,
+            budget_used: false,
+            trials: 3,
+            evaluations_failed: 0,
+        }
+    }
+
+    /// A stall is a confirmed minimum when the gradient or the predicted
+    /// decrease passes its test, and only then.
+    #[test]
+    fn a_stall_converges_only_when_a_test_passes() {
+        let s = LmSettings::default();
+        let at = |st: &Stall| stall_reason(st, &s).0;
+        // The gradient test, as before.
+        assert_eq!(at(&stall(5e-7, 1.0)), StopReason::GradientTolerance);
+        // Gradient above its tolerance, nothing measurable left to gain.
+        let r = at(&stall(1.8e-6, 3e-12));
+        assert_eq!(r, StopReason::PredictedCostTolerance);
+        assert!(r.converged());
+        // Something left to gain: not a minimum.
+        let r = at(&stall(1.8e-6, 1e-8));
+        assert_eq!(r, StopReason::NoDescent);
+        assert!(!r.converged());
+        // No trial evaluated: the prediction (−∞) confirms nothing.
+        let failed = Stall {
+            evaluations_failed: 3,
+            ..stall(1e-3, f64::NEG_INFINITY)
+        };
+        assert_eq!(at(&failed), StopReason::EvaluationFailed);
+        let none = Stall {
+            trials: 0,
+            ..stall(1e-3, f64::NEG_INFINITY)
+        };
+        assert_eq!(at(&none), StopReason::NoDescent);
+        // A projected step the model predicts to raise the cost confirms nothing.
+        assert_eq!(at(&stall(1e-3, -1e-12)), StopReason::NoDescent);
+        // The budget, when the predicted decrease is still above the test.
+        let budget = Stall {
+            budget_used: true,
+            ..stall(1e-3, 1e-6)
+        };
+        assert_eq!(at(&budget), StopReason::MaxIterations);
+    }
 }

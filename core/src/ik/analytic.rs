@@ -44,9 +44,9 @@
 //! so the branch conventions are written once.
 
 use super::config::{Configuration, Elbow, Shoulder, Wrist};
+use crate::kinematics::chain::sin_cos;
 use crate::kinematics::chain::tool_pose;
 use crate::kinematics::loop_closure::solve_loop;
-use crate::kinematics::prepared::sin_cos;
 use crate::model::{Pose, RobotModel};
 use nalgebra::{Matrix3, Vector2, Vector3};
 use serde::{Deserialize, Serialize};

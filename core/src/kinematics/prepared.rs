@@ -16,29 +16,14 @@
 //! kept, in a caller's buffer: no allocation per call.
 
 use super::chain::{
-    chain_angles, check_q, link_constant_apply, link_constant_step, ChainConstants, KinematicsError,
+    chain_angles, check_q, link_constant_apply, link_constant_step, sin_cos, ChainConstants,
+    KinematicsError,
 };
 use super::gravity::gravity_torques_into;
 use super::loop_closure::LoopPartials;
 use crate::model::pose::Pose;
 use crate::model::robot::RobotModel;
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, Vector3, U6};
-
-/// `(sin x, cos x)` [x in rad] on the IK's evaluation path: this module and
-/// the closed form (`ik::analytic`).
-///
-/// The `libm` crate's `sincos` (musl's algorithm; error below 1 ulp, as the
-/// standard library's) rather than `f64::sin_cos`, for speed: on x86-64 Linux
-/// the standard one calls glibc's `sincos`, which saves and restores the
-/// floating-point rounding mode on every call (`cargo bench --bench ik`
-/// measures the IK). The general [`super::chain::chain`] and [`super::fk`]
-/// (identification, simulation, the model's own prediction) keep the standard
-/// library's, so their results do not move with the IK's speed choices; the
-/// two agree to a few ulps (compared in the tests below to 1e-12).
-#[inline]
-pub fn sin_cos(x: f64) -> (f64, f64) {
-    libm::sincos(x)
-}
 
 /// Joint counts up to this use stack buffers; larger models use the heap.
 pub const STACK_DOF: usize = 8;
