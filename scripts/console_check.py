@@ -11,7 +11,7 @@ Debian's Chromium and chromedriver through Selenium.
     scripts/console_check.sh [path/to/robocal]     (installs what it needs)
     python3 scripts/console_check.py --robocal target/debug/robocal --out DIR
 
-Data: the real UR5 laser-tracker set in ../shared/data (grid for
+Data: the real UR5 laser-tracker set in data/ur5-wam-laser-tracker (grid for
 identification, the 20 random poses for validation). Exits non-zero on the
 first step that does not behave.
 """
@@ -35,7 +35,7 @@ from selenium.webdriver.support.ui import Select, WebDriverWait
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 DATA = pathlib.Path(os.environ.get(
-    "ROBOCAL_DATA_DIR", ROOT.parent / "shared/data/ur5-wam-laser-tracker"))
+    "ROBOCAL_DATA_DIR", ROOT / "data/ur5-wam-laser-tracker"))
 KEY = "console-check-key"
 
 

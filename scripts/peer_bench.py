@@ -53,7 +53,7 @@ from scipy.optimize import least_squares
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-DATA = os.path.join(ROOT, "..", "shared", "data", "ur5-wam-laser-tracker", "UR5")
+DATA = os.path.join(ROOT, "data", "ur5-wam-laser-tracker", "UR5")
 
 # UR5 standard DH (mm, deg), as robocal's `ur5` preset and the data's README.
 A = np.array([0.0, -425.0, -392.25, 0.0, 0.0, 0.0])

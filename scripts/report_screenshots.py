@@ -23,7 +23,7 @@ from selenium.webdriver.common.by import By
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 DATA = pathlib.Path(os.environ.get(
-    "ROBOCAL_DATA_DIR", ROOT.parent / "shared/data/ur5-wam-laser-tracker"))
+    "ROBOCAL_DATA_DIR", ROOT / "data/ur5-wam-laser-tracker"))
 SECTIONS = ["warnings", "statistics", "histograms", "per-axis", "positions",
             "poses", "solvers", "parameters"]
 

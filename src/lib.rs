@@ -8,7 +8,7 @@
 //! runtime or command-line crates.
 
 pub use robocal_core::{
-    compensate, csv_text, export, identify, ik, kinematics, measure, model, sim,
+    compensate, csv_text, export, identify, ik, kinematics, measure, model, optim, sim, stats,
 };
 
 pub mod cli;

@@ -1,6 +1,6 @@
 //! Learned compensators (issue 9) against simulated ground truth with effects
 //! the model-based calibration does not have, and against the real
-//! laser-tracker data (../shared/data/ur5-wam-laser-tracker).
+//! laser-tracker data (data/ur5-wam-laser-tracker).
 //!
 //! The simulated truth is `compensate::unmodelled_truth` on the YS100: ~1 mm /
 //! 0.1° geometric errors, the joint stiffness of the seed's Table 7.2, link
@@ -24,12 +24,13 @@ use rand_chacha::ChaCha8Rng;
 use robocal::compensate::{unmodelled_truth, CompensatedModel, CompensatorSpec, StoredCompensator};
 use robocal::identify::{
     calibrate, calibrate_with_training, CalibrationOptions, CalibrationReport, CompensatorOptions,
-    ErrorStats, Method,
+    Method,
 };
 use robocal::ik::{Goal, IkSettings, IkSolver, SolveOptions};
 use robocal::measure::{self, Measurement};
 use robocal::model::{preset, RobotModel};
 use robocal::sim::random_configurations;
+use robocal::stats::ErrorStats;
 use std::sync::OnceLock;
 
 /// The base model of a calibrated method, in the measurement frame.

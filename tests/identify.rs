@@ -1,5 +1,5 @@
 //! Identification checked against simulated ground truth and real laser-tracker
-//! data (../shared/data/ur5-wam-laser-tracker).
+//! data (data/ur5-wam-laser-tracker).
 
 mod common;
 

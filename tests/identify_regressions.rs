@@ -313,7 +313,7 @@ fn skcm_payload_identifies_an_unknown_payload_mass() {
 /// every session's frame.
 #[test]
 fn two_session_skcm_c_is_as_accurate_as_one() {
-    use robocal::identify::TlboSettings;
+    use robocal::optim::TlboSettings;
     use robocal::sim::tracker_frame;
     let nominal = preset("ys100").unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(41);

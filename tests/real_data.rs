@@ -1,4 +1,4 @@
-//! The real laser-tracker data (../shared/data/ur5-wam-laser-tracker) with the
+//! The real laser-tracker data (data/ur5-wam-laser-tracker) with the
 //! shipped model files (models/ur5.json, models/wam.json), over HTTP and the
 //! command line, as a new user runs them.
 
@@ -242,9 +242,11 @@ fn real_data_cli_commands_run_as_written() {
                 "--model",
                 &format!("models/{model}.json"),
                 "--identify",
-                &format!("../shared/data/ur5-wam-laser-tracker/{dir}/3D_{dir}_uncalibrated_grid_cleaned.csv"),
+                &format!("data/ur5-wam-laser-tracker/{dir}/3D_{dir}_uncalibrated_grid_cleaned.csv"),
                 "--validate",
-                &format!("../shared/data/ur5-wam-laser-tracker/{dir}/3D_{dir}_uncalibrated_random_cleaned.csv"),
+                &format!(
+                    "data/ur5-wam-laser-tracker/{dir}/3D_{dir}_uncalibrated_random_cleaned.csv"
+                ),
                 "--method",
                 methods,
                 "--population",

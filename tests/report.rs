@@ -144,7 +144,7 @@ fn older_newer_and_unreadable_reports_say_so() {
 fn real_ur5_report_renders() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("ur5.html");
-    let data = format!("{ROOT}/../shared/data/ur5-wam-laser-tracker/UR5");
+    let data = format!("{ROOT}/data/ur5-wam-laser-tracker/UR5");
     let status = std::process::Command::new(env!("CARGO_BIN_EXE_robocal"))
         .current_dir(ROOT)
         .args([

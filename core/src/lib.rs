@@ -14,4 +14,6 @@ pub mod ik;
 pub mod kinematics;
 pub mod measure;
 pub mod model;
+pub mod optim;
 pub mod sim;
+pub mod stats;

@@ -181,7 +181,7 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     let opts = CalibrationOptions {
         methods,
         register: !a.no_register,
-        tlbo: crate::identify::TlboSettings {
+        tlbo: crate::optim::TlboSettings {
             population: a.population,
             generations: a.generations,
             seed: a.seed,
@@ -297,23 +297,22 @@ pub fn render_report(r: &CalibrationReport) -> String {
         "{:<22} {:>8} {:>8} {:>8} {:>8} {:>8}   {:>8} {:>8} {:>8} {:>8} {:>8}",
         "", "id mean", "max", "std", "rms", "p95", "val mean", "max", "std", "rms", "p95"
     );
-    let mut line = |label: &str,
-                    id: &crate::identify::ErrorStats,
-                    va: Option<&crate::identify::ErrorStats>| {
-        let _ = write!(
-            s,
-            "{:<22} {:>8.4} {:>8.4} {:>8.4} {:>8.4} {:>8.4}",
-            label, id.mean_mm, id.max_mm, id.std_mm, id.rms_mm, id.p95_mm
-        );
-        if let Some(v) = va {
+    let mut line =
+        |label: &str, id: &crate::stats::ErrorStats, va: Option<&crate::stats::ErrorStats>| {
             let _ = write!(
                 s,
-                "   {:>8.4} {:>8.4} {:>8.4} {:>8.4} {:>8.4}",
-                v.mean_mm, v.max_mm, v.std_mm, v.rms_mm, v.p95_mm
+                "{:<22} {:>8.4} {:>8.4} {:>8.4} {:>8.4} {:>8.4}",
+                label, id.mean_mm, id.max_mm, id.std_mm, id.rms_mm, id.p95_mm
             );
-        }
-        let _ = writeln!(s);
-    };
+            if let Some(v) = va {
+                let _ = write!(
+                    s,
+                    "   {:>8.4} {:>8.4} {:>8.4} {:>8.4} {:>8.4}",
+                    v.mean_mm, v.max_mm, v.std_mm, v.rms_mm, v.p95_mm
+                );
+            }
+            let _ = writeln!(s);
+        };
     line(
         "Nominal robot model",
         &r.nominal.identification.stats,
@@ -461,7 +460,7 @@ pub fn render_comparison(r: &CalibrationReport) -> String {
         let _ = write!(s, " {:>19}", "validation (Q3)");
     }
     let _ = writeln!(s);
-    let cell = |e: Option<&crate::identify::ErrorStats>| match e {
+    let cell = |e: Option<&crate::stats::ErrorStats>| match e {
         Some(e) => format!("{:>9.4} / {:<7.4}", e.mean_mm, e.max_mm),
         None => format!("{:>19}", "-"),
     };
@@ -513,7 +512,7 @@ pub fn render_compensators(r: &CalibrationReport) -> String {
         return s;
     }
     let _ = writeln!(s, "\nCompensators (mean / max in mm, base -> compensated)");
-    let pair = |b: &crate::identify::ErrorStats, c: &crate::identify::ErrorStats| {
+    let pair = |b: &crate::stats::ErrorStats, c: &crate::stats::ErrorStats| {
         format!(
             "{:.4} -> {:.4} / {:.4} -> {:.4}",
             b.mean_mm, c.mean_mm, b.max_mm, c.max_mm

@@ -91,7 +91,7 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     println!("payload 110 kg, tracker noise 0.01 mm per axis, 30 identification poses (D-optimal among 500 random) / 45 random validation poses.\n");
     println!("Table 7.5 equivalent: absolute position accuracy on the validation poses (mm)");
     println!("{:<22} {:>9} {:>9} {:>9}", "", "Mean", "Max.", "Std.");
-    let row = |label: &str, s: &crate::identify::ErrorStats| {
+    let row = |label: &str, s: &crate::stats::ErrorStats| {
         println!(
             "{:<22} {:>9.4} {:>9.4} {:>9.4}",
             label, s.mean_mm, s.max_mm, s.std_mm

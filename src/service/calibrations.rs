@@ -28,10 +28,10 @@ use crate::db::{
 use crate::identify::{
     calibrate_with_training, CalibrationError, CalibrationOptions, CalibrationReport,
     CompensatorOptions, FailedMethod, LmSettings, Method, PoseSource, PoseSources, Progress,
-    TlboSettings,
 };
 use crate::measure::Measurement;
 use crate::model::RobotModel;
+use crate::optim::TlboSettings;
 use serde_json::json;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;

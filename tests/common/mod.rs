@@ -1,7 +1,7 @@
 //! Helpers shared by the identification, regression, compensation and
 //! real-data test crates (each includes this file as `mod common;`):
 //! simulated measurements of a ground-truth robot, the real laser-tracker data
-//! (../shared/data/ur5-wam-laser-tracker beside the repository, or
+//! (data/ur5-wam-laser-tracker in the repository, or
 //! `ROBOCAL_DATA_DIR`), the shipped model files (models/*.json) and the
 //! `robocal` binary run for its JSON, and the service in-process.
 #![allow(dead_code)]
@@ -101,10 +101,10 @@ pub fn run_with(
 
 /// The text of a file of the real data set (`UR5/…`, `WAM/…`): in
 /// `ROBOCAL_DATA_DIR` when set (as the core's CSV tests read it), else in
-/// ../shared/data/ur5-wam-laser-tracker beside the repository.
+/// data/ur5-wam-laser-tracker in the repository.
 pub fn data(path: &str) -> String {
     let dir = std::env::var("ROBOCAL_DATA_DIR")
-        .unwrap_or_else(|_| format!("{ROOT}/../shared/data/ur5-wam-laser-tracker"));
+        .unwrap_or_else(|_| format!("{ROOT}/data/ur5-wam-laser-tracker"));
     std::fs::read_to_string(format!("{dir}/{path}"))
         .unwrap_or_else(|e| panic!("real data {dir}/{path}: {e} (set ROBOCAL_DATA_DIR)"))
 }

@@ -13,7 +13,7 @@
 //! cross-validated max is not higher: a compensator worse on either never wins.
 
 use super::{Compensator, Sample};
-use crate::identify::ErrorStats;
+use crate::stats::ErrorStats;
 use rand::seq::SliceRandom;
 use rand::Rng;
 use serde::{Deserialize, Serialize};

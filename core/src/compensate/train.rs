@@ -2,7 +2,7 @@
 //! [`mlp`](super::mlp) by Levenberg–Marquardt backpropagation (seed ch. 4, the
 //! MATLAB toolbox default `trainlm`), by invasive weed optimisation (ch. 5,
 //! eqs. 5.6–5.10) or by TLBO (ch. 6, eqs. 6.10–6.11, the engine of
-//! [`identify::tlbo`](crate::identify::tlbo)), all over the same flat weight
+//! [`optim::tlbo`](crate::optim::tlbo)), all over the same flat weight
 //! vector in normalised units; and the RBF of [`rbf`](super::rbf) (ch. 3).
 //!
 //! Loss per sample (eqs. 5.5 / 6.9): `E = (1/3)·Σ_o e_o²` with `e` the error of
@@ -47,7 +47,7 @@
 use super::mlp::{Features, Mlp, Normalisation, Shape};
 use super::rbf::{train_rbf_with_progress, RbfReport, RbfSettings};
 use super::{Sample, StoredCompensator};
-use crate::identify::tlbo::{self, TlboSettings};
+use crate::optim::tlbo::{self, TlboSettings};
 use nalgebra::{DMatrix, DVector};
 use rand::seq::SliceRandom;
 use rand::Rng;

@@ -39,7 +39,6 @@ use super::options::{CalibrationOptions, Method};
 use super::report::{
     predict_compensated, AutoCandidate, AutoSummary, CompensatorSummary, MethodReport, SetErrors,
 };
-use super::stats::ErrorStats;
 use crate::compensate::{
     choose, cross_validate, train, Compensator, CvStats, Sample, StoredCompensator, TrainError,
     TrainReport,
@@ -48,6 +47,7 @@ use crate::kinematics::{chain, gravity_torques_of};
 use crate::measure::Measurement;
 use crate::model::pose::Pose;
 use crate::model::RobotModel;
+use crate::stats::ErrorStats;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use std::collections::BTreeMap;

@@ -36,11 +36,11 @@ use super::least_squares::{
 };
 use super::options::{CalibrationOptions, Method};
 use super::report::{estimates, MethodReport, MethodWarning, SetErrors, TlboSummary, WarningKind};
-use super::tlbo;
 use crate::kinematics::{chain, gravity_torques_of, Chain};
 use crate::measure::Measurement;
 use crate::model::pose::Pose;
 use crate::model::{ModelDescription, ParamId, ParamKind, RobotModel};
+use crate::optim::tlbo;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 

@@ -19,8 +19,6 @@ pub mod options;
 pub mod pose_selection;
 pub mod registration;
 pub mod report;
-pub mod stats;
-pub mod tlbo;
 
 pub use calibrate::{calibrate, calibrate_with_training};
 pub use checks::CalibrationError;
@@ -33,5 +31,3 @@ pub use report::{
     MethodWarning, ParamEstimate, PoseSource, PoseSources, SetErrors, WarningKind,
     REPORT_FORMAT_VERSION,
 };
-pub use stats::ErrorStats;
-pub use tlbo::TlboSettings;

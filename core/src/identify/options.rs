@@ -7,10 +7,10 @@
 
 use super::identifiability::IdentifiabilitySettings;
 use super::least_squares::LmSettings;
-use super::tlbo::TlboSettings;
 use crate::compensate::{
     CompensatorSpec, IwoSettings, LmTrainSettings, MlpSpec, RbfSettings, TlboTrainSettings, Trainer,
 };
+use crate::optim::TlboSettings;
 use serde::{Deserialize, Serialize};
 
 /// A calibration method.

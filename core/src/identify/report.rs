@@ -9,12 +9,12 @@
 use super::identifiability::IdentifiabilityReport;
 use super::least_squares::LmReport;
 use super::options::Method;
-use super::stats::ErrorStats;
 use crate::compensate::{Compensator, CvStats, StoredCompensator, TrainReport};
 use crate::measure::Measurement;
 use crate::model::description::PoseDescription;
 use crate::model::pose::Pose;
 use crate::model::{ModelDescription, ParamId, RobotModel};
+use crate::stats::ErrorStats;
 use nalgebra::{DMatrix, DVector, Vector3};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;

@@ -23,7 +23,7 @@
 //! empty field means "not given" for that row (the orientation needs all three
 //! fields or none). Unknown and duplicate columns are rejected.
 //!
-//! **Real-data layout** (`shared/data/ur5-wam-laser-tracker`): `step_order`,
+//! **Real-data layout** (`data/ur5-wam-laser-tracker`): `step_order`,
 //! `x_t,y_t,z_t` (nominal target [mm]), `x_dif,y_dif,z_dif` [mm] and
 //! `joint_1..joint_N` [deg]. The sign of `dif` is not documented by the data's
 //! authors; the working assumption (it fits gravity sag) is

@@ -246,15 +246,14 @@ fn joint_count_check() {
     );
 }
 
-/// The real UR5/WAM laser-tracker files (shared/data beside the checkout, or
+/// The real UR5/WAM laser-tracker files (data/ur5-wam-laser-tracker in the repository, or
 /// `ROBOCAL_DATA_DIR`).
 #[test]
 fn real_ur5_wam_files_parse() {
     let dir = std::env::var("ROBOCAL_DATA_DIR")
         .map(std::path::PathBuf::from)
         .unwrap_or_else(|_| {
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-                .join("../../shared/data/ur5-wam-laser-tracker")
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/ur5-wam-laser-tracker")
         });
     assert!(
         dir.exists(),
