@@ -1,4 +1,4 @@
-//! Error statistics of a pose set (DESIGN "Data roles"): mean, maximum, standard
+//! Error statistics of a pose set (docs/design.md "Data roles"): mean, maximum, standard
 //! deviation, RMS and 95th percentile of the position-error norm, in millimetres.
 
 use serde::{Deserialize, Serialize};

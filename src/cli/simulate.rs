@@ -1,5 +1,5 @@
 //! `robocal simulate`: measure a simulated "true" robot and write the measurement
-//! CSV (DESIGN "Measurement CSV"; the seed's §7.4 simulation study).
+//! CSV (docs/design.md "Measurement CSV"; the seed's §7.4 simulation study).
 //!
 //! ```text
 //! robocal simulate --preset ys100 --poses 30 --noise-mm 0.01 --seed 1 --out q1.csv \

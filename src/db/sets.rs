@@ -4,7 +4,7 @@ use super::{commit_inserted, Db, DbError, Json};
 use crate::measure::{MeasuredPose, SetRole};
 use sqlx::{FromRow, Row};
 
-/// Data role of a set as stored (DESIGN "Data roles").
+/// Data role of a set as stored (docs/design.md "Data roles").
 #[derive(Debug, Clone, Copy, PartialEq, Eq, sqlx::Type)]
 #[sqlx(rename_all = "lowercase")]
 pub enum StoredRole {

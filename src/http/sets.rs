@@ -1,5 +1,5 @@
 //! `/v1/robots/{id}/measurement-sets`: upload (JSON rows or the measurement CSV
-//! of DESIGN as `text/csv`), list, get (rows read back bit for bit), the
+//! of docs/design.md as `text/csv`), list, get (rows read back bit for bit), the
 //! original upload, delete.
 //!
 //! Declared units (`length_unit` mm|m, `angle_unit` deg|rad) convert the rows to

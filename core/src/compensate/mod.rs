@@ -1,4 +1,4 @@
-//! The compensated model (DESIGN "Compensated model and false targets", seed
+//! The compensated model (docs/design.md "Compensated model and false targets", seed
 //! eq. 2.1): calibrated geometry, joint compliance under the given payload and an
 //! optional learned residual compensator.
 //!

@@ -2,37 +2,19 @@
 //! and modified-DH tables, and robocal's own JSON. Writing files is the
 //! caller's business.
 //!
-//! What is exported is the *geometric* model: the calibrated link geometry,
-//! the registered base frame and the tool. Joint compliance (deflection under
-//! gravity, seed eq. 2.5) and learned compensators change the pose with the
-//! load and cannot be written in these formats; every text says so.
+//! Only the *geometric* model is exported: calibrated link geometry, registered
+//! base frame and tool. Joint compliance (seed eq. 2.8) and learned
+//! compensators cannot be written in these formats, and every text says so.
 //!
 //! Conventions (robocal's chain, `model::robot`): link k (0-based) is
-//! `Rx(α)·Tx(a)·[Ry(β)]·Tz(d)·Rz(θ)` with `θ = q + θ_offset`, the base link
-//! `Tr(a0, b0, d0)·Rx(α0)·Ry(β0)·Rz(θ0)`, the tool `Tr(p)·Rz·Ry·Rx`, and the
-//! controller reading `q_ctrl = sign·(q − zero)`.
-//!
-//! - **URDF** (`urdf`): metres and radians. Root link `cell` (the measurement
-//!   frame), a fixed joint `base_joint` to link `base` (the registered base
-//!   frame, `cell_from_base`), revolute joints `joint_1..joint_N` whose origin is
-//!   the constant part of each link with `θ_offset + zero` folded in and whose
-//!   axis is `(0, 0, sign)`, so the URDF joint values are the controller's
-//!   readings (in radians); limits in the controller convention; a fixed joint
-//!   `tcp_joint` to link `tcp`. `rpy` is URDF's fixed-axis roll-pitch-yaw,
-//!   `R = Rz(yaw)·Ry(pitch)·Rx(roll)` (`model::orientation::fixed_xyz_angles`).
-//! - **Modified DH** (`mdh-csv`): rows `cell_from_base`, `base`, `j1..jN`,
-//!   `tool`; joint rows `a_mm, alpha_deg, d_mm, theta_offset_deg, beta_deg`
-//!   (`T_k = Rx(α)·Tx(a)·Ry(β)·Tz(d)·Rz(θ)`, Craig's convention with Hayati's
-//!   β), transform rows `x_mm, y_mm, z_mm, rx_deg, ry_deg, rz_deg`
-//!   (`Tr(x,y,z)·Rz(rz)·Ry(ry)·Rx(rx)`); `T = cell_from_base·base·T_1⋯T_N·tool`.
-//! - **Standard DH** (`dh-csv`): the same rows, joint rows
-//!   `T_i = Rz(θ)·Tz(d)·Tx(a)·Rx(α)`. Exact regrouping of the modified chain
-//!   (`Rx(α)·Tx(a)` commute, so link k+1's `a, α` become joint k's); only
-//!   without Hayati twists β on the links after the base.
-//! - **JSON** (`json`): the calibrated model file (`robocal-calibrated-model/2`).
-//!
-//! Closed-loop models (HH800) have no URDF or DH form here (the passive angle
-//! is not a joint reading): those exports fail with a message.
+//! `Rx(α)·Tx(a)·[Ry(β)]·Tz(d)·Rz(θ)` with `θ = q + θ_offset`, the controller
+//! reading `q_ctrl = sign·(q − zero)`. URDF in metres and radians, root link
+//! `cell` (the measurement frame), joint values the controller's readings;
+//! `mdh-csv` rows `a_mm, alpha_deg, d_mm, theta_offset_deg, beta_deg`;
+//! `dh-csv` the exact regrouping `Rz(θ)·Tz(d)·Tx(a)·Rx(α)` (only without
+//! Hayati twists after the base); transform rows `x_mm, y_mm, z_mm, rx_deg,
+//! ry_deg, rz_deg` as `Tr·Rz·Ry·Rx`. Closed-loop models (HH800) have no URDF
+//! or DH form here. More: docs/design.md "Exports".
 
 use crate::compensate::{CalibratedModelFile, CompensatedModel};
 use crate::kinematics::chain::{base_constant, tool_pose};

@@ -229,7 +229,7 @@ pub fn calibrate(
     calibrate_with_training(nominal, identification, &[], validation, opts, progress)
 }
 
-/// Runs the calibration with the data roles of DESIGN "Data roles": Q1
+/// Runs the calibration with the data roles of docs/design.md "Data roles": Q1
 /// `identification` fits the model-based part, Q2 `training` trains the
 /// compensators (empty: they train on Q1 and are judged by k-fold
 /// cross-validation inside it), Q3 `validation` is never fitted. Training

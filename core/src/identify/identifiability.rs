@@ -1,4 +1,4 @@
-//! Automatic identifiability analysis (DESIGN "Identifiability").
+//! Automatic identifiability analysis (docs/design.md "Identifiability").
 //!
 //! Nothing is hard-coded: the stacked identification Jacobian (eq. 4.9 with
 //! β, base, tool, loop and compliance columns) is built over the actual poses,

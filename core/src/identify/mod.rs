@@ -3,7 +3,7 @@
 //! SKCM (§2.3, eq. 2.8; closed loop eq. 4.17) and SKCM-C by TLBO (ch. 7,
 //! eqs. 7.7–7.12), and SKCM with the payload's centre of mass (beyond the
 //! seed); the compensator methods KM-RBF, SKCM-NN, SKCM-IWONN, SKCM-TLBONN
-//! (ch. 3–6) and `auto` on top of them (`hybrid`). Statistics per set follow DESIGN "Data roles".
+//! (ch. 3–6) and `auto` on top of them (`hybrid`). Statistics per set follow docs/design.md "Data roles".
 //!
 //! Units: SI inside; reports speak millimetres and degrees (compliance in
 //! rad/(N·m), stiffness in N·m/rad).

@@ -1,5 +1,5 @@
 //! Closed-form registration of the measurement (tracker) frame to the robot base
-//! frame (DESIGN "Registration"): Kabsch/Horn on the measured points and the
+//! frame (docs/design.md "Registration"): Kabsch/Horn on the measured points and the
 //! nominal TCP positions, before any linearised identification runs.
 //!
 //! Convention: `tracker_to_base` maps tracker coordinates to base coordinates,

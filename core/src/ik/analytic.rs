@@ -1,47 +1,19 @@
 //! Closed-form inverse kinematics of the *nominal* model, used as the seed of
-//! the calibrated solve. All branches (up to 8) with their configuration flags.
+//! the calibrated solve: all branches (up to 8) with their configuration flags
+//! (`ik::config`).
 //!
 //! Frames and units: the target is the TCP pose in the model's base frame
 //! (metres, radians); solutions are model-convention joint values
 //! `q = θ − θ_offset` [rad] (controller conventions are applied elsewhere).
+//! Chain: Craig's modified DH (`model::robot`, seed eq. 4.1), 0-based links;
+//! base and tool are removed first, `T = B⁻¹·T_tcp·T_tool⁻¹`.
 //!
-//! Chain (Craig's modified DH, see `model::robot`), 0-based links `k = 0..5`:
-//! the constant base `B = Tr(a0,b0,d0)·Rx(α0)·Ry(β0)` precedes `Rz(θ0)`; link k
-//! is `Rx(α_k)·Tx(a_k)·Tz(d_k)·Rz(θ_k)`; the tool follows the flange. Base and
-//! tool are removed first (`T = B⁻¹·T_tcp·T_tool⁻¹`, the flange in frame 0′).
-//!
-//! Two structures are solved in closed form, with arbitrary offsets
-//! (`a0 b0 d0 α0 β0`, `a1 d1`, `a2 d2`, `a3 d3`, `d5`, θ offsets, tool):
-//!
-//! - **Spherical wrist** (YS100, HH800 open chain, KUKA/ABB/Fanuc-like):
-//!   axes 2 ∥ 3 (α2 = 0), axes 4, 5, 6 meet at the wrist centre
-//!   (`a4 = d4 = a5 = 0`, α4, α5 ≠ 0). The wrist centre `W = p − d5·z` lies at a
-//!   fixed offset `c_n = d1 + d2 + d3·cos α3` along the arm-plane normal
-//!   `n = Rz(θ0)·Rx(α1)·e_z`, which gives θ0 (two shoulder solutions); a planar
-//!   2R problem in link 1's frame gives θ1, θ2 (two elbow solutions); the wrist
-//!   rotation `Rz(θ3)·Rx(α4)·Rz(θ4)·Rx(α5)·Rz(θ5)` gives θ3, θ4, θ5 (two wrist
-//!   solutions) for any α4, α5.
-//! - **Three parallel axes** (UR-style: axes 2 ∥ 3 ∥ 4, `a5 = 0`): the point
-//!   `O4 = p − d5·z` has the fixed normal offset `d1 + d2 + d3 + d4·cos α4`, giving
-//!   θ0; `n·z5` gives θ4; `n` seen from the flange gives θ5; then frame 3 is
-//!   known and a planar 2R problem gives θ1, θ2 and θ3 (the UR closed form,
-//!   generalised to modified DH with offsets).
-//!
-//! Closed loop (HH800): the open chain is solved with the passive angle θ3p as
-//! the joint, then the crank motor angle is recovered from the loop closure
-//! (circle intersection, checked and polished against `solve_loop`).
-//!
-//! Hayati β ≠ 0, 7-joint arms and other geometries are not supported here
-//! (`AnalyticError::Unsupported`). A model that is only slightly off a solvable
-//! structure (a calibrated model used as the nominal one) can be seeded from
-//! its [`closed_form_proxy`]; otherwise the solver seeds numerically.
-//!
-//! Configuration flags: see `ik::config`. At a singularity (wrist: joint 5 at
-//! 0/π; shoulder: wrist point on axis 1) the free angle is taken from the hint.
-//!
-//! Length: the three closed forms (spherical wrist, three parallel axes, the
-//! HH800 loop) share the frame, branch, reach and limit helpers in one file,
-//! so the branch conventions are written once.
+//! Structures solved: spherical wrist (YS100, HH800's open chain, KUKA/ABB/
+//! Fanuc-like) and three parallel axes (UR), with arbitrary offsets; the HH800's
+//! loop recovers the crank angle from the passive one (eqs. 4.10–4.14). Hayati
+//! β ≠ 0 and 7-joint arms are `AnalyticError::Unsupported`; a model slightly
+//! off a solvable structure is seeded from its [`closed_form_proxy`]. The
+//! derivations: docs/design.md "Closed-form inverse kinematics".
 
 use super::config::{Configuration, Elbow, Shoulder, Wrist};
 use crate::kinematics::chain::sin_cos;
@@ -832,108 +804,4 @@ fn motor_from_passive(driver: f64, passive: f64, g: &LoopGeom) -> Option<f64> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::kinematics::fk;
-    use crate::model::preset;
-
-    #[test]
-    fn structures_are_detected() {
-        assert_eq!(
-            AnalyticIk::new(&preset("ys100").unwrap())
-                .unwrap()
-                .structure(),
-            Structure::SphericalWrist
-        );
-        assert_eq!(
-            AnalyticIk::new(&preset("hh800").unwrap())
-                .unwrap()
-                .structure(),
-            Structure::SphericalWrist
-        );
-        assert_eq!(
-            AnalyticIk::new(&preset("ur5").unwrap())
-                .unwrap()
-                .structure(),
-            Structure::ThreeParallel
-        );
-        let mut m = preset("ys100").unwrap();
-        m.links[4].a = 0.01;
-        assert!(AnalyticIk::new(&m).is_err());
-    }
-
-    #[test]
-    fn wrap_and_round_turns_match_the_library_functions() {
-        let reference = |x: f64| {
-            let y = x.rem_euclid(TAU);
-            if y > PI {
-                y - TAU
-            } else {
-                y
-            }
-        };
-        let mut xs = vec![
-            0.0,
-            -0.0,
-            PI,
-            -PI,
-            TAU,
-            -TAU,
-            3.0 * PI,
-            -3.0 * PI,
-            0.5,
-            -0.5,
-            1.5,
-            -2.5,
-        ];
-        xs.extend((0..20_000).map(|k| (k as f64 - 10_000.0) * 0.0123));
-        xs.extend([1e3, -1e3 - 0.25, 4.4e15 + 0.5, 1e17, -1e17]);
-        for x in xs {
-            let (a, b) = (wrap(x), reference(x));
-            assert!(a > -PI && a <= PI, "wrap({x}) = {a}");
-            // The same angle up to rounding, and the same representative.
-            assert!(
-                (a - b).abs() <= 1e-12 * x.abs().max(1.0),
-                "wrap({x}) = {a}, fmod gives {b}"
-            );
-            assert_eq!(round_turns(x), x.round(), "round_turns({x})");
-        }
-        assert!(wrap(f64::INFINITY).is_nan() && wrap(f64::NAN).is_nan());
-        assert!(round_turns(f64::NAN).is_nan());
-        assert_eq!(round_turns(0.49999999999999994), 0.0);
-        assert_eq!(round_turns(-0.5), -1.0);
-        assert_eq!(round_turns(2.5), 3.0);
-    }
-
-    #[test]
-    fn wrap_into_prefers_limits_then_reference() {
-        assert_eq!(wrap_into(3.0, [-PI, PI], 0.0), (3.0, true));
-        let (v, ok) = wrap_into(3.0, [-2.0 * TAU, 2.0 * TAU], -3.0);
-        assert!(ok && (v - (3.0 - TAU)).abs() < 1e-12);
-        let (_, ok) = wrap_into(3.0, [-1.0, 1.0], 0.0);
-        assert!(!ok);
-    }
-
-    #[test]
-    fn every_branch_maps_back_on_the_presets() {
-        for name in ["ys100", "hh800", "ur10"] {
-            let m = preset(name).unwrap();
-            let ik = AnalyticIk::new(&m).unwrap();
-            let q = [0.3, 1.45, 0.2, 0.4, 0.7, -0.6];
-            let t = fk(&m, &q).unwrap();
-            let sols = ik.solve(&t, None);
-            assert!(sols.len() >= 2, "{name}: {}", sols.len());
-            let mut found = false;
-            for s in &sols {
-                let p = fk(&m, &s.q).unwrap();
-                assert!((p.p - t.p).norm() < 1e-9, "{name} {:?}", s.configuration);
-                assert!((p.r - t.r).norm() < 1e-9, "{name}");
-                assert_eq!(ik.configuration(&s.q), Some(s.configuration), "{name}");
-                if s.q.iter().zip(&q).all(|(a, b)| wrap(a - b).abs() < 1e-7) {
-                    found = true;
-                }
-            }
-            assert!(found, "{name}: original branch missing");
-        }
-    }
-}
+mod tests;

@@ -1,5 +1,5 @@
 //! Inverse kinematics on the calibrated, compensated model, and false targets
-//! (DESIGN "Compensated model and false targets").
+//! (docs/design.md "Compensated model and false targets").
 //!
 //! - [`analytic`]: closed-form IK of the nominal model (spherical wrist and
 //!   UR-style three parallel axes), all branches with configuration flags: the seed.

@@ -1,80 +1,21 @@
 //! Calibrated inverse kinematics: damped Newton (Levenberg–Marquardt) on the
 //! compensated model's prediction, seeded by the nominal closed form.
 //!
-//! Solves `P_base(q) = target` where `P_base` is `CompensatedModel::predict_base`
+//! Solves `P_base(q) = target`, `P_base` being `CompensatedModel::predict_base`
 //! (calibrated geometry at the deflected joints `q + c∘τ(q)`, plus the
-//! compensator residual). Frames: the target is given in the measurement (cell)
-//! frame or the registered base frame (`TargetFrame`), and converted to the
-//! registered base frame. Units: SI inside (m, rad); residuals are reported in
-//! mm and rad.
-//!
-//! Error vector (base frame): `e = [p* − p(q); L·log(R*·R(q)ᵀ)]`, with `L` the
-//! orientation length of `IkSettings` (1 m). Step: `Δq = J_wᵀ (J_w J_wᵀ + λ² I)⁻¹ e`
-//! with `J_w` the weighted quasi-Newton Jacobian (geometric Jacobian of the
-//! calibrated chain at the deflected joints plus the compensator's `∂NN/∂q`,
-//! taken at the start of each damped Newton run and kept for its trial steps
-//! (a chord: it is about 1e-4 of the chain's); `∂τ/∂q` is neglected, which
-//! leaves a linear convergence factor of about `‖c·∂τ/∂q‖` ≈ 1e-3–1e-2). The same formula gives the minimum-norm step for
-//! position-only targets (3 rows). The damping `μ = λ²` follows the gain ratio
-//! of each step (Nielsen's rule); a step that does not lower `‖e‖²` is
-//! discarded and μ grows, so steps stay damped near singularities (wrist:
-//! joint 5 at 0; stretched elbow; wrist point on axis 1). Steps are capped to
-//! `max_step_rad` and projected onto the joint limits (after trying the 2π
-//! equivalent for joints with a range of 2π or more).
-//!
-//! Seeds: the closed-form branches of the nominal model (or of its closed-form
-//! proxy, `analytic::closed_form_proxy`) for the target in the base frame,
-//! ordered by the requested branch, by the distance to
-//! a joint seed, or (default) by the distance to the middle of the joint ranges,
-//! within-limit branches first. Each branch seed is first *corrected*: the
-//! closed form is re-solved in the same branch for `T·P(q)⁻¹·FK_nom(q)` (the
-//! target moved by the calibrated model's deviation at the seed), which removes
-//! most of the nominal/calibrated difference exactly, including near
-//! singularities where it maps to large joint changes; then damped Newton runs
-//! from the corrected seed, and from the plain one if that fails. A seed whose
-//! corrected target lies outside its branch's nominal workspace (the branch
-//! most likely cannot reach it: a damped Newton run there stalls for tens of
-//! evaluations at the boundary) waits until the other seeds have been tried.
-//! A last long run starts from the best attempt when it ended within 1 cm.
-//! Targets without
-//! a closed-form branch within the reach margin, position-only targets and
-//! models without a closed form use a deterministic multi-start (the joint seed,
-//! the middle of the ranges, then Halton points within the limits).
-//!
-//! Reach test (targets with an orientation): the closed form gives the signed
-//! distance `e` of the target's wrist point outside the nominal workspace
-//! (`AnalyticIk::reach_excess`). With `m` the reach margin
-//! (`IkSolver::reach_margin_m`, twice the sampled calibrated-vs-nominal
-//! wrist-point deviation plus 5 mm): `e > m` fails at once (no evaluation);
-//! `e > −m` (near the boundary, either side) runs the corrected test (for
-//! `e > 0` before any seed; for `e ≤ 0` only once the seeds whose branches
-//! reach the target have failed, since a converged solution proves reach) — the
-//! target moved by the calibrated model's deviation at each closed-form
-//! branch within the margin, re-solved up to 4 times (one evaluation each)
-//! until one branch reaches it — and a corrected excess above 0.1 mm fails as
-//! unreachable. Cruder, for every target: beyond the sum of link lengths and
-//! offsets plus the tool.
-//!
-//! Failure reasons: `InvalidTarget` (non-finite values, non-rotation, bad
-//! seed); `Unreachable` (the reach test, or beyond the nominal or corrected
-//! workspace and no calibrated solution found, or no closed-form branch even
-//! with the margin); with a required branch (`SolveOptions::branch`, or path
-//! mode's kept branch) every other failure is `BranchUnavailable`, naming the
-//! branch (exists only outside the limits, stalled on a limit or at a
-//! singular configuration, converged only into other branches), with the
-//! branches that do reach the target; without one, `OutOfLimits` (branches
-//! exist but only outside the limits, or the iteration stalled on a limit),
-//! `Singular` (stalled inside the workspace where the weighted Jacobian's
-//! smallest singular value is below `singular_threshold`), `DidNotConverge`
-//! otherwise. A required branch is never replaced by another.
+//! compensator's residual). Frames: the target is given in the measurement
+//! (cell) frame or the registered base frame (`TargetFrame`) and converted to
+//! the registered base frame. Units: SI inside (m, rad); residuals are reported
+//! in mm and rad. Error `e = [p* − p(q); L·log(R*·R(q)ᵀ)]`, step
+//! `Δq = J_wᵀ(J_w J_wᵀ + λ²I)⁻¹e` with Nielsen's damping; the seeds, the reach
+//! test and the failure reasons are explained in docs/design.md "Inverse
+//! kinematics".
 //!
 //! Layout: this file holds the settings, the result types and the per-target
 //! strategy (`solve_base`); the seeds, the reach test and the damped Newton
-//! iteration are in `solver/seeds.rs`, `solver/reach.rs` and `solver/newton.rs`. The
-//! model evaluation (pose and Jacobian of the compensated model in one pass) is
-//! `solver/eval.rs`. Length: the per-target strategy reads as one sequence
-//! (reach, branches, seeds, refinement, the failure reason) and about 250
-//! lines are its settings and result types with their documentation.
+//! iteration are in `solver/seeds.rs`, `solver/reach.rs` and
+//! `solver/newton.rs`; the model evaluation (pose and Jacobian of the
+//! compensated model in one pass) is `solver/eval.rs`.
 
 use super::analytic::{closed_form_proxy, AnalyticIk, AnalyticSolution};
 use super::config::Configuration;

@@ -1,4 +1,5 @@
-//! The measurement CSV format (DESIGN "Measurement CSV"); see [`parse`] and [`write`].
+//! The measurement CSV format (docs/design.md "Measurement CSV"): [`parse`]
+//! and [`write`].
 //!
 //! Canonical layout (what [`write`] produces):
 //!
@@ -8,53 +9,16 @@
 //! 10,95,-20,0,30,0,1523.2,12.5,980.1,,,,110,21.5,identification
 //! ```
 //!
-//! - `q1..qN`: controller joint readings [deg], N = 2..7, contiguous.
-//! - `x, y, z`: measured TCP position in the measurement (tracker) frame [mm].
-//! - `rx, ry, rz` (optional, all three or none): measured orientation as fixed-axis
-//!   XYZ angles in DEGREES, `R = Rz(rz)·Ry(ry)·Rx(rx)` — not a rotation vector
-//!   (a UR controller's `rx, ry, rz`). The explicit names `rx_deg, ry_deg,
-//!   rz_deg` are accepted for the same columns and say so in the file.
-//! - `session` (optional): a tracker-session label per row (e.g. `A`, `B`);
-//!   rows with different labels get their own frame registration.
-//! - `payload_kg`, `temperature_c`, `set` (optional). `set` is `identification`,
-//!   `training` or `validation` (also `q1`, `q2`, `q3`).
-//!
-//! Columns are found by name (case-insensitive, any order). In optional columns an
-//! empty field means "not given" for that row (the orientation needs all three
-//! fields or none). Unknown and duplicate columns are rejected.
-//!
-//! **Real-data layout** (`data/ur5-wam-laser-tracker`): `step_order`,
-//! `x_t,y_t,z_t` (nominal target [mm]), `x_dif,y_dif,z_dif` [mm] and
-//! `joint_1..joint_N` [deg]. The sign of `dif` is not documented by the data's
-//! authors; the working assumption (it fits gravity sag) is
-//! `measured = x_t + dif` ([`DifSign::Plus`], what [`parse`] uses);
-//! [`parse_with`] with [`DifSign::Minus`] flips it. `step_order` is accepted and
-//! ignored; `joint_i` is an alias of `qi`.
-//!
-//! Unit sanity checks (the file is rejected, naming the line/column):
-//! - a joint reading with |q| > 720° "looks like wrong units" (encoder counts,
-//!   millidegrees, …);
-//! - every position coordinate of the whole file within ±5 "looks like metres,
-//!   expected millimetres";
-//! - a position coordinate beyond ±100 m, or a `payload_kg` outside
-//!   0..10,000 kg, is rejected naming line and column.
-//!
-//! Fields may be separated by `,`, `;` or tabs, and with `;` or tabs numbers may
-//! use a decimal comma (`1523,2`), as tracker software in many locales writes
-//! them; both are detected from the text or declared ([`ReadOptions::dialect`],
-//! see `csv_text`). Quoted fields are read as CSV quotes them.
-//!
-//! A file in metres or radians is read with [`ReadOptions::metres`] /
-//! [`ReadOptions::radians`]: its positions and angles are converted to mm and
-//! degrees before the checks above.
-//!
-//! Radians given as degrees cannot be told apart from a small-angle degree file
-//! reliably, so that case is not checked. Values in messages are short
-//! (scientific notation for large magnitudes, long fields cut).
-//!
-//! Length: one file for the reader and the writer of the format, so the column
-//! rules, the unit checks and the round trip stay side by side; the tests are
-//! in `csv/tests.rs`.
+//! Units: `q1..qN` controller joint readings [deg] (N = 2..7), `x, y, z` the
+//! TCP position in the measurement (tracker) frame [mm], optional `rx, ry, rz`
+//! fixed-axis XYZ angles in degrees, `R = Rz(rz)·Ry(ry)·Rx(rx)` (not a
+//! rotation vector). Optional `session`, `payload_kg`, `temperature_c`, `set`
+//! (`identification`, `training`, `validation`). Columns are found by name;
+//! unit checks reject what looks like wrong units, naming line and column.
+//! The real data's layout (`x_t`, `x_dif`, `joint_i`) reads as
+//! `measured = x_t + dif` ([`DifSign::Plus`]); [`parse_with`] flips it.
+//! [`ReadOptions`] declares the dialect (`;`/tab, decimal comma), metres or
+//! radians. The tests are in `csv/tests.rs`.
 
 use super::{MeasuredPose, SetRole};
 use crate::csv_text::{self, short_text, Dialect, TextError};

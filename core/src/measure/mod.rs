@@ -16,7 +16,7 @@ use serde::{Deserialize, Serialize};
 
 pub mod csv;
 
-/// Role of a measurement in the calibration (DESIGN "Data roles").
+/// Role of a measurement in the calibration (docs/design.md "Data roles").
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SetRole {

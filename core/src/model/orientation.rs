@@ -1,43 +1,18 @@
 //! Orientation conventions used by robot controllers, and conversion to and
-//! from rotation matrices.
-//!
-//! Conventions at this boundary (read carefully, they are easy to get wrong):
+//! from rotation matrices (the table: docs/design.md "Units and conventions").
 //!
 //! * **Angles are in DEGREES** in every `values` slice accepted or returned by
-//!   [`rotation_from`] / [`rotation_to`]. Only [`rotation_angle_between`]
-//!   returns radians (it is an internal error metric, not a controller value).
+//!   [`rotation_from`] / [`rotation_to`]; only [`rotation_angle_between`]
+//!   returns radians (an internal error metric), and `ur_rotvec` is a rotation
+//!   vector in RADIANS, as UR controllers write `p[x, y, z, rx, ry, rz]`.
 //! * A rotation matrix `R` maps **tool-frame vectors into the base/cell
-//!   frame**: `v_base = R * v_tool`. Its columns are the tool x, y and z axes
-//!   expressed in the base frame.
-//! * Quaternions are **Hamilton** quaternions ordered **(w, x, y, z)**
-//!   (scalar first, as on ABB controllers) and must be unit length.
-//!   Quaternions returned by this module always have `w >= 0`.
-//! * KUKA `A, B, C`: `R = Rz(A) · Ry(B) · Rx(C)` (C about x is applied first
-//!   to a tool vector, then B about y, then A about z).
-//! * Fanuc `W, P, R`: fixed-axis XYZ, `R = Rz(R) · Ry(P) · Rx(W)`, i.e. W is
-//!   about x and applied first. Numerically the same matrix as KUKA with
-//!   `A = R`, `B = P`, `C = W`.
-//! * Matrix: nine values in **row-major** order `r11 r12 r13 r21 ... r33`.
-//! * UR rotation vector (`ur_rotvec`, columns `ur_rx_rad, ur_ry_rad,
-//!   ur_rz_rad`): axis · angle in **RADIANS**, as Universal Robots controllers
-//!   write `p[x, y, z, rx, ry, rz]` — the one exception to "degrees", stated in
-//!   its name and column names. Returned with angle ≤ π.
-//! * ABB `q1..q4` (`abb_q1q4`, columns `q1, q2, q3, q4`): the same unit
-//!   quaternion as `quaternion`, with ABB's naming: `q1` is the scalar part.
-//!
-//! | name | values | rotation |
-//! |---|---|---|
-//! | `quaternion` | `qw, qx, qy, qz` | Hamilton, scalar first |
-//! | `abb_q1q4` | `q1, q2, q3, q4` | Hamilton, `q1` scalar |
-//! | `kuka_abc` | `a, b, c` [deg] | `Rz(A)·Ry(B)·Rx(C)` |
-//! | `fanuc_wpr` | `w, p, r` [deg] | `Rz(R)·Ry(P)·Rx(W)` |
-//! | `ur_rotvec` | `ur_rx_rad, ur_ry_rad, ur_rz_rad` [rad] | `exp([r]×)`, angle `|r|` about `r/|r|` |
-//! | `matrix` | `r11 … r33` | row-major |
-//!
-//! Euler angles returned by [`rotation_to`] lie in `(-180, 180]`, with the
-//! middle angle (B or P) in `[-90, 90]`. At gimbal lock (B or P = ±90°) the
-//! first/last split is arbitrary; this module then reports `C = 0` (KUKA) or
-//! `W = 0` (Fanuc) and puts the whole rotation about the vertical into A / R.
+//!   frame**, `v_base = R * v_tool`; `matrix` values are row-major.
+//! * Quaternions are **Hamilton**, ordered **(w, x, y, z)** (ABB; `abb_q1q4`
+//!   names the scalar `q1`), unit length; returned ones have `w >= 0`.
+//! * KUKA `A, B, C`: `R = Rz(A)·Ry(B)·Rx(C)`. Fanuc `W, P, R`: fixed-axis XYZ,
+//!   `R = Rz(R)·Ry(P)·Rx(W)` — the same matrix as KUKA with A = R, B = P, C = W.
+//! * Returned Euler angles lie in `(-180, 180]`, the middle one in `[-90, 90]`;
+//!   at gimbal lock C = 0 (KUKA) or W = 0 (Fanuc).
 
 use std::fmt;
 use std::str::FromStr;

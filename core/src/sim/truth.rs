@@ -12,7 +12,7 @@
 //! 6. tracker noise `N(0, noise_mm)` on each axis (§7.4: σ = 0.01 mm).
 //!
 //! Units: m and rad inside; the produced rows carry controller joint readings [deg]
-//! and positions [mm] (DESIGN "Units and conventions").
+//! and positions [mm] (docs/design.md "Units and conventions").
 
 use super::SimError;
 use crate::kinematics::{chain, fk, gravity_torques_of, KinematicsError};

@@ -1,5 +1,5 @@
 //! The solver's evaluation of the compensated model (the prediction
-//! `P_base(q) = FK_cal(q + c∘τ(q)) + NN(q, τ)` of `CompensatedModel`, DESIGN
+//! `P_base(q) = FK_cal(q + c∘τ(q)) + NN(q, τ)` of `CompensatedModel`, docs/design.md
 //! "Compensated model and false targets", seed eq. 2.1), with the model's
 //! constants computed once ([`PreparedChain`]) and every per-call buffer on
 //! the stack for up to `STACK_DOF` joints.
