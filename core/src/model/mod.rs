@@ -2,6 +2,7 @@
 //! the JSON description.
 
 pub mod description;
+pub mod joint_maps;
 pub mod orientation;
 pub mod params;
 pub mod pose;
@@ -9,6 +10,7 @@ pub mod presets;
 pub mod robot;
 
 pub use description::{ModelDescription, ModelError};
+pub use joint_maps::{Coverage, JointMap, JointMapError, JointMaps};
 pub use params::{ParamId, ParamKind, ParamLayout};
 pub use pose::Pose;
 pub use presets::preset;

@@ -1,0 +1,317 @@
+//! Per-joint angle error maps (beyond the seed): the angle error of joint i as
+//! a fine function of its own angle, `Δθ_i = f_i(q_i)` (transmission and
+//! encoder errors), added to the joint before forward kinematics:
+//! `p = FK(q + c∘τ(q) + f(q))` (docs/design.md "Joint angle error maps").
+//!
+//! `f_i(q) = s_i(q)·Σ_k (a_ik·cos(k·q) + b_ik·sin(k·q))`: a Fourier series of
+//! period 2π, confined to the range `[lo, hi]` the training poses covered by
+//! the fade `s_i`, 1 inside the range, falling to 0 over `fade` outside it
+//! along a C¹ smoothstep, so the map never extrapolates and the IK sees a
+//! continuous derivative. Units: q, f and the range in rad, coefficients in
+//! rad; model-convention joints (commanded, before deflection).
+
+use serde::{Deserialize, Serialize};
+
+/// One joint's angle error map.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct JointMap {
+    /// Cosine coefficients `a_k`, k = 1..=K [rad].
+    pub cos: Vec<f64>,
+    /// Sine coefficients `b_k`, k = 1..=K [rad].
+    pub sin: Vec<f64>,
+    /// Joint range covered by the training poses `[lo, hi]` [rad].
+    pub range: [f64; 2],
+    /// Width of the fade to zero outside the range [rad].
+    pub fade: f64,
+}
+
+/// Where a joint angle lies with respect to its map's trained range.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Coverage {
+    /// Inside the range: the map applies fully.
+    Inside,
+    /// In the fade band: the map applies partly.
+    Faded,
+    /// Beyond the fade band: the map does not apply.
+    Outside,
+}
+
+/// `s(x) = 3x² − 2x³` on [0, 1] and its derivative: C¹ at both ends.
+fn smoothstep(x: f64) -> (f64, f64) {
+    if x <= 0.0 {
+        (0.0, 0.0)
+    } else if x >= 1.0 {
+        (1.0, 0.0)
+    } else {
+        (x * x * (3.0 - 2.0 * x), 6.0 * x * (1.0 - x))
+    }
+}
+
+impl JointMap {
+    /// A map with all coefficients zero over `range`.
+    pub fn zero(harmonics: usize, range: [f64; 2], fade: f64) -> Self {
+        JointMap {
+            cos: vec![0.0; harmonics],
+            sin: vec![0.0; harmonics],
+            range,
+            fade,
+        }
+    }
+
+    /// Number of harmonics K.
+    pub fn harmonics(&self) -> usize {
+        self.cos.len()
+    }
+
+    /// The fade weight `s(q)` and `ds/dq`: 1 inside the range, a smoothstep to
+    /// 0 over `fade` on either side.
+    pub fn weight(&self, q: f64) -> (f64, f64) {
+        let [lo, hi] = self.range;
+        let w = self.fade.max(1e-12);
+        if q < lo {
+            let (s, ds) = smoothstep(1.0 - (lo - q) / w);
+            (s, ds / w)
+        } else if q > hi {
+            let (s, ds) = smoothstep(1.0 - (q - hi) / w);
+            (s, -ds / w)
+        } else {
+            (1.0, 0.0)
+        }
+    }
+
+    /// Where `q` lies with respect to the trained range.
+    pub fn coverage(&self, q: f64) -> Coverage {
+        match self.weight(q).0 {
+            s if s >= 1.0 => Coverage::Inside,
+            s if s > 0.0 => Coverage::Faded,
+            _ => Coverage::Outside,
+        }
+    }
+
+    /// The unfaded series `g(q) = Σ a_k cos kq + b_k sin kq` and `dg/dq`, by
+    /// the angle-addition recurrence (one sine and cosine per call).
+    fn series(&self, q: f64) -> (f64, f64) {
+        let (s1, c1) = q.sin_cos();
+        let (mut sk, mut ck) = (s1, c1);
+        let (mut g, mut dg) = (0.0, 0.0);
+        for (k, (a, b)) in self.cos.iter().zip(&self.sin).enumerate() {
+            let kf = (k + 1) as f64;
+            g += a * ck + b * sk;
+            dg += kf * (b * ck - a * sk);
+            let next_s = sk * c1 + ck * s1;
+            ck = ck * c1 - sk * s1;
+            sk = next_s;
+        }
+        (g, dg)
+    }
+
+    /// `f(q)` [rad] and `df/dq`.
+    pub fn value_and_derivative(&self, q: f64) -> (f64, f64) {
+        let (s, ds) = self.weight(q);
+        if s == 0.0 {
+            return (0.0, 0.0);
+        }
+        let (g, dg) = self.series(q);
+        (s * g, s * dg + ds * g)
+    }
+
+    /// `f(q)` [rad].
+    pub fn value(&self, q: f64) -> f64 {
+        self.value_and_derivative(q).0
+    }
+
+    /// The basis of the series at `q` (unfaded): `[cos q … cos Kq, sin q … sin Kq]`,
+    /// the columns a linear fit of the coefficients uses.
+    pub fn basis(harmonics: usize, q: f64, out: &mut [f64]) {
+        let (s1, c1) = q.sin_cos();
+        let (mut sk, mut ck) = (s1, c1);
+        for k in 0..harmonics {
+            out[k] = ck;
+            out[harmonics + k] = sk;
+            let next_s = sk * c1 + ck * s1;
+            ck = ck * c1 - sk * s1;
+            sk = next_s;
+        }
+    }
+
+    /// Largest |f| over the range, sampled every 0.1° [rad].
+    pub fn amplitude(&self) -> f64 {
+        let [lo, hi] = self.range;
+        let n = (((hi - lo) / 0.1f64.to_radians()).ceil() as usize).max(1);
+        (0..=n)
+            .map(|i| self.series(lo + (hi - lo) * i as f64 / n as f64).0.abs())
+            .fold(0.0, f64::max)
+    }
+
+    /// Checks sizes, finiteness and the range.
+    pub fn validate(&self) -> Result<(), JointMapError> {
+        if self.cos.len() != self.sin.len() {
+            return Err(JointMapError::Shape {
+                cos: self.cos.len(),
+                sin: self.sin.len(),
+            });
+        }
+        let finite = self.cos.iter().chain(&self.sin).all(|v| v.is_finite());
+        let [lo, hi] = self.range;
+        if !finite || !lo.is_finite() || !hi.is_finite() || !self.fade.is_finite() {
+            return Err(JointMapError::NotFinite);
+        }
+        if lo > hi || self.fade < 0.0 {
+            return Err(JointMapError::Range {
+                lo,
+                hi,
+                fade: self.fade,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Why a stored joint map is refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum JointMapError {
+    #[error("joint map: {cos} cosine but {sin} sine coefficients")]
+    Shape { cos: usize, sin: usize },
+    #[error("joint map: a coefficient or the range is not finite")]
+    NotFinite,
+    #[error("joint map: range [{lo}, {hi}] rad with fade {fade} rad is not a range")]
+    Range { lo: f64, hi: f64, fade: f64 },
+    #[error("joint maps: {maps} maps for a robot with {dof} joints")]
+    Count { maps: usize, dof: usize },
+}
+
+/// The maps of every joint (`None`: that joint has no map).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct JointMaps {
+    pub joints: Vec<Option<JointMap>>,
+}
+
+impl JointMaps {
+    /// Adds `f(q)` to `q_out` and writes `1 + f_i'(q_i)` into `dq_scale`
+    /// (the chain rule factor of joint i's Jacobian column).
+    pub fn apply(&self, q: &[f64], q_out: &mut [f64], dq_scale: &mut [f64]) {
+        for (i, m) in self.joints.iter().enumerate() {
+            match m {
+                Some(m) => {
+                    let (f, df) = m.value_and_derivative(q[i]);
+                    q_out[i] += f;
+                    dq_scale[i] = 1.0 + df;
+                }
+                None => dq_scale[i] = 1.0,
+            }
+        }
+    }
+
+    /// Per joint, where `q` lies with respect to its map (`None`: no map).
+    pub fn coverage(&self, q: &[f64]) -> Vec<Option<Coverage>> {
+        self.joints
+            .iter()
+            .zip(q)
+            .map(|(m, q)| m.as_ref().map(|m| m.coverage(*q)))
+            .collect()
+    }
+
+    /// Checks every map and their count against the robot's joints.
+    pub fn validate(&self, dof: usize) -> Result<(), JointMapError> {
+        if self.joints.len() != dof {
+            return Err(JointMapError::Count {
+                maps: self.joints.len(),
+                dof,
+            });
+        }
+        self.joints
+            .iter()
+            .flatten()
+            .try_for_each(JointMap::validate)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample_map() -> JointMap {
+        let k = 12;
+        JointMap {
+            cos: (0..k).map(|i| 1e-4 * ((i as f64) * 0.7).sin()).collect(),
+            sin: (0..k).map(|i| 8e-5 * ((i as f64) * 1.3).cos()).collect(),
+            range: [-0.4, 1.1],
+            fade: 0.1,
+        }
+    }
+
+    /// The recurrence gives the closed-form series.
+    #[test]
+    fn series_matches_the_direct_sum() {
+        let m = sample_map();
+        for q in [-0.3, 0.0, 0.4, 1.05] {
+            let direct: f64 = (0..m.harmonics())
+                .map(|k| {
+                    let kq = (k + 1) as f64 * q;
+                    m.cos[k] * kq.cos() + m.sin[k] * kq.sin()
+                })
+                .sum();
+            assert!((m.value(q) - direct).abs() < 1e-15, "{q}");
+            let mut b = vec![0.0; 2 * m.harmonics()];
+            JointMap::basis(m.harmonics(), q, &mut b);
+            let via_basis: f64 = b
+                .iter()
+                .zip(m.cos.iter().chain(&m.sin))
+                .map(|(x, c)| x * c)
+                .sum();
+            assert!((via_basis - direct).abs() < 1e-15);
+        }
+    }
+
+    /// The derivative agrees with central differences inside, in the fade
+    /// bands and outside.
+    #[test]
+    fn derivative_matches_finite_differences() {
+        let m = sample_map();
+        let h = 1e-6;
+        for q in [-0.6, -0.47, -0.41, 0.3, 1.12, 1.17, 1.4] {
+            let (_, d) = m.value_and_derivative(q);
+            let fd = (m.value(q + h) - m.value(q - h)) / (2.0 * h);
+            assert!((d - fd).abs() < 1e-9 * (1.0 + fd.abs()), "{q}: {d} vs {fd}");
+        }
+    }
+
+    /// The map is continuous with a continuous derivative at the four ends of
+    /// the fade bands, and zero beyond them.
+    #[test]
+    fn fade_is_c1_and_ends_at_zero() {
+        let m = sample_map();
+        let e = 1e-9;
+        for edge in [-0.5, -0.4, 1.1, 1.2] {
+            let (a, da) = m.value_and_derivative(edge - e);
+            let (b, db) = m.value_and_derivative(edge + e);
+            assert!((a - b).abs() < 1e-11, "value jumps at {edge}");
+            assert!(
+                (da - db).abs() < 1e-6,
+                "derivative jumps at {edge}: {da} {db}"
+            );
+        }
+        assert_eq!(m.value_and_derivative(-0.51), (0.0, 0.0));
+        assert_eq!(m.value_and_derivative(1.3), (0.0, 0.0));
+        assert_eq!(m.coverage(0.0), Coverage::Inside);
+        assert_eq!(m.coverage(1.15), Coverage::Faded);
+        assert_eq!(m.coverage(1.3), Coverage::Outside);
+    }
+
+    #[test]
+    fn apply_adds_the_error_and_the_chain_rule_factor() {
+        let maps = JointMaps {
+            joints: vec![Some(sample_map()), None],
+        };
+        let q = [0.2, 0.5];
+        let mut out = q;
+        let mut scale = [0.0; 2];
+        maps.apply(&q, &mut out, &mut scale);
+        let (f, df) = sample_map().value_and_derivative(0.2);
+        assert_eq!(out, [0.2 + f, 0.5]);
+        assert_eq!(scale, [1.0 + df, 1.0]);
+        assert!(maps.validate(2).is_ok());
+        assert!(matches!(maps.validate(3), Err(JointMapError::Count { .. })));
+    }
+}
