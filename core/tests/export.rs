@@ -3,9 +3,9 @@
 //! scripts/golden/make_urdf_golden.py) reproduces robocal's geometric forward
 //! kinematics to 1e-6 mm; the command line writes every format.
 
-use robocal::cli::export::{export_to_string, ExportArgs};
-use robocal::cli::model_files::load_compensated;
-use robocal::kinematics::fk;
+use robocal_core::cli::export::{export_to_string, ExportArgs};
+use robocal_core::cli::model_files::load_compensated;
+use robocal_core::kinematics::fk;
 
 const CALIBRATED: &str = "tests/golden/ur5_km_calibrated.json";
 

@@ -15,21 +15,21 @@ use nalgebra::{Matrix3, Vector3};
 use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use robocal::cli::model_files::{load_compensated, save_model_file};
-use robocal::cli::solve::{solve_to_string, OutputFormat, SolveArgs};
-use robocal::compensate::{
+use robocal_core::cli::model_files::{load_compensated, save_model_file};
+use robocal_core::cli::solve::{solve_to_string, OutputFormat, SolveArgs};
+use robocal_core::compensate::{
     parse_compensated, synthetic_calibration, CalibratedModelFile, CompensatedModel, Compensator,
     SyntheticErrors,
 };
-use robocal::ik::{
+use robocal_core::ik::{
     AnalyticIk, Configuration, FailureReason, Goal, IkSettings, IkSolver, SolveOptions,
     TargetFrame, TargetInput,
 };
-use robocal::kinematics::fk;
-use robocal::model::orientation::{
+use robocal_core::kinematics::fk;
+use robocal_core::model::orientation::{
     rotation_angle_between, rotation_from, rotation_to, OrientationConvention,
 };
-use robocal::model::{preset, Pose, RobotModel};
+use robocal_core::model::{preset, Pose, RobotModel};
 use std::f64::consts::{PI, TAU};
 use std::fmt::Write as _;
 use std::sync::Arc;

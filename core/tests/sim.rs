@@ -8,10 +8,10 @@ use clap::Parser;
 use nalgebra::Vector3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal::kinematics::fk;
-use robocal::measure::{csv, SetRole};
-use robocal::model::{preset, RobotModel};
-use robocal::sim::{
+use robocal_core::kinematics::fk;
+use robocal_core::measure::{csv, SetRole};
+use robocal_core::model::{preset, RobotModel};
+use robocal_core::sim::{
     perturb_geometry, random_configurations, tracker_frame, ys100_table_7_1, ErrorMagnitudes,
     TrueRobot,
 };
@@ -164,8 +164,8 @@ fn temp_path(name: &str) -> std::path::PathBuf {
 fn simulate(args: &[&str]) {
     let mut argv = vec!["robocal", "simulate"];
     argv.extend_from_slice(args);
-    let cli = robocal::cli::Cli::try_parse_from(argv).unwrap();
-    robocal::cli::run(cli).unwrap();
+    let cli = robocal_core::cli::Cli::try_parse_from(argv).unwrap();
+    robocal_core::cli::run(cli).unwrap();
 }
 
 #[test]
@@ -259,8 +259,8 @@ fn simulate_cli_writes_csv_that_parses_back() {
     ] {
         let mut argv = vec!["robocal", "simulate", "--out", o];
         argv.extend(bad.iter().copied());
-        let cli = robocal::cli::Cli::try_parse_from(&argv).unwrap();
-        assert!(robocal::cli::run(cli).is_err(), "{bad:?}");
+        let cli = robocal_core::cli::Cli::try_parse_from(&argv).unwrap();
+        assert!(robocal_core::cli::run(cli).is_err(), "{bad:?}");
     }
     let _ = std::fs::remove_dir_all(out.parent().unwrap());
 }

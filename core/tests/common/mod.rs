@@ -11,14 +11,14 @@ use axum::http::{HeaderMap, Request, StatusCode};
 use axum::Router;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal::db::Db;
-use robocal::http::{app, AppState, ServiceConfig};
-use robocal::identify::{
+use robocal_core::db::Db;
+use robocal_core::http::{app, AppState, ServiceConfig};
+use robocal_core::identify::{
     calibrate, CalibrationError, CalibrationOptions, CalibrationReport, Method,
 };
-use robocal::measure::{self, csv, MeasuredPose, Measurement};
-use robocal::model::{preset, RobotModel};
-use robocal::sim::{
+use robocal_core::measure::{self, csv, MeasuredPose, Measurement};
+use robocal_core::model::{preset, RobotModel};
+use robocal_core::sim::{
     perturb_geometry, random_configurations, tracker_frame, ErrorMagnitudes, TrueRobot,
 };
 use std::path::Path;
