@@ -66,7 +66,7 @@ fn ys100_position_km_keeps_the_seeds_27_parameters() {
 /// `robocal demo ys100-simulation` (seed §7.4) meets the acceptance.
 #[test]
 fn ys100_simulation_study_reaches_the_noise_floor() {
-    let study = robocal_core::cli::demo::ys100_simulation(1, &|_| true).unwrap();
+    let study = robocal_core::study::ys100_simulation(1, &|_| true).unwrap();
     let r = &study.report;
     let (km, skcm, tlbo) = (
         val_mean(r, "km"),
@@ -163,7 +163,9 @@ fn ur5_real_data_km() {
         // Before calibration, in the base frame as recorded: ~2.57 mm.
         let before: f64 = test
             .iter()
-            .map(|m| (robocal_core::kinematics::fk(&model, &m.q).unwrap().p - m.position).norm() * 1e3)
+            .map(|m| {
+                (robocal_core::kinematics::fk(&model, &m.q).unwrap().p - m.position).norm() * 1e3
+            })
             .sum::<f64>()
             / test.len() as f64;
         assert!((before - 2.57).abs() < 0.1, "nominal error {before}");
