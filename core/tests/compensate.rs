@@ -21,7 +21,9 @@ mod common;
 use common::{measure_truth, real, shipped_model};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal_core::compensate::{unmodelled_truth, CompensatedModel, CompensatorSpec, StoredCompensator};
+use robocal_core::compensate::{
+    unmodelled_truth, CompensatedModel, CompensatorSpec, StoredCompensator,
+};
 use robocal_core::identify::{
     calibrate, calibrate_with_training, CalibrationOptions, CalibrationReport, CompensatorOptions,
     Method,

@@ -3,16 +3,14 @@
 
 mod common;
 
-use common::{
-    measure_truth, opts, real, robocal_json, run_with, shipped_model, two_tracker_sessions,
-};
+use common::{measure_truth, opts, real, run_with, shipped_model};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal_core::identify::{
     CalibrationError, CalibrationOptions, CalibrationReport, DropKind, LmSettings, Method,
     StopReason, WarningKind,
 };
-use robocal_core::measure::{self, csv, Measurement};
+use robocal_core::measure::{self, Measurement};
 use robocal_core::model::{preset, RobotModel};
 use robocal_core::sim::{perturb_geometry, random_configurations, ErrorMagnitudes, TrueRobot};
 
@@ -365,61 +363,6 @@ fn two_session_skcm_c_is_as_accurate_as_one() {
     eprintln!("SKCM-C one session {one:.4} mm, two sessions {two:.4} mm");
     assert!(one < 0.03, "one session {one} mm");
     assert!(two <= 1.15 * one, "two sessions {two} mm vs one {one} mm");
-}
-
-/// The command line takes several measurement files (one tracker session
-/// each) or one file with a `session` column, as the service takes sets with
-/// sessions; both give the same calibration.
-#[test]
-fn cli_takes_several_files_or_a_session_column() {
-    let (_, sessions) = two_tracker_sessions();
-    let dir = tempfile::tempdir().unwrap();
-    let mut combined_id = Vec::new();
-    let mut combined_va = Vec::new();
-    for (s, (id, va)) in sessions.into_iter().enumerate() {
-        std::fs::write(dir.path().join(format!("id{s}.csv")), csv::write(&id)).unwrap();
-        std::fs::write(dir.path().join(format!("va{s}.csv")), csv::write(&va)).unwrap();
-        let tag = |rows: Vec<measure::MeasuredPose>| {
-            rows.into_iter().map(move |mut r| {
-                r.session = Some(["A", "B"][s].to_string());
-                r
-            })
-        };
-        combined_id.extend(tag(id));
-        combined_va.extend(tag(va));
-    }
-    std::fs::write(dir.path().join("id.csv"), csv::write(&combined_id)).unwrap();
-    std::fs::write(dir.path().join("va.csv"), csv::write(&combined_va)).unwrap();
-    let run = |identify: &str, validate: &str| -> serde_json::Value {
-        robocal_json(
-            dir.path(),
-            &[
-                "calibrate",
-                "--model",
-                "ys100",
-                "--identify",
-                identify,
-                "--validate",
-                validate,
-                "--method",
-                "km",
-                "--json",
-            ],
-        )
-    };
-    let files = run("id0.csv,id1.csv", "va0.csv,va1.csv");
-    let column = run("id.csv", "va.csv");
-    for r in [&files, &column] {
-        assert_eq!(r["registration"].as_array().unwrap().len(), 2);
-        let v = r["methods"]["km"]["validation"]["mean_mm"]
-            .as_f64()
-            .unwrap();
-        assert!(v < 0.015, "validation mean {v}");
-    }
-    assert_eq!(
-        files["methods"]["km"]["validation"]["mean_mm"],
-        column["methods"]["km"]["validation"]["mean_mm"]
-    );
 }
 
 /// A truth with effects the model does not have (cubic springs, gear

@@ -1,18 +1,14 @@
-//! Helpers shared by the identification, regression, compensation and
-//! real-data test crates (each includes this file as `mod common;`):
-//! simulated measurements of a ground-truth robot, the real laser-tracker data
-//! (data/ur5-wam-laser-tracker in the repository, or
-//! `ROBOCAL_DATA_DIR`), the shipped model files (models/*.json) and the
-//! `robocal` binary run for its JSON, and the service in-process.
+//! Helpers shared by the core's test crates (each includes this file as
+//! `mod common;`; the root crate's tests by `#[path]`): simulated measurements
+//! of a ground-truth robot, the real laser-tracker data
+//! (data/ur5-wam-laser-tracker in the repository, or `ROBOCAL_DATA_DIR`), the
+//! shipped model files (models/*.json) and the IK tests' fixtures (`ik`).
 #![allow(dead_code)]
 
-use axum::body::Body;
-use axum::http::{HeaderMap, Request, StatusCode};
-use axum::Router;
+pub mod ik;
+
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal_core::db::Db;
-use robocal_core::http::{app, AppState, ServiceConfig};
 use robocal_core::identify::{
     calibrate, CalibrationError, CalibrationOptions, CalibrationReport, Method,
 };
@@ -21,11 +17,17 @@ use robocal_core::model::{preset, RobotModel};
 use robocal_core::sim::{
     perturb_geometry, random_configurations, tracker_frame, ErrorMagnitudes, TrueRobot,
 };
-use std::path::Path;
-use tower::ServiceExt;
+use std::path::{Path, PathBuf};
 
-/// The repository root.
-pub const ROOT: &str = env!("CARGO_MANIFEST_DIR");
+/// The repository root: the core crate's parent directory, or the root
+/// crate's own directory when one of its tests includes this file.
+pub fn root() -> PathBuf {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"));
+    match env!("CARGO_PKG_NAME") {
+        "robocal-core" => dir.parent().unwrap().to_path_buf(),
+        _ => dir.to_path_buf(),
+    }
+}
 
 /// `n` random configurations of `nominal` measured on `truth` with the
 /// model's payload, as measurements of `nominal`.
@@ -104,7 +106,7 @@ pub fn run_with(
 /// data/ur5-wam-laser-tracker in the repository.
 pub fn data(path: &str) -> String {
     let dir = std::env::var("ROBOCAL_DATA_DIR")
-        .unwrap_or_else(|_| format!("{ROOT}/data/ur5-wam-laser-tracker"));
+        .unwrap_or_else(|_| format!("{}/data/ur5-wam-laser-tracker", root().display()));
     std::fs::read_to_string(format!("{dir}/{path}"))
         .unwrap_or_else(|e| panic!("real data {dir}/{path}: {e} (set ROBOCAL_DATA_DIR)"))
 }
@@ -121,51 +123,10 @@ pub fn real_with(path: &str, sign: csv::DifSign) -> Vec<MeasuredPose> {
 
 /// The text of a shipped model file, `models/{name}.json`.
 pub fn model_text(name: &str) -> String {
-    std::fs::read_to_string(format!("{ROOT}/models/{name}.json")).unwrap()
+    std::fs::read_to_string(format!("{}/models/{name}.json", root().display())).unwrap()
 }
 
 /// A shipped model file, `models/{name}.json`, loaded.
 pub fn shipped_model(name: &str) -> RobotModel {
     RobotModel::from_json(&model_text(name)).unwrap()
-}
-
-/// Runs the `robocal` binary with `args` in `dir`, asserts it succeeded and
-/// returns its standard output as JSON.
-pub fn robocal_json(dir: &Path, args: &[&str]) -> serde_json::Value {
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_robocal"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
-}
-
-/// The service on a new SQLite file in a temporary directory: its router,
-/// its state and the directory (which must outlive them).
-pub async fn service(config: ServiceConfig) -> (Router, AppState, tempfile::TempDir) {
-    let dir = tempfile::tempdir().unwrap();
-    let url = format!(
-        "sqlite://{}?mode=rwc",
-        dir.path().join("service.db").display()
-    );
-    let db = Db::connect(&url).await.unwrap();
-    let state = AppState::new(db, config);
-    (app(state.clone()), state, dir)
-}
-
-/// Sends one request through `router` in-process: status, headers and body.
-pub async fn oneshot(router: &Router, req: Request<Body>) -> (StatusCode, HeaderMap, Vec<u8>) {
-    let res = router.clone().oneshot(req).await.unwrap();
-    let status = res.status();
-    let headers = res.headers().clone();
-    let body = axum::body::to_bytes(res.into_body(), usize::MAX)
-        .await
-        .unwrap()
-        .to_vec();
-    (status, headers, body)
 }
