@@ -1,7 +1,8 @@
-//! Inverse kinematics (issue 3): the closed form, calibrated acceptance,
-//! compensators and frames, branches, seeds, position-only and path mode,
-//! models without a closed form. False targets and failure reasons are in
-//! `ik_targets.rs`; the command line's solve in the root crate's tests.
+//! Inverse kinematics and false targets (issue 3): the closed form,
+//! calibrated acceptance, compensators and frames, branches, seeds,
+//! position-only and path mode, false and bad targets, models without a closed
+//! form. The truthful failure reasons of issue 11 are in
+//! `ik_failure_reasons.rs`; the command line's solve in the root crate's tests.
 //!
 //! The acceptance tests solve random reachable targets — the compensated
 //! prediction of random in-limit joints — on synthetic calibrated models
@@ -22,11 +23,14 @@ use robocal_core::compensate::{
     synthetic_calibration, CompensatedModel, Compensator, SyntheticErrors,
 };
 use robocal_core::ik::{
-    AnalyticIk, Configuration, FailureReason, Goal, IkSettings, IkSolver, SolveOptions, TargetFrame,
+    AnalyticIk, Configuration, FailureReason, Goal, IkSettings, IkSolver, SolveOptions,
+    TargetFrame, TargetInput,
 };
 use robocal_core::kinematics::fk;
-use robocal_core::model::orientation::rotation_angle_between;
-use robocal_core::model::{preset, RobotModel};
+use robocal_core::model::orientation::{
+    rotation_angle_between, rotation_from, rotation_to, OrientationConvention,
+};
+use robocal_core::model::{preset, Pose, RobotModel};
 use std::f64::consts::PI;
 use std::sync::Arc;
 
@@ -450,6 +454,133 @@ fn path_mode_keeps_the_branch_and_reports_jumps() {
     let jump = jump.expect("joint jump reported");
     assert_eq!(jump.joint, 6);
     assert!(jump.delta_deg.abs() > 150.0);
+}
+
+// ---------------------------------------------------------------------------
+// Boundary targets, failures and false targets
+// ---------------------------------------------------------------------------
+
+fn input(p: &Pose, conv: OrientationConvention) -> TargetInput {
+    TargetInput {
+        id: None,
+        xyz_mm: [p.p.x * 1e3, p.p.y * 1e3, p.p.z * 1e3],
+        convention: Some(conv.name().to_string()),
+        orientation: rotation_to(conv, &p.r),
+    }
+}
+
+#[test]
+fn false_targets_in_every_convention() {
+    let cm = calibrated("ys100", 10);
+    let solver = IkSolver::new(cm.clone(), IkSettings::default());
+    let q = [-0.4, 1.1, 0.2, 0.8, -0.9, 1.5];
+    let target = cm.predict(&q).unwrap();
+    for conv in OrientationConvention::ALL {
+        let r = &solver.solve_targets(&[input(&target, conv)], &SolveOptions::default())[0];
+        assert!(r.solution.converged, "{conv}");
+        let ft = r.false_target.as_ref().unwrap();
+        assert_eq!(ft.convention, conv);
+        let nominal = fk(&cm.nominal, &r.solution.q).unwrap();
+        let back = rotation_from(conv, &ft.orientation).unwrap();
+        assert!(rotation_angle_between(&back, &nominal.r) < 1e-9, "{conv}");
+        assert!((Vector3::from(ft.xyz_mm) * 1e-3 - nominal.p).norm() < 1e-12);
+        // Joint commands in the controller convention.
+        let jd = r.joints_deg.as_ref().unwrap();
+        let back: Vec<f64> = cm
+            .nominal
+            .joints_from_controller(&jd.iter().map(|v| v.to_radians()).collect::<Vec<_>>());
+        assert!(wrapped_diff(&back, &r.solution.q) < 1e-12);
+    }
+    // On an uncalibrated model the false target is the target itself.
+    let plain = IkSolver::new(
+        CompensatedModel::from_nominal(kuka_like()),
+        IkSettings::default(),
+    );
+    let q = [0.3, -1.0, 0.5, 0.3, 0.8, -0.4];
+    let model = kuka_like();
+    let t = fk(&model, &model.joints_from_controller(&q)).unwrap();
+    let r = &plain.solve_targets(
+        &[input(&t, OrientationConvention::KukaAbc)],
+        &SolveOptions::default(),
+    )[0];
+    let ft = r.false_target.as_ref().unwrap();
+    let want = rotation_to(OrientationConvention::KukaAbc, &t.r);
+    for (a, b) in ft.orientation.iter().zip(&want) {
+        assert!((a - b).abs() < 1e-7);
+    }
+    assert!((Vector3::from(ft.xyz_mm) - t.p * 1e3).norm() < 1e-6);
+}
+
+#[test]
+fn bad_targets_get_per_target_reasons_and_the_batch_goes_on() {
+    let cm = calibrated("ys100", 12);
+    let solver = IkSolver::new(cm.clone(), IkSettings::default());
+    let good = cm.predict(&[0.1, 1.3, -0.2, 0.3, 0.8, 0.1]).unwrap();
+    let quat = OrientationConvention::Quaternion;
+    let mut nan = input(&good, quat);
+    nan.xyz_mm[1] = f64::NAN;
+    let mut non_unit = input(&good, quat);
+    non_unit.orientation = vec![1.2, 0.0, 0.0, 0.0];
+    let mut unknown = input(&good, quat);
+    unknown.convention = Some("euler_zyz".into());
+    let mut count = input(&good, OrientationConvention::KukaAbc);
+    count.orientation.pop();
+    let mut far = input(&good, quat);
+    far.xyz_mm[0] += 10_000.0;
+    let mut nan_angle = input(&good, OrientationConvention::FanucWpr);
+    nan_angle.orientation[1] = f64::NAN;
+    let targets = vec![
+        input(&good, quat),
+        nan,
+        non_unit,
+        unknown,
+        count,
+        far,
+        nan_angle,
+        input(&good, OrientationConvention::Matrix),
+    ];
+    let results = solver.solve_targets(&targets, &SolveOptions::default());
+    assert_eq!(results.len(), targets.len());
+    let codes: Vec<&str> = results
+        .iter()
+        .map(|r| r.solution.reason.as_ref().map_or("ok", |x| x.code()))
+        .collect();
+    assert_eq!(
+        codes,
+        [
+            "ok",
+            "invalid_target",
+            "invalid_target",
+            "invalid_target",
+            "invalid_target",
+            "unreachable",
+            "invalid_target",
+            "ok"
+        ]
+    );
+    assert_eq!(results[3].id, "4");
+    let msg = results[2].solution.reason.as_ref().unwrap().to_string();
+    assert!(msg.contains("quaternion"), "{msg}");
+    assert!(results[1].joints_deg.is_none() && results[1].false_target.is_none());
+
+    // Reachable, but only outside the joint limits.
+    let mut narrow = cm.clone();
+    narrow.nominal.links[0].limits = [-0.2, 0.2];
+    narrow.calibrated.links[0].limits = [-0.2, 0.2];
+    let solver = IkSolver::new(narrow.clone(), IkSettings::default());
+    let target = narrow.predict(&[1.5, 1.3, -0.2, 0.3, 0.8, 0.1]).unwrap();
+    let s = solver.solve(&target, &SolveOptions::default());
+    assert_eq!(s.reason, Some(FailureReason::OutOfLimits));
+    // Reachable, but not in the requested branch within the limits.
+    let target = narrow.predict(&[0.1, 1.3, -0.2, 0.3, 0.8, 0.1]).unwrap();
+    let s = solver.solve(
+        &target,
+        &SolveOptions {
+            branch: Configuration::parse("back,up,noflip").ok(),
+            ..SolveOptions::default()
+        },
+    );
+    assert!(!s.converged && s.reason.is_some());
 }
 
 // ---------------------------------------------------------------------------
