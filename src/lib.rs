@@ -9,6 +9,7 @@
 
 pub use robocal_core::{
     compensate, csv_text, export, identify, ik, kinematics, measure, model, optim, sim, stats,
+    study,
 };
 
 pub mod cli;

@@ -3,6 +3,8 @@
 //! command line, as a new user runs them.
 
 mod common;
+#[path = "../core/tests/common/mod.rs"]
+mod core_common;
 
 use axum::body::Body;
 use axum::http::{header, Request, StatusCode};
@@ -11,7 +13,8 @@ use robocal::http::ServiceConfig;
 use serde_json::{json, Value};
 use std::time::{Duration, Instant};
 
-use common::{data, model_text, oneshot, robocal_json, service, ROOT};
+use common::{oneshot, robocal_json, service};
+use core_common::{data, model_text, root};
 
 fn model_file(name: &str) -> Value {
     serde_json::from_str(&model_text(name)).unwrap()
@@ -236,7 +239,7 @@ async fn real_wam_all_methods_over_http() {
 fn real_data_cli_commands_run_as_written() {
     let run = |model: &str, dir: &str, methods: &str| -> Value {
         robocal_json(
-            std::path::Path::new(ROOT),
+            &root(),
             &[
                 "calibrate",
                 "--model",

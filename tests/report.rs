@@ -11,7 +11,7 @@ const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 fn demo() -> &'static Value {
     static REPORT: OnceLock<Value> = OnceLock::new();
     REPORT.get_or_init(|| {
-        let study = robocal::cli::demo::ys100_simulation(1, &|_| true).unwrap();
+        let study = robocal::study::ys100_simulation(1, &|_| true).unwrap();
         serde_json::to_value(&study.report).unwrap()
     })
 }

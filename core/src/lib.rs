@@ -1,10 +1,11 @@
 //! robocal-core: the numerical core of robocal.
 //!
 //! Flow: measure (`measure`, `sim`) → calibrate (`identify`) → solve
-//! (`compensate`, `ik`). Every function takes the model and the joint values as
-//! arguments; there is no hidden mutable chain state, and nothing here touches
-//! HTTP, a database, the async runtime or the file system. `csv_text` reads the
-//! CSV texts of measurement and target files for both.
+//! (`compensate`, `ik`); `study` runs the seed's §7.4 simulation study. Every
+//! function takes the model and the joint values as arguments; there is no
+//! hidden mutable chain state, and nothing here touches HTTP, a database, the
+//! async runtime or the file system. `csv_text` reads the CSV texts of
+//! measurement and target files for both.
 
 pub mod compensate;
 pub mod csv_text;
@@ -17,3 +18,4 @@ pub mod model;
 pub mod optim;
 pub mod sim;
 pub mod stats;
+pub mod study;

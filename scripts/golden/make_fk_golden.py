@@ -10,7 +10,7 @@ Cross-checks   : (1) pybotics (MDH-only library; a standard-DH chain is
 Every sample must agree across all three to 1e-9 (mm for translation,
 unitless for rotation), otherwise the script aborts without writing.
 
-Output: tests/golden/fk_<name>.json (mm, degrees). See scripts/golden/README.md.
+Output: core/tests/golden/fk_<name>.json (mm, degrees). See scripts/golden/README.md.
 This file is a record of how the golden values were made; it is not part of
 the Rust build.
 """
@@ -215,7 +215,7 @@ def clean(x):
 
 def main():
     repo = Path(__file__).resolve().parents[2]
-    outdir = repo / "tests" / "golden"
+    outdir = repo / "core" / "tests" / "golden"
     v_rtb = version("roboticstoolbox-python")
     v_pb = version("pybotics")
     v_sm = version("spatialmath-python")

@@ -1,13 +1,13 @@
 #!/usr/bin/env python3
 """Golden forward kinematics of robocal's URDF export, from an outside implementation.
 
-Loads tests/golden/ur5_km.urdf (written by
-`robocal export --model tests/golden/ur5_km_calibrated.json --format urdf`, the UR5
+Loads core/tests/golden/ur5_km.urdf (written by
+`robocal export --model core/tests/golden/ur5_km_calibrated.json --format urdf`, the UR5
 calibrated by KM on the real laser-tracker grid) with pinocchio (PyPI package `pin`),
-and writes tests/golden/urdf_fk_ur5_km.json: 40 joint vectors (controller readings,
+and writes core/tests/golden/urdf_fk_ur5_km.json: 40 joint vectors (controller readings,
 degrees, q = 0 first, then uniform in [-170, 170] from a fixed numpy seed, rounded to
 6 decimals) with the pose of the `tcp` frame in the root link `cell` (translation in
-mm, rotation matrix). tests/export.rs compares robocal's geometric FK with it.
+mm, rotation matrix). core/tests/export.rs compares robocal's geometric FK with it.
 
 Rerun (not part of the Rust build):
 
@@ -24,8 +24,8 @@ import numpy as np
 import pinocchio as pin
 
 ROOT = Path(__file__).resolve().parents[2]
-URDF = ROOT / "tests" / "golden" / "ur5_km.urdf"
-OUT = ROOT / "tests" / "golden" / "urdf_fk_ur5_km.json"
+URDF = ROOT / "core" / "tests" / "golden" / "ur5_km.urdf"
+OUT = ROOT / "core" / "tests" / "golden" / "urdf_fk_ur5_km.json"
 SEED = 20261122
 N_RANDOM = 39
 
@@ -53,7 +53,7 @@ def main() -> None:
         )
     doc = {
         "source": "pinocchio buildModelFromUrdf + forwardKinematics + updateFramePlacements, frame `tcp` in root link `cell`",
-        "urdf": "tests/golden/ur5_km.urdf",
+        "urdf": "core/tests/golden/ur5_km.urdf",
         "versions": {"pin": version("pin"), "numpy": np.__version__},
         "samples": samples,
     }

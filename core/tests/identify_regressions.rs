@@ -3,18 +3,16 @@
 
 mod common;
 
-use common::{
-    measure_truth, opts, real, robocal_json, run_with, shipped_model, two_tracker_sessions,
-};
+use common::{measure_truth, opts, real, run_with, shipped_model};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal::identify::{
+use robocal_core::identify::{
     CalibrationError, CalibrationOptions, CalibrationReport, DropKind, LmSettings, Method,
     StopReason, WarningKind,
 };
-use robocal::measure::{self, csv, Measurement};
-use robocal::model::{preset, RobotModel};
-use robocal::sim::{perturb_geometry, random_configurations, ErrorMagnitudes, TrueRobot};
+use robocal_core::measure::{self, Measurement};
+use robocal_core::model::{preset, RobotModel};
+use robocal_core::sim::{perturb_geometry, random_configurations, ErrorMagnitudes, TrueRobot};
 
 /// A truth whose joint 3 deflects *against* its gravity torque (an effect no
 /// admissible compliance has): SKCM keeps every c ≥ 0, says c3 is held at its
@@ -188,7 +186,7 @@ fn skcm_and_payload(
     nominal: &RobotModel,
     id: &[Measurement],
     va: &[Measurement],
-) -> (f64, f64, robocal::identify::MethodReport) {
+) -> (f64, f64, robocal_core::identify::MethodReport) {
     let mut r = run_with(nominal, id, va, opts(&[Method::Skcm, Method::SkcmPayload])).unwrap();
     let v = |m: &str| r.methods[m].validation.as_ref().unwrap().stats.mean_mm;
     let (skcm, payload) = (v("skcm"), v("skcm-payload"));
@@ -198,8 +196,8 @@ fn skcm_and_payload(
 /// Validation means of SKCM and SKCM-payload, the CoM error [mm] and the
 /// SKCM-payload report, for a truth whose payload CoM is 250 mm from the
 /// model's and whose link masses are `mass_factor` times the model's.
-fn payload_case(mass_factor: f64) -> (f64, f64, f64, robocal::identify::MethodReport) {
-    use robocal::sim::tracker_frame;
+fn payload_case(mass_factor: f64) -> (f64, f64, f64, robocal_core::identify::MethodReport) {
+    use robocal_core::sim::tracker_frame;
     let nominal = preset("ys100").unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(77);
     let mut tm = table_7_2_truth(&nominal, &mut rng);
@@ -264,7 +262,7 @@ fn skcm_payload_with_link_masses_off_stays_at_the_floor() {
 /// comes back to the noise floor and finds the offset within 1 kg with its σ.
 #[test]
 fn skcm_payload_identifies_an_unknown_payload_mass() {
-    use robocal::sim::tracker_frame;
+    use robocal_core::sim::tracker_frame;
     let nominal = preset("ys100").unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(78);
     let tm = table_7_2_truth(&nominal, &mut rng);
@@ -313,8 +311,8 @@ fn skcm_payload_identifies_an_unknown_payload_mass() {
 /// every session's frame.
 #[test]
 fn two_session_skcm_c_is_as_accurate_as_one() {
-    use robocal::optim::TlboSettings;
-    use robocal::sim::tracker_frame;
+    use robocal_core::optim::TlboSettings;
+    use robocal_core::sim::tracker_frame;
     let nominal = preset("ys100").unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(41);
     let tm = table_7_2_truth(&nominal, &mut rng);
@@ -367,61 +365,6 @@ fn two_session_skcm_c_is_as_accurate_as_one() {
     assert!(two <= 1.15 * one, "two sessions {two} mm vs one {one} mm");
 }
 
-/// The command line takes several measurement files (one tracker session
-/// each) or one file with a `session` column, as the service takes sets with
-/// sessions; both give the same calibration.
-#[test]
-fn cli_takes_several_files_or_a_session_column() {
-    let (_, sessions) = two_tracker_sessions();
-    let dir = tempfile::tempdir().unwrap();
-    let mut combined_id = Vec::new();
-    let mut combined_va = Vec::new();
-    for (s, (id, va)) in sessions.into_iter().enumerate() {
-        std::fs::write(dir.path().join(format!("id{s}.csv")), csv::write(&id)).unwrap();
-        std::fs::write(dir.path().join(format!("va{s}.csv")), csv::write(&va)).unwrap();
-        let tag = |rows: Vec<measure::MeasuredPose>| {
-            rows.into_iter().map(move |mut r| {
-                r.session = Some(["A", "B"][s].to_string());
-                r
-            })
-        };
-        combined_id.extend(tag(id));
-        combined_va.extend(tag(va));
-    }
-    std::fs::write(dir.path().join("id.csv"), csv::write(&combined_id)).unwrap();
-    std::fs::write(dir.path().join("va.csv"), csv::write(&combined_va)).unwrap();
-    let run = |identify: &str, validate: &str| -> serde_json::Value {
-        robocal_json(
-            dir.path(),
-            &[
-                "calibrate",
-                "--model",
-                "ys100",
-                "--identify",
-                identify,
-                "--validate",
-                validate,
-                "--method",
-                "km",
-                "--json",
-            ],
-        )
-    };
-    let files = run("id0.csv,id1.csv", "va0.csv,va1.csv");
-    let column = run("id.csv", "va.csv");
-    for r in [&files, &column] {
-        assert_eq!(r["registration"].as_array().unwrap().len(), 2);
-        let v = r["methods"]["km"]["validation"]["mean_mm"]
-            .as_f64()
-            .unwrap();
-        assert!(v < 0.015, "validation mean {v}");
-    }
-    assert_eq!(
-        files["methods"]["km"]["validation"]["mean_mm"],
-        column["methods"]["km"]["validation"]["mean_mm"]
-    );
-}
-
 /// A truth with effects the model does not have (cubic springs, gear
 /// transmission error, backlash, link bending; link masses and centres of mass
 /// different from the model's): SKCM still beats KM clearly, every compliance
@@ -429,7 +372,7 @@ fn cli_takes_several_files_or_a_session_column() {
 /// passed test, a warning for every compliance at its bound).
 #[test]
 fn unmodelled_effects_keep_reports_honest() {
-    use robocal::sim::UnmodelledEffects;
+    use robocal_core::sim::UnmodelledEffects;
     let nominal = preset("ys100").unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(93);
     let mut tm = perturb_geometry(&nominal, &ErrorMagnitudes::from_mm_deg(1.0, 0.1), &mut rng);

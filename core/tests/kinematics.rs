@@ -5,12 +5,12 @@
 use nalgebra::{Matrix3, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use robocal::kinematics::{
+use robocal_core::kinematics::{
     chain, deflected_joints, fk, geometric_jacobian, gravity_torques, identification_jacobian,
 };
-use robocal::model::pose::rotation_log;
-use robocal::model::presets::{preset, PRESETS};
-use robocal::model::{ParamLayout, RobotModel};
+use robocal_core::model::pose::rotation_log;
+use robocal_core::model::presets::{preset, PRESETS};
+use robocal_core::model::{ParamLayout, RobotModel};
 
 fn golden(name: &str) -> serde_json::Value {
     let path = format!("{}/tests/golden/fk_{name}.json", env!("CARGO_MANIFEST_DIR"));
@@ -90,7 +90,7 @@ fn perturbed(name: &str, rng: &mut ChaCha8Rng) -> RobotModel {
     let mut v = layout.values(&m);
     for (x, id) in v.iter_mut().zip(&layout.ids) {
         *x += match id.unit() {
-            robocal::model::params::ParamUnit::Angle => rng.gen_range(-0.01..0.01),
+            robocal_core::model::params::ParamUnit::Angle => rng.gen_range(-0.01..0.01),
             _ => rng.gen_range(-0.005..0.005),
         };
     }

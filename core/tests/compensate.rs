@@ -21,16 +21,18 @@ mod common;
 use common::{measure_truth, real, shipped_model};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal::compensate::{unmodelled_truth, CompensatedModel, CompensatorSpec, StoredCompensator};
-use robocal::identify::{
+use robocal_core::compensate::{
+    unmodelled_truth, CompensatedModel, CompensatorSpec, StoredCompensator,
+};
+use robocal_core::identify::{
     calibrate, calibrate_with_training, CalibrationOptions, CalibrationReport, CompensatorOptions,
     Method,
 };
-use robocal::ik::{Goal, IkSettings, IkSolver, SolveOptions};
-use robocal::measure::{self, Measurement};
-use robocal::model::{preset, RobotModel};
-use robocal::sim::random_configurations;
-use robocal::stats::ErrorStats;
+use robocal_core::ik::{Goal, IkSettings, IkSolver, SolveOptions};
+use robocal_core::measure::{self, Measurement};
+use robocal_core::model::{preset, RobotModel};
+use robocal_core::sim::random_configurations;
+use robocal_core::stats::ErrorStats;
 use std::sync::OnceLock;
 
 /// The base model of a calibrated method, in the measurement frame.
@@ -365,7 +367,7 @@ fn base_failure_pool_choice_and_cancellation() {
     });
     assert!(matches!(
         r,
-        Err(robocal::identify::CalibrationError::Cancelled)
+        Err(robocal_core::identify::CalibrationError::Cancelled)
     ));
     assert_eq!(seen.load(std::sync::atomic::Ordering::SeqCst), 1);
     // Without Q2 the compensator says it trained on the identification poses.

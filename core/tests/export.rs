@@ -1,25 +1,25 @@
 //! Exports (issue 11): the URDF of a calibrated UR5 (KM on the real laser-tracker
 //! grid) loaded by an outside implementation (pinocchio; golden values from
 //! scripts/golden/make_urdf_golden.py) reproduces robocal's geometric forward
-//! kinematics to 1e-6 mm; the command line writes every format.
+//! kinematics to 1e-6 mm. (`robocal export` writing every format is a test of
+//! the root crate.)
 
-use robocal::cli::export::{export_to_string, ExportArgs};
-use robocal::cli::model_files::load_compensated;
-use robocal::kinematics::fk;
+use robocal_core::compensate::CalibratedModelFile;
+use robocal_core::export::{export, ExportFormat, ExportSource};
+use robocal_core::kinematics::fk;
 
 const CALIBRATED: &str = "tests/golden/ur5_km_calibrated.json";
 
-fn args(model: &str, format: &str) -> ExportArgs {
-    ExportArgs {
-        model: model.into(),
-        format: format.into(),
-        out: None,
-    }
-}
-
 #[test]
 fn urdf_of_a_calibrated_ur5_matches_pinocchio_to_a_nanometre() {
-    let urdf = export_to_string(&args(CALIBRATED, "urdf")).unwrap();
+    let file =
+        CalibratedModelFile::from_json(&std::fs::read_to_string(CALIBRATED).unwrap()).unwrap();
+    let model = file.to_compensated().unwrap();
+    let source = ExportSource {
+        robot: &file.robot,
+        method: &file.method,
+    };
+    let urdf = export(&model, &source, ExportFormat::Urdf).unwrap();
     // The golden values were computed on this very text.
     let golden_urdf = std::fs::read_to_string("tests/golden/ur5_km.urdf").unwrap();
     assert_eq!(
@@ -29,7 +29,6 @@ fn urdf_of_a_calibrated_ur5_matches_pinocchio_to_a_nanometre() {
     let golden: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string("tests/golden/urdf_fk_ur5_km.json").unwrap())
             .unwrap();
-    let model = load_compensated(CALIBRATED).unwrap();
     let samples = golden["samples"].as_array().unwrap();
     assert_eq!(samples.len(), 40);
     let mut worst_mm: f64 = 0.0;
@@ -57,26 +56,4 @@ fn urdf_of_a_calibrated_ur5_matches_pinocchio_to_a_nanometre() {
     eprintln!("URDF vs pinocchio: worst {worst_mm:e} mm, {worst_rot:e} in the rotation");
     assert!(worst_mm < 1e-6, "{worst_mm} mm");
     assert!(worst_rot < 1e-9, "{worst_rot}");
-}
-
-#[test]
-fn command_line_exports_every_format_or_says_why_not() {
-    for f in ["urdf", "dh-csv", "mdh-csv", "json"] {
-        let text = export_to_string(&args("ur10", f)).unwrap();
-        assert!(text.len() > 200, "{f}");
-    }
-    let json = export_to_string(&args(CALIBRATED, "json")).unwrap();
-    assert!(json.contains("\"method\": \"km\""));
-    let mdh = export_to_string(&args(CALIBRATED, "mdh-csv")).unwrap();
-    assert!(mdh.contains("beta_deg") && mdh.contains("not representable"));
-    // The calibrated UR5 has Hayati twists on its parallel axes.
-    let e = export_to_string(&args(CALIBRATED, "dh-csv")).unwrap_err();
-    assert!(e.to_string().contains("Hayati"), "{e}");
-    let e = export_to_string(&args("hh800", "urdf")).unwrap_err();
-    assert!(e.to_string().contains("closed loop"), "{e}");
-    let e = export_to_string(&args("ur10", "sdf")).unwrap_err();
-    assert!(
-        e.to_string().contains("urdf, dh-csv, mdh-csv or json"),
-        "{e}"
-    );
 }

@@ -6,12 +6,12 @@ mod common;
 use common::{measure_truth, opts, real_with, run_with, two_tracker_sessions};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal::identify::{
+use robocal_core::identify::{
     calibrate, CalibrationError, CalibrationOptions, CalibrationReport, Method,
 };
-use robocal::measure::{self, csv, Measurement};
-use robocal::model::{preset, ParamId, RobotModel};
-use robocal::sim::{
+use robocal_core::measure::{self, csv, Measurement};
+use robocal_core::model::{preset, ParamId, RobotModel};
+use robocal_core::sim::{
     perturb_geometry, random_configurations, tracker_frame, ErrorMagnitudes, TrueRobot,
 };
 
@@ -66,7 +66,7 @@ fn ys100_position_km_keeps_the_seeds_27_parameters() {
 /// `robocal demo ys100-simulation` (seed §7.4) meets the acceptance.
 #[test]
 fn ys100_simulation_study_reaches_the_noise_floor() {
-    let study = robocal::cli::demo::ys100_simulation(1, &|_| true).unwrap();
+    let study = robocal_core::study::ys100_simulation(1, &|_| true).unwrap();
     let r = &study.report;
     let (km, skcm, tlbo) = (
         val_mean(r, "km"),
@@ -144,7 +144,7 @@ fn tracker_frame_is_registered_away() {
 fn ur5_real_data_km() {
     let mut model = preset("ur5").unwrap();
     // TCP offset in the flange frame given by the data's README.
-    let desc = robocal::model::ModelDescription::from_model(&model);
+    let desc = robocal_core::model::ModelDescription::from_model(&model);
     let mut desc = desc;
     desc.tool.xyz_mm = [0.0, 0.09, 31.0];
     // Standard-DH import put Rx(α6)Tx(a6) = identity into the tool, so this is exact.
@@ -163,7 +163,9 @@ fn ur5_real_data_km() {
         // Before calibration, in the base frame as recorded: ~2.57 mm.
         let before: f64 = test
             .iter()
-            .map(|m| (robocal::kinematics::fk(&model, &m.q).unwrap().p - m.position).norm() * 1e3)
+            .map(|m| {
+                (robocal_core::kinematics::fk(&model, &m.q).unwrap().p - m.position).norm() * 1e3
+            })
             .sum::<f64>()
             / test.len() as f64;
         assert!((before - 2.57).abs() < 0.1, "nominal error {before}");
@@ -211,7 +213,7 @@ fn hh800_closed_loop_recovers_truth() {
             .any(|d| d.name == "l3" && d.reason.contains("scale")));
         for name in ["l4", "l5"] {
             let id = ParamId::parse(name).unwrap();
-            let truth_v = robocal::model::params::get(&tm, id) * 1e3;
+            let truth_v = robocal_core::model::params::get(&tm, id) * 1e3;
             let p = m.parameters.iter().find(|p| p.name == name).unwrap();
             let sd = p.std.unwrap();
             assert!(

@@ -1,17 +1,16 @@
 //! The simulator against independent expectations: an error-free truth measures
 //! the nominal forward kinematics exactly, compliance sags the TCP along gravity,
 //! the tracker frame maps base to tracker coordinates, the noise has the requested
-//! spread, `robocal simulate` writes CSV that parses back, and the seed's §7.4
-//! robot carries Tables 7.1/7.2.
+//! spread, and the seed's §7.4 robot carries Tables 7.1/7.2 (`robocal
+//! simulate` writing CSV that parses back is a test of the root crate).
 
-use clap::Parser;
 use nalgebra::Vector3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal::kinematics::fk;
-use robocal::measure::{csv, SetRole};
-use robocal::model::{preset, RobotModel};
-use robocal::sim::{
+use robocal_core::kinematics::fk;
+use robocal_core::measure::SetRole;
+use robocal_core::model::{preset, RobotModel};
+use robocal_core::sim::{
     perturb_geometry, random_configurations, tracker_frame, ys100_table_7_1, ErrorMagnitudes,
     TrueRobot,
 };
@@ -153,116 +152,6 @@ fn noise_has_the_requested_standard_deviation() {
     assert_eq!(again[..], rows[..10]);
     let other = truth.measure(&qs[..10], None, None, &mut rng(100)).unwrap();
     assert_ne!(other[..], rows[..10]);
-}
-
-fn temp_path(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("robocal-sim-test-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
-
-fn simulate(args: &[&str]) {
-    let mut argv = vec!["robocal", "simulate"];
-    argv.extend_from_slice(args);
-    let cli = robocal::cli::Cli::try_parse_from(argv).unwrap();
-    robocal::cli::run(cli).unwrap();
-}
-
-#[test]
-fn simulate_cli_writes_csv_that_parses_back() {
-    let out = temp_path("q2.csv");
-    let truth_path = temp_path("truth.json");
-    let (o, t) = (out.to_str().unwrap(), truth_path.to_str().unwrap());
-    let tracker = "1,-2,3,100,-3240,50";
-    let args = [
-        "--preset",
-        "ys100",
-        "--poses",
-        "12",
-        "--noise-mm",
-        "0",
-        "--seed",
-        "3",
-        "--out",
-        o,
-        "--truth",
-        t,
-        "--set",
-        "training",
-        "--tracker",
-        tracker,
-    ];
-    simulate(&args);
-    let text = std::fs::read_to_string(&out).unwrap();
-    assert!(text.starts_with('#'));
-    let rows = csv::parse(&text).unwrap();
-    assert_eq!(rows.len(), 12);
-    csv::check_joint_count(&rows, 6).unwrap();
-    assert!(rows.iter().all(|r| r.set == Some(SetRole::Training)));
-    assert!(rows.iter().all(|r| r.payload_kg == Some(110.0)));
-
-    // The truth file is the Table 7.1 robot, and the noise-free rows are its
-    // true positions in the tracker frame.
-    let truth_model =
-        RobotModel::from_json(&std::fs::read_to_string(&truth_path).unwrap()).unwrap();
-    let table = ys100_table_7_1();
-    for (a, b) in truth_model.links.iter().zip(&table.links) {
-        assert!((a.a - b.a).abs() < 1e-12 && (a.alpha - b.alpha).abs() < 1e-12);
-        assert!((a.d - b.d).abs() < 1e-12 && (a.theta - b.theta).abs() < 1e-12);
-        assert!((a.compliance - b.compliance).abs() < 1e-18);
-    }
-    let truth = TrueRobot {
-        tracker_from_base: tracker_frame(1.0, -2.0, 3.0, [100.0, -3240.0, 50.0]),
-        ..TrueRobot::new(truth_model.clone())
-    };
-    for r in &rows {
-        let qc: Vec<f64> = r.q_deg.iter().map(|d| d.to_radians()).collect();
-        let q = truth_model.joints_from_controller(&qc);
-        let p = truth.true_position(&q, Some(110.0)).unwrap() * 1e3;
-        assert!((p - Vector3::from(r.xyz_mm)).norm() < 1e-8, "{r:?}");
-        assert!(r.xyz_mm[1] < -500.0, "{r:?}");
-    }
-
-    // Deterministic: the same command writes the same file.
-    simulate(&args);
-    assert_eq!(std::fs::read_to_string(&out).unwrap(), text);
-
-    // Another preset with a random truth, noise and stiffness.
-    let out2 = temp_path("ur5.csv");
-    simulate(&[
-        "--preset",
-        "ur5",
-        "--poses",
-        "7",
-        "--out",
-        out2.to_str().unwrap(),
-        "--truth-from",
-        "random",
-        "--error-mm",
-        "0.3",
-        "--stiffness",
-        "0,2e5,2e5,1e5,0,0",
-        "--backlash-deg",
-        "0.001",
-    ]);
-    let rows = csv::parse(&std::fs::read_to_string(&out2).unwrap()).unwrap();
-    assert_eq!(rows.len(), 7);
-    assert!(rows.iter().all(|r| r.set.is_none() && r.q_deg.len() == 6));
-
-    // Bad arguments are reported, not panicked on.
-    for bad in [
-        vec!["--preset", "ur5", "--truth-from", "table-7-1"],
-        vec!["--set", "calibration"],
-        vec!["--tracker", "1,2,3"],
-        vec!["--noise-mm=-1"],
-        vec!["--stiffness", "1,2"],
-    ] {
-        let mut argv = vec!["robocal", "simulate", "--out", o];
-        argv.extend(bad.iter().copied());
-        let cli = robocal::cli::Cli::try_parse_from(&argv).unwrap();
-        assert!(robocal::cli::run(cli).is_err(), "{bad:?}");
-    }
-    let _ = std::fs::remove_dir_all(out.parent().unwrap());
 }
 
 #[test]
