@@ -9,7 +9,8 @@
 //!   one of the three that occurs most often in the header (ties go to `,`);
 //! - the decimal separator is `.`, or `,` when the delimiter is not `,`
 //!   (tracker software in many locales writes `1523,2;12,5;980,1`): declared,
-//!   or accepted in either form when the delimiter allows it;
+//!   or accepted in either form when the delimiter allows it; a declared
+//!   decimal comma in a `,`-separated text is read in quoted fields (`"1523,2"`);
 //! - every record keeps its 1-based line number for messages.
 //!
 //! Whether a record has as many fields as the header is for the caller to
@@ -63,8 +64,6 @@ pub fn parse_delimiter(text: &str) -> Option<u8> {
 pub enum TextError {
     #[error("the delimiter must be `,`, `;` or a tab")]
     BadDelimiter,
-    #[error("a decimal comma needs `;` or a tab as the field delimiter")]
-    CommaWithCommaDelimiter,
     #[error("line {line}: {message}")]
     Malformed { line: usize, message: String },
 }
@@ -201,9 +200,6 @@ pub fn read(text: &str, dialect: Dialect) -> Result<Option<Table>, TextError> {
         None => detect_delimiter(header_text),
     };
     let decimal_comma = match dialect.decimal {
-        Some(Decimal::Comma) if delimiter == b',' => {
-            return Err(TextError::CommaWithCommaDelimiter)
-        }
         Some(Decimal::Comma) => true,
         Some(Decimal::Point) => false,
         None => delimiter != b',',
@@ -308,7 +304,7 @@ mod tests {
     }
 
     #[test]
-    fn declared_dialects_win_and_contradictions_fail() {
+    fn declared_dialects_win() {
         let d = Dialect {
             delimiter: Some(b';'),
             decimal: Some(Decimal::Point),
@@ -316,14 +312,15 @@ mod tests {
         let t = read("x,y;z\n1,5;2\n", d).unwrap().unwrap();
         assert_eq!(t.header, ["x,y", "z"]);
         assert_eq!(t.number("1,5"), None);
-        let bad = Dialect {
+        // A decimal comma in a comma-separated text: quoted fields.
+        let d = Dialect {
             delimiter: Some(b','),
             decimal: Some(Decimal::Comma),
         };
-        assert_eq!(
-            read("x\n1\n", bad).unwrap_err(),
-            TextError::CommaWithCommaDelimiter
-        );
+        let t = read("x,y\n\"1,5\",2.25\n", d).unwrap().unwrap();
+        assert_eq!(t.delimiter, b',');
+        let v: Vec<Option<f64>> = t.records[0].fields.iter().map(|f| t.number(f)).collect();
+        assert_eq!(v, [Some(1.5), Some(2.25)]);
     }
 
     #[test]
