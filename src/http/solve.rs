@@ -418,7 +418,7 @@ fn plain_number(text: &str) -> Option<f64> {
         None => (unsigned, None),
     };
     let mantissa_ok = match mantissa.split_once('.') {
-        Some((int, frac)) if int.is_empty() => digits(frac, 1),
+        Some(("", frac)) => digits(frac, 1),
         Some((int, frac)) => digits(int, 1) && digits(frac, 0),
         None => digits(mantissa, 1),
     };
