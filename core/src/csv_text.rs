@@ -118,23 +118,33 @@ pub fn short_text(s: &str) -> String {
     }
 }
 
+/// A delimiter or decimal separator name that is not one.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum DialectError {
+    #[error("the delimiter must be `,`, `;` or `tab`, got `{value}`")]
+    Delimiter { value: String },
+    #[error("the decimal separator must be point or comma, got `{value}`")]
+    Decimal { value: String },
+}
+
 /// Delimiter and decimal separator by name (`,` / `;` / `tab`, `point` /
 /// `comma`), each `None` to detect; the error names the bad value.
 pub fn dialect_from_names(
     delimiter: Option<&str>,
     decimal: Option<&str>,
-) -> Result<Dialect, String> {
+) -> Result<Dialect, DialectError> {
     Ok(Dialect {
         delimiter: delimiter
             .map(|d| {
-                parse_delimiter(d)
-                    .ok_or_else(|| format!("the delimiter must be `,`, `;` or `tab`, got `{d}`"))
+                parse_delimiter(d).ok_or_else(|| DialectError::Delimiter {
+                    value: d.to_string(),
+                })
             })
             .transpose()?,
         decimal: decimal
             .map(|d| {
-                Decimal::parse(d).ok_or_else(|| {
-                    format!("the decimal separator must be point or comma, got `{d}`")
+                Decimal::parse(d).ok_or_else(|| DialectError::Decimal {
+                    value: d.to_string(),
                 })
             })
             .transpose()?,
@@ -321,6 +331,26 @@ mod tests {
         assert_eq!(t.delimiter, b',');
         let v: Vec<Option<f64>> = t.records[0].fields.iter().map(|f| t.number(f)).collect();
         assert_eq!(v, [Some(1.5), Some(2.25)]);
+    }
+
+    #[test]
+    fn dialect_names() {
+        let d = dialect_from_names(Some("tab"), Some("comma")).unwrap();
+        assert_eq!(
+            (d.delimiter, d.decimal),
+            (Some(b'\t'), Some(Decimal::Comma))
+        );
+        let e = dialect_from_names(Some("|"), None).unwrap_err();
+        assert_eq!(e, DialectError::Delimiter { value: "|".into() });
+        assert_eq!(
+            e.to_string(),
+            "the delimiter must be `,`, `;` or `tab`, got `|`"
+        );
+        let e = dialect_from_names(None, Some("dot,")).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "the decimal separator must be point or comma, got `dot,`"
+        );
     }
 
     #[test]

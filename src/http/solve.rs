@@ -293,11 +293,7 @@ fn command(robot_id: i64, c: Common) -> Result<SolveCommand, ApiError> {
         }
     }
     // With both, the solution in the branch nearest the seed is chosen.
-    let branch = c
-        .branch
-        .map(Configuration::parse)
-        .transpose()
-        .map_err(|e| ApiError::invalid(format!("`branch`: {e}")))?;
+    let branch = c.branch.map(Configuration::parse).transpose()?;
     let false_target_convention = c
         .convention
         .map(|name| convention(name, "`convention`"))
@@ -477,7 +473,7 @@ impl CsvSolveQuery {
 
 /// The decimal separator a query declares (the delimiter is detected).
 pub fn dialect(decimal: Option<&str>) -> Result<Dialect, ApiError> {
-    dialect_from_names(None, decimal).map_err(ApiError::invalid)
+    Ok(dialect_from_names(None, decimal)?)
 }
 
 /// A targets CSV and its query as a service command.
@@ -498,8 +494,7 @@ pub fn csv_command(robot_id: i64, q: &CsvSolveQuery, text: &str) -> Result<Solve
         },
     )?;
     let d = dialect(q.decimal.as_deref())?;
-    let csv =
-        parse_targets_csv(text, d).map_err(|e| ApiError::invalid(format!("targets CSV: {e}")))?;
+    let csv = parse_targets_csv(text, d)?;
     if csv.rows.is_empty() {
         return Err(ApiError::invalid(
             "targets CSV: no target rows after the header",
