@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # API fuzzing of `robocal serve` against openapi.yaml with Schemathesis.
 #
-#   scripts/schemathesis.sh [path/to/robocal]      (default: target/debug/robocal)
+#   scripts/schemathesis.sh [path/to/robocal [schemathesis options...]]
+#
+# (robocal default: target/debug/robocal; further options go to `schemathesis
+# run`, e.g. `--include-operation-id solve` or `--report har`.)
 #
 # Starts the service on a loopback port with a temporary database and two API
 # keys, then runs Schemathesis with every check (`--checks all`), every phase
@@ -15,6 +18,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 BIN=${1:-target/debug/robocal}
+shift || true
 VENV=${SCHEMATHESIS_VENV:-target/schemathesis-venv}
 VERSION=4.32.5
 MAX_EXAMPLES=${SCHEMATHESIS_MAX_EXAMPLES:-25}
@@ -78,6 +82,7 @@ status=0
     --generation-database none \
     --no-color \
     --report junit --report-dir "${SCHEMATHESIS_REPORT_DIR:-target/schemathesis-report}" \
+    "$@" \
     || status=$?
 echo "schemathesis.sh: finished in $(( $(date +%s) - start )) s with exit code $status"
 

@@ -9,7 +9,8 @@
 //!   one of the three that occurs most often in the header (ties go to `,`);
 //! - the decimal separator is `.`, or `,` when the delimiter is not `,`
 //!   (tracker software in many locales writes `1523,2;12,5;980,1`): declared,
-//!   or accepted in either form when the delimiter allows it;
+//!   or accepted in either form when the delimiter allows it; a declared
+//!   decimal comma in a `,`-separated text is read in quoted fields (`"1523,2"`);
 //! - every record keeps its 1-based line number for messages.
 //!
 //! Whether a record has as many fields as the header is for the caller to
@@ -63,8 +64,6 @@ pub fn parse_delimiter(text: &str) -> Option<u8> {
 pub enum TextError {
     #[error("the delimiter must be `,`, `;` or a tab")]
     BadDelimiter,
-    #[error("a decimal comma needs `;` or a tab as the field delimiter")]
-    CommaWithCommaDelimiter,
     #[error("line {line}: {message}")]
     Malformed { line: usize, message: String },
 }
@@ -119,23 +118,33 @@ pub fn short_text(s: &str) -> String {
     }
 }
 
+/// A delimiter or decimal separator name that is not one.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum DialectError {
+    #[error("the delimiter must be `,`, `;` or `tab`, got `{value}`")]
+    Delimiter { value: String },
+    #[error("the decimal separator must be point or comma, got `{value}`")]
+    Decimal { value: String },
+}
+
 /// Delimiter and decimal separator by name (`,` / `;` / `tab`, `point` /
 /// `comma`), each `None` to detect; the error names the bad value.
 pub fn dialect_from_names(
     delimiter: Option<&str>,
     decimal: Option<&str>,
-) -> Result<Dialect, String> {
+) -> Result<Dialect, DialectError> {
     Ok(Dialect {
         delimiter: delimiter
             .map(|d| {
-                parse_delimiter(d)
-                    .ok_or_else(|| format!("the delimiter must be `,`, `;` or `tab`, got `{d}`"))
+                parse_delimiter(d).ok_or_else(|| DialectError::Delimiter {
+                    value: d.to_string(),
+                })
             })
             .transpose()?,
         decimal: decimal
             .map(|d| {
-                Decimal::parse(d).ok_or_else(|| {
-                    format!("the decimal separator must be point or comma, got `{d}`")
+                Decimal::parse(d).ok_or_else(|| DialectError::Decimal {
+                    value: d.to_string(),
                 })
             })
             .transpose()?,
@@ -201,9 +210,6 @@ pub fn read(text: &str, dialect: Dialect) -> Result<Option<Table>, TextError> {
         None => detect_delimiter(header_text),
     };
     let decimal_comma = match dialect.decimal {
-        Some(Decimal::Comma) if delimiter == b',' => {
-            return Err(TextError::CommaWithCommaDelimiter)
-        }
         Some(Decimal::Comma) => true,
         Some(Decimal::Point) => false,
         None => delimiter != b',',
@@ -308,7 +314,7 @@ mod tests {
     }
 
     #[test]
-    fn declared_dialects_win_and_contradictions_fail() {
+    fn declared_dialects_win() {
         let d = Dialect {
             delimiter: Some(b';'),
             decimal: Some(Decimal::Point),
@@ -316,13 +322,34 @@ mod tests {
         let t = read("x,y;z\n1,5;2\n", d).unwrap().unwrap();
         assert_eq!(t.header, ["x,y", "z"]);
         assert_eq!(t.number("1,5"), None);
-        let bad = Dialect {
+        // A decimal comma in a comma-separated text: quoted fields.
+        let d = Dialect {
             delimiter: Some(b','),
             decimal: Some(Decimal::Comma),
         };
+        let t = read("x,y\n\"1,5\",2.25\n", d).unwrap().unwrap();
+        assert_eq!(t.delimiter, b',');
+        let v: Vec<Option<f64>> = t.records[0].fields.iter().map(|f| t.number(f)).collect();
+        assert_eq!(v, [Some(1.5), Some(2.25)]);
+    }
+
+    #[test]
+    fn dialect_names() {
+        let d = dialect_from_names(Some("tab"), Some("comma")).unwrap();
         assert_eq!(
-            read("x\n1\n", bad).unwrap_err(),
-            TextError::CommaWithCommaDelimiter
+            (d.delimiter, d.decimal),
+            (Some(b'\t'), Some(Decimal::Comma))
+        );
+        let e = dialect_from_names(Some("|"), None).unwrap_err();
+        assert_eq!(e, DialectError::Delimiter { value: "|".into() });
+        assert_eq!(
+            e.to_string(),
+            "the delimiter must be `,`, `;` or `tab`, got `|`"
+        );
+        let e = dialect_from_names(None, Some("dot,")).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "the decimal separator must be point or comma, got `dot,`"
         );
     }
 

@@ -78,7 +78,7 @@ pub struct SolveArgs {
     #[arg(long)]
     pub delimiter: Option<String>,
     /// Decimal separator of the targets file: `point` or `comma` (default:
-    /// detected; a comma needs `;` or tab delimiters).
+    /// detected; with `,` delimiters a decimal comma is read in quoted fields).
     #[arg(long)]
     pub decimal: Option<String>,
 }

@@ -192,6 +192,27 @@ impl From<crate::service::ServiceError> for ApiError {
     }
 }
 
+/// A delimiter or decimal separator option that names none (422).
+impl From<crate::csv_text::DialectError> for ApiError {
+    fn from(e: crate::csv_text::DialectError) -> Self {
+        ApiError::Unprocessable(e.to_string())
+    }
+}
+
+/// A `branch` option that is not a configuration branch (422).
+impl From<crate::ik::BranchError> for ApiError {
+    fn from(e: crate::ik::BranchError) -> Self {
+        ApiError::Unprocessable(format!("`branch`: {e}"))
+    }
+}
+
+/// A targets file whose header cannot be read (422, naming the line).
+impl From<crate::ik::TargetsCsvError> for ApiError {
+    fn from(e: crate::ik::TargetsCsvError) -> Self {
+        ApiError::Unprocessable(format!("targets CSV: {e}"))
+    }
+}
+
 fn bytes_rejection(e: BytesRejection) -> ApiError {
     if e.status() == StatusCode::PAYLOAD_TOO_LARGE {
         ApiError::PayloadTooLarge(

@@ -35,7 +35,10 @@ pub(crate) fn set_not_found(robot: i64, id: i64) -> ApiError {
     ))
 }
 
-/// Metadata of an upload: query parameters for CSV, body fields for JSON.
+/// Options of an upload: the query string of a CSV upload, the body fields of
+/// a JSON upload. A JSON upload takes the set's name, role, session and
+/// payload from the query for the fields its body leaves out; the options that
+/// say how to read a CSV text (units, `dif_sign`, `decimal`) are for CSV only.
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SetParams {
@@ -47,8 +50,6 @@ pub struct SetParams {
     pub angle_unit: Option<String>,
     /// CSV only: sign of the real-data `*_dif` columns (`plus` | `minus`).
     pub dif_sign: Option<String>,
-    /// CSV only: `,`, `;` or `tab` (detected when absent).
-    pub delimiter: Option<String>,
     /// CSV only: `point` or `comma` (detected when absent).
     pub decimal: Option<String>,
 }
@@ -92,12 +93,14 @@ pub struct JsonUpload {
 }
 
 impl JsonUpload {
-    fn params(&self) -> SetParams {
+    /// The body's options, with the query's set metadata for the fields the
+    /// body leaves out.
+    fn params(&self, query: &SetParams) -> SetParams {
         SetParams {
-            name: self.name.clone(),
-            role: self.role.clone(),
-            session: self.session.clone(),
-            payload_kg: self.payload_kg,
+            name: self.name.clone().or_else(|| query.name.clone()),
+            role: self.role.clone().or_else(|| query.role.clone()),
+            session: self.session.clone().or_else(|| query.session.clone()),
+            payload_kg: self.payload_kg.or(query.payload_kg),
             length_unit: self.length_unit.clone(),
             angle_unit: self.angle_unit.clone(),
             ..SetParams::default()
@@ -169,11 +172,14 @@ fn check_params(p: &SetParams) -> Result<Checked, ApiError> {
         .role
         .as_deref()
         .map(|r| {
-            SetRole::parse(r).ok_or_else(|| {
-                ApiError::invalid(format!(
-                    "`role` must be identification, training or validation, got `{r}`"
-                ))
-            })
+            // The names exactly as the spec lists them.
+            SetRole::parse(r)
+                .filter(|role| role.as_str() == r)
+                .ok_or_else(|| {
+                    ApiError::invalid(format!(
+                        "`role` must be identification, training or validation, got `{r}`"
+                    ))
+                })
         })
         .transpose()?;
     let session = p.session.clone().unwrap_or_else(|| "default".into());
@@ -212,15 +218,40 @@ fn check_params(p: &SetParams) -> Result<Checked, ApiError> {
     })
 }
 
+/// The JSON rows' bounds in their declared units: the measurement CSV's
+/// (`|q| ≤ 720°`, positions within ±100 m, not every coordinate within ±5 mm)
+/// converted into the units, so that `openapi.yaml` states them exactly.
+struct RowBounds {
+    joint: f64,
+    position: f64,
+    metres_suspect: f64,
+}
+
+impl RowBounds {
+    fn of(c: &Checked) -> RowBounds {
+        let (length, angle) = (c.length == Length::M, c.angle == Angle::Rad);
+        let mm = |v: f64| if length { v / 1e3 } else { v };
+        RowBounds {
+            joint: if angle {
+                csv::MAX_JOINT_DEG.to_radians()
+            } else {
+                csv::MAX_JOINT_DEG
+            },
+            position: mm(csv::MAX_POSITION_MM),
+            metres_suspect: mm(csv::METRES_SUSPECT_MM),
+        }
+    }
+}
+
 fn json_rows(rows: Vec<RowInput>, c: &Checked) -> Result<Vec<MeasuredPose>, ApiError> {
     if rows.is_empty() {
         return Err(ApiError::invalid(
             "`rows` is empty: upload at least one measured pose",
         ));
     }
-    let lf = if c.length == Length::M { 1e3 } else { 1.0 };
-    let mut out = Vec::with_capacity(rows.len());
-    for (i, r) in rows.into_iter().enumerate() {
+    let b = RowBounds::of(c);
+    let (lu, au) = (c.length.as_str(), c.angle.as_str());
+    for (i, r) in rows.iter().enumerate() {
         let n = i + 1;
         let bad = |what: &str| ApiError::invalid(format!("row {n}: {what} must be finite numbers"));
         if r.q.iter().any(|v| !v.is_finite()) {
@@ -238,50 +269,51 @@ fn json_rows(rows: Vec<RowInput>, c: &Checked) -> Result<Vec<MeasuredPose>, ApiE
         if r.temperature_c.is_some_and(|t| !t.is_finite()) {
             return Err(bad("`temperature_c`"));
         }
-        out.push(MeasuredPose {
-            q_deg: r.q,
-            xyz_mm: r.xyz.map(|v| v * lf),
-            rpy_deg: r.rpy,
-            payload_kg: r.payload_kg,
-            temperature_c: r.temperature_c,
-            set: r.set,
-            session: None,
-        });
-    }
-    if c.angle == Angle::Rad {
-        for r in out.iter_mut() {
-            r.q_deg.iter_mut().for_each(|q| *q = q.to_degrees());
-            if let Some(rpy) = r.rpy_deg.as_mut() {
-                rpy.iter_mut().for_each(|a| *a = a.to_degrees());
-            }
-        }
-    }
-    // The same bounds as the measurement CSV (after unit conversion).
-    for (i, r) in out.iter().enumerate() {
-        let n = i + 1;
-        if let Some(q) = r.q_deg.iter().find(|q| q.abs() > csv::MAX_JOINT_DEG) {
+        if let Some(q) = r.q.iter().find(|q| q.abs() > b.joint) {
             return Err(ApiError::invalid(format!(
-                "row {n}: joint value {q:.4e} deg is beyond ±{} deg: wrong units (encoder counts, or radians declared as degrees)?",
+                "row {n}: joint value {q:.4e} {au} is beyond ±{} {au} (±{} deg): wrong units (encoder counts, or radians declared as degrees)?",
+                b.joint,
                 csv::MAX_JOINT_DEG
             )));
         }
-        if let Some(x) = r.xyz_mm.iter().find(|x| x.abs() > csv::MAX_POSITION_MM) {
+        if let Some(x) = r.xyz.iter().find(|x| x.abs() > b.position) {
             return Err(ApiError::invalid(format!(
-                "row {n}: position coordinate {x:.4e} mm is beyond ±{} m of the tracker",
+                "row {n}: position coordinate {x:.4e} {lu} is beyond ±{} m of the tracker",
                 csv::MAX_POSITION_MM / 1e3
             )));
         }
     }
-    if out
+    if rows
         .iter()
-        .all(|r| r.xyz_mm.iter().all(|v| v.abs() < csv::METRES_SUSPECT_MM))
+        .all(|r| r.xyz.iter().all(|v| v.abs() < b.metres_suspect))
     {
-        return Err(ApiError::invalid(format!(
-            "every position coordinate is within ±{} mm: looks like metres; declare \"length_unit\": \"m\" or send millimetres",
-            csv::METRES_SUSPECT_MM
-        )));
+        return Err(ApiError::invalid(if c.length == Length::M {
+            format!(
+                "every position coordinate is within ±{} m: the rows do not look like tracker positions",
+                b.metres_suspect
+            )
+        } else {
+            format!(
+                "every position coordinate is within ±{} mm: looks like metres; declare \"length_unit\": \"m\" or send millimetres",
+                csv::METRES_SUSPECT_MM
+            )
+        }));
     }
-    Ok(out)
+    let lf = if c.length == Length::M { 1e3 } else { 1.0 };
+    let rad = c.angle == Angle::Rad;
+    let angle = |a: f64| if rad { a.to_degrees() } else { a };
+    Ok(rows
+        .into_iter()
+        .map(|r| MeasuredPose {
+            q_deg: r.q.into_iter().map(angle).collect(),
+            xyz_mm: r.xyz.map(|v| v * lf),
+            rpy_deg: r.rpy.map(|a| a.map(angle)),
+            payload_kg: r.payload_kg,
+            temperature_c: r.temperature_c,
+            set: r.set,
+            session: None,
+        })
+        .collect())
 }
 
 /// The CSV reading options of an upload's query.
@@ -297,7 +329,7 @@ fn read_options(q: &SetParams, c: &Checked) -> Result<ReadOptions, ApiError> {
     };
     Ok(ReadOptions {
         dif,
-        dialect: super::solve::dialect(q.delimiter.as_deref(), q.decimal.as_deref())?,
+        dialect: super::solve::dialect(q.decimal.as_deref())?,
         metres: c.length == Length::M,
         radians: c.angle == Angle::Rad,
     })
@@ -316,24 +348,8 @@ fn upload_command(
         let read = read_options(query, &c)?;
         (c, SetContent::Csv { text, read })
     } else {
-        let SetParams {
-            name: None,
-            role: None,
-            session: None,
-            payload_kg: None,
-            length_unit: None,
-            angle_unit: None,
-            dif_sign: None,
-            delimiter: None,
-            decimal: None,
-        } = query
-        else {
-            return Err(ApiError::invalid(
-                "for JSON uploads give name, role, session, payload_kg and units in the body, not the query string (dif_sign, delimiter and decimal are for CSV uploads)",
-            ));
-        };
         let up: JsonUpload = from_json_object(text.as_bytes())?;
-        let c = check_params(&up.params())?;
+        let c = check_params(&up.params(query))?;
         let rows = json_rows(up.rows, &c)?;
         let original = text;
         (c, SetContent::Rows { rows, original })
@@ -353,7 +369,7 @@ fn upload_command(
 /// Whether the upload is a CSV (else JSON rows); 415 for other media types.
 fn upload_is_csv(headers: &HeaderMap) -> Result<bool, ApiError> {
     let ct = content_type(headers);
-    let is_csv = matches!(ct.as_str(), "text/csv" | "application/csv" | "text/plain");
+    let is_csv = ct == "text/csv";
     let is_json = json_content_type(headers);
     if !is_csv && !is_json {
         let not = if ct.is_empty() {

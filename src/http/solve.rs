@@ -21,7 +21,6 @@ use super::error::{content_type, json_content_type};
 use super::input::{check_payload, from_json_object, object_or_null, objects, present, Int};
 use super::{ApiError, ApiPath, ApiQuery, AppState};
 use crate::csv_text::{dialect_from_names, Dialect};
-use crate::ik::targets_csv::CONVENTION_COLUMNS;
 use crate::ik::{
     parse_targets_csv, results_csv, Configuration, JointJump, SolveOptions, TargetFrame,
     TargetInput, TargetResult,
@@ -127,12 +126,12 @@ pub struct SolveRequest {
     pub branch: Option<String>,
     #[serde(default, deserialize_with = "present")]
     pub seed_deg: Option<Vec<f64>>,
-    #[serde(default)]
-    pub path: bool,
+    #[serde(default, deserialize_with = "present")]
+    pub path: Option<bool>,
     #[serde(default, deserialize_with = "present")]
     pub frame: Option<String>,
-    #[serde(default)]
-    pub position_only: bool,
+    #[serde(default, deserialize_with = "present")]
+    pub position_only: Option<bool>,
     #[serde(default, deserialize_with = "present")]
     pub version: Option<VersionSelector>,
     #[serde(default, deserialize_with = "present")]
@@ -293,16 +292,8 @@ fn command(robot_id: i64, c: Common) -> Result<SolveCommand, ApiError> {
             )));
         }
     }
-    let branch = c
-        .branch
-        .map(Configuration::parse)
-        .transpose()
-        .map_err(|e| ApiError::invalid(format!("`branch`: {e}")))?;
-    if c.seed_deg.is_some() && branch.is_some() {
-        return Err(ApiError::invalid(
-            "give either `branch` or `seed_deg`, not both",
-        ));
-    }
+    // With both, the solution in the branch nearest the seed is chosen.
+    let branch = c.branch.map(Configuration::parse).transpose()?;
     let false_target_convention = c
         .convention
         .map(|name| convention(name, "`convention`"))
@@ -336,32 +327,50 @@ fn command(robot_id: i64, c: Common) -> Result<SolveCommand, ApiError> {
     })
 }
 
-/// A JSON solve request as a service command.
-pub fn json_command(robot_id: i64, req: &SolveRequest) -> Result<SolveCommand, ApiError> {
+/// A JSON solve request as a service command; the query's options (`q`)
+/// stand for the fields the body leaves out, and a body that chooses the seed
+/// (`branch` or `seed_deg`) replaces the query's choice.
+pub fn json_command(
+    robot_id: i64,
+    req: &SolveRequest,
+    q: &CsvSolveQuery,
+) -> Result<SolveCommand, ApiError> {
     if req.targets.is_empty() {
         return Err(ApiError::invalid(
             "`targets` is empty: send at least one target",
         ));
     }
+    let query = q.options()?;
+    let seed_in_body = req.branch.is_some() || req.seed_deg.is_some();
+    let (branch, seed_deg) = if seed_in_body {
+        (req.branch.as_deref(), req.seed_deg.clone())
+    } else {
+        (query.branch, query.seed_deg)
+    };
     let mut cmd = command(
         robot_id,
         Common {
-            version: req.version.as_ref(),
-            payload_kg: req.payload_kg,
-            jump_deg: req.jump_deg,
-            frame: req.frame.as_deref(),
-            branch: req.branch.as_deref(),
-            seed_deg: req.seed_deg.clone(),
-            convention: req.convention.as_deref(),
-            position_only: req.position_only,
-            path: req.path,
+            version: req.version.as_ref().or(query.version.as_ref()),
+            payload_kg: req.payload_kg.or(query.payload_kg),
+            jump_deg: req.jump_deg.or(query.jump_deg),
+            frame: req.frame.as_deref().or(query.frame),
+            branch,
+            seed_deg,
+            convention: req.convention.as_deref().or(query.convention),
+            position_only: req.position_only.or(query.position_only).unwrap_or(false),
+            path: req.path.or(query.path).unwrap_or(false),
         },
     )?;
-    cmd.targets = Targets::Inputs(to_inputs(req)?);
+    let mut req = req.clone();
+    req.convention = req
+        .convention
+        .or_else(|| query.convention.map(str::to_string));
+    cmd.targets = Targets::Inputs(to_inputs(&req)?);
     Ok(cmd)
 }
 
-/// Query parameters of a `text/csv` solve (the JSON body's options).
+/// Query parameters of a solve: the options of a `text/csv` solve, and the
+/// defaults of a JSON solve's body fields (`decimal` only reads a CSV).
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CsvSolveQuery {
@@ -375,77 +384,117 @@ pub struct CsvSolveQuery {
     pub convention: Option<String>,
     pub position_only: Option<bool>,
     pub path: Option<bool>,
-    /// `,`, `;` or `tab` (detected when absent).
-    pub delimiter: Option<String>,
     /// `point` or `comma` (detected when absent).
     pub decimal: Option<String>,
 }
 
+/// The options of a solve query, read.
+struct QueryOptions<'a> {
+    version: Option<VersionSelector>,
+    payload_kg: Option<f64>,
+    jump_deg: Option<f64>,
+    frame: Option<&'a str>,
+    branch: Option<&'a str>,
+    seed_deg: Option<Vec<f64>>,
+    convention: Option<&'a str>,
+    position_only: Option<bool>,
+    path: Option<bool>,
+}
+
+/// A decimal number as `openapi.yaml`'s `seed_deg` pattern writes it: an
+/// optional sign, at most 15 digits before and after the point, an optional
+/// exponent of at most two digits.
+fn plain_number(text: &str) -> Option<f64> {
+    let digits = |s: &str, min: usize| {
+        s.len() >= min && s.len() <= 15 && s.bytes().all(|b| b.is_ascii_digit())
+    };
+    let unsigned = text.strip_prefix(['+', '-']).unwrap_or(text);
+    let (mantissa, exponent) = match unsigned.split_once(['e', 'E']) {
+        Some((m, e)) => (m, Some(e)),
+        None => (unsigned, None),
+    };
+    let mantissa_ok = match mantissa.split_once('.') {
+        Some(("", frac)) => digits(frac, 1),
+        Some((int, frac)) => digits(int, 1) && digits(frac, 0),
+        None => digits(mantissa, 1),
+    };
+    let exponent_ok = exponent.is_none_or(|e| {
+        let e = e.strip_prefix(['+', '-']).unwrap_or(e);
+        (1..=2).contains(&e.len()) && e.bytes().all(|b| b.is_ascii_digit())
+    });
+    (mantissa_ok && exponent_ok)
+        .then(|| text.parse().ok())
+        .flatten()
+}
+
 impl CsvSolveQuery {
-    fn is_empty(&self) -> bool {
-        self.version.is_none()
-            && self.payload_kg.is_none()
-            && self.jump_deg.is_none()
-            && self.frame.is_none()
-            && self.branch.is_none()
-            && self.seed_deg.is_none()
-            && self.convention.is_none()
-            && self.position_only.is_none()
-            && self.path.is_none()
-            && self.delimiter.is_none()
-            && self.decimal.is_none()
+    fn options(&self) -> Result<QueryOptions<'_>, ApiError> {
+        let version = self.version.as_deref().map(|v| match v.parse::<i64>() {
+            Ok(n) if v.bytes().all(|b| b.is_ascii_digit()) => VersionSelector::Number(Int(n)),
+            _ => VersionSelector::Name(v.to_string()),
+        });
+        let seed_deg = self
+            .seed_deg
+            .as_deref()
+            .map(|s| {
+                s.split(',')
+                    .map(|v| {
+                        plain_number(v.trim_matches(' ')).ok_or_else(|| {
+                            ApiError::invalid(format!(
+                                "`seed_deg`: `{}` is not a number; give the joint values in degrees (at most 15 digits before and after the point) separated by commas",
+                                v.trim()
+                            ))
+                        })
+                    })
+                    .collect::<Result<Vec<f64>, ApiError>>()
+            })
+            .transpose()?;
+        if let Some(s) = &seed_deg {
+            if !(2..=7).contains(&s.len()) {
+                return Err(ApiError::invalid(format!(
+                    "`seed_deg`: {} values; give one per joint (2 to 7)",
+                    s.len()
+                )));
+            }
+        }
+        Ok(QueryOptions {
+            version,
+            payload_kg: self.payload_kg,
+            jump_deg: self.jump_deg,
+            frame: self.frame.as_deref(),
+            branch: self.branch.as_deref(),
+            seed_deg,
+            convention: self.convention.as_deref(),
+            position_only: self.position_only,
+            path: self.path,
+        })
     }
 }
 
-/// The delimiter and decimal separator a query declares.
-pub fn dialect(delimiter: Option<&str>, decimal: Option<&str>) -> Result<Dialect, ApiError> {
-    dialect_from_names(delimiter, decimal).map_err(ApiError::invalid)
+/// The decimal separator a query declares (the delimiter is detected).
+pub fn dialect(decimal: Option<&str>) -> Result<Dialect, ApiError> {
+    Ok(dialect_from_names(None, decimal)?)
 }
 
 /// A targets CSV and its query as a service command.
 pub fn csv_command(robot_id: i64, q: &CsvSolveQuery, text: &str) -> Result<SolveCommand, ApiError> {
-    let version = q.version.as_deref().map(|v| match v.parse::<i64>() {
-        Ok(n) => VersionSelector::Number(Int(n)),
-        Err(_) => VersionSelector::Name(v.to_string()),
-    });
-    let seed_deg = q
-        .seed_deg
-        .as_deref()
-        .map(|s| {
-            s.split(',')
-                .map(|v| {
-                    v.trim().parse::<f64>().map_err(|_| {
-                        ApiError::invalid(format!(
-                            "`seed_deg`: `{}` is not a number; give the joint values in degrees separated by commas",
-                            v.trim()
-                        ))
-                    })
-                })
-                .collect::<Result<Vec<f64>, ApiError>>()
-        })
-        .transpose()?;
+    let query = q.options()?;
     let mut cmd = command(
         robot_id,
         Common {
-            version: version.as_ref(),
-            payload_kg: q.payload_kg,
-            jump_deg: q.jump_deg,
-            frame: q.frame.as_deref(),
-            branch: q.branch.as_deref(),
-            seed_deg,
-            convention: q.convention.as_deref(),
-            position_only: q.position_only.unwrap_or(false),
-            path: q.path.unwrap_or(false),
+            version: query.version.as_ref(),
+            payload_kg: query.payload_kg,
+            jump_deg: query.jump_deg,
+            frame: query.frame,
+            branch: query.branch,
+            seed_deg: query.seed_deg,
+            convention: query.convention,
+            position_only: query.position_only.unwrap_or(false),
+            path: query.path.unwrap_or(false),
         },
     )?;
-    let d = dialect(q.delimiter.as_deref(), q.decimal.as_deref())?;
-    let csv =
-        parse_targets_csv(text, d).map_err(|e| ApiError::invalid(format!("targets CSV: {e}")))?;
-    if csv.convention.is_none() && !cmd.options.position_only {
-        return Err(ApiError::invalid(format!(
-            "targets CSV: no orientation columns ({CONVENTION_COLUMNS}); add them or solve with `position_only=true`"
-        )));
-    }
+    let d = dialect(q.decimal.as_deref())?;
+    let csv = parse_targets_csv(text, d)?;
     if csv.rows.is_empty() {
         return Err(ApiError::invalid(
             "targets CSV: no target rows after the header",
@@ -460,7 +509,7 @@ pub fn csv_command(robot_id: i64, q: &CsvSolveQuery, text: &str) -> Result<Solve
 }
 
 fn is_csv_type(ct: &str) -> bool {
-    matches!(ct, "text/csv" | "application/csv")
+    ct == "text/csv"
 }
 
 /// Whether the answer is CSV: as `Accept` asks, else the request's format.
@@ -492,13 +541,8 @@ fn solve_command(
             .map_err(|_| ApiError::invalid("the targets CSV is not UTF-8 text"))?;
         return csv_command(robot_id, query, text);
     }
-    if !query.is_empty() {
-        return Err(ApiError::invalid(
-            "for JSON solves give the options in the body, not the query string",
-        ));
-    }
     let req: SolveRequest = from_json_object(body)?;
-    json_command(robot_id, &req)
+    json_command(robot_id, &req, query)
 }
 
 /// A solve's answer as CSV, the model used in `X-Robocal-*` headers.

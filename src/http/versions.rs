@@ -156,7 +156,9 @@ pub async fn export_version(
         robot: &file.robot,
         method: &row.method,
     };
-    let out = export(&model, &source, format).map_err(|e| ApiError::invalid(e.to_string()))?;
+    // A model the format cannot describe is a conflict with the version, not
+    // a bad request: another format of the same version works.
+    let out = export(&model, &source, format).map_err(|e| ApiError::Conflict(e.to_string()))?;
     let disposition = format!(
         "attachment; filename=\"robot-{robot_id}-v{v}-{}.{}\"",
         row.method,

@@ -144,8 +144,10 @@ fn select_sets(
             "no identification set: upload one with role identification (POST /v1/robots/{robot_id}/measurement-sets) or list its id in `identification_set_ids`"
         )));
     }
+    // A set in two roles conflicts with the job's data roles (each set plays
+    // one), which the request's schema cannot state.
     if let Some(s) = valid.iter().find(|v| ident.iter().any(|i| i.id == v.id)) {
-        return Err(ServiceError::Invalid(format!(
+        return Err(ServiceError::Conflict(format!(
             "measurement set {} is listed for both identification and validation; validation data must never be used for fitting",
             s.id
         )));
@@ -154,7 +156,7 @@ fn select_sets(
         .iter()
         .find(|t| ident.iter().any(|i| i.id == t.id) || valid.iter().any(|v| v.id == t.id))
     {
-        return Err(ServiceError::Invalid(format!(
+        return Err(ServiceError::Conflict(format!(
             "measurement set {} is listed for training and for identification or validation; each set plays one role",
             s.id
         )));

@@ -9,7 +9,7 @@
 
 use super::{AppState, ServiceError};
 use crate::db::{AngleUnit, LengthUnit, NewSet, SetFormat, SetRow};
-use crate::measure::csv::{self, CsvError, ReadOptions, MAX_JOINT_DEG, MAX_PAYLOAD_KG};
+use crate::measure::csv::{self, CsvError, ReadOptions, MAX_PAYLOAD_KG};
 use crate::measure::{MeasuredPose, SetRole};
 
 /// What the upload carries.
@@ -70,7 +70,9 @@ fn read_csv(
     Ok(rows)
 }
 
-/// The checks that need the robot and the service's limits.
+/// The checks that need the robot and the service's limits (the rows' own
+/// bounds are the reader's: the CSV parser's or the JSON handler's). Rows
+/// whose joint count is not the robot's conflict with the robot.
 fn check_rows(rows: &[MeasuredPose], dof: usize, max_rows: usize) -> Result<(), ServiceError> {
     if rows.len() > max_rows {
         return Err(ServiceError::Invalid(format!(
@@ -79,7 +81,7 @@ fn check_rows(rows: &[MeasuredPose], dof: usize, max_rows: usize) -> Result<(), 
         )));
     }
     csv::check_joint_count(rows, dof).map_err(|e| {
-        ServiceError::Invalid(format!("{e} (the robot has {dof} joints: send q1..q{dof})"))
+        ServiceError::Conflict(format!("{e} (the robot has {dof} joints: send q1..q{dof})"))
     })?;
     for (i, r) in rows.iter().enumerate() {
         if let Some(p) = r.payload_kg {
@@ -89,18 +91,6 @@ fn check_rows(rows: &[MeasuredPose], dof: usize, max_rows: usize) -> Result<(), 
                     i + 1
                 )));
             }
-        }
-        if let Some((k, v)) = r
-            .q_deg
-            .iter()
-            .enumerate()
-            .find(|(_, v)| v.abs() > MAX_JOINT_DEG)
-        {
-            return Err(ServiceError::Invalid(format!(
-                "row {}: joint q{} = {v} deg is beyond ±{MAX_JOINT_DEG} deg; check the angle unit",
-                i + 1,
-                k + 1
-            )));
         }
     }
     Ok(())

@@ -176,12 +176,18 @@ async fn prepare(
     Ok((solver, version, method))
 }
 
-/// The seed in the solver's joint convention, checked against the joint count.
+/// The seed in the solver's joint convention, checked against the joint count
+/// (a seed for another joint count conflicts with the robot).
 pub fn seed_joints(seed_deg: &[f64], solver: &IkSolver) -> Result<Vec<f64>, ServiceError> {
     let dof = solver.model().dof();
-    if seed_deg.len() != dof || seed_deg.iter().any(|v| !v.is_finite()) {
-        return Err(ServiceError::Invalid(format!(
-            "`seed_deg` needs {dof} finite joint values (controller convention, degrees), got {}",
+    if seed_deg.iter().any(|v| !v.is_finite()) {
+        return Err(ServiceError::Invalid(
+            "`seed_deg` values must be finite (controller convention, degrees)".into(),
+        ));
+    }
+    if seed_deg.len() != dof {
+        return Err(ServiceError::Conflict(format!(
+            "`seed_deg` needs one value per joint: the robot has {dof} joints, got {} values (controller convention, degrees)",
             seed_deg.len()
         )));
     }

@@ -150,7 +150,7 @@ fn bad_inputs() -> Vec<Bad> {
             "POST",
             "/v1/robots",
             JSON,
-            r#"{"model": {"joints": [{"alpha_deg": 0, "a_mm": 0, "d_mm": 1, "limits_deg": [90, -90]}, {"alpha_deg": 90, "a_mm": 1, "d_mm": 0}]}}"#,
+            r#"{"model": {"joints": [{"alpha_deg": 0, "a_mm": 0, "d_mm": 1, "limits_deg": [90, 90]}, {"alpha_deg": 90, "a_mm": 1, "d_mm": 0}]}}"#,
             S::UNPROCESSABLE_ENTITY,
             &["limits_deg"],
         ),
@@ -192,7 +192,7 @@ fn bad_inputs() -> Vec<Bad> {
             UPLOAD,
             CSV,
             "q1,q2,q3,x,y,z\n0,90,0,1500,0,1000\n",
-            S::UNPROCESSABLE_ENTITY,
+            S::CONFLICT,
             &["6 joints"],
         ),
         // Metres without declaring them.

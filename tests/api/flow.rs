@@ -243,7 +243,7 @@ async fn quickstart_flow_calibrate_version_and_solve() {
         .await;
     assert!(
         r.status == StatusCode::OK
-            || (r.status == StatusCode::UNPROCESSABLE_ENTITY && r.text().contains("Hayati")),
+            || (r.status == StatusCode::CONFLICT && r.text().contains("Hayati")),
         "{}",
         r.text()
     );

@@ -16,4 +16,5 @@ mod flow;
 mod jobs;
 mod sets;
 mod solve;
+mod spec;
 mod support;

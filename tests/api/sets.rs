@@ -210,7 +210,7 @@ async fn locale_csv_and_dif_sign_uploads_read_like_the_canonical_file() {
         .map(|l| l.replace(',', ";").replace('.', ","))
         .collect::<Vec<_>>()
         .join("\n");
-    for query in ["", "?delimiter=;&decimal=comma"] {
+    for query in ["", "?decimal=comma"] {
         let set = t.upload_csv(robot, &semi, query).await;
         assert_eq!(rows_of(&set).await, csv::parse(&text).unwrap(), "{query}");
     }
@@ -223,11 +223,10 @@ async fn locale_csv_and_dif_sign_uploads_read_like_the_canonical_file() {
     assert_eq!(plus[0].xyz_mm, [1500.5, 99.75, 1201.0]);
     assert_eq!(minus[0].xyz_mm, [1499.5, 100.25, 1199.0]);
 
-    // Bad options name themselves; CSV options are refused on JSON uploads.
-    for (query, expect) in [
-        ("?dif_sign=up", "dif_sign"),
-        ("?delimiter=|", "delimiter"),
-        ("?decimal=comma&delimiter=,", "decimal comma"),
+    // Bad options name themselves; the delimiter is always detected.
+    for (query, status, expect) in [
+        ("?dif_sign=up", StatusCode::UNPROCESSABLE_ENTITY, "dif_sign"),
+        ("?delimiter=;", StatusCode::BAD_REQUEST, "delimiter"),
     ] {
         let r = t
             .send(
@@ -239,21 +238,28 @@ async fn locale_csv_and_dif_sign_uploads_read_like_the_canonical_file() {
                 text.clone().into_bytes(),
             )
             .await;
-        assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{query}");
+        assert_eq!(r.status, status, "{query}");
         assert!(r.detail().contains(expect), "{query}: {}", r.detail());
     }
+    // A declared decimal comma in a comma-separated file: quoted fields.
+    let quoted = "q1,q2,q3,q4,q5,q6,x,y,z\n0,\"90,5\",0,0,0,0,\"1500,25\",0,1000\n";
+    let set = t.upload_csv(robot, quoted, "?decimal=comma").await;
+    let rows = rows_of(&set).await;
+    assert_eq!((rows[0].q_deg[1], rows[0].xyz_mm[0]), (90.5, 1500.25));
+    // The CSV reading options do not apply to JSON rows, which declare their
+    // units in the body: `dif_sign` and `length_unit` change nothing.
+    let sent = simulated_rows(6, 3, None);
     let r = t
         .send(
             "POST",
             "/v1/robots/{id}/measurement-sets",
             &[&rid],
-            "?dif_sign=minus",
+            "?dif_sign=minus&length_unit=m&angle_unit=rad",
             Some("application/json"),
-            json!({"rows": simulated_rows(6, 3, None)})
-                .to_string()
-                .into_bytes(),
+            json!({ "rows": sent }).to_string().into_bytes(),
         )
         .await;
-    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY);
-    assert!(r.detail().contains("CSV uploads"), "{}", r.detail());
+    assert_eq!(r.status, StatusCode::CREATED, "{}", r.text());
+    assert_eq!(r.json()["units"], json!({"length": "mm", "angle": "deg"}));
+    assert_eq!(rows_of(&r.json()).await, sent);
 }

@@ -62,6 +62,36 @@ impl Spec {
         v
     }
 
+    /// Whether `value` is valid for `schema` (a schema of the spec).
+    pub(crate) fn accepts(&self, schema: &Value, value: &Value) -> bool {
+        self.validator(schema).is_valid(value)
+    }
+
+    /// The schema of the request body of `method template` as `content_type`.
+    pub(crate) fn request_schema(&self, method: &str, template: &str, content_type: &str) -> Value {
+        let op = &self.doc["paths"][template][method.to_ascii_lowercase()];
+        let schema = op["requestBody"]["content"][content_type]["schema"].clone();
+        assert!(
+            schema.is_object(),
+            "{method} {template} takes no {content_type}"
+        );
+        schema
+    }
+
+    /// The schema of query parameter `name` of `method template`.
+    pub(crate) fn query_schema(&self, method: &str, template: &str, name: &str) -> Value {
+        let op = &self.doc["paths"][template][method.to_ascii_lowercase()];
+        op["parameters"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .map(|p| self.deref(p))
+            .find(|p| p["name"] == name && p["in"] == "query")
+            .unwrap_or_else(|| panic!("{method} {template} has no query parameter {name}"))
+            ["schema"]
+            .clone()
+    }
+
     /// Validates `value` against component schema `name`.
     pub(crate) fn validate_component(&self, name: &str, value: &Value) {
         let schema = json!({ "$ref": format!("#/components/schemas/{name}") });

@@ -11,6 +11,7 @@
 //!
 //! A bad target only fails itself (per-target `FailureReason`).
 
+use super::invalid::TargetError;
 use super::solver::{Goal, IkSolution, IkSolver, SolveOptions};
 use super::targets::JointJump;
 use crate::ik::config::Configuration;
@@ -28,18 +29,18 @@ impl IkSolver {
         goals: &[Goal],
         options: &SolveOptions,
     ) -> Vec<(IkSolution, Option<JointJump>)> {
-        let checked: Vec<Result<Goal, String>> = goals.iter().map(|g| Ok(*g)).collect();
+        let checked: Vec<Result<Goal, TargetError>> = goals.iter().map(|g| Ok(*g)).collect();
         self.solve_path_checked(&checked, options)
     }
 
     pub(crate) fn solve_batch_checked(
         &self,
-        goals: &[Result<Goal, String>],
+        goals: &[Result<Goal, TargetError>],
         options: &SolveOptions,
     ) -> Vec<IkSolution> {
         self.parallel_map(goals, |g| match g {
             Ok(g) => self.solve_goal(g, options),
-            Err(msg) => IkSolution::invalid(msg.clone()),
+            Err(e) => IkSolution::invalid(e.clone()),
         })
     }
 
@@ -61,14 +62,14 @@ impl IkSolver {
 
     pub(crate) fn solve_path_checked(
         &self,
-        goals: &[Result<Goal, String>],
+        goals: &[Result<Goal, TargetError>],
         options: &SolveOptions,
     ) -> Vec<(IkSolution, Option<JointJump>)> {
         let mut prev: Option<(Vec<f64>, Option<Configuration>)> = None;
         let mut out = Vec::with_capacity(goals.len());
         for g in goals {
             let sol = match g {
-                Err(msg) => IkSolution::invalid(msg.clone()),
+                Err(e) => IkSolution::invalid(e.clone()),
                 Ok(g) => self.path_step(g, options, prev.as_ref()),
             };
             let mut jump = None;

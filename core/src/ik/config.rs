@@ -90,11 +90,10 @@ impl Configuration {
     /// Parses `front,up,noflip` (any order and separators `,` `-` `/` or
     /// spaces; `flip`/`noflip`, also `no-flip`) or a branch index `0`..`7`.
     /// Flags left out default to `front`, `up`, `noflip`.
-    pub fn parse(text: &str) -> Result<Configuration, String> {
+    pub fn parse(text: &str) -> Result<Configuration, BranchError> {
         let t = text.trim().to_ascii_lowercase();
         if let Ok(i) = t.parse::<usize>() {
-            return Configuration::from_index(i)
-                .ok_or_else(|| format!("branch index must be 0..=7, got {i}"));
+            return Configuration::from_index(i).ok_or(BranchError::Index { index: i });
         }
         let t = t.replace("no-flip", "noflip").replace("no_flip", "noflip");
         let mut c = Configuration::new(Shoulder::Front, Elbow::Up, Wrist::NoFlip);
@@ -112,17 +111,28 @@ impl Configuration {
                 "noflip" => c.wrist = Wrist::NoFlip,
                 "flip" => c.wrist = Wrist::Flip,
                 other => {
-                    return Err(format!(
-                        "unknown branch flag `{other}`; use front|back, up|down, noflip|flip or an index 0..7"
-                    ))
+                    return Err(BranchError::UnknownFlag {
+                        flag: other.to_string(),
+                    })
                 }
             }
         }
         if !any {
-            return Err("empty branch".into());
+            return Err(BranchError::Empty);
         }
         Ok(c)
     }
+}
+
+/// Why a text is not a configuration branch.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum BranchError {
+    #[error("branch index must be 0..=7, got {index}")]
+    Index { index: usize },
+    #[error("unknown branch flag `{flag}`; use front|back, up|down, noflip|flip or an index 0..7")]
+    UnknownFlag { flag: String },
+    #[error("empty branch")]
+    Empty,
 }
 
 impl fmt::Display for Configuration {
@@ -159,7 +169,16 @@ mod tests {
             c,
             Configuration::new(Shoulder::Back, Elbow::Up, Wrist::NoFlip)
         );
-        assert!(Configuration::parse("sideways").is_err());
-        assert!(Configuration::parse("9").is_err());
+        assert_eq!(
+            Configuration::parse("front,sideways"),
+            Err(BranchError::UnknownFlag {
+                flag: "sideways".into()
+            })
+        );
+        assert_eq!(
+            Configuration::parse("9"),
+            Err(BranchError::Index { index: 9 })
+        );
+        assert_eq!(Configuration::parse(" ,/ "), Err(BranchError::Empty));
     }
 }

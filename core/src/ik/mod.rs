@@ -7,19 +7,27 @@
 //!   seed (branch, joint seed, limits, per-target result and failure reason).
 //! - [`batch`]: parallel batches and path mode.
 //! - [`targets`]: boundary targets (mm, degrees, orientation conventions), joint
-//!   commands in the controller convention and false targets `FK_nominal(q_cmd)`.
+//!   commands in the controller convention and false targets `FK_nominal(q_cmd)`;
+//!   [`targets_csv`]: the same as a targets file; [`invalid`]: why a target fails
+//!   alone.
 //!
 //! Units: SI inside (m, rad); mm and degrees at the boundary (`targets`).
 
 pub mod analytic;
 pub mod batch;
 pub mod config;
+pub mod invalid;
 pub mod solver;
 pub mod targets;
 pub mod targets_csv;
 
 pub use analytic::{AnalyticError, AnalyticIk, AnalyticSolution, Structure};
-pub use config::{Configuration, Elbow, Shoulder, Wrist};
-pub use solver::{FailureReason, Goal, IkSettings, IkSolution, IkSolver, Refined, SolveOptions};
+pub use config::{BranchError, Configuration, Elbow, Shoulder, Wrist};
+pub use invalid::TargetError;
+pub use solver::{
+    FailureReason, Goal, IkSettings, IkSolution, IkSolver, Refined, SolveOptions, UnknownFrame,
+};
 pub use targets::{FalseTarget, JointJump, TargetFrame, TargetInput, TargetResult};
-pub use targets_csv::{parse_targets_csv, results_csv, TargetRow, TargetsCsv, TargetsCsvError};
+pub use targets_csv::{
+    parse_targets_csv, results_csv, RowError, TargetRow, TargetsCsv, TargetsCsvError,
+};

@@ -19,6 +19,7 @@
 
 use super::analytic::{closed_form_proxy, AnalyticIk, AnalyticSolution};
 use super::config::Configuration;
+use super::invalid::TargetError;
 use crate::compensate::CompensatedModel;
 use crate::model::orientation::OrientationConvention;
 use crate::model::pose::rotation_log;
@@ -57,13 +58,22 @@ pub enum TargetFrame {
     Base,
 }
 
+/// A target frame name that is not one.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown target frame `{name}` (use cell or base)")]
+pub struct UnknownFrame {
+    pub name: String,
+}
+
 impl FromStr for TargetFrame {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = UnknownFrame;
+    fn from_str(s: &str) -> Result<Self, UnknownFrame> {
         match s.trim().to_ascii_lowercase().as_str() {
             "cell" | "measurement" | "tracker" => Ok(TargetFrame::Cell),
             "base" | "robot" => Ok(TargetFrame::Base),
-            other => Err(format!("unknown target frame `{other}` (use cell or base)")),
+            other => Err(UnknownFrame {
+                name: other.to_string(),
+            }),
         }
     }
 }
@@ -167,7 +177,7 @@ pub struct SolveOptions {
 }
 
 /// Why a target has no solution.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, thiserror::Error)]
+#[derive(Debug, Clone, PartialEq, Serialize, thiserror::Error)]
 #[serde(tag = "kind", content = "detail", rename_all = "snake_case")]
 pub enum FailureReason {
     #[error("target is out of reach")]
@@ -179,7 +189,7 @@ pub enum FailureReason {
     #[error("the solver did not converge")]
     DidNotConverge,
     #[error("invalid target: {0}")]
-    InvalidTarget(String),
+    InvalidTarget(TargetError),
     /// A configuration branch was required (requested, or kept by path mode)
     /// and the target has no solution in it.
     #[error("{}", branch_message(requested, *out_of_limits, *singular, reachable))]
@@ -236,7 +246,7 @@ impl FailureReason {
 }
 
 /// Result for one target.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct IkSolution {
     /// Residuals within the tolerances and joints within limits.
     pub converged: bool,
@@ -255,7 +265,7 @@ pub struct IkSolution {
 }
 
 impl IkSolution {
-    pub fn invalid(reason: String) -> Self {
+    pub fn invalid(reason: TargetError) -> Self {
         IkSolution::failed(FailureReason::InvalidTarget(reason))
     }
 
@@ -443,29 +453,26 @@ impl IkSolver {
         self.solve_base(&g, options)
     }
 
-    pub(crate) fn validate(&self, goal: &Goal, options: &SolveOptions) -> Result<(), String> {
+    pub(crate) fn validate(&self, goal: &Goal, options: &SolveOptions) -> Result<(), TargetError> {
         if !goal.position.iter().all(|v| v.is_finite()) {
-            return Err("position is not finite".into());
+            return Err(TargetError::GoalPositionNotFinite);
         }
         match &goal.rotation {
-            None if !options.position_only => {
-                return Err("no orientation given (required unless position-only)".into())
-            }
+            None if !options.position_only => return Err(TargetError::NoOrientation),
             Some(r) if !r.iter().all(|v| v.is_finite()) => {
-                return Err("orientation is not finite".into())
+                return Err(TargetError::OrientationNotFinite)
             }
             Some(r) if (r.transpose() * r - Matrix3::identity()).amax() > 1e-6 => {
-                return Err("orientation matrix is not a rotation".into())
+                return Err(TargetError::NotARotation)
             }
             _ => {}
         }
         if let Some(s) = &options.seed {
             if s.len() != self.model.dof() || !s.iter().all(|v| v.is_finite()) {
-                return Err(format!(
-                    "joint seed needs {} finite values, got {}",
-                    self.model.dof(),
-                    s.len()
-                ));
+                return Err(TargetError::Seed {
+                    expected: self.model.dof(),
+                    got: s.len(),
+                });
             }
         }
         Ok(())

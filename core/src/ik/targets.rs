@@ -13,6 +13,7 @@
 //!   the controller's nominal base frame, in the caller's orientation
 //!   convention (quaternion when the target had no orientation).
 
+use super::invalid::TargetError;
 pub use super::solver::TargetFrame;
 use super::solver::{Goal, IkSolution, IkSolver};
 use crate::model::orientation::{rotation_from, rotation_to, OrientationConvention};
@@ -37,19 +38,18 @@ pub struct TargetInput {
 
 impl TargetInput {
     /// The SI goal and the orientation convention, or why the target is invalid.
-    pub fn to_goal(&self) -> Result<(Goal, Option<OrientationConvention>), String> {
+    pub fn to_goal(&self) -> Result<(Goal, Option<OrientationConvention>), TargetError> {
         if let Some(i) = self.xyz_mm.iter().position(|v| !v.is_finite()) {
-            return Err(format!(
-                "position {} is {}; must be finite",
-                ["x", "y", "z"][i],
-                self.xyz_mm[i]
-            ));
+            return Err(TargetError::PositionNotFinite {
+                axis: ['x', 'y', 'z'][i],
+                value: self.xyz_mm[i],
+            });
         }
         let position = Vector3::from(self.xyz_mm) * 1e-3;
         match &self.convention {
             None => {
                 if !self.orientation.is_empty() {
-                    return Err("orientation values given without a convention".into());
+                    return Err(TargetError::ValuesWithoutConvention);
                 }
                 Ok((
                     Goal {
@@ -60,8 +60,8 @@ impl TargetInput {
                 ))
             }
             Some(name) => {
-                let conv = OrientationConvention::from_name(name).map_err(|e| e.to_string())?;
-                let r = rotation_from(conv, &self.orientation).map_err(|e| e.to_string())?;
+                let conv = OrientationConvention::from_name(name)?;
+                let r = rotation_from(conv, &self.orientation)?;
                 Ok((
                     Goal {
                         position,
@@ -93,7 +93,7 @@ pub struct JointJump {
 }
 
 /// Everything returned for one target.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct TargetResult {
     pub id: String,
     pub solution: IkSolution,
@@ -199,7 +199,7 @@ impl IkSolver {
             .map(|(i, t)| {
                 let (solution, conv) = match t.to_goal() {
                     Ok((goal, conv)) => (self.solve_goal(&goal, options), conv),
-                    Err(msg) => (IkSolution::invalid(msg), None),
+                    Err(e) => (IkSolution::invalid(e), None),
                 };
                 self.target_result(i, t, conv, options, solution, None)
             })
@@ -225,10 +225,10 @@ impl IkSolver {
     }
 }
 
-type ParsedTarget = Result<(Goal, Option<OrientationConvention>), String>;
+type ParsedTarget = Result<(Goal, Option<OrientationConvention>), TargetError>;
 
 /// Parses boundary targets into goals (keeping each target's convention).
-fn parse_targets(targets: &[TargetInput]) -> (Vec<ParsedTarget>, Vec<Result<Goal, String>>) {
+fn parse_targets(targets: &[TargetInput]) -> (Vec<ParsedTarget>, Vec<Result<Goal, TargetError>>) {
     let parsed: Vec<ParsedTarget> = targets.iter().map(TargetInput::to_goal).collect();
     let goals = parsed
         .iter()

@@ -43,7 +43,29 @@ pub struct TargetRow {
     pub id: String,
     /// 1-based line in the file.
     pub line: usize,
-    pub target: Result<TargetInput, String>,
+    pub target: Result<TargetInput, RowError>,
+}
+
+/// Why one row of a targets file is not a target (the row fails alone).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RowError {
+    #[error("line {line}: {got} fields, the header has {expected}")]
+    FieldCount {
+        line: usize,
+        got: usize,
+        expected: usize,
+    },
+    #[error(
+        "line {line}: column `{column}`: `{}` is not a number",
+        short_text(value)
+    )]
+    NotNumber {
+        line: usize,
+        column: String,
+        value: String,
+    },
+    #[error("line {line}: some orientation fields are empty")]
+    PartialOrientation { line: usize },
 }
 
 /// A parsed targets file.
@@ -166,12 +188,14 @@ pub fn parse_targets_csv(text: &str, dialect: Dialect) -> Result<TargetsCsv, Tar
                 .cloned()
                 .unwrap_or_else(|| (n + 1).to_string());
             let cells: Vec<&str> = rec.fields.iter().map(String::as_str).collect();
-            let target = parse_row(&cells, &cols, &xyz, &ori_idx, convention, &table)
-                .map(|mut t| {
-                    t.id = Some(id.clone());
-                    t
-                })
-                .map_err(|e| format!("line {}: {e}", rec.line));
+            let row = Row {
+                line: rec.line,
+                cells: &cells,
+            };
+            let target = parse_row(&row, &cols, &xyz, &ori_idx, convention, &table).map(|mut t| {
+                t.id = Some(id.clone());
+                t
+            });
             TargetRow {
                 id,
                 line: rec.line,
@@ -182,28 +206,33 @@ pub fn parse_targets_csv(text: &str, dialect: Dialect) -> Result<TargetsCsv, Tar
     Ok(TargetsCsv { convention, rows })
 }
 
+/// A record's fields and its 1-based line.
+struct Row<'a> {
+    line: usize,
+    cells: &'a [&'a str],
+}
+
 fn parse_row(
-    cells: &[&str],
+    row: &Row,
     cols: &[String],
     xyz: &[usize; 3],
     ori_idx: &[usize],
     convention: Option<OrientationConvention>,
     table: &csv_text::Table,
-) -> Result<TargetInput, String> {
+) -> Result<TargetInput, RowError> {
+    let (line, cells) = (row.line, row.cells);
     if cells.len() != cols.len() {
-        return Err(format!(
-            "{} fields, the header has {}",
-            cells.len(),
-            cols.len()
-        ));
+        return Err(RowError::FieldCount {
+            line,
+            got: cells.len(),
+            expected: cols.len(),
+        });
     }
-    let num = |i: usize| -> Result<f64, String> {
-        table.number(cells[i]).ok_or_else(|| {
-            format!(
-                "column `{}`: `{}` is not a number",
-                cols[i],
-                short_text(cells[i])
-            )
+    let num = |i: usize| -> Result<f64, RowError> {
+        table.number(cells[i]).ok_or_else(|| RowError::NotNumber {
+            line,
+            column: cols[i].clone(),
+            value: cells[i].to_string(),
         })
     };
     let xyz_mm = [num(xyz[0])?, num(xyz[1])?, num(xyz[2])?];
@@ -211,12 +240,12 @@ fn parse_row(
     let (convention, orientation) = if ori_idx.is_empty() || empty == ori_idx.len() {
         (None, Vec::new())
     } else if empty > 0 {
-        return Err("some orientation fields are empty".into());
+        return Err(RowError::PartialOrientation { line });
     } else {
         let values = ori_idx
             .iter()
             .map(|&i| num(i))
-            .collect::<Result<Vec<f64>, String>>()?;
+            .collect::<Result<Vec<f64>, RowError>>()?;
         (convention.map(|k| k.name().to_string()), values)
     };
     Ok(TargetInput {
@@ -251,9 +280,9 @@ impl TargetsCsv {
             .iter()
             .map(|r| match &r.target {
                 Ok(_) => solved.next().expect("one result per valid target"),
-                Err(msg) => TargetResult {
+                Err(e) => TargetResult {
                     id: r.id.clone(),
-                    solution: IkSolution::invalid(msg.clone()),
+                    solution: IkSolution::invalid(e.clone().into()),
                     joints_deg: None,
                     false_target: None,
                     jump: None,
@@ -378,7 +407,28 @@ mod tests {
         assert!(t.rows[0].target.is_ok());
         assert_eq!(t.rows[1].line, 4);
         let e = t.rows[1].target.as_ref().unwrap_err();
-        assert!(e.starts_with("line 4:") && e.contains("`z`"), "{e}");
+        assert_eq!(
+            *e,
+            RowError::NotNumber {
+                line: 4,
+                column: "z".into(),
+                value: "x".into()
+            }
+        );
+        assert_eq!(e.to_string(), "line 4: column `z`: `x` is not a number");
+        let t = parse("x,y,z,a,b,c\n1,2\n1,2,3,0,,0\n").unwrap();
+        let errors: Vec<String> = t
+            .rows
+            .iter()
+            .map(|r| r.target.as_ref().unwrap_err().to_string())
+            .collect();
+        assert_eq!(
+            errors,
+            [
+                "line 2: 2 fields, the header has 6",
+                "line 3: some orientation fields are empty"
+            ]
+        );
         let t = parse("x,y,z,W,P,R\n1,2,3,0,0,0\n").unwrap();
         assert_eq!(t.convention, Some(OrientationConvention::FanucWpr));
         assert_eq!(t.rows[0].id, "1");

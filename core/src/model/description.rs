@@ -18,6 +18,10 @@ use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
 const MM: f64 = 1e-3;
+/// Largest magnitude of a gravity component [m/s²] (larger ones are not m/s²).
+pub const MAX_GRAVITY_MPS2: f64 = 100.0;
+/// Longest model name (characters).
+pub const NAME_MAX_CHARS: usize = 200;
 
 /// An error in a model description, naming the field.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -61,8 +65,13 @@ pub struct JointDescription {
     pub d_mm: f64,
     #[serde(default)]
     pub theta_offset_deg: f64,
-    /// Hayati link (modified convention only); detected from α when omitted.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    /// Hayati link; when omitted, whether the row has a β or its axis is
+    /// parallel to the previous one. `null` is not a value.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "some_bool"
+    )]
     pub parallel: Option<bool>,
     #[serde(default = "default_limits")]
     pub limits_deg: [f64; 2],
@@ -105,11 +114,29 @@ pub struct ToolDescription {
 #[serde(deny_unknown_fields)]
 pub struct ClosedLoopDescription {
     /// 1-based index of the passive joint (3 on the HH800).
+    #[serde(deserialize_with = "joint_number")]
     pub passive_joint: usize,
     pub l3_mm: f64,
     pub l4_mm: f64,
     pub l5_mm: f64,
     pub xi_deg: f64,
+}
+
+/// A boolean that may be left out but is not `null`.
+fn some_bool<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<bool>, D::Error> {
+    bool::deserialize(d).map(Some)
+}
+
+/// A 1-based joint number as JSON Schema counts integers (`3` and `3.0`).
+fn joint_number<'de, D: serde::Deserializer<'de>>(d: D) -> Result<usize, D::Error> {
+    let v = f64::deserialize(d)?;
+    if v.fract() == 0.0 && (0.0..=1e6).contains(&v) {
+        Ok(v as usize)
+    } else {
+        Err(serde::de::Error::custom(format!(
+            "{v} is not a joint number"
+        )))
+    }
 }
 
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
@@ -145,6 +172,17 @@ pub struct ModelDescription {
     pub gravity_mps2: [f64; 3],
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub assumptions: Vec<String>,
+}
+
+/// Millimetres to metres; a nonzero length stays nonzero (below 1e-320 mm it
+/// becomes the smallest length of its sign instead of 0).
+fn metres(mm: f64) -> f64 {
+    let m = mm * MM;
+    if m == 0.0 && mm != 0.0 {
+        f64::from_bits(1).copysign(mm)
+    } else {
+        m
+    }
 }
 
 fn finite(field: &str, v: f64) -> Result<f64, ModelError> {
@@ -184,32 +222,33 @@ impl ModelDescription {
             let f = |name: &str| format!("joints[{i}].{name}");
             let mut link = Link::new(
                 finite(&f("alpha_deg"), j.alpha_deg)?.to_radians(),
-                finite(&f("a_mm"), j.a_mm)? * MM,
+                metres(finite(&f("a_mm"), j.a_mm)?),
                 finite(&f("d_mm"), j.d_mm)? * MM,
                 finite(&f("theta_offset_deg"), j.theta_offset_deg)?.to_radians(),
             );
             link.beta = finite(&f("beta_deg"), j.beta_deg)?.to_radians();
             link.b = finite(&f("b_mm"), j.b_mm)? * MM;
-            if i > 0 && link.b != 0.0 {
+            if i > 0 && j.b_mm != 0.0 {
                 return Err(invalid(
                     f("b_mm"),
                     "only the first joint (the base, eq. 4.3) has a y offset b",
                 ));
             }
-            let lim = [
+            let (l0, l1) = (
                 finite(&f("limits_deg[0]"), j.limits_deg[0])?,
                 finite(&f("limits_deg[1]"), j.limits_deg[1])?,
-            ];
-            if lim[0] >= lim[1] {
+            );
+            // The two limits in either order; they must leave a range.
+            if l0 == l1 {
                 return Err(invalid(
                     f("limits_deg"),
-                    format!(
-                        "lower limit {} must be below upper limit {}",
-                        lim[0], lim[1]
-                    ),
+                    format!("the two limits must differ, got {l0} twice"),
                 ));
             }
-            link.limits = [lim[0].to_radians(), lim[1].to_radians()];
+            let lo = l0.min(l1).to_radians();
+            let hi = l0.max(l1).to_radians();
+            // Limits a few ulps apart stay apart in radians.
+            link.limits = [lo, if hi > lo { hi } else { lo.next_up() }];
             if j.sign != 1.0 && j.sign != -1.0 {
                 return Err(invalid(
                     f("sign"),
@@ -233,7 +272,13 @@ impl ModelDescription {
                     "beta and b belong to the modified convention; use \"convention\": \"modified\"",
                 ));
             }
-            links.push((link, j.parallel));
+            if i == 0 && j.parallel == Some(true) {
+                return Err(invalid(
+                    "joints[0].parallel",
+                    "the first joint has no previous axis to be parallel to",
+                ));
+            }
+            links.push((link, j.parallel, j.beta_deg != 0.0));
         }
 
         let tool_p = finite3("tool.xyz_mm", self.tool.xyz_mm)? * MM;
@@ -246,21 +291,16 @@ impl ModelDescription {
         let mut out: Vec<Link> = Vec::with_capacity(n);
         match self.convention {
             DhConvention::Modified => {
-                for (k, (link, parallel)) in links.into_iter().enumerate() {
+                for (k, (link, parallel, has_beta)) in links.into_iter().enumerate() {
                     let mut link = link;
-                    if let Some(p) = parallel {
-                        if p && k == 0 {
-                            return Err(invalid(
-                                "joints[0].parallel",
-                                "the first joint has no previous axis to be parallel to",
-                            ));
-                        }
-                        link.parallel = p;
-                    } else {
-                        link.parallel =
-                            k > 0 && link.alpha.sin().abs() < RobotModel::parallel_threshold();
-                    }
-                    if !link.parallel && k > 0 && link.beta != 0.0 {
+                    // Omitted: a Hayati link when it has a twist β or its axis
+                    // is parallel to the previous one.
+                    link.parallel = parallel.unwrap_or(
+                        k > 0
+                            && (has_beta
+                                || link.alpha.sin().abs() < RobotModel::parallel_threshold()),
+                    );
+                    if !link.parallel && k > 0 && has_beta {
                         return Err(invalid(
                             format!("joints[{k}].beta_deg"),
                             "beta is only used on parallel (Hayati) links; set \"parallel\": true",
@@ -272,8 +312,8 @@ impl ModelDescription {
             DhConvention::Standard => {
                 // Standard row k: Rz(θ_k)Tz(d_k)Tx(a_k)Rx(α_k). Regrouped: modified link k
                 // takes α_{k-1}, a_{k-1} of the previous standard row.
-                let std_rows: Vec<Link> = links.iter().map(|(l, _)| l.clone()).collect();
-                for (k, (link, parallel)) in links.into_iter().enumerate() {
+                let std_rows: Vec<Link> = links.iter().map(|(l, _, _)| l.clone()).collect();
+                for (k, (link, parallel, _)) in links.into_iter().enumerate() {
                     let mut m = link.clone();
                     if k == 0 {
                         m.alpha = 0.0;
@@ -319,18 +359,22 @@ impl ModelDescription {
                         ),
                     ));
                 }
-                let l3 = finite("closed_loop.l3_mm", c.l3_mm)? * MM;
-                let l4 = finite("closed_loop.l4_mm", c.l4_mm)? * MM;
-                let l5 = finite("closed_loop.l5_mm", c.l5_mm)? * MM;
-                for (name, v) in [("l3_mm", l3), ("l4_mm", l4), ("l5_mm", l5)] {
-                    if v <= 0.0 {
+                for (name, v) in [("l3_mm", c.l3_mm), ("l4_mm", c.l4_mm), ("l5_mm", c.l5_mm)] {
+                    if finite(&format!("closed_loop.{name}"), v)? <= 0.0 {
                         return Err(invalid(format!("closed_loop.{name}"), "must be positive"));
                     }
                 }
+                let (l3, l4, l5) = (metres(c.l3_mm), metres(c.l4_mm), metres(c.l5_mm));
                 let passive = c.passive_joint - 1;
-                if out[passive].a <= 0.0 {
+                // The loop side SP is the passive link's a: its own row in the
+                // modified convention, the row before it in the standard one.
+                let row = match self.convention {
+                    DhConvention::Modified => passive,
+                    DhConvention::Standard => passive - 1,
+                };
+                if self.joints[row].a_mm <= 0.0 {
                     return Err(invalid(
-                        format!("joints[{passive}].a_mm"),
+                        format!("joints[{row}].a_mm"),
                         "the passive joint's a (the loop side SP) must be positive",
                     ));
                 }
@@ -361,14 +405,27 @@ impl ModelDescription {
             mass_offset,
         };
         let gravity = finite3("gravity_mps2", self.gravity_mps2)?;
-        if gravity.norm() > 100.0 {
+        if let Some(g) = gravity.iter().find(|g| g.abs() > MAX_GRAVITY_MPS2) {
             return Err(invalid(
                 "gravity_mps2",
                 format!(
-                    "norm {:.1} m/s² is implausible; give gravity in m/s² (e.g. [0, 0, -9.81])",
-                    gravity.norm()
+                    "component {g:.1} m/s² is implausible (at most ±{MAX_GRAVITY_MPS2}); give gravity in m/s² (e.g. [0, 0, -9.81])"
                 ),
             ));
+        }
+        if self.name.chars().count() > NAME_MAX_CHARS {
+            return Err(invalid(
+                "name",
+                format!("is longer than {NAME_MAX_CHARS} characters"),
+            ));
+        }
+        if !self.name.is_empty()
+            && self
+                .name
+                .chars()
+                .all(|c| matches!(c, ' ' | '\t' | '\r' | '\n'))
+        {
+            return Err(invalid("name", "must not be only blanks"));
         }
         let name = if self.name.is_empty() {
             "robot".to_string()
@@ -518,7 +575,7 @@ mod tests {
     #[test]
     fn rejects_bad_fields_by_name() {
         let mut v = minimal();
-        v["joints"][1]["limits_deg"] = serde_json::json!([90.0, -90.0]);
+        v["joints"][1]["limits_deg"] = serde_json::json!([90.0, 90.0]);
         let e = RobotModel::from_json(&v.to_string()).unwrap_err();
         assert!(e.to_string().contains("joints[1].limits_deg"), "{e}");
 
@@ -554,6 +611,70 @@ mod tests {
 
         let e = RobotModel::from_json("{\"joints\": [ {\"d_mm\": 1e999} ]}").unwrap_err();
         assert!(matches!(e, ModelError::Parse(_)), "{e}");
+    }
+
+    #[test]
+    fn rules_across_fields() {
+        let model = |v: serde_json::Value| RobotModel::from_json(&v.to_string());
+        // Limits in either order; equal ones leave no range.
+        let m = model(serde_json::json!({"joints": [{"limits_deg": [90, -45]}, {}]})).unwrap();
+        assert_eq!(
+            m.links[0].limits,
+            [(-45f64).to_radians(), 90f64.to_radians()]
+        );
+        let m = model(serde_json::json!({"joints": [{"limits_deg": [0, 5e-324]}, {}]})).unwrap();
+        assert!(m.links[0].limits[0] < m.links[0].limits[1]);
+        // A later joint with β is a Hayati link unless it says otherwise.
+        let m =
+            model(serde_json::json!({"joints": [{}, {"alpha_deg": 90, "beta_deg": 1}]})).unwrap();
+        assert!(m.links[1].parallel);
+        // Nonzero lengths stay nonzero in metres.
+        let v = serde_json::json!({"joints": [{}, {"a_mm": 1e-323}], "closed_loop":
+            {"passive_joint": 2.0, "l3_mm": 5e-324, "l4_mm": 1, "l5_mm": 1, "xi_deg": 0}});
+        let m = model(v).unwrap();
+        let c = m.closed_loop.as_ref().unwrap();
+        assert!(m.links[1].a > 0.0 && c.l3 > 0.0 && c.passive == 1);
+        assert!(RobotModel::from_json(&m.to_json()).is_ok());
+        for (v, field) in [
+            (
+                serde_json::json!({"joints": [{"limits_deg": [5, 5]}, {}]}),
+                "joints[0].limits_deg",
+            ),
+            (
+                serde_json::json!({"convention": "standard", "joints": [{"parallel": true}, {}]}),
+                "joints[0].parallel",
+            ),
+            (
+                serde_json::json!({"joints": [{}, {"b_mm": 1e-9}]}),
+                "joints[1].b_mm",
+            ),
+            (
+                serde_json::json!({"joints": [{}, {"beta_deg": 1, "parallel": false}]}),
+                "joints[1].beta_deg",
+            ),
+            (
+                serde_json::json!({"joints": [{}, {}], "gravity_mps2": [0, 0, -100.5]}),
+                "gravity_mps2",
+            ),
+            (serde_json::json!({"name": " ", "joints": [{}, {}]}), "name"),
+            (
+                serde_json::json!({"name": "x".repeat(201), "joints": [{}, {}]}),
+                "name",
+            ),
+            (
+                serde_json::json!({"convention": "standard", "joints": [{}, {"a_mm": 5}], "closed_loop":
+                {"passive_joint": 2, "l3_mm": 1, "l4_mm": 1, "l5_mm": 1, "xi_deg": 0}}),
+                "joints[0].a_mm",
+            ),
+        ] {
+            let e = model(v.clone()).unwrap_err();
+            assert!(e.to_string().contains(field), "{v}: {e}");
+        }
+        // Gravity is checked per component (the norm of this one is 104).
+        assert!(
+            model(serde_json::json!({"joints": [{}, {}], "gravity_mps2": [60, 60, -60]})).is_ok()
+        );
+        assert!(model(serde_json::json!({"joints": [{}, {"parallel": null}]})).is_err());
     }
 
     #[test]
