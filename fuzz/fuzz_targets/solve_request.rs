@@ -5,7 +5,7 @@
 use libfuzzer_sys::fuzz_target;
 use robocal::compensate::CompensatedModel;
 use robocal::http::input::from_json_object;
-use robocal::http::solve::{json_command, SolveRequest};
+use robocal::http::solve::{json_command, CsvSolveQuery, SolveRequest};
 use robocal::ik::{IkSettings, IkSolver};
 use robocal::service::solve::{seed_joints, Targets};
 use std::sync::OnceLock;
@@ -22,7 +22,7 @@ fuzz_target!(|data: &[u8]| {
     let Ok(req) = from_json_object::<SolveRequest>(data) else {
         return;
     };
-    let Ok(mut cmd) = json_command(1, &req) else {
+    let Ok(mut cmd) = json_command(1, &req, &CsvSolveQuery::default()) else {
         return;
     };
     if let Some(s) = &cmd.seed_deg {
