@@ -24,7 +24,9 @@ use super::checks::{
 };
 use super::identifiability::{self, IdentifiabilityReport};
 use super::least_squares::predict;
-use super::methods::{self, Cache, Compliance, Context, Method, MethodError, MethodProgress};
+use super::methods::{
+    self, Cache, Compliance, Context, Method, MethodError, MethodFailure, MethodProgress,
+};
 use super::options::{CalibrationOptions, Progress};
 use super::registration::register;
 use super::report::{
@@ -38,6 +40,208 @@ use crate::model::pose::Pose;
 use crate::model::{ParamId, ParamKind, ParamLayout, RobotModel};
 use nalgebra::Vector3;
 use std::collections::BTreeMap;
+
+/// Runs the calibration without a compensator training pool. `progress`
+/// returns false to cancel.
+pub fn calibrate(
+    nominal: &RobotModel,
+    identification: &[Measurement],
+    validation: &[Measurement],
+    opts: &CalibrationOptions,
+    progress: &dyn Fn(&Progress) -> bool,
+) -> Result<CalibrationReport, CalibrationError> {
+    calibrate_with_training(nominal, identification, &[], validation, opts, progress)
+}
+
+/// Runs the calibration with the data roles of DESIGN "Data roles": Q1
+/// `identification` fits the model-based part, Q2 `training` trains the
+/// compensators (empty: they train on Q1 and are judged by k-fold
+/// cross-validation inside it), Q3 `validation` is never fitted. Training
+/// poses must come from tracker sessions that have identification poses.
+/// `progress` returns false to cancel.
+pub fn calibrate_with_training(
+    nominal: &RobotModel,
+    identification: &[Measurement],
+    training: &[Measurement],
+    validation: &[Measurement],
+    opts: &CalibrationOptions,
+    progress: &dyn Fn(&Progress) -> bool,
+) -> Result<CalibrationReport, CalibrationError> {
+    // The nominal forward kinematics of the identification poses, shared by
+    // the checks, the registration, the nominal errors, the identifiability
+    // Jacobian and the first evaluation of the fits.
+    let chains = check_inputs(nominal, identification, training, validation)?;
+    say(progress, "registration", 0.0)?;
+    let prepared = prepare(nominal, identification, training, validation, &chains, opts)?;
+    let reg = &prepared.reg;
+
+    let gravity = gravity_problem(nominal, &reg.ident);
+    let Plan { to_run, mut failed } = plan(&opts.methods, gravity.as_ref());
+    if to_run.is_empty() {
+        return Err(CalibrationError::AllMethodsFailed { failed });
+    }
+
+    say(progress, "identifiability", 5.0)?;
+    let with_compliance = to_run.iter().any(|m| match m.row().compliance {
+        Compliance::Yes => true,
+        Compliance::IfLoaded => gravity.is_none(),
+        Compliance::No => false,
+    });
+    let idf = identifiability_phase(nominal, reg, &chains, with_compliance, opts)?;
+    let mut identifiability = idf.report;
+    let mut start = nominal.clone();
+    for l in start.links.iter_mut() {
+        l.compliance = 0.0;
+    }
+    let ctx = Context {
+        nominal,
+        start,
+        ident: &reg.ident,
+        ident_chains: &chains,
+        valid: &reg.valid,
+        training: &prepared.training,
+        sessions: reg.sessions,
+        kept_geo: idf.kept_geo,
+        kept_c: idf.kept_c,
+        gravity,
+        opts,
+    };
+    let methods = run_methods(&ctx, &to_run, &mut failed, &mut identifiability, progress)?;
+    if methods.is_empty() {
+        return Err(CalibrationError::AllMethodsFailed { failed });
+    }
+    Ok(CalibrationReport {
+        format_version: REPORT_FORMAT_VERSION,
+        robot: nominal.name.clone(),
+        identification_poses: identification.len(),
+        validation_poses: validation.len(),
+        training_poses: training.len(),
+        registration: prepared.reg.reports,
+        identifiability,
+        nominal: prepared.nominal,
+        methods,
+        failed,
+        session_names: Vec::new(),
+        pose_sources: PoseSources::default(),
+        tracker_to_base: prepared.reg.tracker_to_base[0],
+    })
+}
+
+/// Reports a phase without iterations at `percent`; cancelled when
+/// `progress` says so.
+fn say(
+    progress: &dyn Fn(&Progress) -> bool,
+    phase: &str,
+    percent: f64,
+) -> Result<(), CalibrationError> {
+    if progress(&Progress {
+        phase: phase.to_string(),
+        iteration: 0,
+        percent,
+        rms_mm: None,
+    }) {
+        Ok(())
+    } else {
+        Err(CalibrationError::Cancelled)
+    }
+}
+
+/// Checks every set; returns the nominal forward kinematics of the
+/// identification poses.
+fn check_inputs(
+    nominal: &RobotModel,
+    identification: &[Measurement],
+    training: &[Measurement],
+    validation: &[Measurement],
+) -> Result<Vec<Chain>, CalibrationError> {
+    if identification.is_empty() {
+        return Err(CalibrationError::NoData);
+    }
+    let chains = checked_chains(nominal, identification, "identification")?;
+    check_set(nominal, training, "training")?;
+    check_set(nominal, validation, "validation")?;
+    if let Some((index, m)) = training
+        .iter()
+        .enumerate()
+        .find(|(_, m)| !identification.iter().any(|i| i.session == m.session))
+    {
+        return Err(CalibrationError::UnregisteredSession {
+            set: "training",
+            index,
+            session: m.session,
+        });
+    }
+    Ok(chains)
+}
+
+/// The methods to run, and those that failed before they started.
+struct Plan {
+    to_run: Vec<Method>,
+    failed: Vec<FailedMethod>,
+}
+
+/// Methods that need gravity torques fail fast when gravity loads no joint
+/// (`gravity` says why).
+fn plan(methods: &[Method], gravity: Option<&MethodFailure>) -> Plan {
+    let mut p = Plan {
+        to_run: Vec::new(),
+        failed: Vec::new(),
+    };
+    for &method in methods {
+        match gravity {
+            Some(why) if method.uses_torques() => p.failed.push(FailedMethod {
+                method,
+                reason: why.to_string(),
+            }),
+            _ => p.to_run.push(method),
+        }
+    }
+    p
+}
+
+/// The sets in the registered base frame and the nominal model's errors.
+struct Prepared {
+    reg: Registered,
+    /// The compensators' training poses (Q2) in the base frame.
+    training: Vec<Measurement>,
+    nominal: NominalErrors,
+}
+
+/// Registers every session and measures the nominal model; rejects data
+/// inconsistent with the model.
+fn prepare(
+    nominal: &RobotModel,
+    identification: &[Measurement],
+    training: &[Measurement],
+    validation: &[Measurement],
+    chains: &[Chain],
+    opts: &CalibrationOptions,
+) -> Result<Prepared, CalibrationError> {
+    let predicted = nominal_predictions(nominal, identification, chains);
+    let reg = register_sessions(identification, &predicted, validation, opts)?;
+    let training = reg.to_base(training);
+    let id_frames = vec![Pose::identity(); reg.sessions];
+    let nominal_errors = NominalErrors {
+        identification: SetErrors::from_predictions(
+            &id_frames,
+            &reg.ident,
+            predicted.iter().copied(),
+        ),
+        validation: (!reg.valid.is_empty()).then(|| SetErrors::of(nominal, &id_frames, &reg.valid)),
+    };
+    let nominal_rms = nominal_errors.identification.stats.rms_mm;
+    if nominal_rms > opts.max_nominal_rms_mm {
+        return Err(CalibrationError::Inconsistent {
+            rms_mm: nominal_rms,
+            limit_mm: opts.max_nominal_rms_mm,
+        });
+    }
+    Ok(Prepared {
+        reg,
+        training,
+        nominal: nominal_errors,
+    })
+}
 
 /// Measurements registered into the base frame.
 struct Registered {
@@ -201,194 +405,6 @@ fn identifiability_phase(
         kept_geo,
         kept_c,
         report: analysis.report,
-    })
-}
-
-/// Runs the calibration without a compensator training pool. `progress`
-/// returns false to cancel.
-pub fn calibrate(
-    nominal: &RobotModel,
-    identification: &[Measurement],
-    validation: &[Measurement],
-    opts: &CalibrationOptions,
-    progress: &dyn Fn(&Progress) -> bool,
-) -> Result<CalibrationReport, CalibrationError> {
-    calibrate_with_training(nominal, identification, &[], validation, opts, progress)
-}
-
-/// Runs the calibration with the data roles of DESIGN "Data roles": Q1
-/// `identification` fits the model-based part, Q2 `training` trains the
-/// compensators (empty: they train on Q1 and are judged by k-fold
-/// cross-validation inside it), Q3 `validation` is never fitted. Training
-/// poses must come from tracker sessions that have identification poses.
-/// `progress` returns false to cancel.
-pub fn calibrate_with_training(
-    nominal: &RobotModel,
-    identification: &[Measurement],
-    training: &[Measurement],
-    validation: &[Measurement],
-    opts: &CalibrationOptions,
-    progress: &dyn Fn(&Progress) -> bool,
-) -> Result<CalibrationReport, CalibrationError> {
-    // The nominal forward kinematics of the identification poses, shared by
-    // the checks, the registration, the nominal errors, the identifiability
-    // Jacobian and the first evaluation of the fits.
-    let chains = check_inputs(nominal, identification, training, validation)?;
-    say(progress, "registration", 0.0)?;
-    let prepared = prepare(nominal, identification, training, validation, &chains, opts)?;
-    let reg = &prepared.reg;
-
-    // Methods that need gravity torques fail fast when gravity loads no joint.
-    let gravity = gravity_problem(nominal, &reg.ident);
-    let mut failed: Vec<FailedMethod> = Vec::new();
-    let mut to_run: Vec<Method> = Vec::new();
-    for m in &opts.methods {
-        match &gravity {
-            Some(why) if m.uses_torques() => failed.push(FailedMethod {
-                method: *m,
-                reason: why.to_string(),
-            }),
-            _ => to_run.push(*m),
-        }
-    }
-    if to_run.is_empty() {
-        return Err(CalibrationError::AllMethodsFailed { failed });
-    }
-
-    say(progress, "identifiability", 5.0)?;
-    let with_compliance = to_run.iter().any(|m| match m.row().compliance {
-        Compliance::Yes => true,
-        Compliance::IfLoaded => gravity.is_none(),
-        Compliance::No => false,
-    });
-    let idf = identifiability_phase(nominal, reg, &chains, with_compliance, opts)?;
-    let mut identifiability = idf.report;
-    let mut start = nominal.clone();
-    for l in start.links.iter_mut() {
-        l.compliance = 0.0;
-    }
-    let ctx = Context {
-        nominal,
-        start,
-        ident: &reg.ident,
-        ident_chains: &chains,
-        valid: &reg.valid,
-        training: &prepared.training,
-        sessions: reg.sessions,
-        kept_geo: idf.kept_geo,
-        kept_c: idf.kept_c,
-        gravity,
-        opts,
-    };
-    let methods = run_methods(&ctx, &to_run, &mut failed, &mut identifiability, progress)?;
-    if methods.is_empty() {
-        return Err(CalibrationError::AllMethodsFailed { failed });
-    }
-    Ok(CalibrationReport {
-        format_version: REPORT_FORMAT_VERSION,
-        robot: nominal.name.clone(),
-        identification_poses: identification.len(),
-        validation_poses: validation.len(),
-        training_poses: training.len(),
-        registration: prepared.reg.reports,
-        identifiability,
-        nominal: prepared.nominal,
-        methods,
-        failed,
-        session_names: Vec::new(),
-        pose_sources: PoseSources::default(),
-        tracker_to_base: prepared.reg.tracker_to_base[0],
-    })
-}
-
-/// Reports a phase without iterations at `percent`; cancelled when
-/// `progress` says so.
-fn say(
-    progress: &dyn Fn(&Progress) -> bool,
-    phase: &str,
-    percent: f64,
-) -> Result<(), CalibrationError> {
-    if progress(&Progress {
-        phase: phase.to_string(),
-        iteration: 0,
-        percent,
-        rms_mm: None,
-    }) {
-        Ok(())
-    } else {
-        Err(CalibrationError::Cancelled)
-    }
-}
-
-/// Checks every set; returns the nominal forward kinematics of the
-/// identification poses.
-fn check_inputs(
-    nominal: &RobotModel,
-    identification: &[Measurement],
-    training: &[Measurement],
-    validation: &[Measurement],
-) -> Result<Vec<Chain>, CalibrationError> {
-    if identification.is_empty() {
-        return Err(CalibrationError::NoData);
-    }
-    let chains = checked_chains(nominal, identification, "identification")?;
-    check_set(nominal, training, "training")?;
-    check_set(nominal, validation, "validation")?;
-    if let Some((index, m)) = training
-        .iter()
-        .enumerate()
-        .find(|(_, m)| !identification.iter().any(|i| i.session == m.session))
-    {
-        return Err(CalibrationError::UnregisteredSession {
-            set: "training",
-            index,
-            session: m.session,
-        });
-    }
-    Ok(chains)
-}
-
-/// The sets in the registered base frame and the nominal model's errors.
-struct Prepared {
-    reg: Registered,
-    /// The compensators' training poses (Q2) in the base frame.
-    training: Vec<Measurement>,
-    nominal: NominalErrors,
-}
-
-/// Registers every session and measures the nominal model; rejects data
-/// inconsistent with the model.
-fn prepare(
-    nominal: &RobotModel,
-    identification: &[Measurement],
-    training: &[Measurement],
-    validation: &[Measurement],
-    chains: &[Chain],
-    opts: &CalibrationOptions,
-) -> Result<Prepared, CalibrationError> {
-    let predicted = nominal_predictions(nominal, identification, chains);
-    let reg = register_sessions(identification, &predicted, validation, opts)?;
-    let training = reg.to_base(training);
-    let id_frames = vec![Pose::identity(); reg.sessions];
-    let nominal_errors = NominalErrors {
-        identification: SetErrors::from_predictions(
-            &id_frames,
-            &reg.ident,
-            predicted.iter().copied(),
-        ),
-        validation: (!reg.valid.is_empty()).then(|| SetErrors::of(nominal, &id_frames, &reg.valid)),
-    };
-    let nominal_rms = nominal_errors.identification.stats.rms_mm;
-    if nominal_rms > opts.max_nominal_rms_mm {
-        return Err(CalibrationError::Inconsistent {
-            rms_mm: nominal_rms,
-            limit_mm: opts.max_nominal_rms_mm,
-        });
-    }
-    Ok(Prepared {
-        reg,
-        training,
-        nominal: nominal_errors,
     })
 }
 
