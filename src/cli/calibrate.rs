@@ -120,7 +120,7 @@ impl TypedValueParser for MethodValues {
         let methods = METHODS.iter().map(|r| {
             PossibleValue::new(r.name)
                 .aliases(r.aliases.iter().copied())
-                .help(r.description)
+                .help(format!("{} Fits {}.", r.description, r.fits))
         });
         let all = PossibleValue::new("all").help("Every method, and the comparison table.");
         Some(Box::new(methods.chain(std::iter::once(all))))

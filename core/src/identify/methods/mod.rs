@@ -65,7 +65,7 @@ method_table! {
         aliases: [],
         label: "KM",
         description: "Kinematic calibration (seed §2.2): LM on the identifiable geometric parameters.",
-        fits: "geometry and the frames of later tracker sessions",
+        fits: "geometry",
         compliance: Compliance::No,
         torques: false,
         seed: true,
