@@ -25,11 +25,15 @@ import time
 import urllib.request
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+# The method names: the spec's `Method` enum (a test keeps it equal to the server's table).
+with open(os.path.join(ROOT, "openapi.yaml"), encoding="utf-8") as f:
+    METHODS = re.search(r"^    Method:\n\s+type: string\n\s+enum: \[([^\]]*)\]", f.read(), re.M).group(1)
+METHODS = [m.strip() for m in METHODS.split(",")]
 ap = argparse.ArgumentParser()
 ap.add_argument("--robocal", default=os.path.join(ROOT, "target", "release", "robocal"))
 ap.add_argument("--population", type=int, default=1000)
-ap.add_argument("--method", default="skcm-tlbo",
-                choices=["skcm-tlbo", "km-rbf", "skcm-nn", "skcm-iwonn", "skcm-tlbonn"])
+ap.add_argument("--method", default="skcm-tlbo", choices=METHODS,
+                help="skcm-tlbo or a compensator method; the others end before they can be cancelled")
 a = ap.parse_args()
 
 work = tempfile.mkdtemp()

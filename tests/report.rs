@@ -79,7 +79,7 @@ fn demo_report_has_every_section() {
         })
         .unwrap()
         .0;
-    let label = robocal::report::method_label(best);
+    let label = robocal::report::key_label(best);
     assert!(html.contains(&format!("<dd><strong>{label}</strong></dd>")));
     assert!(html.contains("smallest mean position error on the validation set"));
     // Every row of the statistics table matches the stored figure.

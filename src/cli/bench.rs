@@ -129,7 +129,7 @@ fn km(a: &KmArgs) -> anyhow::Result<serde_json::Value> {
         last = Some(r);
     }
     let r = last.expect("at least one run");
-    let m = r.methods.get("km").context("KM did not run")?;
+    let m = r.methods.get(&Method::Km).context("KM did not run")?;
     let v = m.validation.as_ref().context("no validation")?;
     Ok(json!({
         "bench": "km",

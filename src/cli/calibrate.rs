@@ -5,12 +5,14 @@
 use super::progress::ProgressPrinter;
 use crate::identify::{
     calibrate_with_training, CalibrationOptions, CalibrationReport, CompensatorOptions, Method,
-    PoseSource, PoseSources,
+    PoseSource, PoseSources, METHODS,
 };
 use crate::measure::{self, csv, SetRole};
 use crate::model::RobotModel;
 use crate::report::method_label;
 use anyhow::{bail, Context};
+use clap::builder::{PossibleValue, TypedValueParser};
+use clap::error::ErrorKind;
 use clap::Args;
 use std::fmt::Write as _;
 
@@ -38,11 +40,11 @@ pub struct CalibrateArgs {
     /// first session.
     #[arg(long, num_args = 1.., value_delimiter = ',')]
     pub train: Vec<String>,
-    /// Methods to run and compare, comma-separated: km, skcm, skcm-tlbo,
-    /// skcm-payload, km-rbf, skcm-nn, skcm-iwonn, skcm-tlbonn, auto; `all` runs
-    /// every one and prints the comparison table (rows methods, columns sets).
-    #[arg(long, default_value = "km,skcm,skcm-tlbo")]
-    pub method: String,
+    /// Methods to run and compare, comma-separated (names or aliases, any
+    /// case); `all` runs every one and prints the comparison table (rows
+    /// methods, columns sets).
+    #[arg(long, value_parser = MethodValues, default_value_t = MethodList(Method::SEED.to_vec()))]
+    pub method: MethodList,
     /// Payload mass [kg] for rows without a payload_kg column (default: the model's payload).
     #[arg(long)]
     pub payload_kg: Option<f64>,
@@ -78,6 +80,53 @@ pub struct CalibrateArgs {
     pub save_method: Option<String>,
 }
 
+/// The methods of `--method`, in order, each once.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MethodList(pub Vec<Method>);
+
+impl std::fmt::Display for MethodList {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let names: Vec<&str> = self.0.iter().map(|m| m.name()).collect();
+        f.write_str(&names.join(","))
+    }
+}
+
+/// Parses `--method` ([`Method::parse_list`]); its possible values are the
+/// table's names and `all`.
+#[derive(Debug, Clone, Copy)]
+struct MethodValues;
+
+impl TypedValueParser for MethodValues {
+    type Value = MethodList;
+
+    fn parse_ref(
+        &self,
+        cmd: &clap::Command,
+        arg: Option<&clap::Arg>,
+        value: &std::ffi::OsStr,
+    ) -> Result<MethodList, clap::Error> {
+        let text = value.to_string_lossy();
+        Method::parse_list(&text).map(MethodList).map_err(|e| {
+            let arg = arg.map_or_else(|| "--method".to_string(), |a| a.to_string());
+            clap::Error::raw(
+                ErrorKind::InvalidValue,
+                format!("invalid value '{text}' for '{arg}': {e}\n"),
+            )
+            .with_cmd(cmd)
+        })
+    }
+
+    fn possible_values(&self) -> Option<Box<dyn Iterator<Item = PossibleValue> + '_>> {
+        let methods = METHODS.iter().map(|r| {
+            PossibleValue::new(r.name)
+                .aliases(r.aliases.iter().copied())
+                .help(format!("{} Fits {}.", r.description, r.fits))
+        });
+        let all = PossibleValue::new("all").help("Every method, and the comparison table.");
+        Some(Box::new(methods.chain(std::iter::once(all))))
+    }
+}
+
 fn read_rows(path: &str, dif: csv::DifSign) -> anyhow::Result<Vec<measure::MeasuredPose>> {
     let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {path}"))?;
     csv::parse_with(&text, dif).with_context(|| path.to_string())
@@ -85,7 +134,7 @@ fn read_rows(path: &str, dif: csv::DifSign) -> anyhow::Result<Vec<measure::Measu
 
 pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     let model = crate::cli::load_model(&a.model)?;
-    let methods = Method::parse_list(&a.method).map_err(anyhow::Error::msg)?;
+    let methods = a.method.0;
     let dif = match a.dif_sign.as_str() {
         "plus" => csv::DifSign::Plus,
         "minus" => csv::DifSign::Minus,
@@ -239,7 +288,7 @@ fn save_model(
     let chosen = match method {
         Some(m) => {
             let m = Method::parse(m).with_context(|| format!("unknown --save-method {m}"))?;
-            match report.methods.get(m.name()) {
+            match report.methods.get(&m) {
                 Some(r) => r,
                 None => match report.failed.iter().find(|f| f.method == m) {
                     Some(f) => bail!("--save-method {} failed: {}", m.name(), f.reason),
@@ -320,7 +369,7 @@ pub fn render_report(r: &CalibrationReport) -> String {
     );
     for (name, m) in &r.methods {
         line(
-            method_label(name),
+            method_label(*name),
             &m.identification.stats,
             m.validation.as_ref().map(|v| &v.stats),
         );
@@ -350,14 +399,14 @@ pub fn render_report(r: &CalibrationReport) -> String {
         let _ = writeln!(s, "  correlated {} ~ {}: {:+.3}", p.a, p.b, p.correlation);
     }
     // Parameter table across methods.
-    let names: Vec<&str> = r.methods.keys().map(|k| k.as_str()).collect();
+    let names: Vec<Method> = r.methods.keys().copied().collect();
     let _ = write!(
         s,
         "\nIdentified parameters (mm, deg, rad/(N·m))\n{:<10} {:>14}",
         "name", "nominal"
     );
     for n in &names {
-        let _ = write!(s, " {:>14}", method_label(n));
+        let _ = write!(s, " {:>14}", method_label(*n));
     }
     let _ = writeln!(s);
     let mut all: Vec<String> = Vec::new();
@@ -385,7 +434,7 @@ pub fn render_report(r: &CalibrationReport) -> String {
             .unwrap_or("");
         let _ = write!(s, "{:<10} {:>14}", pname, param_number(nominal_v, unit));
         for n in &names {
-            match r.methods[*n].parameters.iter().find(|p| &p.name == pname) {
+            match r.methods[n].parameters.iter().find(|p| &p.name == pname) {
                 Some(p) => {
                     let _ = write!(s, " {:>14}", param_number(p.value, unit));
                 }
@@ -411,14 +460,14 @@ pub fn render_report(r: &CalibrationReport) -> String {
                 .enumerate()
                 .filter_map(|(k, v)| v.map(|v| format!("K{}={:.4e}", k + 1, v)))
                 .collect();
-            let _ = writeln!(s, "  {:<14} {}", method_label(n), ks.join("  "));
+            let _ = writeln!(s, "  {:<14} {}", method_label(*n), ks.join("  "));
         }
     }
     for (n, m) in &r.methods {
         let _ = writeln!(
             s,
             "solver {:<14} converged={} iterations={} reason={} ({})",
-            method_label(n),
+            method_label(*n),
             m.solver.converged,
             m.solver.iterations,
             m.solver.reason.code(),
@@ -429,14 +478,14 @@ pub fn render_report(r: &CalibrationReport) -> String {
         let _ = writeln!(s, "\nWarnings");
         for (n, m) in &r.methods {
             for w in &m.warnings {
-                let _ = writeln!(s, "  {:<14} {}", method_label(n), w.message);
+                let _ = writeln!(s, "  {:<14} {}", method_label(*n), w.message);
             }
         }
     }
     if !r.failed.is_empty() {
         let _ = writeln!(s, "\nFailed methods (the others above are complete)");
         for f in &r.failed {
-            let _ = writeln!(s, "  {:<14} {}", method_label(f.method.name()), f.reason);
+            let _ = writeln!(s, "  {:<14} {}", method_label(f.method), f.reason);
         }
     }
     s
@@ -485,7 +534,7 @@ pub fn render_comparison(r: &CalibrationReport) -> String {
         let _ = write!(
             s,
             "{:<22} {}",
-            method_label(name),
+            method_label(*name),
             cell(Some(&m.identification.stats))
         );
         if training {
@@ -523,8 +572,8 @@ pub fn render_compensators(r: &CalibrationReport) -> String {
             let _ = writeln!(
                 s,
                 "  {:<14} chose {}: {}",
-                method_label(name),
-                method_label(a.chosen.name()),
+                method_label(*name),
+                method_label(a.chosen),
                 a.reason
             );
         }
@@ -534,11 +583,11 @@ pub fn render_compensators(r: &CalibrationReport) -> String {
         let _ = writeln!(
             s,
             "  {:<14} {} on {}, {} units, over {}; trained by {} on {} {} poses: {} epochs / iterations / generations, {} loss evaluations, stopped: {}; training RMS {:.4} mm",
-            method_label(name),
+            method_label(*name),
             c.kind,
             c.inputs,
             c.units,
-            method_label(c.base.name()),
+            method_label(c.base),
             c.training.trainer,
             c.training_poses,
             c.trained_on,

@@ -51,13 +51,9 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     if let Some(v) = &r.nominal.validation {
         row("Nominal robot model", &v.stats);
     }
-    for (name, label) in [
-        ("km", "KM"),
-        ("skcm", "SKCM"),
-        ("skcm-tlbo", "SKCM-C (TLBO)"),
-    ] {
-        if let Some(v) = r.methods.get(name).and_then(|m| m.validation.as_ref()) {
-            row(label, &v.stats);
+    for method in Method::SEED {
+        if let Some(v) = r.methods.get(&method).and_then(|m| m.validation.as_ref()) {
+            row(method.label(), &v.stats);
         }
     }
     println!("\nStiffness (N·m/rad), Table 7.4 equivalent");
@@ -72,8 +68,9 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
         "{:<16} {:>12.4e} {:>12.4e} {:>12.4e} {:>12.4e}",
         "truth", truth_k[0], truth_k[1], truth_k[2], truth_k[3]
     );
-    for (name, label) in [("skcm", "SKCM"), ("skcm-tlbo", "SKCM-C (TLBO)")] {
-        if let Some(m) = r.methods.get(name) {
+    for method in [Method::Skcm, Method::SkcmTlbo] {
+        let label = method.label();
+        if let Some(m) = r.methods.get(&method) {
             let ks: Vec<String> = (1..5)
                 .map(|k| match m.stiffness_nm_per_rad[k] {
                     Some(v) => format!("{:>12.4e}", v),

@@ -20,7 +20,7 @@ use serde_json::{json, Value};
 use std::sync::atomic::Ordering;
 
 /// Methods run when the request names none.
-pub const DEFAULT_METHODS: [&str; 2] = ["km", "skcm"];
+pub const DEFAULT_METHODS: [Method; 2] = [Method::Km, Method::Skcm];
 
 fn calibration_not_found(robot: i64, id: i64) -> ApiError {
     ApiError::NotFound(format!(
@@ -32,8 +32,8 @@ fn calibration_not_found(robot: i64, id: i64) -> ApiError {
 #[derive(Debug, Default, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct StartCalibration {
-    /// Methods to run and compare (see [`Method::parse`]; `all` for every one).
-    /// Default km, skcm.
+    /// Methods to run and compare: names or aliases ([`Method::parse`]), `all`
+    /// for every one. Default [`DEFAULT_METHODS`].
     #[serde(
         default,
         deserialize_with = "present",
@@ -182,16 +182,17 @@ pub async fn start(
     ApiPath(robot_id): ApiPath<i64>,
     ApiJson(req): ApiJson<StartCalibration>,
 ) -> Result<Response, ApiError> {
-    let method_list = match &req.methods {
+    let methods = match &req.methods {
         Some(m) if m.is_empty() => {
-            return Err(ApiError::invalid(
-                "`methods` is empty; give one or more of km, skcm, skcm-tlbo, skcm-payload, km-rbf, skcm-nn, skcm-iwonn, skcm-tlbonn, auto",
-            ))
+            let names: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
+            return Err(ApiError::invalid(format!(
+                "`methods` is empty; give one or more of {}",
+                names.join(", ")
+            )));
         }
-        Some(m) => m.join(","),
-        None => DEFAULT_METHODS.join(","),
+        Some(m) => Method::parse_names(m).map_err(ApiError::invalid)?,
+        None => DEFAULT_METHODS.to_vec(),
     };
-    let methods = Method::parse_list(&method_list).map_err(ApiError::invalid)?;
     check_count("population", req.population, 2, 1000)?;
     check_count("generations", req.generations, 1, 1_000_000)?;
     check_count("max_iterations", req.max_iterations, 1, 10_000)?;
@@ -372,4 +373,59 @@ pub fn routes() -> Vec<super::Route> {
         get("/v1/robots/{id}/calibrations/{cid}/result", result),
         get("/v1/robots/{id}/calibrations/{cid}/report", report),
     ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::DEFAULT_METHODS;
+    use crate::identify::METHODS;
+    use serde_yaml::Value;
+
+    fn strings(v: &Value) -> Vec<&str> {
+        v.as_sequence()
+            .expect("an enum")
+            .iter()
+            .map(|s| s.as_str().expect("a string"))
+            .collect()
+    }
+
+    /// The words of a description (names may hold `-` and `_`).
+    fn words(v: &Value) -> Vec<&str> {
+        v.as_str()
+            .expect("a description")
+            .split(|c: char| !(c.is_ascii_alphanumeric() || c == '-' || c == '_'))
+            .collect()
+    }
+
+    /// The spec's method enums are the table's (the served spec is this
+    /// text, `tests/api/contract.rs`): `Method` its names, the request's
+    /// `methods` items the names with their aliases, then `all`; both
+    /// descriptions name every method and the request's its default.
+    #[test]
+    fn the_spec_lists_the_method_table() {
+        let doc: Value = serde_yaml::from_str(crate::http::OPENAPI_YAML).unwrap();
+        let schemas = &doc["components"]["schemas"];
+        let names: Vec<&str> = METHODS.iter().map(|r| r.name).collect();
+        assert_eq!(strings(&schemas["Method"]["enum"]), names);
+        let mut request: Vec<&str> = Vec::new();
+        for r in &METHODS {
+            request.push(r.name);
+            request.extend(r.aliases);
+        }
+        request.push("all");
+        let methods = &schemas["StartCalibration"]["properties"]["methods"];
+        assert_eq!(strings(&methods["items"]["enum"]), request);
+        for description in [&schemas["Method"]["description"], &methods["description"]] {
+            let words = words(description);
+            for n in &names {
+                assert!(words.contains(n), "{n} is not described");
+            }
+        }
+        let default: Vec<&str> = DEFAULT_METHODS.iter().map(|m| m.name()).collect();
+        let described = methods["description"].as_str().unwrap();
+        assert!(
+            described.contains(&format!("Default [{}].", default.join(", "))),
+            "{described}"
+        );
+    }
 }

@@ -1,20 +1,20 @@
 //! Number formatting and method names shared by the HTML report and the
 //! command line's text report.
 
-/// Display name of a calibration method key (`km` → `KM`), the same in the
-/// command line's table and the HTML report.
-pub fn method_label(key: &str) -> &str {
-    match key {
-        "km" => "KM",
-        "skcm" => "SKCM",
-        "skcm-tlbo" => "SKCM-C (TLBO)",
-        "skcm-payload" => "SKCM-payload",
-        "km-rbf" => "KM-RBF",
-        "skcm-nn" => "SKCM-NN",
-        "skcm-iwonn" => "SKCM-IWONN",
-        "skcm-tlbonn" => "SKCM-TLBONN",
-        "auto" => "auto",
-        other => other,
+use crate::identify::Method;
+
+/// Display name of a calibration method (`km` → `KM`, the table's label), the
+/// same in the command line's table and the HTML report.
+pub fn method_label(method: Method) -> &'static str {
+    method.label()
+}
+
+/// [`method_label`] of a method name as a stored report keys it; a name of
+/// no method (a report of another version) stays as it is.
+pub fn key_label(key: &str) -> &str {
+    match Method::from_name(key) {
+        Some(m) => method_label(m),
+        None => key,
     }
 }
 
@@ -73,8 +73,10 @@ mod tests {
         assert_eq!(num(2.5e-7, 2), "2.5e-7");
         assert_eq!(num(f64::INFINITY, 3), "—");
         assert_eq!(param(-0.00001, "mm"), "0.0000");
-        assert_eq!(method_label("skcm-tlbo"), "SKCM-C (TLBO)");
-        assert_eq!(method_label("skcm-tlbonn"), "SKCM-TLBONN");
-        assert_eq!(method_label("new"), "new");
+        assert_eq!(method_label(Method::SkcmTlbo), "SKCM-C (TLBO)");
+        assert_eq!(key_label("skcm-tlbo"), "SKCM-C (TLBO)");
+        assert_eq!(key_label("skcm-tlbonn"), "SKCM-TLBONN");
+        assert_eq!(key_label("tlbo"), "tlbo");
+        assert_eq!(key_label("new"), "new");
     }
 }

@@ -19,7 +19,7 @@ pub mod format;
 mod page;
 pub mod view;
 
-pub use format::method_label;
+pub use format::{key_label, method_label};
 pub use view::ReportView;
 
 use maud::{html, Markup, PreEscaped, DOCTYPE};

@@ -4,7 +4,7 @@
 //! base frame of each pose's session.
 
 use super::charts::{self, Point, Series};
-use super::format::{method_label, num, opt, param};
+use super::format::{key_label, method_label, num, opt, param};
 use super::view::{Format, MethodView, ReportView, SetView};
 use maud::{html, Markup};
 
@@ -47,7 +47,7 @@ pub fn models(r: &ReportView) -> Vec<Model<'_>> {
     for (i, (k, m)) in r.ordered_methods().into_iter().enumerate() {
         v.push(Model {
             key: k,
-            label: method_label(k),
+            label: key_label(k),
             color: PALETTE[i % PALETTE.len()],
             sets: &m.sets,
             method: Some(m),
@@ -71,7 +71,7 @@ pub fn header(title: &str, r: &ReportView, models: &[Model]) -> Markup {
                     @for (i, m) in models.iter().skip(1).enumerate() { @if i > 0 { ", " } (m.label) }
                 } }
                 @if let Some(b) = best {
-                    div { dt { "Best method" } dd { strong { (method_label(b)) } } }
+                    div { dt { "Best method" } dd { strong { (key_label(b)) } } }
                 }
             }
             p.rule {
@@ -136,11 +136,11 @@ pub fn alerts(r: &ReportView) -> Markup {
         section #warnings.alerts {
             h2 { "Warnings and failed methods" }
             @for f in &r.failed {
-                p.alert.bad { strong { (method_label(f.method.name())) " failed: " } (f.reason) }
+                p.alert.bad { strong { (method_label(f.method)) " failed: " } (f.reason) }
             }
             @for (k, m) in &warned {
                 div.alert.warn {
-                    strong { (method_label(k)) " — " (m.warnings.len()) " warning" @if m.warnings.len() > 1 { "s" } }
+                    strong { (key_label(k)) " — " (m.warnings.len()) " warning" @if m.warnings.len() > 1 { "s" } }
                     ul { @for w in &m.warnings { li { (w.message) } } }
                 }
             }
@@ -365,7 +365,7 @@ pub fn pose_table(r: &ReportView, models: &[Model], best: Option<&str>) -> Marku
             h2 { "Per-pose errors" }
             p.note {
                 "Errors [mm] of every pose. “Outlier” marks a pose whose error with the best method ("
-                (best.map(method_label).unwrap_or("—")) ") lies beyond Q3 + 3·IQR of its set (Tukey's far-out fence). "
+                (best.map(key_label).unwrap_or("—")) ") lies beyond Q3 + 3·IQR of its set (Tukey's far-out fence). "
                 "Click a column heading to sort."
             }
             div.scroll {
@@ -499,11 +499,11 @@ pub fn compensators(models: &[Model]) -> Markup {
             @for (m, v) in &shown {
                 h3 { (m.label) }
                 @if let Some(a) = &v.auto {
-                    p { strong { "Chose " (method_label(&a.chosen)) ": " } (a.reason) }
+                    p { strong { "Chose " (key_label(&a.chosen)) ": " } (a.reason) }
                 }
                 @if let Some(c) = &v.compensator {
                     p { (c.kind) " on " (c.inputs) ", " (c.units.map_or("—".into(), |u| u.to_string()))
-                        " units, over " (method_label(&c.base)) "; trained by " (c.training.trainer)
+                        " units, over " (key_label(&c.base)) "; trained by " (c.training.trainer)
                         " on " (c.training_poses.map_or("—".into(), |n| n.to_string())) " "
                         (c.trained_on) " poses, " (c.training.epochs.map_or("—".into(), |n| n.to_string()))
                         " epochs / iterations / generations; stopped: " (c.training.stop) }

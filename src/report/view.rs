@@ -12,7 +12,8 @@
 
 use crate::identify::identifiability::IdentifiabilityReport;
 use crate::identify::{
-    FailedMethod, LmReport, MethodWarning, ParamEstimate, PoseSources, REPORT_FORMAT_VERSION,
+    FailedMethod, LmReport, Method, MethodWarning, ParamEstimate, PoseSources,
+    REPORT_FORMAT_VERSION,
 };
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Deserializer};
@@ -57,6 +58,7 @@ pub struct ReportView {
     pub identifiability: Option<IdentifiabilityReport>,
     #[serde(default)]
     pub nominal: SetsView,
+    /// By the name the report stored (a method of another version too).
     #[serde(default)]
     pub methods: BTreeMap<String, MethodView>,
     #[serde(default, deserialize_with = "lenient_list")]
@@ -255,13 +257,14 @@ impl ReportView {
         }
     }
 
-    /// The methods in the seed's order (KM, SKCM, SKCM-C), then any other.
+    /// The methods in the seed's order ([`Method::SEED`]: KM, SKCM, SKCM-C),
+    /// then any other by name.
     pub fn ordered_methods(&self) -> Vec<(&str, &MethodView)> {
-        let rank = |k: &str| match k {
-            "km" => 0,
-            "skcm" => 1,
-            "skcm-tlbo" => 2,
-            _ => 3,
+        let rank = |k: &str| {
+            Method::SEED
+                .iter()
+                .position(|m| m.name() == k)
+                .unwrap_or(Method::SEED.len())
         };
         let mut v: Vec<(&str, &MethodView)> =
             self.methods.iter().map(|(k, m)| (k.as_str(), m)).collect();

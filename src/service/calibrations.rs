@@ -584,7 +584,7 @@ fn versions_of(
     let cell_from_base = r.tracker_to_base.inverse();
     let mut out = Vec::new();
     for method in &opts.methods {
-        let Some(m) = r.methods.get(method.name()) else {
+        let Some(m) = r.methods.get(method) else {
             continue;
         };
         let cm = CompensatedModel {
@@ -596,7 +596,7 @@ fn versions_of(
         };
         let file = CalibratedModelFile::from_compensated(&cm, robot_name, &m.model_file_method());
         if let Err(e) = file.to_compensated() {
-            r.methods.remove(method.name());
+            r.methods.remove(method);
             r.failed.push(FailedMethod {
                 method: *method,
                 reason: format!("the {} model does not load back: {e}", method.name()),

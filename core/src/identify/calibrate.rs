@@ -1,6 +1,5 @@
 //! The calibration pipeline in phases: checks → registration → nominal errors
-//! → identifiability → methods (each on its own, `methods`; compensators and
-//! `auto` in `hybrid`) → report.
+//! → identifiability → methods (each on its own, [`methods::run`]) → report.
 //!
 //! Frames: measured positions arrive in the measurement (tracker) frame of their
 //! session; each session is registered in closed form onto the nominal model's
@@ -23,15 +22,16 @@ use super::checks::{
     check_set, checked_chains, fixed_params, generic_rank, gravity_problem, joint_range_detail,
     stacked_factor, CalibrationError,
 };
-use super::hybrid::{compensate_report, run_auto, run_compensated, Cache, Hybrid};
 use super::identifiability::{self, IdentifiabilityReport};
 use super::least_squares::predict;
-use super::methods::{Context, MethodError, MethodFit};
-use super::options::{CalibrationOptions, Method, Progress};
+use super::methods::{
+    self, Cache, Compliance, Context, Method, MethodError, MethodFailure, MethodProgress,
+};
+use super::options::{CalibrationOptions, Progress};
 use super::registration::register;
 use super::report::{
-    CalibrationReport, FailedMethod, NominalErrors, PoseSources, SessionRegistration, SetErrors,
-    REPORT_FORMAT_VERSION,
+    CalibrationReport, FailedMethod, MethodReport, NominalErrors, PoseSources, SessionRegistration,
+    SetErrors, REPORT_FORMAT_VERSION,
 };
 use crate::kinematics::Chain;
 use crate::measure::Measurement;
@@ -40,6 +40,208 @@ use crate::model::pose::Pose;
 use crate::model::{ParamId, ParamKind, ParamLayout, RobotModel};
 use nalgebra::Vector3;
 use std::collections::BTreeMap;
+
+/// Runs the calibration without a compensator training pool. `progress`
+/// returns false to cancel.
+pub fn calibrate(
+    nominal: &RobotModel,
+    identification: &[Measurement],
+    validation: &[Measurement],
+    opts: &CalibrationOptions,
+    progress: &dyn Fn(&Progress) -> bool,
+) -> Result<CalibrationReport, CalibrationError> {
+    calibrate_with_training(nominal, identification, &[], validation, opts, progress)
+}
+
+/// Runs the calibration with the data roles of docs/design.md "Data roles": Q1
+/// `identification` fits the model-based part, Q2 `training` trains the
+/// compensators (empty: they train on Q1 and are judged by k-fold
+/// cross-validation inside it), Q3 `validation` is never fitted. Training
+/// poses must come from tracker sessions that have identification poses.
+/// `progress` returns false to cancel.
+pub fn calibrate_with_training(
+    nominal: &RobotModel,
+    identification: &[Measurement],
+    training: &[Measurement],
+    validation: &[Measurement],
+    opts: &CalibrationOptions,
+    progress: &dyn Fn(&Progress) -> bool,
+) -> Result<CalibrationReport, CalibrationError> {
+    // The nominal forward kinematics of the identification poses, shared by
+    // the checks, the registration, the nominal errors, the identifiability
+    // Jacobian and the first evaluation of the fits.
+    let chains = check_inputs(nominal, identification, training, validation)?;
+    say(progress, "registration", 0.0)?;
+    let prepared = prepare(nominal, identification, training, validation, &chains, opts)?;
+    let reg = &prepared.reg;
+
+    let gravity = gravity_problem(nominal, &reg.ident);
+    let Plan { to_run, mut failed } = plan(&opts.methods, gravity.as_ref());
+    if to_run.is_empty() {
+        return Err(CalibrationError::AllMethodsFailed { failed });
+    }
+
+    say(progress, "identifiability", 5.0)?;
+    let with_compliance = to_run.iter().any(|m| match m.row().compliance {
+        Compliance::Yes => true,
+        Compliance::IfLoaded => gravity.is_none(),
+        Compliance::No => false,
+    });
+    let idf = identifiability_phase(nominal, reg, &chains, with_compliance, opts)?;
+    let mut identifiability = idf.report;
+    let mut start = nominal.clone();
+    for l in start.links.iter_mut() {
+        l.compliance = 0.0;
+    }
+    let ctx = Context {
+        nominal,
+        start,
+        ident: &reg.ident,
+        ident_chains: &chains,
+        valid: &reg.valid,
+        training: &prepared.training,
+        sessions: reg.sessions,
+        kept_geo: idf.kept_geo,
+        kept_c: idf.kept_c,
+        gravity,
+        opts,
+    };
+    let methods = run_methods(&ctx, &to_run, &mut failed, &mut identifiability, progress)?;
+    if methods.is_empty() {
+        return Err(CalibrationError::AllMethodsFailed { failed });
+    }
+    Ok(CalibrationReport {
+        format_version: REPORT_FORMAT_VERSION,
+        robot: nominal.name.clone(),
+        identification_poses: identification.len(),
+        validation_poses: validation.len(),
+        training_poses: training.len(),
+        registration: prepared.reg.reports,
+        identifiability,
+        nominal: prepared.nominal,
+        methods,
+        failed,
+        session_names: Vec::new(),
+        pose_sources: PoseSources::default(),
+        tracker_to_base: prepared.reg.tracker_to_base[0],
+    })
+}
+
+/// Reports a phase without iterations at `percent`; cancelled when
+/// `progress` says so.
+fn say(
+    progress: &dyn Fn(&Progress) -> bool,
+    phase: &str,
+    percent: f64,
+) -> Result<(), CalibrationError> {
+    if progress(&Progress {
+        phase: phase.to_string(),
+        iteration: 0,
+        percent,
+        rms_mm: None,
+    }) {
+        Ok(())
+    } else {
+        Err(CalibrationError::Cancelled)
+    }
+}
+
+/// Checks every set; returns the nominal forward kinematics of the
+/// identification poses.
+fn check_inputs(
+    nominal: &RobotModel,
+    identification: &[Measurement],
+    training: &[Measurement],
+    validation: &[Measurement],
+) -> Result<Vec<Chain>, CalibrationError> {
+    if identification.is_empty() {
+        return Err(CalibrationError::NoData);
+    }
+    let chains = checked_chains(nominal, identification, "identification")?;
+    check_set(nominal, training, "training")?;
+    check_set(nominal, validation, "validation")?;
+    if let Some((index, m)) = training
+        .iter()
+        .enumerate()
+        .find(|(_, m)| !identification.iter().any(|i| i.session == m.session))
+    {
+        return Err(CalibrationError::UnregisteredSession {
+            set: "training",
+            index,
+            session: m.session,
+        });
+    }
+    Ok(chains)
+}
+
+/// The methods to run, and those that failed before they started.
+struct Plan {
+    to_run: Vec<Method>,
+    failed: Vec<FailedMethod>,
+}
+
+/// Methods that need gravity torques fail fast when gravity loads no joint
+/// (`gravity` says why).
+fn plan(methods: &[Method], gravity: Option<&MethodFailure>) -> Plan {
+    let mut p = Plan {
+        to_run: Vec::new(),
+        failed: Vec::new(),
+    };
+    for &method in methods {
+        match gravity {
+            Some(why) if method.uses_torques() => p.failed.push(FailedMethod {
+                method,
+                reason: why.to_string(),
+            }),
+            _ => p.to_run.push(method),
+        }
+    }
+    p
+}
+
+/// The sets in the registered base frame and the nominal model's errors.
+struct Prepared {
+    reg: Registered,
+    /// The compensators' training poses (Q2) in the base frame.
+    training: Vec<Measurement>,
+    nominal: NominalErrors,
+}
+
+/// Registers every session and measures the nominal model; rejects data
+/// inconsistent with the model.
+fn prepare(
+    nominal: &RobotModel,
+    identification: &[Measurement],
+    training: &[Measurement],
+    validation: &[Measurement],
+    chains: &[Chain],
+    opts: &CalibrationOptions,
+) -> Result<Prepared, CalibrationError> {
+    let predicted = nominal_predictions(nominal, identification, chains);
+    let reg = register_sessions(identification, &predicted, validation, opts)?;
+    let training = reg.to_base(training);
+    let id_frames = vec![Pose::identity(); reg.sessions];
+    let nominal_errors = NominalErrors {
+        identification: SetErrors::from_predictions(
+            &id_frames,
+            &reg.ident,
+            predicted.iter().copied(),
+        ),
+        validation: (!reg.valid.is_empty()).then(|| SetErrors::of(nominal, &id_frames, &reg.valid)),
+    };
+    let nominal_rms = nominal_errors.identification.stats.rms_mm;
+    if nominal_rms > opts.max_nominal_rms_mm {
+        return Err(CalibrationError::Inconsistent {
+            rms_mm: nominal_rms,
+            limit_mm: opts.max_nominal_rms_mm,
+        });
+    }
+    Ok(Prepared {
+        reg,
+        training,
+        nominal: nominal_errors,
+    })
+}
 
 /// Measurements registered into the base frame.
 struct Registered {
@@ -206,278 +408,65 @@ fn identifiability_phase(
     })
 }
 
-/// Relative effort of a method, for the progress percentage.
-fn weight(m: Method) -> f64 {
-    match m {
-        Method::SkcmTlbo => 8.0,
-        Method::SkcmPayload | Method::KmRbf => 2.0,
-        Method::SkcmNn | Method::SkcmIwonn | Method::SkcmTlbonn => 6.0,
-        Method::Auto => 12.0,
-        _ => 1.0,
-    }
-}
-
-/// Runs the calibration without a compensator training pool. `progress`
-/// returns false to cancel.
-pub fn calibrate(
-    nominal: &RobotModel,
-    identification: &[Measurement],
-    validation: &[Measurement],
-    opts: &CalibrationOptions,
+/// Runs every method of `to_run` in order over 10–100 % of the bar, each by
+/// its table weight; a failure joins `failed`. The σ and correlations of
+/// `identifiability` come from SKCM's fit, else KM's.
+fn run_methods(
+    ctx: &Context,
+    to_run: &[Method],
+    failed: &mut Vec<FailedMethod>,
+    identifiability: &mut IdentifiabilityReport,
     progress: &dyn Fn(&Progress) -> bool,
-) -> Result<CalibrationReport, CalibrationError> {
-    calibrate_with_training(nominal, identification, &[], validation, opts, progress)
-}
-
-/// Runs the calibration with the data roles of docs/design.md "Data roles": Q1
-/// `identification` fits the model-based part, Q2 `training` trains the
-/// compensators (empty: they train on Q1 and are judged by k-fold
-/// cross-validation inside it), Q3 `validation` is never fitted. Training
-/// poses must come from tracker sessions that have identification poses.
-/// `progress` returns false to cancel.
-pub fn calibrate_with_training(
-    nominal: &RobotModel,
-    identification: &[Measurement],
-    training: &[Measurement],
-    validation: &[Measurement],
-    opts: &CalibrationOptions,
-    progress: &dyn Fn(&Progress) -> bool,
-) -> Result<CalibrationReport, CalibrationError> {
-    let say = |phase: &str, iteration: usize, percent: f64, rms_mm: Option<f64>| {
-        if progress(&Progress {
-            phase: phase.to_string(),
-            iteration,
-            percent,
-            rms_mm,
-        }) {
-            Ok(())
-        } else {
-            Err(CalibrationError::Cancelled)
-        }
-    };
-    if identification.is_empty() {
-        return Err(CalibrationError::NoData);
-    }
-    // The nominal forward kinematics of the identification poses, shared by
-    // the checks, the registration, the nominal errors, the identifiability
-    // Jacobian and the first evaluation of the fits.
-    let chains = checked_chains(nominal, identification, "identification")?;
-    check_set(nominal, training, "training")?;
-    check_set(nominal, validation, "validation")?;
-    if let Some((index, m)) = training
-        .iter()
-        .enumerate()
-        .find(|(_, m)| !identification.iter().any(|i| i.session == m.session))
-    {
-        return Err(CalibrationError::UnregisteredSession {
-            set: "training",
-            index,
-            session: m.session,
-        });
-    }
-    say("registration", 0, 0.0, None)?;
-    let predicted = nominal_predictions(nominal, identification, &chains);
-    let reg = register_sessions(identification, &predicted, validation, opts)?;
-    let train_base = reg.to_base(training);
-    let id_frames = vec![Pose::identity(); reg.sessions];
-    let nominal_errors = NominalErrors {
-        identification: SetErrors::from_predictions(
-            &id_frames,
-            &reg.ident,
-            predicted.iter().copied(),
-        ),
-        validation: (!reg.valid.is_empty()).then(|| SetErrors::of(nominal, &id_frames, &reg.valid)),
-    };
-    let nominal_rms = nominal_errors.identification.stats.rms_mm;
-    if nominal_rms > opts.max_nominal_rms_mm {
-        return Err(CalibrationError::Inconsistent {
-            rms_mm: nominal_rms,
-            limit_mm: opts.max_nominal_rms_mm,
-        });
-    }
-
-    // Methods that need gravity torques fail fast when gravity loads no joint.
-    let mut failed: Vec<FailedMethod> = Vec::new();
-    let gravity = gravity_problem(nominal, &reg.ident);
-    let mut to_run: Vec<Method> = Vec::new();
-    for m in &opts.methods {
-        match (&gravity, m.uses_torques()) {
-            (Some(why), true) => failed.push(FailedMethod {
-                method: *m,
-                reason: why.clone(),
-            }),
-            _ => to_run.push(*m),
-        }
-    }
-    if to_run.is_empty() {
-        return Err(CalibrationError::AllMethodsFailed { failed });
-    }
-
-    say("identifiability", 0, 5.0, None)?;
-    let with_compliance = to_run
-        .iter()
-        .any(|m| m.uses_compliance() || (*m == Method::Auto && gravity.is_none()));
-    let idf = identifiability_phase(nominal, &reg, &chains, with_compliance, opts)?;
-    let mut ident_report = idf.report;
-    let mut start = nominal.clone();
-    for l in start.links.iter_mut() {
-        l.compliance = 0.0;
-    }
-    let ctx = Context {
-        nominal,
-        start,
-        ident: &reg.ident,
-        ident_chains: &chains,
-        valid: &reg.valid,
-        sessions: reg.sessions,
-        kept_geo: idf.kept_geo,
-        kept_c: idf.kept_c,
-        opts,
-    };
-    // The compensators' training pool: Q2, else Q1.
-    let (pool, pool_name): (&[Measurement], &str) = if train_base.is_empty() {
-        (&reg.ident, "identification")
-    } else {
-        (&train_base, "training")
-    };
-
-    let total: f64 = to_run.iter().map(|m| weight(*m)).sum();
+) -> Result<BTreeMap<Method, MethodReport>, CalibrationError> {
+    let total: f64 = to_run.iter().map(|m| m.row().weight).sum();
     let mut done = 0.0;
-    let mut methods = BTreeMap::new();
+    let mut reports = BTreeMap::new();
     let mut cache = Cache::default();
-    for method in &to_run {
-        let span = 90.0 * weight(*method) / total;
-        let base_pct = 10.0 + 90.0 * done / total;
-        let name = method.name();
-        let max_it = opts.lm.max_iterations.max(1) as f64;
-        let mut lm_progress = |it: usize, rms: f64| {
-            progress(&Progress {
-                phase: name.to_string(),
-                iteration: it,
-                percent: base_pct + span * (it as f64 / max_it).min(1.0),
-                rms_mm: Some(rms),
-            })
+    for &method in to_run {
+        let share = MethodProgress {
+            method,
+            start: 10.0 + 90.0 * done / total,
+            span: 90.0 * method.row().weight / total,
+            opts: ctx.opts,
+            sink: progress,
         };
-        let mut frac_progress = |f: f64, it: usize, loss: Option<f64>| {
-            progress(&Progress {
-                phase: name.to_string(),
-                iteration: it,
-                percent: base_pct + span * f.clamp(0.0, 1.0),
-                rms_mm: loss,
-            })
-        };
-        let plain = |mf: MethodFit| Hybrid {
-            base: mf,
-            compensator: None,
-            auto: None,
-        };
-        let outcome: Result<Hybrid, MethodError> = match method {
-            Method::Km | Method::Skcm => cache.base_fit(&ctx, *method, &mut lm_progress).map(plain),
-            Method::SkcmTlbo => {
-                let warm = match &cache.km {
-                    Some(f) => f.clone(),
-                    None => ctx
-                        .km(&mut |_, _| true)
-                        .map_err(|_| CalibrationError::Cancelled)?,
-                };
-                let generations = opts.tlbo.generations.max(1) as f64;
-                ctx.skcm_tlbo(&warm, &mut |gen, best| {
-                    progress(&Progress {
-                        phase: name.to_string(),
-                        iteration: gen,
-                        percent: base_pct + span * (gen as f64 + 1.0) / generations,
-                        rms_mm: Some(best.sqrt()),
-                    })
-                })
-                .map(plain)
-            }
-            Method::SkcmPayload => cache
-                .base_fit(&ctx, Method::Skcm, &mut |_, _| true)
-                .and_then(|s| ctx.skcm_payload(&s.fit, &mut lm_progress))
-                .map(plain),
-            Method::KmRbf | Method::SkcmNn | Method::SkcmIwonn | Method::SkcmTlbonn => {
-                run_compensated(&ctx, &mut cache, *method, pool, &mut frac_progress)
-            }
-            Method::Auto => run_auto(
-                &ctx,
-                &mut cache,
-                pool,
-                pool_name,
-                gravity.as_deref(),
-                &mut frac_progress,
-            ),
-        };
-        done += weight(*method);
-        let h = match outcome {
-            Ok(h) => h,
+        let outcome = methods::run(method, ctx, &mut cache, &share);
+        done += method.row().weight;
+        let outcome = match outcome {
+            Ok(o) => o,
             Err(MethodError::Cancelled) => return Err(CalibrationError::Cancelled),
-            Err(MethodError::Failed(reason)) => {
+            Err(MethodError::Failed(f)) => {
                 failed.push(FailedMethod {
-                    method: *method,
-                    reason,
+                    method,
+                    reason: f.to_string(),
                 });
-                say(name, 0, 10.0 + 90.0 * done / total, None)?;
+                say(progress, method.name(), 10.0 + 90.0 * done / total)?;
                 continue;
             }
         };
-        let mf = h.base;
         let uncertainty_source =
-            *method == Method::Skcm || (*method == Method::Km && !to_run.contains(&Method::Skcm));
+            method == Method::Skcm || (method == Method::Km && !to_run.contains(&Method::Skcm));
         if uncertainty_source {
-            if let Some(cov) = &mf.fit.covariance {
+            if let Some(cov) = &outcome.fit.fit.covariance {
                 let (sd, pairs) = identifiability::uncertainty(
-                    &mf.ids,
+                    &outcome.fit.ids,
                     cov,
-                    opts.identifiability.correlation_threshold,
+                    ctx.opts.identifiability.correlation_threshold,
                 );
-                ident_report.std_devs = sd;
-                ident_report.correlated_pairs = pairs;
+                identifiability.std_devs = sd;
+                identifiability.correlated_pairs = pairs;
             }
         }
-        let frames = mf.fit.session_frames.clone();
-        match ctx.report(*method, mf) {
-            Ok(mut r) => {
-                if !train_base.is_empty() {
-                    r.training = Some(SetErrors::of(&r.calibrated, &frames, &train_base));
-                }
-                if let Some((m, t)) = &h.compensator {
-                    let base = m.base().expect("a compensator method");
-                    compensate_report(
-                        &mut r,
-                        base,
-                        &frames,
-                        t,
-                        &reg.ident,
-                        &train_base,
-                        &reg.valid,
-                    );
-                }
-                r.auto = h.auto;
-                methods.insert(name.to_string(), r);
+        match ctx.report(method, outcome) {
+            Ok(r) => {
+                reports.insert(method, r);
             }
-            Err(reason) => failed.push(FailedMethod {
-                method: *method,
-                reason,
+            Err(f) => failed.push(FailedMethod {
+                method,
+                reason: f.to_string(),
             }),
         }
-        say(name, 0, 10.0 + 90.0 * done / total, None)?;
+        say(progress, method.name(), 10.0 + 90.0 * done / total)?;
     }
-    if methods.is_empty() {
-        return Err(CalibrationError::AllMethodsFailed { failed });
-    }
-    Ok(CalibrationReport {
-        format_version: REPORT_FORMAT_VERSION,
-        robot: nominal.name.clone(),
-        identification_poses: identification.len(),
-        validation_poses: validation.len(),
-        training_poses: training.len(),
-        registration: reg.reports,
-        identifiability: ident_report,
-        nominal: nominal_errors,
-        methods,
-        failed,
-        session_names: Vec::new(),
-        pose_sources: PoseSources::default(),
-        tracker_to_base: reg.tracker_to_base[0],
-    })
+    Ok(reports)
 }

@@ -7,6 +7,7 @@
 //! Units: SI (m, rad, kg, N·m).
 
 use super::least_squares;
+use super::methods::MethodFailure;
 use super::registration::RegistrationError;
 use super::report::FailedMethod;
 use crate::kinematics::chain::{chain_with, ChainConstants};
@@ -323,17 +324,13 @@ pub(crate) fn joint_range_detail(model: &RobotModel, data: &[Measurement]) -> St
 
 /// Why the compliance methods cannot run on this model and data, if they cannot:
 /// with no link mass and no payload, gravity puts no torque on any joint.
-pub(crate) fn gravity_problem(model: &RobotModel, data: &[Measurement]) -> Option<String> {
+pub(crate) fn gravity_problem(model: &RobotModel, data: &[Measurement]) -> Option<MethodFailure> {
     let link_mass: f64 = model.links.iter().map(|l| l.mass).sum();
     let payload = data.iter().any(|m| m.payload_mass > 0.0);
-    (link_mass <= 0.0 && !payload).then(|| {
-        "the model has no link masses and the measurements carry no payload, so gravity puts no torque on any joint and no compliance can be identified; add link masses (`mass_kg`, `com_mm`) to the model or a payload (`payload_kg`), or use km".to_string()
-    })
+    (link_mass <= 0.0 && !payload).then_some(MethodFailure::NoGravityTorque)
 }
 
 /// Why `skcm-payload` cannot identify the payload's centre of mass, if it cannot.
-pub(crate) fn payload_problem(data: &[Measurement]) -> Option<String> {
-    (!data.iter().any(|m| m.payload_mass > 0.0)).then(|| {
-        "no identification pose carries a payload (payload_kg is 0 everywhere), so its centre of mass has no effect; give the payload mass (`payload_kg`) or use skcm".to_string()
-    })
+pub(crate) fn payload_problem(data: &[Measurement]) -> Option<MethodFailure> {
+    (!data.iter().any(|m| m.payload_mass > 0.0)).then_some(MethodFailure::NoPayload)
 }

@@ -3,7 +3,8 @@
 //! SKCM (§2.3, eq. 2.8; closed loop eq. 4.17) and SKCM-C by TLBO (ch. 7,
 //! eqs. 7.7–7.12), and SKCM with the payload's centre of mass (beyond the
 //! seed); the compensator methods KM-RBF, SKCM-NN, SKCM-IWONN, SKCM-TLBONN
-//! (ch. 3–6) and `auto` on top of them (`hybrid`). Statistics per set follow docs/design.md "Data roles".
+//! (ch. 3–6) and `auto` on top of them. The methods are one table
+//! (`methods::METHODS`). Statistics per set follow docs/design.md "Data roles".
 //!
 //! Units: SI inside; reports speak millimetres and degrees (compliance in
 //! rad/(N·m), stiffness in N·m/rad).
@@ -11,7 +12,6 @@
 pub mod calibrate;
 pub mod checks;
 mod evaluate;
-mod hybrid;
 pub mod identifiability;
 pub mod least_squares;
 pub mod methods;
@@ -24,7 +24,8 @@ pub use calibrate::{calibrate, calibrate_with_training};
 pub use checks::CalibrationError;
 pub use identifiability::{DropKind, IdentifiabilityReport, IdentifiabilitySettings};
 pub use least_squares::{LmReport, LmSettings, StopReason};
-pub use options::{CalibrationOptions, CompensatorOptions, Method, Progress};
+pub use methods::{Method, MethodChoice, MethodFailure, MethodListError, MethodRow, METHODS};
+pub use options::{CalibrationOptions, CompensatorOptions, Progress};
 pub use registration::{register, Registration};
 pub use report::{
     AutoCandidate, AutoSummary, CalibrationReport, CompensatorSummary, FailedMethod, MethodReport,

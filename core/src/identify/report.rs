@@ -364,7 +364,8 @@ pub struct CalibrationReport {
     pub registration: Vec<SessionRegistration>,
     pub identifiability: IdentifiabilityReport,
     pub nominal: NominalErrors,
-    pub methods: BTreeMap<String, MethodReport>,
+    /// Serialised by name, in the order of the names.
+    pub methods: BTreeMap<Method, MethodReport>,
     /// Methods that failed, with their reasons (the others are still reported).
     pub failed: Vec<FailedMethod>,
     /// Names of the tracker sessions by index (empty: unnamed).

@@ -228,7 +228,7 @@ pub fn robot(v: &RobotView) -> Markup {
                         @for m in Method::ALL {
                             label.check {
                                 input type="checkbox" name="method" value=(m.name())
-                                    checked[DEFAULT_METHODS.contains(&m.name())];
+                                    checked[DEFAULT_METHODS.contains(&m)];
                                 " " (m.name())
                             }
                         }

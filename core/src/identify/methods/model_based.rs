@@ -1,5 +1,5 @@
-//! The identification methods, each run on its own (one failing never stops
-//! the others):
+//! The model-based methods, each run on its own (one failing never stops the
+//! others):
 //!
 //! - **KM** (seed §2.2, eqs. 2.3–2.4): LM on the kept geometric parameters.
 //! - **SKCM** (§2.3, eq. 2.8; closed loop eq. 4.17): the same with the
@@ -24,65 +24,21 @@
 //!   tool axis and stays at 0, reported as not identified); like every
 //!   candidate it is then kept only when the poses make it identifiable, and a
 //!   total mass below zero on any pose is a warning.
-//!
-//! After a fit: statistics per set, parameters with σ, stiffness 1/c, warnings
-//! (not converged, compliance held at c = 0, stiffness outside the plausible
-//! range), and the model must load back from its JSON description.
 
-use super::checks::{payload_problem, stacked_factor};
-use super::identifiability::{self, DroppedParam};
-use super::least_squares::{
-    fit, fit_with_start_chains, residual_rows, Cancelled, Fit, FrozenSolver,
-};
-use super::options::{CalibrationOptions, Method};
-use super::report::{estimates, MethodReport, MethodWarning, SetErrors, TlboSummary, WarningKind};
-use crate::kinematics::{chain, gravity_torques_of, Chain};
+use super::run::{Context, MethodFit};
+use super::{MethodError, MethodFailure};
+use crate::identify::checks::{payload_problem, stacked_factor};
+use crate::identify::identifiability::{self, DroppedParam};
+use crate::identify::least_squares::{fit, fit_with_start_chains, Cancelled, Fit, FrozenSolver};
+use crate::identify::options::CalibrationOptions;
+use crate::identify::report::TlboSummary;
+use crate::kinematics::{chain, gravity_torques_of};
 use crate::measure::Measurement;
 use crate::model::pose::Pose;
-use crate::model::{ModelDescription, ParamId, ParamKind, RobotModel};
+use crate::model::{ParamId, ParamKind, RobotModel};
 use crate::optim::tlbo;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-
-/// Why a method did not deliver.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) enum MethodError {
-    Cancelled,
-    Failed(String),
-}
-
-impl From<Cancelled> for MethodError {
-    fn from(_: Cancelled) -> Self {
-        MethodError::Cancelled
-    }
-}
-
-/// What every method needs.
-pub(crate) struct Context<'a> {
-    pub nominal: &'a RobotModel,
-    /// The nominal model with zero compliance: every method's start.
-    pub start: RobotModel,
-    /// Identification and validation data in the registered base frame.
-    pub ident: &'a [Measurement],
-    /// Forward kinematics of `ident` at its commanded joints on the nominal
-    /// geometry (that of `start`), for the first evaluation of a fit from `start`.
-    pub ident_chains: &'a [Chain],
-    pub valid: &'a [Measurement],
-    pub sessions: usize,
-    pub kept_geo: Vec<ParamId>,
-    pub kept_c: Vec<ParamId>,
-    pub opts: &'a CalibrationOptions,
-}
-
-/// A method's fit before it is reported.
-#[derive(Clone)]
-pub(crate) struct MethodFit {
-    pub fit: Fit,
-    pub ids: Vec<ParamId>,
-    pub tlbo: Option<TlboSummary>,
-    /// Parameters the method considered but could not identify.
-    pub not_identified: Vec<DroppedParam>,
-}
 
 impl Context<'_> {
     fn with_compliance(&self) -> Vec<ParamId> {
@@ -113,9 +69,7 @@ impl Context<'_> {
 
     fn require_compliance(&self) -> Result<(), MethodError> {
         if self.kept_c.is_empty() {
-            return Err(MethodError::Failed(
-                "gravity puts no torque on any joint in these poses, so no compliance can be identified; use km".into(),
-            ));
+            return Err(MethodFailure::NoComplianceIdentifiable.into());
         }
         Ok(())
     }
@@ -161,11 +115,7 @@ impl Context<'_> {
     ) -> Result<MethodFit, MethodError> {
         self.require_compliance()?;
         let cost = SkcmCCost::new(warm, &self.kept_geo, &self.kept_c, self.ident, self.opts)
-            .ok_or_else(|| {
-                MethodError::Failed(
-                    "the KM fit's Jacobian is singular at the reference geometry".into(),
-                )
-            })?;
+            .ok_or(MethodFailure::SingularReference)?;
         let hi = cost.search_box(self.opts.tlbo_max_deflection_rad);
         let lo = vec![0.0; hi.len()];
         let mut rng = ChaCha8Rng::seed_from_u64(self.opts.tlbo.seed);
@@ -202,12 +152,10 @@ impl Context<'_> {
     ) -> Result<MethodFit, MethodError> {
         self.require_compliance()?;
         if let Some(why) = payload_problem(self.ident) {
-            return Err(MethodError::Failed(why));
+            return Err(why.into());
         }
         if !skcm.model.has_compliance() {
-            return Err(MethodError::Failed(
-                "SKCM identified no compliance, so the payload's centre of mass has no effect on the measurements; use skcm or km".into(),
-            ));
+            return Err(MethodFailure::NoComplianceIdentified.into());
         }
         // Which payload parameters the poses excite, at the SKCM compliance.
         let base = self.with_compliance();
@@ -250,9 +198,7 @@ impl Context<'_> {
             .filter(|p| analysis.kept.contains(p))
             .collect();
         if kept_payload.is_empty() {
-            return Err(MethodError::Failed(
-                "the poses do not excite the payload (neither its centre of mass nor its mass is identifiable); measure poses that turn the tool through different orientations".into(),
-            ));
+            return Err(MethodFailure::PayloadNotExcited.into());
         }
         let not_identified = analysis
             .report
@@ -268,125 +214,6 @@ impl Context<'_> {
             ids,
             tlbo: None,
             not_identified,
-        })
-    }
-
-    /// The method's report: errors, parameters, stiffness, warnings; fails when
-    /// the model does not load back from its description.
-    pub fn report(&self, method: Method, mf: MethodFit) -> Result<MethodReport, String> {
-        let MethodFit {
-            fit: fitted,
-            ids,
-            tlbo,
-            not_identified,
-        } = mf;
-        let description = ModelDescription::from_model(&fitted.model);
-        if let Err(e) = description.to_model() {
-            return Err(format!(
-                "the {} model does not load back: {e}",
-                method.name()
-            ));
-        }
-        // The fit's last residuals are those of the identification set.
-        let id_err = match &fitted.residuals {
-            Some(r) if r.len() == residual_rows(self.ident) => {
-                SetErrors::from_residual_vector(self.ident, r)
-            }
-            _ => SetErrors::of(&fitted.model, &fitted.session_frames, self.ident),
-        };
-        let va_err = (!self.valid.is_empty())
-            .then(|| SetErrors::of(&fitted.model, &fitted.session_frames, self.valid));
-        let mut warnings = Vec::new();
-        if !fitted.report.converged {
-            warnings.push(MethodWarning {
-                kind: WarningKind::NotConverged,
-                joint: None,
-                message: format!("solver did not converge: {}", fitted.report.detail),
-            });
-        }
-        for d in not_identified {
-            warnings.push(MethodWarning {
-                kind: WarningKind::ParameterNotIdentifiable,
-                joint: None,
-                message: format!("{} kept at its nominal value: {}", d.name, d.reason),
-            });
-        }
-        let [k_lo, k_hi] = self.opts.plausible_stiffness_nm_per_rad;
-        let mut stiffness = Vec::with_capacity(fitted.model.dof());
-        for (k, l) in fitted.model.links.iter().enumerate() {
-            let cid = ParamId::new(ParamKind::Compliance, k);
-            let Some(pos) = ids.iter().position(|i| *i == cid) else {
-                stiffness.push(None);
-                continue;
-            };
-            let at_bound = fitted.at_bound.get(pos).copied().unwrap_or(false)
-                || (method == Method::SkcmTlbo && l.compliance <= 0.0);
-            if at_bound {
-                warnings.push(MethodWarning {
-                    kind: WarningKind::ComplianceAtBound,
-                    joint: Some(k + 1),
-                    message: format!(
-                        "c{} held at its bound 0 (rigid): the data would pull it negative, i.e. the joint would move against its gravity torque; unmodelled effects or wrong masses / centres of mass are likely",
-                        k + 1
-                    ),
-                });
-            }
-            if l.compliance > 0.0 {
-                let kk = 1.0 / l.compliance;
-                if !(k_lo..=k_hi).contains(&kk) {
-                    warnings.push(MethodWarning {
-                        kind: WarningKind::StiffnessImplausible,
-                        joint: Some(k + 1),
-                        message: format!(
-                            "K{} = {kk:.3e} N·m/rad is outside the plausible range {k_lo:.0e}..{k_hi:.0e} N·m/rad",
-                            k + 1
-                        ),
-                    });
-                }
-                stiffness.push(Some(kk));
-            } else {
-                stiffness.push(None);
-            }
-        }
-        let offset = fitted.model.payload.mass_offset;
-        if offset != 0.0 {
-            let lightest = self
-                .ident
-                .iter()
-                .chain(self.valid)
-                .map(|m| m.payload_mass)
-                .fold(f64::INFINITY, f64::min);
-            if lightest + offset < 0.0 {
-                warnings.push(MethodWarning {
-                    kind: WarningKind::PayloadImplausible,
-                    joint: None,
-                    message: format!(
-                        "the identified payload mass offset {offset:+.2} kg leaves a negative mass on poses declared with {lightest:.2} kg: the payload and compliance are not separable in these poses"
-                    ),
-                });
-            }
-        }
-        Ok(MethodReport {
-            method,
-            solver: fitted.report.clone(),
-            identification: id_err,
-            validation: va_err,
-            training: None,
-            parameters: estimates(
-                self.nominal,
-                &fitted.model,
-                &ids,
-                fitted.covariance.as_ref(),
-                &fitted.at_bound,
-            ),
-            stiffness_nm_per_rad: stiffness,
-            tlbo,
-            warnings,
-            model: description,
-            compensator: None,
-            auto: None,
-            calibrated: fitted.model,
-            stored_compensator: None,
         })
     }
 }

@@ -1,0 +1,181 @@
+//! `auto`: the base (KM or SKCM) with the compensator cross-validation
+//! prefers, or the base alone.
+//!
+//! `auto` runs KM and (when gravity loads a joint) SKCM, cross-validates every
+//! candidate compensator of each base on the training pool and keeps, per
+//! base, the compensator `compensate::choose` accepts (cross-validated mean at
+//! least `min_gain` below the base's, max not above) or the base alone; between
+//! the bases it takes the lower cross-validated mean on the training pool. With
+//! fewer than `min_training_poses` training poses it trains nothing and keeps
+//! the base, saying so.
+
+use super::compensated::base_pool_stats;
+use super::run::{AppliedCompensator, Cache, Context, MethodFit, Outcome};
+use super::{Base, Compensated, Method, MethodError, MethodFailure};
+use crate::compensate::{choose, CvStats};
+use crate::identify::report::{AutoCandidate, AutoSummary};
+
+/// One base as `auto` weighs it.
+struct BaseOption {
+    base: Base,
+    fit: MethodFit,
+    /// The compensator `choose` kept, if any.
+    compensator: Option<AppliedCompensator>,
+    /// Cross-validated mean on the pool [mm] (the base's residual mean when
+    /// nothing was trained).
+    mean_mm: f64,
+    reason: String,
+}
+
+/// `auto` (module docs). Without gravity torques (`Context::gravity`) neither
+/// SKCM nor the torque-input RBF is tried.
+pub(crate) fn run_auto(
+    ctx: &Context,
+    cache: &mut Cache,
+    progress: &mut dyn FnMut(f64, usize, Option<f64>) -> bool,
+) -> Result<Outcome, MethodError> {
+    let o = &ctx.opts.compensator;
+    let (pool, pool_name) = ctx.pool();
+    let gravity = ctx.gravity.as_ref();
+    let folds = if o.cv_folds > 0 { o.cv_folds } else { 5 };
+    let enough = pool.len() >= o.min_training_poses;
+    let bases: Vec<Base> = if gravity.is_some() {
+        vec![Base::Km]
+    } else {
+        vec![Base::Km, Base::Skcm]
+    };
+    let per_base: Vec<Vec<(Method, Compensated)>> = bases
+        .iter()
+        .map(|b| {
+            o.auto_candidates
+                .iter()
+                .filter_map(|m| Some((*m, m.compensated()?)))
+                .filter(|(m, c)| c.base == *b && (gravity.is_none() || !m.uses_torques()))
+                .collect()
+        })
+        .collect();
+    let total = per_base.iter().map(Vec::len).sum::<usize>().max(1) as f64;
+    let max_stages = (folds + 1) as f64;
+    let mut done = 0.0;
+    let mut notes: Vec<String> = Vec::new();
+    if let Some(why) = gravity {
+        notes.push(format!("skcm and km-rbf not tried: {why}"));
+    }
+    let mut candidates = Vec::new();
+    let mut options: Vec<BaseOption> = Vec::new();
+    for (base, cands) in bases.iter().zip(&per_base) {
+        let name = base.method().name();
+        let mf = match cache.base_fit(ctx, *base, &mut |it, rms| {
+            progress(done / total, it, Some(rms))
+        }) {
+            Ok(mf) => mf,
+            Err(MethodError::Cancelled) => return Err(MethodError::Cancelled),
+            Err(MethodError::Failed(f)) => {
+                notes.push(format!("{name} failed: {f}"));
+                done += cands.len() as f64;
+                continue;
+            }
+        };
+        let base_mean = base_pool_stats(&mf.fit, pool).mean_mm;
+        if !enough {
+            options.push(BaseOption {
+                base: *base,
+                fit: mf,
+                compensator: None,
+                mean_mm: base_mean,
+                reason: format!(
+                    "{name}: only {} training poses (at least {} are needed to train and cross-validate a compensator), so the base stays",
+                    pool.len(),
+                    o.min_training_poses
+                ),
+            });
+            continue;
+        }
+        let mut cvs: Vec<(String, CvStats)> = Vec::new();
+        let mut trained: Vec<AppliedCompensator> = Vec::new();
+        for (m, c) in cands {
+            let max = o.max_epochs(c.network) as f64;
+            let at = done;
+            let r = cache.trained(ctx, *m, c.network, &mf.fit, folds, &mut |stage, e, l| {
+                let f = (stage as f64 + (e as f64 / max).min(1.0)) / max_stages;
+                progress((at + f) / total, e, Some(l))
+            });
+            done += 1.0;
+            match r {
+                Ok(t) => {
+                    let cv = t.cv.clone().expect("auto cross-validates");
+                    candidates.push(AutoCandidate {
+                        method: *m,
+                        cross_validation: Some(cv.clone()),
+                        failed: None,
+                    });
+                    cvs.push((m.name().to_string(), cv));
+                    trained.push(AppliedCompensator {
+                        method: *m,
+                        base: c.base,
+                        trained: t,
+                    });
+                }
+                Err(MethodError::Cancelled) => return Err(MethodError::Cancelled),
+                Err(MethodError::Failed(f)) => candidates.push(AutoCandidate {
+                    method: *m,
+                    cross_validation: None,
+                    failed: Some(f.to_string()),
+                }),
+            }
+        }
+        let choice = choose(&cvs, o.min_gain);
+        let picked = choice
+            .chosen
+            .as_deref()
+            .and_then(|chosen| trained.into_iter().find(|a| a.method.name() == chosen));
+        let mean_mm = picked
+            .as_ref()
+            .and_then(|a| a.trained.cv.as_ref())
+            .map_or(base_mean, |cv| cv.compensated.mean_mm);
+        options.push(BaseOption {
+            base: *base,
+            fit: mf,
+            compensator: picked,
+            mean_mm,
+            reason: format!("{name}: {}", choice.reason),
+        });
+    }
+    let best = options
+        .iter()
+        .enumerate()
+        .min_by(|a, b| a.1.mean_mm.total_cmp(&b.1.mean_mm))
+        .map(|(i, _)| i)
+        .ok_or_else(|| MethodFailure::NoBaseSucceeded {
+            notes: notes.clone(),
+        })?;
+    let reasons: Vec<String> = options.iter().map(|o| o.reason.clone()).collect();
+    let best = options.swap_remove(best);
+    let chosen = best
+        .compensator
+        .as_ref()
+        .map_or(best.base.method(), |a| a.method);
+    let mut reason = format!(
+        "{}: the lowest {} mean on the {pool_name} poses ({:.4} mm) — {}",
+        chosen.name(),
+        if best.compensator.is_some() || enough {
+            "cross-validated"
+        } else {
+            "residual"
+        },
+        best.mean_mm,
+        reasons.join("; ")
+    );
+    if !notes.is_empty() {
+        reason.push_str(&format!("; {}", notes.join("; ")));
+    }
+    Ok(Outcome {
+        fit: best.fit,
+        compensator: best.compensator,
+        auto: Some(AutoSummary {
+            chosen,
+            reason,
+            candidates,
+        }),
+    })
+}
