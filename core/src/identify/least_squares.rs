@@ -1,6 +1,7 @@
 //! Iterative least squares for KM (seed §2.2, eqs. 2.3–2.4) and SKCM (§2.3,
-//! eq. 2.8; closed loop eq. 4.17): Levenberg–Marquardt on the stacked
-//! identification Jacobian with column scaling.
+//! eq. 2.8; closed loop eq. 4.17): the identification as a problem of the
+//! Levenberg–Marquardt driver [`optim::lm`](crate::optim::lm) (Marquardt's
+//! damping on the column-scaled stacked Jacobian, projected lower bounds).
 //!
 //! Model of one measurement (eq. 2.1 without ΔP_extra), in the registered base
 //! frame of session s: `p = E_s · FK(φ, q + c∘τ(q))`, where τ are the gravity
