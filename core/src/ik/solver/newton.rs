@@ -13,6 +13,8 @@
 
 use super::eval::NnDerivative;
 use super::*;
+
+mod driver;
 use nalgebra::{
     allocator::Allocator, DefaultAllocator, Dim, Dyn, Matrix6, OMatrix, OVector, Vector6, U1, U6,
 };
@@ -60,7 +62,7 @@ impl IkSolver {
     /// The weighted Jacobian: orientation rows times `L`, or 0 for
     /// position-only goals (which then decouple from the position rows in the
     /// step's 6×6 system).
-    fn weighted_jacobian<D: Dim>(&self, jac: &Jac<D>, position_only: bool) -> Jac<D>
+    pub(super) fn weighted_jacobian<D: Dim>(&self, jac: &Jac<D>, position_only: bool) -> Jac<D>
     where
         DefaultAllocator: Allocator<U6, D>,
     {
