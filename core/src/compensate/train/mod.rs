@@ -1,8 +1,8 @@
 //! Training of the residual compensators on [`Sample`]s: the MLP of
 //! [`mlp`](super::mlp) by Levenberg–Marquardt backpropagation (seed ch. 4, the
-//! MATLAB toolbox default `trainlm`; [`lm`]), by invasive weed optimisation
-//! (ch. 5, [`iwo`]) or by TLBO (ch. 6, [`tlbo`]), all over the same flat
-//! weight vector in normalised units ([`data`]); and the RBF of
+//! MATLAB toolbox default `trainlm`; `lm`), by invasive weed optimisation
+//! (ch. 5, `iwo`) or by TLBO (ch. 6, `tlbo`), all over the same flat
+//! weight vector in normalised units (`data`); and the RBF of
 //! [`rbf`](super::rbf) (ch. 3).
 //!
 //! Loss per sample (eqs. 5.5 / 6.9): `E = (1/3)·Σ_o e_o²` with `e` the error of
@@ -10,7 +10,7 @@
 //! early on a held-out part (MATLAB `max_fail`); IWO minimises eq. 5.7,
 //! `mean(E) + 0.7·max(E)`; TLBO minimises `mean(E)` (eq. 6.9). IWO and TLBO
 //! solve the output layer by least squares for every candidate by default
-//! ([`output_layer`]).
+//! (`output_layer`).
 //!
 //! The null network (the mean residual): LM counts it as a final
 //! early-stopping candidate; IWO and TLBO hold out 15 % of the samples the
