@@ -21,7 +21,7 @@
 //! `∂y/∂q_k = diag(1/s_out)·W2·diag(1 − h²)·W1·diag(s_in)·∂f/∂q_k`, where `f` is
 //! the feature map (`∂ sin q/∂q = cos q`, `∂ cos q/∂q = −sin q`).
 
-use super::Compensator;
+use super::{Compensator, InvalidCompensator};
 use nalgebra::{Matrix3xX, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -147,9 +147,14 @@ impl Normalisation {
         }
     }
 
-    pub(crate) fn validate(&self, n: usize, what: &str, outputs: bool) -> Result<(), String> {
+    pub(crate) fn validate(
+        &self,
+        n: usize,
+        what: &'static str,
+        outputs: bool,
+    ) -> Result<(), InvalidCompensator> {
         if self.centre.len() != n || self.scale.len() != n {
-            return Err(format!("{what} normalisation must have {n} values"));
+            return Err(InvalidCompensator::NormalisationLength { what, n });
         }
         if self
             .centre
@@ -157,10 +162,10 @@ impl Normalisation {
             .chain(&self.scale)
             .any(|v| !v.is_finite())
         {
-            return Err(format!("{what} normalisation values must be finite"));
+            return Err(InvalidCompensator::NormalisationNotFinite { what });
         }
         if outputs && self.scale.contains(&0.0) {
-            return Err(format!("{what} normalisation scales must be non-zero"));
+            return Err(InvalidCompensator::NormalisationZeroScale { what });
         }
         Ok(())
     }
@@ -282,22 +287,21 @@ impl Mlp {
     }
 
     /// Checks sizes and finiteness (file input).
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), InvalidCompensator> {
         let s = self.shape();
         if self.dof == 0 || self.hidden == 0 {
-            return Err("mlp: dof and hidden must be positive".into());
+            return Err(InvalidCompensator::MlpSize);
         }
         if self.weights.len() != s.n_weights() {
-            return Err(format!(
-                "mlp: {} weights, a {}-{}-3 network has {}",
-                self.weights.len(),
-                s.inputs,
-                s.hidden,
-                s.n_weights()
-            ));
+            return Err(InvalidCompensator::MlpWeightCount {
+                got: self.weights.len(),
+                inputs: s.inputs,
+                hidden: s.hidden,
+                expected: s.n_weights(),
+            });
         }
         if self.weights.iter().any(|w| !w.is_finite()) {
-            return Err("mlp: weights must be finite".into());
+            return Err(InvalidCompensator::MlpWeightsNotFinite);
         }
         self.input_norm.validate(s.inputs, "mlp input", false)?;
         self.output_norm.validate(3, "mlp output", true)

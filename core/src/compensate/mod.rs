@@ -36,7 +36,9 @@ pub mod train;
 
 pub use file::{parse_compensated, CalibratedModelFile, PoseDescription, CALIBRATED_MODEL_FORMAT};
 pub use mlp::{Features, Mlp, Normalisation};
-pub use rbf::{train_rbf, train_rbf_with_progress, OutputFrame, Rbf, RbfReport, RbfSettings};
+pub use rbf::{
+    train_rbf, train_rbf_with_progress, OutputFrame, Rbf, RbfReport, RbfSettings, RbfTrainError,
+};
 pub use select::{choose, cross_validate, Choice, CvStats};
 pub use synthetic::{synthetic_calibration, unmodelled_truth, SyntheticErrors};
 pub use train::{
@@ -108,7 +110,7 @@ pub enum StoredCompensator {
 }
 
 impl StoredCompensator {
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), InvalidCompensator> {
         match self {
             StoredCompensator::Mlp(m) => m.validate(),
             StoredCompensator::Rbf(r) => r.validate(),
@@ -141,6 +143,40 @@ pub struct Sample {
     pub payload_kg: f64,
     /// Measured minus predicted position [m], registered base frame.
     pub residual: Vector3<f64>,
+}
+
+/// Why a stored compensator is not a usable network (file input).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum InvalidCompensator {
+    #[error("mlp: dof and hidden must be positive")]
+    MlpSize,
+    #[error("mlp: {got} weights, a {inputs}-{hidden}-3 network has {expected}")]
+    MlpWeightCount {
+        got: usize,
+        inputs: usize,
+        hidden: usize,
+        expected: usize,
+    },
+    #[error("mlp: weights must be finite")]
+    MlpWeightsNotFinite,
+    #[error("rbf: centres must hold dof values per unit")]
+    RbfCentres,
+    #[error("rbf: {got} output weights, {units} units need {expected}")]
+    RbfWeightCount {
+        got: usize,
+        units: usize,
+        expected: usize,
+    },
+    #[error("rbf: spread must be positive")]
+    RbfSpread,
+    #[error("rbf: centres and weights must be finite")]
+    RbfNotFinite,
+    #[error("{what} normalisation must have {n} values")]
+    NormalisationLength { what: &'static str, n: usize },
+    #[error("{what} normalisation values must be finite")]
+    NormalisationNotFinite { what: &'static str },
+    #[error("{what} normalisation scales must be non-zero")]
+    NormalisationZeroScale { what: &'static str },
 }
 
 /// Errors of the compensated model and its files.

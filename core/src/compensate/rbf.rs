@@ -24,7 +24,7 @@
 //! Jacobian (see [`CompensatedModel::predict_base_with_jacobian`](super::CompensatedModel::predict_base_with_jacobian)).
 
 use super::mlp::Normalisation;
-use super::{Compensator, Sample};
+use super::{Compensator, InvalidCompensator, Sample};
 use nalgebra::{DMatrix, Matrix3, Matrix3xX, Vector3};
 use rand::seq::SliceRandom;
 use rand::Rng;
@@ -95,20 +95,19 @@ impl Rbf {
         self.centres.len() / self.dof.max(1)
     }
 
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), InvalidCompensator> {
         if self.dof == 0 || !self.centres.len().is_multiple_of(self.dof) {
-            return Err("rbf: centres must hold dof values per unit".into());
+            return Err(InvalidCompensator::RbfCentres);
         }
         if self.weights.len() != 3 * (self.units() + 1) {
-            return Err(format!(
-                "rbf: {} output weights, {} units need {}",
-                self.weights.len(),
-                self.units(),
-                3 * (self.units() + 1)
-            ));
+            return Err(InvalidCompensator::RbfWeightCount {
+                got: self.weights.len(),
+                units: self.units(),
+                expected: 3 * (self.units() + 1),
+            });
         }
         if !(self.spread.is_finite() && self.spread > 0.0) {
-            return Err("rbf: spread must be positive".into());
+            return Err(InvalidCompensator::RbfSpread);
         }
         if self
             .centres
@@ -116,7 +115,7 @@ impl Rbf {
             .chain(&self.weights)
             .any(|v| !v.is_finite())
         {
-            return Err("rbf: centres and weights must be finite".into());
+            return Err(InvalidCompensator::RbfNotFinite);
         }
         self.input_norm.validate(self.dof, "rbf input", false)
     }
@@ -264,13 +263,22 @@ fn network(
     }
 }
 
+/// Why an RBF cannot be trained.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum RbfTrainError {
+    #[error("the RBF needs at least 5 training poses, got {got}")]
+    TooFewSamples { got: usize },
+    #[error("the RBF least-squares problem could not be solved")]
+    Unsolvable,
+}
+
 /// Trains an RBF network on `samples` (needs at least 5). The random generator
 /// only splits off the held-out part.
 pub fn train_rbf(
     samples: &[Sample],
     settings: &RbfSettings,
     rng: &mut impl Rng,
-) -> Result<(Rbf, RbfReport), String> {
+) -> Result<(Rbf, RbfReport), RbfTrainError> {
     train_rbf_with_progress(samples, settings, rng, &mut |_, _| true)
         .map(|r| r.expect("never cancelled"))
 }
@@ -284,12 +292,9 @@ pub fn train_rbf_with_progress(
     settings: &RbfSettings,
     rng: &mut impl Rng,
     progress: &mut dyn FnMut(usize, f64) -> bool,
-) -> Result<Option<(Rbf, RbfReport)>, String> {
+) -> Result<Option<(Rbf, RbfReport)>, RbfTrainError> {
     if samples.len() < 5 {
-        return Err(format!(
-            "the RBF needs at least 5 training poses, got {}",
-            samples.len()
-        ));
+        return Err(RbfTrainError::TooFewSamples { got: samples.len() });
     }
     let dof = samples[0].tau.len();
     let taus: Vec<Vec<f64>> = samples.iter().map(|s| s.tau.clone()).collect();
@@ -352,7 +357,7 @@ pub fn train_rbf_with_progress(
     if !go {
         return Ok(None);
     }
-    let net = out.ok_or("the RBF least-squares problem could not be solved")?;
+    let net = out.ok_or(RbfTrainError::Unsolvable)?;
     Ok(Some((
         net,
         RbfReport {

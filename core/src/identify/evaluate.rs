@@ -20,28 +20,6 @@ use crate::model::pose::{rotation_log, Pose};
 use crate::model::{ParamId, ParamKind, RobotModel};
 use nalgebra::{DMatrix, DMatrixView, DVector, Matrix3, Vector3};
 
-/// Column scaling `1/‖J_j‖` (1 for an all-zero column).
-pub(crate) fn column_scale(j: &DMatrix<f64>) -> DVector<f64> {
-    DVector::from_iterator(
-        j.ncols(),
-        j.column_iter().map(|c| {
-            let n = c.norm();
-            if n > 0.0 {
-                1.0 / n
-            } else {
-                1.0
-            }
-        }),
-    )
-}
-
-/// Scales the columns of `j` by `scale` in place.
-pub(crate) fn scale_columns(j: &mut DMatrix<f64>, scale: &DVector<f64>) {
-    for (c, s) in scale.iter().enumerate() {
-        j.column_mut(c).scale_mut(*s);
-    }
-}
-
 /// `jᵀj` by `matrixmultiply`'s blocked kernels (through nalgebra's `gemm`,
 /// which picks the widest vector unit the processor has at run time), with
 /// `jᵀ` a strided view of `j`'s storage: no copy. Faster than the column dot

@@ -1,6 +1,7 @@
 //! Iterative least squares for KM (seed §2.2, eqs. 2.3–2.4) and SKCM (§2.3,
-//! eq. 2.8; closed loop eq. 4.17): Levenberg–Marquardt on the stacked
-//! identification Jacobian with column scaling.
+//! eq. 2.8; closed loop eq. 4.17): the identification as a problem of the
+//! Levenberg–Marquardt driver [`optim::lm`](crate::optim::lm) (Marquardt's
+//! damping on the column-scaled stacked Jacobian, projected lower bounds).
 //!
 //! Model of one measurement (eq. 2.1 without ΔP_extra), in the registered base
 //! frame of session s: `p = E_s · FK(φ, q + c∘τ(q))`, where τ are the gravity
@@ -17,11 +18,15 @@
 //! into two residual/Jacobian buffers swapped on acceptance.
 
 pub use super::evaluate::residual_rows;
-use super::evaluate::{column_scale, evaluate, evaluate_into, gram, scale_columns};
+use super::evaluate::{evaluate, evaluate_into, gram};
 use crate::kinematics::Chain;
 use crate::measure::Measurement;
 use crate::model::pose::Pose;
 use crate::model::{ParamId, ParamKind, ParamLayout, RobotModel};
+use crate::optim::lm::{
+    self, column_scale, scale_columns, Bounds, Flow, Iterate, LeastSquaresProblem,
+};
+pub use crate::optim::lm::{Cancelled, StopReason};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -58,68 +63,6 @@ impl Default for LmSettings {
             initial_lambda: 1e-6,
             orientation_weight: 1.0,
             gradient_tolerance: default_gradient_tolerance(),
-        }
-    }
-}
-
-/// Why a least-squares run stopped. Only the first three are convergence tests
-/// that passed; every other reason leaves `converged = false`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum StopReason {
-    /// An accepted step decreased the cost by less than `cost_tolerance` (relative).
-    CostTolerance,
-    /// An accepted step was shorter than `step_tolerance` (scaled).
-    StepTolerance,
-    /// No trial step reduced the cost and the projected scaled gradient (the
-    /// largest cosine between the residual and a free column) is below
-    /// `gradient_tolerance`: a (bound-constrained) minimum.
-    GradientTolerance,
-    /// The iteration budget ran out (accepted and rejected steps both count).
-    MaxIterations,
-    /// No trial step reduced the cost, and the decrease the linear model
-    /// predicts for the trials (at most, over this iteration's damping values)
-    /// is below `cost_tolerance` (relative): what is left to gain is below
-    /// the cost test, within the rounding of the cost itself. The same test
-    /// as [`StopReason::CostTolerance`], on the predicted decrease.
-    PredictedCostTolerance,
-    /// No trial step reduced the cost although the gradient is not small
-    /// and the predicted decrease is above `cost_tolerance` (damping
-    /// exhausted): not a minimum that a test confirmed.
-    NoDescent,
-    /// Trial models could not be evaluated (e.g. a closed loop that does not
-    /// close).
-    EvaluationFailed,
-    /// Fewer residuals than unknowns.
-    Underdetermined,
-    /// The starting model cannot be evaluated at some measured joints.
-    StartNotEvaluable,
-}
-
-impl StopReason {
-    /// Whether this reason is a passed convergence test.
-    pub fn converged(&self) -> bool {
-        matches!(
-            self,
-            StopReason::CostTolerance
-                | StopReason::StepTolerance
-                | StopReason::GradientTolerance
-                | StopReason::PredictedCostTolerance
-        )
-    }
-
-    /// The snake_case code used in JSON.
-    pub fn code(&self) -> &'static str {
-        match self {
-            StopReason::CostTolerance => "cost_tolerance",
-            StopReason::StepTolerance => "step_tolerance",
-            StopReason::GradientTolerance => "gradient_tolerance",
-            StopReason::PredictedCostTolerance => "predicted_cost_tolerance",
-            StopReason::MaxIterations => "max_iterations",
-            StopReason::NoDescent => "no_descent",
-            StopReason::EvaluationFailed => "evaluation_failed",
-            StopReason::Underdetermined => "underdetermined",
-            StopReason::StartNotEvaluable => "start_not_evaluable",
         }
     }
 }
@@ -170,10 +113,6 @@ pub fn lower_bound(id: &ParamId) -> f64 {
         f64::NEG_INFINITY
     }
 }
-
-/// A fit was stopped by the caller.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Cancelled;
 
 /// Predicted TCP position and rotation of one measurement in its session frame.
 pub fn predict(model: &RobotModel, m: &Measurement) -> Option<(Vector3<f64>, Matrix3<f64>)> {
@@ -313,94 +252,6 @@ fn apply_step(
     (m, f)
 }
 
-/// Largest |cosine| between the residual and a free scaled column: the
-/// first-order optimality measure of the scaled, bound-constrained problem.
-/// The state of an LM iteration none of whose trial steps reduced the cost.
-struct Stall {
-    /// Projected scaled gradient ([`gradient_measure`]).
-    gradient: f64,
-    /// Largest relative decrease the linear model predicts for an evaluated
-    /// trial (−∞ when none could be evaluated).
-    predicted: f64,
-    /// The iteration budget ran out while the damping was still usable.
-    budget_used: bool,
-    trials: usize,
-    evaluations_failed: usize,
-}
-
-/// Why the LM stops when no trial step reduced the cost: a minimum confirmed
-/// by the gradient or by the predicted decrease, or the reason it is not.
-fn stall_reason(s: &Stall, settings: &LmSettings) -> (StopReason, String) {
-    let Stall {
-        gradient,
-        predicted,
-        trials,
-        ..
-    } = *s;
-    if gradient <= settings.gradient_tolerance {
-        (
-            StopReason::GradientTolerance,
-            format!(
-                "no step reduces the cost and the projected scaled gradient {gradient:.1e} is below {:.0e}",
-                settings.gradient_tolerance
-            ),
-        )
-    } else if (0.0..=settings.cost_tolerance).contains(&predicted) {
-        (
-            StopReason::PredictedCostTolerance,
-            format!(
-                "no step reduces the cost; the largest relative decrease the linear model predicts, {predicted:.1e}, is below {:.0e} (scaled gradient {gradient:.1e})",
-                settings.cost_tolerance
-            ),
-        )
-    } else if s.budget_used {
-        (
-            StopReason::MaxIterations,
-            format!(
-                "iteration budget of {} used up during rejected steps (scaled gradient {gradient:.1e})",
-                settings.max_iterations
-            ),
-        )
-    } else if s.evaluations_failed == trials && trials > 0 {
-        (
-            StopReason::EvaluationFailed,
-            format!("none of {trials} trial steps could be evaluated (closed loop does not close)"),
-        )
-    } else {
-        (
-            StopReason::NoDescent,
-            format!(
-                "no step reduces the cost, but the scaled gradient {gradient:.1e} is above {:.0e} and the predicted relative decrease {predicted:.1e} above {:.0e}: not a confirmed minimum",
-                settings.gradient_tolerance, settings.cost_tolerance
-            ),
-        )
-    }
-}
-
-/// The decrease of the squared residual norm that the linear model predicts
-/// for the scaled step `d`: `‖r‖² − ‖r − J·d‖² = 2·dᵀg − dᵀA·d`, with
-/// `A = JᵀJ` and `g = Jᵀr` of the scaled Jacobian.
-fn predicted_decrease(a: &DMatrix<f64>, g: &DVector<f64>, d: &DVector<f64>) -> f64 {
-    2.0 * d.dot(g) - (a * d).dot(d)
-}
-
-fn gradient_measure(js: &DMatrix<f64>, g: &DVector<f64>, r_norm: f64, active: &[bool]) -> f64 {
-    if r_norm == 0.0 {
-        return 0.0;
-    }
-    (0..g.len())
-        .filter(|&i| !active.get(i).copied().unwrap_or(false))
-        .map(|i| {
-            let n = js.column(i).norm();
-            if n > 0.0 {
-                g[i].abs() / (n * r_norm)
-            } else {
-                0.0
-            }
-        })
-        .fold(0.0, f64::max)
-}
-
 /// Fits the parameters `ids` (and the frames of sessions ≥ 1) to `data` by
 /// Levenberg–Marquardt, starting from `start`. `progress(iteration, rms_mm)`
 /// returns false to cancel.
@@ -433,39 +284,16 @@ pub(crate) fn fit_with_start_chains(
     start_chains: Option<&[Chain]>,
     progress: &mut dyn FnMut(usize, f64) -> bool,
 ) -> Result<Fit, Cancelled> {
-    let layout = ParamLayout { ids: ids.to_vec() };
-    let lower: Vec<f64> = ids.iter().map(lower_bound).collect();
-    let mut model = start.clone();
-    {
-        let x: Vec<f64> = layout
-            .values(&model)
-            .iter()
-            .zip(&lower)
-            .map(|(v, lo)| v.max(*lo))
-            .collect();
-        layout.apply(&mut model, &x);
-    }
-    let mut frames = vec![Pose::identity(); sessions.max(1)];
     let rows = residual_rows(data);
     let rms_mm = |c: f64| (c / rows.max(1) as f64).sqrt() * 1e3;
-    let ncols = ids.len() + (frames.len() - 1) * 6;
-    // The current point and the trial buffers (residuals, Jacobian), swapped
-    // when a trial is accepted.
-    let mut ev = (DVector::zeros(rows), DMatrix::zeros(rows, ncols));
-    let mut trial = (DVector::zeros(rows), DMatrix::zeros(rows, ncols));
-    if !evaluate_into(
-        &model,
-        &frames,
-        ids,
-        data,
-        settings.orientation_weight,
-        &mut ev.0,
-        Some(&mut ev.1),
-        start_chains,
-    ) {
+    let Some(mut problem) =
+        Identification::new(start, ids, data, sessions, settings, start_chains, progress)
+    else {
+        let mut model = start.clone();
+        ParamLayout { ids: ids.to_vec() }.apply(&mut model, &clamped_start(start, ids));
         return Ok(Fit {
             model,
-            session_frames: frames,
+            session_frames: vec![Pose::identity(); sessions.max(1)],
             report: LmReport {
                 converged: false,
                 iterations: 0,
@@ -480,150 +308,17 @@ pub(crate) fn fit_with_start_chains(
             residuals: None,
         });
     };
-    let mut cost = ev.0.norm_squared();
-    let initial = rms_mm(cost);
-    // Column scaling, fixed from the first Jacobian; every accepted
-    // evaluation's Jacobian is scaled in place.
-    let scale = column_scale(&ev.1);
-    scale_columns(&mut ev.1, &scale);
-    let mut lambda = settings.initial_lambda;
-    let mut iterations = 0;
-    let mut reason = StopReason::MaxIterations;
-    let mut detail = format!(
-        "iteration budget of {} used up before a convergence test passed",
-        settings.max_iterations
-    );
-    let mut active = vec![false; ncols];
-    let mut gradient: f64;
-    if rows < ncols {
-        reason = StopReason::Underdetermined;
-        detail = format!("underdetermined: {rows} residuals for {ncols} unknowns");
-    }
-    while rows >= ncols && iterations < settings.max_iterations {
-        if !progress(iterations, rms_mm(cost)) {
-            return Err(Cancelled);
-        }
-        let js = &ev.1;
-        let a = gram(js);
-        let g = js.tr_mul(&ev.0);
-        let x = layout.values(&model);
-        // Active bounds: at the bound with the descent direction (+g) below it.
-        for i in 0..ncols {
-            active[i] = i < ids.len() && x[i] <= lower[i] && g[i] < 0.0;
-        }
-        gradient = gradient_measure(js, &g, cost.sqrt(), &active);
-        let mut accepted = None;
-        let mut evaluations_failed = 0;
-        let mut trials = 0;
-        // Largest relative cost decrease the linear model predicts for a trial.
-        let mut predicted = f64::NEG_INFINITY;
-        while lambda < 1e12 && iterations < settings.max_iterations {
-            iterations += 1;
-            trials += 1;
-            let mut damped = a.clone();
-            let mut rhs = g.clone();
-            for i in 0..ncols {
-                damped[(i, i)] += lambda * (1.0 + a[(i, i)]);
-                if active[i] {
-                    damped.row_mut(i).fill(0.0);
-                    damped.column_mut(i).fill(0.0);
-                    damped[(i, i)] = 1.0;
-                    rhs[i] = 0.0;
-                }
-            }
-            let Some(chol) = damped.cholesky() else {
-                lambda *= 10.0;
-                continue;
-            };
-            let mut delta = chol.solve(&rhs).component_mul(&scale);
-            // Projection onto the bounds.
-            for i in 0..ids.len() {
-                if x[i] + delta[i] < lower[i] {
-                    delta[i] = lower[i] - x[i];
-                }
-            }
-            let scaled = delta.component_div(&scale);
-            let step = scaled.norm();
-            let (m2, f2) = apply_step(&model, &frames, &layout, &x, &delta);
-            // With the Jacobian: an accepted trial is the next iterate, whose
-            // Jacobian is needed next (one forward-kinematics pass per trial).
-            if !evaluate_into(
-                &m2,
-                &f2,
-                ids,
-                data,
-                settings.orientation_weight,
-                &mut trial.0,
-                Some(&mut trial.1),
-                None,
-            ) {
-                evaluations_failed += 1;
-                lambda *= 10.0;
-                continue;
-            }
-            let c2 = trial.0.norm_squared();
-            // Over evaluated trials only: a step that cannot be evaluated
-            // says nothing about what is left to gain.
-            predicted = predicted.max(predicted_decrease(&a, &g, &scaled) / cost);
-            if c2 < cost {
-                accepted = Some((m2, f2, c2, step));
-                lambda = (lambda / 10.0).max(1e-15);
-                break;
-            }
-            lambda *= 10.0;
-        }
-        let Some((m2, f2, c2, step)) = accepted else {
-            (reason, detail) = stall_reason(
-                &Stall {
-                    gradient,
-                    predicted,
-                    budget_used: iterations >= settings.max_iterations && lambda < 1e12,
-                    trials,
-                    evaluations_failed,
-                },
-                settings,
-            );
-            break;
-        };
-        let rel = (cost - c2) / cost.max(f64::MIN_POSITIVE);
-        model = m2;
-        frames = f2;
-        cost = c2;
-        std::mem::swap(&mut ev, &mut trial);
-        scale_columns(&mut ev.1, &scale);
-        if rel < settings.cost_tolerance {
-            reason = StopReason::CostTolerance;
-            detail = format!(
-                "relative cost decrease {rel:.1e} below {:.0e}",
-                settings.cost_tolerance
-            );
-            break;
-        }
-        if step < settings.step_tolerance {
-            reason = StopReason::StepTolerance;
-            detail = format!(
-                "scaled step {step:.1e} below {:.0e}",
-                settings.step_tolerance
-            );
-            break;
-        }
-    }
-    // Final bound state and gradient at the returned model.
-    let js = &ev.1;
-    let g = js.tr_mul(&ev.0);
-    let x = layout.values(&model);
-    for i in 0..ncols {
-        active[i] = i < ids.len() && x[i] <= lower[i] && g[i] < 0.0;
-    }
-    gradient = gradient_measure(js, &g, cost.sqrt(), &active);
-    let at_bound = active[..ids.len()].to_vec();
+    let run = lm::minimise(&mut problem, &driver_settings(settings))?;
+    let active = &run.active;
+    let scale = run.scale.as_ref().expect("the fit scales its columns");
+    let ncols = active.len();
     let covariance = (|| {
         let free = ncols - active.iter().filter(|a| **a).count();
         let dof = rows as f64 - free as f64;
         if dof <= 0.0 {
             return None;
         }
-        let mut a = gram(js);
+        let mut a = gram(&problem.ev.1);
         for i in 0..ncols {
             if active[i] {
                 a.row_mut(i).fill(0.0);
@@ -632,7 +327,7 @@ pub(crate) fn fit_with_start_chains(
             }
         }
         let inv = a.try_inverse()?;
-        let sigma2 = cost / dof;
+        let sigma2 = run.cost / dof;
         let mut cov = DMatrix::zeros(ids.len(), ids.len());
         for a in 0..ids.len() {
             for b in 0..ids.len() {
@@ -644,91 +339,196 @@ pub(crate) fn fit_with_start_chains(
         Some(cov)
     })();
     Ok(Fit {
-        model,
-        session_frames: frames,
+        model: problem.model,
+        session_frames: problem.frames,
         report: LmReport {
-            converged: reason.converged(),
-            iterations,
-            reason,
-            detail,
-            gradient,
-            initial_rms_mm: initial,
-            final_rms_mm: rms_mm(cost),
+            converged: run.converged,
+            iterations: run.iterations,
+            reason: run.reason,
+            detail: run.detail,
+            gradient: run.gradient,
+            initial_rms_mm: rms_mm(run.initial_cost),
+            final_rms_mm: rms_mm(run.cost),
         },
         covariance,
-        at_bound,
-        residuals: Some(ev.0),
+        at_bound: active[..ids.len()].to_vec(),
+        residuals: Some(problem.ev.0),
     })
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use rand::{Rng, SeedableRng};
-    use rand_chacha::ChaCha8Rng;
+/// The identification's driver settings: Marquardt's damping on the
+/// column-scaled Jacobian, every test of [`LmSettings`].
+fn driver_settings(s: &LmSettings) -> lm::Settings {
+    lm::Settings {
+        max_iterations: s.max_iterations,
+        cost_tolerance: s.cost_tolerance,
+        step_tolerance: s.step_tolerance,
+        gradient_tolerance: s.gradient_tolerance,
+        damping: lm::Damping::Marquardt {
+            initial: s.initial_lambda,
+        },
+        ..lm::Settings::default()
+    }
+}
 
-    /// The predicted decrease against its definition `‖r‖² − ‖r − J·d‖²`,
-    /// computed directly, on random tall systems and steps.
-    #[test]
-    fn predicted_decrease_is_the_linear_models_decrease() {
-        let mut rng = ChaCha8Rng::seed_from_u64(9);
-        for (m, n) in [(30, 4), (300, 25), (7, 7)] {
-            let j = DMatrix::from_fn(m, n, |_, _| rng.gen_range(-1.0..1.0));
-            let r = DVector::from_fn(m, |_, _| rng.gen_range(-1.0..1.0));
-            let d = DVector::from_fn(n, |_, _| rng.gen_range(-0.5..0.5));
-            let direct = r.norm_squared() - (&r - &j * &d).norm_squared();
-            let p = predicted_decrease(&j.tr_mul(&j), &j.tr_mul(&r), &d);
-            assert!(
-                (p - direct).abs() <= 1e-12 * r.norm_squared(),
-                "{p} vs {direct}"
-            );
+/// The values of `ids` in `start`, raised to their lower bounds.
+fn clamped_start(start: &RobotModel, ids: &[ParamId]) -> Vec<f64> {
+    ParamLayout { ids: ids.to_vec() }
+        .values(start)
+        .iter()
+        .zip(ids)
+        .map(|(v, id)| v.max(lower_bound(id)))
+        .collect()
+}
+
+/// The fit as a driver problem: the model's parameters `ids`, then 6 columns
+/// per session ≥ 1. A trial is evaluated with its Jacobian (an accepted trial
+/// is the next point, whose Jacobian is needed next: one forward-kinematics
+/// pass per trial) into the trial buffers, swapped with the current ones on
+/// acceptance.
+struct Identification<'a> {
+    layout: ParamLayout,
+    data: &'a [Measurement],
+    orientation_weight: f64,
+    model: RobotModel,
+    frames: Vec<Pose>,
+    /// Column values: the parameters, then 0 for the session frames' columns.
+    x: Vec<f64>,
+    lower: Vec<f64>,
+    upper: Vec<f64>,
+    cost: f64,
+    /// Residuals and Jacobian at the current point and at the last trial.
+    ev: (DVector<f64>, DMatrix<f64>),
+    trial: (DVector<f64>, DMatrix<f64>),
+    /// The last evaluated trial: model, session frames, cost.
+    next: Option<(RobotModel, Vec<Pose>, f64)>,
+    rows: usize,
+    progress: &'a mut dyn FnMut(usize, f64) -> bool,
+}
+
+impl<'a> Identification<'a> {
+    /// The problem at `start` (parameters raised to their bounds, session
+    /// frames identity); `None` when the start cannot be evaluated.
+    fn new(
+        start: &RobotModel,
+        ids: &[ParamId],
+        data: &'a [Measurement],
+        sessions: usize,
+        settings: &LmSettings,
+        start_chains: Option<&[Chain]>,
+        progress: &'a mut dyn FnMut(usize, f64) -> bool,
+    ) -> Option<Self> {
+        let layout = ParamLayout { ids: ids.to_vec() };
+        let mut model = start.clone();
+        layout.apply(&mut model, &clamped_start(start, ids));
+        let frames = vec![Pose::identity(); sessions.max(1)];
+        let rows = residual_rows(data);
+        let ncols = ids.len() + (frames.len() - 1) * 6;
+        let mut ev = (DVector::zeros(rows), DMatrix::zeros(rows, ncols));
+        if !evaluate_into(
+            &model,
+            &frames,
+            ids,
+            data,
+            settings.orientation_weight,
+            &mut ev.0,
+            Some(&mut ev.1),
+            start_chains,
+        ) {
+            return None;
         }
+        let mut lower: Vec<f64> = ids.iter().map(lower_bound).collect();
+        lower.resize(ncols, f64::NEG_INFINITY);
+        let mut problem = Identification {
+            layout,
+            data,
+            orientation_weight: settings.orientation_weight,
+            model,
+            frames,
+            x: Vec::new(),
+            lower,
+            upper: vec![f64::INFINITY; ncols],
+            cost: ev.0.norm_squared(),
+            ev,
+            trial: (DVector::zeros(rows), DMatrix::zeros(rows, ncols)),
+            next: None,
+            rows,
+            progress,
+        };
+        problem.update_x();
+        Some(problem)
     }
 
-    fn stall(gradient: f64, predicted: f64) -> Stall {
-        Stall {
-            gradient,
-            predicted,
-            budget_used: false,
-            trials: 3,
-            evaluations_failed: 0,
-        }
+    fn update_x(&mut self) {
+        self.x = self.layout.values(&self.model);
+        self.x.resize(self.upper.len(), 0.0);
+    }
+}
+
+impl LeastSquaresProblem for Identification<'_> {
+    fn cost(&self) -> f64 {
+        self.cost
     }
 
-    /// A stall is a confirmed minimum when the gradient or the predicted
-    /// decrease passes its test, and only then.
-    #[test]
-    fn a_stall_converges_only_when_a_test_passes() {
-        let s = LmSettings::default();
-        let at = |st: &Stall| stall_reason(st, &s).0;
-        // The gradient test, as before.
-        assert_eq!(at(&stall(5e-7, 1.0)), StopReason::GradientTolerance);
-        // Gradient above its tolerance, nothing measurable left to gain.
-        let r = at(&stall(1.8e-6, 3e-12));
-        assert_eq!(r, StopReason::PredictedCostTolerance);
-        assert!(r.converged());
-        // Something left to gain: not a minimum.
-        let r = at(&stall(1.8e-6, 1e-8));
-        assert_eq!(r, StopReason::NoDescent);
-        assert!(!r.converged());
-        // No trial evaluated: the prediction (−∞) confirms nothing.
-        let failed = Stall {
-            evaluations_failed: 3,
-            ..stall(1e-3, f64::NEG_INFINITY)
-        };
-        assert_eq!(at(&failed), StopReason::EvaluationFailed);
-        let none = Stall {
-            trials: 0,
-            ..stall(1e-3, f64::NEG_INFINITY)
-        };
-        assert_eq!(at(&none), StopReason::NoDescent);
-        // A projected step the model predicts to raise the cost confirms nothing.
-        assert_eq!(at(&stall(1e-3, -1e-12)), StopReason::NoDescent);
-        // The budget, when the predicted decrease is still above the test.
-        let budget = Stall {
-            budget_used: true,
-            ..stall(1e-3, 1e-6)
-        };
-        assert_eq!(at(&budget), StopReason::MaxIterations);
+    fn linearise(&mut self) -> &mut DMatrix<f64> {
+        &mut self.ev.1
+    }
+
+    fn residuals(&self) -> &DVector<f64> {
+        &self.ev.0
+    }
+
+    fn jacobian(&self) -> &DMatrix<f64> {
+        &self.ev.1
+    }
+
+    fn gram(&self, j: &DMatrix<f64>) -> DMatrix<f64> {
+        gram(j)
+    }
+
+    fn bounds(&self) -> Option<Bounds<'_>> {
+        Some(Bounds {
+            x: &self.x,
+            lower: &self.lower,
+            upper: &self.upper,
+        })
+    }
+
+    fn trial(&mut self, delta: &mut DVector<f64>) -> Option<f64> {
+        let n = self.layout.len();
+        let (m2, f2) = apply_step(&self.model, &self.frames, &self.layout, &self.x[..n], delta);
+        if !evaluate_into(
+            &m2,
+            &f2,
+            &self.layout.ids,
+            self.data,
+            self.orientation_weight,
+            &mut self.trial.0,
+            Some(&mut self.trial.1),
+            None,
+        ) {
+            return None;
+        }
+        let cost = self.trial.0.norm_squared();
+        self.next = Some((m2, f2, cost));
+        Some(cost)
+    }
+
+    fn accept(&mut self) {
+        let (model, frames, cost) = self.next.take().expect("an evaluated trial");
+        self.model = model;
+        self.frames = frames;
+        self.cost = cost;
+        std::mem::swap(&mut self.ev, &mut self.trial);
+        self.update_x();
+    }
+
+    fn start(&mut self, at: &Iterate) -> Flow {
+        let rms_mm = (at.cost / self.rows.max(1) as f64).sqrt() * 1e3;
+        if (self.progress)(at.iterations, rms_mm) {
+            Flow::Continue
+        } else {
+            Flow::Cancel
+        }
     }
 }

@@ -1,0 +1,797 @@
+//! One Levenberg–Marquardt driver for robocal's least-squares problems: the
+//! identification fit (`identify::least_squares`, seed eqs. 2.3–2.4 and 2.8)
+//! and the MLP's backpropagation (`compensate::train`, seed ch. 4, MATLAB
+//! `trainlm`).
+//!
+//! A problem ([`LeastSquaresProblem`]) gives the residuals `r = target −
+//! prediction` and the Jacobian `J` of the prediction at its current point, so
+//! that `r(x ⊕ δ) ≈ r − J·δ`, and evaluates trial points `x ⊕ δ` (the problem
+//! applies the step: the identification rotates session frames). Cost `‖r‖²`.
+//! One outer iteration linearises at the current point and solves damped
+//! trials `(A + D(μ))·δ = g`, `A = JᵀJ`, `g = Jᵀr` of the column-scaled
+//! Jacobian, until one lowers the cost; the damping `D(μ)` and its updates are
+//! the rule of [`Damping`]. Bounds: a projected LM — a column at a bound whose
+//! descent direction `+g` points out of the box is held for the step, a step
+//! crossing a bound is cut onto it.
+//!
+//! Stops after an accepted step: relative cost decrease below
+//! `cost_tolerance`, scaled step below `step_tolerance`, or the caller's hook.
+//! When no trial is accepted: one stall verdict ([`stall_verdict`]).
+//!
+//! Why not the `levenberg-marquardt` crate: it ports MINPACK's `lmder`
+//! (trust region, pivoted QR, adaptive diagonal), has no bounds, sets a flat
+//! parameter vector (no retraction for the session frames' rotations) and
+//! would change every identification result; the trainer's `trainlm` μ rule
+//! and early stopping are not expressible in it either.
+
+mod stop;
+
+pub use stop::{stall_verdict, Stall, StopReason, Verdict};
+
+use nalgebra::{DMatrix, DVector};
+
+/// A least-squares problem with a current point that the driver moves.
+pub trait LeastSquaresProblem {
+    /// Cost `‖r‖²` at the current point (the problem's own summation).
+    fn cost(&self) -> f64;
+    /// Computes `r` and `J` at the current point if not yet done; returns `J`
+    /// for in-place column scaling.
+    fn linearise(&mut self) -> &mut DMatrix<f64>;
+    /// `r` of the last linearisation.
+    fn residuals(&self) -> &DVector<f64>;
+    /// `J` of the last linearisation (column-scaled by the driver).
+    fn jacobian(&self) -> &DMatrix<f64>;
+    /// `JᵀJ`; a problem with tall Jacobians may use a faster kernel.
+    fn gram(&self, j: &DMatrix<f64>) -> DMatrix<f64> {
+        j.tr_mul(j)
+    }
+    /// Column values and box at the current point; `None` when unbounded.
+    fn bounds(&self) -> Option<Bounds<'_>> {
+        None
+    }
+    /// Evaluates the trial `x ⊕ δ` (unscaled `δ`, which the problem may
+    /// shorten in place): its cost, `None` when it cannot be evaluated.
+    fn trial(&mut self, delta: &mut DVector<f64>) -> Option<f64>;
+    /// Makes the last evaluated trial the current point.
+    fn accept(&mut self);
+    /// Called before every outer iteration (progress, cancellation).
+    fn start(&mut self, _at: &Iterate) -> Flow {
+        Flow::Continue
+    }
+    /// Called after every accepted step, before the stop tests (early stopping).
+    fn accepted(&mut self, _at: &Iterate) -> Flow {
+        Flow::Continue
+    }
+}
+
+/// Column values `x` and the box `lower ≤ x ≤ upper` (±∞ for free columns).
+pub struct Bounds<'a> {
+    pub x: &'a [f64],
+    pub lower: &'a [f64],
+    pub upper: &'a [f64],
+}
+
+/// Where a run stands when a callback is called.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Iterate {
+    /// Trial steps so far (accepted and rejected).
+    pub iterations: usize,
+    /// Outer iterations begun so far (each one linearisation).
+    pub linearisations: usize,
+    /// Cost at the current point.
+    pub cost: f64,
+}
+
+/// A callback's answer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Flow {
+    Continue,
+    /// End the run at the current point ([`StopReason::Stopped`]).
+    Stop,
+    /// Abandon the run ([`Cancelled`]).
+    Cancel,
+}
+
+/// A run was cancelled by a callback.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Cancelled;
+
+/// How the damping enters the step and changes between trials.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Damping {
+    /// Marquardt's: diagonal `+= λ·(1 + A_ii)`; `λ/10` (not below 1e-15) on
+    /// acceptance, `10·λ` on rejection; trials while `λ < 1e12`.
+    Marquardt { initial: f64 },
+    /// MATLAB `trainlm`'s: diagonal `+= μ`; `μ·decrease` on acceptance,
+    /// `μ·increase` on rejection; trials while `μ ≤ max`.
+    Trainlm {
+        initial: f64,
+        decrease: f64,
+        increase: f64,
+        max: f64,
+    },
+    /// Nielsen's: diagonal `+= μ`; on acceptance with gain ratio `ρ`,
+    /// `μ·max(1/3, 1 − (2ρ − 1)³)` (not below 1e-30) and `ν = 2`; on
+    /// rejection `μ·ν` (not below 1e-18) and `ν·2`; trials while `μ ≤ 1e8`.
+    Nielsen { initial: f64 },
+}
+
+/// Marquardt's λ bounds and factor.
+const MARQUARDT_FLOOR: f64 = 1e-15;
+const MARQUARDT_CEILING: f64 = 1e12;
+const MARQUARDT_FACTOR: f64 = 10.0;
+/// Nielsen's largest usable μ.
+const NIELSEN_CEILING: f64 = 1e8;
+
+/// The damping's value (`mu`) and Nielsen's growth factor `nu`.
+struct DampingState {
+    rule: Damping,
+    mu: f64,
+    nu: f64,
+}
+
+impl DampingState {
+    fn new(rule: Damping) -> Self {
+        let mu = match rule {
+            Damping::Marquardt { initial }
+            | Damping::Trainlm { initial, .. }
+            | Damping::Nielsen { initial } => initial,
+        };
+        DampingState { rule, mu, nu: 2.0 }
+    }
+
+    fn usable(&self) -> bool {
+        match self.rule {
+            Damping::Marquardt { .. } => self.mu < MARQUARDT_CEILING,
+            Damping::Trainlm { max, .. } => self.mu <= max,
+            Damping::Nielsen { .. } => self.mu <= NIELSEN_CEILING,
+        }
+    }
+
+    /// Adds the damping to the diagonal of `damped` (a copy of `a`).
+    fn add(&self, damped: &mut DMatrix<f64>, a: &DMatrix<f64>, i: usize) {
+        damped[(i, i)] += match self.rule {
+            Damping::Marquardt { .. } => self.mu * (1.0 + a[(i, i)]),
+            Damping::Trainlm { .. } | Damping::Nielsen { .. } => self.mu,
+        };
+    }
+
+    /// After an accepted step that lowered the cost from `cost` to `trial`
+    /// where the linear model predicted the decrease `predicted`.
+    fn accept(&mut self, predicted: f64, cost: f64, trial: f64) {
+        match self.rule {
+            Damping::Marquardt { .. } => {
+                self.mu = (self.mu / MARQUARDT_FACTOR).max(MARQUARDT_FLOOR)
+            }
+            Damping::Trainlm { decrease, .. } => self.mu *= decrease,
+            Damping::Nielsen { .. } => {
+                let rho = if predicted > 0.0 {
+                    (cost - trial) / predicted
+                } else {
+                    1.0
+                };
+                self.mu *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
+                self.mu = self.mu.max(1e-30);
+                self.nu = 2.0;
+            }
+        }
+    }
+
+    /// After a rejected, unsolvable or unevaluable trial.
+    fn reject(&mut self) {
+        match self.rule {
+            Damping::Marquardt { .. } => self.mu *= MARQUARDT_FACTOR,
+            Damping::Trainlm { increase, .. } => self.mu *= increase,
+            Damping::Nielsen { .. } => {
+                self.mu = (self.mu * self.nu).max(1e-18);
+                self.nu *= 2.0;
+            }
+        }
+    }
+}
+
+/// Driver settings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Settings {
+    /// Budget of trial steps (accepted and rejected).
+    pub max_iterations: usize,
+    /// Budget of outer iterations (linearisations).
+    pub max_linearisations: usize,
+    /// Converged when an accepted step lowers the cost by less than this (relative).
+    pub cost_tolerance: f64,
+    /// Converged when an accepted scaled step is shorter than this.
+    pub step_tolerance: f64,
+    /// A stall is a minimum when the projected scaled gradient ([`gradient_measure`]) is at most this.
+    pub gradient_tolerance: f64,
+    /// Converged before any trial when `max|g_i|` is below this (0: off).
+    pub gradient_floor: f64,
+    pub damping: Damping,
+    /// Scale the columns by `1/‖J_j‖` of the first Jacobian (the scaled
+    /// parameters are dimensionless).
+    pub column_scaling: bool,
+    /// Stop with [`StopReason::Underdetermined`] when there are fewer residuals than columns.
+    pub require_overdetermined: bool,
+    /// Linearise at the returned point for the report's gradient and active
+    /// bounds (else they are NaN and none).
+    pub linearise_at_end: bool,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            max_iterations: 100,
+            max_linearisations: usize::MAX,
+            cost_tolerance: 1e-10,
+            step_tolerance: 1e-10,
+            gradient_tolerance: 1e-6,
+            gradient_floor: 0.0,
+            damping: Damping::Marquardt { initial: 1e-6 },
+            column_scaling: true,
+            require_overdetermined: true,
+            linearise_at_end: true,
+        }
+    }
+}
+
+/// How a run ended (non-convergence is data, not an error).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Report {
+    /// True only when `reason` is a passed convergence test.
+    pub converged: bool,
+    /// Trial steps (accepted and rejected).
+    pub iterations: usize,
+    /// Outer iterations (linearisations with trials).
+    pub linearisations: usize,
+    /// Trial points evaluated.
+    pub evaluations: usize,
+    pub initial_cost: f64,
+    /// Cost at the returned point.
+    pub cost: f64,
+    pub reason: StopReason,
+    /// The reason in words, with the figures of the test.
+    pub detail: String,
+    /// Projected scaled gradient at the returned point ([`gradient_measure`]).
+    pub gradient: f64,
+    /// Per column: held at a bound at the returned point.
+    pub active: Vec<bool>,
+    /// The column scale `1/‖J_j‖` (of the first Jacobian), if scaled.
+    pub scale: Option<DVector<f64>>,
+}
+
+/// The decrease of the squared residual norm that the linear model predicts
+/// for the scaled step `d`: `‖r‖² − ‖r − J·d‖² = 2·dᵀg − dᵀA·d`, with
+/// `A = JᵀJ` and `g = Jᵀr` of the scaled Jacobian.
+pub fn predicted_decrease(a: &DMatrix<f64>, g: &DVector<f64>, d: &DVector<f64>) -> f64 {
+    2.0 * d.dot(g) - (a * d).dot(d)
+}
+
+/// Largest |cosine| between the residual and a free scaled column: the
+/// first-order optimality measure of the scaled, bound-constrained problem.
+pub fn gradient_measure(js: &DMatrix<f64>, g: &DVector<f64>, r_norm: f64, active: &[bool]) -> f64 {
+    if r_norm == 0.0 {
+        return 0.0;
+    }
+    (0..g.len())
+        .filter(|&i| !active.get(i).copied().unwrap_or(false))
+        .map(|i| {
+            let n = js.column(i).norm();
+            if n > 0.0 {
+                g[i].abs() / (n * r_norm)
+            } else {
+                0.0
+            }
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Column scaling `1/‖J_j‖` (1 for an all-zero column).
+pub(crate) fn column_scale(j: &DMatrix<f64>) -> DVector<f64> {
+    DVector::from_iterator(
+        j.ncols(),
+        j.column_iter().map(|c| {
+            let n = c.norm();
+            if n > 0.0 {
+                1.0 / n
+            } else {
+                1.0
+            }
+        }),
+    )
+}
+
+/// Scales the columns of `j` by `scale` in place.
+pub(crate) fn scale_columns(j: &mut DMatrix<f64>, scale: &DVector<f64>) {
+    for (c, s) in scale.iter().enumerate() {
+        j.column_mut(c).scale_mut(*s);
+    }
+}
+
+/// Marks the columns held at a bound: at it, with the descent direction
+/// (`+g`) pointing out of the box.
+fn mark_active(active: &mut [bool], bounds: Option<Bounds<'_>>, g: &DVector<f64>) {
+    let Some(b) = bounds else {
+        active.fill(false);
+        return;
+    };
+    for (i, a) in active.iter_mut().enumerate() {
+        *a = (b.x[i] <= b.lower[i] && g[i] < 0.0) || (b.x[i] >= b.upper[i] && g[i] > 0.0);
+    }
+}
+
+/// Cuts the step `delta` onto the box.
+fn project(delta: &mut DVector<f64>, b: &Bounds<'_>) {
+    for (i, d) in delta.iter_mut().enumerate() {
+        if b.x[i] + *d < b.lower[i] {
+            *d = b.lower[i] - b.x[i];
+        } else if b.x[i] + *d > b.upper[i] {
+            *d = b.upper[i] - b.x[i];
+        }
+    }
+}
+
+/// An evaluated trial that lowered the cost.
+struct AcceptedTrial {
+    cost: f64,
+    /// Scaled step length.
+    step: f64,
+}
+
+/// Runs LM on `p` from its current point; `p` ends at the returned point.
+pub fn minimise<P: LeastSquaresProblem + ?Sized>(
+    p: &mut P,
+    s: &Settings,
+) -> Result<Report, Cancelled> {
+    let mut cost = p.cost();
+    let initial_cost = cost;
+    let scale = {
+        let j = p.linearise();
+        s.column_scaling.then(|| {
+            let scale = column_scale(j);
+            scale_columns(j, &scale);
+            scale
+        })
+    };
+    // Whether the current point's `r` and `J` (scaled) are at hand.
+    let mut fresh = true;
+    let (rows, ncols) = p.jacobian().shape();
+    let mut damping = DampingState::new(s.damping);
+    let (mut iterations, mut linearisations, mut evaluations) = (0, 0, 0);
+    let mut active = vec![false; ncols];
+    let mut verdict = None;
+    if s.require_overdetermined && rows < ncols {
+        verdict = Some(Verdict {
+            reason: StopReason::Underdetermined,
+            detail: format!("underdetermined: {rows} residuals for {ncols} unknowns"),
+        });
+    }
+    while verdict.is_none()
+        && iterations < s.max_iterations
+        && linearisations < s.max_linearisations
+    {
+        let at = Iterate {
+            iterations,
+            linearisations,
+            cost,
+        };
+        match p.start(&at) {
+            Flow::Continue => {}
+            Flow::Stop => {
+                verdict = Some(stopped());
+                break;
+            }
+            Flow::Cancel => return Err(Cancelled),
+        }
+        if !fresh {
+            let j = p.linearise();
+            if let Some(scale) = &scale {
+                scale_columns(j, scale);
+            }
+            fresh = true;
+        }
+        linearisations += 1;
+        let js = p.jacobian();
+        let a = p.gram(js);
+        let g = js.tr_mul(p.residuals());
+        mark_active(&mut active, p.bounds(), &g);
+        let gradient = gradient_measure(js, &g, cost.sqrt(), &active);
+        if g.amax() < s.gradient_floor {
+            verdict = Some(Verdict {
+                reason: StopReason::GradientTolerance,
+                detail: format!("gradient below {:e}", s.gradient_floor),
+            });
+            break;
+        }
+        let mut accepted = None;
+        let (mut trials, mut evaluations_failed) = (0, 0);
+        // Largest relative cost decrease the linear model predicts for a trial.
+        let mut predicted = f64::NEG_INFINITY;
+        while damping.usable() && iterations < s.max_iterations {
+            iterations += 1;
+            trials += 1;
+            let mut damped = a.clone();
+            let mut rhs = g.clone();
+            for i in 0..ncols {
+                damping.add(&mut damped, &a, i);
+                if active[i] {
+                    damped.row_mut(i).fill(0.0);
+                    damped.column_mut(i).fill(0.0);
+                    damped[(i, i)] = 1.0;
+                    rhs[i] = 0.0;
+                }
+            }
+            let Some(chol) = damped.cholesky() else {
+                damping.reject();
+                continue;
+            };
+            let mut delta = chol.solve(&rhs);
+            if let Some(scale) = &scale {
+                delta = delta.component_mul(scale);
+            }
+            if let Some(b) = p.bounds() {
+                project(&mut delta, &b);
+            }
+            evaluations += 1;
+            let Some(trial_cost) = p.trial(&mut delta) else {
+                evaluations_failed += 1;
+                damping.reject();
+                continue;
+            };
+            let scaled = match &scale {
+                Some(scale) => delta.component_div(scale),
+                None => delta,
+            };
+            // Over evaluated trials only: a step that cannot be evaluated
+            // says nothing about what is left to gain.
+            let decrease = predicted_decrease(&a, &g, &scaled);
+            predicted = predicted.max(decrease / cost);
+            if trial_cost < cost {
+                damping.accept(decrease, cost, trial_cost);
+                accepted = Some(AcceptedTrial {
+                    cost: trial_cost,
+                    step: scaled.norm(),
+                });
+                break;
+            }
+            damping.reject();
+        }
+        let Some(step) = accepted else {
+            let stall = Stall {
+                gradient,
+                predicted,
+                budget_used: iterations >= s.max_iterations && damping.usable(),
+                trials,
+                evaluations_failed,
+            };
+            verdict = Some(stall_verdict(&stall, s));
+            break;
+        };
+        let rel = (cost - step.cost) / cost.max(f64::MIN_POSITIVE);
+        p.accept();
+        cost = step.cost;
+        fresh = false;
+        let at = Iterate {
+            iterations,
+            linearisations,
+            cost,
+        };
+        match p.accepted(&at) {
+            Flow::Continue => {}
+            Flow::Stop => {
+                verdict = Some(stopped());
+                break;
+            }
+            Flow::Cancel => return Err(Cancelled),
+        }
+        if rel < s.cost_tolerance {
+            verdict = Some(Verdict {
+                reason: StopReason::CostTolerance,
+                detail: format!(
+                    "relative cost decrease {rel:.1e} below {:.0e}",
+                    s.cost_tolerance
+                ),
+            });
+        } else if step.step < s.step_tolerance {
+            verdict = Some(Verdict {
+                reason: StopReason::StepTolerance,
+                detail: format!(
+                    "scaled step {:.1e} below {:.0e}",
+                    step.step, s.step_tolerance
+                ),
+            });
+        }
+    }
+    let verdict = verdict.unwrap_or_else(|| Verdict {
+        reason: StopReason::MaxIterations,
+        detail: if iterations >= s.max_iterations {
+            format!(
+                "iteration budget of {} used up before a convergence test passed",
+                s.max_iterations
+            )
+        } else {
+            format!(
+                "budget of {} linearisations used up before a convergence test passed",
+                s.max_linearisations
+            )
+        },
+    });
+    // Bound state and gradient at the returned point.
+    if s.linearise_at_end && !fresh {
+        let j = p.linearise();
+        if let Some(scale) = &scale {
+            scale_columns(j, scale);
+        }
+        fresh = true;
+    }
+    let gradient = if fresh {
+        let js = p.jacobian();
+        let g = js.tr_mul(p.residuals());
+        mark_active(&mut active, p.bounds(), &g);
+        gradient_measure(js, &g, cost.sqrt(), &active)
+    } else {
+        active.fill(false);
+        f64::NAN
+    };
+    Ok(Report {
+        converged: verdict.reason.converged(),
+        iterations,
+        linearisations,
+        evaluations,
+        initial_cost,
+        cost,
+        reason: verdict.reason,
+        detail: verdict.detail,
+        gradient,
+        active,
+        scale,
+    })
+}
+
+fn stopped() -> Verdict {
+    Verdict {
+        reason: StopReason::Stopped,
+        detail: "stopped by the caller".into(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// The predicted decrease against its definition `‖r‖² − ‖r − J·d‖²`,
+    /// computed directly, on random tall systems and steps.
+    #[test]
+    fn predicted_decrease_is_the_linear_models_decrease() {
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        for (m, n) in [(30, 4), (300, 25), (7, 7)] {
+            let j = DMatrix::from_fn(m, n, |_, _| rng.gen_range(-1.0..1.0));
+            let r = DVector::from_fn(m, |_, _| rng.gen_range(-1.0..1.0));
+            let d = DVector::from_fn(n, |_, _| rng.gen_range(-0.5..0.5));
+            let direct = r.norm_squared() - (&r - &j * &d).norm_squared();
+            let p = predicted_decrease(&j.tr_mul(&j), &j.tr_mul(&r), &d);
+            assert!(
+                (p - direct).abs() <= 1e-12 * r.norm_squared(),
+                "{p} vs {direct}"
+            );
+        }
+    }
+
+    /// `r(x) = t − f(x)` for the model `f(x)_i = x₀·exp(x₁·s_i) + x₂` (the
+    /// Jacobian in closed form), with an optional box and a hook that stops
+    /// after `stop_after` accepted steps.
+    struct Exponential {
+        s: Vec<f64>,
+        t: Vec<f64>,
+        x: Vec<f64>,
+        lower: Vec<f64>,
+        upper: Vec<f64>,
+        bounded: bool,
+        r: DVector<f64>,
+        j: DMatrix<f64>,
+        next: Option<(Vec<f64>, f64)>,
+        accepted: Vec<f64>,
+        stop_after: usize,
+    }
+
+    impl Exponential {
+        fn new(truth: [f64; 3], start: [f64; 3], noise: f64) -> Self {
+            let mut rng = ChaCha8Rng::seed_from_u64(4);
+            let s: Vec<f64> = (0..40).map(|i| i as f64 / 20.0).collect();
+            let t = s
+                .iter()
+                .map(|s| {
+                    truth[0] * (truth[1] * s).exp() + truth[2] + noise * rng.gen_range(-1.0..1.0)
+                })
+                .collect();
+            Exponential {
+                s,
+                t,
+                x: start.to_vec(),
+                lower: vec![f64::NEG_INFINITY; 3],
+                upper: vec![f64::INFINITY; 3],
+                bounded: false,
+                r: DVector::zeros(40),
+                j: DMatrix::zeros(40, 3),
+                next: None,
+                accepted: Vec::new(),
+                stop_after: usize::MAX,
+            }
+        }
+
+        fn residuals_at(&self, x: &[f64]) -> DVector<f64> {
+            DVector::from_fn(self.s.len(), |i, _| {
+                self.t[i] - (x[0] * (x[1] * self.s[i]).exp() + x[2])
+            })
+        }
+    }
+
+    impl LeastSquaresProblem for Exponential {
+        fn cost(&self) -> f64 {
+            self.residuals_at(&self.x).norm_squared()
+        }
+        fn linearise(&mut self) -> &mut DMatrix<f64> {
+            self.r = self.residuals_at(&self.x);
+            for (i, s) in self.s.iter().enumerate() {
+                let e = (self.x[1] * s).exp();
+                self.j[(i, 0)] = e;
+                self.j[(i, 1)] = self.x[0] * s * e;
+                self.j[(i, 2)] = 1.0;
+            }
+            &mut self.j
+        }
+        fn residuals(&self) -> &DVector<f64> {
+            &self.r
+        }
+        fn jacobian(&self) -> &DMatrix<f64> {
+            &self.j
+        }
+        fn bounds(&self) -> Option<Bounds<'_>> {
+            self.bounded.then_some(Bounds {
+                x: &self.x,
+                lower: &self.lower,
+                upper: &self.upper,
+            })
+        }
+        fn trial(&mut self, delta: &mut DVector<f64>) -> Option<f64> {
+            let x: Vec<f64> = self
+                .x
+                .iter()
+                .zip(delta.iter())
+                .map(|(a, d)| a + d)
+                .collect();
+            let c = self.residuals_at(&x).norm_squared();
+            self.next = Some((x, c));
+            Some(c)
+        }
+        fn accept(&mut self) {
+            self.x = self.next.take().unwrap().0;
+        }
+        fn accepted(&mut self, at: &Iterate) -> Flow {
+            self.accepted.push(at.cost);
+            if self.accepted.len() >= self.stop_after {
+                Flow::Stop
+            } else {
+                Flow::Continue
+            }
+        }
+    }
+
+    /// Every damping rule reaches the exact fit of noise-free data from the
+    /// same start, on a passed convergence test.
+    #[test]
+    fn every_damping_rule_fits_an_exact_exponential() {
+        for damping in [
+            Damping::Marquardt { initial: 1e-3 },
+            Damping::Trainlm {
+                initial: 1e-3,
+                decrease: 0.1,
+                increase: 10.0,
+                max: 1e10,
+            },
+            Damping::Nielsen { initial: 1e-3 },
+        ] {
+            let mut p = Exponential::new([2.0, -1.3, 0.5], [1.0, -0.5, 0.0], 0.0);
+            let s = Settings {
+                damping,
+                ..Settings::default()
+            };
+            let r = minimise(&mut p, &s).unwrap();
+            assert!(r.converged, "{damping:?}: {r:?}");
+            for (x, t) in p.x.iter().zip([2.0, -1.3, 0.5]) {
+                assert!((x - t).abs() < 1e-6, "{damping:?}: {:?}", p.x);
+            }
+            assert!(r.cost < 1e-20 * r.initial_cost, "{damping:?}: {r:?}");
+            // Every accepted step lowered the cost.
+            assert!(p.accepted.windows(2).all(|w| w[1] < w[0]));
+        }
+    }
+
+    /// With a lower bound the unconstrained minimum violates, the run ends on
+    /// the bound with that column held, at the minimiser of the other two
+    /// columns with it fixed: the linear least-squares fit of `t − x₀·exp(b·s)`
+    /// by `x₀·exp(b·s) + x₂` at `b` on its bound is checked by the closed form
+    /// of the 2-column normal equations.
+    #[test]
+    fn a_bound_holds_its_column_at_the_constrained_minimum() {
+        let truth = [2.0, -1.3, 0.5];
+        let mut p = Exponential::new(truth, [1.0, -0.5, 0.0], 1e-3);
+        p.bounded = true;
+        p.lower[1] = -1.0;
+        let r = minimise(&mut p, &Settings::default()).unwrap();
+        assert!(r.converged, "{r:?}");
+        assert_eq!(p.x[1], -1.0);
+        assert_eq!(r.active, vec![false, true, false]);
+        // Closed form of the fit of (x₀, x₂) with x₁ = −1.
+        let e: Vec<f64> = p.s.iter().map(|s| (-s).exp()).collect();
+        let n = e.len() as f64;
+        let (se, see) = (e.iter().sum::<f64>(), e.iter().map(|v| v * v).sum::<f64>());
+        let st: f64 = p.t.iter().sum();
+        let set: f64 = e.iter().zip(&p.t).map(|(a, b)| a * b).sum();
+        let det = see * n - se * se;
+        let x0 = (set * n - se * st) / det;
+        let x2 = (see * st - se * set) / det;
+        assert!((p.x[0] - x0).abs() < 1e-7, "{} vs {x0}", p.x[0]);
+        assert!((p.x[2] - x2).abs() < 1e-7, "{} vs {x2}", p.x[2]);
+    }
+
+    /// The accepted hook ends the run at the point it last saw; the start
+    /// callback cancels it; the budgets stop it with `MaxIterations`.
+    #[test]
+    fn callbacks_and_budgets_end_the_run() {
+        let mut p = Exponential::new([2.0, -1.3, 0.5], [1.0, -0.5, 0.0], 0.0);
+        p.stop_after = 2;
+        let r = minimise(&mut p, &Settings::default()).unwrap();
+        assert_eq!(r.reason, StopReason::Stopped);
+        assert!(!r.converged);
+        assert_eq!(r.linearisations, 2);
+        assert_eq!(r.cost, p.accepted[1]);
+        assert_eq!(r.cost, p.cost());
+
+        struct Cancelling(Exponential);
+        impl LeastSquaresProblem for Cancelling {
+            fn cost(&self) -> f64 {
+                self.0.cost()
+            }
+            fn linearise(&mut self) -> &mut DMatrix<f64> {
+                self.0.linearise()
+            }
+            fn residuals(&self) -> &DVector<f64> {
+                self.0.residuals()
+            }
+            fn jacobian(&self) -> &DMatrix<f64> {
+                self.0.jacobian()
+            }
+            fn trial(&mut self, delta: &mut DVector<f64>) -> Option<f64> {
+                self.0.trial(delta)
+            }
+            fn accept(&mut self) {
+                self.0.accept()
+            }
+            fn start(&mut self, at: &Iterate) -> Flow {
+                if at.linearisations == 3 {
+                    Flow::Cancel
+                } else {
+                    Flow::Continue
+                }
+            }
+        }
+        let mut c = Cancelling(Exponential::new([2.0, -1.3, 0.5], [1.0, -0.5, 0.0], 0.0));
+        assert_eq!(minimise(&mut c, &Settings::default()), Err(Cancelled));
+
+        let mut p = Exponential::new([2.0, -1.3, 0.5], [1.0, -0.5, 0.0], 0.0);
+        let s = Settings {
+            max_linearisations: 2,
+            ..Settings::default()
+        };
+        let r = minimise(&mut p, &s).unwrap();
+        assert_eq!((r.reason, r.linearisations), (StopReason::MaxIterations, 2));
+        let mut p = Exponential::new([2.0, -1.3, 0.5], [1.0, -0.5, 0.0], 0.0);
+        let s = Settings {
+            max_iterations: 1,
+            ..Settings::default()
+        };
+        let r = minimise(&mut p, &s).unwrap();
+        assert_eq!((r.reason, r.iterations), (StopReason::MaxIterations, 1));
+    }
+}
