@@ -4,6 +4,7 @@
 //! stiffness next to the truth.
 
 use super::progress::ProgressPrinter;
+use crate::identify::Method;
 use crate::study::ys100_simulation;
 use anyhow::bail;
 use clap::Args;
