@@ -383,7 +383,9 @@ fn base_failure_pool_choice_and_cancellation() {
 /// and centres of mass, so SKCM and the torque-based RBF can run): the grid
 /// identifies the base and, with no training pool, trains the compensators
 /// (judged by 5-fold cross-validation inside it); the 20 random poses
-/// validate. `auto` is never worse than KM on mean or max. Every method's figures are printed beside the published hybrid
+/// validate. `auto` is never worse than KM on mean or max; on the UR5 the
+/// joint-map methods and `auto` reach 0.068 mm mean and 0.13 mm max. Every
+/// method's figures are printed beside the published hybrid
 /// (MDH + graph neural network) on the same 20 poses: UR5 0.155 mm, WAM 2.92 mm.
 #[test]
 fn real_data_auto_never_worse_than_km() {
@@ -406,7 +408,7 @@ fn real_data_auto_never_worse_than_km() {
         let ident = measure::to_measurements(&model, &real(grid), 0.0);
         let valid = measure::to_measurements(&model, &real(random), 0.0);
         let mut methods = BASES_AND_COMPENSATORS.to_vec();
-        methods.push(Method::Auto);
+        methods.extend([Method::KmMaps, Method::SkcmMaps, Method::Auto]);
         let opts = options(&methods, 1, 5);
         let r = calibrate(&model, &ident, &valid, &opts, &|_| true).unwrap();
         for (m, rep) in &r.methods {
@@ -435,5 +437,18 @@ fn real_data_auto_never_worse_than_km() {
             got.mean_mm <= km.mean_mm + resolution_mm && got.max_mm <= km.max_mm + resolution_mm,
             "{name}: auto {got:?} vs KM {km:?}"
         );
+        if name == "UR5" {
+            // Issue acceptance on the real UR5: the joint maps and auto at
+            // most 0.068 mm mean and 0.13 mm max on the 20 random poses.
+            for m in ["km-maps", "skcm-maps", "auto"] {
+                let v = &r.methods[m].validation.as_ref().unwrap().stats;
+                assert!(
+                    v.mean_mm <= 0.068 && v.max_mm <= 0.13,
+                    "UR5 {m}: {:.4} / {:.4} mm",
+                    v.mean_mm,
+                    v.max_mm
+                );
+            }
+        }
     }
 }

@@ -388,6 +388,7 @@ fn unmodelled_effects_keep_reports_honest() {
         gear_error: Some((2e-6, 2)),
         hysteresis_rad: 1e-6,
         link_bending: 2e-8,
+        transmission: Vec::new(),
     };
     truth.noise_mm = 0.01;
     let id = measure_truth(&truth, &nominal, 60, &mut rng);

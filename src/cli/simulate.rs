@@ -92,6 +92,12 @@ pub struct SimulateArgs {
     /// Unmodelled: link bending compliance [rad/(N·m²)] (see sim::UnmodelledEffects).
     #[arg(long, default_value_t = 0.0)]
     pub link_bending: f64,
+    /// Transmission errors with fine structure, "amplitude_arcsec,harmonics": per
+    /// joint harmonics 1..=harmonics of its own angle (amplitude/√k) and a
+    /// motor-side term at k = 101 (sim::fine_transmission_errors), drawn from
+    /// --truth-seed.
+    #[arg(long)]
+    pub transmission: Option<String>,
 }
 
 fn numbers(what: &str, s: &str) -> anyhow::Result<Vec<f64>> {
@@ -201,11 +207,23 @@ fn effects(a: &SimulateArgs, dof: usize) -> anyhow::Result<UnmodelledEffects> {
     };
     non_negative("--backlash-deg", a.backlash_deg)?;
     non_negative("--link-bending", a.link_bending)?;
+    let transmission = match &a.transmission {
+        Some(s) => {
+            let v = numbers("--transmission", s)?;
+            if v.len() != 2 || v[0] < 0.0 || v[1] < 1.0 || v[1] > 1000.0 || v[1].fract() != 0.0 {
+                bail!("--transmission must be \"amplitude_arcsec,harmonics\" with amplitude >= 0 and an integer 1..1000 harmonics");
+            }
+            let mut rng = ChaCha8Rng::seed_from_u64(a.truth_seed.wrapping_add(7));
+            crate::sim::fine_transmission_errors(dof, v[1] as u32, v[0], &mut rng)
+        }
+        None => Vec::new(),
+    };
     Ok(UnmodelledEffects {
         nonlinear_k2,
         gear_error,
         hysteresis_rad: a.backlash_deg.to_radians(),
         link_bending: a.link_bending,
+        transmission,
     })
 }
 

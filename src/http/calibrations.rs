@@ -428,4 +428,21 @@ mod tests {
             "{described}"
         );
     }
+
+    /// The identification solver's `reason` enum is every LM stop reason but
+    /// `stopped`, which only a caller's callback gives (network training's
+    /// early stop); the identification has none.
+    #[test]
+    fn the_spec_lists_the_solver_stop_reasons() {
+        use robocal_core::optim::lm::StopReason;
+        let doc: Value = serde_yaml::from_str(crate::http::OPENAPI_YAML).unwrap();
+        let reason = &doc["components"]["schemas"]["MethodReport"]["properties"]["solver"]
+            ["properties"]["reason"];
+        let codes: Vec<&str> = StopReason::ALL
+            .iter()
+            .filter(|r| **r != StopReason::Stopped)
+            .map(|r| r.code())
+            .collect();
+        assert_eq!(strings(&reason["enum"]), codes);
+    }
 }

@@ -287,12 +287,11 @@ impl CompensatedModel {
             .collect()
     }
 
+    /// `q + c∘τ + f(q)`: the joints the calibrated chain sees.
     fn deflect(&self, q: &[f64], tau: &[f64]) -> Vec<f64> {
-        q.iter()
-            .zip(tau)
-            .zip(&self.calibrated.links)
-            .map(|((q, t), l)| q + l.compliance * t)
-            .collect()
+        let mut out = Vec::with_capacity(q.len());
+        self.calibrated.effective_joints_into(q, tau, &mut out);
+        out
     }
 
     /// Full prediction in the registered base frame.
@@ -313,7 +312,7 @@ impl CompensatedModel {
         } else {
             vec![0.0; m.dof()]
         };
-        let deflected = if m.has_compliance() {
+        let deflected = if m.deflects() {
             self.deflect(q, &tau)
         } else {
             q.to_vec()
@@ -343,7 +342,8 @@ impl CompensatedModel {
     /// (6×N, rows `[v; ω]`, base frame): the geometric Jacobian of the
     /// calibrated chain at the deflected joints plus the compensator's
     /// `∂NN/∂q` on the position rows (when it gives one), neglecting `∂τ/∂q`
-    /// (small against the arm's lever arms: relative size `‖c·∂τ/∂q‖` ≈ 1e-3).
+    /// (small against the arm's lever arms: relative size `‖c·∂τ/∂q‖` ≈ 1e-3);
+    /// joint maps scale column i by `1 + f_i'(q_i)`.
     pub fn predict_base_with_jacobian(
         &self,
         q: &[f64],
@@ -356,12 +356,20 @@ impl CompensatedModel {
         } else {
             Vec::new()
         };
-        let (mut pose, mut jac) = if m.has_compliance() {
+        let (mut pose, mut jac) = if m.deflects() {
             let c1 = chain(m, &self.deflect(q, &tau))?;
             (c1.tcp, geometric_jacobian(m, &c1))
         } else {
             (c0.tcp, geometric_jacobian(m, &c0))
         };
+        if let Some(maps) = &m.joint_maps {
+            // Chain rule through the maps: column i times `1 + f_i'(q_i)`.
+            let mut scale = vec![1.0; q.len()];
+            maps.derivative_scale(q, &mut scale);
+            for (i, s) in scale.iter().enumerate().take(jac.ncols()) {
+                jac.column_mut(i).scale_mut(*s);
+            }
+        }
         if let Some(c) = &self.compensator {
             pose.p += c.residual_at(q, &tau, self.payload_kg);
             if let Some(d) = c.jacobian_q(q, &tau, self.payload_kg) {

@@ -3,8 +3,9 @@
 //! caller's business.
 //!
 //! Only the *geometric* model is exported: calibrated link geometry, registered
-//! base frame and tool. Joint compliance (seed eq. 2.8) and learned
-//! compensators cannot be written in these formats, and every text says so.
+//! base frame and tool. Joint compliance (seed eq. 2.8), joint angle error
+//! maps and learned compensators cannot be written in these formats, and every
+//! text says so.
 //!
 //! Conventions (robocal's chain, `model::robot`): link k (0-based) is
 //! `Rx(α)·Tx(a)·[Ry(β)]·Tz(d)·Rz(θ)` with `θ = q + θ_offset`, the controller
@@ -122,6 +123,17 @@ const NOT_REPRESENTABLE: &str =
     "joint compliance (deflection under load) and learned compensators \
 are not representable in this format: this is the geometric model only";
 
+/// What the format drops from `m` beyond [`NOT_REPRESENTABLE`]: its joint
+/// angle error maps, when it has them.
+fn dropped_maps(m: &RobotModel) -> &'static str {
+    if m.joint_maps.is_some() {
+        "; its joint angle error maps (km-maps / skcm-maps) are not carried either: \
+positions computed from this file miss them (export json keeps them)"
+    } else {
+        ""
+    }
+}
+
 fn open_chain(m: &RobotModel, what: &str) -> Result<(), ExportError> {
     if m.closed_loop.is_some() {
         return Err(ExportError::NotRepresentable(format!(
@@ -178,10 +190,11 @@ fn urdf(model: &CompensatedModel, source: &ExportSource) -> Result<String, Expor
         "<!-- robocal export: {} model of {} ({} joints). Metres, radians.\n     \
          Root link `cell` is the measurement frame; `base` the registered robot base; `tcp` the tool centre point.\n     \
          Joint values are controller readings (q_ctrl, radians); origins include the calibrated joint offsets.\n     \
-         Note: {NOT_REPRESENTABLE}. -->",
+         Note: {NOT_REPRESENTABLE}{}. -->",
         xml_escape(source.method),
         xml_escape(source.robot),
-        m.dof()
+        m.dof(),
+        dropped_maps(m)
     );
     let _ = writeln!(s, "<robot name=\"{}\">", xml_escape(source.robot));
     let _ = writeln!(s, "  <link name=\"cell\"/>");
@@ -275,7 +288,8 @@ fn dh_csv(
     );
     let _ = writeln!(
         s,
-        "# transform rows: Tr(x,y,z)*Rz(rz)*Ry(ry)*Rx(rx). Note: {NOT_REPRESENTABLE}"
+        "# transform rows: Tr(x,y,z)*Rz(rz)*Ry(ry)*Rx(rx). Note: {NOT_REPRESENTABLE}{}",
+        dropped_maps(m)
     );
     let _ = writeln!(
         s,

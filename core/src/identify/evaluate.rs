@@ -3,8 +3,9 @@
 //! matrix `JᵀJ`.
 //!
 //! Model of one measurement (seed eq. 2.1 without ΔP_extra), in the registered
-//! base frame of session s: `p = E_s · FK(φ, q + c∘τ(q))`, τ the gravity
-//! torques at the commanded joints with the measured payload, `E_s` the rigid
+//! base frame of session s: `p = E_s · FK(φ, q + c∘τ(q) + f(q))`, τ the gravity
+//! torques at the commanded joints with the measured payload, `f` the joint
+//! maps (held fixed: no columns here), `E_s` the rigid
 //! correction of session s's frame (identity for session 0). Residuals
 //! (measured − predicted) in metres, 3 rows per pose, plus 3 orientation rows
 //! (rotation vector [rad] × `orientation_weight` [m/rad]) where measured.
@@ -114,7 +115,7 @@ pub(crate) fn evaluate_into(
     let (mut commanded, mut deflected) = (Chain::empty(), Chain::empty());
     let mut row = 0;
     for (i, m) in data.iter().enumerate() {
-        let known = if needs_tau {
+        let known = if needs_tau || model.joint_maps.is_some() {
             None
         } else {
             chains.map(|c| &c[i])
@@ -131,6 +132,14 @@ pub(crate) fn evaluate_into(
                     .zip(&model.links)
                     .map(|((q, t), l)| q + l.compliance * t),
             );
+            if let Some(maps) = &model.joint_maps {
+                maps.add_to(&m.q, &mut q_eff);
+            }
+            &q_eff
+        } else if let Some(maps) = &model.joint_maps {
+            q_eff.clear();
+            q_eff.extend_from_slice(&m.q);
+            maps.add_to(&m.q, &mut q_eff);
             &q_eff
         } else {
             &m.q

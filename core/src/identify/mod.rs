@@ -13,6 +13,7 @@ pub mod calibrate;
 pub mod checks;
 mod evaluate;
 pub mod identifiability;
+pub mod joint_maps;
 pub mod least_squares;
 pub mod methods;
 pub mod options;
@@ -28,7 +29,7 @@ pub use methods::{Method, MethodChoice, MethodFailure, MethodListError, MethodRo
 pub use options::{CalibrationOptions, CompensatorOptions, Progress};
 pub use registration::{register, Registration};
 pub use report::{
-    AutoCandidate, AutoSummary, CalibrationReport, CompensatorSummary, FailedMethod, MethodReport,
-    MethodWarning, ParamEstimate, PoseSource, PoseSources, SetErrors, WarningKind,
-    REPORT_FORMAT_VERSION,
+    AutoCandidate, AutoSummary, CalibrationReport, CompensatorSummary, FailedMethod,
+    JointMapExtent, JointMapsSummary, MethodReport, MethodWarning, ParamEstimate, PoseSource,
+    PoseSources, SetErrors, WarningKind, REPORT_FORMAT_VERSION,
 };

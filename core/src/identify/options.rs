@@ -6,6 +6,7 @@
 //! speaks mm and deg.
 
 use super::identifiability::IdentifiabilitySettings;
+use super::joint_maps::JointMapSettings;
 use super::least_squares::LmSettings;
 pub use super::methods::Method;
 use super::methods::Network;
@@ -37,6 +38,9 @@ pub struct CalibrationOptions {
     /// Training, cross-validation and choice of the learned compensators.
     #[serde(default)]
     pub compensator: CompensatorOptions,
+    /// The joint-map methods' fit ([`Method::JOINT_MAPS`]).
+    #[serde(default)]
+    pub joint_maps: JointMapSettings,
 }
 
 /// Settings of the compensator methods ([`Method::COMPENSATED`]) and of `auto`.
@@ -55,7 +59,7 @@ pub struct CompensatorOptions {
     pub min_gain: f64,
     /// With fewer training poses `auto` keeps the base without training.
     pub min_training_poses: usize,
-    /// The compensator methods `auto` considers.
+    /// The joint-map and compensator methods `auto` considers.
     pub auto_candidates: Vec<Method>,
     pub rbf: RbfSettings,
     /// Network of SKCM-NN ([`Network::LmMlp`]).
@@ -75,7 +79,11 @@ impl Default for CompensatorOptions {
             cv_folds: 5,
             min_gain: 0.05,
             min_training_poses: 20,
-            auto_candidates: Method::COMPENSATED.to_vec(),
+            auto_candidates: Method::JOINT_MAPS
+                .iter()
+                .chain(&Method::COMPENSATED)
+                .copied()
+                .collect(),
             rbf: RbfSettings::default(),
             nn: MlpSpec::SKCM_NN,
             lm: LmTrainSettings::default(),
@@ -131,6 +139,7 @@ impl Default for CalibrationOptions {
             tlbo_max_deflection_rad: 0.01,
             plausible_stiffness_nm_per_rad: [1e3, 1e9],
             compensator: CompensatorOptions::default(),
+            joint_maps: JointMapSettings::default(),
         }
     }
 }

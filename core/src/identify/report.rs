@@ -7,6 +7,7 @@
 //! calibrated `RobotModel` inside stays SI.
 
 use super::identifiability::IdentifiabilityReport;
+use super::joint_maps::{MapCandidate, MapFit};
 use super::least_squares::LmReport;
 use super::options::Method;
 use crate::compensate::{Compensator, CvStats, StoredCompensator, TrainReport};
@@ -227,6 +228,10 @@ pub struct MethodReport {
     /// What `auto` compared and why it chose what it did.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub auto: Option<AutoSummary>,
+    /// The joint maps of a joint-map method: how they were chosen, per joint
+    /// its range and amplitude.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub joint_maps: Option<JointMapsSummary>,
     #[serde(skip)]
     pub calibrated: RobotModel,
     /// The trained compensator (the model file stores it).
@@ -241,6 +246,64 @@ impl MethodReport {
         match &self.auto {
             Some(a) => format!("{}: {}", self.method.name(), a.chosen.name()),
             None => self.method.name().to_string(),
+        }
+    }
+}
+
+/// How the joint maps were chosen (cross-validated over the poses, K = 0 is
+/// the geometry alone) and what they hold per joint.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct JointMapsSummary {
+    /// Poses the maps were fitted on (identification and training).
+    pub poses: usize,
+    /// The chosen number of harmonics (0: no maps kept) and ridge weight.
+    pub harmonics: usize,
+    pub ridge: f64,
+    pub cv_mean_mm: f64,
+    pub cv_max_mm: f64,
+    /// The geometry alone on the same folds.
+    pub cv_without_maps_mean_mm: f64,
+    pub cv_without_maps_max_mm: f64,
+    pub candidates: Vec<MapCandidate>,
+    /// Per joint: its trained range and largest |Δθ| [deg] (`None`: no map).
+    pub joints: Vec<Option<JointMapExtent>>,
+}
+
+/// One joint's map in a report.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct JointMapExtent {
+    pub range_deg: [f64; 2],
+    pub fade_deg: f64,
+    pub amplitude_arcsec: f64,
+}
+
+impl JointMapsSummary {
+    pub fn of(fit: &MapFit, model: &RobotModel) -> Self {
+        let n = model.dof();
+        let joints = match &model.joint_maps {
+            None => vec![None; n],
+            Some(maps) => maps
+                .joints
+                .iter()
+                .map(|m| {
+                    m.as_ref().map(|m| JointMapExtent {
+                        range_deg: m.range.map(f64::to_degrees),
+                        fade_deg: m.fade.to_degrees(),
+                        amplitude_arcsec: m.amplitude().to_degrees() * 3600.0,
+                    })
+                })
+                .collect(),
+        };
+        JointMapsSummary {
+            poses: fit.poses,
+            harmonics: fit.chosen.harmonics,
+            ridge: fit.chosen.ridge,
+            cv_mean_mm: fit.chosen.cv_mean_mm,
+            cv_max_mm: fit.chosen.cv_max_mm,
+            cv_without_maps_mean_mm: fit.without_maps.cv_mean_mm,
+            cv_without_maps_max_mm: fit.without_maps.cv_max_mm,
+            candidates: fit.candidates.clone(),
+            joints,
         }
     }
 }

@@ -129,19 +129,22 @@ pub fn gravity_torques(
     Ok(gravity_torques_of(model, &chain(model, q)?, payload_mass))
 }
 
-/// Joint values after compliance deflection: `q + c ∘ τ(q)` (eq. 7.9).
+/// Joint values after compliance deflection and the joint maps:
+/// `q + c ∘ τ(q) + f(q)` (eq. 7.9, `RobotModel::effective_joints_into`).
 pub fn deflected_joints(
     model: &RobotModel,
     q: &[f64],
     payload_mass: f64,
 ) -> Result<Vec<f64>, KinematicsError> {
-    if !model.has_compliance() {
+    if !model.deflects() {
         return Ok(q.to_vec());
     }
-    let tau = gravity_torques(model, q, payload_mass)?;
-    Ok(q.iter()
-        .zip(&tau)
-        .zip(&model.links)
-        .map(|((q, t), l)| q + l.compliance * t)
-        .collect())
+    let tau = if model.has_compliance() {
+        gravity_torques(model, q, payload_mass)?
+    } else {
+        Vec::new()
+    };
+    let mut out = Vec::with_capacity(q.len());
+    model.effective_joints_into(q, &tau, &mut out);
+    Ok(out)
 }

@@ -12,6 +12,7 @@
 //!
 //! `from_description` validates every field and names the offending one.
 
+use super::joint_maps::JointMapsDescription;
 use super::pose::{rpy_matrix, Pose};
 use super::robot::{ClosedLoop, Link, Payload, RobotModel, Tool, G0};
 use nalgebra::{Matrix3, Vector3};
@@ -172,6 +173,9 @@ pub struct ModelDescription {
     pub gravity_mps2: [f64; 3],
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub assumptions: Vec<String>,
+    /// Per-joint angle error maps of a calibrated model (degrees).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub joint_maps: Option<JointMapsDescription>,
 }
 
 /// Millimetres to metres; a nonzero length stays nonzero (below 1e-320 mm it
@@ -440,6 +444,10 @@ impl ModelDescription {
             payload,
             gravity,
             assumptions: self.assumptions.clone(),
+            joint_maps: match &self.joint_maps {
+                None => None,
+                Some(d) => Some(d.to_maps(n)?),
+            },
         })
     }
 
@@ -490,6 +498,7 @@ impl ModelDescription {
             },
             gravity_mps2: [m.gravity.x, m.gravity.y, m.gravity.z],
             assumptions: m.assumptions.clone(),
+            joint_maps: m.joint_maps.as_ref().map(JointMapsDescription::from_maps),
         }
     }
 }

@@ -10,6 +10,7 @@
 //! continuous derivative. Units: q, f and the range in rad, coefficients in
 //! rad; model-convention joints (commanded, before deflection).
 
+use super::ModelError;
 use serde::{Deserialize, Serialize};
 
 /// One joint's angle error map.
@@ -179,6 +180,8 @@ pub enum JointMapError {
     Range { lo: f64, hi: f64, fade: f64 },
     #[error("joint maps: {maps} maps for a robot with {dof} joints")]
     Count { maps: usize, dof: usize },
+    #[error("joint map: {got} harmonics, at most {MAX_HARMONICS}")]
+    Harmonics { got: usize },
 }
 
 /// The maps of every joint (`None`: that joint has no map).
@@ -203,6 +206,24 @@ impl JointMaps {
         }
     }
 
+    /// Adds `f(q)` to `q_out`.
+    pub fn add_to(&self, q: &[f64], q_out: &mut [f64]) {
+        for ((m, q), out) in self.joints.iter().zip(q).zip(q_out) {
+            if let Some(m) = m {
+                *out += m.value(*q);
+            }
+        }
+    }
+
+    /// Writes `1 + f_i'(q_i)` into `scale` (1 for joints without a map).
+    pub fn derivative_scale(&self, q: &[f64], scale: &mut [f64]) {
+        for ((m, q), s) in self.joints.iter().zip(q).zip(scale) {
+            *s = m
+                .as_ref()
+                .map_or(1.0, |m| 1.0 + m.value_and_derivative(*q).1);
+        }
+    }
+
     /// Per joint, where `q` lies with respect to its map (`None`: no map).
     pub fn coverage(&self, q: &[f64]) -> Vec<Option<Coverage>> {
         self.joints
@@ -224,6 +245,102 @@ impl JointMaps {
             .iter()
             .flatten()
             .try_for_each(JointMap::validate)
+    }
+}
+
+/// Largest number of harmonics a stored map may have.
+pub const MAX_HARMONICS: usize = 200;
+
+/// Largest magnitude of a described angle or coefficient [deg].
+pub const MAX_DESCRIBED_DEG: f64 = 1e6;
+
+/// One joint's map in the model description [deg]: the trained range
+/// `[start, start + span]`, the fade width, and per harmonic k = 1..=K the
+/// pair `[a_k, b_k]` (cos, sin).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointMapDescription {
+    pub start_deg: f64,
+    pub span_deg: f64,
+    pub fade_deg: f64,
+    pub harmonics_deg: Vec<[f64; 2]>,
+}
+
+/// The maps of the description, one entry per joint (`null`: no map).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(transparent)]
+pub struct JointMapsDescription(pub Vec<Option<JointMapDescription>>);
+
+impl JointMapsDescription {
+    pub fn from_maps(maps: &JointMaps) -> Self {
+        JointMapsDescription(
+            maps.joints
+                .iter()
+                .map(|m| {
+                    m.as_ref().map(|m| JointMapDescription {
+                        start_deg: m.range[0].to_degrees(),
+                        span_deg: (m.range[1] - m.range[0]).to_degrees(),
+                        fade_deg: m.fade.to_degrees(),
+                        harmonics_deg: m
+                            .cos
+                            .iter()
+                            .zip(&m.sin)
+                            .map(|(a, b)| [a.to_degrees(), b.to_degrees()])
+                            .collect(),
+                    })
+                })
+                .collect(),
+        )
+    }
+
+    /// The SI maps of a robot with `dof` joints, checked.
+    pub fn to_maps(&self, dof: usize) -> Result<JointMaps, ModelError> {
+        let invalid = |reason: String| ModelError::InvalidField {
+            field: "joint_maps".into(),
+            reason,
+        };
+        let mut joints = Vec::with_capacity(self.0.len());
+        for (i, m) in self.0.iter().enumerate() {
+            let Some(m) = m else {
+                joints.push(None);
+                continue;
+            };
+            let values = [m.start_deg, m.span_deg, m.fade_deg]
+                .into_iter()
+                .chain(m.harmonics_deg.iter().flatten().copied());
+            for v in values {
+                if !v.is_finite() || v.abs() > MAX_DESCRIBED_DEG {
+                    return Err(invalid(format!(
+                        "joint {}: every value must be finite and within ±{MAX_DESCRIBED_DEG} deg",
+                        i + 1
+                    )));
+                }
+            }
+            if m.span_deg < 0.0 || m.fade_deg < 0.0 {
+                return Err(invalid(format!(
+                    "joint {}: span_deg and fade_deg must not be negative",
+                    i + 1
+                )));
+            }
+            let lo = m.start_deg.to_radians();
+            joints.push(Some(JointMap {
+                cos: m.harmonics_deg.iter().map(|h| h[0].to_radians()).collect(),
+                sin: m.harmonics_deg.iter().map(|h| h[1].to_radians()).collect(),
+                range: [lo, lo + m.span_deg.to_radians()],
+                fade: m.fade_deg.to_radians(),
+            }));
+        }
+        let maps = JointMaps { joints };
+        maps.validate(dof).map_err(|e| invalid(e.to_string()))?;
+        if let Some(m) = maps.joints.iter().flatten().find(|m| m.harmonics() > MAX_HARMONICS) {
+            return Err(invalid(
+                JointMapError::Harmonics {
+                    got: m.harmonics(),
+                }
+                .to_string(),
+            ));
+        }
+        Ok(maps)
     }
 }
 

@@ -10,7 +10,9 @@ pub mod presets;
 pub mod robot;
 
 pub use description::{ModelDescription, ModelError};
-pub use joint_maps::{Coverage, JointMap, JointMapError, JointMaps};
+pub use joint_maps::{
+    Coverage, JointMap, JointMapDescription, JointMapError, JointMaps, JointMapsDescription,
+};
 pub use params::{ParamId, ParamKind, ParamLayout};
 pub use pose::Pose;
 pub use presets::preset;

@@ -85,6 +85,7 @@ fn ys100() -> ModelDescription {
             "payload CoM (not in the seed): 250 mm out along the flange axis, i.e. (-200, -50, -250) mm in the tool frame".into(),
             "joint limits (not in the seed): J1 ±180, J2 20..160, J3 -110..90, J4 ±180, J5 ±125, J6 ±180 deg".into(),
         ],
+        joint_maps: None,
     }
 }
 
@@ -133,6 +134,7 @@ fn hh800() -> ModelDescription {
             "payload 745 kg (seed), CoM 300 mm out along the flange axis (assumed)".into(),
             "joint limits (not in the seed): J2 50..130, J3 -40..40 deg keep the parallelogram away from its flat singularity".into(),
         ],
+        joint_maps: None,
     }
 }
 
@@ -166,6 +168,7 @@ fn ur(
             "geometry, masses and centres of mass: Universal Robots' published standard DH and dynamics tables".into(),
             "tool: flange (set the TCP offset for your tool)".into(),
         ],
+        joint_maps: None,
     }
 }
 

@@ -20,6 +20,7 @@
 //! Joint angle of link k: `θ_k = q_k + theta_k` where `q` are the model-convention
 //! joint values; controller readings convert by `q = sign·q_ctrl + zero`.
 
+use super::joint_maps::JointMaps;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
@@ -157,6 +158,10 @@ pub struct RobotModel {
     pub gravity: Vector3<f64>,
     /// Assumptions behind values the source does not give.
     pub assumptions: Vec<String>,
+    /// Per-joint angle error maps (`joint_maps`), added to the joints with
+    /// the compliance deflection; `None` for a model without them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub joint_maps: Option<JointMaps>,
 }
 
 impl RobotModel {
@@ -196,6 +201,31 @@ impl RobotModel {
 
     pub fn has_compliance(&self) -> bool {
         self.links.iter().any(|l| l.compliance != 0.0)
+    }
+
+    /// Whether the chain sees other joints than the commanded ones:
+    /// compliance or joint angle error maps.
+    pub fn deflects(&self) -> bool {
+        self.has_compliance() || self.joint_maps.is_some()
+    }
+
+    /// The joints the chain sees: `q + c∘τ + f(q)` (eq. 2.5 with the joint
+    /// maps), `tau` the gravity torques at `q` (ignored without compliance).
+    pub fn effective_joints_into(&self, q: &[f64], tau: &[f64], out: &mut Vec<f64>) {
+        out.clear();
+        if self.has_compliance() {
+            out.extend(
+                q.iter()
+                    .zip(tau)
+                    .zip(&self.links)
+                    .map(|((q, t), l)| q + l.compliance * t),
+            );
+        } else {
+            out.extend_from_slice(q);
+        }
+        if let Some(maps) = &self.joint_maps {
+            maps.add_to(q, out);
+        }
     }
 
     /// Cosine threshold above which two consecutive axes count as parallel (1°).

@@ -32,7 +32,7 @@ pub use perturb::{
 pub use poses::{
     random_configurations, random_configurations_with, try_random_configurations, PoseFilter,
 };
-pub use truth::{tracker_frame, TrueRobot, UnmodelledEffects};
+pub use truth::{fine_transmission_errors, tracker_frame, Harmonic, TrueRobot, UnmodelledEffects};
 
 use crate::kinematics::KinematicsError;
 

@@ -4,8 +4,8 @@
 //! 1. gravity torques `τ = τ(q, M)` at the commanded configuration (eqs. 7.1–7.2);
 //! 2. joint deflection `δ_i` solving `k1·δ + k2·δ³ = τ_i` with `k1 = 1/c_i`
 //!    (eq. 7.3; `k2 = 0`, the default, gives the linear `δ = c∘τ` of eq. 7.4);
-//! 3. unmodelled joint effects ([`UnmodelledEffects`]): gear transmission error and
-//!    backlash added to the joint angle;
+//! 3. unmodelled joint effects ([`UnmodelledEffects`]): gear transmission error,
+//!    fine transmission / encoder errors and backlash added to the joint angle;
 //! 4. `FK(truth, q + δ + …)` in the base frame (eq. 2.9), then optional link
 //!    bending (a small rotation of the distal structure, see [`UnmodelledEffects`]);
 //! 5. the TCP expressed in the tracker frame, `x_tracker = tracker_from_base · x_base`;
@@ -53,7 +53,50 @@ pub struct UnmodelledEffects {
     /// end moment, `EI = 1/(link_bending)` per unit length up to a constant).
     /// Rotations are applied from the tip to the base at the deflected
     /// configuration. Example: `2e-8` gives some 0.05 mm on the YS100's upper arm.
-    pub link_bending: f64,
+    pub link_bending: f64,    /// Transmission and encoder errors with fine structure, per joint its
+    /// harmonics of its own angle: joint i gets `Σ A·sin(k·q_i + φ)` (empty:
+    /// none). See [`fine_transmission_errors`].
+    pub transmission: Vec<Vec<Harmonic>>,
+}
+
+/// One harmonic of a joint's transmission error: `A·sin(k·q + φ)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Harmonic {
+    pub k: u32,
+    pub amplitude_rad: f64,
+    pub phase_rad: f64,
+}
+
+/// Transmission errors as measured on real arms (docs/design.md "Joint angle
+/// error maps"): per joint, harmonics k = 1..=`harmonics` of its own angle
+/// with amplitudes `amplitude_arcsec / √k` (random phases, amplitudes drawn
+/// in [0.5, 1] of that), plus one motor-side term at k = 101 of
+/// `amplitude_arcsec / 20` that no map of up to 100 harmonics can hold.
+pub fn fine_transmission_errors(
+    dof: usize,
+    harmonics: u32,
+    amplitude_arcsec: f64,
+    rng: &mut impl rand::Rng,
+) -> Vec<Vec<Harmonic>> {
+    let arcsec = std::f64::consts::PI / 180.0 / 3600.0;
+    (0..dof)
+        .map(|_| {
+            let mut h: Vec<Harmonic> = (1..=harmonics)
+                .map(|k| Harmonic {
+                    k,
+                    amplitude_rad: amplitude_arcsec * arcsec * rng.gen_range(0.5..1.0)
+                        / f64::from(k).sqrt(),
+                    phase_rad: rng.gen_range(0.0..std::f64::consts::TAU),
+                })
+                .collect();
+            h.push(Harmonic {
+                k: 101,
+                amplitude_rad: amplitude_arcsec * arcsec / 20.0,
+                phase_rad: rng.gen_range(0.0..std::f64::consts::TAU),
+            });
+            h
+        })
+        .collect()
 }
 
 impl UnmodelledEffects {
@@ -80,7 +123,21 @@ impl UnmodelledEffects {
                 return bad("gear_error amplitude must be finite".into());
             }
         }
-        if !self.hysteresis_rad.is_finite() || !self.link_bending.is_finite() {
+        if !self.transmission.is_empty() && self.transmission.len() != dof {
+            return bad(format!(
+                "transmission has {} joints, the robot has {dof}",
+                self.transmission.len()
+            ));
+        }
+        if self
+            .transmission
+            .iter()
+            .flatten()
+            .any(|h| !h.amplitude_rad.is_finite() || !h.phase_rad.is_finite())
+        {
+            return bad("transmission amplitudes and phases must be finite".into());
+        }
+                if !self.hysteresis_rad.is_finite() || !self.link_bending.is_finite() {
             return bad("hysteresis_rad and link_bending must be finite".into());
         }
         Ok(())
@@ -172,6 +229,11 @@ impl TrueRobot {
         if let Some((amp, h)) = self.effects.gear_error {
             for (i, (x, q)) in qe.iter_mut().zip(q).enumerate() {
                 *x += amp * (f64::from(h) * q + 0.7 * i as f64).sin();
+            }
+        }
+        for (x, (q, hs)) in qe.iter_mut().zip(q.iter().zip(&self.effects.transmission)) {
+            for h in hs {
+                *x += h.amplitude_rad * (f64::from(h.k) * q + h.phase_rad).sin();
             }
         }
         if self.effects.hysteresis_rad != 0.0 {

@@ -35,7 +35,7 @@ pub use output_layer::OutputLayer;
 pub use tlbo::TlboTrainSettings;
 
 use super::mlp::Features;
-use super::rbf::{train_rbf_with_progress, RbfReport, RbfSettings};
+use super::rbf::{train_rbf_with_progress, RbfReport, RbfSettings, RbfTrainError};
 use super::{Sample, StoredCompensator};
 use data::Prepared;
 use rand::Rng;
@@ -160,8 +160,14 @@ impl CompensatorSpec {
 pub enum TrainError {
     #[error("training cancelled")]
     Cancelled,
-    #[error("{0}")]
-    Data(String),
+    #[error("a compensator needs at least 5 training poses, got {got}")]
+    TooFewSamples { got: usize },
+    #[error("training samples must have the same number of joints and finite residuals")]
+    InconsistentSamples,
+    #[error("the MLP needs at least one hidden unit")]
+    NoHiddenUnits,
+    #[error(transparent)]
+    Rbf(#[from] RbfTrainError),
 }
 
 /// What a training run did.
@@ -276,23 +282,17 @@ pub fn train(
     progress: &mut dyn FnMut(usize, f64) -> bool,
 ) -> Result<(StoredCompensator, TrainReport), TrainError> {
     if samples.len() < 5 {
-        return Err(TrainError::Data(format!(
-            "a compensator needs at least 5 training poses, got {}",
-            samples.len()
-        )));
+        return Err(TrainError::TooFewSamples { got: samples.len() });
     }
     let dof = samples[0].q.len();
     if samples.iter().any(|s| {
         s.q.len() != dof || s.tau.len() != dof || !s.residual.iter().all(|v| v.is_finite())
     }) {
-        return Err(TrainError::Data(
-            "training samples must have the same number of joints and finite residuals".into(),
-        ));
+        return Err(TrainError::InconsistentSamples);
     }
     match spec {
         CompensatorSpec::Rbf(settings) => {
-            let (net, rep) = train_rbf_with_progress(samples, settings, rng, progress)
-                .map_err(|e| TrainError::Data(e.to_string()))?
+            let (net, rep) = train_rbf_with_progress(samples, settings, rng, progress)?
                 .ok_or(TrainError::Cancelled)?;
             let stored = StoredCompensator::Rbf(net);
             Ok((
@@ -314,9 +314,7 @@ pub fn train(
         }
         CompensatorSpec::Mlp { spec: m, trainer } => {
             if m.hidden == 0 {
-                return Err(TrainError::Data(
-                    "the MLP needs at least one hidden unit".into(),
-                ));
+                return Err(TrainError::NoHiddenUnits);
             }
             let data = Prepared::new(samples, m);
             let outcome = match trainer {
@@ -453,7 +451,7 @@ mod tests {
                 &mut rng,
                 &mut |_, _| true
             ),
-            Err(TrainError::Data(_))
+            Err(TrainError::TooFewSamples { got: 3 })
         ));
     }
 }

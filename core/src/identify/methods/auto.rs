@@ -7,17 +7,24 @@
 //! least `min_gain` below the base's, max not above) or the base alone; between
 //! the bases it takes the lower cross-validated mean on the training pool. With
 //! fewer than `min_training_poses` training poses it trains nothing and keeps
-//! the base, saying so.
+//! the base, saying so. The joint-map methods among the candidates are options
+//! of their own: kept when their cross-validated mean (over the identification
+//! and training poses, `identify::joint_maps`) is at least `min_gain` below the
+//! geometry's alone on the same folds and their max not above; they then
+//! compete with the bases by that cross-validated mean.
 
 use super::compensated::base_pool_stats;
+use super::maps::run_maps;
 use super::run::{AppliedCompensator, Cache, Context, MethodFit, Outcome};
-use super::{Base, Compensated, Method, MethodError, MethodFailure};
+use super::{Base, Compensated, Method, MethodError, MethodFailure, Run};
 use crate::compensate::{choose, CvStats};
 use crate::identify::report::{AutoCandidate, AutoSummary};
 
 /// One base as `auto` weighs it.
 struct BaseOption {
     base: Base,
+    /// The joint-map method whose fit this is, if any.
+    maps: Option<Method>,
     fit: MethodFit,
     /// The compensator `choose` kept, if any.
     compensator: Option<AppliedCompensator>,
@@ -54,7 +61,11 @@ pub(crate) fn run_auto(
                 .collect()
         })
         .collect();
-    let total = per_base.iter().map(Vec::len).sum::<usize>().max(1) as f64;
+    let maps_runs = bases
+        .iter()
+        .filter(|b| maps_candidate(&o.auto_candidates, **b).is_some())
+        .count();
+    let total = (per_base.iter().map(Vec::len).sum::<usize>() + maps_runs).max(1) as f64;
     let max_stages = (folds + 1) as f64;
     let mut done = 0.0;
     let mut notes: Vec<String> = Vec::new();
@@ -80,6 +91,7 @@ pub(crate) fn run_auto(
         if !enough {
             options.push(BaseOption {
                 base: *base,
+                maps: None,
                 fit: mf,
                 compensator: None,
                 mean_mm: base_mean,
@@ -135,11 +147,73 @@ pub(crate) fn run_auto(
             .map_or(base_mean, |cv| cv.compensated.mean_mm);
         options.push(BaseOption {
             base: *base,
+            maps: None,
             fit: mf,
             compensator: picked,
             mean_mm,
             reason: format!("{name}: {}", choice.reason),
         });
+    }
+    for base in &bases {
+        let Some(method) = maps_candidate(&o.auto_candidates, *base) else {
+            continue;
+        };
+        let (at, span) = (done / total, 1.0 / total);
+        let outcome = run_maps(ctx, cache, *base, &mut |f, it, l| {
+            progress(at + span * f, it, l)
+        });
+        match outcome {
+            Err(MethodError::Cancelled) => return Err(MethodError::Cancelled),
+            Err(MethodError::Failed(f)) => {
+                candidates.push(AutoCandidate {
+                    method,
+                    cross_validation: None,
+                    failed: Some(f.to_string()),
+                });
+                notes.push(format!("{} failed: {f}", method.name()));
+            }
+            Ok(out) => {
+                let fit = out.fit;
+                let Some(m) = fit.maps.clone() else { continue };
+                candidates.push(AutoCandidate {
+                    method,
+                    cross_validation: None,
+                    failed: None,
+                });
+                let (with, without) = (&m.chosen, &m.without_maps);
+                let gain = 1.0 - with.cv_mean_mm / without.cv_mean_mm;
+                if m.maps.is_some() && gain >= o.min_gain && with.cv_max_mm <= without.cv_max_mm {
+                    options.push(BaseOption {
+                        base: *base,
+                        maps: Some(method),
+                        fit,
+                        compensator: None,
+                        mean_mm: with.cv_mean_mm,
+                        reason: format!(
+                            "{}: {} harmonics cross-validated over {} poses at {:.4} / {:.4} mm mean / max against {:.4} / {:.4} without maps",
+                            method.name(),
+                            with.harmonics,
+                            m.poses,
+                            with.cv_mean_mm,
+                            with.cv_max_mm,
+                            without.cv_mean_mm,
+                            without.cv_max_mm
+                        ),
+                    });
+                } else {
+                    notes.push(format!(
+                        "{} not kept: cross-validated {:.4} / {:.4} mm mean / max against {:.4} / {:.4} without maps (needs {:.0} % lower mean and no higher max)",
+                        method.name(),
+                        with.cv_mean_mm,
+                        with.cv_max_mm,
+                        without.cv_mean_mm,
+                        without.cv_max_mm,
+                        o.min_gain * 100.0
+                    ));
+                }
+            }
+        }
+        done += 1.0;
     }
     let best = options
         .iter()
@@ -151,14 +225,15 @@ pub(crate) fn run_auto(
         })?;
     let reasons: Vec<String> = options.iter().map(|o| o.reason.clone()).collect();
     let best = options.swap_remove(best);
-    let chosen = best
-        .compensator
-        .as_ref()
-        .map_or(best.base.method(), |a| a.method);
+    let chosen = match (&best.compensator, best.maps) {
+        (Some(a), _) => a.method,
+        (None, Some(m)) => m,
+        (None, None) => best.base.method(),
+    };
     let mut reason = format!(
         "{}: the lowest {} mean on the {pool_name} poses ({:.4} mm) — {}",
         chosen.name(),
-        if best.compensator.is_some() || enough {
+        if best.compensator.is_some() || best.maps.is_some() || enough {
             "cross-validated"
         } else {
             "residual"
@@ -178,4 +253,12 @@ pub(crate) fn run_auto(
             candidates,
         }),
     })
+}
+
+/// The joint-map method on `base` among `auto`'s candidates.
+fn maps_candidate(candidates: &[Method], base: Base) -> Option<Method> {
+    candidates
+        .iter()
+        .copied()
+        .find(|m| m.row().run == Run::Maps(base))
 }

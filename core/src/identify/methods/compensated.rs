@@ -77,7 +77,7 @@ pub(crate) fn samples(
 fn train_error(e: TrainError) -> MethodError {
     match e {
         TrainError::Cancelled => MethodError::Cancelled,
-        TrainError::Data(e) => MethodError::Failed(MethodFailure::Training(e.to_string())),
+        e => MethodError::Failed(MethodFailure::Training(e)),
     }
 }
 

@@ -2,6 +2,8 @@
 //! lists with its message (`FailedMethod::reason`) while the other methods go on.
 
 use super::Method;
+use crate::compensate::train::TrainError;
+use crate::identify::joint_maps::MapFitError;
 use crate::identify::least_squares::Cancelled;
 use crate::kinematics::KinematicsError;
 use crate::model::ModelError;
@@ -55,9 +57,11 @@ pub enum MethodFailure {
     TrainingPose { pose: usize, cause: KinematicsError },
     #[error("the model has no masses, so every gravity torque is zero and the torque-input RBF has nothing to learn from; use skcm-nn or km")]
     NoTorqueToLearn,
-    /// The compensator's training refused its data (`TrainError::Data`).
-    #[error("{0}")]
-    Training(String),
+    #[error("joint maps: {0}")]
+    JointMaps(MapFitError),
+    /// The compensator's training refused its data (any [`TrainError`] but a cancel).
+    #[error(transparent)]
+    Training(TrainError),
     /// `auto`: neither base fitted; the notes say why.
     #[error("no base method succeeded: {}", .notes.join("; "))]
     NoBaseSucceeded { notes: Vec<String> },

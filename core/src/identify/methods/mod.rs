@@ -13,6 +13,7 @@
 mod auto;
 mod compensated;
 mod failure;
+mod maps;
 mod model_based;
 mod report;
 mod run;
@@ -108,6 +109,30 @@ method_table! {
         weight: 2.0,
         run: Run::SkcmPayload,
     }
+    KmMaps {
+        name: "km-maps",
+        aliases: ["km_maps"],
+        label: "KM+maps",
+        description: "KM, then per-joint angle error maps (a Fourier series of each joint's own angle, confined to its trained range) fitted jointly with the linearised geometry and chosen by cross-validation; the geometry refitted with them (beyond the seed).",
+        fits: "geometry and per-joint angle error maps",
+        compliance: Compliance::No,
+        torques: false,
+        seed: false,
+        weight: 3.0,
+        run: Run::Maps(Base::Km),
+    }
+    SkcmMaps {
+        name: "skcm-maps",
+        aliases: ["skcm_maps"],
+        label: "SKCM+maps",
+        description: "SKCM, then per-joint angle error maps as km-maps, the geometry and compliance refitted with them (beyond the seed).",
+        fits: "geometry, joint compliance and per-joint angle error maps",
+        compliance: Compliance::Yes,
+        torques: true,
+        seed: false,
+        weight: 3.0,
+        run: Run::Maps(Base::Skcm),
+    }
     KmRbf {
         name: "km-rbf",
         aliases: ["km_rbf"],
@@ -136,7 +161,7 @@ method_table! {
         name: "skcm-iwonn",
         aliases: ["skcm_iwonn"],
         label: "SKCM-IWONN",
-        description: "SKCM, then the 6-5-3 MLP trained by invasive weed optimisation (ch. 5).",
+        description: "SKCM, then an 18-40-3 MLP (the seed's 6-5-3, widened) trained by invasive weed optimisation (ch. 5).",
         fits: "SKCM, then a residual network",
         compliance: Compliance::Yes,
         torques: true,
@@ -148,7 +173,7 @@ method_table! {
         name: "skcm-tlbonn",
         aliases: ["skcm_tlbonn"],
         label: "SKCM-TLBONN",
-        description: "SKCM, then the 6-5-3 MLP trained by TLBO (ch. 6).",
+        description: "SKCM, then an 18-40-3 MLP (the seed's 6-5-3, widened) trained by TLBO (ch. 6).",
         fits: "SKCM, then a residual network",
         compliance: Compliance::Yes,
         torques: true,
@@ -160,7 +185,7 @@ method_table! {
         name: "auto",
         aliases: [],
         label: "auto",
-        description: "The base (KM or SKCM) with the compensator chosen by cross-validated error, or the base alone when none is better on both mean and max.",
+        description: "The base (KM or SKCM) with the compensator or the joint maps chosen by cross-validated error, or the base alone when none is better on both mean and max.",
         fits: "what the method it chooses fits",
         compliance: Compliance::IfLoaded,
         torques: false,
@@ -209,6 +234,8 @@ pub enum Run {
     Skcm,
     SkcmTlbo,
     SkcmPayload,
+    /// Joint angle error maps on a base (`maps`).
+    Maps(Base),
     Compensated(Compensated),
     Auto,
 }
@@ -254,13 +281,15 @@ pub enum Network {
 enum Group {
     ModelBased,
     Seed,
+    JointMaps,
     Compensated,
 }
 
 const fn in_group(row: &MethodRow, group: Group) -> bool {
     match group {
-        Group::ModelBased => !matches!(row.run, Run::Compensated(_) | Run::Auto),
+        Group::ModelBased => !matches!(row.run, Run::Compensated(_) | Run::Auto | Run::Maps(_)),
         Group::Seed => row.seed,
+        Group::JointMaps => matches!(row.run, Run::Maps(_)),
         Group::Compensated => matches!(row.run, Run::Compensated(_)),
     }
 }
@@ -303,10 +332,12 @@ const fn all() -> [Method; METHODS.len()] {
 impl Method {
     /// Every method (`all`, the `compare` table).
     pub const ALL: [Method; METHODS.len()] = all();
-    /// The model-based methods (no compensator).
+    /// The model-based methods (no compensator, no joint maps).
     pub const MODEL_BASED: [Method; group_len(Group::ModelBased)] = group(Group::ModelBased);
     /// The seed's three methods (the default of `robocal calibrate`).
     pub const SEED: [Method; group_len(Group::Seed)] = group(Group::Seed);
+    /// The joint-map methods.
+    pub const JOINT_MAPS: [Method; group_len(Group::JointMaps)] = group(Group::JointMaps);
     /// The methods with a learned compensator.
     pub const COMPENSATED: [Method; group_len(Group::Compensated)] = group(Group::Compensated);
 
@@ -529,16 +560,23 @@ mod tests {
         assert!(!Method::Auto.uses_torques() && !Method::Auto.uses_compliance());
     }
 
-    /// The groups split the table: model-based, compensated, and `auto`.
+    /// The groups split the table: model-based, joint maps, compensated, and
+    /// `auto`.
     #[test]
     fn groups() {
         assert_eq!(Method::SEED, [Method::Km, Method::Skcm, Method::SkcmTlbo]);
+        assert_eq!(Method::JOINT_MAPS, [Method::KmMaps, Method::SkcmMaps]);
         for m in Method::ALL {
             let model_based = Method::MODEL_BASED.contains(&m);
             let compensated = Method::COMPENSATED.contains(&m);
+            let maps = Method::JOINT_MAPS.contains(&m);
             assert_eq!(compensated, m.compensated().is_some(), "{m}");
             assert_eq!(m.base().is_some(), compensated, "{m}");
-            assert_eq!(model_based, !compensated && m != Method::Auto, "{m}");
+            assert_eq!(
+                model_based,
+                !compensated && !maps && m != Method::Auto,
+                "{m}"
+            );
         }
         assert!(Method::MODEL_BASED.starts_with(&Method::SEED));
         assert!(Method::MODEL_BASED.contains(&Method::SkcmPayload));

@@ -104,6 +104,7 @@ impl Context<'_> {
             ids,
             tlbo: None,
             not_identified: vec![],
+            maps: None,
         })
     }
 
@@ -141,6 +142,7 @@ impl Context<'_> {
                 history: result.history,
             }),
             not_identified: vec![],
+            maps: None,
         })
     }
 
@@ -214,6 +216,7 @@ impl Context<'_> {
             ids,
             tlbo: None,
             not_identified,
+            maps: None,
         })
     }
 }

@@ -8,7 +8,9 @@ use super::compensated::compensate_report;
 use super::run::{Context, MethodFit, Outcome};
 use super::{Method, MethodFailure};
 use crate::identify::least_squares::residual_rows;
-use crate::identify::report::{estimates, MethodReport, MethodWarning, SetErrors, WarningKind};
+use crate::identify::report::{
+    estimates, JointMapsSummary, MethodReport, MethodWarning, SetErrors, WarningKind,
+};
 use crate::model::{ModelDescription, ParamId, ParamKind};
 
 impl Context<'_> {
@@ -41,6 +43,7 @@ impl Context<'_> {
             ids,
             tlbo,
             not_identified,
+            maps,
         } = mf;
         let description = ModelDescription::from_model(&fitted.model);
         if let Err(cause) = description.to_model() {
@@ -145,6 +148,7 @@ impl Context<'_> {
             model: description,
             compensator: None,
             auto: None,
+            joint_maps: maps.map(|m| JointMapsSummary::of(&m, &fitted.model)),
             calibrated: fitted.model,
             stored_compensator: None,
         })

@@ -5,8 +5,10 @@
 
 use super::auto::run_auto;
 use super::compensated::{run_compensated, train_network, Trained};
+use super::maps::run_maps;
 use super::{Base, Method, MethodError, MethodFailure, Network, Run};
 use crate::identify::identifiability::DroppedParam;
+use crate::identify::joint_maps::MapFit;
 use crate::identify::least_squares::Fit;
 use crate::identify::options::{CalibrationOptions, Progress};
 use crate::identify::report::{AutoSummary, TlboSummary};
@@ -54,6 +56,8 @@ pub(crate) struct MethodFit {
     pub tlbo: Option<TlboSummary>,
     /// Parameters the method considered but could not identify.
     pub not_identified: Vec<DroppedParam>,
+    /// The joint maps' fit and choice (joint-map methods).
+    pub maps: Option<MapFit>,
 }
 
 /// What a method delivers before it is reported.
@@ -64,7 +68,7 @@ pub(crate) struct Outcome {
 }
 
 impl Outcome {
-    fn plain(fit: MethodFit) -> Self {
+    pub(crate) fn plain(fit: MethodFit) -> Self {
         Outcome {
             fit,
             compensator: None,
@@ -103,6 +107,9 @@ pub(crate) fn run(
             .base_fit(ctx, Base::Skcm, &mut |_, _| true)
             .and_then(|s| ctx.skcm_payload(&s.fit, &mut lm))
             .map(Outcome::plain),
+        Run::Maps(base) => run_maps(ctx, cache, base, &mut |f, it, loss| {
+            progress.fraction(f, it, loss)
+        }),
         Run::Compensated(c) => run_compensated(ctx, cache, method, c, &mut |f, it, loss| {
             progress.fraction(f, it, loss)
         }),
@@ -187,6 +194,7 @@ impl Cache {
                     ids: ctx.kept_geo.clone(),
                     tlbo: None,
                     not_identified: vec![],
+                    maps: None,
                 })
             }
             Base::Skcm => {

@@ -1,5 +1,5 @@
 //! The solver's evaluation of the compensated model (the prediction
-//! `P_base(q) = FK_cal(q + c∘τ(q)) + NN(q, τ)` of `CompensatedModel`, docs/design.md
+//! `P_base(q) = FK_cal(q + c∘τ(q) + f(q)) + NN(q, τ)` of `CompensatedModel`, docs/design.md
 //! "Compensated model and false targets", seed eq. 2.1), with the model's
 //! constants computed once ([`PreparedChain`]) and every per-call buffer on
 //! the stack for up to `STACK_DOF` joints.
@@ -8,8 +8,9 @@
 //! [`PreparedModel::predict_with_jacobian`] equals
 //! `CompensatedModel::predict_base_with_jacobian` (pose in the registered base
 //! frame [m]; quasi-Newton Jacobian 6×N, rows `[v; ω]`: the geometric Jacobian
-//! of the calibrated chain at the deflected joints plus the compensator's
-//! `∂NN/∂q` on the position rows, `∂τ/∂q` neglected), compared in the tests
+//! of the calibrated chain at the deflected joints, column i times the joint
+//! map's `1 + f_i'(q_i)`, plus the compensator's `∂NN/∂q` on the position
+//! rows, `∂τ/∂q` neglected), compared in the tests
 //! below; [`PreparedModel::predict_with_chord`] takes `∂NN/∂q` from an earlier
 //! evaluation; [`PreparedModel::seed_fk`] is the seed model's forward kinematics.
 //! Joints in the model convention [rad], torques N·m, payload kg.
@@ -17,7 +18,7 @@
 use crate::compensate::{CompensatedModel, Compensator};
 use crate::kinematics::prepared::{stack_or_heap, PreparedChain, STACK_DOF};
 use crate::kinematics::LoopPartials;
-use crate::model::{Pose, RobotModel};
+use crate::model::{JointMaps, Pose, RobotModel};
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, Vector3, U6};
 use std::sync::Arc;
 
@@ -76,6 +77,8 @@ pub(crate) struct PreparedModel {
     /// Joint compliances of the calibrated model [rad/(N·m)].
     compliance: Vec<f64>,
     has_compliance: bool,
+    /// The calibrated model's joint angle error maps.
+    maps: Option<JointMaps>,
     payload_kg: f64,
     compensator: Option<Arc<dyn Compensator>>,
 }
@@ -102,6 +105,7 @@ impl PreparedModel {
             seed: PreparedChain::new(seed_model),
             compliance: cal.links.iter().map(|l| l.compliance).collect(),
             has_compliance: cal.has_compliance(),
+            maps: cal.joint_maps.clone(),
             payload_kg: model.payload_kg,
             compensator: model.compensator.clone(),
         }
@@ -145,6 +149,7 @@ impl PreparedModel {
                 r
             },
         )?;
+        self.scale_by_maps(q, jac);
         nn_dq.written = with_dq;
         nn_dq.add_to(jac);
         Some(pose)
@@ -171,8 +176,25 @@ impl PreparedModel {
             |frames, tcp, lp| chain.jacobian_into(frames, tcp, lp, jac),
             |c, q, tau, payload| c.residual_at(q, tau, payload),
         )?;
+        self.scale_by_maps(q, jac);
         nn_dq.add_to(jac);
         Some(pose)
+    }
+
+    /// The chain rule through the joint maps: column i of the chain's
+    /// Jacobian (taken at the mapped joints) times `1 + f_i'(q_i)`.
+    fn scale_by_maps<D: Dim>(&self, q: &[f64], jac: &mut OMatrix<f64, U6, D>)
+    where
+        DefaultAllocator: Allocator<U6, D>,
+    {
+        if let Some(maps) = &self.maps {
+            let (mut s_s, mut s_h) = ([1.0; STACK_DOF], Vec::new());
+            let scale = stack_or_heap(&mut s_s, &mut s_h, q.len(), 1.0);
+            maps.derivative_scale(q, scale);
+            for (i, s) in scale.iter().enumerate().take(jac.ncols()) {
+                jac.column_mut(i).scale_mut(*s);
+            }
+        }
     }
 
     /// The prediction: `at_deflected(frames, tcp, loop partials)` sees the
@@ -195,11 +217,14 @@ impl PreparedModel {
         if needs_tau {
             chain.gravity_torques(frames, &tcp0, lp0.as_ref(), self.payload_kg, tau);
         }
-        let mut pose = if self.has_compliance {
+        let mut pose = if self.has_compliance || self.maps.is_some() {
             let (mut d_s, mut d_h) = ([0.0; STACK_DOF], Vec::new());
             let deflected = stack_or_heap(&mut d_s, &mut d_h, n, 0.0);
             for (((d, q), t), c) in deflected.iter_mut().zip(q).zip(&*tau).zip(&self.compliance) {
                 *d = q + c * t;
+            }
+            if let Some(maps) = &self.maps {
+                maps.add_to(q, deflected);
             }
             let (tcp1, lp1) = chain.frames(deflected, frames).ok()?;
             at_deflected(frames, &tcp1, lp1.as_ref());

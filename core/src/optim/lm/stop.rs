@@ -45,6 +45,20 @@ pub enum StopReason {
 }
 
 impl StopReason {
+    /// Every reason, in declaration order.
+    pub const ALL: [StopReason; 10] = [
+        StopReason::CostTolerance,
+        StopReason::StepTolerance,
+        StopReason::GradientTolerance,
+        StopReason::PredictedCostTolerance,
+        StopReason::MaxIterations,
+        StopReason::NoDescent,
+        StopReason::EvaluationFailed,
+        StopReason::Underdetermined,
+        StopReason::StartNotEvaluable,
+        StopReason::Stopped,
+    ];
+
     /// Whether this reason is a passed convergence test.
     pub fn converged(&self) -> bool {
         matches!(

@@ -1,0 +1,437 @@
+//! Fitting the per-joint angle error maps (beyond the seed; docs/design.md
+//! "Joint angle error maps"): `Δθ_i = f_i(q_i)`, a Fourier series per joint
+//! (`model::joint_maps`), identified jointly with the linearised geometry.
+//!
+//! At a calibrated model φ (no maps), the residual of pose p (measured −
+//! predicted, registered base frame of its session, m) is linear in the map
+//! coefficients through joint i's column `J_θi(q)` of the identification
+//! Jacobian (the column of the θ_i offset, eq. 4.9):
+//! `r ≈ J_φ·Δφ + Σ_i J_θi(q)·Σ_k (a_ik·cos(k·q_i) + b_ik·sin(k·q_i))`.
+//! The stacked problem is solved by ridge regression: λ times the mean
+//! squared norm of the map columns on every map coefficient (one penalty in
+//! radians for all joints), the geometry and session-frame columns free
+//! (1e-9 on unit-norm columns, for conditioning). The number of harmonics K and λ are chosen
+//! by k-fold cross-validation over the poses (seeded folds): the lowest cost
+//! of the seed's eq. 7.10 (mean, max and spread of the squared position
+//! errors) on the held-out poses; K = 0 (geometry only) is always a
+//! candidate, so maps are kept only when they help on poses they never saw.
+//! Each joint's map covers the range of its training angles and fades to
+//! zero beyond it; a joint that moves less than `min_range_rad` gets none.
+
+use super::evaluate::{evaluate, gram};
+use crate::measure::Measurement;
+use crate::model::{JointMap, JointMaps, ParamId, ParamKind, Pose, RobotModel};
+use nalgebra::{DMatrix, DVector};
+use rand::seq::SliceRandom;
+use rand::Rng;
+use serde::{Deserialize, Serialize};
+
+/// Settings of the joint-map fit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct JointMapSettings {
+    /// Candidate numbers of harmonics K per joint (0, geometry only, is
+    /// always tried).
+    pub harmonics: Vec<usize>,
+    /// Candidate ridge weights λ on the unit-norm map columns.
+    pub ridge: Vec<f64>,
+    /// Cross-validation folds.
+    pub folds: usize,
+    /// At least this many residual rows per unknown, else a K is skipped.
+    pub rows_per_unknown: f64,
+    /// Width of the fade to zero beyond a joint's trained range [rad].
+    pub fade_rad: f64,
+    /// A joint whose training angles span less than this gets no map [rad].
+    pub min_range_rad: f64,
+    /// Rounds of (map fit, LM refit of the geometry with the maps fixed).
+    pub rounds: usize,
+}
+
+impl Default for JointMapSettings {
+    fn default() -> Self {
+        JointMapSettings {
+            harmonics: vec![10, 20, 40, 60, 80],
+            ridge: vec![1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0],
+            folds: 5,
+            rows_per_unknown: 4.0,
+            fade_rad: 5f64.to_radians(),
+            min_range_rad: 10f64.to_radians(),
+            rounds: 2,
+        }
+    }
+}
+
+/// One (K, λ) the cross-validation tried.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MapCandidate {
+    pub harmonics: usize,
+    pub ridge: f64,
+    /// Mean / max held-out position error over all poses [mm].
+    pub cv_mean_mm: f64,
+    pub cv_max_mm: f64,
+    /// The seed's eq. 7.10 on the held-out errors,
+    /// `mean(e²) + 0.5·max(e²) + 0.3·std(e²)` [mm²]: the choice's criterion.
+    pub cv_cost_mm2: f64,
+}
+
+/// Eq. 7.10 of errors [mm]: `mean(e²) + 0.5·max(e²) + 0.3·std(e²)` [mm²].
+fn seed_cost(errors: &[f64]) -> f64 {
+    let sq: Vec<f64> = errors.iter().map(|e| e * e).collect();
+    let n = sq.len().max(1) as f64;
+    let mean = sq.iter().sum::<f64>() / n;
+    let max = sq.iter().copied().fold(0.0, f64::max);
+    let std = (sq.iter().map(|s| (s - mean).powi(2)).sum::<f64>() / n).sqrt();
+    mean + 0.5 * max + 0.3 * std
+}
+
+/// The maps fitted and how they were chosen.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MapFit {
+    /// `None` when K = 0 (geometry alone) won the cross-validation.
+    pub maps: Option<JointMaps>,
+    pub chosen: MapCandidate,
+    /// Geometry alone (K = 0), on the same folds.
+    pub without_maps: MapCandidate,
+    pub candidates: Vec<MapCandidate>,
+    /// Poses the maps were fitted on.
+    pub poses: usize,
+}
+
+/// Why the maps cannot be fitted.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MapFitError {
+    #[error("joint maps need a serial chain (this model has a closed loop)")]
+    ClosedLoop,
+    #[error("joint maps need at least {need} poses, got {got}")]
+    TooFewPoses { need: usize, got: usize },
+    #[error("the model cannot be evaluated at some training pose")]
+    NotEvaluable,
+    #[error("no joint moves over {min_deg:.1}° in the training poses")]
+    NoJointMoves { min_deg: f64 },
+}
+
+/// The design of one fit: residuals, the geometry / session columns and the
+/// map columns for the largest K, pose by pose.
+struct Design {
+    r: DVector<f64>,
+    a: DMatrix<f64>,
+    /// Geometry and session-frame columns (the first ones of `a`).
+    geo: usize,
+    /// First row of each pose, and its row count.
+    pose_rows: Vec<(usize, usize)>,
+    /// Joints with a map, with their range.
+    joints: Vec<(usize, [f64; 2])>,
+    kmax: usize,
+}
+
+impl Design {
+    /// Column of (joint slot j, harmonic k ≥ 1, sine?) for the largest K.
+    fn col(&self, j: usize, k: usize, sine: bool) -> usize {
+        self.geo + j * 2 * self.kmax + usize::from(sine) * self.kmax + (k - 1)
+    }
+
+    /// The columns of the problem with K harmonics.
+    fn columns(&self, k: usize) -> Vec<usize> {
+        let mut c: Vec<usize> = (0..self.geo).collect();
+        for j in 0..self.joints.len() {
+            for h in 1..=k {
+                c.push(self.col(j, h, false));
+                c.push(self.col(j, h, true));
+            }
+        }
+        c
+    }
+}
+
+fn build(
+    model: &RobotModel,
+    frames: &[Pose],
+    ids: &[ParamId],
+    data: &[Measurement],
+    weight: f64,
+    kmax: usize,
+    settings: &JointMapSettings,
+) -> Result<Design, MapFitError> {
+    let n = model.dof();
+    let geo_eval =
+        evaluate(model, frames, ids, data, weight, true).ok_or(MapFitError::NotEvaluable)?;
+    let theta: Vec<ParamId> = (0..n).map(|k| ParamId::new(ParamKind::Theta, k)).collect();
+    let theta_eval =
+        evaluate(model, frames, &theta, data, weight, true).ok_or(MapFitError::NotEvaluable)?;
+    let (jg, jt) = (geo_eval.j.expect("asked"), theta_eval.j.expect("asked"));
+    let mut joints = Vec::new();
+    for i in 0..n {
+        let lo = data.iter().map(|m| m.q[i]).fold(f64::INFINITY, f64::min);
+        let hi = data
+            .iter()
+            .map(|m| m.q[i])
+            .fold(f64::NEG_INFINITY, f64::max);
+        if hi - lo >= settings.min_range_rad {
+            joints.push((i, [lo, hi]));
+        }
+    }
+    if joints.is_empty() {
+        return Err(MapFitError::NoJointMoves {
+            min_deg: settings.min_range_rad.to_degrees(),
+        });
+    }
+    let geo = jg.ncols();
+    let rows = jg.nrows();
+    let mut a = DMatrix::zeros(rows, geo + joints.len() * 2 * kmax);
+    a.columns_mut(0, geo).copy_from(&jg);
+    let mut pose_rows = Vec::with_capacity(data.len());
+    let mut row = 0;
+    let mut basis = vec![0.0; 2 * kmax];
+    let mut design = Design {
+        r: geo_eval.r,
+        a: DMatrix::zeros(0, 0),
+        geo,
+        pose_rows: Vec::new(),
+        joints,
+        kmax,
+    };
+    for m in data {
+        let nr = if m.orientation.is_some() { 6 } else { 3 };
+        pose_rows.push((row, nr));
+        for (slot, (i, _)) in design.joints.iter().enumerate() {
+            JointMap::basis(kmax, m.q[*i], &mut basis);
+            for h in 1..=kmax {
+                let (c, s) = (basis[h - 1], basis[kmax + h - 1]);
+                let (cc, cs) = (design.col(slot, h, false), design.col(slot, h, true));
+                for rr in row..row + nr {
+                    let t = jt[(rr, *i)];
+                    a[(rr, cc)] = t * c;
+                    a[(rr, cs)] = t * s;
+                }
+            }
+        }
+        row += nr;
+    }
+    design.a = a;
+    design.pose_rows = pose_rows;
+    Ok(design)
+}
+
+/// Ridge solution on the columns `cols` of the normal equations `g`, `b`,
+/// columns scaled to unit norm by `scale`. The map columns (index ≥ `geo`)
+/// are penalised by `ridge·(s̄/s_c)²`, `s̄` the RMS norm of the map columns:
+/// one penalty on the coefficients in radians for every joint, so a joint
+/// whose angle barely moves the TCP (a short lever) gets no large map.
+/// `None` when the system is not positive definite.
+fn solve(
+    g: &DMatrix<f64>,
+    b: &DVector<f64>,
+    cols: &[usize],
+    scale: &[f64],
+    geo: usize,
+    ridge: f64,
+) -> Option<DVector<f64>> {
+    let maps: Vec<f64> = cols
+        .iter()
+        .filter(|c| **c >= geo)
+        .map(|c| scale[*c])
+        .collect();
+    let mean_sq = if maps.is_empty() {
+        1.0
+    } else {
+        maps.iter().map(|s| s * s).sum::<f64>() / maps.len() as f64
+    };
+    let m = cols.len();
+    let mut h = DMatrix::zeros(m, m);
+    let mut v = DVector::zeros(m);
+    for (x, &cx) in cols.iter().enumerate() {
+        v[x] = b[cx] / scale[cx];
+        for (y, &cy) in cols.iter().enumerate() {
+            h[(x, y)] = g[(cx, cy)] / (scale[cx] * scale[cy]);
+        }
+        h[(x, x)] += if cx >= geo {
+            ridge * mean_sq / (scale[cx] * scale[cx])
+        } else {
+            1e-9
+        };
+    }
+    let x = h.cholesky()?.solve(&v);
+    Some(DVector::from_iterator(
+        m,
+        x.iter().zip(cols).map(|(x, c)| x / scale[*c]),
+    ))
+}
+
+/// Position error norms [mm] of the poses `poses` after subtracting `a·x`.
+fn held_out_errors(d: &Design, poses: &[usize], cols: &[usize], x: &DVector<f64>) -> Vec<f64> {
+    poses
+        .iter()
+        .map(|&p| {
+            let (row, _) = d.pose_rows[p];
+            let mut e2 = 0.0;
+            for rr in row..row + 3 {
+                let fit: f64 = cols
+                    .iter()
+                    .zip(x.iter())
+                    .map(|(c, x)| d.a[(rr, *c)] * x)
+                    .sum();
+                e2 += (d.r[rr] - fit).powi(2);
+            }
+            e2.sqrt() * 1e3
+        })
+        .collect()
+}
+
+/// The normal equations `AᵀA`, `Aᵀr` of the rows of `poses`.
+fn normal_of(d: &Design, poses: &[usize]) -> (DMatrix<f64>, DVector<f64>) {
+    let rows: usize = poses.iter().map(|p| d.pose_rows[*p].1).sum();
+    let mut a = DMatrix::zeros(rows, d.a.ncols());
+    let mut r = DVector::zeros(rows);
+    let mut at = 0;
+    for &p in poses {
+        let (row, nr) = d.pose_rows[p];
+        a.rows_mut(at, nr).copy_from(&d.a.rows(row, nr));
+        r.rows_mut(at, nr).copy_from(&d.r.rows(row, nr));
+        at += nr;
+    }
+    (gram(&a), a.tr_mul(&r))
+}
+
+/// Fits the maps of `model` (its own maps ignored) on `data` with the session
+/// frames `frames` and the identified parameters `ids`: K and λ by
+/// cross-validation, then the coefficients on all poses. `progress(done,
+/// total)` after each candidate; false cancels (`Ok(None)`).
+#[allow(clippy::too_many_arguments)]
+pub fn fit_joint_maps(
+    model: &RobotModel,
+    frames: &[Pose],
+    ids: &[ParamId],
+    data: &[Measurement],
+    orientation_weight: f64,
+    settings: &JointMapSettings,
+    rng: &mut impl Rng,
+    progress: &mut dyn FnMut(usize, usize) -> bool,
+) -> Result<Option<MapFit>, MapFitError> {
+    if model.closed_loop.is_some() {
+        return Err(MapFitError::ClosedLoop);
+    }
+    let folds = settings.folds.max(2);
+    let need = 4 * folds;
+    if data.len() < need {
+        return Err(MapFitError::TooFewPoses {
+            need,
+            got: data.len(),
+        });
+    }
+    let mut plain = model.clone();
+    plain.joint_maps = None;
+    let rows = super::evaluate::residual_rows(data);
+    let n = model.dof();
+    let geo_cols = ids.len() + frames.len().saturating_sub(1) * 6;
+    let affordable =
+        |k: usize| ((geo_cols + 2 * k * n) as f64) * settings.rows_per_unknown <= rows as f64;
+    let mut ks: Vec<usize> = settings
+        .harmonics
+        .iter()
+        .copied()
+        .filter(|k| *k > 0 && affordable(*k))
+        .collect();
+    ks.sort_unstable();
+    ks.dedup();
+    let kmax = ks.last().copied().unwrap_or(0);
+    let d = build(
+        &plain,
+        frames,
+        ids,
+        data,
+        orientation_weight,
+        kmax.max(1),
+        settings,
+    )?;
+    let (g, b) = (gram(&d.a), d.a.tr_mul(&d.r));
+    let scale: Vec<f64> = (0..g.ncols())
+        .map(|c| {
+            let s = g[(c, c)].sqrt();
+            if s > 0.0 {
+                s
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    // Seeded folds over the poses.
+    let mut order: Vec<usize> = (0..data.len()).collect();
+    order.shuffle(rng);
+    let fold_poses: Vec<Vec<usize>> = (0..folds)
+        .map(|f| order.iter().copied().skip(f).step_by(folds).collect())
+        .collect();
+    let fold_normals: Vec<(DMatrix<f64>, DVector<f64>)> =
+        fold_poses.iter().map(|p| normal_of(&d, p)).collect();
+    let mut grid: Vec<(usize, f64)> = vec![(0, 0.0)];
+    for k in &ks {
+        for l in &settings.ridge {
+            grid.push((*k, *l));
+        }
+    }
+    let mut candidates = Vec::new();
+    for (done, (k, ridge)) in grid.iter().enumerate() {
+        let cols = d.columns(*k);
+        let mut errors = Vec::with_capacity(data.len());
+        let mut ok = true;
+        for (poses, (gf, bf)) in fold_poses.iter().zip(&fold_normals) {
+            match solve(&(&g - gf), &(&b - bf), &cols, &scale, d.geo, *ridge) {
+                Some(x) => errors.extend(held_out_errors(&d, poses, &cols, &x)),
+                None => ok = false,
+            }
+        }
+        if ok {
+            candidates.push(MapCandidate {
+                harmonics: *k,
+                ridge: *ridge,
+                cv_mean_mm: errors.iter().sum::<f64>() / errors.len() as f64,
+                cv_max_mm: errors.iter().copied().fold(0.0, f64::max),
+                cv_cost_mm2: seed_cost(&errors),
+            });
+        }
+        if !progress(done + 1, grid.len() + 1) {
+            return Ok(None);
+        }
+    }
+    let without_maps = candidates
+        .iter()
+        .find(|c| c.harmonics == 0)
+        .cloned()
+        .ok_or(MapFitError::NotEvaluable)?;
+    // The lowest held-out eq. 7.10 cost (K = 0 is a candidate).
+    let chosen = candidates
+        .iter()
+        .min_by(|a, b| a.cv_cost_mm2.total_cmp(&b.cv_cost_mm2))
+        .cloned()
+        .expect("K = 0 is a candidate");
+    let maps = if chosen.harmonics == 0 {
+        None
+    } else {
+        let cols = d.columns(chosen.harmonics);
+        let x =
+            solve(&g, &b, &cols, &scale, d.geo, chosen.ridge).ok_or(MapFitError::NotEvaluable)?;
+        let k = chosen.harmonics;
+        let mut joints: Vec<Option<JointMap>> = vec![None; n];
+        for (slot, (i, range)) in d.joints.iter().enumerate() {
+            let mut map = JointMap::zero(k, *range, settings.fade_rad);
+            for h in 1..=k {
+                let at = |sine: bool| {
+                    let c = d.col(slot, h, sine);
+                    let pos = cols.iter().position(|x| *x == c).expect("in cols");
+                    x[pos]
+                };
+                map.cos[h - 1] = at(false);
+                map.sin[h - 1] = at(true);
+            }
+            joints[*i] = Some(map);
+        }
+        Some(JointMaps { joints })
+    };
+    progress(grid.len() + 1, grid.len() + 1);
+    Ok(Some(MapFit {
+        maps,
+        chosen,
+        without_maps,
+        candidates,
+        poses: data.len(),
+    }))
+}

@@ -1,0 +1,201 @@
+//! Joint angle error maps: the model file keeps them, the IK uses them with
+//! their exact derivative, and the joint-map method recovers fine
+//! transmission errors of a simulated truth to the floor that noise and an
+//! unrepresentable motor-side harmonic leave, while a truth without them is
+//! left as KM leaves it.
+
+mod common;
+
+use common::ik::calibrated;
+use common::{opts, run_with};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use robocal_core::compensate::CompensatedModel;
+use robocal_core::identify::Method;
+use robocal_core::ik::{Goal, IkSettings, IkSolver, SolveOptions};
+use robocal_core::measure::{self, Measurement};
+use robocal_core::model::orientation::rotation_angle_between;
+use robocal_core::model::{preset, JointMap, JointMaps, ModelDescription, RobotModel};
+use robocal_core::sim::{
+    fine_transmission_errors, perturb_geometry, random_configurations, ErrorMagnitudes, TrueRobot,
+};
+
+/// Maps of tens of arc seconds on joints 1–3 and 5, over ranges that leave
+/// part of each joint's travel outside them.
+fn sample_maps(dof: usize, rng: &mut ChaCha8Rng) -> JointMaps {
+    let arcsec = 1f64.to_radians() / 3600.0;
+    let joints = (0..dof)
+        .map(|i| {
+            matches!(i, 0 | 1 | 2 | 4).then(|| {
+                let k = 12;
+                JointMap {
+                    cos: (0..k).map(|_| rng.gen_range(-30.0..30.0) * arcsec).collect(),
+                    sin: (0..k).map(|_| rng.gen_range(-30.0..30.0) * arcsec).collect(),
+                    range: [-1.5, 1.2],
+                    fade: 0.1,
+                }
+            })
+        })
+        .collect();
+    JointMaps { joints }
+}
+
+fn with_maps(mut m: RobotModel, seed: u64) -> RobotModel {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    m.joint_maps = Some(sample_maps(m.dof(), &mut rng));
+    m
+}
+
+#[test]
+fn the_description_keeps_the_maps() {
+    let m = with_maps(preset("ur5").unwrap(), 1);
+    let text = serde_json::to_string(&ModelDescription::from_model(&m)).unwrap();
+    let back: ModelDescription = serde_json::from_str(&text).unwrap();
+    let back = back.to_model().unwrap();
+    let (a, b) = (m.joint_maps.unwrap(), back.joint_maps.unwrap());
+    let mut rng = ChaCha8Rng::seed_from_u64(2);
+    for _ in 0..200 {
+        let q: Vec<f64> = (0..6).map(|_| rng.gen_range(-1.8..1.5)).collect();
+        let (mut x, mut y) = (q.clone(), q.clone());
+        a.add_to(&q, &mut x);
+        b.add_to(&q, &mut y);
+        for (x, y) in x.iter().zip(&y) {
+            assert!((x - y).abs() < 1e-15, "{x} {y}");
+        }
+    }
+    // A model without maps writes no `joint_maps` field.
+    let plain = serde_json::to_string(&ModelDescription::from_model(&preset("ur5").unwrap()));
+    assert!(!plain.unwrap().contains("joint_maps"));
+}
+
+#[test]
+fn a_map_count_other_than_the_joints_is_refused() {
+    let m = with_maps(preset("ur5").unwrap(), 1);
+    let mut d = ModelDescription::from_model(&m);
+    d.joint_maps.as_mut().unwrap().0.pop();
+    let e = d.to_model().unwrap_err().to_string();
+    assert!(e.contains("joint_maps") && e.contains("5 maps"), "{e}");
+}
+
+/// The prediction's Jacobian with maps (chain rule `1 + f'`) against central
+/// differences of the prediction, inside the ranges, in the fade bands and
+/// beyond them.
+#[test]
+fn the_jacobian_with_maps_matches_finite_differences() {
+    let mut cm = CompensatedModel::from_nominal(preset("ur5").unwrap());
+    cm.calibrated = with_maps(cm.calibrated.clone(), 3);
+    let h = 1e-6;
+    for q in [
+        [0.3, -1.0, 0.8, 0.1, 0.5, 0.2],
+        [1.25, -1.55, 1.17, -0.4, 1.28, 0.0],
+        [-1.7, 1.4, -2.0, 1.0, -1.0, 1.0],
+    ] {
+        let (_, jac) = cm.predict_base_with_jacobian(&q).unwrap();
+        for k in 0..6 {
+            let (mut qp, mut qm) = (q, q);
+            qp[k] += h;
+            qm[k] -= h;
+            let (pp, pm) = (cm.predict_base(&qp).unwrap(), cm.predict_base(&qm).unwrap());
+            let fd = (pp.p - pm.p) / (2.0 * h);
+            let err = (jac.fixed_view::<3, 1>(0, k) - fd).norm();
+            assert!(err < 1e-8, "q {q:?} column {k}: {err:e}");
+        }
+    }
+}
+
+/// The IK solves 1000 targets of a calibrated model with joint maps, each
+/// checked through the prediction with the maps.
+#[test]
+fn the_ik_solves_through_the_maps() {
+    let mut cm = calibrated("ur5", 3);
+    cm.calibrated = with_maps(cm.calibrated.clone(), 4);
+    let solver = IkSolver::new(cm.clone(), IkSettings::default());
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let goals: Vec<Goal> = (0..1000)
+        .map(|_| {
+            let q: Vec<f64> = (0..6).map(|_| rng.gen_range(-1.8..1.5)).collect();
+            Goal::from(&cm.predict(&q).unwrap())
+        })
+        .collect();
+    let sols = solver.solve_batch(&goals, &SolveOptions::default());
+    for (g, s) in goals.iter().zip(&sols) {
+        assert!(s.converged, "{:?}", s.reason);
+        let p = cm.predict(&s.q).unwrap();
+        assert!((p.p - g.position).norm() * 1e3 < 1e-3);
+        assert!(rotation_angle_between(&p.r, &g.rotation.unwrap()) < 1e-6);
+    }
+}
+
+/// A UR5 truth with ~0.5 mm / 0.05° geometric errors, optionally fine
+/// transmission errors (30 harmonics, 30″, plus the k = 101 term), tracker
+/// noise 0.01 mm: identification and validation measurements over the whole
+/// joint range, and the validation rows measured on the truth without the
+/// unrepresentable k = 101 term and without noise (the floor's reference).
+struct Study {
+    nominal: RobotModel,
+    id: Vec<Measurement>,
+    va: Vec<Measurement>,
+    floor_mm: f64,
+}
+
+fn study(transmission: bool) -> Study {
+    let nominal = preset("ur5").unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(21);
+    let tm = perturb_geometry(&nominal, &ErrorMagnitudes::from_mm_deg(0.5, 0.05), &mut rng);
+    let mut truth = TrueRobot::new(tm);
+    if transmission {
+        truth.effects.transmission = fine_transmission_errors(6, 30, 30.0, &mut rng);
+    }
+    truth.noise_mm = 0.01;
+    let measure = |truth: &TrueRobot, qs: &[Vec<f64>], rng: &mut ChaCha8Rng| {
+        let rows = truth.measure(qs, Some(0.0), None, rng).unwrap();
+        measure::to_measurements(&nominal, &rows, 0.0)
+    };
+    let qi = random_configurations(&nominal, 1200, &mut rng);
+    let qv = random_configurations(&nominal, 300, &mut rng);
+    let id = measure(&truth, &qi, &mut rng);
+    let va = measure(&truth, &qv, &mut rng);
+    // The best any map of up to 100 harmonics can do: the truth without its
+    // k = 101 term and without noise, against the measured validation rows.
+    let mut ideal = truth.clone();
+    ideal.noise_mm = 0.0;
+    for h in &mut ideal.effects.transmission {
+        h.retain(|h| h.k <= 100);
+    }
+    let clean = measure(&ideal, &qv, &mut rng);
+    let floor_mm = clean
+        .iter()
+        .zip(&va)
+        .map(|(c, m)| (c.position - m.position).norm() * 1e3)
+        .sum::<f64>()
+        / va.len() as f64;
+    Study {
+        nominal,
+        id,
+        va,
+        floor_mm,
+    }
+}
+
+fn validation_means(s: &Study) -> (f64, f64) {
+    let r = run_with(&s.nominal, &s.id, &s.va, opts(&[Method::Km, Method::KmMaps])).unwrap();
+    let v = |m: &str| r.methods[m].validation.as_ref().unwrap().stats.mean_mm;
+    (v("km"), v("km-maps"))
+}
+
+#[test]
+fn maps_recover_fine_transmission_errors_to_the_floor() {
+    let s = study(true);
+    let (km, maps) = validation_means(&s);
+    eprintln!("floor {:.4} mm, KM {km:.4}, km-maps {maps:.4}", s.floor_mm);
+    assert!(km > 2.0 * s.floor_mm, "the errors must matter: KM {km}");
+    assert!(maps < 1.15 * s.floor_mm, "km-maps {maps} floor {}", s.floor_mm);
+}
+
+#[test]
+fn maps_leave_a_truth_without_them_unchanged() {
+    let s = study(false);
+    let (km, maps) = validation_means(&s);
+    eprintln!("floor {:.4} mm, KM {km:.4}, km-maps {maps:.4}", s.floor_mm);
+    assert!((maps - km).abs() <= 0.02 * km, "KM {km} km-maps {maps}");
+}
