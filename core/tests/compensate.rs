@@ -123,7 +123,7 @@ impl Study {
     fn model(&self, method: &str) -> CompensatedModel {
         let m = &self.report.methods[method];
         CompensatedModel {
-            compensator: m.stored_compensator.clone().map(|c| c.into_arc()),
+            compensator: m.compensator_arc(),
             ..base(&self.nominal, &self.report, method)
         }
     }
@@ -285,11 +285,18 @@ fn fifty_poses_auto_falls_back_to_the_base() {
         "auto ({}) {got:?} vs its base {base} {want:?}",
         a.chosen.name()
     );
-    // Every candidate was cross-validated on the 50 training poses.
-    assert_eq!(a.candidates.len(), 4, "{:?}", a.candidates);
-    for c in &a.candidates {
+    // Every compensator candidate was cross-validated on the 50 training
+    // poses; the joint maps by their own cross-validation.
+    let (nets, maps): (Vec<_>, Vec<_>) = a
+        .candidates
+        .iter()
+        .partition(|c| c.method.compensated().is_some());
+    assert_eq!(nets.len(), 4, "{:?}", a.candidates);
+    for c in &nets {
         assert_eq!(c.cross_validation.as_ref().unwrap().compensated.n, 50);
     }
+    let maps: Vec<Method> = maps.iter().map(|c| c.method).collect();
+    assert_eq!(maps, Method::JOINT_MAPS, "{:?}", a.candidates);
 }
 
 /// Without unmodelled effects there is nothing to learn but noise: no
@@ -349,7 +356,9 @@ fn base_failure_pool_choice_and_cancellation() {
         "{}",
         a.reason
     );
-    assert!(a.candidates.is_empty(), "{:?}", a.candidates);
+    // No compensator; the joint maps on KM are tried (they need no torques).
+    let tried: Vec<Method> = a.candidates.iter().map(|c| c.method).collect();
+    assert_eq!(tried, [Method::KmMaps], "{:?}", a.candidates);
     // Its model file names the method it delivers.
     assert_eq!(r.methods["auto"].model_file_method(), "auto: km");
     assert_eq!(r.methods["auto"].method.name(), "auto");

@@ -29,8 +29,12 @@ fn sample_maps(dof: usize, rng: &mut ChaCha8Rng) -> JointMaps {
             matches!(i, 0 | 1 | 2 | 4).then(|| {
                 let k = 12;
                 JointMap {
-                    cos: (0..k).map(|_| rng.gen_range(-30.0..30.0) * arcsec).collect(),
-                    sin: (0..k).map(|_| rng.gen_range(-30.0..30.0) * arcsec).collect(),
+                    cos: (0..k)
+                        .map(|_| rng.gen_range(-30.0..30.0) * arcsec)
+                        .collect(),
+                    sin: (0..k)
+                        .map(|_| rng.gen_range(-30.0..30.0) * arcsec)
+                        .collect(),
                     range: [-1.5, 1.2],
                     fade: 0.1,
                 }
@@ -178,7 +182,13 @@ fn study(transmission: bool) -> Study {
 }
 
 fn validation_means(s: &Study) -> (f64, f64) {
-    let r = run_with(&s.nominal, &s.id, &s.va, opts(&[Method::Km, Method::KmMaps])).unwrap();
+    let r = run_with(
+        &s.nominal,
+        &s.id,
+        &s.va,
+        opts(&[Method::Km, Method::KmMaps]),
+    )
+    .unwrap();
     let v = |m: &str| r.methods[m].validation.as_ref().unwrap().stats.mean_mm;
     (v("km"), v("km-maps"))
 }
@@ -189,7 +199,11 @@ fn maps_recover_fine_transmission_errors_to_the_floor() {
     let (km, maps) = validation_means(&s);
     eprintln!("floor {:.4} mm, KM {km:.4}, km-maps {maps:.4}", s.floor_mm);
     assert!(km > 2.0 * s.floor_mm, "the errors must matter: KM {km}");
-    assert!(maps < 1.15 * s.floor_mm, "km-maps {maps} floor {}", s.floor_mm);
+    assert!(
+        maps < 1.15 * s.floor_mm,
+        "km-maps {maps} floor {}",
+        s.floor_mm
+    );
 }
 
 #[test]

@@ -303,7 +303,7 @@ fn save_model(
         nominal: nominal.clone(),
         cell_from_base: report.tracker_to_base.inverse(),
         payload_kg: payload,
-        compensator: chosen.stored_compensator.clone().map(|c| c.into_arc()),
+        compensator: chosen.compensator_arc(),
     };
     let label = chosen.model_file_method();
     let file =

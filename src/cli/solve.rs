@@ -225,6 +225,8 @@ fn render_json(h: &Header, results: &[TargetResult]) -> String {
                 "iterations": s.iterations,
                 "false_target": false_target,
                 "jump": r.jump.map(|j| json!({"joint": j.joint, "delta_deg": j.delta_deg})),
+                "compensation": r.compensation.as_ref().map(|c| c.label()),
+                "warning": r.compensation.as_ref().and_then(|c| c.warning()),
             })
         })
         .collect();

@@ -165,6 +165,11 @@ pub struct TargetOut {
     pub orientation_residual_rad: Option<f64>,
     pub iterations: usize,
     pub jump: Option<JointJump>,
+    /// `full`, `faded` or `none`: how much of the joint maps' and the
+    /// compensator's correction applies (null: the model has neither).
+    pub compensation: Option<&'static str>,
+    /// Joints outside the trained range, or far from the training poses.
+    pub warning: Option<String>,
 }
 
 impl From<TargetResult> for TargetOut {
@@ -189,6 +194,8 @@ impl From<TargetResult> for TargetOut {
             orientation_residual_rad: finite(r.solution.orientation_residual_rad),
             iterations: r.solution.iterations,
             jump: r.jump,
+            compensation: r.compensation.as_ref().map(|c| c.label()),
+            warning: r.compensation.as_ref().and_then(|c| c.warning()),
             id: r.id,
         }
     }

@@ -592,7 +592,7 @@ fn versions_of(
             nominal: nominal.clone(),
             cell_from_base,
             payload_kg,
-            compensator: m.stored_compensator.clone().map(|c| c.into_arc()),
+            compensator: m.compensator_arc(),
         };
         let file = CalibratedModelFile::from_compensated(&cm, robot_name, &m.model_file_method());
         if let Err(e) = file.to_compensated() {

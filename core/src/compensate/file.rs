@@ -28,7 +28,7 @@
 //! values are SI (inputs rad, kg, N·m; outputs m) as the network computes them.
 //! A file with an unknown `kind` is rejected.
 
-use super::{CompensateError, CompensatedModel, StoredCompensator};
+use super::{CompensateError, CompensatedModel, StoredCompensator, Support};
 use crate::model::{ModelDescription, RobotModel};
 use serde::{Deserialize, Serialize};
 
@@ -61,6 +61,11 @@ pub struct CalibratedModelFile {
     /// Learned residual compensator (format 2).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub compensator: Option<StoredCompensator>,
+    /// Where the compensator was trained; beyond it its correction fades to
+    /// zero (`support`). Absent in files written before it existed: the
+    /// compensator then applies everywhere.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compensator_support: Option<Support>,
 }
 
 impl CalibratedModelFile {
@@ -76,6 +81,7 @@ impl CalibratedModelFile {
             cell_from_base: PoseDescription::from_pose(&m.cell_from_base),
             payload_kg: m.payload_kg,
             compensator: m.compensator.as_ref().and_then(|c| c.stored()),
+            compensator_support: m.compensator.as_ref().and_then(|c| c.support().cloned()),
         }
     }
 
@@ -97,6 +103,17 @@ impl CalibratedModelFile {
         if let Some(c) = &self.compensator {
             c.validate()
                 .map_err(|e| CompensateError::Format(format!("compensator: {e}")))?;
+        }
+        match (&self.compensator, &self.compensator_support) {
+            (None, Some(_)) => {
+                return Err(CompensateError::Format(
+                    "compensator_support without a compensator".into(),
+                ))
+            }
+            (Some(c), Some(s)) => s
+                .validate(c.dof())
+                .map_err(|e| CompensateError::Format(e.to_string()))?,
+            _ => {}
         }
         let calibrated = self.model.to_model()?;
         let nominal = self.nominal.to_model()?;
@@ -123,7 +140,10 @@ impl CalibratedModelFile {
                         nominal.dof()
                     )))
                 }
-                Some(c) => Some(c.clone().into_arc()),
+                Some(c) => Some(
+                    c.clone()
+                        .into_arc_supported(self.compensator_support.clone()),
+                ),
                 None => None,
             },
             nominal,

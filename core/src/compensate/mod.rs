@@ -31,6 +31,7 @@ pub mod file;
 pub mod mlp;
 pub mod rbf;
 pub mod select;
+pub mod support;
 pub mod synthetic;
 pub mod train;
 
@@ -40,6 +41,7 @@ pub use rbf::{
     train_rbf, train_rbf_with_progress, OutputFrame, Rbf, RbfReport, RbfSettings, RbfTrainError,
 };
 pub use select::{choose, cross_validate, Choice, CvStats};
+pub use support::{Compensation, Faded, Support, SupportCoverage};
 pub use synthetic::{synthetic_calibration, unmodelled_truth, SyntheticErrors};
 pub use train::{
     train, CompensatorSpec, IwoSettings, LmTrainSettings, MlpSpec, OutputLayer, TlboTrainSettings,
@@ -94,6 +96,10 @@ pub trait Compensator: Send + Sync {
     /// The storable form for the model file; `None` for compensators that
     /// cannot be stored (the file then carries no compensator).
     fn stored(&self) -> Option<StoredCompensator> {
+        None
+    }
+    /// Where it was trained, when it fades beyond that ([`Faded`]).
+    fn support(&self) -> Option<&Support> {
         None
     }
 }

@@ -10,7 +10,7 @@ use super::identifiability::IdentifiabilityReport;
 use super::joint_maps::{MapCandidate, MapFit};
 use super::least_squares::LmReport;
 use super::options::Method;
-use crate::compensate::{Compensator, CvStats, StoredCompensator, TrainReport};
+use crate::compensate::{Compensator, CvStats, StoredCompensator, Support, TrainReport};
 use crate::measure::Measurement;
 use crate::model::description::PoseDescription;
 use crate::model::pose::Pose;
@@ -19,6 +19,7 @@ use crate::stats::ErrorStats;
 use nalgebra::{DMatrix, DVector, Vector3};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
 /// Version of the serialised [`CalibrationReport`]. 1: no version field, error
 /// norms only; 2: per-pose error vectors and positions, pose sources; 3: the
@@ -237,9 +238,20 @@ pub struct MethodReport {
     /// The trained compensator (the model file stores it).
     #[serde(skip)]
     pub stored_compensator: Option<StoredCompensator>,
+    /// Where the compensator was trained (the model file stores it).
+    #[serde(skip)]
+    pub stored_support: Option<Support>,
 }
 
 impl MethodReport {
+    /// The trained compensator as predictions use it: faded beyond its
+    /// support.
+    pub fn compensator_arc(&self) -> Option<Arc<dyn Compensator>> {
+        self.stored_compensator
+            .clone()
+            .map(|c| c.into_arc_supported(self.stored_support.clone()))
+    }
+
     /// The method a model file of this result names: the method itself, or
     /// for `auto` the method it chose (`auto: skcm-nn`).
     pub fn model_file_method(&self) -> String {

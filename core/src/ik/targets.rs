@@ -16,6 +16,7 @@
 use super::invalid::TargetError;
 pub use super::solver::TargetFrame;
 use super::solver::{Goal, IkSolution, IkSolver};
+use crate::compensate::Compensation;
 use crate::model::orientation::{rotation_from, rotation_to, OrientationConvention};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -103,6 +104,9 @@ pub struct TargetResult {
     pub false_target: Option<FalseTarget>,
     /// Path mode: the joint jump from the previous solved target above the threshold.
     pub jump: Option<JointJump>,
+    /// How much of the joint maps' and the compensator's correction applies
+    /// at the solution (`None`: the model has neither, or not converged).
+    pub compensation: Option<Compensation>,
 }
 
 impl TargetResult {
@@ -158,12 +162,18 @@ impl IkSolver {
         } else {
             (None, None)
         };
+        let compensation = if solution.converged {
+            self.model().compensation_at(&solution.q)
+        } else {
+            None
+        };
         TargetResult {
             id,
             solution,
             joints_deg,
             false_target,
             jump,
+            compensation,
         }
     }
 

@@ -30,7 +30,10 @@
 //! orientation column of the output convention (the false target
 //! `FK_nominal(q_cmd)` in the controller's base frame),
 //! `position_residual_mm, orientation_residual_rad, iterations, jump_joint,
-//! jump_deg, message`. Fields that do not apply are empty.
+//! jump_deg, message, compensation, warning` (`compensation`: `full`, `faded`
+//! or `none` of the joint maps' and the compensator's correction at the
+//! solution, `warning` naming the joints outside the trained range). Fields
+//! that do not apply are empty.
 
 use super::solver::{IkSolution, IkSolver, SolveOptions};
 use super::targets::{TargetInput, TargetResult};
@@ -286,6 +289,7 @@ impl TargetsCsv {
                     joints_deg: None,
                     false_target: None,
                     jump: None,
+                    compensation: None,
                 },
             })
             .collect()
@@ -313,6 +317,8 @@ pub fn results_header(dof: usize, convention: OrientationConvention) -> Vec<Stri
             "jump_joint",
             "jump_deg",
             "message",
+            "compensation",
+            "warning",
         ]
         .map(String::from),
     );
@@ -385,6 +391,13 @@ pub fn results_csv(
             None => row.extend([String::new(), String::new()]),
         }
         row.push(s.reason.as_ref().map(|x| x.to_string()).unwrap_or_default());
+        match &r.compensation {
+            Some(c) => {
+                row.push(c.label().to_string());
+                row.push(c.warning().unwrap_or_default());
+            }
+            None => row.extend([String::new(), String::new()]),
+        }
         let _ = w.write_record(&row);
     }
     let bytes = w.into_inner().unwrap_or_default();
@@ -478,6 +491,6 @@ mod tests {
                 "false_c"
             ]
         );
-        assert_eq!(h.last().unwrap(), "message");
+        assert_eq!(&h[h.len() - 3..], ["message", "compensation", "warning"]);
     }
 }

@@ -38,6 +38,21 @@ pub enum Coverage {
     Outside,
 }
 
+/// The fade weight of `q` for the range `[lo, hi]` and fade width `w`, and
+/// its derivative: 1 inside, a smoothstep to 0 over `w` on either side (C¹).
+pub fn fade_weight(q: f64, lo: f64, hi: f64, w: f64) -> (f64, f64) {
+    let w = w.max(1e-12);
+    if q < lo {
+        let (s, ds) = smoothstep(1.0 - (lo - q) / w);
+        (s, ds / w)
+    } else if q > hi {
+        let (s, ds) = smoothstep(1.0 - (q - hi) / w);
+        (s, -ds / w)
+    } else {
+        (1.0, 0.0)
+    }
+}
+
 /// `s(x) = 3x² − 2x³` on [0, 1] and its derivative: C¹ at both ends.
 fn smoothstep(x: f64) -> (f64, f64) {
     if x <= 0.0 {
@@ -68,17 +83,7 @@ impl JointMap {
     /// The fade weight `s(q)` and `ds/dq`: 1 inside the range, a smoothstep to
     /// 0 over `fade` on either side.
     pub fn weight(&self, q: f64) -> (f64, f64) {
-        let [lo, hi] = self.range;
-        let w = self.fade.max(1e-12);
-        if q < lo {
-            let (s, ds) = smoothstep(1.0 - (lo - q) / w);
-            (s, ds / w)
-        } else if q > hi {
-            let (s, ds) = smoothstep(1.0 - (q - hi) / w);
-            (s, -ds / w)
-        } else {
-            (1.0, 0.0)
-        }
+        fade_weight(q, self.range[0], self.range[1], self.fade)
     }
 
     /// Where `q` lies with respect to the trained range.
@@ -332,12 +337,14 @@ impl JointMapsDescription {
         }
         let maps = JointMaps { joints };
         maps.validate(dof).map_err(|e| invalid(e.to_string()))?;
-        if let Some(m) = maps.joints.iter().flatten().find(|m| m.harmonics() > MAX_HARMONICS) {
+        if let Some(m) = maps
+            .joints
+            .iter()
+            .flatten()
+            .find(|m| m.harmonics() > MAX_HARMONICS)
+        {
             return Err(invalid(
-                JointMapError::Harmonics {
-                    got: m.harmonics(),
-                }
-                .to_string(),
+                JointMapError::Harmonics { got: m.harmonics() }.to_string(),
             ));
         }
         Ok(maps)

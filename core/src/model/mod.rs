@@ -11,7 +11,8 @@ pub mod robot;
 
 pub use description::{ModelDescription, ModelError};
 pub use joint_maps::{
-    Coverage, JointMap, JointMapDescription, JointMapError, JointMaps, JointMapsDescription,
+    fade_weight, Coverage, JointMap, JointMapDescription, JointMapError, JointMaps,
+    JointMapsDescription,
 };
 pub use params::{ParamId, ParamKind, ParamLayout};
 pub use pose::Pose;

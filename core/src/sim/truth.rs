@@ -53,7 +53,8 @@ pub struct UnmodelledEffects {
     /// end moment, `EI = 1/(link_bending)` per unit length up to a constant).
     /// Rotations are applied from the tip to the base at the deflected
     /// configuration. Example: `2e-8` gives some 0.05 mm on the YS100's upper arm.
-    pub link_bending: f64,    /// Transmission and encoder errors with fine structure, per joint its
+    pub link_bending: f64,
+    /// Transmission and encoder errors with fine structure, per joint its
     /// harmonics of its own angle: joint i gets `Σ A·sin(k·q_i + φ)` (empty:
     /// none). See [`fine_transmission_errors`].
     pub transmission: Vec<Vec<Harmonic>>,
@@ -137,7 +138,7 @@ impl UnmodelledEffects {
         {
             return bad("transmission amplitudes and phases must be finite".into());
         }
-                if !self.hysteresis_rad.is_finite() || !self.link_bending.is_finite() {
+        if !self.hysteresis_rad.is_finite() || !self.link_bending.is_finite() {
             return bad("hysteresis_rad and link_bending must be finite".into());
         }
         Ok(())

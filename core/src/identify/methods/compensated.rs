@@ -29,7 +29,8 @@
 use super::run::{AppliedCompensator, Cache, Context, Outcome};
 use super::{Compensated, Method, MethodError, MethodFailure, Network};
 use crate::compensate::{
-    cross_validate, train, Compensator, CvStats, Sample, StoredCompensator, TrainError, TrainReport,
+    cross_validate, train, Compensator, CvStats, Sample, StoredCompensator, Support, TrainError,
+    TrainReport,
 };
 use crate::identify::least_squares::Fit;
 use crate::identify::report::{predict_compensated, CompensatorSummary, MethodReport, SetErrors};
@@ -40,12 +41,13 @@ use crate::model::RobotModel;
 use crate::stats::ErrorStats;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use std::sync::Arc;
 
 /// A trained compensator with its training report and cross-validation.
 #[derive(Clone)]
 pub(crate) struct Trained {
     pub stored: StoredCompensator,
+    /// Where it was trained: its correction fades to zero beyond it.
+    pub support: Support,
     pub report: TrainReport,
     pub cv: Option<CvStats>,
 }
@@ -108,7 +110,7 @@ pub(crate) fn train_network(
             let s = stage;
             stage += 1;
             let (c, _) = train(&spec, part, &mut rng, &mut |e, l| progress(s, e, l))?;
-            Ok::<_, TrainError>(c.into_arc() as Arc<dyn Compensator>)
+            Ok::<_, TrainError>(c.into_arc_supported(Some(support_of(part))))
         })
         .map_err(train_error)?;
         Some(cv)
@@ -118,8 +120,22 @@ pub(crate) fn train_network(
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let (stored, report) =
         train(&spec, &data, &mut rng, &mut |e, l| progress(folds, e, l)).map_err(train_error)?;
-    Ok(Trained { stored, report, cv })
+    Ok(Trained {
+        stored,
+        support: support_of(&data),
+        report,
+        cv,
+    })
 }
+
+/// The support of training samples, with the joint maps' fade width.
+fn support_of(samples: &[Sample]) -> Support {
+    let qs: Vec<&[f64]> = samples.iter().map(|s| s.q.as_slice()).collect();
+    Support::of(&qs, SUPPORT_FADE_RAD)
+}
+
+/// Width of a compensator's fade beyond its trained joint ranges [rad] (5°).
+pub(crate) const SUPPORT_FADE_RAD: f64 = 5.0 * std::f64::consts::PI / 180.0;
 
 /// A compensator method: its base (from the cache), then its compensator.
 /// `progress(fraction, iteration, loss)` with `fraction` in [0, 1].
@@ -207,7 +223,10 @@ pub(crate) fn compensate_report(
     valid: &[Measurement],
 ) {
     let trained = &applied.trained;
-    let arc = trained.stored.clone().into_arc();
+    let arc = trained
+        .stored
+        .clone()
+        .into_arc_supported(Some(trained.support.clone()));
     let c: Option<&dyn Compensator> = Some(arc.as_ref());
     let model = report.calibrated.clone();
     let base_identification = report.identification.stats.clone();
@@ -244,6 +263,7 @@ pub(crate) fn compensate_report(
         base_training,
     });
     report.stored_compensator = Some(trained.stored.clone());
+    report.stored_support = Some(trained.support.clone());
 }
 
 /// Error statistics of the base alone on the pool [mm] (the residual norms).

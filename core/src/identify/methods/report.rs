@@ -151,6 +151,7 @@ impl Context<'_> {
             joint_maps: maps.map(|m| JointMapsSummary::of(&m, &fitted.model)),
             calibrated: fitted.model,
             stored_compensator: None,
+            stored_support: None,
         })
     }
 }
