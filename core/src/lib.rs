@@ -7,6 +7,7 @@
 //! async runtime or the file system. `csv_text` reads the CSV texts of
 //! measurement and target files for both.
 
+pub mod cell;
 pub mod compensate;
 pub mod csv_text;
 pub mod export;
