@@ -127,12 +127,18 @@ fn matches(name: &str, number: Option<u32>, r: &CellRef) -> bool {
 }
 
 impl Cell {
-    /// The tool named or numbered `r`.
-    pub fn tool(&self, r: &CellRef) -> Result<&Tool, CellError> {
-        self.tools
-            .iter()
-            .find(|t| matches(&t.name, t.number, r))
-            .ok_or_else(|| CellError::UnknownTool(r.clone()))
+    /// The tool named or numbered `r`; number 0 is the bare flange when the
+    /// cell does not define it.
+    pub fn tool(&self, r: &CellRef) -> Result<Tool, CellError> {
+        match self.tools.iter().find(|t| matches(&t.name, t.number, r)) {
+            Some(t) => Ok(t.clone()),
+            None if *r == CellRef::Number(0) => Ok(Tool {
+                name: "flange".into(),
+                number: Some(0),
+                tcp: Pose::identity(),
+            }),
+            None => Err(CellError::UnknownTool(r.clone())),
+        }
     }
 
     /// The work object named or numbered `r`; number 0 is the base frame when

@@ -1,0 +1,157 @@
+//! Robot programs: find every Cartesian target of a program, and rewrite it
+//! as its false target for its tool and work object ("filter program").
+//!
+//! One module per language parses the files into [`Site`]s: where a target's
+//! values are (byte ranges), its pose in its work object, its configuration
+//! flags, tool and work object. [`filter`] solves each on the calibrated
+//! model (`cell`) and rewrites only those values; every other byte stays.
+//! A target that cannot be solved stays as it was, marked with a comment in
+//! the language, and the report says why.
+//!
+//! Units: the programs' own (KRL: mm and degrees, A,B,C = `Rz(A)·Ry(B)·Rx(C)`);
+//! SI (m, rad) in [`Site::pose`].
+
+pub mod krl;
+mod rewrite;
+
+pub use rewrite::{filter, FilterOutput, FilterReport, TargetReport, TargetStatus};
+
+use crate::cell::CellRef;
+use crate::ik::{Configuration, Elbow, Shoulder};
+use crate::model::orientation::OrientationConvention;
+use crate::model::Pose;
+use serde::{Deserialize, Serialize};
+use std::ops::Range;
+
+/// The program languages.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Language {
+    /// KUKA KRL: `.src` and `.dat` files.
+    Krl,
+}
+
+/// One file of a program.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ProgramFile {
+    pub name: String,
+    pub text: String,
+}
+
+/// A program that cannot be parsed: where and why.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, thiserror::Error)]
+#[error("{file}:{line}:{column}: {message}")]
+pub struct ParseError {
+    pub file: String,
+    /// 1-based.
+    pub line: usize,
+    /// 1-based, in characters.
+    pub column: usize,
+    pub message: String,
+}
+
+/// The tool or work object a target is taught with.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub enum FrameSpec {
+    /// By the controller's number or name (looked up in the cell).
+    Ref(CellRef),
+    /// Given in the program itself (flange → TCP, or base → work object) [m].
+    Inline(Pose),
+    /// The program does not say.
+    Unset,
+}
+
+/// Configuration flags of a target as the program writes them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum Flags {
+    /// None given: the controller takes the solution nearest its current joints.
+    Nearest,
+    /// KUKA status `S` (bit 0 overhead, bit 1 elbow, bit 2 A5 < 0) and turn
+    /// `T` (bit i: axis i+1 < 0), each optional.
+    Kuka { s: Option<u32>, t: Option<u32> },
+}
+
+impl Flags {
+    /// Whether controller joints `q_deg` of configuration `c` carry these flags.
+    pub fn admits(&self, q_deg: &[f64], c: Option<Configuration>) -> bool {
+        match *self {
+            Flags::Nearest => true,
+            Flags::Kuka { s, t } => {
+                let s_ok = s.is_none_or(|s| c.is_some_and(|c| kuka_status(q_deg, c) == s & 7));
+                let t_ok = t.is_none_or(|t| kuka_turn(q_deg) == t & 63);
+                s_ok && t_ok
+            }
+        }
+    }
+}
+
+/// KUKA status bits of controller joints `q_deg` in configuration `c`.
+pub fn kuka_status(q_deg: &[f64], c: Configuration) -> u32 {
+    u32::from(c.shoulder == Shoulder::Back)
+        | u32::from(c.elbow == Elbow::Down) << 1
+        | u32::from(q_deg.get(4).is_some_and(|a5| *a5 < 0.0)) << 2
+}
+
+/// KUKA turn bits of controller joints `q_deg`: bit i set when axis i+1 < 0.
+pub fn kuka_turn(q_deg: &[f64]) -> u32 {
+    q_deg
+        .iter()
+        .take(6)
+        .enumerate()
+        .map(|(i, q)| u32::from(*q < 0.0) << i)
+        .sum()
+}
+
+/// One Cartesian target found in a program.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Site {
+    /// Index of the file in the program.
+    pub file: usize,
+    /// 1-based line of the target.
+    pub line: usize,
+    /// The point's name, or `inline`.
+    pub name: String,
+    /// TCP pose in the work object [m] (None: the program gives no complete pose).
+    pub pose: Option<Pose>,
+    pub flags: Flags,
+    pub tool: FrameSpec,
+    pub work_object: FrameSpec,
+    /// Byte ranges of x, y, z and the orientation values, in `convention` order.
+    pub slots: Vec<Range<usize>>,
+    pub convention: OrientationConvention,
+    /// Program length unit in metres (1e-3 for mm).
+    pub unit_m: f64,
+    /// Decimals written for lengths and for orientation values.
+    pub decimals: [usize; 2],
+    /// Byte offset of the end of the target's line (where a mark goes).
+    pub line_end: usize,
+    /// Why the target is not filtered even though it is a Cartesian target
+    /// (a relative motion, an incomplete aggregate, ...).
+    pub skip: Option<String>,
+}
+
+/// A parsed program: its targets.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Program {
+    pub language: Language,
+    pub sites: Vec<Site>,
+}
+
+/// Parses a program's files.
+pub fn parse(language: Language, files: &[ProgramFile]) -> Result<Program, ParseError> {
+    let sites = match language {
+        Language::Krl => krl::parse(files)?,
+    };
+    Ok(Program { language, sites })
+}
+
+/// The comment that marks a target left unchanged, in the language's syntax.
+pub fn mark(language: Language, reason: &str) -> String {
+    let reason: String = reason
+        .chars()
+        .map(|c| if c.is_control() { ' ' } else { c })
+        .collect();
+    match language {
+        Language::Krl => format!(" ; robocal: not filtered: {reason}"),
+    }
+}
