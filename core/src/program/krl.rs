@@ -325,10 +325,6 @@ struct Context {
     base: FrameSpec,
 }
 
-fn spec_eq(a: &FrameSpec, b: &FrameSpec) -> bool {
-    a == b
-}
-
 /// A declared point and the contexts of the motions that use it.
 struct Declared {
     site: Site,
@@ -579,12 +575,11 @@ impl Parser<'_> {
                     break;
                 }
             }
-            for (t, r) in &toks {
+            for (t, _) in &toks {
                 let Tok::Agg(a) = t else { continue };
                 let a = shift(a, line.start);
                 let kind = classify(&a, &file.text, 0);
                 let skip = relative.then(|| "relative motion".to_string());
-                let _ = r;
                 if let Some(site) = site_of(fi, &line, "inline", kind, &ctx, skip) {
                     self.order.push(Ok(site));
                 }
@@ -625,9 +620,10 @@ impl Parser<'_> {
                         Some((_, ctx)) => {
                             site.tool = ctx.tool.clone();
                             site.work_object = ctx.base.clone();
-                            let other = d.uses.iter().find(|(_, c)| {
-                                !spec_eq(&c.tool, &ctx.tool) || !spec_eq(&c.base, &ctx.base)
-                            });
+                            let other = d
+                                .uses
+                                .iter()
+                                .find(|(_, c)| c.tool != ctx.tool || c.base != ctx.base);
                             if let Some((line, _)) = other {
                                 site.skip.get_or_insert(format!(
                                     "used with different tools or bases (lines {} and {line})",
@@ -674,8 +670,8 @@ pub fn parse(files: &[ProgramFile]) -> Result<Vec<Site>, ParseError> {
     for fi in 0..files.len() {
         p.declarations(fi)?;
     }
-    for fi in 0..files.len() {
-        if has_ext(&files[fi].name, "src") {
+    for (fi, f) in files.iter().enumerate() {
+        if has_ext(&f.name, "src") {
             p.statements(fi)?;
         }
     }

@@ -74,12 +74,45 @@ pub enum Flags {
 impl Flags {
     /// Whether controller joints `q_deg` of configuration `c` carry these flags.
     pub fn admits(&self, q_deg: &[f64], c: Option<Configuration>) -> bool {
+        self.mismatch(q_deg, c).is_none()
+    }
+
+    /// Which flag controller joints `q_deg` of configuration `c` do not carry.
+    pub fn mismatch(&self, q_deg: &[f64], c: Option<Configuration>) -> Option<String> {
         match *self {
-            Flags::Nearest => true,
+            Flags::Nearest => None,
             Flags::Kuka { s, t } => {
-                let s_ok = s.is_none_or(|s| c.is_some_and(|c| kuka_status(q_deg, c) == s & 7));
-                let t_ok = t.is_none_or(|t| kuka_turn(q_deg) == t & 63);
-                s_ok && t_ok
+                if let Some(s) = s {
+                    match c.map(|c| kuka_status(q_deg, c)) {
+                        None => return Some("no configuration to compare S with".into()),
+                        Some(got) if got != s & 7 => {
+                            return Some(format!("status S would be {got}, the program has {s}"))
+                        }
+                        _ => {}
+                    }
+                }
+                let got = kuka_turn(q_deg);
+                match t {
+                    Some(t) if got != t & 63 => {
+                        let axis = (0..6).find(|i| (got ^ t) >> i & 1 == 1).unwrap_or(0) + 1;
+                        Some(format!(
+                            "turn T would be {got}, the program has {t} (A{axis} changes sign)"
+                        ))
+                    }
+                    _ => None,
+                }
+            }
+        }
+    }
+}
+
+impl std::fmt::Display for Flags {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Flags::Nearest => f.write_str("(none)"),
+            Flags::Kuka { s, t } => {
+                let show = |v: &Option<u32>| v.map_or("-".to_string(), |v| v.to_string());
+                write!(f, "S {} T {}", show(s), show(t))
             }
         }
     }

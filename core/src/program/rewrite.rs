@@ -7,9 +7,10 @@
 //! the calibrated solve runs in that branch from that seed; its flags must be
 //! the program's (turn flags kept), else the target is left unchanged.
 
-use super::{mark, parse, FrameSpec, Language, ParseError, ProgramFile, Site};
-use crate::cell::{Cell, CellOptions, CellSolver, WorkObject, WorkObjectFrame};
+use super::{mark, parse, Flags, FrameSpec, Language, ParseError, ProgramFile, Site};
+use crate::cell::{Cell, CellOptions, CellSolution, CellSolver, WorkObject, WorkObjectFrame};
 use crate::compensate::CompensatedModel;
+use crate::ik::Configuration;
 use crate::ik::IkSettings;
 use crate::model::orientation::rotation_to;
 use crate::model::Pose;
@@ -211,11 +212,27 @@ fn solve_site(
     };
     let solver = &solvers[index].1;
     let q_nominal = controller_joints(solver, site, &wobj, &pose, previous);
-    let options = CellOptions {
-        branch: q_nominal.as_deref().and_then(|q| solver.configuration(q)),
-        seed: q_nominal.or_else(|| previous.map(<[f64]>::to_vec)),
+    let solved = match q_nominal {
+        Some(q) => solver.solve(
+            &wobj,
+            &pose,
+            &CellOptions {
+                branch: solver.configuration(&q),
+                seed: Some(q),
+            },
+        ),
+        // The nominal model has no solution on the flags (out of its reach or
+        // limits): the branch whose calibrated solution carries them.
+        None if site.flags == Flags::Nearest => solver.solve(
+            &wobj,
+            &pose,
+            &CellOptions {
+                branch: None,
+                seed: previous.map(<[f64]>::to_vec),
+            },
+        ),
+        None => solve_on_flags(solver, site, &wobj, &pose, previous)?,
     };
-    let solved = solver.solve(&wobj, &pose, &options);
     let Some(false_target) = solved.false_target else {
         let reason = solved
             .solution
@@ -226,8 +243,11 @@ fn solve_site(
     let s = solver.solver();
     let q = solved.solution.q;
     let configuration = s.configuration(&q);
-    if !site.flags.admits(&s.controller_degrees(&q), configuration) {
-        return Err("the calibrated solution has other configuration flags".into());
+    if let Some(m) = site
+        .flags
+        .mismatch(&s.controller_degrees(&q), configuration)
+    {
+        return Err(format!("the calibrated solution changes the flags: {m}"));
     }
     Ok(Solved {
         shift_m: (false_target.p - pose.p).norm(),
@@ -235,6 +255,38 @@ fn solve_site(
         false_target,
         q,
     })
+}
+
+/// The first branch whose calibrated solution carries the site's flags.
+fn solve_on_flags(
+    solver: &CellSolver,
+    site: &Site,
+    wobj: &WorkObject,
+    pose: &Pose,
+    previous: Option<&[f64]>,
+) -> Result<CellSolution, String> {
+    for branch in Configuration::all() {
+        let s = solver.solve(
+            wobj,
+            pose,
+            &CellOptions {
+                branch: Some(branch),
+                seed: previous.map(<[f64]>::to_vec),
+            },
+        );
+        let q = &s.solution.q;
+        if s.solution.converged
+            && site
+                .flags
+                .admits(&solver.solver().controller_degrees(q), Some(branch))
+        {
+            return Ok(s);
+        }
+    }
+    Err(format!(
+        "no solution within the joint limits carries the program's flags {}",
+        site.flags
+    ))
 }
 
 /// The new values of a site's slots for `pose`.
