@@ -379,7 +379,8 @@ fn site_of(
         convention: OrientationConvention::KukaAbc,
         unit_m: 1e-3,
         decimals: [4, 4],
-        line_end: line.end,
+        mark_at: line.end..line.end,
+        after_joints: None,
         skip,
     })
 }

@@ -12,6 +12,8 @@
 //! SI (m, rad) in [`Site::pose`].
 
 pub mod krl;
+mod lex;
+pub mod rapid;
 mod rewrite;
 
 pub use rewrite::{filter, FilterOutput, FilterReport, TargetReport, TargetStatus};
@@ -29,6 +31,8 @@ use std::ops::Range;
 pub enum Language {
     /// KUKA KRL: `.src` and `.dat` files.
     Krl,
+    /// ABB RAPID modules.
+    Rapid,
 }
 
 /// One file of a program.
@@ -69,6 +73,9 @@ pub enum Flags {
     /// KUKA status `S` (bit 0 overhead, bit 1 elbow, bit 2 A5 < 0) and turn
     /// `T` (bit i: axis i+1 < 0), each optional.
     Kuka { s: Option<u32>, t: Option<u32> },
+    /// ABB `[cf1, cf4, cf6, cfx]`: quadrants `⌊A/90°⌋` of axes 1, 4, 6 and
+    /// `cfx = 4·back + 2·down + [A5 < 0]`.
+    Abb { cf: [i32; 4] },
 }
 
 impl Flags {
@@ -102,6 +109,14 @@ impl Flags {
                     _ => None,
                 }
             }
+            Flags::Abb { cf } => {
+                let Some(c) = c else {
+                    return Some("no configuration to compare cfx with".into());
+                };
+                let got = abb_cf(q_deg, c);
+                (got != cf)
+                    .then(|| format!("[cf1,cf4,cf6,cfx] would be {got:?}, the program has {cf:?}"))
+            }
         }
     }
 }
@@ -114,6 +129,7 @@ impl std::fmt::Display for Flags {
                 let show = |v: &Option<u32>| v.map_or("-".to_string(), |v| v.to_string());
                 write!(f, "S {} T {}", show(s), show(t))
             }
+            Flags::Abb { cf } => write!(f, "{cf:?}"),
         }
     }
 }
@@ -123,6 +139,15 @@ pub fn kuka_status(q_deg: &[f64], c: Configuration) -> u32 {
     u32::from(c.shoulder == Shoulder::Back)
         | u32::from(c.elbow == Elbow::Down) << 1
         | u32::from(q_deg.get(4).is_some_and(|a5| *a5 < 0.0)) << 2
+}
+
+/// ABB `[cf1, cf4, cf6, cfx]` of controller joints `q_deg` in configuration `c`.
+pub fn abb_cf(q_deg: &[f64], c: Configuration) -> [i32; 4] {
+    let quadrant = |k: usize| q_deg.get(k).map_or(0, |a| (a / 90.0).floor() as i32);
+    let cfx = 4 * i32::from(c.shoulder == Shoulder::Back)
+        + 2 * i32::from(c.elbow == Elbow::Down)
+        + i32::from(q_deg.get(4).is_some_and(|a5| *a5 < 0.0));
+    [quadrant(0), quadrant(3), quadrant(5), cfx]
 }
 
 /// KUKA turn bits of controller joints `q_deg`: bit i set when axis i+1 < 0.
@@ -156,11 +181,23 @@ pub struct Site {
     pub unit_m: f64,
     /// Decimals written for lengths and for orientation values.
     pub decimals: [usize; 2],
-    /// Byte offset of the end of the target's line (where a mark goes).
-    pub line_end: usize,
+    /// Bytes the mark of an unsolved target replaces (empty: an insertion),
+    /// in the same file.
+    pub mark_at: Range<usize>,
+    /// The controller joints [deg] of the joint move just before this target,
+    /// if any (where the controller starts from).
+    pub after_joints: Option<Vec<f64>>,
     /// Why the target is not filtered even though it is a Cartesian target
     /// (a relative motion, an incomplete aggregate, ...).
     pub skip: Option<String>,
+}
+
+impl Site {
+    /// `self` with `skip` (a reason already set is kept).
+    pub fn with_skip(mut self, skip: Option<String>) -> Self {
+        self.skip = self.skip.or(skip);
+        self
+    }
 }
 
 /// A parsed program: its targets.
@@ -174,6 +211,7 @@ pub struct Program {
 pub fn parse(language: Language, files: &[ProgramFile]) -> Result<Program, ParseError> {
     let sites = match language {
         Language::Krl => krl::parse(files)?,
+        Language::Rapid => rapid::parse(files)?,
     };
     Ok(Program { language, sites })
 }
@@ -186,5 +224,6 @@ pub fn mark(language: Language, reason: &str) -> String {
         .collect();
     match language {
         Language::Krl => format!(" ; robocal: not filtered: {reason}"),
+        Language::Rapid => format!(" ! robocal: not filtered: {reason}"),
     }
 }

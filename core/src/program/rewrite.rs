@@ -109,7 +109,7 @@ pub fn filter(
                 previous = Some(done.q);
             }
             Err(reason) => {
-                edits[site.file].push((site.line_end..site.line_end, mark(language, &reason)));
+                edits[site.file].push((site.mark_at.clone(), mark(language, &reason)));
                 report.status = TargetStatus::Failed;
                 report.reason = Some(reason);
             }

@@ -7,6 +7,7 @@
 //! production TCP to the targets.
 
 mod krl;
+mod rapid;
 
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
@@ -15,7 +16,7 @@ use robocal_core::cell::{Cell, Tool, WorkObject, WorkObjectFrame};
 use robocal_core::compensate::CompensatedModel;
 use robocal_core::identify::pose_selection::choose_d_optimal;
 use robocal_core::identify::{calibrate, CalibrationOptions, Method};
-use robocal_core::ik::{AnalyticIk, IkSettings};
+use robocal_core::ik::{AnalyticIk, Configuration, IkSettings};
 use robocal_core::measure;
 use robocal_core::model::orientation::fixed_xyz_angles;
 use robocal_core::model::pose::rpy_matrix;
@@ -154,6 +155,19 @@ impl Fixture {
         self.wobj_cell
             .inverse()
             .compose(&self.true_tcp(&self.joints[i]))
+    }
+
+    /// Controller joints [deg] and configuration of target `i` (what an OLP writes flags from).
+    pub fn flag_input(&self, i: usize) -> (Vec<f64>, Configuration) {
+        let q = &self.joints[i];
+        let deg = self
+            .controller
+            .joints_to_controller(q)
+            .iter()
+            .map(|v| v.to_degrees())
+            .collect();
+        let ik = AnalyticIk::new(&self.controller).unwrap();
+        (deg, ik.configuration(q).unwrap())
     }
 
     /// The controller's frame of the work object (its base frame, from the registration).

@@ -51,7 +51,7 @@ fn targets_flags_tools_and_bases() {
     let text = &files[1].text;
     let values: Vec<&str> = p1.slots.iter().map(|r| &text[r.clone()]).collect();
     assert_eq!(values, ["1200.5", "-30", "900", "10", "20", "30"]);
-    assert_eq!(&text[p1.line_end..p1.line_end + 2], "\r\n");
+    assert_eq!(&text[p1.mark_at.start..p1.mark_at.start + 2], "\r\n");
     // FDAT_ACT selects tool 3, base 2; no S/T: the nearest solution.
     assert_eq!(sites[1].tool, FrameSpec::Ref(CellRef::Number(3)));
     assert_eq!(sites[1].flags, Flags::Nearest);
