@@ -11,6 +11,7 @@
 //! Units: the programs' own (KRL: mm and degrees, A,B,C = `Rz(A)·Ry(B)·Rx(C)`);
 //! SI (m, rad) in [`Site::pose`].
 
+pub mod fanuc;
 pub mod krl;
 mod lex;
 pub mod rapid;
@@ -33,6 +34,8 @@ pub enum Language {
     Krl,
     /// ABB RAPID modules.
     Rapid,
+    /// Fanuc TP programs, ASCII `.ls`.
+    Fanuc,
 }
 
 /// One file of a program.
@@ -76,6 +79,14 @@ pub enum Flags {
     /// ABB `[cf1, cf4, cf6, cfx]`: quadrants `⌊A/90°⌋` of axes 1, 4, 6 and
     /// `cfx = 4·back + 2·down + [A5 < 0]`.
     Abb { cf: [i32; 4] },
+    /// Fanuc `CONFIG : 'F|N U|D T|B, t1, t4, t6'`: axis 5 < 0, elbow up,
+    /// wrist centre in front, turn numbers `⌊(A + 180°)/360°⌋` of axes 1, 4, 6.
+    Fanuc {
+        flip: bool,
+        up: bool,
+        front: bool,
+        turns: [i32; 3],
+    },
 }
 
 impl Flags {
@@ -109,6 +120,19 @@ impl Flags {
                     _ => None,
                 }
             }
+            Flags::Fanuc { .. } => {
+                let Some(c) = c else {
+                    return Some("no configuration to compare CONFIG with".into());
+                };
+                let got = fanuc_config(q_deg, c);
+                (got != *self).then(|| {
+                    format!(
+                        "CONFIG would be {}, the program has {}",
+                        fanuc_config_text(&got),
+                        fanuc_config_text(self)
+                    )
+                })
+            }
             Flags::Abb { cf } => {
                 let Some(c) = c else {
                     return Some("no configuration to compare cfx with".into());
@@ -130,6 +154,7 @@ impl std::fmt::Display for Flags {
                 write!(f, "S {} T {}", show(s), show(t))
             }
             Flags::Abb { cf } => write!(f, "{cf:?}"),
+            Flags::Fanuc { .. } => f.write_str(&fanuc_config_text(self)),
         }
     }
 }
@@ -148,6 +173,42 @@ pub fn abb_cf(q_deg: &[f64], c: Configuration) -> [i32; 4] {
         + 2 * i32::from(c.elbow == Elbow::Down)
         + i32::from(q_deg.get(4).is_some_and(|a5| *a5 < 0.0));
     [quadrant(0), quadrant(3), quadrant(5), cfx]
+}
+
+/// Fanuc configuration of controller joints `q_deg` in configuration `c`.
+pub fn fanuc_config(q_deg: &[f64], c: Configuration) -> Flags {
+    let turn = |k: usize| {
+        q_deg
+            .get(k)
+            .map_or(0, |a| ((a + 180.0) / 360.0).floor() as i32)
+    };
+    Flags::Fanuc {
+        flip: q_deg.get(4).is_some_and(|a5| *a5 < 0.0),
+        up: c.elbow == Elbow::Up,
+        front: c.shoulder == Shoulder::Front,
+        turns: [turn(0), turn(3), turn(5)],
+    }
+}
+
+/// `N U T, 0, 0, 0` (without quotes) of Fanuc flags; empty for other flags.
+pub fn fanuc_config_text(flags: &Flags) -> String {
+    match flags {
+        Flags::Fanuc {
+            flip,
+            up,
+            front,
+            turns,
+        } => format!(
+            "{} {} {}, {}, {}, {}",
+            if *flip { 'F' } else { 'N' },
+            if *up { 'U' } else { 'D' },
+            if *front { 'T' } else { 'B' },
+            turns[0],
+            turns[1],
+            turns[2]
+        ),
+        _ => String::new(),
+    }
 }
 
 /// KUKA turn bits of controller joints `q_deg`: bit i set when axis i+1 < 0.
@@ -212,6 +273,7 @@ pub fn parse(language: Language, files: &[ProgramFile]) -> Result<Program, Parse
     let sites = match language {
         Language::Krl => krl::parse(files)?,
         Language::Rapid => rapid::parse(files)?,
+        Language::Fanuc => fanuc::parse(files)?,
     };
     Ok(Program { language, sites })
 }
@@ -225,5 +287,6 @@ pub fn mark(language: Language, reason: &str) -> String {
     match language {
         Language::Krl => format!(" ; robocal: not filtered: {reason}"),
         Language::Rapid => format!(" ! robocal: not filtered: {reason}"),
+        Language::Fanuc => fanuc::MARK.to_string(),
     }
 }

@@ -10,8 +10,8 @@
 use super::{mark, parse, Flags, FrameSpec, Language, ParseError, ProgramFile, Site};
 use crate::cell::{Cell, CellOptions, CellSolution, CellSolver, WorkObject, WorkObjectFrame};
 use crate::compensate::CompensatedModel;
-use crate::ik::Configuration;
 use crate::ik::IkSettings;
+use crate::ik::{Configuration, FailureReason};
 use crate::model::orientation::rotation_to;
 use crate::model::Pose;
 use serde::Serialize;
@@ -265,6 +265,8 @@ fn solve_on_flags(
     pose: &Pose,
     previous: Option<&[f64]>,
 ) -> Result<CellSolution, String> {
+    let mut failure: Option<String> = None;
+    let mut converged = false;
     for branch in Configuration::all() {
         let s = solver.solve(
             wobj,
@@ -275,6 +277,7 @@ fn solve_on_flags(
             },
         );
         let q = &s.solution.q;
+        converged |= s.solution.converged;
         if s.solution.converged
             && site
                 .flags
@@ -282,11 +285,19 @@ fn solve_on_flags(
         {
             return Ok(s);
         }
+        if let (None, Some(r)) = (&failure, &s.solution.reason) {
+            if !matches!(r, FailureReason::BranchUnavailable { .. }) {
+                failure = Some(r.to_string());
+            }
+        }
     }
-    Err(format!(
-        "no solution within the joint limits carries the program's flags {}",
-        site.flags
-    ))
+    match failure {
+        Some(reason) if !converged => Err(reason),
+        _ => Err(format!(
+            "no solution within the joint limits carries the program's flags {}",
+            site.flags
+        )),
+    }
 }
 
 /// The new values of a site's slots for `pose`.

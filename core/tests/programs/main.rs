@@ -6,6 +6,7 @@
 //! model on the program's configuration flags), brings the true robot's
 //! production TCP to the targets.
 
+mod fanuc;
 mod krl;
 mod rapid;
 
