@@ -185,17 +185,12 @@ fn is(t: Option<&Token>, c: char) -> bool {
     matches!(t, Some((Tok::Punct(p), _)) if *p == c)
 }
 
-/// The element starting at token `i`: a list, a signed number, or anything
-/// up to the next `,` or closing bracket at this depth.
-pub fn value(toks: &[Token], i: usize, close: char) -> Result<(Val, usize), Fail> {
-    let open = toks.get(i).map_or(0, |t| t.1.start);
-    value_at_depth(toks, i, close, 0, open)
-}
-
 /// Deepest nesting of bracket literals read (deeper input is an error, not a stack overflow).
 const MAX_DEPTH: usize = 32;
 
-/// `open`: where the enclosing bracket opens (for the error of a missing close).
+/// The element starting at token `i`: a list, a signed number, or anything
+/// up to the next `,` or closing bracket at this depth; `open`: where the
+/// enclosing bracket opens (for the error of a missing close).
 fn value_at_depth(
     toks: &[Token],
     i: usize,

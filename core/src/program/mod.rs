@@ -16,6 +16,7 @@ pub mod krl;
 mod lex;
 pub mod rapid;
 mod rewrite;
+pub mod urscript;
 
 pub use rewrite::{filter, FilterOutput, FilterReport, TargetReport, TargetStatus};
 
@@ -36,6 +37,9 @@ pub enum Language {
     Rapid,
     /// Fanuc TP programs, ASCII `.ls`.
     Fanuc,
+    /// Universal Robots URScript.
+    #[serde(rename = "urscript")]
+    UrScript,
 }
 
 /// One file of a program.
@@ -274,6 +278,7 @@ pub fn parse(language: Language, files: &[ProgramFile]) -> Result<Program, Parse
         Language::Krl => krl::parse(files)?,
         Language::Rapid => rapid::parse(files)?,
         Language::Fanuc => fanuc::parse(files)?,
+        Language::UrScript => urscript::parse(files)?,
     };
     Ok(Program { language, sites })
 }
@@ -288,5 +293,6 @@ pub fn mark(language: Language, reason: &str) -> String {
         Language::Krl => format!(" ; robocal: not filtered: {reason}"),
         Language::Rapid => format!(" ! robocal: not filtered: {reason}"),
         Language::Fanuc => fanuc::MARK.to_string(),
+        Language::UrScript => format!("  # robocal: not filtered: {reason}"),
     }
 }

@@ -29,8 +29,11 @@ const MOTIONS: [&str; 9] = [
     "movel", "movej", "movec", "moveldo", "movejdo", "movecdo", "triggl", "triggj", "triggc",
 ];
 
-/// A pose from `[[x,y,z],[q1..q4]]` (mm): the pose or why not, and the ranges.
-fn frame(v: &Val) -> Option<(Result<Pose, String>, Vec<Range<usize>>)> {
+/// A pose or why not, and the ranges of its values.
+type Frame = (Result<Pose, String>, Vec<Range<usize>>);
+
+/// A pose from `[[x,y,z],[q1..q4]]` (mm).
+fn frame(v: &Val) -> Option<Frame> {
     let items = v.list()?;
     let (p, mut ranges) = items.first()?.numbers(3)?;
     let (q, qr) = items.get(1)?.numbers(4)?;

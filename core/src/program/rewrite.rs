@@ -94,6 +94,10 @@ pub fn filter(
             targets.push(report);
             continue;
         }
+        if let Some(j) = &site.after_joints {
+            let rad: Vec<f64> = j.iter().map(|v| v.to_radians()).collect();
+            previous = Some(model.nominal.joints_from_controller(&rad));
+        }
         match solve_site(
             site,
             cell,
