@@ -22,6 +22,10 @@
 //!
 //! Units: SI (m, rad) inside; the programs' units are converted by the parsers.
 
+pub mod file;
+
+pub use file::{CellDescription, CellFileError};
+
 use crate::compensate::CompensatedModel;
 use crate::ik::{Configuration, Goal, IkSettings, IkSolution, IkSolver, SolveOptions, TargetFrame};
 use crate::model::orientation::fixed_xyz_angles;

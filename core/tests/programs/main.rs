@@ -6,6 +6,7 @@
 //! model on the program's configuration flags), brings the true robot's
 //! production TCP to the targets.
 
+mod examples;
 mod fanuc;
 mod krl;
 mod rapid;
