@@ -42,6 +42,39 @@ pub enum Language {
     UrScript,
 }
 
+/// A language name that is not one.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown program language `{0}` (use krl, rapid, fanuc or urscript)")]
+pub struct UnknownLanguage(pub String);
+
+impl std::str::FromStr for Language {
+    type Err = UnknownLanguage;
+    fn from_str(s: &str) -> Result<Self, UnknownLanguage> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "krl" | "kuka" => Ok(Language::Krl),
+            "rapid" | "abb" => Ok(Language::Rapid),
+            "fanuc" | "ls" | "tp" => Ok(Language::Fanuc),
+            "urscript" | "ur" | "script" => Ok(Language::UrScript),
+            other => Err(UnknownLanguage(other.to_string())),
+        }
+    }
+}
+
+impl Language {
+    /// The language of a file name by its extension (`.src`/`.dat`,
+    /// `.mod`/`.modx`/`.prg`/`.sys`, `.ls`, `.script`/`.urscript`).
+    pub fn of_file(name: &str) -> Option<Language> {
+        let ext = name.rsplit_once('.')?.1.to_ascii_lowercase();
+        match ext.as_str() {
+            "src" | "dat" => Some(Language::Krl),
+            "mod" | "modx" | "prg" | "sys" => Some(Language::Rapid),
+            "ls" => Some(Language::Fanuc),
+            "script" | "urscript" => Some(Language::UrScript),
+            _ => None,
+        }
+    }
+}
+
 /// One file of a program.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ProgramFile {
