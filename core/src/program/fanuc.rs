@@ -14,7 +14,7 @@
 //! comment, `P[n:"robocal: failed"]`.
 
 use super::lex::{error, position, tokens, Fail, Tok, Token};
-use super::{Flags, FrameSpec, ParseError, ProgramFile, Site};
+use super::{Flags, FrameSpec, JointTarget, ParseError, ProgramFile, Site, Targets};
 use crate::cell::CellRef;
 use crate::model::orientation::{rotation_from, OrientationConvention};
 use crate::model::Pose;
@@ -66,9 +66,16 @@ fn config(text: &str) -> Option<Flags> {
     })
 }
 
-/// One `P[n]{…};` block from token `i` (at `P`); returns the site (if a
-/// Cartesian GP1 position) and the token after the block.
-fn block(fi: usize, text: &str, toks: &[Token], i: usize) -> Result<(Option<Site>, usize), Fail> {
+/// What one `P[n]` block holds for group 1.
+enum Position {
+    Cartesian(Box<Site>),
+    Joint(JointTarget),
+    Neither,
+}
+
+/// One `P[n]{…};` block from token `i` (at `P`); returns its group-1
+/// position and the token after the block.
+fn block(fi: usize, text: &str, toks: &[Token], i: usize) -> Result<(Position, usize), Fail> {
     let at = |k: usize| toks.get(k).map_or(text.len(), |t| t.1.start);
     if !(word(toks.get(i)) == Some("P") && punct(toks.get(i + 1), '[')) {
         return Err((at(i), "expected `P[n]{`".into()));
@@ -95,7 +102,8 @@ fn block(fi: usize, text: &str, toks: &[Token], i: usize) -> Result<(Option<Site
     let mut group = 0;
     let (mut uf, mut ut, mut flags) = (None, None, None);
     let mut values: [Option<(f64, Range<usize>)>; 6] = Default::default();
-    let mut joint = false;
+    let mut joint: [Option<f64>; 6] = [None; 6];
+    let mut any_joint = false;
     loop {
         let Some((t, r)) = toks.get(k) else {
             return Err((at(i), format!("{name} is not closed by `}};`")));
@@ -165,7 +173,13 @@ fn block(fi: usize, text: &str, toks: &[Token], i: usize) -> Result<(Option<Site
                     match "XYZWPR".find(key.as_str()).filter(|_| key.len() == 1) {
                         Some(idx) => values[idx] = Some((sign * v, slot)),
                         None if key.starts_with('J') || key.starts_with('E') => {
-                            joint |= key.starts_with('J')
+                            let axis = key.strip_prefix('J').and_then(|n| n.parse::<usize>().ok());
+                            if let Some(n) = axis {
+                                any_joint = true;
+                                if (1..=6).contains(&n) {
+                                    joint[n - 1] = Some(sign * v);
+                                }
+                            }
                         }
                         None => return Err((r.start, format!("unknown component {w}"))),
                     }
@@ -175,10 +189,21 @@ fn block(fi: usize, text: &str, toks: &[Token], i: usize) -> Result<(Option<Site
             _ => return Err((r.start, "unexpected text in the position".into())),
         }
     }
-    if joint || values.iter().all(Option::is_none) {
-        return Ok((None, k));
-    }
     let line = position(text, toks[i].1.start).0;
+    if any_joint {
+        let deg: Option<Vec<f64>> = joint.iter().copied().collect();
+        let found = deg.map_or(Position::Neither, |deg| {
+            Position::Joint(JointTarget {
+                file: fi,
+                line,
+                deg,
+            })
+        });
+        return Ok((found, k));
+    }
+    if values.iter().all(Option::is_none) {
+        return Ok((Position::Neither, k));
+    }
     let complete: Option<Vec<(f64, Range<usize>)>> = values.iter().cloned().collect();
     let (pose, slots, skip) = match complete {
         Some(v) => {
@@ -199,7 +224,7 @@ fn block(fi: usize, text: &str, toks: &[Token], i: usize) -> Result<(Option<Site
     };
     let spec = |v: Option<u32>| v.map_or(FrameSpec::Unset, |n| FrameSpec::Ref(CellRef::Number(n)));
     Ok((
-        Some(Site {
+        Position::Cartesian(Box::new(Site {
             file: fi,
             line,
             name,
@@ -214,14 +239,14 @@ fn block(fi: usize, text: &str, toks: &[Token], i: usize) -> Result<(Option<Site
             mark_at,
             after_joints: None,
             skip,
-        }),
+        })),
         k,
     ))
 }
 
 /// Parses `.ls` files: the Cartesian positions of their `/POS` sections.
-pub fn parse(files: &[ProgramFile]) -> Result<Vec<Site>, ParseError> {
-    let mut sites = Vec::new();
+pub fn parse(files: &[ProgramFile]) -> Result<Targets, ParseError> {
+    let mut found = Targets::default();
     for (fi, f) in files.iter().enumerate() {
         let text = f.text.as_str();
         let Some(pos) = section(text, "/POS") else {
@@ -239,11 +264,15 @@ pub fn parse(files: &[ProgramFile]) -> Result<Vec<Site>, ParseError> {
         while i < toks.len() {
             let (site, next) =
                 block(fi, text, &toks, i).map_err(|(at, m)| error(&f.name, text, (at, m)))?;
-            sites.extend(site);
+            match site {
+                Position::Cartesian(s) => found.sites.push(*s),
+                Position::Joint(j) => found.joints.push(j),
+                Position::Neither => {}
+            }
             i = next;
         }
     }
-    Ok(sites)
+    Ok(found)
 }
 
 /// Byte offset of a line that starts with `name` (a section header).

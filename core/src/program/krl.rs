@@ -14,7 +14,7 @@
 //!
 //! Units: mm and degrees, `R = Rz(A)·Ry(B)·Rx(C)`. `S` and `T` are kept.
 
-use super::{Flags, FrameSpec, ParseError, ProgramFile, Site};
+use super::{Flags, FrameSpec, JointTarget, ParseError, ProgramFile, Site, Targets};
 use crate::cell::CellRef;
 use crate::model::orientation::{rotation_from, OrientationConvention};
 use crate::model::Pose;
@@ -311,6 +311,17 @@ fn classify(agg: &Agg, text: &str, offset: usize) -> Kind {
     Kind::Cartesian { pose, flags, slots }
 }
 
+/// The axis values `A1..A6` of a joint aggregate [deg] (ranges relative to `code`).
+fn joint_values(agg: &Agg, code: &str) -> Option<Vec<f64>> {
+    ["A1", "A2", "A3", "A4", "A5", "A6"]
+        .iter()
+        .map(|k| {
+            let (_, r) = agg.items.iter().find(|(key, _)| key == k)?;
+            real(code.get(r.clone())?)
+        })
+        .collect()
+}
+
 /// A frame aggregate `{X, Y, Z, A, B, C}` as a pose [m].
 fn frame_of(agg: &Agg, text: &str, offset: usize) -> Option<Pose> {
     match classify(agg, text, offset) {
@@ -340,6 +351,7 @@ struct Parser<'a> {
     bases: HashMap<u32, Pose>,
     /// Sites in execution order; `Err(i)` is declared point `i` at its first use.
     order: Vec<Result<Site, usize>>,
+    joints: Vec<JointTarget>,
 }
 
 fn err(file: &ProgramFile, line: &Line, at: usize, message: String) -> ParseError {
@@ -411,6 +423,17 @@ impl Parser<'_> {
         for line in lines(&file.text) {
             let code = code_of(line.text).map_err(|(at, m)| err(file, &line, at, m))?;
             let toks = tokens(code).map_err(|(at, m)| err(file, &line, at, m))?;
+            for (t, _) in &toks {
+                if let Tok::Agg(a) = t {
+                    if let Some(deg) = joint_values(a, code) {
+                        self.joints.push(JointTarget {
+                            file: fi,
+                            line: line.no,
+                            deg,
+                        });
+                    }
+                }
+            }
             let words: Vec<&str> = toks
                 .iter()
                 .map(|(t, _)| match t {
@@ -599,14 +622,15 @@ impl Parser<'_> {
         self.declared[i].uses.push((line, ctx.clone()));
     }
 
-    fn finish(mut self) -> Vec<Site> {
+    fn finish(mut self) -> Targets {
         for (i, d) in self.declared.iter().enumerate() {
             if d.uses.is_empty() {
                 self.order.push(Err(i));
             }
         }
         let declared = std::mem::take(&mut self.declared);
-        self.order
+        let order = std::mem::take(&mut self.order);
+        let sites = order
             .into_iter()
             .map(|s| match s {
                 Ok(site) => site,
@@ -636,7 +660,11 @@ impl Parser<'_> {
                     site
                 }
             })
-            .collect()
+            .collect();
+        Targets {
+            sites,
+            joints: self.joints,
+        }
     }
 }
 
@@ -658,7 +686,7 @@ fn has_ext(name: &str, ext: &str) -> bool {
 }
 
 /// Parses a KRL program (`.src` and `.dat` files; other files are read as data lists).
-pub fn parse(files: &[ProgramFile]) -> Result<Vec<Site>, ParseError> {
+pub fn parse(files: &[ProgramFile]) -> Result<Targets, ParseError> {
     let mut p = Parser {
         files,
         declared: Vec::new(),
@@ -667,6 +695,7 @@ pub fn parse(files: &[ProgramFile]) -> Result<Vec<Site>, ParseError> {
         tools: HashMap::new(),
         bases: HashMap::new(),
         order: Vec::new(),
+        joints: Vec::new(),
     };
     for fi in 0..files.len() {
         p.declarations(fi)?;

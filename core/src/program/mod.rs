@@ -11,6 +11,7 @@
 //! Units: the programs' own (KRL: mm and degrees, A,B,C = `Rz(A)·Ry(B)·Rx(C)`);
 //! SI (m, rad) in [`Site::pose`].
 
+pub mod export;
 pub mod fanuc;
 pub mod krl;
 mod lex;
@@ -298,22 +299,45 @@ impl Site {
     }
 }
 
+/// A joint target of a program, in the controller's convention.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct JointTarget {
+    pub file: usize,
+    /// 1-based.
+    pub line: usize,
+    /// Axis values [deg].
+    pub deg: Vec<f64>,
+}
+
+/// What a parser finds: the Cartesian targets (in the order the program
+/// runs them) and the joint targets (in file order).
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
+pub struct Targets {
+    pub sites: Vec<Site>,
+    pub joints: Vec<JointTarget>,
+}
+
 /// A parsed program: its targets.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Program {
     pub language: Language,
     pub sites: Vec<Site>,
+    pub joints: Vec<JointTarget>,
 }
 
 /// Parses a program's files.
 pub fn parse(language: Language, files: &[ProgramFile]) -> Result<Program, ParseError> {
-    let sites = match language {
+    let found = match language {
         Language::Krl => krl::parse(files)?,
         Language::Rapid => rapid::parse(files)?,
         Language::Fanuc => fanuc::parse(files)?,
         Language::UrScript => urscript::parse(files)?,
     };
-    Ok(Program { language, sites })
+    Ok(Program {
+        language,
+        sites: found.sites,
+        joints: found.joints,
+    })
 }
 
 /// The comment that marks a target left unchanged, in the language's syntax.

@@ -17,7 +17,7 @@
 //! negative). All four are kept.
 
 use super::lex::{blank_comments, error, line_end, list, tokens, Fail, Tok, Token, Val};
-use super::{Flags, FrameSpec, ParseError, ProgramFile, Site};
+use super::{Flags, FrameSpec, JointTarget, ParseError, ProgramFile, Site, Targets};
 use crate::cell::CellRef;
 use crate::model::orientation::{rotation_from, OrientationConvention};
 use crate::model::Pose;
@@ -138,6 +138,7 @@ struct Parser<'a> {
     declared: Vec<Declared>,
     by_name: HashMap<String, Vec<usize>>,
     order: Vec<Result<Site, usize>>,
+    joints: Vec<JointTarget>,
 }
 
 fn statements(toks: &[Token]) -> impl Iterator<Item = &[Token]> {
@@ -234,6 +235,7 @@ impl Parser<'_> {
                         });
                     }
                 }
+                "jointtarget" => self.joint(fi, &v),
                 "tooldata" => {
                     let tool = v.list().and_then(|i| i.get(1)).and_then(frame);
                     let robhold = v
@@ -291,6 +293,18 @@ impl Parser<'_> {
         Ok(())
     }
 
+    /// A jointtarget literal `[[j1..j6],[eax]]` [deg].
+    fn joint(&mut self, fi: usize, v: &Val) {
+        if let Some((deg, _)) = v.list().and_then(|i| i.first()).and_then(|j| j.numbers(6)) {
+            let line = super::lex::position(&self.files[fi].text, v.range().start).0;
+            self.joints.push(JointTarget {
+                file: fi,
+                line,
+                deg,
+            });
+        }
+    }
+
     fn text_of(&self, fi: usize, v: &Val) -> String {
         self.masked[fi][v.range()].trim().to_string()
     }
@@ -314,6 +328,16 @@ impl Parser<'_> {
     fn motions(&mut self, fi: usize) -> Result<(), Fail> {
         let toks = std::mem::take(&mut self.toks[fi]);
         for st in statements(&toks) {
+            if let Some(m) = st
+                .iter()
+                .position(|t| word(Some(t)).is_some_and(|w| w.eq_ignore_ascii_case("moveabsj")))
+            {
+                if st.get(m + 1).is_some_and(|t| t.0 == Tok::Punct('[')) {
+                    let (v, _) = list(st, m + 1)?;
+                    self.joint(fi, &v);
+                }
+                continue;
+            }
             // After whatever has no `;` (PROC headers, THEN, DO, …).
             let Some(m) = st.iter().position(|t| {
                 word(Some(t)).is_some_and(|w| MOTIONS.contains(&w.to_ascii_lowercase().as_str()))
@@ -381,7 +405,7 @@ impl Parser<'_> {
         }
     }
 
-    fn finish(self) -> Vec<Site> {
+    fn finish(self) -> Targets {
         let declared = self.declared;
         let mut order = self.order;
         for (i, d) in declared.iter().enumerate() {
@@ -389,7 +413,7 @@ impl Parser<'_> {
                 order.push(Err(i));
             }
         }
-        order
+        let sites = order
             .into_iter()
             .map(|s| match s {
                 Ok(site) => site,
@@ -412,12 +436,16 @@ impl Parser<'_> {
                     site
                 }
             })
-            .collect()
+            .collect();
+        Targets {
+            sites,
+            joints: self.joints,
+        }
     }
 }
 
 /// Parses RAPID modules.
-pub fn parse(files: &[ProgramFile]) -> Result<Vec<Site>, ParseError> {
+pub fn parse(files: &[ProgramFile]) -> Result<Targets, ParseError> {
     let mut masked = Vec::with_capacity(files.len());
     let mut toks = Vec::with_capacity(files.len());
     for f in files {
@@ -434,6 +462,7 @@ pub fn parse(files: &[ProgramFile]) -> Result<Vec<Site>, ParseError> {
         declared: Vec::new(),
         by_name: HashMap::new(),
         order: Vec::new(),
+        joints: Vec::new(),
     };
     for (fi, f) in files.iter().enumerate() {
         p.declarations(fi).map_err(|e| error(&f.name, &f.text, e))?;

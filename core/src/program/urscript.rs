@@ -16,7 +16,7 @@
 //! current joints.
 
 use super::lex::{blank_comments, error, line_end, list, position, tokens, Fail, Tok, Token};
-use super::{Flags, FrameSpec, ParseError, ProgramFile, Site};
+use super::{Flags, FrameSpec, JointTarget, ParseError, ProgramFile, Site, Targets};
 use crate::cell::CellRef;
 use crate::model::orientation::{rotation_from, OrientationConvention};
 use crate::model::Pose;
@@ -91,6 +91,7 @@ struct Parser<'a> {
     declared: Vec<Declared>,
     order: Vec<Result<Site, usize>>,
     joints: Option<Vec<f64>>,
+    joint_targets: Vec<JointTarget>,
 }
 
 impl Parser<'_> {
@@ -180,7 +181,13 @@ impl Parser<'_> {
             // A joint target: where the controller starts the next target from.
             let (v, _) = list(&self.toks, i)?;
             if let Some((q, _)) = v.numbers(6) {
-                self.joints = Some(q.iter().map(|r| r.to_degrees()).collect());
+                let deg: Vec<f64> = q.iter().map(|r| r.to_degrees()).collect();
+                self.joint_targets.push(JointTarget {
+                    file: self.file,
+                    line: position(self.text, v.range().start).0,
+                    deg: deg.clone(),
+                });
+                self.joints = Some(deg);
             }
         }
         Ok(())
@@ -231,9 +238,10 @@ impl Parser<'_> {
         Ok(())
     }
 
-    fn finish(self) -> Vec<Site> {
+    fn finish(self) -> Targets {
         let declared = self.declared;
-        self.order
+        let sites = self
+            .order
             .into_iter()
             .map(|s| match s {
                 Ok(site) => site,
@@ -252,13 +260,17 @@ impl Parser<'_> {
                     site
                 }
             })
-            .collect()
+            .collect();
+        Targets {
+            sites,
+            joints: self.joint_targets,
+        }
     }
 }
 
 /// Parses URScript files.
-pub fn parse(files: &[ProgramFile]) -> Result<Vec<Site>, ParseError> {
-    let mut sites = Vec::new();
+pub fn parse(files: &[ProgramFile]) -> Result<Targets, ParseError> {
+    let mut found = Targets::default();
     for (fi, f) in files.iter().enumerate() {
         let fail = |e: Fail| error(&f.name, &f.text, e);
         let masked = blank_comments(&f.text, '#', &['"', '\'']).map_err(fail)?;
@@ -271,11 +283,14 @@ pub fn parse(files: &[ProgramFile]) -> Result<Vec<Site>, ParseError> {
             declared: Vec::new(),
             order: Vec::new(),
             joints: None,
+            joint_targets: Vec::new(),
         };
         p.run().map_err(fail)?;
-        sites.extend(p.finish());
+        let t = p.finish();
+        found.sites.extend(t.sites);
+        found.joints.extend(t.joints);
     }
-    Ok(sites)
+    Ok(found)
 }
 
 #[cfg(test)]

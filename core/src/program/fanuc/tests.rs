@@ -8,7 +8,7 @@ fn cartesian_positions_with_frames_and_config() {
         name: "seam.ls".into(),
         text: LS.into(),
     };
-    let sites = parse(std::slice::from_ref(&f)).unwrap();
+    let sites = parse(std::slice::from_ref(&f)).unwrap().sites;
     assert_eq!(sites.len(), 1);
     let p = &sites[0];
     assert_eq!((p.name.as_str(), p.line), ("P[1]", 10));

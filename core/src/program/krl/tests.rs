@@ -29,7 +29,7 @@ END\n";
 #[test]
 fn targets_flags_tools_and_bases() {
     let files = [file("demo.src", SRC), file("demo.dat", DAT)];
-    let sites = parse(&files).unwrap();
+    let sites = parse(&files).unwrap().sites;
     let names: Vec<&str> = sites.iter().map(|s| s.name.as_str()).collect();
     assert_eq!(names, ["XP1", "inline", "inline", "inline", "XUNUSED"]);
     let p1 = &sites[0];
@@ -66,7 +66,9 @@ fn a_point_used_with_two_tools_is_skipped_and_program_frames_win() {
     let dat =
         "DECL POS P={X 1,Y 2,Z 3,A 0,B 0,C 0,S 6}\nTOOL_DATA[4]={X 0,Y 0,Z 250,A 0,B 30,C 0}\n";
     let src = "BAS(#TOOL, 4)\nPTP P\n$TOOL=$NULLFRAME\nLIN P\n";
-    let sites = parse(&[file("a.src", src), file("a.dat", dat)]).unwrap();
+    let sites = parse(&[file("a.src", src), file("a.dat", dat)])
+        .unwrap()
+        .sites;
     assert_eq!(sites.len(), 1);
     assert!(sites[0].skip.as_ref().unwrap().contains("lines 2 and 4"));
     let FrameSpec::Inline(tool) = &sites[0].tool else {

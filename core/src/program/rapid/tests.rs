@@ -27,7 +27,7 @@ ENDMODULE\n";
 #[test]
 fn robtargets_tools_and_work_objects() {
     let f = file(MODULE);
-    let sites = parse(std::slice::from_ref(&f)).unwrap();
+    let sites = parse(std::slice::from_ref(&f)).unwrap().sites;
     let names: Vec<&str> = sites.iter().map(|s| s.name.as_str()).collect();
     assert_eq!(names, ["p10", "inline", "path{1}", "path{2}"]);
     let p10 = &sites[0];

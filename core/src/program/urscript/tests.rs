@@ -11,7 +11,7 @@ fn targets_tools_and_frames() {
         name: "seam.script".into(),
         text: SCRIPT.into(),
     };
-    let sites = parse(std::slice::from_ref(&f)).unwrap();
+    let sites = parse(std::slice::from_ref(&f)).unwrap().sites;
     let names: Vec<&str> = sites.iter().map(|s| s.name.as_str()).collect();
     assert_eq!(names, ["start", "inline", "inline", "inline"]);
     let s = &sites[0];
