@@ -7,7 +7,9 @@
 #   scripts/fuzz.sh [SECONDS_PER_TARGET]     (default 60)
 #
 # Targets (fuzz/fuzz_targets/): measurement_csv, targets_csv, model_json,
-# solve_request. Each run starts from the seeds in fuzz/seeds/<target>/ with a
+# solve_request and the program parsers program_krl, program_rapid,
+# program_fanuc, program_urscript (with the filter).
+# Each run starts from the seeds in fuzz/seeds/<target>/ with a
 # fixed libFuzzer seed and writes new inputs to a temporary corpus, so the
 # repository is not changed. A crash leaves its input in
 # fuzz/artifacts/<target>/ and fails the script; turn it into a regression
@@ -22,7 +24,8 @@ fi
 cd fuzz
 cargo fuzz build --sanitizer none
 status=0
-for target in measurement_csv targets_csv model_json solve_request; do
+for target in measurement_csv targets_csv model_json solve_request \
+    program_krl program_rapid program_fanuc program_urscript; do
     corpus=$(mktemp -d)
     log=$(mktemp)
     code=0

@@ -7,6 +7,7 @@
 //! async runtime or the file system. `csv_text` reads the CSV texts of
 //! measurement and target files for both.
 
+pub mod cell;
 pub mod compensate;
 pub mod csv_text;
 pub mod export;
@@ -16,6 +17,7 @@ pub mod kinematics;
 pub mod measure;
 pub mod model;
 pub mod optim;
+pub mod program;
 pub mod sim;
 pub mod stats;
 pub mod study;

@@ -1,4 +1,4 @@
-//! The `robocal` command line: simulate, calibrate, demo, solve, serve, bench.
+//! The `robocal` command line: simulate, calibrate, demo, solve, filter, serve, bench.
 
 use clap::{Parser, Subcommand};
 
@@ -6,6 +6,7 @@ pub mod bench;
 pub mod calibrate;
 pub mod demo;
 pub mod export;
+pub mod filter;
 pub mod model_files;
 pub mod progress;
 pub mod serve;
@@ -35,6 +36,8 @@ pub enum Command {
     Solve(solve::SolveArgs),
     /// Export the (calibrated) geometric model: URDF, standard/modified DH CSV, JSON.
     Export(export::ExportArgs),
+    /// Filter robot programs (KRL, RAPID, Fanuc, URScript): targets become false targets.
+    Filter(filter::FilterArgs),
     /// Run the HTTP service.
     Serve(serve::ServeArgs),
     /// Time robocal's side of the peer benchmark (KM, IK), as JSON.
@@ -49,6 +52,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Demo(a) => demo::run(a),
         Command::Solve(a) => solve::run(a),
         Command::Export(a) => export::run(a),
+        Command::Filter(a) => filter::run(a),
         Command::Serve(a) => serve::run(a),
         Command::Bench(a) => bench::run(a),
     }

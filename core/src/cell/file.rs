@@ -1,0 +1,114 @@
+//! The cell file: tools and work objects in boundary units (mm, degrees; the
+//! rotation `Rz(rz)·Ry(ry)·Rx(rx)` of `rpy_deg = [rx, ry, rz]`, as a model
+//! file's tool).
+
+use super::{Cell, Tool, WorkObject, WorkObjectFrame};
+use crate::model::pose::rpy_matrix;
+use crate::model::Pose;
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+/// A pose in boundary units.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PoseMmDeg {
+    pub xyz_mm: [f64; 3],
+    #[serde(default)]
+    pub rpy_deg: [f64; 3],
+}
+
+impl PoseMmDeg {
+    fn to_pose(&self, what: &str) -> Result<Pose, CellFileError> {
+        if !self
+            .xyz_mm
+            .iter()
+            .chain(&self.rpy_deg)
+            .all(|v| v.is_finite())
+        {
+            return Err(CellFileError::NotFinite(what.to_string()));
+        }
+        let [rx, ry, rz] = self.rpy_deg.map(f64::to_radians);
+        Ok(Pose::new(
+            rpy_matrix(rx, ry, rz),
+            Vector3::from(self.xyz_mm) * 1e-3,
+        ))
+    }
+}
+
+/// A tool of the cell file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ToolDescription {
+    pub name: String,
+    #[serde(default)]
+    pub number: Option<u32>,
+    #[serde(flatten)]
+    pub tcp: PoseMmDeg,
+}
+
+/// A work object of the cell file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct WorkObjectDescription {
+    pub name: String,
+    #[serde(default)]
+    pub number: Option<u32>,
+    #[serde(default)]
+    pub frame: WorkObjectFrame,
+    #[serde(flatten)]
+    pub pose: PoseMmDeg,
+}
+
+/// The cell file.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CellDescription {
+    #[serde(default)]
+    pub tools: Vec<ToolDescription>,
+    #[serde(default)]
+    pub work_objects: Vec<WorkObjectDescription>,
+}
+
+/// Why a cell file is not one.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CellFileError {
+    #[error("cell file: {0}")]
+    Json(String),
+    #[error("cell file: {0} has a value that is not finite")]
+    NotFinite(String),
+}
+
+impl CellDescription {
+    /// Parses a cell file's JSON text.
+    pub fn from_json(text: &str) -> Result<Self, CellFileError> {
+        serde_json::from_str(text).map_err(|e| CellFileError::Json(e.to_string()))
+    }
+
+    /// The cell in SI units.
+    pub fn to_cell(&self) -> Result<Cell, CellFileError> {
+        let tools = self
+            .tools
+            .iter()
+            .map(|t| {
+                Ok(Tool {
+                    name: t.name.clone(),
+                    number: t.number,
+                    tcp: t.tcp.to_pose(&format!("tool {}", t.name))?,
+                })
+            })
+            .collect::<Result<_, CellFileError>>()?;
+        let work_objects = self
+            .work_objects
+            .iter()
+            .map(|w| {
+                Ok(WorkObject {
+                    name: w.name.clone(),
+                    number: w.number,
+                    frame: w.frame,
+                    pose: w.pose.to_pose(&format!("work object {}", w.name))?,
+                })
+            })
+            .collect::<Result<_, CellFileError>>()?;
+        Ok(Cell {
+            tools,
+            work_objects,
+        })
+    }
+}

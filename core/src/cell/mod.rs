@@ -1,0 +1,287 @@
+//! The cell around a calibrated robot: production tools on the calibrated
+//! flange, work objects (user frames), and solving a target taught in a work
+//! object for a tool (docs/design.md "Tools, work objects and programs").
+//!
+//! Frames: a [`Tool`] is the TCP pose in the flange frame (the last link's
+//! frame of the model, before the model's own tool). A [`WorkObject`] is a
+//! frame given in the robot base frame (the controller's base frame, taken as
+//! the calibrated model's registered base frame) or in the measurement
+//! (tracker) frame; the controller knows it in its base frame,
+//! [`WorkObject::in_base`]. A program target `T` in a work object `W` means the
+//! TCP pose `W·T` in the base frame. The false target is the nominal model's
+//! pose of the calibrated solution, with the same tool, expressed in `W`:
+//! `W⁻¹·FK_nom(q)·tool`.
+//!
+//! What a tracker measurement of one reflector cannot separate: the reflector
+//! offset absorbs the errors of `d` and of the θ offset of the last joint
+//! (identifiability keeps the tool's z over d6 and its x, y over θ6), so the
+//! calibrated flange carries the nominal d6 and θ6. A production tool on it is
+//! off by the true Δd6 along the last axis and by Δθ6 times the TCP's distance
+//! from that axis. The compensator's residual (a position at the reflector) is
+//! applied unchanged at the production TCP.
+//!
+//! Units: SI (m, rad) inside; the programs' units are converted by the parsers.
+
+pub mod file;
+
+pub use file::{CellDescription, CellFileError};
+
+use crate::compensate::CompensatedModel;
+use crate::ik::{Configuration, Goal, IkSettings, IkSolution, IkSolver, SolveOptions, TargetFrame};
+use crate::model::orientation::fixed_xyz_angles;
+use crate::model::Pose;
+use serde::{Deserialize, Serialize};
+
+/// A production tool: TCP pose in the flange frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Tool {
+    pub name: String,
+    /// The controller's number (KUKA `TOOL_DATA[n]`, Fanuc `UT`), if any.
+    #[serde(default)]
+    pub number: Option<u32>,
+    /// Flange → TCP [m].
+    pub tcp: Pose,
+}
+
+/// In which frame a work object's pose is given.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum WorkObjectFrame {
+    /// The robot (controller) base frame.
+    #[default]
+    Base,
+    /// The measurement (tracker) frame of the calibration.
+    Measurement,
+}
+
+/// A work object / user frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct WorkObject {
+    pub name: String,
+    /// The controller's number (KUKA `BASE_DATA[n]`, Fanuc `UF`), if any.
+    #[serde(default)]
+    pub number: Option<u32>,
+    #[serde(default)]
+    pub frame: WorkObjectFrame,
+    /// Frame → work object [m].
+    pub pose: Pose,
+}
+
+impl WorkObject {
+    /// The robot base frame itself.
+    pub fn base() -> Self {
+        WorkObject {
+            name: "base".into(),
+            number: Some(0),
+            frame: WorkObjectFrame::Base,
+            pose: Pose::identity(),
+        }
+    }
+
+    /// The work object in the robot base frame: `base_from_cell·pose` for a
+    /// measurement-frame work object.
+    pub fn in_base(&self, model: &CompensatedModel) -> Pose {
+        match self.frame {
+            WorkObjectFrame::Base => self.pose,
+            WorkObjectFrame::Measurement => model.cell_to_base(&self.pose),
+        }
+    }
+}
+
+/// A name or a controller number of a tool or work object.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum CellRef {
+    Number(u32),
+    Name(String),
+}
+
+impl std::fmt::Display for CellRef {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            CellRef::Number(n) => write!(f, "#{n}"),
+            CellRef::Name(s) => f.write_str(s),
+        }
+    }
+}
+
+/// The tools and work objects of one robot.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct Cell {
+    #[serde(default)]
+    pub tools: Vec<Tool>,
+    #[serde(default)]
+    pub work_objects: Vec<WorkObject>,
+}
+
+/// Why a tool or work object cannot be found.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum CellError {
+    #[error("no tool {0} in the cell")]
+    UnknownTool(CellRef),
+    #[error("no work object {0} in the cell")]
+    UnknownWorkObject(CellRef),
+}
+
+fn matches(name: &str, number: Option<u32>, r: &CellRef) -> bool {
+    match r {
+        CellRef::Number(n) => number == Some(*n),
+        CellRef::Name(s) => name.eq_ignore_ascii_case(s),
+    }
+}
+
+impl Cell {
+    /// The tool named or numbered `r`; number 0 is the bare flange when the
+    /// cell does not define it.
+    pub fn tool(&self, r: &CellRef) -> Result<Tool, CellError> {
+        match self.tools.iter().find(|t| matches(&t.name, t.number, r)) {
+            Some(t) => Ok(t.clone()),
+            None if *r == CellRef::Number(0) => Ok(Tool {
+                name: "flange".into(),
+                number: Some(0),
+                tcp: Pose::identity(),
+            }),
+            None => Err(CellError::UnknownTool(r.clone())),
+        }
+    }
+
+    /// The work object named or numbered `r`; number 0 is the base frame when
+    /// the cell does not define it.
+    pub fn work_object(&self, r: &CellRef) -> Result<WorkObject, CellError> {
+        match self
+            .work_objects
+            .iter()
+            .find(|w| matches(&w.name, w.number, r))
+        {
+            Some(w) => Ok(w.clone()),
+            None if *r == CellRef::Number(0) => Ok(WorkObject::base()),
+            None => Err(CellError::UnknownWorkObject(r.clone())),
+        }
+    }
+}
+
+/// `model` with the production tool `tcp` on its calibrated flange and on its
+/// nominal flange (the controller's tool data).
+pub fn with_tool(model: &CompensatedModel, tcp: &Pose) -> CompensatedModel {
+    let tool = crate::model::Tool {
+        p: tcp.p,
+        rpy: fixed_xyz_angles(&tcp.r),
+    };
+    let mut m = model.clone();
+    m.calibrated.tool = tool.clone();
+    m.nominal.tool = tool;
+    m
+}
+
+/// Options of one cell solve.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct CellOptions {
+    /// Required configuration branch.
+    pub branch: Option<Configuration>,
+    /// Joint seed (model convention, rad).
+    pub seed: Option<Vec<f64>>,
+}
+
+/// The calibrated solution of a cell target and its false target.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CellSolution {
+    pub solution: IkSolution,
+    /// `W⁻¹·FK_nom(q)·tool` when converged: what to write in the program.
+    pub false_target: Option<Pose>,
+}
+
+/// A calibrated IK solver for one production tool.
+#[derive(Debug, Clone)]
+pub struct CellSolver {
+    solver: IkSolver,
+    /// The closed form of the nominal model with the tool (the controller's IK).
+    nominal_ik: Option<crate::ik::AnalyticIk>,
+}
+
+impl CellSolver {
+    /// A solver of `model` carrying the tool `tcp` (flange → TCP).
+    pub fn new(model: &CompensatedModel, tcp: &Pose, settings: IkSettings) -> Self {
+        let m = with_tool(model, tcp);
+        CellSolver {
+            nominal_ik: crate::ik::AnalyticIk::new(&m.nominal).ok(),
+            solver: IkSolver::new(m, settings),
+        }
+    }
+
+    /// The underlying solver (model with the tool).
+    pub fn solver(&self) -> &IkSolver {
+        &self.solver
+    }
+
+    /// Solves `target` (pose of the TCP in `wobj`) on the calibrated model.
+    pub fn solve(&self, wobj: &WorkObject, target: &Pose, options: &CellOptions) -> CellSolution {
+        let model = self.solver.model();
+        let w = wobj.in_base(model);
+        let goal = Goal::from(&w.compose(target));
+        let solution = self.solver.solve_goal(
+            &goal,
+            &SolveOptions {
+                frame: TargetFrame::Base,
+                branch: options.branch,
+                seed: options.seed.clone(),
+                ..SolveOptions::default()
+            },
+        );
+        let false_target = if solution.converged {
+            model
+                .false_target(&solution.q)
+                .ok()
+                .map(|p| w.inverse().compose(&p))
+        } else {
+            None
+        };
+        CellSolution {
+            solution,
+            false_target,
+        }
+    }
+
+    /// The nominal controller: closed-form solutions of the nominal model for
+    /// `target` in `wobj` (model convention), every branch and every 2π
+    /// representative of a joint within the limits; empty without a closed form.
+    pub fn nominal_solutions(&self, wobj: &WorkObject, target: &Pose) -> Vec<Vec<f64>> {
+        let Some(ik) = &self.nominal_ik else {
+            return Vec::new();
+        };
+        let model = self.solver.model();
+        let tcp = wobj.in_base(model).compose(target);
+        let limits = self.solver.limits();
+        let mut out: Vec<Vec<f64>> = Vec::new();
+        for s in ik.solve(&tcp, None) {
+            let mut set: Vec<Vec<f64>> = vec![Vec::new()];
+            for (k, q) in s.q.iter().enumerate() {
+                let [lo, hi] = limits[k];
+                let reps: Vec<f64> = [-2.0, -1.0, 0.0, 1.0, 2.0]
+                    .iter()
+                    .map(|t| q + t * std::f64::consts::TAU)
+                    .filter(|v| *v >= lo - 1e-9 && *v <= hi + 1e-9)
+                    .collect();
+                set = set
+                    .into_iter()
+                    .flat_map(|head| {
+                        reps.iter().map(move |v| {
+                            let mut h = head.clone();
+                            h.push(*v);
+                            h
+                        })
+                    })
+                    .collect();
+            }
+            out.extend(set);
+        }
+        out
+    }
+
+    /// Configuration flags of model-convention joints `q`.
+    pub fn configuration(&self, q: &[f64]) -> Option<Configuration> {
+        self.solver.configuration(q)
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,84 @@
+use super::*;
+
+fn file(text: &str) -> ProgramFile {
+    ProgramFile {
+        name: "weld.mod".into(),
+        text: text.into(),
+    }
+}
+
+const MODULE: &str = "MODULE weld\n\
+  PERS tooldata torch:=[TRUE,[[0,0,250],[1,0,0,0]],[2,[0,0,100],[1,0,0,0],0,0,0]];\n\
+  PERS tooldata gun:=[FALSE,[[10,0,250],[0.9659258,0,0.2588190,0]],[2,[0,0,100],[1,0,0,0],0,0,0]];\n\
+  TASK PERS wobjdata table:=[FALSE,TRUE,\"\",[[1500,200,300],[1,0,0,0]],[[0,0,0],[1,0,0,0]]];\n\
+  CONST robtarget p10:=[[100,-20.5,300],[0.7071068,0,0.7071068,0],[0,-1,2,1],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]]; ! start\n\
+  CONST robtarget path{2}:=[[[1,2,3],[1,0,0,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]],\n\
+     [[4,5,6],[1,0,0,0],[0,0,0,4],[9E9,9E9,9E9,9E9,9E9,9E9]]];\n\
+  CONST jointtarget home:=[[0,0,0,0,30,0],[9E9,9E9,9E9,9E9,9E9,9E9]];\n\
+  PROC main()\n\
+    MoveAbsJ home, v1000, fine, tool0;\n\
+    MoveJ p10, v1000, z50, gun\\WObj:=table; ! approach\n\
+    MoveL [[10,20,30],[1,0,0,0],[0,0,0,1],[9E9,9E9,9E9,9E9,9E9,9E9]], v100, fine, gun;\n\
+    MoveC \\Conc, path{1}, path{2}, v100, z1, torch\\WObj:=table;\n\
+    SetDO do1, 1;\n\
+  ENDPROC\n\
+ENDMODULE\n";
+
+#[test]
+fn robtargets_tools_and_work_objects() {
+    let f = file(MODULE);
+    let sites = parse(std::slice::from_ref(&f)).unwrap().sites;
+    let names: Vec<&str> = sites.iter().map(|s| s.name.as_str()).collect();
+    assert_eq!(names, ["p10", "inline", "path{1}", "path{2}"]);
+    let p10 = &sites[0];
+    assert_eq!(p10.line, 5);
+    assert_eq!(p10.flags, Flags::Abb { cf: [0, -1, 2, 1] });
+    let values: Vec<&str> = p10.slots.iter().map(|r| &f.text[r.clone()]).collect();
+    assert_eq!(
+        values,
+        ["100", "-20.5", "300", "0.7071068", "0", "0.7071068", "0"]
+    );
+    let FrameSpec::Inline(gun) = &p10.tool else {
+        panic!("{:?}", p10.tool)
+    };
+    assert!((gun.p - Vector3::new(0.01, 0.0, 0.25)).norm() < 1e-12);
+    let FrameSpec::Inline(table) = &p10.work_object else {
+        panic!()
+    };
+    assert!((table.p - Vector3::new(1.5, 0.2, 0.3)).norm() < 1e-12);
+    assert!(p10.skip.is_none());
+    // The inline target: work object wobj0 (base).
+    assert_eq!(sites[1].work_object, FrameSpec::Ref(CellRef::Number(0)));
+    // A stationary tool is not filtered.
+    assert!(sites[2].skip.as_ref().unwrap().contains("stationary"));
+    assert_eq!(sites[3].line, 7);
+}
+
+#[test]
+fn errors_name_file_line_and_column() {
+    let cases = [
+        (
+            "MODULE m\n  CONST robtarget p:=[[1,2,3],[1,0,0,0],[0,0,0,0]];\nENDMODULE",
+            2,
+            22,
+            "not a robtarget",
+        ),
+        (
+            "MODULE m\n  MoveL [[1,2,3],[1,0,0,0],[0,0,0,0],[9E9], v1, z1, tool0;\nENDMODULE",
+            2,
+            9,
+            "not closed",
+        ),
+        (
+            "MODULE m\n  TPWrite \"abc;\nENDMODULE",
+            2,
+            11,
+            "unterminated",
+        ),
+    ];
+    for (text, line, column, what) in cases {
+        let e = parse(&[file(text)]).unwrap_err();
+        assert_eq!((e.line, e.column), (line, column), "{text}: {e}");
+        assert!(e.message.contains(what), "{}", e.message);
+    }
+}

@@ -1,0 +1,338 @@
+//! The filter: solve every site on the calibrated model for its tool and work
+//! object, on the branch its flags name, and rewrite its values; the report.
+//!
+//! Per target: the nominal controller's solutions (closed form of the nominal
+//! model with the tool) that carry the target's flags give the branch and the
+//! seed (with `Flags::Nearest`, the one nearest the previous target's joints);
+//! the calibrated solve runs in that branch from that seed; its flags must be
+//! the program's (turn flags kept), else the target is left unchanged.
+
+use super::{mark, parse, Flags, FrameSpec, Language, ParseError, ProgramFile, Site};
+use crate::cell::{Cell, CellOptions, CellSolution, CellSolver, WorkObject, WorkObjectFrame};
+use crate::compensate::CompensatedModel;
+use crate::ik::IkSettings;
+use crate::ik::{Configuration, FailureReason};
+use crate::model::orientation::rotation_to;
+use crate::model::Pose;
+use serde::Serialize;
+
+/// What happened to one target.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TargetStatus {
+    /// Replaced by its false target.
+    Filtered,
+    /// Left unchanged and marked: it could not be solved.
+    Failed,
+    /// Left unchanged, not marked: not a target the filter can change (a
+    /// relative motion, a point no motion uses).
+    Skipped,
+}
+
+/// The report line of one target.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TargetReport {
+    pub file: String,
+    /// 1-based.
+    pub line: usize,
+    pub name: String,
+    pub status: TargetStatus,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+    /// Configuration branch of the solution.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub configuration: Option<String>,
+    /// Distance the position moved [mm].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shift_mm: Option<f64>,
+}
+
+/// The per-target report of a filtered program.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FilterReport {
+    pub language: Language,
+    pub filtered: usize,
+    pub failed: usize,
+    pub skipped: usize,
+    pub targets: Vec<TargetReport>,
+}
+
+/// The filtered files (same names and order) and the report.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FilterOutput {
+    pub files: Vec<ProgramFile>,
+    pub report: FilterReport,
+}
+
+/// Filters a program: every Cartesian target becomes its false target on
+/// `model` for its tool and work object (looked up in `cell`).
+pub fn filter(
+    language: Language,
+    files: &[ProgramFile],
+    cell: &Cell,
+    model: &CompensatedModel,
+    settings: &IkSettings,
+) -> Result<FilterOutput, ParseError> {
+    let program = parse(language, files)?;
+    let mut solvers: Vec<(Pose, CellSolver)> = Vec::new();
+    let mut edits: Vec<Vec<(std::ops::Range<usize>, String)>> = vec![Vec::new(); files.len()];
+    let mut targets = Vec::with_capacity(program.sites.len());
+    let mut previous: Option<Vec<f64>> = None;
+    for site in &program.sites {
+        let mut report = TargetReport {
+            file: files[site.file].name.clone(),
+            line: site.line,
+            name: site.name.clone(),
+            status: TargetStatus::Filtered,
+            reason: None,
+            configuration: None,
+            shift_mm: None,
+        };
+        if let Some(why) = &site.skip {
+            report.status = TargetStatus::Skipped;
+            report.reason = Some(why.clone());
+            targets.push(report);
+            continue;
+        }
+        if let Some(j) = &site.after_joints {
+            let rad: Vec<f64> = j.iter().map(|v| v.to_radians()).collect();
+            previous = Some(model.nominal.joints_from_controller(&rad));
+        }
+        match solve_site(
+            site,
+            cell,
+            model,
+            settings,
+            &mut solvers,
+            previous.as_deref(),
+        ) {
+            Ok(done) => {
+                report.configuration = done.configuration;
+                report.shift_mm = Some(done.shift_m * 1e3);
+                edits[site.file].extend(values(site, &done.false_target));
+                previous = Some(done.q);
+            }
+            Err(reason) => {
+                edits[site.file].push((site.mark_at.clone(), mark(language, &reason)));
+                report.status = TargetStatus::Failed;
+                report.reason = Some(reason);
+            }
+        }
+        targets.push(report);
+    }
+    let files = files
+        .iter()
+        .zip(edits)
+        .map(|(f, e)| ProgramFile {
+            name: f.name.clone(),
+            text: apply(&f.text, e),
+        })
+        .collect();
+    let count = |s: TargetStatus| targets.iter().filter(|t| t.status == s).count();
+    Ok(FilterOutput {
+        files,
+        report: FilterReport {
+            language,
+            filtered: count(TargetStatus::Filtered),
+            failed: count(TargetStatus::Failed),
+            skipped: count(TargetStatus::Skipped),
+            targets,
+        },
+    })
+}
+
+struct Solved {
+    q: Vec<f64>,
+    false_target: Pose,
+    configuration: Option<String>,
+    shift_m: f64,
+}
+
+fn resolve_tool(spec: &FrameSpec, cell: &Cell) -> Result<Pose, String> {
+    match spec {
+        FrameSpec::Ref(r) => cell.tool(r).map(|t| t.tcp).map_err(|e| e.to_string()),
+        FrameSpec::Inline(p) => Ok(*p),
+        FrameSpec::Unset => Err("the program selects no tool".into()),
+    }
+}
+
+fn resolve_work_object(spec: &FrameSpec, cell: &Cell) -> Result<WorkObject, String> {
+    match spec {
+        FrameSpec::Ref(r) => cell.work_object(r).map_err(|e| e.to_string()),
+        FrameSpec::Inline(p) => Ok(WorkObject {
+            name: "inline".into(),
+            number: None,
+            frame: WorkObjectFrame::Base,
+            pose: *p,
+        }),
+        FrameSpec::Unset => Ok(WorkObject::base()),
+    }
+}
+
+fn distance(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y).abs()).sum()
+}
+
+/// The nominal controller's joints for a site: its solutions carrying the
+/// site's flags, the one nearest `previous` (model convention, rad).
+pub(crate) fn controller_joints(
+    solver: &CellSolver,
+    site: &Site,
+    wobj: &WorkObject,
+    pose: &Pose,
+    previous: Option<&[f64]>,
+) -> Option<Vec<f64>> {
+    let s = solver.solver();
+    solver
+        .nominal_solutions(wobj, pose)
+        .into_iter()
+        .filter(|q| {
+            site.flags
+                .admits(&s.controller_degrees(q), s.configuration(q))
+        })
+        .min_by(|a, b| match previous {
+            Some(p) => distance(a, p).total_cmp(&distance(b, p)),
+            None => std::cmp::Ordering::Equal,
+        })
+}
+
+fn solve_site(
+    site: &Site,
+    cell: &Cell,
+    model: &CompensatedModel,
+    settings: &IkSettings,
+    solvers: &mut Vec<(Pose, CellSolver)>,
+    previous: Option<&[f64]>,
+) -> Result<Solved, String> {
+    let pose = site.pose.ok_or("the target is not a complete pose")?;
+    let tcp = resolve_tool(&site.tool, cell)?;
+    let wobj = resolve_work_object(&site.work_object, cell)?;
+    let index = match solvers.iter().position(|(p, _)| *p == tcp) {
+        Some(i) => i,
+        None => {
+            solvers.push((tcp, CellSolver::new(model, &tcp, settings.clone())));
+            solvers.len() - 1
+        }
+    };
+    let solver = &solvers[index].1;
+    let q_nominal = controller_joints(solver, site, &wobj, &pose, previous);
+    let solved = match q_nominal {
+        Some(q) => solver.solve(
+            &wobj,
+            &pose,
+            &CellOptions {
+                branch: solver.configuration(&q),
+                seed: Some(q),
+            },
+        ),
+        // The nominal model has no solution on the flags (out of its reach or
+        // limits): the branch whose calibrated solution carries them.
+        None if site.flags == Flags::Nearest => solver.solve(
+            &wobj,
+            &pose,
+            &CellOptions {
+                branch: None,
+                seed: previous.map(<[f64]>::to_vec),
+            },
+        ),
+        None => solve_on_flags(solver, site, &wobj, &pose, previous)?,
+    };
+    let Some(false_target) = solved.false_target else {
+        let reason = solved
+            .solution
+            .reason
+            .map_or_else(|| "not solved".to_string(), |r| r.to_string());
+        return Err(reason);
+    };
+    let s = solver.solver();
+    let q = solved.solution.q;
+    let configuration = s.configuration(&q);
+    if let Some(m) = site
+        .flags
+        .mismatch(&s.controller_degrees(&q), configuration)
+    {
+        return Err(format!("the calibrated solution changes the flags: {m}"));
+    }
+    Ok(Solved {
+        shift_m: (false_target.p - pose.p).norm(),
+        configuration: configuration.map(|c| c.to_string()),
+        false_target,
+        q,
+    })
+}
+
+/// The first branch whose calibrated solution carries the site's flags.
+fn solve_on_flags(
+    solver: &CellSolver,
+    site: &Site,
+    wobj: &WorkObject,
+    pose: &Pose,
+    previous: Option<&[f64]>,
+) -> Result<CellSolution, String> {
+    let mut failure: Option<String> = None;
+    let mut converged = false;
+    for branch in Configuration::all() {
+        let s = solver.solve(
+            wobj,
+            pose,
+            &CellOptions {
+                branch: Some(branch),
+                seed: previous.map(<[f64]>::to_vec),
+            },
+        );
+        let q = &s.solution.q;
+        converged |= s.solution.converged;
+        if s.solution.converged
+            && site
+                .flags
+                .admits(&solver.solver().controller_degrees(q), Some(branch))
+        {
+            return Ok(s);
+        }
+        if let (None, Some(r)) = (&failure, &s.solution.reason) {
+            if !matches!(r, FailureReason::BranchUnavailable { .. }) {
+                failure = Some(r.to_string());
+            }
+        }
+    }
+    match failure {
+        Some(reason) if !converged => Err(reason),
+        _ => Err(format!(
+            "no solution within the joint limits carries the program's flags {}",
+            site.flags
+        )),
+    }
+}
+
+/// The new values of a site's slots for `pose`.
+fn values(site: &Site, pose: &Pose) -> Vec<(std::ops::Range<usize>, String)> {
+    let [dl, da] = site.decimals;
+    let mut text: Vec<String> = pose
+        .p
+        .iter()
+        .map(|v| format!("{:.*}", dl, v / site.unit_m))
+        .collect();
+    text.extend(
+        rotation_to(site.convention, &pose.r)
+            .iter()
+            .map(|v| format!("{:.*}", da, v + 0.0)),
+    );
+    site.slots.iter().cloned().zip(text).collect()
+}
+
+/// Applies non-overlapping edits (replacements and insertions) to `text`.
+fn apply(text: &str, mut edits: Vec<(std::ops::Range<usize>, String)>) -> String {
+    edits.sort_by_key(|(r, _)| (r.start, r.end));
+    let mut out = String::with_capacity(text.len() + 64 * edits.len());
+    let mut at = 0;
+    for (r, s) in edits {
+        if r.start < at {
+            continue; // overlapping (a point edited twice): keep the first
+        }
+        out.push_str(&text[at..r.start]);
+        out.push_str(&s);
+        at = r.end;
+    }
+    out.push_str(&text[at..]);
+    out
+}

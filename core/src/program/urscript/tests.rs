@@ -1,0 +1,57 @@
+use super::*;
+
+const SCRIPT: &str = "def seam():\n  # tool and frame\n  set_tcp(p[0.0, 0.0, 0.25, 0.0, 0.5, 0.0])\n  table = p[1.5, 0.2, 0.3, 0, 0, 0.35]\n  \
+start = p[0.1,0.2,0.3,0,3.14159,0]  # approach\n  movej([0, -1.57, 1.57, 0, 1.57, 0], a=1.4, v=1.05)\n  movej(pose_trans(table, start), a=1.2, v=0.25)\n  \
+movel(p[-0.4,0.1,0.2,0,0,1e-3], a=1.2, v=0.25, r=0.001)\n  movec(pose_trans(fixture, p[0.1,0,0,0,0,0]), p[0.2,0,0,0,0,0], a=1, v=0.1)\n  \
+force_mode(p[0,0,0,0,0,0], [0,0,1,0,0,0], [0,0,10,0,0,0], 2, [0.1,0.1,0.1,0.35,0.35,0.35])\n  set_digital_out(1, True)\nend\n";
+
+#[test]
+fn targets_tools_and_frames() {
+    let f = ProgramFile {
+        name: "seam.script".into(),
+        text: SCRIPT.into(),
+    };
+    let sites = parse(std::slice::from_ref(&f)).unwrap().sites;
+    let names: Vec<&str> = sites.iter().map(|s| s.name.as_str()).collect();
+    assert_eq!(names, ["start", "inline", "inline", "inline"]);
+    let s = &sites[0];
+    assert_eq!(s.line, 5);
+    let values: Vec<&str> = s.slots.iter().map(|r| &SCRIPT[r.clone()]).collect();
+    assert_eq!(values, ["0.1", "0.2", "0.3", "0", "3.14159", "0"]);
+    let FrameSpec::Inline(table) = &s.work_object else {
+        panic!("{:?}", s.work_object)
+    };
+    assert!((table.p - Vector3::new(1.5, 0.2, 0.3)).norm() < 1e-12);
+    let FrameSpec::Inline(tool) = &s.tool else {
+        panic!()
+    };
+    assert!((tool.p.z - 0.25).abs() < 1e-12);
+    assert_eq!(s.after_joints.as_ref().unwrap().len(), 6);
+    assert!((s.after_joints.as_ref().unwrap()[1] + 89.954).abs() < 1e-2);
+    assert_eq!(&SCRIPT[s.mark_at.start..s.mark_at.start + 1], "\n");
+    assert_eq!(sites[1].work_object, FrameSpec::Unset);
+    assert_eq!(sites[1].slots.len(), 6);
+    assert_eq!(
+        sites[2].work_object,
+        FrameSpec::Ref(CellRef::Name("fixture".into()))
+    );
+    assert_eq!(sites[3].work_object, FrameSpec::Unset);
+}
+
+#[test]
+fn errors_name_file_line_and_column() {
+    let cases = [
+        ("movel(p[1,2,3], a=1)\n", 1, 8, "six numbers"),
+        ("x = 1\nmovel(p[1,2,3,4,5,6, a=1)\n", 2, 8, "not closed"),
+        ("textmsg(\"abc)\n", 1, 9, "unterminated"),
+    ];
+    for (text, line, column, what) in cases {
+        let f = ProgramFile {
+            name: "p.script".into(),
+            text: text.into(),
+        };
+        let e = parse(&[f]).unwrap_err();
+        assert_eq!((e.line, e.column), (line, column), "{text}: {e}");
+        assert!(e.message.contains(what), "{}", e.message);
+    }
+}

@@ -1,0 +1,152 @@
+//! KUKA KRL: a `.src` with its `.dat`, 50 targets declared and inline.
+
+use super::*;
+use robocal_core::model::orientation::{rotation_to, OrientationConvention};
+use robocal_core::program::{filter, kuka_status, kuka_turn, TargetStatus};
+
+/// A KRL program visiting the fixture's 50 targets: even ones declared in the
+/// `.dat` and moved to by `PTP`, odd ones inline in `LIN`, with logic and
+/// comments between them.
+fn program(f: &Fixture) -> Vec<ProgramFile> {
+    let ik = AnalyticIk::new(&f.controller).unwrap();
+    let mut src = String::from(
+        "&ACCESS RVP\r\nDEF seam()\r\n; welding seam, taught on the table\r\n\
+         INI\r\nPTP {A1 0,A2 90,A3 -20,A4 0,A5 45,A6 0} ; home\r\n\
+         $TOOL = TOOL_DATA[1] ; torch\r\nBAS(#BASE, 2)\r\n$VEL.CP = 0.2\r\n",
+    );
+    let mut dat = String::from("&ACCESS RVP\r\nDEFDAT seam\r\n");
+    for (i, q) in f.joints.iter().enumerate() {
+        let t = f.target(i);
+        let abc = rotation_to(OrientationConvention::KukaAbc, &t.r);
+        let deg: Vec<f64> = f
+            .controller
+            .joints_to_controller(q)
+            .iter()
+            .map(|v| v.to_degrees())
+            .collect();
+        let s = kuka_status(&deg, ik.configuration(q).unwrap());
+        let agg = format!(
+            "{{X {:.4},Y {:.4},Z {:.4},A {:.4},B {:.4},C {:.4},S {s},T {}",
+            t.p.x * 1e3,
+            t.p.y * 1e3,
+            t.p.z * 1e3,
+            abc[0],
+            abc[1],
+            abc[2],
+            kuka_turn(&deg)
+        );
+        if i % 2 == 0 {
+            src.push_str(&format!("PTP XP{i} C_PTP\r\n"));
+            dat.push_str(&format!("DECL E6POS XP{i}={agg},E1 0.0,E2 0.0}}\r\n"));
+        } else {
+            src.push_str(&format!("LIN {agg}}} C_DIS ; seam point {i}\r\n"));
+            src.push_str("$OUT[3] = TRUE\r\nWAIT SEC 0.2\r\n");
+        }
+    }
+    src.push_str("PTP {A1 0,A2 90,A3 -20,A4 0,A5 45,A6 0}\r\nEND\r\n");
+    dat.push_str("ENDDAT\r\n");
+    vec![
+        ProgramFile {
+            name: "seam.src".into(),
+            text: src,
+        },
+        ProgramFile {
+            name: "seam.dat".into(),
+            text: dat,
+        },
+    ]
+}
+
+#[test]
+fn filtered_krl_brings_the_true_tcp_to_the_targets() {
+    let f = fixture();
+    let files = program(f);
+    let out = filter(Language::Krl, &files, &f.cell, &f.model, &settings()).unwrap();
+    let r = &out.report;
+    assert_eq!(
+        (r.filtered, r.failed, r.skipped),
+        (50, 0, 0),
+        "{:?}",
+        r.targets
+    );
+    assert!(r.targets.iter().all(|t| t.status == TargetStatus::Filtered));
+    // The sites come in the order the program runs them: the truth in that order.
+    let truth: Vec<Pose> = (0..50).map(|i| f.target(i)).collect();
+    let (filtered, n) = mean(&f.run(Language::Krl, &out.files, &truth));
+    let (nominal, n0) = mean(&f.run(Language::Krl, &files, &truth));
+    eprintln!("KRL: true TCP from the targets, mean: filtered {filtered:.4} mm ({n}), unfiltered {nominal:.3} mm ({n0})");
+    assert_eq!(n, 50);
+    assert!(filtered < 0.03, "filtered {filtered} mm");
+    assert!(nominal > 1.0, "unfiltered {nominal} mm");
+    assert_only_targets_changed(Language::Krl, &files, &out.files);
+}
+
+#[test]
+fn krl_without_targets_is_byte_identical_and_failures_are_marked() {
+    let f = fixture();
+    let logic = ProgramFile {
+        name: "io.src".into(),
+        text: "DEF io()\n; no Cartesian target\nPTP {A1 10,A2 90,A3 -20,A4 0,A5 45,A6 0}\n\
+               $OUT[1]=TRUE\nWAIT FOR $IN[2]\nEND\n"
+            .into(),
+    };
+    let out = filter(
+        Language::Krl,
+        std::slice::from_ref(&logic),
+        &f.cell,
+        &f.model,
+        &settings(),
+    )
+    .unwrap();
+    assert_eq!(out.files[0], logic);
+    assert!(out.report.targets.is_empty());
+
+    // Out of reach, an unknown tool: unchanged but for the mark, reported with line and reason.
+    let text = "DEF bad()\n$TOOL=TOOL_DATA[1]\n$BASE=BASE_DATA[2]\n\
+                LIN {X 9000,Y 0,Z 0,A 0,B 0,C 0} ; far\n$TOOL=TOOL_DATA[7]\n\
+                LIN {X 100,Y 0,Z 0,A 0,B 0,C 0}\nEND\n";
+    let file = ProgramFile {
+        name: "bad.src".into(),
+        text: text.into(),
+    };
+    let out = filter(Language::Krl, &[file], &f.cell, &f.model, &settings()).unwrap();
+    let t = &out.report.targets;
+    assert_eq!((t[0].line, t[0].status), (4, TargetStatus::Failed));
+    assert!(
+        t[0].reason.as_ref().unwrap().contains("reach"),
+        "{:?}",
+        t[0].reason
+    );
+    assert_eq!((t[1].line, t[1].status), (6, TargetStatus::Failed));
+    assert!(t[1].reason.as_ref().unwrap().contains("no tool #7"));
+    let lines: Vec<&str> = out.files[0].text.lines().collect();
+    assert!(
+        lines[3].starts_with("LIN {X 9000,Y 0,Z 0,A 0,B 0,C 0} ; far ; robocal: not filtered: ")
+    );
+    assert_eq!(
+        lines[5],
+        format!(
+            "LIN {{X 100,Y 0,Z 0,A 0,B 0,C 0}} ; robocal: not filtered: {}",
+            t[1].reason.as_ref().unwrap()
+        )
+    );
+    let rest: Vec<&str> = text.lines().collect();
+    for i in [0, 1, 2, 4, 6] {
+        assert_eq!(lines[i], rest[i]);
+    }
+}
+
+#[test]
+fn an_unparsable_krl_program_fails_with_file_line_and_column() {
+    let f = fixture();
+    let file = ProgramFile {
+        name: "broken.src".into(),
+        text: "DEF broken()\n  LIN {X 1,Y 2,Z\nEND\n".into(),
+    };
+    let e = filter(Language::Krl, &[file], &f.cell, &f.model, &settings()).unwrap_err();
+    assert_eq!((e.file.as_str(), e.line, e.column), ("broken.src", 2, 7));
+    assert_eq!(
+        e.to_string(),
+        "broken.src:2:7: aggregate not closed on its line"
+    );
+}

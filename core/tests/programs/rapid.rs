@@ -1,0 +1,131 @@
+//! ABB RAPID: a module with tooldata, wobjdata and 50 robtargets, declared and inline.
+
+use super::*;
+use robocal_core::model::orientation::{rotation_to, OrientationConvention};
+use robocal_core::program::{abb_cf, filter, TargetStatus};
+
+fn literal(p: &Pose, cf: [i32; 4]) -> String {
+    let q = rotation_to(OrientationConvention::AbbQ1q4, &p.r);
+    format!(
+        "[[{:.4},{:.4},{:.4}],[{:.9},{:.9},{:.9},{:.9}],[{},{},{},{}],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]]",
+        p.p.x * 1e3,
+        p.p.y * 1e3,
+        p.p.z * 1e3,
+        q[0],
+        q[1],
+        q[2],
+        q[3],
+        cf[0],
+        cf[1],
+        cf[2],
+        cf[3]
+    )
+}
+
+fn frame(p: &Pose) -> String {
+    let q = rotation_to(OrientationConvention::AbbQ1q4, &p.r);
+    format!(
+        "[[{:.4},{:.4},{:.4}],[{:.9},{:.9},{:.9},{:.9}]]",
+        p.p.x * 1e3,
+        p.p.y * 1e3,
+        p.p.z * 1e3,
+        q[0],
+        q[1],
+        q[2],
+        q[3]
+    )
+}
+
+/// A module visiting the fixture's targets: even ones declared and moved to
+/// by `MoveJ`, odd ones inline in `MoveL`, with the tool and work object
+/// declared in the module (the work object in the controller's base frame).
+fn module(f: &Fixture) -> Vec<ProgramFile> {
+    let mut decl = format!(
+        "MODULE Seam\r\n  ! welding seam on the table\r\n  PERS tooldata torch:=[FALSE,{},[2.5,[0,0,120],[1,0,0,0],0,0,0]];\r\n  \
+         TASK PERS wobjdata table:=[FALSE,TRUE,\"\",{},[[0,0,0],[1,0,0,0]]];\r\n  \
+         CONST jointtarget home:=[[0,90,-20,0,45,0],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]];\r\n",
+        frame(&torch()),
+        frame(&f.wobj_controller())
+    );
+    let mut body = String::from("  PROC main()\r\n    MoveAbsJ home, v1000, fine, tool0;\r\n");
+    for i in 0..f.joints.len() {
+        let (deg, c) = f.flag_input(i);
+        let lit = literal(&f.target(i), abb_cf(&deg, c));
+        if i % 2 == 0 {
+            decl.push_str(&format!("  CONST robtarget p{i}:={lit};\r\n"));
+            body.push_str(&format!(
+                "    MoveJ p{i}, v1000, z50, torch\\WObj:=table;\r\n"
+            ));
+        } else {
+            body.push_str(&format!(
+                "    MoveL {lit}, v200, fine, torch\\WObj:=table; ! seam point {i}\r\n    SetDO doWeld, 1;\r\n"
+            ));
+        }
+    }
+    body.push_str("    MoveAbsJ home, v1000, fine, tool0;\r\n  ENDPROC\r\nENDMODULE\r\n");
+    vec![ProgramFile {
+        name: "Seam.mod".into(),
+        text: decl + &body,
+    }]
+}
+
+#[test]
+fn filtered_rapid_brings_the_true_tcp_to_the_targets() {
+    let f = fixture();
+    let files = module(f);
+    let empty = Cell::default();
+    let out = filter(Language::Rapid, &files, &empty, &f.model, &settings()).unwrap();
+    let r = &out.report;
+    assert_eq!(
+        (r.filtered, r.failed, r.skipped),
+        (50, 0, 0),
+        "{:?}",
+        r.targets
+    );
+    assert!(r.targets.iter().all(|t| t.status == TargetStatus::Filtered));
+    let truth: Vec<Pose> = (0..50).map(|i| f.target(i)).collect();
+    let (filtered, n) = mean(&f.run(Language::Rapid, &out.files, &truth));
+    let (nominal, n0) = mean(&f.run(Language::Rapid, &files, &truth));
+    eprintln!("RAPID: true TCP from the targets, mean: filtered {filtered:.4} mm ({n}), unfiltered {nominal:.3} mm ({n0})");
+    assert_eq!(n, 50);
+    assert!(filtered < 0.03, "filtered {filtered} mm");
+    assert!(nominal > 1.0, "unfiltered {nominal} mm");
+    assert_only_targets_changed(Language::Rapid, &files, &out.files);
+}
+
+#[test]
+fn rapid_without_targets_is_byte_identical_and_failures_are_marked() {
+    let f = fixture();
+    let logic = ProgramFile {
+        name: "Io.mod".into(),
+        text: "MODULE Io\n  PROC main()\n    MoveAbsJ [[0,90,-20,0,45,0],[9E9,9E9,9E9,9E9,9E9,9E9]], v100, fine, tool0;\n    \
+               SetDO do1, 1; ! gripper\n    WaitDI di2, 1;\n  ENDPROC\nENDMODULE\n"
+            .into(),
+    };
+    let out = filter(
+        Language::Rapid,
+        std::slice::from_ref(&logic),
+        &f.cell,
+        &f.model,
+        &settings(),
+    )
+    .unwrap();
+    assert_eq!(out.files[0], logic);
+    let text = "MODULE Bad\n  PROC main()\n    MoveL [[9000,0,0],[1,0,0,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]], v100, fine, torch\\WObj:=table;\n  ENDPROC\nENDMODULE\n";
+    let file = ProgramFile {
+        name: "Bad.mod".into(),
+        text: text.into(),
+    };
+    let out = filter(Language::Rapid, &[file], &f.cell, &f.model, &settings()).unwrap();
+    let t = &out.report.targets[0];
+    assert_eq!((t.line, t.status), (3, TargetStatus::Failed));
+    let line = out.files[0].text.lines().nth(2).unwrap().to_string();
+    assert_eq!(
+        line,
+        format!(
+            "{} ! robocal: not filtered: {}",
+            text.lines().nth(2).unwrap(),
+            t.reason.as_ref().unwrap()
+        )
+    );
+}

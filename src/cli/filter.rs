@@ -1,0 +1,109 @@
+//! `robocal filter`: robot programs in, filtered programs and a per-target
+//! JSON report out (`core::program`). Every Cartesian target becomes its
+//! false target on the calibrated model for its tool and work object; the
+//! rest of each file is unchanged. Tools and work objects the programs refer
+//! to by number or name come from a cell file (`core::cell::file`: mm,
+//! degrees); RAPID modules and URScript carry their own.
+
+use super::model_files::load_compensated;
+use crate::cell::{Cell, CellDescription};
+use crate::ik::IkSettings;
+use crate::program::{filter, Language, ProgramFile};
+use anyhow::{bail, Context};
+use clap::Args;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, Args)]
+pub struct FilterArgs {
+    /// Robot model: a preset, a model JSON file, or a calibrated model file
+    /// written by `robocal calibrate --save`.
+    #[arg(long)]
+    pub model: String,
+    /// Cell file: tools and work objects (JSON, mm and degrees), e.g.
+    /// examples/programs/cell.json.
+    #[arg(long)]
+    pub cell: Option<String>,
+    /// Program language: krl, rapid, fanuc or urscript (default: from the
+    /// files' extensions).
+    #[arg(long)]
+    pub language: Option<String>,
+    /// Payload mass [kg] (default: the model file's payload).
+    #[arg(long)]
+    pub payload_kg: Option<f64>,
+    /// Directory for the filtered files (same names as the inputs).
+    #[arg(long)]
+    pub out_dir: PathBuf,
+    /// Write the JSON report here instead of printing it.
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+    /// The program's files (KRL: the `.src` with its `.dat`).
+    #[arg(required = true)]
+    pub files: Vec<PathBuf>,
+}
+
+fn name_of(path: &Path) -> anyhow::Result<String> {
+    path.file_name()
+        .and_then(|n| n.to_str())
+        .map(str::to_string)
+        .with_context(|| format!("{} is not a file name", path.display()))
+}
+
+/// Runs the command; returns the report JSON.
+pub fn filter_to_string(a: &FilterArgs) -> anyhow::Result<String> {
+    let mut model = load_compensated(&a.model).map_err(|e| anyhow::anyhow!("{e}"))?;
+    if let Some(p) = a.payload_kg {
+        if !(p.is_finite() && p >= 0.0) {
+            bail!("--payload-kg must be a non-negative number, got {p}");
+        }
+        model.payload_kg = p;
+    }
+    let cell = match &a.cell {
+        None => Cell::default(),
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .with_context(|| format!("cannot read cell file {path}"))?;
+            CellDescription::from_json(&text)
+                .and_then(|d| d.to_cell())
+                .with_context(|| path.clone())?
+        }
+    };
+    let mut files = Vec::with_capacity(a.files.len());
+    for path in &a.files {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read {}", path.display()))?;
+        files.push(ProgramFile {
+            name: name_of(path)?,
+            text,
+        });
+    }
+    let language = match &a.language {
+        Some(l) => l.parse::<Language>()?,
+        None => {
+            let found: Vec<Option<Language>> =
+                files.iter().map(|f| Language::of_file(&f.name)).collect();
+            match found.first().copied().flatten() {
+                Some(l) if found.iter().all(|x| *x == Some(l)) => l,
+                _ => bail!("cannot tell the program language from the file names; pass --language"),
+            }
+        }
+    };
+    let out = filter(language, &files, &cell, &model, &IkSettings::default())?;
+    std::fs::create_dir_all(&a.out_dir)
+        .with_context(|| format!("cannot create {}", a.out_dir.display()))?;
+    for f in &out.files {
+        let path = a.out_dir.join(&f.name);
+        std::fs::write(&path, &f.text)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    Ok(serde_json::to_string_pretty(&out.report)? + "\n")
+}
+
+pub fn run(a: FilterArgs) -> anyhow::Result<()> {
+    let report = filter_to_string(&a)?;
+    match &a.report {
+        Some(path) => std::fs::write(path, report)
+            .with_context(|| format!("cannot write {}", path.display()))?,
+        None => print!("{report}"),
+    }
+    Ok(())
+}
