@@ -27,12 +27,15 @@ struct App {
 
 impl App {
     async fn new() -> App {
-        let (router, _, dir) = service(ServiceConfig {
+        let s = service(ServiceConfig {
             progress_interval: Duration::from_millis(50),
             ..ServiceConfig::default()
         })
         .await;
-        App { router, _dir: dir }
+        App {
+            router: s.router,
+            _dir: s.dir,
+        }
     }
 
     async fn call(&self, method: &str, uri: &str, ct: Option<&str>, body: Vec<u8>) -> (u16, Value) {

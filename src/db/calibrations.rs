@@ -1,7 +1,7 @@
 //! Calibration jobs: queue, progress, cancellation and their reports.
 
 use super::versions::{activate_in, NewVersion};
-use super::{commit_inserted, Db, DbError, Json};
+use super::{commit_inserted, Db, Json, Listing, StoreError};
 use serde_json::Value;
 use sqlx::FromRow;
 
@@ -67,7 +67,7 @@ impl JobStatus {
 impl Db {
     /// Marks jobs that a previous process left queued or running as failed.
     /// Returns their ids.
-    pub async fn fail_interrupted_jobs(&self) -> Result<Vec<i64>, DbError> {
+    pub async fn fail_interrupted_jobs(&self) -> Result<Vec<i64>, StoreError> {
         let mut tx = self.write().await?;
         let ids: Vec<i64> = sqlx::query_scalar(
             "SELECT id FROM calibrations WHERE status IN ('queued', 'running') ORDER BY id",
@@ -89,7 +89,7 @@ impl Db {
     pub async fn insert_calibration(
         &self,
         c: &NewCalibration<'_>,
-    ) -> Result<Option<CalibrationRow>, DbError> {
+    ) -> Result<Option<CalibrationRow>, StoreError> {
         let Some(mut tx) = self.write_for_robot(c.robot_id).await? else {
             return Ok(None);
         };
@@ -113,12 +113,12 @@ impl Db {
         robot_id: i64,
         limit: i64,
         offset: i64,
-    ) -> Result<(Vec<CalibrationRow>, i64), DbError> {
+    ) -> Result<Listing<CalibrationRow>, StoreError> {
         self.robot_page(CAL_SELECT, "calibrations", "id", robot_id, limit, offset)
             .await
     }
 
-    pub async fn calibrations(&self, robot_id: i64) -> Result<Vec<CalibrationRow>, DbError> {
+    pub async fn calibrations(&self, robot_id: i64) -> Result<Vec<CalibrationRow>, StoreError> {
         self.robot_rows(CAL_SELECT, "id", robot_id).await
     }
 
@@ -126,12 +126,12 @@ impl Db {
         &self,
         robot_id: i64,
         id: i64,
-    ) -> Result<Option<CalibrationRow>, DbError> {
+    ) -> Result<Option<CalibrationRow>, StoreError> {
         self.robot_row(CAL_SELECT, "id", robot_id, id).await
     }
 
     /// The stored report JSON of a calibration.
-    pub async fn calibration_report(&self, id: i64) -> Result<Option<String>, DbError> {
+    pub async fn calibration_report(&self, id: i64) -> Result<Option<String>, StoreError> {
         Ok(
             sqlx::query_scalar::<_, Option<String>>("SELECT report FROM calibrations WHERE id = ?")
                 .bind(id)
@@ -142,7 +142,7 @@ impl Db {
     }
 
     /// queued → running; false when the job is no longer queued (cancelled).
-    pub async fn start_calibration(&self, id: i64) -> Result<bool, DbError> {
+    pub async fn start_calibration(&self, id: i64) -> Result<bool, StoreError> {
         let start = sqlx::query(concat!(
             "UPDATE calibrations SET status = 'running', phase = 'starting', started_at = ",
             now!(),
@@ -161,7 +161,7 @@ impl Db {
         phase: &str,
         iteration: i64,
         percent: f64,
-    ) -> Result<(), DbError> {
+    ) -> Result<(), StoreError> {
         let progress = sqlx::query(concat!(
             "UPDATE calibrations SET phase = ?, iteration = ?, percent = ?, updated_at = ",
             now!(),
@@ -182,7 +182,7 @@ impl Db {
         &self,
         robot_id: i64,
         id: i64,
-    ) -> Result<Option<CalibrationRow>, DbError> {
+    ) -> Result<Option<CalibrationRow>, StoreError> {
         let mut tx = self.write().await?;
         sqlx::query(concat!(
             "UPDATE calibrations SET status = 'cancelled', cancel_requested = 1, \
@@ -213,7 +213,7 @@ impl Db {
         id: i64,
         status: JobStatus,
         error: &str,
-    ) -> Result<(), DbError> {
+    ) -> Result<(), StoreError> {
         let end = sqlx::query(concat!(
             "UPDATE calibrations SET status = ?, error = ?, ",
             finished_now!(),
@@ -238,7 +238,7 @@ impl Db {
         best_method: &str,
         summary: &JobSummary,
         versions: &[NewVersion],
-    ) -> Result<Vec<(String, i64)>, DbError> {
+    ) -> Result<Vec<(String, i64)>, StoreError> {
         let mut tx = self.write().await?;
         let n = sqlx::query(concat!(
             "UPDATE calibrations SET status = 'succeeded', report = ?, best_method = ?, \

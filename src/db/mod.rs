@@ -31,7 +31,51 @@ use std::str::FromStr;
 use std::time::Duration;
 
 pub use sqlx::types::Json;
-pub use sqlx::Error as DbError;
+
+/// Why a store operation failed, in robocal's own terms: `sqlx` errors stay
+/// inside this module.
+#[derive(Debug, thiserror::Error)]
+pub enum StoreError {
+    /// A row the operation needs does not exist.
+    #[error("{0}")]
+    NotFound(String),
+    /// The write conflicts with the stored state (its parent was deleted meanwhile, a duplicate).
+    #[error("{0}")]
+    Conflict(String),
+    /// The database cannot be reached now (no connection, pool exhausted, closed).
+    #[error("database unavailable: {0}")]
+    Unavailable(String),
+    /// Anything else: a bug, corrupt data, a failed migration.
+    #[error("database: {0}")]
+    Internal(String),
+}
+
+impl From<sqlx::Error> for StoreError {
+    fn from(e: sqlx::Error) -> Self {
+        use sqlx::Error as E;
+        match &e {
+            // Writes check their parent inside their transaction; this is the
+            // last line of defence should one be missed.
+            E::Database(d) if d.is_foreign_key_violation() => StoreError::Conflict(
+                "the resource this write belongs to was deleted meanwhile".into(),
+            ),
+            E::Database(d) if d.is_unique_violation() => {
+                StoreError::Conflict("a concurrent write made the same change; retry".into())
+            }
+            E::RowNotFound => StoreError::NotFound(e.to_string()),
+            E::PoolTimedOut | E::PoolClosed | E::Io(_) | E::Tls(_) | E::WorkerCrashed => {
+                StoreError::Unavailable(e.to_string())
+            }
+            _ => StoreError::Internal(e.to_string()),
+        }
+    }
+}
+
+impl From<sqlx::migrate::MigrateError> for StoreError {
+    fn from(e: sqlx::migrate::MigrateError) -> Self {
+        StoreError::Internal(format!("migrations: {e}"))
+    }
+}
 
 /// The SQL expression for the current time as stored (UTC, RFC 3339, ms).
 macro_rules! now {
@@ -50,6 +94,33 @@ pub use robots::{NewRobot, RobotRow};
 pub use sets::{AngleUnit, LengthUnit, NewSet, SetFormat, SetRow, StoredRole};
 pub use versions::{NewVersion, Rollback, VersionRow};
 
+/// One page of a list and the length of the whole list.
+#[derive(Debug, Clone)]
+pub struct Listing<T> {
+    pub rows: Vec<T>,
+    pub total: i64,
+}
+
+/// The number of rows of every table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RowCounts {
+    pub robots: i64,
+    pub measurement_sets: i64,
+    pub calibrations: i64,
+    pub model_versions: i64,
+    pub activations: i64,
+}
+
+impl RowCounts {
+    const TABLES: [&'static str; 5] = [
+        "robots",
+        "measurement_sets",
+        "calibrations",
+        "model_versions",
+        "activations",
+    ];
+}
+
 /// Default database location: `robocal.db` in the working directory, created on first start.
 pub const DEFAULT_DATABASE_URL: &str = "sqlite://robocal.db?mode=rwc";
 
@@ -62,7 +133,7 @@ pub struct Db {
 /// Turns `DATABASE_URL` into connect options. Accepts `sqlite://path?mode=rwc`,
 /// `sqlite:path`, `sqlite::memory:` or a plain file path; the file is created
 /// when missing.
-pub fn connect_options(url: &str) -> Result<SqliteConnectOptions, DbError> {
+pub fn connect_options(url: &str) -> Result<SqliteConnectOptions, StoreError> {
     let url = url.trim();
     let opts = if url.starts_with("sqlite:") {
         SqliteConnectOptions::from_str(url)?
@@ -79,36 +150,63 @@ pub fn connect_options(url: &str) -> Result<SqliteConnectOptions, DbError> {
 
 impl Db {
     /// Opens (creating if needed) the database and applies the migrations.
-    pub async fn connect(url: &str) -> Result<Db, DbError> {
+    pub async fn connect(url: &str) -> Result<Db, StoreError> {
         let opts = connect_options(url)?;
         let pool = SqlitePoolOptions::new()
             .max_connections(8)
             .min_connections(1)
             .connect_with(opts)
             .await?;
-        sqlx::migrate!()
-            .run(&pool)
-            .await
-            .map_err(|e| DbError::Migrate(Box::new(e)))?;
+        sqlx::migrate!().run(&pool).await?;
         Ok(Db { pool })
-    }
-
-    pub fn pool(&self) -> &SqlitePool {
-        &self.pool
     }
 
     /// Starts a write transaction that holds the write lock from its first
     /// statement (`BEGIN IMMEDIATE`), so it cannot fail half-way on a lock.
-    pub async fn write(&self) -> Result<Transaction<'static, Sqlite>, DbError> {
-        self.pool.begin_with("BEGIN IMMEDIATE").await
+    async fn write(&self) -> Result<Transaction<'static, Sqlite>, StoreError> {
+        Ok(self.pool.begin_with("BEGIN IMMEDIATE").await?)
+    }
+
+    /// One round trip to the database (`SELECT 1`): whether it answers now.
+    pub async fn ping(&self) -> Result<(), StoreError> {
+        sqlx::query("SELECT 1").execute(&self.pool).await?;
+        Ok(())
     }
 
     /// `PRAGMA integrity_check` (`"ok"` when the file is sound).
-    pub async fn integrity_check(&self) -> Result<String, DbError> {
+    pub async fn integrity_check(&self) -> Result<String, StoreError> {
         let row = sqlx::query("PRAGMA integrity_check")
             .fetch_one(&self.pool)
             .await?;
-        row.try_get::<String, _>(0)
+        Ok(row.try_get::<String, _>(0)?)
+    }
+
+    /// Rows whose foreign key names no parent (`PRAGMA foreign_key_check`); 0 when sound.
+    pub async fn foreign_key_violations(&self) -> Result<usize, StoreError> {
+        let rows = sqlx::query("PRAGMA foreign_key_check")
+            .fetch_all(&self.pool)
+            .await?;
+        Ok(rows.len())
+    }
+
+    /// How many rows each table holds.
+    pub async fn row_counts(&self) -> Result<RowCounts, StoreError> {
+        let count = |table: &str| format!("SELECT COUNT(*) FROM {table}");
+        let mut tx = self.pool.begin().await?;
+        let mut n = [0i64; 5];
+        for (i, table) in RowCounts::TABLES.iter().enumerate() {
+            n[i] = sqlx::query_scalar(&count(table))
+                .fetch_one(&mut *tx)
+                .await?;
+        }
+        tx.commit().await?;
+        Ok(RowCounts {
+            robots: n[0],
+            measurement_sets: n[1],
+            calibrations: n[2],
+            model_versions: n[3],
+            activations: n[4],
+        })
     }
 
     /// One page of a list query (`… LIMIT ? OFFSET ?`, with a leading
@@ -121,7 +219,7 @@ impl Db {
         robot_id: Option<i64>,
         limit: i64,
         offset: i64,
-    ) -> Result<(Vec<T>, i64), DbError>
+    ) -> Result<Listing<T>, StoreError>
     where
         T: for<'r> FromRow<'r, SqliteRow> + Send + Unpin,
     {
@@ -135,7 +233,7 @@ impl Db {
         let rows = list.bind(limit).bind(offset).fetch_all(&mut *tx).await?;
         let total = count.fetch_one(&mut *tx).await?;
         tx.commit().await?;
-        Ok((rows, total))
+        Ok(Listing { rows, total })
     }
 
     /// One page of a robot's rows: `{select} WHERE robot_id = ? ORDER BY
@@ -148,7 +246,7 @@ impl Db {
         robot_id: i64,
         limit: i64,
         offset: i64,
-    ) -> Result<(Vec<T>, i64), DbError>
+    ) -> Result<Listing<T>, StoreError>
     where
         T: for<'r> FromRow<'r, SqliteRow> + Send + Unpin,
     {
@@ -168,14 +266,16 @@ impl Db {
         select: &str,
         order_by: &str,
         robot_id: i64,
-    ) -> Result<Vec<T>, DbError>
+    ) -> Result<Vec<T>, StoreError>
     where
         T: for<'r> FromRow<'r, SqliteRow> + Send + Unpin,
     {
-        sqlx::query_as::<_, T>(&format!("{select} WHERE robot_id = ? ORDER BY {order_by}"))
-            .bind(robot_id)
-            .fetch_all(&self.pool)
-            .await
+        Ok(
+            sqlx::query_as::<_, T>(&format!("{select} WHERE robot_id = ? ORDER BY {order_by}"))
+                .bind(robot_id)
+                .fetch_all(&self.pool)
+                .await?,
+        )
     }
 
     /// One row of a robot: `{select} WHERE robot_id = ? AND {key} = ?`.
@@ -185,22 +285,24 @@ impl Db {
         key: &str,
         robot_id: i64,
         value: i64,
-    ) -> Result<Option<T>, DbError>
+    ) -> Result<Option<T>, StoreError>
     where
         T: for<'r> FromRow<'r, SqliteRow> + Send + Unpin,
     {
-        sqlx::query_as::<_, T>(&format!("{select} WHERE robot_id = ? AND {key} = ?"))
-            .bind(robot_id)
-            .bind(value)
-            .fetch_optional(&self.pool)
-            .await
+        Ok(
+            sqlx::query_as::<_, T>(&format!("{select} WHERE robot_id = ? AND {key} = ?"))
+                .bind(robot_id)
+                .bind(value)
+                .fetch_optional(&self.pool)
+                .await?,
+        )
     }
 
     /// Runs one statement in its own write transaction; the rows it changed.
     pub(super) async fn write_one<'q>(
         &self,
         statement: Query<'q, Sqlite, SqliteArguments<'q>>,
-    ) -> Result<u64, DbError> {
+    ) -> Result<u64, StoreError> {
         let mut tx = self.write().await?;
         let n = statement.execute(&mut *tx).await?.rows_affected();
         tx.commit().await?;
@@ -212,7 +314,7 @@ impl Db {
     pub(super) async fn write_for_robot(
         &self,
         robot_id: i64,
-    ) -> Result<Option<Transaction<'static, Sqlite>>, DbError> {
+    ) -> Result<Option<Transaction<'static, Sqlite>>, StoreError> {
         let mut tx = self.write().await?;
         if !robot_exists_in(&mut tx, robot_id).await? {
             tx.rollback().await?;
@@ -229,7 +331,7 @@ pub(super) async fn commit_inserted<T>(
     select: &str,
     id_column: &str,
     id: i64,
-) -> Result<T, DbError>
+) -> Result<T, StoreError>
 where
     T: for<'r> FromRow<'r, SqliteRow> + Send + Unpin,
 {
@@ -244,9 +346,11 @@ where
 async fn robot_exists_in(
     tx: &mut Transaction<'static, Sqlite>,
     robot_id: i64,
-) -> Result<bool, DbError> {
-    sqlx::query_scalar("SELECT EXISTS (SELECT 1 FROM robots WHERE id = ?)")
-        .bind(robot_id)
-        .fetch_one(&mut **tx)
-        .await
+) -> Result<bool, StoreError> {
+    Ok(
+        sqlx::query_scalar("SELECT EXISTS (SELECT 1 FROM robots WHERE id = ?)")
+            .bind(robot_id)
+            .fetch_one(&mut **tx)
+            .await?,
+    )
 }

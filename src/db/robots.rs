@@ -1,11 +1,11 @@
 //! Robots: the cell's robots and their nominal models.
 
-use super::{commit_inserted, Db, DbError, Json};
+use super::{commit_inserted, Db, Json, Listing, StoreError};
 use serde_json::{Map, Value};
 use sqlx::FromRow;
 
 impl Db {
-    pub async fn insert_robot(&self, r: &NewRobot<'_>) -> Result<RobotRow, DbError> {
+    pub async fn insert_robot(&self, r: &NewRobot<'_>) -> Result<RobotRow, StoreError> {
         let mut tx = self.write().await?;
         let id: i64 = sqlx::query_scalar(
             "INSERT INTO robots (name, preset, model_json, dof, metadata) VALUES (?, ?, ?, ?, ?) RETURNING id",
@@ -25,7 +25,7 @@ impl Db {
         &self,
         limit: i64,
         offset: i64,
-    ) -> Result<(Vec<RobotRow>, i64), DbError> {
+    ) -> Result<Listing<RobotRow>, StoreError> {
         self.page(
             &format!("{ROBOT_SELECT} ORDER BY r.id LIMIT ? OFFSET ?"),
             "SELECT COUNT(*) FROM robots",
@@ -36,11 +36,13 @@ impl Db {
         .await
     }
 
-    pub async fn robot(&self, id: i64) -> Result<Option<RobotRow>, DbError> {
-        sqlx::query_as::<_, RobotRow>(&format!("{ROBOT_SELECT} WHERE r.id = ?"))
-            .bind(id)
-            .fetch_optional(&self.pool)
-            .await
+    pub async fn robot(&self, id: i64) -> Result<Option<RobotRow>, StoreError> {
+        Ok(
+            sqlx::query_as::<_, RobotRow>(&format!("{ROBOT_SELECT} WHERE r.id = ?"))
+                .bind(id)
+                .fetch_optional(&self.pool)
+                .await?,
+        )
     }
 
     /// Updates name and/or metadata; `None` when the robot does not exist.
@@ -49,7 +51,7 @@ impl Db {
         id: i64,
         name: Option<&str>,
         metadata: Option<&Map<String, Value>>,
-    ) -> Result<Option<RobotRow>, DbError> {
+    ) -> Result<Option<RobotRow>, StoreError> {
         let update = sqlx::query(concat!(
             "UPDATE robots SET name = COALESCE(?, name), metadata = COALESCE(?, metadata), \
              updated_at = ",
@@ -66,7 +68,7 @@ impl Db {
     }
 
     /// Deletes a robot and everything that belongs to it; false when missing.
-    pub async fn delete_robot(&self, id: i64) -> Result<bool, DbError> {
+    pub async fn delete_robot(&self, id: i64) -> Result<bool, StoreError> {
         let delete = sqlx::query("DELETE FROM robots WHERE id = ?").bind(id);
         Ok(self.write_one(delete).await? > 0)
     }

@@ -1,6 +1,6 @@
 //! Measurement sets: the uploads as received and their parsed rows.
 
-use super::{commit_inserted, Db, DbError, Json};
+use super::{commit_inserted, Db, Json, Listing, StoreError};
 use crate::measure::{MeasuredPose, SetRole};
 use sqlx::{FromRow, Row};
 
@@ -86,7 +86,7 @@ impl SetFormat {
 
 impl Db {
     /// Stores a set; `None` when its robot does not exist (any more).
-    pub async fn insert_set(&self, s: &NewSet<'_>) -> Result<Option<SetRow>, DbError> {
+    pub async fn insert_set(&self, s: &NewSet<'_>) -> Result<Option<SetRow>, StoreError> {
         let Some(mut tx) = self.write_for_robot(s.robot_id).await? else {
             return Ok(None);
         };
@@ -118,7 +118,7 @@ impl Db {
         robot_id: i64,
         limit: i64,
         offset: i64,
-    ) -> Result<(Vec<SetRow>, i64), DbError> {
+    ) -> Result<Listing<SetRow>, StoreError> {
         self.robot_page(
             SET_SELECT,
             "measurement_sets",
@@ -130,11 +130,11 @@ impl Db {
         .await
     }
 
-    pub async fn sets(&self, robot_id: i64) -> Result<Vec<SetRow>, DbError> {
+    pub async fn sets(&self, robot_id: i64) -> Result<Vec<SetRow>, StoreError> {
         self.robot_rows(SET_SELECT, "id", robot_id).await
     }
 
-    pub async fn set(&self, robot_id: i64, id: i64) -> Result<Option<SetRow>, DbError> {
+    pub async fn set(&self, robot_id: i64, id: i64) -> Result<Option<SetRow>, StoreError> {
         self.robot_row(SET_SELECT, "id", robot_id, id).await
     }
 
@@ -143,7 +143,7 @@ impl Db {
         &self,
         robot_id: i64,
         id: i64,
-    ) -> Result<Option<Vec<MeasuredPose>>, DbError> {
+    ) -> Result<Option<Vec<MeasuredPose>>, StoreError> {
         let rows: Option<Json<Vec<MeasuredPose>>> = sqlx::query_scalar(
             "SELECT rows_json FROM measurement_sets WHERE robot_id = ? AND id = ?",
         )
@@ -159,7 +159,7 @@ impl Db {
         &self,
         robot_id: i64,
         id: i64,
-    ) -> Result<Option<(SetFormat, String)>, DbError> {
+    ) -> Result<Option<(SetFormat, String)>, StoreError> {
         let row = sqlx::query(
             "SELECT format, original FROM measurement_sets WHERE robot_id = ? AND id = ?",
         )
@@ -170,7 +170,7 @@ impl Db {
         row.map(|r| Ok((r.try_get(0)?, r.try_get(1)?))).transpose()
     }
 
-    pub async fn delete_set(&self, robot_id: i64, id: i64) -> Result<bool, DbError> {
+    pub async fn delete_set(&self, robot_id: i64, id: i64) -> Result<bool, StoreError> {
         let delete = sqlx::query("DELETE FROM measurement_sets WHERE robot_id = ? AND id = ?")
             .bind(robot_id)
             .bind(id);

@@ -1,7 +1,7 @@
 //! Model versions: one calibrated model per method of each calibration, the
 //! active one per robot, and the activation history used by rollback.
 
-use super::{Db, DbError, Json};
+use super::{Db, Json, Listing, StoreError};
 use serde_json::Value;
 use sqlx::{FromRow, Sqlite, Transaction};
 
@@ -12,7 +12,7 @@ impl Db {
         robot_id: i64,
         limit: i64,
         offset: i64,
-    ) -> Result<(Vec<VersionRow>, i64), DbError> {
+    ) -> Result<Listing<VersionRow>, StoreError> {
         self.robot_page(
             VERSION_SELECT,
             "model_versions",
@@ -24,7 +24,7 @@ impl Db {
         .await
     }
 
-    pub async fn versions(&self, robot_id: i64) -> Result<Vec<VersionRow>, DbError> {
+    pub async fn versions(&self, robot_id: i64) -> Result<Vec<VersionRow>, StoreError> {
         self.robot_rows(VERSION_SELECT, "version", robot_id).await
     }
 
@@ -32,26 +32,28 @@ impl Db {
         &self,
         robot_id: i64,
         version: i64,
-    ) -> Result<Option<VersionRow>, DbError> {
+    ) -> Result<Option<VersionRow>, StoreError> {
         self.robot_row(VERSION_SELECT, "version", robot_id, version)
             .await
     }
 
-    pub async fn active_version(&self, robot_id: i64) -> Result<Option<VersionRow>, DbError> {
-        sqlx::query_as::<_, VersionRow>(&format!(
+    pub async fn active_version(&self, robot_id: i64) -> Result<Option<VersionRow>, StoreError> {
+        Ok(sqlx::query_as::<_, VersionRow>(&format!(
             "{VERSION_SELECT} WHERE robot_id = ? AND active = 1"
         ))
         .bind(robot_id)
         .fetch_optional(&self.pool)
-        .await
+        .await?)
     }
 
     /// The calibrated model file JSON of a version (by row id).
-    pub async fn version_model(&self, version_id: i64) -> Result<Option<String>, DbError> {
-        sqlx::query_scalar("SELECT model_json FROM model_versions WHERE id = ?")
-            .bind(version_id)
-            .fetch_optional(&self.pool)
-            .await
+    pub async fn version_model(&self, version_id: i64) -> Result<Option<String>, StoreError> {
+        Ok(
+            sqlx::query_scalar("SELECT model_json FROM model_versions WHERE id = ?")
+                .bind(version_id)
+                .fetch_optional(&self.pool)
+                .await?,
+        )
     }
 
     /// Activates a version (no-op when already active); `None` when missing.
@@ -59,7 +61,7 @@ impl Db {
         &self,
         robot_id: i64,
         version: i64,
-    ) -> Result<Option<VersionRow>, DbError> {
+    ) -> Result<Option<VersionRow>, StoreError> {
         let mut tx = self.write().await?;
         let row: Option<(i64, bool)> = sqlx::query_as(
             "SELECT id, active FROM model_versions WHERE robot_id = ? AND version = ?",
@@ -80,7 +82,7 @@ impl Db {
     }
 
     /// Rolls back to the version that was active before the current one.
-    pub async fn rollback(&self, robot_id: i64) -> Result<Rollback, DbError> {
+    pub async fn rollback(&self, robot_id: i64) -> Result<Rollback, StoreError> {
         let mut tx = self.write().await?;
         let stack: Vec<(i64, i64)> = sqlx::query_as(
             "SELECT id, version_id FROM activations WHERE robot_id = ? AND undone = 0 \
@@ -123,7 +125,7 @@ async fn set_active_in(
     tx: &mut Transaction<'static, Sqlite>,
     robot_id: i64,
     version_id: i64,
-) -> Result<(), DbError> {
+) -> Result<(), StoreError> {
     sqlx::query("UPDATE model_versions SET active = 0 WHERE robot_id = ? AND active = 1")
         .bind(robot_id)
         .execute(&mut **tx)
@@ -139,7 +141,7 @@ pub(super) async fn activate_in(
     tx: &mut Transaction<'static, Sqlite>,
     robot_id: i64,
     version_id: i64,
-) -> Result<(), DbError> {
+) -> Result<(), StoreError> {
     set_active_in(tx, robot_id, version_id).await?;
     sqlx::query("INSERT INTO activations (robot_id, version_id) VALUES (?, ?)")
         .bind(robot_id)

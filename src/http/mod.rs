@@ -159,10 +159,7 @@ pub fn app(state: AppState) -> Router {
 }
 
 async fn healthz(State(state): State<AppState>) -> Result<Response, ApiError> {
-    sqlx::query("SELECT 1")
-        .execute(state.db().pool())
-        .await
-        .map_err(|e| ApiError::Unavailable(format!("database unavailable: {e}")))?;
+    crate::service::health(&state).await?;
     Ok(axum::Json(serde_json::json!({
         "status": "ok",
         "version": env!("CARGO_PKG_VERSION"),

@@ -23,7 +23,7 @@ use super::limits::Ticket;
 use super::{AppState, ServiceError};
 use crate::compensate::{CalibratedModelFile, CompensatedModel};
 use crate::db::{
-    CalibrationRow, JobStatus, JobSummary, NewCalibration, NewVersion, SetRow, StoredRole,
+    CalibrationRow, JobStatus, JobSummary, Listing, NewCalibration, NewVersion, SetRow, StoredRole,
 };
 use crate::identify::{
     calibrate_with_training, CalibrationError, CalibrationOptions, CalibrationReport,
@@ -614,4 +614,60 @@ fn versions_of(
         });
     }
     out
+}
+
+/// One page of a robot's calibrations by id (the robot must exist).
+pub async fn page(
+    state: &AppState,
+    robot_id: i64,
+    limit: i64,
+    offset: i64,
+) -> Result<Listing<CalibrationRow>, ServiceError> {
+    Ok(state
+        .db()
+        .calibrations_page(robot_id, limit, offset)
+        .await?)
+}
+
+/// Every calibration of a robot by id.
+pub async fn list(state: &AppState, robot_id: i64) -> Result<Vec<CalibrationRow>, ServiceError> {
+    Ok(state.db().calibrations(robot_id).await?)
+}
+
+/// Calibration `id` of a robot, or `NotFound`.
+pub async fn get(state: &AppState, robot_id: i64, id: i64) -> Result<CalibrationRow, ServiceError> {
+    state
+        .db()
+        .calibration(robot_id, id)
+        .await?
+        .ok_or_else(|| ServiceError::calibration_not_found(robot_id, id))
+}
+
+/// Requests cancellation: a queued job is cancelled at once, a running one
+/// stops at its next progress check. A job that already ended conflicts.
+pub async fn cancel(
+    state: &AppState,
+    robot_id: i64,
+    id: i64,
+) -> Result<CalibrationRow, ServiceError> {
+    let row = get(state, robot_id, id).await?;
+    if !row.status.is_active() {
+        return Err(ServiceError::Conflict(format!(
+            "calibration {id} is already {}; only queued or running jobs can be cancelled",
+            row.status
+        )));
+    }
+    if let Some(flag) = state.existing_cancel_flag(id) {
+        flag.store(true, Ordering::SeqCst);
+    }
+    state
+        .db()
+        .request_cancel(robot_id, id)
+        .await?
+        .ok_or_else(|| ServiceError::calibration_not_found(robot_id, id))
+}
+
+/// The stored report JSON of a calibration (set when it succeeded).
+pub async fn report_text(state: &AppState, id: i64) -> Result<Option<String>, ServiceError> {
+    Ok(state.db().calibration_report(id).await?)
 }

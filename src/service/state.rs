@@ -112,7 +112,7 @@ impl AppState {
         }
     }
 
-    pub fn db(&self) -> &Db {
+    pub(in crate::service) fn db(&self) -> &Db {
         &self.inner.db
     }
 

@@ -28,17 +28,31 @@ pub fn robocal_json(dir: &Path, args: &[&str]) -> serde_json::Value {
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
-/// The service on a new SQLite file in a temporary directory: its router,
-/// its state and the directory (which must outlive them).
-pub async fn service(config: ServiceConfig) -> (Router, AppState, tempfile::TempDir) {
+/// The service in-process on a new, empty store.
+pub struct TestService {
+    pub router: Router,
+    pub state: AppState,
+    /// The store the service uses, for checks behind its back.
+    pub db: Db,
+    /// Holds the SQLite file; must outlive the service.
+    pub dir: tempfile::TempDir,
+}
+
+/// The service on a new SQLite file in a temporary directory.
+pub async fn service(config: ServiceConfig) -> TestService {
     let dir = tempfile::tempdir().unwrap();
     let url = format!(
         "sqlite://{}?mode=rwc",
         dir.path().join("service.db").display()
     );
     let db = Db::connect(&url).await.unwrap();
-    let state = AppState::new(db, config);
-    (app(state.clone()), state, dir)
+    let state = AppState::new(db.clone(), config);
+    TestService {
+        router: app(state.clone()),
+        state,
+        db,
+        dir,
+    }
 }
 
 /// Sends one request through `router` in-process: status, headers and body.
