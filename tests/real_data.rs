@@ -23,6 +23,7 @@ fn model_file(name: &str) -> Value {
 struct App {
     router: Router,
     _dir: tempfile::TempDir,
+    _pg: Option<common::TempDatabase>,
 }
 
 impl App {
@@ -35,6 +36,7 @@ impl App {
         App {
             router: s.router,
             _dir: s.dir,
+            _pg: s.pg,
         }
     }
 

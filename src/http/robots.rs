@@ -143,6 +143,13 @@ fn requested_model(body: &CreateRobot) -> Result<(RobotModel, Option<String>), A
             )
         }
         (None, Some(m)) => {
+            if let Some(Value::String(name)) = m.get("name") {
+                if name.contains('\0') {
+                    return Err(ApiError::invalid(
+                        "model field 'name' must not contain the NUL character (U+0000)",
+                    ));
+                }
+            }
             let text = serde_json::to_string(m).map_err(|e| ApiError::Internal(e.to_string()))?;
             let model = RobotModel::from_json(&text).map_err(ApiError::invalid)?;
             check_payload("model field 'payload.mass_kg'", model.payload.mass)?;

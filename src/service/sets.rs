@@ -109,6 +109,13 @@ pub async fn upload(state: &AppState, cmd: NewSetCommand) -> Result<SetRow, Serv
     let session = cmd.session.clone();
     let (rows, format, original) = tokio::task::spawn_blocking(move || {
         let (rows, format, original) = match cmd.content {
+            // Text columns hold no NUL on PostgreSQL; refused alike on SQLite.
+            SetContent::Csv { text, .. } if text.contains('\0') => {
+                return Err(ServiceError::Invalid(
+                    "the upload contains the NUL character (U+0000); measurement files are text"
+                        .into(),
+                ))
+            }
             SetContent::Csv { text, read } => {
                 (read_csv(&text, &read, &session)?, SetFormat::Csv, text)
             }

@@ -488,6 +488,7 @@ async fn the_server_refuses_what_the_spec_refuses() {
         r#"{"preset": "YS100"}"#,
         r#"{"preset": "ys100", "name": ""}"#,
         r#"{"preset": "ys100", "name": " \t"}"#,
+        r#"{"preset": "ys100", "name": "cell\u0000 3"}"#,
         r#"{"preset": "ys100", "metadata": [1, 2]}"#,
         r#"[null, "ys100", null, null]"#,
         r#"["cell", "ys100"]"#,
@@ -500,6 +501,21 @@ async fn the_server_refuses_what_the_spec_refuses() {
             r.text()
         );
     }
+    // NUL is refused alike on both stores (PostgreSQL text holds none), as the spec says.
+    let name = serde_json::json!({ "$ref": "#/components/schemas/Name" });
+    assert!(!t.spec.accepts(&name, &serde_json::json!("cell\u{0} 3")));
+    assert!(t.spec.accepts(&name, &serde_json::json!("cell 3")));
+    let r = t
+        .raw(
+            "POST",
+            &format!("/v1/robots/{rid}/measurement-sets?role=identification"),
+            Some("text/csv"),
+            format!("# \u{0}\n{}", simulated_csv(5, 10)).into_bytes(),
+            Some("k1"),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+    assert!(r.detail().contains("NUL"), "{}", r.detail());
     // A JSON array never renames a robot or starts a calibration.
     let r = t
         .raw(

@@ -155,6 +155,7 @@ pub(crate) struct TestApp {
     pub(crate) db: robocal::db::Db,
     pub(crate) spec: Arc<Spec>,
     pub(crate) _dir: tempfile::TempDir,
+    pub(crate) _pg: Option<crate::common::TempDatabase>,
     pub(crate) key: Option<String>,
 }
 
@@ -207,6 +208,7 @@ pub(crate) async fn setup_config(config: ServiceConfig) -> TestApp {
         db: s.db,
         spec: Arc::new(Spec::load()),
         _dir: s.dir,
+        _pg: s.pg,
         key: keys.first().cloned(),
     }
 }
