@@ -158,6 +158,7 @@ impl Db {
     pub async fn update_progress(
         &self,
         id: i64,
+        claim: Option<&str>,
         phase: &str,
         iteration: i64,
         percent: f64,
@@ -165,7 +166,8 @@ impl Db {
         on_pool!(self, |p, k| {
             let sql = k.sql(
                 "UPDATE calibrations SET phase = $1, iteration = $2, percent = $3, \
-                 updated_at = {now} WHERE id = $4 AND status = 'running'",
+                 updated_at = {now} WHERE id = $4 AND status = 'running' \
+                 AND ($5 IS NULL OR claim = $5)",
             );
             write_one!(
                 p,
@@ -175,6 +177,7 @@ impl Db {
                     .bind(iteration)
                     .bind(percent)
                     .bind(id)
+                    .bind(claim)
             )
         });
         Ok(())
@@ -214,19 +217,30 @@ impl Db {
         self.calibration(robot_id, id).await
     }
 
-    /// Ends a job without a result (failed or cancelled).
+    /// Ends a job without a result (failed or cancelled). With `claim`, only
+    /// while that claim holds the job (a job taken over elsewhere is not
+    /// written by its former runner).
     pub async fn finish_calibration_error(
         &self,
         id: i64,
+        claim: Option<&str>,
         status: JobStatus,
         error: &str,
     ) -> Result<(), StoreError> {
         on_pool!(self, |p, k| {
             let sql = k.sql(&format!(
                 "UPDATE calibrations SET status = $1, error = $2, {FINISHED_NOW} \
-                 WHERE id = $3 AND status IN ('queued', 'running')"
+                 WHERE id = $3 AND status IN ('queued', 'running') AND ($4 IS NULL OR claim = $4)"
             ));
-            write_one!(p, k, sqlx::query(&sql).bind(status).bind(error).bind(id))
+            write_one!(
+                p,
+                k,
+                sqlx::query(&sql)
+                    .bind(status)
+                    .bind(error)
+                    .bind(id)
+                    .bind(claim)
+            )
         });
         Ok(())
     }
@@ -234,16 +248,21 @@ impl Db {
     /// Stores a successful calibration in one transaction: the report, one
     /// model version per method (in the given order), and the activation of
     /// `activate_method`'s version when the robot has no active version.
-    /// Returns the created versions as (method, version number).
+    /// Returns the created versions as (method, version number). `claim`:
+    /// see [`Db::finish_calibration_error`].
     pub async fn finish_calibration_success(
         &self,
         robot_id: i64,
         id: i64,
-        report_json: &str,
-        best_method: &str,
-        summary: &JobSummary,
-        versions: &[NewVersion],
+        claim: Option<&str>,
+        result: &JobResult<'_>,
     ) -> Result<Vec<(String, i64)>, StoreError> {
+        let JobResult {
+            report_json,
+            best_method,
+            summary,
+            versions,
+        } = *result;
         Ok(on_pool!(self, |p, k| {
             // Holding the robot's row serialises the version numbers of its jobs.
             let Some(mut tx) = write_for_robot!(p, k, robot_id) else {
@@ -252,13 +271,14 @@ impl Db {
             let sql = k.sql(&format!(
                 "UPDATE calibrations SET status = 'succeeded', report = $1, best_method = $2, \
                  summary = $3, phase = 'done', percent = 100, {FINISHED_NOW} \
-                 WHERE id = $4 AND status = 'running'"
+                 WHERE id = $4 AND status = 'running' AND ($5 IS NULL OR claim = $5)"
             ));
             let n = sqlx::query(&sql)
                 .bind(report_json)
                 .bind(best_method)
                 .bind(Json(summary))
                 .bind(id)
+                .bind(claim)
                 .execute(&mut *tx)
                 .await?
                 .rows_affected();
@@ -303,6 +323,17 @@ impl Db {
             out
         }))
     }
+}
+
+/// What a succeeded job stores.
+#[derive(Debug, Clone, Copy)]
+pub struct JobResult<'a> {
+    /// The report as JSON (mm/deg).
+    pub report_json: &'a str,
+    pub best_method: &'a str,
+    pub summary: &'a JobSummary,
+    /// One model version per method, in the order the methods ran.
+    pub versions: &'a [NewVersion],
 }
 
 const CAL_SELECT: &str = "SELECT id, robot_id, status, phase, iteration, percent, \

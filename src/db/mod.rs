@@ -80,12 +80,14 @@ impl From<sqlx::migrate::MigrateError> for StoreError {
 }
 
 mod calibrations;
+mod queue;
 mod robots;
 mod sets;
 mod types;
 mod versions;
 
-pub use calibrations::{CalibrationRow, JobStatus, JobSummary, NewCalibration};
+pub use calibrations::{CalibrationRow, JobResult, JobStatus, JobSummary, NewCalibration};
+pub use queue::{ClaimedJob, Lease};
 pub use robots::{NewRobot, RobotRow};
 pub use sets::{AngleUnit, LengthUnit, NewSet, SetFormat, SetRow, StoredRole};
 pub use types::Json;

@@ -12,6 +12,7 @@
 
 pub mod calibrations;
 pub mod limits;
+pub mod queue;
 pub mod robots;
 pub mod sets;
 pub mod solve;
