@@ -87,7 +87,7 @@ mod types;
 mod versions;
 
 pub use calibrations::{CalibrationRow, JobResult, JobStatus, JobSummary, NewCalibration};
-pub use queue::{ClaimedJob, Lease};
+pub use queue::{ClaimedJob, Lease, RobotChange, RobotChanges};
 pub use robots::{NewRobot, RobotRow};
 pub use sets::{AngleUnit, LengthUnit, NewSet, SetFormat, SetRow, StoredRole};
 pub use types::Json;

@@ -114,3 +114,58 @@ impl Db {
         Ok(n > 0)
     }
 }
+
+/// The channel on which replicas announce that a robot's model changed.
+const ROBOT_CHANNEL: &str = "robocal_robots";
+
+/// Announcements of changed robots (PostgreSQL `LISTEN`).
+pub struct RobotChanges {
+    listener: sqlx::postgres::PgListener,
+}
+
+/// What [`RobotChanges::next`] received.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RobotChange {
+    /// Robot `0` changed (its active version, name, or it was deleted).
+    Robot(i64),
+    /// The connection was lost and re-made: announcements may have been missed.
+    Missed,
+}
+
+impl RobotChanges {
+    /// The next announcement (waits for it).
+    pub async fn next(&mut self) -> Result<RobotChange, StoreError> {
+        Ok(match self.listener.try_recv().await? {
+            Some(n) => match n.payload().parse() {
+                Ok(id) => RobotChange::Robot(id),
+                Err(_) => RobotChange::Missed,
+            },
+            None => RobotChange::Missed,
+        })
+    }
+}
+
+impl Db {
+    /// Tells every replica that robot `robot_id` changed (PostgreSQL
+    /// `NOTIFY`; nothing to do on SQLite, where this process is the only one).
+    pub async fn announce_robot_change(&self, robot_id: i64) -> Result<(), StoreError> {
+        if let Pool::Postgres(p) = &self.pool {
+            sqlx::query("SELECT pg_notify($1, $2)")
+                .bind(ROBOT_CHANNEL)
+                .bind(robot_id.to_string())
+                .execute(p)
+                .await?;
+        }
+        Ok(())
+    }
+
+    /// Subscribes to [`Db::announce_robot_change`] (PostgreSQL only).
+    pub async fn robot_changes(&self) -> Result<RobotChanges, StoreError> {
+        let Pool::Postgres(p) = &self.pool else {
+            return Err(postgres_only("listening for changes"));
+        };
+        let mut listener = sqlx::postgres::PgListener::connect_with(p).await?;
+        listener.listen(ROBOT_CHANNEL).await?;
+        Ok(RobotChanges { listener })
+    }
+}

@@ -649,7 +649,7 @@ pub(super) async fn execute(state: AppState, job: Job, claim: Option<String>) {
         tracing::error!(job = id, error = %e, "cannot store the calibration outcome");
     }
     state.drop_cancel_flag(id);
-    state.invalidate_robot(robot_id);
+    super::changes::robot_changed(&state, robot_id).await;
     if claim.is_some() {
         state.wake_runner();
     }

@@ -11,6 +11,7 @@
 //! and a handler file (`http/<resource>.rs` with its `routes()`).
 
 pub mod calibrations;
+mod changes;
 pub mod limits;
 pub mod queue;
 pub mod robots;

@@ -43,7 +43,7 @@ pub async fn update(
         .update_robot(id, name, metadata)
         .await?
         .ok_or_else(|| ServiceError::robot_not_found(id))?;
-    state.invalidate_robot(id);
+    super::changes::robot_changed(state, id).await;
     Ok(row)
 }
 
@@ -58,6 +58,6 @@ pub async fn delete(state: &AppState, id: i64) -> Result<(), ServiceError> {
     if !state.db().delete_robot(id).await? {
         return Err(ServiceError::robot_not_found(id));
     }
-    state.invalidate_robot(id);
+    super::changes::robot_changed(state, id).await;
     Ok(())
 }

@@ -7,7 +7,7 @@ use super::ServiceError;
 use crate::db::Db;
 use crate::ik::IkSolver;
 use std::collections::HashMap;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, Weak};
 use std::time::Duration;
 use tokio::sync::{Notify, Semaphore};
@@ -97,6 +97,8 @@ struct Inner {
     draining: AtomicBool,
     /// Wakes the runner of the shared store.
     runner_wake: Arc<Notify>,
+    /// Counts cache invalidations (a read that saw another count is not cached).
+    invalidations: AtomicU64,
     robots: Mutex<HashMap<i64, Arc<RobotContext>>>,
     solvers: Mutex<HashMap<SolverKey, Arc<IkSolver>>>,
 }
@@ -115,6 +117,7 @@ impl AppState {
         let state = AppState::build(db, config);
         if shared {
             super::queue::spawn_runner(&state);
+            super::changes::spawn_listener(&state);
         }
         state
     }
@@ -134,6 +137,7 @@ impl AppState {
                 claims: Mutex::new(HashMap::new()),
                 draining: AtomicBool::new(false),
                 runner_wake: Arc::new(Notify::new()),
+                invalidations: AtomicU64::new(0),
                 robots: Mutex::new(HashMap::new()),
                 solvers: Mutex::new(HashMap::new()),
             }),
@@ -253,8 +257,20 @@ impl AppState {
 
     /// Forgets what is cached about a robot (after its versions changed or it was deleted).
     pub(crate) fn invalidate_robot(&self, robot_id: i64) {
-        lock(&self.inner.robots).remove(&robot_id);
+        let mut robots = lock(&self.inner.robots);
+        self.inner.invalidations.fetch_add(1, Ordering::SeqCst);
+        robots.remove(&robot_id);
+        drop(robots);
         lock(&self.inner.solvers).retain(|k, _| k.0 != robot_id);
+    }
+
+    /// Forgets what is cached about every robot.
+    pub(crate) fn invalidate_all_robots(&self) {
+        let mut robots = lock(&self.inner.robots);
+        self.inner.invalidations.fetch_add(1, Ordering::SeqCst);
+        robots.clear();
+        drop(robots);
+        lock(&self.inner.solvers).clear();
     }
 
     /// The robot and its active version, cached.
@@ -262,9 +278,15 @@ impl AppState {
         &self,
         robot_id: i64,
     ) -> Result<Arc<RobotContext>, ServiceError> {
-        if let Some(c) = lock(&self.inner.robots).get(&robot_id) {
-            return Ok(c.clone());
-        }
+        // Read before the store: a change announced while the store is read
+        // makes this read stale, and it is then not cached.
+        let seen = {
+            let robots = lock(&self.inner.robots);
+            if let Some(c) = robots.get(&robot_id) {
+                return Ok(c.clone());
+            }
+            self.inner.invalidations.load(Ordering::SeqCst)
+        };
         let robot = self
             .db()
             .robot(robot_id)
@@ -282,7 +304,10 @@ impl AppState {
             dof: robot.dof as usize,
             active,
         });
-        lock(&self.inner.robots).insert(robot_id, ctx.clone());
+        let mut robots = lock(&self.inner.robots);
+        if self.inner.invalidations.load(Ordering::SeqCst) == seen {
+            robots.insert(robot_id, ctx.clone());
+        }
         Ok(ctx)
     }
 

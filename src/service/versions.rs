@@ -55,7 +55,7 @@ pub async fn activate(state: &AppState, robot_id: i64, v: i64) -> Result<Version
             return Err(ServiceError::version_not_found(robot_id, v));
         }
     };
-    state.invalidate_robot(robot_id);
+    super::changes::robot_changed(state, robot_id).await;
     tracing::info!(robot = robot_id, version = v, "model version activated");
     Ok(row)
 }
@@ -65,7 +65,7 @@ pub async fn rollback(state: &AppState, robot_id: i64) -> Result<VersionRow, Ser
     robots::get(state, robot_id).await?;
     match state.db().rollback(robot_id).await? {
         Rollback::Done(row) => {
-            state.invalidate_robot(robot_id);
+            super::changes::robot_changed(state, robot_id).await;
             tracing::info!(robot = robot_id, version = row.version, "rolled back");
             Ok(row)
         }

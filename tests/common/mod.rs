@@ -84,7 +84,7 @@ pub struct TempDatabase {
 }
 
 impl TempDatabase {
-    async fn create(admin: &str) -> TempDatabase {
+    pub async fn create(admin: &str) -> TempDatabase {
         use sqlx::Connection;
         static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
         let stamp = std::time::SystemTime::now()
