@@ -342,6 +342,29 @@ impl Db {
         Ok(())
     }
 
+    /// Migrations of this build that the database has not applied (0 when
+    /// its schema is current).
+    pub async fn pending_migrations(&self) -> Result<usize, StoreError> {
+        let (migrator, applied): (sqlx::migrate::Migrator, Vec<i64>) = match &self.pool {
+            Pool::Sqlite(p) => (
+                sqlx::migrate!("migrations/sqlite"),
+                sqlx::query_scalar("SELECT version FROM _sqlx_migrations WHERE success")
+                    .fetch_all(p)
+                    .await?,
+            ),
+            Pool::Postgres(p) => (
+                sqlx::migrate!("migrations/postgres"),
+                sqlx::query_scalar("SELECT version FROM _sqlx_migrations WHERE success")
+                    .fetch_all(p)
+                    .await?,
+            ),
+        };
+        Ok(migrator
+            .iter()
+            .filter(|m| !applied.contains(&m.version))
+            .count())
+    }
+
     /// SQLite: `PRAGMA integrity_check` (`"ok"` when the file is sound).
     /// PostgreSQL checks its pages itself: `"ok"` when it answers.
     pub async fn integrity_check(&self) -> Result<String, StoreError> {

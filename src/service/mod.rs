@@ -76,6 +76,27 @@ impl ServiceError {
     }
 }
 
+/// Whether this replica should get requests: the store answers, its schema
+/// is current, and the replica is not shutting down; `Unavailable` when not.
+pub async fn ready(state: &AppState) -> Result<(), ServiceError> {
+    if state.draining() {
+        return Err(ServiceError::Unavailable(
+            "this replica is shutting down".into(),
+        ));
+    }
+    let pending = state
+        .db()
+        .pending_migrations()
+        .await
+        .map_err(|e| ServiceError::Unavailable(format!("database unavailable: {e}")))?;
+    if pending > 0 {
+        return Err(ServiceError::Unavailable(format!(
+            "the database lacks {pending} migration(s) of this build"
+        )));
+    }
+    Ok(())
+}
+
 /// Whether the store answers now (one round trip): `Unavailable` when not.
 pub async fn health(state: &AppState) -> Result<(), ServiceError> {
     state

@@ -722,3 +722,25 @@ async fn urls_over_64_kib_get_a_problem_document() {
     assert!(buf.starts_with(b"HTTP/1.1 200 "));
     server.abort();
 }
+
+/// `/readyz` answers 200 while the store answers and its schema is current,
+/// 503 when a migration of this build is missing (SQLite file edited here).
+#[tokio::test]
+async fn readiness_follows_the_schema() {
+    let t = setup().await;
+    let r = t.get("/readyz", &[]).await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    assert_eq!(t.db.pending_migrations().await.unwrap(), 0);
+    if t._pg.is_some() {
+        return;
+    }
+    let url = format!("sqlite://{}", t._dir.path().join("service.db").display());
+    let pool = sqlx::SqlitePool::connect(&url).await.unwrap();
+    sqlx::query("DELETE FROM _sqlx_migrations WHERE version = 3")
+        .execute(&pool)
+        .await
+        .unwrap();
+    let r = t.get("/readyz", &[]).await;
+    assert_eq!(r.status, StatusCode::SERVICE_UNAVAILABLE);
+    assert!(r.detail().contains("1 migration"), "{}", r.detail());
+}
