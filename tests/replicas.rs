@@ -144,8 +144,9 @@ fn jobs_through_two_replicas_run_once_and_survive_a_kill() {
         eprintln!("skipped: set ROBOCAL_TEST_DATABASE_URL=postgres://… (scripts/pg_temp.sh)");
         return;
     };
+    // B has room to take A's jobs over while it runs its own.
     let a = replica(&db.url, "2");
-    let b = replica(&db.url, "2");
+    let b = replica(&db.url, "4");
     let robot = robot_with_data(a.addr);
 
     // 100 short jobs through both: each runs exactly once.
@@ -173,8 +174,8 @@ fn jobs_through_two_replicas_run_once_and_survive_a_kill() {
     eprintln!("100 jobs: {} ran on replica A, the rest on B", on_a.count());
 
     // Slow jobs; SIGKILL replica A while it runs some: they finish on B.
-    let slow = json!({"methods": ["skcm-tlbo"], "population": 20, "generations": 400});
-    let slow_jobs = queue(&[a.addr, b.addr], robot, 6, &slow);
+    let slow = json!({"methods": ["skcm-tlbo"], "population": 20, "generations": 150});
+    let slow_jobs = queue(&[a.addr, b.addr], robot, 4, &slow);
     let t0 = Instant::now();
     let on_a: Vec<i64> = loop {
         let running: Vec<i64> = starts(&[&a])
