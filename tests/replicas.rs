@@ -6,6 +6,7 @@
 //!   started" log line per job over both logs, and one model version per job.
 //! - SIGKILL one replica while it runs jobs: they finish on the other within
 //!   the lease + 10 s, each stored once.
+//! - SIGTERM hands a running job back to the queue; another replica runs it.
 //! - Activating a version on one replica is what the other's next solve uses.
 
 #[path = "common/mod.rs"]
@@ -265,4 +266,44 @@ fn activating_on_one_replica_is_what_the_other_solves_with() {
         "replica B solved with the version activated on A {:.3} s later",
         activated.elapsed().as_secs_f64()
     );
+}
+
+/// SIGTERM hands the replica's running job back to the queue: the other
+/// replica runs it to success, and it is stored once.
+#[test]
+fn sigterm_hands_running_jobs_to_the_other_replica() {
+    let Some(db) = database() else {
+        eprintln!("skipped: set ROBOCAL_TEST_DATABASE_URL=postgres://… (scripts/pg_temp.sh)");
+        return;
+    };
+    let mut a = replica(&db.url, "1");
+    let robot = robot_with_data(a.addr);
+    let slow = json!({"methods": ["skcm-tlbo"], "population": 20, "generations": 150});
+    let jobs = queue(&[a.addr], robot, 1, &slow);
+    let t0 = Instant::now();
+    while starts(&[&a]).is_empty() {
+        assert!(
+            t0.elapsed() < Duration::from_secs(60),
+            "replica A never started the job"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    // SAFETY: kill(2) on our own child's pid.
+    let rc = unsafe { libc::kill(a.child.id() as i32, libc::SIGTERM) };
+    assert_eq!(rc, 0);
+    let status = a.child.wait().unwrap();
+    assert!(status.success(), "replica A exited with {status}");
+    assert!(
+        a.log
+            .lock()
+            .unwrap()
+            .iter()
+            .any(|l| l.contains("handed back to the queue")),
+        "replica A did not hand its job back"
+    );
+    let b = replica(&db.url, "1");
+    let done = wait_all(b.addr, robot, &jobs, Duration::from_secs(120));
+    assert_eq!(done[&jobs[0]]["status"], "succeeded", "{}", done[&jobs[0]]);
+    assert_eq!(versions_of(b.addr, robot, jobs[0]), 1);
+    assert_eq!(starts(&[&b]).get(&jobs[0]), Some(&1));
 }
