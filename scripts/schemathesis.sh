@@ -9,11 +9,13 @@
 # Starts the service on a loopback port with a temporary database and two API
 # keys, then runs Schemathesis with every check (`--checks all`), every phase
 # (examples, coverage, fuzzing, stateful), a bounded number of examples per
-# operation and a fixed seed. Exits non-zero on any failure. Afterwards the
-# database must pass `PRAGMA integrity_check` and `PRAGMA foreign_key_check`.
+# operation and a fixed seed. Exits non-zero on any failure. Afterwards a
+# SQLite database must pass `PRAGMA integrity_check` and `PRAGMA foreign_key_check`.
 #
 # Environment: SCHEMATHESIS_VENV (default target/schemathesis-venv),
-# SCHEMATHESIS_MAX_EXAMPLES (default 25), SCHEMATHESIS_SEED (default 20261122).
+# SCHEMATHESIS_MAX_EXAMPLES (default 25), SCHEMATHESIS_SEED (default 20261122),
+# SCHEMATHESIS_DATABASE_URL (default a SQLite file in a temporary directory;
+# `postgres://…` runs the server on that (empty) PostgreSQL database).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -45,11 +47,13 @@ cleanup() {
 }
 trap cleanup EXIT
 
+DATABASE_URL=${SCHEMATHESIS_DATABASE_URL:-sqlite://$WORK/api.db?mode=rwc}
+
 # Small budgets keep jobs short in a debug build; queues large enough that a
 # run of this size never saturates the service (429 is tested in tests/api.rs).
 ROBOCAL_API_KEYS=ci-key-1,ci-key-2 RUST_LOG=warn,robocal::cli::serve=info "$BIN" serve \
     --bind 127.0.0.1:0 \
-    --database-url "sqlite://$WORK/api.db?mode=rwc" \
+    --database-url "$DATABASE_URL" \
     --job-time-limit 20 \
     --max-queued-jobs 10000 --max-queued-solves 64 \
     2> >(tee "$WORK/server.log" >&2) &
@@ -89,6 +93,13 @@ echo "schemathesis.sh: finished in $(( $(date +%s) - start )) s with exit code $
 kill "$SERVER_PID"
 wait "$SERVER_PID" 2>/dev/null || true
 SERVER_PID=
+case "$DATABASE_URL" in
+postgres*)
+    # PostgreSQL enforces every key and check on every write.
+    echo "schemathesis.sh: database after the run: $(psql -At "$DATABASE_URL" -c 'SELECT COUNT(*) FROM robots') robots (PostgreSQL)"
+    exit $status
+    ;;
+esac
 # The database the fuzzing left behind is sound.
 "$VENV/bin/python" - "$WORK/api.db" <<'EOF'
 import sqlite3, sys

@@ -8,145 +8,17 @@
 //! ("interrupted by a restart"), the service works (a new calibration
 //! succeeds), and `PRAGMA integrity_check` says `ok`.
 
+#[path = "common/process.rs"]
+mod process;
+
+use process::{http, json_req, simulated, Server};
 use robocal::measure::{csv, MeasuredPose};
 use serde_json::{json, Value};
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::Write;
 use std::net::{SocketAddr, TcpStream};
-use std::path::Path;
-use std::process::{Child, Command, Stdio};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{mpsc, Arc, Mutex};
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
-
-struct Server {
-    child: Child,
-    addr: SocketAddr,
-}
-
-impl Server {
-    fn start(db: &Path) -> Server {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_robocal"))
-            .args(["serve", "--bind", "127.0.0.1:0"])
-            .env(
-                "DATABASE_URL",
-                format!("sqlite://{}?mode=rwc", db.display()),
-            )
-            .env("RUST_LOG", "info")
-            .env_remove("ROBOCAL_API_KEYS")
-            .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
-            .expect("robocal starts");
-        let stderr = child.stderr.take().unwrap();
-        let (tx, rx) = mpsc::channel();
-        std::thread::spawn(move || {
-            let mut sent = false;
-            for line in BufReader::new(stderr).lines().map_while(Result::ok) {
-                if !sent {
-                    if let Some(i) = line.find("listening on http://") {
-                        let rest = &line[i + "listening on http://".len()..];
-                        let addr = rest.split_whitespace().next().unwrap().to_string();
-                        let _ = tx.send(addr);
-                        sent = true;
-                    }
-                }
-                eprintln!("[server] {line}");
-            }
-        });
-        let addr = rx
-            .recv_timeout(Duration::from_secs(60))
-            .expect("the server reports its address")
-            .parse()
-            .unwrap();
-        Server { child, addr }
-    }
-
-    fn kill9(mut self) {
-        // Child::kill sends SIGKILL on Unix: no shutdown code runs.
-        self.child.kill().unwrap();
-        self.child.wait().unwrap();
-    }
-}
-
-/// A minimal HTTP/1.1 client (one request per connection).
-fn http(
-    addr: SocketAddr,
-    method: &str,
-    path: &str,
-    ct: Option<&str>,
-    body: &[u8],
-) -> std::io::Result<(u16, Vec<u8>)> {
-    let mut s = TcpStream::connect(addr)?;
-    s.set_read_timeout(Some(Duration::from_secs(60)))?;
-    let mut head = format!(
-        "{method} {path} HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\nContent-Length: {}\r\n",
-        body.len()
-    );
-    if let Some(ct) = ct {
-        head.push_str(&format!("Content-Type: {ct}\r\n"));
-    }
-    head.push_str("\r\n");
-    s.write_all(head.as_bytes())?;
-    s.write_all(body)?;
-    let mut buf = Vec::new();
-    s.read_to_end(&mut buf)?;
-    let split = buf
-        .windows(4)
-        .position(|w| w == b"\r\n\r\n")
-        .ok_or_else(|| std::io::Error::other("no header end"))?;
-    let headers = String::from_utf8_lossy(&buf[..split]).to_ascii_lowercase();
-    let status: u16 = headers
-        .split_whitespace()
-        .nth(1)
-        .and_then(|s| s.parse().ok())
-        .ok_or_else(|| std::io::Error::other("no status"))?;
-    let mut payload = buf[split + 4..].to_vec();
-    if headers.contains("transfer-encoding: chunked") {
-        let mut out = Vec::new();
-        let mut rest = &payload[..];
-        loop {
-            let nl = rest.windows(2).position(|w| w == b"\r\n").unwrap();
-            let n = usize::from_str_radix(std::str::from_utf8(&rest[..nl]).unwrap().trim(), 16)
-                .unwrap();
-            if n == 0 {
-                break;
-            }
-            out.extend_from_slice(&rest[nl + 2..nl + 2 + n]);
-            rest = &rest[nl + 4 + n..];
-        }
-        payload = out;
-    }
-    Ok((status, payload))
-}
-
-fn json_req(addr: SocketAddr, method: &str, path: &str, body: Option<Value>) -> (u16, Value) {
-    let b = body.map(|b| b.to_string()).unwrap_or_default();
-    let (status, bytes) = http(addr, method, path, body_ct(&b), b.as_bytes()).expect("request");
-    let v = if bytes.is_empty() {
-        Value::Null
-    } else {
-        serde_json::from_slice(&bytes).unwrap_or(Value::Null)
-    };
-    (status, v)
-}
-
-fn body_ct(b: &str) -> Option<&'static str> {
-    (!b.is_empty()).then_some("application/json")
-}
-
-fn simulated(seed: u64, n: usize) -> String {
-    use rand::SeedableRng;
-    use robocal::sim::{try_random_configurations, ys100_table_7_1, PoseFilter, TrueRobot};
-    let mut t = TrueRobot::new(ys100_table_7_1());
-    t.noise_mm = 0.01;
-    let nominal = robocal::model::preset("ys100").unwrap();
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-    let qs = try_random_configurations(&nominal, n, &PoseFilter::default(), &mut rng, |q| {
-        t.true_position(q, Some(110.0)).is_ok()
-    })
-    .unwrap();
-    csv::write(&t.measure(&qs, Some(110.0), None, &mut rng).unwrap())
-}
 
 fn rows_of(addr: SocketAddr, robot: i64, set: i64) -> (u16, Vec<MeasuredPose>) {
     let (s, v) = json_req(
@@ -169,7 +41,7 @@ fn rows_of(addr: SocketAddr, robot: i64, set: i64) -> (u16, Vec<MeasuredPose>) {
 fn kill_9_during_uploads_and_calibration_loses_nothing_committed() {
     let dir = tempfile::tempdir().unwrap();
     let db = dir.path().join("durable.db");
-    let server = Server::start(&db);
+    let server = Server::start(&format!("sqlite://{}?mode=rwc", db.display()), &[]);
     let addr = server.addr;
 
     // Committed before the crash.
@@ -275,7 +147,7 @@ fn kill_9_during_uploads_and_calibration_loses_nothing_committed() {
     let attempts = *attempts.lock().unwrap();
 
     // Restart on the same file.
-    let server = Server::start(&db);
+    let server = Server::start(&format!("sqlite://{}?mode=rwc", db.display()), &[]);
     let addr = server.addr;
     let (s, _) = json_req(addr, "GET", "/healthz", None);
     assert_eq!(s, 200);
@@ -361,11 +233,7 @@ fn kill_9_during_uploads_and_calibration_loses_nothing_committed() {
             .await
             .unwrap();
         assert_eq!(db.integrity_check().await.unwrap(), "ok");
-        let fk: Vec<(String, Option<i64>, String, i64)> =
-            sqlx::query_as("PRAGMA foreign_key_check")
-                .fetch_all(db.pool())
-                .await
-                .unwrap();
-        assert!(fk.is_empty(), "foreign key violations: {fk:?}");
+        let fk = db.foreign_key_violations().await.unwrap();
+        assert_eq!(fk, 0, "foreign key violations");
     });
 }

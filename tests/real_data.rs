@@ -23,16 +23,21 @@ fn model_file(name: &str) -> Value {
 struct App {
     router: Router,
     _dir: tempfile::TempDir,
+    _pg: Option<common::TempDatabase>,
 }
 
 impl App {
     async fn new() -> App {
-        let (router, _, dir) = service(ServiceConfig {
+        let s = service(ServiceConfig {
             progress_interval: Duration::from_millis(50),
             ..ServiceConfig::default()
         })
         .await;
-        App { router, _dir: dir }
+        App {
+            router: s.router,
+            _dir: s.dir,
+            _pg: s.pg,
+        }
     }
 
     async fn call(&self, method: &str, uri: &str, ct: Option<&str>, body: Vec<u8>) -> (u16, Value) {

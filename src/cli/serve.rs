@@ -4,7 +4,9 @@
 //! - `--bind ADDR` / `ROBOCAL_BIND`: listen address, default `127.0.0.1:8080`
 //!   (loopback; bind `0.0.0.0:8080` explicitly to serve the network);
 //! - `--database-url URL` / `DATABASE_URL`: default `sqlite://robocal.db?mode=rwc`,
-//!   created in the working directory on first start;
+//!   created in the working directory on first start; `postgres://…` selects
+//!   PostgreSQL (docs/deployment.md), with `--db-pool N` / `ROBOCAL_DB_POOL`
+//!   connections per replica (default 10);
 //! - `ROBOCAL_API_KEYS`: comma-separated bearer keys for writes (none: writes
 //!   are open; reads are always open);
 //! - `--workers N` / `ROBOCAL_WORKERS`: calibration jobs run at once, default 1;
@@ -14,11 +16,14 @@
 //!   `--page-max`, each with a `ROBOCAL_…` variable; see [`crate::service::limits`]);
 //! - `RUST_LOG`: log filter, default `info`.
 //!
-//! Start-up: open the database, apply the migrations, mark jobs that a previous
-//! process left queued or running as failed ("interrupted by a restart"), then
-//! serve until SIGINT/SIGTERM.
+//! Start-up: open the database, apply the migrations; on SQLite mark jobs that
+//! a previous process left queued or running as failed ("interrupted by a
+//! restart"); then serve until SIGINT/SIGTERM. On PostgreSQL jobs are shared
+//! by replicas (`--job-lease N` / `ROBOCAL_JOB_LEASE`, default 15 s; see
+//! [`crate::service::queue`]) and SIGTERM hands this replica's running jobs
+//! back to the queue.
 
-use crate::db::{Db, DEFAULT_DATABASE_URL};
+use crate::db::{Backend, Db, DEFAULT_DATABASE_URL, DEFAULT_PG_POOL};
 use crate::http::{app, AppState, Limits, ServiceConfig, ServiceListener};
 use anyhow::Context;
 use clap::Args;
@@ -29,12 +34,19 @@ pub struct ServeArgs {
     /// Listen address (loopback by default).
     #[arg(long, env = "ROBOCAL_BIND", default_value = "127.0.0.1:8080")]
     pub bind: String,
-    /// SQLite database URL or file path.
+    /// SQLite database URL or file path, or a PostgreSQL URL (`postgres://…`).
     #[arg(long, env = "DATABASE_URL", default_value = DEFAULT_DATABASE_URL)]
     pub database_url: String,
-    /// Calibration jobs that run at the same time.
+    /// Connections to PostgreSQL this replica keeps at most.
+    #[arg(long, env = "ROBOCAL_DB_POOL", default_value_t = DEFAULT_PG_POOL)]
+    pub db_pool: u32,
+    /// Calibration jobs that run at the same time (on this replica).
     #[arg(long, env = "ROBOCAL_WORKERS", default_value_t = 1)]
     pub workers: usize,
+    /// PostgreSQL: seconds a claimed job's lease lasts unless renewed; a job
+    /// whose replica died is taken over once it lapsed.
+    #[arg(long, env = "ROBOCAL_JOB_LEASE", default_value_t = 15)]
+    pub job_lease: u64,
     /// Solve batches (above 64 targets) that run at the same time.
     #[arg(long, env = "ROBOCAL_SOLVE_WORKERS", default_value_t = 2)]
     pub solve_workers: usize,
@@ -138,30 +150,37 @@ pub fn run(args: ServeArgs) -> anyhow::Result<()> {
 }
 
 async fn serve(addr: SocketAddr, args: ServeArgs) -> anyhow::Result<()> {
-    let db = Db::connect(&args.database_url)
+    let db = Db::connect_with(&args.database_url, args.db_pool)
         .await
-        .with_context(|| format!("cannot open the database {}", args.database_url))?;
-    let interrupted = db.fail_interrupted_jobs().await?;
-    if !interrupted.is_empty() {
-        tracing::warn!(jobs = ?interrupted, "marked calibrations interrupted by a restart as failed");
+        .with_context(|| format!("cannot open the database {}", redact(&args.database_url)))?;
+    // SQLite: this process owned every job. PostgreSQL: other replicas may be
+    // running theirs; a dead replica's jobs are taken over when their lease lapses.
+    if db.backend() == Backend::Sqlite {
+        let interrupted = db.fail_interrupted_jobs().await?;
+        if !interrupted.is_empty() {
+            tracing::warn!(jobs = ?interrupted, "marked calibrations interrupted by a restart as failed");
+        }
     }
     let keys = api_keys_from_env();
     let config = ServiceConfig {
         api_keys: keys.clone(),
         workers: args.workers,
         solve_workers: args.solve_workers.max(1),
+        job_lease: std::time::Duration::from_secs(args.job_lease.max(1)),
         limits: args.limits()?,
         ..ServiceConfig::default()
     };
+    let backend = db.backend();
     let state = AppState::new(db, config);
     let listener = tokio::net::TcpListener::bind(addr)
         .await
         .with_context(|| format!("cannot listen on {addr}"))?;
     let local = listener.local_addr()?;
     tracing::info!(
-        "robocal {} listening on http://{local} (database {}, {} calibration worker(s), API keys {})",
+        "robocal {} listening on http://{local} (database {} {}, {} calibration worker(s), API keys {})",
         env!("CARGO_PKG_VERSION"),
-        args.database_url,
+        backend.name(),
+        redact(&args.database_url),
         args.workers,
         if keys.is_empty() {
             "off: writes are open".to_string()
@@ -169,12 +188,33 @@ async fn serve(addr: SocketAddr, args: ServeArgs) -> anyhow::Result<()> {
             format!("on: {} key(s)", keys.len())
         }
     );
+    let draining = state.clone();
     axum::serve(ServiceListener::new(listener), app(state))
-        .with_graceful_shutdown(shutdown())
+        .with_graceful_shutdown(async move {
+            shutdown().await;
+            // PostgreSQL: running jobs go back to the queue for other replicas.
+            if draining.shared_jobs() {
+                crate::service::queue::drain(&draining).await;
+            }
+        })
         .await
         .context("server error")?;
     tracing::info!("stopped");
     Ok(())
+}
+
+/// A database URL for the log: the password of `scheme://user:password@host` replaced by `***`.
+fn redact(url: &str) -> String {
+    let Some((scheme, rest)) = url.split_once("://") else {
+        return url.to_string();
+    };
+    match rest.split_once('@') {
+        Some((user, host)) if user.contains(':') => {
+            let name = user.split(':').next().unwrap_or("");
+            format!("{scheme}://{name}:***@{host}")
+        }
+        _ => url.to_string(),
+    }
 }
 
 async fn shutdown() {

@@ -1,68 +1,278 @@
-//! The SQLite store (sqlx): connection set-up, migrations, and the queries of
-//! the service, one file per resource (`robots`, `sets`, `calibrations`,
-//! `versions`). No SQL is written outside this module.
+//! The store (sqlx): SQLite (the embedded default) or PostgreSQL (shared by
+//! several replicas), connection set-up, migrations, and the queries of the
+//! service, one file per resource (`robots`, `sets`, `calibrations`,
+//! `versions`). No SQL is written outside this module, and no `sqlx` error
+//! leaves it: callers get a [`StoreError`].
 //!
-//! - One file, WAL journal, `synchronous = FULL` (a committed transaction
-//!   survives a crash of the process and of the machine), foreign keys on,
-//!   a busy timeout so concurrent writers wait instead of failing.
-//! - Every write runs in one `BEGIN IMMEDIATE` transaction: a crash at any point
-//!   leaves either all of it or none of it. A write that belongs to a robot
-//!   checks inside its transaction that the robot still exists (and returns
-//!   `None` when not), so a concurrent delete gives a clean "not found", never
-//!   a foreign-key failure.
-//! - Schema: `migrations/` (numbered, commented), applied at start-up by
-//!   [`Db::connect`].
-//! - Typed columns: status, role, units and format are `sqlx::Type` enums
-//!   stored as the lowercase text the schema's CHECK constraints name; JSON
-//!   columns are `sqlx::types::Json<T>` holding boundary units (mm/deg)
-//!   exactly as the API returns them.
-//! - Timestamps: UTC RFC 3339 text with milliseconds, written by SQLite
-//!   ([`now!`] is the one expression for "now").
-//!
-//! The service is the only writer: run one `robocal serve` per database file.
+//! - `DATABASE_URL` picks the backend: `postgres://…`/`postgresql://…` is
+//!   PostgreSQL, anything else a SQLite file (created when missing; WAL
+//!   journal, `synchronous = FULL`, foreign keys on, a busy timeout).
+//! - One SQL text per query for both backends: `$1, $2, …` placeholders
+//!   (sqlx binds them by number on SQLite too), `TRUE`/`FALSE` for flags, and
+//!   `{now}` for the current time, which [`Backend::sql`] turns into the
+//!   backend's expression. Each method is compiled once per backend by
+//!   [`on_pool!`].
+//! - Every write runs in one transaction (SQLite: `BEGIN IMMEDIATE`, which
+//!   serialises writers; PostgreSQL: the rows a write depends on are locked
+//!   with `FOR UPDATE`). A write that belongs to a robot locks the robot's row
+//!   inside its transaction and returns `None` when it is gone, so a
+//!   concurrent delete gives a clean "not found", never a foreign-key failure.
+//! - Schema: `migrations/sqlite/` and `migrations/postgres/` (numbered,
+//!   commented, the same tables), applied at start-up by [`Db::connect`].
+//! - Typed columns ([`types`]): status, role, units and format are enums stored
+//!   as the lowercase text the schema's CHECK constraints name; JSON columns
+//!   are [`Json<T>`], text holding boundary units (mm/deg) exactly as the API
+//!   returns them, on both backends.
+//! - Timestamps: UTC RFC 3339 text with milliseconds, written by the database.
 
-use sqlx::query::Query;
+use sqlx::postgres::{PgPool, PgPoolOptions, PgRow};
 use sqlx::sqlite::{
-    SqliteArguments, SqliteConnectOptions, SqliteJournalMode, SqlitePool, SqlitePoolOptions,
-    SqliteRow, SqliteSynchronous,
+    SqliteConnectOptions, SqliteJournalMode, SqlitePool, SqlitePoolOptions, SqliteRow,
+    SqliteSynchronous,
 };
-use sqlx::{FromRow, Row, Sqlite, Transaction};
+use sqlx::{FromRow, Row};
 use std::str::FromStr;
 use std::time::Duration;
 
-pub use sqlx::types::Json;
-pub use sqlx::Error as DbError;
+/// Why a store operation failed, in robocal's own terms: `sqlx` errors stay
+/// inside this module.
+#[derive(Debug, thiserror::Error)]
+pub enum StoreError {
+    /// A row the operation needs does not exist.
+    #[error("{0}")]
+    NotFound(String),
+    /// The write conflicts with the stored state (its parent was deleted meanwhile, a duplicate).
+    #[error("{0}")]
+    Conflict(String),
+    /// The database cannot be reached now (no connection, pool exhausted, closed).
+    #[error("database unavailable: {0}")]
+    Unavailable(String),
+    /// Anything else: a bug, corrupt data, a failed migration.
+    #[error("database: {0}")]
+    Internal(String),
+}
 
-/// The SQL expression for the current time as stored (UTC, RFC 3339, ms).
-macro_rules! now {
-    () => {
-        "strftime('%Y-%m-%dT%H:%M:%fZ', 'now')"
-    };
+impl From<sqlx::Error> for StoreError {
+    fn from(e: sqlx::Error) -> Self {
+        use sqlx::Error as E;
+        match &e {
+            // Writes check their parent inside their transaction; this is the
+            // last line of defence should one be missed.
+            E::Database(d) if d.is_foreign_key_violation() => StoreError::Conflict(
+                "the resource this write belongs to was deleted meanwhile".into(),
+            ),
+            E::Database(d) if d.is_unique_violation() => {
+                StoreError::Conflict("a concurrent write made the same change; retry".into())
+            }
+            E::RowNotFound => StoreError::NotFound(e.to_string()),
+            E::PoolTimedOut | E::PoolClosed | E::Io(_) | E::Tls(_) | E::WorkerCrashed => {
+                StoreError::Unavailable(e.to_string())
+            }
+            _ => StoreError::Internal(e.to_string()),
+        }
+    }
+}
+
+impl From<sqlx::migrate::MigrateError> for StoreError {
+    fn from(e: sqlx::migrate::MigrateError) -> Self {
+        StoreError::Internal(format!("migrations: {e}"))
+    }
 }
 
 mod calibrations;
+mod queue;
 mod robots;
 mod sets;
+mod types;
 mod versions;
 
-pub use calibrations::{CalibrationRow, JobStatus, JobSummary, NewCalibration};
+pub use calibrations::{CalibrationRow, JobResult, JobStatus, JobSummary, NewCalibration};
+pub use queue::{ClaimedJob, Lease, RobotChange, RobotChanges};
 pub use robots::{NewRobot, RobotRow};
 pub use sets::{AngleUnit, LengthUnit, NewSet, SetFormat, SetRow, StoredRole};
+pub use types::Json;
 pub use versions::{NewVersion, Rollback, VersionRow};
+
+/// One page of a list and the length of the whole list.
+#[derive(Debug, Clone)]
+pub struct Listing<T> {
+    pub rows: Vec<T>,
+    pub total: i64,
+}
+
+/// The number of rows of every table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RowCounts {
+    pub robots: i64,
+    pub measurement_sets: i64,
+    pub calibrations: i64,
+    pub model_versions: i64,
+    pub activations: i64,
+}
+
+impl RowCounts {
+    const TABLES: [&'static str; 5] = [
+        "robots",
+        "measurement_sets",
+        "calibrations",
+        "model_versions",
+        "activations",
+    ];
+}
 
 /// Default database location: `robocal.db` in the working directory, created on first start.
 pub const DEFAULT_DATABASE_URL: &str = "sqlite://robocal.db?mode=rwc";
 
-/// The connection pool of the store.
-#[derive(Debug, Clone)]
-pub struct Db {
-    pool: SqlitePool,
+/// Connections to PostgreSQL per replica unless `Db::connect_with` says otherwise.
+pub const DEFAULT_PG_POOL: u32 = 10;
+
+/// Which database engine a [`Db`] talks to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Backend {
+    Sqlite,
+    Postgres,
 }
 
-/// Turns `DATABASE_URL` into connect options. Accepts `sqlite://path?mode=rwc`,
-/// `sqlite:path`, `sqlite::memory:` or a plain file path; the file is created
-/// when missing.
-pub fn connect_options(url: &str) -> Result<SqliteConnectOptions, DbError> {
+impl Backend {
+    /// The backend `url` names: PostgreSQL for `postgres://` or `postgresql://`.
+    pub fn of_url(url: &str) -> Backend {
+        let url = url.trim();
+        if url.starts_with("postgres://") || url.starts_with("postgresql://") {
+            Backend::Postgres
+        } else {
+            Backend::Sqlite
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Backend::Sqlite => "sqlite",
+            Backend::Postgres => "postgres",
+        }
+    }
+
+    /// The expression for the current time as stored (UTC, RFC 3339, ms).
+    fn now(self) -> &'static str {
+        match self {
+            Backend::Sqlite => "strftime('%Y-%m-%dT%H:%M:%fZ', 'now')",
+            Backend::Postgres => "robocal_now()",
+        }
+    }
+
+    /// `sql` with `{now}` replaced by this backend's current time.
+    fn sql(self, sql: &str) -> String {
+        sql.replace("{now}", self.now())
+    }
+
+    /// Starts a write transaction.
+    fn begin_write(self) -> &'static str {
+        match self {
+            Backend::Sqlite => "BEGIN IMMEDIATE",
+            Backend::Postgres => "BEGIN",
+        }
+    }
+
+    /// Starts a read transaction whose statements all see one snapshot.
+    fn begin_read(self) -> &'static str {
+        match self {
+            Backend::Sqlite => "BEGIN",
+            Backend::Postgres => "BEGIN ISOLATION LEVEL REPEATABLE READ READ ONLY",
+        }
+    }
+
+    /// Selects robot `$1`, locking its row until the transaction ends
+    /// (SQLite's write transaction already excludes every other writer).
+    fn lock_robot(self) -> &'static str {
+        match self {
+            Backend::Sqlite => "SELECT id FROM robots WHERE id = $1",
+            Backend::Postgres => "SELECT id FROM robots WHERE id = $1 FOR UPDATE",
+        }
+    }
+}
+
+/// The connection pool of one backend.
+#[derive(Debug, Clone)]
+enum Pool {
+    Sqlite(SqlitePool),
+    Postgres(PgPool),
+}
+
+/// The store: a connection pool to SQLite or PostgreSQL.
+#[derive(Debug, Clone)]
+pub struct Db {
+    pool: Pool,
+}
+
+/// Runs `$body` with `$p` bound to the pool of the backend in use and `$k` to
+/// the [`Backend`]; the body is compiled once per backend.
+macro_rules! on_pool {
+    ($db:expr, |$p:ident, $k:ident| $body:expr) => {
+        match &$db.pool {
+            $crate::db::Pool::Sqlite($p) => {
+                #[allow(unused_variables)]
+                let $k = $crate::db::Backend::Sqlite;
+                $body
+            }
+            $crate::db::Pool::Postgres($p) => {
+                #[allow(unused_variables)]
+                let $k = $crate::db::Backend::Postgres;
+                $body
+            }
+        }
+    };
+}
+pub(crate) use on_pool;
+
+/// Runs one statement (`$q`, built per backend) in its own write transaction;
+/// the rows it changed.
+macro_rules! write_one {
+    ($p:ident, $k:ident, $q:expr) => {{
+        let mut tx = $p.begin_with($k.begin_write()).await?;
+        let n = $q.execute(&mut *tx).await?.rows_affected();
+        tx.commit().await?;
+        n
+    }};
+}
+pub(crate) use write_one;
+
+/// Starts a write transaction for a write that belongs to robot `$robot`,
+/// holding the robot's row: `None` (rolled back) when the robot does not
+/// exist (any more).
+macro_rules! write_for_robot {
+    ($p:ident, $k:ident, $robot:expr) => {{
+        let mut tx = $p.begin_with($k.begin_write()).await?;
+        let found: Option<i64> = sqlx::query_scalar($k.lock_robot())
+            .bind($robot)
+            .fetch_optional(&mut *tx)
+            .await?;
+        if found.is_some() {
+            Some(tx)
+        } else {
+            tx.rollback().await?;
+            None
+        }
+    }};
+}
+pub(crate) use write_for_robot;
+
+/// Reads back the row `$select WHERE $id_column = $1` just inserted in `$tx`
+/// and commits, so the caller gets the row as stored (defaults, timestamps).
+macro_rules! commit_inserted {
+    ($tx:ident, $T:ty, $select:expr, $id_column:expr, $id:expr) => {{
+        let row = sqlx::query_as::<_, $T>(&format!("{} WHERE {} = $1", $select, $id_column))
+            .bind($id)
+            .fetch_one(&mut *$tx)
+            .await?;
+        $tx.commit().await?;
+        row
+    }};
+}
+pub(crate) use commit_inserted;
+
+/// Turns a SQLite `DATABASE_URL` into connect options. Accepts
+/// `sqlite://path?mode=rwc`, `sqlite:path`, `sqlite::memory:` or a plain file
+/// path; the file is created when missing.
+pub fn connect_options(url: &str) -> Result<SqliteConnectOptions, StoreError> {
     let url = url.trim();
     let opts = if url.starts_with("sqlite:") {
         SqliteConnectOptions::from_str(url)?
@@ -77,70 +287,162 @@ pub fn connect_options(url: &str) -> Result<SqliteConnectOptions, DbError> {
         .busy_timeout(Duration::from_secs(10)))
 }
 
+/// A row type that both backends can read.
+pub(crate) trait AnyRow:
+    for<'r> FromRow<'r, SqliteRow> + for<'r> FromRow<'r, PgRow> + Send + Unpin
+{
+}
+
+impl<T> AnyRow for T where
+    T: for<'r> FromRow<'r, SqliteRow> + for<'r> FromRow<'r, PgRow> + Send + Unpin
+{
+}
+
 impl Db {
-    /// Opens (creating if needed) the database and applies the migrations.
-    pub async fn connect(url: &str) -> Result<Db, DbError> {
-        let opts = connect_options(url)?;
-        let pool = SqlitePoolOptions::new()
-            .max_connections(8)
-            .min_connections(1)
-            .connect_with(opts)
-            .await?;
-        sqlx::migrate!()
-            .run(&pool)
-            .await
-            .map_err(|e| DbError::Migrate(Box::new(e)))?;
+    /// Opens the database `url` names (creating a SQLite file if needed) and
+    /// applies the migrations; PostgreSQL with [`DEFAULT_PG_POOL`] connections.
+    pub async fn connect(url: &str) -> Result<Db, StoreError> {
+        Db::connect_with(url, DEFAULT_PG_POOL).await
+    }
+
+    /// [`Db::connect`] with `pg_pool` connections to PostgreSQL at most.
+    pub async fn connect_with(url: &str, pg_pool: u32) -> Result<Db, StoreError> {
+        let pool = match Backend::of_url(url) {
+            Backend::Sqlite => {
+                let pool = SqlitePoolOptions::new()
+                    .max_connections(8)
+                    .min_connections(1)
+                    .connect_with(connect_options(url)?)
+                    .await?;
+                sqlx::migrate!("migrations/sqlite").run(&pool).await?;
+                Pool::Sqlite(pool)
+            }
+            Backend::Postgres => {
+                let pool = PgPoolOptions::new()
+                    .max_connections(pg_pool.max(1))
+                    .acquire_timeout(Duration::from_secs(10))
+                    .connect(url.trim())
+                    .await?;
+                sqlx::migrate!("migrations/postgres").run(&pool).await?;
+                Pool::Postgres(pool)
+            }
+        };
         Ok(Db { pool })
     }
 
-    pub fn pool(&self) -> &SqlitePool {
-        &self.pool
+    pub fn backend(&self) -> Backend {
+        on_pool!(self, |_p, k| k)
     }
 
-    /// Starts a write transaction that holds the write lock from its first
-    /// statement (`BEGIN IMMEDIATE`), so it cannot fail half-way on a lock.
-    pub async fn write(&self) -> Result<Transaction<'static, Sqlite>, DbError> {
-        self.pool.begin_with("BEGIN IMMEDIATE").await
+    /// One round trip to the database (`SELECT 1`): whether it answers now.
+    pub async fn ping(&self) -> Result<(), StoreError> {
+        on_pool!(self, |p, k| {
+            sqlx::query("SELECT 1").execute(p).await?;
+        });
+        Ok(())
     }
 
-    /// `PRAGMA integrity_check` (`"ok"` when the file is sound).
-    pub async fn integrity_check(&self) -> Result<String, DbError> {
-        let row = sqlx::query("PRAGMA integrity_check")
-            .fetch_one(&self.pool)
-            .await?;
-        row.try_get::<String, _>(0)
+    /// Migrations of this build that the database has not applied (0 when
+    /// its schema is current).
+    pub async fn pending_migrations(&self) -> Result<usize, StoreError> {
+        let (migrator, applied): (sqlx::migrate::Migrator, Vec<i64>) = match &self.pool {
+            Pool::Sqlite(p) => (
+                sqlx::migrate!("migrations/sqlite"),
+                sqlx::query_scalar("SELECT version FROM _sqlx_migrations WHERE success")
+                    .fetch_all(p)
+                    .await?,
+            ),
+            Pool::Postgres(p) => (
+                sqlx::migrate!("migrations/postgres"),
+                sqlx::query_scalar("SELECT version FROM _sqlx_migrations WHERE success")
+                    .fetch_all(p)
+                    .await?,
+            ),
+        };
+        Ok(migrator
+            .iter()
+            .filter(|m| !applied.contains(&m.version))
+            .count())
     }
 
-    /// One page of a list query (`… LIMIT ? OFFSET ?`, with a leading
-    /// `robot_id = ?` parameter when `robot_id` is given) and the count of the
-    /// whole list, read in one transaction so both agree.
-    pub(super) async fn page<T>(
+    /// SQLite: `PRAGMA integrity_check` (`"ok"` when the file is sound).
+    /// PostgreSQL checks its pages itself: `"ok"` when it answers.
+    pub async fn integrity_check(&self) -> Result<String, StoreError> {
+        match &self.pool {
+            Pool::Sqlite(p) => {
+                let row = sqlx::query("PRAGMA integrity_check").fetch_one(p).await?;
+                Ok(row.try_get::<String, _>(0)?)
+            }
+            Pool::Postgres(p) => Ok(sqlx::query_scalar("SELECT 'ok'::text").fetch_one(p).await?),
+        }
+    }
+
+    /// Rows whose foreign key names no parent; 0 when sound (SQLite: `PRAGMA
+    /// foreign_key_check`; PostgreSQL enforces every key on every write).
+    pub async fn foreign_key_violations(&self) -> Result<usize, StoreError> {
+        match &self.pool {
+            Pool::Sqlite(p) => Ok(sqlx::query("PRAGMA foreign_key_check")
+                .fetch_all(p)
+                .await?
+                .len()),
+            Pool::Postgres(p) => {
+                self.ping().await?;
+                let _ = p;
+                Ok(0)
+            }
+        }
+    }
+
+    /// How many rows each table holds.
+    pub async fn row_counts(&self) -> Result<RowCounts, StoreError> {
+        let mut n = [0i64; 5];
+        on_pool!(self, |p, k| {
+            let mut tx = p.begin_with(k.begin_read()).await?;
+            for (i, table) in RowCounts::TABLES.iter().enumerate() {
+                n[i] = sqlx::query_scalar(&format!("SELECT COUNT(*) FROM {table}"))
+                    .fetch_one(&mut *tx)
+                    .await?;
+            }
+            tx.commit().await?;
+        });
+        Ok(RowCounts {
+            robots: n[0],
+            measurement_sets: n[1],
+            calibrations: n[2],
+            model_versions: n[3],
+            activations: n[4],
+        })
+    }
+
+    /// One page of a list query (`… LIMIT $n OFFSET $n+1`, after a leading
+    /// `robot_id = $1` parameter when `robot_id` is given) and the count of the
+    /// whole list, read in one snapshot so both agree.
+    async fn page<T: AnyRow>(
         &self,
         list_sql: &str,
         count_sql: &str,
         robot_id: Option<i64>,
         limit: i64,
         offset: i64,
-    ) -> Result<(Vec<T>, i64), DbError>
-    where
-        T: for<'r> FromRow<'r, SqliteRow> + Send + Unpin,
-    {
-        let mut tx = self.pool.begin().await?;
-        let mut list = sqlx::query_as::<_, T>(list_sql);
-        let mut count = sqlx::query_scalar::<_, i64>(count_sql);
-        if let Some(id) = robot_id {
-            list = list.bind(id);
-            count = count.bind(id);
-        }
-        let rows = list.bind(limit).bind(offset).fetch_all(&mut *tx).await?;
-        let total = count.fetch_one(&mut *tx).await?;
-        tx.commit().await?;
-        Ok((rows, total))
+    ) -> Result<Listing<T>, StoreError> {
+        on_pool!(self, |p, k| {
+            let mut tx = p.begin_with(k.begin_read()).await?;
+            let mut list = sqlx::query_as::<_, T>(list_sql);
+            let mut count = sqlx::query_scalar::<_, i64>(count_sql);
+            if let Some(id) = robot_id {
+                list = list.bind(id);
+                count = count.bind(id);
+            }
+            let rows = list.bind(limit).bind(offset).fetch_all(&mut *tx).await?;
+            let total = count.fetch_one(&mut *tx).await?;
+            tx.commit().await?;
+            Ok(Listing { rows, total })
+        })
     }
 
-    /// One page of a robot's rows: `{select} WHERE robot_id = ? ORDER BY
+    /// One page of a robot's rows: `{select} WHERE robot_id = $1 ORDER BY
     /// {order_by}` and the count of that robot's rows in `table`.
-    pub(super) async fn robot_page<T>(
+    async fn robot_page<T: AnyRow>(
         &self,
         select: &str,
         table: &str,
@@ -148,13 +450,10 @@ impl Db {
         robot_id: i64,
         limit: i64,
         offset: i64,
-    ) -> Result<(Vec<T>, i64), DbError>
-    where
-        T: for<'r> FromRow<'r, SqliteRow> + Send + Unpin,
-    {
+    ) -> Result<Listing<T>, StoreError> {
         self.page(
-            &format!("{select} WHERE robot_id = ? ORDER BY {order_by} LIMIT ? OFFSET ?"),
-            &format!("SELECT COUNT(*) FROM {table} WHERE robot_id = ?"),
+            &format!("{select} WHERE robot_id = $1 ORDER BY {order_by} LIMIT $2 OFFSET $3"),
+            &format!("SELECT COUNT(*) FROM {table} WHERE robot_id = $1"),
             Some(robot_id),
             limit,
             offset,
@@ -162,91 +461,33 @@ impl Db {
         .await
     }
 
-    /// All rows of a robot: `{select} WHERE robot_id = ? ORDER BY {order_by}`.
-    pub(super) async fn robot_rows<T>(
+    /// All rows of a robot: `{select} WHERE robot_id = $1 ORDER BY {order_by}`.
+    async fn robot_rows<T: AnyRow>(
         &self,
         select: &str,
         order_by: &str,
         robot_id: i64,
-    ) -> Result<Vec<T>, DbError>
-    where
-        T: for<'r> FromRow<'r, SqliteRow> + Send + Unpin,
-    {
-        sqlx::query_as::<_, T>(&format!("{select} WHERE robot_id = ? ORDER BY {order_by}"))
+    ) -> Result<Vec<T>, StoreError> {
+        let sql = format!("{select} WHERE robot_id = $1 ORDER BY {order_by}");
+        Ok(on_pool!(self, |p, k| sqlx::query_as::<_, T>(&sql)
             .bind(robot_id)
-            .fetch_all(&self.pool)
-            .await
+            .fetch_all(p)
+            .await?))
     }
 
-    /// One row of a robot: `{select} WHERE robot_id = ? AND {key} = ?`.
-    pub(super) async fn robot_row<T>(
+    /// One row of a robot: `{select} WHERE robot_id = $1 AND {key} = $2`.
+    async fn robot_row<T: AnyRow>(
         &self,
         select: &str,
         key: &str,
         robot_id: i64,
         value: i64,
-    ) -> Result<Option<T>, DbError>
-    where
-        T: for<'r> FromRow<'r, SqliteRow> + Send + Unpin,
-    {
-        sqlx::query_as::<_, T>(&format!("{select} WHERE robot_id = ? AND {key} = ?"))
+    ) -> Result<Option<T>, StoreError> {
+        let sql = format!("{select} WHERE robot_id = $1 AND {key} = $2");
+        Ok(on_pool!(self, |p, k| sqlx::query_as::<_, T>(&sql)
             .bind(robot_id)
             .bind(value)
-            .fetch_optional(&self.pool)
-            .await
+            .fetch_optional(p)
+            .await?))
     }
-
-    /// Runs one statement in its own write transaction; the rows it changed.
-    pub(super) async fn write_one<'q>(
-        &self,
-        statement: Query<'q, Sqlite, SqliteArguments<'q>>,
-    ) -> Result<u64, DbError> {
-        let mut tx = self.write().await?;
-        let n = statement.execute(&mut *tx).await?.rows_affected();
-        tx.commit().await?;
-        Ok(n)
-    }
-
-    /// Starts a write transaction for a write that belongs to a robot; `None`
-    /// (rolled back) when the robot does not exist (any more).
-    pub(super) async fn write_for_robot(
-        &self,
-        robot_id: i64,
-    ) -> Result<Option<Transaction<'static, Sqlite>>, DbError> {
-        let mut tx = self.write().await?;
-        if !robot_exists_in(&mut tx, robot_id).await? {
-            tx.rollback().await?;
-            return Ok(None);
-        }
-        Ok(Some(tx))
-    }
-}
-
-/// Reads back the row `{select} WHERE {id_column} = ?` just inserted in `tx`
-/// and commits, so the caller gets the row as stored (defaults, timestamps).
-pub(super) async fn commit_inserted<T>(
-    mut tx: Transaction<'static, Sqlite>,
-    select: &str,
-    id_column: &str,
-    id: i64,
-) -> Result<T, DbError>
-where
-    T: for<'r> FromRow<'r, SqliteRow> + Send + Unpin,
-{
-    let row = sqlx::query_as::<_, T>(&format!("{select} WHERE {id_column} = ?"))
-        .bind(id)
-        .fetch_one(&mut *tx)
-        .await?;
-    tx.commit().await?;
-    Ok(row)
-}
-
-async fn robot_exists_in(
-    tx: &mut Transaction<'static, Sqlite>,
-    robot_id: i64,
-) -> Result<bool, DbError> {
-    sqlx::query_scalar("SELECT EXISTS (SELECT 1 FROM robots WHERE id = ?)")
-        .bind(robot_id)
-        .fetch_one(&mut **tx)
-        .await
 }

@@ -1,23 +1,26 @@
 //! Robots: the cell's robots and their nominal models.
 
-use super::{commit_inserted, Db, DbError, Json};
+use super::{commit_inserted, on_pool, write_one, Db, Json, Listing, StoreError};
 use serde_json::{Map, Value};
 use sqlx::FromRow;
 
 impl Db {
-    pub async fn insert_robot(&self, r: &NewRobot<'_>) -> Result<RobotRow, DbError> {
-        let mut tx = self.write().await?;
-        let id: i64 = sqlx::query_scalar(
-            "INSERT INTO robots (name, preset, model_json, dof, metadata) VALUES (?, ?, ?, ?, ?) RETURNING id",
-        )
-        .bind(r.name)
-        .bind(r.preset)
-        .bind(r.model_json)
-        .bind(r.dof)
-        .bind(Json(r.metadata))
-        .fetch_one(&mut *tx)
-        .await?;
-        commit_inserted(tx, ROBOT_SELECT, "r.id", id).await
+    pub async fn insert_robot(&self, r: &NewRobot<'_>) -> Result<RobotRow, StoreError> {
+        Ok(on_pool!(self, |p, k| {
+            let mut tx = p.begin_with(k.begin_write()).await?;
+            let id: i64 = sqlx::query_scalar(
+                "INSERT INTO robots (name, preset, model_json, dof, metadata) \
+                 VALUES ($1, $2, $3, $4, $5) RETURNING id",
+            )
+            .bind(r.name)
+            .bind(r.preset)
+            .bind(r.model_json)
+            .bind(r.dof)
+            .bind(Json(r.metadata))
+            .fetch_one(&mut *tx)
+            .await?;
+            commit_inserted!(tx, RobotRow, ROBOT_SELECT, "r.id", id)
+        }))
     }
 
     /// One page of robots by id, and how many there are.
@@ -25,9 +28,9 @@ impl Db {
         &self,
         limit: i64,
         offset: i64,
-    ) -> Result<(Vec<RobotRow>, i64), DbError> {
+    ) -> Result<Listing<RobotRow>, StoreError> {
         self.page(
-            &format!("{ROBOT_SELECT} ORDER BY r.id LIMIT ? OFFSET ?"),
+            &format!("{ROBOT_SELECT} ORDER BY r.id LIMIT $1 OFFSET $2"),
             "SELECT COUNT(*) FROM robots",
             None,
             limit,
@@ -36,11 +39,12 @@ impl Db {
         .await
     }
 
-    pub async fn robot(&self, id: i64) -> Result<Option<RobotRow>, DbError> {
-        sqlx::query_as::<_, RobotRow>(&format!("{ROBOT_SELECT} WHERE r.id = ?"))
+    pub async fn robot(&self, id: i64) -> Result<Option<RobotRow>, StoreError> {
+        let sql = format!("{ROBOT_SELECT} WHERE r.id = $1");
+        Ok(on_pool!(self, |p, k| sqlx::query_as::<_, RobotRow>(&sql)
             .bind(id)
-            .fetch_optional(&self.pool)
-            .await
+            .fetch_optional(p)
+            .await?))
     }
 
     /// Updates name and/or metadata; `None` when the robot does not exist.
@@ -49,32 +53,42 @@ impl Db {
         id: i64,
         name: Option<&str>,
         metadata: Option<&Map<String, Value>>,
-    ) -> Result<Option<RobotRow>, DbError> {
-        let update = sqlx::query(concat!(
-            "UPDATE robots SET name = COALESCE(?, name), metadata = COALESCE(?, metadata), \
-             updated_at = ",
-            now!(),
-            " WHERE id = ?"
-        ))
-        .bind(name)
-        .bind(metadata.map(Json))
-        .bind(id);
-        if self.write_one(update).await? == 0 {
+    ) -> Result<Option<RobotRow>, StoreError> {
+        let n = on_pool!(self, |p, k| {
+            let sql = k.sql(
+                "UPDATE robots SET name = COALESCE($1, name), \
+                 metadata = COALESCE($2, metadata), updated_at = {now} WHERE id = $3",
+            );
+            write_one!(
+                p,
+                k,
+                sqlx::query(&sql)
+                    .bind(name)
+                    .bind(metadata.map(Json))
+                    .bind(id)
+            )
+        });
+        if n == 0 {
             return Ok(None);
         }
         self.robot(id).await
     }
 
     /// Deletes a robot and everything that belongs to it; false when missing.
-    pub async fn delete_robot(&self, id: i64) -> Result<bool, DbError> {
-        let delete = sqlx::query("DELETE FROM robots WHERE id = ?").bind(id);
-        Ok(self.write_one(delete).await? > 0)
+    pub async fn delete_robot(&self, id: i64) -> Result<bool, StoreError> {
+        let n = on_pool!(self, |p, k| write_one!(
+            p,
+            k,
+            sqlx::query("DELETE FROM robots WHERE id = $1").bind(id)
+        ));
+        Ok(n > 0)
     }
 }
 
 const ROBOT_SELECT: &str = "SELECT r.id, r.name, r.preset, r.model_json, r.dof, r.metadata, \
     r.created_at, r.updated_at, \
-    (SELECT v.version FROM model_versions v WHERE v.robot_id = r.id AND v.active = 1) AS active_version \
+    (SELECT v.version FROM model_versions v WHERE v.robot_id = r.id AND v.active = TRUE) \
+    AS active_version \
     FROM robots r";
 
 /// A robot to insert.

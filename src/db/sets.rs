@@ -1,12 +1,12 @@
 //! Measurement sets: the uploads as received and their parsed rows.
 
-use super::{commit_inserted, Db, DbError, Json};
+use super::types::text_enum;
+use super::{commit_inserted, on_pool, write_for_robot, write_one, Db, Json, Listing, StoreError};
 use crate::measure::{MeasuredPose, SetRole};
 use sqlx::{FromRow, Row};
 
 /// Data role of a set as stored (docs/design.md "Data roles").
-#[derive(Debug, Clone, Copy, PartialEq, Eq, sqlx::Type)]
-#[sqlx(rename_all = "lowercase")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum StoredRole {
     Identification,
     Training,
@@ -34,28 +34,36 @@ impl From<StoredRole> for SetRole {
 }
 
 /// Declared length unit of an upload.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, sqlx::Type)]
-#[sqlx(rename_all = "lowercase")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LengthUnit {
     Mm,
     M,
 }
 
 /// Declared angle unit of an upload.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, sqlx::Type)]
-#[sqlx(rename_all = "lowercase")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum AngleUnit {
     Deg,
     Rad,
 }
 
 /// Format of the upload as received.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, sqlx::Type)]
-#[sqlx(rename_all = "lowercase")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SetFormat {
     Csv,
     Json,
 }
+
+impl StoredRole {
+    pub fn as_str(self) -> &'static str {
+        SetRole::from(self).as_str()
+    }
+}
+
+text_enum!(StoredRole, [Identification, Training, Validation]);
+text_enum!(LengthUnit, [Mm, M]);
+text_enum!(AngleUnit, [Deg, Rad]);
+text_enum!(SetFormat, [Csv, Json]);
 
 impl LengthUnit {
     pub fn as_str(self) -> &'static str {
@@ -86,30 +94,32 @@ impl SetFormat {
 
 impl Db {
     /// Stores a set; `None` when its robot does not exist (any more).
-    pub async fn insert_set(&self, s: &NewSet<'_>) -> Result<Option<SetRow>, DbError> {
-        let Some(mut tx) = self.write_for_robot(s.robot_id).await? else {
-            return Ok(None);
-        };
-        let id: i64 = sqlx::query_scalar(
-            "INSERT INTO measurement_sets (robot_id, name, role, session, payload_kg, length_unit, \
-             angle_unit, format, original, rows_json, row_count, dof) \
-             VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?) RETURNING id",
-        )
-        .bind(s.robot_id)
-        .bind(s.name)
-        .bind(s.role)
-        .bind(s.session)
-        .bind(s.payload_kg)
-        .bind(s.length_unit)
-        .bind(s.angle_unit)
-        .bind(s.format)
-        .bind(s.original)
-        .bind(Json(s.rows))
-        .bind(s.row_count)
-        .bind(s.dof)
-        .fetch_one(&mut *tx)
-        .await?;
-        commit_inserted(tx, SET_SELECT, "id", id).await.map(Some)
+    pub async fn insert_set(&self, s: &NewSet<'_>) -> Result<Option<SetRow>, StoreError> {
+        Ok(on_pool!(self, |p, k| {
+            let Some(mut tx) = write_for_robot!(p, k, s.robot_id) else {
+                return Ok(None);
+            };
+            let id: i64 = sqlx::query_scalar(
+                "INSERT INTO measurement_sets (robot_id, name, role, session, payload_kg, \
+                 length_unit, angle_unit, format, original, rows_json, row_count, dof) \
+                 VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12) RETURNING id",
+            )
+            .bind(s.robot_id)
+            .bind(s.name)
+            .bind(s.role)
+            .bind(s.session)
+            .bind(s.payload_kg)
+            .bind(s.length_unit)
+            .bind(s.angle_unit)
+            .bind(s.format)
+            .bind(s.original)
+            .bind(Json(s.rows))
+            .bind(s.row_count)
+            .bind(s.dof)
+            .fetch_one(&mut *tx)
+            .await?;
+            Some(commit_inserted!(tx, SetRow, SET_SELECT, "id", id))
+        }))
     }
 
     /// One page of a robot's sets by id, and how many it has.
@@ -118,7 +128,7 @@ impl Db {
         robot_id: i64,
         limit: i64,
         offset: i64,
-    ) -> Result<(Vec<SetRow>, i64), DbError> {
+    ) -> Result<Listing<SetRow>, StoreError> {
         self.robot_page(
             SET_SELECT,
             "measurement_sets",
@@ -130,11 +140,11 @@ impl Db {
         .await
     }
 
-    pub async fn sets(&self, robot_id: i64) -> Result<Vec<SetRow>, DbError> {
+    pub async fn sets(&self, robot_id: i64) -> Result<Vec<SetRow>, StoreError> {
         self.robot_rows(SET_SELECT, "id", robot_id).await
     }
 
-    pub async fn set(&self, robot_id: i64, id: i64) -> Result<Option<SetRow>, DbError> {
+    pub async fn set(&self, robot_id: i64, id: i64) -> Result<Option<SetRow>, StoreError> {
         self.robot_row(SET_SELECT, "id", robot_id, id).await
     }
 
@@ -143,14 +153,15 @@ impl Db {
         &self,
         robot_id: i64,
         id: i64,
-    ) -> Result<Option<Vec<MeasuredPose>>, DbError> {
-        let rows: Option<Json<Vec<MeasuredPose>>> = sqlx::query_scalar(
-            "SELECT rows_json FROM measurement_sets WHERE robot_id = ? AND id = ?",
-        )
-        .bind(robot_id)
-        .bind(id)
-        .fetch_optional(&self.pool)
-        .await?;
+    ) -> Result<Option<Vec<MeasuredPose>>, StoreError> {
+        let sql = "SELECT rows_json FROM measurement_sets WHERE robot_id = $1 AND id = $2";
+        let rows: Option<Json<Vec<MeasuredPose>>> = on_pool!(self, |p, k| {
+            sqlx::query_scalar(sql)
+                .bind(robot_id)
+                .bind(id)
+                .fetch_optional(p)
+                .await?
+        });
         Ok(rows.map(|r| r.0))
     }
 
@@ -159,22 +170,29 @@ impl Db {
         &self,
         robot_id: i64,
         id: i64,
-    ) -> Result<Option<(SetFormat, String)>, DbError> {
-        let row = sqlx::query(
-            "SELECT format, original FROM measurement_sets WHERE robot_id = ? AND id = ?",
-        )
-        .bind(robot_id)
-        .bind(id)
-        .fetch_optional(&self.pool)
-        .await?;
-        row.map(|r| Ok((r.try_get(0)?, r.try_get(1)?))).transpose()
+    ) -> Result<Option<(SetFormat, String)>, StoreError> {
+        let sql = "SELECT format, original FROM measurement_sets WHERE robot_id = $1 AND id = $2";
+        Ok(on_pool!(self, |p, k| {
+            let row = sqlx::query(sql)
+                .bind(robot_id)
+                .bind(id)
+                .fetch_optional(p)
+                .await?;
+            match row {
+                Some(r) => Some((r.try_get(0)?, r.try_get(1)?)),
+                None => None,
+            }
+        }))
     }
 
-    pub async fn delete_set(&self, robot_id: i64, id: i64) -> Result<bool, DbError> {
-        let delete = sqlx::query("DELETE FROM measurement_sets WHERE robot_id = ? AND id = ?")
-            .bind(robot_id)
-            .bind(id);
-        Ok(self.write_one(delete).await? > 0)
+    pub async fn delete_set(&self, robot_id: i64, id: i64) -> Result<bool, StoreError> {
+        let sql = "DELETE FROM measurement_sets WHERE robot_id = $1 AND id = $2";
+        let n = on_pool!(self, |p, k| write_one!(
+            p,
+            k,
+            sqlx::query(sql).bind(robot_id).bind(id)
+        ));
+        Ok(n > 0)
     }
 }
 

@@ -1,9 +1,9 @@
 //! Model versions: one calibrated model per method of each calibration, the
 //! active one per robot, and the activation history used by rollback.
 
-use super::{Db, DbError, Json};
+use super::{on_pool, Db, Json, Listing, StoreError};
 use serde_json::Value;
-use sqlx::{FromRow, Sqlite, Transaction};
+use sqlx::FromRow;
 
 impl Db {
     /// One page of a robot's versions by number, and how many it has.
@@ -12,7 +12,7 @@ impl Db {
         robot_id: i64,
         limit: i64,
         offset: i64,
-    ) -> Result<(Vec<VersionRow>, i64), DbError> {
+    ) -> Result<Listing<VersionRow>, StoreError> {
         self.robot_page(
             VERSION_SELECT,
             "model_versions",
@@ -24,7 +24,7 @@ impl Db {
         .await
     }
 
-    pub async fn versions(&self, robot_id: i64) -> Result<Vec<VersionRow>, DbError> {
+    pub async fn versions(&self, robot_id: i64) -> Result<Vec<VersionRow>, StoreError> {
         self.robot_rows(VERSION_SELECT, "version", robot_id).await
     }
 
@@ -32,26 +32,27 @@ impl Db {
         &self,
         robot_id: i64,
         version: i64,
-    ) -> Result<Option<VersionRow>, DbError> {
+    ) -> Result<Option<VersionRow>, StoreError> {
         self.robot_row(VERSION_SELECT, "version", robot_id, version)
             .await
     }
 
-    pub async fn active_version(&self, robot_id: i64) -> Result<Option<VersionRow>, DbError> {
-        sqlx::query_as::<_, VersionRow>(&format!(
-            "{VERSION_SELECT} WHERE robot_id = ? AND active = 1"
-        ))
-        .bind(robot_id)
-        .fetch_optional(&self.pool)
-        .await
+    pub async fn active_version(&self, robot_id: i64) -> Result<Option<VersionRow>, StoreError> {
+        let sql = format!("{VERSION_SELECT} WHERE robot_id = $1 AND active = TRUE");
+        Ok(on_pool!(self, |p, k| sqlx::query_as::<_, VersionRow>(&sql)
+            .bind(robot_id)
+            .fetch_optional(p)
+            .await?))
     }
 
     /// The calibrated model file JSON of a version (by row id).
-    pub async fn version_model(&self, version_id: i64) -> Result<Option<String>, DbError> {
-        sqlx::query_scalar("SELECT model_json FROM model_versions WHERE id = ?")
-            .bind(version_id)
-            .fetch_optional(&self.pool)
-            .await
+    pub async fn version_model(&self, version_id: i64) -> Result<Option<String>, StoreError> {
+        Ok(on_pool!(self, |p, k| sqlx::query_scalar(
+            "SELECT model_json FROM model_versions WHERE id = $1"
+        )
+        .bind(version_id)
+        .fetch_optional(p)
+        .await?))
     }
 
     /// Activates a version (no-op when already active); `None` when missing.
@@ -59,52 +60,68 @@ impl Db {
         &self,
         robot_id: i64,
         version: i64,
-    ) -> Result<Option<VersionRow>, DbError> {
-        let mut tx = self.write().await?;
-        let row: Option<(i64, bool)> = sqlx::query_as(
-            "SELECT id, active FROM model_versions WHERE robot_id = ? AND version = ?",
-        )
-        .bind(robot_id)
-        .bind(version)
-        .fetch_optional(&mut *tx)
-        .await?;
-        let Some((vid, active)) = row else {
-            tx.rollback().await?;
-            return Ok(None);
-        };
-        if !active {
-            activate_in(&mut tx, robot_id, vid).await?;
-        }
-        tx.commit().await?;
+    ) -> Result<Option<VersionRow>, StoreError> {
+        on_pool!(self, |p, k| {
+            let mut tx = p.begin_with(k.begin_write()).await?;
+            // Holds the robot's row: activations of one robot are serialised.
+            let _: Option<i64> = sqlx::query_scalar(k.lock_robot())
+                .bind(robot_id)
+                .fetch_optional(&mut *tx)
+                .await?;
+            let row: Option<(i64, bool)> = sqlx::query_as(
+                "SELECT id, active FROM model_versions WHERE robot_id = $1 AND version = $2",
+            )
+            .bind(robot_id)
+            .bind(version)
+            .fetch_optional(&mut *tx)
+            .await?;
+            let Some((vid, active)) = row else {
+                tx.rollback().await?;
+                return Ok(None);
+            };
+            if !active {
+                activate_in!(tx, robot_id, vid);
+            }
+            tx.commit().await?;
+        });
         self.version(robot_id, version).await
     }
 
     /// Rolls back to the version that was active before the current one.
-    pub async fn rollback(&self, robot_id: i64) -> Result<Rollback, DbError> {
-        let mut tx = self.write().await?;
-        let stack: Vec<(i64, i64)> = sqlx::query_as(
-            "SELECT id, version_id FROM activations WHERE robot_id = ? AND undone = 0 \
-             ORDER BY id DESC LIMIT 2",
+    pub async fn rollback(&self, robot_id: i64) -> Result<Rollback, StoreError> {
+        let previous: i64 = on_pool!(self, |p, k| {
+            let mut tx = p.begin_with(k.begin_write()).await?;
+            let _: Option<i64> = sqlx::query_scalar(k.lock_robot())
+                .bind(robot_id)
+                .fetch_optional(&mut *tx)
+                .await?;
+            let stack: Vec<(i64, i64)> = sqlx::query_as(
+                "SELECT id, version_id FROM activations WHERE robot_id = $1 AND undone = FALSE \
+                 ORDER BY id DESC LIMIT 2",
+            )
+            .bind(robot_id)
+            .fetch_all(&mut *tx)
+            .await?;
+            if stack.len() < 2 {
+                tx.rollback().await?;
+                return Ok(Rollback::NothingToRollBack);
+            }
+            let (top, _) = stack[0];
+            let (_, previous) = stack[1];
+            sqlx::query("UPDATE activations SET undone = TRUE WHERE id = $1")
+                .bind(top)
+                .execute(&mut *tx)
+                .await?;
+            set_active_in!(tx, robot_id, previous);
+            tx.commit().await?;
+            previous
+        });
+        let v: i64 = on_pool!(self, |p, k| sqlx::query_scalar(
+            "SELECT version FROM model_versions WHERE id = $1"
         )
-        .bind(robot_id)
-        .fetch_all(&mut *tx)
-        .await?;
-        if stack.len() < 2 {
-            tx.rollback().await?;
-            return Ok(Rollback::NothingToRollBack);
-        }
-        let (top, _) = stack[0];
-        let (_, previous) = stack[1];
-        sqlx::query("UPDATE activations SET undone = 1 WHERE id = ?")
-            .bind(top)
-            .execute(&mut *tx)
-            .await?;
-        set_active_in(&mut tx, robot_id, previous).await?;
-        tx.commit().await?;
-        let v: i64 = sqlx::query_scalar("SELECT version FROM model_versions WHERE id = ?")
-            .bind(previous)
-            .fetch_one(&self.pool)
-            .await?;
+        .bind(previous)
+        .fetch_one(p)
+        .await?);
         Ok(match self.version(robot_id, v).await? {
             Some(row) => Rollback::Done(row),
             None => Rollback::NothingToRollBack,
@@ -119,35 +136,36 @@ pub enum Rollback {
     NothingToRollBack,
 }
 
-async fn set_active_in(
-    tx: &mut Transaction<'static, Sqlite>,
-    robot_id: i64,
-    version_id: i64,
-) -> Result<(), DbError> {
-    sqlx::query("UPDATE model_versions SET active = 0 WHERE robot_id = ? AND active = 1")
-        .bind(robot_id)
-        .execute(&mut **tx)
+/// Makes version row `$vid` the one active version of robot `$robot` in `$tx`.
+macro_rules! set_active_in {
+    ($tx:ident, $robot:expr, $vid:expr) => {{
+        sqlx::query(
+            "UPDATE model_versions SET active = FALSE WHERE robot_id = $1 AND active = TRUE",
+        )
+        .bind($robot)
+        .execute(&mut *$tx)
         .await?;
-    sqlx::query("UPDATE model_versions SET active = 1 WHERE id = ?")
-        .bind(version_id)
-        .execute(&mut **tx)
-        .await?;
-    Ok(())
+        sqlx::query("UPDATE model_versions SET active = TRUE WHERE id = $1")
+            .bind($vid)
+            .execute(&mut *$tx)
+            .await?;
+    }};
 }
+pub(super) use set_active_in;
 
-pub(super) async fn activate_in(
-    tx: &mut Transaction<'static, Sqlite>,
-    robot_id: i64,
-    version_id: i64,
-) -> Result<(), DbError> {
-    set_active_in(tx, robot_id, version_id).await?;
-    sqlx::query("INSERT INTO activations (robot_id, version_id) VALUES (?, ?)")
-        .bind(robot_id)
-        .bind(version_id)
-        .execute(&mut **tx)
-        .await?;
-    Ok(())
+/// Activates version row `$vid` of robot `$robot` in `$tx` and pushes it on
+/// the activation stack.
+macro_rules! activate_in {
+    ($tx:ident, $robot:expr, $vid:expr) => {{
+        $crate::db::versions::set_active_in!($tx, $robot, $vid);
+        sqlx::query("INSERT INTO activations (robot_id, version_id) VALUES ($1, $2)")
+            .bind($robot)
+            .bind($vid)
+            .execute(&mut *$tx)
+            .await?;
+    }};
 }
+pub(super) use activate_in;
 
 const VERSION_SELECT: &str = "SELECT id, robot_id, version, calibration_id, method, stats_json, \
     active, created_at FROM model_versions";

@@ -17,16 +17,9 @@ use axum::http::StatusCode;
 use axum::response::{Html, IntoResponse, Response};
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
-use std::sync::atomic::Ordering;
 
 /// Methods run when the request names none.
 pub const DEFAULT_METHODS: [Method; 2] = [Method::Km, Method::Skcm];
-
-fn calibration_not_found(robot: i64, id: i64) -> ApiError {
-    ApiError::NotFound(format!(
-        "calibration {id} of robot {robot} does not exist; list them with GET /v1/robots/{robot}/calibrations"
-    ))
-}
 
 /// `POST /v1/robots/{id}/calibrations` body.
 #[derive(Debug, Default, Deserialize, Serialize)]
@@ -229,20 +222,18 @@ pub async fn list(
     ApiQuery(page): ApiQuery<PageQuery>,
 ) -> Result<Response, ApiError> {
     let (page, _) = robot_list_page(&state, robot_id, page).await?;
-    let (rows, total) = state
-        .db()
-        .calibrations_page(robot_id, page.limit, page.offset)
-        .await?;
-    let jobs: Vec<Calibration> = rows.into_iter().map(Calibration::from_row).collect();
+    let listing = service::calibrations::page(&state, robot_id, page.limit, page.offset).await?;
+    let total = listing.total;
+    let jobs: Vec<Calibration> = listing
+        .rows
+        .into_iter()
+        .map(Calibration::from_row)
+        .collect();
     Ok(axum::Json(page_body(page, total, "calibrations", jobs)?).into_response())
 }
 
 async fn load(state: &AppState, robot_id: i64, id: i64) -> Result<CalibrationRow, ApiError> {
-    state
-        .db()
-        .calibration(robot_id, id)
-        .await?
-        .ok_or_else(|| calibration_not_found(robot_id, id))
+    Ok(service::calibrations::get(state, robot_id, id).await?)
 }
 
 pub async fn get_one(
@@ -257,21 +248,7 @@ pub async fn cancel(
     State(state): State<AppState>,
     ApiPath((robot_id, id)): ApiPath<(i64, i64)>,
 ) -> Result<Response, ApiError> {
-    let row = load(&state, robot_id, id).await?;
-    if !row.status.is_active() {
-        return Err(ApiError::Conflict(format!(
-            "calibration {id} is already {}; only queued or running jobs can be cancelled",
-            row.status
-        )));
-    }
-    if let Some(flag) = state.existing_cancel_flag(id) {
-        flag.store(true, Ordering::SeqCst);
-    }
-    let row = state
-        .db()
-        .request_cancel(robot_id, id)
-        .await?
-        .ok_or_else(|| calibration_not_found(robot_id, id))?;
+    let row = service::calibrations::cancel(&state, robot_id, id).await?;
     Ok((StatusCode::ACCEPTED, axum::Json(Calibration::from_row(row))).into_response())
 }
 
@@ -297,9 +274,11 @@ async fn succeeded_report(
             )))
         }
     }
-    let text = state.db().calibration_report(id).await?.ok_or_else(|| {
-        ApiError::Internal(format!("calibration {id} succeeded without a report"))
-    })?;
+    let text = service::calibrations::report_text(state, id)
+        .await?
+        .ok_or_else(|| {
+            ApiError::Internal(format!("calibration {id} succeeded without a report"))
+        })?;
     let report: Value = serde_json::from_str(&text)
         .map_err(|e| ApiError::Internal(format!("stored report of calibration {id}: {e}")))?;
     Ok((row, report))
@@ -310,9 +289,7 @@ pub async fn result(
     ApiPath((robot_id, id)): ApiPath<(i64, i64)>,
 ) -> Result<Response, ApiError> {
     let (row, report) = succeeded_report(&state, robot_id, id).await?;
-    let versions: Vec<Value> = state
-        .db()
-        .versions(robot_id)
+    let versions: Vec<Value> = service::versions::list(&state, robot_id)
         .await?
         .into_iter()
         .filter(|v| v.calibration_id == Some(id))
@@ -349,9 +326,7 @@ pub async fn report(
     ApiPath((robot_id, id)): ApiPath<(i64, i64)>,
 ) -> Result<Response, ApiError> {
     let (_, report) = succeeded_report(&state, robot_id, id).await?;
-    let name = state
-        .db()
-        .robot(robot_id)
+    let name = service::robots::find(&state, robot_id)
         .await?
         .map(|r| r.name)
         .unwrap_or_default();

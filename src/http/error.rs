@@ -158,19 +158,6 @@ impl IntoResponse for ApiError {
     }
 }
 
-impl From<sqlx::Error> for ApiError {
-    fn from(e: sqlx::Error) -> Self {
-        match &e {
-            // Writes check their parent inside their transaction; this is the
-            // last line of defence should one be missed.
-            sqlx::Error::Database(d) if d.is_foreign_key_violation() => ApiError::Conflict(
-                "the resource this write belongs to was deleted meanwhile".into(),
-            ),
-            _ => ApiError::Internal(format!("database: {e}")),
-        }
-    }
-}
-
 impl From<crate::service::ServiceError> for ApiError {
     fn from(e: crate::service::ServiceError) -> Self {
         use crate::service::ServiceError as S;
@@ -186,7 +173,15 @@ impl From<crate::service::ServiceError> for ApiError {
                 retry_after_s,
             },
             S::Unavailable(m) => ApiError::Unavailable(m),
-            S::Db(e) => ApiError::from(e),
+            S::Store(e) => {
+                use crate::db::StoreError as E;
+                match e {
+                    E::NotFound(m) => ApiError::NotFound(m),
+                    E::Conflict(m) => ApiError::Conflict(m),
+                    e @ E::Unavailable(_) => ApiError::Unavailable(e.to_string()),
+                    e @ E::Internal(_) => ApiError::Internal(e.to_string()),
+                }
+            }
             S::Internal(m) => ApiError::Internal(m),
         }
     }

@@ -182,6 +182,12 @@ pub fn check_name(name: &str, what: &str) -> Result<(), ApiError> {
             "{what} is longer than {NAME_MAX} characters"
         )));
     }
+    // Text columns hold no NUL on PostgreSQL; refused alike on SQLite.
+    if name.contains('\0') {
+        return Err(ApiError::invalid(format!(
+            "{what} must not contain the NUL character (U+0000)"
+        )));
+    }
     Ok(())
 }
 

@@ -120,7 +120,11 @@ pub(crate) fn located<B: serde::Serialize>(
 
 /// Every route of the service, resource by resource.
 fn routes() -> Vec<Route> {
-    let mut all = vec![get("/healthz", healthz), get("/openapi.yaml", openapi)];
+    let mut all = vec![
+        get("/healthz", healthz),
+        get("/readyz", readyz),
+        get("/openapi.yaml", openapi),
+    ];
     all.extend(robots::routes());
     all.extend(sets::routes());
     all.extend(calibrations::routes());
@@ -159,10 +163,17 @@ pub fn app(state: AppState) -> Router {
 }
 
 async fn healthz(State(state): State<AppState>) -> Result<Response, ApiError> {
-    sqlx::query("SELECT 1")
-        .execute(state.db().pool())
-        .await
-        .map_err(|e| ApiError::Unavailable(format!("database unavailable: {e}")))?;
+    crate::service::health(&state).await?;
+    Ok(axum::Json(serde_json::json!({
+        "status": "ok",
+        "version": env!("CARGO_PKG_VERSION"),
+    }))
+    .into_response())
+}
+
+/// Readiness for a load balancer (see [`crate::service::ready`]).
+async fn readyz(State(state): State<AppState>) -> Result<Response, ApiError> {
+    crate::service::ready(&state).await?;
     Ok(axum::Json(serde_json::json!({
         "status": "ok",
         "version": env!("CARGO_PKG_VERSION"),

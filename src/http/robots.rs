@@ -6,6 +6,7 @@ use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState};
 use crate::db::{NewRobot, RobotRow};
 use crate::model::presets::{preset_description, PRESETS};
 use crate::model::RobotModel;
+use crate::service;
 use axum::extract::State;
 use axum::http::StatusCode;
 use axum::response::{IntoResponse, Response};
@@ -13,10 +14,6 @@ use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 
 pub(crate) use super::input::check_name;
-
-pub(crate) fn robot_not_found(id: i64) -> ApiError {
-    crate::service::ServiceError::robot_not_found(id).into()
-}
 
 /// The checked page of a list that belongs to robot `id`, and the robot
 /// (404 when missing; a bad page is refused first).
@@ -26,16 +23,7 @@ pub(crate) async fn robot_list_page(
     page: PageQuery,
 ) -> Result<(Page, RobotRow), ApiError> {
     let page = page.check(state.limits().page_max)?;
-    Ok((page, load_robot(state, id).await?))
-}
-
-/// The stored robot `id`, or 404.
-pub(crate) async fn load_robot(state: &AppState, id: i64) -> Result<RobotRow, ApiError> {
-    state
-        .db()
-        .robot(id)
-        .await?
-        .ok_or_else(|| robot_not_found(id))
+    Ok((page, service::robots::get(state, id).await?))
 }
 
 /// `POST /v1/robots` body: exactly one of `preset` and `model`; no field may
@@ -155,6 +143,13 @@ fn requested_model(body: &CreateRobot) -> Result<(RobotModel, Option<String>), A
             )
         }
         (None, Some(m)) => {
+            if let Some(Value::String(name)) = m.get("name") {
+                if name.contains('\0') {
+                    return Err(ApiError::invalid(
+                        "model field 'name' must not contain the NUL character (U+0000)",
+                    ));
+                }
+            }
             let text = serde_json::to_string(m).map_err(|e| ApiError::Internal(e.to_string()))?;
             let model = RobotModel::from_json(&text).map_err(ApiError::invalid)?;
             check_payload("model field 'payload.mass_kg'", model.payload.mass)?;
@@ -176,16 +171,17 @@ pub async fn create(
         None => &empty,
     };
     let model_json = model.to_json();
-    let row = state
-        .db()
-        .insert_robot(&NewRobot {
+    let row = service::robots::create(
+        &state,
+        &NewRobot {
             name: &name,
             preset: preset.as_deref(),
             model_json: &model_json,
             dof: model.dof() as i64,
             metadata,
-        })
-        .await?;
+        },
+    )
+    .await?;
     let location = format!("/v1/robots/{}", row.id);
     Ok(super::located(
         StatusCode::CREATED,
@@ -199,8 +195,10 @@ pub async fn list(
     ApiQuery(page): ApiQuery<PageQuery>,
 ) -> Result<Response, ApiError> {
     let page = page.check(state.limits().page_max)?;
-    let (rows, total) = state.db().robots_page(page.limit, page.offset).await?;
-    let robots: Vec<Robot> = rows
+    let listing = service::robots::page(&state, page.limit, page.offset).await?;
+    let total = listing.total;
+    let robots: Vec<Robot> = listing
+        .rows
         .into_iter()
         .map(|r| Robot::from_row(r, false))
         .collect();
@@ -211,7 +209,7 @@ pub async fn get_one(
     State(state): State<AppState>,
     ApiPath(id): ApiPath<i64>,
 ) -> Result<Response, ApiError> {
-    let row = load_robot(&state, id).await?;
+    let row = service::robots::get(&state, id).await?;
     Ok(axum::Json(Robot::from_row(row, true)).into_response())
 }
 
@@ -233,12 +231,7 @@ pub async fn update(
             "nothing to update: give `name` and/or `metadata` (the model of a robot cannot change; create a new robot instead)",
         ));
     }
-    let row = state
-        .db()
-        .update_robot(id, body.name.as_deref(), metadata)
-        .await?
-        .ok_or_else(|| robot_not_found(id))?;
-    state.invalidate_robot(id);
+    let row = service::robots::update(&state, id, body.name.as_deref(), metadata).await?;
     Ok(axum::Json(Robot::from_row(row, true)).into_response())
 }
 
@@ -246,16 +239,7 @@ pub async fn delete(
     State(state): State<AppState>,
     ApiPath(id): ApiPath<i64>,
 ) -> Result<Response, ApiError> {
-    // Stop its running jobs first; they find their row gone when they finish.
-    for c in state.db().calibrations(id).await? {
-        if let Some(flag) = state.existing_cancel_flag(c.id) {
-            flag.store(true, std::sync::atomic::Ordering::SeqCst);
-        }
-    }
-    if !state.db().delete_robot(id).await? {
-        return Err(robot_not_found(id));
-    }
-    state.invalidate_robot(id);
+    service::robots::delete(&state, id).await?;
     Ok(StatusCode::NO_CONTENT.into_response())
 }
 

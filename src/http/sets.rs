@@ -29,12 +29,6 @@ use serde::{Deserialize, Serialize};
 /// Most sets one calibration may use.
 pub const MAX_SETS: usize = 100;
 
-pub(crate) fn set_not_found(robot: i64, id: i64) -> ApiError {
-    ApiError::NotFound(format!(
-        "measurement set {id} of robot {robot} does not exist; list them with GET /v1/robots/{robot}/measurement-sets"
-    ))
-}
-
 /// Options of an upload: the query string of a CSV upload, the body fields of
 /// a JSON upload. A JSON upload takes the set's name, role, session and
 /// payload from the query for the fields its body leaves out; the options that
@@ -410,40 +404,21 @@ pub async fn list(
     ApiQuery(page): ApiQuery<PageQuery>,
 ) -> Result<Response, ApiError> {
     let (page, _) = robot_list_page(&state, robot_id, page).await?;
-    let (rows, total) = state
-        .db()
-        .sets_page(robot_id, page.limit, page.offset)
-        .await?;
-    let sets: Vec<MeasurementSet> = rows
+    let listing = service::sets::page(&state, robot_id, page.limit, page.offset).await?;
+    let total = listing.total;
+    let sets: Vec<MeasurementSet> = listing
+        .rows
         .into_iter()
         .map(|r| MeasurementSet::from_row(r, None))
         .collect();
     Ok(axum::Json(page_body(page, total, "measurement_sets", sets)?).into_response())
 }
 
-/// Loads the parsed rows of a set.
-pub(crate) async fn load_rows(
-    state: &AppState,
-    robot_id: i64,
-    set_id: i64,
-) -> Result<Vec<MeasuredPose>, ApiError> {
-    state
-        .db()
-        .set_rows(robot_id, set_id)
-        .await?
-        .ok_or_else(|| set_not_found(robot_id, set_id))
-}
-
 pub async fn get_one(
     State(state): State<AppState>,
     ApiPath((robot_id, set_id)): ApiPath<(i64, i64)>,
 ) -> Result<Response, ApiError> {
-    let row = state
-        .db()
-        .set(robot_id, set_id)
-        .await?
-        .ok_or_else(|| set_not_found(robot_id, set_id))?;
-    let rows = load_rows(&state, robot_id, set_id).await?;
+    let (row, rows) = service::sets::get(&state, robot_id, set_id).await?;
     Ok(axum::Json(MeasurementSet::from_row(row, Some(rows))).into_response())
 }
 
@@ -451,11 +426,7 @@ pub async fn original(
     State(state): State<AppState>,
     ApiPath((robot_id, set_id)): ApiPath<(i64, i64)>,
 ) -> Result<Response, ApiError> {
-    let (format, text) = state
-        .db()
-        .set_original(robot_id, set_id)
-        .await?
-        .ok_or_else(|| set_not_found(robot_id, set_id))?;
+    let (format, text) = service::sets::original(&state, robot_id, set_id).await?;
     let ct = if format == SetFormat::Csv {
         "text/csv; charset=utf-8"
     } else {
@@ -468,9 +439,7 @@ pub async fn delete(
     State(state): State<AppState>,
     ApiPath((robot_id, set_id)): ApiPath<(i64, i64)>,
 ) -> Result<Response, ApiError> {
-    if !state.db().delete_set(robot_id, set_id).await? {
-        return Err(set_not_found(robot_id, set_id));
-    }
+    service::sets::delete(&state, robot_id, set_id).await?;
     Ok(StatusCode::NO_CONTENT.into_response())
 }
 

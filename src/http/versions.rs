@@ -5,22 +5,17 @@
 //! text of `crate::export`).
 
 use super::input::{page_body, PageQuery};
-use super::robots::{load_robot, robot_list_page};
+use super::robots::robot_list_page;
 use super::{ApiError, ApiPath, ApiQuery, AppState};
 use crate::compensate::CalibratedModelFile;
-use crate::db::{Rollback, VersionRow};
+use crate::db::VersionRow;
 use crate::export::{export, ExportFormat, ExportSource};
+use crate::service;
 use axum::extract::State;
 use axum::http::header;
 use axum::response::{IntoResponse, Response};
 use serde::Serialize;
 use serde_json::{json, Value};
-
-fn version_not_found(robot: i64, v: i64) -> ApiError {
-    ApiError::NotFound(format!(
-        "robot {robot} has no model version {v}; list them with GET /v1/robots/{robot}/versions"
-    ))
-}
 
 /// A model version as the API returns it.
 #[derive(Debug, Serialize)]
@@ -60,51 +55,23 @@ pub async fn list(
     ApiQuery(page): ApiQuery<PageQuery>,
 ) -> Result<Response, ApiError> {
     let (page, robot) = robot_list_page(&state, robot_id, page).await?;
-    let (rows, total) = state
-        .db()
-        .versions_page(robot_id, page.limit, page.offset)
-        .await?;
-    let versions: Vec<ModelVersion> = rows.into_iter().map(ModelVersion::from_row).collect();
+    let listing = service::versions::page(&state, robot_id, page.limit, page.offset).await?;
+    let total = listing.total;
+    let versions: Vec<ModelVersion> = listing
+        .rows
+        .into_iter()
+        .map(ModelVersion::from_row)
+        .collect();
     let mut out = page_body(page, total, "versions", versions)?;
     out["active_version"] = json!(robot.active_version);
     Ok(axum::Json(out).into_response())
-}
-
-async fn load(state: &AppState, robot_id: i64, v: i64) -> Result<VersionRow, ApiError> {
-    match state.db().version(robot_id, v).await? {
-        Some(row) => Ok(row),
-        None => {
-            load_robot(state, robot_id).await?;
-            Err(version_not_found(robot_id, v))
-        }
-    }
-}
-
-/// A version and its stored model file text.
-async fn load_with_model(
-    state: &AppState,
-    robot_id: i64,
-    v: i64,
-) -> Result<(VersionRow, String), ApiError> {
-    let row = load(state, robot_id, v).await?;
-    let text = state
-        .db()
-        .version_model(row.id)
-        .await?
-        .ok_or_else(|| version_not_found(robot_id, v))?;
-    Ok((row, text))
 }
 
 pub async fn get_one(
     State(state): State<AppState>,
     ApiPath((robot_id, v)): ApiPath<(i64, i64)>,
 ) -> Result<Response, ApiError> {
-    let row = load(&state, robot_id, v).await?;
-    let model_text = state
-        .db()
-        .version_model(row.id)
-        .await?
-        .ok_or_else(|| version_not_found(robot_id, v))?;
+    let (row, model_text) = service::versions::with_model(&state, robot_id, v).await?;
     let mut out = serde_json::to_value(ModelVersion::from_row(row))
         .map_err(|e| ApiError::Internal(e.to_string()))?;
     out["model"] = serde_json::from_str(&model_text)
@@ -116,7 +83,7 @@ pub async fn download(
     State(state): State<AppState>,
     ApiPath((robot_id, v)): ApiPath<(i64, i64)>,
 ) -> Result<Response, ApiError> {
-    let (row, text) = load_with_model(&state, robot_id, v).await?;
+    let (row, text) = service::versions::with_model(&state, robot_id, v).await?;
     let disposition = format!(
         "attachment; filename=\"robot-{robot_id}-v{v}-{}.json\"",
         row.method
@@ -146,7 +113,7 @@ pub async fn export_version(
         .format
         .parse()
         .map_err(|e: crate::export::ExportError| ApiError::BadRequest(e.to_string()))?;
-    let (row, text) = load_with_model(&state, robot_id, v).await?;
+    let (row, text) = service::versions::with_model(&state, robot_id, v).await?;
     let file = CalibratedModelFile::from_json(&text)
         .map_err(|e| ApiError::Internal(format!("stored model of version {v}: {e}")))?;
     let model = file
@@ -178,15 +145,7 @@ pub async fn activate(
     State(state): State<AppState>,
     ApiPath((robot_id, v)): ApiPath<(i64, i64)>,
 ) -> Result<Response, ApiError> {
-    let row = match state.db().activate(robot_id, v).await? {
-        Some(row) => row,
-        None => {
-            load_robot(&state, robot_id).await?;
-            return Err(version_not_found(robot_id, v));
-        }
-    };
-    state.invalidate_robot(robot_id);
-    tracing::info!(robot = robot_id, version = v, "model version activated");
+    let row = service::versions::activate(&state, robot_id, v).await?;
     Ok(axum::Json(ModelVersion::from_row(row)).into_response())
 }
 
@@ -194,21 +153,8 @@ pub async fn rollback(
     State(state): State<AppState>,
     ApiPath(robot_id): ApiPath<i64>,
 ) -> Result<Response, ApiError> {
-    load_robot(&state, robot_id).await?;
-    match state.db().rollback(robot_id).await? {
-        Rollback::Done(row) => {
-            state.invalidate_robot(robot_id);
-            tracing::info!(robot = robot_id, version = row.version, "rolled back");
-            Ok(axum::Json(ModelVersion::from_row(row)).into_response())
-        }
-        Rollback::NothingToRollBack => {
-            // Deleted meanwhile: say so rather than "nothing to roll back".
-            load_robot(&state, robot_id).await?;
-            Err(ApiError::Conflict(format!(
-            "robot {robot_id} has no earlier active version to roll back to; activate a version with POST /v1/robots/{robot_id}/versions/{{version}}/activate"
-        )))
-        }
-    }
+    let row = service::versions::rollback(&state, robot_id).await?;
+    Ok(axum::Json(ModelVersion::from_row(row)).into_response())
 }
 
 /// The routes of model versions.

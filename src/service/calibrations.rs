@@ -23,7 +23,8 @@ use super::limits::Ticket;
 use super::{AppState, ServiceError};
 use crate::compensate::{CalibratedModelFile, CompensatedModel};
 use crate::db::{
-    CalibrationRow, JobStatus, JobSummary, NewCalibration, NewVersion, SetRow, StoredRole,
+    CalibrationRow, JobResult, JobStatus, JobSummary, Listing, NewCalibration, NewVersion, SetRow,
+    StoredRole,
 };
 use crate::identify::{
     calibrate_with_training, CalibrationError, CalibrationOptions, CalibrationReport,
@@ -246,7 +247,133 @@ fn calibration_options(cmd: &StartCommand) -> CalibrationOptions {
     }
 }
 
+/// A job's data, read from the store: the poses by role, where each came
+/// from, the tracker sessions and the solver options.
+pub(super) struct Prepared {
+    sets: SelectedSets,
+    ident: Vec<Measurement>,
+    valid: Vec<Measurement>,
+    training: Vec<Measurement>,
+    session_names: Vec<String>,
+    pose_sources: PoseSources,
+    opts: CalibrationOptions,
+    payload_kg: f64,
+}
+
+/// Selects and reads the sets of `cmd` for robot `robot_id`.
+pub(super) async fn prepare(
+    state: &AppState,
+    robot_id: i64,
+    nominal: &RobotModel,
+    cmd: &StartCommand,
+) -> Result<Prepared, ServiceError> {
+    let all_sets = state.db().sets(robot_id).await?;
+    // A delete of the robot may have run between the robot lookup and the set
+    // list (the cascade removes its sets): the robot still existing now means
+    // it existed when the sets were read, so the list is that robot's.
+    if state.db().robot(robot_id).await?.is_none() {
+        return Err(ServiceError::robot_not_found(robot_id));
+    }
+    let sets = select_sets(&all_sets, cmd, robot_id)?;
+    let sessions = sessions_of(&sets)?;
+    let default_payload = cmd.payload_kg.unwrap_or(nominal.payload.mass);
+    let (ident, ident_sources) = load_sets(
+        state,
+        robot_id,
+        &sets.ident,
+        &sessions,
+        nominal,
+        default_payload,
+    )
+    .await?;
+    let (valid, valid_sources) = load_sets(
+        state,
+        robot_id,
+        &sets.valid,
+        &sessions,
+        nominal,
+        default_payload,
+    )
+    .await?;
+    let (training, train_sources) = load_sets(
+        state,
+        robot_id,
+        &sets.train,
+        &sessions,
+        nominal,
+        default_payload,
+    )
+    .await?;
+    let pose_sources = PoseSources {
+        identification: ident_sources,
+        validation: valid_sources,
+        training: train_sources,
+    };
+    Ok(Prepared {
+        ident,
+        valid,
+        training,
+        session_names: sessions,
+        pose_sources,
+        opts: calibration_options(cmd),
+        payload_kg: default_payload,
+        sets,
+    })
+}
+
+/// The command a stored job was queued with (the inverse of the row that
+/// [`start`] writes): the same sets, methods and options.
+pub(super) fn stored_command(row: &CalibrationRow) -> Result<StartCommand, ServiceError> {
+    let bad = |what: &str| ServiceError::Internal(format!("calibration {}: stored {what}", row.id));
+    let methods = Method::parse_names(&row.methods.0).map_err(|_| bad("methods"))?;
+    let o = &row.options.0;
+    let int = |key: &str| o[key].as_u64().ok_or_else(|| bad(key));
+    let training: Vec<i64> = serde_json::from_value(o["training_set_ids"].clone())
+        .map_err(|_| bad("training_set_ids"))?;
+    Ok(StartCommand {
+        methods,
+        identification_set_ids: Some(row.identification_set_ids.0.clone()),
+        validation_set_ids: Some(row.validation_set_ids.0.clone()),
+        training_set_ids: Some(training),
+        register: o["register"].as_bool().ok_or_else(|| bad("register"))?,
+        max_iterations: int("max_iterations")? as usize,
+        population: int("population")? as usize,
+        generations: int("generations")? as usize,
+        seed: int("seed")?,
+        payload_kg: Some(o["payload_kg"].as_f64().ok_or_else(|| bad("payload_kg"))?),
+    })
+}
+
+/// The job of a prepared calibration.
+pub(super) fn job_of(
+    id: i64,
+    robot_id: i64,
+    robot_name: String,
+    nominal: RobotModel,
+    p: Prepared,
+    ticket: Option<Ticket>,
+) -> Job {
+    Job {
+        id,
+        robot_id,
+        robot_name,
+        nominal,
+        ident: p.ident,
+        valid: p.valid,
+        training: p.training,
+        session_names: p.session_names,
+        pose_sources: p.pose_sources,
+        opts: p.opts,
+        payload_kg: p.payload_kg,
+        ticket,
+    }
+}
+
 /// Queues a calibration of a robot and starts its job; returns the queued job.
+///
+/// SQLite: the job runs in this process (its rows read now). PostgreSQL: the
+/// job is checked and queued in the database; a replica's runner
+/// ([`super::queue`]) claims it and reads its rows then.
 pub async fn start(
     state: &AppState,
     robot_id: i64,
@@ -259,52 +386,15 @@ pub async fn start(
         .ok_or_else(|| ServiceError::robot_not_found(robot_id))?;
     let nominal = RobotModel::from_json(&robot.model_json)
         .map_err(|e| ServiceError::Internal(format!("stored model of robot {robot_id}: {e}")))?;
-    let ticket = state.admit_job()?;
-
-    let all_sets = state.db().sets(robot_id).await?;
-    // A delete of the robot may have run between the robot lookup and the set
-    // list (the cascade removes its sets): the robot still existing now means
-    // it existed when the sets were read, so the list is that robot's.
-    if state.db().robot(robot_id).await?.is_none() {
-        return Err(ServiceError::robot_not_found(robot_id));
-    }
-    let sets = select_sets(&all_sets, &cmd, robot_id)?;
-    let sessions = sessions_of(&sets)?;
-    let default_payload = cmd.payload_kg.unwrap_or(nominal.payload.mass);
-    let (ident, ident_sources) = load_sets(
-        state,
-        robot_id,
-        &sets.ident,
-        &sessions,
-        &nominal,
-        default_payload,
-    )
-    .await?;
-    let (valid, valid_sources) = load_sets(
-        state,
-        robot_id,
-        &sets.valid,
-        &sessions,
-        &nominal,
-        default_payload,
-    )
-    .await?;
-    let (training, train_sources) = load_sets(
-        state,
-        robot_id,
-        &sets.train,
-        &sessions,
-        &nominal,
-        default_payload,
-    )
-    .await?;
-    let pose_sources = PoseSources {
-        identification: ident_sources,
-        validation: valid_sources,
-        training: train_sources,
+    let ticket = if state.shared_jobs() {
+        super::queue::admit(state).await?;
+        None
+    } else {
+        Some(state.admit_job()?)
     };
-
-    let opts = calibration_options(&cmd);
+    let prepared = prepare(state, robot_id, &nominal, &cmd).await?;
+    let opts = &prepared.opts;
+    let sets = &prepared.sets;
     let method_names: Vec<String> = cmd.methods.iter().map(|m| m.name().to_string()).collect();
     let ids = |list: &[SetRow]| list.iter().map(|s| s.id).collect::<Vec<i64>>();
     let options = json!({
@@ -314,7 +404,7 @@ pub async fn start(
         "generations": opts.tlbo.generations,
         "max_iterations": opts.lm.max_iterations,
         "register": opts.register,
-        "payload_kg": default_payload,
+        "payload_kg": prepared.payload_kg,
     });
     let row = state
         .db()
@@ -327,27 +417,18 @@ pub async fn start(
         })
         .await?
         .ok_or_else(|| ServiceError::robot_not_found(robot_id))?;
-    let job = Job {
-        id: row.id,
-        robot_id,
-        robot_name: robot.name.clone(),
-        nominal,
-        ident,
-        valid,
-        training,
-        session_names: sessions,
-        pose_sources,
-        opts,
-        payload_kg: default_payload,
-        ticket,
-    };
+    if state.shared_jobs() {
+        state.wake_runner();
+        return Ok(row);
+    }
+    let job = job_of(row.id, robot_id, robot.name, nominal, prepared, ticket);
     state.cancel_flag(job.id);
     tokio::spawn(run_job(state.clone(), job));
     Ok(row)
 }
 
 /// Everything a queued job needs; the rows are read when it is queued.
-struct Job {
+pub(super) struct Job {
     id: i64,
     robot_id: i64,
     robot_name: String,
@@ -362,14 +443,16 @@ struct Job {
     session_names: Vec<String>,
     /// Set, row and session of every identification and validation pose.
     pose_sources: PoseSources,
-    /// Its place in the job queue, released when the job ends.
-    ticket: Ticket,
+    /// Its place in this process's job queue, released when the job ends
+    /// (`None`: queued in the shared store).
+    ticket: Option<Ticket>,
 }
 
 /// Writes progress to the database, at most once per `interval`.
 async fn write_progress(
     state: AppState,
     id: i64,
+    claim: Option<String>,
     mut rx: watch::Receiver<Option<Progress>>,
     interval: Duration,
 ) {
@@ -383,7 +466,7 @@ async fn write_progress(
             };
             if let Err(e) = state
                 .db()
-                .update_progress(id, &p.phase, p.iteration as i64, pct)
+                .update_progress(id, claim.as_deref(), &p.phase, p.iteration as i64, pct)
                 .await
             {
                 tracing::warn!(job = id, error = %e, "cannot store job progress");
@@ -393,10 +476,9 @@ async fn write_progress(
     }
 }
 
+/// Runs a job of this process (SQLite) once a worker slot is free.
 async fn run_job(state: AppState, job: Job) {
     let id = job.id;
-    let robot_id = job.robot_id;
-    let cancel = state.cancel_flag(id);
     let slots = state.calibration_slots();
     let Ok(_permit) = slots.acquire_owned().await else {
         return;
@@ -414,11 +496,30 @@ async fn run_job(state: AppState, job: Job) {
             return;
         }
     }
+    execute(state, job, None).await;
+}
+
+/// Runs a started job and stores its outcome. `claim`: the token of this
+/// replica's claim on a shared job, which every write of the job must match
+/// (a job taken over by another replica is no longer this one's to write).
+pub(super) async fn execute(state: AppState, job: Job, claim: Option<String>) {
+    let id = job.id;
+    let robot_id = job.robot_id;
+    let cancel = state.cancel_flag(id);
     tracing::info!(job = id, robot = robot_id, "calibration started");
+    let heartbeat = claim.clone().map(|c| {
+        tokio::spawn(super::queue::heartbeat(
+            state.clone(),
+            id,
+            c,
+            cancel.clone(),
+        ))
+    });
     let (tx, rx) = watch::channel(None::<Progress>);
     let writer = tokio::spawn(write_progress(
         state.clone(),
         id,
+        claim.clone(),
         rx,
         state.config().progress_interval,
     ));
@@ -473,14 +574,28 @@ async fn run_job(state: AppState, job: Job) {
     })
     .await;
     let _ = writer.await;
+    if let Some(h) = heartbeat {
+        h.abort();
+    }
     let db = state.db();
+    let claim = claim.as_deref();
     let stored = match outcome {
         Ok(Ok((report, versions))) => {
             let summary = summary_of(&report);
             let best = summary.best_method.clone();
             match serde_json::to_string(&report) {
                 Ok(text) => db
-                    .finish_calibration_success(robot_id, id, &text, &best, &summary, &versions)
+                    .finish_calibration_success(
+                        robot_id,
+                        id,
+                        claim,
+                        &JobResult {
+                            report_json: &text,
+                            best_method: &best,
+                            summary: &summary,
+                            versions: &versions,
+                        },
+                    )
                     .await
                     .map(|v| {
                         tracing::info!(job = id, robot = robot_id, best = %best, versions = v.len(), failed = report.failed.len(), "calibration succeeded");
@@ -488,6 +603,7 @@ async fn run_job(state: AppState, job: Job) {
                 Err(e) => {
                     db.finish_calibration_error(
                         id,
+                        claim,
                         JobStatus::Failed,
                         &format!("internal error: {e}"),
                     )
@@ -499,6 +615,7 @@ async fn run_job(state: AppState, job: Job) {
             tracing::info!(job = id, "calibration stopped at its time budget");
             db.finish_calibration_error(
                 id,
+                claim,
                 JobStatus::Failed,
                 &format!(
                     "stopped after the job time budget of {} s (`--job-time-limit`); use fewer poses, generations or a smaller population",
@@ -509,25 +626,33 @@ async fn run_job(state: AppState, job: Job) {
         }
         Ok(Err(CalibrationError::Cancelled)) => {
             tracing::info!(job = id, "calibration cancelled");
-            db.finish_calibration_error(id, JobStatus::Cancelled, "cancelled by request")
+            db.finish_calibration_error(id, claim, JobStatus::Cancelled, "cancelled by request")
                 .await
         }
         Ok(Err(e)) => {
             tracing::info!(job = id, error = %e, "calibration failed");
-            db.finish_calibration_error(id, JobStatus::Failed, &e.to_string())
+            db.finish_calibration_error(id, claim, JobStatus::Failed, &e.to_string())
                 .await
         }
         Err(e) => {
             tracing::error!(job = id, error = %e, "calibration task panicked");
-            db.finish_calibration_error(id, JobStatus::Failed, "internal error in the calibration")
-                .await
+            db.finish_calibration_error(
+                id,
+                claim,
+                JobStatus::Failed,
+                "internal error in the calibration",
+            )
+            .await
         }
     };
     if let Err(e) = stored {
         tracing::error!(job = id, error = %e, "cannot store the calibration outcome");
     }
     state.drop_cancel_flag(id);
-    state.invalidate_robot(robot_id);
+    super::changes::robot_changed(&state, robot_id).await;
+    if claim.is_some() {
+        state.wake_runner();
+    }
 }
 
 /// The summary of a report: the best method by validation mean (by
@@ -614,4 +739,60 @@ fn versions_of(
         });
     }
     out
+}
+
+/// One page of a robot's calibrations by id (the robot must exist).
+pub async fn page(
+    state: &AppState,
+    robot_id: i64,
+    limit: i64,
+    offset: i64,
+) -> Result<Listing<CalibrationRow>, ServiceError> {
+    Ok(state
+        .db()
+        .calibrations_page(robot_id, limit, offset)
+        .await?)
+}
+
+/// Every calibration of a robot by id.
+pub async fn list(state: &AppState, robot_id: i64) -> Result<Vec<CalibrationRow>, ServiceError> {
+    Ok(state.db().calibrations(robot_id).await?)
+}
+
+/// Calibration `id` of a robot, or `NotFound`.
+pub async fn get(state: &AppState, robot_id: i64, id: i64) -> Result<CalibrationRow, ServiceError> {
+    state
+        .db()
+        .calibration(robot_id, id)
+        .await?
+        .ok_or_else(|| ServiceError::calibration_not_found(robot_id, id))
+}
+
+/// Requests cancellation: a queued job is cancelled at once, a running one
+/// stops at its next progress check. A job that already ended conflicts.
+pub async fn cancel(
+    state: &AppState,
+    robot_id: i64,
+    id: i64,
+) -> Result<CalibrationRow, ServiceError> {
+    let row = get(state, robot_id, id).await?;
+    if !row.status.is_active() {
+        return Err(ServiceError::Conflict(format!(
+            "calibration {id} is already {}; only queued or running jobs can be cancelled",
+            row.status
+        )));
+    }
+    if let Some(flag) = state.existing_cancel_flag(id) {
+        flag.store(true, Ordering::SeqCst);
+    }
+    state
+        .db()
+        .request_cancel(robot_id, id)
+        .await?
+        .ok_or_else(|| ServiceError::calibration_not_found(robot_id, id))
+}
+
+/// The stored report JSON of a calibration (set when it succeeded).
+pub async fn report_text(state: &AppState, id: i64) -> Result<Option<String>, ServiceError> {
+    Ok(state.db().calibration_report(id).await?)
 }

@@ -3,16 +3,26 @@
 //! calibration jobs (set selection, tracker sessions, the job runner and its
 //! progress, model versions), measurement-set uploads and solves (model choice, solver cache, batches). It takes domain commands, not HTTP bodies, and
 //! answers with a typed [`ServiceError`] that the HTTP layer maps to a status.
+//!
+//! Layering: handlers (`crate::http`) call this layer only; only this layer
+//! calls the store (`crate::db`), whose errors ([`StoreError`]) are robocal's
+//! own. A new resource gets a store file (`db/<resource>.rs`), a service file
+//! here (`<resource>.rs`: the commands and reads, with the caches kept in step)
+//! and a handler file (`http/<resource>.rs` with its `routes()`).
 
 pub mod calibrations;
+mod changes;
 pub mod limits;
+pub mod queue;
+pub mod robots;
 pub mod sets;
 pub mod solve;
 mod state;
+pub mod versions;
 
 pub use state::{AppState, RobotContext, ServiceConfig};
 
-use crate::db::DbError;
+use crate::db::StoreError;
 
 /// Why a service operation did not happen.
 #[derive(Debug, thiserror::Error)]
@@ -32,9 +42,9 @@ pub enum ServiceError {
     /// The service cannot take the command now (shutting down).
     #[error("{0}")]
     Unavailable(String),
-    /// The store failed.
-    #[error("database error: {0}")]
-    Db(#[from] DbError),
+    /// The store failed (unavailable, a conflicting concurrent write, a bug).
+    #[error("{0}")]
+    Store(#[from] StoreError),
     /// A bug or corrupt stored data; logged, never shown to the client.
     #[error("{0}")]
     Internal(String),
@@ -46,4 +56,52 @@ impl ServiceError {
             "robot {id} does not exist; list robots with GET /v1/robots"
         ))
     }
+
+    pub fn set_not_found(robot: i64, id: i64) -> Self {
+        ServiceError::NotFound(format!(
+            "measurement set {id} of robot {robot} does not exist; list them with GET /v1/robots/{robot}/measurement-sets"
+        ))
+    }
+
+    pub fn calibration_not_found(robot: i64, id: i64) -> Self {
+        ServiceError::NotFound(format!(
+            "calibration {id} of robot {robot} does not exist; list them with GET /v1/robots/{robot}/calibrations"
+        ))
+    }
+
+    pub fn version_not_found(robot: i64, v: i64) -> Self {
+        ServiceError::NotFound(format!(
+            "robot {robot} has no model version {v}; list them with GET /v1/robots/{robot}/versions"
+        ))
+    }
+}
+
+/// Whether this replica should get requests: the store answers, its schema
+/// is current, and the replica is not shutting down; `Unavailable` when not.
+pub async fn ready(state: &AppState) -> Result<(), ServiceError> {
+    if state.draining() {
+        return Err(ServiceError::Unavailable(
+            "this replica is shutting down".into(),
+        ));
+    }
+    let pending = state
+        .db()
+        .pending_migrations()
+        .await
+        .map_err(|e| ServiceError::Unavailable(format!("database unavailable: {e}")))?;
+    if pending > 0 {
+        return Err(ServiceError::Unavailable(format!(
+            "the database lacks {pending} migration(s) of this build"
+        )));
+    }
+    Ok(())
+}
+
+/// Whether the store answers now (one round trip): `Unavailable` when not.
+pub async fn health(state: &AppState) -> Result<(), ServiceError> {
+    state
+        .db()
+        .ping()
+        .await
+        .map_err(|e| ServiceError::Unavailable(format!("database unavailable: {e}")))
 }

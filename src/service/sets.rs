@@ -8,7 +8,7 @@
 //! upload declared.
 
 use super::{AppState, ServiceError};
-use crate::db::{AngleUnit, LengthUnit, NewSet, SetFormat, SetRow};
+use crate::db::{AngleUnit, LengthUnit, Listing, NewSet, SetFormat, SetRow};
 use crate::measure::csv::{self, CsvError, ReadOptions, MAX_PAYLOAD_KG};
 use crate::measure::{MeasuredPose, SetRole};
 
@@ -109,6 +109,13 @@ pub async fn upload(state: &AppState, cmd: NewSetCommand) -> Result<SetRow, Serv
     let session = cmd.session.clone();
     let (rows, format, original) = tokio::task::spawn_blocking(move || {
         let (rows, format, original) = match cmd.content {
+            // Text columns hold no NUL on PostgreSQL; refused alike on SQLite.
+            SetContent::Csv { text, .. } if text.contains('\0') => {
+                return Err(ServiceError::Invalid(
+                    "the upload contains the NUL character (U+0000); measurement files are text"
+                        .into(),
+                ))
+            }
             SetContent::Csv { text, read } => {
                 (read_csv(&text, &read, &session)?, SetFormat::Csv, text)
             }
@@ -148,4 +155,55 @@ pub async fn upload(state: &AppState, cmd: NewSetCommand) -> Result<SetRow, Serv
         })
         .await?
         .ok_or_else(|| ServiceError::robot_not_found(robot_id))
+}
+
+/// One page of a robot's sets by id (the robot must exist).
+pub async fn page(
+    state: &AppState,
+    robot_id: i64,
+    limit: i64,
+    offset: i64,
+) -> Result<Listing<SetRow>, ServiceError> {
+    Ok(state.db().sets_page(robot_id, limit, offset).await?)
+}
+
+/// Every set of a robot by id.
+pub async fn list(state: &AppState, robot_id: i64) -> Result<Vec<SetRow>, ServiceError> {
+    Ok(state.db().sets(robot_id).await?)
+}
+
+/// A set and its parsed rows (mm/deg).
+pub async fn get(
+    state: &AppState,
+    robot_id: i64,
+    id: i64,
+) -> Result<(SetRow, Vec<MeasuredPose>), ServiceError> {
+    let missing = || ServiceError::set_not_found(robot_id, id);
+    let row = state.db().set(robot_id, id).await?.ok_or_else(missing)?;
+    let rows = state
+        .db()
+        .set_rows(robot_id, id)
+        .await?
+        .ok_or_else(missing)?;
+    Ok((row, rows))
+}
+
+/// The upload of a set as received: its format and text.
+pub async fn original(
+    state: &AppState,
+    robot_id: i64,
+    id: i64,
+) -> Result<(SetFormat, String), ServiceError> {
+    state
+        .db()
+        .set_original(robot_id, id)
+        .await?
+        .ok_or_else(|| ServiceError::set_not_found(robot_id, id))
+}
+
+pub async fn delete(state: &AppState, robot_id: i64, id: i64) -> Result<(), ServiceError> {
+    if !state.db().delete_set(robot_id, id).await? {
+        return Err(ServiceError::set_not_found(robot_id, id));
+    }
+    Ok(())
 }

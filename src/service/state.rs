@@ -7,10 +7,10 @@ use super::ServiceError;
 use crate::db::Db;
 use crate::ik::IkSolver;
 use std::collections::HashMap;
-use std::sync::atomic::AtomicBool;
-use std::sync::{Arc, Mutex};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{Arc, Mutex, Weak};
 use std::time::Duration;
-use tokio::sync::Semaphore;
+use tokio::sync::{Notify, Semaphore};
 
 /// Service settings that are not the database.
 #[derive(Clone)]
@@ -23,6 +23,9 @@ pub struct ServiceConfig {
     pub solve_workers: usize,
     /// Shortest interval between two progress writes of a job.
     pub progress_interval: Duration,
+    /// Lease of a claimed job on the shared store (PostgreSQL): another
+    /// replica takes the job over once its runner stopped renewing it this long.
+    pub job_lease: Duration,
     /// Sizes, queues and budgets.
     pub limits: Limits,
 }
@@ -38,6 +41,7 @@ impl std::fmt::Debug for ServiceConfig {
             .field("workers", &self.workers)
             .field("solve_workers", &self.solve_workers)
             .field("progress_interval", &self.progress_interval)
+            .field("job_lease", &self.job_lease)
             .field("limits", &self.limits)
             .finish()
     }
@@ -50,6 +54,7 @@ impl Default for ServiceConfig {
             workers: 1,
             solve_workers: 2,
             progress_interval: Duration::from_millis(250),
+            job_lease: Duration::from_secs(15),
             limits: Limits::default(),
         }
     }
@@ -86,6 +91,14 @@ struct Inner {
     /// Large solve batches running or waiting (solve_workers + queued_solves).
     solve_gate: Arc<Admission>,
     cancel_flags: Mutex<HashMap<i64, Arc<AtomicBool>>>,
+    /// Jobs of the shared store this replica runs, with their claim tokens.
+    claims: Mutex<HashMap<i64, String>>,
+    /// Set on SIGTERM: the runner claims no more jobs.
+    draining: AtomicBool,
+    /// Wakes the runner of the shared store.
+    runner_wake: Arc<Notify>,
+    /// Counts cache invalidations (a read that saw another count is not cached).
+    invalidations: AtomicU64,
     robots: Mutex<HashMap<i64, Arc<RobotContext>>>,
     solvers: Mutex<HashMap<SolverKey, Arc<IkSolver>>>,
 }
@@ -93,8 +106,23 @@ struct Inner {
 /// Prepared solvers kept in memory (model versions are immutable).
 const SOLVER_CACHE_MAX: usize = 64;
 
+/// A reference to the state that does not keep it alive.
+pub(crate) struct WeakState(Weak<Inner>);
+
 impl AppState {
+    /// The state over `db`; on PostgreSQL it starts this replica's job
+    /// runner, so it must be made inside a Tokio runtime.
     pub fn new(db: Db, config: ServiceConfig) -> Self {
+        let shared = db.backend() == crate::db::Backend::Postgres;
+        let state = AppState::build(db, config);
+        if shared {
+            super::queue::spawn_runner(&state);
+            super::changes::spawn_listener(&state);
+        }
+        state
+    }
+
+    fn build(db: Db, config: ServiceConfig) -> Self {
         let workers = config.workers.max(1);
         let solve_workers = config.solve_workers.max(1);
         AppState {
@@ -106,18 +134,69 @@ impl AppState {
                 solve_gate: Admission::new(solve_workers + config.limits.queued_solves),
                 config,
                 cancel_flags: Mutex::new(HashMap::new()),
+                claims: Mutex::new(HashMap::new()),
+                draining: AtomicBool::new(false),
+                runner_wake: Arc::new(Notify::new()),
+                invalidations: AtomicU64::new(0),
                 robots: Mutex::new(HashMap::new()),
                 solvers: Mutex::new(HashMap::new()),
             }),
         }
     }
 
-    pub fn db(&self) -> &Db {
+    pub(in crate::service) fn db(&self) -> &Db {
         &self.inner.db
     }
 
     pub fn config(&self) -> &ServiceConfig {
         &self.inner.config
+    }
+
+    /// Whether jobs live in a store shared by replicas (PostgreSQL) rather
+    /// than in this process.
+    pub(crate) fn shared_jobs(&self) -> bool {
+        self.inner.db.backend() == crate::db::Backend::Postgres
+    }
+
+    pub(crate) fn downgrade(&self) -> WeakState {
+        WeakState(Arc::downgrade(&self.inner))
+    }
+
+    pub(crate) fn upgrade(weak: &WeakState) -> Option<AppState> {
+        weak.0.upgrade().map(|inner| AppState { inner })
+    }
+
+    pub(crate) fn runner_wake(&self) -> Arc<Notify> {
+        self.inner.runner_wake.clone()
+    }
+
+    /// Lets the job runner look for work now.
+    pub(crate) fn wake_runner(&self) {
+        self.inner.runner_wake.notify_one();
+    }
+
+    pub(crate) fn draining(&self) -> bool {
+        self.inner.draining.load(Ordering::SeqCst)
+    }
+
+    pub(crate) fn start_draining(&self) {
+        self.inner.draining.store(true, Ordering::SeqCst);
+    }
+
+    pub(crate) fn hold_claim(&self, job: i64, claim: &str) {
+        lock(&self.inner.claims).insert(job, claim.to_string());
+    }
+
+    pub(crate) fn drop_claim(&self, job: i64) {
+        lock(&self.inner.claims).remove(&job);
+    }
+
+    /// The jobs this replica runs and their claim tokens.
+    pub(crate) fn held_claims(&self) -> Vec<(i64, String)> {
+        lock(&self.inner.claims)
+            .iter()
+            .map(|(k, v)| (*k, v.clone()))
+            .collect()
     }
 
     pub(crate) fn calibration_slots(&self) -> Arc<Semaphore> {
@@ -178,8 +257,20 @@ impl AppState {
 
     /// Forgets what is cached about a robot (after its versions changed or it was deleted).
     pub(crate) fn invalidate_robot(&self, robot_id: i64) {
-        lock(&self.inner.robots).remove(&robot_id);
+        let mut robots = lock(&self.inner.robots);
+        self.inner.invalidations.fetch_add(1, Ordering::SeqCst);
+        robots.remove(&robot_id);
+        drop(robots);
         lock(&self.inner.solvers).retain(|k, _| k.0 != robot_id);
+    }
+
+    /// Forgets what is cached about every robot.
+    pub(crate) fn invalidate_all_robots(&self) {
+        let mut robots = lock(&self.inner.robots);
+        self.inner.invalidations.fetch_add(1, Ordering::SeqCst);
+        robots.clear();
+        drop(robots);
+        lock(&self.inner.solvers).clear();
     }
 
     /// The robot and its active version, cached.
@@ -187,9 +278,15 @@ impl AppState {
         &self,
         robot_id: i64,
     ) -> Result<Arc<RobotContext>, ServiceError> {
-        if let Some(c) = lock(&self.inner.robots).get(&robot_id) {
-            return Ok(c.clone());
-        }
+        // Read before the store: a change announced while the store is read
+        // makes this read stale, and it is then not cached.
+        let seen = {
+            let robots = lock(&self.inner.robots);
+            if let Some(c) = robots.get(&robot_id) {
+                return Ok(c.clone());
+            }
+            self.inner.invalidations.load(Ordering::SeqCst)
+        };
         let robot = self
             .db()
             .robot(robot_id)
@@ -207,7 +304,10 @@ impl AppState {
             dof: robot.dof as usize,
             active,
         });
-        lock(&self.inner.robots).insert(robot_id, ctx.clone());
+        let mut robots = lock(&self.inner.robots);
+        if self.inner.invalidations.load(Ordering::SeqCst) == seen {
+            robots.insert(robot_id, ctx.clone());
+        }
         Ok(ctx)
     }
 

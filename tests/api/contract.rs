@@ -488,6 +488,7 @@ async fn the_server_refuses_what_the_spec_refuses() {
         r#"{"preset": "YS100"}"#,
         r#"{"preset": "ys100", "name": ""}"#,
         r#"{"preset": "ys100", "name": " \t"}"#,
+        r#"{"preset": "ys100", "name": "cell\u0000 3"}"#,
         r#"{"preset": "ys100", "metadata": [1, 2]}"#,
         r#"[null, "ys100", null, null]"#,
         r#"["cell", "ys100"]"#,
@@ -500,6 +501,21 @@ async fn the_server_refuses_what_the_spec_refuses() {
             r.text()
         );
     }
+    // NUL is refused alike on both stores (PostgreSQL text holds none), as the spec says.
+    let name = serde_json::json!({ "$ref": "#/components/schemas/Name" });
+    assert!(!t.spec.accepts(&name, &serde_json::json!("cell\u{0} 3")));
+    assert!(t.spec.accepts(&name, &serde_json::json!("cell 3")));
+    let r = t
+        .raw(
+            "POST",
+            &format!("/v1/robots/{rid}/measurement-sets?role=identification"),
+            Some("text/csv"),
+            format!("# \u{0}\n{}", simulated_csv(5, 10)).into_bytes(),
+            Some("k1"),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+    assert!(r.detail().contains("NUL"), "{}", r.detail());
     // A JSON array never renames a robot or starts a calibration.
     let r = t
         .raw(
@@ -705,4 +721,26 @@ async fn urls_over_64_kib_get_a_problem_document() {
     s.read_to_end(&mut buf).await.unwrap();
     assert!(buf.starts_with(b"HTTP/1.1 200 "));
     server.abort();
+}
+
+/// `/readyz` answers 200 while the store answers and its schema is current,
+/// 503 when a migration of this build is missing (SQLite file edited here).
+#[tokio::test]
+async fn readiness_follows_the_schema() {
+    let t = setup().await;
+    let r = t.get("/readyz", &[]).await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    assert_eq!(t.db.pending_migrations().await.unwrap(), 0);
+    if t._pg.is_some() {
+        return;
+    }
+    let url = format!("sqlite://{}", t._dir.path().join("service.db").display());
+    let pool = sqlx::SqlitePool::connect(&url).await.unwrap();
+    sqlx::query("DELETE FROM _sqlx_migrations WHERE version = 3")
+        .execute(&pool)
+        .await
+        .unwrap();
+    let r = t.get("/readyz", &[]).await;
+    assert_eq!(r.status, StatusCode::SERVICE_UNAVAILABLE);
+    assert!(r.detail().contains("1 migration"), "{}", r.detail());
 }

@@ -385,9 +385,7 @@ async fn quickstart_flow_calibrate_version_and_solve() {
     assert_eq!(r.status, StatusCode::NO_CONTENT);
     let r = t.get("/v1/robots/{id}/versions", &[&rid]).await;
     assert_eq!(r.status, StatusCode::NOT_FOUND);
-    let left: i64 = sqlx::query_scalar("SELECT COUNT(*) FROM model_versions")
-        .fetch_one(t.state.db().pool())
-        .await
-        .unwrap();
-    assert_eq!(left, 0);
+    let left = t.db.row_counts().await.unwrap();
+    assert_eq!(left.model_versions, 0);
+    assert_eq!(left.activations, 0);
 }

@@ -285,7 +285,7 @@ async fn writes_racing_a_robot_delete_never_fail_with_500() {
         ));
     }
     // The parent check itself, without timing luck.
-    let db = t.state.db();
+    let db = &t.db;
     let missing = robocal::db::NewCalibration {
         robot_id: 999_999,
         methods: &["km".to_string()],

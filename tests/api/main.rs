@@ -1,5 +1,7 @@
-//! The HTTP API against a real SQLite file in a temporary directory, driven
-//! in-process through the router (`tower::ServiceExt::oneshot`).
+//! The HTTP API against a real store, driven in-process through the router
+//! (`tower::ServiceExt::oneshot`): a SQLite file in a temporary directory, or
+//! with `ROBOCAL_TEST_DATABASE_URL=postgres://…` a new PostgreSQL database
+//! per test on that server (`scripts/pg_temp.sh` starts one).
 //!
 //! Every response is checked against `openapi.yaml`: its status must be
 //! documented for the route and method, and a JSON body must validate against

@@ -151,8 +151,11 @@ impl Spec {
 pub(crate) struct TestApp {
     pub(crate) router: Router,
     pub(crate) state: AppState,
+    /// The store behind the service.
+    pub(crate) db: robocal::db::Db,
     pub(crate) spec: Arc<Spec>,
     pub(crate) _dir: tempfile::TempDir,
+    pub(crate) _pg: Option<crate::common::TempDatabase>,
     pub(crate) key: Option<String>,
 }
 
@@ -198,12 +201,14 @@ pub(crate) async fn setup_with(keys: &[&str], workers: usize) -> TestApp {
 
 pub(crate) async fn setup_config(config: ServiceConfig) -> TestApp {
     let keys = config.api_keys.clone();
-    let (router, state, dir) = service(config).await;
+    let s = service(config).await;
     TestApp {
-        router,
-        state,
+        router: s.router,
+        state: s.state,
+        db: s.db,
         spec: Arc::new(Spec::load()),
-        _dir: dir,
+        _dir: s.dir,
+        _pg: s.pg,
         key: keys.first().cloned(),
     }
 }

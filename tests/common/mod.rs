@@ -28,17 +28,110 @@ pub fn robocal_json(dir: &Path, args: &[&str]) -> serde_json::Value {
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
-/// The service on a new SQLite file in a temporary directory: its router,
-/// its state and the directory (which must outlive them).
-pub async fn service(config: ServiceConfig) -> (Router, AppState, tempfile::TempDir) {
+/// The service in-process on a new, empty store.
+pub struct TestService {
+    pub router: Router,
+    pub state: AppState,
+    /// The store the service uses, for checks behind its back.
+    pub db: Db,
+    /// Holds the SQLite file; must outlive the service.
+    pub dir: tempfile::TempDir,
+    /// The PostgreSQL database of this test, dropped last.
+    pub pg: Option<TempDatabase>,
+}
+
+/// The environment variable that selects the backend of the service tests:
+/// unset, SQLite files; a PostgreSQL URL (a role that may create databases),
+/// one new database per test on that server.
+pub const TEST_DATABASE_URL: &str = "ROBOCAL_TEST_DATABASE_URL";
+
+/// The service on a new, empty store: a SQLite file in a temporary
+/// directory, or a new PostgreSQL database when [`TEST_DATABASE_URL`] says so.
+pub async fn service(config: ServiceConfig) -> TestService {
     let dir = tempfile::tempdir().unwrap();
-    let url = format!(
-        "sqlite://{}?mode=rwc",
-        dir.path().join("service.db").display()
-    );
-    let db = Db::connect(&url).await.unwrap();
-    let state = AppState::new(db, config);
-    (app(state.clone()), state, dir)
+    let (db, pg) = test_store(dir.path()).await;
+    let state = AppState::new(db.clone(), config);
+    TestService {
+        router: app(state.clone()),
+        state,
+        db,
+        dir,
+        pg,
+    }
+}
+
+/// A new, empty store for one test (see [`service`]).
+pub async fn test_store(dir: &Path) -> (Db, Option<TempDatabase>) {
+    match std::env::var(TEST_DATABASE_URL) {
+        Ok(admin) if !admin.trim().is_empty() => {
+            let pg = TempDatabase::create(admin.trim()).await;
+            let db = Db::connect_with(&pg.url, 4).await.unwrap();
+            (db, Some(pg))
+        }
+        _ => {
+            let url = format!("sqlite://{}?mode=rwc", dir.join("service.db").display());
+            (Db::connect(&url).await.unwrap(), None)
+        }
+    }
+}
+
+/// A PostgreSQL database made for one test and dropped with this guard.
+pub struct TempDatabase {
+    admin: String,
+    name: String,
+    /// The URL of the new database.
+    pub url: String,
+}
+
+impl TempDatabase {
+    pub async fn create(admin: &str) -> TempDatabase {
+        use sqlx::Connection;
+        static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+        let stamp = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .unwrap()
+            .as_millis();
+        let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+        let name = format!("robocal_test_{}_{stamp}_{n}", std::process::id());
+        let mut admin_conn = sqlx::PgConnection::connect(admin).await.unwrap();
+        sqlx::query(&format!("CREATE DATABASE \"{name}\""))
+            .execute(&mut admin_conn)
+            .await
+            .unwrap();
+        admin_conn.close().await.unwrap();
+        let (base, query) = match admin.split_once('?') {
+            Some((b, q)) => (b, format!("?{q}")),
+            None => (admin, String::new()),
+        };
+        let (server, _) = base.rsplit_once('/').expect("a URL with a database path");
+        TempDatabase {
+            admin: admin.to_string(),
+            url: format!("{server}/{name}{query}"),
+            name,
+        }
+    }
+}
+
+impl Drop for TempDatabase {
+    fn drop(&mut self) {
+        let admin = self.admin.clone();
+        let sql = format!("DROP DATABASE IF EXISTS \"{}\" WITH (FORCE)", self.name);
+        // Its own runtime on its own thread: drop may run inside a runtime.
+        let _ = std::thread::spawn(move || {
+            let rt = tokio::runtime::Builder::new_current_thread()
+                .enable_all()
+                .build()
+                .unwrap();
+            rt.block_on(async {
+                use sqlx::Connection;
+                if let Ok(mut c) = sqlx::PgConnection::connect(&admin).await {
+                    let _ = sqlx::query(&sql).execute(&mut c).await;
+                    let _ = c.close().await;
+                }
+            });
+        })
+        .join();
+    }
 }
 
 /// Sends one request through `router` in-process: status, headers and body.

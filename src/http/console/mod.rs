@@ -1,7 +1,7 @@
 //! The web console: server-rendered pages (maud, escaping by default) for the
 //! whole flow — robots, measurement uploads, calibration jobs with live
 //! progress, reports, model versions with activate and rollback, and solving a
-//! targets CSV. The pages read the store directly; every write is made by the
+//! targets CSV. The pages read through the service layer; every write is made by the
 //! page's own script through the REST API (`/v1`), so the console obeys the
 //! same API keys, limits and validation as any client. No external assets:
 //! the style sheet and the script are inlined.
@@ -11,8 +11,8 @@
 
 mod pages;
 
-use super::robots::robot_not_found;
 use super::{route, ApiError, ApiPath, AppState, Route};
+use crate::service;
 use axum::extract::State;
 use axum::http::Method;
 use axum::response::{Html, IntoResponse, Response};
@@ -29,21 +29,20 @@ pub fn routes() -> Vec<Route> {
 }
 
 async fn robots_page(State(state): State<AppState>) -> Result<Response, ApiError> {
-    let (robots, total) = state.db().robots_page(ROBOTS_SHOWN, 0).await?;
+    let listing = service::robots::page(&state, ROBOTS_SHOWN, 0).await?;
     let keys = !state.config().api_keys.is_empty();
-    Ok(Html(pages::robots(&robots, total, keys).into_string()).into_response())
+    Ok(Html(pages::robots(&listing.rows, listing.total, keys).into_string()).into_response())
 }
 
 async fn robot_page(
     State(state): State<AppState>,
     ApiPath(id): ApiPath<i64>,
 ) -> Result<Response, ApiError> {
-    let db = state.db();
-    let robot = db.robot(id).await?.ok_or_else(|| robot_not_found(id))?;
+    let robot = service::robots::get(&state, id).await?;
     let view = pages::RobotView {
-        sets: db.sets(id).await?,
-        calibrations: db.calibrations(id).await?,
-        versions: db.versions(id).await?,
+        sets: service::sets::list(&state, id).await?,
+        calibrations: service::calibrations::list(&state, id).await?,
+        versions: service::versions::list(&state, id).await?,
         keys: !state.config().api_keys.is_empty(),
         robot,
     };
