@@ -1,38 +1,9 @@
-//! The UrScript program parser and the filter: never panic. The input is one file,
-//! or two split at the first NUL byte; every target's value ranges lie inside
-//! its file, and a program that parses filters (on the nominal model, no tool
-//! or work object in the cell) without panicking.
+//! The URScript program parser and the filter never panic (`common/program.rs`).
 #![no_main]
 use libfuzzer_sys::fuzz_target;
-use robocal::cell::Cell;
-use robocal::compensate::CompensatedModel;
-use robocal::ik::IkSettings;
-use robocal::program::{filter, parse, Language, ProgramFile};
+use robocal::program::Language;
 
-fuzz_target!(|data: &[u8]| {
-    let Ok(text) = std::str::from_utf8(data) else {
-        return;
-    };
-    let mut parts = text.splitn(2, '\0');
-    let files: Vec<ProgramFile> = ["a.script", "b.script"]
-        .iter()
-        .zip(&mut parts)
-        .map(|(name, text)| ProgramFile {
-            name: name.to_string(),
-            text: text.to_string(),
-        })
-        .collect();
-    let Ok(program) = parse(Language::UrScript, &files) else {
-        return;
-    };
-    for s in &program.sites {
-        let t = &files[s.file].text;
-        for r in s.slots.iter().chain([&s.mark_at]) {
-            assert!(r.start <= r.end && t.is_char_boundary(r.start) && t.is_char_boundary(r.end));
-        }
-    }
-    if program.sites.len() <= 8 {
-        let model = CompensatedModel::from_nominal(robocal::model::preset("ur5").unwrap());
-        let _ = filter(Language::UrScript, &files, &Cell::default(), &model, &IkSettings::default());
-    }
-});
+#[path = "../common/program.rs"]
+mod program;
+
+fuzz_target!(|data: &[u8]| program::check(Language::UrScript, ["a.script", "b.script"], data));

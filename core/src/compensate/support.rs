@@ -245,8 +245,14 @@ impl Compensator for Faded {
         payload_kg: f64,
         dq: &mut [Vector3<f64>],
     ) -> (Vector3<f64>, bool) {
-        let mut grad = vec![0.0; q.len()];
-        let s = self.support.weight(q, Some(&mut grad));
+        let (mut stack, mut heap) = ([0.0; 16], Vec::new());
+        let grad: &mut [f64] = if q.len() <= stack.len() {
+            &mut stack[..q.len()]
+        } else {
+            heap.resize(q.len(), 0.0);
+            &mut heap
+        };
+        let s = self.support.weight(q, Some(&mut *grad));
         if s == 0.0 && grad.iter().all(|g| *g == 0.0) {
             return (Vector3::zeros(), false);
         }

@@ -125,21 +125,10 @@ pub(crate) fn evaluate_into(
                 return false;
             }
             tau = gravity_torques_of(model, &commanded, m.payload_mass);
-            q_eff.clear();
-            q_eff.extend(
-                m.q.iter()
-                    .zip(&tau)
-                    .zip(&model.links)
-                    .map(|((q, t), l)| q + l.compliance * t),
-            );
-            if let Some(maps) = &model.joint_maps {
-                maps.add_to(&m.q, &mut q_eff);
-            }
+            model.effective_joints_into(&m.q, &tau, &mut q_eff);
             &q_eff
-        } else if let Some(maps) = &model.joint_maps {
-            q_eff.clear();
-            q_eff.extend_from_slice(&m.q);
-            maps.add_to(&m.q, &mut q_eff);
+        } else if model.joint_maps.is_some() {
+            model.effective_joints_into(&m.q, &[], &mut q_eff);
             &q_eff
         } else {
             &m.q

@@ -56,23 +56,7 @@ fn program(f: &Fixture) -> Vec<ProgramFile> {
 fn filtered_fanuc_brings_the_true_tcp_to_the_targets() {
     let f = fixture();
     let files = program(f);
-    let out = filter(Language::Fanuc, &files, &f.cell, &f.model, &settings()).unwrap();
-    let r = &out.report;
-    assert_eq!(
-        (r.filtered, r.failed, r.skipped),
-        (50, 0, 0),
-        "{:?}",
-        r.targets
-    );
-    assert!(r.targets.iter().all(|t| t.status == TargetStatus::Filtered));
-    let truth: Vec<Pose> = (0..50).map(|i| f.target(i)).collect();
-    let (filtered, n) = mean(&f.run(Language::Fanuc, &out.files, &truth));
-    let (nominal, n0) = mean(&f.run(Language::Fanuc, &files, &truth));
-    eprintln!("Fanuc: true TCP from the targets, mean: filtered {filtered:.4} mm ({n}), unfiltered {nominal:.3} mm ({n0})");
-    assert_eq!(n, 50);
-    assert!(filtered < 0.03, "filtered {filtered} mm");
-    assert!(nominal > 1.0, "unfiltered {nominal} mm");
-    assert_only_targets_changed(Language::Fanuc, &files, &out.files);
+    assert_filter_reaches_targets(f, Language::Fanuc, "Fanuc", &files, &f.cell);
 }
 
 #[test]

@@ -24,7 +24,7 @@ use robocal_core::measure;
 use robocal_core::model::orientation::fixed_xyz_angles;
 use robocal_core::model::pose::rpy_matrix;
 use robocal_core::model::{preset, Pose, RobotModel};
-use robocal_core::program::{parse, Language, ProgramFile, Site};
+use robocal_core::program::{filter, parse, Language, ProgramFile, Site, TargetStatus};
 use robocal_core::sim::{
     perturb_geometry, random_configurations, random_configurations_with, tracker_frame,
     ys100_table_7_1, ErrorMagnitudes, PoseFilter, TrueRobot,
@@ -361,6 +361,37 @@ pub fn assert_only_targets_changed(
             fa.name
         );
     }
+}
+
+/// Issue 21's acceptance for one language: all 50 targets of `files` are
+/// filtered; run through the nominal controller, the filtered program brings
+/// the true robot's production TCP within 0.03 mm mean of the targets and the
+/// unfiltered one more than 1 mm off; only the target bytes changed.
+pub fn assert_filter_reaches_targets(
+    f: &Fixture,
+    language: Language,
+    label: &str,
+    files: &[ProgramFile],
+    cell: &Cell,
+) {
+    let out = filter(language, files, cell, &f.model, &settings()).unwrap();
+    let r = &out.report;
+    assert_eq!(
+        (r.filtered, r.failed, r.skipped),
+        (50, 0, 0),
+        "{:?}",
+        r.targets
+    );
+    assert!(r.targets.iter().all(|t| t.status == TargetStatus::Filtered));
+    // The sites come in the order the program runs them: the truth in that order.
+    let truth: Vec<Pose> = (0..50).map(|i| f.target(i)).collect();
+    let (filtered, n) = mean(&f.run(language, &out.files, &truth));
+    let (nominal, n0) = mean(&f.run(language, files, &truth));
+    eprintln!("{label}: true TCP from the targets, mean: filtered {filtered:.4} mm ({n}), unfiltered {nominal:.3} mm ({n0})");
+    assert_eq!(n, 50);
+    assert!(filtered < 0.03, "filtered {filtered} mm");
+    assert!(nominal > 1.0, "unfiltered {nominal} mm");
+    assert_only_targets_changed(language, files, &out.files);
 }
 
 pub fn settings() -> IkSettings {

@@ -9,7 +9,7 @@
 //! Randomness: the folds draw from `ChaCha8Rng(seed + 101)`
 //! (`CompensatorOptions::seed`).
 
-use super::run::{Cache, Context, Outcome};
+use super::run::{Cache, Context, MethodFit, Outcome};
 use super::{Base, MethodError, MethodFailure};
 use crate::identify::joint_maps::fit_joint_maps;
 use crate::identify::least_squares::fit;
@@ -17,13 +17,31 @@ use crate::measure::Measurement;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
-/// The joint-map method on `base` (module docs).
+/// The joint-map method on `base` (module docs), computed once per run.
 pub(crate) fn run_maps(
     ctx: &Context,
     cache: &mut Cache,
     base: Base,
     progress: &mut dyn FnMut(f64, usize, Option<f64>) -> bool,
 ) -> Result<Outcome, MethodError> {
+    if let Some((_, r)) = cache.maps.iter().find(|(b, _)| *b == base) {
+        return r.clone().map(Outcome::plain).map_err(MethodError::Failed);
+    }
+    let r = match fit_maps(ctx, cache, base, progress) {
+        Err(MethodError::Cancelled) => return Err(MethodError::Cancelled),
+        Err(MethodError::Failed(f)) => Err(f),
+        Ok(mf) => Ok(mf),
+    };
+    cache.maps.push((base, r.clone()));
+    r.map(Outcome::plain).map_err(MethodError::Failed)
+}
+
+fn fit_maps(
+    ctx: &Context,
+    cache: &mut Cache,
+    base: Base,
+    progress: &mut dyn FnMut(f64, usize, Option<f64>) -> bool,
+) -> Result<MethodFit, MethodError> {
     let settings = &ctx.opts.joint_maps;
     let rounds = settings.rounds.max(1);
     let stages = (2 * rounds + 1) as f64;
@@ -70,5 +88,5 @@ pub(crate) fn run_maps(
         mf.fit = refit;
         mf.maps = Some(fitted);
     }
-    Ok(Outcome::plain(mf))
+    Ok(mf)
 }

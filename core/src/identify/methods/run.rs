@@ -173,6 +173,8 @@ pub(crate) struct Cache {
     km: Option<Fit>,
     skcm: Option<Result<MethodFit, MethodFailure>>,
     trained: BTreeMap<(Method, usize), Result<Trained, MethodFailure>>,
+    /// Joint-map fits per base (`km-maps` and `auto` share them).
+    pub(super) maps: Vec<(Base, Result<MethodFit, MethodFailure>)>,
 }
 
 impl Cache {
