@@ -8,22 +8,27 @@
 //! - `predict/mlp_18-20-3_residual`: one residual of the trained SKCM-NN
 //!   network (18-20-3: q, sin q, cos q);
 //! - `predict/mlp_18-20-3_residual_and_dq`: residual plus its 3×6 derivative;
-//! - `ik/solve_{plain,compensated}`: one calibrated IK solve without and with
-//!   the 18-20-3 compensator (cycling through 1000 targets).
+//! - `predict/gp_residual_and_dq`: residual plus derivative of the Gaussian
+//!   process (300 inducing configurations) trained on the same 1000 samples;
+//! - `train_{1500,10000}/gp`: one training of the Gaussian process;
+//! - `ik/solve_{plain,compensated,gp,maps}`: one calibrated IK solve without
+//!   a compensator, with the 18-20-3 network, with the Gaussian process, and
+//!   with joint angle error maps of 80 harmonics on every joint and no
+//!   compensator (cycling through 1000 targets).
 //!
 //! Trainer comparison over 20 seeds (final validation error and wall time):
 //! `cargo run --release -p robocal-core --example compare_trainers`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::Vector3;
-use rand::SeedableRng;
+use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use robocal_core::compensate::{
     synthetic_calibration, train, CompensatedModel, CompensatorSpec, Sample, StoredCompensator,
     SyntheticErrors,
 };
 use robocal_core::ik::{Goal, IkSettings, IkSolver, SolveOptions};
-use robocal_core::model::preset;
+use robocal_core::model::{preset, JointMap, JointMaps};
 use robocal_core::sim::random_configurations;
 use std::hint::black_box;
 use std::sync::Arc;
@@ -72,8 +77,18 @@ fn bench(c: &mut Criterion) {
         g.finish();
     }
 
+    for n in [1500, 10_000] {
+        let s = samples(&cm, n, 2);
+        let mut g = c.benchmark_group(format!("train_{n}"));
+        g.sample_size(10);
+        let gp = CompensatorSpec::Gp(Default::default());
+        g.bench_function("gp", |b| b.iter(|| black_box(fit(&gp, black_box(&s)))));
+        g.finish();
+    }
+
     let s = samples(&cm, 1000, 2);
     let net = fit(&CompensatorSpec::skcm_nn(), &s).into_arc();
+    let gp = fit(&CompensatorSpec::Gp(Default::default()), &s).into_arc();
     let qs: Vec<Vec<f64>> = s.iter().map(|s| s.q.clone()).collect();
     let tau = vec![0.0; 6];
     let mut g = c.benchmark_group("predict");
@@ -92,15 +107,52 @@ fn bench(c: &mut Criterion) {
             black_box((net.residual(q, &tau), net.jacobian_q(q, &tau, 110.0)))
         })
     });
+    let mut i = 0;
+    let mut dq = vec![Vector3::zeros(); 6];
+    g.bench_function("gp_residual_and_dq", |b| {
+        b.iter(|| {
+            i = (i + 1) % qs.len();
+            let q = black_box(&qs[i]);
+            black_box(gp.residual_and_jacobian(q, &tau, 110.0, &mut dq))
+        })
+    });
     g.finish();
 
     let compensated = CompensatedModel {
         compensator: Some(Arc::clone(&net)),
         ..cm.clone()
     };
+    let with_gp = CompensatedModel {
+        compensator: Some(Arc::clone(&gp)),
+        ..cm.clone()
+    };
+    let mut with_maps = cm.clone();
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let arcsec = 1f64.to_radians() / 3600.0;
+    with_maps.calibrated.joint_maps = Some(JointMaps {
+        joints: (0..6)
+            .map(|_| {
+                Some(JointMap {
+                    cos: (0..80)
+                        .map(|_| rng.gen_range(-10.0..10.0) * arcsec)
+                        .collect(),
+                    sin: (0..80)
+                        .map(|_| rng.gen_range(-10.0..10.0) * arcsec)
+                        .collect(),
+                    range: [-3.2, 3.2],
+                    fade: 0.087,
+                })
+            })
+            .collect(),
+    });
     let mut g = c.benchmark_group("ik");
     let options = SolveOptions::default();
-    for (name, m) in [("solve_plain", &cm), ("solve_compensated", &compensated)] {
+    for (name, m) in [
+        ("solve_plain", &cm),
+        ("solve_compensated", &compensated),
+        ("solve_gp", &with_gp),
+        ("solve_maps", &with_maps),
+    ] {
         let solver = IkSolver::new(
             m.clone(),
             IkSettings {

@@ -65,16 +65,20 @@ fn hybrids() -> Vec<(&'static str, &'static str, CompensatorSpec)> {
         ("skcm-nn", "skcm", CompensatorSpec::skcm_nn()),
         ("skcm-iwonn", "skcm", CompensatorSpec::skcm_iwonn()),
         ("skcm-tlbonn", "skcm", CompensatorSpec::skcm_tlbonn()),
+        ("km-gp", "km", CompensatorSpec::Gp(Default::default())),
+        ("skcm-gp", "skcm", CompensatorSpec::Gp(Default::default())),
     ]
 }
 
-const BASES_AND_COMPENSATORS: [Method; 6] = [
+const BASES_AND_COMPENSATORS: [Method; 8] = [
     Method::Km,
     Method::Skcm,
     Method::KmRbf,
     Method::SkcmNn,
     Method::SkcmIwonn,
     Method::SkcmTlbonn,
+    Method::KmGp,
+    Method::SkcmGp,
 ];
 
 /// A calibration through the pipeline with the three data roles: 100
@@ -291,7 +295,7 @@ fn fifty_poses_auto_falls_back_to_the_base() {
         .candidates
         .iter()
         .partition(|c| c.method.compensated().is_some());
-    assert_eq!(nets.len(), 4, "{:?}", a.candidates);
+    assert_eq!(nets.len(), Method::COMPENSATED.len(), "{:?}", a.candidates);
     for c in &nets {
         assert_eq!(c.cross_validation.as_ref().unwrap().compensated.n, 50);
     }

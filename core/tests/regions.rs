@@ -36,7 +36,12 @@ fn region(
 
 const INSIDE: [f64; 2] = [-60.0, 0.0];
 const OUTSIDE: [f64; 2] = [20.0, 80.0];
-const METHODS: [Method; 3] = [Method::KmRbf, Method::SkcmNn, Method::KmMaps];
+const METHODS: [Method; 4] = [
+    Method::KmRbf,
+    Method::SkcmNn,
+    Method::SkcmGp,
+    Method::KmMaps,
+];
 
 #[test]
 fn compensators_fall_back_to_their_base_outside_and_solve_flags_it() {

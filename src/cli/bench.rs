@@ -10,6 +10,12 @@
 //!   solution is measured independently by forward kinematics of the returned
 //!   joints (position error in mm, rotation angle in rad).
 //!
+//! - `bench methods`: every calibration method alone on a simulated YS100 with
+//!   effects no model has (`compensate::unmodelled_truth`): 100
+//!   identification poses, N training poses, 200 validation poses; per method
+//!   and N the wall time of its whole run (base fit, cross-validation with the
+//!   blocked folds, training) and its validation mean and max.
+//!
 //! Times are wall-clock on the calling thread (pin with `taskset -c 0`).
 
 use crate::compensate::{CalibratedModelFile, CompensatedModel};
@@ -34,6 +40,21 @@ pub enum BenchCommand {
     Km(KmArgs),
     /// Inverse kinematics: solve rate, accuracy and time per target.
     Ik(IkArgs),
+    /// Every calibration method's run time on simulated training pools.
+    Methods(MethodsArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct MethodsArgs {
+    /// Training pool sizes, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "1500,10000")]
+    pub poses: Vec<usize>,
+    /// Methods (default: every one but `auto`).
+    #[arg(long, value_delimiter = ',')]
+    pub method: Vec<String>,
+    /// Seed of the truth, the poses and the training.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
 }
 
 #[derive(Debug, Args)]
@@ -85,9 +106,75 @@ pub fn run(a: BenchArgs) -> anyhow::Result<()> {
     let out = match a.what {
         BenchCommand::Km(k) => km(&k)?,
         BenchCommand::Ik(i) => ik(&i)?,
+        BenchCommand::Methods(m) => methods(&m)?,
     };
     println!("{}", serde_json::to_string_pretty(&out)?);
     Ok(())
+}
+
+fn methods(a: &MethodsArgs) -> anyhow::Result<serde_json::Value> {
+    use crate::compensate::unmodelled_truth;
+    use crate::identify::calibrate_with_training;
+    use crate::sim::random_configurations;
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+    let methods: Vec<Method> = if a.method.is_empty() {
+        Method::ALL
+            .into_iter()
+            .filter(|m| *m != Method::Auto)
+            .collect()
+    } else {
+        a.method
+            .iter()
+            .map(|m| Method::parse(m).with_context(|| format!("unknown method {m}")))
+            .collect::<anyhow::Result<_>>()?
+    };
+    let nominal = crate::model::preset("ys100")?;
+    let truth = unmodelled_truth(&nominal, true, a.seed);
+    let mut rng = ChaCha8Rng::seed_from_u64(a.seed + 100);
+    let mut measure = |n: usize| -> anyhow::Result<Vec<measure::Measurement>> {
+        let qs = random_configurations(&nominal, n, &mut rng);
+        let rows = truth.measure(&qs, Some(nominal.payload.mass), None, &mut rng)?;
+        Ok(measure::to_measurements(
+            &nominal,
+            &rows,
+            nominal.payload.mass,
+        ))
+    };
+    let ident = measure(100)?;
+    let valid = measure(200)?;
+    let mut rows = Vec::new();
+    for &n in &a.poses {
+        let train = measure(n)?;
+        for m in &methods {
+            let mut opts = CalibrationOptions {
+                methods: vec![*m],
+                ..Default::default()
+            };
+            opts.compensator.seed = a.seed;
+            let t = Instant::now();
+            let r = calibrate_with_training(&nominal, &ident, &train, &valid, &opts, &|_| true)?;
+            let seconds = t.elapsed().as_secs_f64();
+            let v = r
+                .methods
+                .get(m)
+                .and_then(|x| x.validation.as_ref())
+                .map(|v| v.stats.clone());
+            let row = json!({
+                "method": m.name(),
+                "training_poses": n,
+                "seconds": seconds,
+                "validation_mean_mm": v.as_ref().map(|v| v.mean_mm),
+                "validation_max_mm": v.as_ref().map(|v| v.max_mm),
+                "failed": r.failed.iter().find(|f| f.method == *m).map(|f| f.reason.clone()),
+            });
+            eprintln!("{row}");
+            rows.push(row);
+        }
+    }
+    Ok(
+        json!({"bench": "methods", "robot": "ys100", "identification_poses": ident.len(), "validation_poses": valid.len(), "runs": rows}),
+    )
 }
 
 fn median(mut v: Vec<f64>) -> f64 {

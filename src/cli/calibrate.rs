@@ -55,6 +55,10 @@ pub struct CalibrateArgs {
     /// (0: none for the explicit methods; `auto` then uses 5).
     #[arg(long, default_value_t = 5)]
     pub cv_folds: usize,
+    /// Spatially blocked folds run with the cross-validation (regions of joint
+    /// space held out; `auto` rejects a compensator worse on any); 0: none.
+    #[arg(long, default_value_t = 4)]
+    pub blocked_folds: usize,
     /// TLBO population and generations.
     #[arg(long, default_value_t = 50)]
     pub population: usize,
@@ -238,6 +242,7 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         compensator: CompensatorOptions {
             seed: a.seed,
             cv_folds: a.cv_folds,
+            blocked_folds: a.blocked_folds,
             ..Default::default()
         },
         ..Default::default()

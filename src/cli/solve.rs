@@ -227,6 +227,7 @@ fn render_json(h: &Header, results: &[TargetResult]) -> String {
                 "jump": r.jump.map(|j| json!({"joint": j.joint, "delta_deg": j.delta_deg})),
                 "compensation": r.compensation.as_ref().map(|c| c.label()),
                 "warning": r.compensation.as_ref().and_then(|c| c.warning()),
+                "expected_error_mm": r.compensation.as_ref().and_then(|c| c.expected_error_mm),
             })
         })
         .collect();

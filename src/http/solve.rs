@@ -170,6 +170,9 @@ pub struct TargetOut {
     pub compensation: Option<&'static str>,
     /// Joints outside the trained range, or far from the training poses.
     pub warning: Option<String>,
+    /// The compensator's expected position error at the solution [mm]
+    /// (compensators that give one).
+    pub expected_error_mm: Option<f64>,
 }
 
 impl From<TargetResult> for TargetOut {
@@ -196,6 +199,11 @@ impl From<TargetResult> for TargetOut {
             jump: r.jump,
             compensation: r.compensation.as_ref().map(|c| c.label()),
             warning: r.compensation.as_ref().and_then(|c| c.warning()),
+            expected_error_mm: r
+                .compensation
+                .as_ref()
+                .and_then(|c| c.expected_error_mm)
+                .and_then(finite),
             id: r.id,
         }
     }

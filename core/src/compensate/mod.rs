@@ -28,6 +28,7 @@ use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 
 pub mod file;
+pub mod gp;
 pub mod mlp;
 pub mod rbf;
 pub mod select;
@@ -36,11 +37,12 @@ pub mod synthetic;
 pub mod train;
 
 pub use file::{parse_compensated, CalibratedModelFile, PoseDescription, CALIBRATED_MODEL_FORMAT};
+pub use gp::{train_gp, Gp, GpReport, GpSettings, Uncertainty};
 pub use mlp::{Features, Mlp, Normalisation};
 pub use rbf::{
     train_rbf, train_rbf_with_progress, OutputFrame, Rbf, RbfReport, RbfSettings, RbfTrainError,
 };
-pub use select::{choose, cross_validate, Choice, CvStats};
+pub use select::{blocked_fold_assignment, choose, cross_validate, BlockedFold, Choice, CvStats};
 pub use support::{Compensation, Faded, Support, SupportCoverage};
 pub use synthetic::{synthetic_calibration, unmodelled_truth, SyntheticErrors};
 pub use train::{
@@ -102,6 +104,12 @@ pub trait Compensator: Send + Sync {
     fn support(&self) -> Option<&Support> {
         None
     }
+    /// The expected position error at `q`, for compensators that know it
+    /// ([`Gp`]).
+    fn uncertainty(&self, q: &[f64]) -> Option<Uncertainty> {
+        let _ = q;
+        None
+    }
 }
 
 /// A compensator as the model file stores it, tagged by `kind`. An unknown kind
@@ -113,6 +121,8 @@ pub enum StoredCompensator {
     Mlp(Mlp),
     /// Torque-space RBF (KM-RBF).
     Rbf(Rbf),
+    /// Joint-space sparse Gaussian process (KM-GP, SKCM-GP).
+    Gp(Gp),
 }
 
 impl StoredCompensator {
@@ -120,6 +130,7 @@ impl StoredCompensator {
         match self {
             StoredCompensator::Mlp(m) => m.validate(),
             StoredCompensator::Rbf(r) => r.validate(),
+            StoredCompensator::Gp(g) => g.validate(),
         }
     }
 
@@ -127,6 +138,7 @@ impl StoredCompensator {
         match self {
             StoredCompensator::Mlp(m) => m.dof,
             StoredCompensator::Rbf(r) => r.dof,
+            StoredCompensator::Gp(g) => g.dof,
         }
     }
 
@@ -134,6 +146,7 @@ impl StoredCompensator {
         match self {
             StoredCompensator::Mlp(m) => Arc::new(m),
             StoredCompensator::Rbf(r) => Arc::new(r),
+            StoredCompensator::Gp(g) => Arc::new(g),
         }
     }
 }
@@ -177,6 +190,10 @@ pub enum InvalidCompensator {
     RbfSpread,
     #[error("rbf: centres and weights must be finite")]
     RbfNotFinite,
+    #[error("gp: inducing points, weights, variance and length scales must match dof and units")]
+    GpSizes,
+    #[error("gp: values must be finite, variances and scales positive")]
+    GpValues,
     #[error("{what} normalisation must have {n} values")]
     NormalisationLength { what: &'static str, n: usize },
     #[error("{what} normalisation values must be finite")]

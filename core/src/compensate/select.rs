@@ -8,9 +8,15 @@
 //! compensation, next to the base's (the residual itself, since the
 //! model-based part is the same in every fold).
 //!
+//! Spatially blocked folds ([`blocked_fold_assignment`]) hold out whole
+//! regions of joint space instead: k-means clusters of the joint vectors, each
+//! joint scaled by its range. A compensator that is good between its training
+//! poses but wild away from them shows there.
+//!
 //! `auto` ([`choose`]) keeps the base unless a compensator's cross-validated
 //! mean is lower than the base's by at least `min_gain` (relative) **and** its
-//! cross-validated max is not higher: a compensator worse on either never wins.
+//! cross-validated max is not higher **and** no blocked fold's mean is higher
+//! than the base's on that fold: a compensator worse on any never wins.
 
 use super::{Compensator, Sample};
 use crate::stats::ErrorStats;
@@ -27,6 +33,28 @@ pub struct CvStats {
     pub base: ErrorStats,
     /// Out-of-fold errors after compensation [mm].
     pub compensated: ErrorStats,
+    /// The spatially blocked folds, when they were run.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub blocked: Vec<BlockedFold>,
+}
+
+/// One spatially blocked fold: a region of joint space held out.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BlockedFold {
+    pub poses: usize,
+    /// Centre of the region, model-convention joints [rad].
+    pub centre: Vec<f64>,
+    /// Mean error of the base on the region [mm].
+    pub base_mean_mm: f64,
+    /// Mean error after compensation, trained without the region [mm].
+    pub compensated_mean_mm: f64,
+}
+
+impl BlockedFold {
+    /// Whether the compensator made this region worse than its base.
+    pub fn worse(&self) -> bool {
+        self.compensated_mean_mm > self.base_mean_mm
+    }
 }
 
 /// Fold index of each of `n` samples: shuffled, sizes differing by at most one.
@@ -40,11 +68,122 @@ pub fn fold_assignment(n: usize, k: usize, rng: &mut impl Rng) -> Vec<usize> {
     fold
 }
 
-/// k-fold cross-validation of a compensator trainer (module docs). `fit`
-/// trains on the given samples; its error aborts the run.
+/// Fold index of each sample by region: `k` k-means clusters (k-means++
+/// start from `rng`, Lloyd iterations) of the joint vectors, each joint divided
+/// by its range over the samples.
+pub fn blocked_fold_assignment(qs: &[&[f64]], k: usize, rng: &mut impl Rng) -> Vec<usize> {
+    let n = qs.len();
+    let k = k.clamp(1, n.max(1));
+    let dim = qs.first().map_or(0, |q| q.len());
+    let scale: Vec<f64> = (0..dim)
+        .map(|j| {
+            let (lo, hi) = qs.iter().fold((f64::MAX, f64::MIN), |(lo, hi), q| {
+                (lo.min(q[j]), hi.max(q[j]))
+            });
+            if hi > lo {
+                1.0 / (hi - lo)
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let x: Vec<Vec<f64>> = qs
+        .iter()
+        .map(|q| q.iter().zip(&scale).map(|(v, s)| v * s).collect())
+        .collect();
+    let d2 = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(p, q)| (p - q).powi(2)).sum::<f64>();
+    let mut centres: Vec<Vec<f64>> = Vec::with_capacity(k);
+    if n == 0 {
+        return vec![];
+    }
+    centres.push(x[rng.gen_range(0..n)].clone());
+    let mut near: Vec<f64> = x.iter().map(|p| d2(p, &centres[0])).collect();
+    while centres.len() < k {
+        let total: f64 = near.iter().sum();
+        let next = if total > 0.0 {
+            let mut r = rng.gen_range(0.0..total);
+            near.iter()
+                .position(|d| {
+                    r -= d;
+                    r < 0.0
+                })
+                .unwrap_or(n - 1)
+        } else {
+            rng.gen_range(0..n)
+        };
+        centres.push(x[next].clone());
+        for (d, p) in near.iter_mut().zip(&x) {
+            *d = d.min(d2(p, &centres[centres.len() - 1]));
+        }
+    }
+    let mut fold = vec![0; n];
+    for _ in 0..50 {
+        let mut changed = false;
+        for (f, p) in fold.iter_mut().zip(&x) {
+            let best = (0..k)
+                .min_by(|&a, &b| d2(p, &centres[a]).total_cmp(&d2(p, &centres[b])))
+                .unwrap_or(0);
+            changed |= best != *f;
+            *f = best;
+        }
+        for (c, centre) in centres.iter_mut().enumerate() {
+            let members: Vec<&Vec<f64>> = x
+                .iter()
+                .zip(&fold)
+                .filter(|(_, &f)| f == c)
+                .map(|(p, _)| p)
+                .collect();
+            if !members.is_empty() {
+                for (j, v) in centre.iter_mut().enumerate() {
+                    *v = members.iter().map(|p| p[j]).sum::<f64>() / members.len() as f64;
+                }
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    fold
+}
+
+/// Out-of-fold compensated errors [mm] of `samples` for a fold assignment.
+fn out_of_fold<E, F>(
+    samples: &[Sample],
+    fold: &[usize],
+    k: usize,
+    fit: &mut F,
+) -> Result<Vec<f64>, E>
+where
+    F: FnMut(&[Sample]) -> Result<Arc<dyn Compensator>, E>,
+{
+    let mut after = vec![0.0; samples.len()];
+    for f in 0..k {
+        let train: Vec<Sample> = samples
+            .iter()
+            .zip(fold)
+            .filter(|(_, &g)| g != f)
+            .map(|(s, _)| s.clone())
+            .collect();
+        if train.is_empty() || train.len() == samples.len() {
+            continue;
+        }
+        let c = fit(&train)?;
+        for (i, s) in samples.iter().enumerate() {
+            if fold[i] == f {
+                after[i] = (s.residual - c.residual_at(&s.q, &s.tau, s.payload_kg)).norm() * 1e3;
+            }
+        }
+    }
+    Ok(after)
+}
+
+/// k-fold cross-validation of a compensator trainer, then `blocked` spatially
+/// blocked folds (none for 0; module docs). `fit` trains on the given samples;
+/// its error aborts the run.
 pub fn cross_validate<E, F>(
     samples: &[Sample],
     k: usize,
+    blocked: usize,
     rng: &mut impl Rng,
     mut fit: F,
 ) -> Result<CvStats, E>
@@ -53,26 +192,35 @@ where
 {
     let k = k.clamp(2, samples.len().max(2));
     let fold = fold_assignment(samples.len(), k, rng);
-    let mut after = vec![0.0; samples.len()];
-    for f in 0..k {
-        let train: Vec<Sample> = samples
-            .iter()
-            .zip(&fold)
-            .filter(|(_, &g)| g != f)
-            .map(|(s, _)| s.clone())
-            .collect();
-        let c = fit(&train)?;
-        for (i, s) in samples.iter().enumerate() {
-            if fold[i] == f {
-                after[i] = (s.residual - c.residual_at(&s.q, &s.tau, s.payload_kg)).norm() * 1e3;
+    let after = out_of_fold(samples, &fold, k, &mut fit)?;
+    let before: Vec<f64> = samples.iter().map(|s| s.residual.norm() * 1e3).collect();
+    let mut regions = Vec::new();
+    if blocked >= 2 && samples.len() >= 2 * blocked {
+        let qs: Vec<&[f64]> = samples.iter().map(|s| s.q.as_slice()).collect();
+        let region = blocked_fold_assignment(&qs, blocked, rng);
+        let held = out_of_fold(samples, &region, blocked, &mut fit)?;
+        for r in 0..blocked {
+            let idx: Vec<usize> = (0..samples.len()).filter(|&i| region[i] == r).collect();
+            if idx.is_empty() {
+                continue;
             }
+            let mean = |v: &[f64]| idx.iter().map(|&i| v[i]).sum::<f64>() / idx.len() as f64;
+            let dim = samples[0].q.len();
+            regions.push(BlockedFold {
+                poses: idx.len(),
+                centre: (0..dim)
+                    .map(|j| idx.iter().map(|&i| samples[i].q[j]).sum::<f64>() / idx.len() as f64)
+                    .collect(),
+                base_mean_mm: mean(&before),
+                compensated_mean_mm: mean(&held),
+            });
         }
     }
-    let before: Vec<f64> = samples.iter().map(|s| s.residual.norm() * 1e3).collect();
     Ok(CvStats {
         folds: k,
         base: ErrorStats::from_errors_mm(&before),
         compensated: ErrorStats::from_errors_mm(&after),
+        blocked: regions,
     })
 }
 
@@ -92,7 +240,12 @@ pub fn choose(candidates: &[(String, CvStats)], min_gain: f64) -> Choice {
     let mut rejected = Vec::new();
     for c in candidates {
         let (b, a) = (&c.1.base, &c.1.compensated);
-        if a.max_mm > b.max_mm {
+        if let Some(w) = c.1.blocked.iter().find(|f| f.worse()) {
+            rejected.push(format!(
+                "{}: worse than the base on a held-out region of {} poses ({:.4} mm against {:.4} mm)",
+                c.0, w.poses, w.compensated_mean_mm, w.base_mean_mm
+            ));
+        } else if a.max_mm > b.max_mm {
             rejected.push(format!(
                 "{}: cross-validated max {:.4} mm > base {:.4} mm",
                 c.0, a.max_mm, b.max_mm
@@ -164,7 +317,7 @@ mod tests {
             })
             .collect();
         let mut fits = 0;
-        let cv = cross_validate(&samples, 4, &mut rng, |train| {
+        let cv = cross_validate(&samples, 4, 0, &mut rng, |train| {
             fits += 1;
             assert_eq!(train.len(), 15);
             let m = train.iter().map(|s| s.residual).sum::<Vector3<f64>>() / train.len() as f64;
@@ -208,6 +361,7 @@ mod tests {
             folds: 5,
             base: stats(0.10, 0.30),
             compensated: stats(m, x),
+            blocked: vec![],
         };
         let c = choose(
             &[
@@ -222,5 +376,88 @@ mod tests {
         let c = choose(&[("worse-max".into(), cv(0.05, 0.31))], 0.02);
         assert_eq!(c.chosen, None);
         assert!(c.reason.contains("max"), "{}", c.reason);
+    }
+
+    #[test]
+    fn blocked_folds_are_the_regions_of_joint_space() {
+        // Three tight clusters far apart in joint 1 and 3: every cluster is one
+        // fold, whatever the seed.
+        let centres = [[-2.0, 0.0, 1.0], [0.0, 0.5, -1.0], [2.0, -0.5, 0.0]];
+        let mut qs: Vec<Vec<f64>> = Vec::new();
+        for i in 0..60 {
+            let c = centres[i % 3];
+            let d = 0.01 * (i as f64).sin();
+            qs.push(vec![c[0] + d, c[1] - d, c[2] + 0.5 * d]);
+        }
+        let refs: Vec<&[f64]> = qs.iter().map(Vec::as_slice).collect();
+        for seed in 0..5 {
+            let f = blocked_fold_assignment(&refs, 3, &mut ChaCha8Rng::seed_from_u64(seed));
+            for i in 0..60 {
+                assert_eq!(f[i], f[i % 3], "seed {seed}, sample {i}");
+            }
+            let mut distinct = vec![f[0], f[1], f[2]];
+            distinct.sort();
+            distinct.dedup();
+            assert_eq!(distinct.len(), 3);
+        }
+    }
+
+    /// A compensator that is right on its training region and wild beyond it
+    /// passes random folds and fails a blocked one.
+    #[test]
+    fn a_compensator_wild_outside_its_region_is_rejected_by_the_blocked_folds() {
+        // Residual 0.1 mm in x everywhere; the "compensator" copies the mean
+        // residual of its training samples but adds 1 mm more than 0.2 rad
+        // beyond their range of q0.
+        struct Wild {
+            lo: f64,
+            hi: f64,
+            r: Vector3<f64>,
+        }
+        impl Compensator for Wild {
+            fn residual(&self, q: &[f64], _: &[f64]) -> Vector3<f64> {
+                if q[0] < self.lo - 0.2 || q[0] > self.hi + 0.2 {
+                    self.r + Vector3::new(1e-3, 0.0, 0.0)
+                } else {
+                    self.r
+                }
+            }
+            fn name(&self) -> &str {
+                "wild"
+            }
+        }
+        let samples: Vec<Sample> = (0..80)
+            .map(|i| Sample {
+                q: vec![-2.0 + 4.0 * i as f64 / 79.0, 0.3],
+                tau: vec![0.0, 0.0],
+                payload_kg: 0.0,
+                residual: Vector3::new(1e-4, 0.0, 0.0),
+            })
+            .collect();
+        let fit = |train: &[Sample]| {
+            let (lo, hi) = train.iter().fold((f64::MAX, f64::MIN), |(a, b), s| {
+                (a.min(s.q[0]), b.max(s.q[0]))
+            });
+            Ok::<_, ()>(Arc::new(Wild {
+                lo,
+                hi,
+                r: Vector3::new(1e-4, 0.0, 0.0),
+            }) as Arc<dyn Compensator>)
+        };
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let random = cross_validate(&samples, 5, 0, &mut rng, fit).unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let blocked = cross_validate(&samples, 5, 4, &mut rng, fit).unwrap();
+        // Random folds: no held-out sample lies 0.2 rad beyond the others.
+        assert!(random.compensated.mean_mm < 1e-9, "{random:?}");
+        assert_eq!(blocked.blocked.len(), 4);
+        assert_eq!(blocked.blocked.iter().map(|b| b.poses).sum::<usize>(), 80);
+        // The end regions lie outside the rest's range of q0: 1 mm there.
+        assert!(blocked.blocked.iter().filter(|b| b.worse()).count() >= 2);
+        let c = choose(&[("wild".into(), random.clone())], 0.02);
+        assert_eq!(c.chosen.as_deref(), Some("wild"));
+        let c = choose(&[("wild".into(), blocked)], 0.02);
+        assert_eq!(c.chosen, None);
+        assert!(c.reason.contains("held-out region"), "{}", c.reason);
     }
 }

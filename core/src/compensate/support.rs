@@ -14,7 +14,7 @@
 //! training points only flags a target (`coverage`); the fade uses the
 //! ranges, which cost nothing per IK iteration.
 
-use super::{Compensator, StoredCompensator};
+use super::{Compensator, StoredCompensator, Uncertainty};
 use crate::model::{fade_weight, Coverage};
 use nalgebra::{Matrix3xX, Vector3};
 use serde::{Deserialize, Serialize};
@@ -272,6 +272,14 @@ impl Compensator for Faded {
         self.inner.stored()
     }
 
+    fn uncertainty(&self, q: &[f64]) -> Option<Uncertainty> {
+        let u = self.inner.uncertainty(q)?;
+        Some(Uncertainty {
+            compensated_m: u.at_weight(self.support.weight(q, None)),
+            ..u
+        })
+    }
+
     fn support(&self) -> Option<&Support> {
         Some(&self.support)
     }
@@ -289,6 +297,9 @@ pub struct Compensation {
     /// The compensator's nearest training configuration is farther than its
     /// support's radius (`false` without a compensator support).
     pub far_from_training: bool,
+    /// The compensator's expected position error at the pose [mm], when it
+    /// gives one ([`Compensator::uncertainty`]).
+    pub expected_error_mm: Option<f64>,
 }
 
 impl Compensation {
@@ -353,6 +364,7 @@ impl super::CompensatedModel {
             level: Coverage::Inside,
             joints_outside: Vec::new(),
             far_from_training: false,
+            expected_error_mm: None,
         };
         if let Some(maps) = maps {
             for (i, c) in maps.coverage(q).into_iter().enumerate() {
@@ -370,6 +382,11 @@ impl super::CompensatedModel {
             out.joints_outside.extend(c.joints_outside);
             out.far_from_training = c.far;
         }
+        out.expected_error_mm = self
+            .compensator
+            .as_ref()
+            .and_then(|c| c.uncertainty(q))
+            .map(|u| u.compensated_m * 1e3);
         out.joints_outside.sort_unstable();
         out.joints_outside.dedup();
         Some(out)

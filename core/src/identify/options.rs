@@ -11,7 +11,8 @@ use super::least_squares::LmSettings;
 pub use super::methods::Method;
 use super::methods::Network;
 use crate::compensate::{
-    CompensatorSpec, IwoSettings, LmTrainSettings, MlpSpec, RbfSettings, TlboTrainSettings, Trainer,
+    CompensatorSpec, GpSettings, IwoSettings, LmTrainSettings, MlpSpec, RbfSettings,
+    TlboTrainSettings, Trainer,
 };
 use crate::optim::TlboSettings;
 use serde::{Deserialize, Serialize};
@@ -54,6 +55,10 @@ pub struct CompensatorOptions {
     /// compensator method; `auto` chooses by it). 0 skips it for the explicit
     /// methods (`auto` then uses 5).
     pub cv_folds: usize,
+    /// Spatially blocked folds run with the cross-validation (whole regions
+    /// of joint space held out, `compensate::select`); `auto` rejects a
+    /// compensator that makes any of them worse than its base. 0 skips them.
+    pub blocked_folds: usize,
     /// `auto` takes a compensator only when its cross-validated mean is at
     /// least this fraction below its base's (and its max not above).
     pub min_gain: f64,
@@ -70,6 +75,13 @@ pub struct CompensatorOptions {
     pub small: MlpSpec,
     pub iwo: IwoSettings,
     pub tlbo: TlboTrainSettings,
+    /// The Gaussian-process compensator ([`Network::Gp`]).
+    pub gp: GpSettings,
+    /// The networks (MLP, RBF) train and cross-validate on at most this many
+    /// poses of the pool, a seeded subsample beyond it: their training grows
+    /// with the square of the poses, the Gaussian process's linearly (it takes
+    /// every pose). 0: no limit.
+    pub max_network_poses: usize,
 }
 
 impl Default for CompensatorOptions {
@@ -77,6 +89,7 @@ impl Default for CompensatorOptions {
         CompensatorOptions {
             seed: 1,
             cv_folds: 5,
+            blocked_folds: 4,
             min_gain: 0.05,
             min_training_poses: 20,
             auto_candidates: Method::JOINT_MAPS
@@ -90,11 +103,23 @@ impl Default for CompensatorOptions {
             small: MlpSpec::POPULATION,
             iwo: IwoSettings::default(),
             tlbo: TlboTrainSettings::default(),
+            gp: GpSettings::default(),
+            max_network_poses: 1000,
         }
     }
 }
 
 impl CompensatorOptions {
+    /// Trainings of one cross-validated compensator: the random folds, the
+    /// blocked ones and the final training.
+    pub fn cv_stages(&self, folds: usize) -> usize {
+        if folds == 0 {
+            1
+        } else {
+            folds + self.blocked_folds + 1
+        }
+    }
+
     /// The network and trainer of a compensator.
     pub fn spec(&self, network: Network) -> CompensatorSpec {
         match network {
@@ -111,6 +136,7 @@ impl CompensatorOptions {
                 spec: self.small,
                 trainer: Trainer::Tlbo(self.tlbo.clone()),
             },
+            Network::Gp => CompensatorSpec::Gp(self.gp.clone()),
         }
     }
 
@@ -122,6 +148,8 @@ impl CompensatorOptions {
             Network::LmMlp => self.lm.max_epochs,
             Network::IwoMlp => self.iwo.iterations,
             Network::TlboMlp => self.tlbo.generations,
+            // The grid, then three trials per joint of a six-axis robot.
+            Network::Gp => self.gp.length_fractions.len() * self.gp.noise_ratios.len() + 3 * 6,
         }
         .max(1)
     }

@@ -349,6 +349,67 @@ pub struct CompensatorSummary {
     /// The base alone on the training pool, when it is a set of its own [mm].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub base_training: Option<ErrorStats>,
+    /// The expected error per pose checked on the validation set, for
+    /// compensators that give one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub uncertainty: Option<UncertaintyCheck>,
+}
+
+/// How well a compensator's expected error per pose `u` (the RMS of the 3-D
+/// error it expects) matches the validation errors `e`. For Gaussian errors
+/// `e > u` in 39.2 % of poses and `e > 2u` in 0.74 % (P(χ²₃ > 3), P(χ²₃ > 12)).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct UncertaintyCheck {
+    pub poses: usize,
+    /// Mean of `u` over the validation poses [mm].
+    pub mean_expected_mm: f64,
+    /// RMS of the validation errors over RMS of `u` (1: calibrated).
+    pub rms_ratio: f64,
+    /// Share of poses with `e > u`, and the Gaussian expectation.
+    pub above_expected: f64,
+    pub above_expected_gaussian: f64,
+    /// Share of poses with `e > 2u`, and the Gaussian expectation.
+    pub above_twice_expected: f64,
+    pub above_twice_expected_gaussian: f64,
+}
+
+impl UncertaintyCheck {
+    /// The check of expected errors `u` against errors `e` [mm], pose by pose.
+    pub fn of(expected_mm: &[f64], errors_mm: &[f64]) -> Option<Self> {
+        let n = expected_mm.len().min(errors_mm.len());
+        if n == 0 {
+            return None;
+        }
+        let pairs = || expected_mm.iter().zip(errors_mm).take(n);
+        let share = |k: f64| pairs().filter(|(u, e)| **e > k * **u).count() as f64 / n as f64;
+        let rms =
+            |v: &mut dyn Iterator<Item = f64>| (v.map(|x| x * x).sum::<f64>() / n as f64).sqrt();
+        let ru = rms(&mut pairs().map(|(u, _)| *u));
+        let re = rms(&mut pairs().map(|(_, e)| *e));
+        Some(UncertaintyCheck {
+            poses: n,
+            mean_expected_mm: pairs().map(|(u, _)| *u).sum::<f64>() / n as f64,
+            rms_ratio: if ru > 0.0 { re / ru } else { f64::INFINITY },
+            above_expected: share(1.0),
+            above_expected_gaussian: 0.392,
+            above_twice_expected: share(2.0),
+            above_twice_expected_gaussian: 0.0074,
+        })
+    }
+
+    /// A warning when the expected errors are too optimistic: more than
+    /// twice the Gaussian share of poses above `2u`, and at least 3 poses.
+    pub fn warning(&self) -> Option<String> {
+        let above = (self.above_twice_expected * self.poses as f64).round();
+        (above >= 3.0 && self.above_twice_expected > 2.0 * self.above_twice_expected_gaussian + 0.01)
+            .then(|| {
+                format!(
+                    "the compensator's expected errors are optimistic: {:.1} % of the validation poses are above twice theirs (Gaussian: {:.1} %)",
+                    self.above_twice_expected * 100.0,
+                    self.above_twice_expected_gaussian * 100.0
+                )
+            })
+    }
 }
 
 /// One candidate `auto` weighed: cross-validated errors on the training pool
@@ -388,6 +449,8 @@ pub enum WarningKind {
     ParameterNotIdentifiable,
     /// The identified payload is physically implausible (a negative total mass).
     PayloadImplausible,
+    /// The compensator's expected errors are below what validation shows.
+    UncertaintyOptimistic,
 }
 
 /// A warning about one method's result.

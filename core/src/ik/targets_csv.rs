@@ -30,10 +30,11 @@
 //! orientation column of the output convention (the false target
 //! `FK_nominal(q_cmd)` in the controller's base frame),
 //! `position_residual_mm, orientation_residual_rad, iterations, jump_joint,
-//! jump_deg, message, compensation, warning` (`compensation`: `full`, `faded`
-//! or `none` of the joint maps' and the compensator's correction at the
-//! solution, `warning` naming the joints outside the trained range). Fields
-//! that do not apply are empty.
+//! jump_deg, message, compensation, warning, expected_error_mm`
+//! (`compensation`: `full`, `faded` or `none` of the joint maps' and the
+//! compensator's correction at the solution, `warning` naming the joints
+//! outside the trained range, `expected_error_mm` the compensator's expected
+//! position error when it gives one). Fields that do not apply are empty.
 
 use super::solver::{IkSolution, IkSolver, SolveOptions};
 use super::targets::{TargetInput, TargetResult};
@@ -319,6 +320,7 @@ pub fn results_header(dof: usize, convention: OrientationConvention) -> Vec<Stri
             "message",
             "compensation",
             "warning",
+            "expected_error_mm",
         ]
         .map(String::from),
     );
@@ -395,8 +397,9 @@ pub fn results_csv(
             Some(c) => {
                 row.push(c.label().to_string());
                 row.push(c.warning().unwrap_or_default());
+                row.push(c.expected_error_mm.map(finite).unwrap_or_default());
             }
-            None => row.extend([String::new(), String::new()]),
+            None => row.extend([String::new(), String::new(), String::new()]),
         }
         let _ = w.write_record(&row);
     }
@@ -491,6 +494,9 @@ mod tests {
                 "false_c"
             ]
         );
-        assert_eq!(&h[h.len() - 3..], ["message", "compensation", "warning"]);
+        assert_eq!(
+            &h[h.len() - 4..],
+            ["message", "compensation", "warning", "expected_error_mm"]
+        );
     }
 }

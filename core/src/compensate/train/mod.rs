@@ -34,6 +34,7 @@ pub use lm::LmTrainSettings;
 pub use output_layer::OutputLayer;
 pub use tlbo::TlboTrainSettings;
 
+use super::gp::{train_gp, GpReport, GpSettings};
 use super::mlp::Features;
 use super::rbf::{train_rbf_with_progress, RbfReport, RbfSettings, RbfTrainError};
 use super::{Sample, StoredCompensator};
@@ -114,6 +115,7 @@ impl Trainer {
 pub enum CompensatorSpec {
     Mlp { spec: MlpSpec, trainer: Trainer },
     Rbf(RbfSettings),
+    Gp(GpSettings),
 }
 
 impl CompensatorSpec {
@@ -146,6 +148,7 @@ impl CompensatorSpec {
     pub fn label(&self) -> &'static str {
         match self {
             CompensatorSpec::Rbf(_) => "rbf",
+            CompensatorSpec::Gp(_) => "gp",
             CompensatorSpec::Mlp { trainer, .. } => match trainer {
                 Trainer::Lm(_) => "nn",
                 Trainer::Iwo(_) => "iwonn",
@@ -168,6 +171,8 @@ pub enum TrainError {
     NoHiddenUnits,
     #[error(transparent)]
     Rbf(#[from] RbfTrainError),
+    #[error("gp: no length scale and noise gave a positive definite system")]
+    GpSingular,
 }
 
 /// What a training run did.
@@ -187,6 +192,8 @@ pub struct TrainReport {
     pub rms_mm: f64,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rbf: Option<RbfReport>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gp: Option<GpReport>,
 }
 
 /// What a trainer found and how it ended.
@@ -309,6 +316,28 @@ pub fn train(
                     ),
                     rms_mm: training_rms_mm(&stored, samples),
                     rbf: Some(rep),
+                    gp: None,
+                },
+            ))
+        }
+        CompensatorSpec::Gp(settings) => {
+            let (gp, rep) = train_gp(samples, settings, rng, progress)?;
+            let stored = StoredCompensator::Gp(gp);
+            Ok((
+                stored.clone(),
+                TrainReport {
+                    trainer: "gp".into(),
+                    samples: samples.len(),
+                    epochs: rep.fits,
+                    evaluations: rep.fits,
+                    loss: rep.holdout_after_mm,
+                    stop: format!(
+                        "{} inducing poses, length scales and noise chosen on held-out data ({} fits)",
+                        rep.inducing, rep.fits
+                    ),
+                    rms_mm: training_rms_mm(&stored, samples),
+                    rbf: None,
+                    gp: Some(rep),
                 },
             ))
         }
@@ -335,6 +364,7 @@ pub fn train(
                     stop,
                     rms_mm: training_rms_mm(&stored, samples),
                     rbf: None,
+                    gp: None,
                 },
             ))
         }

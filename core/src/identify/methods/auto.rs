@@ -66,7 +66,7 @@ pub(crate) fn run_auto(
         .filter(|b| maps_candidate(&o.auto_candidates, **b).is_some())
         .count();
     let total = (per_base.iter().map(Vec::len).sum::<usize>() + maps_runs).max(1) as f64;
-    let max_stages = (folds + 1) as f64;
+    let max_stages = o.cv_stages(folds) as f64;
     let mut done = 0.0;
     let mut notes: Vec<String> = Vec::new();
     if let Some(why) = gravity {

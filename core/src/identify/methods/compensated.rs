@@ -23,8 +23,9 @@
 //!
 //! Randomness: the final training draws from `ChaCha8Rng(seed)`, the fold
 //! assignment from `ChaCha8Rng(seed + 1)`, fold `f`'s training from
-//! `ChaCha8Rng(seed + 2 + f)` (`CompensatorOptions::seed`): a calibration is
-//! reproducible bit for bit.
+//! `ChaCha8Rng(seed + 2 + f)`, the networks' subsample of a pool larger than
+//! `max_network_poses` from `ChaCha8Rng(seed + 1000)`
+//! (`CompensatorOptions::seed`): a calibration is reproducible bit for bit.
 
 use super::run::{AppliedCompensator, Cache, Context, Outcome};
 use super::{Compensated, Method, MethodError, MethodFailure, Network};
@@ -33,7 +34,10 @@ use crate::compensate::{
     TrainReport,
 };
 use crate::identify::least_squares::Fit;
-use crate::identify::report::{predict_compensated, CompensatorSummary, MethodReport, SetErrors};
+use crate::identify::report::{
+    predict_compensated, CompensatorSummary, MethodReport, MethodWarning, SetErrors,
+    UncertaintyCheck, WarningKind,
+};
 use crate::kinematics::{chain, gravity_torques_of};
 use crate::measure::Measurement;
 use crate::model::pose::Pose;
@@ -84,10 +88,11 @@ fn train_error(e: TrainError) -> MethodError {
 }
 
 /// Trains `network` on the residuals of `base` on the context's training
-/// pool, after a `folds`-fold cross-validation (none for `folds` = 0).
-/// `progress(stage, epoch, loss)` runs after every epoch / iteration /
-/// generation, with stage `0..folds` the cross-validation folds and `folds`
-/// the final training, and returns false to cancel.
+/// pool, after a `folds`-fold cross-validation and the options' blocked folds
+/// (none for `folds` = 0). `progress(stage, epoch, loss)` runs after every
+/// epoch / iteration / generation, with stages before the last the
+/// cross-validation's trainings and the last (`cv_stages(folds) - 1`) the
+/// final training, and returns false to cancel.
 pub(crate) fn train_network(
     network: Network,
     base: &Fit,
@@ -97,7 +102,15 @@ pub(crate) fn train_network(
 ) -> Result<Trained, MethodError> {
     let spec = ctx.opts.compensator.spec(network);
     let (pool, _) = ctx.pool();
-    let data = samples(&base.model, &base.session_frames, pool)?;
+    let mut data = samples(&base.model, &base.session_frames, pool)?;
+    let cap = ctx.opts.compensator.max_network_poses;
+    if network != Network::Gp && cap > 0 && data.len() > cap {
+        let mut rng = ChaCha8Rng::seed_from_u64(ctx.opts.compensator.seed.wrapping_add(1000));
+        data = rand::seq::index::sample(&mut rng, data.len(), cap)
+            .into_iter()
+            .map(|i| data[i].clone())
+            .collect();
+    }
     if network == Network::Rbf && data.iter().all(|s| s.tau.iter().all(|t| *t == 0.0)) {
         return Err(MethodFailure::NoTorqueToLearn.into());
     }
@@ -105,7 +118,8 @@ pub(crate) fn train_network(
     let cv = if folds > 0 {
         let mut fold_rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(1));
         let mut stage = 0usize;
-        let cv = cross_validate(&data, folds, &mut fold_rng, |part| {
+        let blocked = ctx.opts.compensator.blocked_folds;
+        let cv = cross_validate(&data, folds, blocked, &mut fold_rng, |part| {
             let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(2 + stage as u64));
             let s = stage;
             stage += 1;
@@ -117,9 +131,10 @@ pub(crate) fn train_network(
     } else {
         None
     };
+    let last = ctx.opts.compensator.cv_stages(folds) - 1;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let (stored, report) =
-        train(&spec, &data, &mut rng, &mut |e, l| progress(folds, e, l)).map_err(train_error)?;
+        train(&spec, &data, &mut rng, &mut |e, l| progress(last, e, l)).map_err(train_error)?;
     Ok(Trained {
         stored,
         support: support_of(&data),
@@ -157,7 +172,7 @@ pub(crate) fn run_compensated(
         })?;
     let folds = ctx.opts.compensator.cv_folds;
     let max = ctx.opts.compensator.max_epochs(c.network) as f64;
-    let stages = (folds + 1) as f64;
+    let stages = ctx.opts.compensator.cv_stages(folds) as f64;
     let t = cache.trained(
         ctx,
         method,
@@ -208,6 +223,11 @@ fn network_of(c: &StoredCompensator) -> NetworkSummary {
             units: r.units(),
             inputs: "gravity torques".into(),
         },
+        StoredCompensator::Gp(g) => NetworkSummary {
+            kind: "gp",
+            units: g.units(),
+            inputs: "q".into(),
+        },
     }
 }
 
@@ -239,6 +259,14 @@ pub(crate) fn compensate_report(
     if !training.is_empty() {
         report.training = Some(SetErrors::of_compensated(&model, c, frames, training));
     }
+    let uncertainty = report.validation.as_ref().and_then(|v| {
+        let u: Option<Vec<f64>> = valid
+            .iter()
+            .map(|m| arc.uncertainty(&m.q).map(|u| u.compensated_m * 1e3))
+            .collect();
+        let u = u.filter(|u| u.len() == v.errors_mm.len())?;
+        UncertaintyCheck::of(&u, &v.errors_mm)
+    });
     let network = network_of(&trained.stored);
     report.compensator = Some(CompensatorSummary {
         base: applied.base.method(),
@@ -261,7 +289,20 @@ pub(crate) fn compensate_report(
         base_identification,
         base_validation,
         base_training,
+        uncertainty,
     });
+    if let Some(w) = report
+        .compensator
+        .as_ref()
+        .and_then(|c| c.uncertainty.as_ref())
+        .and_then(|u| u.warning())
+    {
+        report.warnings.push(MethodWarning {
+            kind: WarningKind::UncertaintyOptimistic,
+            joint: None,
+            message: w,
+        });
+    }
     report.stored_compensator = Some(trained.stored.clone());
     report.stored_support = Some(trained.support.clone());
 }

@@ -181,6 +181,30 @@ method_table! {
         weight: 6.0,
         run: Run::Compensated(Compensated { base: Base::Skcm, network: Network::TlboMlp }),
     }
+    KmGp {
+        name: "km-gp",
+        aliases: ["km_gp"],
+        label: "KM-GP",
+        description: "KM, then a sparse Gaussian process on the joints with per-joint length scales, which also gives an expected error per pose (beyond the seed).",
+        fits: "KM, then a residual Gaussian process",
+        compliance: Compliance::No,
+        torques: false,
+        seed: false,
+        weight: 2.0,
+        run: Run::Compensated(Compensated { base: Base::Km, network: Network::Gp }),
+    }
+    SkcmGp {
+        name: "skcm-gp",
+        aliases: ["skcm_gp"],
+        label: "SKCM-GP",
+        description: "SKCM, then a sparse Gaussian process on the joints as km-gp (beyond the seed).",
+        fits: "SKCM, then a residual Gaussian process",
+        compliance: Compliance::Yes,
+        torques: true,
+        seed: false,
+        weight: 2.0,
+        run: Run::Compensated(Compensated { base: Base::Skcm, network: Network::Gp }),
+    }
     Auto {
         name: "auto",
         aliases: [],
@@ -274,6 +298,8 @@ pub enum Network {
     IwoMlp,
     /// The small MLP trained by TLBO (ch. 6).
     TlboMlp,
+    /// The sparse Gaussian process on the joints (`compensate::gp`).
+    Gp,
 }
 
 /// Which methods a group holds.
