@@ -331,9 +331,9 @@ impl Client {
         write: Option<InFlight>,
     ) -> Option<Reply> {
         let addr = self.control.up(&mut self.route)?;
-        if !self.conns.contains_key(&addr) {
+        if let std::collections::btree_map::Entry::Vacant(e) = self.conns.entry(addr) {
             if let Ok(c) = Conn::open(addr) {
-                self.conns.insert(addr, c);
+                e.insert(c);
             }
         }
         let result = match self.conns.get_mut(&addr) {
