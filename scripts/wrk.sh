@@ -222,7 +222,7 @@ for round in $(seq 1 "$ROUNDS"); do
 done
 
 echo
-echo "== summary (PostgreSQL: two replicas, load balancer: $LB)"
+echo "== summary$([[ $BACKENDS == *postgres* ]] && echo " (PostgreSQL: two replicas, load balancer: $LB)")"
 printf 'round\tbackend\trun\treq/s\tp50 ms\tp99 ms\tCPU us/req\tdb statements (all/solve path)\n'
 cat "$WORK/results.tsv"
 if [[ $BACKENDS == *sqlite* && $BACKENDS == *postgres* ]]; then
