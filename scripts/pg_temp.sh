@@ -9,7 +9,8 @@
 # only, default 55432, socket in DIR), starts it and prints
 # `postgres://postgres@127.0.0.1:PORT/postgres`. Run as root, the cluster
 # belongs to the `postgres` user (initdb refuses root). `stop` stops it; DIR
-# can then be removed.
+# can then be removed. `PG_TEMP_OPTS` adds server options to `start` (e.g.
+# `-c shared_preload_libraries=pg_stat_statements`).
 set -euo pipefail
 
 cmd=${1:?usage: pg_temp.sh start|stop DIR [PORT]}
@@ -48,7 +49,7 @@ start)
     # Small settings for a shared 2-core machine; fsync stays on (the tests
     # check durability through the database, not around it).
     as_owner "$bin/pg_ctl" -D "$dir/data" -l "$dir/server.log" -w -t 60 start \
-        -o "-c listen_addresses=127.0.0.1 -p $port -k $dir -c max_connections=300 -c shared_buffers=64MB" >/dev/null \
+        -o "-c listen_addresses=127.0.0.1 -p $port -k $dir -c max_connections=300 -c shared_buffers=64MB ${PG_TEMP_OPTS:-}" >/dev/null \
         || { cat "$dir/server.log" >&2; exit 1; }
     echo "postgres://postgres@127.0.0.1:$port/postgres"
     ;;
