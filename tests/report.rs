@@ -179,3 +179,50 @@ fn real_ur5_report_renders() {
     assert_eq!(p.matches("<circle").count(), 2 * 2 * 1020);
     assert_eq!(p.matches("<circle").count(), p.matches("<title>").count());
 }
+
+/// A Gaussian-process compensator's report: the page draws each joint's
+/// trained range (the report's own figures), lists the held-out regions of
+/// the blocked cross-validation and the check of the expected errors.
+#[test]
+fn compensator_support_regions_and_expected_errors_are_shown() {
+    use rand::SeedableRng;
+    use robocal::compensate::unmodelled_truth;
+    use robocal::identify::{calibrate_with_training, CalibrationOptions, Method};
+    use robocal::model::preset;
+    use robocal::sim::random_configurations;
+    let nominal = preset("ys100").unwrap();
+    let truth = unmodelled_truth(&nominal, true, 5);
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+    let mut measure = |n: usize| {
+        let qs = random_configurations(&nominal, n, &mut rng);
+        let rows = truth
+            .measure(&qs, Some(nominal.payload.mass), None, &mut rng)
+            .unwrap();
+        robocal::measure::to_measurements(&nominal, &rows, nominal.payload.mass)
+    };
+    let (ident, train, valid) = (measure(60), measure(150), measure(40));
+    let opts = CalibrationOptions {
+        methods: vec![Method::Km, Method::KmGp],
+        ..Default::default()
+    };
+    let report =
+        calibrate_with_training(&nominal, &ident, &train, &valid, &opts, &|_| true).unwrap();
+    let c = report.methods[&Method::KmGp].compensator.as_ref().unwrap();
+    assert_eq!(c.trained_ranges_deg.len(), 6);
+    let u = c.uncertainty.as_ref().expect("a GP gives expected errors");
+    assert_eq!(u.poses, 40);
+    let blocked = &c.cross_validation.as_ref().unwrap().blocked;
+    assert_eq!(blocked.len(), 4);
+    let html = render_html("", &serde_json::to_value(&report).unwrap());
+    self_contained(&html);
+    let s = section(&html, "compensators");
+    assert_eq!(s.matches("aria-label=\"Trained joint ranges\"").count(), 1);
+    for (i, r) in c.trained_ranges_deg.iter().enumerate() {
+        let title = format!("J{}: {:.1}° to {:.1}°", i + 1, r[0], r[1]);
+        assert!(s.contains(&title), "{title}");
+    }
+    for i in 1..=4 {
+        assert!(s.contains(&format!("Held-out region {i} (")), "region {i}");
+    }
+    assert!(s.contains("Expected error per pose on the 40 validation poses"));
+}

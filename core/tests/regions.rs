@@ -36,12 +36,14 @@ fn region(
 
 const INSIDE: [f64; 2] = [-60.0, 0.0];
 const OUTSIDE: [f64; 2] = [20.0, 80.0];
-const METHODS: [Method; 4] = [
-    Method::KmRbf,
-    Method::SkcmNn,
-    Method::SkcmGp,
-    Method::KmMaps,
-];
+/// Every compensator method and the joint maps.
+fn methods() -> Vec<Method> {
+    Method::COMPENSATED
+        .iter()
+        .chain(&Method::JOINT_MAPS)
+        .copied()
+        .collect()
+}
 
 #[test]
 fn compensators_fall_back_to_their_base_outside_and_solve_flags_it() {
@@ -55,7 +57,7 @@ fn compensators_fall_back_to_their_base_outside_and_solve_flags_it() {
     let mut opts = CalibrationOptions {
         methods: [Method::Km, Method::Skcm]
             .into_iter()
-            .chain(METHODS)
+            .chain(methods())
             .collect(),
         ..Default::default()
     };
@@ -64,10 +66,11 @@ fn compensators_fall_back_to_their_base_outside_and_solve_flags_it() {
         calibrate_with_training(&nominal, &ident, &train, valid, &opts, &|_| true).unwrap()
     };
     let (r_in, r_out) = (run(&inside), run(&outside));
-    for m in METHODS {
-        let base = match m {
-            Method::KmRbf | Method::KmMaps => "km",
-            _ => "skcm",
+    for m in methods() {
+        let base = match (m.base(), m) {
+            (Some(b), _) => b.name(),
+            (None, Method::KmMaps) => "km",
+            (None, _) => "skcm",
         };
         let stats = |r: &robocal_core::identify::CalibrationReport, name: &str| {
             r.methods[name].validation.as_ref().unwrap().stats.clone()

@@ -288,6 +288,30 @@ pub fn colour_bar(vmax: f64, label: &str) -> Markup {
     }
 }
 
+/// Each joint's trained range [deg] as a bar over −180…180°, with its fade
+/// band beyond it: where a compensator applies fully, fades, and is off.
+pub fn ranges(ranges_deg: &[[f64; 2]], fade_deg: f64) -> Markup {
+    let row = 18.0;
+    let h = row * ranges_deg.len() as f64 + 22.0;
+    let x = |d: f64| 40.0 + (d.clamp(-180.0, 180.0) + 180.0) / 360.0 * 560.0;
+    html! {
+        svg.ranges viewBox=(format!("0 0 620 {}", f1(h))) role="img" aria-label="Trained joint ranges" {
+            @for (i, r) in ranges_deg.iter().enumerate() {
+                @let y = 4.0 + row * i as f64;
+                text x="4" y=(f1(y + 11.0)) { "J" (i + 1) }
+                rect x=(f1(x(-180.0))) y=(f1(y + 5.0)) width="560" height="2" fill="#ddd" {}
+                rect x=(f1(x(r[0] - fade_deg))) y=(f1(y + 1.0)) width=(f1(x(r[1] + fade_deg) - x(r[0] - fade_deg))) height="10" fill="#c6dbef" {}
+                rect x=(f1(x(r[0]))) y=(f1(y + 1.0)) width=(f1(x(r[1]) - x(r[0]))) height="10" fill="#3182bd" {
+                    title { "J" (i + 1) ": " (format!("{:.1}", r[0])) "° to " (format!("{:.1}", r[1])) "°" }
+                }
+            }
+            @for d in [-180.0, -90.0, 0.0, 90.0, 180.0] {
+                text x=(f1(x(d))) y=(f1(h - 4.0)) text-anchor="middle" { (format!("{d:.0}")) "°" }
+            }
+        }
+    }
+}
+
 /// A line chart of one series against its index (1-based), log y when `log`.
 pub fn line(values: &[f64], log: bool, color: &str, x_label: &str, y_label: &str) -> Markup {
     let pts: Vec<(f64, f64)> = values

@@ -532,7 +532,25 @@ pub fn compensators(models: &[Model]) -> Markup {
                                         td.n { (opt(b.max_mm, 4)) } td.n { (opt(a.max_mm, 4)) } td.n { (gain(b.max_mm, a.max_mm)) } }
                                 }
                             }
+                            @for (i, r) in c.cross_validation.iter().flat_map(|cv| cv.blocked.iter()).enumerate() {
+                                tr { td { "Held-out region " (i + 1) " (" (r.poses.map_or("—".into(), |n| n.to_string())) " poses)" }
+                                    td.n { (opt(r.base_mean_mm, 4)) } td.n { (opt(r.compensated_mean_mm, 4)) }
+                                    td.n { (gain(r.base_mean_mm, r.compensated_mean_mm)) } td.n { "" } td.n { "" } td.n { "" } }
+                            }
                         }
+                    }
+                    @if !c.trained_ranges_deg.is_empty() {
+                        p.note { "Where it was trained: each joint's range (dark), the band over which its correction "
+                            "fades to zero (light, " (opt(c.fade_deg, 1)) "°); beyond it the base alone applies and "
+                            "solve flags the target." }
+                        (crate::report::charts::ranges(&c.trained_ranges_deg, c.fade_deg.unwrap_or(0.0)))
+                    }
+                    @if let Some(u) = &c.uncertainty {
+                        p { "Expected error per pose on the " (u.poses.map_or("—".into(), |n| n.to_string()))
+                            " validation poses: mean " (opt(u.mean_expected_mm, 4)) " mm; the error exceeds it in "
+                            (opt(u.above_expected.map(|x| x * 100.0), 1)) " % of the poses (Gaussian: 39.2 %) and "
+                            "twice it in " (opt(u.above_twice_expected.map(|x| x * 100.0), 1)) " % (0.7 %); RMS error / RMS expected "
+                            (opt(u.rms_ratio, 2)) "." }
                     }
                 }
             }

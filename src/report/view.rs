@@ -171,6 +171,8 @@ pub struct CvView {
     pub base: StatsView,
     #[serde(default)]
     pub compensated: StatsView,
+    #[serde(default, deserialize_with = "lenient_list")]
+    pub blocked: Vec<BlockedView>,
 }
 
 /// The training run of a compensator.
@@ -209,6 +211,40 @@ pub struct CompensatorView {
     pub base_validation: Option<StatsView>,
     #[serde(default)]
     pub base_training: Option<StatsView>,
+    #[serde(default, deserialize_with = "lenient_list")]
+    pub trained_ranges_deg: Vec<[f64; 2]>,
+    #[serde(default)]
+    pub fade_deg: Option<f64>,
+    #[serde(default, deserialize_with = "lenient")]
+    pub uncertainty: Option<UncertaintyView>,
+}
+
+/// The expected errors checked on the validation set.
+#[derive(Debug, Clone, Default, Deserialize)]
+pub struct UncertaintyView {
+    #[serde(default)]
+    pub poses: Option<usize>,
+    #[serde(default)]
+    pub mean_expected_mm: Option<f64>,
+    #[serde(default)]
+    pub rms_ratio: Option<f64>,
+    #[serde(default)]
+    pub above_expected: Option<f64>,
+    #[serde(default)]
+    pub above_twice_expected: Option<f64>,
+}
+
+/// A region of joint space held out whole in cross-validation.
+#[derive(Debug, Clone, Default, Deserialize)]
+pub struct BlockedView {
+    #[serde(default)]
+    pub poses: Option<usize>,
+    #[serde(default)]
+    pub centre: Vec<f64>,
+    #[serde(default)]
+    pub base_mean_mm: Option<f64>,
+    #[serde(default)]
+    pub compensated_mean_mm: Option<f64>,
 }
 
 /// What `auto` chose and why.

@@ -349,6 +349,12 @@ pub struct CompensatorSummary {
     /// The base alone on the training pool, when it is a set of its own [mm].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub base_training: Option<ErrorStats>,
+    /// Each joint's trained range [deg]: the correction fades to zero over
+    /// `fade_deg` beyond it.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub trained_ranges_deg: Vec<[f64; 2]>,
+    #[serde(default)]
+    pub fade_deg: f64,
     /// The expected error per pose checked on the validation set, for
     /// compensators that give one.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -11,7 +11,10 @@
 //! of their own: kept when their cross-validated mean (over the identification
 //! and training poses, `identify::joint_maps`) is at least `min_gain` below the
 //! geometry's alone on the same folds and their max not above; they then
-//! compete with the bases by that cross-validated mean.
+//! compete with the bases by that cross-validated mean. On kept maps the
+//! compensators built on them (`km-maps-gp`, `skcm-maps-gp`) are
+//! cross-validated on what the maps leave and one is added when `choose`
+//! accepts it against the maps alone; the option keeps the maps' mean.
 
 use super::compensated::base_pool_stats;
 use super::maps::run_maps;
@@ -65,7 +68,16 @@ pub(crate) fn run_auto(
         .iter()
         .filter(|b| maps_candidate(&o.auto_candidates, **b).is_some())
         .count();
-    let total = (per_base.iter().map(Vec::len).sum::<usize>() + maps_runs).max(1) as f64;
+    let maps_compensators = o
+        .auto_candidates
+        .iter()
+        .filter(|m| {
+            m.compensated()
+                .is_some_and(|c| matches!(c.base, Base::KmMaps | Base::SkcmMaps))
+        })
+        .count();
+    let total = (per_base.iter().map(Vec::len).sum::<usize>() + maps_runs + maps_compensators)
+        .max(1) as f64;
     let max_stages = o.cv_stages(folds) as f64;
     let mut done = 0.0;
     let mut notes: Vec<String> = Vec::new();
@@ -183,13 +195,23 @@ pub(crate) fn run_auto(
                 let (with, without) = (&m.chosen, &m.without_maps);
                 let gain = 1.0 - with.cv_mean_mm / without.cv_mean_mm;
                 if m.maps.is_some() && gain >= o.min_gain && with.cv_max_mm <= without.cv_max_mm {
+                    let on_maps = maps_compensator(
+                        ctx,
+                        cache,
+                        *base,
+                        &fit,
+                        folds,
+                        &mut candidates,
+                        &mut |f, e, l| progress((done + f) / total, e, l),
+                    )?;
+                    done += on_maps.trained as f64;
                     options.push(BaseOption {
                         base: *base,
                         maps: Some(method),
                         fit,
-                        compensator: None,
+                        compensator: on_maps.kept,
                         mean_mm: with.cv_mean_mm,
-                        reason: format!(
+                        reason: format!("{}{}", on_maps.reason, format_args!(
                             "{}: {} harmonics cross-validated over {} poses at {:.4} / {:.4} mm mean / max against {:.4} / {:.4} without maps",
                             method.name(),
                             with.harmonics,
@@ -198,7 +220,7 @@ pub(crate) fn run_auto(
                             with.cv_max_mm,
                             without.cv_mean_mm,
                             without.cv_max_mm
-                        ),
+                        )),
                     });
                 } else {
                     notes.push(format!(
@@ -252,6 +274,91 @@ pub(crate) fn run_auto(
             reason,
             candidates,
         }),
+    })
+}
+
+/// What `auto` made of the compensators on a kept joint-map fit.
+struct OnMaps {
+    kept: Option<AppliedCompensator>,
+    /// How many were trained (for the progress).
+    trained: usize,
+    /// The choice, as a prefix of the maps' reason (empty: none tried).
+    reason: String,
+}
+
+/// Cross-validates the candidate compensators on the joint-map fit of `base`
+/// (their residuals) and keeps the one `choose` accepts against the maps
+/// alone on the same pool. The option keeps the maps' own cross-validated
+/// mean for the comparison with the other bases.
+fn maps_compensator(
+    ctx: &Context,
+    cache: &mut Cache,
+    base: Base,
+    fit: &MethodFit,
+    folds: usize,
+    candidates: &mut Vec<AutoCandidate>,
+    progress: &mut dyn FnMut(f64, usize, Option<f64>) -> bool,
+) -> Result<OnMaps, MethodError> {
+    let on = if base == Base::Km {
+        Base::KmMaps
+    } else {
+        Base::SkcmMaps
+    };
+    let o = &ctx.opts.compensator;
+    let mut cvs = Vec::new();
+    let mut trained = Vec::new();
+    let methods: Vec<(Method, Compensated)> = o
+        .auto_candidates
+        .iter()
+        .filter_map(|m| Some((*m, m.compensated()?)))
+        .filter(|(_, c)| c.base == on)
+        .collect();
+    let stages = o.cv_stages(folds) as f64;
+    for (i, (m, c)) in methods.iter().enumerate() {
+        let max = o.max_epochs(c.network) as f64;
+        let r = cache.trained(ctx, *m, c.network, &fit.fit, folds, &mut |stage, e, l| {
+            let f = (stage as f64 + (e as f64 / max).min(1.0)) / stages;
+            progress(i as f64 + f, e, Some(l))
+        });
+        match r {
+            Ok(t) => {
+                let cv = t.cv.clone().expect("auto cross-validates");
+                candidates.push(AutoCandidate {
+                    method: *m,
+                    cross_validation: Some(cv.clone()),
+                    failed: None,
+                });
+                cvs.push((m.name().to_string(), cv));
+                trained.push(AppliedCompensator {
+                    method: *m,
+                    base: c.base,
+                    trained: t,
+                });
+            }
+            Err(MethodError::Cancelled) => return Err(MethodError::Cancelled),
+            Err(MethodError::Failed(f)) => candidates.push(AutoCandidate {
+                method: *m,
+                cross_validation: None,
+                failed: Some(f.to_string()),
+            }),
+        }
+    }
+    if methods.is_empty() {
+        return Ok(OnMaps {
+            kept: None,
+            trained: 0,
+            reason: String::new(),
+        });
+    }
+    let choice = choose(&cvs, o.min_gain);
+    let kept = choice
+        .chosen
+        .as_deref()
+        .and_then(|chosen| trained.into_iter().find(|a| a.method.name() == chosen));
+    Ok(OnMaps {
+        kept,
+        trained: methods.len(),
+        reason: format!("on {}: {}; ", base.method().name(), choice.reason),
     })
 }
 

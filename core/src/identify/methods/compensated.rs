@@ -289,6 +289,13 @@ pub(crate) fn compensate_report(
         base_identification,
         base_validation,
         base_training,
+        trained_ranges_deg: trained
+            .support
+            .ranges_rad
+            .iter()
+            .map(|r| r.map(f64::to_degrees))
+            .collect(),
+        fade_deg: trained.support.fade_rad.to_degrees(),
         uncertainty,
     });
     if let Some(w) = report

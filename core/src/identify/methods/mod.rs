@@ -205,6 +205,30 @@ method_table! {
         weight: 2.0,
         run: Run::Compensated(Compensated { base: Base::Skcm, network: Network::Gp }),
     }
+    KmMapsGp {
+        name: "km-maps-gp",
+        aliases: ["km_maps_gp"],
+        label: "KM+maps-GP",
+        description: "km-maps, then a sparse Gaussian process on what the maps leave, as km-gp (beyond the seed).",
+        fits: "KM with joint maps, then a residual Gaussian process",
+        compliance: Compliance::No,
+        torques: false,
+        seed: false,
+        weight: 4.0,
+        run: Run::Compensated(Compensated { base: Base::KmMaps, network: Network::Gp }),
+    }
+    SkcmMapsGp {
+        name: "skcm-maps-gp",
+        aliases: ["skcm_maps_gp"],
+        label: "SKCM+maps-GP",
+        description: "skcm-maps, then a sparse Gaussian process on what the maps leave, as km-gp (beyond the seed).",
+        fits: "SKCM with joint maps, then a residual Gaussian process",
+        compliance: Compliance::Yes,
+        torques: true,
+        seed: false,
+        weight: 4.0,
+        run: Run::Compensated(Compensated { base: Base::SkcmMaps, network: Network::Gp }),
+    }
     Auto {
         name: "auto",
         aliases: [],
@@ -276,6 +300,10 @@ pub struct Compensated {
 pub enum Base {
     Km,
     Skcm,
+    /// KM with its joint maps (`km-maps`).
+    KmMaps,
+    /// SKCM with its joint maps (`skcm-maps`).
+    SkcmMaps,
 }
 
 impl Base {
@@ -283,6 +311,8 @@ impl Base {
         match self {
             Base::Km => Method::Km,
             Base::Skcm => Method::Skcm,
+            Base::KmMaps => Method::KmMaps,
+            Base::SkcmMaps => Method::SkcmMaps,
         }
     }
 }
@@ -610,8 +640,8 @@ mod tests {
         assert_eq!(Method::KmRbf.base(), Some(Method::Km));
         assert_eq!(
             Method::COMPENSATED.len(),
-            4,
-            "KM-RBF and SKCM-NN, -IWONN, -TLBONN"
+            8,
+            "KM-RBF, SKCM-NN, -IWONN, -TLBONN, KM-GP, SKCM-GP and the GPs on the maps"
         );
     }
 

@@ -199,6 +199,17 @@ impl Cache {
                     maps: None,
                 })
             }
+            Base::KmMaps | Base::SkcmMaps => {
+                let inner = if base == Base::KmMaps {
+                    Base::Km
+                } else {
+                    Base::Skcm
+                };
+                run_maps(ctx, self, inner, &mut |_, it, l| {
+                    progress(it, l.unwrap_or(f64::NAN))
+                })
+                .map(|o| o.fit)
+            }
             Base::Skcm => {
                 let skcm = match &self.skcm {
                     Some(r) => r,
