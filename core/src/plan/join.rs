@@ -85,6 +85,8 @@ pub enum JoinError {
     Extra(Vec<String>),
     #[error("joining by order: the plan has {plan} points, the tracker export {tracker}")]
     Count { plan: usize, tracker: usize },
+    #[error("tracker point {0}: a coordinate is out of range once in millimetres")]
+    OutOfRange(usize),
     #[error("units unclear: the points spread over {spread} (neither clearly metres, below {METRES_BELOW}, nor millimetres, above {MM_ABOVE}); give the units (mm or m)")]
     UnitsUnclear { spread: f64 },
 }
@@ -246,15 +248,22 @@ pub fn join(plan: &[PlanPoint], text: &str, opts: &JoinOptions) -> Result<Joined
     let rows = plan
         .iter()
         .zip(slot.into_iter().flatten())
-        .map(|(p, xyz)| MeasuredPose {
-            q_deg: p.q_deg.clone(),
-            xyz_mm: xyz.map(|v| v * scale),
-            rpy_deg: None,
-            payload_kg: None,
-            temperature_c: None,
-            set: None,
-            session: None,
+        .enumerate()
+        .map(|(i, (p, xyz))| {
+            let xyz_mm = xyz.map(|v| v * scale);
+            if xyz_mm.iter().any(|v| !v.is_finite()) {
+                return Err(JoinError::OutOfRange(i + 1));
+            }
+            Ok(MeasuredPose {
+                q_deg: p.q_deg.clone(),
+                xyz_mm,
+                rpy_deg: None,
+                payload_kg: None,
+                temperature_c: None,
+                set: None,
+                session: None,
+            })
         })
-        .collect();
+        .collect::<Result<_, _>>()?;
     Ok(Joined { rows, units, by })
 }
