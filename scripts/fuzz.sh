@@ -8,7 +8,8 @@
 #
 # Targets (fuzz/fuzz_targets/): measurement_csv, targets_csv, model_json,
 # solve_request and the program parsers program_krl, program_rapid,
-# program_fanuc, program_urscript (with the filter).
+# program_fanuc, program_urscript (with the filter), and plan_join (the plan
+# CSV and the tracker export join).
 # Each run starts from the seeds in fuzz/seeds/<target>/ with a
 # fixed libFuzzer seed and writes new inputs to a temporary corpus, so the
 # repository is not changed. A crash leaves its input in
@@ -25,7 +26,7 @@ cd fuzz
 cargo fuzz build --sanitizer none
 status=0
 for target in measurement_csv targets_csv model_json solve_request \
-    program_krl program_rapid program_fanuc program_urscript; do
+    program_krl program_rapid program_fanuc program_urscript plan_join; do
     corpus=$(mktemp -d)
     log=$(mktemp)
     code=0

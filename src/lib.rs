@@ -8,8 +8,8 @@
 //! runtime or command-line crates.
 
 pub use robocal_core::{
-    cell, compensate, csv_text, export, identify, ik, kinematics, measure, model, optim, program,
-    sim, stats, study,
+    cell, compensate, csv_text, export, identify, ik, kinematics, measure, model, optim, plan,
+    program, sim, stats, study,
 };
 
 pub mod cli;

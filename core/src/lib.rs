@@ -17,6 +17,7 @@ pub mod kinematics;
 pub mod measure;
 pub mod model;
 pub mod optim;
+pub mod plan;
 pub mod program;
 pub mod sim;
 pub mod stats;

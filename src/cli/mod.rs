@@ -1,4 +1,4 @@
-//! The `robocal` command line: simulate, calibrate, demo, solve, filter, serve, bench.
+//! The `robocal` command line: simulate, calibrate, demo, solve, filter, plan, serve, bench.
 
 use clap::{Parser, Subcommand};
 
@@ -8,6 +8,7 @@ pub mod demo;
 pub mod export;
 pub mod filter;
 pub mod model_files;
+pub mod plan;
 pub mod progress;
 pub mod serve;
 pub mod simulate;
@@ -38,6 +39,8 @@ pub enum Command {
     Export(export::ExportArgs),
     /// Filter robot programs (KRL, RAPID, Fanuc, URScript): targets become false targets.
     Filter(filter::FilterArgs),
+    /// Plan measurement poses (joint CSV or program) and join tracker exports back.
+    Plan(plan::PlanArgs),
     /// Run the HTTP service.
     Serve(serve::ServeArgs),
     /// Time robocal's side of the peer benchmark (KM, IK), as JSON.
@@ -53,6 +56,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Solve(a) => solve::run(a),
         Command::Export(a) => export::run(a),
         Command::Filter(a) => filter::run(a),
+        Command::Plan(a) => plan::run(a),
         Command::Serve(a) => serve::run(a),
         Command::Bench(a) => bench::run(a),
     }

@@ -1,0 +1,269 @@
+//! The join of a tracker export back to the plan: a CSV of points (a name or
+//! 1-based index column, optional; `x`, `y`, `z` in mm or m) matched to the
+//! plan's points by name or by order, written as the measurement CSV the
+//! calibration reads (controller joints [deg], positions [mm] in the tracker
+//! frame).
+
+use super::PlanPoint;
+use crate::csv_text::{self, Dialect};
+use crate::measure::MeasuredPose;
+use serde::{Deserialize, Serialize};
+
+/// Position units of a tracker export.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Units {
+    Mm,
+    M,
+    /// From the header (`x_mm`, `x [m]`, …), else from the points' spread.
+    Detect,
+}
+
+/// How tracker points find their plan points.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum JoinBy {
+    /// By name (or 1-based index) when the export has a name column, else by order.
+    Detect,
+    Name,
+    Order,
+}
+
+/// Join options.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct JoinOptions {
+    pub units: Units,
+    pub by: JoinBy,
+}
+
+impl Default for JoinOptions {
+    fn default() -> Self {
+        JoinOptions {
+            units: Units::Detect,
+            by: JoinBy::Detect,
+        }
+    }
+}
+
+/// The joined measurement set and how it was joined.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Joined {
+    pub rows: Vec<MeasuredPose>,
+    pub units: Units,
+    pub by: JoinBy,
+}
+
+/// Spread of the points [in their own unit] below which they are read as
+/// metres, and above which as millimetres; in between the units are unclear.
+const METRES_BELOW: f64 = 5.0;
+const MM_ABOVE: f64 = 50.0;
+
+/// Why a tracker export does not join.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum JoinError {
+    #[error("the tracker export: {0}")]
+    Text(String),
+    #[error("the tracker export has no points")]
+    Empty,
+    #[error("the tracker export's header needs x, y and z columns (and optionally point/name/id/index); got {0}")]
+    Header(String),
+    #[error("the tracker export, line {line}: `{field}` is not a number")]
+    Number { line: usize, field: String },
+    #[error("the tracker export, line {line}: {got} fields, the header has {expected}")]
+    Fields {
+        line: usize,
+        expected: usize,
+        got: usize,
+    },
+    #[error("the tracker export has no point name column, so it can only join by order")]
+    NoNames,
+    #[error("the tracker export has point `{0}` twice")]
+    Duplicate(String),
+    #[error("plan points missing from the tracker export: {}", .0.join(", "))]
+    Missing(Vec<String>),
+    #[error("tracker points that are not in the plan: {}", .0.join(", "))]
+    Extra(Vec<String>),
+    #[error("joining by order: the plan has {plan} points, the tracker export {tracker}")]
+    Count { plan: usize, tracker: usize },
+    #[error("tracker point {0}: a coordinate is out of range once in millimetres")]
+    OutOfRange(usize),
+    #[error("units unclear: the points spread over {spread} (neither clearly metres, below {METRES_BELOW}, nor millimetres, above {MM_ABOVE}); give the units (mm or m)")]
+    UnitsUnclear { spread: f64 },
+}
+
+struct Export {
+    names: Option<Vec<String>>,
+    xyz: Vec<[f64; 3]>,
+    header_units: Option<Units>,
+}
+
+fn read(text: &str) -> Result<Export, JoinError> {
+    let t = csv_text::read(text, Dialect::default())
+        .map_err(|e| JoinError::Text(e.to_string()))?
+        .ok_or(JoinError::Empty)?;
+    let keys: Vec<String> = t
+        .header
+        .iter()
+        .map(|h| {
+            h.chars()
+                .filter(char::is_ascii_alphanumeric)
+                .collect::<String>()
+                .to_ascii_lowercase()
+        })
+        .collect();
+    let find = |axis: &str| -> Option<(usize, Option<Units>)> {
+        keys.iter()
+            .enumerate()
+            .find_map(|(i, k)| match k.strip_prefix(axis)? {
+                "" => Some((i, None)),
+                "mm" => Some((i, Some(Units::Mm))),
+                "m" => Some((i, Some(Units::M))),
+                _ => None,
+            })
+    };
+    let (Some(x), Some(y), Some(z)) = (find("x"), find("y"), find("z")) else {
+        return Err(JoinError::Header(t.header.join(",")));
+    };
+    let name = keys
+        .iter()
+        .position(|k| ["point", "name", "id", "index", "pointname", "label"].contains(&k.as_str()));
+    let mut names = Vec::new();
+    let mut xyz = Vec::new();
+    for r in &t.records {
+        if r.fields.len() != t.header.len() {
+            return Err(JoinError::Fields {
+                line: r.line,
+                expected: t.header.len(),
+                got: r.fields.len(),
+            });
+        }
+        let mut p = [0.0; 3];
+        for (v, c) in p.iter_mut().zip([x.0, y.0, z.0]) {
+            *v = t
+                .number(r.fields[c].trim())
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| JoinError::Number {
+                    line: r.line,
+                    field: csv_text::short_text(&r.fields[c]),
+                })?;
+        }
+        xyz.push(p);
+        if let Some(n) = name {
+            names.push(r.fields[n].trim().to_string());
+        }
+    }
+    if xyz.is_empty() {
+        return Err(JoinError::Empty);
+    }
+    Ok(Export {
+        names: name.map(|_| names),
+        xyz,
+        header_units: x.1.or(y.1).or(z.1),
+    })
+}
+
+/// Metres or millimetres from the points' largest extent along an axis.
+fn detect_units(xyz: &[[f64; 3]]) -> Result<Units, JoinError> {
+    let spread = (0..3)
+        .map(|k| {
+            let (lo, hi) = xyz
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+                    (a.min(p[k]), b.max(p[k]))
+                });
+            hi - lo
+        })
+        .fold(0.0, f64::max);
+    if spread < METRES_BELOW {
+        Ok(Units::M)
+    } else if spread > MM_ABOVE {
+        Ok(Units::Mm)
+    } else {
+        Err(JoinError::UnitsUnclear { spread })
+    }
+}
+
+/// Index of the plan point a tracker point `name` refers to: its name
+/// (case-insensitive), else a 1-based index.
+fn plan_index(plan: &[PlanPoint], name: &str) -> Option<usize> {
+    plan.iter()
+        .position(|p| p.name.eq_ignore_ascii_case(name))
+        .or_else(|| {
+            let k: usize = name.parse().ok()?;
+            (1..=plan.len()).contains(&k).then(|| k - 1)
+        })
+}
+
+/// Joins the tracker export `text` to `plan` into measurement rows.
+pub fn join(plan: &[PlanPoint], text: &str, opts: &JoinOptions) -> Result<Joined, JoinError> {
+    let e = read(text)?;
+    let units = match opts.units {
+        Units::Detect => match e.header_units {
+            Some(u) => u,
+            None => detect_units(&e.xyz)?,
+        },
+        u => u,
+    };
+    let scale = if units == Units::M { 1e3 } else { 1.0 };
+    let by = match (opts.by, &e.names) {
+        (JoinBy::Detect, Some(_)) => JoinBy::Name,
+        (JoinBy::Detect, None) => JoinBy::Order,
+        (JoinBy::Name, None) => return Err(JoinError::NoNames),
+        (b, _) => b,
+    };
+    let mut slot: Vec<Option<[f64; 3]>> = vec![None; plan.len()];
+    if by == JoinBy::Order {
+        if e.xyz.len() != plan.len() {
+            return Err(JoinError::Count {
+                plan: plan.len(),
+                tracker: e.xyz.len(),
+            });
+        }
+        for (s, p) in slot.iter_mut().zip(&e.xyz) {
+            *s = Some(*p);
+        }
+    } else {
+        let names = e.names.as_deref().unwrap_or_default();
+        let mut extra = Vec::new();
+        for (n, p) in names.iter().zip(&e.xyz) {
+            match plan_index(plan, n) {
+                Some(i) if slot[i].is_some() => return Err(JoinError::Duplicate(n.clone())),
+                Some(i) => slot[i] = Some(*p),
+                None => extra.push(n.clone()),
+            }
+        }
+        if !extra.is_empty() {
+            return Err(JoinError::Extra(extra));
+        }
+    }
+    let missing: Vec<String> = plan
+        .iter()
+        .zip(&slot)
+        .filter(|(_, s)| s.is_none())
+        .map(|(p, _)| p.name.clone())
+        .collect();
+    if !missing.is_empty() {
+        return Err(JoinError::Missing(missing));
+    }
+    let rows = plan
+        .iter()
+        .zip(slot.into_iter().flatten())
+        .enumerate()
+        .map(|(i, (p, xyz))| {
+            let xyz_mm = xyz.map(|v| v * scale);
+            if xyz_mm.iter().any(|v| !v.is_finite()) {
+                return Err(JoinError::OutOfRange(i + 1));
+            }
+            Ok(MeasuredPose {
+                q_deg: p.q_deg.clone(),
+                xyz_mm,
+                rpy_deg: None,
+                payload_kg: None,
+                temperature_c: None,
+                set: None,
+                session: None,
+            })
+        })
+        .collect::<Result<_, _>>()?;
+    Ok(Joined { rows, units, by })
+}

@@ -1,0 +1,167 @@
+//! Measurement plans: N poses chosen for identifiability (greedy D-optimal,
+//! `identify::pose_selection`) among seeded random candidates within the joint
+//! limits, a workspace box and the tracker's line of sight; the standard
+//! deviations they predict for a tracker noise σ; their exports (joint CSV,
+//! programs) and the join of a tracker export back into a measurement CSV.
+//!
+//! Frames: the workspace box and the tracker position are in the robot's base
+//! frame; the reflector axis is in the tool (TCP) frame. Units: mm and degrees
+//! at the boundary (joints in the controller convention), SI inside.
+//! Predicted σ: `σ²·(JᵀJ)⁻¹` over the parameters the calibration identifies,
+//! in mm, deg or rad/(N·m).
+
+mod candidates;
+pub mod export;
+pub mod join;
+mod predict;
+
+pub use candidates::FilterCounts;
+pub use export::{plan_csv, plan_program, read_plan_csv, PlanCsvError, PlanPoint};
+pub use join::{join, JoinBy, JoinError, JoinOptions, Joined, Units};
+pub use predict::{ParamPrediction, PredictedStd};
+
+use crate::model::RobotModel;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+
+/// An axis-aligned box for the TCP position, base frame [mm].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct WorkspaceBox {
+    pub min_mm: [f64; 3],
+    pub max_mm: [f64; 3],
+}
+
+/// The tracker's line of sight: the angle between the reflector's axis and
+/// the line from the TCP to the tracker is at most `max_angle_deg`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct TrackerSight {
+    /// Tracker position in the base frame [mm].
+    pub position_mm: [f64; 3],
+    /// The reflector's axis in the tool frame (default: the tool's z axis).
+    pub axis: [f64; 3],
+    pub max_angle_deg: f64,
+}
+
+impl Default for TrackerSight {
+    fn default() -> Self {
+        TrackerSight {
+            position_mm: [2000.0, 0.0, 500.0],
+            axis: [0.0, 0.0, 1.0],
+            max_angle_deg: 60.0,
+        }
+    }
+}
+
+/// How a plan is made.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlanSettings {
+    /// Poses to choose.
+    pub poses: usize,
+    /// Random configurations drawn (uniform within the joint limits less the margin).
+    pub candidates: usize,
+    /// Margin kept from both joint limits [deg].
+    pub margin_deg: f64,
+    pub workspace: Option<WorkspaceBox>,
+    pub tracker: Option<TrackerSight>,
+    /// Tracker noise, standard deviation per axis [mm].
+    pub noise_mm: f64,
+    /// Payload mass [kg] (default: the model's).
+    pub payload_kg: Option<f64>,
+    pub seed: u64,
+}
+
+impl Default for PlanSettings {
+    fn default() -> Self {
+        PlanSettings {
+            poses: 50,
+            candidates: 1000,
+            margin_deg: 2.0,
+            workspace: None,
+            tracker: None,
+            noise_mm: 0.01,
+            payload_kg: None,
+            seed: 1,
+        }
+    }
+}
+
+/// Why no plan can be made.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PlanError {
+    #[error("invalid setting: {0}")]
+    Setting(String),
+    #[error("only {} of {} candidates pass the constraints ({} reachable, {} inside the box, {} in the tracker's sight), {needed} poses asked; draw more candidates or widen the box or the angle", counts.in_sight, counts.drawn, counts.reachable, counts.in_box, counts.in_sight)]
+    TooFewCandidates { counts: FilterCounts, needed: usize },
+    #[error("the chosen poses identify too little: {0}")]
+    Unidentifiable(String),
+}
+
+/// The plan: poses in order, what the constraints let through and the
+/// predicted standard deviations.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MeasurementPlan {
+    pub robot: String,
+    /// Chosen configurations, model convention [rad].
+    pub q: Vec<Vec<f64>>,
+    /// The same in the controller convention [deg], with point names.
+    pub points: Vec<PlanPoint>,
+    pub counts: FilterCounts,
+    pub noise_mm: f64,
+    pub payload_kg: f64,
+    /// KM's prediction, and SKCM's when gravity loads a joint.
+    pub predicted: Vec<PredictedStd>,
+}
+
+/// Makes a plan for `model`.
+pub fn make_plan(model: &RobotModel, s: &PlanSettings) -> Result<MeasurementPlan, PlanError> {
+    if s.poses == 0 {
+        return Err(PlanError::Setting("at least one pose".into()));
+    }
+    if !(s.noise_mm.is_finite() && s.noise_mm > 0.0) {
+        return Err(PlanError::Setting(format!(
+            "the tracker noise must be a positive number of mm, got {}",
+            s.noise_mm
+        )));
+    }
+    let payload_kg = s.payload_kg.unwrap_or(model.payload.mass);
+    if !(payload_kg.is_finite() && payload_kg >= 0.0) {
+        return Err(PlanError::Setting(format!(
+            "the payload must be a non-negative mass, got {payload_kg}"
+        )));
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(s.seed);
+    let (pool, counts) = candidates::draw(model, s, &mut rng)?;
+    if pool.len() < s.poses {
+        return Err(PlanError::TooFewCandidates {
+            counts,
+            needed: s.poses,
+        });
+    }
+    let gravity = predict::gravity_loads(model, &pool, payload_kg);
+    let q = crate::identify::pose_selection::choose_d_optimal(
+        model, &pool, s.poses, payload_kg, gravity,
+    );
+    let predicted = predict::predict(model, &q, payload_kg, s.noise_mm, gravity)?;
+    let points = q
+        .iter()
+        .enumerate()
+        .map(|(i, q)| PlanPoint {
+            name: format!("P{}", i + 1),
+            q_deg: model
+                .joints_to_controller(q)
+                .into_iter()
+                .map(f64::to_degrees)
+                .collect(),
+        })
+        .collect();
+    Ok(MeasurementPlan {
+        robot: model.name.clone(),
+        q,
+        points,
+        counts,
+        noise_mm: s.noise_mm,
+        payload_kg,
+        predicted,
+    })
+}

@@ -1,0 +1,272 @@
+//! `robocal plan`: a measurement plan (`core::plan`): N poses chosen for
+//! identifiability within the joint limits, a workspace box and the tracker's
+//! line of sight, written as a joint CSV or a program that waits at each pose,
+//! with the parameter standard deviations it predicts for the tracker noise.
+//! `robocal plan join`: a tracker export joined back to the plan's joints into
+//! a measurement CSV.
+//!
+//! ```text
+//! robocal plan --model ur5 --poses 50 --box "-800,-800,0,800,800,1000" \
+//!     --tracker "2500,0,500" --max-angle-deg 60 --noise-mm 0.01 --format krl --out plan.src \
+//!     --csv plan.csv
+//! robocal plan join --plan plan.csv --tracker-export export.csv --out measurements.csv
+//! ```
+//!
+//! Box and tracker position: base frame, mm; the reflector axis: tool frame.
+
+use crate::plan::{
+    join, make_plan, plan_csv, plan_program, read_plan_csv, JoinBy, JoinOptions, MeasurementPlan,
+    PlanSettings, TrackerSight, Units, WorkspaceBox,
+};
+use crate::program::Language;
+use anyhow::{bail, Context};
+use clap::{Args, Subcommand, ValueEnum};
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+#[derive(Debug, Args)]
+#[command(args_conflicts_with_subcommands = true)]
+pub struct PlanArgs {
+    #[command(subcommand)]
+    pub command: Option<PlanCommand>,
+    #[command(flatten)]
+    pub make: MakeArgs,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum PlanCommand {
+    /// Join a tracker export to the plan's joints into a measurement CSV.
+    Join(JoinArgs),
+}
+
+/// Output format of `robocal plan`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum PlanFormat {
+    Csv,
+    Krl,
+    Rapid,
+    Fanuc,
+    Urscript,
+}
+
+#[derive(Debug, Args)]
+pub struct MakeArgs {
+    /// Robot model: a preset (ys100, hh800, ur5, ur10) or a model JSON file.
+    #[arg(long)]
+    pub model: Option<String>,
+    /// Number of poses.
+    #[arg(long, default_value_t = 50)]
+    pub poses: usize,
+    /// Random candidate configurations drawn within the joint limits.
+    #[arg(long, default_value_t = 1000)]
+    pub candidates: usize,
+    /// Workspace box of the TCP, base frame: "xmin,ymin,zmin,xmax,ymax,zmax" [mm].
+    #[arg(long = "box", allow_hyphen_values = true)]
+    pub workspace: Option<String>,
+    /// Tracker position in the base frame: "x,y,z" [mm].
+    #[arg(long, allow_hyphen_values = true)]
+    pub tracker: Option<String>,
+    /// Reflector axis in the tool frame: "x,y,z" (default: the tool's z axis).
+    #[arg(long, allow_hyphen_values = true)]
+    pub reflector_axis: Option<String>,
+    /// Maximum angle between the reflector axis and the line to the tracker [deg].
+    #[arg(long, default_value_t = 60.0)]
+    pub max_angle_deg: f64,
+    /// Tracker noise, standard deviation per axis [mm].
+    #[arg(long, default_value_t = 0.01)]
+    pub noise_mm: f64,
+    /// Payload mass [kg] (default: the model's).
+    #[arg(long)]
+    pub payload_kg: Option<f64>,
+    /// Seed of the candidates.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Output: the joint CSV or a program.
+    #[arg(long, value_enum, default_value_t = PlanFormat::Csv)]
+    pub format: PlanFormat,
+    /// Program name.
+    #[arg(long, default_value = "plan")]
+    pub name: String,
+    /// Wait at each pose [s].
+    #[arg(long, default_value_t = 2.0)]
+    pub wait_s: f64,
+    /// Output file (`-`: standard output, the σ table then goes to standard error).
+    #[arg(long)]
+    pub out: Option<String>,
+    /// Also write the joint CSV here (what `plan join` reads).
+    #[arg(long)]
+    pub csv: Option<PathBuf>,
+}
+
+#[derive(Debug, Args)]
+pub struct JoinArgs {
+    /// The plan's joint CSV (`robocal plan --format csv`, or `--csv`).
+    #[arg(long)]
+    pub plan: PathBuf,
+    /// The tracker export: point name or index (optional), x, y, z.
+    #[arg(long)]
+    pub tracker_export: PathBuf,
+    /// Units of the export's positions: mm, m or detect.
+    #[arg(long, default_value = "detect")]
+    pub units: String,
+    /// Join by name, order or detect (name when the export has a name column).
+    #[arg(long, default_value = "detect")]
+    pub by: String,
+    /// Output measurement CSV.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+fn numbers<const N: usize>(flag: &str, s: &str) -> anyhow::Result<[f64; N]> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .with_context(|| format!("{flag}: expected {N} comma-separated numbers, got {s:?}"))?;
+    match <[f64; N]>::try_from(v) {
+        Ok(a) if a.iter().all(|x| x.is_finite()) => Ok(a),
+        _ => bail!("{flag}: expected {N} finite comma-separated numbers, got {s:?}"),
+    }
+}
+
+fn settings(a: &MakeArgs) -> anyhow::Result<PlanSettings> {
+    let workspace = match &a.workspace {
+        Some(s) => {
+            let v = numbers::<6>("--box", s)?;
+            Some(WorkspaceBox {
+                min_mm: [v[0], v[1], v[2]],
+                max_mm: [v[3], v[4], v[5]],
+            })
+        }
+        None => None,
+    };
+    let tracker = match &a.tracker {
+        Some(s) => Some(TrackerSight {
+            position_mm: numbers::<3>("--tracker", s)?,
+            axis: match &a.reflector_axis {
+                Some(r) => numbers::<3>("--reflector-axis", r)?,
+                None => [0.0, 0.0, 1.0],
+            },
+            max_angle_deg: a.max_angle_deg,
+        }),
+        None => None,
+    };
+    Ok(PlanSettings {
+        poses: a.poses,
+        candidates: a.candidates,
+        workspace,
+        tracker,
+        noise_mm: a.noise_mm,
+        payload_kg: a.payload_kg,
+        seed: a.seed,
+        ..PlanSettings::default()
+    })
+}
+
+/// The predicted standard deviations as a text table.
+pub fn sigma_table(plan: &MeasurementPlan) -> String {
+    let c = plan.counts;
+    let mut s = format!(
+        "# {} poses of {}: {} candidates drawn, {} reachable, {} inside the box, {} in the tracker's sight\n\
+         # predicted standard deviations for a tracker noise of {} mm per axis\n",
+        plan.q.len(),
+        plan.robot,
+        c.drawn,
+        c.reachable,
+        c.in_box,
+        c.in_sight,
+        plan.noise_mm
+    );
+    for m in &plan.predicted {
+        let _ = writeln!(s, "{}:", m.method);
+        for p in &m.params {
+            let _ = writeln!(s, "  {:<10} {:>12.4e} {}", p.name, p.std, p.unit);
+        }
+        if !m.not_identified.is_empty() {
+            let _ = writeln!(s, "  not identified: {}", m.not_identified.join(", "));
+        }
+    }
+    s
+}
+
+/// Makes the plan and writes its exports; returns the σ table.
+pub fn make(a: &MakeArgs) -> anyhow::Result<String> {
+    let Some(model) = &a.model else {
+        bail!("--model is required (or use `robocal plan join`)");
+    };
+    let model = super::load_model(model)?;
+    let plan = make_plan(&model, &settings(a)?)?;
+    let language = match a.format {
+        PlanFormat::Csv => None,
+        PlanFormat::Krl => Some(Language::Krl),
+        PlanFormat::Rapid => Some(Language::Rapid),
+        PlanFormat::Fanuc => Some(Language::Fanuc),
+        PlanFormat::Urscript => Some(Language::UrScript),
+    };
+    let text = match language {
+        None => plan_csv(&plan.points),
+        Some(l) => plan_program(&plan, l, &a.name, a.wait_s)?
+            .into_iter()
+            .map(|f| f.text)
+            .collect(),
+    };
+    match a.out.as_deref() {
+        None | Some("-") => print!("{text}"),
+        Some(path) => std::fs::write(path, text).with_context(|| format!("cannot write {path}"))?,
+    }
+    if let Some(path) = &a.csv {
+        std::fs::write(path, plan_csv(&plan.points))
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    Ok(sigma_table(&plan))
+}
+
+/// Joins the tracker export; returns a one-line summary.
+pub fn join_files(a: &JoinArgs) -> anyhow::Result<String> {
+    let read = |p: &PathBuf| {
+        std::fs::read_to_string(p).with_context(|| format!("cannot read {}", p.display()))
+    };
+    let plan = read_plan_csv(&read(&a.plan)?).with_context(|| a.plan.display().to_string())?;
+    let units = match a.units.as_str() {
+        "mm" => Units::Mm,
+        "m" => Units::M,
+        "detect" => Units::Detect,
+        u => bail!("--units: mm, m or detect, got {u:?}"),
+    };
+    let by = match a.by.as_str() {
+        "name" => JoinBy::Name,
+        "order" => JoinBy::Order,
+        "detect" => JoinBy::Detect,
+        b => bail!("--by: name, order or detect, got {b:?}"),
+    };
+    let joined = join(&plan, &read(&a.tracker_export)?, &JoinOptions { units, by })
+        .with_context(|| a.tracker_export.display().to_string())?;
+    std::fs::write(&a.out, crate::measure::csv::write(&joined.rows))
+        .with_context(|| format!("cannot write {}", a.out.display()))?;
+    Ok(format!(
+        "{} measurements joined by {} (positions read in {}) into {}\n",
+        joined.rows.len(),
+        if joined.by == JoinBy::Order {
+            "order"
+        } else {
+            "name"
+        },
+        if joined.units == Units::M { "m" } else { "mm" },
+        a.out.display()
+    ))
+}
+
+pub fn run(a: PlanArgs) -> anyhow::Result<()> {
+    match &a.command {
+        Some(PlanCommand::Join(j)) => print!("{}", join_files(j)?),
+        None => {
+            let table = make(&a.make)?;
+            if matches!(a.make.out.as_deref(), None | Some("-")) {
+                eprint!("{table}");
+            } else {
+                print!("{table}");
+            }
+        }
+    }
+    Ok(())
+}
