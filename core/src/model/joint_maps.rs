@@ -95,21 +95,41 @@ impl JointMap {
         }
     }
 
-    /// The unfaded series `g(q) = Σ a_k cos kq + b_k sin kq` and `dg/dq`, by
-    /// the angle-addition recurrence (one sine and cosine per call).
-    fn series(&self, q: f64) -> (f64, f64) {
+    /// The unfaded series `g(q) = Σ a_k cos kq + b_k sin kq` and, when
+    /// `derivative`, `dg/dq`, by the angle-addition recurrence (one sine and
+    /// cosine per call): four interleaved chains, harmonics `j, j + 4, …`
+    /// advanced by `4q`, so the recurrence's latency overlaps.
+    fn series(&self, q: f64, derivative: bool) -> (f64, f64) {
         let (s1, c1) = q.sin_cos();
-        let (mut sk, mut ck) = (s1, c1);
-        let (mut g, mut dg) = (0.0, 0.0);
-        for (k, (a, b)) in self.cos.iter().zip(&self.sin).enumerate() {
-            let kf = (k + 1) as f64;
-            g += a * ck + b * sk;
-            dg += kf * (b * ck - a * sk);
-            let next_s = sk * c1 + ck * s1;
-            ck = ck * c1 - sk * s1;
-            sk = next_s;
+        let mut c = [c1, 0.0, 0.0, 0.0];
+        let mut s = [s1, 0.0, 0.0, 0.0];
+        for j in 1..4 {
+            c[j] = c[j - 1] * c1 - s[j - 1] * s1;
+            s[j] = s[j - 1] * c1 + c[j - 1] * s1;
         }
-        (g, dg)
+        let (c4, s4) = (c[3], s[3]);
+        let (mut g, mut dg) = ([0.0; 4], [0.0; 4]);
+        let n = self.cos.len();
+        let mut k = 0;
+        while k < n {
+            for j in 0..4.min(n - k) {
+                let (a, b) = (self.cos[k + j], self.sin[k + j]);
+                g[j] += a * c[j] + b * s[j];
+                if derivative {
+                    dg[j] += (k + j + 1) as f64 * (b * c[j] - a * s[j]);
+                }
+            }
+            for j in 0..4 {
+                let next_s = s[j] * c4 + c[j] * s4;
+                c[j] = c[j] * c4 - s[j] * s4;
+                s[j] = next_s;
+            }
+            k += 4;
+        }
+        (
+            (g[0] + g[1]) + (g[2] + g[3]),
+            (dg[0] + dg[1]) + (dg[2] + dg[3]),
+        )
     }
 
     /// `f(q)` [rad] and `df/dq`.
@@ -118,13 +138,17 @@ impl JointMap {
         if s == 0.0 {
             return (0.0, 0.0);
         }
-        let (g, dg) = self.series(q);
+        let (g, dg) = self.series(q, true);
         (s * g, s * dg + ds * g)
     }
 
     /// `f(q)` [rad].
     pub fn value(&self, q: f64) -> f64 {
-        self.value_and_derivative(q).0
+        let (s, _) = self.weight(q);
+        if s == 0.0 {
+            return 0.0;
+        }
+        s * self.series(q, false).0
     }
 
     /// The basis of the series at `q` (unfaded): `[cos q … cos Kq, sin q … sin Kq]`,
@@ -146,7 +170,11 @@ impl JointMap {
         let [lo, hi] = self.range;
         let n = (((hi - lo) / 0.1f64.to_radians()).ceil() as usize).max(1);
         (0..=n)
-            .map(|i| self.series(lo + (hi - lo) * i as f64 / n as f64).0.abs())
+            .map(|i| {
+                self.series(lo + (hi - lo) * i as f64 / n as f64, false)
+                    .0
+                    .abs()
+            })
             .fold(0.0, f64::max)
     }
 
