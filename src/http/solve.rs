@@ -270,6 +270,21 @@ struct Common<'a> {
     path: bool,
 }
 
+/// The model a `version` field names (absent: the active version).
+pub(crate) fn model_choice(v: Option<&VersionSelector>) -> Result<ModelChoice, ApiError> {
+    Ok(match v {
+        None => ModelChoice::Active,
+        Some(VersionSelector::Name(n)) if n == "active" => ModelChoice::Active,
+        Some(VersionSelector::Name(n)) if n == "nominal" => ModelChoice::Nominal,
+        Some(VersionSelector::Name(n)) => {
+            return Err(ApiError::invalid(format!(
+                "`version` must be a version number, \"active\" or \"nominal\", got \"{n}\""
+            )))
+        }
+        Some(VersionSelector::Number(Int(v))) => ModelChoice::Version(*v),
+    })
+}
+
 /// Every check that does not need the robot (422 naming the field), as a
 /// service command with no targets yet.
 fn command(robot_id: i64, c: Common) -> Result<SolveCommand, ApiError> {
@@ -305,17 +320,7 @@ fn command(robot_id: i64, c: Common) -> Result<SolveCommand, ApiError> {
         .convention
         .map(|name| convention(name, "`convention`"))
         .transpose()?;
-    let model = match c.version {
-        None => ModelChoice::Active,
-        Some(VersionSelector::Name(n)) if n == "active" => ModelChoice::Active,
-        Some(VersionSelector::Name(n)) if n == "nominal" => ModelChoice::Nominal,
-        Some(VersionSelector::Name(n)) => {
-            return Err(ApiError::invalid(format!(
-                "`version` must be a version number, \"active\" or \"nominal\", got \"{n}\""
-            )))
-        }
-        Some(VersionSelector::Number(Int(v))) => ModelChoice::Version(*v),
-    };
+    let model = model_choice(c.version)?;
     Ok(SolveCommand {
         robot_id,
         model,

@@ -123,6 +123,59 @@ async fn choose_version(
     }
 }
 
+/// The compensated model of a chosen version (`None`: the nominal model).
+async fn load_model(
+    state: &AppState,
+    robot_id: i64,
+    nominal_json: &str,
+    chosen: &Option<(i64, i64, String)>,
+) -> Result<CompensatedModel, ServiceError> {
+    Ok(match chosen {
+        Some((vid, v, _)) => {
+            let text = state.db().version_model(*vid).await?.ok_or_else(|| {
+                ServiceError::NotFound(format!("robot {robot_id} has no model version {v}"))
+            })?;
+            CalibratedModelFile::from_json(&text)
+                .and_then(|f| f.to_compensated())
+                .map_err(|e| ServiceError::Internal(format!("stored model version {v}: {e}")))?
+        }
+        None => {
+            let m = RobotModel::from_json(nominal_json).map_err(|e| {
+                ServiceError::Internal(format!("stored model of robot {robot_id}: {e}"))
+            })?;
+            CompensatedModel::from_nominal(m)
+        }
+    })
+}
+
+/// A model for work other than a solve batch (program filtering): the chosen
+/// version's compensated model, its number (`None`: nominal) and its method.
+pub struct ChosenModel {
+    pub model: CompensatedModel,
+    pub version: Option<i64>,
+    pub method: String,
+}
+
+/// The compensated model `choice` names for robot `robot_id`.
+pub async fn chosen_model(
+    state: &AppState,
+    robot_id: i64,
+    choice: ModelChoice,
+) -> Result<ChosenModel, ServiceError> {
+    let ctx = state.robot_context(robot_id).await?;
+    let chosen = choose_version(state, robot_id, choice, ctx.active.clone()).await?;
+    let model = load_model(state, robot_id, &ctx.model_json, &chosen).await?;
+    let (version, method) = match chosen {
+        Some((_, v, m)) => (Some(v), m),
+        None => (None, "nominal".to_string()),
+    };
+    Ok(ChosenModel {
+        model,
+        version,
+        method,
+    })
+}
+
 /// The prepared solver of a command, from the cache when it can be.
 async fn prepare(
     state: &AppState,
@@ -146,22 +199,7 @@ async fn prepare(
             return Ok((solver, version, method));
         }
     }
-    let mut model = match &chosen {
-        Some((vid, v, _)) => {
-            let text = state.db().version_model(*vid).await?.ok_or_else(|| {
-                ServiceError::NotFound(format!("robot {robot_id} has no model version {v}"))
-            })?;
-            CalibratedModelFile::from_json(&text)
-                .and_then(|f| f.to_compensated())
-                .map_err(|e| ServiceError::Internal(format!("stored model version {v}: {e}")))?
-        }
-        None => {
-            let m = RobotModel::from_json(&ctx.model_json).map_err(|e| {
-                ServiceError::Internal(format!("stored model of robot {robot_id}: {e}"))
-            })?;
-            CompensatedModel::from_nominal(m)
-        }
-    };
+    let mut model = load_model(state, robot_id, &ctx.model_json, &chosen).await?;
     if let Some(p) = cmd.payload_kg {
         model.payload_kg = p;
     }
