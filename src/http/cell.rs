@@ -56,9 +56,19 @@ pub struct ItemIn {
     /// Work objects only: `base` (default) or `measurement`.
     #[serde(default, deserialize_with = "present")]
     pub frame: Option<String>,
-    pub xyz_mm: [f64; 3],
+    pub xyz_mm: Vec<f64>,
     #[serde(default, deserialize_with = "present")]
-    pub rpy_deg: Option<[f64; 3]>,
+    pub rpy_deg: Option<Vec<f64>>,
+}
+
+/// Three values, or 422 naming the field.
+fn three(values: &[f64], what: &str, name: &str) -> Result<[f64; 3], ApiError> {
+    <[f64; 3]>::try_from(values).map_err(|_| {
+        ApiError::invalid(format!(
+            "`{name}`: `{what}` needs 3 values, got {}",
+            values.len()
+        ))
+    })
 }
 
 /// `PUT /v1/robots/{id}/tools` body.
@@ -106,18 +116,23 @@ impl ItemOut {
 }
 
 /// The item checked against the spec's bounds; `path_name` is the name the
-/// URL gives (a body name must then be the same).
-fn checked(
+/// URL gives (a body name must then be the same), `default_name` the name of
+/// an item that gives none (empty: a name is required).
+pub(crate) fn checked(
     kind: CellKind,
     item: &ItemIn,
     path_name: Option<&str>,
+    default_name: &str,
 ) -> Result<NewCellItem, ApiError> {
     let name = match (path_name, &item.name) {
-        (Some(p), Some(b)) if p != b => return Err(ApiError::invalid(format!(
+        (Some(p), Some(b)) if p != b => {
+            return Err(ApiError::invalid(format!(
             "`name` `{b}` differs from the name in the URL `{p}`; leave it out or make them equal"
-        ))),
+        )))
+        }
         (Some(p), _) => p.to_string(),
         (None, Some(b)) => b.clone(),
+        (None, None) if !default_name.is_empty() => default_name.to_string(),
         (None, None) => return Err(ApiError::invalid("every item needs a `name`")),
     };
     check_item_name(&name)?;
@@ -129,8 +144,12 @@ fn checked(
             )));
         }
     }
-    let rpy_deg = item.rpy_deg.unwrap_or([0.0; 3]);
-    if item.xyz_mm.iter().any(|v| v.abs() > CELL_XYZ_MAX_MM) {
+    let xyz_mm = three(&item.xyz_mm, "xyz_mm", &name)?;
+    let rpy_deg = match &item.rpy_deg {
+        Some(v) => three(v, "rpy_deg", &name)?,
+        None => [0.0; 3],
+    };
+    if xyz_mm.iter().any(|v| v.abs() > CELL_XYZ_MAX_MM) {
         return Err(ApiError::invalid(format!(
             "`{name}`: `xyz_mm` values must be within ±{CELL_XYZ_MAX_MM} mm"
         )));
@@ -159,10 +178,7 @@ fn checked(
         name,
         number,
         frame,
-        pose: PoseMmDeg {
-            xyz_mm: item.xyz_mm,
-            rpy_deg,
-        },
+        pose: PoseMmDeg { xyz_mm, rpy_deg },
     })
 }
 
@@ -203,7 +219,7 @@ async fn replace(
     }
     let items = items
         .iter()
-        .map(|i| checked(kind, i, None))
+        .map(|i| checked(kind, i, None, ""))
         .collect::<Result<Vec<_>, _>>()?;
     let rows = service::cell::replace(&state, robot_id, kind, &items).await?;
     Ok(list_body(robot_id, kind, rows))
@@ -226,7 +242,7 @@ async fn put_item(
     name: &str,
     item: &ItemIn,
 ) -> Result<Response, ApiError> {
-    let item = checked(kind, item, Some(name))?;
+    let item = checked(kind, item, Some(name), "")?;
     let done = service::cell::put(&state, robot_id, kind, &item).await?;
     let status = if done.created {
         StatusCode::CREATED

@@ -60,7 +60,7 @@ fn check_file_name(name: &str) -> Result<(), ApiError> {
     if name.is_empty()
         || name.chars().count() > FILE_NAME_MAX
         || name.contains(['/', '\\', '\0'])
-        || name.trim().is_empty()
+        || name.chars().all(|c| matches!(c, ' ' | '\t' | '\r' | '\n'))
     {
         return Err(ApiError::invalid(format!(
             "file name `{name}`: 1 to {FILE_NAME_MAX} characters, not blank, without `/`, `\\` or NUL"

@@ -21,13 +21,14 @@ use super::error::{content_type, json_content_type};
 use super::input::{check_payload, from_json_object, object_or_null, objects, present, Int};
 use super::{ApiError, ApiPath, ApiQuery, AppState};
 use crate::csv_text::{dialect_from_names, Dialect};
+use crate::db::CellKind;
 use crate::ik::{
     parse_targets_csv, results_csv, Configuration, JointJump, SolveOptions, TargetFrame,
     TargetInput, TargetResult,
 };
 use crate::model::orientation::OrientationConvention;
 use crate::service;
-use crate::service::solve::{ModelChoice, SolveCommand, SolveOutcome, Targets};
+use crate::service::solve::{ItemChoice, ModelChoice, SolveCommand, SolveOutcome, Targets};
 use axum::body::Bytes;
 use axum::extract::rejection::BytesRejection;
 use axum::extract::State;
@@ -136,6 +137,36 @@ pub struct SolveRequest {
     pub version: Option<VersionSelector>,
     #[serde(default, deserialize_with = "present")]
     pub jump_deg: Option<f64>,
+    /// A stored tool by name, or one inline (TCP in the flange frame).
+    #[serde(default, deserialize_with = "present")]
+    pub tool: Option<ItemRef>,
+    /// A stored work object by name, or one inline: the targets and false
+    /// targets are in it.
+    #[serde(default, deserialize_with = "present")]
+    pub work_object: Option<ItemRef>,
+}
+
+/// A tool or work object of a solve: a stored one's name, or one inline.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+pub enum ItemRef {
+    Name(String),
+    Inline(super::cell::ItemIn),
+}
+
+impl ItemRef {
+    fn choice(&self, kind: CellKind) -> Result<ItemChoice, ApiError> {
+        Ok(match self {
+            ItemRef::Name(n) => {
+                super::cell::check_item_name(n)?;
+                ItemChoice::Stored(n.clone())
+            }
+            ItemRef::Inline(item) => {
+                let name = item.name.clone().unwrap_or_else(|| "inline".into());
+                ItemChoice::Inline(super::cell::checked(kind, item, None, &name)?)
+            }
+        })
+    }
 }
 
 #[derive(Debug, Serialize)]
@@ -336,6 +367,8 @@ fn command(robot_id: i64, c: Common) -> Result<SolveCommand, ApiError> {
         },
         path: c.path,
         targets: Targets::Inputs(Vec::new()),
+        tool: None,
+        work_object: None,
     })
 }
 
@@ -373,6 +406,19 @@ pub fn json_command(
             path: req.path.or(query.path).unwrap_or(false),
         },
     )?;
+    cmd.tool = req
+        .tool
+        .as_ref()
+        .map(|t| t.choice(CellKind::Tool))
+        .transpose()?;
+    if let Some(w) = &req.work_object {
+        if req.frame.is_some() || query.frame.is_some() {
+            return Err(ApiError::invalid(
+                "with `work_object` the targets are in the work object: leave `frame` out",
+            ));
+        }
+        cmd.work_object = Some(w.choice(CellKind::WorkObject)?);
+    }
     let mut req = req.clone();
     req.convention = req
         .convention
@@ -597,6 +643,11 @@ pub async fn solve(
     }
     let cmd = solve_command(robot_id, &query, request_is_csv, &body?)?;
     let (frame, position_only, path) = (cmd.options.frame, cmd.options.position_only, cmd.path);
+    let frame = if cmd.work_object.is_some() {
+        "work_object".to_string()
+    } else {
+        frame.to_string()
+    };
     let out_conv = cmd
         .options
         .false_target_convention
@@ -611,7 +662,7 @@ pub async fn solve(
         robot_id,
         version: done.version,
         method: done.method,
-        frame: frame.to_string(),
+        frame,
         payload_kg: done.payload_kg,
         path,
         position_only,

@@ -13,9 +13,16 @@
 
 use super::limits::SMALL_SOLVE_MAX;
 use super::{AppState, ServiceError};
+use crate::cell::file::PoseMmDeg;
+use crate::cell::{with_tool, WorkObject, WorkObjectFrame};
 use crate::compensate::{CalibratedModelFile, CompensatedModel};
+use crate::db::{CellKind, ItemFrame, NewCellItem};
+use crate::ik::TargetFrame;
 use crate::ik::{IkSettings, IkSolver, SolveOptions, TargetInput, TargetResult, TargetsCsv};
-use crate::model::RobotModel;
+use crate::model::orientation::{rotation_from, rotation_to};
+use crate::model::pose::rpy_matrix;
+use crate::model::{Pose, RobotModel};
+use nalgebra::Vector3;
 use std::sync::Arc;
 
 /// Which model to solve with.
@@ -78,6 +85,17 @@ pub struct SolveCommand {
     pub options: SolveOptions,
     pub path: bool,
     pub targets: Targets,
+    /// Production tool on the calibrated flange (`None`: the model's tool).
+    pub tool: Option<ItemChoice>,
+    /// Work object the targets and false targets are in (`None`: `options.frame`).
+    pub work_object: Option<ItemChoice>,
+}
+
+/// A tool or work object of a solve: stored by name, or given inline.
+#[derive(Debug, Clone)]
+pub enum ItemChoice {
+    Stored(String),
+    Inline(NewCellItem),
 }
 
 /// What a solve produced.
@@ -247,7 +265,40 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
             cmd.targets.len()
         )));
     }
-    let (solver, version, method) = prepare(state, &cmd).await?;
+    let (mut solver, version, method) = prepare(state, &cmd).await?;
+    let work_object = match &cmd.work_object {
+        None => None,
+        Some(choice) => {
+            let (name, frame, pose) =
+                resolve(state, cmd.robot_id, CellKind::WorkObject, choice).await?;
+            let wobj = WorkObject {
+                name,
+                number: None,
+                frame: match frame {
+                    ItemFrame::Measurement => WorkObjectFrame::Measurement,
+                    ItemFrame::Base | ItemFrame::Flange => WorkObjectFrame::Base,
+                },
+                pose,
+            };
+            Some(wobj.in_base(solver.model()))
+        }
+    };
+    if let Some(choice) = &cmd.tool {
+        let (_, _, tcp) = resolve(state, cmd.robot_id, CellKind::Tool, choice).await?;
+        let settings = solver.settings().clone();
+        solver = Arc::new(IkSolver::new(with_tool(solver.model(), &tcp), settings));
+    }
+    if let Some(w) = &work_object {
+        let Targets::Inputs(inputs) = &mut cmd.targets else {
+            return Err(ServiceError::Invalid(
+                "a work object needs JSON targets (the targets CSV has no work object)".into(),
+            ));
+        };
+        for t in inputs.iter_mut() {
+            to_base(w, t);
+        }
+        cmd.options.frame = TargetFrame::Base;
+    }
     if let Some(s) = &cmd.seed_deg {
         cmd.options.seed = Some(seed_joints(s, &solver)?);
     }
@@ -270,6 +321,19 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
         .await
         .map_err(|e| ServiceError::Internal(format!("solver task: {e}")))?
     };
+    let mut results = results;
+    if let Some(w) = &work_object {
+        let w_inv = w.inverse();
+        for r in results.iter_mut() {
+            if let Some(f) = &mut r.false_target {
+                if let Ok(rot) = rotation_from(f.convention, &f.orientation) {
+                    let p = w_inv.compose(&Pose::new(rot, Vector3::from(f.xyz_mm) * 1e-3));
+                    f.xyz_mm = [p.p.x * 1e3, p.p.y * 1e3, p.p.z * 1e3];
+                    f.orientation = rotation_to(f.convention, &p.r);
+                }
+            }
+        }
+    }
     Ok(SolveOutcome {
         version,
         method,
@@ -277,4 +341,40 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
         dof,
         results,
     })
+}
+
+/// SI pose of boundary `xyz_mm` and `rpy_deg` (`Rz·Ry·Rx`).
+pub fn pose_of(p: &PoseMmDeg) -> Pose {
+    let [rx, ry, rz] = p.rpy_deg.map(f64::to_radians);
+    Pose::new(rpy_matrix(rx, ry, rz), Vector3::from(p.xyz_mm) * 1e-3)
+}
+
+/// The name, frame and SI pose of a stored or inline tool or work object.
+async fn resolve(
+    state: &AppState,
+    robot_id: i64,
+    kind: CellKind,
+    choice: &ItemChoice,
+) -> Result<(String, ItemFrame, Pose), ServiceError> {
+    Ok(match choice {
+        ItemChoice::Inline(item) => (item.name.clone(), item.frame, pose_of(&item.pose)),
+        ItemChoice::Stored(name) => {
+            let row = super::cell::get(state, robot_id, kind, name).await?;
+            let pose = pose_of(&row.pose_json.0);
+            (row.name, row.frame, pose)
+        }
+    })
+}
+
+/// A target given in work object `w` (pose in the base frame) as a base-frame
+/// target: `W·T`; an invalid target is left to fail alone.
+fn to_base(w: &Pose, t: &mut TargetInput) {
+    let Ok((goal, conv)) = t.to_goal() else {
+        return;
+    };
+    let p = w.r * goal.position + w.p;
+    t.xyz_mm = [p.x * 1e3, p.y * 1e3, p.z * 1e3];
+    if let (Some(r), Some(conv)) = (goal.rotation, conv) {
+        t.orientation = rotation_to(conv, &(w.r * r));
+    }
 }
