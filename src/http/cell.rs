@@ -116,8 +116,8 @@ impl ItemOut {
 }
 
 /// The item checked against the spec's bounds; `path_name` is the name the
-/// URL gives (a body name must then be the same), `default_name` the name of
-/// an item that gives none (empty: a name is required).
+/// URL gives (the body has none then), `default_name` the name of an inline
+/// item, which has none (empty: the body's name is required).
 pub(crate) fn checked(
     kind: CellKind,
     item: &ItemIn,
@@ -125,13 +125,18 @@ pub(crate) fn checked(
     default_name: &str,
 ) -> Result<NewCellItem, ApiError> {
     let name = match (path_name, &item.name) {
-        (Some(p), Some(b)) if p != b => {
-            return Err(ApiError::invalid(format!(
-            "`name` `{b}` differs from the name in the URL `{p}`; leave it out or make them equal"
-        )))
+        (Some(_), Some(_)) => {
+            return Err(ApiError::invalid(
+                "`name`: the name is the URL's; leave `name` out of the body",
+            ))
         }
-        (Some(p), _) => p.to_string(),
-        (None, Some(b)) => b.clone(),
+        (Some(p), None) => p.to_string(),
+        (None, Some(b)) if default_name.is_empty() => b.clone(),
+        (None, Some(_)) => {
+            return Err(ApiError::invalid(
+                "`name`: an inline tool or work object has no name; leave it out",
+            ))
+        }
         (None, None) if !default_name.is_empty() => default_name.to_string(),
         (None, None) => return Err(ApiError::invalid("every item needs a `name`")),
     };

@@ -35,9 +35,8 @@ pub struct FileIn {
 pub struct FilterRequest {
     #[serde(deserialize_with = "objects")]
     pub files: Vec<FileIn>,
-    /// krl, rapid, fanuc or urscript (default: from the file names).
-    #[serde(default, deserialize_with = "present")]
-    pub language: Option<String>,
+    /// krl, rapid, fanuc or urscript.
+    pub language: String,
     #[serde(default, deserialize_with = "present")]
     pub version: Option<VersionSelector>,
     #[serde(default, deserialize_with = "present")]
@@ -89,18 +88,16 @@ fn command(robot_id: i64, req: FilterRequest) -> Result<FilterCommand, ApiError>
     if let Some(p) = req.payload_kg {
         super::input::check_payload("`payload_kg`", p)?;
     }
-    let language = req
-        .language
-        .as_deref()
-        .map(|l| match l {
-            "krl" | "rapid" | "fanuc" | "urscript" => l
-                .parse::<Language>()
-                .map_err(|e| ApiError::invalid(format!("`language`: {e}"))),
-            _ => Err(ApiError::invalid(format!(
+    let language = match req.language.as_str() {
+        l @ ("krl" | "rapid" | "fanuc" | "urscript") => l
+            .parse::<Language>()
+            .map_err(|e| ApiError::invalid(format!("`language`: {e}")))?,
+        l => {
+            return Err(ApiError::invalid(format!(
                 "`language` must be krl, rapid, fanuc or urscript, got `{l}`"
-            ))),
-        })
-        .transpose()?;
+            )))
+        }
+    };
     Ok(FilterCommand {
         robot_id,
         model: model_choice(req.version.as_ref())?,

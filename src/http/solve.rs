@@ -162,8 +162,7 @@ impl ItemRef {
                 ItemChoice::Stored(n.clone())
             }
             ItemRef::Inline(item) => {
-                let name = item.name.clone().unwrap_or_else(|| "inline".into());
-                ItemChoice::Inline(super::cell::checked(kind, item, None, &name)?)
+                ItemChoice::Inline(super::cell::checked(kind, item, None, "inline")?)
             }
         })
     }

@@ -60,7 +60,7 @@ pub async fn put(
 }
 
 /// Replaces all of a robot's tools or work objects; names (any ASCII case)
-/// and numbers must be unique in `items` (`Invalid` if not).
+/// and numbers must be unique in `items` (`Conflict` if not).
 pub async fn replace(
     state: &AppState,
     robot_id: i64,
@@ -71,7 +71,7 @@ pub async fn replace(
     let mut numbers = HashSet::new();
     for item in items {
         if !names.insert(crate::db::cell_name_key(&item.name)) {
-            return Err(ServiceError::Invalid(format!(
+            return Err(ServiceError::Conflict(format!(
                 "{} name `{}` appears twice (names are unique per robot, regardless of case)",
                 kind.label(),
                 item.name
@@ -79,7 +79,7 @@ pub async fn replace(
         }
         if let Some(n) = item.number {
             if !numbers.insert(n) {
-                return Err(ServiceError::Invalid(format!(
+                return Err(ServiceError::Conflict(format!(
                     "{} number {n} appears twice (numbers are unique per robot)",
                     kind.label()
                 )));

@@ -17,8 +17,7 @@ pub struct FilterCommand {
     pub model: ModelChoice,
     /// Payload mass [kg] instead of the model's.
     pub payload_kg: Option<f64>,
-    /// The language; `None`: from the files' extensions.
-    pub language: Option<Language>,
+    pub language: Language,
     pub files: Vec<ProgramFile>,
 }
 
@@ -32,30 +31,12 @@ pub struct FilterOutcome {
     pub output: FilterOutput,
 }
 
-/// The language of a program's files: as given, else the one all their
-/// extensions name (`Invalid` when they name none or several).
-pub fn language_of(
-    given: Option<Language>,
-    files: &[ProgramFile],
-) -> Result<Language, ServiceError> {
-    if let Some(l) = given {
-        return Ok(l);
-    }
-    let found: Vec<Option<Language>> = files.iter().map(|f| Language::of_file(&f.name)).collect();
-    match found.first().copied().flatten() {
-        Some(l) if found.iter().all(|x| *x == Some(l)) => Ok(l),
-        _ => Err(ServiceError::Invalid(
-            "cannot tell the program language from the file names (.src/.dat, .mod/.modx/.prg/.sys, .ls, .script/.urscript); give `language`".into(),
-        )),
-    }
-}
-
 /// Filters a program with the robot's model and cell.
 pub async fn filter_program(
     state: &AppState,
     cmd: FilterCommand,
 ) -> Result<FilterOutcome, ServiceError> {
-    let language = language_of(cmd.language, &cmd.files)?;
+    let language = cmd.language;
     let cell = super::cell::cell(state, cmd.robot_id).await?;
     let chosen = chosen_model(state, cmd.robot_id, cmd.model).await?;
     let mut model = chosen.model;

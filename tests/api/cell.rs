@@ -111,7 +111,7 @@ async fn tools_and_work_objects_are_stored_per_robot_by_unique_name_and_number()
         ),
         (
             "gripper",
-            json!({ "xyz_mm": [0, 0, 1], "name": "other" }),
+            json!({ "xyz_mm": [0, 0, 1], "name": "gripper" }),
             "name",
         ),
         ("bad%20name", json!({ "xyz_mm": [0, 0, 1] }), "name"),
@@ -164,14 +164,24 @@ async fn tools_and_work_objects_are_stored_per_robot_by_unique_name_and_number()
         .map(|w| w["name"].as_str().unwrap().to_string())
         .collect();
     assert_eq!(names, ["fixture", "table"]);
-    // A list with a name or number twice is refused whole.
-    for list in [
-        json!([{ "name": "a", "xyz_mm": [0, 0, 0] }, { "name": "A", "xyz_mm": [0, 0, 0] }]),
-        json!([{ "name": "a", "number": 4, "xyz_mm": [0, 0, 0] }, { "name": "b", "number": 4, "xyz_mm": [0, 0, 0] }]),
-        json!([{ "xyz_mm": [0, 0, 0] }]),
+    // A list with a name or number twice conflicts with itself, an entry
+    // without a name is invalid; either way nothing changes.
+    for (list, status) in [
+        (
+            json!([{ "name": "a", "xyz_mm": [0, 0, 0] }, { "name": "A", "xyz_mm": [0, 0, 0] }]),
+            StatusCode::CONFLICT,
+        ),
+        (
+            json!([{ "name": "a", "number": 4, "xyz_mm": [0, 0, 0] }, { "name": "b", "number": 4, "xyz_mm": [0, 0, 0] }]),
+            StatusCode::CONFLICT,
+        ),
+        (
+            json!([{ "xyz_mm": [0, 0, 0] }]),
+            StatusCode::UNPROCESSABLE_ENTITY,
+        ),
     ] {
         let r = put(&t, FRAMES, &[&rid], json!({ "work_objects": list })).await;
-        assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{list}");
+        assert_eq!(r.status, status, "{list}");
     }
     assert_eq!(
         t.get(FRAMES, &[&rid]).await.json()["work_objects"]
@@ -268,7 +278,7 @@ async fn a_program_filtered_over_http_is_what_robocal_filter_writes() {
         .post_json(
             FILTER,
             &[&rid],
-            json!({ "files": [file_json(&src), file_json(&dat)] }),
+            json!({ "language": "krl", "files": [file_json(&src), file_json(&dat)] }),
         )
         .await;
     assert_eq!(r.status, StatusCode::OK, "{}", r.text());
@@ -317,7 +327,7 @@ async fn a_program_filtered_over_http_is_what_robocal_filter_writes() {
         .post_json(
             FILTER,
             &[&rid],
-            json!({ "files": [{ "name": "idle.src", "content": plain }] }),
+            json!({ "language": "krl", "files": [{ "name": "idle.src", "content": plain }] }),
         )
         .await;
     assert_eq!(r.status, StatusCode::OK, "{}", r.text());
@@ -329,7 +339,7 @@ async fn a_program_filtered_over_http_is_what_robocal_filter_writes() {
         .post_json(
             FILTER,
             &[&rid],
-            json!({ "files": [{ "name": "bad.src", "content": "DEF bad()\nLIN {X 1,\nEND\n" }] }),
+            json!({ "language": "krl", "files": [{ "name": "bad.src", "content": "DEF bad()\nLIN {X 1,\nEND\n" }] }),
         )
         .await;
     assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
@@ -342,13 +352,16 @@ async fn a_program_filtered_over_http_is_what_robocal_filter_writes() {
     assert!(p["column"].as_u64().unwrap() >= 1);
     // Other refusals.
     for (body, status) in [
-        (json!({ "files": [] }), StatusCode::UNPROCESSABLE_ENTITY),
         (
-            json!({ "files": [{ "name": "a.txt", "content": "" }] }),
+            json!({ "language": "krl", "files": [] }),
             StatusCode::UNPROCESSABLE_ENTITY,
         ),
         (
-            json!({ "files": [{ "name": "a/b.src", "content": "" }] }),
+            json!({ "files": [{ "name": "a.src", "content": "" }] }),
+            StatusCode::UNPROCESSABLE_ENTITY,
+        ),
+        (
+            json!({ "language": "krl", "files": [{ "name": "a/b.src", "content": "" }] }),
             StatusCode::UNPROCESSABLE_ENTITY,
         ),
         (
@@ -356,7 +369,7 @@ async fn a_program_filtered_over_http_is_what_robocal_filter_writes() {
             StatusCode::UNPROCESSABLE_ENTITY,
         ),
         (
-            json!({ "files": [{ "name": "a.src", "content": "" }], "version": 7 }),
+            json!({ "language": "krl", "files": [{ "name": "a.src", "content": "" }], "version": 7 }),
             StatusCode::CONFLICT,
         ),
     ] {
@@ -364,7 +377,11 @@ async fn a_program_filtered_over_http_is_what_robocal_filter_writes() {
         assert_eq!(r.status, status, "{body}: {}", r.text());
     }
     let r = t
-        .post_json(FILTER, &["999"], json!({ "files": [file_json(&src)] }))
+        .post_json(
+            FILTER,
+            &["999"],
+            json!({ "language": "krl", "files": [file_json(&src)] }),
+        )
         .await;
     assert_eq!(r.status, StatusCode::NOT_FOUND);
 }

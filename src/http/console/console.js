@@ -193,8 +193,11 @@ handlers.filter = async function (form) {
   const body = { files };
   const version = formValue(form, "version");
   if (version) body.version = /^[0-9]+$/.test(version) ? Number(version) : version;
-  const language = formValue(form, "language");
-  if (language) body.language = language;
+  // The language as chosen, else from the first file's extension.
+  const byExtension = { src: "krl", dat: "krl", mod: "rapid", modx: "rapid", prg: "rapid", sys: "rapid", ls: "fanuc", script: "urscript", urscript: "urscript" };
+  const ext = files[0].name.split(".").pop().toLowerCase();
+  body.language = formValue(form, "language") || byExtension[ext];
+  if (!body.language) throw new Error("choose the program's language");
   const r = (await api("POST", `/v1/robots/${robot}/programs/filter`, JSON.stringify(body), "application/json")).json();
   const rep = r.report;
   const summary = `${rep.filtered} targets filtered, ${rep.failed} failed, ${rep.skipped} skipped (model: ${r.version === null ? "nominal" : "v" + r.version} ${r.method})`;
