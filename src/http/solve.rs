@@ -410,14 +410,12 @@ pub fn json_command(
         .as_ref()
         .map(|t| t.choice(CellKind::Tool))
         .transpose()?;
-    if let Some(w) = &req.work_object {
-        if req.frame.is_some() || query.frame.is_some() {
-            return Err(ApiError::invalid(
-                "with `work_object` the targets are in the work object: leave `frame` out",
-            ));
-        }
-        cmd.work_object = Some(w.choice(CellKind::WorkObject)?);
-    }
+    // With a work object the targets are in it: `frame` does not apply.
+    cmd.work_object = req
+        .work_object
+        .as_ref()
+        .map(|w| w.choice(CellKind::WorkObject))
+        .transpose()?;
     let mut req = req.clone();
     req.convention = req
         .convention

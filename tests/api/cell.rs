@@ -481,7 +481,8 @@ async fn a_solve_with_a_tool_and_a_work_object_is_the_cell_solvers() {
         // The false target differs from the target by the calibration.
         assert!(((ft.p * 1e3) - nalgebra::Vector3::from(*p)).norm() > 0.01);
     }
-    // A stored name that the robot lacks is a 404; a frame with it a 422.
+    // A stored name that the robot lacks is a 404; with a work object
+    // `frame` does not apply.
     let r = t
         .post_json(
             SOLVE,
@@ -494,8 +495,13 @@ async fn a_solve_with_a_tool_and_a_work_object_is_the_cell_solvers() {
         .post_json(
             SOLVE,
             &[&rid],
-            json!({ "targets": [{ "x": 0, "y": 0, "z": 0 }], "work_object": "table", "frame": "base" }),
+            json!({ "targets": [body_targets[0]], "convention": "kuka_abc", "tool": "torch",
+                    "work_object": "table", "branch": "front,up,noflip", "frame": "base" }),
         )
         .await;
-    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    assert_eq!(
+        r.json()["results"][0]["false_target"],
+        stored["results"][0]["false_target"]
+    );
 }
