@@ -14,12 +14,11 @@
 use super::limits::SMALL_SOLVE_MAX;
 use super::{AppState, ServiceError};
 use crate::cell::file::PoseMmDeg;
-use crate::cell::{with_tool, WorkObject, WorkObjectFrame};
+use crate::cell::{false_target_in, target_in_base, with_tool, WorkObject, WorkObjectFrame};
 use crate::compensate::{CalibratedModelFile, CompensatedModel};
 use crate::db::{CellKind, ItemFrame, NewCellItem};
 use crate::ik::TargetFrame;
 use crate::ik::{IkSettings, IkSolver, SolveOptions, TargetInput, TargetResult, TargetsCsv};
-use crate::model::orientation::{rotation_from, rotation_to};
 use crate::model::pose::rpy_matrix;
 use crate::model::{Pose, RobotModel};
 use nalgebra::Vector3;
@@ -295,7 +294,7 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
             ));
         };
         for t in inputs.iter_mut() {
-            to_base(w, t);
+            *t = target_in_base(w, t);
         }
         cmd.options.frame = TargetFrame::Base;
     }
@@ -323,14 +322,9 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
     };
     let mut results = results;
     if let Some(w) = &work_object {
-        let w_inv = w.inverse();
         for r in results.iter_mut() {
-            if let Some(f) = &mut r.false_target {
-                if let Ok(rot) = rotation_from(f.convention, &f.orientation) {
-                    let p = w_inv.compose(&Pose::new(rot, Vector3::from(f.xyz_mm) * 1e-3));
-                    f.xyz_mm = [p.p.x * 1e3, p.p.y * 1e3, p.p.z * 1e3];
-                    f.orientation = rotation_to(f.convention, &p.r);
-                }
+            if let Some(f) = &r.false_target {
+                r.false_target = Some(false_target_in(w, f));
             }
         }
     }
@@ -364,17 +358,4 @@ async fn resolve(
             (row.name, row.frame, pose)
         }
     })
-}
-
-/// A target given in work object `w` (pose in the base frame) as a base-frame
-/// target: `W·T`; an invalid target is left to fail alone.
-fn to_base(w: &Pose, t: &mut TargetInput) {
-    let Ok((goal, conv)) = t.to_goal() else {
-        return;
-    };
-    let p = w.r * goal.position + w.p;
-    t.xyz_mm = [p.x * 1e3, p.y * 1e3, p.z * 1e3];
-    if let (Some(r), Some(conv)) = (goal.rotation, conv) {
-        t.orientation = rotation_to(conv, &(w.r * r));
-    }
 }
