@@ -8,6 +8,10 @@
 //! versions never change once written. A custom jump threshold gets a fresh
 //! solver that is not cached.
 //!
+//! A solve may name a production tool (on the calibrated flange, `with_tool`;
+//! not cached) and a work object `W`: targets `T` are then solved as `W·T` in
+//! the base frame and false targets returned in `W` (`core::cell`).
+//!
 //! Units at this boundary: targets in mm and degrees (`TargetInput`), joint
 //! seeds and commands in the controller convention in degrees.
 
@@ -268,22 +272,23 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
     let work_object = match &cmd.work_object {
         None => None,
         Some(choice) => {
-            let (name, frame, pose) =
-                resolve(state, cmd.robot_id, CellKind::WorkObject, choice).await?;
+            let item = resolve(state, cmd.robot_id, CellKind::WorkObject, choice).await?;
             let wobj = WorkObject {
-                name,
+                name: item.name,
                 number: None,
-                frame: match frame {
+                frame: match item.frame {
                     ItemFrame::Measurement => WorkObjectFrame::Measurement,
                     ItemFrame::Base | ItemFrame::Flange => WorkObjectFrame::Base,
                 },
-                pose,
+                pose: item.pose,
             };
             Some(wobj.in_base(solver.model()))
         }
     };
     if let Some(choice) = &cmd.tool {
-        let (_, _, tcp) = resolve(state, cmd.robot_id, CellKind::Tool, choice).await?;
+        let tcp = resolve(state, cmd.robot_id, CellKind::Tool, choice)
+            .await?
+            .pose;
         let settings = solver.settings().clone();
         solver = Arc::new(IkSolver::new(with_tool(solver.model(), &tcp), settings));
     }
@@ -337,25 +342,41 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
     })
 }
 
-/// SI pose of boundary `xyz_mm` and `rpy_deg` (`Rz·Ry·Rx`).
+/// SI pose of boundary `xyz_mm` and `rpy_deg` (`Rz·Ry·Rx`), as the cell file
+/// reads it (its own conversion is private to `core::cell::file`).
 pub fn pose_of(p: &PoseMmDeg) -> Pose {
     let [rx, ry, rz] = p.rpy_deg.map(f64::to_radians);
     Pose::new(rpy_matrix(rx, ry, rz), Vector3::from(p.xyz_mm) * 1e-3)
 }
 
-/// The name, frame and SI pose of a stored or inline tool or work object.
+/// A tool or work object of a solve, resolved.
+struct ResolvedItem {
+    name: String,
+    frame: ItemFrame,
+    /// SI pose in `frame`.
+    pose: Pose,
+}
+
+/// A stored or inline tool or work object (`NotFound` for an unknown name).
 async fn resolve(
     state: &AppState,
     robot_id: i64,
     kind: CellKind,
     choice: &ItemChoice,
-) -> Result<(String, ItemFrame, Pose), ServiceError> {
+) -> Result<ResolvedItem, ServiceError> {
     Ok(match choice {
-        ItemChoice::Inline(item) => (item.name.clone(), item.frame, pose_of(&item.pose)),
+        ItemChoice::Inline(item) => ResolvedItem {
+            name: item.name.clone(),
+            frame: item.frame,
+            pose: pose_of(&item.pose),
+        },
         ItemChoice::Stored(name) => {
             let row = super::cell::get(state, robot_id, kind, name).await?;
-            let pose = pose_of(&row.pose_json.0);
-            (row.name, row.frame, pose)
+            ResolvedItem {
+                pose: pose_of(&row.pose_json.0),
+                name: row.name,
+                frame: row.frame,
+            }
         }
     })
 }
