@@ -4,6 +4,7 @@ screenshot of each step:
 
   create robot -> upload measurements -> calibrate (live progress) -> report
   -> versions (the best is active) -> solve a targets CSV into a CSV answer
+  -> tools and work objects (add, delete) -> filter a URScript program
 
 against a real `robocal serve` with API keys on a temporary database, using
 Debian's Chromium and chromedriver through Selenium.
@@ -194,6 +195,62 @@ def main():
         assert answer[0].startswith("id,status,reason,branch,j1_deg"), answer[0]
         assert len(answer) == 11 and all(",ok," in l for l in answer[1:]), answer
         shot("solved", "solve-section")
+
+        # 7. Tools and work objects: add a tool and a work object, add a
+        # spare tool and delete it again.
+        def save_item(form_id, name, number, xyz, rpy, frame=None):
+            form = driver.find_element(By.ID, form_id)
+            form.find_element(By.NAME, "name").send_keys(name)
+            form.find_element(By.NAME, "number").send_keys(str(number))
+            for k, v in zip(("x", "y", "z", "rx", "ry", "rz"), list(xyz) + list(rpy)):
+                box = form.find_element(By.NAME, k)
+                box.clear()
+                box.send_keys(str(v))
+            if frame:
+                Select(form.find_element(By.NAME, "frame")).select_by_value(frame)
+            form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+            wait.until(replaced(form))
+            wait.until(EC.presence_of_element_located((By.ID, form_id)))
+
+        def names(table_id):
+            return [td.text for td in driver.find_elements(By.CSS_SELECTOR, f"#{table_id} td.name")]
+
+        save_item("add-tool", "torch", 1, (125, 0, 216.5), (0, 30, 0))
+        save_item("add-tool", "spare", 2, (0, 0, 100), (0, 0, 0))
+        save_item("add-frame", "table", 1, (450, -100, 50), (0, 0, 20), "base")
+        assert names("tools") == ["spare", "torch"], names("tools")
+        assert names("work-objects") == ["table"], names("work-objects")
+        shot("cell", "cell")
+        button = driver.find_element(
+            By.XPATH, "//div[@id='tools']//tr[td[@class='name' and text()='spare']]//button")
+        button.click()
+        wait.until(replaced(button))
+        wait.until(EC.presence_of_element_located((By.ID, "add-tool")))
+        assert names("tools") == ["torch"], names("tools")
+
+        # 8. Filter the sample URScript program: the report lists its targets
+        # and the filtered file is offered for download.
+        program = ROOT / "examples/programs/urscript/seam.script"
+        form = driver.find_element(By.ID, "filter")
+        form.find_element(By.NAME, "files").send_keys(str(program))
+        form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+        wait.until(EC.visibility_of_element_located((By.ID, "filter-result")))
+        summary = driver.find_element(By.ID, "filter-summary").text
+        import re
+        m = re.match(r"(\d+) targets filtered, (\d+) failed, (\d+) skipped", summary)
+        assert m and int(m.group(1)) > 0, f"filter: {summary}"
+        rows = driver.find_elements(By.CSS_SELECTOR, "#filter-report tbody tr")
+        assert len(rows) == sum(int(g) for g in m.groups()), (summary, len(rows))
+        links = [a.text for a in driver.find_elements(By.CSS_SELECTOR, "#filter-downloads a.filtered-file")]
+        assert links == ["seam.script"], links
+        filtered = driver.execute_async_script(
+            "const done = arguments[0];"
+            "fetch(document.querySelector('#filter-downloads a').href)"
+            ".then(r => r.text()).then(done);")
+        original = program.read_text()
+        assert filtered != original and len(filtered.splitlines()) == len(original.splitlines()), \
+            "the filtered program should differ in its target values only"
+        shot("filtered", "filter-section")
 
         print(f"console_check: the whole flow passed; screenshots in {out}")
     finally:

@@ -179,6 +179,9 @@ fn cli_args(model: &str, targets: &str) -> SolveArgs {
         seed_deg: None,
         path: false,
         frame: "cell".into(),
+        cell: None,
+        tool: None,
+        work_object: None,
         position_only: false,
         jump_deg: 30.0,
         threads: 0,
@@ -375,4 +378,84 @@ fn cli_takes_several_files_or_a_session_column() {
         files["methods"]["km"]["validation"]["mean_mm"],
         column["methods"]["km"]["validation"]["mean_mm"]
     );
+}
+
+/// `robocal solve --cell --tool --work-object`: the false targets are the
+/// core's `CellSolver`'s for that tool, expressed in the work object.
+#[test]
+fn cli_solves_targets_in_a_work_object_for_a_production_tool() {
+    use robocal::cell::{CellDescription, CellOptions, CellRef, CellSolver};
+    let cm = calibrated("ys100", 14);
+    let dir = std::env::temp_dir().join(format!("robocal-cli-cell-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let model = dir.join("cal.json");
+    save_model_file(
+        &CalibratedModelFile::from_compensated(&cm, "ys100", "skcm"),
+        &model,
+    )
+    .unwrap();
+    let cell_path = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/programs/cell.json");
+    let cell = CellDescription::from_json(&std::fs::read_to_string(cell_path).unwrap())
+        .unwrap()
+        .to_cell()
+        .unwrap();
+    let tool = cell.tool(&CellRef::Name("torch".into())).unwrap();
+    let wobj = cell.work_object(&CellRef::Number(2)).unwrap();
+    let targets = dir.join("wobj-targets.csv");
+    let rows = [
+        [0.0, 0.0, 0.0, 0.0, 0.0, 180.0],
+        [100.0, 150.0, 30.0, 10.0, 5.0, 175.0],
+    ];
+    let mut csv = String::from("id,x,y,z,a,b,c\n");
+    for (i, r) in rows.iter().enumerate() {
+        let _ = writeln!(
+            csv,
+            "t{i},{},{},{},{},{},{}",
+            r[0], r[1], r[2], r[3], r[4], r[5]
+        );
+    }
+    std::fs::write(&targets, csv).unwrap();
+    let mut args = cli_args(model.to_str().unwrap(), targets.to_str().unwrap());
+    args.cell = Some(cell_path.into());
+    args.tool = Some("torch".into());
+    args.work_object = Some("2".into());
+    args.branch = Some("front,up,noflip".into());
+    let v: serde_json::Value = serde_json::from_str(&solve_to_string(&args).unwrap()).unwrap();
+    assert_eq!(v["frame"], "work object table");
+    let solver = CellSolver::new(&cm, &tool.tcp, IkSettings::default());
+    for (i, r) in rows.iter().enumerate() {
+        let target = robocal::model::Pose::new(
+            robocal::model::orientation::rotation_from(OrientationConvention::KukaAbc, &r[3..])
+                .unwrap(),
+            Vector3::new(r[0], r[1], r[2]) * 1e-3,
+        );
+        let options = CellOptions {
+            branch: Some(robocal::ik::Configuration::parse("front,up,noflip").unwrap()),
+            seed: None,
+        };
+        let want = solver.solve(&wobj, &target, &options).false_target.unwrap();
+        let got = &v["targets"][i]["false_target"];
+        assert_eq!(v["targets"][i]["status"], "ok", "{got}");
+        let xyz = Vector3::new(
+            got["x"].as_f64().unwrap(),
+            got["y"].as_f64().unwrap(),
+            got["z"].as_f64().unwrap(),
+        );
+        assert!(
+            (xyz - want.p * 1e3).norm() < 1e-6,
+            "{xyz} vs {}",
+            want.p * 1e3
+        );
+        let abc = [
+            got["a"].as_f64().unwrap(),
+            got["b"].as_f64().unwrap(),
+            got["c"].as_f64().unwrap(),
+        ];
+        let r_got =
+            robocal::model::orientation::rotation_from(OrientationConvention::KukaAbc, &abc)
+                .unwrap();
+        assert!((r_got - want.r).norm() < 1e-9);
+        // The calibration moves the target.
+        assert!((want.p * 1e3 - Vector3::new(r[0], r[1], r[2])).norm() > 0.01);
+    }
 }

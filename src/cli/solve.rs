@@ -15,8 +15,13 @@
 //! (`FK_nominal(q_cmd)`, controller base frame, mm, same orientation convention
 //! as the input), as a table (`--format table`, the default), CSV
 //! (`--format csv`, the columns of `ik::targets_csv::results_csv`) or JSON.
+//!
+//! With `--cell FILE --tool NAME` the production tool of the cell file is on
+//! the calibrated flange; with `--work-object NAME` the targets and the false
+//! targets are poses in that work object (`core::cell`).
 
 use super::model_files::load_compensated;
+use crate::cell::{false_target_in, target_in_base, with_tool, Cell, CellDescription, CellRef};
 use crate::csv_text::dialect_from_names;
 use crate::ik::targets_csv::CONVENTION_COLUMNS;
 use crate::ik::{
@@ -59,6 +64,17 @@ pub struct SolveArgs {
     /// Frame of the targets: cell (measurement frame of the calibration) or base.
     #[arg(long, default_value = "cell")]
     pub frame: String,
+    /// Cell file (tools and work objects, mm and degrees, e.g.
+    /// examples/programs/cell.json) that --tool and --work-object name from.
+    #[arg(long)]
+    pub cell: Option<String>,
+    /// Production tool on the calibrated flange: a name or number of the cell file.
+    #[arg(long, requires = "cell")]
+    pub tool: Option<String>,
+    /// Work object (name or number of the cell file) the targets and false
+    /// targets are in; --frame does not apply then.
+    #[arg(long, requires = "cell")]
+    pub work_object: Option<String>,
     /// Solve the position only (the orientation, if given, guides the seed).
     #[arg(long)]
     pub position_only: bool,
@@ -118,7 +134,31 @@ pub fn solve_to_string(a: &SolveArgs) -> anyhow::Result<String> {
         }
         model.payload_kg = p;
     }
-    let frame: TargetFrame = a.frame.parse().map_err(anyhow::Error::msg)?;
+    let mut frame: TargetFrame = a.frame.parse().map_err(anyhow::Error::msg)?;
+    let mut frame_label = frame.to_string();
+    let cell = match &a.cell {
+        None => Cell::default(),
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .with_context(|| format!("cannot read cell file {path}"))?;
+            CellDescription::from_json(&text)
+                .and_then(|d| d.to_cell())
+                .with_context(|| path.clone())?
+        }
+    };
+    if let Some(t) = &a.tool {
+        let tool = cell.tool(&t.parse::<CellRef>()?)?;
+        model = with_tool(&model, &tool.tcp);
+    }
+    let work_object = match &a.work_object {
+        None => None,
+        Some(w) => {
+            let wobj = cell.work_object(&w.parse::<CellRef>()?)?;
+            frame = TargetFrame::Base;
+            frame_label = format!("work object {}", wobj.name);
+            Some(wobj.in_base(&model))
+        }
+    };
     let branch = a
         .branch
         .as_deref()
@@ -146,7 +186,14 @@ pub fn solve_to_string(a: &SolveArgs) -> anyhow::Result<String> {
         .with_context(|| format!("cannot read targets file {}", a.targets))?;
     let dialect = dialect_from_names(a.delimiter.as_deref(), a.decimal.as_deref())
         .map_err(anyhow::Error::msg)?;
-    let csv = parse_targets_csv(&text, dialect).with_context(|| a.targets.clone())?;
+    let mut csv = parse_targets_csv(&text, dialect).with_context(|| a.targets.clone())?;
+    if let Some(w) = &work_object {
+        for row in csv.rows.iter_mut() {
+            if let Ok(t) = &mut row.target {
+                *t = target_in_base(w, t);
+            }
+        }
+    }
     if csv.convention.is_none() && !a.position_only {
         bail!(
             "{}: no orientation columns ({CONVENTION_COLUMNS}); add them or pass --position-only",
@@ -167,11 +214,18 @@ pub fn solve_to_string(a: &SolveArgs) -> anyhow::Result<String> {
         seed,
         false_target_convention: csv.convention,
     };
-    let results: Vec<TargetResult> = csv.solve(&solver, &options, a.path);
+    let mut results: Vec<TargetResult> = csv.solve(&solver, &options, a.path);
+    if let Some(w) = &work_object {
+        for r in results.iter_mut() {
+            if let Some(f) = &r.false_target {
+                r.false_target = Some(false_target_in(w, f));
+            }
+        }
+    }
     let conv = csv.convention.unwrap_or(OrientationConvention::Quaternion);
     let header = Header {
         model: &a.model,
-        frame,
+        frame: frame_label,
         convention: conv,
         payload_kg: payload,
         path: a.path,
@@ -188,7 +242,8 @@ pub fn solve_to_string(a: &SolveArgs) -> anyhow::Result<String> {
 
 struct Header<'a> {
     model: &'a str,
-    frame: TargetFrame,
+    /// `cell`, `base` or `work object NAME`.
+    frame: String,
     convention: OrientationConvention,
     payload_kg: f64,
     path: bool,
@@ -233,7 +288,7 @@ fn render_json(h: &Header, results: &[TargetResult]) -> String {
         .collect();
     let doc = json!({
         "model": h.model,
-        "frame": h.frame.to_string(),
+        "frame": h.frame,
         "convention": h.convention.name(),
         "columns": cols,
         "payload_kg": h.payload_kg,

@@ -1,7 +1,7 @@
 //! The store (sqlx): SQLite (the embedded default) or PostgreSQL (shared by
 //! several replicas), connection set-up, migrations, and the queries of the
 //! service, one file per resource (`robots`, `sets`, `calibrations`,
-//! `versions`). No SQL is written outside this module, and no `sqlx` error
+//! `versions`, `cell`). No SQL is written outside this module, and no `sqlx` error
 //! leaves it: callers get a [`StoreError`].
 //!
 //! - `DATABASE_URL` picks the backend: `postgres://…`/`postgresql://…` is
@@ -80,6 +80,7 @@ impl From<sqlx::migrate::MigrateError> for StoreError {
 }
 
 mod calibrations;
+mod cell;
 mod queue;
 mod robots;
 mod sets;
@@ -87,6 +88,7 @@ mod types;
 mod versions;
 
 pub use calibrations::{CalibrationRow, JobResult, JobStatus, JobSummary, NewCalibration};
+pub use cell::{name_key as cell_name_key, CellItemRow, CellKind, CellPut, ItemFrame, NewCellItem};
 pub use queue::{ClaimedJob, Lease, RobotChange, RobotChanges};
 pub use robots::{NewRobot, RobotRow};
 pub use sets::{AngleUnit, LengthUnit, NewSet, SetFormat, SetRow, StoredRole};

@@ -46,6 +46,9 @@ pub enum ApiError {
     /// 422: well-formed but invalid content (unknown preset, bad CSV line, ...).
     #[error("{0}")]
     Unprocessable(String),
+    /// 422 with `file`, `line` and `column`: a robot program that cannot be parsed.
+    #[error("{0}")]
+    Unparsable(crate::program::ParseError),
     /// 431: the request head is too large (answered for the HTTP parser).
     #[error("{0}")]
     HeadersTooLarge(String),
@@ -69,6 +72,19 @@ pub struct Problem {
     pub title: String,
     pub status: u16,
     pub detail: String,
+    /// Where a program cannot be parsed (422 `unparsable-program` only).
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    pub location: Option<ProgramLocation>,
+}
+
+/// The place in a program's files that cannot be parsed.
+#[derive(Debug, Serialize)]
+pub struct ProgramLocation {
+    pub file: String,
+    /// 1-based.
+    pub line: usize,
+    /// 1-based, in characters.
+    pub column: usize,
 }
 
 impl ApiError {
@@ -82,7 +98,9 @@ impl ApiError {
             ApiError::PayloadTooLarge(_) => StatusCode::PAYLOAD_TOO_LARGE,
             ApiError::UnsupportedMediaType(_) => StatusCode::UNSUPPORTED_MEDIA_TYPE,
             ApiError::UriTooLong(_) => StatusCode::URI_TOO_LONG,
-            ApiError::Unprocessable(_) => StatusCode::UNPROCESSABLE_ENTITY,
+            ApiError::Unprocessable(_) | ApiError::Unparsable(_) => {
+                StatusCode::UNPROCESSABLE_ENTITY
+            }
             ApiError::HeadersTooLarge(_) => StatusCode::REQUEST_HEADER_FIELDS_TOO_LARGE,
             ApiError::Unavailable(_) => StatusCode::SERVICE_UNAVAILABLE,
             ApiError::Busy { .. } => StatusCode::TOO_MANY_REQUESTS,
@@ -102,6 +120,7 @@ impl ApiError {
             ApiError::UnsupportedMediaType(_) => "unsupported-media-type",
             ApiError::UriTooLong(_) => "uri-too-long",
             ApiError::Unprocessable(_) => "invalid-input",
+            ApiError::Unparsable(_) => "unparsable-program",
             ApiError::HeadersTooLarge(_) => "headers-too-large",
             ApiError::Unavailable(_) => "unavailable",
             ApiError::Busy { .. } => "busy",
@@ -122,6 +141,14 @@ impl ApiError {
             title: status.canonical_reason().unwrap_or("Error").to_string(),
             status: status.as_u16(),
             detail,
+            location: match self {
+                ApiError::Unparsable(e) => Some(ProgramLocation {
+                    file: e.file.clone(),
+                    line: e.line,
+                    column: e.column,
+                }),
+                _ => None,
+            },
         }
     }
 
@@ -182,6 +209,7 @@ impl From<crate::service::ServiceError> for ApiError {
                     e @ E::Internal(_) => ApiError::Internal(e.to_string()),
                 }
             }
+            S::Unparsable(e) => ApiError::Unparsable(e),
             S::Internal(m) => ApiError::Internal(m),
         }
     }

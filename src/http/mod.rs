@@ -25,12 +25,14 @@ use tower_http::trace::{DefaultMakeSpan, DefaultOnFailure, DefaultOnResponse, Tr
 use tracing::Level;
 
 pub mod calibrations;
+pub mod cell;
 pub mod client;
 pub mod console;
 pub mod error;
 pub mod input;
 
 pub mod listener;
+pub mod programs;
 pub mod robots;
 pub mod sets;
 pub mod solve;
@@ -130,6 +132,8 @@ fn routes() -> Vec<Route> {
     all.extend(calibrations::routes());
     all.extend(versions::routes());
     all.extend(solve::routes());
+    all.extend(cell::routes());
+    all.extend(programs::routes());
     all
 }
 

@@ -21,13 +21,14 @@ use super::error::{content_type, json_content_type};
 use super::input::{check_payload, from_json_object, object_or_null, objects, present, Int};
 use super::{ApiError, ApiPath, ApiQuery, AppState};
 use crate::csv_text::{dialect_from_names, Dialect};
+use crate::db::CellKind;
 use crate::ik::{
     parse_targets_csv, results_csv, Configuration, JointJump, SolveOptions, TargetFrame,
     TargetInput, TargetResult,
 };
 use crate::model::orientation::OrientationConvention;
 use crate::service;
-use crate::service::solve::{ModelChoice, SolveCommand, SolveOutcome, Targets};
+use crate::service::solve::{ItemChoice, ModelChoice, SolveCommand, SolveOutcome, Targets};
 use axum::body::Bytes;
 use axum::extract::rejection::BytesRejection;
 use axum::extract::State;
@@ -136,6 +137,35 @@ pub struct SolveRequest {
     pub version: Option<VersionSelector>,
     #[serde(default, deserialize_with = "present")]
     pub jump_deg: Option<f64>,
+    /// A stored tool by name, or one inline (TCP in the flange frame).
+    #[serde(default, deserialize_with = "present")]
+    pub tool: Option<ItemRef>,
+    /// A stored work object by name, or one inline: the targets and false
+    /// targets are in it.
+    #[serde(default, deserialize_with = "present")]
+    pub work_object: Option<ItemRef>,
+}
+
+/// A tool or work object of a solve: a stored one's name, or one inline.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+pub enum ItemRef {
+    Name(String),
+    Inline(super::cell::ItemIn),
+}
+
+impl ItemRef {
+    fn choice(&self, kind: CellKind) -> Result<ItemChoice, ApiError> {
+        Ok(match self {
+            ItemRef::Name(n) => {
+                super::cell::check_item_name(n)?;
+                ItemChoice::Stored(n.clone())
+            }
+            ItemRef::Inline(item) => {
+                ItemChoice::Inline(super::cell::checked(kind, item, None, "inline")?)
+            }
+        })
+    }
 }
 
 #[derive(Debug, Serialize)]
@@ -278,6 +308,21 @@ struct Common<'a> {
     path: bool,
 }
 
+/// The model a `version` field names (absent: the active version).
+pub(crate) fn model_choice(v: Option<&VersionSelector>) -> Result<ModelChoice, ApiError> {
+    Ok(match v {
+        None => ModelChoice::Active,
+        Some(VersionSelector::Name(n)) if n == "active" => ModelChoice::Active,
+        Some(VersionSelector::Name(n)) if n == "nominal" => ModelChoice::Nominal,
+        Some(VersionSelector::Name(n)) => {
+            return Err(ApiError::invalid(format!(
+                "`version` must be a version number, \"active\" or \"nominal\", got \"{n}\""
+            )))
+        }
+        Some(VersionSelector::Number(Int(v))) => ModelChoice::Version(*v),
+    })
+}
+
 /// Every check that does not need the robot (422 naming the field), as a
 /// service command with no targets yet.
 fn command(robot_id: i64, c: Common) -> Result<SolveCommand, ApiError> {
@@ -313,17 +358,7 @@ fn command(robot_id: i64, c: Common) -> Result<SolveCommand, ApiError> {
         .convention
         .map(|name| convention(name, "`convention`"))
         .transpose()?;
-    let model = match c.version {
-        None => ModelChoice::Active,
-        Some(VersionSelector::Name(n)) if n == "active" => ModelChoice::Active,
-        Some(VersionSelector::Name(n)) if n == "nominal" => ModelChoice::Nominal,
-        Some(VersionSelector::Name(n)) => {
-            return Err(ApiError::invalid(format!(
-                "`version` must be a version number, \"active\" or \"nominal\", got \"{n}\""
-            )))
-        }
-        Some(VersionSelector::Number(Int(v))) => ModelChoice::Version(*v),
-    };
+    let model = model_choice(c.version)?;
     Ok(SolveCommand {
         robot_id,
         model,
@@ -339,6 +374,8 @@ fn command(robot_id: i64, c: Common) -> Result<SolveCommand, ApiError> {
         },
         path: c.path,
         targets: Targets::Inputs(Vec::new()),
+        tool: None,
+        work_object: None,
     })
 }
 
@@ -376,6 +413,17 @@ pub fn json_command(
             path: req.path.or(query.path).unwrap_or(false),
         },
     )?;
+    cmd.tool = req
+        .tool
+        .as_ref()
+        .map(|t| t.choice(CellKind::Tool))
+        .transpose()?;
+    // With a work object the targets are in it: `frame` does not apply.
+    cmd.work_object = req
+        .work_object
+        .as_ref()
+        .map(|w| w.choice(CellKind::WorkObject))
+        .transpose()?;
     let mut req = req.clone();
     req.convention = req
         .convention
@@ -600,6 +648,11 @@ pub async fn solve(
     }
     let cmd = solve_command(robot_id, &query, request_is_csv, &body?)?;
     let (frame, position_only, path) = (cmd.options.frame, cmd.options.position_only, cmd.path);
+    let frame = if cmd.work_object.is_some() {
+        "work_object".to_string()
+    } else {
+        frame.to_string()
+    };
     let out_conv = cmd
         .options
         .false_target_convention
@@ -614,7 +667,7 @@ pub async fn solve(
         robot_id,
         version: done.version,
         method: done.method,
-        frame: frame.to_string(),
+        frame,
         payload_kg: done.payload_kg,
         path,
         position_only,

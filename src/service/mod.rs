@@ -11,8 +11,10 @@
 //! and a handler file (`http/<resource>.rs` with its `routes()`).
 
 pub mod calibrations;
+pub mod cell;
 mod changes;
 pub mod limits;
+pub mod programs;
 pub mod queue;
 pub mod robots;
 pub mod sets;
@@ -45,6 +47,9 @@ pub enum ServiceError {
     /// The store failed (unavailable, a conflicting concurrent write, a bug).
     #[error("{0}")]
     Store(#[from] StoreError),
+    /// A robot program that cannot be parsed: file, line and column.
+    #[error("{0}")]
+    Unparsable(#[from] crate::program::ParseError),
     /// A bug or corrupt stored data; logged, never shown to the client.
     #[error("{0}")]
     Internal(String),

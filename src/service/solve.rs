@@ -8,14 +8,24 @@
 //! versions never change once written. A custom jump threshold gets a fresh
 //! solver that is not cached.
 //!
+//! A solve may name a production tool (on the calibrated flange, `with_tool`;
+//! not cached) and a work object `W`: targets `T` are then solved as `W·T` in
+//! the base frame and false targets returned in `W` (`core::cell`).
+//!
 //! Units at this boundary: targets in mm and degrees (`TargetInput`), joint
 //! seeds and commands in the controller convention in degrees.
 
 use super::limits::SMALL_SOLVE_MAX;
 use super::{AppState, ServiceError};
+use crate::cell::file::PoseMmDeg;
+use crate::cell::{false_target_in, target_in_base, with_tool, WorkObject, WorkObjectFrame};
 use crate::compensate::{CalibratedModelFile, CompensatedModel};
+use crate::db::{CellKind, ItemFrame, NewCellItem};
+use crate::ik::TargetFrame;
 use crate::ik::{IkSettings, IkSolver, SolveOptions, TargetInput, TargetResult, TargetsCsv};
-use crate::model::RobotModel;
+use crate::model::pose::rpy_matrix;
+use crate::model::{Pose, RobotModel};
+use nalgebra::Vector3;
 use std::sync::Arc;
 
 /// Which model to solve with.
@@ -78,6 +88,17 @@ pub struct SolveCommand {
     pub options: SolveOptions,
     pub path: bool,
     pub targets: Targets,
+    /// Production tool on the calibrated flange (`None`: the model's tool).
+    pub tool: Option<ItemChoice>,
+    /// Work object the targets and false targets are in (`None`: `options.frame`).
+    pub work_object: Option<ItemChoice>,
+}
+
+/// A tool or work object of a solve: stored by name, or given inline.
+#[derive(Debug, Clone)]
+pub enum ItemChoice {
+    Stored(String),
+    Inline(NewCellItem),
 }
 
 /// What a solve produced.
@@ -123,6 +144,59 @@ async fn choose_version(
     }
 }
 
+/// The compensated model of a chosen version (`None`: the nominal model).
+async fn load_model(
+    state: &AppState,
+    robot_id: i64,
+    nominal_json: &str,
+    chosen: &Option<(i64, i64, String)>,
+) -> Result<CompensatedModel, ServiceError> {
+    Ok(match chosen {
+        Some((vid, v, _)) => {
+            let text = state.db().version_model(*vid).await?.ok_or_else(|| {
+                ServiceError::NotFound(format!("robot {robot_id} has no model version {v}"))
+            })?;
+            CalibratedModelFile::from_json(&text)
+                .and_then(|f| f.to_compensated())
+                .map_err(|e| ServiceError::Internal(format!("stored model version {v}: {e}")))?
+        }
+        None => {
+            let m = RobotModel::from_json(nominal_json).map_err(|e| {
+                ServiceError::Internal(format!("stored model of robot {robot_id}: {e}"))
+            })?;
+            CompensatedModel::from_nominal(m)
+        }
+    })
+}
+
+/// A model for work other than a solve batch (program filtering): the chosen
+/// version's compensated model, its number (`None`: nominal) and its method.
+pub struct ChosenModel {
+    pub model: CompensatedModel,
+    pub version: Option<i64>,
+    pub method: String,
+}
+
+/// The compensated model `choice` names for robot `robot_id`.
+pub async fn chosen_model(
+    state: &AppState,
+    robot_id: i64,
+    choice: ModelChoice,
+) -> Result<ChosenModel, ServiceError> {
+    let ctx = state.robot_context(robot_id).await?;
+    let chosen = choose_version(state, robot_id, choice, ctx.active.clone()).await?;
+    let model = load_model(state, robot_id, &ctx.model_json, &chosen).await?;
+    let (version, method) = match chosen {
+        Some((_, v, m)) => (Some(v), m),
+        None => (None, "nominal".to_string()),
+    };
+    Ok(ChosenModel {
+        model,
+        version,
+        method,
+    })
+}
+
 /// The prepared solver of a command, from the cache when it can be.
 async fn prepare(
     state: &AppState,
@@ -146,22 +220,7 @@ async fn prepare(
             return Ok((solver, version, method));
         }
     }
-    let mut model = match &chosen {
-        Some((vid, v, _)) => {
-            let text = state.db().version_model(*vid).await?.ok_or_else(|| {
-                ServiceError::NotFound(format!("robot {robot_id} has no model version {v}"))
-            })?;
-            CalibratedModelFile::from_json(&text)
-                .and_then(|f| f.to_compensated())
-                .map_err(|e| ServiceError::Internal(format!("stored model version {v}: {e}")))?
-        }
-        None => {
-            let m = RobotModel::from_json(&ctx.model_json).map_err(|e| {
-                ServiceError::Internal(format!("stored model of robot {robot_id}: {e}"))
-            })?;
-            CompensatedModel::from_nominal(m)
-        }
-    };
+    let mut model = load_model(state, robot_id, &ctx.model_json, &chosen).await?;
     if let Some(p) = cmd.payload_kg {
         model.payload_kg = p;
     }
@@ -209,7 +268,41 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
             cmd.targets.len()
         )));
     }
-    let (solver, version, method) = prepare(state, &cmd).await?;
+    let (mut solver, version, method) = prepare(state, &cmd).await?;
+    let work_object = match &cmd.work_object {
+        None => None,
+        Some(choice) => {
+            let item = resolve(state, cmd.robot_id, CellKind::WorkObject, choice).await?;
+            let wobj = WorkObject {
+                name: item.name,
+                number: None,
+                frame: match item.frame {
+                    ItemFrame::Measurement => WorkObjectFrame::Measurement,
+                    ItemFrame::Base | ItemFrame::Flange => WorkObjectFrame::Base,
+                },
+                pose: item.pose,
+            };
+            Some(wobj.in_base(solver.model()))
+        }
+    };
+    if let Some(choice) = &cmd.tool {
+        let tcp = resolve(state, cmd.robot_id, CellKind::Tool, choice)
+            .await?
+            .pose;
+        let settings = solver.settings().clone();
+        solver = Arc::new(IkSolver::new(with_tool(solver.model(), &tcp), settings));
+    }
+    if let Some(w) = &work_object {
+        let Targets::Inputs(inputs) = &mut cmd.targets else {
+            return Err(ServiceError::Invalid(
+                "a work object needs JSON targets (the targets CSV has no work object)".into(),
+            ));
+        };
+        for t in inputs.iter_mut() {
+            *t = target_in_base(w, t);
+        }
+        cmd.options.frame = TargetFrame::Base;
+    }
     if let Some(s) = &cmd.seed_deg {
         cmd.options.seed = Some(seed_joints(s, &solver)?);
     }
@@ -232,11 +325,58 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
         .await
         .map_err(|e| ServiceError::Internal(format!("solver task: {e}")))?
     };
+    let mut results = results;
+    if let Some(w) = &work_object {
+        for r in results.iter_mut() {
+            if let Some(f) = &r.false_target {
+                r.false_target = Some(false_target_in(w, f));
+            }
+        }
+    }
     Ok(SolveOutcome {
         version,
         method,
         payload_kg,
         dof,
         results,
+    })
+}
+
+/// SI pose of boundary `xyz_mm` and `rpy_deg` (`Rz·Ry·Rx`), as the cell file
+/// reads it (its own conversion is private to `core::cell::file`).
+pub fn pose_of(p: &PoseMmDeg) -> Pose {
+    let [rx, ry, rz] = p.rpy_deg.map(f64::to_radians);
+    Pose::new(rpy_matrix(rx, ry, rz), Vector3::from(p.xyz_mm) * 1e-3)
+}
+
+/// A tool or work object of a solve, resolved.
+struct ResolvedItem {
+    name: String,
+    frame: ItemFrame,
+    /// SI pose in `frame`.
+    pose: Pose,
+}
+
+/// A stored or inline tool or work object (`NotFound` for an unknown name).
+async fn resolve(
+    state: &AppState,
+    robot_id: i64,
+    kind: CellKind,
+    choice: &ItemChoice,
+) -> Result<ResolvedItem, ServiceError> {
+    Ok(match choice {
+        ItemChoice::Inline(item) => ResolvedItem {
+            name: item.name.clone(),
+            frame: item.frame,
+            pose: pose_of(&item.pose),
+        },
+        ItemChoice::Stored(name) => {
+            let row = super::cell::get(state, robot_id, kind, name).await?;
+            ResolvedItem {
+                pose: pose_of(&row.pose_json.0),
+                name: row.name,
+                frame: row.frame,
+            }
+        }
     })
 }

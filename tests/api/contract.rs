@@ -35,7 +35,8 @@ async fn every_route_is_in_the_spec_and_the_spec_has_no_other() {
             .replace("{id}", "999")
             .replace("{sid}", "998")
             .replace("{cid}", "997")
-            .replace("{version}", "996");
+            .replace("{version}", "996")
+            .replace("{name}", "torch");
         let r = t
             .raw(
                 method.as_str(),

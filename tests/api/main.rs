@@ -8,9 +8,11 @@
 //! the documented schema (JSON Schema 2020-12, via `jsonschema`).
 //!
 //! One file per theme: `contract` (routes, spec, bad input, keys, paging),
-//! `flow` (the quickstart end to end), `sets` (uploads), `solve` (targets CSV in and out), `jobs` (progress,
-//! cancellation, saturation, races); the harness is `support`.
+//! `flow` (the quickstart end to end), `sets` (uploads), `solve` (targets CSV
+//! in and out), `cell` (tools, work objects, program filtering), `jobs`
+//! (progress, cancellation, saturation, races); the harness is `support`.
 
+mod cell;
 #[path = "../common/mod.rs"]
 mod common;
 mod contract;

@@ -283,5 +283,45 @@ impl CellSolver {
     }
 }
 
+/// A boundary target given in work object `w` (its pose in the base frame)
+/// as a base-frame target, `W·T`, in the same convention; an invalid target
+/// is returned as it is (it fails alone).
+pub fn target_in_base(w: &Pose, t: &crate::ik::TargetInput) -> crate::ik::TargetInput {
+    let mut out = t.clone();
+    if let Ok((goal, conv)) = t.to_goal() {
+        let p = w.r * goal.position + w.p;
+        out.xyz_mm = [p.x * 1e3, p.y * 1e3, p.z * 1e3];
+        if let (Some(r), Some(conv)) = (goal.rotation, conv) {
+            out.orientation = crate::model::orientation::rotation_to(conv, &(w.r * r));
+        }
+    }
+    out
+}
+
+/// A base-frame false target expressed in work object `w`: `W⁻¹·F`.
+pub fn false_target_in(w: &Pose, f: &crate::ik::FalseTarget) -> crate::ik::FalseTarget {
+    use crate::model::orientation::{rotation_from, rotation_to};
+    let mut out = f.clone();
+    if let Ok(r) = rotation_from(f.convention, &f.orientation) {
+        let p = w
+            .inverse()
+            .compose(&Pose::new(r, nalgebra::Vector3::from(f.xyz_mm) * 1e-3));
+        out.xyz_mm = [p.p.x * 1e3, p.p.y * 1e3, p.p.z * 1e3];
+        out.orientation = rotation_to(f.convention, &p.r);
+    }
+    out
+}
+
+impl std::str::FromStr for CellRef {
+    type Err = std::convert::Infallible;
+    /// A number when the text is one, else a name.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Ok(match s.trim().parse::<u32>() {
+            Ok(n) => CellRef::Number(n),
+            Err(_) => CellRef::Name(s.trim().to_string()),
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests;

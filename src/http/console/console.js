@@ -151,3 +151,80 @@ document.addEventListener("DOMContentLoaded", () => {
     }, 1000);
   }
 });
+
+// Tools and work objects: save one (PUT by name), delete one.
+handlers["put-item"] = async function (form) {
+  const num = (k) => Number(formValue(form, k) || "0");
+  const body = {
+    xyz_mm: [num("x"), num("y"), num("z")],
+    rpy_deg: [num("rx"), num("ry"), num("rz")],
+  };
+  const n = formValue(form, "number");
+  if (n) body.number = Number(n);
+  const frame = formValue(form, "frame");
+  if (frame) body.frame = frame;
+  const url = form.dataset.url + encodeURIComponent(formValue(form, "name"));
+  await api("PUT", url, JSON.stringify(body), "application/json");
+  location.reload();
+};
+
+document.addEventListener("click", async (ev) => {
+  const b = ev.target.closest("button[data-delete]");
+  if (!b) return;
+  ev.preventDefault();
+  b.disabled = true;
+  try {
+    await api("DELETE", b.dataset.delete);
+    location.reload();
+  } catch (e) {
+    show(e.message, false);
+    b.disabled = false;
+  }
+});
+
+// Program filtering: the files in, the report as a table, each filtered file
+// as a download link.
+handlers.filter = async function (form) {
+  const robot = form.dataset.robot;
+  const input = form.elements["files"];
+  if (!input.files.length) throw new Error("choose the program's files");
+  const files = [];
+  for (const f of input.files) files.push({ name: f.name, content: await f.text() });
+  const body = { files };
+  const version = formValue(form, "version");
+  if (version) body.version = /^[0-9]+$/.test(version) ? Number(version) : version;
+  // The language as chosen, else from the first file's extension.
+  const byExtension = { src: "krl", dat: "krl", mod: "rapid", modx: "rapid", prg: "rapid", sys: "rapid", ls: "fanuc", script: "urscript", urscript: "urscript" };
+  const ext = files[0].name.split(".").pop().toLowerCase();
+  body.language = formValue(form, "language") || byExtension[ext];
+  if (!body.language) throw new Error("choose the program's language");
+  const r = (await api("POST", `/v1/robots/${robot}/programs/filter`, JSON.stringify(body), "application/json")).json();
+  const rep = r.report;
+  const summary = `${rep.filtered} targets filtered, ${rep.failed} failed, ${rep.skipped} skipped (model: ${r.version === null ? "nominal" : "v" + r.version} ${r.method})`;
+  document.getElementById("filter-summary").textContent = summary;
+  const links = document.getElementById("filter-downloads");
+  links.textContent = "Download: ";
+  for (const f of r.files) {
+    const a = document.createElement("a");
+    a.href = URL.createObjectURL(new Blob([f.content], { type: "text/plain" }));
+    a.download = f.name;
+    a.className = "filtered-file";
+    a.textContent = f.name;
+    links.append(a, " ");
+  }
+  const tbody = document.querySelector("#filter-report tbody");
+  tbody.textContent = "";
+  for (const t of rep.targets) {
+    const tr = document.createElement("tr");
+    tr.className = "target " + t.status;
+    const cells = [t.file, t.line, t.name, t.status, t.shift_mm === undefined ? "" : t.shift_mm.toFixed(3), t.configuration || "", t.reason || ""];
+    for (const c of cells) {
+      const td = document.createElement("td");
+      td.textContent = String(c);
+      tr.append(td);
+    }
+    tbody.append(tr);
+  }
+  document.getElementById("filter-result").hidden = false;
+  show(summary, true);
+};

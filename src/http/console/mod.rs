@@ -1,7 +1,8 @@
 //! The web console: server-rendered pages (maud, escaping by default) for the
 //! whole flow — robots, measurement uploads, calibration jobs with live
-//! progress, reports, model versions with activate and rollback, and solving a
-//! targets CSV. The pages read through the service layer; every write is made by the
+//! progress, reports, model versions with activate and rollback, solving a
+//! targets CSV, tools and work objects, and filtering robot programs. The
+//! pages read through the service layer; every write is made by the
 //! page's own script through the REST API (`/v1`), so the console obeys the
 //! same API keys, limits and validation as any client. No external assets:
 //! the style sheet and the script are inlined.
@@ -9,9 +10,11 @@
 //! Routes: `GET /ui` (robots), `GET /ui/robots/{id}` (one robot). They are
 //! HTML, not part of the JSON API, so `openapi.yaml` does not list them.
 
+mod cell_pages;
 mod pages;
 
 use super::{route, ApiError, ApiPath, AppState, Route};
+use crate::db::CellKind;
 use crate::service;
 use axum::extract::State;
 use axum::http::Method;
@@ -43,6 +46,8 @@ async fn robot_page(
         sets: service::sets::list(&state, id).await?,
         calibrations: service::calibrations::list(&state, id).await?,
         versions: service::versions::list(&state, id).await?,
+        tools: service::cell::list(&state, id, CellKind::Tool).await?,
+        work_objects: service::cell::list(&state, id, CellKind::WorkObject).await?,
         keys: !state.config().api_keys.is_empty(),
         robot,
     };

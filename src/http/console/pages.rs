@@ -1,7 +1,7 @@
 //! The console's pages as maud templates (every interpolated value is
 //! HTML-escaped by maud).
 
-use crate::db::{CalibrationRow, JobStatus, RobotRow, SetRow, VersionRow};
+use crate::db::{CalibrationRow, CellItemRow, JobStatus, RobotRow, SetRow, VersionRow};
 use crate::http::calibrations::DEFAULT_METHODS;
 use crate::identify::Method;
 use crate::measure::SetRole;
@@ -18,6 +18,8 @@ pub struct RobotView {
     pub sets: Vec<SetRow>,
     pub calibrations: Vec<CalibrationRow>,
     pub versions: Vec<VersionRow>,
+    pub tools: Vec<CellItemRow>,
+    pub work_objects: Vec<CellItemRow>,
     pub keys: bool,
 }
 
@@ -297,6 +299,9 @@ pub fn robot(v: &RobotView) -> Markup {
                     pre #solve-csv {}
                 }
             }
+
+            (super::cell_pages::cell_section(id, &v.tools, &v.work_objects))
+            (super::cell_pages::filter_section(id, &v.versions))
 
         },
     )

@@ -1,0 +1,145 @@
+//! `POST /v1/robots/{id}/programs/filter`: robot program files in (KRL,
+//! RAPID, Fanuc `.ls`, URScript), the filtered files and the per-target report
+//! out, as `robocal filter` writes them. Every Cartesian target becomes its
+//! false target on the active model version (or a named one); the program's
+//! tool and base numbers and names refer to the robot's stored tools and work
+//! objects (`/tools`, `/frames`) and to what the program declares itself. A
+//! program that cannot be parsed is a 422 naming its file, line and column.
+
+use super::input::{objects, present};
+use super::solve::{model_choice, VersionSelector};
+use super::{ApiError, ApiJson, ApiPath, AppState};
+use crate::program::{FilterReport, Language, ProgramFile};
+use crate::service;
+use crate::service::programs::FilterCommand;
+use axum::extract::State;
+use axum::response::{IntoResponse, Response};
+use serde::{Deserialize, Serialize};
+
+/// Most files in one program.
+pub const PROGRAM_FILES_MAX: usize = 32;
+/// Longest file name.
+pub const FILE_NAME_MAX: usize = 255;
+
+/// One file of a program.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct FileIn {
+    pub name: String,
+    pub content: String,
+}
+
+/// `POST /v1/robots/{id}/programs/filter` body.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FilterRequest {
+    #[serde(deserialize_with = "objects")]
+    pub files: Vec<FileIn>,
+    /// krl, rapid, fanuc or urscript.
+    pub language: String,
+    #[serde(default, deserialize_with = "present")]
+    pub version: Option<VersionSelector>,
+    #[serde(default, deserialize_with = "present")]
+    pub payload_kg: Option<f64>,
+}
+
+/// The answer: the filtered files (same names and order) and the report.
+#[derive(Debug, Serialize)]
+pub struct FilterResponse {
+    pub robot_id: i64,
+    /// Model version used (null: the nominal model).
+    pub version: Option<i64>,
+    pub method: String,
+    pub files: Vec<FileIn>,
+    pub report: FilterReport,
+}
+
+/// A file name: 1 to 255 characters, no path separators, no NUL.
+fn check_file_name(name: &str) -> Result<(), ApiError> {
+    if name.is_empty()
+        || name.chars().count() > FILE_NAME_MAX
+        || name.contains(['/', '\\', '\0'])
+        || name.chars().all(|c| matches!(c, ' ' | '\t' | '\r' | '\n'))
+    {
+        return Err(ApiError::invalid(format!(
+            "file name `{name}`: 1 to {FILE_NAME_MAX} characters, not blank, without `/`, `\\` or NUL"
+        )));
+    }
+    Ok(())
+}
+
+/// The request as a service command (422 naming what is wrong).
+fn command(robot_id: i64, req: FilterRequest) -> Result<FilterCommand, ApiError> {
+    if req.files.is_empty() || req.files.len() > PROGRAM_FILES_MAX {
+        return Err(ApiError::invalid(format!(
+            "`files`: 1 to {PROGRAM_FILES_MAX} program files, got {}",
+            req.files.len()
+        )));
+    }
+    for (i, f) in req.files.iter().enumerate() {
+        check_file_name(&f.name)?;
+        if req.files[..i].iter().any(|g| g.name == f.name) {
+            return Err(ApiError::invalid(format!(
+                "file name `{}` appears twice",
+                f.name
+            )));
+        }
+    }
+    if let Some(p) = req.payload_kg {
+        super::input::check_payload("`payload_kg`", p)?;
+    }
+    let language = match req.language.as_str() {
+        l @ ("krl" | "rapid" | "fanuc" | "urscript") => l
+            .parse::<Language>()
+            .map_err(|e| ApiError::invalid(format!("`language`: {e}")))?,
+        l => {
+            return Err(ApiError::invalid(format!(
+                "`language` must be krl, rapid, fanuc or urscript, got `{l}`"
+            )))
+        }
+    };
+    Ok(FilterCommand {
+        robot_id,
+        model: model_choice(req.version.as_ref())?,
+        payload_kg: req.payload_kg,
+        language,
+        files: req
+            .files
+            .into_iter()
+            .map(|f| ProgramFile {
+                name: f.name,
+                text: f.content,
+            })
+            .collect(),
+    })
+}
+
+pub async fn filter(
+    State(state): State<AppState>,
+    ApiPath(robot_id): ApiPath<i64>,
+    ApiJson(req): ApiJson<FilterRequest>,
+) -> Result<Response, ApiError> {
+    let cmd = command(robot_id, req)?;
+    let done = service::programs::filter_program(&state, cmd).await?;
+    Ok(axum::Json(FilterResponse {
+        robot_id,
+        version: done.version,
+        method: done.method,
+        files: done
+            .output
+            .files
+            .into_iter()
+            .map(|f| FileIn {
+                name: f.name,
+                content: f.text,
+            })
+            .collect(),
+        report: done.output.report,
+    })
+    .into_response())
+}
+
+/// The route of program filtering.
+pub fn routes() -> Vec<super::Route> {
+    vec![super::post("/v1/robots/{id}/programs/filter", filter)]
+}

@@ -1,0 +1,65 @@
+//! Program filtering for a robot: the program's Cartesian targets become
+//! false targets on the chosen model version (`core::program::filter`), with
+//! the robot's stored tools and work objects as what the program's numbers
+//! and names refer to (plus what the program declares itself). CPU-heavy:
+//! runs on the solve workers behind the same admission control as large
+//! solve batches.
+
+use super::solve::{chosen_model, ModelChoice};
+use super::{AppState, ServiceError};
+use crate::ik::IkSettings;
+use crate::program::{filter, FilterOutput, Language, ProgramFile};
+
+/// A filter, in domain terms.
+#[derive(Debug, Clone)]
+pub struct FilterCommand {
+    pub robot_id: i64,
+    pub model: ModelChoice,
+    /// Payload mass [kg] instead of the model's.
+    pub payload_kg: Option<f64>,
+    pub language: Language,
+    pub files: Vec<ProgramFile>,
+}
+
+/// What a filter produced.
+#[derive(Debug)]
+pub struct FilterOutcome {
+    /// Version number used (`None`: the nominal model).
+    pub version: Option<i64>,
+    /// Calibration method of that version, or `nominal`.
+    pub method: String,
+    pub output: FilterOutput,
+}
+
+/// Filters a program with the robot's model and cell.
+pub async fn filter_program(
+    state: &AppState,
+    cmd: FilterCommand,
+) -> Result<FilterOutcome, ServiceError> {
+    let language = cmd.language;
+    let cell = super::cell::cell(state, cmd.robot_id).await?;
+    let chosen = chosen_model(state, cmd.robot_id, cmd.model).await?;
+    let mut model = chosen.model;
+    if let Some(p) = cmd.payload_kg {
+        model.payload_kg = p;
+    }
+    let ticket = state.admit_solve()?;
+    let permit = state
+        .solve_slots()
+        .acquire_owned()
+        .await
+        .map_err(|_| ServiceError::Unavailable("the service is shutting down".into()))?;
+    let files = cmd.files;
+    let output = tokio::task::spawn_blocking(move || {
+        let _permit = permit;
+        let _ticket = ticket;
+        filter(language, &files, &cell, &model, &IkSettings::default())
+    })
+    .await
+    .map_err(|e| ServiceError::Internal(format!("filter task: {e}")))??;
+    Ok(FilterOutcome {
+        version: chosen.version,
+        method: chosen.method,
+        output,
+    })
+}
