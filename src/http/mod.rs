@@ -32,6 +32,7 @@ pub mod error;
 pub mod input;
 
 pub mod listener;
+pub mod plans;
 pub mod programs;
 pub mod robots;
 pub mod sets;
@@ -134,6 +135,7 @@ fn routes() -> Vec<Route> {
     all.extend(solve::routes());
     all.extend(cell::routes());
     all.extend(programs::routes());
+    all.extend(plans::routes());
     all
 }
 

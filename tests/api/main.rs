@@ -18,6 +18,7 @@ mod common;
 mod contract;
 mod flow;
 mod jobs;
+mod plans;
 mod sets;
 mod solve;
 mod spec;

@@ -1,0 +1,241 @@
+//! `POST /v1/robots/{id}/measurement-plans`: N poses chosen for
+//! identifiability on the robot's nominal model, within its joint limits, a
+//! workspace box and the tracker's line of sight, with the parameter standard
+//! deviations they predict for the tracker noise; the joints as a CSV and,
+//! when `language` is given, as a program visiting them with a wait at each.
+//! The same as `robocal plan`.
+
+use super::programs::FileIn;
+use super::{ApiError, ApiJson, ApiPath, AppState};
+use crate::plan::{
+    FilterCounts, PlanPoint, PlanSettings, PredictedStd, TrackerSight, WorkspaceBox,
+};
+use crate::program::Language;
+use crate::service;
+use crate::service::plans::PlanCommand;
+use axum::extract::State;
+use axum::response::{IntoResponse, Response};
+use serde::{Deserialize, Serialize};
+
+/// Most poses in a plan.
+pub const PLAN_POSES_MAX: usize = 300;
+/// Most candidates drawn.
+pub const PLAN_CANDIDATES_MAX: usize = 5000;
+/// Longest wait at a pose [s].
+pub const WAIT_MAX_S: f64 = 3600.0;
+
+/// A box for the TCP, base frame [mm].
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoxIn {
+    pub min_mm: [f64; 3],
+    pub max_mm: [f64; 3],
+}
+
+/// The tracker's position and the reflector's allowed angle to it.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrackerIn {
+    pub position_mm: [f64; 3],
+    /// The reflector's axis in the tool frame (default: z).
+    #[serde(default)]
+    pub axis: Option<[f64; 3]>,
+    pub max_angle_deg: f64,
+}
+
+/// `POST /v1/robots/{id}/measurement-plans` body; every field optional.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlanRequest {
+    pub poses: Option<usize>,
+    pub candidates: Option<usize>,
+    pub workspace: Option<BoxIn>,
+    pub tracker: Option<TrackerIn>,
+    pub noise_mm: Option<f64>,
+    pub payload_kg: Option<f64>,
+    pub seed: Option<u64>,
+    /// krl, rapid, fanuc or urscript: also return the plan as a program.
+    pub language: Option<String>,
+    pub name: Option<String>,
+    pub wait_s: Option<f64>,
+}
+
+/// The plan as a program.
+#[derive(Debug, Serialize)]
+pub struct ProgramOut {
+    pub language: Language,
+    pub files: Vec<FileIn>,
+}
+
+/// The answer.
+#[derive(Debug, Serialize)]
+pub struct PlanResponse {
+    pub robot_id: i64,
+    pub poses: usize,
+    pub counts: FilterCounts,
+    pub noise_mm: f64,
+    pub payload_kg: f64,
+    pub predicted: Vec<PredictedStd>,
+    pub points: Vec<PlanPoint>,
+    pub joints_csv: String,
+    pub program: Option<ProgramOut>,
+}
+
+fn finite3(what: &str, v: &[f64; 3]) -> Result<(), ApiError> {
+    if v.iter().all(|x| x.is_finite() && x.abs() <= 1e6) {
+        Ok(())
+    } else {
+        Err(ApiError::invalid(format!(
+            "`{what}`: three finite numbers of at most 1e6 mm"
+        )))
+    }
+}
+
+/// The request as a service command (422 naming what is wrong).
+fn command(robot_id: i64, req: PlanRequest) -> Result<PlanCommand, ApiError> {
+    let d = PlanSettings::default();
+    let poses = req.poses.unwrap_or(d.poses);
+    if !(1..=PLAN_POSES_MAX).contains(&poses) {
+        return Err(ApiError::invalid(format!(
+            "`poses`: 1 to {PLAN_POSES_MAX}, got {poses}"
+        )));
+    }
+    let candidates = req.candidates.unwrap_or(d.candidates.max(poses));
+    if !(poses..=PLAN_CANDIDATES_MAX).contains(&candidates) {
+        return Err(ApiError::invalid(format!(
+            "`candidates`: from `poses` ({poses}) to {PLAN_CANDIDATES_MAX}, got {candidates}"
+        )));
+    }
+    let workspace = match req.workspace {
+        Some(b) => {
+            finite3("workspace.min_mm", &b.min_mm)?;
+            finite3("workspace.max_mm", &b.max_mm)?;
+            if (0..3).any(|i| b.min_mm[i] >= b.max_mm[i]) {
+                return Err(ApiError::invalid(
+                    "`workspace`: each of min_mm must be below max_mm",
+                ));
+            }
+            Some(WorkspaceBox {
+                min_mm: b.min_mm,
+                max_mm: b.max_mm,
+            })
+        }
+        None => None,
+    };
+    let tracker = match req.tracker {
+        Some(t) => {
+            finite3("tracker.position_mm", &t.position_mm)?;
+            let axis = t.axis.unwrap_or([0.0, 0.0, 1.0]);
+            let norm = axis.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if !(axis.iter().all(|x| x.is_finite()) && norm > 1e-9 && norm.is_finite()) {
+                return Err(ApiError::invalid(
+                    "`tracker.axis`: a non-zero finite vector",
+                ));
+            }
+            if !(t.max_angle_deg.is_finite() && t.max_angle_deg > 0.0 && t.max_angle_deg <= 180.0) {
+                return Err(ApiError::invalid(format!(
+                    "`tracker.max_angle_deg`: above 0 and at most 180, got {}",
+                    t.max_angle_deg
+                )));
+            }
+            Some(TrackerSight {
+                position_mm: t.position_mm,
+                axis,
+                max_angle_deg: t.max_angle_deg,
+            })
+        }
+        None => None,
+    };
+    let noise_mm = req.noise_mm.unwrap_or(d.noise_mm);
+    if !(noise_mm.is_finite() && noise_mm > 0.0 && noise_mm <= 100.0) {
+        return Err(ApiError::invalid(format!(
+            "`noise_mm`: above 0 and at most 100 mm, got {noise_mm}"
+        )));
+    }
+    if let Some(p) = req.payload_kg {
+        super::input::check_payload("`payload_kg`", p)?;
+    }
+    let program = match req.language.as_deref() {
+        None => None,
+        Some(l @ ("krl" | "rapid" | "fanuc" | "urscript")) => {
+            let language = l
+                .parse::<Language>()
+                .map_err(|e| ApiError::invalid(format!("`language`: {e}")))?;
+            let name = req.name.clone().unwrap_or_else(|| "plan".into());
+            let ok = name.len() <= 24
+                && name.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
+                && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+            if !ok {
+                return Err(ApiError::invalid(format!(
+                    "`name`: a letter, then up to 23 letters, digits or `_`, got `{name}`"
+                )));
+            }
+            let wait_s = req.wait_s.unwrap_or(1.0);
+            if !(wait_s.is_finite() && (0.0..=WAIT_MAX_S).contains(&wait_s)) {
+                return Err(ApiError::invalid(format!(
+                    "`wait_s`: 0 to {WAIT_MAX_S} s, got {wait_s}"
+                )));
+            }
+            Some((language, name, wait_s))
+        }
+        Some(l) => {
+            return Err(ApiError::invalid(format!(
+                "`language` must be krl, rapid, fanuc or urscript, got `{l}`"
+            )))
+        }
+    };
+    if program.is_none() && (req.name.is_some() || req.wait_s.is_some()) {
+        return Err(ApiError::invalid(
+            "`name` and `wait_s` shape the program: give `language` too",
+        ));
+    }
+    Ok(PlanCommand {
+        robot_id,
+        settings: PlanSettings {
+            poses,
+            candidates,
+            workspace,
+            tracker,
+            noise_mm,
+            payload_kg: req.payload_kg,
+            seed: req.seed.unwrap_or(d.seed),
+            ..d
+        },
+        program,
+    })
+}
+
+pub async fn plan(
+    State(state): State<AppState>,
+    ApiPath(robot_id): ApiPath<i64>,
+    ApiJson(req): ApiJson<PlanRequest>,
+) -> Result<Response, ApiError> {
+    let cmd = command(robot_id, req)?;
+    let language = cmd.program.as_ref().map(|p| p.0);
+    let done = service::plans::make(&state, cmd).await?;
+    Ok(axum::Json(PlanResponse {
+        robot_id,
+        poses: done.plan.points.len(),
+        counts: done.plan.counts,
+        noise_mm: done.plan.noise_mm,
+        payload_kg: done.plan.payload_kg,
+        predicted: done.plan.predicted,
+        points: done.plan.points,
+        joints_csv: done.joints_csv,
+        program: done.program.zip(language).map(|(files, l)| ProgramOut {
+            language: l,
+            files: files
+                .into_iter()
+                .map(|f| FileIn {
+                    name: f.name,
+                    content: f.text,
+                })
+                .collect(),
+        }),
+    })
+    .into_response())
+}
+
+pub fn routes() -> Vec<super::Route> {
+    vec![super::post("/v1/robots/{id}/measurement-plans", plan)]
+}

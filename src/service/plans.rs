@@ -1,0 +1,64 @@
+//! Measurement plans for a robot (`core::plan`): poses chosen for
+//! identifiability on the robot's nominal model within its joint limits, a
+//! workspace box and the tracker's line of sight, with the parameter standard
+//! deviations they predict, as a joint CSV and optionally a program.
+//! CPU-bound (forward kinematics of every candidate, a greedy D-optimal
+//! choice): runs on the solve workers behind their admission control.
+
+use super::solve::{chosen_model, ModelChoice};
+use super::{AppState, ServiceError};
+use crate::plan::{make_plan, plan_csv, plan_program, MeasurementPlan, PlanSettings};
+use crate::program::{Language, ProgramFile};
+
+/// A plan request, in domain terms.
+#[derive(Debug, Clone)]
+pub struct PlanCommand {
+    pub robot_id: i64,
+    pub settings: PlanSettings,
+    /// Also write the plan as a program in this language, named `name`,
+    /// waiting `wait_s` at each pose.
+    pub program: Option<(Language, String, f64)>,
+}
+
+/// What a plan request produced.
+#[derive(Debug)]
+pub struct PlanOutcome {
+    pub plan: MeasurementPlan,
+    /// `point,q1..qN` in controller degrees.
+    pub joints_csv: String,
+    pub program: Option<Vec<ProgramFile>>,
+}
+
+/// Makes the plan on the robot's nominal model.
+pub async fn make(state: &AppState, cmd: PlanCommand) -> Result<PlanOutcome, ServiceError> {
+    let nominal = chosen_model(state, cmd.robot_id, ModelChoice::Nominal)
+        .await?
+        .model
+        .nominal;
+    let ticket = state.admit_solve()?;
+    let permit = state
+        .solve_slots()
+        .acquire_owned()
+        .await
+        .map_err(|_| ServiceError::Unavailable("the service is shutting down".into()))?;
+    tokio::task::spawn_blocking(move || {
+        let _permit = permit;
+        let _ticket = ticket;
+        let plan =
+            make_plan(&nominal, &cmd.settings).map_err(|e| ServiceError::Invalid(e.to_string()))?;
+        let program = match &cmd.program {
+            Some((language, name, wait_s)) => Some(
+                plan_program(&plan, *language, name, *wait_s)
+                    .map_err(|e| ServiceError::Invalid(e.to_string()))?,
+            ),
+            None => None,
+        };
+        Ok(PlanOutcome {
+            joints_csv: plan_csv(&plan.points),
+            plan,
+            program,
+        })
+    })
+    .await
+    .map_err(|e| ServiceError::Internal(format!("plan task: {e}")))?
+}

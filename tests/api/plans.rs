@@ -1,0 +1,130 @@
+//! Measurement plans over HTTP (`/measurement-plans`): the same plan as the
+//! core's `make_plan` on the robot's nominal model (independent path: the
+//! library), its program parsing back to its joints, the constraints honoured
+//! by forward kinematics, and clear errors.
+
+use crate::support::*;
+use axum::http::StatusCode;
+use robocal::kinematics::fk;
+use robocal::model::preset;
+use robocal::plan::{make_plan, read_plan_csv, PlanSettings, TrackerSight, WorkspaceBox};
+use robocal::program::{parse, Language, ProgramFile};
+use serde_json::json;
+
+const PLANS: &str = "/v1/robots/{id}/measurement-plans";
+
+#[tokio::test]
+async fn a_plan_over_http_is_the_core_plan_and_its_program_parses_back() {
+    let t = setup().await;
+    let rid = t.create_robot("ys100").await.to_string();
+    let body = json!({
+        "poses": 30,
+        "workspace": { "min_mm": [500, -1500, 0], "max_mm": [2500, 1500, 2000] },
+        "tracker": { "position_mm": [4000, 0, 1000], "max_angle_deg": 60 },
+        "noise_mm": 0.02,
+        "seed": 4,
+        "language": "krl",
+        "name": "cal_poses",
+        "wait_s": 2
+    });
+    let r = t.post_json(PLANS, &[&rid], body).await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let v = r.json();
+    // The library on the same nominal model and settings.
+    let nominal = preset("ys100").unwrap();
+    let want = make_plan(
+        &nominal,
+        &PlanSettings {
+            poses: 30,
+            workspace: Some(WorkspaceBox {
+                min_mm: [500.0, -1500.0, 0.0],
+                max_mm: [2500.0, 1500.0, 2000.0],
+            }),
+            tracker: Some(TrackerSight {
+                position_mm: [4000.0, 0.0, 1000.0],
+                axis: [0.0, 0.0, 1.0],
+                max_angle_deg: 60.0,
+            }),
+            noise_mm: 0.02,
+            seed: 4,
+            ..PlanSettings::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(v["poses"], 30);
+    assert_eq!(
+        serde_json::to_value(&want.points).unwrap(),
+        v["points"],
+        "points"
+    );
+    assert_eq!(
+        serde_json::to_value(&want.predicted).unwrap(),
+        v["predicted"]
+    );
+    assert_eq!(serde_json::to_value(want.counts).unwrap(), v["counts"]);
+    // The CSV reads back to the points.
+    let csv = read_plan_csv(v["joints_csv"].as_str().unwrap()).unwrap();
+    assert_eq!(csv, want.points);
+    // Every pose inside the box, by forward kinematics of the model joints.
+    for q in &want.q {
+        let p = fk(&nominal, q).unwrap().p * 1e3;
+        assert!(
+            (500.0..=2500.0).contains(&p.x)
+                && (-1500.0..=1500.0).contains(&p.y)
+                && (0.0..=2000.0).contains(&p.z),
+            "{p:?}"
+        );
+    }
+    // The program parses back to the same joints, with a wait at each.
+    assert_eq!(v["program"]["language"], "krl");
+    let files: Vec<ProgramFile> = v["program"]["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| ProgramFile {
+            name: f["name"].as_str().unwrap().into(),
+            text: f["content"].as_str().unwrap().into(),
+        })
+        .collect();
+    assert!(files[0].text.contains("cal_poses"));
+    let back = parse(Language::Krl, &files).unwrap();
+    assert_eq!(back.joints.len(), 30);
+    for (j, p) in back.joints.iter().zip(&want.points) {
+        for (a, b) in j.deg.iter().zip(&p.q_deg) {
+            assert!((a - b).abs() < 1e-4, "{:?} vs {:?}", j.deg, p.q_deg);
+        }
+    }
+}
+
+#[tokio::test]
+async fn plan_requests_that_cannot_be_met_say_why() {
+    let t = setup().await;
+    let rid = t.create_robot("ys100").await.to_string();
+    // No program asked: none returned.
+    let r = t.post_json(PLANS, &[&rid], json!({ "poses": 20 })).await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    assert!(r.json()["program"].is_null());
+    for (body, words) in [
+        (json!({ "poses": 20, "candidates": 10 }), "`candidates`"),
+        (
+            json!({ "workspace": { "min_mm": [0, 0, 0], "max_mm": [0, 1, 1] } }),
+            "below max_mm",
+        ),
+        (
+            json!({ "poses": 10, "workspace": { "min_mm": [90000, 0, 0], "max_mm": [90001, 1, 1] } }),
+            "inside the box",
+        ),
+        (json!({ "wait_s": 3 }), "give `language`"),
+        (json!({ "language": "gcode" }), "`language`"),
+        (
+            json!({ "tracker": { "position_mm": [1, 2, 3], "axis": [0, 0, 0], "max_angle_deg": 30 } }),
+            "`tracker.axis`",
+        ),
+    ] {
+        let r = t.post_json(PLANS, &[&rid], body.clone()).await;
+        assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{body}");
+        assert!(r.text().contains(words), "{body}: {}", r.text());
+    }
+    let r = t.post_json(PLANS, &["999999"], json!({})).await;
+    assert_eq!(r.status, StatusCode::NOT_FOUND);
+}
