@@ -371,9 +371,10 @@ fn base_failure_pool_choice_and_cancellation() {
         "{}",
         a.reason
     );
-    // No compensator; the joint maps on KM are tried (they need no torques).
+    // Only what needs no torques is tried: the compensators on KM with
+    // joint inputs (the Gaussian process), then the joint maps on KM.
     let tried: Vec<Method> = a.candidates.iter().map(|c| c.method).collect();
-    assert_eq!(tried, [Method::KmMaps], "{:?}", a.candidates);
+    assert_eq!(tried, [Method::KmGp, Method::KmMaps], "{:?}", a.candidates);
     // Its model file names the method it delivers.
     assert_eq!(r.methods["auto"].model_file_method(), "auto: km");
     assert_eq!(r.methods["auto"].method.name(), "auto");

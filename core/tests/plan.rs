@@ -336,3 +336,20 @@ fn tracker_exports_join_back() {
         JoinError::NoNames
     );
 }
+
+/// A model whose lengths overflow (a description the service accepts) gives an
+/// error naming the cause, not a hang in the factorisation.
+#[test]
+fn a_model_that_overflows_is_refused() {
+    let mut model = preset("ur5").unwrap();
+    model.links[1].a = 2e304;
+    model.links[0].mass = 1e308;
+    let e = make_plan(&model, &PlanSettings::default()).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            PlanError::Unidentifiable(_) | PlanError::TooFewCandidates { .. }
+        ),
+        "{e}"
+    );
+}

@@ -10,6 +10,9 @@ use super::{AppState, ServiceError};
 use crate::plan::{make_plan, plan_csv, plan_program, MeasurementPlan, PlanSettings};
 use crate::program::{Language, ProgramFile};
 
+/// Most work a plan request may ask (module docs of [`make`]).
+pub const PLAN_WORK_MAX: f64 = 2e9;
+
 /// A plan request, in domain terms.
 #[derive(Debug, Clone)]
 pub struct PlanCommand {
@@ -35,6 +38,19 @@ pub async fn make(state: &AppState, cmd: PlanCommand) -> Result<PlanOutcome, Ser
         .await?
         .model
         .nominal;
+    // The greedy D-optimal choice costs about candidates · poses · p²
+    // (p ≈ 4 parameters per joint); beyond this it would hold a solve worker
+    // for many seconds.
+    let p = (4 * nominal.dof() + 6) as f64;
+    let work = cmd.settings.candidates as f64 * cmd.settings.poses as f64 * p * p;
+    if work > PLAN_WORK_MAX {
+        return Err(ServiceError::Invalid(format!(
+            "a plan of {} poses among {} candidates of a {}-joint robot is too much work for one request (candidates × poses × (4·joints + 6)² is {work:.1e}, at most {PLAN_WORK_MAX:.0e}); ask fewer candidates or poses, or use `robocal plan`",
+            cmd.settings.poses,
+            cmd.settings.candidates,
+            nominal.dof()
+        )));
+    }
     let ticket = state.admit_solve()?;
     let permit = state
         .solve_slots()

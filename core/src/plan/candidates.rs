@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct FilterCounts {
     pub drawn: usize,
-    /// Forward kinematics defined (a closed loop closes).
+    /// Forward kinematics defined (a closed loop closes) and finite.
     pub reachable: usize,
     pub in_box: usize,
     pub in_sight: usize,
@@ -83,6 +83,9 @@ pub(super) fn draw(
             .map(|&(lo, hi)| if lo < hi { rng.gen_range(lo..hi) } else { lo })
             .collect();
         let Ok(tcp) = fk(model, &q) else { continue };
+        if !(tcp.p.iter().all(|v| v.is_finite()) && tcp.r.iter().all(|v| v.is_finite())) {
+            continue;
+        }
         counts.reachable += 1;
         if s.workspace.as_ref().is_some_and(|b| !inside_box(b, &tcp.p)) {
             continue;

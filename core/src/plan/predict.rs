@@ -107,6 +107,15 @@ fn one(
         candidates.extend((0..model.dof()).map(|k| ParamId::new(ParamKind::Compliance, k)));
     }
     let (r, rows) = stacked_factor(model, &candidates, data, None);
+    if r.iter().any(|v| !v.is_finite())
+        || data
+            .iter()
+            .any(|m| !m.position.iter().all(|v| v.is_finite()))
+    {
+        return Err(PlanError::Unidentifiable(
+            "the model's positions or Jacobian overflow at the chosen poses (check its lengths and masses)".into(),
+        ));
+    }
     let analysis = analyse_factor(
         model,
         &r,
