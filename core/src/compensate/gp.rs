@@ -137,16 +137,30 @@ impl Gp {
         Ok(())
     }
 
+    /// `Σ_j ((q_j − z_mj)/ℓ_j)²` to inducing configuration `m`.
+    fn scaled_distance(&self, q: &[f64], m: usize) -> f64 {
+        kernel_exponent(q, self.inducing(m), &self.inverse_length_scales)
+    }
+
+    /// Inducing configuration `m` [rad].
+    fn inducing(&self, m: usize) -> &[f64] {
+        &self.inducing[m * self.dof..(m + 1) * self.dof]
+    }
+
+    /// `α_m·k(q, z_m)` [m]; `None` beyond the cutoff.
+    fn term(&self, q: &[f64], m: usize) -> Option<Vector3<f64>> {
+        let e = self.scaled_distance(q, m);
+        if e > CUTOFF {
+            return None;
+        }
+        let a = &self.alpha[3 * m..3 * m + 3];
+        Some(Vector3::new(a[0], a[1], a[2]) * (self.signal_variance * (-0.5 * e).exp()))
+    }
+
     /// Kernel values `k_Z(q)` into `k` (M values).
     fn kernel_row(&self, q: &[f64], k: &mut [f64]) {
         for (m, km) in k.iter_mut().enumerate() {
-            let z = &self.inducing[m * self.dof..(m + 1) * self.dof];
-            let e: f64 = q
-                .iter()
-                .zip(z)
-                .zip(&self.inverse_length_scales)
-                .map(|((a, b), il)| ((a - b) * il).powi(2))
-                .sum();
+            let e = self.scaled_distance(q, m);
             *km = if e > CUTOFF {
                 0.0
             } else {
@@ -171,23 +185,9 @@ impl Gp {
 
 impl Compensator for Gp {
     fn residual(&self, q: &[f64], _tau: &[f64]) -> Vector3<f64> {
-        let mut r = Vector3::from(self.mean);
-        for m in 0..self.units() {
-            let z = &self.inducing[m * self.dof..(m + 1) * self.dof];
-            let e: f64 = q
-                .iter()
-                .zip(z)
-                .zip(&self.inverse_length_scales)
-                .map(|((a, b), il)| ((a - b) * il).powi(2))
-                .sum();
-            if e > CUTOFF {
-                continue;
-            }
-            let k = self.signal_variance * (-0.5 * e).exp();
-            let a = &self.alpha[3 * m..3 * m + 3];
-            r += Vector3::new(a[0], a[1], a[2]) * k;
-        }
-        r
+        (0..self.units())
+            .filter_map(|m| self.term(q, m))
+            .fold(Vector3::from(self.mean), |r, t| r + t)
     }
 
     fn name(&self) -> &str {
@@ -206,20 +206,11 @@ impl Compensator for Gp {
             *c = Vector3::zeros();
         }
         for m in 0..self.units() {
-            let z = &self.inducing[m * self.dof..(m + 1) * self.dof];
-            let e: f64 = q
-                .iter()
-                .zip(z)
-                .zip(&self.inverse_length_scales)
-                .map(|((a, b), il)| ((a - b) * il).powi(2))
-                .sum();
-            if e > CUTOFF {
+            let Some(ak) = self.term(q, m) else {
                 continue;
-            }
-            let k = self.signal_variance * (-0.5 * e).exp();
-            let a = &self.alpha[3 * m..3 * m + 3];
-            let ak = Vector3::new(a[0], a[1], a[2]) * k;
+            };
             r += ak;
+            let z = self.inducing(m);
             // ∂k/∂q_j = −k·(q_j − z_j)/ℓ_j².
             for (j, c) in dq.iter_mut().enumerate().take(self.dof) {
                 let il = self.inverse_length_scales[j];
@@ -282,14 +273,18 @@ struct Fitted {
     variance: DMatrix<f64>,
 }
 
-fn kernel(a: &[f64], b: &[f64], il: &[f64], s2: f64) -> f64 {
-    let e: f64 = a
-        .iter()
+/// `Σ_j ((a_j − b_j)·il_j)²`.
+fn kernel_exponent(a: &[f64], b: &[f64], il: &[f64]) -> f64 {
+    a.iter()
         .zip(b)
         .zip(il)
         .map(|((x, y), l)| ((x - y) * l).powi(2))
-        .sum();
-    s2 * (-0.5 * e).exp()
+        .sum()
+}
+
+/// `s²·exp(−½·Σ_j ((a_j − b_j)·il_j)²)`.
+fn kernel(a: &[f64], b: &[f64], il: &[f64], s2: f64) -> f64 {
+    s2 * (-0.5 * kernel_exponent(a, b, il)).exp()
 }
 
 impl Data<'_> {

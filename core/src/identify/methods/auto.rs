@@ -20,7 +20,8 @@ use super::compensated::base_pool_stats;
 use super::maps::run_maps;
 use super::run::{AppliedCompensator, Cache, Context, MethodFit, Outcome};
 use super::{Base, Compensated, Method, MethodError, MethodFailure, Run};
-use crate::compensate::{choose, CvStats};
+use crate::compensate::{choose, Choice, CvStats};
+use crate::identify::least_squares::Fit;
 use crate::identify::report::{AutoCandidate, AutoSummary};
 
 /// One base as `auto` weighs it.
@@ -78,7 +79,6 @@ pub(crate) fn run_auto(
         .count();
     let total = (per_base.iter().map(Vec::len).sum::<usize>() + maps_runs + maps_compensators)
         .max(1) as f64;
-    let max_stages = o.cv_stages(folds) as f64;
     let mut done = 0.0;
     let mut notes: Vec<String> = Vec::new();
     if let Some(why) = gravity {
@@ -115,44 +115,17 @@ pub(crate) fn run_auto(
             });
             continue;
         }
-        let mut cvs: Vec<(String, CvStats)> = Vec::new();
-        let mut trained: Vec<AppliedCompensator> = Vec::new();
-        for (m, c) in cands {
-            let max = o.max_epochs(c.network) as f64;
-            let at = done;
-            let r = cache.trained(ctx, *m, c.network, &mf.fit, folds, &mut |stage, e, l| {
-                let f = (stage as f64 + (e as f64 / max).min(1.0)) / max_stages;
-                progress((at + f) / total, e, Some(l))
-            });
-            done += 1.0;
-            match r {
-                Ok(t) => {
-                    let cv = t.cv.clone().expect("auto cross-validates");
-                    candidates.push(AutoCandidate {
-                        method: *m,
-                        cross_validation: Some(cv.clone()),
-                        failed: None,
-                    });
-                    cvs.push((m.name().to_string(), cv));
-                    trained.push(AppliedCompensator {
-                        method: *m,
-                        base: c.base,
-                        trained: t,
-                    });
-                }
-                Err(MethodError::Cancelled) => return Err(MethodError::Cancelled),
-                Err(MethodError::Failed(f)) => candidates.push(AutoCandidate {
-                    method: *m,
-                    cross_validation: None,
-                    failed: Some(f.to_string()),
-                }),
-            }
-        }
-        let choice = choose(&cvs, o.min_gain);
-        let picked = choice
-            .chosen
-            .as_deref()
-            .and_then(|chosen| trained.into_iter().find(|a| a.method.name() == chosen));
+        let done0 = done;
+        let (choice, picked) = cross_validate_and_choose(
+            ctx,
+            cache,
+            cands,
+            &mf.fit,
+            folds,
+            &mut candidates,
+            &mut |x, e, l| progress((done0 + x) / total, e, l),
+        )?;
+        done += cands.len() as f64;
         let mean_mm = picked
             .as_ref()
             .and_then(|a| a.trained.cv.as_ref())
@@ -304,19 +277,49 @@ fn maps_compensator(
     } else {
         Base::SkcmMaps
     };
-    let o = &ctx.opts.compensator;
-    let mut cvs = Vec::new();
-    let mut trained = Vec::new();
-    let methods: Vec<(Method, Compensated)> = o
+    let methods: Vec<(Method, Compensated)> = ctx
+        .opts
+        .compensator
         .auto_candidates
         .iter()
         .filter_map(|m| Some((*m, m.compensated()?)))
         .filter(|(_, c)| c.base == on)
         .collect();
+    if methods.is_empty() {
+        return Ok(OnMaps {
+            kept: None,
+            trained: 0,
+            reason: String::new(),
+        });
+    }
+    let (choice, kept) =
+        cross_validate_and_choose(ctx, cache, &methods, &fit.fit, folds, candidates, progress)?;
+    Ok(OnMaps {
+        kept,
+        trained: methods.len(),
+        reason: format!("on {}: {}; ", base.method().name(), choice.reason),
+    })
+}
+
+/// Trains and cross-validates each compensator method on `fit`'s residuals,
+/// lists each as an `auto` candidate, and keeps the one `choose` accepts.
+/// `progress(x, epoch, loss)` with `x` in methods done (fractional).
+fn cross_validate_and_choose(
+    ctx: &Context,
+    cache: &mut Cache,
+    methods: &[(Method, Compensated)],
+    fit: &Fit,
+    folds: usize,
+    candidates: &mut Vec<AutoCandidate>,
+    progress: &mut dyn FnMut(f64, usize, Option<f64>) -> bool,
+) -> Result<(Choice, Option<AppliedCompensator>), MethodError> {
+    let o = &ctx.opts.compensator;
     let stages = o.cv_stages(folds) as f64;
+    let mut cvs: Vec<(String, CvStats)> = Vec::new();
+    let mut trained: Vec<AppliedCompensator> = Vec::new();
     for (i, (m, c)) in methods.iter().enumerate() {
         let max = o.max_epochs(c.network) as f64;
-        let r = cache.trained(ctx, *m, c.network, &fit.fit, folds, &mut |stage, e, l| {
+        let r = cache.trained(ctx, *m, c.network, fit, folds, &mut |stage, e, l| {
             let f = (stage as f64 + (e as f64 / max).min(1.0)) / stages;
             progress(i as f64 + f, e, Some(l))
         });
@@ -343,23 +346,12 @@ fn maps_compensator(
             }),
         }
     }
-    if methods.is_empty() {
-        return Ok(OnMaps {
-            kept: None,
-            trained: 0,
-            reason: String::new(),
-        });
-    }
     let choice = choose(&cvs, o.min_gain);
-    let kept = choice
+    let picked = choice
         .chosen
         .as_deref()
         .and_then(|chosen| trained.into_iter().find(|a| a.method.name() == chosen));
-    Ok(OnMaps {
-        kept,
-        trained: methods.len(),
-        reason: format!("on {}: {}; ", base.method().name(), choice.reason),
-    })
+    Ok((choice, picked))
 }
 
 /// The joint-map method on `base` among `auto`'s candidates.
