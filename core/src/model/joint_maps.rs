@@ -41,27 +41,42 @@ pub enum Coverage {
 /// The fade weight of `q` for the range `[lo, hi]` and fade width `w`, and
 /// its derivative: 1 inside, a smoothstep to 0 over `w` on either side (C¹).
 pub fn fade_weight(q: f64, lo: f64, hi: f64, w: f64) -> (f64, f64) {
+    let [s, ds, _] = fade_taylor(q, lo, hi, w);
+    (s, ds)
+}
+
+/// [`fade_weight`] with its second derivative: `[s, s', s'']`.
+fn fade_taylor(q: f64, lo: f64, hi: f64, w: f64) -> [f64; 3] {
     let w = w.max(1e-12);
     if q < lo {
-        let (s, ds) = smoothstep(1.0 - (lo - q) / w);
-        (s, ds / w)
+        let [s, ds, d2s] = smoothstep(1.0 - (lo - q) / w);
+        [s, ds / w, d2s / (w * w)]
     } else if q > hi {
-        let (s, ds) = smoothstep(1.0 - (q - hi) / w);
-        (s, -ds / w)
+        let [s, ds, d2s] = smoothstep(1.0 - (q - hi) / w);
+        [s, -ds / w, d2s / (w * w)]
     } else {
-        (1.0, 0.0)
+        [1.0, 0.0, 0.0]
     }
 }
 
-/// `s(x) = 3x² − 2x³` on [0, 1] and its derivative: C¹ at both ends.
-fn smoothstep(x: f64) -> (f64, f64) {
+/// `s(x) = 3x² − 2x³` on [0, 1] and its first two derivatives: C¹ at both ends.
+fn smoothstep(x: f64) -> [f64; 3] {
     if x <= 0.0 {
-        (0.0, 0.0)
+        [0.0; 3]
     } else if x >= 1.0 {
-        (1.0, 0.0)
+        [1.0, 0.0, 0.0]
     } else {
-        (x * x * (3.0 - 2.0 * x), 6.0 * x * (1.0 - x))
+        [x * x * (3.0 - 2.0 * x), 6.0 * x * (1.0 - x), 6.0 - 12.0 * x]
     }
+}
+
+/// A map's value and first two derivatives at one angle: `f` [rad], `f'`,
+/// `f''` [1/rad].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct MapTaylor {
+    pub value: f64,
+    pub slope: f64,
+    pub curvature: f64,
 }
 
 impl JointMap {
@@ -95,11 +110,12 @@ impl JointMap {
         }
     }
 
-    /// The unfaded series `g(q) = Σ a_k cos kq + b_k sin kq` and, when
-    /// `derivative`, `dg/dq`, by the angle-addition recurrence (one sine and
-    /// cosine per call): four interleaved chains, harmonics `j, j + 4, …`
-    /// advanced by `4q`, so the recurrence's latency overlaps.
-    fn series(&self, q: f64, derivative: bool) -> (f64, f64) {
+    /// The unfaded series `g(q) = Σ a_k cos kq + b_k sin kq` and its first
+    /// `ORDER` derivatives (`[g, g', g'']`, zeros beyond `ORDER`), by the
+    /// angle-addition recurrence (one sine and cosine per call): four
+    /// interleaved chains, harmonics `j, j + 4, …` advanced by `4q`, so the
+    /// recurrence's latency overlaps.
+    fn series<const ORDER: usize>(&self, q: f64) -> [f64; 3] {
         let (s1, c1) = q.sin_cos();
         let mut c = [c1, 0.0, 0.0, 0.0];
         let mut s = [s1, 0.0, 0.0, 0.0];
@@ -108,15 +124,20 @@ impl JointMap {
             s[j] = s[j - 1] * c1 + c[j - 1] * s1;
         }
         let (c4, s4) = (c[3], s[3]);
-        let (mut g, mut dg) = ([0.0; 4], [0.0; 4]);
+        let (mut g, mut dg, mut d2g) = ([0.0; 4], [0.0; 4], [0.0; 4]);
         let n = self.cos.len();
         let mut k = 0;
         while k < n {
             for j in 0..4.min(n - k) {
                 let (a, b) = (self.cos[k + j], self.sin[k + j]);
-                g[j] += a * c[j] + b * s[j];
-                if derivative {
-                    dg[j] += (k + j + 1) as f64 * (b * c[j] - a * s[j]);
+                let even = a * c[j] + b * s[j];
+                g[j] += even;
+                if ORDER >= 1 {
+                    let m = (k + j + 1) as f64;
+                    dg[j] += m * (b * c[j] - a * s[j]);
+                    if ORDER >= 2 {
+                        d2g[j] -= m * m * even;
+                    }
                 }
             }
             for j in 0..4 {
@@ -126,10 +147,8 @@ impl JointMap {
             }
             k += 4;
         }
-        (
-            (g[0] + g[1]) + (g[2] + g[3]),
-            (dg[0] + dg[1]) + (dg[2] + dg[3]),
-        )
+        let sum = |v: [f64; 4]| (v[0] + v[1]) + (v[2] + v[3]);
+        [sum(g), sum(dg), sum(d2g)]
     }
 
     /// `f(q)` [rad] and `df/dq`.
@@ -138,8 +157,22 @@ impl JointMap {
         if s == 0.0 {
             return (0.0, 0.0);
         }
-        let (g, dg) = self.series(q, true);
+        let [g, dg, _] = self.series::<1>(q);
         (s * g, s * dg + ds * g)
+    }
+
+    /// `f`, `f'` and `f''` at `q` (the product rule through the fade).
+    pub fn taylor(&self, q: f64) -> MapTaylor {
+        let [s, ds, d2s] = fade_taylor(q, self.range[0], self.range[1], self.fade);
+        if s == 0.0 {
+            return MapTaylor::default();
+        }
+        let [g, dg, d2g] = self.series::<2>(q);
+        MapTaylor {
+            value: s * g,
+            slope: s * dg + ds * g,
+            curvature: s * d2g + 2.0 * ds * dg + d2s * g,
+        }
     }
 
     /// `f(q)` [rad].
@@ -148,7 +181,7 @@ impl JointMap {
         if s == 0.0 {
             return 0.0;
         }
-        s * self.series(q, false).0
+        s * self.series::<0>(q)[0]
     }
 
     /// The basis of the series at `q` (unfaded): `[cos q … cos Kq, sin q … sin Kq]`,
@@ -170,11 +203,7 @@ impl JointMap {
         let [lo, hi] = self.range;
         let n = (((hi - lo) / 0.1f64.to_radians()).ceil() as usize).max(1);
         (0..=n)
-            .map(|i| {
-                self.series(lo + (hi - lo) * i as f64 / n as f64, false)
-                    .0
-                    .abs()
-            })
+            .map(|i| self.series::<0>(lo + (hi - lo) * i as f64 / n as f64)[0].abs())
             .fold(0.0, f64::max)
     }
 
@@ -254,6 +283,13 @@ impl JointMaps {
             *s = m
                 .as_ref()
                 .map_or(1.0, |m| 1.0 + m.value_and_derivative(*q).1);
+        }
+    }
+
+    /// Each joint's [`MapTaylor`] at `q` into `out` (zero for joints without a map).
+    pub fn taylor(&self, q: &[f64], out: &mut [MapTaylor]) {
+        for ((m, q), t) in self.joints.iter().zip(q).zip(out) {
+            *t = m.as_ref().map_or(MapTaylor::default(), |m| m.taylor(*q));
         }
     }
 
@@ -426,6 +462,26 @@ mod tests {
             let (_, d) = m.value_and_derivative(q);
             let fd = (m.value(q + h) - m.value(q - h)) / (2.0 * h);
             assert!((d - fd).abs() < 1e-9 * (1.0 + fd.abs()), "{q}: {d} vs {fd}");
+        }
+    }
+
+    /// `taylor`'s value and slope are `value_and_derivative`'s, and its
+    /// curvature agrees with central differences of the slope inside, in the
+    /// fade bands and outside.
+    #[test]
+    fn curvature_matches_finite_differences() {
+        let m = sample_map();
+        let h = 1e-6;
+        for q in [-0.6, -0.47, -0.41, 0.3, 1.12, 1.17, 1.4] {
+            let t = m.taylor(q);
+            assert_eq!((t.value, t.slope), m.value_and_derivative(q));
+            let fd =
+                (m.value_and_derivative(q + h).1 - m.value_and_derivative(q - h).1) / (2.0 * h);
+            assert!(
+                (t.curvature - fd).abs() < 1e-7 * (1.0 + fd.abs()),
+                "{q}: {} vs {fd}",
+                t.curvature
+            );
         }
     }
 

@@ -12,7 +12,7 @@ pub mod robot;
 pub use description::{ModelDescription, ModelError};
 pub use joint_maps::{
     fade_weight, Coverage, JointMap, JointMapDescription, JointMapError, JointMaps,
-    JointMapsDescription,
+    JointMapsDescription, MapTaylor,
 };
 pub use params::{ParamId, ParamKind, ParamLayout};
 pub use pose::Pose;

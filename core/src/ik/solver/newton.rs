@@ -9,7 +9,12 @@
 //! zero orientation rows in `J_w` and `e` and a unit diagonal there, which
 //! decouples them (their solution is 0), so the step is the 3-row
 //! minimum-norm step of the parent module's header. The prediction and its
-//! Jacobian come from the prepared model (`solver/eval.rs`).
+//! Jacobian come from the prepared model (`solver/eval.rs`): trial steps take
+//! the joint maps and the compensator from their expansion at the last exact
+//! evaluation (the chain itself is always exact); where the expanded
+//! prediction meets the tolerance, the exact one is evaluated there, and the
+//! iteration ends if it meets the tolerance too or goes on expanded there.
+//! The residuals reported are always those of the exact prediction.
 //!
 //! Kept beside the generic LM driver (`optim::lm`; the same iteration on it is
 //! `newton/driver.rs`): on `cargo bench -p robocal-core --bench ik_newton`
@@ -17,7 +22,7 @@
 //! about 1.4× faster, 6.7 µs against 9.6 µs per refinement (best of 8 runs;
 //! medians 8.2 against 14.8 µs on a loaded 2-core machine).
 
-use super::eval::NnDerivative;
+use super::eval::Local;
 use super::*;
 
 mod driver;
@@ -135,14 +140,22 @@ impl IkSolver {
             failed_evaluation: true,
         };
         let mut jac = Jac::<D>::zeros_generic(U6, d);
-        // The compensator's derivative at the start: a chord for the trial steps.
-        let mut nn_dq = NnDerivative::new();
+        // The joint maps and the compensator expanded at the start; trial
+        // steps use the expansion (`eval::Local`), and the exact prediction
+        // is checked, and expanded again, where the expanded one meets the
+        // tolerance.
+        let mut local = Local::new();
         let Some(pose) = self
             .prepared
-            .predict_with_jacobian(&q_start, &mut jac, &mut nn_dq)
+            .predict_with_jacobian(&q_start, &mut jac, &mut local)
         else {
             return fail(q_start, 1);
         };
+        let linearised = self.prepared.has_local_terms();
+        // `e`, `pos` and `rot` are of the exact prediction at `q`.
+        let mut exact = true;
+        // Checks of the exact prediction that failed since the last expansion.
+        let mut failed_checks = 0;
         let mut q = OVector::<f64, D>::from_column_slice_generic(d, U1, &q_start);
         let mut jac_t = jac.clone();
         let (mut e, mut pos, mut rot) = self.error(goal, &pose, position_only);
@@ -155,7 +168,35 @@ impl IkSolver {
         // Rows of the system: the orientation rows of position-only goals are
         // zero and get a unit diagonal (their step component is 0).
         let m = if position_only { 3 } else { 6 };
-        while !self.done(pos, rot, position_only) && iterations < max_iterations {
+        while iterations < max_iterations {
+            if self.done(pos, rot, position_only) {
+                if exact {
+                    break;
+                }
+                // The expanded prediction meets the tolerance: check the
+                // exact one, which also shifts the expansion onto it at `q`.
+                iterations += 1;
+                let Some(pose_x) = self.prepared.predict_checked(q.as_slice(), &mut local) else {
+                    return fail(q.as_slice().to_vec(), iterations);
+                };
+                (e, pos, rot) = self.error(goal, &pose_x, position_only);
+                cost = e.norm_squared();
+                exact = true;
+                failed_checks += 1;
+                if failed_checks > 1 && !self.done(pos, rot, position_only) {
+                    // Twice off: the expansion's derivatives are too old; expand here.
+                    iterations += 1;
+                    failed_checks = 0;
+                    if self
+                        .prepared
+                        .predict_with_jacobian(q.as_slice(), &mut jac, &mut local)
+                        .is_none()
+                    {
+                        return fail(q.as_slice().to_vec(), iterations);
+                    }
+                }
+                continue;
+            }
             let jw = self.weighted_jacobian(&jac, position_only);
             let mut a: Matrix6<f64> = &jw * jw.transpose();
             for i in 0..6 {
@@ -184,9 +225,9 @@ impl IkSolver {
             }
             iterations += 1;
             at_limit = clamped;
-            let Some(pose_t) =
-                self.prepared
-                    .predict_with_chord(trial.as_slice(), &mut jac_t, &nn_dq)
+            let Some(pose_t) = self
+                .prepared
+                .predict_local(trial.as_slice(), &mut jac_t, &local)
             else {
                 mu = (mu * nu).max(1e-18);
                 nu *= 2.0;
@@ -211,6 +252,7 @@ impl IkSolver {
                 cost = cost_t;
                 pos = pos_t;
                 rot = rot_t;
+                exact = !linearised;
             } else {
                 mu = (mu * nu).max(1e-18);
                 nu *= 2.0;
@@ -218,6 +260,15 @@ impl IkSolver {
                     break;
                 }
             }
+        }
+        if !exact {
+            // The budget or the damping ended on the expanded prediction:
+            // the residuals reported are the exact ones.
+            iterations += 1;
+            let Some(pose_x) = self.prepared.predict_checked(q.as_slice(), &mut local) else {
+                return fail(q.as_slice().to_vec(), iterations);
+            };
+            (_, pos, rot) = self.error(goal, &pose_x, position_only);
         }
         let converged = self.done(pos, rot, position_only);
         let sigma_min = if converged {

@@ -5,7 +5,7 @@
 //! It exists for the comparison that keeps the fixed-size iteration
 //! (`core/benches/ik_newton.rs`, ratio in `newton.rs`'s header).
 
-use super::super::eval::NnDerivative;
+use super::super::eval::Local;
 use super::super::*;
 use super::Jac;
 use crate::optim::lm::{self, Damping, Flow, Iterate, LeastSquaresProblem};
@@ -24,10 +24,10 @@ impl IkSolver {
         let q = self.clamp_to_limits(q0);
         let n = q.len();
         let mut jac = Jac::<Dyn>::zeros_generic(U6, Dyn(n));
-        let mut nn_dq = NnDerivative::new();
+        let mut local = Local::new();
         let Some(pose) = self
             .prepared
-            .predict_with_jacobian(&q, &mut jac, &mut nn_dq)
+            .predict_with_jacobian(&q, &mut jac, &mut local)
         else {
             return Refined {
                 q,
@@ -48,7 +48,7 @@ impl IkSolver {
             q,
             jac_t: jac.clone(),
             jac,
-            nn_dq,
+            local,
             point: Point {
                 e,
                 pos,
@@ -114,7 +114,8 @@ struct Newton<'a> {
     q: Vec<f64>,
     jac: Jac<Dyn>,
     jac_t: Jac<Dyn>,
-    nn_dq: NnDerivative,
+    /// The compensator's derivative at the start (a chord for every step).
+    local: Local,
     point: Point,
     /// The weighted Jacobian and error of the last linearisation.
     jw: DMatrix<f64>,
@@ -172,10 +173,11 @@ impl LeastSquaresProblem for Newton<'_> {
             *t = x;
         }
         self.at_limit = clamped;
-        let pose = self
-            .solver
-            .prepared
-            .predict_with_chord(&trial, &mut self.jac_t, &self.nn_dq)?;
+        let pose = self.solver.prepared.predict_with_chord(
+            &trial,
+            &mut self.jac_t,
+            self.local.derivative(),
+        )?;
         let (e, pos, rot) = self.solver.error(self.goal, &pose, self.position_only);
         let point = Point {
             e,
