@@ -173,7 +173,7 @@ impl<'a> Backprop<'a> {
             reported: (0, 0.0),
         };
         p.cost = p.sse(&p.w);
-        p.reported = (0, p.cost / (rows.max(1)) as f64);
+        p.reported = (0, p.cost / rows.max(1) as f64);
         p
     }
 
@@ -304,7 +304,7 @@ mod tests {
         let mut go = |_: usize, _: f64| true;
         let mut p = Backprop::new(&data, &fit, &[], w, 6, &mut go);
         p.linearise();
-        assert!(p.jac.ncols() > 2 * GRAM_COLUMNS && p.jac.ncols() % GRAM_COLUMNS != 0);
+        assert!(p.jac.ncols() > 2 * GRAM_COLUMNS && !p.jac.ncols().is_multiple_of(GRAM_COLUMNS));
         let blocked = p.gram_of_jacobian().unwrap();
         let whole = p.jac.tr_mul(&p.jac);
         for (x, y) in blocked.iter().zip(whole.iter()) {
