@@ -1,16 +1,17 @@
 //! The sparse Gaussian-process compensator (`compensate::gp`) on its own:
 //! its joint derivative against central finite differences, recovery of a
 //! smooth function outside the kernel's family on poses it never saw,
-//! determinism, and the calibration of its expected error on held-out noisy
-//! poses (for Gaussian errors the 3-D error norm exceeds its RMS `u` in 39.2 %
-//! of poses and `2u` in 0.74 %: P(χ²₃ > 3) and P(χ²₃ > 12)).
+//! determinism, cancellation within a fit, and the calibration of its
+//! expected error on held-out noisy poses (for Gaussian errors the 3-D error
+//! norm exceeds its RMS `u` in 39.2 % of poses and `2u` in 0.74 %: P(χ²₃ > 3)
+//! and P(χ²₃ > 12)).
 
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 use robocal_core::compensate::{
-    train_gp, Compensator, GpSettings, Sample, StoredCompensator, Support,
+    train_gp, Compensator, GpSettings, Sample, StoredCompensator, Support, TrainError,
 };
 
 /// A smooth residual of a few tenths of a millimetre [m]: products of sines of
@@ -154,4 +155,44 @@ fn a_stored_gp_round_trips_through_json_and_bad_ones_are_refused() {
     let mut bad = gp;
     bad.noise_variance = -1.0;
     assert!(StoredCompensator::Gp(bad).validate().is_err());
+}
+
+/// The progress is asked within every candidate fit, not only after it (the
+/// count of fits repeats before it grows), and a false anywhere, the final
+/// fit on all samples included, ends the training as cancelled with no
+/// further call.
+#[test]
+fn a_cancel_within_a_fit_ends_the_training() {
+    let data = samples(400, 1e-5, -1.5, 1.5, 7);
+    let settings = GpSettings::default();
+    let mut calls: Vec<usize> = Vec::new();
+    let (_, report) = train_gp(
+        &data,
+        &settings,
+        &mut ChaCha8Rng::seed_from_u64(1),
+        &mut |f, _| {
+            calls.push(f);
+            true
+        },
+    )
+    .unwrap();
+    assert!(calls.len() > 3 * report.fits, "{} calls", calls.len());
+    assert!(calls.iter().filter(|f| **f == 0).count() >= 2, "{calls:?}");
+    for stop_at in [1, 2, calls.len() / 2, calls.len()] {
+        let mut n = 0;
+        let r = train_gp(
+            &data,
+            &settings,
+            &mut ChaCha8Rng::seed_from_u64(1),
+            &mut |_, _| {
+                n += 1;
+                n < stop_at
+            },
+        );
+        assert!(
+            matches!(r, Err(TrainError::Cancelled)),
+            "stopped at {stop_at}"
+        );
+        assert_eq!(n, stop_at, "asked again after the cancel");
+    }
 }

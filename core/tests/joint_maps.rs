@@ -11,7 +11,7 @@ use common::{opts, run_with};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use robocal_core::compensate::CompensatedModel;
-use robocal_core::identify::Method;
+use robocal_core::identify::{calibrate, CalibrationError, Method};
 use robocal_core::ik::{Goal, IkSettings, IkSolver, SolveOptions};
 use robocal_core::measure::{self, Measurement};
 use robocal_core::model::orientation::rotation_angle_between;
@@ -212,4 +212,32 @@ fn maps_leave_a_truth_without_them_unchanged() {
     let (km, maps) = validation_means(&s);
     eprintln!("floor {:.4} mm, KM {km:.4}, km-maps {maps:.4}", s.floor_mm);
     assert!((maps - km).abs() <= 0.02 * km, "KM {km} km-maps {maps}");
+}
+
+/// A cancel while the maps' design and normal equations are built (before
+/// the cross-validation's first candidate) ends the method: the progress
+/// callback is asked at the start of the maps' stage, its false stops the
+/// calibration as `Cancelled`, and nothing is reported after it.
+#[test]
+fn a_cancel_while_the_maps_are_built_stops_the_method() {
+    let s = study(true);
+    // km-maps alone spans 10–100 %; the first round's map fit is stage 1 of
+    // 2·rounds + 1 = 5 (methods/maps.rs), from 10 + 90·1/5 %.
+    let start = 10.0 + 90.0 * (1.0 / 5.0);
+    for stop_at in [1, 3] {
+        let seen = std::sync::Mutex::new(Vec::new());
+        let r = calibrate(&s.nominal, &s.id, &s.va, &opts(&[Method::KmMaps]), &|p| {
+            let mut seen = seen.lock().unwrap();
+            if p.phase == "km-maps" && p.percent >= start - 1e-9 {
+                seen.push(p.percent);
+            }
+            seen.len() < stop_at
+        });
+        assert!(matches!(r, Err(CalibrationError::Cancelled)), "{r:?}");
+        let seen = seen.into_inner().unwrap();
+        assert_eq!(seen.len(), stop_at, "reported after the cancel: {seen:?}");
+        for p in seen {
+            assert!((p - start).abs() < 1e-9, "{p}: a candidate ran first");
+        }
+    }
 }

@@ -5,16 +5,17 @@
 //! to the sets do not affect it). A job waits for one of the `--workers`
 //! slots, then runs `identify::calibrate` on the blocking pool. Progress
 //! (phase, iteration, percent) goes to the store at most every
-//! `progress_interval`; cancellation sets a flag that the progress callback
-//! reads (after every LM iteration, TLBO generation and compensator training
-//! epoch / iteration / generation), as does the job's time budget. Sets with
-//! role `training` (or those named in `training_set_ids`) train the
-//! compensator methods; a model version of a compensator method stores its
-//! compensator (model file format 2). A successful job stores its report and
-//! **one model version per method** that succeeded (a method that failed is
-//! listed with its reason; the others are kept); the best method (by
-//! validation mean, identification mean without validation) is activated only
-//! when the robot has no active version yet.
+//! `progress_interval`, the last one at once when the job ends (the pause
+//! never delays its outcome); cancellation sets a flag that the progress
+//! callback reads (after every LM iteration, TLBO generation, compensator
+//! training epoch / iteration / generation and step of the joint maps' fit),
+//! as does the job's time budget. Sets with role `training` (or those named
+//! in `training_set_ids`) train the compensator methods; a model version of a
+//! compensator method stores its compensator (model file format 2). A
+//! successful job stores its report and **one model version per method** that
+//! succeeded (a method that failed is listed with its reason; the others are
+//! kept); the best method (by validation mean, identification mean without
+//! validation) is activated only when the robot has no active version yet.
 //!
 //! Length: the phases of a job (set selection, loading, running, storing
 //! versions and the summary) are kept together, each in its own function.
@@ -37,7 +38,7 @@ use serde_json::json;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
-use tokio::sync::watch;
+use tokio::sync::{oneshot, watch};
 
 /// Most sets one job may name per role.
 pub const MAX_SETS: usize = crate::http::sets::MAX_SETS;
@@ -454,8 +455,10 @@ async fn write_progress(
     id: i64,
     claim: Option<String>,
     mut rx: watch::Receiver<Option<Progress>>,
+    mut ended: oneshot::Receiver<()>,
     interval: Duration,
 ) {
+    let mut running = true;
     while rx.changed().await.is_ok() {
         let p = rx.borrow_and_update().clone();
         if let Some(p) = p {
@@ -472,7 +475,15 @@ async fn write_progress(
                 tracing::warn!(job = id, error = %e, "cannot store job progress");
             }
         }
-        tokio::time::sleep(interval).await;
+        // At most one write per interval while the job runs; once it ended
+        // (its sender of `ended` dropped), the last progress at once, so the
+        // job's outcome is not held back by the pause.
+        if running {
+            tokio::select! {
+                _ = tokio::time::sleep(interval) => {}
+                _ = &mut ended => running = false,
+            }
+        }
     }
 }
 
@@ -516,11 +527,13 @@ pub(super) async fn execute(state: AppState, job: Job, claim: Option<String>) {
         ))
     });
     let (tx, rx) = watch::channel(None::<Progress>);
+    let (end_tx, end_rx) = oneshot::channel::<()>();
     let writer = tokio::spawn(write_progress(
         state.clone(),
         id,
         claim.clone(),
         rx,
+        end_rx,
         state.config().progress_interval,
     ));
     let flag = cancel.clone();
@@ -560,6 +573,7 @@ pub(super) async fn execute(state: AppState, job: Job, claim: Option<String>) {
             },
         );
         drop(tx);
+        drop(end_tx);
         report.and_then(|mut r| {
             r.session_names = session_names;
             r.pose_sources = pose_sources;

@@ -288,9 +288,16 @@ fn kernel(a: &[f64], b: &[f64], il: &[f64], s2: f64) -> f64 {
 }
 
 impl Data<'_> {
-    /// Fits the DTC model on the samples `idx` (module docs); `None` when a
-    /// factorisation fails.
-    fn fit(&self, h: &Hyper, idx: &[usize]) -> Option<Fitted> {
+    /// Fits the DTC model on the samples `idx` (module docs); `Ok(None)` when
+    /// a factorisation fails. `go()` is asked between its steps; false
+    /// cancels.
+    fn fit(
+        &self,
+        h: &Hyper,
+        idx: &[usize],
+        go: &mut dyn FnMut() -> bool,
+    ) -> Result<Option<Fitted>, TrainError> {
+        let mut check = || go().then_some(()).ok_or(TrainError::Cancelled);
         let m = self.inducing.len();
         let s2 = self.signal;
         let noise = h.noise_ratio * s2;
@@ -303,13 +310,21 @@ impl Data<'_> {
         let kzx = DMatrix::from_fn(m, idx.len(), |a, n| {
             kernel(z(a), &self.samples[idx[n]].q, &h.inverse_length, s2)
         });
+        check()?;
         let y = DMatrix::from_fn(idx.len(), 3, |n, o| self.y[idx[n]][o]);
         let a = &kzz * noise + &kzx * kzx.transpose();
-        let chol_a = a.cholesky()?;
+        check()?;
+        let Some(chol_a) = a.cholesky() else {
+            return Ok(None);
+        };
         let alpha = chol_a.solve(&(&kzx * y));
-        let kzz_inv = kzz.cholesky()?.inverse();
+        let Some(chol_kzz) = kzz.cholesky() else {
+            return Ok(None);
+        };
+        let kzz_inv = chol_kzz.inverse();
+        check()?;
         let variance = kzz_inv - chol_a.inverse() * noise;
-        Some(Fitted { alpha, variance })
+        Ok(Some(Fitted { alpha, variance }))
     }
 
     /// The predicted (centred) residual at sample `i` [mm].
@@ -324,10 +339,17 @@ impl Data<'_> {
         out
     }
 
-    /// Held-out RMS of the error norm [mm] (infinite when the fit fails).
-    fn holdout_rms(&self, h: &Hyper, train: &[usize], test: &[usize]) -> f64 {
-        let Some(f) = self.fit(h, train) else {
-            return f64::INFINITY;
+    /// Held-out RMS of the error norm [mm] (infinite when the fit fails);
+    /// `go` as in [`Data::fit`].
+    fn holdout_rms(
+        &self,
+        h: &Hyper,
+        train: &[usize],
+        test: &[usize],
+        go: &mut dyn FnMut() -> bool,
+    ) -> Result<f64, TrainError> {
+        let Some(f) = self.fit(h, train, go)? else {
+            return Ok(f64::INFINITY);
         };
         let sum: f64 = test
             .iter()
@@ -336,7 +358,7 @@ impl Data<'_> {
                 (0..3).map(|o| (self.y[i][o] - p[o]).powi(2)).sum::<f64>()
             })
             .sum();
-        (sum / test.len().max(1) as f64).sqrt()
+        Ok((sum / test.len().max(1) as f64).sqrt())
     }
 }
 
@@ -385,7 +407,8 @@ fn farthest_points(samples: &[Sample], m: usize, rng: &mut impl Rng) -> Vec<usiz
 }
 
 /// Trains the sparse GP on `samples` (module docs). `progress(fit, holdout
-/// RMS [mm])` after every candidate fit; false cancels.
+/// RMS [mm])` after every candidate fit and between the steps of every fit
+/// (the last values again); false cancels.
 pub fn train_gp(
     samples: &[Sample],
     settings: &GpSettings,
@@ -437,8 +460,14 @@ pub fn train_gp(
         .collect();
     let mut fits = 0;
     let mut best: Option<(Hyper, f64)> = None;
+    // Before any fit, the checks report the RMS of the centred residuals [mm].
+    let spread = (3.0 * signal).sqrt();
     let mut consider = |h: Hyper, best: &mut Option<(Hyper, f64)>| -> bool {
-        let rms = data.holdout_rms(&h, train, test);
+        let shown = best.as_ref().map_or(spread, |b| b.1);
+        let done = fits;
+        let Ok(rms) = data.holdout_rms(&h, train, test, &mut || progress(done, shown)) else {
+            return false;
+        };
         fits += 1;
         if best.as_ref().is_none_or(|b| rms < b.1) {
             *best = Some((h, rms));
@@ -471,8 +500,11 @@ pub fn train_gp(
     let (hyper, holdout_after) = best
         .filter(|b| b.1.is_finite())
         .ok_or(TrainError::GpSingular)?;
+    let mut go = || progress(fits, holdout_after);
     // κ: held-out RMS error over the held-out RMS of √(3·v).
-    let fitted = data.fit(&hyper, train).ok_or(TrainError::GpSingular)?;
+    let fitted = data
+        .fit(&hyper, train, &mut go)?
+        .ok_or(TrainError::GpSingular)?;
     let gp_part = to_gp(&data, &hyper, &fitted, dof, 1.0, uncompensated_rms);
     let predicted: f64 = test
         .iter()
@@ -484,8 +516,13 @@ pub fn train_gp(
     } else {
         1.0
     };
+    if !go() {
+        return Err(TrainError::Cancelled);
+    }
     let all: Vec<usize> = (0..n).collect();
-    let fitted = data.fit(&hyper, &all).ok_or(TrainError::GpSingular)?;
+    let fitted = data
+        .fit(&hyper, &all, &mut go)?
+        .ok_or(TrainError::GpSingular)?;
     let gp = to_gp(&data, &hyper, &fitted, dof, error_scale, uncompensated_rms);
     let holdout_before = (test
         .iter()

@@ -41,6 +41,41 @@ pub(crate) fn gram(j: &DMatrix<f64>) -> DMatrix<f64> {
     a
 }
 
+/// Rows of `j` per step of [`gram_checked`]: a multiple of `matrixmultiply`'s
+/// depth block for f64 (`kc` = 256 for every kernel of matrixmultiply 0.3).
+const GRAM_STEP_ROWS: usize = 8 * 256;
+
+/// [`gram`] in steps of [`GRAM_STEP_ROWS`] rows of `j` (`jᵀj = Σ_steps
+/// j_sᵀj_s`, each step accumulated into the result by `gemm` with β = 1), with
+/// `go()` between steps; `None` as soon as it returns false. The steps start
+/// where `gram`'s own depth blocks start, so the result is `gram(j)` bit for
+/// bit (the blocks add the same partial sums in the same order).
+pub(crate) fn gram_checked(j: &DMatrix<f64>, go: &mut dyn FnMut() -> bool) -> Option<DMatrix<f64>> {
+    let (m, n) = j.shape();
+    // A step of 5 rows or fewer would leave matrixmultiply (see `gram`).
+    if m <= GRAM_STEP_ROWS + 5 || n <= 5 {
+        return Some(gram(j));
+    }
+    let mut a = DMatrix::zeros(n, n);
+    let mut start = 0;
+    while start < m {
+        let rest = m - start;
+        let len = if rest <= GRAM_STEP_ROWS + 5 {
+            rest
+        } else {
+            GRAM_STEP_ROWS
+        };
+        let jt = DMatrixView::from_slice_with_strides(&j.as_slice()[start..], n, len, m, 1);
+        let beta = if start == 0 { 0.0 } else { 1.0 };
+        a.gemm(1.0, &jt, &j.rows(start, len), beta);
+        start += len;
+        if start < m && !go() {
+            return None;
+        }
+    }
+    Some(a)
+}
+
 pub(crate) struct Eval {
     pub r: DVector<f64>,
     pub j: Option<DMatrix<f64>>,
@@ -267,6 +302,46 @@ mod tests {
                         assert_eq!(x, 0.0);
                     }
                 }
+            }
+        }
+    }
+
+    /// `gram_checked` is `gram` bit for bit (tall shapes of several steps,
+    /// a last step of 6 rows, a remainder of 5 rows folded into the step
+    /// before, a single step), calls `go` between its steps only, and stops
+    /// at the first false.
+    #[test]
+    fn gram_in_steps_is_gram_bit_for_bit_and_stops_when_asked() {
+        let mut rng = ChaCha8Rng::seed_from_u64(6);
+        for (m, n, steps) in [
+            (30_000, 40, 15),
+            (3 * GRAM_STEP_ROWS + 6, 12, 4),
+            (3 * GRAM_STEP_ROWS + 5, 12, 3),
+            (GRAM_STEP_ROWS + 5, 9, 1),
+            (5000, 5, 1),
+        ] {
+            let j = DMatrix::from_fn(m, n, |_, c| {
+                rng.gen_range(-1.0..1.0) * 10f64.powi(c as i32 % 7 - 3)
+            });
+            let mut calls = 0;
+            let a = gram_checked(&j, &mut || {
+                calls += 1;
+                true
+            })
+            .unwrap();
+            assert_eq!(calls, steps - 1, "{m}×{n}");
+            let b = gram(&j);
+            for (x, y) in a.iter().zip(b.iter()) {
+                assert_eq!(x.to_bits(), y.to_bits(), "{m}×{n}");
+            }
+            if steps > 2 {
+                let mut calls = 0;
+                let stopped = gram_checked(&j, &mut || {
+                    calls += 1;
+                    calls < 2
+                });
+                assert!(stopped.is_none());
+                assert_eq!(calls, 2);
             }
         }
     }

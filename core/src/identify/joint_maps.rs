@@ -18,7 +18,7 @@
 //! Each joint's map covers the range of its training angles and fades to
 //! zero beyond it; a joint that moves less than `min_range_rad` gets none.
 
-use super::evaluate::{evaluate, gram};
+use super::evaluate::{evaluate, gram_checked};
 use crate::measure::Measurement;
 use crate::model::{JointMap, JointMaps, ParamId, ParamKind, Pose, RobotModel};
 use nalgebra::{DMatrix, DVector};
@@ -143,6 +143,13 @@ impl Design {
     }
 }
 
+/// Poses of the design filled between two checks of `go` in [`build`].
+const BUILD_CHECK_POSES: usize = 1000;
+
+/// The design matrix of the maps on `data` (module docs); `Ok(None)` as soon
+/// as `go()` returns false (it is asked after the Jacobians and every
+/// [`BUILD_CHECK_POSES`] poses).
+#[allow(clippy::too_many_arguments)]
 fn build(
     model: &RobotModel,
     frames: &[Pose],
@@ -151,7 +158,8 @@ fn build(
     weight: f64,
     kmax: usize,
     settings: &JointMapSettings,
-) -> Result<Design, MapFitError> {
+    go: &mut dyn FnMut() -> bool,
+) -> Result<Option<Design>, MapFitError> {
     let n = model.dof();
     let geo_eval =
         evaluate(model, frames, ids, data, weight, true).ok_or(MapFitError::NotEvaluable)?;
@@ -159,6 +167,9 @@ fn build(
     let theta_eval =
         evaluate(model, frames, &theta, data, weight, true).ok_or(MapFitError::NotEvaluable)?;
     let (jg, jt) = (geo_eval.j.expect("asked"), theta_eval.j.expect("asked"));
+    if !go() {
+        return Ok(None);
+    }
     let mut joints = Vec::new();
     for i in 0..n {
         let lo = data.iter().map(|m| m.q[i]).fold(f64::INFINITY, f64::min);
@@ -190,7 +201,10 @@ fn build(
         joints,
         kmax,
     };
-    for m in data {
+    for (p, m) in data.iter().enumerate() {
+        if p % BUILD_CHECK_POSES == BUILD_CHECK_POSES - 1 && !go() {
+            return Ok(None);
+        }
         let nr = if m.orientation.is_some() { 6 } else { 3 };
         pose_rows.push((row, nr));
         for (slot, (i, _)) in design.joints.iter().enumerate() {
@@ -209,7 +223,7 @@ fn build(
     }
     design.a = a;
     design.pose_rows = pose_rows;
-    Ok(design)
+    Ok(Some(design))
 }
 
 /// Ridge solution on the columns `cols` of the normal equations `g`, `b`,
@@ -277,8 +291,13 @@ fn held_out_errors(d: &Design, poses: &[usize], cols: &[usize], x: &DVector<f64>
         .collect()
 }
 
-/// The normal equations `AᵀA`, `Aᵀr` of the rows of `poses`.
-fn normal_of(d: &Design, poses: &[usize]) -> (DMatrix<f64>, DVector<f64>) {
+/// The normal equations `AᵀA`, `Aᵀr` of the rows of `poses`; `None` when
+/// `go()` returns false between the steps of `AᵀA` ([`gram_checked`]).
+fn normal_of(
+    d: &Design,
+    poses: &[usize],
+    go: &mut dyn FnMut() -> bool,
+) -> Option<(DMatrix<f64>, DVector<f64>)> {
     let rows: usize = poses.iter().map(|p| d.pose_rows[*p].1).sum();
     let mut a = DMatrix::zeros(rows, d.a.ncols());
     let mut r = DVector::zeros(rows);
@@ -289,13 +308,15 @@ fn normal_of(d: &Design, poses: &[usize]) -> (DMatrix<f64>, DVector<f64>) {
         r.rows_mut(at, nr).copy_from(&d.r.rows(row, nr));
         at += nr;
     }
-    (gram(&a), a.tr_mul(&r))
+    Some((gram_checked(&a, go)?, a.tr_mul(&r)))
 }
 
 /// Fits the maps of `model` (its own maps ignored) on `data` with the session
 /// frames `frames` and the identified parameters `ids`: K and λ by
 /// cross-validation, then the coefficients on all poses. `progress(done,
-/// total)` after each candidate; false cancels (`Ok(None)`).
+/// total)` after each candidate's fold and between the steps of building the
+/// design and its normal equations (`done` = candidates done); false cancels
+/// (`Ok(None)`).
 #[allow(clippy::too_many_arguments)]
 pub fn fit_joint_maps(
     model: &RobotModel,
@@ -334,7 +355,15 @@ pub fn fit_joint_maps(
     ks.sort_unstable();
     ks.dedup();
     let kmax = ks.last().copied().unwrap_or(0);
-    let d = build(
+    let mut grid: Vec<(usize, f64)> = vec![(0, 0.0)];
+    for k in &ks {
+        for l in &settings.ridge {
+            grid.push((*k, *l));
+        }
+    }
+    let total = grid.len() + 1;
+    let mut go = || progress(0, total);
+    let Some(d) = build(
         &plain,
         frames,
         ids,
@@ -342,8 +371,15 @@ pub fn fit_joint_maps(
         orientation_weight,
         kmax.max(1),
         settings,
-    )?;
-    let (g, b) = (gram(&d.a), d.a.tr_mul(&d.r));
+        &mut go,
+    )?
+    else {
+        return Ok(None);
+    };
+    let Some(g) = gram_checked(&d.a, &mut go) else {
+        return Ok(None);
+    };
+    let b = d.a.tr_mul(&d.r);
     let scale: Vec<f64> = (0..g.ncols())
         .map(|c| {
             let s = g[(c, c)].sqrt();
@@ -360,12 +396,11 @@ pub fn fit_joint_maps(
     let fold_poses: Vec<Vec<usize>> = (0..folds)
         .map(|f| order.iter().copied().skip(f).step_by(folds).collect())
         .collect();
-    let fold_normals: Vec<(DMatrix<f64>, DVector<f64>)> =
-        fold_poses.iter().map(|p| normal_of(&d, p)).collect();
-    let mut grid: Vec<(usize, f64)> = vec![(0, 0.0)];
-    for k in &ks {
-        for l in &settings.ridge {
-            grid.push((*k, *l));
+    let mut fold_normals: Vec<(DMatrix<f64>, DVector<f64>)> = Vec::with_capacity(folds);
+    for p in &fold_poses {
+        match normal_of(&d, p, &mut go) {
+            Some(n) if go() => fold_normals.push(n),
+            _ => return Ok(None),
         }
     }
     let mut candidates = Vec::new();
@@ -378,6 +413,9 @@ pub fn fit_joint_maps(
                 Some(x) => errors.extend(held_out_errors(&d, poses, &cols, &x)),
                 None => ok = false,
             }
+            if !progress(done, total) {
+                return Ok(None);
+            }
         }
         if ok {
             candidates.push(MapCandidate {
@@ -388,7 +426,7 @@ pub fn fit_joint_maps(
                 cv_cost_mm2: seed_cost(&errors),
             });
         }
-        if !progress(done + 1, grid.len() + 1) {
+        if !progress(done + 1, total) {
             return Ok(None);
         }
     }
@@ -426,7 +464,9 @@ pub fn fit_joint_maps(
         }
         Some(JointMaps { joints })
     };
-    progress(grid.len() + 1, grid.len() + 1);
+    if !progress(total, total) {
+        return Ok(None);
+    }
     Ok(Some(MapFit {
         maps,
         chosen,

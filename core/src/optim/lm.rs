@@ -45,6 +45,15 @@ pub trait LeastSquaresProblem {
     fn gram(&self, j: &DMatrix<f64>) -> DMatrix<f64> {
         j.tr_mul(j)
     }
+    /// `JᵀJ` of [`jacobian`](Self::jacobian); a problem may compute it in
+    /// parts and cancel between them (`None`). Default: [`gram`](Self::gram).
+    fn gram_of_jacobian(&mut self) -> Option<DMatrix<f64>> {
+        Some(self.gram(self.jacobian()))
+    }
+    /// Asked before every trial step; false cancels the run.
+    fn go_on(&mut self) -> bool {
+        true
+    }
     /// Column values and box at the current point; `None` when unbounded.
     fn bounds(&self) -> Option<Bounds<'_>> {
         None
@@ -389,8 +398,10 @@ pub fn minimise<P: LeastSquaresProblem + ?Sized>(
             fresh = true;
         }
         linearisations += 1;
+        let Some(a) = p.gram_of_jacobian() else {
+            return Err(Cancelled);
+        };
         let js = p.jacobian();
-        let a = p.gram(js);
         let g = js.tr_mul(p.residuals());
         mark_active(&mut active, p.bounds(), &g);
         let gradient = gradient_measure(js, &g, cost.sqrt(), &active);
@@ -406,6 +417,9 @@ pub fn minimise<P: LeastSquaresProblem + ?Sized>(
         // Largest relative cost decrease the linear model predicts for a trial.
         let mut predicted = f64::NEG_INFINITY;
         while damping.usable() && iterations < s.max_iterations {
+            if !p.go_on() {
+                return Err(Cancelled);
+            }
             iterations += 1;
             trials += 1;
             let mut damped = a.clone();

@@ -135,7 +135,12 @@ struct Backprop<'a> {
     fails: usize,
     max_fail: usize,
     progress: &'a mut dyn FnMut(usize, f64) -> bool,
+    /// The last (epoch, loss) reported, repeated by the checks within an epoch.
+    reported: (usize, f64),
 }
+
+/// Columns of `JᵀJ` per part in [`Backprop::gram_of_jacobian`].
+const GRAM_COLUMNS: usize = 64;
 
 impl<'a> Backprop<'a> {
     fn new(
@@ -165,8 +170,10 @@ impl<'a> Backprop<'a> {
             max_fail,
             w,
             progress,
+            reported: (0, 0.0),
         };
         p.cost = p.sse(&p.w);
+        p.reported = (0, p.cost / rows.max(1) as f64);
         p
     }
 
@@ -208,6 +215,31 @@ impl LeastSquaresProblem for Backprop<'_> {
         &self.jac
     }
 
+    /// `JᵀJ` by blocks of [`GRAM_COLUMNS`] columns, each entry the same
+    /// column dot product as in `jac.tr_mul(&jac)` (bit for bit), with the
+    /// progress asked between blocks: an epoch's longest step, cancellable.
+    fn gram_of_jacobian(&mut self) -> Option<DMatrix<f64>> {
+        let nw = self.jac.ncols();
+        let mut a = DMatrix::zeros(nw, nw);
+        let mut c = 0;
+        while c < nw {
+            let w = GRAM_COLUMNS.min(nw - c);
+            let block = self.jac.tr_mul(&self.jac.columns(c, w));
+            a.columns_mut(c, w).copy_from(&block);
+            c += w;
+            if c < nw && !self.go_on() {
+                return None;
+            }
+        }
+        Some(a)
+    }
+
+    /// The progress of the epoch under way (the last one reported, again).
+    fn go_on(&mut self) -> bool {
+        let (epoch, loss) = self.reported;
+        (self.progress)(epoch, loss)
+    }
+
     fn trial(&mut self, delta: &mut DVector<f64>) -> Option<f64> {
         let trial: Vec<f64> = self
             .w
@@ -243,10 +275,85 @@ impl LeastSquaresProblem for Backprop<'_> {
             }
         }
         let loss = self.cost / (self.fit.len() * 3) as f64;
+        self.reported = (at.linearisations - 1, loss);
         if (self.progress)(at.linearisations - 1, loss) {
             Flow::Continue
         } else {
             Flow::Cancel
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::tests::smooth;
+    use super::super::MlpSpec;
+    use super::*;
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+
+    /// The blocked `JᵀJ` of an epoch is `tr_mul`'s bit for bit (a network
+    /// of 443 weights: several blocks and a partial last one).
+    #[test]
+    fn the_blocked_gram_is_tr_mul_bit_for_bit() {
+        let samples = smooth(200, 8);
+        let data = Prepared::new(&samples, &MlpSpec::SKCM_NN);
+        let mut rng = ChaCha8Rng::seed_from_u64(2);
+        let w = nguyen_widrow(&data.shape, &mut rng);
+        let fit: Vec<usize> = (0..data.n()).collect();
+        let mut go = |_: usize, _: f64| true;
+        let mut p = Backprop::new(&data, &fit, &[], w, 6, &mut go);
+        p.linearise();
+        assert!(p.jac.ncols() > 2 * GRAM_COLUMNS && !p.jac.ncols().is_multiple_of(GRAM_COLUMNS));
+        let blocked = p.gram_of_jacobian().unwrap();
+        let whole = p.jac.tr_mul(&p.jac);
+        for (x, y) in blocked.iter().zip(whole.iter()) {
+            assert_eq!(x.to_bits(), y.to_bits());
+        }
+    }
+
+    /// The progress is asked within every epoch (between the blocks of
+    /// `JᵀJ` and before every trial), not only after it, and a false there
+    /// ends the training at once as cancelled.
+    #[test]
+    fn a_cancel_within_an_epoch_ends_the_training() {
+        let samples = smooth(200, 9);
+        let data = Prepared::new(&samples, &MlpSpec::SKCM_NN);
+        let settings = LmTrainSettings {
+            max_epochs: 5,
+            ..Default::default()
+        };
+        let mut calls: Vec<(usize, f64)> = Vec::new();
+        let run = lm(
+            &data,
+            &settings,
+            &mut ChaCha8Rng::seed_from_u64(4),
+            &mut |e, l| {
+                calls.push((e, l));
+                true
+            },
+        )
+        .unwrap();
+        // One report per epoch after it, plus the checks within each.
+        assert!(calls.len() > 3 * run.epochs, "{} calls", calls.len());
+        // The first epoch's checks come before it ended: its report repeats
+        // the untrained loss until the epoch's own loss, which is lower.
+        let first_epoch_end = calls.iter().position(|c| c.1 != calls[0].1).unwrap();
+        assert!(first_epoch_end >= 2, "{calls:?}");
+        assert!(calls[first_epoch_end].1 < calls[0].1);
+        for stop_at in [1, first_epoch_end / 2 + 1, calls.len() / 2] {
+            let mut n = 0;
+            let r = lm(
+                &data,
+                &settings,
+                &mut ChaCha8Rng::seed_from_u64(4),
+                &mut |_, _| {
+                    n += 1;
+                    n < stop_at
+                },
+            );
+            assert!(matches!(r, Err(TrainError::Cancelled)));
+            assert_eq!(n, stop_at, "asked again after the cancel");
         }
     }
 }

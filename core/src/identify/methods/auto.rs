@@ -143,7 +143,11 @@ pub(crate) fn run_auto(
         let Some(method) = maps_candidate(&o.auto_candidates, *base) else {
             continue;
         };
+        // The maps, then the compensators on them: a unit of the bar each,
+        // whether they run or not.
         let (at, span) = (done / total, 1.0 / total);
+        let on_maps_at = done + 1.0;
+        done += 1.0 + on_maps_candidates(ctx, *base).len() as f64;
         let outcome = run_maps(ctx, cache, *base, &mut |f, it, l| {
             progress(at + span * f, it, l)
         });
@@ -175,9 +179,8 @@ pub(crate) fn run_auto(
                         &fit,
                         folds,
                         &mut candidates,
-                        &mut |f, e, l| progress((done + f) / total, e, l),
+                        &mut |f, e, l| progress((on_maps_at + f) / total, e, l),
                     )?;
-                    done += on_maps.trained as f64;
                     options.push(BaseOption {
                         base: *base,
                         maps: Some(method),
@@ -208,7 +211,6 @@ pub(crate) fn run_auto(
                 }
             }
         }
-        done += 1.0;
     }
     let best = options
         .iter()
@@ -253,10 +255,24 @@ pub(crate) fn run_auto(
 /// What `auto` made of the compensators on a kept joint-map fit.
 struct OnMaps {
     kept: Option<AppliedCompensator>,
-    /// How many were trained (for the progress).
-    trained: usize,
     /// The choice, as a prefix of the maps' reason (empty: none tried).
     reason: String,
+}
+
+/// The candidate compensators on the joint-map fit of `base`.
+fn on_maps_candidates(ctx: &Context, base: Base) -> Vec<(Method, Compensated)> {
+    let on = if base == Base::Km {
+        Base::KmMaps
+    } else {
+        Base::SkcmMaps
+    };
+    ctx.opts
+        .compensator
+        .auto_candidates
+        .iter()
+        .filter_map(|m| Some((*m, m.compensated()?)))
+        .filter(|(_, c)| c.base == on)
+        .collect()
 }
 
 /// Cross-validates the candidate compensators on the joint-map fit of `base`
@@ -272,23 +288,10 @@ fn maps_compensator(
     candidates: &mut Vec<AutoCandidate>,
     progress: &mut dyn FnMut(f64, usize, Option<f64>) -> bool,
 ) -> Result<OnMaps, MethodError> {
-    let on = if base == Base::Km {
-        Base::KmMaps
-    } else {
-        Base::SkcmMaps
-    };
-    let methods: Vec<(Method, Compensated)> = ctx
-        .opts
-        .compensator
-        .auto_candidates
-        .iter()
-        .filter_map(|m| Some((*m, m.compensated()?)))
-        .filter(|(_, c)| c.base == on)
-        .collect();
+    let methods = on_maps_candidates(ctx, base);
     if methods.is_empty() {
         return Ok(OnMaps {
             kept: None,
-            trained: 0,
             reason: String::new(),
         });
     }
@@ -296,7 +299,6 @@ fn maps_compensator(
         cross_validate_and_choose(ctx, cache, &methods, &fit.fit, folds, candidates, progress)?;
     Ok(OnMaps {
         kept,
-        trained: methods.len(),
         reason: format!("on {}: {}; ", base.method().name(), choice.reason),
     })
 }
