@@ -183,6 +183,8 @@ impl Gp {
     }
 }
 
+// The reference evaluation; a stored GP becomes a compensator as
+// [`super::PreparedGp`], the same numbers faster.
 impl Compensator for Gp {
     fn residual(&self, q: &[f64], _tau: &[f64]) -> Vector3<f64> {
         (0..self.units())

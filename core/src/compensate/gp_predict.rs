@@ -366,9 +366,9 @@ fn kernel_weight(d2: f64) -> f64 {
 fn exp_nonpositive(x: f64) -> f64 {
     // 1.5·2⁵²: adding it rounds to an integer held in the low mantissa bits.
     const MAGIC: f64 = 6_755_399_441_055_744.0;
-    // ln 2 in two parts (fdlibm): `n·LN2_HI` is exact for |n| < 2²⁰.
-    const LN2_HI: f64 = 6.931_471_803_691_238_164_90e-1;
-    const LN2_LO: f64 = 1.908_214_929_270_587_700_02e-10;
+    // ln 2 in two parts (fdlibm's bits): `n·LN2_HI` is exact for |n| < 2²⁰.
+    const LN2_HI: f64 = f64::from_bits(0x3fe6_2e42_fee0_0000);
+    const LN2_LO: f64 = f64::from_bits(0x3dea_39ef_3579_3c76);
     const C: [f64; 14] = [
         1.0,
         1.0,
