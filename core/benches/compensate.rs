@@ -8,8 +8,9 @@
 //! - `predict/mlp_18-20-3_residual`: one residual of the trained SKCM-NN
 //!   network (18-20-3: q, sin q, cos q);
 //! - `predict/mlp_18-20-3_residual_and_dq`: residual plus its 3×6 derivative;
-//! - `predict/gp_residual_and_dq`: residual plus derivative of the Gaussian
-//!   process (300 inducing configurations) trained on the same 1000 samples;
+//! - `predict/gp_residual`, `predict/gp_residual_and_dq`: residual alone and
+//!   residual plus derivative of the Gaussian process (300 inducing
+//!   configurations) trained on the same 1000 samples;
 //! - `train_{1500,10000}/gp`: one training of the Gaussian process;
 //! - `ik/solve_{plain,compensated,gp,maps}`: one calibrated IK solve without
 //!   a compensator, with the 18-20-3 network, with the Gaussian process, and
@@ -105,6 +106,13 @@ fn bench(c: &mut Criterion) {
             i = (i + 1) % qs.len();
             let q = black_box(&qs[i]);
             black_box((net.residual(q, &tau), net.jacobian_q(q, &tau, 110.0)))
+        })
+    });
+    let mut i = 0;
+    g.bench_function("gp_residual", |b| {
+        b.iter(|| {
+            i = (i + 1) % qs.len();
+            black_box(gp.residual(black_box(&qs[i]), &tau))
         })
     });
     let mut i = 0;

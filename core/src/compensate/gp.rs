@@ -30,7 +30,7 @@ use serde::{Deserialize, Serialize};
 
 /// Inducing configurations farther than this squared scaled distance add
 /// nothing (`exp(−25)` ≈ 1.4e-11 of the signal) and are skipped.
-const CUTOFF: f64 = 50.0;
+pub(super) const CUTOFF: f64 = 50.0;
 
 /// Settings of the Gaussian-process compensator.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -183,6 +183,8 @@ impl Gp {
     }
 }
 
+// The reference evaluation; a stored GP becomes a compensator as
+// [`super::PreparedGp`], the same numbers faster.
 impl Compensator for Gp {
     fn residual(&self, q: &[f64], _tau: &[f64]) -> Vector3<f64> {
         (0..self.units())

@@ -29,6 +29,7 @@ use std::sync::Arc;
 
 pub mod file;
 pub mod gp;
+pub mod gp_predict;
 pub mod mlp;
 pub mod rbf;
 pub mod select;
@@ -38,6 +39,7 @@ pub mod train;
 
 pub use file::{parse_compensated, CalibratedModelFile, PoseDescription, CALIBRATED_MODEL_FORMAT};
 pub use gp::{train_gp, Gp, GpReport, GpSettings, Uncertainty};
+pub use gp_predict::PreparedGp;
 pub use mlp::{Features, Mlp, Normalisation};
 pub use rbf::{
     train_rbf, train_rbf_with_progress, OutputFrame, Rbf, RbfReport, RbfSettings, RbfTrainError,
@@ -146,7 +148,7 @@ impl StoredCompensator {
         match self {
             StoredCompensator::Mlp(m) => Arc::new(m),
             StoredCompensator::Rbf(r) => Arc::new(r),
-            StoredCompensator::Gp(g) => Arc::new(g),
+            StoredCompensator::Gp(g) => Arc::new(PreparedGp::new(g)),
         }
     }
 }

@@ -1,0 +1,546 @@
+//! The trained Gaussian process ([`Gp`]) prepared for fast prediction: its
+//! mean residual, the joint derivative and the kernel row in
+//! structure-of-arrays form (docs/design.md "Gaussian-process compensator").
+//!
+//! Units as [`Gp`]: joints `q` [rad], residual [m], derivative [m/rad]. For
+//! each *active* joint a (`1/ℓ_a > 0`; the others are left out) it holds
+//! `u_am = z_ma/ℓ_a` contiguous over the inducing configurations m, and per
+//! component c the weights `s²·α_cm`. With `v_a = q_a/ℓ_a`,
+//! `d²_m = Σ_a (v_a − u_am)²` and `w_m = exp(−½·d²_m)` (0 beyond the cutoff):
+//!
+//! - `μ_c(q) = r̄_c + Σ_m w_m·s²α_cm`;
+//! - `∂μ_c/∂q_a = −(1/ℓ_a)·Σ_m w_m·s²α_cm·(v_a − u_am)`.
+//!
+//! The loops run branch-free over chunks of [`CHUNK`] inducing configurations
+//! (zero weights pad them to a multiple of [`LANES`]), sums in [`LANES`]
+//! partial sums, which the compiler vectorises for plain x86-64 (SSE2). On
+//! CPUs with AVX2 (detected at run time) the same code compiled for AVX2 runs:
+//! the same operations per lane in the same order, so bitwise the same results
+//! (Rust never fuses a multiply and an add), in less time. Built once when a
+//! `Gp` becomes a compensator ([`StoredCompensator::into_arc`]);
+//! [`Compensator::stored`] returns the `Gp`.
+
+use super::gp::{Gp, Uncertainty, CUTOFF};
+use super::{Compensator, StoredCompensator};
+use nalgebra::Vector3;
+
+/// Partial sums of a reduction (a loop over arrays of this length vectorises).
+const LANES: usize = 4;
+/// Inducing configurations handled per pass: the loops over them are long
+/// enough for the compiler's loop vectoriser, their values stay on the stack.
+const CHUNK: usize = 64;
+/// Active joints held on the stack (more go to the heap).
+const STACK_JOINTS: usize = 16;
+
+/// A [`Gp`] with its prediction data laid out for vectorised loops (module docs).
+#[derive(Debug, Clone)]
+pub struct PreparedGp {
+    gp: Gp,
+    /// Active joints (`1/ℓ > 0`), ascending.
+    joints: Vec<usize>,
+    /// `1/ℓ_a` of the active joints [1/rad].
+    inverse_lengths: Vec<f64>,
+    /// Inducing configurations rounded up to a multiple of [`LANES`].
+    padded: usize,
+    /// `u_am`, active joint a's row at `a·padded`; 0 in the padding.
+    scaled: Vec<f64>,
+    /// `s²·α_cm` [m], component c's row at `c·padded`; 0 in the padding.
+    weights: Vec<f64>,
+    /// The CPU has AVX2: the same loops compiled for it run (module docs).
+    avx2: bool,
+}
+
+impl PreparedGp {
+    /// The prepared form of `gp` (assumed valid: [`Gp::validate`]).
+    pub fn new(gp: Gp) -> Self {
+        let m = gp.units();
+        let padded = m.div_ceil(LANES) * LANES;
+        let (joints, inverse_lengths): (Vec<usize>, Vec<f64>) = gp
+            .inverse_length_scales
+            .iter()
+            .enumerate()
+            .filter(|(_, il)| **il > 0.0)
+            .map(|(j, il)| (j, *il))
+            .unzip();
+        let mut scaled = vec![0.0; joints.len() * padded];
+        for (a, (&j, &il)) in joints.iter().zip(&inverse_lengths).enumerate() {
+            for i in 0..m {
+                scaled[a * padded + i] = gp.inducing[i * gp.dof + j] * il;
+            }
+        }
+        let mut weights = vec![0.0; 3 * padded];
+        for i in 0..m {
+            for c in 0..3 {
+                weights[c * padded + i] = gp.signal_variance * gp.alpha[3 * i + c];
+            }
+        }
+        PreparedGp {
+            gp,
+            joints,
+            inverse_lengths,
+            padded,
+            scaled,
+            weights,
+            avx2: has_avx2(),
+        }
+    }
+
+    /// The model it was prepared from.
+    pub fn gp(&self) -> &Gp {
+        &self.gp
+    }
+
+    /// `v_a = q_a/ℓ_a` of the active joints into `v`.
+    fn scale_joints(&self, q: &[f64], v: &mut [f64]) {
+        for ((va, &j), &il) in v.iter_mut().zip(&self.joints).zip(&self.inverse_lengths) {
+            *va = q[j] * il;
+        }
+    }
+
+    /// `w_m` of the inducing configurations from `start` into `w` (one each).
+    #[inline(always)]
+    fn chunk_weights(&self, v: &[f64], start: usize, w: &mut [f64]) {
+        // `w` holds d² first.
+        w.fill(0.0);
+        for (a, va) in v.iter().enumerate() {
+            let u = &self.scaled[a * self.padded + start..][..w.len()];
+            for (d, u) in w.iter_mut().zip(u) {
+                let t = va - u;
+                *d += t * t;
+            }
+        }
+        for x in w.iter_mut() {
+            *x = kernel_weight(*x);
+        }
+    }
+
+    /// `s²·α_c` of the inducing configurations from `start` (`len` of them).
+    fn signal_weights(&self, c: usize, start: usize, len: usize) -> &[f64] {
+        &self.weights[c * self.padded + start..][..len]
+    }
+
+    /// `μ(q)` [m] (module docs).
+    fn mean_at(&self, v: &[f64]) -> Vector3<f64> {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: the CPU has AVX2 (`has_avx2` in `new`).
+            return unsafe { self.mean_at_avx2(v) };
+        }
+        self.mean_at_generic(v)
+    }
+
+    /// [`Self::mean_at_generic`] compiled for AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn mean_at_avx2(&self, v: &[f64]) -> Vector3<f64> {
+        self.mean_at_generic(v)
+    }
+
+    /// [`Self::mean_and_sums_generic`] compiled for AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn mean_and_sums_avx2(&self, v: &[f64], s: &mut [[[f64; LANES]; 3]]) -> Vector3<f64> {
+        self.mean_and_sums_generic(v, s)
+    }
+
+    /// `μ(q)` [m] and the sums `S_ca` ([`Self::mean_and_sums_generic`]).
+    fn mean_and_sums(&self, v: &[f64], s: &mut [[[f64; LANES]; 3]]) -> Vector3<f64> {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: the CPU has AVX2 (`has_avx2` in `new`).
+            return unsafe { self.mean_and_sums_avx2(v, s) };
+        }
+        self.mean_and_sums_generic(v, s)
+    }
+
+    /// `μ(q)` [m], for any target.
+    #[inline(always)]
+    fn mean_at_generic(&self, v: &[f64]) -> Vector3<f64> {
+        let mut r = [[0.0; LANES]; 3];
+        let mut w = [0.0; CHUNK];
+        for start in (0..self.padded).step_by(CHUNK) {
+            let w = &mut w[..CHUNK.min(self.padded - start)];
+            self.chunk_weights(v, start, w);
+            for (c, rc) in r.iter_mut().enumerate() {
+                let s2a = self.signal_weights(c, start, w.len());
+                for (x, y) in w.chunks_exact(LANES).zip(s2a.chunks_exact(LANES)) {
+                    for k in 0..LANES {
+                        rc[k] += x[k] * y[k];
+                    }
+                }
+            }
+        }
+        Vector3::from(self.gp.mean) + Vector3::from_fn(|c, _| r[c].iter().sum::<f64>())
+    }
+
+    /// `μ(q)` [m] and the sums `S_ca = Σ_m w_m·s²α_cm·(v_a − u_am)` into `s`
+    /// (partial sums per lane), for any target.
+    #[inline(always)]
+    fn mean_and_sums_generic(&self, v: &[f64], s: &mut [[[f64; LANES]; 3]]) -> Vector3<f64> {
+        let mut r = [[0.0; LANES]; 3];
+        let mut w = [0.0; CHUNK];
+        let mut wa = [[0.0; CHUNK]; 3];
+        for start in (0..self.padded).step_by(CHUNK) {
+            let len = CHUNK.min(self.padded - start);
+            let w = &mut w[..len];
+            self.chunk_weights(v, start, w);
+            for (c, (rc, wac)) in r.iter_mut().zip(wa.iter_mut()).enumerate() {
+                let s2a = self.signal_weights(c, start, len);
+                for ((o, x), y) in wac[..len].iter_mut().zip(&*w).zip(s2a) {
+                    *o = x * y;
+                }
+                for x in wac[..len].chunks_exact(LANES) {
+                    for k in 0..LANES {
+                        rc[k] += x[k];
+                    }
+                }
+            }
+            for (a, (va, sa)) in v.iter().zip(s.iter_mut()).enumerate() {
+                let u = &self.scaled[a * self.padded + start..][..len];
+                let [w0, w1, w2] = &wa;
+                let groups = u
+                    .chunks_exact(LANES)
+                    .zip(w0[..len].chunks_exact(LANES))
+                    .zip(w1[..len].chunks_exact(LANES))
+                    .zip(w2[..len].chunks_exact(LANES));
+                let mut acc = *sa;
+                for (((ug, x0), x1), x2) in groups {
+                    for k in 0..LANES {
+                        let t = va - ug[k];
+                        acc[0][k] += x0[k] * t;
+                        acc[1][k] += x1[k] * t;
+                        acc[2][k] += x2[k] * t;
+                    }
+                }
+                *sa = acc;
+            }
+        }
+        Vector3::from(self.gp.mean) + Vector3::from_fn(|c, _| r[c].iter().sum::<f64>())
+    }
+
+    /// Kernel values `k_Z(q) = s²·w` into `k` (one per inducing configuration).
+    pub fn kernel_row(&self, q: &[f64], k: &mut [f64]) {
+        with_joints(self.joints.len(), |v| {
+            self.scale_joints(q, v);
+            let mut w = [0.0; CHUNK];
+            for (start, out) in (0..self.padded).step_by(CHUNK).zip(k.chunks_mut(CHUNK)) {
+                let w = &mut w[..CHUNK.min(self.padded - start)];
+                self.chunk_weights(v, start, w);
+                for (o, x) in out.iter_mut().zip(&*w) {
+                    *o = self.gp.signal_variance * x;
+                }
+            }
+        })
+    }
+
+    /// Predictive variance of one residual component at `q` [m²] ([`Gp::variance_at`]).
+    pub fn variance_at(&self, q: &[f64]) -> f64 {
+        let m = self.gp.units();
+        let mut k = vec![0.0; m];
+        self.kernel_row(q, &mut k);
+        let mut quad = 0.0;
+        for (i, ki) in k.iter().enumerate() {
+            if *ki != 0.0 {
+                quad += ki * dot(&self.gp.variance[i * m..(i + 1) * m], &k);
+            }
+        }
+        (self.gp.signal_variance - quad).max(0.0) + self.gp.noise_variance
+    }
+}
+
+impl Compensator for PreparedGp {
+    fn residual(&self, q: &[f64], _tau: &[f64]) -> Vector3<f64> {
+        with_joints(self.joints.len(), |v| {
+            self.scale_joints(q, v);
+            self.mean_at(v)
+        })
+    }
+
+    fn name(&self) -> &str {
+        "gp"
+    }
+
+    fn residual_and_jacobian(
+        &self,
+        q: &[f64],
+        _tau: &[f64],
+        _payload_kg: f64,
+        dq: &mut [Vector3<f64>],
+    ) -> (Vector3<f64>, bool) {
+        let na = self.joints.len();
+        let (mut stack, mut heap) = ([[[0.0; LANES]; 3]; STACK_JOINTS], Vec::new());
+        let s: &mut [[[f64; LANES]; 3]] = if na <= STACK_JOINTS {
+            &mut stack[..na]
+        } else {
+            heap.resize(na, [[0.0; LANES]; 3]);
+            &mut heap
+        };
+        let r = with_joints(na, |v| {
+            self.scale_joints(q, v);
+            self.mean_and_sums(v, s)
+        });
+        for c in dq.iter_mut() {
+            *c = Vector3::zeros();
+        }
+        for ((&j, &il), sa) in self.joints.iter().zip(&self.inverse_lengths).zip(&*s) {
+            if let Some(c) = dq.get_mut(j) {
+                *c = Vector3::from_fn(|o, _| -il * sa[o].iter().sum::<f64>());
+            }
+        }
+        (r, true)
+    }
+
+    fn stored(&self) -> Option<StoredCompensator> {
+        Some(StoredCompensator::Gp(self.gp.clone()))
+    }
+
+    fn uncertainty(&self, q: &[f64]) -> Option<Uncertainty> {
+        Some(Uncertainty {
+            compensated_m: self.gp.error_scale * (3.0 * self.variance_at(q)).sqrt(),
+            uncompensated_m: self.gp.uncompensated_rms,
+        })
+    }
+}
+
+/// Whether the CPU has AVX2 (run-time detection; false off x86-64).
+fn has_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// Runs `f` on a scratch slice of `n` values (on the stack when small).
+#[inline(always)]
+fn with_joints<T>(n: usize, f: impl FnOnce(&mut [f64]) -> T) -> T {
+    if n <= STACK_JOINTS {
+        f(&mut [0.0; STACK_JOINTS][..n])
+    } else {
+        f(&mut vec![0.0; n])
+    }
+}
+
+/// `Σ a_i·b_i` with [`LANES`] partial sums (vectorised).
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut acc = [0.0; LANES];
+    let (ac, bc) = (a.chunks_exact(LANES), b.chunks_exact(LANES));
+    let tail: f64 = ac
+        .remainder()
+        .iter()
+        .zip(bc.remainder())
+        .map(|(x, y)| x * y)
+        .sum();
+    for (x, y) in ac.zip(bc) {
+        for k in 0..LANES {
+            acc[k] += x[k] * y[k];
+        }
+    }
+    acc.iter().sum::<f64>() + tail
+}
+
+/// `exp(−½·d²)`, 0 beyond the cutoff (`d² > CUTOFF`, as [`Gp`]); NaN stays NaN.
+#[inline(always)]
+fn kernel_weight(d2: f64) -> f64 {
+    let x = -0.5 * d2;
+    let lowest = -0.5 * CUTOFF;
+    let e = exp_nonpositive(if x < lowest { lowest } else { x });
+    if d2 > CUTOFF {
+        0.0
+    } else {
+        e
+    }
+}
+
+/// `eˣ` for `x` in `[−CUTOFF/2, 0]`, branch-free so that loops over it
+/// vectorise. Hand-written because libm's `exp` is a scalar call that took
+/// most of the prediction's time (5.6 µs per pose with it, README).
+/// Cody–Waite reduction `x = n·ln 2 + r`, `n = round(x·log₂e)` by the
+/// 1.5·2⁵² trick, `|r| ≤ ln2/2`; `eʳ` by its Taylor series to degree 13
+/// (truncation below 5e-18 relative); `2ⁿ` from the exponent bits. Relative
+/// error ≤ 2⁻⁵¹ against `f64::exp` (tested).
+#[inline(always)]
+fn exp_nonpositive(x: f64) -> f64 {
+    // 1.5·2⁵²: adding it rounds to an integer held in the low mantissa bits.
+    const MAGIC: f64 = 6_755_399_441_055_744.0;
+    // ln 2 in two parts (fdlibm's bits): `n·LN2_HI` is exact for |n| < 2²⁰.
+    const LN2_HI: f64 = f64::from_bits(0x3fe6_2e42_fee0_0000);
+    const LN2_LO: f64 = f64::from_bits(0x3dea_39ef_3579_3c76);
+    const C: [f64; 14] = [
+        1.0,
+        1.0,
+        1.0 / 2.0,
+        1.0 / 6.0,
+        1.0 / 24.0,
+        1.0 / 120.0,
+        1.0 / 720.0,
+        1.0 / 5040.0,
+        1.0 / 40_320.0,
+        1.0 / 362_880.0,
+        1.0 / 3_628_800.0,
+        1.0 / 39_916_800.0,
+        1.0 / 479_001_600.0,
+        1.0 / 6_227_020_800.0,
+    ];
+    let t = x * std::f64::consts::LOG2_E + MAGIC;
+    let n = t - MAGIC;
+    let r = (x - n * LN2_HI) - n * LN2_LO;
+    // eʳ = 1 + (r + r²·T(r)), T by Estrin's scheme: a shorter dependency chain
+    // than Horner's (measured faster), and the 1 added last (rounding once).
+    let (r2, r4) = (r * r, r * r * (r * r));
+    let a: [f64; 6] = std::array::from_fn(|i| C[2 * i + 2] + C[2 * i + 3] * r);
+    let b = [a[0] + a[1] * r2, a[2] + a[3] * r2, a[4] + a[5] * r2];
+    let p = 1.0 + (r + r2 * ((b[0] + b[1] * r4) + b[2] * (r4 * r4)));
+    // The low 12 bits of t's bits are n mod 2¹²: the biased exponent n + 1023.
+    p * f64::from_bits(t.to_bits().wrapping_add(1023) << 52)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::compensate::Compensator;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// A Gp with random inducing configurations and weights: `m` units, joint
+    /// 4 ignored (1/ℓ = 0), a random symmetric variance matrix small enough
+    /// that the variance stays positive.
+    fn random_gp(m: usize, seed: u64) -> Gp {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let dof = 6;
+        let s2 = 4e-8;
+        let mut variance = vec![0.0; m * m];
+        for i in 0..m {
+            for j in 0..=i {
+                let v = rng.gen_range(-0.5..0.5) / ((m * m) as f64 * s2);
+                variance[i * m + j] = v;
+                variance[j * m + i] = v;
+            }
+        }
+        Gp {
+            dof,
+            inverse_length_scales: (0..dof)
+                .map(|j| if j == 4 { 0.0 } else { rng.gen_range(0.5..3.0) })
+                .collect(),
+            signal_variance: s2,
+            noise_variance: 1e-10,
+            mean: [1e-5, -2e-5, 3e-5],
+            inducing: (0..m * dof).map(|_| rng.gen_range(-2.0..2.0)).collect(),
+            alpha: (0..3 * m).map(|_| rng.gen_range(-1e3..1e3)).collect(),
+            variance,
+            error_scale: 1.3,
+            uncompensated_rms: 2e-4,
+        }
+    }
+
+    /// The prepared form gives the reference [`Gp`]'s residual, derivative and
+    /// variance to 1e-13 of their scale (`s²·Σ|α|`, times `1/ℓ` for the
+    /// derivative), inside the inducing set and far from it, for sizes that
+    /// fill a part of a lane group and several chunks.
+    #[test]
+    fn the_prepared_form_agrees_with_the_reference_gp() {
+        for (m, seed) in [(1, 1), (7, 2), (150, 3), (300, 4)] {
+            let gp = random_gp(m, seed);
+            let fast = PreparedGp::new(gp.clone());
+            let scale = gp.signal_variance * gp.alpha.iter().map(|a| a.abs()).sum::<f64>();
+            let il_max = gp
+                .inverse_length_scales
+                .iter()
+                .fold(0.0, |a: f64, b| a.max(*b));
+            let mut rng = ChaCha8Rng::seed_from_u64(10 + seed);
+            for i in 0..200 {
+                let spread = if i % 4 == 3 { 6.0 } else { 2.0 };
+                let q: Vec<f64> = (0..6).map(|_| rng.gen_range(-spread..spread)).collect();
+                let (mut d_ref, mut d_fast) =
+                    (vec![Vector3::zeros(); 6], vec![Vector3::zeros(); 6]);
+                let (r_ref, _) = gp.residual_and_jacobian(&q, &[0.0; 6], 0.0, &mut d_ref);
+                let (r_fast, written) = fast.residual_and_jacobian(&q, &[0.0; 6], 0.0, &mut d_fast);
+                assert!(written);
+                assert!(
+                    (r_ref - r_fast).norm() <= 1e-13 * scale,
+                    "m {m}: {r_ref} vs {r_fast}"
+                );
+                assert_eq!(r_fast, fast.residual(&q, &[0.0; 6]));
+                for j in 0..6 {
+                    let e = (d_ref[j] - d_fast[j]).norm();
+                    assert!(e <= 1e-13 * scale * il_max, "m {m} joint {j}: {e:e}");
+                }
+                assert_eq!(d_fast[4], Vector3::zeros());
+                let (v_ref, v_fast) = (gp.variance_at(&q), fast.variance_at(&q));
+                assert!(
+                    (v_ref - v_fast).abs() <= 1e-13 * gp.signal_variance,
+                    "{v_ref} vs {v_fast}"
+                );
+            }
+            assert_eq!(fast.stored(), Some(StoredCompensator::Gp(gp)));
+        }
+    }
+
+    /// The AVX2 build of the loops gives bitwise the results of the generic one.
+    #[test]
+    fn the_avx2_path_gives_bitwise_the_generic_results() {
+        let fast = PreparedGp::new(random_gp(150, 5));
+        if !fast.avx2 {
+            eprintln!("no AVX2 on this CPU: nothing to compare");
+            return;
+        }
+        let mut generic = fast.clone();
+        generic.avx2 = false;
+        let mut rng = ChaCha8Rng::seed_from_u64(6);
+        for _ in 0..100 {
+            let q: Vec<f64> = (0..6).map(|_| rng.gen_range(-2.5..2.5)).collect();
+            let (mut da, mut dg) = (vec![Vector3::zeros(); 6], vec![Vector3::zeros(); 6]);
+            let ra = fast.residual_and_jacobian(&q, &[0.0; 6], 0.0, &mut da);
+            let rg = generic.residual_and_jacobian(&q, &[0.0; 6], 0.0, &mut dg);
+            assert_eq!((ra, &da), (rg, &dg));
+            assert_eq!(
+                fast.residual(&q, &[0.0; 6]),
+                generic.residual(&q, &[0.0; 6])
+            );
+        }
+    }
+
+    #[test]
+    fn the_exponential_matches_the_standard_one_over_the_range_used() {
+        let lowest = -0.5 * CUTOFF;
+        let n = 2_000_000;
+        let mut worst: f64 = 0.0;
+        for i in 0..=n {
+            let x = lowest * i as f64 / n as f64;
+            let (fast, exact) = (exp_nonpositive(x), x.exp());
+            worst = worst.max((fast - exact).abs() / exact);
+        }
+        // The end points, and x = −ln2/2 where the rounding of n is a tie.
+        let ends = [
+            0.0,
+            -0.0,
+            lowest,
+            -f64::MIN_POSITIVE,
+            -0.5 * std::f64::consts::LN_2,
+        ];
+        for x in ends {
+            let (fast, exact) = (exp_nonpositive(x), x.exp());
+            worst = worst.max((fast - exact).abs() / exact);
+        }
+        eprintln!("worst relative error {worst:e}");
+        assert!(
+            worst <= 2.0 * f64::EPSILON,
+            "worst relative error {worst:e}"
+        );
+        assert_eq!(exp_nonpositive(0.0), 1.0);
+    }
+
+    #[test]
+    fn the_kernel_weight_cuts_off_like_the_gp_and_keeps_nan() {
+        assert_eq!(kernel_weight(CUTOFF + 1e-9), 0.0);
+        assert_eq!(kernel_weight(1e300), 0.0);
+        assert_eq!(kernel_weight(f64::INFINITY), 0.0);
+        assert!((kernel_weight(CUTOFF) - (-0.5 * CUTOFF).exp()).abs() < 1e-26);
+        assert!(kernel_weight(f64::NAN).is_nan());
+        assert_eq!(kernel_weight(0.0), 1.0);
+        assert!((kernel_weight(2.0) - (-1f64).exp()).abs() < 1e-16);
+    }
+}
