@@ -131,6 +131,11 @@ pub(crate) struct Local {
     /// `NN(q₀)` [m].
     residual: Vector3<f64>,
     derivative: NnDerivative,
+    /// Gravity torques at the iteration's current point [N·m] (the
+    /// expansion's point, then each accepted trial step's).
+    tau: Small<f64>,
+    /// Gravity torques at the last trial step [N·m].
+    trial_tau: Small<f64>,
 }
 
 impl Local {
@@ -140,7 +145,14 @@ impl Local {
             maps: Small::new(MapTaylor::default()),
             residual: Vector3::zeros(),
             derivative: NnDerivative::new(),
+            tau: Small::new(0.0),
+            trial_tau: Small::new(0.0),
         }
+    }
+
+    /// The last trial step becomes the current point.
+    pub(crate) fn accept(&mut self) {
+        std::mem::swap(&mut self.tau, &mut self.trial_tau);
     }
 
     /// The compensator's `∂NN/∂q` at the point.
@@ -211,6 +223,7 @@ impl PreparedModel {
             |maps, q, deflected| maps.add_to(q, deflected),
             |_, _, _| {},
             |c, q, tau, payload| c.residual_at(q, tau, payload),
+            |_| {},
         )
     }
 
@@ -233,6 +246,7 @@ impl PreparedModel {
         let dq = local.derivative.columns(n);
         let residual = &mut local.residual;
         *residual = Vector3::new(0.0, 0.0, 0.0);
+        let tau_at = &mut local.tau;
         let mut written = false;
         let pose = self.predict(
             q,
@@ -250,6 +264,7 @@ impl PreparedModel {
                 *residual = r;
                 r
             },
+            |tau| tau_at.reset(n, 0.0).copy_from_slice(tau),
         )?;
         local.derivative.written = written;
         if self.maps.is_some() {
@@ -274,14 +289,17 @@ impl PreparedModel {
         &self,
         q: &[f64],
         jac: &mut OMatrix<f64, U6, D>,
-        local: &Local,
+        local: &mut Local,
     ) -> Option<Pose>
     where
         DefaultAllocator: Allocator<U6, D>,
     {
         let chain = &self.calibrated;
+        let n = q.len();
         let q0 = local.q0.get();
         let taylor = local.maps.get();
+        let (residual, derivative) = (&local.residual, &local.derivative);
+        let trial_tau = &mut local.trial_tau;
         // The chain rule factor of the expansion, `1 + f'(q₀) + f''(q₀)·Δ`.
         let (mut s_s, mut s_h) = ([1.0; STACK_DOF], Vec::new());
         let scale = stack_or_heap(&mut s_s, &mut s_h, q.len(), 1.0);
@@ -295,7 +313,8 @@ impl PreparedModel {
                 }
             },
             |frames, tcp, lp| chain.jacobian_into(frames, tcp, lp, jac),
-            |_, q, _, _| local.residual + local.derivative.times(q, q0),
+            |_, q, _, _| residual + derivative.times(q, q0),
+            |tau| trial_tau.reset(n, 0.0).copy_from_slice(tau),
         )?;
         if self.maps.is_some() {
             scale_columns(jac, scale);
@@ -304,13 +323,32 @@ impl PreparedModel {
         Some(pose)
     }
 
-    /// The exact prediction at `q` (as [`PreparedModel::predict_base`]),
+    /// The exact prediction at the iteration's current point `q`, whose
+    /// expanded prediction is `current` (as [`PreparedModel::predict_base`]),
     /// with `local`'s constant terms shifted so that the expansion equals
     /// the exact prediction at `q` too (its derivatives stay those of its
     /// point): after a failed check the iteration goes on from `q` without
-    /// expanding again.
-    pub(crate) fn predict_checked(&self, q: &[f64], local: &mut Local) -> Option<Pose> {
+    /// expanding again. Without joint maps the chain of `current` is already
+    /// exact and only the compensator is evaluated, at `q` and the gravity
+    /// torques kept for it.
+    pub(crate) fn predict_checked(
+        &self,
+        q: &[f64],
+        current: &Pose,
+        local: &mut Local,
+    ) -> Option<Pose> {
         let q0 = local.q0.get();
+        if self.maps.is_none() {
+            let Some(c) = &self.compensator else {
+                return Some(*current);
+            };
+            let expanded = local.residual + local.derivative.times(q, q0);
+            let r = c.residual_at(q, local.tau.get(), self.payload_kg);
+            local.residual = r - local.derivative.times(q, q0);
+            let mut pose = *current;
+            pose.p += r - expanded;
+            return Some(pose);
+        }
         let taylor = local.maps.get_mut();
         let residual = &mut local.residual;
         let derivative = &local.derivative;
@@ -331,6 +369,7 @@ impl PreparedModel {
                 *residual = r - derivative.times(q, q0);
                 r
             },
+            |_| {},
         )
     }
 
@@ -356,6 +395,7 @@ impl PreparedModel {
             |maps, q, deflected| maps.apply(q, deflected, scale),
             |frames, tcp, lp| chain.jacobian_into(frames, tcp, lp, jac),
             |c, q, tau, payload| c.residual_at(q, tau, payload),
+            |_| {},
         )?;
         if self.maps.is_some() {
             scale_columns(jac, scale);
@@ -367,13 +407,15 @@ impl PreparedModel {
     /// The prediction: `add_maps(maps, q, deflected)` adds the joint maps'
     /// angle errors to the deflected joints, `at_deflected(frames, tcp, loop
     /// partials)` sees the calibrated chain at the deflected joints,
-    /// `residual(compensator, q, τ, payload)` gives the compensator's residual.
+    /// `residual(compensator, q, τ, payload)` gives the compensator's residual,
+    /// `on_tau(τ)` sees the gravity torques (zeros when nothing needs them).
     fn predict(
         &self,
         q: &[f64],
         add_maps: impl FnOnce(&JointMaps, &[f64], &mut [f64]),
         at_deflected: impl FnOnce(&[Pose], &Pose, Option<&LoopPartials>),
         residual: impl FnOnce(&dyn Compensator, &[f64], &[f64], f64) -> Vector3<f64>,
+        on_tau: impl FnOnce(&[f64]),
     ) -> Option<Pose> {
         let chain = &self.calibrated;
         let n = q.len();
@@ -386,6 +428,7 @@ impl PreparedModel {
         if needs_tau {
             chain.gravity_torques(frames, &tcp0, lp0.as_ref(), self.payload_kg, tau);
         }
+        on_tau(tau);
         let mut pose = if self.has_compliance || self.maps.is_some() {
             let (mut d_s, mut d_h) = ([0.0; STACK_DOF], Vec::new());
             let deflected = stack_or_heap(&mut d_s, &mut d_h, n, 0.0);
@@ -545,7 +588,7 @@ mod tests {
                 assert!((jc - &jac).amax() <= 1e-12, "{name}");
                 // So is the expansion at its own point.
                 let mut jl = nalgebra::Matrix6::zeros();
-                let pl = p.predict_local(&q, &mut jl, &local).unwrap();
+                let pl = p.predict_local(&q, &mut jl, &mut local).unwrap();
                 assert!((pl.p - pose.p).amax() <= 1e-12, "{name}");
                 assert!((pl.r - pose.r).amax() <= 1e-12, "{name}");
                 assert!((jl - &jac).amax() <= 1e-12, "{name}");
@@ -585,7 +628,7 @@ mod tests {
                 let mut gap = |h: f64| {
                     let qh: Vec<f64> = q.iter().zip(&dir).map(|(q, d)| q + h * d).collect();
                     let exact = p.predict_base(&qh)?;
-                    let expanded = p.predict_local(&qh, &mut jac, &local)?;
+                    let expanded = p.predict_local(&qh, &mut jac, &mut local)?;
                     Some((exact.p - expanded.p).norm())
                 };
                 let (Some(a), Some(b)) = (gap(2e-3), gap(1e-3)) else {
@@ -598,5 +641,43 @@ mod tests {
             }
         }
         assert!(checked >= 80, "{checked} points checked");
+    }
+
+    /// The check at an accepted trial step is the exact prediction there
+    /// (with and without joint maps), and shifts the expansion onto it.
+    #[test]
+    fn the_check_is_the_exact_prediction_and_shifts_the_expansion() {
+        let mut rng = ChaCha8Rng::seed_from_u64(31);
+        let mut checked = 0;
+        for (name, m) in models() {
+            let p = PreparedModel::new(&m, &m.nominal);
+            if !p.has_local_terms() {
+                continue;
+            }
+            let mut local = Local::new();
+            let mut jac = nalgebra::Matrix6::zeros();
+            for _ in 0..10 {
+                let q0: Vec<f64> = (0..6).map(|_| rng.gen_range(-0.8..1.3)).collect();
+                let q1: Vec<f64> = q0.iter().map(|q| q + rng.gen_range(-0.01..0.01)).collect();
+                if p.predict_with_jacobian(&q0, &mut jac, &mut local).is_none() {
+                    continue;
+                }
+                let (Some(expanded), Some(exact)) = (
+                    p.predict_local(&q1, &mut jac, &mut local),
+                    p.predict_base(&q1),
+                ) else {
+                    continue;
+                };
+                local.accept();
+                let checked_pose = p.predict_checked(&q1, &expanded, &mut local).unwrap();
+                assert!((checked_pose.p - exact.p).amax() <= 1e-12, "{name}");
+                assert!((checked_pose.r - exact.r).amax() <= 1e-12, "{name}");
+                let shifted = p.predict_local(&q1, &mut jac, &mut local).unwrap();
+                assert!((shifted.p - exact.p).amax() <= 1e-12, "{name}");
+                assert!((shifted.r - exact.r).amax() <= 1e-12, "{name}");
+                checked += 1;
+            }
+        }
+        assert!(checked >= 100, "{checked} points checked");
     }
 }

@@ -159,6 +159,8 @@ impl IkSolver {
         let mut q = OVector::<f64, D>::from_column_slice_generic(d, U1, &q_start);
         let mut jac_t = jac.clone();
         let (mut e, mut pos, mut rot) = self.error(goal, &pose, position_only);
+        // The prediction at `q` (expanded, or exact where `exact`).
+        let mut current = pose;
         let mut cost = e.norm_squared();
         // Damping μ = λ² [m²], updated from the gain ratio (Nielsen).
         let mut mu = s.initial_damping * s.initial_damping;
@@ -176,10 +178,14 @@ impl IkSolver {
                 // The expanded prediction meets the tolerance: check the
                 // exact one, which also shifts the expansion onto it at `q`.
                 iterations += 1;
-                let Some(pose_x) = self.prepared.predict_checked(q.as_slice(), &mut local) else {
+                let Some(pose_x) =
+                    self.prepared
+                        .predict_checked(q.as_slice(), &current, &mut local)
+                else {
                     return fail(q.as_slice().to_vec(), iterations);
                 };
                 (e, pos, rot) = self.error(goal, &pose_x, position_only);
+                current = pose_x;
                 cost = e.norm_squared();
                 exact = true;
                 failed_checks += 1;
@@ -225,9 +231,9 @@ impl IkSolver {
             }
             iterations += 1;
             at_limit = clamped;
-            let Some(pose_t) = self
-                .prepared
-                .predict_local(trial.as_slice(), &mut jac_t, &local)
+            let Some(pose_t) =
+                self.prepared
+                    .predict_local(trial.as_slice(), &mut jac_t, &mut local)
             else {
                 mu = (mu * nu).max(1e-18);
                 nu *= 2.0;
@@ -247,6 +253,8 @@ impl IkSolver {
                 mu = mu.max(1e-30);
                 nu = 2.0;
                 q = trial;
+                current = pose_t;
+                local.accept();
                 std::mem::swap(&mut jac, &mut jac_t);
                 e = e_t;
                 cost = cost_t;
@@ -265,7 +273,10 @@ impl IkSolver {
             // The budget or the damping ended on the expanded prediction:
             // the residuals reported are the exact ones.
             iterations += 1;
-            let Some(pose_x) = self.prepared.predict_checked(q.as_slice(), &mut local) else {
+            let Some(pose_x) = self
+                .prepared
+                .predict_checked(q.as_slice(), &current, &mut local)
+            else {
                 return fail(q.as_slice().to_vec(), iterations);
             };
             (_, pos, rot) = self.error(goal, &pose_x, position_only);
