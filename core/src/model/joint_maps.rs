@@ -79,6 +79,18 @@ pub struct MapTaylor {
     pub curvature: f64,
 }
 
+impl MapTaylor {
+    /// The second-order expansion's value at `Δ` from its point: `f + f'·Δ + ½f''·Δ²`.
+    pub fn value_at(&self, delta: f64) -> f64 {
+        self.value + delta * (self.slope + 0.5 * self.curvature * delta)
+    }
+
+    /// The expansion's slope at `Δ` from its point: `f' + f''·Δ`.
+    pub fn slope_at(&self, delta: f64) -> f64 {
+        self.slope + self.curvature * delta
+    }
+}
+
 impl JointMap {
     /// A map with all coefficients zero over `range`.
     pub fn zero(harmonics: usize, range: [f64; 2], fade: f64) -> Self {

@@ -308,8 +308,8 @@ impl PreparedModel {
             |_, q, deflected| {
                 for (i, d) in deflected.iter_mut().enumerate() {
                     let (t, delta) = (&taylor[i], q[i] - q0[i]);
-                    *d += t.value + delta * (t.slope + 0.5 * t.curvature * delta);
-                    scale[i] = 1.0 + t.slope + t.curvature * delta;
+                    *d += t.value_at(delta);
+                    scale[i] = 1.0 + t.slope_at(delta);
                 }
             },
             |frames, tcp, lp| chain.jacobian_into(frames, tcp, lp, jac),
@@ -360,7 +360,7 @@ impl PreparedModel {
                     *d += f;
                     let t = &mut taylor[i];
                     let delta = q[i] - q0[i];
-                    t.value += f - (t.value + delta * (t.slope + 0.5 * t.curvature * delta));
+                    t.value += f - t.value_at(delta);
                 }
             },
             |_, _, _| {},
