@@ -34,7 +34,7 @@ mod newton;
 mod reach;
 mod seeds;
 
-use eval::PreparedModel;
+use eval::{Local, PreparedModel};
 
 use reach::{
     wrist_deviation, CORRECTED_REACH_TOLERANCE_M, REACH_MARGIN_FACTOR, REACH_MARGIN_FLOOR_M,
@@ -551,10 +551,11 @@ impl IkSolver {
         let max_iterations = self.settings.max_iterations;
         let attempt = |q0: &[f64],
                        budget: usize,
+                       expansion: Option<&Local>,
                        total_iters: &mut usize,
                        best: &mut Option<Refined>|
          -> Option<IkSolution> {
-            let r = self.refine_with(goal, q0, position_only, budget);
+            let r = self.refine_from(goal, q0, position_only, budget, expansion);
             *total_iters += r.iterations;
             if r.converged && branch_ok(&r.q) {
                 return Some(self.solution(goal, r, *total_iters, None));
@@ -573,16 +574,20 @@ impl IkSolver {
         // Seeds whose corrected target lies beyond their branch's reach wait
         // until the other seeds have been tried (a damped Newton run that
         // cannot reach stalls for tens of evaluations at the boundary).
-        let mut deferred: Vec<Vec<Vec<f64>>> = Vec::new();
+        // Each seed's starts, with the expansion of the joint maps and the
+        // compensator at the seed (from its correction) that both start on.
+        let mut deferred: Vec<(Vec<Vec<f64>>, Option<Local>)> = Vec::new();
         let seeds_now = seeds.list.iter().take(seeds.max_attempts.max(1));
         for seed in seeds_now {
             // The corrected closed-form seed first, then the plain one.
             let mut starts = Vec::with_capacity(2);
             let mut beyond_reach = false;
+            let mut expansion = None;
             if let (Some(a), Some(c)) = (&self.analytic, seed.configuration) {
                 let corrected = self.corrected_seed(a, &seeds.target, seed, c);
                 total_iters += corrected.evaluations;
                 beyond_reach = corrected.beyond_reach;
+                expansion = corrected.expansion;
                 if corrected
                     .q
                     .iter()
@@ -594,11 +599,12 @@ impl IkSolver {
             }
             starts.push(seed.q.clone());
             if beyond_reach {
-                deferred.push(starts);
+                deferred.push((starts, expansion));
                 continue;
             }
             for q0 in starts {
-                if let Some(s) = attempt(&q0, max_iterations, &mut total_iters, &mut best) {
+                let e = expansion.as_ref();
+                if let Some(s) = attempt(&q0, max_iterations, e, &mut total_iters, &mut best) {
                     return s;
                 }
             }
@@ -608,9 +614,12 @@ impl IkSolver {
                 return unreachable;
             }
         }
-        for q0 in deferred.into_iter().flatten() {
-            if let Some(s) = attempt(&q0, max_iterations, &mut total_iters, &mut best) {
-                return s;
+        for (starts, expansion) in deferred {
+            for q0 in starts {
+                let e = expansion.as_ref();
+                if let Some(s) = attempt(&q0, max_iterations, e, &mut total_iters, &mut best) {
+                    return s;
+                }
             }
         }
         // Last resort: a long run from the best end point (slow progress along
@@ -624,7 +633,7 @@ impl IkSolver {
             .map(|b| b.q.clone())
         {
             let budget = max_iterations * self.settings.final_iterations_factor;
-            if let Some(s) = attempt(&q0, budget, &mut total_iters, &mut best) {
+            if let Some(s) = attempt(&q0, budget, None, &mut total_iters, &mut best) {
                 return s;
             }
         }

@@ -127,7 +127,7 @@ impl JointMap {
     /// angle-addition recurrence (one sine and cosine per call): four
     /// interleaved chains, harmonics `j, j + 4, …` advanced by `4q`, so the
     /// recurrence's latency overlaps.
-    fn series<const ORDER: usize>(&self, q: f64) -> [f64; 3] {
+    pub(crate) fn series<const ORDER: usize>(&self, q: f64) -> [f64; 3] {
         let (s1, c1) = q.sin_cos();
         let mut c = [c1, 0.0, 0.0, 0.0];
         let mut s = [s1, 0.0, 0.0, 0.0];
@@ -163,37 +163,44 @@ impl JointMap {
         [sum(g), sum(dg), sum(d2g)]
     }
 
-    /// `f(q)` [rad] and `df/dq`.
-    pub fn value_and_derivative(&self, q: f64) -> (f64, f64) {
-        let (s, ds) = self.weight(q);
-        if s == 0.0 {
-            return (0.0, 0.0);
-        }
-        let [g, dg, _] = self.series::<1>(q);
-        (s * g, s * dg + ds * g)
-    }
-
-    /// `f`, `f'` and `f''` at `q` (the product rule through the fade).
-    pub fn taylor(&self, q: f64) -> MapTaylor {
+    /// `f`, `f'` and `f''` at `q` (zeros beyond `ORDER`) from the unfaded
+    /// series' `[g, g', g'']` at `q` as `series` gives them (this map's own
+    /// sum, or a table of it), by the product rule through the fade.
+    pub(crate) fn faded<const ORDER: usize>(
+        &self,
+        q: f64,
+        series: impl FnOnce(f64) -> [f64; 3],
+    ) -> MapTaylor {
         let [s, ds, d2s] = fade_taylor(q, self.range[0], self.range[1], self.fade);
         if s == 0.0 {
             return MapTaylor::default();
         }
-        let [g, dg, d2g] = self.series::<2>(q);
+        let [g, dg, d2g] = series(q);
         MapTaylor {
             value: s * g,
-            slope: s * dg + ds * g,
-            curvature: s * d2g + 2.0 * ds * dg + d2s * g,
+            slope: if ORDER >= 1 { s * dg + ds * g } else { 0.0 },
+            curvature: if ORDER >= 2 {
+                s * d2g + 2.0 * ds * dg + d2s * g
+            } else {
+                0.0
+            },
         }
+    }
+
+    /// `f(q)` [rad] and `df/dq`.
+    pub fn value_and_derivative(&self, q: f64) -> (f64, f64) {
+        let t = self.faded::<1>(q, |q| self.series::<1>(q));
+        (t.value, t.slope)
+    }
+
+    /// `f`, `f'` and `f''` at `q` (the product rule through the fade).
+    pub fn taylor(&self, q: f64) -> MapTaylor {
+        self.faded::<2>(q, |q| self.series::<2>(q))
     }
 
     /// `f(q)` [rad].
     pub fn value(&self, q: f64) -> f64 {
-        let (s, _) = self.weight(q);
-        if s == 0.0 {
-            return 0.0;
-        }
-        s * self.series::<0>(q)[0]
+        self.faded::<0>(q, |q| self.series::<0>(q)).value
     }
 
     /// The basis of the series at `q` (unfaded): `[cos q … cos Kq, sin q … sin Kq]`,
@@ -268,25 +275,12 @@ impl JointMaps {
     /// Adds `f(q)` to `q_out` and writes `1 + f_i'(q_i)` into `dq_scale`
     /// (the chain rule factor of joint i's Jacobian column).
     pub fn apply(&self, q: &[f64], q_out: &mut [f64], dq_scale: &mut [f64]) {
-        for (i, m) in self.joints.iter().enumerate() {
-            match m {
-                Some(m) => {
-                    let (f, df) = m.value_and_derivative(q[i]);
-                    q_out[i] += f;
-                    dq_scale[i] = 1.0 + df;
-                }
-                None => dq_scale[i] = 1.0,
-            }
-        }
+        apply(&self.joints, q, q_out, dq_scale)
     }
 
     /// Adds `f(q)` to `q_out`.
     pub fn add_to(&self, q: &[f64], q_out: &mut [f64]) {
-        for ((m, q), out) in self.joints.iter().zip(q).zip(q_out) {
-            if let Some(m) = m {
-                *out += m.value(*q);
-            }
-        }
+        add_to(&self.joints, q, q_out)
     }
 
     /// Writes `1 + f_i'(q_i)` into `scale` (1 for joints without a map).
@@ -300,9 +294,7 @@ impl JointMaps {
 
     /// Each joint's [`MapTaylor`] at `q` into `out` (zero for joints without a map).
     pub fn taylor(&self, q: &[f64], out: &mut [MapTaylor]) {
-        for ((m, q), t) in self.joints.iter().zip(q).zip(out) {
-            *t = m.as_ref().map_or(MapTaylor::default(), |m| m.taylor(*q));
-        }
+        taylor(&self.joints, q, out)
     }
 
     /// Per joint, where `q` lies with respect to its map (`None`: no map).
@@ -326,6 +318,64 @@ impl JointMaps {
             .iter()
             .flatten()
             .try_for_each(JointMap::validate)
+    }
+}
+
+/// One joint's angle error map as evaluated: the stored series
+/// ([`JointMap`]) or its table (`joint_map_table::TabulatedMap`, the IK's).
+pub(crate) trait AngleError {
+    /// `f(q)` [rad] and `df/dq`.
+    fn value_and_derivative(&self, q: f64) -> (f64, f64);
+    /// `f`, `f'` and `f''` at `q`.
+    fn taylor(&self, q: f64) -> MapTaylor;
+    /// `f(q)` [rad].
+    fn value(&self, q: f64) -> f64;
+}
+
+impl AngleError for JointMap {
+    fn value_and_derivative(&self, q: f64) -> (f64, f64) {
+        JointMap::value_and_derivative(self, q)
+    }
+    fn taylor(&self, q: f64) -> MapTaylor {
+        JointMap::taylor(self, q)
+    }
+    fn value(&self, q: f64) -> f64 {
+        JointMap::value(self, q)
+    }
+}
+
+/// [`JointMaps::apply`] over any per-joint maps.
+pub(crate) fn apply<M: AngleError>(
+    joints: &[Option<M>],
+    q: &[f64],
+    q_out: &mut [f64],
+    dq_scale: &mut [f64],
+) {
+    for (i, m) in joints.iter().enumerate() {
+        match m {
+            Some(m) => {
+                let (f, df) = m.value_and_derivative(q[i]);
+                q_out[i] += f;
+                dq_scale[i] = 1.0 + df;
+            }
+            None => dq_scale[i] = 1.0,
+        }
+    }
+}
+
+/// [`JointMaps::add_to`] over any per-joint maps.
+pub(crate) fn add_to<M: AngleError>(joints: &[Option<M>], q: &[f64], q_out: &mut [f64]) {
+    for ((m, q), out) in joints.iter().zip(q).zip(q_out) {
+        if let Some(m) = m {
+            *out += m.value(*q);
+        }
+    }
+}
+
+/// [`JointMaps::taylor`] over any per-joint maps.
+pub(crate) fn taylor<M: AngleError>(joints: &[Option<M>], q: &[f64], out: &mut [MapTaylor]) {
+    for ((m, q), t) in joints.iter().zip(q).zip(out) {
+        *t = m.as_ref().map_or(MapTaylor::default(), |m| m.taylor(*q));
     }
 }
 
@@ -441,26 +491,50 @@ mod tests {
         }
     }
 
-    /// The recurrence gives the closed-form series.
+    /// The recurrence gives the closed-form series and its two derivatives
+    /// (12 harmonics, and 83: twenty steps of the chains and a remainder).
     #[test]
     fn series_matches_the_direct_sum() {
-        let m = sample_map();
-        for q in [-0.3, 0.0, 0.4, 1.05] {
-            let direct: f64 = (0..m.harmonics())
-                .map(|k| {
-                    let kq = (k + 1) as f64 * q;
-                    m.cos[k] * kq.cos() + m.sin[k] * kq.sin()
-                })
-                .sum();
-            assert!((m.value(q) - direct).abs() < 1e-15, "{q}");
-            let mut b = vec![0.0; 2 * m.harmonics()];
-            JointMap::basis(m.harmonics(), q, &mut b);
-            let via_basis: f64 = b
-                .iter()
-                .zip(m.cos.iter().chain(&m.sin))
-                .map(|(x, c)| x * c)
-                .sum();
-            assert!((via_basis - direct).abs() < 1e-15);
+        for k in [12, 83] {
+            let mut m = sample_map();
+            m.cos = (0..k).map(|i| 1e-4 * ((i as f64) * 0.7).sin()).collect();
+            m.sin = (0..k).map(|i| 8e-5 * ((i as f64) * 1.3).cos()).collect();
+            for q in [-0.3, 0.0, 0.4, 1.05] {
+                // Σ over harmonics of (term, its size) for f, f' and f''.
+                let mut direct = [0.0; 3];
+                let mut size = [0.0; 3];
+                for h in 0..k {
+                    let kk = (h + 1) as f64;
+                    let (s, c) = (kk * q).sin_cos();
+                    let (a, b) = (m.cos[h], m.sin[h]);
+                    let terms = [
+                        a * c + b * s,
+                        kk * (b * c - a * s),
+                        -kk * kk * (a * c + b * s),
+                    ];
+                    for i in 0..3 {
+                        direct[i] += terms[i];
+                        size[i] += terms[i].abs();
+                    }
+                }
+                assert!((m.value(q) - direct[0]).abs() < 1e-15, "{k} {q}");
+                let t = m.taylor(q);
+                for (i, got) in [t.value, t.slope, t.curvature].into_iter().enumerate() {
+                    assert!(
+                        (got - direct[i]).abs() <= 1e-13 * size[i],
+                        "{k} {q} order {i}: {got} vs {}",
+                        direct[i]
+                    );
+                }
+                let mut b = vec![0.0; 2 * m.harmonics()];
+                JointMap::basis(m.harmonics(), q, &mut b);
+                let via_basis: f64 = b
+                    .iter()
+                    .zip(m.cos.iter().chain(&m.sin))
+                    .map(|(x, c)| x * c)
+                    .sum();
+                assert!((via_basis - direct[0]).abs() < 1e-15);
+            }
         }
     }
 

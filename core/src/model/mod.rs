@@ -2,6 +2,7 @@
 //! the JSON description.
 
 pub mod description;
+pub mod joint_map_table;
 pub mod joint_maps;
 pub mod orientation;
 pub mod params;

@@ -4,6 +4,9 @@
 //! constants computed once ([`PreparedChain`]) and every per-call buffer on
 //! the stack for up to `STACK_DOF` joints.
 //!
+//! The joint maps' series come from their tables (`model/joint_map_table.rs`:
+//! within 1e-13 rad of the series in `f`, 1e-12 in `f'`), so "equals" below
+//! means within those bounds where a model has maps.
 //! [`PreparedModel::predict_base`] equals `CompensatedModel::predict_base`;
 //! [`PreparedModel::predict_with_jacobian`] equals
 //! `CompensatedModel::predict_base_with_jacobian` (pose in the registered base
@@ -21,7 +24,9 @@
 use crate::compensate::{CompensatedModel, Compensator};
 use crate::kinematics::prepared::{stack_or_heap, PreparedChain, STACK_DOF};
 use crate::kinematics::LoopPartials;
-use crate::model::{JointMaps, MapTaylor, Pose, RobotModel};
+use crate::model::joint_map_table::TabulatedMaps;
+use crate::model::joint_maps::AngleError;
+use crate::model::{MapTaylor, Pose, RobotModel};
 use nalgebra::{allocator::Allocator, DefaultAllocator, Dim, OMatrix, Vector3, U6};
 use std::sync::Arc;
 
@@ -70,6 +75,7 @@ impl<T: Copy> Small<T> {
 
 /// The compensator's `∂NN/∂q` [m/rad] at one point (position rows of the
 /// IK Jacobian), kept on the stack for up to `STACK_DOF` joints.
+#[derive(Clone)]
 pub(crate) struct NnDerivative {
     columns: Small<Vector3<f64>>,
     /// The compensator wrote a derivative (false: none, or no compensator).
@@ -118,17 +124,23 @@ impl NnDerivative {
 
 /// The prediction's terms outside the calibrated chain expanded at a point
 /// `q₀`: each joint map to second order, `f(q₀) + f'(q₀)·Δ + ½·f''(q₀)·Δ²`
-/// (Δ = q − q₀), and the compensator to first, `NN(q₀) + ∂NN/∂q(q₀)·Δ`
-/// (docs/design.md "Compensated model and false targets"). The damped
-/// Newton's trial steps evaluate the chain exactly and these terms from
-/// their expansion, which costs a few multiplications instead of a series of
-/// 80 harmonics per joint or a network; it checks the exact prediction where
-/// the expanded one meets the tolerance.
+/// (Δ = q − q₀), and the compensator to first, `NN(q₁) + ∂NN/∂q(q₁)·(q − q₁)`
+/// (docs/design.md "Compensated model and false targets"). The compensator's
+/// point `q₁` is `q₀`, or the closed-form seed's when the damped Newton run
+/// starts from the corrected seed ([`PreparedModel::predict_restart`]). The
+/// damped Newton's trial steps evaluate the chain exactly and these terms
+/// from their expansion, which costs a few multiplications instead of a
+/// series of 80 harmonics per joint or a network; it checks the exact
+/// prediction where the expanded one meets the tolerance.
+#[derive(Clone)]
 pub(crate) struct Local {
+    /// The joint maps' point `q₀` [rad].
     q0: Small<f64>,
+    /// The compensator's point `q₁` [rad].
+    nn_q0: Small<f64>,
     /// `f_i`, `f_i'` and `f_i''` at `q₀_i` (zero without a map).
     maps: Small<MapTaylor>,
-    /// `NN(q₀)` [m].
+    /// `NN(q₁)` [m].
     residual: Vector3<f64>,
     derivative: NnDerivative,
     /// Gravity torques at the iteration's current point [N·m] (the
@@ -142,6 +154,7 @@ impl Local {
     pub(crate) fn new() -> Self {
         Local {
             q0: Small::new(0.0),
+            nn_q0: Small::new(0.0),
             maps: Small::new(MapTaylor::default()),
             residual: Vector3::zeros(),
             derivative: NnDerivative::new(),
@@ -153,6 +166,12 @@ impl Local {
     /// The last trial step becomes the current point.
     pub(crate) fn accept(&mut self) {
         std::mem::swap(&mut self.tau, &mut self.trial_tau);
+    }
+
+    /// Whether `q` is the point of both expansions (where the expanded
+    /// prediction is the exact one).
+    pub(crate) fn is_exact_at(&self, q: &[f64]) -> bool {
+        self.q0.get() == q && self.nn_q0.get() == q
     }
 
     /// The compensator's `∂NN/∂q` at the point.
@@ -170,8 +189,9 @@ pub(crate) struct PreparedModel {
     /// Joint compliances of the calibrated model [rad/(N·m)].
     compliance: Vec<f64>,
     has_compliance: bool,
-    /// The calibrated model's joint angle error maps.
-    maps: Option<JointMaps>,
+    /// The calibrated model's joint angle error maps, tabulated (equal to
+    /// the series within `TOLERANCE_RAD`, `model/joint_map_table.rs`).
+    maps: Option<TabulatedMaps>,
     payload_kg: f64,
     compensator: Option<Arc<dyn Compensator>>,
 }
@@ -198,7 +218,7 @@ impl PreparedModel {
             seed: PreparedChain::new(seed_model),
             compliance: cal.links.iter().map(|l| l.compliance).collect(),
             has_compliance: cal.has_compliance(),
-            maps: cal.joint_maps.clone(),
+            maps: cal.joint_maps.as_ref().map(TabulatedMaps::new),
             payload_kg: model.payload_kg,
             compensator: model.compensator.clone(),
         }
@@ -214,6 +234,19 @@ impl PreparedModel {
     /// differ from the exact one.
     pub(crate) fn has_local_terms(&self) -> bool {
         self.maps.is_some() || self.compensator.is_some()
+    }
+
+    /// The bounds of the joint maps' tables on `f` and `f'` (zeros without
+    /// maps): the prepared prediction's distance from `CompensatedModel`'s.
+    #[cfg(test)]
+    fn maps_bound(&self) -> [f64; 2] {
+        let b = self.maps.as_ref().map_or([0.0; 3], TabulatedMaps::bound);
+        [b[0], b[1]]
+    }
+
+    /// Whether the prediction has a compensator.
+    pub(crate) fn has_compensator(&self) -> bool {
+        self.compensator.is_some()
     }
 
     /// `CompensatedModel::predict_base`.
@@ -239,15 +272,62 @@ impl PreparedModel {
     where
         DefaultAllocator: Allocator<U6, D>,
     {
+        self.expand(q, Some(jac), false, local)
+    }
+
+    /// [`PreparedModel::predict_base`], with the terms outside the chain
+    /// expanded at `q` into `local` (the closed-form seed's correction: the
+    /// damped Newton runs from that seed start on this expansion of the
+    /// compensator).
+    pub(crate) fn predict_expanded(&self, q: &[f64], local: &mut Local) -> Option<Pose> {
+        self.expand::<U6>(q, None, false, local)
+    }
+
+    /// The start of a damped Newton run near the point of `local`'s
+    /// compensator: the chain exact and the joint maps expanded at `q`, as
+    /// in [`PreparedModel::predict_with_jacobian`], and the compensator
+    /// from its expansion in `local` (exact at that point; elsewhere second
+    /// order in the distance). Saves the compensator's evaluation at the
+    /// start of the run.
+    pub(crate) fn predict_restart<D: Dim>(
+        &self,
+        q: &[f64],
+        jac: &mut OMatrix<f64, U6, D>,
+        local: &mut Local,
+    ) -> Option<Pose>
+    where
+        DefaultAllocator: Allocator<U6, D>,
+    {
+        self.expand(q, Some(jac), true, local)
+    }
+
+    /// The prediction at `q`, its Jacobian into `jac` when given, the joint
+    /// maps expanded at `q` into `local`, and the compensator expanded there
+    /// too unless `keep_compensator` (then its expansion in `local` gives it).
+    fn expand<D: Dim>(
+        &self,
+        q: &[f64],
+        mut jac: Option<&mut OMatrix<f64, U6, D>>,
+        keep_compensator: bool,
+        local: &mut Local,
+    ) -> Option<Pose>
+    where
+        DefaultAllocator: Allocator<U6, D>,
+    {
         let n = q.len();
         let chain = &self.calibrated;
         local.q0.reset(n, 0.0).copy_from_slice(q);
+        if !keep_compensator {
+            local.nn_q0.reset(n, 0.0).copy_from_slice(q);
+            local.residual = Vector3::new(0.0, 0.0, 0.0);
+            local.derivative.columns(n);
+            local.derivative.written = false;
+        }
         let taylor = local.maps.reset(n, MapTaylor::default());
-        let dq = local.derivative.columns(n);
+        let nn_q0 = local.nn_q0.get();
         let residual = &mut local.residual;
-        *residual = Vector3::new(0.0, 0.0, 0.0);
+        let derivative = &mut local.derivative;
         let tau_at = &mut local.tau;
-        let mut written = false;
         let pose = self.predict(
             q,
             |maps, q, deflected| {
@@ -257,16 +337,25 @@ impl PreparedModel {
                     *d += t.value;
                 }
             },
-            |frames, tcp, lp| chain.jacobian_into(frames, tcp, lp, jac),
+            |frames, tcp, lp| {
+                if let Some(jac) = jac.as_deref_mut() {
+                    chain.jacobian_into(frames, tcp, lp, jac);
+                }
+            },
             |c, q, tau, payload| {
-                let (r, w) = c.residual_and_jacobian(q, tau, payload, dq);
-                written = w;
+                if keep_compensator {
+                    return *residual + derivative.times(q, nn_q0);
+                }
+                let (r, w) = c.residual_and_jacobian(q, tau, payload, derivative.columns(n));
+                derivative.written = w;
                 *residual = r;
                 r
             },
             |tau| tau_at.reset(n, 0.0).copy_from_slice(tau),
         )?;
-        local.derivative.written = written;
+        let Some(jac) = jac else {
+            return Some(pose);
+        };
         if self.maps.is_some() {
             let (mut s_s, mut s_h) = ([1.0; STACK_DOF], Vec::new());
             let scale = stack_or_heap(&mut s_s, &mut s_h, n, 1.0);
@@ -296,7 +385,7 @@ impl PreparedModel {
     {
         let chain = &self.calibrated;
         let n = q.len();
-        let q0 = local.q0.get();
+        let (q0, nn_q0) = (local.q0.get(), local.nn_q0.get());
         let taylor = local.maps.get();
         let (residual, derivative) = (&local.residual, &local.derivative);
         let trial_tau = &mut local.trial_tau;
@@ -313,7 +402,7 @@ impl PreparedModel {
                 }
             },
             |frames, tcp, lp| chain.jacobian_into(frames, tcp, lp, jac),
-            |_, q, _, _| residual + derivative.times(q, q0),
+            |_, q, _, _| residual + derivative.times(q, nn_q0),
             |tau| trial_tau.reset(n, 0.0).copy_from_slice(tau),
         )?;
         if self.maps.is_some() {
@@ -337,14 +426,14 @@ impl PreparedModel {
         current: &Pose,
         local: &mut Local,
     ) -> Option<Pose> {
-        let q0 = local.q0.get();
+        let (q0, nn_q0) = (local.q0.get(), local.nn_q0.get());
         if self.maps.is_none() {
             let Some(c) = &self.compensator else {
                 return Some(*current);
             };
-            let expanded = local.residual + local.derivative.times(q, q0);
+            let expanded = local.residual + local.derivative.times(q, nn_q0);
             let r = c.residual_at(q, local.tau.get(), self.payload_kg);
-            local.residual = r - local.derivative.times(q, q0);
+            local.residual = r - local.derivative.times(q, nn_q0);
             let mut pose = *current;
             pose.p += r - expanded;
             return Some(pose);
@@ -366,7 +455,7 @@ impl PreparedModel {
             |_, _, _| {},
             |c, q, tau, payload| {
                 let r = c.residual_at(q, tau, payload);
-                *residual = r - derivative.times(q, q0);
+                *residual = r - derivative.times(q, nn_q0);
                 r
             },
             |_| {},
@@ -412,7 +501,7 @@ impl PreparedModel {
     fn predict(
         &self,
         q: &[f64],
-        add_maps: impl FnOnce(&JointMaps, &[f64], &mut [f64]),
+        add_maps: impl FnOnce(&TabulatedMaps, &[f64], &mut [f64]),
         at_deflected: impl FnOnce(&[Pose], &Pose, Option<&LoopPartials>),
         residual: impl FnOnce(&dyn Compensator, &[f64], &[f64], f64) -> Vector3<f64>,
         on_tau: impl FnOnce(&[f64]),
@@ -469,7 +558,7 @@ mod tests {
     use crate::compensate::mlp::{Features, Mlp, Normalisation, Shape};
     use crate::compensate::{synthetic_calibration, SyntheticErrors};
     use crate::kinematics::fk;
-    use crate::model::preset;
+    use crate::model::{preset, JointMaps};
     use nalgebra::Dyn;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
@@ -548,11 +637,19 @@ mod tests {
         }
     }
 
+    /// To 1e-12 plus, with joint maps, what their tables' bounds allow: the
+    /// bound on `f` through a lever of at most 4 m for the pose, on `f'`
+    /// times a Jacobian entry of at most 4 m for the Jacobian (the tables
+    /// are tested against the series in `model/joint_map_table.rs`).
     #[test]
     fn prepared_prediction_equals_the_compensated_model() {
         let mut rng = ChaCha8Rng::seed_from_u64(23);
         for (name, m) in models() {
             let p = PreparedModel::new(&m, &m.nominal);
+            let [bf, bs] = p.maps_bound();
+            assert!(bf <= 1e-13 && bs <= 1e-12, "{name}: {bf:e} {bs:e}");
+            let tol = 1e-12 + 4.0 * bf;
+            let tol_j = 1e-12 + 4.0 * (bs + bf);
             let mut local = Local::new();
             for _ in 0..40 {
                 let q: Vec<f64> = m
@@ -567,15 +664,15 @@ mod tests {
                 };
                 let base = p.predict_base(&q).unwrap();
                 let expect = m.predict_base(&q).unwrap();
-                assert!((base.p - expect.p).amax() <= 1e-12, "{name}");
-                assert!((base.r - expect.r).amax() <= 1e-12, "{name}");
+                assert!((base.p - expect.p).amax() <= tol, "{name}");
+                assert!((base.r - expect.r).amax() <= tol, "{name}");
                 let mut j = OMatrix::<f64, U6, Dyn>::zeros(6);
                 let pj = p
                     .predict_with_jacobian(&q, &mut j, &mut Local::new())
                     .unwrap();
-                assert!((pj.p - pose.p).amax() <= 1e-12, "{name}");
-                assert!((pj.r - pose.r).amax() <= 1e-12, "{name}");
-                assert!((j - &jac).amax() <= 1e-12, "{name}");
+                assert!((pj.p - pose.p).amax() <= tol, "{name}");
+                assert!((pj.r - pose.r).amax() <= tol, "{name}");
+                assert!((j - &jac).amax() <= tol_j, "{name}");
                 let mut j6 = nalgebra::Matrix6::zeros();
                 // One expansion reused from point to point, as the IK does.
                 p.predict_with_jacobian(&q, &mut j6, &mut local).unwrap();
@@ -584,15 +681,15 @@ mod tests {
                 let pc = p
                     .predict_with_chord(&q, &mut jc, &local.derivative)
                     .unwrap();
-                assert!((pc.p - pose.p).amax() <= 1e-12, "{name}");
-                assert!((jc - &jac).amax() <= 1e-12, "{name}");
+                assert!((pc.p - pose.p).amax() <= tol, "{name}");
+                assert!((jc - &jac).amax() <= tol_j, "{name}");
                 // So is the expansion at its own point.
                 let mut jl = nalgebra::Matrix6::zeros();
                 let pl = p.predict_local(&q, &mut jl, &mut local).unwrap();
-                assert!((pl.p - pose.p).amax() <= 1e-12, "{name}");
-                assert!((pl.r - pose.r).amax() <= 1e-12, "{name}");
-                assert!((jl - &jac).amax() <= 1e-12, "{name}");
-                assert!((j6 - &jac).amax() <= 1e-12, "{name}");
+                assert!((pl.p - pose.p).amax() <= tol, "{name}");
+                assert!((pl.r - pose.r).amax() <= tol, "{name}");
+                assert!((jl - &jac).amax() <= tol_j, "{name}");
+                assert!((j6 - &jac).amax() <= tol_j, "{name}");
                 let n = p.seed_fk(&q).unwrap();
                 let e = fk(&m.nominal, &q).unwrap();
                 assert!((n.p - e.p).amax() <= 1e-12 && (n.r - e.r).amax() <= 1e-12);
@@ -637,6 +734,68 @@ mod tests {
                 assert!(a > 1e-12, "{name}: gap {a:e} m");
                 let ratio = a / b;
                 assert!(expected.contains(&ratio), "{name}: ratio {ratio}");
+                checked += 1;
+            }
+        }
+        assert!(checked >= 80, "{checked} points checked");
+    }
+
+    /// The seed's correction expands the compensator on its exact prediction
+    /// (`predict_expanded` is `predict_base`), and a run that starts nearby on
+    /// that expansion (`predict_restart`) has the exact chain and joint maps
+    /// and the compensator's first-order expansion: at the seed it equals
+    /// `predict_with_jacobian` (pose and Jacobian); away from it the gap to
+    /// the exact prediction is second order (halving the distance divides it
+    /// by 4) with and without joint maps; the check there is exact.
+    #[test]
+    fn a_run_starts_on_the_seeds_expansion_of_the_compensator() {
+        let mut rng = ChaCha8Rng::seed_from_u64(37);
+        let mut checked = 0;
+        for (name, m) in models() {
+            let p = PreparedModel::new(&m, &m.nominal);
+            if !p.has_compensator() {
+                continue;
+            }
+            for _ in 0..10 {
+                let q1: Vec<f64> = (0..6).map(|_| rng.gen_range(-0.8..1.3)).collect();
+                let dir: Vec<f64> = (0..6).map(|_| rng.gen_range(-1.0..1.0)).collect();
+                let mut seed = Local::new();
+                let (Some(pose), Some(exact)) =
+                    (p.predict_expanded(&q1, &mut seed), p.predict_base(&q1))
+                else {
+                    continue;
+                };
+                assert!((pose.p - exact.p).amax() <= 1e-12, "{name}");
+                assert!((pose.r - exact.r).amax() <= 1e-12, "{name}");
+                let (mut ja, mut jb) = (nalgebra::Matrix6::zeros(), nalgebra::Matrix6::zeros());
+                let mut fresh = Local::new();
+                let a = p.predict_with_jacobian(&q1, &mut ja, &mut fresh).unwrap();
+                let mut local = seed.clone();
+                let b = p.predict_restart(&q1, &mut jb, &mut local).unwrap();
+                assert!(local.is_exact_at(&q1), "{name}");
+                assert!(
+                    (a.p - b.p).amax() <= 1e-12 && (a.r - b.r).amax() <= 1e-12,
+                    "{name}"
+                );
+                assert!((ja - jb).amax() <= 1e-12, "{name}");
+                let gap = |h: f64| {
+                    let qh: Vec<f64> = q1.iter().zip(&dir).map(|(q, d)| q + h * d).collect();
+                    let mut local = seed.clone();
+                    let mut jac = nalgebra::Matrix6::zeros();
+                    let restarted = p.predict_restart(&qh, &mut jac, &mut local)?;
+                    assert!(!local.is_exact_at(&qh), "{name}");
+                    let exact = p.predict_base(&qh)?;
+                    let checked = p.predict_checked(&qh, &restarted, &mut local)?;
+                    assert!((checked.p - exact.p).amax() <= 1e-12, "{name}");
+                    assert!((checked.r - exact.r).amax() <= 1e-12, "{name}");
+                    Some((exact.p - restarted.p).norm())
+                };
+                let (Some(a), Some(b)) = (gap(2e-3), gap(1e-3)) else {
+                    continue;
+                };
+                assert!(a > 1e-12, "{name}: gap {a:e} m");
+                let ratio = a / b;
+                assert!((3.5..4.5).contains(&ratio), "{name}: ratio {ratio}");
                 checked += 1;
             }
         }

@@ -106,13 +106,34 @@ impl IkSolver {
         position_only: bool,
         max_iterations: usize,
     ) -> Refined {
+        self.refine_from(goal, q0, position_only, max_iterations, None)
+    }
+
+    /// [`IkSolver::refine_with`] starting on `expansion` (the joint maps and
+    /// the compensator expanded at a nearby point, the closed-form seed's;
+    /// see `PreparedModel::predict_expanded`) instead of expanding at `q0`.
+    pub(super) fn refine_from(
+        &self,
+        goal: &Goal,
+        q0: &[f64],
+        position_only: bool,
+        max_iterations: usize,
+        expansion: Option<&Local>,
+    ) -> Refined {
         let q = self.clamp_to_limits(q0);
         // Six joints on the stack (fixed-size matrices), others on the heap:
         // the same iteration.
         if q.len() == 6 {
-            self.refine_in(U6, goal, q, position_only, max_iterations)
+            self.refine_in(U6, goal, q, position_only, max_iterations, expansion)
         } else {
-            self.refine_in(Dyn(q.len()), goal, q, position_only, max_iterations)
+            self.refine_in(
+                Dyn(q.len()),
+                goal,
+                q,
+                position_only,
+                max_iterations,
+                expansion,
+            )
         }
     }
 
@@ -124,6 +145,7 @@ impl IkSolver {
         q_start: Vec<f64>,
         position_only: bool,
         max_iterations: usize,
+        expansion: Option<&Local>,
     ) -> Refined
     where
         DefaultAllocator: Allocator<U6, D> + Allocator<D> + Allocator<D, U6>,
@@ -140,20 +162,29 @@ impl IkSolver {
             failed_evaluation: true,
         };
         let mut jac = Jac::<D>::zeros_generic(U6, d);
-        // The joint maps and the compensator expanded at the start; trial
-        // steps use the expansion (`eval::Local`), and the exact prediction
-        // is checked, and expanded again, where the expanded one meets the
-        // tolerance.
+        // The joint maps and the compensator expanded at the start (or
+        // taken expanded at a nearby point); trial steps use the expansion
+        // (`eval::Local`), and the exact prediction is checked, and expanded
+        // again, where the expanded one meets the tolerance.
+        let linearised = self.prepared.has_local_terms();
         let mut local = Local::new();
-        let Some(pose) = self
-            .prepared
-            .predict_with_jacobian(&q_start, &mut jac, &mut local)
-        else {
+        let start = match expansion {
+            Some(e) if linearised => {
+                local.clone_from(e);
+                self.prepared
+                    .predict_restart(&q_start, &mut jac, &mut local)
+            }
+            _ => self
+                .prepared
+                .predict_with_jacobian(&q_start, &mut jac, &mut local),
+        };
+        let start = start.map(|p| (p, local.is_exact_at(&q_start)));
+        let Some((pose, at_expansion)) = start else {
             return fail(q_start, 1);
         };
-        let linearised = self.prepared.has_local_terms();
-        // `e`, `pos` and `rot` are of the exact prediction at `q`.
-        let mut exact = true;
+        // `e`, `pos` and `rot` are of the exact prediction at `q` (the
+        // expansion at its own point is exact).
+        let mut exact = at_expansion;
         // Checks of the exact prediction that failed since the last expansion.
         let mut failed_checks = 0;
         let mut q = OVector::<f64, D>::from_column_slice_generic(d, U1, &q_start);
@@ -334,8 +365,8 @@ mod tests {
                 let q0: Vec<f64> = q.iter().map(|v| v + rng.gen_range(-0.05..0.05)).collect();
                 let q0 = solver.clamp_to_limits(&q0);
                 let position_only = i % 3 == 0;
-                let a = solver.refine_in(U6, &goal, q0.clone(), position_only, 60);
-                let b = solver.refine_in(Dyn(6), &goal, q0, position_only, 60);
+                let a = solver.refine_in(U6, &goal, q0.clone(), position_only, 60, None);
+                let b = solver.refine_in(Dyn(6), &goal, q0, position_only, 60, None);
                 assert_eq!(a.converged, b.converged, "{name} {i}");
                 assert_eq!(a.iterations, b.iterations, "{name} {i}");
                 for (x, y) in a.q.iter().zip(&b.q) {

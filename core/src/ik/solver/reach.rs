@@ -72,7 +72,7 @@ impl IkSolver {
             let mut q = branch.q;
             let mut excess = branch.reach_excess_m;
             for _ in 0..CORRECTED_REACH_STEPS {
-                let Some(moved) = self.moved_target(target, &q, None) else {
+                let Some(moved) = self.moved_target(target, &q, None, None) else {
                     break;
                 };
                 evaluations += 1;
@@ -106,14 +106,19 @@ impl IkSolver {
     /// The target moved by the calibrated model's deviation from the seed
     /// model at `q`: `T·P(q)⁻¹·FK_nom(q)` (one evaluation of the prediction).
     /// `seed_pose` is `FK_nom(q)` when the caller knows it (a closed-form
-    /// solution of `T` itself).
+    /// solution of `T` itself). With `expansion`, the joint maps and the
+    /// compensator are expanded at `q` into it on the way.
     pub(super) fn moved_target(
         &self,
         target: &Pose,
         q: &[f64],
         seed_pose: Option<&Pose>,
+        expansion: Option<&mut Local>,
     ) -> Option<Pose> {
-        let p = self.prepared.predict_base(q)?;
+        let p = match expansion {
+            Some(local) => self.prepared.predict_expanded(q, local)?,
+            None => self.prepared.predict_base(q)?,
+        };
         let n = match seed_pose {
             Some(n) => *n,
             None => self.prepared.seed_fk(q)?,

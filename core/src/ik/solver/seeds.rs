@@ -243,13 +243,19 @@ impl IkSolver {
             q: seed.q.clone(),
             evaluations: 0,
             beyond_reach: false,
+            expansion: None,
         };
         for k in 0..self.settings.seed_corrections {
             // An unclamped closed-form branch is where the seed model reaches the target.
             let seed_pose = (k == 0 && seed.on_target).then_some(target);
-            let Some(moved) = self.moved_target(target, &out.q, seed_pose) else {
+            // The first correction's prediction, at the seed, also expands
+            // the compensator there (the runs from this seed start on it).
+            let mut expansion = (k == 0 && self.prepared.has_compensator()).then(Local::new);
+            let Some(moved) = self.moved_target(target, &out.q, seed_pose, expansion.as_mut())
+            else {
                 break;
             };
+            out.expansion = out.expansion.or(expansion);
             out.evaluations += 1;
             let best = analytic.solve_branch(
                 &moved,
@@ -284,6 +290,9 @@ pub(super) struct CorrectedSeed {
     /// the target in this branch either, so the solver tries it after the
     /// others.
     pub(super) beyond_reach: bool,
+    /// The compensator expanded at the seed (none without a compensator or
+    /// a correction).
+    pub(super) expansion: Option<Local>,
 }
 
 pub(super) struct Seed {
