@@ -15,22 +15,34 @@
 //! - `ik/solve_{plain,compensated,gp,maps}`: one calibrated IK solve without
 //!   a compensator, with the 18-20-3 network, with the Gaussian process, and
 //!   with joint angle error maps of 80 harmonics on every joint and no
-//!   compensator (cycling through 1000 targets).
+//!   compensator (cycling through 1000 targets);
+//! - `ik_unmodelled/solve_{skcm,skcm-nn,skcm-gp,skcm-maps,skcm-maps-gp}`: the
+//!   same on the models the pipeline delivers for a simulated YS100 with
+//!   effects the calibration does not model (`compensate::unmodelled_truth`
+//!   with its effects, as in `tests/compensate.rs`: 100 identification and
+//!   1000 training poses, each method with its support and fade), cycling
+//!   through the calibrated model's predictions at 1000 random
+//!   configurations.
 //!
 //! Trainer comparison over 20 seeds (final validation error and wall time):
 //! `cargo run --release -p robocal-core --example compare_trainers`.
 
+use criterion::measurement::WallTime;
 use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use robocal_core::compensate::{
-    synthetic_calibration, train, CompensatedModel, CompensatorSpec, Sample, StoredCompensator,
-    SyntheticErrors,
+    synthetic_calibration, train, unmodelled_truth, CompensatedModel, CompensatorSpec, Sample,
+    StoredCompensator, SyntheticErrors,
+};
+use robocal_core::identify::{
+    calibrate_with_training, CalibrationOptions, CompensatorOptions, Method,
 };
 use robocal_core::ik::{Goal, IkSettings, IkSolver, SolveOptions};
-use robocal_core::model::{preset, JointMap, JointMaps};
-use robocal_core::sim::random_configurations;
+use robocal_core::measure::{self, Measurement};
+use robocal_core::model::{preset, JointMap, JointMaps, RobotModel};
+use robocal_core::sim::{random_configurations, TrueRobot};
 use std::hint::black_box;
 use std::sync::Arc;
 
@@ -54,6 +66,90 @@ fn samples(cm: &CompensatedModel, n: usize, seed: u64) -> Vec<Sample> {
 fn fit(spec: &CompensatorSpec, s: &[Sample]) -> StoredCompensator {
     let mut rng = ChaCha8Rng::seed_from_u64(1);
     train(spec, s, &mut rng, &mut |_, _| true).unwrap().0
+}
+
+/// `n` random configurations measured on `truth` with the model's payload.
+fn measure_truth(
+    truth: &TrueRobot,
+    nominal: &RobotModel,
+    n: usize,
+    rng: &mut ChaCha8Rng,
+) -> Vec<Measurement> {
+    let qs = random_configurations(nominal, n, rng);
+    let rows = truth
+        .measure(&qs, Some(nominal.payload.mass), None, rng)
+        .unwrap();
+    measure::to_measurements(nominal, &rows, nominal.payload.mass)
+}
+
+/// One calibrated IK solve per iteration, cycling through `goals`.
+fn bench_ik(
+    g: &mut criterion::BenchmarkGroup<'_, WallTime>,
+    name: &str,
+    m: &CompensatedModel,
+    qs: &[Vec<f64>],
+) {
+    let solver = IkSolver::new(
+        m.clone(),
+        IkSettings {
+            threads: 1,
+            ..IkSettings::default()
+        },
+    );
+    let goals: Vec<Goal> = qs
+        .iter()
+        .map(|q| Goal::from(&m.predict(q).unwrap()))
+        .collect();
+    let options = SolveOptions::default();
+    let mut i = 0;
+    g.bench_function(name, |b| {
+        b.iter(|| {
+            i = (i + 1) % goals.len();
+            black_box(solver.solve_goal(black_box(&goals[i]), &options))
+        })
+    });
+}
+
+/// The IK on the models of the unmodelled-effects study (module docs).
+fn bench_unmodelled(c: &mut Criterion) {
+    let nominal = preset("ys100").unwrap();
+    let truth = unmodelled_truth(&nominal, true, 1);
+    let mut rng = ChaCha8Rng::seed_from_u64(101);
+    let ident = measure_truth(&truth, &nominal, 100, &mut rng);
+    let train = measure_truth(&truth, &nominal, 1000, &mut rng);
+    let valid = measure_truth(&truth, &nominal, 200, &mut rng);
+    let methods = [
+        Method::Skcm,
+        Method::SkcmNn,
+        Method::SkcmGp,
+        Method::SkcmMaps,
+        Method::SkcmMapsGp,
+    ];
+    let options = CalibrationOptions {
+        methods: methods.to_vec(),
+        compensator: CompensatorOptions {
+            seed: 1,
+            cv_folds: 0,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let report =
+        calibrate_with_training(&nominal, &ident, &train, &valid, &options, &|_| true).unwrap();
+    let qs = random_configurations(&nominal, 1000, &mut ChaCha8Rng::seed_from_u64(5));
+    let mut g = c.benchmark_group("ik_unmodelled");
+    for method in methods {
+        let r = &report.methods[method.name()];
+        let m = CompensatedModel {
+            calibrated: r.calibrated.clone(),
+            nominal: nominal.clone(),
+            cell_from_base: report.tracker_to_base.inverse(),
+            payload_kg: nominal.payload.mass,
+            compensator: r.compensator_arc(),
+        };
+        bench_ik(&mut g, &format!("solve_{}", method.name()), &m, &qs);
+    }
+    g.finish();
 }
 
 fn bench(c: &mut Criterion) {
@@ -154,34 +250,16 @@ fn bench(c: &mut Criterion) {
             .collect(),
     });
     let mut g = c.benchmark_group("ik");
-    let options = SolveOptions::default();
     for (name, m) in [
         ("solve_plain", &cm),
         ("solve_compensated", &compensated),
         ("solve_gp", &with_gp),
         ("solve_maps", &with_maps),
     ] {
-        let solver = IkSolver::new(
-            m.clone(),
-            IkSettings {
-                threads: 1,
-                ..IkSettings::default()
-            },
-        );
-        let goals: Vec<Goal> = qs
-            .iter()
-            .map(|q| Goal::from(&m.predict(q).unwrap()))
-            .collect();
-        let mut i = 0;
-        g.bench_function(name, |b| {
-            b.iter(|| {
-                i = (i + 1) % goals.len();
-                black_box(solver.solve_goal(black_box(&goals[i]), &options))
-            })
-        });
+        bench_ik(&mut g, name, m, &qs);
     }
     g.finish();
 }
 
-criterion_group!(benches, bench);
+criterion_group!(benches, bench, bench_unmodelled);
 criterion_main!(benches);
