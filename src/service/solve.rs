@@ -197,7 +197,9 @@ pub async fn chosen_model(
     })
 }
 
-/// The prepared solver of a command, from the cache when it can be.
+/// The prepared solver of a command (carrying its production tool when it
+/// names one), from the cache when it can be: building one prepares the
+/// model, among it the joint maps' tables.
 async fn prepare(
     state: &AppState,
     cmd: &SolveCommand,
@@ -209,10 +211,19 @@ async fn prepare(
         Some((_, v, m)) => (Some(*v), m.clone()),
         None => (None, "nominal".to_string()),
     };
+    let tcp = match &cmd.tool {
+        Some(choice) => Some(resolve(state, robot_id, CellKind::Tool, choice).await?.pose),
+        None => None,
+    };
+    let tcp = tcp.as_ref();
     let key = (
         robot_id,
         chosen.as_ref().map(|c| c.0),
         cmd.payload_kg.map(f64::to_bits),
+        tcp.map(|t| {
+            let bits = t.p.iter().chain(t.r.iter()).map(|v| v.to_bits());
+            bits.collect::<Vec<u64>>()
+        }),
     );
     let cacheable = cmd.jump_deg.is_none();
     if cacheable {
@@ -227,6 +238,9 @@ async fn prepare(
     let mut settings = IkSettings::default();
     if let Some(j) = cmd.jump_deg {
         settings.jump_threshold_rad = j.to_radians();
+    }
+    if let Some(tcp) = tcp {
+        model = with_tool(&model, tcp);
     }
     let solver = Arc::new(IkSolver::new(model, settings));
     if cacheable {
@@ -268,7 +282,7 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
             cmd.targets.len()
         )));
     }
-    let (mut solver, version, method) = prepare(state, &cmd).await?;
+    let (solver, version, method) = prepare(state, &cmd).await?;
     let work_object = match &cmd.work_object {
         None => None,
         Some(choice) => {
@@ -285,13 +299,6 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
             Some(wobj.in_base(solver.model()))
         }
     };
-    if let Some(choice) = &cmd.tool {
-        let tcp = resolve(state, cmd.robot_id, CellKind::Tool, choice)
-            .await?
-            .pose;
-        let settings = solver.settings().clone();
-        solver = Arc::new(IkSolver::new(with_tool(solver.model(), &tcp), settings));
-    }
     if let Some(w) = &work_object {
         let Targets::Inputs(inputs) = &mut cmd.targets else {
             return Err(ServiceError::Invalid(

@@ -73,7 +73,8 @@ pub struct RobotContext {
 
 /// Cache key of a prepared solver: robot, version row (None: nominal model),
 /// payload override bits.
-type SolverKey = (i64, Option<i64>, Option<u64>);
+/// Robot, model version, payload and production tool (the bits of `p` and `R`).
+type SolverKey = (i64, Option<i64>, Option<u64>, Option<Vec<u64>>);
 
 /// Shared state of the service.
 #[derive(Clone)]

@@ -504,4 +504,48 @@ async fn a_solve_with_a_tool_and_a_work_object_is_the_cell_solvers() {
         r.json()["results"][0]["false_target"],
         stored["results"][0]["false_target"]
     );
+    // Solvers are kept per tool: the torch moved by 10 mm along its z axis
+    // solves as the cell solver of the moved torch, not the kept one.
+    let mut tools = c["tools"].clone();
+    let z = tools[0]["xyz_mm"][2].as_f64().unwrap();
+    tools[0]["xyz_mm"][2] = json!(z + 10.0);
+    let r = put(&t, TOOLS, &[&rid], json!({ "tools": tools })).await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let moved = CellDescription::from_json(&json!({ "tools": tools }).to_string())
+        .unwrap()
+        .to_cell()
+        .unwrap();
+    let moved = moved
+        .tool(&robocal::cell::CellRef::Name("torch".into()))
+        .unwrap();
+    let want = CellSolver::new(&model, &moved.tcp, IkSettings::default()).solve(
+        &wobj,
+        &pose_of(targets[0].0, targets[0].1),
+        &CellOptions {
+            branch: Some(robocal::ik::Configuration::parse("front,up,noflip").unwrap()),
+            seed: None,
+        },
+    );
+    let ft = want.false_target.unwrap();
+    let r = t
+        .post_json(
+            SOLVE,
+            &[&rid],
+            json!({ "targets": [body_targets[0]], "convention": "kuka_abc", "tool": "torch",
+                    "work_object": "table", "branch": "front,up,noflip" }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let f = &r.json()["results"][0]["false_target"];
+    let xyz = nalgebra::Vector3::new(
+        f["x"].as_f64().unwrap(),
+        f["y"].as_f64().unwrap(),
+        f["z"].as_f64().unwrap(),
+    );
+    assert!(
+        (xyz - ft.p * 1e3).norm() < 1e-6,
+        "{xyz} vs {} mm",
+        ft.p * 1e3
+    );
+    assert_ne!(f, &stored["results"][0]["false_target"]);
 }

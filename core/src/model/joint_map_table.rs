@@ -6,17 +6,20 @@
 //! applied as for the series ([`JointMap::faded`]).
 //!
 //! Interval j of width `h = 2π/N` has centre `c_j = −π + (j + ½)·h` and the
-//! coefficients `g⁽ᵏ⁾(c_j)/k!`, k = 0..=DEGREE, computed from the series in
-//! closed form. With `M = Σ_k k^(DEGREE+1)·√(a_k² + b_k²) ≥ max |g⁽ᴰᴱᴳᴿᴱᴱ⁺¹⁾|`
-//! the Lagrange remainder bounds the table's error against the series for
-//! `|u| ≤ h/2`: `M·(h/2)^(D+1)/(D+1)!` for `g`, `M·(h/2)^D/D!` for `g'`,
+//! coefficients `g⁽ᵏ⁾(c_j)/k!`, k = 0..=DEGREE, computed from the series
+//! (`cos n·c_j`, `sin n·c_j` by the angle-addition recurrence). With
+//! `M = Σ_k k^(DEGREE+1)·√(a_k² + b_k²) ≥ max |g⁽ᴰᴱᴳᴿᴱᴱ⁺¹⁾|` the Lagrange
+//! remainder bounds the table's error against the series for `|u| ≤ h/2`:
+//! `M·(h/2)^(D+1)/(D+1)!` for `g`, `M·(h/2)^D/D!` for `g'`,
 //! `M·(h/2)^(D−1)/(D−1)!` for `g''` (D = DEGREE). N is the smallest count
 //! that keeps the first at or below [`TOLERANCE_RAD`] (1e-13 rad, about
 //! 3e-13 m at 3 m of reach, seven orders below the IK's 1e-3 mm tolerance)
 //! and the second at or below [`SLOPE_TOLERANCE`] (1e-12: the Jacobian's
-//! chain rule factor `1 + f'`); rounding adds a few ulps of
-//! `Σ_k √(a_k² + b_k²)`. A map that would need more than [`MAX_INTERVALS`]
-//! keeps its series. Units: q and g in rad; model-convention joints.
+//! chain rule factor `1 + f'`); rounding (the recurrence over K harmonics,
+//! the sums) adds about K ulps of `Σ_k √(a_k² + b_k²)`. A map that would need
+//! more than [`MAX_INTERVALS`] keeps its series. The tables are built with
+//! the solver (the service keeps its solvers per model version, payload and
+//! tool). Units: q and g in rad; model-convention joints.
 
 use super::joint_maps::{self, AngleError, JointMap, JointMaps, MapTaylor};
 use std::f64::consts::{PI, TAU};
@@ -107,27 +110,35 @@ impl MapTable {
             coefficients: Vec::with_capacity(intervals),
             bound,
         };
-        let inverse_factorials: [f64; COEFFS] = std::array::from_fn(|k| 1.0 / factorial(k as i32));
+        // g⁽ᵏ⁾(c)/k! = Σ_n w_nk·(A_n or B_n) with A_n = a cos nc + b sin nc,
+        // B_n = b cos nc − a sin nc (A for even k, B for odd; g⁽ᵏ⁾ cycles
+        // through A, B, −A, −B) and the weights w_nk = ±n^k/k!.
+        let weights: Vec<[f64; COEFFS]> = (1..=map.harmonics())
+            .map(|n| {
+                let n = n as f64;
+                std::array::from_fn(|k| {
+                    let sign = if k % 4 < 2 { 1.0 } else { -1.0 };
+                    sign * n.powi(k as i32) / factorial(k as i32)
+                })
+            })
+            .collect();
         for j in 0..intervals {
             let c = table.centre(j);
-            // Σ_n n^k·A_n and Σ_n n^k·B_n with A_n = a cos nc + b sin nc,
-            // B_n = b cos nc − a sin nc; g⁽ᵏ⁾ cycles through A, B, −A, −B.
+            // cos nc and sin nc by the angle-addition recurrence from one
+            // sine and cosine (a few ulps per harmonic, far below the bound).
+            let (s1, c1) = c.sin_cos();
+            let (mut sn, mut cn) = (s1, c1);
             let mut sums = [0.0; COEFFS];
-            for (i, (a, b)) in map.cos.iter().zip(&map.sin).enumerate() {
-                let n = (i + 1) as f64;
-                let (s, co) = (n * c).sin_cos();
-                let (big_a, big_b) = (a * co + b * s, b * co - a * s);
-                let mut power = 1.0;
-                for (k, sum) in sums.iter_mut().enumerate() {
-                    let term = if k % 2 == 0 { big_a } else { big_b };
-                    let sign = if k % 4 < 2 { 1.0 } else { -1.0 };
-                    *sum += sign * power * term;
-                    power *= n;
+            for ((a, b), w) in map.cos.iter().zip(&map.sin).zip(&weights) {
+                let ab = [a * cn + b * sn, b * cn - a * sn];
+                for k in 0..COEFFS {
+                    sums[k] += w[k] * ab[k % 2];
                 }
+                let next = sn * c1 + cn * s1;
+                cn = cn * c1 - sn * s1;
+                sn = next;
             }
-            table
-                .coefficients
-                .push(std::array::from_fn(|k| sums[k] * inverse_factorials[k]));
+            table.coefficients.push(sums);
         }
         Some(table)
     }
