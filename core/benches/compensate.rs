@@ -27,6 +27,10 @@
 //! Trainer comparison over 20 seeds (final validation error and wall time):
 //! `cargo run --release -p robocal-core --example compare_trainers`.
 
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+use common::measure_truth;
 use criterion::measurement::WallTime;
 use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::Vector3;
@@ -40,9 +44,8 @@ use robocal_core::identify::{
     calibrate_with_training, CalibrationOptions, CompensatorOptions, Method,
 };
 use robocal_core::ik::{Goal, IkSettings, IkSolver, SolveOptions};
-use robocal_core::measure::{self, Measurement};
-use robocal_core::model::{preset, JointMap, JointMaps, RobotModel};
-use robocal_core::sim::{random_configurations, TrueRobot};
+use robocal_core::model::{preset, JointMap, JointMaps};
+use robocal_core::sim::random_configurations;
 use std::hint::black_box;
 use std::sync::Arc;
 
@@ -66,20 +69,6 @@ fn samples(cm: &CompensatedModel, n: usize, seed: u64) -> Vec<Sample> {
 fn fit(spec: &CompensatorSpec, s: &[Sample]) -> StoredCompensator {
     let mut rng = ChaCha8Rng::seed_from_u64(1);
     train(spec, s, &mut rng, &mut |_, _| true).unwrap().0
-}
-
-/// `n` random configurations measured on `truth` with the model's payload.
-fn measure_truth(
-    truth: &TrueRobot,
-    nominal: &RobotModel,
-    n: usize,
-    rng: &mut ChaCha8Rng,
-) -> Vec<Measurement> {
-    let qs = random_configurations(nominal, n, rng);
-    let rows = truth
-        .measure(&qs, Some(nominal.payload.mass), None, rng)
-        .unwrap();
-    measure::to_measurements(nominal, &rows, nominal.payload.mass)
 }
 
 /// One calibrated IK solve per iteration, cycling through `goals`.

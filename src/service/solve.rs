@@ -220,10 +220,7 @@ async fn prepare(
         robot_id,
         chosen.as_ref().map(|c| c.0),
         cmd.payload_kg.map(f64::to_bits),
-        tcp.map(|t| {
-            let bits = t.p.iter().chain(t.r.iter()).map(|v| v.to_bits());
-            bits.collect::<Vec<u64>>()
-        }),
+        tcp.map(|t| std::array::from_fn(|i| if i < 3 { t.p[i] } else { t.r[i - 3] }.to_bits())),
     );
     let cacheable = cmd.jump_deg.is_none();
     if cacheable {

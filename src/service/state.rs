@@ -74,7 +74,7 @@ pub struct RobotContext {
 /// Cache key of a prepared solver: robot, version row (None: nominal model),
 /// payload override bits.
 /// Robot, model version, payload and production tool (the bits of `p` and `R`).
-type SolverKey = (i64, Option<i64>, Option<u64>, Option<Vec<u64>>);
+type SolverKey = (i64, Option<i64>, Option<u64>, Option<[u64; 12]>);
 
 /// Shared state of the service.
 #[derive(Clone)]

@@ -386,6 +386,25 @@ async fn a_program_filtered_over_http_is_what_robocal_filter_writes() {
     assert_eq!(r.status, StatusCode::NOT_FOUND);
 }
 
+/// The TCP of the tool "torch" of a cell file.
+fn torch(cell: &Value) -> Pose {
+    let cell = CellDescription::from_json(&cell.to_string())
+        .unwrap()
+        .to_cell()
+        .unwrap();
+    cell.tool(&robocal::cell::CellRef::Name("torch".into()))
+        .unwrap()
+        .tcp
+}
+
+/// The cell options of the branch the solves below ask for.
+fn front_up_noflip() -> CellOptions {
+    CellOptions {
+        branch: Some(robocal::ik::Configuration::parse("front,up,noflip").unwrap()),
+        seed: None,
+    }
+}
+
 fn pose_of(xyz_mm: [f64; 3], abc_deg: [f64; 3]) -> Pose {
     let r = rotation_from(OrientationConvention::KukaAbc, &abc_deg).unwrap();
     Pose::new(r, nalgebra::Vector3::from(xyz_mm) * 1e-3)
@@ -405,13 +424,10 @@ async fn a_solve_with_a_tool_and_a_work_object_is_the_cell_solvers() {
         .unwrap()
         .to_cell()
         .unwrap();
-    let tool = cell
-        .tool(&robocal::cell::CellRef::Name("torch".into()))
-        .unwrap();
     let wobj = cell
         .work_object(&robocal::cell::CellRef::Number(2))
         .unwrap();
-    let solver = CellSolver::new(&model, &tool.tcp, IkSettings::default());
+    let solver = CellSolver::new(&model, &torch(&cell_file()), IkSettings::default());
 
     let targets = [
         ([0.0, 0.0, 0.0], [0.0, 0.0, 180.0]),
@@ -443,14 +459,7 @@ async fn a_solve_with_a_tool_and_a_work_object_is_the_cell_solvers() {
         .await
         .json();
     for (i, (p, o)) in targets.iter().enumerate() {
-        let want = solver.solve(
-            &wobj,
-            &pose_of(*p, *o),
-            &CellOptions {
-                branch: Some(robocal::ik::Configuration::parse("front,up,noflip").unwrap()),
-                seed: None,
-            },
-        );
+        let want = solver.solve(&wobj, &pose_of(*p, *o), &front_up_noflip());
         assert!(want.solution.converged);
         let ft = want.false_target.unwrap();
         for got in [&stored["results"][i], &inline["results"][i]] {
@@ -511,20 +520,11 @@ async fn a_solve_with_a_tool_and_a_work_object_is_the_cell_solvers() {
     tools[0]["xyz_mm"][2] = json!(z + 10.0);
     let r = put(&t, TOOLS, &[&rid], json!({ "tools": tools })).await;
     assert_eq!(r.status, StatusCode::OK, "{}", r.text());
-    let moved = CellDescription::from_json(&json!({ "tools": tools }).to_string())
-        .unwrap()
-        .to_cell()
-        .unwrap();
-    let moved = moved
-        .tool(&robocal::cell::CellRef::Name("torch".into()))
-        .unwrap();
-    let want = CellSolver::new(&model, &moved.tcp, IkSettings::default()).solve(
+    let moved = torch(&json!({ "tools": tools }));
+    let want = CellSolver::new(&model, &moved, IkSettings::default()).solve(
         &wobj,
         &pose_of(targets[0].0, targets[0].1),
-        &CellOptions {
-            branch: Some(robocal::ik::Configuration::parse("front,up,noflip").unwrap()),
-            seed: None,
-        },
+        &front_up_noflip(),
     );
     let ft = want.false_target.unwrap();
     let r = t

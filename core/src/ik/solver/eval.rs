@@ -275,10 +275,10 @@ impl PreparedModel {
         self.expand(q, Some(jac), false, local)
     }
 
-    /// [`PreparedModel::predict_base`], with the terms outside the chain
-    /// expanded at `q` into `local` (the closed-form seed's correction: the
-    /// damped Newton runs from that seed start on this expansion of the
-    /// compensator).
+    /// [`PreparedModel::predict_base`], with the compensator expanded at `q`
+    /// into `local` (the closed-form seed's correction: the damped Newton runs
+    /// from that seed start on this expansion of the compensator). The joint
+    /// maps only add their values: the runs expand them where they start.
     pub(crate) fn predict_expanded(&self, q: &[f64], local: &mut Local) -> Option<Pose> {
         self.expand::<U6>(q, None, false, local)
     }
@@ -301,9 +301,10 @@ impl PreparedModel {
         self.expand(q, Some(jac), true, local)
     }
 
-    /// The prediction at `q`, its Jacobian into `jac` when given, the joint
-    /// maps expanded at `q` into `local`, and the compensator expanded there
-    /// too unless `keep_compensator` (then its expansion in `local` gives it).
+    /// The prediction at `q`, its Jacobian into `jac` and the joint maps
+    /// expanded at `q` into `local` when `jac` is given (otherwise the maps
+    /// only add their values), and the compensator expanded there too unless
+    /// `keep_compensator` (then its expansion in `local` gives it).
     fn expand<D: Dim>(
         &self,
         q: &[f64],
@@ -316,7 +317,10 @@ impl PreparedModel {
     {
         let n = q.len();
         let chain = &self.calibrated;
-        local.q0.reset(n, 0.0).copy_from_slice(q);
+        let expand_maps = jac.is_some();
+        // Without the maps' expansion `local` has no maps' point.
+        let q0: &[f64] = if expand_maps { q } else { &[] };
+        local.q0.reset(q0.len(), 0.0).copy_from_slice(q0);
         if !keep_compensator {
             local.nn_q0.reset(n, 0.0).copy_from_slice(q);
             local.residual = Vector3::new(0.0, 0.0, 0.0);
@@ -331,6 +335,10 @@ impl PreparedModel {
         let pose = self.predict(
             q,
             |maps, q, deflected| {
+                if !expand_maps {
+                    maps.add_to(q, deflected);
+                    return;
+                }
                 // One pass over each series: the value and two derivatives.
                 maps.taylor(q, taylor);
                 for (d, t) in deflected.iter_mut().zip(&*taylor) {
