@@ -86,6 +86,40 @@ fn the_joint_derivative_matches_finite_differences_also_where_it_fades() {
     }
 }
 
+/// Inside every trained range the faded GP is the GP itself (weight 1, zero
+/// gradient), bit for bit; just outside one range it is faded below it.
+#[test]
+fn inside_its_ranges_the_faded_gp_is_the_gp() {
+    let data = samples(400, 0.0, -1.5, 1.5, 1);
+    let gp = trained(&data, 1);
+    let qs: Vec<&[f64]> = data.iter().map(|s| s.q.as_slice()).collect();
+    let support = Support::of(&qs, 5f64.to_radians());
+    let faded = StoredCompensator::Gp(gp.clone()).into_arc_supported(Some(support.clone()));
+    let inner = StoredCompensator::Gp(gp).into_arc();
+    let mut rng = ChaCha8Rng::seed_from_u64(10);
+    let (mut inside, mut outside) = (0, 0);
+    for _ in 0..200 {
+        let q: Vec<f64> = (0..6).map(|_| rng.gen_range(-1.55..1.55)).collect();
+        let (mut da, mut db) = (vec![Vector3::zeros(); 6], vec![Vector3::zeros(); 6]);
+        let a = faded.residual_and_jacobian(&q, &[0.0; 6], 0.0, &mut da);
+        let b = inner.residual_and_jacobian(&q, &[0.0; 6], 0.0, &mut db);
+        if support.inside(&q) {
+            inside += 1;
+            assert_eq!((a, &da), (b, &db));
+            assert_eq!(faded.residual(&q, &[0.0; 6]), inner.residual(&q, &[0.0; 6]));
+        } else {
+            outside += 1;
+            let s = support.weight(&q, None);
+            assert!(s < 1.0, "{q:?}");
+            assert!((a.0 - b.0 * s).norm() <= 1e-15 * b.0.norm().max(1e-12));
+        }
+    }
+    assert!(
+        inside > 20 && outside > 20,
+        "{inside} inside, {outside} outside"
+    );
+}
+
 #[test]
 fn it_learns_a_smooth_residual_on_poses_it_never_saw_and_is_deterministic() {
     let data = samples(1500, 5e-6, -1.5, 1.5, 2);

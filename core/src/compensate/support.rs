@@ -93,6 +93,15 @@ impl Support {
         }
     }
 
+    /// Whether `q` lies inside every joint's range, where `s = 1` and
+    /// `∂s/∂q = 0` (false for NaN).
+    pub fn inside(&self, q: &[f64]) -> bool {
+        self.ranges_rad
+            .iter()
+            .zip(q)
+            .all(|([lo, hi], q)| lo <= q && q <= hi)
+    }
+
     /// `s(q)` and, into `grad` (N values, when given), `∂s/∂q`.
     pub fn weight(&self, q: &[f64], grad: Option<&mut [f64]>) -> f64 {
         let n = self.ranges_rad.len().min(q.len());
@@ -213,6 +222,9 @@ impl StoredCompensator {
 
 impl Compensator for Faded {
     fn residual(&self, q: &[f64], tau: &[f64]) -> Vector3<f64> {
+        if self.support.inside(q) {
+            return self.inner.residual(q, tau);
+        }
         let s = self.support.weight(q, None);
         if s == 0.0 {
             return Vector3::zeros();
@@ -225,6 +237,9 @@ impl Compensator for Faded {
     }
 
     fn residual_at(&self, q: &[f64], tau: &[f64], payload_kg: f64) -> Vector3<f64> {
+        if self.support.inside(q) {
+            return self.inner.residual_at(q, tau, payload_kg);
+        }
         let s = self.support.weight(q, None);
         if s == 0.0 {
             return Vector3::zeros();
@@ -245,6 +260,11 @@ impl Compensator for Faded {
         payload_kg: f64,
         dq: &mut [Vector3<f64>],
     ) -> (Vector3<f64>, bool) {
+        // Inside every range the fade is 1 with a zero gradient: the inner
+        // compensator's own values.
+        if self.support.inside(q) {
+            return self.inner.residual_and_jacobian(q, tau, payload_kg, dq);
+        }
         let (mut stack, mut heap) = ([0.0; 16], Vec::new());
         let grad: &mut [f64] = if q.len() <= stack.len() {
             &mut stack[..q.len()]
