@@ -227,6 +227,11 @@ impl AppState {
         })
     }
 
+    /// Large solve batches running or queued now.
+    pub fn solves_admitted(&self) -> usize {
+        self.inner.solve_gate.in_flight()
+    }
+
     /// A place for a large solve batch, or 429 with `Retry-After`.
     pub(crate) fn admit_solve(&self) -> Result<Ticket, ServiceError> {
         let gate = &self.inner.solve_gate;

@@ -178,6 +178,16 @@ async fn saturation_answers_429_with_retry_after() {
             router.oneshot(req).await.unwrap().status()
         })
     };
+    // The spawned batch must hold the place first (or the loop's own batch
+    // would take it and the spawned one be the refused one).
+    let deadline = Instant::now() + Duration::from_secs(30);
+    while t.state.solves_admitted() == 0 && !big_task.is_finished() {
+        assert!(
+            Instant::now() < deadline,
+            "the big batch was never admitted"
+        );
+        tokio::time::sleep(Duration::from_millis(1)).await;
+    }
     let mut refused = false;
     while !big_task.is_finished() {
         let r = t
