@@ -436,11 +436,7 @@ fn cli_solves_targets_in_a_work_object_for_a_production_tool() {
         let want = solver.solve(&wobj, &target, &options).false_target.unwrap();
         let got = &v["targets"][i]["false_target"];
         assert_eq!(v["targets"][i]["status"], "ok", "{got}");
-        let xyz = Vector3::new(
-            got["x"].as_f64().unwrap(),
-            got["y"].as_f64().unwrap(),
-            got["z"].as_f64().unwrap(),
-        );
+        let xyz = common::json_xyz(got);
         assert!(
             (xyz - want.p * 1e3).norm() < 1e-6,
             "{xyz} vs {}",

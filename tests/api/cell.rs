@@ -537,11 +537,7 @@ async fn a_solve_with_a_tool_and_a_work_object_is_the_cell_solvers() {
         .await;
     assert_eq!(r.status, StatusCode::OK, "{}", r.text());
     let f = &r.json()["results"][0]["false_target"];
-    let xyz = nalgebra::Vector3::new(
-        f["x"].as_f64().unwrap(),
-        f["y"].as_f64().unwrap(),
-        f["z"].as_f64().unwrap(),
-    );
+    let xyz = crate::common::json_xyz(f);
     assert!(
         (xyz - ft.p * 1e3).norm() < 1e-6,
         "{xyz} vs {} mm",

@@ -448,11 +448,7 @@ async fn compensator_job_yields_a_version_whose_solve_uses_it() {
         let q = nominal
             .joints_from_controller(&joints.iter().map(|d| d.to_radians()).collect::<Vec<_>>());
         let reached = model.predict(&q).unwrap().p * 1e3;
-        let want = nalgebra::Vector3::new(
-            tgt["x"].as_f64().unwrap(),
-            tgt["y"].as_f64().unwrap(),
-            tgt["z"].as_f64().unwrap(),
-        );
+        let want = crate::common::json_xyz(tgt);
         assert!(
             (reached - want).norm() < 1e-3,
             "compensated prediction misses by {} mm",

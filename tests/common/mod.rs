@@ -12,6 +12,15 @@ use robocal::http::{app, AppState, ServiceConfig};
 use std::path::Path;
 use tower::ServiceExt;
 
+/// The `x`, `y`, `z` fields of a JSON position (a target, a false target).
+pub fn json_xyz(v: &serde_json::Value) -> nalgebra::Vector3<f64> {
+    let c = |k: &str| {
+        v[k].as_f64()
+            .unwrap_or_else(|| panic!("no number {k} in {v}"))
+    };
+    nalgebra::Vector3::new(c("x"), c("y"), c("z"))
+}
+
 /// Runs the `robocal` binary with `args` in `dir`, asserts it succeeded and
 /// returns its standard output as JSON.
 pub fn robocal_json(dir: &Path, args: &[&str]) -> serde_json::Value {
