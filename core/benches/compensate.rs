@@ -11,6 +11,8 @@
 //! - `predict/gp_residual`, `predict/gp_residual_and_dq`: residual alone and
 //!   residual plus derivative of the Gaussian process (300 inducing
 //!   configurations) trained on the same 1000 samples;
+//!   `predict/gp_residual_and_dq_rough`: the same in single precision (the
+//!   IK's expansion at its seed);
 //! - `train_{1500,10000}/gp`: one training of the Gaussian process;
 //! - `ik/solve_{plain,compensated,gp,maps}`: one calibrated IK solve without
 //!   a compensator, with the 18-20-3 network, with the Gaussian process, and
@@ -207,6 +209,14 @@ fn bench(c: &mut Criterion) {
             i = (i + 1) % qs.len();
             let q = black_box(&qs[i]);
             black_box(gp.residual_and_jacobian(q, &tau, 110.0, &mut dq))
+        })
+    });
+    let mut i = 0;
+    g.bench_function("gp_residual_and_dq_rough", |b| {
+        b.iter(|| {
+            i = (i + 1) % qs.len();
+            let q = black_box(&qs[i]);
+            black_box(gp.residual_and_jacobian_rough(q, &tau, 110.0, &mut dq))
         })
     });
     g.finish();

@@ -103,21 +103,28 @@ fn inside_its_ranges_the_faded_gp_is_the_gp() {
         let (mut da, mut db) = (vec![Vector3::zeros(); 6], vec![Vector3::zeros(); 6]);
         let a = faded.residual_and_jacobian(&q, &[0.0; 6], 0.0, &mut da);
         let b = inner.residual_and_jacobian(&q, &[0.0; 6], 0.0, &mut db);
+        // The rough (single-precision) prediction fades the same way.
+        let (mut ra, mut rb) = (vec![Vector3::zeros(); 6], vec![Vector3::zeros(); 6]);
+        let rough_a = faded.residual_and_jacobian_rough(&q, &[0.0; 6], 0.0, &mut ra);
+        let rough_b = inner.residual_and_jacobian_rough(&q, &[0.0; 6], 0.0, &mut rb);
         if support.inside(&q) {
             inside += 1;
             assert_eq!((a, &da), (b, &db));
             assert_eq!(faded.residual(&q, &[0.0; 6]), inner.residual(&q, &[0.0; 6]));
+            assert_eq!((rough_a, &ra), (rough_b, &rb));
         } else {
             outside += 1;
             let s = support.weight(&q, None);
             assert!(s < 1.0, "{q:?}");
             assert!((a.0 - b.0 * s).norm() <= 1e-15 * b.0.norm().max(1e-12));
+            assert!((rough_a.0 - rough_b.0 * s).norm() <= 1e-15 * rough_b.0.norm().max(1e-12));
         }
     }
     assert!(
         inside > 20 && outside > 20,
         "{inside} inside, {outside} outside"
     );
+    assert!(faded.has_rough() && inner.has_rough());
 }
 
 #[test]

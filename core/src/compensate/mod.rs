@@ -29,7 +29,10 @@ use std::sync::Arc;
 
 pub mod file;
 pub mod gp;
+#[cfg(target_arch = "x86_64")]
+mod gp_avx2;
 pub mod gp_predict;
+mod gp_rough;
 pub mod mlp;
 pub mod rbf;
 pub mod select;
@@ -96,6 +99,32 @@ pub trait Compensator: Send + Sync {
             }
             None => (r, false),
         }
+    }
+    /// [`Compensator::residual_and_jacobian`] to a lower precision where that
+    /// is much cheaper (a GP's in single precision, `compensate/gp_rough.rs`);
+    /// the default is the exact one. For the IK's expansion at its
+    /// closed-form seed, whose end point the exact prediction checks.
+    /// [`Compensator::has_rough`] tells whether it differs.
+    fn residual_and_jacobian_rough(
+        &self,
+        q: &[f64],
+        tau: &[f64],
+        payload_kg: f64,
+        dq: &mut [Vector3<f64>],
+    ) -> (Vector3<f64>, bool) {
+        self.residual_and_jacobian(q, tau, payload_kg, dq)
+    }
+    /// Whether [`Compensator::residual_and_jacobian_rough`] differs from
+    /// the exact prediction.
+    fn has_rough(&self) -> bool {
+        false
+    }
+    /// The typical size [m] of the remainder of the first-order expansion
+    /// at `a` evaluated at `b` (what the IK's expansion misses there), for
+    /// compensators that know their own scale ([`Gp`]); `None` otherwise.
+    fn expansion_remainder(&self, a: &[f64], b: &[f64]) -> Option<f64> {
+        let _ = (a, b);
+        None
     }
     /// The storable form for the model file; `None` for compensators that
     /// cannot be stored (the file then carries no compensator).

@@ -220,6 +220,45 @@ impl StoredCompensator {
     }
 }
 
+impl Faded {
+    /// The inner compensator's residual and derivative (`inner(dq)`, as
+    /// `Compensator::residual_and_jacobian`) faded at `q`: the residual
+    /// times the fade weight `s`, its derivative `s·∂r/∂q + r·∂s/∂q`.
+    fn faded(
+        &self,
+        q: &[f64],
+        dq: &mut [Vector3<f64>],
+        inner: impl FnOnce(&mut [Vector3<f64>]) -> (Vector3<f64>, bool),
+    ) -> (Vector3<f64>, bool) {
+        // Inside every range the fade is 1 with a zero gradient: the inner
+        // compensator's own values.
+        if self.support.inside(q) {
+            return inner(dq);
+        }
+        let (mut stack, mut heap) = ([0.0; 16], Vec::new());
+        let grad: &mut [f64] = if q.len() <= stack.len() {
+            &mut stack[..q.len()]
+        } else {
+            heap.resize(q.len(), 0.0);
+            &mut heap
+        };
+        let s = self.support.weight(q, Some(&mut *grad));
+        if s == 0.0 && grad.iter().all(|g| *g == 0.0) {
+            return (Vector3::zeros(), false);
+        }
+        let (r, written) = inner(dq);
+        let fading = grad.iter().any(|g| *g != 0.0);
+        if !written && !fading {
+            return (r * s, false);
+        }
+        for (k, c) in dq.iter_mut().enumerate() {
+            let inner = if written { *c } else { Vector3::zeros() };
+            *c = inner * s + r * grad.get(k).copied().unwrap_or(0.0);
+        }
+        (r * s, true)
+    }
+}
+
 impl Compensator for Faded {
     fn residual(&self, q: &[f64], tau: &[f64]) -> Vector3<f64> {
         if self.support.inside(q) {
@@ -260,32 +299,30 @@ impl Compensator for Faded {
         payload_kg: f64,
         dq: &mut [Vector3<f64>],
     ) -> (Vector3<f64>, bool) {
-        // Inside every range the fade is 1 with a zero gradient: the inner
-        // compensator's own values.
-        if self.support.inside(q) {
-            return self.inner.residual_and_jacobian(q, tau, payload_kg, dq);
-        }
-        let (mut stack, mut heap) = ([0.0; 16], Vec::new());
-        let grad: &mut [f64] = if q.len() <= stack.len() {
-            &mut stack[..q.len()]
-        } else {
-            heap.resize(q.len(), 0.0);
-            &mut heap
-        };
-        let s = self.support.weight(q, Some(&mut *grad));
-        if s == 0.0 && grad.iter().all(|g| *g == 0.0) {
-            return (Vector3::zeros(), false);
-        }
-        let (r, written) = self.inner.residual_and_jacobian(q, tau, payload_kg, dq);
-        let fading = grad.iter().any(|g| *g != 0.0);
-        if !written && !fading {
-            return (r * s, false);
-        }
-        for (k, c) in dq.iter_mut().enumerate() {
-            let inner = if written { *c } else { Vector3::zeros() };
-            *c = inner * s + r * grad.get(k).copied().unwrap_or(0.0);
-        }
-        (r * s, true)
+        self.faded(q, dq, |dq| {
+            self.inner.residual_and_jacobian(q, tau, payload_kg, dq)
+        })
+    }
+
+    fn residual_and_jacobian_rough(
+        &self,
+        q: &[f64],
+        tau: &[f64],
+        payload_kg: f64,
+        dq: &mut [Vector3<f64>],
+    ) -> (Vector3<f64>, bool) {
+        self.faded(q, dq, |dq| {
+            self.inner
+                .residual_and_jacobian_rough(q, tau, payload_kg, dq)
+        })
+    }
+
+    fn has_rough(&self) -> bool {
+        self.inner.has_rough()
+    }
+
+    fn expansion_remainder(&self, a: &[f64], b: &[f64]) -> Option<f64> {
+        self.inner.expansion_remainder(a, b)
     }
 
     fn stored(&self) -> Option<StoredCompensator> {

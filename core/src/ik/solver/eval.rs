@@ -148,6 +148,21 @@ pub(crate) struct Local {
     tau: Small<f64>,
     /// Gravity torques at the last trial step [N·m].
     trial_tau: Small<f64>,
+    /// The compensator's expansion is the rough one
+    /// (`Compensator::residual_and_jacobian_rough`), not exact even at its
+    /// point.
+    rough: bool,
+}
+
+/// How [`PreparedModel::expand`] takes the compensator.
+#[derive(Clone, Copy, PartialEq)]
+enum CompensatorAt {
+    /// Evaluated at the point, exactly.
+    Exact,
+    /// Evaluated at the point to the compensator's rough precision.
+    Rough,
+    /// From its expansion in `Local`.
+    Kept,
 }
 
 impl Local {
@@ -160,6 +175,7 @@ impl Local {
             derivative: NnDerivative::new(),
             tau: Small::new(0.0),
             trial_tau: Small::new(0.0),
+            rough: false,
         }
     }
 
@@ -168,10 +184,10 @@ impl Local {
         std::mem::swap(&mut self.tau, &mut self.trial_tau);
     }
 
-    /// Whether `q` is the point of both expansions (where the expanded
-    /// prediction is the exact one).
+    /// Whether `q` is the point of both expansions and the compensator's is
+    /// exact (then the expanded prediction is the exact one there).
     pub(crate) fn is_exact_at(&self, q: &[f64]) -> bool {
-        self.q0.get() == q && self.nn_q0.get() == q
+        !self.rough && self.q0.get() == q && self.nn_q0.get() == q
     }
 
     /// The compensator's `∂NN/∂q` at the point.
@@ -272,22 +288,52 @@ impl PreparedModel {
     where
         DefaultAllocator: Allocator<U6, D>,
     {
-        self.expand(q, Some(jac), false, local)
+        self.expand(q, Some(jac), CompensatorAt::Exact, local)
     }
 
-    /// [`PreparedModel::predict_base`], with the compensator expanded at `q`
-    /// into `local` (the closed-form seed's correction: the damped Newton runs
-    /// from that seed start on this expansion of the compensator). The joint
-    /// maps only add their values: the runs expand them where they start.
+    /// [`PreparedModel::predict_with_jacobian`] with the compensator's rough
+    /// prediction (`Compensator::residual_and_jacobian_rough`): the start of
+    /// a damped Newton run too far from the point of a seed's expansion
+    /// ([`PreparedModel::expansion_holds`]).
+    pub(crate) fn predict_rough_with_jacobian<D: Dim>(
+        &self,
+        q: &[f64],
+        jac: &mut OMatrix<f64, U6, D>,
+        local: &mut Local,
+    ) -> Option<Pose>
+    where
+        DefaultAllocator: Allocator<U6, D>,
+    {
+        self.expand(q, Some(jac), CompensatorAt::Rough, local)
+    }
+
+    /// Whether the compensator's expansion in `local` is expected to hold at
+    /// `q` to within `tolerance_m` (`Compensator::expansion_remainder`; true
+    /// for compensators that do not know it).
+    pub(crate) fn expansion_holds(&self, local: &Local, q: &[f64], tolerance_m: f64) -> bool {
+        let Some(c) = &self.compensator else {
+            return true;
+        };
+        c.expansion_remainder(local.nn_q0.get(), q)
+            .is_none_or(|r| r <= tolerance_m)
+    }
+
+    /// [`PreparedModel::predict_base`] with the compensator's rough
+    /// prediction (`Compensator::residual_and_jacobian_rough`), expanded at
+    /// `q` into `local` (the closed-form seed's correction: the damped Newton
+    /// runs from that seed start on this expansion of the compensator, and
+    /// check the exact prediction where they end). The joint maps only add
+    /// their values: the runs expand them where they start.
     pub(crate) fn predict_expanded(&self, q: &[f64], local: &mut Local) -> Option<Pose> {
-        self.expand::<U6>(q, None, false, local)
+        self.expand::<U6>(q, None, CompensatorAt::Rough, local)
     }
 
     /// The start of a damped Newton run near the point of `local`'s
     /// compensator: the chain exact and the joint maps expanded at `q`, as
     /// in [`PreparedModel::predict_with_jacobian`], and the compensator
-    /// from its expansion in `local` (exact at that point; elsewhere second
-    /// order in the distance). Saves the compensator's evaluation at the
+    /// from its expansion in `local` (at that point exact, or rough where
+    /// [`PreparedModel::predict_expanded`] made it; elsewhere second order
+    /// in the distance). Saves the compensator's evaluation at the
     /// start of the run.
     pub(crate) fn predict_restart<D: Dim>(
         &self,
@@ -298,18 +344,17 @@ impl PreparedModel {
     where
         DefaultAllocator: Allocator<U6, D>,
     {
-        self.expand(q, Some(jac), true, local)
+        self.expand(q, Some(jac), CompensatorAt::Kept, local)
     }
 
     /// The prediction at `q`, its Jacobian into `jac` and the joint maps
     /// expanded at `q` into `local` when `jac` is given (otherwise the maps
-    /// only add their values), and the compensator expanded there too unless
-    /// `keep_compensator` (then its expansion in `local` gives it).
+    /// only add their values), and the compensator as `at` says.
     fn expand<D: Dim>(
         &self,
         q: &[f64],
         mut jac: Option<&mut OMatrix<f64, U6, D>>,
-        keep_compensator: bool,
+        at: CompensatorAt,
         local: &mut Local,
     ) -> Option<Pose>
     where
@@ -321,7 +366,10 @@ impl PreparedModel {
         // Without the maps' expansion `local` has no maps' point.
         let q0: &[f64] = if expand_maps { q } else { &[] };
         local.q0.reset(q0.len(), 0.0).copy_from_slice(q0);
+        let keep_compensator = at == CompensatorAt::Kept;
         if !keep_compensator {
+            local.rough = at == CompensatorAt::Rough
+                && self.compensator.as_ref().is_some_and(|c| c.has_rough());
             local.nn_q0.reset(n, 0.0).copy_from_slice(q);
             local.residual = Vector3::new(0.0, 0.0, 0.0);
             local.derivative.columns(n);
@@ -354,7 +402,12 @@ impl PreparedModel {
                 if keep_compensator {
                     return *residual + derivative.times(q, nn_q0);
                 }
-                let (r, w) = c.residual_and_jacobian(q, tau, payload, derivative.columns(n));
+                let dq = derivative.columns(n);
+                let (r, w) = if at == CompensatorAt::Rough {
+                    c.residual_and_jacobian_rough(q, tau, payload, dq)
+                } else {
+                    c.residual_and_jacobian(q, tau, payload, dq)
+                };
                 derivative.written = w;
                 *residual = r;
                 r
@@ -425,9 +478,10 @@ impl PreparedModel {
     /// with `local`'s constant terms shifted so that the expansion equals
     /// the exact prediction at `q` too (its derivatives stay those of its
     /// point): after a failed check the iteration goes on from `q` without
-    /// expanding again. Without joint maps the chain of `current` is already
-    /// exact and only the compensator is evaluated, at `q` and the gravity
-    /// torques kept for it.
+    /// expanding again. `local` holds the gravity torques at `q` (the
+    /// iteration's current point): without joint maps the chain of `current`
+    /// is already exact and only the compensator is evaluated, at `q` and
+    /// those torques; with them, only the deflected chain is evaluated again.
     pub(crate) fn predict_checked(
         &self,
         q: &[f64],
@@ -449,8 +503,12 @@ impl PreparedModel {
         let taylor = local.maps.get_mut();
         let residual = &mut local.residual;
         let derivative = &local.derivative;
-        self.predict(
+        let (mut f_s, mut f_h) = ([Pose::identity(); STACK_DOF], Vec::new());
+        let frames = stack_or_heap(&mut f_s, &mut f_h, q.len(), Pose::identity());
+        self.predict_deflected(
             q,
+            local.tau.get(),
+            frames,
             |maps, q, deflected| {
                 for (i, (m, d)) in maps.joints.iter().zip(deflected.iter_mut()).enumerate() {
                     let f = m.as_ref().map_or(0.0, |m| m.value(q[i]));
@@ -466,7 +524,6 @@ impl PreparedModel {
                 *residual = r - derivative.times(q, nn_q0);
                 r
             },
-            |_| {},
         )
     }
 
@@ -526,22 +583,48 @@ impl PreparedModel {
             chain.gravity_torques(frames, &tcp0, lp0.as_ref(), self.payload_kg, tau);
         }
         on_tau(tau);
-        let mut pose = if self.has_compliance || self.maps.is_some() {
-            let (mut d_s, mut d_h) = ([0.0; STACK_DOF], Vec::new());
-            let deflected = stack_or_heap(&mut d_s, &mut d_h, n, 0.0);
-            for (((d, q), t), c) in deflected.iter_mut().zip(q).zip(&*tau).zip(&self.compliance) {
-                *d = q + c * t;
-            }
-            if let Some(maps) = &self.maps {
-                add_maps(maps, q, deflected);
-            }
-            let (tcp1, lp1) = chain.frames(deflected, frames).ok()?;
-            at_deflected(frames, &tcp1, lp1.as_ref());
-            tcp1
-        } else {
-            at_deflected(frames, &tcp0, lp0.as_ref());
-            tcp0
-        };
+        if self.deflects() {
+            return self.predict_deflected(q, tau, frames, add_maps, at_deflected, residual);
+        }
+        at_deflected(frames, &tcp0, lp0.as_ref());
+        let mut pose = tcp0;
+        if let Some(c) = &self.compensator {
+            pose.p += residual(c.as_ref(), q, tau, self.payload_kg);
+        }
+        Some(pose)
+    }
+
+    /// Whether the calibrated chain is evaluated at joints other than `q`
+    /// (compliance or joint maps).
+    fn deflects(&self) -> bool {
+        self.has_compliance || self.maps.is_some()
+    }
+
+    /// [`PreparedModel::predict`] given the gravity torques `tau` at `q`,
+    /// for a model that [deflects](PreparedModel::deflects): the chain at
+    /// `q + c∘τ` plus the joint maps (its frames into `frames`, one per
+    /// joint), and the compensator's residual.
+    fn predict_deflected(
+        &self,
+        q: &[f64],
+        tau: &[f64],
+        frames: &mut [Pose],
+        add_maps: impl FnOnce(&TabulatedMaps, &[f64], &mut [f64]),
+        at_deflected: impl FnOnce(&[Pose], &Pose, Option<&LoopPartials>),
+        residual: impl FnOnce(&dyn Compensator, &[f64], &[f64], f64) -> Vector3<f64>,
+    ) -> Option<Pose> {
+        let n = q.len();
+        let (mut d_s, mut d_h) = ([0.0; STACK_DOF], Vec::new());
+        let deflected = stack_or_heap(&mut d_s, &mut d_h, n, 0.0);
+        for (((d, q), t), c) in deflected.iter_mut().zip(q).zip(tau).zip(&self.compliance) {
+            *d = q + c * t;
+        }
+        if let Some(maps) = &self.maps {
+            add_maps(maps, q, deflected);
+        }
+        let (tcp, lp) = self.calibrated.frames(deflected, frames).ok()?;
+        at_deflected(frames, &tcp, lp.as_ref());
+        let mut pose = tcp;
         if let Some(c) = &self.compensator {
             pose.p += residual(c.as_ref(), q, tau, self.payload_kg);
         }
@@ -808,6 +891,50 @@ mod tests {
             }
         }
         assert!(checked >= 80, "{checked} points checked");
+    }
+
+    /// With a compensator whose seed expansion is rough (a GP's, single
+    /// precision): the expansion is within the rough prediction's bound of
+    /// the exact one but not taken as exact at its own point, so a run
+    /// starting there checks; the check is the exact prediction. A start too
+    /// far from the seed (in the GP's length scales) does not hold the
+    /// expansion, one next to it does.
+    #[test]
+    fn a_rough_seed_expansion_is_checked() {
+        let gp = crate::compensate::gp_predict::tests::random_gp(60, 3);
+        let scale = gp.signal_variance * gp.alpha.iter().map(|a| a.abs()).sum::<f64>();
+        let nominal = preset("ys100").unwrap();
+        let mut m = synthetic_calibration(&nominal, &SyntheticErrors::typical(1e-6), 7);
+        m.compensator = Some(Arc::new(crate::compensate::PreparedGp::new(gp)));
+        for with_maps in [false, true] {
+            if with_maps {
+                m.calibrated.joint_maps = Some(maps(6));
+            }
+            let p = PreparedModel::new(&m, &m.nominal);
+            let mut rng = ChaCha8Rng::seed_from_u64(41);
+            let mut differs = false;
+            for _ in 0..20 {
+                let q1: Vec<f64> = (0..6).map(|_| rng.gen_range(-0.8..1.3)).collect();
+                let mut seed = Local::new();
+                let pose = p.predict_expanded(&q1, &mut seed).unwrap();
+                let exact = p.predict_base(&q1).unwrap();
+                let gap = (pose.p - exact.p).norm();
+                assert!(gap <= 1e-7 * scale, "{gap:e} m");
+                assert!((pose.r - exact.r).amax() <= 1e-12);
+                differs |= gap > 0.0;
+                let mut local = seed.clone();
+                let mut jac = nalgebra::Matrix6::zeros();
+                let restarted = p.predict_restart(&q1, &mut jac, &mut local).unwrap();
+                assert!(!local.is_exact_at(&q1));
+                let checked = p.predict_checked(&q1, &restarted, &mut local).unwrap();
+                assert!((checked.p - exact.p).amax() <= 1e-12);
+                assert!((checked.r - exact.r).amax() <= 1e-12);
+                assert!(p.expansion_holds(&seed, &q1, 1e-7));
+                let far: Vec<f64> = q1.iter().map(|q| q + 0.5).collect();
+                assert!(!p.expansion_holds(&seed, &far, 1e-7));
+            }
+            assert!(differs, "the rough prediction is its own computation");
+        }
     }
 
     /// The check at an accepted trial step is the exact prediction there

@@ -168,12 +168,20 @@ impl IkSolver {
         // again, where the expanded one meets the tolerance.
         let linearised = self.prepared.has_local_terms();
         let mut local = Local::new();
+        let near = |e: &Local| {
+            self.prepared
+                .expansion_holds(e, &q_start, s.position_tolerance_m)
+        };
         let start = match expansion {
-            Some(e) if linearised => {
+            Some(e) if linearised && near(e) => {
                 local.clone_from(e);
                 self.prepared
                     .predict_restart(&q_start, &mut jac, &mut local)
             }
+            // Too far from that expansion's point: a rough expansion here.
+            Some(_) if linearised => self
+                .prepared
+                .predict_rough_with_jacobian(&q_start, &mut jac, &mut local),
             _ => self
                 .prepared
                 .predict_with_jacobian(&q_start, &mut jac, &mut local),
