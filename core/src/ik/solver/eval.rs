@@ -14,7 +14,9 @@
 //! of the calibrated chain at the deflected joints, column i times the joint
 //! map's `1 + f_i'(q_i)`, plus the compensator's `∂NN/∂q` on the position
 //! rows, `∂τ/∂q` neglected), compared in the tests below, and expands the
-//! joint maps and the compensator there ([`Local`]);
+//! joint maps and the compensator there ([`Local`]; at a closed-form seed,
+//! [`PreparedModel::predict_expanded`], with the compensator's rough
+//! prediction, which the runs' checks replace by the exact one);
 //! [`PreparedModel::predict_local`] evaluates the chain exactly and those
 //! terms from their expansion (the damped Newton's trial steps);
 //! [`PreparedModel::predict_with_chord`] takes `∂NN/∂q` from an earlier

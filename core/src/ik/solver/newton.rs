@@ -10,11 +10,15 @@
 //! decouples them (their solution is 0), so the step is the 3-row
 //! minimum-norm step of the parent module's header. The prediction and its
 //! Jacobian come from the prepared model (`solver/eval.rs`): trial steps take
-//! the joint maps and the compensator from their expansion at the last exact
-//! evaluation (the chain itself is always exact); where the expanded
-//! prediction meets the tolerance, the exact one is evaluated there, and the
-//! iteration ends if it meets the tolerance too or goes on expanded there.
-//! The residuals reported are always those of the exact prediction.
+//! the joint maps and the compensator from their expansion at the last
+//! evaluation that expanded them (the chain itself is always exact; the
+//! compensator's expansion at a closed-form seed is its rough prediction, and
+//! a run whose start lies where that expansion is not expected to hold,
+//! `PreparedModel::expansion_holds`, expands it roughly at its start); where
+//! the expanded prediction meets the tolerance, the exact one is evaluated
+//! there, and the iteration ends if it meets the tolerance too or goes on
+//! expanded there. The residuals reported are always those of the exact
+//! prediction.
 //!
 //! Kept beside the generic LM driver (`optim::lm`; the same iteration on it is
 //! `newton/driver.rs`): on `cargo bench -p robocal-core --bench ik_newton`
