@@ -409,9 +409,9 @@ impl Compensator for PreparedGp {
 }
 
 /// `f64` values in storage aligned to whole vectors of [`LANES`] (32
-/// bytes), rows of `padded` values included: a vector load that crosses a
-/// cache line costs two (measured up to 1.7× slower on the allocator's
-/// 16-byte alignment).
+/// bytes), rows of `padded` values included, so that no vector load
+/// crosses a cache line (such a load costs two; the allocator only
+/// promises 16 bytes).
 #[derive(Debug, Clone)]
 struct Aligned {
     groups: Vec<Group>,

@@ -33,8 +33,8 @@ pub(super) struct RoughGp {
     active: usize,
     /// Per group, `u_am` of each active joint (`LANES` values each), then
     /// `s²·α_cm` of each component; zero weights pad the last group.
-    /// Aligned to whole vectors: a load that crosses a cache line costs
-    /// twice (measured up to 1.7× slower with the allocator's alignment).
+    /// Aligned to whole vectors, so that no vector load crosses a cache
+    /// line (such a load costs two).
     groups: Vec<Lanes8>,
     mean: [f64; 3],
     /// The CPU has AVX2 and FMA (module docs).
