@@ -483,7 +483,7 @@ fn with_joints<T>(n: usize, f: impl FnOnce(&mut [f64]) -> T) -> T {
 
 /// Runs `f` on `n` copies of `fill` (on the stack when `n` ≤ [`STACK_JOINTS`]).
 #[inline(always)]
-fn with_scratch<S: Copy, T>(n: usize, fill: S, f: impl FnOnce(&mut [S]) -> T) -> T {
+pub(super) fn with_scratch<S: Copy, T>(n: usize, fill: S, f: impl FnOnce(&mut [S]) -> T) -> T {
     if n <= STACK_JOINTS {
         f(&mut [fill; STACK_JOINTS][..n])
     } else {

@@ -18,12 +18,11 @@
 //! elsewhere, so every CPU gives bitwise the same results.
 
 use super::gp::{Gp, CUTOFF};
+use super::gp_predict::with_scratch;
 use nalgebra::Vector3;
 
 /// Inducing configurations per group (one AVX vector of `f32`).
 const LANES: usize = 8;
-/// Active joints held on the stack (more go to the heap).
-const STACK_JOINTS: usize = 16;
 
 /// A `Gp`'s prediction data in single precision, by groups of [`LANES`]
 /// inducing configurations (module docs).
@@ -80,23 +79,18 @@ impl RoughGp {
     /// `1/ℓ_a` it is `∂μ/∂q`), from the scaled active joints `v`.
     pub(super) fn mean_and_derivative(&self, v: &[f64], dv: &mut [Vector3<f64>]) -> Vector3<f64> {
         let na = self.active;
-        let mut vs = [0.0f32; STACK_JOINTS];
-        let mut ss = [[[0.0f32; LANES]; 3]; STACK_JOINTS];
-        let (mut vh, mut sh) = (Vec::new(), Vec::new());
-        let (v32, s) = if na <= STACK_JOINTS {
-            (&mut vs[..na], &mut ss[..na])
-        } else {
-            vh.resize(na, 0.0);
-            sh.resize(na, [[0.0; LANES]; 3]);
-            (&mut vh[..], &mut sh[..])
-        };
-        for (x, y) in v32.iter_mut().zip(v) {
-            *x = *y as f32;
-        }
-        let r = self.sums(v32, s);
-        for (d, sa) in dv.iter_mut().zip(&*s) {
-            *d = Vector3::from_fn(|c, _| -lane_sum(&sa[c]));
-        }
+        let r = with_scratch(na, 0.0f32, |v32| {
+            for (x, y) in v32.iter_mut().zip(v) {
+                *x = *y as f32;
+            }
+            with_scratch(na, [[0.0f32; LANES]; 3], |s| {
+                let r = self.sums(v32, s);
+                for (d, sa) in dv.iter_mut().zip(&*s) {
+                    *d = Vector3::from_fn(|c, _| -lane_sum(&sa[c]));
+                }
+                r
+            })
+        });
         Vector3::from_fn(|c, _| self.mean[c] + lane_sum(&r[c]))
     }
 
