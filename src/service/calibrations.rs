@@ -789,21 +789,32 @@ pub async fn cancel(
     robot_id: i64,
     id: i64,
 ) -> Result<CalibrationRow, ServiceError> {
-    let row = get(state, robot_id, id).await?;
-    if !row.status.is_active() {
-        return Err(ServiceError::Conflict(format!(
+    let ended = |row: &CalibrationRow| {
+        ServiceError::Conflict(format!(
             "calibration {id} is already {}; only queued or running jobs can be cancelled",
             row.status
-        )));
+        ))
+    };
+    let row = get(state, robot_id, id).await?;
+    if !row.status.is_active() {
+        return Err(ended(&row));
+    }
+    // The request is stored before the runner is told: a runner that stopped
+    // first would end the job as cancelled before the request was recorded,
+    // and the answer would say no cancel was requested.
+    let row = state
+        .db()
+        .request_cancel(robot_id, id)
+        .await?
+        .ok_or_else(|| ServiceError::calibration_not_found(robot_id, id))?;
+    if !row.cancel_requested {
+        // It ended between the read above and the request.
+        return Err(ended(&row));
     }
     if let Some(flag) = state.existing_cancel_flag(id) {
         flag.store(true, Ordering::SeqCst);
     }
-    state
-        .db()
-        .request_cancel(robot_id, id)
-        .await?
-        .ok_or_else(|| ServiceError::calibration_not_found(robot_id, id))
+    Ok(row)
 }
 
 /// The stored report JSON of a calibration (set when it succeeded).
