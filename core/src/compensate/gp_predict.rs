@@ -27,6 +27,7 @@ use super::gp::{Gp, Uncertainty, CUTOFF};
 use super::gp_avx2;
 use super::gp_rough::RoughGp;
 use super::{Compensator, StoredCompensator};
+use crate::kinematics::prepared::with_scratch;
 use nalgebra::Vector3;
 
 /// Partial sums of a reduction (a loop over arrays of this length vectorises).
@@ -34,8 +35,6 @@ const LANES: usize = 4;
 /// Inducing configurations handled per pass: the loops over them are long
 /// enough for the compiler's loop vectoriser, their values stay on the stack.
 const CHUNK: usize = 64;
-/// Active joints held on the stack (more go to the heap).
-const STACK_JOINTS: usize = 16;
 
 /// A [`Gp`] with its prediction data laid out for vectorised loops (module docs).
 #[derive(Debug, Clone)]
@@ -301,7 +300,7 @@ impl PreparedGp {
 
     /// Kernel values `k_Z(q) = s²·w` into `k` (one per inducing configuration).
     pub fn kernel_row(&self, q: &[f64], k: &mut [f64]) {
-        with_joints(self.joints.len(), |v| {
+        with_scratch(self.joints.len(), 0.0, |v| {
             self.scale_joints(q, v);
             let mut w = [0.0; CHUNK];
             for (start, out) in (0..self.padded).step_by(CHUNK).zip(k.chunks_mut(CHUNK)) {
@@ -331,7 +330,7 @@ impl PreparedGp {
 
 impl Compensator for PreparedGp {
     fn residual(&self, q: &[f64], _tau: &[f64]) -> Vector3<f64> {
-        with_joints(self.joints.len(), |v| {
+        with_scratch(self.joints.len(), 0.0, |v| {
             self.scale_joints(q, v);
             self.mean_at(v)
         })
@@ -350,7 +349,7 @@ impl Compensator for PreparedGp {
     ) -> (Vector3<f64>, bool) {
         let na = self.joints.len();
         with_scratch(na, [[0.0; LANES]; 3], |s| {
-            let r = with_joints(na, |v| {
+            let r = with_scratch(na, 0.0, |v| {
                 self.scale_joints(q, v);
                 self.mean_and_sums(v, s)
             });
@@ -374,7 +373,7 @@ impl Compensator for PreparedGp {
     ) -> (Vector3<f64>, bool) {
         let na = self.joints.len();
         with_scratch(na, Vector3::zeros(), |dv| {
-            let r = with_joints(na, |v| {
+            let r = with_scratch(na, 0.0, |v| {
                 self.scale_joints(q, v);
                 self.rough.mean_and_derivative(v, dv)
             });
@@ -473,22 +472,6 @@ fn weighted_sums(w: &[f64], y: [&[f64]; 3], mut r: [[f64; LANES]; 3]) -> [[f64; 
         }
     }
     r
-}
-
-/// Runs `f` on a scratch slice of `n` values (on the stack when small).
-#[inline(always)]
-fn with_joints<T>(n: usize, f: impl FnOnce(&mut [f64]) -> T) -> T {
-    with_scratch(n, 0.0, f)
-}
-
-/// Runs `f` on `n` copies of `fill` (on the stack when `n` ≤ [`STACK_JOINTS`]).
-#[inline(always)]
-pub(super) fn with_scratch<S: Copy, T>(n: usize, fill: S, f: impl FnOnce(&mut [S]) -> T) -> T {
-    if n <= STACK_JOINTS {
-        f(&mut [fill; STACK_JOINTS][..n])
-    } else {
-        f(&mut vec![fill; n])
-    }
 }
 
 /// `Σ a_i·b_i` with [`LANES`] partial sums (vectorised).

@@ -18,7 +18,7 @@
 //! elsewhere, so every CPU gives bitwise the same results.
 
 use super::gp::{Gp, CUTOFF};
-use super::gp_predict::with_scratch;
+use crate::kinematics::prepared::with_scratch;
 use nalgebra::Vector3;
 
 /// Inducing configurations per group (one AVX vector of `f32`).

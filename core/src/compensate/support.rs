@@ -15,6 +15,7 @@
 //! ranges, which cost nothing per IK iteration.
 
 use super::{Compensator, StoredCompensator, Uncertainty};
+use crate::kinematics::prepared::with_scratch;
 use crate::model::{fade_weight, Coverage};
 use nalgebra::{Matrix3xX, Vector3};
 use serde::{Deserialize, Serialize};
@@ -235,27 +236,22 @@ impl Faded {
         if self.support.inside(q) {
             return inner(dq);
         }
-        let (mut stack, mut heap) = ([0.0; 16], Vec::new());
-        let grad: &mut [f64] = if q.len() <= stack.len() {
-            &mut stack[..q.len()]
-        } else {
-            heap.resize(q.len(), 0.0);
-            &mut heap
-        };
-        let s = self.support.weight(q, Some(&mut *grad));
-        if s == 0.0 && grad.iter().all(|g| *g == 0.0) {
-            return (Vector3::zeros(), false);
-        }
-        let (r, written) = inner(dq);
-        let fading = grad.iter().any(|g| *g != 0.0);
-        if !written && !fading {
-            return (r * s, false);
-        }
-        for (k, c) in dq.iter_mut().enumerate() {
-            let inner = if written { *c } else { Vector3::zeros() };
-            *c = inner * s + r * grad.get(k).copied().unwrap_or(0.0);
-        }
-        (r * s, true)
+        with_scratch(q.len(), 0.0, |grad| {
+            let s = self.support.weight(q, Some(&mut *grad));
+            if s == 0.0 && grad.iter().all(|g| *g == 0.0) {
+                return (Vector3::zeros(), false);
+            }
+            let (r, written) = inner(dq);
+            let fading = grad.iter().any(|g| *g != 0.0);
+            if !written && !fading {
+                return (r * s, false);
+            }
+            for (k, c) in dq.iter_mut().enumerate() {
+                let inner = if written { *c } else { Vector3::zeros() };
+                *c = inner * s + r * grad.get(k).copied().unwrap_or(0.0);
+            }
+            (r * s, true)
+        })
     }
 }
 

@@ -44,6 +44,13 @@ pub fn stack_or_heap<'a, T: Copy>(
     }
 }
 
+/// Runs `f` on `n` copies of `fill`, through [`stack_or_heap`].
+#[inline(always)]
+pub fn with_scratch<T: Copy, R>(n: usize, fill: T, f: impl FnOnce(&mut [T]) -> R) -> R {
+    let (mut stack, mut heap) = ([fill; STACK_DOF], Vec::new());
+    f(stack_or_heap(&mut stack, &mut heap, n, fill))
+}
+
 /// A robot model with its constant link transforms' trigonometry, base link
 /// and tool transform precomputed (see the module docs).
 #[derive(Debug, Clone)]

@@ -129,7 +129,7 @@ impl NnDerivative {
 /// (Δ = q − q₀), and the compensator to first, `NN(q₁) + ∂NN/∂q(q₁)·(q − q₁)`
 /// (docs/design.md "Compensated model and false targets"). The compensator's
 /// point `q₁` is `q₀`, or the closed-form seed's when the damped Newton run
-/// starts from the corrected seed ([`PreparedModel::predict_restart`]). The
+/// starts from the corrected seed ([`CompensatorAt::Kept`]). The
 /// damped Newton's trial steps evaluate the chain exactly and these terms
 /// from their expansion, which costs a few multiplications instead of a
 /// series of 80 harmonics per joint or a network; it checks the exact
@@ -158,12 +158,18 @@ pub(crate) struct Local {
 
 /// How [`PreparedModel::expand`] takes the compensator.
 #[derive(Clone, Copy, PartialEq)]
-enum CompensatorAt {
+pub(crate) enum CompensatorAt {
     /// Evaluated at the point, exactly.
     Exact,
-    /// Evaluated at the point to the compensator's rough precision.
+    /// Evaluated at the point to the compensator's rough precision
+    /// (`Compensator::residual_and_jacobian_rough`): a run's start too far
+    /// from the point of a seed's expansion
+    /// ([`PreparedModel::expansion_holds`]).
     Rough,
-    /// From its expansion in `Local`.
+    /// From its expansion in `Local`: a run's start near the point of that
+    /// expansion (there exact, or rough where
+    /// [`PreparedModel::predict_expanded`] made it; elsewhere second order in
+    /// the distance). Saves the compensator's evaluation at the start.
     Kept,
 }
 
@@ -293,22 +299,6 @@ impl PreparedModel {
         self.expand(q, Some(jac), CompensatorAt::Exact, local)
     }
 
-    /// [`PreparedModel::predict_with_jacobian`] with the compensator's rough
-    /// prediction (`Compensator::residual_and_jacobian_rough`): the start of
-    /// a damped Newton run too far from the point of a seed's expansion
-    /// ([`PreparedModel::expansion_holds`]).
-    pub(crate) fn predict_rough_with_jacobian<D: Dim>(
-        &self,
-        q: &[f64],
-        jac: &mut OMatrix<f64, U6, D>,
-        local: &mut Local,
-    ) -> Option<Pose>
-    where
-        DefaultAllocator: Allocator<U6, D>,
-    {
-        self.expand(q, Some(jac), CompensatorAt::Rough, local)
-    }
-
     /// Whether the compensator's expansion in `local` is expected to hold at
     /// `q` to within `tolerance_m` (`Compensator::expansion_remainder`; true
     /// for compensators that do not know it).
@@ -330,23 +320,20 @@ impl PreparedModel {
         self.expand::<U6>(q, None, CompensatorAt::Rough, local)
     }
 
-    /// The start of a damped Newton run near the point of `local`'s
-    /// compensator: the chain exact and the joint maps expanded at `q`, as
-    /// in [`PreparedModel::predict_with_jacobian`], and the compensator
-    /// from its expansion in `local` (at that point exact, or rough where
-    /// [`PreparedModel::predict_expanded`] made it; elsewhere second order
-    /// in the distance). Saves the compensator's evaluation at the
-    /// start of the run.
-    pub(crate) fn predict_restart<D: Dim>(
+    /// The start of a damped Newton run: the chain exact and the joint maps
+    /// expanded at `q`, as in [`PreparedModel::predict_with_jacobian`], and
+    /// the compensator as `at` says.
+    pub(crate) fn predict_start<D: Dim>(
         &self,
         q: &[f64],
         jac: &mut OMatrix<f64, U6, D>,
+        at: CompensatorAt,
         local: &mut Local,
     ) -> Option<Pose>
     where
         DefaultAllocator: Allocator<U6, D>,
     {
-        self.expand(q, Some(jac), CompensatorAt::Kept, local)
+        self.expand(q, Some(jac), at, local)
     }
 
     /// The prediction at `q`, its Jacobian into `jac` and the joint maps
@@ -835,7 +822,7 @@ mod tests {
 
     /// The seed's correction expands the compensator on its exact prediction
     /// (`predict_expanded` is `predict_base`), and a run that starts nearby on
-    /// that expansion (`predict_restart`) has the exact chain and joint maps
+    /// that expansion (`predict_start` with `CompensatorAt::Kept`) has the exact chain and joint maps
     /// and the compensator's first-order expansion: at the seed it equals
     /// `predict_with_jacobian` (pose and Jacobian); away from it the gap to
     /// the exact prediction is second order (halving the distance divides it
@@ -864,7 +851,9 @@ mod tests {
                 let mut fresh = Local::new();
                 let a = p.predict_with_jacobian(&q1, &mut ja, &mut fresh).unwrap();
                 let mut local = seed.clone();
-                let b = p.predict_restart(&q1, &mut jb, &mut local).unwrap();
+                let b = p
+                    .predict_start(&q1, &mut jb, CompensatorAt::Kept, &mut local)
+                    .unwrap();
                 assert!(local.is_exact_at(&q1), "{name}");
                 assert!(
                     (a.p - b.p).amax() <= 1e-12 && (a.r - b.r).amax() <= 1e-12,
@@ -875,7 +864,8 @@ mod tests {
                     let qh: Vec<f64> = q1.iter().zip(&dir).map(|(q, d)| q + h * d).collect();
                     let mut local = seed.clone();
                     let mut jac = nalgebra::Matrix6::zeros();
-                    let restarted = p.predict_restart(&qh, &mut jac, &mut local)?;
+                    let restarted =
+                        p.predict_start(&qh, &mut jac, CompensatorAt::Kept, &mut local)?;
                     assert!(!local.is_exact_at(&qh), "{name}");
                     let exact = p.predict_base(&qh)?;
                     let checked = p.predict_checked(&qh, &restarted, &mut local)?;
@@ -926,7 +916,9 @@ mod tests {
                 differs |= gap > 0.0;
                 let mut local = seed.clone();
                 let mut jac = nalgebra::Matrix6::zeros();
-                let restarted = p.predict_restart(&q1, &mut jac, &mut local).unwrap();
+                let restarted = p
+                    .predict_start(&q1, &mut jac, CompensatorAt::Kept, &mut local)
+                    .unwrap();
                 assert!(!local.is_exact_at(&q1));
                 let checked = p.predict_checked(&q1, &restarted, &mut local).unwrap();
                 assert!((checked.p - exact.p).amax() <= 1e-12);

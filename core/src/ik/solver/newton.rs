@@ -26,7 +26,7 @@
 //! about 1.4× faster, 6.7 µs against 9.6 µs per refinement (best of 8 runs;
 //! medians 8.2 against 14.8 µs on a loaded 2-core machine).
 
-use super::eval::Local;
+use super::eval::{CompensatorAt, Local};
 use super::*;
 
 mod driver;
@@ -176,20 +176,18 @@ impl IkSolver {
             self.prepared
                 .expansion_holds(e, &q_start, s.position_tolerance_m)
         };
-        let start = match expansion {
+        let at = match expansion {
             Some(e) if linearised && near(e) => {
                 local.clone_from(e);
-                self.prepared
-                    .predict_restart(&q_start, &mut jac, &mut local)
+                CompensatorAt::Kept
             }
             // Too far from that expansion's point: a rough expansion here.
-            Some(_) if linearised => self
-                .prepared
-                .predict_rough_with_jacobian(&q_start, &mut jac, &mut local),
-            _ => self
-                .prepared
-                .predict_with_jacobian(&q_start, &mut jac, &mut local),
+            Some(_) if linearised => CompensatorAt::Rough,
+            _ => CompensatorAt::Exact,
         };
+        let start = self
+            .prepared
+            .predict_start(&q_start, &mut jac, at, &mut local);
         let start = start.map(|p| (p, local.is_exact_at(&q_start)));
         let Some((pose, at_expansion)) = start else {
             return fail(q_start, 1);
