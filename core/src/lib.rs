@@ -8,11 +8,13 @@
 //! measurement and target files for both.
 
 pub mod cell;
+pub mod check;
 pub mod compensate;
 pub mod csv_text;
 pub mod export;
 pub mod identify;
 pub mod ik;
+pub mod iso9283;
 pub mod kinematics;
 pub mod measure;
 pub mod model;

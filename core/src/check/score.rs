@@ -1,0 +1,196 @@
+//! Scoring a check set against a model (see [`super`] for the conventions).
+
+use super::{CheckStatus, CheckThresholds};
+use crate::compensate::CompensatedModel;
+use crate::identify::registration::register;
+use crate::measure::MeasuredPose;
+use crate::model::orientation::rotation_angle_between;
+use crate::stats::ErrorStats;
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+/// Poses the frame-shift analysis needs at least.
+pub const MIN_FRAME_SHIFT_POSES: usize = 6;
+
+/// Why a check cannot be scored.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CheckError {
+    #[error("invalid check: {0}")]
+    InvalidInput(String),
+    #[error("check pose {index}: {detail}")]
+    Pose { index: usize, detail: String },
+}
+
+/// One pose's error.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PoseError {
+    /// 1-based row of the set.
+    pub index: usize,
+    pub position_mm: f64,
+    /// Rotation angle between measured and predicted orientation [deg].
+    pub orientation_deg: Option<f64>,
+}
+
+/// Mean, p95 and max of angle errors [deg].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AngleStats {
+    pub n: usize,
+    pub mean_deg: f64,
+    pub p95_deg: f64,
+    pub max_deg: f64,
+}
+
+/// The rigid transform that best explains the errors.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FrameShift {
+    /// Translation of the fitted transform at the measured points' centre [mm].
+    pub translation_mm: f64,
+    /// Its rotation angle [deg].
+    pub rotation_deg: f64,
+    /// Mean position error after removing it [mm].
+    pub residual_mean_mm: f64,
+    /// Whether it explains the errors (see the thresholds).
+    pub explains: bool,
+}
+
+/// A check scored.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CheckResult {
+    pub position: ErrorStats,
+    pub orientation: Option<AngleStats>,
+    pub poses: Vec<PoseError>,
+    /// `None` with fewer than [`MIN_FRAME_SHIFT_POSES`] poses or collinear ones.
+    pub frame_shift: Option<FrameShift>,
+    pub status: CheckStatus,
+    /// One sentence on why this status.
+    pub summary: String,
+}
+
+/// Scores `rows` (controller joints [deg], positions [mm] in the model's
+/// measurement frame) against `model`, without fitting anything.
+pub fn score(
+    model: &CompensatedModel,
+    rows: &[MeasuredPose],
+    thresholds: &CheckThresholds,
+) -> Result<CheckResult, CheckError> {
+    thresholds.validate()?;
+    if rows.is_empty() {
+        return Err(CheckError::InvalidInput(
+            "the check set has no poses".into(),
+        ));
+    }
+    let dof = model.dof();
+    let mut poses = Vec::with_capacity(rows.len());
+    let (mut measured, mut predicted) = (Vec::new(), Vec::new());
+    for (i, row) in rows.iter().enumerate() {
+        if row.q_deg.len() != dof {
+            return Err(CheckError::Pose {
+                index: i + 1,
+                detail: format!("{} joint values, the model has {dof}", row.q_deg.len()),
+            });
+        }
+        let m = row.to_measurement(&model.nominal, model.payload_kg);
+        let p = model
+            .predict_detailed_at(&m.q, m.payload_mass)
+            .map_err(|e| CheckError::Pose {
+                index: i + 1,
+                detail: e.to_string(),
+            })?;
+        let cell = model.cell_from_base.compose(&p.pose);
+        poses.push(PoseError {
+            index: i + 1,
+            position_mm: (m.position - cell.p).norm() * 1e3,
+            orientation_deg: m
+                .orientation
+                .map(|r| rotation_angle_between(&r, &cell.r).to_degrees()),
+        });
+        measured.push(m.position);
+        predicted.push(cell.p);
+    }
+    let e: Vec<f64> = poses.iter().map(|p| p.position_mm).collect();
+    let position = ErrorStats::from_errors_mm(&e);
+    let angles: Vec<f64> = poses.iter().filter_map(|p| p.orientation_deg).collect();
+    let orientation = (!angles.is_empty()).then(|| {
+        let s = ErrorStats::from_errors_mm(&angles);
+        AngleStats {
+            n: s.n,
+            mean_deg: s.mean_mm,
+            p95_deg: s.p95_mm,
+            max_deg: s.max_mm,
+        }
+    });
+    let frame_shift = frame_shift(&measured, &predicted, position.mean_mm, thresholds);
+    let (status, summary) = judge(&position, frame_shift.as_ref(), thresholds);
+    Ok(CheckResult {
+        position,
+        orientation,
+        poses,
+        frame_shift,
+        status,
+        summary,
+    })
+}
+
+fn frame_shift(
+    measured: &[Vector3<f64>],
+    predicted: &[Vector3<f64>],
+    raw_mean_mm: f64,
+    t: &CheckThresholds,
+) -> Option<FrameShift> {
+    if measured.len() < MIN_FRAME_SHIFT_POSES {
+        return None;
+    }
+    let reg = register(measured, predicted).ok()?;
+    let pose = reg.tracker_to_base;
+    let centre = measured.iter().sum::<Vector3<f64>>() / measured.len() as f64;
+    let residual: Vec<f64> = measured
+        .iter()
+        .zip(predicted)
+        .map(|(m, p)| (pose.transform_point(m) - p).norm() * 1e3)
+        .collect();
+    let residual_mean = residual.iter().sum::<f64>() / residual.len() as f64;
+    let angle = rotation_angle_between(&pose.r, &nalgebra::Matrix3::identity());
+    Some(FrameShift {
+        translation_mm: (pose.transform_point(&centre) - centre).norm() * 1e3,
+        rotation_deg: angle.to_degrees(),
+        residual_mean_mm: residual_mean,
+        explains: raw_mean_mm > t.degraded_mm
+            && residual_mean <= t.frame_shift_ratio * raw_mean_mm
+            && residual_mean <= t.degraded_mm,
+    })
+}
+
+fn judge(
+    position: &ErrorStats,
+    shift: Option<&FrameShift>,
+    t: &CheckThresholds,
+) -> (CheckStatus, String) {
+    match shift.filter(|s| s.explains) {
+        Some(s) => (
+            t.status(s.residual_mean_mm),
+            format!(
+                "the errors (mean {:.3} mm) are a rigid frame shift ({:.3} mm, {:.4}°; mean {:.3} mm after removing it): \
+                 the tracker or the base moved; re-register rather than recalibrate",
+                position.mean_mm, s.translation_mm, s.rotation_deg, s.residual_mean_mm
+            ),
+        ),
+        None => {
+            let status = t.status(position.mean_mm);
+            let why = match status {
+                CheckStatus::Ok => format!("at most {} mm", t.degraded_mm),
+                CheckStatus::Degraded => format!(
+                    "above {} mm, at most {} mm",
+                    t.degraded_mm, t.recalibrate_mm
+                ),
+                CheckStatus::Recalibrate => format!(
+                    "above {} mm, not explained by a frame shift",
+                    t.recalibrate_mm
+                ),
+            };
+            (
+                status,
+                format!("mean position error {:.3} mm: {why}", position.mean_mm),
+            )
+        }
+    }
+}

@@ -1,0 +1,61 @@
+//! ISO 9283 pose characteristics: the test cube, its poses solved to joint
+//! commands, and accuracy and repeatability from measured cycles.
+//!
+//! The standard (ISO 9283:1998, "Manipulating industrial robots —
+//! Performance criteria and related test methods", clauses on the test cube,
+//! pose accuracy and repeatability, and distance accuracy and repeatability):
+//!
+//! - **Test cube** ([`cube`]): the largest cube in the part of the workspace
+//!   that is used (here: an axis-aligned box given in the robot's base frame),
+//!   edges parallel to the base frame. Corners (offsets from the centre in
+//!   units of half the edge): C1 (−,−,−), C2 (+,−,−), C3 (+,+,−), C4 (−,+,−),
+//!   C5 (−,−,+), C6 (+,−,+), C7 (+,+,+), C8 (−,+,+). The poses lie on the
+//!   diagonal plane C1–C2–C7–C8: P1 the cube's centre; P2, P3, P4, P5 on the
+//!   plane's diagonals C1–C7 and C2–C8 at 10 % of the diagonal's length from
+//!   C1, C2, C7 and C8. All poses share one orientation. n = 30 cycles
+//!   P1 → P2 → … → P5.
+//! - **Pose accuracy** ([`figures`]), per pose, from the `n` attained
+//!   positions `(x_j, y_j, z_j)` and the commanded `(x_c, y_c, z_c)`:
+//!   barycentre `x̄ = (1/n)·Σ x_j` (and ȳ, z̄);
+//!   `AP = √((x̄ − x_c)² + (ȳ − y_c)² + (z̄ − z_c)²)`, `APx = x̄ − x_c`, …;
+//!   for the angles `a, b, c` (rotations about x, y, z):
+//!   `APa = ā − a_c`, `APb = b̄ − b_c`, `APc = c̄ − c_c`.
+//!   AP is the distance of the barycentre, not the mean single-shot error.
+//! - **Pose repeatability**: `l_j = √((x_j − x̄)² + (y_j − ȳ)² + (z_j − z̄)²)`,
+//!   `l̄ = (1/n)·Σ l_j`, `S_l = √(Σ (l_j − l̄)² / (n − 1))`, `RP = l̄ + 3·S_l`;
+//!   `RPa = ±3·S_a`, `S_a = √(Σ (a_j − ā)² / (n − 1))` (and b, c).
+//! - **Distance accuracy and repeatability** between two poses P and Q over
+//!   the same cycles: `D_c = |P_c − Q_c|`, `D_j = |P_j − Q_j|`,
+//!   `D̄ = (1/n)·Σ D_j`, `AD = D̄ − D_c`, `RD = ±3·S_D`,
+//!   `S_D = √(Σ (D_j − D̄)² / (n − 1))`.
+//!
+//! Frames and units: positions in millimetres in the frame the attained
+//! positions are measured in (the calibrated model's measurement (cell)
+//! frame; the base frame for an unregistered model); angles in degrees,
+//! `a, b, c` the fixed-axis rotations of robocal's one convention
+//! `R = Rz(c)·Ry(b)·Rx(a)` (the measurement CSV's `rx_deg, ry_deg, rz_deg`,
+//! Fanuc W, P, R). Angle deviations are taken from the commanded angle (the
+//! first cycle's when none is commanded) and wrapped to (−180°, 180°], so a
+//! pose near ±180° averages correctly.
+
+pub mod csv;
+pub mod cube;
+pub mod figures;
+
+pub use cube::{plan_cube, Commands, CubePlan, CubePose, CubeSettings, TestCube};
+pub use figures::{evaluate, DistanceFigures, Iso9283Figures, PoseCycles, PoseFigures};
+
+/// Why the ISO 9283 plan or figures cannot be computed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Iso9283Error {
+    #[error("invalid input: {0}")]
+    InvalidInput(String),
+    #[error("pose {pose}: {cycles} cycle(s); the standard's statistics need at least 2 (30 recommended)")]
+    TooFewCycles { pose: String, cycles: usize },
+    #[error(
+        "no cube of edge ≥ {min_edge_mm:.1} mm in the box has all five poses reachable: {detail}"
+    )]
+    Unreachable { min_edge_mm: f64, detail: String },
+    #[error("line {line}: {message}")]
+    Csv { line: usize, message: String },
+}

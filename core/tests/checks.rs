@@ -1,0 +1,86 @@
+//! Check poses on a simulated robot (issue "Is it still accurate?",
+//! acceptance): a calibrated YS100 is checked with fresh poses before, after
+//! a "crash" that shifts joint offsets, and after the tracker moved.
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use robocal_core::check::{score, CheckStatus, CheckThresholds};
+use robocal_core::compensate::CompensatedModel;
+use robocal_core::identify::pose_selection::choose_d_optimal;
+use robocal_core::identify::{calibrate, CalibrationOptions, Method};
+use robocal_core::measure;
+use robocal_core::model::preset;
+use robocal_core::sim::{random_configurations, tracker_frame, ys100_table_7_1, TrueRobot};
+
+fn calibrated(truth: &TrueRobot, rng: &mut ChaCha8Rng) -> CompensatedModel {
+    let nominal = preset("ys100").unwrap();
+    let payload = nominal.payload.mass;
+    let candidates = random_configurations(&nominal, 500, rng);
+    let q_id = choose_d_optimal(&nominal, &candidates, 30, payload, true);
+    let q_va = random_configurations(&nominal, 20, rng);
+    let rows = |q: &[Vec<f64>], rng: &mut ChaCha8Rng| {
+        measure::to_measurements(
+            &nominal,
+            &truth.measure(q, Some(payload), None, rng).unwrap(),
+            payload,
+        )
+    };
+    let (id, va) = (rows(&q_id, rng), rows(&q_va, rng));
+    let opts = CalibrationOptions {
+        methods: vec![Method::Skcm],
+        ..Default::default()
+    };
+    let report = calibrate(&nominal, &id, &va, &opts, &|_| true).unwrap();
+    CompensatedModel {
+        calibrated: report.methods["skcm"].calibrated.clone(),
+        nominal: nominal.clone(),
+        cell_from_base: report.tracker_to_base.inverse(),
+        payload_kg: payload,
+        compensator: None,
+    }
+}
+
+#[test]
+fn checks_tell_ok_a_crash_and_a_moved_tracker_apart() {
+    let mut truth = TrueRobot::new(ys100_table_7_1());
+    truth.noise_mm = 0.01;
+    truth.tracker_from_base = tracker_frame(2.0, -1.0, 95.0, [1200.0, -3240.0, 400.0]);
+    let mut rng = ChaCha8Rng::seed_from_u64(33);
+    let model = calibrated(&truth, &mut rng);
+    let nominal = preset("ys100").unwrap();
+    let t = CheckThresholds::default();
+    let check = |truth: &TrueRobot, rng: &mut ChaCha8Rng| {
+        let q = random_configurations(&nominal, 20, rng);
+        let rows = truth.measure(&q, None, None, rng).unwrap();
+        score(&model, &rows, &t).unwrap()
+    };
+
+    let before = check(&truth, &mut rng);
+    eprintln!("before: {}", before.summary);
+    assert_eq!(before.status, CheckStatus::Ok);
+    assert!(before.position.mean_mm < 0.1, "{:?}", before.position);
+    assert!(!before.frame_shift.as_ref().unwrap().explains);
+
+    // A crash: joints 2, 3 and 5 lose 0.1°, −0.08° and 0.12° of their zero.
+    let mut crashed = truth.clone();
+    for (k, deg) in [(1, 0.1), (2, -0.08), (4, 0.12)] {
+        crashed.model.links[k].theta += f64::to_radians(deg);
+    }
+    let after = check(&crashed, &mut rng);
+    eprintln!("after the crash: {}", after.summary);
+    assert_eq!(after.status, CheckStatus::Recalibrate, "{}", after.summary);
+    assert!(!after.frame_shift.as_ref().unwrap().explains);
+
+    // The tracker moved 12 mm and turned 0.2° about a tilted axis.
+    let mut moved = truth.clone();
+    moved.tracker_from_base =
+        tracker_frame(0.0, 0.0, 0.2, [12.0, -5.0, 3.0]).compose(&truth.tracker_from_base);
+    let shifted = check(&moved, &mut rng);
+    eprintln!("tracker moved: {}", shifted.summary);
+    let s = shifted.frame_shift.as_ref().unwrap();
+    assert!(s.explains, "{}", shifted.summary);
+    assert!(shifted.position.mean_mm > t.recalibrate_mm);
+    assert_eq!(shifted.status, CheckStatus::Ok);
+    assert!(shifted.summary.contains("frame shift"));
+    assert!((s.rotation_deg - 0.2).abs() < 0.01, "{}", s.rotation_deg);
+}
