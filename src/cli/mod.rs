@@ -4,9 +4,11 @@ use clap::{Parser, Subcommand};
 
 pub mod bench;
 pub mod calibrate;
+pub mod check;
 pub mod demo;
 pub mod export;
 pub mod filter;
+pub mod iso9283;
 pub mod model_files;
 pub mod plan;
 pub mod progress;
@@ -31,6 +33,8 @@ pub enum Command {
     Simulate(simulate::SimulateArgs),
     /// Identify calibrated models from measurement CSVs and compare methods.
     Calibrate(calibrate::CalibrateArgs),
+    /// Score check poses against a calibrated model without fitting: the status.
+    Check(check::CheckArgs),
     /// Run a built-in end-to-end study.
     Demo(demo::DemoArgs),
     /// Solve target poses into joint commands and false targets.
@@ -41,6 +45,8 @@ pub enum Command {
     Filter(filter::FilterArgs),
     /// Plan measurement poses (joint CSV or program) and join tracker exports back.
     Plan(plan::PlanArgs),
+    /// ISO 9283 pose accuracy and repeatability: the test cube plan and the figures.
+    Iso9283(iso9283::Iso9283Args),
     /// Run the HTTP service.
     Serve(serve::ServeArgs),
     /// Time robocal's side of the peer benchmark (KM, IK), as JSON.
@@ -52,11 +58,13 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Simulate(a) => simulate::run(a),
         Command::Calibrate(a) => calibrate::run(a),
+        Command::Check(a) => check::run(a),
         Command::Demo(a) => demo::run(a),
         Command::Solve(a) => solve::run(a),
         Command::Export(a) => export::run(a),
         Command::Filter(a) => filter::run(a),
         Command::Plan(a) => plan::run(a),
+        Command::Iso9283(a) => iso9283::run(a),
         Command::Serve(a) => serve::run(a),
         Command::Bench(a) => bench::run(a),
     }

@@ -81,16 +81,20 @@ impl From<sqlx::migrate::MigrateError> for StoreError {
 
 mod calibrations;
 mod cell;
+mod checks;
 mod queue;
 mod robots;
+mod set_usage;
 mod sets;
 mod types;
 mod versions;
 
 pub use calibrations::{CalibrationRow, JobResult, JobStatus, JobSummary, NewCalibration};
 pub use cell::{name_key as cell_name_key, CellItemRow, CellKind, CellPut, ItemFrame, NewCellItem};
+pub use checks::{CheckRow, NewCheck, ThresholdRow};
 pub use queue::{ClaimedJob, Lease, RobotChange, RobotChanges};
 pub use robots::{NewRobot, RobotRow};
+pub use set_usage::SetDeletion;
 pub use sets::{AngleUnit, LengthUnit, NewSet, SetFormat, SetRow, StoredRole};
 pub use types::Json;
 pub use versions::{NewVersion, Rollback, VersionRow};

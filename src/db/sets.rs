@@ -1,7 +1,7 @@
 //! Measurement sets: the uploads as received and their parsed rows.
 
 use super::types::text_enum;
-use super::{commit_inserted, on_pool, write_for_robot, write_one, Db, Json, Listing, StoreError};
+use super::{commit_inserted, on_pool, write_for_robot, Db, Json, Listing, StoreError};
 use crate::measure::{MeasuredPose, SetRole};
 use sqlx::{FromRow, Row};
 
@@ -183,16 +183,6 @@ impl Db {
                 None => None,
             }
         }))
-    }
-
-    pub async fn delete_set(&self, robot_id: i64, id: i64) -> Result<bool, StoreError> {
-        let sql = "DELETE FROM measurement_sets WHERE robot_id = $1 AND id = $2";
-        let n = on_pool!(self, |p, k| write_one!(
-            p,
-            k,
-            sqlx::query(sql).bind(robot_id).bind(id)
-        ));
-        Ok(n > 0)
     }
 }
 

@@ -331,9 +331,12 @@ pub async fn report(
         .map(|r| r.name)
         .unwrap_or_default();
     let title = format!("Calibration {id} of robot {robot_id} ({name})");
-    let html = tokio::task::spawn_blocking(move || crate::report::render_html(&title, &report))
-        .await
-        .map_err(|e| ApiError::Internal(format!("report page: {e}")))?;
+    let record = service::record::calibration_record(&state, robot_id, id).await?;
+    let html = tokio::task::spawn_blocking(move || {
+        crate::report::render_html_with(&title, &report, Some(&record))
+    })
+    .await
+    .map_err(|e| ApiError::Internal(format!("report page: {e}")))?;
     Ok(Html(html).into_response())
 }
 

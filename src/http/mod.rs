@@ -26,6 +26,7 @@ use tracing::Level;
 
 pub mod calibrations;
 pub mod cell;
+pub mod checks;
 pub mod client;
 pub mod console;
 pub mod error;
@@ -34,6 +35,7 @@ pub mod input;
 pub mod listener;
 pub mod plans;
 pub mod programs;
+pub mod record;
 pub mod robots;
 pub mod sets;
 pub mod solve;
@@ -136,6 +138,8 @@ fn routes() -> Vec<Route> {
     all.extend(cell::routes());
     all.extend(programs::routes());
     all.extend(plans::routes());
+    all.extend(checks::routes());
+    all.extend(record::routes());
     all
 }
 

@@ -17,6 +17,7 @@
 pub mod charts;
 pub mod format;
 mod page;
+pub mod record;
 pub mod view;
 
 pub use format::{key_label, method_label};
@@ -31,6 +32,16 @@ const SCRIPT: &str = include_str!("sort.js");
 /// page heading ("Calibration report" when blank). A report that does not
 /// read as a calibration report renders a page that says so.
 pub fn render_html(title: &str, report: &serde_json::Value) -> String {
+    render_html_with(title, report, None)
+}
+
+/// [`render_html`] with the calibration record (`record::record_section`)
+/// after the header.
+pub fn render_html_with(
+    title: &str,
+    report: &serde_json::Value,
+    record: Option<&crate::service::record::CalibrationRecord>,
+) -> String {
     let title = if title.trim().is_empty() {
         "Calibration report"
     } else {
@@ -59,6 +70,7 @@ pub fn render_html(title: &str, report: &serde_json::Value) -> String {
             let best = r.best();
             html! {
                 (page::header(title, r, &models))
+                @if let Some(rec) = record { (record::record_section(rec)) }
                 (page::alerts(r))
                 (page::statistics(&models, best))
                 (page::compensators(&models))

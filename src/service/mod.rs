@@ -13,10 +13,12 @@
 pub mod calibrations;
 pub mod cell;
 mod changes;
+pub mod checks;
 pub mod limits;
 pub mod plans;
 pub mod programs;
 pub mod queue;
+pub mod record;
 pub mod robots;
 pub mod sets;
 pub mod solve;

@@ -201,9 +201,32 @@ pub async fn original(
         .ok_or_else(|| ServiceError::set_not_found(robot_id, id))
 }
 
+/// Deletes a set no version and no pending calibration uses (409 naming them otherwise).
 pub async fn delete(state: &AppState, robot_id: i64, id: i64) -> Result<(), ServiceError> {
-    if !state.db().delete_set(robot_id, id).await? {
-        return Err(ServiceError::set_not_found(robot_id, id));
+    match state.db().delete_unused_set(robot_id, id).await? {
+        crate::db::SetDeletion::Deleted => Ok(()),
+        crate::db::SetDeletion::NotFound => Err(ServiceError::set_not_found(robot_id, id)),
+        crate::db::SetDeletion::InUse { versions, jobs } => {
+            Err(ServiceError::Conflict(set_in_use(id, &versions, &jobs)))
+        }
     }
-    Ok(())
+}
+
+/// Why a set in use is kept.
+fn set_in_use(id: i64, versions: &[i64], jobs: &[i64]) -> String {
+    let list = |v: &[i64]| v.iter().map(i64::to_string).collect::<Vec<_>>().join(", ");
+    let mut users = Vec::new();
+    if !versions.is_empty() {
+        users.push(format!(
+            "model version(s) {} were fitted or validated on it",
+            list(versions)
+        ));
+    }
+    if !jobs.is_empty() {
+        users.push(format!("calibration job(s) {} will read it", list(jobs)));
+    }
+    format!(
+        "measurement set {id} is part of the calibration record and is kept: {}",
+        users.join("; ")
+    )
 }

@@ -19,6 +19,7 @@ mod contract;
 mod flow;
 mod jobs;
 mod plans;
+mod record;
 mod sets;
 mod solve;
 mod spec;

@@ -1,0 +1,128 @@
+//! Check poses scored against a model version (`core::check`), and the
+//! per-robot thresholds of the status.
+
+use super::{commit_inserted, on_pool, write_for_robot, Db, Json, Listing, StoreError};
+use serde_json::Value;
+use sqlx::FromRow;
+
+const CHECK_SELECT: &str = "SELECT id, robot_id, set_id, version, status, mean_mm, \
+    temperature_c, result_json, created_at FROM checks";
+
+/// A stored check.
+#[derive(Debug, Clone, FromRow)]
+pub struct CheckRow {
+    pub id: i64,
+    pub robot_id: i64,
+    pub set_id: Option<i64>,
+    pub version: i64,
+    pub status: String,
+    pub mean_mm: f64,
+    pub temperature_c: Option<f64>,
+    #[sqlx(rename = "result_json")]
+    pub result: Json<Value>,
+    pub created_at: String,
+}
+
+/// A check to store.
+#[derive(Debug)]
+pub struct NewCheck<'a> {
+    pub robot_id: i64,
+    pub set_id: i64,
+    pub version: i64,
+    pub status: &'a str,
+    pub mean_mm: f64,
+    pub temperature_c: Option<f64>,
+    pub result: &'a Value,
+}
+
+/// Stored thresholds: (degraded_mm, recalibrate_mm, frame_shift_ratio).
+pub type ThresholdRow = (f64, f64, f64);
+
+impl Db {
+    /// Stores a check; `None` when its robot does not exist (any more).
+    pub async fn insert_check(&self, c: &NewCheck<'_>) -> Result<Option<CheckRow>, StoreError> {
+        Ok(on_pool!(self, |p, k| {
+            let Some(mut tx) = write_for_robot!(p, k, c.robot_id) else {
+                return Ok(None);
+            };
+            let id: i64 = sqlx::query_scalar(
+                "INSERT INTO checks (robot_id, set_id, version, status, mean_mm, temperature_c, \
+                 result_json) VALUES ($1, $2, $3, $4, $5, $6, $7) RETURNING id",
+            )
+            .bind(c.robot_id)
+            .bind(c.set_id)
+            .bind(c.version)
+            .bind(c.status)
+            .bind(c.mean_mm)
+            .bind(c.temperature_c)
+            .bind(Json(c.result))
+            .fetch_one(&mut *tx)
+            .await?;
+            Some(commit_inserted!(tx, CheckRow, CHECK_SELECT, "id", id))
+        }))
+    }
+
+    /// One page of a robot's checks, oldest first, and how many it has.
+    pub async fn checks_page(
+        &self,
+        robot_id: i64,
+        limit: i64,
+        offset: i64,
+    ) -> Result<Listing<CheckRow>, StoreError> {
+        self.robot_page(CHECK_SELECT, "checks", "id", robot_id, limit, offset)
+            .await
+    }
+
+    /// The robot's latest check.
+    pub async fn latest_check(&self, robot_id: i64) -> Result<Option<CheckRow>, StoreError> {
+        let sql = format!("{CHECK_SELECT} WHERE robot_id = $1 ORDER BY id DESC LIMIT 1");
+        Ok(on_pool!(self, |p, k| sqlx::query_as::<_, CheckRow>(&sql)
+            .bind(robot_id)
+            .fetch_optional(p)
+            .await?))
+    }
+
+    /// The robot's thresholds, when set.
+    pub async fn check_thresholds(
+        &self,
+        robot_id: i64,
+    ) -> Result<Option<ThresholdRow>, StoreError> {
+        let sql = "SELECT degraded_mm, recalibrate_mm, frame_shift_ratio FROM check_thresholds \
+                   WHERE robot_id = $1";
+        Ok(on_pool!(self, |p, k| sqlx::query_as::<_, ThresholdRow>(
+            sql
+        )
+        .bind(robot_id)
+        .fetch_optional(p)
+        .await?))
+    }
+
+    /// Sets the robot's thresholds; false when the robot does not exist.
+    pub async fn put_check_thresholds(
+        &self,
+        robot_id: i64,
+        t: ThresholdRow,
+    ) -> Result<bool, StoreError> {
+        Ok(on_pool!(self, |p, k| {
+            let Some(mut tx) = write_for_robot!(p, k, robot_id) else {
+                return Ok(false);
+            };
+            sqlx::query("DELETE FROM check_thresholds WHERE robot_id = $1")
+                .bind(robot_id)
+                .execute(&mut *tx)
+                .await?;
+            sqlx::query(
+                "INSERT INTO check_thresholds (robot_id, degraded_mm, recalibrate_mm, \
+                 frame_shift_ratio) VALUES ($1, $2, $3, $4)",
+            )
+            .bind(robot_id)
+            .bind(t.0)
+            .bind(t.1)
+            .bind(t.2)
+            .execute(&mut *tx)
+            .await?;
+            tx.commit().await?;
+            true
+        }))
+    }
+}

@@ -1,0 +1,75 @@
+//! Which calibrations and model versions use a measurement set: a set a
+//! version was fitted or validated on, or that a queued or running job will
+//! read, is not deleted (the calibration record stays complete).
+
+use super::{on_pool, write_for_robot, Db, StoreError};
+
+/// What deleting a set did.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum SetDeletion {
+    Deleted,
+    NotFound,
+    /// Kept: the version numbers fitted or validated on it, and the queued or
+    /// running calibration jobs that name it.
+    InUse {
+        versions: Vec<i64>,
+        jobs: Vec<i64>,
+    },
+}
+
+fn names(ids_json: &str, set_id: i64) -> bool {
+    serde_json::from_str::<Vec<i64>>(ids_json).is_ok_and(|ids| ids.contains(&set_id))
+}
+
+impl Db {
+    /// Deletes set `id` of robot `robot_id` unless a version or a pending job
+    /// uses it; the check and the delete hold the robot's row.
+    pub async fn delete_unused_set(
+        &self,
+        robot_id: i64,
+        id: i64,
+    ) -> Result<SetDeletion, StoreError> {
+        let users = "SELECT c.id, CAST(c.status AS TEXT), v.version, \
+            CAST(c.identification_set_ids AS TEXT), CAST(c.validation_set_ids AS TEXT) \
+            FROM calibrations c LEFT JOIN model_versions v ON v.calibration_id = c.id \
+            WHERE c.robot_id = $1 ORDER BY c.id, v.version";
+        let delete = "DELETE FROM measurement_sets WHERE robot_id = $1 AND id = $2";
+        Ok(on_pool!(self, |p, k| {
+            let Some(mut tx) = write_for_robot!(p, k, robot_id) else {
+                return Ok(SetDeletion::NotFound);
+            };
+            let rows: Vec<(i64, String, Option<i64>, String, String)> = sqlx::query_as(users)
+                .bind(robot_id)
+                .fetch_all(&mut *tx)
+                .await?;
+            let (mut versions, mut jobs) = (Vec::new(), Vec::new());
+            for (job, status, version, ident, valid) in rows {
+                if !(names(&ident, id) || names(&valid, id)) {
+                    continue;
+                }
+                if let Some(v) = version {
+                    versions.push(v);
+                }
+                if matches!(status.as_str(), "queued" | "running") && !jobs.contains(&job) {
+                    jobs.push(job);
+                }
+            }
+            if !(versions.is_empty() && jobs.is_empty()) {
+                tx.rollback().await?;
+                return Ok(SetDeletion::InUse { versions, jobs });
+            }
+            let n = sqlx::query(delete)
+                .bind(robot_id)
+                .bind(id)
+                .execute(&mut *tx)
+                .await?
+                .rows_affected();
+            tx.commit().await?;
+            if n > 0 {
+                SetDeletion::Deleted
+            } else {
+                SetDeletion::NotFound
+            }
+        }))
+    }
+}

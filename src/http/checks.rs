@@ -1,0 +1,166 @@
+//! Check poses: `POST /v1/robots/{id}/checks` scores a measurement set
+//! against the active (or a named) version without fitting;
+//! `GET /v1/robots/{id}/checks` is the history; `GET /v1/robots/{id}/status`
+//! the status a plant monitor polls; `PUT /v1/robots/{id}/check-thresholds`
+//! sets the thresholds (defaults: `core::check::CheckThresholds`).
+
+use super::input::{page_body, PageQuery};
+use super::robots::robot_list_page;
+use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState};
+use crate::db::CheckRow;
+use crate::service;
+use crate::service::checks::CheckCommand;
+use axum::extract::State;
+use axum::http::StatusCode;
+use axum::response::{IntoResponse, Response};
+use robocal_core::check::CheckThresholds;
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+
+/// `POST /v1/robots/{id}/checks` body.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CheckRequest {
+    pub set_id: i64,
+    #[serde(default)]
+    pub version: Option<i64>,
+    #[serde(default)]
+    pub temperature_c: Option<f64>,
+}
+
+/// A check as the API returns it.
+#[derive(Debug, Serialize)]
+pub struct Check {
+    pub id: i64,
+    pub robot_id: i64,
+    pub set_id: Option<i64>,
+    pub version: i64,
+    pub status: String,
+    pub mean_mm: f64,
+    pub temperature_c: Option<f64>,
+    pub created_at: String,
+    /// Figures, per-pose errors, frame shift, summary and thresholds.
+    pub result: Value,
+}
+
+impl From<CheckRow> for Check {
+    fn from(c: CheckRow) -> Self {
+        Check {
+            id: c.id,
+            robot_id: c.robot_id,
+            set_id: c.set_id,
+            version: c.version,
+            status: c.status,
+            mean_mm: c.mean_mm,
+            temperature_c: c.temperature_c,
+            created_at: c.created_at,
+            result: c.result.0,
+        }
+    }
+}
+
+pub async fn create(
+    State(state): State<AppState>,
+    ApiPath(robot_id): ApiPath<i64>,
+    ApiJson(req): ApiJson<CheckRequest>,
+) -> Result<Response, ApiError> {
+    if req.set_id < 1 || req.version.is_some_and(|v| v < 1) {
+        return Err(ApiError::BadRequest(
+            "`set_id` and `version` are positive integers".into(),
+        ));
+    }
+    if req
+        .temperature_c
+        .is_some_and(|t| !(-100.0..=200.0).contains(&t))
+    {
+        return Err(ApiError::BadRequest(
+            "`temperature_c` must be between -100 and 200 °C".into(),
+        ));
+    }
+    let row = service::checks::create(
+        &state,
+        CheckCommand {
+            robot_id,
+            set_id: req.set_id,
+            version: req.version,
+            temperature_c: req.temperature_c,
+        },
+    )
+    .await?;
+    Ok((StatusCode::CREATED, axum::Json(Check::from(row))).into_response())
+}
+
+pub async fn list(
+    State(state): State<AppState>,
+    ApiPath(robot_id): ApiPath<i64>,
+    ApiQuery(page): ApiQuery<PageQuery>,
+) -> Result<Response, ApiError> {
+    let (page, _) = robot_list_page(&state, robot_id, page).await?;
+    let listing = service::checks::page(&state, robot_id, page.limit, page.offset).await?;
+    let checks: Vec<Check> = listing.rows.into_iter().map(Check::from).collect();
+    Ok(axum::Json(page_body(page, listing.total, "checks", checks)?).into_response())
+}
+
+/// `GET /v1/robots/{id}/status`.
+#[derive(Debug, Serialize)]
+pub struct Status {
+    pub robot_id: i64,
+    /// The latest check's status; `null` before any check.
+    pub status: Option<&'static str>,
+    pub latest_check: Option<Check>,
+    pub thresholds: CheckThresholds,
+}
+
+pub async fn status(
+    State(state): State<AppState>,
+    ApiPath(robot_id): ApiPath<i64>,
+) -> Result<Response, ApiError> {
+    let (status, latest, thresholds) = service::checks::status(&state, robot_id).await?;
+    Ok(axum::Json(Status {
+        robot_id,
+        status: status.map(|s| s.name()),
+        latest_check: latest.map(Check::from),
+        thresholds,
+    })
+    .into_response())
+}
+
+/// `PUT /v1/robots/{id}/check-thresholds` body.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ThresholdsIn {
+    pub degraded_mm: f64,
+    pub recalibrate_mm: f64,
+    #[serde(default)]
+    pub frame_shift_ratio: Option<f64>,
+}
+
+pub async fn put_thresholds(
+    State(state): State<AppState>,
+    ApiPath(robot_id): ApiPath<i64>,
+    ApiJson(t): ApiJson<ThresholdsIn>,
+) -> Result<Response, ApiError> {
+    let t = CheckThresholds {
+        degraded_mm: t.degraded_mm,
+        recalibrate_mm: t.recalibrate_mm,
+        frame_shift_ratio: t
+            .frame_shift_ratio
+            .unwrap_or(CheckThresholds::default().frame_shift_ratio),
+    };
+    let t = service::checks::put_thresholds(&state, robot_id, t).await?;
+    Ok(axum::Json(t).into_response())
+}
+
+pub fn routes() -> Vec<super::Route> {
+    use super::{get, post, route};
+    vec![
+        get("/v1/robots/{id}/checks", list),
+        post("/v1/robots/{id}/checks", create),
+        get("/v1/robots/{id}/status", status),
+        route(
+            axum::http::Method::PUT,
+            "/v1/robots/{id}/check-thresholds",
+            put_thresholds,
+        ),
+    ]
+}

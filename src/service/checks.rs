@@ -1,0 +1,135 @@
+//! Check poses: score a measurement set against the active (or a named) model
+//! version without fitting (`core::check`), keep the history, and give the
+//! robot's status from its latest check and its thresholds.
+
+use super::{robots, versions, AppState, ServiceError};
+use crate::compensate::CalibratedModelFile;
+use crate::db::{CheckRow, Listing, NewCheck};
+use robocal_core::check::{score, CheckResult, CheckStatus, CheckThresholds};
+use serde::Serialize;
+
+/// A check to run.
+#[derive(Debug, Clone)]
+pub struct CheckCommand {
+    pub robot_id: i64,
+    pub set_id: i64,
+    /// Version number; the active version when `None`.
+    pub version: Option<i64>,
+    /// Temperature during the check [°C]; the rows' mean temperature when `None`.
+    pub temperature_c: Option<f64>,
+}
+
+/// What a check stores beside its figures.
+#[derive(Debug, Serialize)]
+struct Stored<'a> {
+    #[serde(flatten)]
+    result: &'a CheckResult,
+    thresholds: CheckThresholds,
+}
+
+/// The robot's thresholds: its own, or the defaults.
+pub async fn thresholds(state: &AppState, robot_id: i64) -> Result<CheckThresholds, ServiceError> {
+    robots::get(state, robot_id).await?;
+    Ok(match state.db().check_thresholds(robot_id).await? {
+        Some((d, r, f)) => CheckThresholds {
+            degraded_mm: d,
+            recalibrate_mm: r,
+            frame_shift_ratio: f,
+        },
+        None => CheckThresholds::default(),
+    })
+}
+
+/// Replaces the robot's thresholds.
+pub async fn put_thresholds(
+    state: &AppState,
+    robot_id: i64,
+    t: CheckThresholds,
+) -> Result<CheckThresholds, ServiceError> {
+    t.validate()
+        .map_err(|e| ServiceError::Invalid(e.to_string()))?;
+    let row = (t.degraded_mm, t.recalibrate_mm, t.frame_shift_ratio);
+    if !state.db().put_check_thresholds(robot_id, row).await? {
+        return Err(ServiceError::robot_not_found(robot_id));
+    }
+    Ok(t)
+}
+
+/// Scores the set and stores the check.
+pub async fn create(state: &AppState, cmd: CheckCommand) -> Result<CheckRow, ServiceError> {
+    let robot_id = cmd.robot_id;
+    let t = thresholds(state, robot_id).await?;
+    let version = match cmd.version {
+        Some(v) => v,
+        None => state.db().active_version(robot_id).await?.map(|v| v.version).ok_or_else(|| {
+            ServiceError::Conflict(format!(
+                "robot {robot_id} has no active model version: name one with `version`, or calibrate first"
+            ))
+        })?,
+    };
+    let (_, text) = versions::with_model(state, robot_id, version).await?;
+    let model = CalibratedModelFile::from_json(&text)
+        .and_then(|f| f.to_compensated())
+        .map_err(|e| ServiceError::Internal(format!("stored model of version {version}: {e}")))?;
+    let rows = state
+        .db()
+        .set_rows(robot_id, cmd.set_id)
+        .await?
+        .ok_or_else(|| ServiceError::set_not_found(robot_id, cmd.set_id))?;
+    let temps: Vec<f64> = rows.iter().filter_map(|r| r.temperature_c).collect();
+    let temperature_c = cmd
+        .temperature_c
+        .or_else(|| (!temps.is_empty()).then(|| temps.iter().sum::<f64>() / temps.len() as f64));
+    let result = tokio::task::spawn_blocking(move || score(&model, &rows, &t))
+        .await
+        .map_err(|e| ServiceError::Internal(format!("check task: {e}")))?
+        .map_err(|e| ServiceError::Invalid(e.to_string()))?;
+    let stored = serde_json::to_value(Stored {
+        result: &result,
+        thresholds: t,
+    })
+    .map_err(|e| ServiceError::Internal(e.to_string()))?;
+    let row = state
+        .db()
+        .insert_check(&NewCheck {
+            robot_id,
+            set_id: cmd.set_id,
+            version,
+            status: result.status.name(),
+            mean_mm: result.position.mean_mm,
+            temperature_c,
+            result: &stored,
+        })
+        .await?
+        .ok_or_else(|| ServiceError::robot_not_found(robot_id))?;
+    tracing::info!(
+        robot = robot_id,
+        version,
+        status = result.status.name(),
+        "check scored"
+    );
+    Ok(row)
+}
+
+/// One page of the robot's checks, oldest first.
+pub async fn page(
+    state: &AppState,
+    robot_id: i64,
+    limit: i64,
+    offset: i64,
+) -> Result<Listing<CheckRow>, ServiceError> {
+    Ok(state.db().checks_page(robot_id, limit, offset).await?)
+}
+
+/// The robot's status: its latest check's (`None` before any check) and the thresholds.
+pub async fn status(
+    state: &AppState,
+    robot_id: i64,
+) -> Result<(Option<CheckStatus>, Option<CheckRow>, CheckThresholds), ServiceError> {
+    let t = thresholds(state, robot_id).await?;
+    let latest = state.db().latest_check(robot_id).await?;
+    let status = latest
+        .as_ref()
+        .and_then(|c| CheckStatus::ALL.into_iter().find(|s| s.name() == c.status));
+    Ok((status, latest, t))
+}

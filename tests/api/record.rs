@@ -1,0 +1,213 @@
+//! The calibration record: a measurement set a model version was fitted or
+//! validated on is kept (409 naming the versions); an unused set is deleted.
+
+use crate::support::*;
+use axum::http::StatusCode;
+use serde_json::json;
+use std::time::Duration;
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_set_a_version_uses_cannot_be_deleted() {
+    let t = setup().await;
+    let robot = t.create_robot("ys100").await;
+    let rid = robot.to_string();
+    let q1 = t
+        .upload_csv(robot, &simulated_csv(1, 30), "?name=q1&role=identification")
+        .await;
+    let q3 = t
+        .upload_csv(robot, &simulated_csv(2, 20), "?name=q3&role=validation")
+        .await;
+    let spare = t
+        .upload_csv(robot, &simulated_csv(3, 10), "?name=spare&role=validation")
+        .await;
+    let r = t
+        .start_job(
+            &rid,
+            json!({ "methods": ["km"], "identification_set_ids": [q1["id"]],
+                    "validation_set_ids": [q3["id"]], "seed": 1 }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::ACCEPTED, "{}", r.text());
+    let cid = r.json()["id"].as_i64().unwrap();
+    let done = t
+        .wait_for(
+            robot,
+            cid,
+            &["succeeded", "failed", "cancelled"],
+            Duration::from_secs(120),
+        )
+        .await;
+    assert_eq!(done["status"], "succeeded", "{done}");
+    let versions = t.get("/v1/robots/{id}/versions", &[&rid]).await.json();
+    let version = versions["versions"][0]["version"].as_i64().unwrap();
+
+    let delete = |sid: String| {
+        let t = &t;
+        let rid = rid.clone();
+        async move {
+            t.send(
+                "DELETE",
+                "/v1/robots/{id}/measurement-sets/{sid}",
+                &[&rid, &sid],
+                "",
+                None,
+                vec![],
+            )
+            .await
+        }
+    };
+    for set in [&q1, &q3] {
+        let sid = set["id"].to_string();
+        let r = delete(sid.clone()).await;
+        assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
+        let detail = r.detail();
+        assert!(
+            detail.contains(&format!("model version(s) {version} ")),
+            "{detail}"
+        );
+        assert!(
+            detail.contains(&format!("measurement set {sid} ")),
+            "{detail}"
+        );
+        // Still there, rows and all.
+        let r = t
+            .get("/v1/robots/{id}/measurement-sets/{sid}", &[&rid, &sid])
+            .await;
+        assert_eq!(r.status, StatusCode::OK);
+    }
+    let r = delete(spare["id"].to_string()).await;
+    assert_eq!(r.status, StatusCode::NO_CONTENT, "{}", r.text());
+    let r = delete(spare["id"].to_string()).await;
+    assert_eq!(r.status, StatusCode::NOT_FOUND);
+}
+
+/// Rows of the test's simulated YS100 after a "crash" that moved the zeros
+/// of joints 2, 3 and 5 by 0.1°, −0.08° and 0.12°.
+fn crashed_rows(seed: u64, n: usize) -> Vec<robocal::measure::MeasuredPose> {
+    use rand::SeedableRng;
+    let mut t = truth();
+    for (k, deg) in [(1, 0.1), (2, -0.08), (4, 0.12)] {
+        t.model.links[k].theta += f64::to_radians(deg);
+    }
+    let nominal = robocal::model::preset("ys100").unwrap();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let qs = robocal::sim::random_configurations(&nominal, n, &mut rng);
+    t.measure(&qs, Some(110.0), None, &mut rng).unwrap()
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn checks_score_the_active_version_and_give_the_status() {
+    let t = setup().await;
+    let robot = t.create_robot("ys100").await;
+    let rid = robot.to_string();
+    // Before any version: nothing to score against.
+    let check_set = t
+        .upload_csv(robot, &simulated_csv(7, 20), "?name=check&role=validation")
+        .await;
+    let r = t
+        .post_json(
+            "/v1/robots/{id}/checks",
+            &[&rid],
+            json!({ "set_id": check_set["id"] }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
+    assert!(r.detail().contains("no active model version"));
+    let r = t.get("/v1/robots/{id}/status", &[&rid]).await;
+    assert_eq!(r.status, StatusCode::OK);
+    assert_eq!(r.json()["status"], serde_json::Value::Null);
+    assert_eq!(r.json()["thresholds"]["degraded_mm"], 0.5);
+
+    let q1 = t
+        .upload_csv(robot, &simulated_csv(1, 30), "?name=q1&role=identification")
+        .await;
+    let r = t
+        .start_job(
+            &rid,
+            json!({ "methods": ["skcm"], "identification_set_ids": [q1["id"]], "seed": 1 }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::ACCEPTED, "{}", r.text());
+    let cid = r.json()["id"].as_i64().unwrap();
+    let done = t
+        .wait_for(
+            robot,
+            cid,
+            &["succeeded", "failed"],
+            Duration::from_secs(120),
+        )
+        .await;
+    assert_eq!(done["status"], "succeeded", "{done}");
+
+    let check = |body: serde_json::Value| {
+        let t = &t;
+        let rid = rid.clone();
+        async move { t.post_json("/v1/robots/{id}/checks", &[&rid], body).await }
+    };
+    // The same robot, fresh poses: ok.
+    let r = check(json!({ "set_id": check_set["id"], "temperature_c": 21.5 })).await;
+    assert_eq!(r.status, StatusCode::CREATED, "{}", r.text());
+    let ok = r.json();
+    assert_eq!(ok["status"], "ok", "{ok}");
+    assert_eq!(ok["version"], 1);
+    assert_eq!(ok["temperature_c"], 21.5);
+    assert_eq!(ok["result"]["poses"].as_array().unwrap().len(), 20);
+    assert!(ok["mean_mm"].as_f64().unwrap() < 0.5);
+
+    // After the crash: recalibrate.
+    let body = json!({ "name": "after-crash", "role": "validation", "rows": crashed_rows(8, 20) });
+    let r = t
+        .post_json("/v1/robots/{id}/measurement-sets", &[&rid], body)
+        .await;
+    assert_eq!(r.status, StatusCode::CREATED, "{}", r.text());
+    let crash_set = r.json()["id"].clone();
+    let r = check(json!({ "set_id": crash_set, "version": 1 })).await;
+    assert_eq!(r.status, StatusCode::CREATED, "{}", r.text());
+    assert_eq!(
+        r.json()["status"],
+        "recalibrate",
+        "{}",
+        r.json()["result"]["summary"]
+    );
+    assert_eq!(r.json()["result"]["frame_shift"]["explains"], false);
+
+    let r = t.get("/v1/robots/{id}/status", &[&rid]).await;
+    assert_eq!(r.json()["status"], "recalibrate");
+    assert_eq!(r.json()["latest_check"]["set_id"], crash_set);
+    let r = t.get("/v1/robots/{id}/checks", &[&rid]).await;
+    assert_eq!(r.json()["total"], 2);
+    assert_eq!(r.json()["checks"][0]["status"], "ok");
+
+    // Looser thresholds judge later checks; inverted ones are refused.
+    let r = t
+        .send(
+            "PUT",
+            "/v1/robots/{id}/check-thresholds",
+            &[&rid],
+            "",
+            Some("application/json"),
+            br#"{"degraded_mm": 50, "recalibrate_mm": 100}"#.to_vec(),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    assert_eq!(r.json()["frame_shift_ratio"], 0.5);
+    let r = check(json!({ "set_id": crash_set })).await;
+    assert_eq!(r.json()["status"], "ok");
+    let r = t
+        .send(
+            "PUT",
+            "/v1/robots/{id}/check-thresholds",
+            &[&rid],
+            "",
+            Some("application/json"),
+            br#"{"degraded_mm": 2, "recalibrate_mm": 1}"#.to_vec(),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+
+    // Missing set or version: 404.
+    let r = check(json!({ "set_id": 999 })).await;
+    assert_eq!(r.status, StatusCode::NOT_FOUND);
+    let r = check(json!({ "set_id": crash_set, "version": 9 })).await;
+    assert_eq!(r.status, StatusCode::NOT_FOUND);
+}

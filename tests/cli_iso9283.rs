@@ -1,0 +1,221 @@
+//! `robocal iso9283 plan`, `robocal iso9283` and `robocal check` in process:
+//! the cube's joint CSV and a program cycling it, figures from a cycles CSV
+//! against hand-computed values, and a check of a shifted frame.
+
+use clap::Parser;
+use robocal::cli::check::check_file;
+use robocal::cli::iso9283::{figures, make, FiguresArgs, Iso9283Args, Iso9283Command};
+use robocal::compensate::CompensatedModel;
+use robocal::measure::{csv, MeasuredPose};
+use robocal::model::preset;
+use robocal::program::{parse, Language, ProgramFile};
+use robocal_core::iso9283::csv::read_plan_csv;
+use std::fmt::Write as _;
+
+fn iso_args(argv: &[&str]) -> Iso9283Args {
+    let mut v = vec!["robocal", "iso9283"];
+    v.extend_from_slice(argv);
+    match robocal::cli::Cli::try_parse_from(v).unwrap().command {
+        robocal::cli::Command::Iso9283(a) => a,
+        other => panic!("{other:?}"),
+    }
+}
+
+fn cube(argv: &[&str]) -> String {
+    match iso_args(argv).command {
+        Some(Iso9283Command::Plan(c)) => make(&c).unwrap(),
+        None => panic!("not a plan"),
+    }
+}
+
+fn figures_of(argv: &[&str]) -> FiguresArgs {
+    let a = iso_args(argv);
+    assert!(a.command.is_none());
+    a.figures
+}
+
+#[test]
+fn the_cube_plan_cycles_in_a_program_and_the_figures_match_hand_values() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let common = [
+        "plan",
+        "--model",
+        "ur10",
+        "--box",
+        "300,-400,100,900,400,700",
+        "--commands",
+        "nominal",
+    ];
+    let summary = cube(&[&common[..], &["--out", &p("plan.csv")]].concat());
+    assert!(summary.contains("edge 600.0 mm"), "{summary}");
+    let plan = read_plan_csv(&std::fs::read_to_string(p("plan.csv")).unwrap()).unwrap();
+    assert_eq!(plan.len(), 5);
+    // P1 is the box's centre; P2 10 % of the diagonal from C1 (300, -300, 100).
+    assert_eq!(plan[0].xyz_mm, [600.0, 0.0, 400.0]);
+    assert_eq!(plan[1].xyz_mm, [360.0, -240.0, 160.0]);
+    assert_eq!(plan[0].abc_deg, Some([180.0, 0.0, 0.0]));
+
+    // A KRL program of 3 cycles visits the five poses' joints in order, 3 times.
+    cube(
+        &[
+            &common[..],
+            &["--format", "krl", "--cycles", "3", "--out", &p("iso.src")],
+        ]
+        .concat(),
+    );
+    let text = std::fs::read_to_string(p("iso.src")).unwrap();
+    let program = parse(
+        Language::Krl,
+        &[ProgramFile {
+            name: "iso.src".into(),
+            text,
+        }],
+    )
+    .unwrap();
+    assert_eq!(program.joints.len(), 15);
+    let plan_text = std::fs::read_to_string(p("plan.csv")).unwrap();
+    let joints: Vec<Vec<f64>> = plan_text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').skip(7).map(|v| v.parse().unwrap()).collect())
+        .collect();
+    for (i, j) in program.joints.iter().enumerate() {
+        for (a, b) in j.deg.iter().zip(&joints[i % 5]) {
+            assert!((a - b).abs() < 1e-4, "move {i}: {a} vs {b}");
+        }
+    }
+
+    // Cycles: each pose reached at c + (-1, -1, 0) + (0 | 2 | 4, 0, 0):
+    // barycentre c + (1, -1, 0), AP = √2; l = 2, 0, 2, RP = 4/3 + 3·√(4/3);
+    // the distances between poses differ from the commanded ones.
+    let mut cycles = String::from("pose,cycle,x_mm,y_mm,z_mm\n");
+    for c in &plan {
+        for (k, dx) in [0.0, 2.0, 4.0].iter().enumerate() {
+            let _ = writeln!(
+                cycles,
+                "{},{},{},{},{}",
+                c.name,
+                k + 1,
+                c.xyz_mm[0] - 1.0 + dx,
+                c.xyz_mm[1] - 1.0,
+                c.xyz_mm[2]
+            );
+        }
+    }
+    std::fs::write(p("cycles.csv"), cycles).unwrap();
+    let args = figures_of(&[
+        "--plan",
+        &p("plan.csv"),
+        "--measured",
+        &p("cycles.csv"),
+        "--json",
+    ]);
+    let out: serde_json::Value = serde_json::from_str(&figures(&args).unwrap()).unwrap();
+    let poses = out[0]["figures"]["poses"].as_array().unwrap();
+    assert_eq!(poses.len(), 5);
+    for f in poses {
+        let ap = f["ap_mm"].as_f64().unwrap();
+        let rp = f["rp_mm"].as_f64().unwrap();
+        assert!((ap - 2f64.sqrt()).abs() < 1e-9, "{f}");
+        assert!(
+            (rp - (4.0 / 3.0 + 3.0 * (4.0f64 / 3.0).sqrt())).abs() < 1e-9,
+            "{f}"
+        );
+    }
+    // Every pose moved the same way in each cycle: the distances are exact.
+    for d in out[0]["figures"]["distances"].as_array().unwrap() {
+        assert!(d["ad_mm"].as_f64().unwrap().abs() < 1e-9, "{d}");
+        assert!(d["rd_mm"].as_f64().unwrap().abs() < 1e-9, "{d}");
+    }
+    let table = figures(&figures_of(&[
+        "--plan",
+        &p("plan.csv"),
+        "--measured",
+        &p("cycles.csv"),
+    ]))
+    .unwrap();
+    assert!(table.contains("P5"), "{table}");
+    // A plan without its cycles file is refused.
+    assert!(figures(&figures_of(&["--plan", &p("plan.csv")])).is_err());
+}
+
+#[test]
+fn check_names_a_moved_tracker_and_a_changed_robot() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = CompensatedModel::from_nominal(preset("ur10").unwrap());
+    let nominal = preset("ur10").unwrap();
+    let qs: Vec<Vec<f64>> = (0..12)
+        .map(|i| {
+            let t = i as f64;
+            vec![
+                0.3 * t - 1.5,
+                -1.2 + 0.07 * t,
+                1.1 - 0.05 * t,
+                -1.4,
+                1.5 + 0.04 * t,
+                0.1 * t,
+            ]
+        })
+        .collect();
+    let rows = |shift: &dyn Fn(usize, [f64; 3]) -> [f64; 3]| -> Vec<MeasuredPose> {
+        qs.iter()
+            .enumerate()
+            .map(|(i, q)| {
+                let p = model.predict(q).unwrap().p * 1e3;
+                MeasuredPose {
+                    q_deg: nominal
+                        .joints_to_controller(q)
+                        .into_iter()
+                        .map(f64::to_degrees)
+                        .collect(),
+                    xyz_mm: shift(i, [p.x, p.y, p.z]),
+                    rpy_deg: None,
+                    payload_kg: None,
+                    temperature_c: None,
+                    set: None,
+                    session: None,
+                }
+            })
+            .collect()
+    };
+    let run = |name: &str, rows: Vec<MeasuredPose>| {
+        let path = dir.path().join(name);
+        std::fs::write(&path, csv::write(&rows)).unwrap();
+        let args = match robocal::cli::Cli::try_parse_from([
+            "robocal",
+            "check",
+            "--model",
+            "ur10",
+            "--measurements",
+            path.to_str().unwrap(),
+        ])
+        .unwrap()
+        .command
+        {
+            robocal::cli::Command::Check(a) => a,
+            other => panic!("{other:?}"),
+        };
+        check_file(&args).unwrap()
+    };
+    // The model's own positions (CSV rounding only): ok.
+    let same = run("same.csv", rows(&|_, p| p));
+    assert_eq!(same.status.name(), "ok");
+    assert!(same.position.max_mm < 1e-3, "{:?}", same.position);
+    // The tracker moved 4 mm: every point shifted alike; named a frame shift.
+    let moved = run("moved.csv", rows(&|_, p| [p[0] + 4.0, p[1], p[2] - 1.0]));
+    assert!(moved.position.mean_mm > 4.0);
+    assert!(
+        moved.frame_shift.as_ref().unwrap().explains,
+        "{}",
+        moved.summary
+    );
+    assert_eq!(moved.status.name(), "ok");
+    // Errors that differ from pose to pose (±3 mm): not a frame shift.
+    let changed = run(
+        "changed.csv",
+        rows(&|i, p| [p[0] + if i % 2 == 0 { 3.0 } else { -3.0 }, p[1], p[2]]),
+    );
+    assert_eq!(changed.status.name(), "recalibrate", "{}", changed.summary);
+    assert!(!changed.frame_shift.as_ref().unwrap().explains);
+}
