@@ -10,7 +10,8 @@
 //! One file per theme: `contract` (routes, spec, bad input, keys, paging),
 //! `flow` (the quickstart end to end), `sets` (uploads), `solve` (targets CSV
 //! in and out), `cell` (tools, work objects, program filtering), `jobs`
-//! (progress, cancellation, saturation, races); the harness is `support`.
+//! (progress, cancellation, saturation, races), `record` (sets a version uses,
+//! the calibration record, check poses); the harness is `support`.
 
 mod cell;
 #[path = "../common/mod.rs"]

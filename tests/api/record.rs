@@ -41,6 +41,37 @@ async fn a_set_a_version_uses_cannot_be_deleted() {
     let versions = t.get("/v1/robots/{id}/versions", &[&rid]).await.json();
     let version = versions["versions"][0]["version"].as_i64().unwrap();
 
+    // The record: what was fitted on what, with the uploads' SHA-256.
+    let cid_s = cid.to_string();
+    let r = t
+        .get("/v1/robots/{id}/calibrations/{cid}/record", &[&rid, &cid_s])
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let record = r.json();
+    assert_eq!(record["robocal_version"], env!("CARGO_PKG_VERSION"));
+    assert_eq!(record["methods"], json!(["km"]));
+    assert_eq!(record["versions"][0]["version"], version);
+    let sha = |text: &str| {
+        use sha2::{Digest, Sha256};
+        Sha256::digest(text.as_bytes())
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect::<String>()
+    };
+    let sets = record["sets"].as_array().unwrap();
+    assert_eq!(sets.len(), 2);
+    assert_eq!(sets[0]["used_as"], "identification");
+    assert_eq!(sets[0]["row_count"], 30);
+    assert_eq!(sets[0]["sha256"], sha(&simulated_csv(1, 30)));
+    assert_eq!(sets[1]["row_count"], 20);
+    assert_eq!(sets[1]["sha256"], sha(&simulated_csv(2, 20)));
+    let html = t
+        .get("/v1/robots/{id}/calibrations/{cid}/report", &[&rid, &cid_s])
+        .await
+        .text();
+    assert!(html.contains("<h2>Record</h2>"), "no record section");
+    assert!(html.contains(&sha(&simulated_csv(1, 30))));
+
     let delete = |sid: String| {
         let t = &t;
         let rid = rid.clone();
