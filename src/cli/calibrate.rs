@@ -137,7 +137,10 @@ fn read_rows(path: &str, dif: csv::DifSign) -> anyhow::Result<Vec<measure::Measu
 }
 
 pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
-    let model = crate::cli::load_model(&a.model)?;
+    let (model, note) = super::model_files::load_start_model(&a.model)?;
+    if let Some(note) = note {
+        eprintln!("{note}");
+    }
     let methods = a.method.0;
     let dif = match a.dif_sign.as_str() {
         "plus" => csv::DifSign::Plus,

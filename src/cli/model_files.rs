@@ -31,6 +31,26 @@ pub fn load_compensated(arg: &str) -> Result<CompensatedModel, CompensateError> 
     }
 }
 
+/// The model a calibration starts from: a preset, a model JSON file, or any
+/// calibrated model file robocal writes (`calibrate --save`, a version's
+/// `model.json`), whose calibrated geometry and compliance it starts from (its
+/// joint maps and compensator are not part of a model-based fit; the note
+/// says so).
+pub fn load_start_model(arg: &str) -> anyhow::Result<(crate::model::RobotModel, Option<String>)> {
+    match super::load_model(arg) {
+        Ok(m) => Ok((m, None)),
+        Err(plain) => {
+            let Ok(cm) = load_compensated(arg) else {
+                return Err(plain);
+            };
+            let note = format!(
+                "{arg}: starting from its calibrated model (joint maps and compensator, if any, are not refitted)"
+            );
+            Ok((cm.calibrated, Some(note)))
+        }
+    }
+}
+
 /// Writes a calibrated model file as pretty JSON.
 pub fn save_model_file(file: &CalibratedModelFile, path: &Path) -> Result<(), CompensateError> {
     std::fs::write(path, file.to_json() + "\n").map_err(|e| CompensateError::Io {
@@ -55,5 +75,13 @@ mod tests {
         save_model_file(&file, &path).unwrap();
         let back = load_compensated(path.to_str().unwrap()).unwrap();
         assert_eq!(back.calibrated, m.calibrated);
+        // A calibration starts from a calibrated model file as from a preset.
+        let (start, note) = load_start_model(path.to_str().unwrap()).unwrap();
+        assert_eq!(start, m.calibrated);
+        assert!(note.is_some());
+        let (start, note) = load_start_model("ur10").unwrap();
+        assert_eq!(start, m.calibrated);
+        assert!(note.is_none());
+        assert!(load_start_model("missing.json").is_err());
     }
 }
