@@ -13,6 +13,7 @@
 pub mod calibrations;
 pub mod cell;
 mod changes;
+mod job_watch;
 pub mod limits;
 pub mod plans;
 pub mod programs;
