@@ -86,11 +86,14 @@ fn a_huge_compliance_fails_without_a_panic() {
     assert!(e.to_string().contains("not finite"), "{e}");
 }
 
+/// A change to a description.
+type Edit = Box<dyn Fn(&mut ModelDescription)>;
+
 /// The description refuses the issue's values naming field, value and bound.
 #[test]
 fn the_issue_values_are_refused_by_name() {
     let base = preset_description("ys100").unwrap();
-    let cases: Vec<(&str, Box<dyn Fn(&mut ModelDescription)>)> = vec![
+    let cases: Vec<(&str, Edit)> = vec![
         ("tool.xyz_mm[0]", Box::new(|d| d.tool.xyz_mm[0] = 1e308)),
         ("joints[1].d_mm", Box::new(|d| d.joints[1].d_mm = 1e308)),
         ("joints[1].a_mm", Box::new(|d| d.joints[1].a_mm = 1e15)),

@@ -18,11 +18,14 @@ fn model_with(edit: impl Fn(&mut Value)) -> Value {
     v
 }
 
+/// A change to a model's JSON.
+type Edit = Box<dyn Fn(&mut Value)>;
+
 /// The models get 422 naming the field, its value and the bound.
 #[tokio::test]
 async fn models_beyond_physical_bounds_are_refused_naming_field_value_and_bound() {
     let t = setup().await;
-    let cases: Vec<(&str, &str, Box<dyn Fn(&mut Value)>)> = vec![
+    let cases: Vec<(&str, &str, Edit)> = vec![
         (
             "tool.xyz_mm[0]",
             "1e308",
