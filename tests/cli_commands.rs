@@ -321,6 +321,31 @@ fn command_line_exports_every_format_or_says_why_not() {
     );
 }
 
+/// `robocal export --format json` writes a file that `--model` reads back
+/// (`calibrate --model`, `plan --model`, ...): its calibrated model.
+#[test]
+fn an_exported_json_is_a_model_where_a_model_is_asked_for() {
+    let dir = tempfile::tempdir().unwrap();
+    for source in ["ur10", CALIBRATED] {
+        let json = export_to_string(&args(source, "json")).unwrap();
+        let path = dir.path().join("exported.json");
+        std::fs::write(&path, &json).unwrap();
+        let read = robocal::cli::load_model(path.to_str().unwrap()).unwrap();
+        let file = CalibratedModelFile::from_json(&json).unwrap();
+        let want = file.model.to_model().unwrap();
+        assert_eq!(read.dof(), want.dof(), "{source}");
+        for (a, b) in read.links.iter().zip(&want.links) {
+            assert_eq!((a.a, a.d, a.alpha, a.theta), (b.a, b.d, b.alpha, b.theta));
+        }
+        assert_eq!(read.tool.p, want.tool.p);
+    }
+    // Neither a model nor a calibrated model file: the model's own message.
+    let path = dir.path().join("bad.json");
+    std::fs::write(&path, "{\"joints\": 3}").unwrap();
+    let e = robocal::cli::load_model(path.to_str().unwrap()).unwrap_err();
+    assert!(e.to_string().contains("cannot read model JSON"), "{e}");
+}
+
 // ---------------------------------------------------------------------------
 // calibrate with tracker sessions
 // ---------------------------------------------------------------------------

@@ -5,7 +5,8 @@
 //!
 //! After the restart: every upload that was acknowledged is there with all its
 //! rows, nothing half-written exists, the interrupted job is reported as failed
-//! ("interrupted by a restart"), the service works (a new calibration
+//! ("interrupted by a restart while it was running"), the job queued behind it
+//! is still queued and runs to success, the service works (a new calibration
 //! succeeds), and `PRAGMA integrity_check` says `ok`.
 
 #[path = "common/process.rs"]
@@ -93,6 +94,20 @@ fn kill_9_during_uploads_and_calibration_loses_nothing_committed() {
         std::thread::sleep(Duration::from_millis(20));
     }
 
+    // A job queued behind it (one worker): it never started, so it must
+    // survive the crash queued and run after the restart.
+    let (s, queued) = json_req(
+        addr,
+        "POST",
+        &format!("/v1/robots/{robot}/calibrations"),
+        Some(
+            json!({ "methods": ["km"], "identification_set_ids": [ident_id], "validation_set_ids": [] }),
+        ),
+    );
+    assert_eq!(s, 202, "{queued}");
+    assert_eq!(queued["status"], "queued", "{queued}");
+    let queued = queued["id"].as_i64().unwrap();
+
     // Uploads streaming in, one half-sent.
     let mut half = TcpStream::connect(addr).unwrap();
     let big = simulated(9, 2000);
@@ -158,8 +173,24 @@ fn kill_9_during_uploads_and_calibration_loses_nothing_committed() {
         None,
     );
     assert_eq!(j["status"], "failed", "{j}");
-    assert_eq!(j["error"], "interrupted by a restart");
+    assert_eq!(j["error"], "interrupted by a restart while it was running");
     assert!(j["finished_at"].is_string());
+    // The queued job was kept and runs now.
+    let start = Instant::now();
+    loop {
+        let (_, j) = json_req(
+            addr,
+            "GET",
+            &format!("/v1/robots/{robot}/calibrations/{queued}"),
+            None,
+        );
+        if j["status"] == "succeeded" {
+            break;
+        }
+        assert!(j["status"] == "queued" || j["status"] == "running", "{j}");
+        assert!(start.elapsed() < Duration::from_secs(120), "{j}");
+        std::thread::sleep(Duration::from_millis(20));
+    }
 
     // Every acknowledged upload is intact; nothing half-written.
     let (s, rows) = rows_of(addr, robot, ident_id);

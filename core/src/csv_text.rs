@@ -18,6 +18,32 @@
 
 use std::borrow::Cow;
 
+/// A text cell of a CSV robocal writes, safe to open in a spreadsheet: a
+/// cell starting with `=`, `+`, `-`, `@`, a tab or a carriage return (which a
+/// spreadsheet would run as a formula) gets a leading `'`, which spreadsheets
+/// show as text and robocal's own readers keep as part of the text. Numbers
+/// robocal formats itself are not text cells and are written as they are.
+pub fn safe_cell(text: &str) -> Cow<'_, str> {
+    match text.chars().next() {
+        Some('=' | '+' | '-' | '@' | '\t' | '\r') => Cow::Owned(format!("'{text}")),
+        _ => Cow::Borrowed(text),
+    }
+}
+
+/// A text for a `#` comment line: every control character (a line break
+/// would end the comment and start a row) becomes a space.
+pub fn comment_text(text: &str) -> Cow<'_, str> {
+    if text.chars().any(char::is_control) {
+        Cow::Owned(
+            text.chars()
+                .map(|c| if c.is_control() { ' ' } else { c })
+                .collect(),
+        )
+    } else {
+        Cow::Borrowed(text)
+    }
+}
+
 /// The decimal separator of numeric fields.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Decimal {
@@ -359,5 +385,25 @@ mod tests {
         assert_eq!(parse_number("1,234,5", true), None);
         assert_eq!(parse_number("-0,25", true), Some(-0.25));
         assert_eq!(parse_number("2e3", true), Some(2000.0));
+    }
+
+    #[test]
+    fn cells_a_spreadsheet_would_run_become_text() {
+        for (cell, want) in [
+            ("=cmd|' /C calc'!A0", "'=cmd|' /C calc'!A0"),
+            ("+SUM(1;2)", "'+SUM(1;2)"),
+            ("-1+1", "'-1+1"),
+            ("@A1", "'@A1"),
+            ("\t=1", "'\t=1"),
+            ("\r=1", "'\r=1"),
+            ("p1", "p1"),
+            ("", ""),
+            ("a=b", "a=b"),
+        ] {
+            assert_eq!(safe_cell(cell), want, "{cell:?}");
+        }
+        assert_eq!(comment_text("arm\nname,1,2"), "arm name,1,2");
+        assert_eq!(comment_text("a\r\u{85}b"), "a  b");
+        assert_eq!(comment_text("plain"), "plain");
     }
 }

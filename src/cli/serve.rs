@@ -17,8 +17,9 @@
 //! - `RUST_LOG`: log filter, default `info`.
 //!
 //! Start-up: open the database, apply the migrations; on SQLite mark jobs that
-//! a previous process left queued or running as failed ("interrupted by a
-//! restart"); then serve until SIGINT/SIGTERM. On PostgreSQL jobs are shared
+//! a previous process left running as failed ("interrupted by a restart while
+//! it was running") and run again, in order, those it left queued; then serve
+//! until SIGINT/SIGTERM. On PostgreSQL jobs are shared
 //! by replicas (`--job-lease N` / `ROBOCAL_JOB_LEASE`, default 15 s; see
 //! [`crate::service::queue`]) and SIGTERM hands this replica's running jobs
 //! back to the queue.
@@ -172,6 +173,15 @@ async fn serve(addr: SocketAddr, args: ServeArgs) -> anyhow::Result<()> {
     };
     let backend = db.backend();
     let state = AppState::new(db, config);
+    if backend == Backend::Sqlite {
+        let resumed = crate::service::queue::resume_queued(&state).await?;
+        if resumed > 0 {
+            tracing::info!(
+                jobs = resumed,
+                "queued calibrations kept across the restart"
+            );
+        }
+    }
     let listener = tokio::net::TcpListener::bind(addr)
         .await
         .with_context(|| format!("cannot listen on {addr}"))?;

@@ -63,23 +63,36 @@ impl JobStatus {
 }
 
 impl Db {
-    /// Marks jobs that a previous process left queued or running as failed.
-    /// Returns their ids.
+    /// Marks jobs that a previous process left running as failed (a queued
+    /// one never started and stays queued, [`Db::queued_jobs`]). Returns their
+    /// ids.
     pub async fn fail_interrupted_jobs(&self) -> Result<Vec<i64>, StoreError> {
         Ok(on_pool!(self, |p, k| {
             let mut tx = p.begin_with(k.begin_write()).await?;
             let ids: Vec<i64> = sqlx::query_scalar(
-                "SELECT id FROM calibrations WHERE status IN ('queued', 'running') ORDER BY id",
+                "SELECT id FROM calibrations WHERE status = 'running' ORDER BY id",
             )
             .fetch_all(&mut *tx)
             .await?;
             let sql = k.sql(&format!(
-                "UPDATE calibrations SET status = 'failed', error = 'interrupted by a restart', \
-                 {FINISHED_NOW} WHERE status IN ('queued', 'running')"
+                "UPDATE calibrations SET status = 'failed', \
+                 error = 'interrupted by a restart while it was running', \
+                 {FINISHED_NOW} WHERE status = 'running'"
             ));
             sqlx::query(&sql).execute(&mut *tx).await?;
             tx.commit().await?;
             ids
+        }))
+    }
+
+    /// The queued jobs, oldest first: `(job id, robot id)`.
+    pub async fn queued_jobs(&self) -> Result<Vec<(i64, i64)>, StoreError> {
+        Ok(on_pool!(self, |p, _k| {
+            sqlx::query_as(
+                "SELECT id, robot_id FROM calibrations WHERE status = 'queued' ORDER BY id",
+            )
+            .fetch_all(p)
+            .await?
         }))
     }
 

@@ -156,6 +156,24 @@ impl Db {
             let Some(mut tx) = write_for_robot!(p, k, robot_id) else {
                 return Ok(None);
             };
+            // Names are identities: the item of this name in another letter
+            // case is not renamed by a PUT.
+            let same: Option<String> = sqlx::query_scalar(
+                "SELECT name FROM cell_items WHERE robot_id = $1 AND kind = $2 AND name_key = $3",
+            )
+            .bind(robot_id)
+            .bind(kind)
+            .bind(&key)
+            .fetch_optional(&mut *tx)
+            .await?;
+            if let Some(existing) = same.filter(|e| *e != item.name) {
+                tx.rollback().await?;
+                return Err(StoreError::Conflict(format!(
+                    "{} `{existing}` of robot {robot_id} exists; names are unique regardless of case, so `{}` would rename it: PUT `{existing}` to replace it, or choose another name",
+                    kind.label(),
+                    item.name
+                )));
+            }
             if let Some(n) = item.number {
                 let other: Option<String> = sqlx::query_scalar(
                     "SELECT name FROM cell_items WHERE robot_id = $1 AND kind = $2 \

@@ -182,10 +182,13 @@ pub fn check_name(name: &str, what: &str) -> Result<(), ApiError> {
             "{what} is longer than {NAME_MAX} characters"
         )));
     }
-    // Text columns hold no NUL on PostgreSQL; refused alike on SQLite.
-    if name.contains('\0') {
+    // Text columns hold no NUL on PostgreSQL; a line break or another
+    // control character would break the CSV rows and comment lines a name
+    // is written into.
+    if let Some(c) = name.chars().find(|c| c.is_control()) {
         return Err(ApiError::invalid(format!(
-            "{what} must not contain the NUL character (U+0000)"
+            "{what} must not contain control characters (found U+{:04X})",
+            c as u32
         )));
     }
     Ok(())

@@ -423,9 +423,14 @@ pub async fn start(
         return Ok(row);
     }
     let job = job_of(row.id, robot_id, robot.name, nominal, prepared, ticket);
+    spawn_local(state, job);
+    Ok(row)
+}
+
+/// Runs a queued job of this process (SQLite) once a worker slot is free.
+pub(super) fn spawn_local(state: &AppState, job: Job) {
     state.cancel_flag(job.id);
     tokio::spawn(run_job(state.clone(), job));
-    Ok(row)
 }
 
 /// Everything a queued job needs; the rows are read when it is queued.
@@ -446,7 +451,7 @@ pub(super) struct Job {
     pose_sources: PoseSources,
     /// Its place in this process's job queue, released when the job ends
     /// (`None`: queued in the shared store).
-    ticket: Option<Ticket>,
+    pub(super) ticket: Option<Ticket>,
 }
 
 /// Writes progress to the database, at most once per `interval`.
@@ -556,7 +561,7 @@ pub(super) async fn execute(state: AppState, job: Job, claim: Option<String>) {
     let deadline = std::time::Instant::now() + budget;
     let over_budget = Arc::new(AtomicBool::new(false));
     let over = over_budget.clone();
-    let outcome = tokio::task::spawn_blocking(move || {
+    let task = tokio::task::spawn_blocking(move || {
         let report = calibrate_with_training(
             &nominal,
             &ident,
@@ -585,9 +590,21 @@ pub(super) async fn execute(state: AppState, job: Job, claim: Option<String>) {
             }
             Ok((r, versions))
         })
-    })
-    .await;
-    let _ = writer.await;
+    });
+    let outcome = match super::job_watch::wait(task, &cancel, deadline, &over_budget).await {
+        super::job_watch::Waited::Done(r) => {
+            let _ = writer.await;
+            r
+        }
+        super::job_watch::Waited::Abandoned => {
+            tracing::warn!(
+                job = id,
+                "calibration did not reach a check in time; abandoned"
+            );
+            writer.abort();
+            Ok(Err(CalibrationError::Cancelled))
+        }
+    };
     if let Some(h) = heartbeat {
         h.abort();
     }

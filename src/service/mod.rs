@@ -14,6 +14,7 @@ pub mod calibrations;
 pub mod cell;
 mod changes;
 pub mod checks;
+mod job_watch;
 pub mod limits;
 pub mod plans;
 pub mod programs;

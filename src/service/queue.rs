@@ -122,7 +122,7 @@ async fn run_claimed(state: AppState, c: ClaimedJob, claim: String) {
             "taking over a calibration whose replica stopped"
         );
     }
-    match load(&state, &c).await {
+    match load(&state, c.robot_id, c.id).await {
         Ok(job) => {
             state.hold_claim(id, &claim);
             execute(state.clone(), job, Some(claim)).await;
@@ -132,25 +132,53 @@ async fn run_claimed(state: AppState, c: ClaimedJob, claim: String) {
     }
 }
 
-/// The job of a claimed row: its robot, sets and options as stored.
-async fn load(state: &AppState, c: &ClaimedJob) -> Result<super::calibrations::Job, ServiceError> {
+/// Starts again the jobs a previous process of this store (SQLite) left
+/// queued: each is read as a claimed job is and waits for a worker slot, in
+/// the order they were queued. A job that cannot be read fails with the
+/// reason. Returns how many were queued again.
+pub async fn resume_queued(state: &AppState) -> Result<usize, ServiceError> {
+    let queued = state.db().queued_jobs().await?;
+    for &(id, robot_id) in &queued {
+        match load(state, robot_id, id).await {
+            Ok(mut job) => {
+                job.ticket = state.admit_job().ok();
+                super::calibrations::spawn_local(state, job);
+            }
+            Err(e) => {
+                if let Err(e) = state
+                    .db()
+                    .finish_calibration_error(id, None, JobStatus::Failed, &e.to_string())
+                    .await
+                {
+                    tracing::error!(job = id, error = %e, "cannot end the calibration");
+                }
+            }
+        }
+    }
+    Ok(queued.len())
+}
+
+/// The job of a stored row: its robot, sets and options as stored.
+async fn load(
+    state: &AppState,
+    robot_id: i64,
+    id: i64,
+) -> Result<super::calibrations::Job, ServiceError> {
     let robot = state
         .db()
-        .robot(c.robot_id)
+        .robot(robot_id)
         .await?
-        .ok_or_else(|| ServiceError::robot_not_found(c.robot_id))?;
+        .ok_or_else(|| ServiceError::robot_not_found(robot_id))?;
     let row = state
         .db()
-        .calibration(c.robot_id, c.id)
+        .calibration(robot_id, id)
         .await?
-        .ok_or_else(|| ServiceError::calibration_not_found(c.robot_id, c.id))?;
+        .ok_or_else(|| ServiceError::calibration_not_found(robot_id, id))?;
     let nominal = RobotModel::from_json(&robot.model_json)
         .map_err(|e| ServiceError::Internal(format!("stored model of robot {}: {e}", robot.id)))?;
     let cmd = stored_command(&row)?;
-    let prepared = prepare(state, c.robot_id, &nominal, &cmd).await?;
-    Ok(job_of(
-        c.id, c.robot_id, robot.name, nominal, prepared, None,
-    ))
+    let prepared = prepare(state, robot_id, &nominal, &cmd).await?;
+    Ok(job_of(id, robot_id, robot.name, nominal, prepared, None))
 }
 
 /// Renews the lease of a running job every fifth of the lease and raises

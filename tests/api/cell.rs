@@ -62,14 +62,18 @@ async fn tools_and_work_objects_are_stored_per_robot_by_unique_name_and_number()
     let r = put(&t, TOOL, &[&rid, "torch"], torch.clone()).await;
     assert_eq!(r.status, StatusCode::CREATED, "{}", r.text());
     assert_eq!(r.json()["xyz_mm"], json!([125.0, 0.0, 216.5]));
-    // Replaced by name in any case; the stored name is the URL's.
+    // Names are identities: another letter case is a conflict naming the
+    // stored tool, never a rename; its own name replaces it, found in any case.
     let mut moved = torch.clone();
     moved["xyz_mm"] = json!([130.0, 0.0, 216.5]);
-    let r = put(&t, TOOL, &[&rid, "TORCH"], moved).await;
+    let r = put(&t, TOOL, &[&rid, "TORCH"], moved.clone()).await;
+    assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
+    assert!(r.detail().contains("`torch`"), "{}", r.detail());
+    let r = put(&t, TOOL, &[&rid, "torch"], moved).await;
     assert_eq!(r.status, StatusCode::OK, "{}", r.text());
     let r = t.get(TOOL, &[&rid, "Torch"]).await;
     assert_eq!(r.status, StatusCode::OK);
-    assert_eq!(r.json()["name"], "TORCH");
+    assert_eq!(r.json()["name"], "torch");
     assert_eq!(r.json()["xyz_mm"][0], 130.0);
     assert_eq!(r.json()["rpy_deg"], json!([0.0, 30.0, 0.0]));
     // A number is the robot's one tool's; another robot may use it.

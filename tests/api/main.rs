@@ -18,6 +18,7 @@ mod cell;
 mod common;
 mod contract;
 mod flow;
+mod hostile;
 mod jobs;
 mod plans;
 mod record;

@@ -18,6 +18,7 @@
 //! or DH form here. More: docs/design.md "Exports".
 
 use crate::compensate::{CalibratedModelFile, CompensatedModel};
+use crate::csv_text::comment_text;
 use crate::kinematics::chain::{base_constant, tool_pose};
 use crate::model::orientation::fixed_xyz_angles;
 use crate::model::{Pose, RobotModel};
@@ -280,7 +281,8 @@ fn dh_csv(
     let _ = writeln!(
         s,
         "# robocal export: {} model of {}, {kind}; mm and degrees",
-        source.method, source.robot
+        comment_text(source.method),
+        comment_text(source.robot)
     );
     let _ = writeln!(
         s,
@@ -455,6 +457,37 @@ mod tests {
         assert!("sdf".parse::<ExportFormat>().is_err());
         for f in ExportFormat::ALL {
             assert_eq!(f.name().parse::<ExportFormat>().unwrap(), f);
+        }
+    }
+
+    /// A robot or method name with a line break stays inside its comment
+    /// line: the CSV has the same rows as with a plain name.
+    #[test]
+    fn a_name_cannot_break_out_of_the_comment_line() {
+        let cm = CompensatedModel::from_nominal(preset("ur5").unwrap());
+        for f in [ExportFormat::DhCsv, ExportFormat::MdhCsv] {
+            let plain = export(
+                &cm,
+                &ExportSource {
+                    robot: "arm",
+                    method: "km",
+                },
+                f,
+            )
+            .unwrap();
+            let src = ExportSource {
+                robot: "arm\nname,a_mm,evil\r\n=1+1",
+                method: "km\n@x",
+            };
+            let text = export(&cm, &src, f).unwrap();
+            assert_eq!(text.lines().count(), plain.lines().count(), "{text}");
+            let rows = |t: &str| {
+                t.lines()
+                    .filter(|l| !l.starts_with('#'))
+                    .map(str::to_string)
+                    .collect::<Vec<_>>()
+            };
+            assert_eq!(rows(&text), rows(&plain));
         }
     }
 }

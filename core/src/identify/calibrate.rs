@@ -218,6 +218,14 @@ fn prepare(
     opts: &CalibrationOptions,
 ) -> Result<Prepared, CalibrationError> {
     let predicted = nominal_predictions(nominal, identification, chains);
+    if predicted
+        .iter()
+        .any(|p| !p.is_some_and(|p| p.iter().all(|v| v.is_finite())))
+    {
+        return Err(CalibrationError::ModelNotFinite {
+            what: "a TCP position that is not finite (or a joint deflection that does not settle)",
+        });
+    }
     let reg = register_sessions(identification, &predicted, validation, opts)?;
     let training = reg.to_base(training);
     let id_frames = vec![Pose::identity(); reg.sessions];
@@ -230,6 +238,11 @@ fn prepare(
         validation: (!reg.valid.is_empty()).then(|| SetErrors::of(nominal, &id_frames, &reg.valid)),
     };
     let nominal_rms = nominal_errors.identification.stats.rms_mm;
+    if !nominal_rms.is_finite() {
+        return Err(CalibrationError::ModelNotFinite {
+            what: "errors to the measurements that are not finite",
+        });
+    }
     if nominal_rms > opts.max_nominal_rms_mm {
         return Err(CalibrationError::Inconsistent {
             rms_mm: nominal_rms,
@@ -269,7 +282,7 @@ fn register_sessions(
                 .iter()
                 .zip(predicted)
                 .filter(|(m, _)| m.session == s)
-                .map(|(m, p)| (m.position, p.expect("checked")))
+                .map(|(m, p)| (m.position, p.unwrap_or(Vector3::repeat(f64::NAN))))
                 .unzip();
             if y.is_empty() {
                 continue;
@@ -360,6 +373,11 @@ fn identifiability_phase(
         candidates.extend((0..nominal.dof()).map(|k| ParamId::new(ParamKind::Compliance, k)));
     }
     let (j, rows) = stacked_factor(nominal, &candidates, ident, Some(chains));
+    if j.iter().any(|v| !v.is_finite()) {
+        return Err(CalibrationError::ModelNotFinite {
+            what: "a non-finite identification Jacobian",
+        });
+    }
     let analysis = identifiability::analyse_factor(
         nominal,
         &j,

@@ -72,6 +72,8 @@ pub enum CalibrationError {
     },
     #[error("calibration cancelled")]
     Cancelled,
+    #[error("the nominal model gives {what} at the identification poses, so nothing can be fitted; check the model's lengths, masses, compliances and tool")]
+    ModelNotFinite { what: &'static str },
     #[error("no method succeeded: {}", failed.iter().map(|f| format!("{}: {}", f.method.name(), f.reason)).collect::<Vec<_>>().join("; "))]
     AllMethodsFailed { failed: Vec<FailedMethod> },
 }
@@ -292,9 +294,7 @@ pub(crate) fn generic_rank(model: &RobotModel, ids: &[ParamId], orientation: boo
     for (k, &c) in live.iter().enumerate() {
         js.set_column(k, &(j.column(c) / norms[c]));
     }
-    let sv = super::identifiability::triangular_factor(js)
-        .svd(false, false)
-        .singular_values;
+    let sv = super::identifiability::singular_values(super::identifiability::triangular_factor(js));
     let smax = sv.max();
     sv.iter().filter(|s| **s > smax * 1e-9).count()
 }

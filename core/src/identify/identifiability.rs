@@ -170,6 +170,25 @@ pub struct Analysis {
 /// follow from R's short columns. One QR replaces an SVD of the rows × cols
 /// matrix for each of these (several for a robot with dependent candidates),
 /// the bulk of the analysis's time on a large pose set.
+/// The singular values of `m` (descending), with nalgebra's SVD capped in
+/// iterations: it loops for ever on a NaN entry. A matrix with a non-finite
+/// entry, or one that does not converge, gives all zeros (rank 0), so a caller
+/// that has not refused such a matrix before gets a bounded, empty answer.
+pub(crate) fn singular_values(m: DMatrix<f64>) -> DVector<f64> {
+    let k = m.nrows().min(m.ncols());
+    if m.iter().any(|v| !v.is_finite()) {
+        return DVector::zeros(k);
+    }
+    m.try_svd(false, false, 5.0 * f64::EPSILON, svd_iterations(k))
+        .map_or_else(|| DVector::zeros(k), |s| s.singular_values)
+}
+
+/// An iteration cap for an SVD of `k` singular values: converging ones take
+/// a few sweeps per value.
+pub(crate) fn svd_iterations(k: usize) -> usize {
+    200 * (k + 1)
+}
+
 pub(crate) fn triangular_factor(js: DMatrix<f64>) -> DMatrix<f64> {
     if js.ncols() == 0 || js.nrows() <= js.ncols() {
         return js;
@@ -243,7 +262,7 @@ pub(crate) fn analyse_factor(
     let rank = if live.is_empty() {
         0
     } else {
-        let sv = rf.clone().svd(false, false).singular_values;
+        let sv = singular_values(rf.clone());
         let smax = sv.max();
         sv.iter().filter(|s| **s > smax * 1e-9).count()
     };
@@ -271,11 +290,12 @@ pub(crate) fn analyse_factor(
                 kmat.set_column(i, &rf.column(kk));
             }
             let target: DVector<f64> = rf.column(k).into_owned();
+            let k = kmat.ncols().min(kmat.nrows());
             let coef = kmat
                 .clone()
-                .svd(true, true)
-                .solve(&target, 1e-12)
-                .unwrap_or_else(|_| DVector::zeros(kept_local.len()));
+                .try_svd(true, true, 5.0 * f64::EPSILON, svd_iterations(k))
+                .and_then(|s| s.solve(&target, 1e-12).ok())
+                .unwrap_or_else(|| DVector::zeros(kept_local.len()));
             let cmax = coef.iter().fold(0.0_f64, |a, c| a.max(c.abs()));
             let depends_on = kept_local
                 .iter()
@@ -317,7 +337,7 @@ pub(crate) fn analyse_factor(
     let (cond, o1) = if kept.is_empty() {
         (f64::INFINITY, 0.0)
     } else {
-        let sv = jk.svd(false, false).singular_values;
+        let sv = singular_values(jk);
         let smax = sv.max();
         let smin = sv.min();
         let l = sv.len() as f64;

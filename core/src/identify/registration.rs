@@ -24,6 +24,8 @@ pub enum RegistrationError {
     TooFewPoints(usize),
     #[error("the measured points are (nearly) collinear, so the tracker frame's rotation is undetermined: measure poses that span the workspace")]
     Degenerate,
+    #[error("the points to register are not finite (a model value too large for its forward kinematics?)")]
+    NotFinite,
 }
 
 /// Registers tracker points `y` onto base points `x`.
@@ -38,7 +40,14 @@ pub fn register(y: &[Vector3<f64>], x: &[Vector3<f64>]) -> Result<Registration, 
     for (a, b) in y.iter().zip(x) {
         h += (a - cy) * (b - cx).transpose();
     }
-    let svd = h.svd(true, true);
+    // nalgebra's SVD iterates for ever on NaN: refuse non-finite sums, and
+    // cap the iterations of a 3×3 (a few dozen suffice).
+    if h.iter().any(|v| !v.is_finite()) {
+        return Err(RegistrationError::NotFinite);
+    }
+    let svd = h
+        .try_svd(true, true, 5.0 * f64::EPSILON, 1000)
+        .ok_or(RegistrationError::NotFinite)?;
     let (u, vt) = (svd.u.unwrap(), svd.v_t.unwrap());
     let sv = svd.singular_values;
     let smax = sv.max();

@@ -351,7 +351,7 @@ pub fn results_csv(
     for r in results {
         let s = &r.solution;
         let mut row: Vec<String> = Vec::with_capacity(header.len());
-        row.push(r.id.clone());
+        row.push(csv_text::safe_cell(&r.id).into_owned());
         row.push(r.status().to_string());
         row.push(
             s.reason
@@ -392,11 +392,20 @@ pub fn results_csv(
             }
             None => row.extend([String::new(), String::new()]),
         }
-        row.push(s.reason.as_ref().map(|x| x.to_string()).unwrap_or_default());
+        row.push(
+            s.reason
+                .as_ref()
+                .map(|x| csv_text::safe_cell(&x.to_string()).into_owned())
+                .unwrap_or_default(),
+        );
         match &r.compensation {
             Some(c) => {
                 row.push(c.label().to_string());
-                row.push(c.warning().unwrap_or_default());
+                row.push(
+                    c.warning()
+                        .map(|w| csv_text::safe_cell(&w).into_owned())
+                        .unwrap_or_default(),
+                );
                 row.push(c.expected_error_mm.map(finite).unwrap_or_default());
             }
             None => row.extend([String::new(), String::new(), String::new()]),

@@ -12,6 +12,10 @@
 //!
 //! `from_description` validates every field and names the offending one.
 
+use super::bounds::{
+    check, check3, ANGLE_DEG, COMPLIANCE_RAD_PER_NM, GRAVITY_MPS2, LENGTH_MM, LIMIT_DEG,
+    LOOP_LENGTH_MM, MASS_KG, MASS_OFFSET_KG,
+};
 use super::joint_maps::JointMapsDescription;
 use super::pose::{rpy_matrix, Pose};
 use super::robot::{ClosedLoop, Link, Payload, RobotModel, Tool, G0};
@@ -20,7 +24,7 @@ use serde::{Deserialize, Serialize};
 
 const MM: f64 = 1e-3;
 /// Largest magnitude of a gravity component [m/s²] (larger ones are not m/s²).
-pub const MAX_GRAVITY_MPS2: f64 = 100.0;
+pub const MAX_GRAVITY_MPS2: f64 = GRAVITY_MPS2.max;
 /// Longest model name (characters).
 pub const NAME_MAX_CHARS: usize = 200;
 
@@ -189,21 +193,6 @@ fn metres(mm: f64) -> f64 {
     }
 }
 
-fn finite(field: &str, v: f64) -> Result<f64, ModelError> {
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        Err(invalid(field, format!("must be a finite number, got {v}")))
-    }
-}
-
-fn finite3(field: &str, v: [f64; 3]) -> Result<Vector3<f64>, ModelError> {
-    for (i, x) in v.iter().enumerate() {
-        finite(&format!("{field}[{i}]"), *x)?;
-    }
-    Ok(Vector3::new(v[0], v[1], v[2]))
-}
-
 impl ModelDescription {
     /// Parses and validates a JSON text.
     pub fn parse_model(text: &str) -> Result<RobotModel, ModelError> {
@@ -225,13 +214,13 @@ impl ModelDescription {
         for (i, j) in self.joints.iter().enumerate() {
             let f = |name: &str| format!("joints[{i}].{name}");
             let mut link = Link::new(
-                finite(&f("alpha_deg"), j.alpha_deg)?.to_radians(),
-                metres(finite(&f("a_mm"), j.a_mm)?),
-                finite(&f("d_mm"), j.d_mm)? * MM,
-                finite(&f("theta_offset_deg"), j.theta_offset_deg)?.to_radians(),
+                check(&f("alpha_deg"), j.alpha_deg, &ANGLE_DEG)?.to_radians(),
+                metres(check(&f("a_mm"), j.a_mm, &LENGTH_MM)?),
+                check(&f("d_mm"), j.d_mm, &LENGTH_MM)? * MM,
+                check(&f("theta_offset_deg"), j.theta_offset_deg, &ANGLE_DEG)?.to_radians(),
             );
-            link.beta = finite(&f("beta_deg"), j.beta_deg)?.to_radians();
-            link.b = finite(&f("b_mm"), j.b_mm)? * MM;
+            link.beta = check(&f("beta_deg"), j.beta_deg, &ANGLE_DEG)?.to_radians();
+            link.b = check(&f("b_mm"), j.b_mm, &LENGTH_MM)? * MM;
             if i > 0 && j.b_mm != 0.0 {
                 return Err(invalid(
                     f("b_mm"),
@@ -239,8 +228,8 @@ impl ModelDescription {
                 ));
             }
             let (l0, l1) = (
-                finite(&f("limits_deg[0]"), j.limits_deg[0])?,
-                finite(&f("limits_deg[1]"), j.limits_deg[1])?,
+                check(&f("limits_deg[0]"), j.limits_deg[0], &LIMIT_DEG)?,
+                check(&f("limits_deg[1]"), j.limits_deg[1], &LIMIT_DEG)?,
             );
             // The two limits in either order; they must leave a range.
             if l0 == l1 {
@@ -260,16 +249,14 @@ impl ModelDescription {
                 ));
             }
             link.sign = j.sign;
-            link.zero = finite(&f("zero_deg"), j.zero_deg)?.to_radians();
-            link.mass = finite(&f("mass_kg"), j.mass_kg)?;
-            if link.mass < 0.0 {
-                return Err(invalid(f("mass_kg"), "must not be negative"));
-            }
-            link.com = finite3(&f("com_mm"), j.com_mm)? * MM;
-            link.compliance = finite(&f("compliance_rad_per_nm"), j.compliance_rad_per_nm)?;
-            if link.compliance < 0.0 {
-                return Err(invalid(f("compliance_rad_per_nm"), "must not be negative"));
-            }
+            link.zero = check(&f("zero_deg"), j.zero_deg, &ANGLE_DEG)?.to_radians();
+            link.mass = check(&f("mass_kg"), j.mass_kg, &MASS_KG)?;
+            link.com = Vector3::from(check3(&f("com_mm"), j.com_mm, &LENGTH_MM)?) * MM;
+            link.compliance = check(
+                &f("compliance_rad_per_nm"),
+                j.compliance_rad_per_nm,
+                &COMPLIANCE_RAD_PER_NM,
+            )?;
             if self.convention == DhConvention::Standard && (j.beta_deg != 0.0 || j.b_mm != 0.0) {
                 return Err(invalid(
                     f("beta_deg"),
@@ -285,8 +272,9 @@ impl ModelDescription {
             links.push((link, j.parallel, j.beta_deg != 0.0));
         }
 
-        let tool_p = finite3("tool.xyz_mm", self.tool.xyz_mm)? * MM;
-        let tool_rpy = finite3("tool.rpy_deg", self.tool.rpy_deg)?.map(f64::to_radians);
+        let tool_p = Vector3::from(check3("tool.xyz_mm", self.tool.xyz_mm, &LENGTH_MM)?) * MM;
+        let tool_rpy = Vector3::from(check3("tool.rpy_deg", self.tool.rpy_deg, &ANGLE_DEG)?)
+            .map(f64::to_radians);
         let mut tool = Tool {
             p: tool_p,
             rpy: [tool_rpy.x, tool_rpy.y, tool_rpy.z],
@@ -364,7 +352,7 @@ impl ModelDescription {
                     ));
                 }
                 for (name, v) in [("l3_mm", c.l3_mm), ("l4_mm", c.l4_mm), ("l5_mm", c.l5_mm)] {
-                    if finite(&format!("closed_loop.{name}"), v)? <= 0.0 {
+                    if check(&format!("closed_loop.{name}"), v, &LOOP_LENGTH_MM)? <= 0.0 {
                         return Err(invalid(format!("closed_loop.{name}"), "must be positive"));
                     }
                 }
@@ -387,40 +375,36 @@ impl ModelDescription {
                     l3,
                     l4,
                     l5,
-                    xi: finite("closed_loop.xi_deg", c.xi_deg)?.to_radians(),
+                    xi: check("closed_loop.xi_deg", c.xi_deg, &ANGLE_DEG)?.to_radians(),
                 })
             }
         };
 
-        let payload_mass = finite("payload.mass_kg", self.payload.mass_kg)?;
-        if payload_mass < 0.0 {
-            return Err(invalid("payload.mass_kg", "must not be negative"));
-        }
-        let mass_offset = finite("payload.mass_offset_kg", self.payload.mass_offset_kg)?;
-        if mass_offset.abs() > 10_000.0 {
-            return Err(invalid(
-                "payload.mass_offset_kg",
-                "must be within ±10000 kg",
-            ));
-        }
+        let payload_mass = check("payload.mass_kg", self.payload.mass_kg, &MASS_KG)?;
+        let mass_offset = check(
+            "payload.mass_offset_kg",
+            self.payload.mass_offset_kg,
+            &MASS_OFFSET_KG,
+        )?;
         let payload = Payload {
             mass: payload_mass,
-            com: finite3("payload.com_mm", self.payload.com_mm)? * MM,
+            com: Vector3::from(check3("payload.com_mm", self.payload.com_mm, &LENGTH_MM)?) * MM,
             mass_offset,
         };
-        let gravity = finite3("gravity_mps2", self.gravity_mps2)?;
-        if let Some(g) = gravity.iter().find(|g| g.abs() > MAX_GRAVITY_MPS2) {
-            return Err(invalid(
-                "gravity_mps2",
-                format!(
-                    "component {g:.1} m/s² is implausible (at most ±{MAX_GRAVITY_MPS2}); give gravity in m/s² (e.g. [0, 0, -9.81])"
-                ),
-            ));
-        }
+        let gravity = Vector3::from(check3("gravity_mps2", self.gravity_mps2, &GRAVITY_MPS2)?);
         if self.name.chars().count() > NAME_MAX_CHARS {
             return Err(invalid(
                 "name",
                 format!("is longer than {NAME_MAX_CHARS} characters"),
+            ));
+        }
+        if let Some(c) = self.name.chars().find(|c| c.is_control()) {
+            return Err(invalid(
+                "name",
+                format!(
+                    "must not contain control characters (found U+{:04X})",
+                    c as u32
+                ),
             ));
         }
         if !self.name.is_empty()

@@ -1,6 +1,7 @@
 //! The robot model: geometry, compliance, inertia, limits, parameter vector and
 //! the JSON description.
 
+pub mod bounds;
 pub mod description;
 pub mod joint_map_table;
 pub mod joint_maps;

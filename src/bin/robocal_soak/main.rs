@@ -12,8 +12,10 @@
 //! - **SQLite** (default, `sqlite.rs`): one server on a temporary file. At
 //!   each kill the clients park; `PRAGMA integrity_check` and
 //!   `foreign_key_check` run on the file, the server restarts and every
-//!   acknowledged write is checked (a job cut off by the kill must be failed,
-//!   "interrupted by a restart").
+//!   acknowledged write is checked (a job cut off by the kill while it ran
+//!   must be failed, "interrupted by a restart while it was running"; a job
+//!   still queued stays queued or runs, and one that never started is never
+//!   failed by a restart).
 //! - **PostgreSQL, several replicas** (`--database-url postgres://… --replicas
 //!   2`, `replicas.rs`): the replicas share an empty database, each client
 //!   request goes to a random live replica; the killer SIGKILLs a random

@@ -131,7 +131,9 @@ impl Context<'_> {
             return Err(MethodError::Cancelled);
         }
         let start = cost.with_c(&result.best);
-        let f = self.fit_from(&start, &self.kept_geo, &mut |_, _| true)?;
+        // The polish after the last generation stays cancellable.
+        let (gens, best) = (result.history.len().saturating_sub(1), result.best_cost);
+        let f = self.fit_from(&start, &self.kept_geo, &mut |_, _| progress(gens, best))?;
         Ok(MethodFit {
             fit: f,
             ids: self.with_compliance(),

@@ -98,13 +98,13 @@ pub(crate) fn run(
         Run::SkcmTlbo => {
             let warm = match &cache.km {
                 Some(f) => f.clone(),
-                None => ctx.km(&mut |_, _| true)?,
+                None => ctx.km(&mut lm)?,
             };
             ctx.skcm_tlbo(&warm, &mut |gen, best| progress.generation(gen, best))
                 .map(Outcome::plain)
         }
         Run::SkcmPayload => cache
-            .base_fit(ctx, Base::Skcm, &mut |_, _| true)
+            .base_fit(ctx, Base::Skcm, &mut lm)
             .and_then(|s| ctx.skcm_payload(&s.fit, &mut lm))
             .map(Outcome::plain),
         Run::Maps(base) => run_maps(ctx, cache, base, &mut |f, it, loss| {

@@ -1,0 +1,211 @@
+//! Models a careless or hostile user can send (issue 35): every numeric field
+//! of a description extreme, finite or not (1e-300 … 1e300, ±∞, NaN). The
+//! description either refuses the model naming the field, or the model it
+//! accepts goes through forward kinematics, a small calibration, a solve and
+//! every export without a panic and in bounded time. Models built in SI
+//! without the description (as the core's callers may) with a huge tool or
+//! compliance end a calibration with a reason instead of hanging or panicking.
+
+use proptest::prelude::*;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use robocal_core::compensate::CompensatedModel;
+use robocal_core::export::{export, ExportFormat, ExportSource};
+use robocal_core::identify::{calibrate, CalibrationError, CalibrationOptions, LmSettings, Method};
+use robocal_core::ik::{IkSettings, IkSolver, SolveOptions};
+use robocal_core::kinematics::fk;
+use robocal_core::measure::{self, Measurement};
+use robocal_core::model::presets::preset_description;
+use robocal_core::model::{preset, ModelDescription, RobotModel};
+use robocal_core::sim::{random_configurations, TrueRobot};
+use std::time::{Duration, Instant};
+
+/// Simulated measurements of `model` itself (no errors): `None` when the
+/// simulation refuses the model.
+fn measured(model: &RobotModel, n: usize, seed: u64) -> Option<Vec<Measurement>> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let qs = random_configurations(model, n, &mut rng);
+    let rows = TrueRobot::new(model.clone())
+        .measure(&qs, Some(model.payload.mass), None, &mut rng)
+        .ok()?;
+    Some(measure::to_measurements(model, &rows, model.payload.mass))
+}
+
+fn small_options(methods: Vec<Method>) -> CalibrationOptions {
+    CalibrationOptions {
+        methods,
+        lm: LmSettings {
+            max_iterations: 20,
+            ..LmSettings::default()
+        },
+        ..CalibrationOptions::default()
+    }
+}
+
+/// A tool 1e308 m away (`tool.xyz_mm = [1e308, 0, 0]` once converted):
+/// the calibration ends with a reason at once instead of iterating for ever
+/// in the identifiability SVD.
+#[test]
+fn a_huge_tool_ends_the_calibration_with_a_reason() {
+    let good = preset("ys100").unwrap();
+    let ident = measured(&good, 30, 3).unwrap();
+    let mut model = good.clone();
+    model.tool.p.x = 1e308;
+    let t0 = Instant::now();
+    let r = calibrate(
+        &model,
+        &ident,
+        &[],
+        &small_options(vec![Method::Km]),
+        &|_| true,
+    );
+    assert!(t0.elapsed() < Duration::from_secs(10), "{:?}", t0.elapsed());
+    let e = r.expect_err("a 1e308 m tool cannot calibrate");
+    assert!(
+        !matches!(e, CalibrationError::Cancelled),
+        "ended as a cancel: {e}"
+    );
+    assert!(e.to_string().contains("not finite"), "{e}");
+}
+
+/// Compliance 1e308 rad/(N·m) on every joint: KM and SKCM end with a reason,
+/// no panic (it was `expect("checked")` in the registration).
+#[test]
+fn a_huge_compliance_fails_without_a_panic() {
+    let good = preset("ys100").unwrap();
+    let ident = measured(&good, 30, 4).unwrap();
+    let mut model = good.clone();
+    for l in model.links.iter_mut() {
+        l.compliance = 1e308;
+    }
+    let opts = small_options(vec![Method::Km, Method::Skcm]);
+    let t0 = Instant::now();
+    let r = calibrate(&model, &ident, &[], &opts, &|_| true);
+    assert!(t0.elapsed() < Duration::from_secs(10), "{:?}", t0.elapsed());
+    let e = r.expect_err("a 1e308 compliance cannot calibrate");
+    assert!(e.to_string().contains("not finite"), "{e}");
+}
+
+/// A change to a description.
+type Edit = Box<dyn Fn(&mut ModelDescription)>;
+
+/// The description refuses the issue's values naming field, value and bound.
+#[test]
+fn the_issue_values_are_refused_by_name() {
+    let base = preset_description("ys100").unwrap();
+    let cases: Vec<(&str, Edit)> = vec![
+        ("tool.xyz_mm[0]", Box::new(|d| d.tool.xyz_mm[0] = 1e308)),
+        ("joints[1].d_mm", Box::new(|d| d.joints[1].d_mm = 1e308)),
+        ("joints[1].a_mm", Box::new(|d| d.joints[1].a_mm = 1e15)),
+        (
+            "joints[2].mass_kg",
+            Box::new(|d| d.joints[2].mass_kg = 1e308),
+        ),
+        (
+            "joints[0].limits_deg[0]",
+            Box::new(|d| d.joints[0].limits_deg = [-1e308, 1e308]),
+        ),
+        (
+            "joints[3].zero_deg",
+            Box::new(|d| d.joints[3].zero_deg = 1e308),
+        ),
+        (
+            "joints[1].compliance_rad_per_nm",
+            Box::new(|d| d.joints[1].compliance_rad_per_nm = 1e308),
+        ),
+        (
+            "payload.com_mm[2]",
+            Box::new(|d| d.payload.com_mm[2] = -1e300),
+        ),
+        (
+            "joints[4].alpha_deg",
+            Box::new(|d| d.joints[4].alpha_deg = f64::NAN),
+        ),
+    ];
+    for (field, set) in cases {
+        let mut d = base.clone();
+        set(&mut d);
+        let e = d.to_model().expect_err(field).to_string();
+        assert!(e.contains(&format!("`{field}`")), "{field}: {e}");
+        assert!(e.contains("outside the bound ["), "{field}: {e}");
+    }
+}
+
+/// Values a field is set to: tiny, ordinary, huge, not finite.
+fn extreme() -> impl Strategy<Value = f64> {
+    prop_oneof![
+        Just(0.0),
+        Just(1e-300),
+        Just(-1e-300),
+        Just(f64::NAN),
+        Just(f64::INFINITY),
+        Just(f64::NEG_INFINITY),
+        (-300i32..=300).prop_map(|e| 10f64.powi(e)),
+        (-300i32..=300).prop_map(|e| -(10f64.powi(e))),
+        -400.0..400.0f64,
+    ]
+}
+
+/// Sets numeric field `k` (of the fields every description has) to `v`.
+fn set_field(d: &mut ModelDescription, k: usize, v: f64) {
+    let n = d.joints.len();
+    let j = (k / 16) % n;
+    let joint = &mut d.joints[j];
+    match k % 16 {
+        0 => joint.alpha_deg = v,
+        1 => joint.a_mm = v,
+        2 => joint.d_mm = v,
+        3 => joint.theta_offset_deg = v,
+        4 => joint.limits_deg[(k / 7) % 2] = v,
+        5 => joint.zero_deg = v,
+        6 => joint.mass_kg = v,
+        7 => joint.com_mm[k % 3] = v,
+        8 => joint.compliance_rad_per_nm = v,
+        9 => d.tool.xyz_mm[k % 3] = v,
+        10 => d.tool.rpy_deg[k % 3] = v,
+        11 => d.payload.mass_kg = v,
+        12 => d.payload.com_mm[k % 3] = v,
+        13 => d.gravity_mps2[k % 3] = v,
+        14 => d.payload.mass_offset_kg = v,
+        _ => joint.b_mm = if j == 0 { v } else { 0.0 },
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+    /// Random extreme fields: refused, or the model works end to end within
+    /// a few seconds.
+    #[test]
+    fn extreme_models_are_refused_or_work(
+        preset_name in prop::sample::select(vec!["ys100", "ur5", "hh800"]),
+        edits in prop::collection::vec((0usize..96, extreme()), 1..4),
+        seed in 0u64..1000,
+    ) {
+        let mut d = preset_description(preset_name).unwrap();
+        for (k, v) in &edits {
+            set_field(&mut d, *k, *v);
+        }
+        let Ok(model) = d.to_model() else {
+            return Ok(());
+        };
+        let t0 = Instant::now();
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let qs = random_configurations(&model, 5, &mut rng);
+        let compensated = CompensatedModel::from_nominal(model.clone());
+        let solver = IkSolver::new(compensated.clone(), IkSettings::default());
+        for q in &qs {
+            if let Ok(p) = fk(&model, q) {
+                let _ = solver.solve(&p, &SolveOptions::default());
+            }
+        }
+        let source = ExportSource { robot: &model.name, method: "nominal" };
+        for f in ExportFormat::ALL {
+            let _ = export(&compensated, &source, f);
+        }
+        if let Some(ident) = measured(&model, 25, seed) {
+            let _ = calibrate(&model, &ident, &[], &small_options(vec![Method::Km, Method::Skcm]), &|_| true);
+        }
+        prop_assert!(t0.elapsed() < Duration::from_secs(20), "{edits:?}: {:?}", t0.elapsed());
+    }
+}
