@@ -143,8 +143,19 @@ fn extreme() -> impl Strategy<Value = f64> {
         (-300i32..=300).prop_map(|e| 10f64.powi(e)),
         (-300i32..=300).prop_map(|e| -(10f64.powi(e))),
         -400.0..400.0f64,
+        // The edges of the accepted bounds (model::bounds), so that most
+        // cases are accepted models at their most extreme.
+        prop::sample::select(vec![
+            100_000.0, -100_000.0, 360.0, -360.0, 3600.0, -3600.0, 10_000.0, 1e-3, 100.0, -100.0,
+        ]),
+        prop::sample::select(vec![
+            100_000.0, -100_000.0, 360.0, -360.0, 3600.0, -3600.0, 10_000.0, 1e-3, 100.0, -100.0,
+        ]),
     ]
 }
+
+/// How many random models the property test accepted and ran end to end.
+static ACCEPTED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
 /// Sets numeric field `k` (of the fields every description has) to `v`.
 fn set_field(d: &mut ModelDescription, k: usize, v: f64) {
@@ -189,6 +200,7 @@ proptest! {
         let Ok(model) = d.to_model() else {
             return Ok(());
         };
+        ACCEPTED.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let t0 = Instant::now();
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let qs = random_configurations(&model, 5, &mut rng);
@@ -208,4 +220,13 @@ proptest! {
         }
         prop_assert!(t0.elapsed() < Duration::from_secs(20), "{edits:?}: {:?}", t0.elapsed());
     }
+}
+
+/// The property test above is not vacuous: a good share of its random
+/// extreme models pass the bounds and run the whole pipeline.
+#[test]
+fn the_property_test_runs_accepted_models() {
+    extreme_models_are_refused_or_work();
+    let n = ACCEPTED.load(std::sync::atomic::Ordering::Relaxed);
+    assert!(n >= 10, "only {n} of 48 random models were accepted");
 }
