@@ -4,6 +4,7 @@ use clap::{Parser, Subcommand};
 
 pub mod bench;
 pub mod calibrate;
+pub mod cell;
 pub mod demo;
 pub mod export;
 pub mod filter;
@@ -39,6 +40,8 @@ pub enum Command {
     Export(export::ExportArgs),
     /// Filter robot programs (KRL, RAPID, Fanuc, URScript): targets become false targets.
     Filter(filter::FilterArgs),
+    /// The cell's tool, load and work object data as a controller needs them.
+    Cell(cell::CellArgs),
     /// Plan measurement poses (joint CSV or program) and join tracker exports back.
     Plan(plan::PlanArgs),
     /// Run the HTTP service.
@@ -56,6 +59,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Solve(a) => solve::run(a),
         Command::Export(a) => export::run(a),
         Command::Filter(a) => filter::run(a),
+        Command::Cell(a) => cell::run(a),
         Command::Plan(a) => plan::run(a),
         Command::Serve(a) => serve::run(a),
         Command::Bench(a) => bench::run(a),

@@ -231,6 +231,7 @@ fn block(fi: usize, text: &str, toks: &[Token], i: usize) -> Result<(Position, u
             pose,
             flags: flags.unwrap_or(Flags::Nearest),
             tool: spec(ut),
+            load: None,
             work_object: spec(uf),
             slots,
             convention: OrientationConvention::FanucWpr,

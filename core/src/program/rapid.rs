@@ -5,9 +5,14 @@
 //! and used by name, or inline, in `MoveL`, `MoveJ`, `MoveC` (and their `DO`
 //! and `Trigg` forms). The tool is the motion's `Tool` argument, the work
 //! object its `\WObj`; both are read from the module's `tooldata`
-//! (`[robhold,[[x,y,z],[q1..q4]],…]`) and `wobjdata` (`[robhold,ufprog,ufmec,
-//! uframe,oframe]`, the work object `uframe·oframe`), else looked up in the
-//! cell by name; `tool0` is the flange and `wobj0` the base frame. A declared
+//! (`[robhold,[[x,y,z],[q1..q4]],[mass,[cx,cy,cz],…]]`) and `wobjdata`
+//! (`[robhold,ufprog,ufmec,uframe,oframe]`, the work object `uframe·oframe`),
+//! else looked up in the cell by name; `tool0` is the flange and `wobj0` the
+//! base frame. A tooldata's `robhold TRUE` is a tool the robot holds (the
+//! ordinary case, filtered); `FALSE` a stationary tool (the robot carries the
+//! work object, `wobjdata` with `robhold TRUE`), reported as not filtered.
+//! A tooldata's `tload` (mass [kg], centre of gravity [mm] in the flange
+//! frame `tool0`, principal moments [kg·m²]) is the target's declared load. A declared
 //! point takes the tool and work object of the motions that use it (all the
 //! same, else it is skipped). Comments: `!` to the end of the line.
 //!
@@ -18,7 +23,7 @@
 
 use super::lex::{blank_comments, error, line_end, list, tokens, Fail, Tok, Token, Val};
 use super::{Flags, FrameSpec, JointTarget, ParseError, ProgramFile, Site, Targets};
-use crate::cell::CellRef;
+use crate::cell::{CellRef, Load};
 use crate::model::orientation::{rotation_from, OrientationConvention};
 use crate::model::Pose;
 use nalgebra::Vector3;
@@ -42,6 +47,27 @@ fn frame(v: &Val) -> Option<Frame> {
         .map(|r| Pose::new(r, Vector3::new(p[0], p[1], p[2]) * 1e-3))
         .map_err(|e| e.to_string());
     Some((pose, ranges))
+}
+
+/// A tooldata's `tload` `[mass,[cx,cy,cz],[q1..q4],ix,iy,iz]` (kg, mm in the
+/// flange frame, kg·m²); `None` when it is not one or the mass is not positive.
+fn tload(v: &Val) -> Option<Load> {
+    let num = |v: &Val| match v {
+        Val::Num(x, _) => Some(*x),
+        _ => None,
+    };
+    let items = v.list()?;
+    let mass = num(items.first()?)?;
+    let (c, _) = items.get(1)?.numbers(3)?;
+    let moments: Option<Vec<f64>> = items.get(3..6).map(|m| m.iter().filter_map(num).collect());
+    let inertia_kgm2 = moments
+        .filter(|m| m.len() == 3 && m.iter().any(|x| *x != 0.0))
+        .map(|m| [m[0], m[1], m[2]]);
+    (mass > 0.0 && mass.is_finite()).then(|| Load {
+        mass_kg: mass,
+        com: Vector3::new(c[0], c[1], c[2]) * 1e-3,
+        inertia_kgm2,
+    })
 }
 
 /// A robtarget literal: pose, flags, value ranges.
@@ -121,6 +147,7 @@ fn word(t: Option<&Token>) -> Option<&str> {
 struct Context {
     tool: FrameSpec,
     wobj: FrameSpec,
+    load: Option<Load>,
     skip: Option<String>,
 }
 
@@ -134,6 +161,7 @@ struct Parser<'a> {
     masked: Vec<String>,
     toks: Vec<Vec<Token>>,
     tools: HashMap<String, Result<Pose, String>>,
+    loads: HashMap<String, Load>,
     wobjs: HashMap<String, Result<Pose, String>>,
     declared: Vec<Declared>,
     by_name: HashMap<String, Vec<usize>>,
@@ -160,6 +188,7 @@ impl Parser<'_> {
             pose,
             flags: t.flags,
             tool: ctx.tool.clone(),
+            load: ctx.load,
             work_object: ctx.wobj.clone(),
             slots: t.slots,
             convention: OrientationConvention::AbbQ1q4,
@@ -222,6 +251,7 @@ impl Parser<'_> {
                         let unset = Context {
                             tool: FrameSpec::Unset,
                             wobj: FrameSpec::Unset,
+                            load: None,
                             skip: None,
                         };
                         let site = self.site(fi, label, t, &unset);
@@ -243,9 +273,9 @@ impl Parser<'_> {
                         .and_then(|i| i.first())
                         .map(|r| self.text_of(fi, r));
                     let value = match (tool, robhold.as_deref()) {
-                        (_, Some(r)) if r.eq_ignore_ascii_case("true") => {
-                            Err(format!("tool {name} is stationary (robhold TRUE)"))
-                        }
+                        (_, Some(r)) if r.eq_ignore_ascii_case("false") => Err(format!(
+                            "tool {name} is stationary (robhold FALSE): stationary tools are not filtered"
+                        )),
                         (Some((pose, _)), _) => pose,
                         (None, _) => {
                             return Err((
@@ -256,6 +286,9 @@ impl Parser<'_> {
                             ))
                         }
                     };
+                    if let Some(load) = v.list().and_then(|i| i.get(2)).and_then(tload) {
+                        self.loads.insert(key.clone(), load);
+                    }
                     self.tools.insert(key, value);
                 }
                 "wobjdata" => {
@@ -368,9 +401,11 @@ impl Parser<'_> {
             };
             let (wobj, wobj_err) =
                 Self::frame_spec(&self.wobjs, wobj_name.unwrap_or("wobj0"), "wobj0");
+            let load = tool_name.and_then(|t| self.loads.get(&t.to_ascii_lowercase()).copied());
             let ctx = Context {
                 tool,
                 wobj,
+                load,
                 skip: tool_err.or(wobj_err),
             };
             for arg in positional.iter().take(n_points) {
@@ -424,6 +459,7 @@ impl Parser<'_> {
                         None => site.skip = site.skip.or(Some("no motion of the program uses it".into())),
                         Some((first, ctx)) => {
                             site.tool = ctx.tool.clone();
+                            site.load = ctx.load;
                             site.work_object = ctx.wobj.clone();
                             site.skip = site.skip.or(ctx.skip.clone());
                             if let Some((line, _)) = d.uses.iter().find(|(_, c)| c.tool != ctx.tool || c.wobj != ctx.wobj) {
@@ -458,6 +494,7 @@ pub fn parse(files: &[ProgramFile]) -> Result<Targets, ParseError> {
         masked,
         toks,
         tools: HashMap::new(),
+        loads: HashMap::new(),
         wobjs: HashMap::new(),
         declared: Vec::new(),
         by_name: HashMap::new(),

@@ -2,7 +2,7 @@
 
 use super::*;
 use robocal_core::model::orientation::{rotation_to, OrientationConvention};
-use robocal_core::program::{abb_cf, filter, TargetStatus};
+use robocal_core::program::{abb_cf, filter, LoadSource, TargetStatus};
 
 fn literal(p: &Pose, cf: [i32; 4]) -> String {
     let q = rotation_to(OrientationConvention::AbbQ1q4, &p.r);
@@ -37,14 +37,19 @@ fn frame(p: &Pose) -> String {
 }
 
 /// A module visiting the fixture's targets: even ones declared and moved to
-/// by `MoveJ`, odd ones inline in `MoveL`, with the tool and work object
-/// declared in the module (the work object in the controller's base frame).
+/// by `MoveJ`, odd ones inline in `MoveL`, with the tool (robot-held,
+/// `robhold TRUE`, its `tload` the true payload on the flange) and the work
+/// object declared in the module (in the controller's base frame).
 fn module(f: &Fixture) -> Vec<ProgramFile> {
     let mut decl = format!(
-        "MODULE Seam\r\n  ! welding seam on the table\r\n  PERS tooldata torch:=[FALSE,{},[2.5,[0,0,120],[1,0,0,0],0,0,0]];\r\n  \
+        "MODULE Seam\r\n  ! welding seam on the table\r\n  PERS tooldata torch:=[TRUE,{},[{:.3},[{:.3},{:.3},{:.3}],[1,0,0,0],0,0,0]];\r\n  \
          TASK PERS wobjdata table:=[FALSE,TRUE,\"\",{},[[0,0,0],[1,0,0,0]]];\r\n  \
          CONST jointtarget home:=[[0,90,-20,0,45,0],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]];\r\n",
         frame(&torch()),
+        f.truth.payload_kg,
+        f.truth.payload_com.x * 1e3,
+        f.truth.payload_com.y * 1e3,
+        f.truth.payload_com.z * 1e3,
         frame(&f.wobj_controller())
     );
     let mut body = String::from("  PROC main()\r\n    MoveAbsJ home, v1000, fine, tool0;\r\n");
@@ -75,6 +80,37 @@ fn filtered_rapid_brings_the_true_tcp_to_the_targets() {
     let files = module(f);
     let empty = Cell::default();
     assert_filter_reaches_targets(f, Language::Rapid, "RAPID", &files, &empty);
+    // Every target was solved with the module's tload.
+    let out = filter(Language::Rapid, &files, &empty, &f.model, &settings()).unwrap();
+    for t in &out.report.targets {
+        let load = t.load.as_ref().unwrap();
+        assert_eq!(load.source, LoadSource::Program);
+        assert_eq!(load.load.mass_kg, f.truth.payload_kg);
+    }
+}
+
+#[test]
+fn a_stationary_tool_is_reported_not_filtered() {
+    let f = fixture();
+    let text = module(f)[0]
+        .text
+        .replacen("tooldata torch:=[TRUE,", "tooldata torch:=[FALSE,", 1);
+    let file = ProgramFile {
+        name: "Fixed.mod".into(),
+        text,
+    };
+    let out = filter(
+        Language::Rapid,
+        &[file],
+        &Cell::default(),
+        &f.model,
+        &settings(),
+    )
+    .unwrap();
+    let r = &out.report;
+    assert_eq!((r.filtered, r.failed, r.skipped), (0, 0, 50));
+    let why = r.targets[0].reason.as_deref().unwrap();
+    assert!(why.contains("stationary (robhold FALSE)"), "{why}");
 }
 
 #[test]
