@@ -27,9 +27,7 @@ use crate::compensate::{CalibratedModelFile, CompensatedModel};
 use crate::db::{CellKind, ItemFrame, NewCellItem};
 use crate::ik::TargetFrame;
 use crate::ik::{IkSettings, IkSolver, SolveOptions, TargetInput, TargetResult, TargetsCsv};
-use crate::model::pose::rpy_matrix;
 use crate::model::{Pose, RobotModel};
-use nalgebra::Vector3;
 use std::sync::Arc;
 
 /// Which model to solve with.

@@ -593,6 +593,20 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_payload_stated_in_the_flange_frame_is_read_into_the_tool_frame() {
+        let mut d = ModelDescription::from_model(&crate::model::preset("ys100").unwrap());
+        assert_eq!(d.payload.com_frame, PayloadFrame::Tool);
+        d.payload.com_mm = [0.0, 0.0, 250.0];
+        d.payload.com_frame = PayloadFrame::Flange;
+        let m = d.to_model().unwrap();
+        // The tool is (200, 50, 500) mm without rotation.
+        assert!((m.payload.com - Vector3::new(-0.2, -0.05, -0.25)).norm() < 1e-12);
+        // Written back in the tool frame, without the field.
+        let text = serde_json::to_string(&ModelDescription::from_model(&m)).unwrap();
+        assert!(!text.contains("com_frame"), "{text}");
+    }
+
+    #[test]
     fn rpy_round_trip() {
         for rpy in [[0.1, 0.2, 0.3], [-2.0, 1.0, 3.0], [0.5, -1.4, -0.2]] {
             let r = rpy_matrix(rpy[0], rpy[1], rpy[2]);
