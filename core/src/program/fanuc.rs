@@ -240,6 +240,7 @@ fn block(fi: usize, text: &str, toks: &[Token], i: usize) -> Result<(Position, u
             mark_at,
             after_joints: None,
             skip,
+            stationary_tool: false,
         })),
         k,
     ))

@@ -436,6 +436,7 @@ fn site_of(
         mark_at: line.end..line.end,
         after_joints: None,
         skip,
+        stationary_tool: false,
     })
 }
 

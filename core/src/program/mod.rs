@@ -294,6 +294,11 @@ pub struct Site {
     /// Why the target is not filtered even though it is a Cartesian target
     /// (a relative motion, an incomplete aggregate, ...).
     pub skip: Option<String>,
+    /// The roles swapped (RAPID `robhold FALSE` tooldata with a `robhold
+    /// TRUE` wobjdata): `tool` is a stationary tool's pose in the base frame
+    /// and `work_object` the work object on the flange (flange → work
+    /// object); the robot carries the work object past the tool.
+    pub stationary_tool: bool,
 }
 
 impl Site {

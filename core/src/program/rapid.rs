@@ -9,10 +9,15 @@
 //! (`[robhold,ufprog,ufmec,uframe,oframe]`, the work object `uframe·oframe`),
 //! else looked up in the cell by name; `tool0` is the flange and `wobj0` the
 //! base frame. A tooldata's `robhold TRUE` is a tool the robot holds (the
-//! ordinary case, filtered); `FALSE` a stationary tool (the robot carries the
-//! work object, `wobjdata` with `robhold TRUE`), reported as not filtered.
-//! A tooldata's `tload` (mass [kg], centre of gravity [mm] in the flange
-//! frame `tool0`, principal moments [kg·m²]) is the target's declared load. A declared
+//! ordinary case); `FALSE` a stationary tool, its `tframe` in the world
+//! (taken as the base) frame, used with a `wobjdata` of `robhold TRUE` whose
+//! `uframe·oframe` is in the flange (wrist) frame: the robot carries the work
+//! object past the fixed tool ([`Site::stationary_tool`]). A stationary tool
+//! with a fixed work object, or a robot-held tool with a robot-held work
+//! object, is reported as not filtered. A tooldata's `tload` (mass [kg],
+//! centre of gravity [mm] in the flange frame `tool0`, principal moments
+//! [kg·m²]) is the target's declared load (for a stationary tool, the load
+//! the robot carries: the gripper and work piece). A declared
 //! point takes the tool and work object of the motions that use it (all the
 //! same, else it is skipped). Comments: `!` to the end of the line.
 //!
@@ -27,7 +32,7 @@ use crate::cell::{CellRef, Load};
 use crate::model::orientation::{rotation_from, OrientationConvention};
 use crate::model::Pose;
 use nalgebra::Vector3;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::ops::Range;
 
 const MOTIONS: [&str; 9] = [
@@ -149,6 +154,7 @@ struct Context {
     wobj: FrameSpec,
     load: Option<Load>,
     skip: Option<String>,
+    stationary: bool,
 }
 
 struct Declared {
@@ -163,6 +169,9 @@ struct Parser<'a> {
     tools: HashMap<String, Result<Pose, String>>,
     loads: HashMap<String, Load>,
     wobjs: HashMap<String, Result<Pose, String>>,
+    /// Tools with `robhold FALSE` and work objects with `robhold TRUE`.
+    stationary_tools: HashSet<String>,
+    held_wobjs: HashSet<String>,
     declared: Vec<Declared>,
     by_name: HashMap<String, Vec<usize>>,
     order: Vec<Result<Site, usize>>,
@@ -197,6 +206,7 @@ impl Parser<'_> {
             mark_at: end..end,
             after_joints: None,
             skip: None,
+            stationary_tool: ctx.stationary,
         }
         .with_skip(skip)
     }
@@ -253,6 +263,7 @@ impl Parser<'_> {
                             wobj: FrameSpec::Unset,
                             load: None,
                             skip: None,
+                            stationary: false,
                         };
                         let site = self.site(fi, label, t, &unset);
                         self.by_name
@@ -272,12 +283,12 @@ impl Parser<'_> {
                         .list()
                         .and_then(|i| i.first())
                         .map(|r| self.text_of(fi, r));
-                    let value = match (tool, robhold.as_deref()) {
-                        (_, Some(r)) if r.eq_ignore_ascii_case("false") => Err(format!(
-                            "tool {name} is stationary (robhold FALSE): stationary tools are not filtered"
-                        )),
-                        (Some((pose, _)), _) => pose,
-                        (None, _) => {
+                    if robhold.is_some_and(|r| r.eq_ignore_ascii_case("false")) {
+                        self.stationary_tools.insert(key.clone());
+                    }
+                    let value = match tool {
+                        Some((pose, _)) => pose,
+                        None => {
                             return Err((
                                 v.range().start,
                                 format!(
@@ -310,9 +321,10 @@ impl Parser<'_> {
                         .get(2)
                         .map(|r| self.text_of(fi, r))
                         .unwrap_or_default();
-                    let value = if robhold.eq_ignore_ascii_case("true") {
-                        Err(format!("the robot holds work object {name}"))
-                    } else if ufmec.trim_matches('"').trim() != "" {
+                    if robhold.eq_ignore_ascii_case("true") {
+                        self.held_wobjs.insert(key.clone());
+                    }
+                    let value = if ufmec.trim_matches('"').trim() != "" {
                         Err(format!("work object {name} moves with {ufmec}"))
                     } else {
                         uf.and_then(|u| of.map(|o| u.compose(&o)))
@@ -402,11 +414,25 @@ impl Parser<'_> {
             let (wobj, wobj_err) =
                 Self::frame_spec(&self.wobjs, wobj_name.unwrap_or("wobj0"), "wobj0");
             let load = tool_name.and_then(|t| self.loads.get(&t.to_ascii_lowercase()).copied());
+            let tool_key = tool_name.unwrap_or_default().to_ascii_lowercase();
+            let wobj_key = wobj_name.unwrap_or_default().to_ascii_lowercase();
+            let stationary = self.stationary_tools.contains(&tool_key);
+            let roles = match (stationary, self.held_wobjs.contains(&wobj_key)) {
+                (true, false) => Some(format!(
+                    "tool {tool_key} is stationary (robhold FALSE) but the robot does not hold work object {}",
+                    wobj_name.unwrap_or("wobj0")
+                )),
+                (false, true) => Some(format!(
+                    "the robot holds both tool {tool_key} and work object {wobj_key} (robhold TRUE)"
+                )),
+                _ => None,
+            };
             let ctx = Context {
                 tool,
                 wobj,
                 load,
-                skip: tool_err.or(wobj_err),
+                skip: tool_err.or(wobj_err).or(roles),
+                stationary,
             };
             for arg in positional.iter().take(n_points) {
                 if arg.first().is_some_and(|t| t.0 == Tok::Punct('[')) {
@@ -461,6 +487,7 @@ impl Parser<'_> {
                             site.tool = ctx.tool.clone();
                             site.load = ctx.load;
                             site.work_object = ctx.wobj.clone();
+                            site.stationary_tool = ctx.stationary;
                             site.skip = site.skip.or(ctx.skip.clone());
                             if let Some((line, _)) = d.uses.iter().find(|(_, c)| c.tool != ctx.tool || c.wobj != ctx.wobj) {
                                 site.skip = site.skip.or(Some(format!(
@@ -496,6 +523,8 @@ pub fn parse(files: &[ProgramFile]) -> Result<Targets, ParseError> {
         tools: HashMap::new(),
         loads: HashMap::new(),
         wobjs: HashMap::new(),
+        stationary_tools: HashSet::new(),
+        held_wobjs: HashSet::new(),
         declared: Vec::new(),
         by_name: HashMap::new(),
         order: Vec::new(),

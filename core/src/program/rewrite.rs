@@ -145,11 +145,11 @@ pub fn filter(
             previous.as_deref(),
         ) {
             Ok(done) => {
-                if !used_tools.contains(&done.tool) {
-                    used_tools.push(done.tool);
+                if let Some(t) = done.tool.filter(|t| !used_tools.contains(t)) {
+                    used_tools.push(t);
                 }
-                if !used_frames.contains(&done.frame) {
-                    used_frames.push(done.frame);
+                if let Some(f) = done.frame.filter(|f| !used_frames.contains(f)) {
+                    used_frames.push(f);
                 }
                 report.load = Some(done.load);
                 report.warnings = done.warnings;
@@ -199,8 +199,10 @@ struct Solved {
     shift_m: f64,
     load: UsedLoad,
     warnings: Vec<String>,
-    tool: ControllerTool,
-    frame: ControllerFrame,
+    /// The tool and work object as the controller holds them (`None` for a
+    /// stationary tool, which `cell::export` does not write).
+    tool: Option<ControllerTool>,
+    frame: Option<ControllerFrame>,
 }
 
 /// The site's tool (the cell's, or one the program defines, without a load).
@@ -300,6 +302,9 @@ fn solve_site(
     previous: Option<&[f64]>,
 ) -> Result<Solved, String> {
     let pose = site.pose.ok_or("the target is not a complete pose")?;
+    if site.stationary_tool {
+        return solve_stationary(site, &pose, model, settings, previous);
+    }
     let tool = resolve_tool(&site.tool, cell)?;
     let tcp = tool.tcp;
     let (load, used_load, warnings) = choose_load(site.load, tool.load, model);
@@ -328,11 +333,71 @@ fn solve_site(
         }
     };
     let solver = &solvers[index].2;
-    let q_nominal = controller_joints(solver, site, &wobj, &pose, previous);
+    let (q, false_target, configuration) = solve_on(solver, site, &wobj, &pose, previous)?;
+    Ok(Solved {
+        shift_m: (false_target.p - pose.p).norm(),
+        configuration: configuration.map(|c| c.to_string()),
+        false_target,
+        q,
+        load: used_load,
+        warnings,
+        tool: Some(used_tool),
+        frame: Some(used_frame),
+    })
+}
+
+/// A target with the roles swapped: the robot carries the work object `W_f`
+/// (flange → work object) past a stationary tool `S` (base frame). The
+/// physical condition `FK_cal(q)·W_f·T = S` is an ordinary solve of the goal
+/// `S` with the effective tool `W_f·T` (flange → the point of the work object
+/// that must meet the tool); the controller, with its nominal model, must be
+/// given `T_false = (FK_nom(q)·W_f)⁻¹·S = T·(FK_nom(q)·W_f·T)⁻¹·S`. The load
+/// is the program's (the carried work piece), else the model's payload at its
+/// flange point.
+fn solve_stationary(
+    site: &Site,
+    pose: &Pose,
+    model: &CompensatedModel,
+    settings: &IkSettings,
+    previous: Option<&[f64]>,
+) -> Result<Solved, String> {
+    let FrameSpec::Inline(fixed) = site.tool else {
+        return Err("a stationary tool must be declared in the program".into());
+    };
+    let FrameSpec::Inline(held) = site.work_object else {
+        return Err("a work object the robot holds must be declared in the program".into());
+    };
+    let (load, used_load, warnings) = choose_load(site.load, None, model);
+    let effective = held.compose(pose);
+    let solver = CellSolver::with_load(model, &effective, load.as_ref(), settings.clone());
+    let (q, f, configuration) = solve_on(&solver, site, &WorkObject::base(), &fixed, previous)?;
+    let false_target = pose.compose(&f.inverse()).compose(&fixed);
+    Ok(Solved {
+        shift_m: (false_target.p - pose.p).norm(),
+        configuration: configuration.map(|c| c.to_string()),
+        false_target,
+        q,
+        load: used_load,
+        warnings,
+        tool: None,
+        frame: None,
+    })
+}
+
+/// The calibrated joints, false target and configuration of `pose` in
+/// `wobj` on the branch and from the seed the site's flags give.
+fn solve_on(
+    solver: &CellSolver,
+    site: &Site,
+    wobj: &WorkObject,
+    pose: &Pose,
+    previous: Option<&[f64]>,
+) -> Result<(Vec<f64>, Pose, Option<Configuration>), String> {
+    let q_nominal = controller_joints(solver, site, wobj, pose, previous);
     let solved = match q_nominal {
         Some(q) => solver.solve(
-            &wobj,
-            &pose,
+            wobj,
+            pose,
             &CellOptions {
                 branch: solver.configuration(&q),
                 seed: Some(q),
@@ -341,14 +406,14 @@ fn solve_site(
         // The nominal model has no solution on the flags (out of its reach or
         // limits): the branch whose calibrated solution carries them.
         None if site.flags == Flags::Nearest => solver.solve(
-            &wobj,
-            &pose,
+            wobj,
+            pose,
             &CellOptions {
                 branch: None,
                 seed: previous.map(<[f64]>::to_vec),
             },
         ),
-        None => solve_on_flags(solver, site, &wobj, &pose, previous)?,
+        None => solve_on_flags(solver, site, wobj, pose, previous)?,
     };
     let Some(false_target) = solved.false_target else {
         let reason = solved
@@ -366,16 +431,7 @@ fn solve_site(
     {
         return Err(format!("the calibrated solution changes the flags: {m}"));
     }
-    Ok(Solved {
-        shift_m: (false_target.p - pose.p).norm(),
-        configuration: configuration.map(|c| c.to_string()),
-        false_target,
-        q,
-        load: used_load,
-        warnings,
-        tool: used_tool,
-        frame: used_frame,
-    })
+    Ok((q, false_target, configuration))
 }
 
 /// The first branch whose calibrated solution carries the site's flags.

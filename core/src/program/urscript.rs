@@ -150,6 +150,7 @@ impl Parser<'_> {
             mark_at: end..end,
             after_joints: None,
             skip,
+            stationary_tool: false,
         }
     }
 

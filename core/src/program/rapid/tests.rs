@@ -54,7 +54,7 @@ fn robtargets_tools_and_work_objects() {
     // The inline target: work object wobj0 (base).
     assert_eq!(sites[1].work_object, FrameSpec::Ref(CellRef::Number(0)));
     // A robot-held tool (robhold TRUE) is filtered; a stationary one
-    // (robhold FALSE) is not.
+    // (robhold FALSE) with a work object the robot does not hold is not.
     assert!(sites[0].skip.is_none() && sites[1].skip.is_none());
     assert!(sites[2]
         .skip
@@ -62,6 +62,26 @@ fn robtargets_tools_and_work_objects() {
         .unwrap()
         .contains("stationary (robhold FALSE)"));
     assert_eq!(sites[3].line, 7);
+}
+
+#[test]
+fn a_stationary_tool_swaps_the_roles_with_a_held_work_object() {
+    let text = MODULE.replace(
+        "wobjdata table:=[FALSE,TRUE,",
+        "wobjdata table:=[TRUE,TRUE,",
+    );
+    let sites = parse(&[file(&text)]).unwrap().sites;
+    // torch (robhold FALSE) with table (robhold TRUE): the roles swapped.
+    assert!(sites[2].skip.is_none() && sites[2].stationary_tool);
+    let FrameSpec::Inline(torch) = &sites[2].tool else {
+        panic!("{:?}", sites[2].tool)
+    };
+    assert!((torch.p - Vector3::new(0.0, 0.0, 0.25)).norm() < 1e-12);
+    // gun (robhold TRUE) with table (robhold TRUE): both held, not filtered.
+    assert!(!sites[0].stationary_tool);
+    assert!(sites[0].skip.as_ref().unwrap().contains("holds both"));
+    // gun without a work object: the ordinary case.
+    assert!(sites[1].skip.is_none() && !sites[1].stationary_tool);
 }
 
 #[test]
