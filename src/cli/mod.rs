@@ -4,6 +4,7 @@ use clap::{Parser, Subcommand};
 
 pub mod bench;
 pub mod calibrate;
+pub mod cell;
 pub mod check;
 pub mod demo;
 pub mod export;
@@ -43,6 +44,8 @@ pub enum Command {
     Export(export::ExportArgs),
     /// Filter robot programs (KRL, RAPID, Fanuc, URScript): targets become false targets.
     Filter(filter::FilterArgs),
+    /// The cell's tool, load and work object data as a controller needs them.
+    Cell(cell::CellArgs),
     /// Plan measurement poses (joint CSV or program) and join tracker exports back.
     Plan(plan::PlanArgs),
     /// ISO 9283 pose accuracy and repeatability: the test cube plan and the figures.
@@ -63,6 +66,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Solve(a) => solve::run(a),
         Command::Export(a) => export::run(a),
         Command::Filter(a) => filter::run(a),
+        Command::Cell(a) => cell::run(a),
         Command::Plan(a) => plan::run(a),
         Command::Iso9283(a) => iso9283::run(a),
         Command::Serve(a) => serve::run(a),

@@ -21,7 +21,9 @@
 //! targets are poses in that work object (`core::cell`).
 
 use super::model_files::load_compensated;
-use crate::cell::{false_target_in, target_in_base, with_tool, Cell, CellDescription, CellRef};
+use crate::cell::{
+    false_target_in, target_in_base, with_tool_load, Cell, CellDescription, CellRef,
+};
 use crate::csv_text::dialect_from_names;
 use crate::ik::targets_csv::CONVENTION_COLUMNS;
 use crate::ik::{
@@ -148,7 +150,7 @@ pub fn solve_to_string(a: &SolveArgs) -> anyhow::Result<String> {
     };
     if let Some(t) = &a.tool {
         let tool = cell.tool(&t.parse::<CellRef>()?)?;
-        model = with_tool(&model, &tool.tcp);
+        model = with_tool_load(&model, &tool.tcp, tool.load.as_ref());
     }
     let work_object = match &a.work_object {
         None => None,

@@ -6,6 +6,7 @@
 use super::types::text_enum;
 use super::{on_pool, write_for_robot, Db, Json, StoreError};
 use crate::cell::file::PoseMmDeg;
+use crate::cell::LoadDescription;
 use sqlx::FromRow;
 
 /// Tool or work object.
@@ -61,6 +62,8 @@ pub struct NewCellItem {
     pub number: Option<i64>,
     pub frame: ItemFrame,
     pub pose: PoseMmDeg,
+    /// A tool's load (None for work objects and tools without one).
+    pub load: Option<LoadDescription>,
 }
 
 /// A stored tool or work object.
@@ -70,6 +73,7 @@ pub struct CellItemRow {
     pub number: Option<i64>,
     pub frame: ItemFrame,
     pub pose_json: Json<PoseMmDeg>,
+    pub load_json: Option<Json<LoadDescription>>,
     pub created_at: String,
     pub updated_at: String,
 }
@@ -82,14 +86,14 @@ pub struct CellPut {
 }
 
 const ITEM_SELECT: &str =
-    "SELECT name, number, frame, pose_json, created_at, updated_at FROM cell_items";
+    "SELECT name, number, frame, pose_json, load_json, created_at, updated_at FROM cell_items";
 
 /// Inserts one item in the transaction `$tx`.
 macro_rules! insert_item {
     ($tx:ident, $robot:expr, $kind:expr, $item:expr) => {
         sqlx::query(
-            "INSERT INTO cell_items (robot_id, kind, name, name_key, number, frame, pose_json) \
-             VALUES ($1, $2, $3, $4, $5, $6, $7)",
+            "INSERT INTO cell_items (robot_id, kind, name, name_key, number, frame, pose_json, \
+             load_json) VALUES ($1, $2, $3, $4, $5, $6, $7, $8)",
         )
         .bind($robot)
         .bind($kind)
@@ -98,6 +102,7 @@ macro_rules! insert_item {
         .bind($item.number)
         .bind($item.frame)
         .bind(Json(&$item.pose))
+        .bind($item.load.as_ref().map(Json))
         .execute(&mut *$tx)
         .await?
     };
@@ -195,7 +200,8 @@ impl Db {
             }
             let update = k.sql(
                 "UPDATE cell_items SET name = $1, number = $2, frame = $3, pose_json = $4, \
-                 updated_at = {now} WHERE robot_id = $5 AND kind = $6 AND name_key = $7",
+                 load_json = $8, updated_at = {now} \
+                 WHERE robot_id = $5 AND kind = $6 AND name_key = $7",
             );
             let n = sqlx::query(&update)
                 .bind(&item.name)
@@ -205,6 +211,7 @@ impl Db {
                 .bind(robot_id)
                 .bind(kind)
                 .bind(&key)
+                .bind(item.load.as_ref().map(Json))
                 .execute(&mut *tx)
                 .await?
                 .rows_affected();

@@ -8,6 +8,7 @@
 use super::input::{objects, present};
 use super::{ApiError, ApiJson, ApiPath, AppState};
 use crate::cell::file::PoseMmDeg;
+use crate::cell::LoadDescription;
 use crate::db::{CellItemRow, CellKind, ItemFrame, NewCellItem};
 use crate::service;
 use axum::extract::State;
@@ -59,6 +60,9 @@ pub struct ItemIn {
     pub xyz_mm: Vec<f64>,
     #[serde(default, deserialize_with = "present")]
     pub rpy_deg: Option<Vec<f64>>,
+    /// Tools only: the load the tool carries (`core::cell::load`).
+    #[serde(default, deserialize_with = "present")]
+    pub load: Option<LoadDescription>,
 }
 
 /// Three values, or 422 naming the field.
@@ -97,6 +101,9 @@ pub struct ItemOut {
     pub frame: Option<&'static str>,
     pub xyz_mm: [f64; 3],
     pub rpy_deg: [f64; 3],
+    /// Tools only, when stated.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub load: Option<LoadDescription>,
     pub created_at: String,
     pub updated_at: String,
 }
@@ -109,6 +116,7 @@ impl ItemOut {
             frame: (r.frame != ItemFrame::Flange).then(|| r.frame.as_str()),
             xyz_mm: r.pose_json.0.xyz_mm,
             rpy_deg: r.pose_json.0.rpy_deg,
+            load: r.load_json.map(|j| j.0),
             created_at: r.created_at,
             updated_at: r.updated_at,
         }
@@ -179,11 +187,22 @@ pub(crate) fn checked(
             )))
         }
     };
+    if let Some(load) = &item.load {
+        if kind != CellKind::Tool {
+            return Err(ApiError::invalid(format!(
+                "`{name}`: only a tool carries a `load`; leave it out of a work object"
+            )));
+        }
+        // The bounds; the tool-frame conversion is made where it is used.
+        load.to_load(&crate::model::Pose::identity())
+            .map_err(|e| ApiError::invalid(format!("`{name}`: {e}")))?;
+    }
     Ok(NewCellItem {
         name,
         number,
         frame,
         pose: PoseMmDeg { xyz_mm, rpy_deg },
+        load: item.load.clone(),
     })
 }
 

@@ -68,6 +68,18 @@ fn check_file_name(name: &str) -> Result<(), ApiError> {
     Ok(())
 }
 
+/// A `language` value as the spec spells it (422 otherwise).
+fn language_of(text: &str) -> Result<Language, ApiError> {
+    match text {
+        l @ ("krl" | "rapid" | "fanuc" | "urscript") => l
+            .parse::<Language>()
+            .map_err(|e| ApiError::invalid(format!("`language`: {e}"))),
+        l => Err(ApiError::invalid(format!(
+            "`language` must be krl, rapid, fanuc or urscript, got `{l}`"
+        ))),
+    }
+}
+
 /// The request as a service command (422 naming what is wrong).
 fn command(robot_id: i64, req: FilterRequest) -> Result<FilterCommand, ApiError> {
     if req.files.is_empty() || req.files.len() > PROGRAM_FILES_MAX {
@@ -88,16 +100,7 @@ fn command(robot_id: i64, req: FilterRequest) -> Result<FilterCommand, ApiError>
     if let Some(p) = req.payload_kg {
         super::input::check_payload("`payload_kg`", p)?;
     }
-    let language = match req.language.as_str() {
-        l @ ("krl" | "rapid" | "fanuc" | "urscript") => l
-            .parse::<Language>()
-            .map_err(|e| ApiError::invalid(format!("`language`: {e}")))?,
-        l => {
-            return Err(ApiError::invalid(format!(
-                "`language` must be krl, rapid, fanuc or urscript, got `{l}`"
-            )))
-        }
-    };
+    let language = language_of(&req.language)?;
     Ok(FilterCommand {
         robot_id,
         model: model_choice(req.version.as_ref())?,
@@ -141,5 +144,54 @@ pub async fn filter(
 
 /// The route of program filtering.
 pub fn routes() -> Vec<super::Route> {
-    vec![super::post("/v1/robots/{id}/programs/filter", filter)]
+    vec![
+        super::post("/v1/robots/{id}/programs/filter", filter),
+        super::post("/v1/robots/{id}/cell/export", export_cell),
+    ]
+}
+
+/// `POST /v1/robots/{id}/cell/export` body.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CellExportRequest {
+    /// krl, rapid, fanuc or urscript.
+    pub language: String,
+    #[serde(default, deserialize_with = "present")]
+    pub version: Option<VersionSelector>,
+    /// Payload mass [kg] of tools without a stated load.
+    #[serde(default, deserialize_with = "present")]
+    pub payload_kg: Option<f64>,
+}
+
+/// What the controller must hold: tool, load and work object data.
+#[derive(Debug, Serialize)]
+pub struct CellExportResponse {
+    pub robot_id: i64,
+    /// Model version used (null: the nominal model).
+    pub version: Option<i64>,
+    pub method: String,
+    pub language: Language,
+    pub text: String,
+}
+
+pub async fn export_cell(
+    State(state): State<AppState>,
+    ApiPath(robot_id): ApiPath<i64>,
+    ApiJson(req): ApiJson<CellExportRequest>,
+) -> Result<Response, ApiError> {
+    let language = language_of(&req.language)?;
+    if let Some(p) = req.payload_kg {
+        super::input::check_payload("`payload_kg`", p)?;
+    }
+    let model = model_choice(req.version.as_ref())?;
+    let done =
+        service::programs::export_cell(&state, robot_id, model, req.payload_kg, language).await?;
+    Ok(axum::Json(CellExportResponse {
+        robot_id,
+        version: done.version,
+        method: done.method,
+        language,
+        text: done.text,
+    })
+    .into_response())
 }

@@ -117,6 +117,7 @@ pub fn description(tools: &[CellItemRow], work_objects: &[CellItemRow]) -> CellD
                 name: r.name.clone(),
                 number: number(r.number),
                 tcp: r.pose_json.0.clone(),
+                load: r.load_json.as_ref().map(|j| j.0.clone()),
             })
             .collect(),
         work_objects: work_objects

@@ -63,3 +63,37 @@ pub async fn filter_program(
         output,
     })
 }
+
+/// What the controller must hold for a robot's cell.
+#[derive(Debug)]
+pub struct CellExport {
+    /// Version number used (`None`: the nominal model).
+    pub version: Option<i64>,
+    pub method: String,
+    /// Tool, load and work object data in the language (`core::cell::export`).
+    pub text: String,
+}
+
+/// The robot's stored tools (with their loads) and work objects as the
+/// controller of `language` holds them, for the chosen model version: work
+/// objects measured in the tracker frame come out in its base frame.
+pub async fn export_cell(
+    state: &AppState,
+    robot_id: i64,
+    model: ModelChoice,
+    payload_kg: Option<f64>,
+    language: Language,
+) -> Result<CellExport, ServiceError> {
+    let cell = super::cell::cell(state, robot_id).await?;
+    let chosen = chosen_model(state, robot_id, model).await?;
+    let mut m = chosen.model;
+    if let Some(p) = payload_kg {
+        m.payload_kg = p;
+    }
+    let (tools, frames) = crate::cell::export::controller_data(&cell, &m);
+    Ok(CellExport {
+        version: chosen.version,
+        method: chosen.method,
+        text: crate::cell::export::controller_text(language, &tools, &frames),
+    })
+}

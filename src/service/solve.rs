@@ -8,8 +8,9 @@
 //! versions never change once written. A custom jump threshold gets a fresh
 //! solver that is not cached.
 //!
-//! A solve may name a production tool (on the calibrated flange, `with_tool`;
-//! not cached) and a work object `W`: targets `T` are then solved as `W·T` in
+//! A solve may name a production tool (on the calibrated flange with its load,
+//! `core::cell::with_tool_load`: the load stated by the tool, else the
+//! model's payload kept at its flange point) and a work object `W`: targets `T` are then solved as `W·T` in
 //! the base frame and false targets returned in `W` (`core::cell`).
 //!
 //! Units at this boundary: targets in mm and degrees (`TargetInput`), joint
@@ -18,14 +19,15 @@
 use super::limits::SMALL_SOLVE_MAX;
 use super::{AppState, ServiceError};
 use crate::cell::file::PoseMmDeg;
-use crate::cell::{false_target_in, target_in_base, with_tool, WorkObject, WorkObjectFrame};
+use crate::cell::{
+    false_target_in, target_in_base, with_tool_load, Load, LoadDescription, WorkObject,
+    WorkObjectFrame,
+};
 use crate::compensate::{CalibratedModelFile, CompensatedModel};
 use crate::db::{CellKind, ItemFrame, NewCellItem};
 use crate::ik::TargetFrame;
 use crate::ik::{IkSettings, IkSolver, SolveOptions, TargetInput, TargetResult, TargetsCsv};
-use crate::model::pose::rpy_matrix;
 use crate::model::{Pose, RobotModel};
-use nalgebra::Vector3;
 use std::sync::Arc;
 
 /// Which model to solve with.
@@ -211,16 +213,18 @@ async fn prepare(
         Some((_, v, m)) => (Some(*v), m.clone()),
         None => (None, "nominal".to_string()),
     };
-    let tcp = match &cmd.tool {
-        Some(choice) => Some(resolve(state, robot_id, CellKind::Tool, choice).await?.pose),
+    let tool = match &cmd.tool {
+        Some(choice) => Some(resolve(state, robot_id, CellKind::Tool, choice).await?),
         None => None,
     };
-    let tcp = tcp.as_ref();
+    let tcp = tool.as_ref().map(|t| &t.pose);
+    let load = tool.as_ref().and_then(|t| t.load.as_ref());
     let key = (
         robot_id,
         chosen.as_ref().map(|c| c.0),
         cmd.payload_kg.map(f64::to_bits),
         tcp.map(|t| std::array::from_fn(|i| if i < 3 { t.p[i] } else { t.r[i - 3] }.to_bits())),
+        load.map(|l| [l.mass_kg, l.com.x, l.com.y, l.com.z].map(f64::to_bits)),
     );
     let cacheable = cmd.jump_deg.is_none();
     if cacheable {
@@ -237,7 +241,7 @@ async fn prepare(
         settings.jump_threshold_rad = j.to_radians();
     }
     if let Some(tcp) = tcp {
-        model = with_tool(&model, tcp);
+        model = with_tool_load(&model, tcp, load);
     }
     let solver = Arc::new(IkSolver::new(model, settings));
     if cacheable {
@@ -348,17 +352,14 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
 
 /// SI pose of boundary `xyz_mm` and `rpy_deg` (`Rz·Ry·Rx`), as the cell file
 /// reads it (its own conversion is private to `core::cell::file`).
-pub fn pose_of(p: &PoseMmDeg) -> Pose {
-    let [rx, ry, rz] = p.rpy_deg.map(f64::to_radians);
-    Pose::new(rpy_matrix(rx, ry, rz), Vector3::from(p.xyz_mm) * 1e-3)
-}
-
 /// A tool or work object of a solve, resolved.
 struct ResolvedItem {
     name: String,
     frame: ItemFrame,
     /// SI pose in `frame`.
     pose: Pose,
+    /// A tool's load, on the flange.
+    load: Option<Load>,
 }
 
 /// A stored or inline tool or work object (`NotFound` for an unknown name).
@@ -369,18 +370,36 @@ async fn resolve(
     choice: &ItemChoice,
 ) -> Result<ResolvedItem, ServiceError> {
     Ok(match choice {
-        ItemChoice::Inline(item) => ResolvedItem {
-            name: item.name.clone(),
-            frame: item.frame,
-            pose: pose_of(&item.pose),
-        },
+        ItemChoice::Inline(item) => resolved(
+            item.name.clone(),
+            item.frame,
+            &item.pose,
+            item.load.as_ref(),
+        )?,
         ItemChoice::Stored(name) => {
             let row = super::cell::get(state, robot_id, kind, name).await?;
-            ResolvedItem {
-                pose: pose_of(&row.pose_json.0),
-                name: row.name,
-                frame: row.frame,
-            }
+            let load = row.load_json.as_ref().map(|j| &j.0);
+            resolved(row.name.clone(), row.frame, &row.pose_json.0, load)?
         }
+    })
+}
+
+/// An item's SI pose and its load on the flange (converted once, `core::cell::load`).
+fn resolved(
+    name: String,
+    frame: ItemFrame,
+    pose: &PoseMmDeg,
+    load: Option<&LoadDescription>,
+) -> Result<ResolvedItem, ServiceError> {
+    let pose = pose.pose();
+    let load = load
+        .map(|l| l.to_load(&pose))
+        .transpose()
+        .map_err(|e| ServiceError::Invalid(format!("`{name}`: {e}")))?;
+    Ok(ResolvedItem {
+        name,
+        frame,
+        pose,
+        load,
     })
 }

@@ -73,8 +73,15 @@ pub struct RobotContext {
 
 /// Cache key of a prepared solver: robot, version row (None: nominal model),
 /// payload override bits.
-/// Robot, model version, payload and production tool (the bits of `p` and `R`).
-type SolverKey = (i64, Option<i64>, Option<u64>, Option<[u64; 12]>);
+/// Robot, model version, payload and production tool (the bits of `p` and `R`)
+/// with its load (mass and centre of mass).
+type SolverKey = (
+    i64,
+    Option<i64>,
+    Option<u64>,
+    Option<[u64; 12]>,
+    Option<[u64; 4]>,
+);
 
 /// Shared state of the service.
 #[derive(Clone)]

@@ -549,3 +549,69 @@ async fn a_solve_with_a_tool_and_a_work_object_is_the_cell_solvers() {
     );
     assert_ne!(f, &stored["results"][0]["false_target"]);
 }
+
+#[tokio::test]
+async fn a_tool_carries_its_load_and_the_cell_exports_for_the_controller() {
+    let t = setup().await;
+    let rid = t.create_robot("ys100").await.to_string();
+    // 12 kg, 100 mm back from the TCP along the torch (tool frame): 150 mm
+    // along it from the flange, tilted 30° about y.
+    let load = json!({ "mass_kg": 12.0, "com_mm": [0.0, 0.0, -100.0], "frame": "tool" });
+    let body = json!({ "number": 1, "xyz_mm": [125.0, 0.0, 216.50635094610965], "rpy_deg": [0.0, 30.0, 0.0], "load": load });
+    let r = put(&t, TOOL, &[&rid, "torch"], body).await;
+    assert_eq!(r.status, StatusCode::CREATED, "{}", r.text());
+    let r = t.get(TOOL, &[&rid, "torch"]).await;
+    assert_eq!(r.json()["load"], load);
+    // A load is a tool's; its values are bounded.
+    for (kind, body, part) in [
+        (
+            FRAME,
+            json!({ "xyz_mm": [0, 0, 1], "load": { "mass_kg": 1.0 } }),
+            "only a tool",
+        ),
+        (
+            TOOL,
+            json!({ "xyz_mm": [0, 0, 1], "load": { "mass_kg": -1.0 } }),
+            "mass_kg",
+        ),
+        (
+            TOOL,
+            json!({ "xyz_mm": [0, 0, 1], "load": { "mass_kg": 1.0, "frame": "wrist" } }),
+            "wrist",
+        ),
+    ] {
+        let r = put(&t, kind, &[&rid, "x"], body).await;
+        assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+        assert!(r.text().contains(part), "{}", r.text());
+    }
+    let r = put(
+        &t,
+        FRAME,
+        &[&rid, "table"],
+        json!({ "number": 2, "xyz_mm": [1300.0, -600.0, 300.0], "rpy_deg": [0.0, 0.0, 20.0] }),
+    )
+    .await;
+    assert_eq!(r.status, StatusCode::CREATED, "{}", r.text());
+    let r = t
+        .post_json(
+            "/v1/robots/{id}/cell/export",
+            &[&rid],
+            json!({ "language": "krl", "version": "nominal" }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let text = r.json()["text"].as_str().unwrap().to_string();
+    assert!(
+        text.contains("LOAD_DATA[1]={M 12.000000,CM {X 75.000000,Y 0.000000,Z 129.903811,"),
+        "{text}"
+    );
+    assert!(text.contains("BASE_DATA[2]={X 1300.000000,Y -600.000000,Z 300.000000,A 20.000000000,B 0.000000000,C 0.000000000}"), "{text}");
+    let r = t
+        .post_json(
+            "/v1/robots/{id}/cell/export",
+            &[&rid],
+            json!({ "language": "cobol", "version": "nominal" }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+}

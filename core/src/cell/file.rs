@@ -1,8 +1,9 @@
 //! The cell file: tools and work objects in boundary units (mm, degrees; the
 //! rotation `Rz(rz)·Ry(ry)·Rx(rx)` of `rpy_deg = [rx, ry, rz]`, as a model
-//! file's tool).
+//! file's tool). A tool may carry a `load` (kg, mm; centre of mass in the
+//! flange or the tool frame, converted once to the flange frame).
 
-use super::{Cell, Tool, WorkObject, WorkObjectFrame};
+use super::{Cell, LoadDescription, Tool, WorkObject, WorkObjectFrame};
 use crate::model::pose::rpy_matrix;
 use crate::model::Pose;
 use nalgebra::Vector3;
@@ -17,7 +18,14 @@ pub struct PoseMmDeg {
 }
 
 impl PoseMmDeg {
-    fn to_pose(&self, what: &str) -> Result<Pose, CellFileError> {
+    /// The pose in SI units (values taken as they are; see [`Self::to_pose`]).
+    pub fn pose(&self) -> Pose {
+        let [rx, ry, rz] = self.rpy_deg.map(f64::to_radians);
+        Pose::new(rpy_matrix(rx, ry, rz), Vector3::from(self.xyz_mm) * 1e-3)
+    }
+
+    /// The pose in SI units, or which item has a value that is not finite.
+    pub fn to_pose(&self, what: &str) -> Result<Pose, CellFileError> {
         if !self
             .xyz_mm
             .iter()
@@ -26,11 +34,7 @@ impl PoseMmDeg {
         {
             return Err(CellFileError::NotFinite(what.to_string()));
         }
-        let [rx, ry, rz] = self.rpy_deg.map(f64::to_radians);
-        Ok(Pose::new(
-            rpy_matrix(rx, ry, rz),
-            Vector3::from(self.xyz_mm) * 1e-3,
-        ))
+        Ok(self.pose())
     }
 }
 
@@ -42,6 +46,9 @@ pub struct ToolDescription {
     pub number: Option<u32>,
     #[serde(flatten)]
     pub tcp: PoseMmDeg,
+    /// The load the tool carries (`cell::load`), if stated.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub load: Option<LoadDescription>,
 }
 
 /// A work object of the cell file.
@@ -73,6 +80,8 @@ pub enum CellFileError {
     Json(String),
     #[error("cell file: {0} has a value that is not finite")]
     NotFinite(String),
+    #[error("cell file: tool {0}: {1}")]
+    Load(String, String),
 }
 
 impl CellDescription {
@@ -87,10 +96,18 @@ impl CellDescription {
             .tools
             .iter()
             .map(|t| {
+                let tcp = t.tcp.to_pose(&format!("tool {}", t.name))?;
+                let load = t
+                    .load
+                    .as_ref()
+                    .map(|l| l.to_load(&tcp))
+                    .transpose()
+                    .map_err(|e| CellFileError::Load(t.name.clone(), e))?;
                 Ok(Tool {
                     name: t.name.clone(),
                     number: t.number,
-                    tcp: t.tcp.to_pose(&format!("tool {}", t.name))?,
+                    tcp,
+                    load,
                 })
             })
             .collect::<Result<_, CellFileError>>()?;

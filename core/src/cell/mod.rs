@@ -22,13 +22,15 @@
 //!
 //! Units: SI (m, rad) inside; the programs' units are converted by the parsers.
 
+pub mod export;
 pub mod file;
+pub mod load;
 
 pub use file::{CellDescription, CellFileError};
+pub use load::{Load, LoadDescription, LoadFrame};
 
 use crate::compensate::CompensatedModel;
 use crate::ik::{Configuration, Goal, IkSettings, IkSolution, IkSolver, SolveOptions, TargetFrame};
-use crate::model::orientation::fixed_xyz_angles;
 use crate::model::Pose;
 use serde::{Deserialize, Serialize};
 
@@ -41,6 +43,10 @@ pub struct Tool {
     pub number: Option<u32>,
     /// Flange → TCP [m].
     pub tcp: Pose,
+    /// The load the tool carries (centre of mass in the flange frame), if
+    /// stated; else a solve takes the model's payload at its flange point.
+    #[serde(default)]
+    pub load: Option<Load>,
 }
 
 /// In which frame a work object's pose is given.
@@ -140,6 +146,7 @@ impl Cell {
                 name: "flange".into(),
                 number: Some(0),
                 tcp: Pose::identity(),
+                load: None,
             }),
             None => Err(CellError::UnknownTool(r.clone())),
         }
@@ -161,15 +168,29 @@ impl Cell {
 }
 
 /// `model` with the production tool `tcp` on its calibrated flange and on its
-/// nominal flange (the controller's tool data).
+/// nominal flange (the controller's tool data), the payload kept where it
+/// hangs on the flange (`load::on_tool`; never moved with the TCP).
 pub fn with_tool(model: &CompensatedModel, tcp: &Pose) -> CompensatedModel {
-    let tool = crate::model::Tool {
-        p: tcp.p,
-        rpy: fixed_xyz_angles(&tcp.r),
+    with_tool_load(model, tcp, None)
+}
+
+/// [`with_tool`] carrying `load` (flange frame) instead of the model's
+/// payload; `None` keeps each model's payload at its flange point.
+pub fn with_tool_load(
+    model: &CompensatedModel,
+    tcp: &Pose,
+    load: Option<&Load>,
+) -> CompensatedModel {
+    let carried = |m: &crate::model::RobotModel| {
+        let l = load.copied().unwrap_or_else(|| Load::of_model(m));
+        load::on_tool(m, tcp, &l)
     };
     let mut m = model.clone();
-    m.calibrated.tool = tool.clone();
-    m.nominal.tool = tool;
+    m.calibrated = carried(&model.calibrated);
+    m.nominal = carried(&model.nominal);
+    if let Some(l) = load {
+        m.payload_kg = l.mass_kg;
+    }
     m
 }
 
@@ -199,9 +220,21 @@ pub struct CellSolver {
 }
 
 impl CellSolver {
-    /// A solver of `model` carrying the tool `tcp` (flange → TCP).
+    /// A solver of `model` carrying the tool `tcp` (flange → TCP) and the
+    /// model's payload at its flange point.
     pub fn new(model: &CompensatedModel, tcp: &Pose, settings: IkSettings) -> Self {
-        let m = with_tool(model, tcp);
+        Self::with_load(model, tcp, None, settings)
+    }
+
+    /// A solver of `model` carrying the tool `tcp` and `load` (flange frame;
+    /// `None`: the model's payload at its flange point).
+    pub fn with_load(
+        model: &CompensatedModel,
+        tcp: &Pose,
+        load: Option<&Load>,
+        settings: IkSettings,
+    ) -> Self {
+        let m = with_tool_load(model, tcp, load);
         CellSolver {
             nominal_ik: crate::ik::AnalyticIk::new(&m.nominal).ok(),
             solver: IkSolver::new(m, settings),

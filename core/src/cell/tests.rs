@@ -85,6 +85,7 @@ fn tools_and_work_objects_by_name_and_number() {
             name: "torch".into(),
             number: Some(3),
             tcp: torch(),
+            load: None,
         }],
         work_objects: vec![wobj],
     };
@@ -103,4 +104,89 @@ fn tools_and_work_objects_by_name_and_number() {
         Pose::identity()
     );
     assert!(cell.work_object(&CellRef::Name("fixture".into())).is_err());
+}
+
+/// The torques of the payload alone (the model's links massless), computed
+/// here from the flange pose: `τ_i = z_i·((c − o_i) × m g)`.
+fn payload_torques(
+    model: &crate::model::RobotModel,
+    q: &[f64],
+    c_flange: &Vector3<f64>,
+    m: f64,
+) -> Vec<f64> {
+    let ch = crate::kinematics::chain(model, q).unwrap();
+    let n = model.dof();
+    let c = ch.links[n - 1].frame.transform_point(c_flange);
+    (0..n)
+        .map(|k| {
+            let f = &ch.links[k].frame;
+            f.z_axis().dot(&(c - f.p).cross(&(model.gravity * m)))
+        })
+        .collect()
+}
+
+#[test]
+fn the_payload_stays_on_the_flange_whatever_the_tool() {
+    let (mut model, _) = fixture();
+    for l in model.calibrated.links.iter_mut() {
+        l.mass = 0.0;
+    }
+    // The preset's payload (110 kg, 250 mm out along the flange axis),
+    // where the calibrated model's tool puts it.
+    let c_flange = crate::kinematics::chain::tool_pose(&model.calibrated)
+        .transform_point(&model.calibrated.payload.com);
+    assert!((c_flange - Vector3::new(0.0, 0.0, 0.25)).norm() < 0.01);
+    let q = [0.3, 1.2, -0.3, 0.5, 0.8, -0.6];
+    let want = payload_torques(&model.calibrated, &q, &c_flange, 110.0);
+    for tcp in [Pose::identity(), torch()] {
+        let m = with_tool(&model, &tcp);
+        let got = m.torques_at(&q, 110.0).unwrap();
+        for (g, w) in got.iter().zip(&want) {
+            assert!(
+                (g - w).abs() < 1e-9 * (1.0 + w.abs()),
+                "{got:?} vs {want:?}"
+            );
+        }
+    }
+    // A tool's own load (stated in the flange frame) replaces the model's.
+    let load = Load {
+        mass_kg: 20.0,
+        com: Vector3::new(0.05, 0.0, 0.1),
+        inertia_kgm2: None,
+    };
+    let m = with_tool_load(&model, &torch(), Some(&load));
+    assert_eq!(m.payload_kg, 20.0);
+    let want = payload_torques(&model.calibrated, &q, &load.com, 20.0);
+    let got = m.torques_at(&q, m.payload_kg).unwrap();
+    for (g, w) in got.iter().zip(&want) {
+        assert!(
+            (g - w).abs() < 1e-9 * (1.0 + w.abs()),
+            "{got:?} vs {want:?}"
+        );
+    }
+}
+
+#[test]
+fn a_load_in_the_tool_frame_is_converted_once_to_the_flange() {
+    let d = LoadDescription {
+        mass_kg: 12.0,
+        com_mm: [0.0, 0.0, -100.0],
+        frame: LoadFrame::Tool,
+        inertia_kgm2: None,
+    };
+    // 100 mm back from the torch's tip along its axis: 150 mm along it from
+    // the flange, tilted 30° about y.
+    let l = d.to_load(&torch()).unwrap();
+    let want = Vector3::new(0.15 * 0.5, 0.0, 0.15 * 3f64.sqrt() / 2.0);
+    assert!((l.com - want).norm() < 1e-15, "{:?}", l.com);
+    let flange = LoadDescription {
+        frame: LoadFrame::Flange,
+        ..d.clone()
+    };
+    assert_eq!(
+        flange.to_load(&torch()).unwrap().com,
+        Vector3::new(0.0, 0.0, -0.1)
+    );
+    let bad = LoadDescription { mass_kg: -1.0, ..d };
+    assert!(bad.to_load(&torch()).unwrap_err().contains("mass_kg"));
 }

@@ -149,13 +149,34 @@ fn joint_number<'de, D: serde::Deserializer<'de>>(d: D) -> Result<usize, D::Erro
 pub struct PayloadDescription {
     #[serde(default)]
     pub mass_kg: f64,
-    /// Centre of mass in the tool frame.
+    /// Centre of mass, in the frame `com_frame` names.
     #[serde(default)]
     pub com_mm: [f64; 3],
+    /// The frame of `com_mm`: `tool` (the model's tool frame; the reading of
+    /// files without the field) or `flange`. Written only when `flange`.
+    #[serde(default, skip_serializing_if = "PayloadFrame::is_tool")]
+    pub com_frame: PayloadFrame,
     /// Mass every pose carries beyond its declared payload (identified by
     /// `skcm-payload`); left out when 0.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub mass_offset_kg: f64,
+}
+
+/// In which frame a model file states its payload's centre of mass.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PayloadFrame {
+    /// The model's tool frame (files without `com_frame`).
+    #[default]
+    Tool,
+    /// The flange frame (the last link's frame).
+    Flange,
+}
+
+impl PayloadFrame {
+    fn is_tool(&self) -> bool {
+        *self == PayloadFrame::Tool
+    }
 }
 
 /// The JSON description of a robot model (mm/deg).
@@ -386,9 +407,18 @@ impl ModelDescription {
             self.payload.mass_offset_kg,
             &MASS_OFFSET_KG,
         )?;
+        let com = Vector3::from(check3("payload.com_mm", self.payload.com_mm, &LENGTH_MM)?) * MM;
         let payload = Payload {
             mass: payload_mass,
-            com: Vector3::from(check3("payload.com_mm", self.payload.com_mm, &LENGTH_MM)?) * MM,
+            // Kept in the tool frame inside (`Payload::com`).
+            com: match self.payload.com_frame {
+                PayloadFrame::Tool => com,
+                PayloadFrame::Flange => {
+                    Pose::new(rpy_matrix(tool.rpy[0], tool.rpy[1], tool.rpy[2]), tool.p)
+                        .inverse()
+                        .transform_point(&com)
+                }
+            },
             mass_offset,
         };
         let gravity = Vector3::from(check3("gravity_mps2", self.gravity_mps2, &GRAVITY_MPS2)?);
@@ -478,6 +508,7 @@ impl ModelDescription {
                     m.payload.com.y / MM,
                     m.payload.com.z / MM,
                 ],
+                com_frame: PayloadFrame::Tool,
                 mass_offset_kg: m.payload.mass_offset,
             },
             gravity_mps2: [m.gravity.x, m.gravity.y, m.gravity.z],
@@ -544,6 +575,20 @@ impl RobotModel {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_payload_stated_in_the_flange_frame_is_read_into_the_tool_frame() {
+        let mut d = ModelDescription::from_model(&crate::model::preset("ys100").unwrap());
+        assert_eq!(d.payload.com_frame, PayloadFrame::Tool);
+        d.payload.com_mm = [0.0, 0.0, 250.0];
+        d.payload.com_frame = PayloadFrame::Flange;
+        let m = d.to_model().unwrap();
+        // The tool is (200, 50, 500) mm without rotation.
+        assert!((m.payload.com - Vector3::new(-0.2, -0.05, -0.25)).norm() < 1e-12);
+        // Written back in the tool frame, without the field.
+        let text = serde_json::to_string(&ModelDescription::from_model(&m)).unwrap();
+        assert!(!text.contains("com_frame"), "{text}");
+    }
 
     #[test]
     fn rpy_round_trip() {

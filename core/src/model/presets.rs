@@ -73,6 +73,7 @@ fn ys100() -> ModelDescription {
         },
         closed_loop: None,
         payload: PayloadDescription {
+            com_frame: Default::default(),
             mass_kg: 110.0,
             com_mm: [-200.0, -50.0, -250.0],
             ..PayloadDescription::default()
@@ -121,6 +122,7 @@ fn hh800() -> ModelDescription {
             xi_deg: -90.0,
         }),
         payload: PayloadDescription {
+            com_frame: Default::default(),
             mass_kg: 745.0,
             com_mm: [-200.0, -200.0, 100.0],
             ..PayloadDescription::default()

@@ -231,6 +231,7 @@ fn block(fi: usize, text: &str, toks: &[Token], i: usize) -> Result<(Position, u
             pose,
             flags: flags.unwrap_or(Flags::Nearest),
             tool: spec(ut),
+            load: None,
             work_object: spec(uf),
             slots,
             convention: OrientationConvention::FanucWpr,
@@ -239,6 +240,7 @@ fn block(fi: usize, text: &str, toks: &[Token], i: usize) -> Result<(Position, u
             mark_at,
             after_joints: None,
             skip,
+            stationary_tool: false,
         })),
         k,
     ))

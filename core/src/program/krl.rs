@@ -7,7 +7,12 @@
 //! Tool and base: `$TOOL = TOOL_DATA[n]`, `$BASE = BASE_DATA[n]`, inline
 //! frames, `$NULLFRAME`, `BAS(#TOOL, n)`, `BAS(#BASE, n)` and `FDAT_ACT = FP1`
 //! with `DECL FDAT FP1={TOOL_NO n, BASE_NO m, …}`; `TOOL_DATA[n]={…}` and
-//! `BASE_DATA[n]={…}` in the files define numbers over the cell's. A declared
+//! `BASE_DATA[n]={…}` in the files define numbers over the cell's. The
+//! declared load: `$LOAD = {M m, CM {X, Y, Z, …}, J {X, Y, Z}}` or
+//! `$LOAD = LOAD_DATA[n]`, and `BAS(#TOOL, n)` takes `LOAD_DATA[n]` when the
+//! files define it (`LOAD_DATA[n]={…}`, as in `$config.dat`); kg, mm in the
+//! flange frame, kg·m²; a mass of −1 (the controller's default) or 0 is no
+//! declaration. A declared
 //! point takes the tool and base of the motions that use it (all the same,
 //! else it is skipped). Comments (`;` to the end of the line) are ignored;
 //! KRL is case-insensitive.
@@ -15,7 +20,7 @@
 //! Units: mm and degrees, `R = Rz(A)·Ry(B)·Rx(C)`. `S` and `T` are kept.
 
 use super::{Flags, FrameSpec, JointTarget, ParseError, ProgramFile, Site, Targets};
-use crate::cell::CellRef;
+use crate::cell::{CellRef, Load};
 use crate::model::orientation::{rotation_from, OrientationConvention};
 use crate::model::Pose;
 use nalgebra::Vector3;
@@ -323,6 +328,40 @@ fn joint_values(agg: &Agg, code: &str) -> Option<Vec<f64>> {
 }
 
 /// A frame aggregate `{X, Y, Z, A, B, C}` as a pose [m].
+/// A load aggregate `{M m, CM {X x, Y y, Z z, A …}, J {X jx, Y jy, Z jz}}`
+/// (kg, mm in the flange frame, kg·m²); `None` when M is missing or not
+/// positive (KUKA's −1: no load data).
+fn load_of(agg: &Agg, code: &str) -> Option<Load> {
+    let get = |a: &Agg, key: &str| {
+        a.items
+            .iter()
+            .find(|(k, _)| k == key)
+            .map(|(_, r)| r.clone())
+    };
+    let xyz = |r: Range<usize>| -> Option<[f64; 3]> {
+        let (inner, _) = aggregate(code, r.start).ok()?;
+        let v = |k: &str| get(&inner, k).and_then(|r| real(&code[r]));
+        Some([
+            v("X").unwrap_or(0.0),
+            v("Y").unwrap_or(0.0),
+            v("Z").unwrap_or(0.0),
+        ])
+    };
+    let mass = real(&code[get(agg, "M")?])?;
+    if !(mass > 0.0 && mass.is_finite()) {
+        return None;
+    }
+    let com = get(agg, "CM").and_then(xyz).unwrap_or([0.0; 3]);
+    let inertia_kgm2 = get(agg, "J")
+        .and_then(xyz)
+        .filter(|j| j.iter().any(|v| *v != 0.0));
+    Some(Load {
+        mass_kg: mass,
+        com: Vector3::from(com) * 1e-3,
+        inertia_kgm2,
+    })
+}
+
 fn frame_of(agg: &Agg, text: &str, offset: usize) -> Option<Pose> {
     match classify(agg, text, offset) {
         Kind::Cartesian { pose: Ok(p), .. } => Some(p),
@@ -334,6 +373,7 @@ fn frame_of(agg: &Agg, text: &str, offset: usize) -> Option<Pose> {
 struct Context {
     tool: FrameSpec,
     base: FrameSpec,
+    load: Option<Load>,
 }
 
 /// A declared point and the contexts of the motions that use it.
@@ -349,6 +389,7 @@ struct Parser<'a> {
     fdat: HashMap<String, (Option<u32>, Option<u32>)>,
     tools: HashMap<u32, Pose>,
     bases: HashMap<u32, Pose>,
+    loads: HashMap<u32, Load>,
     /// Sites in execution order; `Err(i)` is declared point `i` at its first use.
     order: Vec<Result<Site, usize>>,
     joints: Vec<JointTarget>,
@@ -386,6 +427,7 @@ fn site_of(
         pose,
         flags,
         tool: ctx.tool.clone(),
+        load: ctx.load,
         work_object: ctx.base.clone(),
         slots,
         convention: OrientationConvention::KukaAbc,
@@ -394,6 +436,7 @@ fn site_of(
         mark_at: line.end..line.end,
         after_joints: None,
         skip,
+        stationary_tool: false,
     })
 }
 
@@ -449,6 +492,17 @@ impl Parser<'_> {
                 k += 1;
             }
             let ty = words.get(k).copied().unwrap_or("");
+            // LOAD_DATA[n]={M …, CM {…}, J {…}}
+            if ty == "LOAD_DATA" && k == 0 {
+                if let (Some(n), Some((Tok::Punct('='), _)), Some((Tok::Agg(a), _))) =
+                    (self.number_ref(&toks, 1), toks.get(4), toks.get(5))
+                {
+                    if let Some(l) = load_of(a, code) {
+                        self.loads.insert(n, l);
+                    }
+                }
+                continue;
+            }
             // TOOL_DATA[n]={…} / BASE_DATA[n]={…}
             if (ty == "TOOL_DATA" || ty == "BASE_DATA") && k == 0 {
                 if let (Some(n), Some((Tok::Punct('='), _)), Some((Tok::Agg(a), _))) =
@@ -488,6 +542,7 @@ impl Parser<'_> {
             let unset = Context {
                 tool: FrameSpec::Unset,
                 base: FrameSpec::Unset,
+                load: None,
             };
             let kind = classify(&a, file.text.as_str(), 0);
             if let Some(site) = site_of(fi, &line, name, kind, &unset, None) {
@@ -509,6 +564,7 @@ impl Parser<'_> {
         let mut ctx = Context {
             tool: FrameSpec::Unset,
             base: FrameSpec::Unset,
+            load: None,
         };
         for line in lines(&file.text) {
             let code = code_of(line.text).map_err(|(at, m)| err(file, &line, at, m))?;
@@ -519,7 +575,7 @@ impl Parser<'_> {
             };
             let first = word(0);
             let is_decl = first == "DECL" || POSE_TYPES.contains(&first) || first == "FDAT";
-            if is_decl || first == "TOOL_DATA" || first == "BASE_DATA" {
+            if is_decl || matches!(first, "TOOL_DATA" | "BASE_DATA" | "LOAD_DATA") {
                 continue; // handled by `declarations`
             }
             // $TOOL = … / $BASE = …
@@ -549,6 +605,17 @@ impl Parser<'_> {
                 }
                 continue;
             }
+            // $LOAD = {…} / $LOAD = LOAD_DATA[n]
+            if first == "$LOAD" && matches!(toks.get(1), Some((Tok::Punct('='), _))) {
+                ctx.load = match toks.get(2) {
+                    Some((Tok::Agg(a), _)) => load_of(a, code),
+                    Some((Tok::Word(w), _)) if w == "LOAD_DATA" => self
+                        .number_ref(&toks, 3)
+                        .and_then(|n| self.loads.get(&n).copied()),
+                    _ => None,
+                };
+                continue;
+            }
             // BAS(#TOOL, n) / BAS(#BASE, n)
             if first == "BAS" && matches!(word(2), "#TOOL" | "#BASE") {
                 if let (Some((Tok::Punct(','), _)), Some((Tok::Number(n), _))) =
@@ -558,6 +625,9 @@ impl Parser<'_> {
                         let tool = word(2) == "#TOOL";
                         let spec = self.frame_spec(*n as u32, tool);
                         if tool {
+                            if let Some(l) = self.loads.get(&(*n as u32)) {
+                                ctx.load = Some(*l);
+                            }
                             ctx.tool = spec;
                         } else {
                             ctx.base = spec;
@@ -644,6 +714,7 @@ impl Parser<'_> {
                         }
                         Some((_, ctx)) => {
                             site.tool = ctx.tool.clone();
+                            site.load = ctx.load;
                             site.work_object = ctx.base.clone();
                             let other = d
                                 .uses
@@ -693,6 +764,7 @@ pub fn parse(files: &[ProgramFile]) -> Result<Targets, ParseError> {
         by_name: HashMap::new(),
         fdat: HashMap::new(),
         tools: HashMap::new(),
+        loads: HashMap::new(),
         bases: HashMap::new(),
         order: Vec::new(),
         joints: Vec::new(),

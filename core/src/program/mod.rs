@@ -19,9 +19,11 @@ pub mod rapid;
 mod rewrite;
 pub mod urscript;
 
-pub use rewrite::{filter, FilterOutput, FilterReport, TargetReport, TargetStatus};
+pub use rewrite::{
+    filter, FilterOutput, FilterReport, LoadSource, TargetReport, TargetStatus, UsedLoad,
+};
 
-use crate::cell::CellRef;
+use crate::cell::{CellRef, Load};
 use crate::ik::{Configuration, Elbow, Shoulder};
 use crate::model::orientation::OrientationConvention;
 use crate::model::Pose;
@@ -272,6 +274,9 @@ pub struct Site {
     pub pose: Option<Pose>,
     pub flags: Flags,
     pub tool: FrameSpec,
+    /// The load the program declares for the tool in use (flange frame), if
+    /// it declares one (RAPID `tload`, KRL `$LOAD`, URScript `set_payload`).
+    pub load: Option<Load>,
     pub work_object: FrameSpec,
     /// Byte ranges of x, y, z and the orientation values, in `convention` order.
     pub slots: Vec<Range<usize>>,
@@ -289,6 +294,11 @@ pub struct Site {
     /// Why the target is not filtered even though it is a Cartesian target
     /// (a relative motion, an incomplete aggregate, ...).
     pub skip: Option<String>,
+    /// The roles swapped (RAPID `robhold FALSE` tooldata with a `robhold
+    /// TRUE` wobjdata): `tool` is a stationary tool's pose in the base frame
+    /// and `work_object` the work object on the flange (flange → work
+    /// object); the robot carries the work object past the tool.
+    pub stationary_tool: bool,
 }
 
 impl Site {

@@ -5,9 +5,19 @@
 //! and used by name, or inline, in `MoveL`, `MoveJ`, `MoveC` (and their `DO`
 //! and `Trigg` forms). The tool is the motion's `Tool` argument, the work
 //! object its `\WObj`; both are read from the module's `tooldata`
-//! (`[robhold,[[x,y,z],[q1..q4]],…]`) and `wobjdata` (`[robhold,ufprog,ufmec,
-//! uframe,oframe]`, the work object `uframe·oframe`), else looked up in the
-//! cell by name; `tool0` is the flange and `wobj0` the base frame. A declared
+//! (`[robhold,[[x,y,z],[q1..q4]],[mass,[cx,cy,cz],…]]`) and `wobjdata`
+//! (`[robhold,ufprog,ufmec,uframe,oframe]`, the work object `uframe·oframe`),
+//! else looked up in the cell by name; `tool0` is the flange and `wobj0` the
+//! base frame. A tooldata's `robhold TRUE` is a tool the robot holds (the
+//! ordinary case); `FALSE` a stationary tool, its `tframe` in the world
+//! (taken as the base) frame, used with a `wobjdata` of `robhold TRUE` whose
+//! `uframe·oframe` is in the flange (wrist) frame: the robot carries the work
+//! object past the fixed tool ([`Site::stationary_tool`]). A stationary tool
+//! with a fixed work object, or a robot-held tool with a robot-held work
+//! object, is reported as not filtered. A tooldata's `tload` (mass [kg],
+//! centre of gravity [mm] in the flange frame `tool0`, principal moments
+//! [kg·m²]) is the target's declared load (for a stationary tool, the load
+//! the robot carries: the gripper and work piece). A declared
 //! point takes the tool and work object of the motions that use it (all the
 //! same, else it is skipped). Comments: `!` to the end of the line.
 //!
@@ -18,11 +28,11 @@
 
 use super::lex::{blank_comments, error, line_end, list, tokens, Fail, Tok, Token, Val};
 use super::{Flags, FrameSpec, JointTarget, ParseError, ProgramFile, Site, Targets};
-use crate::cell::CellRef;
+use crate::cell::{CellRef, Load};
 use crate::model::orientation::{rotation_from, OrientationConvention};
 use crate::model::Pose;
 use nalgebra::Vector3;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::ops::Range;
 
 const MOTIONS: [&str; 9] = [
@@ -42,6 +52,27 @@ fn frame(v: &Val) -> Option<Frame> {
         .map(|r| Pose::new(r, Vector3::new(p[0], p[1], p[2]) * 1e-3))
         .map_err(|e| e.to_string());
     Some((pose, ranges))
+}
+
+/// A tooldata's `tload` `[mass,[cx,cy,cz],[q1..q4],ix,iy,iz]` (kg, mm in the
+/// flange frame, kg·m²); `None` when it is not one or the mass is not positive.
+fn tload(v: &Val) -> Option<Load> {
+    let num = |v: &Val| match v {
+        Val::Num(x, _) => Some(*x),
+        _ => None,
+    };
+    let items = v.list()?;
+    let mass = num(items.first()?)?;
+    let (c, _) = items.get(1)?.numbers(3)?;
+    let moments: Option<Vec<f64>> = items.get(3..6).map(|m| m.iter().filter_map(num).collect());
+    let inertia_kgm2 = moments
+        .filter(|m| m.len() == 3 && m.iter().any(|x| *x != 0.0))
+        .map(|m| [m[0], m[1], m[2]]);
+    (mass > 0.0 && mass.is_finite()).then(|| Load {
+        mass_kg: mass,
+        com: Vector3::new(c[0], c[1], c[2]) * 1e-3,
+        inertia_kgm2,
+    })
 }
 
 /// A robtarget literal: pose, flags, value ranges.
@@ -121,7 +152,9 @@ fn word(t: Option<&Token>) -> Option<&str> {
 struct Context {
     tool: FrameSpec,
     wobj: FrameSpec,
+    load: Option<Load>,
     skip: Option<String>,
+    stationary: bool,
 }
 
 struct Declared {
@@ -134,7 +167,11 @@ struct Parser<'a> {
     masked: Vec<String>,
     toks: Vec<Vec<Token>>,
     tools: HashMap<String, Result<Pose, String>>,
+    loads: HashMap<String, Load>,
     wobjs: HashMap<String, Result<Pose, String>>,
+    /// Tools with `robhold FALSE` and work objects with `robhold TRUE`.
+    stationary_tools: HashSet<String>,
+    held_wobjs: HashSet<String>,
     declared: Vec<Declared>,
     by_name: HashMap<String, Vec<usize>>,
     order: Vec<Result<Site, usize>>,
@@ -160,6 +197,7 @@ impl Parser<'_> {
             pose,
             flags: t.flags,
             tool: ctx.tool.clone(),
+            load: ctx.load,
             work_object: ctx.wobj.clone(),
             slots: t.slots,
             convention: OrientationConvention::AbbQ1q4,
@@ -168,6 +206,7 @@ impl Parser<'_> {
             mark_at: end..end,
             after_joints: None,
             skip: None,
+            stationary_tool: ctx.stationary,
         }
         .with_skip(skip)
     }
@@ -222,7 +261,9 @@ impl Parser<'_> {
                         let unset = Context {
                             tool: FrameSpec::Unset,
                             wobj: FrameSpec::Unset,
+                            load: None,
                             skip: None,
+                            stationary: false,
                         };
                         let site = self.site(fi, label, t, &unset);
                         self.by_name
@@ -242,12 +283,12 @@ impl Parser<'_> {
                         .list()
                         .and_then(|i| i.first())
                         .map(|r| self.text_of(fi, r));
-                    let value = match (tool, robhold.as_deref()) {
-                        (_, Some(r)) if r.eq_ignore_ascii_case("true") => {
-                            Err(format!("tool {name} is stationary (robhold TRUE)"))
-                        }
-                        (Some((pose, _)), _) => pose,
-                        (None, _) => {
+                    if robhold.is_some_and(|r| r.eq_ignore_ascii_case("false")) {
+                        self.stationary_tools.insert(key.clone());
+                    }
+                    let value = match tool {
+                        Some((pose, _)) => pose,
+                        None => {
                             return Err((
                                 v.range().start,
                                 format!(
@@ -256,6 +297,9 @@ impl Parser<'_> {
                             ))
                         }
                     };
+                    if let Some(load) = v.list().and_then(|i| i.get(2)).and_then(tload) {
+                        self.loads.insert(key.clone(), load);
+                    }
                     self.tools.insert(key, value);
                 }
                 "wobjdata" => {
@@ -277,9 +321,10 @@ impl Parser<'_> {
                         .get(2)
                         .map(|r| self.text_of(fi, r))
                         .unwrap_or_default();
-                    let value = if robhold.eq_ignore_ascii_case("true") {
-                        Err(format!("the robot holds work object {name}"))
-                    } else if ufmec.trim_matches('"').trim() != "" {
+                    if robhold.eq_ignore_ascii_case("true") {
+                        self.held_wobjs.insert(key.clone());
+                    }
+                    let value = if ufmec.trim_matches('"').trim() != "" {
                         Err(format!("work object {name} moves with {ufmec}"))
                     } else {
                         uf.and_then(|u| of.map(|o| u.compose(&o)))
@@ -368,10 +413,26 @@ impl Parser<'_> {
             };
             let (wobj, wobj_err) =
                 Self::frame_spec(&self.wobjs, wobj_name.unwrap_or("wobj0"), "wobj0");
+            let load = tool_name.and_then(|t| self.loads.get(&t.to_ascii_lowercase()).copied());
+            let tool_key = tool_name.unwrap_or_default().to_ascii_lowercase();
+            let wobj_key = wobj_name.unwrap_or_default().to_ascii_lowercase();
+            let stationary = self.stationary_tools.contains(&tool_key);
+            let roles = match (stationary, self.held_wobjs.contains(&wobj_key)) {
+                (true, false) => Some(format!(
+                    "tool {tool_key} is stationary (robhold FALSE) but the robot does not hold work object {}",
+                    wobj_name.unwrap_or("wobj0")
+                )),
+                (false, true) => Some(format!(
+                    "the robot holds both tool {tool_key} and work object {wobj_key} (robhold TRUE)"
+                )),
+                _ => None,
+            };
             let ctx = Context {
                 tool,
                 wobj,
-                skip: tool_err.or(wobj_err),
+                load,
+                skip: tool_err.or(wobj_err).or(roles),
+                stationary,
             };
             for arg in positional.iter().take(n_points) {
                 if arg.first().is_some_and(|t| t.0 == Tok::Punct('[')) {
@@ -424,7 +485,9 @@ impl Parser<'_> {
                         None => site.skip = site.skip.or(Some("no motion of the program uses it".into())),
                         Some((first, ctx)) => {
                             site.tool = ctx.tool.clone();
+                            site.load = ctx.load;
                             site.work_object = ctx.wobj.clone();
+                            site.stationary_tool = ctx.stationary;
                             site.skip = site.skip.or(ctx.skip.clone());
                             if let Some((line, _)) = d.uses.iter().find(|(_, c)| c.tool != ctx.tool || c.wobj != ctx.wobj) {
                                 site.skip = site.skip.or(Some(format!(
@@ -458,7 +521,10 @@ pub fn parse(files: &[ProgramFile]) -> Result<Targets, ParseError> {
         masked,
         toks,
         tools: HashMap::new(),
+        loads: HashMap::new(),
         wobjs: HashMap::new(),
+        stationary_tools: HashSet::new(),
+        held_wobjs: HashSet::new(),
         declared: Vec::new(),
         by_name: HashMap::new(),
         order: Vec::new(),

@@ -8,7 +8,11 @@
 //! the program's (turn flags kept), else the target is left unchanged.
 
 use super::{mark, parse, Flags, FrameSpec, Language, ParseError, ProgramFile, Site};
-use crate::cell::{Cell, CellOptions, CellSolution, CellSolver, WorkObject, WorkObjectFrame};
+use crate::cell::export::{controller_text, ControllerFrame, ControllerTool};
+use crate::cell::{
+    Cell, CellOptions, CellSolution, CellSolver, Load, LoadDescription, Tool, WorkObject,
+    WorkObjectFrame,
+};
 use crate::compensate::CompensatedModel;
 use crate::ik::IkSettings;
 use crate::ik::{Configuration, FailureReason};
@@ -45,6 +49,32 @@ pub struct TargetReport {
     /// Distance the position moved [mm].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub shift_mm: Option<f64>,
+    /// The load the solve carried (flange frame) and where it came from.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub load: Option<UsedLoad>,
+    /// What the user should check (a declared load that differs from the cell's).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
+}
+
+/// Where the load of a solve comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LoadSource {
+    /// Declared by the program (RAPID `tload`, URScript `set_payload`, ...).
+    Program,
+    /// The cell's tool.
+    Cell,
+    /// The model's payload, kept at its flange point.
+    Model,
+}
+
+/// The load a target was solved with.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct UsedLoad {
+    pub source: LoadSource,
+    #[serde(flatten)]
+    pub load: LoadDescription,
 }
 
 /// The per-target report of a filtered program.
@@ -55,6 +85,10 @@ pub struct FilterReport {
     pub failed: usize,
     pub skipped: usize,
     pub targets: Vec<TargetReport>,
+    /// What the controller must hold for the filtered program, in its
+    /// language (`cell::export`): the tools, loads and work objects the
+    /// filter used, work objects in the controller's base frame.
+    pub controller_data: String,
 }
 
 /// The filtered files (same names and order) and the report.
@@ -74,10 +108,12 @@ pub fn filter(
     settings: &IkSettings,
 ) -> Result<FilterOutput, ParseError> {
     let program = parse(language, files)?;
-    let mut solvers: Vec<(Pose, CellSolver)> = Vec::new();
+    let mut solvers: Vec<(Pose, Option<Load>, CellSolver)> = Vec::new();
     let mut edits: Vec<Vec<(std::ops::Range<usize>, String)>> = vec![Vec::new(); files.len()];
     let mut targets = Vec::with_capacity(program.sites.len());
     let mut previous: Option<Vec<f64>> = None;
+    let mut used_tools: Vec<ControllerTool> = Vec::new();
+    let mut used_frames: Vec<ControllerFrame> = Vec::new();
     for site in &program.sites {
         let mut report = TargetReport {
             file: files[site.file].name.clone(),
@@ -87,6 +123,8 @@ pub fn filter(
             reason: None,
             configuration: None,
             shift_mm: None,
+            load: None,
+            warnings: Vec::new(),
         };
         if let Some(why) = &site.skip {
             report.status = TargetStatus::Skipped;
@@ -107,6 +145,14 @@ pub fn filter(
             previous.as_deref(),
         ) {
             Ok(done) => {
+                if let Some(t) = done.tool.filter(|t| !used_tools.contains(t)) {
+                    used_tools.push(t);
+                }
+                if let Some(f) = done.frame.filter(|f| !used_frames.contains(f)) {
+                    used_frames.push(f);
+                }
+                report.load = Some(done.load);
+                report.warnings = done.warnings;
                 report.configuration = done.configuration;
                 report.shift_mm = Some(done.shift_m * 1e3);
                 edits[site.file].extend(values(site, &done.false_target));
@@ -137,6 +183,11 @@ pub fn filter(
             failed: count(TargetStatus::Failed),
             skipped: count(TargetStatus::Skipped),
             targets,
+            controller_data: if used_tools.is_empty() {
+                String::new()
+            } else {
+                controller_text(language, &used_tools, &used_frames)
+            },
         },
     })
 }
@@ -146,14 +197,60 @@ struct Solved {
     false_target: Pose,
     configuration: Option<String>,
     shift_m: f64,
+    load: UsedLoad,
+    warnings: Vec<String>,
+    /// The tool and work object as the controller holds them (`None` for a
+    /// stationary tool, which `cell::export` does not write).
+    tool: Option<ControllerTool>,
+    frame: Option<ControllerFrame>,
 }
 
-fn resolve_tool(spec: &FrameSpec, cell: &Cell) -> Result<Pose, String> {
+/// The site's tool (the cell's, or one the program defines, without a load).
+fn resolve_tool(spec: &FrameSpec, cell: &Cell) -> Result<Tool, String> {
     match spec {
-        FrameSpec::Ref(r) => cell.tool(r).map(|t| t.tcp).map_err(|e| e.to_string()),
-        FrameSpec::Inline(p) => Ok(*p),
+        FrameSpec::Ref(r) => cell.tool(r).map_err(|e| e.to_string()),
+        FrameSpec::Inline(p) => Ok(Tool {
+            name: "inline".into(),
+            number: None,
+            tcp: *p,
+            load: None,
+        }),
         FrameSpec::Unset => Err("the program selects no tool".into()),
     }
+}
+
+/// The load of a site's solve: the program's declaration, else the cell
+/// tool's, else the model's payload at its flange point (`None`); a warning
+/// naming both when the program's and the cell's differ.
+fn choose_load(
+    declared: Option<Load>,
+    cell: Option<Load>,
+    model: &CompensatedModel,
+) -> (Option<Load>, UsedLoad, Vec<String>) {
+    let mut warnings = Vec::new();
+    if let (Some(d), Some(c)) = (declared, cell) {
+        if d.differs(&c) {
+            warnings.push(format!(
+                "the program declares a load of {}, the cell's tool carries {}: solved with the program's",
+                d.describe(),
+                c.describe()
+            ));
+        }
+    }
+    let (load, source) = match (declared, cell) {
+        (Some(d), _) => (Some(d), LoadSource::Program),
+        (None, Some(c)) => (Some(c), LoadSource::Cell),
+        (None, None) => (None, LoadSource::Model),
+    };
+    let used = load.unwrap_or_else(|| Load {
+        mass_kg: model.payload_kg,
+        ..Load::of_model(&model.calibrated)
+    });
+    let used = UsedLoad {
+        source,
+        load: LoadDescription::of(&used),
+    };
+    (load, used, warnings)
 }
 
 fn resolve_work_object(spec: &FrameSpec, cell: &Cell) -> Result<WorkObject, String> {
@@ -201,25 +298,106 @@ fn solve_site(
     cell: &Cell,
     model: &CompensatedModel,
     settings: &IkSettings,
-    solvers: &mut Vec<(Pose, CellSolver)>,
+    solvers: &mut Vec<(Pose, Option<Load>, CellSolver)>,
     previous: Option<&[f64]>,
 ) -> Result<Solved, String> {
     let pose = site.pose.ok_or("the target is not a complete pose")?;
-    let tcp = resolve_tool(&site.tool, cell)?;
+    if site.stationary_tool {
+        return solve_stationary(site, &pose, model, settings, previous);
+    }
+    let tool = resolve_tool(&site.tool, cell)?;
+    let tcp = tool.tcp;
+    let (load, used_load, warnings) = choose_load(site.load, tool.load, model);
     let wobj = resolve_work_object(&site.work_object, cell)?;
-    let index = match solvers.iter().position(|(p, _)| *p == tcp) {
+    let used_tool = ControllerTool {
+        name: tool.name,
+        number: tool.number.unwrap_or(0),
+        tcp,
+        load: Load {
+            mass_kg: used_load.load.mass_kg,
+            com: load.map_or_else(|| Load::of_model(&model.calibrated).com, |l| l.com),
+            inertia_kgm2: load.and_then(|l| l.inertia_kgm2),
+        },
+    };
+    let used_frame = ControllerFrame {
+        name: wobj.name.clone(),
+        number: wobj.number.unwrap_or(0),
+        pose: wobj.in_base(model),
+    };
+    let index = match solvers.iter().position(|(p, l, _)| *p == tcp && *l == load) {
         Some(i) => i,
         None => {
-            solvers.push((tcp, CellSolver::new(model, &tcp, settings.clone())));
+            let solver = CellSolver::with_load(model, &tcp, load.as_ref(), settings.clone());
+            solvers.push((tcp, load, solver));
             solvers.len() - 1
         }
     };
-    let solver = &solvers[index].1;
-    let q_nominal = controller_joints(solver, site, &wobj, &pose, previous);
+    let solver = &solvers[index].2;
+    let (q, false_target, configuration) = solve_on(solver, site, &wobj, &pose, previous)?;
+    Ok(Solved {
+        shift_m: (false_target.p - pose.p).norm(),
+        configuration: configuration.map(|c| c.to_string()),
+        false_target,
+        q,
+        load: used_load,
+        warnings,
+        tool: Some(used_tool),
+        frame: Some(used_frame),
+    })
+}
+
+/// A target with the roles swapped: the robot carries the work object `W_f`
+/// (flange → work object) past a stationary tool `S` (base frame). The
+/// physical condition `FK_cal(q)·W_f·T = S` is an ordinary solve of the goal
+/// `S` with the effective tool `W_f·T` (flange → the point of the work object
+/// that must meet the tool); the controller, with its nominal model, must be
+/// given `T_false = (FK_nom(q)·W_f)⁻¹·S = T·(FK_nom(q)·W_f·T)⁻¹·S`. The load
+/// is the program's (the carried work piece), else the model's payload at its
+/// flange point.
+fn solve_stationary(
+    site: &Site,
+    pose: &Pose,
+    model: &CompensatedModel,
+    settings: &IkSettings,
+    previous: Option<&[f64]>,
+) -> Result<Solved, String> {
+    let FrameSpec::Inline(fixed) = site.tool else {
+        return Err("a stationary tool must be declared in the program".into());
+    };
+    let FrameSpec::Inline(held) = site.work_object else {
+        return Err("a work object the robot holds must be declared in the program".into());
+    };
+    let (load, used_load, warnings) = choose_load(site.load, None, model);
+    let effective = held.compose(pose);
+    let solver = CellSolver::with_load(model, &effective, load.as_ref(), settings.clone());
+    let (q, f, configuration) = solve_on(&solver, site, &WorkObject::base(), &fixed, previous)?;
+    let false_target = pose.compose(&f.inverse()).compose(&fixed);
+    Ok(Solved {
+        shift_m: (false_target.p - pose.p).norm(),
+        configuration: configuration.map(|c| c.to_string()),
+        false_target,
+        q,
+        load: used_load,
+        warnings,
+        tool: None,
+        frame: None,
+    })
+}
+
+/// The calibrated joints, false target and configuration of `pose` in
+/// `wobj` on the branch and from the seed the site's flags give.
+fn solve_on(
+    solver: &CellSolver,
+    site: &Site,
+    wobj: &WorkObject,
+    pose: &Pose,
+    previous: Option<&[f64]>,
+) -> Result<(Vec<f64>, Pose, Option<Configuration>), String> {
+    let q_nominal = controller_joints(solver, site, wobj, pose, previous);
     let solved = match q_nominal {
         Some(q) => solver.solve(
-            &wobj,
-            &pose,
+            wobj,
+            pose,
             &CellOptions {
                 branch: solver.configuration(&q),
                 seed: Some(q),
@@ -228,14 +406,14 @@ fn solve_site(
         // The nominal model has no solution on the flags (out of its reach or
         // limits): the branch whose calibrated solution carries them.
         None if site.flags == Flags::Nearest => solver.solve(
-            &wobj,
-            &pose,
+            wobj,
+            pose,
             &CellOptions {
                 branch: None,
                 seed: previous.map(<[f64]>::to_vec),
             },
         ),
-        None => solve_on_flags(solver, site, &wobj, &pose, previous)?,
+        None => solve_on_flags(solver, site, wobj, pose, previous)?,
     };
     let Some(false_target) = solved.false_target else {
         let reason = solved
@@ -253,12 +431,7 @@ fn solve_site(
     {
         return Err(format!("the calibrated solution changes the flags: {m}"));
     }
-    Ok(Solved {
-        shift_m: (false_target.p - pose.p).norm(),
-        configuration: configuration.map(|c| c.to_string()),
-        false_target,
-        q,
-    })
+    Ok((q, false_target, configuration))
 }
 
 /// The first branch whose calibrated solution carries the site's flags.

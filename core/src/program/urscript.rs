@@ -7,7 +7,10 @@
 //! object `frame` (a variable assigned a literal, else looked up in the cell
 //! by name). Other pose literals are not targets; joint targets
 //! (`movej([…])`) are not either, but the controller starts the next target
-//! from them. The tool is the last `set_tcp(p[…])` before the motion. A
+//! from them. The tool is the last `set_tcp(p[…])` before the motion, its
+//! declared load the last `set_payload(m, [cx, cy, cz])` (or
+//! `set_target_payload`; kg, centre of gravity in metres in the flange
+//! frame). A
 //! variable takes the tool and frame of the motions that use it (all the
 //! same, else it is skipped). Comments: `#` to the end of the line.
 //!
@@ -17,7 +20,7 @@
 
 use super::lex::{blank_comments, error, line_end, list, position, tokens, Fail, Tok, Token};
 use super::{Flags, FrameSpec, JointTarget, ParseError, ProgramFile, Site, Targets};
-use crate::cell::CellRef;
+use crate::cell::{CellRef, Load};
 use crate::model::orientation::{rotation_from, OrientationConvention};
 use crate::model::Pose;
 use nalgebra::Vector3;
@@ -74,6 +77,7 @@ fn argument_end(toks: &[Token], mut i: usize) -> usize {
 struct Context {
     tool: FrameSpec,
     frame: FrameSpec,
+    load: Option<Load>,
 }
 
 struct Declared {
@@ -86,12 +90,34 @@ struct Parser<'a> {
     text: &'a str,
     toks: Vec<Token>,
     tool: FrameSpec,
+    /// The last `set_payload`/`set_target_payload` (flange frame).
+    load: Option<Load>,
     /// Pose variables: name → literal pose (frames) and declared site index.
     vars: HashMap<String, (Option<Pose>, usize)>,
     declared: Vec<Declared>,
     order: Vec<Result<Site, usize>>,
     joints: Option<Vec<f64>>,
     joint_targets: Vec<JointTarget>,
+}
+
+/// The arguments of `set_payload(m, [cx, cy, cz])` at token `i` (kg, m in
+/// the flange frame); `None` when the call is not literal numbers.
+fn payload(toks: &[Token], i: usize) -> Result<Option<Load>, Fail> {
+    let mass = match toks.get(i) {
+        Some((Tok::Number(m), _)) => *m,
+        _ => return Ok(None),
+    };
+    if !punct(toks.get(i + 1), ',') || !punct(toks.get(i + 2), '[') {
+        return Ok(None);
+    }
+    let (v, _) = list(toks, i + 2)?;
+    Ok(v.numbers(3).and_then(|(c, _)| {
+        (mass > 0.0 && mass.is_finite()).then(|| Load {
+            mass_kg: mass,
+            com: Vector3::new(c[0], c[1], c[2]),
+            inertia_kgm2: None,
+        })
+    }))
 }
 
 impl Parser<'_> {
@@ -115,6 +141,7 @@ impl Parser<'_> {
             pose,
             flags: Flags::Nearest,
             tool: ctx.tool.clone(),
+            load: ctx.load,
             work_object: ctx.frame.clone(),
             slots,
             convention: OrientationConvention::UrRotvec,
@@ -123,6 +150,7 @@ impl Parser<'_> {
             mark_at: end..end,
             after_joints: None,
             skip,
+            stationary_tool: false,
         }
     }
 
@@ -147,6 +175,7 @@ impl Parser<'_> {
         let ctx = Context {
             tool: self.tool.clone(),
             frame,
+            load: self.load,
         };
         if let Some((pose, slots, _)) = literal(&self.toks, i)? {
             let site = self.site("inline".into(), pose, slots, &ctx);
@@ -204,6 +233,9 @@ impl Parser<'_> {
                         _ => FrameSpec::Unset,
                     };
                 }
+                Some("set_payload" | "set_target_payload") if punct(self.toks.get(i + 1), '(') => {
+                    self.load = payload(&self.toks, i + 2)?;
+                }
                 Some(m) if MOTIONS.contains(&m) && punct(self.toks.get(i + 1), '(') => {
                     self.target(i + 2, FrameSpec::Unset)?;
                     if m == "movec" {
@@ -220,6 +252,7 @@ impl Parser<'_> {
                         let unset = Context {
                             tool: FrameSpec::Unset,
                             frame: FrameSpec::Unset,
+                            load: None,
                         };
                         let frame = pose.as_ref().ok().copied();
                         let site = self.site(name.to_string(), pose, slots, &unset);
@@ -250,6 +283,7 @@ impl Parser<'_> {
                     let mut site = d.site.clone();
                     if let Some((first, ctx)) = d.uses.first() {
                         site.tool = ctx.tool.clone();
+                        site.load = ctx.load;
                         site.work_object = ctx.frame.clone();
                         if let Some((line, _)) = d.uses.iter().find(|(_, c)| c != ctx) {
                             site.skip = site.skip.or(Some(format!(
@@ -279,6 +313,7 @@ pub fn parse(files: &[ProgramFile]) -> Result<Targets, ParseError> {
             text: &f.text,
             toks: tokens(&masked, &['"', '\'']).map_err(fail)?,
             tool: FrameSpec::Unset,
+            load: None,
             vars: HashMap::new(),
             declared: Vec::new(),
             order: Vec::new(),

@@ -56,7 +56,9 @@ fn program(f: &Fixture) -> Vec<ProgramFile> {
 fn filtered_fanuc_brings_the_true_tcp_to_the_targets() {
     let f = fixture();
     let files = program(f);
-    assert_filter_reaches_targets(f, Language::Fanuc, "Fanuc", &files, &f.cell);
+    // The cell's torch carries the true load (the payload on the flange).
+    let cell = f.cell_with_load();
+    assert_filter_reaches_targets(f, Language::Fanuc, "Fanuc", &files, &cell);
 }
 
 #[test]

@@ -64,6 +64,57 @@ fn filtered_krl_brings_the_true_tcp_to_the_targets() {
     assert_filter_reaches_targets(f, Language::Krl, "KRL", &files, &f.cell);
 }
 
+/// The same program declaring its load: `LOAD_DATA[1]` in a `$config.dat`,
+/// taken by `BAS(#TOOL, 1)`.
+fn with_load_data(f: &Fixture, mass_kg: f64, z_mm: f64) -> Vec<ProgramFile> {
+    let mut files = program(f);
+    files[0].text = files[0]
+        .text
+        .replace("$TOOL = TOOL_DATA[1] ; torch\r\n", "BAS(#TOOL, 1)\r\n");
+    files.push(ProgramFile {
+        name: "$config.dat".into(),
+        text: format!(
+            "DEFDAT $CONFIG PUBLIC\r\nLOAD_DATA[1]={{M {mass_kg},CM {{X 0.0,Y 0.0,Z {z_mm},A 0.0,B 0.0,C 0.0}},J {{X 0.0,Y 0.0,Z 0.0}}}}\r\nENDDAT\r\n"
+        ),
+    });
+    files
+}
+
+#[test]
+fn a_declared_load_is_used_and_one_differing_from_the_cell_is_warned_about() {
+    let f = fixture();
+    let cell = f.cell_with_load();
+    // As the cell's: no warning, solved with the program's load.
+    let files = with_load_data(f, 110.0, 250.0);
+    let out = filter(Language::Krl, &files, &cell, &f.model, &settings()).unwrap();
+    assert_eq!(out.report.filtered, 50);
+    for t in &out.report.targets {
+        assert!(t.warnings.is_empty(), "{:?}", t.warnings);
+        let load = t.load.as_ref().unwrap();
+        assert_eq!(load.source, robocal_core::program::LoadSource::Program);
+        assert_eq!(
+            (load.load.mass_kg, load.load.com_mm),
+            (110.0, [0.0, 0.0, 250.0])
+        );
+    }
+    // 20 kg less and 50 mm nearer the flange: a warning naming both, per target.
+    let files = with_load_data(f, 90.0, 200.0);
+    let out = filter(Language::Krl, &files, &cell, &f.model, &settings()).unwrap();
+    for t in &out.report.targets {
+        assert_eq!(t.warnings.len(), 1, "{t:?}");
+        let w = &t.warnings[0];
+        assert!(
+            w.contains("90.000 kg at [0.0, 0.0, 200.0] mm")
+                && w.contains("110.000 kg at [0.0, 0.0, 250.0] mm"),
+            "{w}"
+        );
+    }
+    // The cell's load without a declaration: solved with the cell's.
+    let out = filter(Language::Krl, &program(f), &cell, &f.model, &settings()).unwrap();
+    let load = out.report.targets[0].load.as_ref().unwrap();
+    assert_eq!(load.source, robocal_core::program::LoadSource::Cell);
+}
+
 #[test]
 fn krl_without_targets_is_byte_identical_and_failures_are_marked() {
     let f = fixture();

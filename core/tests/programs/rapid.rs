@@ -1,8 +1,9 @@
-//! ABB RAPID: a module with tooldata, wobjdata and 50 robtargets, declared and inline.
+//! ABB RAPID: a module with tooldata, wobjdata and 50 robtargets, declared and inline;
+//! a module of 40 with a stationary tool and a work object the robot holds.
 
 use super::*;
 use robocal_core::model::orientation::{rotation_to, OrientationConvention};
-use robocal_core::program::{abb_cf, filter, TargetStatus};
+use robocal_core::program::{abb_cf, filter, LoadSource, TargetStatus};
 
 fn literal(p: &Pose, cf: [i32; 4]) -> String {
     let q = rotation_to(OrientationConvention::AbbQ1q4, &p.r);
@@ -37,14 +38,19 @@ fn frame(p: &Pose) -> String {
 }
 
 /// A module visiting the fixture's targets: even ones declared and moved to
-/// by `MoveJ`, odd ones inline in `MoveL`, with the tool and work object
-/// declared in the module (the work object in the controller's base frame).
+/// by `MoveJ`, odd ones inline in `MoveL`, with the tool (robot-held,
+/// `robhold TRUE`, its `tload` the true payload on the flange) and the work
+/// object declared in the module (in the controller's base frame).
 fn module(f: &Fixture) -> Vec<ProgramFile> {
     let mut decl = format!(
-        "MODULE Seam\r\n  ! welding seam on the table\r\n  PERS tooldata torch:=[FALSE,{},[2.5,[0,0,120],[1,0,0,0],0,0,0]];\r\n  \
+        "MODULE Seam\r\n  ! welding seam on the table\r\n  PERS tooldata torch:=[TRUE,{},[{:.3},[{:.3},{:.3},{:.3}],[1,0,0,0],0,0,0]];\r\n  \
          TASK PERS wobjdata table:=[FALSE,TRUE,\"\",{},[[0,0,0],[1,0,0,0]]];\r\n  \
          CONST jointtarget home:=[[0,90,-20,0,45,0],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]];\r\n",
         frame(&torch()),
+        f.truth.payload_kg,
+        f.truth.payload_com.x * 1e3,
+        f.truth.payload_com.y * 1e3,
+        f.truth.payload_com.z * 1e3,
         frame(&f.wobj_controller())
     );
     let mut body = String::from("  PROC main()\r\n    MoveAbsJ home, v1000, fine, tool0;\r\n");
@@ -75,6 +81,251 @@ fn filtered_rapid_brings_the_true_tcp_to_the_targets() {
     let files = module(f);
     let empty = Cell::default();
     assert_filter_reaches_targets(f, Language::Rapid, "RAPID", &files, &empty);
+    // Every target was solved with the module's tload.
+    let out = filter(Language::Rapid, &files, &empty, &f.model, &settings()).unwrap();
+    for t in &out.report.targets {
+        let load = t.load.as_ref().unwrap();
+        assert_eq!(load.source, LoadSource::Program);
+        assert_eq!(load.load.mass_kg, f.truth.payload_kg);
+    }
+}
+
+/// The roles swapped: a fixed tool (its tip 300 mm from its mount, tilted
+/// 35°, measured in the tracker frame) and a work piece the robot carries
+/// (gripper frame 200 mm out on the flange, tilted 30°). Joints: 40 around a
+/// middle configuration, away from flag boundaries and singular branches.
+struct Swapped {
+    /// Flange → work object (the wobjdata's uframe, robhold TRUE).
+    held: Pose,
+    /// The fixed tool's TCP in the tracker frame (truth) and in the
+    /// controller's base frame (the tooldata's tframe, robhold FALSE).
+    fixed_cell: Pose,
+    fixed_base: Pose,
+    joints: Vec<Vec<f64>>,
+    /// The nominal controller without a tool.
+    bare: RobotModel,
+}
+
+fn swapped(f: &Fixture) -> Swapped {
+    let mut bare = f.controller.clone();
+    bare.tool = Default::default();
+    let ik = AnalyticIk::new(&bare).unwrap();
+    let r = rpy_matrix(0.0, 30f64.to_radians(), 0.0);
+    let held = Pose::new(r, r * Vector3::new(0.0, 0.05, 0.2));
+    let q0 = f.joints[0].clone();
+    let deg = |q: &[f64]| -> Vec<f64> {
+        bare.joints_to_controller(q)
+            .iter()
+            .map(|v| v.to_degrees())
+            .collect()
+    };
+    // The work piece meets the tool tip 80 mm from its origin at q0.
+    let mut t0 = Pose::from_translation(Vector3::new(0.08, -0.03, 0.0));
+    t0.rot_x(std::f64::consts::PI);
+    let flange = |q: &[f64]| f.true_tcp(q).compose(&f.truth.tool.inverse());
+    let fixed_cell = flange(&q0).compose(&held).compose(&t0);
+    let mut rng = ChaCha8Rng::seed_from_u64(31);
+    let mut joints = Vec::new();
+    while joints.len() < 40 {
+        let q: Vec<f64> = q0
+            .iter()
+            .map(|v| v + rng.gen_range(-15f64..15.0).to_radians())
+            .collect();
+        let d = deg(&q);
+        let off_quadrant = |a: f64| (a / 90.0 - (a / 90.0).round()).abs() * 90.0 > 5.0;
+        let flags_clear = [0, 3, 5].iter().all(|&k| off_quadrant(d[k])) && d[4].abs() > 10.0;
+        let branch = (0..13).all(|k| {
+            let mut p = q.clone();
+            if k > 0 {
+                p[(k - 1) / 2] += if k % 2 == 0 { 0.087 } else { -0.087 };
+            }
+            ik.configuration(&p) == ik.configuration(&q)
+        });
+        if flags_clear && branch && bare.within_limits(&q, 0.087) {
+            joints.push(q);
+        }
+    }
+    // The mount 300 mm behind the tip along the tool's axis, tilted 35°.
+    let tilt = rpy_matrix(35f64.to_radians(), 0.0, 0.0);
+    let tool_on_mount = Pose::new(tilt, tilt * Vector3::new(0.0, 0.0, 0.3));
+    let mount = fixed_cell.compose(&tool_on_mount.inverse());
+    assert!((mount.p - fixed_cell.p).norm() >= 0.25);
+    Swapped {
+        held,
+        fixed_base: f.model.cell_to_base(&fixed_cell),
+        fixed_cell,
+        joints,
+        bare,
+    }
+}
+
+impl Swapped {
+    /// The true flange at commanded `q` (tracker frame).
+    fn flange(&self, f: &Fixture, q: &[f64]) -> Pose {
+        f.true_tcp(q).compose(&f.truth.tool.inverse())
+    }
+
+    /// Target `i`: the fixed tool's tip in the truly carried work object at `joints[i]`.
+    fn target(&self, f: &Fixture, i: usize) -> Pose {
+        self.flange(f, &self.joints[i])
+            .compose(&self.held)
+            .inverse()
+            .compose(&self.fixed_cell)
+    }
+
+    /// The module: the stationary tool and the robot-held work object
+    /// declared, the tool's tload the true payload on the flange (RAPID: for
+    /// a stationary tool, the load of the gripper holding the work object).
+    fn module(&self, f: &Fixture) -> ProgramFile {
+        let ik = AnalyticIk::new(&self.bare).unwrap();
+        let mut decl = format!(
+            "MODULE Glue\r\n  PERS tooldata nozzle:=[FALSE,{},[{:.3},[{:.3},{:.3},{:.3}],[1,0,0,0],0,0,0]];\r\n  \
+             PERS wobjdata part:=[TRUE,TRUE,\"\",{},[[0,0,0],[1,0,0,0]]];\r\n",
+            frame(&self.fixed_base),
+            f.truth.payload_kg,
+            f.truth.payload_com.x * 1e3,
+            f.truth.payload_com.y * 1e3,
+            f.truth.payload_com.z * 1e3,
+            frame(&self.held)
+        );
+        let mut body = String::from("  PROC main()\r\n");
+        for (i, q) in self.joints.iter().enumerate() {
+            let deg: Vec<f64> = self
+                .bare
+                .joints_to_controller(q)
+                .iter()
+                .map(|v| v.to_degrees())
+                .collect();
+            let lit = literal(
+                &self.target(f, i),
+                abb_cf(&deg, ik.configuration(q).unwrap()),
+            );
+            if i % 2 == 0 {
+                decl.push_str(&format!("  CONST robtarget g{i}:={lit};\r\n"));
+                body.push_str(&format!(
+                    "    MoveJ g{i}, v500, z10, nozzle\\WObj:=part;\r\n"
+                ));
+            } else {
+                body.push_str(&format!(
+                    "    MoveL {lit}, v100, fine, nozzle\\WObj:=part;\r\n"
+                ));
+            }
+        }
+        body.push_str("  ENDPROC\r\nENDMODULE\r\n");
+        ProgramFile {
+            name: "Glue.mod".into(),
+            text: decl + &body,
+        }
+    }
+
+    /// Runs the module through the nominal controller (flange goal
+    /// `S·(W_f·T)⁻¹` on the target's flags, nearest the previous joints) and
+    /// returns the distance [mm] of the true tool tip in the truly carried
+    /// work object from each target (`None`: no solution on the flags).
+    fn run(&self, f: &Fixture, file: &ProgramFile) -> Vec<Option<f64>> {
+        let ik = AnalyticIk::new(&self.bare).unwrap();
+        let program = parse(Language::Rapid, std::slice::from_ref(file)).unwrap();
+        assert_eq!(program.sites.len(), self.joints.len());
+        let mut previous: Option<Vec<f64>> = None;
+        let mut errors = Vec::new();
+        for (i, site) in program.sites.iter().enumerate() {
+            let goal = self
+                .fixed_base
+                .compose(&self.held.compose(&site.pose.unwrap()).inverse());
+            let q = ik
+                .solve(&goal, previous.as_deref())
+                .into_iter()
+                .filter(|s| s.within_limits)
+                .map(|s| s.q.to_vec())
+                .filter(|q| {
+                    let deg: Vec<f64> = self
+                        .bare
+                        .joints_to_controller(q)
+                        .iter()
+                        .map(|v| v.to_degrees())
+                        .collect();
+                    site.flags.admits(&deg, ik.configuration(q))
+                })
+                .min_by(|a, b| {
+                    let d = |x: &[f64]| match &previous {
+                        Some(p) => x.iter().zip(p).map(|(u, v)| (u - v).abs()).sum::<f64>(),
+                        None => 0.0,
+                    };
+                    d(a).total_cmp(&d(b))
+                });
+            let Some(q) = q else {
+                errors.push(None);
+                continue;
+            };
+            let tip = self
+                .flange(f, &q)
+                .compose(&self.held)
+                .inverse()
+                .compose(&self.fixed_cell);
+            errors.push(Some((tip.p - self.target(f, i).p).norm() * 1e3));
+            previous = Some(q);
+        }
+        errors
+    }
+}
+
+#[test]
+fn a_stationary_tool_with_a_robot_held_work_object_is_filtered() {
+    let f = fixture();
+    let s = swapped(f);
+    let file = s.module(f);
+    let out = filter(
+        Language::Rapid,
+        std::slice::from_ref(&file),
+        &Cell::default(),
+        &f.model,
+        &settings(),
+    )
+    .unwrap();
+    let r = &out.report;
+    assert_eq!(
+        (r.filtered, r.failed, r.skipped),
+        (40, 0, 0),
+        "{:?}",
+        r.targets
+    );
+    assert!(r
+        .targets
+        .iter()
+        .all(|t| t.load.as_ref().unwrap().source == LoadSource::Program));
+    let filtered = s.run(f, &out.files[0]);
+    assert!(filtered.iter().all(Option::is_some), "{filtered:?}");
+    let max_f = filtered.iter().flatten().copied().fold(0.0, f64::max);
+    let (mean_f, _) = mean(&filtered);
+    let (mean_u, reached_u) = mean(&s.run(f, &file));
+    println!(
+        "RAPID stationary tool, robot-held work object: true tool tip vs target filtered \
+         mean {mean_f:.4} mm, max {max_f:.4} mm (40); unfiltered mean {mean_u:.3} mm ({reached_u})"
+    );
+    assert!(mean_f <= 0.05 && max_f <= 0.15, "{mean_f} {max_f}");
+    assert!(mean_u > 1.0, "{mean_u}");
+    // A stationary tool with a fixed work object, and a robot-held tool with
+    // a robot-held work object, are reported, not filtered.
+    for (from, to) in [
+        ("wobjdata part:=[TRUE,", "wobjdata part:=[FALSE,"),
+        ("tooldata nozzle:=[FALSE,", "tooldata nozzle:=[TRUE,"),
+    ] {
+        let bad = ProgramFile {
+            name: "Bad.mod".into(),
+            text: file.text.replacen(from, to, 1),
+        };
+        let out = filter(
+            Language::Rapid,
+            &[bad],
+            &Cell::default(),
+            &f.model,
+            &settings(),
+        )
+        .unwrap();
+        assert_eq!((out.report.filtered, out.report.skipped), (0, 40));
+        let why = out.report.targets[0].reason.as_deref().unwrap();
+        assert!(why.contains("robhold"), "{why}");
+    }
 }
 
 #[test]

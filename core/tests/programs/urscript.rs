@@ -16,9 +16,13 @@ fn pose_literal(p: &Pose) -> String {
 /// in the controller's base frame): even ones through variables, odd ones inline.
 fn script(f: &Fixture) -> Vec<ProgramFile> {
     let mut s = format!(
-        "def seam():\n  # welding seam on the table\n  set_tcp({})\n  global table = {}\n  \
+        "def seam():\n  # welding seam on the table\n  set_tcp({})\n  set_payload({}, [{}, {}, {}])\n  global table = {}\n  \
          movej([{}], a=1.4, v=1.05)  # home\n",
         pose_literal(&torch()),
+        f.truth.payload_kg,
+        f.truth.payload_com.x,
+        f.truth.payload_com.y,
+        f.truth.payload_com.z,
         pose_literal(&f.wobj_controller()),
         UR_HOME.map(|v| v.to_string()).join(", ")
     );

@@ -1,6 +1,6 @@
 MODULE Seam
   ! Fillet weld along the table edge. Tool and work object as in the cell.
-  PERS tooldata torch:=[FALSE,[[125,0,216.50635],[0.965925826,0,0.258819045,0]],[2.5,[0,0,120],[1,0,0,0],0,0,0]];
+  PERS tooldata torch:=[TRUE,[[125,0,216.50635],[0.965925826,0,0.258819045,0]],[2.5,[0,0,120],[1,0,0,0],0,0,0]];
   TASK PERS wobjdata table:=[FALSE,TRUE,"",[[1300,-600,300],[0.984807753,0,0,0.173648178]],[[0,0,0],[1,0,0,0]]];
   CONST jointtarget home:=[[0,90,-20,0,45,0],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]];
   CONST robtarget p10:=[[0,0,0],[0,1,0,0],[-1,1,1,0],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]];

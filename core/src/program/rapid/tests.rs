@@ -8,8 +8,8 @@ fn file(text: &str) -> ProgramFile {
 }
 
 const MODULE: &str = "MODULE weld\n\
-  PERS tooldata torch:=[TRUE,[[0,0,250],[1,0,0,0]],[2,[0,0,100],[1,0,0,0],0,0,0]];\n\
-  PERS tooldata gun:=[FALSE,[[10,0,250],[0.9659258,0,0.2588190,0]],[2,[0,0,100],[1,0,0,0],0,0,0]];\n\
+  PERS tooldata torch:=[FALSE,[[0,0,250],[1,0,0,0]],[2,[0,0,100],[1,0,0,0],0,0,0]];\n\
+  PERS tooldata gun:=[TRUE,[[10,0,250],[0.9659258,0,0.2588190,0]],[2,[0,0,100],[1,0,0,0],0,0,0]];\n\
   TASK PERS wobjdata table:=[FALSE,TRUE,\"\",[[1500,200,300],[1,0,0,0]],[[0,0,0],[1,0,0,0]]];\n\
   CONST robtarget p10:=[[100,-20.5,300],[0.7071068,0,0.7071068,0],[0,-1,2,1],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]]; ! start\n\
   CONST robtarget path{2}:=[[[1,2,3],[1,0,0,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]],\n\
@@ -42,6 +42,10 @@ fn robtargets_tools_and_work_objects() {
         panic!("{:?}", p10.tool)
     };
     assert!((gun.p - Vector3::new(0.01, 0.0, 0.25)).norm() < 1e-12);
+    // The gun's tload: 2 kg, centre of gravity 100 mm along the flange's z.
+    let load = p10.load.expect("declared load");
+    assert_eq!(load.mass_kg, 2.0);
+    assert!((load.com - Vector3::new(0.0, 0.0, 0.1)).norm() < 1e-15);
     let FrameSpec::Inline(table) = &p10.work_object else {
         panic!()
     };
@@ -49,9 +53,35 @@ fn robtargets_tools_and_work_objects() {
     assert!(p10.skip.is_none());
     // The inline target: work object wobj0 (base).
     assert_eq!(sites[1].work_object, FrameSpec::Ref(CellRef::Number(0)));
-    // A stationary tool is not filtered.
-    assert!(sites[2].skip.as_ref().unwrap().contains("stationary"));
+    // A robot-held tool (robhold TRUE) is filtered; a stationary one
+    // (robhold FALSE) with a work object the robot does not hold is not.
+    assert!(sites[0].skip.is_none() && sites[1].skip.is_none());
+    assert!(sites[2]
+        .skip
+        .as_ref()
+        .unwrap()
+        .contains("stationary (robhold FALSE)"));
     assert_eq!(sites[3].line, 7);
+}
+
+#[test]
+fn a_stationary_tool_swaps_the_roles_with_a_held_work_object() {
+    let text = MODULE.replace(
+        "wobjdata table:=[FALSE,TRUE,",
+        "wobjdata table:=[TRUE,TRUE,",
+    );
+    let sites = parse(&[file(&text)]).unwrap().sites;
+    // torch (robhold FALSE) with table (robhold TRUE): the roles swapped.
+    assert!(sites[2].skip.is_none() && sites[2].stationary_tool);
+    let FrameSpec::Inline(torch) = &sites[2].tool else {
+        panic!("{:?}", sites[2].tool)
+    };
+    assert!((torch.p - Vector3::new(0.0, 0.0, 0.25)).norm() < 1e-12);
+    // gun (robhold TRUE) with table (robhold TRUE): both held, not filtered.
+    assert!(!sites[0].stationary_tool);
+    assert!(sites[0].skip.as_ref().unwrap().contains("holds both"));
+    // gun without a work object: the ordinary case.
+    assert!(sites[1].skip.is_none() && !sites[1].stationary_tool);
 }
 
 #[test]

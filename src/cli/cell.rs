@@ -1,0 +1,67 @@
+//! `robocal cell export`: what the controller must hold for a cell — tool,
+//! load and work object data in the controller's language
+//! (`core::cell::export`): a work object measured in the tracker frame comes
+//! out in the robot base frame of the calibrated model given.
+
+use super::model_files::load_compensated;
+use crate::cell::export::{controller_data, controller_text};
+use crate::cell::CellDescription;
+use crate::program::Language;
+use anyhow::{bail, Context};
+use clap::{Args, Subcommand};
+
+#[derive(Debug, Args)]
+pub struct CellArgs {
+    #[command(subcommand)]
+    pub command: CellCommand,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum CellCommand {
+    /// Print the cell's tool, load and work object data for a controller.
+    Export(CellExportArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct CellExportArgs {
+    /// Calibrated model file (`robocal calibrate --save`), a model JSON file or a preset.
+    #[arg(long)]
+    pub model: String,
+    /// Cell file: tools (with their loads) and work objects (JSON, mm and degrees).
+    #[arg(long)]
+    pub cell: String,
+    /// Controller language: krl, rapid, fanuc or urscript.
+    #[arg(long)]
+    pub language: String,
+    /// Payload mass [kg] of tools without a load (default: the model file's payload).
+    #[arg(long)]
+    pub payload_kg: Option<f64>,
+}
+
+/// The exported text.
+pub fn export_to_string(a: &CellExportArgs) -> anyhow::Result<String> {
+    let language: Language = a.language.parse()?;
+    let mut model = load_compensated(&a.model).map_err(|e| anyhow::anyhow!("{e}"))?;
+    if let Some(p) = a.payload_kg {
+        if !(p.is_finite() && p >= 0.0) {
+            bail!("--payload-kg must be a non-negative number, got {p}");
+        }
+        model.payload_kg = p;
+    }
+    let text = std::fs::read_to_string(&a.cell)
+        .with_context(|| format!("cannot read cell file {}", a.cell))?;
+    let cell = CellDescription::from_json(&text)
+        .and_then(|d| d.to_cell())
+        .with_context(|| a.cell.clone())?;
+    let (tools, frames) = controller_data(&cell, &model);
+    Ok(controller_text(language, &tools, &frames))
+}
+
+pub fn run(a: CellArgs) -> anyhow::Result<()> {
+    match a.command {
+        CellCommand::Export(e) => {
+            print!("{}", export_to_string(&e)?);
+            Ok(())
+        }
+    }
+}
