@@ -37,18 +37,16 @@ pub fn load_compensated(arg: &str) -> Result<CompensatedModel, CompensateError> 
 /// joint maps and compensator are not part of a model-based fit; the note
 /// says so).
 pub fn load_start_model(arg: &str) -> anyhow::Result<(crate::model::RobotModel, Option<String>)> {
-    match super::load_model(arg) {
-        Ok(m) => Ok((m, None)),
-        Err(plain) => {
-            let Ok(cm) = load_compensated(arg) else {
-                return Err(plain);
-            };
-            let note = format!(
-                "{arg}: starting from its calibrated model (joint maps and compensator, if any, are not refitted)"
-            );
-            Ok((cm.calibrated, Some(note)))
-        }
-    }
+    let model = super::load_model(arg)?;
+    let calibrated_file = std::fs::read_to_string(arg)
+        .ok()
+        .is_some_and(|text| CalibratedModelFile::from_json(&text).is_ok());
+    let note = calibrated_file.then(|| {
+        format!(
+            "{arg}: starting from its calibrated model (joint maps and compensator, if any, are not refitted)"
+        )
+    });
+    Ok((model, note))
 }
 
 /// Writes a calibrated model file as pretty JSON.
