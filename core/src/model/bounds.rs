@@ -55,11 +55,12 @@ pub const MASS_OFFSET_KG: Bound = Bound {
     max: 10_000.0,
     unit: "kg",
 };
-/// Joint compliance [rad/(N·m)]: 1e-3 turns 100 N·m into 0.1 rad (5.7°),
-/// a hundred times softer than any arm's joint.
+/// Joint compliance [rad/(N·m)]: 0.1 turns 1 N·m into 0.1 rad (5.7°). Far
+/// softer than any industrial joint (1e-8–1e-4), yet above what SKCM fits
+/// on light cable-driven arms (the real WAM's joints: up to about 2.3e-3).
 pub const COMPLIANCE_RAD_PER_NM: Bound = Bound {
     min: 0.0,
-    max: 1e-3,
+    max: 0.1,
     unit: "rad/(N·m)",
 };
 /// Each gravity component [m/s²] (larger ones are not m/s²).
