@@ -55,12 +55,14 @@ pub const MASS_OFFSET_KG: Bound = Bound {
     max: 10_000.0,
     unit: "kg",
 };
-/// Joint compliance [rad/(N·m)]: 0.1 turns 1 N·m into 0.1 rad (5.7°). Far
-/// softer than any industrial joint (1e-8–1e-4), yet above what SKCM fits
-/// on light cable-driven arms (the real WAM's joints: up to about 2.3e-3).
+/// Joint compliance [rad/(N·m)]: 10 turns 0.1 N·m into 1 rad. Far softer
+/// than any industrial joint (1e-8–1e-4), yet above what SKCM fits where a
+/// joint carries almost no torque (the real WAM's wrist with skcm-payload:
+/// about 0.38), so no fitted model is refused when it is loaded back. With
+/// the other bounds the deflection stays finite (at most about 1e9 rad).
 pub const COMPLIANCE_RAD_PER_NM: Bound = Bound {
     min: 0.0,
-    max: 0.1,
+    max: 10.0,
     unit: "rad/(N·m)",
 };
 /// Each gravity component [m/s²] (larger ones are not m/s²).
