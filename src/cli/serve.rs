@@ -39,7 +39,12 @@ pub struct ServeArgs {
     /// With API keys configured, let GET requests through without a key (the
     /// console's pages, reports and downloads on a trusted network); writes
     /// still need a key of their role. `ROBOCAL_OPEN_READS=1` sets it too.
-    #[arg(long, env = "ROBOCAL_OPEN_READS")]
+    #[arg(
+        long,
+        env = "ROBOCAL_OPEN_READS",
+        action = clap::ArgAction::SetTrue,
+        value_parser = clap::builder::BoolishValueParser::new()
+    )]
     pub open_reads: bool,
     /// Listen address (loopback by default).
     #[arg(long, env = "ROBOCAL_BIND", default_value = "127.0.0.1:8080")]

@@ -349,3 +349,49 @@ fn serve_help_documents_the_roles_and_open_reads() {
         assert!(help.contains(&line), "{line} in:\n{help}");
     }
 }
+
+/// `ROBOCAL_OPEN_READS=1` (as the browser check sets it) turns open reads on;
+/// the start-up log says so and counts the keys by role.
+#[test]
+fn open_reads_from_the_environment() {
+    use std::io::BufRead;
+    let dir = tempfile::tempdir().unwrap();
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_robocal"))
+        .args(["serve", "--bind", "127.0.0.1:0", "--database-url"])
+        .arg(format!(
+            "sqlite://{}?mode=rwc",
+            dir.path().join("o.db").display()
+        ))
+        .env("ROBOCAL_API_KEYS", "k1,k2:read")
+        .env("ROBOCAL_OPEN_READS", "1")
+        .env("RUST_LOG", "info")
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let stderr = child.stderr.take().unwrap();
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        for line in std::io::BufReader::new(stderr)
+            .lines()
+            .map_while(Result::ok)
+        {
+            let _ = tx.send(line);
+        }
+    });
+    let mut seen = Vec::new();
+    let listening = loop {
+        match rx.recv_timeout(Duration::from_secs(60)) {
+            Ok(line) if line.contains("listening on") => break Some(line),
+            Ok(line) => seen.push(line),
+            Err(_) => break None,
+        }
+    };
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let line = listening.unwrap_or_else(|| panic!("no start: {seen:?}"));
+    assert!(
+        line.contains("API keys on: 1 read, 1 admin; GETs open"),
+        "{line}"
+    );
+}
