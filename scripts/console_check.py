@@ -92,7 +92,7 @@ def main():
     port = free_port()
     base = f"http://127.0.0.1:{port}"
     env = dict(os.environ, DATABASE_URL=f"sqlite://{work}/console.db?mode=rwc",
-               ROBOCAL_API_KEYS=KEY, RUST_LOG="warn")
+               ROBOCAL_API_KEYS=KEY, ROBOCAL_OPEN_READS="1", RUST_LOG="warn")
     server = subprocess.Popen([args.robocal, "serve", "--bind", f"127.0.0.1:{port}"],
                               env=env, stdout=open(f"{work}/server.log", "w"),
                               stderr=subprocess.STDOUT)

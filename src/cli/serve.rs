@@ -7,8 +7,10 @@
 //!   created in the working directory on first start; `postgres://…` selects
 //!   PostgreSQL (docs/deployment.md), with `--db-pool N` / `ROBOCAL_DB_POOL`
 //!   connections per replica (default 10);
-//! - `ROBOCAL_API_KEYS`: comma-separated bearer keys for writes (none: writes
-//!   are open; reads are always open);
+//! - `ROBOCAL_API_KEYS`: comma-separated bearer keys, each `key` or
+//!   `key:role` with a role of [`Role`] (no role: `admin`); none: every route
+//!   is open. An unknown role stops the start with the entry's position;
+//! - `--open-reads` / `ROBOCAL_OPEN_READS`: with keys, GETs still need none;
 //! - `--workers N` / `ROBOCAL_WORKERS`: calibration jobs run at once, default 1;
 //! - limits and queues (`--max-queued-jobs`, `--max-queued-solves`,
 //!   `--body-limit`, `--metadata-limit`, `--max-poses-per-set`,
@@ -26,12 +28,24 @@
 
 use crate::db::{Backend, Db, DEFAULT_DATABASE_URL, DEFAULT_PG_POOL};
 use crate::http::{app, AppState, Limits, ServiceConfig, ServiceListener};
+use crate::service::keys::{parse_keys, ApiKey, Role};
 use anyhow::Context;
 use clap::Args;
 use std::net::SocketAddr;
 
 #[derive(Debug, Args)]
+#[command(after_long_help = keys_help())]
 pub struct ServeArgs {
+    /// With API keys configured, let GET requests through without a key (the
+    /// console's pages, reports and downloads on a trusted network); writes
+    /// still need a key of their role. `ROBOCAL_OPEN_READS=1` sets it too.
+    #[arg(
+        long,
+        env = "ROBOCAL_OPEN_READS",
+        action = clap::ArgAction::SetTrue,
+        value_parser = clap::builder::BoolishValueParser::new()
+    )]
+    pub open_reads: bool,
     /// Listen address (loopback by default).
     #[arg(long, env = "ROBOCAL_BIND", default_value = "127.0.0.1:8080")]
     pub bind: String,
@@ -104,15 +118,26 @@ impl ServeArgs {
     }
 }
 
-/// Reads `ROBOCAL_API_KEYS` (comma-separated; blanks ignored).
-pub fn api_keys_from_env() -> Vec<String> {
-    std::env::var("ROBOCAL_API_KEYS")
-        .unwrap_or_default()
-        .split(',')
-        .map(str::trim)
-        .filter(|k| !k.is_empty())
-        .map(String::from)
-        .collect()
+/// Reads `ROBOCAL_API_KEYS` (see [`parse_keys`]); an unknown role or an
+/// empty key is an error that names the entry, never the key.
+pub fn api_keys_from_env() -> anyhow::Result<Vec<ApiKey>> {
+    let text = std::env::var("ROBOCAL_API_KEYS").unwrap_or_default();
+    parse_keys(&text).map_err(|e| anyhow::anyhow!("ROBOCAL_API_KEYS: {e}"))
+}
+
+/// The part of `serve --help` on API keys, from the roles themselves.
+fn keys_help() -> String {
+    let mut out = String::from(
+        "API keys: set ROBOCAL_API_KEYS to comma-separated entries `key` or `key:role`, \
+         e.g. ROBOCAL_API_KEYS=k1:admin,k2:read,k3:operate (a key without a role is admin). \
+         Clients send `Authorization: Bearer <key>`; a request without a valid key gets 401, \
+         a key whose role is too low gets 403. /healthz, /readyz and /openapi.yaml stay open. \
+         Without keys every route is open. Roles (each includes the ones above it):\n",
+    );
+    for role in Role::ALL {
+        out.push_str(&format!("  {:<8} {}\n", role.name(), role.allows()));
+    }
+    out
 }
 
 fn init_tracing() {
@@ -132,6 +157,7 @@ pub fn run(args: ServeArgs) -> anyhow::Result<()> {
         anyhow::bail!("--workers must be at least 1");
     }
     args.limits()?;
+    let keys = api_keys_from_env()?;
     let addr: SocketAddr = args.bind.parse().with_context(|| {
         format!(
             "--bind {}: expected HOST:PORT, e.g. 127.0.0.1:8080",
@@ -143,14 +169,14 @@ pub fn run(args: ServeArgs) -> anyhow::Result<()> {
         .thread_name("robocal-http")
         .build()
         .context("cannot start the async runtime")?;
-    let result = runtime.block_on(serve(addr, args));
+    let result = runtime.block_on(serve(addr, args, keys));
     // A calibration still running on the blocking pool is not waited for; the
     // next start reports it as interrupted.
     runtime.shutdown_timeout(std::time::Duration::from_secs(2));
     result
 }
 
-async fn serve(addr: SocketAddr, args: ServeArgs) -> anyhow::Result<()> {
+async fn serve(addr: SocketAddr, args: ServeArgs, keys: Vec<ApiKey>) -> anyhow::Result<()> {
     let db = Db::connect_with(&args.database_url, args.db_pool)
         .await
         .with_context(|| format!("cannot open the database {}", redact(&args.database_url)))?;
@@ -162,9 +188,10 @@ async fn serve(addr: SocketAddr, args: ServeArgs) -> anyhow::Result<()> {
             tracing::warn!(jobs = ?interrupted, "marked calibrations interrupted by a restart as failed");
         }
     }
-    let keys = api_keys_from_env();
+    let keys_on = keys_summary(&keys, args.open_reads);
     let config = ServiceConfig {
-        api_keys: keys.clone(),
+        api_keys: keys,
+        open_reads: args.open_reads,
         workers: args.workers,
         solve_workers: args.solve_workers.max(1),
         job_lease: std::time::Duration::from_secs(args.job_lease.max(1)),
@@ -192,11 +219,7 @@ async fn serve(addr: SocketAddr, args: ServeArgs) -> anyhow::Result<()> {
         backend.name(),
         redact(&args.database_url),
         args.workers,
-        if keys.is_empty() {
-            "off: writes are open".to_string()
-        } else {
-            format!("on: {} key(s)", keys.len())
-        }
+        keys_on
     );
     let draining = state.clone();
     axum::serve(ServiceListener::new(listener), app(state))
@@ -211,6 +234,25 @@ async fn serve(addr: SocketAddr, args: ServeArgs) -> anyhow::Result<()> {
         .context("server error")?;
     tracing::info!("stopped");
     Ok(())
+}
+
+/// The keys for the start-up log: how many of each role, never the keys.
+fn keys_summary(keys: &[ApiKey], open_reads: bool) -> String {
+    if keys.is_empty() {
+        return "off: every route is open".into();
+    }
+    let counts: Vec<String> = Role::ALL
+        .iter()
+        .map(|r| (r, keys.iter().filter(|k| k.role == *r).count()))
+        .filter(|(_, n)| *n > 0)
+        .map(|(r, n)| format!("{n} {r}"))
+        .collect();
+    let reads = if open_reads {
+        "GETs open"
+    } else {
+        "GETs need `read`"
+    };
+    format!("on: {}; {reads}", counts.join(", "))
 }
 
 /// A database URL for the log: the password of `scheme://user:password@host` replaced by `***`.

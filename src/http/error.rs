@@ -22,9 +22,12 @@ pub enum ApiError {
     /// 400: the request cannot be read (malformed JSON, bad path or query).
     #[error("{0}")]
     BadRequest(String),
-    /// 401: a write without a valid API key while keys are configured.
+    /// 401: no valid API key while keys are configured and the route needs one.
     #[error("{0}")]
     Unauthorized(String),
+    /// 403: a valid API key whose role is below the one the route needs.
+    #[error("{0}")]
+    Forbidden(String),
     /// 404: the resource or route does not exist.
     #[error("{0}")]
     NotFound(String),
@@ -92,6 +95,7 @@ impl ApiError {
         match self {
             ApiError::BadRequest(_) => StatusCode::BAD_REQUEST,
             ApiError::Unauthorized(_) => StatusCode::UNAUTHORIZED,
+            ApiError::Forbidden(_) => StatusCode::FORBIDDEN,
             ApiError::NotFound(_) => StatusCode::NOT_FOUND,
             ApiError::MethodNotAllowed(_) => StatusCode::METHOD_NOT_ALLOWED,
             ApiError::Conflict(_) => StatusCode::CONFLICT,
@@ -113,6 +117,7 @@ impl ApiError {
         match self {
             ApiError::BadRequest(_) => "bad-request",
             ApiError::Unauthorized(_) => "unauthorized",
+            ApiError::Forbidden(_) => "forbidden",
             ApiError::NotFound(_) => "not-found",
             ApiError::MethodNotAllowed(_) => "method-not-allowed",
             ApiError::Conflict(_) => "conflict",

@@ -3,9 +3,10 @@
 //!
 //! - [`app`] builds the router over an [`AppState`] (database, API keys,
 //!   bounded job workers, solver caches); tests drive it in-process.
-//! - Writes (POST, PUT, PATCH, DELETE) need `Authorization: Bearer <key>` when
-//!   API keys are configured; reads (GET, HEAD) are open, so dashboards and
-//!   CAM clients can read without a key. Keys are never logged.
+//! - When API keys are configured, each route needs a key of a role
+//!   (`read` ⊆ `operate` ⊆ `admin`, sent as `Authorization: Bearer <key>`),
+//!   decided by one table in [`auth`]; `open_reads` leaves GETs open. Keys
+//!   are never logged.
 //! - CPU-heavy work runs off the async runtime: calibrations on a pool of
 //!   `workers` blocking tasks, solve batches above [`SMALL_SOLVE_MAX`] targets
 //!   on the blocking pool (rayon inside), bounded by a semaphore. Both queues
@@ -16,7 +17,7 @@
 use axum::extract::{DefaultBodyLimit, Request, State};
 use axum::handler::Handler;
 use axum::http::{header, Method};
-use axum::middleware::{self, Next};
+use axum::middleware;
 use axum::response::{IntoResponse, Response};
 use axum::routing::{on, MethodFilter, MethodRouter};
 use axum::Router;
@@ -24,6 +25,7 @@ use tower_http::catch_panic::CatchPanicLayer;
 use tower_http::trace::{DefaultMakeSpan, DefaultOnFailure, DefaultOnResponse, TraceLayer};
 use tracing::Level;
 
+pub mod auth;
 pub mod calibrations;
 pub mod cell;
 pub mod checks;
@@ -148,17 +150,30 @@ pub fn route_table() -> Vec<(Method, &'static str)> {
     routes().into_iter().map(|r| (r.method, r.path)).collect()
 }
 
+/// (method, path template, access) of every JSON API route (see [`auth::access`]).
+pub fn route_access() -> Vec<(Method, &'static str, auth::Access)> {
+    routes()
+        .into_iter()
+        .map(|r| {
+            let access = auth::access(&r.method, r.path);
+            (r.method, r.path, access)
+        })
+        .collect()
+}
+
 /// The router of the service: the JSON API and the web console.
 pub fn app(state: AppState) -> Router {
     let mut router = Router::new();
     for r in routes().into_iter().chain(console::routes()) {
-        // Routes of one path with different methods merge into one.
-        router = router.route(r.path, r.handler);
+        // Each route checks the key its access needs; routes of one path with
+        // different methods merge into one.
+        let access = auth::access(&r.method, r.path);
+        let guard = middleware::from_fn_with_state((state.clone(), access), auth::guard);
+        router = router.route(r.path, r.handler.layer(guard));
     }
     router
         .fallback(not_found)
         .method_not_allowed_fallback(method_not_allowed)
-        .layer(middleware::from_fn_with_state(state.clone(), auth))
         .layer(DefaultBodyLimit::max(state.limits().body_bytes))
         .layer(CatchPanicLayer::custom(panic_response))
         .layer(
@@ -215,52 +230,6 @@ async fn method_not_allowed(req: Request) -> ApiError {
     ))
 }
 
-/// Writes need a bearer key when keys are configured.
-async fn auth(State(state): State<AppState>, req: Request, next: Next) -> Response {
-    let keys = &state.config().api_keys;
-    let read = matches!(*req.method(), Method::GET | Method::HEAD | Method::OPTIONS);
-    if keys.is_empty() || read {
-        return next.run(req).await;
-    }
-    let presented = req
-        .headers()
-        .get(header::AUTHORIZATION)
-        .and_then(|v| v.to_str().ok())
-        .and_then(bearer_token);
-    match presented {
-        None => ApiError::Unauthorized(
-            "this operation needs an API key: send `Authorization: Bearer <key>`".into(),
-        )
-        .into_response(),
-        Some(k)
-            if keys
-                .iter()
-                .any(|key| constant_time_eq(key.as_bytes(), k.as_bytes())) =>
-        {
-            next.run(req).await
-        }
-        Some(_) => ApiError::Unauthorized("the API key is not valid".into()).into_response(),
-    }
-}
-
-/// The token of `Authorization: Bearer <token>`; the scheme is
-/// case-insensitive (RFC 9110 §11.1), followed by one or more spaces.
-fn bearer_token(value: &str) -> Option<&str> {
-    let (scheme, rest) = value.split_once(' ')?;
-    scheme
-        .eq_ignore_ascii_case("bearer")
-        .then(|| rest.trim_matches(' '))
-        .filter(|t| !t.is_empty())
-}
-
-/// Compares without an early exit on the first differing byte.
-fn constant_time_eq(a: &[u8], b: &[u8]) -> bool {
-    if a.len() != b.len() {
-        return false;
-    }
-    a.iter().zip(b).fold(0u8, |acc, (x, y)| acc | (x ^ y)) == 0
-}
-
 /// A handler that panics answers a problem+json 500 instead of dropping the
 /// connection (the panic message is logged, not sent).
 fn panic_response(panic: Box<dyn std::any::Any + Send + 'static>) -> Response {
@@ -301,15 +270,5 @@ mod tests {
         let text = String::from_utf8(body.to_vec()).unwrap();
         assert!(text.contains("\"status\":500"), "{text}");
         assert!(!text.contains("secret detail"), "{text}");
-    }
-
-    #[test]
-    fn bearer_scheme_is_case_insensitive() {
-        for v in ["Bearer k1", "bearer k1", "BEARER k1", "bEaReR   k1"] {
-            assert_eq!(super::bearer_token(v), Some("k1"), "{v}");
-        }
-        for v in ["Basic k1", "Bearerk1", "Bearer ", "k1", ""] {
-            assert_eq!(super::bearer_token(v), None, "{v}");
-        }
     }
 }

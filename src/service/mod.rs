@@ -15,6 +15,7 @@ pub mod cell;
 mod changes;
 pub mod checks;
 mod job_watch;
+pub mod keys;
 pub mod limits;
 pub mod plans;
 pub mod programs;

@@ -15,8 +15,11 @@ use tokio::sync::{Notify, Semaphore};
 /// Service settings that are not the database.
 #[derive(Clone)]
 pub struct ServiceConfig {
-    /// Accepted API keys; empty: writes are open.
-    pub api_keys: Vec<String>,
+    /// Accepted API keys with their roles; empty: every route is open.
+    pub api_keys: Vec<super::keys::ApiKey>,
+    /// With keys configured, GET requests still need no key (a trusted
+    /// network whose browsers open the console).
+    pub open_reads: bool,
     /// Calibration jobs that run at the same time.
     pub workers: usize,
     /// Large solve batches that run at the same time.
@@ -38,6 +41,7 @@ impl std::fmt::Debug for ServiceConfig {
                 "api_keys",
                 &format_args!("[{} redacted]", self.api_keys.len()),
             )
+            .field("open_reads", &self.open_reads)
             .field("workers", &self.workers)
             .field("solve_workers", &self.solve_workers)
             .field("progress_interval", &self.progress_interval)
@@ -51,6 +55,7 @@ impl Default for ServiceConfig {
     fn default() -> Self {
         ServiceConfig {
             api_keys: Vec::new(),
+            open_reads: false,
             workers: 1,
             solve_workers: 2,
             progress_interval: Duration::from_millis(250),

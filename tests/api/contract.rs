@@ -410,7 +410,7 @@ async fn bad_input_gives_problem_json() {
 }
 
 #[tokio::test]
-async fn api_keys_guard_writes_only_when_configured() {
+async fn api_keys_guard_routes_only_when_configured() {
     // Keys on.
     let t = setup_with(&["s3cret", "other"], 1).await;
     let body = br#"{"preset": "ur10"}"#.to_vec();
@@ -433,9 +433,19 @@ async fn api_keys_guard_writes_only_when_configured() {
     let r = create(Some("other")).await;
     assert_eq!(r.status, StatusCode::CREATED);
     let id = r.json()["id"].as_i64().unwrap();
-    // Reads are open.
+    // Reads need a key too (see `roles` for the roles and open reads).
     let r = t
         .raw("GET", &format!("/v1/robots/{id}"), None, vec![], None)
+        .await;
+    assert_eq!(r.status, StatusCode::UNAUTHORIZED);
+    let r = t
+        .raw(
+            "GET",
+            &format!("/v1/robots/{id}"),
+            None,
+            vec![],
+            Some("other"),
+        )
         .await;
     assert_eq!(r.status, StatusCode::OK);
     let r = t
@@ -555,11 +565,23 @@ async fn the_server_refuses_what_the_spec_refuses() {
     assert_eq!(r.status, StatusCode::BAD_REQUEST);
     // Ids above 2^63-1 are refused like other bad path values (spec maximum).
     let r = t
-        .raw("GET", "/v1/robots/9223372036854775808", None, vec![], None)
+        .raw(
+            "GET",
+            "/v1/robots/9223372036854775808",
+            None,
+            vec![],
+            Some("k1"),
+        )
         .await;
     assert_eq!(r.status, StatusCode::BAD_REQUEST);
     let r = t
-        .raw("GET", "/v1/robots/9223372036854775807", None, vec![], None)
+        .raw(
+            "GET",
+            "/v1/robots/9223372036854775807",
+            None,
+            vec![],
+            Some("k1"),
+        )
         .await;
     assert_eq!(r.status, StatusCode::NOT_FOUND);
     // Integral floats are integers (JSON Schema), fractions are not.

@@ -11,7 +11,8 @@
 //! `flow` (the quickstart end to end), `sets` (uploads), `solve` (targets CSV
 //! in and out), `cell` (tools, work objects, program filtering), `jobs`
 //! (progress, cancellation, saturation, races), `record` (sets a version uses,
-//! the calibration record, check poses); the harness is `support`.
+//! the calibration record, check poses), `roles` (keys with roles, open reads,
+//! the console's security headers); the harness is `support`.
 
 mod cell;
 #[path = "../common/mod.rs"]
@@ -22,6 +23,7 @@ mod hostile;
 mod jobs;
 mod plans;
 mod record;
+mod roles;
 mod sets;
 mod solve;
 mod spec;

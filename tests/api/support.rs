@@ -190,7 +190,7 @@ impl Resp {
 
 pub(crate) async fn setup_with(keys: &[&str], workers: usize) -> TestApp {
     setup_config(ServiceConfig {
-        api_keys: keys.iter().map(|k| k.to_string()).collect(),
+        api_keys: robocal::service::keys::parse_keys(&keys.join(",")).unwrap(),
         workers,
         solve_workers: 2,
         progress_interval: Duration::from_millis(20),
@@ -200,7 +200,7 @@ pub(crate) async fn setup_with(keys: &[&str], workers: usize) -> TestApp {
 }
 
 pub(crate) async fn setup_config(config: ServiceConfig) -> TestApp {
-    let keys = config.api_keys.clone();
+    let keys: Vec<String> = config.api_keys.iter().map(|k| k.key.clone()).collect();
     let s = service(config).await;
     TestApp {
         router: s.router,

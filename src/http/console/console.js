@@ -1,6 +1,6 @@
 // robocal web console: the page's forms call the REST API (/v1) with fetch.
 // The API key (when the service has keys) is kept in this tab's
-// sessionStorage and sent as `Authorization: Bearer <key>` on writes.
+// sessionStorage and sent as `Authorization: Bearer <key>` on every request.
 "use strict";
 
 function apiKey() { return sessionStorage.getItem("robocal-key") || ""; }

@@ -8,7 +8,11 @@
 //! the style sheet and the script are inlined.
 //!
 //! Routes: `GET /ui` (robots), `GET /ui/robots/{id}` (one robot). They are
-//! HTML, not part of the JSON API, so `openapi.yaml` does not list them.
+//! HTML, not part of the JSON API, so `openapi.yaml` does not list them. Like
+//! every GET they need a `read` key when keys are configured, unless the
+//! service runs with open reads (a browser does not send a bearer key when it
+//! opens a page). Each page is sent with a `Content-Security-Policy` (see
+//! [`pages::content_security_policy`]) and `X-Frame-Options: DENY`.
 
 mod cell_pages;
 mod pages;
@@ -17,8 +21,9 @@ use super::{route, ApiError, ApiPath, AppState, Route};
 use crate::db::CellKind;
 use crate::service;
 use axum::extract::State;
-use axum::http::Method;
+use axum::http::{header, HeaderValue, Method};
 use axum::response::{Html, IntoResponse, Response};
+use maud::Markup;
 
 /// Robots listed on the start page.
 const ROBOTS_SHOWN: i64 = 500;
@@ -34,7 +39,7 @@ pub fn routes() -> Vec<Route> {
 async fn robots_page(State(state): State<AppState>) -> Result<Response, ApiError> {
     let listing = service::robots::page(&state, ROBOTS_SHOWN, 0).await?;
     let keys = !state.config().api_keys.is_empty();
-    Ok(Html(pages::robots(&listing.rows, listing.total, keys).into_string()).into_response())
+    Ok(page(pages::robots(&listing.rows, listing.total, keys)))
 }
 
 async fn robot_page(
@@ -51,5 +56,17 @@ async fn robot_page(
         keys: !state.config().api_keys.is_empty(),
         robot,
     };
-    Ok(Html(pages::robot(&view).into_string()).into_response())
+    Ok(page(pages::robot(&view)))
+}
+
+/// An HTML page with the console's security headers.
+fn page(markup: Markup) -> Response {
+    let mut res = Html(markup.into_string()).into_response();
+    let headers = res.headers_mut();
+    headers.insert(
+        header::CONTENT_SECURITY_POLICY,
+        HeaderValue::from_static(pages::content_security_policy()),
+    );
+    headers.insert(header::X_FRAME_OPTIONS, HeaderValue::from_static("DENY"));
+    res
 }

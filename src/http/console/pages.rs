@@ -12,6 +12,36 @@ use maud::{html, Markup, PreEscaped, DOCTYPE};
 const SCRIPT: &str = include_str!("console.js");
 const STYLE: &str = include_str!("console.css");
 
+/// The `Content-Security-Policy` of every console page: everything from this
+/// origin only (the pages `fetch` the JSON API), no plug-ins, no framing, no
+/// `<base>`; the one inline script and the one inline style sheet are allowed
+/// by their SHA-256 (CSP Level 2 hash sources), nothing else inline. The
+/// download links are `blob:` URLs the page makes itself; `connect-src`
+/// allows reading them back (the browser check does).
+pub fn content_security_policy() -> &'static str {
+    static CSP: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    CSP.get_or_init(|| {
+        format!(
+            "default-src 'self'; script-src '{}'; style-src '{}'; connect-src 'self' blob:; \
+             img-src 'self'; object-src 'none'; base-uri 'none'; form-action 'self'; \
+             frame-ancestors 'none'",
+            csp_hash(SCRIPT),
+            csp_hash(STYLE)
+        )
+    })
+}
+
+/// `sha256-<base64 of the SHA-256 of text>`.
+fn csp_hash(text: &str) -> String {
+    use base64::Engine;
+    use sha2::{Digest, Sha256};
+    let digest = Sha256::digest(text.as_bytes());
+    format!(
+        "sha256-{}",
+        base64::engine::general_purpose::STANDARD.encode(digest)
+    )
+}
+
 /// Everything the robot page shows.
 pub struct RobotView {
     pub robot: RobotRow,
@@ -36,7 +66,7 @@ fn layout(title: &str, keys: bool, body: Markup) -> Markup {
                         label.key {
                             "API key "
                             input #api-key type="password" autocomplete="off"
-                                placeholder="needed for changes";
+                                placeholder="needed for changes and solves";
                         }
                     }
                 }
