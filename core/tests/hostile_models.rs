@@ -230,3 +230,21 @@ fn the_property_test_runs_accepted_models() {
     let n = ACCEPTED.load(std::sync::atomic::Ordering::Relaxed);
     assert!(n >= 10, "only {n} of 48 random models were accepted");
 }
+
+/// Limits wholly beyond ±180° (here [-3600°, -360°] on a wrist joint) once
+/// made the identifiability's random poses sample an empty range.
+#[test]
+fn multi_turn_limits_beyond_a_half_turn_calibrate() {
+    let mut d = preset_description("ur5").unwrap();
+    d.joints[4].limits_deg = [-3600.0, -360.0];
+    let model = d.to_model().unwrap();
+    let ident = measured(&model, 25, 0).expect("measurable");
+    let r = calibrate(
+        &model,
+        &ident,
+        &[],
+        &small_options(vec![Method::Km]),
+        &|_| true,
+    );
+    assert!(r.is_ok(), "{:?}", r.err());
+}

@@ -274,7 +274,17 @@ pub(crate) fn generic_rank(model: &RobotModel, ids: &[ParamId], orientation: boo
         let q: Vec<f64> = model
             .links
             .iter()
-            .map(|l| rng.gen_range(l.limits[0].max(-3.1)..l.limits[1].min(3.1)))
+            .map(|l| {
+                let (a, b) = (l.limits[0].max(-3.1), l.limits[1].min(3.1));
+                if a < b {
+                    rng.gen_range(a..b)
+                } else {
+                    // A range wholly beyond ±3.1 rad (multi-turn limits):
+                    // its first 6.2 rad.
+                    let (lo, hi) = (l.limits[0], l.limits[1]);
+                    lo + (hi - lo).min(6.2) * rng.gen::<f64>()
+                }
+            })
             .collect();
         if fk(model, &q).is_ok() {
             data.push(Measurement {
