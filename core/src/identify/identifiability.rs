@@ -290,10 +290,10 @@ pub(crate) fn analyse_factor(
                 kmat.set_column(i, &rf.column(kk));
             }
             let target: DVector<f64> = rf.column(k).into_owned();
-            let k = kmat.ncols().min(kmat.nrows());
+            let values = kmat.ncols().min(kmat.nrows());
             let coef = kmat
                 .clone()
-                .try_svd(true, true, 5.0 * f64::EPSILON, svd_iterations(k))
+                .try_svd(true, true, 5.0 * f64::EPSILON, svd_iterations(values))
                 .and_then(|s| s.solve(&target, 1e-12).ok())
                 .unwrap_or_else(|| DVector::zeros(kept_local.len()));
             let cmax = coef.iter().fold(0.0_f64, |a, c| a.max(c.abs()));
