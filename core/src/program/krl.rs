@@ -12,9 +12,14 @@
 //! `$LOAD = LOAD_DATA[n]`, and `BAS(#TOOL, n)` takes `LOAD_DATA[n]` when the
 //! files define it (`LOAD_DATA[n]={…}`, as in `$config.dat`); kg, mm in the
 //! flange frame, kg·m²; a mass of −1 (the controller's default) or 0 is no
-//! declaration. A declared
-//! point takes the tool and base of the motions that use it (all the same,
-//! else it is skipped). Comments (`;` to the end of the line) are ignored;
+//! declaration. External TCP (`$IPO_MODE = #TCP`, or `IPO_FRAME #TCP` in
+//! the active `FDAT`) swaps the roles as the controller does: `$BASE`
+//! (`BASE_DATA[n]`) is the stationary tool in the robot base frame, `$TOOL`
+//! (`TOOL_DATA[n]`) the work piece the robot carries (flange → work piece),
+//! `$LOAD` that work piece's load, and a point the fixed tool's pose in the
+//! carried work piece ([`Site::stationary_tool`]); `#BASE` restores the
+//! ordinary roles. A declared point takes the tool, base and interpolation
+//! mode of the motions that use it (all the same, else it is skipped). Comments (`;` to the end of the line) are ignored;
 //! KRL is case-insensitive.
 //!
 //! Units: mm and degrees, `R = Rz(A)·Ry(B)·Rx(C)`. `S` and `T` are kept.
@@ -374,6 +379,18 @@ struct Context {
     tool: FrameSpec,
     base: FrameSpec,
     load: Option<Load>,
+    /// External TCP (`$IPO_MODE = #TCP`): the tool is fixed, the robot
+    /// carries the work piece.
+    external: bool,
+}
+
+/// What a `DECL FDAT` selects: `TOOL_NO`, `BASE_NO` and `IPO_FRAME`
+/// (`Some(true)` for `#TCP`).
+#[derive(Clone, Copy)]
+struct Fdat {
+    tool: Option<u32>,
+    base: Option<u32>,
+    external: Option<bool>,
 }
 
 /// A declared point and the contexts of the motions that use it.
@@ -386,7 +403,7 @@ struct Parser<'a> {
     files: &'a [ProgramFile],
     declared: Vec<Declared>,
     by_name: HashMap<String, usize>,
-    fdat: HashMap<String, (Option<u32>, Option<u32>)>,
+    fdat: HashMap<String, Fdat>,
     tools: HashMap<u32, Pose>,
     bases: HashMap<u32, Pose>,
     loads: HashMap<u32, Load>,
@@ -420,15 +437,17 @@ fn site_of(
         Ok(p) => (Some(p), skip),
         Err(e) => (None, skip.or(Some(e))),
     };
+    // External TCP: the fixed tool is `$BASE`, the carried work piece `$TOOL`.
+    let (tool, work_object) = ctx.roles();
     Some(Site {
         file,
         line: line.no,
         name: name.to_string(),
         pose,
         flags,
-        tool: ctx.tool.clone(),
+        tool,
         load: ctx.load,
-        work_object: ctx.base.clone(),
+        work_object,
         slots,
         convention: OrientationConvention::KukaAbc,
         unit_m: 1e-3,
@@ -436,8 +455,29 @@ fn site_of(
         mark_at: line.end..line.end,
         after_joints: None,
         skip,
-        stationary_tool: false,
+        stationary_tool: ctx.external,
     })
+}
+
+impl Context {
+    fn unset() -> Context {
+        Context {
+            tool: FrameSpec::Unset,
+            base: FrameSpec::Unset,
+            load: None,
+            external: false,
+        }
+    }
+
+    /// The site's (tool, work object): `($TOOL, $BASE)`, or with an external
+    /// TCP `($BASE, $TOOL)` (the fixed tool, the carried work piece).
+    fn roles(&self) -> (FrameSpec, FrameSpec) {
+        if self.external {
+            (self.base.clone(), self.tool.clone())
+        } else {
+            (self.tool.clone(), self.base.clone())
+        }
+    }
 }
 
 impl Parser<'_> {
@@ -531,19 +571,26 @@ impl Parser<'_> {
                         .find(|(k, _)| k == key)
                         .and_then(|(_, r)| integer(&code[r.clone()]))
                 };
-                self.fdat
-                    .insert(name.clone(), (get("TOOL_NO"), get("BASE_NO")));
+                let external = a
+                    .items
+                    .iter()
+                    .find(|(k, _)| k == "IPO_FRAME")
+                    .map(|(_, r)| code[r.clone()].trim().eq_ignore_ascii_case("#TCP"));
+                self.fdat.insert(
+                    name.clone(),
+                    Fdat {
+                        tool: get("TOOL_NO"),
+                        base: get("BASE_NO"),
+                        external,
+                    },
+                );
                 continue;
             }
             if !POSE_TYPES.contains(&ty) {
                 continue;
             }
             let a = shift(a, line.start);
-            let unset = Context {
-                tool: FrameSpec::Unset,
-                base: FrameSpec::Unset,
-                load: None,
-            };
+            let unset = Context::unset();
             let kind = classify(&a, file.text.as_str(), 0);
             if let Some(site) = site_of(fi, &line, name, kind, &unset, None) {
                 self.by_name
@@ -561,11 +608,7 @@ impl Parser<'_> {
     /// Motions and frame selections (second pass, `.src` files in order).
     fn statements(&mut self, fi: usize) -> Result<(), ParseError> {
         let file = &self.files[fi];
-        let mut ctx = Context {
-            tool: FrameSpec::Unset,
-            base: FrameSpec::Unset,
-            load: None,
-        };
+        let mut ctx = Context::unset();
         for line in lines(&file.text) {
             let code = code_of(line.text).map_err(|(at, m)| err(file, &line, at, m))?;
             let toks = tokens(code).map_err(|(at, m)| err(file, &line, at, m))?;
@@ -605,6 +648,15 @@ impl Parser<'_> {
                 }
                 continue;
             }
+            // $IPO_MODE = #TCP / #BASE
+            if first == "$IPO_MODE" && matches!(toks.get(1), Some((Tok::Punct('='), _))) {
+                match word(2) {
+                    "#TCP" => ctx.external = true,
+                    "#BASE" => ctx.external = false,
+                    _ => {}
+                }
+                continue;
+            }
             // $LOAD = {…} / $LOAD = LOAD_DATA[n]
             if first == "$LOAD" && matches!(toks.get(1), Some((Tok::Punct('='), _))) {
                 ctx.load = match toks.get(2) {
@@ -638,12 +690,15 @@ impl Parser<'_> {
             }
             // FDAT_ACT = FP1
             if first == "FDAT_ACT" && matches!(toks.get(1), Some((Tok::Punct('='), _))) {
-                if let Some((t, b)) = self.fdat.get(word(2)).copied() {
-                    if let Some(t) = t {
+                if let Some(fdat) = self.fdat.get(word(2)).copied() {
+                    if let Some(t) = fdat.tool {
                         ctx.tool = self.frame_spec(t, true);
                     }
-                    if let Some(b) = b {
+                    if let Some(b) = fdat.base {
                         ctx.base = self.frame_spec(b, false);
+                    }
+                    if let Some(e) = fdat.external {
+                        ctx.external = e;
                     }
                 }
                 continue;
@@ -713,16 +768,15 @@ impl Parser<'_> {
                                 .get_or_insert("no motion of the program uses it".into());
                         }
                         Some((_, ctx)) => {
-                            site.tool = ctx.tool.clone();
+                            (site.tool, site.work_object) = ctx.roles();
                             site.load = ctx.load;
-                            site.work_object = ctx.base.clone();
-                            let other = d
-                                .uses
-                                .iter()
-                                .find(|(_, c)| c.tool != ctx.tool || c.base != ctx.base);
+                            site.stationary_tool = ctx.external;
+                            let other = d.uses.iter().find(|(_, c)| {
+                                c.tool != ctx.tool || c.base != ctx.base || c.external != ctx.external
+                            });
                             if let Some((line, _)) = other {
                                 site.skip.get_or_insert(format!(
-                                    "used with different tools or bases (lines {} and {line})",
+                                    "used with different tools, bases or interpolation modes (lines {} and {line})",
                                     d.uses[0].0
                                 ));
                             }

@@ -303,7 +303,7 @@ fn solve_site(
 ) -> Result<Solved, String> {
     let pose = site.pose.ok_or("the target is not a complete pose")?;
     if site.stationary_tool {
-        return solve_stationary(site, &pose, model, settings, previous);
+        return solve_stationary(site, cell, &pose, model, settings, previous);
     }
     let tool = resolve_tool(&site.tool, cell)?;
     let tcp = tool.tcp;
@@ -352,22 +352,41 @@ fn solve_site(
 /// `S` with the effective tool `W_f·T` (flange → the point of the work object
 /// that must meet the tool); the controller, with its nominal model, must be
 /// given `T_false = (FK_nom(q)·W_f)⁻¹·S = T·(FK_nom(q)·W_f·T)⁻¹·S`. The load
-/// is the program's (the carried work piece), else the model's payload at its
-/// flange point.
+/// is the program's (the carried work piece), else the cell's, else the
+/// model's payload at its flange point. Referred to by name or number (KRL's
+/// `BASE_DATA[n]` and `TOOL_DATA[n]` with an external TCP), the stationary
+/// tool is the cell's work object of that reference (a fixed frame, in the
+/// base frame of the calibrated version) and the carried work piece the
+/// cell's tool (a frame on the flange, with its load).
 fn solve_stationary(
     site: &Site,
+    cell: &Cell,
     pose: &Pose,
     model: &CompensatedModel,
     settings: &IkSettings,
     previous: Option<&[f64]>,
 ) -> Result<Solved, String> {
-    let FrameSpec::Inline(fixed) = site.tool else {
-        return Err("a stationary tool must be declared in the program".into());
+    let fixed = match &site.tool {
+        FrameSpec::Inline(p) => *p,
+        FrameSpec::Ref(r) => cell
+            .work_object(r)
+            .map_err(|e| format!("the stationary tool: {e}"))?
+            .in_base(model),
+        FrameSpec::Unset => return Err("the program selects no stationary tool".into()),
     };
-    let FrameSpec::Inline(held) = site.work_object else {
-        return Err("a work object the robot holds must be declared in the program".into());
+    let (held, cell_load) = match &site.work_object {
+        FrameSpec::Inline(p) => (*p, None),
+        FrameSpec::Ref(r) => {
+            let t = cell
+                .tool(r)
+                .map_err(|e| format!("the work piece the robot carries: {e}"))?;
+            (t.tcp, t.load)
+        }
+        FrameSpec::Unset => {
+            return Err("the program selects no work piece for the robot to carry".into())
+        }
     };
-    let (load, used_load, warnings) = choose_load(site.load, None, model);
+    let (load, used_load, warnings) = choose_load(site.load, cell_load, model);
     let effective = held.compose(pose);
     let solver = CellSolver::with_load(model, &effective, load.as_ref(), settings.clone());
     let (q, f, configuration) = solve_on(&solver, site, &WorkObject::base(), &fixed, previous)?;
@@ -442,6 +461,30 @@ fn solve_on_flags(
     pose: &Pose,
     previous: Option<&[f64]>,
 ) -> Result<CellSolution, String> {
+    // One unconstrained solve first: an unreachable target fails here at the
+    // cost of a solved one (the solver's reach test) instead of once per
+    // branch, and a solution already carrying the flags ends the search.
+    let free = solver.solve(
+        wobj,
+        pose,
+        &CellOptions {
+            branch: None,
+            seed: previous.map(<[f64]>::to_vec),
+        },
+    );
+    if let Some(r @ FailureReason::Unreachable) = &free.solution.reason {
+        return Err(r.to_string());
+    }
+    if free.solution.converged {
+        let q = &free.solution.q;
+        let s = solver.solver();
+        if site
+            .flags
+            .admits(&s.controller_degrees(q), s.configuration(q))
+        {
+            return Ok(free);
+        }
+    }
     let mut failure: Option<String> = None;
     let mut converged = false;
     for branch in Configuration::all() {

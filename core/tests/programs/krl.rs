@@ -1,6 +1,8 @@
 //! KUKA KRL: a `.src` with its `.dat`, 50 targets declared and inline.
 
+use super::stationary::{swapped, Swapped};
 use super::*;
+use robocal_core::program::LoadSource;
 use robocal_core::model::orientation::{rotation_to, OrientationConvention};
 use robocal_core::program::{filter, kuka_status, kuka_turn, TargetStatus};
 
@@ -183,4 +185,145 @@ fn an_unparsable_krl_program_fails_with_file_line_and_column() {
         e.to_string(),
         "broken.src:2:7: aggregate not closed on its line"
     );
+}
+
+/// A KRL aggregate of `p` (mm, `A B C` degrees).
+fn frame_agg(p: &Pose) -> String {
+    let abc = rotation_to(OrientationConvention::KukaAbc, &p.r);
+    format!(
+        "X {:.4},Y {:.4},Z {:.4},A {:.4},B {:.4},C {:.4}",
+        p.p.x * 1e3,
+        p.p.y * 1e3,
+        p.p.z * 1e3,
+        abc[0],
+        abc[1],
+        abc[2]
+    )
+}
+
+/// An external-TCP program (`$IPO_MODE = #TCP`): the stationary tool in
+/// `BASE_DATA[4]`, the work piece the robot carries in `TOOL_DATA[3]`, the
+/// points the fixed tool's pose in the carried work piece; even ones declared
+/// and moved to by `PTP`, odd ones inline in `LIN`. With `config` the frames
+/// and the load are in a `$config.dat`, else the cell holds them.
+fn external_tcp(s: &Swapped, f: &Fixture, config: bool) -> Vec<ProgramFile> {
+    let ik = AnalyticIk::new(&s.bare).unwrap();
+    let mut src = String::from(
+        "&ACCESS RVP\r\nDEF glue()\r\nINI\r\n$IPO_MODE = #TCP ; the nozzle is fixed\r\n\
+         $TOOL = TOOL_DATA[3]\r\n$BASE = BASE_DATA[4]\r\n",
+    );
+    if config {
+        src.push_str("$LOAD = LOAD_DATA[3]\r\n");
+    }
+    let mut dat = String::from("&ACCESS RVP\r\nDEFDAT glue\r\n");
+    for (i, q) in s.joints.iter().enumerate() {
+        let deg: Vec<f64> = s
+            .bare
+            .joints_to_controller(q)
+            .iter()
+            .map(|v| v.to_degrees())
+            .collect();
+        let agg = format!(
+            "{{{},S {},T {}",
+            frame_agg(&s.target(f, i)),
+            kuka_status(&deg, ik.configuration(q).unwrap()),
+            kuka_turn(&deg)
+        );
+        if i % 2 == 0 {
+            src.push_str(&format!("PTP XG{i} C_PTP\r\n"));
+            dat.push_str(&format!("DECL E6POS XG{i}={agg},E1 0.0,E2 0.0}}\r\n"));
+        } else {
+            src.push_str(&format!("LIN {agg}}} C_DIS\r\n"));
+        }
+    }
+    src.push_str("$IPO_MODE = #BASE\r\nEND\r\n");
+    dat.push_str("ENDDAT\r\n");
+    let mut files = vec![
+        ProgramFile {
+            name: "glue.src".into(),
+            text: src,
+        },
+        ProgramFile {
+            name: "glue.dat".into(),
+            text: dat,
+        },
+    ];
+    if config {
+        let c = f.truth.payload_com * 1e3;
+        files.push(ProgramFile {
+            name: "$config.dat".into(),
+            text: format!(
+                "DEFDAT $CONFIG PUBLIC\r\nTOOL_DATA[3]={{{}}}\r\nBASE_DATA[4]={{{}}}\r\n\
+                 LOAD_DATA[3]={{M {},CM {{X {:.3},Y {:.3},Z {:.3},A 0.0,B 0.0,C 0.0}},J {{X 0.0,Y 0.0,Z 0.0}}}}\r\nENDDAT\r\n",
+                frame_agg(&s.held),
+                frame_agg(&s.fixed_base),
+                f.truth.payload_kg,
+                c.x,
+                c.y,
+                c.z
+            ),
+        });
+    }
+    files
+}
+
+/// External TCP, the frames from the program's `$config.dat` and from the
+/// cell (the fixed tool a work object measured in the tracker frame, the
+/// carried work piece a tool with the true load): the true tool tip in the
+/// truly carried work piece reaches every target.
+#[test]
+fn an_external_tcp_is_filtered_with_the_roles_swapped() {
+    let f = fixture();
+    let s = swapped(f);
+    let mut cell = Cell::default();
+    cell.tools.push(Tool {
+        name: "part".into(),
+        number: Some(3),
+        tcp: s.held,
+        load: Some(f.true_load()),
+    });
+    cell.work_objects.push(WorkObject {
+        name: "nozzle".into(),
+        number: Some(4),
+        frame: WorkObjectFrame::Measurement,
+        pose: s.fixed_cell,
+    });
+    for (config, cell, source) in [
+        (true, Cell::default(), LoadSource::Program),
+        (false, cell, LoadSource::Cell),
+    ] {
+        let files = external_tcp(&s, f, config);
+        let out = filter(Language::Krl, &files, &cell, &f.model, &settings()).unwrap();
+        let r = &out.report;
+        assert_eq!((r.filtered, r.failed, r.skipped), (40, 0, 0), "{:?}", r.targets);
+        assert!(r
+            .targets
+            .iter()
+            .all(|t| t.load.as_ref().unwrap().source == source));
+        let filtered = s.run(f, Language::Krl, &out.files);
+        assert!(filtered.iter().all(Option::is_some), "{filtered:?}");
+        let max_f = filtered.iter().flatten().copied().fold(0.0, f64::max);
+        let (mean_f, _) = mean(&filtered);
+        let (mean_u, reached_u) = mean(&s.run(f, Language::Krl, &files));
+        println!(
+            "KRL external TCP ({}): true tool tip vs target filtered mean {mean_f:.4} mm, \
+             max {max_f:.4} mm (40); unfiltered mean {mean_u:.3} mm ({reached_u})",
+            if config { "$config.dat" } else { "cell" }
+        );
+        assert!(mean_f <= 0.05 && max_f <= 0.15, "{mean_f} {max_f}");
+        assert!(mean_u > 1.0, "{mean_u}");
+    }
+    // Without the cell's frames the references cannot be resolved: failed,
+    // saying which.
+    let out = filter(
+        Language::Krl,
+        &external_tcp(&s, f, false),
+        &Cell::default(),
+        &f.model,
+        &settings(),
+    )
+    .unwrap();
+    assert_eq!(out.report.failed, 40);
+    let why = out.report.targets[0].reason.as_deref().unwrap();
+    assert!(why.contains("stationary tool"), "{why}");
 }

@@ -12,6 +12,7 @@ mod export;
 mod fanuc;
 mod krl;
 mod rapid;
+mod stationary;
 mod truth;
 mod urscript;
 

@@ -1,6 +1,7 @@
 //! ABB RAPID: a module with tooldata, wobjdata and 50 robtargets, declared and inline;
 //! a module of 40 with a stationary tool and a work object the robot holds.
 
+use super::stationary::{swapped, Swapped};
 use super::*;
 use robocal_core::model::orientation::{rotation_to, OrientationConvention};
 use robocal_core::program::{abb_cf, filter, LoadSource, TargetStatus};
@@ -90,106 +91,23 @@ fn filtered_rapid_brings_the_true_tcp_to_the_targets() {
     }
 }
 
-/// The roles swapped: a fixed tool (its tip 300 mm from its mount, tilted
-/// 35°, measured in the tracker frame) and a work piece the robot carries
-/// (gripper frame 200 mm out on the flange, tilted 30°). Joints: 40 around a
-/// middle configuration, away from flag boundaries and singular branches.
-struct Swapped {
-    /// Flange → work object (the wobjdata's uframe, robhold TRUE).
-    held: Pose,
-    /// The fixed tool's TCP in the tracker frame (truth) and in the
-    /// controller's base frame (the tooldata's tframe, robhold FALSE).
-    fixed_cell: Pose,
-    fixed_base: Pose,
-    joints: Vec<Vec<f64>>,
-    /// The nominal controller without a tool.
-    bare: RobotModel,
-}
-
-fn swapped(f: &Fixture) -> Swapped {
-    let mut bare = f.controller.clone();
-    bare.tool = Default::default();
-    let ik = AnalyticIk::new(&bare).unwrap();
-    let r = rpy_matrix(0.0, 30f64.to_radians(), 0.0);
-    let held = Pose::new(r, r * Vector3::new(0.0, 0.05, 0.2));
-    let q0 = f.joints[0].clone();
-    let deg = |q: &[f64]| -> Vec<f64> {
-        bare.joints_to_controller(q)
-            .iter()
-            .map(|v| v.to_degrees())
-            .collect()
-    };
-    // The work piece meets the tool tip 80 mm from its origin at q0.
-    let mut t0 = Pose::from_translation(Vector3::new(0.08, -0.03, 0.0));
-    t0.rot_x(std::f64::consts::PI);
-    let flange = |q: &[f64]| f.true_tcp(q).compose(&f.truth.tool.inverse());
-    let fixed_cell = flange(&q0).compose(&held).compose(&t0);
-    let mut rng = ChaCha8Rng::seed_from_u64(31);
-    let mut joints = Vec::new();
-    while joints.len() < 40 {
-        let q: Vec<f64> = q0
-            .iter()
-            .map(|v| v + rng.gen_range(-15f64..15.0).to_radians())
-            .collect();
-        let d = deg(&q);
-        let off_quadrant = |a: f64| (a / 90.0 - (a / 90.0).round()).abs() * 90.0 > 5.0;
-        let flags_clear = [0, 3, 5].iter().all(|&k| off_quadrant(d[k])) && d[4].abs() > 10.0;
-        let branch = (0..13).all(|k| {
-            let mut p = q.clone();
-            if k > 0 {
-                p[(k - 1) / 2] += if k % 2 == 0 { 0.087 } else { -0.087 };
-            }
-            ik.configuration(&p) == ik.configuration(&q)
-        });
-        if flags_clear && branch && bare.within_limits(&q, 0.087) {
-            joints.push(q);
-        }
-    }
-    // The mount 300 mm behind the tip along the tool's axis, tilted 35°.
-    let tilt = rpy_matrix(35f64.to_radians(), 0.0, 0.0);
-    let tool_on_mount = Pose::new(tilt, tilt * Vector3::new(0.0, 0.0, 0.3));
-    let mount = fixed_cell.compose(&tool_on_mount.inverse());
-    assert!((mount.p - fixed_cell.p).norm() >= 0.25);
-    Swapped {
-        held,
-        fixed_base: f.model.cell_to_base(&fixed_cell),
-        fixed_cell,
-        joints,
-        bare,
-    }
-}
-
-impl Swapped {
-    /// The true flange at commanded `q` (tracker frame).
-    fn flange(&self, f: &Fixture, q: &[f64]) -> Pose {
-        f.true_tcp(q).compose(&f.truth.tool.inverse())
-    }
-
-    /// Target `i`: the fixed tool's tip in the truly carried work object at `joints[i]`.
-    fn target(&self, f: &Fixture, i: usize) -> Pose {
-        self.flange(f, &self.joints[i])
-            .compose(&self.held)
-            .inverse()
-            .compose(&self.fixed_cell)
-    }
-
     /// The module: the stationary tool and the robot-held work object
     /// declared, the tool's tload the true payload on the flange (RAPID: for
     /// a stationary tool, the load of the gripper holding the work object).
-    fn module(&self, f: &Fixture) -> ProgramFile {
-        let ik = AnalyticIk::new(&self.bare).unwrap();
+fn glue_module(s: &Swapped, f: &Fixture) -> ProgramFile {
+        let ik = AnalyticIk::new(&s.bare).unwrap();
         let mut decl = format!(
             "MODULE Glue\r\n  PERS tooldata nozzle:=[FALSE,{},[{:.3},[{:.3},{:.3},{:.3}],[1,0,0,0],0,0,0]];\r\n  \
              PERS wobjdata part:=[TRUE,TRUE,\"\",{},[[0,0,0],[1,0,0,0]]];\r\n",
-            frame(&self.fixed_base),
+            frame(&s.fixed_base),
             f.truth.payload_kg,
             f.truth.payload_com.x * 1e3,
             f.truth.payload_com.y * 1e3,
             f.truth.payload_com.z * 1e3,
-            frame(&self.held)
+            frame(&s.held)
         );
         let mut body = String::from("  PROC main()\r\n");
-        for (i, q) in self.joints.iter().enumerate() {
+        for (i, q) in s.joints.iter().enumerate() {
             let deg: Vec<f64> = self
                 .bare
                 .joints_to_controller(q)
@@ -197,7 +115,7 @@ impl Swapped {
                 .map(|v| v.to_degrees())
                 .collect();
             let lit = literal(
-                &self.target(f, i),
+                &s.target(f, i),
                 abb_cf(&deg, ik.configuration(q).unwrap()),
             );
             if i % 2 == 0 {
@@ -218,62 +136,12 @@ impl Swapped {
         }
     }
 
-    /// Runs the module through the nominal controller (flange goal
-    /// `S·(W_f·T)⁻¹` on the target's flags, nearest the previous joints) and
-    /// returns the distance [mm] of the true tool tip in the truly carried
-    /// work object from each target (`None`: no solution on the flags).
-    fn run(&self, f: &Fixture, file: &ProgramFile) -> Vec<Option<f64>> {
-        let ik = AnalyticIk::new(&self.bare).unwrap();
-        let program = parse(Language::Rapid, std::slice::from_ref(file)).unwrap();
-        assert_eq!(program.sites.len(), self.joints.len());
-        let mut previous: Option<Vec<f64>> = None;
-        let mut errors = Vec::new();
-        for (i, site) in program.sites.iter().enumerate() {
-            let goal = self
-                .fixed_base
-                .compose(&self.held.compose(&site.pose.unwrap()).inverse());
-            let q = ik
-                .solve(&goal, previous.as_deref())
-                .into_iter()
-                .filter(|s| s.within_limits)
-                .map(|s| s.q.to_vec())
-                .filter(|q| {
-                    let deg: Vec<f64> = self
-                        .bare
-                        .joints_to_controller(q)
-                        .iter()
-                        .map(|v| v.to_degrees())
-                        .collect();
-                    site.flags.admits(&deg, ik.configuration(q))
-                })
-                .min_by(|a, b| {
-                    let d = |x: &[f64]| match &previous {
-                        Some(p) => x.iter().zip(p).map(|(u, v)| (u - v).abs()).sum::<f64>(),
-                        None => 0.0,
-                    };
-                    d(a).total_cmp(&d(b))
-                });
-            let Some(q) = q else {
-                errors.push(None);
-                continue;
-            };
-            let tip = self
-                .flange(f, &q)
-                .compose(&self.held)
-                .inverse()
-                .compose(&self.fixed_cell);
-            errors.push(Some((tip.p - self.target(f, i).p).norm() * 1e3));
-            previous = Some(q);
-        }
-        errors
-    }
-}
 
 #[test]
 fn a_stationary_tool_with_a_robot_held_work_object_is_filtered() {
     let f = fixture();
     let s = swapped(f);
-    let file = s.module(f);
+    let file = glue_module(&s, f);
     let out = filter(
         Language::Rapid,
         std::slice::from_ref(&file),
@@ -293,11 +161,11 @@ fn a_stationary_tool_with_a_robot_held_work_object_is_filtered() {
         .targets
         .iter()
         .all(|t| t.load.as_ref().unwrap().source == LoadSource::Program));
-    let filtered = s.run(f, &out.files[0]);
+    let filtered = s.run(f, Language::Rapid, &out.files);
     assert!(filtered.iter().all(Option::is_some), "{filtered:?}");
     let max_f = filtered.iter().flatten().copied().fold(0.0, f64::max);
     let (mean_f, _) = mean(&filtered);
-    let (mean_u, reached_u) = mean(&s.run(f, &file));
+    let (mean_u, reached_u) = mean(&s.run(f, Language::Rapid, std::slice::from_ref(&file)));
     println!(
         "RAPID stationary tool, robot-held work object: true tool tip vs target filtered \
          mean {mean_f:.4} mm, max {max_f:.4} mm (40); unfiltered mean {mean_u:.3} mm ({reached_u})"
