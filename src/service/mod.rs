@@ -26,6 +26,7 @@ pub mod sets;
 pub mod solve;
 mod state;
 pub mod versions;
+mod waiting;
 
 pub use state::{AppState, RobotContext, ServiceConfig};
 

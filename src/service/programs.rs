@@ -6,9 +6,10 @@
 //! solve batches.
 
 use super::solve::{chosen_model, ModelChoice};
+use super::waiting::Waiting;
 use super::{AppState, ServiceError};
 use crate::ik::IkSettings;
-use crate::program::{filter, FilterOutput, Language, ProgramFile};
+use crate::program::{filter_with, FilterControl, FilterError, FilterOutput, Language, ProgramFile};
 
 /// A filter, in domain terms.
 #[derive(Debug, Clone)]
@@ -50,13 +51,34 @@ pub async fn filter_program(
         .await
         .map_err(|_| ServiceError::Unavailable("the service is shutting down".into()))?;
     let files = cmd.files;
+    let max_targets = state.limits().targets_per_request;
+    // Dropped with this future when the client goes away: the filter stops
+    // before its next target.
+    let (_waiting, flag) = Waiting::new();
+    let task_state = state.clone();
     let output = tokio::task::spawn_blocking(move || {
         let _permit = permit;
         let _ticket = ticket;
-        filter(language, &files, &cell, &model, &IkSettings::default())
+        let control = FilterControl {
+            max_targets: Some(max_targets),
+            keep_going: &|| flag.still_waiting(),
+        };
+        let out = filter_with(language, &files, &cell, &model, &IkSettings::default(), &control);
+        if matches!(out, Err(FilterError::Cancelled)) {
+            task_state.note_abandoned();
+            tracing::info!("a filter was stopped: its client went away");
+        }
+        out
     })
     .await
-    .map_err(|e| ServiceError::Internal(format!("filter task: {e}")))??;
+    .map_err(|e| ServiceError::Internal(format!("filter task: {e}")))?
+    .map_err(|e| match e {
+        FilterError::Parse(p) => ServiceError::Unparsable(p),
+        FilterError::TooManyTargets { .. } => ServiceError::Invalid(format!(
+            "{e} (`--max-targets`)"
+        )),
+        FilterError::Cancelled => ServiceError::Unavailable(e.to_string()),
+    })?;
     Ok(FilterOutcome {
         version: chosen.version,
         method: chosen.method,

@@ -17,6 +17,7 @@
 //! seeds and commands in the controller convention in degrees.
 
 use super::limits::SMALL_SOLVE_MAX;
+use super::waiting::{Waiting, WaitingFlag};
 use super::{AppState, ServiceError};
 use crate::cell::file::PoseMmDeg;
 use crate::cell::{
@@ -62,6 +63,36 @@ impl Targets {
         self.len() == 0
     }
 
+    /// Solves a large batch on a solve worker: JSON targets outside path mode
+    /// in chunks of [`CHUNK`], `None` once `flag` says the client has gone
+    /// (between chunks); a path (each target seeded by the one before) and a
+    /// targets CSV run whole, bounded by the target cap.
+    fn run_large(
+        &mut self,
+        solver: &IkSolver,
+        options: &SolveOptions,
+        path: bool,
+        flag: &WaitingFlag,
+    ) -> Option<Vec<TargetResult>> {
+        match self {
+            Targets::Inputs(t) if !path => {
+                // The ids a whole batch would give (1-based positions).
+                for (i, target) in t.iter_mut().enumerate() {
+                    target.id.get_or_insert_with(|| (i + 1).to_string());
+                }
+                let mut out = Vec::with_capacity(t.len());
+                for chunk in t.chunks(CHUNK) {
+                    if !flag.still_waiting() {
+                        return None;
+                    }
+                    out.extend(solver.solve_targets(chunk, options));
+                }
+                Some(out)
+            }
+            _ => Some(self.run(solver, options, path)),
+        }
+    }
+
     fn run(&self, solver: &IkSolver, options: &SolveOptions, path: bool) -> Vec<TargetResult> {
         match self {
             Targets::Inputs(t) if path => solver.solve_targets_path(t, options),
@@ -73,6 +104,10 @@ impl Targets {
         }
     }
 }
+
+/// Targets of a large batch solved between two checks that the client
+/// still waits (a few hundred milliseconds of one worker).
+const CHUNK: usize = 2048;
 
 /// A solve, in domain terms.
 #[derive(Debug, Clone)]
@@ -325,13 +360,24 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
             .acquire_owned()
             .await
             .map_err(|_| ServiceError::Unavailable("the service is shutting down".into()))?;
+        // Dropped with this future when the client goes away.
+        let (_waiting, flag) = Waiting::new();
+        let task_state = state.clone();
         tokio::task::spawn_blocking(move || {
             let _permit = permit;
             let _ticket = ticket;
-            cmd.targets.run(&solver, &cmd.options, cmd.path)
+            let out = cmd
+                .targets
+                .run_large(&solver, &cmd.options, cmd.path, &flag);
+            if out.is_none() {
+                task_state.note_abandoned();
+                tracing::info!("a solve batch was stopped: its client went away");
+            }
+            out
         })
         .await
         .map_err(|e| ServiceError::Internal(format!("solver task: {e}")))?
+        .ok_or_else(|| ServiceError::Unavailable("the solve was stopped before it finished".into()))?
     };
     let mut results = results;
     if let Some(w) = &work_object {

@@ -104,6 +104,8 @@ struct Inner {
     /// Large solve batches running or waiting (solve_workers + queued_solves).
     solve_gate: Arc<Admission>,
     cancel_flags: Mutex<HashMap<i64, Arc<AtomicBool>>>,
+    /// Filters and solve batches stopped because their client went away.
+    abandoned: std::sync::atomic::AtomicUsize,
     /// Jobs of the shared store this replica runs, with their claim tokens.
     claims: Mutex<HashMap<i64, String>>,
     /// Set on SIGTERM: the runner claims no more jobs.
@@ -145,6 +147,7 @@ impl AppState {
                 solve_slots: Arc::new(Semaphore::new(solve_workers)),
                 job_gate: Admission::new(workers + config.limits.queued_jobs),
                 solve_gate: Admission::new(solve_workers + config.limits.queued_solves),
+                abandoned: std::sync::atomic::AtomicUsize::new(0),
                 config,
                 cancel_flags: Mutex::new(HashMap::new()),
                 claims: Mutex::new(HashMap::new()),
@@ -214,6 +217,21 @@ impl AppState {
 
     pub(crate) fn calibration_slots(&self) -> Arc<Semaphore> {
         self.inner.calibration_slots.clone()
+    }
+
+    /// Large solve batches and filters admitted now (running or waiting).
+    pub fn solves_in_flight(&self) -> usize {
+        self.inner.solve_gate.in_flight()
+    }
+
+    /// How many filters and solve batches stopped because their client
+    /// went away before the answer.
+    pub fn abandoned_work(&self) -> usize {
+        self.inner.abandoned.load(Ordering::Acquire)
+    }
+
+    pub(crate) fn note_abandoned(&self) {
+        self.inner.abandoned.fetch_add(1, Ordering::AcqRel);
     }
 
     pub(crate) fn solve_slots(&self) -> Arc<Semaphore> {

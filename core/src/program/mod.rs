@@ -20,7 +20,8 @@ mod rewrite;
 pub mod urscript;
 
 pub use rewrite::{
-    filter, FilterOutput, FilterReport, LoadSource, TargetReport, TargetStatus, UsedLoad,
+    filter, filter_with, FilterControl, FilterError, FilterOutput, FilterReport, LoadSource,
+    TargetReport, TargetStatus, UsedLoad,
 };
 
 use crate::cell::{CellRef, Load};

@@ -98,6 +98,35 @@ pub struct FilterOutput {
     pub report: FilterReport,
 }
 
+/// Bounds on one filter: the most targets it takes, and a test, asked
+/// before each target, of whether to go on (a client still waiting).
+pub struct FilterControl<'a> {
+    /// Most Cartesian targets (sites) a program may have (`None`: no cap).
+    pub max_targets: Option<usize>,
+    /// `false` stops the filter before the next target.
+    pub keep_going: &'a dyn Fn() -> bool,
+}
+
+impl Default for FilterControl<'_> {
+    fn default() -> Self {
+        FilterControl {
+            max_targets: None,
+            keep_going: &|| true,
+        }
+    }
+}
+
+/// Why a bounded filter produced nothing.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FilterError {
+    #[error(transparent)]
+    Parse(#[from] ParseError),
+    #[error("the program has {targets} Cartesian targets; at most {max} are filtered in one request: split the program")]
+    TooManyTargets { targets: usize, max: usize },
+    #[error("the filter was stopped before it finished")]
+    Cancelled,
+}
+
 /// Filters a program: every Cartesian target becomes its false target on
 /// `model` for its tool and work object (looked up in `cell`).
 pub fn filter(
@@ -107,7 +136,43 @@ pub fn filter(
     model: &CompensatedModel,
     settings: &IkSettings,
 ) -> Result<FilterOutput, ParseError> {
+    filter_with(
+        language,
+        files,
+        cell,
+        model,
+        settings,
+        &FilterControl::default(),
+    )
+    .map_err(|e| match e {
+        FilterError::Parse(p) => p,
+        // Unbounded and never stopped.
+        FilterError::TooManyTargets { .. } | FilterError::Cancelled => {
+            unreachable!("an unbounded filter neither caps nor stops")
+        }
+    })
+}
+
+/// [`filter`] within `control`'s bounds: a program with more targets than
+/// its cap is refused before any solve, and the filter stops between targets
+/// once `keep_going` says so.
+pub fn filter_with(
+    language: Language,
+    files: &[ProgramFile],
+    cell: &Cell,
+    model: &CompensatedModel,
+    settings: &IkSettings,
+    control: &FilterControl,
+) -> Result<FilterOutput, FilterError> {
     let program = parse(language, files)?;
+    if let Some(max) = control.max_targets {
+        if program.sites.len() > max {
+            return Err(FilterError::TooManyTargets {
+                targets: program.sites.len(),
+                max,
+            });
+        }
+    }
     let mut solvers: Vec<(Pose, Option<Load>, CellSolver)> = Vec::new();
     let mut edits: Vec<Vec<(std::ops::Range<usize>, String)>> = vec![Vec::new(); files.len()];
     let mut targets = Vec::with_capacity(program.sites.len());
@@ -115,6 +180,9 @@ pub fn filter(
     let mut used_tools: Vec<ControllerTool> = Vec::new();
     let mut used_frames: Vec<ControllerFrame> = Vec::new();
     for site in &program.sites {
+        if !(control.keep_going)() {
+            return Err(FilterError::Cancelled);
+        }
         let mut report = TargetReport {
             file: files[site.file].name.clone(),
             line: site.line,
