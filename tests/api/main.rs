@@ -14,6 +14,7 @@
 //! the calibration record, check poses), `roles` (keys with roles, open reads,
 //! the console's security headers); the harness is `support`.
 
+mod abandoned;
 mod cell;
 #[path = "../common/mod.rs"]
 mod common;
