@@ -65,6 +65,20 @@ pub struct Robot {
     /// The nominal model description (single-robot responses only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub model: Option<Value>,
+    /// The latest check's status (single-robot responses only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub check: Option<RobotCheck>,
+}
+
+/// Where a robot stands by its latest check (`status` null before any).
+#[derive(Debug, Serialize)]
+pub struct RobotCheck {
+    pub status: Option<&'static str>,
+    pub check_id: Option<i64>,
+    pub checked_at: Option<String>,
+    /// The model version the check scored.
+    pub version: Option<i64>,
+    pub mean_mm: Option<f64>,
 }
 
 impl Robot {
@@ -81,6 +95,7 @@ impl Robot {
             model: with_model
                 .then(|| serde_json::from_str(&r.model_json).ok())
                 .flatten(),
+            check: None,
         }
     }
 }
@@ -210,7 +225,16 @@ pub async fn get_one(
     ApiPath(id): ApiPath<i64>,
 ) -> Result<Response, ApiError> {
     let row = service::robots::get(&state, id).await?;
-    Ok(axum::Json(Robot::from_row(row, true)).into_response())
+    let (status, latest, _) = service::checks::status(&state, id).await?;
+    let mut robot = Robot::from_row(row, true);
+    robot.check = Some(RobotCheck {
+        status: status.map(|s| s.name()),
+        check_id: latest.as_ref().map(|c| c.id),
+        checked_at: latest.as_ref().map(|c| c.created_at.clone()),
+        version: latest.as_ref().map(|c| c.version),
+        mean_mm: latest.as_ref().map(|c| c.mean_mm),
+    });
+    Ok(axum::Json(robot).into_response())
 }
 
 pub async fn update(

@@ -148,6 +148,8 @@ async fn checks_score_the_active_version_and_give_the_status() {
     assert_eq!(r.status, StatusCode::OK);
     assert_eq!(r.json()["status"], serde_json::Value::Null);
     assert_eq!(r.json()["thresholds"]["degraded_mm"], 0.5);
+    let r = t.get("/v1/robots/{id}", &[&rid]).await;
+    assert_eq!(r.json()["check"]["status"], serde_json::Value::Null);
 
     let q1 = t
         .upload_csv(robot, &simulated_csv(1, 30), "?name=q1&role=identification")
@@ -205,6 +207,12 @@ async fn checks_score_the_active_version_and_give_the_status() {
     let r = t.get("/v1/robots/{id}/status", &[&rid]).await;
     assert_eq!(r.json()["status"], "recalibrate");
     assert_eq!(r.json()["latest_check"]["set_id"], crash_set);
+    // The robot shows it too.
+    let r = t.get("/v1/robots/{id}", &[&rid]).await;
+    let shown = &r.json()["check"];
+    assert_eq!(shown["status"], "recalibrate", "{shown}");
+    assert_eq!(shown["version"], 1);
+    assert!(shown["mean_mm"].as_f64().unwrap() > 0.5, "{shown}");
     let r = t.get("/v1/robots/{id}/checks", &[&rid]).await;
     assert_eq!(r.json()["total"], 2);
     assert_eq!(r.json()["checks"][0]["status"], "ok");
