@@ -218,4 +218,47 @@ fn check_names_a_moved_tracker_and_a_changed_robot() {
     );
     assert_eq!(changed.status.name(), "recalibrate", "{}", changed.summary);
     assert!(!changed.frame_shift.as_ref().unwrap().explains);
+
+    // `compare`: the same poses against the UR10 they come from and a UR5:
+    // the UR10 as `check` scored it, the UR5 centimetres off.
+    let path = dir.path().join("same.csv");
+    let args = match robocal::cli::Cli::try_parse_from([
+        "robocal",
+        "compare",
+        "--model",
+        "ur10",
+        "--model",
+        "ur5",
+        "--measurements",
+        path.to_str().unwrap(),
+    ])
+    .unwrap()
+    .command
+    {
+        robocal::cli::Command::Compare(a) => a,
+        other => panic!("{other:?}"),
+    };
+    let scores = robocal::cli::check::compare_files(&args).unwrap();
+    assert_eq!(scores.len(), 2);
+    assert_eq!(scores[0].model, "ur10");
+    assert_eq!(scores[0].result.position, same.position);
+    assert!(scores[1].result.position.mean_mm > 10.0, "{:?}", scores[1].result.position);
+    let table = robocal::cli::check::compare_text(&scores);
+    assert_eq!(table.lines().count(), 3, "{table}");
+    assert!(table.lines().nth(2).unwrap().starts_with("ur5 | recalibrate"), "{table}");
+    // One model is not a comparison.
+    let one = robocal::cli::Cli::try_parse_from([
+        "robocal",
+        "compare",
+        "--model",
+        "ur10",
+        "--measurements",
+        path.to_str().unwrap(),
+    ])
+    .unwrap();
+    let robocal::cli::Command::Compare(a) = one.command else {
+        panic!()
+    };
+    let e = robocal::cli::check::compare_files(&a).unwrap_err();
+    assert!(e.to_string().contains("at least two"), "{e}");
 }

@@ -5,19 +5,30 @@
 //!
 //! ```text
 //! robocal check --model cal.json --measurements check.csv [--degraded-mm 0.5] [--recalibrate-mm 1.0] [--json]
+//! robocal compare --model v1.json --model v2.json --measurements check.csv [--json]
 //! ```
+//!
+//! `compare` scores the same poses against each model, so versions compare
+//! where their own validation figures (from different sets) cannot.
 
 use anyhow::Context;
 use clap::Args;
 use robocal_core::check::{score, CheckResult, CheckThresholds};
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(Debug, Args)]
 pub struct CheckArgs {
     /// A calibrated model file (`calibrate --save`), a model JSON file or a preset.
     #[arg(long)]
     pub model: String,
+    #[command(flatten)]
+    pub check: CheckOptions,
+}
+
+/// The poses a check scores, its thresholds and its output.
+#[derive(Debug, Args)]
+pub struct CheckOptions {
     /// The check poses: a measurement CSV in the model's measurement frame.
     #[arg(long)]
     pub measurements: PathBuf,
@@ -73,22 +84,114 @@ pub fn check_text(r: &CheckResult) -> String {
 
 /// Scores the check file against the model.
 pub fn check_file(a: &CheckArgs) -> anyhow::Result<CheckResult> {
-    let model = super::model_files::load_compensated(&a.model)?;
-    let path = &a.measurements;
+    let c = &a.check;
+    let rows = read_rows(&c.measurements)?;
+    score_model(&a.model, &rows, &c.thresholds(), &c.measurements)
+}
+
+fn read_rows(path: &Path) -> anyhow::Result<Vec<crate::measure::MeasuredPose>> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let rows = crate::measure::csv::parse(&text).with_context(|| path.display().to_string())?;
-    let thresholds = CheckThresholds {
-        degraded_mm: a.degraded_mm,
-        recalibrate_mm: a.recalibrate_mm,
-        frame_shift_ratio: a.frame_shift_ratio,
-    };
-    score(&model, &rows, &thresholds).with_context(|| path.display().to_string())
+    crate::measure::csv::parse(&text).with_context(|| path.display().to_string())
+}
+
+impl CheckOptions {
+    fn thresholds(&self) -> CheckThresholds {
+        CheckThresholds {
+            degraded_mm: self.degraded_mm,
+            recalibrate_mm: self.recalibrate_mm,
+            frame_shift_ratio: self.frame_shift_ratio,
+        }
+    }
+}
+
+fn score_model(
+    model: &str,
+    rows: &[crate::measure::MeasuredPose],
+    t: &CheckThresholds,
+    path: &Path,
+) -> anyhow::Result<CheckResult> {
+    let m = super::model_files::load_compensated(model)?;
+    score(&m, rows, t).with_context(|| format!("{model} on {}", path.display()))
+}
+
+#[derive(Debug, Args)]
+pub struct CompareArgs {
+    /// The model files to compare (at least two), each as `check --model` takes it.
+    #[arg(long = "model", required = true, num_args = 1)]
+    pub models: Vec<String>,
+    /// The poses all are scored on, the thresholds of the statuses.
+    #[command(flatten)]
+    pub check: CheckOptions,
+}
+
+/// One model's score in a comparison.
+#[derive(Debug, serde::Serialize)]
+pub struct ModelScore {
+    pub model: String,
+    #[serde(flatten)]
+    pub result: CheckResult,
+}
+
+/// Scores the same poses against each model.
+pub fn compare_files(a: &CompareArgs) -> anyhow::Result<Vec<ModelScore>> {
+    if a.models.len() < 2 {
+        anyhow::bail!("compare needs at least two models (--model A --model B)");
+    }
+    let c = &a.check;
+    let rows = read_rows(&c.measurements)?;
+    let t = c.thresholds();
+    a.models
+        .iter()
+        .map(|m| {
+            Ok(ModelScore {
+                model: m.clone(),
+                result: score_model(m, &rows, &t, &c.measurements)?,
+            })
+        })
+        .collect()
+}
+
+/// The comparison as a table: a row per model.
+pub fn compare_text(scores: &[ModelScore]) -> String {
+    let mut s = String::from(
+        "model | status | position mean / p95 / max [mm] | orientation mean / max [deg] | frame shift explains\n",
+    );
+    for m in scores {
+        let (p, r) = (&m.result.position, &m.result);
+        let o = r.orientation.as_ref().map_or("—".to_string(), |o| {
+            format!("{:.4} / {:.4}", o.mean_deg, o.max_deg)
+        });
+        let f = r
+            .frame_shift
+            .as_ref()
+            .map_or("—", |f| if f.explains { "yes" } else { "no" });
+        let _ = writeln!(
+            s,
+            "{} | {} | {:.4} / {:.4} / {:.4} | {o} | {f}",
+            m.model,
+            r.status.name(),
+            p.mean_mm,
+            p.p95_mm,
+            p.max_mm
+        );
+    }
+    s
+}
+
+pub fn compare(a: CompareArgs) -> anyhow::Result<()> {
+    let scores = compare_files(&a)?;
+    if a.check.json {
+        println!("{}", serde_json::to_string_pretty(&scores)?);
+    } else {
+        print!("{}", compare_text(&scores));
+    }
+    Ok(())
 }
 
 pub fn run(a: CheckArgs) -> anyhow::Result<()> {
     let r = check_file(&a)?;
-    if a.json {
+    if a.check.json {
         println!("{}", serde_json::to_string_pretty(&r)?);
     } else {
         print!("{}", check_text(&r));

@@ -36,6 +36,8 @@ pub enum Command {
     Calibrate(calibrate::CalibrateArgs),
     /// Score check poses against a calibrated model without fitting: the status.
     Check(check::CheckArgs),
+    /// Score one check set against several calibrated models (versions compared on the same poses).
+    Compare(check::CompareArgs),
     /// Run a built-in end-to-end study.
     Demo(demo::DemoArgs),
     /// Solve target poses into joint commands and false targets.
@@ -62,6 +64,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Simulate(a) => simulate::run(a),
         Command::Calibrate(a) => calibrate::run(a),
         Command::Check(a) => check::run(a),
+        Command::Compare(a) => check::compare(a),
         Command::Demo(a) => demo::run(a),
         Command::Solve(a) => solve::run(a),
         Command::Export(a) => export::run(a),

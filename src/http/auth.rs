@@ -33,6 +33,7 @@ pub const OPERATE: &[&str] = &[
     "/v1/robots/{id}/programs/filter",
     "/v1/robots/{id}/measurement-plans",
     "/v1/robots/{id}/checks",
+    "/v1/robots/{id}/compare",
 ];
 
 /// The access a route (method and path template, as in `openapi.yaml`) needs.

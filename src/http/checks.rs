@@ -125,6 +125,37 @@ pub async fn status(
     .into_response())
 }
 
+/// `POST /v1/robots/{id}/compare` body.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CompareRequest {
+    pub set_id: i64,
+    pub versions: Vec<i64>,
+}
+
+/// `POST /v1/robots/{id}/compare` answer.
+#[derive(Debug, Serialize)]
+pub struct Comparison {
+    pub robot_id: i64,
+    pub set_id: i64,
+    pub versions: Vec<service::checks::VersionScore>,
+}
+
+pub async fn compare(
+    State(state): State<AppState>,
+    ApiPath(robot_id): ApiPath<i64>,
+    ApiJson(body): ApiJson<CompareRequest>,
+) -> Result<Response, ApiError> {
+    let versions =
+        service::checks::compare(&state, robot_id, body.set_id, &body.versions).await?;
+    Ok(axum::Json(Comparison {
+        robot_id,
+        set_id: body.set_id,
+        versions,
+    })
+    .into_response())
+}
+
 /// `PUT /v1/robots/{id}/check-thresholds` body.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -157,6 +188,7 @@ pub fn routes() -> Vec<super::Route> {
         get("/v1/robots/{id}/checks", list),
         post("/v1/robots/{id}/checks", create),
         get("/v1/robots/{id}/status", status),
+        post("/v1/robots/{id}/compare", compare),
         route(
             axum::http::Method::PUT,
             "/v1/robots/{id}/check-thresholds",

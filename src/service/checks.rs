@@ -7,6 +7,7 @@ use crate::compensate::CalibratedModelFile;
 use crate::db::{CheckRow, Listing, NewCheck};
 use robocal_core::check::{score, CheckResult, CheckStatus, CheckThresholds};
 use serde::Serialize;
+use serde_json::Value;
 
 /// A check to run.
 #[derive(Debug, Clone)]
@@ -109,6 +110,79 @@ pub async fn create(state: &AppState, cmd: CheckCommand) -> Result<CheckRow, Ser
         "check scored"
     );
     Ok(row)
+}
+
+/// Most versions one comparison scores.
+pub const COMPARE_VERSIONS_MAX: usize = 20;
+
+/// One version's score in a comparison.
+#[derive(Debug, Serialize)]
+pub struct VersionScore {
+    pub version: i64,
+    pub method: String,
+    /// Figures, per-pose errors, frame shift, status for the robot's
+    /// thresholds, summary and the thresholds.
+    pub result: Value,
+}
+
+/// Scores one set against several versions (nothing is fitted or stored):
+/// figures that compare, unlike versions' validation figures from
+/// different sets.
+pub async fn compare(
+    state: &AppState,
+    robot_id: i64,
+    set_id: i64,
+    versions: &[i64],
+) -> Result<Vec<VersionScore>, ServiceError> {
+    if versions.is_empty() || versions.len() > COMPARE_VERSIONS_MAX {
+        return Err(ServiceError::Invalid(format!(
+            "compare 1 to {COMPARE_VERSIONS_MAX} versions, got {}",
+            versions.len()
+        )));
+    }
+    if let Some(v) = versions.iter().find(|v| **v < 1) {
+        return Err(ServiceError::Invalid(format!(
+            "version numbers start at 1, got {v}"
+        )));
+    }
+    let t = thresholds(state, robot_id).await?;
+    let rows = state
+        .db()
+        .set_rows(robot_id, set_id)
+        .await?
+        .ok_or_else(|| ServiceError::set_not_found(robot_id, set_id))?;
+    let mut models = Vec::with_capacity(versions.len());
+    for &v in versions {
+        let (row, text) = versions::with_model(state, robot_id, v).await?;
+        let model = CalibratedModelFile::from_json(&text)
+            .and_then(|f| f.to_compensated())
+            .map_err(|e| ServiceError::Internal(format!("stored model of version {v}: {e}")))?;
+        models.push((v, row.method, model));
+    }
+    let ticket = state.admit_solve()?;
+    let scored = tokio::task::spawn_blocking(move || {
+        let _ticket = ticket;
+        models
+            .into_iter()
+            .map(|(version, method, model)| {
+                let result = score(&model, &rows, &t)
+                    .map_err(|e| ServiceError::Invalid(format!("version {version}: {e}")))?;
+                let result = serde_json::to_value(Stored {
+                    result: &result,
+                    thresholds: t,
+                })
+                .map_err(|e| ServiceError::Internal(e.to_string()))?;
+                Ok(VersionScore {
+                    version,
+                    method,
+                    result,
+                })
+            })
+            .collect::<Result<Vec<_>, ServiceError>>()
+    })
+    .await
+    .map_err(|e| ServiceError::Internal(format!("compare task: {e}")))?;
+    scored
 }
 
 /// One page of the robot's checks, oldest first.

@@ -217,6 +217,31 @@ async fn checks_score_the_active_version_and_give_the_status() {
     assert_eq!(r.json()["total"], 2);
     assert_eq!(r.json()["checks"][0]["status"], "ok");
 
+    // Compare: the same scoring, nothing stored; a version the robot lacks is 404.
+    let r = t
+        .post_json(
+            "/v1/robots/{id}/compare",
+            &[&rid],
+            json!({ "set_id": check_set["id"], "versions": [1] }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let scored = &r.json()["versions"][0];
+    assert_eq!(scored["version"], 1);
+    assert_eq!(scored["method"], "skcm");
+    assert_eq!(scored["result"]["position"], ok["result"]["position"]);
+    assert_eq!(scored["result"]["status"], "ok");
+    let r = t
+        .post_json(
+            "/v1/robots/{id}/compare",
+            &[&rid],
+            json!({ "set_id": check_set["id"], "versions": [1, 9] }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::NOT_FOUND, "{}", r.text());
+    let r = t.get("/v1/robots/{id}/checks", &[&rid]).await;
+    assert_eq!(r.json()["total"], 2);
+
     // Looser thresholds judge later checks; inverted ones are refused.
     let r = t
         .send(
