@@ -34,6 +34,7 @@ pub const OPERATE: &[&str] = &[
     "/v1/robots/{id}/measurement-plans",
     "/v1/robots/{id}/checks",
     "/v1/robots/{id}/compare",
+    "/v1/iso9283",
 ];
 
 /// The access a route (method and path template, as in `openapi.yaml`) needs.

@@ -33,6 +33,7 @@ pub mod client;
 pub mod console;
 pub mod error;
 pub mod input;
+pub mod iso9283;
 
 pub mod listener;
 pub mod plans;
@@ -142,6 +143,7 @@ fn routes() -> Vec<Route> {
     all.extend(plans::routes());
     all.extend(checks::routes());
     all.extend(record::routes());
+    all.extend(iso9283::routes());
     all
 }
 

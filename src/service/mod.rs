@@ -14,6 +14,7 @@ pub mod calibrations;
 pub mod cell;
 mod changes;
 pub mod checks;
+pub mod iso9283;
 mod job_watch;
 pub mod keys;
 pub mod limits;

@@ -21,6 +21,7 @@ mod common;
 mod contract;
 mod flow;
 mod hostile;
+mod iso9283;
 mod jobs;
 mod plans;
 mod record;
