@@ -87,8 +87,50 @@ const handlers = {
     if (seed) body.seed = Number(seed);
     const payload = formValue(form, "payload_kg");
     if (payload) body.payload_kg = Number(payload);
+    // Ticked sets per role; none ticked: the service takes every set of the role.
+    for (const role of ["identification", "validation", "training"]) {
+      const ids = [...form.querySelectorAll(`input[name=${role}_set]:checked`)].map((c) => Number(c.value));
+      if (ids.length) body[role + "_set_ids"] = ids;
+    }
     await api("POST", `/v1/robots/${robot}/calibrations`, JSON.stringify(body), "application/json");
     location.reload();
+  },
+  async check(form) {
+    const robot = form.dataset.robot;
+    const body = { set_id: Number(formValue(form, "set_id")) };
+    const version = formValue(form, "version");
+    if (version) body.version = Number(version);
+    const temperature = formValue(form, "temperature_c");
+    if (temperature) body.temperature_c = Number(temperature);
+    await api("POST", `/v1/robots/${robot}/checks`, JSON.stringify(body), "application/json");
+    location.reload();
+  },
+  async compare(form) {
+    const robot = form.dataset.robot;
+    const versions = [...form.querySelectorAll("input[name=version]:checked")].map((c) => Number(c.value));
+    if (!versions.length) throw new Error("tick at least one version");
+    const body = { set_id: Number(formValue(form, "set_id")), versions };
+    const r = (await api("POST", `/v1/robots/${robot}/compare`, JSON.stringify(body), "application/json")).json();
+    const table = document.getElementById("compare-result");
+    const tbody = table.querySelector("tbody");
+    tbody.textContent = "";
+    for (const v of r.versions) {
+      const p = v.result.position;
+      const o = v.result.orientation;
+      const f = v.result.frame_shift;
+      const cells = ["v" + v.version, v.method, p.mean_mm.toFixed(4), p.p95_mm.toFixed(4), p.max_mm.toFixed(4),
+        o ? o.mean_deg.toFixed(4) : "—", v.result.status, f ? (f.explains ? "yes" : "no") : "—"];
+      const tr = document.createElement("tr");
+      tr.className = "compared";
+      for (const c of cells) {
+        const td = document.createElement("td");
+        td.textContent = String(c);
+        tr.append(td);
+      }
+      tbody.append(tr);
+    }
+    table.hidden = false;
+    show(`${r.versions.length} versions scored on set ${r.set_id}`, true);
   },
 };
 
@@ -112,6 +154,8 @@ document.addEventListener("click", async (ev) => {
   const b = ev.target.closest("button[data-post]");
   if (!b) return;
   ev.preventDefault();
+  // Activating and rolling back change what every solve uses: asked first.
+  if (b.dataset.confirm && !window.confirm(b.dataset.confirm)) return;
   b.disabled = true;
   try {
     await api("POST", b.dataset.post);
@@ -124,6 +168,14 @@ document.addEventListener("click", async (ev) => {
 
 // The key form stores the key in this tab only.
 document.addEventListener("DOMContentLoaded", () => {
+  // Times as the browser's local time (the server writes UTC).
+  for (const t of document.querySelectorAll("time[datetime]")) {
+    const d = new Date(t.dateTime);
+    if (!isNaN(d)) {
+      t.title = t.dateTime;
+      t.textContent = d.toLocaleString();
+    }
+  }
   const key = document.getElementById("api-key");
   if (key) {
     key.value = apiKey();

@@ -1,7 +1,10 @@
 //! The web console: server-rendered pages (maud, escaping by default) for the
 //! whole flow — robots, measurement uploads, calibration jobs with live
-//! progress, reports, model versions with activate and rollback, solving a
-//! targets CSV, tools and work objects, and filtering robot programs. The
+//! progress, reports, model versions with activate and rollback (each
+//! confirmed first), checks with their status, trend and history, the
+//! comparison of versions on one set, solving a targets CSV, tools and work
+//! objects, and filtering robot programs; times shown in the browser's
+//! local time. The
 //! pages read through the service layer; every write is made by the
 //! page's own script through the REST API (`/v1`), so the console obeys the
 //! same API keys, limits and validation as any client. No external assets:
@@ -15,6 +18,7 @@
 //! [`pages::content_security_policy`]) and `X-Frame-Options: DENY`.
 
 mod cell_pages;
+mod check_pages;
 mod pages;
 
 use super::{route, ApiError, ApiPath, AppState, Route};
@@ -27,6 +31,9 @@ use maud::Markup;
 
 /// Robots listed on the start page.
 const ROBOTS_SHOWN: i64 = 500;
+
+/// Latest checks shown on a robot page.
+const CHECKS_SHOWN: i64 = 500;
 
 /// The routes of the console.
 pub fn routes() -> Vec<Route> {
@@ -47,7 +54,15 @@ async fn robot_page(
     ApiPath(id): ApiPath<i64>,
 ) -> Result<Response, ApiError> {
     let robot = service::robots::get(&state, id).await?;
+    let (status, _, thresholds) = service::checks::status(&state, id).await?;
+    let total = service::checks::page(&state, id, 1, 0).await?.total;
+    let checks = service::checks::page(&state, id, CHECKS_SHOWN, (total - CHECKS_SHOWN).max(0))
+        .await?
+        .rows;
     let view = pages::RobotView {
+        status,
+        thresholds,
+        checks,
         sets: service::sets::list(&state, id).await?,
         calibrations: service::calibrations::list(&state, id).await?,
         versions: service::versions::list(&state, id).await?,

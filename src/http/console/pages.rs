@@ -51,6 +51,10 @@ pub struct RobotView {
     pub tools: Vec<CellItemRow>,
     pub work_objects: Vec<CellItemRow>,
     pub keys: bool,
+    /// The latest check's status, the thresholds and the history (oldest first).
+    pub status: Option<robocal_core::check::CheckStatus>,
+    pub thresholds: robocal_core::check::CheckThresholds,
+    pub checks: Vec<crate::db::CheckRow>,
 }
 
 fn layout(title: &str, keys: bool, body: Markup) -> Markup {
@@ -103,7 +107,7 @@ pub fn robots(robots: &[RobotRow], total: i64, keys: bool) -> Markup {
                                 td { (r.preset.as_deref().unwrap_or("custom model")) }
                                 td { (r.dof) }
                                 td { @match r.active_version { Some(v) => { "v" (v) }, None => { "nominal" } } }
-                                td { (r.created_at) }
+                                td { time datetime=(r.created_at) { (r.created_at) } }
                             }
                         }
                     }
@@ -167,7 +171,7 @@ pub fn robot(v: &RobotView) -> Markup {
                                     td { (s.id) } td { (s.name) } td { (SetRole::from(s.role).as_str()) } td { (s.session) }
                                     td { (s.row_count) }
                                     td { @if let Some(p) = s.payload_kg { (p) } @else { "—" } }
-                                    td { (s.created_at) }
+                                    td { time datetime=(s.created_at) { (s.created_at) } }
                                     td { a href={ "/v1/robots/" (id) "/measurement-sets/" (s.id) "/original" } { "original" } }
                                 }
                             }
@@ -238,7 +242,7 @@ pub fn robot(v: &RobotView) -> Markup {
                                             }
                                         }
                                     }
-                                    td { (c.created_at) }
+                                    td { time datetime=(c.created_at) { (c.created_at) } }
                                     td {
                                         @if c.status == JobStatus::Succeeded {
                                             a href={ (url) "/report" } { "report" } " · "
@@ -265,6 +269,17 @@ pub fn robot(v: &RobotView) -> Markup {
                             }
                         }
                     }
+                    @for (role, legend) in [(SetRole::Identification, "Identification sets"), (SetRole::Validation, "Validation sets"), (SetRole::Training, "Training sets")] {
+                        @let of_role: Vec<&SetRow> = v.sets.iter().filter(|s| SetRole::from(s.role) == role).collect();
+                        @if !of_role.is_empty() {
+                            fieldset.sets data-role=(role.as_str()) {
+                                legend { (legend) " (none ticked: every " (role.as_str()) " set)" }
+                                @for s in of_role {
+                                    label.check { input type="checkbox" name={ (role.as_str()) "_set" } value=(s.id); " " (s.id) " " (s.name) }
+                                }
+                            }
+                        }
+                    }
                     label { "Seed " input name="seed" type="number" min="0" step="1" placeholder="1"; }
                     label { "Payload [kg] " input name="payload_kg" type="number" step="any" min="0" placeholder="model's"; }
                     button type="submit" { "Start calibration" }
@@ -285,18 +300,20 @@ pub fn robot(v: &RobotView) -> Markup {
                                     td { (ver.method) }
                                     td { @if let Some(c) = ver.calibration_id { (c) } @else { "—" } }
                                     td { @if let Some(m) = validation_mean(ver) { (format!("{m:.4}")) } @else { "—" } }
-                                    td { (ver.created_at) }
+                                    td { time datetime=(ver.created_at) { (ver.created_at) } }
                                     td {
                                         a href={ "/v1/robots/" (id) "/versions/" (ver.version) "/model.json" } { "model.json" }
                                         @if !ver.active {
-                                            " " button.small data-post={ "/v1/robots/" (id) "/versions/" (ver.version) "/activate" } { "Activate" }
+                                            " " button.small data-post={ "/v1/robots/" (id) "/versions/" (ver.version) "/activate" }
+                                                data-confirm={ "Activate v" (ver.version) " (" (ver.method) ")? Solves and filters will use it from now on." } { "Activate" }
                                         }
                                     }
                                 }
                             }
                         }
                     }
-                    p { button.small #rollback data-post={ "/v1/robots/" (id) "/versions/rollback" } { "Roll back to the previous active version" } }
+                    p { button.small #rollback data-post={ "/v1/robots/" (id) "/versions/rollback" }
+                        data-confirm="Roll back to the previously active version? Solves and filters will use it from now on." { "Roll back to the previous active version" } }
                 }
             }
 
@@ -330,6 +347,14 @@ pub fn robot(v: &RobotView) -> Markup {
                 }
             }
 
+            (super::check_pages::checks_section(&super::check_pages::ChecksView {
+                robot: id,
+                status: v.status,
+                thresholds: &v.thresholds,
+                checks: &v.checks,
+                sets: &v.sets,
+                versions: &v.versions,
+            }))
             (super::cell_pages::cell_section(id, &v.tools, &v.work_objects))
             (super::cell_pages::filter_section(id, &v.versions))
 
