@@ -146,11 +146,17 @@ def main():
         assert len(rows) == 2, f"expected 2 sets, the page lists {len(rows)}"
         shot("uploaded", "sets")
 
-        # 3. Calibrate with KM only; watch the job until it succeeds.
+        # 3. Calibrate with KM only, the grid picked as the identification set
+        # and the random poses as the validation set; watch the job until it
+        # succeeds.
         form = driver.find_element(By.ID, "calibrate")
         for box in form.find_elements(By.NAME, "method"):
             if box.is_selected() != (box.get_attribute("value") == "km"):
                 box.click()
+        picks = [form.find_elements(By.NAME, f"{role}_set") for role in ("identification", "validation")]
+        assert [len(p) for p in picks] == [1, 1], f"set pickers: {[len(p) for p in picks]}"
+        for p in picks:
+            p[0].click()
         form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
         wait.until(replaced(form))
         wait.until(EC.presence_of_element_located((By.CSS_SELECTOR, "#calibrations tbody tr")))
@@ -195,6 +201,37 @@ def main():
         assert answer[0].startswith("id,status,reason,branch,j1_deg"), answer[0]
         assert len(answer) == 11 and all(",ok," in l for l in answer[1:]), answer
         shot("solved", "solve-section")
+
+        # 6b. Is it still accurate? Check the active version on the random
+        # set: the status, the trend and the history show it; compare the
+        # versions on the same set; a roll back asks first (dismissed here).
+        form = driver.find_element(By.ID, "run-check")
+        Select(form.find_element(By.NAME, "set_id")).select_by_index(0)
+        form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+        wait.until(replaced(form))
+        wait.until(EC.presence_of_element_located((By.ID, "check-trend")))
+        rows = driver.find_elements(By.CSS_SELECTOR, "#checks tbody tr")
+        assert len(rows) == 1, f"expected one check, the page lists {len(rows)}"
+        status = driver.find_element(By.CSS_SELECTOR, "#check-status .status-tag").text
+        assert status in ("ok", "degraded", "recalibrate"), status
+        assert len(driver.find_elements(By.CSS_SELECTOR, "#check-trend circle.check-point")) == 1
+        # Local times: the cell shows the browser's rendering, the UTC stamp stays in the title.
+        cell = driver.find_element(By.CSS_SELECTOR, "#checks tbody tr time")
+        assert cell.get_attribute("title") == cell.get_attribute("datetime"), cell.get_attribute("title")
+        assert cell.text != cell.get_attribute("datetime"), cell.text
+        form = driver.find_element(By.ID, "compare")
+        form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+        wait.until(EC.visibility_of_element_located((By.ID, "compare-result")))
+        compared = driver.find_elements(By.CSS_SELECTOR, "#compare-result tbody tr.compared")
+        assert len(compared) == len(driver.find_elements(By.CSS_SELECTOR, "#versions tbody tr")), len(compared)
+        shot("checks", "checks-section")
+        rollback = driver.find_element(By.ID, "rollback")
+        rollback.click()
+        alert = wait.until(EC.alert_is_present())
+        assert "Roll back" in alert.text, alert.text
+        alert.dismiss()
+        assert rollback.is_enabled(), "a dismissed roll back must not be sent"
+        assert driver.find_elements(By.CSS_SELECTOR, "#versions tr.active"), "still an active version"
 
         # 7. Tools and work objects: add a tool and a work object, add a
         # spare tool and delete it again.
