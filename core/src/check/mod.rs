@@ -18,10 +18,15 @@
 //! - Status ([`CheckStatus`]): `ok` when the judged mean is at most
 //!   `degraded_mm`, `degraded` up to `recalibrate_mm`, `recalibrate` beyond.
 //!
+//! - Quick re-registration ([`reregister`]): the measurement frame and the
+//!   measurement tool refitted on a small set, the rest of the model kept.
+//!
 //! Units: mm and degrees in the results, SI inside.
 
+mod reregister;
 mod score;
 
+pub use reregister::{reregister, Reregistration, ReregisterError, MAX_CONDITION, MIN_POSES};
 pub use score::{score, AngleStats, CheckError, CheckResult, FrameShift, PoseError};
 
 use serde::{Deserialize, Serialize};
