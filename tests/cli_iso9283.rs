@@ -179,14 +179,13 @@ fn check_names_a_moved_tracker_and_a_changed_robot() {
             })
             .collect()
     };
-    let run = |name: &str, rows: Vec<MeasuredPose>| {
+    let run_with_model = |name: &str, model: &str| {
         let path = dir.path().join(name);
-        std::fs::write(&path, csv::write(&rows)).unwrap();
         let args = match robocal::cli::Cli::try_parse_from([
             "robocal",
             "check",
             "--model",
-            "ur10",
+            model,
             "--measurements",
             path.to_str().unwrap(),
         ])
@@ -197,6 +196,10 @@ fn check_names_a_moved_tracker_and_a_changed_robot() {
             other => panic!("{other:?}"),
         };
         check_file(&args).unwrap()
+    };
+    let run = |name: &str, rows: Vec<MeasuredPose>| {
+        std::fs::write(dir.path().join(name), csv::write(&rows)).unwrap();
+        run_with_model(name, "ur10")
     };
     // The model's own positions (CSV rounding only): ok.
     let same = run("same.csv", rows(&|_, p| p));
@@ -261,4 +264,31 @@ fn check_names_a_moved_tracker_and_a_changed_robot() {
     };
     let e = robocal::cli::check::compare_files(&a).unwrap_err();
     assert!(e.to_string().contains("at least two"), "{e}");
+
+    // `reregister`: the tracker moved 4 mm; the refitted model scores the
+    // moved poses to rounding, and the file it saves loads back as a model.
+    let moved = dir.path().join("moved.csv");
+    let saved = dir.path().join("moved-model.json");
+    let argv = [
+        "robocal",
+        "reregister",
+        "--model",
+        "ur10",
+        "--measurements",
+        moved.to_str().unwrap(),
+        "--save",
+        saved.to_str().unwrap(),
+    ];
+    let robocal::cli::Command::Reregister(a) = robocal::cli::Cli::try_parse_from(argv).unwrap().command
+    else {
+        panic!("not reregister")
+    };
+    let report = robocal::cli::reregister::reregister_file(&a).unwrap();
+    assert!(report.before.mean_mm > 4.0, "{:?}", report.before);
+    assert!(report.after.max_mm < 1e-3, "{:?}", report.after);
+    assert!(report.frame_translation_mm > 4.0 && report.tool_shift_mm < 1e-3, "{report:?}");
+    let text = robocal::cli::reregister::report_text(&report);
+    assert!(text.contains("refitted measurement frame, tool position"), "{text}");
+    let rescored = run_with_model("moved.csv", saved.to_str().unwrap());
+    assert!(rescored.position.max_mm < 1e-3, "{:?}", rescored.position);
 }

@@ -13,6 +13,7 @@ pub mod iso9283;
 pub mod model_files;
 pub mod plan;
 pub mod progress;
+pub mod reregister;
 pub mod serve;
 pub mod simulate;
 pub mod solve;
@@ -38,6 +39,8 @@ pub enum Command {
     Check(check::CheckArgs),
     /// Score one check set against several calibrated models (versions compared on the same poses).
     Compare(check::CompareArgs),
+    /// Refit only the measurement frame and tool of a calibrated model on a few poses of a new session.
+    Reregister(reregister::ReregisterArgs),
     /// Run a built-in end-to-end study.
     Demo(demo::DemoArgs),
     /// Solve target poses into joint commands and false targets.
@@ -65,6 +68,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Calibrate(a) => calibrate::run(a),
         Command::Check(a) => check::run(a),
         Command::Compare(a) => check::compare(a),
+        Command::Reregister(a) => reregister::run(a),
         Command::Demo(a) => demo::run(a),
         Command::Solve(a) => solve::run(a),
         Command::Export(a) => export::run(a),
