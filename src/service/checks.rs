@@ -160,7 +160,7 @@ pub async fn compare(
         models.push((v, row.method, model));
     }
     let ticket = state.admit_solve()?;
-    let scored = tokio::task::spawn_blocking(move || {
+    tokio::task::spawn_blocking(move || {
         let _ticket = ticket;
         models
             .into_iter()
@@ -181,8 +181,7 @@ pub async fn compare(
             .collect::<Result<Vec<_>, ServiceError>>()
     })
     .await
-    .map_err(|e| ServiceError::Internal(format!("compare task: {e}")))?;
-    scored
+    .map_err(|e| ServiceError::Internal(format!("compare task: {e}")))?
 }
 
 /// One page of the robot's checks, oldest first.

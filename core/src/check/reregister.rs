@@ -179,7 +179,7 @@ pub fn reregister(
         let svd = j.clone().svd(true, true);
         let (smax, smin) = (svd.singular_values.max(), svd.singular_values.min());
         condition = if smin > 0.0 { smax / smin } else { f64::INFINITY };
-        if !(condition <= MAX_CONDITION) {
+        if condition.is_nan() || condition > MAX_CONDITION {
             return Err(ReregisterError::Undetermined { condition });
         }
         let step = svd

@@ -107,11 +107,15 @@ pub struct FilterControl<'a> {
     pub keep_going: &'a dyn Fn() -> bool,
 }
 
+fn always() -> bool {
+    true
+}
+
 impl Default for FilterControl<'_> {
     fn default() -> Self {
         FilterControl {
             max_targets: None,
-            keep_going: &|| true,
+            keep_going: &always,
         }
     }
 }
