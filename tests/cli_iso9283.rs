@@ -245,10 +245,21 @@ fn check_names_a_moved_tracker_and_a_changed_robot() {
     assert_eq!(scores.len(), 2);
     assert_eq!(scores[0].model, "ur10");
     assert_eq!(scores[0].result.position, same.position);
-    assert!(scores[1].result.position.mean_mm > 10.0, "{:?}", scores[1].result.position);
+    assert!(
+        scores[1].result.position.mean_mm > 10.0,
+        "{:?}",
+        scores[1].result.position
+    );
     let table = robocal::cli::check::compare_text(&scores);
     assert_eq!(table.lines().count(), 3, "{table}");
-    assert!(table.lines().nth(2).unwrap().starts_with("ur5 | recalibrate"), "{table}");
+    assert!(
+        table
+            .lines()
+            .nth(2)
+            .unwrap()
+            .starts_with("ur5 | recalibrate"),
+        "{table}"
+    );
     // One model is not a comparison.
     let one = robocal::cli::Cli::try_parse_from([
         "robocal",
@@ -279,16 +290,23 @@ fn check_names_a_moved_tracker_and_a_changed_robot() {
         "--save",
         saved.to_str().unwrap(),
     ];
-    let robocal::cli::Command::Reregister(a) = robocal::cli::Cli::try_parse_from(argv).unwrap().command
+    let robocal::cli::Command::Reregister(a) =
+        robocal::cli::Cli::try_parse_from(argv).unwrap().command
     else {
         panic!("not reregister")
     };
     let report = robocal::cli::reregister::reregister_file(&a).unwrap();
     assert!(report.before.mean_mm > 4.0, "{:?}", report.before);
     assert!(report.after.max_mm < 1e-3, "{:?}", report.after);
-    assert!(report.frame_translation_mm > 4.0 && report.tool_shift_mm < 1e-3, "{report:?}");
+    assert!(
+        report.frame_translation_mm > 4.0 && report.tool_shift_mm < 1e-3,
+        "{report:?}"
+    );
     let text = robocal::cli::reregister::report_text(&report);
-    assert!(text.contains("refitted measurement frame, tool position"), "{text}");
+    assert!(
+        text.contains("refitted measurement frame, tool position"),
+        "{text}"
+    );
     let rescored = run_with_model("moved.csv", saved.to_str().unwrap());
     assert!(rescored.position.max_mm < 1e-3, "{:?}", rescored.position);
 }

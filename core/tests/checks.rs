@@ -123,7 +123,11 @@ fn reregistration_after_a_remount_restores_the_original_accuracy() {
     );
     assert!(stale > 10.0, "{stale}");
     assert!(report.converged);
-    assert!((report.tool_shift_mm - 17.9).abs() < 0.1, "{}", report.tool_shift_mm);
+    assert!(
+        (report.tool_shift_mm - 17.9).abs() < 0.1,
+        "{}",
+        report.tool_shift_mm
+    );
     assert!(restored <= 1.1 * original, "{restored} vs {original}");
     assert_eq!(report.refitted, ["measurement frame", "tool position"]);
 

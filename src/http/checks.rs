@@ -146,8 +146,7 @@ pub async fn compare(
     ApiPath(robot_id): ApiPath<i64>,
     ApiJson(body): ApiJson<CompareRequest>,
 ) -> Result<Response, ApiError> {
-    let versions =
-        service::checks::compare(&state, robot_id, body.set_id, &body.versions).await?;
+    let versions = service::checks::compare(&state, robot_id, body.set_id, &body.versions).await?;
     Ok(axum::Json(Comparison {
         robot_id,
         set_id: body.set_id,

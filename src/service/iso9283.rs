@@ -20,7 +20,9 @@ pub struct Iso9283Test {
 
 /// The figures of each test, in order; a test that cannot be read says which
 /// and where.
-pub async fn figures(tests: Vec<Iso9283Test>) -> Result<Vec<(String, Iso9283Figures)>, ServiceError> {
+pub async fn figures(
+    tests: Vec<Iso9283Test>,
+) -> Result<Vec<(String, Iso9283Figures)>, ServiceError> {
     if tests.is_empty() || tests.len() > TESTS_MAX {
         return Err(ServiceError::Invalid(format!(
             "send 1 to {TESTS_MAX} tests, got {}",

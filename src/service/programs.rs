@@ -9,7 +9,9 @@ use super::solve::{chosen_model, ModelChoice};
 use super::waiting::Waiting;
 use super::{AppState, ServiceError};
 use crate::ik::IkSettings;
-use crate::program::{filter_with, FilterControl, FilterError, FilterOutput, Language, ProgramFile};
+use crate::program::{
+    filter_with, FilterControl, FilterError, FilterOutput, Language, ProgramFile,
+};
 
 /// A filter, in domain terms.
 #[derive(Debug, Clone)]
@@ -63,7 +65,14 @@ pub async fn filter_program(
             max_targets: Some(max_targets),
             keep_going: &|| flag.still_waiting(),
         };
-        let out = filter_with(language, &files, &cell, &model, &IkSettings::default(), &control);
+        let out = filter_with(
+            language,
+            &files,
+            &cell,
+            &model,
+            &IkSettings::default(),
+            &control,
+        );
         if matches!(out, Err(FilterError::Cancelled)) {
             task_state.note_abandoned();
             tracing::info!("a filter was stopped: its client went away");
@@ -74,9 +83,9 @@ pub async fn filter_program(
     .map_err(|e| ServiceError::Internal(format!("filter task: {e}")))?
     .map_err(|e| match e {
         FilterError::Parse(p) => ServiceError::Unparsable(p),
-        FilterError::TooManyTargets { .. } => ServiceError::Invalid(format!(
-            "{e} (`--max-targets`)"
-        )),
+        FilterError::TooManyTargets { .. } => {
+            ServiceError::Invalid(format!("{e} (`--max-targets`)"))
+        }
         FilterError::Cancelled => ServiceError::Unavailable(e.to_string()),
     })?;
     Ok(FilterOutcome {

@@ -377,7 +377,9 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
         })
         .await
         .map_err(|e| ServiceError::Internal(format!("solver task: {e}")))?
-        .ok_or_else(|| ServiceError::Unavailable("the solve was stopped before it finished".into()))?
+        .ok_or_else(|| {
+            ServiceError::Unavailable("the solve was stopped before it finished".into())
+        })?
     };
     let mut results = results;
     if let Some(w) = &work_object {

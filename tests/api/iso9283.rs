@@ -26,7 +26,8 @@ fn plan_and_cycles(dir: &std::path::Path) -> (String, String) {
         "--out",
         plan_path.to_str().unwrap(),
     ];
-    let robocal::cli::Command::Iso9283(a) = robocal::cli::Cli::try_parse_from(argv).unwrap().command
+    let robocal::cli::Command::Iso9283(a) =
+        robocal::cli::Cli::try_parse_from(argv).unwrap().command
     else {
         panic!("not iso9283")
     };
@@ -92,7 +93,8 @@ async fn iso9283_figures_over_http_are_the_standards_and_the_clis() {
         "--json",
     ]
     .map(str::to_string);
-    let robocal::cli::Command::Iso9283(a) = robocal::cli::Cli::try_parse_from(argv).unwrap().command
+    let robocal::cli::Command::Iso9283(a) =
+        robocal::cli::Cli::try_parse_from(argv).unwrap().command
     else {
         panic!("not iso9283")
     };

@@ -26,7 +26,7 @@
 mod reregister;
 mod score;
 
-pub use reregister::{reregister, Reregistration, ReregisterError, MAX_CONDITION, MIN_POSES};
+pub use reregister::{reregister, ReregisterError, Reregistration, MAX_CONDITION, MIN_POSES};
 pub use score::{score, AngleStats, CheckError, CheckResult, FrameShift, PoseError};
 
 use serde::{Deserialize, Serialize};

@@ -147,17 +147,20 @@ pub fn reregister(
     }
     let data = rows_of(model, rows)?;
     let tool0 = tool_pose(&model.calibrated);
-    let before = ErrorStats::from_errors_mm(&errors_mm(&data, &model.cell_from_base.inverse(), &tool0));
+    let before =
+        ErrorStats::from_errors_mm(&errors_mm(&data, &model.cell_from_base.inverse(), &tool0));
     // Start: the model's tool, the Kabsch registration onto its predictions.
     let predicted: Vec<Vector3<f64>> = data.iter().map(|r| r.flange.compose(&tool0).p).collect();
     let measured: Vec<Vector3<f64>> = data.iter().map(|r| r.y).collect();
-    let start = register(&measured, &predicted).map_err(|e| {
-        CheckError::InvalidInput(format!("the poses cannot be registered: {e}"))
-    })?;
+    let start = register(&measured, &predicted)
+        .map_err(|e| CheckError::InvalidInput(format!("the poses cannot be registered: {e}")))?;
     let (mut rb, mut pb) = (start.tracker_to_base.r, start.tracker_to_base.p);
     let mut t = tool0.p;
     let centre = measured.iter().sum::<Vector3<f64>>() / measured.len() as f64;
-    let spread = (measured.iter().map(|y| (y - centre).norm_squared()).sum::<f64>()
+    let spread = (measured
+        .iter()
+        .map(|y| (y - centre).norm_squared())
+        .sum::<f64>()
         / measured.len() as f64)
         .sqrt()
         .max(1e-3);
@@ -173,12 +176,17 @@ pub fn reregister(
             // Columns scaled to metres: ω by the points' spread.
             let jw = -(rb * skew(&row.y)) / spread;
             j.view_mut((3 * i, 0), (3, 3)).copy_from(&jw);
-            j.view_mut((3 * i, 3), (3, 3)).copy_from(&Matrix3::identity());
+            j.view_mut((3 * i, 3), (3, 3))
+                .copy_from(&Matrix3::identity());
             j.view_mut((3 * i, 6), (3, 3)).copy_from(&(-row.flange.r));
         }
         let svd = j.clone().svd(true, true);
         let (smax, smin) = (svd.singular_values.max(), svd.singular_values.min());
-        condition = if smin > 0.0 { smax / smin } else { f64::INFINITY };
+        condition = if smin > 0.0 {
+            smax / smin
+        } else {
+            f64::INFINITY
+        };
         if condition.is_nan() || condition > MAX_CONDITION {
             return Err(ReregisterError::Undetermined { condition });
         }

@@ -2,8 +2,8 @@
 
 use super::stationary::{swapped, Swapped};
 use super::*;
-use robocal_core::program::LoadSource;
 use robocal_core::model::orientation::{rotation_to, OrientationConvention};
+use robocal_core::program::LoadSource;
 use robocal_core::program::{filter, kuka_status, kuka_turn, TargetStatus};
 
 /// A KRL program visiting the fixture's 50 targets: even ones declared in the
@@ -295,7 +295,12 @@ fn an_external_tcp_is_filtered_with_the_roles_swapped() {
         let files = external_tcp(&s, f, config);
         let out = filter(Language::Krl, &files, &cell, &f.model, &settings()).unwrap();
         let r = &out.report;
-        assert_eq!((r.filtered, r.failed, r.skipped), (40, 0, 0), "{:?}", r.targets);
+        assert_eq!(
+            (r.filtered, r.failed, r.skipped),
+            (40, 0, 0),
+            "{:?}",
+            r.targets
+        );
         assert!(r
             .targets
             .iter()

@@ -91,12 +91,12 @@ fn filtered_rapid_brings_the_true_tcp_to_the_targets() {
     }
 }
 
-    /// The module: the stationary tool and the robot-held work object
-    /// declared, the tool's tload the true payload on the flange (RAPID: for
-    /// a stationary tool, the load of the gripper holding the work object).
+/// The module: the stationary tool and the robot-held work object
+/// declared, the tool's tload the true payload on the flange (RAPID: for
+/// a stationary tool, the load of the gripper holding the work object).
 fn glue_module(s: &Swapped, f: &Fixture) -> ProgramFile {
-        let ik = AnalyticIk::new(&s.bare).unwrap();
-        let mut decl = format!(
+    let ik = AnalyticIk::new(&s.bare).unwrap();
+    let mut decl = format!(
             "MODULE Glue\r\n  PERS tooldata nozzle:=[FALSE,{},[{:.3},[{:.3},{:.3},{:.3}],[1,0,0,0],0,0,0]];\r\n  \
              PERS wobjdata part:=[TRUE,TRUE,\"\",{},[[0,0,0],[1,0,0,0]]];\r\n",
             frame(&s.fixed_base),
@@ -106,36 +106,32 @@ fn glue_module(s: &Swapped, f: &Fixture) -> ProgramFile {
             f.truth.payload_com.z * 1e3,
             frame(&s.held)
         );
-        let mut body = String::from("  PROC main()\r\n");
-        for (i, q) in s.joints.iter().enumerate() {
-            let deg: Vec<f64> = self
-                .bare
-                .joints_to_controller(q)
-                .iter()
-                .map(|v| v.to_degrees())
-                .collect();
-            let lit = literal(
-                &s.target(f, i),
-                abb_cf(&deg, ik.configuration(q).unwrap()),
-            );
-            if i % 2 == 0 {
-                decl.push_str(&format!("  CONST robtarget g{i}:={lit};\r\n"));
-                body.push_str(&format!(
-                    "    MoveJ g{i}, v500, z10, nozzle\\WObj:=part;\r\n"
-                ));
-            } else {
-                body.push_str(&format!(
-                    "    MoveL {lit}, v100, fine, nozzle\\WObj:=part;\r\n"
-                ));
-            }
-        }
-        body.push_str("  ENDPROC\r\nENDMODULE\r\n");
-        ProgramFile {
-            name: "Glue.mod".into(),
-            text: decl + &body,
+    let mut body = String::from("  PROC main()\r\n");
+    for (i, q) in s.joints.iter().enumerate() {
+        let deg: Vec<f64> = s
+            .bare
+            .joints_to_controller(q)
+            .iter()
+            .map(|v| v.to_degrees())
+            .collect();
+        let lit = literal(&s.target(f, i), abb_cf(&deg, ik.configuration(q).unwrap()));
+        if i % 2 == 0 {
+            decl.push_str(&format!("  CONST robtarget g{i}:={lit};\r\n"));
+            body.push_str(&format!(
+                "    MoveJ g{i}, v500, z10, nozzle\\WObj:=part;\r\n"
+            ));
+        } else {
+            body.push_str(&format!(
+                "    MoveL {lit}, v100, fine, nozzle\\WObj:=part;\r\n"
+            ));
         }
     }
-
+    body.push_str("  ENDPROC\r\nENDMODULE\r\n");
+    ProgramFile {
+        name: "Glue.mod".into(),
+        text: decl + &body,
+    }
+}
 
 #[test]
 fn a_stationary_tool_with_a_robot_held_work_object_is_filtered() {
