@@ -17,7 +17,13 @@ const SOLVE: &str = "/v1/robots/{id}/solve";
 fn program(n: usize) -> serde_json::Value {
     let mut bare = robocal::model::preset("ys100").unwrap();
     bare.tool = Default::default();
-    let p = robocal::kinematics::fk(&bare, &[0.2, 0.3, 0.2, 0.1, 0.5, 0.1]).unwrap();
+    // Joints a fifth of the way into each range: within the limits, off singularities.
+    let q: Vec<f64> = bare
+        .links
+        .iter()
+        .map(|l| l.limits[0] + 0.4 * (l.limits[1] - l.limits[0]) + 0.1)
+        .collect();
+    let p = robocal::kinematics::fk(&bare, &q).unwrap();
     let abc = rotation_to(OrientationConvention::KukaAbc, &p.r);
     let line = format!(
         "LIN {{X {:.3},Y {:.3},Z {:.3},A {:.4},B {:.4},C {:.4}}}\n",
@@ -102,5 +108,5 @@ async fn work_whose_client_went_away_stops_and_frees_its_worker() {
     // The worker takes new work.
     let r = t.post_json(FILTER, &[&rid], program(3)).await;
     assert_eq!(r.status, StatusCode::OK, "{}", r.text());
-    assert_eq!(r.json()["report"]["filtered"], 3);
+    assert_eq!(r.json()["report"]["filtered"], 3, "{}", r.json()["report"]);
 }
