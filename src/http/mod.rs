@@ -36,6 +36,7 @@ pub mod input;
 
 pub mod listener;
 pub mod plans;
+pub mod predict;
 pub mod programs;
 pub mod record;
 pub mod robots;
@@ -137,6 +138,7 @@ fn routes() -> Vec<Route> {
     all.extend(calibrations::routes());
     all.extend(versions::routes());
     all.extend(solve::routes());
+    all.extend(predict::routes());
     all.extend(cell::routes());
     all.extend(programs::routes());
     all.extend(plans::routes());
