@@ -68,7 +68,10 @@ fn predict_matches_the_closed_form_of_a_planar_arm() {
         );
         let out = PoseOut::of(&p.pose, None);
         for k in 0..3 {
-            assert!((out.xyz_mm[k] - cell[k] * 1e3).abs() < 1e-9, "{c1},{c2}: {out:?}");
+            assert!(
+                (out.xyz_mm[k] - cell[k] * 1e3).abs() < 1e-9,
+                "{c1},{c2}: {out:?}"
+            );
         }
         // The tool turns about z by q1 + q2 + yaw: rx = ry = 0.
         let rz = (q1 + q2 + yaw).to_degrees();
@@ -79,7 +82,9 @@ fn predict_matches_the_closed_form_of_a_planar_arm() {
         assert!(p.compensation.is_none());
     }
     // A reading beyond joint 2's limits is flagged, still predicted.
-    let p = f.predict_deg(&[0.0, -150.0], &PredictFrame::default()).unwrap();
+    let p = f
+        .predict_deg(&[0.0, -150.0], &PredictFrame::default())
+        .unwrap();
     assert_eq!(p.outside_limits, vec![2]);
     assert!(f.predict_deg(&[0.0], &PredictFrame::default()).is_err());
     assert!(f
@@ -163,9 +168,9 @@ fn round_trip(cm: &CompensatedModel, seed: u64, n: usize) {
         let d_mm = (p2.pose.p - p.pose.p).norm() * 1e3;
         assert!(d_mm < 1e-6, "round trip moved the tool {d_mm:e} mm");
         assert!(rotation_angle_between(&p2.pose.r, &p.pose.r) < 1e-9);
-        let q_back = cm.nominal.joints_from_controller(
-            &back.iter().map(|v| v.to_radians()).collect::<Vec<_>>(),
-        );
+        let q_back = cm
+            .nominal
+            .joints_from_controller(&back.iter().map(|v| v.to_radians()).collect::<Vec<_>>());
         assert!(wrapped_diff(&q_back, &q) < 1e-7, "{q:?} vs {q_back:?}");
     }
     assert!(solved * 10 >= n * 9, "only {solved} of {n} solved");
@@ -314,7 +319,9 @@ fn tool_tip_error_from_6d_validation_matches_the_truth_and_position_only_is_unve
         .map(|m| {
             let meas = truth.true_pose(&m.q, Some(m.payload_mass)).unwrap();
             let tip = meas.transform_point(&d);
-            let pred = f.pose(&m.q, &PredictFrame::Frame(TargetFrame::Cell)).unwrap();
+            let pred = f
+                .pose(&m.q, &PredictFrame::Frame(TargetFrame::Cell))
+                .unwrap();
             (tip - pred.p).norm() * 1e3
         })
         .collect();

@@ -131,7 +131,10 @@ pub fn predict_to_string(a: &PredictArgs) -> anyhow::Result<String> {
         Some(w) => {
             let wobj = cell.work_object(&w.parse::<CellRef>()?)?;
             let label = format!("work object {}", wobj.name);
-            (PredictFrame::WorkObject(wobj.in_base(forward.model())), label)
+            (
+                PredictFrame::WorkObject(wobj.in_base(forward.model())),
+                label,
+            )
         }
     };
     let text = std::fs::read_to_string(&a.joints)
@@ -214,8 +217,14 @@ fn columns(h: &Header) -> Vec<String> {
         c.extend(conv.column_names().iter().map(|s| s.to_string()));
     }
     c.extend(
-        ["outside_limits", "compensation", "warning", "expected_error_mm", "message"]
-            .map(String::from),
+        [
+            "outside_limits",
+            "compensation",
+            "warning",
+            "expected_error_mm",
+            "message",
+        ]
+        .map(String::from),
     );
     c
 }
@@ -227,7 +236,12 @@ fn fields(h: &Header, r: &Row) -> Vec<String> {
     match &r.result {
         Ok(p) => {
             let o = PoseOut::of(&p.pose, h.conv);
-            f.extend(o.xyz_mm.iter().chain(&o.rxyz_deg).map(|v| format!("{v:.6}")));
+            f.extend(
+                o.xyz_mm
+                    .iter()
+                    .chain(&o.rxyz_deg)
+                    .map(|v| format!("{v:.6}")),
+            );
             if let Some((_, v)) = &o.orientation {
                 f.extend(v.iter().map(|v| format!("{v:.9}")));
             }
@@ -277,7 +291,8 @@ fn render_table(h: &Header, rows: &[Row]) -> String {
         out,
         "# robocal predict: model {}, {}, poses in the {} frame, payload {} kg",
         h.model,
-        h.tool.map_or("the measured point".to_string(), |t| format!("tool {t}")),
+        h.tool
+            .map_or("the measured point".to_string(), |t| format!("tool {t}")),
         h.frame,
         h.payload_kg
     );

@@ -57,7 +57,15 @@ pub struct PredictOutcome {
 async fn model_and_evidence(
     state: &AppState,
     cmd: &PredictCommand,
-) -> Result<(CompensatedModel, Option<ValidationEvidence>, Option<i64>, String), ServiceError> {
+) -> Result<
+    (
+        CompensatedModel,
+        Option<ValidationEvidence>,
+        Option<i64>,
+        String,
+    ),
+    ServiceError,
+> {
     let robot_id = cmd.robot_id;
     let ctx = state.robot_context(robot_id).await?;
     let chosen = choose_version(state, robot_id, cmd.model, ctx.active.clone()).await?;
@@ -86,7 +94,10 @@ async fn model_and_evidence(
 }
 
 /// Predicts a command's readings.
-pub async fn predict(state: &AppState, cmd: PredictCommand) -> Result<PredictOutcome, ServiceError> {
+pub async fn predict(
+    state: &AppState,
+    cmd: PredictCommand,
+) -> Result<PredictOutcome, ServiceError> {
     let max = state.limits().targets_per_request;
     if cmd.readings.is_empty() {
         return Err(ServiceError::Invalid(

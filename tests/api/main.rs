@@ -22,6 +22,7 @@ mod flow;
 mod hostile;
 mod jobs;
 mod plans;
+mod predict;
 mod record;
 mod roles;
 mod sets;

@@ -33,7 +33,9 @@ pub struct JointReading {
 pub enum JointsCsvError {
     #[error(transparent)]
     Text(#[from] TextError),
-    #[error("the joints file is empty: give a header `id,q1,...,qN` (N joints) and one row per reading")]
+    #[error(
+        "the joints file is empty: give a header `id,q1,...,qN` (N joints) and one row per reading"
+    )]
     Empty,
     #[error("no joint columns: the header needs q1..q{dof} (or j1..j{dof}), controller degrees")]
     NoJointColumns { dof: usize },
@@ -108,20 +110,19 @@ pub fn parse_joints_csv(
                 expected: width,
             });
         }
-        let joints_deg = idx
-            .iter()
-            .map(|&i| {
-                let v = &rec.fields[i];
-                table
-                    .number(v)
-                    .filter(|x| x.is_finite())
-                    .ok_or_else(|| JointsCsvError::NotNumber {
-                        line,
-                        column: table.header[i].clone(),
-                        value: short_text(v),
+        let joints_deg =
+            idx.iter()
+                .map(|&i| {
+                    let v = &rec.fields[i];
+                    table.number(v).filter(|x| x.is_finite()).ok_or_else(|| {
+                        JointsCsvError::NotNumber {
+                            line,
+                            column: table.header[i].clone(),
+                            value: short_text(v),
+                        }
                     })
-            })
-            .collect::<Result<Vec<f64>, _>>()?;
+                })
+                .collect::<Result<Vec<f64>, _>>()?;
         let id = id_idx
             .and_then(|i| rec.fields.get(i))
             .filter(|s| !s.is_empty())

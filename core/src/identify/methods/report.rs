@@ -5,9 +5,9 @@
 //! model must load back from its JSON description.
 
 use super::compensated::compensate_report;
-use crate::cell::accuracy::ValidationEvidence;
 use super::run::{Context, MethodFit, Outcome};
 use super::{Method, MethodFailure};
+use crate::cell::accuracy::ValidationEvidence;
 use crate::identify::least_squares::residual_rows;
 use crate::identify::report::{
     estimates, JointMapsSummary, MethodReport, MethodWarning, SetErrors, WarningKind,
