@@ -314,8 +314,9 @@ fn save_model(
         compensator: chosen.compensator_arc(),
     };
     let label = chosen.model_file_method();
-    let file =
+    let mut file =
         crate::compensate::CalibratedModelFile::from_compensated(&model, &nominal.name, &label);
+    file.validation = chosen.validation_evidence.clone();
     super::model_files::save_model_file(&file, std::path::Path::new(path))?;
     eprintln!("saved the {label} model to {path}");
     Ok(())

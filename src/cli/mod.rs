@@ -12,6 +12,7 @@ pub mod filter;
 pub mod iso9283;
 pub mod model_files;
 pub mod plan;
+pub mod predict;
 pub mod progress;
 pub mod reregister;
 pub mod serve;
@@ -45,6 +46,8 @@ pub enum Command {
     Demo(demo::DemoArgs),
     /// Solve target poses into joint commands and false targets.
     Solve(solve::SolveArgs),
+    /// Predict the pose of the measured point or a tool from joint readings (solve's forward half).
+    Predict(predict::PredictArgs),
     /// Export the (calibrated) geometric model: URDF, standard/modified DH CSV, JSON.
     Export(export::ExportArgs),
     /// Filter robot programs (KRL, RAPID, Fanuc, URScript): targets become false targets.
@@ -71,6 +74,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Reregister(a) => reregister::run(a),
         Command::Demo(a) => demo::run(a),
         Command::Solve(a) => solve::run(a),
+        Command::Predict(a) => predict::run(a),
         Command::Export(a) => export::run(a),
         Command::Filter(a) => filter::run(a),
         Command::Cell(a) => cell::run(a),

@@ -30,6 +30,7 @@ pub const PUBLIC: &[&str] = &["/healthz", "/readyz", "/openapi.yaml"];
 /// check poses, and change no model, set or cell item.
 pub const OPERATE: &[&str] = &[
     "/v1/robots/{id}/solve",
+    "/v1/robots/{id}/predict",
     "/v1/robots/{id}/programs/filter",
     "/v1/robots/{id}/measurement-plans",
     "/v1/robots/{id}/checks",

@@ -37,6 +37,7 @@ pub mod iso9283;
 
 pub mod listener;
 pub mod plans;
+pub mod predict;
 pub mod programs;
 pub mod record;
 pub mod robots;
@@ -138,6 +139,7 @@ fn routes() -> Vec<Route> {
     all.extend(calibrations::routes());
     all.extend(versions::routes());
     all.extend(solve::routes());
+    all.extend(predict::routes());
     all.extend(cell::routes());
     all.extend(programs::routes());
     all.extend(plans::routes());

@@ -61,7 +61,7 @@ pub const CONVENTION_NAMES: [&str; 17] = [
 ];
 
 /// A convention name exactly as listed in the spec.
-fn convention(name: &str, what: &str) -> Result<OrientationConvention, ApiError> {
+pub(crate) fn convention(name: &str, what: &str) -> Result<OrientationConvention, ApiError> {
     if !CONVENTION_NAMES.contains(&name) {
         return Err(ApiError::invalid(format!(
             "{what}: unknown orientation convention `{name}`; use one of {}",
@@ -155,7 +155,7 @@ pub enum ItemRef {
 }
 
 impl ItemRef {
-    fn choice(&self, kind: CellKind) -> Result<ItemChoice, ApiError> {
+    pub(crate) fn choice(&self, kind: CellKind) -> Result<ItemChoice, ApiError> {
         Ok(match self {
             ItemRef::Name(n) => {
                 super::cell::check_item_name(n)?;
@@ -257,7 +257,7 @@ pub struct SolveResponse {
     pub results: Vec<TargetOut>,
 }
 
-fn target_id(i: usize, id: &Option<Value>) -> Result<String, ApiError> {
+pub(crate) fn target_id(i: usize, id: &Option<Value>) -> Result<String, ApiError> {
     match id {
         None | Some(Value::Null) => Ok((i + 1).to_string()),
         Some(Value::String(s)) => Ok(s.clone()),

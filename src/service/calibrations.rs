@@ -750,7 +750,9 @@ fn versions_of(
             payload_kg,
             compensator: m.compensator_arc(),
         };
-        let file = CalibratedModelFile::from_compensated(&cm, robot_name, &m.model_file_method());
+        let mut file =
+            CalibratedModelFile::from_compensated(&cm, robot_name, &m.model_file_method());
+        file.validation = m.validation_evidence.clone();
         if let Err(e) = file.to_compensated() {
             r.methods.remove(method);
             r.failed.push(FailedMethod {

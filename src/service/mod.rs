@@ -19,6 +19,7 @@ mod job_watch;
 pub mod keys;
 pub mod limits;
 pub mod plans;
+pub mod predict;
 pub mod programs;
 pub mod queue;
 pub mod record;

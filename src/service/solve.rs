@@ -152,7 +152,7 @@ pub struct SolveOutcome {
 
 /// The model a solve uses: (version row id, version number, method), `None`
 /// for the nominal model.
-async fn choose_version(
+pub(super) async fn choose_version(
     state: &AppState,
     robot_id: i64,
     choice: ModelChoice,
@@ -401,17 +401,17 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
 /// SI pose of boundary `xyz_mm` and `rpy_deg` (`Rz·Ry·Rx`), as the cell file
 /// reads it (its own conversion is private to `core::cell::file`).
 /// A tool or work object of a solve, resolved.
-struct ResolvedItem {
-    name: String,
-    frame: ItemFrame,
+pub(super) struct ResolvedItem {
+    pub name: String,
+    pub frame: ItemFrame,
     /// SI pose in `frame`.
-    pose: Pose,
+    pub pose: Pose,
     /// A tool's load, on the flange.
-    load: Option<Load>,
+    pub load: Option<Load>,
 }
 
 /// A stored or inline tool or work object (`NotFound` for an unknown name).
-async fn resolve(
+pub(super) async fn resolve(
     state: &AppState,
     robot_id: i64,
     kind: CellKind,

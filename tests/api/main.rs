@@ -24,6 +24,7 @@ mod hostile;
 mod iso9283;
 mod jobs;
 mod plans;
+mod predict;
 mod record;
 mod roles;
 mod sets;

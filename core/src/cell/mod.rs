@@ -22,12 +22,16 @@
 //!
 //! Units: SI (m, rad) inside; the programs' units are converted by the parsers.
 
+pub mod accuracy;
 pub mod export;
 pub mod file;
+pub mod joints_csv;
 pub mod load;
+pub mod predict;
 
 pub use file::{CellDescription, CellFileError};
 pub use load::{Load, LoadDescription, LoadFrame};
+pub use predict::{Forward, PoseOut, PredictError, PredictFrame, Predicted};
 
 use crate::compensate::CompensatedModel;
 use crate::ik::{Configuration, Goal, IkSettings, IkSolution, IkSolver, SolveOptions, TargetFrame};

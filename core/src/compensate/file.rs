@@ -27,8 +27,15 @@
 //! `dof`, `output_frame`, `input_norm`, `spread`, `centres`, `weights`). Its
 //! values are SI (inputs rad, kg, N·m; outputs m) as the network computes them.
 //! A file with an unknown `kind` is rejected.
+//!
+//! `validation` (optional) keeps the validation poses' errors that the
+//! accuracy at a production tool's tip is computed from
+//! (`cell::accuracy::ValidationEvidence`: the measured point's mean and max
+//! error [mm] and, per pose with a measured orientation, the position error
+//! [mm] and `R_measured − R_predicted`).
 
 use super::{CompensateError, CompensatedModel, StoredCompensator, Support};
+use crate::cell::accuracy::ValidationEvidence;
 use crate::model::{ModelDescription, RobotModel};
 use serde::{Deserialize, Serialize};
 
@@ -66,6 +73,11 @@ pub struct CalibratedModelFile {
     /// compensator then applies everywhere.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub compensator_support: Option<Support>,
+    /// What the calibration's validation poses say about the error at a
+    /// production tool's tip (`cell::accuracy`); absent in files without
+    /// validation data or written before it existed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub validation: Option<ValidationEvidence>,
 }
 
 impl CalibratedModelFile {
@@ -82,6 +94,7 @@ impl CalibratedModelFile {
             payload_kg: m.payload_kg,
             compensator: m.compensator.as_ref().and_then(|c| c.stored()),
             compensator_support: m.compensator.as_ref().and_then(|c| c.support().cloned()),
+            validation: None,
         }
     }
 

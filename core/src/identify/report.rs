@@ -241,6 +241,10 @@ pub struct MethodReport {
     /// Where the compensator was trained (the model file stores it).
     #[serde(skip)]
     pub stored_support: Option<Support>,
+    /// The validation poses' evidence for the accuracy at a production tool
+    /// (the model file stores it as `validation`).
+    #[serde(skip)]
+    pub validation_evidence: Option<crate::cell::accuracy::ValidationEvidence>,
 }
 
 impl MethodReport {

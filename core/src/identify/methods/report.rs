@@ -7,6 +7,7 @@
 use super::compensated::compensate_report;
 use super::run::{Context, MethodFit, Outcome};
 use super::{Method, MethodFailure};
+use crate::cell::accuracy::ValidationEvidence;
 use crate::identify::least_squares::residual_rows;
 use crate::identify::report::{
     estimates, JointMapsSummary, MethodReport, MethodWarning, SetErrors, WarningKind,
@@ -32,6 +33,11 @@ impl Context<'_> {
             );
         }
         r.auto = outcome.auto;
+        let model = crate::compensate::CompensatedModel {
+            compensator: r.compensator_arc(),
+            ..crate::compensate::CompensatedModel::from_nominal(r.calibrated.clone())
+        };
+        r.validation_evidence = ValidationEvidence::of(&model, &frames, self.valid);
         Ok(r)
     }
 
@@ -152,6 +158,7 @@ impl Context<'_> {
             calibrated: fitted.model,
             stored_compensator: None,
             stored_support: None,
+            validation_evidence: None,
         })
     }
 }

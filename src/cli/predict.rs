@@ -1,0 +1,361 @@
+//! `robocal predict`: joint readings → the pose of the measured point or of a
+//! production tool: the forward half of `robocal solve`, on the same
+//! calibrated, compensated model (`core::cell::predict`).
+//!
+//! The joints file (`core::cell::joints_csv`): optional `id` and `q1..qN`,
+//! controller readings in degrees; other columns (a measurements file's
+//! `x, y, z, …`) are ignored. Output per reading: the pose in the
+//! measurement (cell) frame (or `--frame base`, or `--work-object NAME`),
+//! `x, y, z` [mm] and fixed-axis XYZ `rx, ry, rz` [deg] (`R = Rz·Ry·Rx`),
+//! with `--convention` the orientation in a solve convention too, the joints
+//! outside the controller's limits, the compensation flag and the
+//! compensator's expected error as `solve` reports them. The expected error at
+//! the tool (`core::cell::accuracy`) heads the output: measured on 6-D
+//! validation data, or `unverified` for a tool after a position-only
+//! calibration, never the measured point's figure for a tool.
+
+use super::model_files::load_compensated;
+use super::solve::OutputFormat;
+use crate::cell::accuracy::{
+    measurement_tool_accuracy, tool_accuracy, ToolAccuracy, ValidationEvidence,
+};
+use crate::cell::joints_csv::parse_joints_csv;
+use crate::cell::{Cell, CellDescription, CellRef, Forward, PoseOut, PredictFrame, Predicted};
+use crate::compensate::CalibratedModelFile;
+use crate::csv_text::{dialect_from_names, safe_cell};
+use crate::ik::TargetFrame;
+use crate::model::orientation::OrientationConvention;
+use anyhow::{bail, Context};
+use clap::Args;
+use serde_json::json;
+use std::fmt::Write as _;
+
+#[derive(Debug, Args)]
+pub struct PredictArgs {
+    /// Robot model: a calibrated model file (`robocal calibrate --save`), a
+    /// model JSON file or a preset (ys100, hh800, ur5, ur10).
+    #[arg(long)]
+    pub model: String,
+    /// Joints CSV: optional `id` and `q1..qN` (controller readings, degrees).
+    #[arg(long)]
+    pub joints: String,
+    /// Cell file (tools and work objects) that --tool and --work-object name from.
+    #[arg(long)]
+    pub cell: Option<String>,
+    /// Production tool on the calibrated flange: a name or number of the cell
+    /// file (default: the measured point, the model's own tool).
+    #[arg(long, requires = "cell")]
+    pub tool: Option<String>,
+    /// Work object (name or number of the cell file) the poses are given in.
+    #[arg(long, requires = "cell")]
+    pub work_object: Option<String>,
+    /// Frame of the poses: cell (measurement frame of the calibration) or base.
+    #[arg(long, default_value = "cell")]
+    pub frame: String,
+    /// The orientation in this solve convention too (quaternion, kuka_abc,
+    /// fanuc_wpr, matrix, ur_rotvec, abb_q1q4).
+    #[arg(long)]
+    pub convention: Option<String>,
+    /// Payload mass [kg] (default: the model file's payload, or the tool's load).
+    #[arg(long)]
+    pub payload_kg: Option<f64>,
+    #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
+    pub format: OutputFormat,
+    /// Same as `--format json`.
+    #[arg(long, conflicts_with = "format")]
+    pub json: bool,
+    /// Field delimiter of the joints file: `,`, `;` or `tab` (default: detected).
+    #[arg(long)]
+    pub delimiter: Option<String>,
+    /// Decimal separator of the joints file: `point` or `comma` (default: detected).
+    #[arg(long)]
+    pub decimal: Option<String>,
+}
+
+/// The validation evidence of a calibrated model file (none for presets and
+/// model descriptions).
+fn evidence(path: &str) -> Option<ValidationEvidence> {
+    let text = std::fs::read_to_string(path).ok()?;
+    CalibratedModelFile::from_json(&text).ok()?.validation
+}
+
+struct Row {
+    id: String,
+    joints_deg: Vec<f64>,
+    result: Result<Predicted, String>,
+}
+
+/// Runs the command and returns what it prints.
+pub fn predict_to_string(a: &PredictArgs) -> anyhow::Result<String> {
+    let mut model = load_compensated(&a.model).map_err(|e| anyhow::anyhow!("{e}"))?;
+    if let Some(p) = a.payload_kg {
+        if !(p.is_finite() && p >= 0.0) {
+            bail!("--payload-kg must be a non-negative number, got {p}");
+        }
+        model.payload_kg = p;
+    }
+    let frame: TargetFrame = a.frame.parse().map_err(anyhow::Error::msg)?;
+    let conv = a
+        .convention
+        .as_deref()
+        .map(OrientationConvention::from_name)
+        .transpose()
+        .map_err(|e| anyhow::anyhow!("--convention: {e}"))?;
+    let cell = match &a.cell {
+        None => Cell::default(),
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .with_context(|| format!("cannot read cell file {path}"))?;
+            CellDescription::from_json(&text)
+                .and_then(|d| d.to_cell())
+                .with_context(|| path.clone())?
+        }
+    };
+    let tool = match &a.tool {
+        Some(t) => Some(cell.tool(&t.parse::<CellRef>()?)?),
+        None => None,
+    };
+    let ev = evidence(&a.model);
+    let probe = crate::kinematics::chain::tool_pose(&model.calibrated);
+    let accuracy = match &tool {
+        Some(t) => tool_accuracy(ev.as_ref(), &probe, &t.tcp),
+        None => measurement_tool_accuracy(ev.as_ref()),
+    };
+    let forward = Forward::new(
+        &model,
+        tool.as_ref().map(|t| &t.tcp),
+        tool.as_ref().and_then(|t| t.load.as_ref()),
+    );
+    let (frame, frame_label) = match &a.work_object {
+        None => (PredictFrame::Frame(frame), frame.to_string()),
+        Some(w) => {
+            let wobj = cell.work_object(&w.parse::<CellRef>()?)?;
+            let label = format!("work object {}", wobj.name);
+            (
+                PredictFrame::WorkObject(wobj.in_base(forward.model())),
+                label,
+            )
+        }
+    };
+    let text = std::fs::read_to_string(&a.joints)
+        .with_context(|| format!("cannot read joints file {}", a.joints))?;
+    let dialect = dialect_from_names(a.delimiter.as_deref(), a.decimal.as_deref())
+        .map_err(anyhow::Error::msg)?;
+    let dof = model.dof();
+    let readings = parse_joints_csv(&text, dialect, dof).with_context(|| a.joints.clone())?;
+    let rows: Vec<Row> = readings
+        .into_iter()
+        .map(|r| Row {
+            result: forward
+                .predict_deg(&r.joints_deg, &frame)
+                .map_err(|e| format!("line {}: {e}", r.line)),
+            id: r.id,
+            joints_deg: r.joints_deg,
+        })
+        .collect();
+    let h = Header {
+        model: &a.model,
+        tool: tool.as_ref().map(|t| t.name.as_str()),
+        frame: frame_label,
+        payload_kg: forward.model().payload_kg,
+        accuracy,
+        conv,
+        dof,
+    };
+    let format = if a.json { OutputFormat::Json } else { a.format };
+    Ok(match format {
+        OutputFormat::Json => render_json(&h, &rows),
+        OutputFormat::Table => render_table(&h, &rows),
+        OutputFormat::Csv => render_csv(&h, &rows),
+    })
+}
+
+struct Header<'a> {
+    model: &'a str,
+    tool: Option<&'a str>,
+    frame: String,
+    payload_kg: f64,
+    accuracy: ToolAccuracy,
+    conv: Option<OrientationConvention>,
+    dof: usize,
+}
+
+/// `status, mean, max` of the accuracy as CSV fields.
+fn accuracy_fields(a: &ToolAccuracy) -> [String; 3] {
+    match a {
+        ToolAccuracy::Measured {
+            mean_mm, max_mm, ..
+        } => ["measured".into(), mean_mm.to_string(), max_mm.to_string()],
+        ToolAccuracy::Unverified { .. } => ["unverified".into(), String::new(), String::new()],
+        ToolAccuracy::Unknown { .. } => ["unknown".into(), String::new(), String::new()],
+    }
+}
+
+fn accuracy_line(a: &ToolAccuracy, tool: Option<&str>) -> String {
+    let at = tool.map_or("the measured point".to_string(), |t| format!("tool {t}"));
+    match a {
+        ToolAccuracy::Measured {
+            poses,
+            mean_mm,
+            max_mm,
+            from_orientation,
+        } => format!(
+            "expected error at {at}: {mean_mm:.3} mm mean, {max_mm:.3} mm max over {poses} validation poses{}",
+            if *from_orientation { " (6-D: position + orientation × lever arm)" } else { "" }
+        ),
+        ToolAccuracy::Unverified { message } => format!("expected error at {at}: unverified: {message}"),
+        ToolAccuracy::Unknown { message } => format!("expected error at {at}: unknown: {message}"),
+    }
+}
+
+/// The output columns and one row's fields.
+fn columns(h: &Header) -> Vec<String> {
+    let mut c = vec!["id".to_string()];
+    c.extend((1..=h.dof).map(|k| format!("j{k}_deg")));
+    c.extend(["x_mm", "y_mm", "z_mm", "rx_deg", "ry_deg", "rz_deg"].map(String::from));
+    if let Some(conv) = h.conv {
+        c.extend(conv.column_names().iter().map(|s| s.to_string()));
+    }
+    c.extend(
+        [
+            "outside_limits",
+            "compensation",
+            "warning",
+            "expected_error_mm",
+            "message",
+        ]
+        .map(String::from),
+    );
+    c
+}
+
+fn fields(h: &Header, r: &Row) -> Vec<String> {
+    let mut f = vec![r.id.clone()];
+    f.extend(r.joints_deg.iter().map(|v| v.to_string()));
+    let n_ori = h.conv.map_or(0, |c| c.n_values());
+    match &r.result {
+        Ok(p) => {
+            let o = PoseOut::of(&p.pose, h.conv);
+            f.extend(
+                o.xyz_mm
+                    .iter()
+                    .chain(&o.rxyz_deg)
+                    .map(|v| format!("{v:.6}")),
+            );
+            if let Some((_, v)) = &o.orientation {
+                f.extend(v.iter().map(|v| format!("{v:.9}")));
+            }
+            let c = p.compensation.as_ref();
+            f.push(
+                p.outside_limits
+                    .iter()
+                    .map(|j| format!("J{j}"))
+                    .collect::<Vec<_>>()
+                    .join(" "),
+            );
+            f.push(c.map(|c| c.label().to_string()).unwrap_or_default());
+            f.push(c.and_then(|c| c.warning()).unwrap_or_default());
+            f.push(
+                c.and_then(|c| c.expected_error_mm)
+                    .map(|v| v.to_string())
+                    .unwrap_or_default(),
+            );
+            f.push(String::new());
+        }
+        Err(e) => {
+            f.extend((0..6 + n_ori + 4).map(|_| String::new()));
+            f.push(e.clone());
+        }
+    }
+    f
+}
+
+fn render_csv(h: &Header, rows: &[Row]) -> String {
+    let mut cols = columns(h);
+    cols.extend(["tool_accuracy", "tool_error_mean_mm", "tool_error_max_mm"].map(String::from));
+    let acc = accuracy_fields(&h.accuracy);
+    let mut out = cols.join(",") + "\n";
+    for r in rows {
+        let mut f = fields(h, r);
+        f.extend(acc.iter().cloned());
+        let line: Vec<String> = f.iter().map(|v| safe_cell(v).into_owned()).collect();
+        out.push_str(&line.join(","));
+        out.push('\n');
+    }
+    out
+}
+
+fn render_table(h: &Header, rows: &[Row]) -> String {
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "# robocal predict: model {}, {}, poses in the {} frame, payload {} kg",
+        h.model,
+        h.tool
+            .map_or("the measured point".to_string(), |t| format!("tool {t}")),
+        h.frame,
+        h.payload_kg
+    );
+    let _ = writeln!(out, "# {}", accuracy_line(&h.accuracy, h.tool));
+    let _ = writeln!(
+        out,
+        "# joints: controller convention [deg]; x, y, z [mm]; rx, ry, rz fixed-axis XYZ [deg]"
+    );
+    let mut table = vec![columns(h)];
+    table.extend(rows.iter().map(|r| {
+        fields(h, r)
+            .into_iter()
+            .map(|v| if v.is_empty() { "-".into() } else { v })
+            .collect()
+    }));
+    let widths: Vec<usize> = (0..table[0].len())
+        .map(|c| table.iter().map(|r| r[c].len()).max().unwrap_or(0))
+        .collect();
+    for r in &table {
+        let line: Vec<String> = r
+            .iter()
+            .zip(&widths)
+            .map(|(v, w)| format!("{v:>w$}"))
+            .collect();
+        let _ = writeln!(out, "{}", line.join("  ").trim_end());
+    }
+    out
+}
+
+fn render_json(h: &Header, rows: &[Row]) -> String {
+    let results: Vec<serde_json::Value> = rows
+        .iter()
+        .map(|r| match &r.result {
+            Ok(p) => {
+                let o = PoseOut::of(&p.pose, h.conv);
+                let c = p.compensation.as_ref();
+                json!({
+                    "id": r.id, "status": "ok", "joints_deg": r.joints_deg,
+                    "x": o.xyz_mm[0], "y": o.xyz_mm[1], "z": o.xyz_mm[2],
+                    "rx": o.rxyz_deg[0], "ry": o.rxyz_deg[1], "rz": o.rxyz_deg[2],
+                    "orientation": o.orientation.map(|(c, v)| json!({"convention": c.name(), "values": v})),
+                    "outside_limits": p.outside_limits,
+                    "compensation": c.map(|c| c.label()),
+                    "warning": c.and_then(|c| c.warning()),
+                    "expected_error_mm": c.and_then(|c| c.expected_error_mm),
+                })
+            }
+            Err(e) => json!({"id": r.id, "status": "failed", "joints_deg": r.joints_deg, "message": e}),
+        })
+        .collect();
+    let doc = json!({
+        "model": h.model,
+        "tool": h.tool,
+        "frame": h.frame,
+        "payload_kg": h.payload_kg,
+        "accuracy": h.accuracy,
+        "readings": rows.len(),
+        "results": results,
+    });
+    serde_json::to_string_pretty(&doc).expect("JSON output serialises") + "\n"
+}
+
+pub fn run(args: PredictArgs) -> anyhow::Result<()> {
+    print!("{}", predict_to_string(&args)?);
+    Ok(())
+}

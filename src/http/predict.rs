@@ -1,0 +1,235 @@
+//! `POST /v1/robots/{id}/predict`: joint readings → the pose of the measured
+//! point or of a production tool, on the active model version (or a named
+//! one, or the nominal model, chosen as for a solve): the forward half of
+//! `solve` on the same model (`core::cell::predict`).
+//!
+//! Readings are controller joint values in degrees. Poses are in millimetres
+//! in the calibration's measurement (cell) frame, the registered base frame
+//! with `"frame": "base"`, or a work object; orientations as fixed-axis XYZ
+//! degrees `rx, ry, rz` (`R = Rz·Ry·Rx`, the measurement files' convention)
+//! and, with `convention`, in one of the solve conventions too. Each result
+//! carries the compensation flag and the compensator's expected error as a
+//! solve does; the answer states the expected error at the tool
+//! (`core::cell::accuracy`): measured from 6-D validation data, or
+//! `unverified` for a tool when the calibration measured positions only.
+
+use super::input::{check_payload, objects, present};
+use super::solve::{convention, model_choice, target_id, ItemRef, VersionSelector};
+use super::{ApiError, ApiJson, ApiPath, AppState};
+use crate::cell::accuracy::ToolAccuracy;
+use crate::cell::joints_csv::JointReading;
+use crate::cell::PoseOut;
+use crate::db::CellKind;
+use crate::ik::TargetFrame;
+use crate::service;
+use crate::service::predict::PredictCommand;
+use axum::extract::State;
+use axum::response::{IntoResponse, Response};
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReadingIn {
+    #[serde(default)]
+    pub id: Option<Value>,
+    /// Controller joint readings [deg].
+    pub joints_deg: Vec<f64>,
+}
+
+/// `POST /v1/robots/{id}/predict` body.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PredictRequest {
+    #[serde(deserialize_with = "objects")]
+    pub readings: Vec<ReadingIn>,
+    #[serde(default, deserialize_with = "present")]
+    pub version: Option<VersionSelector>,
+    #[serde(default, deserialize_with = "present")]
+    pub payload_kg: Option<f64>,
+    #[serde(default, deserialize_with = "present")]
+    pub frame: Option<String>,
+    /// A second orientation output beside `rx, ry, rz`.
+    #[serde(default, deserialize_with = "present")]
+    pub convention: Option<String>,
+    #[serde(default, deserialize_with = "present")]
+    pub tool: Option<ItemRef>,
+    #[serde(default, deserialize_with = "present")]
+    pub work_object: Option<ItemRef>,
+}
+
+#[derive(Debug, Serialize)]
+pub struct OrientationOut {
+    pub convention: &'static str,
+    pub values: Vec<f64>,
+}
+
+#[derive(Debug, Serialize)]
+pub struct PredictionOut {
+    pub id: String,
+    /// `ok`, or `failed` when the model cannot evaluate the joints.
+    pub status: &'static str,
+    pub message: Option<String>,
+    pub joints_deg: Vec<f64>,
+    pub x: Option<f64>,
+    pub y: Option<f64>,
+    pub z: Option<f64>,
+    pub rx: Option<f64>,
+    pub ry: Option<f64>,
+    pub rz: Option<f64>,
+    pub orientation: Option<OrientationOut>,
+    /// 1-based joints outside the controller's limits.
+    pub outside_limits: Vec<usize>,
+    pub compensation: Option<&'static str>,
+    pub warning: Option<String>,
+    pub expected_error_mm: Option<f64>,
+}
+
+#[derive(Debug, Serialize)]
+pub struct PredictResponse {
+    pub robot_id: i64,
+    pub version: Option<i64>,
+    pub method: String,
+    /// The production tool's name (null: the measured point).
+    pub tool: Option<String>,
+    pub frame: &'static str,
+    pub payload_kg: f64,
+    pub accuracy: ToolAccuracy,
+    pub readings: usize,
+    pub results: Vec<PredictionOut>,
+}
+
+fn command(robot_id: i64, req: &PredictRequest) -> Result<PredictCommand, ApiError> {
+    if req.readings.is_empty() {
+        return Err(ApiError::invalid(
+            "`readings` is empty: send at least one joint reading",
+        ));
+    }
+    if let Some(p) = req.payload_kg {
+        check_payload("`payload_kg`", p)?;
+    }
+    let frame = match req.frame.as_deref() {
+        None | Some("cell") => TargetFrame::Cell,
+        Some("base") => TargetFrame::Base,
+        Some(f) => {
+            return Err(ApiError::invalid(format!(
+                "`frame` must be cell or base, got `{f}`"
+            )))
+        }
+    };
+    let readings = req
+        .readings
+        .iter()
+        .enumerate()
+        .map(|(i, r)| {
+            if !(2..=7).contains(&r.joints_deg.len()) {
+                return Err(ApiError::invalid(format!(
+                    "readings[{i}].joints_deg: {} values; give one per joint (2 to 7), controller degrees",
+                    r.joints_deg.len()
+                )));
+            }
+            Ok(JointReading {
+                id: target_id(i, &r.id)?,
+                line: 0,
+                joints_deg: r.joints_deg.clone(),
+            })
+        })
+        .collect::<Result<Vec<_>, ApiError>>()?;
+    Ok(PredictCommand {
+        robot_id,
+        model: model_choice(req.version.as_ref())?,
+        payload_kg: req.payload_kg,
+        readings,
+        tool: req
+            .tool
+            .as_ref()
+            .map(|t| t.choice(CellKind::Tool))
+            .transpose()?,
+        work_object: req
+            .work_object
+            .as_ref()
+            .map(|w| w.choice(CellKind::WorkObject))
+            .transpose()?,
+        frame,
+    })
+}
+
+pub async fn predict(
+    State(state): State<AppState>,
+    ApiPath(robot_id): ApiPath<i64>,
+    ApiJson(req): ApiJson<PredictRequest>,
+) -> Result<Response, ApiError> {
+    let conv = req
+        .convention
+        .as_deref()
+        .map(|c| convention(c, "`convention`"))
+        .transpose()?;
+    let cmd = command(robot_id, &req)?;
+    let done = service::predict::predict(&state, cmd).await?;
+    let results: Vec<PredictionOut> = done
+        .rows
+        .into_iter()
+        .map(|(r, p)| match p {
+            Ok(p) => {
+                let o = PoseOut::of(&p.pose, conv);
+                let c = p.compensation.as_ref();
+                PredictionOut {
+                    id: r.id,
+                    status: "ok",
+                    message: None,
+                    joints_deg: r.joints_deg,
+                    x: Some(o.xyz_mm[0]),
+                    y: Some(o.xyz_mm[1]),
+                    z: Some(o.xyz_mm[2]),
+                    rx: Some(o.rxyz_deg[0]),
+                    ry: Some(o.rxyz_deg[1]),
+                    rz: Some(o.rxyz_deg[2]),
+                    orientation: o.orientation.map(|(c, values)| OrientationOut {
+                        convention: c.name(),
+                        values,
+                    }),
+                    outside_limits: p.outside_limits,
+                    compensation: c.map(|c| c.label()),
+                    warning: c.and_then(|c| c.warning()),
+                    expected_error_mm: c
+                        .and_then(|c| c.expected_error_mm)
+                        .filter(|v| v.is_finite()),
+                }
+            }
+            Err(e) => PredictionOut {
+                id: r.id,
+                status: "failed",
+                message: Some(e.to_string()),
+                joints_deg: r.joints_deg,
+                x: None,
+                y: None,
+                z: None,
+                rx: None,
+                ry: None,
+                rz: None,
+                orientation: None,
+                outside_limits: Vec::new(),
+                compensation: None,
+                warning: None,
+                expected_error_mm: None,
+            },
+        })
+        .collect();
+    Ok(axum::Json(PredictResponse {
+        robot_id,
+        version: done.version,
+        method: done.method,
+        tool: done.tool,
+        frame: done.frame,
+        payload_kg: done.payload_kg,
+        accuracy: done.accuracy,
+        readings: results.len(),
+        results,
+    })
+    .into_response())
+}
+
+/// The route of the predict endpoint.
+pub fn routes() -> Vec<super::Route> {
+    vec![super::post("/v1/robots/{id}/predict", predict)]
+}

@@ -1,0 +1,182 @@
+//! Predict orchestration: the model a prediction uses (chosen as for a solve:
+//! the active version, a numbered one or the nominal model), the production
+//! tool and work object (stored or inline, as for a solve), the forward
+//! evaluation (`core::cell::predict::Forward`, the model `solve` inverts) and
+//! the expected error at the tool from the version's validation evidence
+//! (`core::cell::accuracy`).
+//!
+//! Units at this boundary: joint readings in the controller convention in
+//! degrees; poses SI (the handler writes mm and degrees).
+
+use super::solve::{choose_version, resolve, ItemChoice, ModelChoice};
+use super::{AppState, ServiceError};
+use crate::cell::accuracy::{
+    measurement_tool_accuracy, tool_accuracy, ToolAccuracy, ValidationEvidence,
+};
+use crate::cell::joints_csv::JointReading;
+use crate::cell::{Forward, PredictError, PredictFrame, Predicted, WorkObject, WorkObjectFrame};
+use crate::compensate::{CalibratedModelFile, CompensatedModel};
+use crate::db::{CellKind, ItemFrame};
+use crate::ik::TargetFrame;
+use crate::model::RobotModel;
+
+/// A prediction, in domain terms.
+#[derive(Debug, Clone)]
+pub struct PredictCommand {
+    pub robot_id: i64,
+    pub model: ModelChoice,
+    /// Payload mass [kg] instead of the model's.
+    pub payload_kg: Option<f64>,
+    pub readings: Vec<JointReading>,
+    /// Production tool on the calibrated flange (`None`: the measured point).
+    pub tool: Option<ItemChoice>,
+    /// Work object the poses are expressed in (`None`: `frame`).
+    pub work_object: Option<ItemChoice>,
+    pub frame: TargetFrame,
+}
+
+/// What a prediction produced.
+#[derive(Debug)]
+pub struct PredictOutcome {
+    /// Version number used (`None`: the nominal model).
+    pub version: Option<i64>,
+    /// Calibration method of that version, or `nominal`.
+    pub method: String,
+    pub payload_kg: f64,
+    /// The production tool's name (`None`: the measured point).
+    pub tool: Option<String>,
+    /// `cell`, `base` or `work_object`.
+    pub frame: &'static str,
+    /// Expected error at the tool (or the measured point).
+    pub accuracy: ToolAccuracy,
+    /// One pose per reading, in order.
+    pub rows: Vec<(JointReading, Result<Predicted, PredictError>)>,
+}
+
+/// The chosen model and the evidence stored with it (none for the nominal model).
+async fn model_and_evidence(
+    state: &AppState,
+    cmd: &PredictCommand,
+) -> Result<
+    (
+        CompensatedModel,
+        Option<ValidationEvidence>,
+        Option<i64>,
+        String,
+    ),
+    ServiceError,
+> {
+    let robot_id = cmd.robot_id;
+    let ctx = state.robot_context(robot_id).await?;
+    let chosen = choose_version(state, robot_id, cmd.model, ctx.active.clone()).await?;
+    Ok(match chosen {
+        Some((vid, v, method)) => {
+            let text = state.db().version_model(vid).await?.ok_or_else(|| {
+                ServiceError::NotFound(format!("robot {robot_id} has no model version {v}"))
+            })?;
+            let bad = |e| ServiceError::Internal(format!("stored model version {v}: {e}"));
+            let file = CalibratedModelFile::from_json(&text).map_err(bad)?;
+            let model = file.to_compensated().map_err(bad)?;
+            (model, file.validation, Some(v), method)
+        }
+        None => {
+            let m = RobotModel::from_json(&ctx.model_json).map_err(|e| {
+                ServiceError::Internal(format!("stored model of robot {robot_id}: {e}"))
+            })?;
+            (
+                CompensatedModel::from_nominal(m),
+                None,
+                None,
+                "nominal".into(),
+            )
+        }
+    })
+}
+
+/// Predicts a command's readings.
+pub async fn predict(
+    state: &AppState,
+    cmd: PredictCommand,
+) -> Result<PredictOutcome, ServiceError> {
+    let max = state.limits().targets_per_request;
+    if cmd.readings.is_empty() {
+        return Err(ServiceError::Invalid(
+            "no readings: send at least one joint reading".into(),
+        ));
+    }
+    if cmd.readings.len() > max {
+        return Err(ServiceError::Invalid(format!(
+            "{} readings in one request; at most {max} (`--max-targets`): split the batch",
+            cmd.readings.len()
+        )));
+    }
+    let (mut model, evidence, version, method) = model_and_evidence(state, &cmd).await?;
+    if let Some(p) = cmd.payload_kg {
+        model.payload_kg = p;
+    }
+    let dof = model.dof();
+    if let Some(r) = cmd.readings.iter().find(|r| r.joints_deg.len() != dof) {
+        return Err(ServiceError::Invalid(format!(
+            "reading `{}`: {} joint values, the robot has {dof} joints (controller degrees)",
+            r.id,
+            r.joints_deg.len()
+        )));
+    }
+    let tool = match &cmd.tool {
+        Some(choice) => Some(resolve(state, cmd.robot_id, CellKind::Tool, choice).await?),
+        None => None,
+    };
+    let probe = crate::kinematics::chain::tool_pose(&model.calibrated);
+    let accuracy = match &tool {
+        Some(t) => tool_accuracy(evidence.as_ref(), &probe, &t.pose),
+        None => measurement_tool_accuracy(evidence.as_ref()),
+    };
+    let forward = Forward::new(
+        &model,
+        tool.as_ref().map(|t| &t.pose),
+        tool.as_ref().and_then(|t| t.load.as_ref()),
+    );
+    let (frame, label) = match &cmd.work_object {
+        None => (PredictFrame::Frame(cmd.frame), frame_label(cmd.frame)),
+        Some(choice) => {
+            let item = resolve(state, cmd.robot_id, CellKind::WorkObject, choice).await?;
+            let wobj = WorkObject {
+                name: item.name,
+                number: None,
+                frame: match item.frame {
+                    ItemFrame::Measurement => WorkObjectFrame::Measurement,
+                    ItemFrame::Base | ItemFrame::Flange => WorkObjectFrame::Base,
+                },
+                pose: item.pose,
+            };
+            (
+                PredictFrame::WorkObject(wobj.in_base(forward.model())),
+                "work_object",
+            )
+        }
+    };
+    let rows = cmd
+        .readings
+        .into_iter()
+        .map(|r| {
+            let p = forward.predict_deg(&r.joints_deg, &frame);
+            (r, p)
+        })
+        .collect();
+    Ok(PredictOutcome {
+        version,
+        method,
+        payload_kg: forward.model().payload_kg,
+        tool: tool.map(|t| t.name),
+        frame: label,
+        accuracy,
+        rows,
+    })
+}
+
+fn frame_label(f: TargetFrame) -> &'static str {
+    match f {
+        TargetFrame::Cell => "cell",
+        TargetFrame::Base => "base",
+    }
+}
