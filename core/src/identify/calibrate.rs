@@ -38,7 +38,7 @@ use crate::measure::Measurement;
 use crate::model::description::PoseDescription;
 use crate::model::pose::Pose;
 use crate::model::{ParamId, ParamKind, ParamLayout, RobotModel};
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 use std::collections::BTreeMap;
 
 /// Runs the calibration without a compensator training pool. `progress`
@@ -217,7 +217,8 @@ fn prepare(
     chains: &[Chain],
     opts: &CalibrationOptions,
 ) -> Result<Prepared, CalibrationError> {
-    let predicted = nominal_predictions(nominal, identification, chains);
+    let poses = nominal_predictions(nominal, identification, chains);
+    let predicted: Vec<Option<Vector3<f64>>> = poses.iter().map(|p| p.map(|(p, _)| p)).collect();
     if predicted
         .iter()
         .any(|p| !p.is_some_and(|p| p.iter().all(|v| v.is_finite())))
@@ -233,7 +234,7 @@ fn prepare(
         identification: SetErrors::from_predictions(
             &id_frames,
             &reg.ident,
-            predicted.iter().copied(),
+            poses.iter().copied(),
         ),
         validation: (!reg.valid.is_empty()).then(|| SetErrors::of(nominal, &id_frames, &reg.valid)),
     };
@@ -329,7 +330,7 @@ impl Registered {
     }
 }
 
-/// The nominal model's TCP positions at the (deflected) joints of `data`
+/// The nominal model's TCP poses (position, rotation) at the (deflected) joints of `data`
 /// (`least_squares::predict`), from the forward kinematics `chains` of `data`
 /// at the commanded joints when the model has no compliance (the joints are
 /// then not deflected: the same numbers without a second pass).
@@ -337,13 +338,11 @@ fn nominal_predictions(
     nominal: &RobotModel,
     data: &[Measurement],
     chains: &[Chain],
-) -> Vec<Option<Vector3<f64>>> {
+) -> Vec<Option<(Vector3<f64>, Matrix3<f64>)>> {
     if nominal.has_compliance() {
-        data.iter()
-            .map(|m| predict(nominal, m).map(|(p, _)| p))
-            .collect()
+        data.iter().map(|m| predict(nominal, m)).collect()
     } else {
-        chains.iter().map(|c| Some(c.tcp.p)).collect()
+        chains.iter().map(|c| Some((c.tcp.p, c.tcp.r))).collect()
     }
 }
 

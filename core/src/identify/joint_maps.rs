@@ -17,6 +17,17 @@
 //! candidate, so maps are kept only when they help on poses they never saw.
 //! Each joint's map covers the range of its training angles and fades to
 //! zero beyond it; a joint that moves less than `min_range_rad` gets none.
+//!
+//! Observability: a map is fitted only where the measurements see its effect.
+//! With position-only data a joint's angle is seen through the position
+//! rows of its column `J_θi` alone, whose norm is the lever arm from joint
+//! i's axis to the measured point [m/rad]; its RMS over the poses,
+//! `L_i = √(mean_p ‖J_pos,θi(q_p)‖²)`, below `min_lever_m` means an angle error
+//! of that joint barely moves the reflector (joint 6 seen from a reflector near
+//! its axis) while it turns a production tool: the joint's map is refused (not
+//! fitted) and [`MapFit::refused`] says why. Any measured orientation sees
+//! every joint's angle directly (`‖J_rot,θi‖ = 1`), so with orientation rows
+//! no map is refused on this ground.
 
 use super::evaluate::{evaluate, gram_checked};
 use crate::measure::Measurement;
@@ -45,6 +56,9 @@ pub struct JointMapSettings {
     pub min_range_rad: f64,
     /// Rounds of (map fit, LM refit of the geometry with the maps fixed).
     pub rounds: usize,
+    /// With position-only data, a joint whose RMS lever arm to the measured
+    /// point is below this gets no map (module docs) [m].
+    pub min_lever_m: f64,
 }
 
 impl Default for JointMapSettings {
@@ -57,6 +71,7 @@ impl Default for JointMapSettings {
             fade_rad: 5f64.to_radians(),
             min_range_rad: 10f64.to_radians(),
             rounds: 2,
+            min_lever_m: 0.02,
         }
     }
 }
@@ -95,6 +110,71 @@ pub struct MapFit {
     pub candidates: Vec<MapCandidate>,
     /// Poses the maps were fitted on.
     pub poses: usize,
+    /// Joints whose map the measurements cannot see, not fitted.
+    pub refused: Vec<RefusedMap>,
+}
+
+/// A joint whose map was refused: the measurements do not see its angle.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RefusedMap {
+    /// Joint number (1-based).
+    pub joint: usize,
+    /// RMS lever arm from the joint's axis to the measured point over the
+    /// poses [mm].
+    pub lever_mm: f64,
+    /// The threshold it is below [mm].
+    pub min_lever_mm: f64,
+    pub reason: String,
+}
+
+/// RMS over the poses of the position rows' norm of each column of `jt`
+/// (one column per joint angle, rows as `evaluate` stacks them) [m/rad];
+/// `None` when some pose measured an orientation (every angle is then seen).
+fn position_levers(jt: &DMatrix<f64>, data: &[Measurement]) -> Option<Vec<f64>> {
+    if data.iter().any(|m| m.orientation.is_some()) || data.is_empty() {
+        return None;
+    }
+    Some(
+        (0..jt.ncols())
+            .map(|i| (jt.column(i).norm_squared() / data.len() as f64).sqrt())
+            .collect(),
+    )
+}
+
+/// The joints (with their trained range) that get a map, and those refused
+/// as unobservable (module docs).
+fn map_joints(
+    jt: &DMatrix<f64>,
+    data: &[Measurement],
+    settings: &JointMapSettings,
+) -> (Vec<(usize, [f64; 2])>, Vec<RefusedMap>) {
+    let levers = position_levers(jt, data);
+    let (mut joints, mut refused) = (Vec::new(), Vec::new());
+    for i in 0..jt.ncols() {
+        let lo = data.iter().map(|m| m.q[i]).fold(f64::INFINITY, f64::min);
+        let hi = data
+            .iter()
+            .map(|m| m.q[i])
+            .fold(f64::NEG_INFINITY, f64::max);
+        if hi - lo < settings.min_range_rad {
+            continue;
+        }
+        match levers.as_ref().map(|l| l[i]) {
+            Some(lever) if lever < settings.min_lever_m => refused.push(RefusedMap {
+                joint: i + 1,
+                lever_mm: lever * 1e3,
+                min_lever_mm: settings.min_lever_m * 1e3,
+                reason: format!(
+                    "joint {}'s angle moves the measured point by only {:.2} mm per radian (RMS over the poses, below {:.0} mm/rad) and no pose measured an orientation: a map of it would be invisible to the measurements yet turn a production tool, so none is fitted",
+                    i + 1,
+                    lever * 1e3,
+                    settings.min_lever_m * 1e3
+                ),
+            }),
+            _ => joints.push((i, [lo, hi])),
+        }
+    }
+    (joints, refused)
 }
 
 /// Why the maps cannot be fitted.
@@ -108,6 +188,8 @@ pub enum MapFitError {
     NotEvaluable,
     #[error("no joint moves over {min_deg:.1}° in the training poses")]
     NoJointMoves { min_deg: f64 },
+    #[error("no joint map is observable: {refused}")]
+    NoObservableJoint { refused: String },
 }
 
 /// The design of one fit: residuals, the geometry / session columns and the
@@ -121,6 +203,8 @@ struct Design {
     pose_rows: Vec<(usize, usize)>,
     /// Joints with a map, with their range.
     joints: Vec<(usize, [f64; 2])>,
+    /// Joints whose map the measurements cannot see.
+    refused: Vec<RefusedMap>,
     kmax: usize,
 }
 
@@ -170,16 +254,15 @@ fn build(
     if !go() {
         return Ok(None);
     }
-    let mut joints = Vec::new();
-    for i in 0..n {
-        let lo = data.iter().map(|m| m.q[i]).fold(f64::INFINITY, f64::min);
-        let hi = data
-            .iter()
-            .map(|m| m.q[i])
-            .fold(f64::NEG_INFINITY, f64::max);
-        if hi - lo >= settings.min_range_rad {
-            joints.push((i, [lo, hi]));
-        }
+    let (joints, refused) = map_joints(&jt, data, settings);
+    if joints.is_empty() && !refused.is_empty() {
+        return Err(MapFitError::NoObservableJoint {
+            refused: refused
+                .iter()
+                .map(|r| r.reason.as_str())
+                .collect::<Vec<_>>()
+                .join("; "),
+        });
     }
     if joints.is_empty() {
         return Err(MapFitError::NoJointMoves {
@@ -199,6 +282,7 @@ fn build(
         geo,
         pose_rows: Vec::new(),
         joints,
+        refused,
         kmax,
     };
     for (p, m) in data.iter().enumerate() {
@@ -473,5 +557,6 @@ pub fn fit_joint_maps(
         without_maps,
         candidates,
         poses: data.len(),
+        refused: d.refused.clone(),
     }))
 }
