@@ -87,6 +87,10 @@ pub struct MapCandidate {
     /// The seed's eq. 7.10 on the held-out errors,
     /// `mean(e²) + 0.5·max(e²) + 0.3·std(e²)` [mm²]: the choice's criterion.
     pub cv_cost_mm2: f64,
+    /// Mean held-out orientation error over the poses that measured one
+    /// (the linearised rotation residual's angle) [deg]; none without.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cv_orientation_mean_deg: Option<f64>,
 }
 
 /// Eq. 7.10 of errors [mm]: `mean(e²) + 0.5·max(e²) + 0.3·std(e²)` [mm²].
@@ -201,6 +205,8 @@ struct Design {
     geo: usize,
     /// First row of each pose, and its row count.
     pose_rows: Vec<(usize, usize)>,
+    /// Weight of the orientation rows [m/rad].
+    weight: f64,
     /// Joints with a map, with their range.
     joints: Vec<(usize, [f64; 2])>,
     /// Joints whose map the measurements cannot see.
@@ -281,6 +287,7 @@ fn build(
         a: DMatrix::zeros(0, 0),
         geo,
         pose_rows: Vec::new(),
+        weight,
         joints,
         refused,
         kmax,
@@ -355,24 +362,33 @@ fn solve(
     ))
 }
 
-/// Position error norms [mm] of the poses `poses` after subtracting `a·x`.
-fn held_out_errors(d: &Design, poses: &[usize], cols: &[usize], x: &DVector<f64>) -> Vec<f64> {
+/// Position error norms [mm] of the poses `poses` after subtracting `a·x`,
+/// and their orientation errors [deg] (the norm of the unweighted rotation
+/// residual; `None` for a pose without a measured orientation).
+fn held_out_errors(
+    d: &Design,
+    poses: &[usize],
+    cols: &[usize],
+    x: &DVector<f64>,
+) -> (Vec<f64>, Vec<Option<f64>>) {
+    let left = |rr: usize| {
+        let fit: f64 = cols
+            .iter()
+            .zip(x.iter())
+            .map(|(c, x)| d.a[(rr, *c)] * x)
+            .sum();
+        d.r[rr] - fit
+    };
+    let norm = |rows: std::ops::Range<usize>| rows.map(|rr| left(rr).powi(2)).sum::<f64>().sqrt();
     poses
         .iter()
         .map(|&p| {
-            let (row, _) = d.pose_rows[p];
-            let mut e2 = 0.0;
-            for rr in row..row + 3 {
-                let fit: f64 = cols
-                    .iter()
-                    .zip(x.iter())
-                    .map(|(c, x)| d.a[(rr, *c)] * x)
-                    .sum();
-                e2 += (d.r[rr] - fit).powi(2);
-            }
-            e2.sqrt() * 1e3
+            let (row, nr) = d.pose_rows[p];
+            let angle = (nr == 6 && d.weight > 0.0)
+                .then(|| (norm(row + 3..row + 6) / d.weight).to_degrees());
+            (norm(row..row + 3) * 1e3, angle)
         })
-        .collect()
+        .unzip()
 }
 
 /// The normal equations `AᵀA`, `Aᵀr` of the rows of `poses`; `None` when
@@ -491,10 +507,15 @@ pub fn fit_joint_maps(
     for (done, (k, ridge)) in grid.iter().enumerate() {
         let cols = d.columns(*k);
         let mut errors = Vec::with_capacity(data.len());
+        let mut angles = Vec::with_capacity(data.len());
         let mut ok = true;
         for (poses, (gf, bf)) in fold_poses.iter().zip(&fold_normals) {
             match solve(&(&g - gf), &(&b - bf), &cols, &scale, d.geo, *ridge) {
-                Some(x) => errors.extend(held_out_errors(&d, poses, &cols, &x)),
+                Some(x) => {
+                    let (e, a) = held_out_errors(&d, poses, &cols, &x);
+                    errors.extend(e);
+                    angles.extend(a.into_iter().flatten());
+                }
                 None => ok = false,
             }
             if !progress(done, total) {
@@ -508,6 +529,8 @@ pub fn fit_joint_maps(
                 cv_mean_mm: errors.iter().sum::<f64>() / errors.len() as f64,
                 cv_max_mm: errors.iter().copied().fold(0.0, f64::max),
                 cv_cost_mm2: seed_cost(&errors),
+                cv_orientation_mean_deg: (!angles.is_empty())
+                    .then(|| angles.iter().sum::<f64>() / angles.len() as f64),
             });
         }
         if !progress(done + 1, total) {

@@ -13,9 +13,9 @@ use super::options::Method;
 use crate::compensate::{Compensator, CvStats, StoredCompensator, Support, TrainReport};
 use crate::measure::Measurement;
 use crate::model::description::PoseDescription;
+use crate::model::orientation::rotation_angle_between;
 use crate::model::pose::Pose;
 use crate::model::{ModelDescription, ParamId, RobotModel};
-use crate::model::orientation::rotation_angle_between;
 use crate::stats::{ErrorStats, OrientationStats};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
@@ -128,7 +128,8 @@ impl SetErrors {
         }
         Some(Self::from_residuals(
             data,
-            (0..data.len()).map(|i| Some((Vector3::new(r[3 * i], r[3 * i + 1], r[3 * i + 2]), None))),
+            (0..data.len())
+                .map(|i| Some((Vector3::new(r[3 * i], r[3 * i + 1], r[3 * i + 2]), None))),
         ))
     }
 

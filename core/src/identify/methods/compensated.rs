@@ -42,7 +42,6 @@ use crate::kinematics::{chain, gravity_torques_of};
 use crate::measure::Measurement;
 use crate::model::pose::Pose;
 use crate::model::RobotModel;
-use crate::stats::ErrorStats;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -331,9 +330,10 @@ pub(crate) fn compensate_report(
     report.stored_support = Some(trained.support.clone());
 }
 
-/// Error statistics of the base alone on the pool [mm] (the residual norms).
-pub(crate) fn base_pool_stats(base: &Fit, pool: &[Measurement]) -> ErrorStats {
-    SetErrors::of(&base.model, &base.session_frames, pool).stats
+/// Errors of the base alone on the pool (the residual norms [mm], and the
+/// orientation errors [deg] where the pool measured orientation).
+pub(crate) fn base_pool_errors(base: &Fit, pool: &[Measurement]) -> SetErrors {
+    SetErrors::of(&base.model, &base.session_frames, pool)
 }
 
 #[cfg(test)]
