@@ -159,6 +159,7 @@ fn six_d_maps_reach_the_probe_noise_in_orientation_and_at_a_tool_tip() {
 
     // Only the orientations identify the tool's rotation.
     let by_o = &r.identifiability.identifiable_by_orientation;
+    eprintln!("identifiable by orientation: {by_o:?}");
     for p in ["tool_rx", "tool_ry", "tool_rz"] {
         assert!(by_o.iter().any(|n| n == p), "{by_o:?}");
     }
