@@ -1,5 +1,7 @@
 //! Error statistics of a pose set (docs/design.md "Data roles"): mean, maximum, standard
-//! deviation, RMS and 95th percentile of the position-error norm, in millimetres.
+//! deviation, RMS and 95th percentile of the position-error norm, in millimetres, and
+//! ([`OrientationStats`]) the same of the orientation error, the angle of
+//! `R_measured·R_predictedᵀ`, in degrees, over the poses that measured an orientation.
 
 use serde::{Deserialize, Serialize};
 
@@ -55,6 +57,50 @@ impl ErrorStats {
     }
 }
 
+/// Orientation-error statistics of a set [deg]: the angle of
+/// `R_measured·R_predictedᵀ` (both in the registered frame) over the poses
+/// with a measured orientation. Serialised with an `orientation_` prefix
+/// beside [`ErrorStats`] (`orientation_mean_deg`, …); a set without any
+/// orientation measurement has none (never zeros).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct OrientationStats {
+    /// Poses with a measured orientation.
+    #[serde(rename = "orientation_n")]
+    pub n: usize,
+    #[serde(rename = "orientation_mean_deg")]
+    pub mean_deg: f64,
+    #[serde(rename = "orientation_max_deg")]
+    pub max_deg: f64,
+    /// Sample standard deviation (n − 1).
+    #[serde(rename = "orientation_std_deg")]
+    pub std_deg: f64,
+    #[serde(rename = "orientation_rms_deg")]
+    pub rms_deg: f64,
+    /// 95th percentile, as [`ErrorStats::p95_mm`].
+    #[serde(rename = "orientation_p95_deg")]
+    pub p95_deg: f64,
+}
+
+impl OrientationStats {
+    /// Statistics of the angles [deg] of the poses that have one (`None`
+    /// entries: no orientation measured); `None` when no pose has one.
+    pub fn from_angles_deg(angles: &[Option<f64>]) -> Option<OrientationStats> {
+        let a: Vec<f64> = angles.iter().flatten().copied().collect();
+        if a.is_empty() {
+            return None;
+        }
+        let s = ErrorStats::from_errors_mm(&a);
+        Some(OrientationStats {
+            n: s.n,
+            mean_deg: s.mean_mm,
+            max_deg: s.max_mm,
+            std_deg: s.std_mm,
+            rms_deg: s.rms_mm,
+            p95_deg: s.p95_mm,
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -69,5 +115,19 @@ mod tests {
         assert!((s.rms_mm - 7.5f64.sqrt()).abs() < 1e-15);
         // 0.95·3 = 2.85 → 3 + 0.85·1
         assert!((s.p95_mm - 3.85).abs() < 1e-12);
+    }
+
+    /// Poses without an orientation are left out; none at all gives none.
+    #[test]
+    fn orientation_stats_skip_poses_without_one() {
+        assert_eq!(OrientationStats::from_angles_deg(&[None, None]), None);
+        let s = OrientationStats::from_angles_deg(&[Some(0.1), None, Some(0.3)]).unwrap();
+        assert_eq!(s.n, 2);
+        assert!((s.mean_deg - 0.2).abs() < 1e-15);
+        assert_eq!(s.max_deg, 0.3);
+        assert!((s.rms_deg - 0.05f64.sqrt()).abs() < 1e-15);
+        let v = serde_json::to_value(&s).unwrap();
+        assert_eq!(v["orientation_max_deg"], 0.3);
+        assert_eq!(v["orientation_n"], 2);
     }
 }

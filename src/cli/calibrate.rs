@@ -5,7 +5,7 @@
 use super::progress::ProgressPrinter;
 use crate::identify::{
     calibrate_with_training, CalibrationOptions, CalibrationReport, CompensatorOptions, Method,
-    PoseSource, PoseSources, METHODS,
+    PoseSource, PoseSources, SetErrors, METHODS,
 };
 use crate::measure::{self, csv, SetRole};
 use crate::model::RobotModel;
@@ -384,6 +384,7 @@ pub fn render_report(r: &CalibrationReport) -> String {
         );
     }
     let _ = write!(s, "{}", render_comparison(r));
+    let _ = write!(s, "{}", render_orientation(r));
     let _ = write!(s, "{}", render_compensators(r));
     let id = &r.identifiability;
     let _ = writeln!(
@@ -406,6 +407,13 @@ pub fn render_report(r: &CalibrationReport) -> String {
     }
     for p in &id.correlated_pairs {
         let _ = writeln!(s, "  correlated {} ~ {}: {:+.3}", p.a, p.b, p.correlation);
+    }
+    if !id.identifiable_by_orientation.is_empty() {
+        let _ = writeln!(
+            s,
+            "  identified only thanks to the measured orientations: {}",
+            id.identifiable_by_orientation.join(", ")
+        );
     }
     // Parameter table across methods.
     let names: Vec<Method> = r.methods.keys().copied().collect();
@@ -554,6 +562,81 @@ pub fn render_comparison(r: &CalibrationReport) -> String {
         }
         let _ = writeln!(s);
     }
+    s
+}
+
+/// Orientation errors per set (mean / max in degrees), for every model, when
+/// some set measured orientation; empty otherwise.
+pub fn render_orientation(r: &CalibrationReport) -> String {
+    let mut s = String::new();
+    let nominal: [Option<&SetErrors>; 2] = [
+        Some(&r.nominal.identification),
+        r.nominal.validation.as_ref(),
+    ];
+    let any = nominal
+        .into_iter()
+        .chain(r.methods.values().flat_map(|m| {
+            [
+                Some(&m.identification),
+                m.training.as_ref(),
+                m.validation.as_ref(),
+            ]
+        }))
+        .flatten()
+        .any(|e| e.orientation.is_some());
+    if !any {
+        return s;
+    }
+    let training = r.training_poses > 0;
+    let validation = r.validation_poses > 0;
+    let _ = write!(
+        s,
+        "\nOrientation, mean / max (deg)\n{:<22} {:>19}",
+        "", "identification (Q1)"
+    );
+    if training {
+        let _ = write!(s, " {:>19}", "training (Q2)");
+    }
+    if validation {
+        let _ = write!(s, " {:>19}", "validation (Q3)");
+    }
+    let _ = writeln!(s);
+    let cell = |e: Option<&SetErrors>| match e.and_then(|e| e.orientation.as_ref()) {
+        Some(o) => format!("{:>9.4} / {:<7.4}", o.mean_deg, o.max_deg),
+        None => format!("{:>19}", "-"),
+    };
+    let _ = write!(
+        s,
+        "{:<22} {}",
+        "Nominal robot model",
+        cell(Some(&r.nominal.identification))
+    );
+    if training {
+        let _ = write!(s, " {}", cell(None));
+    }
+    if validation {
+        let _ = write!(s, " {}", cell(r.nominal.validation.as_ref()));
+    }
+    let _ = writeln!(s);
+    for (name, m) in &r.methods {
+        let _ = write!(
+            s,
+            "{:<22} {}",
+            method_label(*name),
+            cell(Some(&m.identification))
+        );
+        if training {
+            let _ = write!(s, " {}", cell(m.training.as_ref()));
+        }
+        if validation {
+            let _ = write!(s, " {}", cell(m.validation.as_ref()));
+        }
+        let _ = writeln!(s);
+    }
+    let _ = writeln!(
+        s,
+        "(compensators correct position only: their orientation is their base's)"
+    );
     s
 }
 

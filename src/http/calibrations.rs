@@ -295,16 +295,25 @@ pub async fn result(
         .filter(|v| v.calibration_id == Some(id))
         .map(|v| json!({ "version": v.version, "method": v.method, "active": v.active }))
         .collect();
-    // Mean and max position errors per method and set (mm), nominal first.
+    // Mean and max position errors per method and set (mm), nominal first;
+    // the orientation errors (deg) of a set that measured orientation.
     let line = |method: &str, part: &Value| {
         let stat = |set: &str, key: &str| part[set][key].as_f64();
-        json!({
+        let mut l = json!({
             "method": method,
             "identification_mean_mm": stat("identification", "mean_mm"),
             "identification_max_mm": stat("identification", "max_mm"),
             "validation_mean_mm": stat("validation", "mean_mm"),
             "validation_max_mm": stat("validation", "max_mm"),
-        })
+        });
+        for set in ["identification", "validation"] {
+            for key in ["orientation_mean_deg", "orientation_max_deg"] {
+                if let Some(v) = stat(set, key) {
+                    l[format!("{set}_{key}")] = json!(v);
+                }
+            }
+        }
+        l
     };
     let mut summary = vec![line("nominal", &report["nominal"])];
     if let Some(methods) = report["methods"].as_object() {

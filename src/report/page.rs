@@ -175,6 +175,29 @@ pub fn statistics(models: &[Model], best: Option<&str>) -> Markup {
                 }
             }
             p.note { "Millimetres; position-error norm per pose." }
+            @if models.iter().any(|m| SETS.iter().any(|(set, _)| m.set(set).is_some_and(|s| s.orientation_n.is_some()))) {
+                h2 #orientation { "Orientation errors" }
+                table {
+                    thead { tr {
+                        th { "Model" } th { "Set" } th.n { "n" } th.n { "mean" } th.n { "RMS" }
+                        th.n { "std" } th.n { "95 %" } th.n { "max" }
+                    } }
+                    tbody {
+                        @for m in models { @for (set, name) in SETS {
+                            @if let Some(s) = m.set(set).filter(|s| s.orientation_n.is_some()) {
+                                tr.best[best == Some(m.key)] {
+                                    td { span.swatch style={ "background:" (m.color) } {} (m.label) }
+                                    td { (name) }
+                                    td.n { (s.orientation_n.map_or("—".into(), |n| n.to_string())) }
+                                    @for v in [s.orientation_mean_deg, s.orientation_rms_deg, s.orientation_std_deg, s.orientation_p95_deg, s.orientation_max_deg] { td.n { (opt(v, 4)) } }
+                                }
+                            }
+                        } }
+                    }
+                }
+                p.note { "Degrees; the angle of R_measured·R_predictedᵀ per pose that measured an orientation. "
+                    "Compensators correct position only: their orientation is their base's." }
+            }
         }
     }
 }
@@ -438,6 +461,10 @@ pub fn parameters(r: &ReportView, models: &[Model]) -> Markup {
                 h2 { "Identifiability" }
                 p { (i.kept.len()) " of " (i.candidates) " candidate parameters identified from " (i.poses)
                     " poses; condition number " (num(i.condition_number, 4)) ", O1 " (num(i.observability_o1, 4)) "." }
+                @if !i.identifiable_by_orientation.is_empty() {
+                    p { "Identified only thanks to the measured orientations (the positions alone would not): "
+                        (i.identifiable_by_orientation.join(", ")) "." }
+                }
                 @if !i.dropped.is_empty() {
                     table { thead { tr { th { "Not identified" } th { "why" } } }
                         tbody { @for d in &i.dropped { tr { td { (d.name) } td { (d.reason) } } } } }
@@ -507,6 +534,7 @@ pub fn compensators(models: &[Model]) -> Markup {
                         " on " (c.training_poses.map_or("—".into(), |n| n.to_string())) " "
                         (c.trained_on) " poses, " (c.training.epochs.map_or("—".into(), |n| n.to_string()))
                         " epochs / iterations / generations; stopped: " (c.training.stop) }
+                    @if let Some(n) = &c.orientation_note { p.note { (n) } }
                     table {
                         thead { tr { th { "Set" } th.n { "base mean" } th.n { "mean" } th.n { "change" }
                             th.n { "base max" } th.n { "max" } th.n { "change" } } }

@@ -8,7 +8,8 @@
 //! what it can and says what is missing. The format version says which parts
 //! to expect: 1 (no `format_version` field) holds error norms only; 2 adds
 //! per-pose error vectors, positions, session names and pose sources; 3 the
-//! compensator training pool, the compensators and `auto`'s choice.
+//! compensator training pool, the compensators and `auto`'s choice; 4 the
+//! orientation errors of sets that measured orientation.
 
 use crate::identify::identifiability::IdentifiabilityReport;
 use crate::identify::{
@@ -101,6 +102,20 @@ pub struct SetView {
     pub rms_mm: Option<f64>,
     #[serde(default)]
     pub p95_mm: Option<f64>,
+    /// Orientation statistics [deg] (format 4; none when the set measured no
+    /// orientation).
+    #[serde(default)]
+    pub orientation_n: Option<usize>,
+    #[serde(default)]
+    pub orientation_mean_deg: Option<f64>,
+    #[serde(default)]
+    pub orientation_max_deg: Option<f64>,
+    #[serde(default)]
+    pub orientation_std_deg: Option<f64>,
+    #[serde(default)]
+    pub orientation_rms_deg: Option<f64>,
+    #[serde(default)]
+    pub orientation_p95_deg: Option<f64>,
     #[serde(default)]
     pub errors_mm: Vec<Option<f64>>,
     #[serde(default)]
@@ -217,6 +232,9 @@ pub struct CompensatorView {
     pub fade_deg: Option<f64>,
     #[serde(default, deserialize_with = "lenient")]
     pub uncertainty: Option<UncertaintyView>,
+    /// What the compensator does to orientation (format 4).
+    #[serde(default)]
+    pub orientation_note: Option<String>,
 }
 
 /// The expected errors checked on the validation set.

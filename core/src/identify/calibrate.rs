@@ -38,7 +38,7 @@ use crate::measure::Measurement;
 use crate::model::description::PoseDescription;
 use crate::model::pose::Pose;
 use crate::model::{ParamId, ParamKind, ParamLayout, RobotModel};
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 use std::collections::BTreeMap;
 
 /// Runs the calibration without a compensator training pool. `progress`
@@ -217,7 +217,8 @@ fn prepare(
     chains: &[Chain],
     opts: &CalibrationOptions,
 ) -> Result<Prepared, CalibrationError> {
-    let predicted = nominal_predictions(nominal, identification, chains);
+    let poses = nominal_predictions(nominal, identification, chains);
+    let predicted: Vec<Option<Vector3<f64>>> = poses.iter().map(|p| p.map(|(p, _)| p)).collect();
     if predicted
         .iter()
         .any(|p| !p.is_some_and(|p| p.iter().all(|v| v.is_finite())))
@@ -230,11 +231,7 @@ fn prepare(
     let training = reg.to_base(training);
     let id_frames = vec![Pose::identity(); reg.sessions];
     let nominal_errors = NominalErrors {
-        identification: SetErrors::from_predictions(
-            &id_frames,
-            &reg.ident,
-            predicted.iter().copied(),
-        ),
+        identification: SetErrors::from_predictions(&id_frames, &reg.ident, poses.iter().copied()),
         validation: (!reg.valid.is_empty()).then(|| SetErrors::of(nominal, &id_frames, &reg.valid)),
     };
     let nominal_rms = nominal_errors.identification.stats.rms_mm;
@@ -329,7 +326,7 @@ impl Registered {
     }
 }
 
-/// The nominal model's TCP positions at the (deflected) joints of `data`
+/// The nominal model's TCP poses (position, rotation) at the (deflected) joints of `data`
 /// (`least_squares::predict`), from the forward kinematics `chains` of `data`
 /// at the commanded joints when the model has no compliance (the joints are
 /// then not deflected: the same numbers without a second pass).
@@ -337,13 +334,11 @@ fn nominal_predictions(
     nominal: &RobotModel,
     data: &[Measurement],
     chains: &[Chain],
-) -> Vec<Option<Vector3<f64>>> {
+) -> Vec<Option<(Vector3<f64>, Matrix3<f64>)>> {
     if nominal.has_compliance() {
-        data.iter()
-            .map(|m| predict(nominal, m).map(|(p, _)| p))
-            .collect()
+        data.iter().map(|m| predict(nominal, m)).collect()
     } else {
-        chains.iter().map(|c| Some(c.tcp.p)).collect()
+        chains.iter().map(|c| Some((c.tcp.p, c.tcp.r))).collect()
     }
 }
 
@@ -390,11 +385,16 @@ fn identifiability_phase(
     let (kept_geo, kept_c): (Vec<ParamId>, Vec<ParamId>) =
         analysis.kept.iter().partition(|i| i.is_geometric());
     let any_orientation = ident.iter().any(|m| m.orientation.is_some());
+    let mut report = analysis.report;
+    if any_orientation {
+        report.identifiable_by_orientation =
+            identifiable_by_orientation(nominal, ident, chains, &candidates, &analysis.kept, opts);
+    }
     let per_pose = if any_orientation { 6 } else { 3 };
     let gen_rank = generic_rank(nominal, &geometric, any_orientation);
     // Near-dependent parameters are dropped on purpose; only a shortfall in
     // exact rank means the poses are too few or too alike.
-    let near = analysis.report.near_dependent();
+    let near = report.near_dependent();
     if kept_geo.len() + near < gen_rank {
         if rows <= gen_rank {
             return Err(CalibrationError::TooFewPoses {
@@ -422,8 +422,42 @@ fn identifiability_phase(
     Ok(Identifiable {
         kept_geo,
         kept_c,
-        report: analysis.report,
+        report,
     })
+}
+
+/// The parameters of `kept` that the poses of `ident` identify only through
+/// their orientation rows: the analysis of the same poses with the
+/// orientations removed does not keep them.
+fn identifiable_by_orientation(
+    nominal: &RobotModel,
+    ident: &[Measurement],
+    chains: &[Chain],
+    candidates: &[ParamId],
+    kept: &[ParamId],
+    opts: &CalibrationOptions,
+) -> Vec<String> {
+    let position_only: Vec<Measurement> = ident
+        .iter()
+        .map(|m| Measurement {
+            orientation: None,
+            ..m.clone()
+        })
+        .collect();
+    let (j, rows) = stacked_factor(nominal, candidates, &position_only, Some(chains));
+    let without = identifiability::analyse_factor(
+        nominal,
+        &j,
+        rows,
+        candidates,
+        &fixed_params(nominal),
+        ident.len(),
+        &opts.identifiability,
+    );
+    kept.iter()
+        .filter(|id| !without.kept.contains(id))
+        .map(|id| id.name())
+        .collect()
 }
 
 /// Runs every method of `to_run` in order over 10–100 % of the bar, each by

@@ -119,6 +119,11 @@ pub struct IdentifiabilityReport {
     pub std_devs: Vec<(String, f64)>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub correlated_pairs: Vec<CorrelatedPair>,
+    /// With orientation rows: the kept parameters that the same poses without
+    /// their orientations would not identify (typically d6, θ6 and the tool
+    /// frame's rotation), found by analysing the position rows alone.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub identifiable_by_orientation: Vec<String>,
 }
 
 impl IdentifiabilityReport {
@@ -356,6 +361,7 @@ pub(crate) fn analyse_factor(
             observability_o1: o1,
             std_devs: vec![],
             correlated_pairs: vec![],
+            identifiable_by_orientation: vec![],
         },
         kept,
     }

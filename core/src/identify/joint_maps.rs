@@ -17,6 +17,17 @@
 //! candidate, so maps are kept only when they help on poses they never saw.
 //! Each joint's map covers the range of its training angles and fades to
 //! zero beyond it; a joint that moves less than `min_range_rad` gets none.
+//!
+//! Observability: a map is fitted only where the measurements see its effect.
+//! With position-only data a joint's angle is seen through the position
+//! rows of its column `J_θi` alone, whose norm is the lever arm from joint
+//! i's axis to the measured point [m/rad]; its RMS over the poses,
+//! `L_i = √(mean_p ‖J_pos,θi(q_p)‖²)`, below `min_lever_m` means an angle error
+//! of that joint barely moves the reflector (joint 6 seen from a reflector near
+//! its axis) while it turns a production tool: the joint's map is refused (not
+//! fitted) and [`MapFit::refused`] says why. Any measured orientation sees
+//! every joint's angle directly (`‖J_rot,θi‖ = 1`), so with orientation rows
+//! no map is refused on this ground.
 
 use super::evaluate::{evaluate, gram_checked};
 use crate::measure::Measurement;
@@ -45,6 +56,9 @@ pub struct JointMapSettings {
     pub min_range_rad: f64,
     /// Rounds of (map fit, LM refit of the geometry with the maps fixed).
     pub rounds: usize,
+    /// With position-only data, a joint whose RMS lever arm to the measured
+    /// point is below this gets no map (module docs) [m].
+    pub min_lever_m: f64,
 }
 
 impl Default for JointMapSettings {
@@ -57,6 +71,7 @@ impl Default for JointMapSettings {
             fade_rad: 5f64.to_radians(),
             min_range_rad: 10f64.to_radians(),
             rounds: 2,
+            min_lever_m: 0.02,
         }
     }
 }
@@ -72,6 +87,10 @@ pub struct MapCandidate {
     /// The seed's eq. 7.10 on the held-out errors,
     /// `mean(e²) + 0.5·max(e²) + 0.3·std(e²)` [mm²]: the choice's criterion.
     pub cv_cost_mm2: f64,
+    /// Mean held-out orientation error over the poses that measured one
+    /// (the linearised rotation residual's angle) [deg]; none without.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cv_orientation_mean_deg: Option<f64>,
 }
 
 /// Eq. 7.10 of errors [mm]: `mean(e²) + 0.5·max(e²) + 0.3·std(e²)` [mm²].
@@ -95,6 +114,71 @@ pub struct MapFit {
     pub candidates: Vec<MapCandidate>,
     /// Poses the maps were fitted on.
     pub poses: usize,
+    /// Joints whose map the measurements cannot see, not fitted.
+    pub refused: Vec<RefusedMap>,
+}
+
+/// A joint whose map was refused: the measurements do not see its angle.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RefusedMap {
+    /// Joint number (1-based).
+    pub joint: usize,
+    /// RMS lever arm from the joint's axis to the measured point over the
+    /// poses [mm].
+    pub lever_mm: f64,
+    /// The threshold it is below [mm].
+    pub min_lever_mm: f64,
+    pub reason: String,
+}
+
+/// RMS over the poses of the position rows' norm of each column of `jt`
+/// (one column per joint angle, rows as `evaluate` stacks them) [m/rad];
+/// `None` when some pose measured an orientation (every angle is then seen).
+fn position_levers(jt: &DMatrix<f64>, data: &[Measurement]) -> Option<Vec<f64>> {
+    if data.iter().any(|m| m.orientation.is_some()) || data.is_empty() {
+        return None;
+    }
+    Some(
+        (0..jt.ncols())
+            .map(|i| (jt.column(i).norm_squared() / data.len() as f64).sqrt())
+            .collect(),
+    )
+}
+
+/// The joints (with their trained range) that get a map, and those refused
+/// as unobservable (module docs).
+fn map_joints(
+    jt: &DMatrix<f64>,
+    data: &[Measurement],
+    settings: &JointMapSettings,
+) -> (Vec<(usize, [f64; 2])>, Vec<RefusedMap>) {
+    let levers = position_levers(jt, data);
+    let (mut joints, mut refused) = (Vec::new(), Vec::new());
+    for i in 0..jt.ncols() {
+        let lo = data.iter().map(|m| m.q[i]).fold(f64::INFINITY, f64::min);
+        let hi = data
+            .iter()
+            .map(|m| m.q[i])
+            .fold(f64::NEG_INFINITY, f64::max);
+        if hi - lo < settings.min_range_rad {
+            continue;
+        }
+        match levers.as_ref().map(|l| l[i]) {
+            Some(lever) if lever < settings.min_lever_m => refused.push(RefusedMap {
+                joint: i + 1,
+                lever_mm: lever * 1e3,
+                min_lever_mm: settings.min_lever_m * 1e3,
+                reason: format!(
+                    "joint {}'s angle moves the measured point by only {:.2} mm per radian (RMS over the poses, below {:.0} mm/rad) and no pose measured an orientation: a map of it would be invisible to the measurements yet turn a production tool, so none is fitted",
+                    i + 1,
+                    lever * 1e3,
+                    settings.min_lever_m * 1e3
+                ),
+            }),
+            _ => joints.push((i, [lo, hi])),
+        }
+    }
+    (joints, refused)
 }
 
 /// Why the maps cannot be fitted.
@@ -108,6 +192,8 @@ pub enum MapFitError {
     NotEvaluable,
     #[error("no joint moves over {min_deg:.1}° in the training poses")]
     NoJointMoves { min_deg: f64 },
+    #[error("no joint map is observable: {refused}")]
+    NoObservableJoint { refused: String },
 }
 
 /// The design of one fit: residuals, the geometry / session columns and the
@@ -119,8 +205,12 @@ struct Design {
     geo: usize,
     /// First row of each pose, and its row count.
     pose_rows: Vec<(usize, usize)>,
+    /// Weight of the orientation rows [m/rad].
+    weight: f64,
     /// Joints with a map, with their range.
     joints: Vec<(usize, [f64; 2])>,
+    /// Joints whose map the measurements cannot see.
+    refused: Vec<RefusedMap>,
     kmax: usize,
 }
 
@@ -170,16 +260,15 @@ fn build(
     if !go() {
         return Ok(None);
     }
-    let mut joints = Vec::new();
-    for i in 0..n {
-        let lo = data.iter().map(|m| m.q[i]).fold(f64::INFINITY, f64::min);
-        let hi = data
-            .iter()
-            .map(|m| m.q[i])
-            .fold(f64::NEG_INFINITY, f64::max);
-        if hi - lo >= settings.min_range_rad {
-            joints.push((i, [lo, hi]));
-        }
+    let (joints, refused) = map_joints(&jt, data, settings);
+    if joints.is_empty() && !refused.is_empty() {
+        return Err(MapFitError::NoObservableJoint {
+            refused: refused
+                .iter()
+                .map(|r| r.reason.as_str())
+                .collect::<Vec<_>>()
+                .join("; "),
+        });
     }
     if joints.is_empty() {
         return Err(MapFitError::NoJointMoves {
@@ -198,7 +287,9 @@ fn build(
         a: DMatrix::zeros(0, 0),
         geo,
         pose_rows: Vec::new(),
+        weight,
         joints,
+        refused,
         kmax,
     };
     for (p, m) in data.iter().enumerate() {
@@ -271,24 +362,33 @@ fn solve(
     ))
 }
 
-/// Position error norms [mm] of the poses `poses` after subtracting `a·x`.
-fn held_out_errors(d: &Design, poses: &[usize], cols: &[usize], x: &DVector<f64>) -> Vec<f64> {
+/// Position error norms [mm] of the poses `poses` after subtracting `a·x`,
+/// and their orientation errors [deg] (the norm of the unweighted rotation
+/// residual; `None` for a pose without a measured orientation).
+fn held_out_errors(
+    d: &Design,
+    poses: &[usize],
+    cols: &[usize],
+    x: &DVector<f64>,
+) -> (Vec<f64>, Vec<Option<f64>>) {
+    let left = |rr: usize| {
+        let fit: f64 = cols
+            .iter()
+            .zip(x.iter())
+            .map(|(c, x)| d.a[(rr, *c)] * x)
+            .sum();
+        d.r[rr] - fit
+    };
+    let norm = |rows: std::ops::Range<usize>| rows.map(|rr| left(rr).powi(2)).sum::<f64>().sqrt();
     poses
         .iter()
         .map(|&p| {
-            let (row, _) = d.pose_rows[p];
-            let mut e2 = 0.0;
-            for rr in row..row + 3 {
-                let fit: f64 = cols
-                    .iter()
-                    .zip(x.iter())
-                    .map(|(c, x)| d.a[(rr, *c)] * x)
-                    .sum();
-                e2 += (d.r[rr] - fit).powi(2);
-            }
-            e2.sqrt() * 1e3
+            let (row, nr) = d.pose_rows[p];
+            let angle = (nr == 6 && d.weight > 0.0)
+                .then(|| (norm(row + 3..row + 6) / d.weight).to_degrees());
+            (norm(row..row + 3) * 1e3, angle)
         })
-        .collect()
+        .unzip()
 }
 
 /// The normal equations `AᵀA`, `Aᵀr` of the rows of `poses`; `None` when
@@ -407,10 +507,15 @@ pub fn fit_joint_maps(
     for (done, (k, ridge)) in grid.iter().enumerate() {
         let cols = d.columns(*k);
         let mut errors = Vec::with_capacity(data.len());
+        let mut angles = Vec::with_capacity(data.len());
         let mut ok = true;
         for (poses, (gf, bf)) in fold_poses.iter().zip(&fold_normals) {
             match solve(&(&g - gf), &(&b - bf), &cols, &scale, d.geo, *ridge) {
-                Some(x) => errors.extend(held_out_errors(&d, poses, &cols, &x)),
+                Some(x) => {
+                    let (e, a) = held_out_errors(&d, poses, &cols, &x);
+                    errors.extend(e);
+                    angles.extend(a.into_iter().flatten());
+                }
                 None => ok = false,
             }
             if !progress(done, total) {
@@ -424,6 +529,8 @@ pub fn fit_joint_maps(
                 cv_mean_mm: errors.iter().sum::<f64>() / errors.len() as f64,
                 cv_max_mm: errors.iter().copied().fold(0.0, f64::max),
                 cv_cost_mm2: seed_cost(&errors),
+                cv_orientation_mean_deg: (!angles.is_empty())
+                    .then(|| angles.iter().sum::<f64>() / angles.len() as f64),
             });
         }
         if !progress(done + 1, total) {
@@ -473,5 +580,6 @@ pub fn fit_joint_maps(
         without_maps,
         candidates,
         poses: data.len(),
+        refused: d.refused.clone(),
     }))
 }

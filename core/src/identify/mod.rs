@@ -30,6 +30,6 @@ pub use options::{CalibrationOptions, CompensatorOptions, Progress};
 pub use registration::{register, Registration};
 pub use report::{
     AutoCandidate, AutoSummary, CalibrationReport, CompensatorSummary, FailedMethod,
-    JointMapExtent, JointMapsSummary, MethodReport, MethodWarning, ParamEstimate, PoseSource,
-    PoseSources, SetErrors, WarningKind, REPORT_FORMAT_VERSION,
+    JointMapExtent, JointMapsSummary, MethodReport, MethodWarning, NominalErrors, ParamEstimate,
+    PoseSource, PoseSources, SetErrors, WarningKind, REPORT_FORMAT_VERSION,
 };

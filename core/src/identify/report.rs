@@ -7,16 +7,17 @@
 //! calibrated `RobotModel` inside stays SI.
 
 use super::identifiability::IdentifiabilityReport;
-use super::joint_maps::{MapCandidate, MapFit};
+use super::joint_maps::{MapCandidate, MapFit, RefusedMap};
 use super::least_squares::LmReport;
 use super::options::Method;
 use crate::compensate::{Compensator, CvStats, StoredCompensator, Support, TrainReport};
 use crate::measure::Measurement;
 use crate::model::description::PoseDescription;
+use crate::model::orientation::rotation_angle_between;
 use crate::model::pose::Pose;
 use crate::model::{ModelDescription, ParamId, RobotModel};
-use crate::stats::ErrorStats;
-use nalgebra::{DMatrix, DVector, Vector3};
+use crate::stats::{ErrorStats, OrientationStats};
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -24,19 +25,32 @@ use std::sync::Arc;
 /// Version of the serialised [`CalibrationReport`]. 1: no version field, error
 /// norms only; 2: per-pose error vectors and positions, pose sources; 3: the
 /// compensator training pool (`training_poses`, `pose_sources.training`), the
-/// compensator summary of each compensator method and `auto`'s choice.
-pub const REPORT_FORMAT_VERSION: u32 = 3;
+/// compensator summary of each compensator method and `auto`'s choice; 4:
+/// orientation errors per set (`orientation_mean_deg`, …, when the set
+/// measured orientation) and the parameters identifiable only through them.
+pub const REPORT_FORMAT_VERSION: u32 = 4;
 
 /// Errors of one set: statistics plus the per-pose error norms (mm), and
 /// (format 2) the per-pose error vectors `measured − predicted` and the
 /// measured positions, both in the registered base frame of the pose's
 /// session [mm]. A pose the model cannot predict has a norm of infinity and
 /// no finite vector (`[NaN; 3]` serialises as nulls).
+///
+/// Orientation (format 4): when some pose of the set measured an orientation,
+/// `orientation` holds the statistics of the angle of
+/// `R_measured·R_predictedᵀ` [deg] over those poses (serialised flat as
+/// `orientation_mean_deg`, `orientation_max_deg`, …) and
+/// `orientation_errors_deg` the angle per pose (`null` for a pose without
+/// one). A set without any orientation measurement has neither field.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SetErrors {
     #[serde(flatten)]
     pub stats: ErrorStats,
+    #[serde(flatten, default, skip_serializing_if = "Option::is_none")]
+    pub orientation: Option<OrientationStats>,
     pub errors_mm: Vec<f64>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub orientation_errors_deg: Vec<Option<f64>>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub errors_xyz_mm: Vec<[Option<f64>; 3]>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -47,14 +61,17 @@ impl SetErrors {
     pub fn new(errors_mm: Vec<f64>) -> Self {
         SetErrors {
             stats: ErrorStats::from_errors_mm(&errors_mm),
+            orientation: None,
             errors_mm,
+            orientation_errors_deg: Vec::new(),
             errors_xyz_mm: Vec::new(),
             positions_mm: Vec::new(),
         }
     }
 
     /// Errors of `model` on `data` with the session frames applied: norms,
-    /// vectors and measured positions (eq. 2.3's residual, in mm).
+    /// vectors and measured positions (eq. 2.3's residual, in mm), and the
+    /// orientation errors of the poses that measured one.
     pub fn of(model: &RobotModel, frames: &[Pose], data: &[Measurement]) -> Self {
         Self::of_compensated(model, None, frames, data)
     }
@@ -62,7 +79,8 @@ impl SetErrors {
     /// [`SetErrors::of`] through the compensated prediction
     /// `FK(q + c∘τ) + NN(q, τ)` (registered base frame, then the session frame),
     /// τ the gravity torques of `model` at the commanded joints with the pose's
-    /// payload.
+    /// payload. A compensator corrects the position only: the orientation is
+    /// the geometric model's (with its joint maps and compliance).
     pub fn of_compensated(
         model: &RobotModel,
         compensator: Option<&dyn Compensator>,
@@ -77,86 +95,103 @@ impl SetErrors {
         )
     }
 
-    /// [`SetErrors::of`] from the predicted positions [m] of `data` in the
-    /// registered base frame (`None`: the model cannot predict the pose), one
-    /// per measurement in order.
+    /// [`SetErrors::of`] from the predicted poses (position [m], rotation) of
+    /// `data` in the registered base frame (`None`: the model cannot predict
+    /// the pose), one per measurement in order.
     pub(crate) fn from_predictions(
         frames: &[Pose],
         data: &[Measurement],
-        predictions: impl Iterator<Item = Option<Vector3<f64>>>,
+        predictions: impl Iterator<Item = Option<(Vector3<f64>, Matrix3<f64>)>>,
     ) -> Self {
         Self::from_residuals(
             data,
             data.iter().zip(predictions).map(|(m, p)| {
-                p.map(|p| {
+                p.map(|(p, r)| {
                     let e = frames.get(m.session).copied().unwrap_or_default();
-                    m.position - e.transform_point(&p)
+                    let angle = m
+                        .orientation
+                        .map(|rm| rotation_angle_between(&rm, &(e.r * r)).to_degrees());
+                    (m.position - e.transform_point(&p), angle)
                 })
             }),
         )
     }
 
-    /// [`SetErrors::of`] from the fitted model's residual vector on `data`
-    /// (`least_squares::Fit::residuals`: measured minus predicted, the same
-    /// numbers [`SetErrors::of`] computes again; orientation rows skipped).
-    pub(crate) fn from_residual_vector(data: &[Measurement], r: &DVector<f64>) -> Self {
-        let mut row = 0;
-        Self::from_residuals(
+    /// [`SetErrors::of`] from the fitted model's residual vector on
+    /// position-only `data` (`least_squares::Fit::residuals`: measured minus
+    /// predicted, the same numbers [`SetErrors::of`] computes again); `None`
+    /// when some pose measured an orientation (its weighted rows are then
+    /// better recomputed) or the vector does not match the data.
+    pub(crate) fn from_residual_vector(data: &[Measurement], r: &DVector<f64>) -> Option<Self> {
+        if data.iter().any(|m| m.orientation.is_some()) || r.len() != 3 * data.len() {
+            return None;
+        }
+        Some(Self::from_residuals(
             data,
-            data.iter().map(|m| {
-                let d = Vector3::new(r[row], r[row + 1], r[row + 2]);
-                row += if m.orientation.is_some() { 6 } else { 3 };
-                Some(d)
-            }),
-        )
+            (0..data.len())
+                .map(|i| Some((Vector3::new(r[3 * i], r[3 * i + 1], r[3 * i + 2]), None))),
+        ))
     }
 
     /// The set's errors from the position residuals [m] (measured minus
-    /// predicted, in the session frame; `None`: not predictable) of `data`.
+    /// predicted, in the session frame) and orientation errors [deg] (`None`
+    /// without a measured orientation) of `data`; `None`: not predictable.
     fn from_residuals(
         data: &[Measurement],
-        residuals: impl Iterator<Item = Option<Vector3<f64>>>,
+        residuals: impl Iterator<Item = Option<(Vector3<f64>, Option<f64>)>>,
     ) -> Self {
         let mut xyz = Vec::with_capacity(data.len());
         let mut norms = Vec::with_capacity(data.len());
-        for r in residuals {
+        let mut angles = Vec::with_capacity(data.len());
+        for (m, r) in data.iter().zip(residuals) {
             match r {
-                Some(r) => {
+                Some((r, angle)) => {
                     let d = r * 1e3;
                     norms.push(d.norm());
                     xyz.push([Some(d.x), Some(d.y), Some(d.z)]);
+                    angles.push(angle);
                 }
                 None => {
                     norms.push(f64::INFINITY);
                     xyz.push([None; 3]);
+                    angles.push(m.orientation.map(|_| f64::INFINITY));
                 }
             }
         }
+        let orientation = OrientationStats::from_angles_deg(&angles);
         SetErrors {
             positions_mm: data
                 .iter()
                 .map(|m| [m.position.x * 1e3, m.position.y * 1e3, m.position.z * 1e3])
                 .collect(),
             errors_xyz_mm: xyz,
+            orientation_errors_deg: if orientation.is_some() {
+                angles
+            } else {
+                Vec::new()
+            },
+            orientation,
             ..SetErrors::new(norms)
         }
     }
 }
 
-/// Predicted position [m] in the registered base frame, with the compensator's
-/// residual when there is one; `None` when the model cannot predict the pose.
+/// Predicted pose (position [m], rotation) in the registered base frame, the
+/// position with the compensator's residual when there is one (the rotation
+/// is the geometric model's: compensators correct position only); `None`
+/// when the model cannot predict the pose.
 pub(crate) fn predict_compensated(
     model: &RobotModel,
     compensator: Option<&dyn Compensator>,
     m: &Measurement,
-) -> Option<Vector3<f64>> {
-    let (p, _) = super::least_squares::predict(model, m)?;
+) -> Option<(Vector3<f64>, Matrix3<f64>)> {
+    let (p, r) = super::least_squares::predict(model, m)?;
     match compensator {
-        None => Some(p),
+        None => Some((p, r)),
         Some(c) => {
             let ch = crate::kinematics::chain(model, &m.q).ok()?;
             let tau = crate::kinematics::gravity_torques_of(model, &ch, m.payload_mass);
-            Some(p + c.residual_at(&m.q, &tau, m.payload_mass))
+            Some((p + c.residual_at(&m.q, &tau, m.payload_mass), r))
         }
     }
 }
@@ -283,6 +318,10 @@ pub struct JointMapsSummary {
     pub candidates: Vec<MapCandidate>,
     /// Per joint: its trained range and largest |Δθ| [deg] (`None`: no map).
     pub joints: Vec<Option<JointMapExtent>>,
+    /// Joints whose map the measurements cannot see (position-only data, the
+    /// measured point near the joint's axis): not fitted, with the reason.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub refused: Vec<RefusedMap>,
 }
 
 /// One joint's map in a report.
@@ -320,6 +359,7 @@ impl JointMapsSummary {
             cv_without_maps_max_mm: fit.without_maps.cv_max_mm,
             candidates: fit.candidates.clone(),
             joints,
+            refused: fit.refused.clone(),
         }
     }
 }
@@ -363,6 +403,10 @@ pub struct CompensatorSummary {
     /// compensators that give one.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub uncertainty: Option<UncertaintyCheck>,
+    /// With orientation measurements: what the compensator does to them (it
+    /// corrects position only, the orientation figures are the base's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub orientation_note: Option<String>,
 }
 
 /// How well a compensator's expected error per pose `u` (the RMS of the 3-D
@@ -461,6 +505,8 @@ pub enum WarningKind {
     PayloadImplausible,
     /// The compensator's expected errors are below what validation shows.
     UncertaintyOptimistic,
+    /// A joint's map was not fitted: the measurements cannot see its angle.
+    MapRefused,
 }
 
 /// A warning about one method's result.

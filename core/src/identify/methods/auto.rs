@@ -15,14 +15,50 @@
 //! compensators built on them (`km-maps-gp`, `skcm-maps-gp`) are
 //! cross-validated on what the maps leave and one is added when `choose`
 //! accepts it against the maps alone; the option keeps the maps' mean.
+//!
+//! Orientation: when the pool measured orientation, `auto` scores it too, and
+//! a method that gains position but loses orientation is not chosen. Joint
+//! maps are kept only when their cross-validated orientation mean is not
+//! above the geometry's alone on the same folds by more than
+//! [`ORIENTATION_SLACK`] (relative); and between the options only those whose
+//! orientation mean on the pool is within [`ORIENTATION_SLACK`] of the lowest
+//! compete by position ([`choose_option`]). A compensator corrects position
+//! only, so an option's orientation is that of its base (or maps).
 
-use super::compensated::base_pool_stats;
+use super::compensated::base_pool_errors;
 use super::maps::run_maps;
 use super::run::{AppliedCompensator, Cache, Context, MethodFit, Outcome};
 use super::{Base, Compensated, Method, MethodError, MethodFailure, Run};
 use crate::compensate::{choose, Choice, CvStats};
 use crate::identify::least_squares::Fit;
-use crate::identify::report::{AutoCandidate, AutoSummary};
+use crate::identify::report::{AutoCandidate, AutoSummary, SetErrors};
+
+/// Orientation means within this relative margin of each other count as
+/// equal (the fit's noise); a larger excess is a loss `auto` does not accept.
+pub(crate) const ORIENTATION_SLACK: f64 = 0.02;
+
+/// The option `auto` takes among `(position mean [mm], orientation mean
+/// [deg])` pairs (orientation `None`: not measured): those whose orientation
+/// mean exceeds the lowest by more than `slack` (relative) are excluded, then
+/// the lowest position mean wins. Returns its index and the excluded ones;
+/// `None` for no options.
+pub(crate) fn choose_option(
+    options: &[(f64, Option<f64>)],
+    slack: f64,
+) -> Option<(usize, Vec<usize>)> {
+    let best_orientation = options
+        .iter()
+        .filter_map(|o| o.1)
+        .fold(f64::INFINITY, f64::min);
+    let loses = |o: &(f64, Option<f64>)| {
+        o.1.is_some_and(|a| best_orientation.is_finite() && a > best_orientation * (1.0 + slack))
+    };
+    let excluded: Vec<usize> = (0..options.len()).filter(|i| loses(&options[*i])).collect();
+    let chosen = (0..options.len())
+        .filter(|i| !excluded.contains(i))
+        .min_by(|a, b| options[*a].0.total_cmp(&options[*b].0))?;
+    Some((chosen, excluded))
+}
 
 /// One base as `auto` weighs it.
 struct BaseOption {
@@ -35,7 +71,15 @@ struct BaseOption {
     /// Cross-validated mean on the pool [mm] (the base's residual mean when
     /// nothing was trained).
     mean_mm: f64,
+    /// Orientation mean of the fit on the pool [deg] (none without
+    /// orientation measurements).
+    orientation_deg: Option<f64>,
     reason: String,
+}
+
+/// The orientation mean of `errors` [deg], if the set measured any.
+fn orientation_mean(errors: &SetErrors) -> Option<f64> {
+    errors.orientation.as_ref().map(|o| o.mean_deg)
 }
 
 /// `auto` (module docs). Without gravity torques (`Context::gravity`) neither
@@ -99,7 +143,9 @@ pub(crate) fn run_auto(
                 continue;
             }
         };
-        let base_mean = base_pool_stats(&mf.fit, pool).mean_mm;
+        let base_errors = base_pool_errors(&mf.fit, pool);
+        let base_mean = base_errors.stats.mean_mm;
+        let orientation_deg = orientation_mean(&base_errors);
         if !enough {
             options.push(BaseOption {
                 base: *base,
@@ -107,6 +153,7 @@ pub(crate) fn run_auto(
                 fit: mf,
                 compensator: None,
                 mean_mm: base_mean,
+                orientation_deg,
                 reason: format!(
                     "{name}: only {} training poses (at least {} are needed to train and cross-validate a compensator), so the base stays",
                     pool.len(),
@@ -136,6 +183,7 @@ pub(crate) fn run_auto(
             fit: mf,
             compensator: picked,
             mean_mm,
+            orientation_deg,
             reason: format!("{name}: {}", choice.reason),
         });
     }
@@ -171,7 +219,23 @@ pub(crate) fn run_auto(
                 });
                 let (with, without) = (&m.chosen, &m.without_maps);
                 let gain = 1.0 - with.cv_mean_mm / without.cv_mean_mm;
-                if m.maps.is_some() && gain >= o.min_gain && with.cv_max_mm <= without.cv_max_mm {
+                let orientation_loss = match (
+                    with.cv_orientation_mean_deg,
+                    without.cv_orientation_mean_deg,
+                ) {
+                    (Some(a), Some(b)) if a > b * (1.0 + ORIENTATION_SLACK) => Some((a, b)),
+                    _ => None,
+                };
+                if let (Some((a, b)), true) = (orientation_loss, m.maps.is_some()) {
+                    notes.push(format!(
+                        "{} not kept: it loses orientation, cross-validated {a:.4}° mean against {b:.4}° without maps (more than {:.0} % above)",
+                        method.name(),
+                        ORIENTATION_SLACK * 100.0
+                    ));
+                } else if m.maps.is_some()
+                    && gain >= o.min_gain
+                    && with.cv_max_mm <= without.cv_max_mm
+                {
                     let on_maps = maps_compensator(
                         ctx,
                         cache,
@@ -181,12 +245,18 @@ pub(crate) fn run_auto(
                         &mut candidates,
                         &mut |f, e, l| progress((on_maps_at + f) / total, e, l),
                     )?;
+                    let orientation_deg = orientation_mean(&SetErrors::of(
+                        &fit.fit.model,
+                        &fit.fit.session_frames,
+                        pool,
+                    ));
                     options.push(BaseOption {
                         base: *base,
                         maps: Some(method),
                         fit,
                         compensator: on_maps.kept,
                         mean_mm: with.cv_mean_mm,
+                        orientation_deg,
                         reason: format!("{}{}", on_maps.reason, format_args!(
                             "{}: {} harmonics cross-validated over {} poses at {:.4} / {:.4} mm mean / max against {:.4} / {:.4} without maps",
                             method.name(),
@@ -212,21 +282,27 @@ pub(crate) fn run_auto(
             }
         }
     }
-    let best = options
+    let scores: Vec<(f64, Option<f64>)> = options
         .iter()
-        .enumerate()
-        .min_by(|a, b| a.1.mean_mm.total_cmp(&b.1.mean_mm))
-        .map(|(i, _)| i)
-        .ok_or_else(|| MethodFailure::NoBaseSucceeded {
+        .map(|o| (o.mean_mm, o.orientation_deg))
+        .collect();
+    let (best, excluded) = choose_option(&scores, ORIENTATION_SLACK).ok_or_else(|| {
+        MethodFailure::NoBaseSucceeded {
             notes: notes.clone(),
-        })?;
+        }
+    })?;
+    let best_orientation = scores[best].1;
+    for i in excluded {
+        notes.push(format!(
+            "{} not chosen: it loses orientation, {:.4}° mean on the {pool_name} poses, more than {:.0} % above the best option's",
+            option_name(&options[i]),
+            scores[i].1.unwrap_or(f64::NAN),
+            ORIENTATION_SLACK * 100.0
+        ));
+    }
     let reasons: Vec<String> = options.iter().map(|o| o.reason.clone()).collect();
     let best = options.swap_remove(best);
-    let chosen = match (&best.compensator, best.maps) {
-        (Some(a), _) => a.method,
-        (None, Some(m)) => m,
-        (None, None) => best.base.method(),
-    };
+    let chosen = Method::from_name(option_name(&best)).expect("a method's own name");
     let mut reason = format!(
         "{}: the lowest {} mean on the {pool_name} poses ({:.4} mm) — {}",
         chosen.name(),
@@ -238,6 +314,12 @@ pub(crate) fn run_auto(
         best.mean_mm,
         reasons.join("; ")
     );
+    if let Some(a) = best_orientation {
+        reason.push_str(&format!(
+            "; orientation {a:.4}° mean on the {pool_name} poses (orientation within {:.0} % of the best option's is required)",
+            ORIENTATION_SLACK * 100.0
+        ));
+    }
     if !notes.is_empty() {
         reason.push_str(&format!("; {}", notes.join("; ")));
     }
@@ -250,6 +332,15 @@ pub(crate) fn run_auto(
             candidates,
         }),
     })
+}
+
+/// The method an option delivers.
+fn option_name(o: &BaseOption) -> &'static str {
+    match (&o.compensator, o.maps) {
+        (Some(a), _) => a.method.name(),
+        (None, Some(m)) => m.name(),
+        (None, None) => o.base.method().name(),
+    }
 }
 
 /// What `auto` made of the compensators on a kept joint-map fit.
@@ -362,4 +453,36 @@ fn maps_candidate(candidates: &[Method], base: Base) -> Option<Method> {
         .iter()
         .copied()
         .find(|m| m.row().run == Run::Maps(base))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Without orientation the lowest position mean wins; with it, an option
+    /// that gains position but loses orientation beyond the slack is
+    /// excluded, one within the slack still competes by position.
+    #[test]
+    fn an_option_losing_orientation_is_not_chosen() {
+        assert_eq!(
+            choose_option(&[(0.45, None), (0.10, None)], 0.02),
+            Some((1, vec![]))
+        );
+        // Maps: 4× better position, but 0.060° against 0.053°: excluded.
+        assert_eq!(
+            choose_option(&[(0.45, Some(0.053)), (0.10, Some(0.060))], 0.02),
+            Some((0, vec![1]))
+        );
+        // 0.0535° is within 2 % of 0.053°: the better position wins.
+        assert_eq!(
+            choose_option(&[(0.45, Some(0.053)), (0.10, Some(0.0535))], 0.02),
+            Some((1, vec![]))
+        );
+        // Better on both: chosen.
+        assert_eq!(
+            choose_option(&[(0.45, Some(0.053)), (0.10, Some(0.019))], 0.02),
+            Some((1, vec![0]))
+        );
+        assert_eq!(choose_option(&[], 0.02), None);
+    }
 }

@@ -28,7 +28,7 @@
 //! (`CompensatorOptions::seed`): a calibration is reproducible bit for bit.
 
 use super::run::{AppliedCompensator, Cache, Context, Outcome};
-use super::{Compensated, Method, MethodError, MethodFailure, Network};
+use super::{Base, Compensated, Method, MethodError, MethodFailure, Network};
 use crate::compensate::{
     cross_validate, train, Compensator, CvStats, Sample, StoredCompensator, Support, TrainError,
     TrainReport,
@@ -42,7 +42,6 @@ use crate::kinematics::{chain, gravity_torques_of};
 use crate::measure::Measurement;
 use crate::model::pose::Pose;
 use crate::model::RobotModel;
-use crate::stats::ErrorStats;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -65,7 +64,7 @@ pub(crate) fn samples(
     data.iter()
         .enumerate()
         .map(|(i, m)| {
-            let p = predict_compensated(model, None, m)
+            let (p, _) = predict_compensated(model, None, m)
                 .ok_or(MethodFailure::UnpredictableTrainingPose { pose: i + 1 })?;
             let c = chain(model, &m.q)
                 .map_err(|cause| MethodFailure::TrainingPose { pose: i + 1, cause })?;
@@ -297,6 +296,23 @@ pub(crate) fn compensate_report(
             .collect(),
         fade_deg: trained.support.fade_rad.to_degrees(),
         uncertainty,
+        orientation_note: ident
+            .iter()
+            .chain(training)
+            .chain(valid)
+            .any(|m| m.orientation.is_some())
+            .then(|| {
+                format!(
+                    "the compensator corrects the position only: the orientation errors are those of {} (its {}), unchanged by it",
+                    applied.base.method().name(),
+                    match applied.base {
+                        Base::Km => "geometry",
+                        Base::Skcm => "geometry and compliance",
+                        Base::KmMaps => "geometry and joint maps",
+                        Base::SkcmMaps => "geometry, compliance and joint maps",
+                    }
+                )
+            }),
     });
     if let Some(w) = report
         .compensator
@@ -314,9 +330,10 @@ pub(crate) fn compensate_report(
     report.stored_support = Some(trained.support.clone());
 }
 
-/// Error statistics of the base alone on the pool [mm] (the residual norms).
-pub(crate) fn base_pool_stats(base: &Fit, pool: &[Measurement]) -> ErrorStats {
-    SetErrors::of(&base.model, &base.session_frames, pool).stats
+/// Errors of the base alone on the pool (the residual norms [mm], and the
+/// orientation errors [deg] where the pool measured orientation).
+pub(crate) fn base_pool_errors(base: &Fit, pool: &[Measurement]) -> SetErrors {
+    SetErrors::of(&base.model, &base.session_frames, pool)
 }
 
 #[cfg(test)]

@@ -8,7 +8,6 @@ use super::compensated::compensate_report;
 use super::run::{Context, MethodFit, Outcome};
 use super::{Method, MethodFailure};
 use crate::cell::accuracy::ValidationEvidence;
-use crate::identify::least_squares::residual_rows;
 use crate::identify::report::{
     estimates, JointMapsSummary, MethodReport, MethodWarning, SetErrors, WarningKind,
 };
@@ -56,12 +55,11 @@ impl Context<'_> {
             return Err(MethodFailure::DoesNotLoadBack { method, cause });
         }
         // The fit's last residuals are those of the identification set.
-        let id_err = match &fitted.residuals {
-            Some(r) if r.len() == residual_rows(self.ident) => {
-                SetErrors::from_residual_vector(self.ident, r)
-            }
-            _ => SetErrors::of(&fitted.model, &fitted.session_frames, self.ident),
-        };
+        let id_err = fitted
+            .residuals
+            .as_ref()
+            .and_then(|r| SetErrors::from_residual_vector(self.ident, r))
+            .unwrap_or_else(|| SetErrors::of(&fitted.model, &fitted.session_frames, self.ident));
         let va_err = (!self.valid.is_empty())
             .then(|| SetErrors::of(&fitted.model, &fitted.session_frames, self.valid));
         let mut warnings = Vec::new();
@@ -77,6 +75,13 @@ impl Context<'_> {
                 kind: WarningKind::ParameterNotIdentifiable,
                 joint: None,
                 message: format!("{} kept at its nominal value: {}", d.name, d.reason),
+            });
+        }
+        for r in maps.iter().flat_map(|m| &m.refused) {
+            warnings.push(MethodWarning {
+                kind: WarningKind::MapRefused,
+                joint: Some(r.joint),
+                message: format!("no map for joint {}: {}", r.joint, r.reason),
             });
         }
         let [k_lo, k_hi] = self.opts.plausible_stiffness_nm_per_rad;
