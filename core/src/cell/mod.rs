@@ -25,6 +25,8 @@
 pub mod export;
 pub mod file;
 pub mod load;
+pub mod tcp;
+pub mod work_object_fit;
 
 pub use file::{CellDescription, CellFileError};
 pub use load::{Load, LoadDescription, LoadFrame};
