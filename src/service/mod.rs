@@ -12,6 +12,7 @@
 
 pub mod calibrations;
 pub mod cell;
+pub mod cell_fit;
 mod changes;
 pub mod checks;
 mod job_watch;

@@ -15,6 +15,7 @@
 //! the console's security headers); the harness is `support`.
 
 mod cell;
+mod cell_fit;
 #[path = "../common/mod.rs"]
 mod common;
 mod contract;

@@ -24,7 +24,12 @@
 
 pub mod axis;
 pub mod fixed_point;
+pub mod readings;
+pub mod request;
 pub mod tracker;
+
+pub use readings::{Reading, WoPoint};
+pub use request::{fit_tool, fit_work_object, AxisRequest, ToolRequest};
 
 use crate::compensate::CompensatedModel;
 use crate::model::Pose;
