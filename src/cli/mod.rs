@@ -18,6 +18,7 @@ pub mod reregister;
 pub mod serve;
 pub mod simulate;
 pub mod solve;
+pub mod tcp;
 
 #[derive(Debug, Parser)]
 #[command(
@@ -58,6 +59,10 @@ pub enum Command {
     Plan(plan::PlanArgs),
     /// ISO 9283 pose accuracy and repeatability: the test cube plan and the figures.
     Iso9283(iso9283::Iso9283Args),
+    /// A production tool's TCP (and axis) fitted on the calibrated model.
+    Tcp(tcp::TcpArgs),
+    /// A work object from three points (tracker or touched with a calibrated tool).
+    WorkObject(tcp::WorkObjectArgs),
     /// Run the HTTP service.
     Serve(serve::ServeArgs),
     /// Time robocal's side of the peer benchmark (KM, IK), as JSON.
@@ -80,6 +85,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Cell(a) => cell::run(a),
         Command::Plan(a) => plan::run(a),
         Command::Iso9283(a) => iso9283::run(a),
+        Command::Tcp(a) => tcp::run_tcp(a),
+        Command::WorkObject(a) => tcp::run_work_object(a),
         Command::Serve(a) => serve::run(a),
         Command::Bench(a) => bench::run(a),
     }

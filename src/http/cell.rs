@@ -109,7 +109,7 @@ pub struct ItemOut {
 }
 
 impl ItemOut {
-    fn from_row(r: CellItemRow) -> ItemOut {
+    pub(crate) fn from_row(r: CellItemRow) -> ItemOut {
         ItemOut {
             name: r.name,
             number: r.number,

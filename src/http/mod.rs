@@ -28,6 +28,7 @@ use tracing::Level;
 pub mod auth;
 pub mod calibrations;
 pub mod cell;
+pub mod cell_fit;
 pub mod checks;
 pub mod client;
 pub mod console;
@@ -141,6 +142,7 @@ fn routes() -> Vec<Route> {
     all.extend(solve::routes());
     all.extend(predict::routes());
     all.extend(cell::routes());
+    all.extend(cell_fit::routes());
     all.extend(programs::routes());
     all.extend(plans::routes());
     all.extend(checks::routes());

@@ -12,6 +12,7 @@
 
 pub mod calibrations;
 pub mod cell;
+pub mod cell_fit;
 mod changes;
 pub mod checks;
 pub mod iso9283;

@@ -16,6 +16,7 @@
 
 mod abandoned;
 mod cell;
+mod cell_fit;
 #[path = "../common/mod.rs"]
 mod common;
 mod contract;

@@ -28,6 +28,8 @@ pub mod file;
 pub mod joints_csv;
 pub mod load;
 pub mod predict;
+pub mod tcp;
+pub mod work_object_fit;
 
 pub use file::{CellDescription, CellFileError};
 pub use load::{Load, LoadDescription, LoadFrame};

@@ -1,0 +1,235 @@
+//! `POST /v1/robots/{id}/tools/{name}/fit` and
+//! `POST /v1/robots/{id}/frames/{name}/fit`: a tool's TCP (and axis) or a
+//! work object fitted on the robot's calibrated version from joint readings
+//! (controller degrees) or tracker measurements (mm, degrees, the
+//! calibration's measurement frame), stored as the robot's tool or work
+//! object (base frame) and returned with the fit's residuals and σ
+//! (`core::cell::tcp`).
+
+use super::cell::{check_item_name, ItemOut, CELL_NUMBER_MAX};
+use super::input::{objects, present, Int};
+use super::{ApiError, ApiJson, ApiPath, AppState};
+use crate::cell::tcp::{AxisRequest, Reading, TcpMethod, ToolRequest, WoPoint};
+use crate::db::CellPut;
+use crate::service;
+use crate::service::cell_fit::FitTarget;
+use axum::extract::State;
+use axum::http::StatusCode;
+use axum::response::{IntoResponse, Response};
+use serde::{Deserialize, Serialize};
+
+/// Most rows of one fit (each list).
+pub const FIT_ROWS_MAX: usize = 1000;
+/// Largest joint reading magnitude [deg].
+const JOINT_MAX_DEG: f64 = 720.0;
+/// Largest tracker coordinate magnitude [mm].
+const XYZ_MAX_MM: f64 = 100_000.0;
+/// Largest angle magnitude [deg].
+const ANGLE_MAX_DEG: f64 = 360.0;
+
+/// One row as a request gives it.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReadingIn {
+    #[serde(default, deserialize_with = "present")]
+    pub point: Option<WoPoint>,
+    #[serde(default, deserialize_with = "present")]
+    pub joints_deg: Option<Vec<f64>>,
+    #[serde(default, deserialize_with = "present")]
+    pub xyz_mm: Option<Vec<f64>>,
+    #[serde(default, deserialize_with = "present")]
+    pub rpy_deg: Option<Vec<f64>>,
+}
+
+/// `POST …/tools/{name}/fit` body.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ToolFitIn {
+    #[serde(default, deserialize_with = "present")]
+    pub method: Option<TcpMethod>,
+    #[serde(deserialize_with = "objects")]
+    pub readings: Vec<ReadingIn>,
+    #[serde(default, deserialize_with = "present_objects")]
+    pub axis_point: Option<Vec<ReadingIn>>,
+    #[serde(default, deserialize_with = "present_objects")]
+    pub plane: Option<Vec<ReadingIn>>,
+    #[serde(default)]
+    pub number: Option<Int<i64>>,
+    #[serde(default)]
+    pub version: Option<Int<i64>>,
+}
+
+/// `POST …/frames/{name}/fit` body.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WorkObjectFitIn {
+    #[serde(deserialize_with = "objects")]
+    pub readings: Vec<ReadingIn>,
+    #[serde(default, deserialize_with = "present")]
+    pub tool: Option<String>,
+    #[serde(default)]
+    pub number: Option<Int<i64>>,
+    #[serde(default)]
+    pub version: Option<Int<i64>>,
+}
+
+fn present_objects<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<Option<Vec<ReadingIn>>, D::Error> {
+    objects(d).map(Some)
+}
+
+fn triple(
+    v: &Option<Vec<f64>>,
+    what: &str,
+    row: usize,
+    max: f64,
+) -> Result<Option<[f64; 3]>, ApiError> {
+    let Some(v) = v else { return Ok(None) };
+    let t = <[f64; 3]>::try_from(v.as_slice())
+        .map_err(|_| ApiError::invalid(format!("{what} {row}: needs 3 values, got {}", v.len())))?;
+    if t.iter().any(|x| x.abs() > max) {
+        return Err(ApiError::invalid(format!(
+            "{what} {row}: values must be within ±{max}"
+        )));
+    }
+    Ok(Some(t))
+}
+
+/// The rows checked against the spec's bounds.
+fn rows(list: &[ReadingIn], what: &str) -> Result<Vec<Reading>, ApiError> {
+    if list.is_empty() || list.len() > FIT_ROWS_MAX {
+        return Err(ApiError::invalid(format!(
+            "`{what}`: 1 to {FIT_ROWS_MAX} rows, got {}",
+            list.len()
+        )));
+    }
+    list.iter()
+        .enumerate()
+        .map(|(i, r)| {
+            let row = i + 1;
+            if let Some(q) = &r.joints_deg {
+                if !(1..=7).contains(&q.len()) || q.iter().any(|v| v.abs() > JOINT_MAX_DEG) {
+                    return Err(ApiError::invalid(format!(
+                        "`{what}` row {row}: `joints_deg` needs 1 to 7 controller readings within ±{JOINT_MAX_DEG}°"
+                    )));
+                }
+            }
+            Ok(Reading {
+                point: r.point,
+                joints_deg: r.joints_deg.clone(),
+                xyz_mm: triple(&r.xyz_mm, &format!("`{what}` row, `xyz_mm`,"), row, XYZ_MAX_MM)?,
+                rpy_deg: triple(&r.rpy_deg, &format!("`{what}` row, `rpy_deg`,"), row, ANGLE_MAX_DEG)?,
+            })
+        })
+        .collect()
+}
+
+fn target(
+    robot_id: i64,
+    name: &str,
+    number: Option<i64>,
+    version: Option<i64>,
+) -> Result<FitTarget, ApiError> {
+    check_item_name(name)?;
+    if let Some(n) = number {
+        if !(0..=CELL_NUMBER_MAX).contains(&n) {
+            return Err(ApiError::invalid(format!(
+                "`number` must be between 0 and {CELL_NUMBER_MAX}, got {n}"
+            )));
+        }
+    }
+    if let Some(v) = version {
+        if v < 1 {
+            return Err(ApiError::invalid(format!(
+                "`version` numbers start at 1, got {v}"
+            )));
+        }
+    }
+    Ok(FitTarget {
+        robot_id,
+        name: name.to_string(),
+        number,
+        version,
+    })
+}
+
+#[derive(Serialize)]
+struct FitOut<'a, F: Serialize> {
+    item: ItemOut,
+    fit: &'a F,
+    /// The calibrated version the fit was made on.
+    version: i64,
+}
+
+fn answer<F: Serialize>(put: CellPut, fit: &F, version: i64) -> Response {
+    let status = if put.created {
+        StatusCode::CREATED
+    } else {
+        StatusCode::OK
+    };
+    let body = FitOut {
+        item: ItemOut::from_row(put.row),
+        fit,
+        version,
+    };
+    (status, axum::Json(body)).into_response()
+}
+
+pub async fn fit_tool(
+    State(s): State<AppState>,
+    ApiPath((id, name)): ApiPath<(i64, String)>,
+    ApiJson(body): ApiJson<ToolFitIn>,
+) -> Result<Response, ApiError> {
+    let t = target(
+        id,
+        &name,
+        body.number.map(|n| n.0),
+        body.version.map(|v| v.0),
+    )?;
+    let axis = match (&body.axis_point, &body.plane) {
+        (Some(_), Some(_)) => {
+            return Err(ApiError::invalid(
+                "give the tool's axis by `axis_point` or by `plane`, not both",
+            ))
+        }
+        (Some(a), None) => Some(AxisRequest::Point(rows(a, "axis_point")?)),
+        (None, Some(p)) => Some(AxisRequest::Plane(rows(p, "plane")?)),
+        (None, None) => None,
+    };
+    let req = ToolRequest {
+        method: body.method.unwrap_or(TcpMethod::FixedPoint),
+        rows: rows(&body.readings, "readings")?,
+        axis,
+    };
+    let done = service::cell_fit::fit_tool(&s, &t, &req).await?;
+    Ok(answer(done.put, &done.fit, done.version))
+}
+
+pub async fn fit_frame(
+    State(s): State<AppState>,
+    ApiPath((id, name)): ApiPath<(i64, String)>,
+    ApiJson(body): ApiJson<WorkObjectFitIn>,
+) -> Result<Response, ApiError> {
+    let t = target(
+        id,
+        &name,
+        body.number.map(|n| n.0),
+        body.version.map(|v| v.0),
+    )?;
+    if let Some(tool) = &body.tool {
+        check_item_name(tool)?;
+    }
+    let readings = rows(&body.readings, "readings")?;
+    let done = service::cell_fit::fit_work_object(&s, &t, &readings, body.tool.as_deref()).await?;
+    Ok(answer(done.put, &done.fit, done.version))
+}
+
+/// The routes of tool and work-object fits.
+pub fn routes() -> Vec<super::Route> {
+    use super::post;
+    vec![
+        post("/v1/robots/{id}/tools/{name}/fit", fit_tool),
+        post("/v1/robots/{id}/frames/{name}/fit", fit_frame),
+    ]
+}

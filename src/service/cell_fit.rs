@@ -1,0 +1,128 @@
+//! Tool and work-object calibration of a robot (`core::cell::tcp`): fitted on
+//! the chosen calibrated version (the active one by default, never the
+//! nominal model) and stored as the robot's tool or work object. A refit of
+//! an existing tool keeps its load and, unless a new one is given, its
+//! number. Work objects are stored in the robot base frame.
+
+use super::solve::{chosen_model, ModelChoice};
+use super::{cell, AppState, ServiceError};
+use crate::cell::tcp::{self as core_tcp, FitError, Reading, ToolFit, ToolRequest};
+use crate::cell::work_object_fit::WorkObjectFit;
+use crate::cell::CellRef;
+use crate::db::{CellKind, CellPut, ItemFrame, NewCellItem};
+
+/// What a fit asks beyond its readings.
+#[derive(Debug, Clone)]
+pub struct FitTarget {
+    pub robot_id: i64,
+    /// The stored item's name.
+    pub name: String,
+    /// The controller's number; `None` keeps a refitted item's number.
+    pub number: Option<i64>,
+    /// The calibrated version (`None`: the active one).
+    pub version: Option<i64>,
+}
+
+/// A stored fit: the item, the fit and the version it was made on.
+#[derive(Debug, Clone)]
+pub struct Stored<F> {
+    pub put: CellPut,
+    pub fit: F,
+    pub version: i64,
+}
+
+fn invalid(e: FitError) -> ServiceError {
+    ServiceError::Invalid(e.to_string())
+}
+
+async fn calibrated(
+    state: &AppState,
+    t: &FitTarget,
+) -> Result<(crate::compensate::CompensatedModel, i64), ServiceError> {
+    let choice = match t.version {
+        Some(v) => ModelChoice::Version(v),
+        None => {
+            let ctx = state.robot_context(t.robot_id).await?;
+            if ctx.active.is_none() {
+                return Err(ServiceError::Conflict(format!(
+                    "robot {} has no active model version: a TCP or work object is fitted on the calibrated model; run a calibration (POST /v1/robots/{}/calibrations), activate a version, or name one with \"version\": N",
+                    t.robot_id, t.robot_id
+                )));
+            }
+            ModelChoice::Active
+        }
+    };
+    let chosen = chosen_model(state, t.robot_id, choice).await?;
+    let version = chosen
+        .version
+        .ok_or_else(|| ServiceError::Internal("a calibrated version was chosen".into()))?;
+    Ok((chosen.model, version))
+}
+
+/// The number to store: the one given, else the existing item's.
+async fn number_of(
+    state: &AppState,
+    t: &FitTarget,
+    kind: CellKind,
+) -> Result<(Option<i64>, Option<crate::cell::LoadDescription>), ServiceError> {
+    match state.db().cell_item(t.robot_id, kind, &t.name).await? {
+        Some(row) => Ok((t.number.or(row.number), row.load_json.map(|j| j.0))),
+        None => Ok((t.number, None)),
+    }
+}
+
+/// Fits a tool and stores it.
+pub async fn fit_tool(
+    state: &AppState,
+    t: &FitTarget,
+    req: &ToolRequest,
+) -> Result<Stored<ToolFit>, ServiceError> {
+    let (model, version) = calibrated(state, t).await?;
+    let fit = core_tcp::fit_tool(&model, req).map_err(invalid)?;
+    let (number, load) = number_of(state, t, CellKind::Tool).await?;
+    let entry = core_tcp::request::tool_description(&t.name, None, &fit);
+    let item = NewCellItem {
+        name: t.name.clone(),
+        number,
+        frame: ItemFrame::Flange,
+        pose: entry.tcp,
+        load,
+    };
+    let put = cell::put(state, t.robot_id, CellKind::Tool, &item).await?;
+    Ok(Stored { put, fit, version })
+}
+
+/// Fits a work object (touches made with the stored tool `tool`) and stores it.
+pub async fn fit_work_object(
+    state: &AppState,
+    t: &FitTarget,
+    rows: &[Reading],
+    tool: Option<&str>,
+) -> Result<Stored<WorkObjectFit>, ServiceError> {
+    let (model, version) = calibrated(state, t).await?;
+    let tcp = match tool {
+        Some(name) => {
+            let c = cell::cell(state, t.robot_id).await?;
+            let tool = c.tool(&CellRef::Name(name.to_string())).map_err(|e| {
+                ServiceError::Invalid(format!(
+                    "`tool`: {e}; list them with GET /v1/robots/{}/tools",
+                    t.robot_id
+                ))
+            })?;
+            Some(tool.tcp.p)
+        }
+        None => None,
+    };
+    let fit = core_tcp::fit_work_object(&model, rows, tcp.as_ref()).map_err(invalid)?;
+    let (number, _) = number_of(state, t, CellKind::WorkObject).await?;
+    let entry = core_tcp::request::work_object_description(&t.name, None, &fit);
+    let item = NewCellItem {
+        name: t.name.clone(),
+        number,
+        frame: ItemFrame::Base,
+        pose: entry.pose,
+        load: None,
+    };
+    let put = cell::put(state, t.robot_id, CellKind::WorkObject, &item).await?;
+    Ok(Stored { put, fit, version })
+}
