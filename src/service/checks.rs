@@ -146,14 +146,22 @@ pub async fn compare(
         )));
     }
     let t = thresholds(state, robot_id).await?;
+    // A set or version the robot lacks conflicts with its state (the URL
+    // names an existing robot), as in a solve.
+    let conflict = |e: ServiceError| match e {
+        ServiceError::NotFound(m) => ServiceError::Conflict(m),
+        other => other,
+    };
     let rows = state
         .db()
         .set_rows(robot_id, set_id)
         .await?
-        .ok_or_else(|| ServiceError::set_not_found(robot_id, set_id))?;
+        .ok_or_else(|| conflict(ServiceError::set_not_found(robot_id, set_id)))?;
     let mut models = Vec::with_capacity(versions.len());
     for &v in versions {
-        let (row, text) = versions::with_model(state, robot_id, v).await?;
+        let (row, text) = versions::with_model(state, robot_id, v)
+            .await
+            .map_err(conflict)?;
         let model = CalibratedModelFile::from_json(&text)
             .and_then(|f| f.to_compensated())
             .map_err(|e| ServiceError::Internal(format!("stored model of version {v}: {e}")))?;

@@ -217,7 +217,7 @@ async fn checks_score_the_active_version_and_give_the_status() {
     assert_eq!(r.json()["total"], 2);
     assert_eq!(r.json()["checks"][0]["status"], "ok");
 
-    // Compare: the same scoring, nothing stored; a version the robot lacks is 404.
+    // Compare: the same scoring, nothing stored; a version the robot lacks is 409.
     let r = t
         .post_json(
             "/v1/robots/{id}/compare",
@@ -238,7 +238,7 @@ async fn checks_score_the_active_version_and_give_the_status() {
             json!({ "set_id": check_set["id"], "versions": [1, 9] }),
         )
         .await;
-    assert_eq!(r.status, StatusCode::NOT_FOUND, "{}", r.text());
+    assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
     let r = t.get("/v1/robots/{id}/checks", &[&rid]).await;
     assert_eq!(r.json()["total"], 2);
 
