@@ -115,8 +115,9 @@ pub async fn predict(
         model.payload_kg = p;
     }
     let dof = model.dof();
+    // Another joint count conflicts with the robot (as a solve's seed does).
     if let Some(r) = cmd.readings.iter().find(|r| r.joints_deg.len() != dof) {
-        return Err(ServiceError::Invalid(format!(
+        return Err(ServiceError::Conflict(format!(
             "reading `{}`: {} joint values, the robot has {dof} joints (controller degrees)",
             r.id,
             r.joints_deg.len()

@@ -251,7 +251,7 @@ async fn bad_predictions_are_refused_with_the_reason() {
     let rid_arg = [rid.as_str()];
     let post = |body: Value| t.post_json(PREDICT, &rid_arg, body);
     let r = post(json!({ "readings": [{ "joints_deg": [0, 0, 0, 0, 0] }] })).await;
-    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+    assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
     assert!(
         r.detail().contains("the robot has 6 joints"),
         "{}",
