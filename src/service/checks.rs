@@ -68,7 +68,11 @@ pub async fn create(state: &AppState, cmd: CheckCommand) -> Result<CheckRow, Ser
             ))
         })?,
     };
-    let (_, text) = versions::with_model(state, robot_id, version).await?;
+    // A version or set the robot lacks conflicts with its state (the URL
+    // names an existing robot), as in a solve.
+    let (_, text) = versions::with_model(state, robot_id, version)
+        .await
+        .map_err(conflict)?;
     let model = CalibratedModelFile::from_json(&text)
         .and_then(|f| f.to_compensated())
         .map_err(|e| ServiceError::Internal(format!("stored model of version {version}: {e}")))?;
@@ -76,7 +80,7 @@ pub async fn create(state: &AppState, cmd: CheckCommand) -> Result<CheckRow, Ser
         .db()
         .set_rows(robot_id, cmd.set_id)
         .await?
-        .ok_or_else(|| ServiceError::set_not_found(robot_id, cmd.set_id))?;
+        .ok_or_else(|| conflict(ServiceError::set_not_found(robot_id, cmd.set_id)))?;
     let temps: Vec<f64> = rows.iter().filter_map(|r| r.temperature_c).collect();
     let temperature_c = cmd
         .temperature_c
@@ -110,6 +114,15 @@ pub async fn create(state: &AppState, cmd: CheckCommand) -> Result<CheckRow, Ser
         "check scored"
     );
     Ok(row)
+}
+
+/// A set or version the robot lacks, named in a body: a conflict with the
+/// robot's state (the URL names an existing robot), as in a solve.
+fn conflict(e: ServiceError) -> ServiceError {
+    match e {
+        ServiceError::NotFound(m) => ServiceError::Conflict(m),
+        other => other,
+    }
 }
 
 /// Most versions one comparison scores.
@@ -146,12 +159,6 @@ pub async fn compare(
         )));
     }
     let t = thresholds(state, robot_id).await?;
-    // A set or version the robot lacks conflicts with its state (the URL
-    // names an existing robot), as in a solve.
-    let conflict = |e: ServiceError| match e {
-        ServiceError::NotFound(m) => ServiceError::Conflict(m),
-        other => other,
-    };
     let rows = state
         .db()
         .set_rows(robot_id, set_id)

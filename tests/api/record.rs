@@ -269,9 +269,11 @@ async fn checks_score_the_active_version_and_give_the_status() {
         .await;
     assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
 
-    // Missing set or version: 404.
+    // A set or version the robot lacks: 409, naming it.
     let r = check(json!({ "set_id": 999 })).await;
-    assert_eq!(r.status, StatusCode::NOT_FOUND);
+    assert_eq!(r.status, StatusCode::CONFLICT);
+    assert!(r.detail().contains("measurement set 999"), "{}", r.detail());
     let r = check(json!({ "set_id": crash_set, "version": 9 })).await;
-    assert_eq!(r.status, StatusCode::NOT_FOUND);
+    assert_eq!(r.status, StatusCode::CONFLICT);
+    assert!(r.detail().contains("version 9"), "{}", r.detail());
 }
