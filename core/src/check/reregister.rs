@@ -22,7 +22,7 @@
 //! [`MAX_CONDITION`]. With orientation rows the tool's rotation is refitted
 //! too: the chordal mean of `F_i.Rᵀ·R_b·R_i` projected on SO(3).
 
-use super::score::{AngleStats, CheckError};
+use super::score::{predicted_row, AngleStats, CheckError};
 use crate::cell::with_tool;
 use crate::compensate::CompensatedModel;
 use crate::identify::registration::register;
@@ -100,25 +100,12 @@ struct Row {
 
 fn rows_of(model: &CompensatedModel, rows: &[MeasuredPose]) -> Result<Vec<Row>, CheckError> {
     let flange_model = with_tool(model, &Pose::identity());
-    let dof = model.dof();
     rows.iter()
         .enumerate()
         .map(|(i, row)| {
-            if row.q_deg.len() != dof {
-                return Err(CheckError::Pose {
-                    index: i + 1,
-                    detail: format!("{} joint values, the model has {dof}", row.q_deg.len()),
-                });
-            }
-            let m = row.to_measurement(&model.nominal, model.payload_kg);
-            let p = flange_model
-                .predict_detailed_at(&m.q, m.payload_mass)
-                .map_err(|e| CheckError::Pose {
-                    index: i + 1,
-                    detail: e.to_string(),
-                })?;
+            let (m, flange) = predicted_row(model, &flange_model, row, i)?;
             Ok(Row {
-                flange: p.pose,
+                flange,
                 y: m.position,
                 orientation: m.orientation,
             })

@@ -3,8 +3,9 @@
 use super::{CheckStatus, CheckThresholds};
 use crate::compensate::CompensatedModel;
 use crate::identify::registration::register;
-use crate::measure::MeasuredPose;
+use crate::measure::{MeasuredPose, Measurement};
 use crate::model::orientation::rotation_angle_between;
+use crate::model::Pose;
 use crate::stats::ErrorStats;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -79,24 +80,11 @@ pub fn score(
             "the check set has no poses".into(),
         ));
     }
-    let dof = model.dof();
     let mut poses = Vec::with_capacity(rows.len());
     let (mut measured, mut predicted) = (Vec::new(), Vec::new());
     for (i, row) in rows.iter().enumerate() {
-        if row.q_deg.len() != dof {
-            return Err(CheckError::Pose {
-                index: i + 1,
-                detail: format!("{} joint values, the model has {dof}", row.q_deg.len()),
-            });
-        }
-        let m = row.to_measurement(&model.nominal, model.payload_kg);
-        let p = model
-            .predict_detailed_at(&m.q, m.payload_mass)
-            .map_err(|e| CheckError::Pose {
-                index: i + 1,
-                detail: e.to_string(),
-            })?;
-        let cell = model.cell_from_base.compose(&p.pose);
+        let (m, pose) = predicted_row(model, model, row, i)?;
+        let cell = model.cell_from_base.compose(&pose);
         poses.push(PoseError {
             index: i + 1,
             position_mm: (m.position - cell.p).norm() * 1e3,
@@ -129,6 +117,32 @@ pub fn score(
         status,
         summary,
     })
+}
+
+/// Row `i` (0-based) in SI with `model`'s controller conventions and
+/// `predictor`'s base-frame prediction at its joints and payload; a row with
+/// another joint count or an unpredictable pose is an error naming it.
+pub(super) fn predicted_row(
+    model: &CompensatedModel,
+    predictor: &CompensatedModel,
+    row: &MeasuredPose,
+    i: usize,
+) -> Result<(Measurement, Pose), CheckError> {
+    let dof = model.dof();
+    if row.q_deg.len() != dof {
+        return Err(CheckError::Pose {
+            index: i + 1,
+            detail: format!("{} joint values, the model has {dof}", row.q_deg.len()),
+        });
+    }
+    let m = row.to_measurement(&model.nominal, model.payload_kg);
+    let p = predictor
+        .predict_detailed_at(&m.q, m.payload_mass)
+        .map_err(|e| CheckError::Pose {
+            index: i + 1,
+            detail: e.to_string(),
+        })?;
+    Ok((m, p.pose))
 }
 
 fn frame_shift(
