@@ -7,6 +7,7 @@
 //! compliance end a calibration with a reason instead of hanging or panicking.
 
 use proptest::prelude::*;
+use proptest::test_runner::RngSeed;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal_core::compensate::CompensatedModel;
@@ -17,14 +18,25 @@ use robocal_core::kinematics::fk;
 use robocal_core::measure::{self, Measurement};
 use robocal_core::model::presets::preset_description;
 use robocal_core::model::{preset, ModelDescription, RobotModel};
-use robocal_core::sim::{random_configurations, TrueRobot};
+use robocal_core::sim::{try_random_configurations, PoseFilter, TrueRobot};
 use std::time::{Duration, Instant};
+
+/// `n` random configurations of `model`, without the floor check: an
+/// accepted model may hang its whole arm below its base plane (`d1 = −100 m`),
+/// which is odd but not hostile. `None` when no configuration closes.
+fn configurations(model: &RobotModel, n: usize, rng: &mut ChaCha8Rng) -> Option<Vec<Vec<f64>>> {
+    let anywhere = PoseFilter {
+        min_z_m: None,
+        ..PoseFilter::default()
+    };
+    try_random_configurations(model, n, &anywhere, rng, |_| true).ok()
+}
 
 /// Simulated measurements of `model` itself (no errors): `None` when the
 /// simulation refuses the model.
 fn measured(model: &RobotModel, n: usize, seed: u64) -> Option<Vec<Measurement>> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let qs = random_configurations(model, n, &mut rng);
+    let qs = configurations(model, n, &mut rng)?;
     let rows = TrueRobot::new(model.clone())
         .measure(&qs, Some(model.payload.mass), None, &mut rng)
         .ok()?;
@@ -183,7 +195,13 @@ fn set_field(d: &mut ModelDescription, k: usize, v: f64) {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+    // A fixed seed: every run explores the same 48 models (the case that
+    // once failed CI, ys100 with d1 = −100 m, is pinned in a test below).
+    #![proptest_config(ProptestConfig {
+        cases: 48,
+        rng_seed: RngSeed::Fixed(0x5eed_0035),
+        ..ProptestConfig::default()
+    })]
 
     /// Random extreme fields: refused, or the model works end to end within
     /// a few seconds.
@@ -203,7 +221,7 @@ proptest! {
         ACCEPTED.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let t0 = Instant::now();
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let qs = random_configurations(&model, 5, &mut rng);
+        let qs = configurations(&model, 5, &mut rng).unwrap_or_default();
         let compensated = CompensatedModel::from_nominal(model.clone());
         let solver = IkSolver::new(compensated.clone(), IkSettings::default());
         for q in &qs {
@@ -239,6 +257,25 @@ fn multi_turn_limits_beyond_a_half_turn_calibrate() {
     d.joints[4].limits_deg = [-3600.0, -360.0];
     let model = d.to_model().unwrap();
     let ident = measured(&model, 25, 0).expect("measurable");
+    let r = calibrate(
+        &model,
+        &ident,
+        &[],
+        &small_options(vec![Method::Km]),
+        &|_| true,
+    );
+    assert!(r.is_ok(), "{:?}", r.err());
+}
+
+/// A model accepted at the door whose arm hangs wholly below its base plane
+/// (ys100 with `d1 = −100 m`) still solves, exports and calibrates: nothing in
+/// the pipeline assumes a pose above the floor.
+#[test]
+fn an_arm_below_its_base_plane_runs_end_to_end() {
+    let mut d = preset_description("ys100").unwrap();
+    d.joints[0].d_mm = -100_000.0;
+    let model = d.to_model().expect("within the bounds");
+    let ident = measured(&model, 25, 0).expect("configurations close");
     let r = calibrate(
         &model,
         &ident,
