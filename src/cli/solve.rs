@@ -21,13 +21,11 @@
 //! targets are poses in that work object (`core::cell`).
 
 use super::model_files::load_compensated;
-use crate::cell::{
-    false_target_in, target_in_base, with_tool_load, Cell, CellDescription, CellRef,
-};
+use crate::cell::{Cell, CellDescription, CellRef, CellSolver};
 use crate::csv_text::dialect_from_names;
 use crate::ik::targets_csv::CONVENTION_COLUMNS;
 use crate::ik::{
-    parse_targets_csv, results_csv, Configuration, IkSettings, IkSolver, SolveOptions, TargetFrame,
+    parse_targets_csv, results_csv, Configuration, IkSettings, SolveOptions, TargetFrame,
     TargetResult,
 };
 use crate::model::orientation::OrientationConvention;
@@ -148,17 +146,17 @@ pub fn solve_to_string(a: &SolveArgs) -> anyhow::Result<String> {
                 .with_context(|| path.clone())?
         }
     };
-    if let Some(t) = &a.tool {
-        let tool = cell.tool(&t.parse::<CellRef>()?)?;
-        model = with_tool_load(&model, &tool.tcp, tool.load.as_ref());
-    }
+    let tool = match &a.tool {
+        Some(t) => Some(cell.tool(&t.parse::<CellRef>()?)?),
+        None => None,
+    };
     let work_object = match &a.work_object {
         None => None,
         Some(w) => {
             let wobj = cell.work_object(&w.parse::<CellRef>()?)?;
             frame = TargetFrame::Base;
             frame_label = format!("work object {}", wobj.name);
-            Some(wobj.in_base(&model))
+            Some(wobj)
         }
     };
     let branch = a
@@ -189,13 +187,6 @@ pub fn solve_to_string(a: &SolveArgs) -> anyhow::Result<String> {
     let dialect = dialect_from_names(a.delimiter.as_deref(), a.decimal.as_deref())
         .map_err(anyhow::Error::msg)?;
     let mut csv = parse_targets_csv(&text, dialect).with_context(|| a.targets.clone())?;
-    if let Some(w) = &work_object {
-        for row in csv.rows.iter_mut() {
-            if let Ok(t) = &mut row.target {
-                *t = target_in_base(w, t);
-            }
-        }
-    }
     if csv.convention.is_none() && !a.position_only {
         bail!(
             "{}: no orientation columns ({CONVENTION_COLUMNS}); add them or pass --position-only",
@@ -207,8 +198,15 @@ pub fn solve_to_string(a: &SolveArgs) -> anyhow::Result<String> {
         jump_threshold_rad: a.jump_deg.to_radians(),
         ..IkSettings::default()
     };
-    let payload = model.payload_kg;
-    let solver = IkSolver::new(model, settings);
+    let cell_solver = CellSolver::for_tool(&model, tool.as_ref(), settings);
+    let in_work_object = work_object.as_ref().map(|w| {
+        cell_solver.targets_in(
+            w,
+            csv.rows.iter_mut().filter_map(|r| r.target.as_mut().ok()),
+        )
+    });
+    let solver = cell_solver.solver();
+    let payload = solver.model().payload_kg;
     let options = SolveOptions {
         frame,
         position_only: a.position_only,
@@ -216,13 +214,9 @@ pub fn solve_to_string(a: &SolveArgs) -> anyhow::Result<String> {
         seed,
         false_target_convention: csv.convention,
     };
-    let mut results: Vec<TargetResult> = csv.solve(&solver, &options, a.path);
-    if let Some(w) = &work_object {
-        for r in results.iter_mut() {
-            if let Some(f) = &r.false_target {
-                r.false_target = Some(false_target_in(w, f));
-            }
-        }
+    let mut results: Vec<TargetResult> = csv.solve(solver, &options, a.path);
+    if let Some(w) = &in_work_object {
+        w.false_targets_back(&mut results);
     }
     let conv = csv.convention.unwrap_or(OrientationConvention::Quaternion);
     let header = Header {

@@ -8,10 +8,11 @@
 //! versions never change once written. A custom jump threshold gets a fresh
 //! solver that is not cached.
 //!
-//! A solve may name a production tool (on the calibrated flange with its load,
-//! `core::cell::with_tool_load`: the load stated by the tool, else the
-//! model's payload kept at its flange point) and a work object `W`: targets `T` are then solved as `W·T` in
-//! the base frame and false targets returned in `W` (`core::cell`).
+//! A solve may name a production tool and a work object `W`; both enter
+//! through `core::cell::CellSolver`, as in the CLI and the program filter:
+//! the tool on the calibrated flange with its load (the load stated by the
+//! tool, else the model's payload kept at its flange point), targets `T`
+//! solved as `W·T` in the base frame and false targets returned in `W`.
 //!
 //! Units at this boundary: targets in mm and degrees (`TargetInput`), joint
 //! seeds and commands in the controller convention in degrees.
@@ -20,10 +21,7 @@ use super::limits::SMALL_SOLVE_MAX;
 use super::waiting::{Waiting, WaitingFlag};
 use super::{AppState, ServiceError};
 use crate::cell::file::PoseMmDeg;
-use crate::cell::{
-    false_target_in, target_in_base, with_tool_load, Load, LoadDescription, WorkObject,
-    WorkObjectFrame,
-};
+use crate::cell::{CellSolver, Load, LoadDescription, Tool, WorkObject, WorkObjectFrame};
 use crate::compensate::{CalibratedModelFile, CompensatedModel};
 use crate::db::{CellKind, ItemFrame, NewCellItem};
 use crate::ik::TargetFrame;
@@ -240,7 +238,7 @@ pub async fn chosen_model(
 async fn prepare(
     state: &AppState,
     cmd: &SolveCommand,
-) -> Result<(Arc<IkSolver>, Option<i64>, String), ServiceError> {
+) -> Result<(Arc<CellSolver>, Option<i64>, String), ServiceError> {
     let robot_id = cmd.robot_id;
     let ctx = state.robot_context(robot_id).await?;
     let chosen = choose_version(state, robot_id, cmd.model, ctx.active.clone()).await?;
@@ -275,10 +273,13 @@ async fn prepare(
     if let Some(j) = cmd.jump_deg {
         settings.jump_threshold_rad = j.to_radians();
     }
-    if let Some(tcp) = tcp {
-        model = with_tool_load(&model, tcp, load);
-    }
-    let solver = Arc::new(IkSolver::new(model, settings));
+    let tool = tool.map(|t| Tool {
+        name: t.name,
+        number: None,
+        tcp: t.pose,
+        load: t.load,
+    });
+    let solver = Arc::new(CellSolver::for_tool(&model, tool.as_ref(), settings));
     if cacheable {
         state.cache_solver(key, solver.clone());
     }
@@ -318,12 +319,12 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
             cmd.targets.len()
         )));
     }
-    let (solver, version, method) = prepare(state, &cmd).await?;
+    let (cell_solver, version, method) = prepare(state, &cmd).await?;
     let work_object = match &cmd.work_object {
         None => None,
         Some(choice) => {
             let item = resolve(state, cmd.robot_id, CellKind::WorkObject, choice).await?;
-            let wobj = WorkObject {
+            Some(WorkObject {
                 name: item.name,
                 number: None,
                 frame: match item.frame {
@@ -331,28 +332,29 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
                     ItemFrame::Base | ItemFrame::Flange => WorkObjectFrame::Base,
                 },
                 pose: item.pose,
-            };
-            Some(wobj.in_base(solver.model()))
+            })
         }
     };
-    if let Some(w) = &work_object {
-        let Targets::Inputs(inputs) = &mut cmd.targets else {
-            return Err(ServiceError::Invalid(
-                "a work object needs JSON targets (the targets CSV has no work object)".into(),
-            ));
-        };
-        for t in inputs.iter_mut() {
-            *t = target_in_base(w, t);
+    let in_work_object = match &work_object {
+        None => None,
+        Some(wobj) => {
+            let Targets::Inputs(inputs) = &mut cmd.targets else {
+                return Err(ServiceError::Invalid(
+                    "a work object needs JSON targets (the targets CSV has no work object)".into(),
+                ));
+            };
+            cmd.options.frame = TargetFrame::Base;
+            Some(cell_solver.targets_in(wobj, inputs.iter_mut()))
         }
-        cmd.options.frame = TargetFrame::Base;
-    }
+    };
+    let solver = cell_solver.solver();
     if let Some(s) = &cmd.seed_deg {
-        cmd.options.seed = Some(seed_joints(s, &solver)?);
+        cmd.options.seed = Some(seed_joints(s, solver)?);
     }
     let payload_kg = solver.model().payload_kg;
     let dof = solver.model().dof();
     let results = if cmd.targets.len() <= SMALL_SOLVE_MAX {
-        cmd.targets.run(&solver, &cmd.options, cmd.path)
+        cmd.targets.run(solver, &cmd.options, cmd.path)
     } else {
         let ticket = state.admit_solve()?;
         let permit = state
@@ -363,12 +365,13 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
         // Dropped with this future when the client goes away.
         let (_waiting, flag) = Waiting::new();
         let task_state = state.clone();
+        let cell_solver = cell_solver.clone();
         tokio::task::spawn_blocking(move || {
             let _permit = permit;
             let _ticket = ticket;
             let out = cmd
                 .targets
-                .run_large(&solver, &cmd.options, cmd.path, &flag);
+                .run_large(cell_solver.solver(), &cmd.options, cmd.path, &flag);
             if out.is_none() {
                 task_state.note_abandoned();
                 tracing::info!("a solve batch was stopped: its client went away");
@@ -382,12 +385,8 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
         })?
     };
     let mut results = results;
-    if let Some(w) = &work_object {
-        for r in results.iter_mut() {
-            if let Some(f) = &r.false_target {
-                r.false_target = Some(false_target_in(w, f));
-            }
-        }
+    if let Some(w) = &in_work_object {
+        w.false_targets_back(&mut results);
     }
     Ok(SolveOutcome {
         version,
@@ -398,8 +397,6 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
     })
 }
 
-/// SI pose of boundary `xyz_mm` and `rpy_deg` (`Rz·Ry·Rx`), as the cell file
-/// reads it (its own conversion is private to `core::cell::file`).
 /// A tool or work object of a solve, resolved.
 pub(super) struct ResolvedItem {
     pub name: String,

@@ -4,8 +4,8 @@
 
 use super::limits::{Admission, Limits, Ticket, SMALL_SOLVE_MAX};
 use super::ServiceError;
+use crate::cell::CellSolver;
 use crate::db::Db;
-use crate::ik::IkSolver;
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, Weak};
@@ -115,7 +115,7 @@ struct Inner {
     /// Counts cache invalidations (a read that saw another count is not cached).
     invalidations: AtomicU64,
     robots: Mutex<HashMap<i64, Arc<RobotContext>>>,
-    solvers: Mutex<HashMap<SolverKey, Arc<IkSolver>>>,
+    solvers: Mutex<HashMap<SolverKey, Arc<CellSolver>>>,
 }
 
 /// Prepared solvers kept in memory (model versions are immutable).
@@ -347,11 +347,11 @@ impl AppState {
         Ok(ctx)
     }
 
-    pub(crate) fn cached_solver(&self, key: &SolverKey) -> Option<Arc<IkSolver>> {
+    pub(crate) fn cached_solver(&self, key: &SolverKey) -> Option<Arc<CellSolver>> {
         lock(&self.inner.solvers).get(key).cloned()
     }
 
-    pub(crate) fn cache_solver(&self, key: SolverKey, solver: Arc<IkSolver>) {
+    pub(crate) fn cache_solver(&self, key: SolverKey, solver: Arc<CellSolver>) {
         let mut cache = lock(&self.inner.solvers);
         if cache.len() >= SOLVER_CACHE_MAX {
             cache.clear();

@@ -240,11 +240,42 @@ impl CellSolver {
         load: Option<&Load>,
         settings: IkSettings,
     ) -> Self {
-        let m = with_tool_load(model, tcp, load);
+        Self::prepared(with_tool_load(model, tcp, load), settings)
+    }
+
+    /// The one way a production tool enters a solve (the HTTP solve, the CLI
+    /// and the program filter): a solver of `model` carrying `tool` with its
+    /// load (the tool's own, else the model's payload at its flange point);
+    /// `None` keeps the model's own (measurement) tool.
+    pub fn for_tool(model: &CompensatedModel, tool: Option<&Tool>, settings: IkSettings) -> Self {
+        match tool {
+            Some(t) => Self::with_load(model, &t.tcp, t.load.as_ref(), settings),
+            None => Self::prepared(model.clone(), settings),
+        }
+    }
+
+    /// A solver of a model that already carries its tool.
+    fn prepared(m: CompensatedModel, settings: IkSettings) -> Self {
         CellSolver {
             nominal_ik: crate::ik::AnalyticIk::new(&m.nominal).ok(),
             solver: IkSolver::new(m, settings),
         }
+    }
+
+    /// Boundary targets given in `wobj`, converted in place to the base
+    /// frame (`W·T`; an invalid target is left as it is and fails alone), for a
+    /// batch solved with `frame = Base`. The answer converts the batch's
+    /// false targets back into `wobj`.
+    pub fn targets_in<'a>(
+        &self,
+        wobj: &WorkObject,
+        targets: impl IntoIterator<Item = &'a mut crate::ik::TargetInput>,
+    ) -> InWorkObject {
+        let w = wobj.in_base(self.solver.model());
+        for t in targets {
+            *t = target_in_base(&w, t);
+        }
+        InWorkObject { w }
     }
 
     /// The underlying solver (model with the tool).
@@ -322,10 +353,28 @@ impl CellSolver {
     }
 }
 
+/// A batch's work object, `W` in the base frame: its false targets are
+/// returned in `W` ([`CellSolver::targets_in`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct InWorkObject {
+    w: Pose,
+}
+
+impl InWorkObject {
+    /// Each converged result's false target `F` (base frame) as `W⁻¹·F`.
+    pub fn false_targets_back(&self, results: &mut [crate::ik::TargetResult]) {
+        for r in results.iter_mut() {
+            if let Some(f) = &r.false_target {
+                r.false_target = Some(false_target_in(&self.w, f));
+            }
+        }
+    }
+}
+
 /// A boundary target given in work object `w` (its pose in the base frame)
 /// as a base-frame target, `W·T`, in the same convention; an invalid target
 /// is returned as it is (it fails alone).
-pub fn target_in_base(w: &Pose, t: &crate::ik::TargetInput) -> crate::ik::TargetInput {
+fn target_in_base(w: &Pose, t: &crate::ik::TargetInput) -> crate::ik::TargetInput {
     let mut out = t.clone();
     if let Ok((goal, conv)) = t.to_goal() {
         let p = w.r * goal.position + w.p;
@@ -338,7 +387,7 @@ pub fn target_in_base(w: &Pose, t: &crate::ik::TargetInput) -> crate::ik::Target
 }
 
 /// A base-frame false target expressed in work object `w`: `W⁻¹·F`.
-pub fn false_target_in(w: &Pose, f: &crate::ik::FalseTarget) -> crate::ik::FalseTarget {
+fn false_target_in(w: &Pose, f: &crate::ik::FalseTarget) -> crate::ik::FalseTarget {
     use crate::model::orientation::{rotation_from, rotation_to};
     let mut out = f.clone();
     if let Ok(r) = rotation_from(f.convention, &f.orientation) {
