@@ -75,6 +75,7 @@ fn measure(
                 orientation: six_d.then(|| Rotation3::new(dr).into_inner() * pose.r),
                 payload_mass: 0.0,
                 session: 0,
+                std: None,
             }
         })
         .collect()

@@ -302,6 +302,8 @@ fn json_rows(rows: Vec<RowInput>, c: &Checked) -> Result<Vec<MeasuredPose>, ApiE
             q_deg: r.q.into_iter().map(angle).collect(),
             xyz_mm: r.xyz.map(|v| v * lf),
             rpy_deg: r.rpy.map(|a| a.map(angle)),
+            std_mm: None,
+            std_deg: None,
             payload_kg: r.payload_kg,
             temperature_c: r.temperature_c,
             set: r.set,

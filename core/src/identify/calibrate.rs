@@ -160,6 +160,12 @@ fn check_inputs(
     let chains = checked_chains(nominal, identification, "identification")?;
     check_set(nominal, training, "training")?;
     check_set(nominal, validation, "validation")?;
+    let fitted = identification.iter().chain(training);
+    let with = fitted.clone().filter(|m| m.std.is_some()).count();
+    let total = identification.len() + training.len();
+    if with > 0 && with < total {
+        return Err(CalibrationError::MixedStd { with, total });
+    }
     if let Some((index, m)) = training
         .iter()
         .enumerate()
