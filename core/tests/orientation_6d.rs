@@ -14,7 +14,8 @@
 //! - the identifiability report names the parameters only the orientations
 //!   identify;
 //! - with position-only data and a reflector 0.3 mm from joint 6's axis, the
-//!   joint-6 map is refused (the same truth measured in 6-D keeps it);
+//!   joint-6 map is refused (the same truth measured in 6-D keeps it) and
+//!   the report names the tool frame's rotation as unseen;
 //! - rows whose standard deviations say they are 10× noisier weigh less: the
 //!   weighted KM is closer to the truth than the unweighted one.
 
@@ -190,12 +191,20 @@ fn position_only_data_refuses_the_map_of_a_joint_it_cannot_see() {
         .any(|w| w.kind == WarningKind::MapRefused && w.joint == Some(6)));
     assert!(m.validation.as_ref().unwrap().orientation.is_none());
     assert!(r.identifiability.identifiable_by_orientation.is_empty());
+    // The report names the tool-tip terms position-only data cannot see.
+    let unseen = &r.identifiability.unseen_tool_tip_terms;
+    eprintln!("unseen by position-only data: {unseen:?}");
+    for p in ["tool_rx", "tool_ry", "tool_rz"] {
+        assert!(unseen.iter().any(|n| n == p), "{unseen:?}");
+        assert!(!r.identifiability.kept.iter().any(|n| n == p));
+    }
 
     // The same reflector measured in 6-D: every angle is seen.
     let id6 = measure(&truth, &nominal, 300, true, &mut rng);
     let r6 = calibrate(&nominal, &id6, &[], &[Method::KmMaps]);
     let maps6 = r6.methods[&Method::KmMaps].joint_maps.as_ref().unwrap();
     assert!(maps6.refused.is_empty(), "{:?}", maps6.refused);
+    assert!(r6.identifiability.unseen_tool_tip_terms.is_empty());
 }
 
 /// Rows whose standard deviations say they are 10× noisier (every third,

@@ -423,6 +423,13 @@ pub fn render_report(r: &CalibrationReport) -> String {
             id.identifiable_by_orientation.join(", ")
         );
     }
+    if !id.unseen_tool_tip_terms.is_empty() {
+        let _ = writeln!(
+            s,
+            "  not seen by position-only data (a production tool's tip depends on them; its error there is unknown): {}",
+            id.unseen_tool_tip_terms.join(", ")
+        );
+    }
     // Parameter table across methods.
     let names: Vec<Method> = r.methods.keys().copied().collect();
     let _ = write!(
