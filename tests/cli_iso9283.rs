@@ -171,6 +171,8 @@ fn check_names_a_moved_tracker_and_a_changed_robot() {
                         .collect(),
                     xyz_mm: shift(i, [p.x, p.y, p.z]),
                     rpy_deg: None,
+                    std_mm: None,
+                    std_deg: None,
                     payload_kg: None,
                     temperature_c: None,
                     set: None,

@@ -14,7 +14,10 @@
 //! - the identifiability report names the parameters only the orientations
 //!   identify;
 //! - with position-only data and a reflector 0.3 mm from joint 6's axis, the
-//!   joint-6 map is refused (the same truth measured in 6-D keeps it).
+//!   joint-6 map is refused (the same truth measured in 6-D keeps it) and
+//!   the report names the tool frame's rotation as unseen;
+//! - rows whose standard deviations say they are 10× noisier weigh less: the
+//!   weighted KM is closer to the truth than the unweighted one.
 
 mod common;
 
@@ -24,7 +27,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 use robocal_core::identify::report::WarningKind;
 use robocal_core::identify::{CalibrationReport, Method};
-use robocal_core::measure::Measurement;
+use robocal_core::measure::{Measurement, RowStd};
 use robocal_core::model::{preset, Pose, RobotModel};
 use robocal_core::sim::{
     fine_transmission_errors, perturb_geometry, random_configurations, tracker_frame,
@@ -75,6 +78,7 @@ fn measure(
                 orientation: six_d.then(|| Rotation3::new(dr).into_inner() * pose.r),
                 payload_mass: 0.0,
                 session: 0,
+                std: None,
             }
         })
         .collect()
@@ -187,10 +191,100 @@ fn position_only_data_refuses_the_map_of_a_joint_it_cannot_see() {
         .any(|w| w.kind == WarningKind::MapRefused && w.joint == Some(6)));
     assert!(m.validation.as_ref().unwrap().orientation.is_none());
     assert!(r.identifiability.identifiable_by_orientation.is_empty());
+    // The report names the tool-tip terms position-only data cannot see.
+    let unseen = &r.identifiability.unseen_tool_tip_terms;
+    eprintln!("unseen by position-only data: {unseen:?}");
+    for p in ["tool_rx", "tool_ry", "tool_rz"] {
+        assert!(unseen.iter().any(|n| n == p), "{unseen:?}");
+        assert!(!r.identifiability.kept.iter().any(|n| n == p));
+    }
 
     // The same reflector measured in 6-D: every angle is seen.
     let id6 = measure(&truth, &nominal, 300, true, &mut rng);
     let r6 = calibrate(&nominal, &id6, &[], &[Method::KmMaps]);
     let maps6 = r6.methods[&Method::KmMaps].joint_maps.as_ref().unwrap();
     assert!(maps6.refused.is_empty(), "{:?}", maps6.refused);
+    assert!(r6.identifiability.unseen_tool_tip_terms.is_empty());
+}
+
+/// Rows whose standard deviations say they are 10× noisier (every third,
+/// position 0.1 mm and orientation 0.05° per axis instead of 0.01 mm and
+/// 0.005°) weigh less in the fit: KM's error against the truth (no noise) on
+/// validation poses is clearly smaller with the `std` columns than on the
+/// same rows without them, and than with deviations that call every row
+/// equally good (which isolates the noisy subset from the orientation rows'
+/// ratio: without deviations 1 mrad counts as 1 mm, here the probe's 0.005°
+/// weighs like 0.087 mm). A truth without transmission errors, so KM can fit
+/// it and the noise is what is left.
+#[test]
+fn row_standard_deviations_weigh_the_fit() {
+    let mut rng = ChaCha8Rng::seed_from_u64(634);
+    let (nominal, mut truth) = truth([40.0, 25.0, 90.0], &mut rng);
+    truth.effects.transmission.clear();
+    let mut id = measure(&truth, &nominal, 150, true, &mut rng);
+    let va = measure(&truth, &nominal, 200, true, &mut rng);
+    let (p_noise, r_noise) = (
+        Normal::new(0.0, 9.0 * POSITION_NOISE_MM * 1e-3).unwrap(),
+        Normal::new(0.0, 9.0 * ORIENTATION_NOISE_DEG.to_radians()).unwrap(),
+    );
+    for (k, m) in id.iter_mut().enumerate() {
+        let noisy = k % 3 == 0;
+        if noisy {
+            // 1 + 9 = 10× the noise already drawn, in distribution: add an
+            // independent draw of √99·σ ≈ 9.95σ (√(1 + 99) = 10).
+            let f = 99f64.sqrt() / 9.0;
+            m.position += Vector3::from_fn(|_, _| p_noise.sample(&mut rng)) * f;
+            let dr = Vector3::from_fn(|_, _| r_noise.sample(&mut rng)) * f;
+            m.orientation = m.orientation.map(|r| Rotation3::new(dr).into_inner() * r);
+        }
+        let s = if noisy { 10.0 } else { 1.0 };
+        m.std = Some(RowStd::from_axes(
+            [s * POSITION_NOISE_MM; 3],
+            Some([s * ORIENTATION_NOISE_DEG; 3]),
+        ));
+    }
+    let unweighted: Vec<Measurement> = id
+        .iter()
+        .map(|m| Measurement {
+            std: None,
+            ..m.clone()
+        })
+        .collect();
+    let uniform: Vec<Measurement> = id
+        .iter()
+        .map(|m| Measurement {
+            std: Some(RowStd::from_axes(
+                [POSITION_NOISE_MM; 3],
+                Some([ORIENTATION_NOISE_DEG; 3]),
+            )),
+            ..m.clone()
+        })
+        .collect();
+    let tip = Vector3::new(30f64.to_radians().sin(), 0.0, 30f64.to_radians().cos()) * 0.25;
+    let errors = |data: &[Measurement]| {
+        let r = calibrate(&nominal, data, &va, &[Method::Km]);
+        truth_errors(&r, Method::Km, &truth, &va, &tip)
+    };
+    let (w_refl, w_tip) = errors(&id);
+    let (e_refl, e_tip) = errors(&uniform);
+    let (u_refl, u_tip) = errors(&unweighted);
+    eprintln!(
+        "KM vs truth on validation, reflector / 250 mm tip [mm]: weighted {w_refl:.5} / {w_tip:.5}, \
+         every row called equal {e_refl:.5} / {e_tip:.5}, unweighted {u_refl:.5} / {u_tip:.5}"
+    );
+    assert!(w_refl < 0.7 * e_refl, "{w_refl} vs {e_refl}");
+    assert!(w_tip < 0.7 * e_tip, "{w_tip} vs {e_tip}");
+    assert!(w_refl < 0.7 * u_refl, "{w_refl} vs {u_refl}");
+    assert!(w_tip < 0.7 * u_tip, "{w_tip} vs {u_tip}");
+
+    // Some fitted rows with deviations and some without: refused.
+    let mut mixed = id.clone();
+    mixed[0].std = None;
+    let e = common::run_with(&nominal, &mixed, &va, common::opts(&[Method::Km])).unwrap_err();
+    assert!(
+        e.to_string().starts_with(
+            "149 of the 150 identification and training poses carry standard deviations"
+        ),
+        "{e}"
+    );
 }

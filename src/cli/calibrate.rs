@@ -70,6 +70,10 @@ pub struct CalibrateArgs {
     /// Tracker-data files with x_dif columns: measured = target + dif (plus) or − dif (minus).
     #[arg(long, default_value = "plus")]
     pub dif_sign: String,
+    /// Convention of the files' `rx, ry, rz` columns (`qw, qx, qy, qz` columns are
+    /// recognised as a quaternion without it; default fixed_xyz).
+    #[arg(long, value_parser = super::orientation_arg::OrientationValues)]
+    pub orientation: Option<crate::measure::convention::MeasuredOrientation>,
     /// Print the full report as JSON on stdout.
     #[arg(long)]
     pub json: bool,
@@ -131,9 +135,8 @@ impl TypedValueParser for MethodValues {
     }
 }
 
-fn read_rows(path: &str, dif: csv::DifSign) -> anyhow::Result<Vec<measure::MeasuredPose>> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {path}"))?;
-    csv::parse_with(&text, dif).with_context(|| path.to_string())
+fn read_rows(path: &str, read: csv::ReadOptions) -> anyhow::Result<Vec<measure::MeasuredPose>> {
+    super::orientation_arg::read_measurements(std::path::Path::new(path), read)
 }
 
 pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
@@ -146,6 +149,11 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         "plus" => csv::DifSign::Plus,
         "minus" => csv::DifSign::Minus,
         other => bail!("--dif-sign must be plus or minus, got {other}"),
+    };
+    let read = csv::ReadOptions {
+        dif,
+        orientation: a.orientation,
+        ..csv::ReadOptions::default()
     };
     if let Some(p) = a.payload_kg {
         if !(p.is_finite() && p >= 0.0) {
@@ -166,7 +174,7 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     };
     let (mut train_rows, mut train_src) = (Vec::new(), Vec::new());
     for (i, path) in a.identify.iter().enumerate() {
-        let rows = read_rows(path, dif)?;
+        let rows = read_rows(path, read)?;
         csv::check_joint_count(&rows, model.dof()).with_context(|| path.clone())?;
         for (k, r) in rows.into_iter().enumerate() {
             let s = r.session.clone().unwrap_or_else(|| label(i));
@@ -187,7 +195,7 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         }
     }
     for path in &a.train {
-        let more = read_rows(path, dif)?;
+        let more = read_rows(path, read)?;
         csv::check_joint_count(&more, model.dof()).with_context(|| path.clone())?;
         for (k, r) in more.into_iter().enumerate() {
             let s = r.session.clone().unwrap_or_else(|| label(0));
@@ -197,7 +205,7 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     }
     let same_count = a.validate.len() == a.identify.len();
     for (j, path) in a.validate.iter().enumerate() {
-        let more = read_rows(path, dif)?;
+        let more = read_rows(path, read)?;
         csv::check_joint_count(&more, model.dof()).with_context(|| path.clone())?;
         let own = label(if same_count { j } else { 0 });
         for (k, r) in more.into_iter().enumerate() {
@@ -413,6 +421,13 @@ pub fn render_report(r: &CalibrationReport) -> String {
             s,
             "  identified only thanks to the measured orientations: {}",
             id.identifiable_by_orientation.join(", ")
+        );
+    }
+    if !id.unseen_tool_tip_terms.is_empty() {
+        let _ = writeln!(
+            s,
+            "  not seen by position-only data (a production tool's tip depends on them; its error there is unknown): {}",
+            id.unseen_tool_tip_terms.join(", ")
         );
     }
     // Parameter table across methods.

@@ -32,6 +32,10 @@ pub struct CheckOptions {
     /// The check poses: a measurement CSV in the model's measurement frame.
     #[arg(long)]
     pub measurements: PathBuf,
+    /// Convention of the files' `rx, ry, rz` columns (`qw, qx, qy, qz` columns are
+    /// recognised as a quaternion without it; default fixed_xyz).
+    #[arg(long, value_parser = super::orientation_arg::OrientationValues)]
+    pub orientation: Option<crate::measure::convention::MeasuredOrientation>,
     /// Mean position error above which the status is `degraded` [mm].
     #[arg(long, default_value_t = CheckThresholds::default().degraded_mm)]
     pub degraded_mm: f64,
@@ -85,14 +89,16 @@ pub fn check_text(r: &CheckResult) -> String {
 /// Scores the check file against the model.
 pub fn check_file(a: &CheckArgs) -> anyhow::Result<CheckResult> {
     let c = &a.check;
-    let rows = read_rows(&c.measurements)?;
+    let rows = read_rows(c)?;
     score_model(&a.model, &rows, &c.thresholds(), &c.measurements)
 }
 
-fn read_rows(path: &Path) -> anyhow::Result<Vec<crate::measure::MeasuredPose>> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    crate::measure::csv::parse(&text).with_context(|| path.display().to_string())
+fn read_rows(c: &CheckOptions) -> anyhow::Result<Vec<crate::measure::MeasuredPose>> {
+    let read = crate::measure::csv::ReadOptions {
+        orientation: c.orientation,
+        ..Default::default()
+    };
+    super::orientation_arg::read_measurements(&c.measurements, read)
 }
 
 impl CheckOptions {
@@ -139,7 +145,7 @@ pub fn compare_files(a: &CompareArgs) -> anyhow::Result<Vec<ModelScore>> {
         anyhow::bail!("compare needs at least two models (--model A --model B)");
     }
     let c = &a.check;
-    let rows = read_rows(&c.measurements)?;
+    let rows = read_rows(c)?;
     let t = c.thresholds();
     a.models
         .iter()

@@ -11,6 +11,7 @@ pub mod export;
 pub mod filter;
 pub mod iso9283;
 pub mod model_files;
+pub mod orientation_arg;
 pub mod plan;
 pub mod predict;
 pub mod progress;

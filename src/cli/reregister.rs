@@ -22,6 +22,10 @@ pub struct ReregisterArgs {
     /// 20–30 poses of the new session: a measurement CSV in its measurement frame.
     #[arg(long)]
     pub measurements: PathBuf,
+    /// Convention of the files' `rx, ry, rz` columns (`qw, qx, qy, qz` columns are
+    /// recognised as a quaternion without it; default fixed_xyz).
+    #[arg(long, value_parser = super::orientation_arg::OrientationValues)]
+    pub orientation: Option<crate::measure::convention::MeasuredOrientation>,
     /// Write the re-registered model file here.
     #[arg(long)]
     pub save: Option<PathBuf>,
@@ -64,9 +68,11 @@ pub fn report_text(r: &Reregistration) -> String {
 pub fn reregister_file(a: &ReregisterArgs) -> anyhow::Result<Reregistration> {
     let model = super::model_files::load_compensated(&a.model)?;
     let path = &a.measurements;
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let rows = crate::measure::csv::parse(&text).with_context(|| path.display().to_string())?;
+    let read = crate::measure::csv::ReadOptions {
+        orientation: a.orientation,
+        ..Default::default()
+    };
+    let rows = super::orientation_arg::read_measurements(path, read)?;
     let (moved, report) =
         reregister(&model, &rows).with_context(|| format!("{} on {}", a.model, path.display()))?;
     if let Some(out) = &a.save {

@@ -13,6 +13,7 @@ use super::input::{
 use super::robots::robot_list_page;
 use super::{ApiError, ApiPath, ApiQuery, AppState};
 use crate::db::{AngleUnit, LengthUnit, SetFormat, SetRow};
+use crate::measure::convention::MeasuredOrientation;
 use crate::measure::csv::{self, DifSign, ReadOptions};
 use crate::measure::{MeasuredPose, SetRole};
 use crate::service::{
@@ -46,6 +47,9 @@ pub struct SetParams {
     pub dif_sign: Option<String>,
     /// CSV only: `point` or `comma` (detected when absent).
     pub decimal: Option<String>,
+    /// CSV only: convention of the `rx, ry, rz` columns
+    /// ([`MeasuredOrientation`]; default from the header).
+    pub orientation: Option<String>,
 }
 
 /// One row of a JSON upload, in the declared units.
@@ -58,6 +62,12 @@ pub struct RowInput {
     pub xyz: [f64; 3],
     #[serde(default, alias = "rpy_deg")]
     pub rpy: Option<[f64; 3]>,
+    /// Standard deviations of `xyz` (declared length unit).
+    #[serde(default)]
+    pub std_mm: Option<[f64; 3]>,
+    /// Standard deviations of `rpy` (declared angle unit).
+    #[serde(default)]
+    pub std_deg: Option<[f64; 3]>,
     #[serde(default)]
     pub payload_kg: Option<f64>,
     #[serde(default)]
@@ -257,6 +267,7 @@ fn json_rows(rows: Vec<RowInput>, c: &Checked) -> Result<Vec<MeasuredPose>, ApiE
         if r.rpy.is_some_and(|a| a.iter().any(|v| !v.is_finite())) {
             return Err(bad("orientation `rpy`"));
         }
+        check_std(n, r, rows[0].std_mm.is_some())?;
         if let Some(p) = r.payload_kg {
             check_payload(&format!("row {n}: `payload_kg`"), p)?;
         }
@@ -302,12 +313,37 @@ fn json_rows(rows: Vec<RowInput>, c: &Checked) -> Result<Vec<MeasuredPose>, ApiE
             q_deg: r.q.into_iter().map(angle).collect(),
             xyz_mm: r.xyz.map(|v| v * lf),
             rpy_deg: r.rpy.map(|a| a.map(angle)),
+            std_mm: r.std_mm.map(|s| s.map(|v| v * lf)),
+            std_deg: r.std_deg.map(|s| s.map(angle)),
             payload_kg: r.payload_kg,
             temperature_c: r.temperature_c,
             set: r.set,
             session: None,
         })
         .collect())
+}
+
+/// A JSON row's standard deviations: finite and > 0, `std_deg` only with
+/// `rpy` and `std_mm`, and on every row or none (`first`: the first row has them).
+fn check_std(n: usize, r: &RowInput, first: bool) -> Result<(), ApiError> {
+    for (what, v) in [("std_mm", r.std_mm), ("std_deg", r.std_deg)] {
+        if v.is_some_and(|a| a.iter().any(|x| !(x.is_finite() && *x > 0.0))) {
+            return Err(ApiError::invalid(format!(
+                "row {n}: `{what}` must be three finite numbers > 0"
+            )));
+        }
+    }
+    if r.std_mm.is_some() != first {
+        return Err(ApiError::invalid(format!(
+            "row {n}: `std_mm` is given on some rows and not on others; give it on every row or none"
+        )));
+    }
+    if r.std_deg.is_some() && (r.rpy.is_none() || r.std_mm.is_none()) {
+        return Err(ApiError::invalid(format!(
+            "row {n}: `std_deg` needs `rpy` and `std_mm` on the same row"
+        )));
+    }
+    Ok(())
 }
 
 /// The CSV reading options of an upload's query.
@@ -321,11 +357,21 @@ fn read_options(q: &SetParams, c: &Checked) -> Result<ReadOptions, ApiError> {
             )))
         }
     };
+    let orientation = match q.orientation.as_deref() {
+        None => None,
+        Some(name) => Some(MeasuredOrientation::from_name(name).ok_or_else(|| {
+            ApiError::invalid(format!(
+                "`orientation` must be one of {}, got `{name}`",
+                MeasuredOrientation::names()
+            ))
+        })?),
+    };
     Ok(ReadOptions {
         dif,
         dialect: super::solve::dialect(q.decimal.as_deref())?,
         metres: c.length == Length::M,
         radians: c.angle == Angle::Rad,
+        orientation,
     })
 }
 

@@ -465,6 +465,10 @@ pub fn parameters(r: &ReportView, models: &[Model]) -> Markup {
                     p { "Identified only thanks to the measured orientations (the positions alone would not): "
                         (i.identifiable_by_orientation.join(", ")) "." }
                 }
+                @if !i.unseen_tool_tip_terms.is_empty() {
+                    p { "Not seen by position-only data: " (i.unseen_tool_tip_terms.join(", "))
+                        ". A production tool's tip away from the measured point depends on them, so its error there is unknown; measure orientations (a 6-D probe) to identify them." }
+                }
                 @if !i.dropped.is_empty() {
                     table { thead { tr { th { "Not identified" } th { "why" } } }
                         tbody { @for d in &i.dropped { tr { td { (d.name) } td { (d.reason) } } } } }

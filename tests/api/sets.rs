@@ -263,3 +263,119 @@ async fn locale_csv_and_dif_sign_uploads_read_like_the_canonical_file() {
     assert_eq!(r.json()["units"], json!({"length": "mm", "angle": "deg"}));
     assert_eq!(rows_of(&r.json()).await, sent);
 }
+
+/// The `orientation` upload parameter declares the `rx, ry, rz` columns
+/// intrinsic; quaternion columns are recognised by name. Both are stored as
+/// the fixed-axis rows of the same rotation (built here with nalgebra's
+/// rotations, not the reader's); std columns are kept; wrong declarations
+/// and non-unit quaternions are 422s naming line and columns.
+#[tokio::test]
+async fn declared_orientation_conventions_and_std_columns_upload() {
+    use nalgebra::{Rotation3, UnitQuaternion, Vector3};
+    let t = setup().await;
+    let robot = t.create_robot("ys100").await;
+    let rid = robot.to_string();
+    let rows_of = |set: &Value| {
+        let t = &t;
+        let rid = rid.clone();
+        let sid = set["id"].as_i64().unwrap().to_string();
+        async move {
+            let r = t
+                .get("/v1/robots/{id}/measurement-sets/{sid}", &[&rid, &sid])
+                .await;
+            serde_json::from_value::<Vec<MeasuredPose>>(r.json()["rows"].clone()).unwrap()
+        }
+    };
+    let ax = |i: usize, deg: f64| {
+        let a = [Vector3::x_axis(), Vector3::y_axis(), Vector3::z_axis()][i];
+        Rotation3::from_axis_angle(&a, f64::to_radians(deg))
+    };
+    // R = Rx(20)·Ry(-35)·Rz(110), the intrinsic X-Y'-Z'' angles.
+    let r = ax(0, 20.0) * ax(1, -35.0) * ax(2, 110.0);
+    let lead = "q1,q2,q3,q4,q5,q6,x,y,z";
+    let vals = "10,80,-20,5,30,0,1500,100,1200";
+    let intrinsic =
+        format!("{lead},rx,ry,rz,std_x,std_y,std_z\n{vals},20,-35,110,0.02,0.02,0.05\n");
+    let q = UnitQuaternion::from_rotation_matrix(&r);
+    let quat = format!(
+        "{lead},qw,qx,qy,qz\n{vals},{},{},{},{}\n",
+        -q.w, -q.i, -q.j, -q.k
+    );
+    let stored = |rows: &[MeasuredPose]| {
+        let [a, b, c] = rows[0].rpy_deg.unwrap().map(f64::to_radians);
+        Rotation3::from_euler_angles(a, b, c)
+    };
+    let a = rows_of(
+        &t.upload_csv(robot, &intrinsic, "?orientation=intrinsic_xyz")
+            .await,
+    )
+    .await;
+    assert!((stored(&a).matrix() - r.matrix()).amax() < 1e-12);
+    assert_eq!(a[0].std_mm, Some([0.02, 0.02, 0.05]));
+    let b = rows_of(&t.upload_csv(robot, &quat, "").await).await;
+    assert!((stored(&b).matrix() - r.matrix()).amax() < 1e-12);
+    // Undeclared, the same angles are fixed-axis and stored as written.
+    let c = rows_of(&t.upload_csv(robot, &intrinsic, "").await).await;
+    assert_eq!(c[0].rpy_deg, Some([20.0, -35.0, 110.0]));
+
+    let bad_quat = format!("{lead},qw,qx,qy,qz\n{vals},1,0.1,0,0\n");
+    for (text, query, expect) in [
+        (
+            intrinsic.as_str(),
+            "?orientation=euler",
+            "`orientation` must be one of fixed_xyz, intrinsic_xyz, quaternion",
+        ),
+        (
+            intrinsic.as_str(),
+            "?orientation=quaternion",
+            "line 1: the orientation is declared quaternion",
+        ),
+        (
+            quat.as_str(),
+            "?orientation=intrinsic_xyz",
+            "line 1: the orientation is declared intrinsic_xyz",
+        ),
+        (
+            bad_quat.as_str(),
+            "",
+            "line 2, columns qw, qx, qy, qz: the quaternion's norm is 1.004988",
+        ),
+    ] {
+        let r = t
+            .send(
+                "POST",
+                "/v1/robots/{id}/measurement-sets",
+                &[&rid],
+                query,
+                Some("text/csv"),
+                text.as_bytes().to_vec(),
+            )
+            .await;
+        assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{query}");
+        assert!(r.detail().contains(expect), "{query}: {}", r.detail());
+    }
+
+    // The spec's enum is the convention enum's names.
+    let yaml: serde_yaml::Value = serde_yaml::from_str(robocal::http::OPENAPI_YAML).unwrap();
+    let doc = serde_json::to_value(yaml).unwrap();
+    let params = doc["paths"]["/v1/robots/{id}/measurement-sets"]["post"]["parameters"]
+        .as_array()
+        .unwrap();
+    let p = params.iter().find(|p| p["name"] == "orientation").unwrap();
+    let names: Vec<&str> = robocal::measure::convention::MeasuredOrientation::ALL
+        .iter()
+        .map(|c| c.name())
+        .collect();
+    assert_eq!(p["schema"]["enum"], json!(names));
+
+    // JSON rows read back (with their std) upload again unchanged.
+    let r = t
+        .post_json(
+            "/v1/robots/{id}/measurement-sets",
+            &[&rid],
+            json!({ "rows": a }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::CREATED, "{}", r.text());
+    assert_eq!(rows_of(&r.json()).await, a);
+}

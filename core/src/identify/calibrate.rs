@@ -160,6 +160,12 @@ fn check_inputs(
     let chains = checked_chains(nominal, identification, "identification")?;
     check_set(nominal, training, "training")?;
     check_set(nominal, validation, "validation")?;
+    let fitted = identification.iter().chain(training);
+    let with = fitted.clone().filter(|m| m.std.is_some()).count();
+    let total = identification.len() + training.len();
+    if with > 0 && with < total {
+        return Err(CalibrationError::MixedStd { with, total });
+    }
     if let Some((index, m)) = training
         .iter()
         .enumerate()
@@ -389,6 +395,9 @@ fn identifiability_phase(
     if any_orientation {
         report.identifiable_by_orientation =
             identifiable_by_orientation(nominal, ident, chains, &candidates, &analysis.kept, opts);
+    } else {
+        report.unseen_tool_tip_terms =
+            unseen_without_orientation(nominal, ident, chains, &candidates, &analysis.kept, opts);
     }
     let per_pose = if any_orientation { 6 } else { 3 };
     let gen_rank = generic_rank(nominal, &geometric, any_orientation);
@@ -456,6 +465,42 @@ fn identifiable_by_orientation(
     );
     kept.iter()
         .filter(|id| !without.kept.contains(id))
+        .map(|id| id.name())
+        .collect()
+}
+
+/// With position-only `ident`: the parameters the same poses would identify
+/// if each had also measured an orientation, and `kept` (the position-only
+/// analysis) lacks. The Jacobian rows do not depend on the measured values,
+/// so any rotation stands in for the missing ones.
+fn unseen_without_orientation(
+    nominal: &RobotModel,
+    ident: &[Measurement],
+    chains: &[Chain],
+    candidates: &[ParamId],
+    kept: &[ParamId],
+    opts: &CalibrationOptions,
+) -> Vec<String> {
+    let six_d: Vec<Measurement> = ident
+        .iter()
+        .map(|m| Measurement {
+            orientation: Some(Matrix3::identity()),
+            ..m.clone()
+        })
+        .collect();
+    let (j, rows) = stacked_factor(nominal, candidates, &six_d, Some(chains));
+    let with = identifiability::analyse_factor(
+        nominal,
+        &j,
+        rows,
+        candidates,
+        &fixed_params(nominal),
+        ident.len(),
+        &opts.identifiability,
+    );
+    with.kept
+        .iter()
+        .filter(|id| !kept.contains(id))
         .map(|id| id.name())
         .collect()
 }

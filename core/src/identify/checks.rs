@@ -70,6 +70,8 @@ pub enum CalibrationError {
         index: usize,
         session: usize,
     },
+    #[error("{with} of the {total} identification and training poses carry standard deviations (std_x, std_y, std_z) and the others do not; the fit weighs rows by them, so give them for every fitted set or for none")]
+    MixedStd { with: usize, total: usize },
     #[error("calibration cancelled")]
     Cancelled,
     #[error("the nominal model gives {what} at the identification poses, so nothing can be fitted; check the model's lengths, masses, compliances and tool")]
@@ -293,6 +295,7 @@ pub(crate) fn generic_rank(model: &RobotModel, ids: &[ParamId], orientation: boo
                 orientation: orientation.then(nalgebra::Matrix3::identity),
                 payload_mass: model.payload.mass,
                 session: 0,
+                std: None,
             });
         }
     }

@@ -9,6 +9,11 @@
 //! correction of session s's frame (identity for session 0). Residuals
 //! (measured − predicted) in metres, 3 rows per pose, plus 3 orientation rows
 //! (rotation vector [rad] × `orientation_weight` [m/rad]) where measured.
+//! Rows with standard deviations ([`RowStd`], from the CSV's `std_*` columns)
+//! are weighted by their inverse instead: position rows by `σ̄/σ_p`, orientation
+//! rows by `σ̄/σ_r` [m/rad] (or `orientation_weight·σ̄/σ_p` without an
+//! orientation figure), `σ̄` the mean position σ of the rows that have one, so
+//! the residuals stay in metres on average ([`row_weights`]).
 //! Jacobian rows of the prediction: the identification columns of
 //! `kinematics::jacobian` (eq. 4.9 + chain rule + `J_θ·diag(τ)`) rotated into
 //! the session frame, then 6 columns per session ≥ 1 (translation, small
@@ -16,7 +21,7 @@
 
 use crate::kinematics::chain::{chain_into, ChainConstants};
 use crate::kinematics::{gravity_torques_of, jacobian::fill_identification_rows, Chain};
-use crate::measure::Measurement;
+use crate::measure::{Measurement, RowStd};
 use crate::model::pose::{rotation_log, Pose};
 use crate::model::{ParamId, ParamKind, RobotModel};
 use nalgebra::{DMatrix, DMatrixView, DVector, Matrix3, Vector3};
@@ -88,6 +93,40 @@ pub fn residual_rows(data: &[Measurement]) -> usize {
         .sum()
 }
 
+/// Mean position σ [m] of the rows that carry standard deviations.
+fn mean_position_std(data: &[Measurement]) -> Option<f64> {
+    let (sum, n) = data
+        .iter()
+        .filter_map(|m| m.std)
+        .fold((0.0, 0usize), |(s, n), d| (s + d.position, n + 1));
+    (n > 0).then(|| sum / n as f64)
+}
+
+/// Weights of one row's position and orientation residuals given `mean`
+/// (the data's [`mean_position_std`]); `(1, orientation_weight)` without
+/// standard deviations.
+fn weights_of(std: Option<RowStd>, mean: Option<f64>, orientation_weight: f64) -> (f64, f64) {
+    match (std, mean) {
+        (Some(s), Some(mean)) => {
+            let wp = mean / s.position;
+            let wr = s
+                .orientation
+                .map_or(orientation_weight * wp, |sr| mean / sr);
+            (wp, wr)
+        }
+        _ => (1.0, orientation_weight),
+    }
+}
+
+/// Per pose of `data`, the weights `(position, orientation [m/rad])` of its
+/// residual rows (module docs).
+pub(crate) fn row_weights(data: &[Measurement], orientation_weight: f64) -> Vec<(f64, f64)> {
+    let mean = mean_position_std(data);
+    data.iter()
+        .map(|m| weights_of(m.std, mean, orientation_weight))
+        .collect()
+}
+
 /// Residuals (and optionally the Jacobian of the prediction) at the current model.
 pub(crate) fn evaluate(
     model: &RobotModel,
@@ -135,7 +174,7 @@ pub(crate) fn evaluate_into(
         || ids
             .iter()
             .any(|i| i.kind == ParamKind::Compliance || i.is_payload());
-    let w = orientation_weight;
+    let mean_std = mean_position_std(data);
     if let Some(j) = j.as_mut() {
         // Session-frame columns: zero except the entries written below.
         for c in ids.len()..j.ncols() {
@@ -179,7 +218,8 @@ pub(crate) fn evaluate_into(
         };
         let e = frames.get(m.session).copied().unwrap_or_default();
         let pred = e.transform_point(&c.tcp.p);
-        let dp = m.position - pred;
+        let (wp, w) = weights_of(m.std, mean_std, orientation_weight);
+        let dp = (m.position - pred) * wp;
         r[row] = dp.x;
         r[row + 1] = dp.y;
         r[row + 2] = dp.z;
@@ -192,7 +232,7 @@ pub(crate) fn evaluate_into(
         }
         let n_rows = if orient { 6 } else { 3 };
         if let Some(j) = j.as_mut() {
-            if e.r == Matrix3::identity() && w == 1.0 {
+            if e.r == Matrix3::identity() && w == 1.0 && wp == 1.0 {
                 // The frame's rotation and the weight change nothing: the rows
                 // go straight into the Jacobian (the same numbers).
                 fill_identification_rows(model, c, ids, &tau, m.payload_mass, orient, j, row);
@@ -207,14 +247,14 @@ pub(crate) fn evaluate_into(
                     &mut local,
                     0,
                 );
-                rotate_rows(&local, &e.r, w, orient, j, row);
+                rotate_rows(&local, &e.r, (wp, w), orient, j, row);
             }
             if m.session > 0 {
                 let base = ids.len() + (m.session - 1) * 6;
                 for k in 0..3 {
-                    j[(row + k, base + k)] = 1.0;
+                    j[(row + k, base + k)] = wp;
                     let ek = Vector3::ith(k, 1.0);
-                    let v = ek.cross(&pred);
+                    let v = ek.cross(&pred) * wp;
                     j[(row, base + 3 + k)] = v.x;
                     j[(row + 1, base + 3 + k)] = v.y;
                     j[(row + 2, base + 3 + k)] = v.z;
@@ -230,17 +270,18 @@ pub(crate) fn evaluate_into(
 }
 
 /// The pose's Jacobian rows `local` (6 × columns, base frame) rotated into
-/// the session frame `r`, orientation rows weighted by `w`, written at `row`.
+/// the session frame `r`, position rows weighted by `wp`, orientation rows by
+/// `w`, written at `row`.
 fn rotate_rows(
     local: &DMatrix<f64>,
     r: &Matrix3<f64>,
-    w: f64,
+    (wp, w): (f64, f64),
     orient: bool,
     j: &mut DMatrix<f64>,
     row: usize,
 ) {
     for col in 0..local.ncols() {
-        let v = r * Vector3::new(local[(0, col)], local[(1, col)], local[(2, col)]);
+        let v = r * Vector3::new(local[(0, col)], local[(1, col)], local[(2, col)]) * wp;
         j[(row, col)] = v.x;
         j[(row + 1, col)] = v.y;
         j[(row + 2, col)] = v.z;

@@ -124,6 +124,13 @@ pub struct IdentifiabilityReport {
     /// frame's rotation), found by analysing the position rows alone.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub identifiable_by_orientation: Vec<String>,
+    /// With position-only data: the parameters the same poses would identify
+    /// with measured orientations and do not without (typically the tool
+    /// frame's rotation `tool_rx, tool_ry, tool_rz`). A production tool's tip
+    /// away from the measured point depends on them, so its error there is
+    /// unknown; the report names them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub unseen_tool_tip_terms: Vec<String>,
 }
 
 impl IdentifiabilityReport {
@@ -362,6 +369,7 @@ pub(crate) fn analyse_factor(
             std_devs: vec![],
             correlated_pairs: vec![],
             identifiable_by_orientation: vec![],
+            unseen_tool_tip_terms: vec![],
         },
         kept,
     }

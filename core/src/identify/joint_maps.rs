@@ -138,6 +138,22 @@ fn position_levers(jt: &DMatrix<f64>, data: &[Measurement]) -> Option<Vec<f64>> 
     if data.iter().any(|m| m.orientation.is_some()) || data.is_empty() {
         return None;
     }
+    if data.iter().any(|m| m.std.is_some()) {
+        // The rows of `jt` are weighted (`evaluate`): undo it pose by pose.
+        let w = super::evaluate::row_weights(data, 1.0);
+        return Some(
+            (0..jt.ncols())
+                .map(|i| {
+                    let sum: f64 = (0..data.len())
+                        .map(|p| (0..3).map(|k| jt[(3 * p + k, i)].powi(2)).sum::<f64>())
+                        .zip(&w)
+                        .map(|(s, (wp, _))| s / (wp * wp))
+                        .sum();
+                    (sum / data.len() as f64).sqrt()
+                })
+                .collect(),
+        );
+    }
     Some(
         (0..jt.ncols())
             .map(|i| (jt.column(i).norm_squared() / data.len() as f64).sqrt())
@@ -205,8 +221,9 @@ struct Design {
     geo: usize,
     /// First row of each pose, and its row count.
     pose_rows: Vec<(usize, usize)>,
-    /// Weight of the orientation rows [m/rad].
-    weight: f64,
+    /// Per pose, the weights of its position and orientation rows [m/rad]
+    /// (`evaluate::row_weights`).
+    weights: Vec<(f64, f64)>,
     /// Joints with a map, with their range.
     joints: Vec<(usize, [f64; 2])>,
     /// Joints whose map the measurements cannot see.
@@ -287,7 +304,7 @@ fn build(
         a: DMatrix::zeros(0, 0),
         geo,
         pose_rows: Vec::new(),
-        weight,
+        weights: super::evaluate::row_weights(data, weight),
         joints,
         refused,
         kmax,
@@ -384,9 +401,9 @@ fn held_out_errors(
         .iter()
         .map(|&p| {
             let (row, nr) = d.pose_rows[p];
-            let angle = (nr == 6 && d.weight > 0.0)
-                .then(|| (norm(row + 3..row + 6) / d.weight).to_degrees());
-            (norm(row..row + 3) * 1e3, angle)
+            let (wp, wr) = d.weights[p];
+            let angle = (nr == 6 && wr > 0.0).then(|| (norm(row + 3..row + 6) / wr).to_degrees());
+            (norm(row..row + 3) / wp * 1e3, angle)
         })
         .unzip()
 }

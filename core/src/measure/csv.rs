@@ -10,16 +10,23 @@
 //! ```
 //!
 //! Units: `q1..qN` controller joint readings [deg] (N = 2..7), `x, y, z` the
-//! TCP position in the measurement (tracker) frame [mm], optional `rx, ry, rz`
-//! fixed-axis XYZ angles in degrees, `R = Rz(rz)·Ry(ry)·Rx(rx)` (not a
-//! rotation vector). Optional `session`, `payload_kg`, `temperature_c`, `set`
-//! (`identification`, `training`, `validation`). Columns are found by name;
+//! TCP position in the measurement (tracker) frame [mm], optional orientation:
+//! `rx, ry, rz` in degrees, fixed-axis XYZ `R = Rz(rz)·Ry(ry)·Rx(rx)` (not a
+//! rotation vector) unless [`ReadOptions::orientation`] declares the intrinsic
+//! order, or `qw, qx, qy, qz` (a quaternion; [`MeasuredOrientation`]), stored
+//! as fixed-axis angles whatever the file's convention. Optional per-row
+//! standard deviations `std_x, std_y, std_z` [mm] and `std_rx, std_ry, std_rz`
+//! [deg] (all rows or none). Optional `session`, `payload_kg`,
+//! `temperature_c`, `set` (`identification`, `training`, `validation`). Columns are found by name;
 //! unit checks reject what looks like wrong units, naming line and column.
 //! The real data's layout (`x_t`, `x_dif`, `joint_i`) reads as
 //! `measured = x_t + dif` ([`DifSign::Plus`]); [`parse_with`] flips it.
 //! [`ReadOptions`] declares the dialect (`;`/tab, decimal comma), metres or
 //! radians. The tests are in `csv/tests.rs`.
 
+use super::convention::{MeasuredOrientation, OrientationValueError};
+#[cfg(test)]
+use super::RowStd;
 use super::{MeasuredPose, SetRole};
 use crate::csv_text::{self, short_text, Dialect, TextError};
 use std::fmt::Write as _;
@@ -49,8 +56,9 @@ pub fn short_number(v: f64) -> String {
 }
 
 const ACCEPTED: &str =
-    "q1..q7 (alias joint_1..joint_7), x, y, z, rx, ry, rz (fixed-axis XYZ degrees, \
-alias rx_deg, ry_deg, rz_deg), payload_kg, \
+    "q1..q7 (alias joint_1..joint_7), x, y, z, rx, ry, rz (degrees, fixed-axis XYZ unless \
+declared intrinsic_xyz; alias rx_deg, ry_deg, rz_deg) or qw, qx, qy, qz (quaternion), \
+std_x, std_y, std_z, std_rx, std_ry, std_rz, payload_kg, \
 temperature_c, set, session; real-data layout: x_t, y_t, z_t, x_dif, y_dif, z_dif, step_order";
 
 /// Sign of the `*_dif` columns of the real-data layout.
@@ -139,6 +147,18 @@ pub enum CsvError {
     BadSession { line: usize, value: String },
     #[error("line {line}, columns rx, ry, rz: give all three orientation angles or none")]
     PartialOrientation { line: usize },
+    #[error("line {line}, columns {columns}: give all {n} values or none", n = columns.split(", ").count())]
+    PartialColumns { line: usize, columns: String },
+    #[error("line {line}: {detail}")]
+    OrientationColumns { line: usize, detail: String },
+    #[error("line {line}, columns qw, qx, qy, qz: the quaternion's norm is {}, not 1 (within {tol}); check the column order (qw first) and that the values are not scaled or truncated", short_number(*norm), tol = crate::model::orientation::QUATERNION_NORM_TOLERANCE)]
+    NonUnitQuaternion { line: usize, norm: f64 },
+    #[error("line {line}, column `{column}`: {what}")]
+    BadStd {
+        line: usize,
+        column: String,
+        what: String,
+    },
     #[error("line {line}, column `{column}`: {} deg looks like wrong units (|q| > {max} deg; joint readings must be in degrees)", short_number(*value), max = MAX_JOINT_DEG)]
     JointUnits {
         line: usize,
@@ -169,6 +189,9 @@ enum Col {
     Joint(usize),
     Pos(usize),
     Rot(usize),
+    Quat(usize),
+    StdPos(usize),
+    StdRot(usize),
     Payload,
     Temperature,
     Set,
@@ -186,6 +209,16 @@ fn classify(name: &str) -> Option<Col> {
         "rx" | "rx_deg" => Some(Col::Rot(0)),
         "ry" | "ry_deg" => Some(Col::Rot(1)),
         "rz" | "rz_deg" => Some(Col::Rot(2)),
+        "qw" => Some(Col::Quat(0)),
+        "qx" => Some(Col::Quat(1)),
+        "qy" => Some(Col::Quat(2)),
+        "qz" => Some(Col::Quat(3)),
+        "std_x" => Some(Col::StdPos(0)),
+        "std_y" => Some(Col::StdPos(1)),
+        "std_z" => Some(Col::StdPos(2)),
+        "std_rx" => Some(Col::StdRot(0)),
+        "std_ry" => Some(Col::StdRot(1)),
+        "std_rz" => Some(Col::StdRot(2)),
         "payload_kg" => Some(Col::Payload),
         "temperature_c" => Some(Col::Temperature),
         "set" => Some(Col::Set),
@@ -217,6 +250,9 @@ fn canonical_name(c: Col) -> String {
         Col::Joint(i) => format!("q{i}"),
         Col::Pos(i) => XYZ[i].to_string(),
         Col::Rot(i) => format!("r{}", XYZ[i]),
+        Col::Quat(i) => MeasuredOrientation::Quaternion.columns()[i].to_string(),
+        Col::StdPos(i) => format!("std_{}", XYZ[i]),
+        Col::StdRot(i) => format!("std_r{}", XYZ[i]),
         Col::Payload => "payload_kg".into(),
         Col::Temperature => "temperature_c".into(),
         Col::Set => "set".into(),
@@ -234,7 +270,10 @@ struct Header {
     joints: Vec<usize>,
     /// Canonical `x,y,z` or the real-data `(target, dif)` triples.
     position: PositionCols,
-    rot: Option<[usize; 3]>,
+    /// The orientation columns (in the convention's order) and their convention.
+    rot: Option<(MeasuredOrientation, Vec<usize>)>,
+    std_pos: Option<[usize; 3]>,
+    std_rot: Option<[usize; 3]>,
     payload: Option<usize>,
     temperature: Option<usize>,
     set: Option<usize>,
@@ -337,21 +376,36 @@ fn parse_header(line: usize, fields: &[String], opts: &ReadOptions) -> Result<He
         }
     };
 
-    let rot = if (0..3).any(|i| find(Col::Rot(i)).is_some()) {
+    let rot = orientation_columns(line, &find, opts.orientation)?;
+    let triple = |col: fn(usize) -> Col| -> Result<Option<[usize; 3]>, CsvError> {
+        if (0..3).all(|i| find(col(i)).is_none()) {
+            return Ok(None);
+        }
         let mut r = [0; 3];
         for (i, slot) in r.iter_mut().enumerate() {
-            *slot = find(Col::Rot(i)).ok_or_else(|| missing(Col::Rot(i)))?;
+            *slot = find(col(i)).ok_or_else(|| missing(col(i)))?;
         }
-        Some(r)
-    } else {
-        None
+        Ok(Some(r))
     };
+    let std_pos = triple(Col::StdPos)?;
+    let std_rot = triple(Col::StdRot)?;
+    if std_rot.is_some() && std_pos.is_none() {
+        return Err(missing(Col::StdPos(0)));
+    }
+    if std_rot.is_some() && rot.is_none() {
+        return Err(CsvError::OrientationColumns {
+            line,
+            detail: "std_rx, std_ry, std_rz given but no orientation columns".into(),
+        });
+    }
 
     Ok(Header {
         line,
         joints,
         position,
         rot,
+        std_pos,
+        std_rot,
         payload: find(Col::Payload),
         temperature: find(Col::Temperature),
         set: find(Col::Set),
@@ -361,6 +415,55 @@ fn parse_header(line: usize, fields: &[String], opts: &ReadOptions) -> Result<He
         metres: opts.metres,
         radians: opts.radians,
     })
+}
+
+/// The orientation columns of a header: `rx, ry, rz` (fixed-axis unless
+/// `declared` says intrinsic) or `qw, qx, qy, qz`, never both; a declared
+/// convention must match the columns present.
+fn orientation_columns(
+    line: usize,
+    find: &dyn Fn(Col) -> Option<usize>,
+    declared: Option<MeasuredOrientation>,
+) -> Result<Option<(MeasuredOrientation, Vec<usize>)>, CsvError> {
+    let angles = (0..3).any(|i| find(Col::Rot(i)).is_some());
+    let quat = (0..4).any(|i| find(Col::Quat(i)).is_some());
+    let wrong = |detail: String| Err(CsvError::OrientationColumns { line, detail });
+    let conv = match (angles, quat, declared) {
+        (false, false, _) => return Ok(None),
+        (true, true, _) => {
+            return wrong(
+                "both rx, ry, rz and qw, qx, qy, qz given: write one orientation convention".into(),
+            )
+        }
+        (true, false, Some(MeasuredOrientation::Quaternion)) => {
+            return wrong(
+                "the orientation is declared quaternion but the file has rx, ry, rz columns (declare fixed_xyz or intrinsic_xyz)".into(),
+            )
+        }
+        (false, true, Some(c)) if c.is_angles() => {
+            return wrong(format!(
+                "the orientation is declared {c} but the file has qw, qx, qy, qz columns (declare quaternion or nothing)"
+            ))
+        }
+        (true, false, c) => c.unwrap_or_default(),
+        (false, true, _) => MeasuredOrientation::Quaternion,
+    };
+    let col = |i: usize| {
+        if conv.is_angles() {
+            Col::Rot(i)
+        } else {
+            Col::Quat(i)
+        }
+    };
+    let cols = (0..conv.columns().len())
+        .map(|i| {
+            find(col(i)).ok_or_else(|| CsvError::MissingColumn {
+                line,
+                column: canonical_name(col(i)),
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(Some((conv, cols)))
 }
 
 /// Parses one numeric field; `None` for an empty field.
@@ -453,14 +556,53 @@ impl Header {
         }
         let rpy_deg = match &self.rot {
             None => None,
-            Some(r) => {
-                let v = [opt(r[0])?, opt(r[1])?, opt(r[2])?];
-                match v {
-                    [Some(a), Some(b), Some(c)] => Some([angle(a), angle(b), angle(c)]),
-                    [None, None, None] => None,
-                    _ => return Err(CsvError::PartialOrientation { line }),
+            Some((conv, cols)) => {
+                let v = cols
+                    .iter()
+                    .map(|&c| opt(c))
+                    .collect::<Result<Vec<_>, _>>()?;
+                if v.iter().all(Option::is_none) {
+                    None
+                } else if v.iter().any(Option::is_none) {
+                    return Err(if conv.is_angles() {
+                        CsvError::PartialOrientation { line }
+                    } else {
+                        self.partial(line, cols)
+                    });
+                } else {
+                    let v: Vec<f64> = v.into_iter().flatten().collect();
+                    let v: Vec<f64> = if conv.is_angles() {
+                        v.into_iter().map(angle).collect()
+                    } else {
+                        v
+                    };
+                    Some(conv.to_fixed_xyz_deg(&v).map_err(|e| match e {
+                        OrientationValueError::NonUnitQuaternion { norm } => {
+                            CsvError::NonUnitQuaternion { line, norm }
+                        }
+                    })?)
                 }
             }
+        };
+        let std_mm = self.std(line, fields, self.std_pos, length)?;
+        let std_deg = match self.std_rot {
+            Some(cols) if rpy_deg.is_none() => {
+                if let Some(&c) = cols.iter().find(|&&c| !fields[c].is_empty()) {
+                    return Err(CsvError::BadStd {
+                        line,
+                        column: self.names[c].clone(),
+                        what: "an orientation standard deviation on a row without an orientation"
+                            .into(),
+                    });
+                }
+                None
+            }
+            cols => self.std(
+                line,
+                fields,
+                cols,
+                if self.radians { 1f64.to_degrees() } else { 1.0 },
+            )?,
         };
         let payload_kg = self.payload.map(opt).transpose()?.flatten();
         if let (Some(kg), Some(c)) = (payload_kg, self.payload) {
@@ -501,11 +643,61 @@ impl Header {
             q_deg,
             xyz_mm,
             rpy_deg,
+            std_mm,
+            std_deg,
             payload_kg,
             temperature_c,
             set,
             session,
         })
+    }
+
+    fn partial(&self, line: usize, cols: &[usize]) -> CsvError {
+        CsvError::PartialColumns {
+            line,
+            columns: cols
+                .iter()
+                .map(|&c| self.names[c].as_str())
+                .collect::<Vec<_>>()
+                .join(", "),
+        }
+    }
+
+    /// Three standard deviations (scaled by `unit` into mm or degrees); when
+    /// the columns exist every row gives all three, each finite and > 0.
+    fn std(
+        &self,
+        line: usize,
+        fields: &[&str],
+        cols: Option<[usize; 3]>,
+        unit: f64,
+    ) -> Result<Option<[f64; 3]>, CsvError> {
+        let Some(cols) = cols else { return Ok(None) };
+        let mut out = [0.0; 3];
+        for (o, &c) in out.iter_mut().zip(&cols) {
+            let bad = |what: String| CsvError::BadStd {
+                line,
+                column: self.names[c].clone(),
+                what,
+            };
+            let v = number(line, &self.names[c], fields[c], self.decimal_comma)?;
+            *o = match v {
+                None => {
+                    return Err(bad(
+                        "empty: the file has standard-deviation columns, so every row gives them (or leave the columns out)"
+                            .into(),
+                    ))
+                }
+                Some(v) if v <= 0.0 => {
+                    return Err(bad(format!(
+                        "{} is not a standard deviation (must be > 0)",
+                        short_number(v)
+                    )))
+                }
+                Some(v) => v * unit,
+            };
+        }
+        Ok(Some(out))
     }
 }
 
@@ -521,6 +713,9 @@ pub struct ReadOptions {
     pub metres: bool,
     /// Joint and orientation angles are in radians (converted to degrees).
     pub radians: bool,
+    /// The convention of the orientation columns; `None`: from the header
+    /// (`rx, ry, rz` fixed-axis, `qw, qx, qy, qz` quaternion).
+    pub orientation: Option<MeasuredOrientation>,
 }
 
 /// Parses a measurement CSV (either layout; real-data `dif` added: [`DifSign::Plus`]).
@@ -587,7 +782,7 @@ fn num(x: f64) -> String {
 }
 
 /// Writes rows in the canonical layout
-/// `q1..qN,x,y,z[,rx,ry,rz][,payload_kg][,temperature_c][,set][,session]`.
+/// `q1..qN,x,y,z[,rx,ry,rz][,std_x,std_y,std_z][,std_rx,std_ry,std_rz][,payload_kg][,temperature_c][,set][,session]`.
 ///
 /// N is the largest joint count among the rows (rows are expected to agree); an
 /// optional column is written when any row has it, rows without it get an empty
@@ -596,6 +791,8 @@ fn num(x: f64) -> String {
 pub fn write(rows: &[MeasuredPose]) -> String {
     let n = rows.iter().map(|r| r.q_deg.len()).max().unwrap_or(0);
     let rot = rows.iter().any(|r| r.rpy_deg.is_some());
+    let std_pos = rows.iter().any(|r| r.std_mm.is_some());
+    let std_rot = rows.iter().any(|r| r.std_deg.is_some());
     let payload = rows.iter().any(|r| r.payload_kg.is_some());
     let temp = rows.iter().any(|r| r.temperature_c.is_some());
     let set = rows.iter().any(|r| r.set.is_some());
@@ -605,6 +802,12 @@ pub fn write(rows: &[MeasuredPose]) -> String {
     header.extend(["x", "y", "z"].map(String::from));
     if rot {
         header.extend(["rx", "ry", "rz"].map(String::from));
+    }
+    if std_pos {
+        header.extend(["std_x", "std_y", "std_z"].map(String::from));
+    }
+    if std_rot {
+        header.extend(["std_rx", "std_ry", "std_rz"].map(String::from));
     }
     if payload {
         header.push("payload_kg".into());
@@ -633,6 +836,14 @@ pub fn write(rows: &[MeasuredPose]) -> String {
                 None => f.extend([String::new(), String::new(), String::new()]),
             }
         }
+        for (on, v) in [(std_pos, r.std_mm), (std_rot, r.std_deg)] {
+            if on {
+                match v {
+                    Some(a) => f.extend(a.iter().copied().map(num)),
+                    None => f.extend([String::new(), String::new(), String::new()]),
+                }
+            }
+        }
         if payload {
             f.push(opt(r.payload_kg));
         }
@@ -650,5 +861,7 @@ pub fn write(rows: &[MeasuredPose]) -> String {
     out
 }
 
+#[cfg(test)]
+mod orientation_tests;
 #[cfg(test)]
 mod tests;

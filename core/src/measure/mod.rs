@@ -5,7 +5,9 @@
 //! - [`MeasuredPose`]: boundary units of the CSV format (controller joint readings
 //!   in degrees, positions in millimetres in the measurement frame, optional
 //!   orientation as fixed-axis XYZ angles `rx, ry, rz` in degrees, i.e.
-//!   `R = Rz(rz)·Ry(ry)·Rx(rx)`).
+//!   `R = Rz(rz)·Ry(ry)·Rx(rx)`, whatever convention the file used
+//!   ([`convention::MeasuredOrientation`]), optional standard deviations of
+//!   the position [mm] and orientation angles [deg] per axis).
 //! - [`Measurement`]: SI form used by the numerical core (model-convention joint
 //!   values in radians after the controller's sign/zero conversion, metres).
 
@@ -14,6 +16,7 @@ use crate::model::RobotModel;
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
+pub mod convention;
 pub mod csv;
 
 /// Role of a measurement in the calibration (docs/design.md "Data roles").
@@ -56,6 +59,12 @@ pub struct MeasuredPose {
     /// Measured orientation, fixed-axis XYZ `[rx, ry, rz]` [deg].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rpy_deg: Option<[f64; 3]>,
+    /// Standard deviations of the measured `x, y, z` [mm] (CSV `std_x, std_y, std_z`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub std_mm: Option<[f64; 3]>,
+    /// Standard deviations of the measured `rx, ry, rz` [deg] (CSV `std_rx, std_ry, std_rz`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub std_deg: Option<[f64; 3]>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub payload_kg: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -80,6 +89,32 @@ pub struct Measurement {
     pub payload_mass: f64,
     /// Measurement session (tracker placement) index; 0 for a single session.
     pub session: usize,
+    /// The row's standard deviations, when the file gave them: the fits weigh
+    /// its residual rows by their inverse (`identify::evaluate`).
+    pub std: Option<RowStd>,
+}
+
+/// One row's measurement standard deviations in SI, each the RMS of its three
+/// per-axis figures (`√((σx² + σy² + σz²)/3)`): the fit works in the registered
+/// base frame, where the tracker's axes are rotated, so a row's weight is one
+/// figure for its position and one for its orientation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RowStd {
+    /// Position [m].
+    pub position: f64,
+    /// Orientation [rad], when the row measured one and gave its deviations.
+    pub orientation: Option<f64>,
+}
+
+impl RowStd {
+    /// From the CSV's per-axis figures (mm, deg).
+    pub fn from_axes(std_mm: [f64; 3], std_deg: Option<[f64; 3]>) -> RowStd {
+        let rms = |v: [f64; 3]| (v.iter().map(|x| x * x).sum::<f64>() / 3.0).sqrt();
+        RowStd {
+            position: rms(std_mm) * 1e-3,
+            orientation: std_deg.map(|d| rms(d).to_radians()),
+        }
+    }
 }
 
 impl MeasuredPose {
@@ -95,6 +130,9 @@ impl MeasuredPose {
                 .map(|r| rpy_matrix(r[0].to_radians(), r[1].to_radians(), r[2].to_radians())),
             payload_mass: self.payload_kg.unwrap_or(default_payload),
             session: 0,
+            std: self
+                .std_mm
+                .map(|p| RowStd::from_axes(p, self.std_deg.filter(|_| self.rpy_deg.is_some()))),
         }
     }
 }

@@ -258,6 +258,8 @@ pub fn join(plan: &[PlanPoint], text: &str, opts: &JoinOptions) -> Result<Joined
                 q_deg: p.q_deg.clone(),
                 xyz_mm,
                 rpy_deg: None,
+                std_mm: None,
+                std_deg: None,
                 payload_kg: None,
                 temperature_c: None,
                 set: None,

@@ -47,6 +47,7 @@ fn measurements(model: &RobotModel, q: &[Vec<f64>], payload_kg: f64) -> Vec<Meas
                 orientation: None,
                 payload_mass: payload_kg,
                 session: 0,
+                std: None,
             })
         })
         .collect()

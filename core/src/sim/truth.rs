@@ -340,6 +340,8 @@ impl TrueRobot {
                         .collect(),
                     xyz_mm,
                     rpy_deg: None,
+                    std_mm: None,
+                    std_deg: None,
                     payload_kg,
                     temperature_c: None,
                     set,

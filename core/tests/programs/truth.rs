@@ -109,6 +109,8 @@ impl FlangeTruth {
                         .collect(),
                     xyz_mm: [0, 1, 2].map(|k| p[k] * 1e3 + noise.sample(rng)),
                     rpy_deg: None,
+                    std_mm: None,
+                    std_deg: None,
                     payload_kg: Some(self.payload_kg),
                     temperature_c: None,
                     set: None,

@@ -360,6 +360,7 @@ mod tests {
             orientation: None,
             payload_mass: 0.0,
             session: 0,
+            std: None,
         };
         let m1 = Measurement {
             position: frame.transform_point(&(p + offset)),

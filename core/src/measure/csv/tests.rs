@@ -5,6 +5,8 @@ fn row(q: &[f64], xyz: [f64; 3]) -> MeasuredPose {
         q_deg: q.to_vec(),
         xyz_mm: xyz,
         rpy_deg: None,
+        std_mm: None,
+        std_deg: None,
         payload_kg: None,
         temperature_c: None,
         set: None,
