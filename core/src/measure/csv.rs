@@ -13,7 +13,7 @@
 //! TCP position in the measurement (tracker) frame [mm], optional `rx, ry, rz`
 //! fixed-axis XYZ angles in degrees, `R = Rz(rz)·Ry(ry)·Rx(rx)` (not a
 //! rotation vector). Optional `session`, `payload_kg`, `temperature_c`, `set`
-//! (`identification`, `training`, `validation`). Columns are found by name;
+//! (`identification`, `training`, `validation`, `check`). Columns are found by name;
 //! unit checks reject what looks like wrong units, naming line and column.
 //! The real data's layout (`x_t`, `x_dif`, `joint_i`) reads as
 //! `measured = x_t + dif` ([`DifSign::Plus`]); [`parse_with`] flips it.
@@ -133,7 +133,7 @@ pub enum CsvError {
         column: String,
         value: String,
     },
-    #[error("line {line}, column `set`: unknown set `{value}` (expected identification, training, validation or q1, q2, q3)")]
+    #[error("line {line}, column `set`: unknown set `{value}` (expected {names}, or q1, q2, q3)", names = SetRole::names())]
     UnknownSet { line: usize, value: String },
     #[error("line {line}, column `session`: `{value}` is not a session label (at most 64 characters, no control characters)")]
     BadSession { line: usize, value: String },
