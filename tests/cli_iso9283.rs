@@ -133,9 +133,27 @@ fn the_cube_plan_cycles_in_a_program_and_the_figures_match_hand_values() {
         &p("plan.csv"),
         "--measured",
         &p("cycles.csv"),
+        "--report",
+        &p("iso.html"),
     ]))
     .unwrap();
     assert!(table.contains("P5"), "{table}");
+    // The HTML report: a row per pose with the hand values of AP and RP (four
+    // decimals, as the table prints them) and a row per pair of poses.
+    let html = std::fs::read_to_string(p("iso.html")).unwrap();
+    let (ap, rp) = (
+        format!("{:.4}", 2f64.sqrt()),
+        format!("{:.4}", 4.0 / 3.0 + 3.0 * (4.0f64 / 3.0).sqrt()),
+    );
+    assert_eq!((ap.as_str(), rp.as_str()), ("1.4142", "4.7974"));
+    for k in 1..=5 {
+        let row = format!("<td>P{k}</td><td>3</td><td>{ap}</td>");
+        assert!(html.contains(&row), "no {row} in {html}");
+    }
+    assert_eq!(html.matches(&format!("<td>{rp}</td>")).count(), 5, "{html}");
+    assert_eq!(html.matches("<td>P1–P").count(), 4, "{html}");
+    assert!(html.contains("<td>P4–P5</td><td>3</td>"), "{html}");
+    assert!(html.contains(&p("cycles.csv")), "the test's label");
     // A plan without its cycles file is refused.
     assert!(figures(&figures_of(&["--plan", &p("plan.csv")])).is_err());
 }

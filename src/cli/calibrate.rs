@@ -183,7 +183,8 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
                     train_src.push(source(path, k, &s));
                     train_rows.push((s, r));
                 }
-                Some(SetRole::Validation) => {
+                // Check rows are scored like validation rows, never fitted.
+                Some(SetRole::Validation | SetRole::Check) => {
                     valid_src.push(source(path, k, &s));
                     valid_rows.push((s, r));
                 }

@@ -6,7 +6,7 @@
 //! ```text
 //! robocal iso9283 plan --model cal.json --box "1000,-400,300,1800,400,1100" \
 //!     --commands filtered --format krl --cycles 30 --out iso.src --csv iso_plan.csv
-//! robocal iso9283 --plan iso_plan.csv --measured cycles.csv [--json]
+//! robocal iso9283 --plan iso_plan.csv --measured cycles.csv [--json] [--report iso.html]
 //! ```
 //!
 //! Box and orientation (`--rpy`, fixed-axis `R = Rz·Ry·Rx`, deg): base frame.
@@ -112,6 +112,9 @@ pub struct FiguresArgs {
     /// Print JSON instead of the table.
     #[arg(long)]
     pub json: bool,
+    /// Also write the figures as an HTML report (one section per test) here.
+    #[arg(long)]
+    pub report: Option<PathBuf>,
 }
 
 fn numbers<const N: usize>(flag: &str, s: &str) -> anyhow::Result<[f64; N]> {
@@ -266,6 +269,7 @@ pub fn figures(a: &FiguresArgs) -> anyhow::Result<String> {
     };
     let mut out = String::new();
     let mut all = Vec::new();
+    let mut tests = Vec::new();
     for (plan, measured) in a.plan.iter().zip(&a.measured) {
         let commanded = read_plan_csv(&read(plan)?).with_context(|| plan.display().to_string())?;
         let cycles = read_cycles_csv(&read(measured)?, &commanded)
@@ -274,6 +278,11 @@ pub fn figures(a: &FiguresArgs) -> anyhow::Result<String> {
         let label = measured.display().to_string();
         out.push_str(&figures_table(&label, &f));
         all.push(serde_json::json!({ "measured": label, "figures": f }));
+        tests.push((label, f));
+    }
+    if let Some(path) = &a.report {
+        std::fs::write(path, crate::report::iso9283::render_iso9283_html(&tests))
+            .with_context(|| format!("cannot write {}", path.display()))?;
     }
     if a.json {
         return Ok(serde_json::to_string_pretty(&all)? + "\n");

@@ -57,7 +57,7 @@ pub struct SimulateArgs {
     /// Payload mass [kg] (default: the truth's payload).
     #[arg(long)]
     pub payload_kg: Option<f64>,
-    /// Set role written in every row: identification, training or validation.
+    /// Set role written in every row: identification, training, validation or check.
     #[arg(long)]
     pub set: Option<String>,
     /// Truth: table-7-1 (ys100 only), random, or a model JSON file.
@@ -237,9 +237,10 @@ pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
         non_negative("--payload-kg", p)?;
     }
     let set = match &a.set {
-        Some(s) => Some(SetRole::parse(s).with_context(|| {
-            format!("--set must be identification, training or validation, got {s}")
-        })?),
+        Some(s) => Some(
+            SetRole::parse(s)
+                .with_context(|| format!("--set must be {}, got {s}", SetRole::names()))?,
+        ),
         None => None,
     };
     let tracker = match &a.tracker {

@@ -1,6 +1,6 @@
 //! Which calibrations and model versions use a measurement set: a set a
-//! version was fitted or validated on, or that a queued or running job will
-//! read, is not deleted (the calibration record stays complete).
+//! version was fitted or validated on, or re-registered on, or that a queued or
+//! running job will read, is not deleted (the calibration record stays complete).
 
 use super::{on_pool, write_for_robot, Db, StoreError};
 
@@ -19,6 +19,15 @@ pub enum SetDeletion {
 
 fn names(ids_json: &str, set_id: i64) -> bool {
     serde_json::from_str::<Vec<i64>>(ids_json).is_ok_and(|ids| ids.contains(&set_id))
+}
+
+/// The set a re-registered version's frames were refitted on
+/// (`stats.reregistered.set_id`).
+fn reregistered_on(stats_json: &str) -> Option<i64> {
+    serde_json::from_str::<serde_json::Value>(stats_json)
+        .ok()?
+        .pointer("/reregistered/set_id")?
+        .as_i64()
 }
 
 impl Db {
@@ -54,6 +63,20 @@ impl Db {
                     jobs.push(job);
                 }
             }
+            // A re-registered version keeps the set its frames were refitted on.
+            let refits: Vec<(i64, String)> = sqlx::query_as(
+                "SELECT version, CAST(stats_json AS TEXT) FROM model_versions \
+                 WHERE robot_id = $1 ORDER BY version",
+            )
+            .bind(robot_id)
+            .fetch_all(&mut *tx)
+            .await?;
+            for (version, stats) in refits {
+                if reregistered_on(&stats) == Some(id) && !versions.contains(&version) {
+                    versions.push(version);
+                }
+            }
+            versions.sort_unstable();
             if !(versions.is_empty() && jobs.is_empty()) {
                 tx.rollback().await?;
                 return Ok(SetDeletion::InUse { versions, jobs });

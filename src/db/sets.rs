@@ -11,6 +11,7 @@ pub enum StoredRole {
     Identification,
     Training,
     Validation,
+    Check,
 }
 
 impl From<SetRole> for StoredRole {
@@ -19,6 +20,7 @@ impl From<SetRole> for StoredRole {
             SetRole::Identification => StoredRole::Identification,
             SetRole::Training => StoredRole::Training,
             SetRole::Validation => StoredRole::Validation,
+            SetRole::Check => StoredRole::Check,
         }
     }
 }
@@ -29,6 +31,7 @@ impl From<StoredRole> for SetRole {
             StoredRole::Identification => SetRole::Identification,
             StoredRole::Training => SetRole::Training,
             StoredRole::Validation => SetRole::Validation,
+            StoredRole::Check => SetRole::Check,
         }
     }
 }
@@ -60,7 +63,7 @@ impl StoredRole {
     }
 }
 
-text_enum!(StoredRole, [Identification, Training, Validation]);
+text_enum!(StoredRole, [Identification, Training, Validation, Check]);
 text_enum!(LengthUnit, [Mm, M]);
 text_enum!(AngleUnit, [Deg, Rad]);
 text_enum!(SetFormat, [Csv, Json]);

@@ -1,7 +1,7 @@
 //! Model versions: one calibrated model per method of each calibration, the
 //! active one per robot, and the activation history used by rollback.
 
-use super::{on_pool, Db, Json, Listing, StoreError};
+use super::{on_pool, write_for_robot, Db, Json, Listing, StoreError};
 use serde_json::Value;
 use sqlx::FromRow;
 
@@ -85,6 +85,47 @@ impl Db {
             tx.commit().await?;
         });
         self.version(robot_id, version).await
+    }
+
+    /// Adds `v` as the robot's next version (activated when `activate`),
+    /// linked to calibration `calibration_id`; `None` when the robot is gone.
+    pub async fn insert_version(
+        &self,
+        robot_id: i64,
+        calibration_id: Option<i64>,
+        v: &NewVersion,
+        activate: bool,
+    ) -> Result<Option<VersionRow>, StoreError> {
+        let number: i64 = on_pool!(self, |p, k| {
+            // Holding the robot's row serialises its version numbers.
+            let Some(mut tx) = write_for_robot!(p, k, robot_id) else {
+                return Ok(None);
+            };
+            let next: i64 = sqlx::query_scalar(
+                "SELECT COALESCE(MAX(version), 0) + 1 FROM model_versions WHERE robot_id = $1",
+            )
+            .bind(robot_id)
+            .fetch_one(&mut *tx)
+            .await?;
+            let vid: i64 = sqlx::query_scalar(
+                "INSERT INTO model_versions (robot_id, version, calibration_id, method, \
+                 model_json, stats_json) VALUES ($1, $2, $3, $4, $5, $6) RETURNING id",
+            )
+            .bind(robot_id)
+            .bind(next)
+            .bind(calibration_id)
+            .bind(&v.method)
+            .bind(&v.model_json)
+            .bind(Json(&v.stats))
+            .fetch_one(&mut *tx)
+            .await?;
+            if activate {
+                activate_in!(tx, robot_id, vid);
+            }
+            tx.commit().await?;
+            next
+        });
+        self.version(robot_id, number).await
     }
 
     /// Rolls back to the version that was active before the current one.

@@ -2,7 +2,9 @@
 //! against the active (or a named) version without fitting;
 //! `GET /v1/robots/{id}/checks` is the history; `GET /v1/robots/{id}/status`
 //! the status a plant monitor polls; `PUT /v1/robots/{id}/check-thresholds`
-//! sets the thresholds (defaults: `core::check::CheckThresholds`).
+//! sets the thresholds (defaults: `core::check::CheckThresholds`);
+//! `POST /v1/robots/{id}/reregister` refits a version's measurement frame and
+//! tool on a set and stores the result as a new version.
 
 use super::input::{page_body, PageQuery};
 use super::robots::robot_list_page;
@@ -155,6 +157,43 @@ pub async fn compare(
     .into_response())
 }
 
+/// `POST /v1/robots/{id}/reregister` body.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReregisterRequest {
+    pub set_id: i64,
+    #[serde(default)]
+    pub version: Option<i64>,
+    #[serde(default)]
+    pub activate: bool,
+}
+
+/// `POST /v1/robots/{id}/reregister`: the new version (201), not activated
+/// unless asked.
+pub async fn reregister(
+    State(state): State<AppState>,
+    ApiPath(robot_id): ApiPath<i64>,
+    ApiJson(req): ApiJson<ReregisterRequest>,
+) -> Result<Response, ApiError> {
+    if req.set_id < 1 || req.version.is_some_and(|v| v < 1) {
+        return Err(ApiError::BadRequest(
+            "`set_id` and `version` are positive integers".into(),
+        ));
+    }
+    let row = service::reregister::create(
+        &state,
+        service::reregister::ReregisterCommand {
+            robot_id,
+            set_id: req.set_id,
+            version: req.version,
+            activate: req.activate,
+        },
+    )
+    .await?;
+    let v = super::versions::ModelVersion::from_row(row);
+    Ok((StatusCode::CREATED, axum::Json(v)).into_response())
+}
+
 /// `PUT /v1/robots/{id}/check-thresholds` body.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -188,6 +227,7 @@ pub fn routes() -> Vec<super::Route> {
         post("/v1/robots/{id}/checks", create),
         get("/v1/robots/{id}/status", status),
         post("/v1/robots/{id}/compare", compare),
+        post("/v1/robots/{id}/reregister", reregister),
         route(
             axum::http::Method::PUT,
             "/v1/robots/{id}/check-thresholds",

@@ -180,9 +180,7 @@ fn check_params(p: &SetParams) -> Result<Checked, ApiError> {
             SetRole::parse(r)
                 .filter(|role| role.as_str() == r)
                 .ok_or_else(|| {
-                    ApiError::invalid(format!(
-                        "`role` must be identification, training or validation, got `{r}`"
-                    ))
+                    ApiError::invalid(format!("`role` must be {}, got `{r}`", SetRole::names()))
                 })
         })
         .transpose()?;

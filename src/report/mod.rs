@@ -16,6 +16,7 @@
 
 pub mod charts;
 pub mod format;
+pub mod iso9283;
 mod page;
 pub mod record;
 pub mod view;

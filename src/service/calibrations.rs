@@ -140,6 +140,19 @@ fn select_sets(
         "training_set_ids",
         robot_id,
     )?;
+    // A check set is only ever scored: fitting on it would leave the checks
+    // and the re-registrations scored on it no independent data.
+    for (sets, field) in [
+        (&ident, "identification_set_ids"),
+        (&train, "training_set_ids"),
+    ] {
+        if let Some(s) = sets.iter().find(|s| s.role == StoredRole::Check) {
+            return Err(ServiceError::Conflict(format!(
+                "`{field}`: measurement set {} has role check; check sets are scored (checks, re-registration, validation), never fitted on",
+                s.id
+            )));
+        }
+    }
     if ident.is_empty() {
         // The robot's data, not the request, is missing: a state conflict.
         return Err(ServiceError::Conflict(format!(

@@ -24,6 +24,7 @@ pub mod predict;
 pub mod programs;
 pub mod queue;
 pub mod record;
+pub mod reregister;
 pub mod robots;
 pub mod sets;
 pub mod solve;

@@ -218,7 +218,7 @@ fn set_in_use(id: i64, versions: &[i64], jobs: &[i64]) -> String {
     let mut users = Vec::new();
     if !versions.is_empty() {
         users.push(format!(
-            "model version(s) {} were fitted or validated on it",
+            "model version(s) {} were fitted, validated or re-registered on it",
             list(versions)
         ));
     }

@@ -17,7 +17,7 @@
 //! as fixed-axis angles whatever the file's convention. Optional per-row
 //! standard deviations `std_x, std_y, std_z` [mm] and `std_rx, std_ry, std_rz`
 //! [deg] (all rows or none). Optional `session`, `payload_kg`,
-//! `temperature_c`, `set` (`identification`, `training`, `validation`). Columns are found by name;
+//! `temperature_c`, `set` (`identification`, `training`, `validation`, `check`). Columns are found by name;
 //! unit checks reject what looks like wrong units, naming line and column.
 //! The real data's layout (`x_t`, `x_dif`, `joint_i`) reads as
 //! `measured = x_t + dif` ([`DifSign::Plus`]); [`parse_with`] flips it.
@@ -141,7 +141,7 @@ pub enum CsvError {
         column: String,
         value: String,
     },
-    #[error("line {line}, column `set`: unknown set `{value}` (expected identification, training, validation or q1, q2, q3)")]
+    #[error("line {line}, column `set`: unknown set `{value}` (expected {names}, or q1, q2, q3)", names = SetRole::names())]
     UnknownSet { line: usize, value: String },
     #[error("line {line}, column `session`: `{value}` is not a session label (at most 64 characters, no control characters)")]
     BadSession { line: usize, value: String },

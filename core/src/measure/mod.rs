@@ -29,14 +29,27 @@ pub enum SetRole {
     Training,
     /// Q3: validates; never used for fitting.
     Validation,
+    /// Check poses: scored against a model version without fitting
+    /// (`check`), or the small set a re-registration refits the frames on;
+    /// never an identification or training set of a calibration.
+    Check,
 }
 
 impl SetRole {
+    /// Every role, in the order lists and messages name them.
+    pub const ALL: [SetRole; 4] = [
+        SetRole::Identification,
+        SetRole::Training,
+        SetRole::Validation,
+        SetRole::Check,
+    ];
+
     pub fn parse(s: &str) -> Option<SetRole> {
         match s.trim().to_ascii_lowercase().as_str() {
             "identification" | "identify" | "q1" => Some(SetRole::Identification),
             "training" | "train" | "q2" => Some(SetRole::Training),
             "validation" | "validate" | "q3" => Some(SetRole::Validation),
+            "check" => Some(SetRole::Check),
             _ => None,
         }
     }
@@ -45,7 +58,19 @@ impl SetRole {
             SetRole::Identification => "identification",
             SetRole::Training => "training",
             SetRole::Validation => "validation",
+            SetRole::Check => "check",
         }
+    }
+    /// The role names as a message lists them: `identification, training, validation or check`.
+    pub fn names() -> String {
+        let names: Vec<&str> = SetRole::ALL.iter().map(|r| r.as_str()).collect();
+        let (last, rest) = names.split_last().expect("roles");
+        format!("{} or {last}", rest.join(", "))
+    }
+    /// Whether a calibration may fit on a set of this role (identification
+    /// or training); validation and check sets are only ever scored.
+    pub fn fits(&self) -> bool {
+        matches!(self, SetRole::Identification | SetRole::Training)
     }
 }
 
