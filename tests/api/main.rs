@@ -24,6 +24,7 @@ mod flow;
 mod hostile;
 mod iso9283;
 mod jobs;
+mod numbers;
 mod plans;
 mod predict;
 mod record;
