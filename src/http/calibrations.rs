@@ -6,7 +6,7 @@
 //! selection, sessions, the runner, progress, model versions) is
 //! [`crate::service::calibrations`].
 
-use super::input::{check_payload, int, page_body, present, present_int, present_ints, PageQuery};
+use super::input::{check_payload, int, page_body, present, present_ids, present_int, PageQuery};
 use super::robots::robot_list_page;
 use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState};
 use crate::db::{CalibrationRow, JobStatus, JobSummary};
@@ -36,14 +36,14 @@ pub struct StartCalibration {
     /// Sets that identify the model (default: every set with role identification).
     #[serde(
         default,
-        deserialize_with = "present_ints",
+        deserialize_with = "present_ids",
         skip_serializing_if = "Option::is_none"
     )]
     pub identification_set_ids: Option<Vec<i64>>,
     /// Sets that validate it (default: every set with role validation).
     #[serde(
         default,
-        deserialize_with = "present_ints",
+        deserialize_with = "present_ids",
         skip_serializing_if = "Option::is_none"
     )]
     pub validation_set_ids: Option<Vec<i64>>,
@@ -51,7 +51,7 @@ pub struct StartCalibration {
     /// training; none: the compensators train on the identification sets).
     #[serde(
         default,
-        deserialize_with = "present_ints",
+        deserialize_with = "present_ids",
         skip_serializing_if = "Option::is_none"
     )]
     pub training_set_ids: Option<Vec<i64>>,

@@ -6,7 +6,7 @@
 //! `POST /v1/robots/{id}/reregister` refits a version's measurement frame and
 //! tool on a set and stores the result as a new version.
 
-use super::input::{page_body, PageQuery};
+use super::input::{id, ids, page_body, present_id, PageQuery};
 use super::robots::robot_list_page;
 use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState};
 use crate::db::CheckRow;
@@ -23,8 +23,9 @@ use serde_json::Value;
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CheckRequest {
+    #[serde(deserialize_with = "id")]
     pub set_id: i64,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "present_id")]
     pub version: Option<i64>,
     #[serde(default)]
     pub temperature_c: Option<f64>,
@@ -66,11 +67,6 @@ pub async fn create(
     ApiPath(robot_id): ApiPath<i64>,
     ApiJson(req): ApiJson<CheckRequest>,
 ) -> Result<Response, ApiError> {
-    if req.set_id < 1 || req.version.is_some_and(|v| v < 1) {
-        return Err(ApiError::BadRequest(
-            "`set_id` and `version` are positive integers".into(),
-        ));
-    }
     if req
         .temperature_c
         .is_some_and(|t| !(-100.0..=200.0).contains(&t))
@@ -131,7 +127,9 @@ pub async fn status(
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CompareRequest {
+    #[serde(deserialize_with = "id")]
     pub set_id: i64,
+    #[serde(deserialize_with = "ids")]
     pub versions: Vec<i64>,
 }
 

@@ -32,13 +32,18 @@ pub fn from_json_object<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, ApiError
             },
         );
     }
-    serde_json::from_slice::<T>(bytes).map_err(|e| {
-        if e.is_data() {
+    // The path names the field at fault (`versions[1]: …`).
+    let mut de = serde_json::Deserializer::from_slice(bytes);
+    let value = serde_path_to_error::deserialize::<_, T>(&mut de).map_err(|e| {
+        if e.inner().is_data() {
             ApiError::invalid(format!("invalid request body: {e}"))
         } else {
-            ApiError::BadRequest(format!("malformed JSON: {e}"))
+            ApiError::BadRequest(format!("malformed JSON: {}", e.inner()))
         }
-    })
+    })?;
+    de.end()
+        .map_err(|e| ApiError::BadRequest(format!("malformed JSON: {e}")))?;
+    Ok(value)
 }
 
 /// A record that must be a JSON object (not an array of its fields).
@@ -118,11 +123,14 @@ impl<'de, T: TryFrom<i128>> Deserialize<'de> for Int<T> {
                 Self::make(v.into())
             }
             fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<Int<T>, E> {
-                // |v| < 2^100 converts exactly; larger is out of every range here.
-                if v.is_finite() && v.fract() == 0.0 && v.abs() < 1e30 {
+                // |v| < 1e30 < 2^100 converts exactly; larger is out of every
+                // range here.
+                if !v.is_finite() || v.fract() != 0.0 {
+                    Err(E::custom(format!("{v} is not an integer")))
+                } else if v.abs() < 1e30 {
                     Self::make(v as i128)
                 } else {
-                    Err(E::custom(format!("{v} is not an integer in range")))
+                    Err(E::custom(format!("integer {v:e} is out of range")))
                 }
             }
         }
@@ -162,6 +170,49 @@ where
             .map(|i| i.0)
             .collect(),
     ))
+}
+
+/// An id or a version number: a positive integer as JSON Schema counts them
+/// (`73` and `73.0` alike, see [`Int`]), 1 to `i64::MAX`; `73.5`, `0`, `-3`
+/// and numbers beyond `i64` are refused.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Id(pub i64);
+
+impl<'de> Deserialize<'de> for Id {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let Int(v) = Int::<i64>::deserialize(d)?;
+        if v < 1 {
+            return Err(serde::de::Error::custom(format!(
+                "ids and version numbers are positive integers (1 or more), got {v}"
+            )));
+        }
+        Ok(Id(v))
+    }
+}
+
+/// `deserialize_with` for an id or version number field (see [`Id`]).
+pub fn id<'de, D: Deserializer<'de>>(d: D) -> Result<i64, D::Error> {
+    Id::deserialize(d).map(|i| i.0)
+}
+
+/// `deserialize_with` (with `#[serde(default)]`) for an optional id or
+/// version number that may be left out but not be `null`.
+pub fn present_id<'de, D: Deserializer<'de>>(d: D) -> Result<Option<i64>, D::Error> {
+    id(d).map(Some)
+}
+
+/// `deserialize_with` for a list of ids or version numbers.
+pub fn ids<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<i64>, D::Error> {
+    Ok(Vec::<Id>::deserialize(d)?
+        .into_iter()
+        .map(|i| i.0)
+        .collect())
+}
+
+/// `deserialize_with` (with `#[serde(default)]`) for an optional list of ids
+/// that may be left out but not be `null`.
+pub fn present_ids<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Vec<i64>>, D::Error> {
+    ids(d).map(Some)
 }
 
 /// Whitespace as `openapi.yaml` counts it for names: a name needs one

@@ -5,6 +5,7 @@
 //! when `language` is given, as a program visiting them with a wait at each.
 //! The same as `robocal plan`.
 
+use super::input::present_int;
 use super::programs::FileIn;
 use super::{ApiError, ApiJson, ApiPath, AppState};
 use crate::plan::{
@@ -47,12 +48,15 @@ pub struct TrackerIn {
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PlanRequest {
+    #[serde(default, deserialize_with = "present_int")]
     pub poses: Option<usize>,
+    #[serde(default, deserialize_with = "present_int")]
     pub candidates: Option<usize>,
     pub workspace: Option<BoxIn>,
     pub tracker: Option<TrackerIn>,
     pub noise_mm: Option<f64>,
     pub payload_kg: Option<f64>,
+    #[serde(default, deserialize_with = "present_int")]
     pub seed: Option<u64>,
     /// krl, rapid, fanuc or urscript: also return the plan as a program.
     pub language: Option<String>,

@@ -25,6 +25,7 @@ mod hostile;
 mod iso9283;
 mod jobs;
 mod migrations;
+mod numbers;
 mod plans;
 mod predict;
 mod record;

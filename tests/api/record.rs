@@ -231,6 +231,20 @@ async fn checks_score_the_active_version_and_give_the_status() {
     assert_eq!(scored["method"], "skcm");
     assert_eq!(scored["result"]["position"], ok["result"]["position"]);
     assert_eq!(scored["result"]["status"], "ok");
+    // Ids given as integral floats (as JSON Schema allows) score the same.
+    let set_f = check_set["id"].as_i64().unwrap() as f64;
+    let r = t
+        .post_json(
+            "/v1/robots/{id}/compare",
+            &[&rid],
+            json!({ "set_id": set_f, "versions": [1.0] }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    assert_eq!(
+        r.json()["versions"][0]["result"]["position"],
+        ok["result"]["position"]
+    );
     let r = t
         .post_json(
             "/v1/robots/{id}/compare",

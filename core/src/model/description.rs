@@ -14,7 +14,7 @@
 
 use super::bounds::{
     check, check3, ANGLE_DEG, COMPLIANCE_RAD_PER_NM, GRAVITY_MPS2, LENGTH_MM, LIMIT_DEG,
-    LOOP_LENGTH_MM, MASS_KG, MASS_OFFSET_KG,
+    LOOP_LENGTH_MM, MASS_KG, MASS_OFFSET_KG, POINT_MM, TOOL_FRAME_POINT_MM,
 };
 use super::joint_maps::JointMapsDescription;
 use super::pose::{rpy_matrix, Pose};
@@ -231,6 +231,12 @@ impl ModelDescription {
                 format!("a robot needs 2 to 7 revolute joints, got {n}"),
             ));
         }
+        // Points are bounded as given; a standard-DH model's are re-expressed
+        // in the modified frames below, within the modified bound.
+        let point_bound = match self.convention {
+            DhConvention::Standard => &LENGTH_MM,
+            DhConvention::Modified => &POINT_MM,
+        };
         let mut links = Vec::with_capacity(n);
         for (i, j) in self.joints.iter().enumerate() {
             let f = |name: &str| format!("joints[{i}].{name}");
@@ -272,7 +278,7 @@ impl ModelDescription {
             link.sign = j.sign;
             link.zero = check(&f("zero_deg"), j.zero_deg, &ANGLE_DEG)?.to_radians();
             link.mass = check(&f("mass_kg"), j.mass_kg, &MASS_KG)?;
-            link.com = Vector3::from(check3(&f("com_mm"), j.com_mm, &LENGTH_MM)?) * MM;
+            link.com = Vector3::from(check3(&f("com_mm"), j.com_mm, point_bound)?) * MM;
             link.compliance = check(
                 &f("compliance_rad_per_nm"),
                 j.compliance_rad_per_nm,
@@ -293,7 +299,7 @@ impl ModelDescription {
             links.push((link, j.parallel, j.beta_deg != 0.0));
         }
 
-        let tool_p = Vector3::from(check3("tool.xyz_mm", self.tool.xyz_mm, &LENGTH_MM)?) * MM;
+        let tool_p = Vector3::from(check3("tool.xyz_mm", self.tool.xyz_mm, point_bound)?) * MM;
         let tool_rpy = Vector3::from(check3("tool.rpy_deg", self.tool.rpy_deg, &ANGLE_DEG)?)
             .map(f64::to_radians);
         let mut tool = Tool {
@@ -407,7 +413,11 @@ impl ModelDescription {
             self.payload.mass_offset_kg,
             &MASS_OFFSET_KG,
         )?;
-        let com = Vector3::from(check3("payload.com_mm", self.payload.com_mm, &LENGTH_MM)?) * MM;
+        let com_bound = match self.payload.com_frame {
+            PayloadFrame::Flange => &LENGTH_MM,
+            PayloadFrame::Tool => &TOOL_FRAME_POINT_MM,
+        };
+        let com = Vector3::from(check3("payload.com_mm", self.payload.com_mm, com_bound)?) * MM;
         let payload = Payload {
             mass: payload_mass,
             // Kept in the tool frame inside (`Payload::com`).
