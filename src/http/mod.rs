@@ -16,7 +16,7 @@
 
 use axum::extract::{DefaultBodyLimit, Request, State};
 use axum::handler::Handler;
-use axum::http::{header, Method};
+use axum::http::{header, HeaderValue, Method};
 use axum::middleware;
 use axum::response::{IntoResponse, Response};
 use axum::routing::{on, MethodFilter, MethodRouter};
@@ -182,6 +182,7 @@ pub fn app(state: AppState) -> Router {
         .method_not_allowed_fallback(method_not_allowed)
         .layer(DefaultBodyLimit::max(state.limits().body_bytes))
         .layer(CatchPanicLayer::custom(panic_response))
+        .layer(middleware::map_response(safe_to_open))
         .layer(
             // Method, path, status and latency; never headers (they may hold keys).
             TraceLayer::new_for_http()
@@ -191,6 +192,28 @@ pub fn app(state: AppState) -> Router {
                 .on_failure(DefaultOnFailure::new().level(Level::WARN)),
         )
         .with_state(state)
+}
+
+/// The policy of every answer that does not state its own (the console's
+/// pages do): a document may style itself and show inline images, nothing
+/// else — no script, no fetch, no form, no frame around it. The calibration
+/// report is such a document; downloads and JSON need even less.
+const DOCUMENT_CSP: &str = "default-src 'none'; style-src 'unsafe-inline'; img-src data:; \
+     base-uri 'none'; form-action 'none'; frame-ancestors 'none'";
+
+/// Headers that keep every answer safe to open in a browser: no MIME
+/// sniffing, no framing, and [`DOCUMENT_CSP`] unless the handler set a policy.
+async fn safe_to_open(mut res: Response) -> Response {
+    let h = res.headers_mut();
+    h.insert(
+        header::X_CONTENT_TYPE_OPTIONS,
+        HeaderValue::from_static("nosniff"),
+    );
+    h.entry(header::X_FRAME_OPTIONS)
+        .or_insert(HeaderValue::from_static("DENY"));
+    h.entry(header::CONTENT_SECURITY_POLICY)
+        .or_insert(HeaderValue::from_static(DOCUMENT_CSP));
+    res
 }
 
 async fn healthz(State(state): State<AppState>) -> Result<Response, ApiError> {

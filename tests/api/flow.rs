@@ -117,6 +117,11 @@ async fn quickstart_flow_calibrate_version_and_solve() {
         .await;
     assert_eq!(r.status, StatusCode::OK);
     assert!(r.content_type.starts_with("text/html"));
+    assert_safe_to_open(&r, "report");
+    // The report is styled inline and runs no script.
+    let csp = r.headers["content-security-policy"].to_str().unwrap();
+    assert!(csp.contains("default-src 'none'") && csp.contains("style-src 'unsafe-inline'"));
+    assert!(!csp.contains("script-src"), "{csp}");
     let html = r.text();
     assert!(html.contains("<svg") && html.contains("cell-3"));
     // The report's sections over HTTP, self-contained: histograms, per-axis
@@ -223,6 +228,7 @@ async fn quickstart_flow_calibrate_version_and_solve() {
             .await;
         assert_eq!(r.status, StatusCode::OK, "{format}: {}", r.text());
         assert_eq!(r.content_type, ctype);
+        assert_safe_to_open(&r, format);
         let source = robocal::export::ExportSource {
             robot: &file.robot,
             method: "skcm",
@@ -388,4 +394,13 @@ async fn quickstart_flow_calibrate_version_and_solve() {
     let left = t.db.row_counts().await.unwrap();
     assert_eq!(left.model_versions, 0);
     assert_eq!(left.activations, 0);
+}
+
+/// An answer a browser may open: no MIME sniffing, never framed, and a
+/// content security policy.
+fn assert_safe_to_open(r: &Resp, what: &str) {
+    assert_eq!(r.headers["x-content-type-options"], "nosniff", "{what}");
+    assert_eq!(r.headers["x-frame-options"], "DENY", "{what}");
+    let csp = r.headers["content-security-policy"].to_str().unwrap();
+    assert!(csp.contains("frame-ancestors 'none'"), "{what}: {csp}");
 }

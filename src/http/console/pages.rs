@@ -182,9 +182,9 @@ pub fn robot(v: &RobotView) -> Markup {
                     label.wide { "CSV file " input type="file" name="file" accept=".csv,text/csv"; }
                     label { "Role "
                         select name="role" {
-                            option value="identification" { "identification" }
-                            option value="validation" { "validation" }
-                            option value="training" { "training" }
+                            @for role in SetRole::ALL {
+                                option value=(role.as_str()) { (role.as_str()) }
+                            }
                         }
                     }
                     label { "Name " input name="name"; }
