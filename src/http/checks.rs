@@ -159,8 +159,9 @@ pub async fn compare(
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ReregisterRequest {
+    #[serde(deserialize_with = "id")]
     pub set_id: i64,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "present_id")]
     pub version: Option<i64>,
     #[serde(default)]
     pub activate: bool,
@@ -173,11 +174,6 @@ pub async fn reregister(
     ApiPath(robot_id): ApiPath<i64>,
     ApiJson(req): ApiJson<ReregisterRequest>,
 ) -> Result<Response, ApiError> {
-    if req.set_id < 1 || req.version.is_some_and(|v| v < 1) {
-        return Err(ApiError::BadRequest(
-            "`set_id` and `version` are positive integers".into(),
-        ));
-    }
     let row = service::reregister::create(
         &state,
         service::reregister::ReregisterCommand {

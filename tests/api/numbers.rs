@@ -45,6 +45,25 @@ async fn ids_given_as_integral_floats_are_read_as_integers() {
         .await;
     assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
     assert!(r.detail().contains("version 1"), "{}", r.detail());
+    // So does a re-registration: version 5.0 is version 5, which the robot lacks.
+    let r = t
+        .post_json(
+            "/v1/robots/{id}/reregister",
+            &[&rid],
+            json!({ "set_id": set_id, "version": 5.0 }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
+    assert!(r.detail().contains("version 5"), "{}", r.detail());
+    let r = t
+        .post_json(
+            "/v1/robots/{id}/reregister",
+            &[&rid],
+            json!({ "set_id": 2.5 }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+    assert!(r.detail().contains("set_id"), "{}", r.detail());
 }
 
 #[tokio::test]
