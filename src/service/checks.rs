@@ -60,14 +60,7 @@ pub async fn put_thresholds(
 pub async fn create(state: &AppState, cmd: CheckCommand) -> Result<CheckRow, ServiceError> {
     let robot_id = cmd.robot_id;
     let t = thresholds(state, robot_id).await?;
-    let version = match cmd.version {
-        Some(v) => v,
-        None => state.db().active_version(robot_id).await?.map(|v| v.version).ok_or_else(|| {
-            ServiceError::Conflict(format!(
-                "robot {robot_id} has no active model version: name one with `version`, or calibrate first"
-            ))
-        })?,
-    };
+    let version = version_or_active(state, robot_id, cmd.version).await?;
     // A version or set the robot lacks conflicts with its state (the URL
     // names an existing robot), as in a solve.
     let (_, text) = versions::with_model(state, robot_id, version)
@@ -118,7 +111,24 @@ pub async fn create(state: &AppState, cmd: CheckCommand) -> Result<CheckRow, Ser
 
 /// A set or version the robot lacks, named in a body: a conflict with the
 /// robot's state (the URL names an existing robot), as in a solve.
-fn conflict(e: ServiceError) -> ServiceError {
+/// `version`, else the robot's active version (a conflict when it has none).
+pub(super) async fn version_or_active(
+    state: &AppState,
+    robot_id: i64,
+    version: Option<i64>,
+) -> Result<i64, ServiceError> {
+    match version {
+        Some(v) => Ok(v),
+        None => state.db().active_version(robot_id).await?.map(|v| v.version).ok_or_else(|| {
+            ServiceError::Conflict(format!(
+                "robot {robot_id} has no active model version: name one with `version`, or calibrate first"
+            ))
+        }),
+    }
+}
+
+/// A version or set the robot lacks, as a conflict with its state.
+pub(super) fn conflict(e: ServiceError) -> ServiceError {
     match e {
         ServiceError::NotFound(m) => ServiceError::Conflict(m),
         other => other,

@@ -11,6 +11,7 @@
 //! `reregistered`: the parent version, the set, what was refitted and the
 //! position errors on the set before and after.
 
+use super::checks::{self, conflict};
 use super::{versions, AppState, ServiceError};
 use crate::compensate::CalibratedModelFile;
 use crate::db::{NewVersion, VersionRow};
@@ -34,14 +35,7 @@ pub struct ReregisterCommand {
 pub async fn create(state: &AppState, cmd: ReregisterCommand) -> Result<VersionRow, ServiceError> {
     let robot_id = cmd.robot_id;
     super::robots::get(state, robot_id).await?;
-    let version = match cmd.version {
-        Some(v) => v,
-        None => state.db().active_version(robot_id).await?.map(|v| v.version).ok_or_else(|| {
-            ServiceError::Conflict(format!(
-                "robot {robot_id} has no active model version: name one with `version`, or calibrate first"
-            ))
-        })?,
-    };
+    let version = checks::version_or_active(state, robot_id, cmd.version).await?;
     let (parent, text) = versions::with_model(state, robot_id, version)
         .await
         .map_err(conflict)?;
@@ -101,15 +95,6 @@ pub async fn create(state: &AppState, cmd: ReregisterCommand) -> Result<VersionR
         "re-registered"
     );
     Ok(row)
-}
-
-/// A set or version the robot lacks, named in the body: a conflict with the
-/// robot's state, as in a check.
-fn conflict(e: ServiceError) -> ServiceError {
-    match e {
-        ServiceError::NotFound(m) => ServiceError::Conflict(m),
-        other => other,
-    }
 }
 
 /// The core's refusal (too few poses, frames the poses cannot determine, rows

@@ -446,25 +446,9 @@ fn identifiable_by_orientation(
     kept: &[ParamId],
     opts: &CalibrationOptions,
 ) -> Vec<String> {
-    let position_only: Vec<Measurement> = ident
-        .iter()
-        .map(|m| Measurement {
-            orientation: None,
-            ..m.clone()
-        })
-        .collect();
-    let (j, rows) = stacked_factor(nominal, candidates, &position_only, Some(chains));
-    let without = identifiability::analyse_factor(
-        nominal,
-        &j,
-        rows,
-        candidates,
-        &fixed_params(nominal),
-        ident.len(),
-        &opts.identifiability,
-    );
+    let without = kept_with_orientation(nominal, ident, None, chains, candidates, opts);
     kept.iter()
-        .filter(|id| !without.kept.contains(id))
+        .filter(|id| !without.contains(id))
         .map(|id| id.name())
         .collect()
 }
@@ -481,15 +465,39 @@ fn unseen_without_orientation(
     kept: &[ParamId],
     opts: &CalibrationOptions,
 ) -> Vec<String> {
-    let six_d: Vec<Measurement> = ident
+    let with = kept_with_orientation(
+        nominal,
+        ident,
+        Some(Matrix3::identity()),
+        chains,
+        candidates,
+        opts,
+    );
+    with.iter()
+        .filter(|id| !kept.contains(id))
+        .map(|id| id.name())
+        .collect()
+}
+
+/// The parameters the identifiability analysis keeps for the poses of
+/// `ident`, every pose's orientation replaced by `orientation`.
+fn kept_with_orientation(
+    nominal: &RobotModel,
+    ident: &[Measurement],
+    orientation: Option<Matrix3<f64>>,
+    chains: &[Chain],
+    candidates: &[ParamId],
+    opts: &CalibrationOptions,
+) -> Vec<ParamId> {
+    let poses: Vec<Measurement> = ident
         .iter()
         .map(|m| Measurement {
-            orientation: Some(Matrix3::identity()),
+            orientation,
             ..m.clone()
         })
         .collect();
-    let (j, rows) = stacked_factor(nominal, candidates, &six_d, Some(chains));
-    let with = identifiability::analyse_factor(
+    let (j, rows) = stacked_factor(nominal, candidates, &poses, Some(chains));
+    identifiability::analyse_factor(
         nominal,
         &j,
         rows,
@@ -497,12 +505,8 @@ fn unseen_without_orientation(
         &fixed_params(nominal),
         ident.len(),
         &opts.identifiability,
-    );
-    with.kept
-        .iter()
-        .filter(|id| !kept.contains(id))
-        .map(|id| id.name())
-        .collect()
+    )
+    .kept
 }
 
 /// Runs every method of `to_run` in order over 10–100 % of the bar, each by
