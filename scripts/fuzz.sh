@@ -24,12 +24,14 @@ if ! cargo fuzz --version 2>/dev/null | grep -q "$VERSION"; then
 fi
 cd fuzz
 cargo fuzz build --sanitizer none
-status=0
-for target in measurement_csv targets_csv model_json solve_request \
-    program_krl program_rapid program_fanuc program_urscript plan_join; do
+# One libFuzzer process per target, as many at once as there are cores
+# (`FUZZ_JOBS`, default `nproc`): each is single-threaded, so the targets
+# share the wall time instead of queueing.
+JOBS=${FUZZ_JOBS:-$(nproc)}
+fuzz_one() {
+    local target=$1 corpus log code=0 runs new
     corpus=$(mktemp -d)
     log=$(mktemp)
-    code=0
     cargo fuzz run --sanitizer none "$target" "$corpus" "seeds/$target" -- \
         -max_total_time="$SECS" -seed=1 -timeout=10 -rss_limit_mb=2048 \
         -max_len=8192 -print_final_stats=1 >"$log" 2>&1 || code=$?
@@ -38,10 +40,24 @@ for target in measurement_csv targets_csv model_json solve_request \
     if [ "$code" -ne 0 ]; then
         tail -40 "$log" >&2
         echo "fuzz: $target FAILED after ${runs:-?} runs; the input is in fuzz/artifacts/$target/" >&2
-        status=1
     else
         echo "fuzz: $target: ${runs:-?} inputs in ${SECS} s, ${new:-?} new coverage units, no failure"
     fi
     rm -rf "$corpus" "$log"
+    return "$code"
+}
+status=0
+running=()
+for target in measurement_csv targets_csv model_json solve_request \
+    program_krl program_rapid program_fanuc program_urscript plan_join; do
+    if [ "${#running[@]}" -ge "$JOBS" ]; then
+        wait "${running[0]}" || status=1
+        running=("${running[@]:1}")
+    fi
+    fuzz_one "$target" &
+    running+=("$!")
+done
+for pid in "${running[@]}"; do
+    wait "$pid" || status=1
 done
 exit $status
