@@ -19,12 +19,17 @@
 //! cargo run --release --bin robocal-load -- [--connections 4] [--single 20000] [--batches 50]
 //! ```
 
+// Shared with robocal-soak; each binary uses part of it.
+#[allow(dead_code)]
+#[path = "shared/client.rs"]
+mod client;
+
+use crate::client::Conn;
 use anyhow::{bail, Context};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal::compensate::CalibratedModelFile;
 use robocal::db::Db;
-use robocal::http::client::Conn;
 use robocal::http::{app, AppState, ServiceConfig};
 use robocal::measure::csv;
 use robocal::model::orientation::{rotation_to, OrientationConvention};

@@ -30,7 +30,6 @@ pub mod calibrations;
 pub mod cell;
 pub mod cell_fit;
 pub mod checks;
-pub mod client;
 pub mod console;
 pub mod error;
 pub mod input;

@@ -36,14 +36,18 @@
 //!     [--database-url postgres://… --replicas 2 --job-lease 3]
 //! ```
 
+// Shared with robocal-load; each binary uses part of it.
+#[allow(dead_code)]
+#[path = "../shared/client.rs"]
+mod client;
 mod replicas;
 mod sqlite;
 mod verify;
 
+use crate::client::Conn;
 use anyhow::{bail, ensure, Context};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use robocal::http::client::Conn;
 use robocal::measure::{csv, MeasuredPose};
 use serde_json::{json, Value};
 use std::collections::BTreeMap;

@@ -5,11 +5,11 @@
 //! replica is killed at once and restarted, and the checks run once no job is
 //! queued or running: through the first replica, then again through the last.
 
+use crate::client::Conn;
 use crate::{start_server, verify, Args, Load, Server};
 use anyhow::{ensure, Context};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use robocal::http::client::Conn;
 use std::net::SocketAddr;
 use std::time::{Duration, Instant};
 

@@ -1,11 +1,11 @@
 //! The SQLite mode: one server on a temporary file; at each kill the clients
 //! park, the file is checked, the server restarts and every ledger is checked.
 
+use crate::client::Conn;
 use crate::{start_server, verify, Args, Load, Server};
 use anyhow::{bail, ensure, Context};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use robocal::http::client::Conn;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 

@@ -1,10 +1,10 @@
 //! The checks after a crash: every client's ledger against what a restarted
 //! server shows, and no half-written row anywhere.
 
+use crate::client::Conn;
 use crate::{InFlight, Ledger};
 use anyhow::{bail, ensure, Context};
 use robocal::compensate::CalibratedModelFile;
-use robocal::http::client::Conn;
 use robocal::measure::MeasuredPose;
 use serde_json::Value;
 use std::collections::{BTreeMap, BTreeSet};

@@ -1,6 +1,7 @@
-//! A minimal blocking HTTP/1.1 client with keep-alive, for the loopback tools
-//! (`robocal-load`, `robocal-soak`): requests are written in one piece, the
-//! answer is read by `Content-Length` or chunked encoding. Not a general client.
+//! A minimal blocking HTTP/1.1 client with keep-alive, shared by the loopback
+//! binaries `robocal-load` and `robocal-soak` (each includes this file):
+//! requests are written in one piece, the answer is read by `Content-Length`
+//! or chunked encoding. Not a general client, and not part of the service.
 
 use anyhow::{bail, Context};
 use serde_json::Value;
