@@ -23,6 +23,8 @@
 //!   and below the same compensator's without its orientation part;
 //! - the production-tool prediction equals the measurement tool's pose moved
 //!   rigidly to the tip (the lever of the orientation correction);
+//! - the solve of those tool tips (tolerance 1e-9 m, 1e-9 rad) inverts the
+//!   prediction to 1e-9 m (1e-6 mm);
 //! - the model file carries `compensator_orientation` and predicts the same
 //!   after a round trip (to 1e-12: the frames are written in mm / deg).
 
@@ -33,8 +35,10 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 use robocal_core::cell::predict::{Forward, PredictFrame};
+use robocal_core::cell::{CellOptions, CellSolver, WorkObject};
 use robocal_core::compensate::{parse_compensated, CalibratedModelFile, CompensatedModel};
 use robocal_core::identify::{calibrate_with_training, CalibrationReport, Method};
+use robocal_core::ik::IkSettings;
 use robocal_core::measure::Measurement;
 use robocal_core::model::{preset, Pose, RobotModel};
 use robocal_core::sim::{perturb_geometry, tracker_frame, ErrorMagnitudes, TrueRobot};
@@ -183,6 +187,30 @@ fn a_compensator_learns_the_orientation_and_the_tool_tip_benefits() {
         .as_ref()
         .unwrap()
         .contains("orientation too"));
+
+    // Solve inverts predict with the orientation part, at the tool tip.
+    let tool = robocal_core::kinematics::chain::tool_pose(&gp_model.calibrated)
+        .compose(&Pose::from_translation(tip));
+    let forward = Forward::new(&gp_model, Some(&tool), None);
+    let settings = IkSettings {
+        position_tolerance_m: 1e-9,
+        orientation_tolerance_rad: 1e-9,
+        ..IkSettings::default()
+    };
+    let solver = CellSolver::new(&gp_model, &tool, settings);
+    let base = PredictFrame::Frame(robocal_core::ik::TargetFrame::Base);
+    for m in va.iter().take(5) {
+        let target = forward.pose(&m.q, &base).unwrap();
+        let s = solver.solve(&WorkObject::base(), &target, &CellOptions::default());
+        assert!(s.solution.converged, "{:?}", s.solution);
+        let back = forward.pose(&s.solution.q, &base).unwrap();
+        assert!(
+            (back.p - target.p).norm() < 1e-9,
+            "{}",
+            (back.p - target.p).norm()
+        );
+        assert!((back.r - target.r).norm() < 1e-9);
+    }
 
     // The model file carries the orientation part and predicts the same.
     let text = CalibratedModelFile::from_compensated(&gp_model, "ur10", "km-gp").to_json();
