@@ -222,3 +222,37 @@ fn a_compensator_learns_the_orientation_and_the_tool_tip_benefits() {
         assert!((a.p - b.p).norm() < 1e-12 && (a.r - b.r).norm() < 1e-12);
     }
 }
+
+/// `auto` end to end on the same 6-D truth: it scores position and
+/// orientation, and its choice is no worse than KM on the held-out poses in
+/// either (the rule that a method gaining position but losing orientation is
+/// not chosen is unit-tested in `identify/methods/auto.rs`).
+#[test]
+fn auto_on_6d_data_keeps_or_gains_orientation() {
+    let mut rng = ChaCha8Rng::seed_from_u64(3233);
+    let (nominal, truth) = truth(&mut rng);
+    let id = measure(&truth, &nominal, 120, &mut rng);
+    let tr = measure(&truth, &nominal, 200, &mut rng);
+    let va = measure(&truth, &nominal, 100, &mut rng);
+    let mut opts = common::opts(&[Method::Km, Method::Auto]);
+    opts.compensator.auto_candidates = vec![Method::KmGp, Method::KmMaps];
+    let r = calibrate_with_training(&nominal, &id, &tr, &va, &opts, &|_| true).unwrap();
+    let auto = &r.methods[&Method::Auto];
+    let chosen = auto.auto.as_ref().unwrap().chosen;
+    let (km, au) = (
+        r.methods[&Method::Km].validation.clone().unwrap(),
+        auto.validation.clone().unwrap(),
+    );
+    let (km_o, au_o) = (km.orientation.unwrap(), au.orientation.unwrap());
+    eprintln!(
+        "auto chose {}: validation position mean {:.4} mm (km {:.4}), orientation mean {:.5}° (km {:.5}°)",
+        chosen.name(),
+        au.stats.mean_mm,
+        km.stats.mean_mm,
+        au_o.mean_deg,
+        km_o.mean_deg
+    );
+    assert_ne!(chosen, Method::Km, "the unmodelled effects are learnable");
+    assert!(au.stats.mean_mm < km.stats.mean_mm);
+    assert!(au_o.mean_deg <= km_o.mean_deg, "{au_o:?} vs {km_o:?}");
+}
