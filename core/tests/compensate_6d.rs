@@ -169,10 +169,7 @@ fn a_compensator_learns_the_orientation_and_the_tool_tip_benefits() {
          tool tip (250 mm, 30°) vs truth: km {tip_km:.4} mm, km-gp {tip_gp:.4} mm, km-gp without its orientation part {tip_gp_position:.4} mm",
         km_o.mean_deg, km_o.max_deg, gp_o.mean_deg, gp_o.max_deg, km.stats.mean_mm, gp.stats.mean_mm
     );
-    eprintln!(
-        "orientation part: {}",
-        r.methods[&Method::KmGp].stored_orientation.is_some()
-    );
+    assert!(r.methods[&Method::KmGp].stored_orientation.is_some());
     assert!(gp_o.mean_deg <= 0.6 * km_o.mean_deg, "{gp_o:?} vs {km_o:?}");
     assert!(
         tip_gp <= 1.5 * gp.stats.mean_mm,
