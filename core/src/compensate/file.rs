@@ -312,6 +312,47 @@ mod tests {
         assert!(old.compensator.is_none());
     }
 
+    /// An orientation part round-trips, turns the prediction, and is refused
+    /// without a position part or with a broken network.
+    #[test]
+    fn orientation_part_round_trips_and_is_checked() {
+        let m = mlp_compensated();
+        let net = m.compensator.as_ref().unwrap().stored().unwrap();
+        let mut file = CalibratedModelFile::from_compensated(&m, "ys100", "skcm-nn");
+        assert!(file.compensator_orientation.is_none());
+        file.compensator_orientation = Some(StoredOrientation {
+            point_m: [0.0, 0.0, 0.1],
+            network: net,
+        });
+        let text = file.to_json();
+        let back = parse_compensated(&text).unwrap();
+        let q = [0.1, 1.2, -0.3, 0.4, 0.5, -0.6];
+        let (a, b) = (m.predict(&q).unwrap(), back.predict(&q).unwrap());
+        assert!(
+            (a.r - b.r).norm() > 1e-6,
+            "the orientation part turns the pose"
+        );
+        let again = CalibratedModelFile::from_compensated(&back, "ys100", "skcm-nn");
+        assert_eq!(again.compensator_orientation, file.compensator_orientation);
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        v.as_object_mut().unwrap().remove("compensator");
+        let e = parse_compensated(&v.to_string()).unwrap_err().to_string();
+        assert!(
+            e.contains("compensator_orientation without a compensator"),
+            "{e}"
+        );
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        v["compensator_orientation"]["network"]["weights"]
+            .as_array_mut()
+            .unwrap()
+            .pop();
+        let e = parse_compensated(&v.to_string()).unwrap_err().to_string();
+        assert!(
+            e.contains("compensator_orientation") && e.contains("weights"),
+            "{e}"
+        );
+    }
+
     #[test]
     fn unknown_or_broken_compensators_fail_loudly() {
         let m = mlp_compensated();
