@@ -88,6 +88,15 @@ async fn pages_render_the_store_and_escape_user_text() {
         assert!(html.contains(part), "robot page lacks {part}");
     }
     assert!(!html.contains("<script>alert(1)"));
+    // Every orientation convention of a measurement upload is offered.
+    for c in robocal::measure::convention::MeasuredOrientation::ALL {
+        assert!(
+            html.contains(&format!("<option value=\"{}\"", c.name())),
+            "{}",
+            c.name()
+        );
+    }
+    assert!(html.contains("name=\"orientation\""));
     // Every calibration method is offered.
     for m in robocal::identify::Method::ALL {
         assert!(

@@ -28,13 +28,22 @@
 //! values are SI (inputs rad, kg, N·m; outputs m) as the network computes them.
 //! A file with an unknown `kind` is rejected.
 //!
+//! `compensator_orientation` (optional, beside `compensator`; files without it
+//! load as before) is the compensator's orientation part, trained where the
+//! data measured orientations ([`StoredOrientation`](super::StoredOrientation),
+//! `compensate/oriented.rs`): `point_m`, the measured point in the flange
+//! frame [m] the correction turns about, and `network`, a compensator of the
+//! same form whose three outputs are the rotation vector `ω` [rad] in the
+//! registered base frame (`R_measured = exp(ω)·R_predicted`). It fades with
+//! `compensator_support` like the position part.
+//!
 //! `validation` (optional) keeps the validation poses' errors that the
 //! accuracy at a production tool's tip is computed from
 //! (`cell::accuracy::ValidationEvidence`: the measured point's mean and max
 //! error [mm] and, per pose with a measured orientation, the position error
 //! [mm] and `R_measured − R_predicted`).
 
-use super::{CompensateError, CompensatedModel, StoredCompensator, Support};
+use super::{CompensateError, CompensatedModel, StoredCompensator, StoredOrientation, Support};
 use crate::cell::accuracy::ValidationEvidence;
 use crate::model::{ModelDescription, RobotModel};
 use serde::{Deserialize, Serialize};
@@ -73,6 +82,10 @@ pub struct CalibratedModelFile {
     /// compensator then applies everywhere.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub compensator_support: Option<Support>,
+    /// The compensator's orientation part (module docs); absent for a
+    /// compensator of the position only and in files written before it existed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compensator_orientation: Option<StoredOrientation>,
     /// What the calibration's validation poses say about the error at a
     /// production tool's tip (`cell::accuracy`); absent in files without
     /// validation data or written before it existed.
@@ -94,6 +107,7 @@ impl CalibratedModelFile {
             payload_kg: m.payload_kg,
             compensator: m.compensator.as_ref().and_then(|c| c.stored()),
             compensator_support: m.compensator.as_ref().and_then(|c| c.support().cloned()),
+            compensator_orientation: m.compensator.as_ref().and_then(|c| c.stored_orientation()),
             validation: None,
         }
     }
@@ -128,6 +142,15 @@ impl CalibratedModelFile {
                 .map_err(|e| CompensateError::Format(e.to_string()))?,
             _ => {}
         }
+        match (&self.compensator, &self.compensator_orientation) {
+            (None, Some(_)) => {
+                return Err(CompensateError::Format(
+                    "compensator_orientation without a compensator".into(),
+                ))
+            }
+            (Some(c), Some(o)) => o.validate(c.dof()).map_err(CompensateError::Format)?,
+            _ => {}
+        }
         let calibrated = self.model.to_model()?;
         let nominal = self.nominal.to_model()?;
         if calibrated.dof() != nominal.dof() {
@@ -153,10 +176,10 @@ impl CalibratedModelFile {
                         nominal.dof()
                     )))
                 }
-                Some(c) => Some(
-                    c.clone()
-                        .into_arc_supported(self.compensator_support.clone()),
-                ),
+                Some(c) => Some(c.clone().into_arc_oriented(
+                    self.compensator_orientation.clone(),
+                    self.compensator_support.clone(),
+                )),
                 None => None,
             },
             nominal,
@@ -287,6 +310,47 @@ mod tests {
         v1.as_object_mut().unwrap().remove("compensator");
         let old = parse_compensated(&v1.to_string()).unwrap();
         assert!(old.compensator.is_none());
+    }
+
+    /// An orientation part round-trips, turns the prediction, and is refused
+    /// without a position part or with a broken network.
+    #[test]
+    fn orientation_part_round_trips_and_is_checked() {
+        let m = mlp_compensated();
+        let net = m.compensator.as_ref().unwrap().stored().unwrap();
+        let mut file = CalibratedModelFile::from_compensated(&m, "ys100", "skcm-nn");
+        assert!(file.compensator_orientation.is_none());
+        file.compensator_orientation = Some(StoredOrientation {
+            point_m: [0.0, 0.0, 0.1],
+            network: net,
+        });
+        let text = file.to_json();
+        let back = parse_compensated(&text).unwrap();
+        let q = [0.1, 1.2, -0.3, 0.4, 0.5, -0.6];
+        let (a, b) = (m.predict(&q).unwrap(), back.predict(&q).unwrap());
+        assert!(
+            (a.r - b.r).norm() > 1e-6,
+            "the orientation part turns the pose"
+        );
+        let again = CalibratedModelFile::from_compensated(&back, "ys100", "skcm-nn");
+        assert_eq!(again.compensator_orientation, file.compensator_orientation);
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        v.as_object_mut().unwrap().remove("compensator");
+        let e = parse_compensated(&v.to_string()).unwrap_err().to_string();
+        assert!(
+            e.contains("compensator_orientation without a compensator"),
+            "{e}"
+        );
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        v["compensator_orientation"]["network"]["weights"]
+            .as_array_mut()
+            .unwrap()
+            .pop();
+        let e = parse_compensated(&v.to_string()).unwrap_err().to_string();
+        assert!(
+            e.contains("compensator_orientation") && e.contains("weights"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -9,7 +9,9 @@
 //!   calibrated model's payload CoM), eqs. 3.7–3.9;
 //! - `P_base(q) = FK_cal(q + c∘τ)` with the residual `NN(q, τ)` [m] of the
 //!   compensator added to the position (base frame); the orientation is the
-//!   geometric part's;
+//!   geometric part's, turned by the compensator's orientation part where it
+//!   has one (trained on measured orientations: a turn `exp(ω)` about the
+//!   measured point, [`oriented`]);
 //! - `P_cell(q) = cell_from_base · P_base(q)`.
 //!
 //! Frames: the *registered base frame* is the calibrated model's base frame;
@@ -34,6 +36,7 @@ mod gp_avx2;
 pub mod gp_predict;
 mod gp_rough;
 pub mod mlp;
+pub mod oriented;
 pub mod rbf;
 pub mod select;
 pub mod support;
@@ -44,6 +47,7 @@ pub use file::{parse_compensated, CalibratedModelFile, PoseDescription, CALIBRAT
 pub use gp::{train_gp, Gp, GpReport, GpSettings, Uncertainty};
 pub use gp_predict::PreparedGp;
 pub use mlp::{Features, Mlp, Normalisation};
+pub use oriented::{OrientationSamples, Oriented, StoredOrientation};
 pub use rbf::{
     train_rbf, train_rbf_with_progress, OutputFrame, Rbf, RbfReport, RbfSettings, RbfTrainError,
 };
@@ -139,6 +143,21 @@ pub trait Compensator: Send + Sync {
     /// ([`Gp`]).
     fn uncertainty(&self, q: &[f64]) -> Option<Uncertainty> {
         let _ = q;
+        None
+    }
+    /// The orientation correction `ω` [rad] at `q` (registered base frame,
+    /// [`oriented`]); `None` for a compensator of the position only.
+    fn rotation_at(&self, q: &[f64], tau: &[f64], payload_kg: f64) -> Option<Vector3<f64>> {
+        let _ = (q, tau, payload_kg);
+        None
+    }
+    /// The point the orientation correction turns about, flange frame [m]
+    /// ([`oriented`]); `None` without an orientation part.
+    fn rotation_point(&self) -> Option<Vector3<f64>> {
+        None
+    }
+    /// The storable orientation part; `None` without one.
+    fn stored_orientation(&self) -> Option<StoredOrientation> {
         None
     }
 }
@@ -348,6 +367,13 @@ impl CompensatedModel {
         out
     }
 
+    /// The compensator's orientation correction applied to a TCP pose whose
+    /// position correction is in it ([`oriented`]; nothing without one).
+    fn rotate(&self, pose: &mut Pose, c: &dyn Compensator, q: &[f64], tau: &[f64], kg: f64) {
+        let d = oriented::point_in_tcp(c, &self.calibrated);
+        oriented::rotate(pose, c, (q, tau, kg), d.as_ref());
+    }
+
     /// Full prediction in the registered base frame.
     pub fn predict_detailed(&self, q: &[f64]) -> Result<Prediction, KinematicsError> {
         self.predict_detailed_at(q, self.payload_kg)
@@ -374,6 +400,7 @@ impl CompensatedModel {
         let mut pose = fk(m, &deflected)?;
         if let Some(c) = &self.compensator {
             pose.p += c.residual_at(q, &tau, payload_kg);
+            self.rotate(&mut pose, c.as_ref(), q, &tau, payload_kg);
         }
         Ok(Prediction {
             pose,
@@ -395,7 +422,8 @@ impl CompensatedModel {
     /// Predicted pose (registered base frame) and its quasi-Newton Jacobian
     /// (6×N, rows `[v; ω]`, base frame): the geometric Jacobian of the
     /// calibrated chain at the deflected joints plus the compensator's
-    /// `∂NN/∂q` on the position rows (when it gives one), neglecting `∂τ/∂q`
+    /// `∂NN/∂q` on the position rows (when it gives one; an orientation
+    /// part's `∂ω/∂q` is neglected like the compensator's lever), neglecting `∂τ/∂q`
     /// (small against the arm's lever arms: relative size `‖c·∂τ/∂q‖` ≈ 1e-3);
     /// joint maps scale column i by `1 + f_i'(q_i)`.
     pub fn predict_base_with_jacobian(
@@ -426,6 +454,7 @@ impl CompensatedModel {
         }
         if let Some(c) = &self.compensator {
             pose.p += c.residual_at(q, &tau, self.payload_kg);
+            self.rotate(&mut pose, c.as_ref(), q, &tau, self.payload_kg);
             if let Some(d) = c.jacobian_q(q, &tau, self.payload_kg) {
                 let mut v = jac.rows_mut(0, 3);
                 v += d;

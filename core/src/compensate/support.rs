@@ -325,6 +325,22 @@ impl Compensator for Faded {
         self.inner.stored()
     }
 
+    fn rotation_at(&self, q: &[f64], tau: &[f64], payload_kg: f64) -> Option<Vector3<f64>> {
+        let w = self.inner.rotation_at(q, tau, payload_kg)?;
+        if self.support.inside(q) {
+            return Some(w);
+        }
+        Some(w * self.support.weight(q, None))
+    }
+
+    fn rotation_point(&self) -> Option<Vector3<f64>> {
+        self.inner.rotation_point()
+    }
+
+    fn stored_orientation(&self) -> Option<super::StoredOrientation> {
+        self.inner.stored_orientation()
+    }
+
     fn uncertainty(&self, q: &[f64]) -> Option<Uncertainty> {
         let u = self.inner.uncertainty(q)?;
         Some(Uncertainty {

@@ -79,8 +79,9 @@ impl SetErrors {
     /// [`SetErrors::of`] through the compensated prediction
     /// `FK(q + c∘τ) + NN(q, τ)` (registered base frame, then the session frame),
     /// τ the gravity torques of `model` at the commanded joints with the pose's
-    /// payload. A compensator corrects the position only: the orientation is
-    /// the geometric model's (with its joint maps and compliance).
+    /// payload. The orientation is the geometric model's (with its joint maps
+    /// and compliance), turned by the compensator's orientation part where it
+    /// has one (`compensate::oriented`).
     pub fn of_compensated(
         model: &RobotModel,
         compensator: Option<&dyn Compensator>,
@@ -191,7 +192,16 @@ pub(crate) fn predict_compensated(
         Some(c) => {
             let ch = crate::kinematics::chain(model, &m.q).ok()?;
             let tau = crate::kinematics::gravity_torques_of(model, &ch, m.payload_mass);
-            Some((p + c.residual_at(&m.q, &tau, m.payload_mass), r))
+            let mut pose =
+                crate::model::Pose::new(r, p + c.residual_at(&m.q, &tau, m.payload_mass));
+            let d = crate::compensate::oriented::point_in_tcp(c, model);
+            crate::compensate::oriented::rotate(
+                &mut pose,
+                c,
+                (&m.q, &tau, m.payload_mass),
+                d.as_ref(),
+            );
+            Some((pose.p, pose.r))
         }
     }
 }
@@ -276,6 +286,10 @@ pub struct MethodReport {
     /// Where the compensator was trained (the model file stores it).
     #[serde(skip)]
     pub stored_support: Option<Support>,
+    /// The compensator's orientation part, trained where the data measured
+    /// orientations (the model file stores it).
+    #[serde(skip)]
+    pub stored_orientation: Option<crate::compensate::StoredOrientation>,
     /// The validation poses' evidence for the accuracy at a production tool
     /// (the model file stores it as `validation`).
     #[serde(skip)]
@@ -286,9 +300,9 @@ impl MethodReport {
     /// The trained compensator as predictions use it: faded beyond its
     /// support.
     pub fn compensator_arc(&self) -> Option<Arc<dyn Compensator>> {
-        self.stored_compensator
-            .clone()
-            .map(|c| c.into_arc_supported(self.stored_support.clone()))
+        self.stored_compensator.clone().map(|c| {
+            c.into_arc_oriented(self.stored_orientation.clone(), self.stored_support.clone())
+        })
     }
 
     /// The method a model file of this result names: the method itself, or

@@ -51,7 +51,7 @@ const handlers = {
     const text = await fileOrText(form, "file", "csv");
     if (!text) throw new Error("choose a CSV file or paste its text");
     const q = new URLSearchParams();
-    for (const k of ["name", "role", "session", "payload_kg", "length_unit", "angle_unit", "decimal", "dif_sign"]) {
+    for (const k of ["name", "role", "orientation", "session", "payload_kg", "length_unit", "angle_unit", "decimal", "dif_sign"]) {
       const v = formValue(form, k);
       if (v) q.set(k, v);
     }

@@ -4,6 +4,7 @@
 use crate::db::{CalibrationRow, CellItemRow, JobStatus, RobotRow, SetRow, VersionRow};
 use crate::http::calibrations::DEFAULT_METHODS;
 use crate::identify::Method;
+use crate::measure::convention::MeasuredOrientation;
 use crate::measure::SetRole;
 use crate::model::presets::PRESETS;
 use crate::report::page_head;
@@ -188,6 +189,13 @@ pub fn robot(v: &RobotView) -> Markup {
                         }
                     }
                     label { "Name " input name="name"; }
+                    label title="How the file's orientation columns (if any) are to be read" { "Orientation "
+                        select name="orientation" {
+                            @for c in MeasuredOrientation::ALL {
+                                option value=(c.name()) title=(c.meaning()) selected[c == MeasuredOrientation::default()] { (c.name()) " (" (c.columns().join(", ")) ")" }
+                            }
+                        }
+                    }
                     label { "Tracker session " input name="session" placeholder="default"; }
                     label { "Payload [kg] " input name="payload_kg" type="number" step="any" min="0"; }
                     label { "Lengths "

@@ -22,8 +22,11 @@
 //! above the geometry's alone on the same folds by more than
 //! [`ORIENTATION_SLACK`] (relative); and between the options only those whose
 //! orientation mean on the pool is within [`ORIENTATION_SLACK`] of the lowest
-//! compete by position ([`choose_option`]). A compensator corrects position
-//! only, so an option's orientation is that of its base (or maps).
+//! compete by position ([`choose_option`]). An option's orientation is
+//! scored as its base's (or maps'): a compensator's orientation part
+//! (`compensate::oriented`) is trained on the pool without a
+//! cross-validation, so `auto` does not credit it with a gain it has not
+//! shown on held-out poses.
 
 use super::compensated::base_pool_errors;
 use super::maps::run_maps;

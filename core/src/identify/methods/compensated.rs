@@ -30,8 +30,8 @@
 use super::run::{AppliedCompensator, Cache, Context, Outcome};
 use super::{Base, Compensated, Method, MethodError, MethodFailure, Network};
 use crate::compensate::{
-    cross_validate, train, Compensator, CvStats, Sample, StoredCompensator, Support, TrainError,
-    TrainReport,
+    cross_validate, train, Compensator, CompensatorSpec, CvStats, OrientationSamples, Sample,
+    StoredCompensator, StoredOrientation, Support, TrainError, TrainReport,
 };
 use crate::identify::least_squares::Fit;
 use crate::identify::report::{
@@ -42,6 +42,7 @@ use crate::kinematics::{chain, gravity_torques_of};
 use crate::measure::Measurement;
 use crate::model::pose::Pose;
 use crate::model::RobotModel;
+use nalgebra::Matrix3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -49,6 +50,8 @@ use rand_chacha::ChaCha8Rng;
 #[derive(Clone)]
 pub(crate) struct Trained {
     pub stored: StoredCompensator,
+    /// Its orientation part, where the pool measured orientations.
+    pub orientation: Option<StoredOrientation>,
     /// Where it was trained: its correction fades to zero beyond it.
     pub support: Support,
     pub report: TrainReport,
@@ -79,6 +82,52 @@ pub(crate) fn samples(
         .collect()
 }
 
+/// Per pose of `data`, `R_measured·R_predictedᵀ` in the base frame of the
+/// fitted base (`E_sᵀ·R_measured·R_predictedᵀ`, `compensate::oriented`);
+/// `None` for a pose without a measured orientation.
+pub(crate) fn rotations(
+    model: &RobotModel,
+    frames: &[Pose],
+    data: &[Measurement],
+) -> Vec<Option<Matrix3<f64>>> {
+    data.iter()
+        .map(|m| {
+            let rm = m.orientation?;
+            let (_, r) = predict_compensated(model, None, m)?;
+            let e = frames.get(m.session).copied().unwrap_or_default();
+            Some(e.r.transpose() * rm * r.transpose())
+        })
+        .collect()
+}
+
+/// The orientation part trained on `data`'s orientation residuals with the
+/// position part's `spec` (`ChaCha8Rng(seed + 500)`), turning about the
+/// measurement tool's point; `None` when fewer than half of the poses
+/// measured an orientation or the training fails (the compensator then
+/// corrects the position only).
+fn train_orientation(
+    spec: &CompensatorSpec,
+    model: &RobotModel,
+    data: &[Sample],
+    rotations: &[Option<Matrix3<f64>>],
+    seed: u64,
+    cancel: &mut dyn FnMut() -> bool,
+) -> Result<Option<StoredOrientation>, MethodError> {
+    let samples = OrientationSamples::of(data, rotations);
+    if samples.len() < 5 || 2 * samples.len() < data.len() {
+        return Ok(None);
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(500));
+    match train(spec, &samples, &mut rng, &mut |_, _| cancel()) {
+        Ok((network, _)) => Ok(Some(StoredOrientation {
+            point_m: model.tool.p.into(),
+            network,
+        })),
+        Err(TrainError::Cancelled) => Err(MethodError::Cancelled),
+        Err(_) => Ok(None),
+    }
+}
+
 fn train_error(e: TrainError) -> MethodError {
     match e {
         TrainError::Cancelled => MethodError::Cancelled,
@@ -102,13 +151,13 @@ pub(crate) fn train_network(
     let spec = ctx.opts.compensator.spec(network);
     let (pool, _) = ctx.pool();
     let mut data = samples(&base.model, &base.session_frames, pool)?;
+    let mut turns = rotations(&base.model, &base.session_frames, pool);
     let cap = ctx.opts.compensator.max_network_poses;
     if network != Network::Gp && cap > 0 && data.len() > cap {
         let mut rng = ChaCha8Rng::seed_from_u64(ctx.opts.compensator.seed.wrapping_add(1000));
-        data = rand::seq::index::sample(&mut rng, data.len(), cap)
-            .into_iter()
-            .map(|i| data[i].clone())
-            .collect();
+        let keep = rand::seq::index::sample(&mut rng, data.len(), cap).into_vec();
+        data = keep.iter().map(|i| data[*i].clone()).collect();
+        turns = keep.iter().map(|i| turns[*i]).collect();
     }
     if network == Network::Rbf && data.iter().all(|s| s.tau.iter().all(|t| *t == 0.0)) {
         return Err(MethodFailure::NoTorqueToLearn.into());
@@ -132,10 +181,18 @@ pub(crate) fn train_network(
     };
     let last = ctx.opts.compensator.cv_stages(folds) - 1;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let (stored, report) =
-        train(&spec, &data, &mut rng, &mut |e, l| progress(last, e, l)).map_err(train_error)?;
+    let (mut at_epoch, mut at_loss) = (0, 0.0);
+    let (stored, report) = train(&spec, &data, &mut rng, &mut |e, l| {
+        (at_epoch, at_loss) = (e, l);
+        progress(last, e, l)
+    })
+    .map_err(train_error)?;
+    let orientation = train_orientation(&spec, &base.model, &data, &turns, seed, &mut || {
+        progress(last, at_epoch, at_loss)
+    })?;
     Ok(Trained {
         stored,
+        orientation,
         support: support_of(&data),
         report,
         cv,
@@ -245,7 +302,7 @@ pub(crate) fn compensate_report(
     let arc = trained
         .stored
         .clone()
-        .into_arc_supported(Some(trained.support.clone()));
+        .into_arc_oriented(trained.orientation.clone(), Some(trained.support.clone()));
     let c: Option<&dyn Compensator> = Some(arc.as_ref());
     let model = report.calibrated.clone();
     let base_identification = report.identification.stats.clone();
@@ -301,9 +358,10 @@ pub(crate) fn compensate_report(
             .chain(training)
             .chain(valid)
             .any(|m| m.orientation.is_some())
-            .then(|| {
-                format!(
-                    "the compensator corrects the position only: the orientation errors are those of {} (its {}), unchanged by it",
+            .then(|| match &trained.orientation {
+                Some(_) => "the compensator corrects the orientation too: a second network of the same form learned the orientation residuals (rotation vectors, registered base frame) on the same poses, and turns the flange about the measured point".to_string(),
+                None => format!(
+                    "the compensator corrects the position only (too few training poses measured an orientation): the orientation errors are those of {} (its {}), unchanged by it",
                     applied.base.method().name(),
                     match applied.base {
                         Base::Km => "geometry",
@@ -311,7 +369,7 @@ pub(crate) fn compensate_report(
                         Base::KmMaps => "geometry and joint maps",
                         Base::SkcmMaps => "geometry, compliance and joint maps",
                     }
-                )
+                ),
             }),
     });
     if let Some(w) = report
@@ -328,6 +386,7 @@ pub(crate) fn compensate_report(
     }
     report.stored_compensator = Some(trained.stored.clone());
     report.stored_support = Some(trained.support.clone());
+    report.stored_orientation = trained.orientation.clone();
 }
 
 /// Errors of the base alone on the pool (the residual norms [mm], and the

@@ -163,6 +163,7 @@ impl Context<'_> {
             calibrated: fitted.model,
             stored_compensator: None,
             stored_support: None,
+            stored_orientation: None,
             validation_evidence: None,
         })
     }

@@ -23,7 +23,7 @@
 //! evaluation; [`PreparedModel::seed_fk`] is the seed model's forward kinematics.
 //! Joints in the model convention [rad], torques N·m, payload kg.
 
-use crate::compensate::{CompensatedModel, Compensator};
+use crate::compensate::{oriented, CompensatedModel, Compensator};
 use crate::kinematics::prepared::{stack_or_heap, PreparedChain, STACK_DOF};
 use crate::kinematics::LoopPartials;
 use crate::model::joint_map_table::TabulatedMaps;
@@ -218,6 +218,8 @@ pub(crate) struct PreparedModel {
     maps: Option<TabulatedMaps>,
     payload_kg: f64,
     compensator: Option<Arc<dyn Compensator>>,
+    /// The compensator's orientation part's point in the TCP frame (exact everywhere).
+    rotation_point: Option<Vector3<f64>>,
 }
 
 impl std::fmt::Debug for PreparedModel {
@@ -245,6 +247,10 @@ impl PreparedModel {
             maps: cal.joint_maps.as_ref().map(TabulatedMaps::new),
             payload_kg: model.payload_kg,
             compensator: model.compensator.clone(),
+            rotation_point: model
+                .compensator
+                .as_ref()
+                .and_then(|c| oriented::point_in_tcp(c.as_ref(), cal)),
         }
     }
 
@@ -579,6 +585,8 @@ impl PreparedModel {
         let mut pose = tcp0;
         if let Some(c) = &self.compensator {
             pose.p += residual(c.as_ref(), q, tau, self.payload_kg);
+            let d = self.rotation_point.as_ref();
+            oriented::rotate(&mut pose, c.as_ref(), (q, tau, self.payload_kg), d);
         }
         Some(pose)
     }
@@ -616,6 +624,8 @@ impl PreparedModel {
         let mut pose = tcp;
         if let Some(c) = &self.compensator {
             pose.p += residual(c.as_ref(), q, tau, self.payload_kg);
+            let d = self.rotation_point.as_ref();
+            oriented::rotate(&mut pose, c.as_ref(), (q, tau, self.payload_kg), d);
         }
         Some(pose)
     }
