@@ -2,7 +2,8 @@
 //! of a description extreme, finite or not (1e-300 … 1e300, ±∞, NaN). The
 //! description either refuses the model naming the field, or the model it
 //! accepts goes through forward kinematics, a small calibration, a solve and
-//! every export without a panic and in bounded time. Models built in SI
+//! every export, a program filter (a small KRL program) and a measurement
+//! plan without a panic and in bounded time. Models built in SI
 //! without the description (as the core's callers may) with a huge tool or
 //! compliance end a calibration with a reason instead of hanging or panicking.
 
@@ -10,14 +11,19 @@ use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use robocal_core::cell::{Cell, Tool};
 use robocal_core::compensate::CompensatedModel;
 use robocal_core::export::{export, ExportFormat, ExportSource};
 use robocal_core::identify::{calibrate, CalibrationError, CalibrationOptions, LmSettings, Method};
 use robocal_core::ik::{IkSettings, IkSolver, SolveOptions};
+use robocal_core::kinematics::chain::tool_pose;
 use robocal_core::kinematics::fk;
 use robocal_core::measure::{self, Measurement};
+use robocal_core::model::orientation::{rotation_to, OrientationConvention};
 use robocal_core::model::presets::preset_description;
 use robocal_core::model::{preset, ModelDescription, RobotModel};
+use robocal_core::plan::{make_plan, PlanSettings};
+use robocal_core::program::{filter, Language, ProgramFile};
 use robocal_core::sim::{try_random_configurations, PoseFilter, TrueRobot};
 use std::time::{Duration, Instant};
 
@@ -41,6 +47,43 @@ fn measured(model: &RobotModel, n: usize, seed: u64) -> Option<Vec<Measurement>>
         .measure(&qs, Some(model.payload.mass), None, &mut rng)
         .ok()?;
     Some(measure::to_measurements(model, &rows, model.payload.mass))
+}
+
+/// A KRL program of `model`'s own flange poses at `qs` (mm, KUKA A B C,
+/// no status or turn: the filter takes the nearest branch) with tool 1 of
+/// [`cell_of`], then a target a kilometre away that nothing reaches.
+fn krl_program(model: &RobotModel, qs: &[Vec<f64>]) -> Vec<ProgramFile> {
+    let mut src = String::from("DEF hostile()\r\n$TOOL = TOOL_DATA[1]\r\n");
+    for q in qs {
+        let Ok(p) = fk(model, q) else { continue };
+        let abc = rotation_to(OrientationConvention::KukaAbc, &p.r);
+        src.push_str(&format!(
+            "LIN {{X {:.4},Y {:.4},Z {:.4},A {:.4},B {:.4},C {:.4}}}\r\n",
+            p.p.x * 1e3,
+            p.p.y * 1e3,
+            p.p.z * 1e3,
+            abc[0],
+            abc[1],
+            abc[2]
+        ));
+    }
+    src.push_str("LIN {X 1000000.0,Y 0.0,Z 0.0,A 0.0,B 90.0,C 0.0}\r\nEND\r\n");
+    vec![ProgramFile {
+        name: "hostile.src".into(),
+        text: src,
+    }]
+}
+
+/// A cell whose tool 1 is `model`'s own tool (what its poses are of).
+fn cell_of(model: &RobotModel) -> Cell {
+    let mut cell = Cell::default();
+    cell.tools.push(Tool {
+        name: "tool".into(),
+        number: Some(1),
+        tcp: tool_pose(model),
+        load: None,
+    });
+    cell
 }
 
 fn small_options(methods: Vec<Method>) -> CalibrationOptions {
@@ -168,6 +211,10 @@ fn extreme() -> impl Strategy<Value = f64> {
 
 /// How many random models the property test accepted and ran end to end.
 static ACCEPTED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+/// Of those, how many filtered at least one target of their program.
+static FILTERED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+/// Of those, how many the measurement plan answered with poses.
+static PLANNED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
 /// Sets numeric field `k` (of the fields every description has) to `v`.
 fn set_field(d: &mut ModelDescription, k: usize, v: f64) {
@@ -233,6 +280,22 @@ proptest! {
         for f in ExportFormat::ALL {
             let _ = export(&compensated, &source, f);
         }
+        // The filter: every target filtered or failed with a reason (the
+        // unreachable one failed), or the program refused.
+        let files = krl_program(&model, &qs[..qs.len().min(3)]);
+        if let Ok(out) = filter(Language::Krl, &files, &cell_of(&model), &compensated, &IkSettings::default()) {
+            let r = &out.report;
+            prop_assert_eq!(r.filtered + r.failed + r.skipped, r.targets.len());
+            prop_assert!(r.targets.last().is_some_and(|t| t.reason.is_some()), "{:?}", r.targets.last());
+            if r.filtered > 0 {
+                FILTERED.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            }
+        }
+        let plan = make_plan(&model, &PlanSettings { poses: 15, candidates: 60, seed, ..PlanSettings::default() });
+        if let Ok(plan) = plan {
+            prop_assert_eq!(plan.q.len(), 15);
+            PLANNED.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        }
         if let Some(ident) = measured(&model, 25, seed) {
             let _ = calibrate(&model, &ident, &[], &small_options(vec![Method::Km, Method::Skcm]), &|_| true);
         }
@@ -247,6 +310,17 @@ fn the_property_test_runs_accepted_models() {
     extreme_models_are_refused_or_work();
     let n = ACCEPTED.load(std::sync::atomic::Ordering::Relaxed);
     assert!(n >= 10, "only {n} of 48 random models were accepted");
+    let filtered = FILTERED.load(std::sync::atomic::Ordering::Relaxed);
+    let planned = PLANNED.load(std::sync::atomic::Ordering::Relaxed);
+    println!("{n} accepted models: {filtered} filtered a target, {planned} planned");
+    assert!(
+        filtered >= n / 2,
+        "only {filtered} of {n} accepted models filtered a target"
+    );
+    assert!(
+        planned >= n / 2,
+        "only {planned} of {n} accepted models planned"
+    );
 }
 
 /// Limits wholly beyond ±180° (here [-3600°, -360°] on a wrist joint) once
@@ -284,4 +358,36 @@ fn an_arm_below_its_base_plane_runs_end_to_end() {
         &|_| true,
     );
     assert!(r.is_ok(), "{:?}", r.err());
+}
+
+/// The program and plan of the property test work on an ordinary model: its
+/// own poses filter, the far target fails with a reason, the plan has its
+/// poses.
+#[test]
+fn an_ordinary_model_filters_its_program_and_plans() {
+    let model = preset("ys100").unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    let qs = configurations(&model, 3, &mut rng).unwrap();
+    let files = krl_program(&model, &qs);
+    let compensated = CompensatedModel::from_nominal(model.clone());
+    let out = filter(
+        Language::Krl,
+        &files,
+        &cell_of(&model),
+        &compensated,
+        &IkSettings::default(),
+    )
+    .unwrap_or_else(|e| panic!("{e}\n{}", files[0].text));
+    let r = &out.report;
+    assert_eq!((r.filtered, r.failed), (3, 1), "{:?}", r.targets);
+    let plan = make_plan(
+        &model,
+        &PlanSettings {
+            poses: 15,
+            candidates: 60,
+            ..PlanSettings::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(plan.q.len(), 15);
 }

@@ -26,7 +26,9 @@
 //! flat `weights`, `input_norm`, `output_norm`) or `rbf` ([`Rbf`](super::Rbf):
 //! `dof`, `output_frame`, `input_norm`, `spread`, `centres`, `weights`). Its
 //! values are SI (inputs rad, kg, N·m; outputs m) as the network computes them.
-//! A file with an unknown `kind` is rejected.
+//! A file with an unknown `kind` is rejected; every value of the compensator
+//! and its support must lie within the bounds of `model::bounds::compensator`
+//! (the error names the field, its value and the bound).
 //!
 //! `compensator_orientation` (optional, beside `compensator`; files without it
 //! load as before) is the compensator's orientation part, trained where the
@@ -45,6 +47,7 @@
 
 use super::{CompensateError, CompensatedModel, StoredCompensator, StoredOrientation, Support};
 use crate::cell::accuracy::ValidationEvidence;
+use crate::model::bounds::check_compensator;
 use crate::model::{ModelDescription, RobotModel};
 use serde::{Deserialize, Serialize};
 
@@ -128,6 +131,9 @@ impl CalibratedModelFile {
             )));
         }
         if let Some(c) = &self.compensator {
+            // Every value within its bound, named (model::bounds), then the
+            // sizes consistent.
+            check_compensator(c, self.compensator_support.as_ref())?;
             c.validate()
                 .map_err(|e| CompensateError::Format(format!("compensator: {e}")))?;
         }

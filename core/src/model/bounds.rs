@@ -8,8 +8,16 @@
 //! kinematics and the statics form (lengths × angles, masses × g × lengths ×
 //! compliances) far from overflow, so no numerical routine meets an
 //! infinite or NaN intermediate from an accepted model.
+//!
+//! A calibrated model file's learned compensator and its support are
+//! checked by [`check_compensator`] (SI units, as the network computes:
+//! rad, kg, N·m in, m out), called by the file's loader
+//! (`compensate::file`) for every file and stored version.
 
 use super::description::ModelError;
+
+pub mod compensator;
+pub use compensator::check_compensator;
 
 /// A closed interval `[min, max]` in `unit`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -95,6 +103,99 @@ pub const GRAVITY_MPS2: Bound = Bound {
     unit: "m/s²",
 };
 
+/// A learned compensator's weights (the MLP's flat weights in normalised
+/// units, the RBF's output weights [m]). Both output layers are solved by
+/// least squares (a ridge of 1e-10 of the trace, an SVD cut at 1e-12 of the
+/// largest singular value), which lets cancelling weights grow to about
+/// 1e5–1e9 times the target; 1e12 leaves room for every trained network
+/// and keeps a sum of thousands of such products below 1e20.
+pub const NETWORK_WEIGHT: Bound = Bound {
+    min: -1e12,
+    max: 1e12,
+    unit: "(network units)",
+};
+/// A network's input centre (`input_norm.centre`): joints [rad], their sines
+/// and cosines, payload [kg] or gravity torques [N·m]: the largest torque
+/// the model bounds allow (10⁴ kg · 100 m/s² · 10² m … per link) is far
+/// below it.
+pub const INPUT_CENTRE: Bound = Bound {
+    min: -1e9,
+    max: 1e9,
+    unit: "rad, kg or N·m",
+};
+/// A network's input scale (`input_norm.scale`, 2/(max − min) of the
+/// training inputs; 0 ignores a constant input): training keeps a range
+/// above 1e-12 of the values, so a real scale stays below about 2e12.
+pub const INPUT_SCALE: Bound = Bound {
+    min: 0.0,
+    max: 1e13,
+    unit: "1/(rad, kg or N·m)",
+};
+/// An MLP's output scale (`output_norm.scale`, 2/(max − min) of the
+/// residuals [m]; 1 for a constant output): positive, as the network's
+/// output is divided by it.
+pub const OUTPUT_SCALE: Bound = Bound {
+    min: 0.0,
+    max: 1e13,
+    unit: "1/m",
+};
+/// A residual [m]: a compensator's output centre and mean, the RMS it was
+/// trained on. A calibrated model that leaves 100 m is no model.
+pub const RESIDUAL_M: Bound = Bound {
+    min: -100.0,
+    max: 100.0,
+    unit: "m",
+};
+/// An RBF's centres (normalised torques, within [−1, 1] when trained) and
+/// spread (positive) [normalised units].
+pub const RBF_NORMALISED: Bound = Bound {
+    min: -1e6,
+    max: 1e6,
+    unit: "(normalised torque)",
+};
+/// Joint values a compensator stores [rad]: a GP's inducing configurations,
+/// a support's ranges and points. Joint limits are at most ±3600° (62.8 rad).
+pub const JOINT_RAD: Bound = Bound {
+    min: -1000.0,
+    max: 1000.0,
+    unit: "rad",
+};
+/// A distance in joint space [rad]: a support's fade width and radius.
+pub const JOINT_DISTANCE_RAD: Bound = Bound {
+    min: 0.0,
+    max: 10_000.0,
+    unit: "rad",
+};
+/// A GP's inverse length scales `1/ℓ` [1/rad]: ℓ of at least a microradian;
+/// 0 ignores the joint; a negative one is no length scale.
+pub const INVERSE_LENGTH_SCALE: Bound = Bound {
+    min: 0.0,
+    max: 1e6,
+    unit: "1/rad",
+};
+/// A GP's signal and noise variances `s²`, `σ²` [m²]: positive, at most a
+/// 100 m standard deviation.
+pub const GP_VARIANCE_M2: Bound = Bound {
+    min: 0.0,
+    max: 1e4,
+    unit: "m²",
+};
+/// A GP's weights `α` [1/m] and variance matrix `K_ZZ⁻¹ − σ²·A⁻¹` [1/m²]:
+/// they scale as 1/s² times the kernel matrix's condition, far below 1e30
+/// for any trained process; with `s² ≤ 1e4` every prediction stays finite.
+pub const GP_COEFFICIENT: Bound = Bound {
+    min: -1e30,
+    max: 1e30,
+    unit: "1/m or 1/m²",
+};
+/// A GP's error scale `κ` (held-out RMS error over the predicted one):
+/// positive.
+pub const ERROR_SCALE: Bound = Bound {
+    min: 0.0,
+    max: 1e6,
+    unit: "",
+};
+
 /// `v` when finite and within `b`; else an error naming the field, the value
 /// and the bound.
 pub fn check(field: &str, v: f64, b: &Bound) -> Result<f64, ModelError> {
@@ -106,10 +207,51 @@ pub fn check(field: &str, v: f64, b: &Bound) -> Result<f64, ModelError> {
             reason: format!(
                 "{} is outside the bound [{}, {}] {}",
                 show(v),
-                b.min,
-                b.max,
+                show_bound(b.min),
+                show_bound(b.max),
                 b.unit
             ),
+        })
+    }
+}
+
+/// `v` when finite, above `b.min` (excluded) and at most `b.max`: a
+/// quantity that must be positive.
+pub fn check_above(field: &str, v: f64, b: &Bound) -> Result<f64, ModelError> {
+    if v.is_finite() && v > b.min && v <= b.max {
+        Ok(v)
+    } else {
+        Err(ModelError::InvalidField {
+            field: field.to_string(),
+            reason: format!(
+                "{} is outside the bound ({}, {}] {}",
+                show(v),
+                show_bound(b.min),
+                show_bound(b.max),
+                b.unit
+            ),
+        })
+    }
+}
+
+/// [`check`] on each value, named `field[i]`.
+pub fn check_all(field: &str, v: &[f64], b: &Bound) -> Result<(), ModelError> {
+    for (i, x) in v.iter().enumerate() {
+        if !(x.is_finite() && *x >= b.min && *x <= b.max) {
+            check(&format!("{field}[{i}]"), *x, b)?;
+        }
+    }
+    Ok(())
+}
+
+/// At most `max` items in `field`.
+pub fn check_count(field: &str, n: usize, max: usize, what: &str) -> Result<(), ModelError> {
+    if n <= max {
+        Ok(())
+    } else {
+        Err(ModelError::InvalidField {
+            field: field.to_string(),
+            reason: format!("{n} {what} is more than the bound {max}"),
         })
     }
 }
@@ -117,6 +259,15 @@ pub fn check(field: &str, v: f64, b: &Bound) -> Result<f64, ModelError> {
 /// A value as a person reads it: 1e308, not 309 digits.
 pub fn show(v: f64) -> String {
     if v.is_finite() && v != 0.0 && !(1e-4..1e6).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
+/// A bound as a person reads it: 1e12, not 13 digits; 100000 as it is.
+fn show_bound(v: f64) -> String {
+    if v.abs() >= 1e7 {
         format!("{v:e}")
     } else {
         format!("{v}")

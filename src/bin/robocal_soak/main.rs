@@ -20,7 +20,9 @@
 //!   2`, `replicas.rs`): the replicas share an empty database, each client
 //!   request goes to a random live replica; the killer SIGKILLs a random
 //!   replica and restarts it while the clients go on with the other. Jobs of a
-//!   killed replica are taken over once their lease (`--job-lease`) lapsed.
+//!   killed replica are taken over once their lease (`--job-lease`) lapsed;
+//!   one claimed too often fails as interrupted, and as on SQLite a job that
+//!   never started (never claimed) is never failed as interrupted.
 //!
 //! Then the clients stop, every server is killed once more (so `--kills 10`
 //! makes 11 crashes) and restarted; once no job is queued or running every

@@ -111,7 +111,7 @@ pub fn run(args: &Args, url: &str) -> anyhow::Result<()> {
         s.kill()?;
     }
     println!(
-        "soak: {} replicas on PostgreSQL, {crashes} crashes (SIGKILL; {} of one random replica under load, 1 of all at the end) survived in {:.0} s with {} clients; {} acknowledged writes, all present and intact through two replicas; {} acknowledged jobs of robots not deleted: {} succeeded and stored once, {} failed with a reason ({} interrupted), {} cancelled, none queued or running {settled:.1} s after the last kill; {} takeovers of a killed replica's job; {} solve requests; {} set checks and {rows} stored rows verified",
+        "soak: {} replicas on PostgreSQL, {crashes} crashes (SIGKILL; {} of one random replica under load, 1 of all at the end) survived in {:.0} s with {} clients; {} acknowledged writes, all present and intact through two replicas; {} acknowledged jobs of robots not deleted: {} succeeded and stored once, {} failed with a reason ({} interrupted, each after it started), {} cancelled, none queued or running {settled:.1} s after the last kill; {} takeovers of a killed replica's job; {} solve requests; {} set checks and {rows} stored rows verified",
         args.replicas,
         crashes - 1,
         start_time.elapsed().as_secs_f64(),
