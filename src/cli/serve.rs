@@ -201,7 +201,7 @@ async fn serve(addr: SocketAddr, args: ServeArgs, keys: Vec<ApiKey>) -> anyhow::
     let backend = db.backend();
     let state = AppState::new(db, config);
     if backend == Backend::Sqlite {
-        let resumed = crate::service::queue::resume_queued(&state).await?;
+        let resumed = crate::service::jobs::local::resume_queued(&state).await?;
         if resumed > 0 {
             tracing::info!(
                 jobs = resumed,
@@ -227,7 +227,7 @@ async fn serve(addr: SocketAddr, args: ServeArgs, keys: Vec<ApiKey>) -> anyhow::
             shutdown().await;
             // PostgreSQL: running jobs go back to the queue for other replicas.
             if draining.shared_jobs() {
-                crate::service::queue::drain(&draining).await;
+                crate::service::jobs::shared::drain(&draining).await;
             }
         })
         .await

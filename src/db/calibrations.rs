@@ -107,13 +107,15 @@ impl Db {
             };
             let id: i64 = sqlx::query_scalar(
                 "INSERT INTO calibrations (robot_id, status, methods, identification_set_ids, \
-                 validation_set_ids, options) VALUES ($1, 'queued', $2, $3, $4, $5) RETURNING id",
+                 validation_set_ids, options, command) VALUES ($1, 'queued', $2, $3, $4, $5, $6) \
+                 RETURNING id",
             )
             .bind(c.robot_id)
             .bind(Json(c.methods))
             .bind(Json(c.identification_set_ids))
             .bind(Json(c.validation_set_ids))
             .bind(Json(c.options))
+            .bind(c.command)
             .fetch_one(&mut *tx)
             .await?;
             Some(commit_inserted!(tx, CalibrationRow, CAL_SELECT, "id", id))
@@ -351,7 +353,8 @@ pub struct JobResult<'a> {
 
 const CAL_SELECT: &str = "SELECT id, robot_id, status, phase, iteration, percent, \
     cancel_requested, methods, identification_set_ids, validation_set_ids, options, error, \
-    best_method, summary, created_at, started_at, finished_at, updated_at FROM calibrations";
+    best_method, summary, created_at, started_at, finished_at, updated_at, command \
+    FROM calibrations";
 
 /// A calibration job to insert (JSON texts).
 #[derive(Debug)]
@@ -361,6 +364,8 @@ pub struct NewCalibration<'a> {
     pub identification_set_ids: &'a [i64],
     pub validation_set_ids: &'a [i64],
     pub options: &'a Value,
+    /// The start command as the runner reads it (JSON with its format).
+    pub command: &'a str,
 }
 
 #[derive(Debug, Clone, FromRow)]
@@ -384,4 +389,7 @@ pub struct CalibrationRow {
     pub started_at: Option<String>,
     pub finished_at: Option<String>,
     pub updated_at: String,
+    /// The start command as stored (JSON with its format); `None` for a job
+    /// queued before the store kept it (schema 8 on SQLite, 7 on PostgreSQL).
+    pub command: Option<String>,
 }

@@ -9,9 +9,9 @@
 use super::input::{check_payload, int, page_body, present, present_ids, present_int, PageQuery};
 use super::robots::robot_list_page;
 use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState};
-use crate::db::{CalibrationRow, JobStatus, JobSummary};
 use crate::identify::{CalibrationOptions, Method};
-use crate::service::{self, calibrations::StartCommand};
+use crate::service::calibrations::{CalibrationRow, JobStatus, JobSummary};
+use crate::service::{self, jobs::StartCommand};
 use axum::extract::State;
 use axum::http::StatusCode;
 use axum::response::{Html, IntoResponse, Response};

@@ -9,9 +9,9 @@
 use super::input::{id, ids, page_body, present_id, PageQuery};
 use super::robots::robot_list_page;
 use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState};
-use crate::db::CheckRow;
 use crate::service;
 use crate::service::checks::CheckCommand;
+use crate::service::checks::CheckRow;
 use axum::extract::State;
 use axum::http::StatusCode;
 use axum::response::{IntoResponse, Response};

@@ -206,7 +206,7 @@ impl From<crate::service::ServiceError> for ApiError {
             },
             S::Unavailable(m) => ApiError::Unavailable(m),
             S::Store(e) => {
-                use crate::db::StoreError as E;
+                use crate::service::StoreError as E;
                 match e {
                     E::NotFound(m) => ApiError::NotFound(m),
                     E::Conflict(m) => ApiError::Conflict(m),

@@ -3,10 +3,10 @@
 
 use super::input::{check_payload, page_body, present, Page, PageQuery};
 use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState};
-use crate::db::{NewRobot, RobotRow};
 use crate::model::presets::{preset_description, PRESETS};
 use crate::model::RobotModel;
 use crate::service;
+use crate::service::robots::{NewRobot, RobotRow};
 use axum::extract::State;
 use axum::http::StatusCode;
 use axum::response::{IntoResponse, Response};

@@ -12,10 +12,10 @@ use super::input::{
 };
 use super::robots::robot_list_page;
 use super::{ApiError, ApiPath, ApiQuery, AppState};
-use crate::db::{AngleUnit, LengthUnit, SetFormat, SetRow};
 use crate::measure::convention::MeasuredOrientation;
 use crate::measure::csv::{self, DifSign, ReadOptions};
 use crate::measure::{MeasuredPose, SetRole};
+use crate::service::sets::{AngleUnit, LengthUnit, SetFormat, SetRow};
 use crate::service::{
     self,
     sets::{NewSetCommand, SetContent},
@@ -26,9 +26,6 @@ use axum::extract::State;
 use axum::http::{header, HeaderMap, StatusCode};
 use axum::response::{IntoResponse, Response};
 use serde::{Deserialize, Serialize};
-
-/// Most sets one calibration may use.
-pub const MAX_SETS: usize = 100;
 
 /// Options of an upload: the query string of a CSV upload, the body fields of
 /// a JSON upload. A JSON upload takes the set's name, role, session and

@@ -5,7 +5,7 @@
 use super::{robots, AppState, ServiceError};
 use crate::cell::file::{CellDescription, ToolDescription, WorkObjectDescription};
 use crate::cell::{Cell, WorkObjectFrame};
-use crate::db::{CellItemRow, CellKind, CellPut, ItemFrame, NewCellItem};
+pub use crate::db::{CellItemRow, CellKind, CellPut, ItemFrame, NewCellItem};
 use std::collections::HashSet;
 
 /// A robot's tools or work objects by name (`NotFound` for a missing robot).

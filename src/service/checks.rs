@@ -4,7 +4,8 @@
 
 use super::{robots, versions, AppState, ServiceError};
 use crate::compensate::CalibratedModelFile;
-use crate::db::{CheckRow, Listing, NewCheck};
+pub use crate::db::CheckRow;
+use crate::db::{Listing, NewCheck};
 use robocal_core::check::{score, CheckResult, CheckStatus, CheckThresholds};
 use serde::Serialize;
 use serde_json::Value;

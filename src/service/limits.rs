@@ -23,6 +23,9 @@ use std::time::Duration;
 /// gravity-torque arithmetic.
 pub const PAYLOAD_MAX_KG: f64 = 10_000.0;
 
+/// Most sets one calibration may use (per role).
+pub const MAX_SETS: usize = 100;
+
 /// Solve requests up to this many targets are solved at once on the request's
 /// thread; larger ones go through the bounded solve queue.
 pub const SMALL_SOLVE_MAX: usize = 64;

@@ -17,12 +17,12 @@ mod changes;
 pub mod checks;
 pub mod iso9283;
 mod job_watch;
+pub mod jobs;
 pub mod keys;
 pub mod limits;
 pub mod plans;
 pub mod predict;
 pub mod programs;
-pub mod queue;
 pub mod record;
 pub mod reregister;
 pub mod robots;
@@ -34,7 +34,7 @@ mod waiting;
 
 pub use state::{AppState, RobotContext, ServiceConfig};
 
-use crate::db::StoreError;
+pub use crate::db::StoreError;
 
 /// Why a service operation did not happen.
 #[derive(Debug, thiserror::Error)]

@@ -2,7 +2,8 @@
 //! solvers and the cancel flags of a robot's jobs are kept in step here.
 
 use super::{AppState, ServiceError};
-use crate::db::{Listing, NewRobot, RobotRow};
+use crate::db::Listing;
+pub use crate::db::{NewRobot, RobotRow};
 use serde_json::{Map, Value};
 use std::sync::atomic::Ordering;
 

@@ -8,7 +8,8 @@
 //! upload declared.
 
 use super::{AppState, ServiceError};
-use crate::db::{AngleUnit, LengthUnit, Listing, NewSet, SetFormat, SetRow};
+pub use crate::db::{AngleUnit, LengthUnit, SetFormat, SetRow};
+use crate::db::{Listing, NewSet};
 use crate::measure::csv::{self, CsvError, ReadOptions, MAX_PAYLOAD_KG};
 use crate::measure::{MeasuredPose, SetRole};
 

@@ -131,7 +131,7 @@ impl AppState {
         let shared = db.backend() == crate::db::Backend::Postgres;
         let state = AppState::build(db, config);
         if shared {
-            super::queue::spawn_runner(&state);
+            super::jobs::shared::spawn_runner(&state);
             super::changes::spawn_listener(&state);
         }
         state

@@ -2,7 +2,8 @@
 //! of the active version drops the robot's cached context and solvers.
 
 use super::{robots, AppState, ServiceError};
-use crate::db::{Listing, Rollback, VersionRow};
+pub use crate::db::VersionRow;
+use crate::db::{Listing, Rollback};
 
 /// One page of a robot's versions by number (the robot must exist).
 pub async fn page(

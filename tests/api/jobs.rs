@@ -302,6 +302,7 @@ async fn writes_racing_a_robot_delete_never_fail_with_500() {
         identification_set_ids: &[],
         validation_set_ids: &[],
         options: &json!({}),
+        command: "{}",
     };
     assert!(db.insert_calibration(&missing).await.unwrap().is_none());
     assert!(db

@@ -34,4 +34,5 @@ mod roles;
 mod sets;
 mod solve;
 mod spec;
+mod stored_jobs;
 mod support;

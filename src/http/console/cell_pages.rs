@@ -2,7 +2,8 @@
 //! (list, add, delete) and program filtering (drop program files in, see the
 //! per-target report, download the filtered files).
 
-use crate::db::{CellItemRow, ItemFrame, VersionRow};
+use crate::service::cell::{CellItemRow, ItemFrame};
+use crate::service::versions::VersionRow;
 use maud::{html, Markup};
 
 fn pose_text(r: &CellItemRow) -> String {

@@ -3,7 +3,9 @@
 //! time (thresholds drawn, version changes marked), the history, a form to
 //! run a check, and the comparison of versions on one set.
 
-use crate::db::{CheckRow, SetRow, VersionRow};
+use crate::service::checks::CheckRow;
+use crate::service::sets::SetRow;
+use crate::service::versions::VersionRow;
 use maud::{html, Markup};
 use robocal_core::check::{CheckStatus, CheckThresholds};
 

@@ -22,8 +22,8 @@ mod check_pages;
 mod pages;
 
 use super::{route, ApiError, ApiPath, AppState, Route};
-use crate::db::CellKind;
 use crate::service;
+use crate::service::cell::CellKind;
 use axum::extract::State;
 use axum::http::{header, HeaderValue, Method};
 use axum::response::{Html, IntoResponse, Response};

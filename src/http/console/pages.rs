@@ -1,13 +1,17 @@
 //! The console's pages as maud templates (every interpolated value is
 //! HTML-escaped by maud).
 
-use crate::db::{CalibrationRow, CellItemRow, JobStatus, RobotRow, SetRow, VersionRow};
 use crate::http::calibrations::DEFAULT_METHODS;
 use crate::identify::Method;
 use crate::measure::convention::MeasuredOrientation;
 use crate::measure::SetRole;
 use crate::model::presets::PRESETS;
 use crate::report::page_head;
+use crate::service::calibrations::{CalibrationRow, JobStatus};
+use crate::service::cell::CellItemRow;
+use crate::service::robots::RobotRow;
+use crate::service::sets::SetRow;
+use crate::service::versions::VersionRow;
 use maud::{html, Markup, PreEscaped, DOCTYPE};
 
 const SCRIPT: &str = include_str!("console.js");
@@ -55,7 +59,7 @@ pub struct RobotView {
     /// The latest check's status, the thresholds and the history (oldest first).
     pub status: Option<robocal_core::check::CheckStatus>,
     pub thresholds: robocal_core::check::CheckThresholds,
-    pub checks: Vec<crate::db::CheckRow>,
+    pub checks: Vec<crate::service::checks::CheckRow>,
 }
 
 fn layout(title: &str, keys: bool, body: Markup) -> Markup {

@@ -19,10 +19,10 @@
 //! The runner wakes when this replica queues or ends a job, and polls every
 //! [`POLL`] for jobs queued through other replicas.
 
-use super::calibrations::{execute, job_of, prepare, stored_command};
-use super::{AppState, ServiceError};
+use super::runner::{execute, Claim};
+use super::stored::load;
 use crate::db::{ClaimedJob, JobStatus, Lease};
-use crate::model::RobotModel;
+use crate::service::{AppState, ServiceError};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
@@ -34,7 +34,7 @@ pub const POLL: Duration = Duration::from_millis(250);
 pub const MAX_ATTEMPTS: i64 = 3;
 
 /// A 429 when the cluster's job queue is full.
-pub(super) async fn admit(state: &AppState) -> Result<(), ServiceError> {
+pub(crate) async fn admit(state: &AppState) -> Result<(), ServiceError> {
     let active = state.db().active_jobs().await?;
     let workers = state.config().workers.max(1);
     let queued = state.limits().queued_jobs;
@@ -50,7 +50,7 @@ pub(super) async fn admit(state: &AppState) -> Result<(), ServiceError> {
 }
 
 /// Starts the runner of this replica; it ends when the state is dropped.
-pub(super) fn spawn_runner(state: &AppState) {
+pub(crate) fn spawn_runner(state: &AppState) {
     let weak = state.downgrade();
     let wake = state.runner_wake();
     tokio::spawn(async move {
@@ -125,6 +125,12 @@ async fn run_claimed(state: AppState, c: ClaimedJob, claim: String) {
     match load(&state, c.robot_id, c.id).await {
         Ok(job) => {
             state.hold_claim(id, &claim);
+            let cancel = state.cancel_flag(id);
+            let heartbeat = tokio::spawn(heartbeat(state.clone(), id, claim.clone(), cancel));
+            let claim = Claim {
+                token: claim,
+                heartbeat,
+            };
             execute(state.clone(), job, Some(claim)).await;
             state.drop_claim(id);
         }
@@ -132,59 +138,10 @@ async fn run_claimed(state: AppState, c: ClaimedJob, claim: String) {
     }
 }
 
-/// Starts again the jobs a previous process of this store (SQLite) left
-/// queued: each is read as a claimed job is and waits for a worker slot, in
-/// the order they were queued. A job that cannot be read fails with the
-/// reason. Returns how many were queued again.
-pub async fn resume_queued(state: &AppState) -> Result<usize, ServiceError> {
-    let queued = state.db().queued_jobs().await?;
-    for &(id, robot_id) in &queued {
-        match load(state, robot_id, id).await {
-            Ok(mut job) => {
-                job.ticket = state.admit_job().ok();
-                super::calibrations::spawn_local(state, job);
-            }
-            Err(e) => {
-                if let Err(e) = state
-                    .db()
-                    .finish_calibration_error(id, None, JobStatus::Failed, &e.to_string())
-                    .await
-                {
-                    tracing::error!(job = id, error = %e, "cannot end the calibration");
-                }
-            }
-        }
-    }
-    Ok(queued.len())
-}
-
-/// The job of a stored row: its robot, sets and options as stored.
-async fn load(
-    state: &AppState,
-    robot_id: i64,
-    id: i64,
-) -> Result<super::calibrations::Job, ServiceError> {
-    let robot = state
-        .db()
-        .robot(robot_id)
-        .await?
-        .ok_or_else(|| ServiceError::robot_not_found(robot_id))?;
-    let row = state
-        .db()
-        .calibration(robot_id, id)
-        .await?
-        .ok_or_else(|| ServiceError::calibration_not_found(robot_id, id))?;
-    let nominal = RobotModel::from_json(&robot.model_json)
-        .map_err(|e| ServiceError::Internal(format!("stored model of robot {}: {e}", robot.id)))?;
-    let cmd = stored_command(&row)?;
-    let prepared = prepare(state, robot_id, &nominal, &cmd).await?;
-    Ok(job_of(id, robot_id, robot.name, nominal, prepared, None))
-}
-
 /// Renews the lease of a running job every fifth of the lease and raises
 /// its cancel flag when a cancel was requested (from any replica) or the
 /// claim is lost.
-pub(super) async fn heartbeat(state: AppState, id: i64, claim: String, cancel: Arc<AtomicBool>) {
+async fn heartbeat(state: AppState, id: i64, claim: String, cancel: Arc<AtomicBool>) {
     let lease = state.config().job_lease;
     let beat = (lease / 5).max(Duration::from_millis(100));
     loop {

@@ -1,0 +1,97 @@
+//! What a successful job stores: one calibrated model file per method (a
+//! method whose file does not load back moves to the failed list) and the
+//! job's summary.
+
+use crate::compensate::{CalibratedModelFile, CompensatedModel};
+use crate::db::{JobSummary, NewVersion};
+use crate::identify::{CalibrationOptions, CalibrationReport, FailedMethod};
+use crate::model::RobotModel;
+use serde_json::json;
+
+/// The summary of a report: the best method by validation mean (by
+/// identification mean when there are no validation poses), its errors next
+/// to the nominal model's on the same poses, every warning and failed method.
+pub fn summary_of(r: &CalibrationReport) -> JobSummary {
+    let best = r.best_method();
+    let validated = best.is_some_and(|m| m.validation.is_some());
+    let (set, nominal) = match best {
+        Some(m) if validated => (m.validation.as_ref(), r.nominal.validation.as_ref()),
+        Some(m) => (Some(&m.identification), Some(&r.nominal.identification)),
+        None => (None, None),
+    };
+    JobSummary {
+        best_method: best
+            .map(|m| m.method.name().to_string())
+            .unwrap_or_default(),
+        judged_on: if validated {
+            "validation"
+        } else {
+            "identification"
+        }
+        .to_string(),
+        mean_mm: set.map_or(f64::NAN, |s| s.stats.mean_mm),
+        max_mm: set.map_or(f64::NAN, |s| s.stats.max_mm),
+        nominal_mean_mm: nominal.map_or(f64::NAN, |s| s.stats.mean_mm),
+        warnings: r
+            .methods
+            .iter()
+            .flat_map(|(name, m)| {
+                m.warnings
+                    .iter()
+                    .map(move |w| format!("{name}: {}", w.message))
+            })
+            .collect(),
+        failed_methods: r
+            .failed
+            .iter()
+            .map(|f| format!("{}: {}", f.method.name(), f.reason))
+            .collect(),
+    }
+}
+
+/// One calibrated model file per method, in the order the methods ran. A
+/// method whose file does not load back (what solve would use) moves from the
+/// report's methods to its failed list; the others are stored.
+pub(super) fn versions_of(
+    r: &mut CalibrationReport,
+    nominal: &RobotModel,
+    robot_name: &str,
+    opts: &CalibrationOptions,
+    payload_kg: f64,
+) -> Vec<NewVersion> {
+    let cell_from_base = r.tracker_to_base.inverse();
+    let mut out = Vec::new();
+    for method in &opts.methods {
+        let Some(m) = r.methods.get(method) else {
+            continue;
+        };
+        let cm = CompensatedModel {
+            calibrated: m.calibrated.clone(),
+            nominal: nominal.clone(),
+            cell_from_base,
+            payload_kg,
+            compensator: m.compensator_arc(),
+        };
+        let mut file =
+            CalibratedModelFile::from_compensated(&cm, robot_name, &m.model_file_method());
+        file.validation = m.validation_evidence.clone();
+        if let Err(e) = file.to_compensated() {
+            r.methods.remove(method);
+            r.failed.push(FailedMethod {
+                method: *method,
+                reason: format!("the {} model does not load back: {e}", method.name()),
+            });
+            continue;
+        }
+        let stats = json!({
+            "identification": m.identification.stats,
+            "validation": m.validation.as_ref().map(|v| &v.stats),
+        });
+        out.push(NewVersion {
+            method: method.name().to_string(),
+            model_json: file.to_json(),
+            stats,
+        });
+    }
+    out
+}
