@@ -133,7 +133,11 @@ impl CalibratedModelFile {
         if let Some(c) = &self.compensator {
             // Every value within its bound, named (model::bounds), then the
             // sizes consistent.
-            check_compensator(c, self.compensator_support.as_ref())?;
+            check_compensator(
+                c,
+                self.compensator_support.as_ref(),
+                self.compensator_orientation.as_ref(),
+            )?;
             c.validate()
                 .map_err(|e| CompensateError::Format(format!("compensator: {e}")))?;
         }

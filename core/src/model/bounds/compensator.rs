@@ -5,6 +5,9 @@
 //! (inputs rad, kg, N·m; outputs m). The consistency of the sizes (weights
 //! for the layers, one range per joint) is the compensator's own check
 //! (`StoredCompensator::validate`, `Support::validate`).
+//! The orientation part (`compensator_orientation`) is a network of the same
+//! kinds whose outputs are a rotation vector [rad]: its output quantities
+//! have bounds of their own ([`ORIENTATION_OUTPUTS`]).
 
 use super::{
     check_above, check_all, check_count, Bound, ERROR_SCALE, GP_COEFFICIENT, GP_VARIANCE_M2,
@@ -12,7 +15,9 @@ use super::{
     OUTPUT_SCALE, RBF_NORMALISED, RESIDUAL_M,
 };
 use crate::compensate::support::MAX_POINTS;
-use crate::compensate::{Gp, Mlp, Normalisation, Rbf, StoredCompensator, Support};
+use crate::compensate::{
+    Gp, Mlp, Normalisation, Rbf, StoredCompensator, StoredOrientation, Support,
+};
 use crate::model::description::ModelError;
 
 /// Most hidden units of an MLP (the largest trained has 40).
@@ -23,23 +28,88 @@ pub const MAX_RBF_UNITS: usize = 10_000;
 /// matrix holds the square of this).
 pub const MAX_GP_UNITS: usize = 5000;
 
-const C: &str = "compensator";
+/// The bounds of a network's output quantities, which differ between the
+/// position part [m] and the orientation part [rad].
+pub struct Outputs {
+    /// Output centre, GP mean, uncompensated RMS.
+    pub residual: Bound,
+    /// An MLP's output scale.
+    pub output_scale: Bound,
+    /// A GP's signal and noise variances.
+    pub variance: Bound,
+    /// A GP's weights and variance matrix.
+    pub coefficient: Bound,
+}
 
-/// Checks every value of `c` and of `support` against its bound; the error
-/// names the field (`compensator.weights[12]`), its value and the bound.
+/// The position part's outputs [m].
+pub const POSITION_OUTPUTS: Outputs = Outputs {
+    residual: RESIDUAL_M,
+    output_scale: OUTPUT_SCALE,
+    variance: GP_VARIANCE_M2,
+    coefficient: GP_COEFFICIENT,
+};
+
+/// The orientation part's outputs, a rotation vector [rad]: a turn beyond
+/// π is no residual, so ±10 rad leaves room for any centre or mean; the
+/// other bounds are the position part's read in radians.
+pub const ORIENTATION_OUTPUTS: Outputs = Outputs {
+    residual: Bound {
+        min: -10.0,
+        max: 10.0,
+        unit: "rad",
+    },
+    output_scale: Bound {
+        min: 0.0,
+        max: 1e13,
+        unit: "1/rad",
+    },
+    variance: Bound {
+        min: 0.0,
+        max: 1e2,
+        unit: "rad²",
+    },
+    coefficient: Bound {
+        min: -1e30,
+        max: 1e30,
+        unit: "1/rad or 1/rad²",
+    },
+};
+
+/// Checks every value of `c`, of `support` and of the orientation part
+/// against its bound; the error names the field
+/// (`compensator.weights[12]`, `compensator_orientation.network.alpha[3]`),
+/// its value and the bound.
 pub fn check_compensator(
     c: &StoredCompensator,
     support: Option<&Support>,
+    orientation: Option<&StoredOrientation>,
 ) -> Result<(), ModelError> {
-    match c {
-        StoredCompensator::Mlp(m) => check_mlp(m)?,
-        StoredCompensator::Rbf(r) => check_rbf(r)?,
-        StoredCompensator::Gp(g) => check_gp(g)?,
-    }
+    check_network("compensator", c, &POSITION_OUTPUTS)?;
     if let Some(s) = support {
         check_support(s)?;
     }
+    if let Some(o) = orientation {
+        const O: &str = "compensator_orientation";
+        check_all(&format!("{O}.point_m"), &o.point_m, &POINT_M)?;
+        check_network(&format!("{O}.network"), &o.network, &ORIENTATION_OUTPUTS)?;
+    }
     Ok(())
+}
+
+/// The measured point of the orientation part, flange frame [m]: the
+/// model's tool points are bounded by [`super::POINT_MM`] (300 m).
+const POINT_M: Bound = Bound {
+    min: -300.0,
+    max: 300.0,
+    unit: "m",
+};
+
+fn check_network(f: &str, c: &StoredCompensator, out: &Outputs) -> Result<(), ModelError> {
+    match c {
+        StoredCompensator::Mlp(m) => check_mlp(f, m, out),
+        StoredCompensator::Rbf(r) => check_rbf(f, r),
+        StoredCompensator::Gp(g) => check_gp(f, g, out),
+    }
 }
 
 fn check_norm(
@@ -60,37 +130,37 @@ fn check_norm(
     }
 }
 
-fn check_mlp(m: &Mlp) -> Result<(), ModelError> {
+fn check_mlp(f: &str, m: &Mlp, out: &Outputs) -> Result<(), ModelError> {
     check_count(
-        &format!("{C}.hidden"),
+        &format!("{f}.hidden"),
         m.hidden,
         MAX_MLP_HIDDEN,
         "hidden units",
     )?;
-    check_all(&format!("{C}.weights"), &m.weights, &NETWORK_WEIGHT)?;
+    check_all(&format!("{f}.weights"), &m.weights, &NETWORK_WEIGHT)?;
     check_norm(
-        &format!("{C}.input_norm"),
+        &format!("{f}.input_norm"),
         &m.input_norm,
         &INPUT_CENTRE,
         &INPUT_SCALE,
         false,
     )?;
     check_norm(
-        &format!("{C}.output_norm"),
+        &format!("{f}.output_norm"),
         &m.output_norm,
-        &RESIDUAL_M,
-        &OUTPUT_SCALE,
+        &out.residual,
+        &out.output_scale,
         true,
     )
 }
 
-fn check_rbf(r: &Rbf) -> Result<(), ModelError> {
-    check_count(&format!("{C}.centres"), r.units(), MAX_RBF_UNITS, "units")?;
-    check_above(&format!("{C}.spread"), r.spread, &positive(&RBF_NORMALISED))?;
-    check_all(&format!("{C}.centres"), &r.centres, &RBF_NORMALISED)?;
-    check_all(&format!("{C}.weights"), &r.weights, &NETWORK_WEIGHT)?;
+fn check_rbf(f: &str, r: &Rbf) -> Result<(), ModelError> {
+    check_count(&format!("{f}.centres"), r.units(), MAX_RBF_UNITS, "units")?;
+    check_above(&format!("{f}.spread"), r.spread, &positive(&RBF_NORMALISED))?;
+    check_all(&format!("{f}.centres"), &r.centres, &RBF_NORMALISED)?;
+    check_all(&format!("{f}.weights"), &r.weights, &NETWORK_WEIGHT)?;
     check_norm(
-        &format!("{C}.input_norm"),
+        &format!("{f}.input_norm"),
         &r.input_norm,
         &INPUT_CENTRE,
         &INPUT_SCALE,
@@ -98,37 +168,37 @@ fn check_rbf(r: &Rbf) -> Result<(), ModelError> {
     )
 }
 
-fn check_gp(g: &Gp) -> Result<(), ModelError> {
+fn check_gp(f: &str, g: &Gp, out: &Outputs) -> Result<(), ModelError> {
     check_count(
-        &format!("{C}.alpha"),
+        &format!("{f}.alpha"),
         g.units(),
         MAX_GP_UNITS,
         "inducing configurations",
     )?;
     check_all(
-        &format!("{C}.inverse_length_scales"),
+        &format!("{f}.inverse_length_scales"),
         &g.inverse_length_scales,
         &INVERSE_LENGTH_SCALE,
     )?;
     check_above(
-        &format!("{C}.signal_variance"),
+        &format!("{f}.signal_variance"),
         g.signal_variance,
-        &GP_VARIANCE_M2,
+        &out.variance,
     )?;
     check_above(
-        &format!("{C}.noise_variance"),
+        &format!("{f}.noise_variance"),
         g.noise_variance,
-        &GP_VARIANCE_M2,
+        &out.variance,
     )?;
-    check_all(&format!("{C}.mean"), &g.mean, &RESIDUAL_M)?;
-    check_all(&format!("{C}.inducing"), &g.inducing, &JOINT_RAD)?;
-    check_all(&format!("{C}.alpha"), &g.alpha, &GP_COEFFICIENT)?;
-    check_all(&format!("{C}.variance"), &g.variance, &GP_COEFFICIENT)?;
-    check_above(&format!("{C}.error_scale"), g.error_scale, &ERROR_SCALE)?;
+    check_all(&format!("{f}.mean"), &g.mean, &out.residual)?;
+    check_all(&format!("{f}.inducing"), &g.inducing, &JOINT_RAD)?;
+    check_all(&format!("{f}.alpha"), &g.alpha, &out.coefficient)?;
+    check_all(&format!("{f}.variance"), &g.variance, &out.coefficient)?;
+    check_above(&format!("{f}.error_scale"), g.error_scale, &ERROR_SCALE)?;
     super::check(
-        &format!("{C}.uncompensated_rms"),
+        &format!("{f}.uncompensated_rms"),
         g.uncompensated_rms,
-        &positive(&RESIDUAL_M),
+        &positive(&out.residual),
     )?;
     Ok(())
 }
@@ -246,6 +316,36 @@ mod tests {
             let m = load(&v).unwrap_or_else(|e| panic!("{kind}: {e}"));
             assert!(m.compensator.is_some(), "{kind}");
         }
+    }
+
+    /// The orientation part is checked as the position part is, under its
+    /// own name and with its outputs in radians: a GP's mean of 50 rad is a
+    /// turn no residual makes though 50 m would pass the position bound.
+    #[test]
+    fn the_orientation_part_is_checked_under_its_own_name() {
+        let gp = trained_file(&specs()[2].1);
+        let mut v = gp.clone();
+        v["compensator_orientation"] = serde_json::json!({
+            "point_m": [0.0, 0.0, 0.1],
+            "network": gp["compensator"].clone(),
+        });
+        let m = load(&v).expect("a trained network as the orientation part");
+        assert!(m.compensator.is_some());
+        let e = refused(&v, "/compensator_orientation/network/mean/0", 50.0.into());
+        assert!(
+            e.contains("compensator_orientation.network.mean") && e.contains("rad"),
+            "{e}"
+        );
+        assert!(load(&{
+            let mut p = v.clone();
+            p["compensator"]["mean"][0] = 50.0.into();
+            p
+        })
+        .is_ok());
+        let e = refused(&v, "/compensator_orientation/point_m/2", 1e6.into());
+        assert!(e.contains("compensator_orientation.point_m"), "{e}");
+        let e = refused(&v, "/compensator_orientation/network/alpha/0", 1e308.into());
+        assert!(e.contains("compensator_orientation.network.alpha"), "{e}");
     }
 
     /// 1e308 stands for any huge value; JSON has no NaN, so a non-finite
@@ -418,7 +518,9 @@ mod tests {
         if let StoredCompensator::Gp(g) = &mut c {
             g.variance[3] = f64::NAN;
         }
-        let e = super::check_compensator(&c, None).unwrap_err().to_string();
+        let e = super::check_compensator(&c, None, None)
+            .unwrap_err()
+            .to_string();
         assert!(
             e.contains("`compensator.variance[3]`: NaN is outside"),
             "{e}"
@@ -427,7 +529,9 @@ mod tests {
             g.variance[3] = 0.0;
             g.mean[1] = f64::NEG_INFINITY;
         }
-        let e = super::check_compensator(&c, None).unwrap_err().to_string();
+        let e = super::check_compensator(&c, None, None)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("`compensator.mean[1]`: -inf is outside"), "{e}");
     }
 }
