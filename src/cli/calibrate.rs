@@ -315,17 +315,10 @@ fn save_model(
         }
         None => report.best_method().context("no method ran")?,
     };
-    let model = crate::compensate::CompensatedModel {
-        calibrated: chosen.calibrated.clone(),
-        nominal: nominal.clone(),
-        cell_from_base: report.tracker_to_base.inverse(),
-        payload_kg: payload,
-        compensator: chosen.compensator_arc(),
-    };
     let label = chosen.model_file_method();
-    let mut file =
-        crate::compensate::CalibratedModelFile::from_compensated(&model, &nominal.name, &label);
-    file.validation = chosen.validation_evidence.clone();
+    let file =
+        crate::identify::calibrated_model_file(report, chosen, nominal, &nominal.name, payload)
+            .map_err(|e| anyhow::anyhow!("the {label} model does not load back: {e}"))?;
     super::model_files::save_model_file(&file, std::path::Path::new(path))?;
     eprintln!("saved the {label} model to {path}");
     Ok(())

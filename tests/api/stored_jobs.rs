@@ -41,16 +41,19 @@ async fn versions_of(t: &TestApp, robot: i64, job: i64) -> Vec<(String, String, 
     out
 }
 
-#[tokio::test]
-async fn a_job_stored_in_the_old_form_runs_to_the_same_model() {
+/// A service with one worker and a YS100 with one identification set: the
+/// robot's id (number and text) and the set's id.
+async fn robot_with_set() -> (TestApp, i64, String, i64) {
     let t = setup_with(&[], 1).await;
     let (robot, rid) = t.robot_with_identification_set().await;
-    let set = t
-        .get("/v1/robots/{id}/measurement-sets", &[&rid])
-        .await
-        .json()["measurement_sets"][0]["id"]
-        .as_i64()
-        .unwrap();
+    let sets = t.get("/v1/robots/{id}/measurement-sets", &[&rid]).await;
+    let set = sets.json()["measurement_sets"][0]["id"].as_i64().unwrap();
+    (t, robot, rid, set)
+}
+
+#[tokio::test]
+async fn a_job_stored_in_the_old_form_runs_to_the_same_model() {
+    let (t, robot, rid, set) = robot_with_set().await;
     // Queued now, through the API.
     let body =
         json!({ "methods": ["km", "skcm"], "seed": 3, "max_iterations": 40, "payload_kg": 2.5 });
@@ -100,14 +103,7 @@ async fn a_job_stored_in_the_old_form_runs_to_the_same_model() {
 
 #[tokio::test]
 async fn a_job_whose_stored_options_are_unreadable_fails_with_the_reason() {
-    let t = setup_with(&[], 1).await;
-    let (robot, rid) = t.robot_with_identification_set().await;
-    let set = t
-        .get("/v1/robots/{id}/measurement-sets", &[&rid])
-        .await
-        .json()["measurement_sets"][0]["id"]
-        .as_i64()
-        .unwrap();
+    let (t, robot, _, set) = robot_with_set().await;
     // `seed` missing: neither format can be read.
     execute(
         &t,

@@ -16,6 +16,7 @@ pub mod identifiability;
 pub mod joint_maps;
 pub mod least_squares;
 pub mod methods;
+pub mod model_file;
 pub mod options;
 pub mod pose_selection;
 pub mod registration;
@@ -26,6 +27,7 @@ pub use checks::CalibrationError;
 pub use identifiability::{DropKind, IdentifiabilityReport, IdentifiabilitySettings};
 pub use least_squares::{LmReport, LmSettings, StopReason};
 pub use methods::{Method, MethodChoice, MethodFailure, MethodListError, MethodRow, METHODS};
+pub use model_file::calibrated_model_file;
 pub use options::{CalibrationOptions, CompensatorOptions, Progress};
 pub use registration::{register, Registration};
 pub use report::{

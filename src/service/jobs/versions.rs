@@ -2,9 +2,8 @@
 //! method whose file does not load back moves to the failed list) and the
 //! job's summary.
 
-use crate::compensate::{CalibratedModelFile, CompensatedModel};
 use crate::db::{JobSummary, NewVersion};
-use crate::identify::{CalibrationOptions, CalibrationReport, FailedMethod};
+use crate::identify::{calibrated_model_file, CalibrationOptions, CalibrationReport, FailedMethod};
 use crate::model::RobotModel;
 use serde_json::json;
 
@@ -59,30 +58,22 @@ pub(super) fn versions_of(
     opts: &CalibrationOptions,
     payload_kg: f64,
 ) -> Vec<NewVersion> {
-    let cell_from_base = r.tracker_to_base.inverse();
     let mut out = Vec::new();
     for method in &opts.methods {
         let Some(m) = r.methods.get(method) else {
             continue;
         };
-        let cm = CompensatedModel {
-            calibrated: m.calibrated.clone(),
-            nominal: nominal.clone(),
-            cell_from_base,
-            payload_kg,
-            compensator: m.compensator_arc(),
+        let file = match calibrated_model_file(r, m, nominal, robot_name, payload_kg) {
+            Ok(file) => file,
+            Err(e) => {
+                r.methods.remove(method);
+                r.failed.push(FailedMethod {
+                    method: *method,
+                    reason: format!("the {} model does not load back: {e}", method.name()),
+                });
+                continue;
+            }
         };
-        let mut file =
-            CalibratedModelFile::from_compensated(&cm, robot_name, &m.model_file_method());
-        file.validation = m.validation_evidence.clone();
-        if let Err(e) = file.to_compensated() {
-            r.methods.remove(method);
-            r.failed.push(FailedMethod {
-                method: *method,
-                reason: format!("the {} model does not load back: {e}", method.name()),
-            });
-            continue;
-        }
         let stats = json!({
             "identification": m.identification.stats,
             "validation": m.validation.as_ref().map(|v| &v.stats),
