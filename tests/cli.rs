@@ -233,5 +233,28 @@ fn compensator_method_saves_and_solves() {
         let reached = model.predict(&q).unwrap().p * 1e3;
         assert!((reached - p).norm() < 1e-3, "{} mm", (reached - p).norm());
     }
+    // The same file with one network weight out of its bound: refused,
+    // naming the field, its value and the bound.
+    let mut hostile: serde_json::Value = serde_json::from_str(&file).unwrap();
+    hostile["compensator"]["weights"][3] = 1e308.into();
+    std::fs::write(dir.join("hostile.json"), hostile.to_string()).unwrap();
+    let out = robocal(
+        &[
+            "solve",
+            "--model",
+            "hostile.json",
+            "--targets",
+            "targets.csv",
+        ],
+        &dir,
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(
+        err.contains("`compensator.weights[3]`")
+            && err.contains("1e308")
+            && err.contains("[-1e12, 1e12]"),
+        "{err}"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
