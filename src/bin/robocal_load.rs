@@ -21,7 +21,7 @@
 
 // Shared with robocal-soak; each binary uses part of it.
 #[allow(dead_code)]
-#[path = "shared/client.rs"]
+#[path = "loopback/client.rs"]
 mod client;
 
 use crate::client::Conn;

@@ -40,7 +40,7 @@
 
 // Shared with robocal-load; each binary uses part of it.
 #[allow(dead_code)]
-#[path = "../shared/client.rs"]
+#[path = "../loopback/client.rs"]
 mod client;
 mod replicas;
 mod sqlite;
