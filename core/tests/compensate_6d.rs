@@ -40,8 +40,8 @@ use robocal_core::compensate::{parse_compensated, CalibratedModelFile, Compensat
 use robocal_core::identify::{calibrate_with_training, CalibrationReport, Method};
 use robocal_core::ik::IkSettings;
 use robocal_core::measure::Measurement;
-use robocal_core::model::{preset, Pose, RobotModel};
-use robocal_core::sim::{perturb_geometry, tracker_frame, ErrorMagnitudes, TrueRobot};
+use robocal_core::model::{Pose, RobotModel};
+use robocal_core::sim::TrueRobot;
 
 const POSITION_NOISE_MM: f64 = 0.01;
 const ORIENTATION_NOISE_DEG: f64 = 0.005;
@@ -52,15 +52,7 @@ const GEAR_DEG: f64 = 0.02;
 const HOME: [f64; 6] = [0.3, -1.2, 1.4, -1.5, -1.4, 0.5];
 
 fn truth(rng: &mut ChaCha8Rng) -> (RobotModel, TrueRobot) {
-    let mut nominal = preset("ur10").unwrap();
-    nominal.tool.p = Vector3::new(40.0, 25.0, 90.0) * 1e-3;
-    let mut t = perturb_geometry(&nominal, &ErrorMagnitudes::from_mm_deg(0.3, 0.03), rng);
-    t.links[5].d += 0.4e-3;
-    t.links[5].theta += 0.08f64.to_radians();
-    t.tool.p = nominal.tool.p + Vector3::new(0.5e-3, -0.3e-3, 0.4e-3);
-    t.tool.rpy = [0.3f64, -0.2, 0.4].map(f64::to_radians);
-    let mut truth = TrueRobot::new(t);
-    truth.tracker_from_base = tracker_frame(2.0, -1.0, 35.0, [2500.0, -400.0, 300.0]);
+    let (nominal, mut truth) = common::ur10_6d_truth(Vector3::new(40.0, 25.0, 90.0) * 1e-3, rng);
     truth.effects.gear_error = Some((GEAR_DEG.to_radians(), 1));
     (nominal, truth)
 }

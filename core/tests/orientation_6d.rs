@@ -28,11 +28,8 @@ use rand_distr::{Distribution, Normal};
 use robocal_core::identify::report::WarningKind;
 use robocal_core::identify::{CalibrationReport, Method};
 use robocal_core::measure::{Measurement, RowStd};
-use robocal_core::model::{preset, Pose, RobotModel};
-use robocal_core::sim::{
-    fine_transmission_errors, perturb_geometry, random_configurations, tracker_frame,
-    ErrorMagnitudes, TrueRobot,
-};
+use robocal_core::model::{Pose, RobotModel};
+use robocal_core::sim::{fine_transmission_errors, random_configurations, TrueRobot};
 
 const POSITION_NOISE_MM: f64 = 0.01;
 const ORIENTATION_NOISE_DEG: f64 = 0.005;
@@ -42,15 +39,7 @@ const ORIENTATION_NOISE_DEG: f64 = 0.005;
 /// d6 + 0.4 mm, θ6 + 0.08°, the tool 0.5 mm and (0.3°, −0.2°, 0.4°) off,
 /// periodic transmission errors of 3 harmonics at 25 arcsec per joint.
 fn truth(tool_mm: [f64; 3], rng: &mut ChaCha8Rng) -> (RobotModel, TrueRobot) {
-    let mut nominal = preset("ur10").unwrap();
-    nominal.tool.p = Vector3::from(tool_mm) * 1e-3;
-    let mut t = perturb_geometry(&nominal, &ErrorMagnitudes::from_mm_deg(0.3, 0.03), rng);
-    t.links[5].d += 0.4e-3;
-    t.links[5].theta += 0.08f64.to_radians();
-    t.tool.p = nominal.tool.p + Vector3::new(0.5e-3, -0.3e-3, 0.4e-3);
-    t.tool.rpy = [0.3f64, -0.2, 0.4].map(f64::to_radians);
-    let mut truth = TrueRobot::new(t);
-    truth.tracker_from_base = tracker_frame(2.0, -1.0, 35.0, [2500.0, -400.0, 300.0]);
+    let (nominal, mut truth) = common::ur10_6d_truth(Vector3::from(tool_mm) * 1e-3, rng);
     truth.effects.transmission = fine_transmission_errors(6, 3, 25.0, rng);
     (nominal, truth)
 }

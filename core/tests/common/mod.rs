@@ -130,3 +130,23 @@ pub fn model_text(name: &str) -> String {
 pub fn shipped_model(name: &str) -> RobotModel {
     RobotModel::from_json(&model_text(name)).unwrap()
 }
+
+/// The nominal UR10 with a measurement tool (the probe) at `tool_m` from the
+/// flange [m], and its 6-D truth without effects: geometric errors (0.3 mm /
+/// 0.03°, drawn from `rng`), d6 + 0.4 mm, θ6 + 0.08°, the tool 0.5 mm and
+/// (0.3°, −0.2°, 0.4°) off, the tracker 2.5 m away.
+pub fn ur10_6d_truth(
+    tool_m: nalgebra::Vector3<f64>,
+    rng: &mut ChaCha8Rng,
+) -> (RobotModel, TrueRobot) {
+    let mut nominal = preset("ur10").unwrap();
+    nominal.tool.p = tool_m;
+    let mut t = perturb_geometry(&nominal, &ErrorMagnitudes::from_mm_deg(0.3, 0.03), rng);
+    t.links[5].d += 0.4e-3;
+    t.links[5].theta += 0.08f64.to_radians();
+    t.tool.p = nominal.tool.p + nalgebra::Vector3::new(0.5e-3, -0.3e-3, 0.4e-3);
+    t.tool.rpy = [0.3f64, -0.2, 0.4].map(f64::to_radians);
+    let mut truth = TrueRobot::new(t);
+    truth.tracker_from_base = tracker_frame(2.0, -1.0, 35.0, [2500.0, -400.0, 300.0]);
+    (nominal, truth)
+}
