@@ -5,6 +5,7 @@
 # assertions, hangs and broken round trips).
 #
 #   scripts/fuzz.sh [SECONDS_PER_TARGET]     (default 60)
+#   scripts/fuzz.sh --build-only             (install cargo-fuzz, build the targets)
 #
 # Targets (fuzz/fuzz_targets/): measurement_csv, targets_csv, model_json,
 # solve_request and the program parsers program_krl, program_rapid,
@@ -17,6 +18,11 @@
 # test in tests/fuzz_regressions.rs.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+BUILD_ONLY=
+if [ "${1:-}" = "--build-only" ]; then
+    BUILD_ONLY=1
+    shift
+fi
 SECS=${1:-60}
 VERSION=0.13.2
 if ! cargo fuzz --version 2>/dev/null | grep -q "$VERSION"; then
@@ -24,6 +30,7 @@ if ! cargo fuzz --version 2>/dev/null | grep -q "$VERSION"; then
 fi
 cd fuzz
 cargo fuzz build --sanitizer none
+[ -z "$BUILD_ONLY" ] || exit 0
 # One libFuzzer process per target, as many at once as there are cores
 # (`FUZZ_JOBS`, default `nproc`): each is single-threaded, so the targets
 # share the wall time instead of queueing.

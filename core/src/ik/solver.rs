@@ -39,7 +39,7 @@ use eval::{Local, PreparedModel};
 use reach::{
     wrist_deviation, CORRECTED_REACH_TOLERANCE_M, REACH_MARGIN_FACTOR, REACH_MARGIN_FLOOR_M,
 };
-use seeds::halton_joints;
+use seeds::{halton_joints, Seeds, Starts};
 
 /// Slack on the reach bound (compensator residuals, loop geometry) [m].
 const REACH_SLACK_M: f64 = 0.05;
@@ -299,6 +299,51 @@ impl From<&Pose> for Goal {
     }
 }
 
+/// The damped Newton runs of one goal: each from a start with a budget,
+/// the first converged one in an acceptable branch the answer, the best
+/// attempt kept otherwise.
+struct Attempts<'a> {
+    solver: &'a IkSolver,
+    goal: &'a Goal,
+    position_only: bool,
+    branch: Option<Configuration>,
+    total_iters: usize,
+    best: Option<Refined>,
+}
+
+impl Attempts<'_> {
+    /// One damped Newton run of `budget` evaluations from `q0`: the solution
+    /// when it converges in an acceptable branch, otherwise kept in `best`
+    /// when it is the best attempt so far.
+    fn attempt(
+        &mut self,
+        q0: &[f64],
+        budget: usize,
+        expansion: Option<&Local>,
+    ) -> Option<IkSolution> {
+        let s = self.solver;
+        let r = s.refine_from(self.goal, q0, self.position_only, budget, expansion);
+        self.total_iters += r.iterations;
+        let branch_ok = match (self.branch, s.configuration(&r.q)) {
+            (Some(want), Some(got)) => want == got,
+            _ => true,
+        };
+        if r.converged && branch_ok {
+            return Some(s.solution(self.goal, r, self.total_iters, None));
+        }
+        let better = self.best.as_ref().is_none_or(|b| {
+            (r.converged && !b.converged)
+                || (r.converged == b.converged
+                    && r.position_residual_m + r.orientation_residual_rad
+                        < b.position_residual_m + b.orientation_residual_rad)
+        });
+        if better {
+            self.best = Some(r);
+        }
+        None
+    }
+}
+
 /// Outcome of one damped Newton run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Refined {
@@ -491,32 +536,14 @@ impl IkSolver {
         }
         let position_only = options.position_only || goal.rotation.is_none();
         if !self.within_reach(goal) {
-            return IkSolution {
-                converged: false,
-                q: Vec::new(),
-                position_residual_mm: (goal.position.norm() - self.reach) * 1e3,
-                orientation_residual_rad: f64::NAN,
-                iterations: 0,
-                branch: None,
-                reason: Some(FailureReason::Unreachable),
-            };
+            return self.beyond_reach_bound(goal);
         }
         let seeds = self.seeds(goal, options);
         let fail = IkSolution::failed;
-        // The reach test: beyond the nominal workspace by more than the
-        // calibrated model can deviate from it.
+        if let Some(refused) = self.refused_by_seeds(&seeds, options.branch) {
+            return refused;
+        }
         let reach_test = self.settings.reach_test;
-        if reach_test && seeds.reach_excess_m > self.reach_margin_m {
-            return fail(FailureReason::Unreachable);
-        }
-        if let (Some(requested), true) = (options.branch, seeds.branch_out_of_limits) {
-            return fail(FailureReason::BranchUnavailable {
-                requested,
-                out_of_limits: true,
-                singular: false,
-                reachable: seeds.reachable.clone(),
-            });
-        }
         let mut total_iters = 0;
         // Within the margin of the nominal workspace's boundary (either side):
         // the same test with the target moved by the calibrated model's own
@@ -540,84 +567,43 @@ impl IkSolver {
                 return unreachable;
             }
         }
-        let mut best: Option<Refined> = None;
-        let branch_ok = |q: &[f64]| match (options.branch, self.configuration(q)) {
-            (Some(want), Some(got)) => want == got,
-            _ => true,
-        };
-        // One damped Newton run of `budget` evaluations from `q0`: the
-        // solution when it converges in an acceptable branch, otherwise kept
-        // in `best` when it is the best attempt so far.
         let max_iterations = self.settings.max_iterations;
-        let attempt = |q0: &[f64],
-                       budget: usize,
-                       expansion: Option<&Local>,
-                       total_iters: &mut usize,
-                       best: &mut Option<Refined>|
-         -> Option<IkSolution> {
-            let r = self.refine_from(goal, q0, position_only, budget, expansion);
-            *total_iters += r.iterations;
-            if r.converged && branch_ok(&r.q) {
-                return Some(self.solution(goal, r, *total_iters, None));
-            }
-            let better = best.as_ref().is_none_or(|b| {
-                (r.converged && !b.converged)
-                    || (r.converged == b.converged
-                        && r.position_residual_m + r.orientation_residual_rad
-                            < b.position_residual_m + b.orientation_residual_rad)
-            });
-            if better {
-                *best = Some(r);
-            }
-            None
+        let mut runs = Attempts {
+            solver: self,
+            goal,
+            position_only,
+            branch: options.branch,
+            total_iters,
+            best: None,
         };
         // Seeds whose corrected target lies beyond their branch's reach wait
         // until the other seeds have been tried (a damped Newton run that
         // cannot reach stalls for tens of evaluations at the boundary).
         // Each seed's starts, with the expansion of the joint maps and the
         // compensator at the seed (from its correction) that both start on.
-        let mut deferred: Vec<(Vec<Vec<f64>>, Option<Local>)> = Vec::new();
+        let mut deferred: Vec<Starts> = Vec::new();
         let seeds_now = seeds.list.iter().take(seeds.max_attempts.max(1));
         for seed in seeds_now {
-            // The corrected closed-form seed first, then the plain one.
-            let mut starts = Vec::with_capacity(2);
-            let mut beyond_reach = false;
-            let mut expansion = None;
-            if let (Some(a), Some(c)) = (&self.analytic, seed.configuration) {
-                let corrected = self.corrected_seed(a, &seeds.target, seed, c);
-                total_iters += corrected.evaluations;
-                beyond_reach = corrected.beyond_reach;
-                expansion = corrected.expansion;
-                if corrected
-                    .q
-                    .iter()
-                    .zip(&seed.q)
-                    .any(|(x, y)| (x - y).abs() > 1e-9)
-                {
-                    starts.push(corrected.q);
-                }
-            }
-            starts.push(seed.q.clone());
-            if beyond_reach {
-                deferred.push((starts, expansion));
+            let starts = self.starts(&seeds.target, seed);
+            runs.total_iters += starts.evaluations;
+            if starts.beyond_reach {
+                deferred.push(starts);
                 continue;
             }
-            for q0 in starts {
-                let e = expansion.as_ref();
-                if let Some(s) = attempt(&q0, max_iterations, e, &mut total_iters, &mut best) {
+            for q0 in &starts.list {
+                if let Some(s) = runs.attempt(q0, max_iterations, starts.expansion.as_ref()) {
                     return s;
                 }
             }
         }
         if reach_pending {
-            if let Some(unreachable) = corrected_reach(&mut total_iters) {
+            if let Some(unreachable) = corrected_reach(&mut runs.total_iters) {
                 return unreachable;
             }
         }
-        for (starts, expansion) in deferred {
-            for q0 in starts {
-                let e = expansion.as_ref();
-                if let Some(s) = attempt(&q0, max_iterations, e, &mut total_iters, &mut best) {
+        for starts in deferred {
+            for q0 in &starts.list {
+                if let Some(s) = runs.attempt(q0, max_iterations, starts.expansion.as_ref()) {
                     return s;
                 }
             }
@@ -625,7 +611,8 @@ impl IkSolver {
         // Last resort: a long run from the best end point (slow progress along
         // the curved valleys of near-singular configurations; not for targets
         // that are centimetres away).
-        if let Some(q0) = best
+        if let Some(q0) = runs
+            .best
             .as_ref()
             .filter(|b| {
                 !b.converged && !b.failed_evaluation && b.position_residual_m < LAST_RESORT_MAX_M
@@ -633,11 +620,70 @@ impl IkSolver {
             .map(|b| b.q.clone())
         {
             let budget = max_iterations * self.settings.final_iterations_factor;
-            if let Some(s) = attempt(&q0, budget, None, &mut total_iters, &mut best) {
+            if let Some(s) = runs.attempt(&q0, budget, None) {
                 return s;
             }
         }
-        let reason = match (&best, options.branch) {
+        let (best, total_iters) = (runs.best, runs.total_iters);
+        let reason = self.failure_reason(best.as_ref(), options.branch, &seeds, corrected_excess);
+        match best {
+            Some(b) => {
+                let branch_failed = matches!(reason, FailureReason::BranchUnavailable { .. });
+                let mut s = self.solution(goal, b, total_iters, Some(reason));
+                if branch_failed {
+                    // The best attempt is in another branch: do not show it as the answer's.
+                    s.branch = None;
+                }
+                s
+            }
+            None => IkSolution {
+                iterations: total_iters,
+                ..fail(reason)
+            },
+        }
+    }
+
+    /// The answer for a goal beyond the reach bound ([`Self::within_reach`]).
+    fn beyond_reach_bound(&self, goal: &Goal) -> IkSolution {
+        IkSolution {
+            converged: false,
+            q: Vec::new(),
+            position_residual_mm: (goal.position.norm() - self.reach) * 1e3,
+            orientation_residual_rad: f64::NAN,
+            iterations: 0,
+            branch: None,
+            reason: Some(FailureReason::Unreachable),
+        }
+    }
+
+    /// A goal the seeds already refuse: the reach test (beyond the nominal
+    /// workspace by more than the calibrated model can deviate from it), or
+    /// a required `branch` that exists only outside the limits.
+    fn refused_by_seeds(&self, seeds: &Seeds, branch: Option<Configuration>) -> Option<IkSolution> {
+        if self.settings.reach_test && seeds.reach_excess_m > self.reach_margin_m {
+            return Some(IkSolution::failed(FailureReason::Unreachable));
+        }
+        match (branch, seeds.branch_out_of_limits) {
+            (Some(requested), true) => Some(IkSolution::failed(FailureReason::BranchUnavailable {
+                requested,
+                out_of_limits: true,
+                singular: false,
+                reachable: seeds.reachable.clone(),
+            })),
+            _ => None,
+        }
+    }
+
+    /// Why a goal failed, from the best attempt (if any), the required
+    /// branch, the seeds and the corrected reach excess [m].
+    fn failure_reason(
+        &self,
+        best: Option<&Refined>,
+        branch: Option<Configuration>,
+        seeds: &Seeds,
+        corrected_excess: f64,
+    ) -> FailureReason {
+        match (best, branch) {
             (None, _) if seeds.any_out_of_limits => FailureReason::OutOfLimits,
             (None, _) => FailureReason::Unreachable,
             (Some(b), _)
@@ -669,21 +715,6 @@ impl IkSolver {
                     FailureReason::DidNotConverge
                 }
             }
-        };
-        match best {
-            Some(b) => {
-                let branch_failed = matches!(reason, FailureReason::BranchUnavailable { .. });
-                let mut s = self.solution(goal, b, total_iters, Some(reason));
-                if branch_failed {
-                    // The best attempt is in another branch: do not show it as the answer's.
-                    s.branch = None;
-                }
-                s
-            }
-            None => IkSolution {
-                iterations: total_iters,
-                ..fail(reason)
-            },
         }
     }
 

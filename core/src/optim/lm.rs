@@ -345,6 +345,173 @@ struct AcceptedTrial {
     step: f64,
 }
 
+/// A linearised point as the damped trials see it: the Gram matrix `a` and
+/// gradient `g` of the (scaled) Jacobian, the columns held at a bound, the
+/// column scale and the cost.
+struct Linearised<'a> {
+    a: &'a DMatrix<f64>,
+    g: &'a DVector<f64>,
+    active: &'a [bool],
+    scale: Option<&'a DVector<f64>>,
+    cost: f64,
+}
+
+/// Linearises `p` at its start and, with `column_scaling`, scales the
+/// Jacobian's columns to unit norm, returning the scale.
+fn scaled_linearisation<P: LeastSquaresProblem + ?Sized>(
+    p: &mut P,
+    column_scaling: bool,
+) -> Option<DVector<f64>> {
+    let j = p.linearise();
+    column_scaling.then(|| {
+        let scale = column_scale(j);
+        scale_columns(j, &scale);
+        scale
+    })
+}
+
+/// Linearises `p` at its point, scaling the Jacobian's columns by `scale`.
+fn relinearise<P: LeastSquaresProblem + ?Sized>(p: &mut P, scale: Option<&DVector<f64>>) {
+    let j = p.linearise();
+    if let Some(scale) = scale {
+        scale_columns(j, scale);
+    }
+}
+
+/// The gradient measure at `p`'s linearised point (cost `cost`), marking the
+/// columns held at a bound in `active`.
+fn gradient_at<P: LeastSquaresProblem + ?Sized>(p: &P, cost: f64, active: &mut [bool]) -> f64 {
+    let js = p.jacobian();
+    let g = js.tr_mul(p.residuals());
+    mark_active(active, p.bounds(), &g);
+    gradient_measure(js, &g, cost.sqrt(), active)
+}
+
+/// What one linearisation's damped trials came to.
+struct Trials {
+    accepted: Option<AcceptedTrial>,
+    trials: usize,
+    evaluations_failed: usize,
+    /// Largest relative cost decrease the linear model predicted for an
+    /// evaluated trial.
+    predicted: f64,
+}
+
+/// Damped steps from the linearised point `at` until one lowers the cost,
+/// the damping is exhausted or the iteration budget is used up (each trial
+/// counts an iteration; each evaluated one an evaluation).
+fn damped_trials<P: LeastSquaresProblem + ?Sized>(
+    p: &mut P,
+    s: &Settings,
+    at: &Linearised<'_>,
+    damping: &mut DampingState,
+    iterations: &mut usize,
+    evaluations: &mut usize,
+) -> Result<Trials, Cancelled> {
+    let (a, g, cost) = (at.a, at.g, at.cost);
+    let ncols = g.len();
+    let mut accepted = None;
+    let (mut trials, mut evaluations_failed) = (0, 0);
+    let mut predicted = f64::NEG_INFINITY;
+    while damping.usable() && *iterations < s.max_iterations {
+        if !p.go_on() {
+            return Err(Cancelled);
+        }
+        *iterations += 1;
+        trials += 1;
+        let mut damped = a.clone();
+        let mut rhs = g.clone();
+        for i in 0..ncols {
+            damping.add(&mut damped, a, i);
+            if at.active[i] {
+                damped.row_mut(i).fill(0.0);
+                damped.column_mut(i).fill(0.0);
+                damped[(i, i)] = 1.0;
+                rhs[i] = 0.0;
+            }
+        }
+        let Some(chol) = damped.cholesky() else {
+            damping.reject();
+            continue;
+        };
+        let mut delta = chol.solve(&rhs);
+        if let Some(scale) = at.scale {
+            delta = delta.component_mul(scale);
+        }
+        if let Some(b) = p.bounds() {
+            project(&mut delta, &b);
+        }
+        *evaluations += 1;
+        let Some(trial_cost) = p.trial(&mut delta) else {
+            evaluations_failed += 1;
+            damping.reject();
+            continue;
+        };
+        let scaled = match at.scale {
+            Some(scale) => delta.component_div(scale),
+            None => delta,
+        };
+        // Over evaluated trials only: a step that cannot be evaluated
+        // says nothing about what is left to gain.
+        let decrease = predicted_decrease(a, g, &scaled);
+        predicted = predicted.max(decrease / cost);
+        if trial_cost < cost {
+            damping.accept(decrease, cost, trial_cost);
+            accepted = Some(AcceptedTrial {
+                cost: trial_cost,
+                step: scaled.norm(),
+            });
+            break;
+        }
+        damping.reject();
+    }
+    Ok(Trials {
+        accepted,
+        trials,
+        evaluations_failed,
+        predicted,
+    })
+}
+
+/// The convergence test after an accepted step: relative cost decrease
+/// `rel`, scaled step length `step`.
+fn converged_after(rel: f64, step: f64, s: &Settings) -> Option<Verdict> {
+    if rel < s.cost_tolerance {
+        Some(Verdict {
+            reason: StopReason::CostTolerance,
+            detail: format!(
+                "relative cost decrease {rel:.1e} below {:.0e}",
+                s.cost_tolerance
+            ),
+        })
+    } else if step < s.step_tolerance {
+        Some(Verdict {
+            reason: StopReason::StepTolerance,
+            detail: format!("scaled step {step:.1e} below {:.0e}", s.step_tolerance),
+        })
+    } else {
+        None
+    }
+}
+
+/// The verdict when a budget ran out before a convergence test passed.
+fn budget_verdict(iterations: usize, s: &Settings) -> Verdict {
+    Verdict {
+        reason: StopReason::MaxIterations,
+        detail: if iterations >= s.max_iterations {
+            format!(
+                "iteration budget of {} used up before a convergence test passed",
+                s.max_iterations
+            )
+        } else {
+            format!(
+                "budget of {} linearisations used up before a convergence test passed",
+                s.max_linearisations
+            )
+        },
+    }
+}
+
 /// Runs LM on `p` from its current point; `p` ends at the returned point.
 pub fn minimise<P: LeastSquaresProblem + ?Sized>(
     p: &mut P,
@@ -352,27 +519,17 @@ pub fn minimise<P: LeastSquaresProblem + ?Sized>(
 ) -> Result<Report, Cancelled> {
     let mut cost = p.cost();
     let initial_cost = cost;
-    let scale = {
-        let j = p.linearise();
-        s.column_scaling.then(|| {
-            let scale = column_scale(j);
-            scale_columns(j, &scale);
-            scale
-        })
-    };
+    let scale = scaled_linearisation(p, s.column_scaling);
     // Whether the current point's `r` and `J` (scaled) are at hand.
     let mut fresh = true;
     let (rows, ncols) = p.jacobian().shape();
     let mut damping = DampingState::new(s.damping);
     let (mut iterations, mut linearisations, mut evaluations) = (0, 0, 0);
     let mut active = vec![false; ncols];
-    let mut verdict = None;
-    if s.require_overdetermined && rows < ncols {
-        verdict = Some(Verdict {
-            reason: StopReason::Underdetermined,
-            detail: format!("underdetermined: {rows} residuals for {ncols} unknowns"),
-        });
-    }
+    let mut verdict = (s.require_overdetermined && rows < ncols).then(|| Verdict {
+        reason: StopReason::Underdetermined,
+        detail: format!("underdetermined: {rows} residuals for {ncols} unknowns"),
+    });
     while verdict.is_none()
         && iterations < s.max_iterations
         && linearisations < s.max_linearisations
@@ -382,19 +539,12 @@ pub fn minimise<P: LeastSquaresProblem + ?Sized>(
             linearisations,
             cost,
         };
-        match p.start(&at) {
-            Flow::Continue => {}
-            Flow::Stop => {
-                verdict = Some(stopped());
-                break;
-            }
-            Flow::Cancel => return Err(Cancelled),
+        if let Some(v) = flow_verdict(p.start(&at))? {
+            verdict = Some(v);
+            break;
         }
         if !fresh {
-            let j = p.linearise();
-            if let Some(scale) = &scale {
-                scale_columns(j, scale);
-            }
+            relinearise(p, scale.as_ref());
             fresh = true;
         }
         linearisations += 1;
@@ -412,62 +562,25 @@ pub fn minimise<P: LeastSquaresProblem + ?Sized>(
             });
             break;
         }
-        let mut accepted = None;
-        let (mut trials, mut evaluations_failed) = (0, 0);
-        // Largest relative cost decrease the linear model predicts for a trial.
-        let mut predicted = f64::NEG_INFINITY;
-        while damping.usable() && iterations < s.max_iterations {
-            if !p.go_on() {
-                return Err(Cancelled);
-            }
-            iterations += 1;
-            trials += 1;
-            let mut damped = a.clone();
-            let mut rhs = g.clone();
-            for i in 0..ncols {
-                damping.add(&mut damped, &a, i);
-                if active[i] {
-                    damped.row_mut(i).fill(0.0);
-                    damped.column_mut(i).fill(0.0);
-                    damped[(i, i)] = 1.0;
-                    rhs[i] = 0.0;
-                }
-            }
-            let Some(chol) = damped.cholesky() else {
-                damping.reject();
-                continue;
-            };
-            let mut delta = chol.solve(&rhs);
-            if let Some(scale) = &scale {
-                delta = delta.component_mul(scale);
-            }
-            if let Some(b) = p.bounds() {
-                project(&mut delta, &b);
-            }
-            evaluations += 1;
-            let Some(trial_cost) = p.trial(&mut delta) else {
-                evaluations_failed += 1;
-                damping.reject();
-                continue;
-            };
-            let scaled = match &scale {
-                Some(scale) => delta.component_div(scale),
-                None => delta,
-            };
-            // Over evaluated trials only: a step that cannot be evaluated
-            // says nothing about what is left to gain.
-            let decrease = predicted_decrease(&a, &g, &scaled);
-            predicted = predicted.max(decrease / cost);
-            if trial_cost < cost {
-                damping.accept(decrease, cost, trial_cost);
-                accepted = Some(AcceptedTrial {
-                    cost: trial_cost,
-                    step: scaled.norm(),
-                });
-                break;
-            }
-            damping.reject();
-        }
+        let Trials {
+            accepted,
+            trials,
+            evaluations_failed,
+            predicted,
+        } = damped_trials(
+            p,
+            s,
+            &Linearised {
+                a: &a,
+                g: &g,
+                active: &active,
+                scale: scale.as_ref(),
+                cost,
+            },
+            &mut damping,
+            &mut iterations,
+            &mut evaluations,
+        )?;
         let Some(step) = accepted else {
             let stall = Stall {
                 gradient,
@@ -488,59 +601,20 @@ pub fn minimise<P: LeastSquaresProblem + ?Sized>(
             linearisations,
             cost,
         };
-        match p.accepted(&at) {
-            Flow::Continue => {}
-            Flow::Stop => {
-                verdict = Some(stopped());
-                break;
-            }
-            Flow::Cancel => return Err(Cancelled),
+        if let Some(v) = flow_verdict(p.accepted(&at))? {
+            verdict = Some(v);
+            break;
         }
-        if rel < s.cost_tolerance {
-            verdict = Some(Verdict {
-                reason: StopReason::CostTolerance,
-                detail: format!(
-                    "relative cost decrease {rel:.1e} below {:.0e}",
-                    s.cost_tolerance
-                ),
-            });
-        } else if step.step < s.step_tolerance {
-            verdict = Some(Verdict {
-                reason: StopReason::StepTolerance,
-                detail: format!(
-                    "scaled step {:.1e} below {:.0e}",
-                    step.step, s.step_tolerance
-                ),
-            });
-        }
+        verdict = converged_after(rel, step.step, s);
     }
-    let verdict = verdict.unwrap_or_else(|| Verdict {
-        reason: StopReason::MaxIterations,
-        detail: if iterations >= s.max_iterations {
-            format!(
-                "iteration budget of {} used up before a convergence test passed",
-                s.max_iterations
-            )
-        } else {
-            format!(
-                "budget of {} linearisations used up before a convergence test passed",
-                s.max_linearisations
-            )
-        },
-    });
+    let verdict = verdict.unwrap_or_else(|| budget_verdict(iterations, s));
     // Bound state and gradient at the returned point.
     if s.linearise_at_end && !fresh {
-        let j = p.linearise();
-        if let Some(scale) = &scale {
-            scale_columns(j, scale);
-        }
+        relinearise(p, scale.as_ref());
         fresh = true;
     }
     let gradient = if fresh {
-        let js = p.jacobian();
-        let g = js.tr_mul(p.residuals());
-        mark_active(&mut active, p.bounds(), &g);
-        gradient_measure(js, &g, cost.sqrt(), &active)
+        gradient_at(p, cost, &mut active)
     } else {
         active.fill(false);
         f64::NAN
@@ -558,6 +632,16 @@ pub fn minimise<P: LeastSquaresProblem + ?Sized>(
         active,
         scale,
     })
+}
+
+/// What a problem's [`Flow`] means for the run: go on (`None`), stop with
+/// [`stopped`], or cancel.
+fn flow_verdict(flow: Flow) -> Result<Option<Verdict>, Cancelled> {
+    match flow {
+        Flow::Continue => Ok(None),
+        Flow::Stop => Ok(Some(stopped())),
+        Flow::Cancel => Err(Cancelled),
+    }
 }
 
 fn stopped() -> Verdict {

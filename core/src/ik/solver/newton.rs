@@ -37,6 +37,50 @@ use nalgebra::{
 /// Quasi-Newton Jacobian of `N` joints (rows `[v; ω]`).
 type Jac<D> = OMatrix<f64, U6, D>;
 
+/// Nielsen's damping μ = λ² [m²] and its growth factor ν.
+struct Nielsen {
+    mu: f64,
+    nu: f64,
+}
+
+impl Nielsen {
+    fn new(lambda: f64) -> Self {
+        Nielsen {
+            mu: lambda * lambda,
+            nu: 2.0,
+        }
+    }
+
+    /// A step failed or did not lower the cost: μ grows by ν, ν doubles.
+    fn reject(&mut self) {
+        self.mu = (self.mu * self.nu).max(1e-18);
+        self.nu *= 2.0;
+    }
+
+    /// A step lowered the cost with gain ratio `rho`.
+    fn accept(&mut self, rho: f64) {
+        self.mu *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
+        self.mu = self.mu.max(1e-30);
+        self.nu = 2.0;
+    }
+}
+
+impl Refined {
+    /// A run whose prediction failed after `iterations` evaluations at `q`.
+    fn failed_evaluation(q: Vec<f64>, iterations: usize) -> Refined {
+        Refined {
+            q,
+            converged: false,
+            position_residual_m: f64::INFINITY,
+            orientation_residual_rad: f64::INFINITY,
+            iterations,
+            at_limit: false,
+            sigma_min: f64::NAN,
+            failed_evaluation: true,
+        }
+    }
+}
+
 impl IkSolver {
     /// Projects a trial joint value onto the limits, first trying the 2π
     /// equivalent (revolute joints with a range of 2π or more).
@@ -141,6 +185,52 @@ impl IkSolver {
         }
     }
 
+    /// The prediction at `q_start` and whether it is exact there, with the
+    /// joint maps and the compensator expanded at the start (or taken
+    /// expanded at a nearby point, `expansion`): trial steps use the
+    /// expansion (`eval::Local`), and the exact prediction is checked, and
+    /// expanded again, where the expanded one meets the tolerance.
+    fn start<D: Dim>(
+        &self,
+        q_start: &[f64],
+        expansion: Option<&Local>,
+        jac: &mut Jac<D>,
+        local: &mut Local,
+    ) -> Option<(Pose, bool)>
+    where
+        DefaultAllocator: Allocator<U6, D>,
+    {
+        let linearised = self.prepared.has_local_terms();
+        let near = |e: &Local| {
+            self.prepared
+                .expansion_holds(e, q_start, self.settings.position_tolerance_m)
+        };
+        let at = match expansion {
+            Some(e) if linearised && near(e) => {
+                local.clone_from(e);
+                CompensatorAt::Kept
+            }
+            // Too far from that expansion's point: a rough expansion here.
+            Some(_) if linearised => CompensatorAt::Rough,
+            _ => CompensatorAt::Exact,
+        };
+        let start = self.prepared.predict_start(q_start, jac, at, local);
+        start.map(|p| (p, local.is_exact_at(q_start)))
+    }
+
+    /// Smallest singular value of the weighted Jacobian's rows (3 for
+    /// position-only goals) [m].
+    fn sigma_min<D: Dim>(&self, jac: &Jac<D>, position_only: bool) -> f64
+    where
+        DefaultAllocator: Allocator<U6, D>,
+    {
+        let m = if position_only { 3 } else { 6 };
+        let jw = self.weighted_jacobian(jac, position_only);
+        DMatrix::from_fn(m, jw.ncols(), |i, j| jw[(i, j)])
+            .singular_values()
+            .min()
+    }
+
     /// The damped Newton iteration for `d` joints.
     pub(super) fn refine_in<D: Dim>(
         &self,
@@ -155,41 +245,12 @@ impl IkSolver {
         DefaultAllocator: Allocator<U6, D> + Allocator<D> + Allocator<D, U6>,
     {
         let s = &self.settings;
-        let fail = |q: Vec<f64>, iterations| Refined {
-            q,
-            converged: false,
-            position_residual_m: f64::INFINITY,
-            orientation_residual_rad: f64::INFINITY,
-            iterations,
-            at_limit: false,
-            sigma_min: f64::NAN,
-            failed_evaluation: true,
-        };
+        let fail = Refined::failed_evaluation;
         let mut jac = Jac::<D>::zeros_generic(U6, d);
-        // The joint maps and the compensator expanded at the start (or
-        // taken expanded at a nearby point); trial steps use the expansion
-        // (`eval::Local`), and the exact prediction is checked, and expanded
-        // again, where the expanded one meets the tolerance.
         let linearised = self.prepared.has_local_terms();
         let mut local = Local::new();
-        let near = |e: &Local| {
-            self.prepared
-                .expansion_holds(e, &q_start, s.position_tolerance_m)
-        };
-        let at = match expansion {
-            Some(e) if linearised && near(e) => {
-                local.clone_from(e);
-                CompensatorAt::Kept
-            }
-            // Too far from that expansion's point: a rough expansion here.
-            Some(_) if linearised => CompensatorAt::Rough,
-            _ => CompensatorAt::Exact,
-        };
-        let start = self
-            .prepared
-            .predict_start(&q_start, &mut jac, at, &mut local);
-        let start = start.map(|p| (p, local.is_exact_at(&q_start)));
-        let Some((pose, at_expansion)) = start else {
+        let Some((pose, at_expansion)) = self.start(&q_start, expansion, &mut jac, &mut local)
+        else {
             return fail(q_start, 1);
         };
         // `e`, `pos` and `rot` are of the exact prediction at `q` (the
@@ -203,9 +264,7 @@ impl IkSolver {
         // The prediction at `q` (expanded, or exact where `exact`).
         let mut current = pose;
         let mut cost = e.norm_squared();
-        // Damping μ = λ² [m²], updated from the gain ratio (Nielsen).
-        let mut mu = s.initial_damping * s.initial_damping;
-        let mut nu = 2.0;
+        let mut damping = Nielsen::new(s.initial_damping);
         let mut iterations = 1;
         let mut at_limit = false;
         // Rows of the system: the orientation rows of position-only goals are
@@ -247,11 +306,10 @@ impl IkSolver {
             let jw = self.weighted_jacobian(&jac, position_only);
             let mut a: Matrix6<f64> = &jw * jw.transpose();
             for i in 0..6 {
-                a[(i, i)] += if i < m { mu } else { 1.0 };
+                a[(i, i)] += if i < m { damping.mu } else { 1.0 };
             }
             let Some(chol) = a.cholesky() else {
-                mu = (mu * nu).max(1e-18);
-                nu *= 2.0;
+                damping.reject();
                 iterations += 1;
                 continue;
             };
@@ -276,8 +334,7 @@ impl IkSolver {
                 self.prepared
                     .predict_local(trial.as_slice(), &mut jac_t, &mut local)
             else {
-                mu = (mu * nu).max(1e-18);
-                nu *= 2.0;
+                damping.reject();
                 continue;
             };
             let (e_t, pos_t, rot_t) = self.error(goal, &pose_t, position_only);
@@ -290,9 +347,7 @@ impl IkSolver {
                 } else {
                     1.0
                 };
-                mu *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
-                mu = mu.max(1e-30);
-                nu = 2.0;
+                damping.accept(rho);
                 q = trial;
                 current = pose_t;
                 local.accept();
@@ -303,9 +358,8 @@ impl IkSolver {
                 rot = rot_t;
                 exact = !linearised;
             } else {
-                mu = (mu * nu).max(1e-18);
-                nu *= 2.0;
-                if mu > 1e8 {
+                damping.reject();
+                if damping.mu > 1e8 {
                     break;
                 }
             }
@@ -326,10 +380,7 @@ impl IkSolver {
         let sigma_min = if converged {
             f64::NAN
         } else {
-            let jw = self.weighted_jacobian(&jac, position_only);
-            DMatrix::from_fn(m, jw.ncols(), |i, j| jw[(i, j)])
-                .singular_values()
-                .min()
+            self.sigma_min(&jac, position_only)
         };
         Refined {
             q: q.as_slice().to_vec(),

@@ -90,24 +90,7 @@ impl IkSolver {
                         .iter()
                         .all(|s| !s.clamped && self.limit_violation(&s.q) > slack)
             });
-        let mut cands: Vec<(AnalyticSolution, f64, f64)> = sols
-            .into_iter()
-            .filter(|s| options.branch.is_none_or(|b| b == s.configuration))
-            .map(|s| {
-                let violation = self.limit_violation(&s.q);
-                let dist: f64 =
-                    s.q.iter()
-                        .zip(&reference)
-                        .map(|(a, b)| (a - b).powi(2))
-                        .sum();
-                (s, violation, dist)
-            })
-            .collect();
-        cands.sort_by(|a, b| {
-            let ka = (a.1 > 0.0, a.0.clamped);
-            let kb = (b.1 > 0.0, b.0.clamped);
-            ka.cmp(&kb).then(a.2.total_cmp(&b.2))
-        });
+        let cands = self.ranked(sols, options.branch, &reference);
         let any_out_of_limits = cands.iter().any(|c| c.1 > slack);
         let all_out_of_limits = !cands.is_empty() && cands.iter().all(|c| c.1 > slack);
         let all_clamped = cands.iter().all(|c| c.0.clamped);
@@ -168,6 +151,37 @@ impl IkSolver {
             branch_out_of_limits,
             branch_exists,
         }
+    }
+
+    /// The closed-form solutions in `branch` (any without one), each with its
+    /// limit violation [rad] and squared distance to `reference` [rad²]:
+    /// within the limits before beyond them, unclamped before clamped, then
+    /// nearest first.
+    fn ranked(
+        &self,
+        sols: Vec<AnalyticSolution>,
+        branch: Option<Configuration>,
+        reference: &[f64],
+    ) -> Vec<(AnalyticSolution, f64, f64)> {
+        let mut cands: Vec<(AnalyticSolution, f64, f64)> = sols
+            .into_iter()
+            .filter(|s| branch.is_none_or(|b| b == s.configuration))
+            .map(|s| {
+                let violation = self.limit_violation(&s.q);
+                let dist: f64 =
+                    s.q.iter()
+                        .zip(reference)
+                        .map(|(a, b)| (a - b).powi(2))
+                        .sum();
+                (s, violation, dist)
+            })
+            .collect();
+        cands.sort_by(|a, b| {
+            let ka = (a.1 > 0.0, a.0.clamped);
+            let kb = (b.1 > 0.0, b.0.clamped);
+            ka.cmp(&kb).then(a.2.total_cmp(&b.2))
+        });
+        cands
     }
 
     pub(super) fn numeric_seeds(&self, options: &SolveOptions) -> Seeds {
@@ -302,6 +316,47 @@ pub(super) struct Seed {
     /// The seed model's forward kinematics at `q` is the target (an
     /// unclamped closed-form branch), up to rounding.
     pub(super) on_target: bool,
+}
+
+/// The starts of one seed: the corrected closed-form one first (when it
+/// differs), then the plain one; both start on `expansion` (the joint maps'
+/// and the compensator's at the seed, from its correction).
+pub(super) struct Starts {
+    pub(super) list: Vec<Vec<f64>>,
+    /// The corrected target lies beyond the seed's branch's reach: tried
+    /// after the other seeds.
+    pub(super) beyond_reach: bool,
+    pub(super) expansion: Option<Local>,
+    /// Model evaluations the correction took.
+    pub(super) evaluations: usize,
+}
+
+impl IkSolver {
+    /// The starts of `seed` for `target` (base frame).
+    pub(super) fn starts(&self, target: &Pose, seed: &Seed) -> Starts {
+        let mut out = Starts {
+            list: Vec::with_capacity(2),
+            beyond_reach: false,
+            expansion: None,
+            evaluations: 0,
+        };
+        if let (Some(a), Some(c)) = (&self.analytic, seed.configuration) {
+            let corrected = self.corrected_seed(a, target, seed, c);
+            out.evaluations = corrected.evaluations;
+            out.beyond_reach = corrected.beyond_reach;
+            out.expansion = corrected.expansion;
+            if corrected
+                .q
+                .iter()
+                .zip(&seed.q)
+                .any(|(x, y)| (x - y).abs() > 1e-9)
+            {
+                out.list.push(corrected.q);
+            }
+        }
+        out.list.push(seed.q.clone());
+        out
+    }
 }
 
 pub(super) struct Seeds {
