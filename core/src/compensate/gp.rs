@@ -21,12 +21,15 @@
 //! Cholesky: no maintained Rust crate offers sparse GP regression with an
 //! analytic input gradient, which the IK needs.
 
-use super::train::TrainError;
-use super::{Compensator, InvalidCompensator, Sample, StoredCompensator};
+use super::family::{Family, NetworkShape};
+use super::{Compensator, InvalidCompensator, Sample, StoredCompensator, TrainError, TrainReport};
+use crate::model::bounds::compensator::{check_gp, Outputs};
+use crate::model::ModelError;
 use nalgebra::{DMatrix, Vector3};
 use rand::seq::SliceRandom;
 use rand::Rng;
 use serde::{Deserialize, Serialize};
+use std::sync::Arc;
 
 /// Inducing configurations farther than this squared scaled distance add
 /// nothing (`exp(−25)` ≈ 1.4e-11 of the signal) and are skipped.
@@ -223,7 +226,7 @@ impl Compensator for Gp {
     }
 
     fn stored(&self) -> Option<StoredCompensator> {
-        Some(StoredCompensator::Gp(self.clone()))
+        Some(self.clone().into())
     }
 
     fn uncertainty(&self, q: &[f64]) -> Option<Uncertainty> {
@@ -575,5 +578,66 @@ fn to_gp(data: &Data, h: &Hyper, f: &Fitted, dof: usize, error_scale: f64, rms: 
             .collect(),
         error_scale,
         uncompensated_rms: rms,
+    }
+}
+
+impl Family for Gp {
+    type Settings = GpSettings;
+    const EVERY_POSE: bool = true;
+
+    fn validate(&self) -> Result<(), InvalidCompensator> {
+        Gp::validate(self)
+    }
+
+    fn dof(&self) -> usize {
+        self.dof
+    }
+
+    fn check_bounds(&self, field: &str, outputs: &Outputs) -> Result<(), ModelError> {
+        check_gp(field, self, outputs)
+    }
+
+    fn into_arc(self) -> Arc<dyn Compensator> {
+        Arc::new(super::PreparedGp::new(self))
+    }
+
+    fn shape(&self) -> NetworkShape {
+        NetworkShape {
+            units: self.units(),
+            inputs: "q".into(),
+        }
+    }
+
+    fn train(
+        settings: &GpSettings,
+        samples: &[Sample],
+        rng: &mut impl Rng,
+        progress: &mut dyn FnMut(usize, f64) -> bool,
+    ) -> Result<(Gp, TrainReport), TrainError> {
+        let (gp, rep) = train_gp(samples, settings, rng, progress)?;
+        let report = TrainReport {
+            trainer: "gp".into(),
+            samples: samples.len(),
+            epochs: rep.fits,
+            evaluations: rep.fits,
+            loss: rep.holdout_after_mm,
+            stop: format!(
+                "{} inducing poses, length scales and noise chosen on held-out data ({} fits)",
+                rep.inducing, rep.fits
+            ),
+            rms_mm: 0.0,
+            rbf: None,
+            gp: Some(rep),
+        };
+        Ok((gp, report))
+    }
+
+    /// The grid, then three trials per joint of a six-axis robot.
+    fn max_epochs(settings: &GpSettings) -> usize {
+        settings.length_fractions.len() * settings.noise_ratios.len() + 3 * 6
+    }
+
+    fn label(_: &GpSettings) -> &'static str {
+        "gp"
     }
 }

@@ -29,6 +29,7 @@ use nalgebra::{DMatrix, Matrix3xX, Vector3};
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 
+mod family;
 pub mod file;
 pub mod gp;
 #[cfg(target_arch = "x86_64")]
@@ -42,7 +43,9 @@ pub mod select;
 pub mod support;
 pub mod synthetic;
 pub mod train;
+mod training;
 
+pub use family::{Family, NetworkShape};
 pub use file::{parse_compensated, CalibratedModelFile, PoseDescription, CALIBRATED_MODEL_FORMAT};
 pub use gp::{train_gp, Gp, GpReport, GpSettings, Uncertainty};
 pub use gp_predict::PreparedGp;
@@ -55,9 +58,9 @@ pub use select::{blocked_fold_assignment, choose, cross_validate, BlockedFold, C
 pub use support::{Compensation, Faded, Support, SupportCoverage};
 pub use synthetic::{synthetic_calibration, unmodelled_truth, SyntheticErrors};
 pub use train::{
-    train, CompensatorSpec, IwoSettings, LmTrainSettings, MlpSpec, OutputLayer, TlboTrainSettings,
-    TrainError, TrainReport, Trainer,
+    IwoSettings, LmTrainSettings, MlpSettings, MlpSpec, OutputLayer, TlboTrainSettings, Trainer,
 };
+pub use training::{train, TrainError, TrainReport};
 
 /// A learned residual model: what the geometric and compliance model leave.
 ///
@@ -162,42 +165,21 @@ pub trait Compensator: Send + Sync {
     }
 }
 
-/// A compensator as the model file stores it, tagged by `kind`. An unknown kind
-/// fails to parse.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "kebab-case")]
-pub enum StoredCompensator {
-    /// Joint-space MLP (SKCM-NN, SKCM-IWONN, SKCM-TLBONN).
-    Mlp(Mlp),
-    /// Torque-space RBF (KM-RBF).
-    Rbf(Rbf),
-    /// Joint-space sparse Gaussian process (KM-GP, SKCM-GP).
-    Gp(Gp),
-}
-
-impl StoredCompensator {
-    pub fn validate(&self) -> Result<(), InvalidCompensator> {
-        match self {
-            StoredCompensator::Mlp(m) => m.validate(),
-            StoredCompensator::Rbf(r) => r.validate(),
-            StoredCompensator::Gp(g) => g.validate(),
-        }
+family::compensator_table! {
+    Mlp {
+        kind: "mlp",
+        model: Mlp,
+        description: "Joint-space MLP (SKCM-NN, SKCM-IWONN, SKCM-TLBONN).",
     }
-
-    pub fn dof(&self) -> usize {
-        match self {
-            StoredCompensator::Mlp(m) => m.dof,
-            StoredCompensator::Rbf(r) => r.dof,
-            StoredCompensator::Gp(g) => g.dof,
-        }
+    Rbf {
+        kind: "rbf",
+        model: Rbf,
+        description: "Torque-space RBF (KM-RBF).",
     }
-
-    pub fn into_arc(self) -> Arc<dyn Compensator> {
-        match self {
-            StoredCompensator::Mlp(m) => Arc::new(m),
-            StoredCompensator::Rbf(r) => Arc::new(r),
-            StoredCompensator::Gp(g) => Arc::new(PreparedGp::new(g)),
-        }
+    Gp {
+        kind: "gp",
+        model: Gp,
+        description: "Joint-space sparse Gaussian process (KM-GP, SKCM-GP).",
     }
 }
 

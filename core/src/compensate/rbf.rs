@@ -23,12 +23,16 @@
 //! torques' own dependence on `q` is neglected as in the IK's quasi-Newton
 //! Jacobian (see [`CompensatedModel::predict_base_with_jacobian`](super::CompensatedModel::predict_base_with_jacobian)).
 
+use super::family::{Family, NetworkShape};
 use super::mlp::Normalisation;
-use super::{Compensator, InvalidCompensator, Sample};
+use super::{Compensator, InvalidCompensator, Sample, TrainError, TrainReport};
+use crate::model::bounds::compensator::{check_rbf, Outputs};
+use crate::model::ModelError;
 use nalgebra::{DMatrix, Matrix3, Matrix3xX, Vector3};
 use rand::seq::SliceRandom;
 use rand::Rng;
 use serde::{Deserialize, Serialize};
+use std::sync::Arc;
 
 /// Frame of the RBF outputs (module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -171,7 +175,7 @@ impl Compensator for Rbf {
         "rbf"
     }
     fn stored(&self) -> Option<super::StoredCompensator> {
-        Some(super::StoredCompensator::Rbf(self.clone()))
+        Some(self.clone().into())
     }
 }
 
@@ -366,6 +370,74 @@ pub fn train_rbf_with_progress(
             holdout_rms_mm: mse.sqrt() * 1e3,
         },
     )))
+}
+
+impl Family for Rbf {
+    type Settings = RbfSettings;
+    const TORQUE_INPUT: bool = true;
+
+    fn validate(&self) -> Result<(), InvalidCompensator> {
+        Rbf::validate(self)
+    }
+
+    fn dof(&self) -> usize {
+        self.dof
+    }
+
+    fn check_bounds(&self, field: &str, _outputs: &Outputs) -> Result<(), ModelError> {
+        check_rbf(field, self)
+    }
+
+    fn into_arc(self) -> Arc<dyn Compensator> {
+        Arc::new(self)
+    }
+
+    fn shape(&self) -> NetworkShape {
+        NetworkShape {
+            units: self.units(),
+            inputs: "gravity torques".into(),
+        }
+    }
+
+    fn train(
+        settings: &RbfSettings,
+        samples: &[Sample],
+        rng: &mut impl Rng,
+        progress: &mut dyn FnMut(usize, f64) -> bool,
+    ) -> Result<(Rbf, TrainReport), TrainError> {
+        let (net, rep) = train_rbf_with_progress(samples, settings, rng, progress)?
+            .ok_or(TrainError::Cancelled)?;
+        let report = TrainReport {
+            trainer: "rbf".into(),
+            samples: samples.len(),
+            epochs: rep.neurons,
+            evaluations: rep.neurons,
+            loss: rep.holdout_rms_mm,
+            stop: format!(
+                "{} units, spread {} chosen on held-out data",
+                rep.neurons, rep.spread
+            ),
+            rms_mm: 0.0,
+            rbf: Some(rep),
+            gp: None,
+        };
+        Ok((net, report))
+    }
+
+    fn max_epochs(settings: &RbfSettings) -> usize {
+        (settings.max_neurons + 1) * (settings.spreads.len() + 1)
+    }
+
+    fn label(_: &RbfSettings) -> &'static str {
+        "rbf"
+    }
+}
+
+impl super::CompensatorSpec {
+    /// KM-RBF's network.
+    pub fn km_rbf() -> Self {
+        Self::Rbf(RbfSettings::default())
+    }
 }
 
 #[cfg(test)]
