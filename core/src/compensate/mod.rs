@@ -32,24 +32,21 @@ use std::sync::Arc;
 mod family;
 pub mod file;
 pub mod gp;
-#[cfg(target_arch = "x86_64")]
-mod gp_avx2;
-pub mod gp_predict;
-mod gp_rough;
 pub mod mlp;
 pub mod oriented;
 pub mod rbf;
 pub mod select;
 pub mod support;
 pub mod synthetic;
-pub mod train;
 mod training;
 
 pub use family::{Family, NetworkShape};
 pub use file::{parse_compensated, CalibratedModelFile, PoseDescription, CALIBRATED_MODEL_FORMAT};
-pub use gp::{train_gp, Gp, GpReport, GpSettings, Uncertainty};
-pub use gp_predict::PreparedGp;
-pub use mlp::{Features, Mlp, Normalisation};
+pub use gp::{train_gp, Gp, GpReport, GpSettings, PreparedGp, Uncertainty};
+pub use mlp::{
+    Features, IwoSettings, LmTrainSettings, Mlp, MlpSettings, MlpSpec, Normalisation, OutputLayer,
+    TlboTrainSettings, Trainer,
+};
 pub use oriented::{OrientationSamples, Oriented, StoredOrientation};
 pub use rbf::{
     train_rbf, train_rbf_with_progress, OutputFrame, Rbf, RbfReport, RbfSettings, RbfTrainError,
@@ -57,9 +54,6 @@ pub use rbf::{
 pub use select::{blocked_fold_assignment, choose, cross_validate, BlockedFold, Choice, CvStats};
 pub use support::{Compensation, Faded, Support, SupportCoverage};
 pub use synthetic::{synthetic_calibration, unmodelled_truth, SyntheticErrors};
-pub use train::{
-    IwoSettings, LmTrainSettings, MlpSettings, MlpSpec, OutputLayer, TlboTrainSettings, Trainer,
-};
 pub use training::{train, TrainError, TrainReport};
 
 /// A learned residual model: what the geometric and compliance model leave.
@@ -108,7 +102,7 @@ pub trait Compensator: Send + Sync {
         }
     }
     /// [`Compensator::residual_and_jacobian`] to a lower precision where that
-    /// is much cheaper (a GP's in single precision, `compensate/gp_rough.rs`);
+    /// is much cheaper (a GP's in single precision, `compensate/gp/rough.rs`);
     /// the default is the exact one. For the IK's expansion at its
     /// closed-form seed, whose end point the exact prediction checks.
     /// [`Compensator::has_rough`] tells whether it differs.

@@ -1,4 +1,4 @@
-//! Training of the MLP of [`mlp`](super::mlp) on [`Sample`]s: by
+//! Training of the MLP of [`model`](super::model) on [`Sample`]s: by
 //! Levenberg–Marquardt backpropagation (seed ch. 4, the MATLAB toolbox
 //! default `trainlm`; `lm`), by invasive weed optimisation (ch. 5, `iwo`) or
 //! by TLBO (ch. 6, `tlbo`), all over the same flat weight vector in
@@ -33,15 +33,11 @@ pub use lm::LmTrainSettings;
 pub use output_layer::OutputLayer;
 pub use tlbo::TlboTrainSettings;
 
-use super::family::{Family, NetworkShape};
-use super::mlp::{Features, Mlp};
-use super::{Compensator, InvalidCompensator, Sample, TrainError, TrainReport};
-use crate::model::bounds::compensator::{check_mlp, Outputs};
-use crate::model::ModelError;
+use super::model::{Features, Mlp};
+use crate::compensate::{Sample, TrainError, TrainReport};
 use data::Prepared;
 use rand::Rng;
 use serde::{Deserialize, Serialize};
-use std::sync::Arc;
 
 /// Network size and inputs.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -110,7 +106,7 @@ impl Trainer {
     }
 }
 
-/// The MLP's network and trainer (its [`CompensatorSpec`](super::CompensatorSpec)).
+/// The MLP's network and trainer (its [`CompensatorSpec`](crate::compensate::CompensatorSpec)).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MlpSettings {
     pub spec: MlpSpec,
@@ -192,110 +188,38 @@ impl std::fmt::Display for TrainStop {
     }
 }
 
-impl Family for Mlp {
-    type Settings = MlpSettings;
-
-    fn validate(&self) -> Result<(), InvalidCompensator> {
-        Mlp::validate(self)
+/// Trains the MLP of `settings` on `samples` by its trainer: the weights,
+/// their report (its `rms_mm` left to the caller) and the network.
+pub(super) fn train_mlp(
+    settings: &MlpSettings,
+    samples: &[Sample],
+    rng: &mut impl Rng,
+    progress: &mut dyn FnMut(usize, f64) -> bool,
+) -> Result<(Mlp, TrainReport), TrainError> {
+    let MlpSettings { spec: m, trainer } = settings;
+    if m.hidden == 0 {
+        return Err(TrainError::NoHiddenUnits);
     }
-
-    fn dof(&self) -> usize {
-        self.dof
-    }
-
-    fn check_bounds(&self, field: &str, outputs: &Outputs) -> Result<(), ModelError> {
-        check_mlp(field, self, outputs)
-    }
-
-    fn into_arc(self) -> Arc<dyn Compensator> {
-        Arc::new(self)
-    }
-
-    fn shape(&self) -> NetworkShape {
-        let mut inputs = String::from("q");
-        if self.features.sin_cos {
-            inputs.push_str(", sin q, cos q");
-        }
-        if self.features.payload {
-            inputs.push_str(", payload mass");
-        }
-        NetworkShape {
-            units: self.hidden,
-            inputs,
-        }
-    }
-
-    fn train(
-        settings: &MlpSettings,
-        samples: &[Sample],
-        rng: &mut impl Rng,
-        progress: &mut dyn FnMut(usize, f64) -> bool,
-    ) -> Result<(Mlp, TrainReport), TrainError> {
-        let MlpSettings { spec: m, trainer } = settings;
-        if m.hidden == 0 {
-            return Err(TrainError::NoHiddenUnits);
-        }
-        let dof = samples[0].q.len();
-        let data = Prepared::new(samples, m);
-        let outcome = match trainer {
-            Trainer::Lm(s) => lm::lm(&data, s, rng, progress)?,
-            Trainer::Iwo(s) => iwo::iwo(&data, s, rng, progress)?,
-            Trainer::Tlbo(s) => tlbo::tlbo_train(&data, s, rng, progress)?,
-        };
-        let stop = outcome.stop.to_string();
-        let report = TrainReport {
-            trainer: trainer.name().into(),
-            samples: samples.len(),
-            epochs: outcome.epochs,
-            evaluations: outcome.evaluations,
-            loss: outcome.loss,
-            stop,
-            rms_mm: 0.0,
-            rbf: None,
-            gp: None,
-        };
-        Ok((data.into_mlp(m, dof, outcome.weights), report))
-    }
-
-    fn max_epochs(settings: &MlpSettings) -> usize {
-        match &settings.trainer {
-            Trainer::Lm(s) => s.max_epochs,
-            Trainer::Iwo(s) => s.iterations,
-            Trainer::Tlbo(s) => s.generations,
-        }
-    }
-
-    fn label(settings: &MlpSettings) -> &'static str {
-        match settings.trainer {
-            Trainer::Lm(_) => "nn",
-            Trainer::Iwo(_) => "iwonn",
-            Trainer::Tlbo(_) => "tlbonn",
-        }
-    }
-}
-
-impl super::CompensatorSpec {
-    /// SKCM-NN: 18-20-3 by LM backpropagation.
-    pub fn skcm_nn() -> Self {
-        Self::Mlp(MlpSettings {
-            spec: MlpSpec::SKCM_NN,
-            trainer: Trainer::Lm(LmTrainSettings::default()),
-        })
-    }
-    /// SKCM-IWONN: 18-40-3 by IWO.
-    pub fn skcm_iwonn() -> Self {
-        Self::Mlp(MlpSettings {
-            spec: MlpSpec::POPULATION,
-            trainer: Trainer::Iwo(IwoSettings::default()),
-        })
-    }
-    /// SKCM-TLBONN: 18-40-3 by TLBO.
-    pub fn skcm_tlbonn() -> Self {
-        Self::Mlp(MlpSettings {
-            spec: MlpSpec::POPULATION,
-            trainer: Trainer::Tlbo(TlboTrainSettings::default()),
-        })
-    }
+    let dof = samples[0].q.len();
+    let data = Prepared::new(samples, m);
+    let outcome = match trainer {
+        Trainer::Lm(s) => lm::lm(&data, s, rng, progress)?,
+        Trainer::Iwo(s) => iwo::iwo(&data, s, rng, progress)?,
+        Trainer::Tlbo(s) => tlbo::tlbo_train(&data, s, rng, progress)?,
+    };
+    let stop = outcome.stop.to_string();
+    let report = TrainReport {
+        trainer: trainer.name().into(),
+        samples: samples.len(),
+        epochs: outcome.epochs,
+        evaluations: outcome.evaluations,
+        loss: outcome.loss,
+        stop,
+        rms_mm: 0.0,
+        rbf: None,
+        gp: None,
+    };
+    Ok((data.into_mlp(m, dof, outcome.weights), report))
 }
 
 #[cfg(test)]
