@@ -4,7 +4,9 @@
 //!   service, which answers with its own types (or re-exports);
 //! - the service (`src/service`) never names `crate::http`;
 //! - no two files of `src/service` import each other, directly or round a
-//!   longer loop (a folder's `mod.rs` is its namespace, not a node).
+//!   longer loop (a folder's `mod.rs` is its namespace, not a node);
+//! - nor do two files of the core's compensators (`core/src/compensate`,
+//!   a folder per family).
 //!
 //! A file "imports" the module a `crate::`, `super::` or `self::` path in it
 //! resolves to: the deepest file module the path names (`super::jobs::
@@ -403,6 +405,16 @@ fn no_two_service_files_import_each_other() {
         import_loop(&src(), "service"),
         None,
         "an import loop in src/service"
+    );
+}
+
+#[test]
+fn no_two_compensator_files_import_each_other() {
+    let core = Tree::read(&Path::new(env!("CARGO_MANIFEST_DIR")).join("core/src"));
+    assert_eq!(
+        import_loop(&core, "compensate"),
+        None,
+        "an import loop in core/src/compensate"
     );
 }
 

@@ -16,7 +16,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal_core::compensate::{
     train, unmodelled_truth, CompensatedModel, CompensatorSpec, IwoSettings, LmTrainSettings,
-    MlpSpec, OutputLayer, TlboTrainSettings, Trainer,
+    MlpSettings, MlpSpec, OutputLayer, TlboTrainSettings, Trainer,
 };
 use robocal_core::identify::{calibrate, CalibrationOptions, Method};
 use robocal_core::measure::{self, Measurement};
@@ -70,21 +70,23 @@ fn main() {
     println!("SKCM validation mean {base_mean:.4} mm (1000 training poses, 200 validation poses, {seeds} seeds)");
     println!("| trainer | network | validation mean [mm] (mean / min / max over seeds) | wall time per run [s] |");
     println!("|---|---|---|---|");
-    let lm_small = CompensatorSpec::Mlp {
+    let lm_small = CompensatorSpec::Mlp(MlpSettings {
         spec: MlpSpec::SMALL,
         trainer: Trainer::Lm(LmTrainSettings::default()),
+    });
+    let searched = |trainer| {
+        CompensatorSpec::Mlp(MlpSettings {
+            spec: MlpSpec::SMALL,
+            trainer,
+        })
     };
-    let searched = |trainer| CompensatorSpec::Mlp {
-        spec: MlpSpec::SMALL,
-        trainer,
-    };
-    let iwo_mean_only = CompensatorSpec::Mlp {
+    let iwo_mean_only = CompensatorSpec::Mlp(MlpSettings {
         spec: MlpSpec::POPULATION,
         trainer: Trainer::Iwo(IwoSettings {
             max_weight: 0.0,
             ..Default::default()
         }),
-    };
+    });
     for (name, net, spec) in [
         (
             "LM backprop (SKCM-NN)",

@@ -266,7 +266,9 @@ mod tests {
     }
 
     fn mlp_compensated() -> CompensatedModel {
-        use crate::compensate::{train, CompensatorSpec, LmTrainSettings, MlpSpec, Trainer};
+        use crate::compensate::{
+            train, CompensatorSpec, LmTrainSettings, MlpSettings, MlpSpec, Trainer,
+        };
         use rand::SeedableRng;
         let nominal = preset("ys100").unwrap();
         let mut m = CompensatedModel::from_nominal(nominal.clone());
@@ -281,13 +283,13 @@ mod tests {
                 residual: nalgebra::Vector3::new(1e-4 * q[1].sin(), 2e-4 * q[2].cos(), 1e-5),
             })
             .collect();
-        let spec = CompensatorSpec::Mlp {
+        let spec = CompensatorSpec::Mlp(MlpSettings {
             spec: MlpSpec::SMALL,
             trainer: Trainer::Lm(LmTrainSettings {
                 max_epochs: 5,
                 ..Default::default()
             }),
-        };
+        });
         let (c, _) = train(&spec, &samples, &mut rng, &mut |_, _| true).unwrap();
         m.compensator = Some(c.into_arc());
         m

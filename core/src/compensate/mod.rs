@@ -29,24 +29,24 @@ use nalgebra::{DMatrix, Matrix3xX, Vector3};
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 
+mod family;
 pub mod file;
 pub mod gp;
-#[cfg(target_arch = "x86_64")]
-mod gp_avx2;
-pub mod gp_predict;
-mod gp_rough;
 pub mod mlp;
 pub mod oriented;
 pub mod rbf;
 pub mod select;
 pub mod support;
 pub mod synthetic;
-pub mod train;
+mod training;
 
+pub use family::{Family, NetworkShape};
 pub use file::{parse_compensated, CalibratedModelFile, PoseDescription, CALIBRATED_MODEL_FORMAT};
-pub use gp::{train_gp, Gp, GpReport, GpSettings, Uncertainty};
-pub use gp_predict::PreparedGp;
-pub use mlp::{Features, Mlp, Normalisation};
+pub use gp::{train_gp, Gp, GpReport, GpSettings, PreparedGp, Uncertainty};
+pub use mlp::{
+    Features, IwoSettings, LmTrainSettings, Mlp, MlpSettings, MlpSpec, Normalisation, OutputLayer,
+    TlboTrainSettings, Trainer,
+};
 pub use oriented::{OrientationSamples, Oriented, StoredOrientation};
 pub use rbf::{
     train_rbf, train_rbf_with_progress, OutputFrame, Rbf, RbfReport, RbfSettings, RbfTrainError,
@@ -54,10 +54,7 @@ pub use rbf::{
 pub use select::{blocked_fold_assignment, choose, cross_validate, BlockedFold, Choice, CvStats};
 pub use support::{Compensation, Faded, Support, SupportCoverage};
 pub use synthetic::{synthetic_calibration, unmodelled_truth, SyntheticErrors};
-pub use train::{
-    train, CompensatorSpec, IwoSettings, LmTrainSettings, MlpSpec, OutputLayer, TlboTrainSettings,
-    TrainError, TrainReport, Trainer,
-};
+pub use training::{train, TrainError, TrainReport};
 
 /// A learned residual model: what the geometric and compliance model leave.
 ///
@@ -105,7 +102,7 @@ pub trait Compensator: Send + Sync {
         }
     }
     /// [`Compensator::residual_and_jacobian`] to a lower precision where that
-    /// is much cheaper (a GP's in single precision, `compensate/gp_rough.rs`);
+    /// is much cheaper (a GP's in single precision, `compensate/gp/rough.rs`);
     /// the default is the exact one. For the IK's expansion at its
     /// closed-form seed, whose end point the exact prediction checks.
     /// [`Compensator::has_rough`] tells whether it differs.
@@ -162,42 +159,21 @@ pub trait Compensator: Send + Sync {
     }
 }
 
-/// A compensator as the model file stores it, tagged by `kind`. An unknown kind
-/// fails to parse.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "kebab-case")]
-pub enum StoredCompensator {
-    /// Joint-space MLP (SKCM-NN, SKCM-IWONN, SKCM-TLBONN).
-    Mlp(Mlp),
-    /// Torque-space RBF (KM-RBF).
-    Rbf(Rbf),
-    /// Joint-space sparse Gaussian process (KM-GP, SKCM-GP).
-    Gp(Gp),
-}
-
-impl StoredCompensator {
-    pub fn validate(&self) -> Result<(), InvalidCompensator> {
-        match self {
-            StoredCompensator::Mlp(m) => m.validate(),
-            StoredCompensator::Rbf(r) => r.validate(),
-            StoredCompensator::Gp(g) => g.validate(),
-        }
+family::compensator_table! {
+    Mlp {
+        kind: "mlp",
+        model: Mlp,
+        description: "Joint-space MLP (SKCM-NN, SKCM-IWONN, SKCM-TLBONN).",
     }
-
-    pub fn dof(&self) -> usize {
-        match self {
-            StoredCompensator::Mlp(m) => m.dof,
-            StoredCompensator::Rbf(r) => r.dof,
-            StoredCompensator::Gp(g) => g.dof,
-        }
+    Rbf {
+        kind: "rbf",
+        model: Rbf,
+        description: "Torque-space RBF (KM-RBF).",
     }
-
-    pub fn into_arc(self) -> Arc<dyn Compensator> {
-        match self {
-            StoredCompensator::Mlp(m) => Arc::new(m),
-            StoredCompensator::Rbf(r) => Arc::new(r),
-            StoredCompensator::Gp(g) => Arc::new(PreparedGp::new(g)),
-        }
+    Gp {
+        kind: "gp",
+        model: Gp,
+        description: "Joint-space sparse Gaussian process (KM-GP, SKCM-GP).",
     }
 }
 

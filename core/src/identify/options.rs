@@ -11,7 +11,7 @@ use super::least_squares::LmSettings;
 pub use super::methods::Method;
 use super::methods::Network;
 use crate::compensate::{
-    CompensatorSpec, GpSettings, IwoSettings, LmTrainSettings, MlpSpec, RbfSettings,
+    CompensatorSpec, GpSettings, IwoSettings, LmTrainSettings, MlpSettings, MlpSpec, RbfSettings,
     TlboTrainSettings, Trainer,
 };
 use crate::optim::TlboSettings;
@@ -120,38 +120,33 @@ impl CompensatorOptions {
         }
     }
 
-    /// The network and trainer of a compensator.
+    /// The network and trainer of a compensator: its family's settings
+    /// ([`CompensatorSpec`], one variant per family of the compensator
+    /// table) from these options.
     pub fn spec(&self, network: Network) -> CompensatorSpec {
         match network {
             Network::Rbf => CompensatorSpec::Rbf(self.rbf.clone()),
-            Network::LmMlp => CompensatorSpec::Mlp {
+            Network::LmMlp => CompensatorSpec::Mlp(MlpSettings {
                 spec: self.nn,
                 trainer: Trainer::Lm(self.lm.clone()),
-            },
-            Network::IwoMlp => CompensatorSpec::Mlp {
+            }),
+            Network::IwoMlp => CompensatorSpec::Mlp(MlpSettings {
                 spec: self.small,
                 trainer: Trainer::Iwo(self.iwo.clone()),
-            },
-            Network::TlboMlp => CompensatorSpec::Mlp {
+            }),
+            Network::TlboMlp => CompensatorSpec::Mlp(MlpSettings {
                 spec: self.small,
                 trainer: Trainer::Tlbo(self.tlbo.clone()),
-            },
+            }),
             Network::Gp => CompensatorSpec::Gp(self.gp.clone()),
         }
     }
 
     /// Epochs / iterations / generations a training run of `network` may take
-    /// at most (for progress percentages).
+    /// at most (for progress percentages; its family's
+    /// [`CompensatorSpec::max_epochs`]).
     pub fn max_epochs(&self, network: Network) -> usize {
-        match network {
-            Network::Rbf => (self.rbf.max_neurons + 1) * (self.rbf.spreads.len() + 1),
-            Network::LmMlp => self.lm.max_epochs,
-            Network::IwoMlp => self.iwo.iterations,
-            Network::TlboMlp => self.tlbo.generations,
-            // The grid, then three trials per joint of a six-axis robot.
-            Network::Gp => self.gp.length_fractions.len() * self.gp.noise_ratios.len() + 3 * 6,
-        }
-        .max(1)
+        self.spec(network).max_epochs()
     }
 }
 

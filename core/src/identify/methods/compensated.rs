@@ -153,13 +153,13 @@ pub(crate) fn train_network(
     let mut data = samples(&base.model, &base.session_frames, pool)?;
     let mut turns = rotations(&base.model, &base.session_frames, pool);
     let cap = ctx.opts.compensator.max_network_poses;
-    if network != Network::Gp && cap > 0 && data.len() > cap {
+    if !spec.every_pose() && cap > 0 && data.len() > cap {
         let mut rng = ChaCha8Rng::seed_from_u64(ctx.opts.compensator.seed.wrapping_add(1000));
         let keep = rand::seq::index::sample(&mut rng, data.len(), cap).into_vec();
         data = keep.iter().map(|i| data[*i].clone()).collect();
         turns = keep.iter().map(|i| turns[*i]).collect();
     }
-    if network == Network::Rbf && data.iter().all(|s| s.tau.iter().all(|t| *t == 0.0)) {
+    if spec.torque_input() && data.iter().all(|s| s.tau.iter().all(|t| *t == 0.0)) {
         return Err(MethodFailure::NoTorqueToLearn.into());
     }
     let seed = ctx.opts.compensator.seed;
@@ -251,42 +251,6 @@ pub(crate) fn run_compensated(
     })
 }
 
-/// Describes the network: kind, units, inputs.
-struct NetworkSummary {
-    kind: &'static str,
-    units: usize,
-    inputs: String,
-}
-
-fn network_of(c: &StoredCompensator) -> NetworkSummary {
-    match c {
-        StoredCompensator::Mlp(m) => {
-            let mut s = String::from("q");
-            if m.features.sin_cos {
-                s.push_str(", sin q, cos q");
-            }
-            if m.features.payload {
-                s.push_str(", payload mass");
-            }
-            NetworkSummary {
-                kind: "mlp",
-                units: m.hidden,
-                inputs: s,
-            }
-        }
-        StoredCompensator::Rbf(r) => NetworkSummary {
-            kind: "rbf",
-            units: r.units(),
-            inputs: "gravity torques".into(),
-        },
-        StoredCompensator::Gp(g) => NetworkSummary {
-            kind: "gp",
-            units: g.units(),
-            inputs: "q".into(),
-        },
-    }
-}
-
 /// The base's report turned into the compensated method's: errors on every
 /// set through the compensated prediction, the base's next to them, and the
 /// compensator's summary. `training` is the Q2 pool (empty: none given).
@@ -323,12 +287,12 @@ pub(crate) fn compensate_report(
         let u = u.filter(|u| u.len() == v.errors_mm.len())?;
         UncertaintyCheck::of(&u, &v.errors_mm)
     });
-    let network = network_of(&trained.stored);
+    let shape = trained.stored.shape();
     report.compensator = Some(CompensatorSummary {
         base: applied.base.method(),
-        kind: network.kind.into(),
-        units: network.units,
-        inputs: network.inputs,
+        kind: trained.stored.kind().into(),
+        units: shape.units,
+        inputs: shape.inputs,
         training: trained.report.clone(),
         trained_on: if training.is_empty() {
             "identification"

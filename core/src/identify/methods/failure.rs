@@ -2,7 +2,7 @@
 //! lists with its message (`FailedMethod::reason`) while the other methods go on.
 
 use super::Method;
-use crate::compensate::train::TrainError;
+use crate::compensate::TrainError;
 use crate::identify::joint_maps::MapFitError;
 use crate::identify::least_squares::Cancelled;
 use crate::kinematics::KinematicsError;

@@ -104,12 +104,9 @@ const POINT_M: Bound = Bound {
     unit: "m",
 };
 
+/// The family's bounds ([`crate::compensate::Family::check_bounds`]).
 fn check_network(f: &str, c: &StoredCompensator, out: &Outputs) -> Result<(), ModelError> {
-    match c {
-        StoredCompensator::Mlp(m) => check_mlp(f, m, out),
-        StoredCompensator::Rbf(r) => check_rbf(f, r),
-        StoredCompensator::Gp(g) => check_gp(f, g, out),
-    }
+    c.check_bounds(f, out)
 }
 
 fn check_norm(
@@ -130,7 +127,8 @@ fn check_norm(
     }
 }
 
-fn check_mlp(f: &str, m: &Mlp, out: &Outputs) -> Result<(), ModelError> {
+/// An MLP's bounds (its family's `check_bounds`).
+pub(crate) fn check_mlp(f: &str, m: &Mlp, out: &Outputs) -> Result<(), ModelError> {
     check_count(
         &format!("{f}.hidden"),
         m.hidden,
@@ -154,7 +152,8 @@ fn check_mlp(f: &str, m: &Mlp, out: &Outputs) -> Result<(), ModelError> {
     )
 }
 
-fn check_rbf(f: &str, r: &Rbf) -> Result<(), ModelError> {
+/// An RBF network's bounds (its family's `check_bounds`).
+pub(crate) fn check_rbf(f: &str, r: &Rbf) -> Result<(), ModelError> {
     check_count(&format!("{f}.centres"), r.units(), MAX_RBF_UNITS, "units")?;
     check_above(&format!("{f}.spread"), r.spread, &positive(&RBF_NORMALISED))?;
     check_all(&format!("{f}.centres"), &r.centres, &RBF_NORMALISED)?;
@@ -168,7 +167,8 @@ fn check_rbf(f: &str, r: &Rbf) -> Result<(), ModelError> {
     )
 }
 
-fn check_gp(f: &str, g: &Gp, out: &Outputs) -> Result<(), ModelError> {
+/// A Gaussian process's bounds (its family's `check_bounds`).
+pub(crate) fn check_gp(f: &str, g: &Gp, out: &Outputs) -> Result<(), ModelError> {
     check_count(
         &format!("{f}.alpha"),
         g.units(),
@@ -235,7 +235,7 @@ fn positive(b: &Bound) -> Bound {
 mod tests {
     use crate::compensate::{
         parse_compensated, train, CalibratedModelFile, CompensatedModel, CompensatorSpec,
-        GpSettings, LmTrainSettings, MlpSpec, RbfSettings, Sample, Support, Trainer,
+        GpSettings, LmTrainSettings, MlpSettings, MlpSpec, RbfSettings, Sample, Support, Trainer,
     };
     use crate::model::preset;
     use nalgebra::Vector3;
@@ -270,13 +270,13 @@ mod tests {
         vec![
             (
                 "mlp",
-                CompensatorSpec::Mlp {
+                CompensatorSpec::Mlp(MlpSettings {
                     spec: MlpSpec::SKCM_NN,
                     trainer: Trainer::Lm(LmTrainSettings {
                         max_epochs: 20,
                         ..Default::default()
                     }),
-                },
+                }),
             ),
             (
                 "rbf",

@@ -259,7 +259,7 @@ fn a_run_starts_on_the_seeds_expansion_of_the_compensator() {
 /// expansion, one next to it does.
 #[test]
 fn a_rough_seed_expansion_is_checked() {
-    let gp = crate::compensate::gp_predict::tests::random_gp(60, 3);
+    let gp = crate::compensate::gp::predict::tests::random_gp(60, 3);
     let scale = gp.signal_variance * gp.alpha.iter().map(|a| a.abs()).sum::<f64>();
     let nominal = preset("ys100").unwrap();
     let mut m = synthetic_calibration(&nominal, &SyntheticErrors::typical(1e-6), 7);

@@ -21,7 +21,7 @@
 //! `∂y/∂q_k = diag(1/s_out)·W2·diag(1 − h²)·W1·diag(s_in)·∂f/∂q_k`, where `f` is
 //! the feature map (`∂ sin q/∂q = cos q`, `∂ cos q/∂q = −sin q`).
 
-use super::{Compensator, InvalidCompensator};
+use crate::compensate::{Compensator, InvalidCompensator, StoredCompensator};
 use nalgebra::{Matrix3xX, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -430,8 +430,8 @@ impl Compensator for Mlp {
     fn name(&self) -> &str {
         "mlp"
     }
-    fn stored(&self) -> Option<super::StoredCompensator> {
-        Some(super::StoredCompensator::Mlp(self.clone()))
+    fn stored(&self) -> Option<StoredCompensator> {
+        Some(self.clone().into())
     }
 }
 

@@ -1,4 +1,4 @@
-//! The Gaussian process's mean (`gp_predict.rs`) in AVX2 and FMA
+//! The Gaussian process's mean (`gp/predict.rs`) in AVX2 and FMA
 //! intrinsics: one pass over the groups of four inducing configurations,
 //! their distances, weights and the three components' sums in registers.
 //! The compiler's own vectorisation of that fused pass shuffles lanes and
@@ -7,15 +7,15 @@
 //! the operations of the generic loops, in the same order (the distance
 //! summed over the joints in order, `exp_nonpositive`'s reduction, Estrin
 //! scheme and exponent bits, the cutoff, the fused sums), so the results
-//! are bitwise the generic ones (tested in `gp_predict.rs`).
+//! are bitwise the generic ones (tested in `gp/predict.rs`).
 //!
 //! Units and layout as `PreparedGp`: `blocks` holds `u_am = z_ma/ℓ_a` by
 //! groups of four configurations (group g's joint a at `(g·n_a + a)·4`),
 //! `weights` the `s²·α_cm` [m] in component rows of `padded` values, `v`
 //! the scaled joints `q_a/ℓ_a`.
 
-use super::gp::CUTOFF;
-use super::gp_predict::{EXP_LN2_HI, EXP_LN2_LO, EXP_MAGIC, EXP_TAYLOR};
+use super::exp::{EXP_LN2_HI, EXP_LN2_LO, EXP_MAGIC, EXP_TAYLOR};
+use super::model::CUTOFF;
 use std::arch::x86_64::{
     __m256d, _mm256_add_epi64, _mm256_add_pd, _mm256_andnot_pd, _mm256_castpd_si256,
     _mm256_castsi256_pd, _mm256_cmp_pd, _mm256_fmadd_pd, _mm256_fnmadd_pd, _mm256_loadu_pd,
@@ -65,7 +65,7 @@ pub(super) fn mean_sums(
     out
 }
 
-/// `gp_predict::exp_nonpositive` on four lanes, operation for operation.
+/// `exp::exp_nonpositive` on four lanes, operation for operation.
 #[target_feature(enable = "avx2,fma")]
 fn exp_nonpositive(x: __m256d) -> __m256d {
     let splat = _mm256_set1_pd;

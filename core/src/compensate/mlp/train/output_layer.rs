@@ -5,7 +5,7 @@
 //! taken of that fit. [`OutputLayer::Searched`] keeps the seed's search over
 //! every weight.
 
-use super::super::mlp::Shape;
+use super::super::model::Shape;
 use super::data::Prepared;
 use nalgebra::DMatrix;
 use rayon::prelude::*;

@@ -3,9 +3,9 @@
 //! the mean residual), the held-out split and the population methods' guard
 //! against the null network.
 
-use super::super::mlp::{Mlp, Normalisation, Shape};
-use super::super::Sample;
+use super::super::model::{Mlp, Normalisation, Shape};
 use super::{MlpSpec, NullNetwork};
+use crate::compensate::Sample;
 use rand::seq::SliceRandom;
 use rand::Rng;
 

@@ -1,57 +1,14 @@
-//! KM-RBF (seed ch. 3, eqs. 3.10–3.12): a radial basis network from the gravity
-//! torques to the position residual, grown greedily.
-//!
-//! Hidden unit `i`: `o_i = exp(−n²)`, `n = ‖w_i − p‖·b` (eqs. 3.10–3.11) with the
-//! input `p` the normalised gravity torques and one bias `b = √ln2 / spread` for
-//! all units (MATLAB `newrb`: a unit answers 0.5 at distance `spread`). Linear
-//! output layer with bias. Training (§3.2, as `newrb`): start with no unit; run
-//! the network, add a unit centred on the training input with the largest
-//! residual error, re-solve the linear layer by least squares (SVD), repeat up to
-//! `max_neurons` (40 in the seed). The spread and the number of units are chosen
-//! on a held-out part of the training set ([`RbfSettings`]); the network is then
-//! re-grown on all training samples with that spread and size.
-//!
-//! Inputs: the gravity torques τ [N·m] at the commanded joints, min–max
-//! normalised to `[−1, 1]` per joint over the training set (joints whose torque
-//! never changes, e.g. joint 1 of a floor robot, drop out). Outputs: the residual
-//! [m], in the registered base frame (`OutputFrame::Base`, the seed's choice)
-//! or turned by `−q1` about the base z axis (`OutputFrame::Joint1`): gravity
-//! torques do not see `q1`, while an error caused by them turns with the arm
-//! about joint 1, so a network of τ alone can only learn it in a frame that
-//! turns with joint 1 (exact for a floor or ceiling robot whose joint 1 axis is
-//! the base z axis). The derivative in `q` is that of the frame rotation; the
-//! torques' own dependence on `q` is neglected as in the IK's quasi-Newton
-//! Jacobian (see [`CompensatedModel::predict_base_with_jacobian`](super::CompensatedModel::predict_base_with_jacobian)).
+//! Training of the RBF network (module docs of `rbf`, seed §3.2 as MATLAB's
+//! `newrb`): units added greedily on the held-out choice of spread and size,
+//! the output layer by least squares.
 
-use super::mlp::Normalisation;
-use super::{Compensator, InvalidCompensator, Sample};
-use nalgebra::{DMatrix, Matrix3, Matrix3xX, Vector3};
+use super::model::{rot_z, OutputFrame, Rbf};
+use crate::compensate::mlp::Normalisation;
+use crate::compensate::Sample;
+use nalgebra::{DMatrix, Vector3};
 use rand::seq::SliceRandom;
 use rand::Rng;
 use serde::{Deserialize, Serialize};
-
-/// Frame of the RBF outputs (module docs).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum OutputFrame {
-    Base,
-    Joint1,
-}
-
-/// A trained RBF network (a [`Compensator`]).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Rbf {
-    pub dof: usize,
-    pub output_frame: OutputFrame,
-    pub input_norm: Normalisation,
-    /// Spread in normalised torque units.
-    pub spread: f64,
-    /// Centres, `dof` values each (normalised torques), flat.
-    pub centres: Vec<f64>,
-    /// Output weights, row-major `3 × (units + 1)`; the last column is the bias.
-    pub weights: Vec<f64>,
-}
 
 /// RBF training settings.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -83,96 +40,6 @@ pub struct RbfReport {
     pub neurons: usize,
     /// Held-out RMS of the error norm [mm] of the chosen spread and size.
     pub holdout_rms_mm: f64,
-}
-
-fn rot_z(a: f64) -> Matrix3<f64> {
-    let (s, c) = a.sin_cos();
-    Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
-}
-
-impl Rbf {
-    pub fn units(&self) -> usize {
-        self.centres.len() / self.dof.max(1)
-    }
-
-    pub fn validate(&self) -> Result<(), InvalidCompensator> {
-        if self.dof == 0 || !self.centres.len().is_multiple_of(self.dof) {
-            return Err(InvalidCompensator::RbfCentres);
-        }
-        if self.weights.len() != 3 * (self.units() + 1) {
-            return Err(InvalidCompensator::RbfWeightCount {
-                got: self.weights.len(),
-                units: self.units(),
-                expected: 3 * (self.units() + 1),
-            });
-        }
-        if !(self.spread.is_finite() && self.spread > 0.0) {
-            return Err(InvalidCompensator::RbfSpread);
-        }
-        if self
-            .centres
-            .iter()
-            .chain(&self.weights)
-            .any(|v| !v.is_finite())
-        {
-            return Err(InvalidCompensator::RbfNotFinite);
-        }
-        self.input_norm.validate(self.dof, "rbf input", false)
-    }
-
-    /// Output in the network's own frame [m].
-    fn local(&self, tau: &[f64]) -> Vector3<f64> {
-        let mut p = tau.to_vec();
-        self.input_norm.apply(&mut p);
-        let b = std::f64::consts::LN_2.sqrt() / self.spread;
-        let k = self.units();
-        let mut y = Vector3::new(
-            self.weights[k],
-            self.weights[2 * k + 1],
-            self.weights[3 * k + 2],
-        );
-        for (i, c) in self.centres.chunks_exact(self.dof).enumerate() {
-            let d2: f64 = c.iter().zip(&p).map(|(a, b)| (a - b) * (a - b)).sum();
-            let o = (-d2 * b * b).exp();
-            for r in 0..3 {
-                y[r] += self.weights[r * (k + 1) + i] * o;
-            }
-        }
-        y
-    }
-
-    pub fn eval(&self, q: &[f64], tau: &[f64]) -> Vector3<f64> {
-        let y = self.local(tau);
-        match self.output_frame {
-            OutputFrame::Base => y,
-            OutputFrame::Joint1 => rot_z(q[0]) * y,
-        }
-    }
-}
-
-impl Compensator for Rbf {
-    fn residual(&self, q: &[f64], tau: &[f64]) -> Vector3<f64> {
-        self.eval(q, tau)
-    }
-    fn jacobian_q(&self, q: &[f64], tau: &[f64], _payload_kg: f64) -> Option<Matrix3xX<f64>> {
-        match self.output_frame {
-            OutputFrame::Base => None,
-            OutputFrame::Joint1 => {
-                let y = self.local(tau);
-                let (s, c) = q[0].sin_cos();
-                let mut j = Matrix3xX::zeros(q.len());
-                j[(0, 0)] = -s * y.x - c * y.y;
-                j[(1, 0)] = c * y.x - s * y.y;
-                Some(j)
-            }
-        }
-    }
-    fn name(&self) -> &str {
-        "rbf"
-    }
-    fn stored(&self) -> Option<super::StoredCompensator> {
-        Some(super::StoredCompensator::Rbf(self.clone()))
-    }
 }
 
 /// Targets of the RBF: residuals in its output frame [m].
@@ -371,6 +238,7 @@ pub fn train_rbf_with_progress(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::compensate::Compensator;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
 

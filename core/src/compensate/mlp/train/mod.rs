@@ -1,9 +1,8 @@
-//! Training of the residual compensators on [`Sample`]s: the MLP of
-//! [`mlp`](super::mlp) by Levenberg–Marquardt backpropagation (seed ch. 4, the
-//! MATLAB toolbox default `trainlm`; `lm`), by invasive weed optimisation
-//! (ch. 5, `iwo`) or by TLBO (ch. 6, `tlbo`), all over the same flat
-//! weight vector in normalised units (`data`); and the RBF of
-//! [`rbf`](super::rbf) (ch. 3).
+//! Training of the MLP of [`model`](super::model) on [`Sample`]s: by
+//! Levenberg–Marquardt backpropagation (seed ch. 4, the MATLAB toolbox
+//! default `trainlm`; `lm`), by invasive weed optimisation (ch. 5, `iwo`) or
+//! by TLBO (ch. 6, `tlbo`), all over the same flat weight vector in
+//! normalised units (`data`).
 //!
 //! Loss per sample (eqs. 5.5 / 6.9): `E = (1/3)·Σ_o e_o²` with `e` the error of
 //! the normalised outputs. LM minimises `Σ E` on the fitting part and stops
@@ -34,10 +33,8 @@ pub use lm::LmTrainSettings;
 pub use output_layer::OutputLayer;
 pub use tlbo::TlboTrainSettings;
 
-use super::gp::{train_gp, GpReport, GpSettings};
-use super::mlp::Features;
-use super::rbf::{train_rbf_with_progress, RbfReport, RbfSettings, RbfTrainError};
-use super::{Sample, StoredCompensator};
+use super::model::{Features, Mlp};
+use crate::compensate::{Sample, TrainError, TrainReport};
 use data::Prepared;
 use rand::Rng;
 use serde::{Deserialize, Serialize};
@@ -109,91 +106,11 @@ impl Trainer {
     }
 }
 
-/// Which compensator to train.
+/// The MLP's network and trainer (its [`CompensatorSpec`](crate::compensate::CompensatorSpec)).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "kebab-case")]
-pub enum CompensatorSpec {
-    Mlp { spec: MlpSpec, trainer: Trainer },
-    Rbf(RbfSettings),
-    Gp(GpSettings),
-}
-
-impl CompensatorSpec {
-    /// SKCM-NN: 18-20-3 by LM backpropagation.
-    pub fn skcm_nn() -> Self {
-        CompensatorSpec::Mlp {
-            spec: MlpSpec::SKCM_NN,
-            trainer: Trainer::Lm(LmTrainSettings::default()),
-        }
-    }
-    /// SKCM-IWONN: 18-40-3 by IWO.
-    pub fn skcm_iwonn() -> Self {
-        CompensatorSpec::Mlp {
-            spec: MlpSpec::POPULATION,
-            trainer: Trainer::Iwo(IwoSettings::default()),
-        }
-    }
-    /// SKCM-TLBONN: 18-40-3 by TLBO.
-    pub fn skcm_tlbonn() -> Self {
-        CompensatorSpec::Mlp {
-            spec: MlpSpec::POPULATION,
-            trainer: Trainer::Tlbo(TlboTrainSettings::default()),
-        }
-    }
-    /// KM-RBF's network.
-    pub fn km_rbf() -> Self {
-        CompensatorSpec::Rbf(RbfSettings::default())
-    }
-
-    pub fn label(&self) -> &'static str {
-        match self {
-            CompensatorSpec::Rbf(_) => "rbf",
-            CompensatorSpec::Gp(_) => "gp",
-            CompensatorSpec::Mlp { trainer, .. } => match trainer {
-                Trainer::Lm(_) => "nn",
-                Trainer::Iwo(_) => "iwonn",
-                Trainer::Tlbo(_) => "tlbonn",
-            },
-        }
-    }
-}
-
-/// Why training failed.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum TrainError {
-    #[error("training cancelled")]
-    Cancelled,
-    #[error("a compensator needs at least 5 training poses, got {got}")]
-    TooFewSamples { got: usize },
-    #[error("training samples must have the same number of joints and finite residuals")]
-    InconsistentSamples,
-    #[error("the MLP needs at least one hidden unit")]
-    NoHiddenUnits,
-    #[error(transparent)]
-    Rbf(#[from] RbfTrainError),
-    #[error("gp: no length scale and noise gave a positive definite system")]
-    GpSingular,
-}
-
-/// What a training run did.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct TrainReport {
-    /// `lm`, `iwo`, `tlbo` or `rbf`.
-    pub trainer: String,
-    pub samples: usize,
-    /// Epochs (LM), iterations (IWO) or generations (TLBO) run; RBF units.
-    pub epochs: usize,
-    pub evaluations: usize,
-    /// Final training loss (normalised units, see module docs).
-    pub loss: f64,
-    /// Why it stopped.
-    pub stop: String,
-    /// Training RMS of the residual error norm after compensation [mm].
-    pub rms_mm: f64,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub rbf: Option<RbfReport>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub gp: Option<GpReport>,
+pub struct MlpSettings {
+    pub spec: MlpSpec,
+    pub trainer: Trainer,
 }
 
 /// What a trainer found and how it ended.
@@ -271,109 +188,44 @@ impl std::fmt::Display for TrainStop {
     }
 }
 
-fn training_rms_mm(c: &StoredCompensator, samples: &[Sample]) -> f64 {
-    let c = c.clone().into_arc();
-    let ss: f64 = samples
-        .iter()
-        .map(|s| (s.residual - c.residual_at(&s.q, &s.tau, s.payload_kg)).norm_squared())
-        .sum();
-    (ss / samples.len() as f64).sqrt() * 1e3
-}
-
-/// Trains a compensator on `samples`. `progress(epoch, loss)` is called after
-/// every epoch / iteration / generation and returns false to cancel.
-pub fn train(
-    spec: &CompensatorSpec,
+/// Trains the MLP of `settings` on `samples` by its trainer: the weights,
+/// their report (its `rms_mm` left to the caller) and the network.
+pub(super) fn train_mlp(
+    settings: &MlpSettings,
     samples: &[Sample],
     rng: &mut impl Rng,
     progress: &mut dyn FnMut(usize, f64) -> bool,
-) -> Result<(StoredCompensator, TrainReport), TrainError> {
-    if samples.len() < 5 {
-        return Err(TrainError::TooFewSamples { got: samples.len() });
+) -> Result<(Mlp, TrainReport), TrainError> {
+    let MlpSettings { spec: m, trainer } = settings;
+    if m.hidden == 0 {
+        return Err(TrainError::NoHiddenUnits);
     }
     let dof = samples[0].q.len();
-    if samples.iter().any(|s| {
-        s.q.len() != dof || s.tau.len() != dof || !s.residual.iter().all(|v| v.is_finite())
-    }) {
-        return Err(TrainError::InconsistentSamples);
-    }
-    match spec {
-        CompensatorSpec::Rbf(settings) => {
-            let (net, rep) = train_rbf_with_progress(samples, settings, rng, progress)?
-                .ok_or(TrainError::Cancelled)?;
-            let stored = StoredCompensator::Rbf(net);
-            Ok((
-                stored.clone(),
-                TrainReport {
-                    trainer: "rbf".into(),
-                    samples: samples.len(),
-                    epochs: rep.neurons,
-                    evaluations: rep.neurons,
-                    loss: rep.holdout_rms_mm,
-                    stop: format!(
-                        "{} units, spread {} chosen on held-out data",
-                        rep.neurons, rep.spread
-                    ),
-                    rms_mm: training_rms_mm(&stored, samples),
-                    rbf: Some(rep),
-                    gp: None,
-                },
-            ))
-        }
-        CompensatorSpec::Gp(settings) => {
-            let (gp, rep) = train_gp(samples, settings, rng, progress)?;
-            let stored = StoredCompensator::Gp(gp);
-            Ok((
-                stored.clone(),
-                TrainReport {
-                    trainer: "gp".into(),
-                    samples: samples.len(),
-                    epochs: rep.fits,
-                    evaluations: rep.fits,
-                    loss: rep.holdout_after_mm,
-                    stop: format!(
-                        "{} inducing poses, length scales and noise chosen on held-out data ({} fits)",
-                        rep.inducing, rep.fits
-                    ),
-                    rms_mm: training_rms_mm(&stored, samples),
-                    rbf: None,
-                    gp: Some(rep),
-                },
-            ))
-        }
-        CompensatorSpec::Mlp { spec: m, trainer } => {
-            if m.hidden == 0 {
-                return Err(TrainError::NoHiddenUnits);
-            }
-            let data = Prepared::new(samples, m);
-            let outcome = match trainer {
-                Trainer::Lm(s) => lm::lm(&data, s, rng, progress)?,
-                Trainer::Iwo(s) => iwo::iwo(&data, s, rng, progress)?,
-                Trainer::Tlbo(s) => tlbo::tlbo_train(&data, s, rng, progress)?,
-            };
-            let stop = outcome.stop.to_string();
-            let stored = StoredCompensator::Mlp(data.into_mlp(m, dof, outcome.weights));
-            Ok((
-                stored.clone(),
-                TrainReport {
-                    trainer: trainer.name().into(),
-                    samples: samples.len(),
-                    epochs: outcome.epochs,
-                    evaluations: outcome.evaluations,
-                    loss: outcome.loss,
-                    stop,
-                    rms_mm: training_rms_mm(&stored, samples),
-                    rbf: None,
-                    gp: None,
-                },
-            ))
-        }
-    }
+    let data = Prepared::new(samples, m);
+    let outcome = match trainer {
+        Trainer::Lm(s) => lm::lm(&data, s, rng, progress)?,
+        Trainer::Iwo(s) => iwo::iwo(&data, s, rng, progress)?,
+        Trainer::Tlbo(s) => tlbo::tlbo_train(&data, s, rng, progress)?,
+    };
+    let stop = outcome.stop.to_string();
+    let report = TrainReport {
+        trainer: trainer.name().into(),
+        samples: samples.len(),
+        epochs: outcome.epochs,
+        evaluations: outcome.evaluations,
+        loss: outcome.loss,
+        stop,
+        rms_mm: 0.0,
+        rbf: None,
+        gp: None,
+    };
+    Ok((data.into_mlp(m, dof, outcome.weights), report))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::compensate::{train, CompensatorSpec, StoredCompensator};
     use nalgebra::Vector3;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
@@ -425,17 +277,17 @@ mod tests {
         let cases = [
             (CompensatorSpec::skcm_nn(), 0.1),
             (
-                CompensatorSpec::Mlp {
+                CompensatorSpec::Mlp(MlpSettings {
                     spec: MlpSpec::SMALL,
                     trainer: Trainer::Iwo(quick_iwo),
-                },
+                }),
                 0.7,
             ),
             (
-                CompensatorSpec::Mlp {
+                CompensatorSpec::Mlp(MlpSettings {
                     spec: MlpSpec::SMALL,
                     trainer: Trainer::Tlbo(quick_tlbo),
-                },
+                }),
                 0.7,
             ),
         ];

@@ -1,36 +1,13 @@
-//! Sparse Gaussian-process compensator with per-joint length scales and an
-//! expected error per pose (beyond the seed; docs/design.md "Gaussian-process
-//! compensator").
-//!
-//! Inputs: model-convention joints `q` [rad]; outputs: the three components of
-//! the residual [m] in the registered base frame, one shared kernel
-//! `k(a, b) = s²·exp(−½·Σ_j ((a_j − b_j)/ℓ_j)²)` (ℓ_j = ∞: joint j ignored).
-//! The DTC approximation (Quiñonero-Candela & Rasmussen, JMLR 2005, eqs. 20–21)
-//! on `M` inducing configurations `Z` (300 by default), chosen by
-//! farthest-point sampling among the training joints:
-//!
-//! - mean `μ(q) = r̄ + k_Z(q)ᵀ·α`, `α = (σ²·K_ZZ + K_ZX·K_XZ)⁻¹·K_ZX·(Y − r̄)`;
-//! - variance per component `v(q) = s² − k_Zᵀ·(K_ZZ⁻¹ − σ²·A⁻¹)·k_Z + σ²`,
-//!   `A = σ²·K_ZZ + K_ZX·K_XZ`;
-//! - expected position error `u(q) = κ·√(3·v(q))` [m], `κ` the ratio of the
-//!   held-out RMS error to the held-out RMS of `√(3·v)`.
-//!
-//! The length scales (per joint, as fractions of the joint's trained range),
-//! and `σ²/s²` are chosen on a seeded 20 % holdout: a grid, then one pass of
-//! per-joint refinement (halve, double, drop). Hand-written on nalgebra's
-//! Cholesky: no maintained Rust crate offers sparse GP regression with an
-//! analytic input gradient, which the IK needs.
+//! Training of the sparse Gaussian process (module docs of `gp`): inducing
+//! configurations by farthest-point sampling, the DTC fit, length scales and
+//! noise chosen on a seeded holdout.
 
-use super::train::TrainError;
-use super::{Compensator, InvalidCompensator, Sample, StoredCompensator};
-use nalgebra::{DMatrix, Vector3};
+use super::model::{kernel_exponent, Gp};
+use crate::compensate::{Sample, TrainError};
+use nalgebra::DMatrix;
 use rand::seq::SliceRandom;
 use rand::Rng;
 use serde::{Deserialize, Serialize};
-
-/// Inducing configurations farther than this squared scaled distance add
-/// nothing (`exp(−25)` ≈ 1.4e-11 of the signal) and are skipped.
-pub(super) const CUTOFF: f64 = 50.0;
 
 /// Settings of the Gaussian-process compensator.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -57,30 +34,6 @@ impl Default for GpSettings {
     }
 }
 
-/// A trained sparse GP (module docs); SI units.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Gp {
-    pub dof: usize,
-    /// `1/ℓ_j` [1/rad]; 0 ignores joint j.
-    pub inverse_length_scales: Vec<f64>,
-    /// `s²` [m²].
-    pub signal_variance: f64,
-    /// `σ²` [m²].
-    pub noise_variance: f64,
-    /// `r̄` [m].
-    pub mean: [f64; 3],
-    /// `Z`, M rows of `dof` joints [rad], row-major.
-    pub inducing: Vec<f64>,
-    /// `α`, M rows of 3 [m / s²·…], row-major.
-    pub alpha: Vec<f64>,
-    /// `K_ZZ⁻¹ − σ²·A⁻¹`, M×M row-major [1/m²].
-    pub variance: Vec<f64>,
-    /// `κ` (module docs).
-    pub error_scale: f64,
-    /// RMS of the residual norm it was trained on, no compensation [m].
-    pub uncompensated_rms: f64,
-}
-
 /// How the hyperparameters were chosen.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct GpReport {
@@ -94,160 +47,6 @@ pub struct GpReport {
     /// Candidates fitted.
     pub fits: usize,
     pub error_scale: f64,
-}
-
-impl Gp {
-    /// Number of inducing configurations.
-    pub fn units(&self) -> usize {
-        self.alpha.len() / 3
-    }
-
-    pub fn validate(&self) -> Result<(), InvalidCompensator> {
-        let m = self.units();
-        let ok_sizes = self.dof > 0
-            && m > 0
-            && self.alpha.len() == 3 * m
-            && self.inducing.len() == self.dof * m
-            && self.variance.len() == m * m
-            && self.inverse_length_scales.len() == self.dof;
-        if !ok_sizes {
-            return Err(InvalidCompensator::GpSizes);
-        }
-        let finite = self
-            .inverse_length_scales
-            .iter()
-            .chain(&self.inducing)
-            .chain(&self.alpha)
-            .chain(&self.variance)
-            .chain(&self.mean)
-            .chain([
-                &self.signal_variance,
-                &self.noise_variance,
-                &self.error_scale,
-                &self.uncompensated_rms,
-            ])
-            .all(|v| v.is_finite());
-        let positive = self.signal_variance > 0.0
-            && self.noise_variance > 0.0
-            && self.error_scale > 0.0
-            && self.inverse_length_scales.iter().all(|v| *v >= 0.0);
-        if !finite || !positive {
-            return Err(InvalidCompensator::GpValues);
-        }
-        Ok(())
-    }
-
-    /// `Σ_j ((q_j − z_mj)/ℓ_j)²` to inducing configuration `m`.
-    fn scaled_distance(&self, q: &[f64], m: usize) -> f64 {
-        kernel_exponent(q, self.inducing(m), &self.inverse_length_scales)
-    }
-
-    /// Inducing configuration `m` [rad].
-    fn inducing(&self, m: usize) -> &[f64] {
-        &self.inducing[m * self.dof..(m + 1) * self.dof]
-    }
-
-    /// `α_m·k(q, z_m)` [m]; `None` beyond the cutoff.
-    fn term(&self, q: &[f64], m: usize) -> Option<Vector3<f64>> {
-        let e = self.scaled_distance(q, m);
-        if e > CUTOFF {
-            return None;
-        }
-        let a = &self.alpha[3 * m..3 * m + 3];
-        Some(Vector3::new(a[0], a[1], a[2]) * (self.signal_variance * (-0.5 * e).exp()))
-    }
-
-    /// Kernel values `k_Z(q)` into `k` (M values).
-    fn kernel_row(&self, q: &[f64], k: &mut [f64]) {
-        for (m, km) in k.iter_mut().enumerate() {
-            let e = self.scaled_distance(q, m);
-            *km = if e > CUTOFF {
-                0.0
-            } else {
-                self.signal_variance * (-0.5 * e).exp()
-            };
-        }
-    }
-
-    /// Predictive variance of one residual component at `q` [m²].
-    pub fn variance_at(&self, q: &[f64]) -> f64 {
-        let m = self.units();
-        let mut k = vec![0.0; m];
-        self.kernel_row(q, &mut k);
-        let mut quad = 0.0;
-        for (i, ki) in k.iter().enumerate() {
-            let row = &self.variance[i * m..(i + 1) * m];
-            quad += ki * row.iter().zip(&k).map(|(v, kj)| v * kj).sum::<f64>();
-        }
-        (self.signal_variance - quad).max(0.0) + self.noise_variance
-    }
-}
-
-// The reference evaluation; a stored GP becomes a compensator as
-// [`super::PreparedGp`], the same numbers faster.
-impl Compensator for Gp {
-    fn residual(&self, q: &[f64], _tau: &[f64]) -> Vector3<f64> {
-        (0..self.units())
-            .filter_map(|m| self.term(q, m))
-            .fold(Vector3::from(self.mean), |r, t| r + t)
-    }
-
-    fn name(&self) -> &str {
-        "gp"
-    }
-
-    fn residual_and_jacobian(
-        &self,
-        q: &[f64],
-        _tau: &[f64],
-        _payload_kg: f64,
-        dq: &mut [Vector3<f64>],
-    ) -> (Vector3<f64>, bool) {
-        let mut r = Vector3::from(self.mean);
-        for c in dq.iter_mut() {
-            *c = Vector3::zeros();
-        }
-        for m in 0..self.units() {
-            let Some(ak) = self.term(q, m) else {
-                continue;
-            };
-            r += ak;
-            let z = self.inducing(m);
-            // ∂k/∂q_j = −k·(q_j − z_j)/ℓ_j².
-            for (j, c) in dq.iter_mut().enumerate().take(self.dof) {
-                let il = self.inverse_length_scales[j];
-                *c -= ak * ((q[j] - z[j]) * il * il);
-            }
-        }
-        (r, true)
-    }
-
-    fn stored(&self) -> Option<StoredCompensator> {
-        Some(StoredCompensator::Gp(self.clone()))
-    }
-
-    fn uncertainty(&self, q: &[f64]) -> Option<Uncertainty> {
-        Some(Uncertainty {
-            compensated_m: self.error_scale * (3.0 * self.variance_at(q)).sqrt(),
-            uncompensated_m: self.uncompensated_rms,
-        })
-    }
-}
-
-/// Expected position errors at a pose [m]: with the compensator's correction,
-/// and without it (where it fades out).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Uncertainty {
-    pub compensated_m: f64,
-    pub uncompensated_m: f64,
-}
-
-impl Uncertainty {
-    /// The expected error with a fraction `w` of the correction applied:
-    /// `√(w·u_c² + (1 − w)·u_0²)`.
-    pub fn at_weight(&self, w: f64) -> f64 {
-        (w * self.compensated_m.powi(2) + (1.0 - w) * self.uncompensated_m.powi(2)).sqrt()
-    }
 }
 
 /// One candidate's hyperparameters.
@@ -275,18 +74,35 @@ struct Fitted {
     variance: DMatrix<f64>,
 }
 
-/// `Σ_j ((a_j − b_j)·il_j)²`.
-fn kernel_exponent(a: &[f64], b: &[f64], il: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .zip(il)
-        .map(|((x, y), l)| ((x - y) * l).powi(2))
-        .sum()
-}
-
 /// `s²·exp(−½·Σ_j ((a_j − b_j)·il_j)²)`.
 fn kernel(a: &[f64], b: &[f64], il: &[f64], s2: f64) -> f64 {
     s2 * (-0.5 * kernel_exponent(a, b, il)).exp()
+}
+
+impl<'a> Data<'a> {
+    /// The residuals of `samples` centred [mm], their pooled variance and
+    /// `m` inducing configurations by farthest-point sampling.
+    fn new(samples: &'a [Sample], m: usize, rng: &mut impl Rng) -> Self {
+        let n = samples.len();
+        let mut mean_mm = [0.0; 3];
+        for s in samples {
+            for (o, v) in mean_mm.iter_mut().enumerate() {
+                *v += s.residual[o] * 1e3 / n as f64;
+            }
+        }
+        let y: Vec<[f64; 3]> = samples
+            .iter()
+            .map(|s| std::array::from_fn(|o| s.residual[o] * 1e3 - mean_mm[o]))
+            .collect();
+        let signal = (y.iter().flatten().map(|v| v * v).sum::<f64>() / (3 * n) as f64).max(1e-12);
+        Data {
+            samples,
+            y,
+            mean_mm,
+            signal,
+            inducing: farthest_points(samples, m, rng),
+        }
+    }
 }
 
 impl Data<'_> {
@@ -422,17 +238,6 @@ pub fn train_gp(
     }
     let n = samples.len();
     let dof = samples[0].q.len();
-    let mut mean_mm = [0.0; 3];
-    for s in samples {
-        for (o, v) in mean_mm.iter_mut().enumerate() {
-            *v += s.residual[o] * 1e3 / n as f64;
-        }
-    }
-    let y: Vec<[f64; 3]> = samples
-        .iter()
-        .map(|s| std::array::from_fn(|o| s.residual[o] * 1e3 - mean_mm[o]))
-        .collect();
-    let signal = (y.iter().flatten().map(|v| v * v).sum::<f64>() / (3 * n) as f64).max(1e-12);
     let uncompensated_rms = (samples
         .iter()
         .map(|s| s.residual.norm_squared())
@@ -440,14 +245,7 @@ pub fn train_gp(
         / n as f64)
         .sqrt();
     let m = settings.inducing.clamp(1, (n / 2).max(1));
-    let inducing = farthest_points(samples, m, rng);
-    let data = Data {
-        samples,
-        y,
-        mean_mm,
-        signal,
-        inducing,
-    };
+    let data = Data::new(samples, m, rng);
     let mut order: Vec<usize> = (0..n).collect();
     order.shuffle(rng);
     let n_test = ((n as f64 * settings.holdout).round() as usize).clamp(1, n - 1);
@@ -463,7 +261,7 @@ pub fn train_gp(
     let mut fits = 0;
     let mut best: Option<(Hyper, f64)> = None;
     // Before any fit, the checks report the RMS of the centred residuals [mm].
-    let spread = (3.0 * signal).sqrt();
+    let spread = (3.0 * data.signal).sqrt();
     let mut consider = |h: Hyper, best: &mut Option<(Hyper, f64)>| -> bool {
         let shown = best.as_ref().map_or(spread, |b| b.1);
         let done = fits;

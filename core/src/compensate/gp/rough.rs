@@ -1,7 +1,7 @@
 //! The Gaussian process's mean and joint derivative (the formulas of
-//! `gp_predict.rs`) in single precision, eight inducing configurations per
+//! `gp/predict.rs`) in single precision, eight inducing configurations per
 //! vector: the IK's expansion at its closed-form seed
-//! ([`Compensator::residual_and_jacobian_rough`](super::Compensator::residual_and_jacobian_rough)),
+//! ([`Compensator::residual_and_jacobian_rough`](crate::compensate::Compensator::residual_and_jacobian_rough)),
 //! whose end point the double-precision prediction then checks
 //! (docs/design.md "Compensated model and false targets").
 //!
@@ -17,7 +17,7 @@
 //! the CPU has them and from the C library's exactly rounded `fmaf`
 //! elsewhere, so every CPU gives bitwise the same results.
 
-use super::gp::{Gp, CUTOFF};
+use super::model::{Gp, CUTOFF};
 use crate::kinematics::prepared::with_scratch;
 use nalgebra::Vector3;
 
