@@ -17,6 +17,10 @@
 //!   here): what KM leaves of the orientation is the probe's noise, and `auto`
 //!   drops the part, saying why.
 //!
+//! Position-only data of the displacement truth: the compensator has no
+//! orientation part, the report says `not_measured`, a production tool is
+//! `unverified` and keeps the base's orientation.
+//!
 //! Checked against independent figures: the cross-validation's base mean is
 //! KM's orientation mean on the training pool as the report computes it from
 //! the measurements; held-out validation orientation of `auto`'s choice
@@ -30,9 +34,12 @@ use nalgebra::{Rotation3, Vector3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal, Uniform};
+use robocal_core::cell::accuracy::{tool_accuracy, ToolAccuracy};
+use robocal_core::cell::predict::{Forward, PredictFrame};
 use robocal_core::compensate::CompensatedModel;
 use robocal_core::identify::report::OrientationPartStatus;
 use robocal_core::identify::{calibrate_with_training, CalibrationReport, Method};
+use robocal_core::kinematics::chain::tool_pose;
 use robocal_core::measure::Measurement;
 use robocal_core::model::joint_maps::Coverage;
 use robocal_core::model::orientation::rotation_angle_between;
@@ -266,4 +273,76 @@ fn auto_drops_an_orientation_part_that_learns_only_noise() {
         validation_orientation(&r, Method::Auto),
     );
     assert!((auto_o - km_o).abs() < 1e-12, "auto {auto_o} km {km_o}");
+}
+
+/// Position-only data of the displacement truth: the compensator has no
+/// orientation part and the report says why (`not_measured`); a production
+/// tool's accuracy is `unverified`, and the compensated model turns it as
+/// its base does (the position part moves it only).
+#[test]
+fn position_only_data_leave_no_orientation_part_and_the_tool_unverified() {
+    let mut rng = ChaCha8Rng::seed_from_u64(3243);
+    let effect = Effect::Displacement;
+    let (nominal, truth) = truth(effect, &mut rng);
+    let strip = |v: Vec<Measurement>| -> Vec<Measurement> {
+        v.into_iter()
+            .map(|m| Measurement {
+                orientation: None,
+                ..m
+            })
+            .collect()
+    };
+    let id = strip(measure(&truth, effect, 120, &mut rng));
+    let tr = strip(measure(&truth, effect, 200, &mut rng));
+    let va = strip(measure(&truth, effect, 60, &mut rng));
+    let mut opts = common::opts(&[Method::KmGp]);
+    opts.compensator.cv_folds = 0;
+    let r = calibrate_with_training(&nominal, &id, &tr, &va, &opts, &|_| true).unwrap();
+    let gp = &r.methods[&Method::KmGp];
+    let comp = gp.compensator.as_ref().unwrap();
+    eprintln!("position only: {:?}", comp.orientation_part);
+    assert_eq!(
+        comp.orientation_part.status,
+        OrientationPartStatus::NotMeasured
+    );
+    assert!(comp.orientation_part.reason.contains("unverified"));
+    assert!(comp.orientation_part.cross_validation.is_none());
+    assert!(comp.orientation_note.is_none());
+    assert!(gp.stored_orientation.is_none());
+    let json = serde_json::to_value(gp).unwrap();
+    assert_eq!(
+        json["compensator"]["orientation_part"]["status"],
+        "not_measured"
+    );
+    // A production tool 250 mm out, tilted 30°: its accuracy is unverified.
+    let probe = tool_pose(&gp.calibrated);
+    let mut tcp = Pose::identity();
+    tcp.rot_y(30f64.to_radians());
+    tcp.p = Vector3::new(0.0, 0.0, 0.25);
+    match tool_accuracy(gp.validation_evidence.as_ref(), &probe, &tcp) {
+        ToolAccuracy::Unverified { message } => assert!(message.contains("unverified")),
+        other => panic!("{other:?}"),
+    }
+    // The compensator turns nothing: the tool's orientation is the base's.
+    let with = CompensatedModel {
+        compensator: gp.compensator_arc(),
+        cell_from_base: r.tracker_to_base.inverse(),
+        payload_kg: 0.0,
+        ..CompensatedModel::from_nominal(gp.calibrated.clone())
+    };
+    let base = CompensatedModel {
+        compensator: None,
+        ..with.clone()
+    };
+    let tool = probe.compose(&tcp);
+    let (fw, fb) = (
+        Forward::new(&with, Some(&tool), None),
+        Forward::new(&base, Some(&tool), None),
+    );
+    let cell = PredictFrame::default();
+    for m in va.iter().take(10) {
+        let (a, b) = (fw.pose(&m.q, &cell).unwrap(), fb.pose(&m.q, &cell).unwrap());
+        assert!(rotation_angle_between(&a.r, &b.r) < 1e-12);
+        assert!((a.p - b.p).norm() > 0.0, "the position part moves the tool");
+    }
 }
