@@ -29,9 +29,13 @@
 //! tip is `ℓ` from the measured point by `ℓ·α_i` at the tip, unseen. The
 //! joint's map is refused (not fitted) when
 //!
-//! - `ℓ·α_i > max_unseen_tip_m` ([`MapRefusal::AngleNotResolved`]; `ℓ` =
-//!   `production_tool_m`, 250 mm, `max_unseen_tip_m` 0.5 mm, i.e. angles
-//!   coarser than 2 mrad = 0.115°), or else
+//! - `ℓ·α_i > max(max_unseen_tip_m, noise_ratio·σ)`
+//!   ([`MapRefusal::AngleNotResolved`]; `ℓ` = `production_tool_m`, 250 mm,
+//!   `max_unseen_tip_m` 0.5 mm, `noise_ratio` 2): the tip would go wrong by
+//!   more than 0.5 mm unseen **and** by more than twice what the noise
+//!   leaves at the measured point (`ℓ / L_i > 2`; data whose noise is already
+//!   millimetres, where the geometry leaves that much, are not held to a
+//!   finer bound at the tip than at the measured point), or else
 //! - `L_i < min_lever_m` (20 mm), a floor whatever the noise
 //!   ([`MapRefusal::LeverBelowFloor`]): the data's noise estimate may be
 //!   optimistic, and a joint seen through so short a lever is not mapped.
@@ -82,8 +86,10 @@ pub struct JointMapSettings {
     pub production_tool_m: f64,
     /// With position-only data, a joint whose angle one pose resolves
     /// (σ / L_i) would move that tip by more than this unseen gets no map
-    /// (module docs) [m].
+    /// (module docs) [m] …
     pub max_unseen_tip_m: f64,
+    /// … and by more than this many times the position noise σ.
+    pub noise_ratio: f64,
 }
 
 impl Default for JointMapSettings {
@@ -99,6 +105,7 @@ impl Default for JointMapSettings {
             min_lever_m: 0.02,
             production_tool_m: 0.25,
             max_unseen_tip_m: 0.5e-3,
+            noise_ratio: 2.0,
         }
     }
 }
@@ -151,7 +158,7 @@ pub struct MapFit {
 #[serde(rename_all = "snake_case")]
 pub enum MapRefusal {
     /// The angle one pose resolves, `σ / L_i`, would move a production
-    /// tool's tip by more than `max_unseen_tip_m` unseen.
+    /// tool's tip by more than `max_unseen_tip_m` and `noise_ratio·σ` unseen.
     AngleNotResolved,
     /// The lever arm `L_i` is below the floor `min_lever_m`.
     LeverBelowFloor,
@@ -189,7 +196,8 @@ pub struct RefusedMap {
     pub production_tool_mm: f64,
     /// What an angle error of `resolved_deg` moves that tip by, unseen [mm].
     pub unseen_tip_mm: f64,
-    /// The bound on `unseen_tip_mm` [mm].
+    /// The bound on `unseen_tip_mm`, `max(max_unseen_tip_m, noise_ratio·σ)`
+    /// [mm].
     pub max_unseen_tip_mm: f64,
     pub reason: String,
 }
@@ -224,7 +232,8 @@ fn refusal(
         std::f64::consts::PI
     };
     let tip = settings.production_tool_m * resolved;
-    let kind = if tip > settings.max_unseen_tip_m {
+    let bound = settings.max_unseen_tip_m.max(settings.noise_ratio * noise);
+    let kind = if tip > bound {
         MapRefusal::AngleNotResolved
     } else if lever < settings.min_lever_m {
         MapRefusal::LeverBelowFloor
@@ -238,7 +247,7 @@ fn refusal(
             "joint {joint}'s angle moves the measured point by {lever_mm:.2} mm per radian (RMS over the poses) and no pose measured an orientation: with {noise_mm:.4} mm of position noise one pose resolves its angle only to {:.4}°, which would turn the tip of a production tool {tool_mm:.0} mm from the measured point by {:.3} mm unseen (more than {:.3} mm), so no map is fitted",
             resolved.to_degrees(),
             tip * 1e3,
-            settings.max_unseen_tip_m * 1e3
+            bound * 1e3
         ),
         MapRefusal::LeverBelowFloor => format!(
             "joint {joint}'s angle moves the measured point by only {lever_mm:.2} mm per radian (RMS over the poses, below the floor of {:.0} mm/rad) and no pose measured an orientation: a map of it would be nearly invisible to the measurements yet turn a production tool, so none is fitted",
@@ -254,7 +263,7 @@ fn refusal(
         resolved_deg: resolved.to_degrees(),
         production_tool_mm: tool_mm,
         unseen_tip_mm: tip * 1e3,
-        max_unseen_tip_mm: settings.max_unseen_tip_m * 1e3,
+        max_unseen_tip_mm: bound * 1e3,
         reason,
     })
 }
@@ -735,7 +744,7 @@ mod tests {
         let s = JointMapSettings::default();
         // 100 mm lever, 0.1 mm noise: 1 mrad resolved, 0.25 mm at the tip.
         assert_eq!(refusal(6, 0.1, 1e-4, &s), None);
-        // 0.4 mm noise: 4 mrad, 1 mm at the tip, above 0.5 mm.
+        // 0.4 mm noise: 4 mrad, 1 mm at the tip, above 0.5 mm and 2σ = 0.8 mm.
         let r = refusal(6, 0.1, 4e-4, &s).unwrap();
         assert_eq!(r.kind, MapRefusal::AngleNotResolved);
         assert!((r.resolved_deg - 4e-3f64.to_degrees()).abs() < 1e-12);
@@ -746,6 +755,14 @@ mod tests {
         let r = refusal(6, 0.01, 1e-6, &s).unwrap();
         assert_eq!(r.kind, MapRefusal::LeverBelowFloor);
         assert!((r.unseen_tip_mm - 0.025).abs() < 1e-12);
+        // 1 mm noise through a 400 mm lever: 0.625 mm at the tip, above
+        // 0.5 mm but below twice the noise (ℓ/L = 0.625): fitted; through
+        // 100 mm (2.5 mm, above 2 mm): refused, the bound 2 mm.
+        assert_eq!(refusal(2, 0.4, 1e-3, &s), None);
+        let r = refusal(2, 0.1, 1e-3, &s).unwrap();
+        assert_eq!(r.kind, MapRefusal::AngleNotResolved);
+        assert!((r.max_unseen_tip_mm - 2.0).abs() < 1e-12);
+        assert!((r.unseen_tip_mm - 2.5).abs() < 1e-12);
         // A point on the axis resolves nothing: capped at 180°.
         let r = refusal(6, 0.0, 1e-5, &s).unwrap();
         assert_eq!(r.kind, MapRefusal::AngleNotResolved);
