@@ -719,6 +719,14 @@ pub fn render_compensators(r: &CalibrationReport) -> String {
         if let (Some(b), Some(v)) = (&c.base_validation, &m.validation) {
             let _ = writeln!(s, "  {:<14} validation:     {}", "", pair(b, &v.stats));
         }
+        let o = &c.orientation_part;
+        let _ = writeln!(
+            s,
+            "  {:<14} orientation part: {} — {}",
+            "",
+            o.status.name(),
+            o.reason
+        );
     }
     s
 }

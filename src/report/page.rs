@@ -539,6 +539,9 @@ pub fn compensators(models: &[Model]) -> Markup {
                         (c.trained_on) " poses, " (c.training.epochs.map_or("—".into(), |n| n.to_string()))
                         " epochs / iterations / generations; stopped: " (c.training.stop) }
                     @if let Some(n) = &c.orientation_note { p.note { (n) } }
+                    @if let Some(o) = &c.orientation_part {
+                        p.note { "Orientation part: " strong { (o.status) } " — " (o.reason) }
+                    }
                     table {
                         thead { tr { th { "Set" } th.n { "base mean" } th.n { "mean" } th.n { "change" }
                             th.n { "base max" } th.n { "max" } th.n { "change" } } }

@@ -235,6 +235,18 @@ pub struct CompensatorView {
     /// What the compensator does to orientation (format 4).
     #[serde(default)]
     pub orientation_note: Option<String>,
+    /// Whether it has an orientation part, and why (format 4).
+    #[serde(default, deserialize_with = "lenient")]
+    pub orientation_part: Option<OrientationPartView>,
+}
+
+/// A compensator's orientation part: its status and why.
+#[derive(Debug, Clone, Default, Deserialize)]
+pub struct OrientationPartView {
+    #[serde(default)]
+    pub status: String,
+    #[serde(default)]
+    pub reason: String,
 }
 
 /// The expected errors checked on the validation set.

@@ -21,13 +21,35 @@
 //! Observability: a map is fitted only where the measurements see its effect.
 //! With position-only data a joint's angle is seen through the position
 //! rows of its column `J_θi` alone, whose norm is the lever arm from joint
-//! i's axis to the measured point [m/rad]; its RMS over the poses,
-//! `L_i = √(mean_p ‖J_pos,θi(q_p)‖²)`, below `min_lever_m` means an angle error
-//! of that joint barely moves the reflector (joint 6 seen from a reflector near
-//! its axis) while it turns a production tool: the joint's map is refused (not
-//! fitted) and [`MapFit::refused`] says why. Any measured orientation sees
-//! every joint's angle directly (`‖J_rot,θi‖ = 1`), so with orientation rows
-//! no map is refused on this ground.
+//! i's axis to the measured point [m/rad]; its RMS over the poses is
+//! `L_i = √(mean_p ‖J_pos,θi(q_p)‖²)`. One pose measured with a position
+//! noise σ per coordinate resolves an angle of joint i no finer than
+//! `α_i = σ / L_i` [rad]: an angle error of that size moves the measured
+//! point by one σ, no more than the noise. It turns a production tool whose
+//! tip is `ℓ` from the measured point by `ℓ·α_i` at the tip, unseen. The
+//! joint's map is refused (not fitted) when
+//!
+//! - `ℓ·α_i > max(max_unseen_tip_m, noise_ratio·σ)`
+//!   ([`MapRefusal::AngleNotResolved`]; `ℓ` = `production_tool_m`, 250 mm,
+//!   `max_unseen_tip_m` 0.5 mm, `noise_ratio` 2): the tip would go wrong by
+//!   more than 0.5 mm unseen **and** by more than twice what the noise
+//!   leaves at the measured point (`ℓ / L_i > 2`; data whose noise is already
+//!   millimetres, where the geometry leaves that much, are not held to a
+//!   finer bound at the tip than at the measured point), or else
+//! - `L_i < min_lever_m` (20 mm), a floor whatever the noise
+//!   ([`MapRefusal::LeverBelowFloor`]): the data's noise estimate may be
+//!   optimistic, and a joint seen through so short a lever is not mapped.
+//!
+//! σ is the RMS of the rows' position standard deviations where the data
+//! gives them (`std_x..z`), else the RMS per coordinate of the position
+//! residual the calibrated geometry leaves on the poses (over rows minus
+//! fitted columns): an upper bound of the noise, since it also holds what the
+//! maps are to explain, so the rule errs towards refusing. Joint 6 seen from a
+//! reflector 0.3 mm from its axis with σ = 0.01 mm resolves 33 mrad (1.9°):
+//! 8 mm unseen at a 250 mm tip. [`MapFit::refused`] says which rule and its
+//! figures. Any measured orientation sees every joint's angle directly
+//! (`‖J_rot,θi‖ = 1`), so with orientation rows no map is refused on this
+//! ground.
 
 use super::evaluate::{evaluate, gram_checked};
 use crate::measure::Measurement;
@@ -57,8 +79,17 @@ pub struct JointMapSettings {
     /// Rounds of (map fit, LM refit of the geometry with the maps fixed).
     pub rounds: usize,
     /// With position-only data, a joint whose RMS lever arm to the measured
-    /// point is below this gets no map (module docs) [m].
+    /// point is below this gets no map, whatever the noise (module docs) [m].
     pub min_lever_m: f64,
+    /// Distance of a production tool's tip from the measured point the
+    /// observability rule guards (`ℓ`, module docs) [m].
+    pub production_tool_m: f64,
+    /// With position-only data, a joint whose angle one pose resolves
+    /// (σ / L_i) would move that tip by more than this unseen gets no map
+    /// (module docs) [m] …
+    pub max_unseen_tip_m: f64,
+    /// … and by more than this many times the position noise σ.
+    pub noise_ratio: f64,
 }
 
 impl Default for JointMapSettings {
@@ -72,6 +103,9 @@ impl Default for JointMapSettings {
             min_range_rad: 10f64.to_radians(),
             rounds: 2,
             min_lever_m: 0.02,
+            production_tool_m: 0.25,
+            max_unseen_tip_m: 0.5e-3,
+            noise_ratio: 2.0,
         }
     }
 }
@@ -118,17 +152,120 @@ pub struct MapFit {
     pub refused: Vec<RefusedMap>,
 }
 
+/// Why a joint's map was refused (module docs): a closed set whose
+/// snake-case names the report serialises.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MapRefusal {
+    /// The angle one pose resolves, `σ / L_i`, would move a production
+    /// tool's tip by more than `max_unseen_tip_m` and `noise_ratio·σ` unseen.
+    AngleNotResolved,
+    /// The lever arm `L_i` is below the floor `min_lever_m`.
+    LeverBelowFloor,
+}
+
+impl MapRefusal {
+    pub const ALL: [MapRefusal; 2] = [MapRefusal::AngleNotResolved, MapRefusal::LeverBelowFloor];
+
+    /// The serialised name.
+    pub fn name(self) -> &'static str {
+        match self {
+            MapRefusal::AngleNotResolved => "angle_not_resolved",
+            MapRefusal::LeverBelowFloor => "lever_below_floor",
+        }
+    }
+}
+
 /// A joint whose map was refused: the measurements do not see its angle.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RefusedMap {
     /// Joint number (1-based).
     pub joint: usize,
+    /// Which rule refused it (module docs).
+    pub kind: MapRefusal,
     /// RMS lever arm from the joint's axis to the measured point over the
     /// poses [mm].
     pub lever_mm: f64,
-    /// The threshold it is below [mm].
+    /// The floor of the lever [mm].
     pub min_lever_mm: f64,
+    /// The position noise σ per coordinate the rule used [mm].
+    pub noise_mm: f64,
+    /// The angle one pose resolves, `σ / L_i`, at most 180° [deg].
+    pub resolved_deg: f64,
+    /// A production tool's tip distance from the measured point, `ℓ` [mm].
+    pub production_tool_mm: f64,
+    /// What an angle error of `resolved_deg` moves that tip by, unseen [mm].
+    pub unseen_tip_mm: f64,
+    /// The bound on `unseen_tip_mm`, `max(max_unseen_tip_m, noise_ratio·σ)`
+    /// [mm].
+    pub max_unseen_tip_mm: f64,
     pub reason: String,
+}
+
+/// The position noise σ per coordinate of position-only `data` [m] (module
+/// docs): the RMS of the rows' standard deviations where given, else the RMS
+/// of the geometry's position residual `r` over `rows − fitted` degrees of
+/// freedom.
+fn position_noise(r: &DVector<f64>, fitted: usize, data: &[Measurement]) -> f64 {
+    let given: Vec<f64> = data
+        .iter()
+        .filter_map(|m| m.std.map(|s| s.position))
+        .collect();
+    if !given.is_empty() {
+        return (given.iter().map(|s| s * s).sum::<f64>() / given.len() as f64).sqrt();
+    }
+    let dof = r.len().saturating_sub(fitted).max(1);
+    (r.norm_squared() / dof as f64).sqrt()
+}
+
+/// The refusal of a joint seen through the RMS lever `lever` [m] with the
+/// noise `noise` [m], `None` when its map may be fitted (module docs).
+fn refusal(
+    joint: usize,
+    lever: f64,
+    noise: f64,
+    settings: &JointMapSettings,
+) -> Option<RefusedMap> {
+    let resolved = if lever > 0.0 {
+        (noise / lever).min(std::f64::consts::PI)
+    } else {
+        std::f64::consts::PI
+    };
+    let tip = settings.production_tool_m * resolved;
+    let bound = settings.max_unseen_tip_m.max(settings.noise_ratio * noise);
+    let kind = if tip > bound {
+        MapRefusal::AngleNotResolved
+    } else if lever < settings.min_lever_m {
+        MapRefusal::LeverBelowFloor
+    } else {
+        return None;
+    };
+    let (lever_mm, noise_mm, tool_mm) =
+        (lever * 1e3, noise * 1e3, settings.production_tool_m * 1e3);
+    let reason = match kind {
+        MapRefusal::AngleNotResolved => format!(
+            "joint {joint}'s angle moves the measured point by {lever_mm:.2} mm per radian (RMS over the poses) and no pose measured an orientation: with {noise_mm:.4} mm of position noise one pose resolves its angle only to {:.4}°, which would turn the tip of a production tool {tool_mm:.0} mm from the measured point by {:.3} mm unseen (more than {:.3} mm), so no map is fitted",
+            resolved.to_degrees(),
+            tip * 1e3,
+            bound * 1e3
+        ),
+        MapRefusal::LeverBelowFloor => format!(
+            "joint {joint}'s angle moves the measured point by only {lever_mm:.2} mm per radian (RMS over the poses, below the floor of {:.0} mm/rad) and no pose measured an orientation: a map of it would be nearly invisible to the measurements yet turn a production tool, so none is fitted",
+            settings.min_lever_m * 1e3
+        ),
+    };
+    Some(RefusedMap {
+        joint,
+        kind,
+        lever_mm,
+        min_lever_mm: settings.min_lever_m * 1e3,
+        noise_mm,
+        resolved_deg: resolved.to_degrees(),
+        production_tool_mm: tool_mm,
+        unseen_tip_mm: tip * 1e3,
+        max_unseen_tip_mm: bound * 1e3,
+        reason,
+    })
 }
 
 /// RMS over the poses of the position rows' norm of each column of `jt`
@@ -162,10 +299,11 @@ fn position_levers(jt: &DMatrix<f64>, data: &[Measurement]) -> Option<Vec<f64>> 
 }
 
 /// The joints (with their trained range) that get a map, and those refused
-/// as unobservable (module docs).
+/// as unobservable (module docs), `noise` the position noise σ [m].
 fn map_joints(
     jt: &DMatrix<f64>,
     data: &[Measurement],
+    noise: f64,
     settings: &JointMapSettings,
 ) -> (Vec<(usize, [f64; 2])>, Vec<RefusedMap>) {
     let levers = position_levers(jt, data);
@@ -179,19 +317,12 @@ fn map_joints(
         if hi - lo < settings.min_range_rad {
             continue;
         }
-        match levers.as_ref().map(|l| l[i]) {
-            Some(lever) if lever < settings.min_lever_m => refused.push(RefusedMap {
-                joint: i + 1,
-                lever_mm: lever * 1e3,
-                min_lever_mm: settings.min_lever_m * 1e3,
-                reason: format!(
-                    "joint {}'s angle moves the measured point by only {:.2} mm per radian (RMS over the poses, below {:.0} mm/rad) and no pose measured an orientation: a map of it would be invisible to the measurements yet turn a production tool, so none is fitted",
-                    i + 1,
-                    lever * 1e3,
-                    settings.min_lever_m * 1e3
-                ),
-            }),
-            _ => joints.push((i, [lo, hi])),
+        match levers
+            .as_ref()
+            .and_then(|l| refusal(i + 1, l[i], noise, settings))
+        {
+            Some(r) => refused.push(r),
+            None => joints.push((i, [lo, hi])),
         }
     }
     (joints, refused)
@@ -277,7 +408,8 @@ fn build(
     if !go() {
         return Ok(None);
     }
-    let (joints, refused) = map_joints(&jt, data, settings);
+    let noise = position_noise(&geo_eval.r, jg.ncols(), data);
+    let (joints, refused) = map_joints(&jt, data, noise, settings);
     if joints.is_empty() && !refused.is_empty() {
         return Err(MapFitError::NoObservableJoint {
             refused: refused
@@ -599,4 +731,46 @@ pub fn fit_joint_maps(
         poses: data.len(),
         refused: d.refused.clone(),
     }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rule on hand-computed figures (defaults: ℓ = 250 mm, 0.5 mm
+    /// unseen at the tip, 20 mm floor).
+    #[test]
+    fn a_map_is_refused_by_what_one_pose_resolves_then_by_the_floor() {
+        let s = JointMapSettings::default();
+        // 100 mm lever, 0.1 mm noise: 1 mrad resolved, 0.25 mm at the tip.
+        assert_eq!(refusal(6, 0.1, 1e-4, &s), None);
+        // 0.4 mm noise: 4 mrad, 1 mm at the tip, above 0.5 mm and 2σ = 0.8 mm.
+        let r = refusal(6, 0.1, 4e-4, &s).unwrap();
+        assert_eq!(r.kind, MapRefusal::AngleNotResolved);
+        assert!((r.resolved_deg - 4e-3f64.to_degrees()).abs() < 1e-12);
+        assert!((r.unseen_tip_mm - 1.0).abs() < 1e-12);
+        assert!((r.noise_mm - 0.4).abs() < 1e-12 && (r.lever_mm - 100.0).abs() < 1e-12);
+        // 10 mm lever, 1 µm noise: 0.1 mrad, 0.025 mm at the tip, but the
+        // lever is below the 20 mm floor.
+        let r = refusal(6, 0.01, 1e-6, &s).unwrap();
+        assert_eq!(r.kind, MapRefusal::LeverBelowFloor);
+        assert!((r.unseen_tip_mm - 0.025).abs() < 1e-12);
+        // 1 mm noise through a 400 mm lever: 0.625 mm at the tip, above
+        // 0.5 mm but below twice the noise (ℓ/L = 0.625): fitted; through
+        // 100 mm (2.5 mm, above 2 mm): refused, the bound 2 mm.
+        assert_eq!(refusal(2, 0.4, 1e-3, &s), None);
+        let r = refusal(2, 0.1, 1e-3, &s).unwrap();
+        assert_eq!(r.kind, MapRefusal::AngleNotResolved);
+        assert!((r.max_unseen_tip_mm - 2.0).abs() < 1e-12);
+        assert!((r.unseen_tip_mm - 2.5).abs() < 1e-12);
+        // A point on the axis resolves nothing: capped at 180°.
+        let r = refusal(6, 0.0, 1e-5, &s).unwrap();
+        assert_eq!(r.kind, MapRefusal::AngleNotResolved);
+        assert_eq!(r.resolved_deg, 180.0);
+        let names: Vec<_> = MapRefusal::ALL.iter().map(|k| k.name()).collect();
+        for k in MapRefusal::ALL {
+            assert_eq!(serde_json::to_value(k).unwrap(), k.name());
+        }
+        assert_eq!(names, ["angle_not_resolved", "lever_below_floor"]);
+    }
 }

@@ -421,6 +421,96 @@ pub struct CompensatorSummary {
     /// corrects position only, the orientation figures are the base's).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub orientation_note: Option<String>,
+    /// Whether the compensator has an orientation part, and why (always
+    /// given: position-only data say `not_measured`).
+    pub orientation_part: OrientationPart,
+}
+
+/// Whether a compensator corrects the orientation (a closed set; the report
+/// serialises the snake-case names).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum OrientationPartStatus {
+    /// Trained on the pool's orientation residuals and applied.
+    Trained,
+    /// No training pose measured an orientation: there is nothing to learn it
+    /// from, the orientation is the base's and a production tool's
+    /// orientation is unverified.
+    NotMeasured,
+    /// Fewer than half of the training poses (or fewer than 5) measured one.
+    TooFewPoses,
+    /// Its training failed; the compensator corrects the position only.
+    TrainingFailed,
+    /// `auto` dropped it: on held-out poses it did not lower the
+    /// orientation mean below the base's.
+    NotKept,
+}
+
+impl OrientationPartStatus {
+    pub const ALL: [OrientationPartStatus; 5] = [
+        OrientationPartStatus::Trained,
+        OrientationPartStatus::NotMeasured,
+        OrientationPartStatus::TooFewPoses,
+        OrientationPartStatus::TrainingFailed,
+        OrientationPartStatus::NotKept,
+    ];
+
+    /// The serialised name.
+    pub fn name(self) -> &'static str {
+        match self {
+            OrientationPartStatus::Trained => "trained",
+            OrientationPartStatus::NotMeasured => "not_measured",
+            OrientationPartStatus::TooFewPoses => "too_few_poses",
+            OrientationPartStatus::TrainingFailed => "training_failed",
+            OrientationPartStatus::NotKept => "not_kept",
+        }
+    }
+}
+
+/// Out-of-fold orientation errors of a compensator's orientation part on the
+/// training pool's poses that measured an orientation [deg]: the base alone
+/// (`|ω|`, the angle of `R_measured·R_predictedᵀ`) and after the correction
+/// trained without the pose's fold (`|ω − ω̂|`, that angle to first order).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct OrientationCv {
+    pub folds: usize,
+    pub poses: usize,
+    pub base_mean_deg: f64,
+    pub base_max_deg: f64,
+    pub compensated_mean_deg: f64,
+    pub compensated_max_deg: f64,
+}
+
+impl OrientationCv {
+    /// From a cross-validation of rotation-vector samples, whose "mm" are
+    /// mrad (`compensate::cross_validate` scales residual norms by 1e3).
+    pub fn of(cv: &CvStats) -> Self {
+        let deg = |mrad: f64| (mrad * 1e-3).to_degrees();
+        OrientationCv {
+            folds: cv.folds,
+            poses: cv.base.n,
+            base_mean_deg: deg(cv.base.mean_mm),
+            base_max_deg: deg(cv.base.max_mm),
+            compensated_mean_deg: deg(cv.compensated.mean_mm),
+            compensated_max_deg: deg(cv.compensated.max_mm),
+        }
+    }
+
+    /// Whether the part lowered the held-out orientation mean by at least
+    /// `min_gain` (relative).
+    pub fn helps(&self, min_gain: f64) -> bool {
+        self.compensated_mean_deg <= self.base_mean_deg * (1.0 - min_gain)
+    }
+}
+
+/// A compensator's orientation part in a report: its status, why, and its
+/// cross-validation where one ran.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct OrientationPart {
+    pub status: OrientationPartStatus,
+    pub reason: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cross_validation: Option<OrientationCv>,
 }
 
 /// How well a compensator's expected error per pose `u` (the RMS of the 3-D
@@ -490,6 +580,10 @@ pub struct AutoCandidate {
     /// Why it was not available (training failed, base failed).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub failed: Option<String>,
+    /// The cross-validation of its orientation part, where the pool
+    /// measured orientations.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub orientation_cross_validation: Option<OrientationCv>,
 }
 
 /// The choice of `auto`.
@@ -499,6 +593,11 @@ pub struct AutoSummary {
     pub chosen: Method,
     pub reason: String,
     pub candidates: Vec<AutoCandidate>,
+    /// The chosen compensator's orientation part: kept only when it lowered
+    /// the cross-validated orientation mean (none without a compensator or
+    /// without orientation measurements).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub orientation_part: Option<OrientationPart>,
 }
 
 /// Kind of a method warning.

@@ -22,19 +22,25 @@
 //! above the geometry's alone on the same folds by more than
 //! [`ORIENTATION_SLACK`] (relative); and between the options only those whose
 //! orientation mean on the pool is within [`ORIENTATION_SLACK`] of the lowest
-//! compete by position ([`choose_option`]). An option's orientation is
-//! scored as its base's (or maps'): a compensator's orientation part
-//! (`compensate::oriented`) is trained on the pool without a
-//! cross-validation, so `auto` does not credit it with a gain it has not
-//! shown on held-out poses.
+//! compete by position ([`choose_option`]). A kept compensator's
+//! orientation part (`compensate::oriented`) is cross-validated on the same
+//! folds as its position part (`methods::orientation_part`) and kept only
+//! when its cross-validated orientation mean is at least `min_gain` below
+//! the base's on the same poses; the option is then scored by that
+//! cross-validated mean, else the part is dropped (the reason says so,
+//! `AutoSummary::orientation_part` is `not_kept`) and the option scores its
+//! base's (or maps') orientation on the pool.
 
 use super::compensated::base_pool_errors;
 use super::maps::run_maps;
+use super::orientation_part::settle_for_auto;
 use super::run::{AppliedCompensator, Cache, Context, MethodFit, Outcome};
 use super::{Base, Compensated, Method, MethodError, MethodFailure, Run};
 use crate::compensate::{choose, Choice, CvStats};
 use crate::identify::least_squares::Fit;
-use crate::identify::report::{AutoCandidate, AutoSummary, SetErrors};
+use crate::identify::report::{
+    AutoCandidate, AutoSummary, OrientationPart, OrientationPartStatus, SetErrors,
+};
 
 /// Orientation means within this relative margin of each other count as
 /// equal (the fit's noise); a larger excess is a loss `auto` does not accept.
@@ -74,9 +80,13 @@ struct BaseOption {
     /// Cross-validated mean on the pool [mm] (the base's residual mean when
     /// nothing was trained).
     mean_mm: f64,
-    /// Orientation mean of the fit on the pool [deg] (none without
+    /// Orientation mean of the option [deg]: the fit's on the pool, or the
+    /// kept orientation part's cross-validated mean (none without
     /// orientation measurements).
     orientation_deg: Option<f64>,
+    /// The kept compensator's orientation part, where orientation was
+    /// measured.
+    orientation_part: Option<OrientationPart>,
     reason: String,
 }
 
@@ -157,6 +167,7 @@ pub(crate) fn run_auto(
                 compensator: None,
                 mean_mm: base_mean,
                 orientation_deg,
+                orientation_part: None,
                 reason: format!(
                     "{name}: only {} training poses (at least {} are needed to train and cross-validate a compensator), so the base stays",
                     pool.len(),
@@ -166,7 +177,7 @@ pub(crate) fn run_auto(
             continue;
         }
         let done0 = done;
-        let (choice, picked) = cross_validate_and_choose(
+        let (choice, picked, settled) = cross_validate_and_choose(
             ctx,
             cache,
             cands,
@@ -180,13 +191,17 @@ pub(crate) fn run_auto(
             .as_ref()
             .and_then(|a| a.trained.cv.as_ref())
             .map_or(base_mean, |cv| cv.compensated.mean_mm);
+        if let Some((_, Some(dropped))) = &settled {
+            notes.push(dropped.clone());
+        }
         options.push(BaseOption {
             base: *base,
             maps: None,
             fit: mf,
             compensator: picked,
             mean_mm,
-            orientation_deg,
+            orientation_deg: option_orientation(orientation_deg, &settled),
+            orientation_part: settled.map(|s| s.0),
             reason: format!("{name}: {}", choice.reason),
         });
     }
@@ -209,6 +224,7 @@ pub(crate) fn run_auto(
                     method,
                     cross_validation: None,
                     failed: Some(f.to_string()),
+                    orientation_cross_validation: None,
                 });
                 notes.push(format!("{} failed: {f}", method.name()));
             }
@@ -219,6 +235,7 @@ pub(crate) fn run_auto(
                     method,
                     cross_validation: None,
                     failed: None,
+                    orientation_cross_validation: None,
                 });
                 let (with, without) = (&m.chosen, &m.without_maps);
                 let gain = 1.0 - with.cv_mean_mm / without.cv_mean_mm;
@@ -253,13 +270,17 @@ pub(crate) fn run_auto(
                         &fit.fit.session_frames,
                         pool,
                     ));
+                    if let Some((_, Some(dropped))) = &on_maps.settled {
+                        notes.push(dropped.clone());
+                    }
                     options.push(BaseOption {
                         base: *base,
                         maps: Some(method),
                         fit,
                         compensator: on_maps.kept,
                         mean_mm: with.cv_mean_mm,
-                        orientation_deg,
+                        orientation_deg: option_orientation(orientation_deg, &on_maps.settled),
+                        orientation_part: on_maps.settled.map(|s| s.0),
                         reason: format!("{}{}", on_maps.reason, format_args!(
                             "{}: {} harmonics cross-validated over {} poses at {:.4} / {:.4} mm mean / max against {:.4} / {:.4} without maps",
                             method.name(),
@@ -333,6 +354,7 @@ pub(crate) fn run_auto(
             chosen,
             reason,
             candidates,
+            orientation_part: best.orientation_part,
         }),
     })
 }
@@ -349,6 +371,7 @@ fn option_name(o: &BaseOption) -> &'static str {
 /// What `auto` made of the compensators on a kept joint-map fit.
 struct OnMaps {
     kept: Option<AppliedCompensator>,
+    settled: Settled,
     /// The choice, as a prefix of the maps' reason (empty: none tried).
     reason: String,
 }
@@ -386,19 +409,40 @@ fn maps_compensator(
     if methods.is_empty() {
         return Ok(OnMaps {
             kept: None,
+            settled: None,
             reason: String::new(),
         });
     }
-    let (choice, kept) =
+    let (choice, kept, settled) =
         cross_validate_and_choose(ctx, cache, &methods, &fit.fit, folds, candidates, progress)?;
     Ok(OnMaps {
         kept,
+        settled,
         reason: format!("on {}: {}; ", base.method().name(), choice.reason),
     })
 }
 
+/// The kept compensator's orientation part and the note when `auto`
+/// dropped it (`orientation_part::settle_for_auto`).
+type Settled = Option<(OrientationPart, Option<String>)>;
+
+/// The orientation mean [deg] `auto` scores an option by: the base's (or
+/// maps') on the pool, or the kept orientation part's cross-validated mean.
+fn option_orientation(base_deg: Option<f64>, settled: &Settled) -> Option<f64> {
+    match settled {
+        Some((part, _)) if part.status == OrientationPartStatus::Trained => part
+            .cross_validation
+            .as_ref()
+            .map(|c| c.compensated_mean_deg)
+            .or(base_deg),
+        _ => base_deg,
+    }
+}
+
 /// Trains and cross-validates each compensator method on `fit`'s residuals,
-/// lists each as an `auto` candidate, and keeps the one `choose` accepts.
+/// lists each as an `auto` candidate, and keeps the one `choose` accepts
+/// with its orientation part settled (kept only when it lowered the
+/// cross-validated orientation mean).
 /// `progress(x, epoch, loss)` with `x` in methods done (fractional).
 fn cross_validate_and_choose(
     ctx: &Context,
@@ -408,7 +452,7 @@ fn cross_validate_and_choose(
     folds: usize,
     candidates: &mut Vec<AutoCandidate>,
     progress: &mut dyn FnMut(f64, usize, Option<f64>) -> bool,
-) -> Result<(Choice, Option<AppliedCompensator>), MethodError> {
+) -> Result<(Choice, Option<AppliedCompensator>, Settled), MethodError> {
     let o = &ctx.opts.compensator;
     let stages = o.cv_stages(folds) as f64;
     let mut cvs: Vec<(String, CvStats)> = Vec::new();
@@ -426,6 +470,7 @@ fn cross_validate_and_choose(
                     method: *m,
                     cross_validation: Some(cv.clone()),
                     failed: None,
+                    orientation_cross_validation: t.orientation_part.cross_validation.clone(),
                 });
                 cvs.push((m.name().to_string(), cv));
                 trained.push(AppliedCompensator {
@@ -439,15 +484,17 @@ fn cross_validate_and_choose(
                 method: *m,
                 cross_validation: None,
                 failed: Some(f.to_string()),
+                orientation_cross_validation: None,
             }),
         }
     }
     let choice = choose(&cvs, o.min_gain);
-    let picked = choice
+    let mut picked = choice
         .chosen
         .as_deref()
         .and_then(|chosen| trained.into_iter().find(|a| a.method.name() == chosen));
-    Ok((choice, picked))
+    let settled = picked.as_mut().and_then(|p| settle_for_auto(p, o.min_gain));
+    Ok((choice, picked, settled))
 }
 
 /// The joint-map method on `base` among `auto`'s candidates.

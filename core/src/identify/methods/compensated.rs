@@ -27,16 +27,17 @@
 //! `max_network_poses` from `ChaCha8Rng(seed + 1000)`
 //! (`CompensatorOptions::seed`): a calibration is reproducible bit for bit.
 
+use super::orientation_part::{note, train_orientation};
 use super::run::{AppliedCompensator, Cache, Context, Outcome};
-use super::{Base, Compensated, Method, MethodError, MethodFailure, Network};
+use super::{Compensated, Method, MethodError, MethodFailure, Network};
 use crate::compensate::{
-    cross_validate, train, Compensator, CompensatorSpec, CvStats, OrientationSamples, Sample,
-    StoredCompensator, StoredOrientation, Support, TrainError, TrainReport,
+    cross_validate, train, Compensator, CvStats, Sample, StoredCompensator, StoredOrientation,
+    Support, TrainError, TrainReport,
 };
 use crate::identify::least_squares::Fit;
 use crate::identify::report::{
-    predict_compensated, CompensatorSummary, MethodReport, MethodWarning, SetErrors,
-    UncertaintyCheck, WarningKind,
+    predict_compensated, CompensatorSummary, MethodReport, MethodWarning, OrientationPart,
+    SetErrors, UncertaintyCheck, WarningKind,
 };
 use crate::kinematics::{chain, gravity_torques_of};
 use crate::measure::Measurement;
@@ -52,6 +53,8 @@ pub(crate) struct Trained {
     pub stored: StoredCompensator,
     /// Its orientation part, where the pool measured orientations.
     pub orientation: Option<StoredOrientation>,
+    /// Why it has an orientation part or not, and its cross-validation.
+    pub orientation_part: OrientationPart,
     /// Where it was trained: its correction fades to zero beyond it.
     pub support: Support,
     pub report: TrainReport,
@@ -98,34 +101,6 @@ pub(crate) fn rotations(
             Some(e.r.transpose() * rm * r.transpose())
         })
         .collect()
-}
-
-/// The orientation part trained on `data`'s orientation residuals with the
-/// position part's `spec` (`ChaCha8Rng(seed + 500)`), turning about the
-/// measurement tool's point; `None` when fewer than half of the poses
-/// measured an orientation or the training fails (the compensator then
-/// corrects the position only).
-fn train_orientation(
-    spec: &CompensatorSpec,
-    model: &RobotModel,
-    data: &[Sample],
-    rotations: &[Option<Matrix3<f64>>],
-    seed: u64,
-    cancel: &mut dyn FnMut() -> bool,
-) -> Result<Option<StoredOrientation>, MethodError> {
-    let samples = OrientationSamples::of(data, rotations);
-    if samples.len() < 5 || 2 * samples.len() < data.len() {
-        return Ok(None);
-    }
-    let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(500));
-    match train(spec, &samples, &mut rng, &mut |_, _| cancel()) {
-        Ok((network, _)) => Ok(Some(StoredOrientation {
-            point_m: model.tool.p.into(),
-            network,
-        })),
-        Err(TrainError::Cancelled) => Err(MethodError::Cancelled),
-        Err(_) => Ok(None),
-    }
 }
 
 fn train_error(e: TrainError) -> MethodError {
@@ -187,12 +162,18 @@ pub(crate) fn train_network(
         progress(last, e, l)
     })
     .map_err(train_error)?;
-    let orientation = train_orientation(&spec, &base.model, &data, &turns, seed, &mut || {
-        progress(last, at_epoch, at_loss)
-    })?;
+    let (orientation, orientation_part) = train_orientation(
+        &spec,
+        &base.model,
+        (&data, &turns),
+        seed,
+        folds,
+        &mut || progress(last, at_epoch, at_loss),
+    )?;
     Ok(Trained {
         stored,
         orientation,
+        orientation_part,
         support: support_of(&data),
         report,
         cv,
@@ -200,7 +181,7 @@ pub(crate) fn train_network(
 }
 
 /// The support of training samples, with the joint maps' fade width.
-fn support_of(samples: &[Sample]) -> Support {
+pub(crate) fn support_of(samples: &[Sample]) -> Support {
     let qs: Vec<&[f64]> = samples.iter().map(|s| s.q.as_slice()).collect();
     Support::of(&qs, SUPPORT_FADE_RAD)
 }
@@ -317,24 +298,16 @@ pub(crate) fn compensate_report(
             .collect(),
         fade_deg: trained.support.fade_rad.to_degrees(),
         uncertainty,
-        orientation_note: ident
-            .iter()
-            .chain(training)
-            .chain(valid)
-            .any(|m| m.orientation.is_some())
-            .then(|| match &trained.orientation {
-                Some(_) => "the compensator corrects the orientation too: a second network of the same form learned the orientation residuals (rotation vectors, registered base frame) on the same poses, and turns the flange about the measured point".to_string(),
-                None => format!(
-                    "the compensator corrects the position only (too few training poses measured an orientation): the orientation errors are those of {} (its {}), unchanged by it",
-                    applied.base.method().name(),
-                    match applied.base {
-                        Base::Km => "geometry",
-                        Base::Skcm => "geometry and compliance",
-                        Base::KmMaps => "geometry and joint maps",
-                        Base::SkcmMaps => "geometry, compliance and joint maps",
-                    }
-                ),
-            }),
+        orientation_note: note(
+            &trained.orientation_part,
+            applied.base,
+            ident
+                .iter()
+                .chain(training)
+                .chain(valid)
+                .any(|m| m.orientation.is_some()),
+        ),
+        orientation_part: trained.orientation_part.clone(),
     });
     if let Some(w) = report
         .compensator

@@ -15,6 +15,7 @@ mod compensated;
 mod failure;
 mod maps;
 mod model_based;
+mod orientation_part;
 mod report;
 mod run;
 

@@ -81,7 +81,12 @@ impl Context<'_> {
             warnings.push(MethodWarning {
                 kind: WarningKind::MapRefused,
                 joint: Some(r.joint),
-                message: format!("no map for joint {}: {}", r.joint, r.reason),
+                message: format!(
+                    "no map for joint {} ({}): {}",
+                    r.joint,
+                    r.kind.name(),
+                    r.reason
+                ),
             });
         }
         let [k_lo, k_hi] = self.opts.plausible_stiffness_nm_per_rad;
