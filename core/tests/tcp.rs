@@ -6,7 +6,7 @@
 mod truth;
 
 use nalgebra::{Matrix3, Vector3};
-use robocal_core::cell::tcp::{self, axis, fixed_point, tracker, FitError, TcpMethod};
+use robocal_core::cell::tcp::{self, axis, fixed_point, tracker, NotFittedReason, TcpMethod};
 use robocal_core::cell::work_object_fit::{self, WorkObjectPoints};
 use robocal_core::model::orientation::rotation_angle_between;
 use robocal_core::model::Pose;
@@ -109,22 +109,36 @@ fn fixed_point_refuses_orientations_about_one_axis_and_too_few_poses() {
         .collect();
     let flanges = tcp::flange_poses(&model, &q).unwrap();
     match fixed_point::fit(&flanges) {
-        Err(FitError::Degenerate(m)) => {
+        Err(e) => {
+            assert_eq!(e.reason, NotFittedReason::OrientationsTooSimilar, "{e}");
+            let m = &e.message;
             assert!(m.contains("orientations too similar"), "{m}");
             assert!(m.contains("tilt the tool"), "{m}");
+            // About the tool's own axis the spread is 0°, of 5° needed.
+            assert!(e.measured.unwrap() < 0.01, "{e:?}");
+            assert_eq!(e.needed, Some(fixed_point::MIN_SPREAD_DEG));
         }
         other => panic!("expected a refusal, got {other:?}"),
     }
     // Tilts of 2° only.
     let q = fixed_point_readings(&tool, point, 5, 2.0, 6);
     let e = fixed_point::fit(&tcp::flange_poses(&model, &q).unwrap()).unwrap_err();
-    assert!(matches!(e, FitError::Degenerate(_)), "{e}");
+    assert_eq!(e.reason, NotFittedReason::OrientationsTooSimilar, "{e}");
+    let spread = e.measured.unwrap();
+    assert!(spread > 1.0 && spread < 5.0, "2° tilts: spread {spread}°");
     // Three orientations.
     let e = fixed_point::fit(&flanges[..3]).unwrap_err();
     assert!(e.to_string().contains("at least 4"), "{e}");
+    assert_eq!(e.reason, NotFittedReason::TooFewReadings);
+    assert_eq!((e.measured, e.needed), (Some(3.0), Some(4.0)));
     // A row with the wrong joint count.
     let e = tcp::flange_poses(&model, &[vec![0.0; 5]]).unwrap_err();
     assert!(e.to_string().contains("6 joints"), "{e}");
+    assert_eq!(e.reason, NotFittedReason::JointCount);
+    assert_eq!(
+        (e.row, e.measured, e.needed),
+        (Some(1), Some(5.0), Some(6.0))
+    );
 }
 
 /// Random readings and the true flange poses of the calibrated robot.
@@ -222,6 +236,10 @@ fn axis_from_a_second_point_gives_the_tool_z() {
     // A second point at the tip is refused.
     let e = axis::with_axis_point(fit.clone(), &fit.tcp.p, &[0.0; 3]).unwrap_err();
     assert!(e.to_string().contains("at least 5 mm"), "{e}");
+    assert_eq!(e.reason, NotFittedReason::AxisPointTooClose);
+    assert_eq!((e.measured, e.needed), (Some(0.0), Some(5.0)));
+    // The tip stays reported: only its axis failed.
+    assert_eq!(e.tip.as_deref().map(|t| t.tcp.p), Some(fit.tcp.p));
 }
 
 #[test]
@@ -268,6 +286,8 @@ fn axis_from_a_touched_plane_gives_the_tool_z() {
         .collect();
     let e = axis::with_plane(fit, &line).unwrap_err();
     assert!(e.to_string().contains("lie on a line"), "{e}");
+    assert_eq!(e.reason, NotFittedReason::PlaneTouchesInLine);
+    assert!(e.measured.unwrap() < 1e-9 && e.tip.is_some(), "{e:?}");
 }
 
 /// A fit to start an axis from (its TCP is set by the caller).
@@ -375,10 +395,17 @@ fn work_object_refuses_degenerate_points() {
     };
     let e = fit(p(0.0, 0.0), p(0.005, 0.0), p(0.0, 0.2)).unwrap_err();
     assert!(e.to_string().contains("from the origin"), "{e}");
+    assert_eq!(e.reason, NotFittedReason::XPointTooClose);
+    assert!((e.measured.unwrap() - 5.0).abs() < 1e-9, "{e:?}");
     let e = fit(p(0.0, 0.0), p(0.3, 0.0), p(0.5, 0.02)).unwrap_err();
     assert!(e.to_string().contains("on the x axis"), "{e}");
+    assert_eq!(e.reason, NotFittedReason::XyPointOnXAxis);
+    // OX along x, OY = (0.5, 0.02): atan(0.02/0.5) = 2.29°.
+    let want = (0.02f64 / 0.5).atan().to_degrees();
+    assert!((e.measured.unwrap() - want).abs() < 1e-9, "{e:?}");
     let e = fit(p(0.0, 0.0), vec![], p(0.5, 0.2)).unwrap_err();
     assert!(e.to_string().contains("no `x` point"), "{e}");
+    assert_eq!(e.reason, NotFittedReason::MissingPoint);
     let e = fit(p(0.0, 0.0), p(0.3, f64::NAN), p(0.0, 0.2)).unwrap_err();
     assert!(e.to_string().contains("finite"), "{e}");
     // Single touches: a frame, but σ unknown.

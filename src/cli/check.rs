@@ -39,9 +39,13 @@ pub struct CheckOptions {
     /// Mean position error above which the status is `degraded` [mm].
     #[arg(long, default_value_t = CheckThresholds::default().degraded_mm)]
     pub degraded_mm: f64,
-    /// Mean position error above which the status is `recalibrate` [mm].
-    #[arg(long, default_value_t = CheckThresholds::default().recalibrate_mm)]
-    pub recalibrate_mm: f64,
+    /// Mean position error above which the status is `recalibrate` [mm] (default 1.0).
+    #[arg(long, conflicts_with = "margin_mm")]
+    pub recalibrate_mm: Option<f64>,
+    /// Or the step from `--degraded-mm` up to the `recalibrate` level [mm] (≥ 0),
+    /// as the service's thresholds are set.
+    #[arg(long)]
+    pub margin_mm: Option<f64>,
     /// A frame shift explains the errors when it leaves at most this fraction of the mean.
     #[arg(long, default_value_t = CheckThresholds::default().frame_shift_ratio)]
     pub frame_shift_ratio: f64,
@@ -103,10 +107,15 @@ fn read_rows(c: &CheckOptions) -> anyhow::Result<Vec<crate::measure::MeasuredPos
 
 impl CheckOptions {
     fn thresholds(&self) -> CheckThresholds {
-        CheckThresholds {
-            degraded_mm: self.degraded_mm,
-            recalibrate_mm: self.recalibrate_mm,
-            frame_shift_ratio: self.frame_shift_ratio,
+        match self.margin_mm {
+            Some(m) => CheckThresholds::from_margin(self.degraded_mm, m, self.frame_shift_ratio),
+            None => CheckThresholds {
+                degraded_mm: self.degraded_mm,
+                recalibrate_mm: self
+                    .recalibrate_mm
+                    .unwrap_or(CheckThresholds::default().recalibrate_mm),
+                frame_shift_ratio: self.frame_shift_ratio,
+            },
         }
     }
 }

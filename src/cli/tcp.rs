@@ -2,7 +2,10 @@
 //! axis) or a work object fitted on the calibrated model from joint
 //! readings (controller degrees) or tracker measurements (mm, degrees, the
 //! measurement frame of the calibration), printed and optionally written
-//! into a cell file as an entry (`core::cell::tcp`).
+//! into a cell file as an entry (`core::cell::tcp`). Readings that do not
+//! determine the item exit non-zero saying why ([`NotFitted`]); with
+//! `--json` the outcome is also printed as the service answers it
+//! (`fitted: false`, `reason`, `message`, …).
 
 use super::model_files::load_compensated;
 use crate::cell::file::CellDescription;
@@ -90,8 +93,40 @@ fn write_cell(path: &str, cell: &CellDescription) -> anyhow::Result<()> {
 
 #[derive(Serialize)]
 struct Output<'a, E: Serialize, F: Serialize> {
+    /// Always true here (see [`NotFitted`]).
+    fitted: bool,
     entry: &'a E,
     fit: &'a F,
+}
+
+/// Readings that do not determine the tool or work object: the reason and
+/// the fix (nothing is written to the cell file).
+#[derive(Debug, thiserror::Error)]
+#[error("not fitted ({}): {}", .0.reason.as_str(), .0.message)]
+pub struct NotFitted(pub tcp::FitError);
+
+#[derive(Serialize)]
+struct NotFittedJson<'a> {
+    fitted: bool,
+    #[serde(flatten)]
+    why: &'a tcp::FitError,
+}
+
+/// Prints a report; a not-fitted outcome also as JSON with `--json`.
+fn print_outcome(out: anyhow::Result<String>, json: bool) -> anyhow::Result<()> {
+    match out {
+        Ok(s) => {
+            print!("{s}");
+            Ok(())
+        }
+        Err(e) => {
+            if let (true, Some(NotFitted(why))) = (json, e.downcast_ref::<NotFitted>()) {
+                let body = NotFittedJson { fitted: false, why };
+                println!("{}", serde_json::to_string_pretty(&body)?);
+            }
+            Err(e)
+        }
+    }
 }
 
 fn fmt_list(v: &[f64]) -> String {
@@ -115,7 +150,7 @@ pub fn tcp_to_string(a: &TcpArgs) -> anyhow::Result<String> {
         rows: read_rows(&a.readings)?,
         axis,
     };
-    let fit = tcp::fit_tool(&model, &req)?;
+    let fit = tcp::fit_tool(&model, &req).map_err(NotFitted)?;
     let entry = tcp::request::tool_description(&a.name, a.number, &fit);
     if let Some(path) = &a.cell {
         let mut cell = read_cell(path)?;
@@ -125,6 +160,7 @@ pub fn tcp_to_string(a: &TcpArgs) -> anyhow::Result<String> {
     }
     if a.json {
         return Ok(serde_json::to_string_pretty(&Output {
+            fitted: true,
             entry: &entry,
             fit: &fit,
         })? + "\n");
@@ -171,7 +207,7 @@ pub fn work_object_to_string(a: &WorkObjectArgs) -> anyhow::Result<String> {
     if tcp_point.is_none() && rows.iter().any(|r| r.xyz_mm.is_none()) {
         bail!("rows with joint readings only are touches: name the tool that made them with --tool and --cell");
     }
-    let fit = tcp::fit_work_object(&model, &rows, tcp_point.as_ref())?;
+    let fit = tcp::fit_work_object(&model, &rows, tcp_point.as_ref()).map_err(NotFitted)?;
     let entry = tcp::request::work_object_description(&a.name, a.number, &fit);
     if let Some(path) = &a.cell {
         cell.work_objects
@@ -181,6 +217,7 @@ pub fn work_object_to_string(a: &WorkObjectArgs) -> anyhow::Result<String> {
     }
     if a.json {
         return Ok(serde_json::to_string_pretty(&Output {
+            fitted: true,
             entry: &entry,
             fit: &fit,
         })? + "\n");
@@ -209,11 +246,9 @@ pub fn work_object_to_string(a: &WorkObjectArgs) -> anyhow::Result<String> {
 }
 
 pub fn run_tcp(a: TcpArgs) -> anyhow::Result<()> {
-    print!("{}", tcp_to_string(&a)?);
-    Ok(())
+    print_outcome(tcp_to_string(&a), a.json)
 }
 
 pub fn run_work_object(a: WorkObjectArgs) -> anyhow::Result<()> {
-    print!("{}", work_object_to_string(&a)?);
-    Ok(())
+    print_outcome(work_object_to_string(&a), a.json)
 }

@@ -4,15 +4,16 @@
 //! (controller degrees) or tracker measurements (mm, degrees, the
 //! calibration's measurement frame), stored as the robot's tool or work
 //! object (base frame) and returned with the fit's residuals and σ
-//! (`core::cell::tcp`).
+//! (`core::cell::tcp`). Readings that do not determine the item are a 200
+//! with `fitted: false`, a typed `reason` and what to change; nothing is
+//! stored then.
 
 use super::cell::{check_item_name, ItemOut, CELL_NUMBER_MAX};
 use super::input::{objects, present, Int};
 use super::{ApiError, ApiJson, ApiPath, AppState};
-use crate::cell::tcp::{AxisRequest, Reading, TcpMethod, ToolRequest, WoPoint};
+use crate::cell::tcp::{AxisRequest, FitError, Reading, TcpMethod, ToolRequest, WoPoint};
 use crate::service;
-use crate::service::cell::CellPut;
-use crate::service::cell_fit::FitTarget;
+use crate::service::cell_fit::{FitTarget, Fitted};
 use axum::extract::State;
 use axum::http::StatusCode;
 use axum::response::{IntoResponse, Response};
@@ -27,18 +28,58 @@ const XYZ_MAX_MM: f64 = 100_000.0;
 /// Largest angle magnitude [deg].
 const ANGLE_MAX_DEG: f64 = 360.0;
 
-/// One row as a request gives it.
+/// One row of a tool fit: joint readings (every method needs them) and, for
+/// the tracker methods, the tracker's measurement.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct ReadingIn {
-    #[serde(default, deserialize_with = "present")]
-    pub point: Option<WoPoint>,
-    #[serde(default, deserialize_with = "present")]
-    pub joints_deg: Option<Vec<f64>>,
+pub struct ToolReadingIn {
+    pub joints_deg: Vec<f64>,
     #[serde(default, deserialize_with = "present")]
     pub xyz_mm: Option<Vec<f64>>,
     #[serde(default, deserialize_with = "present")]
     pub rpy_deg: Option<Vec<f64>>,
+}
+
+/// One row of a work-object fit: which point, measured by the tracker
+/// (`xyz_mm`) or touched (`joints_deg`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FrameReadingIn {
+    pub point: WoPoint,
+    #[serde(default, deserialize_with = "present")]
+    pub joints_deg: Option<Vec<f64>>,
+    #[serde(default, deserialize_with = "present")]
+    pub xyz_mm: Option<Vec<f64>>,
+}
+
+/// A row in the common form the bounds are checked on.
+struct RowIn<'a> {
+    point: Option<WoPoint>,
+    joints_deg: Option<&'a Vec<f64>>,
+    xyz_mm: &'a Option<Vec<f64>>,
+    rpy_deg: &'a Option<Vec<f64>>,
+}
+
+impl<'a> From<&'a ToolReadingIn> for RowIn<'a> {
+    fn from(r: &'a ToolReadingIn) -> Self {
+        RowIn {
+            point: None,
+            joints_deg: Some(&r.joints_deg),
+            xyz_mm: &r.xyz_mm,
+            rpy_deg: &r.rpy_deg,
+        }
+    }
+}
+
+impl<'a> From<&'a FrameReadingIn> for RowIn<'a> {
+    fn from(r: &'a FrameReadingIn) -> Self {
+        RowIn {
+            point: Some(r.point),
+            joints_deg: r.joints_deg.as_ref(),
+            xyz_mm: &r.xyz_mm,
+            rpy_deg: &None,
+        }
+    }
 }
 
 /// `POST …/tools/{name}/fit` body.
@@ -48,11 +89,11 @@ pub struct ToolFitIn {
     #[serde(default, deserialize_with = "present")]
     pub method: Option<TcpMethod>,
     #[serde(deserialize_with = "objects")]
-    pub readings: Vec<ReadingIn>,
+    pub readings: Vec<ToolReadingIn>,
     #[serde(default, deserialize_with = "present_objects")]
-    pub axis_point: Option<Vec<ReadingIn>>,
+    pub axis_point: Option<Vec<ToolReadingIn>>,
     #[serde(default, deserialize_with = "present_objects")]
-    pub plane: Option<Vec<ReadingIn>>,
+    pub plane: Option<Vec<ToolReadingIn>>,
     #[serde(default)]
     pub number: Option<Int<i64>>,
     #[serde(default)]
@@ -64,7 +105,7 @@ pub struct ToolFitIn {
 #[serde(deny_unknown_fields)]
 pub struct WorkObjectFitIn {
     #[serde(deserialize_with = "objects")]
-    pub readings: Vec<ReadingIn>,
+    pub readings: Vec<FrameReadingIn>,
     #[serde(default, deserialize_with = "present")]
     pub tool: Option<String>,
     #[serde(default)]
@@ -75,7 +116,7 @@ pub struct WorkObjectFitIn {
 
 fn present_objects<'de, D: serde::Deserializer<'de>>(
     d: D,
-) -> Result<Option<Vec<ReadingIn>>, D::Error> {
+) -> Result<Option<Vec<ToolReadingIn>>, D::Error> {
     objects(d).map(Some)
 }
 
@@ -97,7 +138,10 @@ fn triple(
 }
 
 /// The rows checked against the spec's bounds.
-fn rows(list: &[ReadingIn], what: &str) -> Result<Vec<Reading>, ApiError> {
+fn rows<'a, T: 'a>(list: &'a [T], what: &str) -> Result<Vec<Reading>, ApiError>
+where
+    RowIn<'a>: From<&'a T>,
+{
     if list.is_empty() || list.len() > FIT_ROWS_MAX {
         return Err(ApiError::invalid(format!(
             "`{what}`: 1 to {FIT_ROWS_MAX} rows, got {}",
@@ -105,10 +149,16 @@ fn rows(list: &[ReadingIn], what: &str) -> Result<Vec<Reading>, ApiError> {
         )));
     }
     list.iter()
+        .map(RowIn::from)
         .enumerate()
         .map(|(i, r)| {
             let row = i + 1;
-            if let Some(q) = &r.joints_deg {
+            if r.joints_deg.is_none() && r.xyz_mm.is_none() {
+                return Err(ApiError::invalid(format!(
+                    "`{what}` row {row}: give a tracker position `xyz_mm` or joint readings `joints_deg`"
+                )));
+            }
+            if let Some(q) = r.joints_deg {
                 if !(1..=7).contains(&q.len()) || q.iter().any(|v| v.abs() > JOINT_MAX_DEG) {
                     return Err(ApiError::invalid(format!(
                         "`{what}` row {row}: `joints_deg` needs 1 to 7 controller readings within ±{JOINT_MAX_DEG}°"
@@ -117,9 +167,9 @@ fn rows(list: &[ReadingIn], what: &str) -> Result<Vec<Reading>, ApiError> {
             }
             Ok(Reading {
                 point: r.point,
-                joints_deg: r.joints_deg.clone(),
-                xyz_mm: triple(&r.xyz_mm, &format!("`{what}` row, `xyz_mm`,"), row, XYZ_MAX_MM)?,
-                rpy_deg: triple(&r.rpy_deg, &format!("`{what}` row, `rpy_deg`,"), row, ANGLE_MAX_DEG)?,
+                joints_deg: r.joints_deg.cloned(),
+                xyz_mm: triple(r.xyz_mm, &format!("`{what}` row, `xyz_mm`,"), row, XYZ_MAX_MM)?,
+                rpy_deg: triple(r.rpy_deg, &format!("`{what}` row, `rpy_deg`,"), row, ANGLE_MAX_DEG)?,
             })
         })
         .collect()
@@ -156,24 +206,49 @@ fn target(
 
 #[derive(Serialize)]
 struct FitOut<'a, F: Serialize> {
+    /// Always true: the item was fitted and stored.
+    fitted: bool,
     item: ItemOut,
     fit: &'a F,
     /// The calibrated version the fit was made on.
     version: i64,
 }
 
-fn answer<F: Serialize>(put: CellPut, fit: &F, version: i64) -> Response {
-    let status = if put.created {
-        StatusCode::CREATED
-    } else {
-        StatusCode::OK
-    };
-    let body = FitOut {
-        item: ItemOut::from_row(put.row),
-        fit,
-        version,
-    };
-    (status, axum::Json(body)).into_response()
+#[derive(Serialize)]
+struct NotFittedOut<'a> {
+    /// Always false: nothing was stored.
+    fitted: bool,
+    #[serde(flatten)]
+    why: &'a FitError,
+    version: i64,
+}
+
+/// 201 created, 200 replaced, or 200 with `fitted: false` and why.
+fn answer<F: Serialize>(done: Fitted<F>) -> Response {
+    match done {
+        Fitted::Stored(s) => {
+            let status = if s.put.created {
+                StatusCode::CREATED
+            } else {
+                StatusCode::OK
+            };
+            let body = FitOut {
+                fitted: true,
+                item: ItemOut::from_row(s.put.row),
+                fit: &s.fit,
+                version: s.version,
+            };
+            (status, axum::Json(body)).into_response()
+        }
+        Fitted::NotFitted { why, version } => {
+            let body = NotFittedOut {
+                fitted: false,
+                why: &why,
+                version,
+            };
+            (StatusCode::OK, axum::Json(body)).into_response()
+        }
+    }
 }
 
 pub async fn fit_tool(
@@ -202,8 +277,7 @@ pub async fn fit_tool(
         rows: rows(&body.readings, "readings")?,
         axis,
     };
-    let done = service::cell_fit::fit_tool(&s, &t, &req).await?;
-    Ok(answer(done.put, &done.fit, done.version))
+    Ok(answer(service::cell_fit::fit_tool(&s, &t, &req).await?))
 }
 
 pub async fn fit_frame(
@@ -222,7 +296,7 @@ pub async fn fit_frame(
     }
     let readings = rows(&body.readings, "readings")?;
     let done = service::cell_fit::fit_work_object(&s, &t, &readings, body.tool.as_deref()).await?;
-    Ok(answer(done.put, &done.fit, done.version))
+    Ok(answer(done))
 }
 
 /// The routes of tool and work-object fits.

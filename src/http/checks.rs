@@ -188,12 +188,17 @@ pub async fn reregister(
     Ok((StatusCode::CREATED, axum::Json(v)).into_response())
 }
 
-/// `PUT /v1/robots/{id}/check-thresholds` body.
+/// `PUT /v1/robots/{id}/check-thresholds` body: the degraded level and the
+/// margin up to the recalibrate level (`recalibrate_mm` itself is refused
+/// with the margin it stands for).
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ThresholdsIn {
     pub degraded_mm: f64,
-    pub recalibrate_mm: f64,
+    #[serde(default)]
+    pub margin_mm: Option<f64>,
+    #[serde(default)]
+    pub recalibrate_mm: Option<f64>,
     #[serde(default)]
     pub frame_shift_ratio: Option<f64>,
 }
@@ -203,14 +208,26 @@ pub async fn put_thresholds(
     ApiPath(robot_id): ApiPath<i64>,
     ApiJson(t): ApiJson<ThresholdsIn>,
 ) -> Result<Response, ApiError> {
-    let t = CheckThresholds {
-        degraded_mm: t.degraded_mm,
-        recalibrate_mm: t.recalibrate_mm,
-        frame_shift_ratio: t
-            .frame_shift_ratio
-            .unwrap_or(CheckThresholds::default().frame_shift_ratio),
+    let margin_mm = match (t.margin_mm, t.recalibrate_mm) {
+        (Some(m), None) => m,
+        (None, Some(r)) => {
+            return Err(ApiError::invalid(format!(
+                "give `margin_mm`, the step from `degraded_mm` to the recalibrate level (here {} mm), instead of `recalibrate_mm`",
+                r - t.degraded_mm
+            )))
+        }
+        _ => {
+            return Err(ApiError::invalid(
+                "give `degraded_mm` and `margin_mm` (the recalibrate level is degraded_mm + margin_mm)",
+            ))
+        }
     };
-    let t = service::checks::put_thresholds(&state, robot_id, t).await?;
+    let cmd = service::checks::ThresholdsCommand {
+        degraded_mm: t.degraded_mm,
+        margin_mm,
+        frame_shift_ratio: t.frame_shift_ratio,
+    };
+    let t = service::checks::put_thresholds(&state, robot_id, cmd).await?;
     Ok(axum::Json(t).into_response())
 }
 

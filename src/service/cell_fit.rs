@@ -2,7 +2,10 @@
 //! the chosen calibrated version (the active one by default, never the
 //! nominal model) and stored as the robot's tool or work object. A refit of
 //! an existing tool keeps its load and, unless a new one is given, its
-//! number. Work objects are stored in the robot base frame.
+//! number. Work objects are stored in the robot base frame. Readings that
+//! do not determine the item (orientations that do not differ, points in a
+//! line, a joint count not the robot's, …) are an outcome, not an error:
+//! [`Fitted::NotFitted`] says why, and nothing is stored.
 
 use super::solve::{chosen_model, ModelChoice};
 use super::{cell, AppState, ServiceError};
@@ -31,8 +34,12 @@ pub struct Stored<F> {
     pub version: i64,
 }
 
-fn invalid(e: FitError) -> ServiceError {
-    ServiceError::Invalid(e.to_string())
+/// A fit's outcome: the item stored, or why it was not fitted (nothing
+/// stored), on the calibrated version `version`.
+#[derive(Debug, Clone)]
+pub enum Fitted<F> {
+    Stored(Stored<F>),
+    NotFitted { why: FitError, version: i64 },
 }
 
 async fn calibrated(
@@ -71,14 +78,17 @@ async fn number_of(
     }
 }
 
-/// Fits a tool and stores it.
+/// Fits a tool and stores it when the readings determine it.
 pub async fn fit_tool(
     state: &AppState,
     t: &FitTarget,
     req: &ToolRequest,
-) -> Result<Stored<ToolFit>, ServiceError> {
+) -> Result<Fitted<ToolFit>, ServiceError> {
     let (model, version) = calibrated(state, t).await?;
-    let fit = core_tcp::fit_tool(&model, req).map_err(invalid)?;
+    let fit = match core_tcp::fit_tool(&model, req) {
+        Ok(fit) => fit,
+        Err(why) => return Ok(Fitted::NotFitted { why, version }),
+    };
     let (number, load) = number_of(state, t, CellKind::Tool).await?;
     let entry = core_tcp::request::tool_description(&t.name, None, &fit);
     let item = NewCellItem {
@@ -89,23 +99,26 @@ pub async fn fit_tool(
         load,
     };
     let put = cell::put(state, t.robot_id, CellKind::Tool, &item).await?;
-    Ok(Stored { put, fit, version })
+    Ok(Fitted::Stored(Stored { put, fit, version }))
 }
 
-/// Fits a work object (touches made with the stored tool `tool`) and stores it.
+/// Fits a work object (touches made with the stored tool `tool`) and stores
+/// it when the readings determine it. A `tool` the robot does not have is a
+/// conflict with its stored cell.
 pub async fn fit_work_object(
     state: &AppState,
     t: &FitTarget,
     rows: &[Reading],
     tool: Option<&str>,
-) -> Result<Stored<WorkObjectFit>, ServiceError> {
+) -> Result<Fitted<WorkObjectFit>, ServiceError> {
     let (model, version) = calibrated(state, t).await?;
     let tcp = match tool {
         Some(name) => {
             let c = cell::cell(state, t.robot_id).await?;
             let tool = c.tool(&CellRef::Name(name.to_string())).map_err(|e| {
-                ServiceError::Invalid(format!(
-                    "`tool`: {e}; list them with GET /v1/robots/{}/tools",
+                ServiceError::Conflict(format!(
+                    "`tool`: {e}; list them with GET /v1/robots/{}/tools, or fit one with POST /v1/robots/{}/tools/{{name}}/fit",
+                    t.robot_id,
                     t.robot_id
                 ))
             })?;
@@ -113,7 +126,10 @@ pub async fn fit_work_object(
         }
         None => None,
     };
-    let fit = core_tcp::fit_work_object(&model, rows, tcp.as_ref()).map_err(invalid)?;
+    let fit = match core_tcp::fit_work_object(&model, rows, tcp.as_ref()) {
+        Ok(fit) => fit,
+        Err(why) => return Ok(Fitted::NotFitted { why, version }),
+    };
     let (number, _) = number_of(state, t, CellKind::WorkObject).await?;
     let entry = core_tcp::request::work_object_description(&t.name, None, &fit);
     let item = NewCellItem {
@@ -124,5 +140,5 @@ pub async fn fit_work_object(
         load: None,
     };
     let put = cell::put(state, t.robot_id, CellKind::WorkObject, &item).await?;
-    Ok(Stored { put, fit, version })
+    Ok(Fitted::Stored(Stored { put, fit, version }))
 }

@@ -6,7 +6,9 @@ use super::{robots, versions, AppState, ServiceError};
 use crate::compensate::CalibratedModelFile;
 pub use crate::db::CheckRow;
 use crate::db::{Listing, NewCheck};
-use robocal_core::check::{score, CheckResult, CheckStatus, CheckThresholds};
+use robocal_core::check::{
+    score, CheckResult, CheckStatus, CheckThresholds, DEGRADED_MIN_MM, THRESHOLD_MAX_MM,
+};
 use serde::Serialize;
 use serde_json::Value;
 
@@ -42,12 +44,38 @@ pub async fn thresholds(state: &AppState, robot_id: i64) -> Result<CheckThreshol
     })
 }
 
+/// New thresholds: the degraded level, the margin from it to the
+/// recalibrate level (so every pair in bounds is ordered) and the frame-shift
+/// ratio (`None`: the default).
+#[derive(Debug, Clone, Copy)]
+pub struct ThresholdsCommand {
+    pub degraded_mm: f64,
+    pub margin_mm: f64,
+    pub frame_shift_ratio: Option<f64>,
+}
+
 /// Replaces the robot's thresholds.
 pub async fn put_thresholds(
     state: &AppState,
     robot_id: i64,
-    t: CheckThresholds,
+    c: ThresholdsCommand,
 ) -> Result<CheckThresholds, ServiceError> {
+    if !(DEGRADED_MIN_MM..=THRESHOLD_MAX_MM).contains(&c.degraded_mm) {
+        return Err(ServiceError::Invalid(format!(
+            "`degraded_mm` must be within {DEGRADED_MIN_MM} to {THRESHOLD_MAX_MM} mm, got {}",
+            c.degraded_mm
+        )));
+    }
+    if !(0.0..=THRESHOLD_MAX_MM).contains(&c.margin_mm) {
+        return Err(ServiceError::Invalid(format!(
+            "`margin_mm` (recalibrate level minus degraded level) must be within 0 to {THRESHOLD_MAX_MM} mm, got {}",
+            c.margin_mm
+        )));
+    }
+    let ratio = c
+        .frame_shift_ratio
+        .unwrap_or(CheckThresholds::default().frame_shift_ratio);
+    let t = CheckThresholds::from_margin(c.degraded_mm, c.margin_mm, ratio);
     t.validate()
         .map_err(|e| ServiceError::Invalid(e.to_string()))?;
     let row = (t.degraded_mm, t.recalibrate_mm, t.frame_shift_ratio);

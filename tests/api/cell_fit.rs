@@ -1,8 +1,9 @@
 //! Tool and work-object calibration over HTTP (`/tools/{name}/fit`,
 //! `/frames/{name}/fit`): joint readings made for a known tool on the
 //! robot's calibrated version give that tool back, stored and read back;
-//! tracker points give a known work object; bad input is a 422 that says
-//! what to do, a robot without a calibration a 409.
+//! tracker points give a known work object; readings that do not determine
+//! the item are a 200 with `fitted: false`, a typed reason and what to do
+//! (nothing stored); a robot without a calibration is a 409.
 
 use crate::support::*;
 use axum::http::StatusCode;
@@ -136,8 +137,23 @@ async fn a_tool_fitted_from_joint_readings_is_stored_and_read_back() {
         .await;
     assert_eq!(r.status, StatusCode::OK, "{}", r.text());
     assert_eq!(r.json()["item"]["number"], 3);
+    let stored = t
+        .get("/v1/robots/{id}/tools/{name}", &[&rid, "gun"])
+        .await
+        .json();
 
-    // Degenerate and malformed input: 422 naming the fix.
+    // Readings that do not determine the tool: 200, not fitted, with the
+    // reason, the row, the figure against what it needs; the stored tool
+    // stays as it was and no new one appears.
+    let not_fitted = |r: &Resp, reason: &str| {
+        assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+        let b = r.json();
+        assert_eq!(b["fitted"], false, "{b}");
+        assert_eq!(b["reason"], reason, "{b}");
+        assert_eq!(b["version"], 1, "{b}");
+        assert!(b.get("item").is_none(), "{b}");
+        b
+    };
     let r = t
         .post_json(
             TOOL_FIT,
@@ -145,18 +161,24 @@ async fn a_tool_fitted_from_joint_readings_is_stored_and_read_back() {
             json!({ "readings": readings[..3] }),
         )
         .await;
-    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY);
-    assert!(r.detail().contains("at least 4"), "{}", r.detail());
+    let b = not_fitted(&r, "too_few_readings");
+    assert!(b["message"].as_str().unwrap().contains("at least 4"), "{b}");
+    assert_eq!(
+        (b["measured"].as_f64(), b["needed"].as_f64()),
+        (Some(3.0), Some(4.0))
+    );
     let same: Vec<Value> = (0..5).map(|_| readings[0].clone()).collect();
     let r = t
-        .post_json(TOOL_FIT, &[&rid, "gun"], json!({ "readings": same }))
+        .post_json(TOOL_FIT, &[&rid, "other"], json!({ "readings": same }))
         .await;
-    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY);
+    let b = not_fitted(&r, "orientations_too_similar");
     assert!(
-        r.detail().contains("orientations too similar"),
-        "{}",
-        r.detail()
+        b["message"].as_str().unwrap().contains("tilt the tool"),
+        "{b}"
     );
+    // Five readings of one pose: no spread at all, of the 5° needed.
+    assert!(b["measured"].as_f64().unwrap() < 1e-6, "{b}");
+    assert_eq!(b["needed"], 5.0);
     let r = t
         .post_json(
             TOOL_FIT,
@@ -164,8 +186,64 @@ async fn a_tool_fitted_from_joint_readings_is_stored_and_read_back() {
             json!({ "readings": readings, "method": "tracker_point" }),
         )
         .await;
-    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY);
-    assert!(r.detail().contains("x, y, z"), "{}", r.detail());
+    let b = not_fitted(&r, "missing_position");
+    assert!(b["message"].as_str().unwrap().contains("x, y, z"), "{b}");
+    assert_eq!(b["row"], 1);
+    // The YS100 has 6 joints; a row of 5 is named.
+    let mut short = readings.clone();
+    short[2] = json!({ "joints_deg": [0, 10, 20, 0, 30] });
+    let r = t
+        .post_json(TOOL_FIT, &[&rid, "gun"], json!({ "readings": short }))
+        .await;
+    let b = not_fitted(&r, "joint_count");
+    assert_eq!(
+        (
+            b["row"].as_i64(),
+            b["measured"].as_f64(),
+            b["needed"].as_f64()
+        ),
+        (Some(3), Some(5.0), Some(6.0))
+    );
+    // A second axis point at the tip itself: the tip's fit is still given.
+    let r = t
+        .post_json(
+            TOOL_FIT,
+            &[&rid, "gun"],
+            json!({ "readings": readings, "axis_point": readings }),
+        )
+        .await;
+    let b = not_fitted(&r, "axis_point_too_close");
+    assert!(b["measured"].as_f64().unwrap() < 0.01, "{b}");
+    assert_eq!(
+        b["tip"]["residual_mm"].as_array().unwrap().len(),
+        readings.len()
+    );
+    // Both ways of giving the axis: a malformed request.
+    let r = t
+        .post_json(
+            TOOL_FIT,
+            &[&rid, "gun"],
+            json!({ "readings": readings, "axis_point": readings, "plane": readings }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+    let now = t
+        .get("/v1/robots/{id}/tools/{name}", &[&rid, "gun"])
+        .await
+        .json();
+    assert_eq!(
+        now["xyz_mm"], stored["xyz_mm"],
+        "a failed refit left the tool as it was"
+    );
+    assert_eq!(now["updated_at"], stored["updated_at"]);
+    let r = t
+        .get("/v1/robots/{id}/tools/{name}", &[&rid, "other"])
+        .await;
+    assert_eq!(
+        r.status,
+        StatusCode::NOT_FOUND,
+        "nothing stored when not fitted"
+    );
 }
 
 #[tokio::test]
@@ -217,16 +295,34 @@ async fn a_work_object_from_tracker_points_is_stored_in_the_base_frame() {
     }
     let rz = stored["rpy_deg"][2].as_f64().unwrap();
     assert!((rz - 20.0).abs() < 1e-6, "{stored}");
-    // Joint-reading touches need the tool that made them.
+    // Joint-reading touches need the tool that made them: not fitted,
+    // nothing stored under the new name.
     let r = t
         .post_json(
             FRAME_FIT,
-            &[&rid, "fixture"],
+            &[&rid, "bench"],
             json!({ "readings": [{ "point": "origin", "joints_deg": [0, 0, 0, 0, 0, 0] }] }),
         )
         .await;
-    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY);
-    assert!(r.detail().contains("calibrated tool"), "{}", r.detail());
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let b = r.json();
+    assert_eq!(
+        (
+            b["fitted"].as_bool(),
+            b["reason"].as_str(),
+            b["row"].as_i64()
+        ),
+        (Some(false), Some("touches_need_tool"), Some(1)),
+        "{b}"
+    );
+    assert!(
+        b["message"].as_str().unwrap().contains("calibrated tool"),
+        "{b}"
+    );
+    let r = t
+        .get("/v1/robots/{id}/frames/{name}", &[&rid, "bench"])
+        .await;
+    assert_eq!(r.status, StatusCode::NOT_FOUND);
     let r = t
         .post_json(
             FRAME_FIT,
@@ -234,6 +330,59 @@ async fn a_work_object_from_tracker_points_is_stored_in_the_base_frame() {
             json!({ "readings": readings[..2] }),
         )
         .await;
-    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY);
-    assert!(r.detail().contains("no `xy` point"), "{}", r.detail());
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let b = r.json();
+    assert_eq!(
+        (b["fitted"].as_bool(), b["reason"].as_str()),
+        (Some(false), Some("missing_point")),
+        "{b}"
+    );
+    assert!(
+        b["message"].as_str().unwrap().contains("no `xy` point"),
+        "{b}"
+    );
+    // An xy point on the x axis: the angle it makes, of the 10° needed.
+    let mut on_axis = readings.clone();
+    on_axis[2] = json!({ "point": "xy", "xyz_mm": readings[1]["xyz_mm"].clone() });
+    let r = t
+        .post_json(
+            FRAME_FIT,
+            &[&rid, "fixture"],
+            json!({ "readings": on_axis }),
+        )
+        .await;
+    let b = r.json();
+    assert_eq!(
+        (b["fitted"].as_bool(), b["reason"].as_str()),
+        (Some(false), Some("xy_point_on_x_axis")),
+        "{b}"
+    );
+    assert!(
+        b["measured"].as_f64().unwrap() < 1e-6 && b["needed"] == 10.0,
+        "{b}"
+    );
+    let now = t
+        .get("/v1/robots/{id}/frames/{name}", &[&rid, "fixture"])
+        .await
+        .json();
+    assert_eq!(now, stored, "a failed refit left the work object as it was");
+    // A tool the robot does not have: a conflict with its stored cell.
+    let r = t
+        .post_json(
+            FRAME_FIT,
+            &[&rid, "fixture"],
+            json!({ "readings": readings, "tool": "nosuch" }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
+    assert!(r.detail().contains("/tools"), "{}", r.detail());
+    // A row that is neither measured nor touched is malformed.
+    let r = t
+        .post_json(
+            FRAME_FIT,
+            &[&rid, "fixture"],
+            json!({ "readings": [{ "point": "origin" }] }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
 }

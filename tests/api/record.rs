@@ -148,6 +148,8 @@ async fn checks_score_the_active_version_and_give_the_status() {
     assert_eq!(r.status, StatusCode::OK);
     assert_eq!(r.json()["status"], serde_json::Value::Null);
     assert_eq!(r.json()["thresholds"]["degraded_mm"], 0.5);
+    assert_eq!(r.json()["thresholds"]["margin_mm"], 0.5);
+    assert_eq!(r.json()["thresholds"]["recalibrate_mm"], 1.0);
     let r = t.get("/v1/robots/{id}", &[&rid]).await;
     assert_eq!(r.json()["check"]["status"], serde_json::Value::Null);
 
@@ -256,32 +258,55 @@ async fn checks_score_the_active_version_and_give_the_status() {
     let r = t.get("/v1/robots/{id}/checks", &[&rid]).await;
     assert_eq!(r.json()["total"], 2);
 
-    // Looser thresholds judge later checks; inverted ones are refused.
-    let r = t
-        .send(
+    // Looser thresholds judge later checks: the degraded level and the
+    // margin up to the recalibrate level, read back with both levels.
+    let ids: [&str; 1] = [&rid];
+    let put = |body: &'static [u8]| {
+        t.send(
             "PUT",
             "/v1/robots/{id}/check-thresholds",
-            &[&rid],
+            &ids,
             "",
             Some("application/json"),
-            br#"{"degraded_mm": 50, "recalibrate_mm": 100}"#.to_vec(),
+            body.to_vec(),
         )
-        .await;
+    };
+    let r = put(br#"{"degraded_mm": 50, "margin_mm": 50}"#).await;
     assert_eq!(r.status, StatusCode::OK, "{}", r.text());
-    assert_eq!(r.json()["frame_shift_ratio"], 0.5);
+    let b = r.json();
+    assert_eq!(
+        (
+            b["degraded_mm"].as_f64(),
+            b["margin_mm"].as_f64(),
+            b["recalibrate_mm"].as_f64()
+        ),
+        (Some(50.0), Some(50.0), Some(100.0)),
+        "{b}"
+    );
+    assert_eq!(b["frame_shift_ratio"], 0.5);
+    let r = t.get("/v1/robots/{id}/status", &[&rid]).await;
+    assert_eq!(r.json()["thresholds"], b);
     let r = check(json!({ "set_id": crash_set })).await;
     assert_eq!(r.json()["status"], "ok");
-    let r = t
-        .send(
-            "PUT",
-            "/v1/robots/{id}/check-thresholds",
-            &[&rid],
-            "",
-            Some("application/json"),
-            br#"{"degraded_mm": 2, "recalibrate_mm": 1}"#.to_vec(),
-        )
-        .await;
+    // Decimal levels read back as given (no 0.30000000000000004).
+    let r = put(br#"{"degraded_mm": 0.1, "margin_mm": 0.2}"#).await;
+    let b = r.json();
+    assert_eq!(
+        (b["recalibrate_mm"].as_f64(), b["margin_mm"].as_f64()),
+        (Some(0.3), Some(0.2)),
+        "{b}"
+    );
+    // A zero margin is one level; a negative one, or the old
+    // `recalibrate_mm` form, is refused saying what to give.
+    let r = put(br#"{"degraded_mm": 0.5, "margin_mm": 0}"#).await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    assert_eq!(r.json()["recalibrate_mm"], 0.5);
+    let r = put(br#"{"degraded_mm": 2, "margin_mm": -1}"#).await;
     assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+    assert!(r.detail().contains("margin_mm"), "{}", r.detail());
+    let r = put(br#"{"degraded_mm": 0.5, "recalibrate_mm": 1.5}"#).await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+    assert!(r.detail().contains("here 1 mm"), "{}", r.detail());
 
     // A set or version the robot lacks: 409, naming it.
     let r = check(json!({ "set_id": 999 })).await;

@@ -19,7 +19,7 @@
 //!
 //! Units: points in m; reported figures in mm and degrees.
 
-use super::tcp::{check_finite, flange_poses, FitError};
+use super::tcp::{check_finite, flange_poses, FitError, NotFittedReason};
 use crate::compensate::CompensatedModel;
 use crate::model::Pose;
 use nalgebra::{Matrix3, Vector3};
@@ -88,9 +88,12 @@ pub fn fit(points: &WorkObjectPoints) -> Result<WorkObjectFit, FitError> {
         (&points.xy, "xy"),
     ] {
         if v.is_empty() {
-            return Err(FitError::Input(format!(
-                "no `{what}` point: a work object needs the origin, a point on +x and a point in the xy plane"
-            )));
+            return Err(FitError::new(
+                NotFittedReason::MissingPoint,
+                format!(
+                    "no `{what}` point: a work object needs the origin, a point on +x and a point in the xy plane"
+                ),
+            ));
         }
         check_finite(v, &format!("`{what}` point"))?;
     }
@@ -99,21 +102,29 @@ pub fn fit(points: &WorkObjectPoints) -> Result<WorkObjectFit, FitError> {
     let (o, x_pt, y_pt) = (groups[0].0, groups[1].0, groups[2].0);
     let ox = x_pt - o;
     if ox.norm() < MIN_X_DISTANCE_M {
-        return Err(FitError::Degenerate(format!(
-            "the x point is {:.2} mm from the origin; put it at least {} mm away on the +x axis",
-            ox.norm() * 1e3,
-            MIN_X_DISTANCE_M * 1e3
-        )));
+        return Err(FitError::new(
+            NotFittedReason::XPointTooClose,
+            format!(
+                "the x point is {:.2} mm from the origin; put it at least {} mm away on the +x axis",
+                ox.norm() * 1e3,
+                MIN_X_DISTANCE_M * 1e3
+            ),
+        )
+        .figures(ox.norm() * 1e3, MIN_X_DISTANCE_M * 1e3));
     }
     let oy = y_pt - o;
     let angle = ox.cross(&oy).norm().atan2(ox.dot(&oy)).to_degrees();
     if !(MIN_XY_ANGLE_DEG..=180.0 - MIN_XY_ANGLE_DEG).contains(&angle)
         || oy.norm() < MIN_X_DISTANCE_M
     {
-        return Err(FitError::Degenerate(format!(
-            "the xy point is (nearly) on the x axis: OX and OY are {angle:.2}° apart (at least \
-             {MIN_XY_ANGLE_DEG}° needed, 90° best); touch a point on the +y side of the plane"
-        )));
+        return Err(FitError::new(
+            NotFittedReason::XyPointOnXAxis,
+            format!(
+                "the xy point is (nearly) on the x axis: OX and OY are {angle:.2}° apart (at least \
+                 {MIN_XY_ANGLE_DEG}° needed, 90° best); touch a point on the +y side of the plane"
+            ),
+        )
+        .figures(angle.min(180.0 - angle), MIN_XY_ANGLE_DEG));
     }
     let x = ox.normalize();
     let z = x.cross(&oy).normalize();

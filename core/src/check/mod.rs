@@ -56,8 +56,27 @@ impl CheckStatus {
     }
 }
 
-/// Thresholds on the mean position error of a check [mm].
+/// Steps per mm of stored thresholds (1 nm resolution): a threshold built
+/// from a margin ([`CheckThresholds::from_margin`]) is rounded to it, so that
+/// `0.3 + 0.5` reads back as `0.8` and the margin as `0.5`.
+pub const THRESHOLD_STEPS_PER_MM: f64 = 1e6;
+
+/// `mm` rounded to the nearest nanometre (an integer count of steps divided
+/// exactly, giving the double nearest the decimal).
+fn on_grid(mm: f64) -> f64 {
+    (mm * THRESHOLD_STEPS_PER_MM).round() / THRESHOLD_STEPS_PER_MM
+}
+
+/// Smallest degraded level a robot's thresholds take [mm] (1 µm).
+pub const DEGRADED_MIN_MM: f64 = 0.001;
+/// Largest degraded level, and largest margin, of a robot's thresholds [mm].
+pub const THRESHOLD_MAX_MM: f64 = 1000.0;
+
+/// Thresholds on the mean position error of a check [mm]. Written out with
+/// the margin from the degraded to the recalibrate level beside both levels
+/// ([`ThresholdsView`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(into = "ThresholdsView")]
 pub struct CheckThresholds {
     /// Above this mean the status is `degraded` (default 0.5 mm).
     pub degraded_mm: f64,
@@ -78,7 +97,44 @@ impl Default for CheckThresholds {
     }
 }
 
+/// How thresholds are written out: both levels and the margin between them.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ThresholdsView {
+    pub degraded_mm: f64,
+    /// `recalibrate_mm − degraded_mm` (≥ 0).
+    pub margin_mm: f64,
+    pub recalibrate_mm: f64,
+    pub frame_shift_ratio: f64,
+}
+
+impl From<CheckThresholds> for ThresholdsView {
+    fn from(t: CheckThresholds) -> Self {
+        ThresholdsView {
+            degraded_mm: t.degraded_mm,
+            margin_mm: t.margin_mm(),
+            recalibrate_mm: t.recalibrate_mm,
+            frame_shift_ratio: t.frame_shift_ratio,
+        }
+    }
+}
+
 impl CheckThresholds {
+    /// Thresholds from the degraded level and the non-negative margin up to
+    /// the recalibrate level (both rounded to the nanometre, [`THRESHOLD_STEPS_PER_MM`]):
+    /// `degraded ≤ recalibrate` holds by construction, as rounding keeps order.
+    pub fn from_margin(degraded_mm: f64, margin_mm: f64, frame_shift_ratio: f64) -> Self {
+        CheckThresholds {
+            degraded_mm: on_grid(degraded_mm),
+            recalibrate_mm: on_grid(degraded_mm + margin_mm),
+            frame_shift_ratio,
+        }
+    }
+
+    /// The step from the degraded to the recalibrate level [mm].
+    pub fn margin_mm(&self) -> f64 {
+        on_grid(self.recalibrate_mm - self.degraded_mm)
+    }
+
     /// Why the thresholds are not usable.
     pub fn validate(&self) -> Result<(), CheckError> {
         let ok = self.degraded_mm.is_finite()
@@ -106,5 +162,36 @@ impl CheckThresholds {
         } else {
             CheckStatus::Recalibrate
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn thresholds_from_a_margin_read_back_as_given() {
+        let t = CheckThresholds::from_margin(0.3, 0.5, 0.5);
+        assert_eq!(
+            (t.degraded_mm, t.recalibrate_mm, t.margin_mm()),
+            (0.3, 0.8, 0.5)
+        );
+        // A zero margin: one level, valid (degraded never applies).
+        let t = CheckThresholds::from_margin(0.001, 0.0, 0.5);
+        assert_eq!(t.recalibrate_mm, t.degraded_mm);
+        assert!(t.validate().is_ok());
+        // The largest margin on the smallest level stays ordered and finite.
+        let t = CheckThresholds::from_margin(0.001, 1000.0, 0.5);
+        assert_eq!((t.recalibrate_mm, t.margin_mm()), (1000.001, 1000.0));
+        // Written out with the margin beside both levels.
+        let v = serde_json::to_value(CheckThresholds::default()).unwrap();
+        assert_eq!(v["margin_mm"], 0.5);
+        assert_eq!(v["recalibrate_mm"], 1.0);
+        // Stored checks written before the margin existed still read.
+        let old: CheckThresholds = serde_json::from_str(
+            r#"{"degraded_mm":0.4,"recalibrate_mm":0.9,"frame_shift_ratio":0.5}"#,
+        )
+        .unwrap();
+        assert_eq!(old.margin_mm(), 0.5);
     }
 }

@@ -14,7 +14,7 @@
 //!   per-touch residual is the angle between `z` and `z_i`; σ adds the plane
 //!   normal's own uncertainty (flatness RMS / (√n · spread of the touches)).
 
-use super::{rms_max, FitError, ToolFit};
+use super::{rms_max, FitError, NotFittedReason, ToolFit};
 use crate::model::Pose;
 use nalgebra::{Matrix3, Vector3};
 use serde::Serialize;
@@ -64,12 +64,17 @@ pub fn with_axis_point(
     let d = fit.tcp.p - axis;
     let len = d.norm();
     if !len.is_finite() || len < MIN_AXIS_LENGTH_M {
-        return Err(FitError::Degenerate(format!(
-            "the second axis point is {:.2} mm from the tip; it must be at least {} mm away \
-             along the tool's axis (farther is more accurate)",
-            len * 1e3,
-            MIN_AXIS_LENGTH_M * 1e3
-        )));
+        let e = FitError::new(
+            NotFittedReason::AxisPointTooClose,
+            format!(
+                "the second axis point is {:.2} mm from the tip; it must be at least {} mm away \
+                 along the tool's axis (farther is more accurate)",
+                len * 1e3,
+                MIN_AXIS_LENGTH_M * 1e3
+            ),
+        )
+        .figures(len * 1e3, MIN_AXIS_LENGTH_M * 1e3);
+        return Err(e.with_tip(fit));
     }
     fit.tcp.r = frame_from_z(&d);
     let sigma_mm = (norm3(&fit.sigma_mm).powi(2) + norm3(axis_sigma_mm).powi(2)).sqrt();
@@ -84,9 +89,12 @@ pub fn with_axis_point(
 pub fn with_plane(mut fit: ToolFit, touches: &[Pose]) -> Result<ToolFit, FitError> {
     let n = touches.len();
     if n < MIN_PLANE_TOUCHES {
-        return Err(FitError::Input(format!(
-            "a plane needs at least {MIN_PLANE_TOUCHES} touches, got {n}"
-        )));
+        let e = FitError::new(
+            NotFittedReason::TooFewReadings,
+            format!("a plane needs at least {MIN_PLANE_TOUCHES} touches, got {n}"),
+        )
+        .figures(n as f64, MIN_PLANE_TOUCHES as f64);
+        return Err(e.with_tip(fit));
     }
     let tips: Vec<Vector3<f64>> = touches
         .iter()
@@ -102,12 +110,17 @@ pub fn with_plane(mut fit: ToolFit, touches: &[Pose]) -> Result<ToolFit, FitErro
     order.sort_by(|a, b| eig.eigenvalues[*a].total_cmp(&eig.eigenvalues[*b]));
     let spread = (eig.eigenvalues[order[1]].max(0.0) / n as f64).sqrt();
     if spread < MIN_PLANE_SPREAD_M {
-        return Err(FitError::Degenerate(format!(
-            "the plane touches lie on a line (spread {:.2} mm across it, at least {} mm needed); \
-             touch three points that form a triangle",
-            spread * 1e3,
-            MIN_PLANE_SPREAD_M * 1e3
-        )));
+        let e = FitError::new(
+            NotFittedReason::PlaneTouchesInLine,
+            format!(
+                "the plane touches lie on a line (spread {:.2} mm across it, at least {} mm needed); \
+                 touch three points that form a triangle",
+                spread * 1e3,
+                MIN_PLANE_SPREAD_M * 1e3
+            ),
+        )
+        .figures(spread * 1e3, MIN_PLANE_SPREAD_M * 1e3);
+        return Err(e.with_tip(fit));
     }
     let mut normal: Vector3<f64> = eig.eigenvectors.column(order[0]).into_owned();
     let toward_flange: f64 = touches.iter().map(|f| (f.p - c).dot(&normal)).sum();

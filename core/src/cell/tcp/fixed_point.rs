@@ -14,7 +14,7 @@
 //! along that axis is then unobservable). Below [`MIN_SPREAD_DEG`] the fit is
 //! refused.
 
-use super::{rms_max, FitError, TcpMethod, ToolFit};
+use super::{rms_max, FitError, NotFittedReason, TcpMethod, ToolFit};
 use crate::model::Pose;
 use nalgebra::{DMatrix, DVector, Matrix3, SymmetricEigen, Vector3};
 
@@ -44,18 +44,26 @@ pub fn orientation_spread(flanges: &[Pose]) -> (f64, Vector3<f64>) {
 pub fn fit(flanges: &[Pose]) -> Result<ToolFit, FitError> {
     let n = flanges.len();
     if n < MIN_POSES {
-        return Err(FitError::Input(format!(
-            "a fixed-point TCP calibration needs at least {MIN_POSES} orientations, got {n}"
-        )));
+        return Err(FitError::new(
+            NotFittedReason::TooFewReadings,
+            format!(
+                "a fixed-point TCP calibration needs at least {MIN_POSES} orientations, got {n}"
+            ),
+        )
+        .figures(n as f64, MIN_POSES as f64));
     }
     let (spread, axis) = orientation_spread(flanges);
     if spread < MIN_SPREAD_DEG {
-        return Err(FitError::Degenerate(format!(
-            "orientations too similar: they differ by only {spread:.2}° about the flange direction \
-             [{:.2}, {:.2}, {:.2}] (at least {MIN_SPREAD_DEG}° needed); tilt the tool by 20–45° \
-             about two different axes while keeping the tip on the point",
-            axis.x, axis.y, axis.z
-        )));
+        return Err(FitError::new(
+            NotFittedReason::OrientationsTooSimilar,
+            format!(
+                "orientations too similar: they differ by only {spread:.2}° about the flange direction \
+                 [{:.2}, {:.2}, {:.2}] (at least {MIN_SPREAD_DEG}° needed); tilt the tool by 20–45° \
+                 about two different axes while keeping the tip on the point",
+                axis.x, axis.y, axis.z
+            ),
+        )
+        .figures(spread, MIN_SPREAD_DEG));
     }
     let mut a = DMatrix::<f64>::zeros(3 * n, 6);
     let mut b = DVector::<f64>::zeros(3 * n);
@@ -65,11 +73,12 @@ pub fn fit(flanges: &[Pose]) -> Result<ToolFit, FitError> {
             .copy_from(&(-Matrix3::identity()));
         b.fixed_rows_mut::<3>(3 * i).copy_from(&(-f.p));
     }
-    let x = a
-        .clone()
-        .svd(true, true)
-        .solve(&b, 1e-12)
-        .map_err(|e| FitError::Degenerate(format!("the fixed-point solve failed: {e}")))?;
+    let x = a.clone().svd(true, true).solve(&b, 1e-12).map_err(|e| {
+        FitError::new(
+            NotFittedReason::Singular,
+            format!("the fixed-point solve failed: {e}"),
+        )
+    })?;
     let t = Vector3::new(x[0], x[1], x[2]);
     let p = Vector3::new(x[3], x[4], x[5]);
     let residual_mm: Vec<f64> = flanges
@@ -78,10 +87,12 @@ pub fn fit(flanges: &[Pose]) -> Result<ToolFit, FitError> {
         .collect();
     let ss: f64 = residual_mm.iter().map(|r| (r * 1e-3).powi(2)).sum();
     let s2 = ss / (3 * n - 6) as f64;
-    let cov = (a.transpose() * &a)
-        .try_inverse()
-        .ok_or_else(|| FitError::Degenerate("the fixed-point normal matrix is singular".into()))?
-        * s2;
+    let cov = (a.transpose() * &a).try_inverse().ok_or_else(|| {
+        FitError::new(
+            NotFittedReason::Singular,
+            "the fixed-point normal matrix is singular; tilt the tool about two different axes",
+        )
+    })? * s2;
     let sigma_mm = std::array::from_fn(|k| cov[(k, k)].max(0.0).sqrt() * 1e3);
     let (rms_mm, max_mm) = rms_max(&residual_mm);
     Ok(ToolFit {

@@ -36,15 +36,138 @@ use crate::model::Pose;
 use nalgebra::{Matrix3, Vector3};
 use serde::Serialize;
 
-/// Why a tool or work object cannot be fitted from the data given.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum FitError {
-    #[error("{0}")]
-    Input(String),
-    #[error("{0}")]
-    Degenerate(String),
-    #[error("forward kinematics failed at row {row}: {reason}")]
-    Kinematics { row: usize, reason: String },
+/// Why a tool or work object was not fitted: the readings do not determine
+/// it (a closed set: the API's `reason` enum and the CLI's text derive from
+/// it). `measured` and `needed` of a [`FitError`] carry the figure each
+/// reason names, in the unit given here.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum NotFittedReason {
+    /// Fewer rows than the method needs (rows).
+    TooFewReadings,
+    /// A row's joint count is not the robot's (joints).
+    JointCount,
+    /// A row lacks the joint readings the method needs.
+    MissingJoints,
+    /// A tracker method's row lacks the position x, y, z.
+    MissingPosition,
+    /// A 6-D probe's row lacks the orientation rx, ry, rz.
+    MissingOrientation,
+    /// An axis given with a 6-D probe, which gives the orientation itself.
+    AxisWithProbe,
+    /// A work object lacks its origin, x or xy point, or a row names no point.
+    MissingPoint,
+    /// Work-object touches (joint readings) without the tool that made them.
+    TouchesNeedTool,
+    /// A value is not finite.
+    NotFinite,
+    /// The calibrated model's forward kinematics failed at a row.
+    Kinematics,
+    /// Fixed point: the orientations differ too little about some direction
+    /// (degrees).
+    OrientationsTooSimilar,
+    /// The least-squares problem is singular.
+    Singular,
+    /// The second axis point is too near the tip (mm).
+    AxisPointTooClose,
+    /// The plane touches lie on a line (spread across it, mm).
+    PlaneTouchesInLine,
+    /// The work object's x point is too near its origin (mm).
+    XPointTooClose,
+    /// The xy point is (nearly) on the x axis (angle between OX and OY,
+    /// degrees).
+    XyPointOnXAxis,
+}
+
+impl NotFittedReason {
+    pub const ALL: [NotFittedReason; 16] = [
+        NotFittedReason::TooFewReadings,
+        NotFittedReason::JointCount,
+        NotFittedReason::MissingJoints,
+        NotFittedReason::MissingPosition,
+        NotFittedReason::MissingOrientation,
+        NotFittedReason::AxisWithProbe,
+        NotFittedReason::MissingPoint,
+        NotFittedReason::TouchesNeedTool,
+        NotFittedReason::NotFinite,
+        NotFittedReason::Kinematics,
+        NotFittedReason::OrientationsTooSimilar,
+        NotFittedReason::Singular,
+        NotFittedReason::AxisPointTooClose,
+        NotFittedReason::PlaneTouchesInLine,
+        NotFittedReason::XPointTooClose,
+        NotFittedReason::XyPointOnXAxis,
+    ];
+
+    pub fn as_str(self) -> &'static str {
+        match self {
+            NotFittedReason::TooFewReadings => "too_few_readings",
+            NotFittedReason::JointCount => "joint_count",
+            NotFittedReason::MissingJoints => "missing_joints",
+            NotFittedReason::MissingPosition => "missing_position",
+            NotFittedReason::MissingOrientation => "missing_orientation",
+            NotFittedReason::AxisWithProbe => "axis_with_probe",
+            NotFittedReason::MissingPoint => "missing_point",
+            NotFittedReason::TouchesNeedTool => "touches_need_tool",
+            NotFittedReason::NotFinite => "not_finite",
+            NotFittedReason::Kinematics => "kinematics",
+            NotFittedReason::OrientationsTooSimilar => "orientations_too_similar",
+            NotFittedReason::Singular => "singular",
+            NotFittedReason::AxisPointTooClose => "axis_point_too_close",
+            NotFittedReason::PlaneTouchesInLine => "plane_touches_in_line",
+            NotFittedReason::XPointTooClose => "x_point_too_close",
+            NotFittedReason::XyPointOnXAxis => "xy_point_on_x_axis",
+        }
+    }
+}
+
+/// Why a tool or work object was not fitted, with what the user can act on:
+/// the reason, a message naming the fix, the row at fault (1-based, in the
+/// list the message names), the figure the reason names against what it
+/// needs, and for a tool whose axis failed the tip's own fit.
+#[derive(Debug, Clone, PartialEq, Serialize, thiserror::Error)]
+#[error("{message}")]
+pub struct FitError {
+    pub reason: NotFittedReason,
+    pub message: String,
+    pub row: Option<usize>,
+    pub measured: Option<f64>,
+    pub needed: Option<f64>,
+    /// The tip, fitted before its axis could not be.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tip: Option<Box<ToolFit>>,
+}
+
+impl FitError {
+    pub fn new(reason: NotFittedReason, message: impl Into<String>) -> Self {
+        FitError {
+            reason,
+            message: message.into(),
+            row: None,
+            measured: None,
+            needed: None,
+            tip: None,
+        }
+    }
+
+    /// The row at fault (1-based).
+    pub fn at_row(mut self, row: usize) -> Self {
+        self.row = Some(row);
+        self
+    }
+
+    /// The figure the reason names and what it needs.
+    pub fn figures(mut self, measured: f64, needed: f64) -> Self {
+        self.measured = Some(measured);
+        self.needed = Some(needed);
+        self
+    }
+
+    /// The tip's fit, when only the axis failed.
+    pub fn with_tip(mut self, tip: ToolFit) -> Self {
+        self.tip = Some(Box::new(tip));
+        self
+    }
 }
 
 /// How a TCP was found (a closed set: CLI values, API enums and labels).
@@ -141,23 +264,35 @@ pub fn flange_poses(
         .enumerate()
         .map(|(i, q)| {
             if q.len() != dof {
-                return Err(FitError::Input(format!(
-                    "row {}: {} joint readings, the robot has {dof} joints (controller degrees)",
-                    i + 1,
-                    q.len()
-                )));
+                return Err(FitError::new(
+                    NotFittedReason::JointCount,
+                    format!(
+                        "row {}: {} joint readings, the robot has {dof} joints (controller degrees)",
+                        i + 1,
+                        q.len()
+                    ),
+                )
+                .at_row(i + 1)
+                .figures(q.len() as f64, dof as f64));
             }
             if q.iter().any(|v| !v.is_finite()) {
-                return Err(FitError::Input(format!(
-                    "row {}: joint readings must be finite (controller degrees)",
-                    i + 1
-                )));
+                return Err(FitError::new(
+                    NotFittedReason::NotFinite,
+                    format!(
+                        "row {}: joint readings must be finite (controller degrees)",
+                        i + 1
+                    ),
+                )
+                .at_row(i + 1));
             }
             let rad: Vec<f64> = q.iter().map(|d| d.to_radians()).collect();
             let qm = model.nominal.joints_from_controller(&rad);
-            flange.predict_base(&qm).map_err(|e| FitError::Kinematics {
-                row: i + 1,
-                reason: e.to_string(),
+            flange.predict_base(&qm).map_err(|e| {
+                FitError::new(
+                    NotFittedReason::Kinematics,
+                    format!("forward kinematics failed at row {}: {e}", i + 1),
+                )
+                .at_row(i + 1)
             })
         })
         .collect()
@@ -190,10 +325,11 @@ pub(crate) fn rms_max(v: &[f64]) -> (f64, f64) {
 /// Rejects non-finite points.
 pub(crate) fn check_finite(points: &[Vector3<f64>], what: &str) -> Result<(), FitError> {
     match points.iter().position(|p| !p.iter().all(|v| v.is_finite())) {
-        Some(i) => Err(FitError::Input(format!(
-            "{what} {}: coordinates must be finite",
-            i + 1
-        ))),
+        Some(i) => Err(FitError::new(
+            NotFittedReason::NotFinite,
+            format!("{what} {}: coordinates must be finite", i + 1),
+        )
+        .at_row(i + 1)),
         None => Ok(()),
     }
 }

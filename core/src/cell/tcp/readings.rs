@@ -15,7 +15,6 @@
 //!
 //! Delimiter (`,` `;` tab) and decimal comma are detected; `#` starts a comment.
 
-use super::FitError;
 use crate::csv_text::{self, Dialect};
 use serde::{Deserialize, Serialize};
 
@@ -60,6 +59,11 @@ impl std::str::FromStr for WoPoint {
     }
 }
 
+/// A readings file that cannot be read (the line and what is wrong).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct CsvError(pub String);
+
 /// One row: joint readings and/or a tracker measurement.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct Reading {
@@ -98,7 +102,7 @@ fn triple(
     table: &csv_text::Table,
     rec: &csv_text::Record,
     cols: &Option<[usize; 3]>,
-) -> Result<Option<[f64; 3]>, FitError> {
+) -> Result<Option<[f64; 3]>, CsvError> {
     let Some(cols) = cols else { return Ok(None) };
     let mut out = [0.0; 3];
     for (o, c) in out.iter_mut().zip(cols) {
@@ -106,16 +110,16 @@ fn triple(
         *o = table
             .number(f)
             .filter(|v| v.is_finite())
-            .ok_or_else(|| FitError::Input(format!("line {}: `{f}` is not a number", rec.line)))?;
+            .ok_or_else(|| CsvError(format!("line {}: `{f}` is not a number", rec.line)))?;
     }
     Ok(Some(out))
 }
 
 /// Parses the CSV text of readings.
-pub fn parse_csv(text: &str) -> Result<Vec<Reading>, FitError> {
+pub fn parse_csv(text: &str) -> Result<Vec<Reading>, CsvError> {
     let table = csv_text::read(text, Dialect::default())
-        .map_err(|e| FitError::Input(e.to_string()))?
-        .ok_or_else(|| FitError::Input("the file has no header line".into()))?;
+        .map_err(|e| CsvError(e.to_string()))?
+        .ok_or_else(|| CsvError("the file has no header line".into()))?;
     let h = &table.header;
     let joints = joint_columns(h);
     let find3 = |n: [&str; 3]| -> Option<[usize; 3]> {
@@ -125,7 +129,7 @@ pub fn parse_csv(text: &str) -> Result<Vec<Reading>, FitError> {
     let rpy = find3(["rx", "ry", "rz"]);
     let point = column(h, "point");
     if joints.is_empty() && xyz.is_none() {
-        return Err(FitError::Input(
+        return Err(CsvError(
             "no joint columns (q1..qN, controller degrees) and no x, y, z columns (mm)".into(),
         ));
     }
@@ -135,7 +139,7 @@ pub fn parse_csv(text: &str) -> Result<Vec<Reading>, FitError> {
         for c in &joints {
             let f = rec.fields.get(*c).map(|s| s.trim()).unwrap_or("");
             q.push(table.number(f).filter(|v| v.is_finite()).ok_or_else(|| {
-                FitError::Input(format!(
+                CsvError(format!(
                     "line {}: joint reading `{f}` is not a number",
                     rec.line
                 ))
@@ -148,7 +152,7 @@ pub fn parse_csv(text: &str) -> Result<Vec<Reading>, FitError> {
                     .map(|s| s.as_str())
                     .unwrap_or("")
                     .parse::<WoPoint>()
-                    .map_err(|e| FitError::Input(format!("line {}: {e}", rec.line)))
+                    .map_err(|e| CsvError(format!("line {}: {e}", rec.line)))
             })
             .transpose()?;
         rows.push(Reading {
@@ -159,7 +163,7 @@ pub fn parse_csv(text: &str) -> Result<Vec<Reading>, FitError> {
         });
     }
     if rows.is_empty() {
-        return Err(FitError::Input("the file has no rows".into()));
+        return Err(CsvError("the file has no rows".into()));
     }
     Ok(rows)
 }

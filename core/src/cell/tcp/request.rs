@@ -4,7 +4,8 @@
 
 use super::readings::{Reading, WoPoint};
 use super::{
-    axis, cell_points_to_base, fixed_point, flange_poses, tracker, FitError, TcpMethod, ToolFit,
+    axis, cell_points_to_base, fixed_point, flange_poses, tracker, FitError, NotFittedReason,
+    TcpMethod, ToolFit,
 };
 use crate::cell::file::{PoseMmDeg, ToolDescription, WorkObjectDescription};
 use crate::cell::work_object_fit::{self, WorkObjectFit, WorkObjectPoints};
@@ -37,10 +38,14 @@ fn joints(rows: &[Reading], what: &str) -> Result<Vec<Vec<f64>>, FitError> {
         .enumerate()
         .map(|(i, r)| {
             r.joints_deg.clone().ok_or_else(|| {
-                FitError::Input(format!(
-                    "{what} row {}: joint readings missing (controller degrees)",
-                    i + 1
-                ))
+                FitError::new(
+                    NotFittedReason::MissingJoints,
+                    format!(
+                        "{what} row {}: joint readings missing (controller degrees)",
+                        i + 1
+                    ),
+                )
+                .at_row(i + 1)
             })
         })
         .collect()
@@ -51,10 +56,14 @@ fn points_mm(rows: &[Reading], what: &str) -> Result<Vec<Vector3<f64>>, FitError
         .enumerate()
         .map(|(i, r)| {
             r.xyz_mm.map(|p| Vector3::from(p) * 1e-3).ok_or_else(|| {
-                FitError::Input(format!(
-                    "{what} row {}: the tracker position x, y, z (mm) is missing",
-                    i + 1
-                ))
+                FitError::new(
+                    NotFittedReason::MissingPosition,
+                    format!(
+                        "{what} row {}: the tracker position x, y, z (mm) is missing",
+                        i + 1
+                    ),
+                )
+                .at_row(i + 1)
             })
         })
         .collect()
@@ -81,10 +90,14 @@ fn fit_tip(
                 .enumerate()
                 .map(|(i, (r, p))| {
                     let [rx, ry, rz] = r.rpy_deg.ok_or_else(|| {
-                        FitError::Input(format!(
-                            "{what} row {}: a 6-D probe needs rx, ry, rz (degrees)",
-                            i + 1
-                        ))
+                        FitError::new(
+                            NotFittedReason::MissingOrientation,
+                            format!(
+                                "{what} row {}: a 6-D probe needs rx, ry, rz (degrees)",
+                                i + 1
+                            ),
+                        )
+                        .at_row(i + 1)
                     })?;
                     let m = Pose::new(
                         rpy_matrix(rx.to_radians(), ry.to_radians(), rz.to_radians()),
@@ -103,16 +116,20 @@ pub fn fit_tool(model: &CompensatedModel, req: &ToolRequest) -> Result<ToolFit, 
     let tip = fit_tip(model, req.method, &req.rows, "tip")?;
     match &req.axis {
         None => Ok(tip),
-        Some(_) if req.method == TcpMethod::TrackerFrame => Err(FitError::Input(
-            "a 6-D probe gives the tool's orientation itself; leave the axis out".into(),
-        )),
-        Some(AxisRequest::Point(rows)) => {
-            let second = fit_tip(model, req.method, rows, "axis point")?;
-            axis::with_axis_point(tip, &second.tcp.p, &second.sigma_mm)
-        }
+        Some(_) if req.method == TcpMethod::TrackerFrame => Err(FitError::new(
+            NotFittedReason::AxisWithProbe,
+            "a 6-D probe gives the tool's orientation itself; leave the axis out",
+        )
+        .with_tip(tip)),
+        Some(AxisRequest::Point(rows)) => match fit_tip(model, req.method, rows, "axis point") {
+            Ok(second) => axis::with_axis_point(tip, &second.tcp.p, &second.sigma_mm),
+            Err(e) => Err(e.with_tip(tip)),
+        },
         Some(AxisRequest::Plane(rows)) => {
-            let flanges = flange_poses(model, &joints(rows, "plane")?)?;
-            axis::with_plane(tip, &flanges)
+            match joints(rows, "plane").and_then(|q| flange_poses(model, &q)) {
+                Ok(flanges) => axis::with_plane(tip, &flanges),
+                Err(e) => Err(e.with_tip(tip)),
+            }
         }
     }
 }
@@ -128,28 +145,47 @@ pub fn fit_work_object(
     let mut pts = WorkObjectPoints::default();
     for (i, r) in rows.iter().enumerate() {
         let point = r.point.ok_or_else(|| {
-            FitError::Input(format!(
-                "row {}: which point is it? give `point`: origin, x, xy or plane",
-                i + 1
-            ))
+            FitError::new(
+                NotFittedReason::MissingPoint,
+                format!(
+                    "row {}: which point is it? give `point`: origin, x, xy or plane",
+                    i + 1
+                ),
+            )
+            .at_row(i + 1)
         })?;
         let p = match (&r.xyz_mm, &r.joints_deg, tcp) {
             (Some(x), _, _) => cell_points_to_base(model, &[Vector3::from(*x) * 1e-3])[0],
             (None, Some(q), Some(t)) => {
-                work_object_fit::touched_tips(model, t, std::slice::from_ref(q))
-                    .map_err(|e| FitError::Input(format!("row {}: {e}", i + 1)))?[0]
+                work_object_fit::touched_tips(model, t, std::slice::from_ref(q)).map_err(|e| {
+                    FitError {
+                        message: format!(
+                            "row {}: {}",
+                            i + 1,
+                            e.message.trim_start_matches("row 1: ")
+                        ),
+                        row: Some(i + 1),
+                        ..e
+                    }
+                })?[0]
             }
-            (None, Some(_), None) => {
-                return Err(FitError::Input(format!(
+            (None, Some(_), None) => return Err(FitError::new(
+                NotFittedReason::TouchesNeedTool,
+                format!(
                     "row {}: touches with joint readings need the calibrated tool that made them",
                     i + 1
-                )))
-            }
+                ),
+            )
+            .at_row(i + 1)),
             (None, None, _) => {
-                return Err(FitError::Input(format!(
-                    "row {}: give a tracker position (x, y, z mm) or joint readings",
-                    i + 1
-                )))
+                return Err(FitError::new(
+                    NotFittedReason::MissingPosition,
+                    format!(
+                        "row {}: give a tracker position (x, y, z mm) or joint readings",
+                        i + 1
+                    ),
+                )
+                .at_row(i + 1))
             }
         };
         match point {

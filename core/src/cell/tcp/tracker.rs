@@ -11,7 +11,9 @@
 //!   orientation residual is the angle between the mean and each `T_i`, its σ
 //!   their RMS over `√n`.
 
-use super::{check_finite, nearest_rotation, rms_max, FitError, TcpMethod, ToolFit};
+use super::{
+    check_finite, nearest_rotation, rms_max, FitError, NotFittedReason, TcpMethod, ToolFit,
+};
 use crate::model::orientation::rotation_angle_between;
 use crate::model::Pose;
 use nalgebra::{Matrix3, Vector3};
@@ -21,14 +23,20 @@ pub const MIN_POSES: usize = 3;
 
 fn check_counts(flanges: usize, measured: usize) -> Result<(), FitError> {
     if flanges != measured {
-        return Err(FitError::Input(format!(
-            "{flanges} joint rows but {measured} measurements; give one measurement per row"
-        )));
+        return Err(FitError::new(
+            NotFittedReason::MissingPosition,
+            format!(
+                "{flanges} joint rows but {measured} measurements; give one measurement per row"
+            ),
+        )
+        .figures(measured as f64, flanges as f64));
     }
     if flanges < MIN_POSES {
-        return Err(FitError::Input(format!(
-            "a tracker TCP calibration needs at least {MIN_POSES} poses, got {flanges}"
-        )));
+        return Err(FitError::new(
+            NotFittedReason::TooFewReadings,
+            format!("a tracker TCP calibration needs at least {MIN_POSES} poses, got {flanges}"),
+        )
+        .figures(flanges as f64, MIN_POSES as f64));
     }
     Ok(())
 }
