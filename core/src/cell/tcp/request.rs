@@ -154,40 +154,40 @@ pub fn fit_work_object(
             )
             .at_row(i + 1)
         })?;
-        let p = match (&r.xyz_mm, &r.joints_deg, tcp) {
-            (Some(x), _, _) => cell_points_to_base(model, &[Vector3::from(*x) * 1e-3])[0],
-            (None, Some(q), Some(t)) => {
-                work_object_fit::touched_tips(model, t, std::slice::from_ref(q)).map_err(|e| {
-                    FitError {
-                        message: format!(
-                            "row {}: {}",
-                            i + 1,
-                            e.message.trim_start_matches("row 1: ")
-                        ),
-                        row: Some(i + 1),
-                        ..e
-                    }
-                })?[0]
-            }
-            (None, Some(_), None) => return Err(FitError::new(
-                NotFittedReason::TouchesNeedTool,
-                format!(
+        let p =
+            match (&r.xyz_mm, &r.joints_deg, tcp) {
+                (Some(x), _, _) => cell_points_to_base(model, &[Vector3::from(*x) * 1e-3])[0],
+                (None, Some(q), Some(t)) => work_object_fit::touched_tips(
+                    model,
+                    t,
+                    std::slice::from_ref(q),
+                )
+                .map_err(|e| FitError {
+                    message: format!("row {}: {}", i + 1, e.message.trim_start_matches("row 1: ")),
+                    row: Some(i + 1),
+                    ..e
+                })?[0],
+                (None, Some(_), None) => {
+                    return Err(FitError::new(
+                        NotFittedReason::TouchesNeedTool,
+                        format!(
                     "row {}: touches with joint readings need the calibrated tool that made them",
                     i + 1
                 ),
-            )
-            .at_row(i + 1)),
-            (None, None, _) => {
-                return Err(FitError::new(
-                    NotFittedReason::MissingPosition,
-                    format!(
-                        "row {}: give a tracker position (x, y, z mm) or joint readings",
-                        i + 1
-                    ),
-                )
-                .at_row(i + 1))
-            }
-        };
+                    )
+                    .at_row(i + 1))
+                }
+                (None, None, _) => {
+                    return Err(FitError::new(
+                        NotFittedReason::MissingPosition,
+                        format!(
+                            "row {}: give a tracker position (x, y, z mm) or joint readings",
+                            i + 1
+                        ),
+                    )
+                    .at_row(i + 1))
+                }
+            };
         match point {
             WoPoint::Origin => pts.origin.push(p),
             WoPoint::X => pts.x.push(p),
