@@ -95,16 +95,7 @@ fn measure(truth: &TrueRobot, effect: Effect, n: usize, rng: &mut ChaCha8Rng) ->
         .map(|_| {
             let q: Vec<f64> = HOME.iter().map(|h| h + spread.sample(rng)).collect();
             let pose = true_pose(truth, effect, &q);
-            let dp = Vector3::from_fn(|_, _| p_noise.sample(rng));
-            let dr = Vector3::from_fn(|_, _| r_noise.sample(rng));
-            Measurement {
-                q,
-                position: pose.p + dp,
-                orientation: Some(Rotation3::new(dr).into_inner() * pose.r),
-                payload_mass: 0.0,
-                session: 0,
-                std: None,
-            }
+            common::noisy_measurement(q, &pose, (&p_noise, &r_noise), true, rng)
         })
         .collect()
 }

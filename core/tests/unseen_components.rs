@@ -20,10 +20,10 @@
 
 mod common;
 
-use nalgebra::{Rotation3, Vector3};
+use nalgebra::Vector3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use rand_distr::{Distribution, Normal};
+use rand_distr::Normal;
 use robocal_core::identify::joint_maps::MapRefusal;
 use robocal_core::identify::report::WarningKind;
 use robocal_core::identify::{CalibrationReport, Method};
@@ -80,16 +80,7 @@ fn measure(
         .into_iter()
         .map(|q| {
             let pose = truth.true_pose(&q, None).unwrap();
-            let dp = Vector3::from_fn(|_, _| p_noise.sample(rng));
-            let dr = Vector3::from_fn(|_, _| r_noise.sample(rng));
-            Measurement {
-                q,
-                position: pose.p + dp,
-                orientation: six_d.then(|| Rotation3::new(dr).into_inner() * pose.r),
-                payload_mass: 0.0,
-                session: 0,
-                std: None,
-            }
+            common::noisy_measurement(q, &pose, (&p_noise, &r_noise), six_d, rng)
         })
         .collect()
 }

@@ -150,3 +150,27 @@ pub fn ur10_6d_truth(
     truth.tracker_from_base = tracker_frame(2.0, -1.0, 35.0, [2500.0, -400.0, 300.0]);
     (nominal, truth)
 }
+
+/// A measurement of the true `pose` at `q` with Gaussian noise: the position
+/// moved by `p_noise` [m] per coordinate, then the orientation turned by a
+/// rotation vector of `r_noise` [rad] per axis (drawn even when `six_d` is
+/// false, so that a set's draws do not depend on it; kept only with `six_d`).
+pub fn noisy_measurement(
+    q: Vec<f64>,
+    pose: &robocal_core::model::Pose,
+    (p_noise, r_noise): (&rand_distr::Normal<f64>, &rand_distr::Normal<f64>),
+    six_d: bool,
+    rng: &mut impl rand::Rng,
+) -> Measurement {
+    use rand_distr::Distribution;
+    let dp = nalgebra::Vector3::from_fn(|_, _| p_noise.sample(rng));
+    let dr = nalgebra::Vector3::from_fn(|_, _| r_noise.sample(rng));
+    Measurement {
+        q,
+        position: pose.p + dp,
+        orientation: six_d.then(|| nalgebra::Rotation3::new(dr).into_inner() * pose.r),
+        payload_mass: 0.0,
+        session: 0,
+        std: None,
+    }
+}
