@@ -5,7 +5,7 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal::identify::{calibrate, CalibrationOptions, Method};
+use robocal::calibrate::identify::{calibrate, CalibrationOptions, Method};
 use robocal::measure::{self, Measurement};
 use robocal::model::preset;
 use robocal::sim::{perturb_geometry, random_configurations, ErrorMagnitudes, TrueRobot};

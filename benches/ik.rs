@@ -11,10 +11,10 @@
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use robocal::compensate::{synthetic_calibration, SyntheticErrors};
-use robocal::ik::{AnalyticIk, Goal, IkSettings, IkSolver, SolveOptions};
-use robocal::kinematics::fk;
+use robocal::model::kinematics::fk;
 use robocal::model::{preset, Pose};
+use robocal::sim::{synthetic_calibration, SyntheticErrors};
+use robocal::solve::ik::{AnalyticIk, Goal, IkSettings, IkSolver, SolveOptions};
 use std::hint::black_box;
 
 fn setup() -> (IkSolver, Vec<Goal>, Vec<Pose>) {

@@ -23,7 +23,7 @@ configurations: roboticstoolbox-python's C++ `ik_LM` called on a prebuilt ETS
 (position 1e-4 mm, orientation 1e-7 rad). Every solution of both solvers is
 checked with roboticstoolbox's forward kinematics.
 
-KM on a simulated YS100 (the seed's §7.4 robot: Table 7.1 geometric errors,
+KM on a simulated YS100 (the thesis's §7.4 robot: Table 7.1 geometric errors,
 Table 7.2 compliance, 110 kg payload, 0.01 mm noise, tracker frame 2.5 m
 away), 50 identification and 30 validation poses from `robocal simulate`:
   - reference: the YS100's modified DH (Craig, as `robocal export --format
@@ -223,7 +223,7 @@ def km_ys100_bench(robocal, repeat):
     for name, seed, n in (("ident", 1, 50), ("valid", 2, 30)):
         path = os.path.join(work, f"{name}.csv")
         subprocess.check_call([
-            robocal, "simulate", "--preset", "ys100", "--poses", str(n), "--seed", str(seed),
+            robocal, "simulate", "--preset", "ys100", "--poses", str(n), "--seed", str(thesis),
             "--tracker", "1,-2,30,2500,-1000,400", "--out", path],
             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         files[name] = path
@@ -257,7 +257,7 @@ def ik_bench(robocal, n, seed):
     links = [rtb.RevoluteDH(d=D[i] / 1e3, a=A[i] / 1e3, alpha=ALPHA[i]) for i in range(6)]
     robot = rtb.DHRobot(links, name="ur5-preset")
     ets = robot.ets()
-    rng = np.random.default_rng(seed)
+    rng = np.random.default_rng(thesis)
     qs = rng.uniform(-np.pi, np.pi, size=(n, 6))
     Ts = [ets.eval(q) for q in qs]
     tmp = tempfile.mkdtemp()

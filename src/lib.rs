@@ -7,10 +7,7 @@
 //! the same module names), whose dependency tree has no HTTP, database, async
 //! runtime or command-line crates.
 
-pub use robocal_core::{
-    cell, compensate, csv_text, export, identify, ik, kinematics, measure, model, optim, plan,
-    program, sim, stats, study,
-};
+pub use robocal_core::{calibrate, check, measure, model, optim, plan, sim, solve, stats};
 
 pub mod cli;
 pub mod db;

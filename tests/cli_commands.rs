@@ -13,15 +13,15 @@ use common::robocal_json;
 use core_common::ik::{calibrated, kuka_like, pose_close};
 use core_common::two_tracker_sessions;
 use nalgebra::Vector3;
+use robocal::calibrate::compensate::{parse_compensated, CalibratedModelFile};
 use robocal::cli::export::{export_to_string, ExportArgs};
 use robocal::cli::model_files::{load_compensated, save_model_file};
 use robocal::cli::solve::{solve_to_string, OutputFormat, SolveArgs};
-use robocal::compensate::{parse_compensated, CalibratedModelFile};
-use robocal::ik::{IkSettings, IkSolver, SolveOptions};
 use robocal::measure::{self, csv, SetRole};
 use robocal::model::orientation::{rotation_to, OrientationConvention};
 use robocal::model::RobotModel;
 use robocal::sim::{tracker_frame, ys100_table_7_1, TrueRobot};
+use robocal::solve::ik::{IkSettings, IkSolver, SolveOptions};
 use std::fmt::Write as _;
 
 // ---------------------------------------------------------------------------
@@ -409,7 +409,7 @@ fn cli_takes_several_files_or_a_session_column() {
 /// core's `CellSolver`'s for that tool, expressed in the work object.
 #[test]
 fn cli_solves_targets_in_a_work_object_for_a_production_tool() {
-    use robocal::cell::{CellDescription, CellOptions, CellRef, CellSolver};
+    use robocal::solve::cell::{CellDescription, CellOptions, CellRef, CellSolver};
     let cm = calibrated("ys100", 14);
     let dir = std::env::temp_dir().join(format!("robocal-cli-cell-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -455,7 +455,7 @@ fn cli_solves_targets_in_a_work_object_for_a_production_tool() {
             Vector3::new(r[0], r[1], r[2]) * 1e-3,
         );
         let options = CellOptions {
-            branch: Some(robocal::ik::Configuration::parse("front,up,noflip").unwrap()),
+            branch: Some(robocal::solve::ik::Configuration::parse("front,up,noflip").unwrap()),
             seed: None,
         };
         let want = solver.solve(&wobj, &target, &options).false_target.unwrap();

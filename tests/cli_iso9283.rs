@@ -3,13 +3,13 @@
 //! against hand-computed values, and a check of a shifted frame.
 
 use clap::Parser;
+use robocal::calibrate::compensate::CompensatedModel;
 use robocal::cli::check::check_file;
 use robocal::cli::iso9283::{figures, make, FiguresArgs, Iso9283Args, Iso9283Command};
-use robocal::compensate::CompensatedModel;
 use robocal::measure::{csv, MeasuredPose};
 use robocal::model::preset;
-use robocal::program::{parse, Language, ProgramFile};
-use robocal_core::iso9283::csv::read_plan_csv;
+use robocal::solve::program::{parse, Language, ProgramFile};
+use robocal_core::check::iso9283::csv::read_plan_csv;
 use std::fmt::Write as _;
 
 fn iso_args(argv: &[&str]) -> Iso9283Args {

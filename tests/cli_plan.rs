@@ -5,13 +5,13 @@
 use clap::Parser;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use robocal::calibrate::identify::{calibrate, CalibrationOptions, Method};
 use robocal::cli::plan::{join_files, make, JoinArgs, MakeArgs, PlanCommand};
-use robocal::identify::{calibrate, CalibrationOptions, Method};
 use robocal::measure::{csv, to_measurements};
 use robocal::model::preset;
 use robocal::plan::read_plan_csv;
-use robocal::program::{parse, Language, ProgramFile};
 use robocal::sim::{perturb_geometry, tracker_frame, ErrorMagnitudes, TrueRobot};
+use robocal::solve::program::{parse, Language, ProgramFile};
 use std::fmt::Write as _;
 
 fn parsed(argv: &[&str]) -> robocal::cli::plan::PlanArgs {

@@ -9,14 +9,14 @@ mod core_common;
 use clap::Parser;
 use core_common::ik::calibrated;
 use nalgebra::{Rotation3, Unit, Vector3};
-use robocal::cell::{CellDescription, CellOptions, CellSolver, WorkObject};
+use robocal::calibrate::compensate::{CalibratedModelFile, CompensatedModel};
 use robocal::cli::model_files::save_model_file;
 use robocal::cli::tcp::{tcp_to_string, work_object_to_string};
 use robocal::cli::Command;
-use robocal::compensate::{CalibratedModelFile, CompensatedModel};
-use robocal::ik::IkSettings;
 use robocal::model::pose::rpy_matrix;
 use robocal::model::Pose;
+use robocal::solve::cell::{CellDescription, CellOptions, CellSolver, WorkObject};
+use robocal::solve::ik::IkSettings;
 
 fn readings(model: &CompensatedModel, tool: &Pose, targets: &[Pose]) -> Vec<String> {
     let solver = CellSolver::new(model, tool, IkSettings::default());

@@ -98,7 +98,7 @@ async fn pages_render_the_store_and_escape_user_text() {
     }
     assert!(html.contains("name=\"orientation\""));
     // Every calibration method is offered.
-    for m in robocal::identify::Method::ALL {
+    for m in robocal::calibrate::identify::Method::ALL {
         assert!(
             html.contains(&format!("value=\"{}\"", m.name())),
             "{}",

@@ -7,11 +7,11 @@ use std::sync::OnceLock;
 
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
-/// The demo report (seed §7.4 simulation: YS100, KM, SKCM, SKCM-C), computed once.
+/// The demo report (thesis §7.4 simulation: YS100, KM, SKCM, SKCM-C), computed once.
 fn demo() -> &'static Value {
     static REPORT: OnceLock<Value> = OnceLock::new();
     REPORT.get_or_init(|| {
-        let study = robocal::study::ys100_simulation(1, &|_| true).unwrap();
+        let study = robocal::sim::study::ys100_simulation(1, &|_| true).unwrap();
         serde_json::to_value(&study.report).unwrap()
     })
 }
@@ -186,10 +186,10 @@ fn real_ur5_report_renders() {
 #[test]
 fn compensator_support_regions_and_expected_errors_are_shown() {
     use rand::SeedableRng;
-    use robocal::compensate::unmodelled_truth;
-    use robocal::identify::{calibrate_with_training, CalibrationOptions, Method};
+    use robocal::calibrate::identify::{calibrate_with_training, CalibrationOptions, Method};
     use robocal::model::preset;
     use robocal::sim::random_configurations;
+    use robocal::sim::unmodelled_truth;
     let nominal = preset("ys100").unwrap();
     let truth = unmodelled_truth(&nominal, true, 5);
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);

@@ -38,16 +38,16 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use robocal_core::compensate::{
-    synthetic_calibration, train, unmodelled_truth, CompensatedModel, CompensatorSpec, Sample,
-    StoredCompensator, SyntheticErrors,
+use robocal_core::calibrate::compensate::{
+    train, CompensatedModel, CompensatorSpec, Sample, StoredCompensator,
 };
-use robocal_core::identify::{
+use robocal_core::calibrate::identify::{
     calibrate_with_training, CalibrationOptions, CompensatorOptions, Method,
 };
-use robocal_core::ik::{Goal, IkSettings, IkSolver, SolveOptions};
 use robocal_core::model::{preset, JointMap, JointMaps};
 use robocal_core::sim::random_configurations;
+use robocal_core::sim::{synthetic_calibration, unmodelled_truth, SyntheticErrors};
+use robocal_core::solve::ik::{Goal, IkSettings, IkSolver, SolveOptions};
 use std::hint::black_box;
 use std::sync::Arc;
 

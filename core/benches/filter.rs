@@ -10,12 +10,12 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use robocal_core::cell::Cell;
-use robocal_core::compensate::{synthetic_calibration, SyntheticErrors};
-use robocal_core::ik::{AnalyticIk, IkSettings};
 use robocal_core::model::orientation::{rotation_to, OrientationConvention};
 use robocal_core::model::preset;
-use robocal_core::program::{filter, kuka_status, kuka_turn, Language, ProgramFile};
+use robocal_core::sim::{synthetic_calibration, SyntheticErrors};
+use robocal_core::solve::cell::Cell;
+use robocal_core::solve::ik::{AnalyticIk, IkSettings};
+use robocal_core::solve::program::{filter, kuka_status, kuka_turn, Language, ProgramFile};
 use std::hint::black_box;
 use std::time::Duration;
 
@@ -36,7 +36,7 @@ fn program(shift_mm: f64) -> Vec<ProgramFile> {
             .map(|l| rng.gen_range(l.limits[0] * 0.8..l.limits[1] * 0.8))
             .collect();
         let (Ok(p), Some(c)) = (
-            robocal_core::kinematics::fk(&bare, &q),
+            robocal_core::model::kinematics::fk(&bare, &q),
             ik.configuration(&q),
         ) else {
             continue;

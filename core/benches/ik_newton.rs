@@ -10,9 +10,9 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use robocal_core::compensate::{synthetic_calibration, SyntheticErrors};
-use robocal_core::ik::{Goal, IkSettings, IkSolver};
 use robocal_core::model::preset;
+use robocal_core::sim::{synthetic_calibration, SyntheticErrors};
+use robocal_core::solve::ik::{Goal, IkSettings, IkSolver};
 use std::hint::black_box;
 use std::time::Duration;
 

@@ -14,14 +14,15 @@
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal_core::compensate::{
-    train, unmodelled_truth, CompensatedModel, CompensatorSpec, IwoSettings, LmTrainSettings,
-    MlpSettings, MlpSpec, OutputLayer, TlboTrainSettings, Trainer,
+use robocal_core::calibrate::compensate::{
+    train, CompensatedModel, CompensatorSpec, IwoSettings, LmTrainSettings, MlpSettings, MlpSpec,
+    OutputLayer, TlboTrainSettings, Trainer,
 };
-use robocal_core::identify::{calibrate, CalibrationOptions, Method};
+use robocal_core::calibrate::identify::{calibrate, CalibrationOptions, Method};
 use robocal_core::measure::{self, Measurement};
 use robocal_core::model::preset;
 use robocal_core::sim::random_configurations;
+use robocal_core::sim::unmodelled_truth;
 use std::time::Instant;
 
 fn main() {
@@ -111,7 +112,7 @@ fn main() {
         ),
         (
             "IWO, every weight searched",
-            "6-5-3 (the seed's)",
+            "6-5-3 (the thesis's)",
             searched(Trainer::Iwo(IwoSettings {
                 output_layer: OutputLayer::Searched,
                 ..Default::default()
@@ -119,7 +120,7 @@ fn main() {
         ),
         (
             "TLBO, every weight searched",
-            "6-5-3 (the seed's)",
+            "6-5-3 (the thesis's)",
             searched(Trainer::Tlbo(TlboTrainSettings {
                 output_layer: OutputLayer::Searched,
                 ..Default::default()

@@ -1,26 +1,28 @@
-//! robocal-core: the numerical core of robocal.
+//! robocal-core: the numerical core of robocal, one folder per step of the flow.
 //!
-//! Flow: measure (`measure`, `sim`) → calibrate (`identify`) → solve
-//! (`compensate`, `ik`); `study` runs the seed's §7.4 simulation study. Every
-//! function takes the model and the joint values as arguments; there is no
-//! hidden mutable chain state, and nothing here touches HTTP, a database, the
-//! async runtime or the file system. `csv_text` reads the CSV texts of
-//! measurement and target files for both.
+//! - `measure`: read measurement and target CSV texts (`csv_text`), the tracker's conventions.
+//! - `model`: the robot model (`robot`, DH/MDH parameters, joint maps), its kinematics
+//!   (`kinematics`: chain, Jacobian, gravity), its stored description and its exports.
+//! - `calibrate`: identify the model from measurements (`identify`) and train the learned
+//!   compensator (`compensate`); `identify::model_file` assembles the calibrated model file
+//!   the service stores.
+//! - `solve`: inverse kinematics on a calibrated model (`ik`), tools, loads and work objects in
+//!   the cell (`cell`), robot programs (`program`).
+//! - `plan`: measurement plans; `check`: accuracy checks, re-registration, ISO 9283.
+//! - `sim`: simulated true robots, the thesis's §7.4 study and synthetic calibrations, for
+//!   `robocal simulate`, `robocal demo`, tests and benches.
+//! - `optim` (Levenberg–Marquardt, TLBO) and `stats`: numerics shared by the steps.
+//!
+//! Every function takes the model and the joint values as arguments; there is no hidden
+//! mutable chain state, and nothing here touches HTTP, a database, the async runtime or the
+//! file system.
 
-pub mod cell;
+pub mod calibrate;
 pub mod check;
-pub mod compensate;
-pub mod csv_text;
-pub mod export;
-pub mod identify;
-pub mod ik;
-pub mod iso9283;
-pub mod kinematics;
 pub mod measure;
 pub mod model;
 pub mod optim;
 pub mod plan;
-pub mod program;
 pub mod sim;
+pub mod solve;
 pub mod stats;
-pub mod study;

@@ -4,10 +4,10 @@
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use robocal_core::calibrate::compensate::CompensatedModel;
+use robocal_core::calibrate::identify::pose_selection::choose_d_optimal;
+use robocal_core::calibrate::identify::{calibrate, CalibrationOptions, Method};
 use robocal_core::check::{reregister, score, CheckStatus, CheckThresholds, ReregisterError};
-use robocal_core::compensate::CompensatedModel;
-use robocal_core::identify::pose_selection::choose_d_optimal;
-use robocal_core::identify::{calibrate, CalibrationOptions, Method};
 use robocal_core::measure;
 use robocal_core::model::preset;
 use robocal_core::sim::{random_configurations, tracker_frame, ys100_table_7_1, TrueRobot};
@@ -85,7 +85,7 @@ fn checks_tell_ok_a_crash_and_a_moved_tracker_apart() {
     assert!((s.rotation_deg - 0.2).abs() < 0.01, "{}", s.rotation_deg);
 }
 
-/// Seed §2.2's registration and tool, refitted alone: after the reflector was
+/// Thesis §2.2's registration and tool, refitted alone: after the reflector was
 /// remounted 17.9 mm further out and the tracker moved, 20 new poses bring
 /// the model back to within 10 % of its original validation mean; poses that
 /// turn joint 1 only cannot tell the tool from the frame and are refused. The

@@ -3,7 +3,7 @@
 //! laser-tracker data (data/ur5-wam-laser-tracker).
 //!
 //! The simulated truth is `compensate::unmodelled_truth` on the YS100: ~1 mm /
-//! 0.1° geometric errors, the joint stiffness of the seed's Table 7.2, link
+//! 0.1° geometric errors, the joint stiffness of the thesis's Table 7.2, link
 //! masses 25 % above the model's and centres of mass moved by 60 mm, a gear
 //! transmission error of 4e-5 rad (first harmonic) and 2e-5 rad backlash on
 //! every joint, 0.01 mm tracker noise, and a tracker frame 3.4 m from the base,
@@ -21,17 +21,16 @@ mod common;
 use common::{measure_truth, real, shipped_model};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal_core::compensate::{
-    unmodelled_truth, CompensatedModel, CompensatorSpec, StoredCompensator,
-};
-use robocal_core::identify::{
+use robocal_core::calibrate::compensate::{CompensatedModel, CompensatorSpec, StoredCompensator};
+use robocal_core::calibrate::identify::{
     calibrate, calibrate_with_training, CalibrationOptions, CalibrationReport, CompensatorOptions,
     Method,
 };
-use robocal_core::ik::{Goal, IkSettings, IkSolver, SolveOptions};
 use robocal_core::measure::{self, Measurement};
 use robocal_core::model::{preset, RobotModel};
 use robocal_core::sim::random_configurations;
+use robocal_core::sim::unmodelled_truth;
+use robocal_core::solve::ik::{Goal, IkSettings, IkSolver, SolveOptions};
 use robocal_core::stats::ErrorStats;
 use std::sync::OnceLock;
 
@@ -58,7 +57,7 @@ fn errors(m: &CompensatedModel, data: &[Measurement]) -> ErrorStats {
     ErrorStats::from_errors_mm(&e)
 }
 
-/// (method name, base, compensator spec) of the seed's hybrid methods.
+/// (method name, base, compensator spec) of the thesis's hybrid methods.
 fn hybrids() -> Vec<(&'static str, &'static str, CompensatorSpec)> {
     vec![
         ("km-rbf", "km", CompensatorSpec::km_rbf()),
@@ -188,7 +187,7 @@ fn thousand_poses_every_compensator_beats_its_base() {
             base.max_mm,
             comp.max_mm
         );
-        // IWO with the seed's loss (eq. 5.7, mean + 0.7·max over 850 fitting
+        // IWO with the thesis's loss (eq. 5.7, mean + 0.7·max over 850 fitting
         // poses) does not reach the 15 % here (README, "Compensators");
         // it is reported, not held to it.
         if !method.ends_with("iwonn") {
@@ -392,7 +391,7 @@ fn base_failure_pool_choice_and_cancellation() {
     });
     assert!(matches!(
         r,
-        Err(robocal_core::identify::CalibrationError::Cancelled)
+        Err(robocal_core::calibrate::identify::CalibrationError::Cancelled)
     ));
     assert_eq!(seen.load(std::sync::atomic::Ordering::SeqCst), 1);
     // Without Q2 the compensator says it trained on the identification poses.

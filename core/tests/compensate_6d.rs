@@ -34,14 +34,16 @@ use nalgebra::{Rotation3, Vector3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
-use robocal_core::cell::predict::{Forward, PredictFrame};
-use robocal_core::cell::{CellOptions, CellSolver, WorkObject};
-use robocal_core::compensate::{parse_compensated, CalibratedModelFile, CompensatedModel};
-use robocal_core::identify::{calibrate_with_training, CalibrationReport, Method};
-use robocal_core::ik::IkSettings;
+use robocal_core::calibrate::compensate::{
+    parse_compensated, CalibratedModelFile, CompensatedModel,
+};
+use robocal_core::calibrate::identify::{calibrate_with_training, CalibrationReport, Method};
 use robocal_core::measure::Measurement;
 use robocal_core::model::{Pose, RobotModel};
 use robocal_core::sim::TrueRobot;
+use robocal_core::solve::cell::predict::{Forward, PredictFrame};
+use robocal_core::solve::cell::{CellOptions, CellSolver, WorkObject};
+use robocal_core::solve::ik::IkSettings;
 
 const POSITION_NOISE_MM: f64 = 0.01;
 const ORIENTATION_NOISE_DEG: f64 = 0.005;
@@ -104,7 +106,7 @@ fn tip_error_mm(
     va: &[Measurement],
     tip_m: &Vector3<f64>,
 ) -> f64 {
-    let tool = robocal_core::kinematics::chain::tool_pose(&model.calibrated)
+    let tool = robocal_core::model::kinematics::chain::tool_pose(&model.calibrated)
         .compose(&Pose::from_translation(*tip_m));
     let forward = Forward::new(model, Some(&tool), None);
     let frame = PredictFrame::default();
@@ -169,7 +171,7 @@ fn a_compensator_learns_the_orientation_and_the_tool_tip_benefits() {
         .contains("orientation too"));
 
     // Solve inverts predict with the orientation part, at the tool tip.
-    let tool = robocal_core::kinematics::chain::tool_pose(&gp_model.calibrated)
+    let tool = robocal_core::model::kinematics::chain::tool_pose(&gp_model.calibrated)
         .compose(&Pose::from_translation(tip));
     let forward = Forward::new(&gp_model, Some(&tool), None);
     let settings = IkSettings {
@@ -178,7 +180,7 @@ fn a_compensator_learns_the_orientation_and_the_tool_tip_benefits() {
         ..IkSettings::default()
     };
     let solver = CellSolver::new(&gp_model, &tool, settings);
-    let base = PredictFrame::Frame(robocal_core::ik::TargetFrame::Base);
+    let base = PredictFrame::Frame(robocal_core::solve::ik::TargetFrame::Base);
     for m in va.iter().take(5) {
         let target = forward.pose(&m.q, &base).unwrap();
         let s = solver.solve(&WorkObject::base(), &target, &CellOptions::default());

@@ -4,13 +4,13 @@
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal_core::compensate::CompensatedModel;
-use robocal_core::identify::pose_selection::choose_d_optimal;
-use robocal_core::identify::{calibrate, CalibrationOptions, Method};
-use robocal_core::ik::{IkSettings, IkSolver, SolveOptions};
+use robocal_core::calibrate::compensate::CompensatedModel;
+use robocal_core::calibrate::identify::pose_selection::choose_d_optimal;
+use robocal_core::calibrate::identify::{calibrate, CalibrationOptions, Method};
 use robocal_core::measure;
 use robocal_core::model::preset;
 use robocal_core::sim::{random_configurations, tracker_frame, ys100_table_7_1, TrueRobot};
+use robocal_core::solve::ik::{IkSettings, IkSolver, SolveOptions};
 
 #[test]
 fn solved_commands_reach_the_targets_on_the_true_robot() {
@@ -118,9 +118,9 @@ fn calibrated_targets_converge(
     };
     let solver = IkSolver::new(cm.clone(), IkSettings::default());
     let qs = random_configurations(&nominal, 10_000, rng);
-    let goals: Vec<robocal_core::ik::Goal> = qs
+    let goals: Vec<robocal_core::solve::ik::Goal> = qs
         .iter()
-        .map(|q| robocal_core::ik::Goal::from(&cm.predict(q).unwrap()))
+        .map(|q| robocal_core::solve::ik::Goal::from(&cm.predict(q).unwrap()))
         .collect();
     let sols = solver.solve_batch(&goals, &SolveOptions::default());
     let failed: Vec<_> = sols.iter().filter(|s| !s.converged).collect();

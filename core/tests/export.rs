@@ -4,9 +4,9 @@
 //! kinematics to 1e-6 mm. (`robocal export` writing every format is a test of
 //! the root crate.)
 
-use robocal_core::compensate::CalibratedModelFile;
-use robocal_core::export::{export, ExportFormat, ExportSource};
-use robocal_core::kinematics::fk;
+use robocal_core::calibrate::compensate::CalibratedModelFile;
+use robocal_core::model::export::{export, ExportFormat, ExportSource};
+use robocal_core::model::kinematics::fk;
 
 const CALIBRATED: &str = "tests/golden/ur5_km_calibrated.json";
 

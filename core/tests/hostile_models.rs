@@ -11,20 +11,22 @@ use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal_core::cell::{Cell, Tool};
-use robocal_core::compensate::CompensatedModel;
-use robocal_core::export::{export, ExportFormat, ExportSource};
-use robocal_core::identify::{calibrate, CalibrationError, CalibrationOptions, LmSettings, Method};
-use robocal_core::ik::{IkSettings, IkSolver, SolveOptions};
-use robocal_core::kinematics::chain::tool_pose;
-use robocal_core::kinematics::fk;
+use robocal_core::calibrate::compensate::CompensatedModel;
+use robocal_core::calibrate::identify::{
+    calibrate, CalibrationError, CalibrationOptions, LmSettings, Method,
+};
 use robocal_core::measure::{self, Measurement};
+use robocal_core::model::export::{export, ExportFormat, ExportSource};
+use robocal_core::model::kinematics::chain::tool_pose;
+use robocal_core::model::kinematics::fk;
 use robocal_core::model::orientation::{rotation_to, OrientationConvention};
 use robocal_core::model::presets::preset_description;
 use robocal_core::model::{preset, ModelDescription, RobotModel};
 use robocal_core::plan::{make_plan, PlanSettings};
-use robocal_core::program::{filter, Language, ProgramFile};
 use robocal_core::sim::{try_random_configurations, PoseFilter, TrueRobot};
+use robocal_core::solve::cell::{Cell, Tool};
+use robocal_core::solve::ik::{IkSettings, IkSolver, SolveOptions};
+use robocal_core::solve::program::{filter, Language, ProgramFile};
 use std::time::{Duration, Instant};
 
 /// `n` random configurations of `model`, without the floor check: an

@@ -6,7 +6,7 @@ mod common;
 use common::{measure_truth, opts, real_with, run_with, two_tracker_sessions};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal_core::identify::{
+use robocal_core::calibrate::identify::{
     calibrate, CalibrationError, CalibrationOptions, CalibrationReport, Method,
 };
 use robocal_core::measure::{self, csv, Measurement};
@@ -28,7 +28,7 @@ fn val_mean(r: &CalibrationReport, m: &str) -> f64 {
     r.methods[m].validation.as_ref().unwrap().stats.mean_mm
 }
 
-/// Seed §2.2: position-only KM of the YS100 keeps 27 parameters; each dependent
+/// Thesis §2.2: position-only KM of the YS100 keeps 27 parameters; each dependent
 /// pair loses the member the seed sets to nominal.
 #[test]
 fn ys100_position_km_keeps_the_seeds_27_parameters() {
@@ -63,10 +63,10 @@ fn ys100_position_km_keeps_the_seeds_27_parameters() {
     assert!(r.methods["km"].identification.stats.max_mm < 1e-6);
 }
 
-/// `robocal demo ys100-simulation` (seed §7.4) meets the acceptance.
+/// `robocal demo ys100-simulation` (thesis §7.4) meets the acceptance.
 #[test]
 fn ys100_simulation_study_reaches_the_noise_floor() {
-    let study = robocal_core::study::ys100_simulation(1, &|_| true).unwrap();
+    let study = robocal_core::sim::study::ys100_simulation(1, &|_| true).unwrap();
     let r = &study.report;
     let (km, skcm, tlbo) = (
         val_mean(r, "km"),
@@ -164,7 +164,8 @@ fn ur5_real_data_km() {
         let before: f64 = test
             .iter()
             .map(|m| {
-                (robocal_core::kinematics::fk(&model, &m.q).unwrap().p - m.position).norm() * 1e3
+                (robocal_core::model::kinematics::fk(&model, &m.q).unwrap().p - m.position).norm()
+                    * 1e3
             })
             .sum::<f64>()
             / test.len() as f64;

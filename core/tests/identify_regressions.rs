@@ -6,7 +6,7 @@ mod common;
 use common::{measure_truth, opts, real, run_with, shipped_model};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal_core::identify::{
+use robocal_core::calibrate::identify::{
     CalibrationError, CalibrationOptions, CalibrationReport, DropKind, LmSettings, Method,
     StopReason, WarningKind,
 };
@@ -170,7 +170,7 @@ fn ur5_with_tcp_offset_drops_nearly_dependent_wrist_parameters() {
     assert!(skcm <= km * 1.03, "SKCM {skcm} mm vs KM {km} mm");
 }
 
-/// A YS100 truth: geometric errors (1 mm, 0.1°) and the seed's Table 7.2
+/// A YS100 truth: geometric errors (1 mm, 0.1°) and the thesis's Table 7.2
 /// stiffness (K2..K5; joints 1 and 6 rigid).
 fn table_7_2_truth(nominal: &RobotModel, rng: &mut ChaCha8Rng) -> RobotModel {
     let mut tm = perturb_geometry(nominal, &ErrorMagnitudes::from_mm_deg(1.0, 0.1), rng);
@@ -186,7 +186,7 @@ fn skcm_and_payload(
     nominal: &RobotModel,
     id: &[Measurement],
     va: &[Measurement],
-) -> (f64, f64, robocal_core::identify::MethodReport) {
+) -> (f64, f64, robocal_core::calibrate::identify::MethodReport) {
     let mut r = run_with(nominal, id, va, opts(&[Method::Skcm, Method::SkcmPayload])).unwrap();
     let v = |m: &str| r.methods[m].validation.as_ref().unwrap().stats.mean_mm;
     let (skcm, payload) = (v("skcm"), v("skcm-payload"));
@@ -196,7 +196,14 @@ fn skcm_and_payload(
 /// Validation means of SKCM and SKCM-payload, the CoM error [mm] and the
 /// SKCM-payload report, for a truth whose payload CoM is 250 mm from the
 /// model's and whose link masses are `mass_factor` times the model's.
-fn payload_case(mass_factor: f64) -> (f64, f64, f64, robocal_core::identify::MethodReport) {
+fn payload_case(
+    mass_factor: f64,
+) -> (
+    f64,
+    f64,
+    f64,
+    robocal_core::calibrate::identify::MethodReport,
+) {
     use robocal_core::sim::tracker_frame;
     let nominal = preset("ys100").unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(77);

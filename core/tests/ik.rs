@@ -19,18 +19,17 @@ use nalgebra::{Matrix3, Vector3};
 use proptest::prelude::*;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal_core::compensate::{
-    synthetic_calibration, CompensatedModel, Compensator, SyntheticErrors,
-};
-use robocal_core::ik::{
-    AnalyticIk, Configuration, FailureReason, Goal, IkSettings, IkSolver, SolveOptions,
-    TargetFrame, TargetInput,
-};
-use robocal_core::kinematics::fk;
+use robocal_core::calibrate::compensate::{CompensatedModel, Compensator};
+use robocal_core::model::kinematics::fk;
 use robocal_core::model::orientation::{
     rotation_angle_between, rotation_from, rotation_to, OrientationConvention,
 };
 use robocal_core::model::{preset, Pose, RobotModel};
+use robocal_core::sim::{synthetic_calibration, SyntheticErrors};
+use robocal_core::solve::ik::{
+    AnalyticIk, Configuration, FailureReason, Goal, IkSettings, IkSolver, SolveOptions,
+    TargetFrame, TargetInput,
+};
 use std::f64::consts::PI;
 use std::sync::Arc;
 

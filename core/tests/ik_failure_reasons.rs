@@ -8,7 +8,7 @@ use common::ik::{calibrated, random_q};
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use robocal_core::ik::{
+use robocal_core::solve::ik::{
     AnalyticIk, Configuration, FailureReason, Goal, IkSettings, IkSolver, SolveOptions,
 };
 

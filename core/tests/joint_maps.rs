@@ -10,15 +10,15 @@ use common::ik::calibrated;
 use common::{opts, run_with};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use robocal_core::compensate::CompensatedModel;
-use robocal_core::identify::{calibrate, CalibrationError, Method};
-use robocal_core::ik::{Goal, IkSettings, IkSolver, SolveOptions};
+use robocal_core::calibrate::compensate::CompensatedModel;
+use robocal_core::calibrate::identify::{calibrate, CalibrationError, Method};
 use robocal_core::measure::{self, Measurement};
 use robocal_core::model::orientation::rotation_angle_between;
 use robocal_core::model::{preset, JointMap, JointMaps, ModelDescription, RobotModel};
 use robocal_core::sim::{
     fine_transmission_errors, perturb_geometry, random_configurations, ErrorMagnitudes, TrueRobot,
 };
+use robocal_core::solve::ik::{Goal, IkSettings, IkSolver, SolveOptions};
 
 /// Maps of tens of arc seconds on joints 1–3 and 5, over ranges that leave
 /// part of each joint's travel outside them.

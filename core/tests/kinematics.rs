@@ -5,7 +5,7 @@
 use nalgebra::{Matrix3, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use robocal_core::kinematics::{
+use robocal_core::model::kinematics::{
     chain, deflected_joints, fk, geometric_jacobian, gravity_torques, identification_jacobian,
 };
 use robocal_core::model::pose::rotation_log;

@@ -25,8 +25,8 @@ use nalgebra::{Rotation3, Vector3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
-use robocal_core::identify::report::WarningKind;
-use robocal_core::identify::{CalibrationReport, Method};
+use robocal_core::calibrate::identify::report::WarningKind;
+use robocal_core::calibrate::identify::{CalibrationReport, Method};
 use robocal_core::measure::{Measurement, RowStd};
 use robocal_core::model::{Pose, RobotModel};
 use robocal_core::sim::{fine_transmission_errors, random_configurations, TrueRobot};
@@ -86,7 +86,7 @@ fn truth_errors(
     let base_to_tracker: Pose = r.tracker_to_base.inverse();
     let (mut refl, mut tip) = (0.0, 0.0);
     for m in va {
-        let (p, rot) = robocal_core::identify::least_squares::predict(model, m).unwrap();
+        let (p, rot) = robocal_core::calibrate::identify::least_squares::predict(model, m).unwrap();
         let pred = base_to_tracker.compose(&Pose::new(rot, p));
         let t = truth.true_pose(&m.q, None).unwrap();
         refl += (t.p - pred.p).norm();

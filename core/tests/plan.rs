@@ -4,16 +4,16 @@
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal_core::identify::{calibrate, CalibrationOptions, Method};
-use robocal_core::kinematics::fk;
+use robocal_core::calibrate::identify::{calibrate, CalibrationOptions, Method};
 use robocal_core::measure::{csv, to_measurements};
+use robocal_core::model::kinematics::fk;
 use robocal_core::model::{preset, RobotModel};
 use robocal_core::plan::{
     join, make_plan, plan_csv, plan_program, read_plan_csv, JoinBy, JoinError, JoinOptions,
     MeasurementPlan, PlanError, PlanSettings, TrackerSight, Units, WorkspaceBox,
 };
-use robocal_core::program::{parse, Language};
 use robocal_core::sim::{perturb_geometry, tracker_frame, ErrorMagnitudes, TrueRobot};
+use robocal_core::solve::program::{parse, Language};
 use std::collections::BTreeMap;
 
 /// Plans `poses` poses of `model` with `noise_mm` and the default constraints of these tests.
@@ -106,7 +106,7 @@ fn km_prediction_matches_simulated_measurements() {
 
 /// With gravity loading the joints (the YS100 and its payload), the plan also
 /// predicts SKCM's σ, compliance included, within 2× of 30 simulated
-/// measurements of a truth with the seed's Table 7.1 errors and compliance.
+/// measurements of a truth with the thesis's Table 7.1 errors and compliance.
 #[test]
 fn skcm_prediction_matches_simulated_measurements() {
     let nominal = preset("ys100").unwrap();

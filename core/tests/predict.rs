@@ -12,18 +12,18 @@ use common::{measure_truth, opts, run_with};
 use nalgebra::Vector3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal_core::cell::accuracy::{tool_accuracy, ToolAccuracy};
-use robocal_core::cell::{
-    CellOptions, CellSolver, Forward, Load, PoseOut, PredictFrame, WorkObject, WorkObjectFrame,
-};
-use robocal_core::compensate::{CompensatedModel, Compensator};
-use robocal_core::identify::Method;
-use robocal_core::ik::{IkSettings, IkSolver, SolveOptions, TargetFrame, TargetInput};
-use robocal_core::kinematics::chain::tool_pose;
+use robocal_core::calibrate::compensate::{CompensatedModel, Compensator};
+use robocal_core::calibrate::identify::Method;
 use robocal_core::measure::Measurement;
+use robocal_core::model::kinematics::chain::tool_pose;
 use robocal_core::model::orientation::rotation_angle_between;
 use robocal_core::model::{preset, JointMap, JointMaps, Pose, RobotModel};
 use robocal_core::sim::{perturb_geometry, ErrorMagnitudes, TrueRobot};
+use robocal_core::solve::cell::accuracy::{tool_accuracy, ToolAccuracy};
+use robocal_core::solve::cell::{
+    CellOptions, CellSolver, Forward, Load, PoseOut, PredictFrame, WorkObject, WorkObjectFrame,
+};
+use robocal_core::solve::ik::{IkSettings, IkSolver, SolveOptions, TargetFrame, TargetInput};
 use std::sync::Arc;
 
 /// A planar two-link arm: both axes vertical, links 400 and 300 mm, base

@@ -10,10 +10,11 @@ mod common;
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use robocal_core::compensate::{unmodelled_truth, CompensatedModel};
-use robocal_core::identify::{calibrate_with_training, CalibrationOptions, Method};
+use robocal_core::calibrate::compensate::CompensatedModel;
+use robocal_core::calibrate::identify::{calibrate_with_training, CalibrationOptions, Method};
 use robocal_core::measure::{self, Measurement};
 use robocal_core::model::{preset, Coverage, RobotModel};
+use robocal_core::sim::unmodelled_truth;
 use robocal_core::sim::{random_configurations, TrueRobot};
 
 /// `n` measurements with joint 1 drawn uniformly in `[lo, hi]` degrees.
@@ -72,7 +73,7 @@ fn compensators_fall_back_to_their_base_outside_and_solve_flags_it() {
             (None, Method::KmMaps) => "km",
             (None, _) => "skcm",
         };
-        let stats = |r: &robocal_core::identify::CalibrationReport, name: &str| {
+        let stats = |r: &robocal_core::calibrate::identify::CalibrationReport, name: &str| {
             r.methods[name].validation.as_ref().unwrap().stats.clone()
         };
         let (b_in, c_in) = (stats(&r_in, base), stats(&r_in, m.name()));

@@ -1,14 +1,14 @@
 //! The simulator against independent expectations: an error-free truth measures
 //! the nominal forward kinematics exactly, compliance sags the TCP along gravity,
 //! the tracker frame maps base to tracker coordinates, the noise has the requested
-//! spread, and the seed's §7.4 robot carries Tables 7.1/7.2 (`robocal
+//! spread, and the thesis's §7.4 robot carries Tables 7.1/7.2 (`robocal
 //! simulate` writing CSV that parses back is a test of the root crate).
 
 use nalgebra::Vector3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal_core::kinematics::fk;
 use robocal_core::measure::SetRole;
+use robocal_core::model::kinematics::fk;
 use robocal_core::model::{preset, RobotModel};
 use robocal_core::sim::{
     perturb_geometry, random_configurations, tracker_frame, ys100_table_7_1, ErrorMagnitudes,

@@ -6,11 +6,13 @@
 mod truth;
 
 use nalgebra::{Matrix3, Vector3};
-use robocal_core::cell::tcp::{self, axis, fixed_point, tracker, NotFittedReason, TcpMethod};
-use robocal_core::cell::work_object_fit::{self, WorkObjectPoints};
 use robocal_core::model::orientation::rotation_angle_between;
 use robocal_core::model::Pose;
 use robocal_core::sim::random_configurations;
+use robocal_core::solve::cell::tcp::{
+    self, axis, fixed_point, tracker, NotFittedReason, TcpMethod,
+};
+use robocal_core::solve::cell::work_object_fit::{self, WorkObjectPoints};
 use truth::*;
 
 /// The production tool: tip 250 mm out, off-centre, its z tilted 30° about

@@ -24,9 +24,9 @@ use nalgebra::Vector3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::Normal;
-use robocal_core::identify::joint_maps::MapRefusal;
-use robocal_core::identify::report::WarningKind;
-use robocal_core::identify::{CalibrationReport, Method};
+use robocal_core::calibrate::identify::joint_maps::MapRefusal;
+use robocal_core::calibrate::identify::report::WarningKind;
+use robocal_core::calibrate::identify::{CalibrationReport, Method};
 use robocal_core::measure::Measurement;
 use robocal_core::model::{Pose, RobotModel};
 use robocal_core::sim::{random_configurations, Harmonic, TrueRobot};
@@ -128,7 +128,7 @@ fn truth_errors(s: &Study, method: Method, tip_m: &Vector3<f64>) -> (f64, f64) {
     let base_to_tracker: Pose = s.report.tracker_to_base.inverse();
     let (mut refl, mut tip) = (0.0, 0.0);
     for m in &s.va {
-        let (p, rot) = robocal_core::identify::least_squares::predict(model, m).unwrap();
+        let (p, rot) = robocal_core::calibrate::identify::least_squares::predict(model, m).unwrap();
         let pred = base_to_tracker.compose(&Pose::new(rot, p));
         let t = s.truth.true_pose(&m.q, None).unwrap();
         refl += (t.p - pred.p).norm();
@@ -140,7 +140,7 @@ fn truth_errors(s: &Study, method: Method, tip_m: &Vector3<f64>) -> (f64, f64) {
 
 /// Joint 6's refusal in km-maps' report, if any, after checking the report
 /// and its warning agree.
-fn joint6_refusal(s: &Study) -> Option<robocal_core::identify::joint_maps::RefusedMap> {
+fn joint6_refusal(s: &Study) -> Option<robocal_core::calibrate::identify::joint_maps::RefusedMap> {
     let m = &s.report.methods[&Method::KmMaps];
     let maps = m.joint_maps.as_ref().expect("maps summary");
     let r = maps.refused.iter().find(|r| r.joint == 6).cloned();

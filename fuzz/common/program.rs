@@ -3,10 +3,10 @@
 //! target's value ranges lie inside its file, and a program that parses
 //! filters (on the nominal model, no tool or work object in the cell) without
 //! panicking.
-use robocal::cell::Cell;
-use robocal::compensate::CompensatedModel;
-use robocal::ik::IkSettings;
-use robocal::program::{filter, parse, Language, ProgramFile};
+use robocal::solve::cell::Cell;
+use robocal::calibrate::compensate::CompensatedModel;
+use robocal::solve::ik::IkSettings;
+use robocal::solve::program::{filter, parse, Language, ProgramFile};
 
 pub fn check(language: Language, names: [&str; 2], data: &[u8]) {
     let Ok(text) = std::str::from_utf8(data) else {

@@ -3,7 +3,7 @@
 //! its forward kinematics at the zero configuration does not panic.
 #![no_main]
 use libfuzzer_sys::fuzz_target;
-use robocal::compensate::CalibratedModelFile;
+use robocal::calibrate::compensate::CalibratedModelFile;
 use robocal::model::RobotModel;
 
 fuzz_target!(|data: &[u8]| {
@@ -14,7 +14,7 @@ fuzz_target!(|data: &[u8]| {
         let json = model.to_json();
         let again = RobotModel::from_json(&json).expect("written model reads back");
         assert_eq!(again.to_json(), json, "model JSON round trip changed it");
-        let _ = robocal::kinematics::fk(&model, &vec![0.0; model.dof()]);
+        let _ = robocal::model::kinematics::fk(&model, &vec![0.0; model.dof()]);
     }
     if let Ok(file) = CalibratedModelFile::from_json(text) {
         let _ = file.to_compensated();

@@ -3,10 +3,10 @@
 //! on the nominal YS100) into one result per target without panicking.
 #![no_main]
 use libfuzzer_sys::fuzz_target;
-use robocal::compensate::CompensatedModel;
+use robocal::calibrate::compensate::CompensatedModel;
 use robocal::http::input::from_json_object;
 use robocal::http::solve::{json_command, CsvSolveQuery, SolveRequest};
-use robocal::ik::{IkSettings, IkSolver};
+use robocal::solve::ik::{IkSettings, IkSolver};
 use robocal::service::solve::{seed_joints, Targets};
 use std::sync::OnceLock;
 

@@ -3,13 +3,13 @@
 //! goal or a per-target error without panicking.
 #![no_main]
 use libfuzzer_sys::fuzz_target;
-use robocal::csv_text::Dialect;
+use robocal::measure::csv_text::Dialect;
 
 fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else {
         return;
     };
-    if let Ok(parsed) = robocal::ik::parse_targets_csv(text, Dialect::default()) {
+    if let Ok(parsed) = robocal::solve::ik::parse_targets_csv(text, Dialect::default()) {
         for row in &parsed.rows {
             if let Ok(t) = &row.target {
                 let _ = t.to_goal();

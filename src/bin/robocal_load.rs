@@ -2,7 +2,7 @@
 //!
 //! Without `--url` it starts the service in-process on `127.0.0.1:0` with a
 //! temporary SQLite database, creates a YS100 robot, uploads simulated
-//! measurements (seed §7.4 truth, 110 kg), runs a KM + SKCM calibration and
+//! measurements (thesis §7.4 truth, 110 kg), runs a KM + SKCM calibration and
 //! solves against the active (SKCM) version. With `--url` it uses a running
 //! service and `--robot`, which must have an active version.
 //!
@@ -28,7 +28,7 @@ use crate::client::Conn;
 use anyhow::{bail, Context};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal::compensate::CalibratedModelFile;
+use robocal::calibrate::compensate::CalibratedModelFile;
 use robocal::db::Db;
 use robocal::http::{app, AppState, ServiceConfig};
 use robocal::measure::csv;

@@ -1,7 +1,7 @@
 //! `robocal bench`: in-process timings of robocal's side of the peer
 //! benchmark (`scripts/peer_bench.py`), printed as JSON.
 //!
-//! - `bench km`: KM (seed §2.2, eqs. 2.3–2.4) on an identification CSV, the
+//! - `bench km`: KM (thesis §2.2, eqs. 2.3–2.4) on an identification CSV, the
 //!   validation error of the fitted model, and the wall time of the whole
 //!   `identify::calibrate` call (registration, identifiability, KM), repeated.
 //! - `bench ik`: inverse kinematics of target poses (CSV `x,y,z` in mm and
@@ -18,10 +18,10 @@
 //!
 //! Times are wall-clock on the calling thread (pin with `taskset -c 0`).
 
-use crate::compensate::{CalibratedModelFile, CompensatedModel};
-use crate::identify::{calibrate, CalibrationOptions, Method};
-use crate::ik::{Goal, IkSettings, IkSolver, SolveOptions, TargetFrame};
+use crate::calibrate::compensate::{CalibratedModelFile, CompensatedModel};
+use crate::calibrate::identify::{calibrate, CalibrationOptions, Method};
 use crate::measure::{self, csv};
+use crate::solve::ik::{Goal, IkSettings, IkSolver, SolveOptions, TargetFrame};
 use anyhow::{bail, Context};
 use clap::{Args, Subcommand};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
@@ -113,9 +113,9 @@ pub fn run(a: BenchArgs) -> anyhow::Result<()> {
 }
 
 fn methods(a: &MethodsArgs) -> anyhow::Result<serde_json::Value> {
-    use crate::compensate::unmodelled_truth;
-    use crate::identify::calibrate_with_training;
+    use crate::calibrate::identify::calibrate_with_training;
     use crate::sim::random_configurations;
+    use crate::sim::unmodelled_truth;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
     let methods: Vec<Method> = if a.method.is_empty() {

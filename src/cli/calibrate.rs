@@ -1,9 +1,9 @@
 //! `robocal calibrate`: identify calibrated models from measurement CSVs and
-//! print the comparison of methods (like the seed's Tables 2.5/2.6) with the
+//! print the comparison of methods (like the thesis's Tables 2.5/2.6) with the
 //! identifiability report, or the same as JSON.
 
 use super::progress::ProgressPrinter;
-use crate::identify::{
+use crate::calibrate::identify::{
     calibrate_with_training, CalibrationOptions, CalibrationReport, CompensatorOptions, Method,
     PoseSource, PoseSources, SetErrors, METHODS,
 };
@@ -316,9 +316,14 @@ fn save_model(
         None => report.best_method().context("no method ran")?,
     };
     let label = chosen.model_file_method();
-    let file =
-        crate::identify::calibrated_model_file(report, chosen, nominal, &nominal.name, payload)
-            .map_err(|e| anyhow::anyhow!("the {label} model does not load back: {e}"))?;
+    let file = crate::calibrate::identify::calibrated_model_file(
+        report,
+        chosen,
+        nominal,
+        &nominal.name,
+        payload,
+    )
+    .map_err(|e| anyhow::anyhow!("the {label} model does not load back: {e}"))?;
     super::model_files::save_model_file(&file, std::path::Path::new(path))?;
     eprintln!("saved the {label} model to {path}");
     Ok(())

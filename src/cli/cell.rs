@@ -4,9 +4,9 @@
 //! out in the robot base frame of the calibrated model given.
 
 use super::model_files::load_compensated;
-use crate::cell::export::{controller_data, controller_text};
-use crate::cell::CellDescription;
-use crate::program::Language;
+use crate::solve::cell::export::{controller_data, controller_text};
+use crate::solve::cell::CellDescription;
+use crate::solve::program::Language;
 use anyhow::{bail, Context};
 use clap::{Args, Subcommand};
 

@@ -1,11 +1,11 @@
-//! `robocal demo ys100-simulation`: runs the seed's simulation study of §7.4
-//! (`crate::study::ys100_simulation`, whose doc states its set-up) and prints
+//! `robocal demo ys100-simulation`: runs the thesis's simulation study of §7.4
+//! (`crate::sim::study::ys100_simulation`, whose doc states its set-up) and prints
 //! the Table 7.5 comparison of KM, SKCM and SKCM-C and the identified
 //! stiffness next to the truth.
 
 use super::progress::ProgressPrinter;
-use crate::identify::Method;
-use crate::study::ys100_simulation;
+use crate::calibrate::identify::Method;
+use crate::sim::study::ys100_simulation;
 use anyhow::bail;
 use clap::Args;
 
@@ -38,7 +38,7 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     }
     let r = &study.report;
     println!(
-        "YS100 simulation study (seed §7.4): truth = Table 7.1 geometry + Table 7.2 stiffness,"
+        "YS100 simulation study (thesis §7.4): truth = Table 7.1 geometry + Table 7.2 stiffness,"
     );
     println!("payload 110 kg, tracker noise 0.01 mm per axis, 30 identification poses (D-optimal among 500 random) / 45 random validation poses.\n");
     println!("Table 7.5 equivalent: absolute position accuracy on the validation poses (mm)");

@@ -1,9 +1,9 @@
 //! `robocal export`: the (calibrated) geometric model for other tools — URDF,
-//! standard-DH or modified-DH CSV, or robocal's JSON (`crate::export` makes the
+//! standard-DH or modified-DH CSV, or robocal's JSON (`crate::model::export` makes the
 //! text; this command reads the model and writes the file or stdout).
 
 use super::model_files::load_compensated;
-use crate::export::{export, ExportFormat, ExportSource};
+use crate::model::export::{export, ExportFormat, ExportSource};
 use anyhow::Context;
 use clap::Args;
 

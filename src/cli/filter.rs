@@ -6,9 +6,9 @@
 //! degrees); RAPID modules and URScript carry their own.
 
 use super::model_files::load_compensated;
-use crate::cell::{Cell, CellDescription};
-use crate::ik::IkSettings;
-use crate::program::{filter, Language, ProgramFile};
+use crate::solve::cell::{Cell, CellDescription};
+use crate::solve::ik::IkSettings;
+use crate::solve::program::{filter, Language, ProgramFile};
 use anyhow::{bail, Context};
 use clap::Args;
 use std::path::{Path, PathBuf};

@@ -13,14 +13,14 @@
 //! The plan CSV's commanded poses: the model's measurement frame (see
 //! `core::iso9283::csv` for both file formats).
 
-use crate::compensate::CompensatedModel;
+use crate::calibrate::compensate::CompensatedModel;
 use crate::model::orientation::fixed_xyz_matrix;
 use crate::plan::WorkspaceBox;
-use crate::program::{export::joint_program, Language};
+use crate::solve::program::{export::joint_program, Language};
 use anyhow::{bail, Context};
 use clap::{Args, Subcommand, ValueEnum};
-use robocal_core::iso9283::csv::{plan_csv, read_cycles_csv, read_plan_csv};
-use robocal_core::iso9283::{
+use robocal_core::check::iso9283::csv::{plan_csv, read_cycles_csv, read_plan_csv};
+use robocal_core::check::iso9283::{
     evaluate, plan_cube, Commands, CubePlan, CubeSettings, Iso9283Figures,
 };
 use std::fmt::Write as _;

@@ -2,7 +2,7 @@
 //! their text; reading and writing files happens here): a calibrated model
 //! file (`robocal calibrate --save`), a model JSON file, or a preset name.
 
-use crate::compensate::{
+use crate::calibrate::compensate::{
     parse_compensated, CalibratedModelFile, CompensateError, CompensatedModel,
 };
 use crate::model::preset;

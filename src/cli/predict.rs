@@ -16,15 +16,17 @@
 
 use super::model_files::load_compensated;
 use super::solve::OutputFormat;
-use crate::cell::accuracy::{
+use crate::calibrate::compensate::CalibratedModelFile;
+use crate::measure::csv_text::{dialect_from_names, safe_cell};
+use crate::model::orientation::OrientationConvention;
+use crate::solve::cell::accuracy::{
     measurement_tool_accuracy, tool_accuracy, ToolAccuracy, ValidationEvidence,
 };
-use crate::cell::joints_csv::parse_joints_csv;
-use crate::cell::{Cell, CellDescription, CellRef, Forward, PoseOut, PredictFrame, Predicted};
-use crate::compensate::CalibratedModelFile;
-use crate::csv_text::{dialect_from_names, safe_cell};
-use crate::ik::TargetFrame;
-use crate::model::orientation::OrientationConvention;
+use crate::solve::cell::joints_csv::parse_joints_csv;
+use crate::solve::cell::{
+    Cell, CellDescription, CellRef, Forward, PoseOut, PredictFrame, Predicted,
+};
+use crate::solve::ik::TargetFrame;
 use anyhow::{bail, Context};
 use clap::Args;
 use serde_json::json;
@@ -116,7 +118,7 @@ pub fn predict_to_string(a: &PredictArgs) -> anyhow::Result<String> {
         None => None,
     };
     let ev = evidence(&a.model);
-    let probe = crate::kinematics::chain::tool_pose(&model.calibrated);
+    let probe = crate::model::kinematics::chain::tool_pose(&model.calibrated);
     let accuracy = match &tool {
         Some(t) => tool_accuracy(ev.as_ref(), &probe, &t.tcp),
         None => measurement_tool_accuracy(ev.as_ref()),

@@ -7,7 +7,7 @@
 //! work within it. The bar: redrawn at most every 100 ms and when the phase
 //! changes, ended with a newline by [`ProgressPrinter::finish`].
 
-use crate::identify::Progress;
+use crate::calibrate::identify::Progress;
 use std::io::{IsTerminal, Write};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};

@@ -1,5 +1,5 @@
 //! `robocal simulate`: measure a simulated "true" robot and write the measurement
-//! CSV (docs/design.md "Measurement CSV"; the seed's §7.4 simulation study).
+//! CSV (docs/design.md "Measurement CSV"; the thesis's §7.4 simulation study).
 //!
 //! ```text
 //! robocal simulate --preset ys100 --poses 30 --noise-mm 0.01 --seed 1 --out q1.csv \
@@ -8,7 +8,7 @@
 //!     [--tracker "rx,ry,rz,x,y,z"]
 //! ```
 //!
-//! - The truth defaults to `table-7-1` (`sim::ys100_table_7_1`, seed Tables 7.1/7.2)
+//! - The truth defaults to `table-7-1` (`sim::ys100_table_7_1`, thesis Tables 7.1/7.2)
 //!   for the `ys100` preset and to `random` otherwise (`sim::perturb_geometry`:
 //!   uniform errors of ±error-mm / ±error-deg on every geometric parameter; the
 //!   compliance of the nominal model is kept unless `--stiffness` is given). A
@@ -22,8 +22,8 @@
 //!   readings in degrees.
 //! - The payload column is always written (default: the truth's payload mass).
 
-use crate::kinematics::fk;
 use crate::measure::{csv, SetRole};
+use crate::model::kinematics::fk;
 use crate::model::RobotModel;
 use crate::sim::{
     perturb_geometry, tracker_frame, try_random_configurations, ys100_table_7_1, ErrorMagnitudes,
@@ -80,7 +80,7 @@ pub struct SimulateArgs {
     /// (e.g. "0,1.5e6,1e6,1.2e6,1e6,0"); replaces the truth's compliance.
     #[arg(long)]
     pub stiffness: Option<String>,
-    /// Unmodelled: cubic spring term k2 [N·m/rad³] per joint (seed eq. 7.3).
+    /// Unmodelled: cubic spring term k2 [N·m/rad³] per joint (thesis eq. 7.3).
     #[arg(long)]
     pub nonlinear_k2: Option<String>,
     /// Unmodelled: gear transmission error "amplitude_deg,harmonic".
@@ -133,7 +133,7 @@ fn truth_model(a: &SimulateArgs, nominal: &RobotModel) -> anyhow::Result<(RobotM
         "table-7-1" | "table_7_1" | "table7.1" => {
             if !is_ys100 {
                 bail!(
-                    "--truth-from table-7-1 is the seed's simulated YS100 and needs --preset ys100 (got {})",
+                    "--truth-from table-7-1 is the thesis's simulated YS100 and needs --preset ys100 (got {})",
                     a.preset
                 );
             }
@@ -290,7 +290,7 @@ pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
                 + (p.z - r.xyz_mm[2]).powi(2))
             .sqrt())
         })
-        .collect::<Result<_, crate::kinematics::KinematicsError>>()?;
+        .collect::<Result<_, crate::model::kinematics::KinematicsError>>()?;
     let mean = errs.iter().sum::<f64>() / errs.len() as f64;
     let max = errs.iter().fold(0.0_f64, |m, e| m.max(*e));
 

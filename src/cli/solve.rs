@@ -21,14 +21,14 @@
 //! targets are poses in that work object (`core::cell`).
 
 use super::model_files::load_compensated;
-use crate::cell::{Cell, CellDescription, CellRef, CellSolver};
-use crate::csv_text::dialect_from_names;
-use crate::ik::targets_csv::CONVENTION_COLUMNS;
-use crate::ik::{
+use crate::measure::csv_text::dialect_from_names;
+use crate::model::orientation::OrientationConvention;
+use crate::solve::cell::{Cell, CellDescription, CellRef, CellSolver};
+use crate::solve::ik::targets_csv::CONVENTION_COLUMNS;
+use crate::solve::ik::{
     parse_targets_csv, results_csv, Configuration, IkSettings, SolveOptions, TargetFrame,
     TargetResult,
 };
-use crate::model::orientation::OrientationConvention;
 use anyhow::{bail, Context};
 use clap::{Args, ValueEnum};
 use serde_json::json;

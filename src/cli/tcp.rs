@@ -8,9 +8,9 @@
 //! (`fitted: false`, `reason`, `message`, …).
 
 use super::model_files::load_compensated;
-use crate::cell::file::CellDescription;
-use crate::cell::tcp::{self, AxisRequest, Reading, TcpMethod, ToolRequest};
-use crate::cell::CellRef;
+use crate::solve::cell::file::CellDescription;
+use crate::solve::cell::tcp::{self, AxisRequest, Reading, TcpMethod, ToolRequest};
+use crate::solve::cell::CellRef;
 use anyhow::{bail, Context};
 use clap::Args;
 use serde::Serialize;

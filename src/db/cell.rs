@@ -5,8 +5,8 @@
 
 use super::types::text_enum;
 use super::{on_pool, write_for_robot, Db, Json, StoreError};
-use crate::cell::file::PoseMmDeg;
-use crate::cell::LoadDescription;
+use crate::solve::cell::file::PoseMmDeg;
+use crate::solve::cell::LoadDescription;
 use sqlx::FromRow;
 
 /// Tool or work object.

@@ -9,7 +9,7 @@
 use super::input::{check_payload, int, page_body, present, present_ids, present_int, PageQuery};
 use super::robots::robot_list_page;
 use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState};
-use crate::identify::{CalibrationOptions, Method};
+use crate::calibrate::identify::{CalibrationOptions, Method};
 use crate::service::calibrations::{CalibrationRow, JobStatus, JobSummary};
 use crate::service::{self, jobs::StartCommand};
 use axum::extract::State;
@@ -365,7 +365,7 @@ pub fn routes() -> Vec<super::Route> {
 #[cfg(test)]
 mod tests {
     use super::DEFAULT_METHODS;
-    use crate::identify::METHODS;
+    use crate::calibrate::identify::METHODS;
     use serde_yaml::Value;
 
     fn strings(v: &Value) -> Vec<&str> {

@@ -7,10 +7,10 @@
 
 use super::input::{objects, present};
 use super::{ApiError, ApiJson, ApiPath, AppState};
-use crate::cell::file::PoseMmDeg;
-use crate::cell::LoadDescription;
 use crate::service;
 use crate::service::cell::{CellItemRow, CellKind, ItemFrame, NewCellItem};
+use crate::solve::cell::file::PoseMmDeg;
+use crate::solve::cell::LoadDescription;
 use axum::extract::State;
 use axum::http::StatusCode;
 use axum::response::{IntoResponse, Response};

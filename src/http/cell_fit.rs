@@ -11,9 +11,9 @@
 use super::cell::{check_item_name, ItemOut, CELL_NUMBER_MAX};
 use super::input::{objects, present, Int};
 use super::{ApiError, ApiJson, ApiPath, AppState};
-use crate::cell::tcp::{AxisRequest, FitError, Reading, TcpMethod, ToolRequest, WoPoint};
 use crate::service;
 use crate::service::cell_fit::{FitTarget, Fitted};
+use crate::solve::cell::tcp::{AxisRequest, FitError, Reading, TcpMethod, ToolRequest, WoPoint};
 use axum::extract::State;
 use axum::http::StatusCode;
 use axum::response::{IntoResponse, Response};

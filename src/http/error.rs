@@ -51,7 +51,7 @@ pub enum ApiError {
     Unprocessable(String),
     /// 422 with `file`, `line` and `column`: a robot program that cannot be parsed.
     #[error("{0}")]
-    Unparsable(crate::program::ParseError),
+    Unparsable(crate::solve::program::ParseError),
     /// 431: the request head is too large (answered for the HTTP parser).
     #[error("{0}")]
     HeadersTooLarge(String),
@@ -221,22 +221,22 @@ impl From<crate::service::ServiceError> for ApiError {
 }
 
 /// A delimiter or decimal separator option that names none (422).
-impl From<crate::csv_text::DialectError> for ApiError {
-    fn from(e: crate::csv_text::DialectError) -> Self {
+impl From<crate::measure::csv_text::DialectError> for ApiError {
+    fn from(e: crate::measure::csv_text::DialectError) -> Self {
         ApiError::Unprocessable(e.to_string())
     }
 }
 
 /// A `branch` option that is not a configuration branch (422).
-impl From<crate::ik::BranchError> for ApiError {
-    fn from(e: crate::ik::BranchError) -> Self {
+impl From<crate::solve::ik::BranchError> for ApiError {
+    fn from(e: crate::solve::ik::BranchError) -> Self {
         ApiError::Unprocessable(format!("`branch`: {e}"))
     }
 }
 
 /// A targets file whose header cannot be read (422, naming the line).
-impl From<crate::ik::TargetsCsvError> for ApiError {
-    fn from(e: crate::ik::TargetsCsvError) -> Self {
+impl From<crate::solve::ik::TargetsCsvError> for ApiError {
+    fn from(e: crate::solve::ik::TargetsCsvError) -> Self {
         ApiError::Unprocessable(format!("targets CSV: {e}"))
     }
 }

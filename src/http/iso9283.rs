@@ -9,7 +9,7 @@ use crate::service;
 use crate::service::iso9283::Iso9283Test;
 use axum::extract::State;
 use axum::response::{IntoResponse, Response};
-use robocal_core::iso9283::Iso9283Figures;
+use robocal_core::check::iso9283::Iso9283Figures;
 use serde::{Deserialize, Serialize};
 
 /// One test of the request.

@@ -16,13 +16,13 @@
 use super::input::{check_payload, objects, present};
 use super::solve::{convention, model_choice, target_id, ItemRef, VersionSelector};
 use super::{ApiError, ApiJson, ApiPath, AppState};
-use crate::cell::accuracy::ToolAccuracy;
-use crate::cell::joints_csv::JointReading;
-use crate::cell::PoseOut;
-use crate::ik::TargetFrame;
 use crate::service;
 use crate::service::cell::CellKind;
 use crate::service::predict::PredictCommand;
+use crate::solve::cell::accuracy::ToolAccuracy;
+use crate::solve::cell::joints_csv::JointReading;
+use crate::solve::cell::PoseOut;
+use crate::solve::ik::TargetFrame;
 use axum::extract::State;
 use axum::response::{IntoResponse, Response};
 use serde::{Deserialize, Serialize};

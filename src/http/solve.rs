@@ -20,15 +20,15 @@
 use super::error::{content_type, json_content_type};
 use super::input::{check_payload, from_json_object, object_or_null, objects, present, Int};
 use super::{ApiError, ApiPath, ApiQuery, AppState};
-use crate::csv_text::{dialect_from_names, Dialect};
-use crate::ik::{
-    parse_targets_csv, results_csv, Configuration, JointJump, SolveOptions, TargetFrame,
-    TargetInput, TargetResult,
-};
+use crate::measure::csv_text::{dialect_from_names, Dialect};
 use crate::model::orientation::OrientationConvention;
 use crate::service;
 use crate::service::cell::CellKind;
 use crate::service::solve::{ItemChoice, ModelChoice, SolveCommand, SolveOutcome, Targets};
+use crate::solve::ik::{
+    parse_targets_csv, results_csv, Configuration, JointJump, SolveOptions, TargetFrame,
+    TargetInput, TargetResult,
+};
 use axum::body::Bytes;
 use axum::extract::rejection::BytesRejection;
 use axum::extract::State;

@@ -2,13 +2,13 @@
 //! activate, roll back to the previously active version, download the model
 //! file (`robocal-calibrated-model/2`, loadable by `robocal solve --model`),
 //! export it for other tools (`export?format=urdf|dh-csv|mdh-csv|json`, the
-//! text of `crate::export`).
+//! text of `crate::model::export`).
 
 use super::input::{page_body, PageQuery};
 use super::robots::robot_list_page;
 use super::{ApiError, ApiPath, ApiQuery, AppState};
-use crate::compensate::CalibratedModelFile;
-use crate::export::{export, ExportFormat, ExportSource};
+use crate::calibrate::compensate::CalibratedModelFile;
+use crate::model::export::{export, ExportFormat, ExportSource};
 use crate::service;
 use crate::service::versions::VersionRow;
 use axum::extract::State;
@@ -112,7 +112,7 @@ pub async fn export_version(
     let format: ExportFormat = q
         .format
         .parse()
-        .map_err(|e: crate::export::ExportError| ApiError::BadRequest(e.to_string()))?;
+        .map_err(|e: crate::model::export::ExportError| ApiError::BadRequest(e.to_string()))?;
     let (row, text) = service::versions::with_model(&state, robot_id, v).await?;
     let file = CalibratedModelFile::from_json(&text)
         .map_err(|e| ApiError::Internal(format!("stored model of version {v}: {e}")))?;

@@ -1,7 +1,7 @@
 //! Number formatting and method names shared by the HTML report and the
 //! command line's text report.
 
-use crate::identify::Method;
+use crate::calibrate::identify::Method;
 
 /// Display name of a calibration method (`km` → `KM`, the table's label), the
 /// same in the command line's table and the HTML report.

@@ -6,7 +6,7 @@
 
 use super::{page_head, STYLE};
 use maud::{html, Markup, DOCTYPE};
-use robocal_core::iso9283::Iso9283Figures;
+use robocal_core::check::iso9283::Iso9283Figures;
 
 /// Four decimals, as the text table prints them.
 fn mm(x: f64) -> String {

@@ -2,7 +2,7 @@
 //! SVG, one small inline script that sorts the per-pose table; no external
 //! asset), served at `GET /v1/robots/{id}/calibrations/{cid}/report`.
 //!
-//! Input: the stored JSON of [`crate::identify::CalibrationReport`], read into
+//! Input: the stored JSON of [`crate::calibrate::identify::CalibrationReport`], read into
 //! the typed, lenient [`view::ReportView`]. Output sections, in order: header
 //! with the best method (smallest validation mean, stated on the page) and the
 //! report's format version when it is not the current one; warnings and failed

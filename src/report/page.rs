@@ -35,7 +35,7 @@ impl<'a> Model<'a> {
     }
 }
 
-/// Nominal first, then the methods in the seed's order.
+/// Nominal first, then the methods in the thesis's order.
 pub fn models(r: &ReportView) -> Vec<Model<'_>> {
     let mut v = vec![Model {
         key: "nominal",
@@ -88,7 +88,7 @@ pub fn header(title: &str, r: &ReportView, models: &[Model]) -> Markup {
                 }
                 Format::Newer(v) => p.alert.warn {
                     "This report is in format " (v) ", newer than this robocal reads ("
-                    (crate::identify::REPORT_FORMAT_VERSION) "); the parts it understands are shown."
+                    (crate::calibrate::identify::REPORT_FORMAT_VERSION) "); the parts it understands are shown."
                 }
             }
             (cards(r, models, best))
@@ -351,7 +351,7 @@ pub fn source<'a>(
     r: &'a ReportView,
     set: &str,
     i: usize,
-) -> Option<&'a crate::identify::PoseSource> {
+) -> Option<&'a crate::calibrate::identify::PoseSource> {
     let p = r.pose_sources.as_ref()?;
     match set {
         "identification" => p.identification.get(i),

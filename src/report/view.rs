@@ -1,5 +1,5 @@
 //! The typed view of a stored calibration report: what the page reads from the
-//! JSON form of [`crate::identify::CalibrationReport`].
+//! JSON form of [`crate::calibrate::identify::CalibrationReport`].
 //!
 //! Deserialisation is lenient on purpose: a stored report outlives the code
 //! that wrote it. Every field has a default, a non-finite number (written as
@@ -11,8 +11,8 @@
 //! compensator training pool, the compensators and `auto`'s choice; 4 the
 //! orientation errors of sets that measured orientation.
 
-use crate::identify::identifiability::IdentifiabilityReport;
-use crate::identify::{
+use crate::calibrate::identify::identifiability::IdentifiabilityReport;
+use crate::calibrate::identify::{
     FailedMethod, LmReport, Method, MethodWarning, ParamEstimate, PoseSources,
     REPORT_FORMAT_VERSION,
 };
@@ -323,7 +323,7 @@ impl ReportView {
         }
     }
 
-    /// The methods in the seed's order ([`Method::SEED`]: KM, SKCM, SKCM-C),
+    /// The methods in the thesis's order ([`Method::SEED`]: KM, SKCM, SKCM-C),
     /// then any other by name.
     pub fn ordered_methods(&self) -> Vec<(&str, &MethodView)> {
         let rank = |k: &str| {
@@ -338,7 +338,7 @@ impl ReportView {
         v
     }
 
-    /// The best method, as [`crate::identify::CalibrationReport::best_method`]:
+    /// The best method, as [`crate::calibrate::identify::CalibrationReport::best_method`]:
     /// smallest validation mean, identification mean without a validation set.
     pub fn best(&self) -> Option<&str> {
         self.methods

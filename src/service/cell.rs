@@ -3,9 +3,9 @@
 //! program filtering. Poses are in mm and degrees here (`PoseMmDeg`).
 
 use super::{robots, AppState, ServiceError};
-use crate::cell::file::{CellDescription, ToolDescription, WorkObjectDescription};
-use crate::cell::{Cell, WorkObjectFrame};
 pub use crate::db::{CellItemRow, CellKind, CellPut, ItemFrame, NewCellItem};
+use crate::solve::cell::file::{CellDescription, ToolDescription, WorkObjectDescription};
+use crate::solve::cell::{Cell, WorkObjectFrame};
 use std::collections::HashSet;
 
 /// A robot's tools or work objects by name (`NotFound` for a missing robot).

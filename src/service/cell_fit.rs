@@ -9,10 +9,10 @@
 
 use super::solve::{chosen_model, ModelChoice};
 use super::{cell, AppState, ServiceError};
-use crate::cell::tcp::{self as core_tcp, FitError, Reading, ToolFit, ToolRequest};
-use crate::cell::work_object_fit::WorkObjectFit;
-use crate::cell::CellRef;
 use crate::db::{CellKind, CellPut, ItemFrame, NewCellItem};
+use crate::solve::cell::tcp::{self as core_tcp, FitError, Reading, ToolFit, ToolRequest};
+use crate::solve::cell::work_object_fit::WorkObjectFit;
+use crate::solve::cell::CellRef;
 
 /// What a fit asks beyond its readings.
 #[derive(Debug, Clone)]
@@ -45,7 +45,7 @@ pub enum Fitted<F> {
 async fn calibrated(
     state: &AppState,
     t: &FitTarget,
-) -> Result<(crate::compensate::CompensatedModel, i64), ServiceError> {
+) -> Result<(crate::calibrate::compensate::CompensatedModel, i64), ServiceError> {
     let choice = match t.version {
         Some(v) => ModelChoice::Version(v),
         None => {
@@ -71,7 +71,7 @@ async fn number_of(
     state: &AppState,
     t: &FitTarget,
     kind: CellKind,
-) -> Result<(Option<i64>, Option<crate::cell::LoadDescription>), ServiceError> {
+) -> Result<(Option<i64>, Option<crate::solve::cell::LoadDescription>), ServiceError> {
     match state.db().cell_item(t.robot_id, kind, &t.name).await? {
         Some(row) => Ok((t.number.or(row.number), row.load_json.map(|j| j.0))),
         None => Ok((t.number, None)),

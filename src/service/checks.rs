@@ -3,7 +3,7 @@
 //! robot's status from its latest check and its thresholds.
 
 use super::{robots, versions, AppState, ServiceError};
-use crate::compensate::CalibratedModelFile;
+use crate::calibrate::compensate::CalibratedModelFile;
 pub use crate::db::CheckRow;
 use crate::db::{Listing, NewCheck};
 use robocal_core::check::{

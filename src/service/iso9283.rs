@@ -3,8 +3,8 @@
 //! cycle give AP, RP, APa/b/c, ±RPa/b/c, AD and RD. Nothing is stored.
 
 use super::ServiceError;
-use robocal_core::iso9283::csv::{read_cycles_csv, read_plan_csv};
-use robocal_core::iso9283::{evaluate, Iso9283Figures};
+use robocal_core::check::iso9283::csv::{read_cycles_csv, read_plan_csv};
+use robocal_core::check::iso9283::{evaluate, Iso9283Figures};
 
 /// Most tests in one request (a nominal and a filtered run side by side).
 pub const TESTS_MAX: usize = 8;
@@ -33,7 +33,7 @@ pub async fn figures(
         tests
             .into_iter()
             .map(|t| {
-                let fail = |what: &str, e: robocal_core::iso9283::Iso9283Error| {
+                let fail = |what: &str, e: robocal_core::check::iso9283::Iso9283Error| {
                     ServiceError::Invalid(format!("test `{}`, {what}: {e}", t.label))
                 };
                 let commanded = read_plan_csv(&t.plan_csv).map_err(|e| fail("plan_csv", e))?;

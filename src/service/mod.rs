@@ -59,7 +59,7 @@ pub enum ServiceError {
     Store(#[from] StoreError),
     /// A robot program that cannot be parsed: file, line and column.
     #[error("{0}")]
-    Unparsable(#[from] crate::program::ParseError),
+    Unparsable(#[from] crate::solve::program::ParseError),
     /// A bug or corrupt stored data; logged, never shown to the client.
     #[error("{0}")]
     Internal(String),

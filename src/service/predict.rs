@@ -10,15 +10,17 @@
 
 use super::solve::{choose_version, resolve, ItemChoice, ModelChoice};
 use super::{AppState, ServiceError};
-use crate::cell::accuracy::{
+use crate::calibrate::compensate::{CalibratedModelFile, CompensatedModel};
+use crate::db::{CellKind, ItemFrame};
+use crate::model::RobotModel;
+use crate::solve::cell::accuracy::{
     measurement_tool_accuracy, tool_accuracy, ToolAccuracy, ValidationEvidence,
 };
-use crate::cell::joints_csv::JointReading;
-use crate::cell::{Forward, PredictError, PredictFrame, Predicted, WorkObject, WorkObjectFrame};
-use crate::compensate::{CalibratedModelFile, CompensatedModel};
-use crate::db::{CellKind, ItemFrame};
-use crate::ik::TargetFrame;
-use crate::model::RobotModel;
+use crate::solve::cell::joints_csv::JointReading;
+use crate::solve::cell::{
+    Forward, PredictError, PredictFrame, Predicted, WorkObject, WorkObjectFrame,
+};
+use crate::solve::ik::TargetFrame;
 
 /// A prediction, in domain terms.
 #[derive(Debug, Clone)]
@@ -127,7 +129,7 @@ pub async fn predict(
         Some(choice) => Some(resolve(state, cmd.robot_id, CellKind::Tool, choice).await?),
         None => None,
     };
-    let probe = crate::kinematics::chain::tool_pose(&model.calibrated);
+    let probe = crate::model::kinematics::chain::tool_pose(&model.calibrated);
     let accuracy = match &tool {
         Some(t) => tool_accuracy(evidence.as_ref(), &probe, &t.pose),
         None => measurement_tool_accuracy(evidence.as_ref()),

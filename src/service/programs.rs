@@ -8,8 +8,8 @@
 use super::solve::{chosen_model, ModelChoice};
 use super::waiting::Waiting;
 use super::{AppState, ServiceError};
-use crate::ik::IkSettings;
-use crate::program::{
+use crate::solve::ik::IkSettings;
+use crate::solve::program::{
     filter_with, FilterControl, FilterError, FilterOutput, Language, ProgramFile,
 };
 
@@ -121,10 +121,10 @@ pub async fn export_cell(
     if let Some(p) = payload_kg {
         m.payload_kg = p;
     }
-    let (tools, frames) = crate::cell::export::controller_data(&cell, &m);
+    let (tools, frames) = crate::solve::cell::export::controller_data(&cell, &m);
     Ok(CellExport {
         version: chosen.version,
         method: chosen.method,
-        text: crate::cell::export::controller_text(language, &tools, &frames),
+        text: crate::solve::cell::export::controller_text(language, &tools, &frames),
     })
 }

@@ -13,7 +13,7 @@
 
 use super::checks::{self, conflict};
 use super::{versions, AppState, ServiceError};
-use crate::compensate::CalibratedModelFile;
+use crate::calibrate::compensate::CalibratedModelFile;
 use crate::db::{NewVersion, VersionRow};
 use robocal_core::check::{reregister as refit, ReregisterError};
 use serde_json::json;

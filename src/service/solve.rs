@@ -20,13 +20,13 @@
 use super::limits::SMALL_SOLVE_MAX;
 use super::waiting::{Waiting, WaitingFlag};
 use super::{AppState, ServiceError};
-use crate::cell::file::PoseMmDeg;
-use crate::cell::{CellSolver, Load, LoadDescription, Tool, WorkObject, WorkObjectFrame};
-use crate::compensate::{CalibratedModelFile, CompensatedModel};
+use crate::calibrate::compensate::{CalibratedModelFile, CompensatedModel};
 use crate::db::{CellKind, ItemFrame, NewCellItem};
-use crate::ik::TargetFrame;
-use crate::ik::{IkSettings, IkSolver, SolveOptions, TargetInput, TargetResult, TargetsCsv};
 use crate::model::{Pose, RobotModel};
+use crate::solve::cell::file::PoseMmDeg;
+use crate::solve::cell::{CellSolver, Load, LoadDescription, Tool, WorkObject, WorkObjectFrame};
+use crate::solve::ik::TargetFrame;
+use crate::solve::ik::{IkSettings, IkSolver, SolveOptions, TargetInput, TargetResult, TargetsCsv};
 use std::sync::Arc;
 
 /// Which model to solve with.

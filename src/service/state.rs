@@ -4,8 +4,8 @@
 
 use super::limits::{Admission, Limits, Ticket, SMALL_SOLVE_MAX};
 use super::ServiceError;
-use crate::cell::CellSolver;
 use crate::db::Db;
+use crate::solve::cell::CellSolver;
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, Weak};

@@ -23,7 +23,7 @@ fn program(n: usize) -> serde_json::Value {
         .iter()
         .map(|l| l.limits[0] + 0.4 * (l.limits[1] - l.limits[0]) + 0.1)
         .collect();
-    let p = robocal::kinematics::fk(&bare, &q).unwrap();
+    let p = robocal::model::kinematics::fk(&bare, &q).unwrap();
     let abc = rotation_to(OrientationConvention::KukaAbc, &p.r);
     let line = format!(
         "LIN {{X {:.3},Y {:.3},Z {:.3},A {:.4},B {:.4},C {:.4}}}\n",

@@ -6,12 +6,12 @@
 use crate::support::*;
 use axum::http::StatusCode;
 use clap::Parser;
-use robocal::cell::{CellDescription, CellOptions, CellSolver};
+use robocal::calibrate::compensate::CalibratedModelFile;
 use robocal::cli::filter::{filter_to_string, FilterArgs};
-use robocal::compensate::CalibratedModelFile;
-use robocal::ik::IkSettings;
 use robocal::model::orientation::{rotation_from, OrientationConvention};
 use robocal::model::Pose;
+use robocal::solve::cell::{CellDescription, CellOptions, CellSolver};
+use robocal::solve::ik::IkSettings;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -396,7 +396,7 @@ fn torch(cell: &Value) -> Pose {
         .unwrap()
         .to_cell()
         .unwrap();
-    cell.tool(&robocal::cell::CellRef::Name("torch".into()))
+    cell.tool(&robocal::solve::cell::CellRef::Name("torch".into()))
         .unwrap()
         .tcp
 }
@@ -404,7 +404,7 @@ fn torch(cell: &Value) -> Pose {
 /// The cell options of the branch the solves below ask for.
 fn front_up_noflip() -> CellOptions {
     CellOptions {
-        branch: Some(robocal::ik::Configuration::parse("front,up,noflip").unwrap()),
+        branch: Some(robocal::solve::ik::Configuration::parse("front,up,noflip").unwrap()),
         seed: None,
     }
 }
@@ -429,7 +429,7 @@ async fn a_solve_with_a_tool_and_a_work_object_is_the_cell_solvers() {
         .to_cell()
         .unwrap();
     let wobj = cell
-        .work_object(&robocal::cell::CellRef::Number(2))
+        .work_object(&robocal::solve::cell::CellRef::Number(2))
         .unwrap();
     let solver = CellSolver::new(&model, &torch(&cell_file()), IkSettings::default());
 

@@ -8,11 +8,11 @@
 use crate::support::*;
 use axum::http::StatusCode;
 use nalgebra::{Rotation3, Unit, Vector3};
-use robocal::cell::{CellOptions, CellSolver, WorkObject};
-use robocal::compensate::{CalibratedModelFile, CompensatedModel};
-use robocal::ik::IkSettings;
+use robocal::calibrate::compensate::{CalibratedModelFile, CompensatedModel};
 use robocal::model::pose::rpy_matrix;
 use robocal::model::Pose;
+use robocal::solve::cell::{CellOptions, CellSolver, WorkObject};
+use robocal::solve::ik::IkSettings;
 use serde_json::{json, Value};
 use std::time::Duration;
 

@@ -2,8 +2,8 @@ use crate::support::*;
 use axum::http::{header, StatusCode};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal::compensate::CalibratedModelFile;
-use robocal::kinematics::fk;
+use robocal::calibrate::compensate::CalibratedModelFile;
+use robocal::model::kinematics::fk;
 use robocal::model::orientation::{rotation_to, OrientationConvention};
 use robocal::model::preset;
 use robocal::sim::{try_random_configurations, PoseFilter};
@@ -229,11 +229,12 @@ async fn quickstart_flow_calibrate_version_and_solve() {
         assert_eq!(r.status, StatusCode::OK, "{format}: {}", r.text());
         assert_eq!(r.content_type, ctype);
         assert_safe_to_open(&r, format);
-        let source = robocal::export::ExportSource {
+        let source = robocal::model::export::ExportSource {
             robot: &file.robot,
             method: "skcm",
         };
-        let want = robocal::export::export(&model, &source, format.parse().unwrap()).unwrap();
+        let want =
+            robocal::model::export::export(&model, &source, format.parse().unwrap()).unwrap();
         assert_eq!(r.text(), want, "{format}");
     }
     // Standard DH: exact, or refused naming the Hayati twists.

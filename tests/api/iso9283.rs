@@ -36,7 +36,7 @@ fn plan_and_cycles(dir: &std::path::Path) -> (String, String) {
     };
     make(&c).unwrap();
     let plan = std::fs::read_to_string(&plan_path).unwrap();
-    let commanded = robocal_core::iso9283::csv::read_plan_csv(&plan).unwrap();
+    let commanded = robocal_core::check::iso9283::csv::read_plan_csv(&plan).unwrap();
     let mut cycles = String::from("pose,cycle,x_mm,y_mm,z_mm\n");
     for c in &commanded {
         for (k, dx) in [0.0, 2.0, 4.0].iter().enumerate() {

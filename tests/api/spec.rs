@@ -5,7 +5,7 @@
 
 use crate::support::*;
 use axum::http::StatusCode;
-use robocal::kinematics::fk;
+use robocal::model::kinematics::fk;
 use robocal::model::orientation::{rotation_to, OrientationConvention};
 use robocal::model::preset;
 use serde_json::{json, Value};

@@ -478,7 +478,7 @@ impl TestApp {
     }
 }
 
-/// The simulated YS100 of the seed's §7.4 (Table 7.1 + 7.2), measured by a
+/// The simulated YS100 of the thesis's §7.4 (Table 7.1 + 7.2), measured by a
 /// tracker 3.24 m away and turned 90°.
 pub(crate) fn truth() -> TrueRobot {
     let mut t = TrueRobot::new(ys100_table_7_1());

@@ -3,7 +3,7 @@
 //!
 //! - Per pose: the position error `|p_measured − p_predicted|` [mm], the
 //!   prediction that of the compensated model in its measurement (cell) frame
-//!   (`CompensatedModel::predict`, seed eq. 2.1 with the joint maps and the
+//!   (`CompensatedModel::predict`, thesis eq. 2.1 with the joint maps and the
 //!   compensator), and, where the row has an orientation, the rotation angle
 //!   between measured and predicted orientation [deg].
 //! - Statistics: mean, p95 and max (`stats::ErrorStats`).
@@ -23,6 +23,7 @@
 //!
 //! Units: mm and degrees in the results, SI inside.
 
+pub mod iso9283;
 mod reregister;
 mod score;
 

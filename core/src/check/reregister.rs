@@ -5,10 +5,10 @@
 //!
 //! Frames and units: `y_i` measured points in the measurement (tracker)
 //! frame [m]; `F_i` the compensated model's flange pose in its registered
-//! base frame at the row's joints and payload (seed eq. 2.1 with the joint
+//! base frame at the row's joints and payload (thesis eq. 2.1 with the joint
 //! maps, the gravity deflection with the payload at its flange point, and
 //! the compensator's correction); `t` the tool point in the flange frame.
-//! The model (seed eq. 2.3's residual with only these unknowns):
+//! The model (thesis eq. 2.3's residual with only these unknowns):
 //!
 //! `R_b·y_i + p_b = F_i.R·t + F_i.p`, with `(R_b, p_b)` measurement → base.
 //!
@@ -23,13 +23,13 @@
 //! too: the chordal mean of `F_i.Rᵀ·R_b·R_i` projected on SO(3).
 
 use super::score::{predicted_row, AngleStats, CheckError};
-use crate::cell::with_tool;
-use crate::compensate::CompensatedModel;
-use crate::identify::registration::register;
-use crate::kinematics::chain::tool_pose;
+use crate::calibrate::compensate::CompensatedModel;
+use crate::calibrate::identify::registration::register;
 use crate::measure::MeasuredPose;
+use crate::model::kinematics::chain::tool_pose;
 use crate::model::orientation::rotation_angle_between;
 use crate::model::Pose;
+use crate::solve::cell::with_tool;
 use crate::stats::ErrorStats;
 use nalgebra::{DMatrix, DVector, Matrix3, Rotation3, Vector3};
 use serde::Serialize;

@@ -1,8 +1,8 @@
 //! Scoring a check set against a model (see [`super`] for the conventions).
 
 use super::{CheckStatus, CheckThresholds};
-use crate::compensate::CompensatedModel;
-use crate::identify::registration::register;
+use crate::calibrate::compensate::CompensatedModel;
+use crate::calibrate::identify::registration::register;
 use crate::measure::{MeasuredPose, Measurement};
 use crate::model::orientation::rotation_angle_between;
 use crate::model::Pose;

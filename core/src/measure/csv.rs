@@ -28,7 +28,7 @@ use super::convention::{MeasuredOrientation, OrientationValueError};
 #[cfg(test)]
 use super::RowStd;
 use super::{MeasuredPose, SetRole};
-use crate::csv_text::{self, short_text, Dialect, TextError};
+use crate::measure::csv_text::{self, short_text, Dialect, TextError};
 use std::fmt::Write as _;
 
 /// Maximum joint count of a CSV row.

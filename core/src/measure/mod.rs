@@ -18,6 +18,7 @@ use serde::{Deserialize, Serialize};
 
 pub mod convention;
 pub mod csv;
+pub mod csv_text;
 
 /// Role of a measurement in the calibration (docs/design.md "Data roles").
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]

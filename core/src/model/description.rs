@@ -3,7 +3,7 @@
 //! Boundary units: millimetres, degrees, kilograms, m/s², compliance in
 //! rad/(N·m). Two conventions for the joint rows:
 //! - `"modified"` (default): row i holds Craig's α_{i-1}, a_{i-1}, d_i, θ_i offset
-//!   (seed eq. 4.1); row 1 also takes the base's `b_mm` and `beta_deg` (eq. 4.3);
+//!   (thesis eq. 4.1); row 1 also takes the base's `b_mm` and `beta_deg` (eq. 4.3);
 //!   `parallel: true` (auto-detected when omitted) adds Hayati's β_{i-1} (eq. 4.6).
 //! - `"standard"`: distal DH rows a_i, α_i, d_i, θ_i offset, imported exactly by
 //!   regrouping `Tx(a)·Rx(α) = Rx(α)·Tx(a)`; the last row's `Rx(α_n)·Tx(a_n)` moves

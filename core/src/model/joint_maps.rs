@@ -1,4 +1,4 @@
-//! Per-joint angle error maps (beyond the seed): the angle error of joint i as
+//! Per-joint angle error maps (beyond the thesis): the angle error of joint i as
 //! a fine function of its own angle, `Δθ_i = f_i(q_i)` (transmission and
 //! encoder errors), added to the joint before forward kinematics:
 //! `p = FK(q + c∘τ(q) + f(q))` (docs/design.md "Joint angle error maps").

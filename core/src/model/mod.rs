@@ -3,8 +3,10 @@
 
 pub mod bounds;
 pub mod description;
+pub mod export;
 pub mod joint_map_table;
 pub mod joint_maps;
+pub mod kinematics;
 pub mod orientation;
 pub mod params;
 pub mod pose;

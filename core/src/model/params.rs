@@ -4,7 +4,7 @@
 //! parameters a model has, in a fixed order (base, links in chain order, tool,
 //! closed loop, compliance). Optimisers work on `Vec<f64>` values plus a mask of
 //! which entries are free. Units are SI: lengths m, angles rad, compliance
-//! rad/(N·m). Names follow the seed's tables: `alpha0 a0 beta0 b0 d1 theta1`,
+//! rad/(N·m). Names follow the thesis's tables: `alpha0 a0 beta0 b0 d1 theta1`,
 //! `alpha1 a1 d2 theta2`, `alpha2 a2 beta2 d3 theta3`, …, `tool_x`, `l4`, `c2`.
 
 use super::robot::RobotModel;
@@ -112,7 +112,7 @@ impl ParamId {
         )
     }
 
-    /// The seed's name of the parameter.
+    /// The thesis's name of the parameter.
     pub fn name(&self) -> String {
         use ParamKind::*;
         let k = self.link;

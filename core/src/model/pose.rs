@@ -3,7 +3,7 @@
 //! Frames: a `Pose` maps coordinates expressed in a child frame into its parent
 //! frame, `x_parent = r * x_child + p`. Units: metres and radians (SI), as every
 //! internal quantity in robocal. The elementary transforms `Rot(x, ·)`, `Tr(x, ·)`,
-//! … are those of the seed's eq. 4.1 (Craig's modified DH) and are applied by
+//! … are those of the thesis's eq. 4.1 (Craig's modified DH) and are applied by
 //! post-multiplication, which keeps forward kinematics allocation-free.
 
 pub use super::orientation::rotation_log;

@@ -1,9 +1,9 @@
-//! Built-in robot presets. Values the seed does not give are stated as
+//! Built-in robot presets. Values the thesis does not give are stated as
 //! assumptions inside each model (`RobotModel::assumptions`).
 //!
-//! - `ys100`: Hyundai YS100, seed Table 2.1 (modified DH, β on joint 3), link
+//! - `ys100`: Hyundai YS100, thesis Table 2.1 (modified DH, β on joint 3), link
 //!   masses eq. 3.13, payload 110 kg.
-//! - `hh800`: Hyundai HH800, seed Table 4.1 with the PQRS parallelogram, payload 745 kg.
+//! - `hh800`: Hyundai HH800, thesis Table 4.1 with the PQRS parallelogram, payload 745 kg.
 //! - `ur5`, `ur10`: Universal Robots, standard DH imported by regrouping.
 
 use super::description::{
@@ -80,8 +80,8 @@ fn ys100() -> ModelDescription {
         },
         gravity_mps2: [0.0, 0.0, -G0],
         assumptions: vec![
-            "geometry: seed Table 2.1 (its d column is labelled deg; read as metres)".into(),
-            "link masses: seed eq. 3.13; payload 110 kg".into(),
+            "geometry: thesis Table 2.1 (its d column is labelled deg; read as metres)".into(),
+            "link masses: thesis eq. 3.13; payload 110 kg".into(),
             "centres of mass (not in the seed): each link's CoM halfway between its frame origin and the next frame origin at zero joints; link 6 on its axis".into(),
             "payload CoM (not in the seed): 250 mm out along the flange axis, i.e. (-200, -50, -250) mm in the tool frame".into(),
             "joint limits (not in the seed): J1 ±180, J2 20..160, J3 -110..90, J4 ±180, J5 ±125, J6 ±180 deg".into(),
@@ -129,11 +129,11 @@ fn hh800() -> ModelDescription {
         },
         gravity_mps2: [0.0, 0.0, -G0],
         assumptions: vec![
-            "geometry and loop lengths: seed Table 4.1; L3 fixed for scale".into(),
-            "joint 3 is the crank motor; the passive joint θ3p = φ − θ2 − ξ with ξ = -90° so that θ2 = 90°, θ3 = 0 gives θ3p = 0 (the seed prints ξ = 90° with its own angle references)".into(),
+            "geometry and loop lengths: thesis Table 4.1; L3 fixed for scale".into(),
+            "joint 3 is the crank motor; the passive joint θ3p = φ − θ2 − ξ with ξ = -90° so that θ2 = 90°, θ3 = 0 gives θ3p = 0 (the thesis prints ξ = 90° with its own angle references)".into(),
             "link masses (not in the seed): 2500, 1200, 900, 500, 150, 60 kg; crank and rod masses neglected".into(),
             "centres of mass (not in the seed): halfway between consecutive frame origins at zero joints".into(),
-            "payload 745 kg (seed), CoM 300 mm out along the flange axis (assumed)".into(),
+            "payload 745 kg (thesis), CoM 300 mm out along the flange axis (assumed)".into(),
             "joint limits (not in the seed): J2 50..130, J3 -40..40 deg keep the parallelogram away from its flat singularity".into(),
         ],
         joint_maps: None,

@@ -1,4 +1,4 @@
-//! The robot model: an N-joint revolute chain in Craig's modified DH (seed eq. 4.1)
+//! The robot model: an N-joint revolute chain in Craig's modified DH (thesis eq. 4.1)
 //! with Hayati's twist β where consecutive axes are (nearly) parallel (eq. 4.6),
 //! a six-parameter base (eq. 4.3), a tool (eq. 4.4, extended to a full 6-D
 //! transform), an optional HH800-style closed loop (§4.2.1, eqs. 4.5, 4.10),
@@ -8,7 +8,7 @@
 //! Units: SI inside (metres, radians, kilograms, N·m, rad/(N·m)). The JSON
 //! description in `description.rs` speaks millimetres and degrees.
 //!
-//! Link transforms (link `k`, 0-based, maps frame `k-1` to frame `k`; the seed's
+//! Link transforms (link `k`, 0-based, maps frame `k-1` to frame `k`; the thesis's
 //! 1-based link `i = k + 1`):
 //! - base link (k = 0, eq. 4.3): `Tr(x,a0)·Tr(y,b0)·Tr(z,d1)·Rot(x,α0)·Rot(y,β0)·Rot(z,θ1)`
 //! - ordinary link: `Rot(x,α_{i-1})·Tr(x,a_{i-1})·Tr(z,d_i)·Rot(z,θ_i)`

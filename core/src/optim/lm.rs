@@ -1,6 +1,6 @@
 //! One Levenberg–Marquardt driver for robocal's least-squares problems: the
-//! identification fit (`identify::least_squares`, seed eqs. 2.3–2.4 and 2.8)
-//! and the MLP's backpropagation (`compensate::mlp::train`, seed ch. 4, MATLAB
+//! identification fit (`identify::least_squares`, thesis eqs. 2.3–2.4 and 2.8)
+//! and the MLP's backpropagation (`compensate::mlp::train`, thesis ch. 4, MATLAB
 //! `trainlm`).
 //!
 //! A problem ([`LeastSquaresProblem`]) gives the residuals `r = target −

@@ -1,4 +1,4 @@
-//! Teaching–learning-based optimisation (Rao et al.; seed ch. 7, eqs. 7.11–7.12,
+//! Teaching–learning-based optimisation (Rao et al.; thesis ch. 7, eqs. 7.11–7.12,
 //! and ch. 6 §6.3): a population of learners in a box; the teacher phase moves
 //! each learner toward the best one, `x' = x + r·(x_teacher − T_F·x_mean)` with
 //! `T_F ∈ {1, 2}` at random; the learner phase moves it toward (or away from) a
@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 /// TLBO settings.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TlboSettings {
-    /// Number of learners (the seed uses 50).
+    /// Number of learners (the thesis uses 50).
     pub population: usize,
     /// Number of generations (teacher + learner phase each).
     pub generations: usize,

@@ -3,7 +3,7 @@
 //! position, base frame, mm) and the tracker's line of sight.
 
 use super::{PlanError, PlanSettings, TrackerSight, WorkspaceBox};
-use crate::kinematics::fk;
+use crate::model::kinematics::fk;
 use crate::model::pose::Pose;
 use crate::model::RobotModel;
 use nalgebra::Vector3;

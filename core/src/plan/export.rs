@@ -4,9 +4,9 @@
 //! (`program::export::joint_program`).
 
 use super::MeasurementPlan;
-use crate::csv_text::{self, Dialect};
-use crate::program::export::joint_program;
-use crate::program::{Language, ProgramFile};
+use crate::measure::csv_text::{self, Dialect};
+use crate::solve::program::export::joint_program;
+use crate::solve::program::{Language, ProgramFile};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 

@@ -5,7 +5,7 @@
 //! frame).
 
 use super::PlanPoint;
-use crate::csv_text::{self, Dialect};
+use crate::measure::csv_text::{self, Dialect};
 use crate::measure::MeasuredPose;
 use serde::{Deserialize, Serialize};
 

@@ -139,7 +139,7 @@ pub fn make_plan(model: &RobotModel, s: &PlanSettings) -> Result<MeasurementPlan
         });
     }
     let gravity = predict::gravity_loads(model, &pool, payload_kg);
-    let q = crate::identify::pose_selection::choose_d_optimal(
+    let q = crate::calibrate::identify::pose_selection::choose_d_optimal(
         model, &pool, s.poses, payload_kg, gravity,
     );
     let predicted = predict::predict(model, &q, payload_kg, s.noise_mm, gravity)?;

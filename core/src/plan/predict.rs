@@ -11,10 +11,12 @@
 //! measurement frame does not alias (all but the base's, in practice).
 
 use super::PlanError;
-use crate::identify::checks::{fixed_params, gravity_problem, stacked_factor, stacked_jacobian};
-use crate::identify::identifiability::{analyse_factor, IdentifiabilitySettings};
-use crate::kinematics::fk;
+use crate::calibrate::identify::checks::{
+    fixed_params, gravity_problem, stacked_factor, stacked_jacobian,
+};
+use crate::calibrate::identify::identifiability::{analyse_factor, IdentifiabilitySettings};
 use crate::measure::Measurement;
+use crate::model::kinematics::fk;
 use crate::model::{ParamId, ParamKind, ParamLayout, RobotModel};
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};

@@ -3,10 +3,10 @@
 //! from an injected, seeded generator (`&mut impl Rng`, e.g.
 //! `rand_chacha::ChaCha8Rng::seed_from_u64(seed)` at the call site).
 //!
-//! The simulated position follows the seed's error model (eq. 2.1 / 7.6):
+//! The simulated position follows the thesis's error model (eq. 2.1 / 7.6):
 //! `P_real = P_kin + ΔP_kin + ΔP_c + ΔP_extra`
 //! - `ΔP_kin`: the truth's geometry differs from nominal ([`perturb_geometry`], or
-//!   the seed's §7.4 robot [`ys100_table_7_1`]);
+//!   the thesis's §7.4 robot [`ys100_table_7_1`]);
 //! - `ΔP_c`: joint compliance `Δθ = c ∘ τ(q)` with gravity torques at the
 //!   commanded configuration (eqs. 7.1–7.5), optionally with the cubic spring of
 //!   eq. 7.3;
@@ -23,6 +23,8 @@
 
 mod perturb;
 mod poses;
+pub mod study;
+mod synthetic;
 mod truth;
 
 pub use perturb::{
@@ -32,9 +34,10 @@ pub use perturb::{
 pub use poses::{
     random_configurations, random_configurations_with, try_random_configurations, PoseFilter,
 };
+pub use synthetic::{synthetic_calibration, unmodelled_truth, SyntheticErrors};
 pub use truth::{fine_transmission_errors, tracker_frame, Harmonic, TrueRobot, UnmodelledEffects};
 
-use crate::kinematics::KinematicsError;
+use crate::model::kinematics::KinematicsError;
 
 /// Simulation errors.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -1,5 +1,5 @@
 //! Geometric truth models: random perturbations of a nominal model (the
-//! `ΔP_kin` term of eq. 2.1) and the seed's simulated YS100 of §7.4
+//! `ΔP_kin` term of eq. 2.1) and the thesis's simulated YS100 of §7.4
 //! (Tables 7.1 and 7.2). Units SI (m, rad); stiffness N·m/rad.
 
 use crate::model::params::{ParamKind, ParamUnit};
@@ -34,7 +34,7 @@ pub enum ErrorDistribution {
     Normal,
 }
 
-/// Stiffness of seed Table 7.2 as `(0-based link index, K [N·m/rad])`:
+/// Stiffness of thesis Table 7.2 as `(0-based link index, K [N·m/rad])`:
 /// K2 = 1.5e6, K3 = 1.0e6, K4 = 1.2e6, K5 = 1.0e6; joints 1 and 6 rigid.
 pub const TABLE_7_2_STIFFNESS: [(usize, f64); 4] = [(1, 1.5e6), (2, 1.0e6), (3, 1.2e6), (4, 1.0e6)];
 
@@ -94,7 +94,7 @@ pub fn perturb_geometry_with(
     m
 }
 
-/// The seed's simulated YS100 of §7.4: geometry of Table 7.1, stiffness of
+/// The thesis's simulated YS100 of §7.4: geometry of Table 7.1, stiffness of
 /// Table 7.2, everything else (masses, centres of mass, payload 110 kg, limits)
 /// from `preset("ys100")`.
 ///
@@ -156,7 +156,7 @@ pub fn ys100_table_7_1() -> RobotModel {
     }
     m.name = "ys100-table-7-1".into();
     m.assumptions.extend([
-        "simulated truth of seed §7.4: geometry from Table 7.1; joint rows, base angles and d1 as printed (m, deg; θ_i as joint offsets)".to_string(),
+        "simulated truth of thesis §7.4: geometry from Table 7.1; joint rows, base angles and d1 as printed (m, deg; θ_i as joint offsets)".to_string(),
         "Table 7.1 row 1 a/b (-0.5, 0.05) and row T (-0.3, 0.05, 0.45) read as millimetre deviations from Table 2.1 (decimetre differences contradict the 3.39 mm nominal error of Table 7.5): a0 = -0.5 mm, b0 = 0.05 mm, tool = (199.7, 50.05, 500.45) mm".to_string(),
         "Table 7.1 row 3 β = 0.01 deg is β2 of the parallel link (joints 2-3)".to_string(),
         "stiffness from Table 7.2: K2 = 1.5e6, K3 = 1.0e6, K4 = 1.2e6, K5 = 1.0e6 N·m/rad; joints 1 and 6 rigid".to_string(),

@@ -1,9 +1,9 @@
-//! Random measurement configurations (the seed's §7.4 "30 robot joint readings
+//! Random measurement configurations (the thesis's §7.4 "30 robot joint readings
 //! … cover its entire workspace"): joint values uniform within the joint limits
 //! (model convention, rad), filtered by TCP height and loop closure.
 
 use super::SimError;
-use crate::kinematics::fk;
+use crate::model::kinematics::fk;
 use crate::model::RobotModel;
 use rand::Rng;
 

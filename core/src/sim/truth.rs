@@ -15,8 +15,8 @@
 //! and positions [mm] (docs/design.md "Units and conventions").
 
 use super::SimError;
-use crate::kinematics::{chain, fk, gravity_torques_of, KinematicsError};
 use crate::measure::{MeasuredPose, SetRole};
+use crate::model::kinematics::{chain, fk, gravity_torques_of, KinematicsError};
 use crate::model::pose::{rpy_matrix, Pose};
 use crate::model::RobotModel;
 use nalgebra::{Rotation3, Vector3};
@@ -361,7 +361,7 @@ impl From<KinematicsError> for SimError {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::kinematics::deflected_joints;
+    use crate::model::kinematics::deflected_joints;
     use crate::sim::ys100_table_7_1;
 
     #[test]

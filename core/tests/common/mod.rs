@@ -9,7 +9,7 @@ pub mod ik;
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal_core::identify::{
+use robocal_core::calibrate::identify::{
     calibrate, CalibrationError, CalibrationOptions, CalibrationReport, Method,
 };
 use robocal_core::measure::{self, csv, MeasuredPose, Measurement};

@@ -3,11 +3,11 @@
 //! a work object measured in the tracker frame in the base frame, 1e-6 mm).
 
 use super::*;
-use robocal_core::cell::export::{controller_data, controller_text};
 use robocal_core::model::orientation::{
     rotation_angle_between, rotation_from, OrientationConvention,
 };
-use robocal_core::program::FrameSpec;
+use robocal_core::solve::cell::export::{controller_data, controller_text};
+use robocal_core::solve::program::FrameSpec;
 
 /// The one site of `files` with its tool, work object and load.
 fn read_back(language: Language, files: &[ProgramFile]) -> (Pose, Pose, Load) {

@@ -21,21 +21,21 @@ use truth::FlangeTruth;
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use robocal_core::cell::{Cell, Load, Tool, WorkObject, WorkObjectFrame};
-use robocal_core::compensate::CompensatedModel;
-use robocal_core::identify::pose_selection::choose_d_optimal;
-use robocal_core::identify::{calibrate, CalibrationOptions, Method};
-use robocal_core::ik::{AnalyticIk, Configuration, IkSettings};
-use robocal_core::kinematics::chain::tool_pose;
+use robocal_core::calibrate::compensate::CompensatedModel;
+use robocal_core::calibrate::identify::pose_selection::choose_d_optimal;
+use robocal_core::calibrate::identify::{calibrate, CalibrationOptions, Method};
 use robocal_core::measure;
+use robocal_core::model::kinematics::chain::tool_pose;
 use robocal_core::model::orientation::fixed_xyz_angles;
 use robocal_core::model::pose::rpy_matrix;
 use robocal_core::model::{preset, Pose, RobotModel};
-use robocal_core::program::{filter, parse, Language, ProgramFile, Site, TargetStatus};
 use robocal_core::sim::{
     perturb_geometry, random_configurations, random_configurations_with, tracker_frame,
     ys100_table_7_1, ErrorMagnitudes, PoseFilter,
 };
+use robocal_core::solve::cell::{Cell, Load, Tool, WorkObject, WorkObjectFrame};
+use robocal_core::solve::ik::{AnalyticIk, Configuration, IkSettings};
+use robocal_core::solve::program::{filter, parse, Language, ProgramFile, Site, TargetStatus};
 use std::sync::OnceLock;
 
 /// The calibrated cell and the truth with the production tool.
@@ -61,7 +61,7 @@ pub fn torch() -> Pose {
     Pose::new(r, r * Vector3::new(0.0, 0.0, 0.25))
 }
 
-/// The YS100 of seed Table 7.1 (geometry errors, compliance, 110 kg payload)
+/// The YS100 of thesis Table 7.1 (geometry errors, compliance, 110 kg payload)
 /// measured by a tracker 3.4 m away; the table 1.5 m in front of the robot.
 pub fn fixture() -> &'static Fixture {
     static F: OnceLock<Fixture> = OnceLock::new();
@@ -222,7 +222,7 @@ fn target_walk(controller: &RobotModel, rng: &mut ChaCha8Rng) -> Vec<Vec<f64>> {
             .iter()
             .map(|v| v + rng.gen_range(-15f64..15.0).to_radians())
             .collect();
-        let tcp = robocal_core::kinematics::fk(controller, &next).unwrap();
+        let tcp = robocal_core::model::kinematics::fk(controller, &next).unwrap();
         let clear = next[2].abs() > 0.17 && next[4].abs() > 0.17 && tcp.p.z > 0.05;
         let d = |a: &[f64]| a.iter().zip(&q).map(|(x, y)| (x - y).abs()).sum::<f64>();
         let nearest = ik

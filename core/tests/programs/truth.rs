@@ -4,10 +4,10 @@
 //! (centre of mass in the flange frame, whatever TCP a program declares).
 //!
 //! Gravity torques are not robocal's (`kinematics::gravity`, an accumulation
-//! of moments from the tip, seed eqs. 3.7–3.9): here they are the gradient of
+//! of moments from the tip, thesis eqs. 3.7–3.9): here they are the gradient of
 //! the potential of gravity, `τ_i = ∂/∂q_i Σ_j m_j g·c_j(q)` (virtual work,
 //! `τ = J_cᵀ m g`), by central differences of the centres of mass. The joints
-//! the robot takes are `q + c∘τ(q)` (seed eq. 2.5). Frames: base → flange by
+//! the robot takes are `q + c∘τ(q)` (thesis eq. 2.5). Frames: base → flange by
 //! the chain; flange → reflector and flange → production TCP are fixed poses;
 //! the tracker sees the base through `tracker_from_base`. Units: SI, mm at
 //! the tracker's output.
@@ -15,8 +15,8 @@
 use nalgebra::Vector3;
 use rand::Rng;
 use rand_distr::{Distribution, Normal};
-use robocal_core::kinematics::{chain, fk};
 use robocal_core::measure::MeasuredPose;
+use robocal_core::model::kinematics::{chain, fk};
 use robocal_core::model::{Pose, RobotModel};
 
 /// Step of the central differences [rad].

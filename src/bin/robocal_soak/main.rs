@@ -550,7 +550,10 @@ fn simulated_csvs(seed: u64) -> anyhow::Result<(Vec<String>, Vec<Value>)> {
     let targets = qs
         .iter()
         .map(|q| {
-            let p = robocal::kinematics::fk(&nominal, q).expect("in limits").p * 1e3;
+            let p = robocal::model::kinematics::fk(&nominal, q)
+                .expect("in limits")
+                .p
+                * 1e3;
             json!({"x": p.x, "y": p.y, "z": p.z})
         })
         .collect();

@@ -4,7 +4,7 @@
 use crate::client::Conn;
 use crate::{InFlight, Ledger};
 use anyhow::{bail, ensure, Context};
-use robocal::compensate::CalibratedModelFile;
+use robocal::calibrate::compensate::CalibratedModelFile;
 use robocal::measure::MeasuredPose;
 use serde_json::Value;
 use std::collections::{BTreeMap, BTreeSet};

@@ -1,8 +1,8 @@
 //! The console's pages as maud templates (every interpolated value is
 //! HTML-escaped by maud).
 
+use crate::calibrate::identify::Method;
 use crate::http::calibrations::DEFAULT_METHODS;
-use crate::identify::Method;
 use crate::measure::convention::MeasuredOrientation;
 use crate::measure::SetRole;
 use crate::model::presets::PRESETS;

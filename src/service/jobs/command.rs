@@ -11,7 +11,7 @@
 //! and `options` ([`Format1Options`]), which every job still writes because
 //! the API shows them; [`super::stored`] reads either.
 
-use crate::identify::{CalibrationOptions, CompensatorOptions, LmSettings, Method};
+use crate::calibrate::identify::{CalibrationOptions, CompensatorOptions, LmSettings, Method};
 use crate::optim::TlboSettings;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;

@@ -4,8 +4,8 @@
 //! the job is prepared: later changes to the sets do not affect it.
 
 use super::command::StartCommand;
+use crate::calibrate::identify::{CalibrationOptions, PoseSource, PoseSources};
 use crate::db::{SetRow, StoredRole};
-use crate::identify::{CalibrationOptions, PoseSource, PoseSources};
 use crate::measure::Measurement;
 use crate::model::RobotModel;
 use crate::service::limits::{Ticket, MAX_SETS};

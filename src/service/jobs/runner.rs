@@ -10,8 +10,8 @@
 
 use super::prepare::Job;
 use super::versions::{summary_of, versions_of};
+use crate::calibrate::identify::{calibrate_with_training, CalibrationError, Progress};
 use crate::db::{JobResult, JobStatus};
-use crate::identify::{calibrate_with_training, CalibrationError, Progress};
 use crate::service::AppState;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;

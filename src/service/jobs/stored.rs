@@ -5,8 +5,8 @@
 
 use super::command::{Format1Options, StartCommand};
 use super::prepare::{prepare, Job};
+use crate::calibrate::identify::Method;
 use crate::db::CalibrationRow;
-use crate::identify::Method;
 use crate::model::RobotModel;
 use crate::service::{AppState, ServiceError};
 

@@ -2,8 +2,10 @@
 //! method whose file does not load back moves to the failed list) and the
 //! job's summary.
 
+use crate::calibrate::identify::{
+    calibrated_model_file, CalibrationOptions, CalibrationReport, FailedMethod,
+};
 use crate::db::{JobSummary, NewVersion};
-use crate::identify::{calibrated_model_file, CalibrationOptions, CalibrationReport, FailedMethod};
 use crate::model::RobotModel;
 use serde_json::json;
 

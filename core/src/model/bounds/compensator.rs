@@ -14,8 +14,8 @@ use super::{
     INPUT_CENTRE, INPUT_SCALE, INVERSE_LENGTH_SCALE, JOINT_DISTANCE_RAD, JOINT_RAD, NETWORK_WEIGHT,
     OUTPUT_SCALE, RBF_NORMALISED, RESIDUAL_M,
 };
-use crate::compensate::support::MAX_POINTS;
-use crate::compensate::{
+use crate::calibrate::compensate::support::MAX_POINTS;
+use crate::calibrate::compensate::{
     Gp, Mlp, Normalisation, Rbf, StoredCompensator, StoredOrientation, Support,
 };
 use crate::model::description::ModelError;
@@ -104,7 +104,7 @@ const POINT_M: Bound = Bound {
     unit: "m",
 };
 
-/// The family's bounds ([`crate::compensate::Family::check_bounds`]).
+/// The family's bounds ([`crate::calibrate::compensate::Family::check_bounds`]).
 fn check_network(f: &str, c: &StoredCompensator, out: &Outputs) -> Result<(), ModelError> {
     c.check_bounds(f, out)
 }
@@ -233,7 +233,7 @@ fn positive(b: &Bound) -> Bound {
 
 #[cfg(test)]
 mod tests {
-    use crate::compensate::{
+    use crate::calibrate::compensate::{
         parse_compensated, train, CalibratedModelFile, CompensatedModel, CompensatorSpec,
         GpSettings, LmTrainSettings, MlpSettings, MlpSpec, RbfSettings, Sample, Support, Trainer,
     };
@@ -512,7 +512,7 @@ mod tests {
 
     #[test]
     fn non_finite_values_are_refused_by_name() {
-        use crate::compensate::StoredCompensator;
+        use crate::calibrate::compensate::StoredCompensator;
         let v = trained_file(&specs()[2].1);
         let mut c: StoredCompensator = serde_json::from_value(v["compensator"].clone()).unwrap();
         if let StoredCompensator::Gp(g) = &mut c {

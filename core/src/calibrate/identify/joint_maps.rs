@@ -1,0 +1,776 @@
+//! Fitting the per-joint angle error maps (beyond the thesis; docs/design.md
+//! "Joint angle error maps"): `Δθ_i = f_i(q_i)`, a Fourier series per joint
+//! (`model::joint_maps`), identified jointly with the linearised geometry.
+//!
+//! At a calibrated model φ (no maps), the residual of pose p (measured −
+//! predicted, registered base frame of its session, m) is linear in the map
+//! coefficients through joint i's column `J_θi(q)` of the identification
+//! Jacobian (the column of the θ_i offset, eq. 4.9):
+//! `r ≈ J_φ·Δφ + Σ_i J_θi(q)·Σ_k (a_ik·cos(k·q_i) + b_ik·sin(k·q_i))`.
+//! The stacked problem is solved by ridge regression: λ times the mean
+//! squared norm of the map columns on every map coefficient (one penalty in
+//! radians for all joints), the geometry and session-frame columns free
+//! (1e-9 on unit-norm columns, for conditioning). The number of harmonics K and λ are chosen
+//! by k-fold cross-validation over the poses (seeded folds): the lowest cost
+//! of the thesis's eq. 7.10 (mean, max and spread of the squared position
+//! errors) on the held-out poses; K = 0 (geometry only) is always a
+//! candidate, so maps are kept only when they help on poses they never saw.
+//! Each joint's map covers the range of its training angles and fades to
+//! zero beyond it; a joint that moves less than `min_range_rad` gets none.
+//!
+//! Observability: a map is fitted only where the measurements see its effect.
+//! With position-only data a joint's angle is seen through the position
+//! rows of its column `J_θi` alone, whose norm is the lever arm from joint
+//! i's axis to the measured point [m/rad]; its RMS over the poses is
+//! `L_i = √(mean_p ‖J_pos,θi(q_p)‖²)`. One pose measured with a position
+//! noise σ per coordinate resolves an angle of joint i no finer than
+//! `α_i = σ / L_i` [rad]: an angle error of that size moves the measured
+//! point by one σ, no more than the noise. It turns a production tool whose
+//! tip is `ℓ` from the measured point by `ℓ·α_i` at the tip, unseen. The
+//! joint's map is refused (not fitted) when
+//!
+//! - `ℓ·α_i > max(max_unseen_tip_m, noise_ratio·σ)`
+//!   ([`MapRefusal::AngleNotResolved`]; `ℓ` = `production_tool_m`, 250 mm,
+//!   `max_unseen_tip_m` 0.5 mm, `noise_ratio` 2): the tip would go wrong by
+//!   more than 0.5 mm unseen **and** by more than twice what the noise
+//!   leaves at the measured point (`ℓ / L_i > 2`; data whose noise is already
+//!   millimetres, where the geometry leaves that much, are not held to a
+//!   finer bound at the tip than at the measured point), or else
+//! - `L_i < min_lever_m` (20 mm), a floor whatever the noise
+//!   ([`MapRefusal::LeverBelowFloor`]): the data's noise estimate may be
+//!   optimistic, and a joint seen through so short a lever is not mapped.
+//!
+//! σ is the RMS of the rows' position standard deviations where the data
+//! gives them (`std_x..z`), else the RMS per coordinate of the position
+//! residual the calibrated geometry leaves on the poses (over rows minus
+//! fitted columns): an upper bound of the noise, since it also holds what the
+//! maps are to explain, so the rule errs towards refusing. Joint 6 seen from a
+//! reflector 0.3 mm from its axis with σ = 0.01 mm resolves 33 mrad (1.9°):
+//! 8 mm unseen at a 250 mm tip. [`MapFit::refused`] says which rule and its
+//! figures. Any measured orientation sees every joint's angle directly
+//! (`‖J_rot,θi‖ = 1`), so with orientation rows no map is refused on this
+//! ground.
+
+use super::evaluate::{evaluate, gram_checked};
+use crate::measure::Measurement;
+use crate::model::{JointMap, JointMaps, ParamId, ParamKind, Pose, RobotModel};
+use nalgebra::{DMatrix, DVector};
+use rand::seq::SliceRandom;
+use rand::Rng;
+use serde::{Deserialize, Serialize};
+
+/// Settings of the joint-map fit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct JointMapSettings {
+    /// Candidate numbers of harmonics K per joint (0, geometry only, is
+    /// always tried).
+    pub harmonics: Vec<usize>,
+    /// Candidate ridge weights λ on the unit-norm map columns.
+    pub ridge: Vec<f64>,
+    /// Cross-validation folds.
+    pub folds: usize,
+    /// At least this many residual rows per unknown, else a K is skipped.
+    pub rows_per_unknown: f64,
+    /// Width of the fade to zero beyond a joint's trained range [rad].
+    pub fade_rad: f64,
+    /// A joint whose training angles span less than this gets no map [rad].
+    pub min_range_rad: f64,
+    /// Rounds of (map fit, LM refit of the geometry with the maps fixed).
+    pub rounds: usize,
+    /// With position-only data, a joint whose RMS lever arm to the measured
+    /// point is below this gets no map, whatever the noise (module docs) [m].
+    pub min_lever_m: f64,
+    /// Distance of a production tool's tip from the measured point the
+    /// observability rule guards (`ℓ`, module docs) [m].
+    pub production_tool_m: f64,
+    /// With position-only data, a joint whose angle one pose resolves
+    /// (σ / L_i) would move that tip by more than this unseen gets no map
+    /// (module docs) [m] …
+    pub max_unseen_tip_m: f64,
+    /// … and by more than this many times the position noise σ.
+    pub noise_ratio: f64,
+}
+
+impl Default for JointMapSettings {
+    fn default() -> Self {
+        JointMapSettings {
+            harmonics: vec![10, 20, 40, 60, 80],
+            ridge: vec![1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0],
+            folds: 5,
+            rows_per_unknown: 4.0,
+            fade_rad: 5f64.to_radians(),
+            min_range_rad: 10f64.to_radians(),
+            rounds: 2,
+            min_lever_m: 0.02,
+            production_tool_m: 0.25,
+            max_unseen_tip_m: 0.5e-3,
+            noise_ratio: 2.0,
+        }
+    }
+}
+
+/// One (K, λ) the cross-validation tried.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MapCandidate {
+    pub harmonics: usize,
+    pub ridge: f64,
+    /// Mean / max held-out position error over all poses [mm].
+    pub cv_mean_mm: f64,
+    pub cv_max_mm: f64,
+    /// The thesis's eq. 7.10 on the held-out errors,
+    /// `mean(e²) + 0.5·max(e²) + 0.3·std(e²)` [mm²]: the choice's criterion.
+    pub cv_cost_mm2: f64,
+    /// Mean held-out orientation error over the poses that measured one
+    /// (the linearised rotation residual's angle) [deg]; none without.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cv_orientation_mean_deg: Option<f64>,
+}
+
+/// Eq. 7.10 of errors [mm]: `mean(e²) + 0.5·max(e²) + 0.3·std(e²)` [mm²].
+fn seed_cost(errors: &[f64]) -> f64 {
+    let sq: Vec<f64> = errors.iter().map(|e| e * e).collect();
+    let n = sq.len().max(1) as f64;
+    let mean = sq.iter().sum::<f64>() / n;
+    let max = sq.iter().copied().fold(0.0, f64::max);
+    let std = (sq.iter().map(|s| (s - mean).powi(2)).sum::<f64>() / n).sqrt();
+    mean + 0.5 * max + 0.3 * std
+}
+
+/// The maps fitted and how they were chosen.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MapFit {
+    /// `None` when K = 0 (geometry alone) won the cross-validation.
+    pub maps: Option<JointMaps>,
+    pub chosen: MapCandidate,
+    /// Geometry alone (K = 0), on the same folds.
+    pub without_maps: MapCandidate,
+    pub candidates: Vec<MapCandidate>,
+    /// Poses the maps were fitted on.
+    pub poses: usize,
+    /// Joints whose map the measurements cannot see, not fitted.
+    pub refused: Vec<RefusedMap>,
+}
+
+/// Why a joint's map was refused (module docs): a closed set whose
+/// snake-case names the report serialises.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MapRefusal {
+    /// The angle one pose resolves, `σ / L_i`, would move a production
+    /// tool's tip by more than `max_unseen_tip_m` and `noise_ratio·σ` unseen.
+    AngleNotResolved,
+    /// The lever arm `L_i` is below the floor `min_lever_m`.
+    LeverBelowFloor,
+}
+
+impl MapRefusal {
+    pub const ALL: [MapRefusal; 2] = [MapRefusal::AngleNotResolved, MapRefusal::LeverBelowFloor];
+
+    /// The serialised name.
+    pub fn name(self) -> &'static str {
+        match self {
+            MapRefusal::AngleNotResolved => "angle_not_resolved",
+            MapRefusal::LeverBelowFloor => "lever_below_floor",
+        }
+    }
+}
+
+/// A joint whose map was refused: the measurements do not see its angle.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RefusedMap {
+    /// Joint number (1-based).
+    pub joint: usize,
+    /// Which rule refused it (module docs).
+    pub kind: MapRefusal,
+    /// RMS lever arm from the joint's axis to the measured point over the
+    /// poses [mm].
+    pub lever_mm: f64,
+    /// The floor of the lever [mm].
+    pub min_lever_mm: f64,
+    /// The position noise σ per coordinate the rule used [mm].
+    pub noise_mm: f64,
+    /// The angle one pose resolves, `σ / L_i`, at most 180° [deg].
+    pub resolved_deg: f64,
+    /// A production tool's tip distance from the measured point, `ℓ` [mm].
+    pub production_tool_mm: f64,
+    /// What an angle error of `resolved_deg` moves that tip by, unseen [mm].
+    pub unseen_tip_mm: f64,
+    /// The bound on `unseen_tip_mm`, `max(max_unseen_tip_m, noise_ratio·σ)`
+    /// [mm].
+    pub max_unseen_tip_mm: f64,
+    pub reason: String,
+}
+
+/// The position noise σ per coordinate of position-only `data` [m] (module
+/// docs): the RMS of the rows' standard deviations where given, else the RMS
+/// of the geometry's position residual `r` over `rows − fitted` degrees of
+/// freedom.
+fn position_noise(r: &DVector<f64>, fitted: usize, data: &[Measurement]) -> f64 {
+    let given: Vec<f64> = data
+        .iter()
+        .filter_map(|m| m.std.map(|s| s.position))
+        .collect();
+    if !given.is_empty() {
+        return (given.iter().map(|s| s * s).sum::<f64>() / given.len() as f64).sqrt();
+    }
+    let dof = r.len().saturating_sub(fitted).max(1);
+    (r.norm_squared() / dof as f64).sqrt()
+}
+
+/// The refusal of a joint seen through the RMS lever `lever` [m] with the
+/// noise `noise` [m], `None` when its map may be fitted (module docs).
+fn refusal(
+    joint: usize,
+    lever: f64,
+    noise: f64,
+    settings: &JointMapSettings,
+) -> Option<RefusedMap> {
+    let resolved = if lever > 0.0 {
+        (noise / lever).min(std::f64::consts::PI)
+    } else {
+        std::f64::consts::PI
+    };
+    let tip = settings.production_tool_m * resolved;
+    let bound = settings.max_unseen_tip_m.max(settings.noise_ratio * noise);
+    let kind = if tip > bound {
+        MapRefusal::AngleNotResolved
+    } else if lever < settings.min_lever_m {
+        MapRefusal::LeverBelowFloor
+    } else {
+        return None;
+    };
+    let (lever_mm, noise_mm, tool_mm) =
+        (lever * 1e3, noise * 1e3, settings.production_tool_m * 1e3);
+    let reason = match kind {
+        MapRefusal::AngleNotResolved => format!(
+            "joint {joint}'s angle moves the measured point by {lever_mm:.2} mm per radian (RMS over the poses) and no pose measured an orientation: with {noise_mm:.4} mm of position noise one pose resolves its angle only to {:.4}°, which would turn the tip of a production tool {tool_mm:.0} mm from the measured point by {:.3} mm unseen (more than {:.3} mm), so no map is fitted",
+            resolved.to_degrees(),
+            tip * 1e3,
+            bound * 1e3
+        ),
+        MapRefusal::LeverBelowFloor => format!(
+            "joint {joint}'s angle moves the measured point by only {lever_mm:.2} mm per radian (RMS over the poses, below the floor of {:.0} mm/rad) and no pose measured an orientation: a map of it would be nearly invisible to the measurements yet turn a production tool, so none is fitted",
+            settings.min_lever_m * 1e3
+        ),
+    };
+    Some(RefusedMap {
+        joint,
+        kind,
+        lever_mm,
+        min_lever_mm: settings.min_lever_m * 1e3,
+        noise_mm,
+        resolved_deg: resolved.to_degrees(),
+        production_tool_mm: tool_mm,
+        unseen_tip_mm: tip * 1e3,
+        max_unseen_tip_mm: bound * 1e3,
+        reason,
+    })
+}
+
+/// RMS over the poses of the position rows' norm of each column of `jt`
+/// (one column per joint angle, rows as `evaluate` stacks them) [m/rad];
+/// `None` when some pose measured an orientation (every angle is then seen).
+fn position_levers(jt: &DMatrix<f64>, data: &[Measurement]) -> Option<Vec<f64>> {
+    if data.iter().any(|m| m.orientation.is_some()) || data.is_empty() {
+        return None;
+    }
+    if data.iter().any(|m| m.std.is_some()) {
+        // The rows of `jt` are weighted (`evaluate`): undo it pose by pose.
+        let w = super::evaluate::row_weights(data, 1.0);
+        return Some(
+            (0..jt.ncols())
+                .map(|i| {
+                    let sum: f64 = (0..data.len())
+                        .map(|p| (0..3).map(|k| jt[(3 * p + k, i)].powi(2)).sum::<f64>())
+                        .zip(&w)
+                        .map(|(s, (wp, _))| s / (wp * wp))
+                        .sum();
+                    (sum / data.len() as f64).sqrt()
+                })
+                .collect(),
+        );
+    }
+    Some(
+        (0..jt.ncols())
+            .map(|i| (jt.column(i).norm_squared() / data.len() as f64).sqrt())
+            .collect(),
+    )
+}
+
+/// The joints (with their trained range) that get a map, and those refused
+/// as unobservable (module docs), `noise` the position noise σ [m].
+fn map_joints(
+    jt: &DMatrix<f64>,
+    data: &[Measurement],
+    noise: f64,
+    settings: &JointMapSettings,
+) -> (Vec<(usize, [f64; 2])>, Vec<RefusedMap>) {
+    let levers = position_levers(jt, data);
+    let (mut joints, mut refused) = (Vec::new(), Vec::new());
+    for i in 0..jt.ncols() {
+        let lo = data.iter().map(|m| m.q[i]).fold(f64::INFINITY, f64::min);
+        let hi = data
+            .iter()
+            .map(|m| m.q[i])
+            .fold(f64::NEG_INFINITY, f64::max);
+        if hi - lo < settings.min_range_rad {
+            continue;
+        }
+        match levers
+            .as_ref()
+            .and_then(|l| refusal(i + 1, l[i], noise, settings))
+        {
+            Some(r) => refused.push(r),
+            None => joints.push((i, [lo, hi])),
+        }
+    }
+    (joints, refused)
+}
+
+/// Why the maps cannot be fitted.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MapFitError {
+    #[error("joint maps need a serial chain (this model has a closed loop)")]
+    ClosedLoop,
+    #[error("joint maps need at least {need} poses, got {got}")]
+    TooFewPoses { need: usize, got: usize },
+    #[error("the model cannot be evaluated at some training pose")]
+    NotEvaluable,
+    #[error("no joint moves over {min_deg:.1}° in the training poses")]
+    NoJointMoves { min_deg: f64 },
+    #[error("no joint map is observable: {refused}")]
+    NoObservableJoint { refused: String },
+}
+
+/// The design of one fit: residuals, the geometry / session columns and the
+/// map columns for the largest K, pose by pose.
+struct Design {
+    r: DVector<f64>,
+    a: DMatrix<f64>,
+    /// Geometry and session-frame columns (the first ones of `a`).
+    geo: usize,
+    /// First row of each pose, and its row count.
+    pose_rows: Vec<(usize, usize)>,
+    /// Per pose, the weights of its position and orientation rows [m/rad]
+    /// (`evaluate::row_weights`).
+    weights: Vec<(f64, f64)>,
+    /// Joints with a map, with their range.
+    joints: Vec<(usize, [f64; 2])>,
+    /// Joints whose map the measurements cannot see.
+    refused: Vec<RefusedMap>,
+    kmax: usize,
+}
+
+impl Design {
+    /// Column of (joint slot j, harmonic k ≥ 1, sine?) for the largest K.
+    fn col(&self, j: usize, k: usize, sine: bool) -> usize {
+        self.geo + j * 2 * self.kmax + usize::from(sine) * self.kmax + (k - 1)
+    }
+
+    /// The columns of the problem with K harmonics.
+    fn columns(&self, k: usize) -> Vec<usize> {
+        let mut c: Vec<usize> = (0..self.geo).collect();
+        for j in 0..self.joints.len() {
+            for h in 1..=k {
+                c.push(self.col(j, h, false));
+                c.push(self.col(j, h, true));
+            }
+        }
+        c
+    }
+}
+
+/// Poses of the design filled between two checks of `go` in [`build`].
+const BUILD_CHECK_POSES: usize = 1000;
+
+/// The design matrix of the maps on `data` (module docs); `Ok(None)` as soon
+/// as `go()` returns false (it is asked after the Jacobians and every
+/// [`BUILD_CHECK_POSES`] poses).
+#[allow(clippy::too_many_arguments)]
+fn build(
+    model: &RobotModel,
+    frames: &[Pose],
+    ids: &[ParamId],
+    data: &[Measurement],
+    weight: f64,
+    kmax: usize,
+    settings: &JointMapSettings,
+    go: &mut dyn FnMut() -> bool,
+) -> Result<Option<Design>, MapFitError> {
+    let n = model.dof();
+    let geo_eval =
+        evaluate(model, frames, ids, data, weight, true).ok_or(MapFitError::NotEvaluable)?;
+    let theta: Vec<ParamId> = (0..n).map(|k| ParamId::new(ParamKind::Theta, k)).collect();
+    let theta_eval =
+        evaluate(model, frames, &theta, data, weight, true).ok_or(MapFitError::NotEvaluable)?;
+    let (jg, jt) = (geo_eval.j.expect("asked"), theta_eval.j.expect("asked"));
+    if !go() {
+        return Ok(None);
+    }
+    let noise = position_noise(&geo_eval.r, jg.ncols(), data);
+    let (joints, refused) = map_joints(&jt, data, noise, settings);
+    if joints.is_empty() && !refused.is_empty() {
+        return Err(MapFitError::NoObservableJoint {
+            refused: refused
+                .iter()
+                .map(|r| r.reason.as_str())
+                .collect::<Vec<_>>()
+                .join("; "),
+        });
+    }
+    if joints.is_empty() {
+        return Err(MapFitError::NoJointMoves {
+            min_deg: settings.min_range_rad.to_degrees(),
+        });
+    }
+    let geo = jg.ncols();
+    let rows = jg.nrows();
+    let mut a = DMatrix::zeros(rows, geo + joints.len() * 2 * kmax);
+    a.columns_mut(0, geo).copy_from(&jg);
+    let mut pose_rows = Vec::with_capacity(data.len());
+    let mut row = 0;
+    let mut basis = vec![0.0; 2 * kmax];
+    let mut design = Design {
+        r: geo_eval.r,
+        a: DMatrix::zeros(0, 0),
+        geo,
+        pose_rows: Vec::new(),
+        weights: super::evaluate::row_weights(data, weight),
+        joints,
+        refused,
+        kmax,
+    };
+    for (p, m) in data.iter().enumerate() {
+        if p % BUILD_CHECK_POSES == BUILD_CHECK_POSES - 1 && !go() {
+            return Ok(None);
+        }
+        let nr = if m.orientation.is_some() { 6 } else { 3 };
+        pose_rows.push((row, nr));
+        for (slot, (i, _)) in design.joints.iter().enumerate() {
+            JointMap::basis(kmax, m.q[*i], &mut basis);
+            for h in 1..=kmax {
+                let (c, s) = (basis[h - 1], basis[kmax + h - 1]);
+                let (cc, cs) = (design.col(slot, h, false), design.col(slot, h, true));
+                for rr in row..row + nr {
+                    let t = jt[(rr, *i)];
+                    a[(rr, cc)] = t * c;
+                    a[(rr, cs)] = t * s;
+                }
+            }
+        }
+        row += nr;
+    }
+    design.a = a;
+    design.pose_rows = pose_rows;
+    Ok(Some(design))
+}
+
+/// Ridge solution on the columns `cols` of the normal equations `g`, `b`,
+/// columns scaled to unit norm by `scale`. The map columns (index ≥ `geo`)
+/// are penalised by `ridge·(s̄/s_c)²`, `s̄` the RMS norm of the map columns:
+/// one penalty on the coefficients in radians for every joint, so a joint
+/// whose angle barely moves the TCP (a short lever) gets no large map.
+/// `None` when the system is not positive definite.
+fn solve(
+    g: &DMatrix<f64>,
+    b: &DVector<f64>,
+    cols: &[usize],
+    scale: &[f64],
+    geo: usize,
+    ridge: f64,
+) -> Option<DVector<f64>> {
+    let maps: Vec<f64> = cols
+        .iter()
+        .filter(|c| **c >= geo)
+        .map(|c| scale[*c])
+        .collect();
+    let mean_sq = if maps.is_empty() {
+        1.0
+    } else {
+        maps.iter().map(|s| s * s).sum::<f64>() / maps.len() as f64
+    };
+    let m = cols.len();
+    let mut h = DMatrix::zeros(m, m);
+    let mut v = DVector::zeros(m);
+    for (x, &cx) in cols.iter().enumerate() {
+        v[x] = b[cx] / scale[cx];
+        for (y, &cy) in cols.iter().enumerate() {
+            h[(x, y)] = g[(cx, cy)] / (scale[cx] * scale[cy]);
+        }
+        h[(x, x)] += if cx >= geo {
+            ridge * mean_sq / (scale[cx] * scale[cx])
+        } else {
+            1e-9
+        };
+    }
+    let x = h.cholesky()?.solve(&v);
+    Some(DVector::from_iterator(
+        m,
+        x.iter().zip(cols).map(|(x, c)| x / scale[*c]),
+    ))
+}
+
+/// Position error norms [mm] of the poses `poses` after subtracting `a·x`,
+/// and their orientation errors [deg] (the norm of the unweighted rotation
+/// residual; `None` for a pose without a measured orientation).
+fn held_out_errors(
+    d: &Design,
+    poses: &[usize],
+    cols: &[usize],
+    x: &DVector<f64>,
+) -> (Vec<f64>, Vec<Option<f64>>) {
+    let left = |rr: usize| {
+        let fit: f64 = cols
+            .iter()
+            .zip(x.iter())
+            .map(|(c, x)| d.a[(rr, *c)] * x)
+            .sum();
+        d.r[rr] - fit
+    };
+    let norm = |rows: std::ops::Range<usize>| rows.map(|rr| left(rr).powi(2)).sum::<f64>().sqrt();
+    poses
+        .iter()
+        .map(|&p| {
+            let (row, nr) = d.pose_rows[p];
+            let (wp, wr) = d.weights[p];
+            let angle = (nr == 6 && wr > 0.0).then(|| (norm(row + 3..row + 6) / wr).to_degrees());
+            (norm(row..row + 3) / wp * 1e3, angle)
+        })
+        .unzip()
+}
+
+/// The normal equations `AᵀA`, `Aᵀr` of the rows of `poses`; `None` when
+/// `go()` returns false between the steps of `AᵀA` ([`gram_checked`]).
+fn normal_of(
+    d: &Design,
+    poses: &[usize],
+    go: &mut dyn FnMut() -> bool,
+) -> Option<(DMatrix<f64>, DVector<f64>)> {
+    let rows: usize = poses.iter().map(|p| d.pose_rows[*p].1).sum();
+    let mut a = DMatrix::zeros(rows, d.a.ncols());
+    let mut r = DVector::zeros(rows);
+    let mut at = 0;
+    for &p in poses {
+        let (row, nr) = d.pose_rows[p];
+        a.rows_mut(at, nr).copy_from(&d.a.rows(row, nr));
+        r.rows_mut(at, nr).copy_from(&d.r.rows(row, nr));
+        at += nr;
+    }
+    Some((gram_checked(&a, go)?, a.tr_mul(&r)))
+}
+
+/// Fits the maps of `model` (its own maps ignored) on `data` with the session
+/// frames `frames` and the identified parameters `ids`: K and λ by
+/// cross-validation, then the coefficients on all poses. `progress(done,
+/// total)` after each candidate's fold and between the steps of building the
+/// design and its normal equations (`done` = candidates done); false cancels
+/// (`Ok(None)`).
+#[allow(clippy::too_many_arguments)]
+pub fn fit_joint_maps(
+    model: &RobotModel,
+    frames: &[Pose],
+    ids: &[ParamId],
+    data: &[Measurement],
+    orientation_weight: f64,
+    settings: &JointMapSettings,
+    rng: &mut impl Rng,
+    progress: &mut dyn FnMut(usize, usize) -> bool,
+) -> Result<Option<MapFit>, MapFitError> {
+    if model.closed_loop.is_some() {
+        return Err(MapFitError::ClosedLoop);
+    }
+    let folds = settings.folds.max(2);
+    let need = 4 * folds;
+    if data.len() < need {
+        return Err(MapFitError::TooFewPoses {
+            need,
+            got: data.len(),
+        });
+    }
+    let mut plain = model.clone();
+    plain.joint_maps = None;
+    let rows = super::evaluate::residual_rows(data);
+    let n = model.dof();
+    let geo_cols = ids.len() + frames.len().saturating_sub(1) * 6;
+    let affordable =
+        |k: usize| ((geo_cols + 2 * k * n) as f64) * settings.rows_per_unknown <= rows as f64;
+    let mut ks: Vec<usize> = settings
+        .harmonics
+        .iter()
+        .copied()
+        .filter(|k| *k > 0 && affordable(*k))
+        .collect();
+    ks.sort_unstable();
+    ks.dedup();
+    let kmax = ks.last().copied().unwrap_or(0);
+    let mut grid: Vec<(usize, f64)> = vec![(0, 0.0)];
+    for k in &ks {
+        for l in &settings.ridge {
+            grid.push((*k, *l));
+        }
+    }
+    let total = grid.len() + 1;
+    let mut go = || progress(0, total);
+    let Some(d) = build(
+        &plain,
+        frames,
+        ids,
+        data,
+        orientation_weight,
+        kmax.max(1),
+        settings,
+        &mut go,
+    )?
+    else {
+        return Ok(None);
+    };
+    let Some(g) = gram_checked(&d.a, &mut go) else {
+        return Ok(None);
+    };
+    let b = d.a.tr_mul(&d.r);
+    let scale: Vec<f64> = (0..g.ncols())
+        .map(|c| {
+            let s = g[(c, c)].sqrt();
+            if s > 0.0 {
+                s
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    // Seeded folds over the poses.
+    let mut order: Vec<usize> = (0..data.len()).collect();
+    order.shuffle(rng);
+    let fold_poses: Vec<Vec<usize>> = (0..folds)
+        .map(|f| order.iter().copied().skip(f).step_by(folds).collect())
+        .collect();
+    let mut fold_normals: Vec<(DMatrix<f64>, DVector<f64>)> = Vec::with_capacity(folds);
+    for p in &fold_poses {
+        match normal_of(&d, p, &mut go) {
+            Some(n) if go() => fold_normals.push(n),
+            _ => return Ok(None),
+        }
+    }
+    let mut candidates = Vec::new();
+    for (done, (k, ridge)) in grid.iter().enumerate() {
+        let cols = d.columns(*k);
+        let mut errors = Vec::with_capacity(data.len());
+        let mut angles = Vec::with_capacity(data.len());
+        let mut ok = true;
+        for (poses, (gf, bf)) in fold_poses.iter().zip(&fold_normals) {
+            match solve(&(&g - gf), &(&b - bf), &cols, &scale, d.geo, *ridge) {
+                Some(x) => {
+                    let (e, a) = held_out_errors(&d, poses, &cols, &x);
+                    errors.extend(e);
+                    angles.extend(a.into_iter().flatten());
+                }
+                None => ok = false,
+            }
+            if !progress(done, total) {
+                return Ok(None);
+            }
+        }
+        if ok {
+            candidates.push(MapCandidate {
+                harmonics: *k,
+                ridge: *ridge,
+                cv_mean_mm: errors.iter().sum::<f64>() / errors.len() as f64,
+                cv_max_mm: errors.iter().copied().fold(0.0, f64::max),
+                cv_cost_mm2: seed_cost(&errors),
+                cv_orientation_mean_deg: (!angles.is_empty())
+                    .then(|| angles.iter().sum::<f64>() / angles.len() as f64),
+            });
+        }
+        if !progress(done + 1, total) {
+            return Ok(None);
+        }
+    }
+    let without_maps = candidates
+        .iter()
+        .find(|c| c.harmonics == 0)
+        .cloned()
+        .ok_or(MapFitError::NotEvaluable)?;
+    // The lowest held-out eq. 7.10 cost (K = 0 is a candidate).
+    let chosen = candidates
+        .iter()
+        .min_by(|a, b| a.cv_cost_mm2.total_cmp(&b.cv_cost_mm2))
+        .cloned()
+        .expect("K = 0 is a candidate");
+    let maps = if chosen.harmonics == 0 {
+        None
+    } else {
+        let cols = d.columns(chosen.harmonics);
+        let x =
+            solve(&g, &b, &cols, &scale, d.geo, chosen.ridge).ok_or(MapFitError::NotEvaluable)?;
+        let k = chosen.harmonics;
+        let mut joints: Vec<Option<JointMap>> = vec![None; n];
+        for (slot, (i, range)) in d.joints.iter().enumerate() {
+            let mut map = JointMap::zero(k, *range, settings.fade_rad);
+            for h in 1..=k {
+                let at = |sine: bool| {
+                    let c = d.col(slot, h, sine);
+                    let pos = cols.iter().position(|x| *x == c).expect("in cols");
+                    x[pos]
+                };
+                map.cos[h - 1] = at(false);
+                map.sin[h - 1] = at(true);
+            }
+            joints[*i] = Some(map);
+        }
+        Some(JointMaps { joints })
+    };
+    if !progress(total, total) {
+        return Ok(None);
+    }
+    Ok(Some(MapFit {
+        maps,
+        chosen,
+        without_maps,
+        candidates,
+        poses: data.len(),
+        refused: d.refused.clone(),
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rule on hand-computed figures (defaults: ℓ = 250 mm, 0.5 mm
+    /// unseen at the tip, 20 mm floor).
+    #[test]
+    fn a_map_is_refused_by_what_one_pose_resolves_then_by_the_floor() {
+        let s = JointMapSettings::default();
+        // 100 mm lever, 0.1 mm noise: 1 mrad resolved, 0.25 mm at the tip.
+        assert_eq!(refusal(6, 0.1, 1e-4, &s), None);
+        // 0.4 mm noise: 4 mrad, 1 mm at the tip, above 0.5 mm and 2σ = 0.8 mm.
+        let r = refusal(6, 0.1, 4e-4, &s).unwrap();
+        assert_eq!(r.kind, MapRefusal::AngleNotResolved);
+        assert!((r.resolved_deg - 4e-3f64.to_degrees()).abs() < 1e-12);
+        assert!((r.unseen_tip_mm - 1.0).abs() < 1e-12);
+        assert!((r.noise_mm - 0.4).abs() < 1e-12 && (r.lever_mm - 100.0).abs() < 1e-12);
+        // 10 mm lever, 1 µm noise: 0.1 mrad, 0.025 mm at the tip, but the
+        // lever is below the 20 mm floor.
+        let r = refusal(6, 0.01, 1e-6, &s).unwrap();
+        assert_eq!(r.kind, MapRefusal::LeverBelowFloor);
+        assert!((r.unseen_tip_mm - 0.025).abs() < 1e-12);
+        // 1 mm noise through a 400 mm lever: 0.625 mm at the tip, above
+        // 0.5 mm but below twice the noise (ℓ/L = 0.625): fitted; through
+        // 100 mm (2.5 mm, above 2 mm): refused, the bound 2 mm.
+        assert_eq!(refusal(2, 0.4, 1e-3, &s), None);
+        let r = refusal(2, 0.1, 1e-3, &s).unwrap();
+        assert_eq!(r.kind, MapRefusal::AngleNotResolved);
+        assert!((r.max_unseen_tip_mm - 2.0).abs() < 1e-12);
+        assert!((r.unseen_tip_mm - 2.5).abs() < 1e-12);
+        // A point on the axis resolves nothing: capped at 180°.
+        let r = refusal(6, 0.0, 1e-5, &s).unwrap();
+        assert_eq!(r.kind, MapRefusal::AngleNotResolved);
+        assert_eq!(r.resolved_deg, 180.0);
+        let names: Vec<_> = MapRefusal::ALL.iter().map(|k| k.name()).collect();
+        for k in MapRefusal::ALL {
+            assert_eq!(serde_json::to_value(k).unwrap(), k.name());
+        }
+        assert_eq!(names, ["angle_not_resolved", "lever_below_floor"]);
+    }
+}

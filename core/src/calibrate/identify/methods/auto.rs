@@ -1,0 +1,538 @@
+//! `auto`: the base (KM or SKCM) with the compensator cross-validation
+//! prefers, or the base alone.
+//!
+//! `auto` runs KM and (when gravity loads a joint) SKCM, cross-validates every
+//! candidate compensator of each base on the training pool and keeps, per
+//! base, the compensator `compensate::choose` accepts (cross-validated mean at
+//! least `min_gain` below the base's, max not above) or the base alone; between
+//! the bases it takes the lower cross-validated mean on the training pool. With
+//! fewer than `min_training_poses` training poses it trains nothing and keeps
+//! the base, saying so. The joint-map methods among the candidates are options
+//! of their own: kept when their cross-validated mean (over the identification
+//! and training poses, `identify::joint_maps`) is at least `min_gain` below the
+//! geometry's alone on the same folds and their max not above; they then
+//! compete with the bases by that cross-validated mean. On kept maps the
+//! compensators built on them (`km-maps-gp`, `skcm-maps-gp`) are
+//! cross-validated on what the maps leave and one is added when `choose`
+//! accepts it against the maps alone; the option keeps the maps' mean.
+//!
+//! Orientation: when the pool measured orientation, `auto` scores it too, and
+//! a method that gains position but loses orientation is not chosen. Joint
+//! maps are kept only when their cross-validated orientation mean is not
+//! above the geometry's alone on the same folds by more than
+//! [`ORIENTATION_SLACK`] (relative); and between the options only those whose
+//! orientation mean on the pool is within [`ORIENTATION_SLACK`] of the lowest
+//! compete by position ([`choose_option`]). A kept compensator's
+//! orientation part (`compensate::oriented`) is cross-validated on the same
+//! folds as its position part (`methods::orientation_part`) and kept only
+//! when its cross-validated orientation mean is at least `min_gain` below
+//! the base's on the same poses; the option is then scored by that
+//! cross-validated mean, else the part is dropped (the reason says so,
+//! `AutoSummary::orientation_part` is `not_kept`) and the option scores its
+//! base's (or maps') orientation on the pool.
+
+use super::compensated::base_pool_errors;
+use super::maps::run_maps;
+use super::orientation_part::settle_for_auto;
+use super::run::{AppliedCompensator, Cache, Context, MethodFit, Outcome};
+use super::{Base, Compensated, Method, MethodError, MethodFailure, Run};
+use crate::calibrate::compensate::{choose, Choice, CvStats};
+use crate::calibrate::identify::least_squares::Fit;
+use crate::calibrate::identify::report::{
+    AutoCandidate, AutoSummary, OrientationPart, OrientationPartStatus, SetErrors,
+};
+
+/// Orientation means within this relative margin of each other count as
+/// equal (the fit's noise); a larger excess is a loss `auto` does not accept.
+pub(crate) const ORIENTATION_SLACK: f64 = 0.02;
+
+/// The option `auto` takes among `(position mean [mm], orientation mean
+/// [deg])` pairs (orientation `None`: not measured): those whose orientation
+/// mean exceeds the lowest by more than `slack` (relative) are excluded, then
+/// the lowest position mean wins. Returns its index and the excluded ones;
+/// `None` for no options.
+pub(crate) fn choose_option(
+    options: &[(f64, Option<f64>)],
+    slack: f64,
+) -> Option<(usize, Vec<usize>)> {
+    let best_orientation = options
+        .iter()
+        .filter_map(|o| o.1)
+        .fold(f64::INFINITY, f64::min);
+    let loses = |o: &(f64, Option<f64>)| {
+        o.1.is_some_and(|a| best_orientation.is_finite() && a > best_orientation * (1.0 + slack))
+    };
+    let excluded: Vec<usize> = (0..options.len()).filter(|i| loses(&options[*i])).collect();
+    let chosen = (0..options.len())
+        .filter(|i| !excluded.contains(i))
+        .min_by(|a, b| options[*a].0.total_cmp(&options[*b].0))?;
+    Some((chosen, excluded))
+}
+
+/// One base as `auto` weighs it.
+struct BaseOption {
+    base: Base,
+    /// The joint-map method whose fit this is, if any.
+    maps: Option<Method>,
+    fit: MethodFit,
+    /// The compensator `choose` kept, if any.
+    compensator: Option<AppliedCompensator>,
+    /// Cross-validated mean on the pool [mm] (the base's residual mean when
+    /// nothing was trained).
+    mean_mm: f64,
+    /// Orientation mean of the option [deg]: the fit's on the pool, or the
+    /// kept orientation part's cross-validated mean (none without
+    /// orientation measurements).
+    orientation_deg: Option<f64>,
+    /// The kept compensator's orientation part, where orientation was
+    /// measured.
+    orientation_part: Option<OrientationPart>,
+    reason: String,
+}
+
+/// The orientation mean of `errors` [deg], if the set measured any.
+fn orientation_mean(errors: &SetErrors) -> Option<f64> {
+    errors.orientation.as_ref().map(|o| o.mean_deg)
+}
+
+/// `auto` (module docs). Without gravity torques (`Context::gravity`) neither
+/// SKCM nor the torque-input RBF is tried.
+pub(crate) fn run_auto(
+    ctx: &Context,
+    cache: &mut Cache,
+    progress: &mut dyn FnMut(f64, usize, Option<f64>) -> bool,
+) -> Result<Outcome, MethodError> {
+    let o = &ctx.opts.compensator;
+    let (pool, pool_name) = ctx.pool();
+    let gravity = ctx.gravity.as_ref();
+    let folds = if o.cv_folds > 0 { o.cv_folds } else { 5 };
+    let enough = pool.len() >= o.min_training_poses;
+    let bases: Vec<Base> = if gravity.is_some() {
+        vec![Base::Km]
+    } else {
+        vec![Base::Km, Base::Skcm]
+    };
+    let per_base: Vec<Vec<(Method, Compensated)>> = bases
+        .iter()
+        .map(|b| {
+            o.auto_candidates
+                .iter()
+                .filter_map(|m| Some((*m, m.compensated()?)))
+                .filter(|(m, c)| c.base == *b && (gravity.is_none() || !m.uses_torques()))
+                .collect()
+        })
+        .collect();
+    let maps_runs = bases
+        .iter()
+        .filter(|b| maps_candidate(&o.auto_candidates, **b).is_some())
+        .count();
+    let maps_compensators = o
+        .auto_candidates
+        .iter()
+        .filter(|m| {
+            m.compensated()
+                .is_some_and(|c| matches!(c.base, Base::KmMaps | Base::SkcmMaps))
+        })
+        .count();
+    let total = (per_base.iter().map(Vec::len).sum::<usize>() + maps_runs + maps_compensators)
+        .max(1) as f64;
+    let mut done = 0.0;
+    let mut notes: Vec<String> = Vec::new();
+    if let Some(why) = gravity {
+        notes.push(format!("skcm and km-rbf not tried: {why}"));
+    }
+    let mut candidates = Vec::new();
+    let mut options: Vec<BaseOption> = Vec::new();
+    for (base, cands) in bases.iter().zip(&per_base) {
+        let name = base.method().name();
+        let mf = match cache.base_fit(ctx, *base, &mut |it, rms| {
+            progress(done / total, it, Some(rms))
+        }) {
+            Ok(mf) => mf,
+            Err(MethodError::Cancelled) => return Err(MethodError::Cancelled),
+            Err(MethodError::Failed(f)) => {
+                notes.push(format!("{name} failed: {f}"));
+                done += cands.len() as f64;
+                continue;
+            }
+        };
+        let base_errors = base_pool_errors(&mf.fit, pool);
+        let base_mean = base_errors.stats.mean_mm;
+        let orientation_deg = orientation_mean(&base_errors);
+        if !enough {
+            options.push(BaseOption {
+                base: *base,
+                maps: None,
+                fit: mf,
+                compensator: None,
+                mean_mm: base_mean,
+                orientation_deg,
+                orientation_part: None,
+                reason: format!(
+                    "{name}: only {} training poses (at least {} are needed to train and cross-validate a compensator), so the base stays",
+                    pool.len(),
+                    o.min_training_poses
+                ),
+            });
+            continue;
+        }
+        let done0 = done;
+        let (choice, picked, settled) = cross_validate_and_choose(
+            ctx,
+            cache,
+            cands,
+            &mf.fit,
+            folds,
+            &mut candidates,
+            &mut |x, e, l| progress((done0 + x) / total, e, l),
+        )?;
+        done += cands.len() as f64;
+        let mean_mm = picked
+            .as_ref()
+            .and_then(|a| a.trained.cv.as_ref())
+            .map_or(base_mean, |cv| cv.compensated.mean_mm);
+        if let Some((_, Some(dropped))) = &settled {
+            notes.push(dropped.clone());
+        }
+        options.push(BaseOption {
+            base: *base,
+            maps: None,
+            fit: mf,
+            compensator: picked,
+            mean_mm,
+            orientation_deg: option_orientation(orientation_deg, &settled),
+            orientation_part: settled.map(|s| s.0),
+            reason: format!("{name}: {}", choice.reason),
+        });
+    }
+    for base in &bases {
+        let Some(method) = maps_candidate(&o.auto_candidates, *base) else {
+            continue;
+        };
+        // The maps, then the compensators on them: a unit of the bar each,
+        // whether they run or not.
+        let (at, span) = (done / total, 1.0 / total);
+        let on_maps_at = done + 1.0;
+        done += 1.0 + on_maps_candidates(ctx, *base).len() as f64;
+        let outcome = run_maps(ctx, cache, *base, &mut |f, it, l| {
+            progress(at + span * f, it, l)
+        });
+        match outcome {
+            Err(MethodError::Cancelled) => return Err(MethodError::Cancelled),
+            Err(MethodError::Failed(f)) => {
+                candidates.push(AutoCandidate {
+                    method,
+                    cross_validation: None,
+                    failed: Some(f.to_string()),
+                    orientation_cross_validation: None,
+                });
+                notes.push(format!("{} failed: {f}", method.name()));
+            }
+            Ok(out) => {
+                let fit = out.fit;
+                let Some(m) = fit.maps.clone() else { continue };
+                candidates.push(AutoCandidate {
+                    method,
+                    cross_validation: None,
+                    failed: None,
+                    orientation_cross_validation: None,
+                });
+                let (with, without) = (&m.chosen, &m.without_maps);
+                let gain = 1.0 - with.cv_mean_mm / without.cv_mean_mm;
+                let orientation_loss = match (
+                    with.cv_orientation_mean_deg,
+                    without.cv_orientation_mean_deg,
+                ) {
+                    (Some(a), Some(b)) if a > b * (1.0 + ORIENTATION_SLACK) => Some((a, b)),
+                    _ => None,
+                };
+                if let (Some((a, b)), true) = (orientation_loss, m.maps.is_some()) {
+                    notes.push(format!(
+                        "{} not kept: it loses orientation, cross-validated {a:.4}° mean against {b:.4}° without maps (more than {:.0} % above)",
+                        method.name(),
+                        ORIENTATION_SLACK * 100.0
+                    ));
+                } else if m.maps.is_some()
+                    && gain >= o.min_gain
+                    && with.cv_max_mm <= without.cv_max_mm
+                {
+                    let on_maps = maps_compensator(
+                        ctx,
+                        cache,
+                        *base,
+                        &fit,
+                        folds,
+                        &mut candidates,
+                        &mut |f, e, l| progress((on_maps_at + f) / total, e, l),
+                    )?;
+                    let orientation_deg = orientation_mean(&SetErrors::of(
+                        &fit.fit.model,
+                        &fit.fit.session_frames,
+                        pool,
+                    ));
+                    if let Some((_, Some(dropped))) = &on_maps.settled {
+                        notes.push(dropped.clone());
+                    }
+                    options.push(BaseOption {
+                        base: *base,
+                        maps: Some(method),
+                        fit,
+                        compensator: on_maps.kept,
+                        mean_mm: with.cv_mean_mm,
+                        orientation_deg: option_orientation(orientation_deg, &on_maps.settled),
+                        orientation_part: on_maps.settled.map(|s| s.0),
+                        reason: format!("{}{}", on_maps.reason, format_args!(
+                            "{}: {} harmonics cross-validated over {} poses at {:.4} / {:.4} mm mean / max against {:.4} / {:.4} without maps",
+                            method.name(),
+                            with.harmonics,
+                            m.poses,
+                            with.cv_mean_mm,
+                            with.cv_max_mm,
+                            without.cv_mean_mm,
+                            without.cv_max_mm
+                        )),
+                    });
+                } else {
+                    notes.push(format!(
+                        "{} not kept: cross-validated {:.4} / {:.4} mm mean / max against {:.4} / {:.4} without maps (needs {:.0} % lower mean and no higher max)",
+                        method.name(),
+                        with.cv_mean_mm,
+                        with.cv_max_mm,
+                        without.cv_mean_mm,
+                        without.cv_max_mm,
+                        o.min_gain * 100.0
+                    ));
+                }
+            }
+        }
+    }
+    let scores: Vec<(f64, Option<f64>)> = options
+        .iter()
+        .map(|o| (o.mean_mm, o.orientation_deg))
+        .collect();
+    let (best, excluded) = choose_option(&scores, ORIENTATION_SLACK).ok_or_else(|| {
+        MethodFailure::NoBaseSucceeded {
+            notes: notes.clone(),
+        }
+    })?;
+    let best_orientation = scores[best].1;
+    for i in excluded {
+        notes.push(format!(
+            "{} not chosen: it loses orientation, {:.4}° mean on the {pool_name} poses, more than {:.0} % above the best option's",
+            option_name(&options[i]),
+            scores[i].1.unwrap_or(f64::NAN),
+            ORIENTATION_SLACK * 100.0
+        ));
+    }
+    let reasons: Vec<String> = options.iter().map(|o| o.reason.clone()).collect();
+    let best = options.swap_remove(best);
+    let chosen = Method::from_name(option_name(&best)).expect("a method's own name");
+    let mut reason = format!(
+        "{}: the lowest {} mean on the {pool_name} poses ({:.4} mm) — {}",
+        chosen.name(),
+        if best.compensator.is_some() || best.maps.is_some() || enough {
+            "cross-validated"
+        } else {
+            "residual"
+        },
+        best.mean_mm,
+        reasons.join("; ")
+    );
+    if let Some(a) = best_orientation {
+        reason.push_str(&format!(
+            "; orientation {a:.4}° mean on the {pool_name} poses (orientation within {:.0} % of the best option's is required)",
+            ORIENTATION_SLACK * 100.0
+        ));
+    }
+    if !notes.is_empty() {
+        reason.push_str(&format!("; {}", notes.join("; ")));
+    }
+    Ok(Outcome {
+        fit: best.fit,
+        compensator: best.compensator,
+        auto: Some(AutoSummary {
+            chosen,
+            reason,
+            candidates,
+            orientation_part: best.orientation_part,
+        }),
+    })
+}
+
+/// The method an option delivers.
+fn option_name(o: &BaseOption) -> &'static str {
+    match (&o.compensator, o.maps) {
+        (Some(a), _) => a.method.name(),
+        (None, Some(m)) => m.name(),
+        (None, None) => o.base.method().name(),
+    }
+}
+
+/// What `auto` made of the compensators on a kept joint-map fit.
+struct OnMaps {
+    kept: Option<AppliedCompensator>,
+    settled: Settled,
+    /// The choice, as a prefix of the maps' reason (empty: none tried).
+    reason: String,
+}
+
+/// The candidate compensators on the joint-map fit of `base`.
+fn on_maps_candidates(ctx: &Context, base: Base) -> Vec<(Method, Compensated)> {
+    let on = if base == Base::Km {
+        Base::KmMaps
+    } else {
+        Base::SkcmMaps
+    };
+    ctx.opts
+        .compensator
+        .auto_candidates
+        .iter()
+        .filter_map(|m| Some((*m, m.compensated()?)))
+        .filter(|(_, c)| c.base == on)
+        .collect()
+}
+
+/// Cross-validates the candidate compensators on the joint-map fit of `base`
+/// (their residuals) and keeps the one `choose` accepts against the maps
+/// alone on the same pool. The option keeps the maps' own cross-validated
+/// mean for the comparison with the other bases.
+fn maps_compensator(
+    ctx: &Context,
+    cache: &mut Cache,
+    base: Base,
+    fit: &MethodFit,
+    folds: usize,
+    candidates: &mut Vec<AutoCandidate>,
+    progress: &mut dyn FnMut(f64, usize, Option<f64>) -> bool,
+) -> Result<OnMaps, MethodError> {
+    let methods = on_maps_candidates(ctx, base);
+    if methods.is_empty() {
+        return Ok(OnMaps {
+            kept: None,
+            settled: None,
+            reason: String::new(),
+        });
+    }
+    let (choice, kept, settled) =
+        cross_validate_and_choose(ctx, cache, &methods, &fit.fit, folds, candidates, progress)?;
+    Ok(OnMaps {
+        kept,
+        settled,
+        reason: format!("on {}: {}; ", base.method().name(), choice.reason),
+    })
+}
+
+/// The kept compensator's orientation part and the note when `auto`
+/// dropped it (`orientation_part::settle_for_auto`).
+type Settled = Option<(OrientationPart, Option<String>)>;
+
+/// The orientation mean [deg] `auto` scores an option by: the base's (or
+/// maps') on the pool, or the kept orientation part's cross-validated mean.
+fn option_orientation(base_deg: Option<f64>, settled: &Settled) -> Option<f64> {
+    match settled {
+        Some((part, _)) if part.status == OrientationPartStatus::Trained => part
+            .cross_validation
+            .as_ref()
+            .map(|c| c.compensated_mean_deg)
+            .or(base_deg),
+        _ => base_deg,
+    }
+}
+
+/// Trains and cross-validates each compensator method on `fit`'s residuals,
+/// lists each as an `auto` candidate, and keeps the one `choose` accepts
+/// with its orientation part settled (kept only when it lowered the
+/// cross-validated orientation mean).
+/// `progress(x, epoch, loss)` with `x` in methods done (fractional).
+fn cross_validate_and_choose(
+    ctx: &Context,
+    cache: &mut Cache,
+    methods: &[(Method, Compensated)],
+    fit: &Fit,
+    folds: usize,
+    candidates: &mut Vec<AutoCandidate>,
+    progress: &mut dyn FnMut(f64, usize, Option<f64>) -> bool,
+) -> Result<(Choice, Option<AppliedCompensator>, Settled), MethodError> {
+    let o = &ctx.opts.compensator;
+    let stages = o.cv_stages(folds) as f64;
+    let mut cvs: Vec<(String, CvStats)> = Vec::new();
+    let mut trained: Vec<AppliedCompensator> = Vec::new();
+    for (i, (m, c)) in methods.iter().enumerate() {
+        let max = o.max_epochs(c.network) as f64;
+        let r = cache.trained(ctx, *m, c.network, fit, folds, &mut |stage, e, l| {
+            let f = (stage as f64 + (e as f64 / max).min(1.0)) / stages;
+            progress(i as f64 + f, e, Some(l))
+        });
+        match r {
+            Ok(t) => {
+                let cv = t.cv.clone().expect("auto cross-validates");
+                candidates.push(AutoCandidate {
+                    method: *m,
+                    cross_validation: Some(cv.clone()),
+                    failed: None,
+                    orientation_cross_validation: t.orientation_part.cross_validation.clone(),
+                });
+                cvs.push((m.name().to_string(), cv));
+                trained.push(AppliedCompensator {
+                    method: *m,
+                    base: c.base,
+                    trained: t,
+                });
+            }
+            Err(MethodError::Cancelled) => return Err(MethodError::Cancelled),
+            Err(MethodError::Failed(f)) => candidates.push(AutoCandidate {
+                method: *m,
+                cross_validation: None,
+                failed: Some(f.to_string()),
+                orientation_cross_validation: None,
+            }),
+        }
+    }
+    let choice = choose(&cvs, o.min_gain);
+    let mut picked = choice
+        .chosen
+        .as_deref()
+        .and_then(|chosen| trained.into_iter().find(|a| a.method.name() == chosen));
+    let settled = picked.as_mut().and_then(|p| settle_for_auto(p, o.min_gain));
+    Ok((choice, picked, settled))
+}
+
+/// The joint-map method on `base` among `auto`'s candidates.
+fn maps_candidate(candidates: &[Method], base: Base) -> Option<Method> {
+    candidates
+        .iter()
+        .copied()
+        .find(|m| m.row().run == Run::Maps(base))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Without orientation the lowest position mean wins; with it, an option
+    /// that gains position but loses orientation beyond the slack is
+    /// excluded, one within the slack still competes by position.
+    #[test]
+    fn an_option_losing_orientation_is_not_chosen() {
+        assert_eq!(
+            choose_option(&[(0.45, None), (0.10, None)], 0.02),
+            Some((1, vec![]))
+        );
+        // Maps: 4× better position, but 0.060° against 0.053°: excluded.
+        assert_eq!(
+            choose_option(&[(0.45, Some(0.053)), (0.10, Some(0.060))], 0.02),
+            Some((0, vec![1]))
+        );
+        // 0.0535° is within 2 % of 0.053°: the better position wins.
+        assert_eq!(
+            choose_option(&[(0.45, Some(0.053)), (0.10, Some(0.0535))], 0.02),
+            Some((1, vec![]))
+        );
+        // Better on both: chosen.
+        assert_eq!(
+            choose_option(&[(0.45, Some(0.053)), (0.10, Some(0.019))], 0.02),
+            Some((1, vec![0]))
+        );
+        assert_eq!(choose_option(&[], 0.02), None);
+    }
+}

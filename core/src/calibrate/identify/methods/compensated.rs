@@ -1,0 +1,370 @@
+//! The compensator methods (thesis ch. 3–6): a model-based base, then a learned
+//! compensator on the residuals it leaves.
+//!
+//! A compensator method fits its base (KM for `km-rbf`, SKCM for `skcm-nn`,
+//! `skcm-iwonn`, `skcm-tlbonn`), then trains a compensator
+//! ([`compensate::train`](crate::calibrate::compensate::train)) on the residuals the base
+//! leaves on the **training pool**:
+//!
+//! - Q1, the identification poses, fit the base (eq. 2.3 / 2.8);
+//! - Q2, the training poses (rows or sets with role `training`), train the
+//!   compensator and are never used by the base fit; without Q2 the
+//!   compensator trains on Q1 and is judged by k-fold cross-validation inside
+//!   it (`compensate::select`);
+//! - Q3, the validation poses, are only predicted.
+//!
+//! Samples (frames): a pose of session `s` measured at `y` (registered base
+//! frame of its session, `registration`) has the residual
+//! `E_s⁻¹·y − FK_cal(q + c∘τ)` in the calibrated model's base frame, `E_s` the
+//! fit's frame correction of session `s` (identity for session 0); τ are the
+//! calibrated model's gravity torques at the commanded joints with the pose's
+//! payload [N·m]. The compensated prediction is `E_s·(FK_cal(q + c∘τ) +
+//! NN(q, τ))`. Units SI inside, mm in the report.
+//!
+//! Randomness: the final training draws from `ChaCha8Rng(seed)`, the fold
+//! assignment from `ChaCha8Rng(seed + 1)`, fold `f`'s training from
+//! `ChaCha8Rng(seed + 2 + f)`, the networks' subsample of a pool larger than
+//! `max_network_poses` from `ChaCha8Rng(seed + 1000)`
+//! (`CompensatorOptions::seed`): a calibration is reproducible bit for bit.
+
+use super::orientation_part::{note, train_orientation};
+use super::run::{AppliedCompensator, Cache, Context, Outcome};
+use super::{Compensated, Method, MethodError, MethodFailure, Network};
+use crate::calibrate::compensate::{
+    cross_validate, train, Compensator, CvStats, Sample, StoredCompensator, StoredOrientation,
+    Support, TrainError, TrainReport,
+};
+use crate::calibrate::identify::least_squares::Fit;
+use crate::calibrate::identify::report::{
+    predict_compensated, CompensatorSummary, MethodReport, MethodWarning, OrientationPart,
+    SetErrors, UncertaintyCheck, WarningKind,
+};
+use crate::measure::Measurement;
+use crate::model::kinematics::{chain, gravity_torques_of};
+use crate::model::pose::Pose;
+use crate::model::RobotModel;
+use nalgebra::Matrix3;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+
+/// A trained compensator with its training report and cross-validation.
+#[derive(Clone)]
+pub(crate) struct Trained {
+    pub stored: StoredCompensator,
+    /// Its orientation part, where the pool measured orientations.
+    pub orientation: Option<StoredOrientation>,
+    /// Why it has an orientation part or not, and its cross-validation.
+    pub orientation_part: OrientationPart,
+    /// Where it was trained: its correction fades to zero beyond it.
+    pub support: Support,
+    pub report: TrainReport,
+    pub cv: Option<CvStats>,
+}
+
+/// Training samples of `data` on top of the fitted base (module docs).
+pub(crate) fn samples(
+    model: &RobotModel,
+    frames: &[Pose],
+    data: &[Measurement],
+) -> Result<Vec<Sample>, MethodFailure> {
+    data.iter()
+        .enumerate()
+        .map(|(i, m)| {
+            let (p, _) = predict_compensated(model, None, m)
+                .ok_or(MethodFailure::UnpredictableTrainingPose { pose: i + 1 })?;
+            let c = chain(model, &m.q)
+                .map_err(|cause| MethodFailure::TrainingPose { pose: i + 1, cause })?;
+            let e = frames.get(m.session).copied().unwrap_or_default();
+            Ok(Sample {
+                q: m.q.clone(),
+                tau: gravity_torques_of(model, &c, m.payload_mass),
+                payload_kg: m.payload_mass,
+                residual: e.inverse().transform_point(&m.position) - p,
+            })
+        })
+        .collect()
+}
+
+/// Per pose of `data`, `R_measured·R_predictedᵀ` in the base frame of the
+/// fitted base (`E_sᵀ·R_measured·R_predictedᵀ`, `compensate::oriented`);
+/// `None` for a pose without a measured orientation.
+pub(crate) fn rotations(
+    model: &RobotModel,
+    frames: &[Pose],
+    data: &[Measurement],
+) -> Vec<Option<Matrix3<f64>>> {
+    data.iter()
+        .map(|m| {
+            let rm = m.orientation?;
+            let (_, r) = predict_compensated(model, None, m)?;
+            let e = frames.get(m.session).copied().unwrap_or_default();
+            Some(e.r.transpose() * rm * r.transpose())
+        })
+        .collect()
+}
+
+fn train_error(e: TrainError) -> MethodError {
+    match e {
+        TrainError::Cancelled => MethodError::Cancelled,
+        e => MethodError::Failed(MethodFailure::Training(e)),
+    }
+}
+
+/// Trains `network` on the residuals of `base` on the context's training
+/// pool, after a `folds`-fold cross-validation and the options' blocked folds
+/// (none for `folds` = 0). `progress(stage, epoch, loss)` runs after every
+/// epoch / iteration / generation, with stages before the last the
+/// cross-validation's trainings and the last (`cv_stages(folds) - 1`) the
+/// final training, and returns false to cancel.
+pub(crate) fn train_network(
+    network: Network,
+    base: &Fit,
+    ctx: &Context,
+    folds: usize,
+    progress: &mut dyn FnMut(usize, usize, f64) -> bool,
+) -> Result<Trained, MethodError> {
+    let spec = ctx.opts.compensator.spec(network);
+    let (pool, _) = ctx.pool();
+    let mut data = samples(&base.model, &base.session_frames, pool)?;
+    let mut turns = rotations(&base.model, &base.session_frames, pool);
+    let cap = ctx.opts.compensator.max_network_poses;
+    if !spec.every_pose() && cap > 0 && data.len() > cap {
+        let mut rng = ChaCha8Rng::seed_from_u64(ctx.opts.compensator.seed.wrapping_add(1000));
+        let keep = rand::seq::index::sample(&mut rng, data.len(), cap).into_vec();
+        data = keep.iter().map(|i| data[*i].clone()).collect();
+        turns = keep.iter().map(|i| turns[*i]).collect();
+    }
+    if spec.torque_input() && data.iter().all(|s| s.tau.iter().all(|t| *t == 0.0)) {
+        return Err(MethodFailure::NoTorqueToLearn.into());
+    }
+    let seed = ctx.opts.compensator.seed;
+    let cv = if folds > 0 {
+        let mut fold_rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(1));
+        let mut stage = 0usize;
+        let blocked = ctx.opts.compensator.blocked_folds;
+        let cv = cross_validate(&data, folds, blocked, &mut fold_rng, |part| {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(2 + stage as u64));
+            let s = stage;
+            stage += 1;
+            let (c, _) = train(&spec, part, &mut rng, &mut |e, l| progress(s, e, l))?;
+            Ok::<_, TrainError>(c.into_arc_supported(Some(support_of(part))))
+        })
+        .map_err(train_error)?;
+        Some(cv)
+    } else {
+        None
+    };
+    let last = ctx.opts.compensator.cv_stages(folds) - 1;
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let (mut at_epoch, mut at_loss) = (0, 0.0);
+    let (stored, report) = train(&spec, &data, &mut rng, &mut |e, l| {
+        (at_epoch, at_loss) = (e, l);
+        progress(last, e, l)
+    })
+    .map_err(train_error)?;
+    let (orientation, orientation_part) = train_orientation(
+        &spec,
+        &base.model,
+        (&data, &turns),
+        seed,
+        folds,
+        &mut || progress(last, at_epoch, at_loss),
+    )?;
+    Ok(Trained {
+        stored,
+        orientation,
+        orientation_part,
+        support: support_of(&data),
+        report,
+        cv,
+    })
+}
+
+/// The support of training samples, with the joint maps' fade width.
+pub(crate) fn support_of(samples: &[Sample]) -> Support {
+    let qs: Vec<&[f64]> = samples.iter().map(|s| s.q.as_slice()).collect();
+    Support::of(&qs, SUPPORT_FADE_RAD)
+}
+
+/// Width of a compensator's fade beyond its trained joint ranges [rad] (5°).
+pub(crate) const SUPPORT_FADE_RAD: f64 = 5.0 * std::f64::consts::PI / 180.0;
+
+/// A compensator method: its base (from the cache), then its compensator.
+/// `progress(fraction, iteration, loss)` with `fraction` in [0, 1].
+pub(crate) fn run_compensated(
+    ctx: &Context,
+    cache: &mut Cache,
+    method: Method,
+    c: Compensated,
+    progress: &mut dyn FnMut(f64, usize, Option<f64>) -> bool,
+) -> Result<Outcome, MethodError> {
+    let mf = cache
+        .base_fit(ctx, c.base, &mut |it, rms| progress(0.0, it, Some(rms)))
+        .map_err(|e| match e {
+            MethodError::Failed(cause) => MethodError::Failed(MethodFailure::BaseFailed {
+                base: c.base.method(),
+                cause: Box::new(cause),
+            }),
+            cancelled => cancelled,
+        })?;
+    let folds = ctx.opts.compensator.cv_folds;
+    let max = ctx.opts.compensator.max_epochs(c.network) as f64;
+    let stages = ctx.opts.compensator.cv_stages(folds) as f64;
+    let t = cache.trained(
+        ctx,
+        method,
+        c.network,
+        &mf.fit,
+        folds,
+        &mut |stage, e, l| {
+            let f = (stage as f64 + (e as f64 / max).min(1.0)) / stages;
+            progress(0.05 + 0.95 * f, e, Some(l))
+        },
+    )?;
+    Ok(Outcome {
+        fit: mf,
+        compensator: Some(AppliedCompensator {
+            method,
+            base: c.base,
+            trained: t,
+        }),
+        auto: None,
+    })
+}
+
+/// The base's report turned into the compensated method's: errors on every
+/// set through the compensated prediction, the base's next to them, and the
+/// compensator's summary. `training` is the Q2 pool (empty: none given).
+pub(crate) fn compensate_report(
+    report: &mut MethodReport,
+    applied: &AppliedCompensator,
+    frames: &[Pose],
+    ident: &[Measurement],
+    training: &[Measurement],
+    valid: &[Measurement],
+) {
+    let trained = &applied.trained;
+    let arc = trained
+        .stored
+        .clone()
+        .into_arc_oriented(trained.orientation.clone(), Some(trained.support.clone()));
+    let c: Option<&dyn Compensator> = Some(arc.as_ref());
+    let model = report.calibrated.clone();
+    let base_identification = report.identification.stats.clone();
+    let base_validation = report.validation.as_ref().map(|v| v.stats.clone());
+    report.identification = SetErrors::of_compensated(&model, c, frames, ident);
+    if !valid.is_empty() {
+        report.validation = Some(SetErrors::of_compensated(&model, c, frames, valid));
+    }
+    let base_training = report.training.as_ref().map(|t| t.stats.clone());
+    if !training.is_empty() {
+        report.training = Some(SetErrors::of_compensated(&model, c, frames, training));
+    }
+    let uncertainty = report.validation.as_ref().and_then(|v| {
+        let u: Option<Vec<f64>> = valid
+            .iter()
+            .map(|m| arc.uncertainty(&m.q).map(|u| u.compensated_m * 1e3))
+            .collect();
+        let u = u.filter(|u| u.len() == v.errors_mm.len())?;
+        UncertaintyCheck::of(&u, &v.errors_mm)
+    });
+    let shape = trained.stored.shape();
+    report.compensator = Some(CompensatorSummary {
+        base: applied.base.method(),
+        kind: trained.stored.kind().into(),
+        units: shape.units,
+        inputs: shape.inputs,
+        training: trained.report.clone(),
+        trained_on: if training.is_empty() {
+            "identification"
+        } else {
+            "training"
+        }
+        .into(),
+        training_poses: if training.is_empty() {
+            ident.len()
+        } else {
+            training.len()
+        },
+        cross_validation: trained.cv.clone(),
+        base_identification,
+        base_validation,
+        base_training,
+        trained_ranges_deg: trained
+            .support
+            .ranges_rad
+            .iter()
+            .map(|r| r.map(f64::to_degrees))
+            .collect(),
+        fade_deg: trained.support.fade_rad.to_degrees(),
+        uncertainty,
+        orientation_note: note(
+            &trained.orientation_part,
+            applied.base,
+            ident
+                .iter()
+                .chain(training)
+                .chain(valid)
+                .any(|m| m.orientation.is_some()),
+        ),
+        orientation_part: trained.orientation_part.clone(),
+    });
+    if let Some(w) = report
+        .compensator
+        .as_ref()
+        .and_then(|c| c.uncertainty.as_ref())
+        .and_then(|u| u.warning())
+    {
+        report.warnings.push(MethodWarning {
+            kind: WarningKind::UncertaintyOptimistic,
+            joint: None,
+            message: w,
+        });
+    }
+    report.stored_compensator = Some(trained.stored.clone());
+    report.stored_support = Some(trained.support.clone());
+    report.stored_orientation = trained.orientation.clone();
+}
+
+/// Errors of the base alone on the pool (the residual norms [mm], and the
+/// orientation errors [deg] where the pool measured orientation).
+pub(crate) fn base_pool_errors(base: &Fit, pool: &[Measurement]) -> SetErrors {
+    SetErrors::of(&base.model, &base.session_frames, pool)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::preset;
+    use nalgebra::Vector3;
+
+    /// A sample's residual is what the base leaves in the base frame of
+    /// session 0: shifting a session-1 pose by its frame correction gives the
+    /// same residual as the session-0 pose.
+    #[test]
+    fn samples_undo_the_session_frame() {
+        let model = preset("ur10").unwrap();
+        let q = vec![0.1, -0.7, 1.1, 0.3, -0.4, 0.2];
+        let p = crate::model::kinematics::fk(&model, &q).unwrap().p;
+        let offset = Vector3::new(1e-4, -2e-4, 3e-4);
+        let mut frame = Pose::identity();
+        frame.tr_x(0.01);
+        frame.rot_z(0.02);
+        let m0 = Measurement {
+            q: q.clone(),
+            position: p + offset,
+            orientation: None,
+            payload_mass: 0.0,
+            session: 0,
+            std: None,
+        };
+        let m1 = Measurement {
+            position: frame.transform_point(&(p + offset)),
+            session: 1,
+            ..m0.clone()
+        };
+        let s = samples(&model, &[Pose::identity(), frame], &[m0, m1]).unwrap();
+        assert!((s[0].residual - offset).norm() < 1e-12);
+        assert!((s[1].residual - offset).norm() < 1e-12);
+    }
+}

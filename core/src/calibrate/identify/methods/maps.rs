@@ -1,0 +1,92 @@
+//! The joint-map methods (beyond the thesis): KM or SKCM, then per-joint angle
+//! error maps fitted jointly with the linearised geometry
+//! (`identify::joint_maps`) on the identification and training poses, and the
+//! geometry, compliance and session frames refitted by LM on the
+//! identification poses with the maps held fixed; `rounds` times. When the
+//! cross-validation keeps no map (K = 0 wins) the base's fit stays, and the
+//! report says so.
+//!
+//! Randomness: the folds draw from `ChaCha8Rng(seed + 101)`
+//! (`CompensatorOptions::seed`).
+
+use super::run::{Cache, Context, MethodFit, Outcome};
+use super::{Base, MethodError, MethodFailure};
+use crate::calibrate::identify::joint_maps::fit_joint_maps;
+use crate::calibrate::identify::least_squares::fit;
+use crate::measure::Measurement;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+
+/// The joint-map method on `base` (module docs), computed once per run.
+pub(crate) fn run_maps(
+    ctx: &Context,
+    cache: &mut Cache,
+    base: Base,
+    progress: &mut dyn FnMut(f64, usize, Option<f64>) -> bool,
+) -> Result<Outcome, MethodError> {
+    if let Some((_, r)) = cache.maps.iter().find(|(b, _)| *b == base) {
+        return r.clone().map(Outcome::plain).map_err(MethodError::Failed);
+    }
+    let r = match fit_maps(ctx, cache, base, progress) {
+        Err(MethodError::Cancelled) => return Err(MethodError::Cancelled),
+        Err(MethodError::Failed(f)) => Err(f),
+        Ok(mf) => Ok(mf),
+    };
+    cache.maps.push((base, r.clone()));
+    r.map(Outcome::plain).map_err(MethodError::Failed)
+}
+
+fn fit_maps(
+    ctx: &Context,
+    cache: &mut Cache,
+    base: Base,
+    progress: &mut dyn FnMut(f64, usize, Option<f64>) -> bool,
+) -> Result<MethodFit, MethodError> {
+    let settings = &ctx.opts.joint_maps;
+    let rounds = settings.rounds.max(1);
+    let stages = (2 * rounds + 1) as f64;
+    let mut mf = cache.base_fit(ctx, base, &mut |it, rms| progress(0.0, it, Some(rms)))?;
+    let sessions = mf.fit.session_frames.len().max(1);
+    let data: Vec<Measurement> = ctx
+        .ident
+        .iter()
+        .chain(ctx.training)
+        .filter(|m| m.session < sessions)
+        .cloned()
+        .collect();
+    let mut rng = ChaCha8Rng::seed_from_u64(ctx.opts.compensator.seed.wrapping_add(101));
+    let w = ctx.opts.lm.orientation_weight;
+    for round in 0..rounds {
+        let mut plain = mf.fit.model.clone();
+        plain.joint_maps = None;
+        let stage = (1 + 2 * round) as f64;
+        let fitted = fit_joint_maps(
+            &plain,
+            &mf.fit.session_frames,
+            &mf.ids,
+            &data,
+            w,
+            settings,
+            &mut rng,
+            &mut |done, total| progress((stage + done as f64 / total as f64) / stages, done, None),
+        )
+        .map_err(MethodFailure::JointMaps)?
+        .ok_or(MethodError::Cancelled)?;
+        let Some(maps) = fitted.maps.clone() else {
+            mf.maps = Some(fitted);
+            break;
+        };
+        plain.joint_maps = Some(maps);
+        let refit = fit(
+            &plain,
+            &mf.ids,
+            ctx.ident,
+            ctx.sessions,
+            &ctx.opts.lm,
+            &mut |it, rms| progress((stage + 1.0) / stages, it, Some(rms)),
+        )?;
+        mf.fit = refit;
+        mf.maps = Some(fitted);
+    }
+    Ok(mf)
+}

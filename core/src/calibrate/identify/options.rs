@@ -1,0 +1,179 @@
+//! What a calibration runs and with which settings: the methods, the solver
+//! settings, the compensator settings, the plausibility range of identified
+//! stiffness, and the progress reported while it runs.
+//!
+//! Units: SI inside (N·m/rad for stiffness, rad for deflections); the report
+//! speaks mm and deg.
+
+use super::identifiability::IdentifiabilitySettings;
+use super::joint_maps::JointMapSettings;
+use super::least_squares::LmSettings;
+pub use super::methods::Method;
+use super::methods::Network;
+use crate::calibrate::compensate::{
+    CompensatorSpec, GpSettings, IwoSettings, LmTrainSettings, MlpSettings, MlpSpec, RbfSettings,
+    TlboTrainSettings, Trainer,
+};
+use crate::optim::TlboSettings;
+use serde::{Deserialize, Serialize};
+
+/// Calibration settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CalibrationOptions {
+    pub methods: Vec<Method>,
+    /// Register the measurement frame in closed form first (off only when the
+    /// data is already in the base frame and should stay there exactly).
+    pub register: bool,
+    pub lm: LmSettings,
+    pub tlbo: TlboSettings,
+    pub identifiability: IdentifiabilitySettings,
+    /// Above this RMS [mm] of the nominal model after registration, the data is
+    /// rejected as inconsistent with the model (units, joint order, signs).
+    pub max_nominal_rms_mm: f64,
+    /// Upper bound of the TLBO compliance search, as the largest joint deflection
+    /// it may cause in the identification poses [rad].
+    pub tlbo_max_deflection_rad: f64,
+    /// Identified joint stiffness outside `[low, high]` [N·m/rad] is reported as
+    /// a warning (physically implausible for an industrial joint).
+    pub plausible_stiffness_nm_per_rad: [f64; 2],
+    /// Training, cross-validation and choice of the learned compensators.
+    #[serde(default)]
+    pub compensator: CompensatorOptions,
+    /// The joint-map methods' fit ([`Method::JOINT_MAPS`]).
+    #[serde(default)]
+    pub joint_maps: JointMapSettings,
+}
+
+/// Settings of the compensator methods ([`Method::COMPENSATED`]) and of `auto`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct CompensatorOptions {
+    /// Seed of every random draw of the compensators (initial weights,
+    /// held-out splits, folds).
+    pub seed: u64,
+    /// Folds of the cross-validation on the training pool (reported for every
+    /// compensator method; `auto` chooses by it). 0 skips it for the explicit
+    /// methods (`auto` then uses 5).
+    pub cv_folds: usize,
+    /// Spatially blocked folds run with the cross-validation (whole regions
+    /// of joint space held out, `compensate::select`); `auto` rejects a
+    /// compensator that makes any of them worse than its base. 0 skips them.
+    pub blocked_folds: usize,
+    /// `auto` takes a compensator only when its cross-validated mean is at
+    /// least this fraction below its base's (and its max not above).
+    pub min_gain: f64,
+    /// With fewer training poses `auto` keeps the base without training.
+    pub min_training_poses: usize,
+    /// The joint-map and compensator methods `auto` considers.
+    pub auto_candidates: Vec<Method>,
+    pub rbf: RbfSettings,
+    /// Network of SKCM-NN ([`Network::LmMlp`]).
+    pub nn: MlpSpec,
+    pub lm: LmTrainSettings,
+    /// Network of SKCM-IWONN and SKCM-TLBONN ([`Network::IwoMlp`],
+    /// [`Network::TlboMlp`]; `MlpSpec::POPULATION`).
+    pub small: MlpSpec,
+    pub iwo: IwoSettings,
+    pub tlbo: TlboTrainSettings,
+    /// The Gaussian-process compensator ([`Network::Gp`]).
+    pub gp: GpSettings,
+    /// The networks (MLP, RBF) train and cross-validate on at most this many
+    /// poses of the pool, a seeded subsample beyond it: their training grows
+    /// with the square of the poses, the Gaussian process's linearly (it takes
+    /// every pose). 0: no limit.
+    pub max_network_poses: usize,
+}
+
+impl Default for CompensatorOptions {
+    fn default() -> Self {
+        CompensatorOptions {
+            seed: 1,
+            cv_folds: 5,
+            blocked_folds: 4,
+            min_gain: 0.05,
+            min_training_poses: 20,
+            auto_candidates: Method::JOINT_MAPS
+                .iter()
+                .chain(&Method::COMPENSATED)
+                .copied()
+                .collect(),
+            rbf: RbfSettings::default(),
+            nn: MlpSpec::SKCM_NN,
+            lm: LmTrainSettings::default(),
+            small: MlpSpec::POPULATION,
+            iwo: IwoSettings::default(),
+            tlbo: TlboTrainSettings::default(),
+            gp: GpSettings::default(),
+            max_network_poses: 1000,
+        }
+    }
+}
+
+impl CompensatorOptions {
+    /// Trainings of one cross-validated compensator: the random folds, the
+    /// blocked ones and the final training.
+    pub fn cv_stages(&self, folds: usize) -> usize {
+        if folds == 0 {
+            1
+        } else {
+            folds + self.blocked_folds + 1
+        }
+    }
+
+    /// The network and trainer of a compensator: its family's settings
+    /// ([`CompensatorSpec`], one variant per family of the compensator
+    /// table) from these options.
+    pub fn spec(&self, network: Network) -> CompensatorSpec {
+        match network {
+            Network::Rbf => CompensatorSpec::Rbf(self.rbf.clone()),
+            Network::LmMlp => CompensatorSpec::Mlp(MlpSettings {
+                spec: self.nn,
+                trainer: Trainer::Lm(self.lm.clone()),
+            }),
+            Network::IwoMlp => CompensatorSpec::Mlp(MlpSettings {
+                spec: self.small,
+                trainer: Trainer::Iwo(self.iwo.clone()),
+            }),
+            Network::TlboMlp => CompensatorSpec::Mlp(MlpSettings {
+                spec: self.small,
+                trainer: Trainer::Tlbo(self.tlbo.clone()),
+            }),
+            Network::Gp => CompensatorSpec::Gp(self.gp.clone()),
+        }
+    }
+
+    /// Epochs / iterations / generations a training run of `network` may take
+    /// at most (for progress percentages; its family's
+    /// [`CompensatorSpec::max_epochs`]).
+    pub fn max_epochs(&self, network: Network) -> usize {
+        self.spec(network).max_epochs()
+    }
+}
+
+impl Default for CalibrationOptions {
+    fn default() -> Self {
+        CalibrationOptions {
+            methods: Method::SEED.to_vec(),
+            register: true,
+            lm: LmSettings::default(),
+            tlbo: TlboSettings::default(),
+            identifiability: IdentifiabilitySettings::default(),
+            max_nominal_rms_mm: 250.0,
+            tlbo_max_deflection_rad: 0.01,
+            plausible_stiffness_nm_per_rad: [1e3, 1e9],
+            compensator: CompensatorOptions::default(),
+            joint_maps: JointMapSettings::default(),
+        }
+    }
+}
+
+/// Progress of a running calibration.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Progress {
+    pub phase: String,
+    pub iteration: usize,
+    /// Overall completion in [0, 100].
+    pub percent: f64,
+    /// Current RMS residual [mm], when the phase has one.
+    pub rms_mm: Option<f64>,
+}

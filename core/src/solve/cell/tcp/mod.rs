@@ -1,0 +1,335 @@
+//! TCP calibration: a production tool's TCP in the flange frame from joint
+//! readings on the CALIBRATED model.
+//!
+//! Frames: the flange frame is the calibrated model's last link frame (the
+//! model's own measurement tool removed, `super::with_tool` with the identity);
+//! its pose `F_i = (R_i, p_i)` in the registered base frame comes from
+//! [`CompensatedModel::predict_base`] (compliance, joint maps and the
+//! compensator's position residual included, as every solve sees them). A
+//! tracker measures in the measurement frame; `cell_from_base` (the
+//! calibration's registration) maps it into the base frame. The tool's TCP is
+//! `t` (flange frame); its orientation is the flange's unless an axis is
+//! given ([`axis`]), with the tool's z pointing out of the tip.
+//!
+//! Methods:
+//! - [`fixed_point`]: the tip held at one fixed point `p` in ≥ 4 orientations,
+//!   `R_i·t + p_i = p` solved for `(t, p)` by linear least squares;
+//! - [`tracker`]: a reflector (`x_i`) or a 6-D probe (`M_i`) on the tool,
+//!   `t = mean R_i^T (x_i − p_i)`, the frame `F_i⁻¹·M_i` averaged;
+//! - [`axis`]: the tool's z from a second point on its axis or from touches
+//!   with the tool flat on a plane.
+//!
+//! Units: SI (m, rad) in poses and points; the reported residuals and σ are in
+//! mm and degrees (fields named so). Joint readings are controller degrees.
+
+pub mod axis;
+pub mod fixed_point;
+pub mod readings;
+pub mod request;
+pub mod tracker;
+
+pub use readings::{Reading, WoPoint};
+pub use request::{fit_tool, fit_work_object, AxisRequest, ToolRequest};
+
+use crate::calibrate::compensate::CompensatedModel;
+use crate::model::Pose;
+use nalgebra::{Matrix3, Vector3};
+use serde::Serialize;
+
+/// Why a tool or work object was not fitted: the readings do not determine
+/// it (a closed set: the API's `reason` enum and the CLI's text derive from
+/// it). `measured` and `needed` of a [`FitError`] carry the figure each
+/// reason names, in the unit given here.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum NotFittedReason {
+    /// Fewer rows than the method needs (rows).
+    TooFewReadings,
+    /// A row's joint count is not the robot's (joints).
+    JointCount,
+    /// A row lacks the joint readings the method needs.
+    MissingJoints,
+    /// A tracker method's row lacks the position x, y, z.
+    MissingPosition,
+    /// A 6-D probe's row lacks the orientation rx, ry, rz.
+    MissingOrientation,
+    /// An axis given with a 6-D probe, which gives the orientation itself.
+    AxisWithProbe,
+    /// A work object lacks its origin, x or xy point, or a row names no point.
+    MissingPoint,
+    /// Work-object touches (joint readings) without the tool that made them.
+    TouchesNeedTool,
+    /// A value is not finite.
+    NotFinite,
+    /// The calibrated model's forward kinematics failed at a row.
+    Kinematics,
+    /// Fixed point: the orientations differ too little about some direction
+    /// (degrees).
+    OrientationsTooSimilar,
+    /// The least-squares problem is singular.
+    Singular,
+    /// The second axis point is too near the tip (mm).
+    AxisPointTooClose,
+    /// The plane touches lie on a line (spread across it, mm).
+    PlaneTouchesInLine,
+    /// The work object's x point is too near its origin (mm).
+    XPointTooClose,
+    /// The xy point is (nearly) on the x axis (angle between OX and OY,
+    /// degrees).
+    XyPointOnXAxis,
+}
+
+impl NotFittedReason {
+    pub const ALL: [NotFittedReason; 16] = [
+        NotFittedReason::TooFewReadings,
+        NotFittedReason::JointCount,
+        NotFittedReason::MissingJoints,
+        NotFittedReason::MissingPosition,
+        NotFittedReason::MissingOrientation,
+        NotFittedReason::AxisWithProbe,
+        NotFittedReason::MissingPoint,
+        NotFittedReason::TouchesNeedTool,
+        NotFittedReason::NotFinite,
+        NotFittedReason::Kinematics,
+        NotFittedReason::OrientationsTooSimilar,
+        NotFittedReason::Singular,
+        NotFittedReason::AxisPointTooClose,
+        NotFittedReason::PlaneTouchesInLine,
+        NotFittedReason::XPointTooClose,
+        NotFittedReason::XyPointOnXAxis,
+    ];
+
+    pub fn as_str(self) -> &'static str {
+        match self {
+            NotFittedReason::TooFewReadings => "too_few_readings",
+            NotFittedReason::JointCount => "joint_count",
+            NotFittedReason::MissingJoints => "missing_joints",
+            NotFittedReason::MissingPosition => "missing_position",
+            NotFittedReason::MissingOrientation => "missing_orientation",
+            NotFittedReason::AxisWithProbe => "axis_with_probe",
+            NotFittedReason::MissingPoint => "missing_point",
+            NotFittedReason::TouchesNeedTool => "touches_need_tool",
+            NotFittedReason::NotFinite => "not_finite",
+            NotFittedReason::Kinematics => "kinematics",
+            NotFittedReason::OrientationsTooSimilar => "orientations_too_similar",
+            NotFittedReason::Singular => "singular",
+            NotFittedReason::AxisPointTooClose => "axis_point_too_close",
+            NotFittedReason::PlaneTouchesInLine => "plane_touches_in_line",
+            NotFittedReason::XPointTooClose => "x_point_too_close",
+            NotFittedReason::XyPointOnXAxis => "xy_point_on_x_axis",
+        }
+    }
+}
+
+/// Why a tool or work object was not fitted, with what the user can act on:
+/// the reason, a message naming the fix, the row at fault (1-based, in the
+/// list the message names), the figure the reason names against what it
+/// needs, and for a tool whose axis failed the tip's own fit.
+#[derive(Debug, Clone, PartialEq, Serialize, thiserror::Error)]
+#[error("{message}")]
+pub struct FitError {
+    pub reason: NotFittedReason,
+    pub message: String,
+    pub row: Option<usize>,
+    pub measured: Option<f64>,
+    pub needed: Option<f64>,
+    /// The tip, fitted before its axis could not be.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tip: Option<Box<ToolFit>>,
+}
+
+impl FitError {
+    pub fn new(reason: NotFittedReason, message: impl Into<String>) -> Self {
+        FitError {
+            reason,
+            message: message.into(),
+            row: None,
+            measured: None,
+            needed: None,
+            tip: None,
+        }
+    }
+
+    /// The row at fault (1-based).
+    pub fn at_row(mut self, row: usize) -> Self {
+        self.row = Some(row);
+        self
+    }
+
+    /// The figure the reason names and what it needs.
+    pub fn figures(mut self, measured: f64, needed: f64) -> Self {
+        self.measured = Some(measured);
+        self.needed = Some(needed);
+        self
+    }
+
+    /// The tip's fit, when only the axis failed.
+    pub fn with_tip(mut self, tip: ToolFit) -> Self {
+        self.tip = Some(Box::new(tip));
+        self
+    }
+}
+
+/// How a TCP was found (a closed set: CLI values, API enums and labels).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TcpMethod {
+    /// Tip held at one fixed point in ≥ 4 orientations (joint readings only).
+    FixedPoint,
+    /// A reflector on the tool measured by the tracker.
+    TrackerPoint,
+    /// A 6-D probe on the tool measured by the tracker (full frame).
+    TrackerFrame,
+}
+
+impl TcpMethod {
+    pub const ALL: [TcpMethod; 3] = [
+        TcpMethod::FixedPoint,
+        TcpMethod::TrackerPoint,
+        TcpMethod::TrackerFrame,
+    ];
+
+    pub fn as_str(self) -> &'static str {
+        match self {
+            TcpMethod::FixedPoint => "fixed_point",
+            TcpMethod::TrackerPoint => "tracker_point",
+            TcpMethod::TrackerFrame => "tracker_frame",
+        }
+    }
+}
+
+impl std::str::FromStr for TcpMethod {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let k = s.trim().replace('-', "_").to_ascii_lowercase();
+        TcpMethod::ALL
+            .into_iter()
+            .find(|m| m.as_str() == k)
+            .ok_or_else(|| {
+                let all: Vec<&str> = TcpMethod::ALL.iter().map(|m| m.as_str()).collect();
+                format!("method `{s}`: one of {}", all.join(", "))
+            })
+    }
+}
+
+/// A fitted tool: its TCP frame in the flange frame and how well it fits.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ToolFit {
+    pub method: TcpMethod,
+    /// Flange → TCP [m]; the rotation is the flange's unless an axis or a
+    /// 6-D probe gave one.
+    #[serde(skip)]
+    pub tcp: Pose,
+    /// Per pose: distance of the fitted tip from where it should be [mm].
+    pub residual_mm: Vec<f64>,
+    pub rms_mm: f64,
+    pub max_mm: f64,
+    /// 1σ of the TCP position per flange axis [mm] (covariance of the fit).
+    pub sigma_mm: [f64; 3],
+    /// Per pose: angle between the fitted and the measured frame [deg] (6-D
+    /// probe and plane axis only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub orientation_residual_deg: Option<Vec<f64>>,
+    /// 1σ of the tool's orientation [deg], when one was fitted.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sigma_deg: Option<f64>,
+    /// The fixed point in the base frame [mm] (fixed-point method).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fixed_point_mm: Option<[f64; 3]>,
+    /// The smallest orientation spread of the poses [deg] (fixed-point method):
+    /// how far the orientations differ about the worst direction.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub orientation_spread_deg: Option<f64>,
+    /// Where the tool's z came from, when an axis was fitted.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub axis: Option<axis::AxisSource>,
+    /// Distance from the tip to the second axis point [mm] (axis point).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub axis_length_mm: Option<f64>,
+    /// Per touch: the tip's distance from the fitted plane [mm] (plane axis).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub plane_residual_mm: Option<Vec<f64>>,
+}
+
+/// The calibrated flange pose (registered base frame) at every row of
+/// controller joint readings [deg].
+pub fn flange_poses(
+    model: &CompensatedModel,
+    joints_deg: &[Vec<f64>],
+) -> Result<Vec<Pose>, FitError> {
+    let flange = super::with_tool(model, &Pose::identity());
+    let dof = model.dof();
+    joints_deg
+        .iter()
+        .enumerate()
+        .map(|(i, q)| {
+            if q.len() != dof {
+                return Err(FitError::new(
+                    NotFittedReason::JointCount,
+                    format!(
+                        "row {}: {} joint readings, the robot has {dof} joints (controller degrees)",
+                        i + 1,
+                        q.len()
+                    ),
+                )
+                .at_row(i + 1)
+                .figures(q.len() as f64, dof as f64));
+            }
+            if q.iter().any(|v| !v.is_finite()) {
+                return Err(FitError::new(
+                    NotFittedReason::NotFinite,
+                    format!(
+                        "row {}: joint readings must be finite (controller degrees)",
+                        i + 1
+                    ),
+                )
+                .at_row(i + 1));
+            }
+            let rad: Vec<f64> = q.iter().map(|d| d.to_radians()).collect();
+            let qm = model.nominal.joints_from_controller(&rad);
+            flange.predict_base(&qm).map_err(|e| {
+                FitError::new(
+                    NotFittedReason::Kinematics,
+                    format!("forward kinematics failed at row {}: {e}", i + 1),
+                )
+                .at_row(i + 1)
+            })
+        })
+        .collect()
+}
+
+/// Points given in the measurement frame, in the registered base frame.
+pub fn cell_points_to_base(model: &CompensatedModel, points: &[Vector3<f64>]) -> Vec<Vector3<f64>> {
+    let to_base = model.cell_from_base.inverse();
+    points.iter().map(|x| to_base.transform_point(x)).collect()
+}
+
+/// The rotation nearest (Frobenius) to `m`: the chordal mean of rotations
+/// when `m` is their sum.
+pub fn nearest_rotation(m: &Matrix3<f64>) -> Matrix3<f64> {
+    let svd = m.svd(true, true);
+    let (u, vt) = (svd.u.unwrap(), svd.v_t.unwrap());
+    let d = (u * vt).determinant().signum();
+    u * Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, d)) * vt
+}
+
+/// Root mean square and maximum of `v` (0 for none).
+pub(crate) fn rms_max(v: &[f64]) -> (f64, f64) {
+    if v.is_empty() {
+        return (0.0, 0.0);
+    }
+    let rms = (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt();
+    (rms, v.iter().cloned().fold(0.0, f64::max))
+}
+
+/// Rejects non-finite points.
+pub(crate) fn check_finite(points: &[Vector3<f64>], what: &str) -> Result<(), FitError> {
+    match points.iter().position(|p| !p.iter().all(|v| v.is_finite())) {
+        Some(i) => Err(FitError::new(
+            NotFittedReason::NotFinite,
+            format!("{what} {}: coordinates must be finite", i + 1),
+        )
+        .at_row(i + 1)),
+        None => Ok(()),
+    }
+}

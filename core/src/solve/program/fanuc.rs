@@ -1,0 +1,293 @@
+//! Fanuc TP programs in their ASCII form (`.ls`).
+//!
+//! Targets: the `/POS` section's positions `P[n]` or `P[n:"comment"]`, group
+//! `GP1`, in Cartesian form `UF : u, UT : t, CONFIG : 'N U T, 0, 0, 0',
+//! X = … mm, Y = … mm, Z = … mm, W = … deg, P = … deg, R = … deg`; joint
+//! positions (`J1 = …`) are not targets, nor are other groups. The user frame
+//! `UF` and tool `UT` are looked up in the cell by number (`UF : 0` is the
+//! base frame). The rest of the file (`/PROG`, `/ATTR`, `/MN`) is not read.
+//!
+//! Units: mm and degrees, `W, P, R` fixed-axis XYZ (`R = Rz(R)·Ry(P)·Rx(W)`).
+//! `CONFIG`: `F`/`N` (axis 5 < 0 or not), `U`/`D` (elbow), `T`/`B` (wrist
+//! centre in front of or behind axis 1), then the turn numbers of axes 1, 4
+//! and 6, `⌊(A + 180°)/360°⌋`; all kept. An unsolved position is marked by its
+//! comment, `P[n:"robocal: failed"]`.
+
+use super::lex::{error, position, tokens, Fail, Tok, Token};
+use super::{Flags, FrameSpec, JointTarget, ParseError, ProgramFile, Site, Targets};
+use crate::model::orientation::{rotation_from, OrientationConvention};
+use crate::model::Pose;
+use crate::solve::cell::CellRef;
+use nalgebra::Vector3;
+use std::ops::Range;
+
+/// The mark of an unsolved position (Fanuc comments hold 16 characters).
+pub const MARK: &str = ":\"robocal: failed\"";
+
+fn punct(t: Option<&Token>, c: char) -> bool {
+    matches!(t, Some((Tok::Punct(p), _)) if *p == c)
+}
+
+fn word(t: Option<&Token>) -> Option<&str> {
+    match t {
+        Some((Tok::Word(w), _)) => Some(w),
+        _ => None,
+    }
+}
+
+/// Parses `'N U T, 0, 0, 0'`.
+fn config(text: &str) -> Option<Flags> {
+    let inner = text.trim_matches('\'');
+    let mut parts = inner.split(',');
+    let letters: Vec<char> = parts
+        .next()?
+        .chars()
+        .filter(|c| !c.is_whitespace())
+        .map(|c| c.to_ascii_uppercase())
+        .collect();
+    let turns: Vec<i32> = parts
+        .map(|p| p.trim().parse().ok())
+        .collect::<Option<Vec<i32>>>()?;
+    let flag = |a: char, b: char| {
+        letters
+            .iter()
+            .find(|c| **c == a || **c == b)
+            .map(|c| *c == a)
+    };
+    Some(Flags::Fanuc {
+        flip: flag('F', 'N')?,
+        up: flag('U', 'D')?,
+        front: flag('T', 'B')?,
+        turns: [
+            turns.first().copied().unwrap_or(0),
+            turns.get(1).copied().unwrap_or(0),
+            turns.get(2).copied().unwrap_or(0),
+        ],
+    })
+}
+
+/// What one `P[n]` block holds for group 1.
+enum Position {
+    Cartesian(Box<Site>),
+    Joint(JointTarget),
+    Neither,
+}
+
+/// One `P[n]{…};` block from token `i` (at `P`); returns its group-1
+/// position and the token after the block.
+fn block(fi: usize, text: &str, toks: &[Token], i: usize) -> Result<(Position, usize), Fail> {
+    let at = |k: usize| toks.get(k).map_or(text.len(), |t| t.1.start);
+    if !(word(toks.get(i)) == Some("P") && punct(toks.get(i + 1), '[')) {
+        return Err((at(i), "expected `P[n]{`".into()));
+    }
+    let Some((Tok::Number(n), _)) = toks.get(i + 2) else {
+        return Err((at(i + 2), "expected the position number".into()));
+    };
+    let mut k = i + 3;
+    let mark_at: Range<usize>;
+    if punct(toks.get(k), ':') {
+        let Some((Tok::Str, r)) = toks.get(k + 1) else {
+            return Err((at(k + 1), "expected a comment string".into()));
+        };
+        mark_at = toks[k].1.start..r.end;
+        k += 2;
+    } else {
+        mark_at = at(k)..at(k);
+    }
+    if !punct(toks.get(k), ']') || !punct(toks.get(k + 1), '{') {
+        return Err((at(k), "expected `]{`".into()));
+    }
+    k += 2;
+    let name = format!("P[{n}]");
+    let mut group = 0;
+    let (mut uf, mut ut, mut flags) = (None, None, None);
+    let mut values: [Option<(f64, Range<usize>)>; 6] = Default::default();
+    let mut joint: [Option<f64>; 6] = [None; 6];
+    let mut any_joint = false;
+    loop {
+        let Some((t, r)) = toks.get(k) else {
+            return Err((at(i), format!("{name} is not closed by `}};`")));
+        };
+        match t {
+            Tok::Punct('}') => {
+                if !punct(toks.get(k + 1), ';') {
+                    return Err((at(k + 1), "expected `;` after `}`".into()));
+                }
+                k += 2;
+                break;
+            }
+            Tok::Word(w) if w.starts_with("GP") && punct(toks.get(k + 1), ':') => {
+                group = w[2..].parse().unwrap_or(0);
+                k += 2;
+            }
+            Tok::Word(w) if punct(toks.get(k + 1), ':') => {
+                let key = w.to_ascii_uppercase();
+                match (key.as_str(), toks.get(k + 2)) {
+                    ("UF" | "UT", Some((Tok::Number(v), _)))
+                        if v.fract() == 0.0 && *v >= 0.0 && *v < 1e6 =>
+                    {
+                        if group == 1 {
+                            *(if key == "UF" { &mut uf } else { &mut ut }) = Some(*v as u32);
+                        }
+                    }
+                    ("CONFIG", Some((Tok::Str, s))) => {
+                        let c = config(&text[s.clone()])
+                            .ok_or((s.start, "bad CONFIG string".to_string()))?;
+                        if group == 1 {
+                            flags = Some(c);
+                        }
+                    }
+                    _ => return Err((r.start, format!("unexpected value of {w}"))),
+                }
+                k += 3;
+                if punct(toks.get(k), ',') {
+                    k += 1;
+                }
+            }
+            Tok::Word(w) if punct(toks.get(k + 1), '=') => {
+                let key = w.to_ascii_uppercase();
+                let mut j = k + 2;
+                let sign = if punct(toks.get(j), '-') {
+                    j += 1;
+                    -1.0
+                } else {
+                    if punct(toks.get(j), '+') {
+                        j += 1;
+                    }
+                    1.0
+                };
+                let Some((Tok::Number(v), vr)) = toks.get(j) else {
+                    return Err((at(j), format!("{w} is not a number")));
+                };
+                let slot = toks[k + 2].1.start..vr.end;
+                j += 1;
+                if word(toks.get(j))
+                    .is_some_and(|u| u.eq_ignore_ascii_case("mm") || u.eq_ignore_ascii_case("deg"))
+                {
+                    j += 1;
+                }
+                if punct(toks.get(j), ',') {
+                    j += 1;
+                }
+                if group == 1 {
+                    match "XYZWPR".find(key.as_str()).filter(|_| key.len() == 1) {
+                        Some(idx) => values[idx] = Some((sign * v, slot)),
+                        None if key.starts_with('J') || key.starts_with('E') => {
+                            let axis = key.strip_prefix('J').and_then(|n| n.parse::<usize>().ok());
+                            if let Some(n) = axis {
+                                any_joint = true;
+                                if (1..=6).contains(&n) {
+                                    joint[n - 1] = Some(sign * v);
+                                }
+                            }
+                        }
+                        None => return Err((r.start, format!("unknown component {w}"))),
+                    }
+                }
+                k = j;
+            }
+            _ => return Err((r.start, "unexpected text in the position".into())),
+        }
+    }
+    let line = position(text, toks[i].1.start).0;
+    if any_joint {
+        let deg: Option<Vec<f64>> = joint.iter().copied().collect();
+        let found = deg.map_or(Position::Neither, |deg| {
+            Position::Joint(JointTarget {
+                file: fi,
+                line,
+                deg,
+            })
+        });
+        return Ok((found, k));
+    }
+    if values.iter().all(Option::is_none) {
+        return Ok((Position::Neither, k));
+    }
+    let complete: Option<Vec<(f64, Range<usize>)>> = values.iter().cloned().collect();
+    let (pose, slots, skip) = match complete {
+        Some(v) => {
+            let x: Vec<f64> = v.iter().map(|p| p.0).collect();
+            let pose = rotation_from(OrientationConvention::FanucWpr, &x[3..])
+                .map(|r| Pose::new(r, Vector3::new(x[0], x[1], x[2]) * 1e-3));
+            let slots = v.into_iter().map(|p| p.1).collect();
+            match pose {
+                Ok(p) => (Some(p), slots, None),
+                Err(e) => (None, slots, Some(e.to_string())),
+            }
+        }
+        None => (
+            None,
+            Vec::new(),
+            Some("incomplete position: X..R not all given".into()),
+        ),
+    };
+    let spec = |v: Option<u32>| v.map_or(FrameSpec::Unset, |n| FrameSpec::Ref(CellRef::Number(n)));
+    Ok((
+        Position::Cartesian(Box::new(Site {
+            file: fi,
+            line,
+            name,
+            pose,
+            flags: flags.unwrap_or(Flags::Nearest),
+            tool: spec(ut),
+            load: None,
+            work_object: spec(uf),
+            slots,
+            convention: OrientationConvention::FanucWpr,
+            unit_m: 1e-3,
+            decimals: [3, 3],
+            mark_at,
+            after_joints: None,
+            skip,
+            stationary_tool: false,
+        })),
+        k,
+    ))
+}
+
+/// Parses `.ls` files: the Cartesian positions of their `/POS` sections.
+pub fn parse(files: &[ProgramFile]) -> Result<Targets, ParseError> {
+    let mut found = Targets::default();
+    for (fi, f) in files.iter().enumerate() {
+        let text = f.text.as_str();
+        let Some(pos) = section(text, "/POS") else {
+            continue;
+        };
+        let end = section(&text[pos..], "/END").map_or(text.len(), |e| pos + e);
+        let body = pos + "/POS".len();
+        let fail = |(at, m): Fail| error(&f.name, text, (at + body, m));
+        let toks: Vec<Token> = tokens(&text[body..end], &['"', '\''])
+            .map_err(fail)?
+            .into_iter()
+            .map(|(t, r)| (t, r.start + body..r.end + body))
+            .collect();
+        let mut i = 0;
+        while i < toks.len() {
+            let (site, next) =
+                block(fi, text, &toks, i).map_err(|(at, m)| error(&f.name, text, (at, m)))?;
+            match site {
+                Position::Cartesian(s) => found.sites.push(*s),
+                Position::Joint(j) => found.joints.push(j),
+                Position::Neither => {}
+            }
+            i = next;
+        }
+    }
+    Ok(found)
+}
+
+/// Byte offset of a line that starts with `name` (a section header).
+fn section(text: &str, name: &str) -> Option<usize> {
+    let mut start = 0;
+    for line in text.split('\n') {
+        if line.trim_start().starts_with(name) {
+            return Some(start + (line.len() - line.trim_start().len()));
+        }
+        start += line.len() + 1;
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests;
