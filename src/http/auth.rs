@@ -36,6 +36,7 @@ pub const OPERATE: &[&str] = &[
     "/v1/robots/{id}/checks",
     "/v1/robots/{id}/compare",
     "/v1/iso9283",
+    "/v1/iso9283/csv",
 ];
 
 /// The access a route (method and path template, as in `openapi.yaml`) needs.

@@ -1,61 +1,267 @@
 //! `POST /v1/iso9283`: ISO 9283 pose accuracy and repeatability (AP, RP,
 //! APa/b/c, ±RPa/b/c) and distance accuracy and repeatability (AD, RD) from
 //! measured cycles of the standard's test cube, for one or more tests side by
-//! side (e.g. the nominal and the filtered program). The same as `robocal
-//! iso9283 --plan P --measured M`.
+//! side (e.g. the nominal and the filtered program), each figure with its
+//! outcome (`core::iso9283::outcome`): computed, or not with a typed reason.
+//! The plan's commanded poses and the measured cycles come as JSON keyed by
+//! pose (`P1` … `P5`), cycle `k` the `k`-th entry (`null`: not measured).
+//!
+//! `POST /v1/iso9283/csv`: the same figures from the two CSV texts of
+//! `robocal iso9283 --plan P --measured M` (a grammar the spec cannot state:
+//! an unreadable CSV is 422 naming the test, the file and the line).
 
+use super::input::{object_or_null, objects, present};
 use super::{ApiError, ApiJson, AppState};
 use crate::service;
-use crate::service::iso9283::Iso9283Test;
+use crate::service::iso9283::{Iso9283CsvTest, Iso9283Test};
 use axum::extract::State;
 use axum::response::{IntoResponse, Response};
-use robocal_core::check::iso9283::Iso9283Figures;
-use serde::{Deserialize, Serialize};
+use robocal_core::check::iso9283::outcome::{CommandedPose, CycleReading, PoseData, CYCLES_MAX};
+use robocal_core::check::iso9283::Assessment;
+use serde::{Deserialize, Deserializer, Serialize};
+use std::collections::BTreeMap;
+
+/// Longest test label (characters).
+pub const LABEL_MAX: usize = 200;
+
+/// The standard's poses of the test cube.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Deserialize)]
+pub enum PoseName {
+    P1,
+    P2,
+    P3,
+    P4,
+    P5,
+}
+
+impl PoseName {
+    pub const ALL: [PoseName; 5] = [
+        PoseName::P1,
+        PoseName::P2,
+        PoseName::P3,
+        PoseName::P4,
+        PoseName::P5,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            PoseName::P1 => "P1",
+            PoseName::P2 => "P2",
+            PoseName::P3 => "P3",
+            PoseName::P4 => "P4",
+            PoseName::P5 => "P5",
+        }
+    }
+}
+
+/// A record that must be a JSON object (not `null`, not an array).
+#[derive(Debug)]
+struct Rec<T>(T);
+
+impl<'de, T: Deserialize<'de>> Deserialize<'de> for Rec<T> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        object_or_null(d)?
+            .map(Rec)
+            .ok_or_else(|| serde::de::Error::custom("expected a JSON object, not null"))
+    }
+}
+
+/// A cycle's entry: an object, or `null` for a cycle not measured.
+#[derive(Debug)]
+struct Slot(Option<CycleIn>);
+
+impl<'de> Deserialize<'de> for Slot {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        object_or_null(d).map(Slot)
+    }
+}
+
+/// A commanded pose of the plan [mm, deg].
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CommandedIn {
+    xyz_mm: Vec<f64>,
+    #[serde(default, deserialize_with = "present")]
+    abc_deg: Option<Vec<f64>>,
+}
+
+/// An attained pose of one cycle [mm, deg].
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CycleIn {
+    xyz_mm: Vec<f64>,
+    #[serde(default, deserialize_with = "present")]
+    abc_deg: Option<Vec<f64>>,
+}
 
 /// One test of the request.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct TestIn {
-    pub label: String,
-    pub plan_csv: String,
-    pub measured_csv: String,
+struct TestIn {
+    label: String,
+    plan: BTreeMap<PoseName, Rec<CommandedIn>>,
+    measured: BTreeMap<PoseName, Vec<Slot>>,
 }
 
 /// `POST /v1/iso9283` body.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Iso9283Request {
-    pub tests: Vec<TestIn>,
+struct Iso9283Request {
+    #[serde(deserialize_with = "objects")]
+    tests: Vec<TestIn>,
+}
+
+/// One test of the CSV form.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CsvTestIn {
+    label: String,
+    plan_csv: String,
+    measured_csv: String,
+}
+
+/// `POST /v1/iso9283/csv` body.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Iso9283CsvRequest {
+    #[serde(deserialize_with = "objects")]
+    tests: Vec<CsvTestIn>,
 }
 
 /// One test's figures.
 #[derive(Debug, Serialize)]
-pub struct TestFigures {
-    pub label: String,
-    pub figures: Iso9283Figures,
+struct TestOut {
+    label: String,
+    #[serde(flatten)]
+    figures: Assessment,
 }
 
-pub async fn figures(
+fn check_label(label: &str) -> Result<(), ApiError> {
+    let n = label.chars().count();
+    if n > LABEL_MAX {
+        return Err(ApiError::invalid(format!(
+            "a test label has at most {LABEL_MAX} characters, got {n}"
+        )));
+    }
+    Ok(())
+}
+
+fn triple(v: &[f64], what: impl Fn() -> String) -> Result<[f64; 3], ApiError> {
+    v.try_into()
+        .map_err(|_| ApiError::invalid(format!("{}: expected 3 numbers, got {}", what(), v.len())))
+}
+
+/// The poses of one test, in the order P1 … P5: those the plan commands or
+/// `measured` lists; cycle `k` is the `k`-th entry of a pose's list.
+fn poses(t: &TestIn) -> Result<Vec<PoseData>, ApiError> {
+    check_label(&t.label)?;
+    if t.plan.is_empty() {
+        return Err(ApiError::invalid(format!(
+            "test `{}`: the plan commands no pose; give at least one of P1 … P5",
+            t.label
+        )));
+    }
+    let mut out = Vec::new();
+    for name in PoseName::ALL {
+        let (commanded, slots) = (t.plan.get(&name), t.measured.get(&name));
+        if commanded.is_none() && slots.is_none() {
+            continue;
+        }
+        let at = |what: &str| format!("test `{}`, {what}.{}", t.label, name.name());
+        let commanded = commanded
+            .map(|Rec(c)| -> Result<CommandedPose, ApiError> {
+                Ok(CommandedPose {
+                    xyz_mm: triple(&c.xyz_mm, || at("plan") + ".xyz_mm")?,
+                    abc_deg: c
+                        .abc_deg
+                        .as_deref()
+                        .map(|v| triple(v, || at("plan") + ".abc_deg"))
+                        .transpose()?,
+                })
+            })
+            .transpose()?;
+        let measured = slots
+            .map(|slots| -> Result<Vec<CycleReading>, ApiError> {
+                if slots.len() > CYCLES_MAX {
+                    return Err(ApiError::invalid(format!(
+                        "{}: {} cycles; at most {CYCLES_MAX}",
+                        at("measured"),
+                        slots.len()
+                    )));
+                }
+                let mut cycles = Vec::new();
+                for (k, Slot(s)) in slots.iter().enumerate() {
+                    let Some(c) = s else { continue };
+                    let at = || format!("{}[{k}]", at("measured"));
+                    cycles.push(CycleReading {
+                        cycle: k as u32 + 1,
+                        xyz_mm: triple(&c.xyz_mm, || at() + ".xyz_mm")?,
+                        abc_deg: c
+                            .abc_deg
+                            .as_deref()
+                            .map(|v| triple(v, || at() + ".abc_deg"))
+                            .transpose()?,
+                    });
+                }
+                Ok(cycles)
+            })
+            .transpose()?;
+        out.push(PoseData {
+            name: name.name().to_string(),
+            commanded,
+            measured,
+        });
+    }
+    Ok(out)
+}
+
+fn answer(tests: Vec<(String, Assessment)>) -> Response {
+    let tests: Vec<TestOut> = tests
+        .into_iter()
+        .map(|(label, figures)| TestOut { label, figures })
+        .collect();
+    axum::Json(serde_json::json!({ "tests": tests })).into_response()
+}
+
+async fn figures(
     State(_state): State<AppState>,
     ApiJson(body): ApiJson<Iso9283Request>,
 ) -> Result<Response, ApiError> {
     let tests = body
         .tests
-        .into_iter()
-        .map(|t| Iso9283Test {
-            label: t.label,
-            plan_csv: t.plan_csv,
-            measured_csv: t.measured_csv,
+        .iter()
+        .map(|t| {
+            Ok(Iso9283Test {
+                label: t.label.clone(),
+                poses: poses(t)?,
+            })
         })
-        .collect();
-    let out: Vec<TestFigures> = service::iso9283::figures(tests)
-        .await?
+        .collect::<Result<Vec<_>, ApiError>>()?;
+    Ok(answer(service::iso9283::figures(tests).await?))
+}
+
+async fn figures_csv(
+    State(_state): State<AppState>,
+    ApiJson(body): ApiJson<Iso9283CsvRequest>,
+) -> Result<Response, ApiError> {
+    let tests = body
+        .tests
         .into_iter()
-        .map(|(label, figures)| TestFigures { label, figures })
-        .collect();
-    Ok(axum::Json(serde_json::json!({ "tests": out })).into_response())
+        .map(|t| {
+            check_label(&t.label)?;
+            Ok(Iso9283CsvTest {
+                label: t.label,
+                plan_csv: t.plan_csv,
+                measured_csv: t.measured_csv,
+            })
+        })
+        .collect::<Result<Vec<_>, ApiError>>()?;
+    Ok(answer(service::iso9283::figures_csv(tests).await?))
 }
 
 pub fn routes() -> Vec<super::Route> {
-    vec![super::post("/v1/iso9283", figures)]
+    vec![
+        super::post("/v1/iso9283", figures),
+        super::post("/v1/iso9283/csv", figures_csv),
+    ]
 }

@@ -1,49 +1,114 @@
 //! ISO 9283 pose characteristics from measured cycles (`core::iso9283`):
-//! per test, the plan's commanded poses and the attained positions of every
-//! cycle give AP, RP, APa/b/c, ±RPa/b/c, AD and RD. Nothing is stored.
+//! per test, the commanded poses and the attained positions of every cycle
+//! give AP, RP, APa/b/c, ±RPa/b/c, AD and RD, each with its outcome
+//! (`core::iso9283::outcome`). The tests come as poses ([`figures`]) or as
+//! the two CSV texts of `robocal iso9283` ([`figures_csv`]). Nothing is
+//! stored.
 
 use super::ServiceError;
 use robocal_core::check::iso9283::csv::{read_cycles_csv, read_plan_csv};
-use robocal_core::check::iso9283::{evaluate, Iso9283Figures};
+use robocal_core::check::iso9283::outcome::{CommandedPose, CycleReading, PoseData};
+use robocal_core::check::iso9283::{assess, Assessment, Iso9283Error};
 
 /// Most tests in one request (a nominal and a filtered run side by side).
 pub const TESTS_MAX: usize = 8;
 
-/// One test: the plan CSV (`robocal iso9283 plan --csv`) and its measured
-/// cycles (`pose,cycle,x_mm,y_mm,z_mm[,rx_deg,ry_deg,rz_deg]`).
+/// One test: a label and its poses (commanded and measured).
 #[derive(Debug, Clone)]
 pub struct Iso9283Test {
+    pub label: String,
+    pub poses: Vec<PoseData>,
+}
+
+/// One test as CSV: the plan CSV (`robocal iso9283 plan --csv`) and its
+/// measured cycles (`pose,cycle,x_mm,y_mm,z_mm[,rx_deg,ry_deg,rz_deg]`).
+#[derive(Debug, Clone)]
+pub struct Iso9283CsvTest {
     pub label: String,
     pub plan_csv: String,
     pub measured_csv: String,
 }
 
-/// The figures of each test, in order; a test that cannot be read says which
-/// and where.
-pub async fn figures(
-    tests: Vec<Iso9283Test>,
-) -> Result<Vec<(String, Iso9283Figures)>, ServiceError> {
-    if tests.is_empty() || tests.len() > TESTS_MAX {
+fn count(n: usize) -> Result<(), ServiceError> {
+    if n == 0 || n > TESTS_MAX {
         return Err(ServiceError::Invalid(format!(
-            "send 1 to {TESTS_MAX} tests, got {}",
-            tests.len()
+            "send 1 to {TESTS_MAX} tests, got {n}"
         )));
     }
+    Ok(())
+}
+
+fn invalid(label: &str, what: &str, e: Iso9283Error) -> ServiceError {
+    ServiceError::Invalid(format!("test `{label}`, {what}: {e}"))
+}
+
+/// The figures of each test, in order; values out of bounds name the test.
+pub async fn figures(tests: Vec<Iso9283Test>) -> Result<Vec<(String, Assessment)>, ServiceError> {
+    count(tests.len())?;
     tokio::task::spawn_blocking(move || {
         tests
             .into_iter()
             .map(|t| {
-                let fail = |what: &str, e: robocal_core::check::iso9283::Iso9283Error| {
-                    ServiceError::Invalid(format!("test `{}`, {what}: {e}", t.label))
-                };
-                let commanded = read_plan_csv(&t.plan_csv).map_err(|e| fail("plan_csv", e))?;
-                let cycles = read_cycles_csv(&t.measured_csv, &commanded)
-                    .map_err(|e| fail("measured_csv", e))?;
-                let f = evaluate(&cycles).map_err(|e| fail("measured_csv", e))?;
-                Ok((t.label.clone(), f))
+                let a = assess(&t.poses).map_err(|e| invalid(&t.label, "poses", e))?;
+                Ok((t.label, a))
             })
             .collect()
     })
     .await
     .map_err(|e| ServiceError::Internal(format!("iso9283 task: {e}")))?
+}
+
+/// A test's CSV texts as poses: the plan's commands and their cycles.
+fn csv_poses(t: &Iso9283CsvTest) -> Result<Vec<PoseData>, ServiceError> {
+    let commanded = read_plan_csv(&t.plan_csv).map_err(|e| invalid(&t.label, "plan_csv", e))?;
+    let cycles = read_cycles_csv(&t.measured_csv, &commanded)
+        .map_err(|e| invalid(&t.label, "measured_csv", e))?;
+    Ok(commanded
+        .iter()
+        .zip(cycles)
+        .map(|(c, p)| {
+            let abc = p.attained_abc_deg.as_ref();
+            PoseData {
+                name: c.name.clone(),
+                commanded: Some(CommandedPose {
+                    xyz_mm: c.xyz_mm,
+                    abc_deg: c.abc_deg,
+                }),
+                measured: Some(
+                    p.cycles
+                        .iter()
+                        .zip(&p.attained_mm)
+                        .enumerate()
+                        .map(|(k, (cycle, xyz))| CycleReading {
+                            cycle: *cycle,
+                            xyz_mm: *xyz,
+                            abc_deg: abc.map(|a| a[k]),
+                        })
+                        .collect(),
+                ),
+            }
+        })
+        .collect())
+}
+
+/// The figures of each CSV test, in order; a CSV that cannot be read says
+/// which test, which file and where.
+pub async fn figures_csv(
+    tests: Vec<Iso9283CsvTest>,
+) -> Result<Vec<(String, Assessment)>, ServiceError> {
+    count(tests.len())?;
+    let tests = tokio::task::spawn_blocking(move || {
+        tests
+            .iter()
+            .map(|t| {
+                Ok(Iso9283Test {
+                    label: t.label.clone(),
+                    poses: csv_poses(t)?,
+                })
+            })
+            .collect::<Result<Vec<_>, ServiceError>>()
+    })
+    .await
+    .map_err(|e| ServiceError::Internal(format!("iso9283 task: {e}")))??;
+    figures(tests).await
 }

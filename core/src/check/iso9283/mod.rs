@@ -41,9 +41,11 @@
 pub mod csv;
 pub mod cube;
 pub mod figures;
+pub mod outcome;
 
 pub use cube::{plan_cube, Commands, CubePlan, CubePose, CubeSettings, TestCube};
 pub use figures::{evaluate, DistanceFigures, Iso9283Figures, PoseCycles, PoseFigures};
+pub use outcome::{assess, Assessment, NotComputedReason, Outcome};
 
 /// Why the ISO 9283 plan or figures cannot be computed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
