@@ -43,7 +43,7 @@ pub struct CalibrateArgs {
     /// Methods to run and compare, comma-separated (names or aliases, any
     /// case); `all` runs every one and prints the comparison table (rows
     /// methods, columns sets).
-    #[arg(long, value_parser = MethodValues, default_value_t = MethodList(Method::SEED.to_vec()))]
+    #[arg(long, value_parser = MethodValues, default_value_t = MethodList(Method::THESIS.to_vec()))]
     pub method: MethodList,
     /// Payload mass [kg] for rows without a payload_kg column (default: the model's payload).
     #[arg(long)]

@@ -52,7 +52,7 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     if let Some(v) = &r.nominal.validation {
         row("Nominal robot model", &v.stats);
     }
-    for method in Method::SEED {
+    for method in Method::THESIS {
         if let Some(v) = r.methods.get(&method).and_then(|m| m.validation.as_ref()) {
             row(method.label(), &v.stats);
         }

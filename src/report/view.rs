@@ -323,14 +323,14 @@ impl ReportView {
         }
     }
 
-    /// The methods in the thesis's order ([`Method::SEED`]: KM, SKCM, SKCM-C),
+    /// The methods in the thesis's order ([`Method::THESIS`]: KM, SKCM, SKCM-C),
     /// then any other by name.
     pub fn ordered_methods(&self) -> Vec<(&str, &MethodView)> {
         let rank = |k: &str| {
-            Method::SEED
+            Method::THESIS
                 .iter()
                 .position(|m| m.name() == k)
-                .unwrap_or(Method::SEED.len())
+                .unwrap_or(Method::THESIS.len())
         };
         let mut v: Vec<(&str, &MethodView)> =
             self.methods.iter().map(|(k, m)| (k.as_str(), m)).collect();

@@ -153,7 +153,7 @@ impl CompensatorOptions {
 impl Default for CalibrationOptions {
     fn default() -> Self {
         CalibrationOptions {
-            methods: Method::SEED.to_vec(),
+            methods: Method::THESIS.to_vec(),
             register: true,
             lm: LmSettings::default(),
             tlbo: TlboSettings::default(),

@@ -70,7 +70,7 @@ method_table! {
         fits: "geometry",
         compliance: Compliance::No,
         torques: false,
-        seed: true,
+        thesis: true,
         weight: 1.0,
         run: Run::Km,
     }
@@ -82,7 +82,7 @@ method_table! {
         fits: "geometry and joint compliance",
         compliance: Compliance::Yes,
         torques: true,
-        seed: true,
+        thesis: true,
         weight: 1.0,
         run: Run::Skcm,
     }
@@ -94,7 +94,7 @@ method_table! {
         fits: "joint compliance by TLBO, then geometry",
         compliance: Compliance::Yes,
         torques: true,
-        seed: true,
+        thesis: true,
         weight: 8.0,
         run: Run::SkcmTlbo,
     }
@@ -106,7 +106,7 @@ method_table! {
         fits: "geometry, joint compliance and the payload",
         compliance: Compliance::Yes,
         torques: true,
-        seed: false,
+        thesis: false,
         weight: 2.0,
         run: Run::SkcmPayload,
     }
@@ -118,7 +118,7 @@ method_table! {
         fits: "geometry and per-joint angle error maps",
         compliance: Compliance::No,
         torques: false,
-        seed: false,
+        thesis: false,
         weight: 3.0,
         run: Run::Maps(Base::Km),
     }
@@ -130,7 +130,7 @@ method_table! {
         fits: "geometry, joint compliance and per-joint angle error maps",
         compliance: Compliance::Yes,
         torques: true,
-        seed: false,
+        thesis: false,
         weight: 3.0,
         run: Run::Maps(Base::Skcm),
     }
@@ -142,7 +142,7 @@ method_table! {
         fits: "KM, then a residual network",
         compliance: Compliance::No,
         torques: true,
-        seed: false,
+        thesis: false,
         weight: 2.0,
         run: Run::Compensated(Compensated { base: Base::Km, network: Network::Rbf }),
     }
@@ -154,7 +154,7 @@ method_table! {
         fits: "SKCM, then a residual network",
         compliance: Compliance::Yes,
         torques: true,
-        seed: false,
+        thesis: false,
         weight: 6.0,
         run: Run::Compensated(Compensated { base: Base::Skcm, network: Network::LmMlp }),
     }
@@ -166,7 +166,7 @@ method_table! {
         fits: "SKCM, then a residual network",
         compliance: Compliance::Yes,
         torques: true,
-        seed: false,
+        thesis: false,
         weight: 6.0,
         run: Run::Compensated(Compensated { base: Base::Skcm, network: Network::IwoMlp }),
     }
@@ -178,7 +178,7 @@ method_table! {
         fits: "SKCM, then a residual network",
         compliance: Compliance::Yes,
         torques: true,
-        seed: false,
+        thesis: false,
         weight: 6.0,
         run: Run::Compensated(Compensated { base: Base::Skcm, network: Network::TlboMlp }),
     }
@@ -190,7 +190,7 @@ method_table! {
         fits: "KM, then a residual Gaussian process",
         compliance: Compliance::No,
         torques: false,
-        seed: false,
+        thesis: false,
         weight: 2.0,
         run: Run::Compensated(Compensated { base: Base::Km, network: Network::Gp }),
     }
@@ -202,7 +202,7 @@ method_table! {
         fits: "SKCM, then a residual Gaussian process",
         compliance: Compliance::Yes,
         torques: true,
-        seed: false,
+        thesis: false,
         weight: 2.0,
         run: Run::Compensated(Compensated { base: Base::Skcm, network: Network::Gp }),
     }
@@ -214,7 +214,7 @@ method_table! {
         fits: "KM with joint maps, then a residual Gaussian process",
         compliance: Compliance::No,
         torques: false,
-        seed: false,
+        thesis: false,
         weight: 4.0,
         run: Run::Compensated(Compensated { base: Base::KmMaps, network: Network::Gp }),
     }
@@ -226,7 +226,7 @@ method_table! {
         fits: "SKCM with joint maps, then a residual Gaussian process",
         compliance: Compliance::Yes,
         torques: true,
-        seed: false,
+        thesis: false,
         weight: 4.0,
         run: Run::Compensated(Compensated { base: Base::SkcmMaps, network: Network::Gp }),
     }
@@ -238,7 +238,7 @@ method_table! {
         fits: "what the method it chooses fits",
         compliance: Compliance::IfLoaded,
         torques: false,
-        seed: false,
+        thesis: false,
         weight: 12.0,
         run: Run::Auto,
     }
@@ -261,7 +261,7 @@ pub struct MethodRow {
     /// Needs gravity torques on some joint (compliance, or torque inputs).
     pub torques: bool,
     /// One of the thesis's three compared methods (the command line's default).
-    pub seed: bool,
+    pub thesis: bool,
     /// Relative effort, for the progress percentage.
     pub weight: f64,
     pub run: Run,
@@ -337,7 +337,7 @@ pub enum Network {
 #[derive(Clone, Copy)]
 enum Group {
     ModelBased,
-    Seed,
+    Thesis,
     JointMaps,
     Compensated,
 }
@@ -345,7 +345,7 @@ enum Group {
 const fn in_group(row: &MethodRow, group: Group) -> bool {
     match group {
         Group::ModelBased => !matches!(row.run, Run::Compensated(_) | Run::Auto | Run::Maps(_)),
-        Group::Seed => row.seed,
+        Group::Thesis => row.thesis,
         Group::JointMaps => matches!(row.run, Run::Maps(_)),
         Group::Compensated => matches!(row.run, Run::Compensated(_)),
     }
@@ -392,7 +392,7 @@ impl Method {
     /// The model-based methods (no compensator, no joint maps).
     pub const MODEL_BASED: [Method; group_len(Group::ModelBased)] = group(Group::ModelBased);
     /// The thesis's three methods (the default of `robocal calibrate`).
-    pub const SEED: [Method; group_len(Group::Seed)] = group(Group::Seed);
+    pub const THESIS: [Method; group_len(Group::Thesis)] = group(Group::Thesis);
     /// The joint-map methods.
     pub const JOINT_MAPS: [Method; group_len(Group::JointMaps)] = group(Group::JointMaps);
     /// The methods with a learned compensator.
@@ -621,7 +621,7 @@ mod tests {
     /// `auto`.
     #[test]
     fn groups() {
-        assert_eq!(Method::SEED, [Method::Km, Method::Skcm, Method::SkcmTlbo]);
+        assert_eq!(Method::THESIS, [Method::Km, Method::Skcm, Method::SkcmTlbo]);
         assert_eq!(Method::JOINT_MAPS, [Method::KmMaps, Method::SkcmMaps]);
         for m in Method::ALL {
             let model_based = Method::MODEL_BASED.contains(&m);
@@ -635,7 +635,7 @@ mod tests {
                 "{m}"
             );
         }
-        assert!(Method::MODEL_BASED.starts_with(&Method::SEED));
+        assert!(Method::MODEL_BASED.starts_with(&Method::THESIS));
         assert!(Method::MODEL_BASED.contains(&Method::SkcmPayload));
         assert_eq!(Method::SkcmNn.base(), Some(Method::Skcm));
         assert_eq!(Method::KmRbf.base(), Some(Method::Km));
