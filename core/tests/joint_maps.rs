@@ -241,3 +241,28 @@ fn a_cancel_while_the_maps_are_built_stops_the_method() {
         }
     }
 }
+
+/// Two tracker sessions: the second half of the identification poses is
+/// measured from a tracker moved by 40 mm and 2° (a rigid frame change the
+/// fit registers, thesis §2.2). The joint-angle columns of the maps' design
+/// are the first `dof` ones, the second session's frame adds six after them;
+/// the maps still recover the transmission errors to the noise floor.
+#[test]
+fn maps_fit_across_two_tracker_sessions() {
+    let mut s = study(true);
+    let turn = nalgebra::Rotation3::from_euler_angles(0.0, 0.0, 2f64.to_radians());
+    let shift = nalgebra::Vector3::new(0.04, -0.02, 0.01);
+    let half = s.id.len() / 2;
+    for m in &mut s.id[half..] {
+        m.position = turn * m.position + shift;
+        m.session = 1;
+    }
+    let (km, maps) = validation_means(&s);
+    eprintln!("two sessions: floor {:.4} mm, KM {km:.4}, km-maps {maps:.4}", s.floor_mm);
+    assert!(km > 2.0 * s.floor_mm, "the errors must matter: KM {km}");
+    assert!(
+        maps < 1.15 * s.floor_mm,
+        "km-maps {maps} floor {}",
+        s.floor_mm
+    );
+}

@@ -302,13 +302,16 @@ fn position_levers(jt: &DMatrix<f64>, data: &[Measurement]) -> Option<Vec<f64>> 
 /// as unobservable (module docs), `noise` the position noise σ [m].
 fn map_joints(
     jt: &DMatrix<f64>,
+    joints_n: usize,
     data: &[Measurement],
     noise: f64,
     settings: &JointMapSettings,
 ) -> (Vec<(usize, [f64; 2])>, Vec<RefusedMap>) {
     let levers = position_levers(jt, data);
     let (mut joints, mut refused) = (Vec::new(), Vec::new());
-    for i in 0..jt.ncols() {
+    // `jt`'s first `joints_n` columns are the joint angles; the session
+    // frames beyond the first add columns of their own after them.
+    for i in 0..joints_n.min(jt.ncols()) {
         let lo = data.iter().map(|m| m.q[i]).fold(f64::INFINITY, f64::min);
         let hi = data
             .iter()
@@ -409,7 +412,7 @@ fn build(
         return Ok(None);
     }
     let noise = position_noise(&geo_eval.r, jg.ncols(), data);
-    let (joints, refused) = map_joints(&jt, data, noise, settings);
+    let (joints, refused) = map_joints(&jt, n, data, noise, settings);
     if joints.is_empty() && !refused.is_empty() {
         return Err(MapFitError::NoObservableJoint {
             refused: refused
