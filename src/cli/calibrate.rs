@@ -2,19 +2,21 @@
 //! print the comparison of methods (like the thesis's Tables 2.5/2.6) with the
 //! identifiability report, or the same as JSON.
 
+mod render;
+
+pub use render::{render_comparison, render_compensators, render_orientation, render_report};
+
 use super::progress::ProgressPrinter;
 use crate::calibrate::identify::{
     calibrate_with_training, CalibrationOptions, CalibrationReport, CompensatorOptions, Method,
-    PoseSource, PoseSources, SetErrors, METHODS,
+    PoseSource, PoseSources, METHODS,
 };
 use crate::measure::{self, csv, SetRole};
 use crate::model::RobotModel;
-use crate::report::method_label;
 use anyhow::{bail, Context};
 use clap::builder::{PossibleValue, TypedValueParser};
 use clap::error::ErrorKind;
 use clap::Args;
-use std::fmt::Write as _;
 
 #[derive(Debug, Args)]
 pub struct CalibrateArgs {
@@ -139,40 +141,82 @@ fn read_rows(path: &str, read: csv::ReadOptions) -> anyhow::Result<Vec<measure::
     super::orientation_arg::read_measurements(std::path::Path::new(path), read)
 }
 
+/// Measured rows of one role, each with its tracker-session label.
+type Labelled = Vec<(String, measure::MeasuredPose)>;
+
+/// The rows of every file by role, each with its session label, and where
+/// each came from (file name, 1-based data row, session) for the report.
+struct RowsByRole {
+    identification: Labelled,
+    validation: Labelled,
+    training: Labelled,
+    sources: PoseSources,
+}
+
 pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     let (model, note) = super::model_files::load_start_model(&a.model)?;
     if let Some(note) = note {
         eprintln!("{note}");
     }
-    let methods = a.method.0;
-    let dif = match a.dif_sign.as_str() {
-        "plus" => csv::DifSign::Plus,
-        "minus" => csv::DifSign::Minus,
-        other => bail!("--dif-sign must be plus or minus, got {other}"),
-    };
-    let read = csv::ReadOptions {
-        dif,
-        orientation: a.orientation,
-        ..csv::ReadOptions::default()
-    };
+    let read = read_options(&a)?;
     if let Some(p) = a.payload_kg {
         if !(p.is_finite() && p >= 0.0) {
             bail!("--payload-kg must be a non-negative number, got {p}");
         }
     }
     let payload = a.payload_kg.unwrap_or(model.payload.mass);
-    // Rows with their tracker-session label: the `session` column, else the file's.
+    let rows = read_rows_by_role(&a, read, &model)?;
+    let sessions = sessions_of(&rows)?;
+    let ident = to_si(&rows.identification, &sessions, &model, payload);
+    let valid = to_si(&rows.validation, &sessions, &model, payload);
+    let training = to_si(&rows.training, &sessions, &model, payload);
+    let opts = calibration_options(&a);
+    let progress = ProgressPrinter::stderr(!a.json);
+    let report = calibrate_with_training(&model, &ident, &training, &valid, &opts, &|p| {
+        progress.update(p);
+        true
+    });
+    progress.finish();
+    let mut report = report?;
+    report.pose_sources = rows.sources;
+    report.session_names = sessions;
+    write_outputs(&a, &model, &report, payload)
+}
+
+/// How the measurement files are read: `--dif-sign` and `--orientation`.
+fn read_options(a: &CalibrateArgs) -> anyhow::Result<csv::ReadOptions> {
+    let dif = match a.dif_sign.as_str() {
+        "plus" => csv::DifSign::Plus,
+        "minus" => csv::DifSign::Minus,
+        other => bail!("--dif-sign must be plus or minus, got {other}"),
+    };
+    Ok(csv::ReadOptions {
+        dif,
+        orientation: a.orientation,
+        ..csv::ReadOptions::default()
+    })
+}
+
+/// Reads the `--identify`, `--train` and `--validate` files (in that order)
+/// and labels each row with its tracker session: the `session` column, else
+/// the file's (module docs of the options).
+fn read_rows_by_role(
+    a: &CalibrateArgs,
+    read: csv::ReadOptions,
+    model: &RobotModel,
+) -> anyhow::Result<RowsByRole> {
     let label = |file: usize| format!("file {}", file + 1);
-    let mut ident_rows: Vec<(String, measure::MeasuredPose)> = Vec::new();
-    let mut valid_rows: Vec<(String, measure::MeasuredPose)> = Vec::new();
-    // Each pose's source (file name, 1-based data row, session) for the report.
-    let (mut ident_src, mut valid_src) = (Vec::new(), Vec::new());
     let source = |path: &str, k: usize, session: &str| PoseSource {
         set: file_name(path),
         row: k + 1,
         session: session.to_string(),
     };
-    let (mut train_rows, mut train_src) = (Vec::new(), Vec::new());
+    let mut out = RowsByRole {
+        identification: Vec::new(),
+        validation: Vec::new(),
+        training: Vec::new(),
+        sources: PoseSources::default(),
+    };
     for (i, path) in a.identify.iter().enumerate() {
         let rows = read_rows(path, read)?;
         csv::check_joint_count(&rows, model.dof()).with_context(|| path.clone())?;
@@ -180,17 +224,17 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
             let s = r.session.clone().unwrap_or_else(|| label(i));
             match r.set {
                 Some(SetRole::Training) => {
-                    train_src.push(source(path, k, &s));
-                    train_rows.push((s, r));
+                    out.sources.training.push(source(path, k, &s));
+                    out.training.push((s, r));
                 }
                 // Check rows are scored like validation rows, never fitted.
                 Some(SetRole::Validation | SetRole::Check) => {
-                    valid_src.push(source(path, k, &s));
-                    valid_rows.push((s, r));
+                    out.sources.validation.push(source(path, k, &s));
+                    out.validation.push((s, r));
                 }
                 _ => {
-                    ident_src.push(source(path, k, &s));
-                    ident_rows.push((s, r));
+                    out.sources.identification.push(source(path, k, &s));
+                    out.identification.push((s, r));
                 }
             }
         }
@@ -200,8 +244,8 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         csv::check_joint_count(&more, model.dof()).with_context(|| path.clone())?;
         for (k, r) in more.into_iter().enumerate() {
             let s = r.session.clone().unwrap_or_else(|| label(0));
-            train_src.push(source(path, k, &s));
-            train_rows.push((s, r));
+            out.sources.training.push(source(path, k, &s));
+            out.training.push((s, r));
         }
     }
     let same_count = a.validate.len() == a.identify.len();
@@ -211,40 +255,56 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         let own = label(if same_count { j } else { 0 });
         for (k, r) in more.into_iter().enumerate() {
             let s = r.session.clone().unwrap_or_else(|| own.clone());
-            valid_src.push(source(path, k, &s));
-            valid_rows.push((s, r));
+            out.sources.validation.push(source(path, k, &s));
+            out.validation.push((s, r));
         }
     }
+    Ok(out)
+}
+
+/// The tracker sessions in order of their first identification row; an
+/// error when validation or training rows come from a session without
+/// identification rows (its frame could not be registered).
+fn sessions_of(rows: &RowsByRole) -> anyhow::Result<Vec<String>> {
     let mut sessions: Vec<String> = Vec::new();
-    for (s, _) in &ident_rows {
+    for (s, _) in &rows.identification {
         if !sessions.contains(s) {
             sessions.push(s.clone());
         }
     }
-    if let Some((s, _)) = valid_rows.iter().find(|(s, _)| !sessions.contains(s)) {
+    if let Some((s, _)) = rows.validation.iter().find(|(s, _)| !sessions.contains(s)) {
         bail!(
             "validation rows of tracker session `{s}` have no identification rows in that session, so its frame cannot be registered; measure identification poses in that session too"
         );
     }
-    if let Some((s, _)) = train_rows.iter().find(|(s, _)| !sessions.contains(s)) {
+    if let Some((s, _)) = rows.training.iter().find(|(s, _)| !sessions.contains(s)) {
         bail!(
             "training rows of tracker session `{s}` have no identification rows in that session, so its frame cannot be registered; measure identification poses in that session too"
         );
     }
-    let to_si = |rows: &[(String, measure::MeasuredPose)]| -> Vec<measure::Measurement> {
-        rows.iter()
-            .map(|(s, r)| {
-                let mut m = r.to_measurement(&model, payload);
-                m.session = sessions.iter().position(|x| x == s).unwrap_or(0);
-                m
-            })
-            .collect()
-    };
-    let ident = to_si(&ident_rows);
-    let valid = to_si(&valid_rows);
-    let training = to_si(&train_rows);
-    let opts = CalibrationOptions {
-        methods,
+    Ok(sessions)
+}
+
+/// The rows in SI units, each with the index of its session in `sessions`.
+fn to_si(
+    rows: &[(String, measure::MeasuredPose)],
+    sessions: &[String],
+    model: &RobotModel,
+    payload: f64,
+) -> Vec<measure::Measurement> {
+    rows.iter()
+        .map(|(s, r)| {
+            let mut m = r.to_measurement(model, payload);
+            m.session = sessions.iter().position(|x| x == s).unwrap_or(0);
+            m
+        })
+        .collect()
+}
+
+/// The calibration's options from the command line.
+fn calibration_options(a: &CalibrateArgs) -> CalibrationOptions {
+    CalibrationOptions {
+        methods: a.method.0.clone(),
         register: !a.no_register,
         tlbo: crate::optim::TlboSettings {
             population: a.population,
@@ -258,33 +318,30 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
             ..Default::default()
         },
         ..Default::default()
-    };
-    let progress = ProgressPrinter::stderr(!a.json);
-    let report = calibrate_with_training(&model, &ident, &training, &valid, &opts, &|p| {
-        progress.update(p);
-        true
-    });
-    progress.finish();
-    let mut report = report?;
-    report.pose_sources = PoseSources {
-        identification: ident_src,
-        validation: valid_src,
-        training: train_src,
-    };
-    report.session_names = sessions.clone();
+    }
+}
+
+/// Writes what was asked for: the HTML page (`--html`), the chosen model
+/// (`--save`), and the report on stdout as JSON (`--json`) or text.
+fn write_outputs(
+    a: &CalibrateArgs,
+    model: &RobotModel,
+    report: &CalibrationReport,
+    payload: f64,
+) -> anyhow::Result<()> {
     if let Some(path) = &a.html {
         let files: Vec<String> = a.identify.iter().map(|p| file_name(p)).collect();
         let title = format!("Calibration of {}", files.join(", "));
-        let html = crate::report::render_html(&title, &serde_json::to_value(&report)?);
+        let html = crate::report::render_html(&title, &serde_json::to_value(report)?);
         std::fs::write(path, html).with_context(|| format!("cannot write {path}"))?;
     }
     if let Some(path) = &a.save {
-        save_model(&model, &report, a.save_method.as_deref(), payload, path)?;
+        save_model(model, report, a.save_method.as_deref(), payload, path)?;
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        println!("{}", serde_json::to_string_pretty(report)?);
     } else {
-        print!("{}", render_report(&report));
+        print!("{}", render_report(report));
     }
     Ok(())
 }
@@ -327,411 +384,4 @@ fn save_model(
     super::model_files::save_model_file(&file, std::path::Path::new(path))?;
     eprintln!("saved the {label} model to {path}");
     Ok(())
-}
-
-/// The text report: accuracy table, identifiability, parameters, stiffness.
-/// A parameter value in its display unit, one format per unit: lengths and
-/// angles with 6 decimals (0.001 µm, 1e-6 deg), compliances in scientific
-/// notation, masses with 3 decimals.
-fn param_number(v: f64, unit: &str) -> String {
-    match unit {
-        "rad/(N·m)" => format!("{v:.4e}"),
-        "kg" => format!("{v:.3}"),
-        _ => format!("{v:.6}"),
-    }
-}
-
-pub fn render_report(r: &CalibrationReport) -> String {
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "robot {}: {} identification poses, {} validation poses",
-        r.robot, r.identification_poses, r.validation_poses
-    );
-    for reg in &r.registration {
-        let t = &reg.tracker_to_base;
-        let _ = writeln!(
-            s,
-            "registration (session {}): tracker->base xyz [{:.3}, {:.3}, {:.3}] mm, rpy [{:.4}, {:.4}, {:.4}] deg, nominal RMS {:.3} mm",
-            reg.session, t.xyz_mm[0], t.xyz_mm[1], t.xyz_mm[2], t.rpy_deg[0], t.rpy_deg[1], t.rpy_deg[2], reg.rms_mm
-        );
-    }
-    let _ = writeln!(s, "\nAbsolute position accuracy (mm)");
-    let _ = writeln!(
-        s,
-        "{:<22} {:>8} {:>8} {:>8} {:>8} {:>8}   {:>8} {:>8} {:>8} {:>8} {:>8}",
-        "", "id mean", "max", "std", "rms", "p95", "val mean", "max", "std", "rms", "p95"
-    );
-    let mut line =
-        |label: &str, id: &crate::stats::ErrorStats, va: Option<&crate::stats::ErrorStats>| {
-            let _ = write!(
-                s,
-                "{:<22} {:>8.4} {:>8.4} {:>8.4} {:>8.4} {:>8.4}",
-                label, id.mean_mm, id.max_mm, id.std_mm, id.rms_mm, id.p95_mm
-            );
-            if let Some(v) = va {
-                let _ = write!(
-                    s,
-                    "   {:>8.4} {:>8.4} {:>8.4} {:>8.4} {:>8.4}",
-                    v.mean_mm, v.max_mm, v.std_mm, v.rms_mm, v.p95_mm
-                );
-            }
-            let _ = writeln!(s);
-        };
-    line(
-        "Nominal robot model",
-        &r.nominal.identification.stats,
-        r.nominal.validation.as_ref().map(|v| &v.stats),
-    );
-    for (name, m) in &r.methods {
-        line(
-            method_label(*name),
-            &m.identification.stats,
-            m.validation.as_ref().map(|v| &v.stats),
-        );
-    }
-    let _ = write!(s, "{}", render_comparison(r));
-    let _ = write!(s, "{}", render_orientation(r));
-    let _ = write!(s, "{}", render_compensators(r));
-    let id = &r.identifiability;
-    let _ = writeln!(
-        s,
-        "\nIdentifiability: {} parameters kept of {} candidates (rank {}), condition number {:.2}, observability O1 {:.4}",
-        id.kept.len(), id.candidates, id.rank, id.condition_number, id.observability_o1
-    );
-    for d in &id.dropped {
-        if d.depends_on.is_empty() {
-            let _ = writeln!(s, "  dropped {:<8} {}", d.name, d.reason);
-        } else {
-            let _ = writeln!(
-                s,
-                "  dropped {:<8} {} ({})",
-                d.name,
-                d.reason,
-                d.depends_on.join(", ")
-            );
-        }
-    }
-    for p in &id.correlated_pairs {
-        let _ = writeln!(s, "  correlated {} ~ {}: {:+.3}", p.a, p.b, p.correlation);
-    }
-    if !id.identifiable_by_orientation.is_empty() {
-        let _ = writeln!(
-            s,
-            "  identified only thanks to the measured orientations: {}",
-            id.identifiable_by_orientation.join(", ")
-        );
-    }
-    if !id.unseen_tool_tip_terms.is_empty() {
-        let _ = writeln!(
-            s,
-            "  not seen by position-only data (a production tool's tip depends on them; its error there is unknown): {}",
-            id.unseen_tool_tip_terms.join(", ")
-        );
-    }
-    // Parameter table across methods.
-    let names: Vec<Method> = r.methods.keys().copied().collect();
-    let _ = write!(
-        s,
-        "\nIdentified parameters (mm, deg, rad/(N·m))\n{:<10} {:>14}",
-        "name", "nominal"
-    );
-    for n in &names {
-        let _ = write!(s, " {:>14}", method_label(*n));
-    }
-    let _ = writeln!(s);
-    let mut all: Vec<String> = Vec::new();
-    for m in r.methods.values() {
-        for p in &m.parameters {
-            if !all.contains(&p.name) {
-                all.push(p.name.clone());
-            }
-        }
-    }
-    for pname in &all {
-        let nominal_v = r
-            .methods
-            .values()
-            .flat_map(|m| &m.parameters)
-            .find(|p| &p.name == pname)
-            .map(|p| p.nominal)
-            .unwrap_or(0.0);
-        let unit = r
-            .methods
-            .values()
-            .flat_map(|m| &m.parameters)
-            .find(|p| &p.name == pname)
-            .map(|p| p.unit.as_str())
-            .unwrap_or("");
-        let _ = write!(s, "{:<10} {:>14}", pname, param_number(nominal_v, unit));
-        for n in &names {
-            match r.methods[n].parameters.iter().find(|p| &p.name == pname) {
-                Some(p) => {
-                    let _ = write!(s, " {:>14}", param_number(p.value, unit));
-                }
-                None => {
-                    let _ = write!(s, " {:>14}", "-");
-                }
-            }
-        }
-        let _ = writeln!(s);
-    }
-    let any_stiffness = r
-        .methods
-        .values()
-        .any(|m| m.stiffness_nm_per_rad.iter().any(|k| k.is_some()));
-    if any_stiffness {
-        let _ = writeln!(s, "\nJoint stiffness (N·m/rad)");
-    }
-    for (n, m) in &r.methods {
-        if m.stiffness_nm_per_rad.iter().any(|k| k.is_some()) {
-            let ks: Vec<String> = m
-                .stiffness_nm_per_rad
-                .iter()
-                .enumerate()
-                .filter_map(|(k, v)| v.map(|v| format!("K{}={:.4e}", k + 1, v)))
-                .collect();
-            let _ = writeln!(s, "  {:<14} {}", method_label(*n), ks.join("  "));
-        }
-    }
-    for (n, m) in &r.methods {
-        let _ = writeln!(
-            s,
-            "solver {:<14} converged={} iterations={} reason={} ({})",
-            method_label(*n),
-            m.solver.converged,
-            m.solver.iterations,
-            m.solver.reason.code(),
-            m.solver.detail
-        );
-    }
-    if r.methods.values().any(|m| !m.warnings.is_empty()) {
-        let _ = writeln!(s, "\nWarnings");
-        for (n, m) in &r.methods {
-            for w in &m.warnings {
-                let _ = writeln!(s, "  {:<14} {}", method_label(*n), w.message);
-            }
-        }
-    }
-    if !r.failed.is_empty() {
-        let _ = writeln!(s, "\nFailed methods (the others above are complete)");
-        for f in &r.failed {
-            let _ = writeln!(s, "  {:<14} {}", method_label(f.method), f.reason);
-        }
-    }
-    s
-}
-
-/// The seed-style comparison (rows = methods, columns = sets, mean / max in mm),
-/// the compensator training pool between identification and validation.
-pub fn render_comparison(r: &CalibrationReport) -> String {
-    let mut s = String::new();
-    let training = r.training_poses > 0;
-    let validation = r.validation_poses > 0;
-    let _ = write!(
-        s,
-        "\nComparison, mean / max (mm)\n{:<22} {:>19}",
-        "", "identification (Q1)"
-    );
-    if training {
-        let _ = write!(s, " {:>19}", "training (Q2)");
-    }
-    if validation {
-        let _ = write!(s, " {:>19}", "validation (Q3)");
-    }
-    let _ = writeln!(s);
-    let cell = |e: Option<&crate::stats::ErrorStats>| match e {
-        Some(e) => format!("{:>9.4} / {:<7.4}", e.mean_mm, e.max_mm),
-        None => format!("{:>19}", "-"),
-    };
-    let _ = write!(
-        s,
-        "{:<22} {}",
-        "Nominal robot model",
-        cell(Some(&r.nominal.identification.stats))
-    );
-    if training {
-        let _ = write!(s, " {}", cell(None));
-    }
-    if validation {
-        let _ = write!(
-            s,
-            " {}",
-            cell(r.nominal.validation.as_ref().map(|v| &v.stats))
-        );
-    }
-    let _ = writeln!(s);
-    for (name, m) in &r.methods {
-        let _ = write!(
-            s,
-            "{:<22} {}",
-            method_label(*name),
-            cell(Some(&m.identification.stats))
-        );
-        if training {
-            let _ = write!(s, " {}", cell(m.training.as_ref().map(|v| &v.stats)));
-        }
-        if validation {
-            let _ = write!(s, " {}", cell(m.validation.as_ref().map(|v| &v.stats)));
-        }
-        let _ = writeln!(s);
-    }
-    s
-}
-
-/// Orientation errors per set (mean / max in degrees), for every model, when
-/// some set measured orientation; empty otherwise.
-pub fn render_orientation(r: &CalibrationReport) -> String {
-    let mut s = String::new();
-    let nominal: [Option<&SetErrors>; 2] = [
-        Some(&r.nominal.identification),
-        r.nominal.validation.as_ref(),
-    ];
-    let any = nominal
-        .into_iter()
-        .chain(r.methods.values().flat_map(|m| {
-            [
-                Some(&m.identification),
-                m.training.as_ref(),
-                m.validation.as_ref(),
-            ]
-        }))
-        .flatten()
-        .any(|e| e.orientation.is_some());
-    if !any {
-        return s;
-    }
-    let training = r.training_poses > 0;
-    let validation = r.validation_poses > 0;
-    let _ = write!(
-        s,
-        "\nOrientation, mean / max (deg)\n{:<22} {:>19}",
-        "", "identification (Q1)"
-    );
-    if training {
-        let _ = write!(s, " {:>19}", "training (Q2)");
-    }
-    if validation {
-        let _ = write!(s, " {:>19}", "validation (Q3)");
-    }
-    let _ = writeln!(s);
-    let cell = |e: Option<&SetErrors>| match e.and_then(|e| e.orientation.as_ref()) {
-        Some(o) => format!("{:>9.4} / {:<7.4}", o.mean_deg, o.max_deg),
-        None => format!("{:>19}", "-"),
-    };
-    let _ = write!(
-        s,
-        "{:<22} {}",
-        "Nominal robot model",
-        cell(Some(&r.nominal.identification))
-    );
-    if training {
-        let _ = write!(s, " {}", cell(None));
-    }
-    if validation {
-        let _ = write!(s, " {}", cell(r.nominal.validation.as_ref()));
-    }
-    let _ = writeln!(s);
-    for (name, m) in &r.methods {
-        let _ = write!(
-            s,
-            "{:<22} {}",
-            method_label(*name),
-            cell(Some(&m.identification))
-        );
-        if training {
-            let _ = write!(s, " {}", cell(m.training.as_ref()));
-        }
-        if validation {
-            let _ = write!(s, " {}", cell(m.validation.as_ref()));
-        }
-        let _ = writeln!(s);
-    }
-    let _ = writeln!(
-        s,
-        "(compensators correct position only: their orientation is their base's)"
-    );
-    s
-}
-
-/// Each compensator: network, training, cross-validation and its effect on
-/// every set; `auto`'s choice and why.
-pub fn render_compensators(r: &CalibrationReport) -> String {
-    let mut s = String::new();
-    let with: Vec<_> = r
-        .methods
-        .iter()
-        .filter(|(_, m)| m.compensator.is_some() || m.auto.is_some())
-        .collect();
-    if with.is_empty() {
-        return s;
-    }
-    let _ = writeln!(s, "\nCompensators (mean / max in mm, base -> compensated)");
-    let pair = |b: &crate::stats::ErrorStats, c: &crate::stats::ErrorStats| {
-        format!(
-            "{:.4} -> {:.4} / {:.4} -> {:.4}",
-            b.mean_mm, c.mean_mm, b.max_mm, c.max_mm
-        )
-    };
-    for (name, m) in with {
-        if let Some(a) = &m.auto {
-            let _ = writeln!(
-                s,
-                "  {:<14} chose {}: {}",
-                method_label(*name),
-                method_label(a.chosen),
-                a.reason
-            );
-        }
-        let Some(c) = &m.compensator else {
-            continue;
-        };
-        let _ = writeln!(
-            s,
-            "  {:<14} {} on {}, {} units, over {}; trained by {} on {} {} poses: {} epochs / iterations / generations, {} loss evaluations, stopped: {}; training RMS {:.4} mm",
-            method_label(*name),
-            c.kind,
-            c.inputs,
-            c.units,
-            method_label(c.base),
-            c.training.trainer,
-            c.training_poses,
-            c.trained_on,
-            c.training.epochs,
-            c.training.evaluations,
-            c.training.stop,
-            c.training.rms_mm
-        );
-        if let Some(cv) = &c.cross_validation {
-            let _ = writeln!(
-                s,
-                "  {:<14} cross-validated ({} folds on the {} poses): {}",
-                "",
-                cv.folds,
-                c.trained_on,
-                pair(&cv.base, &cv.compensated)
-            );
-        }
-        let _ = writeln!(
-            s,
-            "  {:<14} identification: {}",
-            "",
-            pair(&c.base_identification, &m.identification.stats)
-        );
-        if let (Some(b), Some(t)) = (&c.base_training, &m.training) {
-            let _ = writeln!(s, "  {:<14} training:       {}", "", pair(b, &t.stats));
-        }
-        if let (Some(b), Some(v)) = (&c.base_validation, &m.validation) {
-            let _ = writeln!(s, "  {:<14} validation:     {}", "", pair(b, &v.stats));
-        }
-        let o = &c.orientation_part;
-        let _ = writeln!(
-            s,
-            "  {:<14} orientation part: {} — {}",
-            "",
-            o.status.name(),
-            o.reason
-        );
-    }
-    s
 }
