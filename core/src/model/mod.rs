@@ -7,6 +7,7 @@ pub mod export;
 pub mod joint_map_table;
 pub mod joint_maps;
 pub mod kinematics;
+pub mod load;
 pub mod orientation;
 pub mod params;
 pub mod pose;

@@ -26,7 +26,7 @@ pub mod accuracy;
 pub mod export;
 pub mod file;
 pub mod joints_csv;
-pub mod load;
+pub use crate::model::load;
 pub mod predict;
 pub mod tcp;
 pub mod work_object_fit;
@@ -38,7 +38,7 @@ pub use predict::{Forward, PoseOut, PredictError, PredictFrame, Predicted};
 use crate::calibrate::compensate::CompensatedModel;
 use crate::model::Pose;
 use crate::solve::ik::{
-    Configuration, Goal, IkSettings, IkSolution, IkSolver, SolveOptions, TargetFrame,
+    Configuration, Goal, IkSettings, IkSolution, IkSolver, SolveOptions, TargetFrame, TcpTool,
 };
 use serde::{Deserialize, Serialize};
 
@@ -183,23 +183,15 @@ pub fn with_tool(model: &CompensatedModel, tcp: &Pose) -> CompensatedModel {
 }
 
 /// [`with_tool`] carrying `load` (flange frame) instead of the model's
-/// payload; `None` keeps each model's payload at its flange point.
+/// payload; `None` keeps each model's payload at its flange point. For the
+/// forward predictions; a solve takes the tool as an input
+/// ([`IkSolver::with_tool`]), which applies it the same way.
 pub fn with_tool_load(
     model: &CompensatedModel,
     tcp: &Pose,
     load: Option<&Load>,
 ) -> CompensatedModel {
-    let carried = |m: &crate::model::RobotModel| {
-        let l = load.copied().unwrap_or_else(|| Load::of_model(m));
-        load::on_tool(m, tcp, &l)
-    };
-    let mut m = model.clone();
-    m.calibrated = carried(&model.calibrated);
-    m.nominal = carried(&model.nominal);
-    if let Some(l) = load {
-        m.payload_kg = l.mass_kg;
-    }
-    m
+    crate::solve::ik::tool::carrying(model, tcp, load)
 }
 
 /// Options of one cell solve.
@@ -242,7 +234,11 @@ impl CellSolver {
         load: Option<&Load>,
         settings: IkSettings,
     ) -> Self {
-        Self::prepared(with_tool_load(model, tcp, load), settings)
+        let tool = TcpTool {
+            tcp: *tcp,
+            load: load.copied(),
+        };
+        Self::prepared(IkSolver::with_tool(model, Some(&tool), settings))
     }
 
     /// The one way a production tool enters a solve (the HTTP solve, the CLI
@@ -252,15 +248,16 @@ impl CellSolver {
     pub fn for_tool(model: &CompensatedModel, tool: Option<&Tool>, settings: IkSettings) -> Self {
         match tool {
             Some(t) => Self::with_load(model, &t.tcp, t.load.as_ref(), settings),
-            None => Self::prepared(model.clone(), settings),
+            None => Self::prepared(IkSolver::with_tool(model, None, settings)),
         }
     }
 
-    /// A solver of a model that already carries its tool.
-    fn prepared(m: CompensatedModel, settings: IkSettings) -> Self {
+    /// A cell solver around an IK solver built for its tool, with the
+    /// closed form of the nominal model carrying that tool.
+    fn prepared(solver: IkSolver) -> Self {
         CellSolver {
-            nominal_ik: crate::solve::ik::AnalyticIk::new(&m.nominal).ok(),
-            solver: IkSolver::new(m, settings),
+            nominal_ik: crate::solve::ik::AnalyticIk::new(&solver.model().nominal).ok(),
+            solver,
         }
     }
 

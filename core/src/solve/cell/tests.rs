@@ -190,3 +190,65 @@ fn a_load_in_the_tool_frame_is_converted_once_to_the_flange() {
     let bad = LoadDescription { mass_kg: -1.0, ..d };
     assert!(bad.to_load(&torch()).unwrap_err().contains("mass_kg"));
 }
+
+#[test]
+fn the_solver_takes_the_tool_and_solves_as_a_model_carrying_it() {
+    let (model, _) = fixture();
+    let load = Load {
+        mass_kg: 20.0,
+        com: Vector3::new(0.05, 0.0, 0.1),
+        inertia_kgm2: None,
+    };
+    let tool = TcpTool {
+        tcp: torch(),
+        load: Some(load),
+    };
+    // By hand: the torch on both flanges, the load's centre of mass in the
+    // torch frame, its mass the declared payload.
+    let mut by_hand = model.clone();
+    let rpy = crate::model::orientation::fixed_xyz_angles(&torch().r);
+    let com = torch().inverse().transform_point(&load.com);
+    for m in [&mut by_hand.calibrated, &mut by_hand.nominal] {
+        m.tool.p = torch().p;
+        m.tool.rpy = rpy;
+        m.payload.mass = 20.0;
+        m.payload.com = com;
+    }
+    by_hand.payload_kg = 20.0;
+    let reference = IkSolver::new(by_hand.clone(), IkSettings::default());
+    let solver = IkSolver::with_tool(&model, Some(&tool), IkSettings::default());
+    assert_eq!(solver.tool(), Some(&tool));
+    assert_eq!(reference.tool(), None);
+    let cell = CellSolver::for_tool(
+        &model,
+        Some(&Tool {
+            name: "torch".into(),
+            number: Some(1),
+            tcp: torch(),
+            load: Some(load),
+        }),
+        IkSettings::default(),
+    );
+    assert_eq!(cell.solver().tool(), Some(&tool));
+    for q in [
+        [0.2, 1.4, -0.2, 0.4, 0.9, 0.3],
+        [-0.5, 1.1, 0.1, -0.7, 1.2, 1.0],
+        [0.9, 1.6, -0.4, 0.2, 0.6, -0.8],
+    ] {
+        let target = by_hand.predict_base(&q).unwrap();
+        let opts = SolveOptions {
+            frame: TargetFrame::Base,
+            ..SolveOptions::default()
+        };
+        let want = reference.solve(&target, &opts);
+        assert!(want.converged, "{:?}", want.reason);
+        let got = [
+            solver.solve(&target, &opts),
+            cell.solver().solve(&target, &opts),
+        ];
+        for got in got {
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&got.q), bits(&want.q));
+        }
+    }
+}

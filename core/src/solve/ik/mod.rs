@@ -20,6 +20,7 @@ pub mod invalid;
 pub mod solver;
 pub mod targets;
 pub mod targets_csv;
+pub mod tool;
 
 pub use analytic::{AnalyticError, AnalyticIk, AnalyticSolution, Structure};
 pub use config::{BranchError, Configuration, Elbow, Shoulder, Wrist};
@@ -31,3 +32,4 @@ pub use targets::{FalseTarget, JointJump, TargetFrame, TargetInput, TargetResult
 pub use targets_csv::{
     parse_targets_csv, results_csv, RowError, TargetRow, TargetsCsv, TargetsCsvError,
 };
+pub use tool::TcpTool;

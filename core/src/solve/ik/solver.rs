@@ -378,6 +378,9 @@ pub struct IkSolver {
     /// `model` and the model the closed form solves (the nominal model or its
     /// proxy), prepared for the iteration (constants once).
     prepared: PreparedModel,
+    /// The production tool the solver was built for (`None`: the model's own
+    /// tool, the measurement tool).
+    tool: Option<super::tool::TcpTool>,
 }
 
 impl IkSolver {
@@ -386,6 +389,40 @@ impl IkSolver {
     /// nominal model is only nearly of a solvable structure; otherwise the
     /// solver seeds numerically.
     pub fn new(model: CompensatedModel, settings: IkSettings) -> Self {
+        Self::prepare(model, None, settings)
+    }
+
+    /// A solver of `model` carrying `tool`: the tool's TCP on the calibrated
+    /// and nominal flanges and its load (else the model's payload at its
+    /// flange point), applied here, once ([`super::tool::carrying`]). The
+    /// load's gravity changes the compliance deflection the solver prepares,
+    /// so the tool is fixed for the solver's life; another tool needs another
+    /// solver. `None` keeps the model's own (measurement) tool.
+    pub fn with_tool(
+        model: &CompensatedModel,
+        tool: Option<&super::tool::TcpTool>,
+        settings: IkSettings,
+    ) -> Self {
+        match tool {
+            Some(t) => Self::prepare(
+                super::tool::carrying(model, &t.tcp, t.load.as_ref()),
+                Some(*t),
+                settings,
+            ),
+            None => Self::prepare(model.clone(), None, settings),
+        }
+    }
+
+    /// The production tool this solver was built for (`None`: the model's own).
+    pub fn tool(&self) -> Option<&super::tool::TcpTool> {
+        self.tool.as_ref()
+    }
+
+    fn prepare(
+        model: CompensatedModel,
+        tool: Option<super::tool::TcpTool>,
+        settings: IkSettings,
+    ) -> Self {
         let mut seed_model = model.nominal.clone();
         let (analytic, analytic_error) = if model.nominal.dof() != model.calibrated.dof() {
             (
@@ -429,6 +466,7 @@ impl IkSolver {
             analytic_error,
             settings,
             limits,
+            tool,
         }
     }
 
