@@ -258,7 +258,10 @@ fn maps_fit_across_two_tracker_sessions() {
         m.session = 1;
     }
     let (km, maps) = validation_means(&s);
-    eprintln!("two sessions: floor {:.4} mm, KM {km:.4}, km-maps {maps:.4}", s.floor_mm);
+    eprintln!(
+        "two sessions: floor {:.4} mm, KM {km:.4}, km-maps {maps:.4}",
+        s.floor_mm
+    );
     assert!(km > 2.0 * s.floor_mm, "the errors must matter: KM {km}");
     assert!(
         maps < 1.15 * s.floor_mm,

@@ -1,7 +1,7 @@
 //! The text report of `robocal calibrate`: accuracy, the comparison of
 //! methods, orientation, compensators, identifiability, parameters.
 
-use crate::identify::{CalibrationReport, Method, SetErrors};
+use crate::calibrate::identify::{CalibrationReport, Method, SetErrors};
 use crate::report::method_label;
 use std::fmt::Write as _;
 
