@@ -621,86 +621,7 @@ impl Parser<'_> {
             if is_decl || matches!(first, "TOOL_DATA" | "BASE_DATA" | "LOAD_DATA") {
                 continue; // handled by `declarations`
             }
-            // $TOOL = … / $BASE = …
-            if (first == "$TOOL" || first == "$BASE")
-                && matches!(toks.get(1), Some((Tok::Punct('='), _)))
-            {
-                let tool = first == "$TOOL";
-                let spec = match toks.get(2) {
-                    Some((Tok::Word(w), _)) if w == "$NULLFRAME" => {
-                        FrameSpec::Ref(CellRef::Number(0))
-                    }
-                    Some((Tok::Word(w), _)) if w == "TOOL_DATA" || w == "BASE_DATA" => {
-                        match self.number_ref(&toks, 3) {
-                            Some(n) => self.frame_spec(n, w == "TOOL_DATA"),
-                            None => FrameSpec::Unset,
-                        }
-                    }
-                    Some((Tok::Agg(a), _)) => {
-                        frame_of(a, code, 0).map_or(FrameSpec::Unset, FrameSpec::Inline)
-                    }
-                    _ => FrameSpec::Unset,
-                };
-                if tool {
-                    ctx.tool = spec;
-                } else {
-                    ctx.base = spec;
-                }
-                continue;
-            }
-            // $IPO_MODE = #TCP / #BASE
-            if first == "$IPO_MODE" && matches!(toks.get(1), Some((Tok::Punct('='), _))) {
-                match word(2) {
-                    "#TCP" => ctx.external = true,
-                    "#BASE" => ctx.external = false,
-                    _ => {}
-                }
-                continue;
-            }
-            // $LOAD = {…} / $LOAD = LOAD_DATA[n]
-            if first == "$LOAD" && matches!(toks.get(1), Some((Tok::Punct('='), _))) {
-                ctx.load = match toks.get(2) {
-                    Some((Tok::Agg(a), _)) => load_of(a, code),
-                    Some((Tok::Word(w), _)) if w == "LOAD_DATA" => self
-                        .number_ref(&toks, 3)
-                        .and_then(|n| self.loads.get(&n).copied()),
-                    _ => None,
-                };
-                continue;
-            }
-            // BAS(#TOOL, n) / BAS(#BASE, n)
-            if first == "BAS" && matches!(word(2), "#TOOL" | "#BASE") {
-                if let (Some((Tok::Punct(','), _)), Some((Tok::Number(n), _))) =
-                    (toks.get(3), toks.get(4))
-                {
-                    if n.fract() == 0.0 && *n >= 0.0 && *n < 1e9 {
-                        let tool = word(2) == "#TOOL";
-                        let spec = self.frame_spec(*n as u32, tool);
-                        if tool {
-                            if let Some(l) = self.loads.get(&(*n as u32)) {
-                                ctx.load = Some(*l);
-                            }
-                            ctx.tool = spec;
-                        } else {
-                            ctx.base = spec;
-                        }
-                    }
-                }
-                continue;
-            }
-            // FDAT_ACT = FP1
-            if first == "FDAT_ACT" && matches!(toks.get(1), Some((Tok::Punct('='), _))) {
-                if let Some(fdat) = self.fdat.get(word(2)).copied() {
-                    if let Some(t) = fdat.tool {
-                        ctx.tool = self.frame_spec(t, true);
-                    }
-                    if let Some(b) = fdat.base {
-                        ctx.base = self.frame_spec(b, false);
-                    }
-                    if let Some(e) = fdat.external {
-                        ctx.external = e;
-                    }
-                }
+            if self.context_statement(&toks, code, &mut ctx) {
                 continue;
             }
             let relative = RELATIVE.contains(&first);
@@ -735,6 +656,103 @@ impl Parser<'_> {
             }
         }
         Ok(())
+    }
+
+    /// A statement that sets the motion context (`$TOOL`, `$BASE`,
+    /// `$IPO_MODE`, `$LOAD`, `BAS(#TOOL|#BASE, n)`, `FDAT_ACT`) updates `ctx`;
+    /// true when `toks` was one.
+    fn context_statement(
+        &self,
+        toks: &[(Tok, Range<usize>)],
+        code: &str,
+        ctx: &mut Context,
+    ) -> bool {
+        let word = |i: usize| match toks.get(i) {
+            Some((Tok::Word(w), _)) => w.as_str(),
+            _ => "",
+        };
+        let first = word(0);
+        // $TOOL = … / $BASE = …
+        if (first == "$TOOL" || first == "$BASE")
+            && matches!(toks.get(1), Some((Tok::Punct('='), _)))
+        {
+            let tool = first == "$TOOL";
+            let spec = match toks.get(2) {
+                Some((Tok::Word(w), _)) if w == "$NULLFRAME" => FrameSpec::Ref(CellRef::Number(0)),
+                Some((Tok::Word(w), _)) if w == "TOOL_DATA" || w == "BASE_DATA" => {
+                    match self.number_ref(toks, 3) {
+                        Some(n) => self.frame_spec(n, w == "TOOL_DATA"),
+                        None => FrameSpec::Unset,
+                    }
+                }
+                Some((Tok::Agg(a), _)) => {
+                    frame_of(a, code, 0).map_or(FrameSpec::Unset, FrameSpec::Inline)
+                }
+                _ => FrameSpec::Unset,
+            };
+            if tool {
+                ctx.tool = spec;
+            } else {
+                ctx.base = spec;
+            }
+            return true;
+        }
+        // $IPO_MODE = #TCP / #BASE
+        if first == "$IPO_MODE" && matches!(toks.get(1), Some((Tok::Punct('='), _))) {
+            match word(2) {
+                "#TCP" => ctx.external = true,
+                "#BASE" => ctx.external = false,
+                _ => {}
+            }
+            return true;
+        }
+        // $LOAD = {…} / $LOAD = LOAD_DATA[n]
+        if first == "$LOAD" && matches!(toks.get(1), Some((Tok::Punct('='), _))) {
+            ctx.load = match toks.get(2) {
+                Some((Tok::Agg(a), _)) => load_of(a, code),
+                Some((Tok::Word(w), _)) if w == "LOAD_DATA" => self
+                    .number_ref(toks, 3)
+                    .and_then(|n| self.loads.get(&n).copied()),
+                _ => None,
+            };
+            return true;
+        }
+        // BAS(#TOOL, n) / BAS(#BASE, n)
+        if first == "BAS" && matches!(word(2), "#TOOL" | "#BASE") {
+            if let (Some((Tok::Punct(','), _)), Some((Tok::Number(n), _))) =
+                (toks.get(3), toks.get(4))
+            {
+                if n.fract() == 0.0 && *n >= 0.0 && *n < 1e9 {
+                    let tool = word(2) == "#TOOL";
+                    let spec = self.frame_spec(*n as u32, tool);
+                    if tool {
+                        if let Some(l) = self.loads.get(&(*n as u32)) {
+                            ctx.load = Some(*l);
+                        }
+                        ctx.tool = spec;
+                    } else {
+                        ctx.base = spec;
+                    }
+                }
+            }
+            return true;
+        }
+        // FDAT_ACT = FP1
+        if first == "FDAT_ACT" && matches!(toks.get(1), Some((Tok::Punct('='), _))) {
+            if let Some(fdat) = self.fdat.get(word(2)).copied() {
+                if let Some(t) = fdat.tool {
+                    ctx.tool = self.frame_spec(t, true);
+                }
+                if let Some(b) = fdat.base {
+                    ctx.base = self.frame_spec(b, false);
+                }
+                if let Some(e) = fdat.external {
+                    ctx.external = e;
+                }
+            }
+            return true;
+        }
+        false
     }
 
     fn use_point(&mut self, name: &str, line: usize, ctx: &Context) {

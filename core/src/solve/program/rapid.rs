@@ -246,95 +246,113 @@ impl Parser<'_> {
             }
             let key = name.to_ascii_lowercase();
             match ty.as_str() {
-                "robtarget" => {
-                    let elements: Vec<&Val> = match (&v, array) {
-                        (Val::List(items, _), true) => items.iter().collect(),
-                        _ => vec![&v],
-                    };
-                    for (i, e) in elements.into_iter().enumerate() {
-                        let t = robtarget(e)?;
-                        let label = if array {
-                            format!("{name}{{{}}}", i + 1)
-                        } else {
-                            name.to_string()
-                        };
-                        let unset = Context {
-                            tool: FrameSpec::Unset,
-                            wobj: FrameSpec::Unset,
-                            load: None,
-                            skip: None,
-                            stationary: false,
-                        };
-                        let site = self.site(fi, label, t, &unset);
-                        self.by_name
-                            .entry(key.clone())
-                            .or_default()
-                            .push(self.declared.len());
-                        self.declared.push(Declared {
-                            site,
-                            uses: Vec::new(),
-                        });
-                    }
-                }
+                "robtarget" => self.declare_robtargets(fi, name, key, &v, array)?,
                 "jointtarget" => self.joint(fi, &v),
-                "tooldata" => {
-                    let tool = v.list().and_then(|i| i.get(1)).and_then(frame);
-                    let robhold = v
-                        .list()
-                        .and_then(|i| i.first())
-                        .map(|r| self.text_of(fi, r));
-                    if robhold.is_some_and(|r| r.eq_ignore_ascii_case("false")) {
-                        self.stationary_tools.insert(key.clone());
-                    }
-                    let value = match tool {
-                        Some((pose, _)) => pose,
-                        None => {
-                            return Err((
-                                v.range().start,
-                                format!(
-                                    "tooldata {name} is not `[robhold,[[x,y,z],[q1,q2,q3,q4]],…]`"
-                                ),
-                            ))
-                        }
-                    };
-                    if let Some(load) = v.list().and_then(|i| i.get(2)).and_then(tload) {
-                        self.loads.insert(key.clone(), load);
-                    }
-                    self.tools.insert(key, value);
-                }
-                "wobjdata" => {
-                    let items = v.list().unwrap_or(&[]);
-                    let frames = (items.get(3).and_then(frame), items.get(4).and_then(frame));
-                    let (Some((uf, _)), Some((of, _))) = frames else {
-                        return Err((
-                            v.range().start,
-                            format!(
-                                "wobjdata {name} is not `[robhold,ufprog,ufmec,uframe,oframe]`"
-                            ),
-                        ));
-                    };
-                    let robhold = items
-                        .first()
-                        .map(|r| self.text_of(fi, r))
-                        .unwrap_or_default();
-                    let ufmec = items
-                        .get(2)
-                        .map(|r| self.text_of(fi, r))
-                        .unwrap_or_default();
-                    if robhold.eq_ignore_ascii_case("true") {
-                        self.held_wobjs.insert(key.clone());
-                    }
-                    let value = if ufmec.trim_matches('"').trim() != "" {
-                        Err(format!("work object {name} moves with {ufmec}"))
-                    } else {
-                        uf.and_then(|u| of.map(|o| u.compose(&o)))
-                    };
-                    self.wobjs.insert(key, value);
-                }
+                "tooldata" => self.declare_tool(fi, name, key, &v)?,
+                "wobjdata" => self.declare_wobj(fi, name, key, &v)?,
                 _ => {}
             }
         }
         self.toks[fi] = toks;
+        Ok(())
+    }
+
+    /// A `robtarget` declaration (one target, or one per element of an
+    /// array, labelled `name{i}`).
+    fn declare_robtargets(
+        &mut self,
+        fi: usize,
+        name: &str,
+        key: String,
+        v: &Val,
+        array: bool,
+    ) -> Result<(), Fail> {
+        let elements: Vec<&Val> = match (v, array) {
+            (Val::List(items, _), true) => items.iter().collect(),
+            _ => vec![v],
+        };
+        for (i, e) in elements.into_iter().enumerate() {
+            let t = robtarget(e)?;
+            let label = if array {
+                format!("{name}{{{}}}", i + 1)
+            } else {
+                name.to_string()
+            };
+            let unset = Context {
+                tool: FrameSpec::Unset,
+                wobj: FrameSpec::Unset,
+                load: None,
+                skip: None,
+                stationary: false,
+            };
+            let site = self.site(fi, label, t, &unset);
+            self.by_name
+                .entry(key.clone())
+                .or_default()
+                .push(self.declared.len());
+            self.declared.push(Declared {
+                site,
+                uses: Vec::new(),
+            });
+        }
+        Ok(())
+    }
+
+    /// A `tooldata` declaration: its TCP, its load, and whether the robot
+    /// holds it (`robhold FALSE`: a stationary tool).
+    fn declare_tool(&mut self, fi: usize, name: &str, key: String, v: &Val) -> Result<(), Fail> {
+        let tool = v.list().and_then(|i| i.get(1)).and_then(frame);
+        let robhold = v
+            .list()
+            .and_then(|i| i.first())
+            .map(|r| self.text_of(fi, r));
+        if robhold.is_some_and(|r| r.eq_ignore_ascii_case("false")) {
+            self.stationary_tools.insert(key.clone());
+        }
+        let value = match tool {
+            Some((pose, _)) => pose,
+            None => {
+                return Err((
+                    v.range().start,
+                    format!("tooldata {name} is not `[robhold,[[x,y,z],[q1,q2,q3,q4]],…]`"),
+                ))
+            }
+        };
+        if let Some(load) = v.list().and_then(|i| i.get(2)).and_then(tload) {
+            self.loads.insert(key.clone(), load);
+        }
+        self.tools.insert(key, value);
+        Ok(())
+    }
+
+    /// A `wobjdata` declaration: user frame · object frame, held by the
+    /// robot when `robhold TRUE`, refused when a mechanical unit moves it.
+    fn declare_wobj(&mut self, fi: usize, name: &str, key: String, v: &Val) -> Result<(), Fail> {
+        let items = v.list().unwrap_or(&[]);
+        let frames = (items.get(3).and_then(frame), items.get(4).and_then(frame));
+        let (Some((uf, _)), Some((of, _))) = frames else {
+            return Err((
+                v.range().start,
+                format!("wobjdata {name} is not `[robhold,ufprog,ufmec,uframe,oframe]`"),
+            ));
+        };
+        let robhold = items
+            .first()
+            .map(|r| self.text_of(fi, r))
+            .unwrap_or_default();
+        let ufmec = items
+            .get(2)
+            .map(|r| self.text_of(fi, r))
+            .unwrap_or_default();
+        if robhold.eq_ignore_ascii_case("true") {
+            self.held_wobjs.insert(key.clone());
+        }
+        let value = if ufmec.trim_matches('"').trim() != "" {
+            Err(format!("work object {name} moves with {ufmec}"))
+        } else {
+            uf.and_then(|u| of.map(|o| u.compose(&o)))
+        };
+        self.wobjs.insert(key, value);
         Ok(())
     }
 
