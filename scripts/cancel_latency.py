@@ -166,7 +166,7 @@ try:
             extra = ["--gear-error", "0.003,1", "--backlash-deg", "0.001"]
             if a.transmission:
                 extra += ["--transmission", a.transmission]
-        subprocess.run([a.robocal, "simulate", "--preset", "ys100", "--poses", str(poses), "--seed", str(thesis),
+        subprocess.run([a.robocal, "simulate", "--preset", "ys100", "--poses", str(poses), "--seed", str(seed),
                         "--set", role, "--out", f"{work}/{name}.csv", *extra], check=True, capture_output=True)
         return open(f"{work}/{name}.csv", "rb").read()
 

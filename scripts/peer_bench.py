@@ -223,7 +223,7 @@ def km_ys100_bench(robocal, repeat):
     for name, seed, n in (("ident", 1, 50), ("valid", 2, 30)):
         path = os.path.join(work, f"{name}.csv")
         subprocess.check_call([
-            robocal, "simulate", "--preset", "ys100", "--poses", str(n), "--seed", str(thesis),
+            robocal, "simulate", "--preset", "ys100", "--poses", str(n), "--seed", str(seed),
             "--tracker", "1,-2,30,2500,-1000,400", "--out", path],
             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         files[name] = path
@@ -257,7 +257,7 @@ def ik_bench(robocal, n, seed):
     links = [rtb.RevoluteDH(d=D[i] / 1e3, a=A[i] / 1e3, alpha=ALPHA[i]) for i in range(6)]
     robot = rtb.DHRobot(links, name="ur5-preset")
     ets = robot.ets()
-    rng = np.random.default_rng(thesis)
+    rng = np.random.default_rng(seed)
     qs = rng.uniform(-np.pi, np.pi, size=(n, 6))
     Ts = [ets.eval(q) for q in qs]
     tmp = tempfile.mkdtemp()

@@ -226,7 +226,7 @@ def main():
     for idx, spec in enumerate(ROBOTS):
         n = len(spec["dh"])
         seed = BASE_SEED + idx
-        rng = np.random.default_rng(thesis)
+        rng = np.random.default_rng(seed)
         qs = [np.zeros(n)]
         qs += [np.round(rng.uniform(-Q_LIM_DEG, Q_LIM_DEG, n), Q_DECIMALS) for _ in range(N_RANDOM)]
 
@@ -270,7 +270,7 @@ def main():
             "tool_convention": TOOL_CONV,
             "tolerance_cross_check": TOL,
             "seed": seed,
-            "sampling": f"sample 0: q = 0; then {N_RANDOM} x numpy.random.default_rng(thesis).uniform(-{Q_LIM_DEG:g}, {Q_LIM_DEG:g}, n) rounded to {Q_DECIMALS} decimals",
+            "sampling": f"sample 0: q = 0; then {N_RANDOM} x numpy.random.default_rng(seed).uniform(-{Q_LIM_DEG:g}, {Q_LIM_DEG:g}, n) rounded to {Q_DECIMALS} decimals",
             "dh": [
                 {"a_mm": clean(a), "alpha_deg": clean(al), "d_mm": clean(d), "theta_offset_deg": clean(o)}
                 for a, al, d, o in spec["dh"]

@@ -84,7 +84,7 @@ const handlers = {
     const methods = [...form.querySelectorAll("input[name=method]:checked")].map((c) => c.value);
     const body = { methods };
     const seed = formValue(form, "seed");
-    if (thesis) body.seed = Number(thesis);
+    if (seed) body.seed = Number(seed);
     const payload = formValue(form, "payload_kg");
     if (payload) body.payload_kg = Number(payload);
     // Ticked sets per role; none ticked: the service takes every set of the role.
