@@ -156,209 +156,11 @@ pub fn robot(v: &RobotView) -> Markup {
         &r.name,
         v.keys,
         html! {
-            p.crumbs { a href="/ui" { "Robots" } " / " (r.name) }
-            h1 { (r.name) }
-            p.note {
-                "Robot " (id) " · " (r.preset.as_deref().unwrap_or("custom model")) " · " (r.dof) " axes · "
-                @match r.active_version { Some(a) => { "active model version " (a) }, None => { "no calibrated version yet (solves use the nominal model)" } }
-            }
-
-            section #sets {
-                h2 { "Measurement sets" }
-                @if v.sets.is_empty() {
-                    p.empty { "No measurements yet: upload a laser-tracker CSV below." }
-                } @else {
-                    table {
-                        thead { tr { th { "Id" } th { "Name" } th { "Role" } th { "Session" } th { "Poses" } th { "Payload [kg]" } th { "Uploaded" } th {} } }
-                        tbody {
-                            @for s in &v.sets {
-                                tr {
-                                    td { (s.id) } td { (s.name) } td { (SetRole::from(s.role).as_str()) } td { (s.session) }
-                                    td { (s.row_count) }
-                                    td { @if let Some(p) = s.payload_kg { (p) } @else { "—" } }
-                                    td { time datetime=(s.created_at) { (s.created_at) } }
-                                    td { a href={ "/v1/robots/" (id) "/measurement-sets/" (s.id) "/original" } { "original" } }
-                                }
-                            }
-                        }
-                    }
-                }
-                form #upload data-action="upload" data-robot=(id) {
-                    label.wide { "CSV file " input type="file" name="file" accept=".csv,text/csv"; }
-                    label { "Role "
-                        select name="role" {
-                            @for role in SetRole::ALL {
-                                option value=(role.as_str()) { (role.as_str()) }
-                            }
-                        }
-                    }
-                    label { "Name " input name="name"; }
-                    label title="How the file's orientation columns (if any) are to be read" { "Orientation "
-                        select name="orientation" {
-                            @for c in MeasuredOrientation::ALL {
-                                option value=(c.name()) title=(c.meaning()) selected[c == MeasuredOrientation::default()] { (c.name()) " (" (c.columns().join(", ")) ")" }
-                            }
-                        }
-                    }
-                    label { "Tracker session " input name="session" placeholder="default"; }
-                    label { "Payload [kg] " input name="payload_kg" type="number" step="any" min="0"; }
-                    label { "Lengths "
-                        select name="length_unit" { option value="mm" { "mm" } option value="m" { "m" } }
-                    }
-                    label { "Angles "
-                        select name="angle_unit" { option value="deg" { "deg" } option value="rad" { "rad" } }
-                    }
-                    label { "Decimal separator "
-                        select name="decimal" {
-                            option value="" { "detect" }
-                            option value="point" { "point (1500.25)" }
-                            option value="comma" { "comma (1500,25; fields split by ;)" }
-                        }
-                    }
-                    label { "dif columns "
-                        select name="dif_sign" {
-                            option value="plus" { "measured = target + dif" }
-                            option value="minus" { "measured = target − dif" }
-                        }
-                    }
-                    button type="submit" { "Upload" }
-                }
-            }
-
-            section #calibrations {
-                h2 { "Calibrations" }
-                @if v.calibrations.is_empty() {
-                    p.empty { "No calibration yet." }
-                } @else {
-                    table {
-                        thead { tr { th { "Id" } th { "Methods" } th { "Status" } th { "Phase" } th { "Progress" } th { "Best" } th { "Created" } th {} } }
-                        tbody {
-                            @for c in v.calibrations.iter().rev() {
-                                @let url = format!("/v1/robots/{id}/calibrations/{}", c.id);
-                                tr data-job=(url) data-active=(job_active(c.status)) {
-                                    td { (c.id) }
-                                    td { (c.methods.0.join(", ")) }
-                                    td.status { (c.status.as_str()) }
-                                    td.phase { (c.phase.as_deref().unwrap_or("")) }
-                                    td { progress max="100" value=(c.percent) {} " " span.percent { (format!("{:.0} %", c.percent)) } }
-                                    td {
-                                        (c.best_method.as_deref().unwrap_or("—"))
-                                        @if let Some(sum) = &c.summary {
-                                            br;
-                                            span.note { (format!("{:.4} mm mean on {} (nominal {:.3})", sum.0.mean_mm, sum.0.judged_on, sum.0.nominal_mean_mm)) }
-                                            @if !sum.0.warnings.is_empty() || !sum.0.failed_methods.is_empty() {
-                                                br;
-                                                span.bad title=(sum.0.warnings.iter().chain(&sum.0.failed_methods).cloned().collect::<Vec<_>>().join("\n")) {
-                                                    (sum.0.warnings.len()) " warnings, " (sum.0.failed_methods.len()) " failed methods"
-                                                }
-                                            }
-                                        }
-                                    }
-                                    td { time datetime=(c.created_at) { (c.created_at) } }
-                                    td {
-                                        @if c.status == JobStatus::Succeeded {
-                                            a href={ (url) "/report" } { "report" } " · "
-                                            a href={ (url) "/result" } { "result" }
-                                        } @else if job_active(c.status) {
-                                            button.small data-post={ (url) "/cancel" } { "Cancel" }
-                                        } @else if let Some(e) = &c.error {
-                                            span.bad { (e) }
-                                        }
-                                    }
-                                }
-                            }
-                        }
-                    }
-                }
-                form #calibrate data-action="calibrate" data-robot=(id) {
-                    fieldset {
-                        legend { "Methods" }
-                        @for m in Method::ALL {
-                            label.check {
-                                input type="checkbox" name="method" value=(m.name())
-                                    checked[DEFAULT_METHODS.contains(&m)];
-                                " " (m.name())
-                            }
-                        }
-                    }
-                    @for (role, legend) in [(SetRole::Identification, "Identification sets"), (SetRole::Validation, "Validation sets"), (SetRole::Training, "Training sets")] {
-                        @let of_role: Vec<&SetRow> = v.sets.iter().filter(|s| SetRole::from(s.role) == role).collect();
-                        @if !of_role.is_empty() {
-                            fieldset.sets data-role=(role.as_str()) {
-                                legend { (legend) " (none ticked: every " (role.as_str()) " set)" }
-                                @for s in of_role {
-                                    label.check { input type="checkbox" name={ (role.as_str()) "_set" } value=(s.id); " " (s.id) " " (s.name) }
-                                }
-                            }
-                        }
-                    }
-                    label { "Seed " input name="seed" type="number" min="0" step="1" placeholder="1"; }
-                    label { "Payload [kg] " input name="payload_kg" type="number" step="any" min="0" placeholder="model's"; }
-                    button type="submit" { "Start calibration" }
-                }
-            }
-
-            section #versions {
-                h2 { "Model versions" }
-                @if v.versions.is_empty() {
-                    p.empty { "No model version yet: a successful calibration creates one per method." }
-                } @else {
-                    table {
-                        thead { tr { th { "Version" } th { "Method" } th { "Calibration" } th { "Validation mean [mm]" } th { "Created" } th {} } }
-                        tbody {
-                            @for ver in v.versions.iter().rev() {
-                                tr.active[ver.active] {
-                                    td { "v" (ver.version) @if ver.active { " " span.tag { "active" } } }
-                                    td { (ver.method) }
-                                    td { @if let Some(c) = ver.calibration_id { (c) } @else { "—" } }
-                                    td { @if let Some(m) = validation_mean(ver) { (format!("{m:.4}")) } @else { "—" } }
-                                    td { time datetime=(ver.created_at) { (ver.created_at) } }
-                                    td {
-                                        a href={ "/v1/robots/" (id) "/versions/" (ver.version) "/model.json" } { "model.json" }
-                                        @if !ver.active {
-                                            " " button.small data-post={ "/v1/robots/" (id) "/versions/" (ver.version) "/activate" }
-                                                data-confirm={ "Activate v" (ver.version) " (" (ver.method) ")? Solves and filters will use it from now on." } { "Activate" }
-                                        }
-                                    }
-                                }
-                            }
-                        }
-                    }
-                    p { button.small #rollback data-post={ "/v1/robots/" (id) "/versions/rollback" }
-                        data-confirm="Roll back to the previously active version? Solves and filters will use it from now on." { "Roll back to the previous active version" } }
-                }
-            }
-
-            section #solve-section {
-                h2 { "Solve targets" }
-                p.note { "A targets CSV (id, x, y, z in mm and the orientation columns of one convention, e.g. a,b,c) in, joint commands and false targets out, as CSV." }
-                form #solve data-action="solve" data-robot=(id) {
-                    label.wide { "Targets CSV " input type="file" name="file" accept=".csv,text/csv"; }
-                    label.wide { "or paste it " textarea name="csv" rows="3" placeholder="id,x,y,z,a,b,c" {} }
-                    label { "Model "
-                        select name="version" {
-                            option value="active" { "active version" }
-                            @for ver in v.versions.iter().rev() {
-                                option value=(ver.version) { "v" (ver.version) " " (ver.method) }
-                            }
-                            option value="nominal" { "nominal model" }
-                        }
-                    }
-                    label { "Frame "
-                        select name="frame" { option value="cell" { "cell (tracker)" } option value="base" { "robot base" } }
-                    }
-                    label { "Payload [kg] " input name="payload_kg" type="number" step="any" min="0"; }
-                    label { "Branch " input name="branch" placeholder="e.g. front,up,noflip"; }
-                    label { input type="checkbox" name="position_only" value="true"; " position only" }
-                    button type="submit" { "Solve" }
-                }
-                div #solve-result hidden {
-                    p #solve-summary {}
-                    p { a #solve-download download="solution.csv" href="#" { "Download the CSV" } }
-                    pre #solve-csv {}
-                }
-            }
-
+            (robot_heading(r))
+            (sets_section(id, &v.sets))
+            (calibrations_section(id, &v.calibrations, &v.sets))
+            (versions_section(id, &v.versions))
+            (solve_section(id, &v.versions))
             (super::check_pages::checks_section(&super::check_pages::ChecksView {
                 robot: id,
                 status: v.status,
@@ -369,7 +171,255 @@ pub fn robot(v: &RobotView) -> Markup {
             }))
             (super::cell_pages::cell_section(id, &v.tools, &v.work_objects))
             (super::cell_pages::filter_section(id, &v.versions))
-
         },
     )
+}
+
+/// The robot page's breadcrumbs, title and one-line summary.
+fn robot_heading(r: &RobotRow) -> Markup {
+    html! {
+        p.crumbs { a href="/ui" { "Robots" } " / " (r.name) }
+        h1 { (r.name) }
+        p.note {
+            "Robot " (r.id) " · " (r.preset.as_deref().unwrap_or("custom model")) " · " (r.dof) " axes · "
+            @match r.active_version { Some(a) => { "active model version " (a) }, None => { "no calibrated version yet (solves use the nominal model)" } }
+        }
+    }
+}
+
+/// The measurement sets: their table and the upload form.
+fn sets_section(id: i64, sets: &[SetRow]) -> Markup {
+    html! {
+        section #sets {
+            h2 { "Measurement sets" }
+            @if sets.is_empty() {
+                p.empty { "No measurements yet: upload a laser-tracker CSV below." }
+            } @else {
+                table {
+                    thead { tr { th { "Id" } th { "Name" } th { "Role" } th { "Session" } th { "Poses" } th { "Payload [kg]" } th { "Uploaded" } th {} } }
+                    tbody {
+                        @for s in sets {
+                            tr {
+                                td { (s.id) } td { (s.name) } td { (SetRole::from(s.role).as_str()) } td { (s.session) }
+                                td { (s.row_count) }
+                                td { @if let Some(p) = s.payload_kg { (p) } @else { "—" } }
+                                td { time datetime=(s.created_at) { (s.created_at) } }
+                                td { a href={ "/v1/robots/" (id) "/measurement-sets/" (s.id) "/original" } { "original" } }
+                            }
+                        }
+                    }
+                }
+            }
+            (upload_form(id))
+        }
+    }
+}
+
+/// The form that uploads a measurement CSV with its role, units and conventions.
+fn upload_form(id: i64) -> Markup {
+    html! {
+        form #upload data-action="upload" data-robot=(id) {
+            label.wide { "CSV file " input type="file" name="file" accept=".csv,text/csv"; }
+            label { "Role "
+                select name="role" {
+                    @for role in SetRole::ALL {
+                        option value=(role.as_str()) { (role.as_str()) }
+                    }
+                }
+            }
+            label { "Name " input name="name"; }
+            label title="How the file's orientation columns (if any) are to be read" { "Orientation "
+                select name="orientation" {
+                    @for c in MeasuredOrientation::ALL {
+                        option value=(c.name()) title=(c.meaning()) selected[c == MeasuredOrientation::default()] { (c.name()) " (" (c.columns().join(", ")) ")" }
+                    }
+                }
+            }
+            label { "Tracker session " input name="session" placeholder="default"; }
+            label { "Payload [kg] " input name="payload_kg" type="number" step="any" min="0"; }
+            label { "Lengths "
+                select name="length_unit" { option value="mm" { "mm" } option value="m" { "m" } }
+            }
+            label { "Angles "
+                select name="angle_unit" { option value="deg" { "deg" } option value="rad" { "rad" } }
+            }
+            label { "Decimal separator "
+                select name="decimal" {
+                    option value="" { "detect" }
+                    option value="point" { "point (1500.25)" }
+                    option value="comma" { "comma (1500,25; fields split by ;)" }
+                }
+            }
+            label { "dif columns "
+                select name="dif_sign" {
+                    option value="plus" { "measured = target + dif" }
+                    option value="minus" { "measured = target − dif" }
+                }
+            }
+            button type="submit" { "Upload" }
+        }
+    }
+}
+
+/// The calibrations: their table (newest first) and the form that starts one.
+fn calibrations_section(id: i64, calibrations: &[CalibrationRow], sets: &[SetRow]) -> Markup {
+    html! {
+        section #calibrations {
+            h2 { "Calibrations" }
+            @if calibrations.is_empty() {
+                p.empty { "No calibration yet." }
+            } @else {
+                table {
+                    thead { tr { th { "Id" } th { "Methods" } th { "Status" } th { "Phase" } th { "Progress" } th { "Best" } th { "Created" } th {} } }
+                    tbody {
+                        @for c in calibrations.iter().rev() {
+                            (calibration_row(id, c))
+                        }
+                    }
+                }
+            }
+            (calibrate_form(id, sets))
+        }
+    }
+}
+
+/// One calibration's table row: status, progress, best result and actions.
+fn calibration_row(id: i64, c: &CalibrationRow) -> Markup {
+    html! {
+        @let url = format!("/v1/robots/{id}/calibrations/{}", c.id);
+        tr data-job=(url) data-active=(job_active(c.status)) {
+            td { (c.id) }
+            td { (c.methods.0.join(", ")) }
+            td.status { (c.status.as_str()) }
+            td.phase { (c.phase.as_deref().unwrap_or("")) }
+            td { progress max="100" value=(c.percent) {} " " span.percent { (format!("{:.0} %", c.percent)) } }
+            td {
+                (c.best_method.as_deref().unwrap_or("—"))
+                @if let Some(sum) = &c.summary {
+                    br;
+                    span.note { (format!("{:.4} mm mean on {} (nominal {:.3})", sum.0.mean_mm, sum.0.judged_on, sum.0.nominal_mean_mm)) }
+                    @if !sum.0.warnings.is_empty() || !sum.0.failed_methods.is_empty() {
+                        br;
+                        span.bad title=(sum.0.warnings.iter().chain(&sum.0.failed_methods).cloned().collect::<Vec<_>>().join("\n")) {
+                            (sum.0.warnings.len()) " warnings, " (sum.0.failed_methods.len()) " failed methods"
+                        }
+                    }
+                }
+            }
+            td { time datetime=(c.created_at) { (c.created_at) } }
+            td {
+                @if c.status == JobStatus::Succeeded {
+                    a href={ (url) "/report" } { "report" } " · "
+                    a href={ (url) "/result" } { "result" }
+                } @else if job_active(c.status) {
+                    button.small data-post={ (url) "/cancel" } { "Cancel" }
+                } @else if let Some(e) = &c.error {
+                    span.bad { (e) }
+                }
+            }
+        }
+    }
+}
+
+/// The form that starts a calibration: methods, sets by role, seed, payload.
+fn calibrate_form(id: i64, sets: &[SetRow]) -> Markup {
+    html! {
+        form #calibrate data-action="calibrate" data-robot=(id) {
+            fieldset {
+                legend { "Methods" }
+                @for m in Method::ALL {
+                    label.check {
+                        input type="checkbox" name="method" value=(m.name())
+                            checked[DEFAULT_METHODS.contains(&m)];
+                        " " (m.name())
+                    }
+                }
+            }
+            @for (role, legend) in [(SetRole::Identification, "Identification sets"), (SetRole::Validation, "Validation sets"), (SetRole::Training, "Training sets")] {
+                @let of_role: Vec<&SetRow> = sets.iter().filter(|s| SetRole::from(s.role) == role).collect();
+                @if !of_role.is_empty() {
+                    fieldset.sets data-role=(role.as_str()) {
+                        legend { (legend) " (none ticked: every " (role.as_str()) " set)" }
+                        @for s in of_role {
+                            label.check { input type="checkbox" name={ (role.as_str()) "_set" } value=(s.id); " " (s.id) " " (s.name) }
+                        }
+                    }
+                }
+            }
+            label { "Seed " input name="seed" type="number" min="0" step="1" placeholder="1"; }
+            label { "Payload [kg] " input name="payload_kg" type="number" step="any" min="0" placeholder="model's"; }
+            button type="submit" { "Start calibration" }
+        }
+    }
+}
+
+/// The model versions (newest first), with activation and roll-back.
+fn versions_section(id: i64, versions: &[VersionRow]) -> Markup {
+    html! {
+        section #versions {
+            h2 { "Model versions" }
+            @if versions.is_empty() {
+                p.empty { "No model version yet: a successful calibration creates one per method." }
+            } @else {
+                table {
+                    thead { tr { th { "Version" } th { "Method" } th { "Calibration" } th { "Validation mean [mm]" } th { "Created" } th {} } }
+                    tbody {
+                        @for ver in versions.iter().rev() {
+                            tr.active[ver.active] {
+                                td { "v" (ver.version) @if ver.active { " " span.tag { "active" } } }
+                                td { (ver.method) }
+                                td { @if let Some(c) = ver.calibration_id { (c) } @else { "—" } }
+                                td { @if let Some(m) = validation_mean(ver) { (format!("{m:.4}")) } @else { "—" } }
+                                td { time datetime=(ver.created_at) { (ver.created_at) } }
+                                td {
+                                    a href={ "/v1/robots/" (id) "/versions/" (ver.version) "/model.json" } { "model.json" }
+                                    @if !ver.active {
+                                        " " button.small data-post={ "/v1/robots/" (id) "/versions/" (ver.version) "/activate" }
+                                            data-confirm={ "Activate v" (ver.version) " (" (ver.method) ")? Solves and filters will use it from now on." } { "Activate" }
+                                    }
+                                }
+                            }
+                        }
+                    }
+                }
+                p { button.small #rollback data-post={ "/v1/robots/" (id) "/versions/rollback" }
+                    data-confirm="Roll back to the previously active version? Solves and filters will use it from now on." { "Roll back to the previous active version" } }
+            }
+        }
+    }
+}
+
+/// The form that solves a targets CSV, and where its answer appears.
+fn solve_section(id: i64, versions: &[VersionRow]) -> Markup {
+    html! {
+        section #solve-section {
+            h2 { "Solve targets" }
+            p.note { "A targets CSV (id, x, y, z in mm and the orientation columns of one convention, e.g. a,b,c) in, joint commands and false targets out, as CSV." }
+            form #solve data-action="solve" data-robot=(id) {
+                label.wide { "Targets CSV " input type="file" name="file" accept=".csv,text/csv"; }
+                label.wide { "or paste it " textarea name="csv" rows="3" placeholder="id,x,y,z,a,b,c" {} }
+                label { "Model "
+                    select name="version" {
+                        option value="active" { "active version" }
+                        @for ver in versions.iter().rev() {
+                            option value=(ver.version) { "v" (ver.version) " " (ver.method) }
+                        }
+                        option value="nominal" { "nominal model" }
+                    }
+                }
+                label { "Frame "
+                    select name="frame" { option value="cell" { "cell (tracker)" } option value="base" { "robot base" } }
+                }
+                label { "Payload [kg] " input name="payload_kg" type="number" step="any" min="0"; }
+                label { "Branch " input name="branch" placeholder="e.g. front,up,noflip"; }
+                label { input type="checkbox" name="position_only" value="true"; " position only" }
+                button type="submit" { "Solve" }
+            }
+            div #solve-result hidden {
+                p #solve-summary {}
+                p { a #solve-download download="solution.csv" href="#" { "Download the CSV" } }
+                pre #solve-csv {}
+            }
+        }
+    }
 }
