@@ -305,12 +305,49 @@ fn main() -> anyhow::Result<()> {
     }
 
     // Single-target solves.
-    let per_conn = args.single / args.connections;
     let start = Instant::now();
+    let (mut lat, failed) = single_solves(addr, &path, &singles, &args)?;
+    let wall = start.elapsed();
+    report("single-target solve", &mut lat, wall, failed);
+
+    // Batches, one at a time.
+    conn.request("POST", &path, Some(("application/json", &batch)))?;
+    let start = Instant::now();
+    let (mut lat, failed) = batch_solves(&mut conn, &path, &batch, args.batches)?;
+    let wall = start.elapsed();
+    unsolved_reasons(&mut conn, &path, &batch)?;
+    report(
+        &format!("{}-target batch", args.batch_size),
+        &mut lat,
+        wall,
+        failed,
+    );
+    println!(
+        "{}-target batch: {:.0} targets/s",
+        args.batch_size,
+        (args.batch_size * args.batches) as f64 / wall.as_secs_f64()
+    );
+    if let Some(f) = db_file {
+        for suffix in ["", "-wal", "-shm"] {
+            let _ = std::fs::remove_file(format!("{}{suffix}", f.display()));
+        }
+    }
+    Ok(())
+}
+
+/// `args.single` single-target solves from `args.connections` client
+/// threads: every latency [ms] and the count of unsolved targets.
+fn single_solves(
+    addr: SocketAddr,
+    path: &str,
+    singles: &[Vec<u8>],
+    args: &Args,
+) -> anyhow::Result<(Vec<f64>, usize)> {
+    let per_conn = args.single / args.connections;
     let handles: Vec<_> = (0..args.connections)
         .map(|c| {
-            let singles = singles.clone();
-            let path = path.clone();
+            let singles = singles.to_vec();
+            let path = path.to_string();
             std::thread::spawn(move || -> anyhow::Result<(Vec<f64>, usize)> {
                 let mut conn = Conn::open(addr)?;
                 let mut lat = Vec::with_capacity(per_conn);
@@ -339,26 +376,34 @@ fn main() -> anyhow::Result<()> {
         lat.extend(l);
         failed += f;
     }
-    let wall = start.elapsed();
-    report("single-target solve", &mut lat, wall, failed);
+    Ok((lat, failed))
+}
 
-    // Batches, one at a time.
-    conn.request("POST", &path, Some(("application/json", &batch)))?;
+/// `n` solves of the batch `batch`, one at a time: every latency [ms] and
+/// the count of unsolved targets.
+fn batch_solves(
+    conn: &mut Conn,
+    path: &str,
+    batch: &[u8],
+    n: usize,
+) -> anyhow::Result<(Vec<f64>, usize)> {
     let mut lat = Vec::new();
     let mut failed = 0;
-    let start = Instant::now();
-    for _ in 0..args.batches {
+    for _ in 0..n {
         let t = Instant::now();
-        let (status, body) = conn.request("POST", &path, Some(("application/json", &batch)))?;
+        let (status, body) = conn.request("POST", path, Some(("application/json", batch)))?;
         lat.push(t.elapsed().as_secs_f64() * 1e3);
         if status != 200 {
             bail!("batch solve: {status} {}", String::from_utf8_lossy(&body));
         }
         failed += failed_count(&body);
     }
-    let wall = start.elapsed();
-    // Why targets were not solved (by reason code), from one batch.
-    let (_, body) = conn.request("POST", &path, Some(("application/json", &batch)))?;
+    Ok((lat, failed))
+}
+
+/// Prints why the targets of one batch were not solved, by reason code.
+fn unsolved_reasons(conn: &mut Conn, path: &str, batch: &[u8]) -> anyhow::Result<()> {
+    let (_, body) = conn.request("POST", path, Some(("application/json", batch)))?;
     let v: Value = serde_json::from_slice(&body)?;
     let mut reasons = std::collections::BTreeMap::new();
     for r in v["results"].as_array().into_iter().flatten() {
@@ -368,22 +413,6 @@ fn main() -> anyhow::Result<()> {
     }
     if !reasons.is_empty() {
         println!("unsolved targets of one batch by reason: {reasons:?}");
-    }
-    report(
-        &format!("{}-target batch", args.batch_size),
-        &mut lat,
-        wall,
-        failed,
-    );
-    println!(
-        "{}-target batch: {:.0} targets/s",
-        args.batch_size,
-        (args.batch_size * args.batches) as f64 / wall.as_secs_f64()
-    );
-    if let Some(f) = db_file {
-        for suffix in ["", "-wal", "-shm"] {
-            let _ = std::fs::remove_file(format!("{}{suffix}", f.display()));
-        }
     }
     Ok(())
 }

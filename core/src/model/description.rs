@@ -13,7 +13,7 @@
 //! `from_description` validates every field and names the offending one.
 
 use super::bounds::{
-    check, check3, ANGLE_DEG, COMPLIANCE_RAD_PER_NM, GRAVITY_MPS2, LENGTH_MM, LIMIT_DEG,
+    check, check3, Bound, ANGLE_DEG, COMPLIANCE_RAD_PER_NM, GRAVITY_MPS2, LENGTH_MM, LIMIT_DEG,
     LOOP_LENGTH_MM, MASS_KG, MASS_OFFSET_KG, POINT_MM, TOOL_FRAME_POINT_MM,
 };
 use super::joint_maps::JointMapsDescription;
@@ -237,177 +237,155 @@ impl ModelDescription {
             DhConvention::Standard => &LENGTH_MM,
             DhConvention::Modified => &POINT_MM,
         };
-        let mut links = Vec::with_capacity(n);
-        for (i, j) in self.joints.iter().enumerate() {
-            let f = |name: &str| format!("joints[{i}].{name}");
-            let mut link = Link::new(
-                check(&f("alpha_deg"), j.alpha_deg, &ANGLE_DEG)?.to_radians(),
-                metres(check(&f("a_mm"), j.a_mm, &LENGTH_MM)?),
-                check(&f("d_mm"), j.d_mm, &LENGTH_MM)? * MM,
-                check(&f("theta_offset_deg"), j.theta_offset_deg, &ANGLE_DEG)?.to_radians(),
-            );
-            link.beta = check(&f("beta_deg"), j.beta_deg, &ANGLE_DEG)?.to_radians();
-            link.b = check(&f("b_mm"), j.b_mm, &LENGTH_MM)? * MM;
-            if i > 0 && j.b_mm != 0.0 {
-                return Err(invalid(
-                    f("b_mm"),
-                    "only the first joint (the base, eq. 4.3) has a y offset b",
-                ));
-            }
-            let (l0, l1) = (
-                check(&f("limits_deg[0]"), j.limits_deg[0], &LIMIT_DEG)?,
-                check(&f("limits_deg[1]"), j.limits_deg[1], &LIMIT_DEG)?,
-            );
-            // The two limits in either order; they must leave a range.
-            if l0 == l1 {
-                return Err(invalid(
-                    f("limits_deg"),
-                    format!("the two limits must differ, got {l0} twice"),
-                ));
-            }
-            let lo = l0.min(l1).to_radians();
-            let hi = l0.max(l1).to_radians();
-            // Limits a few ulps apart stay apart in radians.
-            link.limits = [lo, if hi > lo { hi } else { lo.next_up() }];
-            if j.sign != 1.0 && j.sign != -1.0 {
-                return Err(invalid(
-                    f("sign"),
-                    format!("must be 1 or -1, got {}", j.sign),
-                ));
-            }
-            link.sign = j.sign;
-            link.zero = check(&f("zero_deg"), j.zero_deg, &ANGLE_DEG)?.to_radians();
-            link.mass = check(&f("mass_kg"), j.mass_kg, &MASS_KG)?;
-            link.com = Vector3::from(check3(&f("com_mm"), j.com_mm, point_bound)?) * MM;
-            link.compliance = check(
-                &f("compliance_rad_per_nm"),
-                j.compliance_rad_per_nm,
-                &COMPLIANCE_RAD_PER_NM,
-            )?;
-            if self.convention == DhConvention::Standard && (j.beta_deg != 0.0 || j.b_mm != 0.0) {
-                return Err(invalid(
-                    f("beta_deg"),
-                    "beta and b belong to the modified convention; use \"convention\": \"modified\"",
-                ));
-            }
-            if i == 0 && j.parallel == Some(true) {
-                return Err(invalid(
-                    "joints[0].parallel",
-                    "the first joint has no previous axis to be parallel to",
-                ));
-            }
-            links.push((link, j.parallel, j.beta_deg != 0.0));
-        }
-
+        let links = (0..n)
+            .map(|i| self.link(i, point_bound))
+            .collect::<Result<Vec<_>, _>>()?;
         let tool_p = Vector3::from(check3("tool.xyz_mm", self.tool.xyz_mm, point_bound)?) * MM;
         let tool_rpy = Vector3::from(check3("tool.rpy_deg", self.tool.rpy_deg, &ANGLE_DEG)?)
             .map(f64::to_radians);
-        let mut tool = Tool {
+        let tool = Tool {
             p: tool_p,
             rpy: [tool_rpy.x, tool_rpy.y, tool_rpy.z],
         };
-
-        let mut out: Vec<Link> = Vec::with_capacity(n);
-        match self.convention {
-            DhConvention::Modified => {
-                for (k, (link, parallel, has_beta)) in links.into_iter().enumerate() {
-                    let mut link = link;
-                    // Omitted: a Hayati link when it has a twist β or its axis
-                    // is parallel to the previous one.
-                    link.parallel = parallel.unwrap_or(
-                        k > 0
-                            && (has_beta
-                                || link.alpha.sin().abs() < RobotModel::parallel_threshold()),
-                    );
-                    if !link.parallel && k > 0 && has_beta {
-                        return Err(invalid(
-                            format!("joints[{k}].beta_deg"),
-                            "beta is only used on parallel (Hayati) links; set \"parallel\": true",
-                        ));
-                    }
-                    out.push(link);
-                }
-            }
-            DhConvention::Standard => {
-                // Standard row k: Rz(θ_k)Tz(d_k)Tx(a_k)Rx(α_k). Regrouped: modified link k
-                // takes α_{k-1}, a_{k-1} of the previous standard row.
-                let std_rows: Vec<Link> = links.iter().map(|(l, _, _)| l.clone()).collect();
-                for (k, (link, parallel, _)) in links.into_iter().enumerate() {
-                    let mut m = link.clone();
-                    if k == 0 {
-                        m.alpha = 0.0;
-                        m.a = 0.0;
-                    } else {
-                        m.alpha = std_rows[k - 1].alpha;
-                        m.a = std_rows[k - 1].a;
-                    }
-                    // Centre of mass given in the distal frame k: x_prox = Tx(a_k)Rx(α_k) x_dist.
-                    let mut distal = Pose::identity();
-                    distal.tr_x(link.a);
-                    distal.rot_x(link.alpha);
-                    m.com = distal.transform_point(&link.com);
-                    m.parallel = match parallel {
-                        Some(p) => p,
-                        None => k > 0 && m.alpha.sin().abs() < RobotModel::parallel_threshold(),
-                    };
-                    out.push(m);
-                }
-                // The last row's Tx(a_n)Rx(α_n) goes into the tool.
-                let last = &std_rows[n - 1];
-                let mut t = Pose::identity();
-                t.tr_x(last.a);
-                t.rot_x(last.alpha);
-                let user = Pose::new(rpy_matrix(tool.rpy[0], tool.rpy[1], tool.rpy[2]), tool.p);
-                let combined = t.compose(&user);
-                tool = Tool {
-                    p: combined.p,
-                    rpy: matrix_to_rpy(&combined.r),
-                };
-            }
-        }
-
+        let (links, tool) = match self.convention {
+            DhConvention::Modified => (modified_links(links)?, tool),
+            DhConvention::Standard => standard_links(links, tool),
+        };
         let closed_loop = match &self.closed_loop {
             None => None,
-            Some(c) => {
-                if c.passive_joint < 2 || c.passive_joint > n {
-                    return Err(invalid(
-                        "closed_loop.passive_joint",
-                        format!(
-                            "must name a joint from 2 to {n} (1-based) driven by the joint before it, got {}",
-                            c.passive_joint
-                        ),
-                    ));
-                }
-                for (name, v) in [("l3_mm", c.l3_mm), ("l4_mm", c.l4_mm), ("l5_mm", c.l5_mm)] {
-                    if check(&format!("closed_loop.{name}"), v, &LOOP_LENGTH_MM)? <= 0.0 {
-                        return Err(invalid(format!("closed_loop.{name}"), "must be positive"));
-                    }
-                }
-                let (l3, l4, l5) = (metres(c.l3_mm), metres(c.l4_mm), metres(c.l5_mm));
-                let passive = c.passive_joint - 1;
-                // The loop side SP is the passive link's a: its own row in the
-                // modified convention, the row before it in the standard one.
-                let row = match self.convention {
-                    DhConvention::Modified => passive,
-                    DhConvention::Standard => passive - 1,
-                };
-                if self.joints[row].a_mm <= 0.0 {
-                    return Err(invalid(
-                        format!("joints[{row}].a_mm"),
-                        "the passive joint's a (the loop side SP) must be positive",
-                    ));
-                }
-                Some(ClosedLoop {
-                    passive,
-                    l3,
-                    l4,
-                    l5,
-                    xi: check("closed_loop.xi_deg", c.xi_deg, &ANGLE_DEG)?.to_radians(),
-                })
-            }
+            Some(c) => Some(self.closed_loop(c)?),
         };
+        let payload = self.payload(&tool)?;
+        let gravity = Vector3::from(check3("gravity_mps2", self.gravity_mps2, &GRAVITY_MPS2)?);
+        Ok(RobotModel {
+            name: self.checked_name()?,
+            links,
+            tool,
+            closed_loop,
+            payload,
+            gravity,
+            assumptions: self.assumptions.clone(),
+            joint_maps: match &self.joint_maps {
+                None => None,
+                Some(d) => Some(d.to_maps(n)?),
+            },
+        })
+    }
 
-        let payload_mass = check("payload.mass_kg", self.payload.mass_kg, &MASS_KG)?;
+    /// Joint `i` checked field by field, as its link in the description's
+    /// convention, with its `parallel` flag as given and whether it has a
+    /// twist β.
+    fn link(
+        &self,
+        i: usize,
+        point_bound: &Bound,
+    ) -> Result<(Link, Option<bool>, bool), ModelError> {
+        let j = &self.joints[i];
+        let f = |name: &str| format!("joints[{i}].{name}");
+        let mut link = Link::new(
+            check(&f("alpha_deg"), j.alpha_deg, &ANGLE_DEG)?.to_radians(),
+            metres(check(&f("a_mm"), j.a_mm, &LENGTH_MM)?),
+            check(&f("d_mm"), j.d_mm, &LENGTH_MM)? * MM,
+            check(&f("theta_offset_deg"), j.theta_offset_deg, &ANGLE_DEG)?.to_radians(),
+        );
+        link.beta = check(&f("beta_deg"), j.beta_deg, &ANGLE_DEG)?.to_radians();
+        link.b = check(&f("b_mm"), j.b_mm, &LENGTH_MM)? * MM;
+        if i > 0 && j.b_mm != 0.0 {
+            return Err(invalid(
+                f("b_mm"),
+                "only the first joint (the base, eq. 4.3) has a y offset b",
+            ));
+        }
+        let (l0, l1) = (
+            check(&f("limits_deg[0]"), j.limits_deg[0], &LIMIT_DEG)?,
+            check(&f("limits_deg[1]"), j.limits_deg[1], &LIMIT_DEG)?,
+        );
+        // The two limits in either order; they must leave a range.
+        if l0 == l1 {
+            return Err(invalid(
+                f("limits_deg"),
+                format!("the two limits must differ, got {l0} twice"),
+            ));
+        }
+        let lo = l0.min(l1).to_radians();
+        let hi = l0.max(l1).to_radians();
+        // Limits a few ulps apart stay apart in radians.
+        link.limits = [lo, if hi > lo { hi } else { lo.next_up() }];
+        if j.sign != 1.0 && j.sign != -1.0 {
+            return Err(invalid(
+                f("sign"),
+                format!("must be 1 or -1, got {}", j.sign),
+            ));
+        }
+        link.sign = j.sign;
+        link.zero = check(&f("zero_deg"), j.zero_deg, &ANGLE_DEG)?.to_radians();
+        link.mass = check(&f("mass_kg"), j.mass_kg, &MASS_KG)?;
+        link.com = Vector3::from(check3(&f("com_mm"), j.com_mm, point_bound)?) * MM;
+        link.compliance = check(
+            &f("compliance_rad_per_nm"),
+            j.compliance_rad_per_nm,
+            &COMPLIANCE_RAD_PER_NM,
+        )?;
+        if self.convention == DhConvention::Standard && (j.beta_deg != 0.0 || j.b_mm != 0.0) {
+            return Err(invalid(
+                f("beta_deg"),
+                "beta and b belong to the modified convention; use \"convention\": \"modified\"",
+            ));
+        }
+        if i == 0 && j.parallel == Some(true) {
+            return Err(invalid(
+                "joints[0].parallel",
+                "the first joint has no previous axis to be parallel to",
+            ));
+        }
+        Ok((link, j.parallel, j.beta_deg != 0.0))
+    }
+
+    /// The closed loop checked: its passive joint, positive lengths, and a
+    /// positive loop side.
+    fn closed_loop(&self, c: &ClosedLoopDescription) -> Result<ClosedLoop, ModelError> {
+        let n = self.joints.len();
+        if c.passive_joint < 2 || c.passive_joint > n {
+            return Err(invalid(
+                "closed_loop.passive_joint",
+                format!(
+                    "must name a joint from 2 to {n} (1-based) driven by the joint before it, got {}",
+                    c.passive_joint
+                ),
+            ));
+        }
+        for (name, v) in [("l3_mm", c.l3_mm), ("l4_mm", c.l4_mm), ("l5_mm", c.l5_mm)] {
+            if check(&format!("closed_loop.{name}"), v, &LOOP_LENGTH_MM)? <= 0.0 {
+                return Err(invalid(format!("closed_loop.{name}"), "must be positive"));
+            }
+        }
+        let (l3, l4, l5) = (metres(c.l3_mm), metres(c.l4_mm), metres(c.l5_mm));
+        let passive = c.passive_joint - 1;
+        // The loop side SP is the passive link's a: its own row in the
+        // modified convention, the row before it in the standard one.
+        let row = match self.convention {
+            DhConvention::Modified => passive,
+            DhConvention::Standard => passive - 1,
+        };
+        if self.joints[row].a_mm <= 0.0 {
+            return Err(invalid(
+                format!("joints[{row}].a_mm"),
+                "the passive joint's a (the loop side SP) must be positive",
+            ));
+        }
+        Ok(ClosedLoop {
+            passive,
+            l3,
+            l4,
+            l5,
+            xi: check("closed_loop.xi_deg", c.xi_deg, &ANGLE_DEG)?.to_radians(),
+        })
+    }
+
+    /// The payload checked, its centre of mass kept in the tool frame
+    /// (`Payload::com`) whatever frame the file states it in.
+    fn payload(&self, tool: &Tool) -> Result<Payload, ModelError> {
+        let mass = check("payload.mass_kg", self.payload.mass_kg, &MASS_KG)?;
         let mass_offset = check(
             "payload.mass_offset_kg",
             self.payload.mass_offset_kg,
@@ -418,9 +396,8 @@ impl ModelDescription {
             PayloadFrame::Tool => &TOOL_FRAME_POINT_MM,
         };
         let com = Vector3::from(check3("payload.com_mm", self.payload.com_mm, com_bound)?) * MM;
-        let payload = Payload {
-            mass: payload_mass,
-            // Kept in the tool frame inside (`Payload::com`).
+        Ok(Payload {
+            mass,
             com: match self.payload.com_frame {
                 PayloadFrame::Tool => com,
                 PayloadFrame::Flange => {
@@ -430,8 +407,12 @@ impl ModelDescription {
                 }
             },
             mass_offset,
-        };
-        let gravity = Vector3::from(check3("gravity_mps2", self.gravity_mps2, &GRAVITY_MPS2)?);
+        })
+    }
+
+    /// The robot's name: at most `NAME_MAX_CHARS` characters, no control
+    /// characters, not only blanks; `robot` when empty.
+    fn checked_name(&self) -> Result<String, ModelError> {
         if self.name.chars().count() > NAME_MAX_CHARS {
             return Err(invalid(
                 "name",
@@ -455,23 +436,10 @@ impl ModelDescription {
         {
             return Err(invalid("name", "must not be only blanks"));
         }
-        let name = if self.name.is_empty() {
+        Ok(if self.name.is_empty() {
             "robot".to_string()
         } else {
             self.name.clone()
-        };
-        Ok(RobotModel {
-            name,
-            links: out,
-            tool,
-            closed_loop,
-            payload,
-            gravity,
-            assumptions: self.assumptions.clone(),
-            joint_maps: match &self.joint_maps {
-                None => None,
-                Some(d) => Some(d.to_maps(n)?),
-            },
         })
     }
 
@@ -526,6 +494,68 @@ impl ModelDescription {
             joint_maps: m.joint_maps.as_ref().map(JointMapsDescription::from_maps),
         }
     }
+}
+
+/// Modified-convention links as given: a link is a Hayati one (parallel)
+/// when it says so or, unsaid, when it has a twist β or its axis is parallel
+/// to the previous one.
+fn modified_links(links: Vec<(Link, Option<bool>, bool)>) -> Result<Vec<Link>, ModelError> {
+    let mut out = Vec::with_capacity(links.len());
+    for (k, (mut link, parallel, has_beta)) in links.into_iter().enumerate() {
+        link.parallel = parallel.unwrap_or(
+            k > 0 && (has_beta || link.alpha.sin().abs() < RobotModel::parallel_threshold()),
+        );
+        if !link.parallel && k > 0 && has_beta {
+            return Err(invalid(
+                format!("joints[{k}].beta_deg"),
+                "beta is only used on parallel (Hayati) links; set \"parallel\": true",
+            ));
+        }
+        out.push(link);
+    }
+    Ok(out)
+}
+
+/// Standard-DH rows regrouped as modified links and the tool: standard row
+/// k is `Rz(θ_k)Tz(d_k)Tx(a_k)Rx(α_k)`, so modified link k takes `α_{k-1},
+/// a_{k-1}` of the previous row, and the last row's `Tx(a_n)Rx(α_n)` goes
+/// into the tool. Centres of mass given in the distal frame k are moved to
+/// the proximal one, `x_prox = Tx(a_k)Rx(α_k) x_dist`.
+fn standard_links(links: Vec<(Link, Option<bool>, bool)>, tool: Tool) -> (Vec<Link>, Tool) {
+    let std_rows: Vec<Link> = links.iter().map(|(l, _, _)| l.clone()).collect();
+    let mut out = Vec::with_capacity(links.len());
+    for (k, (link, parallel, _)) in links.into_iter().enumerate() {
+        let mut m = link.clone();
+        if k == 0 {
+            m.alpha = 0.0;
+            m.a = 0.0;
+        } else {
+            m.alpha = std_rows[k - 1].alpha;
+            m.a = std_rows[k - 1].a;
+        }
+        let mut distal = Pose::identity();
+        distal.tr_x(link.a);
+        distal.rot_x(link.alpha);
+        m.com = distal.transform_point(&link.com);
+        m.parallel = match parallel {
+            Some(p) => p,
+            None => k > 0 && m.alpha.sin().abs() < RobotModel::parallel_threshold(),
+        };
+        out.push(m);
+    }
+    let last = &std_rows[std_rows.len() - 1];
+    let mut t = Pose::identity();
+    t.tr_x(last.a);
+    t.rot_x(last.alpha);
+    let user = Pose::new(rpy_matrix(tool.rpy[0], tool.rpy[1], tool.rpy[2]), tool.p);
+    let combined = t.compose(&user);
+    (
+        out,
+        Tool {
+            p: combined.p,
+            rpy: matrix_to_rpy(&combined.r),
+        },
+    )
 }
 
 /// A rigid transform in boundary units: translation [mm] and fixed-axis XYZ

@@ -397,6 +397,56 @@ impl Client {
         f(&mut l);
     }
 
+    /// The status of calibration `job` once it left the queue (polled every
+    /// 20 ms, at most a minute); None when told to stop.
+    fn wait_for(&mut self, robot: i64, job: i64) -> Option<String> {
+        let mut status = String::from("queued");
+        for _ in 0..3000 {
+            if let Reply::Ok(200, v) = self.call(
+                "GET",
+                &format!("/v1/robots/{robot}/calibrations/{job}"),
+                None,
+                None,
+            )? {
+                status = v["status"].as_str().unwrap_or("").to_string();
+                if status != "queued" && status != "running" {
+                    break;
+                }
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        Some(status)
+    }
+
+    /// Solves a few targets with a calibrated robot and activates one of its
+    /// versions; None when told to stop.
+    fn use_calibrated(&mut self, robot: i64) -> Option<()> {
+        for _ in 0..3 {
+            let k = self.rng.gen_range(0..self.targets.len() - 5);
+            let body = json!({"position_only": true, "targets": &self.targets[k..k + 5]});
+            if let Reply::Ok(s, v) =
+                self.json("POST", &format!("/v1/robots/{robot}/solve"), body, None)?
+            {
+                if s != 200 {
+                    self.control.fail(format!("solve answered {s}: {v}"));
+                    return None;
+                }
+                self.ledger.lock().unwrap().solves += 1;
+            }
+        }
+        let version = self.rng.gen_range(1..=2);
+        let path = format!("/v1/robots/{robot}/versions/{version}/activate");
+        if let Reply::Ok(200, _) = self.call(
+            "POST",
+            &path,
+            None,
+            Some(InFlight::Activate(robot, version)),
+        )? {
+            self.ack(|l| l.robots.get_mut(&robot).unwrap().active = Some(version));
+        }
+        Some(())
+    }
+
     /// One round of the workload; None when told to stop.
     fn round(&mut self, n: usize) -> Option<()> {
         let name = format!("c{}-{n}", self.id);
@@ -446,45 +496,8 @@ impl Client {
         };
         let job = v["id"].as_i64()?;
         self.ack(|l| l.robots.get_mut(&robot).unwrap().calibrations.push(job));
-        let mut status = String::from("queued");
-        for _ in 0..3000 {
-            if let Reply::Ok(200, v) = self.call(
-                "GET",
-                &format!("/v1/robots/{robot}/calibrations/{job}"),
-                None,
-                None,
-            )? {
-                status = v["status"].as_str().unwrap_or("").to_string();
-                if status != "queued" && status != "running" {
-                    break;
-                }
-            }
-            std::thread::sleep(Duration::from_millis(20));
-        }
-        if status == "succeeded" {
-            for _ in 0..3 {
-                let k = self.rng.gen_range(0..self.targets.len() - 5);
-                let body = json!({"position_only": true, "targets": &self.targets[k..k + 5]});
-                if let Reply::Ok(s, v) =
-                    self.json("POST", &format!("/v1/robots/{robot}/solve"), body, None)?
-                {
-                    if s != 200 {
-                        self.control.fail(format!("solve answered {s}: {v}"));
-                        return None;
-                    }
-                    self.ledger.lock().unwrap().solves += 1;
-                }
-            }
-            let version = self.rng.gen_range(1..=2);
-            let path = format!("/v1/robots/{robot}/versions/{version}/activate");
-            if let Reply::Ok(200, _) = self.call(
-                "POST",
-                &path,
-                None,
-                Some(InFlight::Activate(robot, version)),
-            )? {
-                self.ack(|l| l.robots.get_mut(&robot).unwrap().active = Some(version));
-            }
+        if self.wait_for(robot, job)? == "succeeded" {
+            self.use_calibrated(robot)?;
         }
         let new_name = format!("{name}-renamed");
         let path = format!("/v1/robots/{robot}");

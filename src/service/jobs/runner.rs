@@ -155,9 +155,51 @@ pub(super) async fn execute(state: AppState, job: Job, claim: Option<Claim>) {
     if let Some(h) = heartbeat {
         h.abort();
     }
+    let stored = store_outcome(
+        &state,
+        robot_id,
+        id,
+        claim.as_deref(),
+        outcome,
+        over_budget.load(Ordering::SeqCst).then_some(budget),
+    )
+    .await;
+    if let Err(e) = stored {
+        tracing::error!(job = id, error = %e, "cannot store the calibration outcome");
+    }
+    state.drop_cancel_flag(id);
+    crate::service::changes::robot_changed(&state, robot_id).await;
+    if claim.is_some() {
+        state.wake_runner();
+    }
+}
+
+/// What a job's run ended with: its report and model versions, the
+/// calibration's error, or the blocking task's panic.
+type RunOutcome = Result<
+    Result<
+        (
+            crate::calibrate::identify::CalibrationReport,
+            Vec<crate::db::NewVersion>,
+        ),
+        CalibrationError,
+    >,
+    tokio::task::JoinError,
+>;
+
+/// Stores a job's outcome: its report and versions, or its status and
+/// reason (`over_budget`: the time budget it was stopped at, if that is why
+/// it was cancelled).
+async fn store_outcome(
+    state: &AppState,
+    robot_id: i64,
+    id: i64,
+    claim: Option<&str>,
+    outcome: RunOutcome,
+    over_budget: Option<Duration>,
+) -> Result<(), crate::db::StoreError> {
     let db = state.db();
-    let claim = claim.as_deref();
-    let stored = match outcome {
+    match outcome {
         Ok(Ok((report, versions))) => {
             let summary = summary_of(&report);
             let best = summary.best_method.clone();
@@ -189,7 +231,7 @@ pub(super) async fn execute(state: AppState, job: Job, claim: Option<Claim>) {
                 }
             }
         }
-        Ok(Err(CalibrationError::Cancelled)) if over_budget.load(Ordering::SeqCst) => {
+        Ok(Err(CalibrationError::Cancelled)) if over_budget.is_some() => {
             tracing::info!(job = id, "calibration stopped at its time budget");
             db.finish_calibration_error(
                 id,
@@ -197,7 +239,7 @@ pub(super) async fn execute(state: AppState, job: Job, claim: Option<Claim>) {
                 JobStatus::Failed,
                 &format!(
                     "stopped after the job time budget of {} s (`--job-time-limit`); use fewer poses, generations or a smaller population",
-                    budget.as_secs()
+                    over_budget.map_or(0, |b| b.as_secs())
                 ),
             )
             .await
@@ -222,13 +264,5 @@ pub(super) async fn execute(state: AppState, job: Job, claim: Option<Claim>) {
             )
             .await
         }
-    };
-    if let Err(e) = stored {
-        tracing::error!(job = id, error = %e, "cannot store the calibration outcome");
-    }
-    state.drop_cancel_flag(id);
-    crate::service::changes::robot_changed(&state, robot_id).await;
-    if claim.is_some() {
-        state.wake_runner();
     }
 }

@@ -296,46 +296,8 @@ pub(crate) fn analyse_factor(
             basis.push(v / res);
             kept_local.push(k);
         } else {
-            // Which kept parameters explain it: least squares on the kept columns.
-            let mut kmat = DMatrix::zeros(rf.nrows(), kept_local.len());
-            for (i, &kk) in kept_local.iter().enumerate() {
-                kmat.set_column(i, &rf.column(kk));
-            }
-            let target: DVector<f64> = rf.column(k).into_owned();
-            let values = kmat.ncols().min(kmat.nrows());
-            let coef = kmat
-                .clone()
-                .try_svd(true, true, 5.0 * f64::EPSILON, svd_iterations(values))
-                .and_then(|s| s.solve(&target, 1e-12).ok())
-                .unwrap_or_else(|| DVector::zeros(kept_local.len()));
-            let cmax = coef.iter().fold(0.0_f64, |a, c| a.max(c.abs()));
-            let depends_on = kept_local
-                .iter()
-                .zip(coef.iter())
-                .filter(|(_, c)| c.abs() > 0.1 * cmax)
-                .map(|(&kk, _)| candidates[live[kk]].name())
-                .collect::<Vec<_>>();
-            let (kind, reason) = if res <= settings.dependency_tolerance {
-                (
-                    DropKind::Dependent,
-                    "linearly dependent on kept parameters".to_string(),
-                )
-            } else {
-                (
-                    DropKind::NearlyDependent,
-                    format!(
-                        "nearly dependent on kept parameters: only {res:.1e} of its scaled column is independent of them (threshold {:.0e}), so its σ would be some {:.0}× larger; fixed at nominal",
-                        settings.near_dependency_tolerance,
-                        1.0 / res
-                    ),
-                )
-            };
-            dropped.push(DroppedParam {
-                name: candidates[live[k]].name(),
-                kind,
-                reason,
-                depends_on,
-            });
+            let name_of = |kk: usize| candidates[live[kk]].name();
+            dropped.push(dependent(&rf, &kept_local, k, res, &name_of, settings));
         }
     }
     // Kept parameters in layout order (`live` is increasing, so sorting the
@@ -372,6 +334,60 @@ pub(crate) fn analyse_factor(
             unseen_tool_tip_terms: vec![],
         },
         kept,
+    }
+}
+
+/// The dropped entry of scaled column `k` of `rf`, whose part independent of
+/// the kept columns `kept` has norm `res`: dependent or nearly so, naming
+/// the kept parameters (`name_of` a local index) that explain it by least
+/// squares on their columns.
+fn dependent(
+    rf: &DMatrix<f64>,
+    kept: &[usize],
+    k: usize,
+    res: f64,
+    name_of: &dyn Fn(usize) -> String,
+    settings: &IdentifiabilitySettings,
+) -> DroppedParam {
+    // Which kept parameters explain it: least squares on the kept columns.
+    let mut kmat = DMatrix::zeros(rf.nrows(), kept.len());
+    for (i, &kk) in kept.iter().enumerate() {
+        kmat.set_column(i, &rf.column(kk));
+    }
+    let target: DVector<f64> = rf.column(k).into_owned();
+    let values = kmat.ncols().min(kmat.nrows());
+    let coef = kmat
+        .clone()
+        .try_svd(true, true, 5.0 * f64::EPSILON, svd_iterations(values))
+        .and_then(|s| s.solve(&target, 1e-12).ok())
+        .unwrap_or_else(|| DVector::zeros(kept.len()));
+    let cmax = coef.iter().fold(0.0_f64, |a, c| a.max(c.abs()));
+    let depends_on = kept
+        .iter()
+        .zip(coef.iter())
+        .filter(|(_, c)| c.abs() > 0.1 * cmax)
+        .map(|(&kk, _)| name_of(kk))
+        .collect::<Vec<_>>();
+    let (kind, reason) = if res <= settings.dependency_tolerance {
+        (
+            DropKind::Dependent,
+            "linearly dependent on kept parameters".to_string(),
+        )
+    } else {
+        (
+            DropKind::NearlyDependent,
+            format!(
+                "nearly dependent on kept parameters: only {res:.1e} of its scaled column is independent of them (threshold {:.0e}), so its σ would be some {:.0}× larger; fixed at nominal",
+                settings.near_dependency_tolerance,
+                1.0 / res
+            ),
+        )
+    };
+    DroppedParam {
+        name: name_of(k),
+        kind,
+        reason,
+        depends_on,
     }
 }
 

@@ -563,6 +563,115 @@ fn normal_of(
     Some((gram_checked(&a, go)?, a.tr_mul(&r)))
 }
 
+/// The candidates `(K, λ)` of the cross-validation: K = 0 (no maps), then
+/// every affordable harmonic count of the settings with every ridge.
+fn candidate_grid(
+    settings: &JointMapSettings,
+    affordable: impl Fn(usize) -> bool,
+) -> Vec<(usize, f64)> {
+    let mut ks: Vec<usize> = settings
+        .harmonics
+        .iter()
+        .copied()
+        .filter(|k| *k > 0 && affordable(*k))
+        .collect();
+    ks.sort_unstable();
+    ks.dedup();
+    let mut grid: Vec<(usize, f64)> = vec![(0, 0.0)];
+    for k in &ks {
+        for l in &settings.ridge {
+            grid.push((*k, *l));
+        }
+    }
+    grid
+}
+
+/// The maps of `k` harmonics the solution `x` (over the columns `cols` of
+/// the design) holds, for a robot of `n` joints.
+fn maps_of(
+    d: &Design,
+    cols: &[usize],
+    x: &DVector<f64>,
+    k: usize,
+    n: usize,
+    fade_rad: f64,
+) -> JointMaps {
+    let mut joints: Vec<Option<JointMap>> = vec![None; n];
+    for (slot, (i, range)) in d.joints.iter().enumerate() {
+        let mut map = JointMap::zero(k, *range, fade_rad);
+        for h in 1..=k {
+            let at = |sine: bool| {
+                let c = d.col(slot, h, sine);
+                let pos = cols.iter().position(|x| *x == c).expect("in cols");
+                x[pos]
+            };
+            map.cos[h - 1] = at(false);
+            map.sin[h - 1] = at(true);
+        }
+        joints[*i] = Some(map);
+    }
+    JointMaps { joints }
+}
+
+/// The design's normal equations on all poses and, per fold, on the fold's
+/// poses alone (subtracted to fit without them).
+struct CrossValidation<'a> {
+    d: &'a Design,
+    g: &'a DMatrix<f64>,
+    b: &'a DVector<f64>,
+    /// Column scales of the solve (the Gram diagonal's square roots).
+    scale: &'a [f64],
+    fold_poses: Vec<Vec<usize>>,
+    fold_normals: Vec<(DMatrix<f64>, DVector<f64>)>,
+}
+
+impl CrossValidation<'_> {
+    /// The held-out errors of `k` harmonics with ridge `ridge`, each fold
+    /// fitted without its poses: `Some(None)` when a fold's solve fails,
+    /// `None` when `go` (after each fold) cancels.
+    fn candidate(
+        &self,
+        k: usize,
+        ridge: f64,
+        go: &mut dyn FnMut() -> bool,
+    ) -> Option<Option<MapCandidate>> {
+        let d = self.d;
+        let cols = d.columns(k);
+        let mut errors = Vec::new();
+        let mut angles = Vec::new();
+        let mut ok = true;
+        for (poses, (gf, bf)) in self.fold_poses.iter().zip(&self.fold_normals) {
+            match solve(
+                &(self.g - gf),
+                &(self.b - bf),
+                &cols,
+                self.scale,
+                d.geo,
+                ridge,
+            ) {
+                Some(x) => {
+                    let (e, a) = held_out_errors(d, poses, &cols, &x);
+                    errors.extend(e);
+                    angles.extend(a.into_iter().flatten());
+                }
+                None => ok = false,
+            }
+            if !go() {
+                return None;
+            }
+        }
+        Some(ok.then(|| MapCandidate {
+            harmonics: k,
+            ridge,
+            cv_mean_mm: errors.iter().sum::<f64>() / errors.len() as f64,
+            cv_max_mm: errors.iter().copied().fold(0.0, f64::max),
+            cv_cost_mm2: seed_cost(&errors),
+            cv_orientation_mean_deg:
+                (!angles.is_empty()).then(|| angles.iter().sum::<f64>() / angles.len() as f64),
+        }))
+    }
+}
+
 /// Fits the maps of `model` (its own maps ignored) on `data` with the session
 /// frames `frames` and the identified parameters `ids`: K and λ by
 /// cross-validation, then the coefficients on all poses. `progress(done,
@@ -584,12 +693,9 @@ pub fn fit_joint_maps(
         return Err(MapFitError::ClosedLoop);
     }
     let folds = settings.folds.max(2);
-    let need = 4 * folds;
-    if data.len() < need {
-        return Err(MapFitError::TooFewPoses {
-            need,
-            got: data.len(),
-        });
+    if data.len() < 4 * folds {
+        let (need, got) = (4 * folds, data.len());
+        return Err(MapFitError::TooFewPoses { need, got });
     }
     let mut plain = model.clone();
     plain.joint_maps = None;
@@ -598,21 +704,8 @@ pub fn fit_joint_maps(
     let geo_cols = ids.len() + frames.len().saturating_sub(1) * 6;
     let affordable =
         |k: usize| ((geo_cols + 2 * k * n) as f64) * settings.rows_per_unknown <= rows as f64;
-    let mut ks: Vec<usize> = settings
-        .harmonics
-        .iter()
-        .copied()
-        .filter(|k| *k > 0 && affordable(*k))
-        .collect();
-    ks.sort_unstable();
-    ks.dedup();
-    let kmax = ks.last().copied().unwrap_or(0);
-    let mut grid: Vec<(usize, f64)> = vec![(0, 0.0)];
-    for k in &ks {
-        for l in &settings.ridge {
-            grid.push((*k, *l));
-        }
-    }
+    let grid = candidate_grid(settings, affordable);
+    let kmax = grid.iter().map(|c| c.0).max().unwrap_or(0);
     let total = grid.len() + 1;
     let mut go = || progress(0, total);
     let Some(d) = build(
@@ -633,14 +726,7 @@ pub fn fit_joint_maps(
     };
     let b = d.a.tr_mul(&d.r);
     let scale: Vec<f64> = (0..g.ncols())
-        .map(|c| {
-            let s = g[(c, c)].sqrt();
-            if s > 0.0 {
-                s
-            } else {
-                1.0
-            }
-        })
+        .map(|c| Some(g[(c, c)].sqrt()).filter(|s| *s > 0.0).unwrap_or(1.0))
         .collect();
     // Seeded folds over the poses.
     let mut order: Vec<usize> = (0..data.len()).collect();
@@ -648,42 +734,26 @@ pub fn fit_joint_maps(
     let fold_poses: Vec<Vec<usize>> = (0..folds)
         .map(|f| order.iter().copied().skip(f).step_by(folds).collect())
         .collect();
-    let mut fold_normals: Vec<(DMatrix<f64>, DVector<f64>)> = Vec::with_capacity(folds);
-    for p in &fold_poses {
-        match normal_of(&d, p, &mut go) {
-            Some(n) if go() => fold_normals.push(n),
-            _ => return Ok(None),
-        }
-    }
+    let Some(fold_normals) = fold_poses
+        .iter()
+        .map(|p| normal_of(&d, p, &mut go).filter(|_| go()))
+        .collect::<Option<Vec<_>>>()
+    else {
+        return Ok(None);
+    };
+    let cv = CrossValidation {
+        d: &d,
+        g: &g,
+        b: &b,
+        scale: &scale,
+        fold_poses,
+        fold_normals,
+    };
     let mut candidates = Vec::new();
     for (done, (k, ridge)) in grid.iter().enumerate() {
-        let cols = d.columns(*k);
-        let mut errors = Vec::with_capacity(data.len());
-        let mut angles = Vec::with_capacity(data.len());
-        let mut ok = true;
-        for (poses, (gf, bf)) in fold_poses.iter().zip(&fold_normals) {
-            match solve(&(&g - gf), &(&b - bf), &cols, &scale, d.geo, *ridge) {
-                Some(x) => {
-                    let (e, a) = held_out_errors(&d, poses, &cols, &x);
-                    errors.extend(e);
-                    angles.extend(a.into_iter().flatten());
-                }
-                None => ok = false,
-            }
-            if !progress(done, total) {
-                return Ok(None);
-            }
-        }
-        if ok {
-            candidates.push(MapCandidate {
-                harmonics: *k,
-                ridge: *ridge,
-                cv_mean_mm: errors.iter().sum::<f64>() / errors.len() as f64,
-                cv_max_mm: errors.iter().copied().fold(0.0, f64::max),
-                cv_cost_mm2: seed_cost(&errors),
-                cv_orientation_mean_deg: (!angles.is_empty())
-                    .then(|| angles.iter().sum::<f64>() / angles.len() as f64),
-            });
+        match cv.candidate(*k, *ridge, &mut || progress(done, total)) {
+            None => return Ok(None),
+            Some(c) => candidates.extend(c),
         }
         if !progress(done + 1, total) {
             return Ok(None);
@@ -706,22 +776,14 @@ pub fn fit_joint_maps(
         let cols = d.columns(chosen.harmonics);
         let x =
             solve(&g, &b, &cols, &scale, d.geo, chosen.ridge).ok_or(MapFitError::NotEvaluable)?;
-        let k = chosen.harmonics;
-        let mut joints: Vec<Option<JointMap>> = vec![None; n];
-        for (slot, (i, range)) in d.joints.iter().enumerate() {
-            let mut map = JointMap::zero(k, *range, settings.fade_rad);
-            for h in 1..=k {
-                let at = |sine: bool| {
-                    let c = d.col(slot, h, sine);
-                    let pos = cols.iter().position(|x| *x == c).expect("in cols");
-                    x[pos]
-                };
-                map.cos[h - 1] = at(false);
-                map.sin[h - 1] = at(true);
-            }
-            joints[*i] = Some(map);
-        }
-        Some(JointMaps { joints })
+        Some(maps_of(
+            &d,
+            &cols,
+            &x,
+            chosen.harmonics,
+            n,
+            settings.fade_rad,
+        ))
     };
     if !progress(total, total) {
         return Ok(None);

@@ -73,138 +73,181 @@ enum Position {
     Neither,
 }
 
+/// Offset of token `k` in the section (the end of the text past the last).
+fn at(text: &str, toks: &[Token], k: usize) -> usize {
+    toks.get(k).map_or(text.len(), |t| t.1.start)
+}
+
+/// The head `P[n]{` or `P[n:"comment"]{` at token `i`: the position number,
+/// where an unsolved mark goes (the comment's span, or empty after the
+/// number) and the token after `{`.
+fn head(text: &str, toks: &[Token], i: usize) -> Result<(f64, Range<usize>, usize), Fail> {
+    if !(word(toks.get(i)) == Some("P") && punct(toks.get(i + 1), '[')) {
+        return Err((at(text, toks, i), "expected `P[n]{`".into()));
+    }
+    let Some((Tok::Number(n), _)) = toks.get(i + 2) else {
+        return Err((at(text, toks, i + 2), "expected the position number".into()));
+    };
+    let mut k = i + 3;
+    let mark_at = if punct(toks.get(k), ':') {
+        let Some((Tok::Str, r)) = toks.get(k + 1) else {
+            return Err((at(text, toks, k + 1), "expected a comment string".into()));
+        };
+        let span = toks[k].1.start..r.end;
+        k += 2;
+        span
+    } else {
+        at(text, toks, k)..at(text, toks, k)
+    };
+    if !punct(toks.get(k), ']') || !punct(toks.get(k + 1), '{') {
+        return Err((at(text, toks, k), "expected `]{`".into()));
+    }
+    Ok((*n, mark_at, k + 2))
+}
+
+/// The fields of a block read so far; only group 1's are kept.
+#[derive(Default)]
+struct Fields {
+    group: u32,
+    uf: Option<u32>,
+    ut: Option<u32>,
+    flags: Option<Flags>,
+    /// X, Y, Z, W, P, R with the span each value occupies.
+    values: [Option<(f64, Range<usize>)>; 6],
+    joint: [Option<f64>; 6],
+    any_joint: bool,
+}
+
+impl Fields {
+    /// `UF : u`, `UT : t` or `CONFIG : '…'` at token `k` (the word); returns
+    /// the token after it and its comma.
+    fn colon(&mut self, text: &str, toks: &[Token], k: usize) -> Result<usize, Fail> {
+        let (Tok::Word(w), r) = &toks[k] else {
+            unreachable!("called at a word")
+        };
+        let key = w.to_ascii_uppercase();
+        match (key.as_str(), toks.get(k + 2)) {
+            ("UF" | "UT", Some((Tok::Number(v), _)))
+                if v.fract() == 0.0 && *v >= 0.0 && *v < 1e6 =>
+            {
+                if self.group == 1 {
+                    *(if key == "UF" {
+                        &mut self.uf
+                    } else {
+                        &mut self.ut
+                    }) = Some(*v as u32);
+                }
+            }
+            ("CONFIG", Some((Tok::Str, s))) => {
+                let c =
+                    config(&text[s.clone()]).ok_or((s.start, "bad CONFIG string".to_string()))?;
+                if self.group == 1 {
+                    self.flags = Some(c);
+                }
+            }
+            _ => return Err((r.start, format!("unexpected value of {w}"))),
+        }
+        let k = k + 3;
+        Ok(if punct(toks.get(k), ',') { k + 1 } else { k })
+    }
+
+    /// `X = 1.5 mm,` (or `Jn = …`) at token `k` (the word); returns the
+    /// token after the value, its unit and its comma.
+    fn equals(&mut self, text: &str, toks: &[Token], k: usize) -> Result<usize, Fail> {
+        let (Tok::Word(w), r) = &toks[k] else {
+            unreachable!("called at a word")
+        };
+        let key = w.to_ascii_uppercase();
+        let mut j = k + 2;
+        let sign = if punct(toks.get(j), '-') {
+            j += 1;
+            -1.0
+        } else {
+            if punct(toks.get(j), '+') {
+                j += 1;
+            }
+            1.0
+        };
+        let Some((Tok::Number(v), vr)) = toks.get(j) else {
+            return Err((at(text, toks, j), format!("{w} is not a number")));
+        };
+        let slot = toks[k + 2].1.start..vr.end;
+        j += 1;
+        if word(toks.get(j))
+            .is_some_and(|u| u.eq_ignore_ascii_case("mm") || u.eq_ignore_ascii_case("deg"))
+        {
+            j += 1;
+        }
+        if punct(toks.get(j), ',') {
+            j += 1;
+        }
+        if self.group == 1 {
+            match "XYZWPR".find(key.as_str()).filter(|_| key.len() == 1) {
+                Some(idx) => self.values[idx] = Some((sign * v, slot)),
+                None if key.starts_with('J') || key.starts_with('E') => {
+                    let axis = key.strip_prefix('J').and_then(|n| n.parse::<usize>().ok());
+                    if let Some(n) = axis {
+                        self.any_joint = true;
+                        if (1..=6).contains(&n) {
+                            self.joint[n - 1] = Some(sign * v);
+                        }
+                    }
+                }
+                None => return Err((r.start, format!("unknown component {w}"))),
+            }
+        }
+        Ok(j)
+    }
+}
+
 /// One `P[n]{…};` block from token `i` (at `P`); returns its group-1
 /// position and the token after the block.
 fn block(fi: usize, text: &str, toks: &[Token], i: usize) -> Result<(Position, usize), Fail> {
-    let at = |k: usize| toks.get(k).map_or(text.len(), |t| t.1.start);
-    if !(word(toks.get(i)) == Some("P") && punct(toks.get(i + 1), '[')) {
-        return Err((at(i), "expected `P[n]{`".into()));
-    }
-    let Some((Tok::Number(n), _)) = toks.get(i + 2) else {
-        return Err((at(i + 2), "expected the position number".into()));
-    };
-    let mut k = i + 3;
-    let mark_at: Range<usize>;
-    if punct(toks.get(k), ':') {
-        let Some((Tok::Str, r)) = toks.get(k + 1) else {
-            return Err((at(k + 1), "expected a comment string".into()));
-        };
-        mark_at = toks[k].1.start..r.end;
-        k += 2;
-    } else {
-        mark_at = at(k)..at(k);
-    }
-    if !punct(toks.get(k), ']') || !punct(toks.get(k + 1), '{') {
-        return Err((at(k), "expected `]{`".into()));
-    }
-    k += 2;
+    let (n, mark_at, mut k) = head(text, toks, i)?;
     let name = format!("P[{n}]");
-    let mut group = 0;
-    let (mut uf, mut ut, mut flags) = (None, None, None);
-    let mut values: [Option<(f64, Range<usize>)>; 6] = Default::default();
-    let mut joint: [Option<f64>; 6] = [None; 6];
-    let mut any_joint = false;
+    let mut fields = Fields::default();
     loop {
         let Some((t, r)) = toks.get(k) else {
-            return Err((at(i), format!("{name} is not closed by `}};`")));
+            return Err((at(text, toks, i), format!("{name} is not closed by `}};`")));
         };
-        match t {
+        k = match t {
             Tok::Punct('}') => {
                 if !punct(toks.get(k + 1), ';') {
-                    return Err((at(k + 1), "expected `;` after `}`".into()));
+                    return Err((at(text, toks, k + 1), "expected `;` after `}`".into()));
                 }
                 k += 2;
                 break;
             }
             Tok::Word(w) if w.starts_with("GP") && punct(toks.get(k + 1), ':') => {
-                group = w[2..].parse().unwrap_or(0);
-                k += 2;
+                fields.group = w[2..].parse().unwrap_or(0);
+                k + 2
             }
-            Tok::Word(w) if punct(toks.get(k + 1), ':') => {
-                let key = w.to_ascii_uppercase();
-                match (key.as_str(), toks.get(k + 2)) {
-                    ("UF" | "UT", Some((Tok::Number(v), _)))
-                        if v.fract() == 0.0 && *v >= 0.0 && *v < 1e6 =>
-                    {
-                        if group == 1 {
-                            *(if key == "UF" { &mut uf } else { &mut ut }) = Some(*v as u32);
-                        }
-                    }
-                    ("CONFIG", Some((Tok::Str, s))) => {
-                        let c = config(&text[s.clone()])
-                            .ok_or((s.start, "bad CONFIG string".to_string()))?;
-                        if group == 1 {
-                            flags = Some(c);
-                        }
-                    }
-                    _ => return Err((r.start, format!("unexpected value of {w}"))),
-                }
-                k += 3;
-                if punct(toks.get(k), ',') {
-                    k += 1;
-                }
-            }
-            Tok::Word(w) if punct(toks.get(k + 1), '=') => {
-                let key = w.to_ascii_uppercase();
-                let mut j = k + 2;
-                let sign = if punct(toks.get(j), '-') {
-                    j += 1;
-                    -1.0
-                } else {
-                    if punct(toks.get(j), '+') {
-                        j += 1;
-                    }
-                    1.0
-                };
-                let Some((Tok::Number(v), vr)) = toks.get(j) else {
-                    return Err((at(j), format!("{w} is not a number")));
-                };
-                let slot = toks[k + 2].1.start..vr.end;
-                j += 1;
-                if word(toks.get(j))
-                    .is_some_and(|u| u.eq_ignore_ascii_case("mm") || u.eq_ignore_ascii_case("deg"))
-                {
-                    j += 1;
-                }
-                if punct(toks.get(j), ',') {
-                    j += 1;
-                }
-                if group == 1 {
-                    match "XYZWPR".find(key.as_str()).filter(|_| key.len() == 1) {
-                        Some(idx) => values[idx] = Some((sign * v, slot)),
-                        None if key.starts_with('J') || key.starts_with('E') => {
-                            let axis = key.strip_prefix('J').and_then(|n| n.parse::<usize>().ok());
-                            if let Some(n) = axis {
-                                any_joint = true;
-                                if (1..=6).contains(&n) {
-                                    joint[n - 1] = Some(sign * v);
-                                }
-                            }
-                        }
-                        None => return Err((r.start, format!("unknown component {w}"))),
-                    }
-                }
-                k = j;
-            }
+            Tok::Word(_) if punct(toks.get(k + 1), ':') => fields.colon(text, toks, k)?,
+            Tok::Word(_) if punct(toks.get(k + 1), '=') => fields.equals(text, toks, k)?,
             _ => return Err((r.start, "unexpected text in the position".into())),
-        }
+        };
     }
     let line = position(text, toks[i].1.start).0;
-    if any_joint {
-        let deg: Option<Vec<f64>> = joint.iter().copied().collect();
-        let found = deg.map_or(Position::Neither, |deg| {
+    Ok((found(fi, line, name, mark_at, fields), k))
+}
+
+/// The target a block's group-1 fields make: joint values, a Cartesian site
+/// (skipped with its reason when incomplete or not a rotation), or nothing.
+fn found(fi: usize, line: usize, name: String, mark_at: Range<usize>, f: Fields) -> Position {
+    if f.any_joint {
+        let deg: Option<Vec<f64>> = f.joint.iter().copied().collect();
+        return deg.map_or(Position::Neither, |deg| {
             Position::Joint(JointTarget {
                 file: fi,
                 line,
                 deg,
             })
         });
-        return Ok((found, k));
     }
-    if values.iter().all(Option::is_none) {
-        return Ok((Position::Neither, k));
+    if f.values.iter().all(Option::is_none) {
+        return Position::Neither;
     }
-    let complete: Option<Vec<(f64, Range<usize>)>> = values.iter().cloned().collect();
+    let complete: Option<Vec<(f64, Range<usize>)>> = f.values.iter().cloned().collect();
     let (pose, slots, skip) = match complete {
         Some(v) => {
             let x: Vec<f64> = v.iter().map(|p| p.0).collect();
@@ -223,27 +266,24 @@ fn block(fi: usize, text: &str, toks: &[Token], i: usize) -> Result<(Position, u
         ),
     };
     let spec = |v: Option<u32>| v.map_or(FrameSpec::Unset, |n| FrameSpec::Ref(CellRef::Number(n)));
-    Ok((
-        Position::Cartesian(Box::new(Site {
-            file: fi,
-            line,
-            name,
-            pose,
-            flags: flags.unwrap_or(Flags::Nearest),
-            tool: spec(ut),
-            load: None,
-            work_object: spec(uf),
-            slots,
-            convention: OrientationConvention::FanucWpr,
-            unit_m: 1e-3,
-            decimals: [3, 3],
-            mark_at,
-            after_joints: None,
-            skip,
-            stationary_tool: false,
-        })),
-        k,
-    ))
+    Position::Cartesian(Box::new(Site {
+        file: fi,
+        line,
+        name,
+        pose,
+        flags: f.flags.unwrap_or(Flags::Nearest),
+        tool: spec(f.ut),
+        load: None,
+        work_object: spec(f.uf),
+        slots,
+        convention: OrientationConvention::FanucWpr,
+        unit_m: 1e-3,
+        decimals: [3, 3],
+        mark_at,
+        after_joints: None,
+        skip,
+        stationary_tool: false,
+    }))
 }
 
 /// Parses `.ls` files: the Cartesian positions of their `/POS` sections.

@@ -95,6 +95,18 @@ fn orientation_mean(errors: &SetErrors) -> Option<f64> {
     errors.orientation.as_ref().map(|o| o.mean_deg)
 }
 
+/// What `auto` gathers while it runs: the progress bar's position, the
+/// options it weighs, the candidates it lists and its notes.
+struct Tally<'p> {
+    progress: &'p mut dyn FnMut(f64, usize, Option<f64>) -> bool,
+    /// Units of the bar done, of `total`.
+    done: f64,
+    total: f64,
+    notes: Vec<String>,
+    candidates: Vec<AutoCandidate>,
+    options: Vec<BaseOption>,
+}
+
 /// `auto` (module docs). Without gravity torques (`Context::gravity`) neither
 /// SKCM nor the torque-input RBF is tried.
 pub(crate) fn run_auto(
@@ -103,10 +115,8 @@ pub(crate) fn run_auto(
     progress: &mut dyn FnMut(f64, usize, Option<f64>) -> bool,
 ) -> Result<Outcome, MethodError> {
     let o = &ctx.opts.compensator;
-    let (pool, pool_name) = ctx.pool();
     let gravity = ctx.gravity.as_ref();
     let folds = if o.cv_folds > 0 { o.cv_folds } else { 5 };
-    let enough = pool.len() >= o.min_training_poses;
     let bases: Vec<Base> = if gravity.is_some() {
         vec![Base::Km]
     } else {
@@ -136,176 +146,228 @@ pub(crate) fn run_auto(
         .count();
     let total = (per_base.iter().map(Vec::len).sum::<usize>() + maps_runs + maps_compensators)
         .max(1) as f64;
-    let mut done = 0.0;
-    let mut notes: Vec<String> = Vec::new();
-    if let Some(why) = gravity {
-        notes.push(format!("skcm and km-rbf not tried: {why}"));
-    }
-    let mut candidates = Vec::new();
-    let mut options: Vec<BaseOption> = Vec::new();
+    let mut t = Tally {
+        progress,
+        done: 0.0,
+        total,
+        notes: gravity
+            .map(|why| format!("skcm and km-rbf not tried: {why}"))
+            .into_iter()
+            .collect(),
+        candidates: Vec::new(),
+        options: Vec::new(),
+    };
     for (base, cands) in bases.iter().zip(&per_base) {
-        let name = base.method().name();
-        let mf = match cache.base_fit(ctx, *base, &mut |it, rms| {
-            progress(done / total, it, Some(rms))
-        }) {
-            Ok(mf) => mf,
-            Err(MethodError::Cancelled) => return Err(MethodError::Cancelled),
-            Err(MethodError::Failed(f)) => {
-                notes.push(format!("{name} failed: {f}"));
-                done += cands.len() as f64;
-                continue;
-            }
-        };
-        let base_errors = base_pool_errors(&mf.fit, pool);
-        let base_mean = base_errors.stats.mean_mm;
-        let orientation_deg = orientation_mean(&base_errors);
-        if !enough {
-            options.push(BaseOption {
-                base: *base,
-                maps: None,
-                fit: mf,
-                compensator: None,
-                mean_mm: base_mean,
-                orientation_deg,
-                orientation_part: None,
-                reason: format!(
-                    "{name}: only {} training poses (at least {} are needed to train and cross-validate a compensator), so the base stays",
-                    pool.len(),
-                    o.min_training_poses
-                ),
-            });
-            continue;
-        }
-        let done0 = done;
-        let (choice, picked, settled) = cross_validate_and_choose(
-            ctx,
-            cache,
-            cands,
-            &mf.fit,
-            folds,
-            &mut candidates,
-            &mut |x, e, l| progress((done0 + x) / total, e, l),
-        )?;
-        done += cands.len() as f64;
-        let mean_mm = picked
-            .as_ref()
-            .and_then(|a| a.trained.cv.as_ref())
-            .map_or(base_mean, |cv| cv.compensated.mean_mm);
-        if let Some((_, Some(dropped))) = &settled {
-            notes.push(dropped.clone());
-        }
-        options.push(BaseOption {
-            base: *base,
-            maps: None,
-            fit: mf,
-            compensator: picked,
-            mean_mm,
-            orientation_deg: option_orientation(orientation_deg, &settled),
-            orientation_part: settled.map(|s| s.0),
-            reason: format!("{name}: {}", choice.reason),
-        });
+        base_option(ctx, cache, &mut t, *base, cands, folds)?;
     }
     for base in &bases {
-        let Some(method) = maps_candidate(&o.auto_candidates, *base) else {
-            continue;
-        };
-        // The maps, then the compensators on them: a unit of the bar each,
-        // whether they run or not.
-        let (at, span) = (done / total, 1.0 / total);
-        let on_maps_at = done + 1.0;
-        done += 1.0 + on_maps_candidates(ctx, *base).len() as f64;
-        let outcome = run_maps(ctx, cache, *base, &mut |f, it, l| {
-            progress(at + span * f, it, l)
-        });
-        match outcome {
-            Err(MethodError::Cancelled) => return Err(MethodError::Cancelled),
-            Err(MethodError::Failed(f)) => {
-                candidates.push(AutoCandidate {
-                    method,
-                    cross_validation: None,
-                    failed: Some(f.to_string()),
-                    orientation_cross_validation: None,
-                });
-                notes.push(format!("{} failed: {f}", method.name()));
-            }
-            Ok(out) => {
-                let fit = out.fit;
-                let Some(m) = fit.maps.clone() else { continue };
-                candidates.push(AutoCandidate {
-                    method,
-                    cross_validation: None,
-                    failed: None,
-                    orientation_cross_validation: None,
-                });
-                let (with, without) = (&m.chosen, &m.without_maps);
-                let gain = 1.0 - with.cv_mean_mm / without.cv_mean_mm;
-                let orientation_loss = match (
-                    with.cv_orientation_mean_deg,
-                    without.cv_orientation_mean_deg,
-                ) {
-                    (Some(a), Some(b)) if a > b * (1.0 + ORIENTATION_SLACK) => Some((a, b)),
-                    _ => None,
-                };
-                if let (Some((a, b)), true) = (orientation_loss, m.maps.is_some()) {
-                    notes.push(format!(
-                        "{} not kept: it loses orientation, cross-validated {a:.4}° mean against {b:.4}° without maps (more than {:.0} % above)",
-                        method.name(),
-                        ORIENTATION_SLACK * 100.0
-                    ));
-                } else if m.maps.is_some()
-                    && gain >= o.min_gain
-                    && with.cv_max_mm <= without.cv_max_mm
-                {
-                    let on_maps = maps_compensator(
-                        ctx,
-                        cache,
-                        *base,
-                        &fit,
-                        folds,
-                        &mut candidates,
-                        &mut |f, e, l| progress((on_maps_at + f) / total, e, l),
-                    )?;
-                    let orientation_deg = orientation_mean(&SetErrors::of(
-                        &fit.fit.model,
-                        &fit.fit.session_frames,
-                        pool,
-                    ));
-                    if let Some((_, Some(dropped))) = &on_maps.settled {
-                        notes.push(dropped.clone());
-                    }
-                    options.push(BaseOption {
-                        base: *base,
-                        maps: Some(method),
-                        fit,
-                        compensator: on_maps.kept,
-                        mean_mm: with.cv_mean_mm,
-                        orientation_deg: option_orientation(orientation_deg, &on_maps.settled),
-                        orientation_part: on_maps.settled.map(|s| s.0),
-                        reason: format!("{}{}", on_maps.reason, format_args!(
-                            "{}: {} harmonics cross-validated over {} poses at {:.4} / {:.4} mm mean / max against {:.4} / {:.4} without maps",
-                            method.name(),
-                            with.harmonics,
-                            m.poses,
-                            with.cv_mean_mm,
-                            with.cv_max_mm,
-                            without.cv_mean_mm,
-                            without.cv_max_mm
-                        )),
-                    });
-                } else {
-                    notes.push(format!(
-                        "{} not kept: cross-validated {:.4} / {:.4} mm mean / max against {:.4} / {:.4} without maps (needs {:.0} % lower mean and no higher max)",
-                        method.name(),
-                        with.cv_mean_mm,
-                        with.cv_max_mm,
-                        without.cv_mean_mm,
-                        without.cv_max_mm,
-                        o.min_gain * 100.0
-                    ));
-                }
-            }
+        if let Some(method) = maps_candidate(&o.auto_candidates, *base) {
+            maps_option(ctx, cache, &mut t, *base, method, folds)?;
         }
     }
+    choose_among(ctx, t)
+}
+
+/// Fits `base` and, with enough training poses, cross-validates its
+/// compensator candidates `cands`; adds the base with the compensator
+/// `choose` keeps (or alone) to the options. A failed base is a note.
+fn base_option(
+    ctx: &Context,
+    cache: &mut Cache,
+    t: &mut Tally,
+    base: Base,
+    cands: &[(Method, Compensated)],
+    folds: usize,
+) -> Result<(), MethodError> {
+    let o = &ctx.opts.compensator;
+    let (pool, _) = ctx.pool();
+    let name = base.method().name();
+    let (done, total) = (t.done, t.total);
+    let progress = &mut *t.progress;
+    let mf = match cache.base_fit(ctx, base, &mut |it, rms| {
+        progress(done / total, it, Some(rms))
+    }) {
+        Ok(mf) => mf,
+        Err(MethodError::Cancelled) => return Err(MethodError::Cancelled),
+        Err(MethodError::Failed(f)) => {
+            t.notes.push(format!("{name} failed: {f}"));
+            t.done += cands.len() as f64;
+            return Ok(());
+        }
+    };
+    let base_errors = base_pool_errors(&mf.fit, pool);
+    let base_mean = base_errors.stats.mean_mm;
+    let orientation_deg = orientation_mean(&base_errors);
+    if pool.len() < o.min_training_poses {
+        t.options.push(BaseOption {
+            base,
+            maps: None,
+            fit: mf,
+            compensator: None,
+            mean_mm: base_mean,
+            orientation_deg,
+            orientation_part: None,
+            reason: format!(
+                "{name}: only {} training poses (at least {} are needed to train and cross-validate a compensator), so the base stays",
+                pool.len(),
+                o.min_training_poses
+            ),
+        });
+        return Ok(());
+    }
+    let (choice, picked, settled) = cross_validate_and_choose(
+        ctx,
+        cache,
+        cands,
+        &mf.fit,
+        folds,
+        &mut t.candidates,
+        &mut |x, e, l| progress((done + x) / total, e, l),
+    )?;
+    t.done += cands.len() as f64;
+    let mean_mm = picked
+        .as_ref()
+        .and_then(|a| a.trained.cv.as_ref())
+        .map_or(base_mean, |cv| cv.compensated.mean_mm);
+    if let Some((_, Some(dropped))) = &settled {
+        t.notes.push(dropped.clone());
+    }
+    t.options.push(BaseOption {
+        base,
+        maps: None,
+        fit: mf,
+        compensator: picked,
+        mean_mm,
+        orientation_deg: option_orientation(orientation_deg, &settled),
+        orientation_part: settled.map(|s| s.0),
+        reason: format!("{name}: {}", choice.reason),
+    });
+    Ok(())
+}
+
+/// Runs the joint-map method `method` on `base`; when its maps are kept
+/// (module docs), cross-validates the compensators on them and adds the
+/// option. The maps, then the compensators on them, are a unit of the bar
+/// each, whether they run or not.
+fn maps_option(
+    ctx: &Context,
+    cache: &mut Cache,
+    t: &mut Tally,
+    base: Base,
+    method: Method,
+    folds: usize,
+) -> Result<(), MethodError> {
+    let o = &ctx.opts.compensator;
+    let (pool, _) = ctx.pool();
+    let total = t.total;
+    let (at, span) = (t.done / total, 1.0 / total);
+    let on_maps_at = t.done + 1.0;
+    t.done += 1.0 + on_maps_candidates(ctx, base).len() as f64;
+    let progress = &mut *t.progress;
+    let fit = match run_maps(ctx, cache, base, &mut |f, it, l| {
+        progress(at + span * f, it, l)
+    }) {
+        Err(MethodError::Cancelled) => return Err(MethodError::Cancelled),
+        Err(MethodError::Failed(f)) => {
+            t.candidates.push(AutoCandidate {
+                method,
+                cross_validation: None,
+                failed: Some(f.to_string()),
+                orientation_cross_validation: None,
+            });
+            t.notes.push(format!("{} failed: {f}", method.name()));
+            return Ok(());
+        }
+        Ok(out) => out.fit,
+    };
+    let Some(m) = fit.maps.clone() else {
+        return Ok(());
+    };
+    t.candidates.push(AutoCandidate {
+        method,
+        cross_validation: None,
+        failed: None,
+        orientation_cross_validation: None,
+    });
+    let (with, without) = (&m.chosen, &m.without_maps);
+    let gain = 1.0 - with.cv_mean_mm / without.cv_mean_mm;
+    let orientation_loss = match (
+        with.cv_orientation_mean_deg,
+        without.cv_orientation_mean_deg,
+    ) {
+        (Some(a), Some(b)) if a > b * (1.0 + ORIENTATION_SLACK) => Some((a, b)),
+        _ => None,
+    };
+    if let (Some((a, b)), true) = (orientation_loss, m.maps.is_some()) {
+        t.notes.push(format!(
+            "{} not kept: it loses orientation, cross-validated {a:.4}° mean against {b:.4}° without maps (more than {:.0} % above)",
+            method.name(),
+            ORIENTATION_SLACK * 100.0
+        ));
+        return Ok(());
+    }
+    if !(m.maps.is_some() && gain >= o.min_gain && with.cv_max_mm <= without.cv_max_mm) {
+        t.notes.push(format!(
+            "{} not kept: cross-validated {:.4} / {:.4} mm mean / max against {:.4} / {:.4} without maps (needs {:.0} % lower mean and no higher max)",
+            method.name(),
+            with.cv_mean_mm,
+            with.cv_max_mm,
+            without.cv_mean_mm,
+            without.cv_max_mm,
+            o.min_gain * 100.0
+        ));
+        return Ok(());
+    }
+    let on_maps = maps_compensator(
+        ctx,
+        cache,
+        base,
+        &fit,
+        folds,
+        &mut t.candidates,
+        &mut |f, e, l| progress((on_maps_at + f) / total, e, l),
+    )?;
+    let orientation_deg = orientation_mean(&SetErrors::of(
+        &fit.fit.model,
+        &fit.fit.session_frames,
+        pool,
+    ));
+    if let Some((_, Some(dropped))) = &on_maps.settled {
+        t.notes.push(dropped.clone());
+    }
+    t.options.push(BaseOption {
+        base,
+        maps: Some(method),
+        fit,
+        compensator: on_maps.kept,
+        mean_mm: with.cv_mean_mm,
+        orientation_deg: option_orientation(orientation_deg, &on_maps.settled),
+        orientation_part: on_maps.settled.map(|s| s.0),
+        reason: format!("{}{}", on_maps.reason, format_args!(
+            "{}: {} harmonics cross-validated over {} poses at {:.4} / {:.4} mm mean / max against {:.4} / {:.4} without maps",
+            method.name(),
+            with.harmonics,
+            m.poses,
+            with.cv_mean_mm,
+            with.cv_max_mm,
+            without.cv_mean_mm,
+            without.cv_max_mm
+        )),
+    });
+    Ok(())
+}
+
+/// The option `auto` delivers (`choose_option` over the options' scores),
+/// with its reason, the other options' reasons and the notes.
+fn choose_among(ctx: &Context, t: Tally) -> Result<Outcome, MethodError> {
+    let (pool, pool_name) = ctx.pool();
+    let enough = pool.len() >= ctx.opts.compensator.min_training_poses;
+    let Tally {
+        mut notes,
+        candidates,
+        mut options,
+        ..
+    } = t;
     let scores: Vec<(f64, Option<f64>)> = options
         .iter()
         .map(|o| (o.mean_mm, o.orientation_deg))

@@ -7,6 +7,7 @@
 use super::compensated::compensate_report;
 use super::run::{Context, MethodFit, Outcome};
 use super::{Method, MethodFailure};
+use crate::calibrate::identify::least_squares::Fit;
 use crate::calibrate::identify::report::{
     estimates, JointMapsSummary, MethodReport, MethodWarning, SetErrors, WarningKind,
 };
@@ -89,6 +90,47 @@ impl Context<'_> {
                 ),
             });
         }
+        let stiffness = self.stiffness(&fitted, &ids, tlbo.is_some(), &mut warnings);
+        warnings.extend(self.payload_warning(fitted.model.payload.mass_offset));
+        Ok(MethodReport {
+            method,
+            solver: fitted.report.clone(),
+            identification: id_err,
+            validation: va_err,
+            training: None,
+            parameters: estimates(
+                self.nominal,
+                &fitted.model,
+                &ids,
+                fitted.covariance.as_ref(),
+                &fitted.at_bound,
+            ),
+            stiffness_nm_per_rad: stiffness,
+            tlbo,
+            warnings,
+            model: description,
+            compensator: None,
+            auto: None,
+            joint_maps: maps.map(|m| JointMapsSummary::of(&m, &fitted.model)),
+            calibrated: fitted.model,
+            stored_compensator: None,
+            stored_support: None,
+            stored_orientation: None,
+            validation_evidence: None,
+        })
+    }
+
+    /// The identified joint stiffness `1/c` [N·m/rad] per joint (none where
+    /// compliance was not identified or is 0), with a warning for each
+    /// compliance held at its bound 0 and each stiffness outside the
+    /// plausible range. `by_tlbo`: the compliance was searched by TLBO.
+    fn stiffness(
+        &self,
+        fitted: &Fit,
+        ids: &[ParamId],
+        by_tlbo: bool,
+        warnings: &mut Vec<MethodWarning>,
+    ) -> Vec<Option<f64>> {
         let [k_lo, k_hi] = self.opts.plausible_stiffness_nm_per_rad;
         let mut stiffness = Vec::with_capacity(fitted.model.dof());
         for (k, l) in fitted.model.links.iter().enumerate() {
@@ -99,7 +141,7 @@ impl Context<'_> {
             };
             // TLBO searches c in [0, c_max] outside the LM's bounds.
             let at_bound = fitted.at_bound.get(pos).copied().unwrap_or(false)
-                || (tlbo.is_some() && l.compliance <= 0.0);
+                || (by_tlbo && l.compliance <= 0.0);
             if at_bound {
                 warnings.push(MethodWarning {
                     kind: WarningKind::ComplianceAtBound,
@@ -127,49 +169,30 @@ impl Context<'_> {
                 stiffness.push(None);
             }
         }
-        let offset = fitted.model.payload.mass_offset;
-        if offset != 0.0 {
-            let lightest = self
-                .ident
-                .iter()
-                .chain(self.valid)
-                .map(|m| m.payload_mass)
-                .fold(f64::INFINITY, f64::min);
-            if lightest + offset < 0.0 {
-                warnings.push(MethodWarning {
-                    kind: WarningKind::PayloadImplausible,
-                    joint: None,
-                    message: format!(
-                        "the identified payload mass offset {offset:+.2} kg leaves a negative mass on poses declared with {lightest:.2} kg: the payload and compliance are not separable in these poses"
-                    ),
-                });
-            }
+        stiffness
+    }
+
+    /// A warning when the identified payload mass offset leaves a negative
+    /// mass on some pose.
+    fn payload_warning(&self, offset: f64) -> Option<MethodWarning> {
+        if offset == 0.0 {
+            return None;
         }
-        Ok(MethodReport {
-            method,
-            solver: fitted.report.clone(),
-            identification: id_err,
-            validation: va_err,
-            training: None,
-            parameters: estimates(
-                self.nominal,
-                &fitted.model,
-                &ids,
-                fitted.covariance.as_ref(),
-                &fitted.at_bound,
-            ),
-            stiffness_nm_per_rad: stiffness,
-            tlbo,
-            warnings,
-            model: description,
-            compensator: None,
-            auto: None,
-            joint_maps: maps.map(|m| JointMapsSummary::of(&m, &fitted.model)),
-            calibrated: fitted.model,
-            stored_compensator: None,
-            stored_support: None,
-            stored_orientation: None,
-            validation_evidence: None,
-        })
+        let lightest = self
+            .ident
+            .iter()
+            .chain(self.valid)
+            .map(|m| m.payload_mass)
+            .fold(f64::INFINITY, f64::min);
+        if lightest + offset < 0.0 {
+            return Some(MethodWarning {
+                kind: WarningKind::PayloadImplausible,
+                joint: None,
+                message: format!(
+                    "the identified payload mass offset {offset:+.2} kg leaves a negative mass on poses declared with {lightest:.2} kg: the payload and compliance are not separable in these poses"
+                ),
+            });
+        }
+        None
     }
 }

@@ -231,6 +231,79 @@ impl IkSolver {
             .min()
     }
 
+    /// The prediction `pose` judged against `goal`.
+    fn at(&self, goal: &Goal, pose: Pose, position_only: bool) -> At {
+        let (e, pos, rot) = self.error(goal, &pose, position_only);
+        At {
+            cost: e.norm_squared(),
+            e,
+            pos,
+            rot,
+            pose,
+        }
+    }
+
+    /// The exact prediction at `q` (the expansion shifted onto it), judged
+    /// against `goal`; `None` when it cannot be evaluated.
+    fn exact_at<D: Dim>(
+        &self,
+        goal: &Goal,
+        q: &OVector<f64, D>,
+        current: &Pose,
+        local: &mut Local,
+        position_only: bool,
+    ) -> Option<At>
+    where
+        DefaultAllocator: Allocator<D>,
+    {
+        let pose = self
+            .prepared
+            .predict_checked(q.as_slice(), current, local)?;
+        Some(self.at(goal, pose, position_only))
+    }
+
+    /// The damped Gauss–Newton step `dq = Jwᵀ (Jw Jwᵀ + μ I)⁻¹ e` on the
+    /// first `m` rows (a unit diagonal on the others, whose step component is
+    /// 0), capped at `max_step_rad`; `None` when the system is not positive
+    /// definite.
+    fn damped_step<D: Dim>(
+        &self,
+        jw: &Jac<D>,
+        e: &Vector6<f64>,
+        mu: f64,
+        m: usize,
+    ) -> Option<OVector<f64, D>>
+    where
+        DefaultAllocator: Allocator<U6, D> + Allocator<D> + Allocator<D, U6>,
+    {
+        let mut a: Matrix6<f64> = jw * jw.transpose();
+        for i in 0..6 {
+            a[(i, i)] += if i < m { mu } else { 1.0 };
+        }
+        let mut dq: OVector<f64, D> = jw.transpose() * a.cholesky()?.solve(e);
+        let step = dq.amax();
+        if step > self.settings.max_step_rad {
+            dq *= self.settings.max_step_rad / step;
+        }
+        Some(dq)
+    }
+
+    /// `q + dq` projected into the joint limits, and whether a joint was
+    /// clamped.
+    fn limited<D: Dim>(&self, q: &OVector<f64, D>, dq: &OVector<f64, D>) -> (OVector<f64, D>, bool)
+    where
+        DefaultAllocator: Allocator<D>,
+    {
+        let mut clamped = false;
+        let mut trial = q.clone();
+        for ((t, d), l) in trial.iter_mut().zip(dq.iter()).zip(&self.limits) {
+            let (x, c) = Self::project(*t + d, *l);
+            clamped |= c;
+            *t = x;
+        }
+        (trial, clamped)
+    }
+
     /// The damped Newton iteration for `d` joints.
     pub(super) fn refine_in<D: Dim>(
         &self,
@@ -244,7 +317,6 @@ impl IkSolver {
     where
         DefaultAllocator: Allocator<U6, D> + Allocator<D> + Allocator<D, U6>,
     {
-        let s = &self.settings;
         let fail = Refined::failed_evaluation;
         let mut jac = Jac::<D>::zeros_generic(U6, d);
         let linearised = self.prepared.has_local_terms();
@@ -253,49 +325,38 @@ impl IkSolver {
         else {
             return fail(q_start, 1);
         };
-        // `e`, `pos` and `rot` are of the exact prediction at `q` (the
-        // expansion at its own point is exact).
+        // `now` is the exact prediction at `q` where `exact` (the expansion
+        // at its own point is exact), else the expanded one.
         let mut exact = at_expansion;
         // Checks of the exact prediction that failed since the last expansion.
         let mut failed_checks = 0;
         let mut q = OVector::<f64, D>::from_column_slice_generic(d, U1, &q_start);
         let mut jac_t = jac.clone();
-        let (mut e, mut pos, mut rot) = self.error(goal, &pose, position_only);
-        // The prediction at `q` (expanded, or exact where `exact`).
-        let mut current = pose;
-        let mut cost = e.norm_squared();
-        let mut damping = Nielsen::new(s.initial_damping);
+        let mut now = self.at(goal, pose, position_only);
+        let mut damping = Nielsen::new(self.settings.initial_damping);
         let mut iterations = 1;
         let mut at_limit = false;
-        // Rows of the system: the orientation rows of position-only goals are
-        // zero and get a unit diagonal (their step component is 0).
-        let m = if position_only { 3 } else { 6 };
+        let m = if position_only { 3 } else { 6 }; // rows of the system (`damped_step`)
         while iterations < max_iterations {
-            if self.done(pos, rot, position_only) {
+            if self.done(now.pos, now.rot, position_only) {
                 if exact {
                     break;
                 }
                 // The expanded prediction meets the tolerance: check the
                 // exact one, which also shifts the expansion onto it at `q`.
                 iterations += 1;
-                let Some(pose_x) =
-                    self.prepared
-                        .predict_checked(q.as_slice(), &current, &mut local)
-                else {
+                let Some(x) = self.exact_at(goal, &q, &now.pose, &mut local, position_only) else {
                     return fail(q.as_slice().to_vec(), iterations);
                 };
-                (e, pos, rot) = self.error(goal, &pose_x, position_only);
-                current = pose_x;
-                cost = e.norm_squared();
+                now = x;
                 exact = true;
                 failed_checks += 1;
-                if failed_checks > 1 && !self.done(pos, rot, position_only) {
+                if failed_checks > 1 && !self.done(now.pos, now.rot, position_only) {
                     // Twice off: the expansion's derivatives are too old; expand here.
                     iterations += 1;
                     failed_checks = 0;
-                    if self
-                        .prepared
-                        .predict_with_jacobian(q.as_slice(), &mut jac, &mut local)
+                    let p = &self.prepared;
+                    if p.predict_with_jacobian(q.as_slice(), &mut jac, &mut local)
                         .is_none()
                     {
                         return fail(q.as_slice().to_vec(), iterations);
@@ -304,32 +365,17 @@ impl IkSolver {
                 continue;
             }
             let jw = self.weighted_jacobian(&jac, position_only);
-            let mut a: Matrix6<f64> = &jw * jw.transpose();
-            for i in 0..6 {
-                a[(i, i)] += if i < m { damping.mu } else { 1.0 };
-            }
-            let Some(chol) = a.cholesky() else {
+            let Some(dq) = self.damped_step(&jw, &now.e, damping.mu, m) else {
                 damping.reject();
                 iterations += 1;
                 continue;
             };
-            let mut dq: OVector<f64, D> = jw.transpose() * chol.solve(&e);
-            let step = dq.amax();
-            if step > s.max_step_rad {
-                dq *= s.max_step_rad / step;
-            }
             if !dq.iter().all(|v| v.is_finite()) {
                 break;
             }
-            let mut clamped = false;
-            let mut trial = q.clone();
-            for ((t, d), l) in trial.iter_mut().zip(dq.iter()).zip(&self.limits) {
-                let (x, c) = Self::project(*t + d, *l);
-                clamped |= c;
-                *t = x;
-            }
+            let trial;
+            (trial, at_limit) = self.limited(&q, &dq);
             iterations += 1;
-            at_limit = clamped;
             let Some(pose_t) =
                 self.prepared
                     .predict_local(trial.as_slice(), &mut jac_t, &mut local)
@@ -337,25 +383,13 @@ impl IkSolver {
                 damping.reject();
                 continue;
             };
-            let (e_t, pos_t, rot_t) = self.error(goal, &pose_t, position_only);
-            let cost_t = e_t.norm_squared();
-            if cost_t < cost {
-                let jd: Vector6<f64> = &jw * &dq;
-                let predicted = 2.0 * jd.dot(&e) - jd.norm_squared();
-                let rho = if predicted > 0.0 {
-                    (cost - cost_t) / predicted
-                } else {
-                    1.0
-                };
-                damping.accept(rho);
+            let next = self.at(goal, pose_t, position_only);
+            if next.cost < now.cost {
+                damping.accept(gain_ratio(&jw, &dq, &now, &next));
                 q = trial;
-                current = pose_t;
+                now = next;
                 local.accept();
                 std::mem::swap(&mut jac, &mut jac_t);
-                e = e_t;
-                cost = cost_t;
-                pos = pos_t;
-                rot = rot_t;
                 exact = !linearised;
             } else {
                 damping.reject();
@@ -368,20 +402,13 @@ impl IkSolver {
             // The budget or the damping ended on the expanded prediction:
             // the residuals reported are the exact ones.
             iterations += 1;
-            let Some(pose_x) = self
-                .prepared
-                .predict_checked(q.as_slice(), &current, &mut local)
-            else {
+            let Some(x) = self.exact_at(goal, &q, &now.pose, &mut local, position_only) else {
                 return fail(q.as_slice().to_vec(), iterations);
             };
-            (_, pos, rot) = self.error(goal, &pose_x, position_only);
+            now = x;
         }
+        let (pos, rot) = (now.pos, now.rot);
         let converged = self.done(pos, rot, position_only);
-        let sigma_min = if converged {
-            f64::NAN
-        } else {
-            self.sigma_min(&jac, position_only)
-        };
         Refined {
             q: q.as_slice().to_vec(),
             converged,
@@ -389,10 +416,39 @@ impl IkSolver {
             orientation_residual_rad: rot,
             iterations,
             at_limit: at_limit && !converged,
-            sigma_min,
+            sigma_min: if converged {
+                f64::NAN
+            } else {
+                self.sigma_min(&jac, position_only)
+            },
             failed_evaluation: false,
         }
     }
+}
+
+/// Gain ratio of a step `dq` from `now` to `next`: the actual decrease of
+/// the cost over the linear model's (1 when the model predicts none).
+fn gain_ratio<D: Dim>(jw: &Jac<D>, dq: &OVector<f64, D>, now: &At, next: &At) -> f64
+where
+    DefaultAllocator: Allocator<U6, D> + Allocator<D>,
+{
+    let jd: Vector6<f64> = jw * dq;
+    let predicted = 2.0 * jd.dot(&now.e) - jd.norm_squared();
+    if predicted > 0.0 {
+        (now.cost - next.cost) / predicted
+    } else {
+        1.0
+    }
+}
+
+/// A prediction judged against the goal: the weighted error, its residual
+/// norms [m, rad] and its cost `|e|²`.
+struct At {
+    e: Vector6<f64>,
+    pos: f64,
+    rot: f64,
+    cost: f64,
+    pose: Pose,
 }
 
 #[cfg(test)]
