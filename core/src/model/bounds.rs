@@ -14,7 +14,7 @@
 //! rad, kg, N·m in, m out), called by the file's loader
 //! (`compensate::file`) for every file and stored version.
 
-use super::description::ModelError;
+use super::error::ModelError;
 
 pub mod compensator;
 pub use compensator::check_compensator;

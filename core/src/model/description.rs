@@ -16,6 +16,7 @@ use super::bounds::{
     check, check3, Bound, ANGLE_DEG, COMPLIANCE_RAD_PER_NM, GRAVITY_MPS2, LENGTH_MM, LIMIT_DEG,
     LOOP_LENGTH_MM, MASS_KG, MASS_OFFSET_KG, POINT_MM, TOOL_FRAME_POINT_MM,
 };
+use super::error::ModelError;
 use super::joint_maps::JointMapsDescription;
 use super::pose::{rpy_matrix, Pose};
 use super::robot::{ClosedLoop, Link, Payload, RobotModel, Tool, G0};
@@ -27,17 +28,6 @@ const MM: f64 = 1e-3;
 pub const MAX_GRAVITY_MPS2: f64 = GRAVITY_MPS2.max;
 /// Longest model name (characters).
 pub const NAME_MAX_CHARS: usize = 200;
-
-/// An error in a model description, naming the field.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum ModelError {
-    #[error("model field `{field}`: {reason}")]
-    InvalidField { field: String, reason: String },
-    #[error("unknown robot preset `{0}` (known presets: ys100, hh800, ur5, ur10)")]
-    UnknownPreset(String),
-    #[error("cannot read model JSON: {0}")]
-    Parse(String),
-}
 
 fn invalid(field: impl Into<String>, reason: impl Into<String>) -> ModelError {
     ModelError::InvalidField {

@@ -3,6 +3,7 @@
 
 pub mod bounds;
 pub mod description;
+pub mod error;
 pub mod export;
 pub mod joint_map_table;
 pub mod joint_maps;
@@ -14,7 +15,8 @@ pub mod pose;
 pub mod presets;
 pub mod robot;
 
-pub use description::{ModelDescription, ModelError};
+pub use description::ModelDescription;
+pub use error::ModelError;
 pub use joint_maps::{
     fade_weight, Coverage, JointMap, JointMapDescription, JointMapError, JointMaps,
     JointMapsDescription, MapTaylor,

@@ -7,9 +7,10 @@
 //! - `ur5`, `ur10`: Universal Robots, standard DH imported by regrouping.
 
 use super::description::{
-    ClosedLoopDescription, DhConvention, JointDescription, ModelDescription, ModelError,
-    PayloadDescription, ToolDescription,
+    ClosedLoopDescription, DhConvention, JointDescription, ModelDescription, PayloadDescription,
+    ToolDescription,
 };
+use super::error::ModelError;
 use super::robot::{RobotModel, G0};
 
 pub const PRESETS: [&str; 4] = ["ys100", "hh800", "ur5", "ur10"];

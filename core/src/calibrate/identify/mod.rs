@@ -17,6 +17,7 @@ pub mod joint_maps;
 pub mod least_squares;
 pub mod methods;
 pub mod model_file;
+pub mod network;
 pub mod options;
 pub mod pose_selection;
 pub mod registration;

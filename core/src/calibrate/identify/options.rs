@@ -9,10 +9,8 @@ use super::identifiability::IdentifiabilitySettings;
 use super::joint_maps::JointMapSettings;
 use super::least_squares::LmSettings;
 pub use super::methods::Method;
-use super::methods::Network;
 use crate::calibrate::compensate::{
-    CompensatorSpec, GpSettings, IwoSettings, LmTrainSettings, MlpSettings, MlpSpec, RbfSettings,
-    TlboTrainSettings, Trainer,
+    GpSettings, IwoSettings, LmTrainSettings, MlpSpec, RbfSettings, TlboTrainSettings,
 };
 use crate::optim::TlboSettings;
 use serde::{Deserialize, Serialize};
@@ -67,15 +65,15 @@ pub struct CompensatorOptions {
     /// The joint-map and compensator methods `auto` considers.
     pub auto_candidates: Vec<Method>,
     pub rbf: RbfSettings,
-    /// Network of SKCM-NN ([`Network::LmMlp`]).
+    /// Network of SKCM-NN (`Network::LmMlp`).
     pub nn: MlpSpec,
     pub lm: LmTrainSettings,
-    /// Network of SKCM-IWONN and SKCM-TLBONN ([`Network::IwoMlp`],
-    /// [`Network::TlboMlp`]; `MlpSpec::POPULATION`).
+    /// Network of SKCM-IWONN and SKCM-TLBONN (`Network::IwoMlp`,
+    /// `Network::TlboMlp`; `MlpSpec::POPULATION`).
     pub small: MlpSpec,
     pub iwo: IwoSettings,
     pub tlbo: TlboTrainSettings,
-    /// The Gaussian-process compensator ([`Network::Gp`]).
+    /// The Gaussian-process compensator (`Network::Gp`).
     pub gp: GpSettings,
     /// The networks (MLP, RBF) train and cross-validate on at most this many
     /// poses of the pool, a seeded subsample beyond it: their training grows
@@ -118,35 +116,6 @@ impl CompensatorOptions {
         } else {
             folds + self.blocked_folds + 1
         }
-    }
-
-    /// The network and trainer of a compensator: its family's settings
-    /// ([`CompensatorSpec`], one variant per family of the compensator
-    /// table) from these options.
-    pub fn spec(&self, network: Network) -> CompensatorSpec {
-        match network {
-            Network::Rbf => CompensatorSpec::Rbf(self.rbf.clone()),
-            Network::LmMlp => CompensatorSpec::Mlp(MlpSettings {
-                spec: self.nn,
-                trainer: Trainer::Lm(self.lm.clone()),
-            }),
-            Network::IwoMlp => CompensatorSpec::Mlp(MlpSettings {
-                spec: self.small,
-                trainer: Trainer::Iwo(self.iwo.clone()),
-            }),
-            Network::TlboMlp => CompensatorSpec::Mlp(MlpSettings {
-                spec: self.small,
-                trainer: Trainer::Tlbo(self.tlbo.clone()),
-            }),
-            Network::Gp => CompensatorSpec::Gp(self.gp.clone()),
-        }
-    }
-
-    /// Epochs / iterations / generations a training run of `network` may take
-    /// at most (for progress percentages; its family's
-    /// [`CompensatorSpec::max_epochs`]).
-    pub fn max_epochs(&self, network: Network) -> usize {
-        self.spec(network).max_epochs()
     }
 }
 

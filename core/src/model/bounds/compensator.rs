@@ -18,7 +18,7 @@ use crate::calibrate::compensate::support::MAX_POINTS;
 use crate::calibrate::compensate::{
     Gp, Mlp, Normalisation, Rbf, StoredCompensator, StoredOrientation, Support,
 };
-use crate::model::description::ModelError;
+use crate::model::error::ModelError;
 
 /// Most hidden units of an MLP (the largest trained has 40).
 pub const MAX_MLP_HIDDEN: usize = 1000;

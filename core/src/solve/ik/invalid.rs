@@ -3,7 +3,7 @@
 //! convention, the thesis's joint count, or the line and column of a targets
 //! file. Serialised as its message, as the per-target reason is shown.
 
-use super::targets_csv::RowError;
+use crate::measure::csv_text::short_text;
 use crate::model::orientation::OrientationError;
 use serde::{Serialize, Serializer};
 
@@ -32,6 +32,28 @@ pub enum TargetError {
     /// A row of a targets file.
     #[error(transparent)]
     Row(#[from] RowError),
+}
+
+/// Why one row of a targets file is not a target (the row fails alone).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RowError {
+    #[error("line {line}: {got} fields, the header has {expected}")]
+    FieldCount {
+        line: usize,
+        got: usize,
+        expected: usize,
+    },
+    #[error(
+        "line {line}: column `{column}`: `{}` is not a number",
+        short_text(value)
+    )]
+    NotNumber {
+        line: usize,
+        column: String,
+        value: String,
+    },
+    #[error("line {line}: some orientation fields are empty")]
+    PartialOrientation { line: usize },
 }
 
 impl Serialize for TargetError {

@@ -24,12 +24,10 @@ pub mod tool;
 
 pub use analytic::{AnalyticError, AnalyticIk, AnalyticSolution, Structure};
 pub use config::{BranchError, Configuration, Elbow, Shoulder, Wrist};
-pub use invalid::TargetError;
+pub use invalid::{RowError, TargetError};
 pub use solver::{
     FailureReason, Goal, IkSettings, IkSolution, IkSolver, Refined, SolveOptions, UnknownFrame,
 };
 pub use targets::{FalseTarget, JointJump, TargetFrame, TargetInput, TargetResult};
-pub use targets_csv::{
-    parse_targets_csv, results_csv, RowError, TargetRow, TargetsCsv, TargetsCsvError,
-};
+pub use targets_csv::{parse_targets_csv, results_csv, TargetRow, TargetsCsv, TargetsCsvError};
 pub use tool::TcpTool;

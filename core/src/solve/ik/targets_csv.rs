@@ -36,9 +36,10 @@
 //! outside the trained range, `expected_error_mm` the compensator's expected
 //! position error when it gives one). Fields that do not apply are empty.
 
+use super::invalid::RowError;
 use super::solver::{IkSolution, IkSolver, SolveOptions};
 use super::targets::{TargetInput, TargetResult};
-use crate::measure::csv_text::{self, short_text, Dialect, TextError};
+use crate::measure::csv_text::{self, Dialect, TextError};
 use crate::model::orientation::{rotation_from, rotation_to, OrientationConvention};
 
 /// One row of a targets file: the target, or why the row is invalid.
@@ -48,28 +49,6 @@ pub struct TargetRow {
     /// 1-based line in the file.
     pub line: usize,
     pub target: Result<TargetInput, RowError>,
-}
-
-/// Why one row of a targets file is not a target (the row fails alone).
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum RowError {
-    #[error("line {line}: {got} fields, the header has {expected}")]
-    FieldCount {
-        line: usize,
-        got: usize,
-        expected: usize,
-    },
-    #[error(
-        "line {line}: column `{column}`: `{}` is not a number",
-        short_text(value)
-    )]
-    NotNumber {
-        line: usize,
-        column: String,
-        value: String,
-    },
-    #[error("line {line}: some orientation fields are empty")]
-    PartialOrientation { line: usize },
 }
 
 /// A parsed targets file.

@@ -31,10 +31,13 @@
 //! `AutoSummary::orientation_part` is `not_kept`) and the option scores its
 //! base's (or maps') orientation on the pool.
 
-use super::compensated::base_pool_errors;
+use super::cache::Cache;
+use super::compensated::{self, base_pool_errors};
+use super::context::{Context, MethodFit, Outcome};
+use super::maps::base_fit;
 use super::maps::run_maps;
 use super::orientation_part::settle_for_auto;
-use super::run::{AppliedCompensator, Cache, Context, MethodFit, Outcome};
+use super::trained::AppliedCompensator;
 use super::{Base, Compensated, Method, MethodError, MethodFailure, Run};
 use crate::calibrate::compensate::{choose, Choice, CvStats};
 use crate::calibrate::identify::least_squares::Fit;
@@ -184,7 +187,7 @@ fn base_option(
     let name = base.method().name();
     let (done, total) = (t.done, t.total);
     let progress = &mut *t.progress;
-    let mf = match cache.base_fit(ctx, base, &mut |it, rms| {
+    let mf = match base_fit(ctx, cache, base, &mut |it, rms| {
         progress(done / total, it, Some(rms))
     }) {
         Ok(mf) => mf,
@@ -520,8 +523,8 @@ fn cross_validate_and_choose(
     let mut cvs: Vec<(String, CvStats)> = Vec::new();
     let mut trained: Vec<AppliedCompensator> = Vec::new();
     for (i, (m, c)) in methods.iter().enumerate() {
-        let max = o.max_epochs(c.network) as f64;
-        let r = cache.trained(ctx, *m, c.network, fit, folds, &mut |stage, e, l| {
+        let max = c.network.max_epochs(o) as f64;
+        let r = compensated::trained(ctx, cache, *m, c.network, fit, folds, &mut |stage, e, l| {
             let f = (stage as f64 + (e as f64 / max).min(1.0)) / stages;
             progress(i as f64 + f, e, Some(l))
         });

@@ -27,17 +27,18 @@
 //! `max_network_poses` from `ChaCha8Rng(seed + 1000)`
 //! (`CompensatorOptions::seed`): a calibration is reproducible bit for bit.
 
+use super::cache::Cache;
+use super::context::{Context, Outcome};
+use super::maps::base_fit;
 use super::orientation_part::{note, train_orientation};
-use super::run::{AppliedCompensator, Cache, Context, Outcome};
-use super::{Compensated, Method, MethodError, MethodFailure, Network};
-use crate::calibrate::compensate::{
-    cross_validate, train, Compensator, CvStats, Sample, StoredCompensator, StoredOrientation,
-    Support, TrainError, TrainReport,
-};
+use super::trained::{support_of, AppliedCompensator, Trained};
+use super::{Compensated, Method, MethodError, MethodFailure};
+use crate::calibrate::compensate::{cross_validate, train, Compensator, Sample, TrainError};
 use crate::calibrate::identify::least_squares::Fit;
+use crate::calibrate::identify::network::Network;
 use crate::calibrate::identify::report::{
-    predict_compensated, CompensatorSummary, MethodReport, MethodWarning, OrientationPart,
-    SetErrors, UncertaintyCheck, WarningKind,
+    predict_compensated, CompensatorSummary, MethodReport, MethodWarning, SetErrors,
+    UncertaintyCheck, WarningKind,
 };
 use crate::measure::Measurement;
 use crate::model::kinematics::{chain, gravity_torques_of};
@@ -46,20 +47,6 @@ use crate::model::RobotModel;
 use nalgebra::Matrix3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-
-/// A trained compensator with its training report and cross-validation.
-#[derive(Clone)]
-pub(crate) struct Trained {
-    pub stored: StoredCompensator,
-    /// Its orientation part, where the pool measured orientations.
-    pub orientation: Option<StoredOrientation>,
-    /// Why it has an orientation part or not, and its cross-validation.
-    pub orientation_part: OrientationPart,
-    /// Where it was trained: its correction fades to zero beyond it.
-    pub support: Support,
-    pub report: TrainReport,
-    pub cv: Option<CvStats>,
-}
 
 /// Training samples of `data` on top of the fitted base (module docs).
 pub(crate) fn samples(
@@ -123,7 +110,7 @@ pub(crate) fn train_network(
     folds: usize,
     progress: &mut dyn FnMut(usize, usize, f64) -> bool,
 ) -> Result<Trained, MethodError> {
-    let spec = ctx.opts.compensator.spec(network);
+    let spec = network.spec(&ctx.opts.compensator);
     let (pool, _) = ctx.pool();
     let mut data = samples(&base.model, &base.session_frames, pool)?;
     let mut turns = rotations(&base.model, &base.session_frames, pool);
@@ -180,14 +167,29 @@ pub(crate) fn train_network(
     })
 }
 
-/// The support of training samples, with the joint maps' fade width.
-pub(crate) fn support_of(samples: &[Sample]) -> Support {
-    let qs: Vec<&[f64]> = samples.iter().map(|s| s.q.as_slice()).collect();
-    Support::of(&qs, SUPPORT_FADE_RAD)
+/// `method`'s compensator `network` on the fit `base` and the training
+/// pool, with `folds`-fold cross-validation, trained on first use (the
+/// cache keeps it, or its failure, for the other methods of the run).
+pub(crate) fn trained(
+    ctx: &Context,
+    cache: &mut Cache,
+    method: Method,
+    network: Network,
+    base: &Fit,
+    folds: usize,
+    progress: &mut dyn FnMut(usize, usize, f64) -> bool,
+) -> Result<Trained, MethodError> {
+    if let Some(t) = cache.trained.get(&(method, folds)) {
+        return t.clone().map_err(MethodError::Failed);
+    }
+    let r = match train_network(network, base, ctx, folds, progress) {
+        Err(MethodError::Cancelled) => return Err(MethodError::Cancelled),
+        Err(MethodError::Failed(f)) => Err(f),
+        Ok(t) => Ok(t),
+    };
+    cache.trained.insert((method, folds), r.clone());
+    r.map_err(MethodError::Failed)
 }
-
-/// Width of a compensator's fade beyond its trained joint ranges [rad] (5°).
-pub(crate) const SUPPORT_FADE_RAD: f64 = 5.0 * std::f64::consts::PI / 180.0;
 
 /// A compensator method: its base (from the cache), then its compensator.
 /// `progress(fraction, iteration, loss)` with `fraction` in [0, 1].
@@ -198,20 +200,22 @@ pub(crate) fn run_compensated(
     c: Compensated,
     progress: &mut dyn FnMut(f64, usize, Option<f64>) -> bool,
 ) -> Result<Outcome, MethodError> {
-    let mf = cache
-        .base_fit(ctx, c.base, &mut |it, rms| progress(0.0, it, Some(rms)))
-        .map_err(|e| match e {
-            MethodError::Failed(cause) => MethodError::Failed(MethodFailure::BaseFailed {
-                base: c.base.method(),
-                cause: Box::new(cause),
-            }),
-            cancelled => cancelled,
-        })?;
+    let mf = base_fit(ctx, cache, c.base, &mut |it, rms| {
+        progress(0.0, it, Some(rms))
+    })
+    .map_err(|e| match e {
+        MethodError::Failed(cause) => MethodError::Failed(MethodFailure::BaseFailed {
+            base: c.base.method(),
+            cause: Box::new(cause),
+        }),
+        cancelled => cancelled,
+    })?;
     let folds = ctx.opts.compensator.cv_folds;
-    let max = ctx.opts.compensator.max_epochs(c.network) as f64;
+    let max = c.network.max_epochs(&ctx.opts.compensator) as f64;
     let stages = ctx.opts.compensator.cv_stages(folds) as f64;
-    let t = cache.trained(
+    let t = trained(
         ctx,
+        cache,
         method,
         c.network,
         &mf.fit,

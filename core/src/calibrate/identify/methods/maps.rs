@@ -9,13 +9,34 @@
 //! Randomness: the folds draw from `ChaCha8Rng(seed + 101)`
 //! (`CompensatorOptions::seed`).
 
-use super::run::{Cache, Context, MethodFit, Outcome};
+use super::cache::Cache;
+use super::context::{Context, MethodFit, Outcome};
 use super::{Base, MethodError, MethodFailure};
 use crate::calibrate::identify::joint_maps::fit_joint_maps;
 use crate::calibrate::identify::least_squares::fit;
 use crate::measure::Measurement;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+
+/// The fit of any base: a model-based one from the cache, a joint-map one
+/// (`km-maps`, `skcm-maps`) by [`run_maps`] on its model-based base.
+pub(crate) fn base_fit(
+    ctx: &Context,
+    cache: &mut Cache,
+    base: Base,
+    progress: &mut dyn FnMut(usize, f64) -> bool,
+) -> Result<MethodFit, MethodError> {
+    let inner = match base {
+        Base::Km => return cache.km_fit(ctx, progress),
+        Base::Skcm => return cache.skcm_fit(ctx, progress),
+        Base::KmMaps => Base::Km,
+        Base::SkcmMaps => Base::Skcm,
+    };
+    run_maps(ctx, cache, inner, &mut |_, it, l| {
+        progress(it, l.unwrap_or(f64::NAN))
+    })
+    .map(|o| o.fit)
+}
 
 /// The joint-map method on `base` (module docs), computed once per run.
 pub(crate) fn run_maps(
@@ -45,7 +66,9 @@ fn fit_maps(
     let settings = &ctx.opts.joint_maps;
     let rounds = settings.rounds.max(1);
     let stages = (2 * rounds + 1) as f64;
-    let mut mf = cache.base_fit(ctx, base, &mut |it, rms| progress(0.0, it, Some(rms)))?;
+    let mut mf = base_fit(ctx, cache, base, &mut |it, rms| {
+        progress(0.0, it, Some(rms))
+    })?;
     let sessions = mf.fit.session_frames.len().max(1);
     let data: Vec<Measurement> = ctx
         .ident

@@ -7,21 +7,30 @@
 //!
 //! The methods themselves: `model_based` (KM §2.2, SKCM §2.3, SKCM-C by TLBO
 //! ch. 7, SKCM-payload), `compensated` (a learned compensator on a base,
-//! ch. 3–6), `auto`; `run` dispatches one method and shares fits between the
-//! methods of a calibration; `report` turns a fit into its report.
+//! ch. 3–6), `maps` (joint maps), `auto`; `run` dispatches one method, `cache`
+//! shares fits and compensators between the methods of a calibration,
+//! `context` holds what they all read and `trained` a trained compensator;
+//! `report` turns a fit into its report.
 
 mod auto;
+mod cache;
 mod compensated;
+mod context;
 mod failure;
 mod maps;
 mod model_based;
 mod orientation_part;
 mod report;
 mod run;
+mod trained;
 
 pub(crate) use failure::MethodError;
 pub use failure::MethodFailure;
-pub(crate) use run::{run, Cache, Context, MethodProgress};
+
+use super::network::Network;
+pub(crate) use cache::Cache;
+pub(crate) use context::{Context, MethodProgress};
+pub(crate) use run::run;
 
 use serde::{Deserialize, Serialize};
 use std::borrow::Borrow;
@@ -316,21 +325,6 @@ impl Base {
             Base::SkcmMaps => Method::SkcmMaps,
         }
     }
-}
-
-/// A compensator network and its trainer (`CompensatorOptions::spec`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Network {
-    /// RBF on the gravity torques (ch. 3).
-    Rbf,
-    /// MLP trained by LM backpropagation (ch. 4).
-    LmMlp,
-    /// The small MLP trained by invasive weed optimisation (ch. 5).
-    IwoMlp,
-    /// The small MLP trained by TLBO (ch. 6).
-    TlboMlp,
-    /// The sparse Gaussian process on the joints (`compensate::gp`).
-    Gp,
 }
 
 /// Which methods a group holds.

@@ -25,7 +25,7 @@
 //!   candidate it is then kept only when the poses make it identifiable, and a
 //!   total mass below zero on any pose is a warning.
 
-use super::run::{Context, MethodFit};
+use super::context::{Context, MethodFit};
 use super::{MethodError, MethodFailure};
 use crate::calibrate::identify::checks::{payload_problem, stacked_factor};
 use crate::calibrate::identify::identifiability::{self, DroppedParam};

@@ -29,8 +29,7 @@
 //! unseen. The position part's inputs are seen through the measured point's
 //! position by construction (its outputs are that position's residual).
 
-use super::compensated::{support_of, Trained};
-use super::run::AppliedCompensator;
+use super::trained::{support_of, AppliedCompensator, Trained};
 use super::{Base, MethodError};
 use crate::calibrate::compensate::{
     cross_validate, train, CompensatorSpec, OrientationSamples, Sample, StoredOrientation,

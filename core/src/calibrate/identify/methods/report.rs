@@ -5,7 +5,7 @@
 //! model must load back from its JSON description.
 
 use super::compensated::compensate_report;
-use super::run::{Context, MethodFit, Outcome};
+use super::context::{Context, MethodFit, Outcome};
 use super::{Method, MethodFailure};
 use crate::calibrate::identify::least_squares::Fit;
 use crate::calibrate::identify::report::{
