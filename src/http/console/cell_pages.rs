@@ -2,6 +2,7 @@
 //! (list, add, delete) and program filtering (drop program files in, see the
 //! per-target report, download the filtered files).
 
+use super::fields::model_select;
 use crate::service::cell::{CellItemRow, ItemFrame};
 use crate::service::versions::VersionRow;
 use maud::{html, Markup};
@@ -83,15 +84,7 @@ pub fn filter_section(id: i64, versions: &[VersionRow]) -> Markup {
             p.note { "KUKA KRL (.src with its .dat), ABB RAPID (.mod), Fanuc (.ls) or URScript (.script): every Cartesian target becomes its false target; everything else stays as it is." }
             form #filter data-action="filter" data-robot=(id) {
                 label.wide { "Program files " input type="file" name="files" multiple accept=".src,.dat,.mod,.modx,.prg,.sys,.ls,.script,.urscript"; }
-                label { "Model "
-                    select name="version" {
-                        option value="active" { "active version" }
-                        @for ver in versions.iter().rev() {
-                            option value=(ver.version) { "v" (ver.version) " " (ver.method) }
-                        }
-                        option value="nominal" { "nominal model" }
-                    }
-                }
+                (model_select(versions))
                 label { "Language "
                     select name="language" {
                         option value="" { "from the file names" }

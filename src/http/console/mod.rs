@@ -19,6 +19,7 @@
 
 mod cell_pages;
 mod check_pages;
+mod fields;
 mod pages;
 
 use super::{route, ApiError, ApiPath, AppState, Route};

@@ -1,6 +1,7 @@
 //! The console's pages as maud templates (every interpolated value is
 //! HTML-escaped by maud).
 
+use super::fields::model_select;
 use crate::calibrate::identify::Method;
 use crate::http::calibrations::DEFAULT_METHODS;
 use crate::measure::convention::MeasuredOrientation;
@@ -398,15 +399,7 @@ fn solve_section(id: i64, versions: &[VersionRow]) -> Markup {
             form #solve data-action="solve" data-robot=(id) {
                 label.wide { "Targets CSV " input type="file" name="file" accept=".csv,text/csv"; }
                 label.wide { "or paste it " textarea name="csv" rows="3" placeholder="id,x,y,z,a,b,c" {} }
-                label { "Model "
-                    select name="version" {
-                        option value="active" { "active version" }
-                        @for ver in versions.iter().rev() {
-                            option value=(ver.version) { "v" (ver.version) " " (ver.method) }
-                        }
-                        option value="nominal" { "nominal model" }
-                    }
-                }
+                (model_select(versions))
                 label { "Frame "
                     select name="frame" { option value="cell" { "cell (tracker)" } option value="base" { "robot base" } }
                 }

@@ -186,13 +186,6 @@ fn position_columns(
     let any_real = (0..3)
         .flat_map(|i| [Col::Target(i), Col::Dif(i)])
         .find_map(find);
-    let three = |col: fn(usize) -> Col| -> Result<[usize; 3], CsvError> {
-        let mut r = [0; 3];
-        for (i, slot) in r.iter_mut().enumerate() {
-            *slot = find(col(i)).ok_or_else(|| missing(line, col(i)))?;
-        }
-        Ok(r)
-    };
     match (any_pos, any_real) {
         (Some(a), Some(b)) => Err(CsvError::ConflictingColumns {
             line,
@@ -209,8 +202,21 @@ fn position_columns(
             }
             Ok(PositionCols::TargetPlusDif(t, d))
         }
-        _ => Ok(PositionCols::Measured(three(Col::Pos)?)),
+        _ => Ok(PositionCols::Measured(three(line, find, Col::Pos)?)),
     }
+}
+
+/// The three columns `col(0..3)`, or the first missing one named (line `line`).
+fn three(
+    line: usize,
+    find: &dyn Fn(Col) -> Option<usize>,
+    col: fn(usize) -> Col,
+) -> Result<[usize; 3], CsvError> {
+    let mut r = [0; 3];
+    for (i, slot) in r.iter_mut().enumerate() {
+        *slot = find(col(i)).ok_or_else(|| missing(line, col(i)))?;
+    }
+    Ok(r)
 }
 
 /// The standard-deviation triples (position, orientation): all three
@@ -226,11 +232,7 @@ fn std_columns(
         if (0..3).all(|i| find(col(i)).is_none()) {
             return Ok(None);
         }
-        let mut r = [0; 3];
-        for (i, slot) in r.iter_mut().enumerate() {
-            *slot = find(col(i)).ok_or_else(|| missing(line, col(i)))?;
-        }
-        Ok(Some(r))
+        three(line, find, col).map(Some)
     };
     let std_pos = triple(Col::StdPos)?;
     let std_rot = triple(Col::StdRot)?;
