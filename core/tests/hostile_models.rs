@@ -29,6 +29,11 @@ use robocal_core::solve::ik::{IkSettings, IkSolver, SolveOptions};
 use robocal_core::solve::program::{filter, Language, ProgramFile};
 use std::time::{Duration, Instant};
 
+/// What only a hang takes: the work these tests time takes well under a
+/// second on any machine that builds the project, so only a loop that never
+/// ends reaches this, however slow or loaded the machine.
+const HANG: Duration = Duration::from_secs(120);
+
 /// `n` random configurations of `model`, without the floor check: an
 /// accepted model may hang its whole arm below its base plane (`d1 = −100 m`),
 /// which is odd but not hostile. `None` when no configuration closes.
@@ -116,7 +121,9 @@ fn a_huge_tool_ends_the_calibration_with_a_reason() {
         &small_options(vec![Method::Km]),
         &|_| true,
     );
-    assert!(t0.elapsed() < Duration::from_secs(10), "{:?}", t0.elapsed());
+    // It returns, with a reason: only a hang (the SVD iterating for ever)
+    // takes a minute.
+    assert!(t0.elapsed() < HANG, "{:?}", t0.elapsed());
     let e = r.expect_err("a 1e308 m tool cannot calibrate");
     assert!(
         !matches!(e, CalibrationError::Cancelled),
@@ -138,7 +145,7 @@ fn a_huge_compliance_fails_without_a_panic() {
     let opts = small_options(vec![Method::Km, Method::Skcm]);
     let t0 = Instant::now();
     let r = calibrate(&model, &ident, &[], &opts, &|_| true);
-    assert!(t0.elapsed() < Duration::from_secs(10), "{:?}", t0.elapsed());
+    assert!(t0.elapsed() < HANG, "{:?}", t0.elapsed());
     let e = r.expect_err("a 1e308 compliance cannot calibrate");
     assert!(e.to_string().contains("not finite"), "{e}");
 }
@@ -301,7 +308,7 @@ proptest! {
         if let Some(ident) = measured(&model, 25, seed) {
             let _ = calibrate(&model, &ident, &[], &small_options(vec![Method::Km, Method::Skcm]), &|_| true);
         }
-        prop_assert!(t0.elapsed() < Duration::from_secs(20), "{edits:?}: {:?}", t0.elapsed());
+        prop_assert!(t0.elapsed() < HANG, "{edits:?}: {:?}", t0.elapsed());
     }
 }
 

@@ -196,6 +196,7 @@ async fn serve(addr: SocketAddr, args: ServeArgs, keys: Vec<ApiKey>) -> anyhow::
         solve_workers: args.solve_workers.max(1),
         job_lease: std::time::Duration::from_secs(args.job_lease.max(1)),
         limits: args.limits()?,
+        gate: test_gate(),
         ..ServiceConfig::default()
     };
     let backend = db.backend();
@@ -234,6 +235,19 @@ async fn serve(addr: SocketAddr, args: ServeArgs, keys: Vec<ApiKey>) -> anyhow::
         .context("server error")?;
     tracing::info!("stopped");
     Ok(())
+}
+
+/// The test gate of tests that drive this binary (`ROBOCAL_TEST_GATE_FILE`:
+/// work waits while that file exists; see `service::WorkGate`). Unset in
+/// production; a start with it set says so at WARN.
+fn test_gate() -> Option<std::sync::Arc<crate::service::WorkGate>> {
+    let path = std::env::var_os("ROBOCAL_TEST_GATE_FILE").filter(|p| !p.is_empty())?;
+    let path = std::path::PathBuf::from(path);
+    tracing::warn!(
+        file = %path.display(),
+        "ROBOCAL_TEST_GATE_FILE is set: calibrations and large solves wait while this file exists (a test hook; unset it in production)"
+    );
+    Some(std::sync::Arc::new(crate::service::WorkGate::file(path)))
 }
 
 /// The keys for the start-up log: how many of each role, never the keys.

@@ -9,8 +9,10 @@
 //! any, is dropped.
 
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 use tokio::task::{JoinError, JoinHandle};
+// Tokio's clock, so that tests run the wait on a paused clock.
+use tokio::time::Instant;
 
 /// How long a stopped job's computation may take to reach its next check.
 pub(super) const GRACE: Duration = Duration::from_millis(500);
@@ -58,19 +60,18 @@ mod tests {
     use super::*;
     use std::sync::Arc;
 
-    /// A computation that never checks its flag is abandoned within the grace
-    /// after a cancel; one that returns is waited for.
-    #[tokio::test]
+    /// A computation that never returns: the task is pending until aborted.
+    fn stuck() -> JoinHandle<()> {
+        tokio::spawn(std::future::pending::<()>())
+    }
+
+    /// A computation that never checks its flag is abandoned one grace after
+    /// a cancel (to the poll); one that returns is waited for. The clock is
+    /// paused: the figures are exact whatever the machine's speed.
+    #[tokio::test(start_paused = true)]
     async fn a_computation_that_ignores_the_cancel_is_abandoned_in_time() {
         let cancel = Arc::new(AtomicBool::new(false));
         let over = AtomicBool::new(false);
-        let release = Arc::new(AtomicBool::new(false));
-        let r2 = release.clone();
-        let task = tokio::task::spawn_blocking(move || {
-            while !r2.load(Ordering::SeqCst) {
-                std::thread::sleep(Duration::from_millis(5));
-            }
-        });
         let c2 = cancel.clone();
         tokio::spawn(async move {
             tokio::time::sleep(Duration::from_millis(200)).await;
@@ -78,40 +79,35 @@ mod tests {
         });
         let t0 = Instant::now();
         let far = t0 + Duration::from_secs(3600);
-        let waited = wait(task, &cancel, far, &over).await;
+        let waited = wait(stuck(), &cancel, far, &over).await;
         let took = t0.elapsed();
-        release.store(true, Ordering::SeqCst);
         assert!(matches!(waited, Waited::Abandoned));
-        assert!(took >= Duration::from_millis(700), "{took:?}");
-        assert!(took < Duration::from_millis(1000), "{took:?}");
+        assert!(took >= Duration::from_millis(200) + GRACE, "{took:?}");
+        assert!(
+            took <= Duration::from_millis(200) + GRACE + 2 * POLL,
+            "{took:?}"
+        );
         assert!(!over.load(Ordering::SeqCst));
 
-        let task = tokio::task::spawn_blocking(|| 7);
+        let task = tokio::spawn(async { 7 });
         let waited = wait(task, &cancel, far, &over).await;
         assert!(matches!(waited, Waited::Done(Ok(7))));
     }
 
     /// Past the deadline the wait sets `over` and gives up after the grace.
-    #[tokio::test]
+    #[tokio::test(start_paused = true)]
     async fn the_deadline_stops_the_wait_and_says_so() {
         let cancel = AtomicBool::new(false);
         let over = AtomicBool::new(false);
-        let release = Arc::new(AtomicBool::new(false));
-        let r2 = release.clone();
-        let task = tokio::task::spawn_blocking(move || {
-            while !r2.load(Ordering::SeqCst) {
-                std::thread::sleep(Duration::from_millis(5));
-            }
-        });
         let t0 = Instant::now();
-        let waited = wait(task, &cancel, t0 + Duration::from_millis(100), &over).await;
-        release.store(true, Ordering::SeqCst);
+        let waited = wait(stuck(), &cancel, t0 + Duration::from_millis(100), &over).await;
         assert!(matches!(waited, Waited::Abandoned));
         assert!(over.load(Ordering::SeqCst));
+        let took = t0.elapsed();
+        assert!(took >= Duration::from_millis(100) + GRACE, "{took:?}");
         assert!(
-            t0.elapsed() < Duration::from_millis(900),
-            "{:?}",
-            t0.elapsed()
+            took <= Duration::from_millis(100) + GRACE + 2 * POLL,
+            "{took:?}"
         );
     }
 }

@@ -15,6 +15,7 @@ pub mod cell;
 pub mod cell_fit;
 mod changes;
 pub mod checks;
+pub(crate) mod gate;
 pub mod iso9283;
 mod job_watch;
 pub mod jobs;
@@ -32,6 +33,7 @@ mod state;
 pub mod versions;
 mod waiting;
 
+pub use gate::WorkGate;
 pub use state::{AppState, RobotContext, ServiceConfig};
 
 pub use crate::db::StoreError;

@@ -6,7 +6,6 @@
 //! solve batches.
 
 use super::solve::{chosen_model, ModelChoice};
-use super::waiting::Waiting;
 use super::{AppState, ServiceError};
 use crate::solve::ik::IkSettings;
 use crate::solve::program::{
@@ -56,7 +55,7 @@ pub async fn filter_program(
     let max_targets = state.limits().targets_per_request;
     // Dropped with this future when the client goes away: the filter stops
     // before its next target.
-    let (_waiting, flag) = Waiting::new();
+    let (_waiting, flag) = state.waiting();
     let task_state = state.clone();
     let output = tokio::task::spawn_blocking(move || {
         let _permit = permit;

@@ -18,7 +18,7 @@
 //! seeds and commands in the controller convention in degrees.
 
 use super::limits::SMALL_SOLVE_MAX;
-use super::waiting::{Waiting, WaitingFlag};
+use super::waiting::WaitingFlag;
 use super::{AppState, ServiceError};
 use crate::calibrate::compensate::{CalibratedModelFile, CompensatedModel};
 use crate::db::{CellKind, ItemFrame, NewCellItem};
@@ -363,7 +363,7 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
             .await
             .map_err(|_| ServiceError::Unavailable("the service is shutting down".into()))?;
         // Dropped with this future when the client goes away.
-        let (_waiting, flag) = Waiting::new();
+        let (_waiting, flag) = state.waiting();
         let task_state = state.clone();
         let cell_solver = cell_solver.clone();
         tokio::task::spawn_blocking(move || {

@@ -2,7 +2,9 @@
 //! solve queues, cancellation flags and the caches of robots and prepared
 //! solvers.
 
+use super::gate::{At, WorkGate};
 use super::limits::{Admission, Limits, Ticket, SMALL_SOLVE_MAX};
+use super::waiting::{Waiting, WaitingFlag};
 use super::ServiceError;
 use crate::db::Db;
 use crate::solve::cell::CellSolver;
@@ -31,6 +33,9 @@ pub struct ServiceConfig {
     pub job_lease: Duration,
     /// Sizes, queues and budgets.
     pub limits: Limits,
+    /// Where blocking work waits while a test holds it (`None` in
+    /// production; see [`WorkGate`]).
+    pub gate: Option<Arc<WorkGate>>,
 }
 
 /// Keys are redacted: a config printed by mistake leaks nothing.
@@ -47,6 +52,7 @@ impl std::fmt::Debug for ServiceConfig {
             .field("progress_interval", &self.progress_interval)
             .field("job_lease", &self.job_lease)
             .field("limits", &self.limits)
+            .field("gate", &self.gate)
             .finish()
     }
 }
@@ -61,6 +67,7 @@ impl Default for ServiceConfig {
             progress_interval: Duration::from_millis(250),
             job_lease: Duration::from_secs(15),
             limits: Limits::default(),
+            gate: None,
         }
     }
 }
@@ -232,6 +239,20 @@ impl AppState {
 
     pub(crate) fn note_abandoned(&self) {
         self.inner.abandoned.fetch_add(1, Ordering::AcqRel);
+    }
+
+    /// A guard for the request and a flag for its blocking task: the task
+    /// stops when the request is dropped, and waits at the test gate, if any.
+    pub(crate) fn waiting(&self) -> (Waiting, WaitingFlag) {
+        Waiting::new(self.inner.config.gate.clone())
+    }
+
+    /// Waits at the test gate while it is closed, unless `stop` (no gate in
+    /// production: returns at once).
+    pub(crate) fn pass_gate(&self, at: At<'_>, stop: &dyn Fn() -> bool) {
+        if let Some(g) = &self.inner.config.gate {
+            g.pass(at, stop);
+        }
     }
 
     pub(crate) fn solve_slots(&self) -> Arc<Semaphore> {

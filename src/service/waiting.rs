@@ -2,8 +2,10 @@
 //! function holds a [`Waiting`] guard while the blocking task it started runs;
 //! when the client disconnects, the server drops the request's future and the
 //! guard with it, and the task, which checks its [`WaitingFlag`] between
-//! targets, stops at the next one and frees its solve worker.
+//! targets, stops at the next one and frees its solve worker. Every check
+//! passes the test gate ([`super::gate`]) first, where a test holds the work.
 
+use super::gate::{At, WorkGate};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
@@ -12,12 +14,21 @@ pub(crate) struct Waiting(Arc<AtomicBool>);
 
 /// Held by the task: whether the request still waits for its answer.
 #[derive(Clone)]
-pub(crate) struct WaitingFlag(Arc<AtomicBool>);
+pub(crate) struct WaitingFlag {
+    waiting: Arc<AtomicBool>,
+    gate: Option<Arc<WorkGate>>,
+}
 
 impl Waiting {
-    pub(crate) fn new() -> (Waiting, WaitingFlag) {
+    pub(crate) fn new(gate: Option<Arc<WorkGate>>) -> (Waiting, WaitingFlag) {
         let flag = Arc::new(AtomicBool::new(true));
-        (Waiting(flag.clone()), WaitingFlag(flag))
+        (
+            Waiting(flag.clone()),
+            WaitingFlag {
+                waiting: flag,
+                gate,
+            },
+        )
     }
 }
 
@@ -29,7 +40,10 @@ impl Drop for Waiting {
 
 impl WaitingFlag {
     pub(crate) fn still_waiting(&self) -> bool {
-        self.0.load(Ordering::Acquire)
+        if let Some(g) = &self.gate {
+            g.pass(At::SOLVE, &|| !self.waiting.load(Ordering::Acquire));
+        }
+        self.waiting.load(Ordering::Acquire)
     }
 }
 
@@ -39,7 +53,7 @@ mod tests {
 
     #[test]
     fn dropping_the_guard_stops_the_flag() {
-        let (guard, flag) = Waiting::new();
+        let (guard, flag) = Waiting::new(None);
         assert!(flag.still_waiting());
         drop(guard);
         assert!(!flag.still_waiting());

@@ -1,13 +1,17 @@
 //! Work whose client goes away (issue 35): a filter and a large solve batch
 //! stop and free their solve worker; a program over the target cap is
-//! refused before any solve.
+//! refused before any solve. The work is held at the service's test gate
+//! while its client leaves, so the race is decided by the test, not by how
+//! fast the machine solves.
 
 use crate::support::*;
 use axum::http::StatusCode;
 use robocal::http::ServiceConfig;
 use robocal::model::orientation::{rotation_to, OrientationConvention};
-use robocal::service::limits::Limits;
+use robocal::service::limits::{Limits, SMALL_SOLVE_MAX};
+use robocal::service::WorkGate;
 use serde_json::json;
+use std::sync::Arc;
 use std::time::Duration;
 
 const FILTER: &str = "/v1/robots/{id}/programs/filter";
@@ -42,20 +46,29 @@ fn program(n: usize) -> serde_json::Value {
     json!({ "version": "nominal", "language": "krl", "files": [{ "name": "long.src", "content": src }] })
 }
 
-/// Sends `request` and leaves it 300 ms after the service admitted it, as a
-/// client that gives up.
-async fn leave(t: &TestApp, request: impl std::future::Future<Output = Resp>) {
-    tokio::pin!(request);
-    let admitted_a_while = async {
-        while t.state.solves_in_flight() == 0 {
-            tokio::time::sleep(Duration::from_millis(5)).await;
+/// Sends `request`, waits until its work is held at the closed `gate` (it has
+/// started and checks whether its client still waits), then leaves, as a
+/// client that gives up, and lets the work go on.
+async fn leave(gate: &WorkGate, request: impl std::future::Future<Output = Resp>) {
+    // Boxed, so that dropping it drops the request (and its waiting guard).
+    let mut request = Box::pin(request);
+    gate.close();
+    let held = async {
+        // Only a hang (the work never reaching its first check) waits a minute.
+        for _ in 0..6000 {
+            if gate.held() > 0 {
+                return;
+            }
+            tokio::time::sleep(Duration::from_millis(10)).await;
         }
-        tokio::time::sleep(Duration::from_millis(300)).await;
+        panic!("the work never reached its first check");
     };
     tokio::select! {
         r = &mut request => panic!("answered {} before its client left: {}", r.status, r.text()),
-        _ = admitted_a_while => {}
+        _ = held => {}
     }
+    drop(request);
+    gate.open();
 }
 
 /// Waits (at most a minute) until no solve worker is taken.
@@ -74,38 +87,46 @@ async fn workers_free(t: &TestApp) {
 
 #[tokio::test]
 async fn work_whose_client_went_away_stops_and_frees_its_worker() {
+    let gate = Arc::new(WorkGate::closed());
+    let cap = 2 * SMALL_SOLVE_MAX;
     let t = setup_config(ServiceConfig {
         solve_workers: 1,
         limits: Limits {
-            targets_per_request: 60_000,
+            targets_per_request: cap,
             ..Limits::default()
         },
+        gate: Some(gate.clone()),
         ..ServiceConfig::default()
     })
     .await;
     let rid = t.create_robot("ys100").await.to_string();
     // Over the cap: refused, naming the count and the cap.
-    let r = t.post_json(FILTER, &[&rid], program(60_001)).await;
+    let r = t.post_json(FILTER, &[&rid], program(cap + 1)).await;
     assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY);
     let why = r.detail();
-    assert!(why.contains("60001") && why.contains("60000"), "{why}");
+    assert!(
+        why.contains(&(cap + 1).to_string()) && why.contains(&cap.to_string()),
+        "{why}"
+    );
     assert_eq!(t.state.abandoned_work(), 0);
+    assert_eq!(gate.arrived(), 0, "a refused program reached the solver");
 
-    // 60,000 targets take the debug build minutes; the client waits 300 ms.
-    leave(&t, t.post_json(FILTER, &[&rid], program(60_000))).await;
+    // The filter is held at its first check while its client leaves.
+    leave(&gate, t.post_json(FILTER, &[&rid], program(cap))).await;
     workers_free(&t).await;
     assert_eq!(t.state.abandoned_work(), 1);
 
-    // A JSON batch of 60,000 targets, likewise.
-    let targets: Vec<_> = (0..60_000)
+    // A JSON batch over the small-batch size (it takes a solve worker), likewise.
+    let targets: Vec<_> = (0..cap)
         .map(|i| json!({ "x": 1500.0, "y": (i % 200) as f64, "z": 1200.0 }))
         .collect();
     let body = json!({ "version": "nominal", "position_only": true, "targets": targets });
-    leave(&t, t.post_json(SOLVE, &[&rid], body)).await;
+    leave(&gate, t.post_json(SOLVE, &[&rid], body)).await;
     workers_free(&t).await;
     assert_eq!(t.state.abandoned_work(), 2);
+    assert_eq!(gate.arrived(), 2);
 
-    // The worker takes new work.
+    // The worker takes new work (the gate is open).
     let r = t.post_json(FILTER, &[&rid], program(3)).await;
     assert_eq!(r.status, StatusCode::OK, "{}", r.text());
     assert_eq!(r.json()["report"]["filtered"], 3, "{}", r.json()["report"]);

@@ -21,7 +21,19 @@ pub struct Server {
 impl Server {
     /// Starts `robocal serve` on `database_url` with `args` added; logs at info.
     pub fn start(database_url: &str, args: &[&str]) -> Server {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_robocal"))
+        Server::start_held(database_url, args, None)
+    }
+
+    /// [`Server::start`] whose calibrations and large solves wait while the
+    /// file `gate` exists (`ROBOCAL_TEST_GATE_FILE`): a test holds work there
+    /// instead of hoping it is still running.
+    pub fn start_held(database_url: &str, args: &[&str], gate: Option<&std::path::Path>) -> Server {
+        let mut command = Command::new(env!("CARGO_BIN_EXE_robocal"));
+        command.env_remove("ROBOCAL_TEST_GATE_FILE");
+        if let Some(g) = gate {
+            command.env("ROBOCAL_TEST_GATE_FILE", g);
+        }
+        let mut child = command
             .args(["serve", "--bind", "127.0.0.1:0"])
             .args(args)
             .env("DATABASE_URL", database_url)
@@ -56,6 +68,30 @@ impl Server {
             .parse()
             .unwrap();
         Server { child, addr, log }
+    }
+
+    /// Lines logged so far that contain `text`.
+    pub fn logged(&self, text: &str) -> usize {
+        self.log
+            .lock()
+            .unwrap()
+            .iter()
+            .filter(|l| l.contains(text))
+            .count()
+    }
+
+    /// Waits until the server logged `n` lines with `text` (only a hang
+    /// takes ten minutes).
+    pub fn wait_logged(&self, text: &str, n: usize) {
+        let start = std::time::Instant::now();
+        while self.logged(text) < n {
+            assert!(
+                start.elapsed() < Duration::from_secs(600),
+                "the server logged `{text}` {} of {n} times",
+                self.logged(text)
+            );
+            std::thread::sleep(Duration::from_millis(20));
+        }
     }
 
     pub fn kill9(mut self) {

@@ -12,6 +12,7 @@ use super::prepare::Job;
 use super::versions::{summary_of, versions_of};
 use crate::calibrate::identify::{calibrate_with_training, CalibrationError, Progress};
 use crate::db::{JobResult, JobStatus};
+use crate::service::gate::At;
 use crate::service::AppState;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -107,6 +108,7 @@ pub(super) async fn execute(state: AppState, job: Job, claim: Option<Claim>) {
     let deadline = std::time::Instant::now() + budget;
     let over_budget = Arc::new(AtomicBool::new(false));
     let over = over_budget.clone();
+    let gate_state = state.clone();
     let task = tokio::task::spawn_blocking(move || {
         let report = calibrate_with_training(
             &nominal,
@@ -116,6 +118,13 @@ pub(super) async fn execute(state: AppState, job: Job, claim: Option<Claim>) {
             &opts,
             &|p: &Progress| {
                 tx.send_replace(Some(p.clone()));
+                gate_state.pass_gate(
+                    At {
+                        phase: &p.phase,
+                        percent: p.percent,
+                    },
+                    &|| flag.load(Ordering::SeqCst),
+                );
                 if std::time::Instant::now() > deadline {
                     over.store(true, Ordering::SeqCst);
                     return false;
@@ -137,7 +146,13 @@ pub(super) async fn execute(state: AppState, job: Job, claim: Option<Claim>) {
             Ok((r, versions))
         })
     });
-    let outcome = match crate::service::job_watch::wait(task, &cancel, deadline, &over_budget).await
+    let outcome = match crate::service::job_watch::wait(
+        task,
+        &cancel,
+        tokio::time::Instant::from_std(deadline),
+        &over_budget,
+    )
+    .await
     {
         crate::service::job_watch::Waited::Done(r) => {
             let _ = writer.await;
