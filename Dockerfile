@@ -63,5 +63,7 @@ EXPOSE 8080
 # HEALTHCHECK is kept by Docker and by `podman build --format docker` (the OCI format drops it).
 HEALTHCHECK --interval=30s --timeout=5s --start-period=15s --retries=3 \
     CMD ["curl", "-fsS", "-o", "/dev/null", "--max-time", "4", "http://127.0.0.1:8080/healthz"]
+# It serves 0.0.0.0 inside the container, so without API keys it refuses to start (docs/docker.md): pass
+# ROBOCAL_API_KEYS_FILE=/run/secrets/robocal_api_keys with a secret made by `robocal keygen`, or ROBOCAL_API_KEYS.
 ENTRYPOINT ["robocal"]
 CMD ["serve", "--bind", "0.0.0.0:8080"]

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Builds the robocal container image from the top-level Dockerfile with podman, runs it, and checks that
-# /healthz answers on a loopback-published port; then removes the test container and volume.
+# run without API keys it refuses to start (it binds 0.0.0.0 in its container); run with a key from
+# `robocal keygen` passed as a secret file (ROBOCAL_API_KEYS_FILE), /healthz answers on a loopback-published
+# port, a write without the key is 401 and with it 201; then removes the test container and volume.
 #
 #   sudo scripts/docker-check.sh          # as root; nothing else to prepare
 #
@@ -218,8 +220,26 @@ run "${PODMAN[@]}" run "${ULIMITS[@]}" --rm --no-healthcheck --network none -v "
         touch /data/.write-test && rm /data/.write-test && echo "/data is writable"' ||
     die "the non-root user cannot write the /data volume"
 
-say "serving"
-run nosd "${PODMAN[@]}" run "${ULIMITS[@]}" -d --health-interval disable --name "$NAME" -p 127.0.0.1::8080 -v "$VOLUME:/data" "$IMAGE" >/dev/null
+say "refusing to serve without a key"
+# Run without keys, the image (bound to 0.0.0.0 in its container) must not serve writes: it refuses to start.
+if "${PODMAN[@]}" run "${ULIMITS[@]}" --rm --no-healthcheck --network none -v "$VOLUME:/data" "$IMAGE" \
+        >"$CACHE/nokey.log" 2>&1; then
+    cat "$CACHE/nokey.log" >&2
+    die "the image started without API keys"
+fi
+cat "$CACHE/nokey.log"
+grep -q 'ROBOCAL_API_KEYS' "$CACHE/nokey.log" || die "the refusal does not name ROBOCAL_API_KEYS"
+
+say "serving with a key"
+ENTRY=$("${PODMAN[@]}" run "${ULIMITS[@]}" --rm --no-healthcheck --network none "$IMAGE" keygen --role admin)
+KEY=${ENTRY%:*}
+[[ ${#KEY} -ge 40 && "$ENTRY" == *:admin ]] || die "robocal keygen printed '$ENTRY'"
+# The key as a secret file, as deploy/compose.yaml passes it.
+install -m 0644 /dev/null "$CACHE/api_keys"
+echo "$ENTRY" >"$CACHE/api_keys"
+run nosd "${PODMAN[@]}" run "${ULIMITS[@]}" -d --health-interval disable --name "$NAME" -p 127.0.0.1::8080 -v "$VOLUME:/data" \
+    -v "$CACHE/api_keys:/run/secrets/robocal_api_keys:ro" -e ROBOCAL_API_KEYS_FILE=/run/secrets/robocal_api_keys \
+    "$IMAGE" >/dev/null
 HOSTPORT=$("${PODMAN[@]}" port "$NAME" 8080/tcp | head -1)
 [[ "$HOSTPORT" == 127.0.0.1:* ]] || die "port 8080 not published on loopback (got '$HOSTPORT')"
 URL=http://$HOSTPORT/healthz
@@ -239,6 +259,15 @@ if [[ -z "$BODY" ]]; then
     "${PODMAN[@]}" logs "$NAME" >&2 || true
     die "/healthz did not answer within ${HEALTH_TIMEOUT}s; the container log is above"
 fi
+ROBOTS=http://$HOSTPORT/v1/robots
+code=$(curl -sS -o /dev/null -w '%{http_code}' --max-time 5 -X POST "$ROBOTS" \
+    -H 'Content-Type: application/json' -d '{"preset": "ur5"}')
+echo "a write without a key: $code"
+[[ "$code" == 401 ]] || die "a write without a key answered $code, not 401"
+code=$(curl -sS -o /dev/null -w '%{http_code}' --max-time 5 -X POST "$ROBOTS" -H "Authorization: Bearer $KEY" \
+    -H 'Content-Type: application/json' -d '{"preset": "ur5"}')
+echo "a write with the key: $code"
+[[ "$code" == 201 ]] || die "a write with the key answered $code, not 201"
 run curl -sS -i --max-time 5 "$URL"
 echo
 run nosd "${PODMAN[@]}" healthcheck run "$NAME" && echo "HEALTHCHECK: healthy" ||
@@ -248,4 +277,4 @@ run "${PODMAN[@]}" exec "$NAME" ls -ln /data
     echo "note: /data/robocal.db not created yet (the server may open the database lazily)"
 "${PODMAN[@]}" logs "$NAME" 2>&1 | tail -20
 
-say "OK: $IMAGE (${SIZE_MB} MB, built in ${BUILD_SECONDS}s) serves /healthz: $BODY"
+say "OK: $IMAGE (${SIZE_MB} MB, built in ${BUILD_SECONDS}s) refuses to serve without a key; with one, /healthz: $BODY, a write 401 without the key and 201 with it"

@@ -10,6 +10,7 @@ pub mod demo;
 pub mod export;
 pub mod filter;
 pub mod iso9283;
+pub mod keygen;
 pub mod model_files;
 pub mod orientation_arg;
 pub mod plan;
@@ -66,6 +67,8 @@ pub enum Command {
     WorkObject(tcp::WorkObjectArgs),
     /// Run the HTTP service.
     Serve(serve::ServeArgs),
+    /// Print a new random API key with its role (`KEY:ROLE`) for ROBOCAL_API_KEYS.
+    Keygen(keygen::KeygenArgs),
     /// Time robocal's side of the peer benchmark (KM, IK), as JSON.
     Bench(bench::BenchArgs),
 }
@@ -89,6 +92,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Tcp(a) => tcp::run_tcp(a),
         Command::WorkObject(a) => tcp::run_work_object(a),
         Command::Serve(a) => serve::run(a),
+        Command::Keygen(a) => keygen::run(a),
         Command::Bench(a) => bench::run(a),
     }
 }

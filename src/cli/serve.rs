@@ -8,8 +8,14 @@
 //!   PostgreSQL (docs/deployment.md), with `--db-pool N` / `ROBOCAL_DB_POOL`
 //!   connections per replica (default 10);
 //! - `ROBOCAL_API_KEYS`: comma-separated bearer keys, each `key` or
-//!   `key:role` with a role of [`Role`] (no role: `admin`); none: every route
-//!   is open. An unknown role stops the start with the entry's position;
+//!   `key:role` with a role of [`Role`] (no role: `admin`); or
+//!   `ROBOCAL_API_KEYS_FILE`: a file of such entries (commas or lines, `#`
+//!   comments), e.g. a container secret. An unknown role stops the start with
+//!   the entry's position; a variable that is set but lists no key stops it too;
+//! - without keys every route is open, which is allowed on loopback only:
+//!   a non-loopback `--bind` without keys refuses to start unless
+//!   `--allow-open-writes` / `ROBOCAL_ALLOW_OPEN_WRITES=1` says so, and then
+//!   warns at every start ([`crate::service::keys::exposure`]);
 //! - `--open-reads` / `ROBOCAL_OPEN_READS`: with keys, GETs still need none;
 //! - `--workers N` / `ROBOCAL_WORKERS`: calibration jobs run at once, default 1;
 //! - limits and queues (`--max-queued-jobs`, `--max-queued-solves`,
@@ -28,7 +34,7 @@
 
 use crate::db::{Backend, Db, DEFAULT_DATABASE_URL, DEFAULT_PG_POOL};
 use crate::http::{app, AppState, Limits, ServiceConfig, ServiceListener};
-use crate::service::keys::{parse_keys, ApiKey, Role};
+use crate::service::keys::{exposure, parse_keys, ApiKey, Exposure, Role, SHORT_KEY};
 use anyhow::Context;
 use clap::Args;
 use std::net::SocketAddr;
@@ -46,6 +52,16 @@ pub struct ServeArgs {
         value_parser = clap::builder::BoolishValueParser::new()
     )]
     pub open_reads: bool,
+    /// Without API keys, serve a non-loopback address anyway, every route
+    /// open to anyone who can reach it (warned at every start). Without this,
+    /// such a start is refused. `ROBOCAL_ALLOW_OPEN_WRITES=1` sets it too.
+    #[arg(
+        long,
+        env = "ROBOCAL_ALLOW_OPEN_WRITES",
+        action = clap::ArgAction::SetTrue,
+        value_parser = clap::builder::BoolishValueParser::new()
+    )]
+    pub allow_open_writes: bool,
     /// Listen address (loopback by default).
     #[arg(long, env = "ROBOCAL_BIND", default_value = "127.0.0.1:8080")]
     pub bind: String,
@@ -118,11 +134,44 @@ impl ServeArgs {
     }
 }
 
-/// Reads `ROBOCAL_API_KEYS` (see [`parse_keys`]); an unknown role or an
-/// empty key is an error that names the entry, never the key.
+/// Reads the keys from `ROBOCAL_API_KEYS` or the file `ROBOCAL_API_KEYS_FILE`
+/// names (see [`parse_keys`]); an unknown role or an empty key is an error
+/// that names the entry, never the key. Both set, or one set that lists no
+/// key (`","`, `" "`, an empty file: a typo that would open every route), is
+/// an error too. Neither set: no keys.
 pub fn api_keys_from_env() -> anyhow::Result<Vec<ApiKey>> {
-    let text = std::env::var("ROBOCAL_API_KEYS").unwrap_or_default();
-    parse_keys(&text).map_err(|e| anyhow::anyhow!("ROBOCAL_API_KEYS: {e}"))
+    let inline = std::env::var("ROBOCAL_API_KEYS").ok();
+    let file = std::env::var_os("ROBOCAL_API_KEYS_FILE").filter(|f| !f.is_empty());
+    let (source, text) = match (inline, file) {
+        (Some(_), Some(_)) => anyhow::bail!(
+            "both ROBOCAL_API_KEYS and ROBOCAL_API_KEYS_FILE are set; set one of them"
+        ),
+        (Some(text), None) => ("ROBOCAL_API_KEYS".to_string(), text),
+        (None, Some(path)) => {
+            let source = format!("ROBOCAL_API_KEYS_FILE ({})", path.to_string_lossy());
+            let text = std::fs::read_to_string(&path)
+                .with_context(|| format!("{source}: cannot read the key file"))?;
+            (source, keys_file_entries(&text))
+        }
+        (None, None) => return Ok(Vec::new()),
+    };
+    let keys = parse_keys(&text).map_err(|e| anyhow::anyhow!("{source}: {e}"))?;
+    if keys.is_empty() {
+        anyhow::bail!(
+            "{source} is set but lists no key; list keys (`robocal keygen` prints one), or unset it to serve without keys on loopback only"
+        );
+    }
+    Ok(keys)
+}
+
+/// The entries of a key file: lines or commas, blank lines and `#` comments
+/// dropped, as one `ROBOCAL_API_KEYS` value.
+fn keys_file_entries(text: &str) -> String {
+    text.lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty() && !l.starts_with('#'))
+        .collect::<Vec<_>>()
+        .join(",")
 }
 
 /// The part of `serve --help` on API keys, from the roles themselves.
@@ -130,9 +179,13 @@ fn keys_help() -> String {
     let mut out = String::from(
         "API keys: set ROBOCAL_API_KEYS to comma-separated entries `key` or `key:role`, \
          e.g. ROBOCAL_API_KEYS=k1:admin,k2:read,k3:operate (a key without a role is admin). \
+         or ROBOCAL_API_KEYS_FILE to a file of such entries (commas or lines; e.g. a container secret). \
+         `robocal keygen` prints a new random key. \
          Clients send `Authorization: Bearer <key>`; a request without a valid key gets 401, \
          a key whose role is too low gets 403. /healthz, /readyz and /openapi.yaml stay open. \
-         Without keys every route is open. Roles (each includes the ones above it):\n",
+         Without keys every route is open, so a start without keys on a non-loopback address is \
+         refused unless --allow-open-writes (ROBOCAL_ALLOW_OPEN_WRITES=1) says so. \
+         Roles (each includes the ones above it):\n",
     );
     for role in Role::ALL {
         out.push_str(&format!("  {:<8} {}\n", role.name(), role.allows()));
@@ -164,6 +217,9 @@ pub fn run(args: ServeArgs) -> anyhow::Result<()> {
             args.bind
         )
     })?;
+    let exposed = exposure(addr.ip().is_loopback(), &keys, args.allow_open_writes)
+        .map_err(anyhow::Error::msg)?;
+    warn_about(exposed, &keys, addr);
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .enable_all()
         .thread_name("robocal-http")
@@ -235,6 +291,21 @@ async fn serve(addr: SocketAddr, args: ServeArgs, keys: Vec<ApiKey>) -> anyhow::
         .context("server error")?;
     tracing::info!("stopped");
     Ok(())
+}
+
+/// Warnings a start deserves: every route open to a network, short keys.
+fn warn_about(exposed: Exposure, keys: &[ApiKey], addr: SocketAddr) {
+    if exposed == Exposure::OpenNetwork {
+        tracing::warn!(
+            "serving {addr} without API keys (--allow-open-writes): anyone who can reach it can replace robot models, versions, tools and work objects; set ROBOCAL_API_KEYS"
+        );
+    }
+    let short = keys.iter().filter(|k| k.key.len() < SHORT_KEY).count();
+    if short > 0 {
+        tracing::warn!(
+            "{short} API key(s) shorter than {SHORT_KEY} characters can be guessed; `robocal keygen` prints a 43-character key"
+        );
+    }
 }
 
 /// The test gate of tests that drive this binary (`ROBOCAL_TEST_GATE_FILE`:

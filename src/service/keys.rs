@@ -120,9 +120,97 @@ pub fn parse_keys(text: &str) -> Result<Vec<ApiKey>, String> {
     Ok(keys)
 }
 
+/// How a service is exposed, decided at start from where it listens, its
+/// keys and the operator's explicit choice.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Exposure {
+    /// Keys are set: every route but the health checks needs one.
+    Keyed,
+    /// No keys, listening on loopback only: open to this host's processes.
+    OpenLoopback,
+    /// No keys on a non-loopback address, by the operator's explicit choice
+    /// (`--allow-open-writes`): open to the network, warned at every start.
+    OpenNetwork,
+}
+
+/// The variable and flag that let a service without keys serve a network.
+pub const ALLOW_OPEN_WRITES: &str = "ROBOCAL_ALLOW_OPEN_WRITES";
+
+/// Decides whether a service may start: without keys it serves writes on a
+/// non-loopback address only by the operator's explicit choice, since anyone
+/// on a cell's network could then replace a robot's model or a tool's TCP and
+/// move the robot somewhere else. The error names the fixes.
+pub fn exposure(
+    loopback: bool,
+    keys: &[ApiKey],
+    allow_open_writes: bool,
+) -> Result<Exposure, String> {
+    match (keys.is_empty(), loopback, allow_open_writes) {
+        (false, _, _) => Ok(Exposure::Keyed),
+        (true, true, _) => Ok(Exposure::OpenLoopback),
+        (true, false, true) => Ok(Exposure::OpenNetwork),
+        (true, false, false) => Err(format!(
+            "refusing to serve a non-loopback address without API keys: anyone on the network could replace \
+             a robot's model, a version or a tool. Set ROBOCAL_API_KEYS (e.g. ROBOCAL_API_KEYS=$(robocal keygen)) \
+             or ROBOCAL_API_KEYS_FILE (a file of keys, e.g. a container secret); or bind 127.0.0.1; or, to serve \
+             the network with every route open on purpose, pass --allow-open-writes ({ALLOW_OPEN_WRITES}=1)"
+        )),
+    }
+}
+
+/// A new random key for `ROBOCAL_API_KEYS`: 256 bits from the operating
+/// system's generator, base64url without padding (43 characters).
+pub fn new_key() -> String {
+    use base64::Engine;
+    use rand::RngCore;
+    let mut bytes = [0u8; 32];
+    rand::rngs::OsRng.fill_bytes(&mut bytes);
+    base64::engine::general_purpose::URL_SAFE_NO_PAD.encode(bytes)
+}
+
+/// Keys shorter than this are accepted but warned about at start: they can
+/// be guessed.
+pub const SHORT_KEY: usize = 16;
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn without_keys_only_loopback_or_an_explicit_choice_serves() {
+        let keys = parse_keys("k1:admin").unwrap();
+        assert_eq!(exposure(false, &keys, false), Ok(Exposure::Keyed));
+        assert_eq!(exposure(true, &keys, false), Ok(Exposure::Keyed));
+        assert_eq!(exposure(true, &[], false), Ok(Exposure::OpenLoopback));
+        assert_eq!(exposure(false, &[], true), Ok(Exposure::OpenNetwork));
+        let e = exposure(false, &[], false).unwrap_err();
+        for fix in [
+            "ROBOCAL_API_KEYS",
+            "ROBOCAL_API_KEYS_FILE",
+            "robocal keygen",
+            "127.0.0.1",
+            "--allow-open-writes",
+            ALLOW_OPEN_WRITES,
+        ] {
+            assert!(e.contains(fix), "{fix} in {e}");
+        }
+    }
+
+    #[test]
+    fn new_keys_are_long_distinct_and_parse() {
+        let a = new_key();
+        let b = new_key();
+        assert_eq!(a.len(), 43);
+        assert_ne!(a, b);
+        assert!(a
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_'));
+        let keys = parse_keys(&format!("{a}:operate")).unwrap();
+        assert_eq!(
+            (keys[0].key.as_str(), keys[0].role),
+            (a.as_str(), Role::Operate)
+        );
+    }
 
     #[test]
     fn keys_take_a_role_and_default_to_admin() {

@@ -20,6 +20,7 @@ mod cell_fit;
 #[path = "../common/mod.rs"]
 mod common;
 mod contract;
+mod exposure;
 mod flow;
 mod hostile;
 mod iso9283;
