@@ -33,6 +33,7 @@
 //! back to the queue.
 
 use crate::db::{Backend, Db, DEFAULT_DATABASE_URL, DEFAULT_PG_POOL};
+use crate::http::server::ServerSettings;
 use crate::http::{app, AppState, Limits, ServiceConfig, ServiceListener};
 use crate::service::keys::{exposure, parse_keys, ApiKey, Exposure, Role, SHORT_KEY};
 use anyhow::Context;
@@ -130,6 +131,7 @@ impl ServeArgs {
             job_time: std::time::Duration::from_secs(self.job_time_limit),
             queued_solves: self.max_queued_solves,
             page_max: self.page_max,
+            body_pause: Limits::default().body_pause,
         })
     }
 }
@@ -279,16 +281,26 @@ async fn serve(addr: SocketAddr, args: ServeArgs, keys: Vec<ApiKey>) -> anyhow::
         keys_on
     );
     let draining = state.clone();
-    axum::serve(ServiceListener::new(listener), app(state))
-        .with_graceful_shutdown(async move {
+    let settings = ServerSettings::default();
+    tracing::info!(
+        header_read_timeout_s = settings.header_read_timeout.as_secs(),
+        body_pause_s = state.limits().body_pause.as_secs(),
+        max_connections = settings.max_connections,
+        "connection limits"
+    );
+    crate::http::server::serve(
+        ServiceListener::new(listener),
+        app(state),
+        settings,
+        async move {
             shutdown().await;
             // PostgreSQL: running jobs go back to the queue for other replicas.
             if draining.shared_jobs() {
                 crate::service::jobs::shared::drain(&draining).await;
             }
-        })
-        .await
-        .context("server error")?;
+        },
+    )
+    .await;
     tracing::info!("stopped");
     Ok(())
 }

@@ -224,7 +224,7 @@ fn answer(tests: Vec<(String, Assessment)>) -> Response {
 }
 
 async fn figures(
-    State(_state): State<AppState>,
+    State(state): State<AppState>,
     ApiJson(body): ApiJson<Iso9283Request>,
 ) -> Result<Response, ApiError> {
     let tests = body
@@ -237,11 +237,11 @@ async fn figures(
             })
         })
         .collect::<Result<Vec<_>, ApiError>>()?;
-    Ok(answer(service::iso9283::figures(tests).await?))
+    Ok(answer(service::iso9283::figures(&state, tests).await?))
 }
 
 async fn figures_csv(
-    State(_state): State<AppState>,
+    State(state): State<AppState>,
     ApiJson(body): ApiJson<Iso9283CsvRequest>,
 ) -> Result<Response, ApiError> {
     let tests = body
@@ -256,7 +256,7 @@ async fn figures_csv(
             })
         })
         .collect::<Result<Vec<_>, ApiError>>()?;
-    Ok(answer(service::iso9283::figures_csv(tests).await?))
+    Ok(answer(service::iso9283::figures_csv(&state, tests).await?))
 }
 
 pub fn routes() -> Vec<super::Route> {

@@ -41,6 +41,7 @@ pub mod predict;
 pub mod programs;
 pub mod record;
 pub mod robots;
+pub mod server;
 pub mod sets;
 pub mod solve;
 pub mod versions;
@@ -180,6 +181,12 @@ pub fn app(state: AppState) -> Router {
         .fallback(not_found)
         .method_not_allowed_fallback(method_not_allowed)
         .layer(DefaultBodyLimit::max(state.limits().body_bytes))
+        // A body that stops arriving fails its request (the head's own
+        // timeout is the server's: `server.rs`).
+        .layer(middleware::map_request_with_state(
+            state.limits().body_pause,
+            body_timeout,
+        ))
         .layer(CatchPanicLayer::custom(panic_response))
         .layer(middleware::map_response(safe_to_open))
         .layer(
@@ -191,6 +198,13 @@ pub fn app(state: AppState) -> Router {
                 .on_failure(DefaultOnFailure::new().level(Level::WARN)),
         )
         .with_state(state)
+}
+
+/// Bounds the pause between two pieces of a request body by `pause`
+/// (`Limits::body_pause`): a client that stops sending mid-body gets its
+/// request failed and its connection freed.
+async fn body_timeout(State(pause): State<std::time::Duration>, req: Request) -> Request {
+    req.map(|b| axum::body::Body::new(tower_http::timeout::TimeoutBody::new(pause, b)))
 }
 
 /// The policy of every answer that does not state its own (the console's

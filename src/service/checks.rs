@@ -107,9 +107,8 @@ pub async fn create(state: &AppState, cmd: CheckCommand) -> Result<CheckRow, Ser
     let temperature_c = cmd
         .temperature_c
         .or_else(|| (!temps.is_empty()).then(|| temps.iter().sum::<f64>() / temps.len() as f64));
-    let result = tokio::task::spawn_blocking(move || score(&model, &rows, &t))
-        .await
-        .map_err(|e| ServiceError::Internal(format!("check task: {e}")))?
+    let result = super::heavy::run(state, "check", move |_| score(&model, &rows, &t))
+        .await?
         .map_err(|e| ServiceError::Invalid(e.to_string()))?;
     let stored = serde_json::to_value(Stored {
         result: &result,
@@ -167,6 +166,12 @@ pub(super) fn conflict(e: ServiceError) -> ServiceError {
 /// Most versions one comparison scores.
 pub const COMPARE_VERSIONS_MAX: usize = 20;
 
+/// Most poses × versions one comparison scores: its answer holds every
+/// pose's error per version, so this bounds the answer's size and the
+/// memory it takes (a set of 10,000 poses against 20 versions, or 100,000
+/// against 2).
+pub const COMPARE_POSE_VERSIONS_MAX: usize = 200_000;
+
 /// One version's score in a comparison.
 #[derive(Debug, Serialize)]
 pub struct VersionScore {
@@ -203,6 +208,14 @@ pub async fn compare(
         .set_rows(robot_id, set_id)
         .await?
         .ok_or_else(|| conflict(ServiceError::set_not_found(robot_id, set_id)))?;
+    let work = rows.len() * versions.len();
+    if work > COMPARE_POSE_VERSIONS_MAX {
+        return Err(ServiceError::Invalid(format!(
+            "set {set_id} has {} poses; against {} versions that is {work} pose-versions, at most {COMPARE_POSE_VERSIONS_MAX} in one comparison: compare fewer versions at once, or check a smaller set",
+            rows.len(),
+            versions.len()
+        )));
+    }
     let mut models = Vec::with_capacity(versions.len());
     for &v in versions {
         let (row, text) = versions::with_model(state, robot_id, v)
@@ -213,12 +226,15 @@ pub async fn compare(
             .map_err(|e| ServiceError::Internal(format!("stored model of version {v}: {e}")))?;
         models.push((v, row.method, model));
     }
-    let ticket = state.admit_solve()?;
-    tokio::task::spawn_blocking(move || {
-        let _ticket = ticket;
+    super::heavy::run(state, "compare", move |flag| {
         models
             .into_iter()
             .map(|(version, method, model)| {
+                if !flag.still_waiting() {
+                    return Err(ServiceError::Unavailable(
+                        "the comparison was stopped: its client went away".into(),
+                    ));
+                }
                 let result = score(&model, &rows, &t)
                     .map_err(|e| ServiceError::Invalid(format!("version {version}: {e}")))?;
                 let result = serde_json::to_value(Stored {
@@ -234,8 +250,7 @@ pub async fn compare(
             })
             .collect::<Result<Vec<_>, ServiceError>>()
     })
-    .await
-    .map_err(|e| ServiceError::Internal(format!("compare task: {e}")))?
+    .await?
 }
 
 /// One page of the robot's checks, oldest first.

@@ -5,7 +5,7 @@
 //! the two CSV texts of `robocal iso9283` ([`figures_csv`]). Nothing is
 //! stored.
 
-use super::ServiceError;
+use super::{AppState, ServiceError};
 use robocal_core::check::iso9283::csv::{read_cycles_csv, read_plan_csv};
 use robocal_core::check::iso9283::outcome::{CommandedPose, CycleReading, PoseData};
 use robocal_core::check::iso9283::{assess, Assessment, Iso9283Error};
@@ -43,22 +43,24 @@ fn invalid(label: &str, what: &str, e: Iso9283Error) -> ServiceError {
 }
 
 /// The figures of each test, in order; values out of bounds name the test.
-pub async fn figures(tests: Vec<Iso9283Test>) -> Result<Vec<(String, Assessment)>, ServiceError> {
+pub async fn figures(
+    state: &AppState,
+    tests: Vec<Iso9283Test>,
+) -> Result<Vec<(String, Assessment)>, ServiceError> {
     count(tests.len())?;
-    tokio::task::spawn_blocking(move || {
-        tests
-            .into_iter()
-            .map(|t| {
-                let a = assess(&t.poses).map_err(|e| invalid(&t.label, "poses", e))?;
-                Ok((t.label, a))
-            })
-            .collect()
-    })
-    .await
-    .map_err(|e| ServiceError::Internal(format!("iso9283 task: {e}")))?
+    super::heavy::run(state, "iso9283", move |_| assess_all(tests)).await?
 }
 
-/// A test's CSV texts as poses: the plan's commands and their cycles.
+fn assess_all(tests: Vec<Iso9283Test>) -> Result<Vec<(String, Assessment)>, ServiceError> {
+    tests
+        .into_iter()
+        .map(|t| {
+            let a = assess(&t.poses).map_err(|e| invalid(&t.label, "poses", e))?;
+            Ok((t.label, a))
+        })
+        .collect()
+}
+
 fn csv_poses(t: &Iso9283CsvTest) -> Result<Vec<PoseData>, ServiceError> {
     let commanded = read_plan_csv(&t.plan_csv).map_err(|e| invalid(&t.label, "plan_csv", e))?;
     let cycles = read_cycles_csv(&t.measured_csv, &commanded)
@@ -94,11 +96,12 @@ fn csv_poses(t: &Iso9283CsvTest) -> Result<Vec<PoseData>, ServiceError> {
 /// The figures of each CSV test, in order; a CSV that cannot be read says
 /// which test, which file and where.
 pub async fn figures_csv(
+    state: &AppState,
     tests: Vec<Iso9283CsvTest>,
 ) -> Result<Vec<(String, Assessment)>, ServiceError> {
     count(tests.len())?;
-    let tests = tokio::task::spawn_blocking(move || {
-        tests
+    super::heavy::run(state, "iso9283", move |_| {
+        let tests = tests
             .iter()
             .map(|t| {
                 Ok(Iso9283Test {
@@ -106,9 +109,8 @@ pub async fn figures_csv(
                     poses: csv_poses(t)?,
                 })
             })
-            .collect::<Result<Vec<_>, ServiceError>>()
+            .collect::<Result<Vec<_>, ServiceError>>()?;
+        assess_all(tests)
     })
-    .await
-    .map_err(|e| ServiceError::Internal(format!("iso9283 task: {e}")))??;
-    figures(tests).await
+    .await?
 }

@@ -55,6 +55,9 @@ pub struct Limits {
     pub queued_solves: usize,
     /// Largest page of a list (`limit`).
     pub page_max: usize,
+    /// Longest pause in a request body: a client that stops sending for
+    /// this long mid-body has its request failed and its connection freed.
+    pub body_pause: Duration,
 }
 
 impl Default for Limits {
@@ -68,6 +71,7 @@ impl Default for Limits {
             job_time: Duration::from_secs(1800),
             queued_solves: 4,
             page_max: 1000,
+            body_pause: Duration::from_secs(30),
         }
     }
 }

@@ -16,6 +16,7 @@ pub mod cell_fit;
 mod changes;
 pub mod checks;
 pub(crate) mod gate;
+mod heavy;
 pub mod iso9283;
 mod job_watch;
 pub mod jobs;

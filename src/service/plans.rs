@@ -51,15 +51,7 @@ pub async fn make(state: &AppState, cmd: PlanCommand) -> Result<PlanOutcome, Ser
             nominal.dof()
         )));
     }
-    let ticket = state.admit_solve()?;
-    let permit = state
-        .solve_slots()
-        .acquire_owned()
-        .await
-        .map_err(|_| ServiceError::Unavailable("the service is shutting down".into()))?;
-    tokio::task::spawn_blocking(move || {
-        let _permit = permit;
-        let _ticket = ticket;
+    super::heavy::run(state, "plan", move |_| {
         let plan =
             make_plan(&nominal, &cmd.settings).map_err(|e| ServiceError::Invalid(e.to_string()))?;
         let program = match &cmd.program {
@@ -75,6 +67,5 @@ pub async fn make(state: &AppState, cmd: PlanCommand) -> Result<PlanOutcome, Ser
             program,
         })
     })
-    .await
-    .map_err(|e| ServiceError::Internal(format!("plan task: {e}")))?
+    .await?
 }

@@ -8,6 +8,7 @@
 //! Units at this boundary: joint readings in the controller convention in
 //! degrees; poses SI (the handler writes mm and degrees).
 
+use super::limits::SMALL_SOLVE_MAX;
 use super::solve::{choose_version, resolve, ItemChoice, ModelChoice};
 use super::{AppState, ServiceError};
 use crate::calibrate::compensate::{CalibratedModelFile, CompensatedModel};
@@ -158,14 +159,18 @@ pub async fn predict(
             )
         }
     };
-    let rows = cmd
-        .readings
-        .into_iter()
-        .map(|r| {
-            let p = forward.predict_deg(&r.joints_deg, &frame);
-            (r, p)
+    // Large batches run admitted, on a solve worker, off the async runtime.
+    let readings = cmd.readings;
+    let (forward, rows) = if readings.len() <= SMALL_SOLVE_MAX {
+        let rows = predict_all(&forward, readings, &frame);
+        (forward, rows)
+    } else {
+        super::heavy::run(state, "predict", move |_| {
+            let rows = predict_all(&forward, readings, &frame);
+            (forward, rows)
         })
-        .collect();
+        .await?
+    };
     Ok(PredictOutcome {
         version,
         method,
@@ -175,6 +180,21 @@ pub async fn predict(
         accuracy,
         rows,
     })
+}
+
+/// Each reading with its prediction, in order.
+fn predict_all(
+    forward: &Forward,
+    readings: Vec<JointReading>,
+    frame: &PredictFrame,
+) -> Vec<(JointReading, Result<Predicted, PredictError>)> {
+    readings
+        .into_iter()
+        .map(|r| {
+            let p = forward.predict_deg(&r.joints_deg, frame);
+            (r, p)
+        })
+        .collect()
 }
 
 fn frame_label(f: TargetFrame) -> &'static str {

@@ -45,21 +45,10 @@ pub async fn filter_program(
     if let Some(p) = cmd.payload_kg {
         model.payload_kg = p;
     }
-    let ticket = state.admit_solve()?;
-    let permit = state
-        .solve_slots()
-        .acquire_owned()
-        .await
-        .map_err(|_| ServiceError::Unavailable("the service is shutting down".into()))?;
     let files = cmd.files;
     let max_targets = state.limits().targets_per_request;
-    // Dropped with this future when the client goes away: the filter stops
-    // before its next target.
-    let (_waiting, flag) = state.waiting();
     let task_state = state.clone();
-    let output = tokio::task::spawn_blocking(move || {
-        let _permit = permit;
-        let _ticket = ticket;
+    let output = super::heavy::run(state, "filter", move |flag| {
         let control = FilterControl {
             max_targets: Some(max_targets),
             keep_going: &|| flag.still_waiting(),
@@ -78,8 +67,7 @@ pub async fn filter_program(
         }
         out
     })
-    .await
-    .map_err(|e| ServiceError::Internal(format!("filter task: {e}")))?
+    .await?
     .map_err(|e| match e {
         FilterError::Parse(p) => ServiceError::Unparsable(p),
         FilterError::TooManyTargets { .. } => {

@@ -356,30 +356,19 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
     let results = if cmd.targets.len() <= SMALL_SOLVE_MAX {
         cmd.targets.run(solver, &cmd.options, cmd.path)
     } else {
-        let ticket = state.admit_solve()?;
-        let permit = state
-            .solve_slots()
-            .acquire_owned()
-            .await
-            .map_err(|_| ServiceError::Unavailable("the service is shutting down".into()))?;
-        // Dropped with this future when the client goes away.
-        let (_waiting, flag) = state.waiting();
         let task_state = state.clone();
         let cell_solver = cell_solver.clone();
-        tokio::task::spawn_blocking(move || {
-            let _permit = permit;
-            let _ticket = ticket;
+        super::heavy::run(state, "solver", move |flag| {
             let out = cmd
                 .targets
-                .run_large(cell_solver.solver(), &cmd.options, cmd.path, &flag);
+                .run_large(cell_solver.solver(), &cmd.options, cmd.path, flag);
             if out.is_none() {
                 task_state.note_abandoned();
                 tracing::info!("a solve batch was stopped: its client went away");
             }
             out
         })
-        .await
-        .map_err(|e| ServiceError::Internal(format!("solver task: {e}")))?
+        .await?
         .ok_or_else(|| {
             ServiceError::Unavailable("the solve was stopped before it finished".into())
         })?

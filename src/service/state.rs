@@ -123,7 +123,15 @@ struct Inner {
     invalidations: AtomicU64,
     robots: Mutex<HashMap<i64, Arc<RobotContext>>>,
     solvers: Mutex<HashMap<SolverKey, Arc<CellSolver>>>,
+    /// Trims of the heap still due after large work ([`AppState::trim_soon`]).
+    trims_due: std::sync::atomic::AtomicU8,
+    /// Whether the trimming task runs.
+    trimmer: AtomicBool,
 }
+
+/// How often the trimming task looks, and how many looks trim after large work.
+const TRIM_TICK: Duration = Duration::from_secs(2);
+const TRIMS_AFTER_WORK: u8 = 3;
 
 /// Prepared solvers kept in memory (model versions are immutable).
 const SOLVER_CACHE_MAX: usize = 64;
@@ -163,6 +171,8 @@ impl AppState {
                 invalidations: AtomicU64::new(0),
                 robots: Mutex::new(HashMap::new()),
                 solvers: Mutex::new(HashMap::new()),
+                trims_due: std::sync::atomic::AtomicU8::new(0),
+                trimmer: AtomicBool::new(false),
             }),
         }
     }
@@ -241,6 +251,32 @@ impl AppState {
         self.inner.abandoned.fetch_add(1, Ordering::AcqRel);
     }
 
+    /// Hands freed heap memory back to the system in the seconds after large
+    /// work, at each of the next few looks (every [`TRIM_TICK`]) that find no
+    /// large work running: by then the answers have been written and freed.
+    pub(crate) fn trim_soon(&self) {
+        self.inner
+            .trims_due
+            .store(TRIMS_AFTER_WORK, Ordering::SeqCst);
+        if self.inner.trimmer.swap(true, Ordering::SeqCst) {
+            return;
+        }
+        let weak = self.downgrade();
+        tokio::spawn(async move {
+            loop {
+                tokio::time::sleep(TRIM_TICK).await;
+                let Some(state) = AppState::upgrade(&weak) else {
+                    return;
+                };
+                let due = &state.inner.trims_due;
+                if state.solves_in_flight() == 0 && due.load(Ordering::SeqCst) > 0 {
+                    due.fetch_sub(1, Ordering::SeqCst);
+                    let _ = tokio::task::spawn_blocking(super::heavy::trim).await;
+                }
+            }
+        });
+    }
+
     /// A guard for the request and a flag for its blocking task: the task
     /// stops when the request is dropped, and waits at the test gate, if any.
     pub(crate) fn waiting(&self) -> (Waiting, WaitingFlag) {
@@ -288,7 +324,7 @@ impl AppState {
         let gate = &self.inner.solve_gate;
         gate.try_admit().ok_or_else(|| ServiceError::Busy {
             detail: format!(
-                "{} large solve batches are running or queued, the most this service takes (--solve-workers {} + --max-queued-solves {}); retry later, or send batches of at most {SMALL_SOLVE_MAX} targets, which are never queued",
+                "{} large requests (solve batches, filters, plans, checks, comparisons, predictions, ISO 9283) are running or queued, the most this service takes (--solve-workers {} + --max-queued-solves {}); retry later, or send batches of at most {SMALL_SOLVE_MAX} targets, which are never queued",
                 gate.in_flight(),
                 self.config().solve_workers.max(1),
                 self.limits().queued_solves

@@ -717,11 +717,12 @@ async fn urls_over_64_kib_get_a_problem_document() {
     let listener = tokio::net::TcpListener::bind("127.0.0.1:0").await.unwrap();
     let addr = listener.local_addr().unwrap();
     let router = t.router.clone();
-    let server = tokio::spawn(async move {
-        axum::serve(robocal::http::ServiceListener::new(listener), router)
-            .await
-            .unwrap()
-    });
+    let server = tokio::spawn(robocal::http::server::serve(
+        robocal::http::ServiceListener::new(listener),
+        router,
+        Default::default(),
+        std::future::pending(),
+    ));
     let mut s = tokio::net::TcpStream::connect(addr).await.unwrap();
     let path = format!("/v1/robots?x={}", "a".repeat(70 * 1024));
     s.write_all(format!("GET {path} HTTP/1.1\r\nHost: x\r\n\r\n").as_bytes())

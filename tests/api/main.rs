@@ -15,6 +15,7 @@
 //! the console's security headers); the harness is `support`.
 
 mod abandoned;
+mod admission;
 mod cell;
 mod cell_fit;
 #[path = "../common/mod.rs"]
@@ -33,6 +34,7 @@ mod record;
 mod reregister;
 mod roles;
 mod sets;
+mod slow_clients;
 mod solve;
 mod spec;
 mod stored_jobs;
