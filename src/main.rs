@@ -1,13 +1,32 @@
 use clap::Parser;
+use robocal::cli::exit::Exit;
+use std::process::ExitCode;
 
-fn main() {
-    let cli = robocal::cli::Cli::parse();
+/// Runs the command line; the exit code is `cli::exit::Exit`'s: a command
+/// line clap refuses (`--help` and `--version` are not refusals) and an error
+/// of the command are `refused`.
+fn main() -> ExitCode {
+    let cli = match robocal::cli::Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            let _ = e.print();
+            let code = if e.use_stderr() {
+                Exit::Refused
+            } else {
+                Exit::Success
+            };
+            return ExitCode::from(code.code());
+        }
+    };
     if !matches!(cli.command, robocal::cli::Command::Serve(_)) {
         quiet_closed_pipe();
     }
-    if let Err(e) = robocal::cli::run(cli) {
-        eprintln!("error: {e:#}");
-        std::process::exit(1);
+    match robocal::cli::run(cli) {
+        Ok(exit) => ExitCode::from(exit.code()),
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(Exit::Refused.code())
+        }
     }
 }
 

@@ -189,6 +189,7 @@ fn cli_args(model: &str, targets: &str) -> SolveArgs {
         json: false,
         delimiter: None,
         decimal: None,
+        failures: Default::default(),
     }
 }
 

@@ -233,7 +233,7 @@ fn check_names_a_moved_tracker_and_a_changed_robot() {
         "{}",
         moved.summary
     );
-    assert_eq!(moved.status.name(), "ok");
+    assert_eq!(moved.status.name(), "shifted");
     // Errors that differ from pose to pose (±3 mm): not a frame shift.
     let changed = run(
         "changed.csv",

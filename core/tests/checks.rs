@@ -9,6 +9,7 @@ use robocal_core::calibrate::identify::pose_selection::choose_d_optimal;
 use robocal_core::calibrate::identify::{calibrate, CalibrationOptions, Method};
 use robocal_core::check::{reregister, score, CheckStatus, CheckThresholds, ReregisterError};
 use robocal_core::measure;
+use robocal_core::model::orientation::rotation_angle_between;
 use robocal_core::model::preset;
 use robocal_core::sim::{random_configurations, tracker_frame, ys100_table_7_1, TrueRobot};
 
@@ -80,9 +81,97 @@ fn checks_tell_ok_a_crash_and_a_moved_tracker_apart() {
     let s = shifted.frame_shift.as_ref().unwrap();
     assert!(s.explains, "{}", shifted.summary);
     assert!(shifted.position.mean_mm > t.recalibrate_mm);
-    assert_eq!(shifted.status, CheckStatus::Ok);
+    // Never `ok`: the parts are off by the shift until re-registration.
+    assert_eq!(shifted.status, CheckStatus::Shifted);
     assert!(shifted.summary.contains("frame shift"));
     assert!((s.rotation_deg - 0.2).abs() < 0.01, "{}", s.rotation_deg);
+    let size = shifted.shift().unwrap();
+    assert_eq!(
+        (size.translation_mm, size.rotation_deg),
+        (s.translation_mm, s.rotation_deg)
+    );
+    assert_eq!(before.shift(), None);
+    assert_eq!(after.shift(), None);
+}
+
+/// The robot's base moved (the tracker did not): a rigid transform of 0.27°
+/// about a tilted axis through the base origin and 12 mm, ~13 mm at the
+/// check poses. The check says `shifted` with the shift's size; the
+/// expected size is the truth's own: the rotation angle of the move, and the
+/// mean displacement of the noise-free tool points (the fitted transform's
+/// translation at the measured points' centre). The size is judged within
+/// what the unexplained error allows: twice the mean residual after the
+/// shift, at the centre and (for the angle) over the points' spread.
+#[test]
+fn a_moved_base_is_a_shift_of_its_own_size_not_ok() {
+    let mut truth = TrueRobot::new(ys100_table_7_1());
+    truth.noise_mm = 0.01;
+    truth.tracker_from_base = tracker_frame(2.0, -1.0, 95.0, [1200.0, -3240.0, 400.0]);
+    let mut rng = ChaCha8Rng::seed_from_u64(42);
+    let model = calibrated(&truth, &mut rng);
+    let nominal = preset("ys100").unwrap();
+    let t = CheckThresholds::default();
+
+    // The new base in the old base's frame.
+    let base_move = tracker_frame(0.12, -0.15, 0.18, [7.0, -9.0, 4.0]);
+    let mut moved = truth.clone();
+    moved.tracker_from_base = truth.tracker_from_base.compose(&base_move);
+    let q = random_configurations(&nominal, 20, &mut rng);
+    let rows = moved.measure(&q, None, None, &mut rng).unwrap();
+    let r = score(&model, &rows, &t).unwrap();
+    eprintln!("base moved: {}", r.summary);
+    assert_eq!(r.status, CheckStatus::Shifted, "{}", r.summary);
+    assert!(!r.status.is_ok());
+
+    // The truth's shift: noise-free points before and after the move.
+    let (mut exact, mut exact_moved) = (truth.clone(), moved.clone());
+    exact.noise_mm = 0.0;
+    exact_moved.noise_mm = 0.0;
+    let points = |truth: &TrueRobot| -> Vec<nalgebra::Vector3<f64>> {
+        let mut rng = ChaCha8Rng::seed_from_u64(0);
+        let rows = truth.measure(&q, None, None, &mut rng).unwrap();
+        rows.iter()
+            .map(|r| nalgebra::Vector3::from(r.xyz_mm))
+            .collect()
+    };
+    let (p0, p1) = (points(&exact), points(&exact_moved));
+    let n = p0.len() as f64;
+    let displacement: nalgebra::Vector3<f64> = p0
+        .iter()
+        .zip(&p1)
+        .map(|(a, b)| a - b)
+        .sum::<nalgebra::Vector3<f64>>()
+        / n;
+    let centre = p1.iter().sum::<nalgebra::Vector3<f64>>() / n;
+    let spread_mm = (p1.iter().map(|p| (p - centre).norm_squared()).sum::<f64>() / n).sqrt();
+    let angle_deg =
+        rotation_angle_between(&base_move.r, &nalgebra::Matrix3::identity()).to_degrees();
+    let size = r.shift().unwrap();
+    let residual = r.frame_shift.as_ref().unwrap().residual_mean_mm;
+    eprintln!(
+        "shift {:.4} mm, {:.5}° (truth {:.4} mm, {:.5}°); residual {residual:.4} mm, spread {spread_mm:.0} mm",
+        size.translation_mm,
+        size.rotation_deg,
+        displacement.norm(),
+        angle_deg
+    );
+    assert!(
+        (12.0..16.0).contains(&r.position.mean_mm),
+        "{:?}",
+        r.position
+    );
+    assert!(
+        (size.translation_mm - displacement.norm()).abs() <= 2.0 * residual,
+        "{} vs {}",
+        size.translation_mm,
+        displacement.norm()
+    );
+    let angle_tolerance_deg = (2.0 * residual / spread_mm).to_degrees();
+    assert!(
+        (size.rotation_deg - angle_deg).abs() <= angle_tolerance_deg,
+        "{} vs {angle_deg} (± {angle_tolerance_deg})",
+        size.rotation_deg
+    );
 }
 
 /// Thesis §2.2's registration and tool, refitted alone: after the reflector was

@@ -1,7 +1,8 @@
 //! `robocal check`: score a check set against a calibrated model without any
 //! fitting (`core::check`): per-pose error, mean / p95 / max, whether a rigid
-//! frame shift explains the errors, and the status (ok, degraded,
-//! recalibrate) for the thresholds.
+//! frame shift explains the errors, and the status (`core::check::CheckStatus`:
+//! ok, degraded, recalibrate, shifted) for the thresholds; the exit code is
+//! the status's (`cli::exit`), 0 only for ok.
 //!
 //! ```text
 //! robocal check --model cal.json --measurements check.csv [--degraded-mm 0.5] [--recalibrate-mm 1.0] [--json]
@@ -58,8 +59,14 @@ pub struct CheckOptions {
 pub fn check_text(r: &CheckResult) -> String {
     let p = &r.position;
     let mut s = format!(
-        "status: {}\n{}\nposition error [mm] over {} poses: mean {:.4}, p95 {:.4}, max {:.4}\n",
+        "status: {}{}\n{}\nposition error [mm] over {} poses: mean {:.4}, p95 {:.4}, max {:.4}\n",
         r.status.name(),
+        r.shift().map_or(String::new(), |f| format!(
+            " (frame shift {:.3} mm, {:.4}°: {})",
+            f.translation_mm,
+            f.rotation_deg,
+            r.status.action()
+        )),
         r.summary,
         p.n,
         p.mean_mm,
@@ -170,20 +177,22 @@ pub fn compare_files(a: &CompareArgs) -> anyhow::Result<Vec<ModelScore>> {
 /// The comparison as a table: a row per model.
 pub fn compare_text(scores: &[ModelScore]) -> String {
     let mut s = String::from(
-        "model | status | position mean / p95 / max [mm] | orientation mean / max [deg] | frame shift explains\n",
+        "model | status | position mean / p95 / max [mm] | orientation mean / max [deg] | frame shift [mm, deg] | explains\n",
     );
     for m in scores {
         let (p, r) = (&m.result.position, &m.result);
         let o = r.orientation.as_ref().map_or("—".to_string(), |o| {
             format!("{:.4} / {:.4}", o.mean_deg, o.max_deg)
         });
-        let f = r
-            .frame_shift
-            .as_ref()
-            .map_or("—", |f| if f.explains { "yes" } else { "no" });
+        let (shift, f) = r.frame_shift.as_ref().map_or(("—".into(), "—"), |f| {
+            (
+                format!("{:.3}, {:.4}", f.translation_mm, f.rotation_deg),
+                if f.explains { "yes" } else { "no" },
+            )
+        });
         let _ = writeln!(
             s,
-            "{} | {} | {:.4} / {:.4} / {:.4} | {o} | {f}",
+            "{} | {} | {:.4} / {:.4} / {:.4} | {o} | {shift} | {f}",
             m.model,
             r.status.name(),
             p.mean_mm,
@@ -204,12 +213,13 @@ pub fn compare(a: CompareArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-pub fn run(a: CheckArgs) -> anyhow::Result<()> {
+/// Prints the result; the exit code is the status's.
+pub fn run(a: CheckArgs) -> anyhow::Result<super::exit::Exit> {
     let r = check_file(&a)?;
     if a.check.json {
         println!("{}", serde_json::to_string_pretty(&r)?);
     } else {
         print!("{}", check_text(&r));
     }
-    Ok(())
+    Ok(super::exit::Exit::of_check(r.status))
 }

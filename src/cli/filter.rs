@@ -39,6 +39,8 @@ pub struct FilterArgs {
     /// The program's files (KRL: the `.src` with its `.dat`).
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
+    #[command(flatten)]
+    pub failures: super::exit::AllowFailures,
 }
 
 fn name_of(path: &Path) -> anyhow::Result<String> {
@@ -50,6 +52,11 @@ fn name_of(path: &Path) -> anyhow::Result<String> {
 
 /// Runs the command; returns the report JSON.
 pub fn filter_to_string(a: &FilterArgs) -> anyhow::Result<String> {
+    filter_report(a).map(|r| r.text)
+}
+
+/// The report JSON and how many targets failed or were skipped.
+pub fn filter_report(a: &FilterArgs) -> anyhow::Result<super::exit::Outcome> {
     let mut model = load_compensated(&a.model).map_err(|e| anyhow::anyhow!("{e}"))?;
     if let Some(p) = a.payload_kg {
         if !(p.is_finite() && p >= 0.0) {
@@ -95,15 +102,21 @@ pub fn filter_to_string(a: &FilterArgs) -> anyhow::Result<String> {
         std::fs::write(&path, &f.text)
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
-    Ok(serde_json::to_string_pretty(&out.report)? + "\n")
+    Ok(super::exit::Outcome {
+        text: serde_json::to_string_pretty(&out.report)? + "\n",
+        not_done: out.report.failed + out.report.skipped,
+        total: out.report.targets.len(),
+    })
 }
 
-pub fn run(a: FilterArgs) -> anyhow::Result<()> {
-    let report = filter_to_string(&a)?;
+/// Writes the filtered files and the report; the exit code says whether a
+/// target failed or was skipped.
+pub fn run(a: FilterArgs) -> anyhow::Result<super::exit::Exit> {
+    let report = filter_report(&a)?;
     match &a.report {
-        Some(path) => std::fs::write(path, report)
+        Some(path) => std::fs::write(path, &report.text)
             .with_context(|| format!("cannot write {}", path.display()))?,
-        None => print!("{report}"),
+        None => print!("{}", report.text),
     }
-    Ok(())
+    Ok(report.exit("targets", &a.failures))
 }

@@ -72,6 +72,8 @@ pub struct PredictArgs {
     /// Decimal separator of the joints file: `point` or `comma` (default: detected).
     #[arg(long)]
     pub decimal: Option<String>,
+    #[command(flatten)]
+    pub failures: super::exit::AllowFailures,
 }
 
 /// The validation evidence of a calibrated model file (none for presets and
@@ -89,6 +91,11 @@ struct Row {
 
 /// Runs the command and returns what it prints.
 pub fn predict_to_string(a: &PredictArgs) -> anyhow::Result<String> {
+    predict_outcome(a).map(|o| o.text)
+}
+
+/// What the command prints and how many readings failed.
+pub fn predict_outcome(a: &PredictArgs) -> anyhow::Result<super::exit::Outcome> {
     let mut model = load_compensated(&a.model).map_err(|e| anyhow::anyhow!("{e}"))?;
     if let Some(p) = a.payload_kg {
         if !(p.is_finite() && p >= 0.0) {
@@ -165,10 +172,15 @@ pub fn predict_to_string(a: &PredictArgs) -> anyhow::Result<String> {
         dof,
     };
     let format = if a.json { OutputFormat::Json } else { a.format };
-    Ok(match format {
+    let text = match format {
         OutputFormat::Json => render_json(&h, &rows),
         OutputFormat::Table => render_table(&h, &rows),
         OutputFormat::Csv => render_csv(&h, &rows),
+    };
+    Ok(super::exit::Outcome {
+        text,
+        not_done: rows.iter().filter(|r| r.result.is_err()).count(),
+        total: rows.len(),
     })
 }
 
@@ -357,7 +369,9 @@ fn render_json(h: &Header, rows: &[Row]) -> String {
     serde_json::to_string_pretty(&doc).expect("JSON output serialises") + "\n"
 }
 
-pub fn run(args: PredictArgs) -> anyhow::Result<()> {
-    print!("{}", predict_to_string(&args)?);
-    Ok(())
+/// Prints the poses; the exit code says whether a reading failed.
+pub fn run(args: PredictArgs) -> anyhow::Result<super::exit::Exit> {
+    let out = predict_outcome(&args)?;
+    print!("{}", out.text);
+    Ok(out.exit("readings", &args.failures))
 }

@@ -97,6 +97,8 @@ pub struct SolveArgs {
     /// detected; with `,` delimiters a decimal comma is read in quoted fields).
     #[arg(long)]
     pub decimal: Option<String>,
+    #[command(flatten)]
+    pub failures: super::exit::AllowFailures,
 }
 
 /// How `robocal solve` prints its results.
@@ -127,6 +129,11 @@ fn parse_seed(text: &str) -> anyhow::Result<Vec<f64>> {
 
 /// Runs the command and returns what it prints.
 pub fn solve_to_string(a: &SolveArgs) -> anyhow::Result<String> {
+    solve_outcome(a).map(|o| o.text)
+}
+
+/// What the command prints and how many targets failed.
+pub fn solve_outcome(a: &SolveArgs) -> anyhow::Result<super::exit::Outcome> {
     let mut model = load_compensated(&a.model).map_err(|e| anyhow::anyhow!("{e}"))?;
     if let Some(p) = a.payload_kg {
         if !(p.is_finite() && p >= 0.0) {
@@ -229,10 +236,15 @@ pub fn solve_to_string(a: &SolveArgs) -> anyhow::Result<String> {
         closed_form: solver.analytic().is_some(),
     };
     let format = if a.json { OutputFormat::Json } else { a.format };
-    Ok(match format {
+    let text = match format {
         OutputFormat::Json => render_json(&header, &results),
         OutputFormat::Table => render_table(&header, &results, solver.model().dof()),
         OutputFormat::Csv => results_csv(&results, solver.model().dof(), conv),
+    };
+    Ok(super::exit::Outcome {
+        text,
+        not_done: results.iter().filter(|r| !r.solution.converged).count(),
+        total: results.len(),
     })
 }
 
@@ -392,7 +404,9 @@ fn render_table(h: &Header, results: &[TargetResult], dof: usize) -> String {
     out
 }
 
-pub fn run(args: SolveArgs) -> anyhow::Result<()> {
-    print!("{}", solve_to_string(&args)?);
-    Ok(())
+/// Prints the results; the exit code says whether a target failed.
+pub fn run(args: SolveArgs) -> anyhow::Result<super::exit::Exit> {
+    let out = solve_outcome(&args)?;
+    print!("{}", out.text);
+    Ok(out.exit("targets", &args.failures))
 }

@@ -15,7 +15,7 @@ use crate::service::checks::CheckRow;
 use axum::extract::State;
 use axum::http::StatusCode;
 use axum::response::{IntoResponse, Response};
-use robocal_core::check::CheckThresholds;
+use robocal_core::check::{CheckThresholds, ShiftSize};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
@@ -42,13 +42,17 @@ pub struct Check {
     pub mean_mm: f64,
     pub temperature_c: Option<f64>,
     pub created_at: String,
-    /// Figures, per-pose errors, frame shift, summary and thresholds.
+    /// The frame shift's size when the status is `shifted`.
+    pub shift: Option<ShiftSize>,
+    /// Figures, per-pose errors (at most `CHECK_POSES_KEPT`), frame shift,
+    /// summary and thresholds.
     pub result: Value,
 }
 
 impl From<CheckRow> for Check {
     fn from(c: CheckRow) -> Self {
         Check {
+            shift: service::checks::shift_of(&c),
             id: c.id,
             robot_id: c.robot_id,
             set_id: c.set_id,
@@ -105,6 +109,8 @@ pub struct Status {
     pub robot_id: i64,
     /// The latest check's status; `null` before any check.
     pub status: Option<&'static str>,
+    /// The frame shift's size when the status is `shifted`.
+    pub shift: Option<ShiftSize>,
     pub latest_check: Option<Check>,
     pub thresholds: CheckThresholds,
 }
@@ -114,10 +120,12 @@ pub async fn status(
     ApiPath(robot_id): ApiPath<i64>,
 ) -> Result<Response, ApiError> {
     let (status, latest, thresholds) = service::checks::status(&state, robot_id).await?;
+    let latest = latest.map(Check::from);
     Ok(axum::Json(Status {
         robot_id,
         status: status.map(|s| s.name()),
-        latest_check: latest.map(Check::from),
+        shift: latest.as_ref().and_then(|c| c.shift),
+        latest_check: latest,
         thresholds,
     })
     .into_response())

@@ -79,6 +79,8 @@ pub struct RobotCheck {
     /// The model version the check scored.
     pub version: Option<i64>,
     pub mean_mm: Option<f64>,
+    /// The frame shift's size when the status is `shifted`.
+    pub shift: Option<robocal_core::check::ShiftSize>,
 }
 
 impl Robot {
@@ -233,6 +235,7 @@ pub async fn get_one(
         checked_at: latest.as_ref().map(|c| c.created_at.clone()),
         version: latest.as_ref().map(|c| c.version),
         mean_mm: latest.as_ref().map(|c| c.mean_mm),
+        shift: latest.as_ref().and_then(service::checks::shift_of),
     });
     Ok(axum::Json(robot).into_response())
 }

@@ -1,13 +1,19 @@
 //! Check poses: score a measurement set against the active (or a named) model
 //! version without fitting (`core::check`), keep the history, and give the
 //! robot's status from its latest check and its thresholds.
+//!
+//! A stored (or compared) result keeps at most [`CHECK_POSES_KEPT`] per-pose
+//! errors, the largest (`core::check::worst_poses`), and says how many poses
+//! were scored (`poses_total`): the figures cover every pose, the history and
+//! its pages stay bounded for a set of any size.
 
 use super::{robots, versions, AppState, ServiceError};
 use crate::calibrate::compensate::CalibratedModelFile;
 pub use crate::db::CheckRow;
 use crate::db::{Listing, NewCheck};
 use robocal_core::check::{
-    score, CheckResult, CheckStatus, CheckThresholds, DEGRADED_MIN_MM, THRESHOLD_MAX_MM,
+    score, worst_poses, CheckResult, CheckStatus, CheckThresholds, PoseError, ShiftSize,
+    DEGRADED_MIN_MM, THRESHOLD_MAX_MM,
 };
 use serde::Serialize;
 use serde_json::Value;
@@ -23,12 +29,74 @@ pub struct CheckCommand {
     pub temperature_c: Option<f64>,
 }
 
-/// What a check stores beside its figures.
+/// Most per-pose errors a stored or compared check keeps (the largest).
+pub const CHECK_POSES_KEPT: usize = 100;
+
+/// What a check stores beside its figures: the result with at most
+/// [`CHECK_POSES_KEPT`] per-pose errors, how many poses were scored, the
+/// thresholds.
 #[derive(Debug, Serialize)]
-struct Stored<'a> {
+struct Stored {
     #[serde(flatten)]
-    result: &'a CheckResult,
+    result: CheckResult,
+    poses_total: usize,
     thresholds: CheckThresholds,
+}
+
+impl Stored {
+    fn json(mut result: CheckResult, thresholds: CheckThresholds) -> Result<Value, ServiceError> {
+        let poses_total = result.poses.len();
+        result.poses = worst_poses(&result.poses, CHECK_POSES_KEPT);
+        serde_json::to_value(Stored {
+            result,
+            poses_total,
+            thresholds,
+        })
+        .map_err(|e| ServiceError::Internal(e.to_string()))
+    }
+}
+
+/// A stored check as answered: at most [`CHECK_POSES_KEPT`] per-pose errors
+/// and `poses_total`, also for a check stored before the cap (which holds
+/// every pose: the largest are kept, their count is the total).
+fn bounded(mut check: CheckRow) -> CheckRow {
+    let result = &mut check.result.0;
+    let poses: Option<Vec<PoseError>> = result
+        .get("poses")
+        .and_then(|p| serde_json::from_value(p.clone()).ok());
+    if let (Some(poses), Some(object)) = (poses, result.as_object_mut()) {
+        object
+            .entry("poses_total")
+            .or_insert_with(|| Value::from(poses.len()));
+        if poses.len() > CHECK_POSES_KEPT {
+            let kept = worst_poses(&poses, CHECK_POSES_KEPT);
+            object.insert(
+                "poses".into(),
+                serde_json::to_value(kept).unwrap_or_default(),
+            );
+        }
+    }
+    check
+}
+
+/// The status of a stored check (`None` for a name this robocal does not
+/// know; the store's constraint admits only [`CheckStatus`] names).
+pub fn status_of(check: &CheckRow) -> Option<CheckStatus> {
+    CheckStatus::from_name(&check.status)
+}
+
+/// The size of the frame shift a stored `shifted` check names (its stored
+/// `frame_shift`); `None` for every other status, as for checks stored
+/// before the status existed.
+pub fn shift_of(check: &CheckRow) -> Option<ShiftSize> {
+    if status_of(check) != Some(CheckStatus::Shifted) {
+        return None;
+    }
+    let f = &check.result.0["frame_shift"];
+    Some(ShiftSize {
+        translation_mm: f["translation_mm"].as_f64()?,
+        rotation_deg: f["rotation_deg"].as_f64()?,
+    })
 }
 
 /// The robot's thresholds: its own, or the defaults.
@@ -110,19 +178,16 @@ pub async fn create(state: &AppState, cmd: CheckCommand) -> Result<CheckRow, Ser
     let result = super::heavy::run(state, "check", move |_| score(&model, &rows, &t))
         .await?
         .map_err(|e| ServiceError::Invalid(e.to_string()))?;
-    let stored = serde_json::to_value(Stored {
-        result: &result,
-        thresholds: t,
-    })
-    .map_err(|e| ServiceError::Internal(e.to_string()))?;
+    let (status, mean_mm) = (result.status, result.position.mean_mm);
+    let stored = Stored::json(result, t)?;
     let row = state
         .db()
         .insert_check(&NewCheck {
             robot_id,
             set_id: cmd.set_id,
             version,
-            status: result.status.name(),
-            mean_mm: result.position.mean_mm,
+            status: status.name(),
+            mean_mm,
             temperature_c,
             result: &stored,
         })
@@ -131,7 +196,7 @@ pub async fn create(state: &AppState, cmd: CheckCommand) -> Result<CheckRow, Ser
     tracing::info!(
         robot = robot_id,
         version,
-        status = result.status.name(),
+        status = status.name(),
         "check scored"
     );
     Ok(row)
@@ -177,8 +242,10 @@ pub const COMPARE_POSE_VERSIONS_MAX: usize = 200_000;
 pub struct VersionScore {
     pub version: i64,
     pub method: String,
-    /// Figures, per-pose errors, frame shift, status for the robot's
-    /// thresholds, summary and the thresholds.
+    /// The frame shift's size when the status is `shifted`.
+    pub shift: Option<ShiftSize>,
+    /// Figures, per-pose errors (at most [`CHECK_POSES_KEPT`]), frame shift,
+    /// status for the robot's thresholds, summary and the thresholds.
     pub result: Value,
 }
 
@@ -237,15 +304,11 @@ pub async fn compare(
                 }
                 let result = score(&model, &rows, &t)
                     .map_err(|e| ServiceError::Invalid(format!("version {version}: {e}")))?;
-                let result = serde_json::to_value(Stored {
-                    result: &result,
-                    thresholds: t,
-                })
-                .map_err(|e| ServiceError::Internal(e.to_string()))?;
                 Ok(VersionScore {
                     version,
                     method,
-                    result,
+                    shift: result.shift(),
+                    result: Stored::json(result, t)?,
                 })
             })
             .collect::<Result<Vec<_>, ServiceError>>()
@@ -260,7 +323,9 @@ pub async fn page(
     limit: i64,
     offset: i64,
 ) -> Result<Listing<CheckRow>, ServiceError> {
-    Ok(state.db().checks_page(robot_id, limit, offset).await?)
+    let mut listing = state.db().checks_page(robot_id, limit, offset).await?;
+    listing.rows = listing.rows.into_iter().map(bounded).collect();
+    Ok(listing)
 }
 
 /// The robot's status: its latest check's (`None` before any check) and the thresholds.
@@ -269,9 +334,7 @@ pub async fn status(
     robot_id: i64,
 ) -> Result<(Option<CheckStatus>, Option<CheckRow>, CheckThresholds), ServiceError> {
     let t = thresholds(state, robot_id).await?;
-    let latest = state.db().latest_check(robot_id).await?;
-    let status = latest
-        .as_ref()
-        .and_then(|c| CheckStatus::ALL.into_iter().find(|s| s.name() == c.status));
+    let latest = state.db().latest_check(robot_id).await?.map(bounded);
+    let status = latest.as_ref().and_then(status_of);
     Ok((status, latest, t))
 }

@@ -11,13 +11,15 @@
 //! `flow` (the quickstart end to end), `sets` (uploads), `solve` (targets CSV
 //! in and out), `cell` (tools, work objects, program filtering), `jobs`
 //! (progress, cancellation, saturation, races), `record` (sets a version uses,
-//! the calibration record, check poses), `roles` (keys with roles, open reads,
+//! the calibration record, check poses), `checks` (a moved base: the
+//! `shifted` status everywhere; capped per-pose errors), `roles` (keys with roles, open reads,
 //! the console's security headers); the harness is `support`.
 
 mod abandoned;
 mod admission;
 mod cell;
 mod cell_fit;
+mod checks;
 #[path = "../common/mod.rs"]
 mod common;
 mod contract;

@@ -2,6 +2,8 @@
 //! schema 6 (sets, a calibration, versions, checks referencing the sets) is
 //! opened by the service, which rebuilds `measurement_sets` for the `check`
 //! role (migration 0007); every row, reference, index and id counter survives.
+//! Likewise `checks` at schema 8 for the `shifted` status (migration 0009),
+//! its old checks read through the service.
 
 use robocal::db::Db;
 use sqlx::sqlite::{SqliteConnectOptions, SqlitePool};
@@ -221,4 +223,218 @@ async fn sqlite_check_role_migration_keeps_sets_versions_and_check_references() 
         .await
         .unwrap();
     assert_eq!(left, 0);
+}
+
+/// A check as robocal stored it before the `shifted` status (schema 8):
+/// every pose's error, a frame shift that explains the errors, status `ok`.
+fn old_check_json(poses: usize) -> String {
+    use robocal::check::{CheckResult, CheckStatus, FrameShift, PoseError};
+    let errors: Vec<f64> = (0..poses).map(|i| 10.0 + 0.01 * i as f64).collect();
+    let result = CheckResult {
+        position: robocal::stats::ErrorStats::from_errors_mm(&errors),
+        orientation: None,
+        poses: errors
+            .iter()
+            .enumerate()
+            .map(|(i, e)| PoseError {
+                index: i + 1,
+                position_mm: *e,
+                orientation_deg: None,
+            })
+            .collect(),
+        frame_shift: Some(FrameShift {
+            translation_mm: 10.7,
+            rotation_deg: 0.01,
+            residual_mean_mm: 0.02,
+            explains: true,
+        }),
+        status: CheckStatus::Ok,
+        summary: "the errors are a rigid frame shift".into(),
+    };
+    let mut v = serde_json::to_value(result).unwrap();
+    v["thresholds"] = serde_json::json!({
+        "degraded_mm": 0.5, "margin_mm": 0.5, "recalibrate_mm": 1.0, "frame_shift_ratio": 0.5
+    });
+    v.to_string()
+}
+
+/// A SQLite file at schema 8 in `dir` with a robot, a check set and two
+/// checks in the old form (`ok` and `recalibrate`) of `total` poses each; a
+/// third was deleted (its id must not come back). Its URL and options.
+async fn schema_8_with_old_checks(
+    dir: &std::path::Path,
+    total: usize,
+) -> (String, SqliteConnectOptions) {
+    let path = dir.join("old.db");
+    let url = format!("sqlite://{}?mode=rwc", path.display());
+    let options = SqliteConnectOptions::from_str(&url)
+        .unwrap()
+        .foreign_keys(true);
+    let pool = SqlitePool::connect_with(options.clone()).await.unwrap();
+    let mut old = sqlx::migrate!("migrations/sqlite");
+    let before: Vec<_> = old
+        .migrations
+        .iter()
+        .filter(|m| m.version <= 8)
+        .cloned()
+        .collect();
+    assert_eq!(before.len(), 8);
+    old.migrations = Cow::Owned(before);
+    old.run(&pool).await.unwrap();
+    sqlx::query("INSERT INTO robots (name, model_json, dof) VALUES ('r', '{}', 6)")
+        .execute(&pool)
+        .await
+        .unwrap();
+    sqlx::query(
+        "INSERT INTO measurement_sets (robot_id, name, role, format, original, rows_json, row_count, dof) \
+         VALUES (1, 'c', 'check', 'csv', 'x', '[]', 1, 6)",
+    )
+    .execute(&pool)
+    .await
+    .unwrap();
+    for (set, status) in [
+        (Some(1), "ok"),
+        (None, "recalibrate"),
+        (Some(1), "degraded"),
+    ] {
+        sqlx::query(
+            "INSERT INTO checks (robot_id, set_id, version, status, mean_mm, temperature_c, result_json) \
+             VALUES (1, $1, 1, $2, 10.5, 21.5, $3)",
+        )
+        .bind(set)
+        .bind(status)
+        .bind(old_check_json(total))
+        .execute(&pool)
+        .await
+        .unwrap();
+    }
+    // The newest check deleted: its id (3) must not come back.
+    sqlx::query("DELETE FROM checks WHERE id = 3")
+        .execute(&pool)
+        .await
+        .unwrap();
+    let refused = sqlx::query(
+        "INSERT INTO checks (robot_id, version, status, mean_mm, result_json) \
+         VALUES (1, 1, 'shifted', 1, '{}')",
+    )
+    .execute(&pool)
+    .await;
+    assert!(refused.is_err());
+    pool.close().await;
+    (url, options)
+}
+
+/// Migration 0009 (the `shifted` status) on a file at schema 8: the checks
+/// keep their ids, columns and the id counter; `shifted` is stored, an
+/// unknown status still refused; the old checks read through the service
+/// (their `ok` stays as stored, no shift named, the per-pose errors capped).
+#[tokio::test]
+async fn sqlite_shifted_status_migration_keeps_old_checks_readable() {
+    use robocal::service::checks::CHECK_POSES_KEPT;
+    let dir = tempfile::tempdir().unwrap();
+    let total = CHECK_POSES_KEPT + 50;
+    let (url, options) = schema_8_with_old_checks(dir.path(), total).await;
+    let pool = SqlitePool::connect_with(options.clone()).await.unwrap();
+    let dump =
+        "SELECT id, robot_id, set_id, version, status, mean_mm, temperature_c, result_json, \
+                created_at FROM checks ORDER BY id";
+    type Row = (
+        i64,
+        i64,
+        Option<i64>,
+        i64,
+        String,
+        f64,
+        Option<f64>,
+        String,
+        String,
+    );
+    let checks_before: Vec<Row> = sqlx::query_as(dump).fetch_all(&pool).await.unwrap();
+    pool.close().await;
+
+    let db = Db::connect(&url).await.unwrap();
+    assert_eq!(db.pending_migrations().await.unwrap(), 0);
+    let pool = SqlitePool::connect_with(options).await.unwrap();
+    let checks_after: Vec<Row> = sqlx::query_as(dump).fetch_all(&pool).await.unwrap();
+    assert_eq!(checks_after, checks_before);
+    let index: Option<String> = sqlx::query_scalar(
+        "SELECT sql FROM sqlite_master WHERE type = 'index' AND name = 'checks_robot'",
+    )
+    .fetch_optional(&pool)
+    .await
+    .unwrap();
+    assert!(index.is_some_and(|s| s.contains("checks(robot_id, id)")));
+    let tables: Vec<String> = sqlx::query_scalar(
+        "SELECT name FROM sqlite_master WHERE type = 'table' AND name LIKE 'checks%' ORDER BY name",
+    )
+    .fetch_all(&pool)
+    .await
+    .unwrap();
+    assert_eq!(tables, ["checks"]);
+    let id: i64 = sqlx::query_scalar(
+        "INSERT INTO checks (robot_id, version, status, mean_mm, result_json) \
+         VALUES (1, 1, 'shifted', 1, '{}') RETURNING id",
+    )
+    .fetch_one(&pool)
+    .await
+    .unwrap();
+    assert_eq!(id, 4);
+    let bogus = sqlx::query(
+        "INSERT INTO checks (robot_id, version, status, mean_mm, result_json) \
+         VALUES (1, 1, 'bogus', 1, '{}')",
+    )
+    .execute(&pool)
+    .await;
+    assert!(bogus.is_err());
+    sqlx::query("DELETE FROM checks WHERE id = 4")
+        .execute(&pool)
+        .await
+        .unwrap();
+    // Deleting the set still clears its checks' set_id.
+    sqlx::query("DELETE FROM measurement_sets WHERE id = 1")
+        .execute(&pool)
+        .await
+        .unwrap();
+    let sets: Vec<Option<i64>> = sqlx::query_scalar("SELECT set_id FROM checks ORDER BY id")
+        .fetch_all(&pool)
+        .await
+        .unwrap();
+    assert_eq!(sets, [None, None]);
+    pool.close().await;
+    old_checks_read_through_the_service(db, dir, total).await;
+}
+
+/// The checks of [`schema_8_with_old_checks`], migrated, through the service
+/// (every answer checked against the spec).
+async fn old_checks_read_through_the_service(db: Db, dir: tempfile::TempDir, total: usize) {
+    use crate::support::{Spec, TestApp};
+    use axum::http::StatusCode;
+    use robocal::service::checks::CHECK_POSES_KEPT;
+    let state = robocal::http::AppState::new(db.clone(), robocal::http::ServiceConfig::default());
+    let t = TestApp {
+        router: robocal::http::app(state.clone()),
+        state,
+        db,
+        spec: std::sync::Arc::new(Spec::load()),
+        _dir: dir,
+        _pg: None,
+        key: None,
+    };
+    let r = t.get("/v1/robots/{id}/checks", &["1"]).await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let checks = r.json()["checks"].clone();
+    assert_eq!(checks[0]["status"], "ok");
+    assert_eq!(checks[0]["shift"], serde_json::Value::Null);
+    assert_eq!(checks[1]["status"], "recalibrate");
+    for c in checks.as_array().unwrap() {
+        assert_eq!(c["result"]["poses_total"], total);
+        let poses = c["result"]["poses"].as_array().unwrap();
+        assert_eq!(poses.len(), CHECK_POSES_KEPT);
+        // The largest errors: the last rows.
+        assert_eq!(poses[0]["index"], total - CHECK_POSES_KEPT + 1);
+    }
+    let r = t.get("/v1/robots/{id}/status", &["1"]).await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    assert_eq!(r.json()["status"], "recalibrate");
+    assert_eq!(r.json()["shift"], serde_json::Value::Null);
 }

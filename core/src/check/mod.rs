@@ -12,10 +12,12 @@
 //!   When it removes most of the error (residual mean ≤ `frame_shift_ratio` ×
 //!   the raw mean) and the residual is within the `degraded` threshold, the
 //!   errors are a moved tracker (or base), not a changed robot: the check says
-//!   so and the robot's status is judged on the residual. Joint-1 offsets are
+//!   so, with the shift's size, and the status is `shifted`. Joint-1 offsets are
 //!   a rotation about the base's z axis and are, by nature, indistinguishable
 //!   from a frame shift.
-//! - Status ([`CheckStatus`]): `ok` when the judged mean is at most
+//! - Status ([`CheckStatus`], the table in `status.rs`): `shifted` when a
+//!   frame shift explains the errors (never `ok`: the parts are off by the
+//!   shift until the robot is re-registered); else on the raw mean, `ok` up to
 //!   `degraded_mm`, `degraded` up to `recalibrate_mm`, `recalibrate` beyond.
 //!
 //! - Quick re-registration ([`reregister`]): the measurement frame and the
@@ -26,36 +28,13 @@
 pub mod iso9283;
 mod reregister;
 mod score;
+mod status;
 
 pub use reregister::{reregister, ReregisterError, Reregistration, MAX_CONDITION, MIN_POSES};
-pub use score::{score, AngleStats, CheckError, CheckResult, FrameShift, PoseError};
+pub use score::{score, worst_poses, AngleStats, CheckError, CheckResult, FrameShift, PoseError};
+pub use status::{CheckStatus, ShiftSize};
 
 use serde::{Deserialize, Serialize};
-
-/// The status a check gives a robot.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum CheckStatus {
-    Ok,
-    Degraded,
-    Recalibrate,
-}
-
-impl CheckStatus {
-    pub const ALL: [CheckStatus; 3] = [
-        CheckStatus::Ok,
-        CheckStatus::Degraded,
-        CheckStatus::Recalibrate,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            CheckStatus::Ok => "ok",
-            CheckStatus::Degraded => "degraded",
-            CheckStatus::Recalibrate => "recalibrate",
-        }
-    }
-}
 
 /// Steps per mm of stored thresholds (1 nm resolution): a threshold built
 /// from a margin ([`CheckThresholds::from_margin`]) is rounded to it, so that

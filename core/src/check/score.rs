@@ -1,6 +1,6 @@
 //! Scoring a check set against a model (see [`super`] for the conventions).
 
-use super::{CheckStatus, CheckThresholds};
+use super::{CheckStatus, CheckThresholds, ShiftSize};
 use crate::calibrate::compensate::CompensatedModel;
 use crate::calibrate::identify::registration::register;
 use crate::measure::{MeasuredPose, Measurement};
@@ -65,6 +65,35 @@ pub struct CheckResult {
     pub status: CheckStatus,
     /// One sentence on why this status.
     pub summary: String,
+}
+
+impl CheckResult {
+    /// The shift's size when the status is `shifted`.
+    pub fn shift(&self) -> Option<ShiftSize> {
+        let s = self.frame_shift.as_ref()?;
+        (self.status == CheckStatus::Shifted).then_some(ShiftSize {
+            translation_mm: s.translation_mm,
+            rotation_deg: s.rotation_deg,
+        })
+    }
+}
+
+/// At most `max` of `poses`: all when there are no more, else the `max`
+/// largest position errors (ties: the earlier row), in row order.
+pub fn worst_poses(poses: &[PoseError], max: usize) -> Vec<PoseError> {
+    if poses.len() <= max {
+        return poses.to_vec();
+    }
+    let mut order: Vec<usize> = (0..poses.len()).collect();
+    order.sort_by(|&a, &b| {
+        poses[b]
+            .position_mm
+            .total_cmp(&poses[a].position_mm)
+            .then(a.cmp(&b))
+    });
+    order.truncate(max);
+    order.sort_unstable();
+    order.into_iter().map(|i| poses[i].clone()).collect()
 }
 
 /// Scores `rows` (controller joints [deg], positions [mm] in the model's
@@ -174,6 +203,9 @@ fn frame_shift(
     })
 }
 
+/// The status: `shifted` when the frame shift explains the errors (its
+/// residual is then within `degraded_mm` by [`frame_shift`]'s rule), else
+/// the thresholds' level of the raw mean.
 fn judge(
     position: &ErrorStats,
     shift: Option<&FrameShift>,
@@ -181,7 +213,7 @@ fn judge(
 ) -> (CheckStatus, String) {
     match shift.filter(|s| s.explains) {
         Some(s) => (
-            t.status(s.residual_mean_mm),
+            CheckStatus::Shifted,
             format!(
                 "the errors (mean {:.3} mm) are a rigid frame shift ({:.3} mm, {:.4}°; mean {:.3} mm after removing it): \
                  the tracker or the base moved; re-register rather than recalibrate",
@@ -196,7 +228,8 @@ fn judge(
                     "above {} mm, at most {} mm",
                     t.degraded_mm, t.recalibrate_mm
                 ),
-                CheckStatus::Recalibrate => format!(
+                // The thresholds' levels are ok, degraded and recalibrate.
+                CheckStatus::Recalibrate | CheckStatus::Shifted => format!(
                     "above {} mm, not explained by a frame shift",
                     t.recalibrate_mm
                 ),
@@ -206,5 +239,34 @@ fn judge(
                 format!("mean position error {:.3} mm: {why}", position.mean_mm),
             )
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pose(index: usize, position_mm: f64) -> PoseError {
+        PoseError {
+            index,
+            position_mm,
+            orientation_deg: None,
+        }
+    }
+
+    #[test]
+    fn worst_poses_keep_the_largest_errors_in_row_order() {
+        let poses: Vec<PoseError> = [0.3, 0.9, 0.1, 0.9, 0.5, 0.2]
+            .iter()
+            .enumerate()
+            .map(|(i, e)| pose(i + 1, *e))
+            .collect();
+        let kept: Vec<usize> = worst_poses(&poses, 3).iter().map(|p| p.index).collect();
+        assert_eq!(kept, [2, 4, 5]);
+        // A tie at the cut keeps the earlier row.
+        let kept: Vec<usize> = worst_poses(&poses, 1).iter().map(|p| p.index).collect();
+        assert_eq!(kept, [2]);
+        assert_eq!(worst_poses(&poses, 6), poses);
+        assert_eq!(worst_poses(&poses, 100), poses);
     }
 }

@@ -1,13 +1,15 @@
 //! The console's "Is it still accurate?" section of a robot page: the status
 //! by the latest check, a trend plot of every check's mean error against
 //! time (thresholds drawn, version changes marked), the history, a form to
-//! run a check, and the comparison of versions on one set.
+//! run a check, and the comparison of versions on one set. Every status
+//! (`core::check::CheckStatus`) has its colour and its meaning (the legend);
+//! a `shifted` check shows the shift's size wherever it is shown.
 
-use crate::service::checks::CheckRow;
+use crate::service::checks::{shift_of, status_of, CheckRow};
 use crate::service::sets::SetRow;
 use crate::service::versions::VersionRow;
 use maud::{html, Markup};
-use robocal_core::check::{CheckStatus, CheckThresholds};
+use robocal_core::check::{CheckStatus, CheckThresholds, ShiftSize};
 
 /// Everything the section shows.
 pub struct ChecksView<'a> {
@@ -18,6 +20,49 @@ pub struct ChecksView<'a> {
     pub checks: &'a [CheckRow],
     pub sets: &'a [SetRow],
     pub versions: &'a [VersionRow],
+}
+
+/// The colour a status is drawn in: only `ok` is green.
+pub fn status_colour(s: CheckStatus) -> &'static str {
+    match s {
+        CheckStatus::Ok => "#1e7a3c",
+        CheckStatus::Degraded => "#b07d00",
+        CheckStatus::Recalibrate => "#b3261e",
+        CheckStatus::Shifted => "#7a3fb3",
+    }
+}
+
+/// The colour of a stored check's status (grey for a name not in the table).
+fn row_colour(c: &CheckRow) -> &'static str {
+    status_of(c).map_or("#5b6475", status_colour)
+}
+
+/// The style rules of the statuses (part of the console's one style sheet,
+/// whose hash the page's `Content-Security-Policy` names): a tag's
+/// background, a table cell's text.
+pub fn status_css() -> String {
+    CheckStatus::ALL
+        .iter()
+        .map(|s| {
+            let (name, colour) = (s.name(), status_colour(*s));
+            format!(".status-tag.{name} {{ background: {colour}; }} .status-{name} {{ color: {colour}; font-weight: 600; }}\n")
+        })
+        .collect()
+}
+
+/// `13.127 mm, 0.2636°`.
+fn shift_text(s: &ShiftSize) -> String {
+    format!("{:.3} mm, {:.4}°", s.translation_mm, s.rotation_deg)
+}
+
+/// A status as a coloured tag, with the shift's size when shifted.
+fn status_tag(s: CheckStatus, shift: Option<&ShiftSize>) -> Markup {
+    html! {
+        span class={ "status-tag " (s.name()) } title=(s.meaning()) {
+            (s.name())
+            @if let Some(f) = shift { " " (shift_text(f)) }
+        }
+    }
 }
 
 /// Plot size [px].
@@ -68,8 +113,12 @@ fn trend(checks: &[CheckRow], t: &CheckThresholds) -> Markup {
             }
             @for (i, c) in checks.iter().enumerate() {
                 circle.check-point cx=(format!("{:.1}", x(i))) cy=(format!("{:.1}", y(c.mean_mm))) r="4"
-                    fill=(match c.status.as_str() { "ok" => "#1e7a3c", "degraded" => "#b07d00", _ => "#b3261e" }) {
-                    title { (c.created_at) ": " (format!("{:.4}", c.mean_mm)) " mm, " (c.status) ", v" (c.version) }
+                    fill=(row_colour(c)) data-status=(c.status) {
+                    title {
+                        (c.created_at) ": " (format!("{:.4}", c.mean_mm)) " mm, " (c.status)
+                        @if let Some(f) = shift_of(c) { " by a frame shift of " (shift_text(&f)) }
+                        ", v" (c.version)
+                    }
                 }
             }
         }
@@ -93,17 +142,26 @@ pub fn checks_section(v: &ChecksView) -> Markup {
             p #check-status {
                 "Status: "
                 @match v.status {
-                    Some(s) => { span class={ "status-tag " (s.name()) } { (s.name()) } }
+                    Some(s) => {
+                        (status_tag(s, v.checks.last().and_then(shift_of).as_ref()))
+                        " " span.note { (s.action()) }
+                    }
                     None => { span.note { "no check yet" } }
                 }
                 span.note { " · degraded above " (v.thresholds.degraded_mm) " mm, recalibrate above " (v.thresholds.recalibrate_mm) " mm mean" }
+            }
+            dl #check-statuses {
+                @for s in CheckStatus::ALL {
+                    dt { span class={ "status-tag " (s.name()) } { (s.name()) } }
+                    dd { (s.meaning()) "; " (s.action()) }
+                }
             }
             @if v.checks.is_empty() {
                 p.empty { "No check yet: score a fresh measurement set against a version below." }
             } @else {
                 (trend(v.checks, v.thresholds))
                 table #checks {
-                    thead { tr { th { "Check" } th { "Time" } th { "Version" } th { "Set" } th { "Mean [mm]" } th { "Status" } th { "Temperature [°C]" } } }
+                    thead { tr { th { "Check" } th { "Time" } th { "Version" } th { "Set" } th { "Mean [mm]" } th { "Status" } th { "Frame shift" } th { "Temperature [°C]" } } }
                     tbody {
                         @for c in v.checks.iter().rev() {
                             tr {
@@ -112,7 +170,8 @@ pub fn checks_section(v: &ChecksView) -> Markup {
                                 td { "v" (c.version) }
                                 td { @if let Some(s) = c.set_id { (s) } @else { "—" } }
                                 td { (format!("{:.4}", c.mean_mm)) }
-                                td.check-status { (c.status) }
+                                td class={ "check-status status-" (c.status) } { (c.status) }
+                                td.check-shift { @if let Some(f) = shift_of(c) { (shift_text(&f)) } @else { "—" } }
                                 td { @if let Some(t) = c.temperature_c { (t) } @else { "—" } }
                             }
                         }
@@ -145,7 +204,7 @@ pub fn checks_section(v: &ChecksView) -> Markup {
                     button type="submit" { "Compare" }
                 }
                 table #compare-result hidden {
-                    thead { tr { th { "Version" } th { "Method" } th { "Mean [mm]" } th { "p95 [mm]" } th { "Max [mm]" } th { "Orientation mean [°]" } th { "Status" } th { "Frame shift explains" } } }
+                    thead { tr { th { "Version" } th { "Method" } th { "Mean [mm]" } th { "p95 [mm]" } th { "Max [mm]" } th { "Orientation mean [°]" } th { "Status" } th { "Frame shift [mm, °]" } th { "Explains" } } }
                     tbody {}
                 }
             }

@@ -118,13 +118,15 @@ const handlers = {
       const p = v.result.position;
       const o = v.result.orientation;
       const f = v.result.frame_shift;
+      const shift = f ? `${f.translation_mm.toFixed(3)} mm, ${f.rotation_deg.toFixed(4)}°` : "—";
       const cells = ["v" + v.version, v.method, p.mean_mm.toFixed(4), p.p95_mm.toFixed(4), p.max_mm.toFixed(4),
-        o ? o.mean_deg.toFixed(4) : "—", v.result.status, f ? (f.explains ? "yes" : "no") : "—"];
+        o ? o.mean_deg.toFixed(4) : "—", v.result.status, shift, f ? (f.explains ? "yes" : "no") : "—"];
       const tr = document.createElement("tr");
       tr.className = "compared";
-      for (const c of cells) {
+      for (const [i, c] of cells.entries()) {
         const td = document.createElement("td");
         td.textContent = String(c);
+        if (i === 6) td.className = `status-${c}`;
         tr.append(td);
       }
       tbody.append(tr);

@@ -16,7 +16,14 @@ use crate::service::versions::VersionRow;
 use maud::{html, Markup, PreEscaped, DOCTYPE};
 
 const SCRIPT: &str = include_str!("console.js");
-const STYLE: &str = include_str!("console.css");
+const STYLE_SHEET: &str = include_str!("console.css");
+
+/// The console's one style sheet: `console.css` and the statuses' rules
+/// (`check_pages::status_css`).
+fn style() -> &'static str {
+    static STYLE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    STYLE.get_or_init(|| format!("{STYLE_SHEET}{}", super::check_pages::status_css()))
+}
 
 /// The `Content-Security-Policy` of every console page: everything from this
 /// origin only (the pages `fetch` the JSON API), no plug-ins, no framing, no
@@ -32,7 +39,7 @@ pub fn content_security_policy() -> &'static str {
              img-src 'self'; object-src 'none'; base-uri 'none'; form-action 'self'; \
              frame-ancestors 'none'",
             csp_hash(SCRIPT),
-            csp_hash(STYLE)
+            csp_hash(style())
         )
     })
 }
@@ -67,7 +74,7 @@ fn layout(title: &str, keys: bool, body: Markup) -> Markup {
     html! {
         (DOCTYPE)
         html lang="en" {
-            (page_head(&format!("{title} — robocal"), STYLE))
+            (page_head(&format!("{title} — robocal"), style()))
             body {
                 header {
                     a.brand href="/ui" { "robocal" }
