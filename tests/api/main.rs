@@ -12,7 +12,9 @@
 //! in and out), `cell` (tools, work objects, program filtering), `jobs`
 //! (progress, cancellation, saturation, races), `record` (sets a version uses,
 //! the calibration record, check poses), `roles` (keys with roles, open reads,
-//! the console's security headers); the harness is `support`.
+//! the console's security headers), `one_answer` (a target solved and
+//! filtered, over HTTP and the CLI, gets one configuration); the harness is
+//! `support`.
 
 mod abandoned;
 mod cell;
@@ -26,6 +28,7 @@ mod iso9283;
 mod jobs;
 mod migrations;
 mod numbers;
+mod one_answer;
 mod plans;
 mod predict;
 mod record;
