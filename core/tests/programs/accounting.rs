@@ -502,13 +502,15 @@ fn urscript(items: &[Item]) -> Generated {
             ),
             Item::Declared => {
                 s.push(format!("  w{k} = {}", pose(k)));
-                motion(
-                    format!("movej(pose_trans(table, w{k}), a=1.2)"),
-                    format!("w{k}"),
-                    Expect::Solved,
-                    &mut g,
-                    &mut s,
-                );
+                // As Polyscope writes a joint move to a waypoint, every other time.
+                let call = if k % 2 == 0 {
+                    format!("movej(pose_trans(table, w{k}), a=1.2)")
+                } else {
+                    format!(
+                        "movej(get_inverse_kin(pose_trans(table, w{k}), qnear=[0.0, -1.6, 1.6, 0.0, 1.6, 0.0]), a=1.2)"
+                    )
+                };
+                motion(call, format!("w{k}"), Expect::Solved, &mut g, &mut s);
             }
             Item::Undeclared => motion(
                 format!("movel(q{k}, a=1.2)"),
@@ -518,15 +520,13 @@ fn urscript(items: &[Item]) -> Generated {
                 &mut s,
             ),
             Item::RunTime(v) => {
-                let expr =
-                    ["here", "get_actual_tcp_pose()", "get_inverse_kin(here)"][usize::from(v)];
-                motion(
-                    format!("movel({expr}, a=1.2)"),
-                    expr.into(),
-                    Expect::Skipped,
-                    &mut g,
-                    &mut s,
-                );
+                let (expr, name) = [
+                    ("here", "here"),
+                    ("get_actual_tcp_pose()", "get_actual_tcp_pose()"),
+                    ("get_inverse_kin(here)", "here"),
+                ][usize::from(v)];
+                let call = format!("movel({expr}, a=1.2)");
+                motion(call, name.into(), Expect::Skipped, &mut g, &mut s);
             }
             Item::Relative => motion(
                 "movel(pose_trans(here, p[0, 0, 0.01, 0, 0, 0]))".into(),

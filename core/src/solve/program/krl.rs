@@ -483,6 +483,13 @@ impl Parser<'_> {
             _ => text.clone(),
         };
         if RELATIVE.contains(&instr) {
+            // `PTP_REL {A1 45}` moves axes: a joint motion.
+            if let [(Tok::Agg(a), _)] = expr {
+                let kind = classify(&shift(a, line.start), &self.files[fi].text, 0);
+                if matches!(kind, Kind::Other) {
+                    return (name, MotionTarget::Joints { note: None });
+                }
+            }
             let why = format!("relative motion: {instr} moves from where the robot is");
             return (name, MotionTarget::RunTime(why));
         }

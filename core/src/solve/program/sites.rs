@@ -442,7 +442,7 @@ fn unknown_start(
         _ => "move to known joints (a joint move) before it".to_string(),
     };
     format!(
-        "no configuration flags and no known joints before it: solved in {}, the configuration nearest the middle of the joint ranges (as robocal solve does); a controller takes the solution nearest where the robot stands: {how} to be sure",
+        "no configuration flags and no known joints before it: solved in {} by the rule robocal solve follows (the solution nearest the middle of the joint ranges); a controller takes the solution nearest where the robot stands: {how} to be sure",
         label(configuration)
     )
 }

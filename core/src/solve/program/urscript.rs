@@ -17,9 +17,10 @@
 //! Every position of a motion is reported (`Motion`): a joint list (or a
 //! variable holding one) is a joint motion; a variable assigned anything but
 //! a literal (`get_actual_tcp_pose()`, `pose_add(…)`), a routine's
-//! parameter, any other expression (`get_inverse_kin(…)`, nested
-//! `pose_trans`) is computed at run time and skipped; a name the script
-//! never assigns fails.
+//! parameter, any other expression (nested `pose_trans`, `pose_add`) is
+//! computed at run time and skipped; a name the script never assigns fails.
+//! `get_inverse_kin(x, qnear=q)` (as Polyscope writes a joint move to a
+//! waypoint) goes to the pose `x`, from the joints `q`.
 //!
 //! Units: metres and the rotation vector `rx, ry, rz` in radians. There are
 //! no configuration flags: the controller takes the solution nearest its
@@ -237,6 +238,9 @@ impl Parser<'_> {
         if word(self.toks.get(i)) == Some("pose_trans") && punct(self.toks.get(i + 1), '(') {
             return self.pose_trans(i, line, text);
         }
+        if word(self.toks.get(i)) == Some("get_inverse_kin") && punct(self.toks.get(i + 1), '(') {
+            return self.inverse_kin(i, ctx.frame, line, text);
+        }
         if let (Some(name), true) = (word(self.toks.get(i)).map(str::to_string), end == i + 1) {
             let name = name.as_str();
             let target = match self.vars.get(name).cloned() {
@@ -306,6 +310,56 @@ impl Parser<'_> {
             return run_time(text);
         }
         self.target(point, frame, line)
+    }
+
+    /// `get_inverse_kin(x)` or `get_inverse_kin(x, qnear)` (`qnear=` named
+    /// or not) at token `i`: the controller's own inverse kinematics of the
+    /// pose `x` (a literal, a pose variable, `pose_trans`), nearest the
+    /// joints `qnear` when given — the position is `x`, and the solution
+    /// starts from `qnear`. Other arguments (tolerances, another TCP) make it
+    /// a position computed at run time.
+    fn inverse_kin(
+        &mut self,
+        i: usize,
+        frame: FrameSpec,
+        line: usize,
+        text: String,
+    ) -> Result<(String, MotionTarget), Fail> {
+        let run_time = |text: String| {
+            let why = format!("`{text}` is computed at run time");
+            Ok((text, MotionTarget::RunTime(why)))
+        };
+        let x = i + 2;
+        let mut close = argument_end(&self.toks, x);
+        let mut near: Option<Vec<f64>> = None;
+        if punct(self.toks.get(close), ',') {
+            let mut a = close + 1;
+            if word(self.toks.get(a)) == Some("qnear") && punct(self.toks.get(a + 1), '=') {
+                a += 2;
+            }
+            close = argument_end(&self.toks, a);
+            near = match (self.toks.get(a), close - a) {
+                (Some((Tok::Word(v), _)), 1) => match self.vars.get(v) {
+                    Some(Var::Joints(Some(q))) => Some(q.clone()),
+                    _ => return run_time(text),
+                },
+                (Some((Tok::Punct('['), _)), _) => match list(&self.toks, a)? {
+                    (v, next) if next == close => v.numbers(6).map(|(q, _)| q),
+                    _ => None,
+                },
+                _ => None,
+            };
+            if near.is_none() {
+                return run_time(text);
+            }
+        }
+        if !punct(self.toks.get(close), ')') {
+            return run_time(text);
+        }
+        if let Some(q) = near {
+            self.joints = Some(q.iter().map(|r| r.to_degrees()).collect());
+        }
+        self.target(x, frame, line)
     }
 
     /// A motion call at token `i` (its name): its position arguments (two

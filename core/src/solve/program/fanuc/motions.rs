@@ -72,19 +72,21 @@ fn flush(statement: &mut Vec<(usize, &str, usize)>, out: &mut Vec<MotionLine>) {
     if !motion {
         return;
     }
-    let skip = first.len() - head.len() + 1;
-    // The via point of `C` is on the first line, its end point on the next.
-    let wanted: Vec<(usize, &str)> = if letter == 'C' {
-        parts.iter().take(2).map(|p| (p.0, p.1)).collect()
-    } else {
-        vec![(parts[0].0, parts[0].1)]
-    };
+    // The via point of `C` is on the first line, its end point on the next
+    // (or after the via point on the same line).
     let mut positions = Vec::new();
-    for (k, (offset, content)) in wanted.into_iter().enumerate() {
-        let from = if k == 0 { skip } else { 0 };
-        if let Some(p) = reference(content, from, offset) {
-            positions.push(p);
-        }
+    let (offset, content) = (parts[0].0, parts[0].1);
+    let mut from = first.len() - head.len() + 1;
+    if let Some((p, end)) = reference(content, from, offset) {
+        positions.push(p);
+        from = end;
+    }
+    if letter == 'C' {
+        let second = match parts.get(1) {
+            Some(&(offset, content, _)) => reference(content, 0, offset),
+            None => reference(content, from, offset),
+        };
+        positions.extend(second.map(|(p, _)| p));
     }
     let whole: String = parts.iter().map(|p| p.1).collect::<Vec<_>>().join(" ");
     out.push(MotionLine {
@@ -135,8 +137,9 @@ fn run_time(code: &str) -> Option<String> {
 }
 
 /// The first position reference in `content[from..]` (`content` starts at
-/// file offset `offset`): its text and what it is.
-fn reference(content: &str, from: usize, offset: usize) -> Option<(String, Reference)> {
+/// file offset `offset`): its text and what it is, and where in `content`
+/// it ends.
+fn reference(content: &str, from: usize, offset: usize) -> Option<((String, Reference), usize)> {
     let code = code_of(content.get(from..)?);
     let b = code.as_bytes();
     let mut i = 0;
@@ -149,24 +152,23 @@ fn reference(content: &str, from: usize, offset: usize) -> Option<(String, Refer
                 let open = i + if register { 2 } else { 1 };
                 let close = matching(b, open)?;
                 let text = code[i..=close].to_string();
+                let end = from + close + 1;
                 if register {
                     let why = format!("{text} is a position register, set at run time");
-                    return Some((text, Reference::RunTime(why)));
+                    return Some(((text, Reference::RunTime(why)), end));
                 }
                 let inner = &code[open + 1..close];
                 let digits = inner.bytes().take_while(u8::is_ascii_digit).count();
                 let rest = &inner[digits..];
                 if digits == 0 || !(rest.is_empty() || rest.starts_with(':')) {
                     let why = format!("{text} is chosen at run time");
-                    return Some((text, Reference::RunTime(why)));
+                    return Some(((text, Reference::RunTime(why)), end));
                 }
                 let number: u32 = inner[..digits].parse().ok()?;
                 let base = offset + from + open + 1 + digits;
                 let mark_at = base..base + rest.len();
-                return Some((
-                    format!("P[{number}]"),
-                    Reference::Position { number, mark_at },
-                ));
+                let name = format!("P[{number}]");
+                return Some(((name, Reference::Position { number, mark_at }), end));
             }
         }
         i += 1;
@@ -204,14 +206,22 @@ mod tests {
     fn motions_positions_and_options() {
         let mn = "/MN\n   1:  ! it's P[9] ;\n   2:J P[1] 100% FINE    ;\n   3:L PR[3] 500mm/sec FINE ;\n\
                   \x20  4:C P[4]    \n    :  P[5:\"end\"] 20mm/sec CNT100    ;\n   5:L P[6] 100mm/sec FINE INC ;\n\
-                  \x20  6:L P[7] 100mm/sec FINE Offset,PR[1] ;\n   7:  DO[1]=ON ;\n   8:L P[R[2]] 10mm/sec FINE ;\n/POS\n";
+                  \x20  6:L P[7] 100mm/sec FINE Offset,PR[1] ;\n   7:  DO[1]=ON ;\n   8:L P[R[2]] 10mm/sec FINE ;\n   9:C P[8] P[9] 10mm/sec FINE ;\n/POS\n";
         let end = mn.find("/POS").unwrap();
         let m = motions(mn, 3..end);
         let lines: Vec<(usize, &str)> =
             m.iter().map(|x| (x.line, x.instruction.as_str())).collect();
         assert_eq!(
             lines,
-            [(3, "J"), (4, "L"), (5, "C"), (7, "L"), (8, "L"), (10, "L")]
+            [
+                (3, "J"),
+                (4, "L"),
+                (5, "C"),
+                (7, "L"),
+                (8, "L"),
+                (10, "L"),
+                (11, "C")
+            ]
         );
         let names: Vec<Vec<&str>> = m
             .iter()
@@ -225,7 +235,8 @@ mod tests {
                 vec!["P[4]", "P[5]"],
                 vec!["P[6]"],
                 vec!["P[7]"],
-                vec!["P[R[2]]"]
+                vec!["P[R[2]]"],
+                vec!["P[8]", "P[9]"]
             ]
         );
         let Reference::Position { number, mark_at } = &m[2].positions[1].1 else {

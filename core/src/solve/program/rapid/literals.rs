@@ -63,8 +63,9 @@ pub(super) const INSTRUCTIONS: [Instruction; 27] = [
     instr("triggl", 0, 1, ToolArg::Last),
     instr("triggj", 0, 1, ToolArg::Last),
     instr("triggc", 0, 2, ToolArg::Last),
-    instr("searchl", 1, 1, ToolArg::Last),
-    instr("searchc", 1, 2, ToolArg::Last),
+    // SearchL Signal, SearchPoint (where the search stopped: an output), ToPoint, …
+    instr("searchl", 2, 1, ToolArg::Last),
+    instr("searchc", 2, 2, ToolArg::Last),
     instr("arcl", 0, 1, ToolArg::Last),
     instr("arclstart", 0, 1, ToolArg::Last),
     instr("arclend", 0, 1, ToolArg::Last),
