@@ -638,3 +638,68 @@ proptest! {
         }
     }
 }
+
+/// `text` with `cut` bytes from `at` (a fraction of its length, moved back
+/// to a character boundary) replaced by `snippet`.
+fn spliced(text: &str, at: f64, cut: usize, snippet: &str) -> String {
+    let mut start = ((text.len() as f64) * at) as usize;
+    while !text.is_char_boundary(start) {
+        start -= 1;
+    }
+    let mut end = (start + cut).min(text.len());
+    while !text.is_char_boundary(end) {
+        end += 1;
+    }
+    format!("{}{snippet}{}", &text[..start], &text[end..])
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: 256,
+        rng_seed: RngSeed::Fixed(0x5eed_1042),
+        ..ProptestConfig::default()
+    })]
+
+    /// Generated programs with a random splice of brackets, quotes,
+    /// separators and names: parsing refuses or succeeds without a panic,
+    /// every range it gives lies in its file on character boundaries, and
+    /// the filter runs to a report whose counts add up.
+    #[test]
+    fn spliced_programs_parse_or_are_refused(
+        items in prop::collection::vec(item(), 0..8),
+        at in 0.0..1.0f64,
+        cut in 0usize..24,
+        snippet in "[\\[\\](){},:;=\"'\\\\\n PRE0-9.é@!#$]{0,12}",
+    ) {
+        let f = fixture();
+        let cases = [
+            (Language::Krl, krl(&items, true)),
+            (Language::Rapid, rapid(&items)),
+            (Language::Fanuc, fanuc(&items)),
+            (Language::UrScript, urscript(&items)),
+        ];
+        for (language, g) in cases {
+            let mut files = g.files;
+            files[0].text = spliced(&files[0].text, at, cut, &snippet);
+            let Ok(program) = parse(language, &files) else {
+                continue;
+            };
+            let ranges = program
+                .sites
+                .iter()
+                .flat_map(|s| s.slots.iter().chain([&s.mark_at]).map(move |r| (s.file, r)))
+                .chain(program.motions.iter().map(|m| (m.file, &m.mark_at)));
+            for (file, r) in ranges {
+                let t = &files[file].text;
+                prop_assert!(
+                    r.start <= r.end && r.end <= t.len() && t.is_char_boundary(r.start) && t.is_char_boundary(r.end),
+                    "{:?} {:?} in {}", language, r, files[file].name
+                );
+            }
+            let out = filter(language, &files, &f.cell, &f.model, &settings()).unwrap();
+            let r = &out.report;
+            prop_assert_eq!(r.filtered + r.failed + r.skipped, r.targets.len());
+            prop_assert_eq!(r.targets.len() + r.joint_motions.len(), program.motions.len());
+        }
+    }
+}
