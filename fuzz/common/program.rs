@@ -1,8 +1,8 @@
 //! The check every program fuzz target runs: the input is one file, or two
 //! split at the first NUL byte (named `names`); parsing never panics, every
-//! target's value ranges and every motion's mark lie inside its file, and a program that parses
-//! filters (on the nominal model, no tool or work object in the cell) without
-//! panicking.
+//! target's value ranges and every motion's mark lie inside its file, and a
+//! program that parses filters (on the nominal model, no tool or work object
+//! in the cell) without panicking.
 use robocal::solve::cell::Cell;
 use robocal::calibrate::compensate::CompensatedModel;
 use robocal::solve::ik::IkSettings;
