@@ -1,8 +1,8 @@
 //! The check every program fuzz target runs: the input is one file, or two
 //! split at the first NUL byte (named `names`); parsing never panics, every
-//! target's value ranges lie inside its file, and a program that parses
-//! filters (on the nominal model, no tool or work object in the cell) without
-//! panicking.
+//! target's value ranges and every motion's mark lie inside its file, and a
+//! program that parses filters (on the nominal model, no tool or work object
+//! in the cell) without panicking.
 use robocal::solve::cell::Cell;
 use robocal::calibrate::compensate::CompensatedModel;
 use robocal::solve::ik::IkSettings;
@@ -29,6 +29,10 @@ pub fn check(language: Language, names: [&str; 2], data: &[u8]) {
         for r in s.slots.iter().chain([&s.mark_at]) {
             assert!(r.start <= r.end && t.is_char_boundary(r.start) && t.is_char_boundary(r.end));
         }
+    }
+    for m in &program.motions {
+        let (t, r) = (&files[m.file].text, &m.mark_at);
+        assert!(r.start <= r.end && t.is_char_boundary(r.start) && t.is_char_boundary(r.end));
     }
     if program.sites.len() <= 8 {
         let model = CompensatedModel::from_nominal(robocal::model::preset("ur5").unwrap());

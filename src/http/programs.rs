@@ -1,7 +1,9 @@
 //! `POST /v1/robots/{id}/programs/filter`: robot program files in (KRL,
-//! RAPID, Fanuc `.ls`, URScript), the filtered files and the per-target report
-//! out, as `robocal filter` writes them. Every Cartesian target becomes its
-//! false target on the active model version (or a named one); the program's
+//! RAPID, Fanuc `.ls`, URScript), the filtered files and the report out (one
+//! line per position of every Cartesian motion, the joint motions, unused
+//! points; `core::program::FilterReport`), as `robocal filter` writes them.
+//! Every Cartesian target a motion goes to becomes its false target on the
+//! active model version (or a named one); the program's
 //! tool and base numbers and names refer to the robot's stored tools and work
 //! objects (`/tools`, `/frames`) and to what the program declares itself. A
 //! program that cannot be parsed is a 422 naming its file, line and column.

@@ -23,7 +23,7 @@ const FRAME: &str = "/v1/robots/{id}/frames/{name}";
 const FILTER: &str = "/v1/robots/{id}/programs/filter";
 const SOLVE: &str = "/v1/robots/{id}/solve";
 
-fn examples() -> PathBuf {
+pub(crate) fn examples() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/programs")
 }
 
@@ -212,7 +212,7 @@ async fn tools_and_work_objects_are_stored_per_robot_by_unique_name_and_number()
 
 /// A YS100 with a km calibration of simulated measurements (active version 1)
 /// and the cell of `examples/programs/cell.json`.
-async fn calibrated_robot_with_cell(t: &TestApp) -> (i64, String) {
+pub(crate) async fn calibrated_robot_with_cell(t: &TestApp) -> (i64, String) {
     let (robot, rid) = t.robot_with_identification_set().await;
     let sets = t
         .get("/v1/robots/{id}/measurement-sets", &[&rid])
@@ -250,7 +250,7 @@ async fn calibrated_robot_with_cell(t: &TestApp) -> (i64, String) {
 }
 
 /// The robot's active model as a calibrated model file on disk.
-async fn model_file(t: &TestApp, rid: &str, dir: &Path) -> PathBuf {
+pub(crate) async fn model_file(t: &TestApp, rid: &str, dir: &Path) -> PathBuf {
     let r = t
         .get("/v1/robots/{id}/versions/{version}/model.json", &[rid, "1"])
         .await;

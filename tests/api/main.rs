@@ -12,8 +12,12 @@
 //! in and out), `cell` (tools, work objects, program filtering), `jobs`
 //! (progress, cancellation, saturation, races), `record` (sets a version uses,
 //! the calibration record, check poses), `checks` (a moved base: the
-//! `shifted` status everywhere; capped per-pose errors), `roles` (keys with roles, open reads,
-//! the console's security headers); the harness is `support`.
+//! `shifted` status everywhere; capped per-pose errors), `roles` (keys with
+//! roles, open reads, the console's security headers), `one_answer` (a target
+//! solved and filtered, over HTTP and the CLI, gets one configuration),
+//! `admission` (large requests share one admission), `slow_clients` (header
+//! and body timeouts, the connection cap), `exposure` (no open writes on a
+//! network by default); the harness is `support`.
 
 mod abandoned;
 mod admission;
@@ -30,6 +34,7 @@ mod iso9283;
 mod jobs;
 mod migrations;
 mod numbers;
+mod one_answer;
 mod plans;
 mod predict;
 mod record;

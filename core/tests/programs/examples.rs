@@ -7,7 +7,7 @@ use robocal_core::solve::cell::CellDescription;
 use robocal_core::solve::program::{filter, TargetStatus};
 use std::path::Path;
 
-fn read(rel: &str) -> ProgramFile {
+pub fn read(rel: &str) -> ProgramFile {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../examples/programs")
         .join(rel);
@@ -17,7 +17,7 @@ fn read(rel: &str) -> ProgramFile {
     }
 }
 
-fn cell(rel: &str) -> Cell {
+pub fn cell(rel: &str) -> Cell {
     CellDescription::from_json(&read(rel).text)
         .unwrap()
         .to_cell()

@@ -7,10 +7,12 @@
 //! the nominal model on the program's configuration flags), brings the true
 //! robot's production TCP to the targets.
 
+mod accounting;
 mod examples;
 mod export;
 mod fanuc;
 mod krl;
+mod motions;
 mod rapid;
 mod stationary;
 mod truth;

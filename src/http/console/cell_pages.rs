@@ -98,7 +98,7 @@ pub fn filter_section(id: i64, versions: &[VersionRow]) -> Markup {
                 p #filter-summary {}
                 p #filter-downloads {}
                 table #filter-report {
-                    thead { tr { th { "File" } th { "Line" } th { "Target" } th { "Status" } th { "Shift [mm]" } th { "Configuration" } th { "Reason" } } }
+                    thead { tr { th { "File" } th { "Line" } th { "Motion" } th { "Status" } th { "Shift [mm]" } th { "Configuration" } th { "Reason" } } }
                     tbody {}
                 }
             }

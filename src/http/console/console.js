@@ -254,7 +254,7 @@ handlers.filter = async function (form) {
   if (!body.language) throw new Error("choose the program's language");
   const r = (await api("POST", `/v1/robots/${robot}/programs/filter`, JSON.stringify(body), "application/json")).json();
   const rep = r.report;
-  const summary = `${rep.filtered} targets filtered, ${rep.failed} failed, ${rep.skipped} skipped (model: ${r.version === null ? "nominal" : "v" + r.version} ${r.method})`;
+  const summary = `${rep.filtered} targets filtered, ${rep.failed} failed, ${rep.skipped} skipped; ${rep.joint_motions.length} joint motions (model: ${r.version === null ? "nominal" : "v" + r.version} ${r.method})`;
   document.getElementById("filter-summary").textContent = summary;
   const links = document.getElementById("filter-downloads");
   links.textContent = "Download: ";
@@ -271,7 +271,7 @@ handlers.filter = async function (form) {
   for (const t of rep.targets) {
     const tr = document.createElement("tr");
     tr.className = "target " + t.status;
-    const cells = [t.file, t.line, t.name, t.status, t.shift_mm === undefined ? "" : t.shift_mm.toFixed(3), t.configuration || "", t.reason || ""];
+    const cells = [t.motion.file, t.motion.line, `${t.motion.instruction} ${t.name}`, t.status, t.shift_mm === undefined ? "" : t.shift_mm.toFixed(3), t.configuration || "", t.reason || ""];
     for (const c of cells) {
       const td = document.createElement("td");
       td.textContent = String(c);

@@ -348,16 +348,11 @@ impl AnalyticIk {
         &self.limits
     }
 
-    /// The middle of each joint range (0 for ranges of 2π or more).
+    /// The middle of each joint range (0 for ranges of 2π or more): the
+    /// reference of a target without one ([`super::choice::middle_of_ranges`]).
     pub fn mid_range(&self) -> [f64; 6] {
-        std::array::from_fn(|k| {
-            let [lo, hi] = self.limits[k];
-            if hi - lo >= TAU {
-                0.0f64.clamp(lo, hi)
-            } else {
-                0.5 * (lo + hi)
-            }
-        })
+        let mid = super::choice::middle_of_ranges(&self.limits);
+        std::array::from_fn(|k| mid[k])
     }
 
     fn reference(&self, hint: Option<&[f64]>) -> [f64; 6] {

@@ -6,6 +6,8 @@
 //! - [`solver`]: damped Newton on `CompensatedModel::predict = target` from that
 //!   seed (branch, joint seed, limits, per-target result and failure reason).
 //! - [`batch`]: parallel batches and path mode.
+//! - [`choice`]: the one rule by which a target that names no configuration
+//!   gets one (solve, filter, HTTP).
 //! - [`targets`]: boundary targets (mm, degrees, orientation conventions), joint
 //!   commands in the controller convention and false targets `FK_nominal(q_cmd)`;
 //!   [`targets_csv`]: the same as a targets file; [`invalid`]: why a target fails
@@ -15,6 +17,7 @@
 
 pub mod analytic;
 pub mod batch;
+pub mod choice;
 pub mod config;
 pub mod invalid;
 pub mod solver;

@@ -5,7 +5,15 @@
 //! X = … mm, Y = … mm, Z = … mm, W = … deg, P = … deg, R = … deg`; joint
 //! positions (`J1 = …`) are not targets, nor are other groups. The user frame
 //! `UF` and tool `UT` are looked up in the cell by number (`UF : 0` is the
-//! base frame). The rest of the file (`/PROG`, `/ATTR`, `/MN`) is not read.
+//! base frame). A position with another group (`GP2`, a positioner) or an
+//! extended axis (`E1 = …` in `GP1`) is refused, naming it.
+//!
+//! Motions: the `/MN` section's `J`, `L`, `C` and `A` instructions
+//! (`fanuc/motions.rs`) name the positions; a position in joint form is a
+//! joint motion, a position register `PR[n]` or `P[R[n]]` is set at run
+//! time, as is an incremental (`INC`) or offset (`Offset`, `Tool_Offset`,
+//! `VOFFSET`) motion: skipped; a `P[n]` that `/POS` lacks fails. A file
+//! without `/MN` is a list of positions, each its own motion (`/POS`).
 //!
 //! Units: mm and degrees, `W, P, R` fixed-axis XYZ (`R = Rz(R)·Ry(P)·Rx(W)`).
 //! `CONFIG`: `F`/`N` (axis 5 < 0 or not), `U`/`D` (elbow), `T`/`B` (wrist
@@ -13,12 +21,19 @@
 //! and 6, `⌊(A + 180°)/360°⌋`; all kept. An unsolved position is marked by its
 //! comment, `P[n:"robocal: failed"]`.
 
+mod motions;
+
 use super::lex::{error, position, tokens, Fail, Tok, Token};
-use super::{Flags, FrameSpec, JointTarget, ParseError, ProgramFile, Site, Targets};
+use super::{
+    external_axis_refusal, Flags, FrameSpec, JointTarget, Motion, MotionTarget, ParseError,
+    ProgramFile, Site, Targets,
+};
 use crate::model::orientation::{rotation_from, OrientationConvention};
 use crate::model::Pose;
 use crate::solve::cell::CellRef;
+use motions::{MotionLine, Reference};
 use nalgebra::Vector3;
+use std::collections::HashMap;
 use std::ops::Range;
 
 /// The mark of an unsolved position (Fanuc comments hold 16 characters).
@@ -109,6 +124,10 @@ fn head(text: &str, toks: &[Token], i: usize) -> Result<(f64, Range<usize>, usiz
 #[derive(Default)]
 struct Fields {
     group: u32,
+    /// Groups other than 1 the position moves.
+    other_groups: Vec<u32>,
+    /// The first extended axis of group 1 (`E1 = 100 mm`): its name and value.
+    extended: Option<(String, String)>,
     uf: Option<u32>,
     ut: Option<u32>,
     flags: Option<Flags>,
@@ -173,9 +192,9 @@ impl Fields {
         };
         let slot = toks[k + 2].1.start..vr.end;
         j += 1;
-        if word(toks.get(j))
-            .is_some_and(|u| u.eq_ignore_ascii_case("mm") || u.eq_ignore_ascii_case("deg"))
-        {
+        let unit = word(toks.get(j))
+            .filter(|u| u.eq_ignore_ascii_case("mm") || u.eq_ignore_ascii_case("deg"));
+        if unit.is_some() {
             j += 1;
         }
         if punct(toks.get(j), ',') {
@@ -185,6 +204,10 @@ impl Fields {
             match "XYZWPR".find(key.as_str()).filter(|_| key.len() == 1) {
                 Some(idx) => self.values[idx] = Some((sign * v, slot)),
                 None if key.starts_with('J') || key.starts_with('E') => {
+                    if key.starts_with('E') && self.extended.is_none() {
+                        let value = format!("{} {}", &text[slot.clone()], unit.unwrap_or(""));
+                        self.extended = Some((key.clone(), value.trim_end().to_string()));
+                    }
                     let axis = key.strip_prefix('J').and_then(|n| n.parse::<usize>().ok());
                     if let Some(n) = axis {
                         self.any_joint = true;
@@ -202,7 +225,7 @@ impl Fields {
 
 /// One `P[n]{…};` block from token `i` (at `P`); returns its group-1
 /// position and the token after the block.
-fn block(fi: usize, text: &str, toks: &[Token], i: usize) -> Result<(Position, usize), Fail> {
+fn block(fi: usize, text: &str, toks: &[Token], i: usize) -> Result<(u32, Position, usize), Fail> {
     let (n, mark_at, mut k) = head(text, toks, i)?;
     let name = format!("P[{n}]");
     let mut fields = Fields::default();
@@ -220,6 +243,9 @@ fn block(fi: usize, text: &str, toks: &[Token], i: usize) -> Result<(Position, u
             }
             Tok::Word(w) if w.starts_with("GP") && punct(toks.get(k + 1), ':') => {
                 fields.group = w[2..].parse().unwrap_or(0);
+                if fields.group != 1 {
+                    fields.other_groups.push(fields.group);
+                }
                 k + 2
             }
             Tok::Word(_) if punct(toks.get(k + 1), ':') => fields.colon(text, toks, k)?,
@@ -228,7 +254,7 @@ fn block(fi: usize, text: &str, toks: &[Token], i: usize) -> Result<(Position, u
         };
     }
     let line = position(text, toks[i].1.start).0;
-    Ok((found(fi, line, name, mark_at, fields), k))
+    Ok((n as u32, found(fi, line, name, mark_at, fields), k))
 }
 
 /// The target a block's group-1 fields make: joint values, a Cartesian site
@@ -266,6 +292,13 @@ fn found(fi: usize, line: usize, name: String, mark_at: Range<usize>, f: Fields)
         ),
     };
     let spec = |v: Option<u32>| v.map_or(FrameSpec::Unset, |n| FrameSpec::Ref(CellRef::Number(n)));
+    let refuse = match (f.other_groups.first(), &f.extended) {
+        (Some(g), _) => Some(format!(
+            "the position also moves motion group GP{g} (another mechanical unit), which the cell does not model: not filtered"
+        )),
+        (None, Some((axis, value))) => Some(external_axis_refusal(axis, value)),
+        (None, None) => None,
+    };
     Position::Cartesian(Box::new(Site {
         file: fi,
         line,
@@ -282,39 +315,144 @@ fn found(fi: usize, line: usize, name: String, mark_at: Range<usize>, f: Fields)
         mark_at,
         after_joints: None,
         skip,
+        refuse,
         stationary_tool: false,
     }))
 }
 
-/// Parses `.ls` files: the Cartesian positions of their `/POS` sections.
+/// What `/POS` holds for a position number.
+#[derive(Clone, Copy)]
+enum Held {
+    /// A Cartesian position: its index among the file's.
+    Cartesian(usize),
+    Joint,
+    /// No group-1 values.
+    Neither,
+}
+
+/// Parses `.ls` files: the Cartesian positions of their `/POS` sections and
+/// the motions of their `/MN` sections.
 pub fn parse(files: &[ProgramFile]) -> Result<Targets, ParseError> {
     let mut found = Targets::default();
     for (fi, f) in files.iter().enumerate() {
         let text = f.text.as_str();
-        let Some(pos) = section(text, "/POS") else {
-            continue;
+        let positions = match section(text, "/POS") {
+            Some(pos) => positions(fi, f, pos)?,
+            None => Vec::new(),
         };
-        let end = section(&text[pos..], "/END").map_or(text.len(), |e| pos + e);
-        let body = pos + "/POS".len();
-        let fail = |(at, m): Fail| error(&f.name, text, (at + body, m));
-        let toks: Vec<Token> = tokens(&text[body..end], &['"', '\''])
-            .map_err(fail)?
-            .into_iter()
-            .map(|(t, r)| (t, r.start + body..r.end + body))
-            .collect();
-        let mut i = 0;
-        while i < toks.len() {
-            let (site, next) =
-                block(fi, text, &toks, i).map_err(|(at, m)| error(&f.name, text, (at, m)))?;
-            match site {
-                Position::Cartesian(s) => found.sites.push(*s),
-                Position::Joint(j) => found.joints.push(j),
-                Position::Neither => {}
-            }
-            i = next;
-        }
+        let mn = section(text, "/MN").map(|m| {
+            let body = m + "/MN".len();
+            let end = ["/POS", "/END"]
+                .iter()
+                .filter_map(|h| section(&text[body..], h))
+                .min()
+                .map_or(text.len(), |e| body + e);
+            motions::motions(text, body..end)
+        });
+        file_targets(fi, positions, mn, &mut found);
     }
     Ok(found)
+}
+
+/// The blocks of the `/POS` section at byte `pos`: number and position.
+fn positions(fi: usize, f: &ProgramFile, pos: usize) -> Result<Vec<(u32, Position)>, ParseError> {
+    let text = f.text.as_str();
+    let end = section(&text[pos..], "/END").map_or(text.len(), |e| pos + e);
+    let body = pos + "/POS".len();
+    let fail = |(at, m): Fail| error(&f.name, text, (at + body, m));
+    let toks: Vec<Token> = tokens(&text[body..end], &['"', '\''])
+        .map_err(fail)?
+        .into_iter()
+        .map(|(t, r)| (t, r.start + body..r.end + body))
+        .collect();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < toks.len() {
+        let (number, position, next) =
+            block(fi, text, &toks, i).map_err(|(at, m)| error(&f.name, text, (at, m)))?;
+        out.push((number, position));
+        i = next;
+    }
+    Ok(out)
+}
+
+/// One file's sites (in the order its motions first use them, unused ones
+/// last), motions and joint targets, into `found`.
+fn file_targets(
+    fi: usize,
+    positions: Vec<(u32, Position)>,
+    mn: Option<Vec<MotionLine>>,
+    found: &mut Targets,
+) {
+    let mut held: HashMap<u32, Held> = HashMap::new();
+    let mut cartesian: Vec<Option<Site>> = Vec::new();
+    for (n, p) in positions {
+        let h = match p {
+            Position::Cartesian(s) => {
+                cartesian.push(Some(*s));
+                Held::Cartesian(cartesian.len() - 1)
+            }
+            Position::Joint(j) => {
+                found.joints.push(j);
+                Held::Joint
+            }
+            Position::Neither => Held::Neither,
+        };
+        held.entry(n).or_insert(h);
+    }
+    let count = cartesian.len();
+    let mut at: Vec<Option<usize>> = vec![None; count];
+    let mut visit = |k: usize, found: &mut Targets| {
+        *at[k].get_or_insert_with(|| {
+            found.sites.extend(cartesian[k].take());
+            found.sites.len() - 1
+        })
+    };
+    let Some(mn) = mn else {
+        // A list of positions: each its own motion.
+        for k in 0..count {
+            let i = visit(k, found);
+            let s = &found.sites[i];
+            found.motions.push(Motion {
+                file: fi,
+                line: s.line,
+                instruction: "/POS".into(),
+                name: s.name.clone(),
+                target: MotionTarget::Site(i),
+                mark_at: s.mark_at.clone(),
+            });
+        }
+        return;
+    };
+    for m in mn {
+        for (name, r) in m.positions {
+            let (target, mark_at) = match (&m.run_time, r) {
+                (Some(why), _) => (MotionTarget::RunTime(why.clone()), 0..0),
+                (None, Reference::RunTime(why)) => (MotionTarget::RunTime(why), 0..0),
+                (None, Reference::Position { number, mark_at }) => {
+                    let target = match held.get(&number) {
+                        Some(Held::Cartesian(k)) => MotionTarget::Site(visit(*k, found)),
+                        Some(Held::Joint) => MotionTarget::Joints { note: None },
+                        Some(Held::Neither) | None => MotionTarget::Undeclared,
+                    };
+                    (target, mark_at)
+                }
+            };
+            found.motions.push(Motion {
+                file: fi,
+                line: m.line,
+                instruction: m.instruction.clone(),
+                name,
+                target,
+                mark_at,
+            });
+        }
+    }
+    for s in cartesian.into_iter().flatten() {
+        found
+            .sites
+            .push(s.with_skip(Some("no motion of the program uses it".into())));
+    }
 }
 
 /// Byte offset of a line that starts with `name` (a section header).

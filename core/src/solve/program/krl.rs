@@ -2,8 +2,16 @@
 //!
 //! Targets: `E6POS`, `POS` and `FRAME` aggregates `{X …, Y …, Z …, A …, B …,
 //! C …, S …, T …, E1 …}`, declared (`DECL E6POS XP1={…}`, in any file) and
-//! used by name in `PTP`/`LIN`/`CIRC` (and `SPTP`/`SLIN`/`SCIRC`), or inline
-//! in a motion or an assignment. Joint aggregates (`A1 … A6`) are not targets.
+//! used by name in `PTP`/`LIN`/`CIRC` (and `SPTP`/`SLIN`/`SCIRC`/`SPL`), or
+//! inline in a motion. Joint aggregates (`A1 … A6`) and points declared
+//! `E6AXIS`/`AXIS` are not targets (joint motions); nor are `XHOME` and
+//! `XHOME1`..`XHOME5` when the files do not declare them (KUKA's home
+//! positions, axis values in `$config.dat`). Every motion's position is
+//! reported (`Motion`): a relative motion (`LIN_REL`, `PTP_REL`, …), a
+//! system variable (`$POS_ACT`), an array element, an expression, a point
+//! declared without a value or assigned in a `.src` is set at run time and
+//! skipped; a name no file declares (a `.src` without its `.dat`) fails;
+//! an `E6POS` whose external axes `E1..E6` are not 0 is refused.
 //! Tool and base: `$TOOL = TOOL_DATA[n]`, `$BASE = BASE_DATA[n]`, inline
 //! frames, `$NULLFRAME`, `BAS(#TOOL, n)`, `BAS(#BASE, n)` and `FDAT_ACT = FP1`
 //! with `DECL FDAT FP1={TOOL_NO n, BASE_NO m, …}`; `TOOL_DATA[n]={…}` and
@@ -24,15 +32,22 @@
 //!
 //! Units: mm and degrees, `R = Rz(A)·Ry(B)·Rx(C)`. `S` and `T` are kept.
 
-use super::{Flags, FrameSpec, JointTarget, ParseError, ProgramFile, Site, Targets};
-use crate::model::orientation::{rotation_from, OrientationConvention};
+mod aggregate;
+
+use super::{FrameSpec, JointTarget, Motion, MotionTarget, ParseError, ProgramFile, Site, Targets};
+use crate::model::orientation::OrientationConvention;
 use crate::model::Pose;
 use crate::solve::cell::{CellRef, Load};
-use nalgebra::Vector3;
-use std::collections::HashMap;
+#[cfg(test)]
+use aggregate::real;
+use aggregate::{
+    classify, code_of, frame_of, integer, joint_values, lines, load_of, shift, tokens, Kind, Line,
+    Tok,
+};
+use std::collections::{HashMap, HashSet};
 use std::ops::Range;
 
-const MOTIONS: [&str; 6] = ["PTP", "LIN", "CIRC", "SPTP", "SLIN", "SCIRC"];
+const MOTIONS: [&str; 7] = ["PTP", "LIN", "CIRC", "SPTP", "SLIN", "SCIRC", "SPL"];
 const RELATIVE: [&str; 6] = [
     "PTP_REL",
     "LIN_REL",
@@ -42,337 +57,9 @@ const RELATIVE: [&str; 6] = [
     "SCIRC_REL",
 ];
 const POSE_TYPES: [&str; 3] = ["E6POS", "POS", "FRAME"];
-
-/// A token of a line's code (comments removed); ranges are file byte offsets.
-#[derive(Debug, Clone, PartialEq)]
-enum Tok {
-    /// Identifier, upper-cased (`$TOOL`, `#BASE`, `XP1`).
-    Word(String),
-    Number(f64),
-    Text,
-    Punct(char),
-    Agg(Agg),
-}
-
-/// An aggregate `{KEY value, …}`: upper-cased keys and value ranges.
-#[derive(Debug, Clone, PartialEq)]
-struct Agg {
-    items: Vec<(String, Range<usize>)>,
-}
-
-type Fail = (usize, String);
-
-struct Line<'a> {
-    text: &'a str,
-    /// Byte offset of the line in the file.
-    start: usize,
-    /// Byte offset of the end of the line's content (before `\r\n`).
-    end: usize,
-    /// 1-based.
-    no: usize,
-}
-
-fn lines(text: &str) -> Vec<Line<'_>> {
-    let mut out = Vec::new();
-    let mut start = 0;
-    for (i, raw) in text.split('\n').enumerate() {
-        let content = raw.strip_suffix('\r').unwrap_or(raw);
-        out.push(Line {
-            text: content,
-            start,
-            end: start + content.len(),
-            no: i + 1,
-        });
-        start += raw.len() + 1;
-    }
-    out
-}
-
-/// Code part of a line: up to a `;` outside quotes.
-fn code_of(line: &str) -> Result<&str, Fail> {
-    let mut quote: Option<(char, usize)> = None;
-    for (i, c) in line.char_indices() {
-        match (quote, c) {
-            (None, ';') => return Ok(&line[..i]),
-            (None, '"' | '\'') => quote = Some((c, i)),
-            (Some((q, _)), c) if c == q => quote = None,
-            _ => {}
-        }
-    }
-    match quote {
-        Some((_, i)) => Err((i, "unterminated string".into())),
-        None => Ok(line),
-    }
-}
-
-fn is_word_start(c: char) -> bool {
-    c.is_ascii_alphabetic() || c == '_' || c == '$' || c == '#'
-}
-
-fn is_word(c: char) -> bool {
-    c.is_ascii_alphanumeric() || c == '_' || c == '$'
-}
-
-/// Tokenises a line's code (offsets relative to the line).
-fn tokens(code: &str) -> Result<Vec<(Tok, Range<usize>)>, Fail> {
-    let b = code.as_bytes();
-    let mut out = Vec::new();
-    let mut i = 0;
-    while i < b.len() {
-        let c = code[i..].chars().next().unwrap_or(' ');
-        let start = i;
-        if c.is_whitespace() {
-            i += c.len_utf8();
-        } else if is_word_start(c) {
-            i += 1;
-            while i < b.len() && is_word(b[i] as char) {
-                i += 1;
-            }
-            out.push((Tok::Word(code[start..i].to_ascii_uppercase()), start..i));
-        } else if c.is_ascii_digit() || (c == '.' && b.get(i + 1).is_some_and(u8::is_ascii_digit)) {
-            i = number_end(b, i);
-            let v = code[start..i]
-                .parse()
-                .map_err(|_| (start, "bad number".to_string()))?;
-            out.push((Tok::Number(v), start..i));
-        } else if c == '"' || c == '\'' {
-            let close = code[i + 1..]
-                .find(c)
-                .ok_or((i, "unterminated string".to_string()))?;
-            i += close + 2;
-            out.push((Tok::Text, start..i));
-        } else if c == '{' {
-            let (agg, end) = aggregate(code, i)?;
-            i = end;
-            out.push((Tok::Agg(agg), start..i));
-        } else {
-            i += c.len_utf8();
-            out.push((Tok::Punct(c), start..i));
-        }
-    }
-    Ok(out)
-}
-
-fn number_end(b: &[u8], mut i: usize) -> usize {
-    while i < b.len() && (b[i].is_ascii_digit() || b[i] == b'.') {
-        i += 1;
-    }
-    if i < b.len() && (b[i] == b'e' || b[i] == b'E') {
-        let mut j = i + 1;
-        if j < b.len() && (b[j] == b'+' || b[j] == b'-') {
-            j += 1;
-        }
-        if j < b.len() && b[j].is_ascii_digit() {
-            i = j;
-            while i < b.len() && b[i].is_ascii_digit() {
-                i += 1;
-            }
-        }
-    }
-    i
-}
-
-/// Parses the aggregate opening at `open`; returns it and the offset after `}`.
-fn aggregate(code: &str, open: usize) -> Result<(Agg, usize), Fail> {
-    let b = code.as_bytes();
-    let skip_ws = |mut i: usize| {
-        while i < b.len() && (b[i] as char).is_ascii_whitespace() {
-            i += 1;
-        }
-        i
-    };
-    let word_end = |mut i: usize| {
-        while i < b.len() && is_word(b[i] as char) {
-            i += 1;
-        }
-        i
-    };
-    let mut items = Vec::new();
-    let mut i = skip_ws(open + 1);
-    if b.get(i) == Some(&b'}') {
-        return Ok((Agg { items }, i + 1));
-    }
-    // A typed aggregate `{E6POS: X 1, …}`.
-    let w = word_end(i);
-    if w > i && b.get(skip_ws(w)) == Some(&b':') {
-        i = skip_ws(w) + 1;
-    }
-    loop {
-        i = skip_ws(i);
-        let key_start = i;
-        let key_end = word_end(i);
-        if key_end == key_start {
-            return Err((i, "expected a component name in the aggregate".into()));
-        }
-        let key = code[key_start..key_end].to_ascii_uppercase();
-        i = key_end;
-        if code[i..].starts_with("[]") {
-            i += 2;
-        }
-        let mut depth = 0usize;
-        let value_start = i;
-        let mut quote: Option<u8> = None;
-        loop {
-            let Some(&c) = b.get(i) else {
-                return Err((open, "aggregate not closed on its line".into()));
-            };
-            match (quote, c) {
-                (Some(q), c) if c == q => quote = None,
-                (Some(_), _) => {}
-                (None, b'"' | b'\'') => quote = Some(c),
-                (None, b'{') => depth += 1,
-                (None, b'}') if depth > 0 => depth -= 1,
-                (None, b',' | b'}') if depth == 0 => break,
-                _ => {}
-            }
-            i += 1;
-        }
-        let raw = &code[value_start..i];
-        let lead = raw.len() - raw.trim_start().len();
-        let value = value_start + lead..value_start + raw.trim_end().len();
-        if value.is_empty() {
-            return Err((key_start, format!("component {key} has no value")));
-        }
-        items.push((key, value));
-        if b[i] == b'}' {
-            return Ok((Agg { items }, i + 1));
-        }
-        i += 1;
-    }
-}
-
-/// A real literal (digits, sign, point, exponent; no `inf`/`nan`).
-fn real(s: &str) -> Option<f64> {
-    if s.is_empty() || !s.chars().all(|c| c.is_ascii_digit() || "+-.eE".contains(c)) {
-        return None;
-    }
-    s.parse().ok()
-}
-
-/// An integer literal: decimal, `'B0101'` or `'H1F'`.
-fn integer(s: &str) -> Option<u32> {
-    let upper = s.to_ascii_uppercase();
-    if let Some(bits) = upper.strip_prefix("'B").and_then(|r| r.strip_suffix('\'')) {
-        return u32::from_str_radix(bits, 2).ok();
-    }
-    if let Some(hex) = upper.strip_prefix("'H").and_then(|r| r.strip_suffix('\'')) {
-        return u32::from_str_radix(hex, 16).ok();
-    }
-    s.parse().ok()
-}
-
-const POSE_KEYS: [&str; 6] = ["X", "Y", "Z", "A", "B", "C"];
-
-/// What an aggregate is.
-enum Kind {
-    /// A Cartesian target: its pose (or why not), flags and value ranges.
-    Cartesian {
-        pose: Result<Pose, String>,
-        flags: Flags,
-        slots: Vec<Range<usize>>,
-    },
-    Other,
-}
-
-fn classify(agg: &Agg, text: &str, offset: usize) -> Kind {
-    let get = |k: &str| agg.items.iter().find(|(key, _)| key == k);
-    let joint = agg
-        .items
-        .iter()
-        .any(|(k, _)| matches!(k.as_str(), "A1" | "A2" | "A3" | "A4" | "A5" | "A6"));
-    if joint || !POSE_KEYS.iter().any(|k| get(k).is_some()) {
-        return Kind::Other;
-    }
-    let value = |r: &Range<usize>| &text[r.start - offset..r.end - offset];
-    let mut v = [0.0; 6];
-    let mut slots = Vec::with_capacity(6);
-    let mut missing = Vec::new();
-    let mut pose_err = None;
-    for (i, k) in POSE_KEYS.iter().enumerate() {
-        match get(k) {
-            Some((_, r)) => {
-                slots.push(r.clone());
-                match real(value(r)) {
-                    Some(x) => v[i] = x,
-                    None => pose_err = Some(format!("{k} is not a number: `{}`", value(r))),
-                }
-            }
-            None => missing.push(*k),
-        }
-    }
-    let flag = |k: &str| get(k).and_then(|(_, r)| integer(value(r)));
-    let flags = if get("S").is_some() || get("T").is_some() {
-        Flags::Kuka {
-            s: flag("S"),
-            t: flag("T"),
-        }
-    } else {
-        Flags::Nearest
-    };
-    let pose = if !missing.is_empty() {
-        Err(format!("incomplete pose: no {}", missing.join(", ")))
-    } else if let Some(e) = pose_err {
-        Err(e)
-    } else {
-        rotation_from(OrientationConvention::KukaAbc, &v[3..])
-            .map(|r| Pose::new(r, Vector3::new(v[0], v[1], v[2]) * 1e-3))
-            .map_err(|e| e.to_string())
-    };
-    Kind::Cartesian { pose, flags, slots }
-}
-
-/// The axis values `A1..A6` of a joint aggregate [deg] (ranges relative to `code`).
-fn joint_values(agg: &Agg, code: &str) -> Option<Vec<f64>> {
-    ["A1", "A2", "A3", "A4", "A5", "A6"]
-        .iter()
-        .map(|k| {
-            let (_, r) = agg.items.iter().find(|(key, _)| key == k)?;
-            real(code.get(r.clone())?)
-        })
-        .collect()
-}
-
-/// A frame aggregate `{X, Y, Z, A, B, C}` as a pose [m].
-/// A load aggregate `{M m, CM {X x, Y y, Z z, A …}, J {X jx, Y jy, Z jz}}`
-/// (kg, mm in the flange frame, kg·m²); `None` when M is missing or not
-/// positive (KUKA's −1: no load data).
-fn load_of(agg: &Agg, code: &str) -> Option<Load> {
-    let get = |a: &Agg, key: &str| {
-        a.items
-            .iter()
-            .find(|(k, _)| k == key)
-            .map(|(_, r)| r.clone())
-    };
-    let xyz = |r: Range<usize>| -> Option<[f64; 3]> {
-        let (inner, _) = aggregate(code, r.start).ok()?;
-        let v = |k: &str| get(&inner, k).and_then(|r| real(&code[r]));
-        Some([
-            v("X").unwrap_or(0.0),
-            v("Y").unwrap_or(0.0),
-            v("Z").unwrap_or(0.0),
-        ])
-    };
-    let mass = real(&code[get(agg, "M")?])?;
-    if !(mass > 0.0 && mass.is_finite()) {
-        return None;
-    }
-    let com = get(agg, "CM").and_then(xyz).unwrap_or([0.0; 3]);
-    let inertia_kgm2 = get(agg, "J")
-        .and_then(xyz)
-        .filter(|j| j.iter().any(|v| *v != 0.0));
-    Some(Load {
-        mass_kg: mass,
-        com: Vector3::from(com) * 1e-3,
-        inertia_kgm2,
-    })
-}
-
-fn frame_of(agg: &Agg, text: &str, offset: usize) -> Option<Pose> {
-    match classify(agg, text, offset) {
-        Kind::Cartesian { pose: Ok(p), .. } => Some(p),
-        _ => None,
-    }
-}
+const AXIS_TYPES: [&str; 2] = ["E6AXIS", "AXIS"];
+/// Words that end a motion's position (approximation and spline clauses).
+const CLAUSES: [&str; 7] = ["C_DIS", "C_PTP", "C_VEL", "C_ORI", "C_SPL", "WITH", "CA"];
 
 #[derive(Debug, Clone, PartialEq)]
 struct Context {
@@ -393,22 +80,31 @@ struct Fdat {
     external: Option<bool>,
 }
 
-/// A declared point and the contexts of the motions that use it.
+/// A declared point, the contexts of the motions that use it, and its
+/// place in the execution order (at its first use).
 struct Declared {
     site: Site,
     uses: Vec<(usize, Context)>,
+    at: Option<usize>,
 }
 
 struct Parser<'a> {
     files: &'a [ProgramFile],
     declared: Vec<Declared>,
     by_name: HashMap<String, usize>,
+    /// Points declared with axis values (`E6AXIS`, `AXIS`).
+    axis_names: HashSet<String>,
+    /// Points without a Cartesian value in the files, and why.
+    runtime: HashMap<String, String>,
+    /// Names a `.src` assigns: the first file and line.
+    assigned: HashMap<String, (usize, usize)>,
     fdat: HashMap<String, Fdat>,
     tools: HashMap<u32, Pose>,
     bases: HashMap<u32, Pose>,
     loads: HashMap<u32, Load>,
     /// Sites in execution order; `Err(i)` is declared point `i` at its first use.
     order: Vec<Result<Site, usize>>,
+    motions: Vec<Motion>,
     joints: Vec<JointTarget>,
 }
 
@@ -430,7 +126,13 @@ fn site_of(
     ctx: &Context,
     skip: Option<String>,
 ) -> Option<Site> {
-    let Kind::Cartesian { pose, flags, slots } = kind else {
+    let Kind::Cartesian {
+        pose,
+        flags,
+        slots,
+        refuse,
+    } = kind
+    else {
         return None;
     };
     let (pose, skip) = match pose {
@@ -455,6 +157,7 @@ fn site_of(
         mark_at: line.end..line.end,
         after_joints: None,
         skip,
+        refuse,
         stationary_tool: ctx.external,
     })
 }
@@ -500,9 +203,11 @@ impl Parser<'_> {
         }
     }
 
-    /// Declarations and data definitions (first pass, every file).
+    /// Declarations and data definitions (first pass, every file), and the
+    /// names a `.src` assigns.
     fn declarations(&mut self, fi: usize) -> Result<(), ParseError> {
         let file = &self.files[fi];
+        let src = has_ext(&file.name, "src");
         for line in lines(&file.text) {
             let code = code_of(line.text).map_err(|(at, m)| err(file, &line, at, m))?;
             let toks = tokens(code).map_err(|(at, m)| err(file, &line, at, m))?;
@@ -532,77 +237,162 @@ impl Parser<'_> {
                 k += 1;
             }
             let ty = words.get(k).copied().unwrap_or("");
-            // LOAD_DATA[n]={M …, CM {…}, J {…}}
-            if ty == "LOAD_DATA" && k == 0 {
-                if let (Some(n), Some((Tok::Punct('='), _)), Some((Tok::Agg(a), _))) =
-                    (self.number_ref(&toks, 1), toks.get(4), toks.get(5))
-                {
-                    if let Some(l) = load_of(a, code) {
-                        self.loads.insert(n, l);
-                    }
-                }
+            if k == 0 && matches!(ty, "LOAD_DATA" | "TOOL_DATA" | "BASE_DATA") {
+                self.data_line(ty, &toks, code);
                 continue;
             }
-            // TOOL_DATA[n]={…} / BASE_DATA[n]={…}
-            if (ty == "TOOL_DATA" || ty == "BASE_DATA") && k == 0 {
-                if let (Some(n), Some((Tok::Punct('='), _)), Some((Tok::Agg(a), _))) =
-                    (self.number_ref(&toks, 1), toks.get(4), toks.get(5))
-                {
-                    if let Some(p) = frame_of(a, code, 0) {
-                        let map = if ty == "TOOL_DATA" {
-                            &mut self.tools
-                        } else {
-                            &mut self.bases
-                        };
-                        map.insert(n, p);
-                    }
-                }
+            if let (
+                Some((Tok::Word(name), _)),
+                Some((Tok::Punct('='), _)),
+                Some((Tok::Agg(a), _)),
+            ) = (toks.get(k + 1), toks.get(k + 2), toks.get(k + 3))
+            {
+                self.named_aggregate(fi, &line, ty, name, a, code);
                 continue;
             }
-            let (Some((Tok::Word(name), _)), Some((Tok::Punct('='), _)), Some((Tok::Agg(a), _))) =
-                (toks.get(k + 1), toks.get(k + 2), toks.get(k + 3))
-            else {
-                continue;
+            let typed = POSE_TYPES.contains(&ty) || AXIS_TYPES.contains(&ty);
+            if typed && (k > 0 || words.get(1).is_some_and(|w| !w.is_empty())) {
+                self.declared_without_value(ty, &toks[k + 1..]);
+            } else if src && k == 0 {
+                self.assignment(fi, &line, &toks);
+            }
+        }
+        Ok(())
+    }
+
+    /// `LOAD_DATA[n]={M …, CM {…}, J {…}}`, `TOOL_DATA[n]={…}`, `BASE_DATA[n]={…}`.
+    fn data_line(&mut self, ty: &str, toks: &[(Tok, Range<usize>)], code: &str) {
+        let (Some(n), Some((Tok::Punct('='), _)), Some((Tok::Agg(a), _))) =
+            (self.number_ref(toks, 1), toks.get(4), toks.get(5))
+        else {
+            return;
+        };
+        if ty == "LOAD_DATA" {
+            if let Some(l) = load_of(a, code) {
+                self.loads.insert(n, l);
+            }
+        } else if let Some(p) = frame_of(a, code, 0) {
+            let map = if ty == "TOOL_DATA" {
+                &mut self.tools
+            } else {
+                &mut self.bases
             };
-            if ty == "FDAT" {
-                let get = |key: &str| {
-                    a.items
-                        .iter()
-                        .find(|(k, _)| k == key)
-                        .and_then(|(_, r)| integer(&code[r.clone()]))
-                };
-                let external = a
-                    .items
+            map.insert(n, p);
+        }
+    }
+
+    /// `DECL ty NAME={…}`: an `FDAT`, a Cartesian point, a point with axis values.
+    fn named_aggregate(
+        &mut self,
+        fi: usize,
+        line: &Line,
+        ty: &str,
+        name: &str,
+        a: &aggregate::Agg,
+        code: &str,
+    ) {
+        if ty == "FDAT" {
+            let get = |key: &str| {
+                a.items
                     .iter()
-                    .find(|(k, _)| k == "IPO_FRAME")
-                    .map(|(_, r)| code[r.clone()].trim().eq_ignore_ascii_case("#TCP"));
-                self.fdat.insert(
-                    name.clone(),
-                    Fdat {
-                        tool: get("TOOL_NO"),
-                        base: get("BASE_NO"),
-                        external,
-                    },
-                );
-                continue;
-            }
-            if !POSE_TYPES.contains(&ty) {
-                continue;
-            }
-            let a = shift(a, line.start);
-            let unset = Context::unset();
-            let kind = classify(&a, file.text.as_str(), 0);
-            if let Some(site) = site_of(fi, &line, name, kind, &unset, None) {
+                    .find(|(k, _)| k == key)
+                    .and_then(|(_, r)| integer(&code[r.clone()]))
+            };
+            let external = a
+                .items
+                .iter()
+                .find(|(k, _)| k == "IPO_FRAME")
+                .map(|(_, r)| code[r.clone()].trim().eq_ignore_ascii_case("#TCP"));
+            self.fdat.insert(
+                name.to_string(),
+                Fdat {
+                    tool: get("TOOL_NO"),
+                    base: get("BASE_NO"),
+                    external,
+                },
+            );
+            return;
+        }
+        if AXIS_TYPES.contains(&ty) {
+            self.axis_names.insert(name.to_string());
+            return;
+        }
+        if !POSE_TYPES.contains(&ty) {
+            return;
+        }
+        let a = shift(a, line.start);
+        let kind = classify(&a, self.files[fi].text.as_str(), 0);
+        match site_of(fi, line, name, kind, &Context::unset(), None) {
+            Some(site) => {
                 self.by_name
-                    .entry(name.clone())
+                    .entry(name.to_string())
                     .or_insert(self.declared.len());
                 self.declared.push(Declared {
                     site,
                     uses: Vec::new(),
+                    at: None,
                 });
             }
+            None => {
+                self.runtime
+                    .entry(name.to_string())
+                    .or_insert(format!("{name} has no Cartesian value in the files"));
+            }
         }
-        Ok(())
+    }
+
+    /// `DECL E6POS XP1, XP2[10]` (no value): set at run time; the same with
+    /// `E6AXIS`/`AXIS`: axis values.
+    fn declared_without_value(&mut self, ty: &str, rest: &[(Tok, Range<usize>)]) {
+        let mut depth = 0i32;
+        for (i, (t, _)) in rest.iter().enumerate() {
+            match t {
+                Tok::Punct('[') => depth += 1,
+                Tok::Punct(']') => depth -= 1,
+                Tok::Word(w) if depth == 0 => {
+                    let array = matches!(rest.get(i + 1), Some((Tok::Punct('['), _)));
+                    if AXIS_TYPES.contains(&ty) {
+                        self.axis_names.insert(w.clone());
+                    } else {
+                        let why = if array {
+                            format!("{w} is an array whose elements are set at run time")
+                        } else {
+                            format!("{w} is declared without a value: it is set at run time")
+                        };
+                        self.runtime.entry(w.clone()).or_insert(why);
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+
+    /// `NAME = …`, `NAME.X = …`, `NAME[i] = …` in a `.src`: NAME is set at run time.
+    fn assignment(&mut self, fi: usize, line: &Line, toks: &[(Tok, Range<usize>)]) {
+        let Some((Tok::Word(name), _)) = toks.first() else {
+            return;
+        };
+        if name.starts_with('$') {
+            return;
+        }
+        let mut k = 1;
+        let mut depth = 0i32;
+        while let Some((t, _)) = toks.get(k) {
+            match t {
+                Tok::Punct('[') => depth += 1,
+                Tok::Punct(']') => depth -= 1,
+                Tok::Punct('.') | Tok::Word(_) if depth == 0 => {}
+                Tok::Punct('=') if depth == 0 => {
+                    if !matches!(toks.get(k + 1), Some((Tok::Punct('='), _))) {
+                        self.assigned.entry(name.clone()).or_insert((fi, line.no));
+                    }
+                    return;
+                }
+                _ if depth > 0 => {}
+                _ => return,
+            }
+            k += 1;
+        }
     }
 
     /// Motions and frame selections (second pass, `.src` files in order).
@@ -612,11 +402,10 @@ impl Parser<'_> {
         for line in lines(&file.text) {
             let code = code_of(line.text).map_err(|(at, m)| err(file, &line, at, m))?;
             let toks = tokens(code).map_err(|(at, m)| err(file, &line, at, m))?;
-            let word = |i: usize| match toks.get(i) {
+            let first = match toks.first() {
                 Some((Tok::Word(w), _)) => w.as_str(),
                 _ => "",
             };
-            let first = word(0);
             let is_decl = first == "DECL" || POSE_TYPES.contains(&first) || first == "FDAT";
             if is_decl || matches!(first, "TOOL_DATA" | "BASE_DATA" | "LOAD_DATA") {
                 continue; // handled by `declarations`
@@ -624,38 +413,142 @@ impl Parser<'_> {
             if self.context_statement(&toks, code, &mut ctx) {
                 continue;
             }
-            let relative = RELATIVE.contains(&first);
-            let motion = MOTIONS.contains(&first);
-            if motion {
-                // Targets by name: PTP XP1 / CIRC XAUX, XEND
-                let mut i = 1;
-                loop {
-                    if let Some((Tok::Word(w), _)) = toks.get(i) {
-                        if !matches!(toks.get(i + 1), Some((Tok::Punct('[' | '.'), _))) {
-                            self.use_point(w, line.no, &ctx);
-                        }
-                    }
-                    if first.ends_with("CIRC")
-                        && i == 1
-                        && matches!(toks.get(2), Some((Tok::Punct(','), _)))
-                    {
-                        i = 3;
-                        continue;
-                    }
-                    break;
-                }
-            }
-            for (t, _) in &toks {
-                let Tok::Agg(a) = t else { continue };
-                let a = shift(a, line.start);
-                let kind = classify(&a, &file.text, 0);
-                let skip = relative.then(|| "relative motion".to_string());
-                if let Some(site) = site_of(fi, &line, "inline", kind, &ctx, skip) {
-                    self.order.push(Ok(site));
-                }
+            if MOTIONS.contains(&first) || RELATIVE.contains(&first) {
+                self.motion(fi, &line, &toks, code, &ctx);
             }
         }
         Ok(())
+    }
+
+    /// The positions of a motion statement: one, or two for a circular
+    /// motion (via point, end point), each up to a `,` or a clause.
+    fn motion(
+        &mut self,
+        fi: usize,
+        line: &Line,
+        toks: &[(Tok, Range<usize>)],
+        code: &str,
+        ctx: &Context,
+    ) {
+        let Some((Tok::Word(instr), _)) = toks.first() else {
+            return;
+        };
+        let circular = instr.contains("CIRC");
+        let mut at = 1;
+        for _ in 0..if circular { 2 } else { 1 } {
+            at = at.min(toks.len());
+            let mut end = at;
+            let mut depth = 0i32;
+            while let Some((t, _)) = toks.get(end) {
+                match t {
+                    Tok::Punct('(' | '[') => depth += 1,
+                    Tok::Punct(')' | ']') => depth -= 1,
+                    Tok::Punct(',') if depth == 0 => break,
+                    Tok::Word(w) if depth == 0 && end > at && CLAUSES.contains(&w.as_str()) => {
+                        break
+                    }
+                    _ => {}
+                }
+                end += 1;
+            }
+            let (name, target) = self.position(fi, line, &toks[at..end], code, ctx, instr);
+            self.motions.push(Motion {
+                file: fi,
+                line: line.no,
+                instruction: code[toks[0].1.clone()].to_string(),
+                name,
+                target,
+                mark_at: line.end..line.end,
+            });
+            at = end + 1;
+        }
+    }
+
+    /// What one position of a motion is, and its name as written.
+    fn position(
+        &mut self,
+        fi: usize,
+        line: &Line,
+        expr: &[(Tok, Range<usize>)],
+        code: &str,
+        ctx: &Context,
+        instr: &str,
+    ) -> (String, MotionTarget) {
+        let text = match (expr.first(), expr.last()) {
+            (Some(a), Some(b)) => code[a.1.start..b.1.end].to_string(),
+            _ => String::new(),
+        };
+        let name = match expr {
+            [(Tok::Agg(_), _)] => "inline".to_string(),
+            _ => text.clone(),
+        };
+        if RELATIVE.contains(&instr) {
+            // `PTP_REL {A1 45}` moves axes: a joint motion.
+            if let [(Tok::Agg(a), _)] = expr {
+                let kind = classify(&shift(a, line.start), &self.files[fi].text, 0);
+                if matches!(kind, Kind::Other) {
+                    return (name, MotionTarget::Joints { note: None });
+                }
+            }
+            let why = format!("relative motion: {instr} moves from where the robot is");
+            return (name, MotionTarget::RunTime(why));
+        }
+        let target = match expr {
+            [] => MotionTarget::RunTime("the motion gives no position".into()),
+            [(Tok::Agg(a), _)] => {
+                let kind = classify(&shift(a, line.start), &self.files[fi].text, 0);
+                match site_of(fi, line, "inline", kind, ctx, None) {
+                    Some(site) => {
+                        self.order.push(Ok(site));
+                        MotionTarget::Site(self.order.len() - 1)
+                    }
+                    None => MotionTarget::Joints { note: None },
+                }
+            }
+            [(Tok::Word(w), _)] => self.named(w, line.no, ctx),
+            _ => MotionTarget::RunTime(format!("`{text}` is computed at run time")),
+        };
+        (name, target)
+    }
+
+    /// What a motion to the point named `name` (upper case) goes to.
+    fn named(&mut self, name: &str, line: usize, ctx: &Context) -> MotionTarget {
+        if name.starts_with('$') {
+            return MotionTarget::RunTime(format!("{name} is a system variable, set at run time"));
+        }
+        if let Some(&i) = self.by_name.get(name) {
+            let d = &mut self.declared[i];
+            let at = *d.at.get_or_insert(self.order.len());
+            if at == self.order.len() {
+                self.order.push(Err(i));
+            }
+            d.uses.push((line, ctx.clone()));
+            return MotionTarget::Site(at);
+        }
+        if self.axis_names.contains(name) {
+            return MotionTarget::Joints { note: None };
+        }
+        if let Some(why) = self.runtime.get(name) {
+            return MotionTarget::RunTime(why.clone());
+        }
+        if let Some((fi, l)) = self.assigned.get(name) {
+            return MotionTarget::RunTime(format!(
+                "{name} is assigned at run time ({} line {l})",
+                self.files[*fi].name
+            ));
+        }
+        let home = name == "XHOME"
+            || name
+                .strip_prefix("XHOME")
+                .is_some_and(|n| matches!(n, "1" | "2" | "3" | "4" | "5"));
+        if home {
+            return MotionTarget::Joints {
+                note: Some(format!(
+                    "{name} is not declared in the files: KUKA's home position, axis values in $config.dat"
+                )),
+            };
+        }
+        MotionTarget::Undeclared
     }
 
     /// A statement that sets the motion context (`$TOOL`, `$BASE`,
@@ -755,19 +648,10 @@ impl Parser<'_> {
         false
     }
 
-    fn use_point(&mut self, name: &str, line: usize, ctx: &Context) {
-        let Some(&i) = self.by_name.get(name) else {
-            return;
-        };
-        if self.declared[i].uses.is_empty() {
-            self.order.push(Err(i));
-        }
-        self.declared[i].uses.push((line, ctx.clone()));
-    }
-
     fn finish(mut self) -> Targets {
-        for (i, d) in self.declared.iter().enumerate() {
-            if d.uses.is_empty() {
+        for (i, d) in self.declared.iter_mut().enumerate() {
+            if d.at.is_none() {
+                d.at = Some(self.order.len());
                 self.order.push(Err(i));
             }
         }
@@ -777,48 +661,46 @@ impl Parser<'_> {
             .into_iter()
             .map(|s| match s {
                 Ok(site) => site,
-                Err(i) => {
-                    let d = &declared[i];
-                    let mut site = d.site.clone();
-                    match d.uses.first() {
-                        None => {
-                            site.skip
-                                .get_or_insert("no motion of the program uses it".into());
-                        }
-                        Some((_, ctx)) => {
-                            (site.tool, site.work_object) = ctx.roles();
-                            site.load = ctx.load;
-                            site.stationary_tool = ctx.external;
-                            let other = d.uses.iter().find(|(_, c)| {
-                                c.tool != ctx.tool || c.base != ctx.base || c.external != ctx.external
-                            });
-                            if let Some((line, _)) = other {
-                                site.skip.get_or_insert(format!(
-                                    "used with different tools, bases or interpolation modes (lines {} and {line})",
-                                    d.uses[0].0
-                                ));
-                            }
-                        }
-                    }
-                    site
-                }
+                Err(i) => self.declared_site(&declared[i]),
             })
             .collect();
         Targets {
             sites,
+            motions: self.motions,
             joints: self.joints,
         }
     }
-}
 
-/// `agg` with its ranges moved by `by` bytes.
-fn shift(agg: &Agg, by: usize) -> Agg {
-    Agg {
-        items: agg
-            .items
-            .iter()
-            .map(|(k, r)| (k.clone(), r.start + by..r.end + by))
-            .collect(),
+    /// A declared point with the context of the motions that use it.
+    fn declared_site(&self, d: &Declared) -> Site {
+        let mut site = d.site.clone();
+        if let Some((fi, l)) = self.assigned.get(&site.name.to_ascii_uppercase()) {
+            site.skip.get_or_insert(format!(
+                "{} is assigned at run time ({} line {l})",
+                site.name, self.files[*fi].name
+            ));
+        }
+        match d.uses.first() {
+            None => {
+                site.skip
+                    .get_or_insert("no motion of the program uses it".into());
+            }
+            Some((_, ctx)) => {
+                (site.tool, site.work_object) = ctx.roles();
+                site.load = ctx.load;
+                site.stationary_tool = ctx.external;
+                let other = d.uses.iter().find(|(_, c)| {
+                    c.tool != ctx.tool || c.base != ctx.base || c.external != ctx.external
+                });
+                if let Some((line, _)) = other {
+                    site.skip.get_or_insert(format!(
+                        "used with different tools, bases or interpolation modes (lines {} and {line})",
+                        d.uses[0].0
+                    ));
+                }
+            }
+        }
+        site
     }
 }
 
@@ -834,11 +716,15 @@ pub fn parse(files: &[ProgramFile]) -> Result<Targets, ParseError> {
         files,
         declared: Vec::new(),
         by_name: HashMap::new(),
+        axis_names: HashSet::new(),
+        runtime: HashMap::new(),
+        assigned: HashMap::new(),
         fdat: HashMap::new(),
         tools: HashMap::new(),
         loads: HashMap::new(),
         bases: HashMap::new(),
         order: Vec::new(),
+        motions: Vec::new(),
         joints: Vec::new(),
     };
     for fi in 0..files.len() {

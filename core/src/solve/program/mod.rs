@@ -3,10 +3,13 @@
 //!
 //! One module per language parses the files into [`Site`]s: where a target's
 //! values are (byte ranges), its pose in its work object, its configuration
-//! flags, tool and work object. [`filter`] solves each on the calibrated
-//! model (`cell`) and rewrites only those values; every other byte stays.
-//! A target that cannot be solved stays as it was, marked with a comment in
-//! the language, and the report says why.
+//! flags, tool and work object; and into [`Motion`]s: every position a motion
+//! instruction goes to, with what it is (a site, axis values, a position set
+//! at run time or a relative motion, a name no file declares). [`filter`]
+//! solves each site a motion uses on the calibrated model (`cell`) and
+//! rewrites only those values; every other byte stays. A target that cannot
+//! be solved stays as it was, marked with a comment in the language, and the
+//! report (one line per position of a Cartesian motion) says why.
 //!
 //! Units: the programs' own (KRL: mm and degrees, A,B,C = `Rz(A)·Ry(B)·Rx(C)`);
 //! SI (m, rad) in [`Site::pose`].
@@ -19,10 +22,14 @@ pub mod rapid;
 mod rewrite;
 pub mod urscript;
 
-pub use rewrite::{
-    filter, filter_with, FilterControl, FilterError, FilterOutput, FilterReport, LoadSource,
-    TargetReport, TargetStatus, UsedLoad,
+mod report;
+mod sites;
+
+pub use report::{
+    FilterReport, JointMotionReport, LoadSource, MotionPlace, Reachable, TargetReport,
+    TargetStatus, UnusedReport, UsedLoad,
 };
+pub use rewrite::{filter, filter_with, FilterControl, FilterError, FilterOutput};
 
 use crate::model::orientation::OrientationConvention;
 use crate::model::Pose;
@@ -186,6 +193,24 @@ impl Flags {
     }
 }
 
+impl Flags {
+    /// The flags a program in `language` gives for controller joints `q_deg`
+    /// of configuration `c` (URScript has none: the nearest solution).
+    pub fn of(language: Language, q_deg: &[f64], c: Configuration) -> Flags {
+        match language {
+            Language::Krl => Flags::Kuka {
+                s: Some(kuka_status(q_deg, c)),
+                t: Some(kuka_turn(q_deg)),
+            },
+            Language::Rapid => Flags::Abb {
+                cf: abb_cf(q_deg, c),
+            },
+            Language::Fanuc => fanuc_config(q_deg, c),
+            Language::UrScript => Flags::Nearest,
+        }
+    }
+}
+
 impl std::fmt::Display for Flags {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
@@ -293,8 +318,12 @@ pub struct Site {
     /// if any (where the controller starts from).
     pub after_joints: Option<Vec<f64>>,
     /// Why the target is not filtered even though it is a Cartesian target
-    /// (a relative motion, an incomplete aggregate, ...).
+    /// (an incomplete aggregate, a point set at run time, used with
+    /// different tools, ...): reported `skipped`.
     pub skip: Option<String>,
+    /// Why the target is refused before any solve (it carries external-axis
+    /// values the cell does not model): reported `failed` and marked.
+    pub refuse: Option<String>,
     /// The roles swapped (RAPID `robhold FALSE` tooldata with a `robhold
     /// TRUE` wobjdata): `tool` is a stationary tool's pose in the base frame
     /// and `work_object` the work object on the flange (flange → work
@@ -310,6 +339,14 @@ impl Site {
     }
 }
 
+/// Why a target with external-axis values is refused: the axis and its
+/// value, in the program's unit.
+pub fn external_axis_refusal(axis: &str, value: &str) -> String {
+    format!(
+        "the target sets external axis {axis} to {value}, which the cell does not model: not filtered"
+    )
+}
+
 /// A joint target of a program, in the controller's convention.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct JointTarget {
@@ -320,19 +357,60 @@ pub struct JointTarget {
     pub deg: Vec<f64>,
 }
 
+/// One position a motion instruction goes to: a circular motion has two
+/// (its via point and its end point), any other motion one.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Motion {
+    /// Index of the file in the program.
+    pub file: usize,
+    /// 1-based line of the instruction.
+    pub line: usize,
+    /// The instruction as written (`LIN`, `MoveC`, `L`, `movel`).
+    pub instruction: String,
+    /// The position as written (`XP1`, `p10`, `P[3]`, `PR[3]`), or `inline`.
+    pub name: String,
+    pub target: MotionTarget,
+    /// Where the mark of a failure goes when the position has no site (an
+    /// insertion at the end of the instruction's line, or the comment of a
+    /// Fanuc position reference), in the same file.
+    pub mark_at: Range<usize>,
+}
+
+/// What a motion goes to.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub enum MotionTarget {
+    /// A Cartesian target whose values are in the files: `sites[i]`.
+    Site(usize),
+    /// Axis values (a joint motion): nothing to filter.
+    Joints {
+        /// Why the motion counts as one without axis values in the files
+        /// (KUKA's `XHOME`, held in `$config.dat`).
+        note: Option<String>,
+    },
+    /// A position the program computes or sets at run time, or a motion
+    /// relative to where the robot is: not filtered, for this reason.
+    RunTime(String),
+    /// A name no file of the program declares.
+    Undeclared,
+}
+
 /// What a parser finds: the Cartesian targets (in the order the program
-/// runs them) and the joint targets (in file order).
+/// runs them, points no motion uses last), every position of every motion
+/// instruction (in the order of the files and lines) and the joint targets
+/// (in file order).
 #[derive(Debug, Clone, PartialEq, Default, Serialize)]
 pub struct Targets {
     pub sites: Vec<Site>,
+    pub motions: Vec<Motion>,
     pub joints: Vec<JointTarget>,
 }
 
-/// A parsed program: its targets.
+/// A parsed program: its targets and motions.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Program {
     pub language: Language,
     pub sites: Vec<Site>,
+    pub motions: Vec<Motion>,
     pub joints: Vec<JointTarget>,
 }
 
@@ -347,6 +425,7 @@ pub fn parse(language: Language, files: &[ProgramFile]) -> Result<Program, Parse
     Ok(Program {
         language,
         sites: found.sites,
+        motions: found.motions,
         joints: found.joints,
     })
 }

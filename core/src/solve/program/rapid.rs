@@ -21,132 +21,30 @@
 //! point takes the tool and work object of the motions that use it (all the
 //! same, else it is skipped). Comments: `!` to the end of the line.
 //!
+//! Every position of a motion is reported (`Motion`): `MoveAbsJ` is a joint
+//! motion; `Offs(…)`, `RelTool(…)`, `CRobT()`, an array element chosen at
+//! run time, a routine's parameter, a robtarget declared without a value or
+//! assigned in a routine (`p10 := …`, `p10.trans.z := …`) are set at run
+//! time and skipped; a name no module declares fails; a robtarget whose
+//! external axes are not all 9E9 is refused.
+//!
 //! Units: mm, unit quaternions with the scalar `q1` first. `cf1, cf4, cf6`
 //! are the quadrants `⌊A/90°⌋` of axes 1, 4, 6; `cfx = 4·back + 2·down +
 //! [A5 < 0]` (wrist centre behind axis 1, behind the lower arm, axis 5
 //! negative). All four are kept.
 
+mod literals;
+
 use super::lex::{blank_comments, error, line_end, list, tokens, Fail, Tok, Token, Val};
-use super::{Flags, FrameSpec, JointTarget, ParseError, ProgramFile, Site, Targets};
-use crate::model::orientation::{rotation_from, OrientationConvention};
+use super::{FrameSpec, JointTarget, Motion, MotionTarget, ParseError, ProgramFile, Site, Targets};
+use crate::model::orientation::OrientationConvention;
 use crate::model::Pose;
 use crate::solve::cell::{CellRef, Load};
-use nalgebra::Vector3;
+use literals::{
+    arguments, assigned_root, frame, main_part, robtarget, tload, word, Instruction, Target,
+    ToolArg, INSTRUCTIONS,
+};
 use std::collections::{HashMap, HashSet};
-use std::ops::Range;
-
-const MOTIONS: [&str; 9] = [
-    "movel", "movej", "movec", "moveldo", "movejdo", "movecdo", "triggl", "triggj", "triggc",
-];
-
-/// A pose or why not, and the ranges of its values.
-type Frame = (Result<Pose, String>, Vec<Range<usize>>);
-
-/// A pose from `[[x,y,z],[q1..q4]]` (mm).
-fn frame(v: &Val) -> Option<Frame> {
-    let items = v.list()?;
-    let (p, mut ranges) = items.first()?.numbers(3)?;
-    let (q, qr) = items.get(1)?.numbers(4)?;
-    ranges.extend(qr);
-    let pose = rotation_from(OrientationConvention::AbbQ1q4, &q)
-        .map(|r| Pose::new(r, Vector3::new(p[0], p[1], p[2]) * 1e-3))
-        .map_err(|e| e.to_string());
-    Some((pose, ranges))
-}
-
-/// A tooldata's `tload` `[mass,[cx,cy,cz],[q1..q4],ix,iy,iz]` (kg, mm in the
-/// flange frame, kg·m²); `None` when it is not one or the mass is not positive.
-fn tload(v: &Val) -> Option<Load> {
-    let num = |v: &Val| match v {
-        Val::Num(x, _) => Some(*x),
-        _ => None,
-    };
-    let items = v.list()?;
-    let mass = num(items.first()?)?;
-    let (c, _) = items.get(1)?.numbers(3)?;
-    let moments: Option<Vec<f64>> = items.get(3..6).map(|m| m.iter().filter_map(num).collect());
-    let inertia_kgm2 = moments
-        .filter(|m| m.len() == 3 && m.iter().any(|x| *x != 0.0))
-        .map(|m| [m[0], m[1], m[2]]);
-    (mass > 0.0 && mass.is_finite()).then(|| Load {
-        mass_kg: mass,
-        com: Vector3::new(c[0], c[1], c[2]) * 1e-3,
-        inertia_kgm2,
-    })
-}
-
-/// A robtarget literal: pose, flags, value ranges.
-struct Target {
-    pose: Result<Pose, String>,
-    flags: Flags,
-    slots: Vec<Range<usize>>,
-    start: usize,
-}
-
-fn robtarget(v: &Val) -> Result<Target, Fail> {
-    let bad = || {
-        (
-            v.range().start,
-            "not a robtarget `[[x,y,z],[q1,q2,q3,q4],[cf1,cf4,cf6,cfx],[eax]]`".to_string(),
-        )
-    };
-    let items = v.list().ok_or_else(bad)?;
-    if items.len() != 4 {
-        return Err(bad());
-    }
-    let (pose, slots) = frame(v).ok_or_else(bad)?;
-    let (cf, _) = items[2].numbers(4).ok_or_else(bad)?;
-    let flags = if cf.iter().all(|c| c.fract() == 0.0 && c.abs() < 1e6) {
-        Flags::Abb {
-            cf: [cf[0] as i32, cf[1] as i32, cf[2] as i32, cf[3] as i32],
-        }
-    } else {
-        return Err(bad());
-    };
-    items[3].list().ok_or_else(bad)?;
-    Ok(Target {
-        pose,
-        flags,
-        slots,
-        start: v.range().start,
-    })
-}
-
-/// Splits a statement's tokens at top-level commas.
-fn arguments(toks: &[Token]) -> Vec<&[Token]> {
-    let mut out = Vec::new();
-    let mut depth = 0i32;
-    let mut start = 0;
-    for (i, (t, _)) in toks.iter().enumerate() {
-        match t {
-            Tok::Punct('[' | '(' | '{') => depth += 1,
-            Tok::Punct(']' | ')' | '}') => depth -= 1,
-            Tok::Punct(',') if depth == 0 => {
-                out.push(&toks[start..i]);
-                start = i + 1;
-            }
-            _ => {}
-        }
-    }
-    out.push(&toks[start..]);
-    out
-}
-
-/// The part of an argument before its first `\switch`.
-fn main_part(arg: &[Token]) -> &[Token] {
-    let end = arg
-        .iter()
-        .position(|(t, _)| *t == Tok::Punct('\\'))
-        .unwrap_or(arg.len());
-    &arg[..end]
-}
-
-fn word(t: Option<&Token>) -> Option<&str> {
-    match t {
-        Some((Tok::Word(w), _)) => Some(w),
-        _ => None,
-    }
-}
 
 #[derive(Clone, PartialEq)]
 struct Context {
@@ -160,6 +58,8 @@ struct Context {
 struct Declared {
     site: Site,
     uses: Vec<(usize, Context)>,
+    /// Its place in the execution order (at its first use).
+    at: Option<usize>,
 }
 
 struct Parser<'a> {
@@ -173,8 +73,17 @@ struct Parser<'a> {
     stationary_tools: HashSet<String>,
     held_wobjs: HashSet<String>,
     declared: Vec<Declared>,
+    /// Declared robtargets by lower-case name (one per element of an array).
     by_name: HashMap<String, Vec<usize>>,
+    /// Declared jointtargets (lower case).
+    joint_names: HashSet<String>,
+    /// Robtargets without a value in the modules (declared without one,
+    /// routine parameters), and why.
+    runtime: HashMap<String, String>,
+    /// Robtargets a routine assigns (lower case): the line.
+    assigned: HashMap<String, usize>,
     order: Vec<Result<Site, usize>>,
+    motions: Vec<Motion>,
     joints: Vec<JointTarget>,
 }
 
@@ -206,6 +115,7 @@ impl Parser<'_> {
             mark_at: end..end,
             after_joints: None,
             skip: None,
+            refuse: t.refuse,
             stationary_tool: ctx.stationary,
         }
         .with_skip(skip)
@@ -237,6 +147,16 @@ impl Parser<'_> {
             }
             let assign = st.get(j).is_some_and(|t| t.0 == Tok::Punct(':'))
                 && st.get(j + 1).is_some_and(|t| t.0 == Tok::Punct('='));
+            let key = name.to_ascii_lowercase();
+            if ty == "jointtarget" {
+                self.joint_names.insert(key.clone());
+            }
+            if !assign && ty == "robtarget" {
+                self.runtime.entry(key).or_insert(format!(
+                    "{name} is declared without a value: it is set at run time"
+                ));
+                continue;
+            }
             if !assign || !st.get(j + 2).is_some_and(|t| t.0 == Tok::Punct('[')) {
                 continue;
             }
@@ -244,7 +164,6 @@ impl Parser<'_> {
             if let Some((_, r)) = st.get(next) {
                 return Err((r.start, "expected `;` after the value".into()));
             }
-            let key = name.to_ascii_lowercase();
             match ty.as_str() {
                 "robtarget" => self.declare_robtargets(fi, name, key, &v, array)?,
                 "jointtarget" => self.joint(fi, &v),
@@ -293,6 +212,7 @@ impl Parser<'_> {
             self.declared.push(Declared {
                 site,
                 uses: Vec::new(),
+                at: None,
             });
         }
         Ok(())
@@ -391,138 +311,327 @@ impl Parser<'_> {
     fn motions(&mut self, fi: usize) -> Result<(), Fail> {
         let toks = std::mem::take(&mut self.toks[fi]);
         for st in statements(&toks) {
-            if let Some(m) = st
-                .iter()
-                .position(|t| word(Some(t)).is_some_and(|w| w.eq_ignore_ascii_case("moveabsj")))
-            {
-                if st.get(m + 1).is_some_and(|t| t.0 == Tok::Punct('[')) {
-                    let (v, _) = list(st, m + 1)?;
-                    self.joint(fi, &v);
-                }
+            if let Some(m) = st.iter().position(|t| {
+                word(Some(t)).is_some_and(|w| {
+                    w.eq_ignore_ascii_case("moveabsj") || w.eq_ignore_ascii_case("moveextj")
+                })
+            }) {
+                self.joint_motion(fi, st, m)?;
                 continue;
             }
             // After whatever has no `;` (PROC headers, THEN, DO, …).
-            let Some(m) = st.iter().position(|t| {
-                word(Some(t)).is_some_and(|w| MOTIONS.contains(&w.to_ascii_lowercase().as_str()))
-            }) else {
-                continue;
-            };
-            let st = &st[m..];
-            let instr = word(st.first()).unwrap_or_default().to_ascii_lowercase();
-            let args = arguments(&st[1..]);
-            let positional: Vec<&[Token]> = args
-                .iter()
-                .filter(|a| a.first().is_some_and(|t| t.0 != Tok::Punct('\\')))
-                .map(|a| main_part(a))
-                .collect();
-            let circular = instr.starts_with("movec") || instr == "triggc";
-            let n_points = if circular { 2 } else { 1 };
-            let tool_name = positional.get(n_points + 2).and_then(|a| word(a.first()));
-            let wobj_name = st.windows(5).find_map(|w| {
-                let is_wobj = w[0].0 == Tok::Punct('\\')
-                    && word(Some(&w[1])).is_some_and(|x| x.eq_ignore_ascii_case("wobj"))
-                    && w[2].0 == Tok::Punct(':')
-                    && w[3].0 == Tok::Punct('=');
-                is_wobj.then(|| word(Some(&w[4]))).flatten()
+            let found = st.iter().enumerate().find_map(|(i, t)| {
+                let w = word(Some(t))?;
+                let ins = INSTRUCTIONS
+                    .iter()
+                    .find(|x| w.eq_ignore_ascii_case(x.name))?;
+                Some((i, ins))
             });
-            let (tool, tool_err) = match tool_name {
-                Some(t) => Self::frame_spec(&self.tools, t, "tool0"),
-                None => (FrameSpec::Unset, None),
-            };
-            let (wobj, wobj_err) =
-                Self::frame_spec(&self.wobjs, wobj_name.unwrap_or("wobj0"), "wobj0");
-            let load = tool_name.and_then(|t| self.loads.get(&t.to_ascii_lowercase()).copied());
-            let tool_key = tool_name.unwrap_or_default().to_ascii_lowercase();
-            let wobj_key = wobj_name.unwrap_or_default().to_ascii_lowercase();
-            let stationary = self.stationary_tools.contains(&tool_key);
-            let roles = match (stationary, self.held_wobjs.contains(&wobj_key)) {
-                (true, false) => Some(format!(
-                    "tool {tool_key} is stationary (robhold FALSE) but the robot does not hold work object {}",
-                    wobj_name.unwrap_or("wobj0")
-                )),
-                (false, true) => Some(format!(
-                    "the robot holds both tool {tool_key} and work object {wobj_key} (robhold TRUE)"
-                )),
-                _ => None,
-            };
-            let ctx = Context {
-                tool,
-                wobj,
-                load,
-                skip: tool_err.or(wobj_err).or(roles),
-                stationary,
-            };
-            for arg in positional.iter().take(n_points) {
-                if arg.first().is_some_and(|t| t.0 == Tok::Punct('[')) {
-                    let (v, _) = list(arg, 0)?;
-                    let t = robtarget(&v)?;
-                    let site = self.site(fi, "inline".into(), t, &ctx);
-                    self.order.push(Ok(site));
-                } else {
-                    for (t, _) in arg.iter() {
-                        if let Tok::Word(w) = t {
-                            self.use_point(&w.to_ascii_lowercase(), st[0].1.start, fi, &ctx);
-                        }
-                    }
-                }
+            if let Some((m, ins)) = found {
+                self.motion(fi, &st[m..], ins)?;
             }
         }
         self.toks[fi] = toks;
         Ok(())
     }
 
-    fn use_point(&mut self, key: &str, at: usize, fi: usize, ctx: &Context) {
-        let Some(ids) = self.by_name.get(key).cloned() else {
-            return;
+    /// `MoveAbsJ` (or `MoveExtJ`) at token `m` of a statement: axis values.
+    fn joint_motion(&mut self, fi: usize, st: &[Token], m: usize) -> Result<(), Fail> {
+        if st.get(m + 1).is_some_and(|t| t.0 == Tok::Punct('[')) {
+            let (v, _) = list(st, m + 1)?;
+            self.joint(fi, &v);
+        }
+        let args = arguments(&st[m + 1..]);
+        let first = args
+            .iter()
+            .find(|a| a.first().is_some_and(|t| t.0 != Tok::Punct('\\')))
+            .map(|a| main_part(a));
+        let name = match first {
+            Some([(Tok::Punct('['), _), ..]) | None => "inline".to_string(),
+            Some(a) => self.text_of_tokens(fi, a),
         };
-        let line = super::lex::position(&self.files[fi].text, at).0;
-        for i in ids {
-            if self.declared[i].uses.is_empty() {
-                self.order.push(Err(i));
-            }
-            self.declared[i].uses.push((line, ctx.clone()));
+        let text = &self.files[fi].text;
+        let at = st[m].1.start;
+        let end = line_end(text, at);
+        self.motions.push(Motion {
+            file: fi,
+            line: super::lex::position(text, at).0,
+            instruction: text[st[m].1.clone()].to_string(),
+            name,
+            target: MotionTarget::Joints { note: None },
+            mark_at: end..end,
+        });
+        Ok(())
+    }
+
+    /// The text of tokens `a` (comments blanked out).
+    fn text_of_tokens(&self, fi: usize, a: &[Token]) -> String {
+        match (a.first(), a.last()) {
+            (Some(x), Some(y)) => self.masked[fi][x.1.start..y.1.end].trim().to_string(),
+            _ => String::new(),
         }
     }
 
+    /// A Cartesian motion (the statement from its instruction on): its tool,
+    /// work object and load, and its positions.
+    fn motion(&mut self, fi: usize, st: &[Token], ins: &Instruction) -> Result<(), Fail> {
+        let args = arguments(&st[1..]);
+        let positional: Vec<&[Token]> = args
+            .iter()
+            .filter(|a| a.first().is_some_and(|t| t.0 != Tok::Punct('\\')))
+            .map(|a| main_part(a))
+            .collect();
+        let tool_arg = match ins.tool {
+            ToolArg::Last => positional.len().checked_sub(1),
+            ToolArg::At(k) => Some(k),
+        }
+        .filter(|k| *k >= ins.first + ins.points);
+        let tool_name = tool_arg
+            .and_then(|k| positional.get(k))
+            .and_then(|a| word(a.first()));
+        let ctx = self.context_of(st, tool_name);
+        let text = &self.files[fi].text;
+        let line = super::lex::position(text, st[0].1.start).0;
+        let instruction = text[st[0].1.clone()].to_string();
+        for arg in positional.iter().skip(ins.first).take(ins.points) {
+            let (name, target) = self.position(fi, arg, line, &ctx)?;
+            let text = &self.files[fi].text;
+            let end = line_end(text, arg.first().map_or(st[0].1.start, |t| t.1.start));
+            self.motions.push(Motion {
+                file: fi,
+                line,
+                instruction: instruction.clone(),
+                name,
+                target,
+                mark_at: end..end,
+            });
+        }
+        Ok(())
+    }
+
+    /// The tool, work object and load of a motion statement.
+    fn context_of(&self, st: &[Token], tool_name: Option<&str>) -> Context {
+        let wobj_name = st.windows(5).find_map(|w| {
+            let is_wobj = w[0].0 == Tok::Punct('\\')
+                && word(Some(&w[1])).is_some_and(|x| x.eq_ignore_ascii_case("wobj"))
+                && w[2].0 == Tok::Punct(':')
+                && w[3].0 == Tok::Punct('=');
+            is_wobj.then(|| word(Some(&w[4]))).flatten()
+        });
+        let (tool, tool_err) = match tool_name {
+            Some(t) => Self::frame_spec(&self.tools, t, "tool0"),
+            None => (FrameSpec::Unset, None),
+        };
+        let (wobj, wobj_err) = Self::frame_spec(&self.wobjs, wobj_name.unwrap_or("wobj0"), "wobj0");
+        let load = tool_name.and_then(|t| self.loads.get(&t.to_ascii_lowercase()).copied());
+        let tool_key = tool_name.unwrap_or_default().to_ascii_lowercase();
+        let wobj_key = wobj_name.unwrap_or_default().to_ascii_lowercase();
+        let stationary = self.stationary_tools.contains(&tool_key);
+        let roles = match (stationary, self.held_wobjs.contains(&wobj_key)) {
+            (true, false) => Some(format!(
+                "tool {tool_key} is stationary (robhold FALSE) but the robot does not hold work object {}",
+                wobj_name.unwrap_or("wobj0")
+            )),
+            (false, true) => Some(format!(
+                "the robot holds both tool {tool_key} and work object {wobj_key} (robhold TRUE)"
+            )),
+            _ => None,
+        };
+        Context {
+            tool,
+            wobj,
+            load,
+            skip: tool_err.or(wobj_err).or(roles),
+            stationary,
+        }
+    }
+
+    /// What one position argument of a motion at `line` is, and its name as written.
+    fn position(
+        &mut self,
+        fi: usize,
+        arg: &[Token],
+        line: usize,
+        ctx: &Context,
+    ) -> Result<(String, MotionTarget), Fail> {
+        let text = self.text_of_tokens(fi, arg);
+        let target = match arg {
+            [] => MotionTarget::RunTime("the motion gives no position".into()),
+            [(Tok::Punct('['), _), ..] => {
+                let (v, _) = list(arg, 0)?;
+                let t = robtarget(&v)?;
+                let site = self.site(fi, "inline".into(), t, ctx);
+                self.order.push(Ok(site));
+                return Ok(("inline".into(), MotionTarget::Site(self.order.len() - 1)));
+            }
+            [(Tok::Word(w), _)] => self.named(w, None, line, ctx),
+            [(Tok::Word(w), _), (Tok::Punct('{'), _), (Tok::Number(n), _), (Tok::Punct('}'), _)]
+                if n.fract() == 0.0 && *n >= 1.0 && *n < 1e9 =>
+            {
+                self.named(w, Some(*n as usize), line, ctx)
+            }
+            [(Tok::Word(_), _), (Tok::Punct('{'), _), ..] => {
+                MotionTarget::RunTime(format!("`{text}` is an element chosen at run time"))
+            }
+            _ => MotionTarget::RunTime(format!("`{text}` is computed at run time")),
+        };
+        Ok((text, target))
+    }
+
+    /// What a motion to the robtarget `name` (element `index` of an array,
+    /// 1-based) goes to.
+    fn named(
+        &mut self,
+        name: &str,
+        index: Option<usize>,
+        line: usize,
+        ctx: &Context,
+    ) -> MotionTarget {
+        let key = name.to_ascii_lowercase();
+        if let Some(ids) = self.by_name.get(&key) {
+            let array = self.declared[ids[0]].site.name.ends_with('}');
+            let id = match (array, index) {
+                (false, None) => Some(ids[0]),
+                (true, Some(k)) => ids.get(k - 1).copied(),
+                (true, None) => {
+                    return MotionTarget::RunTime(format!(
+                        "{name} is an array: the motion takes a whole array"
+                    ))
+                }
+                (false, Some(_)) => None,
+            };
+            return match id {
+                Some(i) => MotionTarget::Site(self.use_declared(i, line, ctx)),
+                None => MotionTarget::Undeclared,
+            };
+        }
+        if let Some(why) = self.runtime.get(&key) {
+            return MotionTarget::RunTime(why.clone());
+        }
+        if self.joint_names.contains(&key) {
+            return MotionTarget::Joints { note: None };
+        }
+        MotionTarget::Undeclared
+    }
+
+    /// Declared point `i` used by a motion at `line`: its place in the execution order.
+    fn use_declared(&mut self, i: usize, line: usize, ctx: &Context) -> usize {
+        let d = &mut self.declared[i];
+        let at = *d.at.get_or_insert(self.order.len());
+        if at == self.order.len() {
+            self.order.push(Err(i));
+        }
+        d.uses.push((line, ctx.clone()));
+        at
+    }
+
+    /// Routine parameters of type robtarget (set by the caller) and the
+    /// robtargets a routine assigns (`p10 := …`, `p10.trans.z := …`).
+    fn routines(&mut self, fi: usize) {
+        let toks = std::mem::take(&mut self.toks[fi]);
+        for st in statements(&toks) {
+            let lower = |t: &Token| word(Some(t)).map(str::to_ascii_lowercase);
+            for (j, t) in st.iter().enumerate() {
+                if !matches!(lower(t).as_deref(), Some("proc" | "func" | "trap")) {
+                    continue;
+                }
+                let routine = word(st.get(j + 1)).unwrap_or_default().to_string();
+                let params = st[j..].iter().take_while(|t| t.0 != Tok::Punct(')'));
+                let params: Vec<&Token> = params.collect();
+                for w in params.windows(2) {
+                    if lower(w[0]).as_deref() == Some("robtarget") {
+                        if let Some(p) = word(Some(w[1])) {
+                            self.runtime
+                                .entry(p.to_ascii_lowercase())
+                                .or_insert(format!(
+                                    "{p} is a parameter of {routine}: set at run time"
+                                ));
+                        }
+                    }
+                }
+            }
+            let declaration = st
+                .iter()
+                .any(|t| matches!(lower(t).as_deref(), Some("const" | "pers" | "var")));
+            if declaration {
+                continue;
+            }
+            for k in 0..st.len().saturating_sub(1) {
+                if st[k].0 == Tok::Punct(':') && st[k + 1].0 == Tok::Punct('=') {
+                    if let Some(root) = assigned_root(st, k) {
+                        let line = super::lex::position(&self.files[fi].text, st[k].1.start).0;
+                        self.assigned
+                            .entry(root.to_ascii_lowercase())
+                            .or_insert(line);
+                    }
+                }
+            }
+        }
+        self.toks[fi] = toks;
+    }
+
     fn finish(self) -> Targets {
-        let declared = self.declared;
+        let mut declared = self.declared;
         let mut order = self.order;
-        for (i, d) in declared.iter().enumerate() {
-            if d.uses.is_empty() {
+        for (i, d) in declared.iter_mut().enumerate() {
+            if d.at.is_none() {
+                d.at = Some(order.len());
                 order.push(Err(i));
             }
         }
+        let assigned = &self.assigned;
         let sites = order
             .into_iter()
             .map(|s| match s {
                 Ok(site) => site,
-                Err(i) => {
-                    let d = &declared[i];
-                    let mut site = d.site.clone();
-                    match d.uses.first() {
-                        None => site.skip = site.skip.or(Some("no motion of the program uses it".into())),
-                        Some((first, ctx)) => {
-                            site.tool = ctx.tool.clone();
-                            site.load = ctx.load;
-                            site.work_object = ctx.wobj.clone();
-                            site.stationary_tool = ctx.stationary;
-                            site.skip = site.skip.or(ctx.skip.clone());
-                            if let Some((line, _)) = d.uses.iter().find(|(_, c)| c.tool != ctx.tool || c.wobj != ctx.wobj) {
-                                site.skip = site.skip.or(Some(format!(
-                                    "used with different tools or work objects (lines {first} and {line})"
-                                )));
-                            }
-                        }
-                    }
-                    site
-                }
+                Err(i) => declared_site(&declared[i], assigned),
             })
             .collect();
         Targets {
             sites,
+            motions: self.motions,
             joints: self.joints,
         }
     }
+}
+
+/// A declared point with the context of the motions that use it; skipped
+/// when a routine assigns it.
+fn declared_site(d: &Declared, assigned: &HashMap<String, usize>) -> Site {
+    let mut site = d.site.clone();
+    let key = site
+        .name
+        .split('{')
+        .next()
+        .unwrap_or_default()
+        .to_ascii_lowercase();
+    if let Some(line) = assigned.get(&key) {
+        site.skip
+            .get_or_insert(format!("{key} is assigned at run time (line {line})"));
+    }
+    match d.uses.first() {
+        None => {
+            site.skip
+                .get_or_insert("no motion of the program uses it".into());
+        }
+        Some((first, ctx)) => {
+            site.tool = ctx.tool.clone();
+            site.load = ctx.load;
+            site.work_object = ctx.wobj.clone();
+            site.stationary_tool = ctx.stationary;
+            site.skip = site.skip.take().or(ctx.skip.clone());
+            let other = d
+                .uses
+                .iter()
+                .find(|(_, c)| c.tool != ctx.tool || c.wobj != ctx.wobj);
+            if let Some((line, _)) = other {
+                site.skip.get_or_insert(format!(
+                    "used with different tools or work objects (lines {first} and {line})"
+                ));
+            }
+        }
+    }
+    site
 }
 
 /// Parses RAPID modules.
@@ -545,11 +654,16 @@ pub fn parse(files: &[ProgramFile]) -> Result<Targets, ParseError> {
         held_wobjs: HashSet::new(),
         declared: Vec::new(),
         by_name: HashMap::new(),
+        joint_names: HashSet::new(),
+        runtime: HashMap::new(),
+        assigned: HashMap::new(),
         order: Vec::new(),
+        motions: Vec::new(),
         joints: Vec::new(),
     };
     for (fi, f) in files.iter().enumerate() {
         p.declarations(fi).map_err(|e| error(&f.name, &f.text, e))?;
+        p.routines(fi);
     }
     for (fi, f) in files.iter().enumerate() {
         p.motions(fi).map_err(|e| error(&f.name, &f.text, e))?;

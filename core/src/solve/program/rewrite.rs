@@ -1,95 +1,22 @@
-//! The filter: solve every site on the calibrated model for its tool and work
-//! object, on the branch its flags name, and rewrite its values; the report.
-//!
-//! Per target: the nominal controller's solutions (closed form of the nominal
-//! model with the tool) that carry the target's flags give the branch and the
-//! seed (with `Flags::Nearest`, the one nearest the previous target's joints);
-//! the calibrated solve runs in that branch from that seed; its flags must be
-//! the program's (turn flags kept), else the target is left unchanged.
+//! The filter: every motion of a program in the order the files give them;
+//! each site a motion uses solved once on the calibrated model for its tool
+//! and work object (`sites.rs`, on the branch its flags name, without flags
+//! by the rule of `ik::choice` from the previous target's joints) and its
+//! values rewritten; one report line per position of a Cartesian motion
+//! (`report.rs`).
 
-use super::{mark, parse, Flags, FrameSpec, Language, ParseError, ProgramFile, Site};
+use super::report::{
+    FilterReport, JointMotionReport, MotionPlace, TargetReport, TargetStatus, UnusedReport,
+};
+use super::sites::{Context, Failure, Solved};
+use super::{mark, parse, Language, Motion, MotionTarget, ParseError, Program, ProgramFile, Site};
 use crate::calibrate::compensate::CompensatedModel;
 use crate::model::orientation::rotation_to;
 use crate::model::Pose;
 use crate::solve::cell::export::{controller_text, ControllerFrame, ControllerTool};
-use crate::solve::cell::{
-    Cell, CellOptions, CellSolution, CellSolver, Load, LoadDescription, Tool, WorkObject,
-    WorkObjectFrame,
-};
+use crate::solve::cell::Cell;
 use crate::solve::ik::IkSettings;
-use crate::solve::ik::{Configuration, FailureReason};
 use serde::Serialize;
-
-/// What happened to one target.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum TargetStatus {
-    /// Replaced by its false target.
-    Filtered,
-    /// Left unchanged and marked: it could not be solved.
-    Failed,
-    /// Left unchanged, not marked: not a target the filter can change (a
-    /// relative motion, a point no motion uses).
-    Skipped,
-}
-
-/// The report line of one target.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct TargetReport {
-    pub file: String,
-    /// 1-based.
-    pub line: usize,
-    pub name: String,
-    pub status: TargetStatus,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub reason: Option<String>,
-    /// Configuration branch of the solution.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub configuration: Option<String>,
-    /// Distance the position moved [mm].
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub shift_mm: Option<f64>,
-    /// The load the solve carried (flange frame) and where it came from.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub load: Option<UsedLoad>,
-    /// What the user should check (a declared load that differs from the cell's).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub warnings: Vec<String>,
-}
-
-/// Where the load of a solve comes from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum LoadSource {
-    /// Declared by the program (RAPID `tload`, URScript `set_payload`, ...).
-    Program,
-    /// The cell's tool.
-    Cell,
-    /// The model's payload, kept at its flange point.
-    Model,
-}
-
-/// The load a target was solved with.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct UsedLoad {
-    pub source: LoadSource,
-    #[serde(flatten)]
-    pub load: LoadDescription,
-}
-
-/// The per-target report of a filtered program.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct FilterReport {
-    pub language: Language,
-    pub filtered: usize,
-    pub failed: usize,
-    pub skipped: usize,
-    pub targets: Vec<TargetReport>,
-    /// What the controller must hold for the filtered program, in its
-    /// language (`cell::export`): the tools, loads and work objects the
-    /// filter used, work objects in the controller's base frame.
-    pub controller_data: String,
-}
 
 /// The filtered files (same names and order) and the report.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -99,11 +26,11 @@ pub struct FilterOutput {
 }
 
 /// Bounds on one filter: the most targets it takes, and a test, asked
-/// before each target, of whether to go on (a client still waiting).
+/// before each motion, of whether to go on (a client still waiting).
 pub struct FilterControl<'a> {
     /// Most Cartesian targets (sites) a program may have (`None`: no cap).
     pub max_targets: Option<usize>,
-    /// `false` stops the filter before the next target.
+    /// `false` stops the filter before the next motion.
     pub keep_going: &'a dyn Fn() -> bool,
 }
 
@@ -131,8 +58,8 @@ pub enum FilterError {
     Cancelled,
 }
 
-/// Filters a program: every Cartesian target becomes its false target on
-/// `model` for its tool and work object (looked up in `cell`).
+/// Filters a program: every Cartesian target a motion goes to becomes its
+/// false target on `model` for its tool and work object (looked up in `cell`).
 pub fn filter(
     language: Language,
     files: &[ProgramFile],
@@ -158,7 +85,7 @@ pub fn filter(
 }
 
 /// [`filter`] within `control`'s bounds: a program with more targets than
-/// its cap is refused before any solve, and the filter stops between targets
+/// its cap is refused before any solve, and the filter stops between motions
 /// once `keep_going` says so.
 pub fn filter_with(
     language: Language,
@@ -177,418 +104,252 @@ pub fn filter_with(
             });
         }
     }
-    let mut solvers: Vec<(Pose, Option<Load>, CellSolver)> = Vec::new();
-    let mut edits: Vec<Vec<(std::ops::Range<usize>, String)>> = vec![Vec::new(); files.len()];
-    let mut targets = Vec::with_capacity(program.sites.len());
-    let mut previous: Option<Vec<f64>> = None;
-    let mut used_tools: Vec<ControllerTool> = Vec::new();
-    let mut used_frames: Vec<ControllerFrame> = Vec::new();
-    for site in &program.sites {
-        if !(control.keep_going)() {
-            return Err(FilterError::Cancelled);
-        }
-        let mut report = TargetReport {
-            file: files[site.file].name.clone(),
-            line: site.line,
-            name: site.name.clone(),
-            status: TargetStatus::Filtered,
-            reason: None,
-            configuration: None,
-            shift_mm: None,
-            load: None,
-            warnings: Vec::new(),
-        };
-        if let Some(why) = &site.skip {
-            report.status = TargetStatus::Skipped;
-            report.reason = Some(why.clone());
-            targets.push(report);
-            continue;
-        }
-        if let Some(j) = &site.after_joints {
-            let rad: Vec<f64> = j.iter().map(|v| v.to_radians()).collect();
-            previous = Some(model.nominal.joints_from_controller(&rad));
-        }
-        match solve_site(
-            site,
+    let mut run = Run {
+        files,
+        program: &program,
+        context: Context {
+            language,
             cell,
             model,
             settings,
-            &mut solvers,
-            previous.as_deref(),
-        ) {
-            Ok(done) => {
-                if let Some(t) = done.tool.filter(|t| !used_tools.contains(t)) {
-                    used_tools.push(t);
-                }
-                if let Some(f) = done.frame.filter(|f| !used_frames.contains(f)) {
-                    used_frames.push(f);
-                }
-                report.load = Some(done.load);
-                report.warnings = done.warnings;
-                report.configuration = done.configuration;
-                report.shift_mm = Some(done.shift_m * 1e3);
-                edits[site.file].extend(values(site, &done.false_target));
-                previous = Some(done.q);
-            }
-            Err(reason) => {
-                edits[site.file].push((site.mark_at.clone(), mark(language, &reason)));
-                report.status = TargetStatus::Failed;
-                report.reason = Some(reason);
-            }
-        }
-        targets.push(report);
-    }
-    let files = files
-        .iter()
-        .zip(edits)
-        .map(|(f, e)| ProgramFile {
-            name: f.name.clone(),
-            text: apply(&f.text, e),
-        })
-        .collect();
-    let count = |s: TargetStatus| targets.iter().filter(|t| t.status == s).count();
-    Ok(FilterOutput {
-        files,
-        report: FilterReport {
-            language,
-            filtered: count(TargetStatus::Filtered),
-            failed: count(TargetStatus::Failed),
-            skipped: count(TargetStatus::Skipped),
-            targets,
-            controller_data: if used_tools.is_empty() {
-                String::new()
-            } else {
-                controller_text(language, &used_tools, &used_frames)
-            },
+            solvers: Vec::new(),
         },
-    })
+        outcomes: vec![None; program.sites.len()],
+        edits: vec![Vec::new(); files.len()],
+        previous: None,
+        targets: Vec::with_capacity(program.motions.len()),
+        joint_motions: Vec::new(),
+        used_tools: Vec::new(),
+        used_frames: Vec::new(),
+    };
+    for motion in &program.motions {
+        if !(control.keep_going)() {
+            return Err(FilterError::Cancelled);
+        }
+        run.motion(motion);
+    }
+    Ok(run.finish())
 }
 
-struct Solved {
+/// What became of a site, kept for every motion that goes to it.
+#[derive(Clone)]
+enum Outcome {
+    Filtered(Box<SolvedReport>),
+    Failed {
+        reason: String,
+        reachable: Vec<super::report::Reachable>,
+    },
+    Skipped {
+        reason: String,
+    },
+}
+
+/// The report fields of a solved site.
+#[derive(Clone)]
+struct SolvedReport {
     q: Vec<f64>,
-    false_target: Pose,
+    joints_deg: Vec<f64>,
     configuration: Option<String>,
-    shift_m: f64,
-    load: UsedLoad,
+    shift_mm: f64,
+    load: super::report::UsedLoad,
     warnings: Vec<String>,
-    /// The tool and work object as the controller holds them (`None` for a
-    /// stationary tool, which `cell::export` does not write).
-    tool: Option<ControllerTool>,
-    frame: Option<ControllerFrame>,
 }
 
-/// The site's tool (the cell's, or one the program defines, without a load).
-fn resolve_tool(spec: &FrameSpec, cell: &Cell) -> Result<Tool, String> {
-    match spec {
-        FrameSpec::Ref(r) => cell.tool(r).map_err(|e| e.to_string()),
-        FrameSpec::Inline(p) => Ok(Tool {
-            name: "inline".into(),
-            number: None,
-            tcp: *p,
+/// One filter under way.
+struct Run<'a> {
+    files: &'a [ProgramFile],
+    program: &'a Program,
+    context: Context<'a>,
+    /// Per site: `None` until a motion goes to it.
+    outcomes: Vec<Option<Outcome>>,
+    edits: Vec<Vec<(std::ops::Range<usize>, String)>>,
+    /// The joints of the last position reached (model convention).
+    previous: Option<Vec<f64>>,
+    targets: Vec<TargetReport>,
+    joint_motions: Vec<JointMotionReport>,
+    used_tools: Vec<ControllerTool>,
+    used_frames: Vec<ControllerFrame>,
+}
+
+impl Run<'_> {
+    fn motion(&mut self, motion: &Motion) {
+        let place = MotionPlace {
+            file: self.files[motion.file].name.clone(),
+            line: motion.line,
+            instruction: motion.instruction.clone(),
+        };
+        let mut report = TargetReport {
+            file: place.file.clone(),
+            line: motion.line,
+            motion: place,
+            name: motion.name.clone(),
+            status: TargetStatus::Skipped,
+            reason: None,
+            configuration: None,
+            joints_deg: None,
+            shift_mm: None,
             load: None,
-        }),
-        FrameSpec::Unset => Err("the program selects no tool".into()),
-    }
-}
-
-/// The load of a site's solve: the program's declaration, else the cell
-/// tool's, else the model's payload at its flange point (`None`); a warning
-/// naming both when the program's and the cell's differ.
-fn choose_load(
-    declared: Option<Load>,
-    cell: Option<Load>,
-    model: &CompensatedModel,
-) -> (Option<Load>, UsedLoad, Vec<String>) {
-    let mut warnings = Vec::new();
-    if let (Some(d), Some(c)) = (declared, cell) {
-        if d.differs(&c) {
-            warnings.push(format!(
-                "the program declares a load of {}, the cell's tool carries {}: solved with the program's",
-                d.describe(),
-                c.describe()
-            ));
-        }
-    }
-    let (load, source) = match (declared, cell) {
-        (Some(d), _) => (Some(d), LoadSource::Program),
-        (None, Some(c)) => (Some(c), LoadSource::Cell),
-        (None, None) => (None, LoadSource::Model),
-    };
-    let used = load.unwrap_or_else(|| Load {
-        mass_kg: model.payload_kg,
-        ..Load::of_model(&model.calibrated)
-    });
-    let used = UsedLoad {
-        source,
-        load: LoadDescription::of(&used),
-    };
-    (load, used, warnings)
-}
-
-fn resolve_work_object(spec: &FrameSpec, cell: &Cell) -> Result<WorkObject, String> {
-    match spec {
-        FrameSpec::Ref(r) => cell.work_object(r).map_err(|e| e.to_string()),
-        FrameSpec::Inline(p) => Ok(WorkObject {
-            name: "inline".into(),
-            number: None,
-            frame: WorkObjectFrame::Base,
-            pose: *p,
-        }),
-        FrameSpec::Unset => Ok(WorkObject::base()),
-    }
-}
-
-fn distance(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| (x - y).abs()).sum()
-}
-
-/// The nominal controller's joints for a site: its solutions carrying the
-/// site's flags, the one nearest `previous` (model convention, rad).
-pub(crate) fn controller_joints(
-    solver: &CellSolver,
-    site: &Site,
-    wobj: &WorkObject,
-    pose: &Pose,
-    previous: Option<&[f64]>,
-) -> Option<Vec<f64>> {
-    let s = solver.solver();
-    solver
-        .nominal_solutions(wobj, pose)
-        .into_iter()
-        .filter(|q| {
-            site.flags
-                .admits(&s.controller_degrees(q), s.configuration(q))
-        })
-        .min_by(|a, b| match previous {
-            Some(p) => distance(a, p).total_cmp(&distance(b, p)),
-            None => std::cmp::Ordering::Equal,
-        })
-}
-
-fn solve_site(
-    site: &Site,
-    cell: &Cell,
-    model: &CompensatedModel,
-    settings: &IkSettings,
-    solvers: &mut Vec<(Pose, Option<Load>, CellSolver)>,
-    previous: Option<&[f64]>,
-) -> Result<Solved, String> {
-    let pose = site.pose.ok_or("the target is not a complete pose")?;
-    if site.stationary_tool {
-        return solve_stationary(site, cell, &pose, model, settings, previous);
-    }
-    let tool = resolve_tool(&site.tool, cell)?;
-    let tcp = tool.tcp;
-    let (load, used_load, warnings) = choose_load(site.load, tool.load, model);
-    let wobj = resolve_work_object(&site.work_object, cell)?;
-    let used_tool = ControllerTool {
-        name: tool.name,
-        number: tool.number.unwrap_or(0),
-        tcp,
-        load: Load {
-            mass_kg: used_load.load.mass_kg,
-            com: load.map_or_else(|| Load::of_model(&model.calibrated).com, |l| l.com),
-            inertia_kgm2: load.and_then(|l| l.inertia_kgm2),
-        },
-    };
-    let used_frame = ControllerFrame {
-        name: wobj.name.clone(),
-        number: wobj.number.unwrap_or(0),
-        pose: wobj.in_base(model),
-    };
-    let index = match solvers.iter().position(|(p, l, _)| *p == tcp && *l == load) {
-        Some(i) => i,
-        None => {
-            let solver = CellSolver::with_load(model, &tcp, load.as_ref(), settings.clone());
-            solvers.push((tcp, load, solver));
-            solvers.len() - 1
-        }
-    };
-    let solver = &solvers[index].2;
-    let (q, false_target, configuration) = solve_on(solver, site, &wobj, &pose, previous)?;
-    Ok(Solved {
-        shift_m: (false_target.p - pose.p).norm(),
-        configuration: configuration.map(|c| c.to_string()),
-        false_target,
-        q,
-        load: used_load,
-        warnings,
-        tool: Some(used_tool),
-        frame: Some(used_frame),
-    })
-}
-
-/// A target with the roles swapped: the robot carries the work object `W_f`
-/// (flange → work object) past a stationary tool `S` (base frame). The
-/// physical condition `FK_cal(q)·W_f·T = S` is an ordinary solve of the goal
-/// `S` with the effective tool `W_f·T` (flange → the point of the work object
-/// that must meet the tool); the controller, with its nominal model, must be
-/// given `T_false = (FK_nom(q)·W_f)⁻¹·S = T·(FK_nom(q)·W_f·T)⁻¹·S`. The load
-/// is the program's (the carried work piece), else the cell's, else the
-/// model's payload at its flange point. Referred to by name or number (KRL's
-/// `BASE_DATA[n]` and `TOOL_DATA[n]` with an external TCP), the stationary
-/// tool is the cell's work object of that reference (a fixed frame, in the
-/// base frame of the calibrated version) and the carried work piece the
-/// cell's tool (a frame on the flange, with its load).
-fn solve_stationary(
-    site: &Site,
-    cell: &Cell,
-    pose: &Pose,
-    model: &CompensatedModel,
-    settings: &IkSettings,
-    previous: Option<&[f64]>,
-) -> Result<Solved, String> {
-    let fixed = match &site.tool {
-        FrameSpec::Inline(p) => *p,
-        FrameSpec::Ref(r) => cell
-            .work_object(r)
-            .map_err(|e| format!("the stationary tool: {e}"))?
-            .in_base(model),
-        FrameSpec::Unset => return Err("the program selects no stationary tool".into()),
-    };
-    let (held, cell_load) = match &site.work_object {
-        FrameSpec::Inline(p) => (*p, None),
-        FrameSpec::Ref(r) => {
-            let t = cell
-                .tool(r)
-                .map_err(|e| format!("the work piece the robot carries: {e}"))?;
-            (t.tcp, t.load)
-        }
-        FrameSpec::Unset => {
-            return Err("the program selects no work piece for the robot to carry".into())
-        }
-    };
-    let (load, used_load, warnings) = choose_load(site.load, cell_load, model);
-    let effective = held.compose(pose);
-    let solver = CellSolver::with_load(model, &effective, load.as_ref(), settings.clone());
-    let (q, f, configuration) = solve_on(&solver, site, &WorkObject::base(), &fixed, previous)?;
-    let false_target = pose.compose(&f.inverse()).compose(&fixed);
-    Ok(Solved {
-        shift_m: (false_target.p - pose.p).norm(),
-        configuration: configuration.map(|c| c.to_string()),
-        false_target,
-        q,
-        load: used_load,
-        warnings,
-        tool: None,
-        frame: None,
-    })
-}
-
-/// The calibrated joints, false target and configuration of `pose` in
-/// `wobj` on the branch and from the seed the site's flags give.
-fn solve_on(
-    solver: &CellSolver,
-    site: &Site,
-    wobj: &WorkObject,
-    pose: &Pose,
-    previous: Option<&[f64]>,
-) -> Result<(Vec<f64>, Pose, Option<Configuration>), String> {
-    let q_nominal = controller_joints(solver, site, wobj, pose, previous);
-    let solved = match q_nominal {
-        Some(q) => solver.solve(
-            wobj,
-            pose,
-            &CellOptions {
-                branch: solver.configuration(&q),
-                seed: Some(q),
-            },
-        ),
-        // The nominal model has no solution on the flags (out of its reach or
-        // limits): the branch whose calibrated solution carries them.
-        None if site.flags == Flags::Nearest => solver.solve(
-            wobj,
-            pose,
-            &CellOptions {
-                branch: None,
-                seed: previous.map(<[f64]>::to_vec),
-            },
-        ),
-        None => solve_on_flags(solver, site, wobj, pose, previous)?,
-    };
-    let Some(false_target) = solved.false_target else {
-        let reason = solved
-            .solution
-            .reason
-            .map_or_else(|| "not solved".to_string(), |r| r.to_string());
-        return Err(reason);
-    };
-    let s = solver.solver();
-    let q = solved.solution.q;
-    let configuration = s.configuration(&q);
-    if let Some(m) = site
-        .flags
-        .mismatch(&s.controller_degrees(&q), configuration)
-    {
-        return Err(format!("the calibrated solution changes the flags: {m}"));
-    }
-    Ok((q, false_target, configuration))
-}
-
-/// The first branch whose calibrated solution carries the site's flags.
-fn solve_on_flags(
-    solver: &CellSolver,
-    site: &Site,
-    wobj: &WorkObject,
-    pose: &Pose,
-    previous: Option<&[f64]>,
-) -> Result<CellSolution, String> {
-    // One unconstrained solve first: an unreachable target fails here at the
-    // cost of a solved one (the solver's reach test) instead of once per
-    // branch, and a solution already carrying the flags ends the search.
-    let free = solver.solve(
-        wobj,
-        pose,
-        &CellOptions {
-            branch: None,
-            seed: previous.map(<[f64]>::to_vec),
-        },
-    );
-    if let Some(r @ FailureReason::Unreachable) = &free.solution.reason {
-        return Err(r.to_string());
-    }
-    if free.solution.converged {
-        let q = &free.solution.q;
-        let s = solver.solver();
-        if site
-            .flags
-            .admits(&s.controller_degrees(q), s.configuration(q))
-        {
-            return Ok(free);
-        }
-    }
-    let mut failure: Option<String> = None;
-    let mut converged = false;
-    for branch in Configuration::all() {
-        let s = solver.solve(
-            wobj,
-            pose,
-            &CellOptions {
-                branch: Some(branch),
-                seed: previous.map(<[f64]>::to_vec),
-            },
-        );
-        let q = &s.solution.q;
-        converged |= s.solution.converged;
-        if s.solution.converged
-            && site
-                .flags
-                .admits(&solver.solver().controller_degrees(q), Some(branch))
-        {
-            return Ok(s);
-        }
-        if let (None, Some(r)) = (&failure, &s.solution.reason) {
-            if !matches!(r, FailureReason::BranchUnavailable { .. }) {
-                failure = Some(r.to_string());
+            warnings: Vec::new(),
+            reachable: Vec::new(),
+        };
+        match &motion.target {
+            MotionTarget::Site(i) => {
+                let site = &self.program.sites[*i];
+                report.file = self.files[site.file].name.clone();
+                report.line = site.line;
+                let outcome = match &self.outcomes[*i] {
+                    Some(o) => o.clone(),
+                    None => {
+                        let o = self.first_visit(site);
+                        self.outcomes[*i] = Some(o.clone());
+                        o
+                    }
+                };
+                describe(&mut report, outcome, &mut self.previous);
+            }
+            MotionTarget::Joints { note } => {
+                self.joint_motions.push(JointMotionReport {
+                    file: report.motion.file,
+                    line: motion.line,
+                    instruction: motion.instruction.clone(),
+                    name: motion.name.clone(),
+                    note: note.clone(),
+                });
+                return;
+            }
+            MotionTarget::RunTime(why) => report.reason = Some(why.clone()),
+            MotionTarget::Undeclared => {
+                let why = format!(
+                    "{} is not declared in the program's files{}",
+                    motion.name,
+                    undeclared_hint(self.context.language)
+                );
+                self.edits[motion.file]
+                    .push((motion.mark_at.clone(), mark(self.context.language, &why)));
+                report.status = TargetStatus::Failed;
+                report.reason = Some(why);
             }
         }
+        self.targets.push(report);
     }
-    match failure {
-        Some(reason) if !converged => Err(reason),
-        _ => Err(format!(
-            "no solution within the joint limits carries the program's flags {}",
-            site.flags
-        )),
+
+    /// Solves (or skips, or refuses) a site the first time a motion goes to
+    /// it, and records its edit.
+    fn first_visit(&mut self, site: &Site) -> Outcome {
+        if let Some(why) = &site.skip {
+            return Outcome::Skipped {
+                reason: why.clone(),
+            };
+        }
+        let failed = |edits: &mut Vec<Vec<_>>, language, f: Failure| {
+            edits[site.file].push((site.mark_at.clone(), mark(language, &f.reason)));
+            Outcome::Failed {
+                reason: f.reason,
+                reachable: f.reachable,
+            }
+        };
+        let language = self.context.language;
+        if let Some(why) = &site.refuse {
+            return failed(&mut self.edits, language, Failure::from(why.clone()));
+        }
+        if let Some(j) = &site.after_joints {
+            let rad: Vec<f64> = j.iter().map(|v| v.to_radians()).collect();
+            self.previous = Some(self.context.model.nominal.joints_from_controller(&rad));
+        }
+        match self.context.solve_site(site, self.previous.as_deref()) {
+            Ok(done) => self.solved(site, done),
+            Err(f) => failed(&mut self.edits, language, f),
+        }
+    }
+
+    fn solved(&mut self, site: &Site, done: Solved) -> Outcome {
+        if let Some(t) = done.tool.filter(|t| !self.used_tools.contains(t)) {
+            self.used_tools.push(t);
+        }
+        if let Some(f) = done.frame.filter(|f| !self.used_frames.contains(f)) {
+            self.used_frames.push(f);
+        }
+        self.edits[site.file].extend(values(site, &done.false_target));
+        Outcome::Filtered(Box::new(SolvedReport {
+            q: done.q,
+            joints_deg: done.joints_deg,
+            configuration: done.configuration,
+            shift_mm: done.shift_m * 1e3,
+            load: done.load,
+            warnings: done.warnings,
+        }))
+    }
+
+    fn finish(self) -> FilterOutput {
+        let files = self
+            .files
+            .iter()
+            .zip(self.edits)
+            .map(|(f, e)| ProgramFile {
+                name: f.name.clone(),
+                text: apply(&f.text, e),
+            })
+            .collect();
+        let unused = self
+            .program
+            .sites
+            .iter()
+            .zip(&self.outcomes)
+            .filter(|(_, o)| o.is_none())
+            .map(|(s, _)| UnusedReport {
+                file: self.files[s.file].name.clone(),
+                line: s.line,
+                name: s.name.clone(),
+            })
+            .collect();
+        let language = self.context.language;
+        let controller_data = if self.used_tools.is_empty() {
+            String::new()
+        } else {
+            controller_text(language, &self.used_tools, &self.used_frames)
+        };
+        FilterOutput {
+            files,
+            report: FilterReport::new(
+                language,
+                self.targets,
+                self.joint_motions,
+                unused,
+                controller_data,
+            ),
+        }
+    }
+}
+
+/// A report line from its site's outcome; a filtered position is where the
+/// robot is next.
+fn describe(report: &mut TargetReport, outcome: Outcome, previous: &mut Option<Vec<f64>>) {
+    match outcome {
+        Outcome::Filtered(s) => {
+            report.status = TargetStatus::Filtered;
+            report.configuration = s.configuration;
+            report.joints_deg = Some(s.joints_deg);
+            report.shift_mm = Some(s.shift_mm);
+            report.load = Some(s.load);
+            report.warnings = s.warnings;
+            *previous = Some(s.q);
+        }
+        Outcome::Failed { reason, reachable } => {
+            report.status = TargetStatus::Failed;
+            report.reason = Some(reason);
+            report.reachable = reachable;
+        }
+        Outcome::Skipped { reason } => report.reason = Some(reason),
+    }
+}
+
+/// Where a language's positions are declared, for the failure of one that is not.
+fn undeclared_hint(language: Language) -> &'static str {
+    match language {
+        Language::Krl => " (a .src needs its .dat)",
+        Language::Rapid => " (no robtarget of that name in the modules)",
+        Language::Fanuc => " (no such position in /POS)",
+        Language::UrScript => " (no assignment of that name)",
     }
 }
 

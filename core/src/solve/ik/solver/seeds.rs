@@ -45,10 +45,8 @@ impl IkSolver {
             return self.numeric_seeds(options);
         };
         let hint = options.seed.as_deref();
-        let reference: Vec<f64> = match hint {
-            Some(h) => h.to_vec(),
-            None => analytic.mid_range().to_vec(),
-        };
+        // The rule's reference (`ik::choice`): the seed, else the middle of the ranges.
+        let reference = crate::solve::ik::choice::reference(analytic.limits(), hint);
         // Orientation for the closed form: the goal's, or the predicted one at the reference.
         let rotation = goal.rotation.unwrap_or_else(|| {
             self.model
@@ -154,9 +152,9 @@ impl IkSolver {
     }
 
     /// The closed-form solutions in `branch` (any without one), each with its
-    /// limit violation [rad] and squared distance to `reference` [rad²]:
-    /// within the limits before beyond them, unclamped before clamped, then
-    /// nearest first.
+    /// limit violation [rad] and distance to `reference` [rad²]: within the
+    /// limits before beyond them, unclamped before clamped, then nearest
+    /// first (the rule of [`crate::solve::ik::choice`]).
     fn ranked(
         &self,
         sols: Vec<AnalyticSolution>,
@@ -168,11 +166,7 @@ impl IkSolver {
             .filter(|s| branch.is_none_or(|b| b == s.configuration))
             .map(|s| {
                 let violation = self.limit_violation(&s.q);
-                let dist: f64 =
-                    s.q.iter()
-                        .zip(reference)
-                        .map(|(a, b)| (a - b).powi(2))
-                        .sum();
+                let dist = crate::solve::ik::choice::distance(&s.q, reference);
                 (s, violation, dist)
             })
             .collect();

@@ -66,3 +66,63 @@ fn errors_name_file_line_and_column() {
         assert!(e.message.contains(what), "{}", e.message);
     }
 }
+
+#[test]
+fn motions_name_their_positions_and_what_they_are() {
+    let ls = "/PROG  T\n/MN\n   1:J P[1] 100% FINE    ;\n   2:L PR[3] 500mm/sec FINE    ;\n   3:L P[7] 500mm/sec FINE    ;\n\
+              \x20  4:L P[1] 100mm/sec FINE INC ;\n   5:L P[2] 100mm/sec FINE    ;\n   6:J P[3] 100% FINE ;\n\
+              /POS\nP[1]{\n   GP1:\n\tUF : 2, UT : 1,\t\tCONFIG : 'N U T, 0, 0, 0',\n\
+              \tX = 1.000 mm,\tY = 2.000 mm,\tZ = 3.000 mm,\n\tW = 0.000 deg,\tP = 0.000 deg,\tR = 0.000 deg\n};\n\
+              P[2]{\n   GP1:\n\tUF : 2, UT : 1,\t\tCONFIG : 'N U T, 0, 0, 0',\n\
+              \tX = 1.000 mm,\tY = 2.000 mm,\tZ = 3.000 mm,\n\tW = 0.000 deg,\tP = 0.000 deg,\tR = 0.000 deg,\n\
+              \tE1 = 500.000 mm\n};\n\
+              P[3]{\n   GP1:\n\tUF : 2, UT : 1,\t\tCONFIG : 'N U T, 0, 0, 0',\n\
+              \tX = 1.000 mm,\tY = 2.000 mm,\tZ = 3.000 mm,\n\tW = 0.000 deg,\tP = 0.000 deg,\tR = 0.000 deg\n\
+              \x20  GP2:\n\tUF : 0, UT : 1,\n\tJ1 = 10.000 deg\n};\n/END\n";
+    let f = ProgramFile {
+        name: "t.ls".into(),
+        text: ls.into(),
+    };
+    let found = parse(std::slice::from_ref(&f)).unwrap();
+    let m: Vec<(usize, &str, &str)> = found
+        .motions
+        .iter()
+        .map(|m| (m.line, m.instruction.as_str(), m.name.as_str()))
+        .collect();
+    assert_eq!(
+        m,
+        [
+            (3, "J", "P[1]"),
+            (4, "L", "PR[3]"),
+            (5, "L", "P[7]"),
+            (6, "L", "P[1]"),
+            (7, "L", "P[2]"),
+            (8, "J", "P[3]"),
+        ]
+    );
+    assert_eq!(found.motions[0].target, MotionTarget::Site(0));
+    let MotionTarget::RunTime(why) = &found.motions[1].target else {
+        panic!()
+    };
+    assert!(why.contains("PR[3] is a position register"), "{why}");
+    assert_eq!(found.motions[2].target, MotionTarget::Undeclared);
+    // The mark of P[7] goes into its reference, as the comment of a position.
+    assert_eq!(&ls[found.motions[2].mark_at.start..][..1], "]");
+    let MotionTarget::RunTime(why) = &found.motions[3].target else {
+        panic!()
+    };
+    assert!(why.contains("INC"), "{why}");
+    let refused = |i: usize| {
+        let MotionTarget::Site(s) = found.motions[i].target else {
+            panic!("{i}")
+        };
+        found.sites[s].refuse.clone().unwrap()
+    };
+    assert!(
+        refused(4).contains("external axis E1 to 500.000 mm"),
+        "{}",
+        refused(4)
+    );
+    assert!(refused(5).contains("motion group GP2"), "{}", refused(5));
+    assert!(found.sites[0].refuse.is_none());
+}

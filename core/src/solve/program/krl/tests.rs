@@ -1,4 +1,7 @@
+use super::super::Flags;
 use super::*;
+use crate::model::orientation::rotation_from;
+use nalgebra::Vector3;
 
 fn file(name: &str, text: &str) -> ProgramFile {
     ProgramFile {
@@ -29,9 +32,31 @@ END\n";
 #[test]
 fn targets_flags_tools_and_bases() {
     let files = [file("demo.src", SRC), file("demo.dat", DAT)];
-    let sites = parse(&files).unwrap().sites;
+    let found = parse(&files).unwrap();
+    let sites = found.sites;
     let names: Vec<&str> = sites.iter().map(|s| s.name.as_str()).collect();
-    assert_eq!(names, ["XP1", "inline", "inline", "inline", "XUNUSED"]);
+    assert_eq!(names, ["XP1", "inline", "inline", "XUNUSED"]);
+    // Every motion, in the order of the lines: XHOME and the axis aggregate
+    // are joint motions, LIN_REL is relative.
+    let motions: Vec<(usize, &str, &str, &MotionTarget)> = found
+        .motions
+        .iter()
+        .map(|m| (m.line, m.instruction.as_str(), m.name.as_str(), &m.target))
+        .collect();
+    let joints = MotionTarget::Joints { note: None };
+    let relative =
+        MotionTarget::RunTime("relative motion: LIN_REL moves from where the robot is".into());
+    assert_eq!(
+        motions,
+        [
+            (2, "PTP", "XHOME", &joints),
+            (5, "PTP", "XP1", &MotionTarget::Site(0)),
+            (7, "LIN", "inline", &MotionTarget::Site(1)),
+            (8, "LIN", "inline", &MotionTarget::Site(2)),
+            (9, "LIN_REL", "inline", &relative),
+            (10, "PTP", "inline", &joints),
+        ]
+    );
     let p1 = &sites[0];
     assert_eq!((p1.file, p1.line), (1, 2));
     assert_eq!(
@@ -57,8 +82,81 @@ fn targets_flags_tools_and_bases() {
     assert_eq!(sites[1].flags, Flags::Nearest);
     assert!(sites[1].skip.is_none());
     assert!(sites[2].skip.as_ref().unwrap().contains("incomplete"));
-    assert_eq!(sites[3].skip.as_deref(), Some("relative motion"));
-    assert!(sites[4].skip.as_ref().unwrap().contains("no motion"));
+    assert!(sites[3].skip.as_ref().unwrap().contains("no motion"));
+    assert!(sites.iter().all(|s| s.refuse.is_none()));
+}
+
+/// What the motions of a `.src` go to, by name.
+fn targets_of(files: &[ProgramFile]) -> Vec<(String, MotionTarget)> {
+    parse(files)
+        .unwrap()
+        .motions
+        .into_iter()
+        .map(|m| (m.name, m.target))
+        .collect()
+}
+
+#[test]
+fn a_src_without_its_dat_names_what_it_lacks() {
+    let src = file("demo.src", SRC);
+    let t = targets_of(std::slice::from_ref(&src));
+    // XP1 is in the .dat: undeclared. XHOME: KUKA's home, axis values.
+    assert_eq!(t[1], ("XP1".into(), MotionTarget::Undeclared));
+    let MotionTarget::Joints { note: Some(note) } = &t[0].1 else {
+        panic!("{:?}", t[0])
+    };
+    assert!(note.contains("$config.dat"), "{note}");
+    // With the .dat: declared.
+    let t = targets_of(&[src, file("demo.dat", DAT)]);
+    assert_eq!(t[1], ("XP1".into(), MotionTarget::Site(0)));
+}
+
+#[test]
+fn positions_set_at_run_time_are_named() {
+    let dat = "DECL E6POS XP1={X 1,Y 2,Z 3,A 0,B 0,C 0}\nDECL E6POS XP2={X 1,Y 2,Z 3,A 0,B 0,C 0}\n\
+               DECL E6POS XEMPTY\nDECL E6POS XARR[4]\nDECL E6AXIS XJ={A1 0,A2 0,A3 0,A4 0,A5 0,A6 0}\n";
+    let src = "PTP $POS_ACT\nLIN XARR[2]\nLIN XEMPTY\nLIN XBASE : XP1\nXP2.Z = XP2.Z + 10\n\
+               LIN XP2 C_DIS\nSPTP XJ\nLIN XP1 WITH $VEL = SVEL_CP(0.2, , LCPFAST)\n\
+               CIRC XP1, XP2, CA 90\nXTMP = $POS_ACT\nLIN XTMP\n";
+    let found = parse(&[file("a.src", src), file("a.dat", dat)]).unwrap();
+    let run_time = |i: usize| match &found.motions[i].target {
+        MotionTarget::RunTime(why) => why.clone(),
+        other => panic!("{i}: {other:?}"),
+    };
+    assert!(run_time(0).contains("$POS_ACT is a system variable"));
+    assert!(run_time(1).contains("`XARR[2]` is computed at run time"));
+    assert!(run_time(2).contains("XEMPTY is declared without a value"));
+    assert!(run_time(3).contains("`XBASE : XP1`"));
+    assert!(run_time(9).contains("XTMP is assigned at run time (a.src line 10)"));
+    // XP2 is assigned in the .src: its site is skipped, saying where.
+    let MotionTarget::Site(i) = found.motions[4].target else {
+        panic!()
+    };
+    let xp2 = &found.sites[i];
+    assert_eq!(xp2.name, "XP2");
+    assert_eq!(
+        xp2.skip.as_deref(),
+        Some("XP2 is assigned at run time (a.src line 5)")
+    );
+    assert_eq!(found.motions[5].target, MotionTarget::Joints { note: None });
+    // The clause after the position is not part of it; CIRC has two.
+    assert_eq!(found.motions[6].name, "XP1");
+    let circ: Vec<(&str, usize)> = found.motions[7..9]
+        .iter()
+        .map(|m| (m.name.as_str(), m.line))
+        .collect();
+    assert_eq!(circ, [("XP1", 9), ("XP2", 9)]);
+    assert_eq!(found.motions.len(), 10);
+}
+
+#[test]
+fn external_axes_are_refused_naming_the_axis() {
+    let src =
+        "LIN {X 1,Y 2,Z 3,A 0,B 0,C 0,E1 0.0,E2 0}\nLIN {X 1,Y 2,Z 3,A 0,B 0,C 0,E1 0,E2 250.5}\n";
+    let sites = parse(&[file("e.src", src)]).unwrap().sites;
+    assert!(sites[0].refuse.is_none());
+    let why = sites[1].refuse.as_deref().unwrap();
+    assert!(why.contains("external axis E2 to 250.5"), "{why}");
 }
 
 #[test]

@@ -1,4 +1,6 @@
+use super::super::Flags;
 use super::*;
+use nalgebra::Vector3;
 
 fn file(text: &str) -> ProgramFile {
     ProgramFile {
@@ -111,4 +113,80 @@ fn errors_name_file_line_and_column() {
         assert_eq!((e.line, e.column), (line, column), "{text}: {e}");
         assert!(e.message.contains(what), "{}", e.message);
     }
+}
+
+#[test]
+fn every_motion_is_reported_with_what_it_goes_to() {
+    let text = "MODULE m\n\
+  CONST robtarget p10:=[[1,2,3],[1,0,0,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];\n\
+  CONST robtarget p20:=[[1,2,3],[1,0,0,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];\n\
+  VAR robtarget p30;\n\
+  CONST jointtarget home:=[[0,0,0,0,30,0],[9E9,9E9,9E9,9E9,9E9,9E9]];\n\
+  PROC go(robtarget target)\n\
+    MoveL target, v100, fine, tool0;\n\
+  ENDPROC\n\
+  PROC main()\n\
+    MoveAbsJ home, v1000, fine, tool0;\n\
+    MoveL Offs(p10, 0, 0, 50), v100, fine, tool0;\n\
+    MoveL RelTool(p10, 0, 0, -20 \\Rz:=10), v100, fine, tool0;\n\
+    MoveJ p99, v100, z10, tool0;\n\
+    MoveL p30, v100, fine, tool0;\n\
+    p20.trans.z := p20.trans.z + 5;\n\
+    TriggL p10, v500, gunon, fine, gun1 \\WObj:=wobj0;\n\
+    MoveL p20, v100, fine, tool0;\n\
+    MoveL [[1,2,3],[1,0,0,0],[0,0,0,0],[9E9,250,9E9,9E9,9E9,9E9]], v100, fine, tool0;\n\
+  ENDPROC\n\
+ENDMODULE\n";
+    let found = parse(&[file(text)]).unwrap();
+    let m: Vec<(usize, &str, &str)> = found
+        .motions
+        .iter()
+        .map(|m| (m.line, m.instruction.as_str(), m.name.as_str()))
+        .collect();
+    assert_eq!(
+        m,
+        [
+            (7, "MoveL", "target"),
+            (10, "MoveAbsJ", "home"),
+            (11, "MoveL", "Offs(p10, 0, 0, 50)"),
+            (12, "MoveL", "RelTool(p10, 0, 0, -20 \\Rz:=10)"),
+            (13, "MoveJ", "p99"),
+            (14, "MoveL", "p30"),
+            (16, "TriggL", "p10"),
+            (17, "MoveL", "p20"),
+            (18, "MoveL", "inline"),
+        ]
+    );
+    let why = |i: usize| match &found.motions[i].target {
+        MotionTarget::RunTime(w) => w.clone(),
+        other => panic!("{i}: {other:?}"),
+    };
+    assert!(why(0).contains("target is a parameter of go"), "{}", why(0));
+    assert_eq!(found.motions[1].target, MotionTarget::Joints { note: None });
+    assert!(why(2).contains("`Offs(p10, 0, 0, 50)` is computed at run time"));
+    assert!(why(3).contains("RelTool"));
+    assert_eq!(found.motions[4].target, MotionTarget::Undeclared);
+    assert!(why(5).contains("p30 is declared without a value"));
+    // Offs and RelTool are not uses of p10: TriggL is its first, with the
+    // TriggL's tool (the last positional argument, not its zone).
+    let MotionTarget::Site(i) = found.motions[6].target else {
+        panic!()
+    };
+    assert_eq!(found.sites[i].name, "p10");
+    assert_eq!(
+        found.sites[i].tool,
+        FrameSpec::Ref(CellRef::Name("gun1".into()))
+    );
+    let MotionTarget::Site(i) = found.motions[7].target else {
+        panic!()
+    };
+    assert_eq!(
+        found.sites[i].skip.as_deref(),
+        Some("p20 is assigned at run time (line 15)")
+    );
+    let MotionTarget::Site(i) = found.motions[8].target else {
+        panic!()
+    };
+    let refused = found.sites[i].refuse.as_deref().unwrap();
+    assert!(refused.contains("external axis eax_b to 250"), "{refused}");
 }

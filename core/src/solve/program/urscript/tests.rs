@@ -55,3 +55,55 @@ fn errors_name_file_line_and_column() {
         assert!(e.message.contains(what), "{}", e.message);
     }
 }
+
+#[test]
+fn every_motion_is_reported_with_what_it_goes_to() {
+    let script = "def go(target):\n  movel(target, a=1)\nend\n\
+                  home = [0, -1.57, 1.57, 0, 1.57, 0]\n  movej(home)\n\
+                  here = get_actual_tcp_pose()\n  movel(here)\n\
+                  movel(pose_add(here, p[0, 0, 0.05, 0, 0, 0]))\n  movel(missing)\n\
+                  movej(get_inverse_kin(p[0.4, 0, 0.3, 0, 3.14, 0], qnear=home), a=1.4)\n\
+                  movec(p[0.1,0,0,0,0,0], p[0.2,0,0,0,0,0], a=1, v=0.1)\n\
+                  movej(get_inverse_kin(here))\n";
+    let f = ProgramFile {
+        name: "m.script".into(),
+        text: script.into(),
+    };
+    let found = parse(std::slice::from_ref(&f)).unwrap();
+    let m: Vec<(usize, &str, &str)> = found
+        .motions
+        .iter()
+        .map(|m| (m.line, m.instruction.as_str(), m.name.as_str()))
+        .collect();
+    assert_eq!(
+        m,
+        [
+            (2, "movel", "target"),
+            (5, "movej", "home"),
+            (7, "movel", "here"),
+            (8, "movel", "pose_add(here, p[0, 0, 0.05, 0, 0, 0])"),
+            (9, "movel", "missing"),
+            (10, "movej", "inline"),
+            (11, "movec", "inline"),
+            (11, "movec", "inline"),
+            (12, "movej", "here"),
+        ]
+    );
+    let why = |i: usize| match &found.motions[i].target {
+        MotionTarget::RunTime(w) => w.clone(),
+        other => panic!("{i}: {other:?}"),
+    };
+    assert!(why(0).contains("target is a parameter of go"));
+    assert_eq!(found.motions[1].target, MotionTarget::Joints { note: None });
+    assert!(why(2).contains("here is computed at run time (line 6)"));
+    assert!(why(3).contains("is computed at run time"));
+    assert_eq!(found.motions[4].target, MotionTarget::Undeclared);
+    // get_inverse_kin(x, qnear=home): the pose x, solved from the joints home.
+    assert_eq!(found.motions[5].target, MotionTarget::Site(0));
+    let home = found.sites[0].after_joints.as_ref().unwrap();
+    assert!((home[1] + 89.954).abs() < 1e-2, "{home:?}");
+    assert_eq!(found.motions[6].target, MotionTarget::Site(1));
+    assert_eq!(found.motions[7].target, MotionTarget::Site(2));
+    assert!(found.sites[1].after_joints.is_none());
+    assert!(why(8).contains("here is computed at run time (line 6)"));
+}
