@@ -11,7 +11,9 @@ use super::{mark, parse, Flags, FrameSpec, Language, ParseError, ProgramFile, Si
 use crate::calibrate::compensate::CompensatedModel;
 use crate::model::orientation::rotation_to;
 use crate::model::Pose;
-use crate::solve::cell::export::{controller_text, ControllerFrame, ControllerTool};
+use crate::solve::cell::export::{
+    controller_text, ControllerData, ControllerFrame, ControllerTool, ExportOptions,
+};
 use crate::solve::cell::{
     Cell, CellOptions, CellSolution, CellSolver, Load, LoadDescription, Tool, WorkObject,
     WorkObjectFrame,
@@ -255,13 +257,39 @@ pub fn filter_with(
             failed: count(TargetStatus::Failed),
             skipped: count(TargetStatus::Skipped),
             targets,
-            controller_data: if used_tools.is_empty() {
+            controller_data: if used_tools.is_empty() && used_frames.is_empty() {
                 String::new()
             } else {
-                controller_text(language, &used_tools, &used_frames)
+                used_data(language, used_tools, used_frames)
             },
         },
     })
+}
+
+/// The controller data of the cell's items a filter used (numbers as the
+/// program named them, no position registers), or a comment of the language
+/// saying why they cannot be written.
+fn used_data(
+    language: Language,
+    tools: Vec<ControllerTool>,
+    frames: Vec<ControllerFrame>,
+) -> String {
+    let data = ControllerData {
+        tools,
+        frames,
+        assigned: Vec::new(),
+    };
+    match controller_text(language, &data, &ExportOptions::default()) {
+        Ok(e) => e.text,
+        Err(e) => {
+            let lead = match language {
+                Language::Krl => ";",
+                Language::Rapid | Language::Fanuc => "!",
+                Language::UrScript => "#",
+            };
+            format!("{lead} robocal: the controller data cannot be written: {e}\n")
+        }
+    }
 }
 
 struct Solved {
@@ -396,6 +424,15 @@ fn solve_site(
         number: wobj.number.unwrap_or(0),
         pose: wobj.in_base(model),
     };
+    // Only the cell's own items are the controller's data to hold: the
+    // flange and the base frame are built in, inline frames in the program.
+    let cell_item = |spec: &FrameSpec, tool: bool| match spec {
+        FrameSpec::Ref(r) if tool => cell.defines_tool(r),
+        FrameSpec::Ref(r) => cell.defines_work_object(r),
+        _ => false,
+    };
+    let used_tool = cell_item(&site.tool, true).then_some(used_tool);
+    let used_frame = cell_item(&site.work_object, false).then_some(used_frame);
     let index = match solvers.iter().position(|(p, l, _)| *p == tcp && *l == load) {
         Some(i) => i,
         None => {
@@ -413,8 +450,8 @@ fn solve_site(
         q,
         load: used_load,
         warnings,
-        tool: Some(used_tool),
-        frame: Some(used_frame),
+        tool: used_tool,
+        frame: used_frame,
     })
 }
 
