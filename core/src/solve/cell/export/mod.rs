@@ -315,6 +315,8 @@ pub fn controller_text(
     options: &ExportOptions,
 ) -> Result<ControllerExport, ExportError> {
     check_numbers(language, data)?;
+    let sorted = in_order(language, data);
+    let data = &sorted;
     let mut out = ControllerExport {
         text: String::new(),
         assigned: data
@@ -346,6 +348,24 @@ pub fn controller_text(
         }
     }
     Ok(out)
+}
+
+/// `data`'s items in the order they are written, whatever the cell's order:
+/// by number where the language numbers them, else by name (ASCII case
+/// folded, then as written).
+fn in_order(language: Language, data: &ControllerData) -> ControllerData {
+    let numbered = numbers::range(language, ItemKind::Tool).is_some();
+    let key = |number: u32, name: &str| {
+        (
+            if numbered { number } else { 0 },
+            name.to_ascii_lowercase(),
+            name.to_string(),
+        )
+    };
+    let mut out = data.clone();
+    out.tools.sort_by_cached_key(|t| key(t.number, &t.name));
+    out.frames.sort_by_cached_key(|f| key(f.number, &f.name));
+    out
 }
 
 /// The identifiers of `data`'s items (tools only when the language

@@ -109,6 +109,24 @@ pub enum RenameReason {
     Taken,
 }
 
+impl RenameReason {
+    pub const ALL: [RenameReason; 4] = [
+        RenameReason::Characters,
+        RenameReason::Length,
+        RenameReason::Reserved,
+        RenameReason::Taken,
+    ];
+
+    pub fn as_str(self) -> &'static str {
+        match self {
+            RenameReason::Characters => "characters",
+            RenameReason::Length => "length",
+            RenameReason::Reserved => "reserved",
+            RenameReason::Taken => "taken",
+        }
+    }
+}
+
 /// The item that first had an identifier.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct TakenBy {

@@ -287,7 +287,8 @@ fn fanuc_writes_position_registers_only_when_given_them() {
         );
     }
     assert!(!with.text.contains("PR[95]"), "{}", with.text);
-    assert!(with.text.contains("UTOOL[2]=PR[91] ;") && with.text.contains("UTOOL[1]=PR[92] ;"));
+    // Tools, then work objects, each by number.
+    assert!(with.text.contains("UTOOL[1]=PR[91] ;") && with.text.contains("UTOOL[2]=PR[92] ;"));
     assert!(with.text.contains("UFRAME[1]=PR[93] ;") && with.text.contains("UFRAME[2]=PR[94] ;"));
     let regs: Vec<(u32, &str)> = with
         .registers
@@ -296,7 +297,7 @@ fn fanuc_writes_position_registers_only_when_given_them() {
         .collect();
     assert_eq!(
         regs,
-        vec![(91, "gun"), (92, "torch"), (93, "table"), (94, "fixture")]
+        vec![(91, "torch"), (92, "gun"), (93, "table"), (94, "fixture")]
     );
     let short = ExportOptions {
         registers: Some("91..93".parse().unwrap()),

@@ -134,6 +134,14 @@ pub enum EntryField {
 }
 
 impl EntryField {
+    pub const ALL: [EntryField; 5] = [
+        EntryField::Number,
+        EntryField::Frame,
+        EntryField::Position,
+        EntryField::Orientation,
+        EntryField::Load,
+    ];
+
     pub fn as_str(self) -> &'static str {
         match self {
             EntryField::Number => "number",
