@@ -39,7 +39,7 @@ pub struct FitTarget {
 #[derive(Debug, Clone)]
 pub struct Stored<F> {
     pub put: CellPut,
-    pub fitted: Judged<F>,
+    pub fitted: Box<Judged<F>>,
     pub version: i64,
 }
 

@@ -84,7 +84,7 @@ pub fn program(
         None => {
             lines.push("! robocal: no position register written ;".into());
             lines.push("! enter the frames below by hand ;".into());
-            lines.push("! or export with --registers A..B ;".into());
+            lines.push("! or export with registers FIRST..LAST ;".into());
         }
     }
     for n in notes {

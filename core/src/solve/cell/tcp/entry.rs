@@ -333,7 +333,7 @@ impl<F: Serialize> Fitted<F> {
 /// A fit's outcome.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Outcome<F> {
-    Fitted(Fitted<F>),
+    Fitted(Box<Fitted<F>>),
     NotFitted(FitError),
 }
 
@@ -387,13 +387,13 @@ pub fn tool(fitted: Result<ToolFit, FitError>, req: &StoreRequest) -> Outcome<To
                 .with_fit(JudgedFit::Tool(fit)),
             );
         }
-        return Outcome::Fitted(Fitted {
+        return Outcome::Fitted(Box::new(Fitted {
             fit,
             entry: None,
             orientation: Some(source),
             replaced: None,
             overruled,
-        });
+        }));
     };
     let entry = StoredEntry {
         number: req.number.or(existing.and_then(|e| e.number)),
@@ -402,13 +402,13 @@ pub fn tool(fitted: Result<ToolFit, FitError>, req: &StoreRequest) -> Outcome<To
         rpy_deg,
         load: existing.and_then(|e| e.load.clone()),
     };
-    Outcome::Fitted(Fitted {
+    Outcome::Fitted(Box::new(Fitted {
         replaced: existing.map(|e| Replaced::between(e.clone(), entry.clone())),
         fit,
         entry: Some(entry),
         orientation: Some(source),
         overruled,
-    })
+    }))
 }
 
 /// A work-object fit's outcome for `req` (its orientation is always fitted).
@@ -432,11 +432,11 @@ pub fn work_object(
         rpy_deg: fit.rpy_deg,
         load: None,
     };
-    Outcome::Fitted(Fitted {
+    Outcome::Fitted(Box::new(Fitted {
         replaced: existing.map(|e| Replaced::between(e.clone(), entry.clone())),
         fit,
         entry: Some(entry),
         orientation: None,
         overruled,
-    })
+    }))
 }

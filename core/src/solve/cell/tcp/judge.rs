@@ -113,6 +113,11 @@ impl Limits {
     }
 }
 
+/// `x` is a number no larger than `limit` (NaN is not).
+fn within(x: f64, limit: f64) -> bool {
+    x <= limit
+}
+
 /// The arm's length [m]: `Σ √(a² + d²)` over the links after the base link
 /// (joint 1's axis to the flange, stretched out).
 pub fn arm_length_m(model: &RobotModel) -> f64 {
@@ -134,7 +139,7 @@ pub fn check_residuals(
             limits.sigma_mm
         )
     };
-    if !(rms <= limits.rms_mm) {
+    if !within(rms, limits.rms_mm) {
         return Err(FitError::new(
             NotFittedReason::ResidualsTooLarge,
             format!(
@@ -147,7 +152,7 @@ pub fn check_residuals(
     if let Some((i, r)) = residual_mm
         .iter()
         .enumerate()
-        .find(|(_, r)| !(**r <= limits.max_mm))
+        .find(|(_, r)| !within(**r, limits.max_mm))
     {
         return Err(FitError::new(
             NotFittedReason::ResidualOutlier,
@@ -168,7 +173,7 @@ fn check_plane(distances_mm: &[f64], limits: &Limits, what: &str) -> Result<(), 
     match distances_mm
         .iter()
         .enumerate()
-        .find(|(_, d)| !(**d <= limits.plane_mm))
+        .find(|(_, d)| !within(**d, limits.plane_mm))
     {
         Some((i, d)) => Err(FitError::new(
             NotFittedReason::OffPlane,
@@ -209,7 +214,7 @@ fn verdict(fit: &ToolFit, limits: &Limits) -> Result<(), FitError> {
         }
     };
     check_residuals(&fit.residual_mm, limits, "tip", hint)?;
-    if let Some(far) = limits.distance_mm.filter(|d| !(fit.distance_mm <= *d)) {
+    if let Some(far) = limits.distance_mm.filter(|d| !within(fit.distance_mm, *d)) {
         return Err(FitError::new(
             NotFittedReason::TcpTooFar,
             format!(
@@ -222,7 +227,7 @@ fn verdict(fit: &ToolFit, limits: &Limits) -> Result<(), FitError> {
     if let (Some(angles), Some(limit)) = (&fit.orientation_residual_deg, limits.orientation_rms_deg)
     {
         let (rms, _) = super::rms_max(angles);
-        if !(rms <= limit) {
+        if !within(rms, limit) {
             return Err(FitError::new(
                 NotFittedReason::OrientationResidualsTooLarge,
                 format!(
@@ -246,7 +251,7 @@ pub fn judge_work_object(mut fit: WorkObjectFit, noise: Noise) -> Result<WorkObj
         .scatter_mm
         .iter()
         .zip(["origin", "x", "xy"])
-        .find(|(s, _)| !(**s <= limits.rms_mm));
+        .find(|(s, _)| !within(**s, limits.rms_mm));
     let e = match scatter {
         Some((s, which)) => Some(
             FitError::new(
