@@ -60,9 +60,9 @@ pub enum Command {
     Plan(plan::PlanArgs),
     /// ISO 9283 pose accuracy and repeatability: the test cube plan and the figures.
     Iso9283(iso9283::Iso9283Args),
-    /// A production tool's TCP (and axis) fitted on the calibrated model.
+    /// A production tool's TCP (and axis) fitted on the calibrated model, judged before it is written.
     Tcp(tcp::TcpArgs),
-    /// A work object from three points (tracker or touched with a calibrated tool).
+    /// A work object from three points (tracker or touched with a calibrated tool), judged before it is written.
     WorkObject(tcp::WorkObjectArgs),
     /// Run the HTTP service.
     Serve(serve::ServeArgs),

@@ -62,6 +62,10 @@ fn the_rule_passes_readings_at_the_stated_noise_and_refuses_eight_times_it() {
         let limits = fit.limits.unwrap();
         assert!((limits.rms_mm - 3.0 * 3f64.sqrt() * sigma_mm).abs() < 1e-12);
         assert!(fit.rms_mm < limits.rms_mm, "seed {seed}: {}", fit.rms_mm);
+        eprintln!(
+            "seed {seed}: at σ rms {:.3} mm of ≤ {:.3} mm",
+            fit.rms_mm, limits.rms_mm
+        );
         let q = noisy_fixed_point(&tool, 8, 8.0 * sigma_mm * 1e-3, 200 + seed);
         let e = tcp::fit_tool(&model, &fixed_point_request(&q)).unwrap_err();
         assert!(
@@ -72,6 +76,12 @@ fn the_rule_passes_readings_at_the_stated_noise_and_refuses_eight_times_it() {
             "seed {seed}: {e}"
         );
         assert!(e.measured.unwrap() > e.needed.unwrap(), "{e:?}");
+        eprintln!(
+            "seed {seed}: at 8σ {} {:.3} mm of ≤ {:.3} mm",
+            e.reason.as_str(),
+            e.measured.unwrap(),
+            e.needed.unwrap()
+        );
     }
 }
 
@@ -84,6 +94,12 @@ fn eight_readings_without_a_fixed_point_are_not_fitted_and_not_stored() {
     let fit = judged_tool(&e);
     // The figures: residuals per reading, their RMS against the bound.
     assert_eq!(fit.residual_mm.len(), 8);
+    eprintln!(
+        "8 readings without a fixed point: rms {:.1} mm (bound {:.3} mm), TCP {:.1} mm from the flange",
+        fit.rms_mm,
+        e.needed.unwrap(),
+        fit.distance_mm
+    );
     assert!(fit.rms_mm > 100.0, "rms {} mm", fit.rms_mm);
     assert_eq!(e.measured, Some(fit.rms_mm));
     let bound = 3.0 * 3f64.sqrt() * (0.25f64.powi(2) + 0.15f64.powi(2)).sqrt();
