@@ -5,6 +5,9 @@
 #[path = "tcp/truth.rs"]
 mod truth;
 
+#[path = "tcp/judged.rs"]
+mod judged;
+
 use nalgebra::{Matrix3, Vector3};
 use robocal_core::model::orientation::rotation_angle_between;
 use robocal_core::model::Pose;

@@ -1,10 +1,14 @@
 //! `robocal cell export`: what the controller must hold for a cell — tool,
 //! load and work object data in the controller's language
 //! (`core::cell::export`): a work object measured in the tracker frame comes
-//! out in the robot base frame of the calibrated model given.
+//! out in the robot base frame of the calibrated model given. Unnumbered
+//! items take the lowest free numbers and renamed identifiers are stated in
+//! the output's header comment; a cell the controller could not load (a
+//! number 0 or beyond its range, one held twice) is refused naming the item;
+//! a Fanuc export writes position registers only with `--registers`.
 
 use super::model_files::load_compensated;
-use crate::solve::cell::export::{controller_data, controller_text};
+use crate::solve::cell::export::{export_cell, ExportOptions, RegisterRange};
 use crate::solve::cell::CellDescription;
 use crate::solve::program::Language;
 use anyhow::{bail, Context};
@@ -36,6 +40,11 @@ pub struct CellExportArgs {
     /// Payload mass [kg] of tools without a load (default: the model file's payload).
     #[arg(long)]
     pub payload_kg: Option<f64>,
+    /// Fanuc: the position registers FIRST..LAST the program may overwrite to set
+    /// UTOOL/UFRAME (one per tool and work object); without it, no register is
+    /// written and the frames are listed as remarks for entry by hand.
+    #[arg(long)]
+    pub registers: Option<RegisterRange>,
 }
 
 /// The exported text.
@@ -53,8 +62,12 @@ pub fn export_to_string(a: &CellExportArgs) -> anyhow::Result<String> {
     let cell = CellDescription::from_json(&text)
         .and_then(|d| d.to_cell())
         .with_context(|| a.cell.clone())?;
-    let (tools, frames) = controller_data(&cell, &model);
-    Ok(controller_text(language, &tools, &frames))
+    let options = ExportOptions {
+        registers: a.registers,
+    };
+    let done = export_cell(language, &cell, &model, &options)
+        .with_context(|| format!("{}: cannot be exported for {}", a.cell, a.language))?;
+    Ok(done.text)
 }
 
 pub fn run(a: CellArgs) -> anyhow::Result<()> {

@@ -76,10 +76,10 @@ pub enum Command {
     /// ISO 9283 pose accuracy and repeatability: the test cube plan and the figures.
     #[command(after_help = exit::help_for("iso9283"))]
     Iso9283(iso9283::Iso9283Args),
-    /// A production tool's TCP (and axis) fitted on the calibrated model.
+    /// A production tool's TCP (and axis) fitted on the calibrated model, judged before it is written.
     #[command(after_help = exit::help_for("tcp"))]
     Tcp(tcp::TcpArgs),
-    /// A work object from three points (tracker or touched with a calibrated tool).
+    /// A work object from three points (tracker or touched with a calibrated tool), judged before it is written.
     #[command(after_help = exit::help_for("work-object"))]
     WorkObject(tcp::WorkObjectArgs),
     /// Run the HTTP service.

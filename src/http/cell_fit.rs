@@ -4,15 +4,19 @@
 //! (controller degrees) or tracker measurements (mm, degrees, the
 //! calibration's measurement frame), stored as the robot's tool or work
 //! object (base frame) and returned with the fit's residuals and σ
-//! (`core::cell::tcp`). Readings that do not determine the item are a 200
-//! with `fitted: false`, a typed `reason` and what to change; nothing is
-//! stored then.
+//! (`core::cell::tcp`). Readings that do not determine the item, or a fit
+//! beyond what the readings' noise explains (`tcp::judge`), are a 200 with
+//! `fitted: false`, a typed `reason`, the figures and what to change;
+//! nothing is stored then unless the body says `"force": true` for a judged
+//! fit. A tool whose orientation the readings do not determine keeps the
+//! stored one, or takes `rpy_deg`; it is never written as zeros.
 
 use super::cell::{check_item_name, ItemOut, CELL_NUMBER_MAX};
 use super::input::{objects, present, Int};
 use super::{ApiError, ApiJson, ApiPath, AppState};
 use crate::service;
 use crate::service::cell_fit::{FitTarget, Fitted};
+use crate::solve::cell::tcp::entry::Answer;
 use crate::solve::cell::tcp::{AxisRequest, FitError, Reading, TcpMethod, ToolRequest, WoPoint};
 use axum::extract::State;
 use axum::http::StatusCode;
@@ -98,6 +102,12 @@ pub struct ToolFitIn {
     pub number: Option<Int<i64>>,
     #[serde(default)]
     pub version: Option<Int<i64>>,
+    /// The tool's orientation [deg] when the readings fit its position only.
+    #[serde(default, deserialize_with = "present")]
+    pub rpy_deg: Option<Vec<f64>>,
+    /// Store a fit judged not plausible.
+    #[serde(default, deserialize_with = "present")]
+    pub force: Option<bool>,
 }
 
 /// `POST …/frames/{name}/fit` body.
@@ -112,6 +122,9 @@ pub struct WorkObjectFitIn {
     pub number: Option<Int<i64>>,
     #[serde(default)]
     pub version: Option<Int<i64>>,
+    /// Store a fit judged not plausible.
+    #[serde(default, deserialize_with = "present")]
+    pub force: Option<bool>,
 }
 
 fn present_objects<'de, D: serde::Deserializer<'de>>(
@@ -182,13 +195,15 @@ fn target(
     version: Option<i64>,
 ) -> Result<FitTarget, ApiError> {
     check_item_name(name)?;
-    if let Some(n) = number {
-        if !(0..=CELL_NUMBER_MAX).contains(&n) {
+    let number = match number {
+        Some(n) if !(0..=CELL_NUMBER_MAX).contains(&n) => {
             return Err(ApiError::invalid(format!(
                 "`number` must be between 0 and {CELL_NUMBER_MAX}, got {n}"
-            )));
+            )))
         }
-    }
+        Some(n) => Some(n as u32),
+        None => None,
+    };
     if let Some(v) = version {
         if v < 1 {
             return Err(ApiError::invalid(format!(
@@ -201,15 +216,15 @@ fn target(
         name: name.to_string(),
         number,
         version,
+        ..FitTarget::default()
     })
 }
 
 #[derive(Serialize)]
 struct FitOut<'a, F: Serialize> {
-    /// Always true: the item was fitted and stored.
-    fitted: bool,
+    #[serde(flatten)]
+    answer: Answer<'a, F>,
     item: ItemOut,
-    fit: &'a F,
     /// The calibrated version the fit was made on.
     version: i64,
 }
@@ -233,9 +248,8 @@ fn answer<F: Serialize>(done: Fitted<F>) -> Response {
                 StatusCode::OK
             };
             let body = FitOut {
-                fitted: true,
+                answer: s.fitted.answer(),
                 item: ItemOut::from_row(s.put.row),
-                fit: &s.fit,
                 version: s.version,
             };
             (status, axum::Json(body)).into_response()
@@ -277,6 +291,24 @@ pub async fn fit_tool(
         rows: rows(&body.readings, "readings")?,
         axis,
     };
+    let mut t = t;
+    t.force = body.force.unwrap_or(false);
+    if let Some(v) = &body.rpy_deg {
+        let rpy = <[f64; 3]>::try_from(v.as_slice())
+            .ok()
+            .filter(|a| a.iter().all(|x| x.abs() <= ANGLE_MAX_DEG))
+            .ok_or_else(|| {
+                ApiError::invalid(format!(
+                    "`rpy_deg`: 3 angles within ±{ANGLE_MAX_DEG}°, got {v:?}"
+                ))
+            })?;
+        t.rpy_deg = Some(rpy);
+    }
+    if t.rpy_deg.is_some() && req.determines_orientation() {
+        return Err(ApiError::invalid(
+            "`rpy_deg`: the readings determine the tool's orientation (an axis or a 6-D probe); leave `rpy_deg` out",
+        ));
+    }
     Ok(answer(service::cell_fit::fit_tool(&s, &t, &req).await?))
 }
 
@@ -291,6 +323,8 @@ pub async fn fit_frame(
         body.number.map(|n| n.0),
         body.version.map(|v| v.0),
     )?;
+    let mut t = t;
+    t.force = body.force.unwrap_or(false);
     if let Some(tool) = &body.tool {
         check_item_name(tool)?;
     }

@@ -13,6 +13,8 @@ use super::solve::{model_choice, VersionSelector};
 use super::{ApiError, ApiJson, ApiPath, AppState};
 use crate::service;
 use crate::service::programs::FilterCommand;
+use crate::solve::cell::export::{ExportOptions, RegisterRange, Renamed, UsedRegister};
+use crate::solve::cell::AssignedNumber;
 use crate::solve::program::{FilterReport, Language, ProgramFile};
 use axum::extract::State;
 use axum::response::{IntoResponse, Response};
@@ -163,9 +165,21 @@ pub struct CellExportRequest {
     /// Payload mass [kg] of tools without a stated load.
     #[serde(default, deserialize_with = "present")]
     pub payload_kg: Option<f64>,
+    /// The position registers a Fanuc export may overwrite.
+    #[serde(default, deserialize_with = "present")]
+    pub registers: Option<RegistersIn>,
 }
 
-/// What the controller must hold: tool, load and work object data.
+/// `registers`: `first..=last`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RegistersIn {
+    pub first: super::input::Int<u32>,
+    pub last: super::input::Int<u32>,
+}
+
+/// What the controller must hold: tool, load and work object data, and
+/// what the export decided.
 #[derive(Debug, Serialize)]
 pub struct CellExportResponse {
     pub robot_id: i64,
@@ -174,6 +188,12 @@ pub struct CellExportResponse {
     pub method: String,
     pub language: Language,
     pub text: String,
+    /// Items without a number and the one they were given (KRL, Fanuc).
+    pub assigned: Vec<AssignedNumber>,
+    /// Items declared under another identifier (RAPID, URScript).
+    pub renamed: Vec<Renamed>,
+    /// The position registers the program overwrites (Fanuc with `registers`).
+    pub registers: Vec<UsedRegister>,
 }
 
 pub async fn export_cell(
@@ -185,15 +205,27 @@ pub async fn export_cell(
     if let Some(p) = req.payload_kg {
         super::input::check_payload("`payload_kg`", p)?;
     }
+    let registers = match &req.registers {
+        Some(r) => Some(
+            RegisterRange::new(r.first.0, r.last.0)
+                .map_err(|e| ApiError::invalid(format!("`registers`: {e}")))?,
+        ),
+        None => None,
+    };
     let model = model_choice(req.version.as_ref())?;
+    let options = ExportOptions { registers };
     let done =
-        service::programs::export_cell(&state, robot_id, model, req.payload_kg, language).await?;
+        service::programs::export_cell(&state, robot_id, model, req.payload_kg, language, &options)
+            .await?;
     Ok(axum::Json(CellExportResponse {
         robot_id,
         version: done.version,
         method: done.method,
         language,
-        text: done.text,
+        text: done.export.text,
+        assigned: done.export.assigned,
+        renamed: done.export.renamed,
+        registers: done.export.registers,
     })
     .into_response())
 }

@@ -1,36 +1,45 @@
 //! Tool and work-object calibration of a robot (`core::cell::tcp`): fitted on
 //! the chosen calibrated version (the active one by default, never the
-//! nominal model) and stored as the robot's tool or work object. A refit of
-//! an existing tool keeps its load and, unless a new one is given, its
-//! number. Work objects are stored in the robot base frame. Readings that
-//! do not determine the item (orientations that do not differ, points in a
-//! line, a joint count not the robot's, …) are an outcome, not an error:
-//! [`Fitted::NotFitted`] says why, and nothing is stored.
+//! nominal model), judged (`tcp::judge`) and stored as the robot's tool or
+//! work object (`tcp::entry`: a refit keeps the item's load and, unless a new
+//! one is given, its number; a tool's orientation is the fitted one, the one
+//! given, or the stored one kept — never zeros). Work objects are stored in
+//! the robot base frame. Readings that do not determine the item (orientations
+//! that do not differ, points in a line, a joint count not the robot's, …) or
+//! a fit beyond what the readings' noise explains are an outcome, not an
+//! error: [`Fitted::NotFitted`] says why, and nothing is stored unless the
+//! caller forces a judged fit.
 
 use super::solve::{chosen_model, ModelChoice};
 use super::{cell, AppState, ServiceError};
-use crate::db::{CellKind, CellPut, ItemFrame, NewCellItem};
+use crate::db::{CellItemRow, CellKind, CellPut, ItemFrame, NewCellItem};
+use crate::solve::cell::file::PoseMmDeg;
+use crate::solve::cell::tcp::entry::{self, Fitted as Judged, Outcome, StoreRequest, StoredEntry};
 use crate::solve::cell::tcp::{self as core_tcp, FitError, Reading, ToolFit, ToolRequest};
 use crate::solve::cell::work_object_fit::WorkObjectFit;
-use crate::solve::cell::CellRef;
+use crate::solve::cell::{CellRef, WorkObjectFrame};
 
 /// What a fit asks beyond its readings.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct FitTarget {
     pub robot_id: i64,
     /// The stored item's name.
     pub name: String,
     /// The controller's number; `None` keeps a refitted item's number.
-    pub number: Option<i64>,
+    pub number: Option<u32>,
     /// The calibrated version (`None`: the active one).
     pub version: Option<i64>,
+    /// A tool's orientation given by the caller [deg] (fixed-axis).
+    pub rpy_deg: Option<[f64; 3]>,
+    /// Store a fit judged not plausible (the verdict stays in the answer).
+    pub force: bool,
 }
 
-/// A stored fit: the item, the fit and the version it was made on.
+/// A stored fit: the item, the judged fit and the version it was made on.
 #[derive(Debug, Clone)]
 pub struct Stored<F> {
     pub put: CellPut,
-    pub fit: F,
+    pub fitted: Box<Judged<F>>,
     pub version: i64,
 }
 
@@ -66,45 +75,97 @@ async fn calibrated(
     Ok((chosen.model, version))
 }
 
-/// The number to store: the one given, else the existing item's.
-async fn number_of(
-    state: &AppState,
-    t: &FitTarget,
-    kind: CellKind,
-) -> Result<(Option<i64>, Option<crate::solve::cell::LoadDescription>), ServiceError> {
-    match state.db().cell_item(t.robot_id, kind, &t.name).await? {
-        Some(row) => Ok((t.number.or(row.number), row.load_json.map(|j| j.0))),
-        None => Ok((t.number, None)),
+/// A stored item as an entry (a number beyond `u32` is none).
+fn entry_of(row: CellItemRow) -> StoredEntry {
+    StoredEntry {
+        number: row.number.and_then(|n| u32::try_from(n).ok()),
+        frame: match row.frame {
+            ItemFrame::Flange => None,
+            ItemFrame::Base => Some(WorkObjectFrame::Base),
+            ItemFrame::Measurement => Some(WorkObjectFrame::Measurement),
+        },
+        xyz_mm: row.pose_json.0.xyz_mm,
+        rpy_deg: row.pose_json.0.rpy_deg,
+        load: row.load_json.map(|j| j.0),
     }
 }
 
-/// Fits a tool and stores it when the readings determine it.
+/// What storing `t` asks, with the stored item of that name.
+async fn store_request(
+    state: &AppState,
+    t: &FitTarget,
+    kind: CellKind,
+) -> Result<StoreRequest, ServiceError> {
+    let existing = state.db().cell_item(t.robot_id, kind, &t.name).await?;
+    Ok(StoreRequest {
+        existing: existing.map(entry_of),
+        number: t.number,
+        rpy_deg: t.rpy_deg,
+        store: true,
+        force: t.force,
+    })
+}
+
+/// Stores a judged fit's entry.
+async fn store<F>(
+    state: &AppState,
+    t: &FitTarget,
+    kind: CellKind,
+    outcome: Outcome<F>,
+    version: i64,
+) -> Result<Fitted<F>, ServiceError> {
+    let fitted = match outcome {
+        Outcome::NotFitted(why) => return Ok(Fitted::NotFitted { why, version }),
+        Outcome::Fitted(f) => f,
+    };
+    let e = fitted
+        .entry
+        .as_ref()
+        .ok_or_else(|| ServiceError::Internal("a stored fit has its entry".into()))?;
+    let item = NewCellItem {
+        name: t.name.clone(),
+        number: e.number.map(i64::from),
+        frame: match kind {
+            CellKind::Tool => ItemFrame::Flange,
+            CellKind::WorkObject => ItemFrame::Base,
+        },
+        pose: PoseMmDeg {
+            xyz_mm: e.xyz_mm,
+            rpy_deg: e.rpy_deg,
+        },
+        load: e.load.clone(),
+    };
+    let put = cell::put(state, t.robot_id, kind, &item).await?;
+    Ok(Fitted::Stored(Stored {
+        put,
+        fitted,
+        version,
+    }))
+}
+
+/// Fits a tool and stores it when the fit is judged sound (or forced) and
+/// its orientation is known.
 pub async fn fit_tool(
     state: &AppState,
     t: &FitTarget,
     req: &ToolRequest,
 ) -> Result<Fitted<ToolFit>, ServiceError> {
     let (model, version) = calibrated(state, t).await?;
-    let fit = match core_tcp::fit_tool(&model, req) {
-        Ok(fit) => fit,
-        Err(why) => return Ok(Fitted::NotFitted { why, version }),
-    };
-    let (number, load) = number_of(state, t, CellKind::Tool).await?;
-    let entry = core_tcp::request::tool_description(&t.name, None, &fit);
-    let item = NewCellItem {
-        name: t.name.clone(),
-        number,
-        frame: ItemFrame::Flange,
-        pose: entry.tcp,
-        load,
-    };
-    let put = cell::put(state, t.robot_id, CellKind::Tool, &item).await?;
-    Ok(Fitted::Stored(Stored { put, fit, version }))
+    let fitted = core_tcp::fit_tool(&model, req);
+    let sreq = store_request(state, t, CellKind::Tool).await?;
+    store(
+        state,
+        t,
+        CellKind::Tool,
+        entry::tool(fitted, &sreq),
+        version,
+    )
+    .await
 }
 
 /// Fits a work object (touches made with the stored tool `tool`) and stores
-/// it when the readings determine it. A `tool` the robot does not have is a
-/// conflict with its stored cell.
+/// it when the fit is judged sound (or forced). A `tool` the robot does not
+/// have is a conflict with its stored cell.
 pub async fn fit_work_object(
     state: &AppState,
     t: &FitTarget,
@@ -126,19 +187,8 @@ pub async fn fit_work_object(
         }
         None => None,
     };
-    let fit = match core_tcp::fit_work_object(&model, rows, tcp.as_ref()) {
-        Ok(fit) => fit,
-        Err(why) => return Ok(Fitted::NotFitted { why, version }),
-    };
-    let (number, _) = number_of(state, t, CellKind::WorkObject).await?;
-    let entry = core_tcp::request::work_object_description(&t.name, None, &fit);
-    let item = NewCellItem {
-        name: t.name.clone(),
-        number,
-        frame: ItemFrame::Base,
-        pose: entry.pose,
-        load: None,
-    };
-    let put = cell::put(state, t.robot_id, CellKind::WorkObject, &item).await?;
-    Ok(Fitted::Stored(Stored { put, fit, version }))
+    let fitted = core_tcp::fit_work_object(&model, rows, tcp.as_ref());
+    let sreq = store_request(state, t, CellKind::WorkObject).await?;
+    let outcome = entry::work_object(fitted, &sreq);
+    store(state, t, CellKind::WorkObject, outcome, version).await
 }

@@ -88,30 +88,42 @@ pub struct CellExport {
     /// Version number used (`None`: the nominal model).
     pub version: Option<i64>,
     pub method: String,
-    /// Tool, load and work object data in the language (`core::cell::export`).
-    pub text: String,
+    /// Tool, load and work object data in the language, and what the export
+    /// decided (numbers given, identifiers changed, registers written):
+    /// `core::cell::export`.
+    pub export: crate::solve::cell::export::ControllerExport,
 }
 
 /// The robot's stored tools (with their loads) and work objects as the
 /// controller of `language` holds them, for the chosen model version: work
-/// objects measured in the tracker frame come out in its base frame.
+/// objects measured in the tracker frame come out in its base frame. A cell
+/// the controller could not load (a number 0 or beyond its range, one held
+/// twice) is a conflict naming the item; too few registers for a Fanuc
+/// export is invalid.
 pub async fn export_cell(
     state: &AppState,
     robot_id: i64,
     model: ModelChoice,
     payload_kg: Option<f64>,
     language: Language,
+    options: &crate::solve::cell::export::ExportOptions,
 ) -> Result<CellExport, ServiceError> {
+    use crate::solve::cell::export::{export_cell, ExportError};
     let cell = super::cell::cell(state, robot_id).await?;
     let chosen = chosen_model(state, robot_id, model).await?;
     let mut m = chosen.model;
     if let Some(p) = payload_kg {
         m.payload_kg = p;
     }
-    let (tools, frames) = crate::solve::cell::export::controller_data(&cell, &m);
+    let export = export_cell(language, &cell, &m, options).map_err(|e| match e {
+        ExportError::TooFewRegisters { .. } => ServiceError::Invalid(format!("`registers`: {e}")),
+        _ => ServiceError::Conflict(format!(
+            "the cell of robot {robot_id} cannot be exported for this controller: {e}; change it with PUT /v1/robots/{robot_id}/tools/{{name}} or /frames/{{name}}"
+        )),
+    })?;
     Ok(CellExport {
         version: chosen.version,
         method: chosen.method,
-        text: crate::solve::cell::export::controller_text(language, &tools, &frames),
+        export,
     })
 }

@@ -615,3 +615,154 @@ async fn a_tool_carries_its_load_and_the_cell_exports_for_the_controller() {
         .await;
     assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
 }
+
+#[tokio::test]
+async fn the_cell_exports_one_number_per_item_and_registers_only_when_asked() {
+    let t = setup().await;
+    let rid = t.create_robot("ys100").await.to_string();
+    let items = [
+        (
+            TOOL,
+            "gun",
+            json!({ "number": 2, "xyz_mm": [0.0, 0.0, 200.0] }),
+        ),
+        (TOOL, "torch", json!({ "xyz_mm": [0.0, 0.0, 300.0] })),
+        (
+            FRAME,
+            "table",
+            json!({ "number": 1, "xyz_mm": [1000.0, 0.0, 0.0] }),
+        ),
+        (FRAME, "fixture", json!({ "xyz_mm": [1500.0, 0.0, 0.0] })),
+    ];
+    for (kind, name, body) in &items {
+        let r = put(&t, kind, &[&rid, name], body.clone()).await;
+        assert_eq!(r.status, StatusCode::CREATED, "{}", r.text());
+    }
+    let export = |body: Value| {
+        let t = &t;
+        let rid = rid.clone();
+        async move {
+            t.post_json("/v1/robots/{id}/cell/export", &[&rid], body)
+                .await
+        }
+    };
+    let r = export(json!({ "language": "krl", "version": "nominal" })).await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let krl = r.json();
+    let text = krl["text"].as_str().unwrap().to_string();
+    for data in [
+        "TOOL_DATA[1]=",
+        "TOOL_DATA[2]=",
+        "BASE_DATA[1]=",
+        "BASE_DATA[2]=",
+    ] {
+        assert_eq!(text.matches(data).count(), 1, "{data}: {text}");
+    }
+    assert_eq!(
+        krl["assigned"],
+        json!([{ "kind": "tool", "name": "torch", "number": 1 }, { "kind": "work_object", "name": "fixture", "number": 2 }])
+    );
+    // The command line on the same cell (written in another order) gives
+    // the same text.
+    let dir = tempfile::tempdir().unwrap();
+    let mut file = json!({ "tools": [], "work_objects": [] });
+    for (kind, name, body) in items.iter().rev() {
+        let mut b = body.clone();
+        b["name"] = json!(name);
+        let list = if *kind == TOOL {
+            "tools"
+        } else {
+            "work_objects"
+        };
+        file[list].as_array_mut().unwrap().push(b);
+    }
+    let cell_path = dir.path().join("cell.json");
+    std::fs::write(&cell_path, file.to_string()).unwrap();
+    let cli = |language: &str, more: &[&str]| {
+        let argv = [
+            &[
+                "robocal",
+                "cell",
+                "export",
+                "--model",
+                "ys100",
+                "--cell",
+                cell_path.to_str().unwrap(),
+                "--language",
+                language,
+            ][..],
+            more,
+        ]
+        .concat();
+        let robocal::cli::Command::Cell(a) =
+            robocal::cli::Cli::try_parse_from(argv).unwrap().command
+        else {
+            panic!("cell")
+        };
+        let robocal::cli::cell::CellCommand::Export(e) = a.command;
+        robocal::cli::cell::export_to_string(&e)
+    };
+    assert_eq!(cli("krl", &[]).unwrap(), text);
+    // Fanuc: no register without `registers`; the ones given, stated.
+    let r = export(json!({ "language": "fanuc", "version": "nominal" })).await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let b = r.json();
+    assert!(!b["text"].as_str().unwrap().contains("PR["), "{b}");
+    assert_eq!(b["registers"], json!([]));
+    let r = export(json!({ "language": "fanuc", "version": "nominal", "registers": { "first": 91, "last": 99 } })).await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let b = r.json();
+    let tp = b["text"].as_str().unwrap();
+    assert!(tp.contains("! robocal overwrites PR[91..94] ;"), "{tp}");
+    assert_eq!(
+        b["registers"][0],
+        json!({ "register": 91, "kind": "tool", "name": "torch" })
+    );
+    assert_eq!(b["registers"].as_array().unwrap().len(), 4);
+    assert_eq!(cli("fanuc", &["--registers", "91..99"]).unwrap(), tp);
+    let r = export(json!({ "language": "fanuc", "version": "nominal", "registers": { "first": 91, "last": 92 } })).await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+    assert!(
+        r.detail().contains("needs 4 position registers"),
+        "{}",
+        r.detail()
+    );
+    // RAPID: a tool and a work object of one name are declared apart.
+    let r = put(
+        &t,
+        FRAME,
+        &[&rid, "torch"],
+        json!({ "xyz_mm": [0.0, 500.0, 0.0] }),
+    )
+    .await;
+    assert_eq!(r.status, StatusCode::CREATED, "{}", r.text());
+    let r = export(json!({ "language": "rapid", "version": "nominal" })).await;
+    let b = r.json();
+    let module = b["text"].as_str().unwrap();
+    assert!(
+        module.contains("PERS tooldata torch:=") && module.contains("PERS wobjdata torch_2:="),
+        "{module}"
+    );
+    assert_eq!(b["renamed"][0]["identifier"], "torch_2", "{b}");
+    assert_eq!(
+        b["renamed"][0]["taken_by"],
+        json!({ "kind": "tool", "name": "torch" }),
+        "{b}"
+    );
+    // Number 0 is the flange on KRL: a conflict naming the tool.
+    let r = put(
+        &t,
+        TOOL,
+        &[&rid, "gun"],
+        json!({ "number": 0, "xyz_mm": [0.0, 0.0, 200.0] }),
+    )
+    .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let r = export(json!({ "language": "krl", "version": "nominal" })).await;
+    assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
+    assert!(
+        r.detail().contains("tool `gun` has number 0"),
+        "{}",
+        r.detail()
+    );
+}

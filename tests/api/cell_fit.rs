@@ -2,11 +2,14 @@
 //! `/frames/{name}/fit`): joint readings made for a known tool on the
 //! robot's calibrated version give that tool back, stored and read back;
 //! tracker points give a known work object; readings that do not determine
-//! the item are a 200 with `fitted: false`, a typed reason and what to do
-//! (nothing stored); a robot without a calibration is a 409.
+//! the item, or a fit beyond what their noise explains, are a 200 with
+//! `fitted: false`, a typed reason, the figures and what to do (nothing
+//! stored unless forced); a tool whose orientation is known keeps it; the
+//! command line answers the same; a robot without a calibration is a 409.
 
 use crate::support::*;
 use axum::http::StatusCode;
+use clap::Parser;
 use nalgebra::{Rotation3, Unit, Vector3};
 use robocal::calibrate::compensate::{CalibratedModelFile, CompensatedModel};
 use robocal::model::pose::rpy_matrix;
@@ -105,6 +108,8 @@ async fn a_tool_fitted_from_joint_readings_is_stored_and_read_back() {
         "{} reachable orientations",
         readings.len()
     );
+    // A new tool whose orientation the fixed point does not determine and
+    // nobody gives: not stored (nothing writes zeros for it).
     let r = t
         .post_json(
             TOOL_FIT,
@@ -112,8 +117,28 @@ async fn a_tool_fitted_from_joint_readings_is_stored_and_read_back() {
             json!({ "readings": readings, "number": 3 }),
         )
         .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let b = r.json();
+    assert_eq!(
+        (&b["fitted"], &b["reason"]),
+        (&json!(false), &json!("orientation_unknown")),
+        "{b}"
+    );
+    assert!(b["message"].as_str().unwrap().contains("rpy_deg"), "{b}");
+    assert!(b["fit"]["xyz_mm"].is_array(), "{b}");
+    let r = t.get("/v1/robots/{id}/tools/{name}", &[&rid, "gun"]).await;
+    assert_eq!(r.status, StatusCode::NOT_FOUND);
+    let r = t
+        .post_json(
+            TOOL_FIT,
+            &[&rid, "gun"],
+            json!({ "readings": readings, "number": 3, "rpy_deg": [0, 0, 0] }),
+        )
+        .await;
     assert_eq!(r.status, StatusCode::CREATED, "{}", r.text());
     let body = r.json();
+    assert_eq!(body["orientation"], "given");
+    assert!(body.get("replaced").is_none(), "{body}");
     assert_eq!(body["version"], 1);
     assert_eq!(body["fit"]["method"], "fixed_point");
     assert_eq!(
@@ -136,7 +161,12 @@ async fn a_tool_fitted_from_joint_readings_is_stored_and_read_back() {
         .post_json(TOOL_FIT, &[&rid, "gun"], json!({ "readings": readings }))
         .await;
     assert_eq!(r.status, StatusCode::OK, "{}", r.text());
-    assert_eq!(r.json()["item"]["number"], 3);
+    let b = r.json();
+    assert_eq!(b["item"]["number"], 3);
+    // The same readings: the orientation kept, nothing changed.
+    assert_eq!(b["orientation"], "kept", "{b}");
+    assert_eq!(b["replaced"]["changed"], json!([]), "{b}");
+    assert_eq!(b["replaced"]["moved_mm"], 0.0, "{b}");
     let stored = t
         .get("/v1/robots/{id}/tools/{name}", &[&rid, "gun"])
         .await
@@ -385,4 +415,251 @@ async fn a_work_object_from_tracker_points_is_stored_in_the_base_frame() {
         )
         .await;
     assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+}
+
+/// `a` and `b` alike, numbers to 1e-9 relative.
+fn assert_close(a: &Value, b: &Value, at: &str) {
+    match (a, b) {
+        (Value::Number(x), Value::Number(y)) => {
+            let (x, y) = (x.as_f64().unwrap(), y.as_f64().unwrap());
+            assert!((x - y).abs() <= 1e-9 * x.abs().max(1.0), "{at}: {x} vs {y}");
+        }
+        (Value::Array(x), Value::Array(y)) => {
+            assert_eq!(x.len(), y.len(), "{at}");
+            for (i, (p, q)) in x.iter().zip(y).enumerate() {
+                assert_close(p, q, &format!("{at}[{i}]"));
+            }
+        }
+        (Value::Object(x), Value::Object(y)) => {
+            let (kx, ky): (Vec<_>, Vec<_>) = (x.keys().collect(), y.keys().collect());
+            assert_eq!(kx, ky, "{at}");
+            for (k, v) in x {
+                assert_close(v, &y[k], &format!("{at}.{k}"));
+            }
+        }
+        _ => assert_eq!(a, b, "{at}"),
+    }
+}
+
+#[tokio::test]
+async fn a_fit_keeps_a_known_orientation_is_judged_and_answers_as_the_command_line() {
+    let t = setup().await;
+    let rid = calibrated_robot(&t).await;
+    let model = active_model(&t, &rid).await;
+    // The torch as the user stated it: oriented 30° about y (right), its
+    // position a few mm off, number 1, a load.
+    let stated = json!({ "number": 1, "xyz_mm": [110.0, -5.0, 190.0], "rpy_deg": [0.0, 30.0, 0.0],
+        "load": { "mass_kg": 6.0, "com_mm": [0.0, 0.0, 90.0] } });
+    let r = t
+        .send(
+            "PUT",
+            "/v1/robots/{id}/tools/{name}",
+            &[&rid, "torch"],
+            "",
+            Some("application/json"),
+            stated.to_string().into_bytes(),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::CREATED, "{}", r.text());
+    let tool = Pose::new(
+        rpy_matrix(0.0, 30f64.to_radians(), 0.0),
+        Vector3::new(0.1, 0.0, 0.18),
+    );
+    let readings = fixed_point_readings(&model, &tool, Vector3::new(1.3, -0.3, 0.4));
+    assert!(readings.len() >= 5, "{}", readings.len());
+    let r = t
+        .post_json(TOOL_FIT, &[&rid, "torch"], json!({ "readings": readings }))
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let body = r.json();
+    assert_eq!(
+        (&body["fitted"], &body["orientation"]),
+        (&json!(true), &json!("kept")),
+        "{body}"
+    );
+    assert_eq!(body["item"]["rpy_deg"], json!([0.0, 30.0, 0.0]));
+    assert_eq!(body["item"]["number"], 1);
+    assert_eq!(body["item"]["load"]["mass_kg"], 6.0);
+    assert_eq!(body["replaced"]["changed"], json!(["position"]));
+    assert_eq!(
+        body["replaced"]["old"]["xyz_mm"],
+        json!([110.0, -5.0, 190.0])
+    );
+    for (k, want) in [100.0, 0.0, 180.0].iter().enumerate() {
+        let got = body["item"]["xyz_mm"][k].as_f64().unwrap();
+        assert!((got - want).abs() < 0.01, "axis {k}: {got} mm, want {want}");
+    }
+    // `rpy_deg` beside an axis is a malformed request.
+    let r = t
+        .post_json(
+            TOOL_FIT,
+            &[&rid, "torch"],
+            json!({ "readings": readings, "plane": readings, "rpy_deg": [0, 0, 0] }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+
+    // The command line, on the same version, readings and stated cell,
+    // answers the same.
+    let dir = tempfile::tempdir().unwrap();
+    let m = t
+        .get(
+            "/v1/robots/{id}/versions/{version}/model.json",
+            &[&rid, "1"],
+        )
+        .await;
+    let model_path = dir.path().join("model.json");
+    std::fs::write(&model_path, &m.body).unwrap();
+    let mut file_tool = stated.clone();
+    file_tool["name"] = json!("torch");
+    let cell_path = dir.path().join("cell.json");
+    std::fs::write(&cell_path, json!({ "tools": [file_tool] }).to_string()).unwrap();
+    let csv = |rows: &[Value]| {
+        let lines: Vec<String> = rows
+            .iter()
+            .map(|r| {
+                let q: Vec<String> = r["joints_deg"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|v| format!("{}", v.as_f64().unwrap()))
+                    .collect();
+                q.join(",")
+            })
+            .collect();
+        format!("q1,q2,q3,q4,q5,q6\n{}\n", lines.join("\n"))
+    };
+    let csv_path = dir.path().join("tip.csv");
+    std::fs::write(&csv_path, csv(&readings)).unwrap();
+    let argv = [
+        "robocal",
+        "tcp",
+        "--model",
+        model_path.to_str().unwrap(),
+        "--readings",
+        csv_path.to_str().unwrap(),
+        "--name",
+        "torch",
+        "--cell",
+        cell_path.to_str().unwrap(),
+        "--json",
+    ];
+    let robocal::cli::Command::Tcp(args) = robocal::cli::Cli::try_parse_from(argv).unwrap().command
+    else {
+        panic!("tcp")
+    };
+    let cli: Value =
+        serde_json::from_str(&robocal::cli::tcp::tcp_to_string(&args).unwrap()).unwrap();
+    for k in ["fitted", "orientation", "fit", "replaced"] {
+        assert_close(&cli[k], &body[k], k);
+    }
+    for k in ["xyz_mm", "rpy_deg", "number", "load"] {
+        assert_close(&cli["entry"][k], &body["item"][k], k);
+    }
+
+    // Eight readings that hold no fixed point: not fitted, with the figures;
+    // the torch stays as it was.
+    let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(8);
+    let random: Vec<Value> = robocal::sim::random_configurations(&model.nominal, 8, &mut rng)
+        .iter()
+        .map(|q| {
+            let d: Vec<f64> = model
+                .nominal
+                .joints_to_controller(q)
+                .iter()
+                .map(|v| v.to_degrees())
+                .collect();
+            json!({ "joints_deg": d })
+        })
+        .collect();
+    let before = t
+        .get("/v1/robots/{id}/tools/{name}", &[&rid, "torch"])
+        .await
+        .json();
+    let r = t
+        .post_json(TOOL_FIT, &[&rid, "torch"], json!({ "readings": random }))
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let b = r.json();
+    assert_eq!(
+        (&b["fitted"], &b["reason"]),
+        (&json!(false), &json!("residuals_too_large")),
+        "{b}"
+    );
+    assert_eq!(b["fit"]["residual_mm"].as_array().unwrap().len(), 8, "{b}");
+    assert_eq!(b["measured"], b["fit"]["rms_mm"], "{b}");
+    assert!(
+        b["measured"].as_f64().unwrap() > b["needed"].as_f64().unwrap(),
+        "{b}"
+    );
+    assert!(b.get("item").is_none(), "{b}");
+    let now = t
+        .get("/v1/robots/{id}/tools/{name}", &[&rid, "torch"])
+        .await
+        .json();
+    assert_eq!(now, before, "nothing stored");
+    // The command line says the same and writes nothing.
+    let bad_path = dir.path().join("bad.csv");
+    std::fs::write(&bad_path, csv(&random)).unwrap();
+    let mut bad_args = args;
+    bad_args.readings = bad_path.to_str().unwrap().to_string();
+    let e = robocal::cli::tcp::tcp_to_string(&bad_args).unwrap_err();
+    let why =
+        serde_json::to_value(&e.downcast_ref::<robocal::cli::tcp::NotFitted>().unwrap().0).unwrap();
+    for k in ["reason", "measured", "needed", "fit"] {
+        assert_close(&why[k], &b[k], k);
+    }
+    // Forced: stored, and still `fitted: false`.
+    let r = t
+        .post_json(
+            TOOL_FIT,
+            &[&rid, "torch"],
+            json!({ "readings": random, "force": true }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let b = r.json();
+    assert_eq!(
+        (&b["fitted"], &b["forced"], &b["reason"]),
+        (&json!(false), &json!(true), &json!("residuals_too_large")),
+        "{b}"
+    );
+    assert_eq!(b["item"]["rpy_deg"], json!([0.0, 30.0, 0.0]), "{b}");
+    assert_ne!(b["item"]["xyz_mm"], before["xyz_mm"], "{b}");
+}
+
+/// The spec's closed sets of fits and exports are the code's.
+#[test]
+fn the_spec_lists_the_reasons_orientations_and_renamings_the_code_has() {
+    use robocal::solve::cell::export::RenameReason;
+    use robocal::solve::cell::tcp::{EntryField, NotFittedReason, OrientationSource};
+    let yaml: serde_yaml::Value = serde_yaml::from_str(robocal::http::OPENAPI_YAML).unwrap();
+    let doc: Value = serde_json::to_value(yaml).unwrap();
+    let schemas = &doc["components"]["schemas"];
+    let spec = |v: &Value| -> Vec<String> {
+        v.as_array()
+            .unwrap()
+            .iter()
+            .map(|s| s.as_str().unwrap().to_string())
+            .collect()
+    };
+    let code = |v: Vec<&str>| -> Vec<String> { v.into_iter().map(String::from).collect() };
+    assert_eq!(
+        spec(&schemas["NotFittedReason"]["enum"]),
+        code(NotFittedReason::ALL.map(|r| r.as_str()).to_vec())
+    );
+    assert_eq!(
+        spec(&schemas["OrientationSource"]["enum"]),
+        code(OrientationSource::ALL.map(|o| o.as_str()).to_vec())
+    );
+    assert_eq!(
+        spec(&schemas["Replaced"]["properties"]["changed"]["items"]["enum"]),
+        code(EntryField::ALL.map(|f| f.as_str()).to_vec())
+    );
+    let renamed = &doc["paths"]["/v1/robots/{id}/cell/export"]["post"]["responses"]["200"]
+        ["content"]["application/json"]["schema"]["properties"]["renamed"]["items"];
+    assert_eq!(
+        spec(&renamed["properties"]["reasons"]["items"]["enum"]),
+        code(RenameReason::ALL.map(|r| r.as_str()).to_vec())
+    );
 }

@@ -6,7 +6,7 @@ use super::*;
 use robocal_core::model::orientation::{
     rotation_angle_between, rotation_from, OrientationConvention,
 };
-use robocal_core::solve::cell::export::{controller_data, controller_text};
+use robocal_core::solve::cell::export::{export_cell, ExportOptions};
 use robocal_core::solve::program::FrameSpec;
 
 /// The one site of `files` with its tool, work object and load.
@@ -41,13 +41,18 @@ fn assert_exported(language: Language, files: &[ProgramFile], f: &Fixture) {
 fn exported_cell_data_parse_back_to_what_the_filter_uses() {
     let f = fixture();
     let cell = f.cell_with_load();
-    let (tools, frames) = controller_data(&cell, &f.model);
+    let text = |language: Language, options: &ExportOptions| {
+        export_cell(language, &cell, &f.model, options)
+            .unwrap()
+            .text
+    };
+    let none = ExportOptions::default();
     let file = |name: &str, text: String| ProgramFile {
         name: name.into(),
         text,
     };
 
-    let krl = controller_text(Language::Krl, &tools, &frames);
+    let krl = text(Language::Krl, &none);
     let files = [
         file("$config.dat", format!("DEFDAT $CONFIG\r\n{krl}ENDDAT\r\n")),
         file(
@@ -57,18 +62,24 @@ fn exported_cell_data_parse_back_to_what_the_filter_uses() {
     ];
     assert_exported(Language::Krl, &files, f);
 
-    let rapid = controller_text(Language::Rapid, &tools, &frames);
+    let rapid = text(Language::Rapid, &none);
     let module = format!(
         "MODULE T\r\n{rapid}  PROC main()\r\n    MoveL [[100,0,0],[1,0,0,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]], v100, fine, torch\\WObj:=table;\r\n  ENDPROC\r\nENDMODULE\r\n"
     );
     assert_exported(Language::Rapid, &[file("T.mod", module)], f);
 
-    let ur = controller_text(Language::UrScript, &tools, &frames);
+    let ur = text(Language::UrScript, &none);
     let script = format!("def t():\n{ur}movel(pose_trans(table, p[0.1, 0, 0, 0, 0, 0]))\nend\n");
     assert_exported(Language::UrScript, &[file("t.script", script)], f);
 
-    // Fanuc: the position registers' elements, UTOOL/UFRAME taken from them.
-    let tp = controller_text(Language::Fanuc, &tools, &frames);
+    // Fanuc: the position registers' elements (those the user gives),
+    // UTOOL/UFRAME taken from them.
+    let tp = text(
+        Language::Fanuc,
+        &ExportOptions {
+            registers: Some("91..99".parse().unwrap()),
+        },
+    );
     let register = |n: u32| -> Pose {
         let v: Vec<f64> = (1..=6)
             .map(|j| {
@@ -126,4 +137,116 @@ fn exported_cell_data_parse_back_to_what_the_filter_uses() {
         ),
     ];
     assert_exported(Language::Krl, &files, f);
+}
+
+/// The target of `f` at `i` as a KRL inline frame.
+fn krl_target(f: &Fixture, i: usize) -> String {
+    let t = f.target(i);
+    let abc = robocal_core::model::orientation::rotation_to(OrientationConvention::KukaAbc, &t.r);
+    format!(
+        "{{X {:.4},Y {:.4},Z {:.4},A {:.4},B {:.4},C {:.4}}}",
+        t.p.x * 1e3,
+        t.p.y * 1e3,
+        t.p.z * 1e3,
+        abc[0],
+        abc[1],
+        abc[2]
+    )
+}
+
+#[test]
+fn the_filter_and_the_export_give_an_unnumbered_tool_one_number() {
+    // The torch without a number beside a tool numbered 1: both the export
+    // and the filter give the torch 2, the lowest free number.
+    let f = fixture();
+    let mut cell = f.cell_with_load();
+    cell.tools[0].number = None;
+    cell.tools.push(Tool {
+        name: "gun".into(),
+        number: Some(1),
+        tcp: Pose::from_translation(Vector3::new(0.0, 0.0, 0.1)),
+        load: None,
+    });
+    let krl = export_cell(Language::Krl, &cell, &f.model, &ExportOptions::default()).unwrap();
+    let torch_line = krl
+        .text
+        .lines()
+        .find(|l| l.ends_with("; torch"))
+        .unwrap()
+        .to_string();
+    assert!(torch_line.starts_with("TOOL_DATA[2]="), "{}", krl.text);
+    assert!(krl
+        .text
+        .contains("TOOL_DATA[1]={X 0.000000,Y 0.000000,Z 100.000000"));
+    let prog = format!(
+        "DEF t()\r\n$TOOL = TOOL_DATA[2]\r\nBAS(#BASE, 2)\r\nLIN {}\r\nEND\r\n",
+        krl_target(f, 0)
+    );
+    let file = |name: &str, text: String| ProgramFile {
+        name: name.into(),
+        text,
+    };
+    let out = filter(
+        Language::Krl,
+        &[file("t.src", prog)],
+        &cell,
+        &f.model,
+        &settings(),
+    )
+    .unwrap();
+    assert_eq!(out.report.filtered, 1, "{:?}", out.report.targets);
+    // The filter solved with the torch: its controller data name it under
+    // the export's number and line.
+    let data = &out.report.controller_data;
+    assert!(data.lines().any(|l| l == torch_line), "{data}");
+    // And the filtered target is the one the torch reaches (the cell with
+    // the torch numbered 2 explicitly gives the same program).
+    let mut numbered = cell.clone();
+    numbered.tools[0].number = Some(2);
+    let prog = format!(
+        "DEF t()\r\n$TOOL = TOOL_DATA[2]\r\nBAS(#BASE, 2)\r\nLIN {}\r\nEND\r\n",
+        krl_target(f, 0)
+    );
+    let same = filter(
+        Language::Krl,
+        &[file("t.src", prog)],
+        &numbered,
+        &f.model,
+        &settings(),
+    )
+    .unwrap();
+    assert_eq!(same.files[0].text, out.files[0].text);
+}
+
+#[test]
+fn the_filter_writes_no_data_for_the_flange_the_base_or_inline_frames() {
+    // `$NULLFRAME` base and an inline tool: nothing of the cell is used, so
+    // nothing is written (no TOOL_DATA[0] or BASE_DATA[0]).
+    let f = fixture();
+    let w = f.wobj_controller().compose(&f.target(0));
+    let abc = robocal_core::model::orientation::rotation_to(OrientationConvention::KukaAbc, &w.r);
+    let t = torch();
+    let tabc = robocal_core::model::orientation::rotation_to(OrientationConvention::KukaAbc, &t.r);
+    let prog = format!(
+        "DEF t()\r\n$TOOL = {{X {:.6},Y {:.6},Z {:.6},A {:.9},B {:.9},C {:.9}}}\r\n$BASE = $NULLFRAME\r\nLIN {{X {:.4},Y {:.4},Z {:.4},A {:.4},B {:.4},C {:.4}}}\r\nEND\r\n",
+        t.p.x * 1e3, t.p.y * 1e3, t.p.z * 1e3, tabc[0], tabc[1], tabc[2],
+        w.p.x * 1e3, w.p.y * 1e3, w.p.z * 1e3, abc[0], abc[1], abc[2]
+    );
+    let out = filter(
+        Language::Krl,
+        &[ProgramFile {
+            name: "t.src".into(),
+            text: prog,
+        }],
+        &f.cell_with_load(),
+        &f.model,
+        &settings(),
+    )
+    .unwrap();
+    assert_eq!(out.report.filtered, 1, "{:?}", out.report.targets);
+    assert_eq!(
+        out.report.controller_data, "",
+        "{}",
+        out.report.controller_data
+    );
 }

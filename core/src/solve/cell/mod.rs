@@ -26,6 +26,7 @@ pub mod accuracy;
 pub mod export;
 pub mod file;
 pub mod joints_csv;
+pub mod numbering;
 pub use crate::model::load;
 pub mod predict;
 pub mod tcp;
@@ -33,6 +34,7 @@ pub mod work_object_fit;
 
 pub use file::{CellDescription, CellFileError};
 pub use load::{Load, LoadDescription, LoadFrame};
+pub use numbering::{AssignedNumber, ItemKind};
 pub use predict::{Forward, PoseOut, PredictError, PredictFrame, Predicted};
 
 use crate::calibrate::compensate::CompensatedModel;
@@ -135,21 +137,76 @@ pub enum CellError {
     UnknownTool(CellRef),
     #[error("no work object {0} in the cell")]
     UnknownWorkObject(CellRef),
+    /// Two items answer one reference (a number held twice, or one name
+    /// in two ASCII cases).
+    #[error("{} {reference} is ambiguous: both `{first}` and `{second}` answer it; give each its own name and number", .kind.label())]
+    Ambiguous {
+        kind: ItemKind,
+        reference: CellRef,
+        first: String,
+        second: String,
+    },
 }
 
-fn matches(name: &str, number: Option<u32>, r: &CellRef) -> bool {
-    match r {
-        CellRef::Number(n) => number == Some(*n),
-        CellRef::Name(s) => name.eq_ignore_ascii_case(s),
+/// The index of the one item answering `r` among items named `names` and
+/// numbered `numbers` ([`numbering::numbers`]).
+fn find(
+    kind: ItemKind,
+    names: &[&str],
+    numbers: &[u32],
+    r: &CellRef,
+) -> Result<Option<usize>, CellError> {
+    let hits: Vec<usize> = (0..names.len())
+        .filter(|i| match r {
+            CellRef::Number(n) => numbers[*i] == *n,
+            CellRef::Name(s) => names[*i].eq_ignore_ascii_case(s),
+        })
+        .collect();
+    match hits.as_slice() {
+        [] => Ok(None),
+        [one] => Ok(Some(*one)),
+        [a, b, ..] => Err(CellError::Ambiguous {
+            kind,
+            reference: r.clone(),
+            first: names[*a].to_string(),
+            second: names[*b].to_string(),
+        }),
     }
 }
 
 impl Cell {
-    /// The tool named or numbered `r`; number 0 is the bare flange when the
-    /// cell does not define it.
+    /// The controller numbers of the tools, in their order: their own, else
+    /// the lowest free ones ([`numbering`]).
+    pub fn tool_numbers(&self) -> Vec<u32> {
+        let d: Vec<(&str, Option<u32>)> = self
+            .tools
+            .iter()
+            .map(|t| (t.name.as_str(), t.number))
+            .collect();
+        numbering::numbers(&d)
+    }
+
+    /// The controller numbers of the work objects ([`numbering`]).
+    pub fn work_object_numbers(&self) -> Vec<u32> {
+        let d: Vec<(&str, Option<u32>)> = self
+            .work_objects
+            .iter()
+            .map(|w| (w.name.as_str(), w.number))
+            .collect();
+        numbering::numbers(&d)
+    }
+
+    /// The tool named or numbered `r`, carrying its controller number (its
+    /// own or the one [`numbering`] gives it); number 0 is the bare flange
+    /// when the cell does not define it.
     pub fn tool(&self, r: &CellRef) -> Result<Tool, CellError> {
-        match self.tools.iter().find(|t| matches(&t.name, t.number, r)) {
-            Some(t) => Ok(t.clone()),
+        let numbers = self.tool_numbers();
+        let names: Vec<&str> = self.tools.iter().map(|t| t.name.as_str()).collect();
+        match find(ItemKind::Tool, &names, &numbers, r)? {
+            Some(i) => Ok(Tool {
+                number: Some(numbers[i]),
+                ..self.tools[i].clone()
+            }),
             None if *r == CellRef::Number(0) => Ok(Tool {
                 name: "flange".into(),
                 number: Some(0),
@@ -160,18 +217,34 @@ impl Cell {
         }
     }
 
-    /// The work object named or numbered `r`; number 0 is the base frame when
-    /// the cell does not define it.
+    /// The work object named or numbered `r`, carrying its controller number
+    /// ([`numbering`]); number 0 is the base frame when the cell does not
+    /// define it.
     pub fn work_object(&self, r: &CellRef) -> Result<WorkObject, CellError> {
-        match self
-            .work_objects
-            .iter()
-            .find(|w| matches(&w.name, w.number, r))
-        {
-            Some(w) => Ok(w.clone()),
+        let numbers = self.work_object_numbers();
+        let names: Vec<&str> = self.work_objects.iter().map(|w| w.name.as_str()).collect();
+        match find(ItemKind::WorkObject, &names, &numbers, r)? {
+            Some(i) => Ok(WorkObject {
+                number: Some(numbers[i]),
+                ..self.work_objects[i].clone()
+            }),
             None if *r == CellRef::Number(0) => Ok(WorkObject::base()),
             None => Err(CellError::UnknownWorkObject(r.clone())),
         }
+    }
+
+    /// Whether the cell itself holds the tool `r` (not the bare flange).
+    pub fn defines_tool(&self, r: &CellRef) -> bool {
+        let numbers = self.tool_numbers();
+        let names: Vec<&str> = self.tools.iter().map(|t| t.name.as_str()).collect();
+        !matches!(find(ItemKind::Tool, &names, &numbers, r), Ok(None))
+    }
+
+    /// Whether the cell itself holds the work object `r` (not the base frame).
+    pub fn defines_work_object(&self, r: &CellRef) -> bool {
+        let numbers = self.work_object_numbers();
+        let names: Vec<&str> = self.work_objects.iter().map(|w| w.name.as_str()).collect();
+        !matches!(find(ItemKind::WorkObject, &names, &numbers, r), Ok(None))
     }
 }
 

@@ -46,6 +46,10 @@ pub struct WorkObjectFit {
     /// Base → work object [m].
     #[serde(skip)]
     pub pose: Pose,
+    /// The origin in the robot base frame [mm].
+    pub xyz_mm: [f64; 3],
+    /// The orientation, fixed-axis `[rx, ry, rz]` [deg].
+    pub rpy_deg: [f64; 3],
     /// RMS scatter of the repeated touches of the origin, x and xy points [mm]
     /// (0 for a point touched once).
     pub scatter_mm: [f64; 3],
@@ -57,6 +61,9 @@ pub struct WorkObjectFit {
     pub sigma_mm: Option<f64>,
     /// 1σ of the orientation [deg], from repeated touches.
     pub sigma_deg: Option<f64>,
+    /// The bounds the fit was judged against (`tcp::judge`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub limits: Option<super::tcp::Limits>,
 }
 
 /// The calibrated tool tip `F_i·t` (base frame) at each row of controller
@@ -152,11 +159,14 @@ pub fn fit(points: &WorkObjectPoints) -> Result<WorkObjectFit, FitError> {
         (None, None)
     };
     Ok(WorkObjectFit {
+        xyz_mm: [o.x * 1e3, o.y * 1e3, o.z * 1e3],
+        rpy_deg: crate::model::orientation::fixed_xyz_angles(&pose.r).map(f64::to_degrees),
         pose,
         scatter_mm: [groups[0].1 * 1e3, groups[1].1 * 1e3, groups[2].1 * 1e3],
         plane_residual_mm,
         xy_angle_deg: angle,
         sigma_mm,
         sigma_deg,
+        limits: None,
     })
 }

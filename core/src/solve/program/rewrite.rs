@@ -13,7 +13,9 @@ use super::{mark, parse, Language, Motion, MotionTarget, ParseError, Program, Pr
 use crate::calibrate::compensate::CompensatedModel;
 use crate::model::orientation::rotation_to;
 use crate::model::Pose;
-use crate::solve::cell::export::{controller_text, ControllerFrame, ControllerTool};
+use crate::solve::cell::export::{
+    controller_text, ControllerData, ControllerFrame, ControllerTool, ExportOptions,
+};
 use crate::solve::cell::Cell;
 use crate::solve::ik::IkSettings;
 use serde::Serialize;
@@ -303,10 +305,10 @@ impl Run<'_> {
             })
             .collect();
         let language = self.context.language;
-        let controller_data = if self.used_tools.is_empty() {
+        let controller_data = if self.used_tools.is_empty() && self.used_frames.is_empty() {
             String::new()
         } else {
-            controller_text(language, &self.used_tools, &self.used_frames)
+            used_data(language, self.used_tools, self.used_frames)
         };
         FilterOutput {
             files,
@@ -384,4 +386,30 @@ fn apply(text: &str, mut edits: Vec<(std::ops::Range<usize>, String)>) -> String
     }
     out.push_str(&text[at..]);
     out
+}
+
+/// The controller data of the cell's items a filter used (numbers as the
+/// program named them, no position registers), or a comment of the language
+/// saying why they cannot be written.
+fn used_data(
+    language: Language,
+    tools: Vec<ControllerTool>,
+    frames: Vec<ControllerFrame>,
+) -> String {
+    let data = ControllerData {
+        tools,
+        frames,
+        assigned: Vec::new(),
+    };
+    match controller_text(language, &data, &ExportOptions::default()) {
+        Ok(e) => e.text,
+        Err(e) => {
+            let lead = match language {
+                Language::Krl => ";",
+                Language::Rapid | Language::Fanuc => "!",
+                Language::UrScript => "#",
+            };
+            format!("{lead} robocal: the controller data cannot be written: {e}\n")
+        }
+    }
 }

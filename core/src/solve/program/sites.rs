@@ -264,6 +264,16 @@ impl Context<'_> {
             number: wobj.number.unwrap_or(0),
             pose: wobj.in_base(model),
         };
+        // Only the cell's own items are the controller's data to hold: the
+        // flange and the base frame are built in, inline frames in the program.
+        let cell = self.cell;
+        let cell_item = |spec: &FrameSpec, tool: bool| match spec {
+            FrameSpec::Ref(r) if tool => cell.defines_tool(r),
+            FrameSpec::Ref(r) => cell.defines_work_object(r),
+            _ => false,
+        };
+        let used_tool = cell_item(&site.tool, true).then_some(used_tool);
+        let used_frame = cell_item(&site.work_object, false).then_some(used_frame);
         let language = self.language;
         let solver = self.solver(tcp, load);
         let on = solve_on(solver, site, &wobj, &pose, previous, language)?;
@@ -275,8 +285,8 @@ impl Context<'_> {
             q: on.q,
             load: used_load,
             warnings: warnings.into_iter().chain(on.warning).collect(),
-            tool: Some(used_tool),
-            frame: Some(used_frame),
+            tool: used_tool,
+            frame: used_frame,
         })
     }
 

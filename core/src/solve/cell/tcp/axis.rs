@@ -76,7 +76,7 @@ pub fn with_axis_point(
         .figures(len * 1e3, MIN_AXIS_LENGTH_M * 1e3);
         return Err(e.with_tip(fit));
     }
-    fit.tcp.r = frame_from_z(&d);
+    fit.set_orientation(frame_from_z(&d));
     let sigma_mm = (norm3(&fit.sigma_mm).powi(2) + norm3(axis_sigma_mm).powi(2)).sqrt();
     fit.sigma_deg = Some((sigma_mm * 1e-3 / len).to_degrees());
     fit.axis = Some(AxisSource::Point);
@@ -140,7 +140,7 @@ pub fn with_plane(mut fit: ToolFit, touches: &[Pose]) -> Result<ToolFit, FitErro
     let (rms_deg, _) = rms_max(&angles);
     let (flat_mm, _) = rms_max(&plane_residual_mm);
     let normal_sigma_deg = (flat_mm * 1e-3 / ((n as f64).sqrt() * spread)).to_degrees();
-    fit.tcp.r = frame_from_z(&z);
+    fit.set_orientation(frame_from_z(&z));
     fit.sigma_deg = Some((rms_deg.powi(2) / n as f64 + normal_sigma_deg.powi(2)).sqrt());
     fit.orientation_residual_deg = Some(angles);
     fit.plane_residual_mm = Some(plane_residual_mm);

@@ -14,7 +14,7 @@
 //! along that axis is then unobservable). Below [`MIN_SPREAD_DEG`] the fit is
 //! refused.
 
-use super::{rms_max, FitError, NotFittedReason, TcpMethod, ToolFit};
+use super::{FitError, NotFittedReason, TcpMethod, ToolFit};
 use crate::model::Pose;
 use nalgebra::{DMatrix, DVector, Matrix3, SymmetricEigen, Vector3};
 
@@ -94,20 +94,8 @@ pub fn fit(flanges: &[Pose]) -> Result<ToolFit, FitError> {
         )
     })? * s2;
     let sigma_mm = std::array::from_fn(|k| cov[(k, k)].max(0.0).sqrt() * 1e3);
-    let (rms_mm, max_mm) = rms_max(&residual_mm);
-    Ok(ToolFit {
-        method: TcpMethod::FixedPoint,
-        tcp: Pose::from_translation(t),
-        residual_mm,
-        rms_mm,
-        max_mm,
-        sigma_mm,
-        orientation_residual_deg: None,
-        sigma_deg: None,
-        fixed_point_mm: Some([p.x * 1e3, p.y * 1e3, p.z * 1e3]),
-        orientation_spread_deg: Some(spread),
-        axis: None,
-        axis_length_mm: None,
-        plane_residual_mm: None,
-    })
+    let mut fit = ToolFit::position(TcpMethod::FixedPoint, t, residual_mm, sigma_mm);
+    fit.fixed_point_mm = Some([p.x * 1e3, p.y * 1e3, p.z * 1e3]);
+    fit.orientation_spread_deg = Some(spread);
+    Ok(fit)
 }

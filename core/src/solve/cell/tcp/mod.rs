@@ -19,15 +19,24 @@
 //! - [`axis`]: the tool's z from a second point on its axis or from touches
 //!   with the tool flat on a plane.
 //!
+//! Every fit is judged before it is stored ([`judge`]: residuals against the
+//! readings' noise, the TCP's distance from the flange); what a fit then
+//! stores, where its orientation comes from and what it replaces is
+//! [`entry`].
+//!
 //! Units: SI (m, rad) in poses and points; the reported residuals and σ are in
 //! mm and degrees (fields named so). Joint readings are controller degrees.
 
 pub mod axis;
+pub mod entry;
 pub mod fixed_point;
+pub mod judge;
 pub mod readings;
 pub mod request;
 pub mod tracker;
 
+pub use entry::{EntryField, OrientationSource, Outcome, Replaced, StoreRequest, StoredEntry};
+pub use judge::Limits;
 pub use readings::{Reading, WoPoint};
 pub use request::{fit_tool, fit_work_object, AxisRequest, ToolRequest};
 
@@ -77,10 +86,24 @@ pub enum NotFittedReason {
     /// The xy point is (nearly) on the x axis (angle between OX and OY,
     /// degrees).
     XyPointOnXAxis,
+    /// The residuals' RMS is beyond what the readings' noise explains (mm;
+    /// for a work object the worst point's scatter), [`judge`].
+    ResidualsTooLarge,
+    /// One row's residual is beyond what the noise explains (mm), [`judge`].
+    ResidualOutlier,
+    /// A 6-D probe's orientation residuals' RMS is beyond the noise (deg).
+    OrientationResidualsTooLarge,
+    /// A point is off the plane beyond the noise (mm), [`judge`].
+    OffPlane,
+    /// The TCP is farther from the flange than the arm is long (mm).
+    TcpTooFar,
+    /// The method fits the TCP's position only, and the tool has no stored
+    /// orientation to keep and none was given.
+    OrientationUnknown,
 }
 
 impl NotFittedReason {
-    pub const ALL: [NotFittedReason; 16] = [
+    pub const ALL: [NotFittedReason; 22] = [
         NotFittedReason::TooFewReadings,
         NotFittedReason::JointCount,
         NotFittedReason::MissingJoints,
@@ -97,6 +120,12 @@ impl NotFittedReason {
         NotFittedReason::PlaneTouchesInLine,
         NotFittedReason::XPointTooClose,
         NotFittedReason::XyPointOnXAxis,
+        NotFittedReason::ResidualsTooLarge,
+        NotFittedReason::ResidualOutlier,
+        NotFittedReason::OrientationResidualsTooLarge,
+        NotFittedReason::OffPlane,
+        NotFittedReason::TcpTooFar,
+        NotFittedReason::OrientationUnknown,
     ];
 
     pub fn as_str(self) -> &'static str {
@@ -117,8 +146,35 @@ impl NotFittedReason {
             NotFittedReason::PlaneTouchesInLine => "plane_touches_in_line",
             NotFittedReason::XPointTooClose => "x_point_too_close",
             NotFittedReason::XyPointOnXAxis => "xy_point_on_x_axis",
+            NotFittedReason::ResidualsTooLarge => "residuals_too_large",
+            NotFittedReason::ResidualOutlier => "residual_outlier",
+            NotFittedReason::OrientationResidualsTooLarge => "orientation_residuals_too_large",
+            NotFittedReason::OffPlane => "off_plane",
+            NotFittedReason::TcpTooFar => "tcp_too_far",
+            NotFittedReason::OrientationUnknown => "orientation_unknown",
         }
     }
+
+    /// A verdict of [`judge`] on a computed fit, which the user may overrule
+    /// by forcing it to be stored.
+    pub fn forcible(self) -> bool {
+        matches!(
+            self,
+            NotFittedReason::ResidualsTooLarge
+                | NotFittedReason::ResidualOutlier
+                | NotFittedReason::OrientationResidualsTooLarge
+                | NotFittedReason::OffPlane
+                | NotFittedReason::TcpTooFar
+        )
+    }
+}
+
+/// A fit that was computed and judged not plausible, with its figures.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum JudgedFit {
+    Tool(ToolFit),
+    WorkObject(crate::solve::cell::work_object_fit::WorkObjectFit),
 }
 
 /// Why a tool or work object was not fitted, with what the user can act on:
@@ -136,6 +192,10 @@ pub struct FitError {
     /// The tip, fitted before its axis could not be.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub tip: Option<Box<ToolFit>>,
+    /// The fit itself (residuals, σ, the limits it broke), when it was
+    /// computed and judged not plausible ([`judge`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fit: Option<Box<JudgedFit>>,
 }
 
 impl FitError {
@@ -147,6 +207,7 @@ impl FitError {
             measured: None,
             needed: None,
             tip: None,
+            fit: None,
         }
     }
 
@@ -166,6 +227,12 @@ impl FitError {
     /// The tip's fit, when only the axis failed.
     pub fn with_tip(mut self, tip: ToolFit) -> Self {
         self.tip = Some(Box::new(tip));
+        self
+    }
+
+    /// The fit judged not plausible.
+    pub fn with_fit(mut self, fit: JudgedFit) -> Self {
+        self.fit = Some(Box::new(fit));
         self
     }
 }
@@ -217,9 +284,18 @@ impl std::str::FromStr for TcpMethod {
 pub struct ToolFit {
     pub method: TcpMethod,
     /// Flange → TCP [m]; the rotation is the flange's unless an axis or a
-    /// 6-D probe gave one.
+    /// 6-D probe gave one ([`Self::rpy_deg`]).
     #[serde(skip)]
     pub tcp: Pose,
+    /// The TCP in the flange frame [mm].
+    pub xyz_mm: [f64; 3],
+    /// The tool's orientation, fixed-axis `[rx, ry, rz]` [deg], when the
+    /// readings determined it (an axis or a 6-D probe); absent when they
+    /// fit the position only.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rpy_deg: Option<[f64; 3]>,
+    /// Distance of the TCP from the flange centre [mm].
+    pub distance_mm: f64,
     /// Per pose: distance of the fitted tip from where it should be [mm].
     pub residual_mm: Vec<f64>,
     pub rms_mm: f64,
@@ -249,6 +325,47 @@ pub struct ToolFit {
     /// Per touch: the tip's distance from the fitted plane [mm] (plane axis).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub plane_residual_mm: Option<Vec<f64>>,
+    /// The bounds the fit was judged against ([`judge`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub limits: Option<Limits>,
+}
+
+impl ToolFit {
+    /// A fit of the TCP's position `t` (flange frame, m) with its residuals
+    /// and σ; the orientation is not determined.
+    pub fn position(
+        method: TcpMethod,
+        t: Vector3<f64>,
+        residual_mm: Vec<f64>,
+        sigma_mm: [f64; 3],
+    ) -> Self {
+        let (rms_mm, max_mm) = rms_max(&residual_mm);
+        ToolFit {
+            method,
+            tcp: Pose::from_translation(t),
+            xyz_mm: [t.x * 1e3, t.y * 1e3, t.z * 1e3],
+            rpy_deg: None,
+            distance_mm: t.norm() * 1e3,
+            residual_mm,
+            rms_mm,
+            max_mm,
+            sigma_mm,
+            orientation_residual_deg: None,
+            sigma_deg: None,
+            fixed_point_mm: None,
+            orientation_spread_deg: None,
+            axis: None,
+            axis_length_mm: None,
+            plane_residual_mm: None,
+            limits: None,
+        }
+    }
+
+    /// Sets the tool's orientation (flange frame), as the readings determined it.
+    pub fn set_orientation(&mut self, r: Matrix3<f64>) {
+        self.tcp.r = r;
+        self.rpy_deg = Some(crate::model::orientation::fixed_xyz_angles(&r).map(f64::to_degrees));
+    }
 }
 
 /// The calibrated flange pose (registered base frame) at every row of

@@ -2,18 +2,16 @@
 //! for it: rows of [`Reading`]s, a method, an optional axis, and the result
 //! as a cell-file entry (mm, degrees).
 
+use super::judge::{self, Limits, Noise};
 use super::readings::{Reading, WoPoint};
 use super::{
     axis, cell_points_to_base, fixed_point, flange_poses, tracker, FitError, NotFittedReason,
     TcpMethod, ToolFit,
 };
 use crate::calibrate::compensate::CompensatedModel;
-use crate::model::orientation::fixed_xyz_angles;
 use crate::model::pose::rpy_matrix;
 use crate::model::Pose;
-use crate::solve::cell::file::{PoseMmDeg, ToolDescription, WorkObjectDescription};
 use crate::solve::cell::work_object_fit::{self, WorkObjectFit, WorkObjectPoints};
-use crate::solve::cell::WorkObjectFrame;
 use nalgebra::Vector3;
 
 /// How the tool's axis is given.
@@ -111,32 +109,66 @@ fn fit_tip(
     }
 }
 
-/// Fits a tool on `model`'s calibrated flange.
+/// What a tool fit's residuals are made of ([`judge`]).
+fn noise_of(method: TcpMethod) -> Noise {
+    match method {
+        TcpMethod::FixedPoint => Noise::Pointing,
+        TcpMethod::TrackerPoint | TcpMethod::TrackerFrame => Noise::Tracker,
+    }
+}
+
+impl ToolRequest {
+    /// Whether the readings determine the tool's orientation (an axis or a
+    /// 6-D probe); an orientation given besides is refused at the boundary.
+    pub fn determines_orientation(&self) -> bool {
+        self.method == TcpMethod::TrackerFrame || self.axis.is_some()
+    }
+}
+
+/// Fits a tool on `model`'s calibrated flange and judges it ([`judge`]):
+/// a fit beyond its limits is an error carrying the fit.
 pub fn fit_tool(model: &CompensatedModel, req: &ToolRequest) -> Result<ToolFit, FitError> {
+    let noise = noise_of(req.method);
     let tip = fit_tip(model, req.method, &req.rows, "tip")?;
-    match &req.axis {
-        None => Ok(tip),
-        Some(_) if req.method == TcpMethod::TrackerFrame => Err(FitError::new(
-            NotFittedReason::AxisWithProbe,
-            "a 6-D probe gives the tool's orientation itself; leave the axis out",
-        )
-        .with_tip(tip)),
-        Some(AxisRequest::Point(rows)) => match fit_tip(model, req.method, rows, "axis point") {
-            Ok(second) => axis::with_axis_point(tip, &second.tcp.p, &second.sigma_mm),
-            Err(e) => Err(e.with_tip(tip)),
-        },
-        Some(AxisRequest::Plane(rows)) => {
-            match joints(rows, "plane").and_then(|q| flange_poses(model, &q)) {
-                Ok(flanges) => axis::with_plane(tip, &flanges),
-                Err(e) => Err(e.with_tip(tip)),
+    let fit = match &req.axis {
+        None => tip,
+        Some(_) if req.method == TcpMethod::TrackerFrame => {
+            return Err(FitError::new(
+                NotFittedReason::AxisWithProbe,
+                "a 6-D probe gives the tool's orientation itself; leave the axis out",
+            )
+            .with_tip(tip))
+        }
+        Some(AxisRequest::Point(rows)) => {
+            let second = fit_tip(model, req.method, rows, "axis point").and_then(|second| {
+                judge::check_residuals(
+                    &second.residual_mm,
+                    &Limits::of(noise),
+                    "axis point",
+                    "the axis point's readings do not hold it at one point",
+                )
+                .map(|()| second)
+            });
+            match second {
+                Ok(second) => axis::with_axis_point(tip, &second.tcp.p, &second.sigma_mm)?,
+                Err(e) => return Err(e.with_tip(tip)),
             }
         }
-    }
+        Some(AxisRequest::Plane(rows)) => {
+            match joints(rows, "plane").and_then(|q| flange_poses(model, &q)) {
+                Ok(flanges) => axis::with_plane(tip, &flanges)?,
+                Err(e) => return Err(e.with_tip(tip)),
+            }
+        }
+    };
+    judge::judge_tool(fit, &model.nominal, noise)
 }
 
 /// Fits a work object from rows naming their point: tracker rows (x, y, z in
 /// the measurement frame) or touches (joint readings) with the calibrated
-/// tool tip `tcp` (flange frame, m). The result is in the robot base frame.
+/// tool tip `tcp` (flange frame, m), and judges it ([`judge`]: tracker
+/// noise when every row is a tracker reading, else a touch's). The result
+/// is in the robot base frame.
 pub fn fit_work_object(
     model: &CompensatedModel,
     rows: &[Reading],
@@ -195,37 +227,10 @@ pub fn fit_work_object(
             WoPoint::Plane => pts.plane.push(p),
         }
     }
-    work_object_fit::fit(&pts)
-}
-
-/// A pose in boundary units (mm, fixed-axis degrees).
-pub fn pose_mm_deg(p: &Pose) -> PoseMmDeg {
-    PoseMmDeg {
-        xyz_mm: [p.p.x * 1e3, p.p.y * 1e3, p.p.z * 1e3],
-        rpy_deg: fixed_xyz_angles(&p.r).map(f64::to_degrees),
-    }
-}
-
-/// The fitted tool as a cell-file entry.
-pub fn tool_description(name: &str, number: Option<u32>, fit: &ToolFit) -> ToolDescription {
-    ToolDescription {
-        name: name.to_string(),
-        number,
-        tcp: pose_mm_deg(&fit.tcp),
-        load: None,
-    }
-}
-
-/// The fitted work object as a cell-file entry (base frame).
-pub fn work_object_description(
-    name: &str,
-    number: Option<u32>,
-    fit: &WorkObjectFit,
-) -> WorkObjectDescription {
-    WorkObjectDescription {
-        name: name.to_string(),
-        number,
-        frame: WorkObjectFrame::Base,
-        pose: pose_mm_deg(&fit.pose),
-    }
+    let noise = if rows.iter().all(|r| r.xyz_mm.is_some()) {
+        Noise::TrackerOnly
+    } else {
+        Noise::Pointing
+    };
+    judge::judge_work_object(work_object_fit::fit(&pts)?, noise)
 }

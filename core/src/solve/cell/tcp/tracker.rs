@@ -68,22 +68,12 @@ pub fn fit_points(flanges: &[Pose], measured_base: &[Vector3<f64>]) -> Result<To
         .zip(measured_base)
         .map(|(f, x)| (f.r * t + f.p - x).norm() * 1e3)
         .collect();
-    let (rms_mm, max_mm) = rms_max(&residual_mm);
-    Ok(ToolFit {
-        method: TcpMethod::TrackerPoint,
-        tcp: Pose::from_translation(t),
+    Ok(ToolFit::position(
+        TcpMethod::TrackerPoint,
+        t,
         residual_mm,
-        rms_mm,
-        max_mm,
         sigma_mm,
-        orientation_residual_deg: None,
-        sigma_deg: None,
-        fixed_point_mm: None,
-        orientation_spread_deg: None,
-        axis: None,
-        axis_length_mm: None,
-        plane_residual_mm: None,
-    })
+    ))
 }
 
 /// The full tool frame from a 6-D probe measured at `measured_base[i]`.
@@ -104,7 +94,7 @@ pub fn fit_frames(flanges: &[Pose], measured_base: &[Pose]) -> Result<ToolFit, F
         .collect();
     let (rms_deg, _) = rms_max(&angles);
     fit.method = TcpMethod::TrackerFrame;
-    fit.tcp.r = r;
+    fit.set_orientation(r);
     fit.sigma_deg = Some(rms_deg / (angles.len() as f64).sqrt());
     fit.orientation_residual_deg = Some(angles);
     Ok(fit)

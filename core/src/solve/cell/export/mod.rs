@@ -1,0 +1,485 @@
+//! What the controller must hold for a filtered program: tool data (TCP in
+//! the flange frame), load data (mass, centre of mass in the flange frame,
+//! principal inertia) and work objects in the controller's base frame, in
+//! each language's own form, as a controller loads it.
+//!
+//! Frames: a work object measured in the tracker frame is given to the
+//! controller as `base_from_cell·W` (`WorkObject::in_base`) of the calibrated
+//! version used; a tool without a stated load carries the model's payload
+//! kept at its flange point (`Load::of_model`).
+//!
+//! Units and forms (values written with 6 decimals in mm and 9 in degrees,
+//! so a pose reads back to better than 1e-6 mm):
+//! - KRL, lines for `$config.dat`: `TOOL_DATA[n]={X,Y,Z,A,B,C}`,
+//!   `LOAD_DATA[n]={M kg,CM {X,Y,Z mm,A,B,C},J {X,Y,Z kg·m²}}`,
+//!   `BASE_DATA[n]={…}`; `R = Rz(A)·Ry(B)·Rx(C)`.
+//! - RAPID: `PERS tooldata name:=[TRUE,[[x,y,z],[q1..q4]],[kg,[cx,cy,cz],
+//!   [1,0,0,0],ix,iy,iz]]`, `PERS wobjdata name:=[FALSE,TRUE,"",[uframe],
+//!   [[0,0,0],[1,0,0,0]]]` (mm, quaternion scalar first, kg·m²).
+//! - Fanuc: a TP program with the payload schedules `$PLST_GRP1[n]` (kg;
+//!   centre of gravity in cm; inertia in kgf·cm·s²) and, with the position
+//!   registers the user gives, `UTOOL[n]`, `UFRAME[n]` set from them
+//!   (`PR[i,j]`: X, Y, Z mm, W, P, R deg) — [`fanuc`].
+//! - URScript: `set_tcp(p[…])`, `set_payload(kg, [cx, cy, cz])` (m, the
+//!   rotation vector in rad) and a feature variable `name = p[…]`.
+//!
+//! What a controller loads (the checks, each refusing with the item named):
+//! one number per item ([`super::numbering`]: the cell's own, else the
+//! lowest free, reported in the header comment and [`ControllerExport`]),
+//! within the controller's range and never 0 where 0 is the flange or the
+//! base ([`numbers`]); identifiers valid and distinct ([`names`]), every
+//! renaming reported; registers only those the user names.
+
+pub mod fanuc;
+pub mod names;
+pub mod numbers;
+
+pub use names::{RenameReason, Renamed};
+pub use numbers::{NumberRange, RegisterRange, UsedRegister};
+
+use super::numbering::{self, AssignedNumber, DuplicateNumber, ItemKind};
+use super::{Cell, Load, Tool};
+use crate::calibrate::compensate::CompensatedModel;
+use crate::model::orientation::{rotation_to, OrientationConvention};
+use crate::model::Pose;
+use crate::solve::program::Language;
+use std::fmt::Write as _;
+
+/// One tool as the controller holds it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ControllerTool {
+    pub name: String,
+    /// The controller's number (`Cell::tool_numbers`).
+    pub number: u32,
+    /// Flange → TCP [m].
+    pub tcp: Pose,
+    pub load: Load,
+}
+
+/// One work object in the controller's base frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ControllerFrame {
+    pub name: String,
+    pub number: u32,
+    /// Base → work object [m].
+    pub pose: Pose,
+}
+
+/// The items a controller must hold, and the numbers given to items
+/// without one.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ControllerData {
+    pub tools: Vec<ControllerTool>,
+    pub frames: Vec<ControllerFrame>,
+    pub assigned: Vec<AssignedNumber>,
+}
+
+/// How to export.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ExportOptions {
+    /// The position registers a Fanuc export may overwrite; `None`: none
+    /// (the frames are listed for entry by hand, [`fanuc`]).
+    pub registers: Option<RegisterRange>,
+}
+
+/// The exported text and what it decided.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ControllerExport {
+    pub text: String,
+    /// Items without a number and the one they were given (KRL, Fanuc).
+    pub assigned: Vec<AssignedNumber>,
+    /// Items declared under an identifier other than their name (RAPID,
+    /// URScript).
+    pub renamed: Vec<Renamed>,
+    /// The position registers the program overwrites (Fanuc).
+    pub registers: Vec<UsedRegister>,
+}
+
+/// Why a cell cannot be exported for a controller: the item and the fix.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum ExportError {
+    #[error("{0}")]
+    Duplicate(#[from] DuplicateNumber),
+    #[error("{} `{name}` has number 0, which is {} on this controller: give it a number from {} to {} ({}[{}..{}])", .kind.label(), .range.zero, .range.first, .range.last, .range.data, .range.first, .range.last)]
+    NumberZero {
+        kind: ItemKind,
+        name: String,
+        range: NumberRange,
+    },
+    #[error("{} `{name}` {}: the controller has {}[{}..{}]", .kind.label(), if *.assigned { format!("has no number and the lowest free one is {number}") } else { format!("has number {number}") }, .range.data, .range.first, .range.last)]
+    NumberOutOfRange {
+        kind: ItemKind,
+        name: String,
+        number: u32,
+        /// The number was given by the export (the item has none).
+        assigned: bool,
+        range: NumberRange,
+    },
+    #[error("the Fanuc export needs {needed} position registers (one per tool and work object), {given} given ({range}): give a range of at least {needed}")]
+    TooFewRegisters {
+        needed: usize,
+        given: usize,
+        range: RegisterRange,
+    },
+}
+
+/// The cell's tools and work objects as the controller holds them, for the
+/// calibrated `model`: work objects in its base frame, loads on the flange,
+/// numbers by [`numbering`].
+pub fn controller_data(cell: &Cell, model: &CompensatedModel) -> ControllerData {
+    let model_load = Load {
+        mass_kg: model.payload_kg,
+        ..Load::of_model(&model.calibrated)
+    };
+    let tools = cell
+        .tools
+        .iter()
+        .zip(cell.tool_numbers())
+        .map(|(t, number): (&Tool, u32)| ControllerTool {
+            name: t.name.clone(),
+            number,
+            tcp: t.tcp,
+            load: t.load.unwrap_or(model_load),
+        })
+        .collect();
+    let frames = cell
+        .work_objects
+        .iter()
+        .zip(cell.work_object_numbers())
+        .map(|(w, number)| ControllerFrame {
+            name: w.name.clone(),
+            number,
+            pose: w.in_base(model),
+        })
+        .collect();
+    let declared = |v: Vec<(&str, Option<u32>)>, kind| numbering::assigned(kind, &v);
+    let mut assigned = declared(
+        cell.tools
+            .iter()
+            .map(|t| (t.name.as_str(), t.number))
+            .collect(),
+        ItemKind::Tool,
+    );
+    assigned.extend(declared(
+        cell.work_objects
+            .iter()
+            .map(|w| (w.name.as_str(), w.number))
+            .collect(),
+        ItemKind::WorkObject,
+    ));
+    ControllerData {
+        tools,
+        frames,
+        assigned,
+    }
+}
+
+/// The cell exported for `language` on the calibrated `model`.
+pub fn export_cell(
+    language: Language,
+    cell: &Cell,
+    model: &CompensatedModel,
+    options: &ExportOptions,
+) -> Result<ControllerExport, ExportError> {
+    controller_text(language, &controller_data(cell, model), options)
+}
+
+/// Refuses numbers the controller does not take, or one held twice.
+fn check_numbers(language: Language, data: &ControllerData) -> Result<(), ExportError> {
+    let items: [(ItemKind, Vec<(&str, u32)>); 2] = [
+        (
+            ItemKind::Tool,
+            data.tools
+                .iter()
+                .map(|t| (t.name.as_str(), t.number))
+                .collect(),
+        ),
+        (
+            ItemKind::WorkObject,
+            data.frames
+                .iter()
+                .map(|f| (f.name.as_str(), f.number))
+                .collect(),
+        ),
+    ];
+    for (kind, list) in items {
+        let Some(range) = numbers::range(language, kind) else {
+            continue;
+        };
+        let names: Vec<&str> = list.iter().map(|(n, _)| *n).collect();
+        let nums: Vec<u32> = list.iter().map(|(_, n)| *n).collect();
+        if let Some(d) = numbering::duplicate(kind, &names, &nums) {
+            return Err(d.into());
+        }
+        for (name, number) in list {
+            let assigned = data
+                .assigned
+                .iter()
+                .any(|a| a.kind == kind && a.name == name && a.number == number);
+            if number == 0 {
+                return Err(ExportError::NumberZero {
+                    kind,
+                    name: name.to_string(),
+                    range,
+                });
+            }
+            if number < range.first || number > range.last {
+                return Err(ExportError::NumberOutOfRange {
+                    kind,
+                    name: name.to_string(),
+                    number,
+                    assigned,
+                    range,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A name as comment text: control characters (a line break would end the
+/// comment) and, in Fanuc, the statement end `;` become spaces.
+pub(crate) fn comment(name: &str, language: Language) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_control() || (language == Language::Fanuc && c == ';') {
+                ' '
+            } else {
+                c
+            }
+        })
+        .collect()
+}
+
+/// The header comment lines of the numbers given by the export.
+fn assigned_lines(language: Language, data: &ControllerData) -> Vec<String> {
+    data.assigned
+        .iter()
+        .filter_map(|a| {
+            let range = numbers::range(language, a.kind)?;
+            Some(format!(
+                "{} `{}` has no number: {}[{}], the lowest free",
+                a.kind.label(),
+                comment(&a.name, language),
+                range.data,
+                a.number
+            ))
+        })
+        .collect()
+}
+
+fn kuka_frame(p: &Pose) -> String {
+    let abc = rotation_to(OrientationConvention::KukaAbc, &p.r);
+    format!(
+        "{{X {:.6},Y {:.6},Z {:.6},A {:.9},B {:.9},C {:.9}}}",
+        p.p.x * 1e3,
+        p.p.y * 1e3,
+        p.p.z * 1e3,
+        abc[0],
+        abc[1],
+        abc[2]
+    )
+}
+
+fn abb_frame(p: &Pose) -> String {
+    let q = rotation_to(OrientationConvention::AbbQ1q4, &p.r);
+    format!(
+        "[[{:.6},{:.6},{:.6}],[{:.12},{:.12},{:.12},{:.12}]]",
+        p.p.x * 1e3,
+        p.p.y * 1e3,
+        p.p.z * 1e3,
+        q[0],
+        q[1],
+        q[2],
+        q[3]
+    )
+}
+
+fn ur_pose(p: &Pose) -> String {
+    let r = rotation_to(OrientationConvention::UrRotvec, &p.r);
+    format!(
+        "p[{:.9}, {:.9}, {:.9}, {:.12}, {:.12}, {:.12}]",
+        p.p.x, p.p.y, p.p.z, r[0], r[1], r[2]
+    )
+}
+
+fn inertia(l: &Load) -> [f64; 3] {
+    l.inertia_kgm2.unwrap_or([0.0; 3])
+}
+
+/// The controller's tool, load and work object data in `language`, or why
+/// the controller could not load them.
+pub fn controller_text(
+    language: Language,
+    data: &ControllerData,
+    options: &ExportOptions,
+) -> Result<ControllerExport, ExportError> {
+    check_numbers(language, data)?;
+    let sorted = in_order(language, data);
+    let data = &sorted;
+    let mut out = ControllerExport {
+        text: String::new(),
+        assigned: data
+            .assigned
+            .iter()
+            .filter(|a| numbers::range(language, a.kind).is_some())
+            .cloned()
+            .collect(),
+        renamed: Vec::new(),
+        registers: Vec::new(),
+    };
+    let notes = assigned_lines(language, data);
+    match language {
+        Language::Krl => out.text = krl_text(data, &notes),
+        Language::Rapid => {
+            let ids = identifiers(&names::RAPID, data, true);
+            out.text = rapid_text(data, &ids);
+            out.renamed = ids.renamed;
+        }
+        Language::Fanuc => {
+            let (text, registers) = fanuc::program(data, &notes, options.registers)?;
+            out.text = text;
+            out.registers = registers;
+        }
+        Language::UrScript => {
+            let ids = identifiers(&names::URSCRIPT, data, false);
+            out.text = ur_text(data, &ids);
+            out.renamed = ids.renamed;
+        }
+    }
+    Ok(out)
+}
+
+/// `data`'s items in the order they are written, whatever the cell's order:
+/// by number where the language numbers them, else by name (ASCII case
+/// folded, then as written).
+fn in_order(language: Language, data: &ControllerData) -> ControllerData {
+    let numbered = numbers::range(language, ItemKind::Tool).is_some();
+    let key = |number: u32, name: &str| {
+        (
+            if numbered { number } else { 0 },
+            name.to_ascii_lowercase(),
+            name.to_string(),
+        )
+    };
+    let mut out = data.clone();
+    out.tools.sort_by_cached_key(|t| key(t.number, &t.name));
+    out.frames.sort_by_cached_key(|f| key(f.number, &f.name));
+    out
+}
+
+/// The identifiers of `data`'s items (tools only when the language
+/// declares them).
+fn identifiers(rules: &names::Rules, data: &ControllerData, tools: bool) -> names::Identifiers {
+    let t: Vec<&str> = if tools {
+        data.tools.iter().map(|t| t.name.as_str()).collect()
+    } else {
+        Vec::new()
+    };
+    let f: Vec<&str> = data.frames.iter().map(|f| f.name.as_str()).collect();
+    names::identifiers(rules, &t, &f)
+}
+
+fn krl_text(data: &ControllerData, notes: &[String]) -> String {
+    let mut s = String::from(
+        "; robocal: tool, load and base data for $config.dat (mm, deg, kg, kg m2)\r\n",
+    );
+    for n in notes {
+        let _ = write!(s, "; robocal: {n}\r\n");
+    }
+    for t in &data.tools {
+        let j = inertia(&t.load);
+        let c = t.load.com * 1e3;
+        let _ = write!(
+            s,
+            "TOOL_DATA[{n}]={} ; {name}\r\nLOAD_DATA[{n}]={{M {:.6},CM {{X {:.6},Y {:.6},Z {:.6},A 0.0,B 0.0,C 0.0}},J {{X {:.6},Y {:.6},Z {:.6}}}}}\r\n",
+            kuka_frame(&t.tcp),
+            t.load.mass_kg,
+            c.x,
+            c.y,
+            c.z,
+            j[0],
+            j[1],
+            j[2],
+            n = t.number,
+            name = comment(&t.name, Language::Krl),
+        );
+    }
+    for f in &data.frames {
+        let _ = write!(
+            s,
+            "BASE_DATA[{}]={} ; {}\r\n",
+            f.number,
+            kuka_frame(&f.pose),
+            comment(&f.name, Language::Krl)
+        );
+    }
+    s
+}
+
+fn rapid_text(data: &ControllerData, ids: &names::Identifiers) -> String {
+    let mut s =
+        String::from("  ! robocal: tool and work object data (mm, quaternions, kg, kg m2)\r\n");
+    for r in &ids.renamed {
+        let _ = write!(
+            s,
+            "  ! robocal: {}\r\n",
+            comment(&r.describe(), Language::Rapid)
+        );
+    }
+    for (t, id) in data.tools.iter().zip(&ids.tools) {
+        let j = inertia(&t.load);
+        let c = t.load.com * 1e3;
+        let _ = write!(
+            s,
+            "  PERS tooldata {id}:=[TRUE,{},[{:.6},[{:.6},{:.6},{:.6}],[1,0,0,0],{:.6},{:.6},{:.6}]];\r\n",
+            abb_frame(&t.tcp),
+            t.load.mass_kg,
+            c.x,
+            c.y,
+            c.z,
+            j[0],
+            j[1],
+            j[2]
+        );
+    }
+    for (f, id) in data.frames.iter().zip(&ids.frames) {
+        let _ = write!(
+            s,
+            "  TASK PERS wobjdata {id}:=[FALSE,TRUE,\"\",{},[[0,0,0],[1,0,0,0]]];\r\n",
+            abb_frame(&f.pose)
+        );
+    }
+    s
+}
+
+fn ur_text(data: &ControllerData, ids: &names::Identifiers) -> String {
+    let mut s = String::from("# robocal: tool, payload and feature data (m, rad, kg)\n");
+    for r in &ids.renamed {
+        let _ = writeln!(
+            s,
+            "# robocal: {}",
+            comment(&r.describe(), Language::UrScript)
+        );
+    }
+    for t in &data.tools {
+        let c = t.load.com;
+        let _ = write!(
+            s,
+            "# tool {}\nset_tcp({})\nset_payload({:.6}, [{:.9}, {:.9}, {:.9}])\n",
+            comment(&t.name, Language::UrScript),
+            ur_pose(&t.tcp),
+            t.load.mass_kg,
+            c.x,
+            c.y,
+            c.z
+        );
+    }
+    for (f, id) in data.frames.iter().zip(&ids.frames) {
+        let _ = writeln!(s, "global {id} = {}", ur_pose(&f.pose));
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests;
