@@ -5,7 +5,10 @@
 //! down. Here:
 //! - a request head must arrive within [`ServerSettings::header_read_timeout`]
 //!   of the connection's start (or of the previous answer on a kept-alive
-//!   connection), else hyper closes the connection;
+//!   connection), else hyper closes the connection; a connection accepted
+//!   while more than half the cap is open gets a fifth of that (slow clients
+//!   crowding the service are shed faster, a normal client sends its head in
+//!   milliseconds);
 //! - a request body must keep arriving (`Limits::body_pause`, a layer of
 //!   the router);
 //! - at most [`ServerSettings::max_connections`] connections are open: the
@@ -110,7 +113,12 @@ pub async fn serve(
         }
         let service = TowerToHyperService::new(router.clone());
         let mut stop = stop_rx.clone();
-        let header_timeout = settings.header_read_timeout;
+        let crowded = slots.available_permits() < settings.max_connections / 2;
+        let header_timeout = if crowded {
+            settings.header_read_timeout / 5
+        } else {
+            settings.header_read_timeout
+        };
         tokio::spawn(async move {
             let _slot = slot;
             let mut builder = hyper::server::conn::http1::Builder::new();
