@@ -147,7 +147,8 @@ mod tests {
     #[test]
     fn every_field_at_its_bound_passes_and_beyond_is_named() {
         assert_eq!(pose().check_bounds(), Ok(()));
-        let cases: [(&str, fn(&mut MeasuredPose)); 8] = [
+        type Edit = fn(&mut MeasuredPose);
+        let cases: [(&str, Edit); 8] = [
             ("`q_deg[1]` = -720.5 deg", |p| p.q_deg[1] = -720.5),
             ("`xyz_mm[2]` = inf mm", |p| p.xyz_mm[2] = f64::INFINITY),
             ("`rpy_deg[0]` = 360.5 deg", |p| {
