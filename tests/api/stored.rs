@@ -205,6 +205,25 @@ async fn cell(t: &TestApp, rid: &str) {
     ]});
     let r = put(t, "/v1/robots/{id}/frames", &[rid], frames.clone()).await;
     assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    // One step beyond: a 422 naming the field, the value and the bound.
+    for (body, want) in [
+        (
+            json!({ "xyz_mm": [0, 100000.5, 0] }),
+            "`xyz_mm[1]` = 100000.5 mm is outside the bound [-100000, 100000] mm",
+        ),
+        (
+            json!({ "xyz_mm": [0, 0, 0], "rpy_deg": [0, 0, -360.5] }),
+            "`rpy_deg[2]` = -360.5 deg is outside the bound [-360, 360] deg",
+        ),
+        (
+            json!({ "xyz_mm": [0, 0, 0], "load": { "mass_kg": 1, "inertia_kgm2": [0, 1e7, 0] } }),
+            "inertia_kgm2 must be numbers from 0 to 1e6 kg·m², got [0.0, 10000000.0, 0.0]",
+        ),
+    ] {
+        let r = put(t, "/v1/robots/{id}/tools/{name}", &[rid, "beyond"], body).await;
+        assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+        assert!(r.detail().contains(want), "{}", r.detail());
+    }
     for (list, key, sent) in [
         ("/v1/robots/{id}/tools", "tools", &tools),
         ("/v1/robots/{id}/frames", "work_objects", &frames),
@@ -340,6 +359,18 @@ async fn checks(t: &TestApp, rid: &str, set: i64) {
         assert_eq!(r.json()["temperature_c"], json!(temperature));
         created.push(r.json());
     }
+    let r = t
+        .post_json(
+            "/v1/robots/{id}/checks",
+            &[rid],
+            json!({ "set_id": set, "version": 1, "temperature_c": 200.5 }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+    assert_eq!(
+        r.detail(),
+        "`temperature_c` = 200.5 °C is outside the bound [-100, 200] °C"
+    );
     let r = t.get("/v1/robots/{id}/checks", &[rid]).await;
     assert_eq!(r.status, StatusCode::OK, "{}", r.text());
     let history = r.json()["checks"].clone();

@@ -122,7 +122,10 @@ impl LoadDescription {
             ));
         }
         if !self.com_mm.iter().all(|v| v.is_finite() && v.abs() <= 1e5) {
-            return Err("load com_mm must be finite and within ±100000 mm".into());
+            return Err(format!(
+                "load com_mm must be finite and within ±100000 mm, got {:?}",
+                self.com_mm
+            ));
         }
         if let Some(j) = self.inertia_kgm2 {
             if !j
