@@ -90,6 +90,18 @@ fn predict_matches_the_closed_form_of_a_planar_arm() {
     assert!(f
         .predict_deg(&[0.0, f64::NAN], &PredictFrame::default())
         .is_err());
+    // Two turns is the bound of every joint reading (as in a joints or
+    // measurement file): at it predicted, beyond it refused naming the joint.
+    assert!(f
+        .predict_deg(&[720.0, -720.0], &PredictFrame::default())
+        .is_ok());
+    let e = f
+        .predict_deg(&[0.0, -720.5], &PredictFrame::default())
+        .unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "joint 2 is -720.5 deg; must be finite and within ±720 deg (controller degrees)"
+    );
 }
 
 /// A smooth residual of a few tenths of a millimetre.

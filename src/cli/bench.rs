@@ -20,6 +20,7 @@
 
 use crate::calibrate::compensate::{CalibratedModelFile, CompensatedModel};
 use crate::calibrate::identify::{calibrate, CalibrationOptions, Method};
+use crate::measure::csv_write::{push_row, Cell};
 use crate::measure::{self, csv};
 use crate::solve::ik::{Goal, IkSettings, IkSolver, SolveOptions, TargetFrame};
 use anyhow::{bail, Context};
@@ -318,8 +319,9 @@ fn ik(a: &IkArgs) -> anyhow::Result<serde_json::Value> {
     if let Some(path) = &a.joints_out {
         let mut out = String::new();
         for s in &solutions {
-            let q: Vec<String> = s.q.iter().map(|v| v.to_string()).collect();
-            out.push_str(&format!("{},{}\n", u8::from(s.converged), q.join(",")));
+            let mut row = vec![Cell::int(u8::from(s.converged))];
+            row.extend(s.q.iter().map(|v| Cell::num(*v)));
+            push_row(&mut out, &row);
         }
         std::fs::write(path, out).with_context(|| format!("cannot write {path}"))?;
     }

@@ -17,7 +17,8 @@
 use super::model_files::load_compensated;
 use super::solve::OutputFormat;
 use crate::calibrate::compensate::CalibratedModelFile;
-use crate::measure::csv_text::{dialect_from_names, safe_cell};
+use crate::measure::csv_text::dialect_from_names;
+use crate::measure::csv_write::{push_header, push_row, Cell as CsvCell};
 use crate::model::orientation::OrientationConvention;
 use crate::solve::cell::accuracy::{
     measurement_tool_accuracy, tool_accuracy, ToolAccuracy, ValidationEvidence,
@@ -195,13 +196,23 @@ struct Header<'a> {
 }
 
 /// `status, mean, max` of the accuracy as CSV fields.
-fn accuracy_fields(a: &ToolAccuracy) -> [String; 3] {
+fn accuracy_fields(a: &ToolAccuracy) -> [CsvCell; 3] {
     match a {
         ToolAccuracy::Measured {
             mean_mm, max_mm, ..
-        } => ["measured".into(), mean_mm.to_string(), max_mm.to_string()],
-        ToolAccuracy::Unverified { .. } => ["unverified".into(), String::new(), String::new()],
-        ToolAccuracy::Unknown { .. } => ["unknown".into(), String::new(), String::new()],
+        } => [
+            CsvCell::text("measured"),
+            CsvCell::num(*mean_mm),
+            CsvCell::num(*max_mm),
+        ],
+        ToolAccuracy::Unverified { .. } => [
+            CsvCell::text("unverified"),
+            CsvCell::empty(),
+            CsvCell::empty(),
+        ],
+        ToolAccuracy::Unknown { .. } => {
+            [CsvCell::text("unknown"), CsvCell::empty(), CsvCell::empty()]
+        }
     }
 }
 
@@ -243,9 +254,10 @@ fn columns(h: &Header) -> Vec<String> {
     c
 }
 
-fn fields(h: &Header, r: &Row) -> Vec<String> {
-    let mut f = vec![r.id.clone()];
-    f.extend(r.joints_deg.iter().map(|v| v.to_string()));
+/// One row's cells: numbers as numbers, texts as texts.
+fn fields(h: &Header, r: &Row) -> Vec<CsvCell> {
+    let mut f = vec![CsvCell::text(&r.id)];
+    f.extend(r.joints_deg.iter().map(|v| CsvCell::num(*v)));
     let n_ori = h.conv.map_or(0, |c| c.n_values());
     match &r.result {
         Ok(p) => {
@@ -254,47 +266,48 @@ fn fields(h: &Header, r: &Row) -> Vec<String> {
                 o.xyz_mm
                     .iter()
                     .chain(&o.rxyz_deg)
-                    .map(|v| format!("{v:.6}")),
+                    .map(|v| CsvCell::fixed(*v, 6)),
             );
             if let Some((_, v)) = &o.orientation {
-                f.extend(v.iter().map(|v| format!("{v:.9}")));
+                f.extend(v.iter().map(|v| CsvCell::fixed(*v, 9)));
             }
             let c = p.compensation.as_ref();
-            f.push(
+            f.push(CsvCell::text(
                 p.outside_limits
                     .iter()
                     .map(|j| format!("J{j}"))
                     .collect::<Vec<_>>()
                     .join(" "),
-            );
-            f.push(c.map(|c| c.label().to_string()).unwrap_or_default());
-            f.push(c.and_then(|c| c.warning()).unwrap_or_default());
+            ));
+            f.push(CsvCell::text(c.map(|c| c.label()).unwrap_or_default()));
+            f.push(CsvCell::text(
+                c.and_then(|c| c.warning()).unwrap_or_default(),
+            ));
             f.push(
                 c.and_then(|c| c.expected_error_mm)
-                    .map(|v| v.to_string())
-                    .unwrap_or_default(),
+                    .map_or_else(CsvCell::empty, CsvCell::num),
             );
-            f.push(String::new());
+            f.push(CsvCell::empty());
         }
         Err(e) => {
-            f.extend((0..6 + n_ori + 4).map(|_| String::new()));
-            f.push(e.clone());
+            f.extend((0..6 + n_ori + 4).map(|_| CsvCell::empty()));
+            f.push(CsvCell::text(e));
         }
     }
     f
 }
 
+/// The CSV: numbers as numbers, every text as `csv_write` writes it.
 fn render_csv(h: &Header, rows: &[Row]) -> String {
     let mut cols = columns(h);
     cols.extend(["tool_accuracy", "tool_error_mean_mm", "tool_error_max_mm"].map(String::from));
     let acc = accuracy_fields(&h.accuracy);
-    let mut out = cols.join(",") + "\n";
+    let mut out = String::new();
+    push_header(&mut out, &cols);
     for r in rows {
         let mut f = fields(h, r);
         f.extend(acc.iter().cloned());
-        let line: Vec<String> = f.iter().map(|v| safe_cell(v).into_owned()).collect();
-        out.push_str(&line.join(","));
-        out.push('\n');
+        push_row(&mut out, &f);
     }
     out
 }
@@ -318,8 +331,11 @@ fn render_table(h: &Header, rows: &[Row]) -> String {
     let mut table = vec![columns(h)];
     table.extend(rows.iter().map(|r| {
         fields(h, r)
-            .into_iter()
-            .map(|v| if v.is_empty() { "-".into() } else { v })
+            .iter()
+            .map(|c| match c.shown() {
+                "" => "-".to_string(),
+                v => v.to_string(),
+            })
             .collect()
     }));
     let widths: Vec<usize> = (0..table[0].len())

@@ -22,6 +22,7 @@
 //!   readings in degrees.
 //! - The payload column is always written (default: the truth's payload mass).
 
+use crate::measure::csv_write::comment_line;
 use crate::measure::{csv, SetRole};
 use crate::model::kinematics::fk;
 use crate::model::RobotModel;
@@ -295,11 +296,13 @@ pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
     let max = errs.iter().fold(0.0_f64, |m, e| m.max(*e));
 
     let t = a.tracker.as_deref().unwrap_or("0,0,0,0,0,0");
-    let mut text = format!(
-        "# robocal simulate: nominal {}, truth {}, {} poses, noise {} mm, seed {}, payload {} kg\n\
-         # positions in mm in the tracker frame (base pose in tracker rx,ry,rz,x,y,z = {}); joints are controller readings in deg\n",
-        nominal.name, truth_label, a.poses, a.noise_mm, a.seed, payload, t
-    );
+    let mut text = comment_line(&format!(
+        "robocal simulate: nominal {}, truth {}, {} poses, noise {} mm, seed {}, payload {} kg",
+        nominal.name, truth_label, a.poses, a.noise_mm, a.seed, payload
+    ));
+    text.push_str(&comment_line(&format!(
+        "positions in mm in the tracker frame (base pose in tracker rx,ry,rz,x,y,z = {t}); joints are controller readings in deg"
+    )));
     text.push_str(&csv::write(&rows));
     if a.out == "-" {
         print!("{text}");

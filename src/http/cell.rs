@@ -162,15 +162,16 @@ pub(crate) fn checked(
         Some(v) => three(v, "rpy_deg", &name)?,
         None => [0.0; 3],
     };
-    if xyz_mm.iter().any(|v| v.abs() > CELL_XYZ_MAX_MM) {
-        return Err(ApiError::invalid(format!(
-            "`{name}`: `xyz_mm` values must be within ±{CELL_XYZ_MAX_MM} mm"
-        )));
-    }
-    if rpy_deg.iter().any(|v| v.abs() > CELL_ANGLE_MAX_DEG) {
-        return Err(ApiError::invalid(format!(
-            "`{name}`: `rpy_deg` values must be within ±{CELL_ANGLE_MAX_DEG}°"
-        )));
+    for (field, values, max, unit) in [
+        ("xyz_mm", xyz_mm, CELL_XYZ_MAX_MM, "mm"),
+        ("rpy_deg", rpy_deg, CELL_ANGLE_MAX_DEG, "deg"),
+    ] {
+        if let Some((i, v)) = values.iter().enumerate().find(|(_, v)| v.abs() > max) {
+            return Err(ApiError::invalid(format!(
+                "`{name}`: `{field}[{i}]` = {} {unit} is outside the bound [-{max}, {max}] {unit}",
+                crate::model::bounds::show(*v)
+            )));
+        }
     }
     let frame = match (kind, item.frame.as_deref()) {
         (CellKind::Tool, None) => ItemFrame::Flange,

@@ -9,6 +9,7 @@
 use super::input::{id, ids, page_body, present_id, PageQuery};
 use super::robots::robot_list_page;
 use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState};
+use crate::measure::bounds;
 use crate::service;
 use crate::service::checks::CheckCommand;
 use crate::service::checks::CheckRow;
@@ -71,13 +72,15 @@ pub async fn create(
     ApiPath(robot_id): ApiPath<i64>,
     ApiJson(req): ApiJson<CheckRequest>,
 ) -> Result<Response, ApiError> {
-    if req
+    if let Some(t) = req
         .temperature_c
-        .is_some_and(|t| !(-100.0..=200.0).contains(&t))
+        .filter(|t| !bounds::within(*t, &bounds::TEMPERATURE_C))
     {
-        return Err(ApiError::BadRequest(
-            "`temperature_c` must be between -100 and 200 °C".into(),
-        ));
+        return Err(ApiError::invalid(format!(
+            "`temperature_c` = {} °C is outside the bound {}",
+            crate::model::bounds::show(t),
+            bounds::describe(&bounds::TEMPERATURE_C)
+        )));
     }
     let row = service::checks::create(
         &state,

@@ -84,8 +84,17 @@ pub struct RobotCheck {
 }
 
 impl Robot {
-    pub fn from_row(r: RobotRow, with_model: bool) -> Robot {
-        Robot {
+    /// The robot as the API shows it; with its model, a stored model that
+    /// does not read back is a 500 naming the robot (never left out).
+    pub fn from_row(r: RobotRow, with_model: bool) -> Result<Robot, ApiError> {
+        let model = if with_model {
+            Some(serde_json::from_str(&r.model_json).map_err(|e| {
+                ApiError::Internal(format!("the stored model of robot {}: {e}", r.id))
+            })?)
+        } else {
+            None
+        };
+        Ok(Robot {
             id: r.id,
             name: r.name,
             preset: r.preset,
@@ -94,11 +103,9 @@ impl Robot {
             active_version: r.active_version,
             created_at: r.created_at,
             updated_at: r.updated_at,
-            model: with_model
-                .then(|| serde_json::from_str(&r.model_json).ok())
-                .flatten(),
+            model,
             check: None,
-        }
+        })
     }
 }
 
@@ -203,7 +210,7 @@ pub async fn create(
     Ok(super::located(
         StatusCode::CREATED,
         location,
-        Robot::from_row(row, true),
+        Robot::from_row(row, true)?,
     ))
 }
 
@@ -214,11 +221,11 @@ pub async fn list(
     let page = page.check(state.limits().page_max)?;
     let listing = service::robots::page(&state, page.limit, page.offset).await?;
     let total = listing.total;
-    let robots: Vec<Robot> = listing
+    let robots = listing
         .rows
         .into_iter()
         .map(|r| Robot::from_row(r, false))
-        .collect();
+        .collect::<Result<Vec<Robot>, ApiError>>()?;
     Ok(axum::Json(page_body(page, total, "robots", robots)?).into_response())
 }
 
@@ -228,7 +235,7 @@ pub async fn get_one(
 ) -> Result<Response, ApiError> {
     let row = service::robots::get(&state, id).await?;
     let (status, latest, _) = service::checks::status(&state, id).await?;
-    let mut robot = Robot::from_row(row, true);
+    let mut robot = Robot::from_row(row, true)?;
     robot.check = Some(RobotCheck {
         status: status.map(|s| s.name()),
         check_id: latest.as_ref().map(|c| c.id),
@@ -259,7 +266,7 @@ pub async fn update(
         ));
     }
     let row = service::robots::update(&state, id, body.name.as_deref(), metadata).await?;
-    Ok(axum::Json(Robot::from_row(row, true)).into_response())
+    Ok(axum::Json(Robot::from_row(row, true)?).into_response())
 }
 
 pub async fn delete(

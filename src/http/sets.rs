@@ -12,9 +12,11 @@ use super::input::{
 };
 use super::robots::robot_list_page;
 use super::{ApiError, ApiPath, ApiQuery, AppState};
+use crate::measure::bounds;
 use crate::measure::convention::MeasuredOrientation;
 use crate::measure::csv::{self, DifSign, ReadOptions};
 use crate::measure::{MeasuredPose, SetRole};
+use crate::model::bounds::{show, Bound};
 use crate::service::sets::{AngleUnit, LengthUnit, SetFormat, SetRow};
 use crate::service::{
     self,
@@ -217,27 +219,77 @@ fn check_params(p: &SetParams) -> Result<Checked, ApiError> {
     })
 }
 
-/// The JSON rows' bounds in their declared units: the measurement CSV's
-/// (`|q| ≤ 720°`, positions within ±100 m, not every coordinate within ±5 mm)
-/// converted into the units, so that `openapi.yaml` states them exactly.
-struct RowBounds {
-    joint: f64,
-    position: f64,
+/// The JSON rows' bounds in their declared units: the stored bounds
+/// (`measure::bounds`: `|q| ≤ 720°`, positions within ±100 m, orientation
+/// angles within ±360°, σ of a position 1e-6..1000 mm and of an angle
+/// 1e-6..180°, temperatures −100..200 °C) converted into the units, so that
+/// `openapi.yaml` states them exactly; not every coordinate within ±5 mm.
+/// Converting a value within a declared bound gives a value within the
+/// stored bound (`declared_bounds_convert_into_the_stored_ones`), which the
+/// service checks again on the rows as stored.
+pub(crate) struct RowBounds {
+    pub(crate) joint: Bound,
+    pub(crate) position: Bound,
+    pub(crate) angle: Bound,
+    pub(crate) std_position: Bound,
+    pub(crate) std_angle: Bound,
     metres_suspect: f64,
 }
 
 impl RowBounds {
-    fn of(c: &Checked) -> RowBounds {
-        let (length, angle) = (c.length == Length::M, c.angle == Angle::Rad);
-        let mm = |v: f64| if length { v / 1e3 } else { v };
-        RowBounds {
-            joint: if angle {
-                csv::MAX_JOINT_DEG.to_radians()
-            } else {
-                csv::MAX_JOINT_DEG
+    pub(crate) fn of(length: Length, angle: Angle) -> RowBounds {
+        let (lu, au) = (length.as_str(), angle.as_str());
+        let len = |b: Bound| match length {
+            Length::Mm => b,
+            Length::M => Bound {
+                min: b.min / 1e3,
+                max: b.max / 1e3,
+                unit: lu,
             },
-            position: mm(csv::MAX_POSITION_MM),
-            metres_suspect: mm(csv::METRES_SUSPECT_MM),
+        };
+        let ang = |b: Bound| match angle {
+            Angle::Deg => b,
+            Angle::Rad => Bound {
+                min: b.min.to_radians(),
+                max: b.max.to_radians(),
+                unit: au,
+            },
+        };
+        RowBounds {
+            joint: ang(bounds::JOINT_DEG),
+            position: len(bounds::POSITION_MM),
+            angle: ang(bounds::ANGLE_DEG),
+            std_position: len(bounds::STD_MM),
+            std_angle: ang(bounds::STD_DEG),
+            metres_suspect: match length {
+                Length::Mm => csv::METRES_SUSPECT_MM,
+                Length::M => csv::METRES_SUSPECT_MM / 1e3,
+            },
+        }
+    }
+}
+
+/// Each of `values` within `b` (declared units), else a 422 naming the row,
+/// the field, the value and the bound.
+fn check_field(n: usize, field: &str, values: &[f64], b: &Bound) -> Result<(), ApiError> {
+    match values
+        .iter()
+        .enumerate()
+        .find(|(_, v)| !bounds::within(**v, b))
+    {
+        None => Ok(()),
+        Some((i, v)) => {
+            let at = if values.len() == 1 {
+                format!("`{field}`")
+            } else {
+                format!("`{field}[{i}]`")
+            };
+            Err(ApiError::invalid(format!(
+                "row {n}: {at} = {} {} is outside the bound {}",
+                show(*v),
+                b.unit,
+                bounds::describe(b)
+            )))
         }
     }
 }
@@ -248,7 +300,7 @@ fn json_rows(rows: Vec<RowInput>, c: &Checked) -> Result<Vec<MeasuredPose>, ApiE
             "`rows` is empty: upload at least one measured pose",
         ));
     }
-    let b = RowBounds::of(c);
+    let b = RowBounds::of(c.length, c.angle);
     let (lu, au) = (c.length.as_str(), c.angle.as_str());
     for (i, r) in rows.iter().enumerate() {
         let n = i + 1;
@@ -259,28 +311,37 @@ fn json_rows(rows: Vec<RowInput>, c: &Checked) -> Result<Vec<MeasuredPose>, ApiE
         if r.xyz.iter().any(|v| !v.is_finite()) {
             return Err(bad("position `xyz`"));
         }
-        if r.rpy.is_some_and(|a| a.iter().any(|v| !v.is_finite())) {
-            return Err(bad("orientation `rpy`"));
-        }
         check_std(n, r, rows[0].std_mm.is_some())?;
         if let Some(p) = r.payload_kg {
             check_payload(&format!("row {n}: `payload_kg`"), p)?;
         }
-        if r.temperature_c.is_some_and(|t| !t.is_finite()) {
-            return Err(bad("`temperature_c`"));
-        }
-        if let Some(q) = r.q.iter().find(|q| q.abs() > b.joint) {
+        if let Some(q) = r.q.iter().find(|q| q.abs() > b.joint.max) {
             return Err(ApiError::invalid(format!(
                 "row {n}: joint value {q:.4e} {au} is beyond ±{} {au} (±{} deg): wrong units (encoder counts, or radians declared as degrees)?",
-                b.joint,
+                b.joint.max,
                 csv::MAX_JOINT_DEG
             )));
         }
-        if let Some(x) = r.xyz.iter().find(|x| x.abs() > b.position) {
+        if let Some(x) = r.xyz.iter().find(|x| x.abs() > b.position.max) {
             return Err(ApiError::invalid(format!(
                 "row {n}: position coordinate {x:.4e} {lu} is beyond ±{} m of the tracker",
                 csv::MAX_POSITION_MM / 1e3
             )));
+        }
+        let optional = [
+            ("rpy", r.rpy.as_ref().map(|v| &v[..]), &b.angle),
+            ("std_mm", r.std_mm.as_ref().map(|v| &v[..]), &b.std_position),
+            ("std_deg", r.std_deg.as_ref().map(|v| &v[..]), &b.std_angle),
+            (
+                "temperature_c",
+                r.temperature_c.as_ref().map(std::slice::from_ref),
+                &bounds::TEMPERATURE_C,
+            ),
+        ];
+        for (field, values, bound) in optional {
+            if let Some(values) = values {
+                check_field(n, field, values, bound)?;
+            }
         }
     }
     if rows
@@ -496,4 +557,53 @@ pub fn routes() -> Vec<super::Route> {
         super::delete(SET, delete),
         get("/v1/robots/{id}/measurement-sets/{sid}/original", original),
     ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A value within a declared bound converts (as `json_rows` converts it)
+    /// into a value within the stored bound, at both ends and in every unit,
+    /// so the service's check on the stored rows never refuses what the
+    /// handler and `openapi.yaml` accept; and the declared bounds are the
+    /// numbers the spec states.
+    #[test]
+    fn declared_bounds_convert_into_the_stored_ones() {
+        for length in [Length::Mm, Length::M] {
+            for angle in [Angle::Deg, Angle::Rad] {
+                let b = RowBounds::of(length, angle);
+                let len = |v: f64| if length == Length::M { v * 1e3 } else { v };
+                let ang = |v: f64| {
+                    if angle == Angle::Rad {
+                        v.to_degrees()
+                    } else {
+                        v
+                    }
+                };
+                for (declared, stored, convert) in [
+                    (b.joint, bounds::JOINT_DEG, &ang as &dyn Fn(f64) -> f64),
+                    (b.position, bounds::POSITION_MM, &len),
+                    (b.angle, bounds::ANGLE_DEG, &ang),
+                    (b.std_position, bounds::STD_MM, &len),
+                    (b.std_angle, bounds::STD_DEG, &ang),
+                ] {
+                    for v in [declared.min, declared.max] {
+                        assert!(
+                            bounds::within(convert(v), &stored),
+                            "{v} {} → {} {}",
+                            declared.unit,
+                            convert(v),
+                            stored.unit
+                        );
+                    }
+                }
+            }
+        }
+        let si = RowBounds::of(Length::M, Angle::Rad);
+        assert_eq!((si.std_position.min, si.std_position.max), (1e-8, 1.0));
+        assert_eq!(si.std_angle.max, std::f64::consts::PI);
+        assert_eq!(si.angle.max, std::f64::consts::TAU);
+        assert_eq!(si.joint.max, 12.566370614359172);
+    }
 }

@@ -10,7 +10,7 @@
 use super::{AppState, ServiceError};
 pub use crate::db::{AngleUnit, LengthUnit, SetFormat, SetRow};
 use crate::db::{Listing, NewSet};
-use crate::measure::csv::{self, CsvError, ReadOptions, MAX_PAYLOAD_KG};
+use crate::measure::csv::{self, CsvError, ReadOptions};
 use crate::measure::{MeasuredPose, SetRole};
 
 /// What the upload carries.
@@ -71,9 +71,11 @@ fn read_csv(
     Ok(rows)
 }
 
-/// The checks that need the robot and the service's limits (the rows' own
-/// bounds are the reader's: the CSV parser's or the JSON handler's). Rows
-/// whose joint count is not the robot's conflict with the robot.
+/// The checks that need the robot and the service's limits, and every
+/// row's bounds as it will be stored (`MeasuredPose::check_bounds`, after any
+/// unit conversion: the readers check them first, naming line or row; this
+/// is what keeps a record that could not be read back out of the store).
+/// Rows whose joint count is not the robot's conflict with the robot.
 fn check_rows(rows: &[MeasuredPose], dof: usize, max_rows: usize) -> Result<(), ServiceError> {
     if rows.len() > max_rows {
         return Err(ServiceError::Invalid(format!(
@@ -85,14 +87,9 @@ fn check_rows(rows: &[MeasuredPose], dof: usize, max_rows: usize) -> Result<(), 
         ServiceError::Conflict(format!("{e} (the robot has {dof} joints: send q1..q{dof})"))
     })?;
     for (i, r) in rows.iter().enumerate() {
-        if let Some(p) = r.payload_kg {
-            if !(p.is_finite() && (0.0..=MAX_PAYLOAD_KG).contains(&p)) {
-                return Err(ServiceError::Invalid(format!(
-                    "row {}: `payload_kg` must be between 0 and {MAX_PAYLOAD_KG} kg, got {p}",
-                    i + 1
-                )));
-            }
-        }
+        r.check_bounds().map_err(|e| {
+            ServiceError::Invalid(format!("row {}: {e} (as stored, in mm and degrees)", i + 1))
+        })?;
     }
     Ok(())
 }

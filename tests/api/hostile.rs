@@ -108,7 +108,9 @@ async fn names_with_control_characters_are_refused() {
     assert_eq!(r.status, StatusCode::CREATED, "a formula-like name is text");
 }
 
-/// Target ids a spreadsheet would run come back as text in a CSV answer.
+/// Target ids a spreadsheet would run come back as text in a CSV answer; an
+/// id that is a plain number and every numeric column stay numbers (a
+/// negative coordinate is `-…`, not text).
 #[tokio::test]
 async fn formula_cells_in_a_solve_csv_answer_are_neutralised() {
     let t = setup().await;
@@ -133,8 +135,35 @@ async fn formula_cells_in_a_solve_csv_answer_are_neutralised() {
         .collect();
     assert_eq!(
         ids,
-        ["'=cmd|' /C calc'!A0", "'+SUM(1;2)", "'@x", "'-2", "plain"],
+        ["'=cmd|' /C calc'!A0", "'+SUM(1;2)", "'@x", "-2", "plain"],
         "{answer}"
+    );
+    // The answer read as CSV: ids back as sent, numbers as numbers.
+    let table = robocal::measure::csv_text::read(&answer, Default::default())
+        .unwrap()
+        .unwrap();
+    let col = |name: &str| table.header.iter().position(|h| h == name).unwrap();
+    let sent = ["=cmd|' /C calc'!A0", "+SUM(1;2)", "@x", "-2", "plain"];
+    let status = col("status");
+    assert_eq!(table.records.len(), sent.len());
+    for (r, id) in table.records.iter().zip(sent) {
+        assert_eq!(robocal::measure::csv_write::read_text(&r.fields[0]), id);
+        assert_eq!(r.fields[status], "ok", "{answer}");
+        for name in [
+            "j1_deg",
+            "false_x_mm",
+            "false_y_mm",
+            "false_z_mm",
+            "position_residual_mm",
+        ] {
+            let v = &r.fields[col(name)];
+            assert!(table.number(v).is_some(), "{name} `{v}` in {answer}");
+        }
+    }
+    let y = col("false_y_mm");
+    assert!(
+        table.records.iter().any(|r| r.fields[y].starts_with('-')),
+        "a negative false y: {answer}"
     );
 }
 

@@ -491,4 +491,44 @@ async fn iso9283_csv_figures_are_the_standards_and_the_clis() {
         why.contains("`broken`") && why.contains("measured_csv") && why.contains("z_mm"),
         "{why}"
     );
+    // One attained position with a decimal comma in the comma-separated
+    // cycles (read shifted, it was answered 200 with AP 194 mm), and a plan
+    // row one field short: 422 naming the file, the line and the column.
+    let mut lines: Vec<String> = cycles.lines().map(str::to_string).collect();
+    let row = lines.iter().position(|l| l.starts_with("P1,2,")).unwrap();
+    let fields: Vec<String> = lines[row].split(',').map(str::to_string).collect();
+    let x: f64 = fields[2].parse().unwrap();
+    lines[row] = format!(
+        "P1,2,{},{},{}",
+        format!("{x:.2}").replace('.', ","),
+        fields[3],
+        fields[4]
+    );
+    let comma = lines.join("\n") + "\n";
+    let short: String = plan
+        .lines()
+        .enumerate()
+        .map(|(i, l)| if i == 2 { l.rsplit_once(',').unwrap().0.to_string() } else { l.to_string() } + "\n")
+        .collect();
+    for (plan, measured, file, want) in [
+        (
+            plan.clone(),
+            comma,
+            "measured_csv",
+            format!("line {}: 6 fields, the header has 5: field 6", row + 1),
+        ),
+        (short, cycles.clone(), "plan_csv", "line 3: ".to_string()),
+    ] {
+        let r = t
+            .post_json(
+                "/v1/iso9283/csv",
+                &[],
+                json!({ "tests": [{ "label": "qa", "plan_csv": plan, "measured_csv": measured }] }),
+            )
+            .await;
+        assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+        let why = r.detail();
+        assert!(why.contains(file) && why.contains(&want), "{why}");
+        assert!(why.contains("column"), "{why}");
+    }
 }

@@ -44,5 +44,6 @@ mod sets;
 mod slow_clients;
 mod solve;
 mod spec;
+mod stored;
 mod stored_jobs;
 mod support;

@@ -379,3 +379,98 @@ async fn declared_orientation_conventions_and_std_columns_upload() {
     assert_eq!(r.status, StatusCode::CREATED, "{}", r.text());
     assert_eq!(rows_of(&r.json()).await, a);
 }
+
+/// The set: `length_unit: m` with standard deviations of 1e306 m
+/// (1e309 mm, infinite once converted) was stored with a 201 and every GET
+/// of it was then a 500. Bounds apply to the values as stored, in every
+/// upload form: 422 naming the field (row or line and column), the value and
+/// the bound, and nothing stored.
+#[tokio::test]
+async fn values_beyond_their_bound_once_converted_are_refused() {
+    let t = setup().await;
+    let robot = t.create_robot("ys100").await;
+    let rid = robot.to_string();
+    let rows = simulated_rows(8, 3, None);
+    let row = |r: &MeasuredPose, std: [f64; 3]| json!({ "q": r.q_deg, "xyz": r.xyz_mm.map(|v| v / 1e3), "std_mm": std });
+    let huge: Vec<Value> = rows.iter().map(|r| row(r, [1e306, 1e306, 1e306])).collect();
+    let r = t
+        .post_json(
+            "/v1/robots/{id}/measurement-sets",
+            &[&rid],
+            json!({ "length_unit": "m", "rows": huge }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+    assert_eq!(
+        r.detail(),
+        "row 1: `std_mm[0]` = 1e306 m is outside the bound [1e-8, 1] m"
+    );
+    // 2 m is 2000 mm: beyond the bound although 2 is a small number.
+    let two: Vec<Value> = rows
+        .iter()
+        .map(|r| row(r, [0.00002, 2.0, 0.00002]))
+        .collect();
+    let r = t
+        .post_json(
+            "/v1/robots/{id}/measurement-sets",
+            &[&rid],
+            json!({ "length_unit": "m", "rows": two }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+    assert!(r.detail().contains("`std_mm[1]` = 2 m"), "{}", r.detail());
+    // Temperatures and orientation angles have bounds too.
+    for (field, value, want) in [
+        (
+            "temperature_c",
+            json!(1e300),
+            "`temperature_c` = 1e300 °C is outside the bound [-100, 200] °C",
+        ),
+        (
+            "rpy",
+            json!([0, 720, 0]),
+            "`rpy[1]` = 720 deg is outside the bound [-360, 360] deg",
+        ),
+    ] {
+        let mut body = json!({ "q": rows[0].q_deg, "xyz": rows[0].xyz_mm });
+        body[field] = value;
+        let r = t
+            .post_json(
+                "/v1/robots/{id}/measurement-sets",
+                &[&rid],
+                json!({ "rows": [body] }),
+            )
+            .await;
+        assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+        assert_eq!(r.detail(), format!("row 1: {want}"));
+    }
+    // The same set as a CSV in metres: the line and the column.
+    let mut text = String::from("q1,q2,q3,q4,q5,q6,x,y,z,std_x,std_y,std_z\n");
+    for r in &rows {
+        let q: Vec<String> = r.q_deg.iter().map(f64::to_string).collect();
+        let x: Vec<String> = r.xyz_mm.iter().map(|v| (v / 1e3).to_string()).collect();
+        text.push_str(&format!(
+            "{},{},1e306,1e306,1e306\n",
+            q.join(","),
+            x.join(",")
+        ));
+    }
+    let r = t
+        .send(
+            "POST",
+            "/v1/robots/{id}/measurement-sets",
+            &[&rid],
+            "?length_unit=m",
+            Some("text/csv"),
+            text.into_bytes(),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+    assert_eq!(
+        r.detail(),
+        "measurement CSV: line 2, column `std_x`: inf mm is outside [1e-5, 1000] mm"
+    );
+    // Nothing was stored; every set the robot has reads back.
+    let r = t.get("/v1/robots/{id}/measurement-sets", &[&rid]).await;
+    assert_eq!(r.json()["total"], 0, "{}", r.text());
+}

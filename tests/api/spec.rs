@@ -312,6 +312,60 @@ async fn json_uploads_take_set_options_from_the_query_and_check_rows_in_their_un
             json!({"rows": [{"q": q6(0.0), "xyz": [4.999, 0, 0]}, {"q": q6(0.0), "xyz": [0, -5, 0]}]}),
             StatusCode::CREATED,
         ),
+        // Standard deviations, orientation angles and temperatures: at the
+        // bound and one step beyond, in each unit.
+        (
+            json!({"length_unit": "m", "rows": [{"q": q6(0.0), "xyz": [1.5, 0, 1], "std_mm": [1e-8, 1, 0.5]}]}),
+            StatusCode::CREATED,
+        ),
+        (
+            json!({"length_unit": "m", "rows": [{"q": q6(0.0), "xyz": [1.5, 0, 1], "std_mm": [1e-8_f64.next_down(), 1, 0.5]}]}),
+            StatusCode::UNPROCESSABLE_ENTITY,
+        ),
+        (
+            json!({"length_unit": "m", "rows": [{"q": q6(0.0), "xyz": [1.5, 0, 1], "std_mm": [1e-3, 1_f64.next_up(), 0.5]}]}),
+            StatusCode::UNPROCESSABLE_ENTITY,
+        ),
+        (
+            json!({"length_unit": "m", "rows": [{"q": q6(0.0), "xyz": [1.5, 0, 1], "std_mm": [1e306, 1, 1]}]}),
+            StatusCode::UNPROCESSABLE_ENTITY,
+        ),
+        (
+            json!({"rows": [{"q": q6(0.0), "xyz": [1500, 0, 1000], "std_mm": [0.00001, 1000, 1]}]}),
+            StatusCode::CREATED,
+        ),
+        (
+            json!({"rows": [{"q": q6(0.0), "xyz": [1500, 0, 1000], "std_mm": [0.00001, 1000_f64.next_up(), 1]}]}),
+            StatusCode::UNPROCESSABLE_ENTITY,
+        ),
+        (
+            json!({"angle_unit": "rad", "rows": [{"q": q6(0.0), "xyz": [1500, 0, 1000], "rpy": [std::f64::consts::TAU, 0, -std::f64::consts::TAU], "std_mm": [1, 1, 1], "std_deg": [std::f64::consts::PI, 1.7453292519943295e-8, 0.1]}]}),
+            StatusCode::CREATED,
+        ),
+        (
+            json!({"angle_unit": "rad", "rows": [{"q": q6(0.0), "xyz": [1500, 0, 1000], "rpy": [std::f64::consts::TAU.next_up(), 0, 0]}]}),
+            StatusCode::UNPROCESSABLE_ENTITY,
+        ),
+        (
+            json!({"angle_unit": "rad", "rows": [{"q": q6(0.0), "xyz": [1500, 0, 1000], "rpy": [0, 0, 0], "std_mm": [1, 1, 1], "std_deg": [std::f64::consts::PI.next_up(), 0.1, 0.1]}]}),
+            StatusCode::UNPROCESSABLE_ENTITY,
+        ),
+        (
+            json!({"rows": [{"q": q6(0.0), "xyz": [1500, 0, 1000], "rpy": [360, -360, 0], "std_mm": [1, 1, 1], "std_deg": [180, 0.000001, 1]}]}),
+            StatusCode::CREATED,
+        ),
+        (
+            json!({"rows": [{"q": q6(0.0), "xyz": [1500, 0, 1000], "rpy": [0, 0, 0], "std_mm": [1, 1, 1], "std_deg": [1, 0.000001_f64.next_down(), 1]}]}),
+            StatusCode::UNPROCESSABLE_ENTITY,
+        ),
+        (
+            json!({"rows": [{"q": q6(0.0), "xyz": [1500, 0, 1000], "temperature_c": -100}, {"q": q6(0.0), "xyz": [1500, 0, 1000], "temperature_c": 200}]}),
+            StatusCode::CREATED,
+        ),
+        (
+            json!({"rows": [{"q": q6(0.0), "xyz": [1500, 0, 1000], "temperature_c": 200_f64.next_up()}]}),
+            StatusCode::UNPROCESSABLE_ENTITY,
+        ),
         // Rows read back from a set upload again under their names.
         (
             json!({"rows": [{"q_deg": q6(1.0), "xyz_mm": [1500, 0, 1000], "rpy_deg": null}]}),

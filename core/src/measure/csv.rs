@@ -25,30 +25,33 @@
 //! radians. The header is read in `csv/header.rs`, each row in `csv/row.rs`;
 //! the tests are in `csv/tests.rs`.
 
+use super::bounds;
 use super::convention::MeasuredOrientation;
 #[cfg(test)]
 use super::RowStd;
 use super::{MeasuredPose, SetRole};
 use crate::measure::csv_text::{self, short_text, Dialect, TextError};
+use crate::measure::csv_write::{push_header, push_row, Cell};
 use header::parse_header;
 
 mod header;
 mod row;
-use std::fmt::Write as _;
 
 /// Maximum joint count of a CSV row.
 pub const MAX_JOINTS: usize = 7;
 /// Minimum joint count of a CSV row.
 pub const MIN_JOINTS: usize = 2;
-/// A joint reading beyond this magnitude [deg] is rejected as wrong units.
-pub const MAX_JOINT_DEG: f64 = 720.0;
+/// A joint reading beyond this magnitude [deg] is rejected as wrong units
+/// (`bounds::JOINT_DEG`).
+pub const MAX_JOINT_DEG: f64 = bounds::JOINT_DEG.max;
 /// If every position coordinate of the file is below this magnitude [mm], the
 /// file is rejected as metres.
 pub const METRES_SUSPECT_MM: f64 = 5.0;
-/// Largest accepted magnitude of a position coordinate [mm] (100 m).
-pub const MAX_POSITION_MM: f64 = 100_000.0;
-/// Largest accepted payload [kg].
-pub const MAX_PAYLOAD_KG: f64 = 10_000.0;
+/// Largest accepted magnitude of a position coordinate [mm] (100 m,
+/// `bounds::POSITION_MM`).
+pub const MAX_POSITION_MM: f64 = bounds::POSITION_MM.max;
+/// Largest accepted payload [kg] (`bounds::PAYLOAD_KG`).
+pub const MAX_PAYLOAD_KG: f64 = bounds::PAYLOAD_KG.max;
 
 /// A number for a message: plain when moderate, scientific otherwise (never
 /// hundreds of digits).
@@ -122,12 +125,9 @@ pub enum CsvError {
         min: usize,
         max: usize,
     },
-    #[error("line {line}: expected {expected} fields, got {got}")]
-    FieldCount {
-        line: usize,
-        expected: usize,
-        got: usize,
-    },
+    /// A row whose field count is not the header's.
+    #[error(transparent)]
+    FieldCount(#[from] csv_text::FieldCount),
     #[error(
         "line {line}, column `{column}`: `{}` is not a number",
         short_text(value)
@@ -170,13 +170,15 @@ pub enum CsvError {
         column: String,
         value: f64,
     },
-    #[error("line {line}, column `{column}`: {} {unit} is outside {range}", short_number(*value))]
+    /// A value (as stored: after unit conversion) beyond its bound
+    /// (`measure::bounds`).
+    #[error("line {line}, column `{column}`: {} {} is outside {}{hint}", short_number(*value), bound.unit, bounds::describe(bound))]
     OutOfRange {
         line: usize,
         column: String,
         value: f64,
-        unit: &'static str,
-        range: &'static str,
+        bound: crate::model::bounds::Bound,
+        hint: &'static str,
     },
     #[error("every position coordinate is within ±{limit} mm: looks like metres, expected millimetres", limit = METRES_SUSPECT_MM)]
     PositionUnits,
@@ -228,6 +230,7 @@ pub fn parse_opts(text: &str, opts: &ReadOptions) -> Result<Vec<MeasuredPose>, C
     header.decimal_comma = table.decimal_comma;
     let mut rows = Vec::with_capacity(table.records.len());
     for r in &table.records {
+        table.check_shape(r)?;
         let fields: Vec<&str> = r.fields.iter().map(String::as_str).collect();
         rows.push(header.row(r.line, &fields, opts.dif)?);
     }
@@ -257,23 +260,13 @@ pub fn check_joint_count(rows: &[MeasuredPose], dof: usize) -> Result<(), CsvErr
     }
 }
 
-/// Shortest text that parses back to exactly `x` (plain decimal, or exponent
-/// notation when the decimal would be long, e.g. `1e-17`).
-fn num(x: f64) -> String {
-    let s = x.to_string();
-    if s.len() > 24 {
-        format!("{x:e}")
-    } else {
-        s
-    }
-}
-
 /// Writes rows in the canonical layout
 /// `q1..qN,x,y,z[,rx,ry,rz][,std_x,std_y,std_z][,std_rx,std_ry,std_rz][,payload_kg][,temperature_c][,set][,session]`.
 ///
 /// N is the largest joint count among the rows (rows are expected to agree); an
 /// optional column is written when any row has it, rows without it get an empty
-/// field. Numbers use Rust's shortest exact representation, so
+/// field. Numbers use Rust's shortest exact representation and texts (the
+/// session) are written as `csv_write` writes every text, so
 /// `parse(&write(rows)) == rows` bit for bit (for rows that pass the unit checks).
 pub fn write(rows: &[MeasuredPose]) -> String {
     let n = rows.iter().map(|r| r.q_deg.len()).max().unwrap_or(0);
@@ -308,42 +301,35 @@ pub fn write(rows: &[MeasuredPose]) -> String {
     if session {
         header.push("session".into());
     }
-    let mut out = header.join(",");
-    out.push('\n');
-
-    let opt = |v: Option<f64>| v.map(num).unwrap_or_default();
+    let mut out = String::new();
+    push_header(&mut out, &header);
+    let blank3 = || [Cell::empty(), Cell::empty(), Cell::empty()];
+    let three = |v: Option<[f64; 3]>| v.map_or_else(blank3, |a| a.map(Cell::num));
+    let mut f: Vec<Cell> = Vec::with_capacity(header.len());
     for r in rows {
-        let mut f: Vec<String> = (0..n)
-            .map(|i| r.q_deg.get(i).copied().map(num).unwrap_or_default())
-            .collect();
-        f.extend(r.xyz_mm.iter().copied().map(num));
+        f.clear();
+        f.extend((0..n).map(|i| r.q_deg.get(i).copied().map_or_else(Cell::empty, Cell::num)));
+        f.extend(r.xyz_mm.map(Cell::num));
         if rot {
-            match r.rpy_deg {
-                Some(a) => f.extend(a.iter().copied().map(num)),
-                None => f.extend([String::new(), String::new(), String::new()]),
-            }
+            f.extend(three(r.rpy_deg));
         }
         for (on, v) in [(std_pos, r.std_mm), (std_rot, r.std_deg)] {
             if on {
-                match v {
-                    Some(a) => f.extend(a.iter().copied().map(num)),
-                    None => f.extend([String::new(), String::new(), String::new()]),
-                }
+                f.extend(three(v));
             }
         }
-        if payload {
-            f.push(opt(r.payload_kg));
-        }
-        if temp {
-            f.push(opt(r.temperature_c));
+        for (on, v) in [(payload, r.payload_kg), (temp, r.temperature_c)] {
+            if on {
+                f.push(v.map_or_else(Cell::empty, Cell::num));
+            }
         }
         if set {
-            f.push(r.set.map(|s| s.as_str().to_string()).unwrap_or_default());
+            f.push(Cell::text(r.set.map(|s| s.as_str()).unwrap_or_default()));
         }
         if session {
-            f.push(r.session.clone().unwrap_or_default());
+            f.push(Cell::text(r.session.as_deref().unwrap_or_default()));
         }
-        let _ = writeln!(out, "{}", f.join(","));
+        push_row(&mut out, &f);
     }
     out
 }

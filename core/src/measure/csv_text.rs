@@ -13,36 +13,11 @@
 //!   decimal comma in a `,`-separated text is read in quoted fields (`"1523,2"`);
 //! - every record keeps its 1-based line number for messages.
 //!
-//! Whether a record has as many fields as the header is for the caller to
-//! judge (it names the line and the counts).
+//! Whether a record has as many fields as the header is checked by
+//! [`Table::check_shape`], the one row-shape check of every reader (it names
+//! the line and the first column or field that does not fit).
 
 use std::borrow::Cow;
-
-/// A text cell of a CSV robocal writes, safe to open in a spreadsheet: a
-/// cell starting with `=`, `+`, `-`, `@`, a tab or a carriage return (which a
-/// spreadsheet would run as a formula) gets a leading `'`, which spreadsheets
-/// show as text and robocal's own readers keep as part of the text. Numbers
-/// robocal formats itself are not text cells and are written as they are.
-pub fn safe_cell(text: &str) -> Cow<'_, str> {
-    match text.chars().next() {
-        Some('=' | '+' | '-' | '@' | '\t' | '\r') => Cow::Owned(format!("'{text}")),
-        _ => Cow::Borrowed(text),
-    }
-}
-
-/// A text for a `#` comment line: every control character (a line break
-/// would end the comment and start a row) becomes a space.
-pub fn comment_text(text: &str) -> Cow<'_, str> {
-    if text.chars().any(char::is_control) {
-        Cow::Owned(
-            text.chars()
-                .map(|c| if c.is_control() { ' ' } else { c })
-                .collect(),
-        )
-    } else {
-        Cow::Borrowed(text)
-    }
-}
 
 /// The decimal separator of numeric fields.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -94,6 +69,63 @@ pub enum TextError {
     Malformed { line: usize, message: String },
 }
 
+/// Where a record's fields and its header's columns part (see [`FieldCount`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Misfit {
+    /// The record ends before column `column` (1-based `index`).
+    Missing { index: usize, column: String },
+    /// Field `index` (1-based) holds `value` beyond the last column `last`.
+    Extra {
+        index: usize,
+        value: String,
+        last: String,
+        /// The text is `,`-separated (where a decimal comma splits a number).
+        comma_delimited: bool,
+    },
+}
+
+impl std::fmt::Display for Misfit {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Misfit::Missing { index, column } => {
+                write!(f, "column {index} `{column}` has no field")
+            }
+            Misfit::Extra {
+                index,
+                value,
+                last,
+                comma_delimited,
+            } => {
+                write!(
+                    f,
+                    "field {index} `{}` is beyond the last column `{last}`",
+                    short_text(value)
+                )?;
+                if *comma_delimited {
+                    write!(
+                        f,
+                        "; a decimal comma splits a number in two in a comma-separated file \
+                         (write `8.85`, quote `\"8,85\"`, or separate the fields with `;`)"
+                    )?;
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+/// A record whose field count is not its header's: every column after the
+/// place where they part would be read shifted, so the record is refused,
+/// naming its line and the first column (or field) that does not fit.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("line {line}: {got} fields, the header has {expected}: {misfit}")]
+pub struct FieldCount {
+    pub line: usize,
+    pub got: usize,
+    pub expected: usize,
+    pub misfit: Misfit,
+}
+
 /// One record after the header.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Record {
@@ -115,6 +147,39 @@ pub struct Table {
 }
 
 impl Table {
+    /// The record's field count against the header's (the one row-shape
+    /// check of every reader).
+    pub fn check_shape(&self, r: &Record) -> Result<(), FieldCount> {
+        let (got, expected) = (r.fields.len(), self.header.len());
+        if got == expected {
+            return Ok(());
+        }
+        let misfit = if got < expected {
+            Misfit::Missing {
+                index: got + 1,
+                column: self.header[got].clone(),
+            }
+        } else {
+            Misfit::Extra {
+                index: expected + 1,
+                value: r.fields[expected].clone(),
+                last: self.header.last().cloned().unwrap_or_default(),
+                comma_delimited: self.delimiter == b',',
+            }
+        };
+        Err(FieldCount {
+            line: r.line,
+            got,
+            expected,
+            misfit,
+        })
+    }
+
+    /// [`Table::check_shape`] of every record, the first misfit.
+    pub fn check_shapes(&self) -> Result<(), FieldCount> {
+        self.records.iter().try_for_each(|r| self.check_shape(r))
+    }
+
     /// Parses a numeric field: `None` when it is not a number in the table's
     /// decimal convention. Empty fields are the caller's business.
     pub fn number(&self, field: &str) -> Option<f64> {
@@ -380,30 +445,40 @@ mod tests {
     }
 
     #[test]
+    fn a_record_of_another_width_names_the_column_where_it_parts() {
+        let t = table("pose,cycle,x_mm,y_mm,z_mm\nP1,1,600,0,400\nP1,2,600,0,8,85\nP1,3,600\n");
+        assert_eq!(t.check_shape(&t.records[0]), Ok(()));
+        let e = t.check_shape(&t.records[1]).unwrap_err();
+        assert_eq!((e.line, e.got, e.expected), (3, 6, 5));
+        assert!(
+            e.to_string().starts_with(
+                "line 3: 6 fields, the header has 5: field 6 `85` is beyond the last column `z_mm`; a decimal comma"
+            ),
+            "{e}"
+        );
+        let e = t.check_shape(&t.records[2]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "line 4: 3 fields, the header has 5: column 4 `y_mm` has no field"
+        );
+        assert_eq!(
+            t.check_shapes(),
+            Err(t.check_shape(&t.records[1]).unwrap_err())
+        );
+        // No decimal-comma hint where the delimiter is not a comma.
+        let t = table("a;b\n1;2;3\n");
+        let e = t.check_shapes().unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "line 2: 3 fields, the header has 2: field 3 `3` is beyond the last column `b`"
+        );
+    }
+
+    #[test]
     fn grouped_or_mixed_separators_are_not_numbers() {
         assert_eq!(parse_number("1.234,5", true), None);
         assert_eq!(parse_number("1,234,5", true), None);
         assert_eq!(parse_number("-0,25", true), Some(-0.25));
         assert_eq!(parse_number("2e3", true), Some(2000.0));
-    }
-
-    #[test]
-    fn cells_a_spreadsheet_would_run_become_text() {
-        for (cell, want) in [
-            ("=cmd|' /C calc'!A0", "'=cmd|' /C calc'!A0"),
-            ("+SUM(1;2)", "'+SUM(1;2)"),
-            ("-1+1", "'-1+1"),
-            ("@A1", "'@A1"),
-            ("\t=1", "'\t=1"),
-            ("\r=1", "'\r=1"),
-            ("p1", "p1"),
-            ("", ""),
-            ("a=b", "a=b"),
-        ] {
-            assert_eq!(safe_cell(cell), want, "{cell:?}");
-        }
-        assert_eq!(comment_text("arm\nname,1,2"), "arm name,1,2");
-        assert_eq!(comment_text("a\r\u{85}b"), "a  b");
-        assert_eq!(comment_text("plain"), "plain");
     }
 }

@@ -107,6 +107,9 @@ pub struct LoadDescription {
 
 /// Largest load mass accepted [kg].
 pub const MAX_LOAD_KG: f64 = 10_000.0;
+/// Largest principal moment of inertia accepted [kg·m²]: the largest mass
+/// with a radius of gyration of 10 m.
+pub const MAX_INERTIA_KGM2: f64 = 1e6;
 
 impl LoadDescription {
     /// The load on the flange of a tool `tcp` (flange → TCP); an error names
@@ -119,11 +122,19 @@ impl LoadDescription {
             ));
         }
         if !self.com_mm.iter().all(|v| v.is_finite() && v.abs() <= 1e5) {
-            return Err("load com_mm must be finite and within ±100000 mm".into());
+            return Err(format!(
+                "load com_mm must be finite and within ±100000 mm, got {:?}",
+                self.com_mm
+            ));
         }
         if let Some(j) = self.inertia_kgm2 {
-            if !j.iter().all(|v| v.is_finite() && *v >= 0.0) {
-                return Err("load inertia_kgm2 must be finite and not negative".into());
+            if !j
+                .iter()
+                .all(|v| v.is_finite() && (0.0..=MAX_INERTIA_KGM2).contains(v))
+            {
+                return Err(format!(
+                    "load inertia_kgm2 must be numbers from 0 to {MAX_INERTIA_KGM2:e} kg·m², got {j:?}"
+                ));
             }
         }
         let c = Vector3::from(self.com_mm) * 1e-3;

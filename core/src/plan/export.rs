@@ -4,11 +4,13 @@
 //! (`program::export::joint_program`).
 
 use super::MeasurementPlan;
-use crate::measure::csv_text::{self, Dialect};
+use crate::measure::bounds::{within, JOINT_DEG};
+use crate::measure::csv_text::{self, Dialect, FieldCount};
+use crate::measure::csv_write::{push_header, push_row, read_text, Cell};
+use crate::model::bounds::show;
 use crate::solve::program::export::joint_program;
 use crate::solve::program::{Language, ProgramFile};
 use serde::{Deserialize, Serialize};
-use std::fmt::Write as _;
 
 /// One planned pose: its point name and controller joints [deg].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -28,11 +30,13 @@ pub enum PlanCsvError {
     Header(String),
     #[error("the plan CSV, line {line}: `{field}` is not a number")]
     Number { line: usize, field: String },
-    #[error("the plan CSV, line {line}: {got} fields, the header has {expected}")]
-    Fields {
+    #[error("the plan CSV, {0}")]
+    Fields(#[from] FieldCount),
+    #[error("the plan CSV, line {line}, column `{column}`: {} deg is beyond the bound ±{} deg (controller degrees)", show(*value), JOINT_DEG.max)]
+    Joint {
         line: usize,
-        expected: usize,
-        got: usize,
+        column: String,
+        value: f64,
     },
     #[error("the plan CSV: point `{0}` appears twice")]
     Duplicate(String),
@@ -40,20 +44,17 @@ pub enum PlanCsvError {
     Axes(usize),
 }
 
-/// The joint CSV of `points`: `point,q1..qN`, degrees.
+/// The joint CSV of `points`: `point,q1..qN`, degrees (point names as
+/// `csv_write` writes every text).
 pub fn plan_csv(points: &[PlanPoint]) -> String {
     let n = points.iter().map(|p| p.q_deg.len()).max().unwrap_or(0);
-    let mut s = String::from("point");
-    for i in 1..=n {
-        let _ = write!(s, ",q{i}");
-    }
-    s.push('\n');
+    let mut s = String::new();
+    let header = std::iter::once("point".to_string()).chain((1..=n).map(|i| format!("q{i}")));
+    push_header(&mut s, header);
     for p in points {
-        s.push_str(&p.name);
-        for v in &p.q_deg {
-            let _ = write!(s, ",{v}");
-        }
-        s.push('\n');
+        let mut row = vec![Cell::text(&p.name)];
+        row.extend(p.q_deg.iter().map(|v| Cell::num(*v)));
+        push_row(&mut s, &row);
     }
     s
 }
@@ -73,26 +74,29 @@ pub fn read_plan_csv(text: &str) -> Result<Vec<PlanPoint>, PlanCsvError> {
     };
     let mut out: Vec<PlanPoint> = Vec::new();
     for r in &t.records {
-        if r.fields.len() != t.header.len() {
-            return Err(PlanCsvError::Fields {
-                line: r.line,
-                expected: t.header.len(),
-                got: r.fields.len(),
-            });
-        }
-        let name = r.fields[point].trim().to_string();
+        t.check_shape(r)?;
+        let name = read_text(r.fields[point].trim()).into_owned();
         if out.iter().any(|p| p.name == name) {
             return Err(PlanCsvError::Duplicate(name));
         }
         let q_deg = joints
             .iter()
             .map(|&c| {
-                t.number(r.fields[c].trim())
+                let v = t
+                    .number(r.fields[c].trim())
                     .filter(|v| v.is_finite())
                     .ok_or_else(|| PlanCsvError::Number {
                         line: r.line,
                         field: csv_text::short_text(&r.fields[c]),
-                    })
+                    })?;
+                if !within(v, &JOINT_DEG) {
+                    return Err(PlanCsvError::Joint {
+                        line: r.line,
+                        column: t.header[c].clone(),
+                        value: v,
+                    });
+                }
+                Ok(v)
             })
             .collect::<Result<Vec<f64>, _>>()?;
         out.push(PlanPoint { name, q_deg });

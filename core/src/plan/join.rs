@@ -5,8 +5,11 @@
 //! frame).
 
 use super::PlanPoint;
-use crate::measure::csv_text::{self, Dialect};
+use crate::measure::bounds::{within, POSITION_MM};
+use crate::measure::csv_text::{self, Dialect, FieldCount};
+use crate::measure::csv_write::read_text;
 use crate::measure::MeasuredPose;
+use crate::model::bounds::show;
 use serde::{Deserialize, Serialize};
 
 /// Position units of a tracker export.
@@ -69,12 +72,8 @@ pub enum JoinError {
     Header(String),
     #[error("the tracker export, line {line}: `{field}` is not a number")]
     Number { line: usize, field: String },
-    #[error("the tracker export, line {line}: {got} fields, the header has {expected}")]
-    Fields {
-        line: usize,
-        expected: usize,
-        got: usize,
-    },
+    #[error("the tracker export, {0}")]
+    Fields(#[from] FieldCount),
     #[error("the tracker export has no point name column, so it can only join by order")]
     NoNames,
     #[error("the tracker export has point `{0}` twice")]
@@ -85,8 +84,8 @@ pub enum JoinError {
     Extra(Vec<String>),
     #[error("joining by order: the plan has {plan} points, the tracker export {tracker}")]
     Count { plan: usize, tracker: usize },
-    #[error("tracker point {0}: a coordinate is out of range once in millimetres")]
-    OutOfRange(usize),
+    #[error("tracker point {point}: {} mm (in millimetres) is beyond the bound ±{} mm of a measured position", show(*value), POSITION_MM.max)]
+    OutOfRange { point: usize, value: f64 },
     #[error("units unclear: the points spread over {spread} (neither clearly metres, below {METRES_BELOW}, nor millimetres, above {MM_ABOVE}); give the units (mm or m)")]
     UnitsUnclear { spread: f64 },
 }
@@ -130,13 +129,7 @@ fn read(text: &str) -> Result<Export, JoinError> {
     let mut names = Vec::new();
     let mut xyz = Vec::new();
     for r in &t.records {
-        if r.fields.len() != t.header.len() {
-            return Err(JoinError::Fields {
-                line: r.line,
-                expected: t.header.len(),
-                got: r.fields.len(),
-            });
-        }
+        t.check_shape(r)?;
         let mut p = [0.0; 3];
         for (v, c) in p.iter_mut().zip([x.0, y.0, z.0]) {
             *v = t
@@ -149,7 +142,7 @@ fn read(text: &str) -> Result<Export, JoinError> {
         }
         xyz.push(p);
         if let Some(n) = name {
-            names.push(r.fields[n].trim().to_string());
+            names.push(read_text(r.fields[n].trim()).into_owned());
         }
     }
     if xyz.is_empty() {
@@ -251,8 +244,11 @@ pub fn join(plan: &[PlanPoint], text: &str, opts: &JoinOptions) -> Result<Joined
         .enumerate()
         .map(|(i, (p, xyz))| {
             let xyz_mm = xyz.map(|v| v * scale);
-            if xyz_mm.iter().any(|v| !v.is_finite()) {
-                return Err(JoinError::OutOfRange(i + 1));
+            if let Some(v) = xyz_mm.iter().find(|v| !within(**v, &POSITION_MM)) {
+                return Err(JoinError::OutOfRange {
+                    point: i + 1,
+                    value: *v,
+                });
             }
             Ok(MeasuredPose {
                 q_deg: p.q_deg.clone(),

@@ -60,4 +60,7 @@ pub enum Iso9283Error {
     Unreachable { min_edge_mm: f64, detail: String },
     #[error("line {line}: {message}")]
     Csv { line: usize, message: String },
+    /// A CSV row whose field count is not its header's.
+    #[error(transparent)]
+    FieldCount(#[from] crate::measure::csv_text::FieldCount),
 }

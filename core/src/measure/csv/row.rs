@@ -2,10 +2,13 @@
 //! module docs for the units and bounds).
 
 use super::header::{Header, PositionCols};
-use super::{short_number, CsvError, DifSign, MAX_JOINT_DEG, MAX_PAYLOAD_KG, MAX_POSITION_MM};
+use super::{short_number, CsvError, DifSign, MAX_JOINT_DEG};
+use crate::measure::bounds::{self, within};
 use crate::measure::convention::OrientationValueError;
 use crate::measure::csv_text::{self, short_text};
+use crate::measure::csv_write::read_text;
 use crate::measure::{MeasuredPose, SetRole};
+use crate::model::bounds::Bound;
 
 /// Parses one numeric field; `None` for an empty field.
 fn number(
@@ -48,33 +51,16 @@ impl Header {
         fields: &[&str],
         sign: DifSign,
     ) -> Result<MeasuredPose, CsvError> {
-        if fields.len() != self.names.len() {
-            return Err(CsvError::FieldCount {
-                line,
-                expected: self.names.len(),
-                got: fields.len(),
-            });
-        }
-        let opt = |c: usize| number(line, &self.names[c], fields[c], self.decimal_comma);
+        // The caller checked the row's shape (`Table::check_shape`).
+        debug_assert_eq!(fields.len(), self.names.len());
         let length = if self.metres { 1e3 } else { 1.0 };
         let q_deg = self.joints(line, fields)?;
         let xyz_mm = self.position(line, fields, sign)?;
         let rpy_deg = self.orientation(line, fields)?;
-        let std_mm = self.std(line, fields, self.std_pos, length)?;
+        let std_mm = self.std(line, fields, self.std_pos, length, &bounds::STD_MM)?;
         let std_deg = self.std_deg(line, fields, rpy_deg.is_some())?;
-        let payload_kg = self.payload.map(opt).transpose()?.flatten();
-        if let (Some(kg), Some(c)) = (payload_kg, self.payload) {
-            if !(0.0..=MAX_PAYLOAD_KG).contains(&kg) {
-                return Err(CsvError::OutOfRange {
-                    line,
-                    column: self.names[c].clone(),
-                    value: kg,
-                    unit: "kg",
-                    range: "0..10000 kg",
-                });
-            }
-        }
-        let temperature_c = self.temperature.map(opt).transpose()?.flatten();
+        let payload_kg = self.bounded(line, fields, self.payload, &bounds::PAYLOAD_KG)?;
+        let temperature_c = self.bounded(line, fields, self.temperature, &bounds::TEMPERATURE_C)?;
         Ok(MeasuredPose {
             q_deg,
             xyz_mm,
@@ -85,6 +71,44 @@ impl Header {
             temperature_c,
             set: self.set(line, fields)?,
             session: self.session(line, fields)?,
+        })
+    }
+
+    /// An optional number of column `c` (if the header has it), within `b`.
+    fn bounded(
+        &self,
+        line: usize,
+        fields: &[&str],
+        c: Option<usize>,
+        b: &Bound,
+    ) -> Result<Option<f64>, CsvError> {
+        let Some(c) = c else { return Ok(None) };
+        let v = number(line, &self.names[c], fields[c], self.decimal_comma)?;
+        if let Some(v) = v {
+            self.within(line, c, v, b, "")?;
+        }
+        Ok(v)
+    }
+
+    /// `v` (as stored) of column `c` within `b`, else an error naming line,
+    /// column, value and bound (`hint` after it).
+    fn within(
+        &self,
+        line: usize,
+        c: usize,
+        v: f64,
+        b: &Bound,
+        hint: &'static str,
+    ) -> Result<(), CsvError> {
+        if within(v, b) {
+            return Ok(());
+        }
+        Err(CsvError::OutOfRange {
+            line,
+            column: self.names[c].clone(),
+            value: v,
+            bound: *b,
+            hint,
         })
     }
 
@@ -141,15 +165,13 @@ impl Header {
             }
         };
         for (x, &c) in xyz_mm.iter().zip(&cols) {
-            if x.abs() > MAX_POSITION_MM {
-                return Err(CsvError::OutOfRange {
-                    line,
-                    column: self.names[c].clone(),
-                    value: *x,
-                    unit: "mm",
-                    range: "±100 m (positions are in millimetres)",
-                });
-            }
+            self.within(
+                line,
+                c,
+                *x,
+                &bounds::POSITION_MM,
+                " (positions are in millimetres)",
+            )?;
         }
         Ok(xyz_mm)
     }
@@ -180,11 +202,15 @@ impl Header {
         } else {
             v
         };
-        conv.to_fixed_xyz_deg(&v).map(Some).map_err(|e| match e {
+        let rpy = conv.to_fixed_xyz_deg(&v).map_err(|e| match e {
             OrientationValueError::NonUnitQuaternion { norm } => {
                 CsvError::NonUnitQuaternion { line, norm }
             }
-        })
+        })?;
+        for (a, &c) in rpy.iter().zip(cols) {
+            self.within(line, c, *a, &bounds::ANGLE_DEG, "")?;
+        }
+        Ok(Some(rpy))
     }
 
     /// The orientation's standard deviations [deg]; a row without an
@@ -207,7 +233,7 @@ impl Header {
                 }
                 Ok(None)
             }
-            cols => self.std(line, fields, cols, self.degrees(1.0)),
+            cols => self.std(line, fields, cols, self.degrees(1.0), &bounds::STD_DEG),
         }
     }
 
@@ -226,19 +252,19 @@ impl Header {
         }
     }
 
-    /// The row's tracker session, if named: at most 64 characters, none a
-    /// control character.
+    /// The row's tracker session, if named (as written: `read_text`): at
+    /// most 64 characters, none a control character.
     fn session(&self, line: usize, fields: &[&str]) -> Result<Option<String>, CsvError> {
         match self.session {
             Some(c) if !fields[c].is_empty() => {
-                let v = fields[c];
+                let v = read_text(fields[c]);
                 if v.chars().count() > 64 || v.chars().any(|ch| ch.is_control()) {
                     return Err(CsvError::BadSession {
                         line,
-                        value: short_text(v),
+                        value: short_text(&v),
                     });
                 }
-                Ok(Some(v.to_string()))
+                Ok(Some(v.into_owned()))
             }
             _ => Ok(None),
         }
@@ -256,13 +282,15 @@ impl Header {
     }
 
     /// Three standard deviations (scaled by `unit` into mm or degrees); when
-    /// the columns exist every row gives all three, each finite and > 0.
+    /// the columns exist every row gives all three, each > 0 and, as stored,
+    /// within `b`.
     fn std(
         &self,
         line: usize,
         fields: &[&str],
         cols: Option<[usize; 3]>,
         unit: f64,
+        b: &Bound,
     ) -> Result<Option<[f64; 3]>, CsvError> {
         let Some(cols) = cols else { return Ok(None) };
         let mut out = [0.0; 3];
@@ -288,6 +316,7 @@ impl Header {
                 }
                 Some(v) => v * unit,
             };
+            self.within(line, c, *o, b, "")?;
         }
         Ok(Some(out))
     }

@@ -170,13 +170,21 @@ fn errors_name_line_and_column() {
             column: "rz".into()
         }
     );
+}
+
+#[test]
+fn row_errors_name_line_and_column() {
     assert_eq!(
         err("q1,q2,x,y,z\n1,2,100,0,0\n\n1,2,100,0\n"),
-        CsvError::FieldCount {
+        CsvError::FieldCount(csv_text::FieldCount {
             line: 4,
             expected: 5,
-            got: 4
-        }
+            got: 4,
+            misfit: csv_text::Misfit::Missing {
+                index: 5,
+                column: "z".into()
+            }
+        })
     );
     assert_eq!(
         err("q1,q2,x,y,z\n1,2,100,0,0\n1,abc,100,0,0\n"),
@@ -303,7 +311,9 @@ mod bounds_tests {
         let ok = "0,0,0,0,0,0,1000,200,300,5\n";
         let e = err(&format!("{head}{ok}0,0,0,0,0,0,1e300,200,300,5\n"));
         assert!(
-            e.starts_with("line 3, column `x`: 1.000e300 mm is outside ±100 m"),
+            e.starts_with(
+                "line 3, column `x`: 1.000e300 mm is outside [-100000, 100000] mm (positions are in millimetres)"
+            ),
             "{e}"
         );
         assert!(e.len() < 120, "{e}");
@@ -312,7 +322,7 @@ mod bounds_tests {
         for bad in ["-1", "10000.5", "1e308"] {
             let e = err(&format!("{head}0,0,0,0,0,0,1000,200,300,{bad}\n"));
             assert!(
-                e.starts_with("line 2, column `payload_kg`") && e.contains("0..10000 kg"),
+                e.starts_with("line 2, column `payload_kg`") && e.contains("[0, 10000] kg"),
                 "{e}"
             );
             assert!(e.len() < 120, "{e}");
@@ -357,8 +367,76 @@ mod bounds_tests {
         // never a silently different number.
         assert!(matches!(
             parse("q1,q2,x,y,z\n1,5,2,3,4,5\n"),
-            Err(CsvError::FieldCount { .. })
+            Err(CsvError::FieldCount(_))
         ));
+    }
+
+    /// Standard deviations, temperatures and angles are bounded as stored,
+    /// after the unit conversion: a σ of 1e306 m (1e309 mm, infinite) is
+    /// refused naming line, column, value and bound, as is one that a
+    /// declared unit takes beyond the bound; at the bounds the rows read
+    /// and write back exactly.
+    #[test]
+    fn every_numeric_column_is_bounded_as_stored() {
+        let metres = ReadOptions {
+            metres: true,
+            ..ReadOptions::default()
+        };
+        let head = "q1,q2,x,y,z,std_x,std_y,std_z\n";
+        let e = parse_opts(&format!("{head}1,2,1.5,0,0,1e306,0.001,0.001\n"), &metres)
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "line 2, column `std_x`: inf mm is outside [1e-5, 1000] mm"
+        );
+        // 2 m is 2000 mm: beyond a metre although 2 is a small number.
+        let e = parse_opts(&format!("{head}1,2,1.5,0,0,0.001,2,0.001\n"), &metres).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("line 2, column `std_y`: 2000 mm is outside"),
+            "{e}"
+        );
+        let e = parse(&format!("{head}1,2,150,0,0,1e-6,1,1\n")).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("line 2, column `std_x`: 1.000e-6 mm"),
+            "{e}"
+        );
+        let e =
+            parse("q1,q2,x,y,z,temperature_c\n1,2,150,0,0,21\n1,2,150,0,0,1e300\n").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "line 3, column `temperature_c`: 1.000e300 °C is outside [-100, 200] °C"
+        );
+        let e = parse("q1,q2,x,y,z,rx,ry,rz\n1,2,150,0,0,0,400,0\n").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "line 2, column `ry`: 400 deg is outside [-360, 360] deg"
+        );
+        let std_deg = "q1,q2,x,y,z,rx,ry,rz,std_x,std_y,std_z,std_rx,std_ry,std_rz\n\
+                       1,2,150,0,0,0,0,0,1,1,1,1,1,4\n";
+        let radians = ReadOptions {
+            radians: true,
+            ..ReadOptions::default()
+        };
+        let e = parse_opts(std_deg, &radians).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("line 2, column `std_rz`: 229.183118 deg"),
+            "{e}"
+        );
+        // At every bound: accepted, and written back exactly.
+        let edge = "q1,q2,x,y,z,rx,ry,rz,std_x,std_y,std_z,std_rx,std_ry,std_rz,payload_kg,temperature_c\n\
+                    720,-720,100000,-100000,5,360,-360,0,1e-5,1000,1,1e-6,180,1,10000,-100\n\
+                    0,0,100,0,0,0,0,0,1,1,1,1,1,1,0,200\n";
+        let rows = parse(edge).unwrap();
+        assert_eq!(rows[0].std_mm, Some([1e-5, 1000.0, 1.0]));
+        assert_eq!(rows[1].temperature_c, Some(200.0));
+        assert_eq!(parse(&write(&rows)).unwrap(), rows);
+        for r in &rows {
+            assert_eq!(r.check_bounds(), Ok(()));
+        }
     }
 
     #[test]

@@ -18,7 +18,7 @@
 //! or DH form here. More: docs/design.md "Exports".
 
 use crate::calibrate::compensate::{CalibratedModelFile, CompensatedModel};
-use crate::measure::csv_text::comment_text;
+use crate::measure::csv_write::{comment_line, push_header, push_row, Cell};
 use crate::model::kinematics::chain::{base_constant, tool_pose};
 use crate::model::orientation::fixed_xyz_angles;
 use crate::model::{Pose, RobotModel};
@@ -233,15 +233,18 @@ fn urdf(model: &CompensatedModel, source: &ExportSource) -> Result<String, Expor
     Ok(s)
 }
 
-/// A transform row: `x_mm, y_mm, z_mm, rx_deg, ry_deg, rz_deg`.
-fn transform_cells(p: &Pose) -> String {
+/// A transform's cells: `x_mm, y_mm, z_mm, rx_deg, ry_deg, rz_deg`.
+fn transform_cells(p: &Pose) -> [Cell; 6] {
     let [rx, ry, rz] = fixed_xyz_angles(&p.r).map(f64::to_degrees);
-    format!(
-        "{},{},{},{rx},{ry},{rz}",
-        p.p.x * 1e3,
-        p.p.y * 1e3,
-        p.p.z * 1e3
-    )
+    [p.p.x * 1e3, p.p.y * 1e3, p.p.z * 1e3, rx, ry, rz].map(Cell::num)
+}
+
+/// A transform row of a DH table: its name, the joint columns empty.
+fn transform_row(s: &mut String, name: &str, joint_columns: usize, p: &Pose) {
+    let mut row = vec![Cell::text(name)];
+    row.extend((0..joint_columns).map(|_| Cell::empty()));
+    row.extend(transform_cells(p));
+    push_row(s, &row);
 }
 
 fn dh_csv(
@@ -278,35 +281,43 @@ fn dh_csv(
     } else {
         ("standard DH", "Rz(theta)*Tz(d)*Tx(a)*Rx(alpha)")
     };
-    let _ = writeln!(
-        s,
-        "# robocal export: {} model of {}, {kind}; mm and degrees",
-        comment_text(source.method),
-        comment_text(source.robot)
-    );
-    let _ = writeln!(
-        s,
-        "# T = cell_from_base * base * T_1 * ... * T_{n} * tool; T_i = {link}; theta = q + theta_offset_deg; q_ctrl = sign * (q - zero_deg)"
-    );
-    let _ = writeln!(
-        s,
-        "# transform rows: Tr(x,y,z)*Rz(rz)*Ry(ry)*Rx(rx). Note: {NOT_REPRESENTABLE}{}",
+    s.push_str(&comment_line(&format!(
+        "robocal export: {} model of {}, {kind}; mm and degrees",
+        source.method, source.robot
+    )));
+    s.push_str(&comment_line(&format!(
+        "T = cell_from_base * base * T_1 * ... * T_{n} * tool; T_i = {link}; theta = q + theta_offset_deg; q_ctrl = sign * (q - zero_deg)"
+    )));
+    s.push_str(&comment_line(&format!(
+        "transform rows: Tr(x,y,z)*Rz(rz)*Ry(ry)*Rx(rx). Note: {NOT_REPRESENTABLE}{}",
         dropped_maps(m)
-    );
-    let _ = writeln!(
-        s,
-        "name,a_mm,alpha_deg,d_mm,theta_offset_deg,{}sign,zero_deg,lower_deg,upper_deg,x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg",
-        if modified { "beta_deg," } else { "" }
-    );
-    let blank_joint = if modified { ",,,,,,,,," } else { ",,,,,,,," };
-    let _ = writeln!(
-        s,
-        "cell_from_base{blank_joint},{}",
-        transform_cells(&model.cell_from_base)
+    )));
+    let mut header = vec!["name", "a_mm", "alpha_deg", "d_mm", "theta_offset_deg"];
+    if modified {
+        header.push("beta_deg");
+    }
+    header.extend([
+        "sign",
+        "zero_deg",
+        "lower_deg",
+        "upper_deg",
+        "x_mm",
+        "y_mm",
+        "z_mm",
+        "rx_deg",
+        "ry_deg",
+        "rz_deg",
+    ]);
+    push_header(&mut s, &header);
+    let joint_columns = if modified { 9 } else { 8 };
+    transform_row(
+        &mut s,
+        "cell_from_base",
+        joint_columns,
+        &model.cell_from_base,
     );
     // The base link's constant part is the base transform; joint 1 keeps θ0.
-    let base = base_constant(&m.links[0]);
-    let _ = writeln!(s, "base{blank_joint},{}", transform_cells(&base));
+    transform_row(&mut s, "base", joint_columns, &base_constant(&m.links[0]));
     for k in 0..n {
         let l = &m.links[k];
         // Modified: link k's own a, α, β, d (0 for the base link's, moved
@@ -326,28 +337,24 @@ fn dh_csv(
                 if k == 0 { 0.0 } else { l.d },
             )
         };
-        let _ = write!(
-            s,
-            "j{},{},{},{},{},",
-            k + 1,
-            a * 1e3,
-            alpha.to_degrees(),
-            d * 1e3,
-            l.theta.to_degrees()
-        );
+        let mut row = vec![Cell::text(format!("j{}", k + 1))];
+        row.extend([a * 1e3, alpha.to_degrees(), d * 1e3, l.theta.to_degrees()].map(Cell::num));
         if modified {
-            let _ = write!(s, "{},", beta.to_degrees());
+            row.push(Cell::num(beta.to_degrees()));
         }
-        let _ = writeln!(
-            s,
-            "{},{},{},{},,,,,,",
-            l.sign,
-            l.zero.to_degrees(),
-            l.limits[0].to_degrees(),
-            l.limits[1].to_degrees()
+        row.extend(
+            [
+                l.sign,
+                l.zero.to_degrees(),
+                l.limits[0].to_degrees(),
+                l.limits[1].to_degrees(),
+            ]
+            .map(Cell::num),
         );
+        row.extend((0..6).map(|_| Cell::empty()));
+        push_row(&mut s, &row);
     }
-    let _ = writeln!(s, "tool{blank_joint},{}", transform_cells(&tool_pose(m)));
+    transform_row(&mut s, "tool", joint_columns, &tool_pose(m));
     Ok(s)
 }
 
@@ -488,6 +495,49 @@ mod tests {
                     .collect::<Vec<_>>()
             };
             assert_eq!(rows(&text), rows(&plain));
+        }
+    }
+
+    /// The issue's robot name: a spreadsheet splits the comment line at its
+    /// comma (or `;`, or a tab, by locale); no cell of any line is then a
+    /// formula, and every data cell is a number or a name.
+    #[test]
+    fn a_formula_in_a_name_is_no_live_cell_of_any_line() {
+        let cm = CompensatedModel::from_nominal(preset("ur5").unwrap());
+        let src = ExportSource {
+            robot: "cell,=cmd|' /C calc'!A0",
+            method: "km",
+        };
+        for f in [ExportFormat::DhCsv, ExportFormat::MdhCsv] {
+            let text = export(&cm, &src, f).unwrap();
+            let first = text.lines().next().unwrap();
+            assert_eq!(
+                first,
+                "# robocal export: km model of cell,'=cmd|' /C calc'!A0, standard DH; mm and degrees"
+                    .replace(
+                        "standard DH",
+                        if f == ExportFormat::DhCsv {
+                            "standard DH"
+                        } else {
+                            "modified DH (Craig) with Hayati beta"
+                        }
+                    )
+            );
+            for line in text.lines() {
+                for sep in [',', ';', '\t'] {
+                    for cell in line.split(sep) {
+                        let c = cell.trim_start_matches([' ', '"']);
+                        let formula = c.starts_with(['=', '+', '@'])
+                            || (c.starts_with('-') && c.parse::<f64>().is_err());
+                        assert!(!formula, "{f:?}: `{cell}` in {line}");
+                    }
+                }
+            }
+            for line in text.lines().filter(|l| !l.starts_with('#')).skip(1) {
+                for cell in line.split(',').skip(1).filter(|c| !c.is_empty()) {
+                    assert!(cell.parse::<f64>().is_ok(), "{cell} in {line}");
+                }
+            }
         }
     }
 }

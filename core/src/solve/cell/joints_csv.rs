@@ -13,10 +13,17 @@
 //! - any other column (`x, y, z, rx, ry, rz, payload_kg`, … of a measurements
 //!   file) is ignored, so a measurements file can be predicted as it is.
 //!
-//! Every error names its line; a file with one is rejected whole (a reading
-//! is never silently dropped).
+//! Every error names its line (and column); a file with one is rejected
+//! whole (a reading is never silently dropped): a row whose field count is
+//! not the header's (every column after the place they part would be read
+//! shifted), a value that is not a number, a reading beyond two turns
+//! (`measure::bounds::JOINT_DEG`, the bound of the measurement files and
+//! of a JSON prediction). Ids are read as `csv_write` wrote them.
 
-use crate::measure::csv_text::{self, short_text, Dialect, TextError};
+use crate::measure::bounds::{within, JOINT_DEG};
+use crate::measure::csv_text::{self, short_text, Dialect, FieldCount, TextError};
+use crate::measure::csv_write::read_text;
+use crate::model::bounds::show;
 
 /// One joint reading.
 #[derive(Debug, Clone, PartialEq)]
@@ -43,17 +50,20 @@ pub enum JointsCsvError {
     JointColumns { got: usize, dof: usize },
     #[error("joint column q{joint} appears twice")]
     Duplicate { joint: usize },
-    #[error("line {line}: {got} fields, the header has {expected}")]
-    FieldCount {
-        line: usize,
-        got: usize,
-        expected: usize,
-    },
+    /// A row whose field count is not the header's.
+    #[error(transparent)]
+    FieldCount(#[from] FieldCount),
     #[error("line {line}, column {column}: `{value}` is not a number (controller degrees)")]
     NotNumber {
         line: usize,
         column: String,
         value: String,
+    },
+    #[error("line {line}, column {column}: {} deg is beyond the bound ±{} deg (controller degrees; wrong units?)", show(*value), JOINT_DEG.max)]
+    OutOfBounds {
+        line: usize,
+        column: String,
+        value: f64,
     },
     #[error("no readings after the header")]
     NoRows,
@@ -99,34 +109,35 @@ pub fn parse_joints_csv(
         return Err(JointsCsvError::JointColumns { got, dof });
     }
     let idx: Vec<usize> = cols.iter().take(dof).map(|c| c.unwrap_or(0)).collect();
-    let width = table.header.len();
     let mut out = Vec::with_capacity(table.records.len());
     for (n, rec) in table.records.iter().enumerate() {
         let line = rec.line;
-        if rec.fields.len() != width {
-            return Err(JointsCsvError::FieldCount {
-                line,
-                got: rec.fields.len(),
-                expected: width,
-            });
-        }
-        let joints_deg =
-            idx.iter()
-                .map(|&i| {
-                    let v = &rec.fields[i];
-                    table.number(v).filter(|x| x.is_finite()).ok_or_else(|| {
-                        JointsCsvError::NotNumber {
-                            line,
-                            column: table.header[i].clone(),
-                            value: short_text(v),
-                        }
-                    })
-                })
-                .collect::<Result<Vec<f64>, _>>()?;
+        table.check_shape(rec)?;
+        let joints_deg = idx
+            .iter()
+            .map(|&i| {
+                let (v, column) = (&rec.fields[i], || table.header[i].clone());
+                let x = table.number(v).filter(|x| x.is_finite()).ok_or_else(|| {
+                    JointsCsvError::NotNumber {
+                        line,
+                        column: column(),
+                        value: short_text(v),
+                    }
+                })?;
+                if !within(x, &JOINT_DEG) {
+                    return Err(JointsCsvError::OutOfBounds {
+                        line,
+                        column: column(),
+                        value: x,
+                    });
+                }
+                Ok(x)
+            })
+            .collect::<Result<Vec<f64>, _>>()?;
         let id = id_idx
             .and_then(|i| rec.fields.get(i))
             .filter(|s| !s.is_empty())
-            .cloned()
+            .map(|s| read_text(s).into_owned())
             .unwrap_or_else(|| (n + 1).to_string());
         out.push(JointReading {
             id,
@@ -171,6 +182,31 @@ mod tests {
         assert_eq!(e, JointsCsvError::NoJointColumns { dof: 2 });
         let e = parse_joints_csv("q1,q2\n1,2,3\n", d, 2).unwrap_err();
         assert!(e.to_string().starts_with("line 2: 3 fields"), "{e}");
+        // A decimal comma in a comma-separated file, a row one field short:
+        // refused naming line and column, never read shifted.
+        let e = parse_joints_csv("id,q1,q2\na,10,20\nb,12,5,20\n", d, 2).unwrap_err();
+        assert!(
+            e.to_string().starts_with(
+                "line 3: 4 fields, the header has 3: field 4 `20` is beyond the last column `q2`; a decimal comma"
+            ),
+            "{e}"
+        );
+        let e = parse_joints_csv("q1,q2,id\n10,20\n", d, 2).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "line 2: 2 fields, the header has 3: column 3 `id` has no field"
+        );
+        // Beyond two turns: wrong units, as in a measurement file.
+        let e = parse_joints_csv("q1,q2\n1,2\n1,-720.5\n", d, 2).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "line 3, column q2: -720.5 deg is beyond the bound ±720 deg (controller degrees; wrong units?)"
+        );
+        let r = parse_joints_csv("id,q1,q2\n'=x,720,-720\n", d, 2).unwrap();
+        assert_eq!(
+            (r[0].id.as_str(), &r[0].joints_deg[..]),
+            ("=x", &[720.0, -720.0][..])
+        );
         let e = parse_joints_csv("q1,q2\n1,abc\n", d, 2).unwrap_err();
         assert!(e.to_string().contains("column q2: `abc`"), "{e}");
         let e = parse_joints_csv("q1,q3\n1,2\n", d, 2).unwrap_err();

@@ -19,6 +19,8 @@
 
 use super::{with_tool_load, Load};
 use crate::calibrate::compensate::{CompensatedModel, Compensation};
+use crate::measure::bounds::{within, JOINT_DEG};
+use crate::model::bounds::show;
 use crate::model::kinematics::KinematicsError;
 use crate::model::orientation::{rotation_to, OrientationConvention};
 use crate::model::Pose;
@@ -44,8 +46,10 @@ impl Default for PredictFrame {
 pub enum PredictError {
     #[error("{got} joint values, the robot has {expected} joints")]
     JointCount { expected: usize, got: usize },
-    #[error("joint {joint} is not a finite number")]
-    NotFinite { joint: usize },
+    /// A reading that is not finite or beyond two turns
+    /// (`measure::bounds::JOINT_DEG`, as the measurement and joints files).
+    #[error("joint {joint} is {} deg; must be finite and within ±{} deg (controller degrees)", show(*value), JOINT_DEG.max)]
+    JointOutOfBounds { joint: usize, value: f64 },
     #[error("the model cannot evaluate these joints: {0}")]
     Kinematics(#[from] KinematicsError),
 }
@@ -111,8 +115,11 @@ impl Forward {
                 got: joints_deg.len(),
             });
         }
-        if let Some(i) = joints_deg.iter().position(|v| !v.is_finite()) {
-            return Err(PredictError::NotFinite { joint: i + 1 });
+        if let Some(i) = joints_deg.iter().position(|v| !within(*v, &JOINT_DEG)) {
+            return Err(PredictError::JointOutOfBounds {
+                joint: i + 1,
+                value: joints_deg[i],
+            });
         }
         let ctrl: Vec<f64> = joints_deg.iter().map(|d| d.to_radians()).collect();
         let q = self.model.nominal.joints_from_controller(&ctrl);

@@ -3,16 +3,19 @@
 //! convention, the thesis's joint count, or the line and column of a targets
 //! file. Serialised as its message, as the per-target reason is shown.
 
-use crate::measure::csv_text::short_text;
+use crate::measure::bounds::POSITION_MM;
+use crate::measure::csv_text::{short_text, FieldCount};
+use crate::model::bounds::show;
 use crate::model::orientation::OrientationError;
 use serde::{Serialize, Serializer};
 
 /// Why one target cannot be solved as given.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum TargetError {
-    /// A boundary coordinate (mm) that is NaN or infinite.
-    #[error("position {axis} is {value}; must be finite")]
-    PositionNotFinite { axis: char, value: f64 },
+    /// A boundary coordinate (mm) that is not finite or beyond
+    /// [`POSITION_MM`] (100 m, the measurement files' bound).
+    #[error("position {axis} is {} mm; must be finite and within ±{} mm", show(*value), POSITION_MM.max)]
+    PositionOutOfBounds { axis: char, value: f64 },
     /// A goal position (SI) that is not finite.
     #[error("position is not finite")]
     GoalPositionNotFinite,
@@ -37,12 +40,9 @@ pub enum TargetError {
 /// Why one row of a targets file is not a target (the row fails alone).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RowError {
-    #[error("line {line}: {got} fields, the header has {expected}")]
-    FieldCount {
-        line: usize,
-        got: usize,
-        expected: usize,
-    },
+    /// A row whose field count is not the header's.
+    #[error(transparent)]
+    FieldCount(#[from] FieldCount),
     #[error(
         "line {line}: column `{column}`: `{}` is not a number",
         short_text(value)
@@ -52,8 +52,17 @@ pub enum RowError {
         column: String,
         value: String,
     },
-    #[error("line {line}: some orientation fields are empty")]
-    PartialOrientation { line: usize },
+    #[error(
+        "line {line}: orientation column(s) {columns} empty; give every orientation value or none"
+    )]
+    PartialOrientation { line: usize, columns: String },
+    /// A position beyond [`POSITION_MM`] (100 m).
+    #[error("line {line}: column `{column}`: {} mm is beyond the bound ±{} mm", show(*value), POSITION_MM.max)]
+    Position {
+        line: usize,
+        column: String,
+        value: f64,
+    },
 }
 
 impl Serialize for TargetError {

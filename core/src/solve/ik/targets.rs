@@ -3,7 +3,8 @@
 //!
 //! - Positions are in millimetres, in the measurement (cell) frame of the
 //!   calibrated model by default, or its registered base frame
-//!   ([`TargetFrame::Base`]).
+//!   ([`TargetFrame::Base`]); within 100 m (`measure::bounds::POSITION_MM`,
+//!   as measured positions), else the target fails alone.
 //! - Orientations use one of `model::orientation`'s conventions (quaternion
 //!   w,x,y,z; KUKA A,B,C; Fanuc W,P,R; row-major matrix), angles in degrees; the
 //!   rotation maps tool vectors into the target frame.
@@ -17,6 +18,7 @@ use super::invalid::TargetError;
 pub use super::solver::TargetFrame;
 use super::solver::{Goal, IkSolution, IkSolver};
 use crate::calibrate::compensate::Compensation;
+use crate::measure::bounds::{within, POSITION_MM};
 use crate::model::orientation::{rotation_from, rotation_to, OrientationConvention};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -40,8 +42,8 @@ pub struct TargetInput {
 impl TargetInput {
     /// The SI goal and the orientation convention, or why the target is invalid.
     pub fn to_goal(&self) -> Result<(Goal, Option<OrientationConvention>), TargetError> {
-        if let Some(i) = self.xyz_mm.iter().position(|v| !v.is_finite()) {
-            return Err(TargetError::PositionNotFinite {
+        if let Some(i) = self.xyz_mm.iter().position(|v| !within(*v, &POSITION_MM)) {
+            return Err(TargetError::PositionOutOfBounds {
                 axis: ['x', 'y', 'z'][i],
                 value: self.xyz_mm[i],
             });

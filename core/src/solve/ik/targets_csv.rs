@@ -21,8 +21,11 @@
 //!   `Rz(R)·Ry(P)·Rx(W)`) | `r11..r33` (row-major matrix). They may be left
 //!   empty in a row (a position-only target).
 //!
-//! A malformed row fails alone (its result is `invalid_target`, naming the
-//! line); header errors reject the file.
+//! A malformed row (a field count other than the header's, a value that is
+//! not a number, a position beyond 100 m, some orientation values empty)
+//! fails alone: its result is `invalid_target`, naming the line and the
+//! column. Header errors reject the file. Ids are read as `csv_write` wrote
+//! them (`read_text`).
 //!
 //! Results ([`results_csv`]), one row per target in input order:
 //! `id, status, reason, branch, j1_deg..jN_deg` (controller convention),
@@ -39,7 +42,9 @@
 use super::invalid::RowError;
 use super::solver::{IkSolution, IkSolver, SolveOptions};
 use super::targets::{TargetInput, TargetResult};
-use crate::measure::csv_text::{self, Dialect, TextError};
+use crate::measure::bounds::{within, POSITION_MM};
+use crate::measure::csv_text::{self, Dialect, Record, TextError};
+use crate::measure::csv_write::{self, push_row, read_text, Cell};
 use crate::model::orientation::{rotation_from, rotation_to, OrientationConvention};
 
 /// One row of a targets file: the target, or why the row is invalid.
@@ -168,14 +173,15 @@ pub fn parse_targets_csv(text: &str, dialect: Dialect) -> Result<TargetsCsv, Tar
             let id = id_idx
                 .and_then(|i| rec.fields.get(i))
                 .filter(|s| !s.is_empty())
-                .cloned()
+                .map(|s| read_text(s).into_owned())
                 .unwrap_or_else(|| (n + 1).to_string());
-            let cells: Vec<&str> = rec.fields.iter().map(String::as_str).collect();
-            let row = Row {
-                line: rec.line,
-                cells: &cells,
+            let columns = Columns {
+                names: &cols,
+                xyz: &xyz,
+                orientation: &ori_idx,
+                convention,
             };
-            let target = parse_row(&row, &cols, &xyz, &ori_idx, convention, &table).map(|mut t| {
+            let target = parse_row(rec, &columns, &table).map(|mut t| {
                 t.id = Some(id.clone());
                 t
             });
@@ -189,47 +195,59 @@ pub fn parse_targets_csv(text: &str, dialect: Dialect) -> Result<TargetsCsv, Tar
     Ok(TargetsCsv { convention, rows })
 }
 
-/// A record's fields and its 1-based line.
-struct Row<'a> {
-    line: usize,
-    cells: &'a [&'a str],
+/// Where a targets file holds what (lower-cased header names, indices).
+struct Columns<'a> {
+    names: &'a [String],
+    xyz: &'a [usize; 3],
+    orientation: &'a [usize],
+    convention: Option<OrientationConvention>,
 }
 
 fn parse_row(
-    row: &Row,
-    cols: &[String],
-    xyz: &[usize; 3],
-    ori_idx: &[usize],
-    convention: Option<OrientationConvention>,
+    rec: &Record,
+    cols: &Columns,
     table: &csv_text::Table,
 ) -> Result<TargetInput, RowError> {
-    let (line, cells) = (row.line, row.cells);
-    if cells.len() != cols.len() {
-        return Err(RowError::FieldCount {
-            line,
-            got: cells.len(),
-            expected: cols.len(),
-        });
-    }
+    table.check_shape(rec)?;
+    let (line, cells) = (rec.line, &rec.fields);
     let num = |i: usize| -> Result<f64, RowError> {
-        table.number(cells[i]).ok_or_else(|| RowError::NotNumber {
+        table.number(&cells[i]).ok_or_else(|| RowError::NotNumber {
             line,
-            column: cols[i].clone(),
+            column: cols.names[i].clone(),
             value: cells[i].to_string(),
         })
     };
-    let xyz_mm = [num(xyz[0])?, num(xyz[1])?, num(xyz[2])?];
-    let empty = ori_idx.iter().filter(|&&i| cells[i].is_empty()).count();
-    let (convention, orientation) = if ori_idx.is_empty() || empty == ori_idx.len() {
+    let mut xyz_mm = [0.0; 3];
+    for (v, &i) in xyz_mm.iter_mut().zip(cols.xyz) {
+        *v = num(i)?;
+        if !within(*v, &POSITION_MM) {
+            return Err(RowError::Position {
+                line,
+                column: cols.names[i].clone(),
+                value: *v,
+            });
+        }
+    }
+    let empty: Vec<&str> = cols
+        .orientation
+        .iter()
+        .filter(|&&i| cells[i].is_empty())
+        .map(|&i| cols.names[i].as_str())
+        .collect();
+    let (convention, orientation) = if empty.len() == cols.orientation.len() {
         (None, Vec::new())
-    } else if empty > 0 {
-        return Err(RowError::PartialOrientation { line });
+    } else if !empty.is_empty() {
+        return Err(RowError::PartialOrientation {
+            line,
+            columns: empty.join(", "),
+        });
     } else {
-        let values = ori_idx
+        let values = cols
+            .orientation
             .iter()
             .map(|&i| num(i))
             .collect::<Result<Vec<f64>, RowError>>()?;
-        (convention.map(|k| k.name().to_string()), values)
+        (cols.convention.map(|k| k.name().to_string()), values)
     };
     Ok(TargetInput {
         id: None,
@@ -307,46 +325,39 @@ pub fn results_header(dof: usize, convention: OrientationConvention) -> Vec<Stri
 }
 
 /// Solve results as CSV (see the module docs), false targets in `convention`
-/// (converted when a result carries another one).
+/// (converted when a result carries another one); numbers as numbers, texts
+/// (ids, messages, warnings) as `csv_write` writes every text.
 pub fn results_csv(
     results: &[TargetResult],
     dof: usize,
     convention: OrientationConvention,
 ) -> String {
-    let mut w = csv::WriterBuilder::new()
-        .terminator(csv::Terminator::Any(b'\n'))
-        .from_writer(Vec::new());
     let header = results_header(dof, convention);
     let n_ori = convention.n_values();
-    // Writing to a Vec cannot fail.
-    let _ = w.write_record(&header);
-    let finite = |v: f64| {
-        if v.is_finite() {
-            format!("{v:.6e}")
-        } else {
-            String::new()
-        }
-    };
+    let mut out = String::new();
+    csv_write::push_header(&mut out, &header);
+    let mut row: Vec<Cell> = Vec::with_capacity(header.len());
     for r in results {
         let s = &r.solution;
-        let mut row: Vec<String> = Vec::with_capacity(header.len());
-        row.push(csv_text::safe_cell(&r.id).into_owned());
-        row.push(r.status().to_string());
+        row.clear();
+        row.push(Cell::text(&r.id));
+        row.push(Cell::text(r.status()));
+        row.push(Cell::text(
+            s.reason.as_ref().map(|x| x.code()).unwrap_or_default(),
+        ));
         row.push(
-            s.reason
-                .as_ref()
-                .map(|x| x.code().to_string())
-                .unwrap_or_default(),
+            s.branch
+                .map_or_else(Cell::empty, |b| Cell::text(b.to_string())),
         );
-        row.push(s.branch.map(|b| b.to_string()).unwrap_or_default());
-        match &r.joints_deg {
-            Some(j) => row
-                .extend((0..dof).map(|k| j.get(k).map(|v| format!("{v:.6}")).unwrap_or_default())),
-            None => row.extend((0..dof).map(|_| String::new())),
-        }
+        let joints = r.joints_deg.as_deref().unwrap_or_default();
+        row.extend((0..dof).map(|k| {
+            joints
+                .get(k)
+                .map_or_else(Cell::empty, |v| Cell::fixed(*v, 6))
+        }));
         match &r.false_target {
             Some(f) => {
-                row.extend(f.xyz_mm.iter().map(|v| format!("{v:.4}")));
+                row.extend(f.xyz_mm.iter().map(|v| Cell::fixed(*v, 4)));
                 let values = if f.convention == convention {
                     f.orientation.clone()
                 } else {
@@ -354,45 +365,41 @@ pub fn results_csv(
                         .map(|m| rotation_to(convention, &m))
                         .unwrap_or_default()
                 };
-                row.extend(
-                    (0..n_ori)
-                        .map(|k| values.get(k).map(|v| format!("{v:.9}")).unwrap_or_default()),
-                );
+                row.extend((0..n_ori).map(|k| {
+                    values
+                        .get(k)
+                        .map_or_else(Cell::empty, |v| Cell::fixed(*v, 9))
+                }));
             }
-            None => row.extend((0..3 + n_ori).map(|_| String::new())),
+            None => row.extend((0..3 + n_ori).map(|_| Cell::empty())),
         }
-        row.push(finite(s.position_residual_mm));
-        row.push(finite(s.orientation_residual_rad));
-        row.push(s.iterations.to_string());
+        row.push(Cell::sci(s.position_residual_mm, 6));
+        row.push(Cell::sci(s.orientation_residual_rad, 6));
+        row.push(Cell::int(s.iterations));
         match r.jump {
             Some(j) => {
-                row.push(j.joint.to_string());
-                row.push(format!("{:.3}", j.delta_deg));
+                row.push(Cell::int(j.joint));
+                row.push(Cell::fixed(j.delta_deg, 3));
             }
-            None => row.extend([String::new(), String::new()]),
+            None => row.extend([Cell::empty(), Cell::empty()]),
         }
-        row.push(
-            s.reason
-                .as_ref()
-                .map(|x| csv_text::safe_cell(&x.to_string()).into_owned())
-                .unwrap_or_default(),
-        );
+        row.push(Cell::text(
+            s.reason.as_ref().map(|x| x.to_string()).unwrap_or_default(),
+        ));
         match &r.compensation {
             Some(c) => {
-                row.push(c.label().to_string());
+                row.push(Cell::text(c.label()));
+                row.push(Cell::text(c.warning().unwrap_or_default()));
                 row.push(
-                    c.warning()
-                        .map(|w| csv_text::safe_cell(&w).into_owned())
-                        .unwrap_or_default(),
+                    c.expected_error_mm
+                        .map_or_else(Cell::empty, |v| Cell::sci(v, 6)),
                 );
-                row.push(c.expected_error_mm.map(finite).unwrap_or_default());
             }
-            None => row.extend([String::new(), String::new(), String::new()]),
+            None => row.extend([Cell::empty(), Cell::empty(), Cell::empty()]),
         }
-        let _ = w.write_record(&row);
+        push_row(&mut out, &row);
     }
-    let bytes = w.into_inner().unwrap_or_default();
-    String::from_utf8(bytes).expect("CSV of UTF-8 fields is UTF-8")
+    out
 }
 
 #[cfg(test)]
@@ -429,8 +436,8 @@ mod tests {
         assert_eq!(
             errors,
             [
-                "line 2: 2 fields, the header has 6",
-                "line 3: some orientation fields are empty"
+                "line 2: 2 fields, the header has 6: column 3 `z` has no field",
+                "line 3: orientation column(s) b empty; give every orientation value or none"
             ]
         );
         let t = parse("x,y,z,W,P,R\n1,2,3,0,0,0\n").unwrap();
@@ -454,6 +461,35 @@ mod tests {
         ));
         assert_eq!(parse("# only a comment\n"), Err(TargetsCsvError::NoHeader));
         assert_eq!(parse("x,y,z\n1,2,3\n").unwrap().convention, None);
+    }
+
+    /// A row one field longer than the header (a decimal comma in a
+    /// comma-separated file) and a position beyond 100 m fail alone, naming
+    /// line and column; the other rows are read, ids as they were written.
+    #[test]
+    fn misaligned_rows_and_positions_beyond_the_bound_fail_alone() {
+        let t = parse("id,x,y,z,a,b,c\n'=p1,1500,0,1200,180,0,180\np2,1500,0,1200,5,180,0,180\np3,1e6,0,1200,180,0,180\n")
+            .unwrap();
+        assert_eq!(t.rows[0].id, "=p1");
+        assert!(t.rows[0].target.is_ok());
+        let errors: Vec<String> = t.rows[1..]
+            .iter()
+            .map(|r| r.target.as_ref().unwrap_err().to_string())
+            .collect();
+        assert_eq!(errors[0], "line 3: 8 fields, the header has 7: field 8 `180` is beyond the last column `c`; a decimal comma splits a number in two in a comma-separated file (write `8.85`, quote `\"8,85\"`, or separate the fields with `;`)");
+        assert_eq!(
+            errors[1],
+            "line 4: column `x`: 1e6 mm is beyond the bound ±100000 mm"
+        );
+        // The JSON form has the same bound: the target fails alone.
+        let far = TargetInput {
+            xyz_mm: [0.0, -100_000.5, 0.0],
+            ..TargetInput::default()
+        };
+        assert_eq!(
+            far.to_goal().unwrap_err().to_string(),
+            "position y is -100000.5 mm; must be finite and within ±100000 mm"
+        );
     }
 
     #[test]

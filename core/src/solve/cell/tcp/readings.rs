@@ -135,6 +135,10 @@ pub fn parse_csv(text: &str) -> Result<Vec<Reading>, CsvError> {
     }
     let mut rows = Vec::with_capacity(table.records.len());
     for rec in &table.records {
+        // A row of another width would be read shifted.
+        table
+            .check_shape(rec)
+            .map_err(|e| CsvError(e.to_string()))?;
         let mut q = Vec::with_capacity(joints.len());
         for c in &joints {
             let f = rec.fields.get(*c).map(|s| s.trim()).unwrap_or("");
