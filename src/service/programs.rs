@@ -98,8 +98,8 @@ pub struct CellExport {
 /// controller of `language` holds them, for the chosen model version: work
 /// objects measured in the tracker frame come out in its base frame. A cell
 /// the controller could not load (a number 0 or beyond its range, one held
-/// twice) is a conflict naming the item; too few registers for a Fanuc
-/// export is invalid.
+/// twice) is a conflict naming the item, and so is a Fanuc register range
+/// shorter than the cell's tools and work objects.
 pub async fn export_cell(
     state: &AppState,
     robot_id: i64,
@@ -116,7 +116,9 @@ pub async fn export_cell(
         m.payload_kg = p;
     }
     let export = export_cell(language, &cell, &m, options).map_err(|e| match e {
-        ExportError::TooFewRegisters { .. } => ServiceError::Invalid(format!("`registers`: {e}")),
+        ExportError::TooFewRegisters { .. } => ServiceError::Conflict(format!(
+            "`registers`: {e}; widen the range or remove items with DELETE /v1/robots/{robot_id}/tools/{{name}} or /frames/{{name}}"
+        )),
         _ => ServiceError::Conflict(format!(
             "the cell of robot {robot_id} cannot be exported for this controller: {e}; change it with PUT /v1/robots/{robot_id}/tools/{{name}} or /frames/{{name}}"
         )),

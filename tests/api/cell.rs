@@ -720,8 +720,9 @@ async fn the_cell_exports_one_number_per_item_and_registers_only_when_asked() {
     );
     assert_eq!(b["registers"].as_array().unwrap().len(), 4);
     assert_eq!(cli("fanuc", &["--registers", "91..99"]).unwrap(), tp);
+    // The range is the request's, the items the robot's: too short is a conflict.
     let r = export(json!({ "language": "fanuc", "version": "nominal", "registers": { "first": 91, "last": 92 } })).await;
-    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+    assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
     assert!(
         r.detail().contains("needs 4 position registers"),
         "{}",
