@@ -12,5 +12,6 @@ pub use robocal_core::{calibrate, check, measure, model, optim, plan, sim, solve
 pub mod cli;
 pub mod db;
 pub mod http;
+pub mod records;
 pub mod report;
 pub mod service;

@@ -3,6 +3,8 @@
 //! - the HTTP layer (`src/http`) never names `crate::db`: it calls the
 //!   service, which answers with its own types (or re-exports);
 //! - the service (`src/service`) never names `crate::http`;
+//! - the service re-exports nothing of the store (`pub use crate::db::…`):
+//!   the rows both speak of are `crate::records`;
 //! - no two files of the service crate (`src`, the binaries aside) import
 //!   each other, directly or round a longer loop (a folder's `mod.rs` is its
 //!   namespace, not a node);
@@ -403,6 +405,48 @@ fn the_service_never_imports_the_http_layer() {
     );
 }
 
+/// Every `pub use` (or `pub(crate) use`) path of the files under `folder`.
+fn public_uses(tree: &Tree, folder: &str) -> Vec<(Module, Vec<String>)> {
+    let mut out = Vec::new();
+    for (m, (_, code)) in &tree.files {
+        if m.first().map(String::as_str) != Some(folder) {
+            continue;
+        }
+        let toks = tokens(&strip(code));
+        for i in 0..toks.len() {
+            let public = i >= 1 && toks[i - 1] == Tok::Ident("pub".into())
+                || i >= 4
+                    && toks[i - 1] == Tok::Other(')')
+                    && toks[i - 4] == Tok::Ident("pub".into());
+            if public && toks[i] == Tok::Ident("use".into()) {
+                let mut found = Vec::new();
+                use_tree(&toks, i + 1, &mut Vec::new(), &mut found);
+                out.extend(found.into_iter().map(|p| (m.clone(), p)));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn the_service_re_exports_nothing_of_the_store() {
+    let tree = src();
+    let found: Vec<String> = public_uses(&tree, "service")
+        .into_iter()
+        .filter(|(m, p)| {
+            tree.resolve(m, p)
+                .and_then(|t| t.first().cloned())
+                .as_deref()
+                == Some("db")
+        })
+        .map(|(m, p)| format!("{}: pub use {}", name(&m), p.join("::")))
+        .collect();
+    assert!(
+        found.is_empty(),
+        "the service answers with its own types or crate::records, never the store's: {found:#?}"
+    );
+}
+
 #[test]
 fn no_two_files_of_the_service_crate_import_each_other() {
     assert_eq!(import_loop(&src(), ""), None, "an import loop in src");
@@ -459,6 +503,31 @@ fn the_checker_sees_grouped_nested_and_inline_paths() {
     assert_eq!(cycle.first(), cycle.last());
     assert!(cycle.contains(&"service/a".to_string()), "{cycle:?}");
     assert!(cycle.contains(&"service/jobs/run".to_string()), "{cycle:?}");
+}
+
+#[test]
+fn the_checker_sees_a_store_type_re_exported() {
+    let t = tree(&[
+        ("service/mod", "pub mod a; pub use crate::db::Row;"),
+        (
+            "service/a",
+            "pub(crate) use crate::db::{rows::Other, Listing}; use crate::db::Db;",
+        ),
+        ("db/mod", "pub mod rows;"),
+        ("db/rows", "pub struct Other;"),
+    ]);
+    let reexported: Vec<String> = public_uses(&t, "service")
+        .into_iter()
+        .map(|(m, p)| format!("{}: {}", name(&m), p.join("::")))
+        .collect();
+    assert_eq!(
+        reexported,
+        vec![
+            "service: crate::db::Row",
+            "service/a: crate::db::rows::Other",
+            "service/a: crate::db::Listing"
+        ]
+    );
 }
 
 #[test]

@@ -2,26 +2,11 @@
 //! per-robot thresholds of the status.
 
 use super::{commit_inserted, on_pool, write_for_robot, Db, Json, Listing, StoreError};
+use crate::records::CheckRow;
 use serde_json::Value;
-use sqlx::FromRow;
 
 const CHECK_SELECT: &str = "SELECT id, robot_id, set_id, version, status, mean_mm, \
     temperature_c, result_json, created_at FROM checks";
-
-/// A stored check.
-#[derive(Debug, Clone, FromRow)]
-pub struct CheckRow {
-    pub id: i64,
-    pub robot_id: i64,
-    pub set_id: Option<i64>,
-    pub version: i64,
-    pub status: String,
-    pub mean_mm: f64,
-    pub temperature_c: Option<f64>,
-    #[sqlx(rename = "result_json")]
-    pub result: Json<Value>,
-    pub created_at: String,
-}
 
 /// A check to store.
 #[derive(Debug)]

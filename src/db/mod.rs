@@ -89,15 +89,14 @@ mod sets;
 mod types;
 mod versions;
 
-pub use calibrations::{CalibrationRow, JobResult, JobStatus, JobSummary, NewCalibration};
-pub use cell::{name_key as cell_name_key, CellItemRow, CellKind, CellPut, ItemFrame, NewCellItem};
-pub use checks::{CheckRow, NewCheck, ThresholdRow};
+use crate::records::Json;
+pub use calibrations::{JobResult, NewCalibration};
+pub use cell::name_key as cell_name_key;
+pub use checks::{NewCheck, ThresholdRow};
 pub use queue::{ClaimedJob, Lease, RobotChange, RobotChanges};
-pub use robots::{NewRobot, RobotRow};
 pub use set_usage::SetDeletion;
-pub use sets::{AngleUnit, LengthUnit, NewSet, SetFormat, SetRow, StoredRole};
-pub use types::Json;
-pub use versions::{NewVersion, Rollback, VersionRow};
+pub use sets::NewSet;
+pub use versions::{NewVersion, Rollback};
 
 /// One page of a list and the length of the whole list.
 #[derive(Debug, Clone)]

@@ -1,8 +1,8 @@
 //! Robots: the cell's robots and their nominal models.
 
 use super::{commit_inserted, on_pool, write_one, Db, Json, Listing, StoreError};
+use crate::records::{NewRobot, RobotRow};
 use serde_json::{Map, Value};
-use sqlx::FromRow;
 
 impl Db {
     pub async fn insert_robot(&self, r: &NewRobot<'_>) -> Result<RobotRow, StoreError> {
@@ -90,26 +90,3 @@ const ROBOT_SELECT: &str = "SELECT r.id, r.name, r.preset, r.model_json, r.dof, 
     (SELECT v.version FROM model_versions v WHERE v.robot_id = r.id AND v.active = TRUE) \
     AS active_version \
     FROM robots r";
-
-/// A robot to insert.
-#[derive(Debug)]
-pub struct NewRobot<'a> {
-    pub name: &'a str,
-    pub preset: Option<&'a str>,
-    pub model_json: &'a str,
-    pub dof: i64,
-    pub metadata: &'a Map<String, Value>,
-}
-
-#[derive(Debug, Clone, FromRow)]
-pub struct RobotRow {
-    pub id: i64,
-    pub name: String,
-    pub preset: Option<String>,
-    pub model_json: String,
-    pub dof: i64,
-    pub metadata: Json<Map<String, Value>>,
-    pub created_at: String,
-    pub updated_at: String,
-    pub active_version: Option<i64>,
-}

@@ -3,16 +3,8 @@
 use super::types::text_enum;
 use super::{commit_inserted, on_pool, write_for_robot, Db, Json, Listing, StoreError};
 use crate::measure::{MeasuredPose, SetRole};
-use sqlx::{FromRow, Row};
-
-/// Data role of a set as stored (docs/design.md "Data roles").
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum StoredRole {
-    Identification,
-    Training,
-    Validation,
-    Check,
-}
+use crate::records::{AngleUnit, LengthUnit, SetFormat, SetRow, StoredRole};
+use sqlx::Row;
 
 impl From<SetRole> for StoredRole {
     fn from(r: SetRole) -> Self {
@@ -34,27 +26,6 @@ impl From<StoredRole> for SetRole {
             StoredRole::Check => SetRole::Check,
         }
     }
-}
-
-/// Declared length unit of an upload.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum LengthUnit {
-    Mm,
-    M,
-}
-
-/// Declared angle unit of an upload.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum AngleUnit {
-    Deg,
-    Rad,
-}
-
-/// Format of the upload as received.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SetFormat {
-    Csv,
-    Json,
 }
 
 impl StoredRole {
@@ -207,20 +178,4 @@ pub struct NewSet<'a> {
     pub rows: &'a [MeasuredPose],
     pub row_count: i64,
     pub dof: i64,
-}
-
-#[derive(Debug, Clone, FromRow)]
-pub struct SetRow {
-    pub id: i64,
-    pub robot_id: i64,
-    pub name: String,
-    pub role: StoredRole,
-    pub session: String,
-    pub payload_kg: Option<f64>,
-    pub length_unit: LengthUnit,
-    pub angle_unit: AngleUnit,
-    pub format: SetFormat,
-    pub row_count: i64,
-    pub dof: i64,
-    pub created_at: String,
 }

@@ -8,15 +8,12 @@
 //! numbers) and its derived enums name a PostgreSQL enum type; both would make
 //! the two stores differ, hence these.
 
+use crate::records::Json;
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 use sqlx::encode::IsNull;
 use sqlx::error::BoxDynError;
 use sqlx::{Database, Decode, Encode, Type};
-
-/// A JSON document stored as text.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct Json<T>(pub T);
 
 impl<T, DB: Database> Type<DB> for Json<T>
 where

@@ -2,8 +2,8 @@
 //! active one per robot, and the activation history used by rollback.
 
 use super::{on_pool, write_for_robot, Db, Json, Listing, StoreError};
+use crate::records::VersionRow;
 use serde_json::Value;
-use sqlx::FromRow;
 
 impl Db {
     /// One page of a robot's versions by number, and how many it has.
@@ -217,17 +217,4 @@ pub struct NewVersion {
     pub method: String,
     pub model_json: String,
     pub stats: Value,
-}
-
-#[derive(Debug, Clone, FromRow)]
-pub struct VersionRow {
-    pub id: i64,
-    pub robot_id: i64,
-    pub version: i64,
-    pub calibration_id: Option<i64>,
-    pub method: String,
-    #[sqlx(rename = "stats_json")]
-    pub stats: Json<Value>,
-    pub active: bool,
-    pub created_at: String,
 }

@@ -10,7 +10,7 @@ use super::input::{check_payload, int, page_body, present, present_ids, present_
 use super::robots::robot_list_page;
 use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState};
 use crate::calibrate::identify::{CalibrationOptions, Method};
-use crate::service::calibrations::{CalibrationRow, JobStatus, JobSummary};
+use crate::records::{CalibrationRow, JobStatus, JobSummary};
 use crate::service::{self, jobs::StartCommand};
 use axum::extract::State;
 use axum::http::StatusCode;

@@ -7,8 +7,8 @@
 
 use super::input::{objects, present};
 use super::{ApiError, ApiJson, ApiPath, AppState};
+use crate::records::{CellItemRow, CellKind, ItemFrame, NewCellItem};
 use crate::service;
-use crate::service::cell::{CellItemRow, CellKind, ItemFrame, NewCellItem};
 use crate::solve::cell::file::PoseMmDeg;
 use crate::solve::cell::LoadDescription;
 use axum::extract::State;

@@ -205,15 +205,6 @@ impl From<crate::service::ServiceError> for ApiError {
                 retry_after_s,
             },
             S::Unavailable(m) => ApiError::Unavailable(m),
-            S::Store(e) => {
-                use crate::service::StoreError as E;
-                match e {
-                    E::NotFound(m) => ApiError::NotFound(m),
-                    E::Conflict(m) => ApiError::Conflict(m),
-                    e @ E::Unavailable(_) => ApiError::Unavailable(e.to_string()),
-                    e @ E::Internal(_) => ApiError::Internal(e.to_string()),
-                }
-            }
             S::Unparsable(e) => ApiError::Unparsable(e),
             S::Internal(m) => ApiError::Internal(m),
         }

@@ -16,8 +16,8 @@
 use super::input::{check_payload, objects, present};
 use super::solve::{convention, model_choice, target_id, ItemRef, VersionSelector};
 use super::{ApiError, ApiJson, ApiPath, AppState};
+use crate::records::CellKind;
 use crate::service;
-use crate::service::cell::CellKind;
 use crate::service::predict::PredictCommand;
 use crate::solve::cell::accuracy::ToolAccuracy;
 use crate::solve::cell::joints_csv::JointReading;

@@ -17,7 +17,7 @@ use crate::measure::convention::MeasuredOrientation;
 use crate::measure::csv::{self, DifSign, ReadOptions};
 use crate::measure::{MeasuredPose, SetRole};
 use crate::model::bounds::{show, Bound};
-use crate::service::sets::{AngleUnit, LengthUnit, SetFormat, SetRow};
+use crate::records::{AngleUnit, LengthUnit, SetFormat, SetRow};
 use crate::service::{
     self,
     sets::{NewSetCommand, SetContent},

@@ -22,8 +22,8 @@ use super::input::{check_payload, from_json_object, object_or_null, objects, pre
 use super::{ApiError, ApiPath, ApiQuery, AppState};
 use crate::measure::csv_text::{dialect_from_names, Dialect};
 use crate::model::orientation::OrientationConvention;
+use crate::records::CellKind;
 use crate::service;
-use crate::service::cell::CellKind;
 use crate::service::solve::{ItemChoice, ModelChoice, SolveCommand, SolveOutcome, Targets};
 use crate::solve::ik::{
     parse_targets_csv, results_csv, Configuration, JointJump, SolveOptions, TargetFrame,

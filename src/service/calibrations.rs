@@ -16,9 +16,9 @@ use super::jobs::prepare::{prepare, Job};
 use super::jobs::shared::admit;
 use super::jobs::StartCommand;
 use super::{AppState, ServiceError};
-pub use crate::db::{CalibrationRow, JobStatus, JobSummary};
 use crate::db::{Listing, NewCalibration};
 use crate::model::RobotModel;
+use crate::records::CalibrationRow;
 use std::sync::atomic::Ordering;
 
 /// Queues a calibration of a robot and starts its job; returns the queued job.

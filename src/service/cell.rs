@@ -3,7 +3,7 @@
 //! program filtering. Poses are in mm and degrees here (`PoseMmDeg`).
 
 use super::{robots, AppState, ServiceError};
-pub use crate::db::{CellItemRow, CellKind, CellPut, ItemFrame, NewCellItem};
+use crate::records::{CellItemRow, CellKind, CellPut, ItemFrame, NewCellItem};
 use crate::solve::cell::file::{CellDescription, ToolDescription, WorkObjectDescription};
 use crate::solve::cell::{Cell, WorkObjectFrame};
 use std::collections::HashSet;

@@ -12,7 +12,7 @@
 
 use super::solve::{chosen_model, ModelChoice};
 use super::{cell, AppState, ServiceError};
-use crate::db::{CellItemRow, CellKind, CellPut, ItemFrame, NewCellItem};
+use crate::records::{CellItemRow, CellKind, CellPut, ItemFrame, NewCellItem};
 use crate::solve::cell::file::PoseMmDeg;
 use crate::solve::cell::tcp::entry::{self, Fitted as Judged, Outcome, StoreRequest, StoredEntry};
 use crate::solve::cell::tcp::{self as core_tcp, FitError, Reading, ToolFit, ToolRequest};

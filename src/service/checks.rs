@@ -9,8 +9,8 @@
 
 use super::{robots, versions, AppState, ServiceError};
 use crate::calibrate::compensate::CalibratedModelFile;
-pub use crate::db::CheckRow;
 use crate::db::{Listing, NewCheck};
+use crate::records::CheckRow;
 use robocal_core::check::{
     score, worst_poses, CheckResult, CheckStatus, CheckThresholds, PoseError, ShiftSize,
     DEGRADED_MIN_MM, THRESHOLD_MAX_MM,

@@ -5,8 +5,9 @@
 //! answers with a typed [`ServiceError`] that the HTTP layer maps to a status.
 //!
 //! Layering: handlers (`crate::http`) call this layer only; only this layer
-//! calls the store (`crate::db`), whose errors ([`StoreError`]) are robocal's
-//! own. A new resource gets a store file (`db/<resource>.rs`), a service file
+//! calls the store (`crate::db`), whose errors (`StoreError`) are robocal's
+//! own and become a [`ServiceError`] here. The rows both layers speak of are
+//! in `crate::records`. A new resource gets a store file (`db/<resource>.rs`), a service file
 //! here (`<resource>.rs`: the commands and reads, with the caches kept in step)
 //! and a handler file (`http/<resource>.rs` with its `routes()`).
 
@@ -37,7 +38,7 @@ mod waiting;
 pub use gate::WorkGate;
 pub use state::{AppState, RobotContext, ServiceConfig};
 
-pub use crate::db::StoreError;
+use crate::db::StoreError;
 
 /// Why a service operation did not happen.
 #[derive(Debug, thiserror::Error)]
@@ -57,15 +58,25 @@ pub enum ServiceError {
     /// The service cannot take the command now (shutting down).
     #[error("{0}")]
     Unavailable(String),
-    /// The store failed (unavailable, a conflicting concurrent write, a bug).
-    #[error("{0}")]
-    Store(#[from] StoreError),
     /// A robot program that cannot be parsed: file, line and column.
     #[error("{0}")]
     Unparsable(#[from] crate::solve::program::ParseError),
     /// A bug or corrupt stored data; logged, never shown to the client.
     #[error("{0}")]
     Internal(String),
+}
+
+/// A store failure in the service's terms: a missing row is not found, a
+/// concurrent write a conflict, no connection unavailable, anything else a bug.
+impl From<StoreError> for ServiceError {
+    fn from(e: StoreError) -> Self {
+        match e {
+            StoreError::NotFound(m) => ServiceError::NotFound(m),
+            StoreError::Conflict(m) => ServiceError::Conflict(m),
+            e @ StoreError::Unavailable(_) => ServiceError::Unavailable(e.to_string()),
+            e @ StoreError::Internal(_) => ServiceError::Internal(e.to_string()),
+        }
+    }
 }
 
 impl ServiceError {

@@ -12,8 +12,8 @@ use super::limits::SMALL_SOLVE_MAX;
 use super::solve::{choose_version, resolve, ItemChoice, ModelChoice};
 use super::{AppState, ServiceError};
 use crate::calibrate::compensate::{CalibratedModelFile, CompensatedModel};
-use crate::db::{CellKind, ItemFrame};
 use crate::model::RobotModel;
+use crate::records::{CellKind, ItemFrame};
 use crate::solve::cell::accuracy::{
     measurement_tool_accuracy, tool_accuracy, ToolAccuracy, ValidationEvidence,
 };

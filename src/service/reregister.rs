@@ -14,7 +14,8 @@
 use super::checks::{self, conflict};
 use super::{versions, AppState, ServiceError};
 use crate::calibrate::compensate::CalibratedModelFile;
-use crate::db::{NewVersion, VersionRow};
+use crate::db::NewVersion;
+use crate::records::VersionRow;
 use robocal_core::check::{reregister as refit, ReregisterError};
 use serde_json::json;
 

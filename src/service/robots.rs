@@ -3,7 +3,7 @@
 
 use super::{AppState, ServiceError};
 use crate::db::Listing;
-pub use crate::db::{NewRobot, RobotRow};
+use crate::records::{NewRobot, RobotRow};
 use serde_json::{Map, Value};
 use std::sync::atomic::Ordering;
 

@@ -8,10 +8,10 @@
 //! upload declared.
 
 use super::{AppState, ServiceError};
-pub use crate::db::{AngleUnit, LengthUnit, SetFormat, SetRow};
 use crate::db::{Listing, NewSet};
 use crate::measure::csv::{self, CsvError, ReadOptions};
 use crate::measure::{MeasuredPose, SetRole};
+use crate::records::{AngleUnit, LengthUnit, SetFormat, SetRow};
 
 /// What the upload carries.
 #[derive(Debug, Clone)]

@@ -2,8 +2,8 @@
 //! of the active version drops the robot's cached context and solvers.
 
 use super::{robots, AppState, ServiceError};
-pub use crate::db::VersionRow;
 use crate::db::{Listing, Rollback};
+use crate::records::VersionRow;
 
 /// One page of a robot's versions by number (the robot must exist).
 pub async fn page(

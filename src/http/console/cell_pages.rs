@@ -3,8 +3,8 @@
 //! per-target report, download the filtered files).
 
 use super::fields::model_select;
-use crate::service::cell::{CellItemRow, ItemFrame};
-use crate::service::versions::VersionRow;
+use crate::records::VersionRow;
+use crate::records::{CellItemRow, ItemFrame};
 use maud::{html, Markup};
 
 fn pose_text(r: &CellItemRow) -> String {

@@ -5,9 +5,10 @@
 //! (`core::check::CheckStatus`) has its colour and its meaning (the legend);
 //! a `shifted` check shows the shift's size wherever it is shown.
 
-use crate::service::checks::{shift_of, status_of, CheckRow};
-use crate::service::sets::SetRow;
-use crate::service::versions::VersionRow;
+use crate::records::CheckRow;
+use crate::records::SetRow;
+use crate::records::VersionRow;
+use crate::service::checks::{shift_of, status_of};
 use maud::{html, Markup};
 use robocal_core::check::{CheckStatus, CheckThresholds, ShiftSize};
 

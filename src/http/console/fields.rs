@@ -1,6 +1,6 @@
 //! Form fields more than one console page shows.
 
-use crate::service::versions::VersionRow;
+use crate::records::VersionRow;
 use maud::{html, Markup};
 
 /// The "Model" picker of a solve or a filter: the active version, every

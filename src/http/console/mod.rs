@@ -23,8 +23,8 @@ mod fields;
 mod pages;
 
 use super::{route, ApiError, ApiPath, AppState, Route};
+use crate::records::CellKind;
 use crate::service;
-use crate::service::cell::CellKind;
 use axum::extract::State;
 use axum::http::{header, HeaderValue, Method};
 use axum::response::{Html, IntoResponse, Response};

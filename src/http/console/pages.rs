@@ -7,12 +7,12 @@ use crate::http::calibrations::DEFAULT_METHODS;
 use crate::measure::convention::MeasuredOrientation;
 use crate::measure::SetRole;
 use crate::model::presets::PRESETS;
+use crate::records::CellItemRow;
+use crate::records::RobotRow;
+use crate::records::SetRow;
+use crate::records::VersionRow;
+use crate::records::{CalibrationRow, JobStatus};
 use crate::report::page_head;
-use crate::service::calibrations::{CalibrationRow, JobStatus};
-use crate::service::cell::CellItemRow;
-use crate::service::robots::RobotRow;
-use crate::service::sets::SetRow;
-use crate::service::versions::VersionRow;
 use maud::{html, Markup, PreEscaped, DOCTYPE};
 
 const SCRIPT: &str = include_str!("console.js");
@@ -67,7 +67,7 @@ pub struct RobotView {
     /// The latest check's status, the thresholds and the history (oldest first).
     pub status: Option<robocal_core::check::CheckStatus>,
     pub thresholds: robocal_core::check::CheckThresholds,
-    pub checks: Vec<crate::service::checks::CheckRow>,
+    pub checks: Vec<crate::records::CheckRow>,
 }
 
 fn layout(title: &str, keys: bool, body: Markup) -> Markup {

@@ -5,7 +5,7 @@
 use super::prepare::Job;
 use super::runner::execute;
 use super::stored::load;
-use crate::db::JobStatus;
+use crate::records::JobStatus;
 use crate::service::{AppState, ServiceError};
 
 /// Runs a queued job of this process (SQLite) once a worker slot is free.

@@ -5,9 +5,9 @@
 
 use super::command::StartCommand;
 use crate::calibrate::identify::{CalibrationOptions, PoseSource, PoseSources};
-use crate::db::{SetRow, StoredRole};
 use crate::measure::Measurement;
 use crate::model::RobotModel;
+use crate::records::{SetRow, StoredRole};
 use crate::service::limits::{Ticket, MAX_SETS};
 use crate::service::{AppState, ServiceError};
 

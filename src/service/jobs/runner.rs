@@ -11,7 +11,8 @@
 use super::prepare::Job;
 use super::versions::{summary_of, versions_of};
 use crate::calibrate::identify::{calibrate_with_training, CalibrationError, Progress};
-use crate::db::{JobResult, JobStatus};
+use crate::db::JobResult;
+use crate::records::JobStatus;
 use crate::service::gate::At;
 use crate::service::AppState;
 use std::sync::atomic::{AtomicBool, Ordering};

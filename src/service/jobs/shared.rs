@@ -21,7 +21,8 @@
 
 use super::runner::{execute, Claim};
 use super::stored::load;
-use crate::db::{ClaimedJob, JobStatus, Lease};
+use crate::db::{ClaimedJob, Lease};
+use crate::records::JobStatus;
 use crate::service::{AppState, ServiceError};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;

@@ -6,8 +6,8 @@
 use super::command::{Format1Options, StartCommand};
 use super::prepare::{prepare, Job};
 use crate::calibrate::identify::Method;
-use crate::db::CalibrationRow;
 use crate::model::RobotModel;
+use crate::records::CalibrationRow;
 use crate::service::{AppState, ServiceError};
 
 /// The command a stored job was queued with: the same sets, methods and

@@ -5,8 +5,9 @@
 use crate::calibrate::identify::{
     calibrated_model_file, CalibrationOptions, CalibrationReport, FailedMethod,
 };
-use crate::db::{JobSummary, NewVersion};
+use crate::db::NewVersion;
 use crate::model::RobotModel;
+use crate::records::JobSummary;
 use serde_json::json;
 
 /// The summary of a report: the best method by validation mean (by
