@@ -7,11 +7,10 @@
 //! number 0 or beyond its range, one held twice) is refused naming the item;
 //! a Fanuc export writes position registers only with `--registers`.
 
-use super::model_files::load_compensated;
 use crate::solve::cell::export::{export_cell, ExportOptions, RegisterRange};
 use crate::solve::cell::CellDescription;
 use crate::solve::program::Language;
-use anyhow::{bail, Context};
+use anyhow::Context;
 use clap::{Args, Subcommand};
 
 #[derive(Debug, Args)]
@@ -50,13 +49,7 @@ pub struct CellExportArgs {
 /// The exported text.
 pub fn export_to_string(a: &CellExportArgs) -> anyhow::Result<String> {
     let language: Language = a.language.parse()?;
-    let mut model = load_compensated(&a.model).map_err(|e| anyhow::anyhow!("{e}"))?;
-    if let Some(p) = a.payload_kg {
-        if !(p.is_finite() && p >= 0.0) {
-            bail!("--payload-kg must be a non-negative number, got {p}");
-        }
-        model.payload_kg = p;
-    }
+    let model = super::model_files::load_with_payload(&a.model, a.payload_kg)?;
     let text = std::fs::read_to_string(&a.cell)
         .with_context(|| format!("cannot read cell file {}", a.cell))?;
     let cell = CellDescription::from_json(&text)

@@ -5,8 +5,6 @@
 //! to by number or name come from a cell file (`core::cell::file`: mm,
 //! degrees); RAPID modules and URScript carry their own.
 
-use super::model_files::load_compensated;
-use crate::solve::cell::{Cell, CellDescription};
 use crate::solve::ik::IkSettings;
 use crate::solve::program::{filter, Language, ProgramFile};
 use anyhow::{bail, Context};
@@ -57,23 +55,8 @@ pub fn filter_to_string(a: &FilterArgs) -> anyhow::Result<String> {
 
 /// The report JSON and how many targets failed or were skipped.
 pub fn filter_report(a: &FilterArgs) -> anyhow::Result<super::exit::Outcome> {
-    let mut model = load_compensated(&a.model).map_err(|e| anyhow::anyhow!("{e}"))?;
-    if let Some(p) = a.payload_kg {
-        if !(p.is_finite() && p >= 0.0) {
-            bail!("--payload-kg must be a non-negative number, got {p}");
-        }
-        model.payload_kg = p;
-    }
-    let cell = match &a.cell {
-        None => Cell::default(),
-        Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .with_context(|| format!("cannot read cell file {path}"))?;
-            CellDescription::from_json(&text)
-                .and_then(|d| d.to_cell())
-                .with_context(|| path.clone())?
-        }
-    };
+    let model = super::model_files::load_with_payload(&a.model, a.payload_kg)?;
+    let cell = super::model_files::load_cell(a.cell.as_deref())?;
     let mut files = Vec::with_capacity(a.files.len());
     for path in &a.files {
         let text = std::fs::read_to_string(path)

@@ -6,6 +6,8 @@ use crate::calibrate::compensate::{
     parse_compensated, CalibratedModelFile, CompensateError, CompensatedModel,
 };
 use crate::model::preset;
+use crate::solve::cell::{Cell, CellDescription};
+use anyhow::Context;
 use std::path::Path;
 
 /// Loads a calibrated model file, a model JSON file or a preset name.
@@ -29,6 +31,32 @@ pub fn load_compensated(arg: &str) -> Result<CompensatedModel, CompensateError> 
     } else {
         Ok(CompensatedModel::from_nominal(preset(arg)?))
     }
+}
+
+/// The model of `--model` with `--payload-kg` applied: the payload of tools
+/// without a load of their own (default: the model file's).
+pub fn load_with_payload(arg: &str, payload_kg: Option<f64>) -> anyhow::Result<CompensatedModel> {
+    let mut model = load_compensated(arg).map_err(|e| anyhow::anyhow!("{e}"))?;
+    if let Some(p) = payload_kg {
+        if !(p.is_finite() && p >= 0.0) {
+            anyhow::bail!("--payload-kg must be a non-negative number, got {p}");
+        }
+        model.payload_kg = p;
+    }
+    Ok(model)
+}
+
+/// The cell of `--cell` (tools with their loads, work objects; JSON, mm and
+/// degrees), or an empty cell without the option.
+pub fn load_cell(path: Option<&str>) -> anyhow::Result<Cell> {
+    let Some(path) = path else {
+        return Ok(Cell::default());
+    };
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read cell file {path}"))?;
+    CellDescription::from_json(&text)
+        .and_then(|d| d.to_cell())
+        .with_context(|| path.to_string())
 }
 
 /// The model a calibration starts from: a preset, a model JSON file, or any

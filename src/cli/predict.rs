@@ -14,7 +14,6 @@
 //! validation data, or `unverified` for a tool after a position-only
 //! calibration, never the measured point's figure for a tool.
 
-use super::model_files::load_compensated;
 use super::solve::OutputFormat;
 use crate::calibrate::compensate::CalibratedModelFile;
 use crate::measure::csv_text::dialect_from_names;
@@ -24,11 +23,9 @@ use crate::solve::cell::accuracy::{
     measurement_tool_accuracy, tool_accuracy, ToolAccuracy, ValidationEvidence,
 };
 use crate::solve::cell::joints_csv::parse_joints_csv;
-use crate::solve::cell::{
-    Cell, CellDescription, CellRef, Forward, PoseOut, PredictFrame, Predicted,
-};
+use crate::solve::cell::{CellRef, Forward, PoseOut, PredictFrame, Predicted};
 use crate::solve::ik::TargetFrame;
-use anyhow::{bail, Context};
+use anyhow::Context;
 use clap::Args;
 use serde_json::json;
 use std::fmt::Write as _;
@@ -97,13 +94,7 @@ pub fn predict_to_string(a: &PredictArgs) -> anyhow::Result<String> {
 
 /// What the command prints and how many readings failed.
 pub fn predict_outcome(a: &PredictArgs) -> anyhow::Result<super::exit::Outcome> {
-    let mut model = load_compensated(&a.model).map_err(|e| anyhow::anyhow!("{e}"))?;
-    if let Some(p) = a.payload_kg {
-        if !(p.is_finite() && p >= 0.0) {
-            bail!("--payload-kg must be a non-negative number, got {p}");
-        }
-        model.payload_kg = p;
-    }
+    let model = super::model_files::load_with_payload(&a.model, a.payload_kg)?;
     let frame: TargetFrame = a.frame.parse().map_err(anyhow::Error::msg)?;
     let conv = a
         .convention
@@ -111,16 +102,7 @@ pub fn predict_outcome(a: &PredictArgs) -> anyhow::Result<super::exit::Outcome> 
         .map(OrientationConvention::from_name)
         .transpose()
         .map_err(|e| anyhow::anyhow!("--convention: {e}"))?;
-    let cell = match &a.cell {
-        None => Cell::default(),
-        Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .with_context(|| format!("cannot read cell file {path}"))?;
-            CellDescription::from_json(&text)
-                .and_then(|d| d.to_cell())
-                .with_context(|| path.clone())?
-        }
-    };
+    let cell = super::model_files::load_cell(a.cell.as_deref())?;
     let tool = match &a.tool {
         Some(t) => Some(cell.tool(&t.parse::<CellRef>()?)?),
         None => None,

@@ -20,10 +20,9 @@
 //! the calibrated flange; with `--work-object NAME` the targets and the false
 //! targets are poses in that work object (`core::cell`).
 
-use super::model_files::load_compensated;
 use crate::measure::csv_text::dialect_from_names;
 use crate::model::orientation::OrientationConvention;
-use crate::solve::cell::{Cell, CellDescription, CellRef, CellSolver};
+use crate::solve::cell::{CellRef, CellSolver};
 use crate::solve::ik::targets_csv::CONVENTION_COLUMNS;
 use crate::solve::ik::{
     parse_targets_csv, results_csv, Configuration, IkSettings, SolveOptions, TargetFrame,
@@ -134,25 +133,10 @@ pub fn solve_to_string(a: &SolveArgs) -> anyhow::Result<String> {
 
 /// What the command prints and how many targets failed.
 pub fn solve_outcome(a: &SolveArgs) -> anyhow::Result<super::exit::Outcome> {
-    let mut model = load_compensated(&a.model).map_err(|e| anyhow::anyhow!("{e}"))?;
-    if let Some(p) = a.payload_kg {
-        if !(p.is_finite() && p >= 0.0) {
-            bail!("--payload-kg must be a non-negative number, got {p}");
-        }
-        model.payload_kg = p;
-    }
+    let model = super::model_files::load_with_payload(&a.model, a.payload_kg)?;
     let mut frame: TargetFrame = a.frame.parse().map_err(anyhow::Error::msg)?;
     let mut frame_label = frame.to_string();
-    let cell = match &a.cell {
-        None => Cell::default(),
-        Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .with_context(|| format!("cannot read cell file {path}"))?;
-            CellDescription::from_json(&text)
-                .and_then(|d| d.to_cell())
-                .with_context(|| path.clone())?
-        }
-    };
+    let cell = super::model_files::load_cell(a.cell.as_deref())?;
     let tool = match &a.tool {
         Some(t) => Some(cell.tool(&t.parse::<CellRef>()?)?),
         None => None,
