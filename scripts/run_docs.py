@@ -12,6 +12,7 @@ set (as in one terminal), and with these changes, and nothing else:
 - `cargo run [--release] [-q] --` becomes the given binary (`robocal` is on PATH too);
 - the ports of `127.0.0.1:NNNN` / `localhost:NNNN` become free ports, one per port the pages
   name (8080 is the service of the quick start), and `$API` is its address;
+- `curl` fails on an HTTP error answer (4xx, 5xx), printing it (`--fail-with-body`);
 - a line that starts `robocal serve` (after any `VAR=value` prefix) starts the service in the
   background with `--bind` on its mapped port, stopping the one this script started on that
   port before (the pages say to stop it), and waits until `/readyz` answers.
@@ -125,7 +126,7 @@ __robocal_serve() {  # PORT, then the command; the service runs in the backgroun
     echo $! > ".serve.$port.pid"
     local i
     for i in $(seq 1 $((READY_TIMEOUT_S * 10))); do
-        if curl -sf "http://127.0.0.1:$port/readyz" >/dev/null; then return 0; fi
+        if command curl -sf "http://127.0.0.1:$port/readyz" >/dev/null; then return 0; fi
         if ! kill -0 "$(cat ".serve.$port.pid")" 2>/dev/null; then
             echo "the service on port $port ended:" >&2; cat "serve.$port.log" >&2; return 1
         fi
@@ -133,11 +134,12 @@ __robocal_serve() {  # PORT, then the command; the service runs in the backgroun
     done
     echo "the service on port $port did not become ready" >&2; return 1
 }
+curl() { command curl --fail-with-body "$@"; }  # an HTTP error answer fails the block
 __vars_before=$(compgen -v | sort)
 [ -f .vars.sh ] && . ./.vars.sh
 __save_vars() {  # the shell variables the blocks so far set, for the next block
     local names
-    names=$(comm -13 <(echo "$__vars_before") <(compgen -v | sort) | grep -Ev '^(_|__.*|BASH.*|REPLY|OPT.*|COMP.*)$' || true)
+    names=$(comm -13 <(echo "$__vars_before") <(compgen -v | sort) | grep -Ev '^(_|__.*|BASH.*|REPLY|OPT.*|COMP.*|FUNCNAME|PIPESTATUS|GROUPS|LINENO|RANDOM|SRANDOM|SECONDS|EPOCH.*)$' || true)
     if [ -n "$names" ]; then declare -p $names > .vars.sh; fi
 }
 """
