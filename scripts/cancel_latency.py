@@ -12,7 +12,7 @@ compensator, joint-map or `auto` method it uploads `--ident` identification
 and `--poses` training poses of the simulated YS100 with unmodelled effects
 (gear transmission error, backlash; `--one-set`: the `--poses` poses identify
 and train, and `--transmission` adds fine per-joint transmission errors, as the
-README's 10,000-pose `skcm,auto` run). `auto` runs as `["skcm", "auto"]`, what
+docs/benchmarks.md's 10,000-pose `skcm,auto` run). `auto` runs as `["skcm", "auto"]`, what
 the CLI's `--method skcm,auto` runs.
 
 When to cancel: by default once the method's training reports progress; with

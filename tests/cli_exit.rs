@@ -1,7 +1,7 @@
 //! Exit codes a script can gate on (issue 42), asserted on the real binary:
 //! `check` ends with its status's code (0 only for `ok`), `filter` and
 //! `solve` with 2 when a target failed unless `--allow-failures`, refused
-//! input with 1; README's "Exit codes and statuses" is the code's table.
+//! input with 1; docs/guide/exit-codes.md states the code's table.
 
 use robocal::calibrate::compensate::CompensatedModel;
 use robocal::check::CheckStatus;
@@ -27,19 +27,16 @@ fn stdout(out: &Output) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
-/// The rows of a markdown table under `heading` of README.md, the cells
-/// trimmed; every table of the section, in order.
-fn readme_tables(heading: &str) -> Vec<Vec<Vec<String>>> {
-    let readme =
-        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md")).unwrap();
-    let start = readme
-        .find(&format!("\n## {heading}\n"))
-        .unwrap_or_else(|| panic!("README has no section {heading}"));
-    let section = &readme[start + 1..];
-    let end = section[3..].find("\n## ").map_or(section.len(), |e| e + 3);
+/// The rows of every markdown table of the guide's page `name`
+/// (docs/guide/), the cells trimmed, in order.
+fn guide_tables(name: &str) -> Vec<Vec<Vec<String>>> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("docs/guide")
+        .join(name);
+    let page = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let mut tables: Vec<Vec<Vec<String>>> = Vec::new();
     let mut in_table = false;
-    for line in section[..end].lines() {
+    for line in page.lines() {
         let line = line.trim();
         if !line.starts_with('|') {
             in_table = false;
@@ -66,8 +63,8 @@ fn readme_tables(heading: &str) -> Vec<Vec<Vec<String>>> {
 }
 
 #[test]
-fn readme_states_the_exit_codes_and_statuses_of_the_code() {
-    let tables = readme_tables("Exit codes and statuses");
+fn the_guide_states_the_exit_codes_and_statuses_of_the_code() {
+    let tables = guide_tables("exit-codes.md");
     assert_eq!(tables.len(), 2, "{tables:?}");
     let codes = &tables[0];
     assert_eq!(codes[0], ["code", "name", "commands", "meaning"]);

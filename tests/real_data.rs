@@ -239,7 +239,7 @@ async fn real_wam_all_methods_over_http() {
     eprintln!("{line}");
 }
 
-/// The README's real-data commands run as written (from the repository root).
+/// The real-data commands of docs/guide/cli.md run as written (from the repository root).
 #[test]
 fn real_data_cli_commands_run_as_written() {
     let run = |model: &str, dir: &str, methods: &str| -> Value {

@@ -3,7 +3,7 @@
 //! the robot reaches (from the nominal model's forward kinematics of random
 //! joints, with their `S`/`T` flags) against the same targets moved 3 m out
 //! of the workspace. The cost of an unreachable target is quoted as a ratio
-//! to a reached one (README "Limits").
+//! to a reached one (docs/guide/api.md, "The service: storage, routes and limits").
 //!
 //! Run: `cargo bench -p robocal-core --bench filter` (about 15 s).
 

@@ -188,7 +188,7 @@ fn thousand_poses_every_compensator_beats_its_base() {
             comp.max_mm
         );
         // IWO with the thesis's loss (eq. 5.7, mean + 0.7·max over 850 fitting
-        // poses) does not reach the 15 % here (README, "Compensators");
+        // poses) does not reach the 15 % here (docs/guide/compensators.md);
         // it is reported, not held to it.
         if !method.ends_with("iwonn") {
             assert!(gain >= 0.15, "{method}: only {:.1} % better", gain * 100.0);

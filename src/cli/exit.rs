@@ -1,6 +1,6 @@
 //! The exit codes of `robocal`: one table from which each command's `--help`,
-//! the process's exit status (`main.rs`) and README's "Exit codes and
-//! statuses" derive (`tests/cli_exit.rs` checks README against it).
+//! the process's exit status (`main.rs`) and the tables of
+//! docs/guide/exit-codes.md derive (`tests/cli_exit.rs` checks them).
 //!
 //! A script gates on them: `0` only when every result is right (for `check`:
 //! the status is `ok`); `1` when the input was refused and nothing was
@@ -51,7 +51,7 @@ impl Scope {
         }
     }
 
-    /// As README's table writes it.
+    /// As the guide's table writes it.
     pub fn label(self) -> String {
         match self {
             Scope::Every => "every command".into(),
@@ -199,7 +199,7 @@ pub fn help_for(command: &str) -> String {
     for e in Exit::ALL.iter().filter(|e| e.scope().includes(command)) {
         let _ = writeln!(s, "  {}  {:<11}  {}", e.code(), e.name(), e.meaning());
     }
-    s.push_str("(README.md, \"Exit codes and statuses\")");
+    s.push_str("(docs/guide/exit-codes.md)");
     s
 }
 
@@ -216,11 +216,12 @@ pub fn help_all() -> String {
             e.meaning()
         );
     }
-    s.push_str("(README.md, \"Exit codes and statuses\")");
+    s.push_str("(docs/guide/exit-codes.md)");
     s
 }
 
-/// README's two tables: the exit codes, and the statuses of a check.
+/// The guide's two tables (docs/guide/exit-codes.md): the exit codes, and
+/// the statuses of a check.
 pub fn readme_tables() -> String {
     let mut s = String::from("| code | name | commands | meaning |\n|---|---|---|---|\n");
     for e in Exit::ALL {

@@ -1,8 +1,9 @@
 //! Limits and back-pressure of the service.
 //!
 //! Every limit has a default that suits one cell on a 2-core machine and can be
-//! changed with a `robocal serve` flag or its environment variable (README
-//! "The service"). Requests beyond a size limit get a 4xx that names the limit;
+//! changed with a `robocal serve` flag or its environment variable
+//! (docs/guide/api.md, "The service: storage, routes and limits"). Requests
+//! beyond a size limit get a 4xx that names the limit;
 //! work that cannot be admitted because the service is saturated gets
 //! `429 Too Many Requests` with `Retry-After`, never a silent wait:
 //!

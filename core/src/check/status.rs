@@ -1,6 +1,6 @@
 //! The statuses a check gives a robot: one table (name, when, what to do)
 //! from which the CLI's output and exit codes, the API's `CheckStatus` enum,
-//! the console's colours and README's "Exit codes and statuses" derive.
+//! the console's colours and docs/guide/exit-codes.md derive.
 //!
 //! Judged on the mean position error [mm] of the check with the robot's
 //! thresholds ([`super::CheckThresholds`]); a rigid frame shift that explains
