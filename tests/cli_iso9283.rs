@@ -28,7 +28,7 @@ fn iso_args(argv: &[&str]) -> Iso9283Args {
 fn cube(argv: &[&str]) -> String {
     match iso_args(argv).command {
         Some(Iso9283Command::Plan(c)) => make(&c).unwrap(),
-        None => panic!("not a plan"),
+        _ => panic!("not a plan"),
     }
 }
 
@@ -154,7 +154,7 @@ fn the_cube_plan_cycles_in_a_program_and_the_figures_match_hand_values() {
     assert_eq!((ap.as_str(), rp.as_str()), ("1.4142", "4.7974"));
     assert_eq!(
         rows[0],
-        ["pose", "characteristic", "unit", &p("cycles.csv")]
+        ["pose", "characteristic", "unit", p("cycles.csv").as_str()]
     );
     for k in 1..=5 {
         let pose = format!("P{k}");
@@ -164,7 +164,13 @@ fn the_cube_plan_cycles_in_a_program_and_the_figures_match_hand_values() {
         assert_eq!(cell(&rows, &pose, "APa"), ["— (no_orientation_measured)"]);
     }
     assert_eq!(cell(&rows, "P4–P5", "n"), ["3"]);
-    assert_eq!(cell(&rows, "P1–P2", "AD"), ["0.0000"]);
+    // D_c is the commanded distance of P1 and P2.
+    let dc: f64 = cell(&rows, "P1–P2", "D_c")[0].parse().unwrap();
+    let d: f64 = (0..3)
+        .map(|k| (plan[0].xyz_mm[k] - plan[1].xyz_mm[k]).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    assert!((dc - d).abs() < 1e-4, "{dc} vs {d}");
     // A plan without its cycles file is refused.
     assert!(figures(&figures_of(&["--plan", &p("plan.csv")])).is_err());
 }
@@ -559,8 +565,8 @@ fn a_before_after_report_is_one_table_under_its_conditions_and_the_tracker_expor
             "pose",
             "characteristic",
             "unit",
-            &p("before.csv"),
-            &p("after.csv"),
+            p("before.csv").as_str(),
+            p("after.csv").as_str(),
             "change"
         ]
     );
