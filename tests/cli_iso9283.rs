@@ -78,6 +78,30 @@ fn the_cube_plan_cycles_in_a_program_and_the_figures_match_hand_values() {
     )
     .unwrap();
     assert_eq!(program.joints.len(), 15);
+    // The Fanuc program, with a comment line per motion, parses back the same.
+    cube(
+        &[
+            &common[..],
+            &["--format", "fanuc", "--cycles", "3", "--out", &p("ISO.LS")],
+        ]
+        .concat(),
+    );
+    let fanuc = std::fs::read_to_string(p("ISO.LS")).unwrap();
+    assert!(fanuc.contains("  ! P5 cycle 3 ;"), "{fanuc}");
+    let fanuc = parse(
+        Language::Fanuc,
+        &[ProgramFile {
+            name: "ISO.LS".into(),
+            text: fanuc,
+        }],
+    )
+    .unwrap();
+    assert_eq!(fanuc.joints.len(), 15);
+    for (a, b) in fanuc.joints.iter().zip(&program.joints) {
+        for (x, y) in a.deg.iter().zip(&b.deg) {
+            assert!((x - y).abs() < 1e-9, "{x} vs {y}");
+        }
+    }
     let plan_text = std::fs::read_to_string(p("plan.csv")).unwrap();
     let joints: Vec<Vec<f64>> = plan_text
         .lines()

@@ -167,7 +167,10 @@ pub fn join_cycles(
     let mut rows: Vec<(usize, CycleRow)> = Vec::with_capacity(keys.len());
     for (k, ((i, cycle), xyz)) in keys.iter().zip(&e.xyz).enumerate() {
         let xyz_mm = xyz.map(|v| v * scale);
-        if let Some(v) = xyz_mm.iter().find(|v| !(v.abs() <= XYZ_MAX_MM)) {
+        if let Some(v) = xyz_mm
+            .iter()
+            .find(|v| !(v.is_finite() && v.abs() <= XYZ_MAX_MM))
+        {
             return Err(CycleJoinError::OutOfRange {
                 point: k + 1,
                 value: *v,
