@@ -372,8 +372,8 @@ fn check_names_a_moved_tracker_and_a_changed_robot() {
     assert!(rescored.position.max_mm < 1e-3, "{:?}", rescored.position);
 }
 
-/// The attained positions of a run: each pose reached at its command
-/// + `s`·((−1, −1, 0) + (0 | 2 | 4, 0, 0)) in cycles 1, 2, 3, so that
+/// The attained positions of a run: each pose reached at its command plus
+/// `s`·((−1, −1, 0) + (0 | 2 | 4, 0, 0)) in cycles 1, 2, 3, so that
 /// AP = s·√2 and RP = s·(4/3 + 3·√(4/3)) at every pose.
 fn run_positions(
     plan: &[robocal_core::check::iso9283::csv::Commanded],

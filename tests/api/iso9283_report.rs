@@ -18,9 +18,9 @@ fn hex(bytes: &[u8]) -> String {
     bytes.iter().map(|b| format!("{b:02x}")).collect()
 }
 
-/// Cycles CSV of a run of `plan`: each pose reached at its command
-/// + `s`·((−1, −1, 0) + (0 | 2 | 4, 0, 0)) in cycles 1, 2, 3, so that
-///   AP = s·√2 and RP = s·(4/3 + 3·√(4/3)) at every pose.
+/// Cycles CSV of a run of `plan`: each pose reached at its command plus
+/// `s`·((−1, −1, 0) + (0 | 2 | 4, 0, 0)) in cycles 1, 2, 3, so that
+/// AP = s·√2 and RP = s·(4/3 + 3·√(4/3)) at every pose.
 fn run_csv(plan: &str, s: f64) -> String {
     let mut out = String::from("pose,cycle,x_mm,y_mm,z_mm\n");
     for c in &read_plan_csv(plan).unwrap() {
