@@ -56,7 +56,7 @@ Controller flags, as robocal reads them in programs (filter) and writes them (re
              in front; t = floor((A + 180 deg)/360 deg) of axes 1, 4, 6.
   URScript   none: the controller takes the solution nearest its joints.
 A1 ... A6 are this model's controller joints (its per-joint `sign` and `zero`), so the A5 and turn bits follow
-this model's axis directions, which can differ from the maker's: the presets use the kinematic angles (the
+this model's axis directions, which can differ from the maker's: the Hyundai presets use the kinematic angles (the
 YS100's A2 is 90 deg with the arm upright, where a KUKA's is -90 deg, so T bit 1 is never set on it).
 A required branch the target lacks, or program flags no solution carries, fails naming the branches (and
 their flags) that do reach it within the joint limits. Per robot family: docs/configurations.md.";
