@@ -6,7 +6,9 @@
 //! ```text
 //! robocal iso9283 plan --model cal.json --box "1000,-400,300,1800,400,1100" \
 //!     --commands filtered --format krl --cycles 30 --out iso.src --csv iso_plan.csv
-//! robocal iso9283 --plan iso_plan.csv --measured cycles.csv [--json] [--report iso.html]
+//! robocal iso9283 join --plan iso_plan.csv --tracker-export export.csv --out cycles.csv
+//! robocal iso9283 --plan iso_plan.csv --measured cycles.csv [--json] \
+//!     [--report iso.html --robot R --model cal.json --load-kg 10 --speed-percent 100]
 //! ```
 //!
 //! Box and orientation (`--rpy`, fixed-axis `R = Rz·Ry·Rx`, deg): base frame.
@@ -16,13 +18,20 @@
 use crate::calibrate::compensate::CompensatedModel;
 use crate::model::orientation::fixed_xyz_matrix;
 use crate::plan::WorkspaceBox;
-use crate::solve::program::{export::joint_program, Language};
+use crate::plan::{JoinBy, JoinOptions, Units};
+use crate::report::iso9283::{
+    cycles_of, is_date, render_iso9283_html, today_utc, Iso9283Conditions, MeasuredSet,
+};
+use crate::solve::program::Language;
 use anyhow::{bail, Context};
 use clap::{Args, Subcommand, ValueEnum};
-use robocal_core::check::iso9283::csv::{plan_csv, read_cycles_csv, read_plan_csv};
+use robocal_core::check::iso9283::csv::{plan_csv, pose_data, read_cycles_csv, read_plan_csv};
+use robocal_core::check::iso9283::join::{cycles_csv, join_cycles};
+use robocal_core::check::iso9283::program::cycle_program;
 use robocal_core::check::iso9283::{
-    evaluate, plan_cube, Commands, CubePlan, CubeSettings, Iso9283Figures,
+    assess, evaluate, plan_cube, Commands, CubePlan, CubeSettings, Iso9283Figures,
 };
+use sha2::{Digest, Sha256};
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
@@ -39,6 +48,27 @@ pub struct Iso9283Args {
 pub enum Iso9283Command {
     /// Lay out the test cube and write its joint commands (CSV or a program).
     Plan(CubeArgs),
+    /// Join the tracker's export of a run to the plan into a cycles CSV.
+    Join(JoinArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct JoinArgs {
+    /// The plan CSV (`robocal iso9283 plan --csv`).
+    #[arg(long)]
+    pub plan: PathBuf,
+    /// The tracker export: point name (`P<i> cycle <k>`, optional), x, y, z.
+    #[arg(long)]
+    pub tracker_export: PathBuf,
+    /// Units of the export's positions: mm, m or detect.
+    #[arg(long, default_value = "detect")]
+    pub units: String,
+    /// Join by name, order (P1 … P5 of cycle 1, then of cycle 2, …) or detect.
+    #[arg(long, default_value = "detect")]
+    pub by: String,
+    /// Output cycles CSV (what `robocal iso9283 --measured` reads).
+    #[arg(long)]
+    pub out: PathBuf,
 }
 
 /// Which joint commands a plan drives.
@@ -112,9 +142,32 @@ pub struct FiguresArgs {
     /// Print JSON instead of the table.
     #[arg(long)]
     pub json: bool,
-    /// Also write the figures as an HTML report (one section per test) here.
+    /// Also write the ISO 9283 report as HTML here: the test conditions, then
+    /// one table of every test's figures side by side with the change.
     #[arg(long)]
     pub report: Option<PathBuf>,
+    /// The report's robot (name, serial number).
+    #[arg(long)]
+    pub robot: Option<String>,
+    /// The model file the commands were solved with: the report gives its
+    /// SHA-256 (a version's `model.json` hashes as the service's report does).
+    #[arg(long)]
+    pub model: Option<PathBuf>,
+    /// The model's version (default: the `--model` file's name).
+    #[arg(long)]
+    pub model_version: Option<String>,
+    /// Test date, YYYY-MM-DD (default: today, UTC).
+    #[arg(long)]
+    pub date: Option<String>,
+    /// Load carried during the test [kg].
+    #[arg(long)]
+    pub load_kg: Option<f64>,
+    /// Speed between the poses [% of the rated speed].
+    #[arg(long)]
+    pub speed_percent: Option<f64>,
+    /// What measured the cycles (tracker, reflector, session).
+    #[arg(long)]
+    pub measurement: Option<String>,
 }
 
 fn numbers<const N: usize>(flag: &str, s: &str) -> anyhow::Result<[f64; N]> {
@@ -145,7 +198,8 @@ pub fn cube_plan(model: &CompensatedModel, a: &CubeArgs) -> anyhow::Result<CubeP
     Ok(plan_cube(model, &settings)?)
 }
 
-/// The program text cycling `cycles` times through the plan's poses.
+/// The program text cycling `cycles` times through the plan's poses, each
+/// motion commented `P<i> cycle <k>` (`core::iso9283::program`).
 pub fn cube_program(
     plan: &CubePlan,
     language: Language,
@@ -153,18 +207,7 @@ pub fn cube_program(
     cycles: u32,
     wait_s: f64,
 ) -> anyhow::Result<String> {
-    let mut joints = Vec::new();
-    for p in &plan.poses {
-        let q: [f64; 6] = p.joints_deg.as_slice().try_into().map_err(|_| {
-            anyhow::anyhow!(
-                "programs need 6 joints, the model has {}",
-                p.joints_deg.len()
-            )
-        })?;
-        joints.push(q);
-    }
-    let cycled: Vec<[f64; 6]> = (0..cycles).flat_map(|_| joints.iter().copied()).collect();
-    Ok(joint_program(language, name, &cycled, wait_s)
+    Ok(cycle_program(plan, language, name, cycles, wait_s)?
         .into_iter()
         .map(|f| f.text)
         .collect())
@@ -255,6 +298,64 @@ pub fn figures_table(label: &str, f: &Iso9283Figures) -> String {
     s
 }
 
+fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// The report's conditions from the flags; `sets` the tests' measured sets.
+pub fn conditions(a: &FiguresArgs, sets: Vec<MeasuredSet>) -> anyhow::Result<Iso9283Conditions> {
+    let date = match &a.date {
+        Some(d) if is_date(d) => d.clone(),
+        Some(d) => bail!("--date: expected a date YYYY-MM-DD, got {d:?}"),
+        None => today_utc(),
+    };
+    for (flag, v) in [
+        ("--load-kg", a.load_kg),
+        ("--speed-percent", a.speed_percent),
+    ] {
+        if v.is_some_and(|v| !(v.is_finite() && v >= 0.0)) {
+            bail!("{flag}: expected a finite number ≥ 0");
+        }
+    }
+    let model_sha256 = match &a.model {
+        Some(p) => Some(hex(&Sha256::digest(
+            std::fs::read(p).with_context(|| format!("cannot read {}", p.display()))?,
+        ))),
+        None => None,
+    };
+    let model_version = a.model_version.clone().or_else(|| {
+        a.model
+            .as_ref()
+            .and_then(|p| p.file_name())
+            .map(|n| n.to_string_lossy().into_owned())
+    });
+    Ok(Iso9283Conditions {
+        robot: a.robot.clone(),
+        model_version,
+        model_sha256,
+        date,
+        load_kg: a.load_kg,
+        speed_percent: a.speed_percent,
+        measurement: a.measurement.clone(),
+        sets,
+        robocal_version: env!("CARGO_PKG_VERSION"),
+    })
+}
+
+/// The conditions a report should state and `a` leaves out (flag names).
+pub fn unstated(a: &FiguresArgs) -> Vec<&'static str> {
+    [
+        ("--robot", a.robot.is_none()),
+        ("--model", a.model.is_none() && a.model_version.is_none()),
+        ("--load-kg", a.load_kg.is_none()),
+        ("--speed-percent", a.speed_percent.is_none()),
+    ]
+    .into_iter()
+    .filter(|(_, missing)| *missing)
+    .map(|(f, _)| f)
+    .collect()
+}
+
 /// The figures of each plan and its measured cycles, as text or JSON.
 pub fn figures(a: &FiguresArgs) -> anyhow::Result<String> {
     if a.plan.is_empty() || a.plan.len() != a.measured.len() {
@@ -269,25 +370,82 @@ pub fn figures(a: &FiguresArgs) -> anyhow::Result<String> {
     };
     let mut out = String::new();
     let mut all = Vec::new();
-    let mut tests = Vec::new();
+    let mut assessed = Vec::new();
+    let mut sets = Vec::new();
     for (plan, measured) in a.plan.iter().zip(&a.measured) {
         let commanded = read_plan_csv(&read(plan)?).with_context(|| plan.display().to_string())?;
-        let cycles = read_cycles_csv(&read(measured)?, &commanded)
-            .with_context(|| measured.display().to_string())?;
+        let text = read(measured)?;
+        let cycles =
+            read_cycles_csv(&text, &commanded).with_context(|| measured.display().to_string())?;
         let f = evaluate(&cycles).with_context(|| measured.display().to_string())?;
         let label = measured.display().to_string();
         out.push_str(&figures_table(&label, &f));
         all.push(serde_json::json!({ "measured": label, "figures": f }));
-        tests.push((label, f));
+        let assessment = assess(&pose_data(&commanded, cycles))
+            .with_context(|| measured.display().to_string())?;
+        sets.push(MeasuredSet {
+            label: label.clone(),
+            cycles: cycles_of(&assessment),
+            sha256: Some(hex(&Sha256::digest(text.as_bytes()))),
+        });
+        assessed.push((label, assessment));
     }
     if let Some(path) = &a.report {
-        std::fs::write(path, crate::report::iso9283::render_iso9283_html(&tests))
+        let c = conditions(a, sets)?;
+        std::fs::write(path, render_iso9283_html(&c, &assessed))
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
     if a.json {
         return Ok(serde_json::to_string_pretty(&all)? + "\n");
     }
     Ok(out)
+}
+
+/// Joins the tracker export; returns a summary (the poses and cycles it
+/// lacks among them).
+pub fn join_files(a: &JoinArgs) -> anyhow::Result<String> {
+    let read = |p: &PathBuf| {
+        std::fs::read_to_string(p).with_context(|| format!("cannot read {}", p.display()))
+    };
+    let plan = read_plan_csv(&read(&a.plan)?).with_context(|| a.plan.display().to_string())?;
+    let units = match a.units.as_str() {
+        "mm" => Units::Mm,
+        "m" => Units::M,
+        "detect" => Units::Detect,
+        u => bail!("--units: mm, m or detect, got {u:?}"),
+    };
+    let by = match a.by.as_str() {
+        "name" => JoinBy::Name,
+        "order" => JoinBy::Order,
+        "detect" => JoinBy::Detect,
+        b => bail!("--by: name, order or detect, got {b:?}"),
+    };
+    let joined = join_cycles(&plan, &read(&a.tracker_export)?, &JoinOptions { units, by })
+        .with_context(|| a.tracker_export.display().to_string())?;
+    std::fs::write(&a.out, cycles_csv(&joined.rows))
+        .with_context(|| format!("cannot write {}", a.out.display()))?;
+    let mut s = format!(
+        "{} positions of {} poses over {} cycles joined by {} (read in {}) into {}\n",
+        joined.rows.len(),
+        plan.len(),
+        joined.cycles,
+        if joined.by == JoinBy::Order {
+            "order"
+        } else {
+            "name"
+        },
+        if joined.units == Units::M { "m" } else { "mm" },
+        a.out.display()
+    );
+    if !joined.missing.is_empty() {
+        let _ = writeln!(
+            s,
+            "not in the export ({}): {}",
+            joined.missing.len(),
+            joined.missing.join(", ")
+        );
+    }
+    Ok(s)
 }
 
 pub fn run(a: Iso9283Args) -> anyhow::Result<()> {
@@ -300,7 +458,24 @@ pub fn run(a: Iso9283Args) -> anyhow::Result<()> {
                 print!("{summary}");
             }
         }
-        None => print!("{}", figures(&a.figures)?),
+        Some(Iso9283Command::Join(j)) => print!("{}", join_files(j)?),
+        None => {
+            if a.figures.report.is_some() {
+                let missing = unstated(&a.figures);
+                if !missing.is_empty() {
+                    eprintln!(
+                        "the report states no {} (give {})",
+                        missing
+                            .iter()
+                            .map(|f| f.trim_start_matches("--").replace('-', " "))
+                            .collect::<Vec<_>>()
+                            .join(", "),
+                        missing.join(", ")
+                    );
+                }
+            }
+            print!("{}", figures(&a.figures)?)
+        }
     }
     Ok(())
 }

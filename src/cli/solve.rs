@@ -33,6 +33,33 @@ use clap::{Args, ValueEnum};
 use serde_json::json;
 use std::fmt::Write as _;
 
+/// `--branch` in `robocal solve --help`: the branches and how each
+/// controller's flags name them (`solve::program::Flags`; set out in
+/// docs/configurations.md).
+pub const CONFIGURATIONS_HELP: &str = "\
+Configuration branch: `front,up,noflip` (shoulder front|back, elbow up|down, wrist noflip|flip) or its index \
+0..7 (bit 0 back, bit 1 down, bit 2 flip). Without it, the solution nearest the previous target's joints \
+(--path), else --seed-deg, else the middle of the joint ranges.
+
+The branch is geometric, the same on every robot:
+  shoulder  front: the wrist centre in front of axis 1 (x >= 0 in link 1's frame); back: over the robot's back.
+  elbow     up: the elbow on the base-z side of the shoulder-wrist line, seen with the shoulder in front (so
+            with the shoulder back, `up` is physically below that line); down: the other side.
+  wrist     noflip: sin(theta5) >= 0 for joint 5's angle in the kinematic chain; flip: < 0.
+
+Controller flags, as robocal reads them in programs (filter) and writes them (reports, exports):
+  KUKA KRL   S = 1*back + 2*down + 4*[A5 < 0];  T: bit i set when axis i+1 < 0 (A1 = bit 0 ... A6 = bit 5).
+  ABB RAPID  [cf1, cf4, cf6, cfx]: cf1, cf4, cf6 the quadrant floor(A/90 deg) of axes 1, 4, 6;
+             cfx = 4*back + 2*down + [A5 < 0].
+  Fanuc      CONFIG 'F|N U|D T|B, t1, t4, t6': F when A5 < 0, U when the elbow is up, T when the shoulder is
+             in front; t = floor((A + 180 deg)/360 deg) of axes 1, 4, 6.
+  URScript   none: the controller takes the solution nearest its joints.
+A1 ... A6 are this model's controller joints (its per-joint `sign` and `zero`), so the A5 and turn bits follow
+this model's axis directions, which can differ from the maker's: the Hyundai presets use the kinematic angles (the
+YS100's A2 is 90 deg with the arm upright, where a KUKA's is -90 deg, so T bit 1 is never set on it).
+A required branch the target lacks, or program flags no solution carries, fails naming the branches (and
+their flags) that do reach it within the joint limits. Per robot family: docs/configurations.md.";
+
 #[derive(Debug, Args)]
 pub struct SolveArgs {
     /// Robot model: a preset (ys100, hh800, ur5, ur10), a model JSON file, or a
@@ -50,7 +77,7 @@ pub struct SolveArgs {
     pub payload_kg: Option<f64>,
     /// Configuration branch, e.g. `front,up,noflip` (shoulder front|back, elbow
     /// up|down, wrist noflip|flip) or a branch index 0..7.
-    #[arg(long)]
+    #[arg(long, long_help = CONFIGURATIONS_HELP)]
     pub branch: Option<String>,
     /// Joint seed in the controller convention [deg], e.g. "0,90,0,0,45,0": the
     /// branch nearest it is chosen.

@@ -37,6 +37,7 @@ pub const OPERATE: &[&str] = &[
     "/v1/robots/{id}/compare",
     "/v1/iso9283",
     "/v1/iso9283/csv",
+    "/v1/robots/{id}/iso9283/plan",
 ];
 
 /// The access a route (method and path template, as in `openapi.yaml`) needs.

@@ -9,12 +9,19 @@
 //! `POST /v1/iso9283/csv`: the same figures from the two CSV texts of
 //! `robocal iso9283 --plan P --measured M` (a grammar the spec cannot state:
 //! an unreadable CSV is 422 naming the test, the file and the line).
+//!
+//! Both take optional `conditions` (robot id and version, date, load,
+//! speed, measurement) and answer them resolved beside the figures — the
+//! robot's name and the version's SHA-256 from the store — or, with
+//! `Accept: text/html`, the ISO 9283 report page (`report::iso9283`).
 
-use super::input::{object_or_null, objects, present};
+use super::input::{object_or_null, objects, present, present_int};
 use super::{ApiError, ApiJson, AppState};
+use crate::report::iso9283::render_iso9283_html;
 use crate::service;
-use crate::service::iso9283::{Iso9283CsvTest, Iso9283Test};
+use crate::service::iso9283::{ConditionsCommand, Iso9283CsvTest, Iso9283Test};
 use axum::extract::State;
+use axum::http::{header, HeaderMap};
 use axum::response::{IntoResponse, Response};
 use robocal_core::check::iso9283::outcome::{CommandedPose, CycleReading, PoseData, CYCLES_MAX};
 use robocal_core::check::iso9283::Assessment;
@@ -103,12 +110,68 @@ struct TestIn {
     measured: BTreeMap<PoseName, Vec<Slot>>,
 }
 
+/// The test's conditions as a request states them.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ConditionsIn {
+    #[serde(default, deserialize_with = "present_int")]
+    robot_id: Option<i64>,
+    #[serde(default, deserialize_with = "present_int")]
+    version: Option<i64>,
+    #[serde(default, deserialize_with = "present")]
+    date: Option<String>,
+    #[serde(default, deserialize_with = "present")]
+    load_kg: Option<f64>,
+    #[serde(default, deserialize_with = "present")]
+    speed_percent: Option<f64>,
+    #[serde(default, deserialize_with = "present")]
+    measurement: Option<String>,
+}
+
+/// Longest `conditions.measurement` (characters).
+pub const MEASUREMENT_MAX: usize = 500;
+/// Largest `conditions.load_kg`.
+pub const LOAD_MAX_KG: f64 = 10_000.0;
+/// Largest `conditions.speed_percent`.
+pub const SPEED_MAX_PERCENT: f64 = 1_000.0;
+
+impl ConditionsIn {
+    fn command(self) -> Result<ConditionsCommand, ApiError> {
+        let within = |what: &str, v: Option<f64>, max: f64| match v {
+            Some(x) if !(x.is_finite() && (0.0..=max).contains(&x)) => Err(ApiError::invalid(
+                format!("`conditions.{what}`: 0 to {max}, got {x}"),
+            )),
+            _ => Ok(()),
+        };
+        within("load_kg", self.load_kg, LOAD_MAX_KG)?;
+        within("speed_percent", self.speed_percent, SPEED_MAX_PERCENT)?;
+        if let Some(m) = &self.measurement {
+            let n = m.chars().count();
+            if n > MEASUREMENT_MAX {
+                return Err(ApiError::invalid(format!(
+                    "`conditions.measurement`: at most {MEASUREMENT_MAX} characters, got {n}"
+                )));
+            }
+        }
+        Ok(ConditionsCommand {
+            robot_id: self.robot_id,
+            version: self.version,
+            date: self.date,
+            load_kg: self.load_kg,
+            speed_percent: self.speed_percent,
+            measurement: self.measurement,
+        })
+    }
+}
+
 /// `POST /v1/iso9283` body.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct Iso9283Request {
     #[serde(deserialize_with = "objects")]
     tests: Vec<TestIn>,
+    #[serde(default, deserialize_with = "present")]
+    conditions: Option<ConditionsIn>,
 }
 
 /// One test of the CSV form.
@@ -126,6 +189,8 @@ struct CsvTestIn {
 struct Iso9283CsvRequest {
     #[serde(deserialize_with = "objects")]
     tests: Vec<CsvTestIn>,
+    #[serde(default, deserialize_with = "present")]
+    conditions: Option<ConditionsIn>,
 }
 
 /// One test's figures.
@@ -215,16 +280,51 @@ fn poses(t: &TestIn) -> Result<Vec<PoseData>, ApiError> {
     Ok(out)
 }
 
-fn answer(tests: Vec<(String, Assessment)>) -> Response {
+/// Whether the client asks for the HTML report (`Accept` lists `text/html`
+/// with a non-zero quality).
+fn wants_html(headers: &HeaderMap) -> bool {
+    headers
+        .get_all(header::ACCEPT)
+        .iter()
+        .filter_map(|v| v.to_str().ok())
+        .flat_map(|v| v.split(','))
+        .any(|range| {
+            let mut parts = range.split(';').map(str::trim);
+            let media = parts.next().unwrap_or("");
+            let zero = parts.any(|p| {
+                p.strip_prefix("q=")
+                    .and_then(|q| q.parse::<f64>().ok())
+                    .is_some_and(|q| q == 0.0)
+            });
+            media.eq_ignore_ascii_case("text/html") && !zero
+        })
+}
+
+/// The figures as JSON (with the conditions) or as the HTML report.
+async fn answer(
+    state: &AppState,
+    headers: &HeaderMap,
+    tests: Vec<(String, Assessment)>,
+    texts: &[Option<String>],
+    conditions: Option<ConditionsIn>,
+) -> Result<Response, ApiError> {
+    let cmd = conditions.unwrap_or_default().command()?;
+    let sets = service::iso9283::measured_sets(&tests, texts);
+    let conditions = service::iso9283::conditions(state, cmd, sets).await?;
+    if wants_html(headers) {
+        let page = render_iso9283_html(&conditions, &tests);
+        return Ok(([(header::CONTENT_TYPE, "text/html; charset=utf-8")], page).into_response());
+    }
     let tests: Vec<TestOut> = tests
         .into_iter()
         .map(|(label, figures)| TestOut { label, figures })
         .collect();
-    axum::Json(serde_json::json!({ "tests": tests })).into_response()
+    Ok(axum::Json(serde_json::json!({ "conditions": conditions, "tests": tests })).into_response())
 }
 
 async fn figures(
     State(state): State<AppState>,
+    headers: HeaderMap,
     ApiJson(body): ApiJson<Iso9283Request>,
 ) -> Result<Response, ApiError> {
     let tests = body
@@ -237,11 +337,13 @@ async fn figures(
             })
         })
         .collect::<Result<Vec<_>, ApiError>>()?;
-    Ok(answer(service::iso9283::figures(&state, tests).await?))
+    let assessed = service::iso9283::figures(&state, tests).await?;
+    answer(&state, &headers, assessed, &[], body.conditions).await
 }
 
 async fn figures_csv(
     State(state): State<AppState>,
+    headers: HeaderMap,
     ApiJson(body): ApiJson<Iso9283CsvRequest>,
 ) -> Result<Response, ApiError> {
     let tests = body
@@ -256,12 +358,15 @@ async fn figures_csv(
             })
         })
         .collect::<Result<Vec<_>, ApiError>>()?;
-    Ok(answer(service::iso9283::figures_csv(&state, tests).await?))
+    let texts: Vec<Option<String>> = tests.iter().map(|t| Some(t.measured_csv.clone())).collect();
+    let assessed = service::iso9283::figures_csv(&state, tests).await?;
+    answer(&state, &headers, assessed, &texts, body.conditions).await
 }
 
 pub fn routes() -> Vec<super::Route> {
     vec![
         super::post("/v1/iso9283", figures),
         super::post("/v1/iso9283/csv", figures_csv),
+        super::post("/v1/robots/{id}/iso9283/plan", super::iso9283_plan::plan),
     ]
 }

@@ -34,6 +34,7 @@ pub mod console;
 pub mod error;
 pub mod input;
 pub mod iso9283;
+pub mod iso9283_plan;
 
 pub mod listener;
 pub mod plans;

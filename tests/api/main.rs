@@ -30,7 +30,10 @@ mod contract;
 mod exposure;
 mod flow;
 mod hostile;
+#[path = "../common/html_table.rs"]
+mod html_table;
 mod iso9283;
+mod iso9283_report;
 mod jobs;
 mod migrations;
 mod numbers;

@@ -90,13 +90,16 @@ pub enum JoinError {
     UnitsUnclear { spread: f64 },
 }
 
-struct Export {
-    names: Option<Vec<String>>,
-    xyz: Vec<[f64; 3]>,
-    header_units: Option<Units>,
+/// A tracker export as read: point names (when it has a name column), the
+/// positions in the export's own unit, and the unit its header names.
+pub(crate) struct Export {
+    pub(crate) names: Option<Vec<String>>,
+    pub(crate) xyz: Vec<[f64; 3]>,
+    pub(crate) header_units: Option<Units>,
 }
 
-fn read(text: &str) -> Result<Export, JoinError> {
+/// The tracker export's points (also read by the ISO 9283 cycles' join).
+pub(crate) fn read(text: &str) -> Result<Export, JoinError> {
     let t = csv_text::read(text, Dialect::default())
         .map_err(|e| JoinError::Text(e.to_string()))?
         .ok_or(JoinError::Empty)?;
@@ -156,7 +159,7 @@ fn read(text: &str) -> Result<Export, JoinError> {
 }
 
 /// Metres or millimetres from the points' largest extent along an axis.
-fn detect_units(xyz: &[[f64; 3]]) -> Result<Units, JoinError> {
+pub(crate) fn detect_units(xyz: &[[f64; 3]]) -> Result<Units, JoinError> {
     let spread = (0..3)
         .map(|k| {
             let (lo, hi) = xyz

@@ -21,7 +21,7 @@
 
 use super::cube::CubePlan;
 use super::figures::PoseCycles;
-use super::outcome::{ABC_MAX_DEG, CYCLES_MAX, XYZ_MAX_MM};
+use super::outcome::{CommandedPose, CycleReading, PoseData, ABC_MAX_DEG, CYCLES_MAX, XYZ_MAX_MM};
 use super::Iso9283Error;
 use crate::measure::csv_text::{read, short_text, Dialect, Record, Table};
 use crate::measure::csv_write::{push_header, push_row, read_text, Cell};
@@ -267,6 +267,44 @@ pub fn read_cycles_csv(text: &str, plan: &[Commanded]) -> Result<Vec<PoseCycles>
         )));
     }
     Ok(out)
+}
+
+/// The poses of a plan CSV and its cycles CSV as [`super::assess`] takes
+/// them: every commanded pose with its measured cycles.
+pub fn read_pose_data(plan_text: &str, cycles_text: &str) -> Result<Vec<PoseData>, Iso9283Error> {
+    let commanded = read_plan_csv(plan_text)?;
+    let cycles = read_cycles_csv(cycles_text, &commanded)?;
+    Ok(pose_data(&commanded, cycles))
+}
+
+/// [`read_pose_data`] of texts already read.
+pub fn pose_data(commanded: &[Commanded], cycles: Vec<PoseCycles>) -> Vec<PoseData> {
+    commanded
+        .iter()
+        .zip(cycles)
+        .map(|(c, p)| {
+            let abc = p.attained_abc_deg.as_ref();
+            PoseData {
+                name: c.name.clone(),
+                commanded: Some(CommandedPose {
+                    xyz_mm: c.xyz_mm,
+                    abc_deg: c.abc_deg,
+                }),
+                measured: Some(
+                    p.cycles
+                        .iter()
+                        .zip(&p.attained_mm)
+                        .enumerate()
+                        .map(|(k, (cycle, xyz))| CycleReading {
+                            cycle: *cycle,
+                            xyz_mm: *xyz,
+                            abc_deg: abc.map(|a| a[k]),
+                        })
+                        .collect(),
+                ),
+            }
+        })
+        .collect()
 }
 
 #[cfg(test)]

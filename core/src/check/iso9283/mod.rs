@@ -41,7 +41,9 @@
 pub mod csv;
 pub mod cube;
 pub mod figures;
+pub mod join;
 pub mod outcome;
+pub mod program;
 
 pub use cube::{plan_cube, Commands, CubePlan, CubePose, CubeSettings, TestCube};
 pub use figures::{evaluate, DistanceFigures, Iso9283Figures, PoseCycles, PoseFigures};

@@ -6,7 +6,8 @@
 use super::{Language, ProgramFile};
 use std::fmt::Write as _;
 
-/// A program `name` moving to each of `joints_deg` (6 axes) and waiting `wait_s` seconds.
+/// A program `name` moving to each of `joints_deg` (6 axes) and waiting
+/// `wait_s` seconds, each motion commented `pose 1`, `pose 2`, ….
 pub fn joint_program(
     language: Language,
     name: &str,
@@ -15,22 +16,53 @@ pub fn joint_program(
 ) -> Vec<ProgramFile> {
     let n = joints_deg.len();
     let head = format!("robocal measurement plan: {n} poses, a wait of {wait_s} s at each");
+    let targets: Vec<LabelledJoints> = joints_deg
+        .iter()
+        .enumerate()
+        .map(|(i, q)| LabelledJoints {
+            label: format!("pose {}", i + 1),
+            joints_deg: *q,
+        })
+        .collect();
+    labelled_joint_program(language, name, &head, &targets, wait_s)
+}
+
+/// One joint target of a program and the comment beside its motion.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LabelledJoints {
+    /// The motion's comment (e.g. `P3 cycle 12`).
+    pub label: String,
+    /// Controller convention [deg].
+    pub joints_deg: [f64; 6],
+}
+
+/// A program `name` headed by the comment `head`, moving to each target and
+/// waiting `wait_s` seconds, each motion commented with its label.
+pub fn labelled_joint_program(
+    language: Language,
+    name: &str,
+    head: &str,
+    targets: &[LabelledJoints],
+    wait_s: f64,
+) -> Vec<ProgramFile> {
+    let n = targets.len();
     let list = |q: &[f64; 6], f: &dyn Fn(f64) -> String| q.map(f).join(", ");
     let mut s = String::new();
     match language {
         Language::Krl => {
             let _ = write!(s, "&ACCESS RVP\r\nDEF {name}()\r\n; {head}\r\n");
-            for (i, q) in joints_deg.iter().enumerate() {
-                let axes: Vec<String> = q
+            for t in targets {
+                let axes: Vec<String> = t
+                    .joints_deg
                     .iter()
                     .enumerate()
                     .map(|(k, v)| format!("A{} {v:.4}", k + 1))
                     .collect();
                 let _ = write!(
                     s,
-                    "PTP {{{}}} ; pose {}\r\nWAIT SEC {wait_s}\r\n",
+                    "PTP {{{}}} ; {}\r\nWAIT SEC {wait_s}\r\n",
                     axes.join(","),
-                    i + 1
+                    t.label
                 );
             }
             s.push_str("END\r\n");
@@ -38,12 +70,12 @@ pub fn joint_program(
         }
         Language::Rapid => {
             let _ = write!(s, "MODULE {name}\r\n  ! {head}\r\n  PROC main()\r\n");
-            for (i, q) in joints_deg.iter().enumerate() {
+            for t in targets {
                 let _ = write!(
                     s,
-                    "    MoveAbsJ [[{}],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]], v100, fine, tool0; ! pose {}\r\n    WaitTime {wait_s};\r\n",
-                    list(q, &|v| format!("{v:.4}")),
-                    i + 1
+                    "    MoveAbsJ [[{}],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]], v100, fine, tool0; ! {}\r\n    WaitTime {wait_s};\r\n",
+                    list(&t.joints_deg, &|v| format!("{v:.4}")),
+                    t.label
                 );
             }
             s.push_str("  ENDPROC\r\nENDMODULE\r\n");
@@ -55,17 +87,20 @@ pub fn joint_program(
                 s,
                 "/PROG  {upper}\r\n/ATTR\r\nCOMMENT\t\t= \"robocal plan\";\r\nDEFAULT_GROUP\t= 1,*,*,*,*;\r\n/MN\r\n   1:  ! {n} poses ;\r\n"
             );
-            for i in 0..n {
+            for (i, t) in targets.iter().enumerate() {
                 let _ = write!(
                     s,
-                    "{:4}:J P[{}] 20% FINE    ;\r\n{:4}:  WAIT {wait_s:.2}(sec) ;\r\n",
-                    2 * i + 2,
+                    "{:4}:  ! {} ;\r\n{:4}:J P[{}] 20% FINE    ;\r\n{:4}:  WAIT {wait_s:.2}(sec) ;\r\n",
+                    3 * i + 2,
+                    t.label,
+                    3 * i + 3,
                     i + 1,
-                    2 * i + 3
+                    3 * i + 4
                 );
             }
             s.push_str("/POS\r\n");
-            for (i, q) in joints_deg.iter().enumerate() {
+            for (i, t) in targets.iter().enumerate() {
+                let q = &t.joints_deg;
                 let _ = write!(s, "P[{}]{{\r\n   GP1:\r\n\tUF : 0, UT : 0,\r\n", i + 1);
                 let _ = write!(
                     s,
@@ -78,12 +113,12 @@ pub fn joint_program(
         }
         Language::UrScript => {
             let _ = write!(s, "def {name}():\n  # {head}\n");
-            for (i, q) in joints_deg.iter().enumerate() {
+            for t in targets {
                 let _ = write!(
                     s,
-                    "  movej([{}], a=0.5, v=0.3)  # pose {}\n  sleep({wait_s})\n",
-                    list(q, &|v| format!("{:.8}", v.to_radians())),
-                    i + 1
+                    "  movej([{}], a=0.5, v=0.3)  # {}\n  sleep({wait_s})\n",
+                    list(&t.joints_deg, &|v| format!("{:.8}", v.to_radians())),
+                    t.label
                 );
             }
             let _ = write!(s, "end\n{name}()\n");

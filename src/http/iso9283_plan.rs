@@ -1,0 +1,160 @@
+//! `POST /v1/robots/{id}/iso9283/plan`: the ISO 9283 test cube in a box of
+//! the robot's workspace (base frame, mm), solved on a version of its model
+//! (default the active one) to joint commands — nominal or filtered — as the
+//! plan CSV `robocal iso9283 --plan` and `POST /v1/iso9283/csv` read, and
+//! optionally the cycle program whose motions are commented `P<i> cycle <k>`.
+//! The same as `robocal iso9283 plan` on the version's `model.json`; the
+//! answer names the version and its SHA-256.
+
+use super::input::present_int;
+use super::plans::{ProgramOut, WAIT_MAX_S};
+use super::programs::FileIn;
+use super::{ApiError, ApiJson, ApiPath, AppState};
+use crate::plan::WorkspaceBox;
+use crate::service;
+use crate::service::iso9283::CubeCommand;
+use crate::solve::program::Language;
+use axum::extract::State;
+use axum::response::{IntoResponse, Response};
+use robocal_core::check::iso9283::{Commands, CubePose};
+use serde::{Deserialize, Serialize};
+
+/// Most cycles of a program (the standard asks 30).
+pub const CYCLES_MAX: u32 = 1000;
+/// Largest box coordinate [mm].
+pub const BOX_MAX_MM: f64 = 100_000.0;
+
+/// `POST /v1/robots/{id}/iso9283/plan` body.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CubeRequest {
+    pub min_mm: [f64; 3],
+    pub max_mm: [f64; 3],
+    #[serde(default)]
+    pub rpy_deg: Option<[f64; 3]>,
+    #[serde(default)]
+    pub commands: Option<Commands>,
+    #[serde(default, deserialize_with = "present_int")]
+    pub version: Option<i64>,
+    #[serde(default)]
+    pub language: Option<Language>,
+    #[serde(default, deserialize_with = "present_int")]
+    pub cycles: Option<u32>,
+    #[serde(default)]
+    pub name: Option<String>,
+    #[serde(default)]
+    pub wait_s: Option<f64>,
+}
+
+#[derive(Debug, Serialize)]
+struct CubeResponse {
+    robot_id: i64,
+    robot: String,
+    version: i64,
+    model_sha256: String,
+    commands: &'static str,
+    edge_mm: f64,
+    largest_edge_mm: f64,
+    centre_mm: [f64; 3],
+    poses: Vec<CubePose>,
+    plan_csv: String,
+    program: Option<ProgramOut>,
+}
+
+fn command(robot_id: i64, req: CubeRequest) -> Result<CubeCommand, ApiError> {
+    let finite = |what: &str, v: &[f64; 3], max: f64| {
+        if v.iter().all(|x| x.is_finite() && x.abs() <= max) {
+            Ok(())
+        } else {
+            Err(ApiError::invalid(format!(
+                "`{what}`: three finite numbers of at most {max}"
+            )))
+        }
+    };
+    finite("min_mm", &req.min_mm, BOX_MAX_MM)?;
+    finite("max_mm", &req.max_mm, BOX_MAX_MM)?;
+    if (0..3).any(|i| req.min_mm[i] >= req.max_mm[i]) {
+        return Err(ApiError::invalid("each of `min_mm` must be below `max_mm`"));
+    }
+    let rpy_deg = req.rpy_deg.unwrap_or([180.0, 0.0, 0.0]);
+    finite("rpy_deg", &rpy_deg, 360.0)?;
+    let program = match req.language {
+        None => {
+            if req.cycles.is_some() || req.name.is_some() || req.wait_s.is_some() {
+                return Err(ApiError::invalid(
+                    "`cycles`, `name` and `wait_s` shape the program: give `language` too",
+                ));
+            }
+            None
+        }
+        Some(language) => {
+            let cycles = req.cycles.unwrap_or(30);
+            if !(2..=CYCLES_MAX).contains(&cycles) {
+                return Err(ApiError::invalid(format!(
+                    "`cycles`: 2 to {CYCLES_MAX}, got {cycles}"
+                )));
+            }
+            let name = req.name.unwrap_or_else(|| "iso9283".into());
+            let ok = name.len() <= 24
+                && name.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
+                && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+            if !ok {
+                return Err(ApiError::invalid(format!(
+                    "`name`: a letter, then up to 23 letters, digits or `_`, got `{name}`"
+                )));
+            }
+            let wait_s = req.wait_s.unwrap_or(2.0);
+            if !(wait_s.is_finite() && (0.0..=WAIT_MAX_S).contains(&wait_s)) {
+                return Err(ApiError::invalid(format!(
+                    "`wait_s`: 0 to {WAIT_MAX_S} s, got {wait_s}"
+                )));
+            }
+            Some((language, name, cycles, wait_s))
+        }
+    };
+    Ok(CubeCommand {
+        robot_id,
+        version: req.version,
+        workspace: WorkspaceBox {
+            min_mm: req.min_mm,
+            max_mm: req.max_mm,
+        },
+        rpy_deg,
+        commands: req.commands.unwrap_or(Commands::Filtered),
+        program,
+    })
+}
+
+pub async fn plan(
+    State(state): State<AppState>,
+    ApiPath(robot_id): ApiPath<i64>,
+    ApiJson(req): ApiJson<CubeRequest>,
+) -> Result<Response, ApiError> {
+    let cmd = command(robot_id, req)?;
+    let language = cmd.program.as_ref().map(|p| p.0);
+    let done = service::iso9283::plan(&state, cmd).await?;
+    let p = done.plan;
+    Ok(axum::Json(CubeResponse {
+        robot_id,
+        robot: done.robot,
+        version: done.version,
+        model_sha256: done.model_sha256,
+        commands: p.commands.name(),
+        edge_mm: p.cube.edge_mm,
+        largest_edge_mm: p.largest_edge_mm,
+        centre_mm: p.cube.centre_mm,
+        poses: p.poses,
+        plan_csv: done.plan_csv,
+        program: done.program.zip(language).map(|(files, l)| ProgramOut {
+            language: l,
+            files: files
+                .into_iter()
+                .map(|f| FileIn {
+                    name: f.name,
+                    content: f.text,
+                })
+                .collect(),
+        }),
+    })
+    .into_response())
+}
