@@ -3,17 +3,26 @@
 //! standard error is a terminal, plain lines otherwise (a log file, CI), so a
 //! pipe or a log never fills with carriage returns.
 //!
-//! Plain lines: one when a phase starts and one each further 10 % of the whole
-//! work within it. The bar: redrawn at most every 100 ms and when the phase
-//! changes, ended with a newline by [`ProgressPrinter::finish`].
+//! Each report shows the percentage (never decreasing), the phase, the
+//! candidate and cross-validation fold it is on, the iteration and the
+//! estimated time left, e.g. `[ 64.2%] auto · skcm-nn · fold 3/9 · iteration
+//! 12 · rms 0.1234 mm · 1 min 20 s left`.
+//!
+//! Plain lines: one when a phase or candidate starts and one each further
+//! 10 % of the whole work within it. The bar: redrawn at most every 100 ms
+//! and when the phase or candidate changes, ended with a newline by
+//! [`ProgressPrinter::finish`].
 
-use crate::calibrate::identify::Progress;
+use crate::calibrate::identify::progress::time_left;
+use crate::calibrate::identify::{Method, Phase, Progress};
 use std::io::{IsTerminal, Write};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 /// Width of the bar in characters.
 const BAR: usize = 24;
+/// Width of the bar's line in characters.
+const WIDTH: usize = 130;
 /// Least time between two redraws of the bar.
 const REDRAW: Duration = Duration::from_millis(100);
 /// Plain lines within a phase: one per this many percent.
@@ -21,7 +30,8 @@ const PLAIN_STEP: f64 = 10.0;
 
 struct State {
     out: Box<dyn Write + Send>,
-    phase: Option<String>,
+    /// The phase and candidate of the last report.
+    at: Option<(Phase, Option<Method>)>,
     last_draw: Option<Instant>,
     last_line_percent: f64,
     drawn: bool,
@@ -48,7 +58,7 @@ impl ProgressPrinter {
         ProgressPrinter {
             state: Mutex::new(State {
                 out,
-                phase: None,
+                at: None,
                 last_draw: None,
                 last_line_percent: f64::NEG_INFINITY,
                 drawn: false,
@@ -64,16 +74,12 @@ impl ProgressPrinter {
             return;
         }
         let mut s = self.state.lock().unwrap_or_else(|e| e.into_inner());
-        let new_phase = s.phase.as_deref() != Some(p.phase.as_str());
+        let new_phase = s.at != Some((p.phase, p.candidate));
         if new_phase {
-            s.phase = Some(p.phase.clone());
+            s.at = Some((p.phase, p.candidate));
             s.last_line_percent = f64::NEG_INFINITY;
         }
-        let detail = match (p.iteration, p.rms_mm) {
-            (0, _) => String::new(),
-            (i, Some(rms)) => format!(" · iteration {i} · rms {rms:.4} mm"),
-            (i, None) => format!(" · step {i}"),
-        };
+        let detail = detail(p);
         let percent = p.percent.clamp(0.0, 100.0);
         if self.terminal {
             let due = s.last_draw.is_none_or(|t| t.elapsed() >= REDRAW);
@@ -87,8 +93,8 @@ impl ProgressPrinter {
                 "-".repeat(BAR - filled),
                 p.phase
             );
-            line = line.chars().take(110).collect();
-            let _ = write!(s.out, "\r{line:<110}");
+            line = line.chars().take(WIDTH).collect();
+            let _ = write!(s.out, "\r{line:<WIDTH$}");
             let _ = s.out.flush();
             s.last_draw = Some(Instant::now());
             s.drawn = true;
@@ -106,6 +112,26 @@ impl ProgressPrinter {
             s.drawn = false;
         }
     }
+}
+
+/// What follows the phase: candidate, fold, iteration, residual, time left.
+fn detail(p: &Progress) -> String {
+    let mut d = String::new();
+    if let Some(c) = p.candidate {
+        d += &format!(" · {c}");
+    }
+    if let Some(f) = p.fold {
+        d += &format!(" · fold {}/{}", f.index, f.of);
+    }
+    d += &match (p.iteration, p.rms_mm) {
+        (0, _) => String::new(),
+        (i, Some(rms)) => format!(" · iteration {i} · rms {rms:.4} mm"),
+        (i, None) => format!(" · step {i}"),
+    };
+    if let Some(eta) = p.eta_s {
+        d += &format!(" · {} left", time_left(eta));
+    }
+    d
 }
 
 #[cfg(test)]
@@ -128,10 +154,8 @@ mod tests {
 
     fn p(phase: &str, iteration: usize, percent: f64) -> Progress {
         Progress {
-            phase: phase.into(),
             iteration,
-            percent,
-            rms_mm: None,
+            ..Progress::at(Phase::from_label(phase).unwrap(), percent)
         }
     }
 
@@ -168,6 +192,35 @@ mod tests {
         assert!(text.contains("skcm-tlbo"));
         assert!(text.ends_with('\n'));
         assert_eq!(text.matches('\n').count(), 1);
+    }
+
+    #[test]
+    fn a_line_names_the_candidate_fold_and_time_left() {
+        let buf = Shared::default();
+        let pr = ProgressPrinter::to(Box::new(buf.clone()), false, true);
+        pr.update(&Progress {
+            iteration: 12,
+            rms_mm: Some(0.12341),
+            candidate: Some(Method::SkcmNn),
+            fold: Some(crate::calibrate::identify::Fold { index: 3, of: 9 }),
+            eta_s: Some(80.4),
+            ..Progress::at(Phase::Method(Method::Auto), 64.24)
+        });
+        // A new candidate starts a line of its own, though 0.1 % further.
+        pr.update(&Progress {
+            candidate: Some(Method::SkcmGp),
+            eta_s: Some(3725.0),
+            ..Progress::at(Phase::Method(Method::Auto), 64.3)
+        });
+        let text = String::from_utf8(buf.0.lock().unwrap().clone()).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(
+            lines,
+            [
+                "[ 64.2%] auto · skcm-nn · fold 3/9 · iteration 12 · rms 0.1234 mm · 1 min 20 s left",
+                "[ 64.3%] auto · skcm-gp · 1 h 02 min left"
+            ]
+        );
     }
 
     #[test]

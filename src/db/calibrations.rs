@@ -3,7 +3,7 @@
 use super::types::text_enum;
 use super::versions::{activate_in, NewVersion};
 use super::{commit_inserted, on_pool, write_for_robot, write_one, Db, Json, Listing, StoreError};
-use crate::records::{CalibrationRow, JobStatus, JobSummary};
+use crate::records::{CalibrationRow, JobStatus, JobSummary, ProgressDetail};
 use serde_json::Value;
 
 /// The SQL assignments that stamp a job as ended now.
@@ -149,12 +149,13 @@ impl Db {
         phase: &str,
         iteration: i64,
         percent: f64,
+        detail: &ProgressDetail,
     ) -> Result<(), StoreError> {
         on_pool!(self, |p, k| {
             let sql = k.sql(
                 "UPDATE calibrations SET phase = $1, iteration = $2, percent = $3, \
-                 updated_at = {now} WHERE id = $4 AND status = 'running' \
-                 AND ($5 IS NULL OR claim = $5)",
+                 progress_detail = $6, updated_at = {now} WHERE id = $4 \
+                 AND status = 'running' AND ($5 IS NULL OR claim = $5)",
             );
             write_one!(
                 p,
@@ -165,6 +166,7 @@ impl Db {
                     .bind(percent)
                     .bind(id)
                     .bind(claim)
+                    .bind(Json(detail.clone()))
             )
         });
         Ok(())
@@ -257,7 +259,7 @@ impl Db {
             };
             let sql = k.sql(&format!(
                 "UPDATE calibrations SET status = 'succeeded', report = $1, best_method = $2, \
-                 summary = $3, phase = 'done', percent = 100, {FINISHED_NOW} \
+                 summary = $3, phase = 'done', percent = 100, progress_detail = NULL, {FINISHED_NOW} \
                  WHERE id = $4 AND status = 'running' AND ($5 IS NULL OR claim = $5)"
             ));
             let n = sqlx::query(&sql)
@@ -324,7 +326,7 @@ pub struct JobResult<'a> {
 }
 
 const CAL_SELECT: &str = "SELECT id, robot_id, status, phase, iteration, percent, \
-    cancel_requested, methods, identification_set_ids, validation_set_ids, options, error, \
+    progress_detail, cancel_requested, methods, identification_set_ids, validation_set_ids, options, error, \
     best_method, summary, created_at, started_at, finished_at, updated_at, command \
     FROM calibrations";
 

@@ -57,7 +57,7 @@ impl Db {
                    OR (status = 'running' AND lease_expires_at < now()) \
                 ORDER BY id LIMIT 1 FOR UPDATE SKIP LOCKED) \
              UPDATE calibrations c SET status = 'running', phase = 'starting', iteration = 0, \
-                percent = 0, started_at = robocal_now(), updated_at = robocal_now(), \
+                percent = 0, progress_detail = NULL, started_at = robocal_now(), updated_at = robocal_now(), \
                 claim = $1, lease_expires_at = now() + make_interval(secs => $2), \
                 attempts = c.attempts + 1 \
              FROM next WHERE c.id = next.id \
@@ -102,6 +102,7 @@ impl Db {
         };
         let n = sqlx::query(
             "UPDATE calibrations SET status = 'queued', phase = NULL, iteration = 0, percent = 0, \
+             progress_detail = NULL, \
              started_at = NULL, claim = NULL, lease_expires_at = NULL, \
              attempts = GREATEST(attempts - 1, 0), updated_at = robocal_now() \
              WHERE id = $1 AND claim = $2 AND status = 'running'",

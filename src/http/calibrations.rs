@@ -9,7 +9,7 @@
 use super::input::{check_payload, int, page_body, present, present_ids, present_int, PageQuery};
 use super::robots::robot_list_page;
 use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState};
-use crate::calibrate::identify::{CalibrationOptions, Method};
+use crate::calibrate::identify::{CalibrationOptions, Fold, Method};
 use crate::records::{CalibrationRow, JobStatus, JobSummary};
 use crate::service::{self, jobs::StartCommand};
 use axum::extract::State;
@@ -118,11 +118,17 @@ pub struct Calibration {
     pub links: Value,
 }
 
+/// A job's progress: the phase, the candidate and fold it is on, a
+/// percentage that never goes back and the estimated time left.
 #[derive(Debug, Serialize)]
 pub struct JobProgress {
     pub phase: Option<String>,
     pub iteration: i64,
     pub percent: f64,
+    pub candidate: Option<String>,
+    pub fold: Option<Fold>,
+    pub rms_mm: Option<f64>,
+    pub eta_s: Option<f64>,
 }
 
 impl Calibration {
@@ -140,10 +146,17 @@ impl Calibration {
             id: r.id,
             robot_id: r.robot_id,
             status: r.status,
-            progress: JobProgress {
-                phase: r.phase,
-                iteration: r.iteration,
-                percent: r.percent,
+            progress: {
+                let d = r.progress_detail.map(|d| d.0).unwrap_or_default();
+                JobProgress {
+                    phase: r.phase,
+                    iteration: r.iteration,
+                    percent: r.percent,
+                    candidate: d.candidate,
+                    fold: d.fold,
+                    rms_mm: d.rms_mm,
+                    eta_s: d.eta_s,
+                }
             },
             cancel_requested: r.cancel_requested,
             methods: r.methods.0,

@@ -2,6 +2,7 @@
 //! succeeded job reached.
 
 use super::Json;
+use crate::calibrate::identify::{Fold, Progress};
 use serde_json::Value;
 use sqlx::FromRow;
 
@@ -20,6 +21,30 @@ pub struct JobSummary {
     pub warnings: Vec<String>,
     /// Methods that failed, as "method: reason"; the others were kept.
     pub failed_methods: Vec<String>,
+}
+
+/// What a running job's progress adds to its phase, iteration and percent
+/// (stored as JSON beside them): the candidate and fold the phase is on, the
+/// residual and the estimated seconds left (`identify::Progress`).
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ProgressDetail {
+    pub candidate: Option<String>,
+    pub fold: Option<Fold>,
+    pub rms_mm: Option<f64>,
+    pub eta_s: Option<f64>,
+}
+
+impl ProgressDetail {
+    /// The detail of a progress report (non-finite numbers dropped).
+    pub fn of(p: &Progress) -> Self {
+        let finite = |x: Option<f64>| x.filter(|v| v.is_finite());
+        ProgressDetail {
+            candidate: p.candidate.map(|m| m.name().to_string()),
+            fold: p.fold,
+            rms_mm: finite(p.rms_mm),
+            eta_s: finite(p.eta_s).map(|s| s.max(0.0)),
+        }
+    }
 }
 
 /// State of a calibration job.
@@ -41,6 +66,9 @@ pub struct CalibrationRow {
     pub phase: Option<String>,
     pub iteration: i64,
     pub percent: f64,
+    /// NULL while nothing is known (queued, starting, done, or stored
+    /// before schema 10 on SQLite, 9 on PostgreSQL).
+    pub progress_detail: Option<Json<ProgressDetail>>,
     pub cancel_requested: bool,
     pub methods: Json<Vec<String>>,
     pub identification_set_ids: Json<Vec<i64>>,

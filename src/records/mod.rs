@@ -12,7 +12,7 @@ mod robots;
 mod sets;
 mod versions;
 
-pub use calibrations::{CalibrationRow, JobStatus, JobSummary};
+pub use calibrations::{CalibrationRow, JobStatus, JobSummary, ProgressDetail};
 pub use cell::{CellItemRow, CellKind, CellPut, ItemFrame, NewCellItem};
 pub use checks::CheckRow;
 pub use robots::{NewRobot, RobotRow};

@@ -476,12 +476,13 @@ async fn compensator_job_yields_a_version_whose_solve_uses_it() {
 
 /// Cancelling a job while a compensator trains (SKCM-NN by LM on 1000
 /// training poses, progress per epoch) ends it as cancelled: the job is held
-/// at the gate once past the base fit (15 % of its span), so the cancel
-/// reaches it in training whatever the machine's speed.
+/// at the gate once past the base fit (its plan, methods/plan.rs: SKCM's fit
+/// 1 unit of 6, so training from 10 + 90/6 = 25 %), so the cancel reaches it
+/// in training whatever the machine's speed.
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn cancelling_a_compensator_job_during_training_takes_effect_quickly() {
     use robocal::measure::SetRole;
-    let gate = Arc::new(WorkGate::closed_from("skcm-nn", 15.0));
+    let gate = Arc::new(WorkGate::closed_from("skcm-nn", 26.0));
     let t = setup_config(ServiceConfig {
         workers: 1,
         progress_interval: Duration::from_millis(20),

@@ -15,6 +15,8 @@
 //! `shifted` status everywhere; capped per-pose errors), `roles` (keys with
 //! roles, open reads, the console's security headers), `one_answer` (a target
 //! solved and filtered, over HTTP and the CLI, gets one configuration),
+//! `progress` (an `auto` job polled to its end:
+//! a percentage that never goes back, its candidate, fold and time left),
 //! `admission` (large requests share one admission), `slow_clients` (header
 //! and body timeouts, the connection cap), `exposure` (no open writes on a
 //! network by default); the harness is `support`.
@@ -40,6 +42,7 @@ mod numbers;
 mod one_answer;
 mod plans;
 mod predict;
+mod progress;
 mod record;
 mod reregister;
 mod roles;

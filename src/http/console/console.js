@@ -191,10 +191,10 @@ document.addEventListener("DOMContentLoaded", () => {
       try {
         const j = (await api("GET", url)).json();
         row.querySelector(".status").textContent = j.status;
-        row.querySelector(".phase").textContent = j.progress.phase || "";
+        row.querySelector(".phase").textContent = phaseText(j.progress);
         const bar = row.querySelector("progress");
         bar.value = j.progress.percent;
-        row.querySelector(".percent").textContent = j.progress.percent.toFixed(0) + " %";
+        row.querySelector(".percent").textContent = percentText(j.progress);
         if (j.status !== "queued" && j.status !== "running") {
           clearInterval(timer);
           location.reload();
@@ -205,6 +205,29 @@ document.addEventListener("DOMContentLoaded", () => {
     }, 1000);
   }
 });
+
+// A job's phase with the candidate and fold it is on (pages.rs `phase_text`).
+function phaseText(p) {
+  let t = p.phase || "";
+  if (p.candidate) t += " · " + p.candidate;
+  if (p.fold) t += " · fold " + p.fold.index + "/" + p.fold.of;
+  return t;
+}
+
+// Seconds left as `42 s`, `3 min 05 s`, `1 h 02 min` (identify::progress::time_left).
+function timeLeft(s) {
+  s = Math.max(0, Math.round(s));
+  if (s < 60) return s + " s";
+  const pad = (n) => String(n).padStart(2, "0");
+  if (s < 3600) return Math.floor(s / 60) + " min " + pad(s % 60) + " s";
+  return Math.floor(s / 3600) + " h " + pad(Math.floor((s % 3600) / 60)) + " min";
+}
+
+// The percentage with the time left (pages.rs `percent_text`).
+function percentText(p) {
+  const pct = p.percent.toFixed(0) + " %";
+  return p.eta_s == null ? pct : pct + " · " + timeLeft(p.eta_s) + " left";
+}
 
 // Tools and work objects: save one (PUT by name), delete one.
 handlers["put-item"] = async function (form) {

@@ -2,6 +2,7 @@
 //! HTML-escaped by maud).
 
 use super::fields::model_select;
+use crate::calibrate::identify::progress::time_left;
 use crate::calibrate::identify::Method;
 use crate::http::calibrations::DEFAULT_METHODS;
 use crate::measure::convention::MeasuredOrientation;
@@ -11,7 +12,7 @@ use crate::records::CellItemRow;
 use crate::records::RobotRow;
 use crate::records::SetRow;
 use crate::records::VersionRow;
-use crate::records::{CalibrationRow, JobStatus};
+use crate::records::{CalibrationRow, JobStatus, ProgressDetail};
 use crate::report::page_head;
 use maud::{html, Markup, PreEscaped, DOCTYPE};
 
@@ -291,6 +292,28 @@ fn calibrations_section(id: i64, calibrations: &[CalibrationRow], sets: &[SetRow
     }
 }
 
+/// The phase with the candidate and fold it is on, as console.js's
+/// `phaseText` writes it: `auto · skcm-nn · fold 3/9`.
+fn phase_text(phase: Option<&str>, d: Option<&ProgressDetail>) -> String {
+    let mut t = phase.unwrap_or("").to_string();
+    if let Some(c) = d.and_then(|d| d.candidate.as_deref()) {
+        t += &format!(" · {c}");
+    }
+    if let Some(f) = d.and_then(|d| d.fold) {
+        t += &format!(" · fold {}/{}", f.index, f.of);
+    }
+    t
+}
+
+/// The percentage with the time left, as console.js's `percentText`
+/// writes it: `64 % · 1 min 20 s left`.
+fn percent_text(percent: f64, d: Option<&ProgressDetail>) -> String {
+    match d.and_then(|d| d.eta_s) {
+        Some(eta) => format!("{percent:.0} % · {} left", time_left(eta)),
+        None => format!("{percent:.0} %"),
+    }
+}
+
 /// One calibration's table row: status, progress, best result and actions.
 fn calibration_row(id: i64, c: &CalibrationRow) -> Markup {
     html! {
@@ -299,8 +322,9 @@ fn calibration_row(id: i64, c: &CalibrationRow) -> Markup {
             td { (c.id) }
             td { (c.methods.0.join(", ")) }
             td.status { (c.status.as_str()) }
-            td.phase { (c.phase.as_deref().unwrap_or("")) }
-            td { progress max="100" value=(c.percent) {} " " span.percent { (format!("{:.0} %", c.percent)) } }
+            @let d = c.progress_detail.as_ref().map(|d| &d.0);
+            td.phase { (phase_text(c.phase.as_deref(), d)) }
+            td { progress max="100" value=(c.percent) {} " " span.percent { (percent_text(c.percent, d)) } }
             td {
                 (c.best_method.as_deref().unwrap_or("—"))
                 @if let Some(sum) = &c.summary {

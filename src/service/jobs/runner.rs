@@ -1,5 +1,6 @@
 //! The job runner: runs a started job on the blocking pool, writes its
-//! progress (phase, iteration, percent) to the store at most every
+//! progress (phase, iteration, percent, and the candidate, fold, residual and
+//! time left as `records::ProgressDetail`) to the store at most every
 //! `progress_interval`, the last one at once when the job ends (the pause
 //! never delays its outcome), and stores its outcome. Cancellation sets a
 //! flag that the progress callback reads (after every LM iteration, TLBO
@@ -12,7 +13,7 @@ use super::prepare::Job;
 use super::versions::{summary_of, versions_of};
 use crate::calibrate::identify::{calibrate_with_training, CalibrationError, Progress};
 use crate::db::JobResult;
-use crate::records::JobStatus;
+use crate::records::{JobStatus, ProgressDetail};
 use crate::service::gate::At;
 use crate::service::AppState;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -49,7 +50,14 @@ async fn write_progress(
             };
             if let Err(e) = state
                 .db()
-                .update_progress(id, claim.as_deref(), &p.phase, p.iteration as i64, pct)
+                .update_progress(
+                    id,
+                    claim.as_deref(),
+                    p.phase.label(),
+                    p.iteration as i64,
+                    pct,
+                    &ProgressDetail::of(&p),
+                )
                 .await
             {
                 tracing::warn!(job = id, error = %e, "cannot store job progress");
@@ -121,7 +129,7 @@ pub(super) async fn execute(state: AppState, job: Job, claim: Option<Claim>) {
                 tx.send_replace(Some(p.clone()));
                 gate_state.pass_gate(
                     At {
-                        phase: &p.phase,
+                        phase: p.phase.label(),
                         percent: p.percent,
                     },
                     &|| flag.load(Ordering::SeqCst),

@@ -25,9 +25,10 @@ use super::checks::{
 use super::identifiability::{self, IdentifiabilityReport};
 use super::least_squares::predict;
 use super::methods::{
-    self, Cache, Compliance, Context, Method, MethodError, MethodFailure, MethodProgress,
+    self, Cache, Compliance, Context, Method, MethodError, MethodFailure, MethodProgress, Planner,
 };
-use super::options::{CalibrationOptions, Progress};
+use super::options::CalibrationOptions;
+use super::progress::{Phase, Progress, ProgressReporter, SystemClock};
 use super::registration::register;
 use super::report::{
     CalibrationReport, FailedMethod, MethodReport, NominalErrors, PoseSources, SessionRegistration,
@@ -58,7 +59,8 @@ pub fn calibrate(
 /// compensators (empty: they train on Q1 and are judged by k-fold
 /// cross-validation inside it), Q3 `validation` is never fitted. Training
 /// poses must come from tracker sessions that have identification poses.
-/// `progress` returns false to cancel.
+/// `progress` returns false to cancel; its reports come through a
+/// [`ProgressReporter`] (percentage never decreasing, time left estimated).
 pub fn calibrate_with_training(
     nominal: &RobotModel,
     identification: &[Measurement],
@@ -67,11 +69,14 @@ pub fn calibrate_with_training(
     opts: &CalibrationOptions,
     progress: &dyn Fn(&Progress) -> bool,
 ) -> Result<CalibrationReport, CalibrationError> {
+    let clock = SystemClock::start();
+    let reporter = ProgressReporter::new(progress, &clock);
+    let progress = &|p: &Progress| reporter.report(p);
     // The nominal forward kinematics of the identification poses, shared by
     // the checks, the registration, the nominal errors, the identifiability
     // Jacobian and the first evaluation of the fits.
     let chains = check_inputs(nominal, identification, training, validation)?;
-    say(progress, "registration", 0.0)?;
+    say(progress, Phase::Registration, 0.0)?;
     let prepared = prepare(nominal, identification, training, validation, &chains, opts)?;
     let reg = &prepared.reg;
 
@@ -81,7 +86,7 @@ pub fn calibrate_with_training(
         return Err(CalibrationError::AllMethodsFailed { failed });
     }
 
-    say(progress, "identifiability", 5.0)?;
+    say(progress, Phase::Identifiability, 5.0)?;
     let with_compliance = to_run.iter().any(|m| match m.row().compliance {
         Compliance::Yes => true,
         Compliance::IfLoaded => gravity.is_none(),
@@ -131,15 +136,10 @@ pub fn calibrate_with_training(
 /// `progress` says so.
 fn say(
     progress: &dyn Fn(&Progress) -> bool,
-    phase: &str,
+    phase: Phase,
     percent: f64,
 ) -> Result<(), CalibrationError> {
-    if progress(&Progress {
-        phase: phase.to_string(),
-        iteration: 0,
-        percent,
-        rms_mm: None,
-    }) {
+    if progress(&Progress::at(phase, percent)) {
         Ok(())
     } else {
         Err(CalibrationError::Cancelled)
@@ -510,7 +510,8 @@ fn kept_with_orientation(
 }
 
 /// Runs every method of `to_run` in order over 10–100 % of the bar, each by
-/// its table weight; a failure joins `failed`. The σ and correlations of
+/// the work planned for it up front (`methods::Planner`: what an earlier
+/// method already computed costs it nothing); a failure joins `failed`. The σ and correlations of
 /// `identifiability` come from SKCM's fit, else KM's.
 fn run_methods(
     ctx: &Context,
@@ -519,20 +520,23 @@ fn run_methods(
     identifiability: &mut IdentifiabilityReport,
     progress: &dyn Fn(&Progress) -> bool,
 ) -> Result<BTreeMap<Method, MethodReport>, CalibrationError> {
-    let total: f64 = to_run.iter().map(|m| m.row().weight).sum();
+    let mut plan = Planner::default();
+    let units: Vec<f64> = to_run.iter().map(|m| plan.method(ctx, *m)).collect();
+    let total = units.iter().sum::<f64>().max(f64::MIN_POSITIVE);
     let mut done = 0.0;
     let mut reports = BTreeMap::new();
     let mut cache = Cache::default();
-    for &method in to_run {
+    for (&method, units) in to_run.iter().zip(&units) {
         let share = MethodProgress {
             method,
             start: 10.0 + 90.0 * done / total,
-            span: 90.0 * method.row().weight / total,
+            span: 90.0 * units / total,
             opts: ctx.opts,
             sink: progress,
         };
         let outcome = methods::run(method, ctx, &mut cache, &share);
-        done += method.row().weight;
+        done += units;
+        let phase = Phase::Method(method);
         let outcome = match outcome {
             Ok(o) => o,
             Err(MethodError::Cancelled) => return Err(CalibrationError::Cancelled),
@@ -541,7 +545,7 @@ fn run_methods(
                     method,
                     reason: f.to_string(),
                 });
-                say(progress, method.name(), 10.0 + 90.0 * done / total)?;
+                say(progress, phase, 10.0 + 90.0 * done / total)?;
                 continue;
             }
         };
@@ -567,7 +571,7 @@ fn run_methods(
                 reason: f.to_string(),
             }),
         }
-        say(progress, method.name(), 10.0 + 90.0 * done / total)?;
+        say(progress, phase, 10.0 + 90.0 * done / total)?;
     }
     Ok(reports)
 }

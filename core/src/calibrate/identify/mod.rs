@@ -20,6 +20,7 @@ pub mod model_file;
 pub mod network;
 pub mod options;
 pub mod pose_selection;
+pub mod progress;
 pub mod registration;
 pub mod report;
 
@@ -29,7 +30,8 @@ pub use identifiability::{DropKind, IdentifiabilityReport, IdentifiabilitySettin
 pub use least_squares::{LmReport, LmSettings, StopReason};
 pub use methods::{Method, MethodChoice, MethodFailure, MethodListError, MethodRow, METHODS};
 pub use model_file::calibrated_model_file;
-pub use options::{CalibrationOptions, CompensatorOptions, Progress};
+pub use options::{CalibrationOptions, CompensatorOptions};
+pub use progress::{Clock, Fold, Phase, Progress, ProgressReporter, SystemClock};
 pub use registration::{register, Registration};
 pub use report::{
     AutoCandidate, AutoSummary, CalibrationReport, CompensatorSummary, FailedMethod,

@@ -1,6 +1,6 @@
 //! What a calibration runs and with which settings: the methods, the solver
 //! settings, the compensator settings, the plausibility range of identified
-//! stiffness, and the progress reported while it runs.
+//! stiffness (the progress reported while it runs is `super::progress`).
 //!
 //! Units: SI inside (N·m/rad for stiffness, rad for deflections); the report
 //! speaks mm and deg.
@@ -9,6 +9,7 @@ use super::identifiability::IdentifiabilitySettings;
 use super::joint_maps::JointMapSettings;
 use super::least_squares::LmSettings;
 pub use super::methods::Method;
+pub use super::progress::Progress;
 use crate::calibrate::compensate::{
     GpSettings, IwoSettings, LmTrainSettings, MlpSpec, RbfSettings, TlboTrainSettings,
 };
@@ -134,15 +135,4 @@ impl Default for CalibrationOptions {
             joint_maps: JointMapSettings::default(),
         }
     }
-}
-
-/// Progress of a running calibration.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Progress {
-    pub phase: String,
-    pub iteration: usize,
-    /// Overall completion in [0, 100].
-    pub percent: f64,
-    /// Current RMS residual [mm], when the phase has one.
-    pub rms_mm: Option<f64>,
 }

@@ -33,14 +33,16 @@
 
 use super::cache::Cache;
 use super::compensated::{self, base_pool_errors};
-use super::context::{Context, MethodFit, Outcome};
+use super::context::{Context, MethodFit, Outcome, Step};
 use super::maps::base_fit;
 use super::maps::run_maps;
 use super::orientation_part::settle_for_auto;
+use super::plan::Planner;
 use super::trained::AppliedCompensator;
 use super::{Base, Compensated, Method, MethodError, MethodFailure, Run};
 use crate::calibrate::compensate::{choose, Choice, CvStats};
 use crate::calibrate::identify::least_squares::Fit;
+use crate::calibrate::identify::progress::Fold;
 use crate::calibrate::identify::report::{
     AutoCandidate, AutoSummary, OrientationPart, OrientationPartStatus, SetErrors,
 };
@@ -101,10 +103,12 @@ fn orientation_mean(errors: &SetErrors) -> Option<f64> {
 /// What `auto` gathers while it runs: the progress bar's position, the
 /// options it weighs, the candidates it lists and its notes.
 struct Tally<'p> {
-    progress: &'p mut dyn FnMut(f64, usize, Option<f64>) -> bool,
-    /// Units of the bar done, of `total`.
+    progress: &'p mut dyn FnMut(&Step) -> bool,
+    /// Units of work done (`plan::Planner`), of `total`; `plan` knows what
+    /// is done or cached.
     done: f64,
     total: f64,
+    plan: Planner,
     notes: Vec<String>,
     candidates: Vec<AutoCandidate>,
     options: Vec<BaseOption>,
@@ -115,10 +119,11 @@ struct Tally<'p> {
 pub(crate) fn run_auto(
     ctx: &Context,
     cache: &mut Cache,
-    progress: &mut dyn FnMut(f64, usize, Option<f64>) -> bool,
+    progress: &mut dyn FnMut(&Step) -> bool,
 ) -> Result<Outcome, MethodError> {
     let o = &ctx.opts.compensator;
     let gravity = ctx.gravity.as_ref();
+    let plan = Planner::from_cache(cache);
     let folds = if o.cv_folds > 0 { o.cv_folds } else { 5 };
     let bases: Vec<Base> = if gravity.is_some() {
         vec![Base::Km]
@@ -135,24 +140,12 @@ pub(crate) fn run_auto(
                 .collect()
         })
         .collect();
-    let maps_runs = bases
-        .iter()
-        .filter(|b| maps_candidate(&o.auto_candidates, **b).is_some())
-        .count();
-    let maps_compensators = o
-        .auto_candidates
-        .iter()
-        .filter(|m| {
-            m.compensated()
-                .is_some_and(|c| matches!(c.base, Base::KmMaps | Base::SkcmMaps))
-        })
-        .count();
-    let total = (per_base.iter().map(Vec::len).sum::<usize>() + maps_runs + maps_compensators)
-        .max(1) as f64;
+    let total = plan.clone().auto(ctx).max(f64::MIN_POSITIVE);
     let mut t = Tally {
         progress,
         done: 0.0,
         total,
+        plan,
         notes: gravity
             .map(|why| format!("skcm and km-rbf not tried: {why}"))
             .into_iter()
@@ -186,15 +179,24 @@ fn base_option(
     let (pool, _) = ctx.pool();
     let name = base.method().name();
     let (done, total) = (t.done, t.total);
+    let fit_units = t.plan.base(base);
+    let max_it = ctx.opts.lm.max_iterations.max(1) as f64;
     let progress = &mut *t.progress;
-    let mf = match base_fit(ctx, cache, base, &mut |it, rms| {
-        progress(done / total, it, Some(rms))
-    }) {
+    let fitted = base_fit(ctx, cache, base, &mut |it, rms| {
+        let f = (done + fit_units * (it as f64 / max_it).min(1.0)) / total;
+        progress(&Step {
+            candidate: Some(base.method()),
+            ..Step::plain(f, it, Some(rms))
+        })
+    });
+    t.done += fit_units;
+    let spans = candidate_spans(ctx, &mut t.plan, cands, folds);
+    let mf = match fitted {
         Ok(mf) => mf,
         Err(MethodError::Cancelled) => return Err(MethodError::Cancelled),
         Err(MethodError::Failed(f)) => {
             t.notes.push(format!("{name} failed: {f}"));
-            t.done += cands.len() as f64;
+            t.done += spans.units;
             return Ok(());
         }
     };
@@ -202,6 +204,7 @@ fn base_option(
     let base_mean = base_errors.stats.mean_mm;
     let orientation_deg = orientation_mean(&base_errors);
     if pool.len() < o.min_training_poses {
+        t.done += spans.units;
         t.options.push(BaseOption {
             base,
             maps: None,
@@ -225,9 +228,9 @@ fn base_option(
         &mf.fit,
         folds,
         &mut t.candidates,
-        &mut |x, e, l| progress((done + x) / total, e, l),
+        &mut |s| progress(&spans.step(t.done, total, s)),
     )?;
-    t.done += cands.len() as f64;
+    t.done += spans.units;
     let mean_mm = picked
         .as_ref()
         .and_then(|a| a.trained.cv.as_ref())
@@ -263,12 +266,21 @@ fn maps_option(
     let o = &ctx.opts.compensator;
     let (pool, _) = ctx.pool();
     let total = t.total;
-    let (at, span) = (t.done / total, 1.0 / total);
-    let on_maps_at = t.done + 1.0;
-    t.done += 1.0 + on_maps_candidates(ctx, base).len() as f64;
+    let at = t.done;
+    let maps_units = t.plan.base(if base == Base::Km {
+        Base::KmMaps
+    } else {
+        Base::SkcmMaps
+    });
+    let on_maps_at = at + maps_units;
+    let spans = candidate_spans(ctx, &mut t.plan, &on_maps_candidates(ctx, base), folds);
+    t.done = on_maps_at + spans.units;
     let progress = &mut *t.progress;
     let fit = match run_maps(ctx, cache, base, &mut |f, it, l| {
-        progress(at + span * f, it, l)
+        progress(&Step {
+            candidate: Some(method),
+            ..Step::plain((at + maps_units * f) / total, it, l)
+        })
     }) {
         Err(MethodError::Cancelled) => return Err(MethodError::Cancelled),
         Err(MethodError::Failed(f)) => {
@@ -321,15 +333,9 @@ fn maps_option(
         ));
         return Ok(());
     }
-    let on_maps = maps_compensator(
-        ctx,
-        cache,
-        base,
-        &fit,
-        folds,
-        &mut t.candidates,
-        &mut |f, e, l| progress((on_maps_at + f) / total, e, l),
-    )?;
+    let on_maps = maps_compensator(ctx, cache, base, &fit, folds, &mut t.candidates, &mut |s| {
+        progress(&spans.step(on_maps_at, total, s))
+    })?;
     let orientation_deg = orientation_mean(&SetErrors::of(
         &fit.fit.model,
         &fit.fit.session_frames,
@@ -468,7 +474,7 @@ fn maps_compensator(
     fit: &MethodFit,
     folds: usize,
     candidates: &mut Vec<AutoCandidate>,
-    progress: &mut dyn FnMut(f64, usize, Option<f64>) -> bool,
+    progress: &mut dyn FnMut(&Step) -> bool,
 ) -> Result<OnMaps, MethodError> {
     let methods = on_maps_candidates(ctx, base);
     if methods.is_empty() {
@@ -508,7 +514,8 @@ fn option_orientation(base_deg: Option<f64>, settled: &Settled) -> Option<f64> {
 /// lists each as an `auto` candidate, and keeps the one `choose` accepts
 /// with its orientation part settled (kept only when it lowered the
 /// cross-validated orientation mean).
-/// `progress(x, epoch, loss)` with `x` in methods done (fractional).
+/// `progress(step)` names the candidate and fold, with the fraction of that
+/// candidate's training done.
 fn cross_validate_and_choose(
     ctx: &Context,
     cache: &mut Cache,
@@ -516,17 +523,21 @@ fn cross_validate_and_choose(
     fit: &Fit,
     folds: usize,
     candidates: &mut Vec<AutoCandidate>,
-    progress: &mut dyn FnMut(f64, usize, Option<f64>) -> bool,
+    progress: &mut dyn FnMut(&Step) -> bool,
 ) -> Result<(Choice, Option<AppliedCompensator>, Settled), MethodError> {
     let o = &ctx.opts.compensator;
-    let stages = o.cv_stages(folds) as f64;
+    let stages = o.cv_stages(folds);
     let mut cvs: Vec<(String, CvStats)> = Vec::new();
     let mut trained: Vec<AppliedCompensator> = Vec::new();
-    for (i, (m, c)) in methods.iter().enumerate() {
+    for (m, c) in methods {
         let max = c.network.max_epochs(o) as f64;
         let r = compensated::trained(ctx, cache, *m, c.network, fit, folds, &mut |stage, e, l| {
-            let f = (stage as f64 + (e as f64 / max).min(1.0)) / stages;
-            progress(i as f64 + f, e, Some(l))
+            let f = (stage as f64 + (e as f64 / max).min(1.0)) / stages as f64;
+            progress(&Step {
+                candidate: Some(*m),
+                fold: Fold::of_stage(stage, stages),
+                ..Step::plain(f, e, Some(l))
+            })
         });
         match r {
             Ok(t) => {
@@ -560,6 +571,50 @@ fn cross_validate_and_choose(
         .and_then(|chosen| trained.into_iter().find(|a| a.method.name() == chosen));
     let settled = picked.as_mut().and_then(|p| settle_for_auto(p, o.min_gain));
     Ok((choice, picked, settled))
+}
+
+/// The units planned for each of `auto`'s candidate compensators, in the
+/// order they train.
+struct Spans {
+    /// Per candidate: the units before it and its own.
+    each: Vec<(Method, f64, f64)>,
+    units: f64,
+}
+
+impl Spans {
+    /// A candidate's step (fraction of its own training) as a step of
+    /// `auto` (fraction of its planned units), the candidates starting at
+    /// `at` units of `total`.
+    fn step(&self, at: f64, total: f64, s: &Step) -> Step {
+        let (before, units) = self
+            .each
+            .iter()
+            .find(|(m, ..)| Some(*m) == s.candidate)
+            .map_or((0.0, 0.0), |(_, b, u)| (*b, *u));
+        Step {
+            fraction: (at + before + units * s.fraction.clamp(0.0, 1.0)) / total,
+            ..*s
+        }
+    }
+}
+
+/// Plans the trainings of `cands` with `folds` folds.
+fn candidate_spans(
+    ctx: &Context,
+    plan: &mut Planner,
+    cands: &[(Method, Compensated)],
+    folds: usize,
+) -> Spans {
+    let mut units = 0.0;
+    let each = cands
+        .iter()
+        .map(|(m, _)| {
+            let u = plan.training(ctx, *m, folds);
+            units += u;
+            (*m, units - u, u)
+        })
+        .collect();
+    Spans { each, units }
 }
 
 /// The joint-map method on `base` among `auto`'s candidates.

@@ -22,6 +22,26 @@ pub(crate) struct Cache {
 }
 
 impl Cache {
+    /// The bases it holds a fit (or failure) of and the compensators, with
+    /// their folds, it holds a training of (for `plan::Planner`).
+    pub fn held(&self) -> (Vec<Base>, Vec<(Method, usize)>) {
+        let mut bases = Vec::new();
+        if self.km.is_some() {
+            bases.push(Base::Km);
+        }
+        if self.skcm.is_some() {
+            bases.push(Base::Skcm);
+        }
+        for (b, _) in &self.maps {
+            bases.push(if *b == Base::Km {
+                Base::KmMaps
+            } else {
+                Base::SkcmMaps
+            });
+        }
+        (bases, self.trained.keys().copied().collect())
+    }
+
     /// The KM fit, if a method has computed it.
     pub fn km(&self) -> Option<&Fit> {
         self.km.as_ref()

@@ -28,14 +28,16 @@
 //! (`CompensatorOptions::seed`): a calibration is reproducible bit for bit.
 
 use super::cache::Cache;
-use super::context::{Context, Outcome};
+use super::context::{Context, Outcome, Step};
 use super::maps::base_fit;
 use super::orientation_part::{note, train_orientation};
+use super::plan::Planner;
 use super::trained::{support_of, AppliedCompensator, Trained};
 use super::{Compensated, Method, MethodError, MethodFailure};
 use crate::calibrate::compensate::{cross_validate, train, Compensator, Sample, TrainError};
 use crate::calibrate::identify::least_squares::Fit;
 use crate::calibrate::identify::network::Network;
+use crate::calibrate::identify::progress::Fold;
 use crate::calibrate::identify::report::{
     predict_compensated, CompensatorSummary, MethodReport, MethodWarning, SetErrors,
     UncertaintyCheck, WarningKind,
@@ -192,16 +194,25 @@ pub(crate) fn trained(
 }
 
 /// A compensator method: its base (from the cache), then its compensator.
-/// `progress(fraction, iteration, loss)` with `fraction` in [0, 1].
+/// `progress(step)` with the step's fraction in [0, 1] of the work planned
+/// for it (`plan::Planner`: the base fit unless cached, then its trainings)
+/// and the fold it trains.
 pub(crate) fn run_compensated(
     ctx: &Context,
     cache: &mut Cache,
     method: Method,
     c: Compensated,
-    progress: &mut dyn FnMut(f64, usize, Option<f64>) -> bool,
+    progress: &mut dyn FnMut(&Step) -> bool,
 ) -> Result<Outcome, MethodError> {
+    let folds = ctx.opts.compensator.cv_folds;
+    let mut plan = Planner::from_cache(cache);
+    let base_units = plan.base(c.base);
+    let train_units = plan.training(ctx, method, folds);
+    let total = (base_units + train_units).max(f64::MIN_POSITIVE);
+    let max_it = ctx.opts.lm.max_iterations.max(1) as f64;
     let mf = base_fit(ctx, cache, c.base, &mut |it, rms| {
-        progress(0.0, it, Some(rms))
+        let f = base_units * (it as f64 / max_it).min(1.0) / total;
+        progress(&Step::plain(f, it, Some(rms)))
     })
     .map_err(|e| match e {
         MethodError::Failed(cause) => MethodError::Failed(MethodFailure::BaseFailed {
@@ -210,9 +221,8 @@ pub(crate) fn run_compensated(
         }),
         cancelled => cancelled,
     })?;
-    let folds = ctx.opts.compensator.cv_folds;
     let max = c.network.max_epochs(&ctx.opts.compensator) as f64;
-    let stages = ctx.opts.compensator.cv_stages(folds) as f64;
+    let stages = ctx.opts.compensator.cv_stages(folds);
     let t = trained(
         ctx,
         cache,
@@ -221,8 +231,11 @@ pub(crate) fn run_compensated(
         &mf.fit,
         folds,
         &mut |stage, e, l| {
-            let f = (stage as f64 + (e as f64 / max).min(1.0)) / stages;
-            progress(0.05 + 0.95 * f, e, Some(l))
+            let f = (stage as f64 + (e as f64 / max).min(1.0)) / stages as f64;
+            progress(&Step {
+                fold: Fold::of_stage(stage, stages),
+                ..Step::plain((base_units + train_units * f) / total, e, Some(l))
+            })
         },
     )?;
     Ok(Outcome {

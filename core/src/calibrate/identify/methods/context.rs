@@ -8,7 +8,8 @@ use super::{Method, MethodFailure};
 use crate::calibrate::identify::identifiability::DroppedParam;
 use crate::calibrate::identify::joint_maps::MapFit;
 use crate::calibrate::identify::least_squares::Fit;
-use crate::calibrate::identify::options::{CalibrationOptions, Progress};
+use crate::calibrate::identify::options::CalibrationOptions;
+use crate::calibrate::identify::progress::{Fold, Phase, Progress};
 use crate::calibrate::identify::report::{AutoSummary, TlboSummary};
 use crate::measure::Measurement;
 use crate::model::kinematics::Chain;
@@ -74,6 +75,32 @@ impl Outcome {
     }
 }
 
+/// One step of a method's progress within its own share of the bar.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Step {
+    /// The method's work done, in [0, 1].
+    pub fraction: f64,
+    pub iteration: usize,
+    pub loss: Option<f64>,
+    /// The candidate worked on (`auto`).
+    pub candidate: Option<Method>,
+    /// The cross-validation training under way.
+    pub fold: Option<Fold>,
+}
+
+impl Step {
+    /// A step at `fraction` with no candidate and no fold.
+    pub fn plain(fraction: f64, iteration: usize, loss: Option<f64>) -> Self {
+        Step {
+            fraction,
+            iteration,
+            loss,
+            candidate: None,
+            fold: None,
+        }
+    }
+}
+
 /// Progress of one method over its span of the bar [%], reported under its
 /// name.
 pub(crate) struct MethodProgress<'a> {
@@ -86,37 +113,36 @@ pub(crate) struct MethodProgress<'a> {
 }
 
 impl MethodProgress<'_> {
-    fn say(&self, iteration: usize, percent: f64, rms_mm: Option<f64>) -> bool {
-        (self.sink)(&Progress {
-            phase: self.method.name().to_string(),
-            iteration,
-            percent,
-            rms_mm,
-        })
-    }
-
     /// LM iteration `it` of at most `LmSettings::max_iterations`.
     pub fn lm(&self, it: usize, rms: f64) -> bool {
         let max_it = self.opts.lm.max_iterations.max(1) as f64;
-        self.say(
-            it,
-            self.start + self.span * (it as f64 / max_it).min(1.0),
-            Some(rms),
-        )
+        self.fraction(it as f64 / max_it, it, Some(rms))
     }
 
     /// TLBO generation `gen` (0-based) with the best eq. 7.10 cost [mm²].
     pub fn generation(&self, gen: usize, best: f64) -> bool {
         let generations = self.opts.tlbo.generations.max(1) as f64;
-        self.say(
-            gen,
-            self.start + self.span * (gen as f64 + 1.0) / generations,
-            Some(best.sqrt()),
-        )
+        self.fraction((gen as f64 + 1.0) / generations, gen, Some(best.sqrt()))
     }
 
     /// A fraction in [0, 1] of the method done.
     pub fn fraction(&self, f: f64, it: usize, loss: Option<f64>) -> bool {
-        self.say(it, self.start + self.span * f.clamp(0.0, 1.0), loss)
+        self.step(&Step::plain(f, it, loss))
+    }
+
+    /// A step of the method, with its candidate and fold.
+    pub fn step(&self, s: &Step) -> bool {
+        let f = if s.fraction.is_finite() {
+            s.fraction.clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (self.sink)(&Progress {
+            iteration: s.iteration,
+            rms_mm: s.loss,
+            candidate: s.candidate,
+            fold: s.fold,
+            ..Progress::at(Phase::Method(self.method), self.start + self.span * f)
+        })
     }
 }

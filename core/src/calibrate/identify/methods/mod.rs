@@ -8,7 +8,8 @@
 //! The methods themselves: `model_based` (KM §2.2, SKCM §2.3, SKCM-C by TLBO
 //! ch. 7, SKCM-payload), `compensated` (a learned compensator on a base,
 //! ch. 3–6), `maps` (joint maps), `auto`; `run` dispatches one method, `cache`
-//! shares fits and compensators between the methods of a calibration,
+//! shares fits and compensators between the methods of a calibration, `plan`
+//! sizes their work for the progress bar,
 //! `context` holds what they all read and `trained` a trained compensator;
 //! `report` turns a fit into its report.
 
@@ -20,6 +21,7 @@ mod failure;
 mod maps;
 mod model_based;
 mod orientation_part;
+mod plan;
 mod report;
 mod run;
 mod trained;
@@ -30,6 +32,7 @@ pub use failure::MethodFailure;
 use super::network::Network;
 pub(crate) use cache::Cache;
 pub(crate) use context::{Context, MethodProgress};
+pub(crate) use plan::Planner;
 pub(crate) use run::run;
 
 use serde::{Deserialize, Serialize};

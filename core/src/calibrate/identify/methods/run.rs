@@ -35,11 +35,7 @@ pub(crate) fn run(
         Run::Maps(base) => run_maps(ctx, cache, base, &mut |f, it, loss| {
             progress.fraction(f, it, loss)
         }),
-        Run::Compensated(c) => run_compensated(ctx, cache, method, c, &mut |f, it, loss| {
-            progress.fraction(f, it, loss)
-        }),
-        Run::Auto => run_auto(ctx, cache, &mut |f, it, loss| {
-            progress.fraction(f, it, loss)
-        }),
+        Run::Compensated(c) => run_compensated(ctx, cache, method, c, &mut |s| progress.step(s)),
+        Run::Auto => run_auto(ctx, cache, &mut |s| progress.step(s)),
     }
 }

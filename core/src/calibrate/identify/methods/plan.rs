@@ -1,0 +1,170 @@
+//! The work of a calibration's methods planned up front, in units of one
+//! model-based LM fit (KM or SKCM), so that the progress bar moves with work
+//! done over work planned ([`Planner`]).
+//!
+//! A unit's cost follows the table's `weight` (relative effort): a joint-map
+//! fit costs its method's weight less its base's, a compensator's
+//! cross-validated training its method's weight less its base's, scaled by
+//! its trainings over [`REFERENCE_TRAININGS`] (the weight is set for 5 random
+//! folds, 4 blocked and the final training), `skcm-tlbo` its weight and
+//! `skcm-payload` its weight less SKCM's. `auto` sums what it runs: per base
+//! (KM, SKCM when gravity loads a joint) the fit and each candidate
+//! compensator, then per base with a joint-map candidate the maps and the
+//! compensators on them. Work the run's cache already holds (a base fitted,
+//! a compensator trained with the same folds by an earlier method) costs
+//! nothing, as it costs no time.
+
+use super::cache::Cache;
+use super::context::Context;
+use super::{Base, Method, Run};
+
+/// Trainings of one cross-validated compensator that its table weight is set
+/// for: 5 random folds, 4 blocked ones and the final training.
+pub(crate) const REFERENCE_TRAININGS: f64 = 10.0;
+
+/// What the plan already counts as done (or the cache holds): the fitted
+/// bases and the trained compensators with their folds.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Planner {
+    fitted: Vec<Base>,
+    trained: Vec<(Method, usize)>,
+}
+
+impl Planner {
+    /// A plan that knows what `cache` holds.
+    pub fn from_cache(cache: &Cache) -> Self {
+        let (fitted, trained) = cache.held();
+        Planner { fitted, trained }
+    }
+
+    /// Units of fitting `base` (and what it builds on), 0 when fitted before;
+    /// marks it fitted.
+    pub fn base(&mut self, base: Base) -> f64 {
+        if self.fitted.contains(&base) {
+            return 0.0;
+        }
+        self.fitted.push(base);
+        match base {
+            Base::Km | Base::Skcm => base.method().row().weight,
+            Base::KmMaps => self.base(Base::Km) + maps_units(Method::KmMaps, Method::Km),
+            Base::SkcmMaps => self.base(Base::Skcm) + maps_units(Method::SkcmMaps, Method::Skcm),
+        }
+    }
+
+    /// Units of training compensator `method` with `folds`-fold
+    /// cross-validation, 0 when trained before; marks it trained.
+    pub fn training(&mut self, ctx: &Context, method: Method, folds: usize) -> f64 {
+        let Some(c) = method.compensated() else {
+            return 0.0;
+        };
+        if self.trained.contains(&(method, folds)) {
+            return 0.0;
+        }
+        self.trained.push((method, folds));
+        let stages = ctx.opts.compensator.cv_stages(folds) as f64;
+        let cost = (method.row().weight - c.base.method().row().weight).max(0.0);
+        cost * stages / REFERENCE_TRAININGS
+    }
+
+    /// Units of running `method` after what the plan holds; marks its work
+    /// done.
+    pub fn method(&mut self, ctx: &Context, method: Method) -> f64 {
+        let row = method.row();
+        match row.run {
+            Run::Km => self.base(Base::Km),
+            Run::Skcm => self.base(Base::Skcm),
+            // Warm-started from KM, fitted for it when no method did.
+            Run::SkcmTlbo => {
+                let warm = if self.fitted.contains(&Base::Km) {
+                    0.0
+                } else {
+                    Method::Km.row().weight
+                };
+                warm + row.weight
+            }
+            Run::SkcmPayload => {
+                self.base(Base::Skcm) + (row.weight - Method::Skcm.row().weight).max(0.0)
+            }
+            Run::Maps(Base::Km) => self.base(Base::KmMaps),
+            Run::Maps(_) => self.base(Base::SkcmMaps),
+            Run::Compensated(c) => {
+                self.base(c.base) + self.training(ctx, method, ctx.opts.compensator.cv_folds)
+            }
+            Run::Auto => self.auto(ctx),
+        }
+    }
+
+    /// Units of `auto` (module docs), in the order it runs them.
+    pub fn auto(&mut self, ctx: &Context) -> f64 {
+        let folds = auto_folds(ctx);
+        let bases = auto_bases(ctx);
+        let mut units = 0.0;
+        for base in &bases {
+            units += self.base(*base);
+            for m in auto_compensators(ctx, *base) {
+                units += self.training(ctx, m, folds);
+            }
+        }
+        for base in &bases {
+            let maps = if *base == Base::Km {
+                Base::KmMaps
+            } else {
+                Base::SkcmMaps
+            };
+            if !auto_has_maps(ctx, *base) {
+                continue;
+            }
+            units += self.base(maps);
+            for m in auto_compensators(ctx, maps) {
+                units += self.training(ctx, m, folds);
+            }
+        }
+        units
+    }
+}
+
+/// Units of a joint-map fit on its base's fit.
+fn maps_units(maps: Method, base: Method) -> f64 {
+    (maps.row().weight - base.row().weight).max(0.0)
+}
+
+/// The folds `auto` cross-validates with (5 when the options say 0).
+pub(crate) fn auto_folds(ctx: &Context) -> usize {
+    match ctx.opts.compensator.cv_folds {
+        0 => 5,
+        k => k,
+    }
+}
+
+/// The bases `auto` weighs: KM, and SKCM when gravity loads a joint.
+pub(crate) fn auto_bases(ctx: &Context) -> Vec<Base> {
+    if ctx.gravity.is_some() {
+        vec![Base::Km]
+    } else {
+        vec![Base::Km, Base::Skcm]
+    }
+}
+
+/// `auto`'s candidate compensators on `base` (none needing torques without
+/// gravity).
+pub(crate) fn auto_compensators(ctx: &Context, base: Base) -> Vec<Method> {
+    ctx.opts
+        .compensator
+        .auto_candidates
+        .iter()
+        .copied()
+        .filter(|m| {
+            m.compensated().is_some_and(|c| c.base == base)
+                && (ctx.gravity.is_none() || !m.uses_torques())
+        })
+        .collect()
+}
+
+/// Whether `auto` runs a joint-map candidate on `base`.
+fn auto_has_maps(ctx: &Context, base: Base) -> bool {
+    ctx.opts
+        .compensator
+        .auto_candidates
+        .iter()
+        .any(|m| m.row().run == Run::Maps(base))
+}

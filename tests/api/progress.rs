@@ -1,0 +1,121 @@
+//! A running job's progress as a client polls it: an `auto` job on the real
+//! WAM laser-tracker data (data/ur5-wam-laser-tracker, models/wam.json).
+
+use crate::support::*;
+use axum::http::StatusCode;
+use robocal::http::ServiceConfig;
+use robocal::service::WorkGate;
+use serde_json::{json, Value};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// Where the job is held once: within `auto`, at this percent or later. With
+/// the WAM's candidates (module `methods::plan`: KM's fit is 1 unit of about
+/// 26, KM-RBF's cross-validation the next), 14 % falls in KM-RBF's second
+/// fold.
+const HOLD_AT: f64 = 14.0;
+
+fn real(path: &str) -> String {
+    let file = format!(
+        "{}/data/ur5-wam-laser-tracker/{path}",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    std::fs::read_to_string(&file).unwrap_or_else(|e| panic!("{file}: {e}"))
+}
+
+/// Polls an `auto` job from start to end: its percentage never decreases;
+/// held at the gate inside `auto`, it names the candidate and the fold it
+/// trains and estimates the time left; it ends at 100 % with the candidate
+/// it named among those the report lists. The gate makes the observation
+/// independent of the machine's speed.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn an_auto_job_reports_progress_that_never_goes_back() {
+    let gate = Arc::new(WorkGate::closed_from("auto", HOLD_AT));
+    let t = setup_config(ServiceConfig {
+        workers: 1,
+        progress_interval: Duration::from_millis(20),
+        gate: Some(gate.clone()),
+        ..ServiceConfig::default()
+    })
+    .await;
+    let model: Value = serde_json::from_str(
+        &std::fs::read_to_string(format!("{}/models/wam.json", env!("CARGO_MANIFEST_DIR")))
+            .unwrap(),
+    )
+    .unwrap();
+    let r = t
+        .post_json("/v1/robots", &[], json!({ "name": "wam", "model": model }))
+        .await;
+    assert_eq!(r.status, StatusCode::CREATED, "{}", r.text());
+    let robot = r.json()["id"].as_i64().unwrap();
+    let rid = robot.to_string();
+    for (file, role) in [("grid", "identification"), ("random", "validation")] {
+        let csv = real(&format!("WAM/3D_WAM_uncalibrated_{file}_cleaned.csv"));
+        t.upload_csv(robot, &csv, &format!("?role={role}")).await;
+    }
+    let r = t.start_job(&rid, json!({ "methods": ["auto"] })).await;
+    assert_eq!(r.status, StatusCode::ACCEPTED, "{}", r.text());
+    let job = r.json()["id"].as_i64().unwrap();
+
+    let start = Instant::now();
+    let mut last = 0.0;
+    let mut polls = 0usize;
+    let mut held: Option<Value> = None;
+    let end = loop {
+        let j = t.job(&rid, job).await.json();
+        let p = &j["progress"];
+        let percent = p["percent"].as_f64().unwrap();
+        assert!(percent >= last, "{percent} % after {last} %: {j}");
+        last = percent;
+        polls += 1;
+        if j["status"] != "queued" && j["status"] != "running" {
+            break j;
+        }
+        // Held: once the stored progress is the held report, it names what
+        // the job is on; then the job goes on.
+        if held.is_none() && gate.held() > 0 && p["phase"] == "auto" && percent >= HOLD_AT {
+            held = Some(p.clone());
+            gate.open();
+        }
+        // Only a hang takes ten minutes.
+        assert!(start.elapsed() < Duration::from_secs(600), "{j}");
+        tokio::time::sleep(Duration::from_millis(10)).await;
+    };
+    assert_eq!(end["status"], "succeeded", "{end}");
+    assert_eq!(end["progress"]["phase"], "done");
+    assert_eq!(end["progress"]["percent"], 100.0);
+    assert_eq!(end["progress"]["eta_s"], Value::Null);
+    let held = held.expect("the job was held inside auto");
+    let candidate = held["candidate"].as_str().expect("a candidate named");
+    let fold = &held["fold"];
+    let (index, of) = (
+        fold["index"].as_u64().unwrap(),
+        fold["of"].as_u64().unwrap(),
+    );
+    // 5 random folds and 4 blocked ones (the defaults).
+    assert!((1..=of).contains(&index) && of == 9, "{held}");
+    let eta = held["eta_s"].as_f64().expect("a time left while running");
+    assert!(eta > 0.0, "{held}");
+    // The candidate named is one `auto` weighed.
+    let r = t
+        .get(
+            "/v1/robots/{id}/calibrations/{cid}/result",
+            &[&rid, &job.to_string()],
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::OK);
+    let listed: Vec<String> = r.json()["report"]["methods"]["auto"]["auto"]["candidates"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["method"].as_str().unwrap().to_string())
+        .collect();
+    assert!(
+        listed.iter().any(|m| m == candidate),
+        "{candidate} not among {listed:?}"
+    );
+    eprintln!(
+        "auto on the real WAM: held at {:.1} % on {candidate} fold {index}/{of}, {eta:.1} s left estimated; {polls} polls",
+        held["percent"]
+    );
+}
