@@ -32,7 +32,7 @@ pub use model_file::calibrated_model_file;
 pub use options::{CalibrationOptions, CompensatorOptions, Progress};
 pub use registration::{register, Registration};
 pub use report::{
-    AutoCandidate, AutoSummary, CalibrationReport, CompensatorSummary, FailedMethod,
-    JointMapExtent, JointMapsSummary, MethodReport, MethodWarning, NominalErrors, ParamEstimate,
-    PoseSource, PoseSources, SetErrors, WarningKind, REPORT_FORMAT_VERSION,
+    AutoCandidate, AutoDecision, AutoSummary, BaseFallback, CalibrationReport, CompensatorSummary,
+    FailedMethod, JointMapExtent, JointMapsSummary, MethodReport, MethodWarning, NominalErrors,
+    ParamEstimate, PoseSource, PoseSources, SetErrors, WarningKind, REPORT_FORMAT_VERSION,
 };

@@ -13,6 +13,7 @@
 //! `report` turns a fit into its report.
 
 mod auto;
+mod auto_choice;
 mod cache;
 mod compensated;
 mod context;
@@ -22,6 +23,7 @@ mod model_based;
 mod orientation_part;
 mod report;
 mod run;
+pub mod ties;
 mod trained;
 
 pub(crate) use failure::MethodError;
