@@ -61,6 +61,11 @@ pub struct CalibrateArgs {
     /// space held out; `auto` rejects a compensator worse on any); 0: none.
     #[arg(long, default_value_t = 4)]
     pub blocked_folds: usize,
+    /// `auto`'s options whose cross-validated means differ by less than this
+    /// fraction are a tie, broken by the blocked folds, the max, the base that
+    /// models more physics, then fewer fitted quantities.
+    #[arg(long, default_value_t = 0.05)]
+    pub tie_margin: f64,
     /// TLBO population and generations.
     #[arg(long, default_value_t = 50)]
     pub population: usize,
@@ -315,6 +320,7 @@ fn calibration_options(a: &CalibrateArgs) -> CalibrationOptions {
             seed: a.seed,
             cv_folds: a.cv_folds,
             blocked_folds: a.blocked_folds,
+            tie_margin: a.tie_margin,
             ..Default::default()
         },
         ..Default::default()

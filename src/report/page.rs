@@ -506,6 +506,40 @@ pub fn parameters(r: &ReportView, models: &[Model]) -> Markup {
     }
 }
 
+/// `auto`'s decision in one line: tie or not, the deciding step, the
+/// runner-up and the margin, and the fallback to the better base.
+fn decision_line(d: &super::view::AutoDecisionView) -> String {
+    let pct = d.tie_margin * 100.0;
+    let mut s = match (&d.runner_up, d.tie) {
+        (None, _) => "The only option.".to_string(),
+        (Some(r), false) => format!(
+            "No tie: the cross-validated mean is {:.4} mm below {}'s (more than {pct:.0} % apart).",
+            d.mean_margin_mm,
+            key_label(r)
+        ),
+        (Some(r), true) => format!(
+            "Tie with {} on the cross-validated mean (within {pct:.0} %, {:+.4} mm), decided by {}, by {:.4} {}.",
+            key_label(r),
+            d.mean_margin_mm,
+            d.step_label,
+            d.margin,
+            d.margin_unit
+        ),
+    };
+    if let Some(f) = &d.fallback {
+        s.push_str(&format!(
+            " {} was set aside: it sits on {}, which {} beats outside the trained region ({:.4} against {:.4} mm, {}).",
+            key_label(&f.instead_of),
+            key_label(&f.weaker_base),
+            key_label(&f.better_base),
+            f.weaker_mm,
+            f.better_mm,
+            f.measured_by
+        ));
+    }
+    s
+}
+
 /// The learned compensators: what each is, how it was trained, and its effect
 /// on every set (base → compensated), with `auto`'s choice.
 pub fn compensators(models: &[Model]) -> Markup {
@@ -531,6 +565,9 @@ pub fn compensators(models: &[Model]) -> Markup {
                 h3 { (m.label) }
                 @if let Some(a) = &v.auto {
                     p { strong { "Chose " (key_label(&a.chosen)) ": " } (a.reason) }
+                    @if let Some(d) = &a.decision {
+                        p.note { (decision_line(d)) }
+                    }
                 }
                 @if let Some(c) = &v.compensator {
                     p { (c.kind) " on " (c.inputs) ", " (c.units.map_or("—".into(), |u| u.to_string()))

@@ -284,6 +284,48 @@ pub struct AutoView {
     pub chosen: String,
     #[serde(default)]
     pub reason: String,
+    /// How the rule between the options decided (absent in older reports).
+    #[serde(default, deserialize_with = "lenient")]
+    pub decision: Option<AutoDecisionView>,
+}
+
+/// `auto`'s decision: the tie, the step that decided, the runner-up and the
+/// margin.
+#[derive(Debug, Clone, Default, Deserialize)]
+pub struct AutoDecisionView {
+    #[serde(default)]
+    pub tie: bool,
+    #[serde(default)]
+    pub step_label: String,
+    #[serde(default)]
+    pub runner_up: Option<String>,
+    #[serde(default)]
+    pub margin: f64,
+    #[serde(default)]
+    pub margin_unit: String,
+    #[serde(default)]
+    pub mean_margin_mm: f64,
+    #[serde(default)]
+    pub tie_margin: f64,
+    #[serde(default)]
+    pub fallback: Option<BaseFallbackView>,
+}
+
+/// The better base that took over from an option on the weaker one.
+#[derive(Debug, Clone, Default, Deserialize)]
+pub struct BaseFallbackView {
+    #[serde(default)]
+    pub instead_of: String,
+    #[serde(default)]
+    pub weaker_base: String,
+    #[serde(default)]
+    pub better_base: String,
+    #[serde(default)]
+    pub weaker_mm: f64,
+    #[serde(default)]
+    pub better_mm: f64,
+    #[serde(default)]
+    pub measured_by: String,
 }
 
 /// TLBO convergence (cost per generation).

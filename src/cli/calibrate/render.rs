@@ -393,6 +393,12 @@ pub fn render_compensators(r: &CalibrationReport) -> String {
                 method_label(a.chosen),
                 a.reason
             );
+            let _ = writeln!(
+                s,
+                "  {:<14} decision: {}",
+                "",
+                a.decision.sentence(a.chosen)
+            );
         }
         let Some(c) = &m.compensator else {
             continue;

@@ -51,6 +51,10 @@
 //! (`‖J_rot,θi‖ = 1`), so with orientation rows no map is refused on this
 //! ground.
 
+mod blocked;
+
+pub use blocked::BlockedMaps;
+
 use super::evaluate::{evaluate, gram_checked};
 use crate::measure::Measurement;
 use crate::model::{JointMap, JointMaps, ParamId, ParamKind, Pose, RobotModel};
@@ -90,6 +94,9 @@ pub struct JointMapSettings {
     pub max_unseen_tip_m: f64,
     /// … and by more than this many times the position noise σ.
     pub noise_ratio: f64,
+    /// Spatially blocked folds the chosen maps are also judged on (whole
+    /// regions of joint space held out, `blocked`); fewer than 2 skips them.
+    pub blocked_folds: usize,
 }
 
 impl Default for JointMapSettings {
@@ -106,6 +113,7 @@ impl Default for JointMapSettings {
             production_tool_m: 0.25,
             max_unseen_tip_m: 0.5e-3,
             noise_ratio: 2.0,
+            blocked_folds: 4,
         }
     }
 }
@@ -150,6 +158,9 @@ pub struct MapFit {
     pub poses: usize,
     /// Joints whose map the measurements cannot see, not fitted.
     pub refused: Vec<RefusedMap>,
+    /// The chosen maps and the geometry alone on the spatially blocked
+    /// folds (none when they were not run).
+    pub blocked: Option<BlockedMaps>,
 }
 
 /// Why a joint's map was refused (module docs): a closed set whose
@@ -677,7 +688,7 @@ impl CrossValidation<'_> {
 /// cross-validation, then the coefficients on all poses. `progress(done,
 /// total)` after each candidate's fold and between the steps of building the
 /// design and its normal equations (`done` = candidates done); false cancels
-/// (`Ok(None)`).
+/// (`Ok(None)`). The blocked folds draw from `blocked_rng`.
 #[allow(clippy::too_many_arguments)]
 pub fn fit_joint_maps(
     model: &RobotModel,
@@ -687,6 +698,7 @@ pub fn fit_joint_maps(
     orientation_weight: f64,
     settings: &JointMapSettings,
     rng: &mut impl Rng,
+    blocked_rng: &mut impl Rng,
     progress: &mut dyn FnMut(usize, usize) -> bool,
 ) -> Result<Option<MapFit>, MapFitError> {
     if model.closed_loop.is_some() {
@@ -785,10 +797,25 @@ pub fn fit_joint_maps(
             settings.fade_rad,
         ))
     };
+    let input = blocked::BlockedInput {
+        d: &d,
+        g: &g,
+        b: &b,
+        scale: &scale,
+        data,
+        fade_rad: settings.fade_rad,
+    };
+    let regions = settings.blocked_folds;
+    let pair = (chosen.harmonics, chosen.ridge);
+    let mut go = || progress(total, total);
+    let Some(blocked) = blocked::blocked_errors(&input, regions, pair, blocked_rng, &mut go) else {
+        return Ok(None);
+    };
     if !progress(total, total) {
         return Ok(None);
     }
     Ok(Some(MapFit {
+        blocked,
         maps,
         chosen,
         without_maps,

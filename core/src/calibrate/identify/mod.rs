@@ -34,7 +34,7 @@ pub use options::{CalibrationOptions, CompensatorOptions};
 pub use progress::{Clock, Fold, Phase, Progress, ProgressReporter, SystemClock};
 pub use registration::{register, Registration};
 pub use report::{
-    AutoCandidate, AutoSummary, CalibrationReport, CompensatorSummary, FailedMethod,
-    JointMapExtent, JointMapsSummary, MethodReport, MethodWarning, NominalErrors, ParamEstimate,
-    PoseSource, PoseSources, SetErrors, WarningKind, REPORT_FORMAT_VERSION,
+    AutoCandidate, AutoDecision, AutoSummary, BaseFallback, CalibrationReport, CompensatorSummary,
+    FailedMethod, JointMapExtent, JointMapsSummary, MethodReport, MethodWarning, NominalErrors,
+    ParamEstimate, PoseSource, PoseSources, SetErrors, WarningKind, REPORT_FORMAT_VERSION,
 };

@@ -61,6 +61,13 @@ pub struct CompensatorOptions {
     /// `auto` takes a compensator only when its cross-validated mean is at
     /// least this fraction below its base's (and its max not above).
     pub min_gain: f64,
+    /// `auto`'s options whose cross-validated means differ by less than this
+    /// fraction (relative to the lower) are a tie, broken by the blocked
+    /// folds, the max, the physics of the base and the count of fitted
+    /// quantities (`methods::ties`); the later steps compare within the
+    /// same margin. The default is `min_gain`'s: a difference `auto` would
+    /// not take a compensator for does not choose between options either.
+    pub tie_margin: f64,
     /// With fewer training poses `auto` keeps the base without training.
     pub min_training_poses: usize,
     /// The joint-map and compensator methods `auto` considers.
@@ -90,6 +97,7 @@ impl Default for CompensatorOptions {
             cv_folds: 5,
             blocked_folds: 4,
             min_gain: 0.05,
+            tie_margin: 0.05,
             min_training_poses: 20,
             auto_candidates: Method::JOINT_MAPS
                 .iter()

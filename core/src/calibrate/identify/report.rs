@@ -9,6 +9,7 @@
 use super::identifiability::IdentifiabilityReport;
 use super::joint_maps::{MapCandidate, MapFit, RefusedMap};
 use super::least_squares::LmReport;
+use super::methods::ties::DecidingStep;
 use super::options::Method;
 use crate::calibrate::compensate::{Compensator, CvStats, StoredCompensator, Support, TrainReport};
 use crate::measure::Measurement;
@@ -598,6 +599,77 @@ pub struct AutoSummary {
     /// without orientation measurements).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub orientation_part: Option<OrientationPart>,
+    /// How the rule between the options decided (`methods::ties`).
+    pub decision: AutoDecision,
+}
+
+/// How `auto` decided between its options: a tie or not, the step of the
+/// tie rule that decided, the runner-up and the margin
+/// (`methods::ties::break_ties`), and the fallback from an option on the
+/// weaker base.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AutoDecision {
+    /// Whether another option's cross-validated mean was within
+    /// `tie_margin` of the lowest.
+    pub tie: bool,
+    pub step: DecidingStep,
+    /// What the step compares ([`DecidingStep::label`]).
+    pub step_label: &'static str,
+    /// The best of the options the deciding step removed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub runner_up: Option<Method>,
+    /// By how much the winner led the runner-up at the deciding step, in
+    /// `margin_unit` (0 without a runner-up).
+    pub margin: f64,
+    pub margin_unit: &'static str,
+    /// The runner-up's cross-validated mean less the winner's [mm].
+    pub mean_margin_mm: f64,
+    /// The relative margin within which figures are a tie.
+    pub tie_margin: f64,
+    /// The option the rule chose first, set aside because it sits on the
+    /// weaker base.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fallback: Option<BaseFallback>,
+}
+
+/// The better base took over from an option on the weaker one: beyond its
+/// trained region a compensator or map fades to its base.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BaseFallback {
+    /// The option the tie rule chose among all.
+    pub instead_of: Method,
+    pub weaker_base: Method,
+    pub better_base: Method,
+    /// The two bases alone, weaker and better [mm], measured as `measured_by`
+    /// says.
+    pub weaker_mm: f64,
+    pub better_mm: f64,
+    pub measured_by: String,
+}
+
+impl AutoDecision {
+    /// The decision in words, with `winner` the chosen method.
+    pub fn sentence(&self, winner: Method) -> String {
+        let pct = self.tie_margin * 100.0;
+        let mut s = match (self.runner_up, self.tie) {
+            (None, _) => format!("{winner}: the only option"),
+            (Some(r), false) => format!(
+                "{winner}: no tie, its cross-validated mean {:.4} mm below {r}'s (more than {pct:.0} % apart)",
+                self.mean_margin_mm
+            ),
+            (Some(r), true) => format!(
+                "{winner}: tied with {r} on the cross-validated mean (within {pct:.0} %, {:+.4} mm), decided by {} by {:.4} {}",
+                self.mean_margin_mm, self.step_label, self.margin, self.margin_unit
+            ),
+        };
+        if let Some(f) = &self.fallback {
+            s.push_str(&format!(
+                "; {} was set aside: it sits on {}, which {} beats outside the trained region ({:.4} against {:.4} mm, {})",
+                f.instead_of, f.weaker_base, f.better_base, f.weaker_mm, f.better_mm, f.measured_by
+            ));
+        }
+        s
+    }
 }
 
 /// Kind of a method warning.

@@ -4,14 +4,20 @@
 //! `auto` runs KM and (when gravity loads a joint) SKCM, cross-validates every
 //! candidate compensator of each base on the training pool and keeps, per
 //! base, the compensator `compensate::choose` accepts (cross-validated mean at
-//! least `min_gain` below the base's, max not above) or the base alone; between
-//! the bases it takes the lower cross-validated mean on the training pool. With
+//! least `min_gain` below the base's, max not above) or the base alone.
+//! Between the options (each base with what it kept, and the kept joint maps
+//! below) it chooses by the tie rule (`methods::ties`: cross-validated means
+//! within `tie_margin` of each other are a tie, broken by the spatially
+//! blocked folds, the max, the physics of the base, the fewer fitted
+//! quantities), and never delivers an option on the weaker base while one
+//! on the better base is there (`auto_choice`). With
 //! fewer than `min_training_poses` training poses it trains nothing and keeps
 //! the base, saying so. The joint-map methods among the candidates are options
 //! of their own: kept when their cross-validated mean (over the identification
 //! and training poses, `identify::joint_maps`) is at least `min_gain` below the
 //! geometry's alone on the same folds and their max not above; they then
-//! compete with the bases by that cross-validated mean. On kept maps the
+//! compete with the bases by that cross-validated mean and their blocked
+//! folds (`joint_maps::BlockedMaps`). On kept maps the
 //! compensators built on them (`km-maps-gp`, `skcm-maps-gp`) are
 //! cross-validated on what the maps leave and one is added when `choose`
 //! accepts it against the maps alone; the option keeps the maps' mean.
@@ -31,6 +37,7 @@
 //! `AutoSummary::orientation_part` is `not_kept`) and the option scores its
 //! base's (or maps') orientation on the pool.
 
+use super::auto_choice::{choose_among, decide};
 use super::cache::Cache;
 use super::compensated::{self, base_pool_errors};
 use super::context::{Context, MethodFit, Outcome, Step};
@@ -39,60 +46,58 @@ use super::maps::run_maps;
 use super::orientation_part::settle_for_auto;
 use super::plan::Planner;
 use super::trained::AppliedCompensator;
-use super::{Base, Compensated, Method, MethodError, MethodFailure, Run};
+use super::{Base, Compensated, Method, MethodError, Run};
 use crate::calibrate::compensate::{choose, Choice, CvStats};
 use crate::calibrate::identify::least_squares::Fit;
 use crate::calibrate::identify::progress::Fold;
 use crate::calibrate::identify::report::{
-    AutoCandidate, AutoSummary, OrientationPart, OrientationPartStatus, SetErrors,
+    AutoCandidate, OrientationPart, OrientationPartStatus, SetErrors,
 };
 
 /// Orientation means within this relative margin of each other count as
 /// equal (the fit's noise); a larger excess is a loss `auto` does not accept.
 pub(crate) const ORIENTATION_SLACK: f64 = 0.02;
 
-/// The option `auto` takes among `(position mean [mm], orientation mean
-/// [deg])` pairs (orientation `None`: not measured): those whose orientation
-/// mean exceeds the lowest by more than `slack` (relative) are excluded, then
-/// the lowest position mean wins. Returns its index and the excluded ones;
-/// `None` for no options.
-pub(crate) fn choose_option(
-    options: &[(f64, Option<f64>)],
-    slack: f64,
-) -> Option<(usize, Vec<usize>)> {
-    let best_orientation = options
-        .iter()
-        .filter_map(|o| o.1)
-        .fold(f64::INFINITY, f64::min);
-    let loses = |o: &(f64, Option<f64>)| {
-        o.1.is_some_and(|a| best_orientation.is_finite() && a > best_orientation * (1.0 + slack))
-    };
-    let excluded: Vec<usize> = (0..options.len()).filter(|i| loses(&options[*i])).collect();
-    let chosen = (0..options.len())
-        .filter(|i| !excluded.contains(i))
-        .min_by(|a, b| options[*a].0.total_cmp(&options[*b].0))?;
-    Some((chosen, excluded))
-}
-
 /// One base as `auto` weighs it.
-struct BaseOption {
-    base: Base,
+pub(super) struct BaseOption {
+    pub base: Base,
     /// The joint-map method whose fit this is, if any.
-    maps: Option<Method>,
-    fit: MethodFit,
+    pub maps: Option<Method>,
+    pub fit: MethodFit,
     /// The compensator `choose` kept, if any.
-    compensator: Option<AppliedCompensator>,
+    pub compensator: Option<AppliedCompensator>,
     /// Cross-validated mean on the pool [mm] (the base's residual mean when
     /// nothing was trained).
-    mean_mm: f64,
+    pub mean_mm: f64,
+    /// Cross-validated max on the pool [mm] (the base's residual max when
+    /// nothing was trained).
+    pub max_mm: f64,
+    /// Mean over the spatially blocked folds [mm] (`ties::Contender`).
+    pub blocked_mm: Option<f64>,
+    /// The base alone on the pool [mm]: its residual mean (base options
+    /// only, `auto_choice`'s fallback).
+    pub alone_mm: Option<f64>,
     /// Orientation mean of the option [deg]: the fit's on the pool, or the
     /// kept orientation part's cross-validated mean (none without
     /// orientation measurements).
-    orientation_deg: Option<f64>,
+    pub orientation_deg: Option<f64>,
     /// The kept compensator's orientation part, where orientation was
     /// measured.
-    orientation_part: Option<OrientationPart>,
-    reason: String,
+    pub orientation_part: Option<OrientationPart>,
+    pub reason: String,
+}
+
+/// The pose-weighted mean of a cross-validation's blocked folds [mm], if
+/// they ran.
+fn blocked_mean(cv: &CvStats) -> Option<f64> {
+    let poses: usize = cv.blocked.iter().map(|f| f.poses).sum();
+    (poses > 0).then(|| {
+        cv.blocked
+            .iter()
+            .map(|f| f.compensated_mean_mm * f.poses as f64)
+            .sum::<f64>()
+            / poses as f64
+    })
 }
 
 /// The orientation mean of `errors` [deg], if the set measured any.
@@ -102,16 +107,19 @@ fn orientation_mean(errors: &SetErrors) -> Option<f64> {
 
 /// What `auto` gathers while it runs: the progress bar's position, the
 /// options it weighs, the candidates it lists and its notes.
-struct Tally<'p> {
-    progress: &'p mut dyn FnMut(&Step) -> bool,
+pub(super) struct Tally<'p> {
+    pub progress: &'p mut dyn FnMut(&Step) -> bool,
     /// Units of work done (`plan::Planner`), of `total`; `plan` knows what
     /// is done or cached.
-    done: f64,
-    total: f64,
-    plan: Planner,
-    notes: Vec<String>,
-    candidates: Vec<AutoCandidate>,
-    options: Vec<BaseOption>,
+    pub done: f64,
+    pub total: f64,
+    pub plan: Planner,
+    pub notes: Vec<String>,
+    pub candidates: Vec<AutoCandidate>,
+    pub options: Vec<BaseOption>,
+    /// Per base (KM, SKCM) whose joint maps ran, the mean of its geometry
+    /// alone on the maps' spatially blocked folds [mm].
+    pub geometry_blocked: Vec<(Base, f64)>,
 }
 
 /// `auto` (module docs). Without gravity torques (`Context::gravity`) neither
@@ -152,6 +160,7 @@ pub(crate) fn run_auto(
             .collect(),
         candidates: Vec::new(),
         options: Vec::new(),
+        geometry_blocked: Vec::new(),
     };
     for (base, cands) in bases.iter().zip(&per_base) {
         base_option(ctx, cache, &mut t, *base, cands, folds)?;
@@ -161,7 +170,43 @@ pub(crate) fn run_auto(
             maps_option(ctx, cache, &mut t, *base, method, folds)?;
         }
     }
-    choose_among(ctx, t)
+    let mut decision = decide(ctx, &t)?;
+    if let Some(method) = decision.untried.take() {
+        offer(ctx, cache, &mut t, method, folds)?;
+        decision = decide(ctx, &t)?;
+        decision.untried = None;
+    }
+    choose_among(ctx, t, decision)
+}
+
+/// Trains `method`, the counterpart on the better base of an option set
+/// aside (`auto_choice`), and adds it as an option when it is kept.
+fn offer(
+    ctx: &Context,
+    cache: &mut Cache,
+    t: &mut Tally,
+    method: Method,
+    folds: usize,
+) -> Result<(), MethodError> {
+    t.total += 1.0 + on_maps_candidates(ctx, Base::SkcmMaps).len() as f64;
+    match method.row().run {
+        Run::Maps(base) => maps_option(ctx, cache, t, base, method, folds),
+        Run::Compensated(c) if matches!(c.base, Base::Km | Base::Skcm) => {
+            let before = t.options.len();
+            base_option(ctx, cache, t, c.base, &[(method, c)], folds)?;
+            if t.options.len() > before && t.options[before].compensator.is_none() {
+                let dropped = t.options.remove(before);
+                t.notes.push(format!(
+                    "{} offered on {}: {}",
+                    method.name(),
+                    c.base.method().name(),
+                    dropped.reason
+                ));
+            }
+            Ok(())
+        }
+        _ => Ok(()),
+    }
 }
 
 /// Fits `base` and, with enough training poses, cross-validates its
@@ -202,7 +247,11 @@ fn base_option(
     };
     let base_errors = base_pool_errors(&mf.fit, pool);
     let base_mean = base_errors.stats.mean_mm;
+    let base_max = base_errors.stats.max_mm;
     let orientation_deg = orientation_mean(&base_errors);
+    // The base alone is not fitted on a separate training pool: its error
+    // there is its error in every held-out region of it.
+    let alone_blocked = (!ctx.training.is_empty()).then_some(base_mean);
     if pool.len() < o.min_training_poses {
         t.done += spans.units;
         t.options.push(BaseOption {
@@ -211,6 +260,9 @@ fn base_option(
             fit: mf,
             compensator: None,
             mean_mm: base_mean,
+            max_mm: base_max,
+            blocked_mm: alone_blocked,
+            alone_mm: Some(base_mean),
             orientation_deg,
             orientation_part: None,
             reason: format!(
@@ -231,10 +283,10 @@ fn base_option(
         &mut |s| progress(&spans.step(t.done, total, s)),
     )?;
     t.done += spans.units;
-    let mean_mm = picked
-        .as_ref()
-        .and_then(|a| a.trained.cv.as_ref())
-        .map_or(base_mean, |cv| cv.compensated.mean_mm);
+    let cv = picked.as_ref().and_then(|a| a.trained.cv.as_ref());
+    let mean_mm = cv.map_or(base_mean, |cv| cv.compensated.mean_mm);
+    let max_mm = cv.map_or(base_max, |cv| cv.compensated.max_mm);
+    let blocked_mm = cv.map_or(alone_blocked, blocked_mean);
     if let Some((_, Some(dropped))) = &settled {
         t.notes.push(dropped.clone());
     }
@@ -244,6 +296,9 @@ fn base_option(
         fit: mf,
         compensator: picked,
         mean_mm,
+        max_mm,
+        blocked_mm,
+        alone_mm: Some(base_mean),
         orientation_deg: option_orientation(orientation_deg, &settled),
         orientation_part: settled.map(|s| s.0),
         reason: format!("{name}: {}", choice.reason),
@@ -298,6 +353,9 @@ fn maps_option(
     let Some(m) = fit.maps.clone() else {
         return Ok(());
     };
+    if let Some(b) = &m.blocked {
+        t.geometry_blocked.push((base, b.without_maps_mm));
+    }
     t.candidates.push(AutoCandidate {
         method,
         cross_validation: None,
@@ -350,6 +408,9 @@ fn maps_option(
         fit,
         compensator: on_maps.kept,
         mean_mm: with.cv_mean_mm,
+        max_mm: with.cv_max_mm,
+        blocked_mm: m.blocked.as_ref().map(|b| b.with_maps_mm),
+        alone_mm: None,
         orientation_deg: option_orientation(orientation_deg, &on_maps.settled),
         orientation_part: on_maps.settled.map(|s| s.0),
         reason: format!("{}{}", on_maps.reason, format_args!(
@@ -364,79 +425,6 @@ fn maps_option(
         )),
     });
     Ok(())
-}
-
-/// The option `auto` delivers (`choose_option` over the options' scores),
-/// with its reason, the other options' reasons and the notes.
-fn choose_among(ctx: &Context, t: Tally) -> Result<Outcome, MethodError> {
-    let (pool, pool_name) = ctx.pool();
-    let enough = pool.len() >= ctx.opts.compensator.min_training_poses;
-    let Tally {
-        mut notes,
-        candidates,
-        mut options,
-        ..
-    } = t;
-    let scores: Vec<(f64, Option<f64>)> = options
-        .iter()
-        .map(|o| (o.mean_mm, o.orientation_deg))
-        .collect();
-    let (best, excluded) = choose_option(&scores, ORIENTATION_SLACK).ok_or_else(|| {
-        MethodFailure::NoBaseSucceeded {
-            notes: notes.clone(),
-        }
-    })?;
-    let best_orientation = scores[best].1;
-    for i in excluded {
-        notes.push(format!(
-            "{} not chosen: it loses orientation, {:.4}° mean on the {pool_name} poses, more than {:.0} % above the best option's",
-            option_name(&options[i]),
-            scores[i].1.unwrap_or(f64::NAN),
-            ORIENTATION_SLACK * 100.0
-        ));
-    }
-    let reasons: Vec<String> = options.iter().map(|o| o.reason.clone()).collect();
-    let best = options.swap_remove(best);
-    let chosen = Method::from_name(option_name(&best)).expect("a method's own name");
-    let mut reason = format!(
-        "{}: the lowest {} mean on the {pool_name} poses ({:.4} mm) — {}",
-        chosen.name(),
-        if best.compensator.is_some() || best.maps.is_some() || enough {
-            "cross-validated"
-        } else {
-            "residual"
-        },
-        best.mean_mm,
-        reasons.join("; ")
-    );
-    if let Some(a) = best_orientation {
-        reason.push_str(&format!(
-            "; orientation {a:.4}° mean on the {pool_name} poses (orientation within {:.0} % of the best option's is required)",
-            ORIENTATION_SLACK * 100.0
-        ));
-    }
-    if !notes.is_empty() {
-        reason.push_str(&format!("; {}", notes.join("; ")));
-    }
-    Ok(Outcome {
-        fit: best.fit,
-        compensator: best.compensator,
-        auto: Some(AutoSummary {
-            chosen,
-            reason,
-            candidates,
-            orientation_part: best.orientation_part,
-        }),
-    })
-}
-
-/// The method an option delivers.
-fn option_name(o: &BaseOption) -> &'static str {
-    match (&o.compensator, o.maps) {
-        (Some(a), _) => a.method.name(),
-        (None, Some(m)) => m.name(),
-        (None, None) => o.base.method().name(),
-    }
 }
 
 /// What `auto` made of the compensators on a kept joint-map fit.
@@ -623,36 +611,4 @@ fn maps_candidate(candidates: &[Method], base: Base) -> Option<Method> {
         .iter()
         .copied()
         .find(|m| m.row().run == Run::Maps(base))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Without orientation the lowest position mean wins; with it, an option
-    /// that gains position but loses orientation beyond the slack is
-    /// excluded, one within the slack still competes by position.
-    #[test]
-    fn an_option_losing_orientation_is_not_chosen() {
-        assert_eq!(
-            choose_option(&[(0.45, None), (0.10, None)], 0.02),
-            Some((1, vec![]))
-        );
-        // Maps: 4× better position, but 0.060° against 0.053°: excluded.
-        assert_eq!(
-            choose_option(&[(0.45, Some(0.053)), (0.10, Some(0.060))], 0.02),
-            Some((0, vec![1]))
-        );
-        // 0.0535° is within 2 % of 0.053°: the better position wins.
-        assert_eq!(
-            choose_option(&[(0.45, Some(0.053)), (0.10, Some(0.0535))], 0.02),
-            Some((1, vec![]))
-        );
-        // Better on both: chosen.
-        assert_eq!(
-            choose_option(&[(0.45, Some(0.053)), (0.10, Some(0.019))], 0.02),
-            Some((1, vec![0]))
-        );
-        assert_eq!(choose_option(&[], 0.02), None);
-    }
 }

@@ -6,8 +6,8 @@
 //! cross-validation keeps no map (K = 0 wins) the base's fit stays, and the
 //! report says so.
 //!
-//! Randomness: the folds draw from `ChaCha8Rng(seed + 101)`
-//! (`CompensatorOptions::seed`).
+//! Randomness: the folds draw from `ChaCha8Rng(seed + 101)`, the spatially
+//! blocked folds from `ChaCha8Rng(seed + 102)` (`CompensatorOptions::seed`).
 
 use super::cache::Cache;
 use super::context::{Context, MethodFit, Outcome};
@@ -78,6 +78,7 @@ fn fit_maps(
         .cloned()
         .collect();
     let mut rng = ChaCha8Rng::seed_from_u64(ctx.opts.compensator.seed.wrapping_add(101));
+    let mut blocked_rng = ChaCha8Rng::seed_from_u64(ctx.opts.compensator.seed.wrapping_add(102));
     let w = ctx.opts.lm.orientation_weight;
     for round in 0..rounds {
         let mut plain = mf.fit.model.clone();
@@ -91,6 +92,7 @@ fn fit_maps(
             w,
             settings,
             &mut rng,
+            &mut blocked_rng,
             &mut |done, total| progress((stage + done as f64 / total as f64) / stages, done, None),
         )
         .map_err(MethodFailure::JointMaps)?

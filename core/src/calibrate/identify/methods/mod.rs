@@ -14,6 +14,7 @@
 //! `report` turns a fit into its report.
 
 mod auto;
+mod auto_choice;
 mod cache;
 mod compensated;
 mod context;
@@ -24,6 +25,7 @@ mod orientation_part;
 mod plan;
 mod report;
 mod run;
+pub mod ties;
 mod trained;
 
 pub(crate) use failure::MethodError;

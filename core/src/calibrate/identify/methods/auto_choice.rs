@@ -1,0 +1,359 @@
+//! How `auto` chooses among its options (`methods::auto`): those that lose
+//! orientation are excluded ([`choose_option`]), the tie rule
+//! (`ties::break_ties`, margin `CompensatorOptions::tie_margin`) picks among
+//! the rest, and an option on the weaker base is set aside for the best one
+//! on the better base ([`decide`]).
+//!
+//! The better base: KM and SKCM alone compared outside the region they were
+//! fitted on — their geometry alone on the joint maps' spatially blocked
+//! folds when the maps ran on both (`joint_maps::BlockedMaps`), else their
+//! residual mean on the pool — the better when the other's figure exceeds
+//! its own by more than the tie margin. Beyond its trained region a
+//! compensator or a joint map fades to its base, so an option on the weaker
+//! base is not delivered while an option on the better base is there. When
+//! the set-aside option's counterpart on the better base ([`counterpart`]:
+//! the same network, or the joint maps, on it) was not among the candidates,
+//! `auto` trains it first and decides again.
+
+use super::auto::{BaseOption, Tally, ORIENTATION_SLACK};
+use super::context::{Context, Outcome};
+use super::ties::{break_ties, Contender, Physics, TieOutcome};
+use super::{Base, Compensated, Method, MethodError, MethodFailure, Run};
+use crate::calibrate::identify::report::{AutoDecision, AutoSummary, BaseFallback};
+
+/// The option `auto` takes among `(position mean [mm], orientation mean
+/// [deg])` pairs (orientation `None`: not measured): those whose orientation
+/// mean exceeds the lowest by more than `slack` (relative) are excluded, then
+/// the lowest position mean wins. Returns its index and the excluded ones;
+/// `None` for no options.
+pub(crate) fn choose_option(
+    options: &[(f64, Option<f64>)],
+    slack: f64,
+) -> Option<(usize, Vec<usize>)> {
+    let best_orientation = options
+        .iter()
+        .filter_map(|o| o.1)
+        .fold(f64::INFINITY, f64::min);
+    let loses = |o: &(f64, Option<f64>)| {
+        o.1.is_some_and(|a| best_orientation.is_finite() && a > best_orientation * (1.0 + slack))
+    };
+    let excluded: Vec<usize> = (0..options.len()).filter(|i| loses(&options[*i])).collect();
+    let chosen = (0..options.len())
+        .filter(|i| !excluded.contains(i))
+        .min_by(|a, b| options[*a].0.total_cmp(&options[*b].0))?;
+    Some((chosen, excluded))
+}
+
+/// KM or SKCM: the model-based base under an option's fit.
+pub(super) fn family(base: Base) -> Base {
+    match base {
+        Base::Km | Base::KmMaps => Base::Km,
+        Base::Skcm | Base::SkcmMaps => Base::Skcm,
+    }
+}
+
+/// The same base on the other family (KM ↔ SKCM).
+fn swap(base: Base) -> Base {
+    match base {
+        Base::Km => Base::Skcm,
+        Base::Skcm => Base::Km,
+        Base::KmMaps => Base::SkcmMaps,
+        Base::SkcmMaps => Base::KmMaps,
+    }
+}
+
+/// The method on the other family that does what `method` does: the same
+/// network on the swapped base, or the joint maps on it; `None` for a
+/// model-based method or one without a counterpart (`km-rbf`).
+pub(super) fn counterpart(method: Method) -> Option<Method> {
+    let run = match method.row().run {
+        Run::Compensated(c) => Run::Compensated(Compensated {
+            base: swap(c.base),
+            network: c.network,
+        }),
+        Run::Maps(b) => Run::Maps(swap(b)),
+        _ => return None,
+    };
+    Method::ALL.iter().copied().find(|m| m.row().run == run)
+}
+
+/// The method an option delivers.
+pub(super) fn option_name(o: &BaseOption) -> &'static str {
+    match (&o.compensator, o.maps) {
+        (Some(a), _) => a.method.name(),
+        (None, Some(m)) => m.name(),
+        (None, None) => o.base.method().name(),
+    }
+}
+
+fn option_method(o: &BaseOption) -> Method {
+    Method::from_name(option_name(o)).expect("a method's own name")
+}
+
+/// Fitted quantities of an option: identified parameters, joint-map
+/// coefficients, three output weights per compensator unit.
+fn parameters(o: &BaseOption) -> usize {
+    let maps: usize = o.fit.fit.model.joint_maps.as_ref().map_or(0, |m| {
+        m.joints.iter().flatten().map(|j| 2 * j.harmonics()).sum()
+    });
+    let units = o
+        .compensator
+        .as_ref()
+        .map_or(0, |a| 3 * a.trained.stored.shape().units);
+    o.fit.ids.len() + maps + units
+}
+
+fn contender(o: &BaseOption) -> Contender {
+    Contender {
+        mean_mm: o.mean_mm,
+        blocked_mean_mm: o.blocked_mm,
+        max_mm: o.max_mm,
+        physics: Physics::of(option_method(o)),
+        parameters: parameters(o),
+    }
+}
+
+/// The better of KM and SKCM outside the region (module docs).
+struct BetterBase {
+    better: Base,
+    weaker: Base,
+    better_mm: f64,
+    weaker_mm: f64,
+    measured_by: String,
+}
+
+fn better_base(t: &Tally, margin: f64, pool_name: &str) -> Option<BetterBase> {
+    let blocked = |b: Base| t.geometry_blocked.iter().find(|g| g.0 == b).map(|g| g.1);
+    let alone = |b: Base| {
+        t.options
+            .iter()
+            .find(|o| o.base == b && o.maps.is_none())
+            .and_then(|o| o.alone_mm)
+    };
+    let (km, skcm, measured_by) = match (blocked(Base::Km), blocked(Base::Skcm)) {
+        (Some(k), Some(s)) => (
+            k,
+            s,
+            "the geometry alone on the joint maps' spatially blocked folds".to_string(),
+        ),
+        _ => (
+            alone(Base::Km)?,
+            alone(Base::Skcm)?,
+            format!("the base alone on the {pool_name} poses"),
+        ),
+    };
+    let (better, weaker, better_mm, weaker_mm) = if skcm <= km {
+        (Base::Skcm, Base::Km, skcm, km)
+    } else {
+        (Base::Km, Base::Skcm, km, skcm)
+    };
+    (weaker_mm - better_mm > margin * better_mm).then_some(BetterBase {
+        better,
+        weaker,
+        better_mm,
+        weaker_mm,
+        measured_by,
+    })
+}
+
+/// What [`decide`] found; indices are into the tally's options.
+pub(super) struct Decision {
+    pub outcome: TieOutcome,
+    /// Options excluded for losing orientation.
+    pub excluded: Vec<usize>,
+    pub fallback: Option<BaseFallback>,
+    /// The set-aside option's counterpart on the better base, with that
+    /// base, when it was not among the candidates.
+    pub untried: Option<Method>,
+}
+
+/// The tie rule over the options (module docs), then the fallback to the
+/// better base.
+pub(super) fn decide(ctx: &Context, t: &Tally) -> Result<Decision, MethodError> {
+    let margin = ctx.opts.compensator.tie_margin;
+    let (_, pool_name) = ctx.pool();
+    let scores: Vec<(f64, Option<f64>)> = t
+        .options
+        .iter()
+        .map(|o| (o.mean_mm, o.orientation_deg))
+        .collect();
+    let no_option = || MethodFailure::NoBaseSucceeded {
+        notes: t.notes.clone(),
+    };
+    let (_, excluded) = choose_option(&scores, ORIENTATION_SLACK).ok_or_else(no_option)?;
+    let rule = |among: &[usize]| {
+        let c: Vec<Contender> = among.iter().map(|i| contender(&t.options[*i])).collect();
+        break_ties(&c, margin).map(|o| TieOutcome {
+            winner: among[o.winner],
+            runner_up: o.runner_up.map(|r| among[r]),
+            ..o
+        })
+    };
+    let eligible: Vec<usize> = (0..t.options.len())
+        .filter(|i| !excluded.contains(i))
+        .collect();
+    let first = rule(&eligible).ok_or_else(no_option)?;
+    let chosen = &t.options[first.winner];
+    let Some(b) = better_base(t, margin, pool_name).filter(|b| family(chosen.base) == b.weaker)
+    else {
+        return Ok(Decision {
+            outcome: first,
+            excluded,
+            fallback: None,
+            untried: None,
+        });
+    };
+    let set_aside = option_method(chosen);
+    let offer = if chosen.maps.is_some() {
+        chosen.maps.and_then(counterpart)
+    } else {
+        counterpart(set_aside)
+    };
+    let untried = offer.filter(|m| {
+        (ctx.gravity.is_none() || !m.uses_torques()) && !t.candidates.iter().any(|c| c.method == *m)
+    });
+    let better: Vec<usize> = eligible
+        .iter()
+        .copied()
+        .filter(|i| family(t.options[*i].base) == b.better)
+        .collect();
+    let Some(outcome) = rule(&better) else {
+        return Ok(Decision {
+            outcome: first,
+            excluded,
+            fallback: None,
+            untried,
+        });
+    };
+    Ok(Decision {
+        outcome,
+        excluded,
+        fallback: Some(BaseFallback {
+            instead_of: set_aside,
+            weaker_base: b.weaker.method(),
+            better_base: b.better.method(),
+            weaker_mm: b.weaker_mm,
+            better_mm: b.better_mm,
+            measured_by: b.measured_by,
+        }),
+        untried,
+    })
+}
+
+/// The option `auto` delivers by `decision`, with its reason, the other
+/// options' reasons and the notes.
+pub(super) fn choose_among(
+    ctx: &Context,
+    t: Tally,
+    decision: Decision,
+) -> Result<Outcome, MethodError> {
+    let (_, pool_name) = ctx.pool();
+    let Tally {
+        mut notes,
+        candidates,
+        mut options,
+        ..
+    } = t;
+    let best = decision.outcome.winner;
+    let best_orientation = options[best].orientation_deg;
+    for i in &decision.excluded {
+        notes.push(format!(
+            "{} not chosen: it loses orientation, {:.4}° mean on the {pool_name} poses, more than {:.0} % above the best option's",
+            option_name(&options[*i]),
+            options[*i].orientation_deg.unwrap_or(f64::NAN),
+            ORIENTATION_SLACK * 100.0
+        ));
+    }
+    let o = &decision.outcome;
+    let runner_up = o.runner_up.map(|r| option_method(&options[r]));
+    let reasons: Vec<String> = options.iter().map(|o| o.reason.clone()).collect();
+    let best = options.swap_remove(best);
+    let chosen = option_method(&best);
+    let result = AutoDecision {
+        tie: o.tie,
+        step: o.step,
+        step_label: o.step.label(),
+        runner_up,
+        margin: o.margin,
+        margin_unit: o.step.unit(),
+        mean_margin_mm: o.mean_margin_mm,
+        tie_margin: ctx.opts.compensator.tie_margin,
+        fallback: decision.fallback,
+    };
+    let mut reason = format!(
+        "{}; {} mean {:.4} mm on the {pool_name} poses — {}",
+        result.sentence(chosen),
+        chosen.name(),
+        best.mean_mm,
+        reasons.join("; ")
+    );
+    if let Some(a) = best_orientation {
+        reason.push_str(&format!(
+            "; orientation {a:.4}° mean on the {pool_name} poses (orientation within {:.0} % of the best option's is required)",
+            ORIENTATION_SLACK * 100.0
+        ));
+    }
+    if !notes.is_empty() {
+        reason.push_str(&format!("; {}", notes.join("; ")));
+    }
+    Ok(Outcome {
+        fit: best.fit,
+        compensator: best.compensator,
+        auto: Some(AutoSummary {
+            chosen,
+            reason,
+            candidates,
+            orientation_part: best.orientation_part,
+            decision: result,
+        }),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Without orientation the lowest position mean wins; with it, an option
+    /// that gains position but loses orientation beyond the slack is
+    /// excluded, one within the slack still competes by position.
+    #[test]
+    fn an_option_losing_orientation_is_not_chosen() {
+        assert_eq!(
+            choose_option(&[(0.45, None), (0.10, None)], 0.02),
+            Some((1, vec![]))
+        );
+        // Maps: 4× better position, but 0.060° against 0.053°: excluded.
+        assert_eq!(
+            choose_option(&[(0.45, Some(0.053)), (0.10, Some(0.060))], 0.02),
+            Some((0, vec![1]))
+        );
+        // 0.0535° is within 2 % of 0.053°: the better position wins.
+        assert_eq!(
+            choose_option(&[(0.45, Some(0.053)), (0.10, Some(0.0535))], 0.02),
+            Some((1, vec![]))
+        );
+        // Better on both: chosen.
+        assert_eq!(
+            choose_option(&[(0.45, Some(0.053)), (0.10, Some(0.019))], 0.02),
+            Some((1, vec![0]))
+        );
+        assert_eq!(choose_option(&[], 0.02), None);
+    }
+
+    /// Every compensator and joint-map method has its counterpart on the
+    /// other base but the torque-input RBF; counterparts pair up.
+    #[test]
+    fn counterparts_pair_the_bases() {
+        assert_eq!(counterpart(Method::KmMaps), Some(Method::SkcmMaps));
+        assert_eq!(counterpart(Method::KmGp), Some(Method::SkcmGp));
+        assert_eq!(counterpart(Method::KmMapsGp), Some(Method::SkcmMapsGp));
+        assert_eq!(counterpart(Method::KmRbf), None);
+        assert_eq!(counterpart(Method::Skcm), None);
+        for m in Method::ALL {
+            if let Some(c) = counterpart(m) {
+                assert_eq!(counterpart(c), Some(m), "{m}");
+                assert_ne!(Physics::of(c), Physics::of(m), "{m}");
+            }
+        }
+    }
+}
