@@ -15,7 +15,7 @@
 //! the same network, or the joint maps, on it) was not among the candidates,
 //! `auto` trains it first and decides again.
 
-use super::auto::{BaseOption, Tally, ORIENTATION_SLACK};
+use super::auto_tally::{BaseOption, Tally, ORIENTATION_SLACK};
 use super::context::{Context, Outcome};
 use super::ties::{break_ties, Contender, Physics, TieOutcome};
 use super::{Base, Compensated, Method, MethodError, MethodFailure, Run};

@@ -15,6 +15,7 @@
 
 mod auto;
 mod auto_choice;
+mod auto_tally;
 mod cache;
 mod compensated;
 mod context;
