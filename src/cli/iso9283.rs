@@ -18,7 +18,7 @@
 use crate::calibrate::compensate::CompensatedModel;
 use crate::model::orientation::fixed_xyz_matrix;
 use crate::plan::WorkspaceBox;
-use crate::plan::{JoinBy, JoinOptions, Units};
+use crate::plan::{JoinBy, Units};
 use crate::report::iso9283::{
     cycles_of, is_date, render_iso9283_html, today_utc, Iso9283Conditions, MeasuredSet,
 };
@@ -408,19 +408,8 @@ pub fn join_files(a: &JoinArgs) -> anyhow::Result<String> {
         std::fs::read_to_string(p).with_context(|| format!("cannot read {}", p.display()))
     };
     let plan = read_plan_csv(&read(&a.plan)?).with_context(|| a.plan.display().to_string())?;
-    let units = match a.units.as_str() {
-        "mm" => Units::Mm,
-        "m" => Units::M,
-        "detect" => Units::Detect,
-        u => bail!("--units: mm, m or detect, got {u:?}"),
-    };
-    let by = match a.by.as_str() {
-        "name" => JoinBy::Name,
-        "order" => JoinBy::Order,
-        "detect" => JoinBy::Detect,
-        b => bail!("--by: name, order or detect, got {b:?}"),
-    };
-    let joined = join_cycles(&plan, &read(&a.tracker_export)?, &JoinOptions { units, by })
+    let options = super::plan::join_options(&a.units, &a.by)?;
+    let joined = join_cycles(&plan, &read(&a.tracker_export)?, &options)
         .with_context(|| a.tracker_export.display().to_string())?;
     std::fs::write(&a.out, cycles_csv(&joined.rows))
         .with_context(|| format!("cannot write {}", a.out.display()))?;

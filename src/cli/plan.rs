@@ -222,24 +222,31 @@ pub fn make(a: &MakeArgs) -> anyhow::Result<String> {
 }
 
 /// Joins the tracker export; returns a one-line summary.
-pub fn join_files(a: &JoinArgs) -> anyhow::Result<String> {
-    let read = |p: &PathBuf| {
-        std::fs::read_to_string(p).with_context(|| format!("cannot read {}", p.display()))
-    };
-    let plan = read_plan_csv(&read(&a.plan)?).with_context(|| a.plan.display().to_string())?;
-    let units = match a.units.as_str() {
+/// The `--units` and `--by` of a join (`plan join`, `iso9283 join`) as
+/// `JoinOptions`; any other value is refused naming the flag.
+pub(crate) fn join_options(units: &str, by: &str) -> anyhow::Result<JoinOptions> {
+    let units = match units {
         "mm" => Units::Mm,
         "m" => Units::M,
         "detect" => Units::Detect,
         u => bail!("--units: mm, m or detect, got {u:?}"),
     };
-    let by = match a.by.as_str() {
+    let by = match by {
         "name" => JoinBy::Name,
         "order" => JoinBy::Order,
         "detect" => JoinBy::Detect,
         b => bail!("--by: name, order or detect, got {b:?}"),
     };
-    let joined = join(&plan, &read(&a.tracker_export)?, &JoinOptions { units, by })
+    Ok(JoinOptions { units, by })
+}
+
+pub fn join_files(a: &JoinArgs) -> anyhow::Result<String> {
+    let read = |p: &PathBuf| {
+        std::fs::read_to_string(p).with_context(|| format!("cannot read {}", p.display()))
+    };
+    let plan = read_plan_csv(&read(&a.plan)?).with_context(|| a.plan.display().to_string())?;
+    let options = join_options(&a.units, &a.by)?;
+    let joined = join(&plan, &read(&a.tracker_export)?, &options)
         .with_context(|| a.tracker_export.display().to_string())?;
     std::fs::write(&a.out, crate::measure::csv::write(&joined.rows))
         .with_context(|| format!("cannot write {}", a.out.display()))?;
