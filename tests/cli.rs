@@ -195,7 +195,7 @@ fn compensator_method_saves_and_solves() {
     );
     assert!(text.contains("on 80 training poses"), "{text}");
     let file = std::fs::read_to_string(dir.join("cal.json")).unwrap();
-    let model = robocal::calibrate::compensate::parse_compensated(&file).unwrap();
+    let model = robocal_core::model::calibrated::parse_compensated(&file).unwrap();
     assert!(model.compensator.is_some());
     let nominal = robocal::model::preset("ys100").unwrap();
     let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(9);

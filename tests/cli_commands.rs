@@ -13,7 +13,6 @@ use common::robocal_json;
 use core_common::ik::{calibrated, kuka_like, pose_close};
 use core_common::two_tracker_sessions;
 use nalgebra::Vector3;
-use robocal::calibrate::compensate::{parse_compensated, CalibratedModelFile};
 use robocal::cli::export::{export_to_string, ExportArgs};
 use robocal::cli::model_files::{load_compensated, save_model_file};
 use robocal::cli::solve::{solve_to_string, OutputFormat, SolveArgs};
@@ -22,6 +21,7 @@ use robocal::model::orientation::{rotation_to, OrientationConvention};
 use robocal::model::RobotModel;
 use robocal::sim::{tracker_frame, ys100_table_7_1, TrueRobot};
 use robocal::solve::ik::{IkSettings, IkSolver, SolveOptions};
+use robocal_core::model::calibrated::{parse_compensated, CalibratedModelFile};
 use std::fmt::Write as _;
 
 // ---------------------------------------------------------------------------

@@ -3,11 +3,11 @@
 //! `solve` with 2 when a target failed unless `--allow-failures`, refused
 //! input with 1; docs/guide/exit-codes.md states the code's table.
 
-use robocal::calibrate::compensate::CompensatedModel;
 use robocal::check::CheckStatus;
 use robocal::cli::exit::Exit;
 use robocal::measure::{csv, MeasuredPose};
 use robocal::model::preset;
+use robocal_core::model::calibrated::CompensatedModel;
 use std::path::Path;
 use std::process::{Command, Output};
 

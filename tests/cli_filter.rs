@@ -2,12 +2,12 @@
 //! written, only target values changed, a parse error names file, line and column.
 
 use clap::Parser;
-use robocal::calibrate::compensate::CalibratedModelFile;
 use robocal::cli::filter::{filter_to_string, FilterArgs};
 use robocal::cli::model_files::save_model_file;
 use robocal::model::preset;
 use robocal::sim::{synthetic_calibration, SyntheticErrors};
 use robocal::solve::program::{parse, Language, ProgramFile};
+use robocal_core::model::calibrated::CalibratedModelFile;
 use std::path::{Path, PathBuf};
 
 fn examples() -> PathBuf {

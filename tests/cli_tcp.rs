@@ -11,7 +11,6 @@ mod core_common;
 use clap::Parser;
 use core_common::ik::calibrated;
 use nalgebra::{Rotation3, Unit, Vector3};
-use robocal::calibrate::compensate::{CalibratedModelFile, CompensatedModel};
 use robocal::cli::model_files::save_model_file;
 use robocal::cli::tcp::{tcp_to_string, work_object_to_string, NotFitted, TcpArgs};
 use robocal::cli::Command;
@@ -20,6 +19,7 @@ use robocal::model::Pose;
 use robocal::solve::cell::tcp::NotFittedReason;
 use robocal::solve::cell::{CellDescription, CellOptions, CellSolver, WorkObject};
 use robocal::solve::ik::IkSettings;
+use robocal_core::model::calibrated::{CalibratedModelFile, CompensatedModel};
 
 fn readings(model: &CompensatedModel, tool: &Pose, targets: &[Pose]) -> Vec<String> {
     let solver = CellSolver::new(model, tool, IkSettings::default());

@@ -38,12 +38,11 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use robocal_core::calibrate::compensate::{
-    train, CompensatedModel, CompensatorSpec, Sample, StoredCompensator,
-};
+use robocal_core::calibrate::compensate::{train, CompensatorSpec, Sample};
 use robocal_core::calibrate::identify::{
     calibrate_with_training, CalibrationOptions, CompensatorOptions, Method,
 };
+use robocal_core::model::calibrated::{CompensatedModel, Compensator, StoredCompensator};
 use robocal_core::model::{preset, JointMap, JointMaps};
 use robocal_core::sim::random_configurations;
 use robocal_core::sim::{synthetic_calibration, unmodelled_truth, SyntheticErrors};
@@ -175,8 +174,8 @@ fn bench(c: &mut Criterion) {
     }
 
     let s = samples(&cm, 1000, 2);
-    let net = fit(&CompensatorSpec::skcm_nn(), &s).into_arc();
-    let gp = fit(&CompensatorSpec::Gp(Default::default()), &s).into_arc();
+    let net = fit(&CompensatorSpec::skcm_nn(), &s).into_arc_oriented(None, None);
+    let gp = fit(&CompensatorSpec::Gp(Default::default()), &s).into_arc_oriented(None, None);
     let qs: Vec<Vec<f64>> = s.iter().map(|s| s.q.clone()).collect();
     let tau = vec![0.0; 6];
     let mut g = c.benchmark_group("predict");

@@ -15,11 +15,12 @@
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal_core::calibrate::compensate::{
-    train, CompensatedModel, CompensatorSpec, IwoSettings, LmTrainSettings, MlpSettings, MlpSpec,
+    samples_of, train, CompensatorSpec, IwoSettings, LmTrainSettings, MlpSettings, MlpSpec,
     OutputLayer, TlboTrainSettings, Trainer,
 };
 use robocal_core::calibrate::identify::{calibrate, CalibrationOptions, Method};
 use robocal_core::measure::{self, Measurement};
+use robocal_core::model::calibrated::CompensatedModel;
 use robocal_core::model::preset;
 use robocal_core::sim::random_configurations;
 use robocal_core::sim::unmodelled_truth;
@@ -64,8 +65,8 @@ fn main() {
         payload_kg: payload,
         compensator: None,
     };
-    let samples = base.samples(&train_set).unwrap();
-    let vsamples = base.samples(&valid).unwrap();
+    let samples = samples_of(&base, &train_set).unwrap();
+    let vsamples = samples_of(&base, &valid).unwrap();
     let base_mean =
         vsamples.iter().map(|s| s.residual.norm()).sum::<f64>() / vsamples.len() as f64 * 1e3;
     println!("SKCM validation mean {base_mean:.4} mm (1000 training poses, 200 validation poses, {seeds} seeds)");

@@ -2,10 +2,12 @@
 //!
 //! - `measure`: read measurement and target CSV texts (`csv_text`), the tracker's conventions.
 //! - `model`: the robot model (`robot`, DH/MDH parameters, joint maps), its kinematics
-//!   (`kinematics`: chain, Jacobian, gravity), its stored description and its exports.
+//!   (`kinematics`: chain, Jacobian, gravity), its stored description and its exports, and
+//!   the calibrated model as solves use it (`calibrated`: the compensated model, the learned
+//!   compensators' stored forms and prediction, the calibrated model file and its loader).
 //! - `calibrate`: identify the model from measurements (`identify`) and train the learned
-//!   compensator (`compensate`); `identify::model_file` assembles the calibrated model file
-//!   the service stores.
+//!   compensator (`compensate`); `identify::model_file` assembles and checks the calibrated
+//!   model file the service stores.
 //! - `solve`: inverse kinematics on a calibrated model (`ik`), tools, loads and work objects in
 //!   the cell (`cell`), robot programs (`program`).
 //! - `plan`: measurement plans; `check`: accuracy checks, re-registration, ISO 9283.

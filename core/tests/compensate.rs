@@ -21,12 +21,13 @@ mod common;
 use common::{measure_truth, real, shipped_model};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal_core::calibrate::compensate::{CompensatedModel, CompensatorSpec, StoredCompensator};
+use robocal_core::calibrate::compensate::CompensatorSpec;
 use robocal_core::calibrate::identify::{
     calibrate, calibrate_with_training, CalibrationOptions, CalibrationReport, CompensatorOptions,
     Method,
 };
 use robocal_core::measure::{self, Measurement};
+use robocal_core::model::calibrated::{CompensatedModel, StoredCompensator};
 use robocal_core::model::{preset, RobotModel};
 use robocal_core::sim::random_configurations;
 use robocal_core::sim::unmodelled_truth;

@@ -34,11 +34,9 @@ use nalgebra::{Rotation3, Vector3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
-use robocal_core::calibrate::compensate::{
-    parse_compensated, CalibratedModelFile, CompensatedModel,
-};
 use robocal_core::calibrate::identify::{calibrate_with_training, CalibrationReport, Method};
 use robocal_core::measure::Measurement;
+use robocal_core::model::calibrated::{parse_compensated, CalibratedModelFile, CompensatedModel};
 use robocal_core::model::{Pose, RobotModel};
 use robocal_core::sim::TrueRobot;
 use robocal_core::solve::cell::predict::{Forward, PredictFrame};
@@ -145,7 +143,7 @@ fn a_compensator_learns_the_orientation_and_the_tool_tip_benefits() {
         compensator: r.methods[&Method::KmGp]
             .stored_compensator
             .clone()
-            .map(|c| c.into_arc_supported(r.methods[&Method::KmGp].stored_support.clone())),
+            .map(|c| c.into_arc_oriented(None, r.methods[&Method::KmGp].stored_support.clone())),
         ..gp_model.clone()
     };
     let tip_gp_position = tip_error_mm(&position_only, &truth, &va, &tip);

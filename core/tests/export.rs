@@ -4,7 +4,7 @@
 //! kinematics to 1e-6 mm. (`robocal export` writing every format is a test of
 //! the root crate.)
 
-use robocal_core::calibrate::compensate::CalibratedModelFile;
+use robocal_core::model::calibrated::CalibratedModelFile;
 use robocal_core::model::export::{export, ExportFormat, ExportSource};
 use robocal_core::model::kinematics::fk;
 

@@ -10,9 +10,8 @@ use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
-use robocal_core::calibrate::compensate::{
-    train_gp, Compensator, GpSettings, Sample, StoredCompensator, Support, TrainError,
-};
+use robocal_core::calibrate::compensate::{train_gp, GpSettings, Sample, TrainError};
+use robocal_core::model::calibrated::{Compensator, StoredCompensator, Support};
 
 /// A smooth residual of a few tenths of a millimetre [m]: products of sines of
 /// three joints, not a sum of Gaussians.
@@ -44,7 +43,7 @@ fn samples(n: usize, noise_m: f64, q_lo: f64, q_hi: f64, seed: u64) -> Vec<Sampl
         .collect()
 }
 
-fn trained(data: &[Sample], seed: u64) -> robocal_core::calibrate::compensate::Gp {
+fn trained(data: &[Sample], seed: u64) -> robocal_core::model::calibrated::Gp {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     train_gp(data, &GpSettings::default(), &mut rng, &mut |_, _| true)
         .unwrap()

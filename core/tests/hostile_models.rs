@@ -11,11 +11,11 @@ use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal_core::calibrate::compensate::CompensatedModel;
 use robocal_core::calibrate::identify::{
     calibrate, CalibrationError, CalibrationOptions, LmSettings, Method,
 };
 use robocal_core::measure::{self, Measurement};
+use robocal_core::model::calibrated::CompensatedModel;
 use robocal_core::model::export::{export, ExportFormat, ExportSource};
 use robocal_core::model::kinematics::chain::tool_pose;
 use robocal_core::model::kinematics::fk;

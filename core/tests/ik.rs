@@ -19,7 +19,7 @@ use nalgebra::{Matrix3, Vector3};
 use proptest::prelude::*;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal_core::calibrate::compensate::{CompensatedModel, Compensator};
+use robocal_core::model::calibrated::{CompensatedModel, Compensator, LearnedCompensator};
 use robocal_core::model::kinematics::fk;
 use robocal_core::model::orientation::{
     rotation_angle_between, rotation_from, rotation_to, OrientationConvention,
@@ -264,7 +264,7 @@ impl Compensator for Wave {
 #[test]
 fn round_trip_predict_of_ik_equals_target_in_cell_and_base_frames() {
     let mut cm = calibrated("ys100", 8);
-    cm.compensator = Some(Arc::new(Wave));
+    cm.compensator = Some(LearnedCompensator::unstored(Arc::new(Wave)));
     let solver = IkSolver::new(cm.clone(), IkSettings::default());
     let mut rng = ChaCha8Rng::seed_from_u64(21);
     for _ in 0..200 {

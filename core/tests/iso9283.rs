@@ -7,11 +7,11 @@
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
-use robocal_core::calibrate::compensate::CompensatedModel;
 use robocal_core::calibrate::identify::pose_selection::choose_d_optimal;
 use robocal_core::calibrate::identify::{calibrate, CalibrationOptions, Method};
 use robocal_core::check::iso9283::{evaluate, plan_cube, Commands, CubeSettings, PoseCycles};
 use robocal_core::measure;
+use robocal_core::model::calibrated::CompensatedModel;
 use robocal_core::model::orientation::fixed_xyz_matrix;
 use robocal_core::model::preset;
 use robocal_core::plan::WorkspaceBox;

@@ -10,9 +10,9 @@ use common::ik::calibrated;
 use common::{opts, run_with};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use robocal_core::calibrate::compensate::CompensatedModel;
 use robocal_core::calibrate::identify::{calibrate, CalibrationError, Method};
 use robocal_core::measure::{self, Measurement};
+use robocal_core::model::calibrated::CompensatedModel;
 use robocal_core::model::orientation::rotation_angle_between;
 use robocal_core::model::{preset, JointMap, JointMaps, ModelDescription, RobotModel};
 use robocal_core::sim::{

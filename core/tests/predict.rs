@@ -12,9 +12,9 @@ use common::{measure_truth, opts, run_with};
 use nalgebra::Vector3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal_core::calibrate::compensate::{CompensatedModel, Compensator};
 use robocal_core::calibrate::identify::Method;
 use robocal_core::measure::Measurement;
+use robocal_core::model::calibrated::{CompensatedModel, Compensator, LearnedCompensator};
 use robocal_core::model::kinematics::chain::tool_pose;
 use robocal_core::model::orientation::rotation_angle_between;
 use robocal_core::model::{preset, JointMap, JointMaps, Pose, RobotModel};
@@ -205,14 +205,14 @@ fn predict_and_solve_are_inverse_with_joint_maps() {
 fn predict_and_solve_are_inverse_with_a_compensator() {
     let mut cm = calibrated("ur10", 6);
     cm.calibrated.joint_maps = Some(maps(6));
-    cm.compensator = Some(Arc::new(Wave));
+    cm.compensator = Some(LearnedCompensator::unstored(Arc::new(Wave)));
     round_trip(&cm, 4, 60);
 }
 
 #[test]
 fn predict_and_solve_are_inverse_with_a_tool_its_load_and_a_work_object() {
     let mut cm = calibrated("ys100", 7);
-    cm.compensator = Some(Arc::new(Wave));
+    cm.compensator = Some(LearnedCompensator::unstored(Arc::new(Wave)));
     let mut tcp = Pose::identity();
     tcp.rot_y(0.5);
     tcp.p = Vector3::new(0.03, -0.02, 0.25);

@@ -10,9 +10,9 @@ mod common;
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use robocal_core::calibrate::compensate::CompensatedModel;
 use robocal_core::calibrate::identify::{calibrate_with_training, CalibrationOptions, Method};
 use robocal_core::measure::{self, Measurement};
+use robocal_core::model::calibrated::CompensatedModel;
 use robocal_core::model::{preset, Coverage, RobotModel};
 use robocal_core::sim::unmodelled_truth;
 use robocal_core::sim::{random_configurations, TrueRobot};

@@ -18,7 +18,6 @@
 //!
 //! Times are wall-clock on the calling thread (pin with `taskset -c 0`).
 
-use crate::calibrate::compensate::{CalibratedModelFile, CompensatedModel};
 use crate::calibrate::identify::{calibrate, CalibrationOptions, Method};
 use crate::measure::csv_write::{push_row, Cell};
 use crate::measure::{self, csv};
@@ -26,6 +25,7 @@ use crate::solve::ik::{Goal, IkSettings, IkSolver, SolveOptions, TargetFrame};
 use anyhow::{bail, Context};
 use clap::{Args, Subcommand};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use robocal_core::model::calibrated::{CalibratedModelFile, CompensatedModel};
 use serde_json::json;
 use std::time::Instant;
 

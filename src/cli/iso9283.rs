@@ -15,7 +15,6 @@
 //! The plan CSV's commanded poses: the model's measurement frame (see
 //! `core::iso9283::csv` for both file formats).
 
-use crate::calibrate::compensate::CompensatedModel;
 use crate::model::orientation::fixed_xyz_matrix;
 use crate::plan::WorkspaceBox;
 use crate::plan::{JoinBy, Units};
@@ -31,6 +30,7 @@ use robocal_core::check::iso9283::program::cycle_program;
 use robocal_core::check::iso9283::{
     assess, evaluate, plan_cube, Commands, CubePlan, CubeSettings, Iso9283Figures,
 };
+use robocal_core::model::calibrated::CompensatedModel;
 use sha2::{Digest, Sha256};
 use std::fmt::Write as _;
 use std::path::PathBuf;

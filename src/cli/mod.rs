@@ -129,7 +129,7 @@ pub fn load_model(arg: &str) -> anyhow::Result<crate::model::RobotModel> {
             .map_err(|e| anyhow::anyhow!("cannot read model file {arg}: {e}"))?;
         match crate::model::RobotModel::from_json(&text) {
             Err(crate::model::ModelError::Parse(e)) => {
-                match crate::calibrate::compensate::CalibratedModelFile::from_json(&text) {
+                match robocal_core::model::calibrated::CalibratedModelFile::from_json(&text) {
                     Ok(file) => file
                         .model
                         .to_model()

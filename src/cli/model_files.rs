@@ -2,12 +2,12 @@
 //! their text; reading and writing files happens here): a calibrated model
 //! file (`robocal calibrate --save`), a model JSON file, or a preset name.
 
-use crate::calibrate::compensate::{
-    parse_compensated, CalibratedModelFile, CompensateError, CompensatedModel,
-};
 use crate::model::preset;
 use crate::solve::cell::{Cell, CellDescription};
 use anyhow::Context;
+use robocal_core::model::calibrated::{
+    parse_compensated, CalibratedModelFile, CompensateError, CompensatedModel,
+};
 use std::path::Path;
 
 /// Loads a calibrated model file, a model JSON file or a preset name.

@@ -76,7 +76,7 @@ pub fn reregister_file(a: &ReregisterArgs) -> anyhow::Result<Reregistration> {
     let (moved, report) =
         reregister(&model, &rows).with_context(|| format!("{} on {}", a.model, path.display()))?;
     if let Some(out) = &a.save {
-        let file = crate::calibrate::compensate::CalibratedModelFile::from_compensated(
+        let file = robocal_core::model::calibrated::CalibratedModelFile::from_compensated(
             &moved,
             &model.nominal.name,
             "reregister",

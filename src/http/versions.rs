@@ -7,13 +7,13 @@
 use super::input::{page_body, PageQuery};
 use super::robots::robot_list_page;
 use super::{ApiError, ApiPath, ApiQuery, AppState};
-use crate::calibrate::compensate::CalibratedModelFile;
 use crate::model::export::{export, ExportFormat, ExportSource};
 use crate::records::VersionRow;
 use crate::service;
 use axum::extract::State;
 use axum::http::header;
 use axum::response::{IntoResponse, Response};
+use robocal_core::model::calibrated::CalibratedModelFile;
 use serde::Serialize;
 use serde_json::{json, Value};
 

@@ -54,7 +54,7 @@ pub enum Fitted<F> {
 async fn calibrated(
     state: &AppState,
     t: &FitTarget,
-) -> Result<(crate::calibrate::compensate::CompensatedModel, i64), ServiceError> {
+) -> Result<(robocal_core::model::calibrated::CompensatedModel, i64), ServiceError> {
     let choice = match t.version {
         Some(v) => ModelChoice::Version(v),
         None => {

@@ -8,13 +8,13 @@
 //! its pages stay bounded for a set of any size.
 
 use super::{robots, versions, AppState, ServiceError};
-use crate::calibrate::compensate::CalibratedModelFile;
 use crate::db::{Listing, NewCheck};
 use crate::records::CheckRow;
 use robocal_core::check::{
     score, worst_poses, CheckResult, CheckStatus, CheckThresholds, PoseError, ShiftSize,
     DEGRADED_MIN_MM, THRESHOLD_MAX_MM,
 };
+use robocal_core::model::calibrated::CalibratedModelFile;
 use serde::Serialize;
 use serde_json::Value;
 

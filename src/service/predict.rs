@@ -11,17 +11,16 @@
 use super::limits::SMALL_SOLVE_MAX;
 use super::solve::{choose_version, resolve, ItemChoice, ModelChoice};
 use super::{AppState, ServiceError};
-use crate::calibrate::compensate::{CalibratedModelFile, CompensatedModel};
 use crate::model::RobotModel;
 use crate::records::{CellKind, ItemFrame};
-use crate::solve::cell::accuracy::{
-    measurement_tool_accuracy, tool_accuracy, ToolAccuracy, ValidationEvidence,
-};
+use crate::solve::cell::accuracy::{measurement_tool_accuracy, tool_accuracy, ToolAccuracy};
 use crate::solve::cell::joints_csv::JointReading;
 use crate::solve::cell::{
     Forward, PredictError, PredictFrame, Predicted, WorkObject, WorkObjectFrame,
 };
 use crate::solve::ik::TargetFrame;
+use robocal_core::model::calibrated::ValidationEvidence;
+use robocal_core::model::calibrated::{CalibratedModelFile, CompensatedModel};
 
 /// A prediction, in domain terms.
 #[derive(Debug, Clone)]

@@ -13,10 +13,10 @@
 
 use super::checks::{self, conflict};
 use super::{versions, AppState, ServiceError};
-use crate::calibrate::compensate::CalibratedModelFile;
 use crate::db::NewVersion;
 use crate::records::VersionRow;
 use robocal_core::check::{reregister as refit, ReregisterError};
+use robocal_core::model::calibrated::CalibratedModelFile;
 use serde_json::json;
 
 /// A re-registration to run.

@@ -20,13 +20,13 @@
 use super::limits::SMALL_SOLVE_MAX;
 use super::waiting::WaitingFlag;
 use super::{AppState, ServiceError};
-use crate::calibrate::compensate::{CalibratedModelFile, CompensatedModel};
 use crate::model::{Pose, RobotModel};
 use crate::records::{CellKind, ItemFrame, NewCellItem};
 use crate::solve::cell::file::PoseMmDeg;
 use crate::solve::cell::{CellSolver, Load, LoadDescription, Tool, WorkObject, WorkObjectFrame};
 use crate::solve::ik::TargetFrame;
 use crate::solve::ik::{IkSettings, IkSolver, SolveOptions, TargetInput, TargetResult, TargetsCsv};
+use robocal_core::model::calibrated::{CalibratedModelFile, CompensatedModel};
 use std::sync::Arc;
 
 /// Which model to solve with.

@@ -6,12 +6,12 @@
 use crate::support::*;
 use axum::http::StatusCode;
 use clap::Parser;
-use robocal::calibrate::compensate::CalibratedModelFile;
 use robocal::cli::filter::{filter_to_string, FilterArgs};
 use robocal::model::orientation::{rotation_from, OrientationConvention};
 use robocal::model::Pose;
 use robocal::solve::cell::{CellDescription, CellOptions, CellSolver};
 use robocal::solve::ik::IkSettings;
+use robocal_core::model::calibrated::CalibratedModelFile;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::time::Duration;

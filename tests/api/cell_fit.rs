@@ -11,11 +11,11 @@ use crate::support::*;
 use axum::http::StatusCode;
 use clap::Parser;
 use nalgebra::{Rotation3, Unit, Vector3};
-use robocal::calibrate::compensate::{CalibratedModelFile, CompensatedModel};
 use robocal::model::pose::rpy_matrix;
 use robocal::model::Pose;
 use robocal::solve::cell::{CellOptions, CellSolver, WorkObject};
 use robocal::solve::ik::IkSettings;
+use robocal_core::model::calibrated::{CalibratedModelFile, CompensatedModel};
 use serde_json::{json, Value};
 use std::time::Duration;
 

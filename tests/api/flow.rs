@@ -2,11 +2,11 @@ use crate::support::*;
 use axum::http::{header, StatusCode};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal::calibrate::compensate::CalibratedModelFile;
 use robocal::model::kinematics::fk;
 use robocal::model::orientation::{rotation_to, OrientationConvention};
 use robocal::model::preset;
 use robocal::sim::{try_random_configurations, PoseFilter};
+use robocal_core::model::calibrated::CalibratedModelFile;
 use serde_json::{json, Value};
 use std::time::Duration;
 

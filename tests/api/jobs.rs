@@ -336,8 +336,8 @@ async fn writes_racing_a_robot_delete_never_fail_with_500() {
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn compensator_job_yields_a_version_whose_solve_uses_it() {
     use rand::SeedableRng;
-    use robocal::calibrate::compensate::CalibratedModelFile;
     use robocal::measure::SetRole;
+    use robocal_core::model::calibrated::CalibratedModelFile;
     let t = setup_with(&[], 1).await;
     let robot = t.create_robot("ys100").await;
     let rid = robot.to_string();

@@ -8,7 +8,6 @@ use super::cell::{calibrated_robot_with_cell, examples, model_file};
 use crate::support::*;
 use axum::http::StatusCode;
 use clap::Parser;
-use robocal::calibrate::compensate::CalibratedModelFile;
 use robocal::cli::filter::{filter_to_string, FilterArgs};
 use robocal::cli::solve::{solve_to_string, SolveArgs};
 use robocal::model::orientation::{rotation_from, OrientationConvention};
@@ -16,6 +15,7 @@ use robocal::model::Pose;
 use robocal::solve::cell::{CellDescription, CellOptions, CellRef, CellSolver};
 use robocal::solve::ik::IkSettings;
 use robocal::solve::program::{parse, Language, ProgramFile};
+use robocal_core::model::calibrated::CalibratedModelFile;
 use serde_json::{json, Value};
 use std::path::Path;
 

@@ -9,9 +9,9 @@
 
 use crate::support::*;
 use axum::http::StatusCode;
-use robocal::calibrate::compensate::CalibratedModelFile;
 use robocal::measure::{MeasuredPose, SetRole};
 use robocal::model::RobotModel;
+use robocal_core::model::calibrated::CalibratedModelFile;
 use serde_json::{json, Value};
 use std::time::Duration;
 

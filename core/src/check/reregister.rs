@@ -23,9 +23,9 @@
 //! too: the chordal mean of `F_i.Rᵀ·R_b·R_i` projected on SO(3).
 
 use super::score::{predicted_row, AngleStats, CheckError};
-use crate::calibrate::compensate::CompensatedModel;
 use crate::calibrate::identify::registration::register;
 use crate::measure::MeasuredPose;
+use crate::model::calibrated::CompensatedModel;
 use crate::model::kinematics::chain::tool_pose;
 use crate::model::orientation::rotation_angle_between;
 use crate::model::Pose;

@@ -1,9 +1,9 @@
 //! Scoring a check set against a model (see [`super`] for the conventions).
 
 use super::{CheckStatus, CheckThresholds, ShiftSize};
-use crate::calibrate::compensate::CompensatedModel;
 use crate::calibrate::identify::registration::register;
 use crate::measure::{MeasuredPose, Measurement};
+use crate::model::calibrated::CompensatedModel;
 use crate::model::orientation::rotation_angle_between;
 use crate::model::Pose;
 use crate::stats::ErrorStats;

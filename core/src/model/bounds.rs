@@ -10,14 +10,15 @@
 //! infinite or NaN intermediate from an accepted model.
 //!
 //! A calibrated model file's learned compensator and its support are
-//! checked by [`check_compensator`] (SI units, as the network computes:
-//! rad, kg, N·m in, m out), called by the file's loader
-//! (`compensate::file`) for every file and stored version.
+//! checked by [`compensator::check_compensator`] (SI units, as the network
+//! computes: rad, kg, N·m in, m out; the bounds of its outputs in
+//! [`outputs`]), called by the file's loader (`model/calibrated/file.rs`)
+//! for every file and stored version.
 
 use super::error::ModelError;
 
 pub mod compensator;
-pub use compensator::check_compensator;
+pub mod outputs;
 
 /// A closed interval `[min, max]` in `unit`.
 #[derive(Debug, Clone, Copy, PartialEq)]

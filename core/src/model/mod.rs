@@ -2,6 +2,7 @@
 //! the JSON description.
 
 pub mod bounds;
+pub mod calibrated;
 pub mod description;
 pub mod error;
 pub mod export;

@@ -6,7 +6,7 @@
 //! loop lengths except the scale-fixing `l3`) gets a uniform error in
 //! `[−length, length]` [m] or `[−angle, angle]` [rad]. Units SI.
 
-use crate::calibrate::compensate::CompensatedModel;
+use crate::model::calibrated::CompensatedModel;
 use crate::model::params::ParamUnit;
 use crate::model::{ParamKind, ParamLayout, Pose, RobotModel};
 use crate::sim::{

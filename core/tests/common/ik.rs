@@ -2,7 +2,7 @@
 //! distances modulo 2π, synthetic calibrated presets and a KUKA-like arm.
 
 use rand::Rng;
-use robocal_core::calibrate::compensate::CompensatedModel;
+use robocal_core::model::calibrated::CompensatedModel;
 use robocal_core::model::orientation::rotation_angle_between;
 use robocal_core::model::{preset, Pose, RobotModel};
 use robocal_core::sim::{synthetic_calibration, SyntheticErrors};

@@ -7,7 +7,7 @@ use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vect
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
-use robocal_core::calibrate::compensate::CompensatedModel;
+use robocal_core::model::calibrated::CompensatedModel;
 use robocal_core::model::{preset, Pose, RobotModel, Tool};
 use robocal_core::sim::{perturb_geometry, tracker_frame, ErrorMagnitudes};
 use robocal_core::solve::cell::{CellOptions, CellSolver, WorkObject};

@@ -4,8 +4,8 @@
 use crate::client::Conn;
 use crate::{InFlight, Ledger};
 use anyhow::{bail, ensure, Context};
-use robocal::calibrate::compensate::CalibratedModelFile;
 use robocal::measure::MeasuredPose;
+use robocal_core::model::calibrated::CalibratedModelFile;
 use serde_json::Value;
 use std::collections::{BTreeMap, BTreeSet};
 

@@ -18,7 +18,8 @@
 //! cross-validated max is not higher **and** no blocked fold's mean is higher
 //! than the base's on that fold: a compensator worse on any never wins.
 
-use super::{Compensator, Sample};
+use super::sample::Sample;
+use crate::model::calibrated::Compensator;
 use crate::stats::ErrorStats;
 use rand::seq::SliceRandom;
 use rand::Rng;

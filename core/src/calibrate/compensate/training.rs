@@ -1,51 +1,14 @@
 //! Training any family's compensator on [`Sample`]s: the checks every family
-//! shares, the family's own training ([`Family::train`](super::Family::train)
+//! shares, the family's own training ([`Family::train`](super::family::Family::train)
 //! through [`CompensatorSpec`]), and the report with the training RMS after
 //! compensation.
 
-use super::gp::GpReport;
-use super::rbf::{RbfReport, RbfTrainError};
-use super::{CompensatorSpec, Sample, StoredCompensator};
+use super::error::TrainError;
+use super::report::TrainReport;
+use super::sample::Sample;
+use super::spec::CompensatorSpec;
+use crate::model::calibrated::StoredCompensator;
 use rand::Rng;
-use serde::{Deserialize, Serialize};
-
-/// Why training failed.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum TrainError {
-    #[error("training cancelled")]
-    Cancelled,
-    #[error("a compensator needs at least 5 training poses, got {got}")]
-    TooFewSamples { got: usize },
-    #[error("training samples must have the same number of joints and finite residuals")]
-    InconsistentSamples,
-    #[error("the MLP needs at least one hidden unit")]
-    NoHiddenUnits,
-    #[error(transparent)]
-    Rbf(#[from] RbfTrainError),
-    #[error("gp: no length scale and noise gave a positive definite system")]
-    GpSingular,
-}
-
-/// What a training run did.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct TrainReport {
-    /// `lm`, `iwo`, `tlbo` or `rbf`.
-    pub trainer: String,
-    pub samples: usize,
-    /// Epochs (LM), iterations (IWO) or generations (TLBO) run; RBF units.
-    pub epochs: usize,
-    pub evaluations: usize,
-    /// Final training loss (normalised units, see module docs).
-    pub loss: f64,
-    /// Why it stopped.
-    pub stop: String,
-    /// Training RMS of the residual error norm after compensation [mm].
-    pub rms_mm: f64,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub rbf: Option<RbfReport>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub gp: Option<GpReport>,
-}
 
 fn training_rms_mm(c: &StoredCompensator, samples: &[Sample]) -> f64 {
     let c = c.clone().into_arc();

@@ -13,7 +13,7 @@
 //! below any calibrated effect (µm) and far above rounding (1e-15 m).
 
 use super::report::{CalibrationReport, MethodReport};
-use crate::calibrate::compensate::{CalibratedModelFile, CompensatedModel};
+use crate::model::calibrated::{CalibratedModelFile, CompensatedModel};
 use crate::model::orientation::rotation_angle_between;
 use crate::model::RobotModel;
 

@@ -11,8 +11,9 @@ use super::joint_maps::{MapCandidate, MapFit, RefusedMap};
 use super::least_squares::LmReport;
 use super::methods::ties::DecidingStep;
 use super::options::Method;
-use crate::calibrate::compensate::{Compensator, CvStats, StoredCompensator, Support, TrainReport};
+use crate::calibrate::compensate::{CvStats, TrainReport};
 use crate::measure::Measurement;
+use crate::model::calibrated::{Compensator, LearnedCompensator, StoredCompensator, Support};
 use crate::model::description::PoseDescription;
 use crate::model::orientation::rotation_angle_between;
 use crate::model::pose::Pose;
@@ -195,8 +196,8 @@ pub(crate) fn predict_compensated(
             let tau = crate::model::kinematics::gravity_torques_of(model, &ch, m.payload_mass);
             let mut pose =
                 crate::model::Pose::new(r, p + c.residual_at(&m.q, &tau, m.payload_mass));
-            let d = crate::calibrate::compensate::oriented::point_in_tcp(c, model);
-            crate::calibrate::compensate::oriented::rotate(
+            let d = crate::model::calibrated::orientation::point_in_tcp(c, model);
+            crate::model::calibrated::orientation::rotate(
                 &mut pose,
                 c,
                 (&m.q, &tau, m.payload_mass),
@@ -290,17 +291,17 @@ pub struct MethodReport {
     /// The compensator's orientation part, trained where the data measured
     /// orientations (the model file stores it).
     #[serde(skip)]
-    pub stored_orientation: Option<crate::calibrate::compensate::StoredOrientation>,
+    pub stored_orientation: Option<crate::model::calibrated::StoredOrientation>,
     /// The validation poses' evidence for the accuracy at a production tool
     /// (the model file stores it as `validation`).
     #[serde(skip)]
-    pub validation_evidence: Option<crate::solve::cell::accuracy::ValidationEvidence>,
+    pub validation_evidence: Option<crate::model::calibrated::ValidationEvidence>,
 }
 
 impl MethodReport {
     /// The trained compensator as predictions use it: faded beyond its
     /// support.
-    pub fn compensator_arc(&self) -> Option<Arc<dyn Compensator>> {
+    pub fn compensator_arc(&self) -> Option<Arc<LearnedCompensator>> {
         self.stored_compensator.clone().map(|c| {
             c.into_arc_oriented(self.stored_orientation.clone(), self.stored_support.clone())
         })

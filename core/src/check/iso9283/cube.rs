@@ -9,7 +9,7 @@
 //! [deg] in `joints_deg`.
 
 use super::Iso9283Error;
-use crate::calibrate::compensate::CompensatedModel;
+use crate::model::calibrated::CompensatedModel;
 use crate::model::orientation::fixed_xyz_angles;
 use crate::model::Pose;
 use crate::plan::WorkspaceBox;

@@ -7,17 +7,19 @@
 //! (`StoredCompensator::validate`, `Support::validate`).
 //! The orientation part (`compensator_orientation`) is a network of the same
 //! kinds whose outputs are a rotation vector [rad]: its output quantities
-//! have bounds of their own ([`ORIENTATION_OUTPUTS`]).
+//! have bounds of their own (`outputs.rs`).
 
+use super::outputs::{Outputs, ORIENTATION_OUTPUTS, POSITION_OUTPUTS};
 use super::{
-    check_above, check_all, check_count, Bound, ERROR_SCALE, GP_COEFFICIENT, GP_VARIANCE_M2,
-    INPUT_CENTRE, INPUT_SCALE, INVERSE_LENGTH_SCALE, JOINT_DISTANCE_RAD, JOINT_RAD, NETWORK_WEIGHT,
-    OUTPUT_SCALE, RBF_NORMALISED, RESIDUAL_M,
+    check_above, check_all, check_count, Bound, ERROR_SCALE, INPUT_CENTRE, INPUT_SCALE,
+    INVERSE_LENGTH_SCALE, JOINT_DISTANCE_RAD, JOINT_RAD, NETWORK_WEIGHT, RBF_NORMALISED,
 };
-use crate::calibrate::compensate::support::MAX_POINTS;
-use crate::calibrate::compensate::{
-    Gp, Mlp, Normalisation, Rbf, StoredCompensator, StoredOrientation, Support,
-};
+use crate::model::calibrated::gp::Gp;
+use crate::model::calibrated::mlp::{Mlp, Normalisation};
+use crate::model::calibrated::orientation::StoredOrientation;
+use crate::model::calibrated::rbf::Rbf;
+use crate::model::calibrated::stored::StoredCompensator;
+use crate::model::calibrated::support::{Support, MAX_POINTS};
 use crate::model::error::ModelError;
 
 /// Most hidden units of an MLP (the largest trained has 40).
@@ -27,53 +29,6 @@ pub const MAX_RBF_UNITS: usize = 10_000;
 /// Most inducing configurations of a GP (300 by default; its variance
 /// matrix holds the square of this).
 pub const MAX_GP_UNITS: usize = 5000;
-
-/// The bounds of a network's output quantities, which differ between the
-/// position part [m] and the orientation part [rad].
-pub struct Outputs {
-    /// Output centre, GP mean, uncompensated RMS.
-    pub residual: Bound,
-    /// An MLP's output scale.
-    pub output_scale: Bound,
-    /// A GP's signal and noise variances.
-    pub variance: Bound,
-    /// A GP's weights and variance matrix.
-    pub coefficient: Bound,
-}
-
-/// The position part's outputs [m].
-pub const POSITION_OUTPUTS: Outputs = Outputs {
-    residual: RESIDUAL_M,
-    output_scale: OUTPUT_SCALE,
-    variance: GP_VARIANCE_M2,
-    coefficient: GP_COEFFICIENT,
-};
-
-/// The orientation part's outputs, a rotation vector [rad]: a turn beyond
-/// π is no residual, so ±10 rad leaves room for any centre or mean; the
-/// other bounds are the position part's read in radians.
-pub const ORIENTATION_OUTPUTS: Outputs = Outputs {
-    residual: Bound {
-        min: -10.0,
-        max: 10.0,
-        unit: "rad",
-    },
-    output_scale: Bound {
-        min: 0.0,
-        max: 1e13,
-        unit: "1/rad",
-    },
-    variance: Bound {
-        min: 0.0,
-        max: 1e2,
-        unit: "rad²",
-    },
-    coefficient: Bound {
-        min: -1e30,
-        max: 1e30,
-        unit: "1/rad or 1/rad²",
-    },
-};
 
 /// Checks every value of `c`, of `support` and of the orientation part
 /// against its bound; the error names the field
@@ -104,7 +59,7 @@ const POINT_M: Bound = Bound {
     unit: "m",
 };
 
-/// The family's bounds ([`crate::calibrate::compensate::Family::check_bounds`]).
+/// The family's bounds ([`crate::model::calibrated::stored::StoredFamily::check_bounds`]).
 fn check_network(f: &str, c: &StoredCompensator, out: &Outputs) -> Result<(), ModelError> {
     c.check_bounds(f, out)
 }
@@ -234,8 +189,11 @@ fn positive(b: &Bound) -> Bound {
 #[cfg(test)]
 mod tests {
     use crate::calibrate::compensate::{
-        parse_compensated, train, CalibratedModelFile, CompensatedModel, CompensatorSpec,
-        GpSettings, LmTrainSettings, MlpSettings, MlpSpec, RbfSettings, Sample, Support, Trainer,
+        train, CompensatorSpec, GpSettings, LmTrainSettings, MlpSettings, MlpSpec, RbfSettings,
+        Sample, Trainer,
+    };
+    use crate::model::calibrated::{
+        parse_compensated, CalibratedModelFile, CompensatedModel, Support,
     };
     use crate::model::preset;
     use nalgebra::Vector3;
@@ -261,7 +219,7 @@ mod tests {
         let (c, _) = train(spec, &samples, &mut rng, &mut |_, _| true).unwrap();
         let refs: Vec<&[f64]> = qs.iter().map(|q| q.as_slice()).collect();
         let support = Support::of(&refs, 0.087);
-        m.compensator = Some(c.into_arc_supported(Some(support)));
+        m.compensator = Some(c.into_arc_oriented(None, Some(support)));
         let text = CalibratedModelFile::from_compensated(&m, "ys100", "skcm-x").to_json();
         serde_json::from_str(&text).unwrap()
     }
@@ -512,7 +470,7 @@ mod tests {
 
     #[test]
     fn non_finite_values_are_refused_by_name() {
-        use crate::calibrate::compensate::StoredCompensator;
+        use crate::model::calibrated::StoredCompensator;
         let v = trained_file(&specs()[2].1);
         let mut c: StoredCompensator = serde_json::from_value(v["compensator"].clone()).unwrap();
         if let StoredCompensator::Gp(g) = &mut c {

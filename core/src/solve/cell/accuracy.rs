@@ -23,41 +23,14 @@
 //! tool's orientation, and so its tip error, is unverified (`Unverified`),
 //! and the reflector's figure is never given for a tool.
 
-use crate::calibrate::compensate::CompensatedModel;
-use crate::measure::Measurement;
+use crate::model::calibrated::evidence::ValidationEvidence;
 use crate::model::Pose;
 use crate::stats::ErrorStats;
-use nalgebra::{Matrix3, Vector3};
-use serde::{Deserialize, Serialize};
+use nalgebra::Vector3;
+use serde::Serialize;
 
 /// Below this lever arm [m] the tool's tip is the measured point itself.
 const SAME_POINT_M: f64 = 1e-6;
-
-/// One validation pose with a measured orientation.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct TipTerm {
-    /// Position error `measured − predicted` [mm], registered base frame.
-    pub error_mm: [f64; 3],
-    /// `R_measured − R_predicted`, row-major (dimensionless).
-    pub rotation_difference: [f64; 9],
-}
-
-/// What the validation poses of a calibration say about accuracy (stored in
-/// the calibrated model file as `validation`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ValidationEvidence {
-    /// Validation poses the model predicted.
-    pub poses: usize,
-    /// Position error of the measured point (reflector / probe) [mm].
-    pub position_mean_mm: f64,
-    pub position_max_mm: f64,
-    /// One term per validation pose with a measured orientation (empty:
-    /// position-only validation data).
-    #[serde(default)]
-    pub tip_terms: Vec<TipTerm>,
-}
 
 /// The expected error at a tool's tip.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -78,56 +51,6 @@ pub enum ToolAccuracy {
     Unverified { message: String },
     /// No validation data was stored with the model.
     Unknown { message: String },
-}
-
-impl ValidationEvidence {
-    /// The evidence of `model` (its `cell_from_base` unused: `valid` is in
-    /// the registered base frame of each pose's session, `frames` the fitted
-    /// session frames); `None` without validation poses.
-    pub fn of(model: &CompensatedModel, frames: &[Pose], valid: &[Measurement]) -> Option<Self> {
-        let mut norms = Vec::with_capacity(valid.len());
-        let mut tip_terms = Vec::new();
-        for m in valid {
-            let Ok(p) = model.predict_detailed_at(&m.q, m.payload_mass) else {
-                continue;
-            };
-            let frame = frames.get(m.session).copied().unwrap_or_default();
-            let pred = frame.compose(&p.pose);
-            let e = m.position - pred.p;
-            norms.push(e.norm() * 1e3);
-            if let Some(r) = &m.orientation {
-                let d = r - pred.r;
-                // Rounded to 1 nm and 1e-12 (a 1 m lever arm: 1 nm): short files.
-                let round = |v: f64, s: f64| (v * s).round() / s;
-                tip_terms.push(TipTerm {
-                    error_mm: std::array::from_fn(|k| round(e[k] * 1e3, 1e6)),
-                    rotation_difference: std::array::from_fn(|k| round(d[(k / 3, k % 3)], 1e12)),
-                });
-            }
-        }
-        if norms.is_empty() {
-            return None;
-        }
-        let stats = ErrorStats::from_errors_mm(&norms);
-        Some(ValidationEvidence {
-            poses: norms.len(),
-            position_mean_mm: stats.mean_mm,
-            position_max_mm: stats.max_mm,
-            tip_terms,
-        })
-    }
-
-    /// The tip errors [mm] of the tool at `d` [m] in the measured frame, one
-    /// per 6-D validation pose.
-    pub fn tip_errors_mm(&self, d: &Vector3<f64>) -> Vec<f64> {
-        self.tip_terms
-            .iter()
-            .map(|t| {
-                let dm = Matrix3::from_row_slice(&t.rotation_difference);
-                (Vector3::from(t.error_mm) + dm * d * 1e3).norm()
-            })
-            .collect()
-    }
 }
 
 /// The expected error at the tip of tool `tcp` (flange → TCP) of a model

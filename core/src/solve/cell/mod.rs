@@ -37,7 +37,7 @@ pub use load::{Load, LoadDescription, LoadFrame};
 pub use numbering::{AssignedNumber, ItemKind};
 pub use predict::{Forward, PoseOut, PredictError, PredictFrame, Predicted};
 
-use crate::calibrate::compensate::CompensatedModel;
+use crate::model::calibrated::CompensatedModel;
 use crate::model::Pose;
 use crate::solve::ik::{
     Configuration, Goal, IkSettings, IkSolution, IkSolver, SolveOptions, TargetFrame, TcpTool,

@@ -18,9 +18,9 @@
 //! measurement files' convention).
 
 use super::{with_tool_load, Load};
-use crate::calibrate::compensate::{CompensatedModel, Compensation};
 use crate::measure::bounds::{within, JOINT_DEG};
 use crate::model::bounds::show;
+use crate::model::calibrated::{CompensatedModel, Compensation};
 use crate::model::kinematics::KinematicsError;
 use crate::model::orientation::{rotation_to, OrientationConvention};
 use crate::model::Pose;

@@ -20,7 +20,7 @@
 //! Units: points in m; reported figures in mm and degrees.
 
 use super::tcp::{check_finite, flange_poses, FitError, NotFittedReason};
-use crate::calibrate::compensate::CompensatedModel;
+use crate::model::calibrated::CompensatedModel;
 use crate::model::Pose;
 use nalgebra::{Matrix3, Vector3};
 use serde::Serialize;

@@ -20,7 +20,7 @@
 use super::analytic::{closed_form_proxy, AnalyticIk, AnalyticSolution};
 use super::config::Configuration;
 use super::invalid::TargetError;
-use crate::calibrate::compensate::CompensatedModel;
+use crate::model::calibrated::CompensatedModel;
 use crate::model::orientation::OrientationConvention;
 use crate::model::pose::rotation_log;
 use crate::model::{Pose, RobotModel};

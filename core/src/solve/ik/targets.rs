@@ -17,8 +17,8 @@
 use super::invalid::TargetError;
 pub use super::solver::TargetFrame;
 use super::solver::{Goal, IkSolution, IkSolver};
-use crate::calibrate::compensate::Compensation;
 use crate::measure::bounds::{within, POSITION_MM};
+use crate::model::calibrated::Compensation;
 use crate::model::orientation::{rotation_from, rotation_to, OrientationConvention};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};

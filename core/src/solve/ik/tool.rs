@@ -8,7 +8,7 @@
 //! compliance deflection (thesis eqs. 3.7–3.9), so the solver prepares its
 //! model for one tool: a different tool needs a new solver.
 
-use crate::calibrate::compensate::CompensatedModel;
+use crate::model::calibrated::CompensatedModel;
 use crate::model::load::{self, Load};
 use crate::model::{Pose, RobotModel};
 use serde::{Deserialize, Serialize};

@@ -10,7 +10,7 @@ use super::report::{
 };
 use super::sites::{Context, Failure, Solved};
 use super::{mark, parse, Language, Motion, MotionTarget, ParseError, Program, ProgramFile, Site};
-use crate::calibrate::compensate::CompensatedModel;
+use crate::model::calibrated::CompensatedModel;
 use crate::model::orientation::rotation_to;
 use crate::model::Pose;
 use crate::solve::cell::export::{

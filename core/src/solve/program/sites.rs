@@ -17,7 +17,7 @@
 
 use super::report::{LoadSource, Reachable, UsedLoad};
 use super::{Flags, FrameSpec, Language, Site};
-use crate::calibrate::compensate::CompensatedModel;
+use crate::model::calibrated::CompensatedModel;
 use crate::model::Pose;
 use crate::solve::cell::export::{ControllerFrame, ControllerTool};
 use crate::solve::cell::{

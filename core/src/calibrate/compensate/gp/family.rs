@@ -1,44 +1,18 @@
-//! The Gaussian process's entry in the compensator table ([`Family`]): its
-//! checks, bounds, report shape and training; it becomes a compensator as
-//! its prepared form ([`PreparedGp`]).
+//! The Gaussian process's training ([`Family`]): its settings, report and
+//! progress; its stored form is `model::calibrated::gp`.
 
-use super::model::Gp;
-use super::predict::PreparedGp;
 use super::train::{train_gp, GpSettings};
-use crate::calibrate::compensate::{
-    Compensator, Family, InvalidCompensator, NetworkShape, Sample, TrainError, TrainReport,
-};
-use crate::model::bounds::compensator::{check_gp, Outputs};
-use crate::model::ModelError;
+use crate::calibrate::compensate::error::TrainError;
+use crate::calibrate::compensate::family::Family;
+use crate::calibrate::compensate::report::TrainReport;
+use crate::calibrate::compensate::sample::Sample;
+use crate::model::calibrated::gp::Gp;
 use rand::Rng;
-use std::sync::Arc;
 
 impl Family for Gp {
     type Settings = GpSettings;
+
     const EVERY_POSE: bool = true;
-
-    fn validate(&self) -> Result<(), InvalidCompensator> {
-        Gp::validate(self)
-    }
-
-    fn dof(&self) -> usize {
-        self.dof
-    }
-
-    fn check_bounds(&self, field: &str, outputs: &Outputs) -> Result<(), ModelError> {
-        check_gp(field, self, outputs)
-    }
-
-    fn into_arc(self) -> Arc<dyn Compensator> {
-        Arc::new(PreparedGp::new(self))
-    }
-
-    fn shape(&self) -> NetworkShape {
-        NetworkShape {
-            units: self.units(),
-            inputs: "q".into(),
-        }
-    }
 
     fn train(
         settings: &GpSettings,

@@ -2,8 +2,9 @@
 //! configurations by farthest-point sampling, the DTC fit, length scales and
 //! noise chosen on a seeded holdout.
 
-use super::model::{kernel_exponent, Gp};
-use crate::calibrate::compensate::{Sample, TrainError};
+use crate::calibrate::compensate::error::TrainError;
+use crate::calibrate::compensate::sample::Sample;
+use crate::model::calibrated::gp::model::{kernel_exponent, Gp};
 use nalgebra::DMatrix;
 use rand::seq::SliceRandom;
 use rand::Rng;

@@ -1,52 +1,19 @@
-//! The MLP's entry in the compensator table ([`Family`]): its checks,
-//! bounds, report shape and trainers, and the thesis's networks as
-//! [`CompensatorSpec`]s.
+//! The MLP's training ([`Family`]): its trainers, and the thesis's networks
+//! as [`CompensatorSpec`]s; its stored form is `model::calibrated::mlp`.
 
-use super::model::Mlp;
 use super::train::{
     train_mlp, IwoSettings, LmTrainSettings, MlpSettings, MlpSpec, TlboTrainSettings, Trainer,
 };
-use crate::calibrate::compensate::{
-    Compensator, CompensatorSpec, Family, InvalidCompensator, NetworkShape, Sample, TrainError,
-    TrainReport,
-};
-use crate::model::bounds::compensator::{check_mlp, Outputs};
-use crate::model::ModelError;
+use crate::calibrate::compensate::error::TrainError;
+use crate::calibrate::compensate::family::Family;
+use crate::calibrate::compensate::report::TrainReport;
+use crate::calibrate::compensate::sample::Sample;
+use crate::calibrate::compensate::spec::CompensatorSpec;
+use crate::model::calibrated::mlp::Mlp;
 use rand::Rng;
-use std::sync::Arc;
 
 impl Family for Mlp {
     type Settings = MlpSettings;
-
-    fn validate(&self) -> Result<(), InvalidCompensator> {
-        Mlp::validate(self)
-    }
-
-    fn dof(&self) -> usize {
-        self.dof
-    }
-
-    fn check_bounds(&self, field: &str, outputs: &Outputs) -> Result<(), ModelError> {
-        check_mlp(field, self, outputs)
-    }
-
-    fn into_arc(self) -> Arc<dyn Compensator> {
-        Arc::new(self)
-    }
-
-    fn shape(&self) -> NetworkShape {
-        let mut inputs = String::from("q");
-        if self.features.sin_cos {
-            inputs.push_str(", sin q, cos q");
-        }
-        if self.features.payload {
-            inputs.push_str(", payload mass");
-        }
-        NetworkShape {
-            units: self.hidden,
-            inputs,
-        }
-    }
 
     fn train(
         settings: &MlpSettings,

@@ -1,44 +1,19 @@
-//! The RBF's entry in the compensator table ([`Family`]): its checks,
-//! bounds, report shape and training, and KM-RBF's network as a
-//! [`CompensatorSpec`].
+//! The RBF's training ([`Family`]), and KM-RBF's network as a
+//! [`CompensatorSpec`]; its stored form is `model::calibrated::rbf`.
 
-use super::model::Rbf;
 use super::train::{train_rbf_with_progress, RbfSettings};
-use crate::calibrate::compensate::{
-    Compensator, CompensatorSpec, Family, InvalidCompensator, NetworkShape, Sample, TrainError,
-    TrainReport,
-};
-use crate::model::bounds::compensator::{check_rbf, Outputs};
-use crate::model::ModelError;
+use crate::calibrate::compensate::error::TrainError;
+use crate::calibrate::compensate::family::Family;
+use crate::calibrate::compensate::report::TrainReport;
+use crate::calibrate::compensate::sample::Sample;
+use crate::calibrate::compensate::spec::CompensatorSpec;
+use crate::model::calibrated::rbf::Rbf;
 use rand::Rng;
-use std::sync::Arc;
 
 impl Family for Rbf {
     type Settings = RbfSettings;
+
     const TORQUE_INPUT: bool = true;
-
-    fn validate(&self) -> Result<(), InvalidCompensator> {
-        Rbf::validate(self)
-    }
-
-    fn dof(&self) -> usize {
-        self.dof
-    }
-
-    fn check_bounds(&self, field: &str, _outputs: &Outputs) -> Result<(), ModelError> {
-        check_rbf(field, self)
-    }
-
-    fn into_arc(self) -> Arc<dyn Compensator> {
-        Arc::new(self)
-    }
-
-    fn shape(&self) -> NetworkShape {
-        NetworkShape {
-            units: self.units(),
-            inputs: "gravity torques".into(),
-        }
-    }
 
     fn train(
         settings: &RbfSettings,

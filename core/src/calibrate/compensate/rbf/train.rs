@@ -2,9 +2,9 @@
 //! `newrb`): units added greedily on the held-out choice of spread and size,
 //! the output layer by least squares.
 
-use super::model::{rot_z, OutputFrame, Rbf};
-use crate::calibrate::compensate::mlp::Normalisation;
-use crate::calibrate::compensate::Sample;
+use crate::calibrate::compensate::sample::Sample;
+use crate::model::calibrated::mlp::Normalisation;
+use crate::model::calibrated::rbf::model::{rot_z, OutputFrame, Rbf};
 use nalgebra::{DMatrix, Vector3};
 use rand::seq::SliceRandom;
 use rand::Rng;
@@ -238,7 +238,7 @@ pub fn train_rbf_with_progress(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::calibrate::compensate::Compensator;
+    use crate::model::calibrated::Compensator;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
 

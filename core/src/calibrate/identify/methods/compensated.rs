@@ -34,7 +34,7 @@ use super::orientation_part::{note, train_orientation};
 use super::plan::Planner;
 use super::trained::{support_of, AppliedCompensator, Trained};
 use super::{Compensated, Method, MethodError, MethodFailure};
-use crate::calibrate::compensate::{cross_validate, train, Compensator, Sample, TrainError};
+use crate::calibrate::compensate::{cross_validate, train, Sample, TrainError};
 use crate::calibrate::identify::least_squares::Fit;
 use crate::calibrate::identify::network::Network;
 use crate::calibrate::identify::progress::Fold;
@@ -43,6 +43,7 @@ use crate::calibrate::identify::report::{
     UncertaintyCheck, WarningKind,
 };
 use crate::measure::Measurement;
+use crate::model::calibrated::Compensator;
 use crate::model::kinematics::{chain, gravity_torques_of};
 use crate::model::pose::Pose;
 use crate::model::RobotModel;

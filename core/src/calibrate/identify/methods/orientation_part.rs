@@ -32,10 +32,10 @@
 use super::trained::{support_of, AppliedCompensator, Trained};
 use super::{Base, MethodError};
 use crate::calibrate::compensate::{
-    cross_validate, train, CompensatorSpec, OrientationSamples, Sample, StoredOrientation,
-    TrainError,
+    cross_validate, train, CompensatorSpec, OrientationSamples, Sample, TrainError,
 };
 use crate::calibrate::identify::report::{OrientationCv, OrientationPart, OrientationPartStatus};
+use crate::model::calibrated::StoredOrientation;
 use crate::model::RobotModel;
 use nalgebra::Matrix3;
 use rand::SeedableRng;

@@ -11,8 +11,8 @@ use crate::calibrate::identify::least_squares::Fit;
 use crate::calibrate::identify::report::{
     estimates, JointMapsSummary, MethodReport, MethodWarning, SetErrors, WarningKind,
 };
+use crate::model::calibrated::ValidationEvidence;
 use crate::model::{ModelDescription, ParamId, ParamKind};
-use crate::solve::cell::accuracy::ValidationEvidence;
 
 impl Context<'_> {
     /// `method`'s report of its `outcome`.
@@ -33,9 +33,9 @@ impl Context<'_> {
             );
         }
         r.auto = outcome.auto;
-        let model = crate::calibrate::compensate::CompensatedModel {
+        let model = crate::model::calibrated::CompensatedModel {
             compensator: r.compensator_arc(),
-            ..crate::calibrate::compensate::CompensatedModel::from_nominal(r.calibrated.clone())
+            ..crate::model::calibrated::CompensatedModel::from_nominal(r.calibrated.clone())
         };
         r.validation_evidence = ValidationEvidence::of(&model, &frames, self.valid);
         Ok(r)

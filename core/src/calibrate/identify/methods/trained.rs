@@ -4,10 +4,9 @@
 //! Supports are in joint space [rad] and fade over [`SUPPORT_FADE_RAD`].
 
 use super::{Base, Method};
-use crate::calibrate::compensate::{
-    CvStats, Sample, StoredCompensator, StoredOrientation, Support, TrainReport,
-};
+use crate::calibrate::compensate::{CvStats, Sample, TrainReport};
 use crate::calibrate::identify::report::OrientationPart;
+use crate::model::calibrated::{StoredCompensator, StoredOrientation, Support};
 
 /// A trained compensator with its training report and cross-validation.
 #[derive(Clone)]

@@ -39,7 +39,7 @@ pub use numbers::{NumberRange, RegisterRange, UsedRegister};
 
 use super::numbering::{self, AssignedNumber, DuplicateNumber, ItemKind};
 use super::{Cell, Load, Tool};
-use crate::calibrate::compensate::CompensatedModel;
+use crate::model::calibrated::CompensatedModel;
 use crate::model::orientation::{rotation_to, OrientationConvention};
 use crate::model::Pose;
 use crate::solve::program::Language;

@@ -40,7 +40,7 @@ pub use judge::Limits;
 pub use readings::{Reading, WoPoint};
 pub use request::{fit_tool, fit_work_object, AxisRequest, ToolRequest};
 
-use crate::calibrate::compensate::CompensatedModel;
+use crate::model::calibrated::CompensatedModel;
 use crate::model::Pose;
 use nalgebra::{Matrix3, Vector3};
 use serde::Serialize;

@@ -8,7 +8,7 @@ use super::{
     axis, cell_points_to_base, fixed_point, flange_poses, tracker, FitError, NotFittedReason,
     TcpMethod, ToolFit,
 };
-use crate::calibrate::compensate::CompensatedModel;
+use crate::model::calibrated::CompensatedModel;
 use crate::model::pose::rpy_matrix;
 use crate::model::Pose;
 use crate::solve::cell::work_object_fit::{self, WorkObjectFit, WorkObjectPoints};

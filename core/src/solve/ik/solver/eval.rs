@@ -23,7 +23,7 @@
 //! evaluation; [`PreparedModel::seed_fk`] is the seed model's forward kinematics.
 //! Joints in the model convention [rad], torques N·m, payload kg.
 
-use crate::calibrate::compensate::{oriented, CompensatedModel, Compensator};
+use crate::model::calibrated::{orientation, CompensatedModel, Compensator, LearnedCompensator};
 use crate::model::joint_map_table::TabulatedMaps;
 use crate::model::joint_maps::AngleError;
 use crate::model::kinematics::prepared::{stack_or_heap, PreparedChain, STACK_DOF};
@@ -217,7 +217,7 @@ pub(crate) struct PreparedModel {
     /// the series within `TOLERANCE_RAD`, `model/joint_map_table.rs`).
     maps: Option<TabulatedMaps>,
     payload_kg: f64,
-    compensator: Option<Arc<dyn Compensator>>,
+    compensator: Option<Arc<LearnedCompensator>>,
     /// The compensator's orientation part's point in the TCP frame (exact everywhere).
     rotation_point: Option<Vector3<f64>>,
 }
@@ -250,7 +250,7 @@ impl PreparedModel {
             rotation_point: model
                 .compensator
                 .as_ref()
-                .and_then(|c| oriented::point_in_tcp(c.as_ref(), cal)),
+                .and_then(|c| orientation::point_in_tcp(c.as_ref(), cal)),
         }
     }
 
@@ -586,7 +586,7 @@ impl PreparedModel {
         if let Some(c) = &self.compensator {
             pose.p += residual(c.as_ref(), q, tau, self.payload_kg);
             let d = self.rotation_point.as_ref();
-            oriented::rotate(&mut pose, c.as_ref(), (q, tau, self.payload_kg), d);
+            orientation::rotate(&mut pose, c.as_ref(), (q, tau, self.payload_kg), d);
         }
         Some(pose)
     }
@@ -625,7 +625,7 @@ impl PreparedModel {
         if let Some(c) = &self.compensator {
             pose.p += residual(c.as_ref(), q, tau, self.payload_kg);
             let d = self.rotation_point.as_ref();
-            oriented::rotate(&mut pose, c.as_ref(), (q, tau, self.payload_kg), d);
+            orientation::rotate(&mut pose, c.as_ref(), (q, tau, self.payload_kg), d);
         }
         Some(pose)
     }

@@ -3,9 +3,9 @@
 //! the mean residual), the held-out split and the population methods' guard
 //! against the null network.
 
-use super::super::model::{Mlp, Normalisation, Shape};
 use super::{MlpSpec, NullNetwork};
-use crate::calibrate::compensate::Sample;
+use crate::calibrate::compensate::sample::Sample;
+use crate::model::calibrated::mlp::{Mlp, Normalisation, Shape};
 use rand::seq::SliceRandom;
 use rand::Rng;
 

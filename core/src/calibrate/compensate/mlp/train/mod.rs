@@ -33,8 +33,10 @@ pub use lm::LmTrainSettings;
 pub use output_layer::OutputLayer;
 pub use tlbo::TlboTrainSettings;
 
-use super::model::{Features, Mlp};
-use crate::calibrate::compensate::{Sample, TrainError, TrainReport};
+use crate::calibrate::compensate::error::TrainError;
+use crate::calibrate::compensate::report::TrainReport;
+use crate::calibrate::compensate::sample::Sample;
+use crate::model::calibrated::mlp::{Features, Mlp};
 use data::Prepared;
 use rand::Rng;
 use serde::{Deserialize, Serialize};
@@ -225,7 +227,8 @@ pub(super) fn train_mlp(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::calibrate::compensate::{train, CompensatorSpec, StoredCompensator};
+    use crate::calibrate::compensate::{train, CompensatorSpec};
+    use crate::model::calibrated::StoredCompensator;
     use nalgebra::Vector3;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;

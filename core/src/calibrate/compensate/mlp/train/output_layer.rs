@@ -5,8 +5,8 @@
 //! taken of that fit. [`OutputLayer::Searched`] keeps the thesis's search over
 //! every weight.
 
-use super::super::model::Shape;
 use super::data::Prepared;
+use crate::model::calibrated::mlp::Shape;
 use nalgebra::DMatrix;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};

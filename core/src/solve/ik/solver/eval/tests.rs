@@ -3,7 +3,8 @@
 //! expansion's order and the seeds' use and check of it.
 
 use super::*;
-use crate::calibrate::compensate::mlp::{Features, Mlp, Normalisation, Shape};
+use crate::model::calibrated::mlp::{Features, Mlp, Normalisation, Shape};
+use crate::model::calibrated::StoredCompensator;
 use crate::model::kinematics::fk;
 use crate::model::{preset, JointMaps};
 use crate::sim::{synthetic_calibration, SyntheticErrors};
@@ -53,13 +54,14 @@ fn models() -> Vec<(String, CompensatedModel)> {
         out.push((format!("{name} calibrated"), cm.clone()));
         for sin_cos in [false, true] {
             let mut c = cm.clone();
-            c.compensator = Some(Arc::new(net(6, sin_cos)));
+            c.compensator =
+                Some(StoredCompensator::from(net(6, sin_cos)).into_arc_oriented(None, None));
             out.push((format!("{name} compensated {sin_cos}"), c));
         }
         let mut c = cm.clone();
         c.calibrated.joint_maps = Some(maps(c.calibrated.dof()));
         out.push((format!("{name} with joint maps"), c.clone()));
-        c.compensator = Some(Arc::new(net(6, true)));
+        c.compensator = Some(StoredCompensator::from(net(6, true)).into_arc_oriented(None, None));
         out.push((format!("{name} with joint maps and compensator"), c));
     }
     out
@@ -259,11 +261,11 @@ fn a_run_starts_on_the_seeds_expansion_of_the_compensator() {
 /// expansion, one next to it does.
 #[test]
 fn a_rough_seed_expansion_is_checked() {
-    let gp = crate::calibrate::compensate::gp::predict::tests::random_gp(60, 3);
+    let gp = crate::model::calibrated::gp::predict::tests::random_gp(60, 3);
     let scale = gp.signal_variance * gp.alpha.iter().map(|a| a.abs()).sum::<f64>();
     let nominal = preset("ys100").unwrap();
     let mut m = synthetic_calibration(&nominal, &SyntheticErrors::typical(1e-6), 7);
-    m.compensator = Some(Arc::new(crate::calibrate::compensate::PreparedGp::new(gp)));
+    m.compensator = Some(StoredCompensator::Gp(gp).into_arc_oriented(None, None));
     for with_maps in [false, true] {
         if with_maps {
             m.calibrated.joint_maps = Some(maps(6));

@@ -2,8 +2,9 @@
 //! gravity torques [N·m] in, the residual [m] out, in the registered base
 //! frame or turned with joint 1.
 
-use crate::calibrate::compensate::mlp::Normalisation;
-use crate::calibrate::compensate::{Compensator, InvalidCompensator, StoredCompensator};
+use crate::model::calibrated::compensator::Compensator;
+use crate::model::calibrated::invalid::InvalidCompensator;
+use crate::model::calibrated::mlp::Normalisation;
 use nalgebra::{Matrix3, Matrix3xX, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -30,7 +31,7 @@ pub struct Rbf {
     pub weights: Vec<f64>,
 }
 
-pub(super) fn rot_z(a: f64) -> Matrix3<f64> {
+pub fn rot_z(a: f64) -> Matrix3<f64> {
     let (s, c) = a.sin_cos();
     Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
 }
@@ -66,7 +67,7 @@ impl Rbf {
     }
 
     /// Output in the network's own frame [m].
-    pub(super) fn local(&self, tau: &[f64]) -> Vector3<f64> {
+    pub(crate) fn local(&self, tau: &[f64]) -> Vector3<f64> {
         let mut p = tau.to_vec();
         self.input_norm.apply(&mut p);
         let b = std::f64::consts::LN_2.sqrt() / self.spread;
@@ -114,8 +115,5 @@ impl Compensator for Rbf {
     }
     fn name(&self) -> &str {
         "rbf"
-    }
-    fn stored(&self) -> Option<StoredCompensator> {
-        Some(self.clone().into())
     }
 }

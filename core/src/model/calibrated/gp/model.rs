@@ -2,7 +2,8 @@
 //! its reference evaluation: mean, joint derivative, variance and expected
 //! error per pose.
 
-use crate::calibrate::compensate::{Compensator, InvalidCompensator, StoredCompensator};
+use crate::model::calibrated::compensator::{Compensator, Uncertainty};
+use crate::model::calibrated::invalid::InvalidCompensator;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
@@ -160,10 +161,6 @@ impl Compensator for Gp {
         (r, true)
     }
 
-    fn stored(&self) -> Option<StoredCompensator> {
-        Some(self.clone().into())
-    }
-
     fn uncertainty(&self, q: &[f64]) -> Option<Uncertainty> {
         Some(Uncertainty {
             compensated_m: self.error_scale * (3.0 * self.variance_at(q)).sqrt(),
@@ -172,25 +169,9 @@ impl Compensator for Gp {
     }
 }
 
-/// Expected position errors at a pose [m]: with the compensator's correction,
-/// and without it (where it fades out).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Uncertainty {
-    pub compensated_m: f64,
-    pub uncompensated_m: f64,
-}
-
-impl Uncertainty {
-    /// The expected error with a fraction `w` of the correction applied:
-    /// `√(w·u_c² + (1 − w)·u_0²)`.
-    pub fn at_weight(&self, w: f64) -> f64 {
-        (w * self.compensated_m.powi(2) + (1.0 - w) * self.uncompensated_m.powi(2)).sqrt()
-    }
-}
-
 /// `Σ_j ((a_j − b_j)·il_j)²`.
 #[inline]
-pub(super) fn kernel_exponent(a: &[f64], b: &[f64], il: &[f64]) -> f64 {
+pub fn kernel_exponent(a: &[f64], b: &[f64], il: &[f64]) -> f64 {
     a.iter()
         .zip(b)
         .zip(il)

@@ -20,14 +20,14 @@
 //! from the C library's exactly rounded `fma` (much slower). The same
 //! operations per lane in the same order, so bitwise the same results on
 //! every CPU. Built once when a `Gp` becomes a compensator
-//! ([`StoredCompensator::into_arc`]); [`Compensator::stored`] returns the `Gp`.
+//! (`StoredCompensator::into_arc`); [`PreparedGp::gp`] returns the `Gp`.
 
 #[cfg(target_arch = "x86_64")]
 use super::avx2;
 use super::exp::exp_nonpositive;
-use super::model::{Gp, Uncertainty, CUTOFF};
+use super::model::{Gp, CUTOFF};
 use super::rough::RoughGp;
-use crate::calibrate::compensate::{Compensator, StoredCompensator};
+use crate::model::calibrated::compensator::{Compensator, Uncertainty};
 use crate::model::kinematics::prepared::with_scratch;
 use nalgebra::Vector3;
 
@@ -396,10 +396,6 @@ impl Compensator for PreparedGp {
         Some(0.5 * 3f64.sqrt() * self.gp.signal_variance.sqrt() * d2)
     }
 
-    fn stored(&self) -> Option<StoredCompensator> {
-        Some(StoredCompensator::Gp(self.gp.clone()))
-    }
-
     fn uncertainty(&self, q: &[f64]) -> Option<Uncertainty> {
         Some(Uncertainty {
             compensated_m: self.gp.error_scale * (3.0 * self.variance_at(q)).sqrt(),
@@ -509,7 +505,7 @@ fn kernel_weight(d2: f64) -> f64 {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::calibrate::compensate::Compensator;
+    use crate::model::calibrated::compensator::Compensator;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
@@ -590,7 +586,7 @@ pub(crate) mod tests {
                     "{v_ref} vs {v_fast}"
                 );
             }
-            assert_eq!(fast.stored(), Some(StoredCompensator::Gp(gp)));
+            assert_eq!(fast.gp(), &gp);
         }
     }
 

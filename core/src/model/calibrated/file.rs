@@ -22,8 +22,8 @@
 //! `rpy_deg = [rx, ry, rz]` (fixed-axis XYZ, as the tool of a model description).
 //!
 //! `compensator` (optional, format 2) is the learned residual compensator,
-//! tagged by `kind`: `mlp` ([`Mlp`](super::Mlp): `dof`, `hidden`, `features`,
-//! flat `weights`, `input_norm`, `output_norm`) or `rbf` ([`Rbf`](super::Rbf):
+//! tagged by `kind`: `mlp` ([`Mlp`](super::mlp::Mlp): `dof`, `hidden`, `features`,
+//! flat `weights`, `input_norm`, `output_norm`) or `rbf` ([`Rbf`](super::rbf::Rbf):
 //! `dof`, `output_frame`, `input_norm`, `spread`, `centres`, `weights`). Its
 //! values are SI (inputs rad, kg, N·m; outputs m) as the network computes them.
 //! A file with an unknown `kind` is rejected; every value of the compensator
@@ -32,8 +32,8 @@
 //!
 //! `compensator_orientation` (optional, beside `compensator`; files without it
 //! load as before) is the compensator's orientation part, trained where the
-//! data measured orientations ([`StoredOrientation`](super::StoredOrientation),
-//! `compensate/oriented.rs`): `point_m`, the measured point in the flange
+//! data measured orientations ([`StoredOrientation`],
+//! `model/calibrated/orientation.rs`): `point_m`, the measured point in the flange
 //! frame [m] the correction turns about, and `network`, a compensator of the
 //! same form whose three outputs are the rotation vector `ω` [rad] in the
 //! registered base frame (`R_measured = exp(ω)·R_predicted`). It fades with
@@ -41,14 +41,17 @@
 //!
 //! `validation` (optional) keeps the validation poses' errors that the
 //! accuracy at a production tool's tip is computed from
-//! (`cell::accuracy::ValidationEvidence`: the measured point's mean and max
+//! ([`ValidationEvidence`], `model/calibrated/evidence.rs`: the measured point's mean and max
 //! error [mm] and, per pose with a measured orientation, the position error
 //! [mm] and `R_measured − R_predicted`).
 
-use super::{CompensateError, CompensatedModel, StoredCompensator, StoredOrientation, Support};
-use crate::model::bounds::check_compensator;
+use super::compensated::{CompensateError, CompensatedModel};
+use super::evidence::ValidationEvidence;
+use super::orientation::StoredOrientation;
+use super::stored::StoredCompensator;
+use super::support::Support;
+use crate::model::bounds::compensator::check_compensator;
 use crate::model::{ModelDescription, RobotModel};
-use crate::solve::cell::accuracy::ValidationEvidence;
 use serde::{Deserialize, Serialize};
 
 /// The `format` value of a calibrated model file written now.
@@ -267,16 +270,16 @@ mod tests {
 
     fn mlp_compensated() -> CompensatedModel {
         use crate::calibrate::compensate::{
-            train, CompensatorSpec, LmTrainSettings, MlpSettings, MlpSpec, Trainer,
+            train, CompensatorSpec, LmTrainSettings, MlpSettings, MlpSpec, Sample, Trainer,
         };
         use rand::SeedableRng;
         let nominal = preset("ys100").unwrap();
         let mut m = CompensatedModel::from_nominal(nominal.clone());
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(2);
         let qs = crate::sim::random_configurations(&nominal, 40, &mut rng);
-        let samples: Vec<crate::calibrate::compensate::Sample> = qs
+        let samples: Vec<Sample> = qs
             .iter()
-            .map(|q| crate::calibrate::compensate::Sample {
+            .map(|q| Sample {
                 q: q.clone(),
                 tau: m.torques(q).unwrap(),
                 payload_kg: 110.0,
@@ -291,7 +294,7 @@ mod tests {
             }),
         });
         let (c, _) = train(&spec, &samples, &mut rng, &mut |_, _| true).unwrap();
-        m.compensator = Some(c.into_arc());
+        m.compensator = Some(c.into_arc_oriented(None, None));
         m
     }
 

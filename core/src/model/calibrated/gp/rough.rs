@@ -1,7 +1,7 @@
 //! The Gaussian process's mean and joint derivative (the formulas of
 //! `gp/predict.rs`) in single precision, eight inducing configurations per
 //! vector: the IK's expansion at its closed-form seed
-//! ([`Compensator::residual_and_jacobian_rough`](crate::calibrate::compensate::Compensator::residual_and_jacobian_rough)),
+//! ([`Compensator::residual_and_jacobian_rough`](crate::model::calibrated::Compensator::residual_and_jacobian_rough)),
 //! whose end point the double-precision prediction then checks
 //! (docs/design.md "Compensated model and false targets").
 //!

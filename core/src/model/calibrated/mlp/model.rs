@@ -21,7 +21,8 @@
 //! `∂y/∂q_k = diag(1/s_out)·W2·diag(1 − h²)·W1·diag(s_in)·∂f/∂q_k`, where `f` is
 //! the feature map (`∂ sin q/∂q = cos q`, `∂ cos q/∂q = −sin q`).
 
-use crate::calibrate::compensate::{Compensator, InvalidCompensator, StoredCompensator};
+use crate::model::calibrated::compensator::Compensator;
+use crate::model::calibrated::invalid::InvalidCompensator;
 use nalgebra::{Matrix3xX, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -429,9 +430,6 @@ impl Compensator for Mlp {
     }
     fn name(&self) -> &str {
         "mlp"
-    }
-    fn stored(&self) -> Option<StoredCompensator> {
-        Some(self.clone().into())
     }
 }
 
