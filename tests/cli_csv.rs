@@ -6,7 +6,7 @@
 use clap::Parser;
 use robocal::cli::predict::predict_to_string;
 use robocal::measure::csv_text::{read, Dialect};
-use robocal::measure::csv_write::read_text;
+use robocal_core::csv_write::read_text;
 use serde_json::Value;
 
 fn predict(args: &[&str]) -> String {

@@ -21,6 +21,7 @@
 
 pub mod calibrate;
 pub mod check;
+pub mod csv_write;
 pub mod measure;
 pub mod model;
 pub mod optim;

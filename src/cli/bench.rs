@@ -19,12 +19,12 @@
 //! Times are wall-clock on the calling thread (pin with `taskset -c 0`).
 
 use crate::calibrate::identify::{calibrate, CalibrationOptions, Method};
-use crate::measure::csv_write::{push_row, Cell};
 use crate::measure::{self, csv};
 use crate::solve::ik::{Goal, IkSettings, IkSolver, SolveOptions, TargetFrame};
 use anyhow::{bail, Context};
 use clap::{Args, Subcommand};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use robocal_core::csv_write::{push_row, Cell};
 use robocal_core::model::calibrated::{CalibratedModelFile, CompensatedModel};
 use serde_json::json;
 use std::time::Instant;

@@ -16,7 +16,6 @@
 
 use super::solve::OutputFormat;
 use crate::measure::csv_text::dialect_from_names;
-use crate::measure::csv_write::{push_header, push_row, Cell as CsvCell};
 use crate::model::orientation::OrientationConvention;
 use crate::solve::cell::accuracy::{measurement_tool_accuracy, tool_accuracy, ToolAccuracy};
 use crate::solve::cell::joints_csv::parse_joints_csv;
@@ -24,6 +23,7 @@ use crate::solve::cell::{CellRef, Forward, PoseOut, PredictFrame, Predicted};
 use crate::solve::ik::TargetFrame;
 use anyhow::Context;
 use clap::Args;
+use robocal_core::csv_write::{push_header, push_row, Cell as CsvCell};
 use robocal_core::model::calibrated::CalibratedModelFile;
 use robocal_core::model::calibrated::ValidationEvidence;
 use serde_json::json;

@@ -22,7 +22,6 @@
 //!   readings in degrees.
 //! - The payload column is always written (default: the truth's payload mass).
 
-use crate::measure::csv_write::comment_line;
 use crate::measure::{csv, SetRole};
 use crate::model::kinematics::fk;
 use crate::model::RobotModel;
@@ -34,6 +33,7 @@ use anyhow::{bail, Context};
 use clap::Args;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use robocal_core::csv_write::comment_line;
 
 #[derive(Debug, Args)]
 pub struct SimulateArgs {

@@ -147,7 +147,7 @@ async fn formula_cells_in_a_solve_csv_answer_are_neutralised() {
     let status = col("status");
     assert_eq!(table.records.len(), sent.len());
     for (r, id) in table.records.iter().zip(sent) {
-        assert_eq!(robocal::measure::csv_write::read_text(&r.fields[0]), id);
+        assert_eq!(robocal_core::csv_write::read_text(&r.fields[0]), id);
         assert_eq!(r.fields[status], "ok", "{answer}");
         for name in [
             "j1_deg",

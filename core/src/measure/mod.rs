@@ -20,7 +20,6 @@ pub mod bounds;
 pub mod convention;
 pub mod csv;
 pub mod csv_text;
-pub mod csv_write;
 
 /// Role of a measurement in the calibration (docs/design.md "Data roles").
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]

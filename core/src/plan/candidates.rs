@@ -2,23 +2,12 @@
 //! convention, rad), filtered by reachability, the workspace box (TCP
 //! position, base frame, mm) and the tracker's line of sight.
 
-use super::{PlanError, PlanSettings, TrackerSight, WorkspaceBox};
+use super::settings::{FilterCounts, PlanError, PlanSettings, TrackerSight, WorkspaceBox};
 use crate::model::kinematics::fk;
 use crate::model::pose::Pose;
 use crate::model::RobotModel;
 use nalgebra::Vector3;
 use rand::Rng;
-use serde::{Deserialize, Serialize};
-
-/// How many candidates passed each filter, in order.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub struct FilterCounts {
-    pub drawn: usize,
-    /// Forward kinematics defined (a closed loop closes) and finite.
-    pub reachable: usize,
-    pub in_box: usize,
-    pub in_sight: usize,
-}
 
 /// Whether the TCP position `p` [m] is inside `b`.
 pub fn inside_box(b: &WorkspaceBox, p: &Vector3<f64>) -> bool {

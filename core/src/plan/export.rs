@@ -4,9 +4,9 @@
 //! (`program::export::joint_program`).
 
 use super::MeasurementPlan;
+use crate::csv_write::{push_header, push_row, read_text, Cell};
 use crate::measure::bounds::{within, JOINT_DEG};
 use crate::measure::csv_text::{self, Dialect, FieldCount};
-use crate::measure::csv_write::{push_header, push_row, read_text, Cell};
 use crate::model::bounds::show;
 use crate::solve::program::export::joint_program;
 use crate::solve::program::{Language, ProgramFile};

@@ -5,9 +5,9 @@
 //! frame).
 
 use super::PlanPoint;
+use crate::csv_write::read_text;
 use crate::measure::bounds::{within, POSITION_MM};
 use crate::measure::csv_text::{self, Dialect, FieldCount};
-use crate::measure::csv_write::read_text;
 use crate::measure::MeasuredPose;
 use crate::model::bounds::show;
 use serde::{Deserialize, Serialize};

@@ -14,88 +14,18 @@ mod candidates;
 pub mod export;
 pub mod join;
 mod predict;
+mod settings;
 
-pub use candidates::FilterCounts;
 pub use export::{plan_csv, plan_program, read_plan_csv, PlanCsvError, PlanPoint};
 pub use join::{join, JoinBy, JoinError, JoinOptions, Joined, Units};
 pub use predict::{ParamPrediction, PredictedStd};
+
+pub use settings::{FilterCounts, PlanError, PlanSettings, TrackerSight, WorkspaceBox};
 
 use crate::model::RobotModel;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
-
-/// An axis-aligned box for the TCP position, base frame [mm].
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct WorkspaceBox {
-    pub min_mm: [f64; 3],
-    pub max_mm: [f64; 3],
-}
-
-/// The tracker's line of sight: the angle between the reflector's axis and
-/// the line from the TCP to the tracker is at most `max_angle_deg`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct TrackerSight {
-    /// Tracker position in the base frame [mm].
-    pub position_mm: [f64; 3],
-    /// The reflector's axis in the tool frame (default: the tool's z axis).
-    pub axis: [f64; 3],
-    pub max_angle_deg: f64,
-}
-
-impl Default for TrackerSight {
-    fn default() -> Self {
-        TrackerSight {
-            position_mm: [2000.0, 0.0, 500.0],
-            axis: [0.0, 0.0, 1.0],
-            max_angle_deg: 60.0,
-        }
-    }
-}
-
-/// How a plan is made.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct PlanSettings {
-    /// Poses to choose.
-    pub poses: usize,
-    /// Random configurations drawn (uniform within the joint limits less the margin).
-    pub candidates: usize,
-    /// Margin kept from both joint limits [deg].
-    pub margin_deg: f64,
-    pub workspace: Option<WorkspaceBox>,
-    pub tracker: Option<TrackerSight>,
-    /// Tracker noise, standard deviation per axis [mm].
-    pub noise_mm: f64,
-    /// Payload mass [kg] (default: the model's).
-    pub payload_kg: Option<f64>,
-    pub seed: u64,
-}
-
-impl Default for PlanSettings {
-    fn default() -> Self {
-        PlanSettings {
-            poses: 50,
-            candidates: 1000,
-            margin_deg: 2.0,
-            workspace: None,
-            tracker: None,
-            noise_mm: 0.01,
-            payload_kg: None,
-            seed: 1,
-        }
-    }
-}
-
-/// Why no plan can be made.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum PlanError {
-    #[error("invalid setting: {0}")]
-    Setting(String),
-    #[error("only {} of {} candidates pass the constraints ({} reachable, {} inside the box, {} in the tracker's sight), {needed} poses asked; draw more candidates or widen the box or the angle", counts.in_sight, counts.drawn, counts.reachable, counts.in_box, counts.in_sight)]
-    TooFewCandidates { counts: FilterCounts, needed: usize },
-    #[error("the chosen poses identify too little: {0}")]
-    Unidentifiable(String),
-}
 
 /// The plan: poses in order, what the constraints let through and the
 /// predicted standard deviations.

@@ -12,6 +12,7 @@
 pub mod calibrate;
 pub mod checks;
 mod evaluate;
+pub mod evidence;
 pub mod identifiability;
 pub mod joint_maps;
 pub mod least_squares;

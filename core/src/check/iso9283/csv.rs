@@ -23,8 +23,8 @@ use super::cube::CubePlan;
 use super::figures::PoseCycles;
 use super::outcome::{CommandedPose, CycleReading, PoseData, ABC_MAX_DEG, CYCLES_MAX, XYZ_MAX_MM};
 use super::Iso9283Error;
+use crate::csv_write::{push_header, push_row, read_text, Cell};
 use crate::measure::csv_text::{read, short_text, Dialect, Record, Table};
-use crate::measure::csv_write::{push_header, push_row, read_text, Cell};
 use crate::model::bounds::show;
 
 /// A commanded pose read from a plan CSV.

@@ -16,7 +16,7 @@
 
 use super::csv::Commanded;
 use super::outcome::{CYCLES_MAX, XYZ_MAX_MM};
-use crate::measure::csv_write::{push_header, push_row, Cell};
+use crate::csv_write::{push_header, push_row, Cell};
 use crate::model::bounds::show;
 use crate::plan::join::{detect_units, read, JoinError};
 use crate::plan::{JoinBy, JoinOptions, Units};

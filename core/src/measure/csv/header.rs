@@ -1,7 +1,7 @@
 //! The header line of a measurement CSV: which column holds what
 //! (`super` module docs for the names and units).
 
-use super::{CsvError, ReadOptions, ACCEPTED, MAX_JOINTS, MIN_JOINTS};
+use super::format::{CsvError, ReadOptions, ACCEPTED, MAX_JOINTS, MIN_JOINTS};
 use crate::measure::convention::MeasuredOrientation;
 
 /// What one header column means.

@@ -4,6 +4,7 @@
 //! the reader's conversions.
 
 use super::*;
+use crate::measure::convention::MeasuredOrientation;
 use nalgebra::{Rotation3, UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

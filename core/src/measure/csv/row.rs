@@ -1,12 +1,12 @@
 //! One data row of a measurement CSV, read through its header (`super`
 //! module docs for the units and bounds).
 
+use super::format::{short_number, CsvError, DifSign, MAX_JOINT_DEG};
 use super::header::{Header, PositionCols};
-use super::{short_number, CsvError, DifSign, MAX_JOINT_DEG};
+use crate::csv_write::read_text;
 use crate::measure::bounds::{self, within};
 use crate::measure::convention::OrientationValueError;
 use crate::measure::csv_text::{self, short_text};
-use crate::measure::csv_write::read_text;
 use crate::measure::{MeasuredPose, SetRole};
 use crate::model::bounds::Bound;
 

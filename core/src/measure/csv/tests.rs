@@ -1,4 +1,5 @@
 use super::*;
+use crate::measure::SetRole;
 
 fn row(q: &[f64], xyz: [f64; 3]) -> MeasuredPose {
     MeasuredPose {

@@ -5,12 +5,9 @@
 //! the registered base frame of the pose's session, so that the tip error of
 //! any tool (`e_tip,i = e_i + (R_meas,i − R_pred,i)·d`, `d` the tool's tip
 //! in the probe frame) is computed later from its TCP alone
-//! (`solve::cell::accuracy`).
+//! (`solve::cell::accuracy`). The calibration computes it
+//! (`calibrate::identify::evidence`).
 
-use super::compensated::CompensatedModel;
-use crate::measure::Measurement;
-use crate::model::Pose;
-use crate::stats::ErrorStats;
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -41,42 +38,6 @@ pub struct ValidationEvidence {
 }
 
 impl ValidationEvidence {
-    /// The evidence of `model` (its `cell_from_base` unused: `valid` is in
-    /// the registered base frame of each pose's session, `frames` the fitted
-    /// session frames); `None` without validation poses.
-    pub fn of(model: &CompensatedModel, frames: &[Pose], valid: &[Measurement]) -> Option<Self> {
-        let mut norms = Vec::with_capacity(valid.len());
-        let mut tip_terms = Vec::new();
-        for m in valid {
-            let Ok(p) = model.predict_detailed_at(&m.q, m.payload_mass) else {
-                continue;
-            };
-            let frame = frames.get(m.session).copied().unwrap_or_default();
-            let pred = frame.compose(&p.pose);
-            let e = m.position - pred.p;
-            norms.push(e.norm() * 1e3);
-            if let Some(r) = &m.orientation {
-                let d = r - pred.r;
-                // Rounded to 1 nm and 1e-12 (a 1 m lever arm: 1 nm): short files.
-                let round = |v: f64, s: f64| (v * s).round() / s;
-                tip_terms.push(TipTerm {
-                    error_mm: std::array::from_fn(|k| round(e[k] * 1e3, 1e6)),
-                    rotation_difference: std::array::from_fn(|k| round(d[(k / 3, k % 3)], 1e12)),
-                });
-            }
-        }
-        if norms.is_empty() {
-            return None;
-        }
-        let stats = ErrorStats::from_errors_mm(&norms);
-        Some(ValidationEvidence {
-            poses: norms.len(),
-            position_mean_mm: stats.mean_mm,
-            position_max_mm: stats.max_mm,
-            tip_terms,
-        })
-    }
-
     /// The tip errors [mm] of the tool at `d` [m] in the measured frame, one
     /// per 6-D validation pose.
     pub fn tip_errors_mm(&self, d: &Vector3<f64>) -> Vec<f64> {

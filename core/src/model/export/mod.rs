@@ -17,7 +17,7 @@
 //! ry_deg, rz_deg` as `Tr·Rz·Ry·Rx`. Closed-loop models (HH800) have no URDF
 //! or DH form here. More: docs/design.md "Exports".
 
-use crate::measure::csv_write::{comment_line, push_header, push_row, Cell};
+use crate::csv_write::{comment_line, push_header, push_row, Cell};
 use crate::model::calibrated::{CalibratedModelFile, CompensatedModel};
 use crate::model::kinematics::chain::{base_constant, tool_pose};
 use crate::model::orientation::fixed_xyz_angles;

@@ -20,9 +20,9 @@
 //! (`measure::bounds::JOINT_DEG`, the bound of the measurement files and
 //! of a JSON prediction). Ids are read as `csv_write` wrote them.
 
+use crate::csv_write::read_text;
 use crate::measure::bounds::{within, JOINT_DEG};
 use crate::measure::csv_text::{self, short_text, Dialect, FieldCount, TextError};
-use crate::measure::csv_write::read_text;
 use crate::model::bounds::show;
 
 /// One joint reading.

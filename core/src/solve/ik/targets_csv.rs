@@ -42,9 +42,9 @@
 use super::invalid::RowError;
 use super::solver::{IkSolution, IkSolver, SolveOptions};
 use super::targets::{TargetInput, TargetResult};
+use crate::csv_write::{self, push_row, read_text, Cell};
 use crate::measure::bounds::{within, POSITION_MM};
 use crate::measure::csv_text::{self, Dialect, Record, TextError};
-use crate::measure::csv_write::{self, push_row, read_text, Cell};
 use crate::model::orientation::{rotation_from, rotation_to, OrientationConvention};
 
 /// One row of a targets file: the target, or why the row is invalid.

@@ -15,8 +15,8 @@
 //! The payload schedules `$PLST_GRP1[n]` (system variables, kg, cm,
 //! kgf·cm·s²) are set in both forms, `n` the tool's number.
 
+use super::data::{comment, ControllerData, ExportError};
 use super::numbers::{RegisterRange, UsedRegister};
-use super::{comment, ControllerData, ExportError};
 use crate::model::orientation::{rotation_to, OrientationConvention};
 use crate::model::Pose;
 use crate::solve::cell::numbering::ItemKind;

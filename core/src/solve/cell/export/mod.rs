@@ -30,98 +30,25 @@
 //! base ([`numbers`]); identifiers valid and distinct ([`names`]), every
 //! renaming reported; registers only those the user names.
 
+pub mod data;
 pub mod fanuc;
 pub mod names;
 pub mod numbers;
 
+pub(crate) use data::comment;
+pub use data::{
+    ControllerData, ControllerExport, ControllerFrame, ControllerTool, ExportError, ExportOptions,
+};
 pub use names::{RenameReason, Renamed};
 pub use numbers::{NumberRange, RegisterRange, UsedRegister};
 
-use super::numbering::{self, AssignedNumber, DuplicateNumber, ItemKind};
+use super::numbering::{self, ItemKind};
 use super::{Cell, Load, Tool};
 use crate::model::calibrated::CompensatedModel;
 use crate::model::orientation::{rotation_to, OrientationConvention};
 use crate::model::Pose;
 use crate::solve::program::Language;
 use std::fmt::Write as _;
-
-/// One tool as the controller holds it.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ControllerTool {
-    pub name: String,
-    /// The controller's number (`Cell::tool_numbers`).
-    pub number: u32,
-    /// Flange → TCP [m].
-    pub tcp: Pose,
-    pub load: Load,
-}
-
-/// One work object in the controller's base frame.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ControllerFrame {
-    pub name: String,
-    pub number: u32,
-    /// Base → work object [m].
-    pub pose: Pose,
-}
-
-/// The items a controller must hold, and the numbers given to items
-/// without one.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct ControllerData {
-    pub tools: Vec<ControllerTool>,
-    pub frames: Vec<ControllerFrame>,
-    pub assigned: Vec<AssignedNumber>,
-}
-
-/// How to export.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct ExportOptions {
-    /// The position registers a Fanuc export may overwrite; `None`: none
-    /// (the frames are listed for entry by hand, [`fanuc`]).
-    pub registers: Option<RegisterRange>,
-}
-
-/// The exported text and what it decided.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ControllerExport {
-    pub text: String,
-    /// Items without a number and the one they were given (KRL, Fanuc).
-    pub assigned: Vec<AssignedNumber>,
-    /// Items declared under an identifier other than their name (RAPID,
-    /// URScript).
-    pub renamed: Vec<Renamed>,
-    /// The position registers the program overwrites (Fanuc).
-    pub registers: Vec<UsedRegister>,
-}
-
-/// Why a cell cannot be exported for a controller: the item and the fix.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-pub enum ExportError {
-    #[error("{0}")]
-    Duplicate(#[from] DuplicateNumber),
-    #[error("{} `{name}` has number 0, which is {} on this controller: give it a number from {} to {} ({}[{}..{}])", .kind.label(), .range.zero, .range.first, .range.last, .range.data, .range.first, .range.last)]
-    NumberZero {
-        kind: ItemKind,
-        name: String,
-        range: NumberRange,
-    },
-    #[error("{} `{name}` {}: the controller has {}[{}..{}]", .kind.label(), if *.assigned { format!("has no number and the lowest free one is {number}") } else { format!("has number {number}") }, .range.data, .range.first, .range.last)]
-    NumberOutOfRange {
-        kind: ItemKind,
-        name: String,
-        number: u32,
-        /// The number was given by the export (the item has none).
-        assigned: bool,
-        range: NumberRange,
-    },
-    #[error("the Fanuc export needs {needed} position registers (one per tool and work object), {given} given ({range}): give a range of at least {needed}")]
-    TooFewRegisters {
-        needed: usize,
-        given: usize,
-        range: RegisterRange,
-    },
-}
 
 /// The cell's tools and work objects as the controller holds them, for the
 /// calibrated `model`: work objects in its base frame, loads on the flange,
@@ -235,20 +162,6 @@ fn check_numbers(language: Language, data: &ControllerData) -> Result<(), Export
         }
     }
     Ok(())
-}
-
-/// A name as comment text: control characters (a line break would end the
-/// comment) and, in Fanuc, the statement end `;` become spaces.
-pub(crate) fn comment(name: &str, language: Language) -> String {
-    name.chars()
-        .map(|c| {
-            if c.is_control() || (language == Language::Fanuc && c == ';') {
-                ' '
-            } else {
-                c
-            }
-        })
-        .collect()
 }
 
 /// The header comment lines of the numbers given by the export.

@@ -3,7 +3,8 @@
 //! the mean residual), the held-out split and the population methods' guard
 //! against the null network.
 
-use super::{MlpSpec, NullNetwork};
+use super::outcome::NullNetwork;
+use super::spec::MlpSpec;
 use crate::calibrate::compensate::sample::Sample;
 use crate::model::calibrated::mlp::{Mlp, Normalisation, Shape};
 use rand::seq::SliceRandom;

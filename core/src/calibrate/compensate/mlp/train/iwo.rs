@@ -11,8 +11,9 @@
 //! gives no iteration count; the defaults give about 25 000 loss evaluations.
 
 use super::data::{initial_weights, null_guard, split_holdout, Prepared, Split};
+use super::outcome::{TrainOutcome, TrainStop, TrainStopReason};
 use super::output_layer::{candidate, FitMatrices, OutputLayer};
-use super::{TrainError, TrainOutcome, TrainStop, TrainStopReason};
+use crate::calibrate::compensate::error::TrainError;
 use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;

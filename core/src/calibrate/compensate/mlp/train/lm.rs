@@ -6,7 +6,8 @@
 //! the best held-out loss; the null network is a final candidate there.
 
 use super::data::{nguyen_widrow, null_network, split_holdout, Prepared, Split};
-use super::{NullNetwork, TrainError, TrainOutcome, TrainStop, TrainStopReason};
+use super::outcome::{NullNetwork, TrainOutcome, TrainStop, TrainStopReason};
+use crate::calibrate::compensate::error::TrainError;
 use crate::optim::lm::{self, Damping, Flow, Iterate, LeastSquaresProblem, StopReason};
 use nalgebra::{DMatrix, DVector};
 use rand::Rng;

@@ -25,7 +25,9 @@
 mod data;
 mod iwo;
 mod lm;
+mod outcome;
 mod output_layer;
+mod spec;
 mod tlbo;
 
 pub use iwo::IwoSettings;
@@ -36,58 +38,11 @@ pub use tlbo::TlboTrainSettings;
 use crate::calibrate::compensate::error::TrainError;
 use crate::calibrate::compensate::report::TrainReport;
 use crate::calibrate::compensate::sample::Sample;
-use crate::model::calibrated::mlp::{Features, Mlp};
+use crate::model::calibrated::mlp::Mlp;
 use data::Prepared;
 use rand::Rng;
 use serde::{Deserialize, Serialize};
-
-/// Network size and inputs.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct MlpSpec {
-    pub hidden: usize,
-    pub features: Features,
-}
-
-impl MlpSpec {
-    /// The SKCM-NN network of ch. 4: 20 tansig units, here on the joint angles
-    /// and their sines and cosines (18-20-3): a gear transmission error
-    /// `A·sin(q + φ)` is linear in those, and on the compensator study
-    /// (tests/compensate.rs) the validation gain over SKCM rises from 27 % with
-    /// the thesis's 6-20-3 to 46 %.
-    pub const SKCM_NN: MlpSpec = MlpSpec {
-        hidden: 20,
-        features: Features {
-            sin_cos: true,
-            payload: false,
-        },
-    };
-    /// The thesis's 6-20-3 of ch. 4 (joint angles only).
-    pub const SEED_6_20_3: MlpSpec = MlpSpec {
-        hidden: 20,
-        features: Features::JOINTS,
-    };
-    /// The thesis's IWO / TLBO network of ch. 5–6: 6-5-3 (53 weights) on the
-    /// joint angles.
-    pub const SMALL: MlpSpec = MlpSpec {
-        hidden: 5,
-        features: Features::JOINTS,
-    };
-    /// The SKCM-IWONN and SKCM-TLBONN network: 18-40-3 on the joint angles and
-    /// their sines and cosines, its output layer solved by least squares for
-    /// every candidate ([`OutputLayer::LeastSquares`]), so the population
-    /// searches the 760 hidden weights and biases. On the compensator study
-    /// (`cargo run --release -p robocal-core --example compare_trainers`)
-    /// the thesis's 6-5-3 with every weight searched could not lift TLBO above
-    /// −9 % against SKCM nor IWO above −1 %, and even LM backpropagation on
-    /// 6-5-3 stops at −12 %: five units are too few for this residual.
-    pub const POPULATION: MlpSpec = MlpSpec {
-        hidden: 40,
-        features: Features {
-            sin_cos: true,
-            payload: false,
-        },
-    };
-}
+pub use spec::MlpSpec;
 
 /// How the MLP weights are found.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -113,81 +68,6 @@ impl Trainer {
 pub struct MlpSettings {
     pub spec: MlpSpec,
     pub trainer: Trainer,
-}
-
-/// What a trainer found and how it ended.
-#[derive(Debug, Clone, PartialEq)]
-pub struct TrainOutcome {
-    /// Flat weight vector in normalised units.
-    pub weights: Vec<f64>,
-    /// Epochs (LM), iterations (IWO) or generations (TLBO) run.
-    pub epochs: usize,
-    /// Loss evaluations.
-    pub evaluations: usize,
-    /// Final training loss (normalised units, module docs).
-    pub loss: f64,
-    pub stop: TrainStop,
-}
-
-/// Why a trainer stopped, and whether the null network replaced its result.
-#[derive(Debug, Clone, PartialEq)]
-pub struct TrainStop {
-    pub reason: TrainStopReason,
-    pub null_network: Option<NullNetwork>,
-}
-
-/// Why a trainer stopped.
-#[derive(Debug, Clone, PartialEq)]
-pub enum TrainStopReason {
-    /// LM: every one of `max_epochs` epochs ran.
-    Epochs(usize),
-    /// LM: the largest gradient component fell below `floor`.
-    GradientVanished { floor: f64 },
-    /// LM: no damping up to `mu_max` lowered the loss.
-    DampingExhausted { mu_max: f64 },
-    /// LM: the held-out loss was not better for `max_fail` epochs in a row.
-    EarlyStop { max_fail: usize },
-    /// IWO: every iteration ran.
-    Iterations(usize),
-    /// TLBO: every generation ran.
-    Generations(usize),
-}
-
-/// Why the null network (it predicts the mean residual) replaced the trained one.
-#[derive(Debug, Clone, PartialEq)]
-pub enum NullNetwork {
-    /// LM: no epoch beat it on the held-out part.
-    NoEpochBetter,
-    /// IWO, TLBO: the network does not beat it on the held-out part by
-    /// `standard_errors` standard errors of the paired per-sample gains.
-    NotSignificant { standard_errors: f64 },
-}
-
-impl std::fmt::Display for TrainStop {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match &self.reason {
-            TrainStopReason::Epochs(n) => write!(f, "{n} epochs")?,
-            TrainStopReason::GradientVanished { floor } => write!(f, "gradient below {floor:e}")?,
-            TrainStopReason::DampingExhausted { mu_max } => write!(f, "mu above {mu_max:e}")?,
-            TrainStopReason::EarlyStop { max_fail } => write!(
-                f,
-                "early stop: held-out loss not better for {max_fail} epochs"
-            )?,
-            TrainStopReason::Iterations(n) => write!(f, "{n} iterations")?,
-            TrainStopReason::Generations(n) => write!(f, "{n} generations")?,
-        }
-        match &self.null_network {
-            None => Ok(()),
-            Some(NullNetwork::NoEpochBetter) => write!(
-                f,
-                "; no epoch beat the mean residual on the held-out part: null network"
-            ),
-            Some(NullNetwork::NotSignificant { standard_errors }) => write!(
-                f,
-                "; not better than the mean residual on the held-out part by {standard_errors} standard errors: null network"
-            ),
-        }
-    }
 }
 
 /// Trains the MLP of `settings` on `samples` by its trainer: the weights,

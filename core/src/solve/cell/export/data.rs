@@ -1,0 +1,102 @@
+//! What a cell's export holds for a controller ([`ControllerData`]: its
+//! tools, frames and loads with their numbers), the export's options and
+//! answer, why a cell cannot be exported, and names as comment text.
+
+use super::names::Renamed;
+use super::numbers::{NumberRange, RegisterRange, UsedRegister};
+use crate::model::Pose;
+use crate::solve::cell::numbering::{AssignedNumber, DuplicateNumber, ItemKind};
+use crate::solve::cell::Load;
+use crate::solve::program::Language;
+
+/// One tool as the controller holds it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ControllerTool {
+    pub name: String,
+    /// The controller's number (`Cell::tool_numbers`).
+    pub number: u32,
+    /// Flange → TCP [m].
+    pub tcp: Pose,
+    pub load: Load,
+}
+
+/// One work object in the controller's base frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ControllerFrame {
+    pub name: String,
+    pub number: u32,
+    /// Base → work object [m].
+    pub pose: Pose,
+}
+
+/// The items a controller must hold, and the numbers given to items
+/// without one.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ControllerData {
+    pub tools: Vec<ControllerTool>,
+    pub frames: Vec<ControllerFrame>,
+    pub assigned: Vec<AssignedNumber>,
+}
+
+/// How to export.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ExportOptions {
+    /// The position registers a Fanuc export may overwrite; `None`: none
+    /// (the frames are listed for entry by hand, [`fanuc`]).
+    pub registers: Option<RegisterRange>,
+}
+
+/// The exported text and what it decided.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ControllerExport {
+    pub text: String,
+    /// Items without a number and the one they were given (KRL, Fanuc).
+    pub assigned: Vec<AssignedNumber>,
+    /// Items declared under an identifier other than their name (RAPID,
+    /// URScript).
+    pub renamed: Vec<Renamed>,
+    /// The position registers the program overwrites (Fanuc).
+    pub registers: Vec<UsedRegister>,
+}
+
+/// Why a cell cannot be exported for a controller: the item and the fix.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum ExportError {
+    #[error("{0}")]
+    Duplicate(#[from] DuplicateNumber),
+    #[error("{} `{name}` has number 0, which is {} on this controller: give it a number from {} to {} ({}[{}..{}])", .kind.label(), .range.zero, .range.first, .range.last, .range.data, .range.first, .range.last)]
+    NumberZero {
+        kind: ItemKind,
+        name: String,
+        range: NumberRange,
+    },
+    #[error("{} `{name}` {}: the controller has {}[{}..{}]", .kind.label(), if *.assigned { format!("has no number and the lowest free one is {number}") } else { format!("has number {number}") }, .range.data, .range.first, .range.last)]
+    NumberOutOfRange {
+        kind: ItemKind,
+        name: String,
+        number: u32,
+        /// The number was given by the export (the item has none).
+        assigned: bool,
+        range: NumberRange,
+    },
+    #[error("the Fanuc export needs {needed} position registers (one per tool and work object), {given} given ({range}): give a range of at least {needed}")]
+    TooFewRegisters {
+        needed: usize,
+        given: usize,
+        range: RegisterRange,
+    },
+}
+
+/// A name as comment text: control characters (a line break would end the
+/// comment) and, in Fanuc, the statement end `;` become spaces.
+pub(crate) fn comment(name: &str, language: Language) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_control() || (language == Language::Fanuc && c == ';') {
+                ' '
+            } else {
+                c
+            }
+        })
+        .collect()
+}
