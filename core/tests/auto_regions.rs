@@ -24,6 +24,7 @@ mod common;
 use common::{measure_truth, real, shipped_model};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use robocal_core::calibrate::compensate::select::Parallelism;
 use robocal_core::calibrate::identify::{
     calibrate_with_training, CalibrationOptions, CalibrationReport, CompensatorOptions, Method,
 };
@@ -142,6 +143,44 @@ fn simulated_compliance_held_out_joint_range() {
     let train = &train[..train.len().min(300)];
     assert!(held.len() >= 100, "{} held out", held.len());
     accept("ys100-sim", &nominal, (ident, train, &held));
+}
+
+/// The folds train in parallel without changing a bit: `auto` on one thread
+/// and on three gives the same report (every figure compared as the exact
+/// decimal of its f64) and the same choice.
+#[test]
+fn auto_is_the_same_on_one_thread_as_on_three() {
+    let nominal = preset("ys100").unwrap();
+    let truth = unmodelled_truth(&nominal, true, 5);
+    let mut rng = ChaCha8Rng::seed_from_u64(105);
+    let data = measure_truth(&truth, &nominal, 260, &mut rng);
+    let (ident, rest) = data.split_at(60);
+    let (train, valid) = rest.split_at(150);
+    let run = |threads| {
+        let mut opts = options(1);
+        opts.compensator.parallel = Parallelism { threads };
+        calibrate_with_training(&nominal, ident, train, valid, &opts, &|_| true).unwrap()
+    };
+    let (one, three) = (run(1), run(3));
+    let chosen = |r: &CalibrationReport| r.methods["auto"].auto.as_ref().unwrap().chosen;
+    assert_eq!(chosen(&one), chosen(&three));
+    let cv = |r: &CalibrationReport| {
+        r.methods["auto"]
+            .auto
+            .as_ref()
+            .unwrap()
+            .candidates
+            .iter()
+            .filter_map(|c| c.cross_validation.as_ref())
+            .map(|c| c.compensated.mean_mm.to_bits())
+            .collect::<Vec<_>>()
+    };
+    assert!(!cv(&one).is_empty());
+    assert_eq!(cv(&one), cv(&three));
+    assert_eq!(
+        serde_json::to_string(&one).unwrap(),
+        serde_json::to_string(&three).unwrap()
+    );
 }
 
 /// The real UR5: grid against random, and the grid's joint 2 top quarter.

@@ -56,6 +56,13 @@ pub struct MethodsArgs {
     /// Seed of the truth, the poses and the training.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Threads a cross-validation's trainings run on (0: the cores available).
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    /// The candidates `auto` weighs (default: every joint-map and
+    /// compensator method).
+    #[arg(long, value_delimiter = ',')]
+    pub auto_candidates: Vec<String>,
 }
 
 #[derive(Debug, Args)]
@@ -142,6 +149,11 @@ fn methods(a: &MethodsArgs) -> anyhow::Result<serde_json::Value> {
             nominal.payload.mass,
         ))
     };
+    let auto_candidates: Vec<Method> = a
+        .auto_candidates
+        .iter()
+        .map(|m| Method::parse(m).with_context(|| format!("unknown method {m}")))
+        .collect::<anyhow::Result<_>>()?;
     let ident = measure(100)?;
     let valid = measure(200)?;
     let mut rows = Vec::new();
@@ -153,6 +165,10 @@ fn methods(a: &MethodsArgs) -> anyhow::Result<serde_json::Value> {
                 ..Default::default()
             };
             opts.compensator.seed = a.seed;
+            opts.compensator.parallel.threads = a.threads;
+            if !auto_candidates.is_empty() {
+                opts.compensator.auto_candidates = auto_candidates.clone();
+            }
             let t = Instant::now();
             let r = calibrate_with_training(&nominal, &ident, &train, &valid, &opts, &|_| true)?;
             let seconds = t.elapsed().as_secs_f64();
@@ -163,6 +179,8 @@ fn methods(a: &MethodsArgs) -> anyhow::Result<serde_json::Value> {
                 .map(|v| v.stats.clone());
             let row = json!({
                 "method": m.name(),
+                "threads": opts.compensator.parallel.threads(),
+                "chosen": r.methods.get(m).and_then(|x| x.auto.as_ref()).map(|x| x.chosen.name()),
                 "training_poses": n,
                 "seconds": seconds,
                 "validation_mean_mm": v.as_ref().map(|v| v.mean_mm),

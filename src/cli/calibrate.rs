@@ -7,6 +7,7 @@ mod render;
 pub use render::{render_comparison, render_compensators, render_orientation, render_report};
 
 use super::progress::ProgressPrinter;
+use crate::calibrate::compensate::select::Parallelism;
 use crate::calibrate::identify::{
     calibrate_with_training, CalibrationOptions, CalibrationReport, CompensatorOptions, Method,
     PoseSource, PoseSources, METHODS,
@@ -66,6 +67,10 @@ pub struct CalibrateArgs {
     /// models more physics, then fewer fitted quantities.
     #[arg(long, default_value_t = 0.05)]
     pub tie_margin: f64,
+    /// Threads a cross-validation's trainings run on (0: the cores
+    /// available); the results are the same for any count.
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
     /// TLBO population and generations.
     #[arg(long, default_value_t = 50)]
     pub population: usize,
@@ -321,6 +326,7 @@ fn calibration_options(a: &CalibrateArgs) -> CalibrationOptions {
             cv_folds: a.cv_folds,
             blocked_folds: a.blocked_folds,
             tie_margin: a.tie_margin,
+            parallel: Parallelism { threads: a.threads },
             ..Default::default()
         },
         ..Default::default()

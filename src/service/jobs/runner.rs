@@ -11,6 +11,7 @@
 
 use super::prepare::Job;
 use super::versions::{summary_of, versions_of};
+use crate::calibrate::compensate::select::Parallelism;
 use crate::calibrate::identify::{calibrate_with_training, CalibrationError, Progress};
 use crate::db::JobResult;
 use crate::records::{JobStatus, ProgressDetail};
@@ -111,6 +112,10 @@ pub(super) async fn execute(state: AppState, job: Job, claim: Option<Claim>) {
         ticket: _ticket,
         ..
     } = job;
+    // The calibration workers share the cores: each job's cross-validations
+    // train on its share.
+    let mut opts = opts;
+    opts.compensator.parallel = Parallelism::shared_by(state.config().workers);
     // The job's wall-clock budget: past it the job stops like a cancellation
     // and is reported as failed.
     let budget = state.limits().job_time;

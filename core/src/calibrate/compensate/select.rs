@@ -8,6 +8,11 @@
 //! compensation, next to the base's (the residual itself, since the
 //! model-based part is the same in every fold).
 //!
+//! The folds are dealt first ([`FoldPlan`]), then their trainings run side
+//! by side on a pool of [`Parallelism`] threads ([`run_jobs`]): each draws
+//! from its own generator, so the statistics are the same bit for bit on any
+//! number of threads.
+//!
 //! Spatially blocked folds ([`blocked_fold_assignment`]) hold out whole
 //! regions of joint space instead: k-means clusters of the joint vectors, each
 //! joint scaled by its range. A compensator that is good between its training
@@ -24,7 +29,9 @@ use crate::stats::ErrorStats;
 use rand::seq::SliceRandom;
 use rand::Rng;
 use serde::{Deserialize, Serialize};
-use std::sync::Arc;
+use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{mpsc, Arc, Mutex};
 
 /// Cross-validated errors of a base and its compensator.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -147,82 +154,282 @@ pub fn blocked_fold_assignment(qs: &[&[f64]], k: usize, rng: &mut impl Rng) -> V
     fold
 }
 
-/// Out-of-fold compensated errors [mm] of `samples` for a fold assignment.
-fn out_of_fold<E, F>(
-    samples: &[Sample],
-    fold: &[usize],
-    k: usize,
-    fit: &mut F,
-) -> Result<Vec<f64>, E>
-where
-    F: FnMut(&[Sample]) -> Result<Arc<dyn Compensator>, E>,
-{
-    let mut after = vec![0.0; samples.len()];
-    for f in 0..k {
-        let train: Vec<Sample> = samples
-            .iter()
-            .zip(fold)
-            .filter(|(_, &g)| g != f)
-            .map(|(s, _)| s.clone())
-            .collect();
-        if train.is_empty() || train.len() == samples.len() {
-            continue;
-        }
-        let c = fit(&train)?;
-        for (i, s) in samples.iter().enumerate() {
-            if fold[i] == f {
-                after[i] = (s.residual - c.residual_at(&s.q, &s.tau, s.payload_kg)).norm() * 1e3;
-            }
+/// How many threads the trainings of one cross-validation run on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Parallelism {
+    /// Threads of the pool; 0 (the default): the cores available.
+    pub threads: usize,
+}
+
+impl Parallelism {
+    /// One thread: the trainings one after another.
+    pub const SERIAL: Parallelism = Parallelism { threads: 1 };
+
+    /// The threads this stands for (at least 1).
+    pub fn threads(self) -> usize {
+        if self.threads > 0 {
+            self.threads
+        } else {
+            std::thread::available_parallelism().map_or(1, |n| n.get())
         }
     }
-    Ok(after)
+
+    /// The cores shared by `workers` calibrations running at once: each
+    /// gets its share, at least 1 thread.
+    pub fn shared_by(workers: usize) -> Parallelism {
+        Parallelism {
+            threads: (Parallelism::default().threads() / workers.max(1)).max(1),
+        }
+    }
+}
+
+/// How the trainings of a cross-validation run ([`run_jobs`]).
+pub struct Jobs<'a, E> {
+    pub parallel: Parallelism,
+    /// `progress(job, epoch, loss)` of the lowest-numbered training under
+    /// way, on the calling thread, after any training's epoch; false cancels.
+    pub progress: &'a mut dyn FnMut(usize, usize, f64) -> bool,
+    /// The error of a training cancelled before it started.
+    pub cancelled: fn() -> E,
+}
+
+/// A training's report to the calling thread.
+enum JobMessage {
+    Started(usize),
+    Epoch { job: usize, epoch: usize, loss: f64 },
+    Done(usize),
+}
+
+/// Runs `job(0)` … `job(n - 1)` on a pool of `jobs.parallel` threads, each
+/// job started in order as a thread frees, and returns their results in
+/// order, or the error of the first (in order) that failed. A job's results
+/// do not depend on the others nor on the thread count (each draws from its
+/// own generator). `job(i, report)` calls `report(epoch, loss)`, which
+/// returns false once the calling thread's `jobs.progress` cancelled; jobs
+/// not started by then are not run.
+pub fn run_jobs<T, E, J>(n: usize, jobs: Jobs<'_, E>, job: J) -> Result<Vec<T>, E>
+where
+    T: Send,
+    E: Send,
+    J: Fn(usize, &mut dyn FnMut(usize, f64) -> bool) -> Result<T, E> + Sync,
+{
+    let threads = jobs.parallel.threads().clamp(1, n.max(1));
+    let cancelled = AtomicBool::new(false);
+    let next = AtomicUsize::new(0);
+    let results: Vec<Mutex<Option<Result<T, E>>>> = (0..n).map(|_| Mutex::new(None)).collect();
+    let progress = jobs.progress;
+    std::thread::scope(|scope| {
+        let (tx, rx) = mpsc::channel::<JobMessage>();
+        let work = |tx: &mpsc::Sender<JobMessage>| loop {
+            let i = next.fetch_add(1, Ordering::SeqCst);
+            if i >= n || cancelled.load(Ordering::SeqCst) {
+                break;
+            }
+            let _ = tx.send(JobMessage::Started(i));
+            let r = job(i, &mut |epoch, loss| {
+                let _ = tx.send(JobMessage::Epoch {
+                    job: i,
+                    epoch,
+                    loss,
+                });
+                !cancelled.load(Ordering::SeqCst)
+            });
+            *results[i].lock().unwrap_or_else(|e| e.into_inner()) = Some(r);
+            let _ = tx.send(JobMessage::Done(i));
+        };
+        let driver = scope.spawn(move || {
+            match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
+                Ok(pool) => {
+                    pool.broadcast(|_| work(&tx.clone()));
+                }
+                Err(_) => work(&tx),
+            }
+        });
+        // Started jobs: their last epoch and loss (none before the first).
+        let mut running: BTreeMap<usize, Option<(usize, f64)>> = BTreeMap::new();
+        for m in rx {
+            match m {
+                JobMessage::Started(i) => {
+                    running.insert(i, None);
+                }
+                JobMessage::Epoch { job, epoch, loss } => {
+                    running.insert(job, Some((epoch, loss)));
+                }
+                JobMessage::Done(i) => {
+                    running.remove(&i);
+                }
+            }
+            if let Some((&i, Some((epoch, loss)))) = running.first_key_value() {
+                if !progress(i, *epoch, *loss) {
+                    cancelled.store(true, Ordering::SeqCst);
+                }
+            }
+        }
+        if let Err(panic) = driver.join() {
+            std::panic::resume_unwind(panic);
+        }
+    });
+    let mut out = Vec::with_capacity(n);
+    for r in results {
+        match r.into_inner().unwrap_or_else(|e| e.into_inner()) {
+            Some(Ok(t)) => out.push(t),
+            Some(Err(e)) => return Err(e),
+            None => return Err((jobs.cancelled)()),
+        }
+    }
+    Ok(out)
+}
+
+/// The folds of a cross-validation, drawn before any training: the random
+/// folds, then the spatially blocked ones (module docs), and the trainings
+/// they need in order (a fold holding no sample or every sample is none).
+#[derive(Debug, Clone)]
+pub struct FoldPlan {
+    k: usize,
+    fold: Vec<usize>,
+    /// The blocked folds' count and assignment, when they run.
+    regions: Option<(usize, Vec<usize>)>,
+    /// Per training: blocked (else random) and the fold it holds out.
+    trainings: Vec<(bool, usize)>,
+}
+
+impl FoldPlan {
+    /// `k` random folds (at least 2) and `blocked` blocked ones (none
+    /// below 2 or with fewer than `2 * blocked` samples), both drawn from
+    /// `rng` in that order.
+    pub fn draw(samples: &[Sample], k: usize, blocked: usize, rng: &mut impl Rng) -> FoldPlan {
+        let k = k.clamp(2, samples.len().max(2));
+        let fold = fold_assignment(samples.len(), k, rng);
+        let regions = (blocked >= 2 && samples.len() >= 2 * blocked).then(|| {
+            let qs: Vec<&[f64]> = samples.iter().map(|s| s.q.as_slice()).collect();
+            (blocked, blocked_fold_assignment(&qs, blocked, rng))
+        });
+        let trained = |assign: &[usize], f: usize| {
+            let held = assign.iter().filter(|&&g| g == f).count();
+            held > 0 && held < assign.len()
+        };
+        let mut trainings: Vec<(bool, usize)> = (0..k)
+            .filter(|&f| trained(&fold, f))
+            .map(|f| (false, f))
+            .collect();
+        if let Some((b, region)) = &regions {
+            trainings.extend((0..*b).filter(|&r| trained(region, r)).map(|r| (true, r)));
+        }
+        FoldPlan {
+            k,
+            fold,
+            regions,
+            trainings,
+        }
+    }
+
+    /// The trainings the folds need.
+    pub fn trainings(&self) -> usize {
+        self.trainings.len()
+    }
+
+    /// The samples training `training` fits on: all but its fold's.
+    pub fn training_set(&self, samples: &[Sample], training: usize) -> Vec<Sample> {
+        let (assign, f) = self.held_out(training);
+        samples
+            .iter()
+            .zip(assign)
+            .filter(|(_, &g)| g != f)
+            .map(|(s, _)| s.clone())
+            .collect()
+    }
+
+    fn held_out(&self, training: usize) -> (&[usize], usize) {
+        let (blocked, f) = self.trainings[training];
+        match (&self.regions, blocked) {
+            (Some((_, region)), true) => (region, f),
+            _ => (&self.fold, f),
+        }
+    }
+
+    /// Out-of-fold compensated errors [mm] of `samples` for the random
+    /// (`blocked` false) or blocked folds, from the trainings' compensators.
+    fn out_of_fold(
+        &self,
+        samples: &[Sample],
+        fitted: &[Arc<dyn Compensator>],
+        blocked: bool,
+    ) -> Vec<f64> {
+        let mut after = vec![0.0; samples.len()];
+        for (t, c) in fitted.iter().enumerate() {
+            if self.trainings[t].0 != blocked {
+                continue;
+            }
+            let (assign, f) = self.held_out(t);
+            for (i, s) in samples.iter().enumerate() {
+                if assign[i] == f {
+                    after[i] =
+                        (s.residual - c.residual_at(&s.q, &s.tau, s.payload_kg)).norm() * 1e3;
+                }
+            }
+        }
+        after
+    }
+
+    /// The statistics of the cross-validation from the compensators
+    /// `fitted`, one per training in order.
+    pub fn stats(&self, samples: &[Sample], fitted: &[Arc<dyn Compensator>]) -> CvStats {
+        let after = self.out_of_fold(samples, fitted, false);
+        let before: Vec<f64> = samples.iter().map(|s| s.residual.norm() * 1e3).collect();
+        let mut regions = Vec::new();
+        if let Some((blocked, region)) = &self.regions {
+            let held = self.out_of_fold(samples, fitted, true);
+            for r in 0..*blocked {
+                let idx: Vec<usize> = (0..samples.len()).filter(|&i| region[i] == r).collect();
+                if idx.is_empty() {
+                    continue;
+                }
+                let mean = |v: &[f64]| idx.iter().map(|&i| v[i]).sum::<f64>() / idx.len() as f64;
+                let dim = samples[0].q.len();
+                regions.push(BlockedFold {
+                    poses: idx.len(),
+                    centre: (0..dim)
+                        .map(|j| {
+                            idx.iter().map(|&i| samples[i].q[j]).sum::<f64>() / idx.len() as f64
+                        })
+                        .collect(),
+                    base_mean_mm: mean(&before),
+                    compensated_mean_mm: mean(&held),
+                });
+            }
+        }
+        CvStats {
+            folds: self.k,
+            base: ErrorStats::from_errors_mm(&before),
+            compensated: ErrorStats::from_errors_mm(&after),
+            blocked: regions,
+        }
+    }
 }
 
 /// k-fold cross-validation of a compensator trainer, then `blocked` spatially
-/// blocked folds (none for 0; module docs). `fit` trains on the given samples;
-/// its error aborts the run.
+/// blocked folds (none for 0; module docs), the trainings in parallel
+/// ([`run_jobs`]). `fit(training, samples, report)` trains on the given
+/// samples (training `training` of [`FoldPlan::trainings`]); its error
+/// aborts the run.
 pub fn cross_validate<E, F>(
     samples: &[Sample],
     k: usize,
     blocked: usize,
     rng: &mut impl Rng,
-    mut fit: F,
+    jobs: Jobs<'_, E>,
+    fit: F,
 ) -> Result<CvStats, E>
 where
-    F: FnMut(&[Sample]) -> Result<Arc<dyn Compensator>, E>,
+    E: Send,
+    F: Fn(usize, &[Sample], &mut dyn FnMut(usize, f64) -> bool) -> Result<Arc<dyn Compensator>, E>
+        + Sync,
 {
-    let k = k.clamp(2, samples.len().max(2));
-    let fold = fold_assignment(samples.len(), k, rng);
-    let after = out_of_fold(samples, &fold, k, &mut fit)?;
-    let before: Vec<f64> = samples.iter().map(|s| s.residual.norm() * 1e3).collect();
-    let mut regions = Vec::new();
-    if blocked >= 2 && samples.len() >= 2 * blocked {
-        let qs: Vec<&[f64]> = samples.iter().map(|s| s.q.as_slice()).collect();
-        let region = blocked_fold_assignment(&qs, blocked, rng);
-        let held = out_of_fold(samples, &region, blocked, &mut fit)?;
-        for r in 0..blocked {
-            let idx: Vec<usize> = (0..samples.len()).filter(|&i| region[i] == r).collect();
-            if idx.is_empty() {
-                continue;
-            }
-            let mean = |v: &[f64]| idx.iter().map(|&i| v[i]).sum::<f64>() / idx.len() as f64;
-            let dim = samples[0].q.len();
-            regions.push(BlockedFold {
-                poses: idx.len(),
-                centre: (0..dim)
-                    .map(|j| idx.iter().map(|&i| samples[i].q[j]).sum::<f64>() / idx.len() as f64)
-                    .collect(),
-                base_mean_mm: mean(&before),
-                compensated_mean_mm: mean(&held),
-            });
-        }
-    }
-    Ok(CvStats {
-        folds: k,
-        base: ErrorStats::from_errors_mm(&before),
-        compensated: ErrorStats::from_errors_mm(&after),
-        blocked: regions,
-    })
+    let plan = FoldPlan::draw(samples, k, blocked, rng);
+    let fitted = run_jobs(plan.trainings(), jobs, |t, report| {
+        fit(t, &plan.training_set(samples, t), report)
+    })?;
+    Ok(plan.stats(samples, &fitted))
 }
 
 /// The outcome of `auto` for one base.
@@ -317,15 +524,22 @@ mod tests {
                 residual: Vector3::new(1e-4 + 1e-5 * i as f64, 0.0, 0.0),
             })
             .collect();
-        let mut fits = 0;
-        let cv = cross_validate(&samples, 4, 0, &mut rng, |train| {
-            fits += 1;
-            assert_eq!(train.len(), 15);
-            let m = train.iter().map(|s| s.residual).sum::<Vector3<f64>>() / train.len() as f64;
-            Ok::<_, ()>(Arc::new(Fixed(m)) as Arc<dyn Compensator>)
-        })
+        let fits = AtomicUsize::new(0);
+        let cv = cross_validate(
+            &samples,
+            4,
+            0,
+            &mut rng,
+            jobs(1, &mut |_, _, _| true),
+            |_, train, _| {
+                fits.fetch_add(1, Ordering::SeqCst);
+                assert_eq!(train.len(), 15);
+                let m = train.iter().map(|s| s.residual).sum::<Vector3<f64>>() / train.len() as f64;
+                Ok::<_, String>(Arc::new(Fixed(m)) as Arc<dyn Compensator>)
+            },
+        )
         .unwrap();
-        assert_eq!(fits, 4);
+        assert_eq!(fits.into_inner(), 4);
         assert_eq!(cv.compensated.n, 20);
         let mut rng = ChaCha8Rng::seed_from_u64(1);
         let fold = fold_assignment(20, 4, &mut rng);
@@ -343,6 +557,99 @@ mod tests {
         let e = ErrorStats::from_errors_mm(&expect);
         assert!((e.mean_mm - cv.compensated.mean_mm).abs() < 1e-12);
         assert!((cv.base.mean_mm - 0.195).abs() < 1e-12);
+    }
+
+    /// Trainings on `threads` threads, reporting to `progress`.
+    fn jobs<E: From<&'static str>>(
+        threads: usize,
+        progress: &mut dyn FnMut(usize, usize, f64) -> bool,
+    ) -> Jobs<'_, E> {
+        Jobs {
+            parallel: Parallelism { threads },
+            progress,
+            cancelled: || E::from("cancelled"),
+        }
+    }
+
+    /// Jobs whose results depend on their own seeded draws only come back in
+    /// order, the same on one thread as on three; the job the progress names
+    /// never goes back; a cancellation stops the jobs not yet started; the
+    /// first failure in order is the error.
+    #[test]
+    fn jobs_run_in_parallel_as_they_would_in_order() {
+        let job = |i: usize, report: &mut dyn FnMut(usize, f64) -> bool| {
+            let mut rng = ChaCha8Rng::seed_from_u64(i as u64);
+            let mut acc = 0.0f64;
+            for e in 0..50 {
+                acc += rng.gen::<f64>().sqrt();
+                if !report(e, acc) {
+                    return Err(String::from("cancelled"));
+                }
+            }
+            Ok(acc)
+        };
+        let mut named = Vec::new();
+        let serial = run_jobs(
+            12,
+            jobs(1, &mut |j, _, _| {
+                named.push(j);
+                true
+            }),
+            job,
+        )
+        .unwrap();
+        assert!(named.windows(2).all(|w| w[0] <= w[1]), "{named:?}");
+        let mut named = Vec::new();
+        let parallel = run_jobs(
+            12,
+            jobs(3, &mut |j, _, _| {
+                named.push(j);
+                true
+            }),
+            job,
+        )
+        .unwrap();
+        assert!(named.windows(2).all(|w| w[0] <= w[1]), "{named:?}");
+        assert!(
+            !named.is_empty() && named.iter().all(|j| *j < 12),
+            "{named:?}"
+        );
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&serial), bits(&parallel));
+        for (i, x) in serial.iter().enumerate() {
+            assert_eq!(x.to_bits(), job(i, &mut |_, _| true).unwrap().to_bits());
+        }
+        // Jobs that report until told to stop, cancelled at the third report:
+        // the two running stop, the jobs not started never run.
+        let started = AtomicUsize::new(0);
+        let mut calls = 0;
+        let r: Result<Vec<()>, String> = run_jobs(
+            12,
+            jobs(2, &mut |_, _, _| {
+                calls += 1;
+                calls < 3
+            }),
+            |_, report| {
+                started.fetch_add(1, Ordering::SeqCst);
+                let mut e = 0;
+                while report(e, 0.0) {
+                    e += 1;
+                    std::thread::yield_now();
+                }
+                Err(String::from("cancelled"))
+            },
+        );
+        assert_eq!(r, Err("cancelled".to_string()));
+        assert!(started.into_inner() <= 2);
+        // Jobs 3 and 7 fail: job 3's error, whatever ran first.
+        let r = run_jobs(10, jobs(3, &mut |_, _, _| true), |i, report| {
+            if i == 3 || i == 7 {
+                Err(format!("job {i}"))
+            } else {
+                job(i, report)
+            }
+        });
+        assert_eq!(r, Err("job 3".to_string()));
     }
 
     fn stats(mean: f64, max: f64) -> ErrorStats {
@@ -435,20 +742,22 @@ mod tests {
                 residual: Vector3::new(1e-4, 0.0, 0.0),
             })
             .collect();
-        let fit = |train: &[Sample]| {
+        let fit = |_: usize, train: &[Sample], _: &mut dyn FnMut(usize, f64) -> bool| {
             let (lo, hi) = train.iter().fold((f64::MAX, f64::MIN), |(a, b), s| {
                 (a.min(s.q[0]), b.max(s.q[0]))
             });
-            Ok::<_, ()>(Arc::new(Wild {
+            Ok::<_, String>(Arc::new(Wild {
                 lo,
                 hi,
                 r: Vector3::new(1e-4, 0.0, 0.0),
             }) as Arc<dyn Compensator>)
         };
         let mut rng = ChaCha8Rng::seed_from_u64(3);
-        let random = cross_validate(&samples, 5, 0, &mut rng, fit).unwrap();
+        let random =
+            cross_validate(&samples, 5, 0, &mut rng, jobs(2, &mut |_, _, _| true), fit).unwrap();
         let mut rng = ChaCha8Rng::seed_from_u64(3);
-        let blocked = cross_validate(&samples, 5, 4, &mut rng, fit).unwrap();
+        let blocked =
+            cross_validate(&samples, 5, 4, &mut rng, jobs(2, &mut |_, _, _| true), fit).unwrap();
         // Random folds: no held-out sample lies 0.2 rad beyond the others.
         assert!(random.compensated.mean_mm < 1e-9, "{random:?}");
         assert_eq!(blocked.blocked.len(), 4);

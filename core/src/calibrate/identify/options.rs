@@ -10,6 +10,7 @@ use super::joint_maps::JointMapSettings;
 use super::least_squares::LmSettings;
 pub use super::methods::Method;
 pub use super::progress::Progress;
+use crate::calibrate::compensate::select::Parallelism;
 use crate::calibrate::compensate::{
     GpSettings, IwoSettings, LmTrainSettings, MlpSpec, RbfSettings, TlboTrainSettings,
 };
@@ -88,6 +89,12 @@ pub struct CompensatorOptions {
     /// with the square of the poses, the Gaussian process's linearly (it takes
     /// every pose). 0: no limit.
     pub max_network_poses: usize,
+    /// Threads the trainings of one cross-validation (its folds and the
+    /// final training) run on; results do not depend on it. Set by the
+    /// caller (the service shares the cores among its calibration workers),
+    /// not by a request.
+    #[serde(skip)]
+    pub parallel: Parallelism,
 }
 
 impl Default for CompensatorOptions {
@@ -112,6 +119,7 @@ impl Default for CompensatorOptions {
             tlbo: TlboTrainSettings::default(),
             gp: GpSettings::default(),
             max_network_poses: 1000,
+            parallel: Parallelism::default(),
         }
     }
 }

@@ -34,7 +34,9 @@ use super::orientation_part::{note, train_orientation};
 use super::plan::Planner;
 use super::trained::{support_of, AppliedCompensator, Trained};
 use super::{Compensated, Method, MethodError, MethodFailure};
-use crate::calibrate::compensate::{cross_validate, train, Sample, TrainError};
+use crate::calibrate::compensate::select::{run_jobs, FoldPlan, Jobs};
+use crate::calibrate::compensate::{train, Sample, TrainError, TrainReport};
+use crate::model::calibrated::StoredCompensator;
 use crate::calibrate::identify::least_squares::Fit;
 use crate::calibrate::identify::network::Network;
 use crate::calibrate::identify::progress::Fold;
@@ -50,6 +52,7 @@ use crate::model::RobotModel;
 use nalgebra::Matrix3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use std::sync::{Arc, Mutex};
 
 /// Training samples of `data` on top of the fitted base (module docs).
 pub(crate) fn samples(
@@ -128,36 +131,65 @@ pub(crate) fn train_network(
         return Err(MethodFailure::NoTorqueToLearn.into());
     }
     let seed = ctx.opts.compensator.seed;
-    let cv = if folds > 0 {
-        let mut fold_rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(1));
-        let mut stage = 0usize;
-        let blocked = ctx.opts.compensator.blocked_folds;
-        let cv = cross_validate(&data, folds, blocked, &mut fold_rng, |part| {
-            let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(2 + stage as u64));
-            let s = stage;
-            stage += 1;
-            let (c, _) = train(&spec, part, &mut rng, &mut |e, l| progress(s, e, l))?;
-            Ok::<_, TrainError>(c.into_arc_supported(Some(support_of(part))))
-        })
-        .map_err(train_error)?;
-        Some(cv)
-    } else {
-        None
-    };
     let last = ctx.opts.compensator.cv_stages(folds) - 1;
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let (mut at_epoch, mut at_loss) = (0, 0.0);
-    let (stored, report) = train(&spec, &data, &mut rng, &mut |e, l| {
-        (at_epoch, at_loss) = (e, l);
-        progress(last, e, l)
-    })
+    // The folds' trainings and the final one run side by side; the final
+    // training is the last job and reports as the last stage.
+    let plan = (folds > 0).then(|| {
+        let mut fold_rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(1));
+        FoldPlan::draw(
+            &data,
+            folds,
+            ctx.opts.compensator.blocked_folds,
+            &mut fold_rng,
+        )
+    });
+    let cv_jobs = plan.as_ref().map_or(0, FoldPlan::trainings);
+    let at = Mutex::new((0usize, 0.0f64));
+    let outputs = run_jobs(
+        cv_jobs + 1,
+        Jobs {
+            parallel: ctx.opts.compensator.parallel,
+            progress: &mut |j, e, l| progress(if j < cv_jobs { j } else { last }, e, l),
+            cancelled: || TrainError::Cancelled,
+        },
+        |j, report| match &plan {
+            Some(plan) if j < cv_jobs => {
+                let part = plan.training_set(&data, j);
+                let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(2 + j as u64));
+                let (c, _) = train(&spec, &part, &mut rng, report)?;
+                Ok(JobOutput::Fold(
+                    c.into_arc_supported(Some(support_of(&part))),
+                ))
+            }
+            _ => {
+                let mut rng = ChaCha8Rng::seed_from_u64(seed);
+                let (stored, report) = train(&spec, &data, &mut rng, &mut |e, l| {
+                    *at.lock().unwrap_or_else(|p| p.into_inner()) = (e, l);
+                    report(e, l)
+                })?;
+                Ok(JobOutput::Final(Box::new((stored, report))))
+            }
+        },
+    )
     .map_err(train_error)?;
+    let mut fitted = Vec::with_capacity(cv_jobs);
+    let mut last_training = None;
+    for o in outputs {
+        match o {
+            JobOutput::Fold(c) => fitted.push(c),
+            JobOutput::Final(f) => last_training = Some(*f),
+        }
+    }
+    let cv = plan.map(|plan| plan.stats(&data, &fitted));
+    let (stored, report) = last_training.expect("the final training is the last job");
+    let (at_epoch, at_loss) = at.into_inner().unwrap_or_else(|p| p.into_inner());
     let (orientation, orientation_part) = train_orientation(
         &spec,
         &base.model,
         (&data, &turns),
         seed,
         folds,
+        ctx.opts.compensator.parallel,
         &mut || progress(last, at_epoch, at_loss),
     )?;
     Ok(Trained {
@@ -168,6 +200,13 @@ pub(crate) fn train_network(
         report,
         cv,
     })
+}
+
+/// What a job of [`train_network`] trained: a fold's compensator or the
+/// final one with its report.
+enum JobOutput {
+    Fold(Arc<dyn Compensator>),
+    Final(Box<(StoredCompensator, TrainReport)>),
 }
 
 /// `method`'s compensator `network` on the fit `base` and the training

@@ -31,6 +31,7 @@
 
 use super::trained::{support_of, AppliedCompensator, Trained};
 use super::{Base, MethodError};
+use crate::calibrate::compensate::select::{Jobs, Parallelism};
 use crate::calibrate::compensate::{
     cross_validate, train, CompensatorSpec, OrientationSamples, Sample, TrainError,
 };
@@ -60,6 +61,7 @@ pub(crate) fn train_orientation(
     (data, rotations): (&[Sample], &[Option<Matrix3<f64>>]),
     seed: u64,
     folds: usize,
+    parallel: Parallelism,
     cancel: &mut dyn FnMut() -> bool,
 ) -> Result<(Option<StoredOrientation>, OrientationPart), MethodError> {
     let samples = OrientationSamples::of(data, rotations);
@@ -107,7 +109,7 @@ pub(crate) fn train_orientation(
         }
     };
     let cv = if folds > 0 {
-        cross_validate_part(spec, &samples, folds, seed, cancel)?
+        cross_validate_part(spec, &samples, folds, seed, parallel, cancel)?
     } else {
         None
     };
@@ -140,16 +142,27 @@ fn cross_validate_part(
     samples: &[Sample],
     folds: usize,
     seed: u64,
+    parallel: Parallelism,
     cancel: &mut dyn FnMut() -> bool,
 ) -> Result<Option<OrientationCv>, MethodError> {
     let mut fold_rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(1));
-    let mut fold = 0u64;
-    let cv = cross_validate(samples, folds, 0, &mut fold_rng, |part| {
-        let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(600 + fold));
-        fold += 1;
-        let (c, _) = train(spec, part, &mut rng, &mut |_, _| cancel())?;
-        Ok::<_, TrainError>(c.into_arc_supported(Some(support_of(part))))
-    });
+    let jobs = Jobs {
+        parallel,
+        progress: &mut |_, _, _| cancel(),
+        cancelled: || TrainError::Cancelled,
+    };
+    let cv = cross_validate(
+        samples,
+        folds,
+        0,
+        &mut fold_rng,
+        jobs,
+        |fold, part, report| {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(600 + fold as u64));
+            let (c, _) = train(spec, part, &mut rng, report)?;
+            Ok::<_, TrainError>(c.into_arc_supported(Some(support_of(part))))
+        },
+    );
     match cv {
         Ok(cv) => Ok(Some(OrientationCv::of(&cv))),
         Err(TrainError::Cancelled) => Err(MethodError::Cancelled),
