@@ -495,6 +495,37 @@ def main():
         assert re.fullmatch(r"-?\d+\.\d{3}", x), f"x to 0.001 mm: {x}"
         shot("predicted", "predict-section")
 
+        # 7d. Fits: a work object from three tracker points (stored, listed
+        # with the version's base-frame pose), and a tool's TCP from the
+        # moved set's 20 readings (joints and the tracker's position of the
+        # reflector, the tool frame parallel to the flange's): stored.
+        form = driver.find_element(By.ID, "fit-frame")
+        fill(form, dict(name="fixture"))
+        form.find_element(By.NAME, "readings").send_keys(
+            "origin, 400, 0, 100\nx, 500, 0, 100\nxy, 400, 100, 100")
+        form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+        wait.until(replaced(form))
+        wait.until(EC.presence_of_element_located((By.ID, "fit-frame")))
+        msg = driver.find_element(By.ID, "message").text
+        assert msg.startswith("Fitted work object fixture on v"), msg
+        assert names("work-objects") == ["fixture", "table"], names("work-objects")
+        shot("work-object-fitted", "cell")
+        with open(moved) as f:
+            lines = [", ".join([r[f"joint_{j}"] for j in range(1, 7)]
+                               + [repr(float(r[f"{a}_t"]) + float(r[f"{a}_dif"])) for a in "xyz"])
+                     for r in csvmod.DictReader(f)]
+        form = driver.find_element(By.ID, "fit-tool")
+        fill(form, dict(name="probe", method="tracker_point", rpy="0, 0, 0"))
+        driver.execute_script("arguments[0].value = arguments[1]",
+                              form.find_element(By.NAME, "readings"), "\n".join(lines))
+        form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+        wait.until(lambda d: text_of(d, "#message") and (
+            text_of(d, "#message").startswith("Fitted tool probe") or "not fitted" in text_of(d, "#message")))
+        msg = driver.find_element(By.ID, "message").text
+        assert msg.startswith("Fitted tool probe on v"), msg
+        assert names("tools") == ["probe", "torch"], names("tools")
+        shot("tool-fitted", "cell")
+
         # 8. Filter the sample URScript program: the report lists its targets
         # and the filtered file is offered for download.
         program = ROOT / "examples/programs/urscript/seam.script"

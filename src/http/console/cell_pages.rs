@@ -1,7 +1,7 @@
 //! The console's cell sections of a robot page: its tools (with their
 //! loads) and work objects (list, add, edit in a form prefilled with every
-//! stored field, delete after a confirmation), the controller's data for
-//! them, and program filtering (drop program files in, see the per-target
+//! stored field, delete after a confirmation), their fits from readings,
+//! the controller's data for them, and program filtering (drop program files in, see the per-target
 //! report, download the filtered files and the report).
 
 use super::fields::model_select;
@@ -190,6 +190,7 @@ pub fn cell_section(id: i64, tools: &[CellItemRow], work_objects: &[CellItemRow]
             h3 { "Work objects" }
             div #work-objects { (items_table(id, Kind::WorkObject, work_objects)) }
             (item_form(id, Kind::WorkObject, None))
+            (fit_forms(id, tools))
             (export_form(id))
         }
     }
@@ -212,6 +213,44 @@ fn export_form(id: i64) -> Markup {
             p { a #export-download href="#" { "Download" } }
             pre #export-text {}
         }
+    }
+}
+
+/// Fit a tool's TCP or a work object from readings (`POST …/tools/{name}/fit`,
+/// `POST …/frames/{name}/fit`) on the calibrated version; the fitted item
+/// is stored (a refit keeps a tool's load and number).
+fn fit_forms(id: i64, tools: &[CellItemRow]) -> Markup {
+    html! {
+        h3 { "Fit a tool (TCP)" }
+        p.note { "One reading a line: the joints [°] (fixed point: the tip held at one point in 4 or more orientations), followed by the tracker's x, y, z [mm] for a reflector on the tool (tracker point)." }
+        form #fit-tool data-action="fit-tool" data-robot=(id) {
+            label { "Tool " input name="name" required pattern="[A-Za-z0-9_][A-Za-z0-9_.\\-]{0,63}" placeholder="torch"; }
+            label { "Method "
+                select name="method" {
+                    option value="fixed_point" { "fixed point (joints)" }
+                    option value="tracker_point" { "tracker point (joints, x, y, z)" }
+                }
+            }
+            label.wide { "Readings " textarea name="readings" rows="3" placeholder="10, -80, 95, -105, -90, 12" {} }
+            label title="The tool's orientation when the readings fit its position only; empty: the stored tool's, kept" { "rx, ry, rz [°] "
+                input name="rpy" placeholder="e.g. 0, 0, 0"; }
+            label.check { input type="checkbox" name="force" value="true"; " store even a fit judged implausible" }
+            button type="submit" { "Fit tool" }
+        }
+        h3 { "Fit a work object" }
+        p.note { "One point a line: origin, x (on its x axis) or xy (in its xy plane), then the tracker's x, y, z [mm], or the joints [°] when touched with a tool." }
+        form #fit-frame data-action="fit-frame" data-robot=(id) {
+            label { "Work object " input name="name" required pattern="[A-Za-z0-9_][A-Za-z0-9_.\\-]{0,63}" placeholder="table"; }
+            label { "Touched with "
+                select name="tool" {
+                    option value="" { "— (tracker points)" }
+                    @for t in tools { option value=(t.name) { (t.name) } }
+                }
+            }
+            label.wide { "Points " textarea name="readings" rows="3" placeholder="origin, 400, 0, 100" {} }
+            button type="submit" { "Fit work object" }
+        }
+        p #fit-result hidden {}
     }
 }
 

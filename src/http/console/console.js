@@ -530,3 +530,60 @@ handlers["iso-figures"] = async function (form) {
   document.getElementById("iso-result").hidden = false;
   show(`ISO 9283 figures of ${t.poses.length} poses and ${t.distances.length} distances`, true);
 };
+
+// Fits: the rows of a textarea as numbers (a leading word kept apart).
+function rows(text) {
+  const out = [];
+  for (const line of text.split(/\n/)) {
+    const parts = line.split(/[,;\s]+/).filter((p) => p);
+    if (!parts.length) continue;
+    const word = isNaN(Number(parts[0])) ? parts.shift() : null;
+    out.push({ word, values: parts.map(Number) });
+  }
+  return out;
+}
+
+// A fit's answer: stored (the page reloads with it), or why not (shown).
+function fitAnswer(r, what) {
+  const f = r.fit;
+  if (r.fitted || r.forced) {
+    const residual = f.rms_mm !== undefined ? `, residual rms ${fmtMm(f.rms_mm)} mm` : f.scatter_mm ? `, scatter ${f.scatter_mm.map(fmtMm).join(", ")} mm` : "";
+    flash(`Fitted ${what} on v${r.version}: ${f.xyz_mm.map(fmtMm).join(", ")} mm${residual}${r.forced ? " (forced: " + r.message + ")" : ""}`);
+    location.reload();
+    return;
+  }
+  const box = document.getElementById("fit-result");
+  box.textContent = `${what} not fitted (${r.reason}): ${r.message}`;
+  box.className = "bad";
+  box.hidden = false;
+  show(box.textContent, false);
+}
+
+handlers["fit-tool"] = async function (form) {
+  const method = formValue(form, "method");
+  const readings = rows(formValue(form, "readings")).map((r) =>
+    method === "tracker_point" ? { joints_deg: r.values.slice(0, -3), xyz_mm: r.values.slice(-3) } : { joints_deg: r.values });
+  if (!readings.length) throw new Error("give the readings, one a line");
+  const body = { method, readings };
+  const rpy = rows(formValue(form, "rpy"))[0];
+  if (rpy) {
+    if (rpy.values.length !== 3) throw new Error("the orientation is three angles: rx, ry, rz");
+    body.rpy_deg = rpy.values;
+  }
+  if (form.elements["force"].checked) body.force = true;
+  const name = formValue(form, "name");
+  const r = (await api("POST", `/v1/robots/${form.dataset.robot}/tools/${encodeURIComponent(name)}/fit`, JSON.stringify(body), "application/json")).json();
+  fitAnswer(r, "tool " + name);
+};
+
+handlers["fit-frame"] = async function (form) {
+  const tool = formValue(form, "tool");
+  const readings = rows(formValue(form, "readings")).map((r) =>
+    tool ? { point: r.word, joints_deg: r.values } : { point: r.word, xyz_mm: r.values });
+  if (!readings.length) throw new Error("give the points, one a line");
+  const body = { readings };
+  if (tool) body.tool = tool;
+  const name = formValue(form, "name");
+  const r = (await api("POST", `/v1/robots/${form.dataset.robot}/frames/${encodeURIComponent(name)}/fit`, JSON.stringify(body), "application/json")).json();
+  fitAnswer(r, "work object " + name);
+};
