@@ -3,8 +3,16 @@
 screenshot of each step:
 
   create robot -> upload measurements -> calibrate (live progress) -> report
-  -> versions (the best is active) -> solve a targets CSV into a CSV answer
-  -> tools and work objects (add, delete) -> filter a URScript program
+  -> versions (the best is active) -> a second calibration held at the test
+  gate and cancelled (confirmed) -> solve a targets CSV into a CSV answer
+  -> check, its page (per-pose errors, summary, frame shift, thresholds)
+  -> thresholds set -> a check on a rigidly shifted copy of the set says
+  `shifted` -> re-register from it -> activate the new version (confirmed)
+  -> check again -> tools and work objects with loads (add, edit in the
+  prefilled form and read back over the API, delete confirmed) ->
+  controller data -> predict -> filter a URScript program (files and report
+  downloaded) -> delete a set and a robot (confirmed) -> robot list with the
+  latest check's status
 
 against a real `robocal serve` with API keys on a temporary database, using
 Debian's Chromium and chromedriver through Selenium.
@@ -17,8 +25,10 @@ identification, the 20 random poses for validation). Exits non-zero on the
 first step that does not behave.
 """
 import argparse
+import csv as csvmod
 import os
 import pathlib
+import re
 import shutil
 import socket
 import subprocess
@@ -54,6 +64,39 @@ def replaced(element):
     return gone
 
 
+def text_of(driver, css):
+    """The text of the first element matching `css`, or None while the page
+    is reloading (the element left the document) or has none."""
+    try:
+        found = driver.find_elements(By.CSS_SELECTOR, css)
+        return found[0].text if found else None
+    except (StaleElementReferenceException, WebDriverException):
+        return None
+
+
+def api_get(base, path):
+    """GET a JSON resource over the API (not through the page)."""
+    import json
+    import urllib.request
+    req = urllib.request.Request(base + path, headers={"Authorization": f"Bearer {KEY}"})
+    with urllib.request.urlopen(req, timeout=30) as r:
+        return json.loads(r.read())
+
+
+def shifted_copy(src, dst, shift_mm):
+    """`src` with every measured position moved by `shift_mm` (a rigid
+    translation of the tracker frame): measured = target + dif, so the dif
+    columns move."""
+    with open(src) as f, open(dst, "w", newline="") as g:
+        rows = list(csvmod.DictReader(f))
+        out = csvmod.DictWriter(g, fieldnames=list(rows[0].keys()))
+        out.writeheader()
+        for r in rows:
+            for k, d in zip(("x_dif", "y_dif", "z_dif"), shift_mm):
+                r[k] = repr(float(r[k]) + d)
+            out.writerow(r)
+
+
 def free_port():
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
@@ -82,6 +125,8 @@ def main():
     args = ap.parse_args()
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    for old in out.glob("*.png"):
+        old.unlink()
     grid = DATA / "UR5/3D_UR5_uncalibrated_grid_cleaned.csv"
     random = DATA / "UR5/3D_UR5_uncalibrated_random_cleaned.csv"
     for f in (grid, random):
@@ -89,10 +134,15 @@ def main():
             raise SystemExit(f"data not found: {f} (set ROBOCAL_DATA_DIR)")
 
     work = tempfile.mkdtemp(prefix="robocal-console-")
+    # Calibrations wait while this file exists (the service's test gate):
+    # the cancel step holds one there instead of hoping it still runs.
+    gate = pathlib.Path(work) / "gate"
     port = free_port()
     base = f"http://127.0.0.1:{port}"
     env = dict(os.environ, DATABASE_URL=f"sqlite://{work}/console.db?mode=rwc",
-               ROBOCAL_API_KEYS=KEY, ROBOCAL_OPEN_READS="1", RUST_LOG="warn")
+               ROBOCAL_API_KEYS=KEY, ROBOCAL_OPEN_READS="1",
+               ROBOCAL_TEST_GATE_FILE=str(gate),
+               RUST_LOG="warn,robocal::service::gate=info")
     server = subprocess.Popen([args.robocal, "serve", "--bind", f"127.0.0.1:{port}"],
                               env=env, stdout=open(f"{work}/server.log", "w"),
                               stderr=subprocess.STDOUT)
@@ -103,6 +153,7 @@ def main():
         opts.add_argument(a)
     driver = None
     step = 0
+    shots = []
 
     def shot(name, section=None):
         nonlocal step
@@ -112,6 +163,7 @@ def main():
                 "arguments[0].scrollIntoView()", driver.find_element(By.ID, section))
         path = out / f"{step:02d}-{name}.png"
         driver.save_screenshot(str(path))
+        shots.append(path.name)
         print(f"console_check: step {step} {name}: ok ({path})")
 
     try:
@@ -181,9 +233,37 @@ def main():
         assert driver.find_elements(By.CSS_SELECTOR, "#versions tr.active"), "no active version"
         shot("versions", "versions")
 
+
+        # 5b. Cancel a running calibration: the test gate holds it (the
+        # server logs that it waits there), the Cancel button asks first (a
+        # dismissed question sends nothing), then the job ends `cancelled`.
+        gate.touch()
+        form = driver.find_element(By.ID, "calibrate")
+        for box in form.find_elements(By.NAME, "method"):
+            if box.is_selected() != (box.get_attribute("value") == "km"):
+                box.click()
+        form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+        wait.until(replaced(form))
+        log = pathlib.Path(work) / "server.log"
+        wait.until(lambda d: "work held at the test gate" in log.read_text())
+        wait.until(lambda d: text_of(d, "#calibrations tbody tr .status") == "running")
+        shot("calibration-held", "calibrations")
+        cancel = driver.find_element(By.CSS_SELECTOR, "#calibrations tbody tr button.cancel")
+        cancel.click()
+        alert = wait.until(EC.alert_is_present())
+        assert alert.text.startswith("Cancel calibration"), alert.text
+        alert.dismiss()
+        assert text_of(driver, "#calibrations tbody tr .status") == "running", "a dismissed cancel must not be sent"
+        cancel.click()
+        wait.until(EC.alert_is_present()).accept()
+        wait.until(lambda d: text_of(d, "#calibrations tbody tr .status") == "cancelled")
+        gate.unlink()
+        shot("calibration-cancelled", "calibrations")
+        statuses = [td.text for td in driver.find_elements(By.CSS_SELECTOR, "#calibrations tbody tr .status")]
+        assert statuses == ["cancelled", "succeeded"], statuses
+
         # 6. Solve: the first 10 nominal targets of the random set, position
         # only, with the active version; the CSV answer is shown and offered.
-        import csv as csvmod
         targets = pathlib.Path(work) / "targets.csv"
         with open(random) as f, open(targets, "w") as g:
             rows = list(csvmod.DictReader(f))[:10]
@@ -203,19 +283,38 @@ def main():
         shot("solved", "solve-section")
 
         # 6b. Is it still accurate? Check the active version on the random
-        # set: the status, the trend and the history show it; compare the
-        # versions on the same set; a roll back asks first (dismissed here).
-        form = driver.find_element(By.ID, "run-check")
-        Select(form.find_element(By.NAME, "set_id")).select_by_index(0)
-        form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
-        wait.until(replaced(form))
+        # set: the check's page shows the status with its sentence, the
+        # figures, the frame shift, the thresholds and every pose's error.
+        active_version = int(driver.find_element(
+            By.CSS_SELECTOR, "#versions tr.active td").text.split()[0][1:])
+        robot_id = int(robot_url.rstrip("/").split("/")[-1])
+
+        def run_check(set_id):
+            form = driver.find_element(By.ID, "run-check")
+            Select(form.find_element(By.NAME, "set_id")).select_by_value(str(set_id))
+            form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+            wait.until(EC.url_contains("/checks/"))
+            wait.until(EC.presence_of_element_located((By.ID, "check-summary")))
+
+        set_ids = [int(td.text) for td in driver.find_elements(By.CSS_SELECTOR, "#sets tbody tr td:first-child")]
+        random_set = set_ids[1]
+        run_check(random_set)
+        status = driver.find_element(By.CSS_SELECTOR, "#check-verdict .status-tag").text.split()[0]
+        assert status in ("ok", "degraded", "recalibrate", "shifted"), status
+        assert driver.find_element(By.ID, "check-summary").text, "no summary sentence"
+        poses = driver.find_elements(By.CSS_SELECTOR, "#check-poses tbody tr")
+        assert len(poses) == 20, f"expected the 20 poses' errors, the page lists {len(poses)}"
+        figures = driver.find_element(By.ID, "check-figures").text
+        assert "Frame shift" in figures and "degraded above 0.500 mm" in figures, figures
+        for number in re.findall(r"-?\d+\.\d+", figures + driver.find_element(By.ID, "check-poses").text):
+            assert len(number.split(".")[1]) in (1, 2, 3, 4), f"a number to too many decimals: {number}"
+            assert not re.fullmatch(r"-0\.0*", number), f"a negative zero: {number}"
+        shot("check-detail")
+        driver.find_element(By.LINK_TEXT, driver.find_element(By.CSS_SELECTOR, ".crumbs a + a").text).click()
         wait.until(EC.presence_of_element_located((By.ID, "check-trend")))
         rows = driver.find_elements(By.CSS_SELECTOR, "#checks tbody tr")
         assert len(rows) == 1, f"expected one check, the page lists {len(rows)}"
-        status = driver.find_element(By.CSS_SELECTOR, "#check-status .status-tag").text
-        # The tag's first word is the status (a shifted one adds the shift's size).
-        assert status.split()[0] in ("ok", "degraded", "recalibrate", "shifted"), status
-        assert len(driver.find_elements(By.CSS_SELECTOR, "#check-trend circle.check-point")) == 1
+        assert len(driver.find_elements(By.CSS_SELECTOR, "#check-trend .check-point")) == 1
         # Local times: the cell shows the browser's rendering, the UTC stamp stays in the title.
         cell = driver.find_element(By.CSS_SELECTOR, "#checks tbody tr time")
         assert cell.get_attribute("title") == cell.get_attribute("datetime"), cell.get_attribute("title")
@@ -234,37 +333,198 @@ def main():
         assert rollback.is_enabled(), "a dismissed roll back must not be sent"
         assert driver.find_elements(By.CSS_SELECTOR, "#versions tr.active"), "still an active version"
 
-        # 7. Tools and work objects: add a tool and a work object, add a
-        # spare tool and delete it again.
-        def save_item(form_id, name, number, xyz, rpy, frame=None):
-            form = driver.find_element(By.ID, form_id)
-            form.find_element(By.NAME, "name").send_keys(name)
-            form.find_element(By.NAME, "number").send_keys(str(number))
-            for k, v in zip(("x", "y", "z", "rx", "ry", "rz"), list(xyz) + list(rpy)):
+        # 6c. Thresholds: set tighter ones in the form; the page and the
+        # trend show them, and the API reads them back.
+        form = driver.find_element(By.ID, "check-thresholds-form")
+        for k, v in (("degraded_mm", "0.6"), ("recalibrate_mm", "1.2")):
+            box = form.find_element(By.NAME, k)
+            box.clear()
+            box.send_keys(v)
+        form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+        wait.until(replaced(form))
+        wait.until(EC.presence_of_element_located((By.ID, "thresholds-text")))
+        text = driver.find_element(By.ID, "thresholds-text").text
+        assert "degraded above 0.600 mm, recalibrate above 1.200 mm" in text, text
+        t = api_get(base, f"/v1/robots/{robot_id}/status")["thresholds"]
+        assert (t["degraded_mm"], t["recalibrate_mm"]) == (0.6, 1.2), t
+        assert len(driver.find_elements(By.CSS_SELECTOR, "#check-trend line.threshold")) == 2
+        shot("thresholds", "checks-section")
+
+        # 6d. The tracker moved: the same poses measured 2.5 mm off. A check
+        # says `shifted`, its page offers the re-registration; re-register
+        # (a new version, not yet active), activate it (asked first), check
+        # again: the shift is gone.
+        moved = pathlib.Path(work) / "moved.csv"
+        shifted_copy(random, moved, (1.5, -2.0, 0.0))
+        form = driver.find_element(By.ID, "upload")
+        form.find_element(By.NAME, "file").send_keys(str(moved))
+        Select(form.find_element(By.NAME, "role")).select_by_value("check")
+        form.find_element(By.NAME, "name").send_keys("after the move")
+        form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+        wait.until(replaced(form))
+        wait.until(lambda d: len(d.find_elements(By.CSS_SELECTOR, "#sets tbody tr")) == 3)
+        moved_set = max(int(td.text) for td in driver.find_elements(By.CSS_SELECTOR, "#sets tbody tr td:first-child"))
+        run_check(moved_set)
+        tag = driver.find_element(By.CSS_SELECTOR, "#check-verdict .status-tag").text
+        assert tag.startswith("shifted"), f"the moved set should say shifted: {tag}"
+        assert "explains the errors" in driver.find_element(By.ID, "check-frame-shift").text
+        assert driver.find_elements(By.CSS_SELECTOR, "section.alert #reregister"), "no re-register button"
+        shot("check-shifted")
+        driver.get(robot_url)
+        wait.until(EC.presence_of_element_located((By.ID, "shifted-action")))
+        shot("status-shifted", "checks-section")
+        driver.find_element(By.CSS_SELECTOR, "#shifted-action a").click()
+        wait.until(EC.presence_of_element_located((By.ID, "reregister")))
+        form = driver.find_element(By.ID, "reregister")
+        form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+        wait.until(EC.url_contains("#versions"))
+        wait.until(EC.presence_of_element_located((By.CSS_SELECTOR, "#versions .reregistered")))
+        msg = driver.find_element(By.ID, "message").text
+        assert msg.startswith("Re-registered as v"), msg
+        new_version = int(msg.split()[2].rstrip(":")[1:])
+        note = driver.find_element(By.CSS_SELECTOR, "#versions .reregistered").text
+        assert f"from v{active_version} on set {moved_set}" in note, note
+        assert int(driver.find_element(By.CSS_SELECTOR, "#versions tr.active td").text.split()[0][1:]) == active_version
+        shot("reregistered", "versions")
+        activate = driver.find_element(
+            By.CSS_SELECTOR, f"#versions button[data-post$='/versions/{new_version}/activate']")
+        activate.click()
+        alert = wait.until(EC.alert_is_present())
+        assert f"Activate v{new_version}" in alert.text, alert.text
+        alert.accept()
+        wait.until(replaced(activate))
+        wait.until(EC.presence_of_element_located((By.CSS_SELECTOR, "#versions tr.active")))
+        active = driver.find_element(By.CSS_SELECTOR, "#versions tr.active td").text.split()[0]
+        assert active == f"v{new_version}", active
+        shot("activated", "versions")
+        run_check(moved_set)
+        tag = driver.find_element(By.CSS_SELECTOR, "#check-verdict .status-tag").text
+        assert tag.split()[0] in ("ok", "degraded"), f"after re-registration: {tag}"
+        shot("check-after-reregister")
+        driver.get(robot_url)
+        wait.until(EC.presence_of_element_located((By.ID, "check-trend")))
+        assert len(driver.find_elements(By.CSS_SELECTOR, "#check-trend .check-point")) == 3
+        assert len(driver.find_elements(By.CSS_SELECTOR, "#check-trend .version-change")) == 1
+        shot("trend", "checks-section")
+
+        # 7. Tools and work objects: add a tool with its load and a work
+        # object, edit the tool in its prefilled form (only x changes) and
+        # read it back over the API: its number and load are kept. Add a
+        # spare tool and delete it, asked first (a dismissed question keeps it).
+        def fill(form, values):
+            for k, v in values.items():
                 box = form.find_element(By.NAME, k)
-                box.clear()
-                box.send_keys(str(v))
-            if frame:
-                Select(form.find_element(By.NAME, "frame")).select_by_value(frame)
+                if box.tag_name == "select":
+                    Select(box).select_by_value(v)
+                else:
+                    box.clear()
+                    box.send_keys(str(v))
+
+        def save_item(form_id, values):
+            form = driver.find_element(By.ID, form_id)
+            fill(form, values)
             form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
             wait.until(replaced(form))
-            wait.until(EC.presence_of_element_located((By.ID, form_id)))
+            wait.until(EC.presence_of_element_located((By.ID, "add-tool")))
 
         def names(table_id):
             return [td.text for td in driver.find_elements(By.CSS_SELECTOR, f"#{table_id} td.name")]
 
-        save_item("add-tool", "torch", 1, (125, 0, 216.5), (0, 30, 0))
-        save_item("add-tool", "spare", 2, (0, 0, 100), (0, 0, 0))
-        save_item("add-frame", "table", 1, (450, -100, 50), (0, 0, 20), "base")
+        save_item("add-tool", dict(name="torch", number=1, x=125, y=0, z=216.5, rx=0, ry=30, rz=0,
+                                   load_mass_kg=2.5, load_com_x=0, load_com_y=10, load_com_z=80,
+                                   load_frame="tool", load_ixx=0.01, load_iyy=0.02, load_izz=0.015))
+        save_item("add-tool", dict(name="spare", number=2, x=0, y=0, z=100))
+        save_item("add-frame", dict(name="table", number=1, frame="base", x=450, y=-100, z=50, rz=20))
         assert names("tools") == ["spare", "torch"], names("tools")
         assert names("work-objects") == ["table"], names("work-objects")
+        before = api_get(base, f"/v1/robots/{robot_id}/tools/torch")
+        assert before["load"]["mass_kg"] == 2.5 and before["number"] == 1, before
         shot("cell", "cell")
-        button = driver.find_element(
-            By.XPATH, "//div[@id='tools']//tr[td[@class='name' and text()='spare']]//button")
+        row = driver.find_element(By.CSS_SELECTOR, "#tools tr[data-item=torch]")
+        row.find_element(By.CSS_SELECTOR, "details.edit summary").click()
+        form = driver.find_element(By.ID, "edit-tools-torch")
+        assert form.find_element(By.NAME, "load_mass_kg").get_attribute("value") == "2.5"
+        assert form.find_element(By.NAME, "number").get_attribute("value") == "1"
+        shot("tool-edit", "cell")
+        save_item("edit-tools-torch", dict(x=126))
+        after = api_get(base, f"/v1/robots/{robot_id}/tools/torch")
+        expected = dict(before, xyz_mm=[126.0, 0.0, 216.5])
+        for k in ("name", "number", "xyz_mm", "rpy_deg", "load"):
+            assert after.get(k) == expected.get(k), f"re-saving the tool changed {k}: {before.get(k)} -> {after.get(k)}"
+        load_text = driver.find_element(By.CSS_SELECTOR, "#tools tr[data-item=torch] td.load").text
+        assert load_text.startswith("2.500 kg at 0.000, 10.000, 80.000 mm (tool)"), load_text
+        button = driver.find_element(By.CSS_SELECTOR, "#tools tr[data-item=spare] button[data-delete]")
         button.click()
+        alert = wait.until(EC.alert_is_present())
+        assert "Delete tool spare?" in alert.text, alert.text
+        alert.dismiss()
+        assert names("tools") == ["spare", "torch"], names("tools")
+        button.click()
+        wait.until(EC.alert_is_present()).accept()
         wait.until(replaced(button))
         wait.until(EC.presence_of_element_located((By.ID, "add-tool")))
         assert names("tools") == ["torch"], names("tools")
+
+        # 7b. The controller's data for the tools, loads and work objects.
+        form = driver.find_element(By.ID, "export-cell")
+        Select(form.find_element(By.NAME, "language")).select_by_value("krl")
+        form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+        wait.until(EC.visibility_of_element_located((By.ID, "export-result")))
+        text = driver.find_element(By.ID, "export-text").text
+        assert "TOOL_DATA[1]" in text and "LOAD_DATA[1]" in text and "BASE_DATA[1]" in text, text
+        downloaded = driver.execute_async_script(
+            "const done = arguments[0];"
+            "fetch(document.getElementById('export-download').href).then(r => r.text()).then(done);")
+        shown = driver.execute_script("return document.getElementById('export-text').textContent")
+        assert downloaded == shown, "the download differs from the data shown"
+        shot("controller-data", "cell")
+
+        # 7c. Predict the torch's pose from three readings of the random set.
+        with open(random) as f:
+            joints = [[r[f"joint_{j}"] for j in range(1, 7)] for r in list(csvmod.DictReader(f))[:3]]
+        form = driver.find_element(By.ID, "predict")
+        form.find_element(By.NAME, "readings").send_keys(
+            "\n".join(f"p{i + 1}, " + ", ".join(js) for i, js in enumerate(joints)))
+        Select(form.find_element(By.NAME, "tool")).select_by_value("torch")
+        form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+        wait.until(EC.visibility_of_element_located((By.ID, "predict-result")))
+        rows = driver.find_elements(By.CSS_SELECTOR, "#predict-table tbody tr")
+        assert [r.find_elements(By.TAG_NAME, "td")[1].text for r in rows] == ["ok"] * 3, \
+            [r.text for r in rows]
+        x = rows[0].find_elements(By.TAG_NAME, "td")[2].text
+        assert re.fullmatch(r"-?\d+\.\d{3}", x), f"x to 0.001 mm: {x}"
+        shot("predicted", "predict-section")
+
+        # 7d. Fits: a work object from three tracker points (stored, listed
+        # with the version's base-frame pose), and a tool's TCP from the
+        # moved set's 20 readings (joints and the tracker's position of the
+        # reflector, the tool frame parallel to the flange's): stored.
+        form = driver.find_element(By.ID, "fit-frame")
+        fill(form, dict(name="fixture"))
+        form.find_element(By.NAME, "readings").send_keys(
+            "origin, 400, 0, 100\nx, 500, 0, 100\nxy, 400, 100, 100")
+        form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+        wait.until(replaced(form))
+        wait.until(EC.presence_of_element_located((By.ID, "fit-frame")))
+        msg = driver.find_element(By.ID, "message").text
+        assert msg.startswith("Fitted work object fixture on v"), msg
+        assert names("work-objects") == ["fixture", "table"], names("work-objects")
+        shot("work-object-fitted", "cell")
+        with open(moved) as f:
+            lines = [", ".join([r[f"joint_{j}"] for j in range(1, 7)]
+                               + [repr(float(r[f"{a}_t"]) + float(r[f"{a}_dif"])) for a in "xyz"])
+                     for r in csvmod.DictReader(f)]
+        form = driver.find_element(By.ID, "fit-tool")
+        fill(form, dict(name="probe", method="tracker_point", rpy="0, 0, 0"))
+        driver.execute_script("arguments[0].value = arguments[1]",
+                              form.find_element(By.NAME, "readings"), "\n".join(lines))
+        form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+        wait.until(lambda d: text_of(d, "#message") and (
+            text_of(d, "#message").startswith("Fitted tool probe") or "not fitted" in text_of(d, "#message")))
+        msg = driver.find_element(By.ID, "message").text
+        assert msg.startswith("Fitted tool probe on v"), msg
+        assert names("tools") == ["probe", "torch"], names("tools")
+        shot("tool-fitted", "cell")
 
         # 8. Filter the sample URScript program: the report lists its targets
         # and the filtered file is offered for download.
@@ -274,7 +534,6 @@ def main():
         form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
         wait.until(EC.visibility_of_element_located((By.ID, "filter-result")))
         summary = driver.find_element(By.ID, "filter-summary").text
-        import re
         m = re.match(r"(\d+) targets filtered, (\d+) failed, (\d+) skipped", summary)
         assert m and int(m.group(1)) > 0, f"filter: {summary}"
         rows = driver.find_elements(By.CSS_SELECTOR, "#filter-report tbody tr")
@@ -288,10 +547,108 @@ def main():
         original = program.read_text()
         assert filtered != original and len(filtered.splitlines()) == len(original.splitlines()), \
             "the filtered program should differ in its target values only"
+        report = driver.execute_async_script(
+            "const done = arguments[0];"
+            "fetch(document.getElementById('filter-report-download').href).then(r => r.json()).then(done);")
+        assert len(report["targets"]) == len(rows), "the report download lists other targets"
         shot("filtered", "filter-section")
+
+        # 8b. A measurement plan: 12 poses in a box, a KRL program and the
+        # joints CSV to download, every identified parameter's predicted std.
+        form = driver.find_element(By.ID, "measurement-plan")
+        fill(form, dict(poses=12, candidates=200, max_angle_deg=180))
+        Select(form.find_element(By.NAME, "language")).select_by_value("krl")
+        form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+        wait.until(EC.visibility_of_element_located((By.ID, "plan-result")))
+        summary = driver.find_element(By.ID, "plan-summary").text
+        assert summary.startswith("12 poses chosen from 200 candidates"), summary
+        files = [a.text for a in driver.find_elements(By.CSS_SELECTOR, "#plan-downloads a.plan-file")]
+        assert files[0] == "plan-joints.csv" and any(f.endswith(".src") for f in files), files
+        joints_csv = driver.execute_async_script(
+            "const done = arguments[0];"
+            "fetch(document.querySelector('#plan-downloads a').href).then(r => r.text()).then(done);")
+        assert len(joints_csv.strip().splitlines()) == 13, joints_csv
+        assert driver.find_elements(By.CSS_SELECTOR, "#plan-params tr.plan-param"), "no predicted std"
+        shot("measurement-plan", "plan-section")
+
+        # 8c. ISO 9283: lay out the cube on the active version, measure five
+        # cycles (made here: each pose's commanded position plus offsets
+        # whose mean is (0.1, -0.05, 0) mm, so AP = 0.112 mm at every pose),
+        # the figures and the report.
+        form = driver.find_element(By.ID, "iso-plan")
+        Select(form.find_element(By.NAME, "language")).select_by_value("urscript")
+        fill(form, dict(cycles=5))
+        form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+        wait.until(EC.visibility_of_element_located((By.ID, "iso-plan-result")))
+        assert len(driver.find_elements(By.CSS_SELECTOR, "#iso-plan-poses tr.iso-pose")) == 5
+        plan_csv = driver.execute_script("return document.querySelector('#iso-figures [name=plan_csv]').value")
+        measured = pathlib.Path(work) / "iso-measured.csv"
+        with open(measured, "w") as g:
+            g.write("pose,cycle,x_mm,y_mm,z_mm\n")
+            for r in csvmod.DictReader(plan_csv.splitlines()):
+                for k in range(1, 6):
+                    x, y, z = (float(r[c]) for c in ("x_mm", "y_mm", "z_mm"))
+                    g.write(f"{r['pose']},{k},{x + 0.1 + 0.01 * (k - 3)!r},{y - 0.05!r},{z + 0.02 * (k - 3)!r}\n")
+        shot("iso-plan", "iso-section")
+        form = driver.find_element(By.ID, "iso-figures")
+        form.find_element(By.NAME, "measured_file").send_keys(str(measured))
+        form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+        wait.until(EC.visibility_of_element_located((By.ID, "iso-result")))
+        figures = driver.find_elements(By.CSS_SELECTOR, "#iso-poses tr.iso-figure")
+        aps = [r.find_elements(By.TAG_NAME, "td")[2].text for r in figures]
+        assert aps == ["0.112"] * 5, aps
+        assert len(driver.find_elements(By.CSS_SELECTOR, "#iso-distances tr.iso-distance")) == 10
+        report = driver.execute_async_script(
+            "const done = arguments[0];"
+            "fetch(document.getElementById('iso-report-download').href).then(r => r.text()).then(done);")
+        assert "<html" in report.lower() and "P1" in report, report[:200]
+        shot("iso-figures", "iso-section")
+
+        # 9. Delete a set (asked first): a spare upload of eight poses.
+        spare = pathlib.Path(work) / "spare.csv"
+        spare.write_text("".join(random.read_text().splitlines(keepends=True)[:9]))
+        form = driver.find_element(By.ID, "upload")
+        form.find_element(By.NAME, "file").send_keys(str(spare))
+        Select(form.find_element(By.NAME, "role")).select_by_value("check")
+        form.find_element(By.NAME, "name").send_keys("spare")
+        form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+        wait.until(replaced(form))
+        wait.until(lambda d: len(d.find_elements(By.CSS_SELECTOR, "#sets tbody tr")) == 4)
+        button = driver.find_elements(By.CSS_SELECTOR, "#sets tbody tr button[data-delete]")[-1]
+        button.click()
+        alert = wait.until(EC.alert_is_present())
+        assert "Delete set" in alert.text and "(spare)" in alert.text, alert.text
+        alert.accept()
+        wait.until(replaced(button))
+        wait.until(lambda d: len(d.find_elements(By.CSS_SELECTOR, "#sets tbody tr")) == 3)
+        shot("set-deleted", "sets")
+
+        # 10. The robot list shows each robot's latest check; a second robot
+        # is created and deleted from its page (asked first).
+        driver.get(f"{base}/ui")
+        cell = driver.find_element(By.CSS_SELECTOR, "#robots td.latest-check")
+        assert cell.text.split()[0] in ("ok", "degraded"), cell.text
+        form = driver.find_element(By.ID, "create-robot")
+        form.find_element(By.NAME, "name").send_keys("scratch")
+        form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+        wait.until(EC.presence_of_element_located((By.ID, "delete-robot")))
+        button = driver.find_element(By.ID, "delete-robot")
+        button.click()
+        alert = wait.until(EC.alert_is_present())
+        assert "Delete robot" in alert.text and "scratch" in alert.text, alert.text
+        alert.accept()
+        wait.until(EC.url_to_be(f"{base}/ui"))
+        wait.until(EC.presence_of_element_located((By.ID, "robots")))
+        assert [a.text for a in driver.find_elements(By.CSS_SELECTOR, "#robots tbody td a[href^='/ui/robots/']")] \
+            and "scratch" not in driver.find_element(By.ID, "robots").text
+        shot("robots-final")
 
         print(f"console_check: the whole flow passed; screenshots in {out}")
     finally:
+        # One page with every screenshot, for the CI run's artifacts.
+        (out / "index.html").write_text(
+            "<!doctype html><meta charset=utf-8><title>robocal console check</title>\n"
+            + "".join(f"<h2>{n}</h2><img src='{n}' width=1000>\n" for n in shots))
         if driver is not None:
             driver.quit()
         server.terminate()

@@ -1,16 +1,21 @@
 //! The console's "Is it still accurate?" section of a robot page: the status
 //! by the latest check, a trend plot of every check's mean error against
-//! time (thresholds drawn, version changes marked), the history, a form to
-//! run a check, and the comparison of versions on one set. Every status
-//! (`core::check::CheckStatus`) has its colour and its meaning (the legend);
-//! a `shifted` check shows the shift's size wherever it is shown.
+//! time (`super::trend`), the history (each check links to its page,
+//! `super::check_detail`), the thresholds and their form, a form to run a
+//! check, and the comparison of versions on one set. A latest check that says
+//! `shifted` offers the re-registration at once. Every status
+//! (`core::check::CheckStatus`) has its colour (`super::status`) and its
+//! meaning (the legend); a `shifted` check shows the shift's size wherever
+//! it is shown.
 
+use super::format::{mm, trimmed, MM_DECIMALS};
+use super::status::{shift_text, status_tag};
 use crate::records::CheckRow;
 use crate::records::SetRow;
 use crate::records::VersionRow;
-use crate::service::checks::{shift_of, status_of};
+use crate::service::checks::shift_of;
 use maud::{html, Markup};
-use robocal_core::check::{CheckStatus, CheckThresholds, ShiftSize};
+use robocal_core::check::{CheckStatus, CheckThresholds};
 
 /// Everything the section shows.
 pub struct ChecksView<'a> {
@@ -21,109 +26,6 @@ pub struct ChecksView<'a> {
     pub checks: &'a [CheckRow],
     pub sets: &'a [SetRow],
     pub versions: &'a [VersionRow],
-}
-
-/// The colour a status is drawn in: only `ok` is green.
-pub fn status_colour(s: CheckStatus) -> &'static str {
-    match s {
-        CheckStatus::Ok => "#1e7a3c",
-        CheckStatus::Degraded => "#b07d00",
-        CheckStatus::Recalibrate => "#b3261e",
-        CheckStatus::Shifted => "#7a3fb3",
-    }
-}
-
-/// The colour of a stored check's status (grey for a name not in the table).
-fn row_colour(c: &CheckRow) -> &'static str {
-    status_of(c).map_or("#5b6475", status_colour)
-}
-
-/// The style rules of the statuses (part of the console's one style sheet,
-/// whose hash the page's `Content-Security-Policy` names): a tag's
-/// background, a table cell's text.
-pub fn status_css() -> String {
-    CheckStatus::ALL
-        .iter()
-        .map(|s| {
-            let (name, colour) = (s.name(), status_colour(*s));
-            format!(".status-tag.{name} {{ background: {colour}; }} .status-{name} {{ color: {colour}; font-weight: 600; }}\n")
-        })
-        .collect()
-}
-
-/// `13.127 mm, 0.2636°`.
-fn shift_text(s: &ShiftSize) -> String {
-    format!("{:.3} mm, {:.4}°", s.translation_mm, s.rotation_deg)
-}
-
-/// A status as a coloured tag, with the shift's size when shifted.
-fn status_tag(s: CheckStatus, shift: Option<&ShiftSize>) -> Markup {
-    html! {
-        span class={ "status-tag " (s.name()) } title=(s.meaning()) {
-            (s.name())
-            @if let Some(f) = shift { " " (shift_text(f)) }
-        }
-    }
-}
-
-/// Plot size [px].
-const W: f64 = 640.0;
-const H: f64 = 200.0;
-const PAD: f64 = 36.0;
-
-/// The trend of the checks' mean errors as inline SVG: one point per check in
-/// order (x: check number, labelled by date), a dashed line per threshold,
-/// and a vertical mark where the version scored changes.
-fn trend(checks: &[CheckRow], t: &CheckThresholds) -> Markup {
-    let top = checks
-        .iter()
-        .map(|c| c.mean_mm)
-        .filter(|m| m.is_finite())
-        .fold(t.recalibrate_mm * 1.25, f64::max);
-    let n = checks.len().max(2) as f64;
-    let x = |i: usize| PAD + (W - 2.0 * PAD) * i as f64 / (n - 1.0);
-    let y = |mm: f64| H - PAD - (H - 2.0 * PAD) * (mm.clamp(0.0, top) / top);
-    let points: String = checks
-        .iter()
-        .enumerate()
-        .map(|(i, c)| format!("{:.1},{:.1}", x(i), y(c.mean_mm)))
-        .collect::<Vec<_>>()
-        .join(" ");
-    html! {
-        svg #check-trend width=(W) height=(H) viewBox={ "0 0 " (W) " " (H) } role="img"
-            aria-label="mean position error of every check against time" {
-            line x1=(PAD) y1=(H - PAD) x2=(W - PAD) y2=(H - PAD) stroke="#5b6475" {}
-            line x1=(PAD) y1=(PAD) x2=(PAD) y2=(H - PAD) stroke="#5b6475" {}
-            text x="4" y=(PAD - 8.0) font-size="11" fill="#5b6475" { "mean [mm]" }
-            text x="4" y=(H - PAD + 4.0) font-size="11" fill="#5b6475" { "0" }
-            @for (mm, name, colour) in [(t.degraded_mm, "degraded", "#b07d00"), (t.recalibrate_mm, "recalibrate", "#b3261e")] {
-                line x1=(PAD) y1=(y(mm)) x2=(W - PAD) y2=(y(mm)) stroke=(colour) stroke-dasharray="5 4" {
-                    title { (name) }
-                }
-                text x=(W - PAD + 2.0) y=(y(mm) + 4.0) font-size="10" fill=(colour) { (format!("{mm}")) }
-            }
-            @for (i, c) in checks.iter().enumerate() {
-                @if i > 0 && checks[i - 1].version != c.version {
-                    line.version-change x1=(x(i) - 0.5 * (x(i) - x(i - 1))) y1=(PAD) x2=(x(i) - 0.5 * (x(i) - x(i - 1))) y2=(H - PAD)
-                        stroke="#1f5fbf" stroke-dasharray="2 3" {}
-                    text x=(x(i) - 0.5 * (x(i) - x(i - 1)) + 2.0) y=(PAD - 4.0) font-size="10" fill="#1f5fbf" { "v" (c.version) }
-                }
-            }
-            @if checks.len() > 1 {
-                polyline points=(points) fill="none" stroke="#1d2330" stroke-width="1.5" {}
-            }
-            @for (i, c) in checks.iter().enumerate() {
-                circle.check-point cx=(format!("{:.1}", x(i))) cy=(format!("{:.1}", y(c.mean_mm))) r="4"
-                    fill=(row_colour(c)) data-status=(c.status) {
-                    title {
-                        (c.created_at) ": " (format!("{:.4}", c.mean_mm)) " mm, " (c.status)
-                        @if let Some(f) = shift_of(c) { " by a frame shift of " (shift_text(&f)) }
-                        ", v" (c.version)
-                    }
-                }
-            }
-        }
-    }
 }
 
 fn set_options(sets: &[SetRow]) -> Markup {
@@ -149,7 +51,13 @@ pub fn checks_section(v: &ChecksView) -> Markup {
                     }
                     None => { span.note { "no check yet" } }
                 }
-                span.note { " · degraded above " (v.thresholds.degraded_mm) " mm, recalibrate above " (v.thresholds.recalibrate_mm) " mm mean" }
+                span.note #thresholds-text { " · degraded above " (mm(v.thresholds.degraded_mm)) " mm, recalibrate above " (mm(v.thresholds.recalibrate_mm)) " mm mean" }
+            }
+            @if let (Some(CheckStatus::Shifted), Some(last)) = (v.status, v.checks.last()) {
+                p #shifted-action {
+                    "The latest check says the frame moved: "
+                    a.button href={ "/ui/robots/" (id) "/checks/" (last.id) "#reregister-section" } { "Re-register from check " (last.id) }
+                }
             }
             dl #check-statuses {
                 @for s in CheckStatus::ALL {
@@ -160,25 +68,26 @@ pub fn checks_section(v: &ChecksView) -> Markup {
             @if v.checks.is_empty() {
                 p.empty { "No check yet: score a fresh measurement set against a version below." }
             } @else {
-                (trend(v.checks, v.thresholds))
+                (super::trend::trend(v.checks, v.thresholds))
                 table #checks {
                     thead { tr { th { "Check" } th { "Time" } th { "Version" } th { "Set" } th { "Mean [mm]" } th { "Status" } th { "Frame shift" } th { "Temperature [°C]" } } }
                     tbody {
                         @for c in v.checks.iter().rev() {
                             tr {
-                                td { (c.id) }
+                                td { a.check-link href={ "/ui/robots/" (id) "/checks/" (c.id) } { "check " (c.id) } }
                                 td { time datetime=(c.created_at) { (c.created_at) } }
                                 td { "v" (c.version) }
                                 td { @if let Some(s) = c.set_id { (s) } @else { "—" } }
-                                td { (format!("{:.4}", c.mean_mm)) }
+                                td { (mm(c.mean_mm)) }
                                 td class={ "check-status status-" (c.status) } { (c.status) }
                                 td.check-shift { @if let Some(f) = shift_of(c) { (shift_text(&f)) } @else { "—" } }
-                                td { @if let Some(t) = c.temperature_c { (t) } @else { "—" } }
+                                td { @if let Some(t) = c.temperature_c { (super::format::fixed(t, 1)) } @else { "—" } }
                             }
                         }
                     }
                 }
             }
+            (thresholds_form(id, v.thresholds))
             @if v.sets.is_empty() || v.versions.is_empty() {
                 p.note { "A check needs a calibrated version and a measurement set." }
             } @else {
@@ -209,6 +118,19 @@ pub fn checks_section(v: &ChecksView) -> Markup {
                     tbody {}
                 }
             }
+        }
+    }
+}
+
+/// The form that sets the robot's thresholds, prefilled with those in force.
+fn thresholds_form(id: i64, t: &CheckThresholds) -> Markup {
+    html! {
+        form #check-thresholds-form data-action="thresholds" data-robot=(id) {
+            label { "Degraded above [mm] " input name="degraded_mm" type="number" step="any" min="0" value=(trimmed(t.degraded_mm, MM_DECIMALS)); }
+            label { "Recalibrate above [mm] " input name="recalibrate_mm" type="number" step="any" min="0" value=(trimmed(t.recalibrate_mm, MM_DECIMALS)); }
+            label title="A frame shift explains the errors when the mean after removing it is at most this fraction of the mean" { "Frame-shift ratio "
+                input name="frame_shift_ratio" type="number" step="any" min="0" max="1" value=(t.frame_shift_ratio); }
+            button type="submit" { "Set thresholds" }
         }
     }
 }

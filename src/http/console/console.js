@@ -12,6 +12,19 @@ function show(msg, ok) {
   box.hidden = false;
 }
 
+// A message for the next page (the page reloads after most changes).
+function flash(msg) { sessionStorage.setItem("robocal-flash", msg); }
+
+// Numbers as the pages write them (format.rs): mm to 0.001, degrees to
+// 0.0001, never "-0".
+function fixed(x, d) {
+  if (x === null || x === undefined || !isFinite(x)) return "—";
+  const s = Number(x).toFixed(d);
+  return /^-[0.]*$/.test(s) ? s.slice(1) : s;
+}
+const fmtMm = (x) => fixed(x, 3);
+const fmtDeg = (x) => fixed(x, 4);
+
 async function api(method, url, body, contentType, accept) {
   const headers = {};
   if (apiKey()) headers["Authorization"] = "Bearer " + apiKey();
@@ -102,8 +115,9 @@ const handlers = {
     if (version) body.version = Number(version);
     const temperature = formValue(form, "temperature_c");
     if (temperature) body.temperature_c = Number(temperature);
-    await api("POST", `/v1/robots/${robot}/checks`, JSON.stringify(body), "application/json");
-    location.reload();
+    const c = (await api("POST", `/v1/robots/${robot}/checks`, JSON.stringify(body), "application/json")).json();
+    flash(`Check ${c.id}: ${c.status}`);
+    location.href = `/ui/robots/${robot}/checks/${c.id}`;
   },
   async compare(form) {
     const robot = form.dataset.robot;
@@ -118,9 +132,9 @@ const handlers = {
       const p = v.result.position;
       const o = v.result.orientation;
       const f = v.result.frame_shift;
-      const shift = f ? `${f.translation_mm.toFixed(3)} mm, ${f.rotation_deg.toFixed(4)}°` : "—";
-      const cells = ["v" + v.version, v.method, p.mean_mm.toFixed(4), p.p95_mm.toFixed(4), p.max_mm.toFixed(4),
-        o ? o.mean_deg.toFixed(4) : "—", v.result.status, shift, f ? (f.explains ? "yes" : "no") : "—"];
+      const shift = f ? `${fmtMm(f.translation_mm)} mm, ${fmtDeg(f.rotation_deg)}°` : "—";
+      const cells = ["v" + v.version, v.method, fmtMm(p.mean_mm), fmtMm(p.p95_mm), fmtMm(p.max_mm),
+        o ? fmtDeg(o.mean_deg) : "—", v.result.status, shift, f ? (f.explains ? "yes" : "no") : "—"];
       const tr = document.createElement("tr");
       tr.className = "compared";
       for (const [i, c] of cells.entries()) {
@@ -156,11 +170,12 @@ document.addEventListener("click", async (ev) => {
   const b = ev.target.closest("button[data-post]");
   if (!b) return;
   ev.preventDefault();
-  // Activating and rolling back change what every solve uses: asked first.
+  // Activating, rolling back and cancelling are asked first.
   if (b.dataset.confirm && !window.confirm(b.dataset.confirm)) return;
   b.disabled = true;
   try {
     await api("POST", b.dataset.post);
+    flash(b.dataset.done || b.textContent.trim() + ": done");
     location.reload();
   } catch (e) {
     show(e.message, false);
@@ -170,6 +185,11 @@ document.addEventListener("click", async (ev) => {
 
 // The key form stores the key in this tab only.
 document.addEventListener("DOMContentLoaded", () => {
+  const said = sessionStorage.getItem("robocal-flash");
+  if (said) {
+    sessionStorage.removeItem("robocal-flash");
+    show(said, true);
+  }
   // Times as the browser's local time (the server writes UTC).
   for (const t of document.querySelectorAll("time[datetime]")) {
     const d = new Date(t.dateTime);
@@ -229,7 +249,8 @@ function percentText(p) {
   return p.eta_s == null ? pct : pct + " · " + timeLeft(p.eta_s) + " left";
 }
 
-// Tools and work objects: save one (PUT by name), delete one.
+// Tools and work objects: save one (PUT by name) with every field of its
+// form (number, frame, pose, load), delete one after a confirmation.
 handlers["put-item"] = async function (form) {
   const num = (k) => Number(formValue(form, k) || "0");
   const body = {
@@ -240,8 +261,23 @@ handlers["put-item"] = async function (form) {
   if (n) body.number = Number(n);
   const frame = formValue(form, "frame");
   if (frame) body.frame = frame;
-  const url = form.dataset.url + encodeURIComponent(formValue(form, "name"));
+  const mass = formValue(form, "load_mass_kg");
+  if (mass) {
+    body.load = {
+      mass_kg: Number(mass),
+      com_mm: [num("load_com_x"), num("load_com_y"), num("load_com_z")],
+      frame: formValue(form, "load_frame") || "flange",
+    };
+    const inertia = ["load_ixx", "load_iyy", "load_izz"].map((k) => formValue(form, k));
+    if (inertia.some((v) => v)) {
+      if (!inertia.every((v) => v)) throw new Error("give all three moments of inertia, or none");
+      body.load.inertia_kgm2 = inertia.map(Number);
+    }
+  }
+  const name = formValue(form, "name");
+  const url = form.dataset.url + encodeURIComponent(name);
   await api("PUT", url, JSON.stringify(body), "application/json");
+  flash(`Saved ${name}`);
   location.reload();
 };
 
@@ -249,15 +285,95 @@ document.addEventListener("click", async (ev) => {
   const b = ev.target.closest("button[data-delete]");
   if (!b) return;
   ev.preventDefault();
+  if (b.dataset.confirm && !window.confirm(b.dataset.confirm)) return;
   b.disabled = true;
   try {
     await api("DELETE", b.dataset.delete);
-    location.reload();
+    flash("Deleted");
+    if (b.dataset.then) location.href = b.dataset.then; else location.reload();
   } catch (e) {
     show(e.message, false);
     b.disabled = false;
   }
 });
+
+// Check thresholds: the form gives both levels, the API takes the degraded
+// level and the margin up to the recalibrate level.
+handlers.thresholds = async function (form) {
+  const degraded = Number(formValue(form, "degraded_mm"));
+  const recalibrate = Number(formValue(form, "recalibrate_mm"));
+  if (!(recalibrate >= degraded)) throw new Error("the recalibrate level must be at least the degraded level");
+  const body = { degraded_mm: degraded, margin_mm: Number((recalibrate - degraded).toFixed(9)) };
+  const ratio = formValue(form, "frame_shift_ratio");
+  if (ratio) body.frame_shift_ratio = Number(ratio);
+  await api("PUT", `/v1/robots/${form.dataset.robot}/check-thresholds`, JSON.stringify(body), "application/json");
+  flash("Thresholds set");
+  location.reload();
+};
+
+// Re-register a version on a check's set; the new version is listed on the
+// robot page (activated only when asked).
+handlers.reregister = async function (form) {
+  const robot = form.dataset.robot;
+  const body = { set_id: Number(formValue(form, "set_id")), version: Number(formValue(form, "version")) };
+  if (form.elements["activate"].checked) body.activate = true;
+  const v = (await api("POST", `/v1/robots/${robot}/reregister`, JSON.stringify(body), "application/json")).json();
+  const r = v.stats.reregistered.report;
+  flash(`Re-registered as v${v.version}${v.active ? " (active)" : ""}: mean ${fmtMm(r.before.mean_mm)} → ${fmtMm(r.after.mean_mm)} mm on set ${body.set_id}`);
+  location.href = `/ui/robots/${robot}#versions`;
+};
+
+// The controller's tool, load and work object data, shown and offered.
+handlers["export-cell"] = async function (form) {
+  const language = formValue(form, "language");
+  const r = (await api("POST", `/v1/robots/${form.dataset.robot}/cell/export`, JSON.stringify({ language }), "application/json")).json();
+  document.getElementById("export-text").textContent = r.text;
+  const link = document.getElementById("export-download");
+  link.href = URL.createObjectURL(new Blob([r.text], { type: "text/plain" }));
+  link.download = { krl: "config.dat", rapid: "cell.mod", fanuc: "cell.ls", urscript: "cell.script" }[language];
+  link.textContent = "Download " + link.download;
+  document.getElementById("export-result").hidden = false;
+  show(`Controller data for ${language} (model: ${r.version === null ? "nominal" : "v" + r.version})`, true);
+};
+
+// Predict: joint readings in, poses out.
+handlers.predict = async function (form) {
+  const readings = [];
+  for (const line of formValue(form, "readings").split(/\n/)) {
+    const parts = line.split(/[,;\s]+/).filter((p) => p);
+    if (!parts.length) continue;
+    const reading = {};
+    if (isNaN(Number(parts[0]))) reading.id = parts.shift();
+    reading.joints_deg = parts.map(Number);
+    readings.push(reading);
+  }
+  if (!readings.length) throw new Error("give at least one joint reading");
+  const body = { readings, frame: formValue(form, "frame") };
+  const version = formValue(form, "version");
+  if (version) body.version = /^[0-9]+$/.test(version) ? Number(version) : version;
+  const tool = formValue(form, "tool");
+  if (tool) body.tool = tool;
+  const r = (await api("POST", `/v1/robots/${form.dataset.robot}/predict`, JSON.stringify(body), "application/json")).json();
+  const tbody = document.querySelector("#predict-table tbody");
+  tbody.textContent = "";
+  for (const p of r.results) {
+    const note = [p.message, p.warning, p.outside_limits.length ? "outside limits: joints " + p.outside_limits.join(", ") : ""].filter((x) => x).join("; ");
+    const cells = [p.id, p.status, fmtMm(p.x), fmtMm(p.y), fmtMm(p.z), fmtDeg(p.rx), fmtDeg(p.ry), fmtDeg(p.rz), note];
+    const tr = document.createElement("tr");
+    tr.className = "predicted";
+    for (const c of cells) {
+      const td = document.createElement("td");
+      td.textContent = String(c);
+      tr.append(td);
+    }
+    tbody.append(tr);
+  }
+  const acc = r.accuracy && r.accuracy.mean_mm !== undefined ? `; expected error ${fmtMm(r.accuracy.mean_mm)} mm mean` : "";
+  const summary = `${r.results.length} poses of ${r.tool || "the measured point"} in the ${r.frame} frame (model: ${r.version === null ? "nominal" : "v" + r.version} ${r.method})${acc}`;
+  document.getElementById("predict-summary").textContent = summary;
+  document.getElementById("predict-result").hidden = false;
+  show(summary, true);
+};
 
 // Program filtering: the files in, the report as a table, each filtered file
 // as a download link.
@@ -294,7 +410,7 @@ handlers.filter = async function (form) {
   for (const t of rep.targets) {
     const tr = document.createElement("tr");
     tr.className = "target " + t.status;
-    const cells = [t.motion.file, t.motion.line, `${t.motion.instruction} ${t.name}`, t.status, t.shift_mm === undefined ? "" : t.shift_mm.toFixed(3), t.configuration || "", t.reason || ""];
+    const cells = [t.motion.file, t.motion.line, `${t.motion.instruction} ${t.name}`, t.status, t.shift_mm === undefined ? "" : fmtMm(t.shift_mm), t.configuration || "", t.reason || ""];
     for (const c of cells) {
       const td = document.createElement("td");
       td.textContent = String(c);
@@ -302,6 +418,172 @@ handlers.filter = async function (form) {
     }
     tbody.append(tr);
   }
+  const report = document.getElementById("filter-report-download");
+  report.href = URL.createObjectURL(new Blob([JSON.stringify(rep, null, 2)], { type: "application/json" }));
   document.getElementById("filter-result").hidden = false;
   show(summary, true);
+};
+
+// A file a response holds, as a download link in `box`.
+function downloadLink(box, name, text, className) {
+  const a = document.createElement("a");
+  a.href = URL.createObjectURL(new Blob([text], { type: "text/plain" }));
+  a.download = name;
+  a.className = className;
+  a.textContent = name;
+  box.append(a, " ");
+}
+
+// A row of cells (text only) appended to `tbody`.
+function appendRow(tbody, cells, className) {
+  const tr = document.createElement("tr");
+  if (className) tr.className = className;
+  for (const c of cells) {
+    const td = document.createElement("td");
+    td.textContent = String(c);
+    tr.append(td);
+  }
+  tbody.append(tr);
+}
+
+const triple = (form, prefix) => ["x", "y", "z"].map((a) => Number(formValue(form, `${prefix}_${a}`)));
+
+// A measurement plan: the poses, the parameters' predicted standard
+// deviations, the joints CSV and the program.
+handlers["measurement-plan"] = async function (form) {
+  const body = {
+    poses: Number(formValue(form, "poses")),
+    candidates: Number(formValue(form, "candidates")),
+    workspace: { min_mm: triple(form, "min"), max_mm: triple(form, "max") },
+    tracker: { position_mm: triple(form, "tracker"), max_angle_deg: Number(formValue(form, "max_angle_deg")) },
+    noise_mm: Number(formValue(form, "noise_mm")),
+    seed: Number(formValue(form, "seed")),
+  };
+  const language = formValue(form, "language");
+  if (language) body.language = language;
+  const r = (await api("POST", `/v1/robots/${form.dataset.robot}/measurement-plans`, JSON.stringify(body), "application/json")).json();
+  const c = r.counts;
+  const summary = `${r.poses} poses chosen from ${c.drawn} candidates (${c.reachable} reachable, ${c.in_box} in the box, ${c.in_sight} in sight)`;
+  document.getElementById("plan-summary").textContent = summary;
+  const links = document.getElementById("plan-downloads");
+  links.textContent = "Download: ";
+  downloadLink(links, "plan-joints.csv", r.joints_csv, "plan-file");
+  if (r.program) for (const f of r.program.files) downloadLink(links, f.name, f.content, "plan-file");
+  const tbody = document.querySelector("#plan-params tbody");
+  tbody.textContent = "";
+  for (const m of r.predicted) {
+    for (const p of m.params) {
+      const std = p.unit === "mm" ? fmtMm(p.std) : p.unit === "deg" ? fmtDeg(p.std) : Number(p.std).toPrecision(3);
+      appendRow(tbody, [m.method, p.name, std, p.unit], "plan-param");
+    }
+    if (m.not_identified.length) appendRow(tbody, [m.method, "not identified: " + m.not_identified.join(", "), "", ""]);
+  }
+  document.getElementById("plan-result").hidden = false;
+  show(summary, true);
+};
+
+// ISO 9283: the cube, its plan CSV (also put into the figures form) and its program.
+handlers["iso-plan"] = async function (form) {
+  const body = { min_mm: triple(form, "min"), max_mm: triple(form, "max"), commands: formValue(form, "commands") };
+  const language = formValue(form, "language");
+  if (language) {
+    body.language = language;
+    body.cycles = Number(formValue(form, "cycles"));
+  }
+  const r = (await api("POST", `/v1/robots/${form.dataset.robot}/iso9283/plan`, JSON.stringify(body), "application/json")).json();
+  const summary = `Cube of ${fmtMm(r.edge_mm)} mm edge (the box holds ${fmtMm(r.largest_edge_mm)} mm) centred at ${r.centre_mm.map(fmtMm).join(", ")} mm, v${r.version} ${r.commands} commands`;
+  document.getElementById("iso-plan-summary").textContent = summary;
+  const links = document.getElementById("iso-plan-downloads");
+  links.textContent = "Download: ";
+  downloadLink(links, "iso9283-plan.csv", r.plan_csv, "iso-file");
+  if (r.program) for (const f of r.program.files) downloadLink(links, f.name, f.content, "iso-file");
+  const tbody = document.querySelector("#iso-plan-poses tbody");
+  tbody.textContent = "";
+  for (const p of r.poses) {
+    appendRow(tbody, [p.name, p.commanded_mm.map(fmtMm).join(", "), p.commanded_abc_deg.map(fmtDeg).join(", "), p.joints_deg.map(fmtDeg).join(", ")], "iso-pose");
+  }
+  document.querySelector("#iso-figures [name=plan_csv]").value = r.plan_csv;
+  document.getElementById("iso-plan-result").hidden = false;
+  show(summary, true);
+};
+
+// ISO 9283 figures from the plan CSV and the measured cycles, and the report page.
+handlers["iso-figures"] = async function (form) {
+  const measured = await fileOrText(form, "measured_file", "measured_csv");
+  if (!measured) throw new Error("choose the measured cycles CSV or paste it");
+  const body = JSON.stringify({ tests: [{ label: formValue(form, "label") || "test", plan_csv: formValue(form, "plan_csv"), measured_csv: measured }] });
+  const r = (await api("POST", "/v1/iso9283/csv", body, "application/json")).json();
+  const report = await api("POST", "/v1/iso9283/csv", body, "application/json", "text/html");
+  document.getElementById("iso-report-download").href = URL.createObjectURL(new Blob([report.text], { type: "text/html" }));
+  const t = r.tests[0];
+  const figure = (f, value) => (f.outcome === "computed" ? value(f) : "— " + f.message);
+  const poses = document.querySelector("#iso-poses tbody");
+  poses.textContent = "";
+  for (const p of t.poses) {
+    appendRow(poses, [p.pose, p.cycles, figure(p.ap, (f) => fmtMm(f.ap_mm)), figure(p.ap, (f) => f.ap_xyz_mm.map(fmtMm).join(", ")), figure(p.rp, (f) => fmtMm(f.rp_mm))], "iso-figure");
+  }
+  const distances = document.querySelector("#iso-distances tbody");
+  distances.textContent = "";
+  for (const d of t.distances) {
+    appendRow(distances, [`${d.from}–${d.to}`, figure(d.ad, (f) => fmtMm(f.ad_mm)), figure(d.rd, (f) => fmtMm(f.rd_mm))], "iso-distance");
+  }
+  document.getElementById("iso-result").hidden = false;
+  show(`ISO 9283 figures of ${t.poses.length} poses and ${t.distances.length} distances`, true);
+};
+
+// Fits: the rows of a textarea as numbers (a leading word kept apart).
+function rows(text) {
+  const out = [];
+  for (const line of text.split(/\n/)) {
+    const parts = line.split(/[,;\s]+/).filter((p) => p);
+    if (!parts.length) continue;
+    const word = isNaN(Number(parts[0])) ? parts.shift() : null;
+    out.push({ word, values: parts.map(Number) });
+  }
+  return out;
+}
+
+// A fit's answer: stored (the page reloads with it), or why not (shown).
+function fitAnswer(r, what) {
+  const f = r.fit;
+  if (r.fitted || r.forced) {
+    const residual = f.rms_mm !== undefined ? `, residual rms ${fmtMm(f.rms_mm)} mm` : f.scatter_mm ? `, scatter ${f.scatter_mm.map(fmtMm).join(", ")} mm` : "";
+    flash(`Fitted ${what} on v${r.version}: ${f.xyz_mm.map(fmtMm).join(", ")} mm${residual}${r.forced ? " (forced: " + r.message + ")" : ""}`);
+    location.reload();
+    return;
+  }
+  const box = document.getElementById("fit-result");
+  box.textContent = `${what} not fitted (${r.reason}): ${r.message}`;
+  box.className = "bad";
+  box.hidden = false;
+  show(box.textContent, false);
+}
+
+handlers["fit-tool"] = async function (form) {
+  const method = formValue(form, "method");
+  const readings = rows(formValue(form, "readings")).map((r) =>
+    method === "tracker_point" ? { joints_deg: r.values.slice(0, -3), xyz_mm: r.values.slice(-3) } : { joints_deg: r.values });
+  if (!readings.length) throw new Error("give the readings, one a line");
+  const body = { method, readings };
+  const rpy = rows(formValue(form, "rpy"))[0];
+  if (rpy) {
+    if (rpy.values.length !== 3) throw new Error("the orientation is three angles: rx, ry, rz");
+    body.rpy_deg = rpy.values;
+  }
+  if (form.elements["force"].checked) body.force = true;
+  const name = formValue(form, "name");
+  const r = (await api("POST", `/v1/robots/${form.dataset.robot}/tools/${encodeURIComponent(name)}/fit`, JSON.stringify(body), "application/json")).json();
+  fitAnswer(r, "tool " + name);
+};
+
+handlers["fit-frame"] = async function (form) {
+  const tool = formValue(form, "tool");
+  const readings = rows(formValue(form, "readings")).map((r) =>
+    tool ? { point: r.word, joints_deg: r.values } : { point: r.word, xyz_mm: r.values });
+  if (!readings.length) throw new Error("give the points, one a line");
+  const body = { readings };
+  if (tool) body.tool = tool;
+  const name = formValue(form, "name");
+  const r = (await api("POST", `/v1/robots/${form.dataset.robot}/frames/${encodeURIComponent(name)}/fit`, JSON.stringify(body), "application/json")).json();
+  fitAnswer(r, "work object " + name);
 };

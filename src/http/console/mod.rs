@@ -10,7 +10,8 @@
 //! same API keys, limits and validation as any client. No external assets:
 //! the style sheet and the script are inlined.
 //!
-//! Routes: `GET /ui` (robots), `GET /ui/robots/{id}` (one robot). They are
+//! Routes: `GET /ui` (robots), `GET /ui/robots/{id}` (one robot),
+//! `GET /ui/robots/{id}/checks/{cid}` (one check, with its re-registration). They are
 //! HTML, not part of the JSON API, so `openapi.yaml` does not list them. Like
 //! every GET they need a `read` key when keys are configured, unless the
 //! service runs with open reads (a browser does not send a bearer key when it
@@ -18,9 +19,14 @@
 //! [`pages::content_security_policy`]) and `X-Frame-Options: DENY`.
 
 mod cell_pages;
+mod check_detail;
 mod check_pages;
 mod fields;
+mod format;
 mod pages;
+mod plan_pages;
+mod status;
+mod trend;
 
 use super::{route, ApiError, ApiPath, AppState, Route};
 use crate::records::CellKind;
@@ -41,13 +47,23 @@ pub fn routes() -> Vec<Route> {
     vec![
         route(Method::GET, "/ui", robots_page),
         route(Method::GET, "/ui/robots/{id}", robot_page),
+        route(Method::GET, "/ui/robots/{id}/checks/{cid}", check_page),
     ]
 }
 
 async fn robots_page(State(state): State<AppState>) -> Result<Response, ApiError> {
     let listing = service::robots::page(&state, ROBOTS_SHOWN, 0).await?;
     let keys = !state.config().api_keys.is_empty();
-    Ok(page(pages::robots(&listing.rows, listing.total, keys)))
+    let mut latest = Vec::with_capacity(listing.rows.len());
+    for r in &listing.rows {
+        latest.push(service::checks::status(&state, r.id).await?.1);
+    }
+    Ok(page(pages::robots(
+        &listing.rows,
+        &latest,
+        listing.total,
+        keys,
+    )))
 }
 
 async fn robot_page(
@@ -73,6 +89,31 @@ async fn robot_page(
         robot,
     };
     Ok(page(pages::robot(&view)))
+}
+
+/// Checks read per page while looking one up.
+const CHECKS_PAGE: i64 = 1000;
+
+async fn check_page(
+    State(state): State<AppState>,
+    ApiPath((id, cid)): ApiPath<(i64, i64)>,
+) -> Result<Response, ApiError> {
+    let robot = service::robots::get(&state, id).await?;
+    let mut offset = 0;
+    loop {
+        let listing = service::checks::page(&state, id, CHECKS_PAGE, offset).await?;
+        if let Some(c) = listing.rows.iter().find(|c| c.id == cid) {
+            let keys = !state.config().api_keys.is_empty();
+            return Ok(page(check_detail::check_page(&robot, c, keys)));
+        }
+        offset += CHECKS_PAGE;
+        if listing.rows.is_empty() || offset >= listing.total {
+            return Err(service::ServiceError::NotFound(format!(
+                "check {cid} of robot {id} not found"
+            ))
+            .into());
+        }
+    }
 }
 
 /// An HTML page with the console's security headers.

@@ -2,6 +2,7 @@
 //! HTML-escaped by maud).
 
 use super::fields::model_select;
+use super::format::{kg, mm};
 use crate::calibrate::identify::progress::time_left;
 use crate::calibrate::identify::Method;
 use crate::http::calibrations::DEFAULT_METHODS;
@@ -9,21 +10,23 @@ use crate::measure::convention::MeasuredOrientation;
 use crate::measure::SetRole;
 use crate::model::presets::PRESETS;
 use crate::records::CellItemRow;
+use crate::records::CheckRow;
 use crate::records::RobotRow;
 use crate::records::SetRow;
 use crate::records::VersionRow;
 use crate::records::{CalibrationRow, JobStatus, ProgressDetail};
 use crate::report::page_head;
+use crate::service::checks::{shift_of, status_of};
 use maud::{html, Markup, PreEscaped, DOCTYPE};
 
 const SCRIPT: &str = include_str!("console.js");
 const STYLE_SHEET: &str = include_str!("console.css");
 
 /// The console's one style sheet: `console.css` and the statuses' rules
-/// (`check_pages::status_css`).
+/// (`status::status_css`).
 fn style() -> &'static str {
     static STYLE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
-    STYLE.get_or_init(|| format!("{STYLE_SHEET}{}", super::check_pages::status_css()))
+    STYLE.get_or_init(|| format!("{STYLE_SHEET}{}", super::status::status_css()))
 }
 
 /// The `Content-Security-Policy` of every console page: everything from this
@@ -71,7 +74,7 @@ pub struct RobotView {
     pub checks: Vec<crate::records::CheckRow>,
 }
 
-fn layout(title: &str, keys: bool, body: Markup) -> Markup {
+pub(super) fn layout(title: &str, keys: bool, body: Markup) -> Markup {
     html! {
         (DOCTYPE)
         html lang="en" {
@@ -101,8 +104,9 @@ fn layout(title: &str, keys: bool, body: Markup) -> Markup {
     }
 }
 
-/// The start page: robots and a form to add one.
-pub fn robots(robots: &[RobotRow], total: i64, keys: bool) -> Markup {
+/// The start page: robots (each with its latest check's status) and a form
+/// to add one. `latest[i]` is the latest check of `robots[i]`.
+pub fn robots(robots: &[RobotRow], latest: &[Option<CheckRow>], total: i64, keys: bool) -> Markup {
     layout(
         "Robots",
         keys,
@@ -112,15 +116,24 @@ pub fn robots(robots: &[RobotRow], total: i64, keys: bool) -> Markup {
                 p.empty { "No robot yet: add one below." }
             } @else {
                 table #robots {
-                    thead { tr { th { "Id" } th { "Name" } th { "Model" } th { "Axes" } th { "Active version" } th { "Created" } } }
+                    thead { tr { th { "Id" } th { "Name" } th { "Model" } th { "Axes" } th { "Active version" } th { "Latest check" } th { "Created" } } }
                     tbody {
-                        @for r in robots {
+                        @for (r, last) in robots.iter().zip(latest.iter().chain(std::iter::repeat(&None))) {
                             tr {
                                 td { (r.id) }
                                 td { a href={ "/ui/robots/" (r.id) } { (r.name) } }
                                 td { (r.preset.as_deref().unwrap_or("custom model")) }
                                 td { (r.dof) }
                                 td { @match r.active_version { Some(v) => { "v" (v) }, None => { "nominal" } } }
+                                td.latest-check {
+                                    @match last.as_ref().and_then(|c| status_of(c).map(|s| (c, s))) {
+                                        Some((c, s)) => {
+                                            a href={ "/ui/robots/" (r.id) "/checks/" (c.id) } { (super::status::status_tag(s, shift_of(c).as_ref())) }
+                                            " " span.note { (mm(c.mean_mm)) " mm · " time datetime=(c.created_at) { (c.created_at) } }
+                                        }
+                                        None => { span.note { "no check yet" } }
+                                    }
+                                }
                                 td { time datetime=(r.created_at) { (r.created_at) } }
                             }
                         }
@@ -157,6 +170,24 @@ fn validation_mean(v: &VersionRow) -> Option<f64> {
     v.stats.0.get("validation")?.get("mean_mm")?.as_f64()
 }
 
+/// `re-registered from v2 on set 4 (2.104 → 0.215 mm)` for a version a
+/// re-registration made.
+fn reregistered_note(v: &VersionRow) -> Markup {
+    let r = &v.stats.0["reregistered"];
+    let (Some(from), Some(set)) = (r["from_version"].as_i64(), r["set_id"].as_i64()) else {
+        return html! {};
+    };
+    let mean = |k: &str| {
+        r["report"][k]["mean_mm"]
+            .as_f64()
+            .map_or_else(|| "—".into(), mm)
+    };
+    html! {
+        br;
+        span.note.reregistered { "re-registered from v" (from) " on set " (set) " (" (mean("before")) " → " (mean("after")) " mm)" }
+    }
+}
+
 /// One robot: sets, calibrations, versions.
 pub fn robot(v: &RobotView) -> Markup {
     let r = &v.robot;
@@ -179,7 +210,9 @@ pub fn robot(v: &RobotView) -> Markup {
                 versions: &v.versions,
             }))
             (super::cell_pages::cell_section(id, &v.tools, &v.work_objects))
+            (super::cell_pages::predict_section(id, &v.versions, &v.tools))
             (super::cell_pages::filter_section(id, &v.versions))
+            (super::plan_pages::plan_sections(id))
         },
     )
 }
@@ -192,6 +225,9 @@ fn robot_heading(r: &RobotRow) -> Markup {
         p.note {
             "Robot " (r.id) " · " (r.preset.as_deref().unwrap_or("custom model")) " · " (r.dof) " axes · "
             @match r.active_version { Some(a) => { "active model version " (a) }, None => { "no calibrated version yet (solves use the nominal model)" } }
+            " "
+            button.small.danger #delete-robot data-delete={ "/v1/robots/" (r.id) } data-then="/ui"
+                data-confirm={ "Delete robot " (r.id) " (" (r.name) ") with all its measurement sets, calibrations, versions, checks, tools and work objects? This cannot be undone." } { "Delete robot" }
         }
     }
 }
@@ -211,9 +247,13 @@ fn sets_section(id: i64, sets: &[SetRow]) -> Markup {
                             tr {
                                 td { (s.id) } td { (s.name) } td { (SetRole::from(s.role).as_str()) } td { (s.session) }
                                 td { (s.row_count) }
-                                td { @if let Some(p) = s.payload_kg { (p) } @else { "—" } }
+                                td { @if let Some(p) = s.payload_kg { (kg(p)) } @else { "—" } }
                                 td { time datetime=(s.created_at) { (s.created_at) } }
-                                td { a href={ "/v1/robots/" (id) "/measurement-sets/" (s.id) "/original" } { "original" } }
+                                td {
+                                    a href={ "/v1/robots/" (id) "/measurement-sets/" (s.id) "/original" } { "original" } " "
+                                    button.small.danger data-delete={ "/v1/robots/" (id) "/measurement-sets/" (s.id) }
+                                        data-confirm={ "Delete set " (s.id) " (" (s.name) ")? A set a model version or a pending calibration uses is kept." } { "Delete" }
+                                }
                             }
                         }
                     }
@@ -329,7 +369,7 @@ fn calibration_row(id: i64, c: &CalibrationRow) -> Markup {
                 (c.best_method.as_deref().unwrap_or("—"))
                 @if let Some(sum) = &c.summary {
                     br;
-                    span.note { (format!("{:.4} mm mean on {} (nominal {:.3})", sum.0.mean_mm, sum.0.judged_on, sum.0.nominal_mean_mm)) }
+                    span.note { (mm(sum.0.mean_mm)) " mm mean on " (sum.0.judged_on) " (nominal " (mm(sum.0.nominal_mean_mm)) ")" }
                     @if !sum.0.warnings.is_empty() || !sum.0.failed_methods.is_empty() {
                         br;
                         span.bad title=(sum.0.warnings.iter().chain(&sum.0.failed_methods).cloned().collect::<Vec<_>>().join("\n")) {
@@ -344,7 +384,8 @@ fn calibration_row(id: i64, c: &CalibrationRow) -> Markup {
                     a href={ (url) "/report" } { "report" } " · "
                     a href={ (url) "/result" } { "result" }
                 } @else if job_active(c.status) {
-                    button.small data-post={ (url) "/cancel" } { "Cancel" }
+                    button.small.cancel data-post={ (url) "/cancel" }
+                        data-confirm={ "Cancel calibration " (c.id) "? Its work so far is dropped." } { "Cancel" }
                 } @else if let Some(e) = &c.error {
                     span.bad { (e) }
                 }
@@ -399,9 +440,9 @@ fn versions_section(id: i64, versions: &[VersionRow]) -> Markup {
                         @for ver in versions.iter().rev() {
                             tr.active[ver.active] {
                                 td { "v" (ver.version) @if ver.active { " " span.tag { "active" } } }
-                                td { (ver.method) }
+                                td { (ver.method) (reregistered_note(ver)) }
                                 td { @if let Some(c) = ver.calibration_id { (c) } @else { "—" } }
-                                td { @if let Some(m) = validation_mean(ver) { (format!("{m:.4}")) } @else { "—" } }
+                                td { @if let Some(m) = validation_mean(ver) { (mm(m)) } @else { "—" } }
                                 td { time datetime=(ver.created_at) { (ver.created_at) } }
                                 td {
                                     a href={ "/v1/robots/" (id) "/versions/" (ver.version) "/model.json" } { "model.json" }
