@@ -91,6 +91,7 @@ const KNOWN_LOOPS: &[&[&str]] = &[
         "http/cell_fit",
         "http/checks",
         "http/console",
+        "http/console/check_detail",
         "http/console/pages",
         "http/iso9283",
         "http/iso9283_plan",

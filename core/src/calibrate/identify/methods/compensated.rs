@@ -36,7 +36,6 @@ use super::trained::{support_of, AppliedCompensator, Trained};
 use super::{Compensated, Method, MethodError, MethodFailure};
 use crate::calibrate::compensate::select::{run_jobs, FoldPlan, Jobs};
 use crate::calibrate::compensate::{train, Sample, TrainError, TrainReport};
-use crate::model::calibrated::StoredCompensator;
 use crate::calibrate::identify::least_squares::Fit;
 use crate::calibrate::identify::network::Network;
 use crate::calibrate::identify::progress::Fold;
@@ -46,6 +45,7 @@ use crate::calibrate::identify::report::{
 };
 use crate::measure::Measurement;
 use crate::model::calibrated::Compensator;
+use crate::model::calibrated::StoredCompensator;
 use crate::model::kinematics::{chain, gravity_torques_of};
 use crate::model::pose::Pose;
 use crate::model::RobotModel;
