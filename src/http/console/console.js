@@ -40,6 +40,9 @@ async function api(method, url, body, contentType, accept) {
   return { text, json: () => JSON.parse(text), type: res.headers.get("Content-Type") || "", headers: res.headers };
 }
 
+// `body` as JSON to `url`.
+const sendJson = (method, url, body) => api(method, url, JSON.stringify(body), "application/json");
+
 function formValue(form, name) {
   const el = form.elements[name];
   return el ? el.value.trim() : "";
@@ -56,7 +59,7 @@ const handlers = {
     const body = { name: formValue(form, "name") || undefined };
     const model = formValue(form, "model");
     if (model) body.model = JSON.parse(model); else body.preset = formValue(form, "preset");
-    const r = await api("POST", "/v1/robots", JSON.stringify(body), "application/json");
+    const r = await sendJson("POST", "/v1/robots", body);
     location.href = "/ui/robots/" + r.json().id;
   },
   async upload(form) {
@@ -105,7 +108,7 @@ const handlers = {
       const ids = [...form.querySelectorAll(`input[name=${role}_set]:checked`)].map((c) => Number(c.value));
       if (ids.length) body[role + "_set_ids"] = ids;
     }
-    await api("POST", `/v1/robots/${robot}/calibrations`, JSON.stringify(body), "application/json");
+    await sendJson("POST", `/v1/robots/${robot}/calibrations`, body);
     location.reload();
   },
   async check(form) {
@@ -115,7 +118,7 @@ const handlers = {
     if (version) body.version = Number(version);
     const temperature = formValue(form, "temperature_c");
     if (temperature) body.temperature_c = Number(temperature);
-    const c = (await api("POST", `/v1/robots/${robot}/checks`, JSON.stringify(body), "application/json")).json();
+    const c = (await sendJson("POST", `/v1/robots/${robot}/checks`, body)).json();
     flash(`Check ${c.id}: ${c.status}`);
     location.href = `/ui/robots/${robot}/checks/${c.id}`;
   },
@@ -124,7 +127,7 @@ const handlers = {
     const versions = [...form.querySelectorAll("input[name=version]:checked")].map((c) => Number(c.value));
     if (!versions.length) throw new Error("tick at least one version");
     const body = { set_id: Number(formValue(form, "set_id")), versions };
-    const r = (await api("POST", `/v1/robots/${robot}/compare`, JSON.stringify(body), "application/json")).json();
+    const r = (await sendJson("POST", `/v1/robots/${robot}/compare`, body)).json();
     const table = document.getElementById("compare-result");
     const tbody = table.querySelector("tbody");
     tbody.textContent = "";
@@ -276,7 +279,7 @@ handlers["put-item"] = async function (form) {
   }
   const name = formValue(form, "name");
   const url = form.dataset.url + encodeURIComponent(name);
-  await api("PUT", url, JSON.stringify(body), "application/json");
+  await sendJson("PUT", url, body);
   flash(`Saved ${name}`);
   location.reload();
 };
@@ -306,7 +309,7 @@ handlers.thresholds = async function (form) {
   const body = { degraded_mm: degraded, margin_mm: Number((recalibrate - degraded).toFixed(9)) };
   const ratio = formValue(form, "frame_shift_ratio");
   if (ratio) body.frame_shift_ratio = Number(ratio);
-  await api("PUT", `/v1/robots/${form.dataset.robot}/check-thresholds`, JSON.stringify(body), "application/json");
+  await sendJson("PUT", `/v1/robots/${form.dataset.robot}/check-thresholds`, body);
   flash("Thresholds set");
   location.reload();
 };
@@ -317,7 +320,7 @@ handlers.reregister = async function (form) {
   const robot = form.dataset.robot;
   const body = { set_id: Number(formValue(form, "set_id")), version: Number(formValue(form, "version")) };
   if (form.elements["activate"].checked) body.activate = true;
-  const v = (await api("POST", `/v1/robots/${robot}/reregister`, JSON.stringify(body), "application/json")).json();
+  const v = (await sendJson("POST", `/v1/robots/${robot}/reregister`, body)).json();
   const r = v.stats.reregistered.report;
   flash(`Re-registered as v${v.version}${v.active ? " (active)" : ""}: mean ${fmtMm(r.before.mean_mm)} → ${fmtMm(r.after.mean_mm)} mm on set ${body.set_id}`);
   location.href = `/ui/robots/${robot}#versions`;
@@ -353,7 +356,7 @@ handlers.predict = async function (form) {
   if (version) body.version = /^[0-9]+$/.test(version) ? Number(version) : version;
   const tool = formValue(form, "tool");
   if (tool) body.tool = tool;
-  const r = (await api("POST", `/v1/robots/${form.dataset.robot}/predict`, JSON.stringify(body), "application/json")).json();
+  const r = (await sendJson("POST", `/v1/robots/${form.dataset.robot}/predict`, body)).json();
   const tbody = document.querySelector("#predict-table tbody");
   tbody.textContent = "";
   for (const p of r.results) {
@@ -391,32 +394,18 @@ handlers.filter = async function (form) {
   const ext = files[0].name.split(".").pop().toLowerCase();
   body.language = formValue(form, "language") || byExtension[ext];
   if (!body.language) throw new Error("choose the program's language");
-  const r = (await api("POST", `/v1/robots/${robot}/programs/filter`, JSON.stringify(body), "application/json")).json();
+  const r = (await sendJson("POST", `/v1/robots/${robot}/programs/filter`, body)).json();
   const rep = r.report;
   const summary = `${rep.filtered} targets filtered, ${rep.failed} failed, ${rep.skipped} skipped; ${rep.joint_motions.length} joint motions (model: ${r.version === null ? "nominal" : "v" + r.version} ${r.method})`;
   document.getElementById("filter-summary").textContent = summary;
   const links = document.getElementById("filter-downloads");
   links.textContent = "Download: ";
-  for (const f of r.files) {
-    const a = document.createElement("a");
-    a.href = URL.createObjectURL(new Blob([f.content], { type: "text/plain" }));
-    a.download = f.name;
-    a.className = "filtered-file";
-    a.textContent = f.name;
-    links.append(a, " ");
-  }
+  for (const f of r.files) downloadLink(links, f.name, f.content, "filtered-file");
   const tbody = document.querySelector("#filter-report tbody");
   tbody.textContent = "";
   for (const t of rep.targets) {
-    const tr = document.createElement("tr");
-    tr.className = "target " + t.status;
     const cells = [t.motion.file, t.motion.line, `${t.motion.instruction} ${t.name}`, t.status, t.shift_mm === undefined ? "" : fmtMm(t.shift_mm), t.configuration || "", t.reason || ""];
-    for (const c of cells) {
-      const td = document.createElement("td");
-      td.textContent = String(c);
-      tr.append(td);
-    }
-    tbody.append(tr);
+    appendRow(tbody, cells, "target " + t.status);
   }
   const report = document.getElementById("filter-report-download");
   report.href = URL.createObjectURL(new Blob([JSON.stringify(rep, null, 2)], { type: "application/json" }));
@@ -446,6 +435,14 @@ function appendRow(tbody, cells, className) {
   tbody.append(tr);
 }
 
+// A plan's CSV and its program's files (if it has one) as download links in the box `id`.
+function planDownloads(id, csvName, csv, program, className) {
+  const links = document.getElementById(id);
+  links.textContent = "Download: ";
+  downloadLink(links, csvName, csv, className);
+  if (program) for (const f of program.files) downloadLink(links, f.name, f.content, className);
+}
+
 const triple = (form, prefix) => ["x", "y", "z"].map((a) => Number(formValue(form, `${prefix}_${a}`)));
 
 // A measurement plan: the poses, the parameters' predicted standard
@@ -461,14 +458,11 @@ handlers["measurement-plan"] = async function (form) {
   };
   const language = formValue(form, "language");
   if (language) body.language = language;
-  const r = (await api("POST", `/v1/robots/${form.dataset.robot}/measurement-plans`, JSON.stringify(body), "application/json")).json();
+  const r = (await sendJson("POST", `/v1/robots/${form.dataset.robot}/measurement-plans`, body)).json();
   const c = r.counts;
   const summary = `${r.poses} poses chosen from ${c.drawn} candidates (${c.reachable} reachable, ${c.in_box} in the box, ${c.in_sight} in sight)`;
   document.getElementById("plan-summary").textContent = summary;
-  const links = document.getElementById("plan-downloads");
-  links.textContent = "Download: ";
-  downloadLink(links, "plan-joints.csv", r.joints_csv, "plan-file");
-  if (r.program) for (const f of r.program.files) downloadLink(links, f.name, f.content, "plan-file");
+  planDownloads("plan-downloads", "plan-joints.csv", r.joints_csv, r.program, "plan-file");
   const tbody = document.querySelector("#plan-params tbody");
   tbody.textContent = "";
   for (const m of r.predicted) {
@@ -490,13 +484,10 @@ handlers["iso-plan"] = async function (form) {
     body.language = language;
     body.cycles = Number(formValue(form, "cycles"));
   }
-  const r = (await api("POST", `/v1/robots/${form.dataset.robot}/iso9283/plan`, JSON.stringify(body), "application/json")).json();
+  const r = (await sendJson("POST", `/v1/robots/${form.dataset.robot}/iso9283/plan`, body)).json();
   const summary = `Cube of ${fmtMm(r.edge_mm)} mm edge (the box holds ${fmtMm(r.largest_edge_mm)} mm) centred at ${r.centre_mm.map(fmtMm).join(", ")} mm, v${r.version} ${r.commands} commands`;
   document.getElementById("iso-plan-summary").textContent = summary;
-  const links = document.getElementById("iso-plan-downloads");
-  links.textContent = "Download: ";
-  downloadLink(links, "iso9283-plan.csv", r.plan_csv, "iso-file");
-  if (r.program) for (const f of r.program.files) downloadLink(links, f.name, f.content, "iso-file");
+  planDownloads("iso-plan-downloads", "iso9283-plan.csv", r.plan_csv, r.program, "iso-file");
   const tbody = document.querySelector("#iso-plan-poses tbody");
   tbody.textContent = "";
   for (const p of r.poses) {
@@ -572,7 +563,7 @@ handlers["fit-tool"] = async function (form) {
   }
   if (form.elements["force"].checked) body.force = true;
   const name = formValue(form, "name");
-  const r = (await api("POST", `/v1/robots/${form.dataset.robot}/tools/${encodeURIComponent(name)}/fit`, JSON.stringify(body), "application/json")).json();
+  const r = (await sendJson("POST", `/v1/robots/${form.dataset.robot}/tools/${encodeURIComponent(name)}/fit`, body)).json();
   fitAnswer(r, "tool " + name);
 };
 
@@ -584,6 +575,6 @@ handlers["fit-frame"] = async function (form) {
   const body = { readings };
   if (tool) body.tool = tool;
   const name = formValue(form, "name");
-  const r = (await api("POST", `/v1/robots/${form.dataset.robot}/frames/${encodeURIComponent(name)}/fit`, JSON.stringify(body), "application/json")).json();
+  const r = (await sendJson("POST", `/v1/robots/${form.dataset.robot}/frames/${encodeURIComponent(name)}/fit`, body)).json();
   fitAnswer(r, "work object " + name);
 };
