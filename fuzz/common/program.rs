@@ -4,7 +4,7 @@
 //! program that parses filters (on the nominal model, no tool or work object
 //! in the cell) without panicking.
 use robocal::solve::cell::Cell;
-use robocal::calibrate::compensate::CompensatedModel;
+use robocal::model::calibrated::CompensatedModel;
 use robocal::solve::ik::IkSettings;
 use robocal::solve::program::{filter, parse, Language, ProgramFile};
 

@@ -3,7 +3,7 @@
 //! its forward kinematics at the zero configuration does not panic.
 #![no_main]
 use libfuzzer_sys::fuzz_target;
-use robocal::calibrate::compensate::CalibratedModelFile;
+use robocal::model::calibrated::CalibratedModelFile;
 use robocal::model::RobotModel;
 
 fuzz_target!(|data: &[u8]| {

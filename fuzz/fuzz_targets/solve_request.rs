@@ -3,7 +3,7 @@
 //! on the nominal YS100) into one result per target without panicking.
 #![no_main]
 use libfuzzer_sys::fuzz_target;
-use robocal::calibrate::compensate::CompensatedModel;
+use robocal::model::calibrated::CompensatedModel;
 use robocal::http::input::from_json_object;
 use robocal::http::solve::{json_command, CsvSolveQuery, SolveRequest};
 use robocal::solve::ik::{IkSettings, IkSolver};
