@@ -52,12 +52,16 @@
 //! ground.
 
 mod blocked;
+mod design;
+mod refusal;
 
 pub use blocked::BlockedMaps;
+pub use refusal::{MapRefusal, RefusedMap};
 
 use super::evaluate::{evaluate, gram_checked};
 use crate::measure::Measurement;
 use crate::model::{JointMap, JointMaps, ParamId, ParamKind, Pose, RobotModel};
+use design::{normal_of, solve, Design};
 use nalgebra::{DMatrix, DVector};
 use rand::seq::SliceRandom;
 use rand::Rng;
@@ -161,56 +165,6 @@ pub struct MapFit {
     /// The chosen maps and the geometry alone on the spatially blocked
     /// folds (none when they were not run).
     pub blocked: Option<BlockedMaps>,
-}
-
-/// Why a joint's map was refused (module docs): a closed set whose
-/// snake-case names the report serialises.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum MapRefusal {
-    /// The angle one pose resolves, `σ / L_i`, would move a production
-    /// tool's tip by more than `max_unseen_tip_m` and `noise_ratio·σ` unseen.
-    AngleNotResolved,
-    /// The lever arm `L_i` is below the floor `min_lever_m`.
-    LeverBelowFloor,
-}
-
-impl MapRefusal {
-    pub const ALL: [MapRefusal; 2] = [MapRefusal::AngleNotResolved, MapRefusal::LeverBelowFloor];
-
-    /// The serialised name.
-    pub fn name(self) -> &'static str {
-        match self {
-            MapRefusal::AngleNotResolved => "angle_not_resolved",
-            MapRefusal::LeverBelowFloor => "lever_below_floor",
-        }
-    }
-}
-
-/// A joint whose map was refused: the measurements do not see its angle.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct RefusedMap {
-    /// Joint number (1-based).
-    pub joint: usize,
-    /// Which rule refused it (module docs).
-    pub kind: MapRefusal,
-    /// RMS lever arm from the joint's axis to the measured point over the
-    /// poses [mm].
-    pub lever_mm: f64,
-    /// The floor of the lever [mm].
-    pub min_lever_mm: f64,
-    /// The position noise σ per coordinate the rule used [mm].
-    pub noise_mm: f64,
-    /// The angle one pose resolves, `σ / L_i`, at most 180° [deg].
-    pub resolved_deg: f64,
-    /// A production tool's tip distance from the measured point, `ℓ` [mm].
-    pub production_tool_mm: f64,
-    /// What an angle error of `resolved_deg` moves that tip by, unseen [mm].
-    pub unseen_tip_mm: f64,
-    /// The bound on `unseen_tip_mm`, `max(max_unseen_tip_m, noise_ratio·σ)`
-    /// [mm].
-    pub max_unseen_tip_mm: f64,
-    pub reason: String,
 }
 
 /// The position noise σ per coordinate of position-only `data` [m] (module
@@ -357,44 +311,6 @@ pub enum MapFitError {
     NoObservableJoint { refused: String },
 }
 
-/// The design of one fit: residuals, the geometry / session columns and the
-/// map columns for the largest K, pose by pose.
-struct Design {
-    r: DVector<f64>,
-    a: DMatrix<f64>,
-    /// Geometry and session-frame columns (the first ones of `a`).
-    geo: usize,
-    /// First row of each pose, and its row count.
-    pose_rows: Vec<(usize, usize)>,
-    /// Per pose, the weights of its position and orientation rows [m/rad]
-    /// (`evaluate::row_weights`).
-    weights: Vec<(f64, f64)>,
-    /// Joints with a map, with their range.
-    joints: Vec<(usize, [f64; 2])>,
-    /// Joints whose map the measurements cannot see.
-    refused: Vec<RefusedMap>,
-    kmax: usize,
-}
-
-impl Design {
-    /// Column of (joint slot j, harmonic k ≥ 1, sine?) for the largest K.
-    fn col(&self, j: usize, k: usize, sine: bool) -> usize {
-        self.geo + j * 2 * self.kmax + usize::from(sine) * self.kmax + (k - 1)
-    }
-
-    /// The columns of the problem with K harmonics.
-    fn columns(&self, k: usize) -> Vec<usize> {
-        let mut c: Vec<usize> = (0..self.geo).collect();
-        for j in 0..self.joints.len() {
-            for h in 1..=k {
-                c.push(self.col(j, h, false));
-                c.push(self.col(j, h, true));
-            }
-        }
-        c
-    }
-}
-
 /// Poses of the design filled between two checks of `go` in [`build`].
 const BUILD_CHECK_POSES: usize = 1000;
 
@@ -480,51 +396,6 @@ fn build(
     Ok(Some(design))
 }
 
-/// Ridge solution on the columns `cols` of the normal equations `g`, `b`,
-/// columns scaled to unit norm by `scale`. The map columns (index ≥ `geo`)
-/// are penalised by `ridge·(s̄/s_c)²`, `s̄` the RMS norm of the map columns:
-/// one penalty on the coefficients in radians for every joint, so a joint
-/// whose angle barely moves the TCP (a short lever) gets no large map.
-/// `None` when the system is not positive definite.
-fn solve(
-    g: &DMatrix<f64>,
-    b: &DVector<f64>,
-    cols: &[usize],
-    scale: &[f64],
-    geo: usize,
-    ridge: f64,
-) -> Option<DVector<f64>> {
-    let maps: Vec<f64> = cols
-        .iter()
-        .filter(|c| **c >= geo)
-        .map(|c| scale[*c])
-        .collect();
-    let mean_sq = if maps.is_empty() {
-        1.0
-    } else {
-        maps.iter().map(|s| s * s).sum::<f64>() / maps.len() as f64
-    };
-    let m = cols.len();
-    let mut h = DMatrix::zeros(m, m);
-    let mut v = DVector::zeros(m);
-    for (x, &cx) in cols.iter().enumerate() {
-        v[x] = b[cx] / scale[cx];
-        for (y, &cy) in cols.iter().enumerate() {
-            h[(x, y)] = g[(cx, cy)] / (scale[cx] * scale[cy]);
-        }
-        h[(x, x)] += if cx >= geo {
-            ridge * mean_sq / (scale[cx] * scale[cx])
-        } else {
-            1e-9
-        };
-    }
-    let x = h.cholesky()?.solve(&v);
-    Some(DVector::from_iterator(
-        m,
-        x.iter().zip(cols).map(|(x, c)| x / scale[*c]),
-    ))
-}
-
 /// Position error norms [mm] of the poses `poses` after subtracting `a·x`,
 /// and their orientation errors [deg] (the norm of the unweighted rotation
 /// residual; `None` for a pose without a measured orientation).
@@ -552,26 +423,6 @@ fn held_out_errors(
             (norm(row..row + 3) / wp * 1e3, angle)
         })
         .unzip()
-}
-
-/// The normal equations `AᵀA`, `Aᵀr` of the rows of `poses`; `None` when
-/// `go()` returns false between the steps of `AᵀA` ([`gram_checked`]).
-fn normal_of(
-    d: &Design,
-    poses: &[usize],
-    go: &mut dyn FnMut() -> bool,
-) -> Option<(DMatrix<f64>, DVector<f64>)> {
-    let rows: usize = poses.iter().map(|p| d.pose_rows[*p].1).sum();
-    let mut a = DMatrix::zeros(rows, d.a.ncols());
-    let mut r = DVector::zeros(rows);
-    let mut at = 0;
-    for &p in poses {
-        let (row, nr) = d.pose_rows[p];
-        a.rows_mut(at, nr).copy_from(&d.a.rows(row, nr));
-        r.rows_mut(at, nr).copy_from(&d.r.rows(row, nr));
-        at += nr;
-    }
-    Some((gram_checked(&a, go)?, a.tr_mul(&r)))
 }
 
 /// The candidates `(K, λ)` of the cross-validation: K = 0 (no maps), then

@@ -10,7 +10,7 @@
 //! predicted once, from the linearised design of the fit (module docs of
 //! `joint_maps`).
 
-use super::{normal_of, solve, Design};
+use super::design::{normal_of, solve, Design};
 use crate::calibrate::compensate::blocked_fold_assignment;
 use crate::measure::Measurement;
 use crate::model::joint_maps::fade_weight;
