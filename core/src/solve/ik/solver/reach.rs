@@ -3,7 +3,12 @@
 //! corrected excess of a target, a fixed-point iteration of the closed form
 //! onto the calibrated workspace. Frames: base frame; units: m, rad.
 
-use super::*;
+use super::eval::Local;
+use super::seeds::halton_joints;
+use super::types::IkSolver;
+use crate::model::calibrated::CompensatedModel;
+use crate::model::pose::rotation_log;
+use crate::model::{Pose, RobotModel};
 
 /// Safety factor on the sampled calibrated-vs-nominal deviation of the reach test.
 pub(super) const REACH_MARGIN_FACTOR: f64 = 2.0;

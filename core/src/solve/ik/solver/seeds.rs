@@ -4,7 +4,12 @@
 //! deterministic Halton multi-start for models without a closed form.
 //! Joint values in the model convention [rad].
 
-use super::*;
+use super::eval::Local;
+use super::types::{Goal, IkSolver, SolveOptions};
+use crate::model::Pose;
+use crate::solve::ik::analytic::{AnalyticIk, AnalyticSolution};
+use crate::solve::ik::config::Configuration;
+use nalgebra::Matrix3;
 
 /// Radical inverse in base `b` (Halton sequences).
 pub(super) fn halton(mut i: usize, b: usize) -> f64 {
