@@ -43,13 +43,6 @@ const CORE_FLOORS: &[&str] = &[
 /// [`known_loop_edges`] prints the arrows inside each. The test
 /// fails on any other loop, and on an entry here that no longer loops.
 const KNOWN_LOOPS: &[&[&str]] = &[
-    // core: the TCP fits and the work object fit share `tcp/mod.rs`'s types.
-    &[
-        "solve/cell/tcp",
-        "solve/cell/tcp/axis",
-        "solve/cell/tcp/judge",
-        "solve/cell/work_object_fit",
-    ],
     // src: the service state and the jobs that hold it.
     &[
         "service/changes",

@@ -19,11 +19,11 @@
 //!
 //! Units: points in m; reported figures in mm and degrees.
 
+pub use super::tcp::WorkObjectFit;
 use super::tcp::{check_finite, flange_poses, FitError, NotFittedReason};
 use crate::model::calibrated::CompensatedModel;
 use crate::model::Pose;
 use nalgebra::{Matrix3, Vector3};
-use serde::Serialize;
 
 /// Shortest accepted distance from the origin to the x point [m].
 pub const MIN_X_DISTANCE_M: f64 = 0.01;
@@ -38,32 +38,6 @@ pub struct WorkObjectPoints {
     pub xy: Vec<Vector3<f64>>,
     /// Further points of the xy plane (checked, not fitted).
     pub plane: Vec<Vector3<f64>>,
-}
-
-/// A fitted work object and how well the points agree.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct WorkObjectFit {
-    /// Base → work object [m].
-    #[serde(skip)]
-    pub pose: Pose,
-    /// The origin in the robot base frame [mm].
-    pub xyz_mm: [f64; 3],
-    /// The orientation, fixed-axis `[rx, ry, rz]` [deg].
-    pub rpy_deg: [f64; 3],
-    /// RMS scatter of the repeated touches of the origin, x and xy points [mm]
-    /// (0 for a point touched once).
-    pub scatter_mm: [f64; 3],
-    /// The extra plane points' distances from the fitted xy plane [mm].
-    pub plane_residual_mm: Vec<f64>,
-    /// Angle between `OX` and `OY` [deg].
-    pub xy_angle_deg: f64,
-    /// 1σ of the origin per axis [mm], from repeated touches.
-    pub sigma_mm: Option<f64>,
-    /// 1σ of the orientation [deg], from repeated touches.
-    pub sigma_deg: Option<f64>,
-    /// The bounds the fit was judged against (`tcp::judge`).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub limits: Option<super::tcp::Limits>,
 }
 
 /// The calibrated tool tip `F_i·t` (base frame) at each row of controller

@@ -14,10 +14,10 @@
 //!   per-touch residual is the angle between `z` and `z_i`; σ adds the plane
 //!   normal's own uncertainty (flatness RMS / (√n · spread of the touches)).
 
-use super::{rms_max, FitError, NotFittedReason, ToolFit};
+pub use super::outcome::AxisSource;
+use super::outcome::{rms_max, FitError, NotFittedReason, ToolFit};
 use crate::model::Pose;
 use nalgebra::{Matrix3, Vector3};
-use serde::Serialize;
 
 /// Shortest distance between the tip and a second axis point [m].
 pub const MIN_AXIS_LENGTH_M: f64 = 0.005;
@@ -26,16 +26,6 @@ pub const MIN_PLANE_TOUCHES: usize = 3;
 /// Smallest spread (RMS distance from their centroid, in the plane's second
 /// direction) of the plane touches [m].
 pub const MIN_PLANE_SPREAD_M: f64 = 0.005;
-
-/// Where a tool's z came from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum AxisSource {
-    /// A second point on the tool's axis.
-    Point,
-    /// Touches with the tool flat on a plane.
-    Plane,
-}
 
 /// The rotation with z along `z` and x the flange's x made orthogonal to it.
 pub fn frame_from_z(z: &Vector3<f64>) -> Matrix3<f64> {
