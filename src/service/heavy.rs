@@ -7,7 +7,7 @@
 //! measurement plans, checks, comparisons, large predictions and ISO 9283
 //! assessments all go through [`run`], so concurrent large requests are
 //! bounded in CPU and in memory alike, and the memory they freed is handed
-//! back to the system once no large work runs ([`trim`]).
+//! back to the system once no large work runs (`heap::trim`).
 
 use super::waiting::WaitingFlag;
 use super::{AppState, ServiceError};
@@ -36,18 +36,4 @@ where
     .map_err(|e| ServiceError::Internal(format!("{what} task: {e}")));
     state.trim_soon();
     out
-}
-
-/// Hands the heap's free pages back to the operating system (glibc's
-/// `malloc_trim`): after a large request its buffers are free but glibc
-/// keeps them mapped, so the process would stay at its peak size. Costs a
-/// walk of the free lists (milliseconds); the state calls it a few times
-/// in the seconds after large work, once none runs
-/// (`AppState::trim_soon`), when the answers have been written too.
-pub(crate) fn trim() {
-    #[cfg(all(target_os = "linux", target_env = "gnu"))]
-    // SAFETY: malloc_trim only releases free memory of the allocator's arenas.
-    unsafe {
-        libc::malloc_trim(0);
-    }
 }

@@ -140,19 +140,9 @@ const SOLVER_CACHE_MAX: usize = 64;
 pub(crate) struct WeakState(Weak<Inner>);
 
 impl AppState {
-    /// The state over `db`; on PostgreSQL it starts this replica's job
-    /// runner, so it must be made inside a Tokio runtime.
-    pub fn new(db: Db, config: ServiceConfig) -> Self {
-        let shared = db.backend() == crate::db::Backend::Postgres;
-        let state = AppState::build(db, config);
-        if shared {
-            super::jobs::shared::spawn_runner(&state);
-            super::changes::spawn_listener(&state);
-        }
-        state
-    }
-
-    fn build(db: Db, config: ServiceConfig) -> Self {
+    /// The state over `db`, no task started (`start.rs`'s `AppState::new`
+    /// starts the shared store's runner and listener beside it).
+    pub(super) fn build(db: Db, config: ServiceConfig) -> Self {
         let workers = config.workers.max(1);
         let solve_workers = config.solve_workers.max(1);
         AppState {
@@ -271,7 +261,7 @@ impl AppState {
                 let due = &state.inner.trims_due;
                 if state.solves_in_flight() == 0 && due.load(Ordering::SeqCst) > 0 {
                     due.fetch_sub(1, Ordering::SeqCst);
-                    let _ = tokio::task::spawn_blocking(super::heavy::trim).await;
+                    let _ = tokio::task::spawn_blocking(super::heap::trim).await;
                 }
             }
         });
