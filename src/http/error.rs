@@ -1,16 +1,14 @@
 //! One error shape for every 4xx/5xx: `application/problem+json` (RFC 9457)
-//! `{type, title, status, detail}`, and the request extractors that map axum's
-//! rejections (bad JSON, wrong content type, body too large, bad path or
-//! query) into it.
+//! `{type, title, status, detail}`, and axum's rejections (bad JSON, wrong
+//! content type, body too large, bad path or query) mapped into it for the
+//! request extractors (`extract.rs`).
 //!
 //! 4xx details say what to fix. Database and internal errors are logged with
 //! their cause and returned as a generic 500 without it.
 
 use axum::extract::rejection::{BytesRejection, PathRejection, QueryRejection};
-use axum::extract::{FromRequest, FromRequestParts, Request};
 use axum::http::{header, HeaderValue, StatusCode};
 use axum::response::{IntoResponse, Response};
-use serde::de::DeserializeOwned;
 use serde::Serialize;
 
 /// Media type of error bodies.
@@ -293,42 +291,3 @@ pub fn json_content_type(headers: &axum::http::HeaderMap) -> bool {
             .rsplit_once('+')
             .is_some_and(|(t, suffix)| t.contains('/') && suffix.eq_ignore_ascii_case("json"))
 }
-
-/// A JSON object body (arrays and scalars are refused) whose rejections are
-/// problem documents.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct ApiJson<T>(pub T);
-
-impl<S, T> FromRequest<S> for ApiJson<T>
-where
-    T: DeserializeOwned,
-    S: Send + Sync,
-{
-    type Rejection = ApiError;
-
-    async fn from_request(req: Request, state: &S) -> Result<Self, Self::Rejection> {
-        if !json_content_type(req.headers()) {
-            return Err(ApiError::UnsupportedMediaType(
-                "expected a JSON body with `Content-Type: application/json`".into(),
-            ));
-        }
-        let bytes = axum::body::Bytes::from_request(req, state).await?;
-        super::input::from_json_object(&bytes).map(ApiJson)
-    }
-}
-
-impl<T: Serialize> IntoResponse for ApiJson<T> {
-    fn into_response(self) -> Response {
-        axum::Json(self.0).into_response()
-    }
-}
-
-/// `axum::extract::Path` whose rejections are problem documents.
-#[derive(Debug, FromRequestParts)]
-#[from_request(via(axum::extract::Path), rejection(ApiError))]
-pub struct ApiPath<T>(pub T);
-
-/// `axum::extract::Query` whose rejections are problem documents.
-#[derive(Debug, FromRequestParts)]
-#[from_request(via(axum::extract::Query), rejection(ApiError))]
-pub struct ApiQuery<T>(pub T);

@@ -32,6 +32,7 @@ pub mod cell_fit;
 pub mod checks;
 pub mod console;
 pub mod error;
+pub mod extract;
 pub mod input;
 pub mod iso9283;
 pub mod iso9283_plan;
@@ -51,7 +52,8 @@ pub use crate::service::limits::{
     Admission, Limits, Ticket, BODY_LIMIT_BYTES, PAYLOAD_MAX_KG, SMALL_SOLVE_MAX,
 };
 pub use crate::service::{AppState, RobotContext, ServiceConfig};
-pub use error::{ApiError, ApiJson, ApiPath, ApiQuery, Problem, PROBLEM_JSON};
+pub use error::{ApiError, Problem, PROBLEM_JSON};
+pub use extract::{ApiJson, ApiPath, ApiQuery};
 pub use listener::ServiceListener;
 
 /// The text of `openapi.yaml`, served at `/openapi.yaml`.
