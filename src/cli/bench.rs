@@ -209,7 +209,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 fn km(a: &KmArgs) -> anyhow::Result<serde_json::Value> {
-    let model = crate::cli::load_model(&a.model)?;
+    let model = super::model_files::load_model(&a.model)?;
     let dif = match a.dif_sign.as_str() {
         "plus" => csv::DifSign::Plus,
         "minus" => csv::DifSign::Minus,
@@ -301,7 +301,7 @@ fn read_pose_targets(path: &str) -> anyhow::Result<Vec<Goal>> {
 }
 
 fn ik(a: &IkArgs) -> anyhow::Result<serde_json::Value> {
-    let nominal = crate::cli::load_model(&a.model)?;
+    let nominal = super::model_files::load_model(&a.model)?;
     let model = match &a.calibrated {
         None => CompensatedModel::from_nominal(nominal),
         Some(p) => {

@@ -23,6 +23,8 @@ pub mod simulate;
 pub mod solve;
 pub mod tcp;
 
+pub use model_files::load_model;
+
 #[derive(Debug, Parser)]
 #[command(
     name = "robocal",
@@ -116,34 +118,5 @@ pub fn run(cli: Cli) -> anyhow::Result<exit::Exit> {
         Command::Serve(a) => done(serve::run(a)),
         Command::Keygen(a) => done(keygen::run(a)),
         Command::Bench(a) => done(bench::run(a)),
-    }
-}
-
-/// Loads a model from a preset name or a model JSON file path: a model
-/// description, or a calibrated model file (`robocal calibrate --out`,
-/// `robocal export --format json`), which gives its calibrated model.
-pub fn load_model(arg: &str) -> anyhow::Result<crate::model::RobotModel> {
-    let path = std::path::Path::new(arg);
-    if path.exists() {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| anyhow::anyhow!("cannot read model file {arg}: {e}"))?;
-        match crate::model::RobotModel::from_json(&text) {
-            Err(crate::model::ModelError::Parse(e)) => {
-                match robocal_core::model::calibrated::CalibratedModelFile::from_json(&text) {
-                    Ok(file) => file
-                        .model
-                        .to_model()
-                        .map_err(|e| anyhow::anyhow!("model file {arg}: calibrated model: {e}")),
-                    Err(_) => Err(anyhow::anyhow!(
-                        "model file {arg}: cannot read model JSON: {e}"
-                    )),
-                }
-            }
-            r => r.map_err(|e| anyhow::anyhow!("model file {arg}: {e}")),
-        }
-    } else if arg.ends_with(".json") {
-        anyhow::bail!("model file {arg} does not exist")
-    } else {
-        crate::model::preset(arg).map_err(|e| anyhow::anyhow!("{e}"))
     }
 }

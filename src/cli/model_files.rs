@@ -65,7 +65,7 @@ pub fn load_cell(path: Option<&str>) -> anyhow::Result<Cell> {
 /// joint maps and compensator are not part of a model-based fit; the note
 /// says so).
 pub fn load_start_model(arg: &str) -> anyhow::Result<(crate::model::RobotModel, Option<String>)> {
-    let model = super::load_model(arg)?;
+    let model = load_model(arg)?;
     let calibrated_file = std::fs::read_to_string(arg)
         .ok()
         .is_some_and(|text| CalibratedModelFile::from_json(&text).is_ok());
@@ -83,6 +83,35 @@ pub fn save_model_file(file: &CalibratedModelFile, path: &Path) -> Result<(), Co
         path: path.display().to_string(),
         reason: e.to_string(),
     })
+}
+
+/// Loads a model from a preset name or a model JSON file path: a model
+/// description, or a calibrated model file (`robocal calibrate --out`,
+/// `robocal export --format json`), which gives its calibrated model.
+pub fn load_model(arg: &str) -> anyhow::Result<crate::model::RobotModel> {
+    let path = std::path::Path::new(arg);
+    if path.exists() {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| anyhow::anyhow!("cannot read model file {arg}: {e}"))?;
+        match crate::model::RobotModel::from_json(&text) {
+            Err(crate::model::ModelError::Parse(e)) => {
+                match robocal_core::model::calibrated::CalibratedModelFile::from_json(&text) {
+                    Ok(file) => file
+                        .model
+                        .to_model()
+                        .map_err(|e| anyhow::anyhow!("model file {arg}: calibrated model: {e}")),
+                    Err(_) => Err(anyhow::anyhow!(
+                        "model file {arg}: cannot read model JSON: {e}"
+                    )),
+                }
+            }
+            r => r.map_err(|e| anyhow::anyhow!("model file {arg}: {e}")),
+        }
+    } else if arg.ends_with(".json") {
+        anyhow::bail!("model file {arg} does not exist")
+    } else {
+        crate::model::preset(arg).map_err(|e| anyhow::anyhow!("{e}"))
+    }
 }
 
 #[cfg(test)]

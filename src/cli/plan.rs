@@ -194,7 +194,7 @@ pub fn make(a: &MakeArgs) -> anyhow::Result<String> {
     let Some(model) = &a.model else {
         bail!("--model is required (or use `robocal plan join`)");
     };
-    let model = super::load_model(model)?;
+    let model = super::model_files::load_model(model)?;
     let plan = make_plan(&model, &settings(a)?)?;
     let language = match a.format {
         PlanFormat::Csv => None,

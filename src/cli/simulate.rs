@@ -154,7 +154,7 @@ fn truth_model(a: &SimulateArgs, nominal: &RobotModel) -> anyhow::Result<(RobotM
             )
         }
         _ => {
-            let m = crate::cli::load_model(&from).with_context(|| {
+            let m = super::model_files::load_model(&from).with_context(|| {
                 format!("--truth-from {from}: expected table-7-1, random or a model JSON file")
             })?;
             if m.dof() != nominal.dof() {
@@ -229,7 +229,7 @@ fn effects(a: &SimulateArgs, dof: usize) -> anyhow::Result<UnmodelledEffects> {
 }
 
 pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
-    let nominal = crate::cli::load_model(&a.preset)?;
+    let nominal = super::model_files::load_model(&a.preset)?;
     if a.poses == 0 {
         bail!("--poses must be at least 1");
     }

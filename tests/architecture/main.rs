@@ -43,24 +43,6 @@ const CORE_FLOORS: &[&str] = &[
 /// [`known_loop_edges`] prints the arrows inside each. The test
 /// fails on any other loop, and on an entry here that no longer loops.
 const KNOWN_LOOPS: &[&[&str]] = &[
-    // src: `cli/mod.rs` (the arguments and dispatch) and its subcommands.
-    &[
-        "cli",
-        "cli/bench",
-        "cli/calibrate",
-        "cli/cell",
-        "cli/check",
-        "cli/export",
-        "cli/filter",
-        "cli/iso9283",
-        "cli/model_files",
-        "cli/plan",
-        "cli/predict",
-        "cli/reregister",
-        "cli/simulate",
-        "cli/solve",
-        "cli/tcp",
-    ],
     // src: `http/mod.rs` (the router and `AppState`) and its handlers.
     &[
         "http",
