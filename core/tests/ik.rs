@@ -27,7 +27,7 @@ use robocal_core::model::orientation::{
 use robocal_core::model::{preset, Pose, RobotModel};
 use robocal_core::sim::{synthetic_calibration, SyntheticErrors};
 use robocal_core::solve::ik::{
-    AnalyticIk, Configuration, FailureReason, Goal, IkSettings, IkSolver, SolveOptions,
+    AnalyticIk, Configuration, FailureReason, Goal, IkSettings, IkSolver, SolveMode, SolveOptions,
     TargetFrame, TargetInput,
 };
 use std::f64::consts::PI;
@@ -479,7 +479,11 @@ fn false_targets_in_every_convention() {
     let q = [-0.4, 1.1, 0.2, 0.8, -0.9, 1.5];
     let target = cm.predict(&q).unwrap();
     for conv in OrientationConvention::ALL {
-        let r = &solver.solve_targets(&[input(&target, conv)], &SolveOptions::default())[0];
+        let r = &solver.solve_targets(
+            &[input(&target, conv)],
+            SolveMode::Parallel,
+            &SolveOptions::default(),
+        )[0];
         assert!(r.solution.converged, "{conv}");
         let ft = r.false_target.as_ref().unwrap();
         assert_eq!(ft.convention, conv);
@@ -504,6 +508,7 @@ fn false_targets_in_every_convention() {
     let t = fk(&model, &model.joints_from_controller(&q)).unwrap();
     let r = &plain.solve_targets(
         &[input(&t, OrientationConvention::KukaAbc)],
+        SolveMode::Parallel,
         &SolveOptions::default(),
     )[0];
     let ft = r.false_target.as_ref().unwrap();
@@ -542,7 +547,7 @@ fn bad_targets_get_per_target_reasons_and_the_batch_goes_on() {
         nan_angle,
         input(&good, OrientationConvention::Matrix),
     ];
-    let results = solver.solve_targets(&targets, &SolveOptions::default());
+    let results = solver.solve_targets(&targets, SolveMode::Parallel, &SolveOptions::default());
     assert_eq!(results.len(), targets.len());
     let codes: Vec<&str> = results
         .iter()

@@ -23,7 +23,9 @@ use robocal_core::solve::cell::accuracy::{tool_accuracy, ToolAccuracy};
 use robocal_core::solve::cell::{
     CellOptions, CellSolver, Forward, Load, PoseOut, PredictFrame, WorkObject, WorkObjectFrame,
 };
-use robocal_core::solve::ik::{IkSettings, IkSolver, SolveOptions, TargetFrame, TargetInput};
+use robocal_core::solve::ik::{
+    IkSettings, IkSolver, SolveMode, SolveOptions, TargetFrame, TargetInput,
+};
 use std::sync::Arc;
 
 /// A planar two-link arm: both axes vertical, links 400 and 300 mm, base
@@ -169,7 +171,7 @@ fn round_trip(cm: &CompensatedModel, seed: u64, n: usize) {
             branch: solver.configuration(&q),
             ..SolveOptions::default()
         };
-        let r = &solver.solve_targets_serial(&[target], &options)[0];
+        let r = &solver.solve_targets(&[target], SolveMode::Serial, &options)[0];
         if !r.solution.converged {
             // Near a singularity the branch may not be reachable in limits.
             continue;

@@ -6,7 +6,7 @@ use libfuzzer_sys::fuzz_target;
 use robocal::model::calibrated::CompensatedModel;
 use robocal::http::input::from_json_object;
 use robocal::http::solve::{json_command, CsvSolveQuery, SolveRequest};
-use robocal::solve::ik::{IkSettings, IkSolver};
+use robocal::solve::ik::{IkSettings, IkSolver, SolveMode};
 use robocal::service::solve::{seed_joints, Targets};
 use std::sync::OnceLock;
 
@@ -35,10 +35,11 @@ fuzz_target!(|data: &[u8]| {
         panic!("a JSON request gives checked inputs");
     };
     let first = &inputs[..inputs.len().min(8)];
-    let results = if cmd.path {
-        solver().solve_targets_path(first, &cmd.options)
+    let mode = if cmd.path {
+        SolveMode::Path
     } else {
-        solver().solve_targets_serial(first, &cmd.options)
+        SolveMode::Serial
     };
+    let results = solver().solve_targets(first, mode, &cmd.options);
     assert_eq!(results.len(), first.len());
 });

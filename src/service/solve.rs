@@ -25,7 +25,9 @@ use crate::records::{CellKind, ItemFrame, NewCellItem};
 use crate::solve::cell::file::PoseMmDeg;
 use crate::solve::cell::{CellSolver, Load, LoadDescription, Tool, WorkObject, WorkObjectFrame};
 use crate::solve::ik::TargetFrame;
-use crate::solve::ik::{IkSettings, IkSolver, SolveOptions, TargetInput, TargetResult, TargetsCsv};
+use crate::solve::ik::{
+    IkSettings, IkSolver, SolveMode, SolveOptions, TargetInput, TargetResult, TargetsCsv,
+};
 use robocal_core::model::calibrated::{CalibratedModelFile, CompensatedModel};
 use std::sync::Arc;
 
@@ -83,7 +85,7 @@ impl Targets {
                     if !flag.still_waiting() {
                         return None;
                     }
-                    out.extend(solver.solve_targets(chunk, options));
+                    out.extend(solver.solve_targets(chunk, SolveMode::Parallel, options));
                 }
                 Some(out)
             }
@@ -93,11 +95,16 @@ impl Targets {
 
     fn run(&self, solver: &IkSolver, options: &SolveOptions, path: bool) -> Vec<TargetResult> {
         match self {
-            Targets::Inputs(t) if path => solver.solve_targets_path(t, options),
-            Targets::Inputs(t) if t.len() <= SMALL_SOLVE_MAX => {
-                solver.solve_targets_serial(t, options)
+            Targets::Inputs(t) => {
+                let mode = if path {
+                    SolveMode::Path
+                } else if t.len() <= SMALL_SOLVE_MAX {
+                    SolveMode::Serial
+                } else {
+                    SolveMode::Parallel
+                };
+                solver.solve_targets(t, mode, options)
             }
-            Targets::Inputs(t) => solver.solve_targets(t, options),
             Targets::Csv(c) => c.solve(solver, options, path),
         }
     }

@@ -31,6 +31,6 @@ pub use invalid::{RowError, TargetError};
 pub use solver::{
     FailureReason, Goal, IkSettings, IkSolution, IkSolver, Refined, SolveOptions, UnknownFrame,
 };
-pub use targets::{FalseTarget, JointJump, TargetFrame, TargetInput, TargetResult};
+pub use targets::{FalseTarget, JointJump, SolveMode, TargetFrame, TargetInput, TargetResult};
 pub use targets_csv::{parse_targets_csv, results_csv, TargetRow, TargetsCsv, TargetsCsvError};
 pub use tool::TcpTool;

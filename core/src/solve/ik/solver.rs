@@ -278,7 +278,7 @@ impl IkSolver {
     }
 
     /// Solves one goal in the registered base frame.
-    pub fn solve_base(&self, goal: &Goal, options: &SolveOptions) -> IkSolution {
+    fn solve_base(&self, goal: &Goal, options: &SolveOptions) -> IkSolution {
         if let Err(msg) = self.validate(goal, options) {
             return IkSolution::invalid(msg);
         }

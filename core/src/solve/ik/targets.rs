@@ -23,6 +23,19 @@ use crate::model::orientation::{rotation_from, rotation_to, OrientationConventio
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
+/// How a list of targets is solved (a closed set).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SolveMode {
+    /// Independent targets, in parallel on the solver's threads.
+    Parallel,
+    /// Independent targets, one after the other on the calling thread (small
+    /// lists, where handing work to the thread pool costs more than it saves).
+    Serial,
+    /// A path: each target seeded by the previous solution and kept in its
+    /// branch, joint jumps reported (`batch.rs`).
+    Path,
+}
+
 /// One target as a caller sends it (boundary units).
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct TargetInput {
@@ -179,9 +192,24 @@ impl IkSolver {
         }
     }
 
-    /// Solves boundary targets independently, in parallel. Invalid targets get
-    /// an `InvalidTarget` reason; the batch itself never fails.
+    /// Solves boundary targets as `mode` says, one result per target in
+    /// input order. Invalid targets get an `InvalidTarget` reason; the list
+    /// itself never fails.
     pub fn solve_targets(
+        &self,
+        targets: &[TargetInput],
+        mode: SolveMode,
+        options: &super::SolveOptions,
+    ) -> Vec<TargetResult> {
+        match mode {
+            SolveMode::Parallel => self.solve_targets_parallel(targets, options),
+            SolveMode::Serial => self.solve_targets_serial(targets, options),
+            SolveMode::Path => self.solve_targets_path(targets, options),
+        }
+    }
+
+    /// Solves boundary targets independently, in parallel.
+    fn solve_targets_parallel(
         &self,
         targets: &[TargetInput],
         options: &super::SolveOptions,
@@ -200,7 +228,7 @@ impl IkSolver {
     /// Solves boundary targets one after the other on the calling thread (for
     /// small batches, where handing work to the thread pool costs more than
     /// it saves).
-    pub fn solve_targets_serial(
+    fn solve_targets_serial(
         &self,
         targets: &[TargetInput],
         options: &super::SolveOptions,
@@ -219,7 +247,7 @@ impl IkSolver {
     }
 
     /// Solves boundary targets as a path (see `solve_path`).
-    pub fn solve_targets_path(
+    fn solve_targets_path(
         &self,
         targets: &[TargetInput],
         options: &super::SolveOptions,

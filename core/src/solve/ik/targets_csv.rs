@@ -41,7 +41,7 @@
 
 use super::invalid::RowError;
 use super::solver::{IkSolution, IkSolver, SolveOptions};
-use super::targets::{TargetInput, TargetResult};
+use super::targets::{SolveMode, TargetInput, TargetResult};
 use crate::csv_write::{self, push_row, read_text, Cell};
 use crate::measure::bounds::{within, POSITION_MM};
 use crate::measure::csv_text::{self, Dialect, Record, TextError};
@@ -271,12 +271,12 @@ impl TargetsCsv {
             .iter()
             .filter_map(|r| r.target.as_ref().ok().cloned())
             .collect();
-        let mut solved = if path {
-            solver.solve_targets_path(&valid, options)
+        let mode = if path {
+            SolveMode::Path
         } else {
-            solver.solve_targets(&valid, options)
-        }
-        .into_iter();
+            SolveMode::Parallel
+        };
+        let mut solved = solver.solve_targets(&valid, mode, options).into_iter();
         self.rows
             .iter()
             .map(|r| match &r.target {
