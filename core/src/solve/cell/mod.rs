@@ -26,7 +26,7 @@ pub mod accuracy;
 pub mod export;
 pub mod file;
 pub mod joints_csv;
-pub mod numbering;
+mod numbering;
 pub use crate::model::load;
 pub mod predict;
 pub mod tcp;
@@ -149,7 +149,7 @@ pub enum CellError {
 }
 
 /// The index of the one item answering `r` among items named `names` and
-/// numbered `numbers` ([`numbering::numbers`]).
+/// numbered `numbers` (`numbering::numbers`).
 fn find(
     kind: ItemKind,
     names: &[&str],
@@ -176,7 +176,7 @@ fn find(
 
 impl Cell {
     /// The controller numbers of the tools, in their order: their own, else
-    /// the lowest free ones ([`numbering`]).
+    /// the lowest free ones (`numbering`).
     pub fn tool_numbers(&self) -> Vec<u32> {
         let d: Vec<(&str, Option<u32>)> = self
             .tools
@@ -186,7 +186,7 @@ impl Cell {
         numbering::numbers(&d)
     }
 
-    /// The controller numbers of the work objects ([`numbering`]).
+    /// The controller numbers of the work objects (`numbering`).
     pub fn work_object_numbers(&self) -> Vec<u32> {
         let d: Vec<(&str, Option<u32>)> = self
             .work_objects
@@ -197,7 +197,7 @@ impl Cell {
     }
 
     /// The tool named or numbered `r`, carrying its controller number (its
-    /// own or the one [`numbering`] gives it); number 0 is the bare flange
+    /// own or the one `numbering` gives it); number 0 is the bare flange
     /// when the cell does not define it.
     pub fn tool(&self, r: &CellRef) -> Result<Tool, CellError> {
         let numbers = self.tool_numbers();
@@ -218,7 +218,7 @@ impl Cell {
     }
 
     /// The work object named or numbered `r`, carrying its controller number
-    /// ([`numbering`]); number 0 is the base frame when the cell does not
+    /// (`numbering`); number 0 is the base frame when the cell does not
     /// define it.
     pub fn work_object(&self, r: &CellRef) -> Result<WorkObject, CellError> {
         let numbers = self.work_object_numbers();

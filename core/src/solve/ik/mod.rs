@@ -3,25 +3,25 @@
 //!
 //! - [`analytic`]: closed-form IK of the nominal model (spherical wrist and
 //!   UR-style three parallel axes), all branches with configuration flags: the seed.
-//! - [`solver`]: damped Newton on `CompensatedModel::predict = target` from that
+//! - `solver`: damped Newton on `CompensatedModel::predict = target` from that
 //!   seed (branch, joint seed, limits, per-target result and failure reason).
-//! - [`batch`]: parallel batches and path mode.
+//! - `batch`: parallel batches and path mode.
 //! - [`choice`]: the one rule by which a target that names no configuration
 //!   gets one (solve, filter, HTTP).
-//! - [`targets`]: boundary targets (mm, degrees, orientation conventions), joint
+//! - `targets`: boundary targets (mm, degrees, orientation conventions), joint
 //!   commands in the controller convention and false targets `FK_nominal(q_cmd)`;
-//!   [`targets_csv`]: the same as a targets file; [`invalid`]: why a target fails
+//!   [`targets_csv`]: the same as a targets file; `invalid`: why a target fails
 //!   alone.
 //!
 //! Units: SI inside (m, rad); mm and degrees at the boundary (`targets`).
 
 pub mod analytic;
-pub mod batch;
+mod batch;
 pub mod choice;
-pub mod config;
-pub mod invalid;
-pub mod solver;
-pub mod targets;
+mod config;
+mod invalid;
+mod solver;
+mod targets;
 pub mod targets_csv;
 pub mod tool;
 

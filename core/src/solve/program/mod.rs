@@ -15,12 +15,12 @@
 //! SI (m, rad) in [`Site::pose`].
 
 pub mod export;
-pub mod fanuc;
-pub mod krl;
+mod fanuc;
+mod krl;
 mod lex;
-pub mod rapid;
+mod rapid;
 mod rewrite;
-pub mod urscript;
+mod urscript;
 
 mod parsed;
 mod report;
