@@ -660,7 +660,7 @@ def main():
             "fetch(document.getElementById('iso-report-download').href).then(r => r.text()).then(done);")
         assert "<html" in report.lower() and "P1" in report, report[:200]
         assert "UR5 cell 1" in report and "laser tracker AT960" in report and "after" in report, report[:400]
-        shot("iso-figures", "iso-section")
+        shot("iso-figures", "iso-result")
 
         # 9. Delete a set (asked first): a spare upload of eight poses.
         spare = pathlib.Path(work) / "spare.csv"
