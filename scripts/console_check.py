@@ -653,7 +653,7 @@ def main():
         assert aps == [("0.112", "0.050")] * 5, aps
         assert len(driver.find_elements(By.CSS_SELECTOR, "#iso-distances tr.iso-distance")) == 10
         conditions = driver.find_element(By.ID, "iso-conditions").text
-        assert conditions.startswith("UR5 cell 1, model ") and "load 3.5 kg, speed 100 %" in conditions \
+        assert re.match(r"UR5 cell 1, model v\d+, \d{4}-\d{2}-\d{2}; ", conditions) and "load 3.5 kg, speed 100 %" in conditions \
             and "laser tracker AT960" in conditions, conditions
         report = driver.execute_async_script(
             "const done = arguments[0];"

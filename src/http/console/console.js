@@ -544,7 +544,7 @@ handlers["iso-figures"] = async function (form) {
   const c = r.conditions || {};
   const stated = (x, unit) => (x === null || x === undefined ? "not stated" : x + unit);
   document.getElementById("iso-conditions").textContent =
-    `${c.robot || "robot not stated"}, model ${c.model_version || "not stated"}, ${c.date || ""}; load ${stated(c.load_kg, " kg")}, speed ${stated(c.speed_percent, " %")}; measurement: ${c.measurement || "not stated"}`;
+    `${c.robot || "robot not stated"}, model ${/^[0-9]+$/.test(c.model_version || "") ? "v" + c.model_version : c.model_version || "not stated"}, ${c.date || ""}; load ${stated(c.load_kg, " kg")}, speed ${stated(c.speed_percent, " %")}; measurement: ${c.measurement || "not stated"}`;
   const figure = (f, value) => (f.outcome === "computed" ? value(f) : "— " + f.message);
   const head = (table, first, columns) => {
     const thead = document.querySelector(`#${table} thead`);
