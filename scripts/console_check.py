@@ -26,6 +26,7 @@ first step that does not behave.
 """
 import argparse
 import csv as csvmod
+import math
 import os
 import pathlib
 import re
@@ -495,6 +496,39 @@ def main():
         assert re.fullmatch(r"-?\d+\.\d{3}", x), f"x to 0.001 mm: {x}"
         shot("predicted", "predict-section")
 
+        # 7c'. Every option of predict: the same readings in the base frame,
+        # then in the work object `table` (base frame, at 450, -100, 50 mm,
+        # turned 20° about z) with the torch's 2.5 kg given and KUKA A, B, C
+        # beside rx, ry, rz. The work object's pose is the base pose moved by
+        # the inverse of the table's transform; A, B, C = rz, ry, rx (both
+        # R = Rz·Ry·Rx).
+        def predict(frame, **extra):
+            form = driver.find_element(By.ID, "predict")
+            summary = driver.find_element(By.ID, "predict-summary").text
+            fill(form, dict(frame=frame, **extra))
+            form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+            wait.until(lambda d: d.find_element(By.ID, "predict-summary").text != summary)
+            return [[td.text for td in r.find_elements(By.TAG_NAME, "td")]
+                    for r in driver.find_elements(By.CSS_SELECTOR, "#predict-table tbody tr")]
+
+        in_base = predict("base")
+        in_table = predict("wobj:table", payload_kg="2.5", convention="kuka_abc")
+        summary = driver.find_element(By.ID, "predict-summary").text
+        assert "work_object frame at 2.500 kg" in summary, summary
+        assert driver.find_element(By.ID, "predict-convention").text == "kuka_abc"
+        turn = math.radians(20.0)
+        for b, w in zip(in_base, in_table):
+            dx, dy, dz = float(b[2]) - 450.0, float(b[3]) + 100.0, float(b[4]) - 50.0
+            want = (math.cos(turn) * dx + math.sin(turn) * dy,
+                    -math.sin(turn) * dx + math.cos(turn) * dy, dz)
+            got = tuple(float(v) for v in w[2:5])
+            assert all(abs(g - e) < 0.003 for g, e in zip(got, want)), (b, w, want)
+            abc = [float(v) for v in w[8].split(", ")]
+            rpy = [float(v) for v in w[5:8]]
+            for a, r in zip(abc, reversed(rpy)):
+                assert abs((a - r + 180.0) % 360.0 - 180.0) < 0.001, (w, abc, rpy)
+        shot("predicted-work-object", "predict-section")
+
         # 7d. Fits: a work object from three tracker points (stored, listed
         # with the version's base-frame pose), and a tool's TCP from the
         # moved set's 20 readings (joints and the tracker's position of the
@@ -515,15 +549,18 @@ def main():
                                + [repr(float(r[f"{a}_t"]) + float(r[f"{a}_dif"])) for a in "xyz"])
                      for r in csvmod.DictReader(f)]
         form = driver.find_element(By.ID, "fit-tool")
-        fill(form, dict(name="probe", method="tracker_point", rpy="0, 0, 0"))
+        # Named version (the active one, re-registered on the moved set) and tool number.
+        active = api_get(base, f"/v1/robots/{robot_id}")["active_version"]
+        fill(form, dict(name="probe", method="tracker_point", rpy="0, 0, 0", number=7, version=active))
         driver.execute_script("arguments[0].value = arguments[1]",
                               form.find_element(By.NAME, "readings"), "\n".join(lines))
         form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
         wait.until(lambda d: text_of(d, "#message") and (
             text_of(d, "#message").startswith("Fitted tool probe") or "not fitted" in text_of(d, "#message")))
         msg = driver.find_element(By.ID, "message").text
-        assert msg.startswith("Fitted tool probe on v"), msg
+        assert msg.startswith(f"Fitted tool probe on v{active}:"), msg
         assert names("tools") == ["probe", "torch"], names("tools")
+        assert api_get(base, f"/v1/robots/{robot_id}/tools/probe")["number"] == 7
         shot("tool-fitted", "cell")
 
         # 8. Filter the sample URScript program: the report lists its targets
@@ -556,14 +593,17 @@ def main():
         # 8b. A measurement plan: 12 poses in a box, a KRL program and the
         # joints CSV to download, every identified parameter's predicted std.
         form = driver.find_element(By.ID, "measurement-plan")
-        fill(form, dict(poses=12, candidates=200, max_angle_deg=180))
-        Select(form.find_element(By.NAME, "language")).select_by_value("krl")
+        # Every option: the reflector's axis along the tool's x, a 3 kg
+        # payload, the KRL program named CELL_PLAN.
+        fill(form, dict(poses=12, candidates=200, max_angle_deg=180, axis_x=1, axis_z=0,
+                        payload_kg=3, language="krl", name="CELL_PLAN"))
         form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
         wait.until(EC.visibility_of_element_located((By.ID, "plan-result")))
         summary = driver.find_element(By.ID, "plan-summary").text
         assert summary.startswith("12 poses chosen from 200 candidates"), summary
+        assert summary.endswith("at 3.000 kg"), summary
         files = [a.text for a in driver.find_elements(By.CSS_SELECTOR, "#plan-downloads a.plan-file")]
-        assert files[0] == "plan-joints.csv" and any(f.endswith(".src") for f in files), files
+        assert files[0] == "plan-joints.csv" and "CELL_PLAN.src" in files, files
         joints_csv = driver.execute_async_script(
             "const done = arguments[0];"
             "fetch(document.querySelector('#plan-downloads a').href).then(r => r.text()).then(done);")
@@ -589,20 +629,38 @@ def main():
                 for k in range(1, 6):
                     x, y, z = (float(r[c]) for c in ("x_mm", "y_mm", "z_mm"))
                     g.write(f"{r['pose']},{k},{x + 0.1 + 0.01 * (k - 3)!r},{y - 0.05!r},{z + 0.02 * (k - 3)!r}\n")
+        # A second test beside it, "after": offsets whose mean is (0, 0.03,
+        # 0.04) mm, so AP = 0.050 mm at every pose; and the test conditions.
+        after = pathlib.Path(work) / "iso-after.csv"
+        with open(after, "w") as g:
+            g.write("pose,cycle,x_mm,y_mm,z_mm\n")
+            for r in csvmod.DictReader(plan_csv.splitlines()):
+                for k in range(1, 6):
+                    x, y, z = (float(r[c]) for c in ("x_mm", "y_mm", "z_mm"))
+                    g.write(f"{r['pose']},{k},{x + 0.01 * (k - 3)!r},{y + 0.03!r},{z + 0.04 + 0.02 * (k - 3)!r}\n")
         shot("iso-plan", "iso-section")
         form = driver.find_element(By.ID, "iso-figures")
         form.find_element(By.NAME, "measured_file").send_keys(str(measured))
+        form.find_element(By.NAME, "measured_file_2").send_keys(str(after))
+        fill(form, dict(load_kg=3.5, speed_percent=100, measurement="laser tracker AT960"))
         form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
         wait.until(EC.visibility_of_element_located((By.ID, "iso-result")))
+        heads = [th.text for th in driver.find_elements(By.CSS_SELECTOR, "#iso-poses thead th")]
+        assert heads[2] == "AP [mm] (before)" and heads[6] == "AP [mm] (after)", heads
         figures = driver.find_elements(By.CSS_SELECTOR, "#iso-poses tr.iso-figure")
-        aps = [r.find_elements(By.TAG_NAME, "td")[2].text for r in figures]
-        assert aps == ["0.112"] * 5, aps
+        aps = [(r.find_elements(By.TAG_NAME, "td")[2].text, r.find_elements(By.TAG_NAME, "td")[6].text)
+               for r in figures]
+        assert aps == [("0.112", "0.050")] * 5, aps
         assert len(driver.find_elements(By.CSS_SELECTOR, "#iso-distances tr.iso-distance")) == 10
+        conditions = driver.find_element(By.ID, "iso-conditions").text
+        assert re.match(r"UR5 cell 1, model v\d+, \d{4}-\d{2}-\d{2}; ", conditions) and "load 3.5 kg, speed 100 %" in conditions \
+            and "laser tracker AT960" in conditions, conditions
         report = driver.execute_async_script(
             "const done = arguments[0];"
             "fetch(document.getElementById('iso-report-download').href).then(r => r.text()).then(done);")
         assert "<html" in report.lower() and "P1" in report, report[:200]
-        shot("iso-figures", "iso-section")
+        assert "UR5 cell 1" in report and "laser tracker AT960" in report and "after" in report, report[:400]
+        shot("iso-figures", "iso-result")
 
         # 9. Delete a set (asked first): a spare upload of eight poses.
         spare = pathlib.Path(work) / "spare.csv"

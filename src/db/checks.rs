@@ -111,3 +111,25 @@ impl Db {
         }))
     }
 }
+
+/// The latest check of every robot of one page of robots (by id, as
+/// [`Db::robots_page`] pages them, `$1`/`$2` the limit and offset): one query for the whole page, answered
+/// through the `(robot_id, id)` index.
+pub(super) const PAGE_LATEST_CHECKS: &str =
+    "SELECT id, robot_id, set_id, version, status, mean_mm, \
+    temperature_c, result_json, created_at FROM checks WHERE id IN (\
+    SELECT MAX(c.id) FROM checks c \
+    JOIN (SELECT id FROM robots ORDER BY id LIMIT $1 OFFSET $2) r ON c.robot_id = r.id \
+    GROUP BY c.robot_id)";
+
+impl Db {
+    /// One check of a robot; `None` when the robot has no check `id`.
+    pub async fn check(&self, robot_id: i64, id: i64) -> Result<Option<CheckRow>, StoreError> {
+        let sql = format!("{CHECK_SELECT} WHERE robot_id = $1 AND id = $2");
+        Ok(on_pool!(self, |p, k| sqlx::query_as::<_, CheckRow>(&sql)
+            .bind(robot_id)
+            .bind(id)
+            .fetch_optional(p)
+            .await?))
+    }
+}

@@ -94,6 +94,7 @@ pub use calibrations::{JobResult, NewCalibration};
 pub use cell::name_key as cell_name_key;
 pub use checks::{NewCheck, ThresholdRow};
 pub use queue::{ClaimedJob, Lease, RobotChange, RobotChanges};
+pub use robots::RobotsWithChecks;
 pub use set_usage::SetDeletion;
 pub use sets::NewSet;
 pub use versions::{NewVersion, Rollback};

@@ -1,7 +1,7 @@
 //! Robots: the cell's robots and their nominal models.
 
 use super::{commit_inserted, on_pool, write_one, Db, Json, Listing, StoreError};
-use crate::records::{NewRobot, RobotRow};
+use crate::records::{CheckRow, NewRobot, RobotRow};
 use serde_json::{Map, Value};
 
 impl Db {
@@ -90,3 +90,46 @@ const ROBOT_SELECT: &str = "SELECT r.id, r.name, r.preset, r.model_json, r.dof, 
     (SELECT v.version FROM model_versions v WHERE v.robot_id = r.id AND v.active = TRUE) \
     AS active_version \
     FROM robots r";
+
+/// One page of robots and the latest check of each.
+#[derive(Debug, Clone)]
+pub struct RobotsWithChecks {
+    pub robots: Listing<RobotRow>,
+    /// The latest check of each robot of the page that has one (any order).
+    pub latest_checks: Vec<CheckRow>,
+}
+
+impl Db {
+    /// One page of robots by id, how many there are, and the latest check of
+    /// each robot of the page: three statements in one read snapshot, the
+    /// checks of the whole page in one query
+    /// ([`super::checks::PAGE_LATEST_CHECKS`]).
+    pub async fn robots_page_with_checks(
+        &self,
+        limit: i64,
+        offset: i64,
+    ) -> Result<RobotsWithChecks, StoreError> {
+        let list_sql = format!("{ROBOT_SELECT} ORDER BY r.id LIMIT $1 OFFSET $2");
+        on_pool!(self, |p, k| {
+            let mut tx = p.begin_with(k.begin_read()).await?;
+            let rows = sqlx::query_as::<_, RobotRow>(&list_sql)
+                .bind(limit)
+                .bind(offset)
+                .fetch_all(&mut *tx)
+                .await?;
+            let total = sqlx::query_scalar::<_, i64>("SELECT COUNT(*) FROM robots")
+                .fetch_one(&mut *tx)
+                .await?;
+            let latest_checks = sqlx::query_as::<_, CheckRow>(super::checks::PAGE_LATEST_CHECKS)
+                .bind(limit)
+                .bind(offset)
+                .fetch_all(&mut *tx)
+                .await?;
+            tx.commit().await?;
+            Ok(RobotsWithChecks {
+                robots: Listing { rows, total },
+                latest_checks,
+            })
+        })
+    }
+}

@@ -1,6 +1,7 @@
 //! Check poses: `POST /v1/robots/{id}/checks` scores a measurement set
 //! against the active (or a named) version without fitting;
-//! `GET /v1/robots/{id}/checks` is the history; `GET /v1/robots/{id}/status`
+//! `GET /v1/robots/{id}/checks` is the history and
+//! `GET /v1/robots/{id}/checks/{cid}` one check of it; `GET /v1/robots/{id}/status`
 //! the status a plant monitor polls; `PUT /v1/robots/{id}/check-thresholds`
 //! sets the thresholds (defaults: `core::check::CheckThresholds`);
 //! `POST /v1/robots/{id}/reregister` refits a version's measurement frame and
@@ -104,6 +105,16 @@ pub async fn list(
     let listing = service::checks::page(&state, robot_id, page.limit, page.offset).await?;
     let checks: Vec<Check> = listing.rows.into_iter().map(Check::from).collect();
     Ok(axum::Json(page_body(page, listing.total, "checks", checks)?).into_response())
+}
+
+/// `GET /v1/robots/{id}/checks/{cid}`: one check as the history lists it
+/// (404 when the robot or the check is missing).
+pub async fn get_one(
+    State(state): State<AppState>,
+    ApiPath((robot_id, check_id)): ApiPath<(i64, i64)>,
+) -> Result<Response, ApiError> {
+    let row = service::check_reads::get(&state, robot_id, check_id).await?;
+    Ok(axum::Json(Check::from(row)).into_response())
 }
 
 /// `GET /v1/robots/{id}/status`.
@@ -247,6 +258,7 @@ pub fn routes() -> Vec<super::Route> {
     vec![
         get("/v1/robots/{id}/checks", list),
         post("/v1/robots/{id}/checks", create),
+        get("/v1/robots/{id}/checks/{cid}", get_one),
         get("/v1/robots/{id}/status", status),
         post("/v1/robots/{id}/compare", compare),
         post("/v1/robots/{id}/reregister", reregister),

@@ -5,7 +5,7 @@ use super::input::{check_payload, page_body, present, Page, PageQuery};
 use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState};
 use crate::model::presets::{preset_description, PRESETS};
 use crate::model::RobotModel;
-use crate::records::{NewRobot, RobotRow};
+use crate::records::{CheckRow, NewRobot, RobotRow};
 use crate::service;
 use axum::extract::State;
 use axum::http::StatusCode;
@@ -65,7 +65,7 @@ pub struct Robot {
     /// The nominal model description (single-robot responses only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub model: Option<Value>,
-    /// The latest check's status (single-robot responses only).
+    /// Where the robot stands by its latest check.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub check: Option<RobotCheck>,
 }
@@ -81,6 +81,22 @@ pub struct RobotCheck {
     pub mean_mm: Option<f64>,
     /// The frame shift's size when the status is `shifted`.
     pub shift: Option<robocal_core::check::ShiftSize>,
+}
+
+impl RobotCheck {
+    /// Where a robot stands by `latest`, its latest check (`None` before any).
+    pub fn of(latest: Option<&CheckRow>) -> RobotCheck {
+        RobotCheck {
+            status: latest
+                .and_then(service::checks::status_of)
+                .map(|s| s.name()),
+            check_id: latest.map(|c| c.id),
+            checked_at: latest.map(|c| c.created_at.clone()),
+            version: latest.map(|c| c.version),
+            mean_mm: latest.map(|c| c.mean_mm),
+            shift: latest.and_then(service::checks::shift_of),
+        }
+    }
 }
 
 impl Robot {
@@ -219,12 +235,16 @@ pub async fn list(
     ApiQuery(page): ApiQuery<PageQuery>,
 ) -> Result<Response, ApiError> {
     let page = page.check(state.limits().page_max)?;
-    let listing = service::robots::page(&state, page.limit, page.offset).await?;
+    let listing = service::check_reads::robots_page(&state, page.limit, page.offset).await?;
     let total = listing.total;
     let robots = listing
-        .rows
+        .robots
         .into_iter()
-        .map(|r| Robot::from_row(r, false))
+        .map(|r| {
+            let mut robot = Robot::from_row(r.robot, false)?;
+            robot.check = Some(RobotCheck::of(r.latest_check.as_ref()));
+            Ok(robot)
+        })
         .collect::<Result<Vec<Robot>, ApiError>>()?;
     Ok(axum::Json(page_body(page, total, "robots", robots)?).into_response())
 }
@@ -234,16 +254,9 @@ pub async fn get_one(
     ApiPath(id): ApiPath<i64>,
 ) -> Result<Response, ApiError> {
     let row = service::robots::get(&state, id).await?;
-    let (status, latest, _) = service::checks::status(&state, id).await?;
+    let (_, latest, _) = service::checks::status(&state, id).await?;
     let mut robot = Robot::from_row(row, true)?;
-    robot.check = Some(RobotCheck {
-        status: status.map(|s| s.name()),
-        check_id: latest.as_ref().map(|c| c.id),
-        checked_at: latest.as_ref().map(|c| c.created_at.clone()),
-        version: latest.as_ref().map(|c| c.version),
-        mean_mm: latest.as_ref().map(|c| c.mean_mm),
-        shift: latest.as_ref().and_then(service::checks::shift_of),
-    });
+    robot.check = Some(RobotCheck::of(latest.as_ref()));
     Ok(axum::Json(robot).into_response())
 }
 

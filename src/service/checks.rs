@@ -59,7 +59,7 @@ impl Stored {
 /// A stored check as answered: at most [`CHECK_POSES_KEPT`] per-pose errors
 /// and `poses_total`, also for a check stored before the cap (which holds
 /// every pose: the largest are kept, their count is the total).
-fn bounded(mut check: CheckRow) -> CheckRow {
+pub(super) fn bounded(mut check: CheckRow) -> CheckRow {
     let result = &mut check.result.0;
     let poses: Option<Vec<PoseError>> = result
         .get("poses")

@@ -15,6 +15,7 @@ pub mod calibrations;
 pub mod cell;
 pub mod cell_fit;
 mod changes;
+pub mod check_reads;
 pub mod checks;
 pub(crate) mod gate;
 mod heap;

@@ -12,7 +12,8 @@
 //! in and out), `cell` (tools, work objects, program filtering), `jobs`
 //! (progress, cancellation, saturation, races), `record` (sets a version uses,
 //! the calibration record, check poses), `checks` (a moved base: the
-//! `shifted` status everywhere; capped per-pose errors), `roles` (keys with
+//! `shifted` status everywhere; capped per-pose errors), `check_reads` (one
+//! check by id, the latest check of each listed robot), `roles` (keys with
 //! roles, open reads, the console's security headers), `one_answer` (a target
 //! solved and filtered, over HTTP and the CLI, gets one configuration),
 //! `progress` (an `auto` job polled to its end:
@@ -25,6 +26,7 @@ mod abandoned;
 mod admission;
 mod cell;
 mod cell_fit;
+mod check_reads;
 mod checks;
 #[path = "../common/mod.rs"]
 mod common;

@@ -10,6 +10,8 @@ use crate::records::VersionRow;
 use crate::records::{CellItemRow, ItemFrame};
 use maud::{html, Markup};
 use robocal_core::model::load::LoadFrame;
+use robocal_core::model::orientation::OrientationConvention;
+use robocal_core::solve::cell::tcp::TcpMethod;
 
 /// Which kind of cell item a form or table holds.
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -222,18 +224,27 @@ fn export_form(id: i64) -> Markup {
 fn fit_forms(id: i64, tools: &[CellItemRow]) -> Markup {
     html! {
         h3 { "Fit a tool (TCP)" }
-        p.note { "One reading a line: the joints [°] (fixed point: the tip held at one point in 4 or more orientations), followed by the tracker's x, y, z [mm] for a reflector on the tool (tracker point)." }
+        p.note { "One reading a line: the joints [°] (fixed point: the tip held at one point in 4 or more orientations), followed by the tracker's x, y, z [mm] for a reflector on the tool (tracker point), and rx, ry, rz [°] for a 6-D probe (tracker frame). The tool's axis, when the readings fit its position only: readings of a second point on the axis nearer the flange, measured like the tip, or joint readings with the tool flat on a plane (3 or more touches)." }
         form #fit-tool data-action="fit-tool" data-robot=(id) {
             label { "Tool " input name="name" required pattern="[A-Za-z0-9_][A-Za-z0-9_.\\-]{0,63}" placeholder="torch"; }
             label { "Method "
                 select name="method" {
-                    option value="fixed_point" { "fixed point (joints)" }
-                    option value="tracker_point" { "tracker point (joints, x, y, z)" }
+                    @for m in TcpMethod::ALL { option value=(m.as_str()) { (tcp_method_text(m)) } }
                 }
             }
             label.wide { "Readings " textarea name="readings" rows="3" placeholder="10, -80, 95, -105, -90, 12" {} }
+            label { "Tool axis "
+                select name="axis" {
+                    option value="" { "— (position only)" }
+                    option value="axis_point" { "a second point on the axis" }
+                    option value="plane" { "the tool flat on a plane (joints)" }
+                }
+            }
+            label.wide { "Axis readings " textarea name="axis_readings" rows="2" placeholder="as the readings" {} }
             label title="The tool's orientation when the readings fit its position only; empty: the stored tool's, kept" { "rx, ry, rz [°] "
                 input name="rpy" placeholder="e.g. 0, 0, 0"; }
+            label title="The controller's tool number; empty: the stored tool's, kept" { "Number " input name="number" type="number" min="1" max="999" step="1"; }
+            label title="The calibrated version to fit on; empty: the active one" { "Version " input name="version" type="number" min="1" step="1" placeholder="active"; }
             label.check { input type="checkbox" name="force" value="true"; " store even a fit judged implausible" }
             button type="submit" { "Fit tool" }
         }
@@ -251,6 +262,15 @@ fn fit_forms(id: i64, tools: &[CellItemRow]) -> Markup {
             button type="submit" { "Fit work object" }
         }
         p #fit-result hidden {}
+    }
+}
+
+/// What a TCP method reads, for its choice in the form.
+fn tcp_method_text(m: TcpMethod) -> &'static str {
+    match m {
+        TcpMethod::FixedPoint => "fixed point (joints)",
+        TcpMethod::TrackerPoint => "tracker point (joints, x, y, z)",
+        TcpMethod::TrackerFrame => "6-D probe (joints, x, y, z, rx, ry, rz)",
     }
 }
 
@@ -285,12 +305,19 @@ pub fn filter_section(id: i64, versions: &[VersionRow]) -> Markup {
     }
 }
 
-/// Predict poses from joint readings (`POST …/predict`) for robot `id`.
-pub fn predict_section(id: i64, versions: &[VersionRow], tools: &[CellItemRow]) -> Markup {
+/// Predict poses from joint readings (`POST …/predict`) for robot `id`:
+/// every option of the API — model, tool, frame (tracker, base or a work
+/// object), payload and a second orientation convention.
+pub fn predict_section(
+    id: i64,
+    versions: &[VersionRow],
+    tools: &[CellItemRow],
+    work_objects: &[CellItemRow],
+) -> Markup {
     html! {
         section #predict-section {
             h2 { "Predict poses" }
-            p.note { "Controller joint readings in degrees, one reading a line (an id first is optional: p1, 10, -80, 95, 0, 45, 0); the pose of the measured point or of a tool, in mm and degrees (R = Rz·Ry·Rx)." }
+            p.note { "Controller joint readings in degrees, one reading a line (an id first is optional: p1, 10, -80, 95, 0, 45, 0); the pose of the measured point or of a tool, in mm and degrees (R = Rz·Ry·Rx), and in a controller's convention when one is chosen." }
             form #predict data-action="predict" data-robot=(id) {
                 label.wide { "Joint readings " textarea name="readings" rows="3" placeholder="p1, 10, -80, 95, 0, 45, 0" {} }
                 (model_select(versions))
@@ -301,14 +328,26 @@ pub fn predict_section(id: i64, versions: &[VersionRow], tools: &[CellItemRow]) 
                     }
                 }
                 label { "Frame "
-                    select name="frame" { option value="cell" { "cell (tracker)" } option value="base" { "robot base" } }
+                    select name="frame" {
+                        option value="cell" { "tracker (measurement frame)" }
+                        option value="base" { "robot base" }
+                        @for w in work_objects { option value={ "wobj:" (w.name) } { "work object " (w.name) } }
+                    }
+                }
+                label title="The payload the compliance and compensation use; the version's payload when empty" { "Payload [kg] "
+                    input name="payload_kg" type="number" step="any" min="0" max=(crate::http::PAYLOAD_MAX_KG); }
+                label { "Orientation also as "
+                    select name="convention" {
+                        option value="" { "rx, ry, rz only" }
+                        @for c in OrientationConvention::ALL { option value=(c.name()) { (c.name()) } }
+                    }
                 }
                 button type="submit" { "Predict" }
             }
             div #predict-result hidden {
                 p #predict-summary {}
                 table #predict-table {
-                    thead { tr { th { "Id" } th { "Status" } th { "x [mm]" } th { "y [mm]" } th { "z [mm]" } th { "rx [°]" } th { "ry [°]" } th { "rz [°]" } th { "Note" } } }
+                    thead { tr { th { "Id" } th { "Status" } th { "x [mm]" } th { "y [mm]" } th { "z [mm]" } th { "rx [°]" } th { "ry [°]" } th { "rz [°]" } th #predict-convention { "Convention" } th { "Note" } } }
                     tbody {}
                 }
             }

@@ -351,17 +351,26 @@ handlers.predict = async function (form) {
     readings.push(reading);
   }
   if (!readings.length) throw new Error("give at least one joint reading");
-  const body = { readings, frame: formValue(form, "frame") };
+  // The frame: the tracker's, the base, or a work object ("wobj:<name>").
+  const frame = formValue(form, "frame");
+  const body = { readings };
+  if (frame.startsWith("wobj:")) body.work_object = frame.slice(5);
+  else body.frame = frame;
   const version = formValue(form, "version");
   if (version) body.version = /^[0-9]+$/.test(version) ? Number(version) : version;
   const tool = formValue(form, "tool");
   if (tool) body.tool = tool;
+  const payload = formValue(form, "payload_kg");
+  if (payload) body.payload_kg = Number(payload);
+  const convention = formValue(form, "convention");
+  if (convention) body.convention = convention;
   const r = (await sendJson("POST", `/v1/robots/${form.dataset.robot}/predict`, body)).json();
   const tbody = document.querySelector("#predict-table tbody");
   tbody.textContent = "";
   for (const p of r.results) {
     const note = [p.message, p.warning, p.outside_limits.length ? "outside limits: joints " + p.outside_limits.join(", ") : ""].filter((x) => x).join("; ");
-    const cells = [p.id, p.status, fmtMm(p.x), fmtMm(p.y), fmtMm(p.z), fmtDeg(p.rx), fmtDeg(p.ry), fmtDeg(p.rz), note];
+    const other = p.orientation ? p.orientation.values.map((v) => fixed(v, 6)).join(", ") : "—";
+    const cells = [p.id, p.status, fmtMm(p.x), fmtMm(p.y), fmtMm(p.z), fmtDeg(p.rx), fmtDeg(p.ry), fmtDeg(p.rz), other, note];
     const tr = document.createElement("tr");
     tr.className = "predicted";
     for (const c of cells) {
@@ -372,7 +381,8 @@ handlers.predict = async function (form) {
     tbody.append(tr);
   }
   const acc = r.accuracy && r.accuracy.mean_mm !== undefined ? `; expected error ${fmtMm(r.accuracy.mean_mm)} mm mean` : "";
-  const summary = `${r.results.length} poses of ${r.tool || "the measured point"} in the ${r.frame} frame (model: ${r.version === null ? "nominal" : "v" + r.version} ${r.method})${acc}`;
+  document.getElementById("predict-convention").textContent = convention || "Convention";
+  const summary = `${r.results.length} poses of ${r.tool || "the measured point"} in the ${r.frame} frame at ${fixed(r.payload_kg, 3)} kg (model: ${r.version === null ? "nominal" : "v" + r.version} ${r.method})${acc}`;
   document.getElementById("predict-summary").textContent = summary;
   document.getElementById("predict-result").hidden = false;
   show(summary, true);
@@ -452,15 +462,25 @@ handlers["measurement-plan"] = async function (form) {
     poses: Number(formValue(form, "poses")),
     candidates: Number(formValue(form, "candidates")),
     workspace: { min_mm: triple(form, "min"), max_mm: triple(form, "max") },
-    tracker: { position_mm: triple(form, "tracker"), max_angle_deg: Number(formValue(form, "max_angle_deg")) },
+    tracker: {
+      position_mm: triple(form, "tracker"),
+      axis: triple(form, "axis"),
+      max_angle_deg: Number(formValue(form, "max_angle_deg")),
+    },
     noise_mm: Number(formValue(form, "noise_mm")),
     seed: Number(formValue(form, "seed")),
   };
+  const payload = formValue(form, "payload_kg");
+  if (payload) body.payload_kg = Number(payload);
   const language = formValue(form, "language");
-  if (language) body.language = language;
+  if (language) {
+    body.language = language;
+    const name = formValue(form, "name");
+    if (name) body.name = name;
+  }
   const r = (await sendJson("POST", `/v1/robots/${form.dataset.robot}/measurement-plans`, body)).json();
   const c = r.counts;
-  const summary = `${r.poses} poses chosen from ${c.drawn} candidates (${c.reachable} reachable, ${c.in_box} in the box, ${c.in_sight} in sight)`;
+  const summary = `${r.poses} poses chosen from ${c.drawn} candidates (${c.reachable} reachable, ${c.in_box} in the box, ${c.in_sight} in sight) at ${fixed(r.payload_kg, 3)} kg`;
   document.getElementById("plan-summary").textContent = summary;
   planDownloads("plan-downloads", "plan-joints.csv", r.joints_csv, r.program, "plan-file");
   const tbody = document.querySelector("#plan-params tbody");
@@ -498,28 +518,69 @@ handlers["iso-plan"] = async function (form) {
   show(summary, true);
 };
 
-// ISO 9283 figures from the plan CSV and the measured cycles, and the report page.
+// ISO 9283 figures from the plan CSV and the measured cycles of one or two
+// tests (side by side), with the test's conditions, and the report page.
 handlers["iso-figures"] = async function (form) {
-  const measured = await fileOrText(form, "measured_file", "measured_csv");
-  if (!measured) throw new Error("choose the measured cycles CSV or paste it");
-  const body = JSON.stringify({ tests: [{ label: formValue(form, "label") || "test", plan_csv: formValue(form, "plan_csv"), measured_csv: measured }] });
+  const planCsv = formValue(form, "plan_csv");
+  const tests = [];
+  for (const suffix of ["", "_2"]) {
+    const measured = await fileOrText(form, "measured_file" + suffix, "measured_csv" + suffix);
+    if (measured) tests.push({ label: formValue(form, "label" + suffix) || `test ${tests.length + 1}`, plan_csv: planCsv, measured_csv: measured });
+  }
+  if (!tests.length) throw new Error("choose the measured cycles CSV or paste it");
+  const conditions = { robot_id: Number(form.dataset.robot) };
+  for (const name of ["load_kg", "speed_percent"]) {
+    const v = formValue(form, name);
+    if (v) conditions[name] = Number(v);
+  }
+  for (const name of ["date", "measurement"]) {
+    const v = formValue(form, name);
+    if (v) conditions[name] = v;
+  }
+  const body = JSON.stringify({ tests, conditions });
   const r = (await api("POST", "/v1/iso9283/csv", body, "application/json")).json();
   const report = await api("POST", "/v1/iso9283/csv", body, "application/json", "text/html");
   document.getElementById("iso-report-download").href = URL.createObjectURL(new Blob([report.text], { type: "text/html" }));
-  const t = r.tests[0];
+  const c = r.conditions || {};
+  const stated = (x, unit) => (x === null || x === undefined ? "not stated" : x + unit);
+  document.getElementById("iso-conditions").textContent =
+    `${c.robot || "robot not stated"}, model ${/^[0-9]+$/.test(c.model_version || "") ? "v" + c.model_version : c.model_version || "not stated"}, ${c.date || ""}; load ${stated(c.load_kg, " kg")}, speed ${stated(c.speed_percent, " %")}; measurement: ${c.measurement || "not stated"}`;
   const figure = (f, value) => (f.outcome === "computed" ? value(f) : "— " + f.message);
+  const head = (table, first, columns) => {
+    const thead = document.querySelector(`#${table} thead`);
+    thead.textContent = "";
+    const tr = document.createElement("tr");
+    for (const text of [first, ...r.tests.flatMap((t) => columns.map((c) => `${c} (${t.label})`))]) {
+      const th = document.createElement("th");
+      th.textContent = text;
+      tr.append(th);
+    }
+    thead.append(tr);
+  };
+  head("iso-poses", "Pose", ["Cycles", "AP [mm]", "APx, APy, APz [mm]", "RP [mm]"]);
   const poses = document.querySelector("#iso-poses tbody");
   poses.textContent = "";
-  for (const p of t.poses) {
-    appendRow(poses, [p.pose, p.cycles, figure(p.ap, (f) => fmtMm(f.ap_mm)), figure(p.ap, (f) => f.ap_xyz_mm.map(fmtMm).join(", ")), figure(p.rp, (f) => fmtMm(f.rp_mm))], "iso-figure");
-  }
+  r.tests[0].poses.forEach((p, i) => {
+    const cells = [p.pose];
+    for (const t of r.tests) {
+      const q = t.poses[i];
+      cells.push(q.cycles, figure(q.ap, (f) => fmtMm(f.ap_mm)), figure(q.ap, (f) => f.ap_xyz_mm.map(fmtMm).join(", ")), figure(q.rp, (f) => fmtMm(f.rp_mm)));
+    }
+    appendRow(poses, cells, "iso-figure");
+  });
+  head("iso-distances", "Poses", ["AD [mm]", "RD [mm]"]);
   const distances = document.querySelector("#iso-distances tbody");
   distances.textContent = "";
-  for (const d of t.distances) {
-    appendRow(distances, [`${d.from}–${d.to}`, figure(d.ad, (f) => fmtMm(f.ad_mm)), figure(d.rd, (f) => fmtMm(f.rd_mm))], "iso-distance");
-  }
+  r.tests[0].distances.forEach((d, i) => {
+    const cells = [`${d.from}–${d.to}`];
+    for (const t of r.tests) {
+      const e = t.distances[i];
+      cells.push(figure(e.ad, (f) => fmtMm(f.ad_mm)), figure(e.rd, (f) => fmtMm(f.rd_mm)));
+    }
+    appendRow(distances, cells, "iso-distance");
+  });
   document.getElementById("iso-result").hidden = false;
-  show(`ISO 9283 figures of ${t.poses.length} poses and ${t.distances.length} distances`, true);
+  show(`ISO 9283 figures of ${r.tests.length} test(s): ${r.tests[0].poses.length} poses and ${r.tests[0].distances.length} distances`, true);
 };
 
 // Fits: the rows of a textarea as numbers (a leading word kept apart).
@@ -550,12 +611,30 @@ function fitAnswer(r, what) {
   show(box.textContent, false);
 }
 
+// A TCP reading as its method measures it: joints, then the tracker's
+// x, y, z (tracker point) and rx, ry, rz (6-D probe).
+function toolReading(method, values) {
+  if (method === "tracker_point") return { joints_deg: values.slice(0, -3), xyz_mm: values.slice(-3) };
+  if (method === "tracker_frame") return { joints_deg: values.slice(0, -6), xyz_mm: values.slice(-6, -3), rpy_deg: values.slice(-3) };
+  return { joints_deg: values };
+}
+
 handlers["fit-tool"] = async function (form) {
   const method = formValue(form, "method");
-  const readings = rows(formValue(form, "readings")).map((r) =>
-    method === "tracker_point" ? { joints_deg: r.values.slice(0, -3), xyz_mm: r.values.slice(-3) } : { joints_deg: r.values });
+  const readings = rows(formValue(form, "readings")).map((r) => toolReading(method, r.values));
   if (!readings.length) throw new Error("give the readings, one a line");
   const body = { method, readings };
+  const axis = formValue(form, "axis");
+  if (axis) {
+    // A plane is touched: joint readings only; a second axis point is measured like the tip.
+    const axisRows = rows(formValue(form, "axis_readings")).map((r) => (axis === "plane" ? { joints_deg: r.values } : toolReading(method, r.values)));
+    if (!axisRows.length) throw new Error("give the axis readings, one a line");
+    body[axis] = axisRows;
+  }
+  for (const name of ["number", "version"]) {
+    const v = formValue(form, name);
+    if (v) body[name] = Number(v);
+  }
   const rpy = rows(formValue(form, "rpy"))[0];
   if (rpy) {
     if (rpy.values.length !== 3) throw new Error("the orientation is three angles: rx, ry, rz");

@@ -52,18 +52,9 @@ pub fn routes() -> Vec<Route> {
 }
 
 async fn robots_page(State(state): State<AppState>) -> Result<Response, ApiError> {
-    let listing = service::robots::page(&state, ROBOTS_SHOWN, 0).await?;
+    let listing = service::check_reads::robots_page(&state, ROBOTS_SHOWN, 0).await?;
     let keys = !state.config().api_keys.is_empty();
-    let mut latest = Vec::with_capacity(listing.rows.len());
-    for r in &listing.rows {
-        latest.push(service::checks::status(&state, r.id).await?.1);
-    }
-    Ok(page(pages::robots(
-        &listing.rows,
-        &latest,
-        listing.total,
-        keys,
-    )))
+    Ok(page(pages::robots(&listing.robots, listing.total, keys)))
 }
 
 async fn robot_page(
@@ -91,29 +82,14 @@ async fn robot_page(
     Ok(page(pages::robot(&view)))
 }
 
-/// Checks read per page while looking one up.
-const CHECKS_PAGE: i64 = 1000;
-
 async fn check_page(
     State(state): State<AppState>,
     ApiPath((id, cid)): ApiPath<(i64, i64)>,
 ) -> Result<Response, ApiError> {
     let robot = service::robots::get(&state, id).await?;
-    let mut offset = 0;
-    loop {
-        let listing = service::checks::page(&state, id, CHECKS_PAGE, offset).await?;
-        if let Some(c) = listing.rows.iter().find(|c| c.id == cid) {
-            let keys = !state.config().api_keys.is_empty();
-            return Ok(page(check_detail::check_page(&robot, c, keys)));
-        }
-        offset += CHECKS_PAGE;
-        if listing.rows.is_empty() || offset >= listing.total {
-            return Err(service::ServiceError::NotFound(format!(
-                "check {cid} of robot {id} not found"
-            ))
-            .into());
-        }
-    }
+    let c = service::check_reads::get(&state, id, cid).await?;
+    let keys = !state.config().api_keys.is_empty();
+    Ok(page(check_detail::check_page(&robot, &c, keys)))
 }
 
 /// An HTML page with the console's security headers.

@@ -10,12 +10,12 @@ use crate::measure::convention::MeasuredOrientation;
 use crate::measure::SetRole;
 use crate::model::presets::PRESETS;
 use crate::records::CellItemRow;
-use crate::records::CheckRow;
 use crate::records::RobotRow;
 use crate::records::SetRow;
 use crate::records::VersionRow;
 use crate::records::{CalibrationRow, JobStatus, ProgressDetail};
 use crate::report::page_head;
+use crate::service::check_reads::RobotWithCheck;
 use crate::service::checks::{shift_of, status_of};
 use maud::{html, Markup, PreEscaped, DOCTYPE};
 
@@ -105,8 +105,8 @@ pub(super) fn layout(title: &str, keys: bool, body: Markup) -> Markup {
 }
 
 /// The start page: robots (each with its latest check's status) and a form
-/// to add one. `latest[i]` is the latest check of `robots[i]`.
-pub fn robots(robots: &[RobotRow], latest: &[Option<CheckRow>], total: i64, keys: bool) -> Markup {
+/// to add one.
+pub fn robots(robots: &[RobotWithCheck], total: i64, keys: bool) -> Markup {
     layout(
         "Robots",
         keys,
@@ -118,7 +118,7 @@ pub fn robots(robots: &[RobotRow], latest: &[Option<CheckRow>], total: i64, keys
                 table #robots {
                     thead { tr { th { "Id" } th { "Name" } th { "Model" } th { "Axes" } th { "Active version" } th { "Latest check" } th { "Created" } } }
                     tbody {
-                        @for (r, last) in robots.iter().zip(latest.iter().chain(std::iter::repeat(&None))) {
+                        @for RobotWithCheck { robot: r, latest_check: last } in robots {
                             tr {
                                 td { (r.id) }
                                 td { a href={ "/ui/robots/" (r.id) } { (r.name) } }
@@ -210,7 +210,7 @@ pub fn robot(v: &RobotView) -> Markup {
                 versions: &v.versions,
             }))
             (super::cell_pages::cell_section(id, &v.tools, &v.work_objects))
-            (super::cell_pages::predict_section(id, &v.versions, &v.tools))
+            (super::cell_pages::predict_section(id, &v.versions, &v.tools, &v.work_objects))
             (super::cell_pages::filter_section(id, &v.versions))
             (super::plan_pages::plan_sections(id))
         },

@@ -38,17 +38,25 @@ pub fn plan_sections(id: i64) -> Markup {
     html! {
         section #plan-section {
             h2 { "Plan the measurements" }
-            p.note { "Poses chosen for D-optimality of the identification within a box (base frame) and the tracker's line of sight; the standard deviation each parameter would be identified with for the tracker's noise." }
+            p.note { "Poses chosen for D-optimality of the identification within a box (base frame) and the tracker's line of sight (a cone about the reflector's axis); the standard deviation each parameter would be identified with for the tracker's noise, at the payload given." }
             form #measurement-plan data-action="measurement-plan" data-robot=(id) {
                 label { "Poses " input name="poses" type="number" min="1" max="300" step="1" value="30"; }
                 label { "Candidates " input name="candidates" type="number" min="1" max="5000" step="1" value="400"; }
                 (triple("Box min", "min", [-600.0, -600.0, 0.0]))
                 (triple("Box max", "max", [600.0, 600.0, 800.0]))
                 (triple("Tracker", "tracker", [2000.0, 0.0, 500.0]))
+                @for (axis, v) in ["x", "y", "z"].iter().zip([0.0, 0.0, 1.0]) {
+                    label title="The reflector's axis in the tool frame (not zero); the sight cone is about it" { "Reflector axis " (axis) " "
+                        input name={ "axis_" (axis) } type="number" step="any" value=(v) required;
+                    }
+                }
                 label { "Sight cone [°] " input name="max_angle_deg" type="number" step="any" min="0" max="180" value="90"; }
                 label { "Tracker noise [mm] " input name="noise_mm" type="number" step="any" min="0" value="0.01"; }
+                label title="The payload carried while measuring; the robot's when empty" { "Payload [kg] "
+                    input name="payload_kg" type="number" step="any" min="0" max=(crate::http::PAYLOAD_MAX_KG); }
                 label { "Seed " input name="seed" type="number" min="0" step="1" value="1"; }
                 (language_select(true))
+                label { "Program name " input name="name" pattern="[A-Za-z][A-Za-z0-9_]{0,23}" placeholder="plan"; }
                 button type="submit" { "Plan" }
             }
             div #plan-result hidden {
@@ -81,21 +89,38 @@ pub fn plan_sections(id: i64) -> Markup {
                     tbody {}
                 }
             }
-            form #iso-figures data-action="iso-figures" {
-                label { "Test " input name="label" value="nominal"; }
+            form #iso-figures data-action="iso-figures" data-robot=(id) {
                 label.wide { "Plan CSV (filled by the layout above) " textarea name="plan_csv" rows="3" {} }
-                label.wide { "Measured cycles CSV " input type="file" name="measured_file" accept=".csv,text/csv"; }
-                label.wide { "or paste it " textarea name="measured_csv" rows="3" placeholder="pose,cycle,x_mm,y_mm,z_mm" {} }
+                fieldset {
+                    legend { "Test 1" }
+                    label { "Label " input name="label" value="before"; }
+                    label.wide { "Measured cycles CSV " input type="file" name="measured_file" accept=".csv,text/csv"; }
+                    label.wide { "or paste it " textarea name="measured_csv" rows="2" placeholder="pose,cycle,x_mm,y_mm,z_mm" {} }
+                }
+                fieldset {
+                    legend { "Test 2 (optional: side by side with test 1, with the change)" }
+                    label { "Label " input name="label_2" value="after"; }
+                    label.wide { "Measured cycles CSV " input type="file" name="measured_file_2" accept=".csv,text/csv"; }
+                    label.wide { "or paste it " textarea name="measured_csv_2" rows="2" placeholder="pose,cycle,x_mm,y_mm,z_mm" {} }
+                }
+                fieldset {
+                    legend { "Test conditions (stated in the report with this robot, its active version and the model's SHA-256)" }
+                    label { "Date " input name="date" type="date"; }
+                    label { "Load [kg] " input name="load_kg" type="number" step="any" min="0" max=(crate::http::PAYLOAD_MAX_KG); }
+                    label { "Speed [%] " input name="speed_percent" type="number" step="any" min="0" max="100"; }
+                    label.wide { "Measurement " input name="measurement" maxlength="200" placeholder="e.g. laser tracker, serial number, SMR"; }
+                }
                 button type="submit" { "Figures" }
             }
             div #iso-result hidden {
                 p { a #iso-report-download download="iso9283-report.html" href="#" { "Download the report (HTML)" } }
+                p #iso-conditions {}
                 table #iso-poses {
-                    thead { tr { th { "Pose" } th { "Cycles" } th { "AP [mm]" } th { "APx, APy, APz [mm]" } th { "RP [mm]" } } }
+                    thead {}
                     tbody {}
                 }
                 table #iso-distances {
-                    thead { tr { th { "Poses" } th { "AD [mm]" } th { "RD [mm]" } } }
+                    thead {}
                     tbody {}
                 }
             }
