@@ -507,7 +507,8 @@ pub fn parameters(r: &ReportView, models: &[Model]) -> Markup {
 }
 
 /// `auto`'s decision in one line: tie or not, the deciding step, the
-/// runner-up and the margin, and the fallback to the better base.
+/// runner-up and the margin, the fallback to the better base and the
+/// blocked-fold veto.
 fn decision_line(d: &super::view::AutoDecisionView) -> String {
     let pct = d.tie_margin * 100.0;
     let mut s = match (&d.runner_up, d.tie) {
@@ -535,6 +536,20 @@ fn decision_line(d: &super::view::AutoDecisionView) -> String {
             f.weaker_mm,
             f.better_mm,
             f.measured_by
+        ));
+    }
+    for c in &d.blocked_checks {
+        s.push_str(&format!(
+            " Blocked-fold veto: {} on {} blocked regions ({} poses, each refitted without its region) {:.4} / {:.4} mm mean / max against {} alone {:.4} / {:.4}, {}.",
+            key_label(&c.option),
+            c.regions,
+            c.poses,
+            c.option_blocked.mean_mm,
+            c.option_blocked.max_mm,
+            key_label(&c.base),
+            c.base_blocked.mean_mm,
+            c.base_blocked.max_mm,
+            c.verdict_label
         ));
     }
     s

@@ -309,6 +309,39 @@ pub struct AutoDecisionView {
     pub tie_margin: f64,
     #[serde(default)]
     pub fallback: Option<BaseFallbackView>,
+    /// The blocked-fold veto's checks (absent in older reports).
+    #[serde(default)]
+    pub blocked_checks: Vec<BlockedCheckView>,
+}
+
+/// One option checked by the blocked-fold veto.
+#[derive(Debug, Clone, Default, Deserialize)]
+pub struct BlockedCheckView {
+    #[serde(default)]
+    pub option: String,
+    #[serde(default)]
+    pub base: String,
+    #[serde(default)]
+    pub verdict: String,
+    #[serde(default)]
+    pub verdict_label: String,
+    #[serde(default)]
+    pub regions: usize,
+    #[serde(default)]
+    pub poses: usize,
+    #[serde(default)]
+    pub option_blocked: BlockedFiguresView,
+    #[serde(default)]
+    pub base_blocked: BlockedFiguresView,
+}
+
+/// Held-out errors on the blocked regions [mm].
+#[derive(Debug, Clone, Copy, Default, Deserialize)]
+pub struct BlockedFiguresView {
+    #[serde(default)]
+    pub mean_mm: f64,
+    #[serde(default)]
+    pub max_mm: f64,
 }
 
 /// The better base that took over from an option on the weaker one.

@@ -206,7 +206,8 @@ enum JobMessage {
 /// do not depend on the others nor on the thread count (each draws from its
 /// own generator). `job(i, report)` calls `report(epoch, loss)`, which
 /// returns false once the calling thread's `jobs.progress` cancelled; jobs
-/// not started by then are not run.
+/// not started by then are not run, and `jobs.progress` is not called
+/// again.
 pub fn run_jobs<T, E, J>(n: usize, jobs: Jobs<'_, E>, job: J) -> Result<Vec<T>, E>
 where
     T: Send,
@@ -258,6 +259,10 @@ where
                 JobMessage::Done(i) => {
                     running.remove(&i);
                 }
+            }
+            // Once cancelled, `progress` is not called again.
+            if cancelled.load(Ordering::SeqCst) {
+                continue;
             }
             if let Some((&i, Some((epoch, loss)))) = running.first_key_value() {
                 if !progress(i, *epoch, *loss) {
@@ -641,6 +646,9 @@ mod tests {
         );
         assert_eq!(r, Err("cancelled".to_string()));
         assert!(started.into_inner() <= 2);
+        // The progress that cancelled is not called again, though the
+        // running jobs still report.
+        assert_eq!(calls, 3);
         // Jobs 3 and 7 fail: job 3's error, whatever ran first.
         let r = run_jobs(10, jobs(3, &mut |_, _, _| true), |i, report| {
             if i == 3 || i == 7 {

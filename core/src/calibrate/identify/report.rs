@@ -10,6 +10,7 @@ use super::identifiability::IdentifiabilityReport;
 use super::joint_maps::{MapCandidate, MapFit, RefusedMap};
 use super::least_squares::LmReport;
 use super::methods::ties::DecidingStep;
+use super::methods::veto::BlockedCheck;
 use super::options::Method;
 use crate::calibrate::compensate::{CvStats, TrainReport};
 use crate::measure::Measurement;
@@ -631,6 +632,11 @@ pub struct AutoDecision {
     /// weaker base.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fallback: Option<BaseFallback>,
+    /// The options the blocked-fold veto checked, in order: each vetoed
+    /// one, then the one delivered (`methods::veto`); empty when the option
+    /// chosen is a base alone or the veto could not run.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub blocked_checks: Vec<BlockedCheck>,
 }
 
 /// The better base took over from an option on the weaker one: beyond its
@@ -668,6 +674,9 @@ impl AutoDecision {
                 "; {} was set aside: it sits on {}, which {} beats outside the trained region ({:.4} against {:.4} mm, {})",
                 f.instead_of, f.weaker_base, f.better_base, f.weaker_mm, f.better_mm, f.measured_by
             ));
+        }
+        for c in &self.blocked_checks {
+            s.push_str(&format!("; blocked-fold veto: {}", c.sentence()));
         }
         s
     }

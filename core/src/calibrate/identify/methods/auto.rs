@@ -10,7 +10,10 @@
 //! within `tie_margin` of each other are a tie, broken by the spatially
 //! blocked folds, the max, the physics of the base, the fewer fitted
 //! quantities), and never delivers an option on the weaker base while one
-//! on the better base is there (`auto_choice`). With
+//! on the better base is there (`auto_choice`). The option chosen is then
+//! judged as delivered on spatially blocked regions against its base alone,
+//! and vetoed when it extrapolates worse (`methods::veto`,
+//! `auto_choice::apply_veto`): `auto` falls to the next option. With
 //! fewer than `min_training_poses` training poses it trains nothing and keeps
 //! the base, saying so. The joint-map methods among the candidates are options
 //! of their own: kept when their cross-validated mean (over the identification
@@ -37,7 +40,7 @@
 //! `AutoSummary::orientation_part` is `not_kept`) and the option scores its
 //! base's (or maps') orientation on the pool.
 
-use super::auto_choice::{choose_among, decide};
+use super::auto_choice::{apply_veto, choose_among, decide};
 use super::auto_tally::{BaseOption, Tally, ORIENTATION_SLACK};
 use super::cache::Cache;
 use super::compensated::{self, base_pool_errors};
@@ -112,6 +115,7 @@ pub(crate) fn run_auto(
         candidates: Vec::new(),
         options: Vec::new(),
         geometry_blocked: Vec::new(),
+        vetoed: Vec::new(),
     };
     for (base, cands) in bases.iter().zip(&per_base) {
         base_option(ctx, cache, &mut t, *base, cands, folds)?;
@@ -127,6 +131,7 @@ pub(crate) fn run_auto(
         decision = decide(ctx, &t)?;
         decision.untried = None;
     }
+    let decision = apply_veto(ctx, cache, &mut t, decision)?;
     choose_among(ctx, t, decision)
 }
 

@@ -14,10 +14,22 @@
 //! the set-aside option's counterpart on the better base ([`counterpart`]:
 //! the same network, or the joint maps, on it) was not among the candidates,
 //! `auto` trains it first and decides again.
+//!
+//! The blocked-fold veto ([`apply_veto`]): the option decided on (unless a
+//! base alone) is refitted without each blocked region and judged there
+//! against its base alone (`methods::delivered`, `methods::veto`); a vetoed
+//! option leaves the options, its base alone joins them when it is not
+//! there, and the rule decides again among the rest, until an option passes
+//! or a base alone is chosen.
 
 use super::auto_tally::{BaseOption, Tally, ORIENTATION_SLACK};
-use super::context::{Context, Outcome};
+use super::cache::Cache;
+use super::compensated::base_pool_errors;
+use super::context::{Context, Outcome, Step};
+use super::delivered::{DeliveredRegions, Delivery};
+use super::maps::base_fit;
 use super::ties::{break_ties, Contender, Physics, TieOutcome};
+use super::veto::{veto, BlockedCheck};
 use super::{Base, Compensated, Method, MethodError, MethodFailure, Run};
 use crate::calibrate::identify::report::{AutoDecision, AutoSummary, BaseFallback};
 
@@ -165,6 +177,8 @@ pub(super) struct Decision {
     /// The set-aside option's counterpart on the better base, with that
     /// base, when it was not among the candidates.
     pub untried: Option<Method>,
+    /// The blocked-fold veto's checks ([`apply_veto`]).
+    pub checks: Vec<BlockedCheck>,
 }
 
 /// The tie rule over the options (module docs), then the fallback to the
@@ -190,7 +204,7 @@ pub(super) fn decide(ctx: &Context, t: &Tally) -> Result<Decision, MethodError> 
         })
     };
     let eligible: Vec<usize> = (0..t.options.len())
-        .filter(|i| !excluded.contains(i))
+        .filter(|i| !excluded.contains(i) && !t.vetoed.contains(i))
         .collect();
     let first = rule(&eligible).ok_or_else(no_option)?;
     let chosen = &t.options[first.winner];
@@ -201,6 +215,7 @@ pub(super) fn decide(ctx: &Context, t: &Tally) -> Result<Decision, MethodError> 
             excluded,
             fallback: None,
             untried: None,
+            checks: Vec::new(),
         });
     };
     let set_aside = option_method(chosen);
@@ -223,6 +238,7 @@ pub(super) fn decide(ctx: &Context, t: &Tally) -> Result<Decision, MethodError> 
             excluded,
             fallback: None,
             untried,
+            checks: Vec::new(),
         });
     };
     Ok(Decision {
@@ -237,7 +253,144 @@ pub(super) fn decide(ctx: &Context, t: &Tally) -> Result<Decision, MethodError> 
             measured_by: b.measured_by,
         }),
         untried,
+        checks: Vec::new(),
     })
+}
+
+/// What `auto` delivers for option `o` (`delivered::Delivery`).
+fn delivery(o: &BaseOption) -> Delivery {
+    let base = match (o.maps, family(o.base)) {
+        (None, b) => b,
+        (Some(_), Base::Km) => Base::KmMaps,
+        (Some(_), _) => Base::SkcmMaps,
+    };
+    Delivery {
+        base,
+        maps_choice: o
+            .maps
+            .and(o.fit.maps.as_ref())
+            .map(|m| (m.chosen.harmonics, m.chosen.ridge)),
+        compensator: o
+            .compensator
+            .as_ref()
+            .and_then(|a| Some((a.method, a.method.compensated()?.network))),
+    }
+}
+
+/// `base` alone as an option, from its fit on the pool (cached).
+fn base_alone(ctx: &Context, cache: &mut Cache, base: Base) -> Result<BaseOption, MethodError> {
+    let (pool, pool_name) = ctx.pool();
+    let fit = base_fit(ctx, cache, base, &mut |_, _| true)?;
+    let e = base_pool_errors(&fit.fit, pool);
+    Ok(BaseOption {
+        base,
+        maps: None,
+        fit,
+        compensator: None,
+        mean_mm: e.stats.mean_mm,
+        max_mm: e.stats.max_mm,
+        blocked_mm: (!ctx.training.is_empty()).then_some(e.stats.mean_mm),
+        alone_mm: Some(e.stats.mean_mm),
+        orientation_deg: e.orientation.as_ref().map(|o| o.mean_deg),
+        orientation_part: None,
+        reason: format!(
+            "{} alone: {:.4} / {:.4} mm mean / max on the {pool_name} poses, the option on it vetoed",
+            base.method().name(),
+            e.stats.mean_mm,
+            e.stats.max_mm
+        ),
+    })
+}
+
+/// The blocked-fold veto over `decision` (module docs): returns the decision
+/// on the option that passed (or a base alone) with the checks made.
+pub(super) fn apply_veto(
+    ctx: &Context,
+    cache: &mut Cache,
+    t: &mut Tally,
+    mut decision: Decision,
+) -> Result<Decision, MethodError> {
+    let margin = ctx.opts.compensator.tie_margin;
+    let mut regions: Option<Option<DeliveredRegions>> = None;
+    let mut checks = Vec::new();
+    let mut first_fallback = None;
+    loop {
+        let w = decision.outcome.winner;
+        let o = &t.options[w];
+        if o.maps.is_none() && o.compensator.is_none() {
+            break;
+        }
+        let (option, method, base) = (delivery(o), option_method(o), family(o.base));
+        let Some(rs) = regions
+            .get_or_insert_with(|| DeliveredRegions::draw(ctx))
+            .as_mut()
+        else {
+            t.notes.push(
+                "the blocked-fold veto did not run: too few poses for two blocked regions with enough left to refit on"
+                    .to_string(),
+            );
+            break;
+        };
+        let at = t.done / t.total;
+        let progress = &mut *t.progress;
+        let mut go = || {
+            progress(&Step {
+                candidate: Some(method),
+                ..Step::plain(at, 0, None)
+            })
+        };
+        let alone = Delivery {
+            base,
+            maps_choice: None,
+            compensator: None,
+        };
+        let judged = (
+            rs.judge(ctx, option, &mut go)?,
+            rs.judge(ctx, alone, &mut go)?,
+        );
+        let (of, bf) = match judged {
+            (Ok(of), Ok(bf)) => (of, bf),
+            (Err(e), _) | (_, Err(e)) => {
+                t.notes.push(format!(
+                    "the blocked-fold veto could not judge {}: {e}",
+                    method.name()
+                ));
+                break;
+            }
+        };
+        let verdict = veto(&of, &bf, margin);
+        let (count, poses) = rs.size();
+        checks.push(BlockedCheck {
+            option: method,
+            base: base.method(),
+            verdict,
+            verdict_label: verdict.label(),
+            regions: count,
+            poses,
+            option_blocked: of,
+            base_blocked: bf,
+        });
+        if !verdict.vetoed() {
+            break;
+        }
+        t.vetoed.push(w);
+        let has_alone = t.options.iter().enumerate().any(|(i, o)| {
+            !t.vetoed.contains(&i)
+                && family(o.base) == base
+                && o.maps.is_none()
+                && o.compensator.is_none()
+        });
+        if !has_alone {
+            let o = base_alone(ctx, cache, base)?;
+            t.options.push(o);
+        }
+        first_fallback = first_fallback.or(decision.fallback.take());
+        decision = decide(ctx, t)?;
+        decision.untried = None;
+    }
+    decision.fallback = decision.fallback.or(first_fallback);
+    decision.checks = checks;
+    Ok(decision)
 }
 
 /// The option `auto` delivers by `decision`, with its reason, the other
@@ -279,6 +432,7 @@ pub(super) fn choose_among(
         mean_margin_mm: o.mean_margin_mm,
         tie_margin: ctx.opts.compensator.tie_margin,
         fallback: decision.fallback,
+        blocked_checks: decision.checks,
     };
     let mut reason = format!(
         "{}; {} mean {:.4} mm on the {pool_name} poses — {}",

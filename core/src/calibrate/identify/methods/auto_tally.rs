@@ -56,4 +56,6 @@ pub(super) struct Tally<'p> {
     /// Per base (KM, SKCM) whose joint maps ran, the mean of its geometry
     /// alone on the maps' spatially blocked folds [mm].
     pub geometry_blocked: Vec<(Base, f64)>,
+    /// Options the blocked-fold veto set aside (`auto_choice::apply_veto`).
+    pub vetoed: Vec<usize>,
 }

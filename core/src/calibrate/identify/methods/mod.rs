@@ -11,6 +11,7 @@
 //! shares fits and compensators between the methods of a calibration, `plan`
 //! sizes their work for the progress bar,
 //! `context` holds what they all read and `trained` a trained compensator;
+//! `veto` and `delivered` judge `auto`'s choice as delivered on blocked regions;
 //! `report` turns a fit into its report.
 
 mod auto;
@@ -19,6 +20,7 @@ mod auto_tally;
 mod cache;
 mod compensated;
 mod context;
+mod delivered;
 mod failure;
 mod maps;
 mod model_based;
@@ -28,6 +30,7 @@ mod report;
 mod run;
 pub mod ties;
 mod trained;
+pub mod veto;
 
 pub(crate) use failure::MethodError;
 pub use failure::MethodFailure;
