@@ -255,6 +255,10 @@ fn positioner_axes_and_held_out_points_from_tracker_readings() {
         let p0 = Vector3::from(fit.reflectors_mm[0]) * 1e-3;
         let (max_fit, rms_fit) = prediction_error(m, &p0, &t);
         let (max_nom, rms_nom) = prediction_error(&nominal(), &nominal_point(&readings), &t);
+        // The same without the nod, for comparison.
+        let (t0, _, fit0) = fitted(seed, 0.0);
+        let q0 = Vector3::from(fit0.reflectors_mm[0]) * 1e-3;
+        let (max_rigid, rms_rigid) = prediction_error(&fit0.model, &q0, &t0);
         let [o1, o2] = expected_zero_offsets(&t);
         let do1 = (m.tilt.zero_offset - o1).to_degrees();
         let do2 = (m.rotate.zero_offset - o2).to_degrees();
@@ -264,7 +268,8 @@ fn positioner_axes_and_held_out_points_from_tracker_readings() {
             "seed {seed}: fit rms {:.4} mm max {:.4} mm ({} iterations, {:?}); axis 1 {d1:.4} mm {a1:.5}°, \
              axis 2 {d2:.4} mm {a2:.5}°; zero offsets off {do1:+.5}° {do2:+.5}° (σ {:.5}° {:.5}°); \
              scales off {ds1:+.2e} {ds2:+.2e} (σ {:.1e} {:.1e}); held-out point 400 mm from axis 2: \
-             calibrated max {max_fit:.4} mm rms {rms_fit:.4} mm, nominal max {max_nom:.3} mm rms {rms_nom:.3} mm",
+             calibrated max {max_fit:.4} mm rms {rms_fit:.4} mm, nominal max {max_nom:.3} mm rms {rms_nom:.3} mm; \
+             calibrated without the nod max {max_rigid:.4} mm rms {rms_rigid:.4} mm",
             fit.rms_mm,
             fit.max_mm,
             fit.solver.iterations,
@@ -283,6 +288,10 @@ fn positioner_axes_and_held_out_points_from_tracker_readings() {
             "seed {seed}: axis 2 {d2} mm {a2}°"
         );
         assert!(max_fit <= 0.03, "seed {seed}: held-out point {max_fit} mm");
+        assert!(
+            max_rigid <= 0.03,
+            "seed {seed}: held-out point without the nod {max_rigid} mm"
+        );
         assert!(
             max_nom > 10.0 * max_fit,
             "seed {seed}: nominal {max_nom} mm"
@@ -345,8 +354,9 @@ fn refused(readings: Vec<PositionerReading>) -> robocal_core::calibrate::externa
 }
 
 /// Too few angles, a span too small to see the scale, a reflector knocked
-/// in its nest half way, one wrong reading (0.25 mm) and a wobble far beyond the
-/// tracker's noise: each refused with its reason.
+/// in its nest half way, one wrong reading (0.25 mm), a reflector on an
+/// axis, readings that name no reflector or are not finite, and a wobble far
+/// beyond the tracker's noise: each refused with its reason.
 #[test]
 fn fits_the_readings_cannot_carry_are_refused() {
     let t = truth(0.002);
@@ -387,6 +397,21 @@ fn fits_the_readings_cannot_carry_are_refused() {
     let e = refused(readings);
     assert_eq!(e.reason, RefusalReason::ResidualOutlier);
     assert_eq!(e.row, Some(31));
+    // Reflector 1 5 mm from axis 2.
+    let mut near = truth(0.002);
+    near.reflectors[1] = Vector3::new(0.005, 0.0, 1.12);
+    let mut req = request(read(&near, &fit_plan(), 9));
+    req.reflectors_mm[1] = [5.0, 0.0, 20.0];
+    let e = fit_positioner(&req).unwrap_err();
+    println!("refused ({:?}): {}", e.reason, e.message);
+    assert_eq!(e.reason, RefusalReason::ReflectorNearAxis);
+    // A reading naming a reflector not given, and one not finite.
+    let mut readings = read(&t, &fit_plan(), 10);
+    readings[3].reflector = 2;
+    assert_eq!(refused(readings).reason, RefusalReason::UnknownReflector);
+    let mut readings = read(&t, &fit_plan(), 10);
+    readings[3].xyz_mm[1] = f64::NAN;
+    assert_eq!(refused(readings).row, Some(4));
     // A wobble of 0.05°: the positioner is not the rigid model.
     let e = refused(read(&truth(0.05), &fit_plan(), 8));
     assert_eq!(e.reason, RefusalReason::ResidualsTooLarge);

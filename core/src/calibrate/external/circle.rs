@@ -55,7 +55,7 @@ pub fn fit_circle(points: &[Vector3<f64>]) -> Option<Circle> {
     }
     let s = ata.lu().solve(&atb)?;
     let r2 = s.z + s.x * s.x + s.y * s.y;
-    if !(r2 > 0.0) || !s.iter().all(|v| v.is_finite()) {
+    if r2.is_nan() || r2 <= 0.0 || !s.iter().all(|v| v.is_finite()) {
         return None;
     }
     let radius = r2.sqrt();

@@ -19,7 +19,7 @@
 
 use super::circle::fit_circle;
 use super::judge::{
-    check_residuals, rms_max, MAX_CONDITION, MIN_ANGLES, MIN_RADIUS_MM, MIN_SPAN_DEG,
+    check_residuals, rms_max, within, MAX_CONDITION, MIN_ANGLES, MIN_RADIUS_MM, MIN_SPAN_DEG,
 };
 use super::outcome::{
     Axis, AxisSigma, CircleReport, FitLimits, PositionerFit, PositionerFitRequest, RefusalReason,
@@ -193,8 +193,12 @@ fn points(req: &PositionerFitRequest, s: &Sweep) -> Vec<Vector3<f64>> {
 fn circle_reports(req: &PositionerFitRequest, all: &[Sweep]) -> Result<Vec<CircleReport>, Refused> {
     let mut out = Vec::new();
     for s in all {
-        let radius_mm = fit_circle(&points(req, s)).map_or(0.0, |c| c.radius * 1e3);
-        let rms_mm = fit_circle(&points(req, s)).map_or(f64::NAN, |c| rms_max(&c.residual).0 * 1e3);
+        // No circle: the points do not spread (a reflector on the axis).
+        let circle = fit_circle(&points(req, s));
+        let radius_mm = circle.as_ref().map_or(0.0, |c| c.radius * 1e3);
+        let rms_mm = circle
+            .as_ref()
+            .map_or(0.0, |c| rms_max(&c.residual).0 * 1e3);
         if radius_mm < MIN_RADIUS_MM {
             return Err(Refused::new(
                 RefusalReason::ReflectorNearAxis,
@@ -416,7 +420,7 @@ pub fn fit_positioner(req: &PositionerFitRequest) -> Result<PositionerFit, Refus
         },
         limits: FitLimits::of(req.tracker_sigma_mm),
     };
-    if !(cond <= MAX_CONDITION) {
+    if !within(cond, MAX_CONDITION) {
         return Err(Refused::new(
             RefusalReason::Singular,
             format!(

@@ -43,6 +43,11 @@ impl FitLimits {
     }
 }
 
+/// `x` is a number no larger than `limit` (NaN is not).
+pub fn within(x: f64, limit: f64) -> bool {
+    x <= limit
+}
+
 /// RMS and largest of `v`.
 pub fn rms_max(v: &[f64]) -> (f64, f64) {
     if v.is_empty() {
@@ -56,7 +61,7 @@ pub fn rms_max(v: &[f64]) -> (f64, f64) {
 /// reading (1-based row).
 pub fn check_residuals(residual_mm: &[f64], limits: &FitLimits) -> Result<(), Refused> {
     let (rms, max) = rms_max(residual_mm);
-    if !(rms <= limits.rms_mm) {
+    if !within(rms, limits.rms_mm) {
         return Err(Refused::new(
             RefusalReason::ResidualsTooLarge,
             format!(
@@ -72,7 +77,7 @@ pub fn check_residuals(residual_mm: &[f64], limits: &FitLimits) -> Result<(), Re
     if let Some((i, r)) = residual_mm
         .iter()
         .enumerate()
-        .find(|(_, r)| !(**r <= limits.max_mm))
+        .find(|(_, r)| !within(**r, limits.max_mm))
     {
         return Err(Refused::new(
             RefusalReason::ResidualOutlier,
