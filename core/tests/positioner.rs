@@ -343,6 +343,28 @@ fn exact_readings_give_the_truth_back() {
     assert!(fit.max_mm < 1e-6, "{}", fit.max_mm);
 }
 
+/// Zero offsets of several degrees (a positioner re-mastered badly) are
+/// found from the circles' start as well: exact readings give them back.
+#[test]
+fn large_zero_offsets_are_found() {
+    let mut t = truth(0.0);
+    t.noise_mm = 0.0;
+    t.tilt.encoder_offset_rad = 6f64.to_radians();
+    t.rotate.encoder_offset_rad = -14f64.to_radians();
+    let fit = fit_positioner(&request(read(&t, &fit_plan(), 0))).unwrap();
+    let [o1, o2] = expected_zero_offsets(&t);
+    println!(
+        "large offsets: fitted {:.6}° {:.6}°, expected {:.6}° {:.6}°",
+        fit.model.tilt.zero_offset.to_degrees(),
+        fit.model.rotate.zero_offset.to_degrees(),
+        o1.to_degrees(),
+        o2.to_degrees()
+    );
+    assert!((fit.model.tilt.zero_offset - o1).abs() < 1e-9);
+    assert!((fit.model.rotate.zero_offset - o2).abs() < 1e-9);
+    assert!(fit.max_mm < 1e-6, "{}", fit.max_mm);
+}
+
 fn refused(readings: Vec<PositionerReading>) -> robocal_core::calibrate::external::Refused {
     match fit_positioner(&request(readings)) {
         Ok(f) => panic!("fitted: rms {} mm", f.rms_mm),
@@ -405,10 +427,21 @@ fn fits_the_readings_cannot_carry_are_refused() {
     let e = fit_positioner(&req).unwrap_err();
     println!("refused ({:?}): {}", e.reason, e.message);
     assert_eq!(e.reason, RefusalReason::ReflectorNearAxis);
-    // A reading naming a reflector not given, and one not finite.
+    // A reading naming a reflector not given, a reflector given but not
+    // read, and a reading not finite.
     let mut readings = read(&t, &fit_plan(), 10);
     readings[3].reflector = 2;
     assert_eq!(refused(readings).reason, RefusalReason::UnknownReflector);
+    let mut req = request(read(&t, &fit_plan(), 10));
+    req.reflectors_mm.push([0.0, 300.0, 20.0]);
+    let e = fit_positioner(&req).unwrap_err();
+    assert_eq!(e.reason, RefusalReason::UnknownReflector);
+    assert!(
+        e.message
+            .contains("reflector 2 is given but has no readings"),
+        "{}",
+        e.message
+    );
     let mut readings = read(&t, &fit_plan(), 10);
     readings[3].xyz_mm[1] = f64::NAN;
     assert_eq!(refused(readings).row, Some(4));

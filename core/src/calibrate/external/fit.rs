@@ -141,6 +141,17 @@ fn check_inputs(req: &PositionerFitRequest) -> Result<(), Refused> {
             .at_row(i + 1));
         }
     }
+    if let Some(k) =
+        (0..req.reflectors_mm.len()).find(|k| !req.readings.iter().any(|r| r.reflector == *k))
+    {
+        let what = if k == 0 {
+            "reflector 0, the reference that defines axis 2's zero, has no readings; read it, or list a reflector that was read first"
+                .to_string()
+        } else {
+            format!("reflector {k} is given but has no readings; leave it out")
+        };
+        return Err(Refused::new(RefusalReason::UnknownReflector, what));
+    }
     Ok(())
 }
 
