@@ -71,7 +71,8 @@ pub struct PositionerFitRequest {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct AxisSigma {
     pub axis: Axis,
-    /// Of the direction (both tilts combined) [deg].
+    /// Of the direction [deg]: axis 1's two tilts combined; axis 2's tilt
+    /// toward axis 1 (its turn about axis 1 is axis 1's zero offset).
     pub direction_deg: f64,
     /// Of the line's position across it (both directions combined) [mm].
     pub point_mm: f64,
