@@ -4,4 +4,5 @@
 //! model leaves (`compensate`).
 
 pub mod compensate;
+pub mod external;
 pub mod identify;

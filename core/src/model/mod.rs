@@ -6,6 +6,7 @@ pub mod calibrated;
 pub mod description;
 pub mod error;
 pub mod export;
+pub mod external;
 pub mod joint_map_table;
 pub mod joint_maps;
 pub mod kinematics;

@@ -23,6 +23,7 @@
 
 mod perturb;
 mod poses;
+pub mod positioner;
 pub mod study;
 mod synthetic;
 mod truth;
