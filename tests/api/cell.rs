@@ -225,16 +225,7 @@ pub(crate) async fn calibrated_robot_with_cell(t: &TestApp) -> (i64, String) {
             json!({ "methods": ["km"], "identification_set_ids": [set], "seed": 1 }),
         )
         .await;
-    assert_eq!(r.status, StatusCode::ACCEPTED, "{}", r.text());
-    let done = t
-        .wait_for(
-            robot,
-            r.json()["id"].as_i64().unwrap(),
-            &["succeeded", "failed"],
-            Duration::from_secs(300),
-        )
-        .await;
-    assert_eq!(done["status"], "succeeded", "{done}");
+    t.succeeds(robot, &r, Duration::from_secs(300)).await;
     let cell = cell_file();
     let r = put(t, TOOLS, &[&rid], json!({ "tools": cell["tools"] })).await;
     assert_eq!(r.status, StatusCode::OK, "{}", r.text());

@@ -36,16 +36,7 @@ async fn calibrated_robot(t: &TestApp) -> String {
             json!({ "methods": ["km"], "identification_set_ids": [set], "seed": 1 }),
         )
         .await;
-    assert_eq!(r.status, StatusCode::ACCEPTED, "{}", r.text());
-    let done = t
-        .wait_for(
-            robot,
-            r.json()["id"].as_i64().unwrap(),
-            &["succeeded", "failed"],
-            Duration::from_secs(300),
-        )
-        .await;
-    assert_eq!(done["status"], "succeeded", "{done}");
+    t.succeeds(robot, &r, Duration::from_secs(300)).await;
     rid
 }
 

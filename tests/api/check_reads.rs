@@ -14,16 +14,7 @@ async fn calibrated(t: &TestApp) -> (i64, String) {
     let r = t
         .start_job(&rid, json!({ "methods": ["km"], "seed": 1 }))
         .await;
-    assert_eq!(r.status, StatusCode::ACCEPTED, "{}", r.text());
-    let done = t
-        .wait_for(
-            robot,
-            r.json()["id"].as_i64().unwrap(),
-            &["succeeded", "failed"],
-            Duration::from_secs(120),
-        )
-        .await;
-    assert_eq!(done["status"], "succeeded", "{done}");
+    t.succeeds(robot, &r, Duration::from_secs(120)).await;
     (robot, rid)
 }
 

@@ -87,16 +87,7 @@ async fn a_moved_base_is_shifted_everywhere_with_its_size() {
             json!({ "methods": ["skcm"], "identification_set_ids": [q1["id"]], "seed": 1 }),
         )
         .await;
-    assert_eq!(r.status, StatusCode::ACCEPTED, "{}", r.text());
-    let done = t
-        .wait_for(
-            robot,
-            r.json()["id"].as_i64().unwrap(),
-            &["succeeded", "failed"],
-            Duration::from_secs(120),
-        )
-        .await;
-    assert_eq!(done["status"], "succeeded", "{done}");
+    t.succeeds(robot, &r, Duration::from_secs(120)).await;
 
     let (seed, n) = (40, 20);
     let set = t
@@ -199,16 +190,7 @@ async fn per_pose_errors_of_a_large_check_are_capped_and_say_so() {
             json!({ "methods": ["km"], "identification_set_ids": [q1["id"]], "seed": 1 }),
         )
         .await;
-    assert_eq!(r.status, StatusCode::ACCEPTED, "{}", r.text());
-    let done = t
-        .wait_for(
-            robot,
-            r.json()["id"].as_i64().unwrap(),
-            &["succeeded", "failed"],
-            Duration::from_secs(120),
-        )
-        .await;
-    assert_eq!(done["status"], "succeeded", "{done}");
+    t.succeeds(robot, &r, Duration::from_secs(120)).await;
     let n = CHECK_POSES_KEPT + 50;
     let set = t
         .upload_csv(robot, &simulated_csv(9, n), "?name=large&role=check")

@@ -39,16 +39,7 @@ async fn calibrated_robot(t: &TestApp) -> String {
                     "validation_set_ids": [va["id"]], "seed": 1 }),
         )
         .await;
-    assert_eq!(r.status, StatusCode::ACCEPTED, "{}", r.text());
-    let done = t
-        .wait_for(
-            robot,
-            r.json()["id"].as_i64().unwrap(),
-            &["succeeded", "failed"],
-            Duration::from_secs(300),
-        )
-        .await;
-    assert_eq!(done["status"], "succeeded", "{done}");
+    t.succeeds(robot, &r, Duration::from_secs(300)).await;
     let cell: Value = serde_json::from_str(&std::fs::read_to_string(cell_path()).unwrap()).unwrap();
     for (path, key) in [
         ("/v1/robots/{id}/tools", "tools"),

@@ -476,6 +476,18 @@ impl TestApp {
             tokio::time::sleep(Duration::from_millis(25)).await;
         }
     }
+
+    /// Asserts that `started` (a `start_job` answer) was accepted and that its
+    /// job ends `succeeded` within `timeout`; the job's last state.
+    pub(crate) async fn succeeds(&self, robot: i64, started: &Resp, timeout: Duration) -> Value {
+        assert_eq!(started.status, StatusCode::ACCEPTED, "{}", started.text());
+        let job = started.json()["id"].as_i64().unwrap();
+        let done = self
+            .wait_for(robot, job, &["succeeded", "failed"], timeout)
+            .await;
+        assert_eq!(done["status"], "succeeded", "{done}");
+        done
+    }
 }
 
 /// The simulated YS100 of the thesis's §7.4 (Table 7.1 + 7.2), measured by a
