@@ -1,5 +1,6 @@
 //! The measurement CSV parser: never panics; what it accepts is finite and
-//! survives a write/parse round trip unchanged.
+//! survives a write/parse round trip unchanged, with its external-axis
+//! columns too.
 #![no_main]
 use libfuzzer_sys::fuzz_target;
 use robocal::measure::csv;
@@ -14,5 +15,10 @@ fuzz_target!(|data: &[u8]| {
         }
         let again = csv::parse(&csv::write(&rows)).expect("written CSV parses");
         assert_eq!(again, rows, "round trip changed the rows");
+    }
+    if let Ok(set) = csv::parse_set(text) {
+        assert!(set.external.iter().all(|e| e.0.iter().flatten().all(|v| v.is_finite())));
+        let again = csv::parse_set(&csv::write_set(&set)).expect("written set parses");
+        assert_eq!(again, set, "round trip changed the set");
     }
 });

@@ -60,6 +60,14 @@ pub const TEMPERATURE_C: Bound = Bound {
     unit: "°C",
 };
 
+/// External-axis values (`e1…e6`) as the controller shows them [mm or
+/// deg]: a 100 m track, or a rotary axis's value within 100000°.
+pub const EXTERNAL_VALUE: Bound = Bound {
+    min: -100_000.0,
+    max: 100_000.0,
+    unit: "mm or deg",
+};
+
 /// Whether `v` is finite and within `b`.
 pub fn within(v: f64, b: &Bound) -> bool {
     v.is_finite() && v >= b.min && v <= b.max

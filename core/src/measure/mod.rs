@@ -20,6 +20,7 @@ pub mod bounds;
 pub mod convention;
 pub mod csv;
 pub mod csv_text;
+pub mod external;
 
 /// Role of a measurement in the calibration (docs/design.md "Data roles").
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]

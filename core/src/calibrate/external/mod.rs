@@ -5,7 +5,8 @@
 //! over every reading gives both lines, zero offsets and scales and the
 //! reflectors' positions ([`problem`]), with residuals and σ; the fit is
 //! judged before it is stored ([`judge`]) and the outcome is typed
-//! ([`outcome`]).
+//! ([`outcome`]); its readings can come from measurement sets with the
+//! axes' columns ([`readings`]).
 //!
 //! Frames: readings in the cell (tracker) frame; the nominal model places the
 //! positioner base in it; lines of axis 1 in the base frame, of axis 2 in the
@@ -17,6 +18,7 @@ pub mod fit;
 pub mod judge;
 pub mod outcome;
 pub mod problem;
+pub mod readings;
 
 pub use fit::fit_positioner;
 pub use outcome::{

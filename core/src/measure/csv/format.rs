@@ -34,7 +34,8 @@ pub fn short_number(v: f64) -> String {
 }
 
 pub(super) const ACCEPTED: &str =
-    "q1..q7 (alias joint_1..joint_7), x, y, z, rx, ry, rz (degrees, fixed-axis XYZ unless \
+    "q1..q7 (alias joint_1..joint_7), e1..e6 (external axes: mm for a linear axis, degrees \
+for a rotary one), x, y, z, rx, ry, rz (degrees, fixed-axis XYZ unless \
 declared intrinsic_xyz; alias rx_deg, ry_deg, rz_deg) or qw, qx, qy, qz (quaternion), \
 std_x, std_y, std_z, std_rx, std_ry, std_rz, payload_kg, \
 temperature_c, set, session; real-data layout: x_t, y_t, z_t, x_dif, y_dif, z_dif, step_order";
@@ -150,6 +151,12 @@ pub enum CsvError {
         bound: crate::model::bounds::Bound,
         hint: &'static str,
     },
+    #[error("line {line}, column `{column}`: empty; the file has this external-axis column, so every row gives its value (or leave the column out)")]
+    MissingExternal { line: usize, column: String },
+    #[error("line {line}, column `{column}`: external-axis values are read as written (mm for a linear axis, degrees for a rotary one); read the file without declaring metres or radians")]
+    ExternalUnits { line: usize, column: String },
+    #[error("line {line}, column `{column}`: external-axis values are read by the track and positioner fits only (docs/external-axes.md); a robot calibration, check or solve does not compose through external axes yet, so the file is refused rather than read as if the axes stood still")]
+    ExternalNotComposed { line: usize, column: String },
     #[error("every position coordinate is within ±{limit} mm: looks like metres, expected millimetres", limit = METRES_SUSPECT_MM)]
     PositionUnits,
     #[error("row {row}: {got} joint values, but the model has {expected} joints")]

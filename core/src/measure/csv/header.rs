@@ -3,11 +3,14 @@
 
 use super::format::{CsvError, ReadOptions, ACCEPTED, MAX_JOINTS, MIN_JOINTS};
 use crate::measure::convention::MeasuredOrientation;
+use crate::measure::external::ExternalAxis;
 
 /// What one header column means.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Col {
     Joint(usize),
+    /// `e1…e6`, by 0-based index.
+    External(usize),
     Pos(usize),
     Rot(usize),
     Quat(usize),
@@ -56,6 +59,12 @@ fn classify(name: &str) -> Option<Col> {
     if fixed.is_some() {
         return fixed;
     }
+    if let Some(n) = name.strip_prefix('e') {
+        return match n.as_bytes() {
+            [d @ b'1'..=b'6'] => Some(Col::External(usize::from(d - b'1'))),
+            _ => None,
+        };
+    }
     let num = name
         .strip_prefix("joint_")
         .or_else(|| name.strip_prefix('q'))?;
@@ -69,6 +78,7 @@ fn canonical_name(c: Col) -> String {
     const XYZ: [&str; 3] = ["x", "y", "z"];
     match c {
         Col::Joint(i) => format!("q{i}"),
+        Col::External(i) => ExternalAxis::ALL[i].column().to_string(),
         Col::Pos(i) => XYZ[i].to_string(),
         Col::Rot(i) => format!("r{}", XYZ[i]),
         Col::Quat(i) => MeasuredOrientation::Quaternion.columns()[i].to_string(),
@@ -89,6 +99,8 @@ pub(super) struct Header {
     pub(super) line: usize,
     pub(super) names: Vec<String>,
     pub(super) joints: Vec<usize>,
+    /// The external-axis columns `e1…e6` the file has, in axis order.
+    pub(super) external: Vec<(ExternalAxis, usize)>,
     /// Canonical `x,y,z` or the real-data `(target, dif)` triples.
     pub(super) position: PositionCols,
     /// The orientation columns (in the convention's order) and their convention.
@@ -140,11 +152,14 @@ fn missing(line: usize, c: Col) -> CsvError {
     }
 }
 
-/// Joints: `q1..qN` contiguous, `MIN_JOINTS <= N <= MAX_JOINTS`.
+/// Joints: `q1..qN` contiguous, `MIN_JOINTS <= N <= MAX_JOINTS`; none at
+/// all only in a file with external-axis columns (`external`: a positioner's
+/// readings carry no robot joints).
 fn joint_columns(
     line: usize,
     cols: &[(Col, usize)],
     find: &dyn Fn(Col) -> Option<usize>,
+    external: bool,
 ) -> Result<Vec<usize>, CsvError> {
     let mut idx: Vec<usize> = cols
         .iter()
@@ -155,6 +170,9 @@ fn joint_columns(
         .collect();
     idx.sort_unstable();
     let n = idx.last().copied().unwrap_or(0);
+    if n == 0 && external {
+        return Ok(Vec::new());
+    }
     if n == 0 {
         return Err(missing(line, Col::Joint(1)));
     }
@@ -257,13 +275,26 @@ pub(super) fn parse_header(
     let names: Vec<String> = fields.iter().map(|s| s.to_ascii_lowercase()).collect();
     let cols = columns(line, &names)?;
     let find = |c: Col| cols.iter().find(|(x, _)| *x == c).map(|(_, i)| *i);
-    let joints = joint_columns(line, &cols, &find)?;
+    let external: Vec<(ExternalAxis, usize)> = ExternalAxis::ALL
+        .into_iter()
+        .filter_map(|a| find(Col::External(a.index())).map(|c| (a, c)))
+        .collect();
+    if let Some(&(axis, _)) = external.first() {
+        if opts.metres || opts.radians {
+            return Err(CsvError::ExternalUnits {
+                line,
+                column: axis.column().to_string(),
+            });
+        }
+    }
+    let joints = joint_columns(line, &cols, &find, !external.is_empty())?;
     let position = position_columns(line, &names, &find)?;
     let rot = orientation_columns(line, &find, opts.orientation)?;
     let (std_pos, std_rot) = std_columns(line, &find, rot.is_some())?;
     Ok(Header {
         line,
         joints,
+        external,
         position,
         rot,
         std_pos,

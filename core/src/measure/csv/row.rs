@@ -7,6 +7,7 @@ use crate::csv_write::read_text;
 use crate::measure::bounds::{self, within};
 use crate::measure::convention::OrientationValueError;
 use crate::measure::csv_text::{self, short_text};
+use crate::measure::external::ExternalValues;
 use crate::measure::{MeasuredPose, SetRole};
 use crate::model::bounds::Bound;
 
@@ -72,6 +73,28 @@ impl Header {
             set: self.set(line, fields)?,
             session: self.session(line, fields)?,
         })
+    }
+
+    /// The row's external-axis values: every column the header has, given,
+    /// finite and within `bounds::EXTERNAL_VALUE`.
+    pub(super) fn external_values(
+        &self,
+        line: usize,
+        fields: &[&str],
+    ) -> Result<ExternalValues, CsvError> {
+        let mut out = ExternalValues::default();
+        for &(axis, c) in &self.external {
+            let v =
+                number(line, &self.names[c], fields[c], self.decimal_comma)?.ok_or_else(|| {
+                    CsvError::MissingExternal {
+                        line,
+                        column: self.names[c].clone(),
+                    }
+                })?;
+            self.within(line, c, v, &bounds::EXTERNAL_VALUE, "")?;
+            out.0[axis.index()] = Some(v);
+        }
+        Ok(out)
     }
 
     /// An optional number of column `c` (if the header has it), within `b`.

@@ -1,0 +1,74 @@
+//! A positioner fit's readings from a measurement set: the reflector's
+//! position `x, y, z` [mm, cell frame] of each row and the values of the two
+//! external-axis columns that hold the positioner's axes (which column is
+//! the tilt and which the rotate axis is the caller's: [`PositionerColumns`]).
+//! One set holds one reflector's readings (a tracker's file per nest); the
+//! request gathers the sets of every reflector.
+
+use super::outcome::PositionerReading;
+use crate::measure::external::{ExternalAxis, MeasurementSet};
+
+/// Which external-axis column holds which positioner axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PositionerColumns {
+    /// Axis 1 (tilt) [deg].
+    pub tilt: ExternalAxis,
+    /// Axis 2 (rotate) [deg].
+    pub rotate: ExternalAxis,
+}
+
+/// Why a set's rows are not a positioner's readings.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ColumnsError {
+    #[error("the tilt and rotate axes are both column `{0}`: name two columns")]
+    SameColumn(ExternalAxis),
+    #[error("the set has no column `{column}` (it has: {has}); the {role} axis's values are read from it")]
+    Missing {
+        column: ExternalAxis,
+        role: &'static str,
+        has: String,
+    },
+    #[error("row {row} has no value of column `{column}`")]
+    MissingValue { row: usize, column: ExternalAxis },
+}
+
+/// Every row of `set` as a reading of reflector `reflector` at the values of
+/// `columns`.
+pub fn positioner_readings(
+    set: &MeasurementSet,
+    columns: PositionerColumns,
+    reflector: usize,
+) -> Result<Vec<PositionerReading>, ColumnsError> {
+    if columns.tilt == columns.rotate {
+        return Err(ColumnsError::SameColumn(columns.tilt));
+    }
+    for (column, role) in [(columns.tilt, "tilt"), (columns.rotate, "rotate")] {
+        if !set.has(column) {
+            let has: Vec<&str> = set.axes.iter().map(|a| a.column()).collect();
+            return Err(ColumnsError::Missing {
+                column,
+                role,
+                has: if has.is_empty() {
+                    "none".into()
+                } else {
+                    has.join(", ")
+                },
+            });
+        }
+    }
+    set.readings()
+        .enumerate()
+        .map(|(i, r)| {
+            let value = |column: ExternalAxis| {
+                r.external
+                    .get(column)
+                    .ok_or(ColumnsError::MissingValue { row: i + 1, column })
+            };
+            Ok(PositionerReading {
+                reflector,
+                values_deg: [value(columns.tilt)?, value(columns.rotate)?],
+                xyz_mm: r.pose.xyz_mm,
+            })
+        })
+        .collect()
+}

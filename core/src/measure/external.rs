@@ -1,0 +1,126 @@
+//! External-axis values carried with measurement readings: the CSV columns
+//! `e1…e6` beside the joints, one value per axis and reading, as the
+//! controller shows it (mm for a linear axis such as a track, degrees for a
+//! rotary one such as a positioner's; the reader cannot tell which and
+//! converts nothing).
+//!
+//! A file without these columns reads as before; a file with them reads
+//! through [`super::csv::parse_set`] into a [`MeasurementSet`], each reading's
+//! values in [`ExternalValues`] (every row gives every column the header
+//! names). The robot-only readers ([`super::csv::parse`]) refuse such a file
+//! naming the column: a robot calibration does not compose through external
+//! axes, and reading the rows as if the axes stood still would be wrong.
+
+use super::MeasuredPose;
+
+/// How many external axes a reading carries at most (`e1…e6`).
+pub const MAX_EXTERNAL_AXES: usize = 6;
+
+/// An external axis by its controller number (a closed set; the column
+/// names, lists and messages derive from it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum ExternalAxis {
+    E1,
+    E2,
+    E3,
+    E4,
+    E5,
+    E6,
+}
+
+impl ExternalAxis {
+    /// Every axis, in column order.
+    pub const ALL: [ExternalAxis; MAX_EXTERNAL_AXES] = [
+        ExternalAxis::E1,
+        ExternalAxis::E2,
+        ExternalAxis::E3,
+        ExternalAxis::E4,
+        ExternalAxis::E5,
+        ExternalAxis::E6,
+    ];
+
+    /// 0 for `e1` … 5 for `e6`.
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    /// The axis of 1-based controller number `n`.
+    pub fn from_number(n: usize) -> Option<ExternalAxis> {
+        n.checked_sub(1).and_then(|i| Self::ALL.get(i).copied())
+    }
+
+    /// The CSV column: `e1` … `e6`.
+    pub fn column(self) -> &'static str {
+        ["e1", "e2", "e3", "e4", "e5", "e6"][self.index()]
+    }
+}
+
+impl std::fmt::Display for ExternalAxis {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.column())
+    }
+}
+
+/// One reading's external-axis values, by axis (mm or degrees as the
+/// controller shows them); `None` for an axis the set does not carry.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ExternalValues(pub [Option<f64>; MAX_EXTERNAL_AXES]);
+
+impl ExternalValues {
+    /// The value of `axis`, if the reading carries it.
+    pub fn get(&self, axis: ExternalAxis) -> Option<f64> {
+        self.0[axis.index()]
+    }
+
+    /// Whether the reading carries no external axis.
+    pub fn is_empty(&self) -> bool {
+        self.0.iter().all(Option::is_none)
+    }
+}
+
+/// A measurement set as read with its external-axis columns: the readings
+/// and, per reading in the same order, its external-axis values. `axes` are
+/// the columns the file had (in column order); every reading carries exactly
+/// those. A set without external axes has `axes` empty and every reading's
+/// values empty.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct MeasurementSet {
+    pub poses: Vec<MeasuredPose>,
+    pub external: Vec<ExternalValues>,
+    pub axes: Vec<ExternalAxis>,
+}
+
+impl MeasurementSet {
+    /// A set of `poses` without external axes.
+    pub fn without_axes(poses: Vec<MeasuredPose>) -> Self {
+        let external = vec![ExternalValues::default(); poses.len()];
+        MeasurementSet {
+            poses,
+            external,
+            axes: Vec::new(),
+        }
+    }
+
+    /// The readings one by one with their external-axis values.
+    pub fn readings(&self) -> impl Iterator<Item = Reading<'_>> {
+        self.poses
+            .iter()
+            .zip(&self.external)
+            .map(|(pose, external)| Reading {
+                pose,
+                external: *external,
+            })
+    }
+
+    /// Whether the set carries `axis`.
+    pub fn has(&self, axis: ExternalAxis) -> bool {
+        self.axes.contains(&axis)
+    }
+}
+
+/// One reading of a [`MeasurementSet`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Reading<'a> {
+    pub pose: &'a MeasuredPose,
+    pub external: ExternalValues,
+}
