@@ -27,6 +27,7 @@ pub mod positioner;
 pub mod positioner_sets;
 pub mod study;
 mod synthetic;
+pub mod track;
 mod truth;
 
 pub use perturb::{
