@@ -1,4 +1,6 @@
-//! Identification of external axes from tracker data. A two-axis tilt-rotate
+//! Identification of external axes from tracker data: a linear track
+//! carrying the robot ([`track`]), its readings a measurement set with the
+//! track's column; and a two-axis tilt-rotate
 //! positioner ([`fit::fit_positioner`]): reflectors on its face plate read by
 //! a tracker at several values of each axis with the other held; a circle per
 //! sweep gives each axis's line as a start ([`circle`]); one least-squares fit
@@ -19,6 +21,7 @@ pub mod judge;
 pub mod outcome;
 pub mod problem;
 pub mod readings;
+pub mod track;
 
 pub use fit::fit_positioner;
 pub use outcome::{

@@ -1,0 +1,388 @@
+//! A linear track identified from simulated tracker readings of the robot it
+//! carries: a 4 m rail from its physics (`robocal_core::sim::track`: scale
+//! off by 0.2 mm/m, rails bent by sums of sines within ±0.1 mm, a carriage
+//! on two bearing blocks yawing by up to about 30″, pitch and roll), the
+//! YS100 with ~1 mm / 0.1° geometric errors calibrated on a fixed base by
+//! the project's own calibration, then measured at 11 track positions and
+//! predicted at 6 held-out positions (values never fitted) through the
+//! fitted track and the calibrated robot. The readings go through a
+//! measurement CSV with an `e1` column.
+//!
+//! Figures: `cargo test -p robocal-core --test track -- --nocapture`.
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use robocal_core::calibrate::external::track::{
+    fit_track, TrackFit, TrackFitRequest, TrackRefusalReason, TrackRefused, UnseenTerm,
+    DEFAULT_MAX_ORDER,
+};
+use robocal_core::calibrate::identify::{calibrate, CalibrationOptions, Method};
+use robocal_core::measure::csv;
+use robocal_core::measure::external::{ExternalAxis, MeasurementSet};
+use robocal_core::measure::to_measurements;
+use robocal_core::model::external::CarriageTerm;
+use robocal_core::model::kinematics::fk;
+use robocal_core::model::{preset, RobotModel};
+use robocal_core::sim::track::TrueTrack;
+use robocal_core::sim::{perturb_geometry, random_configurations, ErrorMagnitudes, TrueRobot};
+
+const SIGMA_MM: f64 = 0.01;
+/// Fitted track values [mm]: every 400 mm over the 4 m.
+const STATIONS: [f64; 11] = [
+    0.0, 400.0, 800.0, 1200.0, 1600.0, 2000.0, 2400.0, 2800.0, 3200.0, 3600.0, 4000.0,
+];
+/// Held-out track values [mm], between the fitted ones.
+const HELD_OUT: [f64; 6] = [200.0, 1000.0, 1400.0, 2600.0, 3000.0, 3800.0];
+const POSES_PER_STATION: usize = 15;
+/// The track's value while the robot is calibrated on a fixed base [mm].
+const FIXED_AT_MM: f64 = 2000.0;
+
+/// The nominal YS100 and its truth: ~1 mm / 0.1° geometric errors, rigid,
+/// 0.01 mm tracker noise.
+fn robot(rng: &mut ChaCha8Rng) -> (RobotModel, TrueRobot) {
+    let nominal = preset("ys100").unwrap();
+    let mut truth = TrueRobot::new(perturb_geometry(
+        &nominal,
+        &ErrorMagnitudes::from_mm_deg(1.0, 0.1),
+        rng,
+    ));
+    truth.noise_mm = SIGMA_MM;
+    (nominal, truth)
+}
+
+/// The robot calibrated on a fixed base (the track standing at
+/// `FIXED_AT_MM`): 40 identification and 30 validation poses, KM. The
+/// calibrated model and the validation RMS [mm].
+fn calibrated_on_fixed_base(
+    nominal: &RobotModel,
+    truth: &TrueRobot,
+    track: &TrueTrack,
+    rng: &mut ChaCha8Rng,
+) -> (RobotModel, f64) {
+    let mut fixed = truth.clone();
+    fixed.tracker_from_base = track.cell_from_base(FIXED_AT_MM);
+    let rows = |n: usize, rng: &mut ChaCha8Rng| {
+        let qs = random_configurations(nominal, n, rng);
+        let r = fixed
+            .measure(&qs, Some(nominal.payload.mass), None, rng)
+            .unwrap();
+        to_measurements(nominal, &r, nominal.payload.mass)
+    };
+    let id = rows(40, rng);
+    let va = rows(30, rng);
+    let opts = CalibrationOptions {
+        methods: vec![Method::Km],
+        ..Default::default()
+    };
+    let report = calibrate(nominal, &id, &va, &opts, &|_| true).unwrap();
+    let km = &report.methods["km"];
+    let val = km.validation.as_ref().unwrap().stats.rms_mm;
+    (km.calibrated.clone(), val)
+}
+
+/// `POSES_PER_STATION` random poses at each of `values`, measured on the
+/// truth carried by `track`, as a set with column e1.
+fn measure(
+    truth: &TrueRobot,
+    nominal: &RobotModel,
+    track: &TrueTrack,
+    values: &[f64],
+    rng: &mut ChaCha8Rng,
+) -> MeasurementSet {
+    let stations: Vec<(f64, Vec<Vec<f64>>)> = values
+        .iter()
+        .map(|v| (*v, random_configurations(nominal, POSES_PER_STATION, rng)))
+        .collect();
+    track
+        .measure(
+            truth,
+            ExternalAxis::E1,
+            &stations,
+            Some(nominal.payload.mass),
+            rng,
+        )
+        .unwrap()
+}
+
+fn request<'a>(
+    robot: &'a RobotModel,
+    set: &'a MeasurementSet,
+    max_order: usize,
+) -> TrackFitRequest<'a> {
+    TrackFitRequest {
+        robot,
+        payload_kg: robot.payload.mass,
+        set,
+        column: ExternalAxis::E1,
+        tracker_sigma_mm: SIGMA_MM,
+        max_order,
+    }
+}
+
+/// 3-D errors [mm] of the readings of `set` predicted through `fit`'s
+/// track and the robot model `robot`.
+fn prediction_errors(fit: &TrackFit, robot: &RobotModel, set: &MeasurementSet) -> Vec<f64> {
+    set.readings()
+        .map(|r| {
+            let v = r.external.get(ExternalAxis::E1).unwrap();
+            let q_ctrl: Vec<f64> = r.pose.q_deg.iter().map(|d| d.to_radians()).collect();
+            let q = robot.joints_from_controller(&q_ctrl);
+            let p = fk(robot, &q).unwrap().p;
+            let x = fit.model.cell_from_base(v).unwrap().transform_point(&p) * 1e3;
+            (x - nalgebra::Vector3::from(r.pose.xyz_mm)).norm()
+        })
+        .collect()
+}
+
+fn rms(v: &[f64]) -> f64 {
+    (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
+}
+
+fn max(v: &[f64]) -> f64 {
+    v.iter().copied().fold(0.0, f64::max)
+}
+
+/// The acceptance: held-out track positions within 1.5× the robot's own
+/// validation error on a fixed base; a fit without maps refused; the terms
+/// the readings cannot see named.
+#[test]
+fn held_out_track_positions_are_predicted_within_the_robots_own_error() {
+    let track = TrueTrack::rail_4m();
+    for seed in [1u64, 2, 3] {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let (nominal, truth) = robot(&mut rng);
+        let (calibrated, robot_val_rms) =
+            calibrated_on_fixed_base(&nominal, &truth, &track, &mut rng);
+        let measured = measure(&truth, &nominal, &track, &STATIONS, &mut rng);
+        // Through the CSV: written with its e1 column, read back.
+        let text = csv::write_set(&measured);
+        assert!(text.starts_with("q1,q2,q3,q4,q5,q6,e1,x,y,z,payload_kg\n"));
+        let set = csv::parse_set(&text).unwrap();
+        assert_eq!(set, measured);
+        let fit = fit_track(&request(&calibrated, &set, DEFAULT_MAX_ORDER)).unwrap_or_else(|e| {
+            panic!(
+                "seed {seed}: {e} {:?}",
+                e.fit.as_ref().map(|f| (&f.maps, &f.stations))
+            )
+        });
+        let held = measure(&truth, &nominal, &track, &HELD_OUT, &mut rng);
+        let errors = prediction_errors(&fit, &calibrated, &held);
+        let (held_rms, held_max) = (rms(&errors), max(&errors));
+        // Without maps (a straight rail: line, scale, zero, mount).
+        let straight = match fit_track(&request(&calibrated, &set, 0)) {
+            Err(TrackRefused {
+                reason: TrackRefusalReason::ResidualsTooLarge,
+                fit: Some(f),
+                ..
+            }) => *f,
+            other => panic!("seed {seed}: a straight rail should be refused, got {other:?}"),
+        };
+        let straight_errors = prediction_errors(&straight, &calibrated, &held);
+        let scale_error_mm_per_m = (fit.model.scale - 1.0) * 1e3;
+        let rail_x = track.cell_from_rail.r.column(0).into_owned();
+        let direction_arcsec = fit
+            .model
+            .rail
+            .direction
+            .cross(&rail_x)
+            .norm()
+            .asin()
+            .to_degrees()
+            * 3600.0;
+        println!(
+            "seed {seed}: robot on a fixed base, validation rms {robot_val_rms:.4} mm; \
+             held-out track positions rms {held_rms:.4} mm (max {held_max:.4}), ratio {:.2}; \
+             without maps rms {:.4} mm (max {:.4}); fit residuals rms {:.4} (max {:.4}) mm; \
+             scale error {scale_error_mm_per_m:.4} mm/m (truth 0.2); direction off the true rail {direction_arcsec:.1}″",
+            held_rms / robot_val_rms,
+            rms(&straight_errors),
+            max(&straight_errors),
+            fit.rms_mm,
+            fit.max_mm,
+        );
+        for m in &fit.maps {
+            println!(
+                "  {:?}: order {} (cv rms {}), amplitude {:.4} {}, station σ {:.4}",
+                m.term,
+                m.order,
+                m.candidates
+                    .iter()
+                    .map(|c| format!("{}:{:.4}", c.order, c.cv_rms))
+                    .collect::<Vec<_>>()
+                    .join(" "),
+                m.amplitude,
+                m.unit,
+                m.station_sigma
+            );
+        }
+        if seed == 1 {
+            println!("{}", fit.model.to_json());
+            for u in &fit.unseen {
+                println!("  unseen {:?}: {}", u.term, u.note);
+            }
+        }
+        assert!(
+            held_rms <= 1.5 * robot_val_rms,
+            "seed {seed}: held-out rms {held_rms} vs robot {robot_val_rms}"
+        );
+        assert!(rms(&straight_errors) > 3.0 * held_rms);
+        assert!(
+            (scale_error_mm_per_m - 0.2).abs() < 0.03,
+            "{scale_error_mm_per_m}"
+        );
+        assert!(direction_arcsec < 20.0, "{direction_arcsec}");
+        let terms: Vec<UnseenTerm> = fit.unseen.iter().map(|u| u.term).collect();
+        assert_eq!(terms, UnseenTerm::ALL.to_vec());
+        // The yaw the truth has is found: its map reaches ≥ 15″.
+        let yaw = fit
+            .maps
+            .iter()
+            .find(|m| m.term == CarriageTerm::Yaw)
+            .unwrap();
+        assert!(yaw.amplitude > 15.0, "yaw {}", yaw.amplitude);
+        // Stored and read back, the same track.
+        let back =
+            robocal_core::model::external::LinearTrack::from_json(&fit.model.to_json()).unwrap();
+        for v in HELD_OUT {
+            let (a, b) = (
+                back.cell_from_base(v).unwrap(),
+                fit.model.cell_from_base(v).unwrap(),
+            );
+            assert!((a.p - b.p).norm() < 1e-9);
+        }
+        // Beyond the travel measured the track refuses.
+        assert!(fit.model.cell_from_base(4000.5).is_err());
+    }
+}
+
+/// With exact readings, the truth robot held and a straight rail whose only
+/// error is its scale, the fit gives the truth back to rounding.
+#[test]
+fn a_straight_rail_comes_back_exactly() {
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let (nominal, mut truth) = robot(&mut rng);
+    truth.noise_mm = 0.0;
+    let mut track = TrueTrack::rail_4m();
+    track.lateral.clear();
+    track.vertical.clear();
+    track.yaw_extra.clear();
+    track.pitch_extra.clear();
+    track.roll.clear();
+    let set = measure(&truth, &nominal, &track, &STATIONS[..6], &mut rng);
+    let fit = fit_track(&request(&truth.model, &set, DEFAULT_MAX_ORDER)).unwrap();
+    assert!(
+        (fit.model.scale - (1.0 + 2e-4)).abs() < 1e-10,
+        "{}",
+        fit.model.scale
+    );
+    assert!(fit.max_mm < 1e-7, "{}", fit.max_mm);
+    for v in [0.0, 777.0, 2000.0] {
+        let (a, b) = (
+            fit.model.cell_from_base(v).unwrap(),
+            track.cell_from_base(v),
+        );
+        assert!(
+            (a.p - b.p).norm() < 1e-10 && (a.r - b.r).norm() < 1e-10,
+            "{v}"
+        );
+    }
+}
+
+/// Readings the track fit cannot carry are refused, naming the station or
+/// the reading.
+#[test]
+fn fits_the_readings_cannot_carry_are_refused() {
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let (nominal, truth) = robot(&mut rng);
+    let track = TrueTrack::rail_4m();
+    let model = &truth.model;
+    let why =
+        |set: &MeasurementSet| fit_track(&request(model, set, DEFAULT_MAX_ORDER)).unwrap_err();
+
+    let few = measure(&truth, &nominal, &track, &STATIONS[..4], &mut rng);
+    assert_eq!(why(&few).reason, TrackRefusalReason::TooFewStations);
+
+    let good = measure(&truth, &nominal, &track, &STATIONS[..7], &mut rng);
+    assert!(fit_track(&request(model, &good, DEFAULT_MAX_ORDER)).is_ok());
+
+    // Station 1200 mm keeps two readings.
+    let mut thin = good.clone();
+    let keep: Vec<usize> = (0..thin.poses.len())
+        .filter(|&i| {
+            thin.external[i].get(ExternalAxis::E1) != Some(1200.0) || i % POSES_PER_STATION < 2
+        })
+        .collect();
+    thin.poses = keep.iter().map(|&i| good.poses[i].clone()).collect();
+    thin.external = keep.iter().map(|&i| good.external[i]).collect();
+    let e = why(&thin);
+    assert_eq!(
+        (e.reason, e.station_mm),
+        (TrackRefusalReason::TooFewPoses, Some(1200.0))
+    );
+
+    // Station 800 mm: the robot held two poses only, read again and again.
+    let mut line = good.clone();
+    let rows: Vec<usize> = (0..good.poses.len())
+        .filter(|&i| good.external[i].get(ExternalAxis::E1) == Some(800.0))
+        .collect();
+    let stations = vec![(
+        800.0,
+        (0..POSES_PER_STATION)
+            .map(|k| {
+                let q = &good.poses[rows[k % 2]].q_deg;
+                nominal
+                    .joints_from_controller(&q.iter().map(|d| d.to_radians()).collect::<Vec<_>>())
+            })
+            .collect::<Vec<_>>(),
+    )];
+    let again = track
+        .measure(
+            &truth,
+            ExternalAxis::E1,
+            &stations,
+            Some(nominal.payload.mass),
+            &mut rng,
+        )
+        .unwrap();
+    for (k, &i) in rows.iter().enumerate() {
+        line.poses[i] = again.poses[k].clone();
+    }
+    let e = why(&line);
+    assert_eq!(
+        (e.reason, e.station_mm),
+        (TrackRefusalReason::Collinear, Some(800.0))
+    );
+
+    // One reading off by 0.15 mm: named.
+    let mut off = good.clone();
+    let i = rows[3];
+    off.poses[i].xyz_mm[2] += 0.15;
+    let e = why(&off);
+    assert_eq!(
+        (e.reason, e.row),
+        (TrackRefusalReason::ResidualOutlier, Some(i + 1))
+    );
+    assert!(e.fit.is_some());
+
+    // The robot's model wrong by 2 mm in a link: stations do not fit it.
+    let mut wrong = truth.model.clone();
+    wrong.links[2].a += 0.002;
+    let e = fit_track(&request(&wrong, &good, DEFAULT_MAX_ORDER)).unwrap_err();
+    assert_eq!(e.reason, TrackRefusalReason::StationResiduals);
+
+    // No column, or the wrong one.
+    let bare = MeasurementSet::without_axes(good.poses.clone());
+    assert_eq!(why(&bare).reason, TrackRefusalReason::MissingColumn);
+    let mut e2 = request(model, &good, DEFAULT_MAX_ORDER);
+    e2.column = ExternalAxis::E2;
+    assert_eq!(
+        fit_track(&e2).unwrap_err().reason,
+        TrackRefusalReason::MissingColumn
+    );
+    let mut sigma = request(model, &good, DEFAULT_MAX_ORDER);
+    sigma.tracker_sigma_mm = 0.0;
+    assert_eq!(
+        fit_track(&sigma).unwrap_err().reason,
+        TrackRefusalReason::NotFinite
+    );
+}
