@@ -28,8 +28,9 @@ use super::compensated::base_pool_errors;
 use super::context::{Context, Outcome, Step};
 use super::delivered::{DeliveredRegions, Delivery};
 use super::maps::base_fit;
+use super::plan::Planner;
 use super::ties::{break_ties, Contender, Physics, TieOutcome};
-use super::veto::{veto, BlockedCheck};
+use super::veto::{veto, worst_edge, BlockedCheck};
 use super::{Base, Compensated, Method, MethodError, MethodFailure, Run};
 use crate::calibrate::identify::report::{AutoDecision, AutoSummary, BaseFallback};
 
@@ -303,7 +304,9 @@ fn base_alone(ctx: &Context, cache: &mut Cache, base: Base) -> Result<BaseOption
 }
 
 /// The blocked-fold veto over `decision` (module docs): returns the decision
-/// on the option that passed (or a base alone) with the checks made.
+/// on the option that passed (or a base alone) with the checks made. Each
+/// check moves the bar over the units `plan::Planner::veto` plans for it
+/// (the first was planned with `auto`; a check after a veto adds its units).
 pub(super) fn apply_veto(
     ctx: &Context,
     cache: &mut Cache,
@@ -311,6 +314,7 @@ pub(super) fn apply_veto(
     mut decision: Decision,
 ) -> Result<Decision, MethodError> {
     let margin = ctx.opts.compensator.tie_margin;
+    let planned = Planner::veto(ctx);
     let mut regions: Option<Option<DeliveredRegions>> = None;
     let mut checks = Vec::new();
     let mut first_fallback = None;
@@ -331,12 +335,16 @@ pub(super) fn apply_veto(
             );
             break;
         };
-        let at = t.done / t.total;
+        if !checks.is_empty() {
+            t.total += planned;
+        }
+        let (at, total) = (t.done, t.total);
         let progress = &mut *t.progress;
-        let mut go = || {
+        // The option's refits, then its base's: half the check's units each.
+        let mut step = |half: f64, f: f64| {
             progress(&Step {
                 candidate: Some(method),
-                ..Step::plain(at, 0, None)
+                ..Step::plain((at + planned * 0.5 * (half + f)) / total, 0, None)
             })
         };
         let alone = Delivery {
@@ -344,11 +352,10 @@ pub(super) fn apply_veto(
             maps_choice: None,
             compensator: None,
         };
-        let judged = (
-            rs.judge(ctx, option, &mut go)?,
-            rs.judge(ctx, alone, &mut go)?,
-        );
-        let (of, bf) = match judged {
+        let of = rs.judge(ctx, option, &mut |f| step(0.0, f))?;
+        let bf = rs.judge(ctx, alone, &mut |f| step(1.0, f))?;
+        t.done += planned;
+        let (of, bf) = match (of, bf) {
             (Ok(of), Ok(bf)) => (of, bf),
             (Err(e), _) | (_, Err(e)) => {
                 t.notes.push(format!(
@@ -358,8 +365,9 @@ pub(super) fn apply_veto(
                 break;
             }
         };
-        let verdict = veto(&of, &bf, margin);
-        let (count, poses) = rs.size();
+        let c = rs.compare(&of, &bf);
+        let verdict = veto(&c.option, &c.base, margin);
+        let [(count, poses), (edges, edge_poses)] = rs.size();
         checks.push(BlockedCheck {
             option: method,
             base: base.method(),
@@ -367,8 +375,11 @@ pub(super) fn apply_veto(
             verdict_label: verdict.label(),
             regions: count,
             poses,
-            option_blocked: of,
-            base_blocked: bf,
+            option_blocked: c.option,
+            base_blocked: c.base,
+            edges,
+            edge_poses,
+            worst_edge: worst_edge(&c.edges).copied(),
         });
         if !verdict.vetoed() {
             break;
@@ -387,6 +398,10 @@ pub(super) fn apply_veto(
         first_fallback = first_fallback.or(decision.fallback.take());
         decision = decide(ctx, t)?;
         decision.untried = None;
+    }
+    if checks.is_empty() {
+        // The check planned with `auto` did not run.
+        t.done += planned;
     }
     decision.fallback = decision.fallback.or(first_fallback);
     decision.checks = checks;

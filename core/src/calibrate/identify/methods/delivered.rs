@@ -1,27 +1,38 @@
-//! `auto`'s options judged as delivered on spatially blocked regions, for
-//! the veto (`methods::veto`).
+//! `auto`'s options judged as delivered on held-out regions of joint space,
+//! for the veto (`methods::veto`).
 //!
-//! The identification and training poses together are split into regions of
-//! joint space (`compensate::blocked_fold_assignment`: k-means of the joint
-//! vectors, each joint scaled by its range; `CompensatorOptions::
-//! blocked_folds` regions, drawn from `ChaCha8Rng(seed + 103)`). For each
-//! region the option is refitted as `auto` would deliver it from the other
-//! poses: the base (KM or SKCM) by LM on the remaining identification poses;
-//! its joint maps, when it has them, cross-validated again over the
-//! harmonics up to the count `auto` chose with its ridge (`joint_maps`,
-//! K = 0 still competing, the maps' own blocked folds skipped); its compensator, when it has one, trained without
+//! The identification and training poses together give two kinds of region
+//! ([`HeldOut`]):
+//!
+//! - **clusters**: `CompensatorOptions::blocked_folds` k-means regions of the
+//!   joint vectors, each joint scaled by its range
+//!   (`compensate::blocked_fold_assignment`, drawn from
+//!   `ChaCha8Rng(seed + 103)`): places inside the drawn poses;
+//! - **edges**: per joint whose drawn range spans at least
+//!   `JointMapSettings::min_range_rad`, the poses in the lowest and in the
+//!   highest [`EDGE_SHARE`] (20 %) of that range: what a joint range cut off
+//!   looks like from inside the data, the model refitted without them
+//!   predicting beyond the range it was fitted on.
+//!
+//! For each region the option is refitted as `auto` would deliver it from
+//! the other poses: the base (KM or SKCM) by LM on the remaining
+//! identification poses; its joint maps, when it has them, cross-validated
+//! again over the harmonics up to the count `auto` chose with its ridge
+//! (`joint_maps`, K = 0 still competing, the maps' own blocked folds
+//! skipped); its compensator, when it has one, trained without
 //! cross-validation on the residuals of the remaining training pool (the
 //! identification poses without one) with its support, so it fades beyond
 //! the joint ranges it saw (`trained::support_of`). The region's poses are
-//! then predicted by that model (`report::predict_compensated`), each once,
-//! in the registered base frame with the refit's session frames; the figures
-//! are their position errors [mm]. A region that leaves too few poses to
-//! refit on is not held out.
+//! then predicted by that model (`report::predict_compensated`) in the
+//! registered base frame with the refit's session frames; the figures are
+//! their position errors [mm], pooled over the clusters (each pose once) and
+//! per edge. A region that leaves fewer than half the identification poses
+//! to refit on is not held out; without two clusters nothing is.
 
 use super::cache::Cache;
 use super::context::Context;
 use super::maps::base_fit;
-use super::veto::BlockedFigures;
+use super::veto::{BlockedFigures, EdgeFigures, EdgeSide};
 use super::{compensated, Base, Method, MethodError};
 use crate::calibrate::compensate::blocked_fold_assignment;
 use crate::calibrate::identify::network::Network;
@@ -34,6 +45,9 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use std::sync::Arc;
 
+/// Share of a joint's drawn range an edge region holds out, at either end.
+pub const EDGE_SHARE: f64 = 0.2;
+
 /// What `auto` delivers for an option: a base with or without its joint
 /// maps, and the compensator on it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -45,9 +59,19 @@ pub(super) struct Delivery {
     pub compensator: Option<(Method, Network)>,
 }
 
+/// What a region holds out (module docs): a closed set.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum HeldOut {
+    /// A k-means cluster of the joint vectors.
+    Cluster,
+    /// The poses at one end of joint `joint`'s (0-based) drawn range.
+    Edge { joint: usize, side: EdgeSide },
+}
+
 /// One region held out: the poses left to refit on, the region's poses and
 /// the fits shared by the options judged on it.
 struct Region {
+    held_out: HeldOut,
     ident: Vec<Measurement>,
     chains: Vec<Chain>,
     training: Vec<Measurement>,
@@ -55,10 +79,25 @@ struct Region {
     cache: Cache,
 }
 
-/// The blocked regions of one `auto` run and what was judged on them.
+/// One delivery's held-out errors [mm], per region in the regions' order.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct Judged {
+    per_region: Vec<Vec<f64>>,
+}
+
+/// An option and its base alone on the same regions: pooled over the
+/// clusters, and per edge.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct Compared {
+    pub option: BlockedFigures,
+    pub base: BlockedFigures,
+    pub edges: Vec<EdgeFigures>,
+}
+
+/// The held-out regions of one `auto` run and what was judged on them.
 pub(super) struct DeliveredRegions {
     regions: Vec<Region>,
-    judged: Vec<(Delivery, Result<BlockedFigures, String>)>,
+    judged: Vec<(Delivery, Result<Judged, String>)>,
 }
 
 /// The options the sub-runs take: the maps' harmonics up to the chosen
@@ -76,73 +115,138 @@ fn sub_options(opts: &CalibrationOptions, maps_choice: Option<(usize, f64)>) -> 
     o
 }
 
+/// The joints whose drawn range over `poses` spans at least
+/// `JointMapSettings::min_range_rad`, with that range [rad].
+fn moving_joints(ctx: &Context, poses: &[&Measurement]) -> Vec<(usize, [f64; 2])> {
+    let n = poses.first().map_or(0, |m| m.q.len());
+    (0..n)
+        .filter_map(|j| {
+            let [lo, hi] = poses.iter().fold([f64::MAX, f64::MIN], |[lo, hi], m| {
+                [lo.min(m.q[j]), hi.max(m.q[j])]
+            });
+            (hi - lo >= ctx.opts.joint_maps.min_range_rad).then_some((j, [lo, hi]))
+        })
+        .collect()
+}
+
+/// Whether `ctx` has poses enough for the clusters (module docs).
+fn clusters_drawn(ctx: &Context) -> bool {
+    let k = ctx.opts.compensator.blocked_folds;
+    k >= 2 && ctx.ident.len() + ctx.training.len() >= 2 * k
+}
+
+/// The regions [`DeliveredRegions::draw`] holds out at most: the clusters
+/// and two edges per moving joint (for the progress plan).
+pub(super) fn planned_regions(ctx: &Context) -> usize {
+    if !clusters_drawn(ctx) {
+        return 0;
+    }
+    let all: Vec<&Measurement> = ctx.ident.iter().chain(ctx.training).collect();
+    ctx.opts.compensator.blocked_folds + 2 * moving_joints(ctx, &all).len()
+}
+
+/// The region of the poses `all[i]` with `held(i)` (identification poses
+/// first, then training).
+fn region_of(
+    ctx: &Context,
+    all: &[&Measurement],
+    held_out: HeldOut,
+    held: impl Fn(usize) -> bool,
+) -> Region {
+    let n_ident = ctx.ident.len();
+    let kept: Vec<usize> = (0..n_ident).filter(|i| !held(*i)).collect();
+    Region {
+        held_out,
+        ident: kept.iter().map(|i| ctx.ident[*i].clone()).collect(),
+        chains: kept.iter().map(|i| ctx.ident_chains[*i].clone()).collect(),
+        training: (0..ctx.training.len())
+            .filter(|i| !held(n_ident + i))
+            .map(|i| ctx.training[i].clone())
+            .collect(),
+        held: (0..all.len())
+            .filter(|i| held(*i))
+            .map(|i| all[i].clone())
+            .collect(),
+        cache: Cache::default(),
+    }
+}
+
 impl DeliveredRegions {
     /// The regions of `ctx`'s identification and training poses (module
-    /// docs); `None` for fewer than two regions or poses than twice their
-    /// number.
+    /// docs); `None` without two clusters.
     pub fn draw(ctx: &Context) -> Option<DeliveredRegions> {
-        let k = ctx.opts.compensator.blocked_folds;
-        let all: Vec<&Measurement> = ctx.ident.iter().chain(ctx.training).collect();
-        if k < 2 || all.len() < 2 * k {
+        if !clusters_drawn(ctx) {
             return None;
         }
+        let k = ctx.opts.compensator.blocked_folds;
+        let all: Vec<&Measurement> = ctx.ident.iter().chain(ctx.training).collect();
         let qs: Vec<&[f64]> = all.iter().map(|m| m.q.as_slice()).collect();
         let mut rng = ChaCha8Rng::seed_from_u64(ctx.opts.compensator.seed.wrapping_add(103));
-        let region = blocked_fold_assignment(&qs, k, &mut rng);
-        let n_ident = ctx.ident.len();
-        let regions = (0..k)
-            .map(|r| {
-                let kept = |i: &usize| region[*i] != r;
-                let idx: Vec<usize> = (0..n_ident).filter(kept).collect();
-                Region {
-                    ident: idx.iter().map(|i| ctx.ident[*i].clone()).collect(),
-                    chains: idx.iter().map(|i| ctx.ident_chains[*i].clone()).collect(),
-                    training: (0..ctx.training.len())
-                        .filter(|i| kept(&(n_ident + i)))
-                        .map(|i| ctx.training[i].clone())
-                        .collect(),
-                    held: (0..all.len())
-                        .filter(|i| region[*i] == r)
-                        .map(|i| all[i].clone())
-                        .collect(),
-                    cache: Cache::default(),
-                }
-            })
-            // Enough left to identify on, and something held out.
-            .filter(|r| !r.held.is_empty() && r.ident.len() >= ctx.ident.len() / 2)
-            .collect::<Vec<_>>();
-        (regions.len() >= 2).then_some(DeliveredRegions {
+        let cluster = blocked_fold_assignment(&qs, k, &mut rng);
+        let mut regions: Vec<Region> = (0..k)
+            .map(|r| region_of(ctx, &all, HeldOut::Cluster, |i| cluster[i] == r))
+            .collect();
+        for (joint, [lo, hi]) in moving_joints(ctx, &all) {
+            let w = EDGE_SHARE * (hi - lo);
+            for side in EdgeSide::ALL {
+                let held = |i: usize| {
+                    let q = all[i].q[joint];
+                    match side {
+                        EdgeSide::Low => q <= lo + w,
+                        EdgeSide::High => q >= hi - w,
+                    }
+                };
+                regions.push(region_of(ctx, &all, HeldOut::Edge { joint, side }, held));
+            }
+        }
+        // Enough left to identify on, and something held out.
+        regions.retain(|r| !r.held.is_empty() && r.ident.len() >= ctx.ident.len() / 2);
+        let clusters = regions
+            .iter()
+            .filter(|r| r.held_out == HeldOut::Cluster)
+            .count();
+        (clusters >= 2).then_some(DeliveredRegions {
             regions,
             judged: Vec::new(),
         })
     }
 
-    /// The regions held out and the poses they hold.
-    pub fn size(&self) -> (usize, usize) {
-        (
-            self.regions.len(),
-            self.regions.iter().map(|r| r.held.len()).sum(),
-        )
+    /// The clusters held out and the poses they hold; the same of the edges.
+    pub fn size(&self) -> [(usize, usize); 2] {
+        let count = |edge: bool| {
+            let of_kind = self
+                .regions
+                .iter()
+                .filter(|r| matches!(r.held_out, HeldOut::Edge { .. }) == edge);
+            of_kind.fold((0, 0), |(n, p), r| (n + 1, p + r.held.len()))
+        };
+        [count(false), count(true)]
     }
 
     /// `delivery` refitted without each region and its poses predicted
     /// (module docs), computed once per run; `Err` says why it could not be
-    /// (a refit failed). `go()` false cancels.
+    /// (a refit failed). `progress(f)` with the fraction `f` of the regions
+    /// done, from inside the refits too; false cancels.
     pub fn judge(
         &mut self,
         ctx: &Context,
         delivery: Delivery,
-        go: &mut dyn FnMut() -> bool,
-    ) -> Result<Result<BlockedFigures, String>, MethodError> {
+        progress: &mut dyn FnMut(f64) -> bool,
+    ) -> Result<Result<Judged, String>, MethodError> {
         if let Some((_, r)) = self.judged.iter().find(|(d, _)| *d == delivery) {
             return Ok(r.clone());
         }
         let opts = sub_options(ctx.opts, delivery.maps_choice);
-        let mut errors = Vec::new();
+        let count = self.regions.len().max(1) as f64;
+        let mut per_region = Vec::with_capacity(self.regions.len());
         let mut failed = None;
-        for region in &mut self.regions {
-            match judge_region(ctx, &opts, region, delivery, go) {
-                Ok(e) => errors.extend(e),
+        for (r, region) in self.regions.iter_mut().enumerate() {
+            let mut go = || progress(r as f64 / count);
+            if !go() {
+                return Err(MethodError::Cancelled);
+            }
+            match judge_region(ctx, &opts, region, delivery, &mut go) {
+                Ok(e) => per_region.push(e),
                 Err(MethodError::Cancelled) => return Err(MethodError::Cancelled),
                 Err(MethodError::Failed(f)) => {
                     failed = Some(f.to_string());
@@ -150,18 +254,57 @@ impl DeliveredRegions {
                 }
             }
         }
+        if !progress(1.0) {
+            return Err(MethodError::Cancelled);
+        }
         let r = match failed {
             Some(f) => Err(f),
-            None => {
-                let n = errors.len().max(1) as f64;
-                Ok(BlockedFigures {
-                    mean_mm: errors.iter().sum::<f64>() / n,
-                    max_mm: errors.iter().copied().fold(0.0, f64::max),
-                })
-            }
+            None => Ok(Judged { per_region }),
         };
         self.judged.push((delivery, r.clone()));
         Ok(r)
+    }
+
+    /// `option` against `base`, both judged on these regions.
+    pub fn compare(&self, option: &Judged, base: &Judged) -> Compared {
+        let pooled = |j: &Judged| {
+            let e: Vec<f64> = self
+                .regions
+                .iter()
+                .zip(&j.per_region)
+                .filter(|(r, _)| r.held_out == HeldOut::Cluster)
+                .flat_map(|(_, e)| e.iter().copied())
+                .collect();
+            figures(&e)
+        };
+        let edges = self
+            .regions
+            .iter()
+            .enumerate()
+            .filter_map(|(i, r)| match r.held_out {
+                HeldOut::Edge { joint, side } => Some(EdgeFigures {
+                    joint: joint + 1,
+                    side,
+                    poses: r.held.len(),
+                    option: figures(&option.per_region[i]),
+                    base: figures(&base.per_region[i]),
+                }),
+                HeldOut::Cluster => None,
+            })
+            .collect();
+        Compared {
+            option: pooled(option),
+            base: pooled(base),
+            edges,
+        }
+    }
+}
+
+/// Mean and max of held-out errors [mm].
+fn figures(errors: &[f64]) -> BlockedFigures {
+    BlockedFigures {
+        mean_mm: errors.iter().sum::<f64>() / errors.len().max(1) as f64,
+        max_mm: errors.iter().copied().fold(0.0, f64::max),
     }
 }
 

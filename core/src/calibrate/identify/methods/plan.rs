@@ -10,12 +10,14 @@
 //! `skcm-payload` its weight less SKCM's. `auto` sums what it runs: per base
 //! (KM, SKCM when gravity loads a joint) the fit and each candidate
 //! compensator, then per base with a joint-map candidate the maps and the
-//! compensators on them. Work the run's cache already holds (a base fitted,
+//! compensators on them, then one check of the blocked-fold veto
+//! ([`Planner::veto`]). Work the run's cache already holds (a base fitted,
 //! a compensator trained with the same folds by an earlier method) costs
 //! nothing, as it costs no time.
 
 use super::cache::Cache;
 use super::context::Context;
+use super::delivered::planned_regions;
 use super::{Base, Method, Run};
 
 /// Trainings of one cross-validated compensator that its table weight is set
@@ -119,7 +121,46 @@ impl Planner {
                 units += self.training(ctx, m, folds);
             }
         }
-        units
+        units + Planner::veto(ctx)
+    }
+
+    /// Units of one check of `auto`'s blocked-fold veto
+    /// (`methods::delivered`): per region it may hold out, the base refitted
+    /// (the heavier of `auto`'s bases) and the costliest of `auto`'s
+    /// joint-map or compensator candidates refitted on it (a joint-map fit's
+    /// units, a compensator's one training without cross-validation); 0 when
+    /// no candidate would be checked. Nothing of it is cached: every region
+    /// refits.
+    pub fn veto(ctx: &Context) -> f64 {
+        let maps = |b: Base| match b {
+            Base::KmMaps => maps_units(Method::KmMaps, Method::Km),
+            Base::SkcmMaps => maps_units(Method::SkcmMaps, Method::Skcm),
+            Base::Km | Base::Skcm => 0.0,
+        };
+        let extra = ctx
+            .opts
+            .compensator
+            .auto_candidates
+            .iter()
+            .filter(|m| ctx.gravity.is_none() || !m.uses_torques())
+            .filter_map(|m| match m.row().run {
+                Run::Maps(b) => Some(maps_units(*m, b.method())),
+                Run::Compensated(c) => Some(
+                    maps(c.base)
+                        + (m.row().weight - c.base.method().row().weight).max(0.0)
+                            / REFERENCE_TRAININGS,
+                ),
+                _ => None,
+            })
+            .reduce(f64::max);
+        let Some(extra) = extra else {
+            return 0.0;
+        };
+        let base = auto_bases(ctx)
+            .iter()
+            .map(|b| b.method().row().weight)
+            .fold(0.0, f64::max);
+        planned_regions(ctx) as f64 * (base + extra)
     }
 }
 
