@@ -10,8 +10,11 @@ screenshot of each step:
   `shifted` -> re-register from it -> activate the new version (confirmed)
   -> check again -> tools and work objects with loads (add, edit in the
   prefilled form and read back over the API, delete confirmed) ->
-  controller data -> predict -> filter a URScript program (files and report
-  downloaded) -> delete a set and a robot (confirmed) -> robot list with the
+  controller data -> predict -> fit a work object, a tool from a tracker
+  point and a tool from a 6-D probe (readings made from a known tool offset
+  with seeded noise; the fit must find it within the noise) -> filter a
+  URScript program (files and report downloaded) -> measurement plan ->
+  ISO 9283 -> delete a set and a robot (confirmed) -> robot list with the
   latest check's status
 
 against a real `robocal serve` with API keys on a temporary database, using
@@ -29,14 +32,18 @@ import csv as csvmod
 import math
 import os
 import pathlib
+from random import Random
 import re
 import shutil
 import socket
+import statistics
 import subprocess
 import sys
 import tempfile
 import time
 
+from console_check_rotations import (fixed_xyz, intrinsic_xyz, matmul, rotation,
+                                     rotation_angle, rotation_rpy)
 from selenium import webdriver
 from selenium.webdriver.chrome.options import Options
 from selenium.common.exceptions import StaleElementReferenceException, WebDriverException
@@ -96,6 +103,17 @@ def shifted_copy(src, dst, shift_mm):
             for k, d in zip(("x_dif", "y_dif", "z_dif"), shift_mm):
                 r[k] = repr(float(r[k]) + d)
             out.writerow(r)
+
+
+def api_post(base, path, body):
+    """POST a JSON body over the API (not through the page); the JSON answer."""
+    import json
+    import urllib.request
+    req = urllib.request.Request(base + path, data=json.dumps(body).encode(), method="POST",
+                                 headers={"Authorization": f"Bearer {KEY}",
+                                          "Content-Type": "application/json"})
+    with urllib.request.urlopen(req, timeout=60) as r:
+        return json.loads(r.read())
 
 
 def free_port():
@@ -248,6 +266,11 @@ def main():
         log = pathlib.Path(work) / "server.log"
         wait.until(lambda d: "work held at the test gate" in log.read_text())
         wait.until(lambda d: text_of(d, "#calibrations tbody tr .status") == "running")
+        # Live progress: the page polls the held job and shows its phase and
+        # percentage (held at its first report, the registration at 0 %).
+        wait.until(lambda d: text_of(d, "#calibrations tbody tr .phase") == "registration")
+        held = text_of(driver, "#calibrations tbody tr .percent")
+        assert held == "0 %", f"the held job's percentage: {held}"
         shot("calibration-held", "calibrations")
         cancel = driver.find_element(By.CSS_SELECTOR, "#calibrations tbody tr button.cancel")
         cancel.click()
@@ -406,6 +429,16 @@ def main():
         wait.until(EC.presence_of_element_located((By.ID, "check-trend")))
         assert len(driver.find_elements(By.CSS_SELECTOR, "#check-trend .check-point")) == 3
         assert len(driver.find_elements(By.CSS_SELECTOR, "#check-trend .version-change")) == 1
+        # A time axis, and a scale the one outlier (the shifted check, about
+        # 2.5 mm) does not set: the thresholds stay in the plot and the
+        # outlier sits on the top edge with its value.
+        ticks = [t.text for t in driver.find_elements(By.CSS_SELECTOR, "#check-trend text.time-tick")]
+        assert len(ticks) >= 2 and all(ticks), f"time axis ticks: {ticks}"
+        top = max(float(t.text) for t in driver.find_elements(By.CSS_SELECTOR, "#check-trend text.y-tick"))
+        assert 1.2 <= top < 2.0, f"the y axis tops out at {top} mm"
+        off = [t.text for t in driver.find_elements(By.CSS_SELECTOR, "#check-trend text.off-scale-label")]
+        assert len(off) == 1 and off[0].startswith("↑ ") and float(off[0][2:]) > top, \
+            f"off-scale labels: {off} above {top} mm"
         shot("trend", "checks-section")
 
         # 7. Tools and work objects: add a tool with its load and a work
@@ -563,6 +596,104 @@ def main():
         assert api_get(base, f"/v1/robots/{robot_id}/tools/probe")["number"] == 7
         shot("tool-fitted", "cell")
 
+        # 7d'. A 6-D probe: the tool `probe6` at a known offset from the
+        # flange, its frame measured by the tracker at the moved set's 20
+        # joint readings. The readings are made here: the active version's
+        # pose of the known tool in the measurement frame (predict over the
+        # API), plus seeded noise of 0.01 mm per axis and a 0.002° rotation
+        # per axis. The console's 6-D fit must find the offset again within
+        # four standard errors of that noise (σ/√20 per axis).
+        known_xyz, known_rpy = [40.0, -25.0, 180.0], [10.0, 25.0, -5.0]
+        with open(moved) as f:
+            joints = [[float(r[f"joint_{j}"]) for j in range(1, 7)] for r in csvmod.DictReader(f)]
+        poses = api_post(base, f"/v1/robots/{robot_id}/predict", {
+            "readings": [{"joints_deg": q} for q in joints],
+            "tool": {"xyz_mm": known_xyz, "rpy_deg": known_rpy}})["results"]
+        rng = Random(2026)
+        noise_mm, noise_deg = 0.01, 0.002
+        lines = []
+        for q, p in zip(joints, poses):
+            assert p["status"] == "ok", p
+            xyz = [p[a] + rng.gauss(0.0, noise_mm) for a in "xyz"]
+            turn = rotation([rng.gauss(0.0, noise_deg) for _ in range(3)])
+            rpy = fixed_xyz(matmul(turn, rotation_rpy([p["rx"], p["ry"], p["rz"]])))
+            lines.append(", ".join(repr(v) for v in q + xyz + rpy))
+        form = driver.find_element(By.ID, "fit-tool")
+        fill(form, dict(name="probe6", method="tracker_frame", rpy="", number="", version=""))
+        driver.execute_script("arguments[0].value = arguments[1]",
+                              form.find_element(By.NAME, "readings"), "\n".join(lines))
+        form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+        wait.until(lambda d: text_of(d, "#message") and (
+            text_of(d, "#message").startswith("Fitted tool probe6") or "not fitted" in text_of(d, "#message")))
+        msg = driver.find_element(By.ID, "message").text
+        assert msg.startswith("Fitted tool probe6 on v") and "rx, ry, rz" in msg, msg
+        fitted = api_get(base, f"/v1/robots/{robot_id}/tools/probe6")
+        bound_mm = 4.0 * noise_mm / math.sqrt(len(lines))
+        off = [g - k for g, k in zip(fitted["xyz_mm"], known_xyz)]
+        assert all(abs(d) < bound_mm for d in off), f"TCP off by {off} mm (bound {bound_mm:.4f})"
+        angle = rotation_angle(rotation_rpy(fitted["rpy_deg"]), rotation_rpy(known_rpy))
+        bound_deg = 4.0 * noise_deg * math.sqrt(3.0 / len(lines))
+        assert angle < bound_deg, f"tool frame off by {angle}° (bound {bound_deg:.5f}°)"
+        shown = driver.find_element(By.CSS_SELECTOR, "#tools tr[data-item=probe6] td.pose").text
+        want = ", ".join(f"{v:.3f}" for v in fitted["xyz_mm"]) + " mm · " \
+            + ", ".join(f"{v:.4f}" for v in fitted["rpy_deg"]) + "°"
+        assert shown == want, (shown, want)
+        print(f"console_check: 6-D probe fit off by {max(abs(d) for d in off):.5f} mm "
+              f"(bound {bound_mm:.5f}) and {angle:.5f}° (bound {bound_deg:.5f})")
+        shot("tool-fitted-6d", "cell")
+        # A work object deleted, asked first.
+        button = driver.find_element(By.CSS_SELECTOR, "#work-objects tr[data-item=fixture] button[data-delete]")
+        button.click()
+        alert = wait.until(EC.alert_is_present())
+        assert "Delete work object fixture?" in alert.text, alert.text
+        alert.accept()
+        wait.until(replaced(button))
+        wait.until(EC.presence_of_element_located((By.ID, "add-tool")))
+        assert names("work-objects") == ["table"], names("work-objects")
+
+        # 7e. A 6-D check set uploaded in another orientation convention: the
+        # measured point's pose at the moved set's joints (predict, no tool)
+        # with the same kind of seeded noise, its orientation written as
+        # intrinsic x, y', z'' angles (R = Rx·Ry·Rz) and uploaded with that
+        # convention chosen in the form. Checked, its errors are the noise's:
+        # under 0.01° and 0.05 mm mean (the same angles read as fixed-axis
+        # ones would be degrees off, checked here too).
+        points = api_post(base, f"/v1/robots/{robot_id}/predict",
+                          {"readings": [{"joints_deg": q} for q in joints]})["results"]
+        six = pathlib.Path(work) / "six-d.csv"
+        misread = []
+        with open(six, "w") as g:
+            g.write("q1,q2,q3,q4,q5,q6,x,y,z,rx,ry,rz\n")
+            for q, p in zip(joints, points):
+                assert p["status"] == "ok", p
+                xyz = [p[a] + rng.gauss(0.0, noise_mm) for a in "xyz"]
+                turn = rotation([rng.gauss(0.0, noise_deg) for _ in range(3)])
+                r = matmul(turn, rotation_rpy([p["rx"], p["ry"], p["rz"]]))
+                abc = intrinsic_xyz(r)
+                misread.append(rotation_angle(rotation_rpy(abc), r))
+                g.write(",".join(repr(v) for v in q + xyz + abc) + "\n")
+        assert statistics.mean(misread) > 1.0, f"the conventions barely differ here: {misread}"
+        n_sets = len(driver.find_elements(By.CSS_SELECTOR, "#sets tbody tr"))
+        form = driver.find_element(By.ID, "upload")
+        form.find_element(By.NAME, "file").send_keys(str(six))
+        Select(form.find_element(By.NAME, "role")).select_by_value("check")
+        Select(form.find_element(By.NAME, "orientation")).select_by_value("intrinsic_xyz")
+        form.find_element(By.NAME, "name").send_keys("6-D probe")
+        form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+        wait.until(replaced(form))
+        wait.until(lambda d: len(d.find_elements(By.CSS_SELECTOR, "#sets tbody tr")) == n_sets + 1)
+        six_set = max(int(td.text) for td in driver.find_elements(By.CSS_SELECTOR, "#sets tbody tr td:first-child"))
+        run_check(six_set)
+        orientation = driver.find_element(
+            By.XPATH, "//table[@id='check-figures']//tr[th[starts-with(., 'Orientation error')]]/td").text
+        assert float(orientation.split(" / ")[0]) < 0.01, f"orientation error mean / p95 / max: {orientation}"
+        position = driver.find_element(By.CSS_SELECTOR, "#check-figures td.position").text
+        assert float(position.split(" / ")[0]) < 0.05, f"position error mean / p95 / max: {position}"
+        shot("check-6d-intrinsic")
+        driver.get(robot_url)
+        wait.until(EC.presence_of_element_located((By.ID, "add-tool")))
+        n_sets += 1
+
         # 8. Filter the sample URScript program: the report lists its targets
         # and the filtered file is offered for download.
         program = ROOT / "examples/programs/urscript/seam.script"
@@ -662,6 +793,20 @@ def main():
         assert "UR5 cell 1" in report and "laser tracker AT960" in report and "after" in report, report[:400]
         shot("iso-figures", "iso-result")
 
+        # 8d. Roll back (asked first): the version active before the
+        # re-registration is active again, on the page and over the API.
+        rollback = driver.find_element(By.ID, "rollback")
+        rollback.click()
+        alert = wait.until(EC.alert_is_present())
+        assert "Roll back" in alert.text, alert.text
+        alert.accept()
+        wait.until(replaced(rollback))
+        wait.until(EC.presence_of_element_located((By.CSS_SELECTOR, "#versions tr.active")))
+        active = driver.find_element(By.CSS_SELECTOR, "#versions tr.active td").text.split()[0]
+        assert active == f"v{active_version}", f"after the roll back {active} is active"
+        assert api_get(base, f"/v1/robots/{robot_id}")["active_version"] == active_version
+        shot("rolled-back", "versions")
+
         # 9. Delete a set (asked first): a spare upload of eight poses.
         spare = pathlib.Path(work) / "spare.csv"
         spare.write_text("".join(random.read_text().splitlines(keepends=True)[:9]))
@@ -671,14 +816,14 @@ def main():
         form.find_element(By.NAME, "name").send_keys("spare")
         form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
         wait.until(replaced(form))
-        wait.until(lambda d: len(d.find_elements(By.CSS_SELECTOR, "#sets tbody tr")) == 4)
+        wait.until(lambda d: len(d.find_elements(By.CSS_SELECTOR, "#sets tbody tr")) == n_sets + 1)
         button = driver.find_elements(By.CSS_SELECTOR, "#sets tbody tr button[data-delete]")[-1]
         button.click()
         alert = wait.until(EC.alert_is_present())
         assert "Delete set" in alert.text and "(spare)" in alert.text, alert.text
         alert.accept()
         wait.until(replaced(button))
-        wait.until(lambda d: len(d.find_elements(By.CSS_SELECTOR, "#sets tbody tr")) == 3)
+        wait.until(lambda d: len(d.find_elements(By.CSS_SELECTOR, "#sets tbody tr")) == n_sets)
         shot("set-deleted", "sets")
 
         # 10. The robot list shows each robot's latest check; a second robot

@@ -17,7 +17,8 @@ set (as in one terminal), and with these changes, and nothing else:
   background with `--bind` on its mapped port, stopping the one this script started on that
   port before (the pages say to stop it), and waits until `/readyz` answers.
 
-A block preceded by `<!-- not run: REASON -->` is not run and is listed with its reason. A
+Run with no file named, it first checks that README.md has at most 300 lines. A block preceded
+by `<!-- not run: REASON -->` is not run and is listed with its reason. A
 block that ends with a non-zero status fails the run with its `file:line`, its output and the
 log of the services started. Python 3 standard library only.
 """
@@ -51,6 +52,8 @@ GUIDE_ORDER = [
 ]
 LINKED = ["examples", "data", "models"]
 BLOCK_TIMEOUT_S = 300
+# The README is a guide, not the manual (run with no file named).
+README_MAX_LINES = 300
 READY_TIMEOUT_S = 60
 
 CARGO_RUN = re.compile(r"cargo run(?: (?:--release|-q|--quiet))* --(?= |$)")
@@ -193,6 +196,10 @@ def main() -> int:
         if missing:
             sys.exit(f"GUIDE_ORDER names pages that do not exist: {missing}")
         files = [ROOT / "README.md"] + [guide / n for n in GUIDE_ORDER + rest]
+        readme_lines = len((ROOT / "README.md").read_text(encoding="utf-8").splitlines())
+        if readme_lines > README_MAX_LINES:
+            sys.exit(f"README.md has {readme_lines} lines, more than {README_MAX_LINES}: it is a "
+                     "guide; the manual belongs in docs/guide/")
 
     work = Path(tempfile.mkdtemp(prefix="robocal-docs-"))
     bindir = work / ".bin"

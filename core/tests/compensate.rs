@@ -22,9 +22,10 @@ use common::{measure_truth, real, shipped_model};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal_core::calibrate::compensate::CompensatorSpec;
+use robocal_core::calibrate::identify::progress::ETA_FROM_FRACTION;
 use robocal_core::calibrate::identify::{
     calibrate, calibrate_with_training, CalibrationOptions, CalibrationReport, CompensatorOptions,
-    Method,
+    Method, Phase, Progress,
 };
 use robocal_core::measure::{self, Measurement};
 use robocal_core::model::calibrated::{CompensatedModel, StoredCompensator};
@@ -379,14 +380,17 @@ fn base_failure_pool_choice_and_cancellation() {
     assert_eq!(r.methods["auto"].model_file_method(), "auto: km");
     assert_eq!(r.methods["auto"].method.name(), "auto");
     // Cancelled from the progress callback during SKCM-NN's training: with
-    // no cross-validation its plan (methods/plan.rs) is SKCM's fit, 1 unit,
-    // and one training, 5 units / 10, so training starts at 10 + 90·1/1.5 %.
+    // no cross-validation its plan (methods/plan.rs) is SKCM's fit, SKCM's
+    // weight, and one training, the weights' difference over the 10
+    // trainings the weight is set for; the training starts after the fit.
     let nominal = preset("ys100").unwrap();
     let ident = measure_truth(&t, &nominal, 60, &mut rng);
     let opts = options(&[Method::SkcmNn], 1, 0);
+    let (fit, nn) = (Method::Skcm.row().weight, Method::SkcmNn.row().weight);
+    let training_from = 10.0 + 90.0 * fit / (fit + (nn - fit) / 10.0);
     let seen = std::sync::atomic::AtomicUsize::new(0);
     let r = calibrate(&nominal, &ident, &[], &opts, &|p| {
-        if p.phase == "skcm-nn" && p.percent > 70.0 + 1e-9 {
+        if p.phase == "skcm-nn" && p.percent > training_from + 1e-9 {
             seen.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
             return false;
         }
@@ -439,6 +443,42 @@ fn real_data_auto_never_worse_than_km_wam() {
     );
 }
 
+/// What a calibration's every progress report showed: the percentage never
+/// going back; the time left, when given, a finite number of seconds, never
+/// negative, and given from 1 % of the methods' work on (they start at 10 %,
+/// progress::ETA_FROM_FRACTION).
+#[derive(Default)]
+struct ProgressWatch {
+    last: f64,
+    reports: usize,
+    with_eta: usize,
+    problems: Vec<String>,
+}
+
+impl ProgressWatch {
+    fn see(&mut self, p: &Progress) {
+        self.reports += 1;
+        if p.percent.is_nan() || p.percent < self.last {
+            self.problems.push(format!(
+                "{} % after {} % ({})",
+                p.percent, self.last, p.phase
+            ));
+        }
+        self.last = p.percent;
+        let eta_from = 10.0 + 90.0 * ETA_FROM_FRACTION + 1e-9;
+        match p.eta_s {
+            Some(eta) if eta.is_finite() && eta >= 0.0 => self.with_eta += 1,
+            Some(eta) => self
+                .problems
+                .push(format!("{eta} s left at {} %", p.percent)),
+            None if matches!(p.phase, Phase::Method(_)) && p.percent >= eta_from => self
+                .problems
+                .push(format!("no time left at {} % ({})", p.percent, p.phase)),
+            None => {}
+        }
+    }
+}
+
 fn real_data_auto_never_worse_than_km(
     name: &str,
     model: RobotModel,
@@ -452,7 +492,25 @@ fn real_data_auto_never_worse_than_km(
         let mut methods = BASES_AND_COMPENSATORS.to_vec();
         methods.extend([Method::KmMaps, Method::SkcmMaps, Method::Auto]);
         let opts = options(&methods, 1, 5);
-        let r = calibrate(&model, &ident, &valid, &opts, &|_| true).unwrap();
+        let watch = std::sync::Mutex::new(ProgressWatch::default());
+        let r = calibrate(&model, &ident, &valid, &opts, &|p| {
+            watch.lock().unwrap().see(p);
+            true
+        })
+        .unwrap();
+        let watch = watch.into_inner().unwrap();
+        assert!(watch.problems.is_empty(), "{name}: {:?}", watch.problems);
+        assert!(
+            watch.with_eta > 0 && watch.last == 100.0,
+            "{name}: {} reports, {} with a time left, last at {} %",
+            watch.reports,
+            watch.with_eta,
+            watch.last
+        );
+        eprintln!(
+            "{name}: {} progress reports, {} with a time left, the percentage never back",
+            watch.reports, watch.with_eta
+        );
         for (m, rep) in &r.methods {
             let v = &rep.validation.as_ref().unwrap().stats;
             eprintln!(

@@ -477,12 +477,15 @@ async fn compensator_job_yields_a_version_whose_solve_uses_it() {
 /// Cancelling a job while a compensator trains (SKCM-NN by LM on 1000
 /// training poses, progress per epoch) ends it as cancelled: the job is held
 /// at the gate once past the base fit (its plan, methods/plan.rs: SKCM's fit
-/// 1 unit of 6, so training from 10 + 90/6 = 25 %), so the cancel reaches it
-/// in training whatever the machine's speed.
+/// is SKCM's weight of SKCM-NN's, the trainings the rest; held a tenth into
+/// them), so the cancel reaches it in training whatever the machine's speed.
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn cancelling_a_compensator_job_during_training_takes_effect_quickly() {
+    use robocal::calibrate::identify::Method;
     use robocal::measure::SetRole;
-    let gate = Arc::new(WorkGate::closed_from("skcm-nn", 26.0));
+    let fit = Method::Skcm.row().weight / Method::SkcmNn.row().weight;
+    let hold_at = 10.0 + 90.0 * (fit + 0.1 * (1.0 - fit));
+    let gate = Arc::new(WorkGate::closed_from("skcm-nn", hold_at));
     let t = setup_config(ServiceConfig {
         workers: 1,
         progress_interval: Duration::from_millis(20),

@@ -600,7 +600,9 @@ function fitAnswer(r, what) {
   const f = r.fit;
   if (r.fitted || r.forced) {
     const residual = f.rms_mm !== undefined ? `, residual rms ${fmtMm(f.rms_mm)} mm` : f.scatter_mm ? `, scatter ${f.scatter_mm.map(fmtMm).join(", ")} mm` : "";
-    flash(`Fitted ${what} on v${r.version}: ${f.xyz_mm.map(fmtMm).join(", ")} mm${residual}${r.forced ? " (forced: " + r.message + ")" : ""}`);
+    const turned = f.rpy_deg ? `, rx, ry, rz ${f.rpy_deg.map(fmtDeg).join(", ")}°` : "";
+    const angle = f.sigma_deg !== undefined ? `, orientation σ ${fmtDeg(f.sigma_deg)}°` : "";
+    flash(`Fitted ${what} on v${r.version}: ${f.xyz_mm.map(fmtMm).join(", ")} mm${turned}${residual}${angle}${r.forced ? " (forced: " + r.message + ")" : ""}`);
     location.reload();
     return;
   }

@@ -488,3 +488,34 @@ fn solve_section(id: i64, versions: &[VersionRow]) -> Markup {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::calibrate::identify::Fold;
+
+    /// A running job's row names the phase, the candidate and the fold, and
+    /// the percentage with the time left, as console.js redraws them.
+    #[test]
+    fn a_running_jobs_row_names_candidate_fold_and_time_left() {
+        let d = ProgressDetail {
+            candidate: Some("skcm-nn".into()),
+            fold: Some(Fold { index: 3, of: 9 }),
+            rms_mm: Some(0.1234),
+            eta_s: Some(80.4),
+        };
+        assert_eq!(
+            phase_text(Some("auto"), Some(&d)),
+            "auto · skcm-nn · fold 3/9"
+        );
+        assert_eq!(percent_text(31.4, Some(&d)), "31 % · 1 min 20 s left");
+        // Before the methods: the phase alone, no time left.
+        let none = ProgressDetail::default();
+        assert_eq!(
+            phase_text(Some("registration"), Some(&none)),
+            "registration"
+        );
+        assert_eq!(percent_text(0.0, Some(&none)), "0 %");
+        assert_eq!(phase_text(None, None), "");
+    }
+}

@@ -4,10 +4,16 @@
 //! [`ProgressReporter`] hands them to the caller.
 //!
 //! The percentage is planned work done over planned work (units estimated up
-//! front per method, `methods::plan`); the reporter is the one place that
-//! keeps it from decreasing. The time left is the elapsed time scaled by the
-//! work still to do, `eta = t · (1 − f) / f` with `f` the fraction done and `t`
-//! the seconds since the reporter started, read from an injected [`Clock`].
+//! front per method from the methods table's measured weights,
+//! `methods::plan`); the reporter is the one place that keeps it from
+//! decreasing. The time left is the methods' elapsed time scaled by their
+//! work still to do, `eta = (t − t₀) · (100 − p) / (p − p₀)`, with `p` the
+//! percentage, `t` the seconds read from an injected [`Clock`] and `(t₀, p₀)`
+//! the time and percentage of the first report of a method. The phases before
+//! the methods (registration, identifiability) hold a fixed share of the bar
+//! whatever they take, so their pace says nothing of the methods'; no time
+//! left is estimated before the methods start nor until
+//! [`ETA_FROM_FRACTION`] of their work is done.
 //! Units: percent in [0, 100], seconds.
 
 use super::methods::Method;
@@ -107,7 +113,8 @@ pub struct Progress {
     pub candidate: Option<Method>,
     /// The cross-validation training under way.
     pub fold: Option<Fold>,
-    /// Estimated seconds left (none until some work is done).
+    /// Estimated seconds left (none before the methods start and until 1 %
+    /// of their work is done).
     pub eta_s: Option<f64>,
 }
 
@@ -147,19 +154,35 @@ impl Clock for SystemClock {
     }
 }
 
-/// Below this fraction done no time left is estimated (the first steps say
-/// little of the rest).
-const ETA_FROM_FRACTION: f64 = 0.01;
+/// Below this fraction of the methods' work done no time left is estimated
+/// (the first steps say little of the rest).
+pub const ETA_FROM_FRACTION: f64 = 0.01;
+
+/// Where the methods started: the time and the percentage of their first
+/// report.
+#[derive(Debug, Clone, Copy)]
+struct Anchor {
+    t_s: f64,
+    percent: f64,
+}
+
+/// What the reporter has seen.
+#[derive(Debug, Default)]
+struct Seen {
+    /// The highest percentage reported so far.
+    highest: f64,
+    anchor: Option<Anchor>,
+}
 
 /// Hands reports on to `sink` with the percentage held monotone (a report
 /// below the highest so far keeps the highest, a non-finite one too) and
-/// clamped to [0, 100], and with the time left estimated from `clock`. The
-/// sink's answer (false: cancel) is returned.
+/// clamped to [0, 100], and with the time left estimated from `clock` (module
+/// docs). The sink's answer (false: cancel) is returned. The sink must not
+/// report to the same reporter.
 pub struct ProgressReporter<'a> {
     sink: &'a dyn Fn(&Progress) -> bool,
     clock: &'a dyn Clock,
-    /// The highest percentage reported so far.
-    highest: Mutex<f64>,
+    seen: Mutex<Seen>,
 }
 
 impl<'a> ProgressReporter<'a> {
@@ -167,24 +190,32 @@ impl<'a> ProgressReporter<'a> {
         ProgressReporter {
             sink,
             clock,
-            highest: Mutex::new(0.0),
+            seen: Mutex::new(Seen::default()),
         }
     }
 
     /// Reports `p` (its `percent` guarded, its `eta_s` set).
     pub fn report(&self, p: &Progress) -> bool {
-        let percent = {
-            let mut highest = self.highest.lock().unwrap_or_else(|e| e.into_inner());
-            if p.percent.is_finite() {
-                *highest = highest.max(p.percent.clamp(0.0, 100.0));
-            }
-            *highest
-        };
-        let f = percent / 100.0;
-        let eta_s = (f >= ETA_FROM_FRACTION).then(|| {
-            let t = self.clock.elapsed_s().max(0.0);
-            t * (1.0 - f) / f
+        let mut seen = self.seen.lock().unwrap_or_else(|e| e.into_inner());
+        let t = self.clock.elapsed_s().max(0.0);
+        if p.percent.is_finite() {
+            seen.highest = seen.highest.max(p.percent.clamp(0.0, 100.0));
+        }
+        if seen.anchor.is_none() && matches!(p.phase, Phase::Method(_)) {
+            seen.anchor = Some(Anchor {
+                t_s: t,
+                percent: seen.highest,
+            });
+        }
+        let percent = seen.highest;
+        let eta_s = seen.anchor.and_then(|a| {
+            let done = percent - a.percent;
+            let work = 100.0 - a.percent;
+            (work > 0.0 && done >= ETA_FROM_FRACTION * work)
+                .then(|| (t - a.t_s).max(0.0) * (100.0 - percent) / done)
         });
+        // The sink is called under the lock: reports reach it one at a time,
+        // in the order of their percentages.
         (self.sink)(&Progress {
             percent,
             eta_s,
@@ -258,7 +289,7 @@ mod tests {
     }
 
     #[test]
-    fn time_left_is_elapsed_scaled_by_the_work_left() {
+    fn time_left_is_the_methods_elapsed_time_scaled_by_their_work_left() {
         let clock = Manual(AtomicU64::new(0));
         let seen = Mutex::new(Vec::new());
         let sink = |p: &Progress| {
@@ -266,28 +297,69 @@ mod tests {
             true
         };
         let r = ProgressReporter::new(&sink, &clock);
-        let phase = Phase::Registration;
-        r.report(&Progress::at(phase, 0.0));
+        let method = Phase::Method(Method::SkcmNn);
+        // The phases before the methods hold 0–10 % whatever they take: no
+        // estimate from them.
+        r.report(&Progress::at(Phase::Registration, 0.0));
+        clock.set(0.5);
+        r.report(&Progress::at(Phase::Identifiability, 5.0));
+        // The methods start at 10 % after 1 s: the anchor.
+        clock.set(1.0);
+        r.report(&Progress::at(method, 10.0));
         clock.set(2.0);
-        r.report(&Progress::at(phase, 0.5));
-        // A quarter done in 30 s: 90 s left; 80 % done in 120 s: 30 s left.
-        clock.set(30.0);
-        r.report(&Progress::at(phase, 25.0));
-        clock.set(120.0);
-        r.report(&Progress::at(phase, 80.0));
+        r.report(&Progress::at(method, 10.5));
+        // A quarter of the methods' 90 % done in 30 s: 90 s left; 80 % of it
+        // in 120 s: 30 s left.
+        clock.set(31.0);
+        r.report(&Progress::at(method, 32.5));
+        clock.set(121.0);
+        r.report(&Progress::at(method, 82.0));
         // A late, lower report does not make the estimate grow from it.
-        clock.set(125.0);
-        r.report(&Progress::at(phase, 40.0));
+        clock.set(126.0);
+        r.report(&Progress::at(method, 40.0));
         clock.set(150.0);
-        r.report(&Progress::at(phase, 100.0));
+        r.report(&Progress::at(method, 100.0));
         let got = seen.lock().unwrap().clone();
-        assert_eq!(got[0], None);
-        assert_eq!(got[1], None, "0.5 % done says nothing yet");
+        assert_eq!(got[..3], [None, None, None], "nothing before the methods");
+        assert_eq!(got[3], None, "0.5 of 90 % done says nothing yet");
         let close = |a: Option<f64>, b: f64| a.is_some_and(|a| (a - b).abs() < 1e-9);
-        assert!(close(got[2], 90.0), "{:?}", got[2]);
-        assert!(close(got[3], 30.0), "{:?}", got[3]);
-        assert!(close(got[4], 125.0 * 0.2 / 0.8), "{:?}", got[4]);
-        assert!(close(got[5], 0.0), "{:?}", got[5]);
+        assert!(close(got[4], 90.0), "{:?}", got[4]);
+        assert!(close(got[5], 30.0), "{:?}", got[5]);
+        assert!(close(got[6], 125.0 * 18.0 / 72.0), "{:?}", got[6]);
+        assert!(close(got[7], 0.0), "{:?}", got[7]);
+    }
+
+    /// A fast start does not make a long job look short: 10 % reached in
+    /// 0.1 s before the methods, then a method at a steady 1 % of the bar
+    /// every 10 s is estimated at its own pace from its first reports on.
+    #[test]
+    fn a_fast_start_does_not_shorten_the_estimate() {
+        let clock = Manual(AtomicU64::new(0));
+        let seen = Mutex::new(Vec::new());
+        let sink = |p: &Progress| {
+            seen.lock().unwrap().push(p.eta_s);
+            true
+        };
+        let r = ProgressReporter::new(&sink, &clock);
+        clock.set(0.1);
+        r.report(&Progress::at(Phase::Identifiability, 10.0));
+        for k in 0..=90 {
+            clock.set(0.1 + 10.0 * k as f64);
+            r.report(&Progress::at(
+                Phase::Method(Method::SkcmNn),
+                10.0 + k as f64,
+            ));
+        }
+        let got = seen.lock().unwrap().clone();
+        // At 10 + k % the truth is 10 s for each of the 90 − k still to do.
+        for (k, eta) in got[2..].iter().enumerate() {
+            let k = k + 1;
+            let want = 10.0 * (90 - k) as f64;
+            assert!(
+                eta.is_some_and(|e| (e - want).abs() < 1e-6),
+                "{k}: {eta:?} vs {want}"
+            );
+        }
     }
 
     #[test]

@@ -1,8 +1,8 @@
-//! The work of a calibration's methods planned up front, in units of one
-//! model-based LM fit (KM or SKCM), so that the progress bar moves with work
-//! done over work planned ([`Planner`]).
+//! The work of a calibration's methods planned up front, in units of SKCM's
+//! fit, so that the progress bar moves with work done over work planned
+//! ([`Planner`]).
 //!
-//! A unit's cost follows the table's `weight` (relative effort): a joint-map
+//! A unit's cost follows the table's `weight` (measured time over SKCM's): a joint-map
 //! fit costs its method's weight less its base's, a compensator's
 //! cross-validated training its method's weight less its base's, scaled by
 //! its trainings over [`REFERENCE_TRAININGS`] (the weight is set for 5 random
