@@ -29,7 +29,7 @@ pub use identifiability::{DropKind, IdentifiabilityReport, IdentifiabilitySettin
 pub use least_squares::{LmReport, LmSettings, StopReason};
 pub use methods::{Method, MethodChoice, MethodFailure, MethodListError, MethodRow, METHODS};
 pub use model_file::calibrated_model_file;
-pub use options::{CalibrationOptions, CompensatorOptions};
+pub use options::{CalibrationOptions, CalibrationSettings, CompensatorOptions};
 pub use pipeline::{calibrate, calibrate_with_training};
 pub use progress::{Clock, Fold, Phase, Progress, ProgressReporter, SystemClock};
 pub use registration::{register, Registration};
