@@ -7,7 +7,9 @@
 //! the same module names), whose dependency tree has no HTTP, database, async
 //! runtime or command-line crates.
 
-pub use robocal_core::{calibrate, check, measure, model, optim, plan, sim, solve, stats};
+pub use robocal_core::{
+    calibrate, cell_fit, check, measure, model, optim, plan, program, sim, solve, stats,
+};
 
 pub mod cli;
 pub mod db;

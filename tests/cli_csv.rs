@@ -100,7 +100,7 @@ fn predict_csv_cells_are_numbers_and_ids_read_back_as_sent() {
 /// shifted: the TCP fit's readings here (the others in their own tests).
 #[test]
 fn tcp_readings_of_another_width_are_refused() {
-    let e = robocal::solve::cell::tcp::readings::parse_csv(
+    let e = robocal::cell_fit::tcp::readings::parse_csv(
         "q1,q2,q3,q4,q5,q6\n10,-80,95,0,45,0\n10,-80,95,0,45,0,7\n",
     )
     .unwrap_err();

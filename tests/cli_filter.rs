@@ -5,8 +5,8 @@ use clap::Parser;
 use robocal::cli::filter::{filter_to_string, FilterArgs};
 use robocal::cli::model_files::save_model_file;
 use robocal::model::preset;
+use robocal::program::{parse, Language, ProgramFile};
 use robocal::sim::{synthetic_calibration, SyntheticErrors};
-use robocal::solve::program::{parse, Language, ProgramFile};
 use robocal_core::model::calibrated::CalibratedModelFile;
 use std::path::{Path, PathBuf};
 
@@ -84,7 +84,7 @@ fn filter_cli_writes_programs_and_a_report() {
         parse(Language::Krl, &after).unwrap(),
     );
     for (i, (x, y)) in before.iter().zip(&after).enumerate() {
-        let mask = |f: &ProgramFile, sites: &[robocal::solve::program::Site]| {
+        let mask = |f: &ProgramFile, sites: &[robocal::program::Site]| {
             let mut text = f.text.clone();
             let mut ranges: Vec<_> = sites
                 .iter()

@@ -7,7 +7,7 @@ use robocal::cli::check::check_file;
 use robocal::cli::iso9283::{figures, join_files, make, FiguresArgs, Iso9283Args, Iso9283Command};
 use robocal::measure::{csv, MeasuredPose};
 use robocal::model::preset;
-use robocal::solve::program::{parse, Language, ProgramFile};
+use robocal::program::{parse, Language, ProgramFile};
 use robocal_core::check::iso9283::csv::read_plan_csv;
 use robocal_core::model::calibrated::CompensatedModel;
 use std::fmt::Write as _;

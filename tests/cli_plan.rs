@@ -10,8 +10,8 @@ use robocal::cli::plan::{join_files, make, JoinArgs, MakeArgs, PlanCommand};
 use robocal::measure::{csv, to_measurements};
 use robocal::model::preset;
 use robocal::plan::read_plan_csv;
+use robocal::program::{parse, Language, ProgramFile};
 use robocal::sim::{perturb_geometry, tracker_frame, ErrorMagnitudes, TrueRobot};
-use robocal::solve::program::{parse, Language, ProgramFile};
 use std::fmt::Write as _;
 
 fn parsed(argv: &[&str]) -> robocal::cli::plan::PlanArgs {

@@ -12,10 +12,10 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use robocal_core::model::orientation::{rotation_to, OrientationConvention};
 use robocal_core::model::preset;
+use robocal_core::program::{filter, kuka_status, kuka_turn, Language, ProgramFile};
 use robocal_core::sim::{synthetic_calibration, SyntheticErrors};
 use robocal_core::solve::cell::Cell;
 use robocal_core::solve::ik::{AnalyticIk, IkSettings};
-use robocal_core::solve::program::{filter, kuka_status, kuka_turn, Language, ProgramFile};
 use std::hint::black_box;
 use std::time::Duration;
 

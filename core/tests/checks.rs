@@ -4,13 +4,13 @@
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal_core::calibrate::identify::pose_selection::choose_d_optimal;
 use robocal_core::calibrate::identify::{calibrate, CalibrationOptions, Method};
 use robocal_core::check::{reregister, score, CheckStatus, CheckThresholds, ReregisterError};
 use robocal_core::measure;
 use robocal_core::model::calibrated::CompensatedModel;
 use robocal_core::model::orientation::rotation_angle_between;
 use robocal_core::model::preset;
+use robocal_core::plan::pose_selection::choose_d_optimal;
 use robocal_core::sim::{random_configurations, tracker_frame, ys100_table_7_1, TrueRobot};
 
 fn calibrated(truth: &TrueRobot, rng: &mut ChaCha8Rng) -> CompensatedModel {

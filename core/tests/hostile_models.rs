@@ -23,10 +23,10 @@ use robocal_core::model::orientation::{rotation_to, OrientationConvention};
 use robocal_core::model::presets::preset_description;
 use robocal_core::model::{preset, ModelDescription, RobotModel};
 use robocal_core::plan::{make_plan, PlanSettings};
+use robocal_core::program::{filter, Language, ProgramFile};
 use robocal_core::sim::{try_random_configurations, PoseFilter, TrueRobot};
 use robocal_core::solve::cell::{Cell, Tool};
 use robocal_core::solve::ik::{IkSettings, IkSolver, SolveOptions};
-use robocal_core::solve::program::{filter, Language, ProgramFile};
 use std::time::{Duration, Instant};
 
 /// What only a hang takes: the work these tests time takes well under a

@@ -7,13 +7,13 @@
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
-use robocal_core::calibrate::identify::pose_selection::choose_d_optimal;
 use robocal_core::calibrate::identify::{calibrate, CalibrationOptions, Method};
 use robocal_core::check::iso9283::{evaluate, plan_cube, Commands, CubeSettings, PoseCycles};
 use robocal_core::measure;
 use robocal_core::model::calibrated::CompensatedModel;
 use robocal_core::model::orientation::fixed_xyz_matrix;
 use robocal_core::model::preset;
+use robocal_core::plan::pose_selection::choose_d_optimal;
 use robocal_core::plan::WorkspaceBox;
 use robocal_core::sim::{random_configurations, tracker_frame, ys100_table_7_1, TrueRobot};
 

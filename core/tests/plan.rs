@@ -12,8 +12,8 @@ use robocal_core::plan::{
     join, make_plan, plan_csv, plan_program, read_plan_csv, JoinBy, JoinError, JoinOptions,
     MeasurementPlan, PlanError, PlanSettings, TrackerSight, Units, WorkspaceBox,
 };
+use robocal_core::program::{parse, Language};
 use robocal_core::sim::{perturb_geometry, tracker_frame, ErrorMagnitudes, TrueRobot};
-use robocal_core::solve::program::{parse, Language};
 use std::collections::BTreeMap;
 
 /// Plans `poses` poses of `model` with `noise_mm` and the default constraints of these tests.

@@ -9,13 +9,11 @@ mod truth;
 mod judged;
 
 use nalgebra::{Matrix3, Vector3};
+use robocal_core::cell_fit::tcp::{self, axis, fixed_point, tracker, NotFittedReason, TcpMethod};
+use robocal_core::cell_fit::work_object::{self, WorkObjectPoints};
 use robocal_core::model::orientation::rotation_angle_between;
 use robocal_core::model::Pose;
 use robocal_core::sim::random_configurations;
-use robocal_core::solve::cell::tcp::{
-    self, axis, fixed_point, tracker, NotFittedReason, TcpMethod,
-};
-use robocal_core::solve::cell::work_object_fit::{self, WorkObjectPoints};
 use truth::*;
 
 /// The production tool: tip 250 mm out, off-centre, its z tilted 30° about
@@ -318,7 +316,7 @@ fn wo_points(w: &Pose) -> [Vector3<f64>; 4] {
     ]
 }
 
-fn check_work_object(fit: &work_object_fit::WorkObjectFit, w: &Pose) {
+fn check_work_object(fit: &work_object::WorkObjectFit, w: &Pose) {
     let pos = (fit.pose.p - w.p).norm() * 1e3;
     let ang = rotation_angle_between(&fit.pose.r, &w.r).to_degrees();
     eprintln!("work object: origin off by {pos:.4} mm, orientation by {ang:.5}°");
@@ -355,7 +353,7 @@ fn work_object_from_tracker_points() {
         x: groups.pop().unwrap(),
         origin: groups.pop().unwrap(),
     };
-    let fit = work_object_fit::fit(&pts).unwrap();
+    let fit = work_object::fit(&pts).unwrap();
     check_work_object(&fit, &w);
     assert!(fit.scatter_mm.iter().all(|s| *s > 0.0 && *s < 0.05));
 }
@@ -376,14 +374,14 @@ fn work_object_touched_with_a_calibrated_tcp() {
             .collect()
     };
     let [o, x, xy, plane] = wo_points(&w);
-    let tips = |q: &[Vec<f64>]| work_object_fit::touched_tips(&model, &tool.p, q).unwrap();
+    let tips = |q: &[Vec<f64>]| work_object::touched_tips(&model, &tool.p, q).unwrap();
     let pts = WorkObjectPoints {
         origin: tips(&touches(&o, &mut noise)),
         x: tips(&touches(&x, &mut noise)),
         xy: tips(&touches(&xy, &mut noise)),
         plane: tips(&touches(&plane, &mut noise)),
     };
-    let fit = work_object_fit::fit(&pts).unwrap();
+    let fit = work_object::fit(&pts).unwrap();
     check_work_object(&fit, &w);
 }
 
@@ -391,7 +389,7 @@ fn work_object_touched_with_a_calibrated_tcp() {
 fn work_object_refuses_degenerate_points() {
     let p = |x: f64, y: f64| vec![Vector3::new(x, y, 0.0)];
     let fit = |o, x, xy| {
-        work_object_fit::fit(&WorkObjectPoints {
+        work_object::fit(&WorkObjectPoints {
             origin: o,
             x,
             xy,

@@ -6,7 +6,7 @@
 use robocal::solve::cell::Cell;
 use robocal::model::calibrated::CompensatedModel;
 use robocal::solve::ik::IkSettings;
-use robocal::solve::program::{filter, parse, Language, ProgramFile};
+use robocal::program::{filter, parse, Language, ProgramFile};
 
 pub fn check(language: Language, names: [&str; 2], data: &[u8]) {
     let Ok(text) = std::str::from_utf8(data) else {

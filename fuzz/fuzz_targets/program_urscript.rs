@@ -1,7 +1,7 @@
 //! The URScript program parser and the filter never panic (`common/program.rs`).
 #![no_main]
 use libfuzzer_sys::fuzz_target;
-use robocal::solve::program::Language;
+use robocal::program::Language;
 
 #[path = "../common/program.rs"]
 mod program;

@@ -18,7 +18,8 @@
 //!
 //! Times are wall-clock on the calling thread (pin with `taskset -c 0`).
 
-use crate::calibrate::identify::{calibrate, CalibrationOptions, Method};
+use crate::calibrate::compensate::select::Parallelism;
+use crate::calibrate::identify::{calibrate, CalibrationSettings, Method};
 use crate::measure::{self, csv};
 use crate::solve::ik::{Goal, IkSettings, IkSolver, SolveOptions, TargetFrame};
 use anyhow::{bail, Context};
@@ -160,15 +161,18 @@ fn methods(a: &MethodsArgs) -> anyhow::Result<serde_json::Value> {
     for &n in &a.poses {
         let train = measure(n)?;
         for m in &methods {
-            let mut opts = CalibrationOptions {
+            let d = CalibrationSettings::default();
+            let settings = CalibrationSettings {
                 methods: vec![*m],
-                ..Default::default()
+                seed: a.seed,
+                auto_candidates: if auto_candidates.is_empty() {
+                    d.auto_candidates.clone()
+                } else {
+                    auto_candidates.clone()
+                },
+                ..d
             };
-            opts.compensator.seed = a.seed;
-            opts.compensator.parallel.threads = a.threads;
-            if !auto_candidates.is_empty() {
-                opts.compensator.auto_candidates = auto_candidates.clone();
-            }
+            let opts = settings.options(Parallelism { threads: a.threads });
             let t = Instant::now();
             let r = calibrate_with_training(&nominal, &ident, &train, &valid, &opts, &|_| true)?;
             let seconds = t.elapsed().as_secs_f64();
@@ -222,10 +226,11 @@ fn km(a: &KmArgs) -> anyhow::Result<serde_json::Value> {
     let payload = model.payload.mass;
     let ident = measure::to_measurements(&model, &read(&a.identify)?, payload);
     let valid = measure::to_measurements(&model, &read(&a.validate)?, payload);
-    let opts = CalibrationOptions {
+    let settings = CalibrationSettings {
         methods: vec![Method::Km],
-        ..Default::default()
+        ..CalibrationSettings::default()
     };
+    let opts = settings.options(Parallelism::default());
     let mut times = Vec::new();
     let mut last = None;
     for _ in 0..a.repeat.max(1) {

@@ -9,7 +9,7 @@ pub use render::{render_comparison, render_compensators, render_orientation, ren
 use super::progress::ProgressPrinter;
 use crate::calibrate::compensate::select::Parallelism;
 use crate::calibrate::identify::{
-    calibrate_with_training, CalibrationOptions, CalibrationReport, CompensatorOptions, Method,
+    calibrate_with_training, CalibrationOptions, CalibrationReport, CalibrationSettings, Method,
     PoseSource, PoseSources, METHODS,
 };
 use crate::measure::{self, csv, SetRole};
@@ -312,25 +312,21 @@ fn to_si(
 }
 
 /// The calibration's options from the command line.
+/// The command line's calibration settings (the core's defaults for what it
+/// does not set) and the options they build, on `--threads` threads.
 fn calibration_options(a: &CalibrateArgs) -> CalibrationOptions {
-    CalibrationOptions {
+    let settings = CalibrationSettings {
         methods: a.method.0.clone(),
         register: !a.no_register,
-        tlbo: crate::optim::TlboSettings {
-            population: a.population,
-            generations: a.generations,
-            seed: a.seed,
-        },
-        compensator: CompensatorOptions {
-            seed: a.seed,
-            cv_folds: a.cv_folds,
-            blocked_folds: a.blocked_folds,
-            tie_margin: a.tie_margin,
-            parallel: Parallelism { threads: a.threads },
-            ..Default::default()
-        },
-        ..Default::default()
-    }
+        seed: a.seed,
+        population: a.population,
+        generations: a.generations,
+        cv_folds: a.cv_folds,
+        blocked_folds: a.blocked_folds,
+        tie_margin: a.tie_margin,
+        ..CalibrationSettings::default()
+    };
+    settings.options(Parallelism { threads: a.threads })
 }
 
 /// Writes what was asked for: the HTML page (`--html`), the chosen model

@@ -1,15 +1,15 @@
 //! `robocal cell export`: what the controller must hold for a cell — tool,
 //! load and work object data in the controller's language
-//! (`core::cell::export`): a work object measured in the tracker frame comes
+//! (`core::program::controller`): a work object measured in the tracker frame comes
 //! out in the robot base frame of the calibrated model given. Unnumbered
 //! items take the lowest free numbers and renamed identifiers are stated in
 //! the output's header comment; a cell the controller could not load (a
 //! number 0 or beyond its range, one held twice) is refused naming the item;
 //! a Fanuc export writes position registers only with `--registers`.
 
-use crate::solve::cell::export::{export_cell, ExportOptions, RegisterRange};
+use crate::program::controller::{export_cell, ExportOptions, RegisterRange};
+use crate::program::Language;
 use crate::solve::cell::CellDescription;
-use crate::solve::program::Language;
 use anyhow::Context;
 use clap::{Args, Subcommand};
 

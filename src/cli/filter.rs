@@ -5,8 +5,8 @@
 //! to by number or name come from a cell file (`core::cell::file`: mm,
 //! degrees); RAPID modules and URScript carry their own.
 
+use crate::program::{filter, Language, ProgramFile};
 use crate::solve::ik::IkSettings;
-use crate::solve::program::{filter, Language, ProgramFile};
 use anyhow::{bail, Context};
 use clap::Args;
 use std::path::{Path, PathBuf};

@@ -18,10 +18,10 @@
 use crate::model::orientation::fixed_xyz_matrix;
 use crate::plan::WorkspaceBox;
 use crate::plan::{JoinBy, Units};
+use crate::program::Language;
 use crate::report::iso9283::{
     cycles_of, is_date, render_iso9283_html, today_utc, Iso9283Conditions, MeasuredSet,
 };
-use crate::solve::program::Language;
 use anyhow::{bail, Context};
 use clap::{Args, Subcommand, ValueEnum};
 use robocal_core::check::iso9283::csv::{plan_csv, pose_data, read_cycles_csv, read_plan_csv};

@@ -18,7 +18,7 @@ use crate::plan::{
     join, make_plan, plan_csv, plan_program, read_plan_csv, JoinBy, JoinOptions, MeasurementPlan,
     PlanSettings, TrackerSight, Units, WorkspaceBox,
 };
-use crate::solve::program::Language;
+use crate::program::Language;
 use anyhow::{bail, Context};
 use clap::{Args, Subcommand, ValueEnum};
 use std::fmt::Write as _;

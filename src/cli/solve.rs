@@ -34,7 +34,7 @@ use serde_json::json;
 use std::fmt::Write as _;
 
 /// `--branch` in `robocal solve --help`: the branches and how each
-/// controller's flags name them (`solve::program::Flags`; set out in
+/// controller's flags name them (`program::Flags`; set out in
 /// docs/configurations.md).
 pub const CONFIGURATIONS_HELP: &str = "\
 Configuration branch: `front,up,noflip` (shoulder front|back, elbow up|down, wrist noflip|flip) or its index \

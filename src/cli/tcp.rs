@@ -2,7 +2,7 @@
 //! axis) or a work object fitted on the calibrated model from joint
 //! readings (controller degrees) or tracker measurements (mm, degrees, the
 //! measurement frame of the calibration), judged (`tcp::judge`), printed and
-//! optionally written into a cell file as an entry (`core::cell::tcp::entry`:
+//! optionally written into a cell file as an entry (`core::cell_fit::tcp::entry`:
 //! a refit keeps the entry's load and number; a tool's orientation is the
 //! fitted one, `--rpy-deg`, or the cell's kept — never zeros). Readings that
 //! do not determine the item, or a fit beyond what the readings' noise
@@ -12,10 +12,10 @@
 //! `message`, `fit`, `orientation`, `replaced`, …).
 
 use super::model_files::load_compensated;
+use crate::cell_fit::tcp::entry::{self, Answer, Fitted, Outcome, StoreRequest, StoredEntry};
+use crate::cell_fit::tcp::{self, AxisRequest, Reading, TcpMethod, ToolFit, ToolRequest};
+use crate::cell_fit::work_object::WorkObjectFit;
 use crate::solve::cell::file::CellDescription;
-use crate::solve::cell::tcp::entry::{self, Answer, Fitted, Outcome, StoreRequest, StoredEntry};
-use crate::solve::cell::tcp::{self, AxisRequest, Reading, TcpMethod, ToolFit, ToolRequest};
-use crate::solve::cell::work_object_fit::WorkObjectFit;
 use crate::solve::cell::CellRef;
 use anyhow::{bail, Context};
 use clap::Args;

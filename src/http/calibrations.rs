@@ -9,7 +9,7 @@
 use super::input::{check_payload, int, page_body, present, present_ids, present_int, PageQuery};
 use super::robots::robot_list_page;
 use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState};
-use crate::calibrate::identify::{CalibrationOptions, Fold, Method};
+use crate::calibrate::identify::{CalibrationSettings, Fold, Method};
 use crate::records::{CalibrationRow, JobStatus, JobSummary};
 use crate::service::{self, jobs::StartCommand};
 use axum::extract::State;
@@ -183,42 +183,53 @@ fn check_count(what: &str, v: Option<usize>, lo: usize, hi: usize) -> Result<(),
     }
 }
 
+impl StartCalibration {
+    /// The request's calibration settings, checked: the named methods (else
+    /// [`DEFAULT_METHODS`]) and each setting given, the core's defaults for
+    /// the rest.
+    fn settings(&self) -> Result<CalibrationSettings, ApiError> {
+        let methods = match &self.methods {
+            Some(m) if m.is_empty() => {
+                let names: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
+                return Err(ApiError::invalid(format!(
+                    "`methods` is empty; give one or more of {}",
+                    names.join(", ")
+                )));
+            }
+            Some(m) => Method::parse_names(m).map_err(ApiError::invalid)?,
+            None => DEFAULT_METHODS.to_vec(),
+        };
+        check_count("population", self.population, 2, 1000)?;
+        check_count("generations", self.generations, 1, 1_000_000)?;
+        check_count("max_iterations", self.max_iterations, 1, 10_000)?;
+        let d = CalibrationSettings::default();
+        Ok(CalibrationSettings {
+            methods,
+            register: self.register.unwrap_or(d.register),
+            seed: self.seed,
+            max_iterations: self.max_iterations.unwrap_or(d.max_iterations),
+            population: self.population.unwrap_or(d.population),
+            generations: self.generations.unwrap_or(d.generations),
+            ..d
+        })
+    }
+}
+
 pub async fn start(
     State(state): State<AppState>,
     ApiPath(robot_id): ApiPath<i64>,
     ApiJson(req): ApiJson<StartCalibration>,
 ) -> Result<Response, ApiError> {
-    let methods = match &req.methods {
-        Some(m) if m.is_empty() => {
-            let names: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
-            return Err(ApiError::invalid(format!(
-                "`methods` is empty; give one or more of {}",
-                names.join(", ")
-            )));
-        }
-        Some(m) => Method::parse_names(m).map_err(ApiError::invalid)?,
-        None => DEFAULT_METHODS.to_vec(),
-    };
-    check_count("population", req.population, 2, 1000)?;
-    check_count("generations", req.generations, 1, 1_000_000)?;
-    check_count("max_iterations", req.max_iterations, 1, 10_000)?;
+    let settings = req.settings()?;
     if let Some(p) = req.payload_kg {
         check_payload("`payload_kg`", p)?;
     }
-    let defaults = CalibrationOptions::default();
-    let population = req.population.unwrap_or(defaults.tlbo.population);
-    let generations = req.generations.unwrap_or(defaults.tlbo.generations);
     let cmd = StartCommand {
-        methods,
         identification_set_ids: req.identification_set_ids.clone(),
         validation_set_ids: req.validation_set_ids.clone(),
         training_set_ids: req.training_set_ids.clone(),
-        register: req.register.unwrap_or(true),
-        max_iterations: req.max_iterations.unwrap_or(defaults.lm.max_iterations),
-        population,
-        generations,
-        seed: req.seed,
         payload_kg: req.payload_kg,
+        settings,
     };
     let row = service::calibrations::start(&state, robot_id, cmd).await?;
     let location = format!("/v1/robots/{robot_id}/calibrations/{}", row.id);

@@ -4,7 +4,7 @@
 //! (controller degrees) or tracker measurements (mm, degrees, the
 //! calibration's measurement frame), stored as the robot's tool or work
 //! object (base frame) and returned with the fit's residuals and σ
-//! (`core::cell::tcp`). Readings that do not determine the item, or a fit
+//! (`core::cell_fit::tcp`). Readings that do not determine the item, or a fit
 //! beyond what the readings' noise explains (`tcp::judge`), are a 200 with
 //! `fitted: false`, a typed `reason`, the figures and what to change;
 //! nothing is stored then unless the body says `"force": true` for a judged
@@ -14,10 +14,10 @@
 use super::cell::{check_item_name, ItemOut, CELL_NUMBER_MAX};
 use super::input::{objects, present, Int};
 use super::{ApiError, ApiJson, ApiPath, AppState};
+use crate::cell_fit::tcp::entry::Answer;
+use crate::cell_fit::tcp::{AxisRequest, FitError, Reading, TcpMethod, ToolRequest, WoPoint};
 use crate::service;
 use crate::service::cell_fit::{FitTarget, Fitted};
-use crate::solve::cell::tcp::entry::Answer;
-use crate::solve::cell::tcp::{AxisRequest, FitError, Reading, TcpMethod, ToolRequest, WoPoint};
 use axum::extract::State;
 use axum::http::StatusCode;
 use axum::response::{IntoResponse, Response};

@@ -49,7 +49,7 @@ pub enum ApiError {
     Unprocessable(String),
     /// 422 with `file`, `line` and `column`: a robot program that cannot be parsed.
     #[error("{0}")]
-    Unparsable(crate::solve::program::ParseError),
+    Unparsable(crate::program::ParseError),
     /// 431: the request head is too large (answered for the HTTP parser).
     #[error("{0}")]
     HeadersTooLarge(String),

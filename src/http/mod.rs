@@ -15,11 +15,9 @@
 //! - Request sizes, list pages and job budgets are limited by [`Limits`].
 
 use axum::extract::{DefaultBodyLimit, Request, State};
-use axum::handler::Handler;
 use axum::http::{header, HeaderValue, Method};
 use axum::middleware;
 use axum::response::{IntoResponse, Response};
-use axum::routing::{on, MethodFilter, MethodRouter};
 use axum::Router;
 use tower_http::catch_panic::CatchPanicLayer;
 use tower_http::trace::{DefaultMakeSpan, DefaultOnFailure, DefaultOnResponse, TraceLayer};
@@ -43,6 +41,7 @@ pub mod predict;
 pub mod programs;
 pub mod record;
 pub mod robots;
+mod routing;
 pub mod server;
 pub mod sets;
 pub mod solve;
@@ -55,81 +54,11 @@ pub use crate::service::{AppState, RobotContext, ServiceConfig};
 pub use error::{ApiError, Problem, PROBLEM_JSON};
 pub use extract::{ApiJson, ApiPath, ApiQuery};
 pub use listener::ServiceListener;
+pub use routing::Route;
+pub(crate) use routing::{delete, get, links, located, post, route};
 
 /// The text of `openapi.yaml`, served at `/openapi.yaml`.
 pub const OPENAPI_YAML: &str = include_str!("../../openapi.yaml");
-
-/// One route of the service: method, path template and handler. Each
-/// resource module lists its own in `routes()`; [`app`] builds the router from
-/// them and [`route_table`] reports the same list (a test checks it against
-/// `openapi.yaml`), so no list of routes is kept by hand beside the router.
-pub struct Route {
-    pub method: Method,
-    pub path: &'static str,
-    handler: MethodRouter<AppState>,
-}
-
-/// A route for one method of a path.
-pub(crate) fn route<H, T>(method: Method, path: &'static str, handler: H) -> Route
-where
-    H: Handler<T, AppState>,
-    T: 'static,
-{
-    let filter = MethodFilter::try_from(method.clone()).expect("a standard HTTP method");
-    Route {
-        method,
-        path,
-        handler: on(filter, handler),
-    }
-}
-
-/// A `GET` route.
-pub(crate) fn get<H, T>(path: &'static str, handler: H) -> Route
-where
-    H: Handler<T, AppState>,
-    T: 'static,
-{
-    route(Method::GET, path, handler)
-}
-
-/// A `POST` route.
-pub(crate) fn post<H, T>(path: &'static str, handler: H) -> Route
-where
-    H: Handler<T, AppState>,
-    T: 'static,
-{
-    route(Method::POST, path, handler)
-}
-
-/// A `DELETE` route.
-pub(crate) fn delete<H, T>(path: &'static str, handler: H) -> Route
-where
-    H: Handler<T, AppState>,
-    T: 'static,
-{
-    route(Method::DELETE, path, handler)
-}
-
-/// The `links` of a resource at `base`: `self`, and each other relation at
-/// `base` followed by its suffix.
-pub(crate) fn links(base: &str, relations: &[(&str, &str)]) -> serde_json::Value {
-    let mut out = serde_json::Map::new();
-    out.insert("self".into(), base.into());
-    for (rel, suffix) in relations {
-        out.insert((*rel).into(), format!("{base}{suffix}").into());
-    }
-    out.into()
-}
-
-/// The answer to a request that made a resource: `status` (201 Created, 202
-/// Accepted), `Location: location` and the resource as JSON.
-pub(crate) fn located<B: serde::Serialize>(
-    status: axum::http::StatusCode,
-    location: String,
-    body: B,
-) -> Response {
-    (status, [(header::LOCATION, location)], axum::Json(body)).into_response()
-}
 
 /// Every route of the service, resource by resource.
 fn routes() -> Vec<Route> {

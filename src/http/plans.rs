@@ -11,9 +11,9 @@ use super::{ApiError, ApiJson, ApiPath, AppState};
 use crate::plan::{
     FilterCounts, PlanPoint, PlanSettings, PredictedStd, TrackerSight, WorkspaceBox,
 };
+use crate::program::Language;
 use crate::service;
 use crate::service::plans::PlanCommand;
-use crate::solve::program::Language;
 use axum::extract::State;
 use axum::response::{IntoResponse, Response};
 use serde::{Deserialize, Serialize};

@@ -11,11 +11,11 @@
 use super::input::{objects, present};
 use super::solve::{model_choice, VersionSelector};
 use super::{ApiError, ApiJson, ApiPath, AppState};
+use crate::program::controller::{ExportOptions, RegisterRange, Renamed, UsedRegister};
+use crate::program::{FilterReport, Language, ProgramFile};
 use crate::service;
 use crate::service::programs::FilterCommand;
-use crate::solve::cell::export::{ExportOptions, RegisterRange, Renamed, UsedRegister};
 use crate::solve::cell::AssignedNumber;
-use crate::solve::program::{FilterReport, Language, ProgramFile};
 use axum::extract::State;
 use axum::response::{IntoResponse, Response};
 use serde::{Deserialize, Serialize};

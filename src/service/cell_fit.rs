@@ -1,4 +1,4 @@
-//! Tool and work-object calibration of a robot (`core::cell::tcp`): fitted on
+//! Tool and work-object calibration of a robot (`core::cell_fit::tcp`): fitted on
 //! the chosen calibrated version (the active one by default, never the
 //! nominal model), judged (`tcp::judge`) and stored as the robot's tool or
 //! work object (`tcp::entry`: a refit keeps the item's load and, unless a new
@@ -12,11 +12,11 @@
 
 use super::solve::{chosen_model, ModelChoice};
 use super::{cell, AppState, ServiceError};
+use crate::cell_fit::tcp::entry::{self, Fitted as Judged, Outcome, StoreRequest, StoredEntry};
+use crate::cell_fit::tcp::{self as core_tcp, FitError, Reading, ToolFit, ToolRequest};
+use crate::cell_fit::work_object::WorkObjectFit;
 use crate::records::{CellItemRow, CellKind, CellPut, ItemFrame, NewCellItem};
 use crate::solve::cell::file::PoseMmDeg;
-use crate::solve::cell::tcp::entry::{self, Fitted as Judged, Outcome, StoreRequest, StoredEntry};
-use crate::solve::cell::tcp::{self as core_tcp, FitError, Reading, ToolFit, ToolRequest};
-use crate::solve::cell::work_object_fit::WorkObjectFit;
 use crate::solve::cell::{CellRef, WorkObjectFrame};
 
 /// What a fit asks beyond its readings.

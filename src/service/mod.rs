@@ -63,7 +63,7 @@ pub enum ServiceError {
     Unavailable(String),
     /// A robot program that cannot be parsed: file, line and column.
     #[error("{0}")]
-    Unparsable(#[from] crate::solve::program::ParseError),
+    Unparsable(#[from] crate::program::ParseError),
     /// A bug or corrupt stored data; logged, never shown to the client.
     #[error("{0}")]
     Internal(String),

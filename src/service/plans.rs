@@ -8,7 +8,7 @@
 use super::solve::{chosen_model, ModelChoice};
 use super::{AppState, ServiceError};
 use crate::plan::{make_plan, plan_csv, plan_program, MeasurementPlan, PlanSettings};
-use crate::solve::program::{Language, ProgramFile};
+use crate::program::{Language, ProgramFile};
 
 /// Most work a plan request may ask (module docs of [`make`]).
 pub const PLAN_WORK_MAX: f64 = 2e9;

@@ -7,10 +7,10 @@
 
 use super::solve::{chosen_model, ModelChoice};
 use super::{AppState, ServiceError};
-use crate::solve::ik::IkSettings;
-use crate::solve::program::{
+use crate::program::{
     filter_with, FilterControl, FilterError, FilterOutput, Language, ProgramFile,
 };
+use crate::solve::ik::IkSettings;
 
 /// A filter, in domain terms.
 #[derive(Debug, Clone)]
@@ -90,8 +90,8 @@ pub struct CellExport {
     pub method: String,
     /// Tool, load and work object data in the language, and what the export
     /// decided (numbers given, identifiers changed, registers written):
-    /// `core::cell::export`.
-    pub export: crate::solve::cell::export::ControllerExport,
+    /// `core::program::controller`.
+    pub export: crate::program::controller::ControllerExport,
 }
 
 /// The robot's stored tools (with their loads) and work objects as the
@@ -106,9 +106,9 @@ pub async fn export_cell(
     model: ModelChoice,
     payload_kg: Option<f64>,
     language: Language,
-    options: &crate::solve::cell::export::ExportOptions,
+    options: &crate::program::controller::ExportOptions,
 ) -> Result<CellExport, ServiceError> {
-    use crate::solve::cell::export::{export_cell, ExportError};
+    use crate::program::controller::{export_cell, ExportError};
     let cell = super::cell::cell(state, robot_id).await?;
     let chosen = chosen_model(state, robot_id, model).await?;
     let mut m = chosen.model;

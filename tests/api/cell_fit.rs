@@ -622,8 +622,8 @@ async fn a_fit_keeps_a_known_orientation_is_judged_and_answers_as_the_command_li
 /// The spec's closed sets of fits and exports are the code's.
 #[test]
 fn the_spec_lists_the_reasons_orientations_and_renamings_the_code_has() {
-    use robocal::solve::cell::export::RenameReason;
-    use robocal::solve::cell::tcp::{EntryField, NotFittedReason, OrientationSource};
+    use robocal::cell_fit::tcp::{EntryField, NotFittedReason, OrientationSource};
+    use robocal::program::controller::RenameReason;
     let yaml: serde_yaml::Value = serde_yaml::from_str(robocal::http::OPENAPI_YAML).unwrap();
     let doc: Value = serde_json::to_value(yaml).unwrap();
     let schemas = &doc["components"]["schemas"];

@@ -8,7 +8,7 @@ use axum::http::StatusCode;
 use robocal::model::kinematics::fk;
 use robocal::model::preset;
 use robocal::plan::{make_plan, read_plan_csv, PlanSettings, TrackerSight, WorkspaceBox};
-use robocal::solve::program::{parse, Language, ProgramFile};
+use robocal::program::{parse, Language, ProgramFile};
 use serde_json::json;
 
 const PLANS: &str = "/v1/robots/{id}/measurement-plans";

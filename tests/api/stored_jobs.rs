@@ -1,8 +1,9 @@
 //! A job queued before the store kept its command (format 1: only the
 //! columns `methods`, `identification_set_ids`, `validation_set_ids` and
-//! `options`, `command` NULL) still runs after an upgrade, to the same model
-//! as the same job queued now. The old row is written by hand as the service
-//! wrote it before, not by the code under test. SQLite: the restart's
+//! `options`, `command` NULL), or whose command is format 2 (the settings'
+//! fields beside the sets), still runs after an upgrade, to the same model
+//! as the same job queued now. The old rows are written by hand as the
+//! service wrote them before, not by the code under test. SQLite: the restart's
 //! `resume_queued` picks it up; PostgreSQL: a replica's runner claims it.
 
 use crate::support::*;
@@ -83,22 +84,40 @@ async fn a_job_stored_in_the_old_form_runs_to_the_same_model() {
         ),
     )
     .await;
+    // The same job as the service stored it in format 2 (the settings'
+    // fields beside the sets, before they were an object of their own).
+    let format2 = format!(
+        r#"{{"format":2,"generations":100,"identification_set_ids":[{set}],"max_iterations":40,"methods":["km","skcm"],"payload_kg":2.5,"population":50,"register":true,"seed":3,"training_set_ids":[],"validation_set_ids":[]}}"#
+    );
+    execute(
+        &t,
+        &format!(
+            "INSERT INTO calibrations (robot_id, status, methods, identification_set_ids, \
+             validation_set_ids, options, command) VALUES ({robot}, 'queued', '[\"km\",\"skcm\"]', \
+             '[{set}]', '[]', '{old_options}', '{format2}')"
+        ),
+    )
+    .await;
     if t._pg.is_none() {
         // A restart of this process picks up what was left queued.
         let resumed = robocal::service::jobs::local::resume_queued(&t.state)
             .await
             .unwrap();
-        assert_eq!(resumed, 1);
+        assert_eq!(resumed, 2);
     }
-    let old_job = new_job + 1;
-    let done = t.wait_for(robot, old_job, &ended, long).await;
-    assert_eq!(done["status"], "succeeded", "{done}");
-    assert_eq!(done["options"], old_options);
+    let (old_job, format2_job) = (new_job + 1, new_job + 2);
+    for job in [old_job, format2_job] {
+        let done = t.wait_for(robot, job, &ended, long).await;
+        assert_eq!(done["status"], "succeeded", "{done}");
+        assert_eq!(done["options"], old_options);
+    }
 
     let new = versions_of(&t, robot, new_job).await;
     let old = versions_of(&t, robot, old_job).await;
     assert_eq!(new.len(), 2);
     assert_eq!(old, new, "the old-form job must reach the same models");
+    let format2 = versions_of(&t, robot, format2_job).await;
+    assert_eq!(format2, new, "the format-2 job must reach the same models");
 }
 
 #[tokio::test]

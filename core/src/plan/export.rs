@@ -8,8 +8,8 @@ use crate::csv_write::{push_header, push_row, read_text, Cell};
 use crate::measure::bounds::{within, JOINT_DEG};
 use crate::measure::csv_text::{self, Dialect, FieldCount};
 use crate::model::bounds::show;
-use crate::solve::program::export::joint_program;
-use crate::solve::program::{Language, ProgramFile};
+use crate::program::export::joint_program;
+use crate::program::{Language, ProgramFile};
 use serde::{Deserialize, Serialize};
 
 /// One planned pose: its point name and controller joints [deg].

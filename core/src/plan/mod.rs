@@ -1,5 +1,5 @@
 //! Measurement plans: N poses chosen for identifiability (greedy D-optimal,
-//! `identify::pose_selection`) among seeded random candidates within the joint
+//! `pose_selection`) among seeded random candidates within the joint
 //! limits, a workspace box and the tracker's line of sight; the standard
 //! deviations they predict for a tracker noise σ; their exports (joint CSV,
 //! programs) and the join of a tracker export back into a measurement CSV.
@@ -13,6 +13,7 @@
 mod candidates;
 pub mod export;
 pub mod join;
+pub mod pose_selection;
 mod predict;
 mod settings;
 
@@ -69,9 +70,7 @@ pub fn make_plan(model: &RobotModel, s: &PlanSettings) -> Result<MeasurementPlan
         });
     }
     let gravity = predict::gravity_loads(model, &pool, payload_kg);
-    let q = crate::calibrate::identify::pose_selection::choose_d_optimal(
-        model, &pool, s.poses, payload_kg, gravity,
-    );
+    let q = pose_selection::choose_d_optimal(model, &pool, s.poses, payload_kg, gravity);
     let predicted = predict::predict(model, &q, payload_kg, s.noise_mm, gravity)?;
     let points = q
         .iter()

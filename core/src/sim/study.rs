@@ -5,13 +5,13 @@
 //! poses) and 45 random validation poses with the 110 kg payload; KM, SKCM and
 //! SKCM-C by TLBO are compared as in Table 7.5.
 
-use crate::calibrate::identify::pose_selection::choose_d_optimal;
 use crate::calibrate::identify::{
     calibrate, CalibrationError, CalibrationOptions, CalibrationReport,
 };
 use crate::calibrate::identify::{Method, Progress};
 use crate::measure;
 use crate::model::{preset, ModelError, RobotModel};
+use crate::plan::pose_selection::choose_d_optimal;
 use crate::sim::{random_configurations, ys100_table_7_1, SimError, TrueRobot};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;

@@ -1,7 +1,6 @@
 //! Solve: turn target poses into joint commands with a calibrated model
-//! (`ik`), place tools, loads and work objects in the cell (`cell`), and read
-//! and filter robot programs (`program`).
+//! (`ik`) and place tools, loads and work objects in the cell (`cell`). The
+//! robot programs a solve filters are the floor above (`crate::program`).
 
 pub mod cell;
 pub mod ik;
-pub mod program;

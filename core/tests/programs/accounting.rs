@@ -9,7 +9,7 @@
 use super::*;
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
-use robocal_core::solve::program::{filter, FilterReport, TargetStatus};
+use robocal_core::program::{filter, FilterReport, TargetStatus};
 
 /// What a generated line of a program is.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -2,9 +2,9 @@
 //! model (synthetic errors), and only their target values change.
 
 use super::*;
+use robocal_core::program::{filter, TargetStatus};
 use robocal_core::sim::{synthetic_calibration, SyntheticErrors};
 use robocal_core::solve::cell::CellDescription;
-use robocal_core::solve::program::{filter, TargetStatus};
 use std::path::Path;
 
 pub fn read(rel: &str) -> ProgramFile {

@@ -1,4 +1,4 @@
-//! `cell::export`: what the controller must hold, read back by the
+//! `program::controller`: what the controller must hold, read back by the
 //! project's own program parsers to the numbers the filter uses (tool, load,
 //! a work object measured in the tracker frame in the base frame, 1e-6 mm).
 
@@ -6,8 +6,8 @@ use super::*;
 use robocal_core::model::orientation::{
     rotation_angle_between, rotation_from, OrientationConvention,
 };
-use robocal_core::solve::cell::export::{export_cell, ExportOptions};
-use robocal_core::solve::program::FrameSpec;
+use robocal_core::program::controller::{export_cell, ExportOptions};
+use robocal_core::program::FrameSpec;
 
 /// The one site of `files` with its tool, work object and load.
 fn read_back(language: Language, files: &[ProgramFile]) -> (Pose, Pose, Load) {

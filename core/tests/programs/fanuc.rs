@@ -2,7 +2,7 @@
 
 use super::*;
 use robocal_core::model::orientation::{rotation_to, OrientationConvention};
-use robocal_core::solve::program::{fanuc_config, fanuc_config_text, filter, TargetStatus};
+use robocal_core::program::{fanuc_config, fanuc_config_text, filter, TargetStatus};
 
 fn program(f: &Fixture) -> Vec<ProgramFile> {
     let n = f.joints.len();

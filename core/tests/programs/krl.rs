@@ -3,8 +3,8 @@
 use super::stationary::{swapped, Swapped};
 use super::*;
 use robocal_core::model::orientation::{rotation_to, OrientationConvention};
-use robocal_core::solve::program::LoadSource;
-use robocal_core::solve::program::{filter, kuka_status, kuka_turn, TargetStatus};
+use robocal_core::program::LoadSource;
+use robocal_core::program::{filter, kuka_status, kuka_turn, TargetStatus};
 
 /// A KRL program visiting the fixture's 50 targets: even ones declared in the
 /// `.dat` and moved to by `PTP`, odd ones inline in `LIN`, with logic and
@@ -93,10 +93,7 @@ fn a_declared_load_is_used_and_one_differing_from_the_cell_is_warned_about() {
     for t in &out.report.targets {
         assert!(t.warnings.is_empty(), "{:?}", t.warnings);
         let load = t.load.as_ref().unwrap();
-        assert_eq!(
-            load.source,
-            robocal_core::solve::program::LoadSource::Program
-        );
+        assert_eq!(load.source, robocal_core::program::LoadSource::Program);
         assert_eq!(
             (load.load.mass_kg, load.load.com_mm),
             (110.0, [0.0, 0.0, 250.0])
@@ -117,7 +114,7 @@ fn a_declared_load_is_used_and_one_differing_from_the_cell_is_warned_about() {
     // The cell's load without a declaration: solved with the cell's.
     let out = filter(Language::Krl, &program(f), &cell, &f.model, &settings()).unwrap();
     let load = out.report.targets[0].load.as_ref().unwrap();
-    assert_eq!(load.source, robocal_core::solve::program::LoadSource::Cell);
+    assert_eq!(load.source, robocal_core::program::LoadSource::Cell);
 }
 
 #[test]

@@ -23,7 +23,6 @@ use truth::FlangeTruth;
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use robocal_core::calibrate::identify::pose_selection::choose_d_optimal;
 use robocal_core::calibrate::identify::{calibrate, CalibrationOptions, Method};
 use robocal_core::measure;
 use robocal_core::model::calibrated::CompensatedModel;
@@ -31,13 +30,14 @@ use robocal_core::model::kinematics::chain::tool_pose;
 use robocal_core::model::orientation::fixed_xyz_angles;
 use robocal_core::model::pose::rpy_matrix;
 use robocal_core::model::{preset, Pose, RobotModel};
+use robocal_core::plan::pose_selection::choose_d_optimal;
+use robocal_core::program::{filter, parse, Language, ProgramFile, Site, TargetStatus};
 use robocal_core::sim::{
     perturb_geometry, random_configurations, random_configurations_with, tracker_frame,
     ys100_table_7_1, ErrorMagnitudes, PoseFilter,
 };
 use robocal_core::solve::cell::{Cell, Load, Tool, WorkObject, WorkObjectFrame};
 use robocal_core::solve::ik::{AnalyticIk, Configuration, IkSettings};
-use robocal_core::solve::program::{filter, parse, Language, ProgramFile, Site, TargetStatus};
 use std::sync::OnceLock;
 
 /// The calibrated cell and the truth with the production tool.

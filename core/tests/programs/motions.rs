@@ -8,9 +8,9 @@
 use super::examples::{cell, read};
 use super::*;
 use robocal_core::model::orientation::{rotation_to, OrientationConvention};
+use robocal_core::program::{filter, kuka_status, kuka_turn, FilterReport, TargetStatus};
 use robocal_core::sim::{synthetic_calibration, SyntheticErrors};
 use robocal_core::solve::cell::{CellOptions, CellRef, CellSolver};
-use robocal_core::solve::program::{filter, kuka_status, kuka_turn, FilterReport, TargetStatus};
 
 use TargetStatus::{Failed, Filtered, Skipped};
 

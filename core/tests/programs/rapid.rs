@@ -4,7 +4,7 @@
 use super::stationary::{swapped, Swapped};
 use super::*;
 use robocal_core::model::orientation::{rotation_to, OrientationConvention};
-use robocal_core::solve::program::{abb_cf, filter, LoadSource, TargetStatus};
+use robocal_core::program::{abb_cf, filter, LoadSource, TargetStatus};
 
 fn literal(p: &Pose, cf: [i32; 4]) -> String {
     let q = rotation_to(OrientationConvention::AbbQ1q4, &p.r);

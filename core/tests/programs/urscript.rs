@@ -2,7 +2,7 @@
 
 use super::*;
 use robocal_core::model::orientation::{rotation_to, OrientationConvention};
-use robocal_core::solve::program::{filter, TargetStatus};
+use robocal_core::program::{filter, TargetStatus};
 
 fn pose_literal(p: &Pose) -> String {
     let r = rotation_to(OrientationConvention::UrRotvec, &p.r);

@@ -4,9 +4,9 @@
 //! objects whose points disagree.
 
 use super::*;
-use robocal_core::solve::cell::tcp::entry::{self, OrientationSource, Outcome, StoreRequest};
-use robocal_core::solve::cell::tcp::judge::{self, Noise as Sources};
-use robocal_core::solve::cell::tcp::{
+use robocal_core::cell_fit::tcp::entry::{self, OrientationSource, Outcome, StoreRequest};
+use robocal_core::cell_fit::tcp::judge::{self, Noise as Sources};
+use robocal_core::cell_fit::tcp::{
     EntryField, JudgedFit, Reading, StoredEntry, ToolRequest, WoPoint,
 };
 use robocal_core::solve::cell::LoadDescription;

@@ -9,9 +9,9 @@ use super::format::{deg, fixed, kg, mm, trimmed, DEG_DECIMALS, KG_DECIMALS, MM_D
 use crate::records::VersionRow;
 use crate::records::{CellItemRow, ItemFrame};
 use maud::{html, Markup};
+use robocal_core::cell_fit::tcp::TcpMethod;
 use robocal_core::model::load::LoadFrame;
 use robocal_core::model::orientation::OrientationConvention;
-use robocal_core::solve::cell::tcp::TcpMethod;
 
 /// Which kind of cell item a form or table holds.
 #[derive(Clone, Copy, PartialEq, Eq)]

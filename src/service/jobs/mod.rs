@@ -1,11 +1,12 @@
 //! Calibration jobs, from the command that starts one to the versions it
-//! stores. A job's options keep one type, [`StartCommand`], from the HTTP
+//! stores. A job keeps one type, [`StartCommand`] (its sets, payload and
+//! [`crate::calibrate::identify::CalibrationSettings`]), from the HTTP
 //! request to the runner on both backends:
 //!
 //! - [`command`]: the typed, serialisable start command and its stored forms;
 //! - [`prepare`]: the sets of a command by role, their sessions and poses,
 //!   read into a [`prepare::Job`];
-//! - [`stored`]: a stored job read back (its command in either stored form);
+//! - [`stored`]: a stored job read back (its command in any stored form);
 //! - [`runner`]: runs a started job, writes its progress and its outcome;
 //! - [`versions`]: what a successful job stores (model versions, summary);
 //! - [`local`]: the jobs of this process (SQLite) and their restart;

@@ -9,7 +9,6 @@
 //! Units: SI inside; reports speak millimetres and degrees (compliance in
 //! rad/(N·m), stiffness in N·m/rad).
 
-pub mod calibrate;
 pub mod checks;
 mod evaluate;
 pub mod evidence;
@@ -20,18 +19,18 @@ pub mod methods;
 pub mod model_file;
 pub mod network;
 pub mod options;
-pub mod pose_selection;
+mod pipeline;
 pub mod progress;
 pub mod registration;
 pub mod report;
 
-pub use calibrate::{calibrate, calibrate_with_training};
 pub use checks::CalibrationError;
 pub use identifiability::{DropKind, IdentifiabilityReport, IdentifiabilitySettings};
 pub use least_squares::{LmReport, LmSettings, StopReason};
 pub use methods::{Method, MethodChoice, MethodFailure, MethodListError, MethodRow, METHODS};
 pub use model_file::calibrated_model_file;
-pub use options::{CalibrationOptions, CompensatorOptions};
+pub use options::{CalibrationOptions, CalibrationSettings, CompensatorOptions};
+pub use pipeline::{calibrate, calibrate_with_training};
 pub use progress::{Clock, Fold, Phase, Progress, ProgressReporter, SystemClock};
 pub use registration::{register, Registration};
 pub use report::{

@@ -2,6 +2,11 @@
 //! settings, the compensator settings, the plausibility range of identified
 //! stiffness (the progress reported while it runs is `super::progress`).
 //!
+//! Two types: [`CalibrationSettings`], what a user chooses (the HTTP request,
+//! the command line and a stored job all convert into it once), and
+//! [`CalibrationOptions`], everything a calibration reads, which
+//! [`CalibrationSettings::options`] alone builds from the settings.
+//!
 //! Units: SI inside (N·m/rad for stiffness, rad for deflections); the report
 //! speaks mm and deg.
 
@@ -17,7 +22,97 @@ use crate::calibrate::compensate::{
 use crate::optim::TlboSettings;
 use serde::{Deserialize, Serialize};
 
-/// Calibration settings.
+/// What a user chooses of a calibration: the methods and the settings a
+/// request, a command line or a stored job may set. Every field has the
+/// default of [`CalibrationSettings::default`] (the core's own), so a stored
+/// form written before a field existed still reads; an unknown field is
+/// refused.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct CalibrationSettings {
+    /// The methods to run and compare, in order.
+    pub methods: Vec<Method>,
+    /// Register the measurement frame in closed form first (off only when
+    /// the data is already in the base frame and should stay there exactly).
+    pub register: bool,
+    /// Seed of every random choice: the TLBO search and the compensators'
+    /// initial weights, subsamples and folds.
+    pub seed: u64,
+    /// Levenberg–Marquardt iteration limit of the identification.
+    pub max_iterations: usize,
+    /// TLBO population (skcm-tlbo).
+    pub population: usize,
+    /// TLBO generations (skcm-tlbo).
+    pub generations: usize,
+    /// Folds of the compensators' cross-validation on the training pool
+    /// ([`CompensatorOptions::cv_folds`]).
+    pub cv_folds: usize,
+    /// Spatially blocked folds run with the cross-validation
+    /// ([`CompensatorOptions::blocked_folds`]).
+    pub blocked_folds: usize,
+    /// The fraction within which `auto`'s options tie
+    /// ([`CompensatorOptions::tie_margin`]).
+    pub tie_margin: f64,
+    /// The joint-map and compensator methods `auto` considers.
+    pub auto_candidates: Vec<Method>,
+}
+
+impl Default for CalibrationSettings {
+    /// The core's defaults: [`Method::THESIS`], registration on, seed 0, and
+    /// each setting as [`CalibrationOptions::default`] holds it.
+    fn default() -> Self {
+        let d = CalibrationOptions::default();
+        CalibrationSettings {
+            methods: d.methods,
+            register: d.register,
+            seed: d.tlbo.seed,
+            max_iterations: d.lm.max_iterations,
+            population: d.tlbo.population,
+            generations: d.tlbo.generations,
+            cv_folds: d.compensator.cv_folds,
+            blocked_folds: d.compensator.blocked_folds,
+            tie_margin: d.compensator.tie_margin,
+            auto_candidates: d.compensator.auto_candidates,
+        }
+    }
+}
+
+impl CalibrationSettings {
+    /// The options a calibration runs with: these settings where they act
+    /// (the one seed seeds both the TLBO search and the compensators), the
+    /// core's defaults elsewhere, and the threads its cross-validations
+    /// train on (`parallel`: the caller's, never a user's stored choice).
+    pub fn options(&self, parallel: Parallelism) -> CalibrationOptions {
+        let d = CalibrationOptions::default();
+        CalibrationOptions {
+            methods: self.methods.clone(),
+            register: self.register,
+            lm: LmSettings {
+                max_iterations: self.max_iterations,
+                ..d.lm
+            },
+            tlbo: TlboSettings {
+                population: self.population,
+                generations: self.generations,
+                seed: self.seed,
+            },
+            compensator: CompensatorOptions {
+                seed: self.seed,
+                cv_folds: self.cv_folds,
+                blocked_folds: self.blocked_folds,
+                tie_margin: self.tie_margin,
+                auto_candidates: self.auto_candidates.clone(),
+                parallel,
+                ..d.compensator
+            },
+            ..d
+        }
+    }
+}
+
+/// Everything a calibration reads; built from [`CalibrationSettings`] by
+/// [`CalibrationSettings::options`], or whole by the core's tests and
+/// benches.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CalibrationOptions {
     pub methods: Vec<Method>,
@@ -150,5 +245,86 @@ impl Default for CalibrationOptions {
             compensator: CompensatorOptions::default(),
             joint_maps: JointMapSettings::default(),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each setting lands where the calibration reads it, and nothing else
+    /// moves from the core's defaults.
+    #[test]
+    fn the_settings_build_the_options_they_name() {
+        let s = CalibrationSettings {
+            methods: vec![Method::Skcm, Method::Km],
+            register: false,
+            seed: 42,
+            max_iterations: 7,
+            population: 12,
+            generations: 3,
+            cv_folds: 2,
+            blocked_folds: 0,
+            tie_margin: 0.2,
+            auto_candidates: vec![Method::KmMaps],
+        };
+        let o = s.options(Parallelism { threads: 3 });
+        let d = CalibrationOptions::default();
+        let want = CalibrationOptions {
+            methods: vec![Method::Skcm, Method::Km],
+            register: false,
+            lm: LmSettings {
+                max_iterations: 7,
+                ..d.lm.clone()
+            },
+            tlbo: TlboSettings {
+                population: 12,
+                generations: 3,
+                seed: 42,
+            },
+            compensator: CompensatorOptions {
+                seed: 42,
+                cv_folds: 2,
+                blocked_folds: 0,
+                tie_margin: 0.2,
+                auto_candidates: vec![Method::KmMaps],
+                parallel: Parallelism { threads: 3 },
+                ..d.compensator.clone()
+            },
+            ..d
+        };
+        assert_eq!(o, want);
+    }
+
+    /// The default settings are the core's defaults but for the one seed,
+    /// which seeds the compensators too (the options' own default is 1).
+    #[test]
+    fn the_default_settings_are_the_core_defaults_with_one_seed() {
+        let o = CalibrationSettings::default().options(Parallelism::default());
+        let d = CalibrationOptions::default();
+        assert_eq!(d.compensator.seed, 1);
+        let want = CalibrationOptions {
+            compensator: CompensatorOptions {
+                seed: 0,
+                ..d.compensator.clone()
+            },
+            ..d
+        };
+        assert_eq!(o, want);
+    }
+
+    /// A stored form that names no setting reads as the defaults; one that
+    /// names an unknown field is refused.
+    #[test]
+    fn the_stored_settings_fill_defaults_and_refuse_unknown_fields() {
+        let s: CalibrationSettings = serde_json::from_str(r#"{"seed": 5}"#).unwrap();
+        assert_eq!(
+            s,
+            CalibrationSettings {
+                seed: 5,
+                ..CalibrationSettings::default()
+            }
+        );
+        assert!(serde_json::from_str::<CalibrationSettings>(r#"{"sed": 5}"#).is_err());
     }
 }

@@ -5,8 +5,8 @@
 
 use super::cube::CubePlan;
 use super::Iso9283Error;
-use crate::solve::program::export::{labelled_joint_program, LabelledJoints};
-use crate::solve::program::{Language, ProgramFile};
+use crate::program::export::{labelled_joint_program, LabelledJoints};
+use crate::program::{Language, ProgramFile};
 
 /// The program `name` in `language` cycling `cycles` times through the
 /// plan's poses with a wait of `wait_s` seconds at each.

@@ -23,14 +23,11 @@
 //! Units: SI (m, rad) inside; the programs' units are converted by the parsers.
 
 pub mod accuracy;
-pub mod export;
 pub mod file;
 pub mod joints_csv;
-mod numbering;
+pub(crate) mod numbering;
 pub use crate::model::load;
 pub mod predict;
-pub mod tcp;
-pub mod work_object_fit;
 
 pub use file::{CellDescription, CellFileError};
 pub use load::{Load, LoadDescription, LoadFrame};

@@ -8,10 +8,10 @@ use super::{
     axis, cell_points_to_base, fixed_point, flange_poses, tracker, FitError, NotFittedReason,
     TcpMethod, ToolFit,
 };
+use crate::cell_fit::work_object::{self, WorkObjectFit, WorkObjectPoints};
 use crate::model::calibrated::CompensatedModel;
 use crate::model::pose::rpy_matrix;
 use crate::model::Pose;
-use crate::solve::cell::work_object_fit::{self, WorkObjectFit, WorkObjectPoints};
 use nalgebra::Vector3;
 
 /// How the tool's axis is given.
@@ -186,40 +186,42 @@ pub fn fit_work_object(
             )
             .at_row(i + 1)
         })?;
-        let p =
-            match (&r.xyz_mm, &r.joints_deg, tcp) {
-                (Some(x), _, _) => cell_points_to_base(model, &[Vector3::from(*x) * 1e-3])[0],
-                (None, Some(q), Some(t)) => work_object_fit::touched_tips(
-                    model,
-                    t,
-                    std::slice::from_ref(q),
-                )
-                .map_err(|e| FitError {
-                    message: format!("row {}: {}", i + 1, e.message.trim_start_matches("row 1: ")),
-                    row: Some(i + 1),
-                    ..e
-                })?[0],
-                (None, Some(_), None) => {
-                    return Err(FitError::new(
-                        NotFittedReason::TouchesNeedTool,
-                        format!(
+        let p = match (&r.xyz_mm, &r.joints_deg, tcp) {
+            (Some(x), _, _) => cell_points_to_base(model, &[Vector3::from(*x) * 1e-3])[0],
+            (None, Some(q), Some(t)) => {
+                work_object::touched_tips(model, t, std::slice::from_ref(q)).map_err(|e| {
+                    FitError {
+                        message: format!(
+                            "row {}: {}",
+                            i + 1,
+                            e.message.trim_start_matches("row 1: ")
+                        ),
+                        row: Some(i + 1),
+                        ..e
+                    }
+                })?[0]
+            }
+            (None, Some(_), None) => {
+                return Err(FitError::new(
+                    NotFittedReason::TouchesNeedTool,
+                    format!(
                     "row {}: touches with joint readings need the calibrated tool that made them",
                     i + 1
                 ),
-                    )
-                    .at_row(i + 1))
-                }
-                (None, None, _) => {
-                    return Err(FitError::new(
-                        NotFittedReason::MissingPosition,
-                        format!(
-                            "row {}: give a tracker position (x, y, z mm) or joint readings",
-                            i + 1
-                        ),
-                    )
-                    .at_row(i + 1))
-                }
-            };
+                )
+                .at_row(i + 1))
+            }
+            (None, None, _) => {
+                return Err(FitError::new(
+                    NotFittedReason::MissingPosition,
+                    format!(
+                        "row {}: give a tracker position (x, y, z mm) or joint readings",
+                        i + 1
+                    ),
+                )
+                .at_row(i + 1))
+            }
+        };
         match point {
             WoPoint::Origin => pts.origin.push(p),
             WoPoint::X => pts.x.push(p),
@@ -232,5 +234,5 @@ pub fn fit_work_object(
     } else {
         Noise::Pointing
     };
-    judge::judge_work_object(work_object_fit::fit(&pts)?, noise)
+    judge::judge_work_object(work_object::fit(&pts)?, noise)
 }

@@ -6,8 +6,8 @@
 
 use super::*;
 use crate::model::preset;
+use crate::program::{parse, FrameSpec, ProgramFile};
 use crate::solve::cell::{Tool, WorkObject, WorkObjectFrame};
-use crate::solve::program::{parse, FrameSpec, ProgramFile};
 use nalgebra::Vector3;
 
 fn model() -> CompensatedModel {
@@ -137,7 +137,7 @@ fn the_filter_finds_an_unnumbered_item_under_the_number_the_export_gives_it() {
     assert!(e.to_string().contains("`gun` and `torch`"), "{e}");
 }
 
-use super::super::CellRef;
+use crate::solve::cell::CellRef;
 
 #[test]
 fn number_0_and_numbers_beyond_the_controller_are_refused_naming_the_item() {

@@ -16,11 +16,11 @@
 //! Units: mm and fixed-axis degrees `[rx, ry, rz]` (`R = Rz·Ry·Rx`).
 
 use super::{FitError, JudgedFit, NotFittedReason, ToolFit};
+use crate::cell_fit::work_object::WorkObjectFit;
 use crate::model::load::LoadDescription;
 use crate::model::orientation::rotation_angle_between;
 use crate::model::pose::rpy_matrix;
 use crate::solve::cell::file::{PoseMmDeg, ToolDescription, WorkObjectDescription};
-use crate::solve::cell::work_object_fit::WorkObjectFit;
 use crate::solve::cell::WorkObjectFrame;
 use serde::Serialize;
 

@@ -19,21 +19,21 @@
 //! - Fanuc: a TP program with the payload schedules `$PLST_GRP1[n]` (kg;
 //!   centre of gravity in cm; inertia in kgf·cm·s²) and, with the position
 //!   registers the user gives, `UTOOL[n]`, `UFRAME[n]` set from them
-//!   (`PR[i,j]`: X, Y, Z mm, W, P, R deg) — [`fanuc`].
+//!   (`PR[i,j]`: X, Y, Z mm, W, P, R deg) — `fanuc.rs`.
 //! - URScript: `set_tcp(p[…])`, `set_payload(kg, [cx, cy, cz])` (m, the
 //!   rotation vector in rad) and a feature variable `name = p[…]`.
 //!
 //! What a controller loads (the checks, each refusing with the item named):
-//! one number per item ([`super::numbering`]: the cell's own, else the
+//! one number per item (`solve::cell::numbering`: the cell's own, else the
 //! lowest free, reported in the header comment and [`ControllerExport`]),
 //! within the controller's range and never 0 where 0 is the flange or the
-//! base ([`numbers`]); identifiers valid and distinct ([`names`]), every
+//! base (`numbers.rs`); identifiers valid and distinct (`names.rs`), every
 //! renaming reported; registers only those the user names.
 
-pub mod data;
-pub mod fanuc;
-pub mod names;
-pub mod numbers;
+mod data;
+mod fanuc;
+mod names;
+mod numbers;
 
 pub(crate) use data::comment;
 pub use data::{
@@ -42,12 +42,12 @@ pub use data::{
 pub use names::{RenameReason, Renamed};
 pub use numbers::{NumberRange, RegisterRange, UsedRegister};
 
-use super::numbering::{self, ItemKind};
-use super::{Cell, Load, Tool};
 use crate::model::calibrated::CompensatedModel;
 use crate::model::orientation::{rotation_to, OrientationConvention};
 use crate::model::Pose;
-use crate::solve::program::Language;
+use crate::program::Language;
+use crate::solve::cell::numbering::{self, ItemKind};
+use crate::solve::cell::{Cell, Load, Tool};
 use std::fmt::Write as _;
 
 /// The cell's tools and work objects as the controller holds them, for the

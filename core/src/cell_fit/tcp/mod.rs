@@ -2,7 +2,7 @@
 //! readings on the CALIBRATED model.
 //!
 //! Frames: the flange frame is the calibrated model's last link frame (the
-//! model's own measurement tool removed, `super::with_tool` with the identity);
+//! model's own measurement tool removed, `solve::cell::with_tool` with the identity);
 //! its pose `F_i = (R_i, p_i)` in the registered base frame comes from
 //! [`CompensatedModel::predict_base`] (compliance, joint maps and the
 //! compensator's position residual included, as every solve sees them). A
@@ -56,7 +56,7 @@ pub fn flange_poses(
     model: &CompensatedModel,
     joints_deg: &[Vec<f64>],
 ) -> Result<Vec<Pose>, FitError> {
-    let flange = super::with_tool(model, &Pose::identity());
+    let flange = crate::solve::cell::with_tool(model, &Pose::identity());
     let dof = model.dof();
     joints_deg
         .iter()

@@ -2,7 +2,7 @@
 //! `tcp`, mm and degrees in the fields named so), the fitted work object
 //! (`WorkObjectFit`), and why a fit was refused (`FitError`, its
 //! `NotFittedReason` and the `JudgedFit` figures), read by every method of
-//! `tcp` and by `work_object_fit`.
+//! `tcp` and by `work_object`.
 
 use super::limits::Limits;
 use crate::model::Pose;

@@ -5,9 +5,9 @@
 use super::names::Renamed;
 use super::numbers::{NumberRange, RegisterRange, UsedRegister};
 use crate::model::Pose;
+use crate::program::Language;
 use crate::solve::cell::numbering::{AssignedNumber, DuplicateNumber, ItemKind};
 use crate::solve::cell::Load;
-use crate::solve::program::Language;
 
 /// One tool as the controller holds it.
 #[derive(Debug, Clone, PartialEq)]

@@ -13,7 +13,7 @@ use super::{mark, parse, Language, Motion, MotionTarget, ParseError, Program, Pr
 use crate::model::calibrated::CompensatedModel;
 use crate::model::orientation::rotation_to;
 use crate::model::Pose;
-use crate::solve::cell::export::{
+use crate::program::controller::{
     controller_text, ControllerData, ControllerFrame, ControllerTool, ExportOptions,
 };
 use crate::solve::cell::Cell;

@@ -19,7 +19,7 @@ use super::report::{LoadSource, Reachable, UsedLoad};
 use super::{Flags, FrameSpec, Language, Site};
 use crate::model::calibrated::CompensatedModel;
 use crate::model::Pose;
-use crate::solve::cell::export::{ControllerFrame, ControllerTool};
+use crate::program::controller::{ControllerFrame, ControllerTool};
 use crate::solve::cell::{
     Cell, CellOptions, CellSolution, CellSolver, Load, LoadDescription, Tool, WorkObject,
     WorkObjectFrame,
@@ -38,7 +38,7 @@ pub(super) struct Solved {
     pub(super) load: UsedLoad,
     pub(super) warnings: Vec<String>,
     /// The tool and work object as the controller holds them (`None` for a
-    /// stationary tool, which `cell::export` does not write).
+    /// stationary tool, which `program::controller` does not write).
     pub(super) tool: Option<ControllerTool>,
     pub(super) frame: Option<ControllerFrame>,
 }

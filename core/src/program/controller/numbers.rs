@@ -10,8 +10,8 @@
 //!   faceplate and user frame 0 the world frame, which cannot be set.
 //! - RAPID and URScript name their data; they have no numbers.
 
-use super::super::numbering::ItemKind;
-use crate::solve::program::Language;
+use crate::program::Language;
+use crate::solve::cell::ItemKind;
 use serde::Serialize;
 
 /// The numbers one kind of a controller's data takes.

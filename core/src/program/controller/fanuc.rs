@@ -19,8 +19,8 @@ use super::data::{comment, ControllerData, ExportError};
 use super::numbers::{RegisterRange, UsedRegister};
 use crate::model::orientation::{rotation_to, OrientationConvention};
 use crate::model::Pose;
+use crate::program::Language;
 use crate::solve::cell::numbering::ItemKind;
-use crate::solve::program::Language;
 use std::fmt::Write as _;
 
 /// Fanuc's inertia unit: 1 kgf·cm·s² = 9.80665 N · 0.01 m · s² =

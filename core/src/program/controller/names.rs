@@ -18,7 +18,7 @@
 //! cell's order. Every identifier that differs from its name is reported
 //! ([`Renamed`]), naming the item that had it first.
 
-use super::super::numbering::ItemKind;
+use crate::solve::cell::ItemKind;
 use serde::Serialize;
 
 /// RAPID's longest identifier.

@@ -14,6 +14,7 @@
 //! Units: the programs' own (KRL: mm and degrees, A,B,C = `Rz(A)·Ry(B)·Rx(C)`);
 //! SI (m, rad) in [`Site::pose`].
 
+pub mod controller;
 pub mod export;
 mod fanuc;
 mod krl;
