@@ -26,6 +26,7 @@ mod maps;
 mod model_based;
 mod orientation_part;
 mod plan;
+mod regions;
 mod report;
 mod run;
 pub mod ties;

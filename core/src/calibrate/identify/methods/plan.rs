@@ -17,7 +17,7 @@
 
 use super::cache::Cache;
 use super::context::Context;
-use super::delivered::planned_regions;
+use super::regions::planned_regions;
 use super::{Base, Method, Run};
 
 /// Trainings of one cross-validated compensator that its table weight is set
