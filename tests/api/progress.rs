@@ -16,6 +16,9 @@ use std::time::{Duration, Instant};
 /// compensators', then the joint maps and the Gaussian processes on them),
 /// the middle of KM-GP's cross-validation, past the first percent of the
 /// methods' work (so with a time left).
+/// The plan also counts the veto's refits, so the report there may be one
+/// that names no fold (a base fit or a final training); the test then lets
+/// reports pass one at a time until one inside a fold is held.
 fn hold_at() -> f64 {
     use robocal::calibrate::identify::Method::*;
     let w = |m: robocal::calibrate::identify::Method| m.row().weight;
@@ -84,6 +87,7 @@ async fn an_auto_job_reports_progress_that_never_goes_back() {
     let mut last = 0.0;
     let mut polls = 0usize;
     let mut held: Option<Value> = None;
+    let mut released: Option<Value> = None;
     let mut etas = 0usize;
     let end = loop {
         let j = t.job(&rid, job).await.json();
@@ -112,9 +116,25 @@ async fn an_auto_job_reports_progress_that_never_goes_back() {
         }
         // Held: once the stored progress is the held report, it names what
         // the job is on; then the job goes on.
-        if held.is_none() && gate.held() > 0 && p["phase"] == "auto" && percent >= hold {
-            held = Some(p.clone());
-            gate.open();
+        if held.is_none()
+            && gate.held() > 0
+            && p["phase"] == "auto"
+            && percent >= hold
+            && Some(p) != released.as_ref()
+        {
+            if p["fold"].is_null() {
+                // Held where no fold runs (a base fit or a final training):
+                // let this report pass and hold the next one.
+                released = Some(p.clone());
+                gate.open();
+                while gate.held() > 0 {
+                    tokio::time::sleep(Duration::from_millis(1)).await;
+                }
+                gate.close();
+            } else {
+                held = Some(p.clone());
+                gate.open();
+            }
         }
         // Only a hang takes ten minutes.
         assert!(start.elapsed() < Duration::from_secs(600), "{j}");
@@ -128,8 +148,12 @@ async fn an_auto_job_reports_progress_that_never_goes_back() {
     let candidate = held["candidate"].as_str().expect("a candidate named");
     let fold = &held["fold"];
     let (index, of) = (
-        fold["index"].as_u64().unwrap(),
-        fold["of"].as_u64().unwrap(),
+        fold["index"]
+            .as_u64()
+            .unwrap_or_else(|| panic!("no fold named at {hold} %: {held}")),
+        fold["of"]
+            .as_u64()
+            .unwrap_or_else(|| panic!("no fold named at {hold} %: {held}")),
     );
     // 5 random folds and 4 blocked ones (the defaults).
     assert!((1..=of).contains(&index) && of == 9, "{held}");
