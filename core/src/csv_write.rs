@@ -30,9 +30,11 @@ const SPLITS: [char; 3] = [',', ';', '\t'];
 /// does not honour quotes starts a row there).
 const SEPARATORS: [char; 5] = [',', ';', '\t', '\n', '\r'];
 
-/// Whether a cell of the split at `split` ends where a part ends with `next`.
-fn ends_cell(next: Option<char>, split: char) -> bool {
-    matches!(next, None | Some('\n' | '\r')) || next == Some(split)
+/// Whether a part holds nothing a spreadsheet shows before a cell's first
+/// character: only blanks, `'` and `"`.
+fn blank(part: &str) -> bool {
+    part.chars()
+        .all(|c| c.is_whitespace() || c == '\'' || c == '"')
 }
 
 /// Whether a part would start a formula: its first character after blanks,
@@ -90,24 +92,13 @@ fn parts(text: &str) -> impl Iterator<Item = (&str, Option<char>)> {
 /// formula (module docs); anything else unchanged.
 pub fn neutralise(text: &str) -> Cow<'_, str> {
     let parts: Vec<(&str, Option<char>)> = parts(text).collect();
-    // A part starts a cell in the split at the separator before it (in every
-    // split at the start of a line), and that cell runs to the next such
-    // separator or line break: it is a plain number only when the part is
-    // one and the cell ends with it.
-    let mark = |i: usize| {
-        let (p, next) = parts[i];
-        let whole_cell = match i.checked_sub(1).and_then(|j| parts[j].1) {
-            None | Some('\n' | '\r') => SPLITS.iter().all(|s| ends_cell(next, *s)),
-            Some(split) => ends_cell(next, split),
-        };
-        formula_like(p) && !(whole_cell && plain_number(p))
-    };
-    if !(0..parts.len()).any(mark) {
+    let marks = marks(&parts);
+    if !marks.iter().any(|m| *m) {
         return Cow::Borrowed(text);
     }
     let mut out = String::with_capacity(text.len() + 4);
-    for (i, (p, sep)) in parts.iter().enumerate() {
-        if mark(i) {
+    for ((p, sep), mark) in parts.iter().zip(&marks) {
+        if *mark {
             out.push('\'');
         }
         out.push_str(p);
@@ -116,6 +107,45 @@ pub fn neutralise(text: &str) -> Cow<'_, str> {
         }
     }
     Cow::Owned(out)
+}
+
+/// Which parts [`neutralise`] marks. In every split, each cell (from a line
+/// start or the split's separator to the next one or a line break) is
+/// looked at from its first character a spreadsheet shows: blank parts joined
+/// by blank separators (a tab inside a `,` cell) are skipped, and the first
+/// part that is not blank is marked when it starts a formula and the whole
+/// cell is not a plain number. Every part starts a cell in some split (the
+/// one of the separator before it), so every part that starts with `'` and a
+/// formula is marked, which is what lets [`read_text`] drop exactly the marks.
+fn marks(parts: &[(&str, Option<char>)]) -> Vec<bool> {
+    let mut marks = vec![false; parts.len()];
+    for split in SPLITS {
+        let mut first = 0;
+        while first < parts.len() {
+            let last = (first..parts.len())
+                .find(|&j| {
+                    matches!(parts[j].1, None | Some('\n' | '\r')) || parts[j].1 == Some(split)
+                })
+                .unwrap_or(parts.len() - 1);
+            let shown = (first..=last)
+                .take_while(|&j| j == first || parts[j - 1].1.is_some_and(char::is_whitespace))
+                .find(|&j| !blank(parts[j].0));
+            if let Some(k) = shown {
+                let mut cell = String::new();
+                for (j, (p, sep)) in parts.iter().enumerate().take(last + 1).skip(first) {
+                    cell.push_str(p);
+                    if j < last {
+                        cell.extend(*sep);
+                    }
+                }
+                if formula_like(parts[k].0) && !plain_number(&cell) {
+                    marks[k] = true;
+                }
+            }
+            first = last + 1;
+        }
+    }
+    marks
 }
 
 /// A part that [`neutralise`] marked: `'` followed by a formula-like part.

@@ -128,3 +128,16 @@ proptest! {
         }
     }
 }
+
+/// A cell that starts with a blank part: split at `,`, `"\t-0\ta"` is one
+/// cell whose first shown character is `-`, though split at a tab `-0` is a
+/// number of its own.
+#[test]
+fn a_formula_after_a_leading_tab_is_marked_for_the_comma_split() {
+    let safe = neutralise("\t-0\ta");
+    assert_eq!(safe, "\t'-0\ta");
+    assert_eq!(read_text(&safe), "\t-0\ta");
+    // A number after blanks that is the whole cell in every split stays a number.
+    assert_eq!(neutralise("\t-0"), "\t-0");
+    assert_eq!(neutralise(" ;-0"), " ;-0");
+}
