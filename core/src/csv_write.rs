@@ -15,9 +15,10 @@
 //! Neutralising: a spreadsheet runs a cell whose first character is `=`, `+`,
 //! `-` or `@` (after blanks and quotes) as a formula, and it splits a line at
 //! `,`, `;` or a tab (by locale). So every part of a text between those
-//! separators that would start such a cell gets a leading `'` (which
-//! spreadsheets show as text), unless the cell it starts is a plain decimal
-//! number (`-20`, `+1.5e3`) in the split where it starts one. robocal's
+//! separators that would start such a cell (in some split, the first part a
+//! cell shows after blank parts, as `-0` in a `,` cell `\t-0\ta`) gets a
+//! leading `'` (which spreadsheets show as text), unless that cell is a plain
+//! decimal number (`-20`, `+1.5e3`). robocal's
 //! readers drop that `'` again ([`read_text`]): `read_text(neutralise(t)) ==
 //! t` for every text.
 
