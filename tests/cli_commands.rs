@@ -190,6 +190,7 @@ fn cli_args(model: &str, targets: &str) -> SolveArgs {
         delimiter: None,
         decimal: None,
         failures: Default::default(),
+        track: Default::default(),
     }
 }
 

@@ -8,23 +8,29 @@
 //! fitted track and the calibrated robot. The readings go through a
 //! measurement CSV with an `e1` column.
 //!
+//! Predictions and solves through the fitted track are checked against the
+//! same truth (`predictions_and_solves_through_the_track_land_on_the_truth`).
+//!
 //! Figures: `cargo test -p robocal-core --test track -- --nocapture`.
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal_core::calibrate::external::track::{
-    fit_track, TrackFit, TrackFitRequest, TrackRefusalReason, TrackRefused, UnseenTerm,
-    DEFAULT_MAX_ORDER,
+    fit_track, fit_track_compensated, TrackFit, TrackFitRequest, TrackRefusalReason, TrackRefused,
+    UnseenTerm, DEFAULT_MAX_ORDER,
 };
 use robocal_core::calibrate::identify::{calibrate, CalibrationOptions, Method};
 use robocal_core::measure::csv;
 use robocal_core::measure::external::{ExternalAxis, MeasurementSet};
 use robocal_core::measure::to_measurements;
+use robocal_core::model::calibrated::CompensatedModel;
 use robocal_core::model::external::CarriageTerm;
 use robocal_core::model::kinematics::fk;
-use robocal_core::model::{preset, RobotModel};
+use robocal_core::model::{preset, Pose, RobotModel};
 use robocal_core::sim::track::TrueTrack;
 use robocal_core::sim::{perturb_geometry, random_configurations, ErrorMagnitudes, TrueRobot};
+use robocal_core::solve::external::{carried, TrackPoseError, TrackSolver};
+use robocal_core::solve::ik::{Goal, IkSettings, SolveOptions};
 
 const SIGMA_MM: f64 = 0.01;
 /// Fitted track values [mm]: every 400 mm over the 4 m.
@@ -385,4 +391,135 @@ fn fits_the_readings_cannot_carry_are_refused() {
         fit_track(&sigma).unwrap_err().reason,
         TrackRefusalReason::NotFinite
     );
+}
+
+/// The robot's compensated model as a calibration gives it: the calibrated
+/// geometry, the controller's nominal model, no compensator.
+fn compensated(calibrated: RobotModel, nominal: &RobotModel) -> CompensatedModel {
+    CompensatedModel {
+        calibrated,
+        nominal: nominal.clone(),
+        cell_from_base: Pose::identity(),
+        payload_kg: nominal.payload.mass,
+        compensator: None,
+    }
+}
+
+/// The truth's tool pose in the cell frame: the true robot (no noise) on the
+/// true track at `value_mm`.
+fn true_pose(truth: &TrueRobot, track: &TrueTrack, q: &[f64], value_mm: f64) -> Pose {
+    track
+        .cell_from_base(value_mm)
+        .compose(&truth.true_pose_base(q, None).unwrap())
+}
+
+/// Predict and solve through the fitted track, checked against the
+/// simulated truth (its physics, not the model's code): the reflector
+/// predicted at held-out track values for new joints, and targets the true
+/// robot reached at held-out values solved back into joints that the true
+/// robot on the true track takes to within the same bound as the fit's
+/// held-out test (1.5 × the robot's own validation error on a fixed base);
+/// the same through a straight rail (no maps) for comparison; values
+/// beyond the travel refused.
+#[test]
+fn predictions_and_solves_through_the_track_land_on_the_truth() {
+    let track = TrueTrack::rail_4m();
+    for seed in [1u64, 2, 3] {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let (nominal, truth) = robot(&mut rng);
+        let (calibrated, robot_val_rms) =
+            calibrated_on_fixed_base(&nominal, &truth, &track, &mut rng);
+        let set = measure(&truth, &nominal, &track, &STATIONS, &mut rng);
+        let model = compensated(calibrated.clone(), &nominal);
+        let fit =
+            fit_track_compensated(&model, &set, ExternalAxis::E1, SIGMA_MM, DEFAULT_MAX_ORDER)
+                .unwrap();
+        // Without a compensator the compensated model places the readings
+        // as the calibrated geometry does: the same track.
+        let plain = fit_track(&request(&calibrated, &set, DEFAULT_MAX_ORDER)).unwrap();
+        for v in HELD_OUT {
+            let (a, b) = (
+                fit.model.cell_from_base(v).unwrap(),
+                plain.model.cell_from_base(v).unwrap(),
+            );
+            assert!((a.p - b.p).norm() < 1e-12 && (a.r - b.r).norm() < 1e-12);
+        }
+        let straight = match fit_track_compensated(&model, &set, ExternalAxis::E1, SIGMA_MM, 0) {
+            Err(TrackRefused { fit: Some(f), .. }) => f.model,
+            other => panic!("seed {seed}: a straight rail should be refused, got {other:?}"),
+        };
+        let on_track = TrackSolver::new(&model, None, fit.model.clone(), IkSettings::default());
+        let on_straight = TrackSolver::new(&model, None, straight, IkSettings::default());
+
+        // Predict: new joints at held-out values.
+        let mut predicted = Vec::new();
+        for v in HELD_OUT {
+            for q in random_configurations(&nominal, POSES_PER_STATION, &mut rng) {
+                let p = on_track.predict(&q, v).unwrap();
+                let want = true_pose(&truth, &track, &q, v).p;
+                predicted.push((p.p - want).norm() * 1e3);
+                // The carried model predicts the same pose in its cell frame.
+                let c = carried(&model, &fit.model, v).unwrap().predict(&q).unwrap();
+                assert!((c.p - p.p).norm() < 1e-12 && (c.r - p.r).norm() < 1e-12);
+            }
+        }
+
+        // Solve: points the true robot reached, solved back at their values
+        // (position only: a reflector's readings do not fix the tool's
+        // orientation; the true orientation guides the seed).
+        let position_only = SolveOptions {
+            position_only: true,
+            ..SolveOptions::default()
+        };
+        let (mut solved, mut straight_solved, mut round_trip) = (Vec::new(), Vec::new(), 0.0f64);
+        for v in HELD_OUT {
+            for q in random_configurations(&nominal, POSES_PER_STATION, &mut rng) {
+                let target = true_pose(&truth, &track, &q, v);
+                let goal = Goal::from(&target);
+                let s = on_track.solve(&goal, v, &position_only).unwrap();
+                assert!(s.converged, "seed {seed} at {v} mm: {:?}", s.reason);
+                round_trip =
+                    round_trip.max((on_track.predict(&s.q, v).unwrap().p - target.p).norm());
+                solved.push((true_pose(&truth, &track, &s.q, v).p - target.p).norm() * 1e3);
+                let s = on_straight.solve(&goal, v, &position_only).unwrap();
+                assert!(s.converged, "seed {seed} at {v} mm: {:?}", s.reason);
+                straight_solved
+                    .push((true_pose(&truth, &track, &s.q, v).p - target.p).norm() * 1e3);
+            }
+        }
+        println!(
+            "seed {seed}: robot on a fixed base, validation rms {robot_val_rms:.4} mm; \
+             predicted at held-out track values: rms {:.4} mm (max {:.4}); \
+             solved there, the true robot off its target: rms {:.4} mm (max {:.4}), \
+             through a straight rail rms {:.4} mm (max {:.4}); round trip within {:.1e} mm",
+            rms(&predicted),
+            max(&predicted),
+            rms(&solved),
+            max(&solved),
+            rms(&straight_solved),
+            max(&straight_solved),
+            round_trip * 1e3,
+        );
+        assert!(rms(&predicted) <= 1.5 * robot_val_rms, "seed {seed}");
+        assert!(rms(&solved) <= 1.5 * robot_val_rms, "seed {seed}");
+        assert!(rms(&straight_solved) > 3.0 * rms(&solved), "seed {seed}");
+        assert!(round_trip < 1e-6, "{round_trip} m");
+
+        // Beyond the travel measured: refused, naming the value and the travel.
+        let q = &random_configurations(&nominal, 1, &mut rng)[0];
+        match on_track.predict(q, 4000.5) {
+            Err(TrackPoseError::OutsideTravel(o)) => {
+                assert_eq!((o.value_mm, o.lo_mm, o.hi_mm), (4000.5, 0.0, 4000.0))
+            }
+            other => panic!("{other:?}"),
+        }
+        let goal = Goal::from(&true_pose(&truth, &track, q, 0.0));
+        assert!(on_track
+            .solve(&goal, -1.0, &SolveOptions::default())
+            .is_err());
+        assert!(on_track
+            .solve(&goal, f64::NAN, &SolveOptions::default())
+            .is_err());
+        assert!(carried(&model, &fit.model, 4001.0).is_err());
+    }
 }

@@ -22,6 +22,7 @@ pub mod serve;
 pub mod simulate;
 pub mod solve;
 pub mod tcp;
+pub mod track;
 
 pub use model_files::load_model;
 
@@ -84,6 +85,9 @@ pub enum Command {
     /// A work object from three points (tracker or touched with a calibrated tool), judged before it is written.
     #[command(after_help = exit::help_for("work-object"))]
     WorkObject(tcp::WorkObjectArgs),
+    /// A robot on a linear track: fit the track from tracker readings at several track values.
+    #[command(after_help = exit::help_for("track"))]
+    Track(track::TrackArgs),
     /// Run the HTTP service.
     #[command(after_help = exit::help_for("serve"))]
     Serve(serve::ServeArgs),
@@ -115,6 +119,7 @@ pub fn run(cli: Cli) -> anyhow::Result<exit::Exit> {
         Command::Iso9283(a) => done(iso9283::run(a)),
         Command::Tcp(a) => done(tcp::run_tcp(a)),
         Command::WorkObject(a) => done(tcp::run_work_object(a)),
+        Command::Track(a) => done(track::run(a)),
         Command::Serve(a) => done(serve::run(a)),
         Command::Keygen(a) => done(keygen::run(a)),
         Command::Bench(a) => done(bench::run(a)),

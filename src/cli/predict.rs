@@ -12,7 +12,9 @@
 //! compensator's expected error as `solve` reports them. The expected error at
 //! the tool (`core::cell::accuracy`) heads the output: measured on 6-D
 //! validation data, or `unverified` for a tool after a position-only
-//! calibration, never the measured point's figure for a tool.
+//! calibration, never the measured point's figure for a tool. With
+//! `--track FILE --e1 MM` the robot's base is carried along a calibrated
+//! track and the cell frame is the track's (`super::track`).
 
 use super::solve::OutputFormat;
 use crate::measure::csv_text::dialect_from_names;
@@ -71,6 +73,8 @@ pub struct PredictArgs {
     pub decimal: Option<String>,
     #[command(flatten)]
     pub failures: super::exit::AllowFailures,
+    #[command(flatten)]
+    pub track: super::track::OnTrack,
 }
 
 /// The validation evidence of a calibrated model file (none for presets and
@@ -93,7 +97,10 @@ pub fn predict_to_string(a: &PredictArgs) -> anyhow::Result<String> {
 
 /// What the command prints and how many readings failed.
 pub fn predict_outcome(a: &PredictArgs) -> anyhow::Result<super::exit::Outcome> {
-    let model = super::model_files::load_with_payload(&a.model, a.payload_kg)?;
+    let model = a.track.carry(super::model_files::load_with_payload(
+        &a.model,
+        a.payload_kg,
+    )?)?;
     let frame: TargetFrame = a.frame.parse().map_err(anyhow::Error::msg)?;
     let conv = a
         .convention
@@ -118,7 +125,7 @@ pub fn predict_outcome(a: &PredictArgs) -> anyhow::Result<super::exit::Outcome> 
         tool.as_ref().and_then(|t| t.load.as_ref()),
     );
     let (frame, frame_label) = match &a.work_object {
-        None => (PredictFrame::Frame(frame), frame.to_string()),
+        None => (PredictFrame::Frame(frame), a.track.label(frame.to_string())),
         Some(w) => {
             let wobj = cell.work_object(&w.parse::<CellRef>()?)?;
             let label = format!("work object {}", wobj.name);

@@ -18,7 +18,10 @@
 //!
 //! With `--cell FILE --tool NAME` the production tool of the cell file is on
 //! the calibrated flange; with `--work-object NAME` the targets and the false
-//! targets are poses in that work object (`core::cell`).
+//! targets are poses in that work object (`core::cell`). With `--track FILE
+//! --e1 MM` the robot's base is carried along a calibrated track to that
+//! value and the cell frame is the track's (`super::track`); the false
+//! targets stay in the controller's base frame.
 
 use crate::measure::csv_text::dialect_from_names;
 use crate::model::orientation::OrientationConvention;
@@ -125,6 +128,8 @@ pub struct SolveArgs {
     pub decimal: Option<String>,
     #[command(flatten)]
     pub failures: super::exit::AllowFailures,
+    #[command(flatten)]
+    pub track: super::track::OnTrack,
 }
 
 /// How `robocal solve` prints its results.
@@ -160,9 +165,12 @@ pub fn solve_to_string(a: &SolveArgs) -> anyhow::Result<String> {
 
 /// What the command prints and how many targets failed.
 pub fn solve_outcome(a: &SolveArgs) -> anyhow::Result<super::exit::Outcome> {
-    let model = super::model_files::load_with_payload(&a.model, a.payload_kg)?;
+    let model = a.track.carry(super::model_files::load_with_payload(
+        &a.model,
+        a.payload_kg,
+    )?)?;
     let mut frame: TargetFrame = a.frame.parse().map_err(anyhow::Error::msg)?;
-    let mut frame_label = frame.to_string();
+    let mut frame_label = a.track.label(frame.to_string());
     let cell = super::model_files::load_cell(a.cell.as_deref())?;
     let tool = match &a.tool {
         Some(t) => Some(cell.tool(&t.parse::<CellRef>()?)?),

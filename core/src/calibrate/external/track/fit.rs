@@ -34,6 +34,8 @@ use super::series::{choose_order, SeriesFit};
 use super::station::{fit_station, StationError, StationPose};
 use crate::calibrate::external::judge::{rms_max, within, RMS_FACTOR};
 use crate::calibrate::external::outcome::FitLimits;
+use crate::measure::external::{ExternalAxis, MeasurementSet};
+use crate::model::calibrated::CompensatedModel;
 use crate::model::external::rotary::{closest_to_origin, Line};
 use crate::model::external::track::{rail_rotation, CarriageTerm, LinearTrack};
 use crate::model::external::travel_map::{Travel, TravelMap, MAX_MAP_ORDER};
@@ -54,8 +56,52 @@ pub const DEFAULT_MAX_ORDER: usize = 6;
 
 const ARCSEC: f64 = std::f64::consts::PI / (180.0 * 3600.0);
 
-/// Fits the track (module docs).
+/// Where the held robot puts the reflector in its base frame [m] for
+/// model-convention joints `q` [rad] and a payload [kg].
+type Place<'a> = dyn Fn(&[f64], f64) -> Result<Vector3<f64>, String> + 'a;
+
+/// Fits the track (module docs), the robot's readings placed by its
+/// calibrated geometry and compliance (`q + c∘τ(q)` and its joint maps).
 pub fn fit_track(req: &TrackFitRequest) -> Result<TrackFit, TrackRefused> {
+    let robot = req.robot;
+    fit_placed(req, &|q, kg| {
+        deflected_joints(robot, q, kg)
+            .and_then(|qd| fk(robot, &qd))
+            .map(|p| p.p)
+            .map_err(|e| e.to_string())
+    })
+}
+
+/// Fits the track with the readings placed by the compensated model
+/// (`CompensatedModel::predict_detailed_at`: geometry, compliance, joint
+/// maps and the compensator's residual), the evaluation every prediction
+/// and solve through the track uses (`solve::external::track`), so that
+/// the track holds what the compensated model does not. The payload of
+/// rows that give none is the model's.
+pub fn fit_track_compensated(
+    model: &CompensatedModel,
+    set: &MeasurementSet,
+    column: ExternalAxis,
+    tracker_sigma_mm: f64,
+    max_order: usize,
+) -> Result<TrackFit, TrackRefused> {
+    let req = TrackFitRequest {
+        robot: &model.calibrated,
+        payload_kg: model.payload_kg,
+        set,
+        column,
+        tracker_sigma_mm,
+        max_order,
+    };
+    fit_placed(&req, &|q, kg| {
+        model
+            .predict_detailed_at(q, kg)
+            .map(|p| p.pose.p)
+            .map_err(|e| e.to_string())
+    })
+}
+
+fn fit_placed(req: &TrackFitRequest, place: &Place) -> Result<TrackFit, TrackRefused> {
     let sigma = req.tracker_sigma_mm;
     if !(sigma.is_finite() && sigma > 0.0) {
         return Err(TrackRefused::new(
@@ -64,7 +110,7 @@ pub fn fit_track(req: &TrackFitRequest) -> Result<TrackFit, TrackRefused> {
         ));
     }
     let limits = FitLimits::of(sigma);
-    let points = model_points(req)?;
+    let points = model_points(req, place)?;
     let stations = stations(&points)?;
     for s in &stations {
         if s.rms_m * 1e3 > limits.rms_mm {
@@ -172,7 +218,7 @@ struct Point {
     in_cell: Vector3<f64>,
 }
 
-fn model_points(req: &TrackFitRequest) -> Result<Vec<Point>, TrackRefused> {
+fn model_points(req: &TrackFitRequest, place: &Place) -> Result<Vec<Point>, TrackRefused> {
     if !req.set.has(req.column) {
         return Err(TrackRefused::new(
             Why::MissingColumn,
@@ -207,9 +253,7 @@ fn model_points(req: &TrackFitRequest) -> Result<Vec<Point>, TrackRefused> {
         let q_ctrl: Vec<f64> = r.pose.q_deg.iter().map(|d| d.to_radians()).collect();
         let q = robot.joints_from_controller(&q_ctrl);
         let payload = r.pose.payload_kg.unwrap_or(req.payload_kg);
-        let in_base = deflected_joints(robot, &q, payload)
-            .and_then(|qd| fk(robot, &qd))
-            .map(|p| p.p);
+        let in_base = place(&q, payload);
         let in_cell = Vector3::from(r.pose.xyz_mm) * 1e-3;
         match in_base {
             Ok(p)
@@ -224,7 +268,7 @@ fn model_points(req: &TrackFitRequest) -> Result<Vec<Point>, TrackRefused> {
             }
             other => {
                 let why = match other {
-                    Err(e) => e.to_string(),
+                    Err(e) => e,
                     Ok(_) => "a value is not finite".into(),
                 };
                 return Err(TrackRefused::new(

@@ -13,7 +13,9 @@ pub mod outcome;
 pub mod series;
 pub mod station;
 
-pub use fit::{fit_track, DEFAULT_MAX_ORDER, MIN_ACROSS_MM, MIN_POSES, MIN_STATIONS};
+pub use fit::{
+    fit_track, fit_track_compensated, DEFAULT_MAX_ORDER, MIN_ACROSS_MM, MIN_POSES, MIN_STATIONS,
+};
 pub use outcome::{
     MapReport, OrderScore, StationReport, TrackFit, TrackFitRequest, TrackRefusalReason,
     TrackRefused, Unseen, UnseenTerm,

@@ -1,0 +1,369 @@
+//! `robocal track calibrate` and the `--track`/`--e1` options of `predict`
+//! and `solve`: a robot on a linear track.
+//!
+//! `track calibrate SET --model MODEL --out TRACK.json` reads a measurement
+//! file with the track's column (`e1` by default; docs/csv.md: controller
+//! joints in degrees, the track's value in mm as the controller shows it,
+//! `x, y, z` in mm in the tracker frame): the reflector read at several
+//! robot poses at each of several track values. It fits the track with the
+//! robot's calibrated model held
+//! (`calibrate::external::track::fit_track_compensated`), judges it, writes
+//! the track model's JSON (`model::external::TrackDescription`) and prints
+//! the fit report: residuals and limits, each carriage map's order with its
+//! leave-one-station-out RMS, the stations, and the terms the readings cannot
+//! see. With `--validate SET` a second file at other track values is
+//! predicted through the fitted track: the held-out figures. A refused fit
+//! writes nothing and exits with `refused` (1), printing its reason code and
+//! message (with `--json` also the refusal as JSON on stdout).
+//!
+//! `predict` and `solve` with `--track TRACK.json --e1 MM` carry the robot's
+//! base to that track value (`solve::external::carried`): the cell frame is
+//! the track's (the tracker frame it was measured in), one value per run; a
+//! value outside the travel measured is refused (exit 1).
+
+use super::model_files::load_with_payload;
+use anyhow::Context;
+use clap::{Args, Subcommand};
+use robocal_core::calibrate::external::track::{
+    fit_track_compensated, TrackFit, TrackRefused, DEFAULT_MAX_ORDER,
+};
+use robocal_core::measure::csv::parse_set;
+use robocal_core::measure::external::{ExternalAxis, MeasurementSet};
+use robocal_core::model::calibrated::CompensatedModel;
+use robocal_core::model::external::travel_map::MAX_MAP_ORDER;
+use robocal_core::model::external::LinearTrack;
+use robocal_core::solve::external::carried;
+use serde::Serialize;
+use std::fmt::Write as _;
+
+#[derive(Debug, Args)]
+pub struct TrackArgs {
+    #[command(subcommand)]
+    pub command: TrackCommand,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum TrackCommand {
+    /// Fit a linear track carrying the robot from tracker readings at several track values.
+    Calibrate(CalibrateArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct CalibrateArgs {
+    /// Measurement CSV with the track's column: `q1..qN` (controller degrees),
+    /// `e1` (the track's value, mm), `x,y,z` (mm, tracker frame); the robot
+    /// at ≥ 3 poses not on a line at each of ≥ 5 track values.
+    pub set: String,
+    /// The robot's calibrated model file (`robocal calibrate --save`), held by the fit.
+    #[arg(long)]
+    pub model: String,
+    /// Where to write the track model (JSON, mm, degrees, arcsec).
+    #[arg(long)]
+    pub out: String,
+    /// The track's column, e1 … e6.
+    #[arg(long, default_value = "e1", value_parser = parse_axis)]
+    pub column: ExternalAxis,
+    /// The tracker's noise per coordinate, 1σ [mm]: the fit is judged against it.
+    #[arg(long, default_value_t = 0.01)]
+    pub sigma_mm: f64,
+    /// Highest order of the carriage maps tried (0: a straight rail).
+    #[arg(long, default_value_t = DEFAULT_MAX_ORDER)]
+    pub max_order: usize,
+    /// Payload mass [kg] of rows that give none (default: the model file's).
+    #[arg(long)]
+    pub payload_kg: Option<f64>,
+    /// Held-out readings at other track values (same columns), predicted
+    /// through the fitted track.
+    #[arg(long)]
+    pub validate: Option<String>,
+    /// Print the outcome as JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn parse_axis(s: &str) -> Result<ExternalAxis, String> {
+    ExternalAxis::ALL
+        .into_iter()
+        .find(|a| a.column().eq_ignore_ascii_case(s.trim()))
+        .ok_or_else(|| format!("`{s}`: give the track's column, e1 … e6"))
+}
+
+/// `--track FILE --e1 MM` of `predict` and `solve`.
+#[derive(Debug, Clone, Default, Args)]
+pub struct OnTrack {
+    /// Track model (`robocal track calibrate --out`): the robot's base is
+    /// carried to `--e1` along it, and the cell frame is the track's.
+    #[arg(long, requires = "e1")]
+    pub track: Option<String>,
+    /// The track's value [mm] as the controller shows it (within the travel
+    /// the track was measured over).
+    #[arg(long, requires = "track", allow_hyphen_values = true)]
+    pub e1: Option<f64>,
+}
+
+impl OnTrack {
+    /// `model` with its base carried to `--e1` (unchanged without `--track`).
+    pub fn carry(&self, model: CompensatedModel) -> anyhow::Result<CompensatedModel> {
+        let (Some(path), Some(value)) = (&self.track, self.e1) else {
+            return Ok(model);
+        };
+        let track = read_track(path)?;
+        carried(&model, &track, value).with_context(|| format!("--e1 {value}: track {path}"))
+    }
+
+    /// `frame` as the output's header names it.
+    pub fn label(&self, frame: String) -> String {
+        match (&self.track, self.e1) {
+            (Some(path), Some(v)) => format!("{frame} (track {path} at e1 = {v} mm)"),
+            _ => frame,
+        }
+    }
+}
+
+/// Reads and checks a track model file.
+pub fn read_track(path: &str) -> anyhow::Result<LinearTrack> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read track file {path}"))?;
+    LinearTrack::from_json(&text).with_context(|| format!("track file {path}"))
+}
+
+fn read_set(path: &str) -> anyhow::Result<MeasurementSet> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {path}"))?;
+    parse_set(&text).with_context(|| path.to_string())
+}
+
+/// A fit the readings cannot carry: its reason and message (nothing is written).
+#[derive(Debug, thiserror::Error)]
+#[error("not fitted ({}): {}", reason_code(.0), .0.message)]
+pub struct TrackNotFitted(pub TrackRefused);
+
+fn reason_code(r: &TrackRefused) -> String {
+    serde_json::to_value(r.reason)
+        .ok()
+        .and_then(|v| v.as_str().map(String::from))
+        .unwrap_or_default()
+}
+
+/// Held-out readings predicted through the fitted track [mm].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Validation {
+    pub file: String,
+    pub readings: usize,
+    /// The distinct track values of the readings [mm].
+    pub values_mm: Vec<f64>,
+    pub rms_mm: f64,
+    pub max_mm: f64,
+}
+
+#[derive(Serialize)]
+struct Fitted<'a> {
+    fitted: bool,
+    out: &'a str,
+    fit: &'a TrackFit,
+    validation: Option<&'a Validation>,
+}
+
+#[derive(Serialize)]
+struct Refusal<'a> {
+    fitted: bool,
+    reason: String,
+    #[serde(flatten)]
+    refused: &'a TrackRefused,
+}
+
+/// The held-out set's readings predicted through `track` and `model`.
+fn validate(
+    path: &str,
+    model: &CompensatedModel,
+    track: &LinearTrack,
+    column: ExternalAxis,
+) -> anyhow::Result<Validation> {
+    let set = read_set(path)?;
+    let mut errors = Vec::with_capacity(set.poses.len());
+    let mut values: Vec<f64> = Vec::new();
+    for (i, r) in set.readings().enumerate() {
+        let row = i + 1;
+        let v = r
+            .external
+            .get(column)
+            .with_context(|| format!("{path}: reading {row} has no value of `{column}`"))?;
+        let base = track
+            .cell_from_base(v)
+            .with_context(|| format!("{path}: reading {row}"))?;
+        if r.pose.q_deg.len() != model.dof() {
+            anyhow::bail!(
+                "{path}: reading {row} has {} joint values, the robot has {}",
+                r.pose.q_deg.len(),
+                model.dof()
+            );
+        }
+        let ctrl: Vec<f64> = r.pose.q_deg.iter().map(|d| d.to_radians()).collect();
+        let q = model.nominal.joints_from_controller(&ctrl);
+        let kg = r.pose.payload_kg.unwrap_or(model.payload_kg);
+        let p = model
+            .predict_detailed_at(&q, kg)
+            .with_context(|| format!("{path}: reading {row}"))?
+            .pose
+            .p;
+        let at = base.transform_point(&p) * 1e3;
+        errors.push((at - nalgebra::Vector3::from(r.pose.xyz_mm)).norm());
+        if !values.contains(&v) {
+            values.push(v);
+        }
+    }
+    if errors.is_empty() {
+        anyhow::bail!("{path}: no readings");
+    }
+    values.sort_by(f64::total_cmp);
+    let n = errors.len() as f64;
+    Ok(Validation {
+        file: path.to_string(),
+        readings: errors.len(),
+        values_mm: values,
+        rms_mm: (errors.iter().map(|e| e * e).sum::<f64>() / n).sqrt(),
+        max_mm: errors.iter().copied().fold(0.0, f64::max),
+    })
+}
+
+/// Fits, judges, validates and writes the track; what the command prints.
+pub fn calibrate_to_string(a: &CalibrateArgs) -> anyhow::Result<String> {
+    if a.max_order > MAX_MAP_ORDER {
+        anyhow::bail!("--max-order: at most {MAX_MAP_ORDER}");
+    }
+    let model = load_with_payload(&a.model, a.payload_kg)?;
+    let set = read_set(&a.set)?;
+    let fit = match fit_track_compensated(&model, &set, a.column, a.sigma_mm, a.max_order) {
+        Ok(f) => f,
+        Err(refused) => {
+            if a.json {
+                let body = Refusal {
+                    fitted: false,
+                    reason: reason_code(&refused),
+                    refused: &refused,
+                };
+                println!("{}", serde_json::to_string_pretty(&body)?);
+            }
+            return Err(TrackNotFitted(refused).into());
+        }
+    };
+    let validation = match &a.validate {
+        Some(path) => Some(validate(path, &model, &fit.model, a.column)?),
+        None => None,
+    };
+    std::fs::write(&a.out, fit.model.to_json() + "\n")
+        .with_context(|| format!("cannot write track file {}", a.out))?;
+    if a.json {
+        let body = Fitted {
+            fitted: true,
+            out: &a.out,
+            fit: &fit,
+            validation: validation.as_ref(),
+        };
+        return Ok(serde_json::to_string_pretty(&body)? + "\n");
+    }
+    Ok(report(a, &set, &fit, validation.as_ref()))
+}
+
+fn report(
+    a: &CalibrateArgs,
+    set: &MeasurementSet,
+    fit: &TrackFit,
+    v: Option<&Validation>,
+) -> String {
+    let d = &fit.description;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "track fitted: {} readings at {} track values ({}), robot {} held",
+        set.poses.len(),
+        fit.stations.len(),
+        a.column,
+        a.model
+    );
+    let [dx, dy, dz] = d.direction;
+    let [px, py, pz] = d.point_mm;
+    let [rx, ry, rz] = d.mount_rpy_deg;
+    let _ = writeln!(
+        s,
+        "rail: direction [{dx:.6}, {dy:.6}, {dz:.6}], point [{px:.4}, {py:.4}, {pz:.4}] mm; \
+         scale {:.6} ({:+.4} mm/m); zero {:.4} mm; travel [{}, {}] mm",
+        d.scale,
+        (d.scale - 1.0) * 1e3,
+        d.zero_mm,
+        d.travel_mm[0],
+        d.travel_mm[1]
+    );
+    let _ = writeln!(s, "mount: rpy [{rx:.5}, {ry:.5}, {rz:.5}] deg");
+    let l = &fit.limits;
+    let _ = writeln!(
+        s,
+        "residuals: rms {:.4} mm, max {:.4} mm (limits: rms ≤ {:.4} mm, each ≤ {:.4} mm; σ {} mm per axis)",
+        fit.rms_mm, fit.max_mm, l.rms_mm, l.max_mm, l.sigma_mm
+    );
+    let _ = writeln!(
+        s,
+        "carriage maps (order chosen by leave-one-station-out cross-validation; held-out rms per order):"
+    );
+    for m in &fit.maps {
+        let cands: Vec<String> = m
+            .candidates
+            .iter()
+            .map(|c| format!("{}:{:.4}", c.order, c.cv_rms))
+            .collect();
+        let _ = writeln!(
+            s,
+            "  {}: order {}, amplitude {:.4} {u}, stations' rms about it {:.4} {u}, station σ {:.4} {u}; held out {}",
+            m.term.name(),
+            m.order,
+            m.amplitude,
+            m.rms,
+            m.station_sigma,
+            cands.join(" "),
+            u = m.unit
+        );
+    }
+    let _ = writeln!(
+        s,
+        "stations (value mm, poses, rigid-fit rms mm, misfit along/lateral/vertical mm, roll/pitch/yaw arcsec):"
+    );
+    for st in &fit.stations {
+        let m = st.misfit;
+        let _ = writeln!(
+            s,
+            "  {:>10}  {:>3}  {:.4}  {:+.4} {:+.4} {:+.4}  {:+.2} {:+.2} {:+.2}",
+            st.value_mm, st.poses, st.rms_mm, m[0], m[1], m[2], m[3], m[4], m[5]
+        );
+    }
+    let _ = writeln!(s, "not seen by these readings:");
+    for u in &fit.unseen {
+        let code = serde_json::to_value(u.term)
+            .ok()
+            .and_then(|v| v.as_str().map(String::from))
+            .unwrap_or_default();
+        let _ = writeln!(s, "  {code}: {}", u.note);
+    }
+    if let Some(v) = v {
+        let values: Vec<String> = v.values_mm.iter().map(|x| format!("{x}")).collect();
+        let _ = writeln!(
+            s,
+            "held out: {} readings of {} at track values {} mm: rms {:.4} mm, max {:.4} mm",
+            v.readings,
+            v.file,
+            values.join(", "),
+            v.rms_mm,
+            v.max_mm
+        );
+    }
+    let _ = writeln!(s, "written: {}", a.out);
+    s
+}
+
+/// Runs `robocal track`.
+pub fn run(a: TrackArgs) -> anyhow::Result<()> {
+    match a.command {
+        TrackCommand::Calibrate(c) => {
+            print!("{}", calibrate_to_string(&c)?);
+            Ok(())
+        }
+    }
+}

@@ -1,0 +1,400 @@
+//! `robocal track calibrate`, and `robocal predict`/`solve` with `--track
+//! --e1`, driven as a process on files: a simulated 4 m track from its
+//! physics (`robocal_core::sim::track::TrueTrack::rail_4m`) carrying a
+//! YS100 whose true geometry is the calibrated model's (the robot's own
+//! calibration is tested elsewhere; here the track and the plumbing are),
+//! read with 0.01 mm tracker noise at 11 track values and written as a
+//! measurement file with an `e1` column. The fitted track, the predicted
+//! poses and the solved joints are checked against the truth at track
+//! values the fit never saw; refusals exit with `refused` (1) and write
+//! nothing.
+
+use nalgebra::{UnitQuaternion, Vector3};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use robocal::cli::model_files::save_model_file;
+use robocal::measure::csv::write_set;
+use robocal::measure::external::{ExternalAxis, MeasurementSet};
+use robocal::model::calibrated::{CalibratedModelFile, CompensatedModel};
+use robocal::model::external::LinearTrack;
+use robocal::model::{preset, Pose, RobotModel};
+use robocal::sim::track::TrueTrack;
+use robocal::sim::{perturb_geometry, random_configurations, ErrorMagnitudes, TrueRobot};
+use std::path::Path;
+use std::process::{Command, Output};
+
+const STATIONS: [f64; 11] = [
+    0.0, 400.0, 800.0, 1200.0, 1600.0, 2000.0, 2400.0, 2800.0, 3200.0, 3600.0, 4000.0,
+];
+/// A track value the fit never saw [mm].
+const HELD_OUT_MM: f64 = 1000.0;
+
+fn robocal(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_robocal"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn code(out: &Output) -> i32 {
+    out.status.code().expect("ended by a signal")
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+struct Cell {
+    nominal: RobotModel,
+    truth: TrueRobot,
+    track: TrueTrack,
+}
+
+impl Cell {
+    fn new(rng: &mut ChaCha8Rng) -> Self {
+        let nominal = preset("ys100").unwrap();
+        let mut truth = TrueRobot::new(perturb_geometry(
+            &nominal,
+            &ErrorMagnitudes::from_mm_deg(1.0, 0.1),
+            rng,
+        ));
+        truth.noise_mm = 0.01;
+        Cell {
+            nominal,
+            truth,
+            track: TrueTrack::rail_4m(),
+        }
+    }
+
+    /// `n` poses at each of `values`, read by the tracker.
+    fn measure(&self, values: &[f64], n: usize, rng: &mut ChaCha8Rng) -> MeasurementSet {
+        let stations: Vec<(f64, Vec<Vec<f64>>)> = values
+            .iter()
+            .map(|v| (*v, random_configurations(&self.nominal, n, rng)))
+            .collect();
+        self.track
+            .measure(
+                &self.truth,
+                ExternalAxis::E1,
+                &stations,
+                Some(self.nominal.payload.mass),
+                rng,
+            )
+            .unwrap()
+    }
+
+    /// The true tool pose in the cell frame (no noise).
+    fn true_pose(&self, q: &[f64], value_mm: f64) -> Pose {
+        self.track
+            .cell_from_base(value_mm)
+            .compose(&self.truth.true_pose_base(q, None).unwrap())
+    }
+
+    /// Controller degrees of model joints.
+    fn controller_deg(&self, q: &[f64]) -> Vec<f64> {
+        self.nominal
+            .joints_to_controller(q)
+            .iter()
+            .map(|v| v.to_degrees())
+            .collect()
+    }
+}
+
+fn row(v: &[f64]) -> String {
+    v.iter()
+        .map(|x| format!("{x:.12}"))
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
+#[test]
+fn a_track_is_calibrated_from_a_file_and_predicts_and_solves_through_it() {
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let cell = Cell::new(&mut rng);
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let model = CompensatedModel {
+        calibrated: cell.truth.model.clone(),
+        nominal: cell.nominal.clone(),
+        cell_from_base: Pose::identity(),
+        payload_kg: cell.nominal.payload.mass,
+        compensator: None,
+    };
+    save_model_file(
+        &CalibratedModelFile::from_compensated(&model, "ys100", "km"),
+        &d.join("robot.json"),
+    )
+    .unwrap();
+    let set = cell.measure(&STATIONS, 15, &mut rng);
+    std::fs::write(d.join("track.csv"), write_set(&set)).unwrap();
+    let held = cell.measure(&[200.0, HELD_OUT_MM, 2600.0, 3800.0], 10, &mut rng);
+    std::fs::write(d.join("held.csv"), write_set(&held)).unwrap();
+
+    let out = robocal(
+        d,
+        &[
+            "track",
+            "calibrate",
+            "track.csv",
+            "--model",
+            "robot.json",
+            "--out",
+            "rail.json",
+            "--validate",
+            "held.csv",
+        ],
+    );
+    let report = text(&out.stdout);
+    assert_eq!(code(&out), 0, "{report}{}", text(&out.stderr));
+    print!("{report}");
+    assert!(report.starts_with("track fitted: 165 readings at 11 track values (e1)"));
+    for term in [
+        "straightness_mean_and_slope",
+        "angle_means",
+        "short_bends",
+        "carriage_pivot",
+    ] {
+        assert!(report.contains(&format!("  {term}: ")), "{term}");
+    }
+    // The held-out line: 40 readings at 4 values within 0.052 mm (3·√3 σ).
+    let line = report
+        .lines()
+        .find(|l| l.starts_with("held out: 40 readings"))
+        .unwrap();
+    let rms: f64 = line
+        .split("rms ")
+        .nth(1)
+        .unwrap()
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(rms > 0.0 && rms < 0.052, "{line}");
+
+    // The written track against the truth at a value never fitted: the
+    // base within 0.05 mm, the scale error 0.2 mm/m within 0.03.
+    let track =
+        LinearTrack::from_json(&std::fs::read_to_string(d.join("rail.json")).unwrap()).unwrap();
+    assert!(
+        ((track.scale - 1.0) * 1e3 - 0.2).abs() < 0.03,
+        "{}",
+        track.scale
+    );
+    let base = track.cell_from_base(HELD_OUT_MM).unwrap();
+    let truth_base = cell.track.cell_from_base(HELD_OUT_MM);
+    assert!((base.p - truth_base.p).norm() < 0.05e-3);
+
+    // Predict at the held-out value: the true reflector within 0.05 mm.
+    let qs = random_configurations(&cell.nominal, 8, &mut rng);
+    let joints: Vec<String> = qs.iter().map(|q| row(&cell.controller_deg(q))).collect();
+    std::fs::write(
+        d.join("joints.csv"),
+        format!("q1,q2,q3,q4,q5,q6\n{}\n", joints.join("\n")),
+    )
+    .unwrap();
+    let e1 = HELD_OUT_MM.to_string();
+    let out = robocal(
+        d,
+        &[
+            "predict",
+            "--model",
+            "robot.json",
+            "--joints",
+            "joints.csv",
+            "--track",
+            "rail.json",
+            "--e1",
+            &e1,
+            "--json",
+        ],
+    );
+    assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(
+        doc["frame"],
+        format!("cell (track rail.json at e1 = {HELD_OUT_MM} mm)")
+    );
+    for (q, r) in qs.iter().zip(doc["results"].as_array().unwrap()) {
+        let got = Vector3::new(
+            r["x"].as_f64().unwrap(),
+            r["y"].as_f64().unwrap(),
+            r["z"].as_f64().unwrap(),
+        );
+        let want = cell.true_pose(q, HELD_OUT_MM).p * 1e3;
+        assert!((got - want).norm() < 0.05, "{got} {want}");
+    }
+
+    // Solve the poses the true robot reached there: the true robot at the
+    // solved joints lands within 0.05 mm of each.
+    let targets: Vec<String> = qs
+        .iter()
+        .enumerate()
+        .map(|(i, q)| {
+            let t = cell.true_pose(q, HELD_OUT_MM);
+            let u = UnitQuaternion::from_matrix(&t.r);
+            format!(
+                "t{i},{}",
+                row(&[t.p.x * 1e3, t.p.y * 1e3, t.p.z * 1e3, u.w, u.i, u.j, u.k])
+            )
+        })
+        .collect();
+    std::fs::write(
+        d.join("targets.csv"),
+        format!("id,x,y,z,qw,qx,qy,qz\n{}\n", targets.join("\n")),
+    )
+    .unwrap();
+    let out = robocal(
+        d,
+        &[
+            "solve",
+            "--model",
+            "robot.json",
+            "--targets",
+            "targets.csv",
+            "--track",
+            "rail.json",
+            "--e1",
+            &e1,
+            "--json",
+        ],
+    );
+    assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for (q, t) in qs.iter().zip(doc["targets"].as_array().unwrap()) {
+        let deg: Vec<f64> = t["joints_deg"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap().to_radians())
+            .collect();
+        let solved = cell.nominal.joints_from_controller(&deg);
+        let miss =
+            (cell.true_pose(&solved, HELD_OUT_MM).p - cell.true_pose(q, HELD_OUT_MM).p).norm();
+        assert!(miss < 0.05e-3, "{} mm", miss * 1e3);
+    }
+
+    // Beyond the travel measured: refused, nothing computed.
+    let out = robocal(
+        d,
+        &[
+            "predict",
+            "--model",
+            "robot.json",
+            "--joints",
+            "joints.csv",
+            "--track",
+            "rail.json",
+            "--e1",
+            "4500",
+        ],
+    );
+    assert_eq!(code(&out), 1);
+    assert!(out.stdout.is_empty());
+    assert!(
+        text(&out.stderr).contains("outside the travel measured, [0, 4000] mm"),
+        "{}",
+        text(&out.stderr)
+    );
+    // --e1 without --track is a usage error.
+    let out = robocal(
+        d,
+        &[
+            "solve",
+            "--model",
+            "robot.json",
+            "--targets",
+            "targets.csv",
+            "--e1",
+            "10",
+        ],
+    );
+    assert_eq!(code(&out), 1);
+}
+
+#[test]
+fn fits_the_file_cannot_carry_exit_refused_and_write_nothing() {
+    let mut rng = ChaCha8Rng::seed_from_u64(6);
+    let cell = Cell::new(&mut rng);
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let model = CompensatedModel {
+        calibrated: cell.truth.model.clone(),
+        nominal: cell.nominal.clone(),
+        cell_from_base: Pose::identity(),
+        payload_kg: cell.nominal.payload.mass,
+        compensator: None,
+    };
+    save_model_file(
+        &CalibratedModelFile::from_compensated(&model, "ys100", "km"),
+        &d.join("robot.json"),
+    )
+    .unwrap();
+
+    // One reading 0.15 mm off: named, with --json the refusal on stdout.
+    let mut set = cell.measure(&STATIONS[..7], 15, &mut rng);
+    set.poses[33].xyz_mm[2] += 0.15;
+    std::fs::write(d.join("off.csv"), write_set(&set)).unwrap();
+    let out = robocal(
+        d,
+        &[
+            "track",
+            "calibrate",
+            "off.csv",
+            "--model",
+            "robot.json",
+            "--out",
+            "rail.json",
+            "--json",
+        ],
+    );
+    assert_eq!(code(&out), 1);
+    let err = text(&out.stderr);
+    assert!(
+        err.contains("not fitted (residual_outlier): reading 34 is "),
+        "{err}"
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(doc["fitted"], false);
+    assert_eq!(doc["reason"], "residual_outlier");
+    assert_eq!(doc["row"], 34);
+    assert!(!d.join("rail.json").exists());
+
+    // Four track values: too few.
+    let few = cell.measure(&STATIONS[..4], 5, &mut rng);
+    std::fs::write(d.join("few.csv"), write_set(&few)).unwrap();
+    let out = robocal(
+        d,
+        &[
+            "track",
+            "calibrate",
+            "few.csv",
+            "--model",
+            "robot.json",
+            "--out",
+            "rail.json",
+        ],
+    );
+    assert_eq!(code(&out), 1);
+    assert!(text(&out.stderr).contains("not fitted (too_few_stations)"));
+    assert!(!d.join("rail.json").exists());
+
+    // The set read for the wrong column.
+    let out = robocal(
+        d,
+        &[
+            "track",
+            "calibrate",
+            "few.csv",
+            "--model",
+            "robot.json",
+            "--out",
+            "rail.json",
+            "--column",
+            "e2",
+        ],
+    );
+    assert_eq!(code(&out), 1);
+    assert!(text(&out.stderr).contains("not fitted (missing_column)"));
+}
