@@ -19,10 +19,11 @@
 //! identification poses; its joint maps, when it has them, with the
 //! harmonics and ridge `auto` chose on all the poses held fixed
 //! (`joint_maps::MapStructure::Fixed`, the maps' own blocked folds skipped),
-//! so that a region's figures depend on the region, not on how the maps'
-//! folds were dealt (cross-validated again inside each region, the UR5's
-//! `skcm-maps` at joint 2's lowest edge went from 0.1215 mm on seed 1 to
-//! 0.1926 on seed 2 as the folds kept other harmonics); its compensator, when it has one, trained without
+//! so that a region's figures depend on the region and the option, not on
+//! how the maps' folds were dealt (cross-validated again inside each
+//! region, the harmonics kept there followed the folds: the unit test's
+//! simulated UR5, joint 3's top edge, 0.0213 mm on seed 1 and 0.0206 on
+//! seed 2); its compensator, when it has one, trained without
 //! cross-validation on the residuals of the remaining training pool (the
 //! identification poses without one) with its support, so it fades beyond
 //! the joint ranges it saw (`trained::support_of`). The region's poses are
@@ -324,75 +325,13 @@ fn judge_region(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::calibrate::identify::methods::MethodFailure;
-    use crate::model::kinematics::{chain, fk};
-    use crate::model::{preset, JointMap, JointMaps, ParamId, ParamKind, RobotModel};
-    use crate::sim::random_configurations;
-    use rand::Rng;
-
-    /// A UR5 whose joint 2 has a one-harmonic angle error of 0.2 mrad over
-    /// its whole travel, and `n` poses measured on it with ±0.02 mm noise.
-    fn measured(n: usize) -> (RobotModel, Vec<Measurement>) {
-        let nominal = preset("ur5").unwrap();
-        let mut map = JointMap::zero(1, [-7.0, 7.0], 0.1);
-        map.cos[0] = 2e-4;
-        map.sin[0] = -1e-4;
-        let mut joints = vec![None; nominal.dof()];
-        joints[1] = Some(map);
-        let maps = JointMaps { joints };
-        let mut rng = ChaCha8Rng::seed_from_u64(11);
-        let qs = random_configurations(&nominal, n, &mut rng);
-        let data = qs
-            .into_iter()
-            .map(|q| {
-                let mut turned = q.clone();
-                maps.add_to(&q, &mut turned);
-                let p = fk(&nominal, &turned).unwrap().p;
-                let noise = nalgebra::Vector3::from_fn(|_, _| rng.gen_range(-2e-5..2e-5));
-                Measurement {
-                    q,
-                    position: p + noise,
-                    orientation: None,
-                    payload_mass: 0.0,
-                    session: 0,
-                    std: None,
-                }
-            })
-            .collect();
-        (nominal, data)
-    }
+    use crate::calibrate::identify::methods::fixture::Fixture;
 
     /// The edges of `km-maps` refitted as delivered with `maps_choice` and
-    /// against KM alone, the folds dealt from `seed`; the harmonics 1–4 and
-    /// one ridge to choose from.
-    fn edges(
-        nominal: &RobotModel,
-        data: &[Measurement],
-        maps_choice: Option<MapOrder>,
-        seed: u64,
-    ) -> Vec<EdgeFigures> {
-        let (ident, training) = data.split_at(data.len() / 2);
-        let chains: Vec<Chain> = ident
-            .iter()
-            .map(|m| chain(nominal, &m.q).unwrap())
-            .collect();
-        let mut opts = CalibrationOptions::default();
-        opts.compensator.seed = seed;
-        opts.joint_maps.harmonics = vec![1, 2, 3, 4];
-        opts.joint_maps.ridge = vec![1e-6];
-        let ctx = Context {
-            nominal,
-            start: nominal.clone(),
-            ident,
-            ident_chains: &chains,
-            valid: &[],
-            training,
-            sessions: 1,
-            kept_geo: (1..5).map(|k| ParamId::new(ParamKind::Theta, k)).collect(),
-            kept_c: Vec::new(),
-            gravity: Some(MethodFailure::NoGravityTorque),
-            opts: &opts,
-        };
+    /// against KM alone, the folds dealt from `seed`.
+    fn edges(fixture: &Fixture, maps_choice: Option<MapOrder>, seed: u64) -> Vec<EdgeFigures> {
+        let opts = fixture.options(seed);
+        let ctx = fixture.context(&opts);
         let mut regions = DeliveredRegions::draw(&ctx).unwrap();
         let mut judge = |d: Delivery| regions.judge(&ctx, d, &mut |_| true).unwrap().unwrap();
         let option = judge(Delivery {
@@ -417,13 +356,13 @@ mod tests {
     /// other joints they remove most of what KM leaves of joint 2's error.
     #[test]
     fn an_edge_refit_does_not_depend_on_how_the_folds_were_dealt() {
-        let (nominal, data) = measured(240);
+        let fixture = Fixture::measured(240);
         let order = MapOrder {
             harmonics: 4,
             ridge: 1e-6,
         };
-        let one = edges(&nominal, &data, Some(order), 1);
-        let two = edges(&nominal, &data, Some(order), 2);
+        let one = edges(&fixture, Some(order), 1);
+        let two = edges(&fixture, Some(order), 2);
         assert!(one.len() >= 8, "{} edges", one.len());
         assert_eq!(one, two);
         for e in one.iter().filter(|e| e.joint != 2) {
