@@ -741,6 +741,21 @@ pub fn fit_joint_maps(
 mod tests {
     use super::*;
 
+    /// A held structure keeps its harmonics when the poses afford them,
+    /// else the largest of the settings' counts below that they afford,
+    /// else none; K = 0 is always a candidate, the ridge is kept.
+    #[test]
+    fn a_held_structure_is_lowered_to_what_the_poses_afford() {
+        let s = JointMapSettings::default();
+        let order = MapOrder {
+            harmonics: 60,
+            ridge: 0.1,
+        };
+        assert_eq!(fixed_grid(&s, order, |_| true), [(0, 0.0), (60, 0.1)]);
+        assert_eq!(fixed_grid(&s, order, |k| k <= 30), [(0, 0.0), (20, 0.1)]);
+        assert_eq!(fixed_grid(&s, order, |k| k < 10), [(0, 0.0)]);
+    }
+
     /// The rule on hand-computed figures (defaults: ℓ = 250 mm, 0.5 mm
     /// unseen at the tip, 20 mm floor).
     #[test]
