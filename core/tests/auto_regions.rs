@@ -116,6 +116,12 @@ fn accept(
             a.chosen,
             a.reason
         );
+        if let Some(m) = &r.methods["auto"].joint_maps {
+            eprintln!(
+                "auto-regions {name} seed {seed}: auto's maps: {} harmonics, ridge {}",
+                m.harmonics, m.ridge
+            );
+        }
         for c in &d.blocked_checks {
             eprintln!(
                 "auto-regions {name} seed {seed}: blocked-fold veto: {}",

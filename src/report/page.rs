@@ -539,8 +539,21 @@ fn decision_line(d: &super::view::AutoDecisionView) -> String {
         ));
     }
     for c in &d.blocked_checks {
+        let edge = c.worst_edge.as_ref().map_or(String::new(), |e| {
+            format!(
+                "; at the worst of {} edges of the joints' drawn ranges, joint {} {} ({} poses), {:.4} / {:.4} mm against {:.4} / {:.4}",
+                c.edges,
+                e.joint,
+                e.side,
+                e.poses,
+                e.option.mean_mm,
+                e.option.max_mm,
+                e.base.mean_mm,
+                e.base.max_mm
+            )
+        });
         s.push_str(&format!(
-            " Blocked-fold veto: {} on {} blocked regions ({} poses, each refitted without its region) {:.4} / {:.4} mm mean / max against {} alone {:.4} / {:.4}, {}.",
+            " Blocked-fold veto: {} on {} blocked regions ({} poses, each refitted without its region) {:.4} / {:.4} mm mean / max against {} alone {:.4} / {:.4}{edge}, {}.",
             key_label(&c.option),
             c.regions,
             c.poses,
@@ -642,5 +655,41 @@ pub fn compensators(models: &[Model]) -> Markup {
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The veto's line shows the worst edge beside the clusters, with the
+    /// report's figures; a check without edges (an older report) shows none.
+    #[test]
+    fn the_veto_line_shows_the_worst_edge() {
+        let d: super::super::view::AutoDecisionView = serde_json::from_value(serde_json::json!({
+            "blocked_checks": [{
+                "option": "skcm-maps", "base": "skcm", "verdict": "blocked_edge",
+                "verdict_label": "vetoed at an edge", "regions": 4, "poses": 400,
+                "option_blocked": {"mean_mm": 0.0924, "max_mm": 0.2677},
+                "base_blocked": {"mean_mm": 0.1395, "max_mm": 0.4089},
+                "edges": 12,
+                "worst_edge": {"joint": 2, "side": "high", "poses": 93,
+                    "option": {"mean_mm": 0.2293, "max_mm": 0.5371},
+                    "base": {"mean_mm": 0.1279, "max_mm": 0.2814}}
+            }, {
+                "option": "km-maps", "base": "km", "verdict": "passed",
+                "verdict_label": "within", "regions": 4, "poses": 400,
+                "option_blocked": {"mean_mm": 0.1, "max_mm": 0.2},
+                "base_blocked": {"mean_mm": 0.2, "max_mm": 0.3}
+            }]
+        }))
+        .unwrap();
+        let line = decision_line(&d);
+        assert!(
+            line.contains("0.1395 / 0.4089; at the worst of 12 edges of the joints' drawn ranges, joint 2 high (93 poses), 0.2293 / 0.5371 mm against 0.1279 / 0.2814, vetoed at an edge."),
+            "{line}"
+        );
+        assert!(line.contains("0.2000 / 0.3000, within."), "{line}");
+        assert_eq!(line.matches("worst of").count(), 1, "{line}");
     }
 }

@@ -333,6 +333,27 @@ pub struct BlockedCheckView {
     pub option_blocked: BlockedFiguresView,
     #[serde(default)]
     pub base_blocked: BlockedFiguresView,
+    /// Edges of the joints' drawn ranges held out (absent in older reports).
+    #[serde(default)]
+    pub edges: usize,
+    /// The edge where the option fared worst against its base.
+    #[serde(default, deserialize_with = "lenient")]
+    pub worst_edge: Option<EdgeFiguresView>,
+}
+
+/// The option and its base at one edge of a joint's drawn range [mm].
+#[derive(Debug, Clone, Default, Deserialize)]
+pub struct EdgeFiguresView {
+    #[serde(default)]
+    pub joint: usize,
+    #[serde(default)]
+    pub side: String,
+    #[serde(default)]
+    pub poses: usize,
+    #[serde(default)]
+    pub option: BlockedFiguresView,
+    #[serde(default)]
+    pub base: BlockedFiguresView,
 }
 
 /// Held-out errors on the blocked regions [mm].

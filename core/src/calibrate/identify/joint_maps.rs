@@ -139,6 +139,29 @@ pub struct MapCandidate {
     pub cv_orientation_mean_deg: Option<f64>,
 }
 
+/// How the maps' structure, the number of harmonics K and the ridge λ, is
+/// set: a closed set.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MapStructure {
+    /// By cross-validation over the settings' harmonics and ridges, K = 0
+    /// competing (module docs).
+    CrossValidated,
+    /// Held at a structure chosen before, on other poses: the maps are
+    /// fitted with that K and λ whatever the folds say, so the fit depends on
+    /// the poses alone, not on how folds were dealt. K is lowered to the
+    /// largest of the settings' harmonics the poses afford
+    /// (`rows_per_unknown`), 0 when none. The folds still cross-validate it
+    /// and K = 0, for the report.
+    Fixed(MapOrder),
+}
+
+/// A structure of the maps: harmonics per joint and ridge weight.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MapOrder {
+    pub harmonics: usize,
+    pub ridge: f64,
+}
+
 /// Eq. 7.10 of errors [mm]: `mean(e²) + 0.5·max(e²) + 0.3·std(e²)` [mm²].
 fn seed_cost(errors: &[f64]) -> f64 {
     let sq: Vec<f64> = errors.iter().map(|e| e * e).collect();
@@ -448,6 +471,29 @@ fn candidate_grid(
     grid
 }
 
+/// The candidates of a structure held fixed at `order`: K = 0 and `order`
+/// with K lowered to the largest affordable harmonic count of the settings
+/// (`MapStructure::Fixed`); K = 0 alone when none is affordable.
+fn fixed_grid(
+    settings: &JointMapSettings,
+    order: MapOrder,
+    affordable: impl Fn(usize) -> bool,
+) -> Vec<(usize, f64)> {
+    let k = if order.harmonics > 0 && affordable(order.harmonics) {
+        Some(order.harmonics)
+    } else {
+        settings
+            .harmonics
+            .iter()
+            .copied()
+            .filter(|k| *k > 0 && *k < order.harmonics && affordable(*k))
+            .max()
+    };
+    std::iter::once((0, 0.0))
+        .chain(k.map(|k| (k, order.ridge)))
+        .collect()
+}
+
 /// The maps of `k` harmonics the solution `x` (over the columns `cols` of
 /// the design) holds, for a robot of `n` joints.
 fn maps_of(
@@ -539,7 +585,8 @@ impl CrossValidation<'_> {
 /// cross-validation, then the coefficients on all poses. `progress(done,
 /// total)` after each candidate's fold and between the steps of building the
 /// design and its normal equations (`done` = candidates done); false cancels
-/// (`Ok(None)`). The blocked folds draw from `blocked_rng`.
+/// (`Ok(None)`). The blocked folds draw from `blocked_rng`. `structure`
+/// says whether K and λ are chosen here or held ([`MapStructure`]).
 #[allow(clippy::too_many_arguments)]
 pub fn fit_joint_maps(
     model: &RobotModel,
@@ -548,6 +595,7 @@ pub fn fit_joint_maps(
     data: &[Measurement],
     orientation_weight: f64,
     settings: &JointMapSettings,
+    structure: MapStructure,
     rng: &mut impl Rng,
     blocked_rng: &mut impl Rng,
     progress: &mut dyn FnMut(usize, usize) -> bool,
@@ -567,7 +615,10 @@ pub fn fit_joint_maps(
     let geo_cols = ids.len() + frames.len().saturating_sub(1) * 6;
     let affordable =
         |k: usize| ((geo_cols + 2 * k * n) as f64) * settings.rows_per_unknown <= rows as f64;
-    let grid = candidate_grid(settings, affordable);
+    let grid = match structure {
+        MapStructure::CrossValidated => candidate_grid(settings, affordable),
+        MapStructure::Fixed(order) => fixed_grid(settings, order, affordable),
+    };
     let kmax = grid.iter().map(|c| c.0).max().unwrap_or(0);
     let total = grid.len() + 1;
     let mut go = || progress(0, total);
@@ -627,12 +678,22 @@ pub fn fit_joint_maps(
         .find(|c| c.harmonics == 0)
         .cloned()
         .ok_or(MapFitError::NotEvaluable)?;
-    // The lowest held-out eq. 7.10 cost (K = 0 is a candidate).
-    let chosen = candidates
-        .iter()
-        .min_by(|a, b| a.cv_cost_mm2.total_cmp(&b.cv_cost_mm2))
-        .cloned()
-        .expect("K = 0 is a candidate");
+    // The lowest held-out eq. 7.10 cost (K = 0 is a candidate); a held
+    // structure is taken whatever its cost (K = 0 when a fold could not
+    // solve it).
+    let chosen = match structure {
+        MapStructure::CrossValidated => candidates
+            .iter()
+            .min_by(|a, b| a.cv_cost_mm2.total_cmp(&b.cv_cost_mm2))
+            .cloned()
+            .expect("K = 0 is a candidate"),
+        MapStructure::Fixed(_) => candidates
+            .iter()
+            .rev()
+            .find(|c| c.harmonics > 0)
+            .unwrap_or(&without_maps)
+            .clone(),
+    };
     let maps = if chosen.harmonics == 0 {
         None
     } else {
@@ -679,6 +740,21 @@ pub fn fit_joint_maps(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A held structure keeps its harmonics when the poses afford them,
+    /// else the largest of the settings' counts below that they afford,
+    /// else none; K = 0 is always a candidate, the ridge is kept.
+    #[test]
+    fn a_held_structure_is_lowered_to_what_the_poses_afford() {
+        let s = JointMapSettings::default();
+        let order = MapOrder {
+            harmonics: 60,
+            ridge: 0.1,
+        };
+        assert_eq!(fixed_grid(&s, order, |_| true), [(0, 0.0), (60, 0.1)]);
+        assert_eq!(fixed_grid(&s, order, |k| k <= 30), [(0, 0.0), (20, 0.1)]);
+        assert_eq!(fixed_grid(&s, order, |k| k < 10), [(0, 0.0)]);
+    }
 
     /// The rule on hand-computed figures (defaults: ℓ = 250 mm, 0.5 mm
     /// unseen at the tip, 20 mm floor).

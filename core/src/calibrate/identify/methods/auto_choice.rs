@@ -32,6 +32,7 @@ use super::plan::Planner;
 use super::ties::{break_ties, Contender, Physics, TieOutcome};
 use super::veto::{veto, worst_edge, BlockedCheck};
 use super::{Base, Compensated, Method, MethodError, MethodFailure, Run};
+use crate::calibrate::identify::joint_maps::MapOrder;
 use crate::calibrate::identify::report::{AutoDecision, AutoSummary, BaseFallback};
 
 /// The option `auto` takes among `(position mean [mm], orientation mean
@@ -267,10 +268,10 @@ fn delivery(o: &BaseOption) -> Delivery {
     };
     Delivery {
         base,
-        maps_choice: o
-            .maps
-            .and(o.fit.maps.as_ref())
-            .map(|m| (m.chosen.harmonics, m.chosen.ridge)),
+        maps_choice: o.maps.and(o.fit.maps.as_ref()).map(|m| MapOrder {
+            harmonics: m.chosen.harmonics,
+            ridge: m.chosen.ridge,
+        }),
         compensator: o
             .compensator
             .as_ref()

@@ -7,6 +7,7 @@
 use super::context::{Context, MethodFit};
 use super::trained::Trained;
 use super::{Base, Method, MethodError, MethodFailure};
+use crate::calibrate::identify::joint_maps::MapStructure;
 use crate::calibrate::identify::least_squares::Fit;
 use std::collections::BTreeMap;
 
@@ -17,8 +18,9 @@ pub(crate) struct Cache {
     km: Option<Fit>,
     skcm: Option<Result<MethodFit, MethodFailure>>,
     pub(super) trained: BTreeMap<(Method, usize), Result<Trained, MethodFailure>>,
-    /// Joint-map fits per base (`km-maps` and `auto` share them).
-    pub(super) maps: Vec<(Base, Result<MethodFit, MethodFailure>)>,
+    /// Joint-map fits per base and structure (`km-maps` and `auto` share
+    /// the cross-validated ones).
+    pub(super) maps: Vec<(Base, MapStructure, Result<MethodFit, MethodFailure>)>,
 }
 
 impl Cache {
@@ -32,7 +34,12 @@ impl Cache {
         if self.skcm.is_some() {
             bases.push(Base::Skcm);
         }
-        for (b, _) in &self.maps {
+        // A structure held fixed is a refit of the veto, not the method's fit.
+        for (b, ..) in self
+            .maps
+            .iter()
+            .filter(|(_, s, _)| *s == MapStructure::CrossValidated)
+        {
             bases.push(if *b == Base::Km {
                 Base::KmMaps
             } else {

@@ -8,11 +8,14 @@
 //!
 //! Randomness: the folds draw from `ChaCha8Rng(seed + 101)`, the spatially
 //! blocked folds from `ChaCha8Rng(seed + 102)` (`CompensatorOptions::seed`).
+//! The veto's region refits ([`base_fit_with`]) hold the harmonics and ridge
+//! chosen on all the poses (`MapStructure::Fixed`), so the maps they fit
+//! depend on the region's poses alone, not on how the folds were dealt.
 
 use super::cache::Cache;
 use super::context::{Context, MethodFit, Outcome};
 use super::{Base, MethodError, MethodFailure};
-use crate::calibrate::identify::joint_maps::fit_joint_maps;
+use crate::calibrate::identify::joint_maps::{fit_joint_maps, MapStructure};
 use crate::calibrate::identify::least_squares::fit;
 use crate::measure::Measurement;
 use rand::SeedableRng;
@@ -26,13 +29,25 @@ pub(crate) fn base_fit(
     base: Base,
     progress: &mut dyn FnMut(usize, f64) -> bool,
 ) -> Result<MethodFit, MethodError> {
+    base_fit_with(ctx, cache, base, MapStructure::CrossValidated, progress)
+}
+
+/// [`base_fit`] with a joint-map base's structure chosen as `structure`
+/// says (a model-based base ignores it).
+pub(crate) fn base_fit_with(
+    ctx: &Context,
+    cache: &mut Cache,
+    base: Base,
+    structure: MapStructure,
+    progress: &mut dyn FnMut(usize, f64) -> bool,
+) -> Result<MethodFit, MethodError> {
     let inner = match base {
         Base::Km => return cache.km_fit(ctx, progress),
         Base::Skcm => return cache.skcm_fit(ctx, progress),
         Base::KmMaps => Base::Km,
         Base::SkcmMaps => Base::Skcm,
     };
-    run_maps(ctx, cache, inner, &mut |_, it, l| {
+    maps_with(ctx, cache, inner, structure, &mut |_, it, l| {
         progress(it, l.unwrap_or(f64::NAN))
     })
     .map(|o| o.fit)
@@ -45,15 +60,31 @@ pub(crate) fn run_maps(
     base: Base,
     progress: &mut dyn FnMut(f64, usize, Option<f64>) -> bool,
 ) -> Result<Outcome, MethodError> {
-    if let Some((_, r)) = cache.maps.iter().find(|(b, _)| *b == base) {
+    maps_with(ctx, cache, base, MapStructure::CrossValidated, progress)
+}
+
+/// The joint maps on `base` with their structure set as `structure` says,
+/// computed once per structure and run.
+fn maps_with(
+    ctx: &Context,
+    cache: &mut Cache,
+    base: Base,
+    structure: MapStructure,
+    progress: &mut dyn FnMut(f64, usize, Option<f64>) -> bool,
+) -> Result<Outcome, MethodError> {
+    if let Some((.., r)) = cache
+        .maps
+        .iter()
+        .find(|(b, s, _)| *b == base && *s == structure)
+    {
         return r.clone().map(Outcome::plain).map_err(MethodError::Failed);
     }
-    let r = match fit_maps(ctx, cache, base, progress) {
+    let r = match fit_maps(ctx, cache, base, structure, progress) {
         Err(MethodError::Cancelled) => return Err(MethodError::Cancelled),
         Err(MethodError::Failed(f)) => Err(f),
         Ok(mf) => Ok(mf),
     };
-    cache.maps.push((base, r.clone()));
+    cache.maps.push((base, structure, r.clone()));
     r.map(Outcome::plain).map_err(MethodError::Failed)
 }
 
@@ -61,6 +92,7 @@ fn fit_maps(
     ctx: &Context,
     cache: &mut Cache,
     base: Base,
+    structure: MapStructure,
     progress: &mut dyn FnMut(f64, usize, Option<f64>) -> bool,
 ) -> Result<MethodFit, MethodError> {
     let settings = &ctx.opts.joint_maps;
@@ -91,6 +123,7 @@ fn fit_maps(
             &data,
             w,
             settings,
+            structure,
             &mut rng,
             &mut blocked_rng,
             &mut |done, total| progress((stage + done as f64 / total as f64) / stages, done, None),

@@ -22,6 +22,8 @@ mod compensated;
 mod context;
 mod delivered;
 mod failure;
+#[cfg(test)]
+mod fixture;
 mod maps;
 mod model_based;
 mod orientation_part;

@@ -209,3 +209,58 @@ fn auto_has_maps(ctx: &Context, base: Base) -> bool {
         .iter()
         .any(|m| m.row().run == Run::Maps(base))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::auto::run_auto;
+    use super::super::fixture::Fixture;
+    use super::*;
+
+    /// `auto`'s plan counts the veto's refits: its share of the bar is one
+    /// check over every region it may hold out, and the region refits of
+    /// the check `auto` makes (`km-maps` against KM, on the simulated UR5
+    /// of `fixture`) report inside that share, region by region. Every
+    /// report stays in [0, 1] and never goes back, and the last is 1.
+    #[test]
+    fn the_plan_counts_the_veto_refits_and_progress_reaches_the_end() {
+        let fixture = Fixture::measured(240);
+        let opts = fixture.options(1);
+        let ctx = fixture.context(&opts);
+        let mut cache = Cache::default();
+        let total = Planner::from_cache(&cache).auto(&ctx);
+        let veto = Planner::veto(&ctx);
+        let regions = planned_regions(&ctx);
+        // Four clusters and two edges of each of the six joints.
+        assert_eq!(regions, 4 + 2 * 6);
+        let per_region = Method::Km.row().weight + maps_units(Method::KmMaps, Method::Km);
+        assert!((veto - regions as f64 * per_region).abs() <= 1e-12 * veto);
+        assert!(veto > 0.0 && veto < total);
+        let mut fractions = Vec::new();
+        let out = run_auto(&ctx, &mut cache, &mut |s| {
+            fractions.push(s.fraction);
+            true
+        })
+        .unwrap();
+        let auto = out.auto.unwrap();
+        let checks = &auto.decision.blocked_checks;
+        assert_eq!(checks.len(), 1, "{}", auto.reason);
+        assert_eq!(checks[0].option, Method::KmMaps);
+        assert_eq!(checks[0].regions + checks[0].edges, regions);
+        for w in fractions.windows(2) {
+            assert!(w[1] >= w[0], "{} after {}", w[1], w[0]);
+        }
+        assert!(fractions.iter().all(|f| (0.0..=1.0).contains(f)));
+        assert_eq!(fractions.last().copied(), Some(1.0));
+        // The check's share starts where the rest of `auto` ends; each of
+        // the option's and the base's region refits reports in it.
+        let start = (total - veto) / total;
+        let inside = fractions
+            .iter()
+            .filter(|f| **f > start + 1e-12 && **f < 1.0)
+            .count();
+        assert!(
+            inside >= 2 * regions - 1,
+            "{inside} reports inside the veto's share"
+        );
+    }
+}

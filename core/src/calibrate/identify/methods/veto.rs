@@ -18,9 +18,14 @@
 //! option fares worst against its base) but do not veto: on the simulated
 //! YS100 with compliance they would set `skcm-maps` aside at joint 2's top
 //! edge on every seed of the folds, as they should, but on the real UR5 they
-//! set it aside on one seed of two (joint 2's lowest 20 %: 0.1926 mm against
-//! SKCM alone's 0.1142 on seed 2, 0.1215 against 0.1142 on seed 1), so the
-//! choice would hang on how the folds were dealt (docs/design.md).
+//! set it aside on one seed of three (joint 2's lowest 20 %: 0.1926 mm
+//! against SKCM alone's 0.1142 on seed 2, 0.1215 on seeds 1 and 3). The
+//! region refits no longer depend on the folds (`methods::delivered`); the
+//! option does: its maps' ridge, chosen by cross-validation on all the
+//! poses over seed-dealt folds, is 0.1 on seeds 1 and 3 and 0.01 on seed 2
+//! (60 harmonics each), and the maps of the smaller ridge extrapolate worse
+//! at that edge, so the choice would hang on how the folds were dealt
+//! (docs/design.md).
 
 use super::Method;
 use serde::{Deserialize, Serialize};
