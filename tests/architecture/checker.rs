@@ -151,3 +151,23 @@ fn test_items_are_left_out() {
     assert!(import_loops(&t, "").is_empty());
     assert!(!t.imports()[&m("a/b")].contains(&m("c")));
 }
+
+/// A file its parent declares `#[cfg(test)] mod f;` is a test item too: read
+/// from disk, it is no node, while its untested sibling is.
+#[test]
+fn files_declared_for_tests_only_are_left_out() {
+    let root = std::env::temp_dir().join(format!("robocal-arch-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    std::fs::create_dir_all(root.join("a")).unwrap();
+    let write = |p: &str, code: &str| std::fs::write(root.join(p), code).unwrap();
+    write("lib.rs", "pub mod a;\npub mod c;\n");
+    write("a/mod.rs", "pub mod b;\n#[cfg(test)]\nmod fixture;\n");
+    write("a/b.rs", "pub struct X;\n");
+    write("a/fixture.rs", "use crate::c::Z;\n");
+    write("c.rs", "pub struct Z; use crate::a::b::X;\n");
+    let t = Tree::read(&root);
+    std::fs::remove_dir_all(&root).unwrap();
+    assert!(t.files.contains_key(&m("a/b")));
+    assert!(!t.files.contains_key(&m("a/fixture")));
+    assert!(import_loops(&t, "").is_empty());
+}

@@ -11,7 +11,8 @@
 //! A re-export itself is no edge of the file that holds it (it passes
 //! names through); a path that ends outside the crate (a re-exported
 //! `nalgebra` type) is no edge. Comments, strings and `#[cfg(test)]` items
-//! are left out.
+//! are left out, and so are files of tests only (`foo/tests.rs`, or a file
+//! its parent declares `#[cfg(test)] mod fixture;`).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
@@ -220,6 +221,7 @@ fn walk(dir: &Path, module: &mut Module, out: &mut BTreeMap<Module, File>) {
         .map(|e| e.unwrap().path())
         .collect();
     entries.sort();
+    let test_only = test_only_children(dir, module.is_empty());
     for p in entries {
         let name = p.file_name().unwrap().to_str().unwrap().to_string();
         if p.is_dir() {
@@ -237,12 +239,43 @@ fn walk(dir: &Path, module: &mut Module, out: &mut BTreeMap<Module, File>) {
                 "main" if module.is_empty() => continue,
                 // A file of tests only (`foo/tests.rs`) is a test item.
                 "tests" => continue,
+                // So is a file its parent declares `#[cfg(test)] mod foo;`.
+                _ if test_only.iter().any(|t| t == stem) => continue,
                 _ => child_of(module, stem),
             };
             let code = std::fs::read_to_string(&p).unwrap();
             out.insert(m, File::new(&code));
         }
     }
+}
+
+/// The modules of `dir` that its parent file (`dir/mod.rs`, `dir.rs`
+/// beside it, or `lib.rs` at the crate root) declares under `#[cfg(test)]`.
+fn test_only_children(dir: &Path, root: bool) -> Vec<String> {
+    let parent = if root {
+        dir.join("lib.rs")
+    } else if dir.join("mod.rs").exists() {
+        dir.join("mod.rs")
+    } else {
+        dir.with_extension("rs")
+    };
+    let code = std::fs::read_to_string(parent).unwrap_or_default();
+    let mut lines = code.lines().map(str::trim).filter(|l| !l.is_empty());
+    let mut out = Vec::new();
+    while let Some(line) = lines.next() {
+        if line != "#[cfg(test)]" {
+            continue;
+        }
+        let Some(next) = lines.next() else { break };
+        let decl = next
+            .strip_prefix("pub(crate) ")
+            .or(next.strip_prefix("pub(super) "))
+            .unwrap_or(next);
+        if let Some(name) = decl.strip_prefix("mod ").and_then(|r| r.strip_suffix(';')) {
+            out.push(name.trim().to_string());
+        }
+    }
+    out
 }
 
 /// The code without comments, string and char literals, and without the
