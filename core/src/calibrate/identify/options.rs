@@ -169,11 +169,11 @@ pub struct CompensatorOptions {
     /// The joint-map and compensator methods `auto` considers.
     pub auto_candidates: Vec<Method>,
     pub rbf: RbfSettings,
-    /// Network of SKCM-NN (`Network::LmMlp`).
+    /// Network of SKCM-NN (`MlpSize::Nn` in the method table).
     pub nn: MlpSpec,
     pub lm: LmTrainSettings,
-    /// Network of SKCM-IWONN and SKCM-TLBONN (`Network::IwoMlp`,
-    /// `Network::TlboMlp`; `MlpSpec::POPULATION`).
+    /// Network of SKCM-IWONN and SKCM-TLBONN (`MlpSize::Small` in the
+    /// method table; `MlpSpec::POPULATION`).
     pub small: MlpSpec,
     pub iwo: IwoSettings,
     pub tlbo: TlboTrainSettings,
