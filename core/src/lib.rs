@@ -24,6 +24,8 @@
 //! mutable chain state, and nothing here touches HTTP, a database, the async runtime or the
 //! file system.
 
+#![warn(unreachable_pub)]
+
 pub mod calibrate;
 pub mod cell_fit;
 pub mod check;
