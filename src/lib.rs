@@ -7,6 +7,8 @@
 //! the same module names), whose dependency tree has no HTTP, database, async
 //! runtime or command-line crates.
 
+#![warn(unreachable_pub)]
+
 pub use robocal_core::{
     calibrate, cell_fit, check, measure, model, optim, plan, program, sim, solve, stats,
 };

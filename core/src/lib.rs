@@ -24,15 +24,20 @@
 //! mutable chain state, and nothing here touches HTTP, a database, the async runtime or the
 //! file system.
 
+#![warn(unreachable_pub)]
+
 pub mod calibrate;
 pub mod cell_fit;
 pub mod check;
+#[warn(missing_docs)]
 pub mod csv_write;
 pub mod measure;
 pub mod model;
+#[warn(missing_docs)]
 pub mod optim;
 pub mod plan;
 pub mod program;
 pub mod sim;
 pub mod solve;
+#[warn(missing_docs)]
 pub mod stats;

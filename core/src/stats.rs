@@ -5,13 +5,18 @@
 
 use serde::{Deserialize, Serialize};
 
+/// Statistics of the position-error norm over a set of poses [mm].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ErrorStats {
+    /// Number of poses.
     pub n: usize,
+    /// Mean of the error norms.
     pub mean_mm: f64,
+    /// Largest error norm.
     pub max_mm: f64,
     /// Sample standard deviation (n − 1), as MATLAB's `std`.
     pub std_mm: f64,
+    /// Root mean square of the error norms.
     pub rms_mm: f64,
     /// 95th percentile, linear interpolation between closest ranks.
     pub p95_mm: f64,
@@ -67,13 +72,16 @@ pub struct OrientationStats {
     /// Poses with a measured orientation.
     #[serde(rename = "orientation_n")]
     pub n: usize,
+    /// Mean of the orientation errors.
     #[serde(rename = "orientation_mean_deg")]
     pub mean_deg: f64,
+    /// Largest orientation error.
     #[serde(rename = "orientation_max_deg")]
     pub max_deg: f64,
     /// Sample standard deviation (n − 1).
     #[serde(rename = "orientation_std_deg")]
     pub std_deg: f64,
+    /// Root mean square of the orientation errors.
     #[serde(rename = "orientation_rms_deg")]
     pub rms_deg: f64,
     /// 95th percentile, as [`ErrorStats::p95_mm`].

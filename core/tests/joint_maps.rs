@@ -10,6 +10,7 @@ use common::ik::calibrated;
 use common::{opts, run_with};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use robocal_core::calibrate::compensate::select::Parallelism;
 use robocal_core::calibrate::identify::{calibrate, CalibrationError, Method};
 use robocal_core::measure::{self, Measurement};
 use robocal_core::model::calibrated::CompensatedModel;
@@ -212,6 +213,23 @@ fn maps_leave_a_truth_without_them_unchanged() {
     let (km, maps) = validation_means(&s);
     eprintln!("floor {:.4} mm, KM {km:.4}, km-maps {maps:.4}", s.floor_mm);
     assert!((maps - km).abs() <= 0.02 * km, "KM {km} km-maps {maps}");
+}
+
+/// The cross-validation folds fitted on two threads give the fit they give
+/// on one, to the bit: every candidate's figures, the choice, the maps and
+/// the validation errors (the method's whole report).
+#[test]
+fn the_maps_folds_fit_alike_on_one_thread_and_on_two() {
+    let s = study(true);
+    let report = |threads: usize| {
+        let mut o = opts(&[Method::KmMaps]);
+        o.joint_maps.parallel = Parallelism { threads };
+        let r = run_with(&s.nominal, &s.id, &s.va, o).unwrap();
+        serde_json::to_string(&r.methods["km-maps"]).unwrap()
+    };
+    let one = report(1);
+    assert!(one.contains("\"candidates\""), "{one}");
+    assert_eq!(one, report(2));
 }
 
 /// A cancel while the maps' design and normal equations are built (before

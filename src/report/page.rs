@@ -9,16 +9,16 @@ use super::view::{Format, MethodView, ReportView, SetView};
 use maud::{html, Markup};
 
 /// The two pose sets: key and display name.
-pub const SETS: [(&str, &str); 2] = [
+pub(super) const SETS: [(&str, &str); 2] = [
     ("identification", "Identification"),
     ("validation", "Validation"),
 ];
-pub const NOMINAL_COLOR: &str = "#d62728";
+pub(super) const NOMINAL_COLOR: &str = "#d62728";
 const PALETTE: [&str; 5] = ["#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf"];
 const AXES: [&str; 3] = ["dx", "dy", "dz"];
 
 /// A model whose errors the page shows: the nominal one or a method's.
-pub struct Model<'a> {
+pub(super) struct Model<'a> {
     pub key: &'a str,
     pub label: &'a str,
     pub color: &'a str,
@@ -27,7 +27,7 @@ pub struct Model<'a> {
 }
 
 impl<'a> Model<'a> {
-    pub fn set(&self, set: &str) -> Option<&'a SetView> {
+    pub(super) fn set(&self, set: &str) -> Option<&'a SetView> {
         match set {
             "identification" => self.sets.identification.as_ref(),
             _ => self.sets.validation.as_ref(),
@@ -36,7 +36,7 @@ impl<'a> Model<'a> {
 }
 
 /// Nominal first, then the methods in the thesis's order.
-pub fn models(r: &ReportView) -> Vec<Model<'_>> {
+pub(super) fn models(r: &ReportView) -> Vec<Model<'_>> {
     let mut v = vec![Model {
         key: "nominal",
         label: "Nominal model",
@@ -56,7 +56,7 @@ pub fn models(r: &ReportView) -> Vec<Model<'_>> {
     v
 }
 
-pub fn header(title: &str, r: &ReportView, models: &[Model]) -> Markup {
+pub(super) fn header(title: &str, r: &ReportView, models: &[Model]) -> Markup {
     let best = r.best();
     html! {
         header.top {
@@ -121,7 +121,7 @@ fn cards(r: &ReportView, models: &[Model], best: Option<&str>) -> Markup {
 }
 
 /// Warnings and failed methods, at the top of the page.
-pub fn alerts(r: &ReportView) -> Markup {
+pub(super) fn alerts(r: &ReportView) -> Markup {
     let warned: Vec<(&str, &MethodView)> = r
         .ordered_methods()
         .into_iter()
@@ -149,7 +149,7 @@ pub fn alerts(r: &ReportView) -> Markup {
 }
 
 /// Error statistics of every model on every set.
-pub fn statistics(models: &[Model], best: Option<&str>) -> Markup {
+pub(super) fn statistics(models: &[Model], best: Option<&str>) -> Markup {
     html! {
         section #statistics {
             h2 { "Position errors" }
@@ -203,7 +203,7 @@ pub fn statistics(models: &[Model], best: Option<&str>) -> Markup {
 }
 
 /// Histograms of the error norms per set, every model overlaid (log bins).
-pub fn histograms(models: &[Model]) -> Markup {
+pub(super) fn histograms(models: &[Model]) -> Markup {
     html! {
         section #histograms {
             h2 { "Error histograms before and after" }
@@ -226,14 +226,14 @@ pub fn histograms(models: &[Model]) -> Markup {
     }
 }
 
-pub fn legend(models: &[Model]) -> Markup {
+pub(super) fn legend(models: &[Model]) -> Markup {
     html! {
         p.legend { @for m in models { span { span.swatch style={ "background:" (m.color) } {} (m.label) } } }
     }
 }
 
 /// Signed errors per axis: a table for every model and histograms of the best.
-pub fn per_axis(models: &[Model], best: Option<&str>) -> Markup {
+pub(super) fn per_axis(models: &[Model], best: Option<&str>) -> Markup {
     let stats = |v: &[f64]| {
         let n = v.len() as f64;
         let mean = v.iter().sum::<f64>() / n;
@@ -285,7 +285,7 @@ pub fn per_axis(models: &[Model], best: Option<&str>) -> Markup {
 
 /// Pose positions seen from above (x–y) and from the side (x–z), coloured by
 /// the error of the nominal model (before) and of the best method (after).
-pub fn positions(r: &ReportView, models: &[Model], best: Option<&str>) -> Markup {
+pub(super) fn positions(r: &ReportView, models: &[Model], best: Option<&str>) -> Markup {
     let shown: Vec<&Model> = models
         .iter()
         .filter(|m| m.key == "nominal" || Some(m.key) == best)
@@ -339,7 +339,7 @@ fn points(r: &ReportView, set: &str, s: &SetView, a: usize, b: usize) -> Vec<Poi
 }
 
 /// "set NAME row N (session S)" or "pose N" when the source is unknown.
-pub fn pose_name(r: &ReportView, set: &str, i: usize) -> String {
+pub(super) fn pose_name(r: &ReportView, set: &str, i: usize) -> String {
     match source(r, set, i) {
         Some(s) if s.session.is_empty() => format!("{} row {}", s.set, s.row),
         Some(s) => format!("{} row {} (session {})", s.set, s.row, s.session),
@@ -347,7 +347,7 @@ pub fn pose_name(r: &ReportView, set: &str, i: usize) -> String {
     }
 }
 
-pub fn source<'a>(
+pub(super) fn source<'a>(
     r: &'a ReportView,
     set: &str,
     i: usize,
@@ -360,7 +360,7 @@ pub fn source<'a>(
 }
 
 /// Far-out threshold of Tukey's fences: Q3 + 3·IQR of the finite errors.
-pub fn outlier_limit(errors: &[f64]) -> Option<f64> {
+pub(super) fn outlier_limit(errors: &[f64]) -> Option<f64> {
     if errors.len() < 4 {
         return None;
     }
@@ -375,7 +375,7 @@ pub fn outlier_limit(errors: &[f64]) -> Option<f64> {
 }
 
 /// One row per pose of both sets; outliers of the best method flagged.
-pub fn pose_table(r: &ReportView, models: &[Model], best: Option<&str>) -> Markup {
+pub(super) fn pose_table(r: &ReportView, models: &[Model], best: Option<&str>) -> Markup {
     let best_model = models.iter().find(|m| Some(m.key) == best);
     let n_ident = models
         .iter()
@@ -427,7 +427,7 @@ pub fn pose_table(r: &ReportView, models: &[Model], best: Option<&str>) -> Marku
 }
 
 /// Solver outcome per method and the TLBO convergence curve.
-pub fn solvers(models: &[Model]) -> Markup {
+pub(super) fn solvers(models: &[Model]) -> Markup {
     html! {
         section #solvers {
             h2 { "Solvers" }
@@ -453,7 +453,7 @@ pub fn solvers(models: &[Model]) -> Markup {
 }
 
 /// Identifiability summary, identified parameters and joint stiffness.
-pub fn parameters(r: &ReportView, models: &[Model]) -> Markup {
+pub(super) fn parameters(r: &ReportView, models: &[Model]) -> Markup {
     let methods: Vec<&Model> = models.iter().filter(|m| m.method.is_some()).collect();
     html! {
         @if let Some(i) = &r.identifiability {
@@ -570,7 +570,7 @@ fn decision_line(d: &super::view::AutoDecisionView) -> String {
 
 /// The learned compensators: what each is, how it was trained, and its effect
 /// on every set (base → compensated), with `auto`'s choice.
-pub fn compensators(models: &[Model]) -> Markup {
+pub(super) fn compensators(models: &[Model]) -> Markup {
     let shown: Vec<(&Model, &MethodView)> = models
         .iter()
         .filter_map(|m| Some((m, m.method?)))

@@ -11,7 +11,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 /// Poses the frame-shift analysis needs at least.
-pub const MIN_FRAME_SHIFT_POSES: usize = 6;
+pub(super) const MIN_FRAME_SHIFT_POSES: usize = 6;
 
 /// Why a check cannot be scored.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -75,8 +75,11 @@ pub trait LeastSquaresProblem {
 
 /// Column values `x` and the box `lower ≤ x ≤ upper` (±∞ for free columns).
 pub struct Bounds<'a> {
+    /// The column values.
     pub x: &'a [f64],
+    /// Each column's lower bound.
     pub lower: &'a [f64],
+    /// Each column's upper bound.
     pub upper: &'a [f64],
 }
 
@@ -94,6 +97,7 @@ pub struct Iterate {
 /// A callback's answer.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Flow {
+    /// Go on with the run.
     Continue,
     /// End the run at the current point ([`StopReason::Stopped`]).
     Stop,
@@ -110,19 +114,29 @@ pub struct Cancelled;
 pub enum Damping {
     /// Marquardt's: diagonal `+= λ·(1 + A_ii)`; `λ/10` (not below 1e-15) on
     /// acceptance, `10·λ` on rejection; trials while `λ < 1e12`.
-    Marquardt { initial: f64 },
+    Marquardt {
+        /// The starting λ.
+        initial: f64,
+    },
     /// MATLAB `trainlm`'s: diagonal `+= μ`; `μ·decrease` on acceptance,
     /// `μ·increase` on rejection; trials while `μ ≤ max`.
     Trainlm {
+        /// The starting μ.
         initial: f64,
+        /// The factor on μ after an accepted step.
         decrease: f64,
+        /// The factor on μ after a rejected step.
         increase: f64,
+        /// The largest μ a trial is made with.
         max: f64,
     },
     /// Nielsen's: diagonal `+= μ`; on acceptance with gain ratio `ρ`,
     /// `μ·max(1/3, 1 − (2ρ − 1)³)` (not below 1e-30) and `ν = 2`; on
     /// rejection `μ·ν` (not below 1e-18) and `ν·2`; trials while `μ ≤ 1e8`.
-    Nielsen { initial: f64 },
+    Nielsen {
+        /// The starting μ.
+        initial: f64,
+    },
 }
 
 /// Marquardt's λ bounds and factor.
@@ -214,6 +228,7 @@ pub struct Settings {
     pub gradient_tolerance: f64,
     /// Converged before any trial when `max|g_i|` is below this (0: off).
     pub gradient_floor: f64,
+    /// How the damping enters the step and changes between trials.
     pub damping: Damping,
     /// Scale the columns by `1/‖J_j‖` of the first Jacobian (the scaled
     /// parameters are dimensionless).
@@ -253,9 +268,11 @@ pub struct Report {
     pub linearisations: usize,
     /// Trial points evaluated.
     pub evaluations: usize,
+    /// Cost at the start point.
     pub initial_cost: f64,
     /// Cost at the returned point.
     pub cost: f64,
+    /// Why the run ended.
     pub reason: StopReason,
     /// The reason in words, with the figures of the test.
     pub detail: String,

@@ -32,10 +32,13 @@ impl Default for TlboSettings {
 /// Result of a TLBO run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TlboResult {
+    /// The best learner found.
     pub best: Vec<f64>,
+    /// Its cost.
     pub best_cost: f64,
     /// Best cost after each generation.
     pub history: Vec<f64>,
+    /// Cost evaluations made.
     pub evaluations: usize,
 }
 

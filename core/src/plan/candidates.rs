@@ -10,7 +10,7 @@ use nalgebra::Vector3;
 use rand::Rng;
 
 /// Whether the TCP position `p` [m] is inside `b`.
-pub fn inside_box(b: &WorkspaceBox, p: &Vector3<f64>) -> bool {
+pub(super) fn inside_box(b: &WorkspaceBox, p: &Vector3<f64>) -> bool {
     (0..3).all(|k| {
         let v = p[k] * 1e3;
         v >= b.min_mm[k] && v <= b.max_mm[k]
@@ -18,7 +18,7 @@ pub fn inside_box(b: &WorkspaceBox, p: &Vector3<f64>) -> bool {
 }
 
 /// Angle [deg] between the reflector's axis at `tcp` and the line to the tracker.
-pub fn sight_angle_deg(t: &TrackerSight, tcp: &Pose) -> f64 {
+pub(super) fn sight_angle_deg(t: &TrackerSight, tcp: &Pose) -> f64 {
     let axis = tcp.r * Vector3::from(t.axis).normalize();
     let to = Vector3::from(t.position_mm) * 1e-3 - tcp.p;
     axis.angle(&to).to_degrees()

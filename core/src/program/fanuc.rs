@@ -37,7 +37,7 @@ use std::collections::HashMap;
 use std::ops::Range;
 
 /// The mark of an unsolved position (Fanuc comments hold 16 characters).
-pub const MARK: &str = ":\"robocal: failed\"";
+pub(super) const MARK: &str = ":\"robocal: failed\"";
 
 fn punct(t: Option<&Token>, c: char) -> bool {
     matches!(t, Some((Tok::Punct(p), _)) if *p == c)
@@ -332,7 +332,7 @@ enum Held {
 
 /// Parses `.ls` files: the Cartesian positions of their `/POS` sections and
 /// the motions of their `/MN` sections.
-pub fn parse(files: &[ProgramFile]) -> Result<Targets, ParseError> {
+pub(super) fn parse(files: &[ProgramFile]) -> Result<Targets, ParseError> {
     let mut found = Targets::default();
     for (fi, f) in files.iter().enumerate() {
         let text = f.text.as_str();

@@ -711,7 +711,7 @@ fn has_ext(name: &str, ext: &str) -> bool {
 }
 
 /// Parses a KRL program (`.src` and `.dat` files; other files are read as data lists).
-pub fn parse(files: &[ProgramFile]) -> Result<Targets, ParseError> {
+pub(super) fn parse(files: &[ProgramFile]) -> Result<Targets, ParseError> {
     let mut p = Parser {
         files,
         declared: Vec::new(),

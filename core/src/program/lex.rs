@@ -6,10 +6,10 @@ use super::ParseError;
 use std::ops::Range;
 
 /// An error at a byte offset of a file.
-pub type Fail = (usize, String);
+pub(super) type Fail = (usize, String);
 
 /// `(line, column)` (1-based, column in characters) of byte offset `at`.
-pub fn position(text: &str, at: usize) -> (usize, usize) {
+pub(super) fn position(text: &str, at: usize) -> (usize, usize) {
     let at = at.min(text.len());
     let mut at = at;
     while !text.is_char_boundary(at) {
@@ -21,7 +21,7 @@ pub fn position(text: &str, at: usize) -> (usize, usize) {
     (line, before[start..].chars().count() + 1)
 }
 
-pub fn error(file: &str, text: &str, (at, message): Fail) -> ParseError {
+pub(super) fn error(file: &str, text: &str, (at, message): Fail) -> ParseError {
     let (line, column) = position(text, at);
     ParseError {
         file: file.to_string(),
@@ -32,7 +32,7 @@ pub fn error(file: &str, text: &str, (at, message): Fail) -> ParseError {
 }
 
 /// Byte offset of the end of the line holding `at` (before `\r\n` or `\n`).
-pub fn line_end(text: &str, at: usize) -> usize {
+pub(super) fn line_end(text: &str, at: usize) -> usize {
     let end = text[at..].find('\n').map_or(text.len(), |i| at + i);
     if end > 0 && text.as_bytes()[end - 1] == b'\r' {
         end - 1
@@ -43,7 +43,7 @@ pub fn line_end(text: &str, at: usize) -> usize {
 
 /// `text` with every comment (from `comment` to the end of the line, outside
 /// strings in `quotes`) replaced by spaces, byte for byte.
-pub fn blank_comments(text: &str, comment: char, quotes: &[char]) -> Result<String, Fail> {
+pub(super) fn blank_comments(text: &str, comment: char, quotes: &[char]) -> Result<String, Fail> {
     let mut out = String::with_capacity(text.len());
     let mut quote: Option<(char, usize)> = None;
     let mut in_comment = false;
@@ -80,7 +80,7 @@ pub fn blank_comments(text: &str, comment: char, quotes: &[char]) -> Result<Stri
 }
 
 #[derive(Debug, Clone, PartialEq)]
-pub enum Tok {
+pub(super) enum Tok {
     /// Identifier as written.
     Word(String),
     Number(f64),
@@ -88,10 +88,10 @@ pub enum Tok {
     Punct(char),
 }
 
-pub type Token = (Tok, Range<usize>);
+pub(super) type Token = (Tok, Range<usize>);
 
 /// Tokens of comment-free `code` (strings in `quotes`).
-pub fn tokens(code: &str, quotes: &[char]) -> Result<Vec<Token>, Fail> {
+pub(super) fn tokens(code: &str, quotes: &[char]) -> Result<Vec<Token>, Fail> {
     let b = code.as_bytes();
     let mut out = Vec::new();
     let mut i = 0;
@@ -141,7 +141,7 @@ pub fn tokens(code: &str, quotes: &[char]) -> Result<Vec<Token>, Fail> {
 
 /// A bracket literal.
 #[derive(Debug, Clone, PartialEq)]
-pub enum Val {
+pub(super) enum Val {
     /// `[…]`: elements and the range from `[` to `]`.
     List(Vec<Val>, Range<usize>),
     /// A (signed) number and the range of its text.
@@ -151,13 +151,13 @@ pub enum Val {
 }
 
 impl Val {
-    pub fn range(&self) -> Range<usize> {
+    pub(super) fn range(&self) -> Range<usize> {
         match self {
             Val::List(_, r) | Val::Num(_, r) | Val::Other(r) => r.clone(),
         }
     }
 
-    pub fn list(&self) -> Option<&[Val]> {
+    pub(super) fn list(&self) -> Option<&[Val]> {
         match self {
             Val::List(v, _) => Some(v),
             _ => None,
@@ -165,7 +165,7 @@ impl Val {
     }
 
     /// `n` numbers: their values and ranges.
-    pub fn numbers(&self, n: usize) -> Option<(Vec<f64>, Vec<Range<usize>>)> {
+    pub(super) fn numbers(&self, n: usize) -> Option<(Vec<f64>, Vec<Range<usize>>)> {
         let items = self.list()?;
         if items.len() != n {
             return None;
@@ -234,7 +234,7 @@ fn value_at_depth(
 }
 
 /// The list opening at token `i` (`[`); returns it and the token after `]`.
-pub fn list(toks: &[Token], i: usize) -> Result<(Val, usize), Fail> {
+pub(super) fn list(toks: &[Token], i: usize) -> Result<(Val, usize), Fail> {
     list_at_depth(toks, i, 0)
 }
 

@@ -635,7 +635,7 @@ fn declared_site(d: &Declared, assigned: &HashMap<String, usize>) -> Site {
 }
 
 /// Parses RAPID modules.
-pub fn parse(files: &[ProgramFile]) -> Result<Targets, ParseError> {
+pub(super) fn parse(files: &[ProgramFile]) -> Result<Targets, ParseError> {
     let mut masked = Vec::with_capacity(files.len());
     let mut toks = Vec::with_capacity(files.len());
     for f in files {

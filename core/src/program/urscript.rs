@@ -540,7 +540,7 @@ impl Parser<'_> {
 }
 
 /// Parses URScript files.
-pub fn parse(files: &[ProgramFile]) -> Result<Targets, ParseError> {
+pub(super) fn parse(files: &[ProgramFile]) -> Result<Targets, ParseError> {
     let mut found = Targets::default();
     for (fi, f) in files.iter().enumerate() {
         let fail = |e: Fail| error(&f.name, &f.text, e);

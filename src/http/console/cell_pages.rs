@@ -181,7 +181,7 @@ fn item_form(id: i64, kind: Kind, item: Option<&CellItemRow>) -> Markup {
 }
 
 /// Tools and work objects of robot `id`.
-pub fn cell_section(id: i64, tools: &[CellItemRow], work_objects: &[CellItemRow]) -> Markup {
+pub(super) fn cell_section(id: i64, tools: &[CellItemRow], work_objects: &[CellItemRow]) -> Markup {
     html! {
         section #cell {
             h2 { "Tools and work objects" }
@@ -275,7 +275,7 @@ fn tcp_method_text(m: TcpMethod) -> &'static str {
 }
 
 /// Program filtering for robot `id`.
-pub fn filter_section(id: i64, versions: &[VersionRow]) -> Markup {
+pub(super) fn filter_section(id: i64, versions: &[VersionRow]) -> Markup {
     html! {
         section #filter-section {
             h2 { "Filter a robot program" }
@@ -308,7 +308,7 @@ pub fn filter_section(id: i64, versions: &[VersionRow]) -> Markup {
 /// Predict poses from joint readings (`POST …/predict`) for robot `id`:
 /// every option of the API — model, tool, frame (tracker, base or a work
 /// object), payload and a second orientation convention.
-pub fn predict_section(
+pub(super) fn predict_section(
     id: i64,
     versions: &[VersionRow],
     tools: &[CellItemRow],

@@ -29,7 +29,7 @@ fn deg_or_dash(v: &Value, key: &str) -> String {
 }
 
 /// The page of check `c` of robot `r`.
-pub fn check_page(r: &RobotRow, c: &CheckRow, keys: bool) -> Markup {
+pub(super) fn check_page(r: &RobotRow, c: &CheckRow, keys: bool) -> Markup {
     let res = &c.result.0;
     let status = status_of(c);
     let pos = &res["position"];

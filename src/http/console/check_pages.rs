@@ -18,7 +18,7 @@ use maud::{html, Markup};
 use robocal_core::check::{CheckStatus, CheckThresholds};
 
 /// Everything the section shows.
-pub struct ChecksView<'a> {
+pub(super) struct ChecksView<'a> {
     pub robot: i64,
     pub status: Option<CheckStatus>,
     pub thresholds: &'a CheckThresholds,
@@ -37,7 +37,7 @@ fn set_options(sets: &[SetRow]) -> Markup {
 }
 
 /// The section.
-pub fn checks_section(v: &ChecksView) -> Markup {
+pub(super) fn checks_section(v: &ChecksView) -> Markup {
     let id = v.robot;
     html! {
         section #checks-section {

@@ -5,7 +5,7 @@ use maud::{html, Markup};
 
 /// The "Model" picker of a solve or a filter: the active version, every
 /// stored version (newest first) or the nominal model, sent as `version`.
-pub fn model_select(versions: &[VersionRow]) -> Markup {
+pub(super) fn model_select(versions: &[VersionRow]) -> Markup {
     html! {
         label { "Model "
             select name="version" {

@@ -4,15 +4,15 @@
 //! (`125`, `216.5`), so a value typed in comes back as typed.
 
 /// Decimals of a length [mm].
-pub const MM_DECIMALS: usize = 3;
+pub(super) const MM_DECIMALS: usize = 3;
 /// Decimals of an angle [deg].
-pub const DEG_DECIMALS: usize = 4;
+pub(super) const DEG_DECIMALS: usize = 4;
 /// Decimals of a mass [kg].
-pub const KG_DECIMALS: usize = 3;
+pub(super) const KG_DECIMALS: usize = 3;
 
 /// `x` with `decimals` decimals; `-0.000` written as `0.000`; a value that
 /// is not finite as `—`.
-pub fn fixed(x: f64, decimals: usize) -> String {
+pub(super) fn fixed(x: f64, decimals: usize) -> String {
     if !x.is_finite() {
         return "—".into();
     }
@@ -24,23 +24,23 @@ pub fn fixed(x: f64, decimals: usize) -> String {
 }
 
 /// A length [mm] to 0.001 mm.
-pub fn mm(x: f64) -> String {
+pub(super) fn mm(x: f64) -> String {
     fixed(x, MM_DECIMALS)
 }
 
 /// An angle [deg] to 0.0001°.
-pub fn deg(x: f64) -> String {
+pub(super) fn deg(x: f64) -> String {
     fixed(x, DEG_DECIMALS)
 }
 
 /// A mass [kg] to 0.001 kg.
-pub fn kg(x: f64) -> String {
+pub(super) fn kg(x: f64) -> String {
     fixed(x, KG_DECIMALS)
 }
 
 /// `x` rounded to `decimals` decimals with the trailing zeros (and a
 /// trailing point) dropped: a form field's value (`125`, `216.5`, `0`).
-pub fn trimmed(x: f64, decimals: usize) -> String {
+pub(super) fn trimmed(x: f64, decimals: usize) -> String {
     let s = fixed(x, decimals);
     if s.contains('.') {
         s.trim_end_matches('0').trim_end_matches('.').to_string()

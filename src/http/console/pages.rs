@@ -35,7 +35,7 @@ fn style() -> &'static str {
 /// by their SHA-256 (CSP Level 2 hash sources), nothing else inline. The
 /// download links are `blob:` URLs the page makes itself; `connect-src`
 /// allows reading them back (the browser check does).
-pub fn content_security_policy() -> &'static str {
+pub(super) fn content_security_policy() -> &'static str {
     static CSP: std::sync::OnceLock<String> = std::sync::OnceLock::new();
     CSP.get_or_init(|| {
         format!(
@@ -60,7 +60,7 @@ fn csp_hash(text: &str) -> String {
 }
 
 /// Everything the robot page shows.
-pub struct RobotView {
+pub(super) struct RobotView {
     pub robot: RobotRow,
     pub sets: Vec<SetRow>,
     pub calibrations: Vec<CalibrationRow>,
@@ -106,7 +106,7 @@ pub(super) fn layout(title: &str, keys: bool, body: Markup) -> Markup {
 
 /// The start page: robots (each with its latest check's status) and a form
 /// to add one.
-pub fn robots(robots: &[RobotWithCheck], total: i64, keys: bool) -> Markup {
+pub(super) fn robots(robots: &[RobotWithCheck], total: i64, keys: bool) -> Markup {
     layout(
         "Robots",
         keys,
@@ -189,7 +189,7 @@ fn reregistered_note(v: &VersionRow) -> Markup {
 }
 
 /// One robot: sets, calibrations, versions.
-pub fn robot(v: &RobotView) -> Markup {
+pub(super) fn robot(v: &RobotView) -> Markup {
     let r = &v.robot;
     let id = r.id;
     layout(

@@ -34,7 +34,7 @@ fn language_select(optional: bool) -> Markup {
 }
 
 /// Both sections, for robot `id`.
-pub fn plan_sections(id: i64) -> Markup {
+pub(super) fn plan_sections(id: i64) -> Markup {
     html! {
         section #plan-section {
             h2 { "Plan the measurements" }

@@ -9,7 +9,7 @@ use maud::{html, Markup};
 use robocal_core::check::{CheckStatus, ShiftSize};
 
 /// The colour a status is drawn in: only `ok` is green.
-pub fn status_colour(s: CheckStatus) -> &'static str {
+pub(super) fn status_colour(s: CheckStatus) -> &'static str {
     match s {
         CheckStatus::Ok => "#1e7a3c",
         CheckStatus::Degraded => "#b07d00",
@@ -19,14 +19,14 @@ pub fn status_colour(s: CheckStatus) -> &'static str {
 }
 
 /// The colour of a stored check's status (grey for a name not in the table).
-pub fn row_colour(c: &CheckRow) -> &'static str {
+pub(super) fn row_colour(c: &CheckRow) -> &'static str {
     status_of(c).map_or("#5b6475", status_colour)
 }
 
 /// The style rules of the statuses (part of the console's one style sheet,
 /// whose hash the page's `Content-Security-Policy` names): a tag's
 /// background, a table cell's text.
-pub fn status_css() -> String {
+pub(super) fn status_css() -> String {
     CheckStatus::ALL
         .iter()
         .map(|s| {
@@ -37,12 +37,12 @@ pub fn status_css() -> String {
 }
 
 /// `13.127 mm, 0.2636°`.
-pub fn shift_text(s: &ShiftSize) -> String {
+pub(super) fn shift_text(s: &ShiftSize) -> String {
     format!("{} mm, {}°", mm(s.translation_mm), deg(s.rotation_deg))
 }
 
 /// A status as a coloured tag, with the shift's size when shifted.
-pub fn status_tag(s: CheckStatus, shift: Option<&ShiftSize>) -> Markup {
+pub(super) fn status_tag(s: CheckStatus, shift: Option<&ShiftSize>) -> Markup {
     html! {
         span class={ "status-tag " (s.name()) } title=(s.meaning()) {
             (s.name())

@@ -26,7 +26,7 @@ const BOTTOM: f64 = 40.0;
 
 /// Seconds since 1970-01-01 UTC of a stored time (`YYYY-MM-DDTHH:MM:SS[.f]Z`,
 /// as the store writes it); `None` for another text.
-pub fn epoch_seconds(stamp: &str) -> Option<f64> {
+pub(super) fn epoch_seconds(stamp: &str) -> Option<f64> {
     let b = stamp.as_bytes();
     if b.len() < 19 || b[4] != b'-' || b[7] != b'-' || b[13] != b':' || b[16] != b':' {
         return None;
@@ -107,7 +107,7 @@ const TIME_STEPS: [f64; 20] = [
 ];
 
 /// The y axis' top [mm]: see the module's header.
-pub fn y_top(means: &[f64], t: &CheckThresholds) -> f64 {
+pub(super) fn y_top(means: &[f64], t: &CheckThresholds) -> f64 {
     let mut m: Vec<f64> = means.iter().copied().filter(|x| x.is_finite()).collect();
     m.sort_by(f64::total_cmp);
     let shown = match (m.last(), m.len()) {
@@ -136,7 +136,7 @@ fn nice_step(span: f64, ticks: f64) -> f64 {
 }
 
 /// The trend plot of `checks` (oldest first).
-pub fn trend(checks: &[CheckRow], t: &CheckThresholds) -> Markup {
+pub(super) fn trend(checks: &[CheckRow], t: &CheckThresholds) -> Markup {
     let times: Vec<Option<f64>> = checks
         .iter()
         .map(|c| epoch_seconds(&c.created_at))

@@ -111,25 +111,28 @@ impl StartCommand {
     }
 }
 
+/// A resolved command the tests of the command and of its stored form share:
+/// two methods, seed 7, a payload that is not a short decimal (0.1 + 0.2).
+#[cfg(test)]
+pub(super) fn resolved() -> StartCommand {
+    use crate::calibrate::identify::Method;
+    StartCommand {
+        identification_set_ids: None,
+        validation_set_ids: None,
+        training_set_ids: None,
+        payload_kg: None,
+        settings: CalibrationSettings {
+            methods: vec![Method::Km, Method::Skcm],
+            seed: 7,
+            ..CalibrationSettings::default()
+        },
+    }
+    .resolved(vec![3, 1], vec![2], vec![], 0.1 + 0.2)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::calibrate::identify::Method;
-
-    fn resolved() -> StartCommand {
-        StartCommand {
-            identification_set_ids: None,
-            validation_set_ids: None,
-            training_set_ids: None,
-            payload_kg: None,
-            settings: CalibrationSettings {
-                methods: vec![Method::Km, Method::Skcm],
-                seed: 7,
-                ..CalibrationSettings::default()
-            },
-        }
-        .resolved(vec![3, 1], vec![2], vec![], 0.1 + 0.2)
-    }
 
     #[test]
     fn the_options_column_has_the_keys_it_always_had() {

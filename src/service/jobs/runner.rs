@@ -113,9 +113,10 @@ pub(super) async fn execute(state: AppState, job: Job, claim: Option<Claim>) {
         ..
     } = job;
     // The calibration workers share the cores: each job's cross-validations
-    // train on its share.
+    // (compensators and joint maps) run on its share.
     let mut opts = opts;
     opts.compensator.parallel = Parallelism::shared_by(state.config().workers);
+    opts.joint_maps.parallel = opts.compensator.parallel;
     // The job's wall-clock budget: past it the job stops like a cancellation
     // and is reported as failed.
     let budget = state.limits().job_time;

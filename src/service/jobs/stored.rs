@@ -119,25 +119,11 @@ pub(super) async fn load(state: &AppState, robot_id: i64, id: i64) -> Result<Job
 
 #[cfg(test)]
 mod tests {
+    use super::super::command::resolved;
     use super::*;
     use crate::calibrate::compensate::select::Parallelism;
     use crate::calibrate::identify::{CalibrationOptions, CompensatorOptions, LmSettings};
     use crate::optim::TlboSettings;
-
-    fn resolved() -> StartCommand {
-        StartCommand {
-            identification_set_ids: None,
-            validation_set_ids: None,
-            training_set_ids: None,
-            payload_kg: None,
-            settings: CalibrationSettings {
-                methods: vec![Method::Km, Method::Skcm],
-                seed: 7,
-                ..CalibrationSettings::default()
-            },
-        }
-        .resolved(vec![3, 1], vec![2], vec![], 0.1 + 0.2)
-    }
 
     #[test]
     fn the_stored_command_reads_back_equal() {

@@ -7,8 +7,9 @@
 //! over every reading gives both lines, zero offsets and scales and the
 //! reflectors' positions ([`problem`]), with residuals and σ; the fit is
 //! judged before it is stored ([`judge`]) and the outcome is typed
-//! ([`outcome`]); its readings can come from measurement sets with the
-//! axes' columns ([`readings`]).
+//! ([`outcome`], its refusal's shape shared with the track's:
+//! [`refusal`]); its readings can come from measurement sets with the axes'
+//! columns ([`readings`]).
 //!
 //! Frames: readings in the cell (tracker) frame; the nominal model places the
 //! positioner base in it; lines of axis 1 in the base frame, of axis 2 in the
@@ -21,6 +22,7 @@ pub mod judge;
 pub mod outcome;
 pub mod problem;
 pub mod readings;
+pub mod refusal;
 pub mod track;
 
 pub use fit::fit_positioner;
@@ -28,3 +30,4 @@ pub use outcome::{
     Axis, AxisSigma, CircleReport, FitLimits, PositionerFit, PositionerFitRequest,
     PositionerReading, RefusalReason, Refused, SolverOutcome,
 };
+pub use refusal::Refusal;

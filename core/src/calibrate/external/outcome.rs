@@ -7,6 +7,7 @@
 //! model's `cell_from_base` places the positioner base; reflector positions
 //! are in the face plate frame.
 
+use super::refusal::{Reason, Refusal};
 use crate::model::external::{TiltRotate, TiltRotateDescription};
 use crate::optim::lm::StopReason;
 use serde::Serialize;
@@ -165,52 +166,10 @@ pub enum RefusalReason {
     ResidualOutlier,
 }
 
-/// A fit refused before it is stored: why, in words a user can act on, the
-/// figures, and the fit itself when one was made.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Refused {
-    pub reason: RefusalReason,
-    pub message: String,
-    pub measured: Option<f64>,
-    pub needed: Option<f64>,
-    /// The reading (1-based) the refusal names.
-    pub row: Option<usize>,
-    pub fit: Option<Box<PositionerFit>>,
+/// A positioner fit refused before it is stored (the shape every external
+/// axis fit's refusal shares, [`Refusal`]).
+pub type Refused = Refusal<RefusalReason, PositionerFit>;
+
+impl Reason for RefusalReason {
+    const NAMES_STATIONS: bool = false;
 }
-
-impl Refused {
-    pub fn new(reason: RefusalReason, message: String) -> Self {
-        Refused {
-            reason,
-            message,
-            measured: None,
-            needed: None,
-            row: None,
-            fit: None,
-        }
-    }
-
-    pub fn figures(mut self, measured: f64, needed: f64) -> Self {
-        self.measured = Some(measured);
-        self.needed = Some(needed);
-        self
-    }
-
-    pub fn at_row(mut self, row: usize) -> Self {
-        self.row = Some(row);
-        self
-    }
-
-    pub fn with_fit(mut self, fit: PositionerFit) -> Self {
-        self.fit = Some(Box::new(fit));
-        self
-    }
-}
-
-impl std::fmt::Display for Refused {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.message)
-    }
-}
-
-impl std::error::Error for Refused {}

@@ -59,6 +59,7 @@ pub use blocked::BlockedMaps;
 pub use refusal::{MapRefusal, RefusedMap};
 
 use super::evaluate::{evaluate, gram_checked};
+use crate::calibrate::compensate::select::Parallelism;
 use crate::measure::Measurement;
 use crate::model::{JointMap, JointMaps, ParamId, ParamKind, Pose, RobotModel};
 use design::{normal_of, solve, Design};
@@ -101,6 +102,10 @@ pub struct JointMapSettings {
     /// Spatially blocked folds the chosen maps are also judged on (whole
     /// regions of joint space held out, `blocked`); fewer than 2 skips them.
     pub blocked_folds: usize,
+    /// Threads a candidate's cross-validation folds are fitted on; results
+    /// do not depend on it. Set by the caller, not by a request.
+    #[serde(skip)]
+    pub parallel: Parallelism,
 }
 
 impl Default for JointMapSettings {
@@ -118,6 +123,7 @@ impl Default for JointMapSettings {
             max_unseen_tip_m: 0.5e-3,
             noise_ratio: 2.0,
             blocked_folds: 4,
+            parallel: Parallelism::default(),
         }
     }
 }
@@ -535,30 +541,37 @@ struct CrossValidation<'a> {
 
 impl CrossValidation<'_> {
     /// The held-out errors of `k` harmonics with ridge `ridge`, each fold
-    /// fitted without its poses: `Some(None)` when a fold's solve fails,
-    /// `None` when `go` (after each fold) cancels.
+    /// fitted without its poses, the folds on up to `threads` threads and
+    /// gathered in fold order: `Some(None)` when a fold's solve fails, `None`
+    /// when `go` (after each fold) cancels.
     fn candidate(
         &self,
         k: usize,
         ridge: f64,
+        threads: usize,
         go: &mut dyn FnMut() -> bool,
     ) -> Option<Option<MapCandidate>> {
         let d = self.d;
         let cols = d.columns(k);
-        let mut errors = Vec::new();
-        let mut angles = Vec::new();
-        let mut ok = true;
-        for (poses, (gf, bf)) in self.fold_poses.iter().zip(&self.fold_normals) {
-            match solve(
+        let fit_fold = |f: usize| {
+            let (gf, bf) = &self.fold_normals[f];
+            let x = solve(
                 &(self.g - gf),
                 &(self.b - bf),
                 &cols,
                 self.scale,
                 d.geo,
                 ridge,
-            ) {
-                Some(x) => {
-                    let (e, a) = held_out_errors(d, poses, &cols, &x);
+            )?;
+            Some(held_out_errors(d, &self.fold_poses[f], &cols, &x))
+        };
+        let per_fold = in_order(self.fold_poses.len(), threads, fit_fold);
+        let mut errors = Vec::new();
+        let mut angles = Vec::new();
+        let mut ok = true;
+        for fold in per_fold {
+            match fold {
+                Some((e, a)) => {
                     errors.extend(e);
                     angles.extend(a.into_iter().flatten());
                 }
@@ -578,6 +591,38 @@ impl CrossValidation<'_> {
                 (!angles.is_empty()).then(|| angles.iter().sum::<f64>() / angles.len() as f64),
         }))
     }
+}
+
+/// `f(0)`, …, `f(n − 1)` on up to `threads` scoped threads, in index order.
+/// Each value is computed by one call alone, so it does not depend on the
+/// threads.
+fn in_order<T: Send>(n: usize, threads: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    let threads = threads.clamp(1, n.max(1));
+    if threads == 1 {
+        return (0..n).map(f).collect();
+    }
+    let f = &f;
+    std::thread::scope(|scope| {
+        let workers: Vec<_> = (0..threads)
+            .map(|t| {
+                scope.spawn(move || {
+                    (t..n)
+                        .step_by(threads)
+                        .map(|i| (i, f(i)))
+                        .collect::<Vec<_>>()
+                })
+            })
+            .collect();
+        let mut out: Vec<Option<T>> = (0..n).map(|_| None).collect();
+        for w in workers {
+            for (i, v) in w.join().expect("a fold's fit panicked") {
+                out[i] = Some(v);
+            }
+        }
+        out.into_iter()
+            .map(|v| v.expect("every fold is fitted"))
+            .collect()
+    })
 }
 
 /// Fits the maps of `model` (its own maps ignored) on `data` with the session
@@ -665,7 +710,8 @@ pub fn fit_joint_maps(
     };
     let mut candidates = Vec::new();
     for (done, (k, ridge)) in grid.iter().enumerate() {
-        match cv.candidate(*k, *ridge, &mut || progress(done, total)) {
+        let threads = settings.parallel.threads();
+        match cv.candidate(*k, *ridge, threads, &mut || progress(done, total)) {
             None => return Ok(None),
             Some(c) => candidates.extend(c),
         }

@@ -81,7 +81,8 @@ impl CalibrationSettings {
     /// The options a calibration runs with: these settings where they act
     /// (the one seed seeds both the TLBO search and the compensators), the
     /// core's defaults elsewhere, and the threads its cross-validations
-    /// train on (`parallel`: the caller's, never a user's stored choice).
+    /// (the compensators' and the joint maps') run on (`parallel`: the
+    /// caller's, never a user's stored choice).
     pub fn options(&self, parallel: Parallelism) -> CalibrationOptions {
         let d = CalibrationOptions::default();
         CalibrationOptions {
@@ -104,6 +105,10 @@ impl CalibrationSettings {
                 auto_candidates: self.auto_candidates.clone(),
                 parallel,
                 ..d.compensator
+            },
+            joint_maps: JointMapSettings {
+                parallel,
+                ..d.joint_maps
             },
             ..d
         }
@@ -169,11 +174,11 @@ pub struct CompensatorOptions {
     /// The joint-map and compensator methods `auto` considers.
     pub auto_candidates: Vec<Method>,
     pub rbf: RbfSettings,
-    /// Network of SKCM-NN (`Network::LmMlp`).
+    /// Network of SKCM-NN (`MlpSize::Nn` in the method table).
     pub nn: MlpSpec,
     pub lm: LmTrainSettings,
-    /// Network of SKCM-IWONN and SKCM-TLBONN (`Network::IwoMlp`,
-    /// `Network::TlboMlp`; `MlpSpec::POPULATION`).
+    /// Network of SKCM-IWONN and SKCM-TLBONN (`MlpSize::Small` in the
+    /// method table; `MlpSpec::POPULATION`).
     pub small: MlpSpec,
     pub iwo: IwoSettings,
     pub tlbo: TlboTrainSettings,
@@ -290,6 +295,10 @@ mod tests {
                 auto_candidates: vec![Method::KmMaps],
                 parallel: Parallelism { threads: 3 },
                 ..d.compensator.clone()
+            },
+            joint_maps: JointMapSettings {
+                parallel: Parallelism { threads: 3 },
+                ..d.joint_maps.clone()
             },
             ..d
         };

@@ -90,7 +90,9 @@ impl StopReason {
 /// A stop reason and its figures in words.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Verdict {
+    /// Why the run stops.
     pub reason: StopReason,
+    /// The reason in words, with the figures of the test.
     pub detail: String,
 }
 
@@ -104,7 +106,9 @@ pub struct Stall {
     pub predicted: f64,
     /// The iteration budget ran out while the damping was still usable.
     pub budget_used: bool,
+    /// Trial steps made in the iteration.
     pub trials: usize,
+    /// Trial points whose residuals could not be evaluated.
     pub evaluations_failed: usize,
 }
 

@@ -47,7 +47,7 @@ fn value(j: usize, x: f64) -> String {
 }
 
 /// The program and the registers it overwrites.
-pub fn program(
+pub(super) fn program(
     data: &ControllerData,
     notes: &[String],
     registers: Option<RegisterRange>,

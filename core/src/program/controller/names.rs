@@ -22,10 +22,10 @@ use crate::solve::cell::ItemKind;
 use serde::Serialize;
 
 /// RAPID's longest identifier.
-pub const RAPID_IDENTIFIER_MAX: usize = 32;
+pub(super) const RAPID_IDENTIFIER_MAX: usize = 32;
 
 /// RAPID's reserved words.
-pub const RAPID_RESERVED: [&str; 58] = [
+pub(super) const RAPID_RESERVED: [&str; 58] = [
     "ALIAS",
     "AND",
     "BACKWARD",
@@ -90,7 +90,7 @@ pub const RAPID_RESERVED: [&str; 58] = [
 const RAPID_PREDEFINED: [&str; 3] = ["tool0", "wobj0", "load0"];
 
 /// URScript's keywords.
-pub const URSCRIPT_RESERVED: [&str; 22] = [
+pub(super) const URSCRIPT_RESERVED: [&str; 22] = [
     "and", "break", "continue", "def", "elif", "else", "end", "False", "for", "global", "halt",
     "if", "join", "kill", "local", "not", "or", "return", "run", "thread", "True", "while",
 ];
@@ -173,7 +173,7 @@ impl Renamed {
 
 /// A language's identifier rules.
 #[derive(Debug, Clone, Copy)]
-pub struct Rules {
+pub(super) struct Rules {
     pub max_len: Option<usize>,
     pub reserved: &'static [&'static str],
     pub predefined: &'static [&'static str],
@@ -182,7 +182,7 @@ pub struct Rules {
     pub frame_prefix: &'static str,
 }
 
-pub const RAPID: Rules = Rules {
+pub(super) const RAPID: Rules = Rules {
     max_len: Some(RAPID_IDENTIFIER_MAX),
     reserved: &RAPID_RESERVED,
     predefined: &RAPID_PREDEFINED,
@@ -190,7 +190,7 @@ pub const RAPID: Rules = Rules {
     frame_prefix: "wobj",
 };
 
-pub const URSCRIPT: Rules = Rules {
+pub(super) const URSCRIPT: Rules = Rules {
     max_len: None,
     reserved: &URSCRIPT_RESERVED,
     predefined: &[],
@@ -201,7 +201,7 @@ pub const URSCRIPT: Rules = Rules {
 /// The identifiers of the tools and work objects, in their order, and the
 /// items renamed.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
-pub struct Identifiers {
+pub(super) struct Identifiers {
     pub tools: Vec<String>,
     pub frames: Vec<String>,
     pub renamed: Vec<Renamed>,
@@ -215,7 +215,7 @@ fn cut(s: &str, max: Option<usize>) -> String {
 }
 
 /// The identifiers of `tools` and `frames` (names) under `rules`.
-pub fn identifiers(rules: &Rules, tools: &[&str], frames: &[&str]) -> Identifiers {
+pub(super) fn identifiers(rules: &Rules, tools: &[&str], frames: &[&str]) -> Identifiers {
     let key = |s: &str| {
         if rules.case_sensitive {
             s.to_string()

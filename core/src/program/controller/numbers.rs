@@ -26,7 +26,7 @@ pub struct NumberRange {
 }
 
 /// The numbers of `kind` in `language`; `None` where data are named.
-pub fn range(language: Language, kind: ItemKind) -> Option<NumberRange> {
+pub(super) fn range(language: Language, kind: ItemKind) -> Option<NumberRange> {
     let r = |data, last, zero| {
         Some(NumberRange {
             data,
@@ -55,7 +55,7 @@ pub struct RegisterRange {
 
 /// Largest register number accepted (the controller's own count, 100 as
 /// shipped, is not known here: the registers must exist on it).
-pub const REGISTER_MAX: u32 = 9999;
+pub(super) const REGISTER_MAX: u32 = 9999;
 
 impl RegisterRange {
     /// `first..=last`, or what is wrong with it.

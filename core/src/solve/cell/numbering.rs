@@ -52,7 +52,7 @@ pub struct AssignedNumber {
 
 /// The numbers of one kind's items, in their order: `declared[i]` is item
 /// i's name and its own number, if any (see the module docs for the rule).
-pub fn numbers(declared: &[(&str, Option<u32>)]) -> Vec<u32> {
+pub(crate) fn numbers(declared: &[(&str, Option<u32>)]) -> Vec<u32> {
     let held: std::collections::BTreeSet<u32> = declared.iter().filter_map(|(_, n)| *n).collect();
     let mut unnumbered: Vec<usize> = (0..declared.len())
         .filter(|i| declared[*i].1.is_none())
@@ -77,7 +77,7 @@ pub fn numbers(declared: &[(&str, Option<u32>)]) -> Vec<u32> {
 }
 
 /// The items of `declared` that took a number ([`numbers`]) and the number.
-pub fn assigned(kind: ItemKind, declared: &[(&str, Option<u32>)]) -> Vec<AssignedNumber> {
+pub(crate) fn assigned(kind: ItemKind, declared: &[(&str, Option<u32>)]) -> Vec<AssignedNumber> {
     numbers(declared)
         .into_iter()
         .zip(declared)
@@ -101,7 +101,11 @@ pub struct DuplicateNumber {
 }
 
 /// The first number held twice among `names` numbered `numbers`.
-pub fn duplicate(kind: ItemKind, names: &[&str], numbers: &[u32]) -> Option<DuplicateNumber> {
+pub(crate) fn duplicate(
+    kind: ItemKind,
+    names: &[&str],
+    numbers: &[u32],
+) -> Option<DuplicateNumber> {
     let mut seen: std::collections::HashMap<u32, usize> = std::collections::HashMap::new();
     for (i, n) in numbers.iter().enumerate() {
         if let Some(j) = seen.insert(*n, i) {

@@ -8,6 +8,7 @@
 //! stated per field.
 
 use crate::calibrate::external::outcome::FitLimits;
+use crate::calibrate::external::refusal::{Reason, Refusal};
 use crate::measure::external::{ExternalAxis, MeasurementSet};
 use crate::model::external::track::{CarriageTerm, LinearTrack, TrackDescription};
 use crate::model::RobotModel;
@@ -159,61 +160,11 @@ pub enum TrackRefusalReason {
     ResidualOutlier,
 }
 
-/// A track fit refused before it is stored: why, in words a user can act
-/// on, the figures, the station or reading it names, and the fit itself
-/// when one was made.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct TrackRefused {
-    pub reason: TrackRefusalReason,
-    pub message: String,
-    pub measured: Option<f64>,
-    pub needed: Option<f64>,
-    /// The station's value [mm] the refusal names.
-    pub station_mm: Option<f64>,
-    /// The reading (1-based, in the set) the refusal names.
-    pub row: Option<usize>,
-    pub fit: Option<Box<TrackFit>>,
+/// A track fit refused before it is stored: the refusal names the station
+/// or reading (the shape every external axis fit's refusal shares,
+/// [`Refusal`]).
+pub type TrackRefused = Refusal<TrackRefusalReason, TrackFit>;
+
+impl Reason for TrackRefusalReason {
+    const NAMES_STATIONS: bool = true;
 }
-
-impl TrackRefused {
-    pub fn new(reason: TrackRefusalReason, message: String) -> Self {
-        TrackRefused {
-            reason,
-            message,
-            measured: None,
-            needed: None,
-            station_mm: None,
-            row: None,
-            fit: None,
-        }
-    }
-
-    pub fn figures(mut self, measured: f64, needed: f64) -> Self {
-        self.measured = Some(measured);
-        self.needed = Some(needed);
-        self
-    }
-
-    pub fn at_station(mut self, value_mm: f64) -> Self {
-        self.station_mm = Some(value_mm);
-        self
-    }
-
-    pub fn at_row(mut self, row: usize) -> Self {
-        self.row = Some(row);
-        self
-    }
-
-    pub fn with_fit(mut self, fit: TrackFit) -> Self {
-        self.fit = Some(Box::new(fit));
-        self
-    }
-}
-
-impl std::fmt::Display for TrackRefused {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.message)
-    }
-}
-
-impl std::error::Error for TrackRefused {}

@@ -1,7 +1,8 @@
 //! The calibration methods as one table, [`METHODS`]: per method its name and
 //! aliases, display label, a description, what it fits, whether it identifies
 //! compliance or needs gravity torques, its share of the progress bar and how
-//! it runs ([`Run`]). Every list of methods derives from it: [`Method::ALL`]
+//! it runs ([`Run`]; a compensator method's base and network, the network
+//! naming which of the options' settings it trains with, `network::Network`). Every list of methods derives from it: [`Method::ALL`]
 //! and the groups, parsing with aliases, the command line's values, the
 //! report's labels and (checked by a test) the spec's enums.
 //!
@@ -38,7 +39,7 @@ pub mod veto;
 pub(crate) use failure::MethodError;
 pub use failure::MethodFailure;
 
-use super::network::Network;
+use super::network::{MlpSize, MlpTrainer, Network};
 pub(crate) use cache::Cache;
 pub(crate) use context::{Context, MethodProgress};
 pub(crate) use plan::Planner;
@@ -187,7 +188,10 @@ method_table! {
         torques: true,
         thesis: false,
         weight: 680.0,
-        run: Run::Compensated(Compensated { base: Base::Skcm, network: Network::LmMlp }),
+        run: Run::Compensated(Compensated {
+            base: Base::Skcm,
+            network: Network::Mlp { size: MlpSize::Nn, trainer: MlpTrainer::Lm },
+        }),
     }
     SkcmIwonn {
         name: "skcm-iwonn",
@@ -199,7 +203,10 @@ method_table! {
         torques: true,
         thesis: false,
         weight: 2800.0,
-        run: Run::Compensated(Compensated { base: Base::Skcm, network: Network::IwoMlp }),
+        run: Run::Compensated(Compensated {
+            base: Base::Skcm,
+            network: Network::Mlp { size: MlpSize::Small, trainer: MlpTrainer::Iwo },
+        }),
     }
     SkcmTlbonn {
         name: "skcm-tlbonn",
@@ -211,7 +218,10 @@ method_table! {
         torques: true,
         thesis: false,
         weight: 2800.0,
-        run: Run::Compensated(Compensated { base: Base::Skcm, network: Network::TlboMlp }),
+        run: Run::Compensated(Compensated {
+            base: Base::Skcm,
+            network: Network::Mlp { size: MlpSize::Small, trainer: MlpTrainer::Tlbo },
+        }),
     }
     KmGp {
         name: "km-gp",
@@ -325,6 +335,8 @@ pub enum Run {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Compensated {
     pub base: Base,
+    /// The network and which of the options' settings it trains with
+    /// ([`Network::spec`]).
     pub network: Network,
 }
 

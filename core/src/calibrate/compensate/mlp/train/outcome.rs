@@ -2,7 +2,7 @@
 
 /// What a trainer found and how it ended.
 #[derive(Debug, Clone, PartialEq)]
-pub struct TrainOutcome {
+pub(super) struct TrainOutcome {
     /// Flat weight vector in normalised units.
     pub weights: Vec<f64>,
     /// Epochs (LM), iterations (IWO) or generations (TLBO) run.
@@ -16,14 +16,14 @@ pub struct TrainOutcome {
 
 /// Why a trainer stopped, and whether the null network replaced its result.
 #[derive(Debug, Clone, PartialEq)]
-pub struct TrainStop {
+pub(super) struct TrainStop {
     pub reason: TrainStopReason,
     pub null_network: Option<NullNetwork>,
 }
 
 /// Why a trainer stopped.
 #[derive(Debug, Clone, PartialEq)]
-pub enum TrainStopReason {
+pub(super) enum TrainStopReason {
     /// LM: every one of `max_epochs` epochs ran.
     Epochs(usize),
     /// LM: the largest gradient component fell below `floor`.
@@ -40,7 +40,7 @@ pub enum TrainStopReason {
 
 /// Why the null network (it predicts the mean residual) replaced the trained one.
 #[derive(Debug, Clone, PartialEq)]
-pub enum NullNetwork {
+pub(super) enum NullNetwork {
     /// LM: no epoch beat it on the held-out part.
     NoEpochBetter,
     /// IWO, TLBO: the network does not beat it on the held-out part by
