@@ -15,9 +15,6 @@ pub mod evidence;
 pub mod identifiability;
 pub mod joint_maps;
 pub mod least_squares;
-// The methods' private modules keep `pub` items until the veto's change to
-// this folder lands; they are narrowed to `pub(crate)` after it.
-#[allow(unreachable_pub)]
 pub mod methods;
 pub mod model_file;
 pub mod network;

@@ -26,7 +26,7 @@ pub(crate) struct Cache {
 impl Cache {
     /// The bases it holds a fit (or failure) of and the compensators, with
     /// their folds, it holds a training of (for `plan::Planner`).
-    pub fn held(&self) -> (Vec<Base>, Vec<(Method, usize)>) {
+    pub(crate) fn held(&self) -> (Vec<Base>, Vec<(Method, usize)>) {
         let mut bases = Vec::new();
         if self.km.is_some() {
             bases.push(Base::Km);
@@ -50,12 +50,12 @@ impl Cache {
     }
 
     /// The KM fit, if a method has computed it.
-    pub fn km(&self) -> Option<&Fit> {
+    pub(crate) fn km(&self) -> Option<&Fit> {
         self.km.as_ref()
     }
 
     /// The KM fit, computed on first use.
-    pub fn km_fit(
+    pub(crate) fn km_fit(
         &mut self,
         ctx: &Context,
         progress: &mut dyn FnMut(usize, f64) -> bool,
@@ -74,7 +74,7 @@ impl Cache {
     }
 
     /// The SKCM fit, computed on first use (a failure is kept).
-    pub fn skcm_fit(
+    pub(crate) fn skcm_fit(
         &mut self,
         ctx: &Context,
         progress: &mut dyn FnMut(usize, f64) -> bool,

@@ -37,7 +37,7 @@ pub(crate) struct Context<'a> {
 
 impl Context<'_> {
     /// The compensators' training pool and its set's name: Q2, else Q1.
-    pub fn pool(&self) -> (&[Measurement], &'static str) {
+    pub(crate) fn pool(&self) -> (&[Measurement], &'static str) {
         if self.training.is_empty() {
             (self.ident, "identification")
         } else {
@@ -90,7 +90,7 @@ pub(crate) struct Step {
 
 impl Step {
     /// A step at `fraction` with no candidate and no fold.
-    pub fn plain(fraction: f64, iteration: usize, loss: Option<f64>) -> Self {
+    pub(crate) fn plain(fraction: f64, iteration: usize, loss: Option<f64>) -> Self {
         Step {
             fraction,
             iteration,
@@ -114,24 +114,24 @@ pub(crate) struct MethodProgress<'a> {
 
 impl MethodProgress<'_> {
     /// LM iteration `it` of at most `LmSettings::max_iterations`.
-    pub fn lm(&self, it: usize, rms: f64) -> bool {
+    pub(crate) fn lm(&self, it: usize, rms: f64) -> bool {
         let max_it = self.opts.lm.max_iterations.max(1) as f64;
         self.fraction(it as f64 / max_it, it, Some(rms))
     }
 
     /// TLBO generation `gen` (0-based) with the best eq. 7.10 cost [mm²].
-    pub fn generation(&self, gen: usize, best: f64) -> bool {
+    pub(crate) fn generation(&self, gen: usize, best: f64) -> bool {
         let generations = self.opts.tlbo.generations.max(1) as f64;
         self.fraction((gen as f64 + 1.0) / generations, gen, Some(best.sqrt()))
     }
 
     /// A fraction in [0, 1] of the method done.
-    pub fn fraction(&self, f: f64, it: usize, loss: Option<f64>) -> bool {
+    pub(crate) fn fraction(&self, f: f64, it: usize, loss: Option<f64>) -> bool {
         self.step(&Step::plain(f, it, loss))
     }
 
     /// A step of the method, with its candidate and fold.
-    pub fn step(&self, s: &Step) -> bool {
+    pub(crate) fn step(&self, s: &Step) -> bool {
         let f = if s.fraction.is_finite() {
             s.fraction.clamp(0.0, 1.0)
         } else {

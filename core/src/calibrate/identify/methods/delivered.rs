@@ -52,7 +52,7 @@ use rand_chacha::ChaCha8Rng;
 use std::sync::Arc;
 
 /// Share of a joint's drawn range an edge region holds out, at either end.
-pub const EDGE_SHARE: f64 = 0.2;
+pub(super) const EDGE_SHARE: f64 = 0.2;
 
 /// What `auto` delivers for an option: a base with or without its joint
 /// maps, and the compensator on it.
@@ -142,7 +142,7 @@ fn region_of(
 impl DeliveredRegions {
     /// The regions of `ctx`'s identification and training poses (module
     /// docs); `None` without two clusters.
-    pub fn draw(ctx: &Context) -> Option<DeliveredRegions> {
+    pub(super) fn draw(ctx: &Context) -> Option<DeliveredRegions> {
         if !clusters_drawn(ctx) {
             return None;
         }
@@ -180,7 +180,7 @@ impl DeliveredRegions {
     }
 
     /// The clusters held out and the poses they hold; the same of the edges.
-    pub fn size(&self) -> [(usize, usize); 2] {
+    pub(super) fn size(&self) -> [(usize, usize); 2] {
         let count = |edge: bool| {
             let of_kind = self
                 .regions
@@ -195,7 +195,7 @@ impl DeliveredRegions {
     /// (module docs), computed once per run; `Err` says why it could not be
     /// (a refit failed). `progress(f)` with the fraction `f` of the regions
     /// done, from inside the refits too; false cancels.
-    pub fn judge(
+    pub(super) fn judge(
         &mut self,
         ctx: &Context,
         delivery: Delivery,
@@ -234,7 +234,7 @@ impl DeliveredRegions {
     }
 
     /// `option` against `base`, both judged on these regions.
-    pub fn compare(&self, option: &Judged, base: &Judged) -> Compared {
+    pub(super) fn compare(&self, option: &Judged, base: &Judged) -> Compared {
         let pooled = |j: &Judged| {
             let e: Vec<f64> = self
                 .regions

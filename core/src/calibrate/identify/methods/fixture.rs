@@ -25,7 +25,7 @@ pub(super) struct Fixture {
 
 impl Fixture {
     /// `n` poses drawn from `ChaCha8Rng(11)` (module docs).
-    pub fn measured(n: usize) -> Fixture {
+    pub(crate) fn measured(n: usize) -> Fixture {
         let nominal = preset("ur5").unwrap();
         let mut map = JointMap::zero(1, [-7.0, 7.0], 0.1);
         map.cos[0] = 2e-4;
@@ -67,7 +67,7 @@ impl Fixture {
 
     /// `auto` weighing `km-maps`, the folds dealt from `seed`, the maps
     /// choosing among 1–4 harmonics with one ridge.
-    pub fn options(&self, seed: u64) -> CalibrationOptions {
+    pub(crate) fn options(&self, seed: u64) -> CalibrationOptions {
         let mut opts = CalibrationOptions::default();
         opts.compensator.seed = seed;
         opts.compensator.auto_candidates = vec![Method::KmMaps];
@@ -78,7 +78,7 @@ impl Fixture {
 
     /// The context of these poses under `opts`: KM identifies the joint
     /// offsets of joints 2–5.
-    pub fn context<'a>(&'a self, opts: &'a CalibrationOptions) -> Context<'a> {
+    pub(crate) fn context<'a>(&'a self, opts: &'a CalibrationOptions) -> Context<'a> {
         Context {
             nominal: &self.nominal,
             start: self.nominal.clone(),

@@ -47,7 +47,10 @@ impl Context<'_> {
         self.kept_geo.iter().chain(&self.kept_c).copied().collect()
     }
 
-    pub fn km(&self, progress: &mut dyn FnMut(usize, f64) -> bool) -> Result<Fit, Cancelled> {
+    pub(crate) fn km(
+        &self,
+        progress: &mut dyn FnMut(usize, f64) -> bool,
+    ) -> Result<Fit, Cancelled> {
         self.fit_from_start(&self.kept_geo, progress)
     }
 
@@ -94,7 +97,7 @@ impl Context<'_> {
         )
     }
 
-    pub fn skcm(
+    pub(crate) fn skcm(
         &self,
         progress: &mut dyn FnMut(usize, f64) -> bool,
     ) -> Result<MethodFit, MethodError> {
@@ -111,7 +114,7 @@ impl Context<'_> {
     }
 
     /// SKCM-C by TLBO from the KM fit `warm`.
-    pub fn skcm_tlbo(
+    pub(crate) fn skcm_tlbo(
         &self,
         warm: &Fit,
         progress: &mut dyn FnMut(usize, f64) -> bool,
@@ -151,7 +154,7 @@ impl Context<'_> {
     }
 
     /// SKCM with the payload's centre of mass, from the SKCM fit `skcm`.
-    pub fn skcm_payload(
+    pub(crate) fn skcm_payload(
         &self,
         skcm: &Fit,
         progress: &mut dyn FnMut(usize, f64) -> bool,
@@ -254,7 +257,7 @@ pub(crate) struct SkcmCCost<'a> {
 }
 
 impl<'a> SkcmCCost<'a> {
-    pub fn new(
+    pub(super) fn new(
         warm: &Fit,
         kept_geo: &[ParamId],
         kept_c: &'a [ParamId],
@@ -274,7 +277,7 @@ impl<'a> SkcmCCost<'a> {
 
     /// Upper bounds of the search: compliance up to the deflection limit at the
     /// largest torque of each loaded joint.
-    pub fn search_box(&self, max_deflection_rad: f64) -> Vec<f64> {
+    pub(super) fn search_box(&self, max_deflection_rad: f64) -> Vec<f64> {
         let mut max_tau = vec![0.0_f64; self.kept_c.len()];
         for m in self.ident {
             let c0 = chain(&self.reference, &m.q).expect("checked");
@@ -290,7 +293,7 @@ impl<'a> SkcmCCost<'a> {
     }
 
     /// The reference geometry with compliance `c`.
-    pub fn with_c(&self, c: &[f64]) -> RobotModel {
+    pub(super) fn with_c(&self, c: &[f64]) -> RobotModel {
         let mut m = self.reference.clone();
         for (id, v) in self.kept_c.iter().zip(c) {
             m.links[id.link].compliance = *v;
@@ -299,7 +302,7 @@ impl<'a> SkcmCCost<'a> {
     }
 
     /// Eq. 7.10 cost [mm²] of candidate `c` (infinite when the inner fit fails).
-    pub fn cost(&self, c: &[f64]) -> f64 {
+    pub(super) fn cost(&self, c: &[f64]) -> f64 {
         match self.solver.solve(
             &self.with_c(c),
             self.ident,

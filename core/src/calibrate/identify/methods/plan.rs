@@ -34,14 +34,14 @@ pub(crate) struct Planner {
 
 impl Planner {
     /// A plan that knows what `cache` holds.
-    pub fn from_cache(cache: &Cache) -> Self {
+    pub(crate) fn from_cache(cache: &Cache) -> Self {
         let (fitted, trained) = cache.held();
         Planner { fitted, trained }
     }
 
     /// Units of fitting `base` (and what it builds on), 0 when fitted before;
     /// marks it fitted.
-    pub fn base(&mut self, base: Base) -> f64 {
+    pub(crate) fn base(&mut self, base: Base) -> f64 {
         if self.fitted.contains(&base) {
             return 0.0;
         }
@@ -55,7 +55,7 @@ impl Planner {
 
     /// Units of training compensator `method` with `folds`-fold
     /// cross-validation, 0 when trained before; marks it trained.
-    pub fn training(&mut self, ctx: &Context, method: Method, folds: usize) -> f64 {
+    pub(crate) fn training(&mut self, ctx: &Context, method: Method, folds: usize) -> f64 {
         let Some(c) = method.compensated() else {
             return 0.0;
         };
@@ -70,7 +70,7 @@ impl Planner {
 
     /// Units of running `method` after what the plan holds; marks its work
     /// done.
-    pub fn method(&mut self, ctx: &Context, method: Method) -> f64 {
+    pub(crate) fn method(&mut self, ctx: &Context, method: Method) -> f64 {
         let row = method.row();
         match row.run {
             Run::Km => self.base(Base::Km),
@@ -97,7 +97,7 @@ impl Planner {
     }
 
     /// Units of `auto` (module docs), in the order it runs them.
-    pub fn auto(&mut self, ctx: &Context) -> f64 {
+    pub(crate) fn auto(&mut self, ctx: &Context) -> f64 {
         let folds = auto_folds(ctx);
         let bases = auto_bases(ctx);
         let mut units = 0.0;
@@ -131,7 +131,7 @@ impl Planner {
     /// units, a compensator's one training without cross-validation); 0 when
     /// no candidate would be checked. Nothing of it is cached: every region
     /// refits.
-    pub fn veto(ctx: &Context) -> f64 {
+    pub(crate) fn veto(ctx: &Context) -> f64 {
         let maps = |b: Base| match b {
             Base::KmMaps => maps_units(Method::KmMaps, Method::Km),
             Base::SkcmMaps => maps_units(Method::SkcmMaps, Method::Skcm),

@@ -16,7 +16,11 @@ use crate::model::{ModelDescription, ParamId, ParamKind};
 
 impl Context<'_> {
     /// `method`'s report of its `outcome`.
-    pub fn report(&self, method: Method, outcome: Outcome) -> Result<MethodReport, MethodFailure> {
+    pub(crate) fn report(
+        &self,
+        method: Method,
+        outcome: Outcome,
+    ) -> Result<MethodReport, MethodFailure> {
         let frames = outcome.fit.fit.session_frames.clone();
         let mut r = self.fit_report(method, outcome.fit)?;
         if !self.training.is_empty() {
