@@ -108,12 +108,9 @@ fn row(v: &[f64]) -> String {
         .join(",")
 }
 
-#[test]
-fn a_track_is_calibrated_from_a_file_and_predicts_and_solves_through_it() {
-    let mut rng = ChaCha8Rng::seed_from_u64(5);
-    let cell = Cell::new(&mut rng);
-    let dir = tempfile::tempdir().unwrap();
-    let d = dir.path();
+/// The cell's robot as its model file `robot.json` in `d` (the robot's own
+/// geometry held: what the track fit is judged on is the track).
+fn save_robot(cell: &Cell, d: &std::path::Path) {
     let model = CompensatedModel {
         calibrated: cell.truth.model.clone(),
         nominal: cell.nominal.clone(),
@@ -126,6 +123,15 @@ fn a_track_is_calibrated_from_a_file_and_predicts_and_solves_through_it() {
         &d.join("robot.json"),
     )
     .unwrap();
+}
+
+#[test]
+fn a_track_is_calibrated_from_a_file_and_predicts_and_solves_through_it() {
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let cell = Cell::new(&mut rng);
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    save_robot(&cell, d);
     let set = cell.measure(&STATIONS, 15, &mut rng);
     std::fs::write(d.join("track.csv"), write_set(&set)).unwrap();
     let held = cell.measure(&[200.0, HELD_OUT_MM, 2600.0, 3800.0], 10, &mut rng);
@@ -319,18 +325,7 @@ fn fits_the_file_cannot_carry_exit_refused_and_write_nothing() {
     let cell = Cell::new(&mut rng);
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let model = CompensatedModel {
-        calibrated: cell.truth.model.clone(),
-        nominal: cell.nominal.clone(),
-        cell_from_base: Pose::identity(),
-        payload_kg: cell.nominal.payload.mass,
-        compensator: None,
-    };
-    save_model_file(
-        &CalibratedModelFile::from_compensated(&model, "ys100", "km"),
-        &d.join("robot.json"),
-    )
-    .unwrap();
+    save_robot(&cell, d);
 
     // One reading 0.15 mm off: named, with --json the refusal on stdout.
     let mut set = cell.measure(&STATIONS[..7], 15, &mut rng);
