@@ -37,6 +37,21 @@ fn robocal(dir: &Path, args: &[&str]) -> Output {
         .unwrap()
 }
 
+/// `robocal track calibrate SET --model robot.json --out rail.json` and `extra`, run in `d`.
+fn track_calibrate(d: &Path, set: &str, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "track",
+        "calibrate",
+        set,
+        "--model",
+        "robot.json",
+        "--out",
+        "rail.json",
+    ];
+    args.extend_from_slice(extra);
+    robocal(d, &args)
+}
+
 fn code(out: &Output) -> i32 {
     out.status.code().expect("ended by a signal")
 }
@@ -137,20 +152,7 @@ fn a_track_is_calibrated_from_a_file_and_predicts_and_solves_through_it() {
     let held = cell.measure(&[200.0, HELD_OUT_MM, 2600.0, 3800.0], 10, &mut rng);
     std::fs::write(d.join("held.csv"), write_set(&held)).unwrap();
 
-    let out = robocal(
-        d,
-        &[
-            "track",
-            "calibrate",
-            "track.csv",
-            "--model",
-            "robot.json",
-            "--out",
-            "rail.json",
-            "--validate",
-            "held.csv",
-        ],
-    );
+    let out = track_calibrate(d, "track.csv", &["--validate", "held.csv"]);
     let report = text(&out.stdout);
     assert_eq!(code(&out), 0, "{report}{}", text(&out.stderr));
     print!("{report}");
@@ -331,19 +333,7 @@ fn fits_the_file_cannot_carry_exit_refused_and_write_nothing() {
     let mut set = cell.measure(&STATIONS[..7], 15, &mut rng);
     set.poses[33].xyz_mm[2] += 0.15;
     std::fs::write(d.join("off.csv"), write_set(&set)).unwrap();
-    let out = robocal(
-        d,
-        &[
-            "track",
-            "calibrate",
-            "off.csv",
-            "--model",
-            "robot.json",
-            "--out",
-            "rail.json",
-            "--json",
-        ],
-    );
+    let out = track_calibrate(d, "off.csv", &["--json"]);
     assert_eq!(code(&out), 1);
     let err = text(&out.stderr);
     assert!(
@@ -359,37 +349,13 @@ fn fits_the_file_cannot_carry_exit_refused_and_write_nothing() {
     // Four track values: too few.
     let few = cell.measure(&STATIONS[..4], 5, &mut rng);
     std::fs::write(d.join("few.csv"), write_set(&few)).unwrap();
-    let out = robocal(
-        d,
-        &[
-            "track",
-            "calibrate",
-            "few.csv",
-            "--model",
-            "robot.json",
-            "--out",
-            "rail.json",
-        ],
-    );
+    let out = track_calibrate(d, "few.csv", &[]);
     assert_eq!(code(&out), 1);
     assert!(text(&out.stderr).contains("not fitted (too_few_stations)"));
     assert!(!d.join("rail.json").exists());
 
     // The set read for the wrong column.
-    let out = robocal(
-        d,
-        &[
-            "track",
-            "calibrate",
-            "few.csv",
-            "--model",
-            "robot.json",
-            "--out",
-            "rail.json",
-            "--column",
-            "e2",
-        ],
-    );
+    let out = track_calibrate(d, "few.csv", &["--column", "e2"]);
     assert_eq!(code(&out), 1);
     assert!(text(&out.stderr).contains("not fitted (missing_column)"));
 }

@@ -146,6 +146,23 @@ impl RowStd {
 }
 
 impl MeasuredPose {
+    /// A row of joints `q_deg` (controller degrees) and a reflector point
+    /// `xyz_mm` [mm], nothing else stated (no orientation, σ, payload,
+    /// temperature, set or session).
+    pub fn position_only(q_deg: Vec<f64>, xyz_mm: [f64; 3]) -> Self {
+        MeasuredPose {
+            q_deg,
+            xyz_mm,
+            rpy_deg: None,
+            std_mm: None,
+            std_deg: None,
+            payload_kg: None,
+            temperature_c: None,
+            set: None,
+            session: None,
+        }
+    }
+
     /// Converts to SI with the model's controller conventions; `default_payload`
     /// applies when the row gives no payload.
     pub fn to_measurement(&self, model: &RobotModel, default_payload: f64) -> Measurement {

@@ -253,17 +253,7 @@ pub fn join(plan: &[PlanPoint], text: &str, opts: &JoinOptions) -> Result<Joined
                     value: *v,
                 });
             }
-            Ok(MeasuredPose {
-                q_deg: p.q_deg.clone(),
-                xyz_mm,
-                rpy_deg: None,
-                std_mm: None,
-                std_deg: None,
-                payload_kg: None,
-                temperature_c: None,
-                set: None,
-                session: None,
-            })
+            Ok(MeasuredPose::position_only(p.q_deg.clone(), xyz_mm))
         })
         .collect::<Result<_, _>>()?;
     Ok(Joined { rows, units, by })

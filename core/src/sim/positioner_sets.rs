@@ -26,17 +26,7 @@ pub fn positioner_set(
     MeasurementSet {
         poses: readings
             .iter()
-            .map(|r| MeasuredPose {
-                q_deg: Vec::new(),
-                xyz_mm: r.xyz_mm,
-                rpy_deg: None,
-                std_mm: None,
-                std_deg: None,
-                payload_kg: None,
-                temperature_c: None,
-                set: None,
-                session: None,
-            })
+            .map(|r| MeasuredPose::position_only(Vec::new(), r.xyz_mm))
             .collect(),
         external: readings
             .iter()

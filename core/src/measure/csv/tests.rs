@@ -2,17 +2,7 @@ use super::*;
 use crate::measure::SetRole;
 
 fn row(q: &[f64], xyz: [f64; 3]) -> MeasuredPose {
-    MeasuredPose {
-        q_deg: q.to_vec(),
-        xyz_mm: xyz,
-        rpy_deg: None,
-        std_mm: None,
-        std_deg: None,
-        payload_kg: None,
-        temperature_c: None,
-        set: None,
-        session: None,
-    }
+    MeasuredPose::position_only(q.to_vec(), xyz)
 }
 
 #[test]
