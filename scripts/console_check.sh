@@ -4,8 +4,14 @@
 # headless Chromium (scripts/console_check.py). Screenshots: target/console-check/.
 #
 #   scripts/console_check.sh [path/to/robocal]    (default target/debug/robocal)
+#   scripts/console_check.sh --install-only       (Chromium and Selenium only)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+INSTALL_ONLY=
+if [ "${1:-}" = "--install-only" ]; then
+    INSTALL_ONLY=1
+    shift
+fi
 BIN=${1:-target/debug/robocal}
 SELENIUM_VERSION=4.51.0
 if ! command -v chromium >/dev/null || ! command -v chromedriver >/dev/null; then
@@ -28,4 +34,5 @@ if [ ! -x "$VENV/bin/python" ]; then
     python3 -m venv "$VENV"
 fi
 "$VENV/bin/pip" install -q "selenium==$SELENIUM_VERSION"
+[ -z "$INSTALL_ONLY" ] || exit 0
 "$VENV/bin/python" scripts/console_check.py --robocal "$BIN" --out target/console-check

@@ -2,6 +2,7 @@
 # API fuzzing of `robocal serve` against openapi.yaml with Schemathesis.
 #
 #   scripts/schemathesis.sh [path/to/robocal [schemathesis options...]]
+#   scripts/schemathesis.sh --install-only   (its Python environment only)
 #
 # (robocal default: target/debug/robocal; further options go to `schemathesis
 # run`, e.g. `--include-operation-id solve` or `--report har`.)
@@ -19,14 +20,17 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+INSTALL_ONLY=
+if [ "${1:-}" = "--install-only" ]; then
+    INSTALL_ONLY=1
+    shift
+fi
 BIN=${1:-target/debug/robocal}
 shift || true
 VENV=${SCHEMATHESIS_VENV:-target/schemathesis-venv}
 VERSION=4.32.5
 MAX_EXAMPLES=${SCHEMATHESIS_MAX_EXAMPLES:-25}
 SEED=${SCHEMATHESIS_SEED:-20261122}
-
-[ -x "$BIN" ] || { echo "schemathesis.sh: $BIN not found; build it with cargo build" >&2; exit 2; }
 
 if ! "$VENV/bin/schemathesis" --version 2>/dev/null | grep -q "$VERSION"; then
     if ! python3 -m venv "$VENV" 2>/dev/null; then
@@ -38,6 +42,8 @@ if ! "$VENV/bin/schemathesis" --version 2>/dev/null | grep -q "$VERSION"; then
     fi
     "$VENV/bin/pip" install -q --disable-pip-version-check "schemathesis==$VERSION"
 fi
+[ -z "$INSTALL_ONLY" ] || exit 0
+[ -x "$BIN" ] || { echo "schemathesis.sh: $BIN not found; build it with cargo build" >&2; exit 2; }
 
 WORK=$(mktemp -d)
 SERVER_PID=

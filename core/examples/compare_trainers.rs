@@ -72,6 +72,47 @@ fn main() {
     println!("SKCM validation mean {base_mean:.4} mm (1000 training poses, 200 validation poses, {seeds} seeds)");
     println!("| trainer | network | validation mean [mm] (mean / min / max over seeds) | wall time per run [s] |");
     println!("|---|---|---|---|");
+    for (name, net, spec) in trainers() {
+        if !selected(name) {
+            continue;
+        }
+        let mut errs = Vec::new();
+        let mut secs = 0.0;
+        for seed in 0..seeds {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            let t0 = Instant::now();
+            let (c, rep) = train(&spec, &samples, &mut rng, &mut |_, _| true).unwrap();
+            secs += t0.elapsed().as_secs_f64();
+            let c = c.into_arc();
+            let e = vsamples
+                .iter()
+                .map(|s| (s.residual - c.residual_at(&s.q, &s.tau, s.payload_kg)).norm())
+                .sum::<f64>()
+                / vsamples.len() as f64
+                * 1e3;
+            if per_seed {
+                println!(
+                    "  seed {seed}: {e:.4} mm, gain {:.1} %, loss {:.4e}, {} evaluations, {}",
+                    (1.0 - e / base_mean) * 100.0,
+                    rep.loss,
+                    rep.evaluations,
+                    rep.stop
+                );
+            }
+            errs.push(e);
+        }
+        let mean = errs.iter().sum::<f64>() / errs.len() as f64;
+        let min = errs.iter().cloned().fold(f64::INFINITY, f64::min);
+        let max = errs.iter().cloned().fold(0.0, f64::max);
+        println!(
+            "| {name} | {net} | {mean:.4} / {min:.4} / {max:.4} | {:.3} |",
+            secs / seeds as f64
+        );
+    }
+}
+
+/// The trainers compared: a name, the network they train and its settings.
+fn trainers() -> Vec<(&'static str, &'static str, CompensatorSpec)> {
     let lm_small = CompensatorSpec::Mlp(MlpSettings {
         spec: MlpSpec::SMALL,
         trainer: Trainer::Lm(LmTrainSettings::default()),
@@ -89,7 +130,7 @@ fn main() {
             ..Default::default()
         }),
     });
-    for (name, net, spec) in [
+    vec![
         (
             "LM backprop (SKCM-NN)",
             "18-20-3 (q, sin q, cos q)",
@@ -127,41 +168,5 @@ fn main() {
                 ..Default::default()
             })),
         ),
-    ] {
-        if !selected(name) {
-            continue;
-        }
-        let mut errs = Vec::new();
-        let mut secs = 0.0;
-        for seed in 0..seeds {
-            let mut rng = ChaCha8Rng::seed_from_u64(seed);
-            let t0 = Instant::now();
-            let (c, rep) = train(&spec, &samples, &mut rng, &mut |_, _| true).unwrap();
-            secs += t0.elapsed().as_secs_f64();
-            let c = c.into_arc();
-            let e = vsamples
-                .iter()
-                .map(|s| (s.residual - c.residual_at(&s.q, &s.tau, s.payload_kg)).norm())
-                .sum::<f64>()
-                / vsamples.len() as f64
-                * 1e3;
-            if per_seed {
-                println!(
-                    "  seed {seed}: {e:.4} mm, gain {:.1} %, loss {:.4e}, {} evaluations, {}",
-                    (1.0 - e / base_mean) * 100.0,
-                    rep.loss,
-                    rep.evaluations,
-                    rep.stop
-                );
-            }
-            errs.push(e);
-        }
-        let mean = errs.iter().sum::<f64>() / errs.len() as f64;
-        let min = errs.iter().cloned().fold(f64::INFINITY, f64::min);
-        let max = errs.iter().cloned().fold(0.0, f64::max);
-        println!(
-            "| {name} | {net} | {mean:.4} / {min:.4} / {max:.4} | {:.3} |",
-            secs / seeds as f64
-        );
-    }
+    ]
 }

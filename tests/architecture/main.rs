@@ -16,6 +16,7 @@
 //!   floor or the floors below.
 
 mod graph;
+mod size;
 
 use graph::{import_loops, name, order_breaches, tokens, use_tree, Module, Tok, Tree};
 use std::path::Path;

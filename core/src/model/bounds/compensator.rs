@@ -306,126 +306,10 @@ mod tests {
         assert!(e.contains("compensator_orientation.network.alpha"), "{e}");
     }
 
-    /// 1e308 stands for any huge value; JSON has no NaN, so a non-finite
-    /// value reaches the check only from a caller in Rust (below).
-    #[test]
-    fn hostile_values_are_refused_naming_field_value_and_bound() {
-        let [mlp, rbf, gp] = [0, 1, 2].map(|i| trained_file(&specs()[i].1));
-        let cases = [
-            (
-                &mlp,
-                "/compensator/weights/7",
-                1e308,
-                "compensator.weights[7]",
-                "[-1e12, 1e12]",
-            ),
-            (
-                &mlp,
-                "/compensator/input_norm/scale/2",
-                -1.0,
-                "compensator.input_norm.scale[2]",
-                "[0, 1e13]",
-            ),
-            (
-                &mlp,
-                "/compensator/output_norm/scale/0",
-                0.0,
-                "compensator.output_norm.scale[0]",
-                "(0, 1e13] 1/m",
-            ),
-            (
-                &mlp,
-                "/compensator/output_norm/centre/1",
-                1e5,
-                "compensator.output_norm.centre[1]",
-                "[-100, 100] m",
-            ),
-            (
-                &rbf,
-                "/compensator/spread",
-                -0.5,
-                "compensator.spread",
-                "(0, 1000000]",
-            ),
-            (
-                &rbf,
-                "/compensator/centres/3",
-                -1e300,
-                "compensator.centres[3]",
-                "[-1000000, 1000000]",
-            ),
-            (
-                &rbf,
-                "/compensator/weights/0",
-                1e15,
-                "compensator.weights[0]",
-                "[-1e12, 1e12]",
-            ),
-            (
-                &gp,
-                "/compensator/inverse_length_scales/1",
-                -2.0,
-                "compensator.inverse_length_scales[1]",
-                "[0, 1000000] 1/rad",
-            ),
-            (
-                &gp,
-                "/compensator/signal_variance",
-                1e308,
-                "compensator.signal_variance",
-                "(0, 10000] m²",
-            ),
-            (
-                &gp,
-                "/compensator/noise_variance",
-                0.0,
-                "compensator.noise_variance",
-                "(0, 10000] m²",
-            ),
-            (
-                &gp,
-                "/compensator/alpha/4",
-                1e308,
-                "compensator.alpha[4]",
-                "[-1e30, 1e30]",
-            ),
-            (
-                &gp,
-                "/compensator/inducing/5",
-                1e4,
-                "compensator.inducing[5]",
-                "[-1000, 1000] rad",
-            ),
-            (
-                &gp,
-                "/compensator/error_scale",
-                -1.0,
-                "compensator.error_scale",
-                "(0, 1000000]",
-            ),
-            (
-                &gp,
-                "/compensator_support/fade_rad",
-                -0.1,
-                "compensator_support.fade_rad",
-                "[0, 10000] rad",
-            ),
-            (
-                &gp,
-                "/compensator_support/ranges_rad/2/1",
-                1e308,
-                "compensator_support.ranges_rad[2][1]",
-                "[-1000, 1000] rad",
-            ),
-            (
-                &mlp,
-                "/compensator_support/points_rad/0/3",
-                -1e200,
-                "compensator_support.points_rad[0][3]",
-                "[-1000, 1000] rad",
-            ),
-        ];
-        for (file, pointer, value, field, bound) in cases {
+    /// Each hostile value written at `pointer` of `file` is refused, the
+    /// message naming the field, the value and the bound it breaks.
+    fn assert_hostile_refused(file: &serde_json::Value, cases: &[(&str, f64, &str, &str)]) {
+        for &(pointer, value, field, bound) in cases {
             let e = refused(file, pointer, value.into());
             assert!(e.contains(&format!("`{field}`")), "{pointer}: {e}");
             assert!(
@@ -434,6 +318,124 @@ mod tests {
             );
             assert!(e.contains(bound), "{pointer}: {e}");
         }
+    }
+
+    /// 1e308 stands for any huge value; JSON has no NaN, so a non-finite
+    /// value reaches the check only from a caller in Rust (below).
+    #[test]
+    fn hostile_values_are_refused_naming_field_value_and_bound() {
+        let [mlp, rbf, gp] = [0, 1, 2].map(|i| trained_file(&specs()[i].1));
+        assert_hostile_refused(
+            &mlp,
+            &[
+                (
+                    "/compensator/weights/7",
+                    1e308,
+                    "compensator.weights[7]",
+                    "[-1e12, 1e12]",
+                ),
+                (
+                    "/compensator/input_norm/scale/2",
+                    -1.0,
+                    "compensator.input_norm.scale[2]",
+                    "[0, 1e13]",
+                ),
+                (
+                    "/compensator/output_norm/scale/0",
+                    0.0,
+                    "compensator.output_norm.scale[0]",
+                    "(0, 1e13] 1/m",
+                ),
+                (
+                    "/compensator/output_norm/centre/1",
+                    1e5,
+                    "compensator.output_norm.centre[1]",
+                    "[-100, 100] m",
+                ),
+                (
+                    "/compensator_support/points_rad/0/3",
+                    -1e200,
+                    "compensator_support.points_rad[0][3]",
+                    "[-1000, 1000] rad",
+                ),
+            ],
+        );
+        assert_hostile_refused(
+            &rbf,
+            &[
+                (
+                    "/compensator/spread",
+                    -0.5,
+                    "compensator.spread",
+                    "(0, 1000000]",
+                ),
+                (
+                    "/compensator/centres/3",
+                    -1e300,
+                    "compensator.centres[3]",
+                    "[-1000000, 1000000]",
+                ),
+                (
+                    "/compensator/weights/0",
+                    1e15,
+                    "compensator.weights[0]",
+                    "[-1e12, 1e12]",
+                ),
+            ],
+        );
+        assert_hostile_refused(
+            &gp,
+            &[
+                (
+                    "/compensator/inverse_length_scales/1",
+                    -2.0,
+                    "compensator.inverse_length_scales[1]",
+                    "[0, 1000000] 1/rad",
+                ),
+                (
+                    "/compensator/signal_variance",
+                    1e308,
+                    "compensator.signal_variance",
+                    "(0, 10000] m²",
+                ),
+                (
+                    "/compensator/noise_variance",
+                    0.0,
+                    "compensator.noise_variance",
+                    "(0, 10000] m²",
+                ),
+                (
+                    "/compensator/alpha/4",
+                    1e308,
+                    "compensator.alpha[4]",
+                    "[-1e30, 1e30]",
+                ),
+                (
+                    "/compensator/inducing/5",
+                    1e4,
+                    "compensator.inducing[5]",
+                    "[-1000, 1000] rad",
+                ),
+                (
+                    "/compensator/error_scale",
+                    -1.0,
+                    "compensator.error_scale",
+                    "(0, 1000000]",
+                ),
+                (
+                    "/compensator_support/fade_rad",
+                    -0.1,
+                    "compensator_support.fade_rad",
+                    "[0, 10000] rad",
+                ),
+                (
+                    "/compensator_support/ranges_rad/2/1",
+                    1e308,
+                    "compensator_support.ranges_rad[2][1]",
+                    "[-1000, 1000] rad",
+                ),
+            ],
+        );
     }
 
     #[test]
