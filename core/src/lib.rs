@@ -27,6 +27,7 @@
 #![warn(unreachable_pub)]
 
 pub mod calibrate;
+#[warn(missing_docs)]
 pub mod cell_fit;
 pub mod check;
 #[warn(missing_docs)]
