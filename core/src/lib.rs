@@ -36,6 +36,7 @@ pub mod measure;
 pub mod model;
 #[warn(missing_docs)]
 pub mod optim;
+#[warn(missing_docs)]
 pub mod plan;
 pub mod program;
 pub mod sim;
