@@ -38,6 +38,7 @@ pub mod model;
 pub mod optim;
 #[warn(missing_docs)]
 pub mod plan;
+#[warn(missing_docs)]
 pub mod program;
 pub mod sim;
 pub mod solve;
