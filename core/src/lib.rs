@@ -29,6 +29,7 @@
 pub mod calibrate;
 #[warn(missing_docs)]
 pub mod cell_fit;
+#[warn(missing_docs)]
 pub mod check;
 #[warn(missing_docs)]
 pub mod csv_write;
