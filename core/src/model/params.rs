@@ -208,8 +208,8 @@ impl ParamId {
 /// The ordered list of parameters of a model.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ParamLayout {
-    /// The parameters, in order: base, links in chain order, tool, closed loop,
-    /// then compliance.
+    /// The parameters, in the order of the value vectors (for [`Self::full`]:
+    /// base, links in chain order, tool, closed loop, compliance).
     pub ids: Vec<ParamId>,
 }
 

@@ -24,7 +24,7 @@ use serde::{Deserialize, Serialize};
 /// One parameter's predicted standard deviation, in `unit`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ParamPrediction {
-    /// The parameter's name, as the calibration reports it.
+    /// The parameter's name in the thesis's tables (`a1`, `theta2`, `c3`, …).
     pub name: String,
     /// mm, deg or rad/(N·m).
     pub unit: String,

@@ -102,7 +102,7 @@ pub enum LoadSource {
 pub struct UsedLoad {
     /// Where the load comes from.
     pub source: LoadSource,
-    /// The load: mass and centre of mass in the flange frame.
+    /// The load: mass, and centre of mass in its `frame`.
     #[serde(flatten)]
     pub load: LoadDescription,
 }

@@ -35,7 +35,7 @@ pub struct Ys100Study {
     /// The model the calibration starts from: `preset("ys100")`.
     pub nominal: RobotModel,
     /// The true robot that produced the measurements:
-    /// [`ys100_table_7_1`](crate::sim::ys100_table_7_1).
+    /// [`ys100_table_7_1`].
     pub truth: RobotModel,
     /// The calibration of KM, SKCM and SKCM-C by TLBO on the 30 identification
     /// and 45 validation poses (cf. Table 7.5).

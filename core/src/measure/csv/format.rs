@@ -93,7 +93,8 @@ pub enum CsvError {
         /// The accepted columns, as one list for the message.
         accepted: String,
     },
-    /// Two header columns mean the same value (a name and its alias).
+    /// Two header columns give the same value (a name twice, or a name and
+    /// its alias).
     #[error("line {line}: duplicate column `{column}` (column `{previous}` already given)")]
     DuplicateColumn {
         /// 1-based line of the header.
@@ -176,8 +177,8 @@ pub enum CsvError {
         /// 1-based line of the record.
         line: usize,
     },
-    /// A row gives some values of a group of columns (a quaternion, standard
-    /// deviations) but not all.
+    /// A row gives some of a non-angle orientation's values (a quaternion, a
+    /// matrix, a rotation vector) but not all.
     #[error("line {line}, columns {columns}: give all {n} values or none", n = columns.split(", ").count())]
     PartialColumns {
         /// 1-based line of the record.
@@ -213,8 +214,8 @@ pub enum CsvError {
         /// What is wrong, for the user.
         what: String,
     },
-    /// A joint reading beyond [`MAX_JOINT_DEG`], read as radians or counts
-    /// rather than degrees.
+    /// A joint reading beyond [`MAX_JOINT_DEG`]: wrong units (joint readings
+    /// are degrees).
     #[error("line {line}, column `{column}`: {} deg looks like wrong units (|q| > {max} deg; joint readings must be in degrees)", short_number(*value), max = MAX_JOINT_DEG)]
     JointUnits {
         /// 1-based line of the record.
@@ -236,7 +237,7 @@ pub enum CsvError {
         value: f64,
         /// The bound it is beyond.
         bound: crate::model::bounds::Bound,
-        /// Text after the message (a likely cause), or empty.
+        /// Text after the message naming the unit expected, or empty.
         hint: &'static str,
     },
     /// An external-axis column is empty on a row.

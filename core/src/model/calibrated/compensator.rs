@@ -20,7 +20,7 @@ pub trait Compensator: Send + Sync {
     /// The position correction [m], registered base frame, at commanded joints
     /// `q` [rad] and gravity torques `tau` [N·m] with the model's payload.
     fn residual(&self, q: &[f64], tau: &[f64]) -> Vector3<f64>;
-    /// The family's short name (`mlp`, `rbf`, `gp`), as reports and files write it.
+    /// The compensator's short name (`mlp`, `rbf`, `gp`), e.g. in debug output.
     fn name(&self) -> &str;
     /// The residual at a given payload mass [kg] (for compensators with a
     /// payload input; the default ignores it).
