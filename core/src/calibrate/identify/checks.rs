@@ -24,10 +24,10 @@ pub enum CalibrationError {
     /// No identification pose was given.
     #[error("the identification set is empty")]
     NoData,
+    /// A measurement has not one joint value per joint of the robot.
     #[error(
         "{set} measurement {index}: expected {expected} joint values for this robot, got {got}"
     )]
-    /// A measurement has not one joint value per joint of the robot.
     JointCount {
         /// The set it belongs to: `identification`, `training` or `validation`.
         set: &'static str,

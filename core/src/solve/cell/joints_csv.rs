@@ -42,10 +42,10 @@ pub enum JointsCsvError {
     /// The text is not a table (`csv_text`).
     #[error(transparent)]
     Text(#[from] TextError),
+    /// The text holds no header.
     #[error(
         "the joints file is empty: give a header `id,q1,...,qN` (N joints) and one row per reading"
     )]
-    /// The text holds no header.
     Empty,
     /// No column names a joint.
     #[error("no joint columns: the header needs q1..q{dof} (or j1..j{dof}), controller degrees")]

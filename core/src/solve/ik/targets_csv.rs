@@ -108,10 +108,10 @@ pub enum TargetsCsvError {
         /// The conventions present, comma-separated.
         names: String,
     },
+    /// A convention's orientation columns are present but not all of them.
     #[error(
         "line {line}: {convention} orientation needs columns {columns}; `{missing}` is missing"
     )]
-    /// A convention's orientation columns are present but not all of them.
     IncompleteConvention {
         /// 1-based line of the header.
         line: usize,
