@@ -38,8 +38,8 @@ pub enum CalibrationError {
         /// Joint values given.
         got: usize,
     },
-    /// A measurement's joints, position, payload mass (or its sign) or orientation is not a finite
-    /// number.
+    /// A measurement's joints, position, payload mass or orientation is not a finite number, or
+    /// its payload mass is negative.
     #[error("{set} measurement {index}: {what} is not a finite number")]
     NotFinite {
         /// The set it belongs to: `identification`, `training` or `validation`.
@@ -49,7 +49,7 @@ pub enum CalibrationError {
         /// Which value, in words.
         what: &'static str,
     },
-    /// The poses give fewer equations than the parameters to identify.
+    /// The poses give no more equations than there are parameters to identify.
     #[error("too few poses: {poses} poses give {rows} equations, but this robot has {params} identifiable parameters; measure at least {needed} poses (3 to 5 times that is better)")]
     TooFewPoses {
         /// Identification poses given.

@@ -90,7 +90,7 @@ pub struct LmReport {
 /// Result of a fit.
 #[derive(Debug, Clone)]
 pub struct Fit {
-    /// The fitted model (parameters not identified stay nominal).
+    /// The model with the fitted parameters (the others as they started).
     pub model: RobotModel,
     /// Frame corrections `E_s` per session (identity for session 0).
     pub session_frames: Vec<Pose>,

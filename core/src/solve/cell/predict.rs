@@ -159,7 +159,8 @@ pub struct PoseOut {
     pub xyz_mm: [f64; 3],
     /// Fixed-axis XYZ angles `rx, ry, rz` [deg] (`R = Rz·Ry·Rx`).
     pub rxyz_deg: [f64; 3],
-    /// The orientation in the convention asked and its values (`rotation_to`: degrees, `w ≥ 0`).
+    /// The convention asked and the orientation's values in it, in `rotation_to`'s units and
+    /// order.
     pub orientation: Option<(OrientationConvention, Vec<f64>)>,
 }
 

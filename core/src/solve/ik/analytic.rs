@@ -48,7 +48,8 @@ pub enum Structure {
 /// Why a model has no closed-form inverse kinematics.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum AnalyticError {
-    /// The model is not one of the [`Structure`]s (which condition fails).
+    /// The model is not a 6-joint arm of one of the [`Structure`]s without Hayati β (the text
+    /// says which condition fails).
     #[error("no closed-form inverse kinematics for this model: {0}")]
     Unsupported(String),
 }
