@@ -61,7 +61,7 @@ pub enum JobStatus {
     Queued,
     /// A runner works on it.
     Running,
-    /// Ended with a report and model versions.
+    /// Ended with a report (stored with the job).
     Succeeded,
     /// Ended with an error.
     Failed,
