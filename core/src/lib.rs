@@ -27,7 +27,9 @@
 #![warn(unreachable_pub)]
 
 pub mod calibrate;
+#[warn(missing_docs)]
 pub mod cell_fit;
+#[warn(missing_docs)]
 pub mod check;
 #[warn(missing_docs)]
 pub mod csv_write;
@@ -35,7 +37,9 @@ pub mod measure;
 pub mod model;
 #[warn(missing_docs)]
 pub mod optim;
+#[warn(missing_docs)]
 pub mod plan;
+#[warn(missing_docs)]
 pub mod program;
 pub mod sim;
 pub mod solve;

@@ -18,6 +18,7 @@ impl std::fmt::Display for JobStatus {
 }
 
 impl JobStatus {
+    /// The status as stored and shown: `queued`, `running`, `succeeded`, `failed` or `cancelled`.
     pub fn as_str(self) -> &'static str {
         match self {
             JobStatus::Queued => "queued",
@@ -105,10 +106,12 @@ impl Db {
             .await
     }
 
+    /// Every calibration job of robot `robot_id`, oldest first.
     pub async fn calibrations(&self, robot_id: i64) -> Result<Vec<CalibrationRow>, StoreError> {
         self.robot_rows(CAL_SELECT, "id", robot_id).await
     }
 
+    /// Calibration job `id` of robot `robot_id`, if it exists.
     pub async fn calibration(
         &self,
         robot_id: i64,
@@ -319,7 +322,9 @@ impl Db {
 pub struct JobResult<'a> {
     /// The report as JSON (mm/deg).
     pub report_json: &'a str,
+    /// The method with the lowest mean error (`JobSummary::best_method`).
     pub best_method: &'a str,
+    /// What the job reached, stored with it.
     pub summary: &'a JobSummary,
     /// One model version per method, in the order the methods ran.
     pub versions: &'a [NewVersion],
@@ -333,10 +338,15 @@ const CAL_SELECT: &str = "SELECT id, robot_id, status, phase, iteration, percent
 /// A calibration job to insert (JSON texts).
 #[derive(Debug)]
 pub struct NewCalibration<'a> {
+    /// The robot the job calibrates.
     pub robot_id: i64,
+    /// Names of the methods to run, in order.
     pub methods: &'a [String],
+    /// Ids of the identification sets.
     pub identification_set_ids: &'a [i64],
+    /// Ids of the validation sets.
     pub validation_set_ids: &'a [i64],
+    /// The calibration options as given (JSON).
     pub options: &'a Value,
     /// The start command as the runner reads it (JSON with its format).
     pub command: &'a str,

@@ -8,6 +8,7 @@ use super::{on_pool, write_for_robot, Db, Json, StoreError};
 use crate::records::{CellItemRow, CellKind, CellPut, ItemFrame, NewCellItem};
 
 impl CellKind {
+    /// The kind as stored: `tool` or `work_object`.
     pub fn as_str(self) -> &'static str {
         match self {
             CellKind::Tool => "tool",
@@ -25,6 +26,7 @@ impl CellKind {
 }
 
 impl ItemFrame {
+    /// The frame as stored: `flange`, `base` or `measurement`.
     pub fn as_str(self) -> &'static str {
         match self {
             ItemFrame::Flange => "flange",

@@ -11,12 +11,19 @@ const CHECK_SELECT: &str = "SELECT id, robot_id, set_id, version, status, mean_m
 /// A check to store.
 #[derive(Debug)]
 pub struct NewCheck<'a> {
+    /// The robot checked.
     pub robot_id: i64,
+    /// The measurement set scored.
     pub set_id: i64,
+    /// The model version it was scored against.
     pub version: i64,
+    /// The status: `ok`, `degraded`, `recalibrate` or `shifted`.
     pub status: &'a str,
+    /// Mean position error of the check poses [mm].
     pub mean_mm: f64,
+    /// Temperature of the check [°C]: the one given, else the mean of the set's readings.
     pub temperature_c: Option<f64>,
+    /// The check's result with its thresholds (JSON).
     pub result: &'a Value,
 }
 

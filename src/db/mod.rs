@@ -25,6 +25,8 @@
 //!   returns them, on both backends.
 //! - Timestamps: UTC RFC 3339 text with milliseconds, written by the database.
 
+#![warn(missing_docs)]
+
 use sqlx::postgres::{PgPool, PgPoolOptions, PgRow};
 use sqlx::sqlite::{
     SqliteConnectOptions, SqliteJournalMode, SqlitePool, SqlitePoolOptions, SqliteRow,
@@ -102,17 +104,24 @@ pub use versions::{NewVersion, Rollback};
 /// One page of a list and the length of the whole list.
 #[derive(Debug, Clone)]
 pub struct Listing<T> {
+    /// The rows of this page.
     pub rows: Vec<T>,
+    /// Rows in the whole list.
     pub total: i64,
 }
 
 /// The number of rows of every table.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct RowCounts {
+    /// Rows of `robots`.
     pub robots: i64,
+    /// Rows of `measurement_sets`.
     pub measurement_sets: i64,
+    /// Rows of `calibrations` (jobs).
     pub calibrations: i64,
+    /// Rows of `model_versions`.
     pub model_versions: i64,
+    /// Rows of `activations` (the history of active versions).
     pub activations: i64,
 }
 
@@ -135,7 +144,9 @@ pub const DEFAULT_PG_POOL: u32 = 10;
 /// Which database engine a [`Db`] talks to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Backend {
+    /// A SQLite file (the embedded default).
     Sqlite,
+    /// PostgreSQL, shared by several replicas.
     Postgres,
 }
 
@@ -150,6 +161,7 @@ impl Backend {
         }
     }
 
+    /// The backend's name: `sqlite` or `postgres`.
     pub fn name(self) -> &'static str {
         match self {
             Backend::Sqlite => "sqlite",
@@ -336,6 +348,7 @@ impl Db {
         Ok(Db { pool })
     }
 
+    /// Which database engine this store talks to.
     pub fn backend(&self) -> Backend {
         on_pool!(self, |_p, k| k)
     }

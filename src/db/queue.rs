@@ -10,10 +10,13 @@ use std::time::Duration;
 /// A job this replica has just claimed.
 #[derive(Debug, Clone, sqlx::FromRow)]
 pub struct ClaimedJob {
+    /// The job's id.
     pub id: i64,
+    /// The robot it calibrates.
     pub robot_id: i64,
     /// How many times the job was claimed, this claim included.
     pub attempts: i64,
+    /// Whether cancellation was requested.
     pub cancel_requested: bool,
 }
 
@@ -21,7 +24,10 @@ pub struct ClaimedJob {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Lease {
     /// Renewed; whether cancellation was requested meanwhile.
-    Held { cancel_requested: bool },
+    Held {
+        /// Whether cancellation was requested meanwhile.
+        cancel_requested: bool,
+    },
     /// The claim is gone (the job was deleted, handed back or taken over).
     Lost,
 }

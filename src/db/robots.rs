@@ -5,6 +5,7 @@ use crate::records::{CheckRow, NewRobot, RobotRow};
 use serde_json::{Map, Value};
 
 impl Db {
+    /// Inserts a robot and returns its stored row.
     pub async fn insert_robot(&self, r: &NewRobot<'_>) -> Result<RobotRow, StoreError> {
         Ok(on_pool!(self, |p, k| {
             let mut tx = p.begin_with(k.begin_write()).await?;
@@ -39,6 +40,7 @@ impl Db {
         .await
     }
 
+    /// Robot `id`, if it exists.
     pub async fn robot(&self, id: i64) -> Result<Option<RobotRow>, StoreError> {
         let sql = format!("{ROBOT_SELECT} WHERE r.id = $1");
         Ok(on_pool!(self, |p, k| sqlx::query_as::<_, RobotRow>(&sql)
@@ -94,6 +96,7 @@ const ROBOT_SELECT: &str = "SELECT r.id, r.name, r.preset, r.model_json, r.dof, 
 /// One page of robots and the latest check of each.
 #[derive(Debug, Clone)]
 pub struct RobotsWithChecks {
+    /// The page of robots and the total count.
     pub robots: Listing<RobotRow>,
     /// The latest check of each robot of the page that has one (any order).
     pub latest_checks: Vec<CheckRow>,

@@ -7,12 +7,16 @@ use super::{on_pool, write_for_robot, Db, StoreError};
 /// What deleting a set did.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum SetDeletion {
+    /// The set was deleted.
     Deleted,
+    /// The robot or the set does not exist.
     NotFound,
     /// Kept: the version numbers fitted or validated on it, and the queued or
     /// running calibration jobs that name it.
     InUse {
+        /// Model version numbers fitted, validated or re-registered on the set.
         versions: Vec<i64>,
+        /// Ids of the queued or running calibration jobs that read it.
         jobs: Vec<i64>,
     },
 }

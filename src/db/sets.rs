@@ -29,6 +29,7 @@ impl From<StoredRole> for SetRole {
 }
 
 impl StoredRole {
+    /// The role as stored and shown: `identification`, `training`, `validation` or `check`.
     pub fn as_str(self) -> &'static str {
         SetRole::from(self).as_str()
     }
@@ -40,6 +41,7 @@ text_enum!(AngleUnit, [Deg, Rad]);
 text_enum!(SetFormat, [Csv, Json]);
 
 impl LengthUnit {
+    /// The unit as stored: `mm` or `m`.
     pub fn as_str(self) -> &'static str {
         match self {
             LengthUnit::Mm => "mm",
@@ -49,6 +51,7 @@ impl LengthUnit {
 }
 
 impl AngleUnit {
+    /// The unit as stored: `deg` or `rad`.
     pub fn as_str(self) -> &'static str {
         match self {
             AngleUnit::Deg => "deg",
@@ -58,6 +61,7 @@ impl AngleUnit {
 }
 
 impl SetFormat {
+    /// The format as stored: `csv` or `json`.
     pub fn as_str(self) -> &'static str {
         match self {
             SetFormat::Csv => "csv",
@@ -114,10 +118,12 @@ impl Db {
         .await
     }
 
+    /// Every set of robot `robot_id`, oldest first.
     pub async fn sets(&self, robot_id: i64) -> Result<Vec<SetRow>, StoreError> {
         self.robot_rows(SET_SELECT, "id", robot_id).await
     }
 
+    /// Set `id` of robot `robot_id`, if it exists.
     pub async fn set(&self, robot_id: i64, id: i64) -> Result<Option<SetRow>, StoreError> {
         self.robot_row(SET_SELECT, "id", robot_id, id).await
     }
@@ -166,16 +172,28 @@ const SET_SELECT: &str = "SELECT id, robot_id, name, role, session, payload_kg, 
 /// A measurement set to insert.
 #[derive(Debug)]
 pub struct NewSet<'a> {
+    /// The robot the set belongs to.
     pub robot_id: i64,
+    /// The set's name.
     pub name: &'a str,
+    /// Its data role.
     pub role: StoredRole,
+    /// The tracker session it was measured in (one session per set).
     pub session: &'a str,
+    /// Payload of rows that carry none [kg], as declared.
     pub payload_kg: Option<f64>,
+    /// The length unit the upload declared.
     pub length_unit: LengthUnit,
+    /// The angle unit the upload declared.
     pub angle_unit: AngleUnit,
+    /// The format the upload came in.
     pub format: SetFormat,
+    /// The upload as received.
     pub original: &'a str,
+    /// The parsed rows (mm/deg).
     pub rows: &'a [MeasuredPose],
+    /// Number of rows.
     pub row_count: i64,
+    /// Joints per row (the robot's).
     pub dof: i64,
 }

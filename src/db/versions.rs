@@ -24,10 +24,12 @@ impl Db {
         .await
     }
 
+    /// Every model version of robot `robot_id`, by version number.
     pub async fn versions(&self, robot_id: i64) -> Result<Vec<VersionRow>, StoreError> {
         self.robot_rows(VERSION_SELECT, "version", robot_id).await
     }
 
+    /// Version `version` of robot `robot_id`, if it exists.
     pub async fn version(
         &self,
         robot_id: i64,
@@ -37,6 +39,7 @@ impl Db {
             .await
     }
 
+    /// The active version of robot `robot_id`, if one is active.
     pub async fn active_version(&self, robot_id: i64) -> Result<Option<VersionRow>, StoreError> {
         let sql = format!("{VERSION_SELECT} WHERE robot_id = $1 AND active = TRUE");
         Ok(on_pool!(self, |p, k| sqlx::query_as::<_, VersionRow>(&sql)
@@ -173,7 +176,9 @@ impl Db {
 /// Outcome of [`Db::rollback`].
 #[derive(Debug)]
 pub enum Rollback {
+    /// The previous version is active again; its row.
     Done(VersionRow),
+    /// No earlier activation to return to.
     NothingToRollBack,
 }
 
@@ -214,7 +219,11 @@ const VERSION_SELECT: &str = "SELECT id, robot_id, version, calibration_id, meth
 /// A model version to insert with a successful calibration.
 #[derive(Debug, Clone)]
 pub struct NewVersion {
+    /// Name of the method that fitted the model.
     pub method: String,
+    /// The calibrated model file (JSON).
     pub model_json: String,
+    /// The version's error statistics (identification, validation; a re-registration adds its
+    /// refit).
     pub stats: Value,
 }

@@ -5,6 +5,8 @@
 //! answers with them); neither layer owns the vocabulary, so the HTTP layer
 //! reads it here without naming the store.
 
+#![warn(missing_docs)]
+
 mod calibrations;
 mod cell;
 mod checks;

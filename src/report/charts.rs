@@ -23,8 +23,11 @@ const BOTTOM: f64 = 44.0;
 
 /// One data series of a chart.
 pub struct Series<'a> {
+    /// The series' name in the legend and tooltips.
     pub name: &'a str,
+    /// Its CSS colour.
     pub color: &'a str,
+    /// Its values, in the data's unit.
     pub values: Vec<f64>,
 }
 
@@ -214,9 +217,13 @@ pub fn ramp(t: f64) -> String {
 /// A point of a scatter view: coordinates, the value that colours it and its
 /// tooltip.
 pub struct Point {
+    /// Horizontal coordinate, in the data's unit.
     pub x: f64,
+    /// Vertical coordinate, in the data's unit.
     pub y: f64,
+    /// The value its colour shows.
     pub value: f64,
+    /// Its tooltip text.
     pub tip: String,
 }
 

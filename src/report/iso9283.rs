@@ -30,6 +30,7 @@ pub struct MeasuredSet {
 /// The test conditions the report states (`None`: not stated).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Iso9283Conditions {
+    /// The robot's name.
     pub robot: Option<String>,
     /// The model version's number or file name.
     pub model_version: Option<String>,
@@ -44,7 +45,9 @@ pub struct Iso9283Conditions {
     pub speed_percent: Option<f64>,
     /// What was measured with what (tracker, reflector, session).
     pub measurement: Option<String>,
+    /// The measurement sets the figures come from.
     pub sets: Vec<MeasuredSet>,
+    /// The version of robocal that wrote the report.
     pub robocal_version: &'static str,
 }
 
@@ -113,21 +116,34 @@ pub fn is_date(s: &str) -> bool {
 /// from [`PoseRow::ALL`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PoseRow {
+    /// `n`: cycles measured.
     Cycles,
+    /// Pose accuracy AP [mm].
     Ap,
+    /// APx [mm].
     ApX,
+    /// APy [mm].
     ApY,
+    /// APz [mm].
     ApZ,
+    /// Pose repeatability RP [mm].
     Rp,
+    /// Orientation accuracy APa [deg].
     ApA,
+    /// Orientation accuracy APb [deg].
     ApB,
+    /// Orientation accuracy APc [deg].
     ApC,
+    /// Orientation repeatability ±RPa [deg].
     RpA,
+    /// Orientation repeatability ±RPb [deg].
     RpB,
+    /// Orientation repeatability ±RPc [deg].
     RpC,
 }
 
 impl PoseRow {
+    /// Every row, in table order.
     pub const ALL: [PoseRow; 12] = [
         PoseRow::Cycles,
         PoseRow::Ap,
@@ -184,13 +200,18 @@ impl PoseRow {
 /// [`DistanceRow::ALL`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum DistanceRow {
+    /// `n`: cycles measured at both poses.
     Cycles,
+    /// The commanded distance D_c [mm].
     Commanded,
+    /// Distance accuracy AD [mm].
     Ad,
+    /// Distance repeatability ±RD [mm].
     Rd,
 }
 
 impl DistanceRow {
+    /// Every row, in table order.
     pub const ALL: [DistanceRow; 4] = [
         DistanceRow::Cycles,
         DistanceRow::Commanded,
@@ -198,6 +219,7 @@ impl DistanceRow {
         DistanceRow::Rd,
     ];
 
+    /// The characteristic's name and unit as the table heads its row.
     pub fn name(self) -> (&'static str, &'static str) {
         match self {
             DistanceRow::Cycles => ("n", "cycles"),

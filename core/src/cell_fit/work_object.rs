@@ -33,8 +33,12 @@ pub const MIN_XY_ANGLE_DEG: f64 = 10.0;
 /// The measured points of a work object (base frame, m).
 #[derive(Debug, Clone, Default)]
 pub struct WorkObjectPoints {
+    /// Touches or measurements of the origin `O` (averaged).
     pub origin: Vec<Vector3<f64>>,
+    /// Touches or measurements of the point `X` on the +x axis (averaged).
     pub x: Vec<Vector3<f64>>,
+    /// Touches or measurements of the point `Y` in the xy plane, on the +y side
+    /// (averaged).
     pub xy: Vec<Vector3<f64>>,
     /// Further points of the xy plane (checked, not fitted).
     pub plane: Vec<Vector3<f64>>,

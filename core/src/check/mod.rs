@@ -80,10 +80,14 @@ impl Default for CheckThresholds {
 /// How thresholds are written out: both levels and the margin between them.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct ThresholdsView {
+    /// Above this mean the status is `degraded` [mm].
     pub degraded_mm: f64,
     /// `recalibrate_mm − degraded_mm` (≥ 0).
     pub margin_mm: f64,
+    /// Above this mean the status is `recalibrate` [mm].
     pub recalibrate_mm: f64,
+    /// Largest ratio of the residual mean after a frame shift to the raw mean
+    /// at which the shift explains the errors.
     pub frame_shift_ratio: f64,
 }
 

@@ -48,34 +48,48 @@ const STEP_TOLERANCE_M: f64 = 1e-10;
 /// What was refitted and how well.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Reregistration {
+    /// Poses the refit used.
     pub poses: usize,
     /// The parts refitted: `measurement frame`, `tool position` and, with
     /// orientation rows, `tool orientation`.
     pub refitted: Vec<&'static str>,
     /// Errors of the model as it was, and after.
     pub before: ErrorStats,
+    /// Position errors after the refit [mm].
     pub after: ErrorStats,
+    /// Orientation errors after the refit [deg], on rows with an orientation.
     pub orientation_after: Option<AngleStats>,
     /// Condition number of the scaled problem.
     pub condition_number: f64,
+    /// Whether Gauss–Newton converged (a step moved no point by more than 1e-10 m).
     pub converged: bool,
+    /// Gauss–Newton iterations taken (at most 50).
     pub iterations: usize,
     /// How far the tool point moved [mm] and the measurement frame's change
     /// (rotation [deg], translation of the base origin [mm]).
     pub tool_shift_mm: f64,
+    /// Rotation of the measurement frame from before to after [deg].
     pub frame_rotation_deg: f64,
+    /// Translation of the base origin from before to after [mm].
     pub frame_translation_mm: f64,
 }
 
 /// Why a re-registration is refused.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ReregisterError {
+    /// The set cannot be scored.
     #[error(transparent)]
     Check(#[from] CheckError),
+    /// Fewer than [`MIN_POSES`] poses; how many were given.
     #[error("re-registration needs at least {MIN_POSES} poses, got {0}; 20–30 poses over the workspace with flange orientations at least 30° apart determine the frame and the tool")]
     TooFewPoses(usize),
+    /// The poses cannot tell the frame and the tool apart: condition beyond
+    /// [`MAX_CONDITION`].
     #[error("the poses cannot determine the measurement frame and the tool apart (condition number {condition:.1e}, at most {MAX_CONDITION:.0e}): measure 20–30 poses whose flange orientations differ by 30° or more about at least two axes")]
-    Undetermined { condition: f64 },
+    Undetermined {
+        /// Condition number of the scaled problem.
+        condition: f64,
+    },
 }
 
 /// `[v]×`.

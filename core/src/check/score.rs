@@ -16,10 +16,17 @@ pub(super) const MIN_FRAME_SHIFT_POSES: usize = 6;
 /// Why a check cannot be scored.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CheckError {
+    /// The check set is empty or does not fit the model; the message says how.
     #[error("invalid check: {0}")]
     InvalidInput(String),
+    /// A pose cannot be predicted (a joint count not the model's, kinematics failing).
     #[error("check pose {index}: {detail}")]
-    Pose { index: usize, detail: String },
+    Pose {
+        /// 1-based row of the set.
+        index: usize,
+        /// What is wrong with it.
+        detail: String,
+    },
 }
 
 /// One pose's error.
@@ -27,6 +34,7 @@ pub enum CheckError {
 pub struct PoseError {
     /// 1-based row of the set.
     pub index: usize,
+    /// Distance between the measured and the predicted position [mm].
     pub position_mm: f64,
     /// Rotation angle between measured and predicted orientation [deg].
     pub orientation_deg: Option<f64>,
@@ -35,9 +43,13 @@ pub struct PoseError {
 /// Mean, p95 and max of angle errors [deg].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct AngleStats {
+    /// Angles counted (rows with an orientation).
     pub n: usize,
+    /// Mean angle [deg].
     pub mean_deg: f64,
+    /// 95th percentile [deg].
     pub p95_deg: f64,
+    /// Largest angle [deg].
     pub max_deg: f64,
 }
 
@@ -57,11 +69,15 @@ pub struct FrameShift {
 /// A check scored.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CheckResult {
+    /// Position errors of the set [mm].
     pub position: ErrorStats,
+    /// Orientation errors [deg], when rows carry an orientation.
     pub orientation: Option<AngleStats>,
+    /// Each pose's error, in the set's order.
     pub poses: Vec<PoseError>,
     /// `None` with fewer than [`MIN_FRAME_SHIFT_POSES`] poses or collinear ones.
     pub frame_shift: Option<FrameShift>,
+    /// The status the errors give with the robot's thresholds.
     pub status: CheckStatus,
     /// One sentence on why this status.
     pub summary: String,

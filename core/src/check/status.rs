@@ -13,13 +13,20 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum CheckStatus {
+    /// Mean position error at most `degraded_mm`.
     Ok,
+    /// Mean above `degraded_mm`, at most `recalibrate_mm`, and no frame shift
+    /// explains it.
     Degraded,
+    /// Mean above `recalibrate_mm`, and no frame shift explains it.
     Recalibrate,
+    /// Mean above `degraded_mm`, explained by a rigid frame shift: the robot is
+    /// to be re-registered.
     Shifted,
 }
 
 impl CheckStatus {
+    /// Every status, in declaration order.
     pub const ALL: [CheckStatus; 4] = [
         CheckStatus::Ok,
         CheckStatus::Degraded,
@@ -27,6 +34,7 @@ impl CheckStatus {
         CheckStatus::Shifted,
     ];
 
+    /// The status's name, as serialized and as the CLI prints it (snake_case).
     pub fn name(self) -> &'static str {
         match self {
             CheckStatus::Ok => "ok",

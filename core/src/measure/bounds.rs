@@ -84,7 +84,9 @@ pub fn describe(b: &Bound) -> String {
 pub struct OutOfBounds {
     /// `q_deg[2]`, `std_mm[0]`, `temperature_c`, …
     pub field: String,
+    /// The value stored, in the bound's unit.
     pub value: f64,
+    /// The bound it is beyond.
     pub bound: Bound,
 }
 

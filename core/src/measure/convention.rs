@@ -42,7 +42,10 @@ pub enum MeasuredOrientation {
 #[derive(Debug, Clone, PartialEq)]
 pub enum OrientationValueError {
     /// The quaternion's norm is this far from 1.
-    NonUnitQuaternion { norm: f64 },
+    NonUnitQuaternion {
+        /// The norm read.
+        norm: f64,
+    },
 }
 
 impl MeasuredOrientation {

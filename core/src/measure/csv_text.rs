@@ -44,6 +44,7 @@ impl Decimal {
 pub struct Dialect {
     /// `b','`, `b';'` or `b'\t'`.
     pub delimiter: Option<u8>,
+    /// `.` or `,` as the decimal separator of numeric fields.
     pub decimal: Option<Decimal>,
 }
 
@@ -63,21 +64,36 @@ pub fn parse_delimiter(text: &str) -> Option<u8> {
 /// Why a text cannot be read as a table.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum TextError {
+    /// The delimiter given is not `,`, `;` or a tab.
     #[error("the delimiter must be `,`, `;` or a tab")]
     BadDelimiter,
+    /// The CSV reader failed (an unclosed quote, a bad encoding).
     #[error("line {line}: {message}")]
-    Malformed { line: usize, message: String },
+    Malformed {
+        /// 1-based line where the reader failed (0 when it does not say).
+        line: usize,
+        /// The reader's message.
+        message: String,
+    },
 }
 
 /// Where a record's fields and its header's columns part (see [`FieldCount`]).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Misfit {
     /// The record ends before column `column` (1-based `index`).
-    Missing { index: usize, column: String },
+    Missing {
+        /// 1-based index of the column.
+        index: usize,
+        /// The column's name.
+        column: String,
+    },
     /// Field `index` (1-based) holds `value` beyond the last column `last`.
     Extra {
+        /// 1-based index of the field.
         index: usize,
+        /// The field as written.
         value: String,
+        /// The header's last column.
         last: String,
         /// The text is `,`-separated (where a decimal comma splits a number).
         comma_delimited: bool,
@@ -120,9 +136,13 @@ impl std::fmt::Display for Misfit {
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error("line {line}: {got} fields, the header has {expected}: {misfit}")]
 pub struct FieldCount {
+    /// 1-based line of the record in the text.
     pub line: usize,
+    /// Fields in the record.
     pub got: usize,
+    /// Columns in the header.
     pub expected: usize,
+    /// Where the record and the header part.
     pub misfit: Misfit,
 }
 
@@ -131,18 +151,22 @@ pub struct FieldCount {
 pub struct Record {
     /// 1-based line of the record in the text.
     pub line: usize,
+    /// The record's fields, in header order, trimmed.
     pub fields: Vec<String>,
 }
 
 /// A text read as a header and records.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Table {
+    /// The delimiter, given or detected: `b','`, `b';'` or `b'\t'`.
     pub delimiter: u8,
     /// Whether numeric fields may use a decimal comma.
     pub decimal_comma: bool,
+    /// 1-based line of the header in the text.
     pub header_line: usize,
     /// Header names as written (trimmed).
     pub header: Vec<String>,
+    /// The records after the header, comments and blank lines left out.
     pub records: Vec<Record>,
 }
 
@@ -212,10 +236,18 @@ pub fn short_text(s: &str) -> String {
 /// A delimiter or decimal separator name that is not one.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum DialectError {
+    /// The delimiter's name is not `,`, `;` or `tab`.
     #[error("the delimiter must be `,`, `;` or `tab`, got `{value}`")]
-    Delimiter { value: String },
+    Delimiter {
+        /// The name given.
+        value: String,
+    },
+    /// The decimal separator's name is not `point` or `comma`.
     #[error("the decimal separator must be point or comma, got `{value}`")]
-    Decimal { value: String },
+    Decimal {
+        /// The name given.
+        value: String,
+    },
 }
 
 /// Delimiter and decimal separator by name (`,` / `;` / `tab`, `point` /

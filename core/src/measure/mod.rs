@@ -16,13 +16,21 @@ use crate::model::RobotModel;
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
+// `missing_docs` is warned module by module and item by item rather than
+// on the whole floor: the external axes' readings (`external`) are not
+// documented item by item yet.
+#[warn(missing_docs)]
 pub mod bounds;
+#[warn(missing_docs)]
 pub mod convention;
+#[warn(missing_docs)]
 pub mod csv;
+#[warn(missing_docs)]
 pub mod csv_text;
 pub mod external;
 
 /// Role of a measurement in the calibration (docs/design.md "Data roles").
+#[warn(missing_docs)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SetRole {
@@ -38,6 +46,7 @@ pub enum SetRole {
     Check,
 }
 
+#[warn(missing_docs)]
 impl SetRole {
     /// Every role, in the order lists and messages name them.
     pub const ALL: [SetRole; 4] = [
@@ -47,6 +56,8 @@ impl SetRole {
         SetRole::Check,
     ];
 
+    /// The role named by `s` (case-insensitive; `identify`, `train`, `validate`
+    /// and `q1`..`q3` too), or `None`.
     pub fn parse(s: &str) -> Option<SetRole> {
         match s.trim().to_ascii_lowercase().as_str() {
             "identification" | "identify" | "q1" => Some(SetRole::Identification),
@@ -56,6 +67,7 @@ impl SetRole {
             _ => None,
         }
     }
+    /// The role's name in CSV `set` fields, the API and messages.
     pub fn as_str(&self) -> &'static str {
         match self {
             SetRole::Identification => "identification",
@@ -78,6 +90,7 @@ impl SetRole {
 }
 
 /// One measured pose in boundary units (mm, deg), as in the CSV.
+#[warn(missing_docs)]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MeasuredPose {
     /// Controller joint readings [deg].
@@ -93,10 +106,14 @@ pub struct MeasuredPose {
     /// Standard deviations of the measured `rx, ry, rz` [deg] (CSV `std_rx, std_ry, std_rz`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub std_deg: Option<[f64; 3]>,
+    /// Payload mass at this pose [kg] (CSV `payload_kg`; `None`: the model's
+    /// default payload).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub payload_kg: Option<f64>,
+    /// Temperature during the measurement [°C] (CSV `temperature_c`), when given.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub temperature_c: Option<f64>,
+    /// The set the pose belongs to (CSV `set`), when given.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub set: Option<SetRole>,
     /// Tracker-session label (CSV `session` column), when given.
@@ -105,6 +122,7 @@ pub struct MeasuredPose {
 }
 
 /// One measured pose in SI units, ready for identification.
+#[warn(missing_docs)]
 #[derive(Debug, Clone, PartialEq)]
 pub struct Measurement {
     /// Model-convention joint values [rad].
@@ -126,6 +144,7 @@ pub struct Measurement {
 /// per-axis figures (`√((σx² + σy² + σz²)/3)`): the fit works in the registered
 /// base frame, where the tracker's axes are rotated, so a row's weight is one
 /// figure for its position and one for its orientation.
+#[warn(missing_docs)]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RowStd {
     /// Position [m].
@@ -134,6 +153,7 @@ pub struct RowStd {
     pub orientation: Option<f64>,
 }
 
+#[warn(missing_docs)]
 impl RowStd {
     /// From the CSV's per-axis figures (mm, deg).
     pub fn from_axes(std_mm: [f64; 3], std_deg: Option<[f64; 3]>) -> RowStd {
@@ -145,6 +165,7 @@ impl RowStd {
     }
 }
 
+#[warn(missing_docs)]
 impl MeasuredPose {
     /// A row of joints `q_deg` (controller degrees) and a reflector point
     /// `xyz_mm` [mm], nothing else stated (no orientation, σ, payload,
@@ -183,6 +204,7 @@ impl MeasuredPose {
 }
 
 /// Converts rows to SI measurements.
+#[warn(missing_docs)]
 pub fn to_measurements(
     model: &RobotModel,
     rows: &[MeasuredPose],

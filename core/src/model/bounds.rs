@@ -23,8 +23,11 @@ pub mod outputs;
 /// A closed interval `[min, max]` in `unit`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Bound {
+    /// Lowest value accepted, in `unit`.
     pub min: f64,
+    /// Highest value accepted, in `unit`.
     pub max: f64,
+    /// The unit messages name (`mm`, `deg`, `kg`, …).
     pub unit: &'static str,
 }
 

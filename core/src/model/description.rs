@@ -36,11 +36,16 @@ fn invalid(field: impl Into<String>, reason: impl Into<String>) -> ModelError {
     }
 }
 
+/// Which DH convention the joint rows are written in (module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum DhConvention {
+    /// Craig's modified DH: row i holds α_{i-1}, a_{i-1}, d_i, θ_i (thesis eq.
+    /// 4.1); the default.
     #[default]
     Modified,
+    /// Distal (standard) DH: row i holds a_i, α_i, d_i, θ_i, regrouped into the
+    /// modified form on import.
     Standard,
 }
 
@@ -48,16 +53,23 @@ pub enum DhConvention {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct JointDescription {
+    /// Twist α [deg]: α_{i-1} (modified) or α_i (standard).
     #[serde(default)]
     pub alpha_deg: f64,
+    /// Length a [mm]: a_{i-1} (modified) or a_i (standard).
     #[serde(default)]
     pub a_mm: f64,
+    /// Hayati twist β_{i-1} about y [deg] (modified only: the base row and
+    /// parallel links).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub beta_deg: f64,
+    /// Base offset b0 along y [mm] (modified, first row only).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub b_mm: f64,
+    /// Offset d_i along z_i [mm].
     #[serde(default)]
     pub d_mm: f64,
+    /// Offset θ_i added to the joint value [deg].
     #[serde(default)]
     pub theta_offset_deg: f64,
     /// Hayati link; when omitted, whether the row has a β or its axis is
@@ -68,16 +80,23 @@ pub struct JointDescription {
         deserialize_with = "some_bool"
     )]
     pub parallel: Option<bool>,
+    /// Joint limits, model convention [deg], in either order (default ±180°).
     #[serde(default = "default_limits")]
     pub limits_deg: [f64; 2],
+    /// Controller convention, 1 or −1: `q_model = sign · q_ctrl + zero` (default 1).
     #[serde(default = "one")]
     pub sign: f64,
+    /// Controller zero offset [deg].
     #[serde(default)]
     pub zero_deg: f64,
+    /// Link mass [kg].
     #[serde(default)]
     pub mass_kg: f64,
+    /// Link centre of mass in the row's link frame [mm] (distal frames in the
+    /// standard convention).
     #[serde(default)]
     pub com_mm: [f64; 3],
+    /// Joint compliance `c_i = 1/k_i` [rad/(N·m)] (eq. 2.5); 0 is rigid.
     #[serde(default)]
     pub compliance_rad_per_nm: f64,
 }
@@ -95,9 +114,12 @@ fn default_gravity() -> [f64; 3] {
     [0.0, 0.0, -G0]
 }
 
+/// The tool in the flange frame (eq. 4.4 extended to a full 6-D transform), mm
+/// and degrees.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ToolDescription {
+    /// TCP position in the flange frame [mm].
     #[serde(default)]
     pub xyz_mm: [f64; 3],
     /// `[rx, ry, rz]`, tool rotation `Rz(rz)·Ry(ry)·Rx(rx)`.
@@ -105,15 +127,21 @@ pub struct ToolDescription {
     pub rpy_deg: [f64; 3],
 }
 
+/// An HH800-style parallelogram driving a passive joint (§4.2.1, eqs. 4.5,
+/// 4.10), mm and degrees.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ClosedLoopDescription {
     /// 1-based index of the passive joint (3 on the HH800).
     #[serde(deserialize_with = "joint_number")]
     pub passive_joint: usize,
+    /// RS, the lever fixed to the upper arm [mm] (positive).
     pub l3_mm: f64,
+    /// QR, the rod [mm] (positive).
     pub l4_mm: f64,
+    /// PQ, the crank [mm] (positive).
     pub l5_mm: f64,
+    /// Constant angle ξ of eq. 4.10 [deg].
     pub xi_deg: f64,
 }
 
@@ -134,9 +162,11 @@ fn joint_number<'de, D: serde::Deserializer<'de>>(d: D) -> Result<usize, D::Erro
     }
 }
 
+/// The default payload carried at the tool, kg and mm.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PayloadDescription {
+    /// Payload mass [kg].
     #[serde(default)]
     pub mass_kg: f64,
     /// Centre of mass, in the frame `com_frame` names.
@@ -173,19 +203,28 @@ impl PayloadFrame {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ModelDescription {
+    /// The model's name (at most [`NAME_MAX_CHARS`] characters).
     #[serde(default)]
     pub name: String,
+    /// Convention of the joint rows (default modified).
     #[serde(default)]
     pub convention: DhConvention,
+    /// One row per active joint, base first.
     pub joints: Vec<JointDescription>,
+    /// The tool in the flange frame (default: the flange itself).
     #[serde(default)]
     pub tool: ToolDescription,
+    /// The closed loop, for a robot with one (HH800).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub closed_loop: Option<ClosedLoopDescription>,
+    /// The default payload (a measurement may override the mass).
     #[serde(default)]
     pub payload: PayloadDescription,
+    /// Gravity in the base frame [m/s²] (default `[0, 0, −9.80665]`; a ceiling
+    /// robot: +z).
     #[serde(default = "default_gravity")]
     pub gravity_mps2: [f64; 3],
+    /// Assumptions behind values the source does not give, as text.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub assumptions: Vec<String>,
     /// Per-joint angle error maps of a calibrated model (degrees).
@@ -553,11 +592,14 @@ fn standard_links(links: Vec<(Link, Option<bool>, bool)>, tool: Tool) -> (Vec<Li
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PoseDescription {
+    /// Translation [mm].
     pub xyz_mm: [f64; 3],
+    /// Fixed-axis angles `[rx, ry, rz]` [deg].
     pub rpy_deg: [f64; 3],
 }
 
 impl PoseDescription {
+    /// The pose `p` in millimetres and degrees.
     pub fn from_pose(p: &Pose) -> Self {
         PoseDescription {
             xyz_mm: [p.p.x / MM, p.p.y / MM, p.p.z / MM],

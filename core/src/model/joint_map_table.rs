@@ -194,6 +194,8 @@ pub struct TabulatedMap {
 }
 
 impl TabulatedMap {
+    /// `map` with its table ([`MapTable::new`]), or with none where the table
+    /// would need too many intervals.
     pub fn new(map: &JointMap) -> Self {
         TabulatedMap {
             map: map.clone(),
@@ -232,10 +234,12 @@ impl AngleError for TabulatedMap {
 /// Every joint's map tabulated: [`JointMaps`] as the IK evaluates it.
 #[derive(Debug, Clone)]
 pub struct TabulatedMaps {
+    /// Per joint, its tabulated map (`None`: that joint has no map).
     pub joints: Vec<Option<TabulatedMap>>,
 }
 
 impl TabulatedMaps {
+    /// Tabulates every joint's map of `maps`.
     pub fn new(maps: &JointMaps) -> Self {
         TabulatedMaps {
             joints: maps

@@ -74,8 +74,11 @@ fn smoothstep(x: f64) -> [f64; 3] {
 /// `f''` [1/rad].
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct MapTaylor {
+    /// `f` [rad].
     pub value: f64,
+    /// `f'` (dimensionless).
     pub slope: f64,
+    /// `f''` [1/rad].
     pub curvature: f64,
 }
 
@@ -253,21 +256,47 @@ impl JointMap {
 /// Why a stored joint map is refused.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum JointMapError {
+    /// The cosine and sine coefficients differ in number.
     #[error("joint map: {cos} cosine but {sin} sine coefficients")]
-    Shape { cos: usize, sin: usize },
+    Shape {
+        /// Cosine coefficients stored.
+        cos: usize,
+        /// Sine coefficients stored.
+        sin: usize,
+    },
+    /// A coefficient, the range or the fade is not finite.
     #[error("joint map: a coefficient or the range is not finite")]
     NotFinite,
+    /// The range's ends are reversed or the fade is negative.
     #[error("joint map: range [{lo}, {hi}] rad with fade {fade} rad is not a range")]
-    Range { lo: f64, hi: f64, fade: f64 },
+    Range {
+        /// Lower end [rad].
+        lo: f64,
+        /// Upper end [rad].
+        hi: f64,
+        /// Fade width [rad].
+        fade: f64,
+    },
+    /// The maps are not one entry per joint.
     #[error("joint maps: {maps} maps for a robot with {dof} joints")]
-    Count { maps: usize, dof: usize },
+    Count {
+        /// Entries stored.
+        maps: usize,
+        /// Joints of the robot.
+        dof: usize,
+    },
+    /// A map has more than [`MAX_HARMONICS`] harmonics.
     #[error("joint map: {got} harmonics, at most {MAX_HARMONICS}")]
-    Harmonics { got: usize },
+    Harmonics {
+        /// Harmonics stored.
+        got: usize,
+    },
 }
 
 /// The maps of every joint (`None`: that joint has no map).
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct JointMaps {
+    /// Per joint, its map (`None`: that joint has none).
     pub joints: Vec<Option<JointMap>>,
 }
 
@@ -391,9 +420,13 @@ pub const MAX_DESCRIBED_DEG: f64 = 1e6;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct JointMapDescription {
+    /// Start of the trained range, model convention [deg].
     pub start_deg: f64,
+    /// Width of the trained range [deg].
     pub span_deg: f64,
+    /// Width of the fade to zero outside the range [deg].
     pub fade_deg: f64,
+    /// Per harmonic k = 1..=K, `[a_k, b_k]` (cos, sin) [deg].
     pub harmonics_deg: Vec<[f64; 2]>,
 }
 
@@ -403,6 +436,7 @@ pub struct JointMapDescription {
 pub struct JointMapsDescription(pub Vec<Option<JointMapDescription>>);
 
 impl JointMapsDescription {
+    /// The description of `maps`, in degrees.
     pub fn from_maps(maps: &JointMaps) -> Self {
         JointMapsDescription(
             maps.joints

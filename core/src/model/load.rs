@@ -98,6 +98,7 @@ pub struct LoadDescription {
     /// Centre of mass [mm] in `frame`.
     #[serde(default)]
     pub com_mm: [f64; 3],
+    /// The frame of `com_mm` (default: the flange).
     #[serde(default)]
     pub frame: LoadFrame,
     /// Principal moments of inertia [kg·m²], optional.

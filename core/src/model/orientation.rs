@@ -148,45 +148,64 @@ impl FromStr for OrientationConvention {
 /// Why a set of orientation values could not be turned into a rotation.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
 pub enum OrientationError {
+    /// No convention has this name or alias.
     #[error(
         "unknown orientation convention '{name}'; expected one of: quaternion (aliases quat, \
          wxyz, abb), kuka_abc (abc, kuka), fanuc_wpr (wpr, fanuc), matrix (rotation_matrix), \
          ur_rotvec (rotvec, rotation_vector; radians), abb_q1q4 (q1q4)"
     )]
-    UnknownConvention { name: String },
+    UnknownConvention {
+        /// The name given.
+        name: String,
+    },
 
+    /// The number of values is not the convention's.
     #[error(
         "{convention} orientation needs {expected} values ({columns}), got {got}",
         columns = convention.column_names().join(", ")
     )]
     WrongCount {
+        /// The convention the values are read in.
         convention: OrientationConvention,
+        /// Values the convention takes.
         expected: usize,
+        /// Values given.
         got: usize,
     },
 
+    /// A value is not finite.
     #[error(
         "{convention} orientation value '{column}' (position {index}) is {value}; all values \
          must be finite numbers"
     )]
     NotFinite {
+        /// The convention the values are read in.
         convention: OrientationConvention,
         /// Zero-based position in the values slice.
         index: usize,
         /// CSV column name of the offending value.
         column: &'static str,
+        /// The value read.
         value: f64,
     },
 
+    /// A quaternion's norm is not 1 within [`QUATERNION_NORM_TOLERANCE`].
     #[error(
         "quaternion (w,x,y,z) has norm {norm:.4}; expected a unit quaternion (|norm - 1| <= \
          {QUATERNION_NORM_TOLERANCE:e}). Check the column order (w first) and that the values \
          are not scaled or truncated"
     )]
-    NonUnitQuaternion { norm: f64 },
+    NonUnitQuaternion {
+        /// The norm read.
+        norm: f64,
+    },
 
+    /// A matrix is not orthonormal within tolerance, or is a reflection.
     #[error("matrix is not a rotation: {detail}")]
-    NotARotation { detail: String },
+    NotARotation {
+        /// How far the matrix is from a rotation.
+        detail: String,
+    },
 }
 
 // ---------------------------------------------------------------------------

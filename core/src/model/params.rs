@@ -10,27 +10,46 @@
 use super::robot::RobotModel;
 use serde::{Deserialize, Serialize};
 
+/// What a parameter is (its unit follows from it; module docs give the names).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum ParamKind {
+    /// Twist α about x [rad] (thesis `alpha{k}`).
     Alpha,
+    /// Length a along x [m] (thesis `a{k}`).
     A,
+    /// Hayati twist β about y [rad], base and parallel links (thesis `beta{k}`).
     Beta,
+    /// Base offset b along y [m] (thesis `b0`).
     B,
+    /// Offset d along z [m] (thesis `d{k+1}`).
     D,
+    /// Joint angle offset θ [rad] (thesis `theta{k+1}`).
     Theta,
+    /// Tool x in the flange frame [m].
     ToolX,
+    /// Tool y in the flange frame [m].
     ToolY,
+    /// Tool z in the flange frame [m].
     ToolZ,
+    /// Tool rotation about x [rad].
     ToolRx,
+    /// Tool rotation about y [rad].
     ToolRy,
+    /// Tool rotation about z [rad].
     ToolRz,
+    /// Closed loop's lever RS [m], fixed for scale in identification.
     LoopL3,
+    /// Closed loop's rod QR [m].
     LoopL4,
+    /// Closed loop's crank PQ [m].
     LoopL5,
+    /// Joint compliance `c_{k+1}` [rad/(N·m)].
     Compliance,
     /// Payload centre of mass in the tool frame, x, y, z (for `skcm-payload`).
     PayloadX,
+    /// Payload centre of mass y in the tool frame [m] (for `skcm-payload`).
     PayloadY,
+    /// Payload centre of mass z in the tool frame [m] (for `skcm-payload`).
     PayloadZ,
     /// Payload mass every pose carries beyond its declared payload [kg] (an
     /// unknown tool or adapter; for `skcm-payload`).
@@ -40,24 +59,32 @@ pub enum ParamKind {
 /// Physical unit class of a parameter (for display and scaling).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ParamUnit {
+    /// Metres (shown as mm).
     Length,
+    /// Radians (shown as degrees).
     Angle,
+    /// rad/(N·m).
     Compliance,
+    /// Kilograms.
     Mass,
 }
 
 /// One scalar parameter: its kind and the 0-based link it belongs to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct ParamId {
+    /// What the parameter is.
     pub kind: ParamKind,
+    /// The 0-based link it belongs to (0 for the tool, the loop and the payload).
     pub link: usize,
 }
 
 impl ParamId {
+    /// The parameter `kind` of link `link`.
     pub const fn new(kind: ParamKind, link: usize) -> Self {
         ParamId { kind, link }
     }
 
+    /// The parameter's SI unit class.
     pub fn unit(&self) -> ParamUnit {
         use ParamKind::*;
         match self.kind {
@@ -181,6 +208,8 @@ impl ParamId {
 /// The ordered list of parameters of a model.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ParamLayout {
+    /// The parameters, in the order of the value vectors (for [`Self::full`]:
+    /// base, links in chain order, tool, closed loop, compliance).
     pub ids: Vec<ParamId>,
 }
 
@@ -222,18 +251,22 @@ impl ParamLayout {
         ParamLayout { ids }
     }
 
+    /// Number of parameters.
     pub fn len(&self) -> usize {
         self.ids.len()
     }
 
+    /// Whether the layout lists no parameter.
     pub fn is_empty(&self) -> bool {
         self.ids.is_empty()
     }
 
+    /// Position of `id` in the layout, if listed.
     pub fn index_of(&self, id: ParamId) -> Option<usize> {
         self.ids.iter().position(|x| *x == id)
     }
 
+    /// The thesis's names of the parameters, in order.
     pub fn names(&self) -> Vec<String> {
         self.ids.iter().map(|i| i.name()).collect()
     }

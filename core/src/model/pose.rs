@@ -26,6 +26,7 @@ impl Default for Pose {
 }
 
 impl Pose {
+    /// The identity transform.
     pub fn identity() -> Self {
         Pose {
             r: Matrix3::identity(),
@@ -33,10 +34,12 @@ impl Pose {
         }
     }
 
+    /// The transform with rotation `r` and translation `p`.
     pub fn new(r: Matrix3<f64>, p: Vector3<f64>) -> Self {
         Pose { r, p }
     }
 
+    /// A pure translation by `p`.
     pub fn from_translation(p: Vector3<f64>) -> Self {
         Pose {
             r: Matrix3::identity(),
@@ -52,6 +55,7 @@ impl Pose {
         }
     }
 
+    /// The inverse transform, `(Rᵀ, −Rᵀ·p)`.
     pub fn inverse(&self) -> Pose {
         let rt = self.r.transpose();
         Pose {
@@ -65,12 +69,15 @@ impl Pose {
         self.r * x + self.p
     }
 
+    /// The child frame's x axis in the parent frame (first column of `r`).
     pub fn x_axis(&self) -> Vector3<f64> {
         self.r.column(0).into_owned()
     }
+    /// The child frame's y axis in the parent frame (second column of `r`).
     pub fn y_axis(&self) -> Vector3<f64> {
         self.r.column(1).into_owned()
     }
+    /// The child frame's z axis in the parent frame (third column of `r`).
     pub fn z_axis(&self) -> Vector3<f64> {
         self.r.column(2).into_owned()
     }

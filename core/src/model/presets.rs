@@ -13,6 +13,7 @@ use super::description::{
 use super::error::ModelError;
 use super::robot::{RobotModel, G0};
 
+/// Names of the built-in robot models [`preset`] knows.
 pub const PRESETS: [&str; 4] = ["ys100", "hh800", "ur5", "ur10"];
 
 fn row(alpha_deg: f64, a_mm: f64, d_mm: f64, limits_deg: [f64; 2]) -> JointDescription {

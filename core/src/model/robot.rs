@@ -59,6 +59,9 @@ pub struct Link {
 }
 
 impl Link {
+    /// A link with twist `alpha` [rad], length `a` [m], offset `d` [m] and
+    /// angle offset `theta` [rad]; no β or b, limits ±π, rigid and massless,
+    /// controller readings equal to the model's joint values (sign 1, zero 0).
     pub fn new(alpha: f64, a: f64, d: f64, theta: f64) -> Self {
         Link {
             alpha,
@@ -148,9 +151,13 @@ impl Default for Payload {
 /// A complete robot model (SI units). See the module header for conventions.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RobotModel {
+    /// The model's name.
     pub name: String,
+    /// The links, base link first, one per active joint.
     pub links: Vec<Link>,
+    /// The tool relative to the flange.
     pub tool: Tool,
+    /// The closed loop, for a robot with one (HH800).
     pub closed_loop: Option<ClosedLoop>,
     /// Default payload (a measurement may override the mass).
     pub payload: Payload,
@@ -199,6 +206,7 @@ impl RobotModel {
         self.links.iter().map(|l| l.compliance).collect()
     }
 
+    /// Whether any joint has a nonzero compliance.
     pub fn has_compliance(&self) -> bool {
         self.links.iter().any(|l| l.compliance != 0.0)
     }

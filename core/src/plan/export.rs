@@ -15,31 +15,50 @@ use serde::{Deserialize, Serialize};
 /// One planned pose: its point name and controller joints [deg].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PlanPoint {
+    /// The point's name (`P1`, `P2`, … in a made plan), which the tracker
+    /// export joins by.
     pub name: String,
+    /// Joint values in the controller convention [deg], `q1..qN`.
     pub q_deg: Vec<f64>,
 }
 
 /// Why a plan CSV cannot be read or exported.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum PlanCsvError {
+    /// The text is not a readable CSV; the reader's message.
     #[error("the plan CSV: {0}")]
     Text(String),
+    /// The CSV has no data rows.
     #[error("the plan CSV has no data rows")]
     Empty,
+    /// The header lacks `point` or `q1`; the header as read.
     #[error("the plan CSV's header needs `point` and `q1`, `q2`, …; got {0}")]
     Header(String),
+    /// A joint value is not a finite number.
     #[error("the plan CSV, line {line}: `{field}` is not a number")]
-    Number { line: usize, field: String },
+    Number {
+        /// 1-based line of the record in the text.
+        line: usize,
+        /// The field as read (shortened).
+        field: String,
+    },
+    /// A record's field count differs from the header's.
     #[error("the plan CSV, {0}")]
     Fields(#[from] FieldCount),
+    /// A joint value is beyond the bound of a controller joint reading.
     #[error("the plan CSV, line {line}, column `{column}`: {} deg is beyond the bound ±{} deg (controller degrees)", show(*value), JOINT_DEG.max)]
     Joint {
+        /// 1-based line of the record in the text.
         line: usize,
+        /// The joint's column, as the header names it.
         column: String,
+        /// The value read [deg].
         value: f64,
     },
+    /// A point name appears twice; the name.
     #[error("the plan CSV: point `{0}` appears twice")]
     Duplicate(String),
+    /// A program needs 6 axes; the plan's number of joints.
     #[error("programs take 6 axes; this plan has {0}")]
     Axes(usize),
 }

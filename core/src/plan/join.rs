@@ -16,7 +16,9 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Units {
+    /// Millimetres.
     Mm,
+    /// Metres (scaled by 1000 into the measurement CSV).
     M,
     /// From the header (`x_mm`, `x [m]`, …), else from the points' spread.
     Detect,
@@ -28,14 +30,18 @@ pub enum Units {
 pub enum JoinBy {
     /// By name (or 1-based index) when the export has a name column, else by order.
     Detect,
+    /// By the name column (a plan point's name, case-insensitive, or its 1-based index).
     Name,
+    /// By order: the n-th tracker point is the n-th plan point.
     Order,
 }
 
 /// Join options.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct JoinOptions {
+    /// The export's position units (`Detect`: from the header, else the points' spread).
     pub units: Units,
+    /// How tracker points find their plan points.
     pub by: JoinBy,
 }
 
@@ -51,8 +57,12 @@ impl Default for JoinOptions {
 /// The joined measurement set and how it was joined.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Joined {
+    /// The measurement rows, in plan order: controller joints [deg] and tracker
+    /// positions [mm].
     pub rows: Vec<MeasuredPose>,
+    /// The units the export was read in (never `Detect`).
     pub units: Units,
+    /// How the points were matched (never `Detect`).
     pub by: JoinBy,
 }
 
@@ -64,30 +74,61 @@ const MM_ABOVE: f64 = 50.0;
 /// Why a tracker export does not join.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum JoinError {
+    /// The text is not a readable CSV; the reader's message.
     #[error("the tracker export: {0}")]
     Text(String),
+    /// The export has no points.
     #[error("the tracker export has no points")]
     Empty,
+    /// The header lacks an x, y or z column; the header as read.
     #[error("the tracker export's header needs x, y and z columns (and optionally point/name/id/index); got {0}")]
     Header(String),
+    /// A coordinate is not a finite number.
     #[error("the tracker export, line {line}: `{field}` is not a number")]
-    Number { line: usize, field: String },
+    Number {
+        /// 1-based line of the record in the text.
+        line: usize,
+        /// The field as read (shortened).
+        field: String,
+    },
+    /// A record's field count differs from the header's.
     #[error("the tracker export, {0}")]
     Fields(#[from] FieldCount),
+    /// Joining by name was asked, but the export has no name column.
     #[error("the tracker export has no point name column, so it can only join by order")]
     NoNames,
+    /// A point name appears twice in the export; the name.
     #[error("the tracker export has point `{0}` twice")]
     Duplicate(String),
+    /// Plan points the export does not have, by name.
     #[error("plan points missing from the tracker export: {}", .0.join(", "))]
     Missing(Vec<String>),
+    /// Export points that name no plan point.
     #[error("tracker points that are not in the plan: {}", .0.join(", "))]
     Extra(Vec<String>),
+    /// Joining by order, the export has not as many points as the plan.
     #[error("joining by order: the plan has {plan} points, the tracker export {tracker}")]
-    Count { plan: usize, tracker: usize },
+    Count {
+        /// Points in the plan.
+        plan: usize,
+        /// Points in the tracker export.
+        tracker: usize,
+    },
+    /// A coordinate, in millimetres, is beyond the bound of a measured position.
     #[error("tracker point {point}: {} mm (in millimetres) is beyond the bound ±{} mm of a measured position", show(*value), POSITION_MM.max)]
-    OutOfRange { point: usize, value: f64 },
+    OutOfRange {
+        /// 1-based index of the point in plan order.
+        point: usize,
+        /// The coordinate [mm].
+        value: f64,
+    },
+    /// The units were to be detected, but the points' spread fits neither
+    /// metres nor millimetres.
     #[error("units unclear: the points spread over {spread} (neither clearly metres, below {METRES_BELOW}, nor millimetres, above {MM_ABOVE}); give the units (mm or m)")]
-    UnitsUnclear { spread: f64 },
+    UnitsUnclear {
+        /// Largest extent of the points along an axis, in their own unit.
+        spread: f64,
+    },
 }
 
 /// A tracker export as read: point names (when it has a name column), the

@@ -32,13 +32,17 @@ use serde::{Deserialize, Serialize};
 /// predicted standard deviations.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MeasurementPlan {
+    /// Name of the robot model the plan was made for.
     pub robot: String,
     /// Chosen configurations, model convention [rad].
     pub q: Vec<Vec<f64>>,
     /// The same in the controller convention [deg], with point names.
     pub points: Vec<PlanPoint>,
+    /// How many candidates passed each constraint.
     pub counts: FilterCounts,
+    /// Tracker noise the prediction assumes, standard deviation per axis [mm].
     pub noise_mm: f64,
+    /// Payload the poses are planned with [kg] (the model's when none was given).
     pub payload_kg: f64,
     /// KM's prediction, and SKCM's when gravity loads a joint.
     pub predicted: Vec<PredictedStd>,

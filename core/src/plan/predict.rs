@@ -24,9 +24,11 @@ use serde::{Deserialize, Serialize};
 /// One parameter's predicted standard deviation, in `unit`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ParamPrediction {
+    /// The parameter's name in the thesis's tables (`a1`, `theta2`, `c3`, …).
     pub name: String,
     /// mm, deg or rad/(N·m).
     pub unit: String,
+    /// Predicted standard deviation from `σ²·(JᵀJ)⁻¹`, in `unit`.
     pub std: f64,
 }
 
@@ -35,6 +37,7 @@ pub struct ParamPrediction {
 pub struct PredictedStd {
     /// `km` (geometry) or `skcm` (geometry and joint compliance).
     pub method: String,
+    /// Predicted standard deviation of each parameter the calibration identifies.
     pub params: Vec<ParamPrediction>,
     /// Parameters the calibration would not identify from these poses.
     pub not_identified: Vec<String>,

@@ -6,7 +6,9 @@ use serde::{Deserialize, Serialize};
 /// An axis-aligned box for the TCP position, base frame [mm].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct WorkspaceBox {
+    /// Lower corner `[x, y, z]` [mm].
     pub min_mm: [f64; 3],
+    /// Upper corner `[x, y, z]` [mm].
     pub max_mm: [f64; 3],
 }
 
@@ -18,6 +20,7 @@ pub struct TrackerSight {
     pub position_mm: [f64; 3],
     /// The reflector's axis in the tool frame (default: the tool's z axis).
     pub axis: [f64; 3],
+    /// Largest angle between the reflector's axis and the line to the tracker [deg].
     pub max_angle_deg: f64,
 }
 
@@ -40,12 +43,15 @@ pub struct PlanSettings {
     pub candidates: usize,
     /// Margin kept from both joint limits [deg].
     pub margin_deg: f64,
+    /// Box the TCP must stay in (`None`: no box).
     pub workspace: Option<WorkspaceBox>,
+    /// The tracker's line of sight the TCP must keep (`None`: not checked).
     pub tracker: Option<TrackerSight>,
     /// Tracker noise, standard deviation per axis [mm].
     pub noise_mm: f64,
     /// Payload mass [kg] (default: the model's).
     pub payload_kg: Option<f64>,
+    /// Seed of the random candidates (the same seed gives the same plan).
     pub seed: u64,
 }
 
@@ -67,10 +73,18 @@ impl Default for PlanSettings {
 /// Why no plan can be made.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum PlanError {
+    /// A setting is out of range; the message says which.
     #[error("invalid setting: {0}")]
     Setting(String),
+    /// Fewer candidates pass the constraints than poses are asked.
     #[error("only {} of {} candidates pass the constraints ({} reachable, {} inside the box, {} in the tracker's sight), {needed} poses asked; draw more candidates or widen the box or the angle", counts.in_sight, counts.drawn, counts.reachable, counts.in_box, counts.in_sight)]
-    TooFewCandidates { counts: FilterCounts, needed: usize },
+    TooFewCandidates {
+        /// How many candidates passed each constraint.
+        counts: FilterCounts,
+        /// Poses asked.
+        needed: usize,
+    },
+    /// The chosen poses leave the parameters unidentifiable; the reason.
     #[error("the chosen poses identify too little: {0}")]
     Unidentifiable(String),
 }
@@ -78,9 +92,14 @@ pub enum PlanError {
 /// How many candidates passed each filter, in order.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct FilterCounts {
+    /// Candidates drawn.
     pub drawn: usize,
     /// Forward kinematics defined (a closed loop closes) and finite.
     pub reachable: usize,
+    /// Of those, candidates whose TCP is inside the workspace box (all of them
+    /// without a box).
     pub in_box: usize,
+    /// Of those, candidates the tracker sees within its angle (all of them
+    /// without a sight): the pool.
     pub in_sight: usize,
 }

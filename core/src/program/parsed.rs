@@ -62,7 +62,9 @@ impl Language {
 /// One file of a program.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ProgramFile {
+    /// The file's name, with its extension (which tells the language).
     pub name: String,
+    /// The file's text.
     pub text: String,
 }
 
@@ -70,11 +72,13 @@ pub struct ProgramFile {
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, thiserror::Error)]
 #[error("{file}:{line}:{column}: {message}")]
 pub struct ParseError {
+    /// The file's name.
     pub file: String,
     /// 1-based.
     pub line: usize,
     /// 1-based, in characters.
     pub column: usize,
+    /// What is wrong, for the user.
     pub message: String,
 }
 
@@ -96,16 +100,28 @@ pub enum Flags {
     Nearest,
     /// KUKA status `S` (bit 0 overhead, bit 1 elbow, bit 2 A5 < 0) and turn
     /// `T` (bit i: axis i+1 < 0), each optional.
-    Kuka { s: Option<u32>, t: Option<u32> },
+    Kuka {
+        /// Status `S`, when given.
+        s: Option<u32>,
+        /// Turn `T`, when given.
+        t: Option<u32>,
+    },
     /// ABB `[cf1, cf4, cf6, cfx]`: quadrants `⌊A/90°⌋` of axes 1, 4, 6 and
     /// `cfx = 4·back + 2·down + [A5 < 0]`.
-    Abb { cf: [i32; 4] },
+    Abb {
+        /// `[cf1, cf4, cf6, cfx]`.
+        cf: [i32; 4],
+    },
     /// Fanuc `CONFIG : 'F|N U|D T|B, t1, t4, t6'`: axis 5 < 0, elbow up,
     /// wrist centre in front, turn numbers `⌊(A + 180°)/360°⌋` of axes 1, 4, 6.
     Fanuc {
+        /// `F` (axis 5 < 0) rather than `N`.
         flip: bool,
+        /// `U` (elbow up) rather than `D`.
         up: bool,
+        /// `T` (wrist centre in front) rather than `B`.
         front: bool,
+        /// Turn numbers `t1, t4, t6` of axes 1, 4 and 6.
         turns: [i32; 3],
     },
 }
@@ -271,14 +287,19 @@ pub struct Site {
     pub name: String,
     /// TCP pose in the work object [m] (None: the program gives no complete pose).
     pub pose: Option<Pose>,
+    /// Configuration flags as the program writes them.
     pub flags: Flags,
+    /// The tool the target is taught with.
     pub tool: FrameSpec,
     /// The load the program declares for the tool in use (flange frame), if
     /// it declares one (RAPID `tload`, KRL `$LOAD`, URScript `set_payload`).
     pub load: Option<Load>,
+    /// The work object the target is taught in.
     pub work_object: FrameSpec,
     /// Byte ranges of x, y, z and the orientation values, in `convention` order.
     pub slots: Vec<Range<usize>>,
+    /// How the program writes the orientation (quaternion, KUKA ABC, Fanuc WPR,
+    /// rotation vector, …).
     pub convention: OrientationConvention,
     /// Program length unit in metres (1e-3 for mm).
     pub unit_m: f64,
@@ -323,6 +344,7 @@ pub fn external_axis_refusal(axis: &str, value: &str) -> String {
 /// A joint target of a program, in the controller's convention.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct JointTarget {
+    /// Index of the file in the program.
     pub file: usize,
     /// 1-based.
     pub line: usize,
@@ -342,6 +364,8 @@ pub struct Motion {
     pub instruction: String,
     /// The position as written (`XP1`, `p10`, `P[3]`, `PR[3]`), or `inline`.
     pub name: String,
+    /// What the position is: a site, axis values, a run-time position or an
+    /// undeclared name.
     pub target: MotionTarget,
     /// Where the mark of a failure goes when the position has no site (an
     /// insertion at the end of the instruction's line, or the comment of a
@@ -373,16 +397,25 @@ pub enum MotionTarget {
 /// (in file order).
 #[derive(Debug, Clone, PartialEq, Default, Serialize)]
 pub struct Targets {
+    /// Cartesian targets, in the order the program runs them (points no motion
+    /// uses last).
     pub sites: Vec<Site>,
+    /// Every position of every motion instruction, in the order of the files and lines.
     pub motions: Vec<Motion>,
+    /// Joint targets, in file order.
     pub joints: Vec<JointTarget>,
 }
 
 /// A parsed program: its targets and motions.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Program {
+    /// The language the program is written in.
     pub language: Language,
+    /// Cartesian targets, in the order the program runs them (points no motion
+    /// uses last).
     pub sites: Vec<Site>,
+    /// Every position of every motion instruction, in the order of the files and lines.
     pub motions: Vec<Motion>,
+    /// Joint targets, in file order.
     pub joints: Vec<JointTarget>,
 }

@@ -27,6 +27,7 @@ pub enum TargetStatus {
 /// Where a motion instruction is.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct MotionPlace {
+    /// The file the motion instruction is in.
     pub file: String,
     /// 1-based.
     pub line: usize,
@@ -58,7 +59,9 @@ pub struct TargetReport {
     pub motion: MotionPlace,
     /// The position as written, or `inline`.
     pub name: String,
+    /// Filtered, failed or skipped.
     pub status: TargetStatus,
+    /// Why the position failed or was skipped.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,
     /// Configuration branch of the solution.
@@ -97,7 +100,9 @@ pub enum LoadSource {
 /// The load a target was solved with.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct UsedLoad {
+    /// Where the load comes from.
     pub source: LoadSource,
+    /// The load: mass, and centre of mass in its `frame`.
     #[serde(flatten)]
     pub load: LoadDescription,
 }
@@ -105,12 +110,16 @@ pub struct UsedLoad {
 /// A motion to axis values: the filter leaves it as it is.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct JointMotionReport {
+    /// The file the instruction is in.
     pub file: String,
     /// 1-based line of the instruction.
     pub line: usize,
+    /// The instruction as written (`PTP`, `MoveAbsJ`, `J`, `movej`).
     pub instruction: String,
     /// The position as written, or `inline`.
     pub name: String,
+    /// Why the motion counts as one to axis values when its values are not in
+    /// the files (KUKA's `XHOME`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub note: Option<String>,
 }
@@ -118,18 +127,24 @@ pub struct JointMotionReport {
 /// A declared Cartesian point that no motion of the program uses: left unchanged.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct UnusedReport {
+    /// The file the point is declared in.
     pub file: String,
     /// 1-based line of the declaration.
     pub line: usize,
+    /// The point's name.
     pub name: String,
 }
 
 /// The report of a filtered program.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FilterReport {
+    /// The program's language.
     pub language: Language,
+    /// Positions replaced by their false targets.
     pub filtered: usize,
+    /// Positions left unchanged and marked.
     pub failed: usize,
+    /// Positions left unchanged, not marked.
     pub skipped: usize,
     /// One line per position of a Cartesian motion, in the order of the
     /// files and lines.

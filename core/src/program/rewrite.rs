@@ -23,7 +23,9 @@ use serde::Serialize;
 /// The filtered files (same names and order) and the report.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FilterOutput {
+    /// The filtered files, with the same names and in the same order as given.
     pub files: Vec<ProgramFile>,
+    /// What happened to every target.
     pub report: FilterReport,
 }
 
@@ -52,10 +54,18 @@ impl Default for FilterControl<'_> {
 /// Why a bounded filter produced nothing.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum FilterError {
+    /// The program cannot be parsed.
     #[error(transparent)]
     Parse(#[from] ParseError),
+    /// The program has more Cartesian targets than the filter takes.
     #[error("the program has {targets} Cartesian targets; at most {max} are filtered in one request: split the program")]
-    TooManyTargets { targets: usize, max: usize },
+    TooManyTargets {
+        /// Cartesian targets (sites) in the program.
+        targets: usize,
+        /// The cap, `FilterControl::max_targets`.
+        max: usize,
+    },
+    /// `keep_going` answered false before the filter finished.
     #[error("the filter was stopped before it finished")]
     Cancelled,
 }

@@ -21,13 +21,21 @@
 //! (`x_tracker = R·x_base + p`, i.e. it is the pose of the base frame in the
 //! tracker frame); measured points are expressed in the tracker frame.
 
+// `missing_docs` is warned here module by module rather than on the whole
+// floor: the track's and the positioner's simulations (`track`, `positioner`,
+// `positioner_sets`) are not documented item by item yet.
+#[warn(missing_docs)]
 mod perturb;
+#[warn(missing_docs)]
 mod poses;
 pub mod positioner;
 pub mod positioner_sets;
+#[warn(missing_docs)]
 pub mod study;
+#[warn(missing_docs)]
 mod synthetic;
 pub mod track;
+#[warn(missing_docs)]
 mod truth;
 
 pub use perturb::{
@@ -43,22 +51,35 @@ pub use truth::{fine_transmission_errors, tracker_frame, Harmonic, TrueRobot, Un
 use crate::model::kinematics::KinematicsError;
 
 /// Simulation errors.
+#[warn(missing_docs)]
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SimError {
+    /// Forward kinematics failed at one of the configurations measured.
     #[error("configuration {index}: {source}")]
     Kinematics {
+        /// Index of that configuration in the measured list (0-based).
         index: usize,
+        /// The kinematics error at that configuration.
         #[source]
         source: KinematicsError,
     },
+    /// Random draws inside the limits and the pose filter gave too few
+    /// admissible configurations.
     #[error("found only {found} of {wanted} admissible configurations after {attempts} random draws; relax the pose filter")]
     TooFewConfigurations {
+        /// Number of configurations asked for.
         wanted: usize,
+        /// Number of admissible configurations found before giving up.
         found: usize,
+        /// Number of random draws made (the cap is `10_000 + 1_000·wanted`).
         attempts: usize,
     },
+    /// Forward kinematics of the true robot failed at a configuration not tied
+    /// to a list index.
     #[error(transparent)]
     Fk(KinematicsError),
+    /// An input of the simulation (noise, unmodelled effects) is out of range;
+    /// the text says which.
     #[error("invalid simulation input: {0}")]
     InvalidInput(String),
 }

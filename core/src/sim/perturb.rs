@@ -10,7 +10,9 @@ use rand_distr::{Distribution, StandardNormal};
 /// Size of the simulated geometric errors: lengths [m], angles [rad].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ErrorMagnitudes {
+    /// Largest (uniform) or standard (normal) error of each length parameter [m].
     pub length_m: f64,
+    /// Largest (uniform) or standard (normal) error of each angle parameter [rad].
     pub angle_rad: f64,
 }
 

@@ -19,18 +19,26 @@ use rand_chacha::ChaCha8Rng;
 /// Why the study did not run to its end.
 #[derive(Debug, thiserror::Error)]
 pub enum StudyError {
+    /// The nominal YS100 preset could not be loaded.
     #[error(transparent)]
     Model(#[from] ModelError),
+    /// Simulating the configurations or measurements failed.
     #[error(transparent)]
     Sim(#[from] SimError),
+    /// The calibration of the simulated measurements failed.
     #[error(transparent)]
     Calibration(#[from] CalibrationError),
 }
 
 /// The §7.4 study's inputs and result.
 pub struct Ys100Study {
+    /// The model the calibration starts from: `preset("ys100")`.
     pub nominal: RobotModel,
+    /// The true robot that produced the measurements:
+    /// [`ys100_table_7_1`].
     pub truth: RobotModel,
+    /// The calibration of KM, SKCM and SKCM-C by TLBO on the 30 identification
+    /// and 45 validation poses (cf. Table 7.5).
     pub report: CalibrationReport,
 }
 

@@ -63,8 +63,11 @@ pub struct UnmodelledEffects {
 /// One harmonic of a joint's transmission error: `A·sin(k·q + φ)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Harmonic {
+    /// Harmonic order `k`: periods per joint revolution.
     pub k: u32,
+    /// Amplitude `A` of the joint-angle error [rad].
     pub amplitude_rad: f64,
+    /// Phase `φ` at `q = 0` [rad].
     pub phase_rad: f64,
 }
 
@@ -193,6 +196,8 @@ pub struct TrueRobot {
     /// tracker_from_base.transform_point(x_base)`, i.e. the pose of the robot base
     /// in the tracker frame. See [`tracker_frame`].
     pub tracker_from_base: Pose,
+    /// Errors the calibration model lacks (`ΔP_extra` of eq. 2.1), applied to
+    /// every true pose.
     pub effects: UnmodelledEffects,
     /// Tracker noise, standard deviation per axis [mm].
     pub noise_mm: f64,

@@ -12,6 +12,8 @@ use nalgebra::Matrix3;
 pub struct OrientationSamples;
 
 impl OrientationSamples {
+    /// The orientation samples of `position`, with `rotations[i]` belonging to `position[i]` (type
+    /// docs).
     pub fn of(position: &[Sample], rotations: &[Option<Matrix3<f64>>]) -> Vec<Sample> {
         position
             .iter()

@@ -9,9 +9,11 @@ use serde::{Deserialize, Serialize};
 pub struct TrainReport {
     /// `lm`, `iwo`, `tlbo` or `rbf`.
     pub trainer: String,
+    /// Training samples (poses).
     pub samples: usize,
     /// Epochs (LM), iterations (IWO) or generations (TLBO) run; RBF units.
     pub epochs: usize,
+    /// Loss evaluations (MLP), units added (RBF) or candidates fitted (GP).
     pub evaluations: usize,
     /// Final training loss (normalised units, see module docs).
     pub loss: f64,
@@ -19,8 +21,10 @@ pub struct TrainReport {
     pub stop: String,
     /// Training RMS of the residual error norm after compensation [mm].
     pub rms_mm: f64,
+    /// What the RBF training chose (RBF only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rbf: Option<RbfReport>,
+    /// How the GP's hyperparameters were chosen (GP only).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gp: Option<GpReport>,
 }

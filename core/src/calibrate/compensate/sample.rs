@@ -14,6 +14,7 @@ pub struct Sample {
     pub q: Vec<f64>,
     /// Gravity torques of the calibrated model at `q` [N·m].
     pub tau: Vec<f64>,
+    /// Payload mass the pose carried [kg].
     pub payload_kg: f64,
     /// Measured minus predicted position [m], registered base frame.
     pub residual: Vector3<f64>,

@@ -36,6 +36,7 @@ use std::sync::{mpsc, Arc, Mutex};
 /// Cross-validated errors of a base and its compensator.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CvStats {
+    /// Number `k` of random folds the samples were dealt into.
     pub folds: usize,
     /// The base alone (no compensator) [mm].
     pub base: ErrorStats,
@@ -49,6 +50,7 @@ pub struct CvStats {
 /// One spatially blocked fold: a region of joint space held out.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BlockedFold {
+    /// Poses in the held-out region.
     pub poses: usize,
     /// Centre of the region, model-convention joints [rad].
     pub centre: Vec<f64>,
@@ -185,6 +187,7 @@ impl Parallelism {
 
 /// How the trainings of a cross-validation run ([`run_jobs`]).
 pub struct Jobs<'a, E> {
+    /// Threads the trainings share.
     pub parallel: Parallelism,
     /// `progress(job, epoch, loss)` of the lowest-numbered training under
     /// way, on the calling thread, after any training's epoch; false cancels.
@@ -442,6 +445,8 @@ where
 pub struct Choice {
     /// Name of the chosen compensator; `None` keeps the base alone.
     pub chosen: Option<String>,
+    /// Why, for the report: the chosen one's cross-validated figures against the base's, or why
+    /// each candidate was rejected.
     pub reason: String,
 }
 

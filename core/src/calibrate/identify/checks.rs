@@ -21,63 +21,117 @@ use rand_chacha::ChaCha8Rng;
 /// Why a calibration cannot run.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CalibrationError {
+    /// No identification pose was given.
     #[error("the identification set is empty")]
     NoData,
+    /// A measurement has not one joint value per joint of the robot.
     #[error(
         "{set} measurement {index}: expected {expected} joint values for this robot, got {got}"
     )]
     JointCount {
+        /// The set it belongs to: `identification`, `training` or `validation`.
         set: &'static str,
+        /// Its 0-based place in the set.
         index: usize,
+        /// Joints of the robot.
         expected: usize,
+        /// Joint values given.
         got: usize,
     },
+    /// A measurement's joints, position, payload mass or orientation is not a finite number, or
+    /// its payload mass is negative.
     #[error("{set} measurement {index}: {what} is not a finite number")]
     NotFinite {
+        /// The set it belongs to: `identification`, `training` or `validation`.
         set: &'static str,
+        /// Its 0-based place in the set.
         index: usize,
+        /// Which value, in words.
         what: &'static str,
     },
+    /// The poses give no more equations than there are parameters to identify.
     #[error("too few poses: {poses} poses give {rows} equations, but this robot has {params} identifiable parameters; measure at least {needed} poses (3 to 5 times that is better)")]
     TooFewPoses {
+        /// Identification poses given.
         poses: usize,
+        /// Rows of the stacked identification Jacobian they give.
         rows: usize,
+        /// Parameters (and session frames' terms) to identify.
         params: usize,
+        /// The smallest number of poses that gives more rows than that.
         needed: usize,
     },
+    /// The poses identify fewer of the geometric parameters than well-spread poses of this robot
+    /// would.
     #[error("singular pose set: the poses excite only {rank} of the robot's {generic_rank} identifiable parameter combinations{detail}; measure poses that move every joint across its range")]
     SingularPoses {
+        /// Geometric parameters the poses identify (exact rank).
         rank: usize,
+        /// Geometric parameters well-spread random poses identify (`generic_rank`).
         generic_rank: usize,
+        /// The joints that move less than 5 deg over the poses, in words (empty when none).
         detail: String,
     },
+    /// A session's tracker frame cannot be registered.
     #[error("registration of session {session}: {source}")]
     Registration {
+        /// The 0-based tracker session.
         session: usize,
+        /// Why its registration failed.
         source: RegistrationError,
     },
+    /// The nominal model's RMS error after registration is above `max_nominal_rms_mm`.
     #[error("the measurements do not fit the model: RMS {rms_mm:.1} mm after registering the tracker frame (limit {limit_mm:.0} mm); check units (positions in mm, joints in degrees), joint order and signs, and the model")]
-    Inconsistent { rms_mm: f64, limit_mm: f64 },
+    Inconsistent {
+        /// RMS error of the nominal model after registration [mm].
+        rms_mm: f64,
+        /// The limit, `max_nominal_rms_mm` [mm].
+        limit_mm: f64,
+    },
+    /// The nominal model's kinematics failed at a measurement's joints.
     #[error("{set} measurement {index}: {source}")]
     Kinematics {
+        /// The set it belongs to: `identification`, `training` or `validation`.
         set: &'static str,
+        /// Its 0-based place in the set.
         index: usize,
+        /// Why the kinematics failed.
         source: KinematicsError,
     },
+    /// A training pose's tracker session has no identification pose to register its frame.
     #[error("{set} measurement {index}: its tracker session has no identification poses, so its frame cannot be registered; measure identification poses in that session too")]
     UnregisteredSession {
+        /// The set it belongs to (`training`).
         set: &'static str,
+        /// Its 0-based place in the set.
         index: usize,
+        /// The 0-based tracker session without identification poses.
         session: usize,
     },
+    /// Some fitted poses carry standard deviations and others do not.
     #[error("{with} of the {total} identification and training poses carry standard deviations (std_x, std_y, std_z) and the others do not; the fit weighs rows by them, so give them for every fitted set or for none")]
-    MixedStd { with: usize, total: usize },
+    MixedStd {
+        /// Identification and training poses with standard deviations.
+        with: usize,
+        /// Identification and training poses in all.
+        total: usize,
+    },
+    /// The progress callback asked to stop.
     #[error("calibration cancelled")]
     Cancelled,
+    /// The nominal model's positions, errors or Jacobian at the identification poses are not
+    /// finite.
     #[error("the nominal model gives {what} at the identification poses, so nothing can be fitted; check the model's lengths, masses, compliances and tool")]
-    ModelNotFinite { what: &'static str },
+    ModelNotFinite {
+        /// What is not finite, in words.
+        what: &'static str,
+    },
+    /// Every method run failed.
     #[error("no method succeeded: {}", failed.iter().map(|f| format!("{}: {}", f.method.name(), f.reason)).collect::<Vec<_>>().join("; "))]
-    AllMethodsFailed { failed: Vec<FailedMethod> },
+    AllMethodsFailed {
+        /// Each method and why it failed.
+        failed: Vec<FailedMethod>,
+    },
 }
 
 pub(crate) fn check_set(

@@ -82,8 +82,11 @@ pub enum DropKind {
 /// A parameter that is not identified, and why.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DroppedParam {
+    /// The parameter's name (`ParamId::name`).
     pub name: String,
+    /// Why it is not identified.
     pub kind: DropKind,
+    /// The reason in words, for the report.
     pub reason: String,
     /// Kept parameters it is (linearly) dependent on.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -93,8 +96,11 @@ pub struct DroppedParam {
 /// A strongly correlated pair of identified parameters.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CorrelatedPair {
+    /// Name of the first parameter.
     pub a: String,
+    /// Name of the second parameter.
     pub b: String,
+    /// Their correlation coefficient from the fit's covariance (|ρ| above `correlation_threshold`).
     pub correlation: f64,
 }
 
@@ -103,12 +109,15 @@ pub struct CorrelatedPair {
 pub struct IdentifiabilityReport {
     /// Number of poses and residual rows used.
     pub poses: usize,
+    /// Residual rows of the stacked Jacobian.
     pub rows: usize,
     /// Candidate parameters considered.
     pub candidates: usize,
     /// Numerical rank of the scaled candidate Jacobian.
     pub rank: usize,
+    /// Names of the identified parameters, in the layout order.
     pub kept: Vec<String>,
+    /// The parameters not identified, with why.
     pub dropped: Vec<DroppedParam>,
     /// σ_max/σ_min of the scaled kept Jacobian.
     pub condition_number: f64,
@@ -117,6 +126,7 @@ pub struct IdentifiabilityReport {
     /// Parameter standard deviations after the fit, by name, in mm, deg or rad/(N·m).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub std_devs: Vec<(String, f64)>,
+    /// Pairs of identified parameters whose |correlation| is above `correlation_threshold`.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub correlated_pairs: Vec<CorrelatedPair>,
     /// With orientation rows: the kept parameters that the same poses without
@@ -168,7 +178,9 @@ fn preference(id: &ParamId, n: usize) -> (usize, usize, usize) {
 /// Result of the analysis: the kept parameters (in the layout order) and the report.
 #[derive(Debug, Clone)]
 pub struct Analysis {
+    /// The identified parameters, in the layout order.
     pub kept: Vec<ParamId>,
+    /// What the analysis found.
     pub report: IdentifiabilityReport,
 }
 

@@ -72,7 +72,9 @@ impl Default for LmSettings {
 pub struct LmReport {
     /// True only when `reason` is a passed convergence test.
     pub converged: bool,
+    /// Iterations run, accepted or rejected.
     pub iterations: usize,
+    /// Why the run stopped.
     pub reason: StopReason,
     /// The reason in words, with the figures of the test.
     pub detail: String,
@@ -81,15 +83,18 @@ pub struct LmReport {
     pub gradient: f64,
     /// RMS of the residual vector before and after [mm].
     pub initial_rms_mm: f64,
+    /// RMS of the residual vector after the fit [mm].
     pub final_rms_mm: f64,
 }
 
 /// Result of a fit.
 #[derive(Debug, Clone)]
 pub struct Fit {
+    /// The model with the fitted parameters (the others as they started).
     pub model: RobotModel,
     /// Frame corrections `E_s` per session (identity for session 0).
     pub session_frames: Vec<Pose>,
+    /// How the run ended.
     pub report: LmReport,
     /// Covariance of the fitted parameters (same order as `ids`) in SI units,
     /// `σ²(JᵀJ)⁻¹` with `σ²` = residual sum of squares / (rows − parameters).

@@ -9,19 +9,32 @@
 //! Units: SI inside; reports speak millimetres and degrees (compliance in
 //! rad/(N·m), stiffness in N·m/rad).
 
+// `missing_docs` is warned module by module: `methods`, `joint_maps` and
+// `progress` are not documented item by item yet.
+#[warn(missing_docs)]
 pub mod checks;
+#[warn(missing_docs)]
 mod evaluate;
+#[warn(missing_docs)]
 pub mod evidence;
+#[warn(missing_docs)]
 pub mod identifiability;
 pub mod joint_maps;
+#[warn(missing_docs)]
 pub mod least_squares;
 pub mod methods;
+#[warn(missing_docs)]
 pub mod model_file;
+#[warn(missing_docs)]
 pub mod network;
+#[warn(missing_docs)]
 pub mod options;
+#[warn(missing_docs)]
 mod pipeline;
 pub mod progress;
+#[warn(missing_docs)]
 pub mod registration;
+#[warn(missing_docs)]
 pub mod report;
 
 pub use checks::CalibrationError;

@@ -14,7 +14,12 @@ pub enum Network {
     /// RBF on the gravity torques (ch. 3), the options' `rbf`.
     Rbf,
     /// An MLP of the options' size `size`, trained by `trainer`.
-    Mlp { size: MlpSize, trainer: MlpTrainer },
+    Mlp {
+        /// The options' MLP shape it has.
+        size: MlpSize,
+        /// The trainer that finds its weights.
+        trainer: MlpTrainer,
+    },
     /// The sparse Gaussian process on the joints (`compensate::gp`), the
     /// options' `gp`.
     Gp,

@@ -120,12 +120,16 @@ impl CalibrationSettings {
 /// benches.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CalibrationOptions {
+    /// The methods to run, in the order given.
     pub methods: Vec<Method>,
     /// Register the measurement frame in closed form first (off only when the
     /// data is already in the base frame and should stay there exactly).
     pub register: bool,
+    /// Levenberg–Marquardt settings of every model-based fit.
     pub lm: LmSettings,
+    /// TLBO settings of SKCM-C's compliance search (`skcm-tlbo`, ch. 7).
     pub tlbo: TlboSettings,
+    /// Which parameters are identified (`identifiability`).
     pub identifiability: IdentifiabilitySettings,
     /// Above this RMS [mm] of the nominal model after registration, the data is
     /// rejected as inconsistent with the model (units, joint order, signs).
@@ -173,14 +177,18 @@ pub struct CompensatorOptions {
     pub min_training_poses: usize,
     /// The joint-map and compensator methods `auto` considers.
     pub auto_candidates: Vec<Method>,
+    /// The RBF compensator (`Network::Rbf`).
     pub rbf: RbfSettings,
     /// Network of SKCM-NN (`MlpSize::Nn` in the method table).
     pub nn: MlpSpec,
+    /// LM backpropagation of SKCM-NN's network (`MlpTrainer::Lm`).
     pub lm: LmTrainSettings,
     /// Network of SKCM-IWONN and SKCM-TLBONN (`MlpSize::Small` in the
     /// method table; `MlpSpec::POPULATION`).
     pub small: MlpSpec,
+    /// Invasive weed optimisation of SKCM-IWONN's network (`MlpTrainer::Iwo`).
     pub iwo: IwoSettings,
+    /// TLBO of SKCM-TLBONN's network (`MlpTrainer::Tlbo`).
     pub tlbo: TlboTrainSettings,
     /// The Gaussian-process compensator (`Network::Gp`).
     pub gp: GpSettings,

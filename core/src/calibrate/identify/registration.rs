@@ -12,6 +12,7 @@ use nalgebra::{Matrix3, Vector3};
 /// Result of a registration.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Registration {
+    /// Tracker → base: `x_base = R·x_tracker + t` [m].
     pub tracker_to_base: Pose,
     /// RMS distance after registration [m].
     pub rms: f64,
@@ -20,10 +21,14 @@ pub struct Registration {
 /// Why a registration cannot be computed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RegistrationError {
+    /// Fewer than 3 point pairs (the number given).
     #[error("registration needs at least 3 poses, got {0}")]
     TooFewPoints(usize),
+    /// The second singular value of the cross-covariance is below 1e-9 of the first: the points are
+    /// (nearly) collinear.
     #[error("the measured points are (nearly) collinear, so the tracker frame's rotation is undetermined: measure poses that span the workspace")]
     Degenerate,
+    /// A point is not finite, or the SVD did not converge.
     #[error("the points to register are not finite (a model value too large for its forward kinematics?)")]
     NotFinite,
 }

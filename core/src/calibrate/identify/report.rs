@@ -47,20 +47,28 @@ pub const REPORT_FORMAT_VERSION: u32 = 4;
 /// one). A set without any orientation measurement has neither field.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SetErrors {
+    /// Statistics of the position error norms [mm] (serialised flat).
     #[serde(flatten)]
     pub stats: ErrorStats,
+    /// Statistics of the orientation error angles [deg] over the poses that measured one
+    /// (serialised flat).
     #[serde(flatten, default, skip_serializing_if = "Option::is_none")]
     pub orientation: Option<OrientationStats>,
+    /// Position error norm per pose [mm] (infinity where the model cannot predict).
     pub errors_mm: Vec<f64>,
+    /// Orientation error angle per pose [deg] (`None` for a pose without a measured orientation).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub orientation_errors_deg: Vec<Option<f64>>,
+    /// Error vector `measured − predicted` per pose, registered base frame of its session [mm].
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub errors_xyz_mm: Vec<[Option<f64>; 3]>,
+    /// Measured position per pose, registered base frame of its session [mm].
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub positions_mm: Vec<[f64; 3]>,
 }
 
 impl SetErrors {
+    /// The set's errors from the position error norms alone [mm].
     pub fn new(errors_mm: Vec<f64>) -> Self {
         SetErrors {
             stats: ErrorStats::from_errors_mm(&errors_mm),
@@ -214,16 +222,21 @@ pub(crate) fn predict_compensated(
 /// caller that knows the uploads; empty when unknown.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct PoseSource {
+    /// The measurement set's name.
     pub set: String,
+    /// 1-based data row in that upload.
     pub row: usize,
+    /// The tracker session's name.
     pub session: String,
 }
 
 /// Pose sources of the sets, in the order of the report's per-pose vectors.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct PoseSources {
+    /// Sources of the identification poses.
     #[serde(default)]
     pub identification: Vec<PoseSource>,
+    /// Sources of the validation poses.
     #[serde(default)]
     pub validation: Vec<PoseSource>,
     /// The compensator training pool (Q2), when one was given.
@@ -234,18 +247,27 @@ pub struct PoseSources {
 /// One identified parameter in display units (mm, deg or rad/(N·m)).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ParamEstimate {
+    /// The parameter's name (`ParamId::name`).
     pub name: String,
+    /// Its display unit: `mm`, `deg`, `rad/(N·m)` or `kg`.
     pub unit: String,
+    /// Its nominal value [unit].
     pub nominal: f64,
+    /// Its identified value [unit].
     pub value: f64,
+    /// Its standard deviation from the fit's covariance [unit] (`None`: no covariance, or held at a
+    /// bound).
     pub std: Option<f64>,
 }
 
 /// TLBO summary of SKCM-C.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TlboSummary {
+    /// Learners in the class.
     pub population: usize,
+    /// Generations run.
     pub generations: usize,
+    /// Cost evaluations (eq. 7.10).
     pub evaluations: usize,
     /// Best eq. 7.10 cost [mm²] after each generation.
     pub history: Vec<f64>,
@@ -254,16 +276,22 @@ pub struct TlboSummary {
 /// Result of one method.
 #[derive(Debug, Clone, Serialize)]
 pub struct MethodReport {
+    /// The method reported.
     pub method: Method,
+    /// How its least-squares fit ended.
     pub solver: LmReport,
+    /// Errors on the identification set.
     pub identification: SetErrors,
+    /// Errors on the validation set, when one was given.
     pub validation: Option<SetErrors>,
     /// Errors on the compensator training pool (Q2), when one was given.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub training: Option<SetErrors>,
+    /// The identified parameters in display units.
     pub parameters: Vec<ParamEstimate>,
     /// Identified joint stiffness 1/c [N·m/rad] (None: not identified / rigid).
     pub stiffness_nm_per_rad: Vec<Option<f64>>,
+    /// The TLBO search's summary (SKCM-C by TLBO only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub tlbo: Option<TlboSummary>,
     /// Physically implausible or doubtful results (the figures stay reported).
@@ -281,6 +309,7 @@ pub struct MethodReport {
     /// its range and amplitude.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub joint_maps: Option<JointMapsSummary>,
+    /// The calibrated model in SI units, registered base frame (the model file stores it).
     #[serde(skip)]
     pub calibrated: RobotModel,
     /// The trained compensator (the model file stores it).
@@ -326,12 +355,17 @@ pub struct JointMapsSummary {
     pub poses: usize,
     /// The chosen number of harmonics (0: no maps kept) and ridge weight.
     pub harmonics: usize,
+    /// The chosen ridge weight λ.
     pub ridge: f64,
+    /// Cross-validated mean position error with the chosen maps [mm].
     pub cv_mean_mm: f64,
+    /// Cross-validated largest position error with the chosen maps [mm].
     pub cv_max_mm: f64,
     /// The geometry alone on the same folds.
     pub cv_without_maps_mean_mm: f64,
+    /// The geometry alone's cross-validated largest error on the same folds [mm].
     pub cv_without_maps_max_mm: f64,
+    /// Every (K, λ) the cross-validation tried.
     pub candidates: Vec<MapCandidate>,
     /// Per joint: its trained range and largest |Δθ| [deg] (`None`: no map).
     pub joints: Vec<Option<JointMapExtent>>,
@@ -344,12 +378,16 @@ pub struct JointMapsSummary {
 /// One joint's map in a report.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct JointMapExtent {
+    /// The joint's trained range `[low, high]` [deg].
     pub range_deg: [f64; 2],
+    /// Width beyond the range over which the map fades to zero [deg].
     pub fade_deg: f64,
+    /// The map's largest |Δθ| [arcsec].
     pub amplitude_arcsec: f64,
 }
 
 impl JointMapsSummary {
+    /// The summary of joint-map fit `fit` and the maps `model` carries.
     pub fn of(fit: &MapFit, model: &RobotModel) -> Self {
         let n = model.dof();
         let joints = match &model.joint_maps {
@@ -399,12 +437,14 @@ pub struct CompensatorSummary {
     /// Which poses trained it: `training` (the Q2 pool) or `identification`
     /// (no training pool given; judged by k-fold cross-validation inside it).
     pub trained_on: String,
+    /// Poses that trained it.
     pub training_poses: usize,
     /// k-fold cross-validation on the training pool (none when switched off).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cross_validation: Option<CvStats>,
     /// The base alone on the identification and validation sets [mm].
     pub base_identification: ErrorStats,
+    /// The base alone on the validation set, when one was given [mm].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub base_validation: Option<ErrorStats>,
     /// The base alone on the training pool, when it is a set of its own [mm].
@@ -414,6 +454,7 @@ pub struct CompensatorSummary {
     /// `fade_deg` beyond it.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub trained_ranges_deg: Vec<[f64; 2]>,
+    /// Width beyond the trained ranges over which the correction fades to zero [deg].
     #[serde(default)]
     pub fade_deg: f64,
     /// The expected error per pose checked on the validation set, for
@@ -450,6 +491,7 @@ pub enum OrientationPartStatus {
 }
 
 impl OrientationPartStatus {
+    /// Every status, in declaration order.
     pub const ALL: [OrientationPartStatus; 5] = [
         OrientationPartStatus::Trained,
         OrientationPartStatus::NotMeasured,
@@ -476,11 +518,17 @@ impl OrientationPartStatus {
 /// trained without the pose's fold (`|ω − ω̂|`, that angle to first order).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct OrientationCv {
+    /// Folds of the cross-validation.
     pub folds: usize,
+    /// Poses that measured an orientation.
     pub poses: usize,
+    /// Mean orientation error of the base alone [deg].
     pub base_mean_deg: f64,
+    /// Largest orientation error of the base alone [deg].
     pub base_max_deg: f64,
+    /// Mean out-of-fold orientation error after the correction [deg].
     pub compensated_mean_deg: f64,
+    /// Largest out-of-fold orientation error after the correction [deg].
     pub compensated_max_deg: f64,
 }
 
@@ -510,8 +558,11 @@ impl OrientationCv {
 /// cross-validation where one ran.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct OrientationPart {
+    /// Whether it is trained and applied.
     pub status: OrientationPartStatus,
+    /// Why, in words.
     pub reason: String,
+    /// The cross-validation of the part, where one ran.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cross_validation: Option<OrientationCv>,
 }
@@ -521,6 +572,7 @@ pub struct OrientationPart {
 /// `e > u` in 39.2 % of poses and `e > 2u` in 0.74 % (P(χ²₃ > 3), P(χ²₃ > 12)).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct UncertaintyCheck {
+    /// Validation poses compared.
     pub poses: usize,
     /// Mean of `u` over the validation poses [mm].
     pub mean_expected_mm: f64,
@@ -528,9 +580,11 @@ pub struct UncertaintyCheck {
     pub rms_ratio: f64,
     /// Share of poses with `e > u`, and the Gaussian expectation.
     pub above_expected: f64,
+    /// The Gaussian share of poses with `e > u`, 0.392.
     pub above_expected_gaussian: f64,
     /// Share of poses with `e > 2u`, and the Gaussian expectation.
     pub above_twice_expected: f64,
+    /// The Gaussian share of poses with `e > 2u`, 0.0074.
     pub above_twice_expected_gaussian: f64,
 }
 
@@ -577,7 +631,10 @@ impl UncertaintyCheck {
 /// [mm] of the base alone and with the compensator.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct AutoCandidate {
+    /// The candidate method.
     pub method: Method,
+    /// Cross-validation of the compensator on the training pool [mm] (`None` for a failed or a
+    /// joint-map candidate).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cross_validation: Option<CvStats>,
     /// Why it was not available (training failed, base failed).
@@ -594,7 +651,9 @@ pub struct AutoCandidate {
 pub struct AutoSummary {
     /// The method whose model `auto` delivers (a base or a compensator method).
     pub chosen: Method,
+    /// The choice in words: the decision, the chosen option's mean, why the others lost.
     pub reason: String,
+    /// Every option `auto` weighed.
     pub candidates: Vec<AutoCandidate>,
     /// The chosen compensator's orientation part: kept only when it lowered
     /// the cross-validated orientation mean (none without a compensator or
@@ -614,6 +673,7 @@ pub struct AutoDecision {
     /// Whether another option's cross-validated mean was within
     /// `tie_margin` of the lowest.
     pub tie: bool,
+    /// The step of the tie rule that decided (`methods::ties`).
     pub step: DecidingStep,
     /// What the step compares ([`DecidingStep::label`]).
     pub step_label: &'static str,
@@ -623,6 +683,7 @@ pub struct AutoDecision {
     /// By how much the winner led the runner-up at the deciding step, in
     /// `margin_unit` (0 without a runner-up).
     pub margin: f64,
+    /// Unit of `margin`: `mm`, `physics rank` or `fitted quantities`.
     pub margin_unit: &'static str,
     /// The runner-up's cross-validated mean less the winner's [mm].
     pub mean_margin_mm: f64,
@@ -645,12 +706,16 @@ pub struct AutoDecision {
 pub struct BaseFallback {
     /// The option the tie rule chose among all.
     pub instead_of: Method,
+    /// The base under `instead_of`.
     pub weaker_base: Method,
+    /// The base that beats it outside the trained region.
     pub better_base: Method,
     /// The two bases alone, weaker and better [mm], measured as `measured_by`
     /// says.
     pub weaker_mm: f64,
+    /// The better base alone [mm], measured as `measured_by` says.
     pub better_mm: f64,
+    /// What the two figures measure, in words.
     pub measured_by: String,
 }
 
@@ -707,23 +772,28 @@ pub enum WarningKind {
 /// A warning about one method's result.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MethodWarning {
+    /// What the warning is about.
     pub kind: WarningKind,
     /// Joint number (1-based) the warning is about.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub joint: Option<usize>,
+    /// The warning in words.
     pub message: String,
 }
 
 /// A method that did not deliver a model, and why.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FailedMethod {
+    /// The method that failed.
     pub method: Method,
+    /// Why it failed, in words.
     pub reason: String,
 }
 
 /// Registration of each measurement session.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SessionRegistration {
+    /// The 0-based tracker session.
     pub session: usize,
     /// Tracker → registered base frame (`x_base = R·x_tracker + t`).
     pub tracker_to_base: PoseDescription,
@@ -734,7 +804,9 @@ pub struct SessionRegistration {
 /// Nominal-model errors (before calibration) in the registered frame.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct NominalErrors {
+    /// Errors of the nominal model on the identification set.
     pub identification: SetErrors,
+    /// Errors of the nominal model on the validation set, when one was given.
     pub validation: Option<SetErrors>,
 }
 
@@ -743,15 +815,21 @@ pub struct NominalErrors {
 pub struct CalibrationReport {
     /// [`REPORT_FORMAT_VERSION`] of the writer.
     pub format_version: u32,
+    /// The robot model's name.
     pub robot: String,
+    /// Identification poses used.
     pub identification_poses: usize,
+    /// Validation poses given (0: none).
     pub validation_poses: usize,
     /// Poses of the compensator training pool (Q2; 0: none given, compensators
     /// train on the identification poses).
     #[serde(default)]
     pub training_poses: usize,
+    /// Each session's registration, by session index.
     pub registration: Vec<SessionRegistration>,
+    /// Which parameters were identified, and how well the poses determine them.
     pub identifiability: IdentifiabilityReport,
+    /// Errors of the nominal model after registration.
     pub nominal: NominalErrors,
     /// Serialised by name, in the order of the names.
     pub methods: BTreeMap<Method, MethodReport>,
@@ -783,6 +861,7 @@ impl CalibrationReport {
 }
 
 impl PoseSources {
+    /// Whether no set has pose sources.
     pub fn is_empty(&self) -> bool {
         self.identification.is_empty() && self.validation.is_empty() && self.training.is_empty()
     }

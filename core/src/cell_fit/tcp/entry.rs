@@ -39,6 +39,7 @@ pub enum OrientationSource {
 }
 
 impl OrientationSource {
+    /// Every source, in declaration order.
     pub const ALL: [OrientationSource; 4] = [
         OrientationSource::Fitted,
         OrientationSource::Given,
@@ -46,6 +47,7 @@ impl OrientationSource {
         OrientationSource::Unknown,
     ];
 
+    /// The source's name in answers and reports, as serialized (snake_case).
     pub fn as_str(self) -> &'static str {
         match self {
             OrientationSource::Fitted => "fitted",
@@ -60,12 +62,18 @@ impl OrientationSource {
 /// robot base frame).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct StoredEntry {
+    /// The controller's tool or work-object number (`None`: none given or stored).
     pub number: Option<u32>,
     /// A work object's frame (tools: `None`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub frame: Option<WorkObjectFrame>,
+    /// Position: a tool's TCP in the flange frame, a work object's origin in
+    /// `frame` [mm].
     pub xyz_mm: [f64; 3],
+    /// Orientation, fixed-axis `[rx, ry, rz]` with `R = Rz·Ry·Rx` [deg].
     pub rpy_deg: [f64; 3],
+    /// A tool's load (mass and centre of mass), kept from the stored tool (work
+    /// objects: `None`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub load: Option<LoadDescription>,
 }
@@ -125,15 +133,20 @@ impl StoredEntry {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum EntryField {
+    /// The controller's number.
     Number,
     /// A work object's frame (base or measurement).
     Frame,
+    /// The position `xyz_mm`.
     Position,
+    /// The orientation `rpy_deg`.
     Orientation,
+    /// A tool's load.
     Load,
 }
 
 impl EntryField {
+    /// Every part, in declaration order.
     pub const ALL: [EntryField; 5] = [
         EntryField::Number,
         EntryField::Frame,
@@ -142,6 +155,7 @@ impl EntryField {
         EntryField::Load,
     ];
 
+    /// The part's name in answers and reports, as serialized (snake_case).
     pub fn as_str(self) -> &'static str {
         match self {
             EntryField::Number => "number",
@@ -158,10 +172,17 @@ impl EntryField {
 /// another frame), and which parts changed.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Replaced {
+    /// The entry stored before the fit.
     pub old: StoredEntry,
+    /// The entry the fit stores in its place.
     pub new: StoredEntry,
+    /// Distance between the old and the new position [mm] (`None` when the
+    /// frames differ).
     pub moved_mm: Option<f64>,
+    /// Angle of the rotation from the old to the new orientation [deg] (`None`
+    /// when the frames differ).
     pub turned_deg: Option<f64>,
+    /// The parts that differ between old and new, in the order of [`EntryField::ALL`].
     pub changed: Vec<EntryField>,
 }
 
@@ -175,6 +196,8 @@ fn fmt3(v: &[f64; 3]) -> String {
 }
 
 impl Replaced {
+    /// Compares `old` with `new`: distance moved and angle turned when both are
+    /// in the same frame, and the parts that changed.
     pub fn between(old: StoredEntry, new: StoredEntry) -> Self {
         let same_frame = old.frame == new.frame;
         let moved_mm = same_frame.then(|| {
@@ -285,10 +308,15 @@ pub struct StoreRequest {
 /// what it replaces, and the verdict it overruled when forced.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Fitted<F> {
+    /// The fit itself (a [`ToolFit`] or a [`WorkObjectFit`]).
     pub fit: F,
     /// `None` only for a report of a tool whose orientation is unknown.
     pub entry: Option<StoredEntry>,
+    /// Where a tool's orientation comes from (`None` for a work object, whose
+    /// orientation is always fitted).
     pub orientation: Option<OrientationSource>,
+    /// The stored entry this one replaces, with what changed (`None`: nothing
+    /// of that name was stored).
     pub replaced: Option<Replaced>,
     /// The verdict of [`super::judge`] the user forced past.
     pub overruled: Option<FitError>,
@@ -304,14 +332,21 @@ fn is_false(b: &bool) -> bool {
 /// and what it replaced.
 #[derive(Debug, Serialize)]
 pub struct Answer<'a, F: Serialize> {
+    /// Whether the fit passed [`super::judge`] (false when it was forced past
+    /// the verdict).
     pub fitted: bool,
+    /// Whether the user forced a fit judged not plausible to be stored.
     #[serde(skip_serializing_if = "is_false")]
     pub forced: bool,
+    /// The verdict forced past (reason, message and figures, flattened into the answer).
     #[serde(flatten)]
     pub overruled: Option<&'a FitError>,
+    /// The fit itself.
     pub fit: &'a F,
+    /// Where a tool's orientation comes from (`None` for a work object).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub orientation: Option<OrientationSource>,
+    /// The stored entry replaced and what changed.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub replaced: Option<&'a Replaced>,
 }
@@ -333,7 +368,10 @@ impl<F: Serialize> Fitted<F> {
 /// A fit's outcome.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Outcome<F> {
+    /// The fit is stored (or reported), judged plausible or forced past its verdict.
     Fitted(Box<Fitted<F>>),
+    /// Nothing is stored: the readings determine nothing, the verdict was not
+    /// forced, or a tool's orientation is unknown.
     NotFitted(FitError),
 }
 

@@ -43,6 +43,7 @@ impl Noise {
 /// The bounds a fit was judged against.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Limits {
+    /// What the residuals are made of, which sets `sigma_mm`.
     pub noise: Noise,
     /// σ per coordinate [mm].
     pub sigma_mm: f64,

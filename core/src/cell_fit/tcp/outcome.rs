@@ -67,6 +67,7 @@ pub enum NotFittedReason {
 }
 
 impl NotFittedReason {
+    /// Every reason, in declaration order.
     pub const ALL: [NotFittedReason; 22] = [
         NotFittedReason::TooFewReadings,
         NotFittedReason::JointCount,
@@ -92,6 +93,7 @@ impl NotFittedReason {
         NotFittedReason::OrientationUnknown,
     ];
 
+    /// The reason's name in the API's `reason` and the command line's text (snake_case).
     pub fn as_str(self) -> &'static str {
         match self {
             NotFittedReason::TooFewReadings => "too_few_readings",
@@ -137,7 +139,9 @@ impl NotFittedReason {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum JudgedFit {
+    /// A fitted tool.
     Tool(ToolFit),
+    /// A fitted work object.
     WorkObject(WorkObjectFit),
 }
 
@@ -148,10 +152,15 @@ pub enum JudgedFit {
 #[derive(Debug, Clone, PartialEq, Serialize, thiserror::Error)]
 #[error("{message}")]
 pub struct FitError {
+    /// Why the fit was refused.
     pub reason: NotFittedReason,
+    /// What went wrong and how to fix it, for the user.
     pub message: String,
+    /// The row at fault (1-based, in the list the message names).
     pub row: Option<usize>,
+    /// The figure the reason names, in the unit [`NotFittedReason`] gives for it.
     pub measured: Option<f64>,
+    /// The bound that figure had to meet, in the same unit.
     pub needed: Option<f64>,
     /// The tip, fitted before its axis could not be.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -163,6 +172,7 @@ pub struct FitError {
 }
 
 impl FitError {
+    /// A refusal for `reason` with `message`, without row, figures or fit.
     pub fn new(reason: NotFittedReason, message: impl Into<String>) -> Self {
         FitError {
             reason,
@@ -214,12 +224,14 @@ pub enum TcpMethod {
 }
 
 impl TcpMethod {
+    /// Every method, in declaration order.
     pub const ALL: [TcpMethod; 3] = [
         TcpMethod::FixedPoint,
         TcpMethod::TrackerPoint,
         TcpMethod::TrackerFrame,
     ];
 
+    /// The method's name on the command line and in the API (snake_case).
     pub fn as_str(self) -> &'static str {
         match self {
             TcpMethod::FixedPoint => "fixed_point",
@@ -246,6 +258,7 @@ impl std::str::FromStr for TcpMethod {
 /// A fitted tool: its TCP frame in the flange frame and how well it fits.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ToolFit {
+    /// How the TCP was found.
     pub method: TcpMethod,
     /// Flange → TCP [m]; the rotation is the flange's unless an axis or a
     /// 6-D probe gave one ([`Self::rpy_deg`]).
@@ -262,7 +275,9 @@ pub struct ToolFit {
     pub distance_mm: f64,
     /// Per pose: distance of the fitted tip from where it should be [mm].
     pub residual_mm: Vec<f64>,
+    /// RMS of `residual_mm` [mm].
     pub rms_mm: f64,
+    /// Largest of `residual_mm` [mm].
     pub max_mm: f64,
     /// 1σ of the TCP position per flange axis [mm] (covariance of the fit).
     pub sigma_mm: [f64; 3],

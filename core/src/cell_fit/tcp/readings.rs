@@ -33,8 +33,10 @@ pub enum WoPoint {
 }
 
 impl WoPoint {
+    /// Every point, in declaration order.
     pub const ALL: [WoPoint; 4] = [WoPoint::Origin, WoPoint::X, WoPoint::Xy, WoPoint::Plane];
 
+    /// The point's name in the `point` column (lower case).
     pub fn as_str(self) -> &'static str {
         match self {
             WoPoint::Origin => "origin",

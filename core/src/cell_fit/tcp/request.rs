@@ -26,8 +26,11 @@ pub enum AxisRequest {
 /// A tool calibration.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ToolRequest {
+    /// How the TCP is to be found.
     pub method: TcpMethod,
+    /// The readings of the tool's tip, one per pose.
     pub rows: Vec<Reading>,
+    /// How the tool's axis is given, when its orientation is to be fitted.
     pub axis: Option<AxisRequest>,
 }
 

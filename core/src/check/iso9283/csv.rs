@@ -30,8 +30,11 @@ use crate::model::bounds::show;
 /// A commanded pose read from a plan CSV.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Commanded {
+    /// The pose's name (`P1` … `P5`).
     pub name: String,
+    /// Commanded position, measurement (cell) frame [mm].
     pub xyz_mm: [f64; 3],
+    /// Commanded `a, b, c` (`R = Rz(c)·Ry(b)·Rx(a)`) [deg], when the plan gives them.
     pub abc_deg: Option<[f64; 3]>,
 }
 

@@ -20,7 +20,9 @@ use serde::{Deserialize, Serialize};
 /// An axis-aligned cube, base frame [mm].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct TestCube {
+    /// Centre of the cube, base frame [mm].
     pub centre_mm: [f64; 3],
+    /// Length of an edge [mm].
     pub edge_mm: f64,
 }
 
@@ -99,8 +101,10 @@ pub enum Commands {
 }
 
 impl Commands {
+    /// Both kinds of commands, in declaration order.
     pub const ALL: [Commands; 2] = [Commands::Nominal, Commands::Filtered];
 
+    /// The name on the command line and in the API (`nominal`, `filtered`).
     pub fn name(self) -> &'static str {
         match self {
             Commands::Nominal => "nominal",
@@ -128,6 +132,7 @@ pub struct CubeSettings {
     pub workspace: WorkspaceBox,
     /// The tool orientation at every pose, base frame (maps tool vectors).
     pub orientation: Matrix3<f64>,
+    /// Which model the poses are solved on.
     pub commands: Commands,
     /// When a pose cannot be solved the edge shrinks by this factor …
     pub shrink: f64,
@@ -171,7 +176,9 @@ pub struct CubePlan {
     pub cube: TestCube,
     /// Edge of the largest cube in the box [mm].
     pub largest_edge_mm: f64,
+    /// Which model the poses were solved on.
     pub commands: Commands,
+    /// The five poses P1 … P5, in order.
     pub poses: Vec<CubePose>,
 }
 

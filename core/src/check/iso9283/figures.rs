@@ -11,11 +11,13 @@ use serde::{Deserialize, Serialize};
 pub struct PoseCycles {
     /// The pose's name (`P1` … `P5`).
     pub name: String,
+    /// Commanded position [mm].
     pub commanded_mm: [f64; 3],
     /// Commanded `a, b, c` [deg], when known.
     pub commanded_abc_deg: Option<[f64; 3]>,
     /// Cycle numbers, one per attained position (distances pair equal cycles).
     pub cycles: Vec<u32>,
+    /// Attained positions, one per cycle, in the order of `cycles` [mm].
     pub attained_mm: Vec<[f64; 3]>,
     /// Attained `a, b, c` [deg], one per cycle, when measured.
     pub attained_abc_deg: Option<Vec<[f64; 3]>>,
@@ -24,6 +26,7 @@ pub struct PoseCycles {
 /// The standard's figures for one pose.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PoseFigures {
+    /// The pose's name.
     pub pose: String,
     /// Number of cycles `n`.
     pub cycles: usize,
@@ -48,7 +51,9 @@ pub struct PoseFigures {
 /// Distance accuracy and repeatability between two poses.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DistanceFigures {
+    /// Name of the distance's first pose.
     pub from: String,
+    /// Name of the distance's second pose.
     pub to: String,
     /// Cycles measured at both poses.
     pub cycles: usize,
@@ -67,7 +72,9 @@ pub struct DistanceFigures {
 /// Every pose's figures and the distances between every pair of poses.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Iso9283Figures {
+    /// The figures of each pose, in the order given.
     pub poses: Vec<PoseFigures>,
+    /// The figures of each pair of poses.
     pub distances: Vec<DistanceFigures>,
 }
 

@@ -37,7 +37,9 @@ pub struct CycleRow {
 pub struct JoinedCycles {
     /// In cycle order, and in the plan's order within a cycle.
     pub rows: Vec<CycleRow>,
+    /// The units the export was read in.
     pub units: Units,
+    /// How the points were matched.
     pub by: JoinBy,
     /// The highest cycle number joined.
     pub cycles: u32,
@@ -49,26 +51,57 @@ pub struct JoinedCycles {
 /// Why a tracker export of the cycles does not join.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CycleJoinError {
+    /// The export cannot be read (see [`JoinError`]).
     #[error(transparent)]
     Export(#[from] JoinError),
+    /// A point name is not `P<i> cycle <k>`; the name.
     #[error("tracker point `{0}` does not name a pose and a cycle (write `P<i> cycle <k>`, as the cycle program's comments do)")]
     Name(String),
+    /// A point names a pose the plan does not have.
     #[error("tracker point `{point}`: the plan has no pose {pose} (it has {plan})")]
     NotInPlan {
+        /// The point's name.
         point: String,
+        /// The pose it names.
         pose: String,
+        /// The plan's poses, for the message.
         plan: String,
     },
+    /// A cycle number is not from 1 to [`CYCLES_MAX`].
     #[error("tracker point `{point}`: cycle {cycle} is not from 1 to {CYCLES_MAX}")]
-    Cycle { point: String, cycle: u64 },
+    Cycle {
+        /// The point's name.
+        point: String,
+        /// The cycle number it names.
+        cycle: u64,
+    },
+    /// A pose and cycle appears twice; which.
     #[error("the tracker export has {0} twice")]
     Duplicate(String),
+    /// Joining by order, the points are not a whole number of cycles of the plan.
     #[error("joining by order: {points} tracker points are not a whole number of cycles of the plan's {poses} poses")]
-    Count { points: usize, poses: usize },
+    Count {
+        /// Points in the export.
+        points: usize,
+        /// Poses in the plan.
+        poses: usize,
+    },
+    /// Joining by order, the points are more than [`CYCLES_MAX`] cycles of the plan.
     #[error("joining by order: {points} tracker points are more than {CYCLES_MAX} cycles of the plan's {poses} poses")]
-    TooManyCycles { points: usize, poses: usize },
+    TooManyCycles {
+        /// Points in the export.
+        points: usize,
+        /// Poses in the plan.
+        poses: usize,
+    },
+    /// A coordinate, in millimetres, is beyond ±[`XYZ_MAX_MM`].
     #[error("tracker point {point}: {} mm (in millimetres) is beyond the bound ±{XYZ_MAX_MM} mm", show(*value))]
-    OutOfRange { point: usize, value: f64 },
+    OutOfRange {
+        /// 1-based index of the point in the export.
+        point: usize,
+        /// The coordinate [mm].
+        value: f64,
+    },
 }
 
 /// `(pose, cycle)` of a point name `P<i>[sep][cycle|c][sep]<k>`.

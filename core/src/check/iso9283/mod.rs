@@ -52,16 +52,35 @@ pub use outcome::{assess, Assessment, NotComputedReason, Outcome};
 /// Why the ISO 9283 plan or figures cannot be computed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum Iso9283Error {
+    /// An input is out of range or missing; the message says which.
     #[error("invalid input: {0}")]
     InvalidInput(String),
+    /// A pose has fewer than 2 cycles.
     #[error("pose {pose}: {cycles} cycle(s); the standard's statistics need at least 2 (30 recommended)")]
-    TooFewCycles { pose: String, cycles: usize },
+    TooFewCycles {
+        /// The pose's name.
+        pose: String,
+        /// Cycles measured at it.
+        cycles: usize,
+    },
+    /// No cube down to the smallest edge has all five poses solved.
     #[error(
         "no cube of edge ≥ {min_edge_mm:.1} mm in the box has all five poses reachable: {detail}"
     )]
-    Unreachable { min_edge_mm: f64, detail: String },
+    Unreachable {
+        /// Smallest edge accepted [mm] (`min_edge_fraction` of the largest cube's).
+        min_edge_mm: f64,
+        /// Why the last pose tried could not be solved.
+        detail: String,
+    },
+    /// A plan or cycles CSV cannot be read.
     #[error("line {line}: {message}")]
-    Csv { line: usize, message: String },
+    Csv {
+        /// 1-based line (0 when the text as a whole cannot be read).
+        line: usize,
+        /// What is wrong, naming the column where one applies.
+        message: String,
+    },
     /// A CSV row whose field count is not its header's.
     #[error(transparent)]
     FieldCount(#[from] crate::measure::csv_text::FieldCount),

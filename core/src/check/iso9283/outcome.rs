@@ -47,6 +47,7 @@ pub enum NotComputedReason {
 }
 
 impl NotComputedReason {
+    /// Every reason, in the order of precedence.
     pub const ALL: [NotComputedReason; 7] = [
         NotComputedReason::PoseNotMeasured,
         NotComputedReason::PoseNotInPlan,
@@ -76,14 +77,19 @@ impl NotComputedReason {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(tag = "outcome", rename_all = "snake_case")]
 pub enum Outcome<T> {
+    /// The figure, computed.
     Computed(T),
+    /// The figure is undetermined by the data.
     NotComputed {
+        /// Why it was not computed.
         reason: NotComputedReason,
+        /// What is missing, for the user.
         message: String,
     },
 }
 
 impl<T> Outcome<T> {
+    /// The computed figure, or `None`.
     pub fn computed(&self) -> Option<&T> {
         match self {
             Outcome::Computed(v) => Some(v),
@@ -91,6 +97,7 @@ impl<T> Outcome<T> {
         }
     }
 
+    /// Why the figure was not computed, or `None` when it was.
     pub fn reason(&self) -> Option<NotComputedReason> {
         match self {
             Outcome::Computed(_) => None,
@@ -106,91 +113,121 @@ fn not<T>(reason: NotComputedReason, message: String) -> Outcome<T> {
 /// AP: the barycentre's distance from the command.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PositionAccuracy {
+    /// Barycentre of the attained positions (x̄, ȳ, z̄) [mm].
     pub barycentre_mm: [f64; 3],
+    /// AP, the barycentre's distance from the commanded position [mm].
     pub ap_mm: f64,
+    /// APx, APy, APz = x̄ − x_c, … [mm].
     pub ap_xyz_mm: [f64; 3],
 }
 
 /// RP = l̄ + 3·S_l.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PositionRepeatability {
+    /// l̄, the mean distance of the attained positions from their barycentre [mm].
     pub l_mean_mm: f64,
+    /// S_l, the standard deviation of those distances (n − 1) [mm].
     pub s_l_mm: f64,
+    /// RP = l̄ + 3·S_l [mm].
     pub rp_mm: f64,
 }
 
 /// APa, APb, APc.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct OrientationAccuracy {
+    /// APa, APb, APc = ā − a_c, … [deg].
     pub ap_abc_deg: [f64; 3],
 }
 
 /// ±RPa, ±RPb, ±RPc = ±3·S.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct OrientationRepeatability {
+    /// RPa, RPb, RPc = 3·S_a, … [deg] (read as ±).
     pub rp_abc_deg: [f64; 3],
 }
 
 /// AD = D̄ − D_c.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct DistanceAccuracy {
+    /// D_c, the commanded distance [mm].
     pub commanded_mm: f64,
+    /// D̄, the mean attained distance [mm].
     pub mean_mm: f64,
+    /// AD = D̄ − D_c [mm].
     pub ad_mm: f64,
 }
 
 /// RD = ±3·S_D.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct DistanceRepeatability {
+    /// D̄, the mean attained distance [mm].
     pub mean_mm: f64,
+    /// S_D, the standard deviation of the attained distances (n − 1) [mm].
     pub s_d_mm: f64,
+    /// RD = 3·S_D [mm] (read as ±).
     pub rd_mm: f64,
 }
 
 /// One pose's figures.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PoseOutcomes {
+    /// The pose's name.
     pub pose: String,
     /// Whether the plan commands the pose.
     pub commanded: bool,
     /// Cycles measured at the pose (`n`).
     pub cycles: usize,
+    /// Pose accuracy AP.
     pub ap: Outcome<PositionAccuracy>,
+    /// Pose repeatability RP.
     pub rp: Outcome<PositionRepeatability>,
+    /// Orientation accuracy APa, APb, APc.
     pub ap_abc: Outcome<OrientationAccuracy>,
+    /// Orientation repeatability RPa, RPb, RPc.
     pub rp_abc: Outcome<OrientationRepeatability>,
 }
 
 /// One pair of poses' figures.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct DistanceOutcomes {
+    /// Name of the distance's first pose.
     pub from: String,
+    /// Name of the distance's second pose.
     pub to: String,
     /// Cycles measured at both poses.
     pub cycles: usize,
+    /// Distance accuracy AD.
     pub ad: Outcome<DistanceAccuracy>,
+    /// Distance repeatability RD.
     pub rd: Outcome<DistanceRepeatability>,
 }
 
 /// Every pose's figures, and every pair's, in the order of the poses given.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Assessment {
+    /// Each pose's figures, in the order given.
     pub poses: Vec<PoseOutcomes>,
+    /// Each pair of poses' figures.
     pub distances: Vec<DistanceOutcomes>,
 }
 
 /// A commanded pose [mm, deg].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CommandedPose {
+    /// Commanded position [mm].
     pub xyz_mm: [f64; 3],
+    /// Commanded `a, b, c` [deg], when the plan gives them.
     pub abc_deg: Option<[f64; 3]>,
 }
 
 /// One attained pose: its cycle number (distances pair equal cycles) [mm, deg].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CycleReading {
+    /// Cycle number, 1 to [`CYCLES_MAX`].
     pub cycle: u32,
+    /// Attained position [mm].
     pub xyz_mm: [f64; 3],
+    /// Attained `a, b, c` [deg], when measured.
     pub abc_deg: Option<[f64; 3]>,
 }
 
@@ -198,8 +235,11 @@ pub struct CycleReading {
 /// measured.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PoseData {
+    /// The pose's name (`P1` … `P5`).
     pub name: String,
+    /// Its command (`None`: the plan does not have the pose).
     pub commanded: Option<CommandedPose>,
+    /// Its cycles (`None`: the pose was not measured).
     pub measured: Option<Vec<CycleReading>>,
 }
 

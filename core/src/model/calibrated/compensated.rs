@@ -35,12 +35,21 @@ use std::sync::Arc;
 /// Errors of the compensated model and its files.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CompensateError {
+    /// The model description in the file is invalid.
     #[error(transparent)]
     Model(#[from] ModelError),
+    /// Forward kinematics failed.
     #[error(transparent)]
     Kinematics(#[from] KinematicsError),
+    /// A file could not be read (raised by the callers that read files).
     #[error("{path}: {reason}")]
-    Io { path: String, reason: String },
+    Io {
+        /// The file's path.
+        path: String,
+        /// Why it could not be read.
+        reason: String,
+    },
+    /// The calibrated model file is malformed; what is wrong.
     #[error("calibrated model file: {0}")]
     Format(String),
 }

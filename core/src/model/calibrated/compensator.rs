@@ -17,7 +17,10 @@ use nalgebra::{Matrix3xX, Vector3};
 /// to be added to `FK_cal(q + c∘τ)`. Implementations must be cheap and
 /// deterministic: the IK calls them once per iteration.
 pub trait Compensator: Send + Sync {
+    /// The position correction [m], registered base frame, at commanded joints
+    /// `q` [rad] and gravity torques `tau` [N·m] with the model's payload.
     fn residual(&self, q: &[f64], tau: &[f64]) -> Vector3<f64>;
+    /// The compensator's short name (`mlp`, `rbf`, `gp`), e.g. in debug output.
     fn name(&self) -> &str;
     /// The residual at a given payload mass [kg] (for compensators with a
     /// payload input; the default ignores it).
@@ -104,7 +107,9 @@ pub trait Compensator: Send + Sync {
 /// and without it (where it fades out).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Uncertainty {
+    /// Expected position error with the full correction applied [m].
     pub compensated_m: f64,
+    /// Expected position error without the correction [m].
     pub uncompensated_m: f64,
 }
 

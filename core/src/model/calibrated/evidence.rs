@@ -30,6 +30,7 @@ pub struct ValidationEvidence {
     pub poses: usize,
     /// Position error of the measured point (reflector / probe) [mm].
     pub position_mean_mm: f64,
+    /// Largest position error of the measured point [mm].
     pub position_max_mm: f64,
     /// One term per validation pose with a measured orientation (empty:
     /// position-only validation data).

@@ -203,10 +203,13 @@ impl CalibratedModelFile {
         })
     }
 
+    /// The file as pretty-printed JSON.
     pub fn to_json(&self) -> String {
         serde_json::to_string_pretty(self).expect("calibrated model file serialises")
     }
 
+    /// Parses a calibrated model file from JSON; structure only (the loader
+    /// checks values and bounds).
     pub fn from_json(text: &str) -> Result<Self, CompensateError> {
         serde_json::from_str(text).map_err(|e| CompensateError::Format(e.to_string()))
     }

@@ -39,6 +39,8 @@ pub struct StoredOrientation {
 }
 
 impl StoredOrientation {
+    /// Checks that the point is finite and the network valid with `dof` joints,
+    /// as the position part has; the error names the field.
     pub fn validate(&self, dof: usize) -> Result<(), String> {
         if !self.point_m.iter().all(|v| v.is_finite()) {
             return Err("compensator_orientation: point_m must be finite".into());

@@ -105,12 +105,14 @@ macro_rules! stored_table {
                 }
             }
 
+            /// Checks the stored network's sizes and values (file input).
             pub fn validate(&self) -> Result<(), InvalidCompensator> {
                 match self {
                     $(StoredCompensator::$variant(m) => StoredFamily::validate(m),)+
                 }
             }
 
+            /// Joints of the robot the network was trained for.
             pub fn dof(&self) -> usize {
                 match self {
                     $(StoredCompensator::$variant(m) => StoredFamily::dof(m),)+

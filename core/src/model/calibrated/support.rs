@@ -23,7 +23,9 @@ pub const MAX_POINTS: usize = 1000;
 /// Where a compensator was trained (module docs). Radians.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Support {
+    /// Per joint, the range `[lo, hi]` of the training joints, model convention [rad].
     pub ranges_rad: Vec<[f64; 2]>,
+    /// Width of the fade beyond each range [rad].
     pub fade_rad: f64,
     /// An even subsample of the training configurations.
     pub points_rad: Vec<Vec<f64>>,
@@ -49,8 +51,15 @@ pub struct SupportCoverage {
 /// Why a stored support is refused.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum InvalidSupport {
+    /// The ranges are not one per joint.
     #[error("compensator support: {got} joint ranges for {dof} joints")]
-    Ranges { got: usize, dof: usize },
+    Ranges {
+        /// Ranges stored.
+        got: usize,
+        /// Joints of the robot.
+        dof: usize,
+    },
+    /// A value is not finite, a range not ordered or a width negative.
     #[error("compensator support: values must be finite, ranges ordered, widths not negative")]
     Values,
 }

@@ -28,17 +28,22 @@ use std::str::FromStr;
 /// An export format.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum ExportFormat {
+    /// URDF (XML), metres and radians, root link `cell`.
     #[serde(rename = "urdf")]
     Urdf,
+    /// Standard (distal) DH table, CSV.
     #[serde(rename = "dh-csv")]
     DhCsv,
+    /// Modified DH table (robocal's own rows), CSV.
     #[serde(rename = "mdh-csv")]
     MdhCsv,
+    /// robocal's own model JSON.
     #[serde(rename = "json")]
     Json,
 }
 
 impl ExportFormat {
+    /// Every format, in declaration order.
     pub const ALL: [ExportFormat; 4] = [
         ExportFormat::Urdf,
         ExportFormat::DhCsv,
@@ -46,6 +51,8 @@ impl ExportFormat {
         ExportFormat::Json,
     ];
 
+    /// The format's name on the command line and in the API (`urdf`, `dh-csv`,
+    /// `mdh-csv`, `json`).
     pub fn name(self) -> &'static str {
         match self {
             ExportFormat::Urdf => "urdf",
@@ -84,10 +91,14 @@ impl FromStr for ExportFormat {
     }
 }
 
+/// Why a model cannot be exported.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ExportError {
+    /// No format has this name; the name given.
     #[error("unknown export format `{0}`; use urdf, dh-csv, mdh-csv or json")]
     UnknownFormat(String),
+    /// The model has what the format cannot hold (a closed loop, Hayati twists
+    /// in DH); the message says what.
     #[error("{0}")]
     NotRepresentable(String),
 }

@@ -13,10 +13,21 @@ use crate::model::robot::{Link, RobotModel};
 /// Kinematics errors.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum KinematicsError {
+    /// The joint values are not one per active joint.
     #[error("expected {expected} joint values, got {got}")]
-    DimensionMismatch { expected: usize, got: usize },
+    DimensionMismatch {
+        /// The model's active joints.
+        expected: usize,
+        /// Joint values given.
+        got: usize,
+    },
+    /// A joint value is not finite.
     #[error("joint value {index} is not finite")]
-    NotFinite { index: usize },
+    NotFinite {
+        /// 0-based index of the value.
+        index: usize,
+    },
+    /// A closed loop cannot close at these joints.
     #[error(transparent)]
     LoopOpen(#[from] LoopOpen),
 }
@@ -37,6 +48,7 @@ pub struct LinkFrames {
 /// Forward kinematics with all intermediate frames.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Chain {
+    /// Each link's frames, base link first.
     pub links: Vec<LinkFrames>,
     /// Chain joint angles θ_k actually used (passive angle for the loop joint) [rad].
     pub angles: Vec<f64>,

@@ -23,8 +23,11 @@ pub struct LoopPartials {
     pub d_motor: f64,
     /// ∂θ3p/∂SP (the passive link's a).
     pub d_sp: f64,
+    /// ∂θ3p/∂L3.
     pub d_l3: f64,
+    /// ∂θ3p/∂L4.
     pub d_l4: f64,
+    /// ∂θ3p/∂L5.
     pub d_l5: f64,
 }
 
@@ -33,6 +36,7 @@ pub struct LoopPartials {
 pub struct LoopSolution {
     /// Passive joint angle θ3p [rad].
     pub passive: f64,
+    /// The passive angle's partial derivatives (eq. 4.11).
     pub partials: LoopPartials,
 }
 
@@ -40,8 +44,11 @@ pub struct LoopSolution {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("closed loop cannot close: crank-to-elbow distance {distance_m:.4} m is outside [{min_m:.4}, {max_m:.4}] m (|L3−L4|, L3+L4)")]
 pub struct LoopOpen {
+    /// Distance from the crank's end Q to the passive joint S [m].
     pub distance_m: f64,
+    /// Shortest distance the loop closes at, `|L3 − L4|` [m].
     pub min_m: f64,
+    /// Longest distance the loop closes at, `L3 + L4` [m].
     pub max_m: f64,
 }
 

@@ -63,6 +63,7 @@ pub struct PreparedChain {
 }
 
 impl PreparedChain {
+    /// Precomputes `model`'s constant trigonometry, base and tool (the model is cloned).
     pub fn new(model: &RobotModel) -> Self {
         let constants = ChainConstants::of(model);
         let mut base = Pose::identity();
@@ -76,10 +77,12 @@ impl PreparedChain {
         }
     }
 
+    /// The model the chain was prepared from.
     pub fn model(&self) -> &RobotModel {
         &self.model
     }
 
+    /// Number of active joints.
     pub fn dof(&self) -> usize {
         self.model.dof()
     }

@@ -12,18 +12,23 @@ use crate::solve::cell::Load;
 /// One tool as the controller holds it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ControllerTool {
+    /// The tool's name in the cell (written as a comment, or as the identifier
+    /// where data are named).
     pub name: String,
     /// The controller's number (`Cell::tool_numbers`).
     pub number: u32,
     /// Flange → TCP [m].
     pub tcp: Pose,
+    /// The tool's load: mass and centre of mass in the flange frame.
     pub load: Load,
 }
 
 /// One work object in the controller's base frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ControllerFrame {
+    /// The work object's name in the cell.
     pub name: String,
+    /// The controller's number (`Cell::work_object_numbers`).
     pub number: u32,
     /// Base → work object [m].
     pub pose: Pose,
@@ -33,8 +38,11 @@ pub struct ControllerFrame {
 /// without one.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct ControllerData {
+    /// The tools the controller must hold.
     pub tools: Vec<ControllerTool>,
+    /// The work objects the controller must hold.
     pub frames: Vec<ControllerFrame>,
+    /// Items without a number and the one they were given.
     pub assigned: Vec<AssignedNumber>,
 }
 
@@ -49,6 +57,7 @@ pub struct ExportOptions {
 /// The exported text and what it decided.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ControllerExport {
+    /// The text of the controller's data file (KRL, RAPID, Fanuc or URScript).
     pub text: String,
     /// Items without a number and the one they were given (KRL, Fanuc).
     pub assigned: Vec<AssignedNumber>,
@@ -62,27 +71,42 @@ pub struct ControllerExport {
 /// Why a cell cannot be exported for a controller: the item and the fix.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum ExportError {
+    /// Two items of one kind have the same number.
     #[error("{0}")]
     Duplicate(#[from] DuplicateNumber),
+    /// An item has number 0, which the controller reserves for its own frame.
     #[error("{} `{name}` has number 0, which is {} on this controller: give it a number from {} to {} ({}[{}..{}])", .kind.label(), .range.zero, .range.first, .range.last, .range.data, .range.first, .range.last)]
     NumberZero {
+        /// Tool or work object.
         kind: ItemKind,
+        /// The item's name in the cell.
         name: String,
+        /// The numbers the controller takes for that kind.
         range: NumberRange,
     },
+    /// An item's number, given or assigned, is beyond the controller's data.
     #[error("{} `{name}` {}: the controller has {}[{}..{}]", .kind.label(), if *.assigned { format!("has no number and the lowest free one is {number}") } else { format!("has number {number}") }, .range.data, .range.first, .range.last)]
     NumberOutOfRange {
+        /// Tool or work object.
         kind: ItemKind,
+        /// The item's name in the cell.
         name: String,
+        /// The number, given or assigned.
         number: u32,
         /// The number was given by the export (the item has none).
         assigned: bool,
+        /// The numbers the controller takes for that kind.
         range: NumberRange,
     },
+    /// The Fanuc export's register range is shorter than the tools and work
+    /// objects it must hold.
     #[error("the Fanuc export needs {needed} position registers (one per tool and work object), {given} given ({range}): give a range of at least {needed}")]
     TooFewRegisters {
+        /// Registers needed: one per tool and work object.
         needed: usize,
+        /// Registers in the range given.
         given: usize,
+        /// The range given.
         range: RegisterRange,
     },
 }

@@ -110,6 +110,7 @@ pub enum RenameReason {
 }
 
 impl RenameReason {
+    /// Every reason, in declaration order.
     pub const ALL: [RenameReason; 4] = [
         RenameReason::Characters,
         RenameReason::Length,
@@ -117,6 +118,7 @@ impl RenameReason {
         RenameReason::Taken,
     ];
 
+    /// The reason's name in the export's answer (snake_case, as serialized).
     pub fn as_str(self) -> &'static str {
         match self {
             RenameReason::Characters => "characters",
@@ -137,10 +139,16 @@ pub struct TakenBy {
 /// An item declared under an identifier other than its name.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct Renamed {
+    /// Tool or work object.
     pub kind: ItemKind,
+    /// The item's name in the cell.
     pub name: String,
+    /// The identifier the export declares it under.
     pub identifier: String,
+    /// Why the identifier differs from the name (one or more).
     pub reasons: Vec<RenameReason>,
+    /// The item that had the identifier first, when the reason is
+    /// [`RenameReason::Taken`].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub taken_by: Option<TakenBy>,
 }

@@ -19,7 +19,9 @@ use serde::Serialize;
 pub struct NumberRange {
     /// The data's name in the language (`TOOL_DATA`, `UFRAME`, …).
     pub data: &'static str,
+    /// Lowest number the data take (1 on every controller here).
     pub first: u32,
+    /// Highest number the data take (16 or 32 in KRL, 10 or 9 in Fanuc).
     pub last: u32,
     /// What number 0 is on that controller.
     pub zero: &'static str,
@@ -49,7 +51,9 @@ pub(super) fn range(language: Language, kind: ItemKind) -> Option<NumberRange> {
 /// The position registers a Fanuc export may overwrite, `first..=last`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct RegisterRange {
+    /// First register the export may write.
     pub first: u32,
+    /// Last register the export may write (inclusive).
     pub last: u32,
 }
 
@@ -101,8 +105,11 @@ impl std::fmt::Display for RegisterRange {
 /// One register the export writes and the item it holds.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct UsedRegister {
+    /// The position register number (`PR[n]`).
     pub register: u32,
+    /// Tool or work object.
     pub kind: ItemKind,
+    /// The item's name in the cell.
     pub name: String,
 }
 

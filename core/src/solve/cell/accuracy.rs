@@ -39,8 +39,11 @@ pub enum ToolAccuracy {
     /// Measured on validation poses (with the tool applied when it is not
     /// the measured point itself).
     Measured {
+        /// Validation poses the figure is taken over.
         poses: usize,
+        /// Mean error at the tip [mm].
         mean_mm: f64,
+        /// Largest error at the tip [mm].
         max_mm: f64,
         /// Whether the figure is the tip's from 6-D data (`false`: the
         /// measured point itself).
@@ -48,9 +51,15 @@ pub enum ToolAccuracy {
     },
     /// Position-only validation data: the tool's orientation is unverified,
     /// its tip error unknown.
-    Unverified { message: String },
+    Unverified {
+        /// Why the tip error is unknown and how to know it, for the user.
+        message: String,
+    },
     /// No validation data was stored with the model.
-    Unknown { message: String },
+    Unknown {
+        /// What is missing, for the user.
+        message: String,
+    },
 }
 
 /// The expected error at the tip of tool `tcp` (flange → TCP) of a model

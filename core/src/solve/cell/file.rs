@@ -12,7 +12,10 @@ use serde::{Deserialize, Serialize};
 /// A pose in boundary units.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PoseMmDeg {
+    /// Position [mm].
     pub xyz_mm: [f64; 3],
+    /// Rotation `[rx, ry, rz]` [deg], applied as `Rz(rz)·Ry(ry)·Rx(rx)` (zero
+    /// when absent).
     #[serde(default)]
     pub rpy_deg: [f64; 3],
 }
@@ -41,9 +44,12 @@ impl PoseMmDeg {
 /// A tool of the cell file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ToolDescription {
+    /// The tool's name.
     pub name: String,
+    /// The controller's number (KUKA `TOOL_DATA[n]`, Fanuc `UT`), if any.
     #[serde(default)]
     pub number: Option<u32>,
+    /// Flange → TCP, as `xyz_mm` and `rpy_deg` at the tool's top level.
     #[serde(flatten)]
     pub tcp: PoseMmDeg,
     /// The load the tool carries (`cell::load`), if stated.
@@ -54,11 +60,15 @@ pub struct ToolDescription {
 /// A work object of the cell file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct WorkObjectDescription {
+    /// The work object's name.
     pub name: String,
+    /// The controller's number (KUKA `BASE_DATA[n]`, Fanuc `UF`), if any.
     #[serde(default)]
     pub number: Option<u32>,
+    /// The frame the pose is given in (`base` by default).
     #[serde(default)]
     pub frame: WorkObjectFrame,
+    /// Frame → work object, as `xyz_mm` and `rpy_deg` at the top level.
     #[serde(flatten)]
     pub pose: PoseMmDeg,
 }
@@ -67,8 +77,10 @@ pub struct WorkObjectDescription {
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CellDescription {
+    /// The production tools.
     #[serde(default)]
     pub tools: Vec<ToolDescription>,
+    /// The work objects (user frames).
     #[serde(default)]
     pub work_objects: Vec<WorkObjectDescription>,
 }
@@ -76,10 +88,13 @@ pub struct CellDescription {
 /// Why a cell file is not one.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CellFileError {
+    /// The text is not a cell file's JSON (the parser's message).
     #[error("cell file: {0}")]
     Json(String),
+    /// A pose of the named item has a value that is not finite.
     #[error("cell file: {0} has a value that is not finite")]
     NotFinite(String),
+    /// The named tool's load is invalid (the tool's name, then why).
     #[error("cell file: tool {0}: {1}")]
     Load(String, String),
 }

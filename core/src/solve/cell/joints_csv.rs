@@ -28,6 +28,7 @@ use crate::model::bounds::show;
 /// One joint reading.
 #[derive(Debug, Clone, PartialEq)]
 pub struct JointReading {
+    /// The row's `id`, or its 1-based row number when the column is absent or empty.
     pub id: String,
     /// 1-based line in the file (0 for readings that come from elsewhere).
     pub line: usize,
@@ -38,33 +39,58 @@ pub struct JointReading {
 /// Why a joints file cannot be read.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum JointsCsvError {
+    /// The text is not a table (`csv_text`).
     #[error(transparent)]
     Text(#[from] TextError),
+    /// The text holds no header.
     #[error(
         "the joints file is empty: give a header `id,q1,...,qN` (N joints) and one row per reading"
     )]
     Empty,
+    /// No column names a joint.
     #[error("no joint columns: the header needs q1..q{dof} (or j1..j{dof}), controller degrees")]
-    NoJointColumns { dof: usize },
+    NoJointColumns {
+        /// Joints of the robot.
+        dof: usize,
+    },
+    /// The joint columns are not `q1..q{dof}` (too few, too many, or a gap).
     #[error("{got} joint columns, the robot has {dof} joints: give q1..q{dof}")]
-    JointColumns { got: usize, dof: usize },
+    JointColumns {
+        /// Joint columns found.
+        got: usize,
+        /// Joints of the robot.
+        dof: usize,
+    },
+    /// Two columns name one joint.
     #[error("joint column q{joint} appears twice")]
-    Duplicate { joint: usize },
+    Duplicate {
+        /// The 1-based joint named twice.
+        joint: usize,
+    },
     /// A row whose field count is not the header's.
     #[error(transparent)]
     FieldCount(#[from] FieldCount),
+    /// A joint value is not a finite number.
     #[error("line {line}, column {column}: `{value}` is not a number (controller degrees)")]
     NotNumber {
+        /// 1-based line in the file.
         line: usize,
+        /// The column's name as in the header.
         column: String,
+        /// The value read (shortened).
         value: String,
     },
+    /// A joint value is beyond ±`JOINT_DEG.max` (two turns).
     #[error("line {line}, column {column}: {} deg is beyond the bound ±{} deg (controller degrees; wrong units?)", show(*value), JOINT_DEG.max)]
     OutOfBounds {
+        /// 1-based line in the file.
         line: usize,
+        /// The column's name as in the header.
         column: String,
+        /// The value read [deg].
         value: f64,
     },
+    /// The header is followed by no reading.
     #[error("no readings after the header")]
     NoRows,
 }

@@ -44,6 +44,7 @@ use serde::{Deserialize, Serialize};
 /// A production tool: TCP pose in the flange frame.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Tool {
+    /// The tool's name (a reference matches it ignoring ASCII case).
     pub name: String,
     /// The controller's number (KUKA `TOOL_DATA[n]`, Fanuc `UT`), if any.
     #[serde(default)]
@@ -70,10 +71,12 @@ pub enum WorkObjectFrame {
 /// A work object / user frame.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct WorkObject {
+    /// The work object's name (a reference matches it ignoring ASCII case).
     pub name: String,
     /// The controller's number (KUKA `BASE_DATA[n]`, Fanuc `UF`), if any.
     #[serde(default)]
     pub number: Option<u32>,
+    /// The frame `pose` is given in (the base frame by default).
     #[serde(default)]
     pub frame: WorkObjectFrame,
     /// Frame → work object [m].
@@ -105,7 +108,9 @@ impl WorkObject {
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(untagged)]
 pub enum CellRef {
+    /// A controller number (shown as `#n`).
     Number(u32),
+    /// A name, matched ignoring ASCII case.
     Name(String),
 }
 
@@ -121,8 +126,10 @@ impl std::fmt::Display for CellRef {
 /// The tools and work objects of one robot.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct Cell {
+    /// The production tools, in the order given.
     #[serde(default)]
     pub tools: Vec<Tool>,
+    /// The work objects (user frames), in the order given.
     #[serde(default)]
     pub work_objects: Vec<WorkObject>,
 }
@@ -130,17 +137,23 @@ pub struct Cell {
 /// Why a tool or work object cannot be found.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum CellError {
+    /// No tool answers the reference (number 0, the bare flange, always does).
     #[error("no tool {0} in the cell")]
     UnknownTool(CellRef),
+    /// No work object answers the reference (number 0, the base frame, always does).
     #[error("no work object {0} in the cell")]
     UnknownWorkObject(CellRef),
     /// Two items answer one reference (a number held twice, or one name
     /// in two ASCII cases).
     #[error("{} {reference} is ambiguous: both `{first}` and `{second}` answer it; give each its own name and number", .kind.label())]
     Ambiguous {
+        /// Whether tools or work objects were searched.
         kind: ItemKind,
+        /// The reference given.
         reference: CellRef,
+        /// Name of the first item answering it.
         first: String,
+        /// Name of the second item answering it.
         second: String,
     },
 }
@@ -276,6 +289,7 @@ pub struct CellOptions {
 /// The calibrated solution of a cell target and its false target.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CellSolution {
+    /// The calibrated model's IK solution for the TCP at `W·T` (base frame).
     pub solution: IkSolution,
     /// `W⁻¹·FK_nom(q)·tool` when converged: what to write in the program.
     pub false_target: Option<Pose>,

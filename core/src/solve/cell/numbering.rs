@@ -19,13 +19,17 @@ use serde::Serialize;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ItemKind {
+    /// A production tool (`TOOL_DATA`, `UTOOL`).
     Tool,
+    /// A work object or user frame (`BASE_DATA`, `UFRAME`).
     WorkObject,
 }
 
 impl ItemKind {
+    /// Both kinds, tools first.
     pub const ALL: [ItemKind; 2] = [ItemKind::Tool, ItemKind::WorkObject];
 
+    /// The API's `kind` value: `tool`, `work_object`.
     pub fn as_str(self) -> &'static str {
         match self {
             ItemKind::Tool => "tool",
@@ -45,8 +49,11 @@ impl ItemKind {
 /// An item without a number of its own and the number it was given.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct AssignedNumber {
+    /// Tool or work object.
     pub kind: ItemKind,
+    /// The item's name.
     pub name: String,
+    /// The controller number it was given.
     pub number: u32,
 }
 

@@ -44,12 +44,24 @@ impl Default for PredictFrame {
 /// Why a joint reading cannot be predicted.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum PredictError {
+    /// The reading has not one value per joint.
     #[error("{got} joint values, the robot has {expected} joints")]
-    JointCount { expected: usize, got: usize },
+    JointCount {
+        /// Joints of the robot.
+        expected: usize,
+        /// Values given.
+        got: usize,
+    },
     /// A reading that is not finite or beyond two turns
     /// (`measure::bounds::JOINT_DEG`, as the measurement and joints files).
     #[error("joint {joint} is {} deg; must be finite and within ±{} deg (controller degrees)", show(*value), JOINT_DEG.max)]
-    JointOutOfBounds { joint: usize, value: f64 },
+    JointOutOfBounds {
+        /// The 1-based joint.
+        joint: usize,
+        /// The value read [deg].
+        value: f64,
+    },
+    /// The model's kinematics failed at these joints.
     #[error("the model cannot evaluate these joints: {0}")]
     Kinematics(#[from] KinematicsError),
 }
@@ -143,12 +155,17 @@ impl Forward {
 /// another convention.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PoseOut {
+    /// Position [mm].
     pub xyz_mm: [f64; 3],
+    /// Fixed-axis XYZ angles `rx, ry, rz` [deg] (`R = Rz·Ry·Rx`).
     pub rxyz_deg: [f64; 3],
+    /// The convention asked and the orientation's values in it, in `rotation_to`'s units and
+    /// order.
     pub orientation: Option<(OrientationConvention, Vec<f64>)>,
 }
 
 impl PoseOut {
+    /// `pose` at the boundary, with its orientation also in `convention` when given.
     pub fn of(pose: &Pose, convention: Option<OrientationConvention>) -> Self {
         // Fanuc W, P, R is fixed-axis XYZ: `Rz(R)·Ry(P)·Rx(W)`, i.e. rx, ry, rz.
         let w = rotation_to(OrientationConvention::FanucWpr, &pose.r);

@@ -39,12 +39,17 @@ const CLAMPED_ELBOW: f64 = 0.01;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Structure {
+    /// The last three axes meet at one point (YS100, HH800's open chain, KUKA/ABB/Fanuc-like).
     SphericalWrist,
+    /// Axes 2, 3 and 4 (1-based) are parallel (UR).
     ThreeParallel,
 }
 
+/// Why a model has no closed-form inverse kinematics.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum AnalyticError {
+    /// The model is not a 6-joint arm of one of the [`Structure`]s without Hayati β (the text
+    /// says which condition fails).
     #[error("no closed-form inverse kinematics for this model: {0}")]
     Unsupported(String),
 }
@@ -55,6 +60,7 @@ pub struct AnalyticSolution {
     /// Model-convention joint values [rad], wrapped by 2π into the limits when
     /// possible (nearest the hint, or the middle of the range).
     pub q: [f64; 6],
+    /// The branch's shoulder, elbow and wrist flags.
     pub configuration: Configuration,
     /// All joints within their limits.
     pub within_limits: bool,
@@ -211,6 +217,7 @@ impl AnalyticIk {
         })
     }
 
+    /// The closed-form structure detected in the model.
     pub fn structure(&self) -> Structure {
         self.structure
     }

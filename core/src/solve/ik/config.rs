@@ -18,36 +18,49 @@
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
+/// Where the wrist point lies about joint 1 (module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Shoulder {
+    /// Wrist point in front of joint 1 (x ≥ 0 in link 1's frame).
     Front,
+    /// Wrist point behind joint 1: the arm reaches over its back.
     Back,
 }
 
+/// Where the elbow lies about the shoulder–wrist line, in the arm's own frame (module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Elbow {
+    /// Elbow on the +z side of the shoulder–wrist line.
     Up,
+    /// Elbow on the −z side of the shoulder–wrist line.
     Down,
 }
 
+/// The sign of sin θ5 (chain angle of joint 5, 1-based).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Wrist {
+    /// sin θ5 ≥ 0.
     NoFlip,
+    /// sin θ5 < 0.
     Flip,
 }
 
 /// One configuration branch of a 6R arm (see module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct Configuration {
+    /// Front or back: where the wrist point lies about joint 1.
     pub shoulder: Shoulder,
+    /// Up or down: the elbow's side of the shoulder–wrist line.
     pub elbow: Elbow,
+    /// No flip or flip: the sign of sin θ5.
     pub wrist: Wrist,
 }
 
 impl Configuration {
+    /// The branch with these flags.
     pub const fn new(shoulder: Shoulder, elbow: Elbow, wrist: Wrist) -> Self {
         Configuration {
             shoulder,
@@ -68,6 +81,7 @@ impl Configuration {
             | usize::from(self.wrist == Wrist::Flip) << 2
     }
 
+    /// The branch of index `i` (bit 0 `Back`, bit 1 `Down`, bit 2 `Flip`), or `None` beyond 7.
     pub fn from_index(i: usize) -> Option<Configuration> {
         if i >= 8 {
             return None;
@@ -127,10 +141,19 @@ impl Configuration {
 /// Why a text is not a configuration branch.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum BranchError {
+    /// A number that is not a branch index.
     #[error("branch index must be 0..=7, got {index}")]
-    Index { index: usize },
+    Index {
+        /// The number given.
+        index: usize,
+    },
+    /// A word that is not a flag.
     #[error("unknown branch flag `{flag}`; use front|back, up|down, noflip|flip or an index 0..7")]
-    UnknownFlag { flag: String },
+    UnknownFlag {
+        /// The word given.
+        flag: String,
+    },
+    /// The text holds no flag.
     #[error("empty branch")]
     Empty,
 }

@@ -180,10 +180,12 @@ impl IkSolver {
         }
     }
 
+    /// The compensated model solved, carrying the solver's tool.
     pub fn model(&self) -> &CompensatedModel {
         &self.model
     }
 
+    /// The numerical settings.
     pub fn settings(&self) -> &IkSettings {
         &self.settings
     }

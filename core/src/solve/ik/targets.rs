@@ -39,6 +39,7 @@ pub enum SolveMode {
 /// One target as a caller sends it (boundary units).
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct TargetInput {
+    /// The caller's id; `None`: the result takes the target's 1-based place in the list.
     #[serde(default)]
     pub id: Option<String>,
     /// TCP position [mm].
@@ -93,7 +94,9 @@ impl TargetInput {
 /// The false target: nominal-model pose of the joint commands (controller's base frame).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FalseTarget {
+    /// TCP position [mm].
     pub xyz_mm: [f64; 3],
+    /// The convention of `orientation`.
     pub convention: OrientationConvention,
     /// Orientation values in `convention` (degrees for angles).
     pub orientation: Vec<f64>,
@@ -111,7 +114,9 @@ pub struct JointJump {
 /// Everything returned for one target.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct TargetResult {
+    /// The target's id (its given one, else its 1-based place in the list).
     pub id: String,
+    /// The calibrated solve's result.
     pub solution: IkSolution,
     /// Controller joint commands [deg], when converged.
     pub joints_deg: Option<Vec<f64>>,
@@ -125,6 +130,7 @@ pub struct TargetResult {
 }
 
 impl TargetResult {
+    /// `ok` when converged, else `failed`.
     pub fn status(&self) -> &'static str {
         if self.solution.converged {
             "ok"

@@ -50,9 +50,11 @@ use crate::model::orientation::{rotation_from, rotation_to, OrientationConventio
 /// One row of a targets file: the target, or why the row is invalid.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TargetRow {
+    /// The row's `id`, or its 1-based target number when the column is absent or empty.
     pub id: String,
     /// 1-based line in the file.
     pub line: usize,
+    /// The target, or why the row is not one (the row fails alone).
     pub target: Result<TargetInput, RowError>,
 }
 
@@ -61,31 +63,63 @@ pub struct TargetRow {
 pub struct TargetsCsv {
     /// The file's orientation convention (`None`: position columns only).
     pub convention: Option<OrientationConvention>,
+    /// The rows after the header, in file order.
     pub rows: Vec<TargetRow>,
 }
 
 /// Why a targets file is rejected as a whole.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum TargetsCsvError {
+    /// The text is not a table (`csv_text`).
     #[error(transparent)]
     Text(#[from] TextError),
+    /// The text holds no header.
     #[error("the targets file has no header row")]
     NoHeader,
+    /// A column is named twice.
     #[error("line {line}: duplicate column `{column}`")]
-    DuplicateColumn { line: usize, column: String },
+    DuplicateColumn {
+        /// 1-based line of the header.
+        line: usize,
+        /// The column's name.
+        column: String,
+    },
+    /// A column is neither `id`, a position nor an orientation column.
     #[error("line {line}: unknown column `{column}`; expected id, x, y, z and the orientation columns of one convention: {}", CONVENTION_COLUMNS)]
-    UnknownColumn { line: usize, column: String },
+    UnknownColumn {
+        /// 1-based line of the header.
+        line: usize,
+        /// The column's name.
+        column: String,
+    },
+    /// One of `x`, `y`, `z` is missing.
     #[error("line {line}: missing column `{column}`")]
-    MissingColumn { line: usize, column: String },
+    MissingColumn {
+        /// 1-based line of the header.
+        line: usize,
+        /// The missing column's name.
+        column: String,
+    },
+    /// The orientation columns of more than one convention are present.
     #[error("line {line}: orientation columns of several conventions ({names}); use one")]
-    SeveralConventions { line: usize, names: String },
+    SeveralConventions {
+        /// 1-based line of the header.
+        line: usize,
+        /// The conventions present, comma-separated.
+        names: String,
+    },
+    /// A convention's orientation columns are present but not all of them.
     #[error(
         "line {line}: {convention} orientation needs columns {columns}; `{missing}` is missing"
     )]
     IncompleteConvention {
+        /// 1-based line of the header.
         line: usize,
+        /// The convention's name.
         convention: &'static str,
+        /// Its columns, comma-separated.
         columns: String,
+        /// The first missing column.
         missing: String,
     },
 }

@@ -19,6 +19,7 @@ pub struct RbfSettings {
     pub spreads: Vec<f64>,
     /// Fraction of the training samples held out to choose spread and size.
     pub holdout: f64,
+    /// Frame the network's outputs are expressed in (`Joint1`: turned with joint 1).
     pub output_frame: OutputFrame,
 }
 
@@ -36,7 +37,9 @@ impl Default for RbfSettings {
 /// What the RBF training chose.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RbfReport {
+    /// The spread chosen [normalised torque units].
     pub spread: f64,
+    /// Hidden units kept.
     pub neurons: usize,
     /// Held-out RMS of the error norm [mm] of the chosen spread and size.
     pub holdout_rms_mm: f64,
@@ -133,8 +136,13 @@ fn network(
 /// Why an RBF cannot be trained.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum RbfTrainError {
+    /// Fewer than 5 training samples.
     #[error("the RBF needs at least 5 training poses, got {got}")]
-    TooFewSamples { got: usize },
+    TooFewSamples {
+        /// Samples given.
+        got: usize,
+    },
+    /// The output layer's least-squares problem had no solution.
     #[error("the RBF least-squares problem could not be solved")]
     Unsolvable,
 }

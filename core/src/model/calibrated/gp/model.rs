@@ -14,6 +14,7 @@ pub(super) const CUTOFF: f64 = 50.0;
 /// A trained sparse GP (module docs); SI units.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Gp {
+    /// Joints of the robot the GP was trained for.
     pub dof: usize,
     /// `1/ℓ_j` [1/rad]; 0 ignores joint j.
     pub inverse_length_scales: Vec<f64>,
@@ -41,6 +42,7 @@ impl Gp {
         self.alpha.len() / 3
     }
 
+    /// Checks sizes, finiteness and positive variances and scales (file input).
     pub fn validate(&self) -> Result<(), InvalidCompensator> {
         let m = self.units();
         let ok_sizes = self.dof > 0

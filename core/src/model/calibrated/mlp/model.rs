@@ -101,7 +101,10 @@ fn scratch<'a, T: Copy + Default, const S: usize>(
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Normalisation {
+    /// `centre` per column: `(max + min)/2` over the training set.
     pub centre: Vec<f64>,
+    /// `scale` per column: `2/(max − min)` over the training set (the constant
+    /// scale for a constant column).
     pub scale: Vec<f64>,
 }
 
@@ -126,10 +129,12 @@ impl Normalisation {
         Normalisation { centre, scale }
     }
 
+    /// Number of columns.
     pub fn len(&self) -> usize {
         self.centre.len()
     }
 
+    /// Whether there are no columns.
     pub fn is_empty(&self) -> bool {
         self.centre.is_empty()
     }
@@ -175,8 +180,11 @@ impl Normalisation {
 /// Layer sizes of a one-hidden-layer network.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Shape {
+    /// Input units `n_in`.
     pub inputs: usize,
+    /// Hidden units `n_h`.
     pub hidden: usize,
+    /// Output units `n_out`.
     pub outputs: usize,
 }
 
@@ -270,15 +278,20 @@ impl Shape {
 pub struct Mlp {
     /// Joints of the robot the network was trained for.
     pub dof: usize,
+    /// Hidden tansig units.
     pub hidden: usize,
+    /// Which inputs the network sees (`q`, `sin q`, `cos q`, payload).
     pub features: Features,
     /// Flat weights (module docs).
     pub weights: Vec<f64>,
+    /// Normalisation of the inputs (a constant input gets scale 0).
     pub input_norm: Normalisation,
+    /// Normalisation of the three outputs (scales non-zero).
     pub output_norm: Normalisation,
 }
 
 impl Mlp {
+    /// The layer sizes: the features of `dof` joints, `hidden`, 3 outputs.
     pub fn shape(&self) -> Shape {
         Shape {
             inputs: self.features.count(self.dof),

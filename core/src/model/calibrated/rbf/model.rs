@@ -12,7 +12,9 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum OutputFrame {
+    /// The registered base frame (the thesis's choice).
     Base,
+    /// Turned by `−q1` about the base z axis: the outputs turn with joint 1.
     Joint1,
 }
 
@@ -20,8 +22,11 @@ pub enum OutputFrame {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Rbf {
+    /// Joints of the robot (the number of torque inputs).
     pub dof: usize,
+    /// Frame the outputs are in.
     pub output_frame: OutputFrame,
+    /// Min–max normalisation of the gravity torques.
     pub input_norm: Normalisation,
     /// Spread in normalised torque units.
     pub spread: f64,
@@ -31,16 +36,19 @@ pub struct Rbf {
     pub weights: Vec<f64>,
 }
 
+/// Rotation by `a` [rad] about z.
 pub fn rot_z(a: f64) -> Matrix3<f64> {
     let (s, c) = a.sin_cos();
     Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
 }
 
 impl Rbf {
+    /// Number of hidden units (centres).
     pub fn units(&self) -> usize {
         self.centres.len() / self.dof.max(1)
     }
 
+    /// Checks sizes, finiteness and a positive spread (file input).
     pub fn validate(&self) -> Result<(), InvalidCompensator> {
         if self.dof == 0 || !self.centres.len().is_multiple_of(self.dof) {
             return Err(InvalidCompensator::RbfCentres);
@@ -87,6 +95,8 @@ impl Rbf {
         y
     }
 
+    /// The residual [m] in the registered base frame at joints `q` [rad] and
+    /// gravity torques `tau` [N·m].
     pub fn eval(&self, q: &[f64], tau: &[f64]) -> Vector3<f64> {
         let y = self.local(tau);
         match self.output_frame {

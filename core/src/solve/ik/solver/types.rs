@@ -32,6 +32,7 @@ pub enum TargetFrame {
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error("unknown target frame `{name}` (use cell or base)")]
 pub struct UnknownFrame {
+    /// The name given (trimmed, lower-cased).
     pub name: String,
 }
 
@@ -150,14 +151,20 @@ pub struct SolveOptions {
 #[derive(Debug, Clone, PartialEq, Serialize, thiserror::Error)]
 #[serde(tag = "kind", content = "detail", rename_all = "snake_case")]
 pub enum FailureReason {
+    /// The target lies beyond the (corrected) workspace, and no iteration reached it.
     #[error("target is out of reach")]
     Unreachable,
+    /// Solutions exist only beyond the joint limits, or the iteration stalled on a limit.
     #[error("the target is only reachable outside the joint limits")]
     OutOfLimits,
+    /// The iteration stalled where the weighted Jacobian's smallest singular value is below
+    /// `singular_threshold`.
     #[error("singular configuration: the solver could not reach the target")]
     Singular,
+    /// The iteration ended short of the tolerances for no reason above.
     #[error("the solver did not converge")]
     DidNotConverge,
+    /// The target is invalid as given (it failed alone, before any iteration).
     #[error("invalid target: {0}")]
     InvalidTarget(TargetError),
     /// A configuration branch was required (requested, or kept by path mode)
@@ -231,10 +238,12 @@ pub struct IkSolution {
     pub iterations: usize,
     /// Configuration of `q` (None for models without a closed form).
     pub branch: Option<Configuration>,
+    /// Why the target has no solution (`None` when converged).
     pub reason: Option<FailureReason>,
 }
 
 impl IkSolution {
+    /// The answer for a target invalid as given: no joints, NaN residuals.
     pub fn invalid(reason: TargetError) -> Self {
         IkSolution::failed(FailureReason::InvalidTarget(reason))
     }
@@ -256,7 +265,9 @@ impl IkSolution {
 /// A target: position and, unless position-only, orientation (in the options' frame, SI).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Goal {
+    /// Target position [m].
     pub position: Vector3<f64>,
+    /// Target rotation (`None`: position only).
     pub rotation: Option<Matrix3<f64>>,
 }
 
@@ -272,10 +283,15 @@ impl From<&Pose> for Goal {
 /// Outcome of one damped Newton run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Refined {
+    /// Model-convention joints where the run ended [rad].
     pub q: Vec<f64>,
+    /// Residuals within the tolerances and joints within limits.
     pub converged: bool,
+    /// `|p(q) − p*|` [m].
     pub position_residual_m: f64,
+    /// Rotation angle between `R(q)` and `R*` [rad].
     pub orientation_residual_rad: f64,
+    /// Evaluations of the prediction.
     pub iterations: usize,
     /// A joint ended on a limit the unconstrained step wanted to cross.
     pub at_limit: bool,

@@ -22,11 +22,17 @@ use serde::{Deserialize, Serialize};
 /// Invasive weed optimisation, thesis ch. 5 hyperparameters.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct IwoSettings {
+    /// Weeds drawn at the start.
     pub initial_population: usize,
+    /// Weeds kept after each iteration's ranking (the best ones).
     pub max_population: usize,
+    /// Seeds of the worst weed (eqs. 5.8–5.9).
     pub seeds_min: usize,
+    /// Seeds of the best weed (eqs. 5.8–5.9).
     pub seeds_max: usize,
+    /// Spread σ of the first iteration (eq. 5.6, normalised weight units).
     pub sigma_initial: f64,
+    /// Spread σ of the last iteration (eq. 5.6).
     pub sigma_final: f64,
     /// Nonlinear modulation index `n` of eq. 5.6.
     pub exponent: f64,
@@ -34,6 +40,7 @@ pub struct IwoSettings {
     pub bound: f64,
     /// Weight of `max(E)` in eq. 5.7 (`mean` has weight 1).
     pub max_weight: f64,
+    /// Iterations run (`iter_max` of eq. 5.6).
     pub iterations: usize,
     /// Fraction of the training samples held out to check the result against
     /// the null network (module docs).

@@ -16,10 +16,15 @@ use serde::{Deserialize, Serialize};
 /// Levenberg–Marquardt backpropagation (MATLAB `trainlm` defaults).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LmTrainSettings {
+    /// Largest number of epochs (linearisations) run.
     pub max_epochs: usize,
+    /// The starting damping μ.
     pub mu: f64,
+    /// The factor on μ after an accepted step.
     pub mu_dec: f64,
+    /// The factor on μ after a rejected step.
     pub mu_inc: f64,
+    /// The largest μ a trial is made with; above it training stops.
     pub mu_max: f64,
     /// Fraction of the training samples held out for early stopping.
     pub holdout: f64,

@@ -48,12 +48,16 @@ pub use spec::MlpSpec;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "trainer", rename_all = "kebab-case")]
 pub enum Trainer {
+    /// Levenberg–Marquardt backpropagation (ch. 4, `trainlm`).
     Lm(LmTrainSettings),
+    /// Invasive weed optimisation (ch. 5).
     Iwo(IwoSettings),
+    /// Teaching–learning-based optimisation (ch. 6).
     Tlbo(TlboTrainSettings),
 }
 
 impl Trainer {
+    /// The trainer's name as the settings' `trainer` tag: `lm`, `iwo`, `tlbo`.
     pub fn name(&self) -> &'static str {
         match self {
             Trainer::Lm(_) => "lm",
@@ -66,7 +70,9 @@ impl Trainer {
 /// The MLP's network and trainer (its [`CompensatorSpec`](crate::calibrate::compensate::CompensatorSpec)).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MlpSettings {
+    /// The network's size and inputs.
     pub spec: MlpSpec,
+    /// How its weights are found.
     pub trainer: Trainer,
 }
 

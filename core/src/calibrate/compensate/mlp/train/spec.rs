@@ -6,7 +6,9 @@ use serde::{Deserialize, Serialize};
 /// Network size and inputs.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct MlpSpec {
+    /// Tansig units in the hidden layer.
     pub hidden: usize,
+    /// The inputs beyond the joint angles (their sines and cosines, the payload).
     pub features: Features,
 }
 

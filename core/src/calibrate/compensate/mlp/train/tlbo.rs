@@ -16,7 +16,9 @@ use serde::{Deserialize, Serialize};
 /// TLBO over the weights (ch. 6).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TlboTrainSettings {
+    /// Learners (weight vectors) in the class.
     pub population: usize,
+    /// Generations run (each a teacher and a learner phase).
     pub generations: usize,
     /// Weights stay in `[−bound, bound]` (the IWO bound of ch. 5).
     pub bound: f64,
