@@ -10,13 +10,12 @@
 //! the tracker frame). A refused fit stores nothing and is `Invalid` with the
 //! command line's words, `not fitted (REASON): MESSAGE`.
 
-use super::solve::{chosen_model, ModelChoice};
 use super::{AppState, ServiceError};
 use crate::records::{NewTrack, TrackRow};
 use robocal_core::calibrate::external::track::{fit_track_compensated, TrackFit, TrackRefused};
 use robocal_core::measure::csv::parse_set;
 use robocal_core::measure::external::ExternalAxis;
-use robocal_core::model::calibrated::CompensatedModel;
+use robocal_core::model::calibrated::{CalibratedModelFile, CompensatedModel};
 use robocal_core::model::external::LinearTrack;
 use robocal_core::solve::external::carried;
 
@@ -65,29 +64,41 @@ fn no_track(robot_id: i64) -> ServiceError {
     ))
 }
 
-/// The calibrated model a fit holds and its version number.
+/// The calibrated model a fit holds and its version number (read here, not
+/// through `super::solve`, which carries its models through this file).
 async fn held_model(
     state: &AppState,
     robot_id: i64,
     version: Option<i64>,
 ) -> Result<(CompensatedModel, i64), ServiceError> {
-    let choice = match version {
-        Some(v) => ModelChoice::Version(v),
-        None => {
-            let ctx = state.robot_context(robot_id).await?;
-            if ctx.active.is_none() {
+    let ctx = state.robot_context(robot_id).await?;
+    let (row_id, number) = match version {
+        Some(v) => {
+            let row = state.db().version(robot_id, v).await?.ok_or_else(|| {
+                ServiceError::Conflict(format!(
+                    "robot {robot_id} has no model version {v}; list them with GET /v1/robots/{robot_id}/versions"
+                ))
+            })?;
+            (row.id, row.version)
+        }
+        None => match ctx.active {
+            Some((row_id, number, _)) => (row_id, number),
+            None => {
                 return Err(ServiceError::Conflict(format!(
                     "robot {robot_id} has no active model version: a track is fitted with the robot's calibrated model held; run a calibration (POST /v1/robots/{robot_id}/calibrations), activate a version, or name one with \"version\": N"
-                )));
+                )))
             }
-            ModelChoice::Active
-        }
+        },
     };
-    let chosen = chosen_model(state, robot_id, choice).await?;
-    let version = chosen
-        .version
-        .ok_or_else(|| ServiceError::Internal("a calibrated version was chosen".into()))?;
-    Ok((chosen.model, version))
+    let text = state
+        .db()
+        .version_model(row_id)
+        .await?
+        .ok_or_else(|| ServiceError::version_not_found(robot_id, number))?;
+    let model = CalibratedModelFile::from_json(&text)
+        .and_then(|f| f.to_compensated())
+        .map_err(|e| ServiceError::Internal(format!("stored model version {number}: {e}")))?;
+    Ok((model, number))
 }
 
 /// Fits the track, judges it and stores it as the robot's (replacing the
