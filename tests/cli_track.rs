@@ -7,7 +7,8 @@
 //! measurement file with an `e1` column. The fitted track, the predicted
 //! poses and the solved joints are checked against the truth at track
 //! values the fit never saw; refusals exit with `refused` (1) and write
-//! nothing.
+//! nothing. `predict --track` without `--e1` takes each row's track value
+//! from the joints file's `e1` column.
 
 use nalgebra::{UnitQuaternion, Vector3};
 use rand::SeedableRng;
@@ -358,4 +359,127 @@ fn fits_the_file_cannot_carry_exit_refused_and_write_nothing() {
     let out = track_calibrate(d, "few.csv", &["--column", "e2"]);
     assert_eq!(code(&out), 1);
     assert!(text(&out.stderr).contains("not fitted (missing_column)"));
+}
+
+#[test]
+fn predict_reads_a_track_value_per_row_from_the_joints_file() {
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let cell = Cell::new(&mut rng);
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    save_robot(&cell, d);
+    let set = cell.measure(&STATIONS, 15, &mut rng);
+    std::fs::write(d.join("track.csv"), write_set(&set)).unwrap();
+    let out = track_calibrate(d, "track.csv", &[]);
+    assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+
+    // Rows at three values the fit never saw, each with its own `e1`.
+    let values = [200.0, HELD_OUT_MM, 2600.0];
+    let qs = random_configurations(&cell.nominal, 9, &mut rng);
+    let rows: Vec<String> = qs
+        .iter()
+        .enumerate()
+        .map(|(i, q)| format!("{},{}", row(&cell.controller_deg(q)), values[i % 3]))
+        .collect();
+    std::fs::write(
+        d.join("rows.csv"),
+        format!("q1,q2,q3,q4,q5,q6,e1\n{}\n", rows.join("\n")),
+    )
+    .unwrap();
+    let predict = |joints: &str, extra: &[&str]| {
+        let mut args = vec![
+            "predict",
+            "--model",
+            "robot.json",
+            "--joints",
+            joints,
+            "--track",
+            "rail.json",
+            "--json",
+        ];
+        args.extend_from_slice(extra);
+        robocal(d, &args)
+    };
+    let out = predict("rows.csv", &[]);
+    assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(doc["frame"], "cell (track rail.json at each row's e1)");
+    let per_row = doc["results"].as_array().unwrap().clone();
+    assert_eq!(per_row.len(), qs.len());
+    // Each row as `--e1` gives it for that row alone, and within 0.05 mm of
+    // the true reflector at its value.
+    for (i, (q, r)) in qs.iter().zip(&per_row).enumerate() {
+        let v = values[i % 3];
+        let got = Vector3::new(
+            r["x"].as_f64().unwrap(),
+            r["y"].as_f64().unwrap(),
+            r["z"].as_f64().unwrap(),
+        );
+        let want = cell.true_pose(q, v).p * 1e3;
+        assert!((got - want).norm() < 0.05, "row {i}: {got} {want}");
+        std::fs::write(
+            d.join("one.csv"),
+            format!("q1,q2,q3,q4,q5,q6\n{}\n", row(&cell.controller_deg(q))),
+        )
+        .unwrap();
+        let e1 = v.to_string();
+        let out = predict("one.csv", &["--e1", &e1]);
+        assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+        let one: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        for k in ["x", "y", "z", "rx", "ry", "rz"] {
+            assert_eq!(one["results"][0][k], r[k], "row {i}, {k}");
+        }
+    }
+
+    // A row beyond the travel fails alone (exit 2), naming its line.
+    let mut beyond = rows.clone();
+    beyond[4] = format!("{},4500", row(&cell.controller_deg(&qs[4])));
+    std::fs::write(
+        d.join("beyond.csv"),
+        format!("q1,q2,q3,q4,q5,q6,e1\n{}\n", beyond.join("\n")),
+    )
+    .unwrap();
+    let out = predict("beyond.csv", &[]);
+    assert_eq!(code(&out), 2, "{}", text(&out.stderr));
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let results = doc["results"].as_array().unwrap();
+    let failed: Vec<usize> = (0..results.len())
+        .filter(|&i| results[i]["status"] != "ok")
+        .collect();
+    assert_eq!(failed, vec![4], "{doc}");
+    let message = results[4]["message"].as_str().unwrap();
+    assert!(message.starts_with("line 6: e1: "), "{message}");
+    assert!(message.contains("[0, 4000] mm"), "{message}");
+
+    // `--e1` beside an `e1` column is ambiguous; `--track` alone without the
+    // column, and `solve --track` without `--e1`, have no value: refused.
+    let out = predict("rows.csv", &["--e1", "1000"]);
+    assert_eq!(code(&out), 1);
+    assert!(
+        text(&out.stderr).contains("ambiguous"),
+        "{}",
+        text(&out.stderr)
+    );
+    let out = predict("one.csv", &[]);
+    assert_eq!(code(&out), 1);
+    assert!(
+        text(&out.stderr).contains("has none: add the column (mm) or give --e1 MM"),
+        "{}",
+        text(&out.stderr)
+    );
+    std::fs::write(d.join("targets.csv"), "x,y,z\n1500,0,1200\n").unwrap();
+    let out = robocal(
+        d,
+        &[
+            "solve",
+            "--model",
+            "robot.json",
+            "--targets",
+            "targets.csv",
+            "--track",
+            "rail.json",
+        ],
+    );
+    assert_eq!(code(&out), 1);
+    assert!(text(&out.stderr).contains("--track needs --e1 MM"));
 }

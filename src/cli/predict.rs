@@ -14,7 +14,9 @@
 //! validation data, or `unverified` for a tool after a position-only
 //! calibration, never the measured point's figure for a tool. With
 //! `--track FILE --e1 MM` the robot's base is carried along a calibrated
-//! track and the cell frame is the track's (`super::track`).
+//! track and the cell frame is the track's (`super::track`); with `--track`
+//! alone each row's track value is the joints file's `e1` column (a value
+//! beyond the track's travel fails its row alone).
 
 use super::solve::OutputFormat;
 use crate::measure::csv_text::dialect_from_names;
@@ -27,7 +29,9 @@ use anyhow::Context;
 use clap::Args;
 use robocal_core::csv_write::{push_header, push_row, Cell as CsvCell};
 use robocal_core::model::calibrated::CalibratedModelFile;
+use robocal_core::model::calibrated::CompensatedModel;
 use robocal_core::model::calibrated::ValidationEvidence;
+use robocal_core::solve::external::carried;
 use serde_json::json;
 use std::fmt::Write as _;
 
@@ -95,12 +99,26 @@ pub fn predict_to_string(a: &PredictArgs) -> anyhow::Result<String> {
     predict_outcome(a).map(|o| o.text)
 }
 
+/// Where each reading is predicted: one forward model, or (a track value
+/// per row) one per distinct value, or why a value has none.
+struct Placed {
+    forward: Forward,
+    frame: PredictFrame,
+}
+
 /// What the command prints and how many readings failed.
 pub fn predict_outcome(a: &PredictArgs) -> anyhow::Result<super::exit::Outcome> {
-    let model = a.track.carry(super::model_files::load_with_payload(
-        &a.model,
-        a.payload_kg,
-    )?)?;
+    let loaded = super::model_files::load_with_payload(&a.model, a.payload_kg)?;
+    let text = std::fs::read_to_string(&a.joints)
+        .with_context(|| format!("cannot read joints file {}", a.joints))?;
+    let dialect = dialect_from_names(a.delimiter.as_deref(), a.decimal.as_deref())
+        .map_err(anyhow::Error::msg)?;
+    // `--track` without `--e1`: each row's value from the file's `e1` column.
+    let per_row = a.track.per_row(&a.joints, &text, dialect)?;
+    let model = match per_row {
+        Some(_) => loaded,
+        None => a.track.carry(loaded)?,
+    };
     let frame: TargetFrame = a.frame.parse().map_err(anyhow::Error::msg)?;
     let conv = a
         .convention
@@ -119,38 +137,72 @@ pub fn predict_outcome(a: &PredictArgs) -> anyhow::Result<super::exit::Outcome> 
         Some(t) => tool_accuracy(ev.as_ref(), &probe, &t.tcp),
         None => measurement_tool_accuracy(ev.as_ref()),
     };
-    let forward = Forward::new(
-        &model,
-        tool.as_ref().map(|t| &t.tcp),
-        tool.as_ref().and_then(|t| t.load.as_ref()),
-    );
-    let (frame, frame_label) = match &a.work_object {
-        None => (PredictFrame::Frame(frame), a.track.label(frame.to_string())),
-        Some(w) => {
-            let wobj = cell.work_object(&w.parse::<CellRef>()?)?;
-            let label = format!("work object {}", wobj.name);
-            (
-                PredictFrame::WorkObject(wobj.in_base(forward.model())),
-                label,
-            )
-        }
+    let wobj = match &a.work_object {
+        Some(w) => Some(cell.work_object(&w.parse::<CellRef>()?)?),
+        None => None,
     };
-    let text = std::fs::read_to_string(&a.joints)
-        .with_context(|| format!("cannot read joints file {}", a.joints))?;
-    let dialect = dialect_from_names(a.delimiter.as_deref(), a.decimal.as_deref())
-        .map_err(anyhow::Error::msg)?;
+    let place = |model: &CompensatedModel| {
+        let forward = Forward::new(
+            model,
+            tool.as_ref().map(|t| &t.tcp),
+            tool.as_ref().and_then(|t| t.load.as_ref()),
+        );
+        let frame = match &wobj {
+            None => PredictFrame::Frame(frame),
+            Some(w) => PredictFrame::WorkObject(w.in_base(forward.model())),
+        };
+        Placed { forward, frame }
+    };
+    let frame_label = match (&wobj, &per_row) {
+        (Some(w), _) => format!("work object {}", w.name),
+        (None, Some(_)) => a.track.label_per_row(frame.to_string()),
+        (None, None) => a.track.label(frame.to_string()),
+    };
+    let one = place(&model);
     let dof = model.dof();
     let readings = parse_joints_csv(&text, dialect, dof).with_context(|| a.joints.clone())?;
+    // Per row: one placement per distinct track value, a value beyond the
+    // travel failing its rows alone.
+    let mut at: Vec<(f64, Result<Placed, String>)> = Vec::new();
+    if let Some((track, values)) = &per_row {
+        for v in values {
+            if !at.iter().any(|(x, _)| *x == v.value_mm) {
+                let placed = carried(&model, track, v.value_mm)
+                    .map(|m| place(&m))
+                    .map_err(|e| e.to_string());
+                at.push((v.value_mm, placed));
+            }
+        }
+    }
+    let value_of = |line: usize| {
+        per_row
+            .as_ref()
+            .and_then(|(_, values)| values.iter().find(|v| v.line == line))
+            .map(|v| v.value_mm)
+    };
     let rows: Vec<Row> = readings
         .into_iter()
-        .map(|r| Row {
-            result: forward
-                .predict_deg(&r.joints_deg, &frame)
-                .map_err(|e| format!("line {}: {e}", r.line)),
-            id: r.id,
-            joints_deg: r.joints_deg,
+        .map(|r| {
+            let placed = match value_of(r.line) {
+                None => Ok(&one),
+                Some(v) => at
+                    .iter()
+                    .find(|(x, _)| *x == v)
+                    .map(|(_, p)| p.as_ref().map_err(|e| format!("line {}: e1: {e}", r.line)))
+                    .unwrap_or(Ok(&one)),
+            };
+            Row {
+                result: placed.and_then(|p| {
+                    p.forward
+                        .predict_deg(&r.joints_deg, &p.frame)
+                        .map_err(|e| format!("line {}: {e}", r.line))
+                }),
+                id: r.id,
+                joints_deg: r.joints_deg,
+            }
         })
         .collect();
+    let forward = one.forward;
     let h = Header {
         model: &a.model,
         tool: tool.as_ref().map(|t| t.name.as_str()),

@@ -18,8 +18,11 @@
 //!
 //! `predict` and `solve` with `--track TRACK.json --e1 MM` carry the robot's
 //! base to that track value (`solve::external::carried`): the cell frame is
-//! the track's (the tracker frame it was measured in), one value per run; a
-//! value outside the travel measured is refused (exit 1).
+//! the track's (the tracker frame it was measured in); a value outside the
+//! travel measured is refused (exit 1). `predict --track` without `--e1`
+//! reads each row's value from the joints file's `e1` column
+//! (`solve::external::track_values`); `--e1` and such a column together are
+//! refused as ambiguous.
 
 use super::model_files::load_with_payload;
 use anyhow::Context;
@@ -28,11 +31,12 @@ use robocal_core::calibrate::external::track::{
     fit_track_compensated, TrackFit, TrackRefused, DEFAULT_MAX_ORDER,
 };
 use robocal_core::measure::csv::parse_set;
+use robocal_core::measure::csv_text::Dialect;
 use robocal_core::measure::external::{ExternalAxis, MeasurementSet};
 use robocal_core::model::calibrated::CompensatedModel;
 use robocal_core::model::external::travel_map::MAX_MAP_ORDER;
 use robocal_core::model::external::LinearTrack;
-use robocal_core::solve::external::carried;
+use robocal_core::solve::external::{carried, track_values, RowValue, TRACK_COLUMN};
 use serde::Serialize;
 use std::fmt::Write as _;
 
@@ -92,8 +96,9 @@ fn parse_axis(s: &str) -> Result<ExternalAxis, String> {
 #[derive(Debug, Clone, Default, Args)]
 pub struct OnTrack {
     /// Track model (`robocal track calibrate --out`): the robot's base is
-    /// carried to `--e1` along it, and the cell frame is the track's.
-    #[arg(long, requires = "e1")]
+    /// carried to `--e1` along it (predict without `--e1`: to each row's
+    /// `e1` column), and the cell frame is the track's.
+    #[arg(long)]
     pub track: Option<String>,
     /// The track's value [mm] as the controller shows it (within the travel
     /// the track was measured over).
@@ -102,13 +107,53 @@ pub struct OnTrack {
 }
 
 impl OnTrack {
-    /// `model` with its base carried to `--e1` (unchanged without `--track`).
+    /// `model` with its base carried to `--e1` (unchanged without `--track`;
+    /// `--track` without `--e1` is refused).
     pub fn carry(&self, model: CompensatedModel) -> anyhow::Result<CompensatedModel> {
         let (Some(path), Some(value)) = (&self.track, self.e1) else {
+            if self.track.is_some() {
+                anyhow::bail!(
+                    "--track needs --e1 MM, the track's value for every target (a targets file carries no `e1` column)"
+                );
+            }
             return Ok(model);
         };
         let track = read_track(path)?;
         carried(&model, &track, value).with_context(|| format!("--e1 {value}: track {path}"))
+    }
+
+    /// A track value per row of a joints file `file` (its text `text`):
+    /// with `--track` and no `--e1`, the track and the file's `e1` column
+    /// (refused when the file has none); `None` otherwise. `--e1` and an
+    /// `e1` column together are refused as ambiguous.
+    pub fn per_row(
+        &self,
+        file: &str,
+        text: &str,
+        dialect: Dialect,
+    ) -> anyhow::Result<Option<(LinearTrack, Vec<RowValue>)>> {
+        let Some(path) = &self.track else {
+            return Ok(None);
+        };
+        let values = track_values(text, dialect).with_context(|| file.to_string())?;
+        match (self.e1, values) {
+            (Some(v), Some(_)) => anyhow::bail!(
+                "{file}: the file has an `{TRACK_COLUMN}` column and --e1 {v} is given: which track value holds is ambiguous; give one or the other"
+            ),
+            (Some(_), None) => Ok(None),
+            (None, None) => anyhow::bail!(
+                "{file}: --track without --e1 reads each row's track value from an `{TRACK_COLUMN}` column, and the file has none: add the column (mm) or give --e1 MM"
+            ),
+            (None, Some(values)) => Ok(Some((read_track(path)?, values))),
+        }
+    }
+
+    /// `frame` as the output's header names it with a track value per row.
+    pub fn label_per_row(&self, frame: String) -> String {
+        match &self.track {
+            Some(path) => format!("{frame} (track {path} at each row's e1)"),
+            None => frame,
+        }
     }
 
     /// `frame` as the output's header names it.

@@ -45,6 +45,7 @@ mod routing;
 pub mod server;
 pub mod sets;
 pub mod solve;
+pub mod tracks;
 pub mod versions;
 
 pub use crate::service::limits::{
@@ -80,6 +81,7 @@ fn routes() -> Vec<Route> {
     all.extend(checks::routes());
     all.extend(record::routes());
     all.extend(iso9283::routes());
+    all.extend(tracks::routes());
     all
 }
 

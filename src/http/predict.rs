@@ -12,6 +12,8 @@
 //! solve does; the answer states the expected error at the tool
 //! (`core::cell::accuracy`): measured from 6-D validation data, or
 //! `unverified` for a tool when the calibration measured positions only.
+//! With `e1` [mm] the robot's base is carried to that value along its stored
+//! track (`service::tracks::carry`), and the cell frame is the track's.
 
 use super::input::{check_payload, objects, present};
 use super::solve::{convention, model_choice, target_id, ItemRef, VersionSelector};
@@ -56,6 +58,9 @@ pub struct PredictRequest {
     pub tool: Option<ItemRef>,
     #[serde(default, deserialize_with = "present")]
     pub work_object: Option<ItemRef>,
+    /// The track's value [mm]: the robot carried along its stored track.
+    #[serde(default, deserialize_with = "present")]
+    pub e1: Option<f64>,
 }
 
 #[derive(Debug, Serialize)]
@@ -151,6 +156,7 @@ fn command(robot_id: i64, req: &PredictRequest) -> Result<PredictCommand, ApiErr
             .map(|w| w.choice(CellKind::WorkObject))
             .transpose()?,
         frame,
+        track_mm: req.e1,
     })
 }
 

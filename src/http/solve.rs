@@ -14,7 +14,9 @@
 //! format of `robocal solve`, options in the query string) and the answer as
 //! CSV (`Accept: text/csv`, or by default for a CSV request; columns of
 //! `ik::targets_csv`, the model used in `X-Robocal-Version` /
-//! `X-Robocal-Method`). The handler turns either body into a
+//! `X-Robocal-Method`). With `e1` [mm] (body or query) the robot's base is
+//! carried to that value along its stored track and the cell frame is the
+//! track's (`service::tracks::carry`). The handler turns either body into a
 //! `service::solve::SolveCommand`; the service picks the model and runs it.
 
 use super::error::{content_type, json_content_type};
@@ -144,6 +146,9 @@ pub struct SolveRequest {
     /// targets are in it.
     #[serde(default, deserialize_with = "present")]
     pub work_object: Option<ItemRef>,
+    /// The track's value [mm]: the robot carried along its stored track.
+    #[serde(default, deserialize_with = "present")]
+    pub e1: Option<f64>,
 }
 
 /// A tool or work object of a solve: a stored one's name, or one inline.
@@ -306,6 +311,7 @@ struct Common<'a> {
     convention: Option<&'a str>,
     position_only: bool,
     path: bool,
+    e1: Option<f64>,
 }
 
 /// The model a `version` field names (absent: the active version).
@@ -376,6 +382,7 @@ fn command(robot_id: i64, c: Common) -> Result<SolveCommand, ApiError> {
         targets: Targets::Inputs(Vec::new()),
         tool: None,
         work_object: None,
+        track_mm: c.e1,
     })
 }
 
@@ -411,6 +418,7 @@ pub fn json_command(
             convention: req.convention.as_deref().or(query.convention),
             position_only: req.position_only.or(query.position_only).unwrap_or(false),
             path: req.path.or(query.path).unwrap_or(false),
+            e1: req.e1.or(query.e1),
         },
     )?;
     cmd.tool = req
@@ -447,6 +455,8 @@ pub struct CsvSolveQuery {
     pub convention: Option<String>,
     pub position_only: Option<bool>,
     pub path: Option<bool>,
+    /// The track's value [mm] (the robot carried along its stored track).
+    pub e1: Option<f64>,
     /// `point` or `comma` (detected when absent).
     pub decimal: Option<String>,
 }
@@ -462,6 +472,7 @@ struct QueryOptions<'a> {
     convention: Option<&'a str>,
     position_only: Option<bool>,
     path: Option<bool>,
+    e1: Option<f64>,
 }
 
 /// A decimal number as `openapi.yaml`'s `seed_deg` pattern writes it: an
@@ -530,6 +541,7 @@ impl CsvSolveQuery {
             convention: self.convention.as_deref(),
             position_only: self.position_only,
             path: self.path,
+            e1: self.e1,
         })
     }
 }
@@ -554,6 +566,7 @@ pub fn csv_command(robot_id: i64, q: &CsvSolveQuery, text: &str) -> Result<Solve
             convention: query.convention,
             position_only: query.position_only.unwrap_or(false),
             path: query.path.unwrap_or(false),
+            e1: query.e1,
         },
     )?;
     let d = dialect(q.decimal.as_deref())?;

@@ -35,6 +35,7 @@ pub mod sets;
 pub mod solve;
 mod start;
 mod state;
+pub mod tracks;
 pub mod versions;
 mod waiting;
 

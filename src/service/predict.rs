@@ -3,7 +3,8 @@
 //! tool and work object (stored or inline, as for a solve), the forward
 //! evaluation (`core::cell::predict::Forward`, the model `solve` inverts) and
 //! the expected error at the tool from the version's validation evidence
-//! (`core::cell::accuracy`).
+//! (`core::cell::accuracy`). A track value carries the model's base along
+//! the robot's stored track first (`super::tracks::carry`).
 //!
 //! Units at this boundary: joint readings in the controller convention in
 //! degrees; poses SI (the handler writes mm and degrees).
@@ -35,6 +36,8 @@ pub struct PredictCommand {
     /// Work object the poses are expressed in (`None`: `frame`).
     pub work_object: Option<ItemChoice>,
     pub frame: TargetFrame,
+    /// A track value [mm]: the base carried along the robot's stored track.
+    pub track_mm: Option<f64>,
 }
 
 /// What a prediction produced.
@@ -115,6 +118,9 @@ pub async fn predict(
     let (mut model, evidence, version, method) = model_and_evidence(state, &cmd).await?;
     if let Some(p) = cmd.payload_kg {
         model.payload_kg = p;
+    }
+    if let Some(value) = cmd.track_mm {
+        model = super::tracks::carry(state, cmd.robot_id, model, value).await?;
     }
     let dof = model.dof();
     // Another joint count conflicts with the robot (as a solve's seed does).

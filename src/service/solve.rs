@@ -14,6 +14,10 @@
 //! tool, else the model's payload kept at its flange point), targets `T`
 //! solved as `W·T` in the base frame and false targets returned in `W`.
 //!
+//! A track value carries the model's base along the robot's stored track
+//! (`super::tracks::carry`): the cell frame is the track's; such a solver
+//! is built per request, not cached.
+//!
 //! Units at this boundary: targets in mm and degrees (`TargetInput`), joint
 //! seeds and commands in the controller convention in degrees.
 
@@ -134,6 +138,9 @@ pub struct SolveCommand {
     pub tool: Option<ItemChoice>,
     /// Work object the targets and false targets are in (`None`: `options.frame`).
     pub work_object: Option<ItemChoice>,
+    /// A track value [mm]: the base carried along the robot's stored track
+    /// (the solver is then built for the request, not cached).
+    pub track_mm: Option<f64>,
 }
 
 /// A tool or work object of a solve: stored by name, or given inline.
@@ -266,7 +273,7 @@ async fn prepare(
         tcp.map(|t| std::array::from_fn(|i| if i < 3 { t.p[i] } else { t.r[i - 3] }.to_bits())),
         load.map(|l| [l.mass_kg, l.com.x, l.com.y, l.com.z].map(f64::to_bits)),
     );
-    let cacheable = cmd.jump_deg.is_none();
+    let cacheable = cmd.jump_deg.is_none() && cmd.track_mm.is_none();
     if cacheable {
         if let Some(solver) = state.cached_solver(&key) {
             return Ok((solver, version, method));
@@ -275,6 +282,9 @@ async fn prepare(
     let mut model = load_model(state, robot_id, &ctx.model_json, &chosen).await?;
     if let Some(p) = cmd.payload_kg {
         model.payload_kg = p;
+    }
+    if let Some(value) = cmd.track_mm {
+        model = super::tracks::carry(state, robot_id, model, value).await?;
     }
     let mut settings = IkSettings::default();
     if let Some(j) = cmd.jump_deg {

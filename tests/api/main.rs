@@ -20,7 +20,8 @@
 //! a percentage that never goes back, its candidate, fold and time left),
 //! `admission` (large requests share one admission), `slow_clients` (header
 //! and body timeouts, the connection cap), `exposure` (no open writes on a
-//! network by default); the harness is `support`.
+//! network by default), `track` (a robot's linear track: fitted, stored,
+//! and carrying predictions and solves, over HTTP and the CLI alike); the harness is `support`.
 
 mod abandoned;
 mod admission;
@@ -55,3 +56,4 @@ mod spec;
 mod stored;
 mod stored_jobs;
 mod support;
+mod track;

@@ -1,0 +1,40 @@
+//! A linear track carrying a robot, as stored: the calibrated track's JSON
+//! description and what its fit was made on and judged against.
+
+use sqlx::FromRow;
+
+/// A fitted track to store for a robot (replacing the one it has).
+#[derive(Debug, Clone, PartialEq)]
+pub struct NewTrack {
+    /// The model version the fit held (its number).
+    pub version: i64,
+    /// The measurement file's column of the track's value, `e1` … `e6`.
+    pub axis_column: String,
+    /// The tracker's σ per coordinate the fit was judged against [mm].
+    pub sigma_mm: f64,
+    /// The highest carriage-map order tried.
+    pub max_order: i64,
+    pub readings: i64,
+    pub stations: i64,
+    /// The fit's residuals: RMS and maximum [mm].
+    pub rms_mm: f64,
+    pub max_mm: f64,
+    /// `LinearTrack::to_json`: mm, degrees, arcsec.
+    pub track_json: String,
+}
+
+/// A robot's stored track.
+#[derive(Debug, Clone, FromRow)]
+pub struct TrackRow {
+    pub robot_id: i64,
+    pub version: i64,
+    pub axis_column: String,
+    pub sigma_mm: f64,
+    pub max_order: i64,
+    pub readings: i64,
+    pub stations: i64,
+    pub rms_mm: f64,
+    pub max_mm: f64,
+    pub track_json: String,
+    pub created_at: String,
+}

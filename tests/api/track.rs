@@ -1,0 +1,545 @@
+//! A robot's linear track over HTTP: fitted from a measurement file with an
+//! `e1` column on the robot's calibrated version (`POST …/track/calibrate`),
+//! stored, read back and deleted, and predictions and solves carried along
+//! it by `e1`. The robot is the harness's simulated YS100, calibrated by a
+//! KM job from its simulated identification set; the robot on the rail is
+//! that version's geometry (as in `tests/cli_track.rs`: the robot's own
+//! calibration is tested elsewhere, here the track and the plumbing are),
+//! carried by the simulated 4 m rail of the core's acceptance test
+//! (`sim::track::TrueTrack::rail_4m`, built from the rail's physics, not
+//! from the model's code) and read with 0.01 mm tracker noise at 11 track
+//! values. The same file and the same
+//! version's model file go through `robocal track calibrate`, `predict` and
+//! `solve`: HTTP and the command line give the same track, the same poses
+//! and the same joints; the poses and joints are checked against the truth
+//! at a track value the fit never saw.
+
+use super::cell::model_file;
+use crate::support::*;
+use axum::http::StatusCode;
+use clap::Parser;
+use nalgebra::{UnitQuaternion, Vector3};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use robocal::measure::csv::write_set;
+use robocal::measure::external::{ExternalAxis, MeasurementSet};
+use robocal::model::calibrated::CalibratedModelFile;
+use robocal::model::{preset, Pose};
+use robocal::sim::random_configurations;
+use robocal::sim::track::TrueTrack;
+use serde_json::{json, Value};
+use std::path::Path;
+use std::time::Duration;
+
+const CALIBRATE: &str = "/v1/robots/{id}/track/calibrate";
+const TRACK: &str = "/v1/robots/{id}/track";
+const PREDICT: &str = "/v1/robots/{id}/predict";
+const SOLVE: &str = "/v1/robots/{id}/solve";
+
+const STATIONS: [f64; 11] = [
+    0.0, 400.0, 800.0, 1200.0, 1600.0, 2000.0, 2400.0, 2800.0, 3200.0, 3600.0, 4000.0,
+];
+/// A track value the fit never saw [mm].
+const HELD_OUT_MM: f64 = 1000.0;
+/// The payload the robot carries on the rail [kg].
+const PAYLOAD_KG: f64 = 110.0;
+
+/// A robot of the calibrated version's geometry on the simulated rail.
+struct Rail {
+    truth: robocal::sim::TrueRobot,
+    track: TrueTrack,
+}
+
+impl Rail {
+    /// The robot of the model file `model` (a version's `model.json`).
+    fn new(model: &Path) -> Self {
+        let text = std::fs::read_to_string(model).unwrap();
+        let file = CalibratedModelFile::from_json(&text).unwrap();
+        let mut truth = robocal::sim::TrueRobot::new(file.to_compensated().unwrap().calibrated);
+        truth.noise_mm = 0.01;
+        Rail {
+            truth,
+            track: TrueTrack::rail_4m(),
+        }
+    }
+
+    /// `n` random poses at each of `values`, read by the tracker.
+    fn measure(&self, values: &[f64], n: usize, rng: &mut ChaCha8Rng) -> MeasurementSet {
+        let nominal = preset("ys100").unwrap();
+        let stations: Vec<(f64, Vec<Vec<f64>>)> = values
+            .iter()
+            .map(|v| (*v, random_configurations(&nominal, n, rng)))
+            .collect();
+        self.track
+            .measure(
+                &self.truth,
+                ExternalAxis::E1,
+                &stations,
+                Some(PAYLOAD_KG),
+                rng,
+            )
+            .unwrap()
+    }
+
+    /// The true pose of the measured point in the tracker frame (no noise).
+    fn true_pose(&self, q: &[f64], value_mm: f64) -> Pose {
+        self.track
+            .cell_from_base(value_mm)
+            .compose(&self.truth.true_pose_base(q, Some(PAYLOAD_KG)).unwrap())
+    }
+}
+
+/// Runs a `robocal` command line in-process; what it prints.
+fn cli(args: &[&str]) -> anyhow::Result<String> {
+    let mut argv = vec!["robocal"];
+    argv.extend_from_slice(args);
+    match robocal::cli::Cli::try_parse_from(argv).unwrap().command {
+        robocal::cli::Command::Track(a) => match a.command {
+            robocal::cli::track::TrackCommand::Calibrate(c) => {
+                robocal::cli::track::calibrate_to_string(&c)
+            }
+        },
+        robocal::cli::Command::Predict(a) => robocal::cli::predict::predict_to_string(&a),
+        robocal::cli::Command::Solve(a) => robocal::cli::solve::solve_to_string(&a),
+        other => panic!("{other:?}"),
+    }
+}
+
+fn path(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn controller_deg(q: &[f64]) -> Vec<f64> {
+    preset("ys100")
+        .unwrap()
+        .joints_to_controller(q)
+        .iter()
+        .map(|v| v.to_degrees())
+        .collect()
+}
+
+fn xyz(v: &Value) -> Vector3<f64> {
+    Vector3::new(
+        v["x"].as_f64().unwrap(),
+        v["y"].as_f64().unwrap(),
+        v["z"].as_f64().unwrap(),
+    )
+}
+
+fn numbers(v: &Value) -> Vec<f64> {
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect()
+}
+
+#[tokio::test]
+async fn a_track_fitted_over_http_is_the_command_lines_and_carries_predict_and_solve() {
+    let t = setup().await;
+    let (robot, rid) = t.robot_with_identification_set().await;
+    let sets = t
+        .get("/v1/robots/{id}/measurement-sets", &[&rid])
+        .await
+        .json();
+    let set = sets["measurement_sets"][0]["id"].clone();
+    let r = t
+        .start_job(
+            &rid,
+            json!({ "methods": ["km"], "identification_set_ids": [set], "seed": 1 }),
+        )
+        .await;
+    t.succeeds(robot, &r, Duration::from_secs(300)).await;
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let model = model_file(&t, &rid, d).await;
+
+    // No track yet: 404, and `e1` is refused naming the route that fits one.
+    let r = t.get(TRACK, &[&rid]).await;
+    assert_eq!(r.status, StatusCode::NOT_FOUND, "{}", r.text());
+    let r = t
+        .post_json(
+            PREDICT,
+            &[&rid],
+            json!({ "readings": [{ "joints_deg": [0, -90, 90, 0, 0, 0] }], "e1": 100 }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY);
+    assert!(r.detail().contains("has no track"), "{}", r.detail());
+
+    let rail = Rail::new(&model);
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let csv = write_set(&rail.measure(&STATIONS, 15, &mut rng));
+    std::fs::write(d.join("track.csv"), &csv).unwrap();
+
+    // The fit over HTTP, stored; the same file through the command line.
+    let r = t.post_json(CALIBRATE, &[&rid], json!({ "csv": csv })).await;
+    assert_eq!(r.status, StatusCode::CREATED, "{}", r.text());
+    let fitted = r.json();
+    assert_eq!(fitted["fitted"], true);
+    assert_eq!(fitted["version"], 1);
+    assert_eq!(fitted["readings"], 165);
+    assert_eq!(fitted["stations"], 11);
+    let printed = cli(&[
+        "track",
+        "calibrate",
+        path(&d.join("track.csv")),
+        "--model",
+        path(&model),
+        "--out",
+        path(&d.join("rail.json")),
+        "--json",
+    ])
+    .unwrap();
+    let cli_fit: Value = serde_json::from_str(&printed).unwrap();
+    assert_eq!(fitted["fit"], cli_fit["fit"], "the fit's report");
+    let file_text = std::fs::read_to_string(d.join("rail.json")).unwrap();
+    let file: Value = serde_json::from_str(&file_text).unwrap();
+    let stored = t.get(TRACK, &[&rid]).await;
+    assert_eq!(stored.status, StatusCode::OK);
+    let stored = stored.json();
+    assert_eq!(stored["track"], file, "the stored track is the file");
+    assert_eq!(stored["created_at"], fitted["created_at"]);
+    // The track, as the file holds it, against the truth at a value never
+    // fitted: the base within 0.05 mm, the scale error 0.2 mm/m within 0.03.
+    let track = robocal::model::external::LinearTrack::from_json(&file_text).unwrap();
+    assert!(
+        ((track.scale - 1.0) * 1e3 - 0.2).abs() < 0.03,
+        "{}",
+        track.scale
+    );
+    let base = track.cell_from_base(HELD_OUT_MM).unwrap();
+    let true_base = rail.track.cell_from_base(HELD_OUT_MM);
+    assert!((base.p - true_base.p).norm() < 0.05e-3);
+
+    // Predict at the held-out value over HTTP and by the command line: the
+    // same poses, and each within 0.05 mm of the true reflector.
+    let nominal = preset("ys100").unwrap();
+    let qs = random_configurations(&nominal, 8, &mut rng);
+    let readings: Vec<Value> = qs
+        .iter()
+        .map(|q| json!({ "joints_deg": controller_deg(q) }))
+        .collect();
+    let r = t
+        .post_json(
+            PREDICT,
+            &[&rid],
+            json!({ "readings": readings, "e1": HELD_OUT_MM, "payload_kg": PAYLOAD_KG }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let http = r.json();
+    let joints: Vec<String> = qs
+        .iter()
+        .map(|q| {
+            controller_deg(q)
+                .iter()
+                .map(|v| format!("{v}"))
+                .collect::<Vec<_>>()
+                .join(",")
+        })
+        .collect();
+    std::fs::write(
+        d.join("joints.csv"),
+        format!("q1,q2,q3,q4,q5,q6\n{}\n", joints.join("\n")),
+    )
+    .unwrap();
+    let e1 = HELD_OUT_MM.to_string();
+    let printed = cli(&[
+        "predict",
+        "--model",
+        path(&model),
+        "--joints",
+        path(&d.join("joints.csv")),
+        "--track",
+        path(&d.join("rail.json")),
+        "--e1",
+        &e1,
+        "--payload-kg",
+        "110",
+        "--json",
+    ])
+    .unwrap();
+    let by_cli: Value = serde_json::from_str(&printed).unwrap();
+    let http_rows = http["results"].as_array().unwrap();
+    let cli_rows = by_cli["results"].as_array().unwrap();
+    assert_eq!(http_rows.len(), qs.len());
+    for ((q, h), c) in qs.iter().zip(http_rows).zip(cli_rows) {
+        for k in ["x", "y", "z", "rx", "ry", "rz"] {
+            assert_eq!(h[k], c[k], "{k}: HTTP {} CLI {}", h[k], c[k]);
+        }
+        let want = rail.true_pose(q, HELD_OUT_MM).p * 1e3;
+        assert!((xyz(h) - want).norm() < 0.05, "{} {want}", xyz(h));
+    }
+
+    // Solve the poses the true robot reached there, over HTTP and by the
+    // command line: the same joints, and the true robot at them within
+    // 0.05 mm of each target.
+    let targets: Vec<(Value, String)> = qs
+        .iter()
+        .enumerate()
+        .map(|(i, q)| {
+            let p = rail.true_pose(q, HELD_OUT_MM);
+            let u = UnitQuaternion::from_matrix(&p.r);
+            let (x, y, z) = (p.p.x * 1e3, p.p.y * 1e3, p.p.z * 1e3);
+            (
+                json!({ "id": format!("t{i}"), "x": x, "y": y, "z": z,
+                        "orientation": { "convention": "quaternion", "values": [u.w, u.i, u.j, u.k] } }),
+                format!("t{i},{x},{y},{z},{},{},{},{}", u.w, u.i, u.j, u.k),
+            )
+        })
+        .collect();
+    let body: Vec<Value> = targets.iter().map(|(j, _)| j.clone()).collect();
+    let rows: Vec<String> = targets.iter().map(|(_, c)| c.clone()).collect();
+    std::fs::write(
+        d.join("targets.csv"),
+        format!("id,x,y,z,qw,qx,qy,qz\n{}\n", rows.join("\n")),
+    )
+    .unwrap();
+    let r = t
+        .post_json(
+            SOLVE,
+            &[&rid],
+            json!({ "targets": body, "e1": HELD_OUT_MM, "payload_kg": PAYLOAD_KG }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let http = r.json();
+    let printed = cli(&[
+        "solve",
+        "--model",
+        path(&model),
+        "--targets",
+        path(&d.join("targets.csv")),
+        "--track",
+        path(&d.join("rail.json")),
+        "--e1",
+        &e1,
+        "--payload-kg",
+        "110",
+        "--json",
+    ])
+    .unwrap();
+    let by_cli: Value = serde_json::from_str(&printed).unwrap();
+    let cli_targets = by_cli["targets"].as_array().unwrap();
+    for ((q, h), c) in qs
+        .iter()
+        .zip(http["results"].as_array().unwrap())
+        .zip(cli_targets)
+    {
+        assert_eq!(h["status"], "ok", "{h}");
+        let deg = numbers(&h["joints_deg"]);
+        for (a, b) in deg.iter().zip(numbers(&c["joints_deg"])) {
+            assert!((a - b).abs() < 1e-9, "HTTP {a} CLI {b} deg");
+        }
+        let rad: Vec<f64> = deg.iter().map(|v| v.to_radians()).collect();
+        let solved = nominal.joints_from_controller(&rad);
+        let miss =
+            (rail.true_pose(&solved, HELD_OUT_MM).p - rail.true_pose(q, HELD_OUT_MM).p).norm();
+        assert!(miss < 0.05e-3, "{} mm", miss * 1e3);
+    }
+    // The targets CSV takes `e1` in the query and gives the same joints.
+    let r = t
+        .send(
+            "POST",
+            SOLVE,
+            &[&rid],
+            &format!("?e1={HELD_OUT_MM}&payload_kg=110"),
+            Some("text/csv"),
+            std::fs::read(d.join("targets.csv")).unwrap(),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let first = r.text().lines().nth(1).unwrap().to_string();
+    let j1 = numbers(&http["results"][0]["joints_deg"])[0];
+    let csv_j1: f64 = first.split(',').nth(4).unwrap().parse().unwrap();
+    assert!((csv_j1 - j1).abs() < 1e-6, "{first}");
+
+    // Beyond the travel measured: refused by predict and solve alike.
+    for (route, body) in [
+        (
+            PREDICT,
+            json!({ "readings": [{ "joints_deg": controller_deg(&qs[0]) }], "e1": 4500 }),
+        ),
+        (
+            SOLVE,
+            json!({ "targets": [{ "x": 1500, "y": 0, "z": 1200 }], "position_only": true, "e1": -1 }),
+        ),
+    ] {
+        let r = t.post_json(route, &[&rid], body).await;
+        assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{route}");
+        assert!(
+            r.detail()
+                .contains("outside the travel measured, [0, 4000] mm"),
+            "{}",
+            r.detail()
+        );
+    }
+}
+
+#[tokio::test]
+async fn a_refused_fit_stores_nothing_and_names_its_reason_as_the_command_line_does() {
+    let t = setup().await;
+    let (robot, rid) = t.robot_with_identification_set().await;
+    // Without a calibrated version there is nothing to hold: 409.
+    let header = "q1,q2,q3,q4,q5,q6,e1,x,y,z\n0,0,0,0,0,0,0,1500,200,1200\n";
+    let r = t
+        .post_json(CALIBRATE, &[&rid], json!({ "csv": header }))
+        .await;
+    assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
+    let sets = t
+        .get("/v1/robots/{id}/measurement-sets", &[&rid])
+        .await
+        .json();
+    let id = sets["measurement_sets"][0]["id"].clone();
+    let r = t
+        .start_job(
+            &rid,
+            json!({ "methods": ["km"], "identification_set_ids": [id], "seed": 1 }),
+        )
+        .await;
+    t.succeeds(robot, &r, Duration::from_secs(300)).await;
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let model = model_file(&t, &rid, d).await;
+    let rail = Rail::new(&model);
+    let mut rng = ChaCha8Rng::seed_from_u64(12);
+    let mut set = rail.measure(&STATIONS[..7], 15, &mut rng);
+
+    // One reading 0.15 mm off: the reason and the reading, in the command
+    // line's words; nothing stored.
+    set.poses[33].xyz_mm[2] += 0.15;
+    let csv = write_set(&set);
+    std::fs::write(d.join("off.csv"), &csv).unwrap();
+    let r = t.post_json(CALIBRATE, &[&rid], json!({ "csv": csv })).await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+    let detail = r.detail();
+    assert!(
+        detail.starts_with("not fitted (residual_outlier): reading 34 is "),
+        "{detail}"
+    );
+    let cli_error = cli(&[
+        "track",
+        "calibrate",
+        path(&d.join("off.csv")),
+        "--model",
+        path(&model),
+        "--out",
+        path(&d.join("rail.json")),
+    ])
+    .unwrap_err();
+    assert_eq!(detail, cli_error.to_string());
+    assert_eq!(t.get(TRACK, &[&rid]).await.status, StatusCode::NOT_FOUND);
+
+    // The wrong column, and four track values: refused by their codes.
+    let r = t
+        .post_json(CALIBRATE, &[&rid], json!({ "csv": csv, "column": "e2" }))
+        .await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY);
+    assert!(r.detail().starts_with("not fitted (missing_column): "));
+    let few = write_set(&rail.measure(&STATIONS[..4], 5, &mut rng));
+    let r = t.post_json(CALIBRATE, &[&rid], json!({ "csv": few })).await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY);
+    assert!(r.detail().starts_with("not fitted (too_few_stations): "));
+    assert_eq!(t.get(TRACK, &[&rid]).await.status, StatusCode::NOT_FOUND);
+
+    // A sound fit is stored (201), a refit replaces it (200), a refused
+    // refit keeps it; DELETE removes it (204, then 404).
+    set.poses[33].xyz_mm[2] -= 0.15;
+    let good = write_set(&set);
+    let r = t
+        .post_json(CALIBRATE, &[&rid], json!({ "csv": good }))
+        .await;
+    assert_eq!(r.status, StatusCode::CREATED, "{}", r.text());
+    let first = t.get(TRACK, &[&rid]).await.json();
+    assert_eq!(first["track"]["travel_mm"], json!([0.0, 2400.0]));
+    let later = write_set(&rail.measure(&STATIONS[4..], 15, &mut rng));
+    let r = t
+        .post_json(CALIBRATE, &[&rid], json!({ "csv": later, "max_order": 4 }))
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let refit = t.get(TRACK, &[&rid]).await.json();
+    assert_eq!(refit["max_order"], 4);
+    assert_eq!(refit["track"]["travel_mm"], json!([1600.0, 4000.0]));
+    let r = t.post_json(CALIBRATE, &[&rid], json!({ "csv": few })).await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY);
+    assert_eq!(t.get(TRACK, &[&rid]).await.json(), refit);
+    let r = t.send("DELETE", TRACK, &[&rid], "", None, Vec::new()).await;
+    assert_eq!(r.status, StatusCode::NO_CONTENT);
+    assert_eq!(t.get(TRACK, &[&rid]).await.status, StatusCode::NOT_FOUND);
+    let r = t.send("DELETE", TRACK, &[&rid], "", None, Vec::new()).await;
+    assert_eq!(r.status, StatusCode::NOT_FOUND);
+
+    // Bad options are 422 naming the field; a missing robot is 404.
+    for (body, field) in [
+        (json!({ "csv": good, "column": "e7" }), "`column`"),
+        (json!({ "csv": good, "sigma_mm": 0 }), "`sigma_mm`"),
+        (json!({ "csv": good, "max_order": 9 }), "`max_order`"),
+        (json!({ "csv": "q1,q2\n1,2\n" }), "measurement CSV"),
+    ] {
+        let r = t
+            .raw(
+                "POST",
+                &format!("/v1/robots/{rid}/track/calibrate"),
+                Some("application/json"),
+                body.to_string().into_bytes(),
+                None,
+            )
+            .await;
+        assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{field}");
+        assert!(r.detail().contains(field), "{field}: {}", r.detail());
+    }
+    let r = t.get(TRACK, &["99999"]).await;
+    assert_eq!(r.status, StatusCode::NOT_FOUND);
+}
+
+#[tokio::test]
+async fn writing_a_track_needs_the_admin_role() {
+    let t = setup_config(robocal::http::ServiceConfig {
+        api_keys: robocal::service::keys::parse_keys("a1:admin,o1:operate,r1:read").unwrap(),
+        ..robocal::http::ServiceConfig::default()
+    })
+    .await;
+    let rid = t.create_robot("ys100").await.to_string();
+    let body =
+        json!({ "csv": "q1,q2,q3,q4,q5,q6,e1,x,y,z\n0,0,0,0,0,0,0,1500,200,1200\n" }).to_string();
+    for (key, post, get, delete) in [
+        (
+            "r1",
+            StatusCode::FORBIDDEN,
+            StatusCode::NOT_FOUND,
+            StatusCode::FORBIDDEN,
+        ),
+        (
+            "o1",
+            StatusCode::FORBIDDEN,
+            StatusCode::NOT_FOUND,
+            StatusCode::FORBIDDEN,
+        ),
+        // Past the role check: a robot without a calibrated version, no track.
+        (
+            "a1",
+            StatusCode::CONFLICT,
+            StatusCode::NOT_FOUND,
+            StatusCode::NOT_FOUND,
+        ),
+    ] {
+        let uri = format!("/v1/robots/{rid}/track");
+        let r = t
+            .raw(
+                "POST",
+                &format!("{uri}/calibrate"),
+                Some("application/json"),
+                body.clone().into_bytes(),
+                Some(key),
+            )
+            .await;
+        assert_eq!(r.status, post, "{key} POST: {}", r.text());
+        let r = t.raw("GET", &uri, None, Vec::new(), Some(key)).await;
+        assert_eq!(r.status, get, "{key} GET: {}", r.text());
+        let r = t.raw("DELETE", &uri, None, Vec::new(), Some(key)).await;
+        assert_eq!(r.status, delete, "{key} DELETE: {}", r.text());
+        let r = t.raw("GET", &uri, None, Vec::new(), None).await;
+        assert_eq!(r.status, StatusCode::UNAUTHORIZED);
+    }
+}
