@@ -152,15 +152,15 @@ fn accept(
 }
 
 /// The simulated robot with compliance, joint 2's top quarter held out.
-/// Fails today: `skcm-maps` wins on the mean beyond the tie margin and is
-/// 30 % above SKCM's mean on the held-out range (seed 1: 0.2083 against
-/// 0.1608 mm, max 0.5222 against 0.6048). The blocked-fold veto passes it
-/// on its clusters (seed 1: 0.0924 / 0.2677 mm mean / max against SKCM
-/// alone's 0.1395 / 0.4089); its worst edge, joint 2's top 20 %, shows what
-/// the held-out range does (0.2293 mm against SKCM alone's 0.1279), but the
-/// edges report and do not veto (`methods::veto`). Run with `--ignored`.
+/// Meets the accuracy bound on every seed but not the three-seed stability:
+/// the edge veto sets `skcm-maps` aside on every seed (joint 2's top 20 %,
+/// 0.3647 mm against SKCM alone's 0.1279), then seed 1 delivers `skcm-gp`
+/// (0.1585 / 0.6048 mm against SKCM's 0.1608 / 0.6048 on the held-out
+/// range), seed 2 vetoes `skcm-gp` on its clusters' max (0.4578 against
+/// 0.4018 mm) and delivers SKCM, and seed 3 delivers SKCM: the Gaussian
+/// process's clusters follow the seed. Run with `--ignored`.
 #[test]
-#[ignore = "skcm-maps extrapolates worse than SKCM into the held-out joint range"]
+#[ignore = "the choice after the edge veto follows the seed through the Gaussian process's clusters"]
 fn simulated_compliance_held_out_joint_range() {
     let nominal = preset("ys100").unwrap();
     let truth = unmodelled_truth(&nominal, true, 7);

@@ -367,7 +367,7 @@ pub(super) fn apply_veto(
             }
         };
         let c = rs.compare(&of, &bf);
-        let verdict = veto(&c.option, &c.base, margin);
+        let verdict = veto(&c.option, &c.base, &c.edges, margin);
         let [(count, poses), (edges, edge_poses)] = rs.size();
         checks.push(BlockedCheck {
             option: method,

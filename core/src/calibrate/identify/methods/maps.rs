@@ -6,8 +6,10 @@
 //! cross-validation keeps no map (K = 0 wins) the base's fit stays, and the
 //! report says so.
 //!
-//! Randomness: the folds draw from `ChaCha8Rng(seed + 101)`, the spatially
-//! blocked folds from `ChaCha8Rng(seed + 102)` (`CompensatorOptions::seed`).
+//! Randomness: the spatially blocked folds draw from `ChaCha8Rng(seed + 102)`
+//! (`CompensatorOptions::seed`); the cross-validation's folds are dealt by
+//! the poses, not the seed (`joint_maps`), so the same poses get the same
+//! harmonics and ridge whatever the seed.
 //! The veto's region refits ([`base_fit_with`]) hold the harmonics and ridge
 //! chosen on all the poses (`MapStructure::Fixed`), so the maps they fit
 //! depend on the region's poses alone, not on how the folds were dealt.
@@ -109,7 +111,6 @@ fn fit_maps(
         .filter(|m| m.session < sessions)
         .cloned()
         .collect();
-    let mut rng = ChaCha8Rng::seed_from_u64(ctx.opts.compensator.seed.wrapping_add(101));
     let mut blocked_rng = ChaCha8Rng::seed_from_u64(ctx.opts.compensator.seed.wrapping_add(102));
     let w = ctx.opts.lm.orientation_weight;
     for round in 0..rounds {
@@ -124,7 +125,6 @@ fn fit_maps(
             w,
             settings,
             structure,
-            &mut rng,
             &mut blocked_rng,
             &mut |done, total| progress((stage + done as f64 / total as f64) / stages, done, None),
         )
