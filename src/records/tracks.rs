@@ -14,10 +14,13 @@ pub struct NewTrack {
     pub sigma_mm: f64,
     /// The highest carriage-map order tried.
     pub max_order: i64,
+    /// The readings the fit used.
     pub readings: i64,
+    /// The track positions (stations) the readings were taken at.
     pub stations: i64,
-    /// The fit's residuals: RMS and maximum [mm].
+    /// RMS of the fit's residuals [mm].
     pub rms_mm: f64,
+    /// Largest residual of the fit [mm].
     pub max_mm: f64,
     /// `LinearTrack::to_json`: mm, degrees, arcsec.
     pub track_json: String,
@@ -26,15 +29,26 @@ pub struct NewTrack {
 /// A robot's stored track.
 #[derive(Debug, Clone, FromRow)]
 pub struct TrackRow {
+    /// The robot the track carries.
     pub robot_id: i64,
+    /// The model version the fit held (its number).
     pub version: i64,
+    /// The measurement file's column of the track's value, `e1` … `e6`.
     pub axis_column: String,
+    /// The tracker's σ per coordinate the fit was judged against [mm].
     pub sigma_mm: f64,
+    /// The highest carriage-map order tried.
     pub max_order: i64,
+    /// The readings the fit used.
     pub readings: i64,
+    /// The track positions (stations) the readings were taken at.
     pub stations: i64,
+    /// RMS of the fit's residuals [mm].
     pub rms_mm: f64,
+    /// Largest residual of the fit [mm].
     pub max_mm: f64,
+    /// `LinearTrack::to_json`: mm, degrees, arcsec.
     pub track_json: String,
+    /// When it was stored (UTC, RFC 3339).
     pub created_at: String,
 }

@@ -549,6 +549,25 @@ impl CrossValidation<'_> {
     /// fitted without its poses, the folds on up to `threads` threads and
     /// gathered in fold order: `Some(None)` when a fold's solve fails, `None`
     /// when `go` (after each fold) cancels.
+    /// Every `(K, λ)` of `grid` cross-validated in order, progress counted
+    /// in candidates of `grid.len() + 1` (`None`: stopped).
+    fn all(
+        &self,
+        grid: &[(usize, f64)],
+        threads: usize,
+        progress: &mut dyn FnMut(usize, usize) -> bool,
+    ) -> Option<Vec<MapCandidate>> {
+        let total = grid.len() + 1;
+        let mut out = Vec::new();
+        for (done, &(k, ridge)) in grid.iter().enumerate() {
+            out.extend(self.candidate(k, ridge, threads, &mut || progress(done, total))?);
+            if !progress(done + 1, total) {
+                return None;
+            }
+        }
+        Some(out)
+    }
+
     fn candidate(
         &self,
         k: usize,
@@ -708,38 +727,10 @@ pub fn fit_joint_maps(
         fold_poses,
         fold_normals,
     };
-    let mut candidates = Vec::new();
-    for (done, (k, ridge)) in grid.iter().enumerate() {
-        let threads = settings.parallel.threads();
-        match cv.candidate(*k, *ridge, threads, &mut || progress(done, total)) {
-            None => return Ok(None),
-            Some(c) => candidates.extend(c),
-        }
-        if !progress(done + 1, total) {
-            return Ok(None);
-        }
-    }
-    let without_maps = candidates
-        .iter()
-        .find(|c| c.harmonics == 0)
-        .cloned()
-        .ok_or(MapFitError::NotEvaluable)?;
-    // The lowest held-out eq. 7.10 cost (K = 0 is a candidate); a held
-    // structure is taken whatever its cost (K = 0 when a fold could not
-    // solve it).
-    let chosen = match structure {
-        MapStructure::CrossValidated => candidates
-            .iter()
-            .min_by(|a, b| a.cv_cost_mm2.total_cmp(&b.cv_cost_mm2))
-            .cloned()
-            .expect("K = 0 is a candidate"),
-        MapStructure::Fixed(_) => candidates
-            .iter()
-            .rev()
-            .find(|c| c.harmonics > 0)
-            .unwrap_or(&without_maps)
-            .clone(),
+    let Some(candidates) = cv.all(&grid, settings.parallel.threads(), progress) else {
+        return Ok(None);
     };
+    let (chosen, without_maps) = choose(&candidates, structure)?;
     let maps = if chosen.harmonics == 0 {
         None
     } else {
@@ -781,6 +772,35 @@ pub fn fit_joint_maps(
         poses: data.len(),
         refused: d.refused.clone(),
     }))
+}
+
+/// The chosen candidate and the one without maps (K = 0). Cross-validated:
+/// the lowest held-out eq. 7.10 cost (K = 0 is a candidate); a held
+/// structure is taken whatever its cost (K = 0 when a fold could not solve
+/// it).
+fn choose(
+    candidates: &[MapCandidate],
+    structure: MapStructure,
+) -> Result<(MapCandidate, MapCandidate), MapFitError> {
+    let without_maps = candidates
+        .iter()
+        .find(|c| c.harmonics == 0)
+        .cloned()
+        .ok_or(MapFitError::NotEvaluable)?;
+    let chosen = match structure {
+        MapStructure::CrossValidated => candidates
+            .iter()
+            .min_by(|a, b| a.cv_cost_mm2.total_cmp(&b.cv_cost_mm2))
+            .cloned()
+            .expect("K = 0 is a candidate"),
+        MapStructure::Fixed(_) => candidates
+            .iter()
+            .rev()
+            .find(|c| c.harmonics > 0)
+            .unwrap_or(&without_maps)
+            .clone(),
+    };
+    Ok((chosen, without_maps))
 }
 
 #[cfg(test)]
