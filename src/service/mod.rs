@@ -38,7 +38,7 @@ mod state;
 pub mod versions;
 mod waiting;
 
-pub use gate::WorkGate;
+pub use gate::{Hold, WorkGate};
 pub use state::{AppState, RobotContext, ServiceConfig};
 
 use crate::db::StoreError;

@@ -137,6 +137,7 @@ pub(super) async fn execute(state: AppState, job: Job, claim: Option<Claim>) {
                     At {
                         phase: p.phase.label(),
                         percent: p.percent,
+                        in_fold: p.fold.is_some(),
                     },
                     &|| flag.load(Ordering::SeqCst),
                 );
