@@ -3,8 +3,9 @@
 screenshot of each step:
 
   create robot -> upload measurements -> calibrate (live progress) -> report
-  -> versions (the best is active) -> a second calibration held at the test
-  gate and cancelled (confirmed) -> solve a targets CSV into a CSV answer
+  -> versions (the best is active) -> a second calibration (`auto`) held at
+  the test gate on a candidate's fold, its row showing `auto · candidate ·
+  fold k/n` and the time left, and cancelled (confirmed) -> solve a targets CSV into a CSV answer
   -> check, its page (per-pose errors, summary, frame shift, thresholds)
   -> thresholds set -> a check on a rigidly shifted copy of the set says
   `shifted` -> re-register from it -> activate the new version (confirmed)
@@ -253,24 +254,40 @@ def main():
         shot("versions", "versions")
 
 
-        # 5b. Cancel a running calibration: the test gate holds it (the
-        # server logs that it waits there), the Cancel button asks first (a
-        # dismissed question sends nothing), then the job ends `cancelled`.
-        gate.touch()
+        # 5b. Cancel a running calibration: the test gate holds an `auto`
+        # job inside a candidate's cross-validation (the file's text: phase
+        # `auto` from 11 %, past the first percent of the methods' 90 % so
+        # with a time left, at a report that names a fold; the server logs
+        # that it waits there), the Cancel button asks first (a dismissed
+        # question sends nothing), then the job ends `cancelled`.
+        gate.write_text("auto 11 fold\n")
         form = driver.find_element(By.ID, "calibrate")
         for box in form.find_elements(By.NAME, "method"):
-            if box.is_selected() != (box.get_attribute("value") == "km"):
+            if box.is_selected() != (box.get_attribute("value") == "auto"):
                 box.click()
         form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
         wait.until(replaced(form))
         log = pathlib.Path(work) / "server.log"
         wait.until(lambda d: "work held at the test gate" in log.read_text())
         wait.until(lambda d: text_of(d, "#calibrations tbody tr .status") == "running")
-        # Live progress: the page polls the held job and shows its phase and
-        # percentage (held at its first report, the registration at 0 %).
-        wait.until(lambda d: text_of(d, "#calibrations tbody tr .phase") == "registration")
-        held = text_of(driver, "#calibrations tbody tr .percent")
-        assert held == "0 %", f"the held job's percentage: {held}"
+        # Live progress: the page polls the held job and shows the candidate
+        # and fold it is held on, its percentage and the time left.
+        # The row may first show reports from before the hold; the held one
+        # (a fold at 11 % or later) stays.
+        held_phase = re.compile(r"auto · ([a-z-]+) · fold (\d+)/(\d+)")
+        held_percent = re.compile(r"(\d+) % · (\d+ s|\d+ min \d\d s|\d+ h \d\d min) left")
+
+        def held_row(d):
+            phase = held_phase.fullmatch(text_of(d, "#calibrations tbody tr .phase") or "")
+            pct = held_percent.fullmatch(text_of(d, "#calibrations tbody tr .percent") or "")
+            return (phase, pct) if phase and pct and int(pct.group(1)) >= 11 else None
+        phase, pct = wait.until(held_row)
+        candidate, index, of = phase.group(1), int(phase.group(2)), int(phase.group(3))
+        assert candidate in ("km-rbf", "km-gp", "skcm-nn", "skcm-iwonn", "skcm-tlbonn", "skcm-gp",
+                             "km-maps-gp", "skcm-maps-gp"), f"not a compensator: {candidate}"
+        # 5 random folds and 4 blocked ones (the defaults).
+        assert of == 9 and 1 <= index <= of, f"the held job's fold: {index}/{of}"
+        print(f"console_check: held at {phase.group(0)}, {pct.group(0)}")
         shot("calibration-held", "calibrations")
         cancel = driver.find_element(By.CSS_SELECTOR, "#calibrations tbody tr button.cancel")
         cancel.click()

@@ -27,7 +27,13 @@ over the share of the method's bar done (the method runs from 10 to 100 %).
 
 `--eta M1,M2,...` runs that job once instead and prints every progress line that
 states a time left beside the time that was actually left (the process's end
-less the line's arrival): how right the estimate is, early and late.
+less the line's arrival), then the first line at or past 5, 10, 25, 50 and
+75 % with its stated and actual time left and their ratio: how right the
+estimate is, early and late. The time left is wall-clock time, so unlike the
+weights it depends on what else the machine runs; beside it the same
+estimator on the process's processor time (from the methods' first line) and
+the processor time actually left, which judge the plan's weights alone.
+`--threads N` runs that job on N threads (1 by default, as the weights).
 
 The weight of a method is its time over SKCM's, except `skcm-tlbo`'s, from which
 KM's warm start is taken off (the plan counts KM's fit apart,
@@ -74,13 +80,13 @@ def cpu_s(pid):
     return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
-def run(robocal, methods):
+def run(robocal, methods, threads=1):
     """Runs one calibration; (start, end, lines) with each progress line as
     (arrival, percent, phase, rest, processor seconds so far); `start` and
     `end` as (wall, processor) seconds."""
     cmd = [robocal, "calibrate", "--model", "ur5", "--identify", str(GRID),
            "--validate", str(RANDOM), "--method", methods, "--cv-folds", "5",
-           "--threads", "1", "--seed", "1"]
+           "--threads", str(threads), "--seed", "1"]
     start = time.monotonic()
     p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     if deadline is not None:
@@ -125,15 +131,51 @@ def timed(robocal, method):
     return (cpu - began) / share, began, percent
 
 
-def eta(robocal, methods):
-    """Every stated time left of one job beside the time actually left."""
-    (start, _), (end, _), lines, _ = run(robocal, methods)
-    print(f"{methods}: {end - start:.1f} s in all")
-    print(f"{'elapsed s':>9} {'percent':>7} {'stated s':>8} {'actual s':>8}  where")
-    for t, percent, phase, rest, _ in lines:
+# Where `--eta` sets the stated time left beside the actual one.
+MILESTONES = (5.0, 10.0, 25.0, 50.0, 75.0)
+
+
+def eta(robocal, methods, threads):
+    """Every stated time left of one job beside the time actually left, then
+    the first report at or past each of `MILESTONES` percent: its stated and
+    actual time left and their ratio; and the same in processor time, where
+    the estimator (the program's, on processor seconds from the first line of
+    a method) is judged on the planned work alone, whatever else the machine
+    runs."""
+    (start, _), (end, cpu_end), lines, finished = run(robocal, methods, threads)
+    if not finished:
+        raise SystemExit(f"{methods}: stopped before its end")
+    print(f"{methods}: {end - start:.1f} s in all, {cpu_end:.1f} processor s, {threads} thread(s)")
+    print(f"{'elapsed s':>9} {'cpu s':>7} {'percent':>7} {'stated s':>8} {'actual s':>8}  where")
+    for t, percent, phase, rest, cpu in lines:
         left = seconds_left(rest)
         if left is not None:
-            print(f"{t - start:9.1f} {percent:7.1f} {left:8d} {end - t:8.1f}  {phase}{LEFT.sub('', rest).split(' · iteration')[0]}")
+            print(f"{t - start:9.1f} {cpu:7.1f} {percent:7.1f} {left:8d} {end - t:8.1f}  "
+                  f"{phase}{LEFT.sub('', rest).split(' · iteration')[0]}")
+    # The methods' first line: the anchor of the estimate.
+    anchor = next(((cpu, percent) for _, percent, phase, _, cpu in lines
+                   if phase not in ("registration", "identifiability")), None)
+    print()
+    print(f"{'at':>4} {'report':>7} {'elapsed s':>9} {'stated s':>8} {'actual s':>8} {'ratio':>6}"
+          f" {'cpu est s':>9} {'cpu left s':>10} {'ratio':>6}")
+    for at in MILESTONES:
+        first = next(((t, percent, seconds_left(rest), cpu) for t, percent, _, rest, cpu in lines
+                      if percent >= at), None)
+        if first is None:
+            print(f"{at:3.0f}% {'none':>7}")
+            continue
+        t, percent, left, cpu = first
+        actual = end - t
+        stated = "none" if left is None else f"{left:d}"
+        ratio = "" if left is None or actual <= 0 else f"{left / actual:.2f}"
+        cpu_est, cpu_ratio = "none", ""
+        if anchor is not None and percent - anchor[1] >= 0.01 * (100.0 - anchor[1]):
+            est = (cpu - anchor[0]) * (100.0 - percent) / (percent - anchor[1])
+            cpu_est = f"{est:.1f}"
+            if cpu_end - cpu > 0:
+                cpu_ratio = f"{est / (cpu_end - cpu):.2f}"
+        print(f"{at:3.0f}% {percent:6.1f}% {t - start:9.1f} {stated:>8} {actual:8.1f} {ratio:>6}"
+              f" {cpu_est:>9} {cpu_end - cpu:10.1f} {cpu_ratio:>6}")
 
 
 def main():
@@ -145,6 +187,7 @@ def main():
     ap.add_argument("--jobs", type=int, default=len(METHODS.split(",")),
                     help="methods measured side by side")
     ap.add_argument("--eta", help="a method list to run once, printing its stated and actual time left")
+    ap.add_argument("--threads", type=int, default=1, help="threads of the `--eta` run")
     ap.add_argument("--deadline", type=float,
                     help="seconds after which runs still going stop; their time is extrapolated "
                          "from the share of their bar done")
@@ -153,7 +196,7 @@ def main():
     if args.deadline is not None:
         deadline = time.monotonic() + args.deadline
     if args.eta:
-        eta(args.robocal, args.eta)
+        eta(args.robocal, args.eta, args.threads)
         return
     methods = args.methods.split(",")
     for needed in ("km", "skcm"):

@@ -321,14 +321,15 @@ fn warn_about(exposed: Exposure, keys: &[ApiKey], addr: SocketAddr) {
 }
 
 /// The test gate of tests that drive this binary (`ROBOCAL_TEST_GATE_FILE`:
-/// work waits while that file exists; see `service::WorkGate`). Unset in
+/// work waits while that file exists, all of it or what the file's text
+/// names, `PHASE [PERCENT] [fold]`; see `service::WorkGate`). Unset in
 /// production; a start with it set says so at WARN.
 fn test_gate() -> Option<std::sync::Arc<crate::service::WorkGate>> {
     let path = std::env::var_os("ROBOCAL_TEST_GATE_FILE").filter(|p| !p.is_empty())?;
     let path = std::path::PathBuf::from(path);
     tracing::warn!(
         file = %path.display(),
-        "ROBOCAL_TEST_GATE_FILE is set: calibrations and large solves wait while this file exists (a test hook; unset it in production)"
+        "ROBOCAL_TEST_GATE_FILE is set: calibrations and large solves wait while this file exists (its text, `PHASE [PERCENT] [fold]`, may name which; a test hook; unset it in production)"
     );
     Some(std::sync::Arc::new(crate::service::WorkGate::file(path)))
 }

@@ -9,7 +9,11 @@
 //!
 //! A gate is either held in memory (in-process tests open and close it) or
 //! follows a file (`ROBOCAL_TEST_GATE_FILE` for `robocal serve`, for tests
-//! that drive the real binary): closed while the file exists.
+//! that drive the real binary): closed while the file exists. Either holds
+//! all work or only a calibration's reports from a phase and percentage on,
+//! optionally only those that name a cross-validation fold ([`Hold`]); a
+//! file says which in its text (`auto 11 fold`, [`Hold::parse`]), read each
+//! time work passes, so a test can move the hold between jobs.
 
 use std::path::PathBuf;
 use std::sync::{Condvar, Mutex};
@@ -22,18 +26,65 @@ const RECHECK: Duration = Duration::from_millis(10);
 #[derive(Debug)]
 pub struct WorkGate {
     kind: Kind,
-    /// Only work at this phase and at least this percent is held (`None`: all).
-    only: Option<(String, f64)>,
+    /// Only the work this names is held (`None`: all); a file gate's text
+    /// overrides it.
+    only: Option<Hold>,
     state: Mutex<GateState>,
     changed: Condvar,
 }
 
-/// Where a task passes the gate: a calibration's phase and percent, or
-/// `solve` for a solve batch or filter.
+/// Which work a closed gate holds: a calibration's reports in `phase` at
+/// `percent` or later and, when `in_fold`, only those that name a
+/// cross-validation fold (a candidate's training, not a base fit or a final
+/// training); other work passes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Hold {
+    pub phase: String,
+    pub percent: f64,
+    pub in_fold: bool,
+}
+
+impl Hold {
+    /// A hold from a gate file's text: empty (or blank) holds all work (`None`),
+    /// otherwise `PHASE [PERCENT] [fold]` on its first line, e.g. `auto 11
+    /// fold`; `Err` names what does not read.
+    pub fn parse(text: &str) -> Result<Option<Hold>, String> {
+        let mut words = text.lines().next().unwrap_or("").split_whitespace();
+        let Some(phase) = words.next() else {
+            return Ok(None);
+        };
+        let (mut percent, mut in_fold) = (None, false);
+        for w in words {
+            match (w, w.parse::<f64>()) {
+                ("fold", _) if !in_fold => in_fold = true,
+                (_, Ok(p)) if p.is_finite() && percent.is_none() && !in_fold => percent = Some(p),
+                _ => {
+                    return Err(format!(
+                        "`{w}`: the gate file reads `PHASE [PERCENT] [fold]`"
+                    ))
+                }
+            }
+        }
+        Ok(Some(Hold {
+            phase: phase.to_string(),
+            percent: percent.unwrap_or(0.0),
+            in_fold,
+        }))
+    }
+
+    /// Whether work at `at` is held by this.
+    fn holds(&self, at: At<'_>) -> bool {
+        at.phase == self.phase && at.percent >= self.percent && (at.in_fold || !self.in_fold)
+    }
+}
+
+/// Where a task passes the gate: a calibration's phase and percent and
+/// whether its report names a fold, or `solve` for a solve batch or filter.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct At<'a> {
     pub(crate) phase: &'a str,
     pub(crate) percent: f64,
+    pub(crate) in_fold: bool,
 }
 
 impl At<'static> {
@@ -41,6 +92,7 @@ impl At<'static> {
     pub(crate) const SOLVE: At<'static> = At {
         phase: "solve",
         percent: 0.0,
+        in_fold: false,
     };
 }
 
@@ -76,8 +128,17 @@ impl WorkGate {
     /// A closed gate that holds only work in `phase` at `percent` or later
     /// (a calibration method past its base fit, say); other work passes.
     pub fn closed_from(phase: &str, percent: f64) -> Self {
+        WorkGate::closed_at(Hold {
+            phase: phase.to_string(),
+            percent,
+            in_fold: false,
+        })
+    }
+
+    /// A closed gate that holds only the work `hold` names.
+    pub fn closed_at(hold: Hold) -> Self {
         WorkGate {
-            only: Some((phase.to_string(), percent)),
+            only: Some(hold),
             ..WorkGate::closed()
         }
     }
@@ -120,16 +181,33 @@ impl WorkGate {
         }
     }
 
+    /// Whether the gate, if closed, holds work at `at`: a file gate by its
+    /// text (all work when it cannot be read, e.g. gone meanwhile; none when
+    /// its text does not read, which is logged), a memory gate by `only`.
+    fn holds(&self, at: At<'_>) -> bool {
+        let read;
+        let only = match &self.kind {
+            Kind::Memory => self.only.as_ref(),
+            Kind::File(p) => match std::fs::read_to_string(p).map(|t| Hold::parse(&t)) {
+                Ok(Ok(hold)) => {
+                    read = hold;
+                    read.as_ref()
+                }
+                Ok(Err(e)) => {
+                    tracing::warn!(file = %p.display(), "test gate file not read: {e}");
+                    return false;
+                }
+                Err(_) => None,
+            },
+        };
+        only.is_none_or(|h| h.holds(at))
+    }
+
     /// Waits while the gate is closed, unless `stop` says the task is to stop;
     /// returns at once when the gate is open.
     pub(crate) fn pass(&self, at: At<'_>, stop: &dyn Fn() -> bool) {
-        if let Some((phase, percent)) = &self.only {
-            if at.phase != phase || at.percent < *percent {
-                return;
-            }
-        }
         let mut s = self.lock();
-        if !self.is_closed(&s) || stop() {
+        if !self.is_closed(&s) || stop() || !self.holds(at) {
             return;
         }
         s.held += 1;
@@ -184,7 +262,11 @@ mod tests {
     #[test]
     fn a_gate_for_one_phase_holds_only_that_phase_from_its_percent() {
         let gate = Arc::new(WorkGate::closed_from("skcm-nn", 15.0));
-        let at = |phase, percent| At { phase, percent };
+        let at = |phase, percent| At {
+            phase,
+            percent,
+            in_fold: false,
+        };
         gate.pass(at("skcm", 50.0), &|| false);
         gate.pass(at("skcm-nn", 10.0), &|| false);
         gate.pass(At::SOLVE, &|| false);
@@ -199,6 +281,75 @@ mod tests {
         gate.open();
         t.join().unwrap();
         assert_eq!(gate.arrived(), 1);
+    }
+
+    #[test]
+    fn a_gate_file_reads_phase_percent_and_fold() {
+        let hold = |phase: &str, percent, in_fold| {
+            Some(Hold {
+                phase: phase.to_string(),
+                percent,
+                in_fold,
+            })
+        };
+        assert_eq!(Hold::parse(""), Ok(None));
+        assert_eq!(Hold::parse(" \n"), Ok(None));
+        assert_eq!(Hold::parse("auto\n"), Ok(hold("auto", 0.0, false)));
+        assert_eq!(Hold::parse("auto 11.5"), Ok(hold("auto", 11.5, false)));
+        assert_eq!(Hold::parse("auto fold"), Ok(hold("auto", 0.0, true)));
+        assert_eq!(
+            Hold::parse(" auto 11 fold\nignored"),
+            Ok(hold("auto", 11.0, true))
+        );
+        for bad in [
+            "auto fold 11",
+            "auto 0 12",
+            "auto fold fold",
+            "auto nan",
+            "auto folds",
+        ] {
+            assert!(Hold::parse(bad).is_err(), "{bad}");
+        }
+    }
+
+    /// A gate that holds only reports naming a fold lets the others pass,
+    /// in memory as from a file's text.
+    #[test]
+    fn a_gate_in_fold_holds_only_reports_that_name_a_fold() {
+        let dir = std::env::temp_dir().join(format!("robocal-gate-fold-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("hold");
+        std::fs::write(&path, b"auto 11 fold\n").unwrap();
+        let gates = [
+            WorkGate::closed_at(Hold::parse("auto 11 fold").unwrap().unwrap()),
+            WorkGate::file(path.clone()),
+        ];
+        for gate in gates {
+            let gate = Arc::new(gate);
+            let at = |phase, percent, in_fold| At {
+                phase,
+                percent,
+                in_fold,
+            };
+            gate.pass(at("auto", 12.0, false), &|| false);
+            gate.pass(at("auto", 10.0, true), &|| false);
+            gate.pass(at("skcm-nn", 50.0, true), &|| false);
+            gate.pass(At::SOLVE, &|| false);
+            assert_eq!(gate.arrived(), 0);
+            let t = {
+                let gate = gate.clone();
+                std::thread::spawn(move || gate.pass(at("auto", 11.0, true), &|| false))
+            };
+            while gate.held() == 0 {
+                std::thread::yield_now();
+            }
+            gate.open();
+            std::fs::remove_file(&path).unwrap();
+            t.join().unwrap();
+            assert_eq!(gate.arrived(), 1);
+            std::fs::write(&path, b"auto 11 fold\n").unwrap();
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

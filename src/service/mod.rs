@@ -39,7 +39,7 @@ pub mod tracks;
 pub mod versions;
 mod waiting;
 
-pub use gate::WorkGate;
+pub use gate::{Hold, WorkGate};
 pub use state::{AppState, RobotContext, ServiceConfig};
 
 use crate::db::StoreError;

@@ -5,7 +5,7 @@ use crate::support::*;
 use axum::http::StatusCode;
 use robocal::calibrate::identify::progress::ETA_FROM_FRACTION;
 use robocal::http::ServiceConfig;
-use robocal::service::WorkGate;
+use robocal::service::{Hold, WorkGate};
 use serde_json::{json, Value};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -15,10 +15,8 @@ use std::time::{Duration, Instant};
 /// fit, then KM-RBF's cross-validation, KM-GP's, SKCM's fit and its four
 /// compensators', then the joint maps and the Gaussian processes on them),
 /// the middle of KM-GP's cross-validation, past the first percent of the
-/// methods' work (so with a time left).
-/// The plan also counts the veto's refits, so the report there may be one
-/// that names no fold (a base fit or a final training); the test then lets
-/// reports pass one at a time until one inside a fold is held.
+/// methods' work (so with a time left). The gate holds only a report that
+/// names a fold there (not a base fit or a final training).
 fn hold_at() -> f64 {
     use robocal::calibrate::identify::Method::*;
     let w = |m: robocal::calibrate::identify::Method| m.row().weight;
@@ -56,7 +54,11 @@ fn real(path: &str) -> String {
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn an_auto_job_reports_progress_that_never_goes_back() {
     let hold = hold_at();
-    let gate = Arc::new(WorkGate::closed_from("auto", hold));
+    let gate = Arc::new(WorkGate::closed_at(Hold {
+        phase: "auto".to_string(),
+        percent: hold,
+        in_fold: true,
+    }));
     let t = setup_config(ServiceConfig {
         workers: 1,
         progress_interval: Duration::from_millis(20),
@@ -87,7 +89,6 @@ async fn an_auto_job_reports_progress_that_never_goes_back() {
     let mut last = 0.0;
     let mut polls = 0usize;
     let mut held: Option<Value> = None;
-    let mut released: Option<Value> = None;
     let mut etas = 0usize;
     let end = loop {
         let j = t.job(&rid, job).await.json();
@@ -114,27 +115,17 @@ async fn an_auto_job_reports_progress_that_never_goes_back() {
                 etas += 1;
             }
         }
-        // Held: once the stored progress is the held report, it names what
-        // the job is on; then the job goes on.
+        // Held: once the stored progress is the held report (the reports
+        // before it that name no fold pass the gate), it names what the job
+        // is on; then the job goes on.
         if held.is_none()
             && gate.held() > 0
             && p["phase"] == "auto"
             && percent >= hold
-            && Some(p) != released.as_ref()
+            && !p["fold"].is_null()
         {
-            if p["fold"].is_null() {
-                // Held where no fold runs (a base fit or a final training):
-                // let this report pass and hold the next one.
-                released = Some(p.clone());
-                gate.open();
-                while gate.held() > 0 {
-                    tokio::time::sleep(Duration::from_millis(1)).await;
-                }
-                gate.close();
-            } else {
-                held = Some(p.clone());
-                gate.open();
-            }
+            held = Some(p.clone());
+            gate.open();
         }
         // Only a hang takes ten minutes.
         assert!(start.elapsed() < Duration::from_secs(600), "{j}");

@@ -211,6 +211,7 @@ fn spawn_calibration(state: &AppState, job: Job, signals: Signals) -> JoinHandle
                     At {
                         phase: p.phase.label(),
                         percent: p.percent,
+                        in_fold: p.fold.is_some(),
                     },
                     &|| flag.load(Ordering::SeqCst),
                 );
