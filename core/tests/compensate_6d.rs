@@ -217,6 +217,9 @@ fn auto_on_6d_data_keeps_or_gains_orientation() {
     let mut opts = common::opts(&[Method::Km, Method::Auto]);
     opts.compensator.auto_candidates = vec![Method::KmGp, Method::KmMaps];
     let r = calibrate_with_training(&nominal, &id, &tr, &va, &opts, &|_| true).unwrap();
+    for f in &r.failed {
+        eprintln!("FAILED {} : {}", f.method.name(), f.reason);
+    }
     let auto = &r.methods[&Method::Auto];
     let chosen = auto.auto.as_ref().unwrap().chosen;
     let (km, au) = (

@@ -188,15 +188,20 @@ pub(super) struct Decision {
 pub(super) fn decide(ctx: &Context, t: &Tally) -> Result<Decision, MethodError> {
     let margin = ctx.opts.compensator.tie_margin;
     let (_, pool_name) = ctx.pool();
-    let scores: Vec<(f64, Option<f64>)> = t
-        .options
+    // The orientation bar is set by the options still in the running: one
+    // the veto set aside no longer excludes the others.
+    let live: Vec<usize> = (0..t.options.len())
+        .filter(|i| !t.vetoed.contains(i))
+        .collect();
+    let scores: Vec<(f64, Option<f64>)> = live
         .iter()
-        .map(|o| (o.mean_mm, o.orientation_deg))
+        .map(|&i| (t.options[i].mean_mm, t.options[i].orientation_deg))
         .collect();
     let no_option = || MethodFailure::NoBaseSucceeded {
         notes: t.notes.clone(),
     };
     let (_, excluded) = choose_option(&scores, ORIENTATION_SLACK).ok_or_else(no_option)?;
+    let excluded: Vec<usize> = excluded.iter().map(|&k| live[k]).collect();
     let rule = |among: &[usize]| {
         let c: Vec<Contender> = among.iter().map(|i| contender(&t.options[*i])).collect();
         break_ties(&c, margin).map(|o| TieOutcome {
