@@ -176,8 +176,9 @@ pub fn model_of(row: &TrackRow) -> Result<LinearTrack, ServiceError> {
 }
 
 /// `model` with its base carried to track value `value_mm` through the
-/// robot's stored track (its cell frame is the track's). No track stored,
-/// or a value outside the travel it was measured over, is `Invalid`.
+/// robot's stored track (its cell frame is the track's). No track stored
+/// is a `Conflict` (the robot's state); a value outside the travel it was
+/// measured over is `Invalid`.
 pub async fn carry(
     state: &AppState,
     robot_id: i64,
@@ -185,7 +186,7 @@ pub async fn carry(
     value_mm: f64,
 ) -> Result<CompensatedModel, ServiceError> {
     let Some(row) = state.db().track(robot_id).await? else {
-        return Err(ServiceError::Invalid(format!(
+        return Err(ServiceError::Conflict(format!(
             "`e1`: robot {robot_id} has no track; fit one with POST /v1/robots/{robot_id}/track/calibrate, or leave `e1` out"
         )));
     };

@@ -164,7 +164,7 @@ async fn a_track_fitted_over_http_is_the_command_lines_and_carries_predict_and_s
             json!({ "readings": [{ "joints_deg": [0, -90, 90, 0, 0, 0] }], "e1": 100 }),
         )
         .await;
-    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY);
+    assert_eq!(r.status, StatusCode::CONFLICT);
     assert!(r.detail().contains("has no track"), "{}", r.detail());
 
     let rail = Rail::new(&model);
