@@ -84,10 +84,7 @@ pub(super) async fn execute(state: AppState, job: Job, claim: Option<Claim>) {
     let robot_id = job.robot_id;
     let cancel = state.cancel_flag(id);
     tracing::info!(job = id, robot = robot_id, "calibration started");
-    let (claim, heartbeat) = match claim {
-        Some(c) => (Some(c.token), Some(c.heartbeat)),
-        None => (None, None),
-    };
+    let (claim, heartbeat) = claim.map(|c| (c.token, c.heartbeat)).unzip();
     let (tx, rx) = watch::channel(None::<Progress>);
     let (end_tx, end_rx) = oneshot::channel::<()>();
     let writer = tokio::spawn(write_progress(
@@ -98,22 +95,68 @@ pub(super) async fn execute(state: AppState, job: Job, claim: Option<Claim>) {
         end_rx,
         state.config().progress_interval,
     ));
-    // The job's wall-clock budget: past it the job stops like a cancellation
-    // and is reported as failed.
+    let flag = cancel.clone();
+    let Job {
+        robot_name,
+        nominal,
+        ident,
+        valid,
+        training,
+        opts,
+        session_names,
+        pose_sources,
+        payload_kg,
+        ticket: _ticket,
+        ..
+    } = job;
+    // The workers share the cores: each job's cross-validations run on its share.
+    let mut opts = opts;
+    opts.compensator.parallel = Parallelism::shared_by(state.config().workers);
+    opts.joint_maps.parallel = opts.compensator.parallel;
+    // The job's time budget: past it the job stops as if cancelled, failed.
     let budget = state.limits().job_time;
     let deadline = std::time::Instant::now() + budget;
     let over_budget = Arc::new(AtomicBool::new(false));
-    let task = spawn_calibration(
-        &state,
-        job,
-        Signals {
-            progress: tx,
-            ended: end_tx,
-            cancel: cancel.clone(),
-            deadline,
-            over_budget: over_budget.clone(),
-        },
-    );
+    let over = over_budget.clone();
+    let gate_state = state.clone();
+    let task = tokio::task::spawn_blocking(move || {
+        let report = calibrate_with_training(
+            &nominal,
+            &ident,
+            &training,
+            &valid,
+            &opts,
+            &|p: &Progress| {
+                tx.send_replace(Some(p.clone()));
+                gate_state.pass_gate(
+                    At {
+                        phase: p.phase.label(),
+                        percent: p.percent,
+                        in_fold: p.fold.is_some(),
+                    },
+                    &|| flag.load(Ordering::SeqCst),
+                );
+                if std::time::Instant::now() > deadline {
+                    over.store(true, Ordering::SeqCst);
+                    return false;
+                }
+                !flag.load(Ordering::SeqCst)
+            },
+        );
+        drop(tx);
+        drop(end_tx);
+        report.and_then(|mut r| {
+            r.session_names = session_names;
+            r.pose_sources = pose_sources;
+            let versions = versions_of(&mut r, &nominal, &robot_name, &opts, payload_kg);
+            if versions.is_empty() {
+                return Err(CalibrationError::AllMethodsFailed {
+                    failed: r.failed.clone(),
+                });
+            }
+            Ok((r, versions))
+        })
+    });
     let outcome = match crate::service::job_watch::wait(
         task,
         &cancel,
@@ -157,99 +200,17 @@ pub(super) async fn execute(state: AppState, job: Job, claim: Option<Claim>) {
     }
 }
 
-/// What the blocking calibration reports back through: the progress channel,
-/// the end signal (dropped when the run ends), the cancel flag, the job's
-/// deadline and the flag set when the deadline stopped it.
-struct Signals {
-    progress: watch::Sender<Option<Progress>>,
-    ended: oneshot::Sender<()>,
-    cancel: Arc<AtomicBool>,
-    deadline: std::time::Instant,
-    over_budget: Arc<AtomicBool>,
-}
-
-/// Runs the job's calibration on the blocking pool, its cross-validations on
-/// this worker's share of the cores; the progress callback passes the test
-/// gate and stops the run on cancel or past the deadline.
-fn spawn_calibration(state: &AppState, job: Job, signals: Signals) -> JoinHandle<Calibrated> {
-    let Signals {
-        progress: tx,
-        ended: end_tx,
-        cancel: flag,
-        deadline,
-        over_budget: over,
-    } = signals;
-    let Job {
-        robot_name,
-        nominal,
-        ident,
-        valid,
-        training,
-        opts,
-        session_names,
-        pose_sources,
-        payload_kg,
-        ticket: _ticket,
-        ..
-    } = job;
-    // The calibration workers share the cores: each job's cross-validations
-    // (compensators and joint maps) run on its share.
-    let mut opts = opts;
-    opts.compensator.parallel = Parallelism::shared_by(state.config().workers);
-    opts.joint_maps.parallel = opts.compensator.parallel;
-    let gate_state = state.clone();
-    tokio::task::spawn_blocking(move || {
-        let report = calibrate_with_training(
-            &nominal,
-            &ident,
-            &training,
-            &valid,
-            &opts,
-            &|p: &Progress| {
-                tx.send_replace(Some(p.clone()));
-                gate_state.pass_gate(
-                    At {
-                        phase: p.phase.label(),
-                        percent: p.percent,
-                        in_fold: p.fold.is_some(),
-                    },
-                    &|| flag.load(Ordering::SeqCst),
-                );
-                if std::time::Instant::now() > deadline {
-                    over.store(true, Ordering::SeqCst);
-                    return false;
-                }
-                !flag.load(Ordering::SeqCst)
-            },
-        );
-        drop(tx);
-        drop(end_tx);
-        report.and_then(|mut r| {
-            r.session_names = session_names;
-            r.pose_sources = pose_sources;
-            let versions = versions_of(&mut r, &nominal, &robot_name, &opts, payload_kg);
-            if versions.is_empty() {
-                return Err(CalibrationError::AllMethodsFailed {
-                    failed: r.failed.clone(),
-                });
-            }
-            Ok((r, versions))
-        })
-    })
-}
-
 /// What a job's run ended with: its report and model versions, the
 /// calibration's error, or the blocking task's panic.
-type RunOutcome = Result<Calibrated, tokio::task::JoinError>;
-
-/// A finished calibration: its report and the model versions to store, or
-/// why it failed.
-type Calibrated = Result<
-    (
-        crate::calibrate::identify::CalibrationReport,
-        Vec<crate::db::NewVersion>,
-    ),
-    CalibrationError,
+type RunOutcome = Result<
+    Result<
+        (
+            crate::calibrate::identify::CalibrationReport,
+            Vec<crate::db::NewVersion>,
+        ),
+        CalibrationError,
+    >,
+    tokio::task::JoinError,
 >;
 
 /// Stores a job's outcome: its report and versions, or its status and
