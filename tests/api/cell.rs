@@ -14,7 +14,6 @@ use robocal::solve::ik::IkSettings;
 use robocal_core::model::calibrated::CalibratedModelFile;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
-use std::time::Duration;
 
 const TOOLS: &str = "/v1/robots/{id}/tools";
 const TOOL: &str = "/v1/robots/{id}/tools/{name}";
@@ -213,19 +212,7 @@ async fn tools_and_work_objects_are_stored_per_robot_by_unique_name_and_number()
 /// A YS100 with a km calibration of simulated measurements (active version 1)
 /// and the cell of `examples/programs/cell.json`.
 pub(crate) async fn calibrated_robot_with_cell(t: &TestApp) -> (i64, String) {
-    let (robot, rid) = t.robot_with_identification_set().await;
-    let sets = t
-        .get("/v1/robots/{id}/measurement-sets", &[&rid])
-        .await
-        .json();
-    let set = sets["measurement_sets"][0]["id"].clone();
-    let r = t
-        .start_job(
-            &rid,
-            json!({ "methods": ["km"], "identification_set_ids": [set], "seed": 1 }),
-        )
-        .await;
-    t.succeeds(robot, &r, Duration::from_secs(300)).await;
+    let (robot, rid) = t.km_calibrated_robot().await;
     let cell = cell_file();
     let r = put(t, TOOLS, &[&rid], json!({ "tools": cell["tools"] })).await;
     assert_eq!(r.status, StatusCode::OK, "{}", r.text());

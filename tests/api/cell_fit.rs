@@ -17,26 +17,13 @@ use robocal::solve::cell::{CellOptions, CellSolver, WorkObject};
 use robocal::solve::ik::IkSettings;
 use robocal_core::model::calibrated::{CalibratedModelFile, CompensatedModel};
 use serde_json::{json, Value};
-use std::time::Duration;
 
 const TOOL_FIT: &str = "/v1/robots/{id}/tools/{name}/fit";
 const FRAME_FIT: &str = "/v1/robots/{id}/frames/{name}/fit";
 
 /// A YS100 with a km calibration of simulated measurements (active version 1).
 async fn calibrated_robot(t: &TestApp) -> String {
-    let (robot, rid) = t.robot_with_identification_set().await;
-    let sets = t
-        .get("/v1/robots/{id}/measurement-sets", &[&rid])
-        .await
-        .json();
-    let set = sets["measurement_sets"][0]["id"].clone();
-    let r = t
-        .start_job(
-            &rid,
-            json!({ "methods": ["km"], "identification_set_ids": [set], "seed": 1 }),
-        )
-        .await;
-    t.succeeds(robot, &r, Duration::from_secs(300)).await;
+    let (_, rid) = t.km_calibrated_robot().await;
     rid
 }
 

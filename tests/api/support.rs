@@ -420,6 +420,25 @@ impl TestApp {
         (robot, robot.to_string())
     }
 
+    /// [`Self::robot_with_identification_set`] with a km calibration of that
+    /// set (seed 1) as its active version 1.
+    pub(crate) async fn km_calibrated_robot(&self) -> (i64, String) {
+        let (robot, rid) = self.robot_with_identification_set().await;
+        let sets = self
+            .get("/v1/robots/{id}/measurement-sets", &[&rid])
+            .await
+            .json();
+        let set = sets["measurement_sets"][0]["id"].clone();
+        let r = self
+            .start_job(
+                &rid,
+                serde_json::json!({ "methods": ["km"], "identification_set_ids": [set], "seed": 1 }),
+            )
+            .await;
+        self.succeeds(robot, &r, Duration::from_secs(300)).await;
+        (robot, rid)
+    }
+
     pub(crate) async fn create_robot(&self, preset: &str) -> i64 {
         let r = self
             .post_json(

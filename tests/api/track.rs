@@ -137,19 +137,7 @@ fn numbers(v: &Value) -> Vec<f64> {
 #[tokio::test]
 async fn a_track_fitted_over_http_is_the_command_lines_and_carries_predict_and_solve() {
     let t = setup().await;
-    let (robot, rid) = t.robot_with_identification_set().await;
-    let sets = t
-        .get("/v1/robots/{id}/measurement-sets", &[&rid])
-        .await
-        .json();
-    let set = sets["measurement_sets"][0]["id"].clone();
-    let r = t
-        .start_job(
-            &rid,
-            json!({ "methods": ["km"], "identification_set_ids": [set], "seed": 1 }),
-        )
-        .await;
-    t.succeeds(robot, &r, Duration::from_secs(300)).await;
+    let (_robot, rid) = t.km_calibrated_robot().await;
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let model = model_file(&t, &rid, d).await;
