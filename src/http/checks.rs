@@ -27,7 +27,7 @@ use serde_json::Value;
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CheckRequest {
-    /// The measurement set to score (its poses in the version's measurement frame).
+    /// The measurement set to score.
     #[serde(deserialize_with = "id")]
     pub set_id: i64,
     /// The model version to score against; absent: the active one.

@@ -160,7 +160,7 @@ fn check_metadata(
     Ok(m)
 }
 
-/// `GET /v1/presets`: every preset's name, joints and payload [kg].
+/// `GET /v1/presets`: every preset's name, number of joints and payload [kg].
 pub async fn list_presets() -> Result<Response, ApiError> {
     let presets: Vec<Value> = PRESETS
         .iter()

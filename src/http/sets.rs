@@ -85,7 +85,7 @@ pub struct RowInput {
     /// Temperature during the measurement [°C].
     #[serde(default)]
     pub temperature_c: Option<f64>,
-    /// The set the pose belongs to.
+    /// The pose's data role (the CSV's `set` column), when given.
     #[serde(default)]
     pub set: Option<SetRole>,
 }

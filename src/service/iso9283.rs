@@ -29,7 +29,7 @@ pub const TESTS_MAX: usize = 8;
 /// One test: a label and its poses (commanded and measured).
 #[derive(Debug, Clone)]
 pub struct Iso9283Test {
-    /// The test's label (e.g. `nominal`, `filtered`).
+    /// The test's label.
     pub label: String,
     /// Its poses P1 … P5, each with its command and measured cycles where given.
     pub poses: Vec<PoseData>,

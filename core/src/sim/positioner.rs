@@ -90,9 +90,9 @@ impl TrueAxis {
 pub struct TruePositioner {
     /// The positioner base frame in the cell (tracker) frame.
     pub cell_from_base: Pose,
-    /// Axis 1, the tilt, in the base frame; its controller value is the first of a reading's.
+    /// Axis 1, the tilt, in the base frame, driven by the first of the two controller values.
     pub tilt: TrueAxis,
-    /// Axis 2, the rotate, in the tilt body's frame; its controller value is the second.
+    /// Axis 2, the rotate, in the tilt body's frame, driven by the second controller value.
     pub rotate: TrueAxis,
     /// Reflectors in the rotate body's frame [m].
     pub reflectors: Vec<Vector3<f64>>,

@@ -351,8 +351,8 @@ pub enum MapFitError {
         /// Poses given.
         got: usize,
     },
-    /// The model cannot be evaluated at some training pose, or the ridge system of the fit is
-    /// not positive definite.
+    /// The model cannot be evaluated at some training pose, or the fit's ridge system cannot be
+    /// solved.
     #[error("the model cannot be evaluated at some training pose")]
     NotEvaluable,
     /// No joint moves over `min_range_rad` in the training poses.
