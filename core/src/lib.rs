@@ -33,6 +33,7 @@ pub mod cell_fit;
 pub mod check;
 #[warn(missing_docs)]
 pub mod csv_write;
+#[warn(missing_docs)]
 pub mod measure;
 pub mod model;
 #[warn(missing_docs)]
@@ -41,6 +42,7 @@ pub mod optim;
 pub mod plan;
 #[warn(missing_docs)]
 pub mod program;
+#[warn(missing_docs)]
 pub mod sim;
 pub mod solve;
 #[warn(missing_docs)]

@@ -18,6 +18,8 @@
 //!
 //! Times are wall-clock on the calling thread (pin with `taskset -c 0`).
 
+#![warn(missing_docs)]
+
 use crate::calibrate::compensate::select::Parallelism;
 use crate::calibrate::identify::{calibrate, CalibrationSettings, Method};
 use crate::measure::{self, csv};
@@ -30,12 +32,15 @@ use robocal_core::model::calibrated::{CalibratedModelFile, CompensatedModel};
 use serde_json::json;
 use std::time::Instant;
 
+/// Arguments of `robocal bench`: which timing to run.
 #[derive(Debug, Args)]
 pub struct BenchArgs {
+    /// The timing to run.
     #[command(subcommand)]
     pub what: BenchCommand,
 }
 
+/// The timings of `robocal bench`.
 #[derive(Debug, Subcommand)]
 pub enum BenchCommand {
     /// KM calibration: validation accuracy and time per calibration.
@@ -46,6 +51,7 @@ pub enum BenchCommand {
     Methods(MethodsArgs),
 }
 
+/// Arguments of `robocal bench methods`.
 #[derive(Debug, Args)]
 pub struct MethodsArgs {
     /// Training pool sizes, comma-separated.
@@ -66,6 +72,7 @@ pub struct MethodsArgs {
     pub auto_candidates: Vec<String>,
 }
 
+/// Arguments of `robocal bench km`.
 #[derive(Debug, Args)]
 pub struct KmArgs {
     /// Preset name or model JSON file.
@@ -85,6 +92,7 @@ pub struct KmArgs {
     pub repeat: usize,
 }
 
+/// Arguments of `robocal bench ik`.
 #[derive(Debug, Args)]
 pub struct IkArgs {
     /// Preset name or model JSON file (the nominal model).
@@ -111,6 +119,7 @@ pub struct IkArgs {
     pub joints_out: Option<String>,
 }
 
+/// Runs the timing and prints its figures as pretty JSON on standard output.
 pub fn run(a: BenchArgs) -> anyhow::Result<()> {
     let out = match a.what {
         BenchCommand::Km(k) => km(&k)?,

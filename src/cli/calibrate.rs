@@ -2,6 +2,8 @@
 //! print the comparison of methods (like the thesis's Tables 2.5/2.6) with the
 //! identifiability report, or the same as JSON.
 
+#![warn(missing_docs)]
+
 mod render;
 
 pub use render::{render_comparison, render_compensators, render_orientation, render_report};
@@ -19,6 +21,7 @@ use clap::builder::{PossibleValue, TypedValueParser};
 use clap::error::ErrorKind;
 use clap::Args;
 
+/// Arguments of `robocal calibrate`.
 #[derive(Debug, Args)]
 pub struct CalibrateArgs {
     /// Robot model: a preset name (ys100, hh800, ur5, ur10) or a model JSON file.
@@ -74,6 +77,7 @@ pub struct CalibrateArgs {
     /// TLBO population and generations.
     #[arg(long, default_value_t = 50)]
     pub population: usize,
+    /// TLBO generations.
     #[arg(long, default_value_t = 100)]
     pub generations: usize,
     /// Keep the measurement frame as given (data already in the robot base frame).
@@ -163,6 +167,8 @@ struct RowsByRole {
     sources: PoseSources,
 }
 
+/// Calibrates with every method asked for and prints the report (text, or JSON with
+/// `--json`), writing the HTML report and the saved model when asked.
 pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     let (model, note) = super::model_files::load_start_model(&a.model)?;
     if let Some(note) = note {

@@ -7,24 +7,30 @@
 //! number 0 or beyond its range, one held twice) is refused naming the item;
 //! a Fanuc export writes position registers only with `--registers`.
 
+#![warn(missing_docs)]
+
 use crate::program::controller::{export_cell, ExportOptions, RegisterRange};
 use crate::program::Language;
 use crate::solve::cell::CellDescription;
 use anyhow::Context;
 use clap::{Args, Subcommand};
 
+/// Arguments of `robocal cell`: which action to run.
 #[derive(Debug, Args)]
 pub struct CellArgs {
+    /// The action to run.
     #[command(subcommand)]
     pub command: CellCommand,
 }
 
+/// The actions of `robocal cell`.
 #[derive(Debug, Subcommand)]
 pub enum CellCommand {
     /// Print the cell's tool, load and work object data for a controller.
     Export(CellExportArgs),
 }
 
+/// Arguments of `robocal cell export`.
 #[derive(Debug, Args)]
 pub struct CellExportArgs {
     /// Calibrated model file (`robocal calibrate --save`), a model JSON file or a preset.
@@ -63,6 +69,7 @@ pub fn export_to_string(a: &CellExportArgs) -> anyhow::Result<String> {
     Ok(done.text)
 }
 
+/// Runs the action: prints the exported text on standard output.
 pub fn run(a: CellArgs) -> anyhow::Result<()> {
     match a.command {
         CellCommand::Export(e) => {

@@ -12,17 +12,21 @@
 //! `compare` scores the same poses against each model, so versions compare
 //! where their own validation figures (from different sets) cannot.
 
+#![warn(missing_docs)]
+
 use anyhow::Context;
 use clap::Args;
 use robocal_core::check::{score, CheckResult, CheckThresholds};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+/// Arguments of `robocal check`.
 #[derive(Debug, Args)]
 pub struct CheckArgs {
     /// A calibrated model file (`calibrate --save`), a model JSON file or a preset.
     #[arg(long)]
     pub model: String,
+    /// The poses it scores, the thresholds of the statuses and the output.
     #[command(flatten)]
     pub check: CheckOptions,
 }
@@ -137,6 +141,7 @@ fn score_model(
     score(&m, rows, t).with_context(|| format!("{model} on {}", path.display()))
 }
 
+/// Arguments of `robocal compare`.
 #[derive(Debug, Args)]
 pub struct CompareArgs {
     /// The model files to compare (at least two), each as `check --model` takes it.
@@ -150,7 +155,9 @@ pub struct CompareArgs {
 /// One model's score in a comparison.
 #[derive(Debug, serde::Serialize)]
 pub struct ModelScore {
+    /// The model file as given to `--model`.
     pub model: String,
+    /// The model's score on the check poses (its fields inline in JSON).
     #[serde(flatten)]
     pub result: CheckResult,
 }
@@ -203,6 +210,8 @@ pub fn compare_text(scores: &[ModelScore]) -> String {
     s
 }
 
+/// Prints each model's score (a table, or JSON with `--json`); the exit code is 0 whatever
+/// the statuses.
 pub fn compare(a: CompareArgs) -> anyhow::Result<()> {
     let scores = compare_files(&a)?;
     if a.check.json {

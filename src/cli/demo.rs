@@ -3,12 +3,15 @@
 //! the Table 7.5 comparison of KM, SKCM and SKCM-C and the identified
 //! stiffness next to the truth.
 
+#![warn(missing_docs)]
+
 use super::progress::ProgressPrinter;
 use crate::calibrate::identify::Method;
 use crate::sim::study::ys100_simulation;
 use anyhow::bail;
 use clap::Args;
 
+/// Arguments of `robocal demo`.
 #[derive(Debug, Args)]
 pub struct DemoArgs {
     /// The study to run: ys100-simulation.
@@ -21,6 +24,8 @@ pub struct DemoArgs {
     pub json: bool,
 }
 
+/// Runs the study named (only `ys100-simulation`) and prints its comparison (text, or the
+/// report as JSON with `--json`).
 pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     if a.name != "ys100-simulation" {
         bail!("unknown demo `{}` (available: ys100-simulation)", a.name);

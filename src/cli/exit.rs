@@ -9,6 +9,8 @@
 //! `3` and up, one per status of `check` other than `ok`
 //! (`core::check::CheckStatus`).
 
+#![warn(missing_docs)]
+
 use clap::Args;
 use robocal_core::check::CheckStatus;
 use std::fmt::Write as _;
@@ -36,13 +38,16 @@ pub const RESULT_COMMANDS: [&str; 3] = ["filter", "solve", "predict"];
 /// Which commands end with a code.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Scope {
+    /// Every command.
     Every,
     /// [`RESULT_COMMANDS`].
     Results,
+    /// `check` alone.
     Check,
 }
 
 impl Scope {
+    /// Whether `command` (as typed, e.g. `filter`) can end with a code of this scope.
     pub fn includes(self, command: &str) -> bool {
         match self {
             Scope::Every => true,
@@ -62,6 +67,7 @@ impl Scope {
 }
 
 impl Exit {
+    /// Every code, in the order of their numbers (0 to 5).
     pub const ALL: [Exit; 6] = [
         Exit::Success,
         Exit::Refused,
@@ -93,6 +99,8 @@ impl Exit {
         }
     }
 
+    /// Its name in `--help` and the guide's table: `ok`, `refused`, `failures`, else the check
+    /// status's name.
     pub fn name(self) -> &'static str {
         match self {
             Exit::Success => "ok",
@@ -102,6 +110,7 @@ impl Exit {
         }
     }
 
+    /// The commands that can end with it.
     pub fn scope(self) -> Scope {
         match self {
             Exit::Success | Exit::Refused => Scope::Every,

@@ -2,11 +2,14 @@
 //! standard-DH or modified-DH CSV, or robocal's JSON (`crate::model::export` makes the
 //! text; this command reads the model and writes the file or stdout).
 
+#![warn(missing_docs)]
+
 use super::model_files::load_compensated;
 use crate::model::export::{export, ExportFormat, ExportSource};
 use anyhow::Context;
 use clap::Args;
 
+/// Arguments of `robocal export`.
 #[derive(Debug, Args)]
 pub struct ExportArgs {
     /// Robot model: a preset (ys100, hh800, ur5, ur10), a model JSON file, or a
@@ -45,6 +48,7 @@ pub fn export_to_string(a: &ExportArgs) -> anyhow::Result<String> {
     Ok(export(&model, &source, format)?)
 }
 
+/// Writes the export to `--out` (saying so on standard error), else to standard output.
 pub fn run(a: ExportArgs) -> anyhow::Result<()> {
     let text = export_to_string(&a)?;
     match &a.out {

@@ -5,12 +5,15 @@
 //! to by number or name come from a cell file (`core::cell::file`: mm,
 //! degrees); RAPID modules and URScript carry their own.
 
+#![warn(missing_docs)]
+
 use crate::program::{filter, Language, ProgramFile};
 use crate::solve::ik::IkSettings;
 use anyhow::{bail, Context};
 use clap::Args;
 use std::path::{Path, PathBuf};
 
+/// Arguments of `robocal filter`.
 #[derive(Debug, Args)]
 pub struct FilterArgs {
     /// Robot model: a preset, a model JSON file, or a calibrated model file
@@ -37,6 +40,7 @@ pub struct FilterArgs {
     /// The program's files (KRL: the `.src` with its `.dat`).
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
+    /// Whether targets that failed or were skipped still end with exit code 0.
     #[command(flatten)]
     pub failures: super::exit::AllowFailures,
 }

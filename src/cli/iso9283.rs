@@ -15,6 +15,8 @@
 //! The plan CSV's commanded poses: the model's measurement frame (see
 //! `core::iso9283::csv` for both file formats).
 
+#![warn(missing_docs)]
+
 use crate::model::orientation::fixed_xyz_matrix;
 use crate::plan::WorkspaceBox;
 use crate::plan::{JoinBy, Units};
@@ -35,15 +37,19 @@ use sha2::{Digest, Sha256};
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
+/// Arguments of `robocal iso9283`: a subcommand, or the figures' own arguments.
 #[derive(Debug, Args)]
 #[command(args_conflicts_with_subcommands = true)]
 pub struct Iso9283Args {
+    /// The subcommand (`plan`, `join`); absent: the figures of the measured cycles.
     #[command(subcommand)]
     pub command: Option<Iso9283Command>,
+    /// The arguments of the figures (without a subcommand).
     #[command(flatten)]
     pub figures: FiguresArgs,
 }
 
+/// The subcommands of `robocal iso9283`.
 #[derive(Debug, Subcommand)]
 pub enum Iso9283Command {
     /// Lay out the test cube and write its joint commands (CSV or a program).
@@ -52,6 +58,7 @@ pub enum Iso9283Command {
     Join(JoinArgs),
 }
 
+/// Arguments of `robocal iso9283 join`.
 #[derive(Debug, Args)]
 pub struct JoinArgs {
     /// The plan CSV (`robocal iso9283 plan --csv`).
@@ -74,7 +81,9 @@ pub struct JoinArgs {
 /// Which joint commands a plan drives.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum CommandsArg {
+    /// Solved on the nominal model: what the robot does without calibration.
     Nominal,
+    /// Solved on the calibrated model (the false targets' joints).
     Filtered,
 }
 
@@ -90,13 +99,19 @@ impl From<CommandsArg> for Commands {
 /// Output format of `robocal iso9283 plan`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum CubeFormat {
+    /// The plan CSV (what `robocal iso9283 --plan` reads).
     Csv,
+    /// A KUKA KRL program (`.src`).
     Krl,
+    /// An ABB RAPID module.
     Rapid,
+    /// A Fanuc TP program (ASCII `.ls`).
     Fanuc,
+    /// A Universal Robots URScript program.
     Urscript,
 }
 
+/// Arguments of `robocal iso9283 plan`.
 #[derive(Debug, Args)]
 pub struct CubeArgs {
     /// A calibrated model file (`calibrate --save`), a model JSON file or a preset.
@@ -131,6 +146,7 @@ pub struct CubeArgs {
     pub csv: Option<PathBuf>,
 }
 
+/// Arguments of `robocal iso9283` without a subcommand: the figures of the measured cycles.
 #[derive(Debug, Args)]
 pub struct FiguresArgs {
     /// Plan CSV(s) with the commanded poses; one per `--measured`, in order.
@@ -437,6 +453,9 @@ pub fn join_files(a: &JoinArgs) -> anyhow::Result<String> {
     Ok(s)
 }
 
+/// Runs the subcommand, or prints the figures (a table, or JSON with `--json`) and writes the
+/// report when asked; a plan's summary goes to standard error when the plan goes to standard
+/// output.
 pub fn run(a: Iso9283Args) -> anyhow::Result<()> {
     match &a.command {
         Some(Iso9283Command::Plan(c)) => {

@@ -2,9 +2,12 @@
 //! on standard output, ready for `ROBOCAL_API_KEYS` or a key file
 //! (`ROBOCAL_API_KEYS_FILE`). Several keys: run it once per client.
 
+#![warn(missing_docs)]
+
 use crate::service::keys::{new_key, Role};
 use clap::Args;
 
+/// Arguments of `robocal keygen`.
 #[derive(Debug, Args)]
 pub struct KeygenArgs {
     /// The key's role: read, operate or admin (each includes the ones before it).
@@ -12,6 +15,8 @@ pub struct KeygenArgs {
     pub role: Role,
 }
 
+/// Prints a new key as `KEY:ROLE` on standard output, with how to use it on standard error
+/// when that is a terminal.
 pub fn run(args: KeygenArgs) -> anyhow::Result<()> {
     println!("{}:{}", new_key(), args.role);
     if std::io::IsTerminal::is_terminal(&std::io::stderr()) {

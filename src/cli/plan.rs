@@ -14,6 +14,8 @@
 //!
 //! Box and tracker position: base frame, mm; the reflector axis: tool frame.
 
+#![warn(missing_docs)]
+
 use crate::plan::{
     join, make_plan, plan_csv, plan_program, read_plan_csv, JoinBy, JoinOptions, MeasurementPlan,
     PlanSettings, TrackerSight, Units, WorkspaceBox,
@@ -24,15 +26,19 @@ use clap::{Args, Subcommand, ValueEnum};
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
+/// Arguments of `robocal plan`: a subcommand, or the plan's own arguments.
 #[derive(Debug, Args)]
 #[command(args_conflicts_with_subcommands = true)]
 pub struct PlanArgs {
+    /// The subcommand (`join`); absent: make a plan.
     #[command(subcommand)]
     pub command: Option<PlanCommand>,
+    /// The arguments of a plan (without a subcommand).
     #[command(flatten)]
     pub make: MakeArgs,
 }
 
+/// The subcommands of `robocal plan`.
 #[derive(Debug, Subcommand)]
 pub enum PlanCommand {
     /// Join a tracker export to the plan's joints into a measurement CSV.
@@ -42,13 +48,19 @@ pub enum PlanCommand {
 /// Output format of `robocal plan`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum PlanFormat {
+    /// The joint CSV (what `robocal plan join` reads).
     Csv,
+    /// A KUKA KRL program (`.src`).
     Krl,
+    /// An ABB RAPID module.
     Rapid,
+    /// A Fanuc TP program (ASCII `.ls`).
     Fanuc,
+    /// A Universal Robots URScript program.
     Urscript,
 }
 
+/// Arguments of `robocal plan` without a subcommand: the plan to make.
 #[derive(Debug, Args)]
 pub struct MakeArgs {
     /// Robot model: a preset (ys100, hh800, ur5, ur10) or a model JSON file.
@@ -98,6 +110,7 @@ pub struct MakeArgs {
     pub csv: Option<PathBuf>,
 }
 
+/// Arguments of `robocal plan join`.
 #[derive(Debug, Args)]
 pub struct JoinArgs {
     /// The plan's joint CSV (`robocal plan --format csv`, or `--csv`).
@@ -240,6 +253,8 @@ pub(crate) fn join_options(units: &str, by: &str) -> anyhow::Result<JoinOptions>
     Ok(JoinOptions { units, by })
 }
 
+/// Joins the export to the plan, writes the measurement CSV to `--out`, and returns the line
+/// that says how many rows were joined, by what and in which unit.
 pub fn join_files(a: &JoinArgs) -> anyhow::Result<String> {
     let read = |p: &PathBuf| {
         std::fs::read_to_string(p).with_context(|| format!("cannot read {}", p.display()))
@@ -263,6 +278,8 @@ pub fn join_files(a: &JoinArgs) -> anyhow::Result<String> {
     ))
 }
 
+/// Runs `join`, or makes the plan and prints its σ table (to standard error when the plan
+/// goes to standard output).
 pub fn run(a: PlanArgs) -> anyhow::Result<()> {
     match &a.command {
         Some(PlanCommand::Join(j)) => print!("{}", join_files(j)?),

@@ -9,11 +9,14 @@
 //! robocal reregister --model cal.json --measurements new.csv --save cal-new.json [--json]
 //! ```
 
+#![warn(missing_docs)]
+
 use anyhow::Context;
 use clap::Args;
 use robocal_core::check::{reregister, Reregistration};
 use std::path::PathBuf;
 
+/// Arguments of `robocal reregister`.
 #[derive(Debug, Args)]
 pub struct ReregisterArgs {
     /// The calibrated model file to move (`calibrate --save`, `export --format json`).
@@ -86,6 +89,8 @@ pub fn reregister_file(a: &ReregisterArgs) -> anyhow::Result<Reregistration> {
     Ok(report)
 }
 
+/// Re-registers the model and prints the report (text, or JSON with `--json`), saying on
+/// standard error where `--save` wrote the moved model.
 pub fn run(a: ReregisterArgs) -> anyhow::Result<()> {
     let r = reregister_file(&a)?;
     if a.json {

@@ -32,6 +32,8 @@
 //! [`crate::service::queue`]) and SIGTERM hands this replica's running jobs
 //! back to the queue.
 
+#![warn(missing_docs)]
+
 use crate::db::{Backend, Db, DEFAULT_DATABASE_URL, DEFAULT_PG_POOL};
 use crate::http::server::ServerSettings;
 use crate::http::{app, AppState, Limits, ServiceConfig, ServiceListener};
@@ -40,6 +42,7 @@ use anyhow::Context;
 use clap::Args;
 use std::net::SocketAddr;
 
+/// Arguments of `robocal serve`.
 #[derive(Debug, Args)]
 #[command(after_long_help = keys_help())]
 pub struct ServeArgs {
@@ -206,6 +209,7 @@ fn init_tracing() {
         .try_init();
 }
 
+/// Starts the service with this configuration and serves until SIGINT or SIGTERM.
 pub fn run(args: ServeArgs) -> anyhow::Result<()> {
     init_tracing();
     if args.workers == 0 {

@@ -22,6 +22,8 @@
 //!   readings in degrees.
 //! - The payload column is always written (default: the truth's payload mass).
 
+#![warn(missing_docs)]
+
 use crate::measure::{csv, SetRole};
 use crate::model::kinematics::fk;
 use crate::model::RobotModel;
@@ -35,6 +37,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal_core::csv_write::comment_line;
 
+/// Arguments of `robocal simulate`.
 #[derive(Debug, Args)]
 pub struct SimulateArgs {
     /// Nominal robot: a preset name (ys100, hh800, ur5, ur10) or a model JSON file.
@@ -228,6 +231,8 @@ fn effects(a: &SimulateArgs, dof: usize) -> anyhow::Result<UnmodelledEffects> {
     })
 }
 
+/// Measures the simulated robot and writes the CSV to `--out` (`-`: standard output), and
+/// the truth's model JSON to `--truth` when given.
 pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
     let nominal = super::model_files::load_model(&a.preset)?;
     if a.poses == 0 {

@@ -11,6 +11,8 @@
 //! outcome is printed as the service answers it (`fitted`, `reason`,
 //! `message`, `fit`, `orientation`, `replaced`, …).
 
+#![warn(missing_docs)]
+
 use super::model_files::load_compensated;
 use crate::cell_fit::tcp::entry::{self, Answer, Fitted, Outcome, StoreRequest, StoredEntry};
 use crate::cell_fit::tcp::{self, AxisRequest, Reading, TcpMethod, ToolFit, ToolRequest};
@@ -21,6 +23,7 @@ use anyhow::{bail, Context};
 use clap::Args;
 use serde::Serialize;
 
+/// Arguments of `robocal tcp`.
 #[derive(Debug, Args)]
 pub struct TcpArgs {
     /// Calibrated model file (`robocal calibrate --save`), a model JSON file or a preset.
@@ -60,6 +63,7 @@ pub struct TcpArgs {
     pub json: bool,
 }
 
+/// Arguments of `robocal work-object`.
 #[derive(Debug, Args)]
 pub struct WorkObjectArgs {
     /// Calibrated model file (`robocal calibrate --save`), a model JSON file or a preset.
@@ -378,10 +382,14 @@ fn work_object_text(a: &WorkObjectArgs, f: &Fitted<WorkObjectFit>) -> String {
     s + &verdict_and_replaced(f, &format!("work object {}", a.name))
 }
 
+/// Fits the tool and prints the outcome (text, or JSON with `--json`); a fit refused is an
+/// error (with `--json`, its reasons are printed first).
 pub fn run_tcp(a: TcpArgs) -> anyhow::Result<()> {
     print_outcome(tcp_to_string(&a), a.json)
 }
 
+/// Fits the work object and prints the outcome (text, or JSON with `--json`); a fit refused
+/// is an error (with `--json`, its reasons are printed first).
 pub fn run_work_object(a: WorkObjectArgs) -> anyhow::Result<()> {
     print_outcome(work_object_to_string(&a), a.json)
 }

@@ -6,6 +6,8 @@
 //! selection, sessions, the runner, progress, model versions) is
 //! [`crate::service::calibrations`].
 
+#![warn(missing_docs)]
+
 use super::input::{check_payload, int, page_body, present, present_ids, present_int, PageQuery};
 use super::robots::robot_list_page;
 use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState};
@@ -98,23 +100,39 @@ pub struct StartCalibration {
 /// A calibration job as the API returns it.
 #[derive(Debug, Serialize)]
 pub struct Calibration {
+    /// The job's id.
     pub id: i64,
+    /// The robot it calibrates.
     pub robot_id: i64,
+    /// Its state: queued, running, succeeded, failed or cancelled.
     pub status: JobStatus,
+    /// How far it is.
     pub progress: JobProgress,
+    /// Whether cancellation was requested.
     pub cancel_requested: bool,
+    /// Names of the methods it runs, in order.
     pub methods: Vec<String>,
+    /// Ids of the identification sets.
     pub identification_set_ids: Vec<i64>,
+    /// Ids of the validation sets.
     pub validation_set_ids: Vec<i64>,
+    /// The calibration options as given (JSON).
     pub options: Value,
+    /// Why the job failed or was cancelled or interrupted, when it ended without a result.
     pub error: Option<String>,
+    /// The method with the lowest mean error, when the job succeeded.
     pub best_method: Option<String>,
     /// What the job reached (set when it succeeded).
     pub summary: Option<JobSummary>,
+    /// When it was queued (UTC, RFC 3339).
     pub created_at: String,
+    /// When a runner started it (UTC, RFC 3339).
     pub started_at: Option<String>,
+    /// When it ended (UTC, RFC 3339).
     pub finished_at: Option<String>,
+    /// When its row last changed (UTC, RFC 3339).
     pub updated_at: String,
+    /// Its URL (`self`) and those of its `cancel`, `result` and `report`.
     pub links: Value,
 }
 
@@ -122,16 +140,24 @@ pub struct Calibration {
 /// percentage that never goes back and the estimated time left.
 #[derive(Debug, Serialize)]
 pub struct JobProgress {
+    /// The phase under way: `starting`, a phase's label (`identify::Phase`), `done` at the end.
     pub phase: Option<String>,
+    /// The iteration, epoch or generation within the current step.
     pub iteration: i64,
+    /// Overall completion in [0, 100], never lower than an earlier report's.
     pub percent: f64,
+    /// The method the phase works on within it (`auto`'s base, joint-map or compensator candidate).
     pub candidate: Option<String>,
+    /// The cross-validation training under way.
     pub fold: Option<Fold>,
+    /// Current RMS residual or training loss [mm], when the step has one.
     pub rms_mm: Option<f64>,
+    /// Estimated seconds left [s], when known.
     pub eta_s: Option<f64>,
 }
 
 impl Calibration {
+    /// The job as the API returns it, from its stored row.
     pub fn from_row(r: CalibrationRow) -> Self {
         let base = format!("/v1/robots/{}/calibrations/{}", r.robot_id, r.id);
         Calibration {
@@ -215,6 +241,8 @@ impl StartCalibration {
     }
 }
 
+/// `POST /v1/robots/{id}/calibrations`: queues a job (202, `Location` the job) after checking the
+/// request's settings and payload.
 pub async fn start(
     State(state): State<AppState>,
     ApiPath(robot_id): ApiPath<i64>,
@@ -240,6 +268,7 @@ pub async fn start(
     ))
 }
 
+/// `GET /v1/robots/{id}/calibrations`: one page of the robot's jobs.
 pub async fn list(
     State(state): State<AppState>,
     ApiPath(robot_id): ApiPath<i64>,
@@ -260,6 +289,7 @@ async fn load(state: &AppState, robot_id: i64, id: i64) -> Result<CalibrationRow
     Ok(service::calibrations::get(state, robot_id, id).await?)
 }
 
+/// `GET /v1/robots/{id}/calibrations/{cid}`: one job.
 pub async fn get_one(
     State(state): State<AppState>,
     ApiPath((robot_id, id)): ApiPath<(i64, i64)>,
@@ -268,6 +298,8 @@ pub async fn get_one(
     Ok(axum::Json(Calibration::from_row(row)).into_response())
 }
 
+/// `POST /v1/robots/{id}/calibrations/{cid}/cancel`: requests cancellation (202 with the job); 409
+/// when it has already ended.
 pub async fn cancel(
     State(state): State<AppState>,
     ApiPath((robot_id, id)): ApiPath<(i64, i64)>,
@@ -308,6 +340,9 @@ async fn succeeded_report(
     Ok((row, report))
 }
 
+/// `GET /v1/robots/{id}/calibrations/{cid}/result`: a succeeded job's mean and max errors per
+/// method and set, its model versions and its full report; 409 while it runs or when it ended
+/// without a result.
 pub async fn result(
     State(state): State<AppState>,
     ApiPath((robot_id, id)): ApiPath<(i64, i64)>,
@@ -354,6 +389,8 @@ pub async fn result(
     .into_response())
 }
 
+/// `GET /v1/robots/{id}/calibrations/{cid}/report`: a succeeded job's HTML report with its record;
+/// 409 as for the result.
 pub async fn report(
     State(state): State<AppState>,
     ApiPath((robot_id, id)): ApiPath<(i64, i64)>,

@@ -5,6 +5,8 @@
 //! file (`core::cell::file`). Names and controller numbers are unique per
 //! robot; a number already taken by another item is a 409.
 
+#![warn(missing_docs)]
+
 use super::input::{objects, present};
 use super::{ApiError, ApiJson, ApiPath, AppState};
 use crate::records::{CellItemRow, CellKind, ItemFrame, NewCellItem};
@@ -49,6 +51,7 @@ pub fn check_item_name(name: &str) -> Result<(), ApiError> {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ItemIn {
+    /// The item's name: required in a list, left out where the URL names it or the item is inline.
     #[serde(default, deserialize_with = "present")]
     pub name: Option<String>,
     /// The controller's number; `null` or absent: none.
@@ -57,7 +60,10 @@ pub struct ItemIn {
     /// Work objects only: `base` (default) or `measurement`.
     #[serde(default, deserialize_with = "present")]
     pub frame: Option<String>,
+    /// Position [mm]: the TCP in the flange frame (tool) or the work object's origin in its frame,
+    /// 3 values.
     pub xyz_mm: Vec<f64>,
+    /// Orientation `[rx, ry, rz]` [deg], the rotation `Rz·Ry·Rx`; absent: `[0, 0, 0]`.
     #[serde(default, deserialize_with = "present")]
     pub rpy_deg: Option<Vec<f64>>,
     /// Tools only: the load the tool carries (`core::cell::load`).
@@ -79,6 +85,7 @@ fn three(values: &[f64], what: &str, name: &str) -> Result<[f64; 3], ApiError> {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ToolsIn {
+    /// The robot's tools, replacing every tool it had.
     #[serde(deserialize_with = "objects")]
     pub tools: Vec<ItemIn>,
 }
@@ -87,6 +94,7 @@ pub struct ToolsIn {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FramesIn {
+    /// The robot's work objects, replacing every work object it had.
     #[serde(deserialize_with = "objects")]
     pub work_objects: Vec<ItemIn>,
 }
@@ -94,17 +102,23 @@ pub struct FramesIn {
 /// A tool or work object as the API returns it.
 #[derive(Debug, Serialize)]
 pub struct ItemOut {
+    /// The item's name, unique per robot.
     pub name: String,
+    /// The controller's number, when given.
     pub number: Option<i64>,
     /// Work objects only.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub frame: Option<&'static str>,
+    /// Position [mm]: the TCP in the flange frame (tool) or the work object's origin in its frame.
     pub xyz_mm: [f64; 3],
+    /// Orientation `[rx, ry, rz]` [deg], the rotation `Rz·Ry·Rx`.
     pub rpy_deg: [f64; 3],
     /// Tools only, when stated.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub load: Option<LoadDescription>,
+    /// When it was stored (UTC, RFC 3339).
     pub created_at: String,
+    /// When it last changed (UTC, RFC 3339).
     pub updated_at: String,
 }
 
@@ -287,6 +301,7 @@ async fn delete_item(
     Ok(StatusCode::NO_CONTENT.into_response())
 }
 
+/// `GET /v1/robots/{id}/tools`: the robot's tools.
 pub async fn list_tools(
     State(s): State<AppState>,
     ApiPath(id): ApiPath<i64>,
@@ -294,6 +309,7 @@ pub async fn list_tools(
     list(s, id, CellKind::Tool).await
 }
 
+/// `PUT /v1/robots/{id}/tools`: replaces every tool of the robot with the list given.
 pub async fn replace_tools(
     State(s): State<AppState>,
     ApiPath(id): ApiPath<i64>,
@@ -302,6 +318,7 @@ pub async fn replace_tools(
     replace(s, id, CellKind::Tool, &body.tools).await
 }
 
+/// `GET /v1/robots/{id}/tools/{name}`: one tool.
 pub async fn get_tool(
     State(s): State<AppState>,
     ApiPath((id, name)): ApiPath<(i64, String)>,
@@ -309,6 +326,7 @@ pub async fn get_tool(
     get_item(s, id, CellKind::Tool, &name).await
 }
 
+/// `PUT /v1/robots/{id}/tools/{name}`: stores the tool (201 when new, 200 when replaced).
 pub async fn put_tool(
     State(s): State<AppState>,
     ApiPath((id, name)): ApiPath<(i64, String)>,
@@ -317,6 +335,7 @@ pub async fn put_tool(
     put_item(s, id, CellKind::Tool, &name, &body).await
 }
 
+/// `DELETE /v1/robots/{id}/tools/{name}`: removes the tool (204).
 pub async fn delete_tool(
     State(s): State<AppState>,
     ApiPath((id, name)): ApiPath<(i64, String)>,
@@ -324,6 +343,7 @@ pub async fn delete_tool(
     delete_item(s, id, CellKind::Tool, &name).await
 }
 
+/// `GET /v1/robots/{id}/frames`: the robot's work objects.
 pub async fn list_frames(
     State(s): State<AppState>,
     ApiPath(id): ApiPath<i64>,
@@ -331,6 +351,7 @@ pub async fn list_frames(
     list(s, id, CellKind::WorkObject).await
 }
 
+/// `PUT /v1/robots/{id}/frames`: replaces every work object of the robot with the list given.
 pub async fn replace_frames(
     State(s): State<AppState>,
     ApiPath(id): ApiPath<i64>,
@@ -339,6 +360,7 @@ pub async fn replace_frames(
     replace(s, id, CellKind::WorkObject, &body.work_objects).await
 }
 
+/// `GET /v1/robots/{id}/frames/{name}`: one work object.
 pub async fn get_frame(
     State(s): State<AppState>,
     ApiPath((id, name)): ApiPath<(i64, String)>,
@@ -346,6 +368,7 @@ pub async fn get_frame(
     get_item(s, id, CellKind::WorkObject, &name).await
 }
 
+/// `PUT /v1/robots/{id}/frames/{name}`: stores the work object (201 when new, 200 when replaced).
 pub async fn put_frame(
     State(s): State<AppState>,
     ApiPath((id, name)): ApiPath<(i64, String)>,
@@ -354,6 +377,7 @@ pub async fn put_frame(
     put_item(s, id, CellKind::WorkObject, &name, &body).await
 }
 
+/// `DELETE /v1/robots/{id}/frames/{name}`: removes the work object (204).
 pub async fn delete_frame(
     State(s): State<AppState>,
     ApiPath((id, name)): ApiPath<(i64, String)>,

@@ -11,6 +11,8 @@
 //! fit. A tool whose orientation the readings do not determine keeps the
 //! stored one, or takes `rpy_deg`; it is never written as zeros.
 
+#![warn(missing_docs)]
+
 use super::cell::{check_item_name, ItemOut, CELL_NUMBER_MAX};
 use super::input::{objects, present, Int};
 use super::{ApiError, ApiJson, ApiPath, AppState};
@@ -37,9 +39,13 @@ const ANGLE_MAX_DEG: f64 = 360.0;
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ToolReadingIn {
+    /// The controller's joint readings [deg].
     pub joints_deg: Vec<f64>,
+    /// The tracker's measurement of the point [mm], in the calibration's measurement frame (tracker
+    /// methods).
     #[serde(default, deserialize_with = "present")]
     pub xyz_mm: Option<Vec<f64>>,
+    /// The tracker's measured orientation `[rx, ry, rz]` [deg] (a 6-D probe, `tracker_frame`).
     #[serde(default, deserialize_with = "present")]
     pub rpy_deg: Option<Vec<f64>>,
 }
@@ -49,9 +55,12 @@ pub struct ToolReadingIn {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FrameReadingIn {
+    /// Which point of the work object the row measures.
     pub point: WoPoint,
+    /// The controller's joint readings [deg] with the tool's tip on the point (touched).
     #[serde(default, deserialize_with = "present")]
     pub joints_deg: Option<Vec<f64>>,
+    /// The tracker's measurement of the point [mm], in the calibration's measurement frame.
     #[serde(default, deserialize_with = "present")]
     pub xyz_mm: Option<Vec<f64>>,
 }
@@ -90,16 +99,23 @@ impl<'a> From<&'a FrameReadingIn> for RowIn<'a> {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ToolFitIn {
+    /// How the TCP is found; default `fixed_point`.
     #[serde(default, deserialize_with = "present")]
     pub method: Option<TcpMethod>,
+    /// The rows that find the TCP.
     #[serde(deserialize_with = "objects")]
     pub readings: Vec<ToolReadingIn>,
+    /// Rows of a second point on the tool's axis, nearer the flange, measured like the tip (not
+    /// with `plane`).
     #[serde(default, deserialize_with = "present_objects")]
     pub axis_point: Option<Vec<ToolReadingIn>>,
+    /// Joint readings with the tool flat on a plane, at least 3 (not with `axis_point`).
     #[serde(default, deserialize_with = "present_objects")]
     pub plane: Option<Vec<ToolReadingIn>>,
+    /// The controller's number; absent keeps a refitted tool's number.
     #[serde(default)]
     pub number: Option<Int<i64>>,
+    /// The calibrated version fitted on; absent: the active one.
     #[serde(default)]
     pub version: Option<Int<i64>>,
     /// The tool's orientation [deg] when the readings fit its position only.
@@ -114,12 +130,16 @@ pub struct ToolFitIn {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct WorkObjectFitIn {
+    /// The rows that find the work object.
     #[serde(deserialize_with = "objects")]
     pub readings: Vec<FrameReadingIn>,
+    /// The stored tool whose tip touched the points (rows with `joints_deg`).
     #[serde(default, deserialize_with = "present")]
     pub tool: Option<String>,
+    /// The controller's number; absent keeps a refitted work object's number.
     #[serde(default)]
     pub number: Option<Int<i64>>,
+    /// The calibrated version fitted on; absent: the active one.
     #[serde(default)]
     pub version: Option<Int<i64>>,
     /// Store a fit judged not plausible.
@@ -265,6 +285,8 @@ fn answer<F: Serialize>(done: Fitted<F>) -> Response {
     }
 }
 
+/// `POST /v1/robots/{id}/tools/{name}/fit`: the tool fitted and stored (201 or 200), or a 200 with
+/// `fitted: false` and why.
 pub async fn fit_tool(
     State(s): State<AppState>,
     ApiPath((id, name)): ApiPath<(i64, String)>,
@@ -312,6 +334,8 @@ pub async fn fit_tool(
     Ok(answer(service::cell_fit::fit_tool(&s, &t, &req).await?))
 }
 
+/// `POST /v1/robots/{id}/frames/{name}/fit`: the work object fitted and stored in the base frame
+/// (201 or 200), or a 200 with `fitted: false` and why.
 pub async fn fit_frame(
     State(s): State<AppState>,
     ApiPath((id, name)): ApiPath<(i64, String)>,

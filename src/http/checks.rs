@@ -7,6 +7,8 @@
 //! `POST /v1/robots/{id}/reregister` refits a version's measurement frame and
 //! tool on a set and stores the result as a new version.
 
+#![warn(missing_docs)]
+
 use super::input::{id, ids, page_body, present_id, PageQuery};
 use super::robots::robot_list_page;
 use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState};
@@ -25,10 +27,13 @@ use serde_json::Value;
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CheckRequest {
+    /// The measurement set to score.
     #[serde(deserialize_with = "id")]
     pub set_id: i64,
+    /// The model version to score against; absent: the active one.
     #[serde(default, deserialize_with = "present_id")]
     pub version: Option<i64>,
+    /// Temperature of the check [°C], when known.
     #[serde(default)]
     pub temperature_c: Option<f64>,
 }
@@ -36,13 +41,21 @@ pub struct CheckRequest {
 /// A check as the API returns it.
 #[derive(Debug, Serialize)]
 pub struct Check {
+    /// The check's id.
     pub id: i64,
+    /// The robot checked.
     pub robot_id: i64,
+    /// The measurement set scored (`null` once the set is deleted).
     pub set_id: Option<i64>,
+    /// The model version it was scored against.
     pub version: i64,
+    /// The status: `ok`, `degraded`, `recalibrate` or `shifted`.
     pub status: String,
+    /// Mean position error of the check poses [mm].
     pub mean_mm: f64,
+    /// Temperature of the check [°C], when known.
     pub temperature_c: Option<f64>,
+    /// When it was stored (UTC, RFC 3339).
     pub created_at: String,
     /// The frame shift's size when the status is `shifted`.
     pub shift: Option<ShiftSize>,
@@ -68,6 +81,8 @@ impl From<CheckRow> for Check {
     }
 }
 
+/// `POST /v1/robots/{id}/checks`: scores the set against the version without fitting and stores the
+/// check (201).
 pub async fn create(
     State(state): State<AppState>,
     ApiPath(robot_id): ApiPath<i64>,
@@ -96,6 +111,7 @@ pub async fn create(
     Ok((StatusCode::CREATED, axum::Json(Check::from(row))).into_response())
 }
 
+/// `GET /v1/robots/{id}/checks`: one page of the robot's checks.
 pub async fn list(
     State(state): State<AppState>,
     ApiPath(robot_id): ApiPath<i64>,
@@ -120,15 +136,19 @@ pub async fn get_one(
 /// `GET /v1/robots/{id}/status`.
 #[derive(Debug, Serialize)]
 pub struct Status {
+    /// The robot.
     pub robot_id: i64,
     /// The latest check's status; `null` before any check.
     pub status: Option<&'static str>,
     /// The frame shift's size when the status is `shifted`.
     pub shift: Option<ShiftSize>,
+    /// The latest check; `null` before any check.
     pub latest_check: Option<Check>,
+    /// The robot's thresholds (its own, or the defaults).
     pub thresholds: CheckThresholds,
 }
 
+/// `GET /v1/robots/{id}/status`: the latest check's status and the thresholds it was judged by.
 pub async fn status(
     State(state): State<AppState>,
     ApiPath(robot_id): ApiPath<i64>,
@@ -149,8 +169,10 @@ pub async fn status(
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CompareRequest {
+    /// The measurement set to score.
     #[serde(deserialize_with = "id")]
     pub set_id: i64,
+    /// The model versions to score it against.
     #[serde(deserialize_with = "ids")]
     pub versions: Vec<i64>,
 }
@@ -158,11 +180,16 @@ pub struct CompareRequest {
 /// `POST /v1/robots/{id}/compare` answer.
 #[derive(Debug, Serialize)]
 pub struct Comparison {
+    /// The robot.
     pub robot_id: i64,
+    /// The measurement set scored.
     pub set_id: i64,
+    /// Each version's score on the set, in the order asked.
     pub versions: Vec<service::checks::VersionScore>,
 }
 
+/// `POST /v1/robots/{id}/compare`: scores one set against several versions; nothing is fitted or
+/// stored.
 pub async fn compare(
     State(state): State<AppState>,
     ApiPath(robot_id): ApiPath<i64>,
@@ -181,10 +208,13 @@ pub async fn compare(
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ReregisterRequest {
+    /// The set of the new session (positions in its measurement frame).
     #[serde(deserialize_with = "id")]
     pub set_id: i64,
+    /// The version to start from; absent: the active one.
     #[serde(default, deserialize_with = "present_id")]
     pub version: Option<i64>,
+    /// Make the new version the active one (default false).
     #[serde(default)]
     pub activate: bool,
 }
@@ -216,15 +246,20 @@ pub async fn reregister(
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ThresholdsIn {
+    /// Above this mean the status is `degraded` [mm].
     pub degraded_mm: f64,
+    /// The step from `degraded_mm` to the recalibrate level [mm]; required.
     #[serde(default)]
     pub margin_mm: Option<f64>,
+    /// Refused: give `margin_mm` instead (the answer says which margin this stands for).
     #[serde(default)]
     pub recalibrate_mm: Option<f64>,
+    /// The frame-shift ratio (`core::check::CheckThresholds`); absent: the default, 0.5.
     #[serde(default)]
     pub frame_shift_ratio: Option<f64>,
 }
 
+/// `PUT /v1/robots/{id}/check-thresholds`: replaces the robot's thresholds and returns them.
 pub async fn put_thresholds(
     State(state): State<AppState>,
     ApiPath(robot_id): ApiPath<i64>,
@@ -253,6 +288,7 @@ pub async fn put_thresholds(
     Ok(axum::Json(t).into_response())
 }
 
+/// The routes of checks, status, comparisons, re-registration and thresholds.
 pub fn routes() -> Vec<super::Route> {
     use super::{get, post, route};
     vec![

@@ -6,6 +6,8 @@
 //! 4xx details say what to fix. Database and internal errors are logged with
 //! their cause and returned as a generic 500 without it.
 
+#![warn(missing_docs)]
+
 use axum::extract::rejection::{BytesRejection, PathRejection, QueryRejection};
 use axum::http::{header, HeaderValue, StatusCode};
 use axum::response::{IntoResponse, Response};
@@ -59,7 +61,12 @@ pub enum ApiError {
     /// 429 with `Retry-After`: the service is saturated (job or solve queue
     /// full); the client should send this work again later.
     #[error("{detail}")]
-    Busy { detail: String, retry_after_s: u32 },
+    Busy {
+        /// What is saturated and what to do.
+        detail: String,
+        /// The `Retry-After` header's value [s].
+        retry_after_s: u32,
+    },
     /// 500: logged with its cause; the client sees a generic message.
     #[error("internal error: {0}")]
     Internal(String),
@@ -68,10 +75,14 @@ pub enum ApiError {
 /// The problem document.
 #[derive(Debug, Serialize)]
 pub struct Problem {
+    /// `urn:robocal:problem:` and the error's [`ApiError::code`].
     #[serde(rename = "type")]
     pub kind: String,
+    /// The status's reason phrase (`Not Found`, …).
     pub title: String,
+    /// The HTTP status code.
     pub status: u16,
+    /// What went wrong and, for a 4xx, what to fix; generic for a 500.
     pub detail: String,
     /// Where a program cannot be parsed (422 `unparsable-program` only).
     #[serde(flatten, skip_serializing_if = "Option::is_none")]
@@ -81,6 +92,7 @@ pub struct Problem {
 /// The place in a program's files that cannot be parsed.
 #[derive(Debug, Serialize)]
 pub struct ProgramLocation {
+    /// The program file, as the request named it.
     pub file: String,
     /// 1-based.
     pub line: usize,
@@ -89,6 +101,7 @@ pub struct ProgramLocation {
 }
 
 impl ApiError {
+    /// The HTTP status the error answers with.
     pub fn status(&self) -> StatusCode {
         match self {
             ApiError::BadRequest(_) => StatusCode::BAD_REQUEST,
@@ -131,6 +144,7 @@ impl ApiError {
         }
     }
 
+    /// The problem document of the error (a 500's detail without its cause).
     pub fn problem(&self) -> Problem {
         let status = self.status();
         let detail = match self {
@@ -155,10 +169,12 @@ impl ApiError {
         }
     }
 
+    /// A 404 saying what is missing.
     pub fn not_found(what: impl std::fmt::Display) -> Self {
         ApiError::NotFound(what.to_string())
     }
 
+    /// A 422 saying what is invalid.
     pub fn invalid(what: impl std::fmt::Display) -> Self {
         ApiError::Unprocessable(what.to_string())
     }

@@ -10,6 +10,8 @@
 //! - names ([`check_name`]), payloads ([`check_payload`]) and list paging
 //!   ([`Page`]).
 
+#![warn(missing_docs)]
+
 use super::ApiError;
 use crate::service::limits::{PAGE_DEFAULT, PAYLOAD_MAX_KG};
 use serde::de::{DeserializeOwned, Deserializer, MapAccess, Visitor};
@@ -258,18 +260,24 @@ pub fn check_payload(what: &str, kg: f64) -> Result<(), ApiError> {
 /// `?limit=&offset=` of a list.
 #[derive(Debug, Clone, Copy, Default, Deserialize)]
 pub struct PageQuery {
+    /// Most items to return; absent: the list's default page size.
     pub limit: Option<u64>,
+    /// Items to skip, 0-based; absent: 0.
     pub offset: Option<u64>,
 }
 
 /// A checked page: at most `limit` items from `offset` (0-based).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Page {
+    /// Most items to return, 1 to the list's maximum.
     pub limit: i64,
+    /// Items skipped, 0-based.
     pub offset: i64,
 }
 
 impl PageQuery {
+    /// The page asked for, with `limit` defaulted and checked against `page_max` (400 outside 1 to
+    /// it).
     pub fn check(self, page_max: usize) -> Result<Page, ApiError> {
         let limit = self.limit.unwrap_or(PAGE_DEFAULT.min(page_max) as u64);
         if limit == 0 || limit > page_max as u64 {

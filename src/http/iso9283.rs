@@ -15,6 +15,8 @@
 //! robot's name and the version's SHA-256 from the store — or, with
 //! `Accept: text/html`, the ISO 9283 report page (`report::iso9283`).
 
+#![warn(missing_docs)]
+
 use super::input::{object_or_null, objects, present, present_int};
 use super::{ApiError, ApiJson, AppState};
 use crate::report::iso9283::render_iso9283_html;
@@ -34,14 +36,20 @@ pub const LABEL_MAX: usize = 200;
 /// The standard's poses of the test cube.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Deserialize)]
 pub enum PoseName {
+    /// Pose P1, the cube's centre.
     P1,
+    /// Pose P2, 10 % of the diagonal from corner C1 towards C7.
     P2,
+    /// Pose P3, 10 % of the diagonal from corner C2 towards C8.
     P3,
+    /// Pose P4, 10 % of the diagonal from corner C7 towards C1.
     P4,
+    /// Pose P5, 10 % of the diagonal from corner C8 towards C2.
     P5,
 }
 
 impl PoseName {
+    /// Every pose, P1 to P5.
     pub const ALL: [PoseName; 5] = [
         PoseName::P1,
         PoseName::P2,
@@ -50,6 +58,7 @@ impl PoseName {
         PoseName::P5,
     ];
 
+    /// The pose's key in requests and answers: `P1` … `P5`.
     pub fn name(self) -> &'static str {
         match self {
             PoseName::P1 => "P1",
@@ -363,6 +372,7 @@ async fn figures_csv(
     answer(&state, &headers, assessed, &texts, body.conditions).await
 }
 
+/// The routes of the ISO 9283 figures and of the test cube's plan.
 pub fn routes() -> Vec<super::Route> {
     vec![
         super::post("/v1/iso9283", figures),

@@ -6,6 +6,8 @@
 //! The same as `robocal iso9283 plan` on the version's `model.json`; the
 //! answer names the version and its SHA-256.
 
+#![warn(missing_docs)]
+
 use super::input::present_int;
 use super::plans::{ProgramOut, WAIT_MAX_S};
 use super::programs::FileIn;
@@ -28,20 +30,31 @@ pub const BOX_MAX_MM: f64 = 100_000.0;
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CubeRequest {
+    /// The box's lowest corner in the base frame [mm].
     pub min_mm: [f64; 3],
+    /// The box's highest corner in the base frame [mm], above `min_mm` on every axis.
     pub max_mm: [f64; 3],
+    /// The tool's orientation at every pose, fixed-axis `[rx, ry, rz]` [deg] in the base frame;
+    /// absent: `[180, 0, 0]`.
     #[serde(default)]
     pub rpy_deg: Option<[f64; 3]>,
+    /// Which joint commands: `nominal` or `filtered` (default).
     #[serde(default)]
     pub commands: Option<Commands>,
+    /// The model version solved on; absent: the active one.
     #[serde(default, deserialize_with = "present_int")]
     pub version: Option<i64>,
+    /// The cycle program's language; absent: no program.
     #[serde(default)]
     pub language: Option<Language>,
+    /// Cycles of the program, 2 to [`CYCLES_MAX`]; absent: 30 (needs `language`).
     #[serde(default, deserialize_with = "present_int")]
     pub cycles: Option<u32>,
+    /// The program's name: a letter, then up to 23 letters, digits or `_`; absent: `iso9283` (needs
+    /// `language`).
     #[serde(default)]
     pub name: Option<String>,
+    /// Wait at each pose [s]; absent: 2 (needs `language`).
     #[serde(default)]
     pub wait_s: Option<f64>,
 }
@@ -125,6 +138,8 @@ fn command(robot_id: i64, req: CubeRequest) -> Result<CubeCommand, ApiError> {
     })
 }
 
+/// `POST /v1/robots/{id}/iso9283/plan`: the test cube's poses, their plan CSV and optionally the
+/// cycle program, solved on the version.
 pub async fn plan(
     State(state): State<AppState>,
     ApiPath(robot_id): ApiPath<i64>,

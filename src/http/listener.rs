@@ -9,6 +9,8 @@
 //! as one piece; the router never answers a 4xx without a body) and sends a
 //! problem document with the same status instead.
 
+#![warn(missing_docs)]
+
 use super::error::ApiError;
 use axum::http::StatusCode;
 use std::io;
@@ -23,6 +25,7 @@ pub struct ServiceListener {
 }
 
 impl ServiceListener {
+    /// A listener on `inner`'s connections.
     pub fn new(inner: TcpListener) -> Self {
         ServiceListener { inner }
     }
@@ -62,6 +65,7 @@ pub struct ProblemIo<S> {
 }
 
 impl<S> ProblemIo<S> {
+    /// The connection `inner`, with nothing rewritten yet.
     pub fn new(inner: S) -> Self {
         ProblemIo {
             inner,

@@ -5,6 +5,8 @@
 //! when `language` is given, as a program visiting them with a wait at each.
 //! The same as `robocal plan`.
 
+#![warn(missing_docs)]
+
 use super::input::present_int;
 use super::programs::FileIn;
 use super::{ApiError, ApiJson, ApiPath, AppState};
@@ -29,7 +31,9 @@ pub const WAIT_MAX_S: f64 = 3600.0;
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BoxIn {
+    /// The box's lowest corner [mm].
     pub min_mm: [f64; 3],
+    /// The box's highest corner [mm], above `min_mm` on every axis.
     pub max_mm: [f64; 3],
 }
 
@@ -37,10 +41,12 @@ pub struct BoxIn {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TrackerIn {
+    /// The tracker's position in the base frame [mm].
     pub position_mm: [f64; 3],
     /// The reflector's axis in the tool frame (default: z).
     #[serde(default)]
     pub axis: Option<[f64; 3]>,
+    /// Largest angle between the reflector's axis and the line to the tracker [deg].
     pub max_angle_deg: f64,
 }
 
@@ -48,40 +54,62 @@ pub struct TrackerIn {
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PlanRequest {
+    /// Poses to choose, 1 to [`PLAN_POSES_MAX`]; absent: 50.
     #[serde(default, deserialize_with = "present_int")]
     pub poses: Option<usize>,
+    /// Random configurations drawn, from `poses` to [`PLAN_CANDIDATES_MAX`]; absent: 1000 (or
+    /// `poses` when more).
     #[serde(default, deserialize_with = "present_int")]
     pub candidates: Option<usize>,
+    /// The box the TCP must stay in; absent: no box.
     pub workspace: Option<BoxIn>,
+    /// The tracker's line of sight the TCP must keep; absent: not checked.
     pub tracker: Option<TrackerIn>,
+    /// Tracker noise, standard deviation per axis [mm], above 0 and at most 100; absent: 0.01.
     pub noise_mm: Option<f64>,
+    /// Payload mass [kg]; absent: the model's.
     pub payload_kg: Option<f64>,
+    /// Seed of the random candidates (the same seed gives the same plan); absent: 1.
     #[serde(default, deserialize_with = "present_int")]
     pub seed: Option<u64>,
     /// krl, rapid, fanuc or urscript: also return the plan as a program.
     pub language: Option<String>,
+    /// The program's name: a letter, then up to 23 letters, digits or `_`; absent: `plan` (needs
+    /// `language`).
     pub name: Option<String>,
+    /// Wait at each pose [s], 0 to [`WAIT_MAX_S`]; absent: 1 (needs `language`).
     pub wait_s: Option<f64>,
 }
 
 /// The plan as a program.
 #[derive(Debug, Serialize)]
 pub struct ProgramOut {
+    /// The program's language.
     pub language: Language,
+    /// The program's files, each with its name and text.
     pub files: Vec<FileIn>,
 }
 
 /// The answer.
 #[derive(Debug, Serialize)]
 pub struct PlanResponse {
+    /// The robot planned for.
     pub robot_id: i64,
+    /// Poses chosen.
     pub poses: usize,
+    /// How many candidates passed each filter, in order.
     pub counts: FilterCounts,
+    /// The tracker noise the prediction used, standard deviation per axis [mm].
     pub noise_mm: f64,
+    /// The payload mass the plan used [kg].
     pub payload_kg: f64,
+    /// Per method, the parameter standard deviations the poses predict.
     pub predicted: Vec<PredictedStd>,
+    /// The chosen poses: point names and controller joints [deg].
     pub points: Vec<PlanPoint>,
+    /// The chosen poses' joints as a CSV.
     pub joints_csv: String,
+    /// The plan as a program, when `language` was given.
     pub program: Option<ProgramOut>,
 }
 
@@ -209,6 +237,8 @@ fn command(robot_id: i64, req: PlanRequest) -> Result<PlanCommand, ApiError> {
     })
 }
 
+/// `POST /v1/robots/{id}/measurement-plans`: poses chosen for identifiability on the nominal model,
+/// with their predicted standard deviations, joints CSV and optional program.
 pub async fn plan(
     State(state): State<AppState>,
     ApiPath(robot_id): ApiPath<i64>,
@@ -240,6 +270,7 @@ pub async fn plan(
     .into_response())
 }
 
+/// The route of measurement plans.
 pub fn routes() -> Vec<super::Route> {
     vec![super::post("/v1/robots/{id}/measurement-plans", plan)]
 }

@@ -8,6 +8,8 @@
 //! objects (`/tools`, `/frames`) and to what the program declares itself. A
 //! program that cannot be parsed is a 422 naming its file, line and column.
 
+#![warn(missing_docs)]
+
 use super::input::{objects, present};
 use super::solve::{model_choice, VersionSelector};
 use super::{ApiError, ApiJson, ApiPath, AppState};
@@ -29,7 +31,9 @@ pub const FILE_NAME_MAX: usize = 255;
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct FileIn {
+    /// The file's name.
     pub name: String,
+    /// The file's text.
     pub content: String,
 }
 
@@ -37,12 +41,15 @@ pub struct FileIn {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FilterRequest {
+    /// The program's files.
     #[serde(deserialize_with = "objects")]
     pub files: Vec<FileIn>,
     /// krl, rapid, fanuc or urscript.
     pub language: String,
+    /// The model: a version number, `active` (default) or `nominal`.
     #[serde(default, deserialize_with = "present")]
     pub version: Option<VersionSelector>,
+    /// Payload mass [kg] instead of the model's.
     #[serde(default, deserialize_with = "present")]
     pub payload_kg: Option<f64>,
 }
@@ -50,11 +57,15 @@ pub struct FilterRequest {
 /// The answer: the filtered files (same names and order) and the report.
 #[derive(Debug, Serialize)]
 pub struct FilterResponse {
+    /// The robot filtered for.
     pub robot_id: i64,
     /// Model version used (null: the nominal model).
     pub version: Option<i64>,
+    /// Calibration method of that version, or `nominal`.
     pub method: String,
+    /// The filtered files, with the same names and in the same order.
     pub files: Vec<FileIn>,
+    /// One line per position of every Cartesian motion, the joint motions and unused points.
     pub report: FilterReport,
 }
 
@@ -121,6 +132,8 @@ fn command(robot_id: i64, req: FilterRequest) -> Result<FilterCommand, ApiError>
     })
 }
 
+/// `POST /v1/robots/{id}/programs/filter`: the program's files with every Cartesian target moved to
+/// its false target on the model, and the report.
 pub async fn filter(
     State(state): State<AppState>,
     ApiPath(robot_id): ApiPath<i64>,
@@ -146,7 +159,7 @@ pub async fn filter(
     .into_response())
 }
 
-/// The route of program filtering.
+/// The routes of program filtering and of the cell's export.
 pub fn routes() -> Vec<super::Route> {
     vec![
         super::post("/v1/robots/{id}/programs/filter", filter),
@@ -160,6 +173,7 @@ pub fn routes() -> Vec<super::Route> {
 pub struct CellExportRequest {
     /// krl, rapid, fanuc or urscript.
     pub language: String,
+    /// The model: a version number, `active` (default) or `nominal`.
     #[serde(default, deserialize_with = "present")]
     pub version: Option<VersionSelector>,
     /// Payload mass [kg] of tools without a stated load.
@@ -174,7 +188,9 @@ pub struct CellExportRequest {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RegistersIn {
+    /// The first register the export may overwrite.
     pub first: super::input::Int<u32>,
+    /// The last register the export may overwrite, at least `first`.
     pub last: super::input::Int<u32>,
 }
 
@@ -182,11 +198,15 @@ pub struct RegistersIn {
 /// what the export decided.
 #[derive(Debug, Serialize)]
 pub struct CellExportResponse {
+    /// The robot exported for.
     pub robot_id: i64,
     /// Model version used (null: the nominal model).
     pub version: Option<i64>,
+    /// Calibration method of that version, or `nominal`.
     pub method: String,
+    /// The controller's language.
     pub language: Language,
+    /// The controller data in that language.
     pub text: String,
     /// Items without a number and the one they were given (KRL, Fanuc).
     pub assigned: Vec<AssignedNumber>,
@@ -196,6 +216,8 @@ pub struct CellExportResponse {
     pub registers: Vec<UsedRegister>,
 }
 
+/// `POST /v1/robots/{id}/cell/export`: the robot's tools, loads and work objects as the controller
+/// must hold them, in its language.
 pub async fn export_cell(
     State(state): State<AppState>,
     ApiPath(robot_id): ApiPath<i64>,

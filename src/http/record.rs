@@ -2,11 +2,14 @@
 //! (robocal version, robot, dates, methods and settings, the versions made,
 //! the sets with row counts and SHA-256), as in the report's "Record" section.
 
+#![warn(missing_docs)]
+
 use super::{ApiError, ApiPath, AppState};
 use crate::service;
 use axum::extract::State;
 use axum::response::{IntoResponse, Response};
 
+/// `GET /v1/robots/{id}/calibrations/{cid}/record`: the calibration's record as JSON.
 pub async fn record(
     State(state): State<AppState>,
     ApiPath((robot_id, id)): ApiPath<(i64, i64)>,
@@ -15,6 +18,7 @@ pub async fn record(
     Ok(axum::Json(r).into_response())
 }
 
+/// The route of a calibration's record.
 pub fn routes() -> Vec<super::Route> {
     vec![super::get(
         "/v1/robots/{id}/calibrations/{cid}/record",

@@ -1,6 +1,8 @@
 //! `/v1/robots`: create from a preset or a model JSON, list, get, update name
 //! and metadata, delete (with its measurement sets, calibrations and versions).
 
+#![warn(missing_docs)]
+
 use super::input::{check_payload, page_body, present, Page, PageQuery};
 use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState};
 use crate::model::presets::{preset_description, PRESETS};
@@ -31,12 +33,16 @@ pub(crate) async fn robot_list_page(
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CreateRobot {
+    /// The robot's name; absent: the model's name.
     #[serde(default, deserialize_with = "present")]
     pub name: Option<String>,
+    /// The preset its nominal model comes from (`GET /v1/presets`).
     #[serde(default, deserialize_with = "present")]
     pub preset: Option<String>,
+    /// Its nominal model as a model JSON object.
     #[serde(default, deserialize_with = "present")]
     pub model: Option<Map<String, Value>>,
+    /// Free-form metadata (a JSON object), within the metadata size limit; absent: `{}`.
     #[serde(default, deserialize_with = "present")]
     pub metadata: Option<Map<String, Value>>,
 }
@@ -45,8 +51,10 @@ pub struct CreateRobot {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct UpdateRobot {
+    /// The robot's new name.
     #[serde(default, deserialize_with = "present")]
     pub name: Option<String>,
+    /// Its new metadata (a JSON object), replacing the old.
     #[serde(default, deserialize_with = "present")]
     pub metadata: Option<Map<String, Value>>,
 }
@@ -54,13 +62,21 @@ pub struct UpdateRobot {
 /// A robot as the API returns it.
 #[derive(Debug, Serialize)]
 pub struct Robot {
+    /// The robot's id.
     pub id: i64,
+    /// The robot's name.
     pub name: String,
+    /// The preset its nominal model came from, if any.
     pub preset: Option<String>,
+    /// Its number of joints.
     pub dof: i64,
+    /// Free-form metadata given by the client (a JSON object).
     pub metadata: Value,
+    /// The number of its active model version, if one is active.
     pub active_version: Option<i64>,
+    /// When it was stored (UTC, RFC 3339).
     pub created_at: String,
+    /// When its name or metadata last changed (UTC, RFC 3339).
     pub updated_at: String,
     /// The nominal model description (single-robot responses only).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -73,11 +89,15 @@ pub struct Robot {
 /// Where a robot stands by its latest check (`status` null before any).
 #[derive(Debug, Serialize)]
 pub struct RobotCheck {
+    /// The latest check's status: `ok`, `degraded`, `recalibrate` or `shifted`.
     pub status: Option<&'static str>,
+    /// The latest check's id.
     pub check_id: Option<i64>,
+    /// When the latest check was stored (UTC, RFC 3339).
     pub checked_at: Option<String>,
     /// The model version the check scored.
     pub version: Option<i64>,
+    /// Mean position error of the latest check's poses [mm].
     pub mean_mm: Option<f64>,
     /// The frame shift's size when the status is `shifted`.
     pub shift: Option<robocal_core::check::ShiftSize>,
@@ -140,6 +160,7 @@ fn check_metadata(
     Ok(m)
 }
 
+/// `GET /v1/presets`: every preset's name, number of joints and payload [kg].
 pub async fn list_presets() -> Result<Response, ApiError> {
     let presets: Vec<Value> = PRESETS
         .iter()
@@ -198,6 +219,7 @@ fn requested_model(body: &CreateRobot) -> Result<(RobotModel, Option<String>), A
     })
 }
 
+/// `POST /v1/robots`: stores a robot with its nominal model (201, `Location` the robot).
 pub async fn create(
     State(state): State<AppState>,
     ApiJson(body): ApiJson<CreateRobot>,
@@ -230,6 +252,7 @@ pub async fn create(
     ))
 }
 
+/// `GET /v1/robots`: one page of robots, each with where it stands by its latest check.
 pub async fn list(
     State(state): State<AppState>,
     ApiQuery(page): ApiQuery<PageQuery>,
@@ -249,6 +272,7 @@ pub async fn list(
     Ok(axum::Json(page_body(page, total, "robots", robots)?).into_response())
 }
 
+/// `GET /v1/robots/{id}`: the robot with its nominal model and where it stands by its latest check.
 pub async fn get_one(
     State(state): State<AppState>,
     ApiPath(id): ApiPath<i64>,
@@ -260,6 +284,8 @@ pub async fn get_one(
     Ok(axum::Json(robot).into_response())
 }
 
+/// `PATCH /v1/robots/{id}`: renames the robot and/or replaces its metadata (its model cannot
+/// change).
 pub async fn update(
     State(state): State<AppState>,
     ApiPath(id): ApiPath<i64>,
@@ -282,6 +308,7 @@ pub async fn update(
     Ok(axum::Json(Robot::from_row(row, true)?).into_response())
 }
 
+/// `DELETE /v1/robots/{id}`: deletes the robot with everything that belongs to it (204).
 pub async fn delete(
     State(state): State<AppState>,
     ApiPath(id): ApiPath<i64>,

@@ -4,6 +4,8 @@
 //! (`links`, a created resource's `located` answer). A file of its own, so
 //! the handlers import it and not the router that imports them.
 
+#![warn(missing_docs)]
+
 use crate::service::AppState;
 use axum::handler::Handler;
 use axum::http::{header, Method};
@@ -15,7 +17,9 @@ use axum::routing::{on, MethodFilter, MethodRouter};
 /// them and [`super::route_table`] reports the same list (a test checks it against
 /// `openapi.yaml`), so no list of routes is kept by hand beside the router.
 pub struct Route {
+    /// The HTTP method.
     pub method: Method,
+    /// The path template, with `{id}`-style parameters.
     pub path: &'static str,
     pub(super) handler: MethodRouter<AppState>,
 }

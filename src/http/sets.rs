@@ -6,6 +6,8 @@
 //! millimetres and degrees when they are stored; the upload itself is kept
 //! verbatim and served by `GET .../original`.
 
+#![warn(missing_docs)]
+
 use super::error::{content_type, json_content_type};
 use super::input::{
     check_name, check_payload, from_json_object, objects, page_body, present, PageQuery,
@@ -36,11 +38,18 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SetParams {
+    /// The set's name; absent: the role's name.
     pub name: Option<String>,
+    /// The set's role (`identification`, `training`, `validation` or `check`); absent: the rows'
+    /// common `set`, else identification.
     pub role: Option<String>,
+    /// The tracker session it was measured in; absent: `default`.
     pub session: Option<String>,
+    /// Payload of rows that carry none [kg].
     pub payload_kg: Option<f64>,
+    /// Length unit of the rows: `mm` (default) or `m`.
     pub length_unit: Option<String>,
+    /// Angle unit of the rows: `deg` (default) or `rad`.
     pub angle_unit: Option<String>,
     /// CSV only: sign of the real-data `*_dif` columns (`plus` | `minus`).
     pub dif_sign: Option<String>,
@@ -55,10 +64,13 @@ pub struct SetParams {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RowInput {
+    /// Controller joint readings (declared angle unit).
     #[serde(alias = "q_deg")]
     pub q: Vec<f64>,
+    /// Measured TCP position in the measurement frame (declared length unit).
     #[serde(alias = "xyz_mm")]
     pub xyz: [f64; 3],
+    /// Measured orientation, fixed-axis XYZ `[rx, ry, rz]` (declared angle unit).
     #[serde(default, alias = "rpy_deg")]
     pub rpy: Option<[f64; 3]>,
     /// Standard deviations of `xyz` (declared length unit).
@@ -67,10 +79,13 @@ pub struct RowInput {
     /// Standard deviations of `rpy` (declared angle unit).
     #[serde(default)]
     pub std_deg: Option<[f64; 3]>,
+    /// Payload mass at this pose [kg]; absent: the set's.
     #[serde(default)]
     pub payload_kg: Option<f64>,
+    /// Temperature during the measurement [°C].
     #[serde(default)]
     pub temperature_c: Option<f64>,
+    /// The pose's data role (the CSV's `set` column), when given.
     #[serde(default)]
     pub set: Option<SetRole>,
 }
@@ -79,18 +94,25 @@ pub struct RowInput {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct JsonUpload {
+    /// The set's name; absent: the query's, else the role's name.
     #[serde(default, deserialize_with = "present")]
     pub name: Option<String>,
+    /// The set's role; absent: the query's, else the rows' common `set`, else identification.
     #[serde(default, deserialize_with = "present")]
     pub role: Option<String>,
+    /// The tracker session it was measured in; absent: the query's, else `default`.
     #[serde(default, deserialize_with = "present")]
     pub session: Option<String>,
+    /// Payload of rows that carry none [kg]; absent: the query's.
     #[serde(default, deserialize_with = "present")]
     pub payload_kg: Option<f64>,
+    /// Length unit of the rows: `mm` (default) or `m`.
     #[serde(default, deserialize_with = "present")]
     pub length_unit: Option<String>,
+    /// Angle unit of the rows: `deg` (default) or `rad`.
     #[serde(default, deserialize_with = "present")]
     pub angle_unit: Option<String>,
+    /// The rows, in the declared units.
     #[serde(deserialize_with = "objects")]
     pub rows: Vec<RowInput>,
 }
@@ -111,25 +133,39 @@ impl JsonUpload {
     }
 }
 
+/// The units an upload declared.
 #[derive(Debug, Serialize)]
 pub struct Units {
+    /// The length unit: `mm` or `m`.
     pub length: String,
+    /// The angle unit: `deg` or `rad`.
     pub angle: String,
 }
 
 /// A measurement set as the API returns it.
 #[derive(Debug, Serialize)]
 pub struct MeasurementSet {
+    /// The set's id.
     pub id: i64,
+    /// The robot it belongs to.
     pub robot_id: i64,
+    /// The set's name.
     pub name: String,
+    /// Its data role.
     pub role: String,
+    /// The tracker session it was measured in.
     pub session: String,
+    /// Payload of rows that carry none [kg], as declared.
     pub payload_kg: Option<f64>,
+    /// The units the upload declared.
     pub units: Units,
+    /// The format the upload came in: `csv` or `json`.
     pub format: String,
+    /// Number of rows.
     pub row_count: i64,
+    /// Joints per row.
     pub dof: i64,
+    /// When it was stored (UTC, RFC 3339).
     pub created_at: String,
     /// The rows in mm/deg (single-set responses only).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -137,6 +173,7 @@ pub struct MeasurementSet {
 }
 
 impl MeasurementSet {
+    /// The set as the API returns it, with its rows (mm, deg) when given.
     pub fn from_row(r: SetRow, rows: Option<Vec<MeasuredPose>>) -> Self {
         MeasurementSet {
             id: r.id,
@@ -480,6 +517,7 @@ fn upload_is_csv(headers: &HeaderMap) -> Result<bool, ApiError> {
     Ok(is_csv)
 }
 
+/// `POST /v1/robots/{id}/measurement-sets`: stores a JSON or CSV upload (201, `Location` the set).
 pub async fn upload(
     State(state): State<AppState>,
     ApiPath(robot_id): ApiPath<i64>,
@@ -500,6 +538,7 @@ pub async fn upload(
     ))
 }
 
+/// `GET /v1/robots/{id}/measurement-sets`: one page of the robot's sets, without rows.
 pub async fn list(
     State(state): State<AppState>,
     ApiPath(robot_id): ApiPath<i64>,
@@ -516,6 +555,7 @@ pub async fn list(
     Ok(axum::Json(page_body(page, total, "measurement_sets", sets)?).into_response())
 }
 
+/// `GET /v1/robots/{id}/measurement-sets/{sid}`: one set with its rows in mm and degrees.
 pub async fn get_one(
     State(state): State<AppState>,
     ApiPath((robot_id, set_id)): ApiPath<(i64, i64)>,
@@ -524,6 +564,8 @@ pub async fn get_one(
     Ok(axum::Json(MeasurementSet::from_row(row, Some(rows))).into_response())
 }
 
+/// `GET /v1/robots/{id}/measurement-sets/{sid}/original`: the upload as it came, with its content
+/// type.
 pub async fn original(
     State(state): State<AppState>,
     ApiPath((robot_id, set_id)): ApiPath<(i64, i64)>,
@@ -537,6 +579,7 @@ pub async fn original(
     Ok(([(header::CONTENT_TYPE, ct)], text).into_response())
 }
 
+/// `DELETE /v1/robots/{id}/measurement-sets/{sid}`: deletes the set (204).
 pub async fn delete(
     State(state): State<AppState>,
     ApiPath((robot_id, set_id)): ApiPath<(i64, i64)>,

@@ -4,6 +4,8 @@
 //! export it for other tools (`export?format=urdf|dh-csv|mdh-csv|json`, the
 //! text of `crate::model::export`).
 
+#![warn(missing_docs)]
+
 use super::input::{page_body, PageQuery};
 use super::robots::robot_list_page;
 use super::{ApiError, ApiPath, ApiQuery, AppState};
@@ -20,17 +22,28 @@ use serde_json::{json, Value};
 /// A model version as the API returns it.
 #[derive(Debug, Serialize)]
 pub struct ModelVersion {
+    /// The version number: per robot, one above its highest so far (from 1).
     pub version: i64,
+    /// The robot it belongs to.
     pub robot_id: i64,
+    /// The calibration job that made it (a re-registration keeps its parent's; `null` once the job
+    /// is deleted).
     pub calibration_id: Option<i64>,
+    /// Name of the method that fitted the model.
     pub method: String,
+    /// Whether it is the robot's active version.
     pub active: bool,
+    /// The version's error statistics (identification, validation; a re-registration adds its
+    /// refit).
     pub stats: Value,
+    /// When it was stored (UTC, RFC 3339).
     pub created_at: String,
+    /// Its URL (`self`) and those of its `activate` and `model` (`model.json`).
     pub links: Value,
 }
 
 impl ModelVersion {
+    /// The version as the API returns it, from its stored row.
     pub fn from_row(v: VersionRow) -> Self {
         let base = format!("/v1/robots/{}/versions/{}", v.robot_id, v.version);
         ModelVersion {
@@ -49,6 +62,7 @@ impl ModelVersion {
     }
 }
 
+/// `GET /v1/robots/{id}/versions`: one page of the robot's versions, with its active version.
 pub async fn list(
     State(state): State<AppState>,
     ApiPath(robot_id): ApiPath<i64>,
@@ -67,6 +81,7 @@ pub async fn list(
     Ok(axum::Json(out).into_response())
 }
 
+/// `GET /v1/robots/{id}/versions/{version}`: one version with its calibrated model file.
 pub async fn get_one(
     State(state): State<AppState>,
     ApiPath((robot_id, v)): ApiPath<(i64, i64)>,
@@ -79,6 +94,7 @@ pub async fn get_one(
     Ok(axum::Json(out).into_response())
 }
 
+/// `GET /v1/robots/{id}/versions/{version}/model.json`: the calibrated model file as an attachment.
 pub async fn download(
     State(state): State<AppState>,
     ApiPath((robot_id, v)): ApiPath<(i64, i64)>,
@@ -101,9 +117,12 @@ pub async fn download(
 /// `?format=` of an export.
 #[derive(Debug, Clone, serde::Deserialize)]
 pub struct ExportQuery {
+    /// The export format: `urdf`, `dh-csv`, `mdh-csv` or `json`.
     pub format: String,
 }
 
+/// `GET /v1/robots/{id}/versions/{version}/export?format=`: the model in another tool's format as
+/// an attachment; 409 when the format cannot describe it.
 pub async fn export_version(
     State(state): State<AppState>,
     ApiPath((robot_id, v)): ApiPath<(i64, i64)>,
@@ -141,6 +160,7 @@ pub async fn export_version(
         .into_response())
 }
 
+/// `POST /v1/robots/{id}/versions/{version}/activate`: makes the version the robot's active one.
 pub async fn activate(
     State(state): State<AppState>,
     ApiPath((robot_id, v)): ApiPath<(i64, i64)>,
@@ -149,6 +169,7 @@ pub async fn activate(
     Ok(axum::Json(ModelVersion::from_row(row)).into_response())
 }
 
+/// `POST /v1/robots/{id}/versions/rollback`: makes the previously active version active again.
 pub async fn rollback(
     State(state): State<AppState>,
     ApiPath(robot_id): ApiPath<i64>,

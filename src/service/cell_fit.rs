@@ -10,6 +10,8 @@
 //! error: [`Fitted::NotFitted`] says why, and nothing is stored unless the
 //! caller forces a judged fit.
 
+#![warn(missing_docs)]
+
 use super::solve::{chosen_model, ModelChoice};
 use super::{cell, AppState, ServiceError};
 use crate::cell_fit::tcp::entry::{self, Fitted as Judged, Outcome, StoreRequest, StoredEntry};
@@ -22,6 +24,7 @@ use crate::solve::cell::{CellRef, WorkObjectFrame};
 /// What a fit asks beyond its readings.
 #[derive(Debug, Clone, Default)]
 pub struct FitTarget {
+    /// The robot whose tool or work object is fitted.
     pub robot_id: i64,
     /// The stored item's name.
     pub name: String,
@@ -38,8 +41,11 @@ pub struct FitTarget {
 /// A stored fit: the item, the judged fit and the version it was made on.
 #[derive(Debug, Clone)]
 pub struct Stored<F> {
+    /// The item as stored, and whether it was new.
     pub put: CellPut,
+    /// The fit and its verdict.
     pub fitted: Box<Judged<F>>,
+    /// The calibrated version the fit was made on.
     pub version: i64,
 }
 
@@ -47,8 +53,16 @@ pub struct Stored<F> {
 /// stored), on the calibrated version `version`.
 #[derive(Debug, Clone)]
 pub enum Fitted<F> {
+    /// The item fitted and stored.
     Stored(Stored<F>),
-    NotFitted { why: FitError, version: i64 },
+    /// Nothing stored: the readings determine nothing, the verdict was not forced, or a tool's
+    /// orientation is unknown.
+    NotFitted {
+        /// Why, with the figures and what to change.
+        why: FitError,
+        /// The calibrated version the fit was tried on.
+        version: i64,
+    },
 }
 
 async fn calibrated(

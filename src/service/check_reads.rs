@@ -2,6 +2,8 @@
 //! by id, and a page of robots with each robot's latest check (read in one
 //! snapshot, the checks of the page in one query).
 
+#![warn(missing_docs)]
+
 use super::checks::bounded;
 use super::{AppState, ServiceError};
 use crate::records::{CheckRow, RobotRow};
@@ -22,14 +24,18 @@ pub async fn get(state: &AppState, robot_id: i64, check_id: i64) -> Result<Check
 /// A robot and its latest check (`None` before any).
 #[derive(Debug, Clone)]
 pub struct RobotWithCheck {
+    /// The robot's stored row.
     pub robot: RobotRow,
+    /// Its latest check; `None` before any.
     pub latest_check: Option<CheckRow>,
 }
 
 /// One page of robots (by id) with their latest checks, and how many robots there are.
 #[derive(Debug, Clone)]
 pub struct RobotsPage {
+    /// The robots of the page, by id.
     pub robots: Vec<RobotWithCheck>,
+    /// How many robots there are in all.
     pub total: i64,
 }
 

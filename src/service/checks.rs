@@ -7,6 +7,8 @@
 //! were scored (`poses_total`): the figures cover every pose, the history and
 //! its pages stay bounded for a set of any size.
 
+#![warn(missing_docs)]
+
 use super::{robots, versions, AppState, ServiceError};
 use crate::db::{Listing, NewCheck};
 use crate::records::CheckRow;
@@ -21,7 +23,9 @@ use serde_json::Value;
 /// A check to run.
 #[derive(Debug, Clone)]
 pub struct CheckCommand {
+    /// The robot to check.
     pub robot_id: i64,
+    /// The measurement set to score.
     pub set_id: i64,
     /// Version number; the active version when `None`.
     pub version: Option<i64>,
@@ -117,8 +121,11 @@ pub async fn thresholds(state: &AppState, robot_id: i64) -> Result<CheckThreshol
 /// ratio (`None`: the default).
 #[derive(Debug, Clone, Copy)]
 pub struct ThresholdsCommand {
+    /// Above this mean the status is `degraded` [mm].
     pub degraded_mm: f64,
+    /// The step from `degraded_mm` to the recalibrate level [mm].
     pub margin_mm: f64,
+    /// The frame-shift ratio; `None`: the default.
     pub frame_shift_ratio: Option<f64>,
 }
 
@@ -240,7 +247,9 @@ pub const COMPARE_POSE_VERSIONS_MAX: usize = 200_000;
 /// One version's score in a comparison.
 #[derive(Debug, Serialize)]
 pub struct VersionScore {
+    /// The version scored.
     pub version: i64,
+    /// Calibration method of that version.
     pub method: String,
     /// The frame shift's size when the status is `shifted`.
     pub shift: Option<ShiftSize>,

@@ -15,6 +15,8 @@
 //! file says which in its text (`auto 11 fold`, [`Hold::parse`]), read each
 //! time work passes, so a test can move the hold between jobs.
 
+#![warn(missing_docs)]
+
 use std::path::PathBuf;
 use std::sync::{Condvar, Mutex};
 use std::time::Duration;
@@ -39,8 +41,11 @@ pub struct WorkGate {
 /// training); other work passes.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Hold {
+    /// The phase held: its label (`identify::Phase`).
     pub phase: String,
+    /// Reports at this percentage or later are held [%].
     pub percent: f64,
+    /// Only reports that name a cross-validation fold are held.
     pub in_fold: bool,
 }
 

@@ -7,6 +7,8 @@
 //! (its SHA-256) from the store ([`conditions`]); [`plan`] lays out the test
 //! cube on a robot's version and writes its cycle program.
 
+#![warn(missing_docs)]
+
 use super::solve::{chosen_model, ModelChoice};
 use super::{robots, versions, AppState, ServiceError};
 use crate::model::orientation::fixed_xyz_matrix;
@@ -27,7 +29,9 @@ pub const TESTS_MAX: usize = 8;
 /// One test: a label and its poses (commanded and measured).
 #[derive(Debug, Clone)]
 pub struct Iso9283Test {
+    /// The test's label.
     pub label: String,
+    /// Its poses P1 … P5, each with its command and measured cycles where given.
     pub poses: Vec<PoseData>,
 }
 
@@ -35,8 +39,11 @@ pub struct Iso9283Test {
 /// measured cycles (`pose,cycle,x_mm,y_mm,z_mm[,rx_deg,ry_deg,rz_deg]`).
 #[derive(Debug, Clone)]
 pub struct Iso9283CsvTest {
+    /// The test's label.
     pub label: String,
+    /// The plan CSV's text.
     pub plan_csv: String,
+    /// The measured cycles' CSV text.
     pub measured_csv: String,
 }
 
@@ -112,8 +119,11 @@ pub struct ConditionsCommand {
     pub version: Option<i64>,
     /// `YYYY-MM-DD` (default: today, UTC).
     pub date: Option<String>,
+    /// Load carried during the test [kg].
     pub load_kg: Option<f64>,
+    /// Speed of the motions between the poses [% of the rated speed].
     pub speed_percent: Option<f64>,
+    /// What was measured with what (tracker, reflector, session).
     pub measurement: Option<String>,
 }
 
@@ -199,12 +209,15 @@ pub fn measured_sets(tests: &[(String, Assessment)], texts: &[Option<String>]) -
 /// An ISO 9283 plan of a robot's model version.
 #[derive(Debug, Clone)]
 pub struct CubeCommand {
+    /// The robot whose model the cube is solved on.
     pub robot_id: i64,
     /// `None`: the active version.
     pub version: Option<i64>,
+    /// The box the cube must fit in, base frame [mm].
     pub workspace: WorkspaceBox,
     /// Fixed-axis `rx, ry, rz` [deg], base frame.
     pub rpy_deg: [f64; 3],
+    /// Which joint commands: solved on the nominal or on the calibrated, compensated model.
     pub commands: Commands,
     /// The cycle program: language, name, cycles, wait [s].
     pub program: Option<(Language, String, u32, f64)>,
@@ -213,11 +226,17 @@ pub struct CubeCommand {
 /// The plan, its CSV and its cycle program, and the version it was solved on.
 #[derive(Debug)]
 pub struct CubeOutcome {
+    /// The cube, its five poses and their joint commands.
     pub plan: CubePlan,
+    /// The plan as the CSV `robocal iso9283 --plan` reads.
     pub plan_csv: String,
+    /// The cycle program's files, when one was asked for.
     pub program: Option<Vec<ProgramFile>>,
+    /// The robot's name.
     pub robot: String,
+    /// The model version solved on.
     pub version: i64,
+    /// SHA-256 (hex) of that version's stored `model.json`.
     pub model_sha256: String,
 }
 

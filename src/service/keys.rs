@@ -3,6 +3,8 @@
 //! a key without a role is `admin`. The roles nest: `admin` ⊇ `operate` ⊇
 //! `read`. Which role each route needs is decided in `crate::http::auth`.
 
+#![warn(missing_docs)]
+
 use std::fmt;
 
 /// What a key may do. Ordered: a role grants everything a lower one grants.
@@ -71,11 +73,14 @@ impl std::str::FromStr for Role {
 /// One accepted key and its role. `Debug` does not print the key.
 #[derive(Clone, PartialEq, Eq)]
 pub struct ApiKey {
+    /// The key as the client sends it after `Bearer `.
     pub key: String,
+    /// What the key may do.
     pub role: Role,
 }
 
 impl ApiKey {
+    /// The key `key` with role `role`.
     pub fn new(key: impl Into<String>, role: Role) -> Self {
         ApiKey {
             key: key.into(),

@@ -15,6 +15,8 @@
 //!   own thread (a few hundred microseconds of CPU), so a 20-target request
 //!   does not wait for four 100k-target batches.
 
+#![warn(missing_docs)]
+
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
@@ -94,6 +96,7 @@ pub struct Ticket {
 }
 
 impl Admission {
+    /// An admission of `capacity` units at once (at least 1), none admitted yet.
     pub fn new(capacity: usize) -> Arc<Admission> {
         Arc::new(Admission {
             in_flight: AtomicUsize::new(0),
@@ -116,6 +119,7 @@ impl Admission {
         self.in_flight.load(Ordering::Acquire)
     }
 
+    /// Most units admitted at once.
     pub fn capacity(&self) -> usize {
         self.capacity
     }

@@ -45,6 +45,7 @@ pub use state::{AppState, RobotContext, ServiceConfig};
 use crate::db::StoreError;
 
 /// Why a service operation did not happen.
+#[warn(missing_docs)]
 #[derive(Debug, thiserror::Error)]
 pub enum ServiceError {
     /// The command is invalid (a value out of range, an unknown name).
@@ -58,7 +59,12 @@ pub enum ServiceError {
     Conflict(String),
     /// The service is saturated; the same command may succeed later.
     #[error("{detail}")]
-    Busy { detail: String, retry_after_s: u32 },
+    Busy {
+        /// What is saturated and what to do.
+        detail: String,
+        /// Seconds after which the command may be sent again [s].
+        retry_after_s: u32,
+    },
     /// The service cannot take the command now (shutting down).
     #[error("{0}")]
     Unavailable(String),
@@ -83,25 +89,30 @@ impl From<StoreError> for ServiceError {
     }
 }
 
+#[warn(missing_docs)]
 impl ServiceError {
+    /// A 404 naming the robot and where to list robots.
     pub fn robot_not_found(id: i64) -> Self {
         ServiceError::NotFound(format!(
             "robot {id} does not exist; list robots with GET /v1/robots"
         ))
     }
 
+    /// A 404 naming the set and where to list the robot's sets.
     pub fn set_not_found(robot: i64, id: i64) -> Self {
         ServiceError::NotFound(format!(
             "measurement set {id} of robot {robot} does not exist; list them with GET /v1/robots/{robot}/measurement-sets"
         ))
     }
 
+    /// A 404 naming the calibration and where to list the robot's calibrations.
     pub fn calibration_not_found(robot: i64, id: i64) -> Self {
         ServiceError::NotFound(format!(
             "calibration {id} of robot {robot} does not exist; list them with GET /v1/robots/{robot}/calibrations"
         ))
     }
 
+    /// A 404 naming the version and where to list the robot's versions.
     pub fn version_not_found(robot: i64, v: i64) -> Self {
         ServiceError::NotFound(format!(
             "robot {robot} has no model version {v}; list them with GET /v1/robots/{robot}/versions"

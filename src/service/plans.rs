@@ -5,6 +5,8 @@
 //! CPU-bound (forward kinematics of every candidate, a greedy D-optimal
 //! choice): runs on the solve workers behind their admission control.
 
+#![warn(missing_docs)]
+
 use super::solve::{chosen_model, ModelChoice};
 use super::{AppState, ServiceError};
 use crate::plan::{make_plan, plan_csv, plan_program, MeasurementPlan, PlanSettings};
@@ -16,7 +18,9 @@ pub const PLAN_WORK_MAX: f64 = 2e9;
 /// A plan request, in domain terms.
 #[derive(Debug, Clone)]
 pub struct PlanCommand {
+    /// The robot planned for (its nominal model).
     pub robot_id: i64,
+    /// How the plan is made.
     pub settings: PlanSettings,
     /// Also write the plan as a program in this language, named `name`,
     /// waiting `wait_s` at each pose.
@@ -26,9 +30,11 @@ pub struct PlanCommand {
 /// What a plan request produced.
 #[derive(Debug)]
 pub struct PlanOutcome {
+    /// The chosen poses, their filter counts and predicted standard deviations.
     pub plan: MeasurementPlan,
     /// `point,q1..qN` in controller degrees.
     pub joints_csv: String,
+    /// The program's files, when a language was given.
     pub program: Option<Vec<ProgramFile>>,
 }
 

@@ -5,6 +5,8 @@
 //! runs on the solve workers behind the same admission control as large
 //! solve batches.
 
+#![warn(missing_docs)]
+
 use super::solve::{chosen_model, ModelChoice};
 use super::{AppState, ServiceError};
 use crate::program::{
@@ -15,11 +17,15 @@ use crate::solve::ik::IkSettings;
 /// A filter, in domain terms.
 #[derive(Debug, Clone)]
 pub struct FilterCommand {
+    /// The robot whose model and cell filter the program.
     pub robot_id: i64,
+    /// The model: the active version, a version or the nominal model.
     pub model: ModelChoice,
     /// Payload mass [kg] instead of the model's.
     pub payload_kg: Option<f64>,
+    /// The program's language.
     pub language: Language,
+    /// The program's files.
     pub files: Vec<ProgramFile>,
 }
 
@@ -30,6 +36,7 @@ pub struct FilterOutcome {
     pub version: Option<i64>,
     /// Calibration method of that version, or `nominal`.
     pub method: String,
+    /// The filtered files and the report.
     pub output: FilterOutput,
 }
 
@@ -87,6 +94,7 @@ pub async fn filter_program(
 pub struct CellExport {
     /// Version number used (`None`: the nominal model).
     pub version: Option<i64>,
+    /// Calibration method of that version, or `nominal`.
     pub method: String,
     /// Tool, load and work object data in the language, and what the export
     /// decided (numbers given, identifiers changed, registers written):

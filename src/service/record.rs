@@ -4,6 +4,8 @@
 //! and each measurement set with its row count and a SHA-256 of the upload
 //! as received (sets a version uses cannot be deleted: `db::set_usage`).
 
+#![warn(missing_docs)]
+
 use super::{calibrations, robots, AppState, ServiceError};
 use serde::Serialize;
 use serde_json::Value;
@@ -12,11 +14,13 @@ use sha2::{Digest, Sha256};
 /// One set of the record.
 #[derive(Debug, Clone, Serialize)]
 pub struct RecordSet {
+    /// The set's id.
     pub id: i64,
     /// `identification` or `validation`: how the calibration used it.
     pub used_as: &'static str,
     /// `None` when the set no longer exists (deleted before it was protected).
     pub name: Option<String>,
+    /// Its number of rows; `None` when the set no longer exists.
     pub row_count: Option<i64>,
     /// SHA-256 of the upload as received (hex).
     pub sha256: Option<String>,
@@ -25,25 +29,38 @@ pub struct RecordSet {
 /// One version the calibration made.
 #[derive(Debug, Clone, Serialize)]
 pub struct RecordVersion {
+    /// The version number.
     pub version: i64,
+    /// Name of the method that fitted it.
     pub method: String,
+    /// Whether it is the robot's active version now.
     pub active: bool,
 }
 
 /// The record of one calibration.
 #[derive(Debug, Clone, Serialize)]
 pub struct CalibrationRecord {
+    /// The version of robocal that wrote the record.
     pub robocal_version: &'static str,
+    /// The robot's id.
     pub robot_id: i64,
+    /// The robot's name.
     pub robot_name: String,
+    /// The calibration job's id.
     pub calibration_id: i64,
+    /// The job's state: queued, running, succeeded, failed or cancelled.
     pub status: String,
+    /// When the job was queued (UTC, RFC 3339).
     pub created_at: String,
+    /// When it ended (UTC, RFC 3339).
     pub finished_at: Option<String>,
+    /// Names of the methods it ran, in order.
     pub methods: Vec<String>,
     /// The request's settings (seed, population, register, ...).
     pub options: Value,
+    /// The model versions it made.
     pub versions: Vec<RecordVersion>,
+    /// The identification sets, then the validation sets it read.
     pub sets: Vec<RecordSet>,
 }
 

@@ -11,6 +11,8 @@
 //! `reregistered`: the parent version, the set, what was refitted and the
 //! position errors on the set before and after.
 
+#![warn(missing_docs)]
+
 use super::checks::{self, conflict};
 use super::{versions, AppState, ServiceError};
 use crate::db::NewVersion;
@@ -22,6 +24,7 @@ use serde_json::json;
 /// A re-registration to run.
 #[derive(Debug, Clone)]
 pub struct ReregisterCommand {
+    /// The robot whose version is re-registered.
     pub robot_id: i64,
     /// The set of the new session (positions in its measurement frame).
     pub set_id: i64,

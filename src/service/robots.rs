@@ -1,12 +1,15 @@
 //! Robots: create, list, read, rename and delete; the cached robot context and
 //! solvers and the cancel flags of a robot's jobs are kept in step here.
 
+#![warn(missing_docs)]
+
 use super::{AppState, ServiceError};
 use crate::db::Listing;
 use crate::records::{NewRobot, RobotRow};
 use serde_json::{Map, Value};
 use std::sync::atomic::Ordering;
 
+/// Stores a new robot with its nominal model.
 pub async fn create(state: &AppState, robot: &NewRobot<'_>) -> Result<RobotRow, ServiceError> {
     Ok(state.db().insert_robot(robot).await?)
 }

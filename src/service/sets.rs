@@ -7,6 +7,8 @@
 //! Units: rows are stored in mm and degrees (`MeasuredPose`), whatever the
 //! upload declared.
 
+#![warn(missing_docs)]
+
 use super::{AppState, ServiceError};
 use crate::db::{Listing, NewSet};
 use crate::measure::csv::{self, CsvError, ReadOptions};
@@ -18,10 +20,17 @@ use crate::records::{AngleUnit, LengthUnit, SetFormat, SetRow};
 pub enum SetContent {
     /// A measurement CSV, read as `read` says (its units must agree with the
     /// command's `length` and `angle`).
-    Csv { text: String, read: ReadOptions },
+    Csv {
+        /// The CSV text as uploaded.
+        text: String,
+        /// How to read it: `*_dif` sign, delimiter and decimal mark, units, orientation convention.
+        read: ReadOptions,
+    },
     /// Rows already in mm and degrees, with the original JSON text.
     Rows {
+        /// The rows in mm and degrees.
         rows: Vec<MeasuredPose>,
+        /// The JSON upload as received.
         original: String,
     },
 }
@@ -29,16 +38,21 @@ pub enum SetContent {
 /// A measurement-set upload, in domain terms.
 #[derive(Debug, Clone)]
 pub struct NewSetCommand {
+    /// The robot the set belongs to.
     pub robot_id: i64,
     /// Set name (empty: the role's name).
     pub name: String,
     /// Declared role; `None`: the rows' common `set` value, else identification.
     pub role: Option<SetRole>,
+    /// The tracker session it was measured in.
     pub session: String,
     /// Payload of rows that carry none [kg].
     pub payload_kg: Option<f64>,
+    /// The length unit the upload declared (stored rows are in mm).
     pub length: LengthUnit,
+    /// The angle unit the upload declared (stored rows are in degrees).
     pub angle: AngleUnit,
+    /// The upload's text or rows.
     pub content: SetContent,
 }
 

@@ -2,6 +2,8 @@
 //! solve queues, cancellation flags and the caches of robots and prepared
 //! solvers.
 
+#![warn(missing_docs)]
+
 use super::gate::{At, WorkGate};
 use super::limits::{Admission, Limits, Ticket, SMALL_SOLVE_MAX};
 use super::waiting::{Waiting, WaitingFlag};
@@ -75,9 +77,13 @@ impl Default for ServiceConfig {
 /// The active model version of a robot, as the solve endpoint needs it.
 #[derive(Debug, Clone)]
 pub struct RobotContext {
+    /// The robot's id.
     pub robot_id: i64,
+    /// The robot's name.
     pub name: String,
+    /// Its nominal model's description (JSON).
     pub model_json: String,
+    /// Its number of joints.
     pub dof: usize,
     /// (row id, version number, method) of the active version.
     pub active: Option<(i64, i64, String)>,
@@ -171,6 +177,7 @@ impl AppState {
         &self.inner.db
     }
 
+    /// The service's configuration.
     pub fn config(&self) -> &ServiceConfig {
         &self.inner.config
     }
@@ -285,6 +292,7 @@ impl AppState {
         self.inner.solve_slots.clone()
     }
 
+    /// The service's limits: body, metadata, set and solve sizes, queues, job budget and page size.
     pub fn limits(&self) -> &Limits {
         &self.inner.config.limits
     }

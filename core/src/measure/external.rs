@@ -20,11 +20,17 @@ pub const MAX_EXTERNAL_AXES: usize = 6;
 /// names, lists and messages derive from it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum ExternalAxis {
+    /// External axis 1, column `e1`.
     E1,
+    /// External axis 2, column `e2`.
     E2,
+    /// External axis 3, column `e3`.
     E3,
+    /// External axis 4, column `e4`.
     E4,
+    /// External axis 5, column `e5`.
     E5,
+    /// External axis 6, column `e6`.
     E6,
 }
 
@@ -85,8 +91,11 @@ impl ExternalValues {
 /// values empty.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct MeasurementSet {
+    /// The readings, in file order.
     pub poses: Vec<MeasuredPose>,
+    /// Each reading's external-axis values, in the order of `poses`.
     pub external: Vec<ExternalValues>,
+    /// The external-axis columns the file had, in column order.
     pub axes: Vec<ExternalAxis>,
 }
 
@@ -121,6 +130,8 @@ impl MeasurementSet {
 /// One reading of a [`MeasurementSet`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Reading<'a> {
+    /// The reading's joints, position and the rest of its row.
     pub pose: &'a MeasuredPose,
+    /// Its external-axis values (mm or degrees as the controller shows them).
     pub external: ExternalValues,
 }

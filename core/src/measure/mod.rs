@@ -16,21 +16,13 @@ use crate::model::RobotModel;
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
-// `missing_docs` is warned module by module and item by item rather than
-// on the whole floor: the external axes' readings (`external`) are not
-// documented item by item yet.
-#[warn(missing_docs)]
 pub mod bounds;
-#[warn(missing_docs)]
 pub mod convention;
-#[warn(missing_docs)]
 pub mod csv;
-#[warn(missing_docs)]
 pub mod csv_text;
 pub mod external;
 
 /// Role of a measurement in the calibration (docs/design.md "Data roles").
-#[warn(missing_docs)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SetRole {
@@ -46,7 +38,6 @@ pub enum SetRole {
     Check,
 }
 
-#[warn(missing_docs)]
 impl SetRole {
     /// Every role, in the order lists and messages name them.
     pub const ALL: [SetRole; 4] = [
@@ -90,7 +81,6 @@ impl SetRole {
 }
 
 /// One measured pose in boundary units (mm, deg), as in the CSV.
-#[warn(missing_docs)]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MeasuredPose {
     /// Controller joint readings [deg].
@@ -122,7 +112,6 @@ pub struct MeasuredPose {
 }
 
 /// One measured pose in SI units, ready for identification.
-#[warn(missing_docs)]
 #[derive(Debug, Clone, PartialEq)]
 pub struct Measurement {
     /// Model-convention joint values [rad].
@@ -144,7 +133,6 @@ pub struct Measurement {
 /// per-axis figures (`√((σx² + σy² + σz²)/3)`): the fit works in the registered
 /// base frame, where the tracker's axes are rotated, so a row's weight is one
 /// figure for its position and one for its orientation.
-#[warn(missing_docs)]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RowStd {
     /// Position [m].
@@ -153,7 +141,6 @@ pub struct RowStd {
     pub orientation: Option<f64>,
 }
 
-#[warn(missing_docs)]
 impl RowStd {
     /// From the CSV's per-axis figures (mm, deg).
     pub fn from_axes(std_mm: [f64; 3], std_deg: Option<[f64; 3]>) -> RowStd {
@@ -165,7 +152,6 @@ impl RowStd {
     }
 }
 
-#[warn(missing_docs)]
 impl MeasuredPose {
     /// A row of joints `q_deg` (controller degrees) and a reflector point
     /// `xyz_mm` [mm], nothing else stated (no orientation, σ, payload,
@@ -204,7 +190,6 @@ impl MeasuredPose {
 }
 
 /// Converts rows to SI measurements.
-#[warn(missing_docs)]
 pub fn to_measurements(
     model: &RobotModel,
     rows: &[MeasuredPose],

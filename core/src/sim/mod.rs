@@ -21,21 +21,13 @@
 //! (`x_tracker = R·x_base + p`, i.e. it is the pose of the base frame in the
 //! tracker frame); measured points are expressed in the tracker frame.
 
-// `missing_docs` is warned here module by module rather than on the whole
-// floor: the track's and the positioner's simulations (`track`, `positioner`,
-// `positioner_sets`) are not documented item by item yet.
-#[warn(missing_docs)]
 mod perturb;
-#[warn(missing_docs)]
 mod poses;
 pub mod positioner;
 pub mod positioner_sets;
-#[warn(missing_docs)]
 pub mod study;
-#[warn(missing_docs)]
 mod synthetic;
 pub mod track;
-#[warn(missing_docs)]
 mod truth;
 
 pub use perturb::{
@@ -51,7 +43,6 @@ pub use truth::{fine_transmission_errors, tracker_frame, Harmonic, TrueRobot, Un
 use crate::model::kinematics::KinematicsError;
 
 /// Simulation errors.
-#[warn(missing_docs)]
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SimError {
     /// Forward kinematics failed at one of the configurations measured.

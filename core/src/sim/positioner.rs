@@ -49,9 +49,11 @@ pub struct TrueAxis {
     pub direction: Vector3<f64>,
     /// A point of the line [m].
     pub through: Vector3<f64>,
-    /// [rad]
+    /// The true angle at controller value 0, `encoder_offset` in `θ` [rad].
     pub encoder_offset_rad: f64,
+    /// True radians turned per controller radian, `scale` in `θ` (1 for a perfect gear).
     pub scale: f64,
+    /// The bearing's nod of the carried body; `None` for a perfect bearing.
     pub wobble: Option<Wobble>,
 }
 
@@ -86,8 +88,11 @@ impl TrueAxis {
 /// A true tilt-rotate positioner and its tracker (module docs).
 #[derive(Debug, Clone, PartialEq)]
 pub struct TruePositioner {
+    /// The positioner base frame in the cell (tracker) frame.
     pub cell_from_base: Pose,
+    /// Axis 1, the tilt, in the base frame, driven by the first of the two controller values.
     pub tilt: TrueAxis,
+    /// Axis 2, the rotate, in the tilt body's frame, driven by the second controller value.
     pub rotate: TrueAxis,
     /// Reflectors in the rotate body's frame [m].
     pub reflectors: Vec<Vector3<f64>>,

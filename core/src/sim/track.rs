@@ -64,8 +64,11 @@ pub struct TrueTrack {
     pub vertical: Vec<Wave>,
     /// Distance of the carriage's front and rear blocks [m].
     pub wheelbase_m: f64,
+    /// Yaw added to the blocks' (about the rail frame's z) over the travel [rad].
     pub yaw_extra: Vec<Wave>,
+    /// Pitch added to the blocks' (about the rail frame's y) over the travel [rad].
     pub pitch_extra: Vec<Wave>,
+    /// The carriage's roll (about the rail frame's x) over the travel [rad].
     pub roll: Vec<Wave>,
     /// The robot base frame in the carriage frame.
     pub base_on_carriage: Pose,
@@ -75,8 +78,11 @@ pub struct TrueTrack {
 /// the rail frame's x, y, z.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CarriageAngles {
+    /// About the rail frame's x [rad].
     pub roll: f64,
+    /// About the rail frame's y, positive with the front down [rad].
     pub pitch: f64,
+    /// About the rail frame's z, positive with the front to +y [rad].
     pub yaw: f64,
 }
 

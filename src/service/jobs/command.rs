@@ -45,12 +45,19 @@ pub struct StartCommand {
 /// are in the order the column has always been written in.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Format1Options {
+    /// Ids of the sets that train the compensators (empty: they train on the identification sets).
     pub training_set_ids: Vec<i64>,
+    /// Seed of every random choice (TLBO, compensator training).
     pub seed: u64,
+    /// TLBO population (skcm-tlbo).
     pub population: usize,
+    /// TLBO generations (skcm-tlbo).
     pub generations: usize,
+    /// Levenberg–Marquardt iteration limit.
     pub max_iterations: usize,
+    /// Whether the tracker frame is registered in closed form first.
     pub register: bool,
+    /// Payload of rows and sets that give none [kg].
     pub payload_kg: f64,
 }
 

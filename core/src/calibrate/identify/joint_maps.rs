@@ -136,10 +136,13 @@ impl Default for JointMapSettings {
 /// One (K, λ) the cross-validation tried.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MapCandidate {
+    /// Harmonics per joint K (0: geometry alone).
     pub harmonics: usize,
+    /// Ridge weight λ, relative to the mean squared norm of the map columns (module docs).
     pub ridge: f64,
     /// Mean / max held-out position error over all poses [mm].
     pub cv_mean_mm: f64,
+    /// Largest held-out position error over all poses [mm].
     pub cv_max_mm: f64,
     /// The thesis's eq. 7.10 on the held-out errors,
     /// `mean(e²) + 0.5·max(e²) + 0.3·std(e²)` [mm²]: the choice's criterion.
@@ -169,7 +172,9 @@ pub enum MapStructure {
 /// A structure of the maps: harmonics per joint and ridge weight.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MapOrder {
+    /// Harmonics per joint K.
     pub harmonics: usize,
+    /// Ridge weight λ, relative to the mean squared norm of the map columns (module docs).
     pub ridge: f64,
 }
 
@@ -188,9 +193,11 @@ fn seed_cost(errors: &[f64]) -> f64 {
 pub struct MapFit {
     /// `None` when K = 0 (geometry alone) won the cross-validation.
     pub maps: Option<JointMaps>,
+    /// The (K, λ) fitted, with its cross-validated errors.
     pub chosen: MapCandidate,
     /// Geometry alone (K = 0), on the same folds.
     pub without_maps: MapCandidate,
+    /// Every (K, λ) the cross-validation tried, K = 0 included.
     pub candidates: Vec<MapCandidate>,
     /// Poses the maps were fitted on.
     pub poses: usize,
@@ -333,16 +340,33 @@ fn map_joints(
 /// Why the maps cannot be fitted.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MapFitError {
+    /// The model has a closed loop; maps need a serial chain.
     #[error("joint maps need a serial chain (this model has a closed loop)")]
     ClosedLoop,
+    /// Fewer poses than four per cross-validation fold.
     #[error("joint maps need at least {need} poses, got {got}")]
-    TooFewPoses { need: usize, got: usize },
+    TooFewPoses {
+        /// Poses needed: four per fold.
+        need: usize,
+        /// Poses given.
+        got: usize,
+    },
+    /// The model cannot be evaluated at some training pose, or the fit's ridge system cannot be
+    /// solved.
     #[error("the model cannot be evaluated at some training pose")]
     NotEvaluable,
+    /// No joint moves over `min_range_rad` in the training poses.
     #[error("no joint moves over {min_deg:.1}° in the training poses")]
-    NoJointMoves { min_deg: f64 },
+    NoJointMoves {
+        /// The least range a mapped joint must cover, `min_range_rad` [deg].
+        min_deg: f64,
+    },
+    /// Every joint that moves enough has its map refused as not observable.
     #[error("no joint map is observable: {refused}")]
-    NoObservableJoint { refused: String },
+    NoObservableJoint {
+        /// Each refused joint's [`RefusedMap::reason`], `; `-separated.
+        refused: String,
+    },
 }
 
 /// Poses of the design filled between two checks of `go` in [`build`].

@@ -9,8 +9,6 @@
 //! Units: SI inside; reports speak millimetres and degrees (compliance in
 //! rad/(N·m), stiffness in N·m/rad).
 
-// `missing_docs` is warned module by module: `methods`, `joint_maps` and
-// `progress` are not documented item by item yet.
 #[warn(missing_docs)]
 pub mod checks;
 #[warn(missing_docs)]
@@ -19,9 +17,11 @@ mod evaluate;
 pub mod evidence;
 #[warn(missing_docs)]
 pub mod identifiability;
+#[warn(missing_docs)]
 pub mod joint_maps;
 #[warn(missing_docs)]
 pub mod least_squares;
+#[warn(missing_docs)]
 pub mod methods;
 #[warn(missing_docs)]
 pub mod model_file;
@@ -31,6 +31,7 @@ pub mod network;
 pub mod options;
 #[warn(missing_docs)]
 mod pipeline;
+#[warn(missing_docs)]
 pub mod progress;
 #[warn(missing_docs)]
 pub mod registration;

@@ -44,6 +44,7 @@ impl Phase {
             .chain(Method::ALL.into_iter().map(Phase::Method))
     }
 
+    /// The phase's name: `registration`, `identifiability` or the method's name.
     pub const fn label(self) -> &'static str {
         match self {
             Phase::Registration => "registration",
@@ -82,7 +83,9 @@ impl std::fmt::Display for Phase {
 /// on the whole pool has no fold.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
 pub struct Fold {
+    /// The training under way, from 1.
     pub index: usize,
+    /// Cross-validation trainings in all (random and blocked folds, without the final one).
     pub of: usize,
 }
 
@@ -100,6 +103,7 @@ impl Fold {
 /// Progress of a running calibration.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Progress {
+    /// What the calibration is doing.
     pub phase: Phase,
     /// The iteration, epoch or generation within the current step (restarts
     /// with every fit or training).
@@ -135,6 +139,7 @@ impl Progress {
 
 /// Seconds since some fixed start.
 pub trait Clock: Send + Sync {
+    /// Seconds since the clock's start [s].
     fn elapsed_s(&self) -> f64;
 }
 
@@ -143,6 +148,7 @@ pub trait Clock: Send + Sync {
 pub struct SystemClock(Instant);
 
 impl SystemClock {
+    /// A clock that starts now.
     pub fn start() -> Self {
         SystemClock(Instant::now())
     }
@@ -186,6 +192,7 @@ pub struct ProgressReporter<'a> {
 }
 
 impl<'a> ProgressReporter<'a> {
+    /// A reporter to `sink` that reads the time from `clock`, with nothing reported yet.
     pub fn new(sink: &'a dyn Fn(&Progress) -> bool, clock: &'a dyn Clock) -> Self {
         ProgressReporter {
             sink,

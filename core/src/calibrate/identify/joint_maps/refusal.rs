@@ -17,6 +17,7 @@ pub enum MapRefusal {
 }
 
 impl MapRefusal {
+    /// Every rule, in the order the module docs give them.
     pub const ALL: [MapRefusal; 2] = [MapRefusal::AngleNotResolved, MapRefusal::LeverBelowFloor];
 
     /// The serialised name.
@@ -51,5 +52,6 @@ pub struct RefusedMap {
     /// The bound on `unseen_tip_mm`, `max(max_unseen_tip_m, noise_ratio·σ)`
     /// [mm].
     pub max_unseen_tip_mm: f64,
+    /// The refusal in words, with those figures, for the report.
     pub reason: String,
 }

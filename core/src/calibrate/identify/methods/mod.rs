@@ -290,6 +290,7 @@ method_table! {
 /// One row of [`METHODS`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MethodRow {
+    /// The method this row describes.
     pub method: Method,
     /// The name in requests, reports and model files.
     pub name: &'static str,
@@ -297,9 +298,11 @@ pub struct MethodRow {
     pub aliases: &'static [&'static str],
     /// Display name in tables and the HTML report.
     pub label: &'static str,
+    /// What the method does, in a sentence (also the [`Method`] variant's doc).
     pub description: &'static str,
     /// What the method identifies.
     pub fits: &'static str,
+    /// Whether the method identifies joint compliance.
     pub compliance: Compliance,
     /// Needs gravity torques on some joint (compliance, or torque inputs).
     pub torques: bool,
@@ -308,13 +311,16 @@ pub struct MethodRow {
     /// Measured time relative to SKCM's (comment above the table), for the
     /// progress percentage and its time left.
     pub weight: f64,
+    /// How the method runs.
     pub run: Run,
 }
 
 /// Whether a method identifies joint compliance.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Compliance {
+    /// Never: the joints are taken as rigid.
     No,
+    /// Always (the method needs gravity torques).
     Yes,
     /// Only when gravity loads a joint (`auto` then also weighs SKCM).
     IfLoaded,
@@ -323,19 +329,27 @@ pub enum Compliance {
 /// How a method runs ([`run`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Run {
+    /// KM: LM on the identifiable geometric parameters (§2.2).
     Km,
+    /// SKCM: LM on the geometry and the joint compliance, c ≥ 0 (§2.3).
     Skcm,
+    /// SKCM-C: the compliance searched by TLBO around an inner KM (ch. 7).
     SkcmTlbo,
+    /// SKCM with the payload's centre of mass (and mass offset) identified jointly.
     SkcmPayload,
     /// Joint angle error maps on a base (`maps`).
     Maps(Base),
+    /// A learned compensator trained on the residuals of a base (`compensated`).
     Compensated(Compensated),
+    /// The base alone, with its joint maps or with a compensator, chosen by cross-validated
+    /// error (`auto`).
     Auto,
 }
 
 /// A compensator method: its network on the residuals of its base.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Compensated {
+    /// The model-based method whose residuals the network is trained on.
     pub base: Base,
     /// The network and which of the options' settings it trains with
     /// ([`Network::spec`]).
@@ -345,7 +359,9 @@ pub struct Compensated {
 /// A model-based method a compensator builds on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Base {
+    /// KM (`km`).
     Km,
+    /// SKCM (`skcm`).
     Skcm,
     /// KM with its joint maps (`km-maps`).
     KmMaps,
@@ -354,6 +370,7 @@ pub enum Base {
 }
 
 impl Base {
+    /// The method of this base, as run on its own.
     pub const fn method(self) -> Method {
         match self {
             Base::Km => Method::Km,
@@ -435,6 +452,7 @@ impl Method {
         &TABLE[self as usize]
     }
 
+    /// The name in requests, reports and model files (`km`, `skcm-tlbo`, …).
     pub const fn name(self) -> &'static str {
         self.row().name
     }
@@ -533,7 +551,9 @@ impl Method {
 /// An entry of a method list: one method, or `all` for every one.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MethodChoice {
+    /// The one method named.
     One(Method),
+    /// Every method, [`Method::ALL`].
     All,
 }
 
@@ -554,8 +574,13 @@ impl MethodChoice {
 /// A method list that names no method, or a name that is none.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum MethodListError {
+    /// An entry is neither a method's name or alias nor `all`.
     #[error("unknown method `{name}` (known: {})", known())]
-    Unknown { name: String },
+    Unknown {
+        /// The entry, blanks trimmed.
+        name: String,
+    },
+    /// The list names no method (it is empty or blank).
     #[error("no method given (known: {})", known())]
     Empty,
 }

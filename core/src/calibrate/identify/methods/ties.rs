@@ -45,6 +45,7 @@ pub enum Physics {
 }
 
 impl Physics {
+    /// Every level, least physics first.
     pub const ALL: [Physics; 3] = [
         Physics::Geometry,
         Physics::Compliance,
@@ -80,6 +81,7 @@ pub struct Contender {
     pub blocked_mean_mm: Option<f64>,
     /// Cross-validated max on the pool [mm].
     pub max_mm: f64,
+    /// What the option's base models.
     pub physics: Physics,
     /// Fitted quantities: identified parameters, map coefficients, three
     /// output weights per compensator unit.
@@ -106,6 +108,7 @@ pub enum DecidingStep {
 }
 
 impl DecidingStep {
+    /// Every step, in the rule's order.
     pub const ALL: [DecidingStep; 6] = [
         DecidingStep::Mean,
         DecidingStep::BlockedFolds,
@@ -155,9 +158,11 @@ impl DecidingStep {
 /// What the tie rule decided among the contenders (indices into them).
 #[derive(Debug, Clone, PartialEq)]
 pub struct TieOutcome {
+    /// The chosen contender.
     pub winner: usize,
     /// Whether another option's mean was within the margin of the lowest.
     pub tie: bool,
+    /// The step of the rule that decided.
     pub step: DecidingStep,
     /// The best of the options the deciding step removed (`None`: one
     /// contender).

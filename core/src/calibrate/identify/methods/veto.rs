@@ -61,6 +61,7 @@ pub enum EdgeSide {
 }
 
 impl EdgeSide {
+    /// Both ends, low first.
     pub const ALL: [EdgeSide; 2] = [EdgeSide::Low, EdgeSide::High];
 
     /// The serialised name.
@@ -78,10 +79,13 @@ impl EdgeSide {
 pub struct EdgeFigures {
     /// The joint (1-based).
     pub joint: usize,
+    /// Which end of the joint's drawn range.
     pub side: EdgeSide,
     /// Poses held out at that edge.
     pub poses: usize,
+    /// The option refitted without those poses, on them [mm].
     pub option: BlockedFigures,
+    /// Its base refitted without those poses, on them [mm].
     pub base: BlockedFigures,
 }
 
@@ -126,6 +130,7 @@ pub enum VetoVerdict {
 }
 
 impl VetoVerdict {
+    /// Every verdict, in the order the veto checks.
     pub const ALL: [VetoVerdict; 4] = [
         VetoVerdict::Passed,
         VetoVerdict::BlockedMean,
@@ -205,18 +210,23 @@ pub struct BlockedCheck {
     pub option: Method,
     /// Its base alone (KM or SKCM).
     pub base: Method,
+    /// What the veto found.
     pub verdict: VetoVerdict,
     /// What the verdict says ([`VetoVerdict::label`]).
     pub verdict_label: &'static str,
     /// Clusters held out, and the poses they held.
     pub regions: usize,
+    /// Poses the held-out clusters held.
     pub poses: usize,
     /// Over the clusters, each pose once.
     pub option_blocked: BlockedFigures,
+    /// The base's figures over the same clusters, each pose once [mm].
     pub base_blocked: BlockedFigures,
     /// Edges of the joints' drawn ranges held out, and the poses they held
     /// (a pose may lie at several edges).
     pub edges: usize,
+    /// Poses the held-out edges held, summed over the edges (a pose at two edges counts
+    /// twice).
     pub edge_poses: usize,
     /// The edge where the option fares worst against its base
     /// ([`worst_edge`]); none without edges.
