@@ -7,3 +7,5 @@
 pub mod compensate;
 pub mod external;
 pub mod identify;
+#[warn(missing_docs)]
+pub mod pose_key;

@@ -1,8 +1,9 @@
 //! Honest model choice for compensators: k-fold cross-validation on the
 //! training pool and the `auto` rule.
 //!
-//! Cross-validation: the samples are shuffled by the injected generator and
-//! dealt into `k` folds; for each fold a compensator is trained on the other
+//! Cross-validation: the samples are dealt into `k` folds by the samples
+//! themselves (`calibrate::pose_key`), so the same samples get the same folds
+//! whatever the seed and the rows' order; for each fold a compensator is trained on the other
 //! folds and predicts the fold. Every sample is predicted exactly once out of
 //! fold; the statistics are those of the position-error norm [mm] after
 //! compensation, next to the base's (the residual itself, since the
@@ -15,7 +16,8 @@
 //!
 //! Spatially blocked folds ([`blocked_fold_assignment`]) hold out whole
 //! regions of joint space instead: k-means clusters of the joint vectors, each
-//! joint scaled by its range. A compensator that is good between its training
+//! joint scaled by its range, started from the joint vectors themselves (the
+//! same regions whatever the seed). A compensator that is good between its training
 //! poses but wild away from them shows there.
 //!
 //! `auto` ([`choose`]) keeps the base unless a compensator's cross-validated
@@ -24,9 +26,9 @@
 //! than the base's on that fold: a compensator worse on any never wins.
 
 use super::sample::Sample;
+use crate::calibrate::pose_key::{deal, generator_of, key_of, key_order};
 use crate::model::calibrated::Compensator;
 use crate::stats::ErrorStats;
-use rand::seq::SliceRandom;
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -67,21 +69,46 @@ impl BlockedFold {
     }
 }
 
-/// Fold index of each of `n` samples: shuffled, sizes differing by at most one.
-pub fn fold_assignment(n: usize, k: usize, rng: &mut impl Rng) -> Vec<usize> {
-    let mut order: Vec<usize> = (0..n).collect();
-    order.shuffle(rng);
-    let mut fold = vec![0; n];
-    for (pos, &i) in order.iter().enumerate() {
-        fold[i] = pos % k.max(1);
+/// The key of a sample (`calibrate::pose_key`): its joints [rad], torques
+/// [N·m], payload [kg] and residual [m].
+pub fn sample_key(s: &Sample) -> u64 {
+    key_of(
+        s.q.iter()
+            .chain(&s.tau)
+            .copied()
+            .chain([s.payload_kg])
+            .chain(s.residual.iter().copied()),
+    )
+}
+
+/// Fold index of each sample: dealt by the samples' keys (module docs), sizes
+/// differing by at most one.
+pub fn fold_assignment(samples: &[Sample], k: usize) -> Vec<usize> {
+    let keys: Vec<u64> = samples.iter().map(sample_key).collect();
+    deal(&keys, k)
+}
+
+/// Fold index of each sample by region: `k` k-means clusters (k-means++
+/// start, Lloyd iterations) of the joint vectors, each joint divided by its
+/// range over the samples. The start is drawn from the joint vectors
+/// themselves (`calibrate::pose_key`: the vectors in key order, a generator
+/// seeded by their keys), so the regions are the same whatever the seed and
+/// the rows' order.
+pub fn blocked_fold_assignment(qs: &[&[f64]], k: usize) -> Vec<usize> {
+    let keys: Vec<u64> = qs.iter().map(|q| key_of(q.iter().copied())).collect();
+    let order = key_order(&keys);
+    let sorted: Vec<&[f64]> = order.iter().map(|i| qs[*i]).collect();
+    let in_order = clusters(&sorted, k, &mut generator_of(&keys));
+    let mut fold = vec![0; qs.len()];
+    for (pos, i) in order.into_iter().enumerate() {
+        fold[i] = in_order[pos];
     }
     fold
 }
 
-/// Fold index of each sample by region: `k` k-means clusters (k-means++
-/// start from `rng`, Lloyd iterations) of the joint vectors, each joint divided
-/// by its range over the samples.
-pub fn blocked_fold_assignment(qs: &[&[f64]], k: usize, rng: &mut impl Rng) -> Vec<usize> {
+/// `k` k-means clusters of `qs` (k-means++ start from `rng`, Lloyd
+/// iterations), each joint divided by its range.
+fn clusters(qs: &[&[f64]], k: usize, rng: &mut impl Rng) -> Vec<usize> {
     let n = qs.len();
     let k = k.clamp(1, n.max(1));
     let dim = qs.first().map_or(0, |q| q.len());
@@ -302,15 +329,15 @@ pub struct FoldPlan {
 }
 
 impl FoldPlan {
-    /// `k` random folds (at least 2) and `blocked` blocked ones (none
-    /// below 2 or with fewer than `2 * blocked` samples), both drawn from
-    /// `rng` in that order.
-    pub fn draw(samples: &[Sample], k: usize, blocked: usize, rng: &mut impl Rng) -> FoldPlan {
+    /// `k` folds dealt by the samples (at least 2) and `blocked` blocked
+    /// ones (none below 2 or with fewer than `2 * blocked` samples), both
+    /// drawn from the samples themselves (module docs).
+    pub fn draw(samples: &[Sample], k: usize, blocked: usize) -> FoldPlan {
         let k = k.clamp(2, samples.len().max(2));
-        let fold = fold_assignment(samples.len(), k, rng);
+        let fold = fold_assignment(samples, k);
         let regions = (blocked >= 2 && samples.len() >= 2 * blocked).then(|| {
             let qs: Vec<&[f64]> = samples.iter().map(|s| s.q.as_slice()).collect();
-            (blocked, blocked_fold_assignment(&qs, blocked, rng))
+            (blocked, blocked_fold_assignment(&qs, blocked))
         });
         let trained = |assign: &[usize], f: usize| {
             let held = assign.iter().filter(|&&g| g == f).count();
@@ -424,7 +451,6 @@ pub fn cross_validate<E, F>(
     samples: &[Sample],
     k: usize,
     blocked: usize,
-    rng: &mut impl Rng,
     jobs: Jobs<'_, E>,
     fit: F,
 ) -> Result<CvStats, E>
@@ -433,7 +459,7 @@ where
     F: Fn(usize, &[Sample], &mut dyn FnMut(usize, f64) -> bool) -> Result<Arc<dyn Compensator>, E>
         + Sync,
 {
-    let plan = FoldPlan::draw(samples, k, blocked, rng);
+    let plan = FoldPlan::draw(samples, k, blocked);
     let fitted = run_jobs(plan.trainings(), jobs, |t, report| {
         fit(t, &plan.training_set(samples, t), report)
     })?;
@@ -507,6 +533,7 @@ pub fn choose(candidates: &[(String, CvStats)], min_gain: f64) -> Choice {
 mod tests {
     use super::*;
     use nalgebra::Vector3;
+    use rand::seq::SliceRandom;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
 
@@ -525,7 +552,6 @@ mod tests {
         // Residual = constant c plus ±d alternating: the mean of the other folds
         // is exactly c when folds are balanced in sign... instead check against
         // a direct leave-fold-out computation.
-        let mut rng = ChaCha8Rng::seed_from_u64(1);
         let samples: Vec<Sample> = (0..20)
             .map(|i| Sample {
                 q: vec![i as f64],
@@ -539,7 +565,6 @@ mod tests {
             &samples,
             4,
             0,
-            &mut rng,
             jobs(1, &mut |_, _, _| true),
             |_, train, _| {
                 fits.fetch_add(1, Ordering::SeqCst);
@@ -551,8 +576,7 @@ mod tests {
         .unwrap();
         assert_eq!(fits.into_inner(), 4);
         assert_eq!(cv.compensated.n, 20);
-        let mut rng = ChaCha8Rng::seed_from_u64(1);
-        let fold = fold_assignment(20, 4, &mut rng);
+        let fold = fold_assignment(&samples, 4);
         let mut expect = Vec::new();
         for (i, s) in samples.iter().enumerate() {
             let others: Vec<f64> = samples
@@ -702,7 +726,7 @@ mod tests {
     #[test]
     fn blocked_folds_are_the_regions_of_joint_space() {
         // Three tight clusters far apart in joint 1 and 3: every cluster is one
-        // fold, whatever the seed.
+        // fold, and the same folds whatever the rows' order.
         let centres = [[-2.0, 0.0, 1.0], [0.0, 0.5, -1.0], [2.0, -0.5, 0.0]];
         let mut qs: Vec<Vec<f64>> = Vec::new();
         for i in 0..60 {
@@ -711,8 +735,18 @@ mod tests {
             qs.push(vec![c[0] + d, c[1] - d, c[2] + 0.5 * d]);
         }
         let refs: Vec<&[f64]> = qs.iter().map(Vec::as_slice).collect();
+        let first = blocked_fold_assignment(&refs, 3);
         for seed in 0..5 {
-            let f = blocked_fold_assignment(&refs, 3, &mut ChaCha8Rng::seed_from_u64(seed));
+            // Row `r` of the shuffled order is sample `order[r]`.
+            let mut order: Vec<usize> = (0..60).collect();
+            order.shuffle(&mut ChaCha8Rng::seed_from_u64(seed));
+            let rows: Vec<&[f64]> = order.iter().map(|i| refs[*i]).collect();
+            let shuffled = blocked_fold_assignment(&rows, 3);
+            let mut f = vec![0; 60];
+            for (r, i) in order.iter().enumerate() {
+                f[*i] = shuffled[r];
+            }
+            assert_eq!(f, first, "rows shuffled with seed {seed}");
             for i in 0..60 {
                 assert_eq!(f[i], f[i % 3], "seed {seed}, sample {i}");
             }
@@ -765,12 +799,8 @@ mod tests {
                 r: Vector3::new(1e-4, 0.0, 0.0),
             }) as Arc<dyn Compensator>)
         };
-        let mut rng = ChaCha8Rng::seed_from_u64(3);
-        let random =
-            cross_validate(&samples, 5, 0, &mut rng, jobs(2, &mut |_, _, _| true), fit).unwrap();
-        let mut rng = ChaCha8Rng::seed_from_u64(3);
-        let blocked =
-            cross_validate(&samples, 5, 4, &mut rng, jobs(2, &mut |_, _, _| true), fit).unwrap();
+        let random = cross_validate(&samples, 5, 0, jobs(2, &mut |_, _, _| true), fit).unwrap();
+        let blocked = cross_validate(&samples, 5, 4, jobs(2, &mut |_, _, _| true), fit).unwrap();
         // Random folds: no held-out sample lies 0.2 rad beyond the others.
         assert!(random.compensated.mean_mm < 1e-9, "{random:?}");
         assert_eq!(blocked.blocked.len(), 4);

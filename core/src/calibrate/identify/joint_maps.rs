@@ -70,7 +70,6 @@ use crate::measure::Measurement;
 use crate::model::{JointMap, JointMaps, ParamId, ParamKind, Pose, RobotModel};
 use design::{normal_of, solve, Design};
 use nalgebra::{DMatrix, DVector};
-use rand::Rng;
 use serde::{Deserialize, Serialize};
 
 /// Settings of the joint-map fit.
@@ -678,7 +677,8 @@ fn in_order<T: Send>(n: usize, threads: usize, f: impl Fn(usize) -> T + Sync) ->
 /// cross-validation, then the coefficients on all poses. `progress(done,
 /// total)` after each candidate's fold and between the steps of building the
 /// design and its normal equations (`done` = candidates done); false cancels
-/// (`Ok(None)`). The blocked folds draw from `blocked_rng`. `structure`
+/// (`Ok(None)`). The blocked folds are drawn from the poses
+/// (`compensate::blocked_fold_assignment`). `structure`
 /// says whether K and λ are chosen here or held ([`MapStructure`]).
 #[allow(clippy::too_many_arguments)]
 pub fn fit_joint_maps(
@@ -689,7 +689,6 @@ pub fn fit_joint_maps(
     orientation_weight: f64,
     settings: &JointMapSettings,
     structure: MapStructure,
-    blocked_rng: &mut impl Rng,
     progress: &mut dyn FnMut(usize, usize) -> bool,
 ) -> Result<Option<MapFit>, MapFitError> {
     if model.closed_loop.is_some() {
@@ -781,7 +780,7 @@ pub fn fit_joint_maps(
     let regions = settings.blocked_folds;
     let pair = (chosen.harmonics, chosen.ridge);
     let mut go = || progress(total, total);
-    let Some(blocked) = blocked::blocked_errors(&input, regions, pair, blocked_rng, &mut go) else {
+    let Some(blocked) = blocked::blocked_errors(&input, regions, pair, &mut go) else {
         return Ok(None);
     };
     if !progress(total, total) {

@@ -17,10 +17,12 @@ impl Family for Gp {
     fn train(
         settings: &GpSettings,
         samples: &[Sample],
-        rng: &mut impl Rng,
+        _rng: &mut impl Rng,
         progress: &mut dyn FnMut(usize, f64) -> bool,
     ) -> Result<(Gp, TrainReport), TrainError> {
-        let (gp, rep) = train_gp(samples, settings, rng, progress)?;
+        // The Gaussian process draws nothing: its holdout and first inducing
+        // configuration follow the samples (`train` module docs).
+        let (gp, rep) = train_gp(samples, settings, progress)?;
         let report = TrainReport {
             trainer: "gp".into(),
             samples: samples.len(),

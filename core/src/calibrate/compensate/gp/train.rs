@@ -1,13 +1,16 @@
 //! Training of the sparse Gaussian process (module docs of `gp`): inducing
 //! configurations by farthest-point sampling, the DTC fit, length scales and
-//! noise chosen on a seeded holdout.
+//! noise chosen on a holdout. The first inducing configuration and the
+//! holdout are drawn from the samples themselves (`calibrate::pose_key`), so
+//! the same samples give the same Gaussian process whatever the seed and the
+//! rows' order.
 
 use crate::calibrate::compensate::error::TrainError;
 use crate::calibrate::compensate::sample::Sample;
+use crate::calibrate::compensate::select::sample_key;
+use crate::calibrate::pose_key::key_order;
 use crate::model::calibrated::gp::model::{kernel_exponent, Gp};
 use nalgebra::DMatrix;
-use rand::seq::SliceRandom;
-use rand::Rng;
 use serde::{Deserialize, Serialize};
 
 /// Settings of the Gaussian-process compensator.
@@ -87,7 +90,7 @@ fn kernel(a: &[f64], b: &[f64], il: &[f64], s2: f64) -> f64 {
 impl<'a> Data<'a> {
     /// The residuals of `samples` centred [mm], their pooled variance and
     /// `m` inducing configurations by farthest-point sampling.
-    fn new(samples: &'a [Sample], m: usize, rng: &mut impl Rng) -> Self {
+    fn new(samples: &'a [Sample], m: usize, keys: &[u64]) -> Self {
         let n = samples.len();
         let mut mean_mm = [0.0; 3];
         for s in samples {
@@ -105,7 +108,7 @@ impl<'a> Data<'a> {
             y,
             mean_mm,
             signal,
-            inducing: farthest_points(samples, m, rng),
+            inducing: farthest_points(samples, m, keys),
         }
     }
 }
@@ -186,8 +189,8 @@ impl Data<'_> {
 }
 
 /// Indices of `m` samples by farthest-point sampling in range-normalised
-/// joint space, the first drawn from `rng`.
-fn farthest_points(samples: &[Sample], m: usize, rng: &mut impl Rng) -> Vec<usize> {
+/// joint space, the first the sample of the lowest key (`keys`, module docs).
+fn farthest_points(samples: &[Sample], m: usize, keys: &[u64]) -> Vec<usize> {
     let n = samples.len();
     let dof = samples[0].q.len();
     let scale: Vec<f64> = (0..dof)
@@ -209,7 +212,7 @@ fn farthest_points(samples: &[Sample], m: usize, rng: &mut impl Rng) -> Vec<usiz
             .map(|((x, y), s)| ((x - y) * s).powi(2))
             .sum()
     };
-    let mut chosen = vec![rng.gen_range(0..n)];
+    let mut chosen = vec![key_order(keys)[0]];
     let mut near: Vec<f64> = samples
         .iter()
         .map(|s| d2(&s.q, &samples[chosen[0]].q))
@@ -235,7 +238,6 @@ fn farthest_points(samples: &[Sample], m: usize, rng: &mut impl Rng) -> Vec<usiz
 pub fn train_gp(
     samples: &[Sample],
     settings: &GpSettings,
-    rng: &mut impl Rng,
     progress: &mut dyn FnMut(usize, f64) -> bool,
 ) -> Result<(Gp, GpReport), TrainError> {
     if samples.len() < 5 {
@@ -250,9 +252,9 @@ pub fn train_gp(
         / n as f64)
         .sqrt();
     let m = settings.inducing.clamp(1, (n / 2).max(1));
-    let data = Data::new(samples, m, rng);
-    let mut order: Vec<usize> = (0..n).collect();
-    order.shuffle(rng);
+    let keys: Vec<u64> = samples.iter().map(sample_key).collect();
+    let data = Data::new(samples, m, &keys);
+    let order = key_order(&keys);
     let n_test = ((n as f64 * settings.holdout).round() as usize).clamp(1, n - 1);
     let (test, train) = order.split_at(n_test);
     let range: Vec<f64> = (0..dof)

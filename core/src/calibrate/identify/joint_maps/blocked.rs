@@ -15,7 +15,6 @@ use crate::calibrate::compensate::blocked_fold_assignment;
 use crate::measure::Measurement;
 use crate::model::joint_maps::fade_weight;
 use nalgebra::{DMatrix, DVector};
-use rand::Rng;
 use serde::{Deserialize, Serialize};
 
 /// The maps and the geometry alone on the blocked folds.
@@ -86,14 +85,13 @@ fn faded_errors(
 }
 
 /// The chosen `(harmonics, ridge)` and K = 0 on `regions` blocked folds
-/// drawn from `rng`; `None` for fewer than two regions or poses than twice
+/// drawn from the poses; `None` for fewer than two regions or poses than twice
 /// their number, or when a region's solve fails. `Some(None)`: cancelled
 /// (`go` returned false).
 pub(super) fn blocked_errors(
     input: &BlockedInput,
     regions: usize,
     chosen: (usize, f64),
-    rng: &mut impl Rng,
     go: &mut dyn FnMut() -> bool,
 ) -> Option<Option<BlockedMaps>> {
     let d = input.d;
@@ -102,7 +100,7 @@ pub(super) fn blocked_errors(
         return Some(None);
     }
     let qs: Vec<&[f64]> = input.data.iter().map(|m| m.q.as_slice()).collect();
-    let region = blocked_fold_assignment(&qs, regions, rng);
+    let region = blocked_fold_assignment(&qs, regions);
     let (mut with, mut without) = (Vec::with_capacity(n), Vec::with_capacity(n));
     for r in 0..regions {
         let held: Vec<usize> = (0..n).filter(|p| region[*p] == r).collect();

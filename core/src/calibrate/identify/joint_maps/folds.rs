@@ -1,40 +1,27 @@
 //! How the joint maps' cross-validation deals its folds: by the poses
-//! themselves, not by a seed. Each pose gets a 64-bit key mixed from the bits
-//! of its joint values [rad], its measured position [m] and its session
-//! (splitmix64's finaliser, Steele, Lea and Flood 2014, applied after each
-//! word); the poses sorted by key (then by index, for identical rows) are
-//! dealt to the folds in turn. So the folds are the same whatever the seed
-//! and whatever the order of the rows, and each holds ⌊n/F⌋ or ⌈n/F⌉ poses;
-//! the key's mixing spreads neighbouring poses over the folds as a shuffle
-//! would.
+//! themselves, not by a seed (`calibrate::pose_key`). A pose's key reads the
+//! bits of its joint values [rad], its measured position [m] and its
+//! session; the poses in key order are dealt to the folds in turn. So the
+//! folds are the same whatever the seed and whatever the order of the rows,
+//! and each holds ⌊n/F⌋ or ⌈n/F⌉ poses.
 
+use crate::calibrate::pose_key::{key_order, words_key};
 use crate::measure::Measurement;
-
-/// splitmix64's finaliser: a bijection of `u64` whose every output bit
-/// depends on every input bit.
-fn mix(mut z: u64) -> u64 {
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
 
 /// The key of one pose (module docs).
 fn pose_key(m: &Measurement) -> u64 {
-    let words =
+    words_key(
         m.q.iter()
             .chain(m.position.iter())
             .map(|v| v.to_bits())
-            .chain(std::iter::once(m.session as u64));
-    words.fold(0x9E37_79B9_7F4A_7C15, |h, w| {
-        mix(h.wrapping_add(w).wrapping_add(0x9E37_79B9_7F4A_7C15))
-    })
+            .chain(std::iter::once(m.session as u64)),
+    )
 }
 
 /// The poses of `data` (indices) in each of `folds` folds (module docs).
 pub(super) fn folds_by_pose(data: &[Measurement], folds: usize) -> Vec<Vec<usize>> {
     let keys: Vec<u64> = data.iter().map(pose_key).collect();
-    let mut order: Vec<usize> = (0..data.len()).collect();
-    order.sort_by_key(|i| (keys[*i], *i));
+    let order = key_order(&keys);
     (0..folds)
         .map(|f| order.iter().copied().skip(f).step_by(folds).collect())
         .collect()

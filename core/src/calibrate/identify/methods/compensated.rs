@@ -134,15 +134,8 @@ pub(crate) fn train_network(
     let last = ctx.opts.compensator.cv_stages(folds) - 1;
     // The folds' trainings and the final one run side by side; the final
     // training is the last job and reports as the last stage.
-    let plan = (folds > 0).then(|| {
-        let mut fold_rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(1));
-        FoldPlan::draw(
-            &data,
-            folds,
-            ctx.opts.compensator.blocked_folds,
-            &mut fold_rng,
-        )
-    });
+    let plan =
+        (folds > 0).then(|| FoldPlan::draw(&data, folds, ctx.opts.compensator.blocked_folds));
     let cv_jobs = plan.as_ref().map_or(0, FoldPlan::trainings);
     let at = Mutex::new((0usize, 0.0f64));
     let outputs = run_jobs(

@@ -47,8 +47,6 @@ use crate::calibrate::identify::report::SetErrors;
 use crate::measure::Measurement;
 use crate::model::calibrated::Compensator;
 use crate::model::kinematics::Chain;
-use rand::SeedableRng;
-use rand_chacha::ChaCha8Rng;
 use std::sync::Arc;
 
 /// Share of a joint's drawn range an edge region holds out, at either end.
@@ -149,8 +147,7 @@ impl DeliveredRegions {
         let k = ctx.opts.compensator.blocked_folds;
         let all: Vec<&Measurement> = ctx.ident.iter().chain(ctx.training).collect();
         let qs: Vec<&[f64]> = all.iter().map(|m| m.q.as_slice()).collect();
-        let mut rng = ChaCha8Rng::seed_from_u64(ctx.opts.compensator.seed.wrapping_add(103));
-        let cluster = blocked_fold_assignment(&qs, k, &mut rng);
+        let cluster = blocked_fold_assignment(&qs, k);
         let mut regions: Vec<Region> = (0..k)
             .map(|r| region_of(ctx, &all, HeldOut::Cluster, |i| cluster[i] == r))
             .collect();

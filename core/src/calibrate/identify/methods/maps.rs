@@ -20,8 +20,6 @@ use super::{Base, MethodError, MethodFailure};
 use crate::calibrate::identify::joint_maps::{fit_joint_maps, MapStructure};
 use crate::calibrate::identify::least_squares::fit;
 use crate::measure::Measurement;
-use rand::SeedableRng;
-use rand_chacha::ChaCha8Rng;
 
 /// The fit of any base: a model-based one from the cache, a joint-map one
 /// (`km-maps`, `skcm-maps`) by [`run_maps`] on its model-based base.
@@ -111,7 +109,6 @@ fn fit_maps(
         .filter(|m| m.session < sessions)
         .cloned()
         .collect();
-    let mut blocked_rng = ChaCha8Rng::seed_from_u64(ctx.opts.compensator.seed.wrapping_add(102));
     let w = ctx.opts.lm.orientation_weight;
     for round in 0..rounds {
         let mut plain = mf.fit.model.clone();
@@ -125,7 +122,6 @@ fn fit_maps(
             w,
             settings,
             structure,
-            &mut blocked_rng,
             &mut |done, total| progress((stage + done as f64 / total as f64) / stages, done, None),
         )
         .map_err(MethodFailure::JointMaps)?

@@ -145,24 +145,16 @@ fn cross_validate_part(
     parallel: Parallelism,
     cancel: &mut dyn FnMut() -> bool,
 ) -> Result<Option<OrientationCv>, MethodError> {
-    let mut fold_rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(1));
     let jobs = Jobs {
         parallel,
         progress: &mut |_, _, _| cancel(),
         cancelled: || TrainError::Cancelled,
     };
-    let cv = cross_validate(
-        samples,
-        folds,
-        0,
-        &mut fold_rng,
-        jobs,
-        |fold, part, report| {
-            let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(600 + fold as u64));
-            let (c, _) = train(spec, part, &mut rng, report)?;
-            Ok::<_, TrainError>(c.into_arc_supported(Some(support_of(part))))
-        },
-    );
+    let cv = cross_validate(samples, folds, 0, jobs, |fold, part, report| {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed.wrapping_add(600 + fold as u64));
+        let (c, _) = train(spec, part, &mut rng, report)?;
+        Ok::<_, TrainError>(c.into_arc_supported(Some(support_of(part))))
+    });
     match cv {
         Ok(cv) => Ok(Some(OrientationCv::of(&cv))),
         Err(TrainError::Cancelled) => Err(MethodError::Cancelled),

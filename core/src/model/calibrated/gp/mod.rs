@@ -16,7 +16,7 @@
 //!   held-out RMS error to the held-out RMS of `√(3·v)`.
 //!
 //! The length scales (per joint, as fractions of the joint's trained range),
-//! and `σ²/s²` are chosen on a seeded 20 % holdout: a grid, then one pass of
+//! and `σ²/s²` are chosen on a 20 % holdout drawn by the samples themselves: a grid, then one pass of
 //! per-joint refinement (halve, double, drop). Hand-written on nalgebra's
 //! Cholesky: no maintained Rust crate offers sparse GP regression with an
 //! analytic input gradient, which the IK needs.
