@@ -20,19 +20,22 @@
 //! the calibrated flange; with `--work-object NAME` the targets and the false
 //! targets are poses in that work object (`core::cell`). With `--track FILE
 //! --e1 MM` the robot's base is carried along a calibrated track to that
-//! value and the cell frame is the track's (`super::track`); the false
-//! targets stay in the controller's base frame.
+//! value and the cell frame is the track's (`super::track`); with `--track`
+//! alone each row's value is the targets file's `e1` column
+//! (`solve::external::targets`: a row beyond the travel, or without a
+//! number there, fails alone). The false targets stay in the controller's
+//! base frame (or the work object).
 
 use crate::measure::csv_text::dialect_from_names;
 use crate::model::orientation::OrientationConvention;
 use crate::solve::cell::{CellRef, CellSolver};
-use crate::solve::ik::targets_csv::CONVENTION_COLUMNS;
+use crate::solve::ik::targets_csv::{parse_targets_csv_beside, CONVENTION_COLUMNS};
 use crate::solve::ik::{
-    parse_targets_csv, results_csv, Configuration, IkSettings, SolveOptions, TargetFrame,
-    TargetResult,
+    results_csv, Configuration, IkSettings, SolveOptions, TargetFrame, TargetResult,
 };
 use anyhow::{bail, Context};
 use clap::{Args, ValueEnum};
+use robocal_core::solve::external::{place_on_track, TRACK_COLUMN};
 use serde_json::json;
 use std::fmt::Write as _;
 
@@ -73,6 +76,7 @@ pub struct SolveArgs {
     /// one convention, angles in degrees: `qw,qx,qy,qz` (quaternion) |
     /// `q1,q2,q3,q4` (ABB) | `ur_rx_rad,ur_ry_rad,ur_rz_rad` (UR, radians) | `a,b,c`
     /// (KUKA) | `w,p,r` (Fanuc) | `r11..r33` (matrix); `#` starts a comment line.
+    /// With --track and no --e1, an `e1` column: each row's track value [mm].
     #[arg(long)]
     pub targets: String,
     /// Payload mass [kg] (default: the model file's payload).
@@ -165,12 +169,22 @@ pub fn solve_to_string(a: &SolveArgs) -> anyhow::Result<String> {
 
 /// What the command prints and how many targets failed.
 pub fn solve_outcome(a: &SolveArgs) -> anyhow::Result<super::exit::Outcome> {
-    let model = a.track.carry(super::model_files::load_with_payload(
-        &a.model,
-        a.payload_kg,
-    )?)?;
+    let text = std::fs::read_to_string(&a.targets)
+        .with_context(|| format!("cannot read targets file {}", a.targets))?;
+    let dialect = dialect_from_names(a.delimiter.as_deref(), a.decimal.as_deref())
+        .map_err(anyhow::Error::msg)?;
+    // `--track` without `--e1`: each row's value from the file's `e1` column.
+    let per_row = a.track.per_target(&a.targets, &text, dialect)?;
+    let loaded = super::model_files::load_with_payload(&a.model, a.payload_kg)?;
+    let model = match per_row {
+        Some(_) => loaded,
+        None => a.track.carry(loaded)?,
+    };
     let mut frame: TargetFrame = a.frame.parse().map_err(anyhow::Error::msg)?;
-    let mut frame_label = a.track.label(frame.to_string());
+    let mut frame_label = match per_row {
+        Some(_) => a.track.label_per_row(frame.to_string()),
+        None => a.track.label(frame.to_string()),
+    };
     let cell = super::model_files::load_cell(a.cell.as_deref())?;
     let tool = match &a.tool {
         Some(t) => Some(cell.tool(&t.parse::<CellRef>()?)?),
@@ -208,11 +222,13 @@ pub fn solve_outcome(a: &SolveArgs) -> anyhow::Result<super::exit::Outcome> {
     if !(a.jump_deg.is_finite() && a.jump_deg > 0.0) {
         bail!("--jump-deg must be a positive number of degrees");
     }
-    let text = std::fs::read_to_string(&a.targets)
-        .with_context(|| format!("cannot read targets file {}", a.targets))?;
-    let dialect = dialect_from_names(a.delimiter.as_deref(), a.decimal.as_deref())
-        .map_err(anyhow::Error::msg)?;
-    let mut csv = parse_targets_csv(&text, dialect).with_context(|| a.targets.clone())?;
+    let beside: &[&str] = if per_row.is_some() {
+        &[TRACK_COLUMN]
+    } else {
+        &[]
+    };
+    let mut csv =
+        parse_targets_csv_beside(&text, dialect, beside).with_context(|| a.targets.clone())?;
     if csv.convention.is_none() && !a.position_only {
         bail!(
             "{}: no orientation columns ({CONVENTION_COLUMNS}); add them or pass --position-only",
@@ -225,12 +241,19 @@ pub fn solve_outcome(a: &SolveArgs) -> anyhow::Result<super::exit::Outcome> {
         ..IkSettings::default()
     };
     let cell_solver = CellSolver::for_tool(&model, tool.as_ref(), settings);
-    let in_work_object = work_object.as_ref().map(|w| {
-        cell_solver.targets_in(
+    // Per row: each target moved into the base frame at its own value.
+    let on_track = per_row.as_ref().map(|(track, values)| {
+        let placed = place_on_track(&mut csv, values, track, frame, work_object.as_ref());
+        frame = TargetFrame::Base;
+        placed
+    });
+    let in_work_object = match (&work_object, &on_track) {
+        (Some(w), None) => Some(cell_solver.targets_in(
             w,
             csv.rows.iter_mut().filter_map(|r| r.target.as_mut().ok()),
-        )
-    });
+        )),
+        _ => None,
+    };
     let solver = cell_solver.solver();
     let payload = solver.model().payload_kg;
     let options = SolveOptions {
@@ -243,6 +266,9 @@ pub fn solve_outcome(a: &SolveArgs) -> anyhow::Result<super::exit::Outcome> {
     let mut results: Vec<TargetResult> = csv.solve(solver, &options, a.path);
     if let Some(w) = &in_work_object {
         w.false_targets_back(&mut results);
+    }
+    if let Some(placed) = &on_track {
+        placed.false_targets_back(&mut results);
     }
     let conv = csv.convention.unwrap_or(OrientationConvention::Quaternion);
     let header = Header {
