@@ -23,14 +23,26 @@ pub struct RowValue {
 /// Why a file's track values cannot be read.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum TrackColumnError {
+    /// The text is not a table.
     #[error(transparent)]
     Text(#[from] TextError),
+    /// A row whose field count is not the header's.
     #[error(transparent)]
     Shape(#[from] FieldCount),
+    /// The header names the column twice.
     #[error("line {line}: the header names `{TRACK_COLUMN}` twice")]
-    Duplicate { line: usize },
+    Duplicate {
+        /// 1-based line of the header.
+        line: usize,
+    },
+    /// A row's value is not a finite number.
     #[error("line {line}: `{TRACK_COLUMN}` is `{value}`, not a finite number of mm")]
-    NotNumber { line: usize, value: String },
+    NotNumber {
+        /// 1-based line of the row.
+        line: usize,
+        /// The field (shortened).
+        value: String,
+    },
 }
 
 /// The `e1` values of every row of `text`, or `None` when its header has
