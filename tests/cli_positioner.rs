@@ -277,3 +277,205 @@ fn fits_the_files_cannot_carry_exit_refused_and_write_nothing() {
     );
     assert!(!d.join("p.json").exists());
 }
+
+/// A YS100 (its true geometry is the model file's, on the cell's origin)
+/// in front of the positioner, placed 1.7 m along the cell's x.
+fn robot_file(d: &Path) -> robocal::sim::TrueRobot {
+    let nominal = robocal::model::preset("ys100").unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(9);
+    let truth = robocal::sim::TrueRobot::new(robocal::sim::perturb_geometry(
+        &nominal,
+        &robocal::sim::ErrorMagnitudes::from_mm_deg(1.0, 0.1),
+        &mut rng,
+    ));
+    let model = robocal::model::calibrated::CompensatedModel {
+        calibrated: truth.model.clone(),
+        nominal: nominal.clone(),
+        cell_from_base: Pose::identity(),
+        payload_kg: nominal.payload.mass,
+        compensator: None,
+    };
+    robocal::cli::model_files::save_model_file(
+        &robocal::model::calibrated::CalibratedModelFile::from_compensated(&model, "ys100", "km"),
+        &d.join("robot.json"),
+    )
+    .unwrap();
+    truth
+}
+
+/// The positioner of the tests moved to 1.7 m in front of the robot.
+fn near(mut t: TruePositioner) -> TruePositioner {
+    t.cell_from_base = Pose::new(
+        rpy_matrix(0.0, 0.0, 30f64.to_radians()),
+        Vector3::new(1.7, 0.3, -0.9),
+    );
+    t
+}
+
+#[test]
+fn solve_takes_targets_on_the_face_plate_at_each_rows_axis_values() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let robot = robot_file(d);
+    let t = near(truth());
+    let mut nom = nominal();
+    nom.cell_from_base = t.cell_from_base;
+    std::fs::write(d.join("nominal.json"), nom.to_json()).unwrap();
+    write(d, "r0.csv", &t, 0, &sweeps(), 1);
+    write(d, "r1.csv", &t, 1, &sweeps(), 2);
+    let out = calibrate(d, ["r0.csv", "r1.csv"], &[]);
+    assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+    let fitted =
+        TiltRotate::from_json(&std::fs::read_to_string(d.join("p.json")).unwrap()).unwrap();
+
+    // Points of a part on the plate, located on the face plate through each
+    // model at axes 0, 0 (as a part is taught), then asked for at values
+    // moved together; `e1` the tilt, `e2` the rotate value.
+    let on_body = [
+        Vector3::new(0.30, 0.20, 1.16),
+        Vector3::new(-0.25, 0.28, 1.16),
+        Vector3::new(0.05, -0.35, 1.18),
+    ];
+    let values = [[-30.0, 40.0], [15.0, -120.0], [35.0, 160.0], [-10.0, -45.0]];
+    let targets = |m: &TiltRotate| -> String {
+        let mut rows = vec!["id,x,y,z,e1,e2".to_string()];
+        for (i, p) in on_body.iter().enumerate() {
+            let at_zero = t.point([0.0, 0.0], p);
+            let fp = m
+                .cell_from_face_plate([0.0, 0.0])
+                .inverse()
+                .transform_point(&at_zero)
+                * 1e3;
+            for (k, v) in values.iter().enumerate() {
+                rows.push(format!(
+                    "p{i}v{k},{},{},{},{},{}",
+                    fp.x, fp.y, fp.z, v[0], v[1]
+                ));
+            }
+        }
+        rows.join("\n") + "\n"
+    };
+    // The true robot at the solved joints against the true point.
+    let misses = |file: &str, positioner: &str| -> Vec<f64> {
+        let out = robocal(
+            d,
+            &[
+                "solve",
+                "--model",
+                "robot.json",
+                "--targets",
+                file,
+                "--positioner",
+                positioner,
+                "--position-only",
+                "--json",
+            ],
+        );
+        assert_eq!(code(&out), 0, "{}{}", text(&out.stdout), text(&out.stderr));
+        let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(
+            doc["frame"],
+            format!("face plate of positioner {positioner} at each row's e1 (tilt), e2 (rotate)")
+        );
+        let nominal = robocal::model::preset("ys100").unwrap();
+        let mut out = Vec::new();
+        for (i, p) in on_body.iter().enumerate() {
+            for (k, v) in values.iter().enumerate() {
+                let r = &doc["targets"][i * values.len() + k];
+                let deg: Vec<f64> = r["joints_deg"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|x| x.as_f64().unwrap().to_radians())
+                    .collect();
+                let q = nominal.joints_from_controller(&deg);
+                let tip = robot.true_pose_base(&q, None).unwrap().p;
+                out.push((tip - t.point(*v, p)).norm() * 1e3);
+            }
+        }
+        out
+    };
+    std::fs::write(d.join("cal.csv"), targets(&fitted)).unwrap();
+    std::fs::write(d.join("nom.csv"), targets(&nom)).unwrap();
+    let cal = misses("cal.csv", "p.json");
+    let nom_miss = misses("nom.csv", "nominal.json");
+    let worst = |v: &[f64]| v.iter().copied().fold(0.0, f64::max);
+    println!(
+        "true tool tip on the true part at 12 targets: calibrated max {:.4} mm, nominal max {:.3} mm",
+        worst(&cal),
+        worst(&nom_miss)
+    );
+    assert!(worst(&cal) < 0.052, "{cal:?}");
+    assert!(worst(&nom_miss) > 0.5, "{nom_miss:?}");
+
+    // A row without its rotate value fails alone; a file without `e2` and
+    // --positioner beside --track are refused.
+    let text_cal = targets(&fitted).replacen(",40\n", ",\n", 1);
+    std::fs::write(d.join("gap.csv"), text_cal).unwrap();
+    let out = robocal(
+        d,
+        &[
+            "solve",
+            "--model",
+            "robot.json",
+            "--targets",
+            "gap.csv",
+            "--positioner",
+            "p.json",
+            "--position-only",
+            "--json",
+        ],
+    );
+    assert_eq!(code(&out), 2, "{}", text(&out.stderr));
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(doc["targets"][0]["reason"], "invalid_target");
+    assert!(
+        doc["targets"][0]["message"]
+            .as_str()
+            .unwrap()
+            .contains("line 2: column `e2`: `` is not a number"),
+        "{}",
+        doc["targets"][0]
+    );
+    std::fs::write(d.join("no_e2.csv"), "x,y,z,e1\n100,0,0,0\n").unwrap();
+    let out = robocal(
+        d,
+        &[
+            "solve",
+            "--model",
+            "robot.json",
+            "--targets",
+            "no_e2.csv",
+            "--positioner",
+            "p.json",
+            "--position-only",
+        ],
+    );
+    assert_eq!(code(&out), 1);
+    assert!(
+        text(&out.stderr).contains("an `e2` column"),
+        "{}",
+        text(&out.stderr)
+    );
+    let out = robocal(
+        d,
+        &[
+            "solve",
+            "--model",
+            "robot.json",
+            "--targets",
+            "cal.csv",
+            "--positioner",
+            "p.json",
+            "--track",
+            "rail.json",
+            "--position-only",
+        ],
+    );
+    assert_eq!(code(&out), 1, "{}", text(&out.stderr));
+    assert!(
+        text(&out.stderr).contains("cannot be used with"),
+        "{}",
+        text(&out.stderr)
+    );
+}

@@ -23,8 +23,11 @@
 //! value and the cell frame is the track's (`super::track`); with `--track`
 //! alone each row's value is the targets file's `e1` column
 //! (`solve::external::targets`: a row beyond the travel, or without a
-//! number there, fails alone). The false targets stay in the controller's
-//! base frame (or the work object).
+//! number there, fails alone). With `--positioner FILE` the targets are in
+//! a calibrated positioner's face plate frame, each row at its `e1` (tilt)
+//! and `e2` (rotate) values [deg] (`solve::external::place_on_positioner`).
+//! The false targets stay in the controller's base frame (or the work
+//! object).
 
 use crate::measure::csv_text::dialect_from_names;
 use crate::model::orientation::OrientationConvention;
@@ -35,7 +38,12 @@ use crate::solve::ik::{
 };
 use anyhow::{bail, Context};
 use clap::{Args, ValueEnum};
-use robocal_core::solve::external::{place_on_track, TRACK_COLUMN};
+use robocal_core::model::calibrated::CompensatedModel;
+use robocal_core::model::external::TiltRotate;
+use robocal_core::solve::external::{
+    place_on_positioner, place_on_track, target_column_values, TargetValue, ROTATE_COLUMN,
+    TILT_COLUMN, TRACK_COLUMN,
+};
 use serde_json::json;
 use std::fmt::Write as _;
 
@@ -134,6 +142,11 @@ pub struct SolveArgs {
     pub failures: super::exit::AllowFailures,
     #[command(flatten)]
     pub track: super::track::OnTrack,
+    /// Calibrated positioner (`robocal positioner calibrate --out`, in the
+    /// robot's measurement frame): the targets are in its face plate frame,
+    /// each row at its `e1` (tilt) and `e2` (rotate) values [deg].
+    #[arg(long, conflicts_with_all = ["work_object", "track"])]
+    pub positioner: Option<String>,
 }
 
 /// How `robocal solve` prints its results.
@@ -173,8 +186,15 @@ pub fn solve_outcome(a: &SolveArgs) -> anyhow::Result<super::exit::Outcome> {
         .with_context(|| format!("cannot read targets file {}", a.targets))?;
     let dialect = dialect_from_names(a.delimiter.as_deref(), a.decimal.as_deref())
         .map_err(anyhow::Error::msg)?;
+    let on_plate = match &a.positioner {
+        Some(path) => Some(positioner_rows(path, &a.targets, &text, dialect)?),
+        None => None,
+    };
     // `--track` without `--e1`: each row's value from the file's `e1` column.
-    let per_row = a.track.per_target(&a.targets, &text, dialect)?;
+    let per_row = match on_plate {
+        Some(_) => None,
+        None => a.track.per_target(&a.targets, &text, dialect)?,
+    };
     let loaded = super::model_files::load_with_payload(&a.model, a.payload_kg)?;
     let model = match per_row {
         Some(_) => loaded,
@@ -205,27 +225,15 @@ pub fn solve_outcome(a: &SolveArgs) -> anyhow::Result<super::exit::Outcome> {
         .map(Configuration::parse)
         .transpose()
         .map_err(|e| anyhow::anyhow!("--branch: {e}"))?;
-    let seed = match &a.seed_deg {
-        None => None,
-        Some(s) => {
-            let q = parse_seed(s)?;
-            if q.len() != model.dof() {
-                bail!(
-                    "--seed-deg needs {} joint values, got {}",
-                    model.dof(),
-                    q.len()
-                );
-            }
-            Some(model.nominal.joints_from_controller(&q))
-        }
-    };
+    let seed = seed_joints(a, &model)?;
     if !(a.jump_deg.is_finite() && a.jump_deg > 0.0) {
         bail!("--jump-deg must be a positive number of degrees");
     }
-    let beside: &[&str] = if per_row.is_some() {
-        &[TRACK_COLUMN]
-    } else {
-        &[]
+    // The external-axis columns read per row, passed over by the parser.
+    let beside: &[&str] = match (&on_plate, &per_row) {
+        (Some(_), _) => &[TILT_COLUMN, ROTATE_COLUMN],
+        (None, Some(_)) => &[TRACK_COLUMN],
+        (None, None) => &[],
     };
     let mut csv =
         parse_targets_csv_beside(&text, dialect, beside).with_context(|| a.targets.clone())?;
@@ -247,6 +255,10 @@ pub fn solve_outcome(a: &SolveArgs) -> anyhow::Result<super::exit::Outcome> {
         frame = TargetFrame::Base;
         placed
     });
+    if let Some(rows) = &on_plate {
+        frame_label = rows.place(&mut csv, &model);
+        frame = TargetFrame::Base;
+    }
     let in_work_object = match (&work_object, &on_track) {
         (Some(w), None) => Some(cell_solver.targets_in(
             w,
@@ -281,15 +293,90 @@ pub fn solve_outcome(a: &SolveArgs) -> anyhow::Result<super::exit::Outcome> {
         closed_form: solver.analytic().is_some(),
     };
     let format = if a.json { OutputFormat::Json } else { a.format };
-    let text = match format {
-        OutputFormat::Json => render_json(&header, &results),
-        OutputFormat::Table => render_table(&header, &results, solver.model().dof()),
-        OutputFormat::Csv => results_csv(&results, solver.model().dof(), conv),
-    };
     Ok(super::exit::Outcome {
-        text,
+        text: render(format, &header, &results, solver.model().dof()),
         not_done: results.iter().filter(|r| !r.solution.converged).count(),
         total: results.len(),
+    })
+}
+
+/// The results as `format` prints them.
+fn render(format: OutputFormat, h: &Header, results: &[TargetResult], dof: usize) -> String {
+    match format {
+        OutputFormat::Json => render_json(h, results),
+        OutputFormat::Table => render_table(h, results, dof),
+        OutputFormat::Csv => results_csv(results, dof, h.convention),
+    }
+}
+
+/// `--seed-deg` in the model's joint convention, checked against its joint count.
+fn seed_joints(a: &SolveArgs, model: &CompensatedModel) -> anyhow::Result<Option<Vec<f64>>> {
+    let Some(s) = &a.seed_deg else {
+        return Ok(None);
+    };
+    let q = parse_seed(s)?;
+    if q.len() != model.dof() {
+        bail!(
+            "--seed-deg needs {} joint values, got {}",
+            model.dof(),
+            q.len()
+        );
+    }
+    Ok(Some(model.nominal.joints_from_controller(&q)))
+}
+
+/// A targets file's rows on a positioner: the positioner and each row's
+/// values of its two axes [deg].
+struct PlateRows {
+    /// The positioner file.
+    path: String,
+    positioner: TiltRotate,
+    tilt: Vec<TargetValue>,
+    rotate: Vec<TargetValue>,
+}
+
+impl PlateRows {
+    /// Moves `csv`'s targets (face plate frame) into `model`'s base frame
+    /// at each row's values; the frame's name for the output's header.
+    fn place(&self, csv: &mut crate::solve::ik::TargetsCsv, model: &CompensatedModel) -> String {
+        place_on_positioner(
+            csv,
+            &self.tilt,
+            &self.rotate,
+            &self.positioner,
+            &model.cell_from_base,
+        );
+        format!(
+            "face plate of positioner {} at each row's e1 (tilt), e2 (rotate)",
+            self.path
+        )
+    }
+}
+
+/// `--positioner FILE`: the positioner and the targets file's `e1` (tilt)
+/// and `e2` (rotate) columns, both required.
+fn positioner_rows(
+    path: &str,
+    file: &str,
+    text: &str,
+    dialect: crate::measure::csv_text::Dialect,
+) -> anyhow::Result<PlateRows> {
+    let json = std::fs::read_to_string(path)
+        .with_context(|| format!("cannot read positioner file {path}"))?;
+    let positioner =
+        TiltRotate::from_json(&json).with_context(|| format!("positioner file {path}"))?;
+    let column = |name: &str, role: &str| -> anyhow::Result<Vec<TargetValue>> {
+        target_column_values(text, dialect, name)
+            .with_context(|| file.to_string())?
+            .with_context(|| {
+                format!("{file}: --positioner reads each row's {role} value [deg] from an `{name}` column, and the file has none")
+            })
+    };
+    Ok(PlateRows {
+        path: path.to_string(),
+        tilt: column(TILT_COLUMN, "tilt (axis 1)")?,
+        rotate: column(ROTATE_COLUMN, "rotate (axis 2)")?,
+        positioner,
     })
 }
 

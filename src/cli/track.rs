@@ -38,7 +38,7 @@ use robocal_core::model::calibrated::CompensatedModel;
 use robocal_core::model::external::travel_map::MAX_MAP_ORDER;
 use robocal_core::model::external::LinearTrack;
 use robocal_core::solve::external::{
-    carried, target_track_values, track_values, RowValue, TargetTrackValue, TRACK_COLUMN,
+    carried, target_track_values, track_values, RowValue, TargetValue, TRACK_COLUMN,
 };
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -152,7 +152,7 @@ impl OnTrack {
         file: &str,
         text: &str,
         dialect: Dialect,
-    ) -> anyhow::Result<Option<(LinearTrack, Vec<TargetTrackValue>)>> {
+    ) -> anyhow::Result<Option<(LinearTrack, Vec<TargetValue>)>> {
         let values = target_track_values(text, dialect).with_context(|| file.to_string())?;
         if self.track.is_none() {
             if values.is_some() {

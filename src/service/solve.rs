@@ -36,7 +36,7 @@ use crate::solve::ik::{
     IkSettings, IkSolver, SolveMode, SolveOptions, TargetInput, TargetResult, TargetsCsv,
 };
 use robocal_core::model::calibrated::{CalibratedModelFile, CompensatedModel};
-use robocal_core::solve::external::{place_on_track, TargetTrackValue};
+use robocal_core::solve::external::{place_on_track, TargetValue};
 use std::sync::Arc;
 
 /// Which model to solve with.
@@ -148,7 +148,7 @@ pub struct SolveCommand {
     /// A track value per row of a targets CSV (its `e1` column): each row
     /// moved into the base frame at its value along the stored track
     /// (`core::solve::external::place_on_track`; the cached solver serves).
-    pub track_rows: Option<Vec<TargetTrackValue>>,
+    pub track_rows: Option<Vec<TargetValue>>,
 }
 
 /// A tool or work object of a solve: stored by name, or given inline.

@@ -30,10 +30,12 @@ pub enum TrackColumnError {
     #[error(transparent)]
     Shape(#[from] FieldCount),
     /// The header names the column twice.
-    #[error("line {line}: the header names `{TRACK_COLUMN}` twice")]
+    #[error("line {line}: the header names `{column}` twice")]
     Duplicate {
         /// 1-based line of the header.
         line: usize,
+        /// The column.
+        column: String,
     },
     /// A row's value is not a finite number.
     #[error("line {line}: `{TRACK_COLUMN}` is `{value}`, not a finite number of mm")]
@@ -66,6 +68,7 @@ pub fn track_values(
     if at.next().is_some() {
         return Err(TrackColumnError::Duplicate {
             line: table.header_line,
+            column: TRACK_COLUMN.to_string(),
         });
     }
     table
@@ -122,7 +125,10 @@ mod tests {
         );
         assert_eq!(
             track_values("e1,q1,e1\n1,2,3\n", d).unwrap_err(),
-            TrackColumnError::Duplicate { line: 1 }
+            TrackColumnError::Duplicate {
+                line: 1,
+                column: "e1".into()
+            }
         );
     }
 }

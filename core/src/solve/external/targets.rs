@@ -1,6 +1,10 @@
-//! A track value per row of a targets file: the `e1` column beside a
-//! target's `x, y, z` and orientation, each target solved with the robot's
-//! base carried to its own value along a calibrated [`LinearTrack`].
+//! External-axis values per row of a targets file, each target moved into
+//! the robot's base frame at its own values: a track's `e1` column, the
+//! robot's base carried along a calibrated [`LinearTrack`]
+//! ([`place_on_track`]); or a positioner's `e1` (tilt) and `e2` (rotate)
+//! columns, the target given in its face plate frame
+//! ([`place_on_positioner`]: `robot_cell_from_base⁻¹·F(v)·T`,
+//! `solve::external::positioner`).
 //!
 //! Frames: a target `T` in the track's cell frame (the tracker frame the
 //! track was measured in) is the base-frame target `B(e)⁻¹·T`, with
@@ -12,41 +16,56 @@
 //! Every target is then solved in the base frame by one solver, so a path
 //! (each target seeded by the one before) runs across track values.
 //!
-//! Units: track values in mm as the controller shows them; positions in mm
-//! and orientations in each row's convention at the boundary, SI inside.
+//! Units: track values in mm, positioner values in degrees, as the
+//! controller shows them; positions in mm and orientations in each row's
+//! convention at the boundary, SI inside.
 //!
 //! A row fails alone (`invalid_target`, naming its line and the column) when
 //! its value is empty, not a finite number, or beyond the travel the track
 //! was measured over ([`RowError::OutsideTravel`]): never extrapolated, never
 //! skipped.
 
+use super::positioner::AxisValues;
 use super::rows::{TrackColumnError, TRACK_COLUMN};
 use crate::measure::csv_text::{self, short_text, Dialect};
-use crate::model::external::LinearTrack;
+use crate::model::external::{LinearTrack, TiltRotate};
 use crate::model::orientation::{rotation_from, rotation_to};
 use crate::model::Pose;
 use crate::solve::cell::{WorkObject, WorkObjectFrame};
 use crate::solve::ik::{FalseTarget, RowError, TargetFrame, TargetInput, TargetResult, TargetsCsv};
 use nalgebra::Vector3;
 
-/// One targets-file row's track value, or why the row has none.
+/// One targets-file row's value of an external axis (a track's [mm], a
+/// positioner axis's [deg]), or why the row has none.
 #[derive(Debug, Clone, PartialEq)]
-pub struct TargetTrackValue {
+pub struct TargetValue {
     /// 1-based line of the row in the text.
     pub line: usize,
-    /// The value [mm], or the row's error (the row fails alone).
-    pub value_mm: Result<f64, RowError>,
+    /// The value, or the row's error (the row fails alone).
+    pub value: Result<f64, RowError>,
 }
 
 /// The `e1` value of every row of a targets file `text`, or `None` when its
-/// header has no `e1` column (any ASCII case) or it has no header. A row
-/// whose field count is not the header's, or whose value is not a finite
-/// number, carries its error (it fails alone, as every malformed targets
-/// row); a header naming `e1` twice refuses the file.
+/// header has no `e1` column (any ASCII case) or it has no header
+/// ([`target_column_values`]).
 pub fn target_track_values(
     text: &str,
     dialect: Dialect,
-) -> Result<Option<Vec<TargetTrackValue>>, TrackColumnError> {
+) -> Result<Option<Vec<TargetValue>>, TrackColumnError> {
+    target_column_values(text, dialect, TRACK_COLUMN)
+}
+
+/// The values of column `column` (any ASCII case) of every row of a
+/// targets file `text`, or `None` when its header has no such column or it
+/// has no header. A row whose field count is not the header's, or whose
+/// value is not a finite number, carries its error (it fails alone, as
+/// every malformed targets row); a header naming the column twice refuses
+/// the file.
+pub fn target_column_values(
+    text: &str,
+    dialect: Dialect,
+    column: &str,
+) -> Result<Option<Vec<TargetValue>>, TrackColumnError> {
     let Some(table) = csv_text::read(text, dialect)? else {
         return Ok(None);
     };
@@ -54,7 +73,7 @@ pub fn target_track_values(
         .header
         .iter()
         .enumerate()
-        .filter(|(_, h)| h.eq_ignore_ascii_case(TRACK_COLUMN))
+        .filter(|(_, h)| h.eq_ignore_ascii_case(column))
         .map(|(i, _)| i);
     let Some(col) = at.next() else {
         return Ok(None);
@@ -62,6 +81,7 @@ pub fn target_track_values(
     if at.next().is_some() {
         return Err(TrackColumnError::Duplicate {
             line: table.header_line,
+            column: column.to_string(),
         });
     }
     let column = table.header[col].clone();
@@ -69,7 +89,7 @@ pub fn target_track_values(
         .records
         .iter()
         .map(|r| {
-            let value_mm = table.check_shape(r).map_err(RowError::from).and_then(|()| {
+            let value = table.check_shape(r).map_err(RowError::from).and_then(|()| {
                 let field = &r.fields[col];
                 table
                     .number(field)
@@ -80,9 +100,9 @@ pub fn target_track_values(
                         value: short_text(field),
                     })
             });
-            TargetTrackValue {
+            TargetValue {
                 line: r.line,
-                value_mm,
+                value,
             }
         })
         .collect();
@@ -119,50 +139,95 @@ impl PlacedRows {
 /// alone, naming its line and column `column`).
 pub fn place_on_track(
     csv: &mut TargetsCsv,
-    values: &[TargetTrackValue],
+    values: &[TargetValue],
     track: &LinearTrack,
     frame: TargetFrame,
     work_object: Option<&WorkObject>,
 ) -> PlacedRows {
+    place(csv, |line| {
+        let v = value_at(values, line, TRACK_COLUMN)?;
+        let b = track
+            .cell_from_base(v)
+            .map_err(|travel| RowError::OutsideTravel {
+                line,
+                column: TRACK_COLUMN.into(),
+                travel,
+            })?;
+        Ok(match (work_object, frame) {
+            (Some(w), _) => {
+                let wb = match w.frame {
+                    WorkObjectFrame::Base => w.pose,
+                    WorkObjectFrame::Measurement => b.inverse().compose(&w.pose),
+                };
+                (wb, Some(wb))
+            }
+            (None, TargetFrame::Cell) => (b.inverse(), None),
+            (None, TargetFrame::Base) => (Pose::identity(), None),
+        })
+    })
+}
+
+/// Moves every valid row of `csv`, a target `T` given in a positioner's
+/// face plate frame, into the robot's base frame at its row's axis values
+/// (`tilt` and `rotate` [deg], matched by line):
+/// `robot_cell_from_base⁻¹·F(v)·T` (`solve::external::positioner`; the
+/// robot and the positioner registered in the same cell frame). The
+/// targets are then solved with `TargetFrame::Base`; their false targets
+/// stay in the controller's base frame. A row without a number in either
+/// column becomes invalid (it fails alone, naming its line and column).
+pub fn place_on_positioner(
+    csv: &mut TargetsCsv,
+    tilt: &[TargetValue],
+    rotate: &[TargetValue],
+    positioner: &TiltRotate,
+    robot_cell_from_base: &Pose,
+) -> PlacedRows {
+    let base_from_cell = robot_cell_from_base.inverse();
+    place(csv, |line| {
+        let values = AxisValues {
+            tilt_deg: value_at(tilt, line, TILT_COLUMN)?,
+            rotate_deg: value_at(rotate, line, ROTATE_COLUMN)?,
+        };
+        let w = base_from_cell.compose(&positioner.cell_from_face_plate(values.as_array()));
+        Ok((w, None))
+    })
+}
+
+/// The columns of a positioner's axes in a targets file: axis 1 (tilt).
+pub const TILT_COLUMN: &str = "e1";
+/// The columns of a positioner's axes in a targets file: axis 2 (rotate).
+pub const ROTATE_COLUMN: &str = "e2";
+
+/// Row `line`'s value in `values`, or its error (no value read: empty).
+fn value_at(values: &[TargetValue], line: usize, column: &str) -> Result<f64, RowError> {
+    values.iter().find(|v| v.line == line).map_or_else(
+        || {
+            Err(RowError::NotNumber {
+                line,
+                column: column.into(),
+                value: String::new(),
+            })
+        },
+        |v| v.value.clone(),
+    )
+}
+
+/// Moves each valid row's target by the pose `frame_of(line)` gives (`W`,
+/// and the work object its false target is returned in), or makes the row
+/// invalid with its error.
+fn place(
+    csv: &mut TargetsCsv,
+    mut frame_of: impl FnMut(usize) -> Result<(Pose, Option<Pose>), RowError>,
+) -> PlacedRows {
     let mut work_objects = Vec::with_capacity(csv.rows.len());
     for row in &mut csv.rows {
-        let value = values.iter().find(|v| v.line == row.line).map_or_else(
-            || {
-                Err(RowError::NotNumber {
-                    line: row.line,
-                    column: TRACK_COLUMN.into(),
-                    value: String::new(),
-                })
-            },
-            |v| v.value_mm.clone(),
-        );
-        let base = value.and_then(|v| {
-            track
-                .cell_from_base(v)
-                .map_err(|travel| RowError::OutsideTravel {
-                    line: row.line,
-                    column: TRACK_COLUMN.into(),
-                    travel,
-                })
-        });
         let mut back = None;
         if let Ok(target) = &mut row.target {
-            match base {
+            match frame_of(row.line) {
                 Err(e) => row.target = Err(e),
-                Ok(b) => {
-                    let w = match (work_object, frame) {
-                        (Some(w), _) => {
-                            let wb = match w.frame {
-                                WorkObjectFrame::Base => w.pose,
-                                WorkObjectFrame::Measurement => b.inverse().compose(&w.pose),
-                            };
-                            back = Some(wb);
-                            wb
-                        }
-                        (None, TargetFrame::Cell) => b.inverse(),
-                        (None, TargetFrame::Base) => Pose::identity(),
-                    };
+                Ok((w, b)) => {
                     *target = moved(&w, target);
+                    back = b;
                 }
             }
         }
@@ -266,5 +331,35 @@ mod tests {
         let wb = placed.work_objects[0].unwrap();
         assert!((wb.p - Vector3::new(0.3, 0.0, 0.0)).norm() < 1e-12);
         assert_eq!(target_track_values("x,y,z\n1,2,3\n", d).unwrap(), None);
+    }
+
+    /// Closed form: a turntable (axis 1 at 0) at a quarter turn carries a
+    /// target at (1, 0, 0) on the plate, 0.5 m above the base, to (0, 1,
+    /// 0.5) in a robot base standing at the cell's origin; a row without its
+    /// rotate value fails alone.
+    #[test]
+    fn a_target_on_the_face_plate_is_moved_by_its_rows_axis_values() {
+        use crate::model::external::RotaryAxis;
+        let p = TiltRotate {
+            cell_from_base: Pose::identity(),
+            tilt: RotaryAxis::new(Vector3::x(), Vector3::zeros(), 0.0, 1.0),
+            rotate: RotaryAxis::new(Vector3::z(), Vector3::zeros(), 0.0, 1.0),
+            face_plate: Pose::from_translation(Vector3::new(0.0, 0.0, 0.5)),
+        };
+        let text = "x,y,z,e1,e2\n1000,0,0,0,90\n1000,0,0,0,\n";
+        let d = Dialect::default();
+        let tilt = target_column_values(text, d, TILT_COLUMN).unwrap().unwrap();
+        let rotate = target_column_values(text, d, ROTATE_COLUMN)
+            .unwrap()
+            .unwrap();
+        let mut csv = parse_targets_csv_beside(text, d, &["e1", "e2"]).unwrap();
+        place_on_positioner(&mut csv, &tilt, &rotate, &p, &Pose::identity());
+        let at = csv.rows[0].target.as_ref().unwrap().xyz_mm;
+        assert!(
+            (Vector3::from(at) - Vector3::new(0.0, 1000.0, 500.0)).norm() < 1e-9,
+            "{at:?}"
+        );
+        let e = csv.rows[1].target.as_ref().unwrap_err().to_string();
+        assert_eq!(e, "line 3: column `e2`: `` is not a number");
     }
 }
