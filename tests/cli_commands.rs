@@ -191,6 +191,7 @@ fn cli_args(model: &str, targets: &str) -> SolveArgs {
         decimal: None,
         failures: Default::default(),
         track: Default::default(),
+        positioner: None,
     }
 }
 

@@ -7,8 +7,8 @@
 //! measurement file with an `e1` column. The fitted track, the predicted
 //! poses and the solved joints are checked against the truth at track
 //! values the fit never saw; refusals exit with `refused` (1) and write
-//! nothing. `predict --track` without `--e1` takes each row's track value
-//! from the joints file's `e1` column.
+//! nothing. `predict --track` and `solve --track` without `--e1` take each
+//! row's track value from the joints or targets file's `e1` column.
 
 use nalgebra::{UnitQuaternion, Vector3};
 use rand::SeedableRng;
@@ -481,5 +481,160 @@ fn predict_reads_a_track_value_per_row_from_the_joints_file() {
         ],
     );
     assert_eq!(code(&out), 1);
-    assert!(text(&out.stderr).contains("--track needs --e1 MM"));
+    assert!(
+        text(&out.stderr).contains("has none: add the column (mm) or give --e1 MM"),
+        "{}",
+        text(&out.stderr)
+    );
+}
+
+/// Solved joints of a `solve --json` document, model convention [rad].
+fn solved_joints(cell: &Cell, t: &serde_json::Value) -> Vec<f64> {
+    let rad: Vec<f64> = t["joints_deg"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap().to_radians())
+        .collect();
+    cell.nominal.joints_from_controller(&rad)
+}
+
+#[test]
+fn solve_reads_a_track_value_per_row_from_the_targets_file() {
+    let mut rng = ChaCha8Rng::seed_from_u64(8);
+    let cell = Cell::new(&mut rng);
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    save_robot(&cell, d);
+    let set = cell.measure(&STATIONS, 15, &mut rng);
+    std::fs::write(d.join("track.csv"), write_set(&set)).unwrap();
+    let out = track_calibrate(d, "track.csv", &[]);
+    assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+
+    // Poses the true robot reached at three values the fit never saw, each
+    // row with its own `e1`.
+    let values = [200.0, HELD_OUT_MM, 2600.0];
+    let qs = random_configurations(&cell.nominal, 9, &mut rng);
+    let target = |i: usize, q: &[f64], v: f64| {
+        let t = cell.true_pose(q, v);
+        let u = UnitQuaternion::from_matrix(&t.r);
+        format!(
+            "t{i},{}",
+            row(&[t.p.x * 1e3, t.p.y * 1e3, t.p.z * 1e3, u.w, u.i, u.j, u.k])
+        )
+    };
+    let rows: Vec<String> = qs
+        .iter()
+        .enumerate()
+        .map(|(i, q)| format!("{},{}", target(i, q, values[i % 3]), values[i % 3]))
+        .collect();
+    let header = "id,x,y,z,qw,qx,qy,qz,e1";
+    std::fs::write(
+        d.join("rows.csv"),
+        format!("{header}\n{}\n", rows.join("\n")),
+    )
+    .unwrap();
+    let solve = |targets: &str, extra: &[&str]| {
+        let mut args = vec![
+            "solve",
+            "--model",
+            "robot.json",
+            "--targets",
+            targets,
+            "--track",
+            "rail.json",
+            "--json",
+        ];
+        args.extend_from_slice(extra);
+        robocal(d, &args)
+    };
+    for extra in [&[][..], &["--path"][..]] {
+        let out = solve("rows.csv", extra);
+        assert_eq!(code(&out), 0, "{extra:?}: {}", text(&out.stderr));
+        let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(doc["frame"], "cell (track rail.json at each row's e1)");
+        let solved = doc["targets"].as_array().unwrap();
+        assert_eq!(solved.len(), qs.len());
+        // The true robot at each row's solved joints, at that row's value,
+        // within 0.05 mm of the pose it reached there.
+        for (i, (q, t)) in qs.iter().zip(solved).enumerate() {
+            let v = values[i % 3];
+            let got = cell.true_pose(&solved_joints(&cell, t), v).p;
+            let miss = (got - cell.true_pose(q, v).p).norm();
+            assert!(miss < 0.05e-3, "{extra:?} row {i}: {} mm", miss * 1e3);
+        }
+    }
+    // Each row as `--e1` solves it alone: the same joints.
+    let out = solve("rows.csv", &[]);
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for (i, q) in qs.iter().enumerate().take(3) {
+        let v = values[i % 3];
+        std::fs::write(
+            d.join("one.csv"),
+            format!("id,x,y,z,qw,qx,qy,qz\n{}\n", target(i, q, v)),
+        )
+        .unwrap();
+        let e1 = v.to_string();
+        let out = solve("one.csv", &["--e1", &e1]);
+        assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+        let one: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let a = numbers(&one["targets"][0]["joints_deg"]);
+        let b = numbers(&doc["targets"][i]["joints_deg"]);
+        for (x, y) in a.iter().zip(&b) {
+            assert!((x - y).abs() < 1e-6, "row {i}: {a:?} {b:?}");
+        }
+    }
+
+    // A row beyond the travel, and one whose value is not a number, fail
+    // alone (exit 2) naming their lines; the others are solved.
+    let mut bad = rows.clone();
+    bad[2] = format!("{},4500", target(2, &qs[2], values[2]));
+    bad[5] = format!("{},", target(5, &qs[5], values[2]));
+    std::fs::write(d.join("bad.csv"), format!("{header}\n{}\n", bad.join("\n"))).unwrap();
+    let out = solve("bad.csv", &[]);
+    assert_eq!(code(&out), 2, "{}", text(&out.stderr));
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let results = doc["targets"].as_array().unwrap();
+    let failed: Vec<usize> = (0..results.len())
+        .filter(|&i| results[i]["status"] != "ok")
+        .collect();
+    assert_eq!(failed, vec![2, 5], "{doc}");
+    assert_eq!(results[2]["reason"], "invalid_target");
+    let m = results[2]["message"].as_str().unwrap();
+    assert!(
+        m.contains(
+            "line 4: column `e1`: value 4500 mm is outside the travel measured, [0, 4000] mm"
+        ),
+        "{m}"
+    );
+    let m = results[5]["message"].as_str().unwrap();
+    assert!(m.contains("line 7: column `e1`: `` is not a number"), "{m}");
+
+    // `--e1` beside the column is ambiguous; the column without `--track`
+    // would solve the rows as if the track stood still: both refused.
+    let out = solve("rows.csv", &["--e1", "1000"]);
+    assert_eq!(code(&out), 1);
+    assert!(
+        text(&out.stderr).contains("ambiguous"),
+        "{}",
+        text(&out.stderr)
+    );
+    let out = robocal(
+        d,
+        &["solve", "--model", "robot.json", "--targets", "rows.csv"],
+    );
+    assert_eq!(code(&out), 1);
+    assert!(
+        text(&out.stderr).contains("give --track FILE"),
+        "{}",
+        text(&out.stderr)
+    );
+}
+
+fn numbers(v: &serde_json::Value) -> Vec<f64> {
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect()
 }

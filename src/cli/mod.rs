@@ -15,6 +15,7 @@ pub mod keygen;
 pub mod model_files;
 pub mod orientation_arg;
 pub mod plan;
+pub mod positioner;
 pub mod predict;
 pub mod progress;
 pub mod reregister;
@@ -93,6 +94,9 @@ pub enum Command {
     /// A robot on a linear track: fit the track from tracker readings at several track values.
     #[command(after_help = exit::help_for("track"))]
     Track(track::TrackArgs),
+    /// A two-axis positioner: fit its axes from tracker readings of reflectors on its face plate.
+    #[command(after_help = exit::help_for("positioner"))]
+    Positioner(positioner::PositionerArgs),
     /// Run the HTTP service.
     #[command(after_help = exit::help_for("serve"))]
     Serve(serve::ServeArgs),
@@ -126,6 +130,7 @@ pub fn run(cli: Cli) -> anyhow::Result<exit::Exit> {
         Command::Tcp(a) => done(tcp::run_tcp(a)),
         Command::WorkObject(a) => done(tcp::run_work_object(a)),
         Command::Track(a) => done(track::run(a)),
+        Command::Positioner(a) => done(positioner::run(a)),
         Command::Serve(a) => done(serve::run(a)),
         Command::Keygen(a) => done(keygen::run(a)),
         Command::Bench(a) => done(bench::run(a)),

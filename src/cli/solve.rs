@@ -20,19 +20,30 @@
 //! the calibrated flange; with `--work-object NAME` the targets and the false
 //! targets are poses in that work object (`core::cell`). With `--track FILE
 //! --e1 MM` the robot's base is carried along a calibrated track to that
-//! value and the cell frame is the track's (`super::track`); the false
-//! targets stay in the controller's base frame.
+//! value and the cell frame is the track's (`super::track`); with `--track`
+//! alone each row's value is the targets file's `e1` column
+//! (`solve::external::targets`: a row beyond the travel, or without a
+//! number there, fails alone). With `--positioner FILE` the targets are in
+//! a calibrated positioner's face plate frame, each row at its `e1` (tilt)
+//! and `e2` (rotate) values [deg] (`solve::external::place_on_positioner`).
+//! The false targets stay in the controller's base frame (or the work
+//! object).
 
 use crate::measure::csv_text::dialect_from_names;
 use crate::model::orientation::OrientationConvention;
 use crate::solve::cell::{CellRef, CellSolver};
-use crate::solve::ik::targets_csv::CONVENTION_COLUMNS;
+use crate::solve::ik::targets_csv::{parse_targets_csv_beside, CONVENTION_COLUMNS};
 use crate::solve::ik::{
-    parse_targets_csv, results_csv, Configuration, IkSettings, SolveOptions, TargetFrame,
-    TargetResult,
+    results_csv, Configuration, IkSettings, SolveOptions, TargetFrame, TargetResult,
 };
 use anyhow::{bail, Context};
 use clap::{Args, ValueEnum};
+use robocal_core::model::calibrated::CompensatedModel;
+use robocal_core::model::external::TiltRotate;
+use robocal_core::solve::external::{
+    place_on_positioner, place_on_track, target_column_values, TargetValue, ROTATE_COLUMN,
+    TILT_COLUMN, TRACK_COLUMN,
+};
 use serde_json::json;
 use std::fmt::Write as _;
 
@@ -73,6 +84,7 @@ pub struct SolveArgs {
     /// one convention, angles in degrees: `qw,qx,qy,qz` (quaternion) |
     /// `q1,q2,q3,q4` (ABB) | `ur_rx_rad,ur_ry_rad,ur_rz_rad` (UR, radians) | `a,b,c`
     /// (KUKA) | `w,p,r` (Fanuc) | `r11..r33` (matrix); `#` starts a comment line.
+    /// With --track and no --e1, an `e1` column: each row's track value [mm].
     #[arg(long)]
     pub targets: String,
     /// Payload mass [kg] (default: the model file's payload).
@@ -130,6 +142,11 @@ pub struct SolveArgs {
     pub failures: super::exit::AllowFailures,
     #[command(flatten)]
     pub track: super::track::OnTrack,
+    /// Calibrated positioner (`robocal positioner calibrate --out`, in the
+    /// robot's measurement frame): the targets are in its face plate frame,
+    /// each row at its `e1` (tilt) and `e2` (rotate) values [deg].
+    #[arg(long, conflicts_with_all = ["work_object", "track"])]
+    pub positioner: Option<String>,
 }
 
 /// How `robocal solve` prints its results.
@@ -165,12 +182,29 @@ pub fn solve_to_string(a: &SolveArgs) -> anyhow::Result<String> {
 
 /// What the command prints and how many targets failed.
 pub fn solve_outcome(a: &SolveArgs) -> anyhow::Result<super::exit::Outcome> {
-    let model = a.track.carry(super::model_files::load_with_payload(
-        &a.model,
-        a.payload_kg,
-    )?)?;
+    let text = std::fs::read_to_string(&a.targets)
+        .with_context(|| format!("cannot read targets file {}", a.targets))?;
+    let dialect = dialect_from_names(a.delimiter.as_deref(), a.decimal.as_deref())
+        .map_err(anyhow::Error::msg)?;
+    let on_plate = match &a.positioner {
+        Some(path) => Some(positioner_rows(path, &a.targets, &text, dialect)?),
+        None => None,
+    };
+    // `--track` without `--e1`: each row's value from the file's `e1` column.
+    let per_row = match on_plate {
+        Some(_) => None,
+        None => a.track.per_target(&a.targets, &text, dialect)?,
+    };
+    let loaded = super::model_files::load_with_payload(&a.model, a.payload_kg)?;
+    let model = match per_row {
+        Some(_) => loaded,
+        None => a.track.carry(loaded)?,
+    };
     let mut frame: TargetFrame = a.frame.parse().map_err(anyhow::Error::msg)?;
-    let mut frame_label = a.track.label(frame.to_string());
+    let mut frame_label = match per_row {
+        Some(_) => a.track.label_per_row(frame.to_string()),
+        None => a.track.label(frame.to_string()),
+    };
     let cell = super::model_files::load_cell(a.cell.as_deref())?;
     let tool = match &a.tool {
         Some(t) => Some(cell.tool(&t.parse::<CellRef>()?)?),
@@ -191,28 +225,18 @@ pub fn solve_outcome(a: &SolveArgs) -> anyhow::Result<super::exit::Outcome> {
         .map(Configuration::parse)
         .transpose()
         .map_err(|e| anyhow::anyhow!("--branch: {e}"))?;
-    let seed = match &a.seed_deg {
-        None => None,
-        Some(s) => {
-            let q = parse_seed(s)?;
-            if q.len() != model.dof() {
-                bail!(
-                    "--seed-deg needs {} joint values, got {}",
-                    model.dof(),
-                    q.len()
-                );
-            }
-            Some(model.nominal.joints_from_controller(&q))
-        }
-    };
+    let seed = seed_joints(a, &model)?;
     if !(a.jump_deg.is_finite() && a.jump_deg > 0.0) {
         bail!("--jump-deg must be a positive number of degrees");
     }
-    let text = std::fs::read_to_string(&a.targets)
-        .with_context(|| format!("cannot read targets file {}", a.targets))?;
-    let dialect = dialect_from_names(a.delimiter.as_deref(), a.decimal.as_deref())
-        .map_err(anyhow::Error::msg)?;
-    let mut csv = parse_targets_csv(&text, dialect).with_context(|| a.targets.clone())?;
+    // The external-axis columns read per row, passed over by the parser.
+    let beside: &[&str] = match (&on_plate, &per_row) {
+        (Some(_), _) => &[TILT_COLUMN, ROTATE_COLUMN],
+        (None, Some(_)) => &[TRACK_COLUMN],
+        (None, None) => &[],
+    };
+    let mut csv =
+        parse_targets_csv_beside(&text, dialect, beside).with_context(|| a.targets.clone())?;
     if csv.convention.is_none() && !a.position_only {
         bail!(
             "{}: no orientation columns ({CONVENTION_COLUMNS}); add them or pass --position-only",
@@ -225,12 +249,23 @@ pub fn solve_outcome(a: &SolveArgs) -> anyhow::Result<super::exit::Outcome> {
         ..IkSettings::default()
     };
     let cell_solver = CellSolver::for_tool(&model, tool.as_ref(), settings);
-    let in_work_object = work_object.as_ref().map(|w| {
-        cell_solver.targets_in(
+    // Per row: each target moved into the base frame at its own value.
+    let on_track = per_row.as_ref().map(|(track, values)| {
+        let placed = place_on_track(&mut csv, values, track, frame, work_object.as_ref());
+        frame = TargetFrame::Base;
+        placed
+    });
+    if let Some(rows) = &on_plate {
+        frame_label = rows.place(&mut csv, &model);
+        frame = TargetFrame::Base;
+    }
+    let in_work_object = match (&work_object, &on_track) {
+        (Some(w), None) => Some(cell_solver.targets_in(
             w,
             csv.rows.iter_mut().filter_map(|r| r.target.as_mut().ok()),
-        )
-    });
+        )),
+        _ => None,
+    };
     let solver = cell_solver.solver();
     let payload = solver.model().payload_kg;
     let options = SolveOptions {
@@ -244,6 +279,9 @@ pub fn solve_outcome(a: &SolveArgs) -> anyhow::Result<super::exit::Outcome> {
     if let Some(w) = &in_work_object {
         w.false_targets_back(&mut results);
     }
+    if let Some(placed) = &on_track {
+        placed.false_targets_back(&mut results);
+    }
     let conv = csv.convention.unwrap_or(OrientationConvention::Quaternion);
     let header = Header {
         model: &a.model,
@@ -255,15 +293,90 @@ pub fn solve_outcome(a: &SolveArgs) -> anyhow::Result<super::exit::Outcome> {
         closed_form: solver.analytic().is_some(),
     };
     let format = if a.json { OutputFormat::Json } else { a.format };
-    let text = match format {
-        OutputFormat::Json => render_json(&header, &results),
-        OutputFormat::Table => render_table(&header, &results, solver.model().dof()),
-        OutputFormat::Csv => results_csv(&results, solver.model().dof(), conv),
-    };
     Ok(super::exit::Outcome {
-        text,
+        text: render(format, &header, &results, solver.model().dof()),
         not_done: results.iter().filter(|r| !r.solution.converged).count(),
         total: results.len(),
+    })
+}
+
+/// The results as `format` prints them.
+fn render(format: OutputFormat, h: &Header, results: &[TargetResult], dof: usize) -> String {
+    match format {
+        OutputFormat::Json => render_json(h, results),
+        OutputFormat::Table => render_table(h, results, dof),
+        OutputFormat::Csv => results_csv(results, dof, h.convention),
+    }
+}
+
+/// `--seed-deg` in the model's joint convention, checked against its joint count.
+fn seed_joints(a: &SolveArgs, model: &CompensatedModel) -> anyhow::Result<Option<Vec<f64>>> {
+    let Some(s) = &a.seed_deg else {
+        return Ok(None);
+    };
+    let q = parse_seed(s)?;
+    if q.len() != model.dof() {
+        bail!(
+            "--seed-deg needs {} joint values, got {}",
+            model.dof(),
+            q.len()
+        );
+    }
+    Ok(Some(model.nominal.joints_from_controller(&q)))
+}
+
+/// A targets file's rows on a positioner: the positioner and each row's
+/// values of its two axes [deg].
+struct PlateRows {
+    /// The positioner file.
+    path: String,
+    positioner: TiltRotate,
+    tilt: Vec<TargetValue>,
+    rotate: Vec<TargetValue>,
+}
+
+impl PlateRows {
+    /// Moves `csv`'s targets (face plate frame) into `model`'s base frame
+    /// at each row's values; the frame's name for the output's header.
+    fn place(&self, csv: &mut crate::solve::ik::TargetsCsv, model: &CompensatedModel) -> String {
+        place_on_positioner(
+            csv,
+            &self.tilt,
+            &self.rotate,
+            &self.positioner,
+            &model.cell_from_base,
+        );
+        format!(
+            "face plate of positioner {} at each row's e1 (tilt), e2 (rotate)",
+            self.path
+        )
+    }
+}
+
+/// `--positioner FILE`: the positioner and the targets file's `e1` (tilt)
+/// and `e2` (rotate) columns, both required.
+fn positioner_rows(
+    path: &str,
+    file: &str,
+    text: &str,
+    dialect: crate::measure::csv_text::Dialect,
+) -> anyhow::Result<PlateRows> {
+    let json = std::fs::read_to_string(path)
+        .with_context(|| format!("cannot read positioner file {path}"))?;
+    let positioner =
+        TiltRotate::from_json(&json).with_context(|| format!("positioner file {path}"))?;
+    let column = |name: &str, role: &str| -> anyhow::Result<Vec<TargetValue>> {
+        target_column_values(text, dialect, name)
+            .with_context(|| file.to_string())?
+            .with_context(|| {
+                format!("{file}: --positioner reads each row's {role} value [deg] from an `{name}` column, and the file has none")
+            })
+    };
+    Ok(PlateRows {
+        path: path.to_string(),
+        tilt: column(TILT_COLUMN, "tilt (axis 1)")?,
+        rotate: column(ROTATE_COLUMN, "rotate (axis 2)")?,
+        positioner,
     })
 }
 

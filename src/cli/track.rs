@@ -19,10 +19,11 @@
 //! `predict` and `solve` with `--track TRACK.json --e1 MM` carry the robot's
 //! base to that track value (`solve::external::carried`): the cell frame is
 //! the track's (the tracker frame it was measured in); a value outside the
-//! travel measured is refused (exit 1). `predict --track` without `--e1`
-//! reads each row's value from the joints file's `e1` column
-//! (`solve::external::track_values`); `--e1` and such a column together are
-//! refused as ambiguous.
+//! travel measured is refused (exit 1). `predict --track` and `solve
+//! --track` without `--e1` read each row's value from the joints or targets
+//! file's `e1` column (`solve::external::track_values`,
+//! `solve::external::target_track_values`; a row beyond the travel fails
+//! alone); `--e1` and such a column together are refused as ambiguous.
 
 use super::model_files::load_with_payload;
 use anyhow::Context;
@@ -36,7 +37,9 @@ use robocal_core::measure::external::{ExternalAxis, MeasurementSet};
 use robocal_core::model::calibrated::CompensatedModel;
 use robocal_core::model::external::travel_map::MAX_MAP_ORDER;
 use robocal_core::model::external::LinearTrack;
-use robocal_core::solve::external::{carried, track_values, RowValue, TRACK_COLUMN};
+use robocal_core::solve::external::{
+    carried, target_track_values, track_values, RowValue, TargetValue, TRACK_COLUMN,
+};
 use serde::Serialize;
 use std::fmt::Write as _;
 
@@ -96,8 +99,9 @@ fn parse_axis(s: &str) -> Result<ExternalAxis, String> {
 #[derive(Debug, Clone, Default, Args)]
 pub struct OnTrack {
     /// Track model (`robocal track calibrate --out`): the robot's base is
-    /// carried to `--e1` along it (predict without `--e1`: to each row's
-    /// `e1` column), and the cell frame is the track's.
+    /// carried to `--e1` along it (without `--e1`: to each row's `e1`
+    /// column of the joints or targets file), and the cell frame is the
+    /// track's.
     #[arg(long)]
     pub track: Option<String>,
     /// The track's value [mm] as the controller shows it (within the travel
@@ -113,7 +117,7 @@ impl OnTrack {
         let (Some(path), Some(value)) = (&self.track, self.e1) else {
             if self.track.is_some() {
                 anyhow::bail!(
-                    "--track needs --e1 MM, the track's value for every target (a targets file carries no `e1` column)"
+                    "--track needs --e1 MM, the track's value for every row, or an `{TRACK_COLUMN}` column in the file"
                 );
             }
             return Ok(model);
@@ -132,10 +136,42 @@ impl OnTrack {
         text: &str,
         dialect: Dialect,
     ) -> anyhow::Result<Option<(LinearTrack, Vec<RowValue>)>> {
+        if self.track.is_none() {
+            return Ok(None);
+        }
+        let values = track_values(text, dialect).with_context(|| file.to_string())?;
+        self.choose(file, values)
+    }
+
+    /// A track value per row of a targets file `file` (its text `text`), as
+    /// [`Self::per_row`] for joints; a row's value that is not a number is
+    /// that row's failure. Without `--track` a file with an `e1` column is
+    /// refused: its rows would be solved as if the track stood still.
+    pub fn per_target(
+        &self,
+        file: &str,
+        text: &str,
+        dialect: Dialect,
+    ) -> anyhow::Result<Option<(LinearTrack, Vec<TargetValue>)>> {
+        let values = target_track_values(text, dialect).with_context(|| file.to_string())?;
+        if self.track.is_none() {
+            if values.is_some() {
+                anyhow::bail!(
+                    "{file}: the file has an `{TRACK_COLUMN}` column (a track value per target): give --track FILE to carry the robot to each row's value"
+                );
+            }
+            return Ok(None);
+        }
+        self.choose(file, values)
+    }
+
+    /// With `--track`: the track and the file's values when the file has
+    /// them and `--e1` is not given; `None` with `--e1` alone; refused with
+    /// both (ambiguous) or neither (no value).
+    fn choose<T>(&self, file: &str, values: Option<T>) -> anyhow::Result<Option<(LinearTrack, T)>> {
         let Some(path) = &self.track else {
             return Ok(None);
         };
-        let values = track_values(text, dialect).with_context(|| file.to_string())?;
         match (self.e1, values) {
             (Some(v), Some(_)) => anyhow::bail!(
                 "{file}: the file has an `{TRACK_COLUMN}` column and --e1 {v} is given: which track value holds is ambiguous; give one or the other"

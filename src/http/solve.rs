@@ -16,7 +16,8 @@
 //! `ik::targets_csv`, the model used in `X-Robocal-Version` /
 //! `X-Robocal-Method`). With `e1` [mm] (body or query) the robot's base is
 //! carried to that value along its stored track and the cell frame is the
-//! track's (`service::tracks::carry`). The handler turns either body into a
+//! track's (`service::tracks::carry`); a targets CSV may instead carry an
+//! `e1` column, a value per row (both: 422). The handler turns either body into a
 //! `service::solve::SolveCommand`; the service picks the model and runs it.
 
 use super::error::{content_type, json_content_type};
@@ -27,15 +28,16 @@ use crate::model::orientation::OrientationConvention;
 use crate::records::CellKind;
 use crate::service;
 use crate::service::solve::{ItemChoice, ModelChoice, SolveCommand, SolveOutcome, Targets};
+use crate::solve::ik::targets_csv::parse_targets_csv_beside;
 use crate::solve::ik::{
-    parse_targets_csv, results_csv, Configuration, JointJump, SolveOptions, TargetFrame,
-    TargetInput, TargetResult,
+    results_csv, Configuration, JointJump, SolveOptions, TargetFrame, TargetInput, TargetResult,
 };
 use axum::body::Bytes;
 use axum::extract::rejection::BytesRejection;
 use axum::extract::State;
 use axum::http::{header, HeaderMap, HeaderName};
 use axum::response::{IntoResponse, Response};
+use robocal_core::solve::external::{target_track_values, TRACK_COLUMN};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::time::Instant;
@@ -383,6 +385,7 @@ fn command(robot_id: i64, c: Common) -> Result<SolveCommand, ApiError> {
         tool: None,
         work_object: None,
         track_mm: c.e1,
+        track_rows: None,
     })
 }
 
@@ -570,7 +573,17 @@ pub fn csv_command(robot_id: i64, q: &CsvSolveQuery, text: &str) -> Result<Solve
         },
     )?;
     let d = dialect(q.decimal.as_deref())?;
-    let csv = parse_targets_csv(text, d)?;
+    // An `e1` column: a track value per row, through the stored track.
+    let rows =
+        target_track_values(text, d).map_err(|e| ApiError::invalid(format!("targets CSV: {e}")))?;
+    if rows.is_some() && cmd.track_mm.is_some() {
+        return Err(ApiError::invalid(format!(
+            "the targets CSV has an `{TRACK_COLUMN}` column and the query gives `e1`: which track value holds is ambiguous; give one or the other"
+        )));
+    }
+    let beside: &[&str] = if rows.is_some() { &[TRACK_COLUMN] } else { &[] };
+    let csv = parse_targets_csv_beside(text, d, beside)?;
+    cmd.track_rows = rows;
     if csv.rows.is_empty() {
         return Err(ApiError::invalid(
             "targets CSV: no target rows after the header",

@@ -16,7 +16,10 @@
 //!
 //! A track value carries the model's base along the robot's stored track
 //! (`super::tracks::carry`): the cell frame is the track's; such a solver
-//! is built per request, not cached.
+//! is built per request, not cached. A targets CSV with an `e1` column has
+//! a value per row: each row is moved into the base frame at its value
+//! along the stored track (a row beyond the travel fails alone) and solved
+//! by the cached solver.
 //!
 //! Units at this boundary: targets in mm and degrees (`TargetInput`), joint
 //! seeds and commands in the controller convention in degrees.
@@ -33,6 +36,7 @@ use crate::solve::ik::{
     IkSettings, IkSolver, SolveMode, SolveOptions, TargetInput, TargetResult, TargetsCsv,
 };
 use robocal_core::model::calibrated::{CalibratedModelFile, CompensatedModel};
+use robocal_core::solve::external::{place_on_track, TargetValue};
 use std::sync::Arc;
 
 /// Which model to solve with.
@@ -141,6 +145,10 @@ pub struct SolveCommand {
     /// A track value [mm]: the base carried along the robot's stored track
     /// (the solver is then built for the request, not cached).
     pub track_mm: Option<f64>,
+    /// A track value per row of a targets CSV (its `e1` column): each row
+    /// moved into the base frame at its value along the stored track
+    /// (`core::solve::external::place_on_track`; the cached solver serves).
+    pub track_rows: Option<Vec<TargetValue>>,
 }
 
 /// A tool or work object of a solve: stored by name, or given inline.
@@ -337,6 +345,16 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
         )));
     }
     let (cell_solver, version, method) = prepare(state, &cmd).await?;
+    if let Some(values) = cmd.track_rows.take() {
+        let track = super::tracks::stored(state, cmd.robot_id).await?;
+        let Targets::Csv(csv) = &mut cmd.targets else {
+            return Err(ServiceError::Internal(
+                "a track value per row comes with a targets CSV".into(),
+            ));
+        };
+        place_on_track(csv, &values, &track, cmd.options.frame, None);
+        cmd.options.frame = TargetFrame::Base;
+    }
     let work_object = match &cmd.work_object {
         None => None,
         Some(choice) => {

@@ -3,7 +3,8 @@
 //! track::fit_track_compensated`, the fit `robocal track calibrate` makes)
 //! with the robot's calibrated version held, judged before it is stored, read
 //! back and deleted; and a model carried to a track value through the stored
-//! track (`core::solve::external::carried`) for predictions and solves.
+//! track (`core::solve::external::carried`) for predictions and solves, or
+//! the stored track itself for a targets CSV with a track value per row.
 //!
 //! Units at this boundary: track values in mm as the controller shows them;
 //! the measurement file as docs/csv.md states it (controller degrees, mm in
@@ -185,11 +186,18 @@ pub async fn carry(
     model: CompensatedModel,
     value_mm: f64,
 ) -> Result<CompensatedModel, ServiceError> {
+    let track = stored(state, robot_id).await?;
+    carried(&model, &track, value_mm).map_err(|e| ServiceError::Invalid(format!("`e1`: {e}")))
+}
+
+/// The robot's stored track as a model, for a request that gives `e1`
+/// (a value, or a column of a targets CSV): no track stored is a
+/// `Conflict` (the robot's state).
+pub async fn stored(state: &AppState, robot_id: i64) -> Result<LinearTrack, ServiceError> {
     let Some(row) = state.db().track(robot_id).await? else {
         return Err(ServiceError::Conflict(format!(
             "`e1`: robot {robot_id} has no track; fit one with POST /v1/robots/{robot_id}/track/calibrate, or leave `e1` out"
         )));
     };
-    let track = model_of(&row)?;
-    carried(&model, &track, value_mm).map_err(|e| ServiceError::Invalid(format!("`e1`: {e}")))
+    model_of(&row)
 }

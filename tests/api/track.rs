@@ -343,6 +343,10 @@ async fn a_track_fitted_over_http_is_the_command_lines_and_carries_predict_and_s
     let csv_j1: f64 = first.split(',').nth(4).unwrap().parse().unwrap();
     assert!((csv_j1 - j1).abs() < 1e-6, "{first}");
 
+    // A targets CSV with an `e1` column: each row at its own value, over
+    // HTTP as by the command line, and the true robot on each target.
+    per_row_csv_solve(&t, &rid, &rail, &model, d, &mut rng).await;
+
     // Beyond the travel measured: refused by predict and solve alike.
     for (route, body) in [
         (
@@ -530,4 +534,139 @@ async fn writing_a_track_needs_the_admin_role() {
         let r = t.raw("GET", &uri, None, Vec::new(), None).await;
         assert_eq!(r.status, StatusCode::UNAUTHORIZED);
     }
+}
+
+/// A CSV answer's rows as maps from column to field.
+fn csv_rows(text: &str) -> Vec<std::collections::HashMap<String, String>> {
+    let mut lines = text.lines();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    lines
+        .map(|l| {
+            let mut fields: Vec<String> = Vec::new();
+            let mut quoted = false;
+            let mut cur = String::new();
+            for ch in l.chars() {
+                match ch {
+                    '"' => quoted = !quoted,
+                    ',' if !quoted => fields.push(std::mem::take(&mut cur)),
+                    c => cur.push(c),
+                }
+            }
+            fields.push(cur);
+            header.iter().cloned().zip(fields).collect()
+        })
+        .collect()
+}
+
+/// The targets CSV solve with a track value per row (`e1` column) against
+/// `robocal solve --track` on the same file and against the truth; a row
+/// beyond the travel fails alone; the column beside `?e1=` is a 422.
+async fn per_row_csv_solve(
+    t: &TestApp,
+    rid: &str,
+    rail: &Rail,
+    model: &Path,
+    d: &Path,
+    rng: &mut ChaCha8Rng,
+) {
+    let nominal = preset("ys100").unwrap();
+    let values = [200.0, HELD_OUT_MM, 2600.0, 4500.0];
+    let qs = random_configurations(&nominal, 8, rng);
+    let rows: Vec<String> = qs
+        .iter()
+        .enumerate()
+        .map(|(i, q)| {
+            // Rows 3 and 7 ask for 4500 mm, beyond the travel (their poses
+            // are at 2600 mm).
+            let v = values[i % 4].min(2600.0);
+            let p = rail.true_pose(q, v);
+            let u = UnitQuaternion::from_matrix(&p.r);
+            let (x, y, z) = (p.p.x * 1e3, p.p.y * 1e3, p.p.z * 1e3);
+            format!(
+                "t{i},{x},{y},{z},{},{},{},{},{}",
+                u.w,
+                u.i,
+                u.j,
+                u.k,
+                values[i % 4]
+            )
+        })
+        .collect();
+    let file = format!("id,x,y,z,qw,qx,qy,qz,e1\n{}\n", rows.join("\n"));
+    std::fs::write(d.join("rows.csv"), &file).unwrap();
+    let r = t
+        .send(
+            "POST",
+            SOLVE,
+            &[rid],
+            "?payload_kg=110",
+            Some("text/csv"),
+            file.clone().into_bytes(),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    assert_eq!(r.headers["x-robocal-solved"], "6/8");
+    let http = csv_rows(&r.text());
+    let printed = cli(&[
+        "solve",
+        "--model",
+        path(model),
+        "--targets",
+        path(&d.join("rows.csv")),
+        "--track",
+        path(&d.join("rail.json")),
+        "--payload-kg",
+        "110",
+        "--format",
+        "csv",
+    ])
+    .unwrap();
+    let by_cli = csv_rows(&printed);
+    assert_eq!(http.len(), 8);
+    let joints = |row: &std::collections::HashMap<String, String>| -> Vec<f64> {
+        (1..=6)
+            .map(|k| row[&format!("j{k}_deg")].parse().unwrap())
+            .collect()
+    };
+    for (i, (h, c)) in http.iter().zip(&by_cli).enumerate() {
+        for k in ["id", "status", "reason", "message"] {
+            assert_eq!(h[k], c[k], "row {i}, {k}");
+        }
+        if i % 4 == 3 {
+            assert_eq!(h["status"], "failed");
+            assert_eq!(h["reason"], "invalid_target");
+            assert!(
+                h["message"].contains(&format!(
+                    "line {}: column `e1`: value 4500 mm is outside the travel measured, [0, 4000] mm",
+                    i + 2
+                )),
+                "{}",
+                h["message"]
+            );
+            continue;
+        }
+        assert_eq!(h["status"], "ok", "row {i}: {h:?}");
+        let deg = joints(h);
+        for (a, b) in deg.iter().zip(joints(c)) {
+            assert!((a - b).abs() < 1e-9, "row {i}: HTTP {a} CLI {b} deg");
+        }
+        let rad: Vec<f64> = deg.iter().map(|v| v.to_radians()).collect();
+        let solved = nominal.joints_from_controller(&rad);
+        let v = values[i % 4];
+        let miss = (rail.true_pose(&solved, v).p - rail.true_pose(&qs[i], v).p).norm();
+        assert!(miss < 0.05e-3, "row {i}: {} mm", miss * 1e3);
+    }
+    // The column and the query's `e1` together: which holds is ambiguous.
+    let r = t
+        .send(
+            "POST",
+            SOLVE,
+            &[rid],
+            "?e1=1000",
+            Some("text/csv"),
+            file.into_bytes(),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+    assert!(r.detail().contains("ambiguous"), "{}", r.detail());
 }

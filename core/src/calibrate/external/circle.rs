@@ -23,7 +23,9 @@ pub const MIN_CIRCLE_POINTS: usize = 3;
 pub struct Circle {
     /// Unit normal, right-handed with the points' order.
     pub normal: Vector3<f64>,
+    /// Centre [m].
     pub centre: Vector3<f64>,
+    /// Radius [m].
     pub radius: f64,
     /// Each point's distance from the circle.
     pub residual: Vec<f64>,

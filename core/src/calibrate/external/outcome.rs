@@ -23,6 +23,7 @@ pub enum Axis {
 }
 
 impl Axis {
+    /// Both axes, axis 1 first.
     pub const ALL: [Axis; 2] = [Axis::Tilt, Axis::Rotate];
 
     /// 0 for the tilt, 1 for the rotate axis (the column of the values).
@@ -33,6 +34,7 @@ impl Axis {
         }
     }
 
+    /// The axis as reports name it.
     pub fn name(self) -> &'static str {
         match self {
             Axis::Tilt => "axis 1 (tilt)",
@@ -62,6 +64,7 @@ pub struct PositionerFitRequest {
     /// first is the reference: its azimuth about axis 2 is held at the design
     /// one, which defines axis 2's zero (docs/external-axes.md).
     pub reflectors_mm: Vec<[f64; 3]>,
+    /// The tracker readings, every reflector at every pair of values.
     pub readings: Vec<PositionerReading>,
     /// The tracker's noise per coordinate, 1σ [mm]: the residuals are judged
     /// against it.
@@ -71,13 +74,16 @@ pub struct PositionerFitRequest {
 /// 1σ of one axis's parameters.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct AxisSigma {
+    /// The axis these σ are of.
     pub axis: Axis,
     /// Of the direction [deg]: axis 1's two tilts combined; axis 2's tilt
     /// toward axis 1 (its turn about axis 1 is axis 1's zero offset).
     pub direction_deg: f64,
     /// Of the line's position across it (both directions combined) [mm].
     pub point_mm: f64,
+    /// Of the zero offset [deg].
     pub zero_offset_deg: f64,
+    /// Of the scale (dimensionless).
     pub scale: f64,
 }
 
@@ -86,6 +92,7 @@ pub struct AxisSigma {
 pub struct CircleReport {
     /// The axis that turned.
     pub axis: Axis,
+    /// The reflector read (index into the request's reflectors).
     pub reflector: usize,
     /// The other axis's value [deg].
     pub held_deg: f64,
@@ -93,6 +100,7 @@ pub struct CircleReport {
     pub angles: usize,
     /// Their span [deg].
     pub span_deg: f64,
+    /// The circle's radius [mm].
     pub radius_mm: f64,
     /// RMS distance of the readings from the circle [mm].
     pub rms_mm: f64,
@@ -101,9 +109,13 @@ pub struct CircleReport {
 /// How the least-squares run ended.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SolverOutcome {
+    /// Whether a convergence test passed.
     pub converged: bool,
+    /// Iterations run.
     pub iterations: usize,
+    /// Why the run stopped.
     pub reason: StopReason,
+    /// The stop in words.
     pub detail: String,
     /// RMS of the 3-D residuals at the start (circle fits) [mm].
     pub start_rms_mm: f64,
@@ -123,6 +135,7 @@ pub struct FitLimits {
 /// A fitted positioner.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PositionerFit {
+    /// The calibrated model.
     #[serde(skip)]
     pub model: TiltRotate,
     /// The calibrated model as stored.
@@ -131,13 +144,19 @@ pub struct PositionerFit {
     pub reflectors_mm: Vec<[f64; 3]>,
     /// 1σ of each reflector's position (3-D) [mm].
     pub reflector_sigma_mm: Vec<f64>,
+    /// 1σ of each axis's parameters, axis 1 first.
     pub sigma: [AxisSigma; 2],
     /// Each reading's 3-D residual [mm].
     pub residual_mm: Vec<f64>,
+    /// RMS of the 3-D residuals [mm].
     pub rms_mm: f64,
+    /// Largest 3-D residual [mm].
     pub max_mm: f64,
+    /// Each sweep's circle (the start of the fit).
     pub circles: Vec<CircleReport>,
+    /// How the least-squares run ended.
     pub solver: SolverOutcome,
+    /// The bounds the fit was judged against.
     pub limits: FitLimits,
 }
 

@@ -56,7 +56,9 @@ pub fn across(u: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
 /// What stays fixed: the nominal frames and the gauge's directions.
 #[derive(Debug, Clone)]
 pub struct Gauge {
+    /// The nominal positioner base in the cell frame.
     pub cell_from_base: Pose,
+    /// The nominal face plate frame in the rotate frame.
     pub face_plate: Pose,
     /// Nominal `u1`.
     pub u1: Vector3<f64>,
@@ -64,11 +66,14 @@ pub struct Gauge {
     pub e: Vector3<f64>,
     /// Reflector 0's design position and its free directions (face plate frame).
     pub reference: Vector3<f64>,
+    /// Reflector 0's radial direction on the face plate (unit).
     pub radial: Vector3<f64>,
+    /// The face plate's normal, the other free direction of reflector 0.
     pub along_z: Vector3<f64>,
 }
 
 impl Gauge {
+    /// The gauge of `nominal` with reflector 0 designed at `reference_m` (face plate frame).
     pub fn new(nominal: &TiltRotate, reference_m: Vector3<f64>) -> Self {
         let u1 = nominal.tilt.direction;
         let u2 = nominal.rotate.direction;
@@ -100,7 +105,9 @@ impl Gauge {
 /// A point of the parameter space.
 #[derive(Debug, Clone, PartialEq)]
 pub struct State {
+    /// Axis 1, in the base frame.
     pub tilt: RotaryAxis,
+    /// Axis 2, in the tilt frame.
     pub rotate: RotaryAxis,
     /// `u2`'s out-of-plane angle [rad].
     pub gamma: f64,
@@ -120,10 +127,12 @@ impl State {
         }
     }
 
+    /// How many reflectors the state holds.
     pub fn reflectors(&self) -> usize {
         1 + self.others.len()
     }
 
+    /// How many parameters the state has.
     pub fn parameters(&self) -> usize {
         AXIS_PARAMETERS + 2 + 3 * self.others.len()
     }
@@ -169,12 +178,16 @@ impl State {
 /// Readings in SI: reflector, controller values [rad], measured point [m].
 #[derive(Debug, Clone)]
 pub struct Row {
+    /// The reflector read.
     pub reflector: usize,
+    /// Controller values of axis 1 and 2 [rad].
     pub values: [f64; 2],
+    /// The measured point in the cell frame [m].
     pub x: Vector3<f64>,
 }
 
 impl Row {
+    /// A reading in SI.
     pub fn of(r: &PositionerReading) -> Self {
         Row {
             reflector: r.reflector,
@@ -264,8 +277,11 @@ pub fn jacobian(g: &Gauge, s: &State, rows: &[Row]) -> DMatrix<f64> {
 
 /// The problem the LM driver moves.
 pub struct Problem<'a> {
+    /// What stays fixed.
     pub gauge: &'a Gauge,
+    /// The readings.
     pub rows: &'a [Row],
+    /// The current point of the parameter space.
     pub state: State,
     next: Option<State>,
     r: DVector<f64>,
@@ -273,6 +289,7 @@ pub struct Problem<'a> {
 }
 
 impl<'a> Problem<'a> {
+    /// The problem of `rows` under `gauge`, started at `state`.
     pub fn new(gauge: &'a Gauge, rows: &'a [Row], state: State) -> Self {
         Problem {
             gauge,

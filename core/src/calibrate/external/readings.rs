@@ -20,16 +20,27 @@ pub struct PositionerColumns {
 /// Why a set's rows are not a positioner's readings.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ColumnsError {
+    /// One column named for both axes.
     #[error("the tilt and rotate axes are both column `{0}`: name two columns")]
     SameColumn(ExternalAxis),
+    /// The set has no column for an axis.
     #[error("the set has no column `{column}` (it has: {has}); the {role} axis's values are read from it")]
     Missing {
+        /// The column named for the axis.
         column: ExternalAxis,
+        /// `tilt` or `rotate`.
         role: &'static str,
+        /// The set's external-axis columns, comma-separated (`none`).
         has: String,
     },
+    /// A row without a value in an axis's column.
     #[error("row {row} has no value of column `{column}`")]
-    MissingValue { row: usize, column: ExternalAxis },
+    MissingValue {
+        /// 1-based row of the set.
+        row: usize,
+        /// The column.
+        column: ExternalAxis,
+    },
 }
 
 /// Every row of `set` as a reading of reflector `reflector` at the values of

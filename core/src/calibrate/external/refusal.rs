@@ -20,15 +20,20 @@ pub trait Reason {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(bound(serialize = "R: Serialize + Reason, F: Serialize"))]
 pub struct Refusal<R, F> {
+    /// Why, from the fit's closed set.
     pub reason: R,
+    /// What is wrong and what to do, in words.
     pub message: String,
+    /// The figure measured, in the unit the reason names.
     pub measured: Option<f64>,
+    /// The bound it failed, in the same unit.
     pub needed: Option<f64>,
     /// The station's value [mm] the refusal names (fits with stations only).
     #[serde(skip_serializing_if = "without_stations::<R>")]
     pub station_mm: Option<f64>,
     /// The reading (1-based, in the request or set) the refusal names.
     pub row: Option<usize>,
+    /// The fit, when one was made before it was judged.
     pub fit: Option<Box<F>>,
 }
 
@@ -37,6 +42,7 @@ fn without_stations<R: Reason>(_: &Option<f64>) -> bool {
 }
 
 impl<R, F> Refusal<R, F> {
+    /// A refusal for `reason`, saying `message`.
     pub fn new(reason: R, message: String) -> Self {
         Refusal {
             reason,
@@ -49,17 +55,20 @@ impl<R, F> Refusal<R, F> {
         }
     }
 
+    /// With the figure measured and the bound it failed.
     pub fn figures(mut self, measured: f64, needed: f64) -> Self {
         self.measured = Some(measured);
         self.needed = Some(needed);
         self
     }
 
+    /// Naming the reading (1-based).
     pub fn at_row(mut self, row: usize) -> Self {
         self.row = Some(row);
         self
     }
 
+    /// With the fit that was judged.
     pub fn with_fit(mut self, fit: F) -> Self {
         self.fit = Some(Box::new(fit));
         self

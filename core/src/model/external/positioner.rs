@@ -110,11 +110,14 @@ impl TiltRotate {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FrameDescription {
+    /// Origin [mm].
     pub xyz_mm: [f64; 3],
+    /// Fixed-axis `[rx, ry, rz]` [deg], `R = Rz·Ry·Rx`.
     pub rpy_deg: [f64; 3],
 }
 
 impl FrameDescription {
+    /// The description of `pose`.
     pub fn of(pose: &Pose) -> Self {
         FrameDescription {
             xyz_mm: (pose.p * 1e3).into(),
@@ -145,9 +148,13 @@ impl FrameDescription {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TiltRotateDescription {
+    /// The positioner base frame in the cell frame.
     pub cell_from_base: FrameDescription,
+    /// Axis 1, in the base frame.
     pub tilt: RotaryAxisDescription,
+    /// Axis 2, in the tilt frame.
     pub rotate: RotaryAxisDescription,
+    /// The face plate frame in the rotate frame.
     pub face_plate: FrameDescription,
 }
 

@@ -114,7 +114,9 @@ impl RotaryAxis {
 /// A line: unit direction and its point closest to the frame's origin [m].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Line {
+    /// Unit direction.
     pub direction: Vector3<f64>,
+    /// The line's point closest to the frame's origin [m].
     pub point: Vector3<f64>,
 }
 

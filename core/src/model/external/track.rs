@@ -73,6 +73,7 @@ pub enum CarriageTerm {
 }
 
 impl CarriageTerm {
+    /// Every term, in map order.
     pub const ALL: [CarriageTerm; 6] = [
         CarriageTerm::Along,
         CarriageTerm::Lateral,
@@ -82,10 +83,12 @@ impl CarriageTerm {
         CarriageTerm::Yaw,
     ];
 
+    /// 0 for `Along` … 5 for `Yaw`.
     pub fn index(self) -> usize {
         self as usize
     }
 
+    /// The term as reports name it.
     pub fn name(self) -> &'static str {
         match self {
             CarriageTerm::Along => "positioning along the rail",
@@ -138,6 +141,7 @@ impl CarriageTerm {
 pub struct CarriageErrors(pub [f64; 6]);
 
 impl CarriageErrors {
+    /// The error of term `t` (m or rad).
     pub fn get(&self, t: CarriageTerm) -> f64 {
         self.0[t.index()]
     }
@@ -281,11 +285,17 @@ impl LinearTrack {
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct MapsDescription {
+    /// Positioning along the rail beyond scale and zero [mm].
     pub along_mm: Vec<f64>,
+    /// Straightness along the rail frame's y [mm].
     pub lateral_mm: Vec<f64>,
+    /// Straightness along the rail frame's z [mm].
     pub vertical_mm: Vec<f64>,
+    /// Roll about the rail frame's x [arcsec].
     pub roll_arcsec: Vec<f64>,
+    /// Pitch about the rail frame's y [arcsec].
     pub pitch_arcsec: Vec<f64>,
+    /// Yaw about the rail frame's z [arcsec].
     pub yaw_arcsec: Vec<f64>,
 }
 
@@ -310,6 +320,7 @@ pub struct TrackDescription {
     pub direction: [f64; 3],
     /// The rail line's point closest to the cell origin [mm].
     pub point_mm: [f64; 3],
+    /// Controller value → travel (dimensionless).
     pub scale: f64,
     /// Travel at controller value 0 along the rail from `point_mm` [mm].
     pub zero_mm: f64,
@@ -318,6 +329,7 @@ pub struct TrackDescription {
     pub mount_rpy_deg: [f64; 3],
     /// The controller values the maps hold over `[lo, hi]` [mm].
     pub travel_mm: [f64; 2],
+    /// The carriage maps (left out: zero, the nominal model).
     #[serde(default)]
     pub maps: MapsDescription,
 }

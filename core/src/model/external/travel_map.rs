@@ -30,7 +30,9 @@ pub fn legendre(x: f64, order: usize) -> Vec<f64> {
 /// The controller values a linear axis was measured over [mm].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Travel {
+    /// Lowest value [mm].
     pub lo_mm: f64,
+    /// Highest value [mm].
     pub hi_mm: f64,
 }
 
@@ -38,8 +40,11 @@ pub struct Travel {
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 #[error("value {value_mm} mm is outside the travel measured, [{lo_mm}, {hi_mm}] mm: the carriage's errors there are unknown (measure the track over it)")]
 pub struct OutsideTravel {
+    /// The value asked for [mm].
     pub value_mm: f64,
+    /// Lowest value [mm].
     pub lo_mm: f64,
+    /// Highest value [mm].
     pub hi_mm: f64,
 }
 
@@ -66,6 +71,7 @@ impl Travel {
 /// One map's coefficients `c_0 … c_N` (none: the zero map).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct TravelMap {
+    /// Legendre coefficients, lowest order first.
     pub coefficients: Vec<f64>,
 }
 

@@ -23,14 +23,28 @@ pub struct RowValue {
 /// Why a file's track values cannot be read.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum TrackColumnError {
+    /// The text is not a table.
     #[error(transparent)]
     Text(#[from] TextError),
+    /// A row whose field count is not the header's.
     #[error(transparent)]
     Shape(#[from] FieldCount),
-    #[error("line {line}: the header names `{TRACK_COLUMN}` twice")]
-    Duplicate { line: usize },
+    /// The header names the column twice.
+    #[error("line {line}: the header names `{column}` twice")]
+    Duplicate {
+        /// 1-based line of the header.
+        line: usize,
+        /// The column.
+        column: String,
+    },
+    /// A row's value is not a finite number.
     #[error("line {line}: `{TRACK_COLUMN}` is `{value}`, not a finite number of mm")]
-    NotNumber { line: usize, value: String },
+    NotNumber {
+        /// 1-based line of the row.
+        line: usize,
+        /// The field (shortened).
+        value: String,
+    },
 }
 
 /// The `e1` values of every row of `text`, or `None` when its header has
@@ -54,6 +68,7 @@ pub fn track_values(
     if at.next().is_some() {
         return Err(TrackColumnError::Duplicate {
             line: table.header_line,
+            column: TRACK_COLUMN.to_string(),
         });
     }
     table
@@ -110,7 +125,10 @@ mod tests {
         );
         assert_eq!(
             track_values("e1,q1,e1\n1,2,3\n", d).unwrap_err(),
-            TrackColumnError::Duplicate { line: 1 }
+            TrackColumnError::Duplicate {
+                line: 1,
+                column: "e1".into()
+            }
         );
     }
 }

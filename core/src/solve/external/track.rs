@@ -35,8 +35,10 @@ use crate::solve::ik::{
 /// Why a pose through the track cannot be given.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum TrackPoseError {
+    /// The value is beyond the travel measured.
     #[error(transparent)]
     OutsideTravel(#[from] OutsideTravel),
+    /// The robot's model cannot evaluate the joints.
     #[error("the model cannot evaluate these joints: {0}")]
     Kinematics(#[from] KinematicsError),
 }
@@ -78,6 +80,7 @@ impl TrackSolver {
         }
     }
 
+    /// The track the robot rides on.
     pub fn track(&self) -> &LinearTrack {
         &self.track
     }

@@ -81,6 +81,17 @@ pub enum RowError {
         /// The empty orientation columns, comma-separated.
         columns: String,
     },
+    /// A row's track value beyond the travel its track was measured over
+    /// (`solve::external::targets`).
+    #[error("line {line}: column `{column}`: {travel}")]
+    OutsideTravel {
+        /// 1-based line in the file.
+        line: usize,
+        /// The track's column as in the header.
+        column: String,
+        /// The value and the travel.
+        travel: crate::model::external::OutsideTravel,
+    },
     /// A position beyond [`POSITION_MM`] (100 m).
     #[error("line {line}: column `{column}`: {} mm is beyond the bound ±{} mm", show(*value), POSITION_MM.max)]
     Position {

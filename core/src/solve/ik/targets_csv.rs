@@ -130,6 +130,17 @@ pub const CONVENTION_COLUMNS: &str =
 
 /// Parses a targets file (see the module docs).
 pub fn parse_targets_csv(text: &str, dialect: Dialect) -> Result<TargetsCsv, TargetsCsvError> {
+    parse_targets_csv_beside(text, dialect, &[])
+}
+
+/// Parses a targets file whose columns named in `beside` (lower case) are
+/// read by the caller (a track value per row, `solve::external::targets`):
+/// they are passed over here instead of refused as unknown.
+pub fn parse_targets_csv_beside(
+    text: &str,
+    dialect: Dialect,
+    beside: &[&str],
+) -> Result<TargetsCsv, TargetsCsvError> {
     let table = csv_text::read(text, dialect)?.ok_or(TargetsCsvError::NoHeader)?;
     let hline = table.header_line;
     let cols: Vec<String> = table
@@ -148,6 +159,7 @@ pub fn parse_targets_csv(text: &str, dialect: Dialect) -> Result<TargetsCsv, Tar
     }
     let known = |c: &str| {
         matches!(c, "id" | "x" | "y" | "z")
+            || beside.contains(&c)
             || OrientationConvention::ALL
                 .iter()
                 .any(|k| k.column_names().contains(&c))

@@ -58,6 +58,7 @@ pub struct StationReport {
 /// One candidate order of a map and its leave-one-station-out RMS.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct OrderScore {
+    /// The series' highest order.
     pub order: usize,
     /// In the map's stored unit (mm or arcsec).
     pub cv_rms: f64,
@@ -66,6 +67,7 @@ pub struct OrderScore {
 /// One carriage map as fitted.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct MapReport {
+    /// The carriage error the map holds.
     pub term: CarriageTerm,
     /// `mm` or `arcsec`.
     pub unit: &'static str,
@@ -100,6 +102,7 @@ pub enum UnseenTerm {
 }
 
 impl UnseenTerm {
+    /// Every term, in report order.
     pub const ALL: [UnseenTerm; 4] = [
         UnseenTerm::StraightnessMeanAndSlope,
         UnseenTerm::AngleMeans,
@@ -111,25 +114,34 @@ impl UnseenTerm {
 /// One term the data cannot see, and its figure.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Unseen {
+    /// Which term.
     pub term: UnseenTerm,
+    /// Why, with the figure (a length, for short bends).
     pub note: String,
 }
 
 /// A fitted track.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct TrackFit {
+    /// The calibrated model.
     #[serde(skip)]
     pub model: LinearTrack,
     /// The calibrated model as stored.
     pub description: TrackDescription,
+    /// Each station, by increasing value.
     pub stations: Vec<StationReport>,
+    /// Each carriage map, by [`CarriageTerm::ALL`].
     pub maps: Vec<MapReport>,
     /// Each reading's 3-D residual through the fitted track and the held
     /// robot [mm], in the set's order.
     pub residual_mm: Vec<f64>,
+    /// RMS of the residuals [mm].
     pub rms_mm: f64,
+    /// Largest residual [mm].
     pub max_mm: f64,
+    /// The terms the readings cannot see.
     pub unseen: Vec<Unseen>,
+    /// The bounds the fit was judged against.
     pub limits: FitLimits,
 }
 

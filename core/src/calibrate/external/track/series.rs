@@ -18,6 +18,7 @@ const MAX_LEVERAGE: f64 = 1.0 - 1e-9;
 /// One order's fit.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SeriesFit {
+    /// The series' highest order.
     pub order: usize,
     /// `c_0 … c_order`.
     pub coefficients: Vec<f64>,

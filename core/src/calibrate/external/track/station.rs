@@ -38,12 +38,15 @@ impl Spread {
 /// A station's fitted base pose.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StationPose {
+    /// The station's track value [mm].
     pub value_mm: f64,
     /// The readings' rows in the set (0-based).
     pub rows: Vec<usize>,
+    /// The robot base's pose in the cell frame there (rigid fit).
     pub cell_from_base: Pose,
     /// RMS of the 3-D residuals of the rigid fit [m].
     pub rms_m: f64,
+    /// The readings' spread along their principal directions.
     pub spread: Spread,
     /// `(Σ |a'|²·I − a'·a'ᵀ)⁻¹` in the cell frame [1/m²]: times σ² the
     /// covariance of the base's small turn; `None` when singular.
@@ -53,8 +56,11 @@ pub struct StationPose {
 /// Why a station's pose was not fitted.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum StationError {
+    /// Fewer readings than a pose needs (how many there were).
     TooFewPoses(usize),
+    /// The readings lie near a line: the turn about it is unseen.
     Collinear(Spread),
+    /// A value is not finite.
     NotFinite,
 }
 

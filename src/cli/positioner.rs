@@ -1,0 +1,366 @@
+//! `robocal positioner calibrate`: a two-axis tilt-rotate positioner fitted
+//! from tracker readings of reflectors on its face plate.
+//!
+//! `positioner calibrate SET… --nominal NOMINAL.json --reflector X,Y,Z…
+//! --out POSITIONER.json` reads one measurement file per reflector
+//! (docs/csv.md: the axes' values in degrees in two external-axis columns,
+//! `e1` the tilt and `e2` the rotate axis by default, `x, y, z` in mm in
+//! the tracker frame; no robot joints), the k-th file holding the readings
+//! of the k-th `--reflector` (its design position on the face plate, mm,
+//! face plate frame; the first is the reference whose azimuth defines axis
+//! 2's zero). The nominal positioner (`model::external::TiltRotate`'s JSON:
+//! what the controller computes from the drawing, and the frames the fit
+//! states its lines in) is the start. It fits the positioner
+//! (`calibrate::external::fit_positioner`), judges it as the core does,
+//! writes the calibrated model's JSON (the same description as the nominal
+//! file) and prints the report: both axes' lines, zero offsets and scales
+//! with their σ, the residuals against their limits, each sweep's circle and
+//! the reflectors' fitted positions. With `--validate FILE…` (the k-th file
+//! held-out readings of reflector k) the held-out readings are predicted
+//! through the fitted positioner: their RMS and maximum. A refused fit
+//! writes nothing and exits with `refused` (1), printing its reason code and
+//! message (with `--json` also the refusal as JSON on stdout).
+
+use anyhow::Context;
+use clap::{Args, Subcommand};
+use nalgebra::Vector3;
+use robocal_core::calibrate::external::readings::{positioner_readings, PositionerColumns};
+use robocal_core::calibrate::external::{
+    fit_positioner, PositionerFit, PositionerFitRequest, PositionerReading, Refused,
+};
+use robocal_core::measure::csv::parse_set;
+use robocal_core::measure::external::ExternalAxis;
+use robocal_core::model::external::TiltRotate;
+use serde::Serialize;
+use std::fmt::Write as _;
+
+#[derive(Debug, Args)]
+pub struct PositionerArgs {
+    #[command(subcommand)]
+    pub command: PositionerCommand,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum PositionerCommand {
+    /// Fit a two-axis tilt-rotate positioner from tracker readings of reflectors on its face plate.
+    Calibrate(CalibrateArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct CalibrateArgs {
+    /// Measurement CSVs, one per reflector in the order of --reflector: the
+    /// axes' values (degrees) in their columns and `x,y,z` (mm, tracker
+    /// frame); each axis swept over ≥ 90° at ≥ 4 values with the other held.
+    #[arg(required = true)]
+    pub sets: Vec<String>,
+    /// The nominal positioner (JSON, mm and degrees, the description this
+    /// command writes): the start and the frames the fit is stated in.
+    #[arg(long)]
+    pub nominal: String,
+    /// A reflector's design position on the face plate, `x,y,z` [mm, face
+    /// plate frame], once per file; the first is the reference.
+    #[arg(long, required = true, allow_hyphen_values = true)]
+    pub reflector: Vec<String>,
+    /// Where to write the calibrated positioner (JSON, mm, degrees).
+    #[arg(long)]
+    pub out: String,
+    /// The tilt axis's (axis 1's) column, e1 … e6.
+    #[arg(long, default_value = "e1", value_parser = parse_axis)]
+    pub tilt_column: ExternalAxis,
+    /// The rotate axis's (axis 2's) column, e1 … e6.
+    #[arg(long, default_value = "e2", value_parser = parse_axis)]
+    pub rotate_column: ExternalAxis,
+    /// The tracker's noise per coordinate, 1σ [mm]: the fit is judged against it.
+    #[arg(long, default_value_t = 0.01)]
+    pub sigma_mm: f64,
+    /// Held-out readings (same columns), the k-th file of reflector k,
+    /// predicted through the fitted positioner.
+    #[arg(long)]
+    pub validate: Vec<String>,
+    /// Print the outcome as JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn parse_axis(s: &str) -> Result<ExternalAxis, String> {
+    ExternalAxis::ALL
+        .into_iter()
+        .find(|a| a.column().eq_ignore_ascii_case(s.trim()))
+        .ok_or_else(|| format!("`{s}`: give an external-axis column, e1 … e6"))
+}
+
+/// `x,y,z` [mm] of a `--reflector`.
+fn parse_point(s: &str) -> anyhow::Result<[f64; 3]> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .ok()
+        .filter(|v: &Vec<f64>| v.len() == 3 && v.iter().all(|x| x.is_finite()))
+        .with_context(|| format!("--reflector `{s}`: give x,y,z in mm (three finite numbers)"))?;
+    Ok([v[0], v[1], v[2]])
+}
+
+/// A fit the readings cannot carry: its reason and message (nothing is written).
+#[derive(Debug, thiserror::Error)]
+#[error("not fitted ({}): {}", reason_code(.0), .0.message)]
+pub struct PositionerNotFitted(pub Box<Refused>);
+
+fn reason_code(r: &Refused) -> String {
+    serde_json::to_value(r.reason)
+        .ok()
+        .and_then(|v| v.as_str().map(String::from))
+        .unwrap_or_default()
+}
+
+/// Held-out readings predicted through the fitted positioner [mm].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Validation {
+    pub files: Vec<String>,
+    pub readings: usize,
+    /// Distinct pairs of axis values `[tilt, rotate]` [deg] among them.
+    pub value_pairs: usize,
+    pub rms_mm: f64,
+    pub max_mm: f64,
+}
+
+#[derive(Serialize)]
+struct Fitted<'a> {
+    fitted: bool,
+    out: &'a str,
+    fit: &'a PositionerFit,
+    validation: Option<&'a Validation>,
+}
+
+#[derive(Serialize)]
+struct Refusal<'a> {
+    fitted: bool,
+    reason: String,
+    #[serde(flatten)]
+    refused: &'a Refused,
+}
+
+/// Every file's rows as readings of its reflector (the file's index).
+fn read_readings(
+    files: &[String],
+    columns: PositionerColumns,
+) -> anyhow::Result<Vec<PositionerReading>> {
+    let mut out = Vec::new();
+    for (k, path) in files.iter().enumerate() {
+        let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {path}"))?;
+        let set = parse_set(&text).with_context(|| path.clone())?;
+        out.extend(positioner_readings(&set, columns, k).with_context(|| path.clone())?);
+    }
+    Ok(out)
+}
+
+/// The held-out readings predicted through `model` at the fitted reflectors.
+fn validate(
+    files: &[String],
+    columns: PositionerColumns,
+    fit: &PositionerFit,
+) -> anyhow::Result<Validation> {
+    let readings = read_readings(files, columns)?;
+    if readings.is_empty() {
+        anyhow::bail!("--validate: no readings");
+    }
+    let mut pairs: Vec<[f64; 2]> = Vec::new();
+    let errors: Vec<f64> = readings
+        .iter()
+        .map(|r| {
+            if !pairs.contains(&r.values_deg) {
+                pairs.push(r.values_deg);
+            }
+            let on_plate = Vector3::from(fit.reflectors_mm[r.reflector]) * 1e-3;
+            let at = fit.model.point_in_cell(r.values_deg, &on_plate) * 1e3;
+            (at - Vector3::from(r.xyz_mm)).norm()
+        })
+        .collect();
+    let n = errors.len() as f64;
+    Ok(Validation {
+        files: files.to_vec(),
+        readings: errors.len(),
+        value_pairs: pairs.len(),
+        rms_mm: (errors.iter().map(|e| e * e).sum::<f64>() / n).sqrt(),
+        max_mm: errors.iter().copied().fold(0.0, f64::max),
+    })
+}
+
+/// Fits, judges, validates and writes the positioner; what the command prints.
+pub fn calibrate_to_string(a: &CalibrateArgs) -> anyhow::Result<String> {
+    if a.reflector.len() != a.sets.len() {
+        anyhow::bail!(
+            "{} files and {} --reflector positions: give one design position per file (the file's reflector)",
+            a.sets.len(),
+            a.reflector.len()
+        );
+    }
+    if a.validate.len() > a.sets.len() {
+        anyhow::bail!(
+            "{} --validate files for {} reflectors: the k-th holds reflector k's held-out readings",
+            a.validate.len(),
+            a.sets.len()
+        );
+    }
+    let reflectors_mm = a
+        .reflector
+        .iter()
+        .map(|s| parse_point(s))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let text = std::fs::read_to_string(&a.nominal)
+        .with_context(|| format!("cannot read nominal positioner {}", a.nominal))?;
+    let nominal = TiltRotate::from_json(&text)
+        .with_context(|| format!("nominal positioner {}", a.nominal))?;
+    let columns = PositionerColumns {
+        tilt: a.tilt_column,
+        rotate: a.rotate_column,
+    };
+    let request = PositionerFitRequest {
+        nominal,
+        reflectors_mm,
+        readings: read_readings(&a.sets, columns)?,
+        tracker_sigma_mm: a.sigma_mm,
+    };
+    let fit = match fit_positioner(&request) {
+        Ok(f) => f,
+        Err(refused) => {
+            if a.json {
+                let body = Refusal {
+                    fitted: false,
+                    reason: reason_code(&refused),
+                    refused: &refused,
+                };
+                println!("{}", serde_json::to_string_pretty(&body)?);
+            }
+            return Err(PositionerNotFitted(Box::new(refused)).into());
+        }
+    };
+    let validation = if a.validate.is_empty() {
+        None
+    } else {
+        Some(validate(&a.validate, columns, &fit)?)
+    };
+    std::fs::write(&a.out, fit.model.to_json() + "\n")
+        .with_context(|| format!("cannot write positioner file {}", a.out))?;
+    if a.json {
+        let body = Fitted {
+            fitted: true,
+            out: &a.out,
+            fit: &fit,
+            validation: validation.as_ref(),
+        };
+        return Ok(serde_json::to_string_pretty(&body)? + "\n");
+    }
+    Ok(report(a, &request, &fit, validation.as_ref()))
+}
+
+fn report(
+    a: &CalibrateArgs,
+    request: &PositionerFitRequest,
+    fit: &PositionerFit,
+    v: Option<&Validation>,
+) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "positioner fitted: {} readings of {} reflectors (tilt {}, rotate {}), nominal {}",
+        request.readings.len(),
+        request.reflectors_mm.len(),
+        a.tilt_column,
+        a.rotate_column,
+        a.nominal
+    );
+    let d = &fit.description;
+    for (axis, desc, sigma) in [
+        ("axis 1 (tilt)", &d.tilt, &fit.sigma[0]),
+        ("axis 2 (rotate)", &d.rotate, &fit.sigma[1]),
+    ] {
+        let [ux, uy, uz] = desc.direction;
+        let [px, py, pz] = desc.point_mm;
+        let _ = writeln!(
+            s,
+            "{axis}: direction [{ux:.6}, {uy:.6}, {uz:.6}] (σ {:.5} deg), point [{px:.4}, {py:.4}, {pz:.4}] mm (σ {:.4} mm); \
+             zero offset {:.5} deg (σ {:.5}); scale {:.6} (σ {:.1e})",
+            sigma.direction_deg,
+            sigma.point_mm,
+            desc.zero_offset_deg,
+            sigma.zero_offset_deg,
+            desc.scale,
+            sigma.scale
+        );
+    }
+    let l = &fit.limits;
+    let _ = writeln!(
+        s,
+        "residuals: rms {:.4} mm, max {:.4} mm (limits: rms ≤ {:.4} mm, each ≤ {:.4} mm; σ {} mm per axis)",
+        fit.rms_mm, fit.max_mm, l.rms_mm, l.max_mm, l.sigma_mm
+    );
+    let _ = writeln!(
+        s,
+        "solver: converged {}, {} iterations, start rms {:.4} mm",
+        fit.solver.converged, fit.solver.iterations, fit.solver.start_rms_mm
+    );
+    let _ = writeln!(
+        s,
+        "sweeps (axis turned, reflector, other axis held at deg, values, span deg, radius mm, rms mm):"
+    );
+    for c in &fit.circles {
+        let _ = writeln!(
+            s,
+            "  {}  {}  {:>8.3}  {:>3}  {:>7.2}  {:>9.3}  {:.4}",
+            c.axis.name(),
+            c.reflector + 1,
+            c.held_deg,
+            c.angles,
+            c.span_deg,
+            c.radius_mm,
+            c.rms_mm
+        );
+    }
+    let _ = writeln!(
+        s,
+        "reflectors on the face plate (design → fitted mm, σ mm):"
+    );
+    for (k, (design, got)) in request
+        .reflectors_mm
+        .iter()
+        .zip(&fit.reflectors_mm)
+        .enumerate()
+    {
+        let _ = writeln!(
+            s,
+            "  {}: [{:.3}, {:.3}, {:.3}] → [{:.4}, {:.4}, {:.4}], σ {:.4}",
+            k + 1,
+            design[0],
+            design[1],
+            design[2],
+            got[0],
+            got[1],
+            got[2],
+            fit.reflector_sigma_mm[k]
+        );
+    }
+    if let Some(v) = v {
+        let _ = writeln!(
+            s,
+            "held out: {} readings at {} pairs of axis values ({}): rms {:.4} mm, max {:.4} mm",
+            v.readings,
+            v.value_pairs,
+            v.files.join(", "),
+            v.rms_mm,
+            v.max_mm
+        );
+    }
+    let _ = writeln!(s, "written: {}", a.out);
+    s
+}
+
+/// Runs `robocal positioner`.
+pub fn run(a: PositionerArgs) -> anyhow::Result<()> {
+    match a.command {
+        PositionerCommand::Calibrate(c) => {
+            print!("{}", calibrate_to_string(&c)?);
+            Ok(())
+        }
+    }
+}

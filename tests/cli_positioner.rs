@@ -1,0 +1,481 @@
+//! `robocal positioner calibrate`, driven as a process on files: a simulated
+//! two-axis positioner from its physics (`robocal_core::sim::positioner`:
+//! rotations about true lines tilted 0.05° and offset ~0.5 mm, zero offsets,
+//! scale errors and a nod of the rotate axis the model lacks), read with
+//! 0.01 mm tracker noise and written as one measurement file per reflector
+//! with the axes in `e1` (tilt) and `e2` (rotate). The written positioner is
+//! checked against the truth at held-out axis values, the held-out figures
+//! the command prints against the fit's limits; refusals exit with
+//! `refused` (1) and write nothing.
+
+use nalgebra::{Rotation3, Vector3};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use robocal::calibrate::external::readings::PositionerColumns;
+use robocal::measure::csv::write_set;
+use robocal::measure::external::ExternalAxis;
+use robocal::model::external::{RotaryAxis, TiltRotate};
+use robocal::model::pose::rpy_matrix;
+use robocal::model::Pose;
+use robocal::sim::positioner::{TrueAxis, TruePositioner, Wobble};
+use robocal::sim::positioner_sets::positioner_set;
+use std::path::Path;
+use std::process::{Command, Output};
+
+const COLUMNS: PositionerColumns = PositionerColumns {
+    tilt: ExternalAxis::E1,
+    rotate: ExternalAxis::E2,
+};
+
+fn robocal(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_robocal"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn code(out: &Output) -> i32 {
+    out.status.code().expect("ended by a signal")
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+fn nominal() -> TiltRotate {
+    TiltRotate {
+        cell_from_base: Pose::new(
+            rpy_matrix(0.0, 0.0, 30f64.to_radians()),
+            Vector3::new(2.5, -0.8, -0.9),
+        ),
+        tilt: RotaryAxis::new(Vector3::x(), Vector3::new(0.0, 0.0, 0.8), 0.0, 1.0),
+        rotate: RotaryAxis::new(Vector3::z(), Vector3::zeros(), 0.0, 1.0),
+        face_plate: Pose::from_translation(Vector3::new(0.0, 0.0, 1.1)),
+    }
+}
+
+fn turned(v: Vector3<f64>, about: Vector3<f64>, deg: f64) -> Vector3<f64> {
+    Rotation3::from_scaled_axis(about.normalize() * deg.to_radians()) * v
+}
+
+fn truth() -> TruePositioner {
+    TruePositioner {
+        cell_from_base: nominal().cell_from_base,
+        tilt: TrueAxis {
+            direction: turned(Vector3::x(), Vector3::new(0.0, 0.6, 0.8), 0.05),
+            through: Vector3::new(0.0, 0.0003, 0.8004),
+            encoder_offset_rad: 0.3f64.to_radians(),
+            scale: 1.0 + 2e-4,
+            wobble: None,
+        },
+        rotate: TrueAxis {
+            direction: turned(Vector3::z(), Vector3::new(1.0, 1.0, 0.0), 0.05),
+            through: Vector3::new(0.0004, -0.0003, 0.0),
+            encoder_offset_rad: -0.4f64.to_radians(),
+            scale: 1.0 - 1.5e-4,
+            wobble: Some(Wobble {
+                amplitude_rad: 0.003f64.to_radians(),
+                phase_rad: 0.7,
+                pivot_along_m: 0.95,
+            }),
+        },
+        reflectors: vec![
+            Vector3::new(0.4002, 0.0003, 1.1198),
+            Vector3::new(-0.1497, 0.1004, 1.1203),
+        ],
+        noise_mm: 0.01,
+    }
+}
+
+/// Axis 2 over 330° at axis 1 = 0, axis 1 over 180° at axis 2 = 0.
+fn sweeps() -> Vec<[f64; 2]> {
+    let mut v: Vec<[f64; 2]> = (0..12)
+        .map(|i| [0.0, -165.0 + 30.0 * f64::from(i)])
+        .collect();
+    v.extend((0..13).map(|i| [-90.0 + 15.0 * f64::from(i), 0.0]));
+    v
+}
+
+/// Both axes moved together, none a fitted pair.
+fn held_out() -> Vec<[f64; 2]> {
+    let mut v = Vec::new();
+    for a in [-80.0, -23.0, 37.0, 84.0] {
+        for b in [-172.0, -71.0, 19.0, 107.0] {
+            v.push([a, b]);
+        }
+    }
+    v
+}
+
+/// Reflector `k`'s readings at `values`, as its file `name` in `d`.
+fn write(d: &Path, name: &str, t: &TruePositioner, k: usize, values: &[[f64; 2]], seed: u64) {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let set = positioner_set(t, k, values, COLUMNS, &mut rng);
+    std::fs::write(d.join(name), write_set(&set)).unwrap();
+}
+
+/// `robocal positioner calibrate r0.csv r1.csv --nominal nominal.json … --out p.json` and `extra`.
+fn calibrate(d: &Path, sets: [&str; 2], extra: &[&str]) -> Output {
+    let mut args = vec![
+        "positioner",
+        "calibrate",
+        sets[0],
+        sets[1],
+        "--nominal",
+        "nominal.json",
+        "--reflector",
+        "400,0,20",
+        "--reflector",
+        "-150,100,20",
+        "--out",
+        "p.json",
+    ];
+    args.extend_from_slice(extra);
+    robocal(d, &args)
+}
+
+#[test]
+fn a_positioner_is_calibrated_from_files_and_carries_points_at_held_out_values() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let t = truth();
+    std::fs::write(d.join("nominal.json"), nominal().to_json()).unwrap();
+    write(d, "r0.csv", &t, 0, &sweeps(), 1);
+    write(d, "r1.csv", &t, 1, &sweeps(), 2);
+    write(d, "h0.csv", &t, 0, &held_out(), 3);
+    write(d, "h1.csv", &t, 1, &held_out(), 4);
+
+    let out = calibrate(
+        d,
+        ["r0.csv", "r1.csv"],
+        &["--validate", "h0.csv", "--validate", "h1.csv"],
+    );
+    let report = text(&out.stdout);
+    assert_eq!(code(&out), 0, "{report}{}", text(&out.stderr));
+    print!("{report}");
+    assert!(
+        report.starts_with("positioner fitted: 50 readings of 2 reflectors (tilt e1, rotate e2)")
+    );
+    // The held-out readings (noise included) within the fit's RMS limit.
+    let line = report
+        .lines()
+        .find(|l| l.starts_with("held out: 32 readings at 16 pairs"))
+        .unwrap();
+    let rms: f64 = line
+        .split("rms ")
+        .nth(1)
+        .unwrap()
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(rms > 0.0 && rms < 0.052, "{line}");
+
+    // The written positioner against the truth, noise-free, at the held-out
+    // values: the reference reflector (400 mm from axis 2) within 0.03 mm;
+    // the nominal positioner misses it by millimetres.
+    let fitted =
+        TiltRotate::from_json(&std::fs::read_to_string(d.join("p.json")).unwrap()).unwrap();
+    let doc = {
+        let out = calibrate(d, ["r0.csv", "r1.csv"], &["--json"]);
+        assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+    };
+    assert_eq!(doc["fitted"], true);
+    let r0: Vec<f64> = doc["fit"]["reflectors_mm"][0]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap() * 1e-3)
+        .collect();
+    let on_plate = Vector3::new(r0[0], r0[1], r0[2]);
+    let worst = |m: &TiltRotate, p: &Vector3<f64>| {
+        held_out()
+            .iter()
+            .map(|v| (m.point_in_cell(*v, p) - t.reflector(0, *v)).norm() * 1e3)
+            .fold(0.0, f64::max)
+    };
+    let cal = worst(&fitted, &on_plate);
+    let nom = worst(&nominal(), &Vector3::new(0.4, 0.0, 0.02));
+    println!("reference reflector at 16 held-out pairs: calibrated max {cal:.4} mm, nominal max {nom:.3} mm");
+    assert!(cal < 0.03, "{cal} mm");
+    assert!(nom > 1.0, "{nom} mm");
+}
+
+#[test]
+fn fits_the_files_cannot_carry_exit_refused_and_write_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let t = truth();
+    std::fs::write(d.join("nominal.json"), nominal().to_json()).unwrap();
+    write(d, "r1.csv", &t, 1, &sweeps(), 2);
+
+    // One reading of reflector 1 off by 0.25 mm: named (reading 6 of the
+    // request), with --json the refusal on stdout.
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    let mut set = positioner_set(&t, 0, &sweeps(), COLUMNS, &mut rng);
+    set.poses[5].xyz_mm[0] += 0.25;
+    std::fs::write(d.join("off.csv"), write_set(&set)).unwrap();
+    let out = calibrate(d, ["off.csv", "r1.csv"], &["--json"]);
+    assert_eq!(code(&out), 1);
+    let err = text(&out.stderr);
+    assert!(err.contains("not fitted (residual_outlier): "), "{err}");
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(doc["fitted"], false);
+    assert_eq!(doc["reason"], "residual_outlier");
+    assert_eq!(doc["row"], 6);
+    assert!(!d.join("p.json").exists());
+
+    // Axis 2 swept over 60° only: its scale cannot be seen.
+    let narrow: Vec<[f64; 2]> = sweeps()
+        .into_iter()
+        .filter(|v| v[0] != 0.0 || v[1] == 0.0)
+        .chain((0..7).map(|i| [0.0, -30.0 + 10.0 * f64::from(i)]))
+        .collect();
+    write(d, "n0.csv", &t, 0, &narrow, 5);
+    write(d, "n1.csv", &t, 1, &narrow, 6);
+    let out = calibrate(d, ["n0.csv", "n1.csv"], &[]);
+    assert_eq!(code(&out), 1);
+    assert!(
+        text(&out.stderr).contains("not fitted (span_too_small)"),
+        "{}",
+        text(&out.stderr)
+    );
+    assert!(!d.join("p.json").exists());
+
+    // The files read for columns they do not have, and one design position
+    // for two files: refused before any fit.
+    let out = calibrate(d, ["n0.csv", "n1.csv"], &["--rotate-column", "e3"]);
+    assert_eq!(code(&out), 1);
+    assert!(
+        text(&out.stderr).contains("no column `e3`"),
+        "{}",
+        text(&out.stderr)
+    );
+    let out = robocal(
+        d,
+        &[
+            "positioner",
+            "calibrate",
+            "n0.csv",
+            "n1.csv",
+            "--nominal",
+            "nominal.json",
+            "--reflector",
+            "400,0,20",
+            "--out",
+            "p.json",
+        ],
+    );
+    assert_eq!(code(&out), 1);
+    assert!(
+        text(&out.stderr).contains("one design position per file"),
+        "{}",
+        text(&out.stderr)
+    );
+    assert!(!d.join("p.json").exists());
+}
+
+/// A YS100 (its true geometry is the model file's, on the cell's origin)
+/// in front of the positioner, placed 1.7 m along the cell's x.
+fn robot_file(d: &Path) -> robocal::sim::TrueRobot {
+    let nominal = robocal::model::preset("ys100").unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(9);
+    let truth = robocal::sim::TrueRobot::new(robocal::sim::perturb_geometry(
+        &nominal,
+        &robocal::sim::ErrorMagnitudes::from_mm_deg(1.0, 0.1),
+        &mut rng,
+    ));
+    let model = robocal::model::calibrated::CompensatedModel {
+        calibrated: truth.model.clone(),
+        nominal: nominal.clone(),
+        cell_from_base: Pose::identity(),
+        payload_kg: nominal.payload.mass,
+        compensator: None,
+    };
+    robocal::cli::model_files::save_model_file(
+        &robocal::model::calibrated::CalibratedModelFile::from_compensated(&model, "ys100", "km"),
+        &d.join("robot.json"),
+    )
+    .unwrap();
+    truth
+}
+
+/// The positioner of the tests moved to 1.7 m in front of the robot.
+fn near(mut t: TruePositioner) -> TruePositioner {
+    t.cell_from_base = Pose::new(
+        rpy_matrix(0.0, 0.0, 30f64.to_radians()),
+        Vector3::new(1.7, 0.3, -0.9),
+    );
+    t
+}
+
+#[test]
+fn solve_takes_targets_on_the_face_plate_at_each_rows_axis_values() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let robot = robot_file(d);
+    let t = near(truth());
+    let mut nom = nominal();
+    nom.cell_from_base = t.cell_from_base;
+    std::fs::write(d.join("nominal.json"), nom.to_json()).unwrap();
+    write(d, "r0.csv", &t, 0, &sweeps(), 1);
+    write(d, "r1.csv", &t, 1, &sweeps(), 2);
+    let out = calibrate(d, ["r0.csv", "r1.csv"], &[]);
+    assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+    let fitted =
+        TiltRotate::from_json(&std::fs::read_to_string(d.join("p.json")).unwrap()).unwrap();
+
+    // Points of a part on the plate, located on the face plate through each
+    // model at axes 0, 0 (as a part is taught), then asked for at values
+    // moved together; `e1` the tilt, `e2` the rotate value.
+    let on_body = [
+        Vector3::new(0.30, 0.20, 1.16),
+        Vector3::new(-0.25, 0.28, 1.16),
+        Vector3::new(0.05, -0.35, 1.18),
+    ];
+    let values = [[-30.0, 40.0], [15.0, -120.0], [35.0, 160.0], [-10.0, -45.0]];
+    let targets = |m: &TiltRotate| -> String {
+        let mut rows = vec!["id,x,y,z,e1,e2".to_string()];
+        for (i, p) in on_body.iter().enumerate() {
+            let at_zero = t.point([0.0, 0.0], p);
+            let fp = m
+                .cell_from_face_plate([0.0, 0.0])
+                .inverse()
+                .transform_point(&at_zero)
+                * 1e3;
+            for (k, v) in values.iter().enumerate() {
+                rows.push(format!(
+                    "p{i}v{k},{},{},{},{},{}",
+                    fp.x, fp.y, fp.z, v[0], v[1]
+                ));
+            }
+        }
+        rows.join("\n") + "\n"
+    };
+    // The true robot at the solved joints against the true point.
+    let misses = |file: &str, positioner: &str| -> Vec<f64> {
+        let out = robocal(
+            d,
+            &[
+                "solve",
+                "--model",
+                "robot.json",
+                "--targets",
+                file,
+                "--positioner",
+                positioner,
+                "--position-only",
+                "--json",
+            ],
+        );
+        assert_eq!(code(&out), 0, "{}{}", text(&out.stdout), text(&out.stderr));
+        let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(
+            doc["frame"],
+            format!("face plate of positioner {positioner} at each row's e1 (tilt), e2 (rotate)")
+        );
+        let nominal = robocal::model::preset("ys100").unwrap();
+        let mut out = Vec::new();
+        for (i, p) in on_body.iter().enumerate() {
+            for (k, v) in values.iter().enumerate() {
+                let r = &doc["targets"][i * values.len() + k];
+                let deg: Vec<f64> = r["joints_deg"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|x| x.as_f64().unwrap().to_radians())
+                    .collect();
+                let q = nominal.joints_from_controller(&deg);
+                let tip = robot.true_pose_base(&q, None).unwrap().p;
+                out.push((tip - t.point(*v, p)).norm() * 1e3);
+            }
+        }
+        out
+    };
+    std::fs::write(d.join("cal.csv"), targets(&fitted)).unwrap();
+    std::fs::write(d.join("nom.csv"), targets(&nom)).unwrap();
+    let cal = misses("cal.csv", "p.json");
+    let nom_miss = misses("nom.csv", "nominal.json");
+    let worst = |v: &[f64]| v.iter().copied().fold(0.0, f64::max);
+    println!(
+        "true tool tip on the true part at 12 targets: calibrated max {:.4} mm, nominal max {:.3} mm",
+        worst(&cal),
+        worst(&nom_miss)
+    );
+    assert!(worst(&cal) < 0.052, "{cal:?}");
+    assert!(worst(&nom_miss) > 0.5, "{nom_miss:?}");
+
+    // A row without its rotate value fails alone; a file without `e2` and
+    // --positioner beside --track are refused.
+    let text_cal = targets(&fitted).replacen(",40\n", ",\n", 1);
+    std::fs::write(d.join("gap.csv"), text_cal).unwrap();
+    let out = robocal(
+        d,
+        &[
+            "solve",
+            "--model",
+            "robot.json",
+            "--targets",
+            "gap.csv",
+            "--positioner",
+            "p.json",
+            "--position-only",
+            "--json",
+        ],
+    );
+    assert_eq!(code(&out), 2, "{}", text(&out.stderr));
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(doc["targets"][0]["reason"], "invalid_target");
+    assert!(
+        doc["targets"][0]["message"]
+            .as_str()
+            .unwrap()
+            .contains("line 2: column `e2`: `` is not a number"),
+        "{}",
+        doc["targets"][0]
+    );
+    std::fs::write(d.join("no_e2.csv"), "x,y,z,e1\n100,0,0,0\n").unwrap();
+    let out = robocal(
+        d,
+        &[
+            "solve",
+            "--model",
+            "robot.json",
+            "--targets",
+            "no_e2.csv",
+            "--positioner",
+            "p.json",
+            "--position-only",
+        ],
+    );
+    assert_eq!(code(&out), 1);
+    assert!(
+        text(&out.stderr).contains("an `e2` column"),
+        "{}",
+        text(&out.stderr)
+    );
+    let out = robocal(
+        d,
+        &[
+            "solve",
+            "--model",
+            "robot.json",
+            "--targets",
+            "cal.csv",
+            "--positioner",
+            "p.json",
+            "--track",
+            "rail.json",
+            "--position-only",
+        ],
+    );
+    assert_eq!(code(&out), 1, "{}", text(&out.stderr));
+    assert!(
+        text(&out.stderr).contains("cannot be used with"),
+        "{}",
+        text(&out.stderr)
+    );
+}
