@@ -25,25 +25,17 @@
 //! file system.
 
 #![warn(unreachable_pub)]
+#![warn(missing_docs)]
 
 pub mod calibrate;
-#[warn(missing_docs)]
 pub mod cell_fit;
-#[warn(missing_docs)]
 pub mod check;
-#[warn(missing_docs)]
 pub mod csv_write;
-#[warn(missing_docs)]
 pub mod measure;
 pub mod model;
-#[warn(missing_docs)]
 pub mod optim;
-#[warn(missing_docs)]
 pub mod plan;
-#[warn(missing_docs)]
 pub mod program;
-#[warn(missing_docs)]
 pub mod sim;
 pub mod solve;
-#[warn(missing_docs)]
 pub mod stats;

@@ -3,9 +3,7 @@
 //! calibrated model file) and train the learned compensator for what the
 //! model leaves (`compensate`).
 
-#[warn(missing_docs)]
 pub mod compensate;
 pub mod external;
 pub mod identify;
-#[warn(missing_docs)]
 pub mod pose_key;

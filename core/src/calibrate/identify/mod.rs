@@ -9,33 +9,19 @@
 //! Units: SI inside; reports speak millimetres and degrees (compliance in
 //! rad/(N·m), stiffness in N·m/rad).
 
-#[warn(missing_docs)]
 pub mod checks;
-#[warn(missing_docs)]
 mod evaluate;
-#[warn(missing_docs)]
 pub mod evidence;
-#[warn(missing_docs)]
 pub mod identifiability;
-#[warn(missing_docs)]
 pub mod joint_maps;
-#[warn(missing_docs)]
 pub mod least_squares;
-#[warn(missing_docs)]
 pub mod methods;
-#[warn(missing_docs)]
 pub mod model_file;
-#[warn(missing_docs)]
 pub mod network;
-#[warn(missing_docs)]
 pub mod options;
-#[warn(missing_docs)]
 mod pipeline;
-#[warn(missing_docs)]
 pub mod progress;
-#[warn(missing_docs)]
 pub mod registration;
-#[warn(missing_docs)]
 pub mod report;
 
 pub use checks::CalibrationError;
