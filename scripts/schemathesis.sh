@@ -80,7 +80,8 @@ echo "schemathesis.sh: robocal on http://$ADDR, schemathesis $VERSION, $MAX_EXAM
 
 start=$(date +%s)
 status=0
-"$VENV/bin/schemathesis" --config-file scripts/schemathesis.toml run openapi.yaml \
+# scripts/schemathesis_site/sitecustomize.py: one ast.parse at a time (its docstring).
+PYTHONPATH="scripts/schemathesis_site${PYTHONPATH:+:$PYTHONPATH}" "$VENV/bin/schemathesis" --config-file scripts/schemathesis.toml run openapi.yaml \
     --url "http://$ADDR" \
     --phases examples,coverage,fuzzing,stateful \
     --max-examples "$MAX_EXAMPLES" \
