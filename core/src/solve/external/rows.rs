@@ -47,6 +47,29 @@ pub enum TrackColumnError {
     },
 }
 
+/// The index of `column` (any ASCII case) in a header read at line
+/// `header_line`, `None` when the header does not name it; a header naming it
+/// twice is refused.
+pub(super) fn column_index(
+    header: &[String],
+    header_line: usize,
+    column: &str,
+) -> Result<Option<usize>, TrackColumnError> {
+    let mut at = header
+        .iter()
+        .enumerate()
+        .filter(|(_, h)| h.eq_ignore_ascii_case(column))
+        .map(|(i, _)| i);
+    let first = at.next();
+    if first.is_some() && at.next().is_some() {
+        return Err(TrackColumnError::Duplicate {
+            line: header_line,
+            column: column.to_string(),
+        });
+    }
+    Ok(first)
+}
+
 /// The `e1` values of every row of `text`, or `None` when its header has
 /// no `e1` column (any ASCII case) or it has no header.
 pub fn track_values(
@@ -56,21 +79,9 @@ pub fn track_values(
     let Some(table) = csv_text::read(text, dialect)? else {
         return Ok(None);
     };
-    let mut at = table
-        .header
-        .iter()
-        .enumerate()
-        .filter(|(_, h)| h.eq_ignore_ascii_case(TRACK_COLUMN))
-        .map(|(i, _)| i);
-    let Some(col) = at.next() else {
+    let Some(col) = column_index(&table.header, table.header_line, TRACK_COLUMN)? else {
         return Ok(None);
     };
-    if at.next().is_some() {
-        return Err(TrackColumnError::Duplicate {
-            line: table.header_line,
-            column: TRACK_COLUMN.to_string(),
-        });
-    }
     table
         .records
         .iter()

@@ -26,7 +26,7 @@
 //! skipped.
 
 use super::positioner::AxisValues;
-use super::rows::{TrackColumnError, TRACK_COLUMN};
+use super::rows::{column_index, TrackColumnError, TRACK_COLUMN};
 use crate::measure::csv_text::{self, short_text, Dialect};
 use crate::model::external::{LinearTrack, TiltRotate};
 use crate::model::orientation::{rotation_from, rotation_to};
@@ -69,21 +69,9 @@ pub fn target_column_values(
     let Some(table) = csv_text::read(text, dialect)? else {
         return Ok(None);
     };
-    let mut at = table
-        .header
-        .iter()
-        .enumerate()
-        .filter(|(_, h)| h.eq_ignore_ascii_case(column))
-        .map(|(i, _)| i);
-    let Some(col) = at.next() else {
+    let Some(col) = column_index(&table.header, table.header_line, column)? else {
         return Ok(None);
     };
-    if at.next().is_some() {
-        return Err(TrackColumnError::Duplicate {
-            line: table.header_line,
-            column: column.to_string(),
-        });
-    }
     let column = table.header[col].clone();
     let values = table
         .records
