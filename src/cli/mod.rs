@@ -11,6 +11,7 @@ pub mod exit;
 pub mod export;
 pub mod filter;
 pub mod iso9283;
+pub mod judged_fit;
 pub mod keygen;
 pub mod model_files;
 pub mod orientation_arg;

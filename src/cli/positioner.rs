@@ -21,6 +21,7 @@
 //! writes nothing and exits with `refused` (1), printing its reason code and
 //! message (with `--json` also the refusal as JSON on stdout).
 
+use super::judged_fit;
 use anyhow::Context;
 use clap::{Args, Subcommand};
 use nalgebra::Vector3;
@@ -124,22 +125,6 @@ pub struct Validation {
     pub max_mm: f64,
 }
 
-#[derive(Serialize)]
-struct Fitted<'a> {
-    fitted: bool,
-    out: &'a str,
-    fit: &'a PositionerFit,
-    validation: Option<&'a Validation>,
-}
-
-#[derive(Serialize)]
-struct Refusal<'a> {
-    fitted: bool,
-    reason: String,
-    #[serde(flatten)]
-    refused: &'a Refused,
-}
-
 /// Every file's rows as readings of its reflector (the file's index).
 fn read_readings(
     files: &[String],
@@ -176,13 +161,13 @@ fn validate(
             (at - Vector3::from(r.xyz_mm)).norm()
         })
         .collect();
-    let n = errors.len() as f64;
+    let (rms_mm, max_mm) = judged_fit::rms_and_max_mm(&errors);
     Ok(Validation {
         files: files.to_vec(),
         readings: errors.len(),
         value_pairs: pairs.len(),
-        rms_mm: (errors.iter().map(|e| e * e).sum::<f64>() / n).sqrt(),
-        max_mm: errors.iter().copied().fold(0.0, f64::max),
+        rms_mm,
+        max_mm,
     })
 }
 
@@ -224,14 +209,7 @@ pub fn calibrate_to_string(a: &CalibrateArgs) -> anyhow::Result<String> {
     let fit = match fit_positioner(&request) {
         Ok(f) => f,
         Err(refused) => {
-            if a.json {
-                let body = Refusal {
-                    fitted: false,
-                    reason: reason_code(&refused),
-                    refused: &refused,
-                };
-                println!("{}", serde_json::to_string_pretty(&body)?);
-            }
+            judged_fit::print_refusal(a.json, &reason_code(&refused), &refused)?;
             return Err(PositionerNotFitted(Box::new(refused)).into());
         }
     };
@@ -240,16 +218,16 @@ pub fn calibrate_to_string(a: &CalibrateArgs) -> anyhow::Result<String> {
     } else {
         Some(validate(&a.validate, columns, &fit)?)
     };
-    std::fs::write(&a.out, fit.model.to_json() + "\n")
-        .with_context(|| format!("cannot write positioner file {}", a.out))?;
-    if a.json {
-        let body = Fitted {
-            fitted: true,
-            out: &a.out,
-            fit: &fit,
-            validation: validation.as_ref(),
-        };
-        return Ok(serde_json::to_string_pretty(&body)? + "\n");
+    let written = judged_fit::write_fitted(
+        "positioner",
+        &a.out,
+        fit.model.to_json(),
+        &fit,
+        validation.as_ref(),
+        a.json,
+    )?;
+    if let Some(json) = written {
+        return Ok(json);
     }
     Ok(report(a, &request, &fit, validation.as_ref()))
 }

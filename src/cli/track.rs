@@ -25,6 +25,7 @@
 //! `solve::external::target_track_values`; a row beyond the travel fails
 //! alone); `--e1` and such a column together are refused as ambiguous.
 
+use super::judged_fit;
 use super::model_files::load_with_payload;
 use anyhow::Context;
 use clap::{Args, Subcommand};
@@ -236,22 +237,6 @@ pub struct Validation {
     pub max_mm: f64,
 }
 
-#[derive(Serialize)]
-struct Fitted<'a> {
-    fitted: bool,
-    out: &'a str,
-    fit: &'a TrackFit,
-    validation: Option<&'a Validation>,
-}
-
-#[derive(Serialize)]
-struct Refusal<'a> {
-    fitted: bool,
-    reason: String,
-    #[serde(flatten)]
-    refused: &'a TrackRefused,
-}
-
 /// The held-out set's readings predicted through `track` and `model`.
 fn validate(
     path: &str,
@@ -296,13 +281,13 @@ fn validate(
         anyhow::bail!("{path}: no readings");
     }
     values.sort_by(f64::total_cmp);
-    let n = errors.len() as f64;
+    let (rms_mm, max_mm) = judged_fit::rms_and_max_mm(&errors);
     Ok(Validation {
         file: path.to_string(),
         readings: errors.len(),
         values_mm: values,
-        rms_mm: (errors.iter().map(|e| e * e).sum::<f64>() / n).sqrt(),
-        max_mm: errors.iter().copied().fold(0.0, f64::max),
+        rms_mm,
+        max_mm,
     })
 }
 
@@ -316,14 +301,7 @@ pub fn calibrate_to_string(a: &CalibrateArgs) -> anyhow::Result<String> {
     let fit = match fit_track_compensated(&model, &set, a.column, a.sigma_mm, a.max_order) {
         Ok(f) => f,
         Err(refused) => {
-            if a.json {
-                let body = Refusal {
-                    fitted: false,
-                    reason: reason_code(&refused),
-                    refused: &refused,
-                };
-                println!("{}", serde_json::to_string_pretty(&body)?);
-            }
+            judged_fit::print_refusal(a.json, &reason_code(&refused), &refused)?;
             return Err(TrackNotFitted(refused).into());
         }
     };
@@ -331,16 +309,16 @@ pub fn calibrate_to_string(a: &CalibrateArgs) -> anyhow::Result<String> {
         Some(path) => Some(validate(path, &model, &fit.model, a.column)?),
         None => None,
     };
-    std::fs::write(&a.out, fit.model.to_json() + "\n")
-        .with_context(|| format!("cannot write track file {}", a.out))?;
-    if a.json {
-        let body = Fitted {
-            fitted: true,
-            out: &a.out,
-            fit: &fit,
-            validation: validation.as_ref(),
-        };
-        return Ok(serde_json::to_string_pretty(&body)? + "\n");
+    let written = judged_fit::write_fitted(
+        "track",
+        &a.out,
+        fit.model.to_json(),
+        &fit,
+        validation.as_ref(),
+        a.json,
+    )?;
+    if let Some(json) = written {
+        return Ok(json);
     }
     Ok(report(a, &set, &fit, validation.as_ref()))
 }
