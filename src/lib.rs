@@ -7,6 +7,7 @@
 //! the same module names), whose dependency tree has no HTTP, database, async
 //! runtime or command-line crates.
 
+#![warn(missing_docs)]
 #![warn(unreachable_pub)]
 
 pub use robocal_core::{

@@ -18,8 +18,6 @@
 //!
 //! Times are wall-clock on the calling thread (pin with `taskset -c 0`).
 
-#![warn(missing_docs)]
-
 use crate::calibrate::compensate::select::Parallelism;
 use crate::calibrate::identify::{calibrate, CalibrationSettings, Method};
 use crate::measure::{self, csv};

@@ -2,8 +2,6 @@
 //! print the comparison of methods (like the thesis's Tables 2.5/2.6) with the
 //! identifiability report, or the same as JSON.
 
-#![warn(missing_docs)]
-
 mod render;
 
 pub use render::{render_comparison, render_compensators, render_orientation, render_report};

@@ -7,8 +7,6 @@
 //! number 0 or beyond its range, one held twice) is refused naming the item;
 //! a Fanuc export writes position registers only with `--registers`.
 
-#![warn(missing_docs)]
-
 use crate::program::controller::{export_cell, ExportOptions, RegisterRange};
 use crate::program::Language;
 use crate::solve::cell::CellDescription;

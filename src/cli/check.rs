@@ -12,8 +12,6 @@
 //! `compare` scores the same poses against each model, so versions compare
 //! where their own validation figures (from different sets) cannot.
 
-#![warn(missing_docs)]
-
 use anyhow::Context;
 use clap::Args;
 use robocal_core::check::{score, CheckResult, CheckThresholds};

@@ -3,8 +3,6 @@
 //! the Table 7.5 comparison of KM, SKCM and SKCM-C and the identified
 //! stiffness next to the truth.
 
-#![warn(missing_docs)]
-
 use super::progress::ProgressPrinter;
 use crate::calibrate::identify::Method;
 use crate::sim::study::ys100_simulation;

@@ -9,8 +9,6 @@
 //! `3` and up, one per status of `check` other than `ok`
 //! (`core::check::CheckStatus`).
 
-#![warn(missing_docs)]
-
 use clap::Args;
 use robocal_core::check::CheckStatus;
 use std::fmt::Write as _;

@@ -2,8 +2,6 @@
 //! standard-DH or modified-DH CSV, or robocal's JSON (`crate::model::export` makes the
 //! text; this command reads the model and writes the file or stdout).
 
-#![warn(missing_docs)]
-
 use super::model_files::load_compensated;
 use crate::model::export::{export, ExportFormat, ExportSource};
 use anyhow::Context;

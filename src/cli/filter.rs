@@ -5,8 +5,6 @@
 //! to by number or name come from a cell file (`core::cell::file`: mm,
 //! degrees); RAPID modules and URScript carry their own.
 
-#![warn(missing_docs)]
-
 use crate::program::{filter, Language, ProgramFile};
 use crate::solve::ik::IkSettings;
 use anyhow::{bail, Context};

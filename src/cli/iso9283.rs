@@ -15,8 +15,6 @@
 //! The plan CSV's commanded poses: the model's measurement frame (see
 //! `core::iso9283::csv` for both file formats).
 
-#![warn(missing_docs)]
-
 use crate::model::orientation::fixed_xyz_matrix;
 use crate::plan::WorkspaceBox;
 use crate::plan::{JoinBy, Units};

@@ -1,4 +1,3 @@
-#![warn(missing_docs)]
 //! What `robocal track calibrate` and `robocal positioner calibrate` print and
 //! write for a fit judged before it is written: a refusal (`--json`: the
 //! reason code and the refusal's fields, nothing written), or the model file

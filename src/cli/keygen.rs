@@ -2,8 +2,6 @@
 //! on standard output, ready for `ROBOCAL_API_KEYS` or a key file
 //! (`ROBOCAL_API_KEYS_FILE`). Several keys: run it once per client.
 
-#![warn(missing_docs)]
-
 use crate::service::keys::{new_key, Role};
 use clap::Args;
 

@@ -29,7 +29,6 @@ pub mod track;
 pub use model_files::load_model;
 
 /// The parsed command line: one subcommand with its arguments.
-#[warn(missing_docs)]
 #[derive(Debug, Parser)]
 #[command(
     name = "robocal",
@@ -44,7 +43,6 @@ pub struct Cli {
 }
 
 /// The subcommands of `robocal`, each with its arguments.
-#[warn(missing_docs)]
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Simulate a "true" robot and write measurements in the CSV format.
@@ -111,7 +109,6 @@ pub enum Command {
 
 /// Runs the parsed command line: how it ended ([`exit::Exit`]), or the
 /// error that refused it (exit code 1).
-#[warn(missing_docs)]
 pub fn run(cli: Cli) -> anyhow::Result<exit::Exit> {
     let done = |r: anyhow::Result<()>| r.map(|()| exit::Exit::Success);
     match cli.command {

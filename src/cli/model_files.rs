@@ -2,8 +2,6 @@
 //! their text; reading and writing files happens here): a calibrated model
 //! file (`robocal calibrate --save`), a model JSON file, or a preset name.
 
-#![warn(missing_docs)]
-
 use crate::model::preset;
 use crate::solve::cell::{Cell, CellDescription};
 use anyhow::Context;

@@ -2,8 +2,6 @@
 //! columns, one of [`MeasuredOrientation`]'s names (the possible values and
 //! their help come from the enum).
 
-#![warn(missing_docs)]
-
 use crate::measure::convention::MeasuredOrientation;
 use clap::builder::{PossibleValue, TypedValueParser};
 use clap::error::ErrorKind;

@@ -14,8 +14,6 @@
 //!
 //! Box and tracker position: base frame, mm; the reflector axis: tool frame.
 
-#![warn(missing_docs)]
-
 use crate::plan::{
     join, make_plan, plan_csv, plan_program, read_plan_csv, JoinBy, JoinOptions, MeasurementPlan,
     PlanSettings, TrackerSight, Units, WorkspaceBox,

@@ -35,18 +35,22 @@ use robocal_core::model::external::TiltRotate;
 use serde::Serialize;
 use std::fmt::Write as _;
 
+/// Arguments of `robocal positioner`.
 #[derive(Debug, Args)]
 pub struct PositionerArgs {
+    /// The positioner subcommand to run.
     #[command(subcommand)]
     pub command: PositionerCommand,
 }
 
+/// The subcommands of `robocal positioner`.
 #[derive(Debug, Subcommand)]
 pub enum PositionerCommand {
     /// Fit a two-axis tilt-rotate positioner from tracker readings of reflectors on its face plate.
     Calibrate(CalibrateArgs),
 }
 
+/// Arguments of `robocal positioner calibrate`.
 #[derive(Debug, Args)]
 pub struct CalibrateArgs {
     /// Measurement CSVs, one per reflector in the order of --reflector: the
@@ -117,11 +121,15 @@ fn reason_code(r: &Refused) -> String {
 /// Held-out readings predicted through the fitted positioner [mm].
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Validation {
+    /// The held-out measurement files, the k-th of reflector k.
     pub files: Vec<String>,
+    /// Their readings, each predicted at its axes' values.
     pub readings: usize,
     /// Distinct pairs of axis values `[tilt, rotate]` [deg] among them.
     pub value_pairs: usize,
+    /// RMS of the readings' position errors, measured − predicted [mm].
     pub rms_mm: f64,
+    /// Largest of those position errors [mm].
     pub max_mm: f64,
 }
 

@@ -35,6 +35,7 @@ use robocal_core::solve::external::carried;
 use serde_json::json;
 use std::fmt::Write as _;
 
+/// Arguments of `robocal predict`.
 #[derive(Debug, Args)]
 pub struct PredictArgs {
     /// Robot model: a calibrated model file (`robocal calibrate --save`), a
@@ -64,6 +65,7 @@ pub struct PredictArgs {
     /// Payload mass [kg] (default: the model file's payload, or the tool's load).
     #[arg(long)]
     pub payload_kg: Option<f64>,
+    /// Output format.
     #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
     pub format: OutputFormat,
     /// Same as `--format json`.
@@ -75,8 +77,10 @@ pub struct PredictArgs {
     /// Decimal separator of the joints file: `point` or `comma` (default: detected).
     #[arg(long)]
     pub decimal: Option<String>,
+    /// `--allow-failures`: the exit code when some rows fail.
     #[command(flatten)]
     pub failures: super::exit::AllowFailures,
+    /// `--track FILE --e1 MM`: the robot carried along a linear track.
     #[command(flatten)]
     pub track: super::track::OnTrack,
 }

@@ -13,8 +13,6 @@
 //! and when the phase or candidate changes, ended with a newline by
 //! [`ProgressPrinter::finish`].
 
-#![warn(missing_docs)]
-
 use crate::calibrate::identify::progress::time_left;
 use crate::calibrate::identify::{Method, Phase, Progress};
 use std::io::{IsTerminal, Write};

@@ -9,8 +9,6 @@
 //! robocal reregister --model cal.json --measurements new.csv --save cal-new.json [--json]
 //! ```
 
-#![warn(missing_docs)]
-
 use anyhow::Context;
 use clap::Args;
 use robocal_core::check::{reregister, Reregistration};

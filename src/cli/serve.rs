@@ -32,8 +32,6 @@
 //! [`crate::service::queue`]) and SIGTERM hands this replica's running jobs
 //! back to the queue.
 
-#![warn(missing_docs)]
-
 use crate::db::{Backend, Db, DEFAULT_DATABASE_URL, DEFAULT_PG_POOL};
 use crate::http::server::ServerSettings;
 use crate::http::{app, AppState, Limits, ServiceConfig, ServiceListener};

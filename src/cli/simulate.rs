@@ -22,8 +22,6 @@
 //!   readings in degrees.
 //! - The payload column is always written (default: the truth's payload mass).
 
-#![warn(missing_docs)]
-
 use crate::measure::{csv, SetRole};
 use crate::model::kinematics::fk;
 use crate::model::RobotModel;

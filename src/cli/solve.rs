@@ -74,6 +74,7 @@ YS100's A2 is 90 deg with the arm upright, where a KUKA's is -90 deg, so T bit 1
 A required branch the target lacks, or program flags no solution carries, fails naming the branches (and
 their flags) that do reach it within the joint limits. Per robot family: docs/configurations.md.";
 
+/// Arguments of `robocal solve`.
 #[derive(Debug, Args)]
 pub struct SolveArgs {
     /// Robot model: a preset (ys100, hh800, ur5, ur10), a model JSON file, or a
@@ -138,8 +139,10 @@ pub struct SolveArgs {
     /// detected; with `,` delimiters a decimal comma is read in quoted fields).
     #[arg(long)]
     pub decimal: Option<String>,
+    /// `--allow-failures`: the exit code when some rows fail.
     #[command(flatten)]
     pub failures: super::exit::AllowFailures,
+    /// `--track FILE --e1 MM`: the robot carried along a linear track.
     #[command(flatten)]
     pub track: super::track::OnTrack,
     /// Calibrated positioner (`robocal positioner calibrate --out`, in the

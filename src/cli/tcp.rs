@@ -11,8 +11,6 @@
 //! outcome is printed as the service answers it (`fitted`, `reason`,
 //! `message`, `fit`, `orientation`, `replaced`, …).
 
-#![warn(missing_docs)]
-
 use super::model_files::load_compensated;
 use crate::cell_fit::tcp::entry::{self, Answer, Fitted, Outcome, StoreRequest, StoredEntry};
 use crate::cell_fit::tcp::{self, AxisRequest, Reading, TcpMethod, ToolFit, ToolRequest};

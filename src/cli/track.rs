@@ -44,18 +44,22 @@ use robocal_core::solve::external::{
 use serde::Serialize;
 use std::fmt::Write as _;
 
+/// Arguments of `robocal track`.
 #[derive(Debug, Args)]
 pub struct TrackArgs {
+    /// The track subcommand to run.
     #[command(subcommand)]
     pub command: TrackCommand,
 }
 
+/// The subcommands of `robocal track`.
 #[derive(Debug, Subcommand)]
 pub enum TrackCommand {
     /// Fit a linear track carrying the robot from tracker readings at several track values.
     Calibrate(CalibrateArgs),
 }
 
+/// Arguments of `robocal track calibrate`.
 #[derive(Debug, Args)]
 pub struct CalibrateArgs {
     /// Measurement CSV with the track's column: `q1..qN` (controller degrees),
@@ -229,11 +233,15 @@ fn reason_code(r: &TrackRefused) -> String {
 /// Held-out readings predicted through the fitted track [mm].
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Validation {
+    /// The held-out measurement file.
     pub file: String,
+    /// Its readings, each predicted at its track value.
     pub readings: usize,
     /// The distinct track values of the readings [mm].
     pub values_mm: Vec<f64>,
+    /// RMS of the readings' position errors, measured − predicted [mm].
     pub rms_mm: f64,
+    /// Largest of those position errors [mm].
     pub max_mm: f64,
 }
 

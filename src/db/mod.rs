@@ -25,8 +25,6 @@
 //!   returns them, on both backends.
 //! - Timestamps: UTC RFC 3339 text with milliseconds, written by the database.
 
-#![warn(missing_docs)]
-
 use sqlx::postgres::{PgPool, PgPoolOptions, PgRow};
 use sqlx::sqlite::{
     SqliteConnectOptions, SqliteJournalMode, SqlitePool, SqlitePoolOptions, SqliteRow,

@@ -7,8 +7,6 @@
 //! gives its (method, path template). Without keys configured every route is
 //! open; with `open_reads`, routes that need `read` are open too.
 
-#![warn(missing_docs)]
-
 use super::{ApiError, AppState};
 use crate::service::keys::Role;
 use axum::extract::{Request, State};

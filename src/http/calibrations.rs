@@ -6,8 +6,6 @@
 //! selection, sessions, the runner, progress, model versions) is
 //! [`crate::service::calibrations`].
 
-#![warn(missing_docs)]
-
 use super::input::{check_payload, int, page_body, present, present_ids, present_int, PageQuery};
 use super::robots::robot_list_page;
 use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState};

@@ -5,8 +5,6 @@
 //! file (`core::cell::file`). Names and controller numbers are unique per
 //! robot; a number already taken by another item is a 409.
 
-#![warn(missing_docs)]
-
 use super::input::{objects, present};
 use super::{ApiError, ApiJson, ApiPath, AppState};
 use crate::records::{CellItemRow, CellKind, ItemFrame, NewCellItem};

@@ -11,8 +11,6 @@
 //! fit. A tool whose orientation the readings do not determine keeps the
 //! stored one, or takes `rpy_deg`; it is never written as zeros.
 
-#![warn(missing_docs)]
-
 use super::cell::{check_item_name, ItemOut, CELL_NUMBER_MAX};
 use super::input::{objects, present, Int};
 use super::{ApiError, ApiJson, ApiPath, AppState};

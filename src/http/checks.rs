@@ -7,8 +7,6 @@
 //! `POST /v1/robots/{id}/reregister` refits a version's measurement frame and
 //! tool on a set and stores the result as a new version.
 
-#![warn(missing_docs)]
-
 use super::input::{id, ids, page_body, present_id, PageQuery};
 use super::robots::robot_list_page;
 use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState};

@@ -6,8 +6,6 @@
 //! 4xx details say what to fix. Database and internal errors are logged with
 //! their cause and returned as a generic 500 without it.
 
-#![warn(missing_docs)]
-
 use axum::extract::rejection::{BytesRejection, PathRejection, QueryRejection};
 use axum::http::{header, HeaderValue, StatusCode};
 use axum::response::{IntoResponse, Response};

@@ -2,8 +2,6 @@
 //! parameters) whose rejections are problem documents (`error.rs`); a body is
 //! read by `input::from_json_object`.
 
-#![warn(missing_docs)]
-
 use super::error::{json_content_type, ApiError};
 use axum::extract::{FromRequest, FromRequestParts, Request};
 use axum::response::{IntoResponse, Response};

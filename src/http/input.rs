@@ -10,8 +10,6 @@
 //! - names ([`check_name`]), payloads ([`check_payload`]) and list paging
 //!   ([`Page`]).
 
-#![warn(missing_docs)]
-
 use super::ApiError;
 use crate::service::limits::{PAGE_DEFAULT, PAYLOAD_MAX_KG};
 use serde::de::{DeserializeOwned, Deserializer, MapAccess, Visitor};

@@ -15,8 +15,6 @@
 //! robot's name and the version's SHA-256 from the store — or, with
 //! `Accept: text/html`, the ISO 9283 report page (`report::iso9283`).
 
-#![warn(missing_docs)]
-
 use super::input::{object_or_null, objects, present, present_int};
 use super::{ApiError, ApiJson, AppState};
 use crate::report::iso9283::render_iso9283_html;

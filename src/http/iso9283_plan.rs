@@ -6,8 +6,6 @@
 //! The same as `robocal iso9283 plan` on the version's `model.json`; the
 //! answer names the version and its SHA-256.
 
-#![warn(missing_docs)]
-
 use super::input::present_int;
 use super::plans::{ProgramOut, WAIT_MAX_S};
 use super::programs::FileIn;

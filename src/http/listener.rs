@@ -9,8 +9,6 @@
 //! as one piece; the router never answers a 4xx without a body) and sends a
 //! problem document with the same status instead.
 
-#![warn(missing_docs)]
-
 use super::error::ApiError;
 use axum::http::StatusCode;
 use std::io;

@@ -5,8 +5,6 @@
 //! when `language` is given, as a program visiting them with a wait at each.
 //! The same as `robocal plan`.
 
-#![warn(missing_docs)]
-
 use super::input::present_int;
 use super::programs::FileIn;
 use super::{ApiError, ApiJson, ApiPath, AppState};

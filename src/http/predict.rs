@@ -30,9 +30,11 @@ use axum::response::{IntoResponse, Response};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
+/// One joint reading to predict the pose of.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ReadingIn {
+    /// Echoed in the result: a string or a number (absent: the 1-based reading number).
     #[serde(default)]
     pub id: Option<Value>,
     /// Controller joint readings [deg].
@@ -43,19 +45,25 @@ pub struct ReadingIn {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PredictRequest {
+    /// The joint readings, predicted in this order (at least one).
     #[serde(deserialize_with = "objects")]
     pub readings: Vec<ReadingIn>,
+    /// The model version to predict with (absent: the active version).
     #[serde(default, deserialize_with = "present")]
     pub version: Option<VersionSelector>,
+    /// Payload now carried [kg] (absent: the model version's payload, or the tool's load).
     #[serde(default, deserialize_with = "present")]
     pub payload_kg: Option<f64>,
+    /// Frame of the poses: `cell` (the calibration's measurement frame, default) or `base`.
     #[serde(default, deserialize_with = "present")]
     pub frame: Option<String>,
     /// A second orientation output beside `rx, ry, rz`.
     #[serde(default, deserialize_with = "present")]
     pub convention: Option<String>,
+    /// A production tool on the calibrated flange instead of the measured point: a stored one's name, or one inline.
     #[serde(default, deserialize_with = "present")]
     pub tool: Option<ItemRef>,
+    /// The work object the poses are given in: a stored one's name, or one inline (`frame` does not apply).
     #[serde(default, deserialize_with = "present")]
     pub work_object: Option<ItemRef>,
     /// The track's value [mm]: the robot carried along its stored track.
@@ -63,44 +71,71 @@ pub struct PredictRequest {
     pub e1: Option<f64>,
 }
 
+/// A predicted orientation in the request's `convention`.
 #[derive(Debug, Serialize)]
 pub struct OrientationOut {
+    /// Orientation convention of `values` (canonical name).
     pub convention: &'static str,
+    /// The orientation in that convention (angles [deg], `ur_rotvec` [rad]).
     pub values: Vec<f64>,
 }
 
+/// One reading's predicted pose, in the answer's frame.
 #[derive(Debug, Serialize)]
 pub struct PredictionOut {
+    /// The reading's id as given (default: its 1-based number).
     pub id: String,
     /// `ok`, or `failed` when the model cannot evaluate the joints.
     pub status: &'static str,
+    /// Why the reading failed (null when predicted).
     pub message: Option<String>,
+    /// The controller joint readings, as given [deg].
     pub joints_deg: Vec<f64>,
+    /// Position x [mm].
     pub x: Option<f64>,
+    /// Position y [mm].
     pub y: Option<f64>,
+    /// Position z [mm].
     pub z: Option<f64>,
+    /// Fixed-axis X angle [deg], `R = Rz(rz)·Ry(ry)·Rx(rx)`.
     pub rx: Option<f64>,
+    /// Fixed-axis Y angle [deg], `R = Rz(rz)·Ry(ry)·Rx(rx)`.
     pub ry: Option<f64>,
+    /// Fixed-axis Z angle [deg], `R = Rz(rz)·Ry(ry)·Rx(rx)`.
     pub rz: Option<f64>,
+    /// The orientation in the request's `convention` too (null without one).
     pub orientation: Option<OrientationOut>,
     /// 1-based joints outside the controller's limits.
     pub outside_limits: Vec<usize>,
+    /// `full`, `faded` or `none`: how much of the joint maps' and the
+    /// compensator's correction applies (null: the model has neither).
     pub compensation: Option<&'static str>,
+    /// Joints outside the trained range, or far from the training poses.
     pub warning: Option<String>,
+    /// The compensator's expected position error at the pose [mm], when it gives one.
     pub expected_error_mm: Option<f64>,
 }
 
+/// The answer of a predict: the model used, the expected error at the tool and one pose per reading.
 #[derive(Debug, Serialize)]
 pub struct PredictResponse {
+    /// The robot predicted for.
     pub robot_id: i64,
+    /// Model version used (null: the nominal model).
     pub version: Option<i64>,
+    /// Calibration method of that version, or `nominal`.
     pub method: String,
     /// The production tool's name (null: the measured point).
     pub tool: Option<String>,
+    /// Frame of the poses: `cell`, `base` or `work_object`.
     pub frame: &'static str,
+    /// Payload the model was evaluated at [kg].
     pub payload_kg: f64,
+    /// The expected error at the tool, from the validation poses stored with the version.
     pub accuracy: ToolAccuracy,
+    /// Number of readings.
     pub readings: usize,
+    /// One pose per reading, in the input order.
     pub results: Vec<PredictionOut>,
 }
 
@@ -160,6 +195,7 @@ fn command(robot_id: i64, req: &PredictRequest) -> Result<PredictCommand, ApiErr
     })
 }
 
+/// `POST /v1/robots/{id}/predict`: the readings' poses on the chosen model.
 pub async fn predict(
     State(state): State<AppState>,
     ApiPath(robot_id): ApiPath<i64>,

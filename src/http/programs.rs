@@ -8,8 +8,6 @@
 //! objects (`/tools`, `/frames`) and to what the program declares itself. A
 //! program that cannot be parsed is a 422 naming its file, line and column.
 
-#![warn(missing_docs)]
-
 use super::input::{objects, present};
 use super::solve::{model_choice, VersionSelector};
 use super::{ApiError, ApiJson, ApiPath, AppState};

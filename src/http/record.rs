@@ -2,8 +2,6 @@
 //! (robocal version, robot, dates, methods and settings, the versions made,
 //! the sets with row counts and SHA-256), as in the report's "Record" section.
 
-#![warn(missing_docs)]
-
 use super::{ApiError, ApiPath, AppState};
 use crate::service;
 use axum::extract::State;

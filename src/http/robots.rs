@@ -1,8 +1,6 @@
 //! `/v1/robots`: create from a preset or a model JSON, list, get, update name
 //! and metadata, delete (with its measurement sets, calibrations and versions).
 
-#![warn(missing_docs)]
-
 use super::input::{check_payload, page_body, present, Page, PageQuery};
 use super::{ApiError, ApiJson, ApiPath, ApiQuery, AppState};
 use crate::model::presets::{preset_description, PRESETS};

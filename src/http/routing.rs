@@ -4,8 +4,6 @@
 //! (`links`, a created resource's `located` answer). A file of its own, so
 //! the handlers import it and not the router that imports them.
 
-#![warn(missing_docs)]
-
 use crate::service::AppState;
 use axum::handler::Handler;
 use axum::http::{header, Method};

@@ -17,8 +17,6 @@
 //! - on shutdown it stops accepting, lets every connection finish the request
 //!   it is serving and waits for them.
 
-#![warn(missing_docs)]
-
 use super::listener::ServiceListener;
 use axum::Router;
 use hyper_util::rt::{TokioIo, TokioTimer};

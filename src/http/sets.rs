@@ -6,8 +6,6 @@
 //! millimetres and degrees when they are stored; the upload itself is kept
 //! verbatim and served by `GET .../original`.
 
-#![warn(missing_docs)]
-
 use super::error::{content_type, json_content_type};
 use super::input::{
     check_name, check_payload, from_json_object, objects, page_body, present, PageQuery,

@@ -91,26 +91,37 @@ fn branch_syntax_ok(text: &str) -> bool {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(untagged)]
 pub enum VersionSelector {
+    /// A stored model version by its number.
     Number(Int<i64>),
+    /// `active` (the robot's active version) or `nominal` (the uncalibrated model).
     Name(String),
 }
 
+/// A target's orientation: its values in a named convention (or the request's).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OrientationIn {
+    /// Orientation convention of `values` (absent: the request's `convention`).
     #[serde(default, deserialize_with = "present")]
     pub convention: Option<String>,
+    /// 4 (quaternion w,x,y,z), 3 (A,B,C or W,P,R [deg]) or 9 (matrix, row-major) values.
     pub values: Vec<f64>,
 }
 
+/// One target pose of a JSON solve, in the request's frame (cell, base or work object).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TargetIn {
+    /// Echoed in the result: a string or a number (absent: the 1-based index).
     #[serde(default)]
     pub id: Option<Value>,
+    /// Position x [mm].
     pub x: f64,
+    /// Position y [mm].
     pub y: f64,
+    /// Position z [mm].
     pub z: f64,
+    /// The target's orientation (absent or null: a position-only target).
     #[serde(default, deserialize_with = "object_or_null")]
     pub orientation: Option<OrientationIn>,
 }
@@ -119,26 +130,35 @@ pub struct TargetIn {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SolveRequest {
+    /// The target poses, solved in this order (at least one).
     #[serde(deserialize_with = "objects")]
     pub targets: Vec<TargetIn>,
     /// Orientation convention of targets that do not name one; also the
     /// convention of false targets of position-only targets.
     #[serde(default, deserialize_with = "present")]
     pub convention: Option<String>,
+    /// Payload now carried [kg] (absent: the model version's payload).
     #[serde(default, deserialize_with = "present")]
     pub payload_kg: Option<f64>,
+    /// Configuration branch, e.g. `front,up,noflip`, or an index `0`..`7`.
     #[serde(default, deserialize_with = "present")]
     pub branch: Option<String>,
+    /// Joint seed in controller degrees [deg], one per joint: the solution nearest it is chosen.
     #[serde(default, deserialize_with = "present")]
     pub seed_deg: Option<Vec<f64>>,
+    /// Path mode: solve in order, each target seeded by the previous solution.
     #[serde(default, deserialize_with = "present")]
     pub path: Option<bool>,
+    /// Frame of the targets: `cell` (the calibration's measurement frame, default) or `base`.
     #[serde(default, deserialize_with = "present")]
     pub frame: Option<String>,
+    /// Solve the position only; an orientation, when given, only guides the seed.
     #[serde(default, deserialize_with = "present")]
     pub position_only: Option<bool>,
+    /// The model version to solve with (absent: the active version).
     #[serde(default, deserialize_with = "present")]
     pub version: Option<VersionSelector>,
+    /// Path mode: joint changes above this are reported [deg] (default 30).
     #[serde(default, deserialize_with = "present")]
     pub jump_deg: Option<f64>,
     /// A stored tool by name, or one inline (TCP in the flange frame).
@@ -157,7 +177,9 @@ pub struct SolveRequest {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(untagged)]
 pub enum ItemRef {
+    /// The name of one of the robot's stored tools or work objects.
     Name(String),
+    /// A tool or work object given in the request.
     Inline(super::cell::ItemIn),
 }
 
@@ -175,32 +197,53 @@ impl ItemRef {
     }
 }
 
+/// Why a target failed: a stable code and a message for people.
 #[derive(Debug, Serialize)]
 pub struct ReasonOut {
+    /// `unreachable`, `out_of_limits`, `singular`, `did_not_converge`, `invalid_target` or `branch_unavailable`.
     pub code: &'static str,
+    /// What went wrong, in words.
     pub message: String,
 }
 
+/// The false target: the nominal model's pose of the joint commands in the
+/// controller's base frame (in the work object when the solve names one).
 #[derive(Debug, Serialize)]
 pub struct FalseTargetOut {
+    /// Position x [mm].
     pub x: f64,
+    /// Position y [mm].
     pub y: f64,
+    /// Position z [mm].
     pub z: f64,
+    /// Orientation convention of `values` (canonical name).
     pub convention: &'static str,
+    /// The orientation in that convention (angles [deg], `ur_rotvec` [rad]).
     pub values: Vec<f64>,
 }
 
+/// One target's result of a JSON solve, in the input order.
 #[derive(Debug, Serialize)]
 pub struct TargetOut {
+    /// The target's id as given (default: its 1-based index).
     pub id: String,
+    /// `ok` or `failed`.
     pub status: &'static str,
+    /// Why the target failed (null when solved).
     pub reason: Option<ReasonOut>,
+    /// Joint commands, controller convention [deg].
     pub joints_deg: Option<Vec<f64>>,
+    /// The nominal model's pose of the joint commands (null when failed).
     pub false_target: Option<FalseTargetOut>,
+    /// Configuration of the joints, e.g. `front-up-noflip` (null for models without a closed form).
     pub branch: Option<String>,
+    /// `|p(q) − p*|`: the model's position at the joints from the target's [mm] (null for invalid targets).
     pub position_residual_mm: Option<f64>,
+    /// Rotation angle between the model's orientation at the joints and the target's [rad] (null without one).
     pub orientation_residual_rad: Option<f64>,
+    /// Evaluations of the model's prediction, summed over the solver's attempts.
     pub iterations: usize,
+    /// Path mode: the largest joint change from the previous solved target, when above `jump_deg`.
     pub jump: Option<JointJump>,
     /// `full`, `faded` or `none`: how much of the joint maps' and the
     /// compensator's correction applies (null: the model has neither).
@@ -246,21 +289,32 @@ impl From<TargetResult> for TargetOut {
     }
 }
 
+/// The JSON answer of a solve: the model used and one result per target.
 #[derive(Debug, Serialize)]
 pub struct SolveResponse {
+    /// The robot solved for.
     pub robot_id: i64,
     /// Model version used (null: the nominal model).
     pub version: Option<i64>,
     /// Calibration method of that version, or `nominal`.
     pub method: String,
+    /// Frame of the targets and false targets: `cell`, `base` or `work_object`.
     pub frame: String,
+    /// Payload the model was evaluated at [kg].
     pub payload_kg: f64,
+    /// Whether the targets were solved as a path.
     pub path: bool,
+    /// Whether the position only was solved.
     pub position_only: bool,
+    /// Number of targets.
     pub targets: usize,
+    /// Number of targets solved.
     pub solved: usize,
+    /// Number of targets that failed.
     pub failed: usize,
+    /// Wall time of the request in the handler [ms].
     pub elapsed_ms: f64,
+    /// One result per target, in the input order.
     pub results: Vec<TargetOut>,
 }
 
@@ -448,15 +502,23 @@ pub fn json_command(
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CsvSolveQuery {
+    /// A version number, `active` (default) or `nominal`.
     pub version: Option<String>,
+    /// Payload now carried [kg] (default: the model version's payload).
     pub payload_kg: Option<f64>,
+    /// Path mode: joint changes above this are reported [deg] (default 30).
     pub jump_deg: Option<f64>,
+    /// Frame of the targets: `cell` (default) or `base`.
     pub frame: Option<String>,
+    /// Configuration branch, as in the JSON body.
     pub branch: Option<String>,
     /// Controller joint seed [deg], comma-separated.
     pub seed_deg: Option<String>,
+    /// Convention of targets without their own and of position-only targets' false targets.
     pub convention: Option<String>,
+    /// Solve the position only.
     pub position_only: Option<bool>,
+    /// Path mode: solve in order, each target seeded by the previous solution.
     pub path: Option<bool>,
     /// The track's value [mm] (the robot carried along its stored track).
     pub e1: Option<f64>,
@@ -658,6 +720,7 @@ fn csv_answer(done: &SolveOutcome, conv: OrientationConvention, solved: usize) -
         .into_response()
 }
 
+/// `POST /v1/robots/{id}/solve`: the targets (JSON or CSV) solved on the chosen model.
 pub async fn solve(
     State(state): State<AppState>,
     ApiPath(robot_id): ApiPath<i64>,

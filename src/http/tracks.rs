@@ -39,12 +39,16 @@ pub struct TrackCalibrateIn {
     /// The track's column, `e1` … `e6` (default `e1`).
     #[serde(default, deserialize_with = "present")]
     pub column: Option<String>,
+    /// The tracker's noise per coordinate, 1σ [mm], the fit is judged against (default 0.01).
     #[serde(default, deserialize_with = "present")]
     pub sigma_mm: Option<f64>,
+    /// Highest order of the carriage maps tried (default 6; 0: a straight rail).
     #[serde(default)]
     pub max_order: Option<Int<i64>>,
+    /// The calibrated version held (default: the active one).
     #[serde(default)]
     pub version: Option<Int<i64>>,
+    /// Payload of rows that give none [kg] (default: the version's).
     #[serde(default, deserialize_with = "present")]
     pub payload_kg: Option<f64>,
 }
@@ -52,19 +56,29 @@ pub struct TrackCalibrateIn {
 /// A stored track.
 #[derive(Debug, Serialize)]
 pub struct TrackOut {
+    /// The robot the track carries.
     pub robot_id: i64,
     /// The model version the fit held.
     pub version: i64,
+    /// The measurement file's column of the track's value, `e1` … `e6`.
     pub column: String,
+    /// The tracker's σ per coordinate the fit was judged against [mm].
     pub sigma_mm: f64,
+    /// The highest carriage-map order tried.
     pub max_order: i64,
+    /// The readings the fit used.
     pub readings: i64,
+    /// Distinct track values of the readings.
     pub stations: i64,
+    /// RMS of the readings' residuals through the track and the held robot [mm].
     pub rms_mm: f64,
+    /// Largest residual of the fit [mm].
     pub max_mm: f64,
+    /// When it was stored (UTC, RFC 3339).
     pub created_at: String,
     /// The track's JSON description (`robocal track calibrate --out`).
     pub track: Value,
+    /// Links to the track, its calibration and the robot.
     pub links: Value,
 }
 
@@ -150,6 +164,7 @@ fn calibration(id: i64, body: TrackCalibrateIn) -> Result<TrackCalibration, ApiE
     })
 }
 
+/// `POST /v1/robots/{id}/track/calibrate`: fits, judges and stores the robot's track.
 pub async fn calibrate(
     State(s): State<AppState>,
     ApiPath(id): ApiPath<i64>,
@@ -170,6 +185,7 @@ pub async fn calibrate(
     Ok((status, axum::Json(body)).into_response())
 }
 
+/// `GET /v1/robots/{id}/track`: the stored track and what it was fitted on.
 pub async fn get_track(
     State(s): State<AppState>,
     ApiPath(id): ApiPath<i64>,
@@ -178,6 +194,7 @@ pub async fn get_track(
     Ok(axum::Json(TrackOut::from_row(row)?).into_response())
 }
 
+/// `DELETE /v1/robots/{id}/track`: removes the robot's track.
 pub async fn delete_track(
     State(s): State<AppState>,
     ApiPath(id): ApiPath<i64>,

@@ -4,8 +4,6 @@
 //! export it for other tools (`export?format=urdf|dh-csv|mdh-csv|json`, the
 //! text of `crate::model::export`).
 
-#![warn(missing_docs)]
-
 use super::input::{page_body, PageQuery};
 use super::robots::robot_list_page;
 use super::{ApiError, ApiPath, ApiQuery, AppState};

@@ -5,8 +5,6 @@
 //! answers with them); neither layer owns the vocabulary, so the HTTP layer
 //! reads it here without naming the store.
 
-#![warn(missing_docs)]
-
 mod calibrations;
 mod cell;
 mod checks;

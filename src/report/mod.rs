@@ -14,8 +14,6 @@
 //! Templates are maud (escaping by default): robot names and messages are user
 //! text. Charts are in [`charts`].
 
-#![warn(missing_docs)]
-
 pub mod charts;
 pub mod format;
 pub mod iso9283;

@@ -11,8 +11,6 @@
 //! kept); the best method (by validation mean, identification mean without
 //! validation) is activated only when the robot has no active version yet.
 
-#![warn(missing_docs)]
-
 use super::jobs::local::spawn_local;
 use super::jobs::prepare::{prepare, Job};
 use super::jobs::shared::admit;

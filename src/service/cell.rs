@@ -2,8 +2,6 @@
 //! replace all, delete), and the core `Cell` (SI) they make for solves and
 //! program filtering. Poses are in mm and degrees here (`PoseMmDeg`).
 
-#![warn(missing_docs)]
-
 use super::{robots, AppState, ServiceError};
 use crate::records::{CellItemRow, CellKind, CellPut, ItemFrame, NewCellItem};
 use crate::solve::cell::file::{CellDescription, ToolDescription, WorkObjectDescription};

@@ -10,8 +10,6 @@
 //! error: [`Fitted::NotFitted`] says why, and nothing is stored unless the
 //! caller forces a judged fit.
 
-#![warn(missing_docs)]
-
 use super::solve::{chosen_model, ModelChoice};
 use super::{cell, AppState, ServiceError};
 use crate::cell_fit::tcp::entry::{self, Fitted as Judged, Outcome, StoreRequest, StoredEntry};

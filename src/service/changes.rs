@@ -6,8 +6,6 @@
 //! database while its cache is valid. When the listening connection is lost,
 //! announcements may have been missed: every cached robot is dropped.
 
-#![warn(missing_docs)]
-
 use super::AppState;
 use crate::db::RobotChange;
 use std::time::Duration;

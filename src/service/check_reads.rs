@@ -2,8 +2,6 @@
 //! by id, and a page of robots with each robot's latest check (read in one
 //! snapshot, the checks of the page in one query).
 
-#![warn(missing_docs)]
-
 use super::checks::bounded;
 use super::{AppState, ServiceError};
 use crate::records::{CheckRow, RobotRow};

@@ -7,8 +7,6 @@
 //! were scored (`poses_total`): the figures cover every pose, the history and
 //! its pages stay bounded for a set of any size.
 
-#![warn(missing_docs)]
-
 use super::{robots, versions, AppState, ServiceError};
 use crate::db::{Listing, NewCheck};
 use crate::records::CheckRow;

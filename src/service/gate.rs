@@ -15,8 +15,6 @@
 //! file says which in its text (`auto 11 fold`, [`Hold::parse`]), read each
 //! time work passes, so a test can move the hold between jobs.
 
-#![warn(missing_docs)]
-
 use std::path::PathBuf;
 use std::sync::{Condvar, Mutex};
 use std::time::Duration;

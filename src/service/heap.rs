@@ -1,8 +1,6 @@
 //! The heap's free pages handed back to the operating system after large
 //! work (what `AppState::trim_soon` calls once no large work runs).
 
-#![warn(missing_docs)]
-
 /// Hands the heap's free pages back to the operating system (glibc's
 /// `malloc_trim`): after a large request its buffers are free but glibc
 /// keeps them mapped, so the process would stay at its peak size. Costs a

@@ -9,8 +9,6 @@
 //! bounded in CPU and in memory alike, and the memory they freed is handed
 //! back to the system once no large work runs (`heap::trim`).
 
-#![warn(missing_docs)]
-
 use super::waiting::WaitingFlag;
 use super::{AppState, ServiceError};
 

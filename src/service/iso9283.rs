@@ -7,8 +7,6 @@
 //! (its SHA-256) from the store ([`conditions`]); [`plan`] lays out the test
 //! cube on a robot's version and writes its cycle program.
 
-#![warn(missing_docs)]
-
 use super::solve::{chosen_model, ModelChoice};
 use super::{robots, versions, AppState, ServiceError};
 use crate::model::orientation::fixed_xyz_matrix;

@@ -8,8 +8,6 @@
 //! (its progress callback answers "stop" from then on) and its result, if
 //! any, is dropped.
 
-#![warn(missing_docs)]
-
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 use tokio::task::{JoinError, JoinHandle};

@@ -3,8 +3,6 @@
 //! a key without a role is `admin`. The roles nest: `admin` ⊇ `operate` ⊇
 //! `read`. Which role each route needs is decided in `crate::http::auth`.
 
-#![warn(missing_docs)]
-
 use std::fmt;
 
 /// What a key may do. Ordered: a role grants everything a lower one grants.

@@ -15,8 +15,6 @@
 //!   own thread (a few hundred microseconds of CPU), so a 20-target request
 //!   does not wait for four 100k-target batches.
 
-#![warn(missing_docs)]
-
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::time::Duration;

@@ -45,7 +45,6 @@ pub use state::{AppState, RobotContext, ServiceConfig};
 use crate::db::StoreError;
 
 /// Why a service operation did not happen.
-#[warn(missing_docs)]
 #[derive(Debug, thiserror::Error)]
 pub enum ServiceError {
     /// The command is invalid (a value out of range, an unknown name).
@@ -89,7 +88,6 @@ impl From<StoreError> for ServiceError {
     }
 }
 
-#[warn(missing_docs)]
 impl ServiceError {
     /// A 404 naming the robot and where to list robots.
     pub fn robot_not_found(id: i64) -> Self {

@@ -5,8 +5,6 @@
 //! CPU-bound (forward kinematics of every candidate, a greedy D-optimal
 //! choice): runs on the solve workers behind their admission control.
 
-#![warn(missing_docs)]
-
 use super::solve::{chosen_model, ModelChoice};
 use super::{AppState, ServiceError};
 use crate::plan::{make_plan, plan_csv, plan_program, MeasurementPlan, PlanSettings};

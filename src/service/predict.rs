@@ -26,15 +26,19 @@ use robocal_core::model::calibrated::{CalibratedModelFile, CompensatedModel};
 /// A prediction, in domain terms.
 #[derive(Debug, Clone)]
 pub struct PredictCommand {
+    /// The robot to predict for.
     pub robot_id: i64,
+    /// The model to predict with.
     pub model: ModelChoice,
     /// Payload mass [kg] instead of the model's.
     pub payload_kg: Option<f64>,
+    /// The joint readings, controller convention [deg].
     pub readings: Vec<JointReading>,
     /// Production tool on the calibrated flange (`None`: the measured point).
     pub tool: Option<ItemChoice>,
     /// Work object the poses are expressed in (`None`: `frame`).
     pub work_object: Option<ItemChoice>,
+    /// Frame of the poses without a work object: the cell (measurement) frame or the registered base frame.
     pub frame: TargetFrame,
     /// A track value [mm]: the base carried along the robot's stored track.
     pub track_mm: Option<f64>,
@@ -47,6 +51,7 @@ pub struct PredictOutcome {
     pub version: Option<i64>,
     /// Calibration method of that version, or `nominal`.
     pub method: String,
+    /// Payload the model was evaluated at [kg].
     pub payload_kg: f64,
     /// The production tool's name (`None`: the measured point).
     pub tool: Option<String>,

@@ -5,8 +5,6 @@
 //! runs on the solve workers behind the same admission control as large
 //! solve batches.
 
-#![warn(missing_docs)]
-
 use super::solve::{chosen_model, ModelChoice};
 use super::{AppState, ServiceError};
 use crate::program::{

@@ -4,8 +4,6 @@
 //! and each measurement set with its row count and a SHA-256 of the upload
 //! as received (sets a version uses cannot be deleted: `db::set_usage`).
 
-#![warn(missing_docs)]
-
 use super::{calibrations, robots, AppState, ServiceError};
 use serde::Serialize;
 use serde_json::Value;

@@ -11,8 +11,6 @@
 //! `reregistered`: the parent version, the set, what was refitted and the
 //! position errors on the set before and after.
 
-#![warn(missing_docs)]
-
 use super::checks::{self, conflict};
 use super::{versions, AppState, ServiceError};
 use crate::db::NewVersion;

@@ -1,8 +1,6 @@
 //! Robots: create, list, read, rename and delete; the cached robot context and
 //! solvers and the cancel flags of a robot's jobs are kept in step here.
 
-#![warn(missing_docs)]
-
 use super::{AppState, ServiceError};
 use crate::db::Listing;
 use crate::records::{NewRobot, RobotRow};

@@ -7,8 +7,6 @@
 //! Units: rows are stored in mm and degrees (`MeasuredPose`), whatever the
 //! upload declared.
 
-#![warn(missing_docs)]
-
 use super::{AppState, ServiceError};
 use crate::db::{Listing, NewSet};
 use crate::measure::csv::{self, CsvError, ReadOptions};

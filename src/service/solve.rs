@@ -55,11 +55,14 @@ pub enum ModelChoice {
 /// (invalid rows fail alone).
 #[derive(Debug, Clone)]
 pub enum Targets {
+    /// Targets checked one by one (a JSON solve), in mm and degrees.
     Inputs(Vec<TargetInput>),
+    /// The parsed rows of a targets CSV.
     Csv(TargetsCsv),
 }
 
 impl Targets {
+    /// Number of targets (of rows, for a targets CSV).
     pub fn len(&self) -> usize {
         match self {
             Targets::Inputs(t) => t.len(),
@@ -67,6 +70,7 @@ impl Targets {
         }
     }
 
+    /// Whether there is no target.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
@@ -125,7 +129,9 @@ const CHUNK: usize = 2048;
 /// A solve, in domain terms.
 #[derive(Debug, Clone)]
 pub struct SolveCommand {
+    /// The robot to solve for.
     pub robot_id: i64,
+    /// The model to solve with.
     pub model: ModelChoice,
     /// Payload mass [kg] instead of the model's.
     pub payload_kg: Option<f64>,
@@ -136,7 +142,9 @@ pub struct SolveCommand {
     /// Frame, branch, position-only and output convention (`seed` is set
     /// from `seed_deg`).
     pub options: SolveOptions,
+    /// Path mode: in order, each target seeded by the previous solution, joint jumps reported.
     pub path: bool,
+    /// The targets to solve.
     pub targets: Targets,
     /// Production tool on the calibrated flange (`None`: the model's tool).
     pub tool: Option<ItemChoice>,
@@ -154,7 +162,9 @@ pub struct SolveCommand {
 /// A tool or work object of a solve: stored by name, or given inline.
 #[derive(Debug, Clone)]
 pub enum ItemChoice {
+    /// The name of one of the robot's stored tools or work objects.
     Stored(String),
+    /// A tool or work object given with the request, checked.
     Inline(NewCellItem),
 }
 
@@ -165,8 +175,11 @@ pub struct SolveOutcome {
     pub version: Option<i64>,
     /// Calibration method of that version, or `nominal`.
     pub method: String,
+    /// Payload the model was evaluated at [kg].
     pub payload_kg: f64,
+    /// The robot's joint count.
     pub dof: usize,
+    /// One result per target, in the input order.
     pub results: Vec<TargetResult>,
 }
 
@@ -229,8 +242,11 @@ async fn load_model(
 /// A model for work other than a solve batch (program filtering): the chosen
 /// version's compensated model, its number (`None`: nominal) and its method.
 pub struct ChosenModel {
+    /// The chosen version's compensated model (or the nominal one).
     pub model: CompensatedModel,
+    /// Its version number (`None`: the nominal model).
     pub version: Option<i64>,
+    /// Its calibration method, or `nominal`.
     pub method: String,
 }
 

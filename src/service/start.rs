@@ -3,8 +3,6 @@
 //! (`changes.rs`) run beside it. Apart from `state.rs`, which every task
 //! holds, so that the state imports none of them.
 
-#![warn(missing_docs)]
-
 use super::state::{AppState, ServiceConfig};
 use crate::db::Db;
 

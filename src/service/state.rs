@@ -2,8 +2,6 @@
 //! solve queues, cancellation flags and the caches of robots and prepared
 //! solvers.
 
-#![warn(missing_docs)]
-
 use super::gate::{At, WorkGate};
 use super::limits::{Admission, Limits, Ticket, SMALL_SOLVE_MAX};
 use super::waiting::{Waiting, WaitingFlag};

@@ -26,6 +26,7 @@ pub const TRACK_READINGS_MAX: usize = 20_000;
 /// A track fit, in domain terms.
 #[derive(Debug, Clone)]
 pub struct TrackCalibration {
+    /// The robot the track carries.
     pub robot_id: i64,
     /// The calibrated version held (`None`: the active one).
     pub version: Option<i64>,
@@ -45,8 +46,11 @@ pub struct TrackCalibration {
 /// and the fit's report.
 #[derive(Debug, Clone)]
 pub struct StoredTrack {
+    /// The track's row as stored.
     pub row: TrackRow,
+    /// Whether the robot had no track before (the fit created it rather than replaced one).
     pub created: bool,
+    /// The fit's report.
     pub fit: Box<TrackFit>,
 }
 

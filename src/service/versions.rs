@@ -1,8 +1,6 @@
 //! Model versions: list and read them, activate one, roll back; every change
 //! of the active version drops the robot's cached context and solvers.
 
-#![warn(missing_docs)]
-
 use super::{robots, AppState, ServiceError};
 use crate::db::{Listing, Rollback};
 use crate::records::VersionRow;

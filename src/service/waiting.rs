@@ -5,8 +5,6 @@
 //! targets, stops at the next one and frees its solve worker. Every check
 //! passes the test gate ([`super::gate`]) first, where a test holds the work.
 
-#![warn(missing_docs)]
-
 use super::gate::{At, WorkGate};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;

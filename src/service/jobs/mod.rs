@@ -17,8 +17,6 @@
 //! `local`, `shared`; nothing here imports `service::calibrations`, which
 //! queues jobs through this folder.
 
-#![warn(missing_docs)]
-
 pub mod command;
 pub mod local;
 pub(crate) mod prepare;
