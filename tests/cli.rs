@@ -2,22 +2,14 @@
 
 mod common;
 
-use common::robocal_json;
-use std::process::Command;
-
-fn robocal(args: &[&str], dir: &std::path::Path) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_robocal"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap()
-}
+use common::{robocal, robocal_json};
 
 #[test]
 fn simulate_then_calibrate_json_is_scriptable() {
     let dir = std::env::temp_dir().join(format!("robocal-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let a = robocal(
+        &dir,
         &[
             "simulate",
             "--preset",
@@ -31,14 +23,13 @@ fn simulate_then_calibrate_json_is_scriptable() {
             "--truth",
             "truth.json",
         ],
-        &dir,
     );
     assert!(a.status.success(), "{}", String::from_utf8_lossy(&a.stderr));
     let b = robocal(
+        &dir,
         &[
             "simulate", "--preset", "ys100", "--poses", "20", "--seed", "2", "--out", "q2.csv",
         ],
-        &dir,
     );
     assert!(b.status.success());
     let v = robocal_json(
@@ -77,6 +68,7 @@ fn simulate_then_calibrate_json_is_scriptable() {
     // The saved model is a valid model description; the truth model loads as a model file.
     robocal::model::RobotModel::from_json(&saved["model"].to_string()).unwrap();
     let t = robocal(
+        &dir,
         &[
             "calibrate",
             "--model",
@@ -86,7 +78,6 @@ fn simulate_then_calibrate_json_is_scriptable() {
             "--method",
             "km",
         ],
-        &dir,
     );
     assert!(t.status.success(), "{}", String::from_utf8_lossy(&t.stderr));
     let text = String::from_utf8_lossy(&t.stdout);
@@ -107,18 +98,19 @@ fn errors_are_reported_not_panicked() {
     )
     .unwrap();
     let out = robocal(
-        &["calibrate", "--model", "ys100", "--identify", "bad.csv"],
         &dir,
+        &["calibrate", "--model", "ys100", "--identify", "bad.csv"],
     );
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("line 2"), "{err}");
     let out = robocal(
-        &["calibrate", "--model", "kr16", "--identify", "bad.csv"],
         &dir,
+        &["calibrate", "--model", "kr16", "--identify", "bad.csv"],
     );
     assert!(String::from_utf8_lossy(&out.stderr).contains("unknown robot preset"));
     let out = robocal(
+        &dir,
         &[
             "calibrate",
             "--model",
@@ -128,10 +120,9 @@ fn errors_are_reported_not_panicked() {
             "--method",
             "fancy",
         ],
-        &dir,
     );
     assert!(String::from_utf8_lossy(&out.stderr).contains("unknown method `fancy`"));
-    let out = robocal(&["demo", "nothing"], &dir);
+    let out = robocal(&dir, &["demo", "nothing"]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("unknown demo"));
     std::fs::remove_dir_all(&dir).ok();
 }
@@ -146,6 +137,7 @@ fn compensator_method_saves_and_solves() {
     std::fs::create_dir_all(&dir).unwrap();
     for (set, n, seed) in [("identification", "40", "1"), ("training", "80", "2")] {
         let a = robocal(
+            &dir,
             &[
                 "simulate",
                 "--poses",
@@ -159,11 +151,11 @@ fn compensator_method_saves_and_solves() {
                 "--out",
                 &format!("{set}.csv"),
             ],
-            &dir,
         );
         assert!(a.status.success(), "{}", String::from_utf8_lossy(&a.stderr));
     }
     let out = robocal(
+        &dir,
         &[
             "calibrate",
             "--model",
@@ -181,7 +173,6 @@ fn compensator_method_saves_and_solves() {
             "--save-method",
             "skcm-nn",
         ],
-        &dir,
     );
     assert!(
         out.status.success(),
@@ -239,6 +230,7 @@ fn compensator_method_saves_and_solves() {
     hostile["compensator"]["weights"][3] = 1e308.into();
     std::fs::write(dir.join("hostile.json"), hostile.to_string()).unwrap();
     let out = robocal(
+        &dir,
         &[
             "solve",
             "--model",
@@ -246,7 +238,6 @@ fn compensator_method_saves_and_solves() {
             "--targets",
             "targets.csv",
         ],
-        &dir,
     );
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success(), "{err}");

@@ -3,28 +3,19 @@
 //! `solve` with 2 when a target failed unless `--allow-failures`, refused
 //! input with 1; docs/guide/exit-codes.md states the code's table.
 
+mod common;
+
+use common::{code, robocal, text};
 use robocal::check::CheckStatus;
 use robocal::cli::exit::Exit;
 use robocal::measure::{csv, MeasuredPose};
 use robocal::model::preset;
 use robocal_core::model::calibrated::CompensatedModel;
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn robocal(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_robocal"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn code(out: &Output) -> i32 {
-    out.status.code().expect("ended by a signal")
-}
+use std::process::Output;
 
 fn stdout(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stdout).into_owned()
+    text(&out.stdout)
 }
 
 /// The rows of every markdown table of the guide's page `name`

@@ -8,93 +8,35 @@
 //! the command prints against the fit's limits; refusals exit with
 //! `refused` (1) and write nothing.
 
-use nalgebra::{Rotation3, Vector3};
+mod common;
+#[path = "../core/tests/common/mod.rs"]
+mod core_common;
+
+use common::{assert_refused, code, line_rms, robocal, save_robot_file, text};
+use core_common::positioner::{nominal, sweeps};
+use core_common::track::ys100_truth;
+use nalgebra::Vector3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal::calibrate::external::readings::PositionerColumns;
 use robocal::measure::csv::write_set;
 use robocal::measure::external::ExternalAxis;
-use robocal::model::external::{RotaryAxis, TiltRotate};
+use robocal::model::external::TiltRotate;
 use robocal::model::pose::rpy_matrix;
 use robocal::model::Pose;
-use robocal::sim::positioner::{TrueAxis, TruePositioner, Wobble};
+use robocal::sim::positioner::TruePositioner;
 use robocal::sim::positioner_sets::positioner_set;
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
 const COLUMNS: PositionerColumns = PositionerColumns {
     tilt: ExternalAxis::E1,
     rotate: ExternalAxis::E2,
 };
 
-fn robocal(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_robocal"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn code(out: &Output) -> i32 {
-    out.status.code().expect("ended by a signal")
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
-
-fn nominal() -> TiltRotate {
-    TiltRotate {
-        cell_from_base: Pose::new(
-            rpy_matrix(0.0, 0.0, 30f64.to_radians()),
-            Vector3::new(2.5, -0.8, -0.9),
-        ),
-        tilt: RotaryAxis::new(Vector3::x(), Vector3::new(0.0, 0.0, 0.8), 0.0, 1.0),
-        rotate: RotaryAxis::new(Vector3::z(), Vector3::zeros(), 0.0, 1.0),
-        face_plate: Pose::from_translation(Vector3::new(0.0, 0.0, 1.1)),
-    }
-}
-
-fn turned(v: Vector3<f64>, about: Vector3<f64>, deg: f64) -> Vector3<f64> {
-    Rotation3::from_scaled_axis(about.normalize() * deg.to_radians()) * v
-}
-
+/// The simulated positioner, its rotate axis nodding 0.003°.
 fn truth() -> TruePositioner {
-    TruePositioner {
-        cell_from_base: nominal().cell_from_base,
-        tilt: TrueAxis {
-            direction: turned(Vector3::x(), Vector3::new(0.0, 0.6, 0.8), 0.05),
-            through: Vector3::new(0.0, 0.0003, 0.8004),
-            encoder_offset_rad: 0.3f64.to_radians(),
-            scale: 1.0 + 2e-4,
-            wobble: None,
-        },
-        rotate: TrueAxis {
-            direction: turned(Vector3::z(), Vector3::new(1.0, 1.0, 0.0), 0.05),
-            through: Vector3::new(0.0004, -0.0003, 0.0),
-            encoder_offset_rad: -0.4f64.to_radians(),
-            scale: 1.0 - 1.5e-4,
-            wobble: Some(Wobble {
-                amplitude_rad: 0.003f64.to_radians(),
-                phase_rad: 0.7,
-                pivot_along_m: 0.95,
-            }),
-        },
-        reflectors: vec![
-            Vector3::new(0.4002, 0.0003, 1.1198),
-            Vector3::new(-0.1497, 0.1004, 1.1203),
-        ],
-        noise_mm: 0.01,
-    }
-}
-
-/// Axis 2 over 330° at axis 1 = 0, axis 1 over 180° at axis 2 = 0.
-fn sweeps() -> Vec<[f64; 2]> {
-    let mut v: Vec<[f64; 2]> = (0..12)
-        .map(|i| [0.0, -165.0 + 30.0 * f64::from(i)])
-        .collect();
-    v.extend((0..13).map(|i| [-90.0 + 15.0 * f64::from(i), 0.0]));
-    v
+    core_common::positioner::truth(0.003)
 }
 
 /// Both axes moved together, none a fitted pair.
@@ -158,19 +100,7 @@ fn a_positioner_is_calibrated_from_files_and_carries_points_at_held_out_values()
         report.starts_with("positioner fitted: 50 readings of 2 reflectors (tilt e1, rotate e2)")
     );
     // The held-out readings (noise included) within the fit's RMS limit.
-    let line = report
-        .lines()
-        .find(|l| l.starts_with("held out: 32 readings at 16 pairs"))
-        .unwrap();
-    let rms: f64 = line
-        .split("rms ")
-        .nth(1)
-        .unwrap()
-        .split(' ')
-        .next()
-        .unwrap()
-        .parse()
-        .unwrap();
+    let (line, rms) = line_rms(&report, "held out: 32 readings at 16 pairs");
     assert!(rms > 0.0 && rms < 0.052, "{line}");
 
     // The written positioner against the truth, noise-free, at the held-out
@@ -237,23 +167,13 @@ fn fits_the_files_cannot_carry_exit_refused_and_write_nothing() {
     write(d, "n0.csv", &t, 0, &narrow, 5);
     write(d, "n1.csv", &t, 1, &narrow, 6);
     let out = calibrate(d, ["n0.csv", "n1.csv"], &[]);
-    assert_eq!(code(&out), 1);
-    assert!(
-        text(&out.stderr).contains("not fitted (span_too_small)"),
-        "{}",
-        text(&out.stderr)
-    );
+    assert_refused(&out, "not fitted (span_too_small)");
     assert!(!d.join("p.json").exists());
 
     // The files read for columns they do not have, and one design position
     // for two files: refused before any fit.
     let out = calibrate(d, ["n0.csv", "n1.csv"], &["--rotate-column", "e3"]);
-    assert_eq!(code(&out), 1);
-    assert!(
-        text(&out.stderr).contains("no column `e3`"),
-        "{}",
-        text(&out.stderr)
-    );
+    assert_refused(&out, "no column `e3`");
     let out = robocal(
         d,
         &[
@@ -269,37 +189,15 @@ fn fits_the_files_cannot_carry_exit_refused_and_write_nothing() {
             "p.json",
         ],
     );
-    assert_eq!(code(&out), 1);
-    assert!(
-        text(&out.stderr).contains("one design position per file"),
-        "{}",
-        text(&out.stderr)
-    );
+    assert_refused(&out, "one design position per file");
     assert!(!d.join("p.json").exists());
 }
 
 /// A YS100 (its true geometry is the model file's, on the cell's origin)
 /// in front of the positioner, placed 1.7 m along the cell's x.
 fn robot_file(d: &Path) -> robocal::sim::TrueRobot {
-    let nominal = robocal::model::preset("ys100").unwrap();
-    let mut rng = ChaCha8Rng::seed_from_u64(9);
-    let truth = robocal::sim::TrueRobot::new(robocal::sim::perturb_geometry(
-        &nominal,
-        &robocal::sim::ErrorMagnitudes::from_mm_deg(1.0, 0.1),
-        &mut rng,
-    ));
-    let model = robocal::model::calibrated::CompensatedModel {
-        calibrated: truth.model.clone(),
-        nominal: nominal.clone(),
-        cell_from_base: Pose::identity(),
-        payload_kg: nominal.payload.mass,
-        compensator: None,
-    };
-    robocal::cli::model_files::save_model_file(
-        &robocal::model::calibrated::CalibratedModelFile::from_compensated(&model, "ys100", "km"),
-        &d.join("robot.json"),
-    )
-    .unwrap();
+    let (nominal, truth) = ys100_truth(&mut ChaCha8Rng::seed_from_u64(9));
+    save_robot_file(&truth.model, &nominal, &d.join("robot.json"));
     truth
 }
 
@@ -451,12 +349,7 @@ fn solve_takes_targets_on_the_face_plate_at_each_rows_axis_values() {
             "--position-only",
         ],
     );
-    assert_eq!(code(&out), 1);
-    assert!(
-        text(&out.stderr).contains("an `e2` column"),
-        "{}",
-        text(&out.stderr)
-    );
+    assert_refused(&out, "an `e2` column");
     let out = robocal(
         d,
         &[
@@ -472,10 +365,5 @@ fn solve_takes_targets_on_the_face_plate_at_each_rows_axis_values() {
             "--position-only",
         ],
     );
-    assert_eq!(code(&out), 1, "{}", text(&out.stderr));
-    assert!(
-        text(&out.stderr).contains("cannot be used with"),
-        "{}",
-        text(&out.stderr)
-    );
+    assert_refused(&out, "cannot be used with");
 }

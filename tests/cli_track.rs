@@ -10,33 +10,26 @@
 //! nothing. `predict --track` and `solve --track` without `--e1` take each
 //! row's track value from the joints or targets file's `e1` column.
 
+mod common;
+#[path = "../core/tests/common/mod.rs"]
+mod core_common;
+
+use common::{assert_refused, code, line_rms, robocal, save_robot_file, text};
+use core_common::track::{measure_on_track, true_pose, ys100_truth, STATIONS};
 use nalgebra::{UnitQuaternion, Vector3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use robocal::cli::model_files::save_model_file;
 use robocal::measure::csv::write_set;
-use robocal::measure::external::{ExternalAxis, MeasurementSet};
-use robocal::model::calibrated::{CalibratedModelFile, CompensatedModel};
+use robocal::measure::external::MeasurementSet;
 use robocal::model::external::LinearTrack;
-use robocal::model::{preset, Pose, RobotModel};
+use robocal::model::{Pose, RobotModel};
 use robocal::sim::track::TrueTrack;
-use robocal::sim::{perturb_geometry, random_configurations, ErrorMagnitudes, TrueRobot};
+use robocal::sim::{random_configurations, TrueRobot};
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
-const STATIONS: [f64; 11] = [
-    0.0, 400.0, 800.0, 1200.0, 1600.0, 2000.0, 2400.0, 2800.0, 3200.0, 3600.0, 4000.0,
-];
 /// A track value the fit never saw [mm].
 const HELD_OUT_MM: f64 = 1000.0;
-
-fn robocal(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_robocal"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap()
-}
 
 /// `robocal track calibrate SET --model robot.json --out rail.json` and `extra`, run in `d`.
 fn track_calibrate(d: &Path, set: &str, extra: &[&str]) -> Output {
@@ -53,14 +46,6 @@ fn track_calibrate(d: &Path, set: &str, extra: &[&str]) -> Output {
     robocal(d, &args)
 }
 
-fn code(out: &Output) -> i32 {
-    out.status.code().expect("ended by a signal")
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
-
 struct Cell {
     nominal: RobotModel,
     truth: TrueRobot,
@@ -69,13 +54,7 @@ struct Cell {
 
 impl Cell {
     fn new(rng: &mut ChaCha8Rng) -> Self {
-        let nominal = preset("ys100").unwrap();
-        let mut truth = TrueRobot::new(perturb_geometry(
-            &nominal,
-            &ErrorMagnitudes::from_mm_deg(1.0, 0.1),
-            rng,
-        ));
-        truth.noise_mm = 0.01;
+        let (nominal, truth) = ys100_truth(rng);
         Cell {
             nominal,
             truth,
@@ -85,26 +64,12 @@ impl Cell {
 
     /// `n` poses at each of `values`, read by the tracker.
     fn measure(&self, values: &[f64], n: usize, rng: &mut ChaCha8Rng) -> MeasurementSet {
-        let stations: Vec<(f64, Vec<Vec<f64>>)> = values
-            .iter()
-            .map(|v| (*v, random_configurations(&self.nominal, n, rng)))
-            .collect();
-        self.track
-            .measure(
-                &self.truth,
-                ExternalAxis::E1,
-                &stations,
-                Some(self.nominal.payload.mass),
-                rng,
-            )
-            .unwrap()
+        measure_on_track(&self.truth, &self.nominal, &self.track, values, n, rng)
     }
 
     /// The true tool pose in the cell frame (no noise).
     fn true_pose(&self, q: &[f64], value_mm: f64) -> Pose {
-        self.track
-            .cell_from_base(value_mm)
-            .compose(&self.truth.true_pose_base(q, None).unwrap())
+        true_pose(&self.truth, &self.track, q, value_mm)
     }
 
     /// Controller degrees of model joints.
@@ -127,18 +92,31 @@ fn row(v: &[f64]) -> String {
 /// The cell's robot as its model file `robot.json` in `d` (the robot's own
 /// geometry held: what the track fit is judged on is the track).
 fn save_robot(cell: &Cell, d: &std::path::Path) {
-    let model = CompensatedModel {
-        calibrated: cell.truth.model.clone(),
-        nominal: cell.nominal.clone(),
-        cell_from_base: Pose::identity(),
-        payload_kg: cell.nominal.payload.mass,
-        compensator: None,
-    };
-    save_model_file(
-        &CalibratedModelFile::from_compensated(&model, "ys100", "km"),
-        &d.join("robot.json"),
-    )
-    .unwrap();
+    save_robot_file(&cell.truth.model, &cell.nominal, &d.join("robot.json"));
+}
+
+/// The cell of `seed` in a new directory: its robot as `robot.json`, its
+/// track fitted from 15 poses at each station as `rail.json`; the generator
+/// goes on where the readings left it.
+fn fitted(seed: u64) -> (ChaCha8Rng, Cell, tempfile::TempDir) {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let cell = Cell::new(&mut rng);
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    save_robot(&cell, d);
+    let set = cell.measure(&STATIONS, 15, &mut rng);
+    std::fs::write(d.join("track.csv"), write_set(&set)).unwrap();
+    let out = track_calibrate(d, "track.csv", &[]);
+    assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+    (rng, cell, dir)
+}
+
+/// The indices of the rows of a `--json` document's results that did not
+/// end `ok`.
+fn failed_rows(results: &[serde_json::Value]) -> Vec<usize> {
+    (0..results.len())
+        .filter(|&i| results[i]["status"] != "ok")
+        .collect()
 }
 
 #[test]
@@ -167,19 +145,7 @@ fn a_track_is_calibrated_from_a_file_and_predicts_and_solves_through_it() {
         assert!(report.contains(&format!("  {term}: ")), "{term}");
     }
     // The held-out line: 40 readings at 4 values within 0.052 mm (3·√3 σ).
-    let line = report
-        .lines()
-        .find(|l| l.starts_with("held out: 40 readings"))
-        .unwrap();
-    let rms: f64 = line
-        .split("rms ")
-        .nth(1)
-        .unwrap()
-        .split(' ')
-        .next()
-        .unwrap()
-        .parse()
-        .unwrap();
+    let (line, rms) = line_rms(&report, "held out: 40 readings");
     assert!(rms > 0.0 && rms < 0.052, "{line}");
 
     // The written track against the truth at a value never fitted: the
@@ -351,27 +317,18 @@ fn fits_the_file_cannot_carry_exit_refused_and_write_nothing() {
     let few = cell.measure(&STATIONS[..4], 5, &mut rng);
     std::fs::write(d.join("few.csv"), write_set(&few)).unwrap();
     let out = track_calibrate(d, "few.csv", &[]);
-    assert_eq!(code(&out), 1);
-    assert!(text(&out.stderr).contains("not fitted (too_few_stations)"));
+    assert_refused(&out, "not fitted (too_few_stations)");
     assert!(!d.join("rail.json").exists());
 
     // The set read for the wrong column.
     let out = track_calibrate(d, "few.csv", &["--column", "e2"]);
-    assert_eq!(code(&out), 1);
-    assert!(text(&out.stderr).contains("not fitted (missing_column)"));
+    assert_refused(&out, "not fitted (missing_column)");
 }
 
 #[test]
 fn predict_reads_a_track_value_per_row_from_the_joints_file() {
-    let mut rng = ChaCha8Rng::seed_from_u64(7);
-    let cell = Cell::new(&mut rng);
-    let dir = tempfile::tempdir().unwrap();
+    let (mut rng, cell, dir) = fitted(7);
     let d = dir.path();
-    save_robot(&cell, d);
-    let set = cell.measure(&STATIONS, 15, &mut rng);
-    std::fs::write(d.join("track.csv"), write_set(&set)).unwrap();
-    let out = track_calibrate(d, "track.csv", &[]);
-    assert_eq!(code(&out), 0, "{}", text(&out.stderr));
 
     // Rows at three values the fit never saw, each with its own `e1`.
     let values = [200.0, HELD_OUT_MM, 2600.0];
@@ -443,9 +400,7 @@ fn predict_reads_a_track_value_per_row_from_the_joints_file() {
     assert_eq!(code(&out), 2, "{}", text(&out.stderr));
     let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let results = doc["results"].as_array().unwrap();
-    let failed: Vec<usize> = (0..results.len())
-        .filter(|&i| results[i]["status"] != "ok")
-        .collect();
+    let failed = failed_rows(results);
     assert_eq!(failed, vec![4], "{doc}");
     let message = results[4]["message"].as_str().unwrap();
     assert!(message.starts_with("line 6: e1: "), "{message}");
@@ -454,19 +409,9 @@ fn predict_reads_a_track_value_per_row_from_the_joints_file() {
     // `--e1` beside an `e1` column is ambiguous; `--track` alone without the
     // column, and `solve --track` without `--e1`, have no value: refused.
     let out = predict("rows.csv", &["--e1", "1000"]);
-    assert_eq!(code(&out), 1);
-    assert!(
-        text(&out.stderr).contains("ambiguous"),
-        "{}",
-        text(&out.stderr)
-    );
+    assert_refused(&out, "ambiguous");
     let out = predict("one.csv", &[]);
-    assert_eq!(code(&out), 1);
-    assert!(
-        text(&out.stderr).contains("has none: add the column (mm) or give --e1 MM"),
-        "{}",
-        text(&out.stderr)
-    );
+    assert_refused(&out, "has none: add the column (mm) or give --e1 MM");
     std::fs::write(d.join("targets.csv"), "x,y,z\n1500,0,1200\n").unwrap();
     let out = robocal(
         d,
@@ -480,12 +425,7 @@ fn predict_reads_a_track_value_per_row_from_the_joints_file() {
             "rail.json",
         ],
     );
-    assert_eq!(code(&out), 1);
-    assert!(
-        text(&out.stderr).contains("has none: add the column (mm) or give --e1 MM"),
-        "{}",
-        text(&out.stderr)
-    );
+    assert_refused(&out, "has none: add the column (mm) or give --e1 MM");
 }
 
 /// Solved joints of a `solve --json` document, model convention [rad].
@@ -501,15 +441,8 @@ fn solved_joints(cell: &Cell, t: &serde_json::Value) -> Vec<f64> {
 
 #[test]
 fn solve_reads_a_track_value_per_row_from_the_targets_file() {
-    let mut rng = ChaCha8Rng::seed_from_u64(8);
-    let cell = Cell::new(&mut rng);
-    let dir = tempfile::tempdir().unwrap();
+    let (mut rng, cell, dir) = fitted(8);
     let d = dir.path();
-    save_robot(&cell, d);
-    let set = cell.measure(&STATIONS, 15, &mut rng);
-    std::fs::write(d.join("track.csv"), write_set(&set)).unwrap();
-    let out = track_calibrate(d, "track.csv", &[]);
-    assert_eq!(code(&out), 0, "{}", text(&out.stderr));
 
     // Poses the true robot reached at three values the fit never saw, each
     // row with its own `e1`.
@@ -595,9 +528,7 @@ fn solve_reads_a_track_value_per_row_from_the_targets_file() {
     assert_eq!(code(&out), 2, "{}", text(&out.stderr));
     let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let results = doc["targets"].as_array().unwrap();
-    let failed: Vec<usize> = (0..results.len())
-        .filter(|&i| results[i]["status"] != "ok")
-        .collect();
+    let failed = failed_rows(results);
     assert_eq!(failed, vec![2, 5], "{doc}");
     assert_eq!(results[2]["reason"], "invalid_target");
     let m = results[2]["message"].as_str().unwrap();
@@ -613,22 +544,12 @@ fn solve_reads_a_track_value_per_row_from_the_targets_file() {
     // `--e1` beside the column is ambiguous; the column without `--track`
     // would solve the rows as if the track stood still: both refused.
     let out = solve("rows.csv", &["--e1", "1000"]);
-    assert_eq!(code(&out), 1);
-    assert!(
-        text(&out.stderr).contains("ambiguous"),
-        "{}",
-        text(&out.stderr)
-    );
+    assert_refused(&out, "ambiguous");
     let out = robocal(
         d,
         &["solve", "--model", "robot.json", "--targets", "rows.csv"],
     );
-    assert_eq!(code(&out), 1);
-    assert!(
-        text(&out.stderr).contains("give --track FILE"),
-        "{}",
-        text(&out.stderr)
-    );
+    assert_refused(&out, "give --track FILE");
 }
 
 fn numbers(v: &serde_json::Value) -> Vec<f64> {

@@ -8,102 +8,17 @@
 //!
 //! Figures: `cargo test -p robocal-core --test positioner -- --nocapture`.
 
+mod common;
+
+use common::positioner::{fit_plan, held_out, nominal, truth, DESIGN_MM, TRACKER_SIGMA_MM};
 use nalgebra::{Rotation3, Vector3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal_core::calibrate::external::{
     fit_positioner, PositionerFit, PositionerFitRequest, PositionerReading, RefusalReason,
 };
-use robocal_core::model::external::{Line, RotaryAxis, TiltRotate};
-use robocal_core::model::pose::rpy_matrix;
-use robocal_core::model::Pose;
-use robocal_core::sim::positioner::{TrueAxis, TruePositioner, Wobble};
-
-const TRACKER_SIGMA_MM: f64 = 0.01;
-/// Design positions of the reflectors on the face plate [mm]; the first is
-/// the reference, 400 mm from axis 2.
-const DESIGN_MM: [[f64; 3]; 2] = [[400.0, 0.0, 20.0], [-150.0, 100.0, 20.0]];
-
-/// Tilt axis along base x at 800 mm, rotate axis along the tilt frame's z,
-/// face plate 300 mm above the tilt axis; the base 2.5 m from the tracker,
-/// turned 30° about the vertical.
-fn nominal() -> TiltRotate {
-    TiltRotate {
-        cell_from_base: Pose::new(
-            rpy_matrix(0.0, 0.0, 30f64.to_radians()),
-            Vector3::new(2.5, -0.8, -0.9),
-        ),
-        tilt: RotaryAxis::new(Vector3::x(), Vector3::new(0.0, 0.0, 0.8), 0.0, 1.0),
-        rotate: RotaryAxis::new(Vector3::z(), Vector3::zeros(), 0.0, 1.0),
-        face_plate: Pose::from_translation(Vector3::new(0.0, 0.0, 1.1)),
-    }
-}
-
-/// `v` turned by `deg` about the unit `about`.
-fn turned(v: Vector3<f64>, about: Vector3<f64>, deg: f64) -> Vector3<f64> {
-    Rotation3::from_scaled_axis(about.normalize() * deg.to_radians()) * v
-}
-
-/// The truth: each axis tilted 0.05° and offset 0.5 mm from nominal, zero
-/// offsets of 0.3° and −0.4°, scales off by 2e-4 and −1.5e-4, the rotate
-/// axis nodding by `wobble_deg` once per revolution; the reflectors placed
-/// 0.2–0.4 mm off their design positions.
-fn truth(wobble_deg: f64) -> TruePositioner {
-    let u1 = turned(Vector3::x(), Vector3::new(0.0, 0.6, 0.8), 0.05);
-    let u2 = turned(Vector3::z(), Vector3::new(1.0, 1.0, 0.0), 0.05);
-    TruePositioner {
-        cell_from_base: nominal().cell_from_base,
-        tilt: TrueAxis {
-            direction: u1,
-            through: Vector3::new(0.0, 0.0003, 0.8004),
-            encoder_offset_rad: 0.3f64.to_radians(),
-            scale: 1.0 + 2e-4,
-            wobble: None,
-        },
-        rotate: TrueAxis {
-            direction: u2,
-            through: Vector3::new(0.0004, -0.0003, 0.0),
-            encoder_offset_rad: -0.4f64.to_radians(),
-            scale: 1.0 - 1.5e-4,
-            wobble: Some(Wobble {
-                amplitude_rad: wobble_deg.to_radians(),
-                phase_rad: 0.7,
-                pivot_along_m: 0.95,
-            }),
-        },
-        reflectors: vec![
-            Vector3::new(0.4002, 0.0003, 1.1198),
-            Vector3::new(-0.1497, 0.1004, 1.1203),
-        ],
-        noise_mm: TRACKER_SIGMA_MM,
-    }
-}
-
-/// Axis 2 swept at axis 1 = 0 over 330° (12 values), axis 1 swept at axis
-/// 2 = 0 over 180° (13 values), both reflectors.
-fn fit_plan() -> Vec<(usize, [f64; 2])> {
-    let mut plan = Vec::new();
-    for k in 0..2 {
-        for i in 0..12 {
-            plan.push((k, [0.0, -165.0 + 30.0 * i as f64]));
-        }
-        for i in 0..13 {
-            plan.push((k, [-90.0 + 15.0 * i as f64, 0.0]));
-        }
-    }
-    plan
-}
-
-/// Held-out values over both axes' travel, none of them a fitted pair.
-fn held_out() -> Vec<[f64; 2]> {
-    let mut v = Vec::new();
-    for a in [-80.0, -52.0, -23.0, 8.0, 37.0, 61.0, 84.0] {
-        for b in [-172.0, -118.0, -71.0, -26.0, 19.0, 66.0, 107.0, 151.0] {
-            v.push([a, b]);
-        }
-    }
-    v
-}
+use robocal_core::model::external::{Line, TiltRotate};
+use robocal_core::sim::positioner::TruePositioner;
 
 fn request(readings: Vec<PositionerReading>) -> PositionerFitRequest {
     PositionerFitRequest {

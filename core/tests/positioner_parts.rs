@@ -17,89 +17,29 @@
 //!
 //! Figures: `cargo test -p robocal-core --test positioner_parts -- --nocapture`.
 
+mod common;
+
+use common::positioner::{self, fit_plan, nominal, DESIGN_MM, TRACKER_SIGMA_MM};
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal_core::calibrate::external::{fit_positioner, PositionerFitRequest};
 use robocal_core::model::calibrated::CompensatedModel;
-use robocal_core::model::external::{RotaryAxis, TiltRotate};
+use robocal_core::model::external::TiltRotate;
 use robocal_core::model::pose::rpy_matrix;
 use robocal_core::model::{preset, Pose};
-use robocal_core::sim::positioner::{TrueAxis, TruePositioner, Wobble};
+use robocal_core::sim::positioner::TruePositioner;
 use robocal_core::solve::external::{base_from_part, cell_from_part, part_from_cell, AxisValues};
 
-const SIGMA_MM: f64 = 0.01;
-/// Reflectors' design positions on the face plate [mm]; the first is the reference.
-const DESIGN_MM: [[f64; 3]; 2] = [[400.0, 0.0, 20.0], [-150.0, 100.0, 20.0]];
-
-fn nominal() -> TiltRotate {
-    TiltRotate {
-        cell_from_base: Pose::new(
-            rpy_matrix(0.0, 0.0, 30f64.to_radians()),
-            Vector3::new(2.5, -0.8, -0.9),
-        ),
-        tilt: RotaryAxis::new(Vector3::x(), Vector3::new(0.0, 0.0, 0.8), 0.0, 1.0),
-        rotate: RotaryAxis::new(Vector3::z(), Vector3::zeros(), 0.0, 1.0),
-        face_plate: Pose::from_translation(Vector3::new(0.0, 0.0, 1.1)),
-    }
-}
-
-fn turned(v: Vector3<f64>, about: Vector3<f64>, deg: f64) -> Vector3<f64> {
-    Rotation3::from_scaled_axis(about.normalize() * deg.to_radians()) * v
-}
-
-/// Each axis tilted 0.05° and offset ~0.5 mm, zero offsets 0.3° and
-/// −0.4°, scales off by 2e-4 and −1.5e-4, the rotate axis nodding 0.003°.
-fn truth() -> TruePositioner {
-    TruePositioner {
-        cell_from_base: nominal().cell_from_base,
-        tilt: TrueAxis {
-            direction: turned(Vector3::x(), Vector3::new(0.0, 0.6, 0.8), 0.05),
-            through: Vector3::new(0.0, 0.0003, 0.8004),
-            encoder_offset_rad: 0.3f64.to_radians(),
-            scale: 1.0 + 2e-4,
-            wobble: None,
-        },
-        rotate: TrueAxis {
-            direction: turned(Vector3::z(), Vector3::new(1.0, 1.0, 0.0), 0.05),
-            through: Vector3::new(0.0004, -0.0003, 0.0),
-            encoder_offset_rad: -0.4f64.to_radians(),
-            scale: 1.0 - 1.5e-4,
-            wobble: Some(Wobble {
-                amplitude_rad: 0.003f64.to_radians(),
-                phase_rad: 0.7,
-                pivot_along_m: 0.95,
-            }),
-        },
-        reflectors: vec![
-            Vector3::new(0.4002, 0.0003, 1.1198),
-            Vector3::new(-0.1497, 0.1004, 1.1203),
-        ],
-        noise_mm: SIGMA_MM,
-    }
-}
-
-/// Axis 2 over 330° at axis 1 = 0, axis 1 over 180° at axis 2 = 0, both reflectors.
-fn fit_plan() -> Vec<(usize, [f64; 2])> {
-    let mut plan = Vec::new();
-    for k in 0..2 {
-        plan.extend((0..12).map(|i| (k, [0.0, -165.0 + 30.0 * f64::from(i)])));
-        plan.extend((0..13).map(|i| (k, [-90.0 + 15.0 * f64::from(i), 0.0])));
-    }
-    plan
-}
-
+/// The held-out values as the carrying functions take them.
 fn held_out() -> Vec<AxisValues> {
-    let mut v = Vec::new();
-    for a in [-80.0, -52.0, -23.0, 8.0, 37.0, 61.0, 84.0] {
-        for b in [-172.0, -118.0, -71.0, -26.0, 19.0, 66.0, 107.0, 151.0] {
-            v.push(AxisValues {
-                tilt_deg: a,
-                rotate_deg: b,
-            });
-        }
-    }
-    v
+    positioner::held_out()
+        .into_iter()
+        .map(|[a, b]| AxisValues {
+            tilt_deg: a,
+            rotate_deg: b,
+        })
+        .collect()
 }
 
 /// The part's true pose in the cell at `v`: its origin and its axes' tips
@@ -149,13 +89,13 @@ fn a_part_on_the_face_plate_lands_where_the_true_positioner_puts_it() {
     // The part: ~430 mm from axis 2, 60 mm above the plate, turned.
     let body = Pose::new(rpy_matrix(0.3, -0.2, 1.1), Vector3::new(0.35, 0.25, 1.16));
     for seed in [1, 2, 3] {
-        let t = truth();
+        let t = positioner::truth(0.003);
         let readings = t.read(&fit_plan(), &mut ChaCha8Rng::seed_from_u64(seed));
         let fit = fit_positioner(&PositionerFitRequest {
             nominal: nominal(),
             reflectors_mm: DESIGN_MM.to_vec(),
             readings,
-            tracker_sigma_mm: SIGMA_MM,
+            tracker_sigma_mm: TRACKER_SIGMA_MM,
         })
         .unwrap_or_else(|e| panic!("seed {seed}: {e}"));
         let cal = miss(&fit.model, &t, &body);

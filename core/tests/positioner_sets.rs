@@ -5,6 +5,9 @@
 //! roles. The fit from the files is the fit from the readings themselves,
 //! bit for bit, and finds the true axes.
 
+mod common;
+
+use common::positioner::{fit_plan, sweeps};
 use nalgebra::{Rotation3, Vector3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -61,15 +64,6 @@ fn truth() -> TruePositioner {
     }
 }
 
-/// Axis 2 swept over 330° at axis 1 = 0, axis 1 over 180° at axis 2 = 0.
-fn values() -> Vec<[f64; 2]> {
-    let mut v: Vec<[f64; 2]> = (0..12)
-        .map(|i| [0.0, -165.0 + 30.0 * f64::from(i)])
-        .collect();
-    v.extend((0..13).map(|i| [-90.0 + 15.0 * f64::from(i), 0.0]));
-    v
-}
-
 #[test]
 fn the_positioner_fit_reads_measurement_sets_by_their_columns() {
     let t = truth();
@@ -80,7 +74,7 @@ fn the_positioner_fit_reads_measurement_sets_by_their_columns() {
     };
     let mut rng = ChaCha8Rng::seed_from_u64(5);
     let files: Vec<String> = (0..2)
-        .map(|k| csv::write_set(&positioner_set(&t, k, &values(), columns, &mut rng)))
+        .map(|k| csv::write_set(&positioner_set(&t, k, &sweeps(), columns, &mut rng)))
         .collect();
     assert!(files[0].starts_with("e1,e2,x,y,z\n"), "{}", files[0]);
     let mut from_files = Vec::new();
@@ -90,9 +84,7 @@ fn the_positioner_fit_reads_measurement_sets_by_their_columns() {
     }
     // The same readings drawn directly from the same generator.
     let mut rng = ChaCha8Rng::seed_from_u64(5);
-    let plan: Vec<(usize, [f64; 2])> = (0..2)
-        .flat_map(|k| values().into_iter().map(move |v| (k, v)))
-        .collect();
+    let plan = fit_plan();
     let direct: Vec<_> = (0..2)
         .flat_map(|k| {
             let p: Vec<(usize, [f64; 2])> = plan.iter().filter(|(r, _)| *r == k).copied().collect();

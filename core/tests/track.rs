@@ -13,6 +13,9 @@
 //!
 //! Figures: `cargo test -p robocal-core --test track -- --nocapture`.
 
+mod common;
+
+use common::track::{measure_on_track, true_pose, ys100_truth, STATIONS, TRACKER_SIGMA_MM};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal_core::calibrate::external::track::{
@@ -26,35 +29,17 @@ use robocal_core::measure::to_measurements;
 use robocal_core::model::calibrated::CompensatedModel;
 use robocal_core::model::external::CarriageTerm;
 use robocal_core::model::kinematics::fk;
-use robocal_core::model::{preset, Pose, RobotModel};
+use robocal_core::model::{Pose, RobotModel};
 use robocal_core::sim::track::TrueTrack;
-use robocal_core::sim::{perturb_geometry, random_configurations, ErrorMagnitudes, TrueRobot};
+use robocal_core::sim::{random_configurations, TrueRobot};
 use robocal_core::solve::external::{carried, TrackPoseError, TrackSolver};
 use robocal_core::solve::ik::{Goal, IkSettings, SolveOptions};
 
-const SIGMA_MM: f64 = 0.01;
-/// Fitted track values [mm]: every 400 mm over the 4 m.
-const STATIONS: [f64; 11] = [
-    0.0, 400.0, 800.0, 1200.0, 1600.0, 2000.0, 2400.0, 2800.0, 3200.0, 3600.0, 4000.0,
-];
 /// Held-out track values [mm], between the fitted ones.
 const HELD_OUT: [f64; 6] = [200.0, 1000.0, 1400.0, 2600.0, 3000.0, 3800.0];
 const POSES_PER_STATION: usize = 15;
 /// The track's value while the robot is calibrated on a fixed base [mm].
 const FIXED_AT_MM: f64 = 2000.0;
-
-/// The nominal YS100 and its truth: ~1 mm / 0.1° geometric errors, rigid,
-/// 0.01 mm tracker noise.
-fn robot(rng: &mut ChaCha8Rng) -> (RobotModel, TrueRobot) {
-    let nominal = preset("ys100").unwrap();
-    let mut truth = TrueRobot::new(perturb_geometry(
-        &nominal,
-        &ErrorMagnitudes::from_mm_deg(1.0, 0.1),
-        rng,
-    ));
-    truth.noise_mm = SIGMA_MM;
-    (nominal, truth)
-}
 
 /// The robot calibrated on a fixed base (the track standing at
 /// `FIXED_AT_MM`): 40 identification and 30 validation poses, KM. The
@@ -86,30 +71,6 @@ fn calibrated_on_fixed_base(
     (km.calibrated.clone(), val)
 }
 
-/// `POSES_PER_STATION` random poses at each of `values`, measured on the
-/// truth carried by `track`, as a set with column e1.
-fn measure(
-    truth: &TrueRobot,
-    nominal: &RobotModel,
-    track: &TrueTrack,
-    values: &[f64],
-    rng: &mut ChaCha8Rng,
-) -> MeasurementSet {
-    let stations: Vec<(f64, Vec<Vec<f64>>)> = values
-        .iter()
-        .map(|v| (*v, random_configurations(nominal, POSES_PER_STATION, rng)))
-        .collect();
-    track
-        .measure(
-            truth,
-            ExternalAxis::E1,
-            &stations,
-            Some(nominal.payload.mass),
-            rng,
-        )
-        .unwrap()
-}
-
 fn request<'a>(
     robot: &'a RobotModel,
     set: &'a MeasurementSet,
@@ -120,7 +81,7 @@ fn request<'a>(
         payload_kg: robot.payload.mass,
         set,
         column: ExternalAxis::E1,
-        tracker_sigma_mm: SIGMA_MM,
+        tracker_sigma_mm: TRACKER_SIGMA_MM,
         max_order,
     }
 }
@@ -156,10 +117,17 @@ fn held_out_track_positions_are_predicted_within_the_robots_own_error() {
     let track = TrueTrack::rail_4m();
     for seed in [1u64, 2, 3] {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let (nominal, truth) = robot(&mut rng);
+        let (nominal, truth) = ys100_truth(&mut rng);
         let (calibrated, robot_val_rms) =
             calibrated_on_fixed_base(&nominal, &truth, &track, &mut rng);
-        let measured = measure(&truth, &nominal, &track, &STATIONS, &mut rng);
+        let measured = measure_on_track(
+            &truth,
+            &nominal,
+            &track,
+            &STATIONS,
+            POSES_PER_STATION,
+            &mut rng,
+        );
         // Through the CSV: written with its e1 column, read back.
         let text = csv::write_set(&measured);
         assert!(text.starts_with("q1,q2,q3,q4,q5,q6,e1,x,y,z,payload_kg\n"));
@@ -171,7 +139,14 @@ fn held_out_track_positions_are_predicted_within_the_robots_own_error() {
                 e.fit.as_ref().map(|f| (&f.maps, &f.stations))
             )
         });
-        let held = measure(&truth, &nominal, &track, &HELD_OUT, &mut rng);
+        let held = measure_on_track(
+            &truth,
+            &nominal,
+            &track,
+            &HELD_OUT,
+            POSES_PER_STATION,
+            &mut rng,
+        );
         let errors = prediction_errors(&fit, &calibrated, &held);
         let (held_rms, held_max) = (rms(&errors), max(&errors));
         // Without maps (a straight rail: line, scale, zero, mount).
@@ -266,7 +241,7 @@ fn held_out_track_positions_are_predicted_within_the_robots_own_error() {
 #[test]
 fn a_straight_rail_comes_back_exactly() {
     let mut rng = ChaCha8Rng::seed_from_u64(7);
-    let (nominal, mut truth) = robot(&mut rng);
+    let (nominal, mut truth) = ys100_truth(&mut rng);
     truth.noise_mm = 0.0;
     let mut track = TrueTrack::rail_4m();
     track.lateral.clear();
@@ -274,7 +249,14 @@ fn a_straight_rail_comes_back_exactly() {
     track.yaw_extra.clear();
     track.pitch_extra.clear();
     track.roll.clear();
-    let set = measure(&truth, &nominal, &track, &STATIONS[..6], &mut rng);
+    let set = measure_on_track(
+        &truth,
+        &nominal,
+        &track,
+        &STATIONS[..6],
+        POSES_PER_STATION,
+        &mut rng,
+    );
     let fit = fit_track(&request(&truth.model, &set, DEFAULT_MAX_ORDER)).unwrap();
     assert!(
         (fit.model.scale - (1.0 + 2e-4)).abs() < 1e-10,
@@ -299,16 +281,30 @@ fn a_straight_rail_comes_back_exactly() {
 #[test]
 fn fits_the_readings_cannot_carry_are_refused() {
     let mut rng = ChaCha8Rng::seed_from_u64(11);
-    let (nominal, truth) = robot(&mut rng);
+    let (nominal, truth) = ys100_truth(&mut rng);
     let track = TrueTrack::rail_4m();
     let model = &truth.model;
     let why =
         |set: &MeasurementSet| fit_track(&request(model, set, DEFAULT_MAX_ORDER)).unwrap_err();
 
-    let few = measure(&truth, &nominal, &track, &STATIONS[..4], &mut rng);
+    let few = measure_on_track(
+        &truth,
+        &nominal,
+        &track,
+        &STATIONS[..4],
+        POSES_PER_STATION,
+        &mut rng,
+    );
     assert_eq!(why(&few).reason, TrackRefusalReason::TooFewStations);
 
-    let good = measure(&truth, &nominal, &track, &STATIONS[..7], &mut rng);
+    let good = measure_on_track(
+        &truth,
+        &nominal,
+        &track,
+        &STATIONS[..7],
+        POSES_PER_STATION,
+        &mut rng,
+    );
     assert!(fit_track(&request(model, &good, DEFAULT_MAX_ORDER)).is_ok());
 
     // Station 1200 mm keeps two readings.
@@ -407,12 +403,6 @@ fn compensated(calibrated: RobotModel, nominal: &RobotModel) -> CompensatedModel
 
 /// The truth's tool pose in the cell frame: the true robot (no noise) on the
 /// true track at `value_mm`.
-fn true_pose(truth: &TrueRobot, track: &TrueTrack, q: &[f64], value_mm: f64) -> Pose {
-    track
-        .cell_from_base(value_mm)
-        .compose(&truth.true_pose_base(q, None).unwrap())
-}
-
 /// Predict and solve through the fitted track, checked against the
 /// simulated truth (its physics, not the model's code): the reflector
 /// predicted at held-out track values for new joints, and targets the true
@@ -426,14 +416,26 @@ fn predictions_and_solves_through_the_track_land_on_the_truth() {
     let track = TrueTrack::rail_4m();
     for seed in [1u64, 2, 3] {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let (nominal, truth) = robot(&mut rng);
+        let (nominal, truth) = ys100_truth(&mut rng);
         let (calibrated, robot_val_rms) =
             calibrated_on_fixed_base(&nominal, &truth, &track, &mut rng);
-        let set = measure(&truth, &nominal, &track, &STATIONS, &mut rng);
+        let set = measure_on_track(
+            &truth,
+            &nominal,
+            &track,
+            &STATIONS,
+            POSES_PER_STATION,
+            &mut rng,
+        );
         let model = compensated(calibrated.clone(), &nominal);
-        let fit =
-            fit_track_compensated(&model, &set, ExternalAxis::E1, SIGMA_MM, DEFAULT_MAX_ORDER)
-                .unwrap();
+        let fit = fit_track_compensated(
+            &model,
+            &set,
+            ExternalAxis::E1,
+            TRACKER_SIGMA_MM,
+            DEFAULT_MAX_ORDER,
+        )
+        .unwrap();
         // Without a compensator the compensated model places the readings
         // as the calibrated geometry does: the same track.
         let plain = fit_track(&request(&calibrated, &set, DEFAULT_MAX_ORDER)).unwrap();
@@ -444,10 +446,11 @@ fn predictions_and_solves_through_the_track_land_on_the_truth() {
             );
             assert!((a.p - b.p).norm() < 1e-12 && (a.r - b.r).norm() < 1e-12);
         }
-        let straight = match fit_track_compensated(&model, &set, ExternalAxis::E1, SIGMA_MM, 0) {
-            Err(TrackRefused { fit: Some(f), .. }) => f.model,
-            other => panic!("seed {seed}: a straight rail should be refused, got {other:?}"),
-        };
+        let straight =
+            match fit_track_compensated(&model, &set, ExternalAxis::E1, TRACKER_SIGMA_MM, 0) {
+                Err(TrackRefused { fit: Some(f), .. }) => f.model,
+                other => panic!("seed {seed}: a straight rail should be refused, got {other:?}"),
+            };
         let on_track = TrackSolver::new(&model, None, fit.model.clone(), IkSettings::default());
         let on_straight = TrackSolver::new(&model, None, straight, IkSettings::default());
 

@@ -1,15 +1,20 @@
 //! Helpers shared by the service and command-line test crates (each includes
-//! this file as `mod common;`): the `robocal` binary run for its JSON, and the
-//! service in-process. The core's helpers (simulated measurements, real data,
+//! this file as `mod common;`): the `robocal` binary run (its exit code, its
+//! output as text or JSON, a report line's RMS), a robot's model file, and
+//! the service in-process. The core's helpers (simulated measurements, real data,
 //! shipped models) are in core/tests/common, included by `#[path]`.
 #![allow(dead_code)]
 
 use axum::body::Body;
 use axum::http::{HeaderMap, Request, StatusCode};
 use axum::Router;
+use robocal::cli::model_files::save_model_file;
 use robocal::db::Db;
 use robocal::http::{app, AppState, ServiceConfig};
+use robocal::model::calibrated::{CalibratedModelFile, CompensatedModel};
+use robocal::model::{Pose, RobotModel};
 use std::path::Path;
+use std::process::Output;
 use tower::ServiceExt;
 
 /// The `x`, `y`, `z` fields of a JSON position (a target, a false target).
@@ -21,20 +26,75 @@ pub fn json_xyz(v: &serde_json::Value) -> nalgebra::Vector3<f64> {
     nalgebra::Vector3::new(c("x"), c("y"), c("z"))
 }
 
-/// Runs the `robocal` binary with `args` in `dir`, asserts it succeeded and
-/// returns its standard output as JSON.
-pub fn robocal_json(dir: &Path, args: &[&str]) -> serde_json::Value {
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_robocal"))
+/// Runs the `robocal` binary with `args` in `dir`: its exit status and what
+/// it wrote.
+pub fn robocal(dir: &Path, args: &[&str]) -> Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_robocal"))
         .current_dir(dir)
         .args(args)
         .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+        .unwrap()
+}
+
+/// The exit code of a finished run (ended by a signal: the test fails).
+pub fn code(out: &Output) -> i32 {
+    out.status.code().expect("ended by a signal")
+}
+
+/// An output stream as text.
+pub fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+/// Asserts a run was refused: exit code 1 and `needle` in its standard error.
+pub fn assert_refused(out: &Output, needle: &str) {
+    assert_eq!(code(out), 1, "{}", text(&out.stderr));
+    assert!(text(&out.stderr).contains(needle), "{}", text(&out.stderr));
+}
+
+/// Runs the `robocal` binary with `args` in `dir`, asserts it succeeded and
+/// returns its standard output as JSON.
+pub fn robocal_json(dir: &Path, args: &[&str]) -> serde_json::Value {
+    let out = robocal(dir, args);
+    assert!(out.status.success(), "{}", text(&out.stderr));
     serde_json::from_slice(&out.stdout).unwrap()
+}
+
+/// The line of a printed report that starts with `prefix` and the RMS [mm]
+/// it states (the number after `rms `).
+pub fn line_rms<'a>(report: &'a str, prefix: &str) -> (&'a str, f64) {
+    let line = report
+        .lines()
+        .find(|l| l.starts_with(prefix))
+        .unwrap_or_else(|| panic!("no line `{prefix}…` in\n{report}"));
+    let rms: f64 = line
+        .split("rms ")
+        .nth(1)
+        .unwrap()
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    (line, rms)
+}
+
+/// A calibrated model file at `path` whose geometry is `truth`'s, on the
+/// cell's origin at the nominal payload, without a compensator (a robot
+/// whose own calibration is not what a test checks).
+pub fn save_robot_file(truth: &RobotModel, nominal: &RobotModel, path: &Path) {
+    let model = CompensatedModel {
+        calibrated: truth.clone(),
+        nominal: nominal.clone(),
+        cell_from_base: Pose::identity(),
+        payload_kg: nominal.payload.mass,
+        compensator: None,
+    };
+    save_model_file(
+        &CalibratedModelFile::from_compensated(&model, "ys100", "km"),
+        path,
+    )
+    .unwrap();
 }
 
 /// The service in-process on a new, empty store.

@@ -2,10 +2,14 @@
 //! `mod common;`; the root crate's tests by `#[path]`): simulated measurements
 //! of a ground-truth robot, the real laser-tracker data
 //! (data/ur5-wam-laser-tracker in the repository, or `ROBOCAL_DATA_DIR`), the
-//! shipped model files (models/*.json) and the IK tests' fixtures (`ik`).
+//! shipped model files (models/*.json), the IK tests' fixtures (`ik`), the
+//! simulated positioner (`positioner`) and the simulated robot on a track
+//! (`track`).
 #![allow(dead_code)]
 
 pub mod ik;
+pub mod positioner;
+pub mod track;
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;

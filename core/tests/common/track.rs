@@ -1,0 +1,66 @@
+//! The simulated robot on a linear track the track tests share: the YS100
+//! with ~1 mm / 0.1° geometric errors (`sim::perturb_geometry`), read by a
+//! tracker with 0.01 mm noise at track values along a true track
+//! (`robocal_core::sim::track::TrueTrack`), as a measurement set with an `e1`
+//! column. Track values in millimetres; poses SI in the cell (tracker) frame.
+
+use rand_chacha::ChaCha8Rng;
+use robocal_core::measure::external::{ExternalAxis, MeasurementSet};
+use robocal_core::model::{preset, Pose, RobotModel};
+use robocal_core::sim::track::TrueTrack;
+use robocal_core::sim::{perturb_geometry, random_configurations, ErrorMagnitudes, TrueRobot};
+
+/// The tracker's noise per coordinate, 1σ [mm].
+pub const TRACKER_SIGMA_MM: f64 = 0.01;
+
+/// Fitted track values [mm]: every 400 mm over the 4 m.
+pub const STATIONS: [f64; 11] = [
+    0.0, 400.0, 800.0, 1200.0, 1600.0, 2000.0, 2400.0, 2800.0, 3200.0, 3600.0, 4000.0,
+];
+
+/// The nominal YS100 and its truth: ~1 mm / 0.1° geometric errors, rigid,
+/// read with [`TRACKER_SIGMA_MM`].
+pub fn ys100_truth(rng: &mut ChaCha8Rng) -> (RobotModel, TrueRobot) {
+    let nominal = preset("ys100").unwrap();
+    let mut truth = TrueRobot::new(perturb_geometry(
+        &nominal,
+        &ErrorMagnitudes::from_mm_deg(1.0, 0.1),
+        rng,
+    ));
+    truth.noise_mm = TRACKER_SIGMA_MM;
+    (nominal, truth)
+}
+
+/// `n` random poses of `nominal` at each of `values` [mm], measured on
+/// `truth` carried by `track` with the nominal payload, as a set with
+/// column e1.
+pub fn measure_on_track(
+    truth: &TrueRobot,
+    nominal: &RobotModel,
+    track: &TrueTrack,
+    values: &[f64],
+    n: usize,
+    rng: &mut ChaCha8Rng,
+) -> MeasurementSet {
+    let stations: Vec<(f64, Vec<Vec<f64>>)> = values
+        .iter()
+        .map(|v| (*v, random_configurations(nominal, n, rng)))
+        .collect();
+    track
+        .measure(
+            truth,
+            ExternalAxis::E1,
+            &stations,
+            Some(nominal.payload.mass),
+            rng,
+        )
+        .unwrap()
+}
+
+/// The true tool pose in the cell frame at joints `q` and track value
+/// `value_mm` (no noise).
+pub fn true_pose(truth: &TrueRobot, track: &TrueTrack, q: &[f64], value_mm: f64) -> Pose {
+    track
+        .cell_from_base(value_mm)
+        .compose(&truth.true_pose_base(q, None).unwrap())
+}
