@@ -108,15 +108,8 @@ fn parse_point(s: &str) -> anyhow::Result<[f64; 3]> {
 
 /// A fit the readings cannot carry: its reason and message (nothing is written).
 #[derive(Debug, thiserror::Error)]
-#[error("not fitted ({}): {}", reason_code(.0), .0.message)]
+#[error("not fitted ({}): {}", judged_fit::code(&.0.reason), .0.message)]
 pub struct PositionerNotFitted(pub Box<Refused>);
-
-fn reason_code(r: &Refused) -> String {
-    serde_json::to_value(r.reason)
-        .ok()
-        .and_then(|v| v.as_str().map(String::from))
-        .unwrap_or_default()
-}
 
 /// Held-out readings predicted through the fitted positioner [mm].
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -217,7 +210,7 @@ pub fn calibrate_to_string(a: &CalibrateArgs) -> anyhow::Result<String> {
     let fit = match fit_positioner(&request) {
         Ok(f) => f,
         Err(refused) => {
-            judged_fit::print_refusal(a.json, &reason_code(&refused), &refused)?;
+            judged_fit::print_refusal(a.json, &judged_fit::code(&refused.reason), &refused)?;
             return Err(PositionerNotFitted(Box::new(refused)).into());
         }
     };

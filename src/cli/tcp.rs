@@ -208,10 +208,7 @@ fn limits_line(l: &Option<tcp::Limits>) -> String {
             l.rms_mm,
             l.max_mm,
             l.sigma_mm,
-            serde_json::to_value(l.noise)
-                .ok()
-                .and_then(|v| v.as_str().map(String::from))
-                .unwrap_or_default(),
+            super::judged_fit::code(&l.noise),
             l.distance_mm
                 .map(|d| format!(", TCP ≤ {d:.1} mm from the flange"))
                 .unwrap_or_default()

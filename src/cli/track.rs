@@ -220,15 +220,8 @@ fn read_set(path: &str) -> anyhow::Result<MeasurementSet> {
 
 /// A fit the readings cannot carry: its reason and message (nothing is written).
 #[derive(Debug, thiserror::Error)]
-#[error("not fitted ({}): {}", reason_code(.0), .0.message)]
+#[error("not fitted ({}): {}", judged_fit::code(&.0.reason), .0.message)]
 pub struct TrackNotFitted(pub TrackRefused);
-
-fn reason_code(r: &TrackRefused) -> String {
-    serde_json::to_value(r.reason)
-        .ok()
-        .and_then(|v| v.as_str().map(String::from))
-        .unwrap_or_default()
-}
 
 /// Held-out readings predicted through the fitted track [mm].
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -309,7 +302,7 @@ pub fn calibrate_to_string(a: &CalibrateArgs) -> anyhow::Result<String> {
     let fit = match fit_track_compensated(&model, &set, a.column, a.sigma_mm, a.max_order) {
         Ok(f) => f,
         Err(refused) => {
-            judged_fit::print_refusal(a.json, &reason_code(&refused), &refused)?;
+            judged_fit::print_refusal(a.json, &judged_fit::code(&refused.reason), &refused)?;
             return Err(TrackNotFitted(refused).into());
         }
     };
@@ -403,11 +396,7 @@ fn report(
     }
     let _ = writeln!(s, "not seen by these readings:");
     for u in &fit.unseen {
-        let code = serde_json::to_value(u.term)
-            .ok()
-            .and_then(|v| v.as_str().map(String::from))
-            .unwrap_or_default();
-        let _ = writeln!(s, "  {code}: {}", u.note);
+        let _ = writeln!(s, "  {}: {}", judged_fit::code(&u.term), u.note);
     }
     if let Some(v) = v {
         let values: Vec<String> = v.values_mm.iter().map(|x| format!("{x}")).collect();
