@@ -309,10 +309,33 @@ fn base_alone(ctx: &Context, cache: &mut Cache, base: Base) -> Result<BaseOption
     })
 }
 
+/// Lays the rest of `auto`'s bar over `need` units of the check about to
+/// run where the plan held `held` (the veto's check planned before the
+/// option was known, `Planner::veto`): the fraction done stays, so the bar
+/// neither jumps nor goes back, and from here it moves with the check's own
+/// work (`Planner::veto_of`) and what the plan holds after it.
+fn lay_rest_over(t: &mut Tally, held: f64, need: f64) {
+    (t.done, t.total) = rebased(t.done, t.total, held, need);
+}
+
+/// `(done, total)` units with `done / total` kept and `need` units in place
+/// of `held` of the `total − done` left.
+pub(super) fn rebased(done: f64, total: f64, held: f64, need: f64) -> (f64, f64) {
+    let fraction = (done / total).clamp(0.0, 1.0);
+    let left = (need + (total - done - held).max(0.0)).max(0.0);
+    if fraction >= 1.0 || left <= 0.0 {
+        return (done, done + left);
+    }
+    let total = left / (1.0 - fraction);
+    (fraction * total, total)
+}
+
 /// The blocked-fold veto over `decision` (module docs): returns the decision
 /// on the option that passed (or a base alone) with the checks made. Each
-/// check moves the bar over the units `plan::Planner::veto` plans for it
-/// (the first was planned with `auto`; a check after a veto adds its units).
+/// check moves the bar over its own units (`plan::Planner::veto_of` of the
+/// option checked): the rest of the bar is laid over them when the check
+/// starts, in place of the units `plan::Planner::veto` planned with `auto`
+/// (the first check) or none (a check after a veto).
 pub(super) fn apply_veto(
     ctx: &Context,
     cache: &mut Cache,
@@ -320,7 +343,8 @@ pub(super) fn apply_veto(
     mut decision: Decision,
 ) -> Result<Decision, MethodError> {
     let margin = ctx.opts.compensator.tie_margin;
-    let planned = Planner::veto(ctx);
+    // What the plan holds for the first check; later checks were not planned.
+    let mut held = Planner::veto(ctx);
     let mut regions: Option<Option<DeliveredRegions>> = None;
     let mut checks = Vec::new();
     let mut first_fallback = None;
@@ -341,9 +365,9 @@ pub(super) fn apply_veto(
             );
             break;
         };
-        if !checks.is_empty() {
-            t.total += planned;
-        }
+        let planned = Planner::veto_of(ctx, method).unwrap_or(held);
+        lay_rest_over(t, held, planned);
+        held = 0.0;
         let (at, total) = (t.done, t.total);
         let progress = &mut *t.progress;
         // The option's refits, then its base's: half the check's units each.
@@ -405,10 +429,8 @@ pub(super) fn apply_veto(
         decision = decide(ctx, t)?;
         decision.untried = None;
     }
-    if checks.is_empty() {
-        // The check planned with `auto` did not run.
-        t.done += planned;
-    }
+    // The check planned with `auto` did not run (`held` is 0 once one did).
+    t.done += held;
     decision.fallback = decision.fallback.or(first_fallback);
     decision.checks = checks;
     Ok(decision)
@@ -487,6 +509,26 @@ pub(super) fn choose_among(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Laying the rest of the bar over other units keeps the fraction done
+    /// and leaves the check's units and what the plan held after it: fewer
+    /// units than planned shorten the rest, more lengthen it, and the bar
+    /// does not move at the switch either way.
+    #[test]
+    fn the_rest_of_the_bar_is_laid_over_the_checks_own_units() {
+        // 600 of 1000 units done; the plan held 300 for the check, 100 after.
+        for need in [30.0, 300.0, 3000.0] {
+            let (done, total) = rebased(600.0, 1000.0, 300.0, need);
+            assert!((done / total - 0.6).abs() < 1e-12, "{done} / {total}");
+            assert!((total - done - (need + 100.0)).abs() < 1e-9 * total);
+        }
+        // Nothing held (a check after a veto): its units are added.
+        let (done, total) = rebased(900.0, 1000.0, 0.0, 50.0);
+        assert!((done / total - 0.9).abs() < 1e-12);
+        assert!((total - done - 150.0).abs() < 1e-9);
+        // The bar at its end stays there.
+        assert_eq!(rebased(1000.0, 1000.0, 0.0, 50.0), (1000.0, 1050.0));
+    }
 
     /// Without orientation the lowest position mean wins; with it, an option
     /// that gains position but loses orientation beyond the slack is

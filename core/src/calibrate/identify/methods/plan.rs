@@ -125,42 +125,67 @@ impl Planner {
     }
 
     /// Units of one check of `auto`'s blocked-fold veto
-    /// (`methods::delivered`): per region it may hold out, the base refitted
-    /// (the heavier of `auto`'s bases) and the costliest of `auto`'s
-    /// joint-map or compensator candidates refitted on it (a joint-map fit's
-    /// units, a compensator's one training without cross-validation); 0 when
-    /// no candidate would be checked. Nothing of it is cached: every region
-    /// refits.
+    /// (`methods::delivered`) as planned before `auto` has chosen: the
+    /// median of [`Planner::veto_of`] over `auto`'s joint-map and compensator
+    /// candidates, 0 when no candidate would be checked. The check refits
+    /// the option `auto` delivers, which is not known until the
+    /// cross-validation ends; the costliest candidates (the population-trained
+    /// networks, whose one training costs some hundred SKCM fits) are seldom
+    /// delivered, so planning the check at the costliest, as an upper bound,
+    /// counted most of a run's planned work in a check that did not run, and
+    /// the time left was stated several times too long (docs/progress.md).
+    /// When the option is known the rest of the bar is laid over its own
+    /// check ([`Planner::veto_of`], `auto_choice::apply_veto`).
     pub(crate) fn veto(ctx: &Context) -> f64 {
+        let mut each: Vec<f64> = ctx
+            .opts
+            .compensator
+            .auto_candidates
+            .iter()
+            .filter_map(|m| Planner::veto_of(ctx, *m))
+            .collect();
+        if each.is_empty() {
+            return 0.0;
+        }
+        each.sort_by(f64::total_cmp);
+        let mid = each.len() / 2;
+        if each.len() % 2 == 1 {
+            each[mid]
+        } else {
+            0.5 * (each[mid - 1] + each[mid])
+        }
+    }
+
+    /// Units of one check of the veto on candidate `option`: per region it
+    /// may hold out, the base refitted (the heavier of `auto`'s bases) and
+    /// the option refitted on it (a joint-map fit's units, a compensator's
+    /// one training without cross-validation on its base's maps, if any).
+    /// Nothing of it is cached: every region refits. `None` when `option` is
+    /// not a candidate the veto checks (a base, or one needing torques
+    /// without gravity).
+    pub(crate) fn veto_of(ctx: &Context, option: Method) -> Option<f64> {
+        if ctx.gravity.is_some() && option.uses_torques() {
+            return None;
+        }
         let maps = |b: Base| match b {
             Base::KmMaps => maps_units(Method::KmMaps, Method::Km),
             Base::SkcmMaps => maps_units(Method::SkcmMaps, Method::Skcm),
             Base::Km | Base::Skcm => 0.0,
         };
-        let extra = ctx
-            .opts
-            .compensator
-            .auto_candidates
-            .iter()
-            .filter(|m| ctx.gravity.is_none() || !m.uses_torques())
-            .filter_map(|m| match m.row().run {
-                Run::Maps(b) => Some(maps_units(*m, b.method())),
-                Run::Compensated(c) => Some(
-                    maps(c.base)
-                        + (m.row().weight - c.base.method().row().weight).max(0.0)
-                            / REFERENCE_TRAININGS,
-                ),
-                _ => None,
-            })
-            .reduce(f64::max);
-        let Some(extra) = extra else {
-            return 0.0;
+        let extra = match option.row().run {
+            Run::Maps(b) => maps_units(option, b.method()),
+            Run::Compensated(c) => {
+                maps(c.base)
+                    + (option.row().weight - c.base.method().row().weight).max(0.0)
+                        / REFERENCE_TRAININGS
+            }
+            _ => return None,
         };
         let base = auto_bases(ctx)
             .iter()
             .map(|b| b.method().row().weight)
             .fold(0.0, f64::max);
-        planned_regions(ctx) as f64 * (base + extra)
+        Some(planned_regions(ctx) as f64 * (base + extra))
     }
 }
 
@@ -262,5 +287,32 @@ mod tests {
             inside >= 2 * regions - 1,
             "{inside} reports inside the veto's share"
         );
+    }
+
+    /// Before `auto` has chosen, one check of its veto is planned at the
+    /// median of its candidates' checks: of KM-GP (one GP training on KM's
+    /// refits), KM+maps (a joint-map fit) and KM+maps-GP (both), the
+    /// joint maps'. With the fixture's single candidate the plan is that
+    /// candidate's check.
+    #[test]
+    fn the_veto_is_planned_at_the_median_candidates_check() {
+        let fixture = Fixture::measured(240);
+        let mut opts = fixture.options(1);
+        let ctx = fixture.context(&opts);
+        assert_eq!(
+            Planner::veto(&ctx),
+            Planner::veto_of(&ctx, Method::KmMaps).unwrap()
+        );
+        opts.compensator.auto_candidates = vec![Method::KmMapsGp, Method::KmGp, Method::KmMaps];
+        let ctx = fixture.context(&opts);
+        let each: Vec<f64> = opts
+            .compensator
+            .auto_candidates
+            .iter()
+            .map(|m| Planner::veto_of(&ctx, *m).unwrap())
+            .collect();
+        assert!(each[1] < each[2] && each[2] < each[0], "{each:?}");
+        assert_eq!(Planner::veto(&ctx), each[2]);
+        assert_eq!(Planner::veto_of(&ctx, Method::Km), None);
     }
 }
