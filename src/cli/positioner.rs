@@ -22,14 +22,13 @@
 //! message (with `--json` also the refusal as JSON on stdout).
 
 use super::judged_fit;
+use crate::service::positioners::{held_out, reason_code, set_readings, HeldOut};
 use anyhow::Context;
 use clap::{Args, Subcommand};
-use nalgebra::Vector3;
-use robocal_core::calibrate::external::readings::{positioner_readings, PositionerColumns};
+use robocal_core::calibrate::external::readings::PositionerColumns;
 use robocal_core::calibrate::external::{
     fit_positioner, PositionerFit, PositionerFitRequest, PositionerReading, Refused,
 };
-use robocal_core::measure::csv::parse_set;
 use robocal_core::measure::external::ExternalAxis;
 use robocal_core::model::external::TiltRotate;
 use serde::Serialize;
@@ -107,22 +106,15 @@ fn parse_point(s: &str) -> anyhow::Result<[f64; 3]> {
 #[error("not fitted ({}): {}", reason_code(.0), .0.message)]
 pub struct PositionerNotFitted(pub Box<Refused>);
 
-fn reason_code(r: &Refused) -> String {
-    serde_json::to_value(r.reason)
-        .ok()
-        .and_then(|v| v.as_str().map(String::from))
-        .unwrap_or_default()
-}
-
-/// Held-out readings predicted through the fitted positioner [mm].
+/// Held-out readings predicted through the fitted positioner [mm]: the
+/// files and the figures the service gives for the same readings.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Validation {
+    /// The held-out files, the k-th of reflector k.
     pub files: Vec<String>,
-    pub readings: usize,
-    /// Distinct pairs of axis values `[tilt, rotate]` [deg] among them.
-    pub value_pairs: usize,
-    pub rms_mm: f64,
-    pub max_mm: f64,
+    /// Their readings' figures through the fitted positioner.
+    #[serde(flatten)]
+    pub held_out: HeldOut,
 }
 
 /// Every file's rows as readings of its reflector (the file's index).
@@ -133,8 +125,7 @@ fn read_readings(
     let mut out = Vec::new();
     for (k, path) in files.iter().enumerate() {
         let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {path}"))?;
-        let set = parse_set(&text).with_context(|| path.clone())?;
-        out.extend(positioner_readings(&set, columns, k).with_context(|| path.clone())?);
+        out.extend(set_readings(&text, columns, k).with_context(|| path.clone())?);
     }
     Ok(out)
 }
@@ -146,28 +137,10 @@ fn validate(
     fit: &PositionerFit,
 ) -> anyhow::Result<Validation> {
     let readings = read_readings(files, columns)?;
-    if readings.is_empty() {
-        anyhow::bail!("--validate: no readings");
-    }
-    let mut pairs: Vec<[f64; 2]> = Vec::new();
-    let errors: Vec<f64> = readings
-        .iter()
-        .map(|r| {
-            if !pairs.contains(&r.values_deg) {
-                pairs.push(r.values_deg);
-            }
-            let on_plate = Vector3::from(fit.reflectors_mm[r.reflector]) * 1e-3;
-            let at = fit.model.point_in_cell(r.values_deg, &on_plate) * 1e3;
-            (at - Vector3::from(r.xyz_mm)).norm()
-        })
-        .collect();
-    let (rms_mm, max_mm) = judged_fit::rms_and_max_mm(&errors);
+    let held_out = held_out(&readings, fit).context("--validate: no readings")?;
     Ok(Validation {
         files: files.to_vec(),
-        readings: errors.len(),
-        value_pairs: pairs.len(),
-        rms_mm,
-        max_mm,
+        held_out,
     })
 }
 
@@ -322,11 +295,11 @@ fn report(
         let _ = writeln!(
             s,
             "held out: {} readings at {} pairs of axis values ({}): rms {:.4} mm, max {:.4} mm",
-            v.readings,
-            v.value_pairs,
+            v.held_out.readings,
+            v.held_out.value_pairs,
             v.files.join(", "),
-            v.rms_mm,
-            v.max_mm
+            v.held_out.rms_mm,
+            v.held_out.max_mm
         );
     }
     let _ = writeln!(s, "written: {}", a.out);

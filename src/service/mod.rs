@@ -26,6 +26,7 @@ pub mod jobs;
 pub mod keys;
 pub mod limits;
 pub mod plans;
+pub mod positioners;
 pub mod predict;
 pub mod programs;
 pub mod record;
