@@ -17,7 +17,9 @@
 //! `X-Robocal-Method`). With `e1` [mm] (body or query) the robot's base is
 //! carried to that value along its stored track and the cell frame is the
 //! track's (`service::tracks::carry`); a targets CSV may instead carry an
-//! `e1` column, a value per row (both: 422). The handler turns either body into a
+//! `e1` column, a value per row (both: 422), or `e1` and `e2` columns, a
+//! positioner's tilt and rotate values per row with the targets on its face
+//! plate (`solve_columns` reads them). The handler turns either body into a
 //! `service::solve::SolveCommand`; the service picks the model and runs it.
 
 use super::error::{content_type, json_content_type};
