@@ -20,6 +20,13 @@
 //! through the fitted positioner: their RMS and maximum. A refused fit
 //! writes nothing and exits with `refused` (1), printing its reason code and
 //! message (with `--json` also the refusal as JSON on stdout).
+//!
+//! `predict --positioner FILE` states the predicted poses in the
+//! positioner's face plate frame at `--e1` (tilt) and `--e2` (rotate)
+//! [deg], or at each row's `e1` and `e2` columns of the joints file
+//! ([`OnPlate`]): `F(v)⁻¹·cell_from_base·pose`, the inverse of what `solve
+//! --positioner` does (`solve::external::positioner`), where the tool is on
+//! the part.
 
 use super::judged_fit;
 use crate::service::positioners::{held_out, reason_code, set_readings, HeldOut};
@@ -29,8 +36,15 @@ use robocal_core::calibrate::external::readings::PositionerColumns;
 use robocal_core::calibrate::external::{
     fit_positioner, PositionerFit, PositionerFitRequest, PositionerReading, Refused,
 };
+use robocal_core::measure::csv_text::Dialect;
 use robocal_core::measure::external::ExternalAxis;
+use robocal_core::model::calibrated::CompensatedModel;
 use robocal_core::model::external::TiltRotate;
+use robocal_core::model::Pose;
+use robocal_core::solve::cell::PredictFrame;
+use robocal_core::solve::external::{
+    base_from_part, target_column_values, AxisValues, TargetValue, ROTATE_COLUMN, TILT_COLUMN,
+};
 use serde::Serialize;
 use std::fmt::Write as _;
 
@@ -313,5 +327,120 @@ pub fn run(a: PositionerArgs) -> anyhow::Result<()> {
             print!("{}", calibrate_to_string(&c)?);
             Ok(())
         }
+    }
+}
+
+/// A positioner's axis values for `robocal predict --positioner`: one pair
+/// for every row (`--e1`, `--e2`), or each row's `e1` and `e2` columns.
+enum PlateValues {
+    /// `--e1 DEG --e2 DEG`.
+    Fixed(AxisValues),
+    /// The joints file's columns, matched by line.
+    PerRow {
+        tilt: Vec<TargetValue>,
+        rotate: Vec<TargetValue>,
+    },
+}
+
+/// `robocal predict --positioner FILE`: the positioner and the axis values
+/// each reading is stated at, its face plate frame being the output's.
+pub struct OnPlate {
+    path: String,
+    positioner: TiltRotate,
+    values: PlateValues,
+}
+
+impl OnPlate {
+    /// Reads the positioner file `path` and the values: `--e1` and `--e2`
+    /// together, or (neither given) the joints file's `e1` and `e2`
+    /// columns; one flag alone, the flags beside such a column, or a file
+    /// without both columns is refused.
+    pub fn read(
+        path: &str,
+        e1: Option<f64>,
+        e2: Option<f64>,
+        file: &str,
+        text: &str,
+        dialect: Dialect,
+    ) -> anyhow::Result<OnPlate> {
+        let json = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read positioner file {path}"))?;
+        let positioner =
+            TiltRotate::from_json(&json).with_context(|| format!("positioner file {path}"))?;
+        let tilt =
+            target_column_values(text, dialect, TILT_COLUMN).with_context(|| file.to_string())?;
+        let rotate =
+            target_column_values(text, dialect, ROTATE_COLUMN).with_context(|| file.to_string())?;
+        let values = match (e1, e2, tilt, rotate) {
+            (Some(t), Some(r), None, None) => {
+                for (v, flag) in [(t, "--e1"), (r, "--e2")] {
+                    if !v.is_finite() || v.abs() > 720.0 {
+                        anyhow::bail!("{flag} {v}: a positioner axis's value is a finite number of degrees within two turns (±720)");
+                    }
+                }
+                PlateValues::Fixed(AxisValues {
+                    tilt_deg: t,
+                    rotate_deg: r,
+                })
+            }
+            (Some(_), Some(_), _, _) => anyhow::bail!(
+                "{file}: the file has an `{TILT_COLUMN}` or `{ROTATE_COLUMN}` column and --e1, --e2 are given: ambiguous (give the flags or the columns)"
+            ),
+            (None, None, Some(tilt), Some(rotate)) => PlateValues::PerRow { tilt, rotate },
+            (None, None, t, _) => {
+                let name = if t.is_none() { TILT_COLUMN } else { ROTATE_COLUMN };
+                anyhow::bail!(
+                    "{file}: --positioner needs --e1 DEG --e2 DEG (tilt, rotate) or an `{TILT_COLUMN}` and an `{ROTATE_COLUMN}` column, and the file has no `{name}` column"
+                )
+            }
+            _ => anyhow::bail!("--positioner needs both --e1 (tilt) and --e2 (rotate) [deg], or neither (each row's `{TILT_COLUMN}` and `{ROTATE_COLUMN}` columns)"),
+        };
+        Ok(OnPlate {
+            path: path.to_string(),
+            positioner,
+            values,
+        })
+    }
+
+    /// The frame's name for the output's header.
+    pub fn label(&self) -> String {
+        match &self.values {
+            PlateValues::Fixed(v) => format!(
+                "face plate of positioner {} at e1 (tilt) {} deg, e2 (rotate) {} deg",
+                self.path, v.tilt_deg, v.rotate_deg
+            ),
+            PlateValues::PerRow { .. } => format!(
+                "face plate of positioner {} at each row's e1 (tilt), e2 (rotate)",
+                self.path
+            ),
+        }
+    }
+
+    /// The face plate at row `line`'s values in `model`'s base frame,
+    /// `robot.cell_from_base⁻¹·F(v)` (a pose predicted in it is
+    /// `F(v)⁻¹·cell_from_base·pose`), or the row's error naming its line and
+    /// column.
+    pub fn frame_at(&self, line: usize, model: &CompensatedModel) -> Result<PredictFrame, String> {
+        let values = match &self.values {
+            PlateValues::Fixed(v) => *v,
+            PlateValues::PerRow { tilt, rotate } => {
+                let at = |values: &[TargetValue], column: &str| {
+                    values.iter().find(|v| v.line == line).map_or_else(
+                        || Err(format!("line {line}: column `{column}`: no value")),
+                        |v| v.value.clone().map_err(|e| e.to_string()),
+                    )
+                };
+                AxisValues {
+                    tilt_deg: at(tilt, TILT_COLUMN)?,
+                    rotate_deg: at(rotate, ROTATE_COLUMN)?,
+                }
+            }
+        };
+        Ok(PredictFrame::WorkObject(base_from_part(
+            model,
+            &self.positioner,
+            values,
+            &Pose::identity(),
+        )))
     }
 }

@@ -75,6 +75,7 @@ A required branch the target lacks, or program flags no solution carries, fails 
 their flags) that do reach it within the joint limits. Per robot family: docs/configurations.md.";
 
 #[derive(Debug, Args)]
+#[command(group = clap::ArgGroup::new("external_axis").multiple(true).args(["track"]))]
 pub struct SolveArgs {
     /// Robot model: a preset (ys100, hh800, ur5, ur10), a model JSON file, or a
     /// calibrated model file written by `robocal calibrate --save`.
