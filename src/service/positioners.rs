@@ -291,6 +291,24 @@ pub async fn for_rows(state: &AppState, robot_id: i64) -> Result<TiltRotate, Ser
     model_of(&row)
 }
 
+/// The robot's stored positioner for a prediction at its values (`e1` and
+/// `e2`): no positioner is a `Conflict`, and so is a robot with a track too
+/// (`e1` would be either's value: ambiguous), as for a targets CSV.
+pub async fn for_predict(state: &AppState, robot_id: i64) -> Result<TiltRotate, ServiceError> {
+    let Some(row) = state.db().positioner(robot_id).await? else {
+        super::robots::get(state, robot_id).await?;
+        return Err(ServiceError::Conflict(format!(
+            "`e1` and `e2` are a positioner's tilt and rotate values, and robot {robot_id} has no positioner; fit one with POST /v1/robots/{robot_id}/positioner/calibrate (a track's value is `e1` alone)"
+        )));
+    };
+    if state.db().track(robot_id).await?.is_some() {
+        return Err(ServiceError::Conflict(format!(
+            "robot {robot_id} has a track and a positioner: `e1` could be the track's value or the positioner's tilt, which is ambiguous (a track and a positioner in one cell are not modelled)"
+        )));
+    }
+    model_of(&row)
+}
+
 /// Moves `csv`'s targets (face plate frame) into the robot's base frame at
 /// each row's values through `positioner`, the robot registered at
 /// `robot_cell_from_base` in the positioner's cell frame; the targets are

@@ -36,6 +36,7 @@ use std::path::Path;
 const CALIBRATE: &str = "/v1/robots/{id}/positioner/calibrate";
 const POSITIONER: &str = "/v1/robots/{id}/positioner";
 const SOLVE: &str = "/v1/robots/{id}/solve";
+const PREDICT: &str = "/v1/robots/{id}/predict";
 /// The payload the robot carries [kg], given to HTTP, the command line and the truth alike.
 const PAYLOAD_KG: f64 = 20.0;
 /// The fit's RMS limit, 3·√3·σ for σ = 0.01 mm: the CLI test's bound on
@@ -139,6 +140,7 @@ fn cli(args: &[&str]) -> anyhow::Result<String> {
             }
         },
         robocal::cli::Command::Solve(a) => robocal::cli::solve::solve_to_string(&a),
+        robocal::cli::Command::Predict(a) => robocal::cli::predict::predict_to_string(&a),
         other => panic!("{other:?}"),
     }
 }
@@ -231,6 +233,15 @@ async fn a_positioner_fitted_over_http_is_the_command_lines_and_carries_a_target
         .await;
     assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
     assert!(r.detail().contains("has no positioner"), "{}", r.detail());
+    let r = t
+        .post_json(
+            PREDICT,
+            &[&rid],
+            json!({ "readings": [{ "joints_deg": [0, -90, 90, 0, 45, 0] }], "e1": 10.0, "e2": 5.0 }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
+    assert!(r.detail().contains("has no positioner"), "{}", r.detail());
 
     // The fit over HTTP, stored; the same files through the command line.
     let r = t
@@ -286,7 +297,8 @@ async fn a_positioner_fitted_over_http_is_the_command_lines_and_carries_a_target
     );
     assert_eq!(stored["created_at"], fitted["created_at"]);
 
-    plate_csv_solve(&t, &rid, &robot, &robot_in_cell, &truth, &model, d).await;
+    let solved = plate_csv_solve(&t, &rid, &robot, &robot_in_cell, &truth, &model, d).await;
+    plate_predict(&t, &rid, &model, d, &solved).await;
 
     // A robot with a track as well: the `e1` column could be either's.
     let rail = super::track::Rail::new(&model);
@@ -313,6 +325,15 @@ async fn a_positioner_fitted_over_http_is_the_command_lines_and_carries_a_target
         .await;
     assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
     assert!(r.detail().contains("ambiguous"), "{}", r.detail());
+    let r = t
+        .post_json(
+            PREDICT,
+            &[&rid],
+            json!({ "readings": [{ "joints_deg": solved[0].0 }], "e1": 10.0, "e2": 5.0 }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
+    assert!(r.detail().contains("ambiguous"), "{}", r.detail());
 }
 
 /// Points of a part on the plate, located on the face plate through the
@@ -329,7 +350,8 @@ async fn plate_csv_solve(
     truth: &TruePositioner,
     model: &Path,
     d: &Path,
-) {
+) -> Vec<(Vec<f64>, [f64; 2], Vector3<f64>)> {
+    let mut solved = Vec::new();
     let fitted =
         TiltRotate::from_json(&std::fs::read_to_string(d.join("p.json")).unwrap()).unwrap();
     let on_body = [
@@ -398,6 +420,12 @@ async fn plate_csv_solve(
                 assert!((a - b).abs() < 1e-9, "target {n}: HTTP {a} CLI {b} deg");
             }
             let rad: Vec<f64> = deg.iter().map(|x| x.to_radians()).collect();
+            let fp = fitted
+                .cell_from_face_plate([0.0, 0.0])
+                .inverse()
+                .transform_point(&truth.point([0.0, 0.0], p))
+                * 1e3;
+            solved.push((deg.clone(), *v, fp));
             let q = nominal.joints_from_controller(&rad);
             let tip = robot.true_pose_base(&q, Some(PAYLOAD_KG)).unwrap().p;
             let miss = (robot_in_cell.transform_point(&tip) - truth.point(*v, p)).norm() * 1e3;
@@ -440,6 +468,104 @@ async fn plate_csv_solve(
             .await;
         assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{q}");
         assert!(r.detail().contains(words), "{q}: {}", r.detail());
+    }
+    solved
+}
+
+/// `predict` with `e1` and `e2` at the joints the solve returned for one
+/// pair of values: the poses on the face plate, the command line's
+/// `predict --positioner --e1 --e2` numbers on the same files and the
+/// targets back within the fit's RMS limit; `e2` alone and `frame` beside
+/// them are 422.
+async fn plate_predict(
+    t: &TestApp,
+    rid: &str,
+    model: &Path,
+    d: &Path,
+    solved: &[(Vec<f64>, [f64; 2], Vector3<f64>)],
+) {
+    let v = solved[1].1;
+    let rows: Vec<_> = solved.iter().filter(|(_, w, _)| *w == v).collect();
+    assert_eq!(rows.len(), 3);
+    let readings: Vec<Value> = rows
+        .iter()
+        .map(|(q, _, _)| json!({ "joints_deg": q }))
+        .collect();
+    let r = t
+        .post_json(
+            PREDICT,
+            &[rid],
+            json!({ "readings": readings, "e1": v[0], "e2": v[1], "payload_kg": PAYLOAD_KG }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let http = r.json();
+    assert_eq!(http["frame"], "face_plate");
+    let mut lines = vec!["q1,q2,q3,q4,q5,q6".to_string()];
+    for (q, _, _) in &rows {
+        lines.push(
+            q.iter()
+                .map(|x| format!("{x:?}"))
+                .collect::<Vec<_>>()
+                .join(","),
+        );
+    }
+    std::fs::write(d.join("joints.csv"), lines.join("\n") + "\n").unwrap();
+    let (e1, e2, payload) = (v[0].to_string(), v[1].to_string(), PAYLOAD_KG.to_string());
+    let printed = cli(&[
+        "predict",
+        "--model",
+        path(model),
+        "--joints",
+        path(&d.join("joints.csv")),
+        "--positioner",
+        path(&d.join("p.json")),
+        "--e1",
+        &e1,
+        "--e2",
+        &e2,
+        "--payload-kg",
+        &payload,
+        "--json",
+    ])
+    .unwrap();
+    let by_cli: Value = serde_json::from_str(&printed).unwrap();
+    let mut worst = 0.0f64;
+    for (k, (_, _, fp)) in rows.iter().enumerate() {
+        let (h, c) = (&http["results"][k], &by_cli["results"][k]);
+        assert_eq!(h["status"], "ok", "{h}");
+        for name in ["x", "y", "z", "rx", "ry", "rz"] {
+            let (a, b) = (h[name].as_f64().unwrap(), c[name].as_f64().unwrap());
+            assert!((a - b).abs() < 1e-9, "row {k} {name}: HTTP {a} CLI {b}");
+        }
+        let got = Vector3::new(
+            h["x"].as_f64().unwrap(),
+            h["y"].as_f64().unwrap(),
+            h["z"].as_f64().unwrap(),
+        );
+        worst = worst.max((got - fp).norm());
+    }
+    println!(
+        "predicted on the face plate at the solved joints: the targets back within {worst:.2e} mm"
+    );
+    assert!(worst < TIP_BOUND_MM, "{worst} mm");
+    for (extra, words) in [
+        (json!({ "e2": 10.0 }), "`e2` without `e1`"),
+        (json!({ "e1": 10.0, "e2": 5.0, "frame": "base" }), "`frame`"),
+        (json!({ "e1": 10.0, "e2": 1e9 }), "`e2`"),
+    ] {
+        let mut body = json!({ "readings": [{ "joints_deg": rows[0].0 }] });
+        for (key, value) in extra.as_object().unwrap() {
+            body[key] = value.clone();
+        }
+        let r = t.post_json(PREDICT, &[rid], body).await;
+        assert_eq!(
+            r.status,
+            StatusCode::UNPROCESSABLE_ENTITY,
+            "{extra}: {}",
+            r.text()
+        );
+        assert!(r.detail().contains(words), "{extra}: {}", r.detail());
     }
 }
 
