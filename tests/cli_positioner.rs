@@ -367,3 +367,223 @@ fn solve_takes_targets_on_the_face_plate_at_each_rows_axis_values() {
     );
     assert_refused(&out, "cannot be used with");
 }
+
+/// `predict --positioner` states the tool's pose in the face plate frame at
+/// the axes' values: at the joints `solve --positioner` returned it gives
+/// the targets back, and one row equals a hand composition through the true
+/// robot and the written positioner.
+#[test]
+fn predict_states_the_pose_on_the_face_plate_at_the_axis_values() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let robot = robot_file(d);
+    let t = near(truth());
+    let mut nom = nominal();
+    nom.cell_from_base = t.cell_from_base;
+    std::fs::write(d.join("nominal.json"), nom.to_json()).unwrap();
+    write(d, "r0.csv", &t, 0, &sweeps(), 1);
+    write(d, "r1.csv", &t, 1, &sweeps(), 2);
+    let out = calibrate(d, ["r0.csv", "r1.csv"], &[]);
+    assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+    let fitted =
+        TiltRotate::from_json(&std::fs::read_to_string(d.join("p.json")).unwrap()).unwrap();
+    let on_body = [
+        Vector3::new(0.30, 0.20, 1.16),
+        Vector3::new(-0.25, 0.28, 1.16),
+    ];
+    let values = [[-30.0, 40.0], [15.0, -120.0], [35.0, 160.0]];
+    let mut rows = vec!["id,x,y,z,e1,e2".to_string()];
+    let mut targets = Vec::new();
+    for (i, p) in on_body.iter().enumerate() {
+        let fp = fitted
+            .cell_from_face_plate([0.0, 0.0])
+            .inverse()
+            .transform_point(&t.point([0.0, 0.0], p))
+            * 1e3;
+        for (k, v) in values.iter().enumerate() {
+            rows.push(format!(
+                "p{i}v{k},{},{},{},{},{}",
+                fp.x, fp.y, fp.z, v[0], v[1]
+            ));
+            targets.push((fp, *v));
+        }
+    }
+    std::fs::write(d.join("part.csv"), rows.join("\n") + "\n").unwrap();
+    let args = [
+        "solve",
+        "--model",
+        "robot.json",
+        "--targets",
+        "part.csv",
+        "--positioner",
+        "p.json",
+        "--position-only",
+        "--json",
+    ];
+    let out = robocal(d, &args);
+    assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let joints: Vec<Vec<f64>> = doc["targets"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| {
+            r["joints_deg"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|x| x.as_f64().unwrap())
+                .collect()
+        })
+        .collect();
+    let mut lines = vec!["id,q1,q2,q3,q4,q5,q6,e1,e2".to_string()];
+    for (k, (q, (_, v))) in joints.iter().zip(&targets).enumerate() {
+        let q: Vec<String> = q.iter().map(|x| format!("{x:.10}")).collect();
+        lines.push(format!("r{k},{},{},{}", q.join(","), v[0], v[1]));
+    }
+    std::fs::write(d.join("joints.csv"), lines.join("\n") + "\n").unwrap();
+    let predict = |extra: &[&str], file: &str| -> serde_json::Value {
+        let mut args = vec![
+            "predict",
+            "--model",
+            "robot.json",
+            "--joints",
+            file,
+            "--json",
+        ];
+        args.extend_from_slice(extra);
+        let out = robocal(d, &args);
+        assert_eq!(code(&out), 0, "{}{}", text(&out.stdout), text(&out.stderr));
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    let xyz = |r: &serde_json::Value| {
+        Vector3::new(
+            r["x"].as_f64().unwrap(),
+            r["y"].as_f64().unwrap(),
+            r["z"].as_f64().unwrap(),
+        )
+    };
+    // The targets back, within the fit's RMS limit (the model and the
+    // positioner are the ones the solve inverted; the true robot reaches
+    // the same points within that limit).
+    let doc = predict(&["--positioner", "p.json"], "joints.csv");
+    assert_eq!(
+        doc["frame"],
+        "face plate of positioner p.json at each row's e1 (tilt), e2 (rotate)"
+    );
+    let mut worst: f64 = 0.0;
+    for (r, (fp, _)) in doc["results"].as_array().unwrap().iter().zip(&targets) {
+        assert_eq!(r["status"], "ok", "{r}");
+        worst = worst.max((xyz(r) - fp).norm());
+    }
+    println!("predict at the solved joints: the targets back within {worst:.2e} mm");
+    assert!(worst < 0.052, "{worst}");
+
+    // One row by hand: the true robot's tool pose (its geometry is the
+    // model file's, base on the cell's origin) carried into the written
+    // positioner's face plate at the row's values; `--e1 --e2` give the same.
+    let k = 4;
+    let q = robocal::model::preset("ys100")
+        .unwrap()
+        .joints_from_controller(&joints[k].iter().map(|x| x.to_radians()).collect::<Vec<_>>());
+    let v = targets[k].1;
+    let tip = fitted
+        .cell_from_face_plate(v)
+        .inverse()
+        .compose(&robot.true_pose_base(&q, None).unwrap());
+    let hand = tip.p * 1e3;
+    let got = xyz(&doc["results"][k]);
+    assert!((got - hand).norm() < 1e-6, "{got} vs {hand}");
+    let r = &doc["results"][k];
+    let deg = |n: &str| r[n].as_f64().unwrap().to_radians();
+    let shown = rpy_matrix(deg("rx"), deg("ry"), deg("rz"));
+    assert!((shown - tip.r).norm() < 1e-8, "{shown} vs {}", tip.r);
+    std::fs::write(
+        d.join("one.csv"),
+        format!(
+            "q1,q2,q3,q4,q5,q6\n{}\n",
+            lines[k + 1]
+                .split(',')
+                .skip(1)
+                .take(6)
+                .collect::<Vec<_>>()
+                .join(",")
+        ),
+    )
+    .unwrap();
+    let (e1, e2) = (v[0].to_string(), v[1].to_string());
+    let one = predict(
+        &["--positioner", "p.json", "--e1", &e1, "--e2", &e2],
+        "one.csv",
+    );
+    assert!((xyz(&one["results"][0]) - got).norm() < 1e-9);
+    // Through the nominal positioner the tool is elsewhere on the part.
+    let nominal_doc = predict(&["--positioner", "nominal.json"], "joints.csv");
+    let off = (xyz(&nominal_doc["results"][k]) - got).norm();
+    println!("the same row through the nominal positioner: {off:.3} mm away");
+    assert!(off > 0.5, "{off}");
+
+    // Refusals: a row without its `e2` fails alone naming line and column;
+    // one flag alone, the flags beside the columns and --positioner beside
+    // --track or --work-object are refused.
+    let gap = std::fs::read_to_string(d.join("joints.csv"))
+        .unwrap()
+        .replacen(",40\n", ",\n", 1);
+    std::fs::write(d.join("gap.csv"), gap).unwrap();
+    let out = robocal(
+        d,
+        &[
+            "predict",
+            "--model",
+            "robot.json",
+            "--joints",
+            "gap.csv",
+            "--positioner",
+            "p.json",
+            "--json",
+        ],
+    );
+    assert_eq!(code(&out), 2, "{}", text(&out.stderr));
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(doc["results"][0]["status"], "failed");
+    assert_eq!(
+        doc["results"][0]["message"],
+        "line 2: column `e2`: `` is not a number"
+    );
+    assert_eq!(doc["results"][1]["status"], "ok");
+    for (extra, says) in [
+        (
+            vec!["--positioner", "p.json", "--e1", "10"],
+            "both --e1 (tilt) and --e2",
+        ),
+        (
+            vec!["--positioner", "p.json", "--e1", "10", "--e2", "5"],
+            "ambiguous",
+        ),
+        (
+            vec!["--positioner", "p.json", "--track", "rail.json"],
+            "cannot be used with",
+        ),
+        (
+            vec![
+                "--positioner",
+                "p.json",
+                "--cell",
+                "c.json",
+                "--work-object",
+                "1",
+            ],
+            "cannot be used with",
+        ),
+    ] {
+        let mut args = vec!["predict", "--model", "robot.json", "--joints", "joints.csv"];
+        args.extend(extra.iter().copied());
+        let out = robocal(d, &args);
+        assert_eq!(code(&out), 1, "{extra:?}: {}", text(&out.stderr));
+        assert!(
+            text(&out.stderr).contains(says),
+            "{extra:?}: {}",
+            text(&out.stderr)
+        );
+    }
+}

@@ -62,15 +62,7 @@ pub fn write_fitted<F: Serialize, V: Serialize>(
     Ok(Some(serde_json::to_string_pretty(&body)? + "\n"))
 }
 
-/// The code a reason, term or noise model serialises to (its snake_case
-/// name, e.g. `residual_outlier`), as the reports print it; empty for a
-/// value that is not one name.
-pub fn code<T: Serialize>(value: &T) -> String {
-    serde_json::to_value(value)
-        .ok()
-        .and_then(|v| v.as_str().map(String::from))
-        .unwrap_or_default()
-}
+pub use crate::service::refusal::code;
 
 /// RMS and max of held-out errors [mm] (`ErrorStats`), as the validations
 /// report them.

@@ -20,18 +20,31 @@
 //! through the fitted positioner: their RMS and maximum. A refused fit
 //! writes nothing and exits with `refused` (1), printing its reason code and
 //! message (with `--json` also the refusal as JSON on stdout).
+//!
+//! `predict --positioner FILE` states the predicted poses in the
+//! positioner's face plate frame at `--e1` (tilt) and `--e2` (rotate)
+//! [deg], or at each row's `e1` and `e2` columns of the joints file
+//! ([`OnPlate`]): `F(v)⁻¹·cell_from_base·pose`, the inverse of what `solve
+//! --positioner` does (`solve::external::positioner`), where the tool is on
+//! the part.
 
 use super::judged_fit;
+use crate::service::positioners::{held_out, set_readings, HeldOut};
 use anyhow::Context;
 use clap::{Args, Subcommand};
-use nalgebra::Vector3;
-use robocal_core::calibrate::external::readings::{positioner_readings, PositionerColumns};
+use robocal_core::calibrate::external::readings::PositionerColumns;
 use robocal_core::calibrate::external::{
     fit_positioner, PositionerFit, PositionerFitRequest, PositionerReading, Refused,
 };
-use robocal_core::measure::csv::parse_set;
+use robocal_core::measure::csv_text::Dialect;
 use robocal_core::measure::external::ExternalAxis;
+use robocal_core::model::calibrated::CompensatedModel;
 use robocal_core::model::external::TiltRotate;
+use robocal_core::model::Pose;
+use robocal_core::solve::cell::PredictFrame;
+use robocal_core::solve::external::{
+    base_from_part, target_column_values, AxisValues, TargetValue, ROTATE_COLUMN, TILT_COLUMN,
+};
 use serde::Serialize;
 use std::fmt::Write as _;
 
@@ -111,19 +124,15 @@ fn parse_point(s: &str) -> anyhow::Result<[f64; 3]> {
 #[error("not fitted ({}): {}", judged_fit::code(&.0.reason), .0.message)]
 pub struct PositionerNotFitted(pub Box<Refused>);
 
-/// Held-out readings predicted through the fitted positioner [mm].
+/// Held-out readings predicted through the fitted positioner [mm]: the
+/// files and the figures the service gives for the same readings.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Validation {
-    /// The held-out measurement files, the k-th of reflector k.
+    /// The held-out files, the k-th of reflector k.
     pub files: Vec<String>,
-    /// Their readings, each predicted at its axes' values.
-    pub readings: usize,
-    /// Distinct pairs of axis values `[tilt, rotate]` [deg] among them.
-    pub value_pairs: usize,
-    /// RMS of the readings' position errors, measured − predicted [mm].
-    pub rms_mm: f64,
-    /// Largest of those position errors [mm].
-    pub max_mm: f64,
+    /// Their readings' figures through the fitted positioner.
+    #[serde(flatten)]
+    pub held_out: HeldOut,
 }
 
 /// Every file's rows as readings of its reflector (the file's index).
@@ -134,8 +143,7 @@ fn read_readings(
     let mut out = Vec::new();
     for (k, path) in files.iter().enumerate() {
         let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {path}"))?;
-        let set = parse_set(&text).with_context(|| path.clone())?;
-        out.extend(positioner_readings(&set, columns, k).with_context(|| path.clone())?);
+        out.extend(set_readings(&text, columns, k).with_context(|| path.clone())?);
     }
     Ok(out)
 }
@@ -147,28 +155,10 @@ fn validate(
     fit: &PositionerFit,
 ) -> anyhow::Result<Validation> {
     let readings = read_readings(files, columns)?;
-    if readings.is_empty() {
-        anyhow::bail!("--validate: no readings");
-    }
-    let mut pairs: Vec<[f64; 2]> = Vec::new();
-    let errors: Vec<f64> = readings
-        .iter()
-        .map(|r| {
-            if !pairs.contains(&r.values_deg) {
-                pairs.push(r.values_deg);
-            }
-            let on_plate = Vector3::from(fit.reflectors_mm[r.reflector]) * 1e-3;
-            let at = fit.model.point_in_cell(r.values_deg, &on_plate) * 1e3;
-            (at - Vector3::from(r.xyz_mm)).norm()
-        })
-        .collect();
-    let (rms_mm, max_mm) = judged_fit::rms_and_max_mm(&errors);
+    let held_out = held_out(&readings, fit).context("--validate: no readings")?;
     Ok(Validation {
         files: files.to_vec(),
-        readings: errors.len(),
-        value_pairs: pairs.len(),
-        rms_mm,
-        max_mm,
+        held_out,
     })
 }
 
@@ -323,11 +313,11 @@ fn report(
         let _ = writeln!(
             s,
             "held out: {} readings at {} pairs of axis values ({}): rms {:.4} mm, max {:.4} mm",
-            v.readings,
-            v.value_pairs,
+            v.held_out.readings,
+            v.held_out.value_pairs,
             v.files.join(", "),
-            v.rms_mm,
-            v.max_mm
+            v.held_out.rms_mm,
+            v.held_out.max_mm
         );
     }
     let _ = writeln!(s, "written: {}", a.out);
@@ -341,5 +331,120 @@ pub fn run(a: PositionerArgs) -> anyhow::Result<()> {
             print!("{}", calibrate_to_string(&c)?);
             Ok(())
         }
+    }
+}
+
+/// A positioner's axis values for `robocal predict --positioner`: one pair
+/// for every row (`--e1`, `--e2`), or each row's `e1` and `e2` columns.
+enum PlateValues {
+    /// `--e1 DEG --e2 DEG`.
+    Fixed(AxisValues),
+    /// The joints file's columns, matched by line.
+    PerRow {
+        tilt: Vec<TargetValue>,
+        rotate: Vec<TargetValue>,
+    },
+}
+
+/// `robocal predict --positioner FILE`: the positioner and the axis values
+/// each reading is stated at, its face plate frame being the output's.
+pub struct OnPlate {
+    path: String,
+    positioner: TiltRotate,
+    values: PlateValues,
+}
+
+impl OnPlate {
+    /// Reads the positioner file `path` and the values: `--e1` and `--e2`
+    /// together, or (neither given) the joints file's `e1` and `e2`
+    /// columns; one flag alone, the flags beside such a column, or a file
+    /// without both columns is refused.
+    pub fn read(
+        path: &str,
+        e1: Option<f64>,
+        e2: Option<f64>,
+        file: &str,
+        text: &str,
+        dialect: Dialect,
+    ) -> anyhow::Result<OnPlate> {
+        let json = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read positioner file {path}"))?;
+        let positioner =
+            TiltRotate::from_json(&json).with_context(|| format!("positioner file {path}"))?;
+        let tilt =
+            target_column_values(text, dialect, TILT_COLUMN).with_context(|| file.to_string())?;
+        let rotate =
+            target_column_values(text, dialect, ROTATE_COLUMN).with_context(|| file.to_string())?;
+        let values = match (e1, e2, tilt, rotate) {
+            (Some(t), Some(r), None, None) => {
+                for (v, flag) in [(t, "--e1"), (r, "--e2")] {
+                    if !v.is_finite() || v.abs() > 720.0 {
+                        anyhow::bail!("{flag} {v}: a positioner axis's value is a finite number of degrees within two turns (±720)");
+                    }
+                }
+                PlateValues::Fixed(AxisValues {
+                    tilt_deg: t,
+                    rotate_deg: r,
+                })
+            }
+            (Some(_), Some(_), _, _) => anyhow::bail!(
+                "{file}: the file has an `{TILT_COLUMN}` or `{ROTATE_COLUMN}` column and --e1, --e2 are given: ambiguous (give the flags or the columns)"
+            ),
+            (None, None, Some(tilt), Some(rotate)) => PlateValues::PerRow { tilt, rotate },
+            (None, None, t, _) => {
+                let name = if t.is_none() { TILT_COLUMN } else { ROTATE_COLUMN };
+                anyhow::bail!(
+                    "{file}: --positioner needs --e1 DEG --e2 DEG (tilt, rotate) or an `{TILT_COLUMN}` and an `{ROTATE_COLUMN}` column, and the file has no `{name}` column"
+                )
+            }
+            _ => anyhow::bail!("--positioner needs both --e1 (tilt) and --e2 (rotate) [deg], or neither (each row's `{TILT_COLUMN}` and `{ROTATE_COLUMN}` columns)"),
+        };
+        Ok(OnPlate {
+            path: path.to_string(),
+            positioner,
+            values,
+        })
+    }
+
+    /// The frame's name for the output's header.
+    pub fn label(&self) -> String {
+        match &self.values {
+            PlateValues::Fixed(v) => format!(
+                "face plate of positioner {} at e1 (tilt) {} deg, e2 (rotate) {} deg",
+                self.path, v.tilt_deg, v.rotate_deg
+            ),
+            PlateValues::PerRow { .. } => format!(
+                "face plate of positioner {} at each row's e1 (tilt), e2 (rotate)",
+                self.path
+            ),
+        }
+    }
+
+    /// The face plate at row `line`'s values in `model`'s base frame,
+    /// `robot.cell_from_base⁻¹·F(v)` (a pose predicted in it is
+    /// `F(v)⁻¹·cell_from_base·pose`), or the row's error naming its line and
+    /// column.
+    pub fn frame_at(&self, line: usize, model: &CompensatedModel) -> Result<PredictFrame, String> {
+        let values = match &self.values {
+            PlateValues::Fixed(v) => *v,
+            PlateValues::PerRow { tilt, rotate } => {
+                let at = |values: &[TargetValue], column: &str| {
+                    values.iter().find(|v| v.line == line).map_or_else(
+                        || Err(format!("line {line}: column `{column}`: no value")),
+                        |v| v.value.clone().map_err(|e| e.to_string()),
+                    )
+                };
+                AxisValues {
+                    tilt_deg: at(tilt, TILT_COLUMN)?,
+                    rotate_deg: at(rotate, ROTATE_COLUMN)?,
+                }
+            }
+        };
+        Ok(PredictFrame::WorkObject(base_from_part(
+            model,
+            &self.positioner,
+            values,
+            &Pose::identity(),
+        )))
     }
 }

@@ -16,7 +16,10 @@
 //! `--track FILE --e1 MM` the robot's base is carried along a calibrated
 //! track and the cell frame is the track's (`super::track`); with `--track`
 //! alone each row's track value is the joints file's `e1` column (a value
-//! beyond the track's travel fails its row alone).
+//! beyond the track's travel fails its row alone). With `--positioner FILE
+//! --e1 DEG --e2 DEG` (or each row's `e1`, `e2` columns) the poses are in
+//! the positioner's face plate frame at those values (`super::positioner::
+//! OnPlate`): `F(v)⁻¹·cell_from_base·pose`.
 
 use super::solve::OutputFormat;
 use crate::measure::csv_text::dialect_from_names;
@@ -37,6 +40,7 @@ use std::fmt::Write as _;
 
 /// Arguments of `robocal predict`.
 #[derive(Debug, Args)]
+#[command(group = clap::ArgGroup::new("external_axis").multiple(true).args(["track", "positioner"]))]
 pub struct PredictArgs {
     /// Robot model: a calibrated model file (`robocal calibrate --save`), a
     /// model JSON file or a preset (ys100, hh800, ur5, ur10).
@@ -83,6 +87,15 @@ pub struct PredictArgs {
     /// `--track FILE --e1 MM`: the robot carried along a linear track.
     #[command(flatten)]
     pub track: super::track::OnTrack,
+    /// Calibrated positioner (`robocal positioner calibrate --out`, in the
+    /// robot's measurement frame): the poses are stated in its face plate
+    /// frame at `--e1` (tilt) and `--e2` (rotate) [deg], or at each row's
+    /// `e1` and `e2` columns.
+    #[arg(long, conflicts_with_all = ["work_object", "track", "frame"])]
+    pub positioner: Option<String>,
+    /// The positioner's rotate (axis 2) value [deg], beside `--e1` its tilt.
+    #[arg(long, requires = "positioner", allow_hyphen_values = true)]
+    pub e2: Option<f64>,
 }
 
 /// The validation evidence of a calibrated model file (none for presets and
@@ -117,6 +130,10 @@ pub fn predict_outcome(a: &PredictArgs) -> anyhow::Result<super::exit::Outcome> 
         .with_context(|| format!("cannot read joints file {}", a.joints))?;
     let dialect = dialect_from_names(a.delimiter.as_deref(), a.decimal.as_deref())
         .map_err(anyhow::Error::msg)?;
+    let plate = a.positioner.as_ref().map(|path| {
+        super::positioner::OnPlate::read(path, a.track.e1, a.e2, &a.joints, &text, dialect)
+    });
+    let plate = plate.transpose()?;
     // `--track` without `--e1`: each row's value from the file's `e1` column.
     let per_row = a.track.per_row(&a.joints, &text, dialect)?;
     let model = match per_row {
@@ -158,6 +175,7 @@ pub fn predict_outcome(a: &PredictArgs) -> anyhow::Result<super::exit::Outcome> 
         Placed { forward, frame }
     };
     let frame_label = match (&wobj, &per_row) {
+        _ if plate.is_some() => plate.as_ref().map(|p| p.label()).unwrap_or_default(),
         (Some(w), _) => format!("work object {}", w.name),
         (None, Some(_)) => a.track.label_per_row(frame.to_string()),
         (None, None) => a.track.label(frame.to_string()),
@@ -197,8 +215,13 @@ pub fn predict_outcome(a: &PredictArgs) -> anyhow::Result<super::exit::Outcome> 
             };
             Row {
                 result: placed.and_then(|p| {
+                    // On a positioner: the face plate at the row's values.
+                    let frame = match &plate {
+                        None => p.frame,
+                        Some(plate) => plate.frame_at(r.line, p.forward.model())?,
+                    };
                     p.forward
-                        .predict_deg(&r.joints_deg, &p.frame)
+                        .predict_deg(&r.joints_deg, &frame)
                         .map_err(|e| format!("line {}: {e}", r.line))
                 }),
                 id: r.id,
@@ -216,17 +239,23 @@ pub fn predict_outcome(a: &PredictArgs) -> anyhow::Result<super::exit::Outcome> 
         conv,
         dof,
     };
+    Ok(rendered(a, &h, &rows))
+}
+
+/// What the command prints of `rows`, in the format asked for, and how many
+/// readings failed.
+fn rendered(a: &PredictArgs, h: &Header, rows: &[Row]) -> super::exit::Outcome {
     let format = if a.json { OutputFormat::Json } else { a.format };
     let text = match format {
-        OutputFormat::Json => render_json(&h, &rows),
-        OutputFormat::Table => render_table(&h, &rows),
-        OutputFormat::Csv => render_csv(&h, &rows),
+        OutputFormat::Json => render_json(h, rows),
+        OutputFormat::Table => render_table(h, rows),
+        OutputFormat::Csv => render_csv(h, rows),
     };
-    Ok(super::exit::Outcome {
+    super::exit::Outcome {
         text,
         not_done: rows.iter().filter(|r| r.result.is_err()).count(),
         total: rows.len(),
-    })
+    }
 }
 
 struct Header<'a> {

@@ -76,6 +76,7 @@ their flags) that do reach it within the joint limits. Per robot family: docs/co
 
 /// Arguments of `robocal solve`.
 #[derive(Debug, Args)]
+#[command(group = clap::ArgGroup::new("external_axis").multiple(true).args(["track"]))]
 pub struct SolveArgs {
     /// Robot model: a preset (ys100, hh800, ur5, ur10), a model JSON file, or a
     /// calibrated model file written by `robocal calibrate --save`.

@@ -110,8 +110,9 @@ pub struct OnTrack {
     #[arg(long)]
     pub track: Option<String>,
     /// The track's value [mm] as the controller shows it (within the travel
-    /// the track was measured over).
-    #[arg(long, requires = "track", allow_hyphen_values = true)]
+    /// the track was measured over); in `predict --positioner`, the
+    /// positioner's tilt (axis 1) value [deg].
+    #[arg(long, requires = "external_axis", allow_hyphen_values = true)]
     pub e1: Option<f64>,
 }
 

@@ -1,7 +1,7 @@
 //! The store (sqlx): SQLite (the embedded default) or PostgreSQL (shared by
 //! several replicas), connection set-up, migrations, and the queries of the
 //! service, one file per resource (`robots`, `sets`, `calibrations`,
-//! `versions`, `cell`, `tracks`). No SQL is written outside this module, and no `sqlx` error
+//! `versions`, `cell`, `tracks`, `positioners`). No SQL is written outside this module, and no `sqlx` error
 //! leaves it: callers get a [`StoreError`].
 //!
 //! - `DATABASE_URL` picks the backend: `postgres://…`/`postgresql://…` is
@@ -82,6 +82,7 @@ impl From<sqlx::migrate::MigrateError> for StoreError {
 mod calibrations;
 mod cell;
 mod checks;
+mod positioners;
 mod queue;
 mod robots;
 mod set_usage;

@@ -37,6 +37,7 @@ pub mod iso9283_plan;
 
 pub mod listener;
 pub mod plans;
+pub mod positioners;
 pub mod predict;
 pub mod programs;
 pub mod record;
@@ -45,6 +46,7 @@ mod routing;
 pub mod server;
 pub mod sets;
 pub mod solve;
+pub mod solve_columns;
 pub mod tracks;
 pub mod versions;
 
@@ -82,6 +84,7 @@ fn routes() -> Vec<Route> {
     all.extend(record::routes());
     all.extend(iso9283::routes());
     all.extend(tracks::routes());
+    all.extend(positioners::routes());
     all
 }
 

@@ -14,6 +14,9 @@
 //! `unverified` for a tool when the calibration measured positions only.
 //! With `e1` [mm] the robot's base is carried to that value along its stored
 //! track (`service::tracks::carry`), and the cell frame is the track's.
+//! With `e1` and `e2` [deg] the poses are in the stored positioner's face
+//! plate frame at those tilt and rotate values (`frame: face_plate`), as
+//! `robocal predict --positioner --e1 --e2` states them.
 
 use super::input::{check_payload, objects, present};
 use super::solve::{convention, model_choice, target_id, ItemRef, VersionSelector};
@@ -24,6 +27,7 @@ use crate::service::predict::PredictCommand;
 use crate::solve::cell::accuracy::ToolAccuracy;
 use crate::solve::cell::joints_csv::JointReading;
 use crate::solve::cell::PoseOut;
+use crate::solve::external::AxisValues;
 use crate::solve::ik::TargetFrame;
 use axum::extract::State;
 use axum::response::{IntoResponse, Response};
@@ -66,9 +70,14 @@ pub struct PredictRequest {
     /// The work object the poses are given in: a stored one's name, or one inline (`frame` does not apply).
     #[serde(default, deserialize_with = "present")]
     pub work_object: Option<ItemRef>,
-    /// The track's value [mm]: the robot carried along its stored track.
+    /// The track's value [mm]: the robot carried along its stored track;
+    /// beside `e2`, the positioner's tilt [deg].
     #[serde(default, deserialize_with = "present")]
     pub e1: Option<f64>,
+    /// The positioner's rotate value [deg] (with `e1` its tilt): the poses
+    /// in the stored positioner's face plate frame.
+    #[serde(default, deserialize_with = "present")]
+    pub e2: Option<f64>,
 }
 
 /// A predicted orientation in the request's `convention`.
@@ -157,6 +166,7 @@ fn command(robot_id: i64, req: &PredictRequest) -> Result<PredictCommand, ApiErr
             )))
         }
     };
+    let (track_mm, positioner_deg) = axis_values(req)?;
     let readings = req
         .readings
         .iter()
@@ -191,8 +201,43 @@ fn command(robot_id: i64, req: &PredictRequest) -> Result<PredictCommand, ApiErr
             .map(|w| w.choice(CellKind::WorkObject))
             .transpose()?,
         frame,
-        track_mm: req.e1,
+        track_mm,
+        positioner_deg,
     })
+}
+
+/// `e1` alone: a track value [mm]; `e1` and `e2`: a positioner's tilt and
+/// rotate [deg], the poses on its face plate (beside `frame` or
+/// `work_object` a 422); `e2` alone a 422.
+fn axis_values(req: &PredictRequest) -> Result<(Option<f64>, Option<AxisValues>), ApiError> {
+    let (tilt, rotate) = match (req.e1, req.e2) {
+        (e1, None) => return Ok((e1, None)),
+        (None, Some(_)) => {
+            return Err(ApiError::invalid(
+                "`e2` without `e1`: a positioner's values are `e1` (tilt) and `e2` (rotate) [deg], both",
+            ))
+        }
+        (Some(t), Some(r)) => (t, r),
+    };
+    if req.frame.is_some() || req.work_object.is_some() {
+        return Err(ApiError::invalid(
+            "`e1` and `e2` state the poses in the positioner's face plate frame: `frame` and `work_object` beside them are ambiguous; leave them out",
+        ));
+    }
+    for (v, name) in [(tilt, "e1"), (rotate, "e2")] {
+        if !v.is_finite() || v.abs() > 720.0 {
+            return Err(ApiError::invalid(format!(
+                "`{name}`: {v} is not a positioner axis's value: a finite number of degrees within two turns (±720)"
+            )));
+        }
+    }
+    Ok((
+        None,
+        Some(AxisValues {
+            tilt_deg: tilt,
+            rotate_deg: rotate,
+        }),
+    ))
 }
 
 /// `POST /v1/robots/{id}/predict`: the readings' poses on the chosen model.

@@ -17,11 +17,14 @@
 //! `X-Robocal-Method`). With `e1` [mm] (body or query) the robot's base is
 //! carried to that value along its stored track and the cell frame is the
 //! track's (`service::tracks::carry`); a targets CSV may instead carry an
-//! `e1` column, a value per row (both: 422). The handler turns either body into a
+//! `e1` column, a value per row (both: 422), or `e1` and `e2` columns, a
+//! positioner's tilt and rotate values per row with the targets on its face
+//! plate (`solve_columns` reads them). The handler turns either body into a
 //! `service::solve::SolveCommand`; the service picks the model and runs it.
 
 use super::error::{content_type, json_content_type};
 use super::input::{check_payload, from_json_object, object_or_null, objects, present, Int};
+use super::solve_columns::{axis_columns, AxisColumns};
 use super::{ApiError, ApiPath, ApiQuery, AppState};
 use crate::measure::csv_text::{dialect_from_names, Dialect};
 use crate::model::orientation::OrientationConvention;
@@ -37,7 +40,6 @@ use axum::extract::rejection::BytesRejection;
 use axum::extract::State;
 use axum::http::{header, HeaderMap, HeaderName};
 use axum::response::{IntoResponse, Response};
-use robocal_core::solve::external::{target_track_values, TRACK_COLUMN};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::time::Instant;
@@ -440,6 +442,7 @@ fn command(robot_id: i64, c: Common) -> Result<SolveCommand, ApiError> {
         work_object: None,
         track_mm: c.e1,
         track_rows: None,
+        positioner_rows: None,
     })
 }
 
@@ -635,17 +638,14 @@ pub fn csv_command(robot_id: i64, q: &CsvSolveQuery, text: &str) -> Result<Solve
         },
     )?;
     let d = dialect(q.decimal.as_deref())?;
-    // An `e1` column: a track value per row, through the stored track.
-    let rows =
-        target_track_values(text, d).map_err(|e| ApiError::invalid(format!("targets CSV: {e}")))?;
-    if rows.is_some() && cmd.track_mm.is_some() {
-        return Err(ApiError::invalid(format!(
-            "the targets CSV has an `{TRACK_COLUMN}` column and the query gives `e1`: which track value holds is ambiguous; give one or the other"
-        )));
+    // External-axis columns: a track's value or a positioner's values per row.
+    let columns = axis_columns(text, d, cmd.track_mm, query.frame.is_some())?;
+    let csv = parse_targets_csv_beside(text, d, columns.beside())?;
+    match columns {
+        AxisColumns::None => {}
+        AxisColumns::Track(rows) => cmd.track_rows = Some(rows),
+        AxisColumns::Positioner(rows) => cmd.positioner_rows = Some(rows),
     }
-    let beside: &[&str] = if rows.is_some() { &[TRACK_COLUMN] } else { &[] };
-    let csv = parse_targets_csv_beside(text, d, beside)?;
-    cmd.track_rows = rows;
     if csv.rows.is_empty() {
         return Err(ApiError::invalid(
             "targets CSV: no target rows after the header",

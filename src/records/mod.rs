@@ -1,6 +1,6 @@
 //! What the store keeps, as the service and the HTTP layer see it: robots,
 //! measurement sets, calibration jobs, model versions, checks, tools and work
-//! objects, linear tracks. Plain data shared by the store (`crate::db`, which reads and
+//! objects, linear tracks, positioners. Plain data shared by the store (`crate::db`, which reads and
 //! writes these rows and maps its columns onto them) and the service (which
 //! answers with them); neither layer owns the vocabulary, so the HTTP layer
 //! reads it here without naming the store.
@@ -8,6 +8,7 @@
 mod calibrations;
 mod cell;
 mod checks;
+mod positioners;
 mod robots;
 mod sets;
 mod tracks;
@@ -16,6 +17,7 @@ mod versions;
 pub use calibrations::{CalibrationRow, JobStatus, JobSummary, ProgressDetail};
 pub use cell::{CellItemRow, CellKind, CellPut, ItemFrame, NewCellItem};
 pub use checks::CheckRow;
+pub use positioners::{NewPositioner, PositionerRow};
 pub use robots::{NewRobot, RobotRow};
 pub use sets::{AngleUnit, LengthUnit, SetFormat, SetRow, StoredRole};
 pub use tracks::{NewTrack, TrackRow};

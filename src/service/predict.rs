@@ -4,7 +4,9 @@
 //! evaluation (`core::cell::predict::Forward`, the model `solve` inverts) and
 //! the expected error at the tool from the version's validation evidence
 //! (`core::cell::accuracy`). A track value carries the model's base along
-//! the robot's stored track first (`super::tracks::carry`).
+//! the robot's stored track first (`super::tracks::carry`). Positioner
+//! values state the poses in the stored positioner's face plate frame at
+//! them (`super::positioners::for_predict`): `F(v)⁻¹·cell_from_base·pose`.
 //!
 //! Units at this boundary: joint readings in the controller convention in
 //! degrees; poses SI (the handler writes mm and degrees).
@@ -22,6 +24,8 @@ use crate::solve::cell::{
 use crate::solve::ik::TargetFrame;
 use robocal_core::model::calibrated::ValidationEvidence;
 use robocal_core::model::calibrated::{CalibratedModelFile, CompensatedModel};
+use robocal_core::model::Pose;
+use robocal_core::solve::external::{base_from_part, AxisValues};
 
 /// A prediction, in domain terms.
 #[derive(Debug, Clone)]
@@ -42,6 +46,8 @@ pub struct PredictCommand {
     pub frame: TargetFrame,
     /// A track value [mm]: the base carried along the robot's stored track.
     pub track_mm: Option<f64>,
+    /// The positioner's values [deg]: the poses in its face plate frame.
+    pub positioner_deg: Option<robocal_core::solve::external::AxisValues>,
 }
 
 /// What a prediction produced.
@@ -55,7 +61,7 @@ pub struct PredictOutcome {
     pub payload_kg: f64,
     /// The production tool's name (`None`: the measured point).
     pub tool: Option<String>,
-    /// `cell`, `base` or `work_object`.
+    /// `cell`, `base`, `work_object` or `face_plate`.
     pub frame: &'static str,
     /// Expected error at the tool (or the measured point).
     pub accuracy: ToolAccuracy,
@@ -151,6 +157,15 @@ pub async fn predict(
         tool.as_ref().and_then(|t| t.load.as_ref()),
     );
     let (frame, label) = match &cmd.work_object {
+        None if cmd.positioner_deg.is_some() => {
+            let positioner = super::positioners::for_predict(state, cmd.robot_id).await?;
+            let values = cmd.positioner_deg.unwrap_or(AxisValues {
+                tilt_deg: 0.0,
+                rotate_deg: 0.0,
+            });
+            let plate = base_from_part(forward.model(), &positioner, values, &Pose::identity());
+            (PredictFrame::WorkObject(plate), "face_plate")
+        }
         None => (PredictFrame::Frame(cmd.frame), frame_label(cmd.frame)),
         Some(choice) => {
             let item = resolve(state, cmd.robot_id, CellKind::WorkObject, choice).await?;

@@ -19,7 +19,11 @@
 //! is built per request, not cached. A targets CSV with an `e1` column has
 //! a value per row: each row is moved into the base frame at its value
 //! along the stored track (a row beyond the travel fails alone) and solved
-//! by the cached solver.
+//! by the cached solver. A targets CSV with `e1` and `e2` columns has a
+//! positioner's tilt and rotate values per row, its targets in the face
+//! plate frame: each row is moved into the base frame through the robot's
+//! stored positioner (`super::positioners::place_rows`) and solved by the
+//! cached solver.
 //!
 //! Units at this boundary: targets in mm and degrees (`TargetInput`), joint
 //! seeds and commands in the controller convention in degrees.
@@ -157,6 +161,11 @@ pub struct SolveCommand {
     /// moved into the base frame at its value along the stored track
     /// (`core::solve::external::place_on_track`; the cached solver serves).
     pub track_rows: Option<Vec<TargetValue>>,
+    /// A positioner's tilt and rotate values per row of a targets CSV (its
+    /// `e1` and `e2` columns), the targets in its face plate frame: each row
+    /// moved into the base frame through the robot's stored positioner
+    /// (`super::positioners::place_rows`; the cached solver serves).
+    pub positioner_rows: Option<super::positioners::PlateValues>,
 }
 
 /// A tool or work object of a solve: stored by name, or given inline.
@@ -369,6 +378,17 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
             ));
         };
         place_on_track(csv, &values, &track, cmd.options.frame, None);
+        cmd.options.frame = TargetFrame::Base;
+    }
+    if let Some(values) = cmd.positioner_rows.take() {
+        let positioner = super::positioners::for_rows(state, cmd.robot_id).await?;
+        let Targets::Csv(csv) = &mut cmd.targets else {
+            return Err(ServiceError::Internal(
+                "a positioner's values per row come with a targets CSV".into(),
+            ));
+        };
+        let robot = &cell_solver.solver().model().cell_from_base;
+        super::positioners::place_rows(csv, &values, &positioner, robot);
         cmd.options.frame = TargetFrame::Base;
     }
     let work_object = match &cmd.work_object {

@@ -56,11 +56,7 @@ pub struct StoredTrack {
 
 /// The command line's words for a refusal: `not fitted (REASON): MESSAGE`.
 pub fn refusal_detail(r: &TrackRefused) -> String {
-    let code = serde_json::to_value(r.reason)
-        .ok()
-        .and_then(|v| v.as_str().map(String::from))
-        .unwrap_or_default();
-    format!("not fitted ({code}): {}", r.message)
+    super::refusal::detail(&r.reason, &r.message)
 }
 
 fn no_track(robot_id: i64) -> ServiceError {

@@ -21,7 +21,9 @@
 //! `admission` (large requests share one admission), `slow_clients` (header
 //! and body timeouts, the connection cap), `exposure` (no open writes on a
 //! network by default), `track` (a robot's linear track: fitted, stored,
-//! and carrying predictions and solves, over HTTP and the CLI alike); the harness is `support`.
+//! and carrying predictions and solves, over HTTP and the CLI alike), `positioner`
+//! (a robot's two-axis positioner: fitted, stored, and carrying a targets CSV,
+//! over HTTP and the CLI alike); the harness is `support`.
 
 mod abandoned;
 mod admission;
@@ -44,6 +46,7 @@ mod migrations;
 mod numbers;
 mod one_answer;
 mod plans;
+mod positioner;
 mod predict;
 mod progress;
 mod record;

@@ -36,7 +36,7 @@ const TRACK: &str = "/v1/robots/{id}/track";
 const PREDICT: &str = "/v1/robots/{id}/predict";
 const SOLVE: &str = "/v1/robots/{id}/solve";
 
-const STATIONS: [f64; 11] = [
+pub(crate) const STATIONS: [f64; 11] = [
     0.0, 400.0, 800.0, 1200.0, 1600.0, 2000.0, 2400.0, 2800.0, 3200.0, 3600.0, 4000.0,
 ];
 /// A track value the fit never saw [mm].
@@ -45,14 +45,14 @@ const HELD_OUT_MM: f64 = 1000.0;
 const PAYLOAD_KG: f64 = 110.0;
 
 /// A robot of the calibrated version's geometry on the simulated rail.
-struct Rail {
+pub(crate) struct Rail {
     truth: robocal::sim::TrueRobot,
     track: TrueTrack,
 }
 
 impl Rail {
     /// The robot of the model file `model` (a version's `model.json`).
-    fn new(model: &Path) -> Self {
+    pub(crate) fn new(model: &Path) -> Self {
         let text = std::fs::read_to_string(model).unwrap();
         let file = CalibratedModelFile::from_json(&text).unwrap();
         let mut truth = robocal::sim::TrueRobot::new(file.to_compensated().unwrap().calibrated);
@@ -64,7 +64,7 @@ impl Rail {
     }
 
     /// `n` random poses at each of `values`, read by the tracker.
-    fn measure(&self, values: &[f64], n: usize, rng: &mut ChaCha8Rng) -> MeasurementSet {
+    pub(crate) fn measure(&self, values: &[f64], n: usize, rng: &mut ChaCha8Rng) -> MeasurementSet {
         let nominal = preset("ys100").unwrap();
         let stations: Vec<(f64, Vec<Vec<f64>>)> = values
             .iter()

@@ -1,0 +1,322 @@
+#![warn(missing_docs)]
+//! A two-axis tilt-rotate positioner beside a robot, stored per robot:
+//! fitted from one measurement file per face-plate reflector
+//! (`core::calibrate::external::fit_positioner`, the fit `robocal positioner
+//! calibrate` makes, reading its files through [`set_readings`] and its
+//! held-out files through [`held_out`] as the command line does), judged
+//! before it is stored, read back and deleted; and the rows of a targets CSV
+//! with `e1` (tilt) and `e2` (rotate) columns moved into the robot's base
+//! frame through it (`core::solve::external::place_on_positioner`:
+//! `robot.cell_from_base⁻¹·F(v)·T`, `T` in the face plate frame).
+//!
+//! Units at this boundary: axis values in degrees as the controller shows
+//! them; reflectors in mm in the face plate frame; readings in mm in the
+//! tracker (cell) frame, the frame the robot is registered in. A refused fit
+//! stores nothing and is `Invalid` with the command line's words, `not
+//! fitted (REASON): MESSAGE`.
+
+use super::{AppState, ServiceError};
+use crate::records::{NewPositioner, PositionerRow};
+use nalgebra::Vector3;
+use robocal_core::calibrate::external::readings::{
+    positioner_readings, ColumnsError, PositionerColumns,
+};
+use robocal_core::calibrate::external::{
+    fit_positioner, PositionerFit, PositionerFitRequest, PositionerReading, Refused,
+};
+use robocal_core::measure::csv::{parse_set, CsvError};
+use robocal_core::model::external::TiltRotate;
+use robocal_core::model::Pose;
+use robocal_core::solve::external::{place_on_positioner, TargetValue};
+use robocal_core::solve::ik::TargetsCsv;
+use robocal_core::stats::ErrorStats;
+use serde::Serialize;
+
+/// Most readings one positioner fit takes (its files and held-out files together).
+pub const POSITIONER_READINGS_MAX: usize = 20_000;
+/// Most reflectors (measurement files) one positioner fit takes.
+pub const POSITIONER_REFLECTORS_MAX: usize = 32;
+
+/// A positioner fit, in domain terms.
+#[derive(Debug, Clone)]
+pub struct PositionerCalibration {
+    /// The robot whose cell holds the positioner.
+    pub robot_id: i64,
+    /// The k-th reflector's measurement file text, per reflector.
+    pub sets: Vec<String>,
+    /// The reflectors' design positions on the face plate [mm, face plate
+    /// frame]; the first is the reference.
+    pub reflectors_mm: Vec<[f64; 3]>,
+    /// The nominal positioner: the start and the frames the fit states its lines in.
+    pub nominal: TiltRotate,
+    /// The files' columns of the tilt and rotate axes.
+    pub columns: PositionerColumns,
+    /// The tracker's σ per coordinate [mm] the fit is judged against.
+    pub sigma_mm: f64,
+    /// Held-out measurement file texts, the k-th of reflector k.
+    pub validate: Vec<String>,
+}
+
+/// Why a measurement file's text is not a reflector's readings.
+#[derive(Debug, thiserror::Error)]
+pub enum SetReadingsError {
+    /// The text is not a measurement file.
+    #[error(transparent)]
+    Csv(#[from] CsvError),
+    /// The file lacks an axis's column, or a row its value.
+    #[error(transparent)]
+    Columns(#[from] ColumnsError),
+}
+
+/// Reflector `k`'s readings from its measurement file `text`, the axes'
+/// values read from `columns` (what `robocal positioner calibrate` reads of
+/// each file).
+pub fn set_readings(
+    text: &str,
+    columns: PositionerColumns,
+    k: usize,
+) -> Result<Vec<PositionerReading>, SetReadingsError> {
+    let set = parse_set(text)?;
+    Ok(positioner_readings(&set, columns, k)?)
+}
+
+/// Held-out readings predicted through a fitted positioner at the fitted
+/// reflectors' positions [mm].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct HeldOut {
+    /// The held-out readings.
+    pub readings: usize,
+    /// Distinct pairs of axis values `[tilt, rotate]` [deg] among them.
+    pub value_pairs: usize,
+    /// RMS of the 3-D errors [mm].
+    pub rms_mm: f64,
+    /// Largest 3-D error [mm].
+    pub max_mm: f64,
+}
+
+/// `readings` (reflector k's held out) predicted through `fit`'s model at
+/// the fitted reflector k; `None` without readings.
+pub fn held_out(readings: &[PositionerReading], fit: &PositionerFit) -> Option<HeldOut> {
+    if readings.is_empty() {
+        return None;
+    }
+    let mut pairs: Vec<[f64; 2]> = Vec::new();
+    let errors: Vec<f64> = readings
+        .iter()
+        .map(|r| {
+            if !pairs.contains(&r.values_deg) {
+                pairs.push(r.values_deg);
+            }
+            let on_plate = Vector3::from(fit.reflectors_mm[r.reflector]) * 1e-3;
+            let at = fit.model.point_in_cell(r.values_deg, &on_plate) * 1e3;
+            (at - Vector3::from(r.xyz_mm)).norm()
+        })
+        .collect();
+    let stats = ErrorStats::from_errors_mm(&errors);
+    Some(HeldOut {
+        readings: errors.len(),
+        value_pairs: pairs.len(),
+        rms_mm: stats.rms_mm,
+        max_mm: stats.max_mm,
+    })
+}
+
+/// The command line's words for a refusal: `not fitted (REASON): MESSAGE`.
+pub fn refusal_detail(r: &Refused) -> String {
+    super::refusal::detail(&r.reason, &r.message)
+}
+
+/// A stored fit: the row as stored, whether the robot had no positioner
+/// before, the fit's report and its held-out readings' figures.
+#[derive(Debug, Clone)]
+pub struct StoredPositioner {
+    /// The row as stored.
+    pub row: PositionerRow,
+    /// Whether the robot had no positioner before.
+    pub created: bool,
+    /// The fit's report (`robocal positioner calibrate --json`'s `fit`).
+    pub fit: Box<PositionerFit>,
+    /// The held-out readings through the fitted positioner, when given.
+    pub validation: Option<HeldOut>,
+}
+
+/// Every text's readings, the k-th as reflector k's; an error names the
+/// field and the text (`sets[k]`, `validate[k]`).
+fn readings_of(
+    field: &str,
+    texts: &[String],
+    columns: PositionerColumns,
+) -> Result<Vec<PositionerReading>, ServiceError> {
+    let mut out = Vec::new();
+    for (k, text) in texts.iter().enumerate() {
+        let r = set_readings(text, columns, k)
+            .map_err(|e| ServiceError::Invalid(format!("`{field}[{k}]`: {e}")))?;
+        out.extend(r);
+        if out.len() > POSITIONER_READINGS_MAX {
+            return Err(ServiceError::Invalid(format!(
+                "`{field}`: more than {POSITIONER_READINGS_MAX} readings; at most that many in one fit"
+            )));
+        }
+    }
+    Ok(out)
+}
+
+/// Fits the positioner, judges it and stores it as the robot's (replacing
+/// the one it had); a refused fit stores nothing (`Invalid`, the reason's
+/// code in the message).
+pub async fn calibrate(
+    state: &AppState,
+    cmd: PositionerCalibration,
+) -> Result<StoredPositioner, ServiceError> {
+    super::robots::get(state, cmd.robot_id).await?;
+    let readings = readings_of("sets", &cmd.sets, cmd.columns)?;
+    let held = readings_of("validate", &cmd.validate, cmd.columns)?;
+    if readings.len() + held.len() > POSITIONER_READINGS_MAX {
+        return Err(ServiceError::Invalid(format!(
+            "`sets` and `validate`: {} readings; at most {POSITIONER_READINGS_MAX} in one fit",
+            readings.len() + held.len()
+        )));
+    }
+    if !cmd.validate.is_empty() && held.is_empty() {
+        return Err(ServiceError::Invalid("`validate`: no readings".into()));
+    }
+    let request = PositionerFitRequest {
+        nominal: cmd.nominal,
+        reflectors_mm: cmd.reflectors_mm,
+        readings,
+        tracker_sigma_mm: cmd.sigma_mm,
+    };
+    let fitted = super::heavy::run(state, "positioner fit", move |_| {
+        fit_positioner(&request).map(|fit| {
+            let validation = held_out(&held, &fit);
+            (
+                fit,
+                validation,
+                request.readings.len(),
+                request.reflectors_mm.len(),
+            )
+        })
+    })
+    .await?;
+    let (fit, validation, readings, reflectors) =
+        fitted.map_err(|r| ServiceError::Invalid(refusal_detail(&r)))?;
+    let new = NewPositioner {
+        tilt_column: cmd.columns.tilt.column().to_string(),
+        rotate_column: cmd.columns.rotate.column().to_string(),
+        sigma_mm: cmd.sigma_mm,
+        reflectors: reflectors as i64,
+        readings: readings as i64,
+        rms_mm: fit.rms_mm,
+        max_mm: fit.max_mm,
+        positioner_json: fit.model.to_json(),
+    };
+    let (row, created) = state
+        .db()
+        .put_positioner(cmd.robot_id, &new)
+        .await?
+        .ok_or_else(|| ServiceError::robot_not_found(cmd.robot_id))?;
+    Ok(StoredPositioner {
+        row,
+        created,
+        fit: Box::new(fit),
+        validation,
+    })
+}
+
+fn no_positioner(robot_id: i64) -> ServiceError {
+    ServiceError::NotFound(format!(
+        "robot {robot_id} has no positioner; fit one with POST /v1/robots/{robot_id}/positioner/calibrate"
+    ))
+}
+
+/// The robot's stored positioner (`NotFound` for a missing robot or positioner).
+pub async fn get(state: &AppState, robot_id: i64) -> Result<PositionerRow, ServiceError> {
+    match state.db().positioner(robot_id).await? {
+        Some(row) => Ok(row),
+        None => {
+            super::robots::get(state, robot_id).await?;
+            Err(no_positioner(robot_id))
+        }
+    }
+}
+
+/// Deletes the robot's positioner (`NotFound` when it has none).
+pub async fn delete(state: &AppState, robot_id: i64) -> Result<(), ServiceError> {
+    if state.db().delete_positioner(robot_id).await? {
+        return Ok(());
+    }
+    super::robots::get(state, robot_id).await?;
+    Err(no_positioner(robot_id))
+}
+
+/// The stored positioner as a model.
+pub fn model_of(row: &PositionerRow) -> Result<TiltRotate, ServiceError> {
+    TiltRotate::from_json(&row.positioner_json).map_err(|e| {
+        ServiceError::Internal(format!("stored positioner of robot {}: {e}", row.robot_id))
+    })
+}
+
+/// Each row's values of a targets CSV with `e1` (tilt) and `e2` (rotate)
+/// columns [deg], matched by line.
+#[derive(Debug, Clone)]
+pub struct PlateValues {
+    /// Axis 1's (tilt) value per row, the `e1` column.
+    pub tilt: Vec<TargetValue>,
+    /// Axis 2's (rotate) value per row, the `e2` column.
+    pub rotate: Vec<TargetValue>,
+}
+
+/// The robot's stored positioner for a targets CSV with `e1` and `e2`
+/// columns: no positioner is a `Conflict` (the robot's state), and so is a
+/// robot with a track too (`e1` would be either's value: ambiguous).
+pub async fn for_rows(state: &AppState, robot_id: i64) -> Result<TiltRotate, ServiceError> {
+    let Some(row) = state.db().positioner(robot_id).await? else {
+        return Err(ServiceError::Conflict(format!(
+            "the targets CSV has `e1` and `e2` columns, a positioner's tilt and rotate values per row, and robot {robot_id} has no positioner; fit one with POST /v1/robots/{robot_id}/positioner/calibrate (a track's value per row is an `e1` column alone)"
+        )));
+    };
+    if state.db().track(robot_id).await?.is_some() {
+        return Err(ServiceError::Conflict(format!(
+            "robot {robot_id} has a track and a positioner: the targets CSV's `e1` column could be the track's value or the positioner's tilt, which is ambiguous (a track and a positioner in one cell are not modelled); solve on the positioner with a robot that has no track, or on the track with an `e1` column alone"
+        )));
+    }
+    model_of(&row)
+}
+
+/// The robot's stored positioner for a prediction at its values (`e1` and
+/// `e2`): no positioner is a `Conflict`, and so is a robot with a track too
+/// (`e1` would be either's value: ambiguous), as for a targets CSV.
+pub async fn for_predict(state: &AppState, robot_id: i64) -> Result<TiltRotate, ServiceError> {
+    let Some(row) = state.db().positioner(robot_id).await? else {
+        super::robots::get(state, robot_id).await?;
+        return Err(ServiceError::Conflict(format!(
+            "`e1` and `e2` are a positioner's tilt and rotate values, and robot {robot_id} has no positioner; fit one with POST /v1/robots/{robot_id}/positioner/calibrate (a track's value is `e1` alone)"
+        )));
+    };
+    if state.db().track(robot_id).await?.is_some() {
+        return Err(ServiceError::Conflict(format!(
+            "robot {robot_id} has a track and a positioner: `e1` could be the track's value or the positioner's tilt, which is ambiguous (a track and a positioner in one cell are not modelled)"
+        )));
+    }
+    model_of(&row)
+}
+
+/// Moves `csv`'s targets (face plate frame) into the robot's base frame at
+/// each row's values through `positioner`, the robot registered at
+/// `robot_cell_from_base` in the positioner's cell frame; the targets are
+/// then solved in the base frame. A row without a number in either column
+/// fails alone, naming its line and column.
+pub fn place_rows(
+    csv: &mut TargetsCsv,
+    values: &PlateValues,
+    positioner: &TiltRotate,
+    robot_cell_from_base: &Pose,
+) {
+    place_on_positioner(
+        csv,
+        &values.tilt,
+        &values.rotate,
+        positioner,
+        robot_cell_from_base,
+    );
+}
