@@ -94,10 +94,24 @@ impl Server {
         }
     }
 
+    /// Kills the server with SIGKILL and reaps it: no shutdown code runs.
     pub fn kill9(mut self) {
-        // Child::kill sends SIGKILL on Unix: no shutdown code runs.
+        // Child::kill sends SIGKILL on Unix.
         self.child.kill().unwrap();
         self.child.wait().unwrap();
+    }
+}
+
+/// A server a test leaves running (a replica still up when its test ends, or
+/// after a failed assertion) is killed and reaped with it, so no `robocal
+/// serve` outlives its test holding the test's database; one already ended
+/// is left as it is.
+impl Drop for Server {
+    fn drop(&mut self) {
+        if let Ok(None) = self.child.try_wait() {
+            let _ = self.child.kill();
+            let _ = self.child.wait();
+        }
     }
 }
 
