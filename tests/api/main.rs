@@ -34,6 +34,9 @@ mod checks;
 #[path = "../common/mod.rs"]
 mod common;
 mod contract;
+#[path = "../../core/tests/common/positioner.rs"]
+#[allow(dead_code)]
+mod core_positioner;
 mod exposure;
 mod flow;
 mod hostile;

@@ -15,22 +15,24 @@
 //! the true point on the true positioner.
 
 use super::cell::model_file;
+use crate::core_positioner as shared;
 use crate::support::*;
 use axum::http::StatusCode;
 use clap::Parser;
-use nalgebra::{Rotation3, Vector3};
+use nalgebra::Vector3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal::calibrate::external::readings::PositionerColumns;
 use robocal::measure::csv::write_set;
 use robocal::measure::external::ExternalAxis;
 use robocal::model::calibrated::CalibratedModelFile;
-use robocal::model::external::{RotaryAxis, TiltRotate};
+use robocal::model::external::TiltRotate;
 use robocal::model::pose::rpy_matrix;
 use robocal::model::{preset, Pose};
-use robocal::sim::positioner::{TrueAxis, TruePositioner, Wobble};
+use robocal::sim::positioner::TruePositioner;
 use robocal::sim::positioner_sets::positioner_set;
 use serde_json::{json, Value};
+use shared::{sweeps, DESIGN_MM as REFLECTORS};
 use std::path::Path;
 
 const CALIBRATE: &str = "/v1/robots/{id}/positioner/calibrate";
@@ -48,10 +50,6 @@ const COLUMNS: PositionerColumns = PositionerColumns {
     rotate: ExternalAxis::E2,
 };
 
-fn turned(v: Vector3<f64>, about: Vector3<f64>, deg: f64) -> Vector3<f64> {
-    Rotation3::from_scaled_axis(about.normalize() * deg.to_radians()) * v
-}
-
 /// The positioner base 1.7 m in front of the robot's base, turned 30°,
 /// stated in the cell frame the robot is registered in (`robot`).
 fn placed(robot: &Pose) -> Pose {
@@ -61,53 +59,22 @@ fn placed(robot: &Pose) -> Pose {
     ))
 }
 
-/// The nominal positioner (what the controller computes from the drawing).
+/// The nominal positioner of the positioner tests (`core/tests/common/positioner.rs`), placed
+/// in front of `robot`.
 fn nominal(robot: &Pose) -> TiltRotate {
     TiltRotate {
         cell_from_base: placed(robot),
-        tilt: RotaryAxis::new(Vector3::x(), Vector3::new(0.0, 0.0, 0.8), 0.0, 1.0),
-        rotate: RotaryAxis::new(Vector3::z(), Vector3::zeros(), 0.0, 1.0),
-        face_plate: Pose::from_translation(Vector3::new(0.0, 0.0, 1.1)),
+        ..shared::nominal()
     }
 }
 
-/// The true positioner of `tests/cli_positioner.rs`, at the same place.
+/// The true positioner of `tests/cli_positioner.rs` (the shared truth with its 0.003° nod), at
+/// the same place.
 fn truth(robot: &Pose) -> TruePositioner {
     TruePositioner {
         cell_from_base: placed(robot),
-        tilt: TrueAxis {
-            direction: turned(Vector3::x(), Vector3::new(0.0, 0.6, 0.8), 0.05),
-            through: Vector3::new(0.0, 0.0003, 0.8004),
-            encoder_offset_rad: 0.3f64.to_radians(),
-            scale: 1.0 + 2e-4,
-            wobble: None,
-        },
-        rotate: TrueAxis {
-            direction: turned(Vector3::z(), Vector3::new(1.0, 1.0, 0.0), 0.05),
-            through: Vector3::new(0.0004, -0.0003, 0.0),
-            encoder_offset_rad: -0.4f64.to_radians(),
-            scale: 1.0 - 1.5e-4,
-            wobble: Some(Wobble {
-                amplitude_rad: 0.003f64.to_radians(),
-                phase_rad: 0.7,
-                pivot_along_m: 0.95,
-            }),
-        },
-        reflectors: vec![
-            Vector3::new(0.4002, 0.0003, 1.1198),
-            Vector3::new(-0.1497, 0.1004, 1.1203),
-        ],
-        noise_mm: 0.01,
+        ..shared::truth(0.003)
     }
-}
-
-/// Axis 2 over 330° at axis 1 = 0, axis 1 over 180° at axis 2 = 0.
-fn sweeps() -> Vec<[f64; 2]> {
-    let mut v: Vec<[f64; 2]> = (0..12)
-        .map(|i| [0.0, -165.0 + 30.0 * f64::from(i)])
-        .collect();
-    v.extend((0..13).map(|i| [-90.0 + 15.0 * f64::from(i), 0.0]));
-    v
 }
 
 /// Both axes moved together, none a fitted pair.
@@ -126,8 +93,6 @@ fn set_text(t: &TruePositioner, k: usize, values: &[[f64; 2]], seed: u64) -> Str
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     write_set(&positioner_set(t, k, values, COLUMNS, &mut rng))
 }
-
-const REFLECTORS: [[f64; 3]; 2] = [[400.0, 0.0, 20.0], [-150.0, 100.0, 20.0]];
 
 /// Runs a `robocal` command line in-process; what it prints.
 fn cli(args: &[&str]) -> anyhow::Result<String> {
