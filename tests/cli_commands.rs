@@ -483,3 +483,63 @@ fn cli_solves_targets_in_a_work_object_for_a_production_tool() {
         assert!((want.p * 1e3 - Vector3::new(r[0], r[1], r[2])).norm() > 0.01);
     }
 }
+
+// ---------------------------------------------------------------------------
+// bench
+// ---------------------------------------------------------------------------
+
+/// `bench methods --phases` prints each step of a run (phase, candidate, fit
+/// or cross-validation) once as it starts, with the wall and processor
+/// seconds since the run started, both never going back, and `end` last.
+#[test]
+fn bench_methods_prints_its_steps_with_phases() {
+    let dir = temp_path("bench-phases");
+    std::fs::create_dir_all(&dir).unwrap();
+    let args = [
+        "bench",
+        "methods",
+        "--method",
+        "skcm-gp",
+        "--poses",
+        "300",
+        "--threads",
+        "1",
+    ];
+    let mut with = args.to_vec();
+    with.push("--phases");
+    let out = common::robocal(&dir, &with);
+    let err = common::text(&out.stderr);
+    assert_eq!(common::code(&out), 0, "{err}");
+    let steps: Vec<(f64, f64, String)> = err
+        .lines()
+        .filter_map(|l| l.strip_prefix("step "))
+        .map(|l| {
+            let w: Vec<&str> = l.split_whitespace().collect();
+            assert_eq!((w[1], w[2], w[4], w[5]), ("s", "wall", "s", "cpu"), "{l}");
+            (
+                w[0].parse().unwrap(),
+                w[3].parse().unwrap(),
+                w[6..].join(" "),
+            )
+        })
+        .collect();
+    let names: Vec<&str> = steps.iter().map(|s| s.2.as_str()).collect();
+    assert_eq!(names.first(), Some(&"registration - fit"), "{err}");
+    assert_eq!(names.last(), Some(&"end"), "{err}");
+    assert!(names.contains(&"skcm-gp - cv"), "{err}");
+    assert!(names.windows(2).all(|w| w[0] != w[1]), "{err}");
+    assert!(
+        steps
+            .windows(2)
+            .all(|w| w[0].0 <= w[1].0 && w[0].1 <= w[1].1),
+        "{err}"
+    );
+    let without = common::robocal(&dir, &args);
+    assert!(!common::text(&without.stderr).contains("step "));
+    let figures = |o: &std::process::Output| -> serde_json::Value {
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        v["runs"][0]["validation_mean_mm"].clone()
+    };
+    assert!(figures(&out).as_f64().is_some_and(f64::is_finite));
+    assert_eq!(figures(&out), figures(&without));
+}

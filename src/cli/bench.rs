@@ -14,7 +14,11 @@
 //!   effects no model has (`compensate::unmodelled_truth`): 100
 //!   identification poses, N training poses, 200 validation poses; per method
 //!   and N the wall time of its whole run (base fit, cross-validation with the
-//!   blocked folds, training) and its validation mean and max.
+//!   blocked folds, training) and its validation mean and max. With
+//!   `--phases`, a line on standard error at each step (phase, candidate,
+//!   fit or cross-validation) with the wall and processor seconds since the
+//!   run started: a step whose processor time grows slower than its wall
+//!   time times the threads leaves cores idle.
 //!
 //! Times are wall-clock on the calling thread (pin with `taskset -c 0`).
 
@@ -68,6 +72,12 @@ pub struct MethodsArgs {
     /// compensator method).
     #[arg(long, value_delimiter = ',')]
     pub auto_candidates: Vec<String>,
+    /// Print a line on standard error at each step of the run (method,
+    /// candidate, fit or cross-validation) with the wall and processor
+    /// seconds since the method started, so the steps that leave cores
+    /// idle show (processor / wall below the thread count).
+    #[arg(long)]
+    pub phases: bool,
 }
 
 /// Arguments of `robocal bench km`.
@@ -181,8 +191,13 @@ fn methods(a: &MethodsArgs) -> anyhow::Result<serde_json::Value> {
             };
             let opts = settings.options(Parallelism { threads: a.threads });
             let t = Instant::now();
-            let r = calibrate_with_training(&nominal, &ident, &train, &valid, &opts, &|_| true)?;
+            let steps = StepLog::new(a.phases);
+            let r = calibrate_with_training(&nominal, &ident, &train, &valid, &opts, &|p| {
+                steps.see(p);
+                true
+            })?;
             let seconds = t.elapsed().as_secs_f64();
+            steps.end();
             let v = r
                 .methods
                 .get(m)
@@ -205,6 +220,69 @@ fn methods(a: &MethodsArgs) -> anyhow::Result<serde_json::Value> {
     Ok(
         json!({"bench": "methods", "robot": "ys100", "identification_poses": ident.len(), "validation_poses": valid.len(), "runs": rows}),
     )
+}
+
+/// The steps of one bench run (`--phases`): a line per change of phase,
+/// candidate or stage (fit or cross-validation) with the wall and processor
+/// seconds since the run started.
+struct StepLog {
+    on: bool,
+    start: Instant,
+    cpu0: f64,
+    last: std::sync::Mutex<Option<String>>,
+}
+
+impl StepLog {
+    fn new(on: bool) -> Self {
+        StepLog {
+            on,
+            start: Instant::now(),
+            cpu0: process_cpu_s(),
+            last: std::sync::Mutex::new(None),
+        }
+    }
+
+    fn see(&self, p: &crate::calibrate::identify::Progress) {
+        if !self.on {
+            return;
+        }
+        let step = format!(
+            "{} {} {}",
+            p.phase.label(),
+            p.candidate.map_or("-", |c| c.name()),
+            if p.fold.is_some() { "cv" } else { "fit" }
+        );
+        let mut last = self.last.lock().unwrap_or_else(|e| e.into_inner());
+        if last.as_deref() != Some(step.as_str()) {
+            self.line(&step);
+            *last = Some(step);
+        }
+    }
+
+    fn end(&self) {
+        if self.on {
+            self.line("end");
+        }
+    }
+
+    fn line(&self, step: &str) {
+        eprintln!(
+            "step {:>9.3} s wall {:>9.3} s cpu  {step}",
+            self.start.elapsed().as_secs_f64(),
+            process_cpu_s() - self.cpu0
+        );
+    }
+}
+
+/// Processor seconds (user and system) the process used so far.
+fn process_cpu_s() -> f64 {
+    // SAFETY: getrusage writes the struct it is given and nothing else.
+    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) } != 0 {
+        return f64::NAN;
+    }
+    let s = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+    s(u.ru_utime) + s(u.ru_stime)
 }
 
 fn median(mut v: Vec<f64>) -> f64 {

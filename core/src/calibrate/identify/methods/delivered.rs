@@ -32,6 +32,10 @@
 //! their position errors [mm], pooled over the clusters (each pose once) and
 //! per edge. A region that leaves fewer than half the identification poses
 //! to refit on is not held out; without two clusters nothing is.
+//!
+//! The regions are refitted side by side on `CompensatorOptions::parallel`
+//! threads (`compensate::select::run_jobs`), each on its own poses and fits,
+//! so the figures are the same bit for bit on any number of threads.
 
 use super::cache::Cache;
 use super::context::Context;
@@ -40,6 +44,7 @@ use super::regions::{clusters_drawn, moving_joints};
 use super::veto::{BlockedFigures, EdgeFigures, EdgeSide};
 use super::{compensated, Base, Method, MethodError};
 use crate::calibrate::compensate::blocked_fold_assignment;
+use crate::calibrate::compensate::select::{run_jobs, Jobs, Parallelism};
 use crate::calibrate::identify::joint_maps::{MapOrder, MapStructure};
 use crate::calibrate::identify::network::Network;
 use crate::calibrate::identify::options::CalibrationOptions;
@@ -47,7 +52,7 @@ use crate::calibrate::identify::report::SetErrors;
 use crate::measure::Measurement;
 use crate::model::calibrated::Compensator;
 use crate::model::kinematics::Chain;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 /// Share of a joint's drawn range an edge region holds out, at either end.
 pub(super) const EDGE_SHARE: f64 = 0.2;
@@ -104,10 +109,14 @@ pub(super) struct DeliveredRegions {
     judged: Vec<(Delivery, Result<Judged, String>)>,
 }
 
-/// The options the sub-runs take: the maps' blocked folds skipped.
+/// The options the sub-runs take: the maps' blocked folds skipped, one
+/// thread each.
 fn sub_options(opts: &CalibrationOptions) -> CalibrationOptions {
     let mut o = opts.clone();
     o.joint_maps.blocked_folds = 0;
+    // The regions share the threads (`DeliveredRegions::judge`); a refit's
+    // own trainings run on its one.
+    o.compensator.parallel = Parallelism { threads: 1 };
     o
 }
 
@@ -203,18 +212,34 @@ impl DeliveredRegions {
         }
         let opts = sub_options(ctx.opts);
         let count = self.regions.len().max(1) as f64;
-        let mut per_region = Vec::with_capacity(self.regions.len());
+        // The regions refit side by side (each on its own poses and cache,
+        // so the figures are the same on any number of threads); the bar
+        // stands at the share of regions before the lowest one under way.
+        let slots: Vec<Mutex<&mut Region>> = self.regions.iter_mut().map(Mutex::new).collect();
+        let outcomes = run_jobs(
+            slots.len(),
+            Jobs {
+                parallel: ctx.opts.compensator.parallel,
+                progress: &mut |r, _, _| progress(r as f64 / count),
+                cancelled: || MethodError::Cancelled,
+            },
+            |r, report| {
+                let mut region = slots[r].lock().unwrap_or_else(|e| e.into_inner());
+                match judge_region(ctx, &opts, &mut region, delivery, &mut || report(0, 0.0)) {
+                    Ok(e) => Ok(Ok(e)),
+                    Err(MethodError::Failed(f)) => Ok(Err(f.to_string())),
+                    Err(MethodError::Cancelled) => Err(MethodError::Cancelled),
+                }
+            },
+        )?;
+        // The first region (in order) whose refit failed says why.
+        let mut per_region = Vec::with_capacity(outcomes.len());
         let mut failed = None;
-        for (r, region) in self.regions.iter_mut().enumerate() {
-            let mut go = || progress(r as f64 / count);
-            if !go() {
-                return Err(MethodError::Cancelled);
-            }
-            match judge_region(ctx, &opts, region, delivery, &mut go) {
+        for o in outcomes {
+            match o {
                 Ok(e) => per_region.push(e),
-                Err(MethodError::Cancelled) => return Err(MethodError::Cancelled),
-                Err(MethodError::Failed(f)) => {
-                    failed = Some(f.to_string());
+                Err(f) => {
+                    failed = Some(f);
                     break;
                 }
             }
@@ -342,6 +367,88 @@ mod tests {
             compensator: None,
         });
         regions.compare(&option, &alone).edges
+    }
+
+    /// The regions refitted side by side give what they give one after
+    /// another, to the bit: an option with maps and a compensator, on one
+    /// thread and on three.
+    #[test]
+    fn the_regions_judge_the_same_on_any_number_of_threads() {
+        let fixture = Fixture::measured(240);
+        let judged = |threads: usize| {
+            let mut opts = fixture.options(1);
+            opts.compensator.parallel = Parallelism { threads };
+            let ctx = fixture.context(&opts);
+            let mut regions = DeliveredRegions::draw(&ctx).unwrap();
+            let mut seen = Vec::new();
+            let j = regions
+                .judge(
+                    &ctx,
+                    Delivery {
+                        base: Base::KmMaps,
+                        maps_choice: Some(MapOrder {
+                            harmonics: 2,
+                            ridge: 1e-6,
+                        }),
+                        compensator: Some((Method::KmMapsGp, Network::Gp)),
+                    },
+                    &mut |f| {
+                        seen.push(f);
+                        true
+                    },
+                )
+                .unwrap()
+                .unwrap();
+            (j, regions.regions.len(), seen)
+        };
+        let (one, n, seen_one) = judged(1);
+        let (three, _, seen_three) = judged(3);
+        assert!(n >= 8, "{n} regions");
+        assert_eq!(one.per_region.len(), n);
+        assert!(one.per_region.iter().all(|e| !e.is_empty()));
+        assert_eq!(one, three);
+        for seen in [seen_one, seen_three] {
+            assert!(seen.windows(2).all(|w| w[0] <= w[1]), "{seen:?}");
+            assert_eq!(seen.last(), Some(&1.0));
+        }
+    }
+
+    /// A cancelled judgement says so, asks nothing after it was told to
+    /// stop, and leaves nothing half-judged: judged again, the regions give
+    /// what fresh regions give.
+    #[test]
+    fn a_judgement_cancelled_on_any_number_of_threads_leaves_nothing_behind() {
+        let fixture = Fixture::measured(240);
+        let delivery = Delivery {
+            base: Base::KmMaps,
+            maps_choice: Some(MapOrder {
+                harmonics: 2,
+                ridge: 1e-6,
+            }),
+            compensator: None,
+        };
+        for threads in [1, 2] {
+            let mut opts = fixture.options(1);
+            opts.compensator.parallel = Parallelism { threads };
+            let ctx = fixture.context(&opts);
+            let mut regions = DeliveredRegions::draw(&ctx).unwrap();
+            let mut asked = 0;
+            let r = regions.judge(&ctx, delivery, &mut |_| {
+                asked += 1;
+                asked < 3
+            });
+            assert!(
+                matches!(r, Err(MethodError::Cancelled)),
+                "{threads} threads"
+            );
+            assert_eq!(asked, 3, "{threads} threads: asked after the cancel");
+            let again = regions.judge(&ctx, delivery, &mut |_| true).unwrap();
+            let fresh = DeliveredRegions::draw(&ctx)
+                .unwrap()
+                .judge(&ctx, delivery, &mut |_| true)
+                .unwrap();
+            assert_eq!(again, fresh, "{threads} threads");
+        }
     }
 
     /// A region's refit holds the harmonics chosen on all the poses: the
