@@ -6,7 +6,8 @@
 //! with the axes in `e1` (tilt) and `e2` (rotate). The written positioner is
 //! checked against the truth at held-out axis values, the held-out figures
 //! the command prints against the fit's limits; refusals exit with
-//! `refused` (1) and write nothing.
+//! `refused` (1) and write nothing. `robocal positioner simulate` writes the
+//! same example's files, which the command fits.
 
 mod common;
 #[path = "../core/tests/common/mod.rs"]
@@ -585,5 +586,101 @@ fn predict_states_the_pose_on_the_face_plate_at_the_axis_values() {
             "{extra:?}: {}",
             text(&out.stderr)
         );
+    }
+}
+
+/// `robocal positioner simulate` writes what `calibrate` reads: the fit
+/// from its files is accepted and carries the example's truth (built from
+/// its physics, with the nod the model lacks) within 0.03 mm at the held-out
+/// values; the same seed writes the same bytes and another seed other noise;
+/// with `--robot` the positioner stands in front of that robot's registered
+/// base, where `solve --positioner` reaches every point of its `part.csv`.
+#[test]
+fn simulate_writes_files_calibrate_fits_and_solve_reaches() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = robocal(
+        d,
+        &["positioner", "simulate", "--out-dir", "sim", "--seed", "5"],
+    );
+    let printed = text(&out.stdout);
+    assert_eq!(code(&out), 0, "{printed}{}", text(&out.stderr));
+    print!("{printed}");
+    for f in ["nominal.json", "r0.csv", "r1.csv", "v0.csv", "v1.csv", "part.csv"] {
+        assert!(printed.contains(&format!("wrote sim/{f}")), "{f}: {printed}");
+    }
+    // The command it prints, run as printed (but for the binary's name).
+    let fit_line = printed
+        .lines()
+        .find_map(|l| l.strip_prefix("fit it with: robocal "))
+        .expect("the fit command");
+    let args: Vec<&str> = fit_line.split(' ').collect();
+    let fitted = robocal(d, &args);
+    let report = text(&fitted.stdout);
+    assert_eq!(code(&fitted), 0, "{report}{}", text(&fitted.stderr));
+    let (line, rms) = line_rms(&report, "held out: 112 readings at 56 pairs");
+    assert!(rms > 0.0 && rms < 0.052, "{line}");
+    let model =
+        TiltRotate::from_json(&std::fs::read_to_string(d.join("positioner.json")).unwrap())
+            .unwrap();
+    let mut with_json = args.clone();
+    with_json.push("--json");
+    let doc: serde_json::Value = serde_json::from_slice(&robocal(d, &with_json).stdout).unwrap();
+    let r0: Vec<f64> = doc["fit"]["reflectors_mm"][0]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap() * 1e-3)
+        .collect();
+    let r0 = Vector3::new(r0[0], r0[1], r0[2]);
+    let t = core_common::positioner::truth(0.003);
+    let worst = core_common::positioner::held_out()
+        .iter()
+        .map(|v| (model.point_in_cell(*v, &r0) - t.reflector(0, *v)).norm() * 1e3)
+        .fold(0.0, f64::max);
+    println!("simulated positioner: reference reflector at 56 held-out pairs within {worst:.4} mm");
+    assert!(worst < 0.03, "{worst} mm");
+
+    // Reproducible: the same seed the same bytes, another seed other noise.
+    let again = robocal(d, &["positioner", "simulate", "--out-dir", "again", "--seed", "5"]);
+    assert_eq!(code(&again), 0);
+    let other = robocal(d, &["positioner", "simulate", "--out-dir", "other", "--seed", "6"]);
+    assert_eq!(code(&other), 0);
+    let read = |p: &str| std::fs::read_to_string(d.join(p)).unwrap();
+    assert_eq!(read("sim/r0.csv"), read("again/r0.csv"));
+    assert_ne!(read("sim/r0.csv"), read("other/r0.csv"));
+    assert_ne!(read("sim/r0.csv"), read("sim/r1.csv"));
+
+    // In front of a robot: the nominal positioner's base is the robot's
+    // registered base moved 1.7 m forward, and the part's 12 targets solve.
+    robot_file(d);
+    let out = robocal(
+        d,
+        &["positioner", "simulate", "--out-dir", "cell", "--robot", "robot.json"],
+    );
+    assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+    let placed =
+        TiltRotate::from_json(&std::fs::read_to_string(d.join("cell/nominal.json")).unwrap())
+            .unwrap();
+    let expected = Pose::new(
+        rpy_matrix(0.0, 0.0, 30f64.to_radians()),
+        Vector3::new(1.7, 0.3, -0.9),
+    );
+    assert!((placed.cell_from_base.p - expected.p).norm() < 1e-9);
+    let solved = robocal(
+        d,
+        &[
+            "solve", "--model", "robot.json", "--targets", "cell/part.csv", "--positioner",
+            "cell/nominal.json", "--position-only", "--json",
+        ],
+    );
+    assert_eq!(code(&solved), 0, "{}", text(&solved.stderr));
+    let doc: serde_json::Value = serde_json::from_slice(&solved.stdout).unwrap();
+    assert_eq!(doc["targets"].as_array().unwrap().len(), 12);
+
+    // Bad values are refused.
+    for (bad, flag) in [("--noise-mm=-1", "--noise-mm"), ("--wobble-deg=5", "--wobble-deg")] {
+        let out = robocal(d, &["positioner", "simulate", "--out-dir", "bad", bad]);
+        assert_refused(&out, flag);
     }
 }

@@ -1,5 +1,7 @@
 //! `robocal positioner calibrate`: a two-axis tilt-rotate positioner fitted
-//! from tracker readings of reflectors on its face plate.
+//! from tracker readings of reflectors on its face plate (`positioner
+//! simulate` writes such readings of an example positioner:
+//! `super::positioner_sim`).
 //!
 //! `positioner calibrate SET… --nominal NOMINAL.json --reflector X,Y,Z…
 //! --out POSITIONER.json` reads one measurement file per reflector
@@ -61,6 +63,8 @@ pub struct PositionerArgs {
 pub enum PositionerCommand {
     /// Fit a two-axis tilt-rotate positioner from tracker readings of reflectors on its face plate.
     Calibrate(CalibrateArgs),
+    /// Write an example positioner's nominal model and simulated tracker readings (the files `calibrate` reads).
+    Simulate(super::positioner_sim::SimulateArgs),
 }
 
 /// Arguments of `robocal positioner calibrate`.
@@ -329,6 +333,10 @@ pub fn run(a: PositionerArgs) -> anyhow::Result<()> {
     match a.command {
         PositionerCommand::Calibrate(c) => {
             print!("{}", calibrate_to_string(&c)?);
+            Ok(())
+        }
+        PositionerCommand::Simulate(s) => {
+            print!("{}", super::positioner_sim::simulate_to_string(&s)?);
             Ok(())
         }
     }

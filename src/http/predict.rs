@@ -19,6 +19,7 @@
 //! `robocal predict --positioner --e1 --e2` states them.
 
 use super::input::{check_payload, objects, present};
+use super::solve_columns::axis_values;
 use super::solve::{convention, model_choice, target_id, ItemRef, VersionSelector};
 use super::{ApiError, ApiJson, ApiPath, AppState};
 use crate::records::CellKind;
@@ -27,7 +28,6 @@ use crate::service::predict::PredictCommand;
 use crate::solve::cell::accuracy::ToolAccuracy;
 use crate::solve::cell::joints_csv::JointReading;
 use crate::solve::cell::PoseOut;
-use crate::solve::external::AxisValues;
 use crate::solve::ik::TargetFrame;
 use axum::extract::State;
 use axum::response::{IntoResponse, Response};
@@ -166,7 +166,11 @@ fn command(robot_id: i64, req: &PredictRequest) -> Result<PredictCommand, ApiErr
             )))
         }
     };
-    let (track_mm, positioner_deg) = axis_values(req)?;
+    let axes = axis_values(
+        req.e1,
+        req.e2,
+        req.frame.is_some() || req.work_object.is_some(),
+    )?;
     let readings = req
         .readings
         .iter()
@@ -201,43 +205,9 @@ fn command(robot_id: i64, req: &PredictRequest) -> Result<PredictCommand, ApiErr
             .map(|w| w.choice(CellKind::WorkObject))
             .transpose()?,
         frame,
-        track_mm,
-        positioner_deg,
+        track_mm: axes.track_mm,
+        positioner_deg: axes.positioner_deg,
     })
-}
-
-/// `e1` alone: a track value [mm]; `e1` and `e2`: a positioner's tilt and
-/// rotate [deg], the poses on its face plate (beside `frame` or
-/// `work_object` a 422); `e2` alone a 422.
-fn axis_values(req: &PredictRequest) -> Result<(Option<f64>, Option<AxisValues>), ApiError> {
-    let (tilt, rotate) = match (req.e1, req.e2) {
-        (e1, None) => return Ok((e1, None)),
-        (None, Some(_)) => {
-            return Err(ApiError::invalid(
-                "`e2` without `e1`: a positioner's values are `e1` (tilt) and `e2` (rotate) [deg], both",
-            ))
-        }
-        (Some(t), Some(r)) => (t, r),
-    };
-    if req.frame.is_some() || req.work_object.is_some() {
-        return Err(ApiError::invalid(
-            "`e1` and `e2` state the poses in the positioner's face plate frame: `frame` and `work_object` beside them are ambiguous; leave them out",
-        ));
-    }
-    for (v, name) in [(tilt, "e1"), (rotate, "e2")] {
-        if !v.is_finite() || v.abs() > 720.0 {
-            return Err(ApiError::invalid(format!(
-                "`{name}`: {v} is not a positioner axis's value: a finite number of degrees within two turns (±720)"
-            )));
-        }
-    }
-    Ok((
-        None,
-        Some(AxisValues {
-            tilt_deg: tilt,
-            rotate_deg: rotate,
-        }),
-    ))
 }
 
 /// `POST /v1/robots/{id}/predict`: the readings' poses on the chosen model.

@@ -19,12 +19,15 @@
 //! track's (`service::tracks::carry`); a targets CSV may instead carry an
 //! `e1` column, a value per row (both: 422), or `e1` and `e2` columns, a
 //! positioner's tilt and rotate values per row with the targets on its face
-//! plate (`solve_columns` reads them). The handler turns either body into a
+//! plate (`solve_columns` reads them). With `e1` and `e2` in a JSON body the
+//! targets are on the stored positioner's face plate at those values (tilt,
+//! rotate [deg]), as a targets CSV's rows with those values are; the query's
+//! `e1` and `frame` then do not apply. The handler turns either body into a
 //! `service::solve::SolveCommand`; the service picks the model and runs it.
 
 use super::error::{content_type, json_content_type};
 use super::input::{check_payload, from_json_object, object_or_null, objects, present, Int};
-use super::solve_columns::{axis_columns, AxisColumns};
+use super::solve_columns::{axis_columns, axis_values, AxisColumns};
 use super::{ApiError, ApiPath, ApiQuery, AppState};
 use crate::measure::csv_text::{dialect_from_names, Dialect};
 use crate::model::orientation::OrientationConvention;
@@ -170,9 +173,14 @@ pub struct SolveRequest {
     /// targets are in it.
     #[serde(default, deserialize_with = "present")]
     pub work_object: Option<ItemRef>,
-    /// The track's value [mm]: the robot carried along its stored track.
+    /// The track's value [mm]: the robot carried along its stored track;
+    /// with `e2`, the positioner's tilt [deg].
     #[serde(default, deserialize_with = "present")]
     pub e1: Option<f64>,
+    /// The positioner's rotate value [deg]: with it, `e1` is the tilt and
+    /// the targets are in the stored positioner's face plate frame.
+    #[serde(default, deserialize_with = "present")]
+    pub e2: Option<f64>,
 }
 
 /// A tool or work object of a solve: a stored one's name, or one inline.
@@ -370,6 +378,9 @@ struct Common<'a> {
     position_only: bool,
     path: bool,
     e1: Option<f64>,
+    e2: Option<f64>,
+    /// Whether the request names a work object.
+    work_object: bool,
 }
 
 /// The model a `version` field names (absent: the active version).
@@ -423,6 +434,7 @@ fn command(robot_id: i64, c: Common) -> Result<SolveCommand, ApiError> {
         .map(|name| convention(name, "`convention`"))
         .transpose()?;
     let model = model_choice(c.version)?;
+    let axes = axis_values(c.e1, c.e2, c.frame.is_some() || c.work_object)?;
     Ok(SolveCommand {
         robot_id,
         model,
@@ -440,9 +452,10 @@ fn command(robot_id: i64, c: Common) -> Result<SolveCommand, ApiError> {
         targets: Targets::Inputs(Vec::new()),
         tool: None,
         work_object: None,
-        track_mm: c.e1,
+        track_mm: axes.track_mm,
         track_rows: None,
         positioner_rows: None,
+        positioner_deg: axes.positioner_deg,
     })
 }
 
@@ -472,13 +485,25 @@ pub fn json_command(
             version: req.version.as_ref().or(query.version.as_ref()),
             payload_kg: req.payload_kg.or(query.payload_kg),
             jump_deg: req.jump_deg.or(query.jump_deg),
-            frame: req.frame.as_deref().or(query.frame),
+            // A positioner's values state the targets' frame (its face
+            // plate): the query's `frame` does not stand in for the body's.
+            frame: if req.e2.is_some() {
+                req.frame.as_deref()
+            } else {
+                req.frame.as_deref().or(query.frame)
+            },
             branch,
             seed_deg,
             convention: req.convention.as_deref().or(query.convention),
             position_only: req.position_only.or(query.position_only).unwrap_or(false),
             path: req.path.or(query.path).unwrap_or(false),
-            e1: req.e1.or(query.e1),
+            e1: if req.e2.is_some() {
+                req.e1
+            } else {
+                req.e1.or(query.e1)
+            },
+            e2: req.e2,
+            work_object: req.work_object.is_some(),
         },
     )?;
     cmd.tool = req
@@ -635,11 +660,13 @@ pub fn csv_command(robot_id: i64, q: &CsvSolveQuery, text: &str) -> Result<Solve
             position_only: query.position_only.unwrap_or(false),
             path: query.path.unwrap_or(false),
             e1: query.e1,
+            e2: None,
+            work_object: false,
         },
     )?;
     let d = dialect(q.decimal.as_deref())?;
     // External-axis columns: a track's value or a positioner's values per row.
-    let columns = axis_columns(text, d, cmd.track_mm, query.frame.is_some())?;
+    let columns = axis_columns(text, d, query.e1, query.frame.is_some())?;
     let csv = parse_targets_csv_beside(text, d, columns.beside())?;
     match columns {
         AxisColumns::None => {}

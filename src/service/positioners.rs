@@ -27,7 +27,7 @@ use robocal_core::calibrate::external::{
 use robocal_core::measure::csv::{parse_set, CsvError};
 use robocal_core::model::external::TiltRotate;
 use robocal_core::model::Pose;
-use robocal_core::solve::external::{place_on_positioner, TargetValue};
+use robocal_core::solve::external::{place_on_positioner, AxisValues, TargetValue};
 use robocal_core::solve::ik::TargetsCsv;
 use robocal_core::stats::ErrorStats;
 use serde::Serialize;
@@ -266,6 +266,25 @@ pub struct PlateValues {
     pub rotate: Vec<TargetValue>,
 }
 
+impl PlateValues {
+    /// The same values for every row of `csv`.
+    pub fn every_row(csv: &TargetsCsv, values: AxisValues) -> PlateValues {
+        let at = |v: f64| {
+            csv.rows
+                .iter()
+                .map(|r| TargetValue {
+                    line: r.line,
+                    value: Ok(v),
+                })
+                .collect()
+        };
+        PlateValues {
+            tilt: at(values.tilt_deg),
+            rotate: at(values.rotate_deg),
+        }
+    }
+}
+
 /// The robot's stored positioner for a targets CSV with `e1` and `e2`
 /// columns: no positioner is a `Conflict` (the robot's state), and so is a
 /// robot with a track too (`e1` would be either's value: ambiguous).
@@ -283,8 +302,8 @@ pub async fn for_rows(state: &AppState, robot_id: i64) -> Result<TiltRotate, Ser
     model_of(&row)
 }
 
-/// The robot's stored positioner for a prediction at its values (`e1` and
-/// `e2`): no positioner is a `Conflict`, and so is a robot with a track too
+/// The robot's stored positioner for a prediction or a solve at its values
+/// (`e1` and `e2`): no positioner is a `Conflict`, and so is a robot with a track too
 /// (`e1` would be either's value: ambiguous), as for a targets CSV.
 pub async fn for_predict(state: &AppState, robot_id: i64) -> Result<TiltRotate, ServiceError> {
     let Some(row) = state.db().positioner(robot_id).await? else {

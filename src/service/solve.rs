@@ -23,7 +23,8 @@
 //! positioner's tilt and rotate values per row, its targets in the face
 //! plate frame: each row is moved into the base frame through the robot's
 //! stored positioner (`super::positioners::place_rows`) and solved by the
-//! cached solver.
+//! cached solver; `e1` and `e2` for the whole request place every target
+//! (JSON or CSV) on the face plate at those values the same way.
 //!
 //! Units at this boundary: targets in mm and degrees (`TargetInput`), joint
 //! seeds and commands in the controller convention in degrees.
@@ -40,7 +41,7 @@ use crate::solve::ik::{
     IkSettings, IkSolver, SolveMode, SolveOptions, TargetInput, TargetResult, TargetsCsv,
 };
 use robocal_core::model::calibrated::{CalibratedModelFile, CompensatedModel};
-use robocal_core::solve::external::{place_on_track, TargetValue};
+use robocal_core::solve::external::{base_from_part, place_on_track, AxisValues, TargetValue};
 use std::sync::Arc;
 
 /// Which model to solve with.
@@ -166,6 +167,11 @@ pub struct SolveCommand {
     /// moved into the base frame through the robot's stored positioner
     /// (`super::positioners::place_rows`; the cached solver serves).
     pub positioner_rows: Option<super::positioners::PlateValues>,
+    /// A positioner's tilt and rotate values for every target [deg] (a JSON
+    /// body's or a query's `e1` and `e2`), the targets in its face plate
+    /// frame: moved into the base frame through the robot's stored
+    /// positioner as a targets CSV's rows at those values are.
+    pub positioner_deg: Option<AxisValues>,
 }
 
 /// A tool or work object of a solve: stored by name, or given inline.
@@ -378,6 +384,27 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
             ));
         };
         place_on_track(csv, &values, &track, cmd.options.frame, None);
+        cmd.options.frame = TargetFrame::Base;
+    }
+    if let Some(values) = cmd.positioner_deg.take() {
+        let positioner = super::positioners::for_predict(state, cmd.robot_id).await?;
+        let robot = cell_solver.solver().model();
+        match &mut cmd.targets {
+            Targets::Csv(csv) => {
+                let every = super::positioners::PlateValues::every_row(csv, values);
+                super::positioners::place_rows(csv, &every, &positioner, &robot.cell_from_base);
+            }
+            Targets::Inputs(inputs) => {
+                let plate = WorkObject {
+                    name: "face_plate".into(),
+                    number: None,
+                    frame: WorkObjectFrame::Base,
+                    pose: base_from_part(robot, &positioner, values, &Pose::identity()),
+                };
+                // The false targets stay in the base frame, as a CSV's rows'.
+                cell_solver.targets_in(&plate, inputs.iter_mut());
+            }
+        }
         cmd.options.frame = TargetFrame::Base;
     }
     if let Some(values) = cmd.positioner_rows.take() {

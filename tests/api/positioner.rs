@@ -182,8 +182,9 @@ async fn a_positioner_fitted_over_http_is_the_command_lines_and_carries_a_target
         std::fs::write(d.join(name), text).unwrap();
     }
 
-    // No positioner yet: 404, and a targets CSV with its columns is a 409
-    // naming the route that fits one.
+    // No positioner yet: 404, and a targets CSV with its columns, a
+    // prediction or a JSON solve at its values is a 409 naming the route that
+    // fits one.
     let r = t.get(POSITIONER, &[&rid]).await;
     assert_eq!(r.status, StatusCode::NOT_FOUND, "{}", r.text());
     let r = t
@@ -203,6 +204,15 @@ async fn a_positioner_fitted_over_http_is_the_command_lines_and_carries_a_target
             PREDICT,
             &[&rid],
             json!({ "readings": [{ "joints_deg": [0, -90, 90, 0, 45, 0] }], "e1": 10.0, "e2": 5.0 }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
+    assert!(r.detail().contains("has no positioner"), "{}", r.detail());
+    let r = t
+        .post_json(
+            SOLVE,
+            &[&rid],
+            json!({ "targets": [{ "xyz_mm": [100.0, 0.0, 50.0] }], "e1": 10.0, "e2": 5.0 }),
         )
         .await;
     assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
@@ -299,6 +309,15 @@ async fn a_positioner_fitted_over_http_is_the_command_lines_and_carries_a_target
         .await;
     assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
     assert!(r.detail().contains("ambiguous"), "{}", r.detail());
+    let r = t
+        .post_json(
+            SOLVE,
+            &[&rid],
+            json!({ "targets": [{ "xyz_mm": [100.0, 0.0, 50.0] }], "e1": 10.0, "e2": 5.0 }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
+    assert!(r.detail().contains("ambiguous"), "{}", r.detail());
 }
 
 /// Points of a part on the plate, located on the face plate through the
@@ -326,6 +345,7 @@ async fn plate_csv_solve(
     ];
     let values = [[-30.0, 40.0], [15.0, -120.0], [35.0, 160.0], [-10.0, -45.0]];
     let mut rows = vec!["id,x,y,z,e1,e2".to_string()];
+    let mut on_plate = Vec::new();
     for (i, p) in on_body.iter().enumerate() {
         let at_zero = truth.point([0.0, 0.0], p);
         let fp = fitted
@@ -333,6 +353,7 @@ async fn plate_csv_solve(
             .inverse()
             .transform_point(&at_zero)
             * 1e3;
+        on_plate.push(fp);
         for (k, v) in values.iter().enumerate() {
             rows.push(format!(
                 "p{i}v{k},{},{},{},{},{}",
@@ -399,6 +420,7 @@ async fn plate_csv_solve(
     }
     println!("true tool tip on the true part at 12 targets through the stored positioner: max {worst:.4} mm");
     assert!(worst < TIP_BOUND_MM, "{worst} mm");
+    plate_json_solve(t, rid, &on_plate, &values, &http).await;
 
     // A row without its rotate value fails alone, naming line and column.
     let gap = text.replacen(",40\n", ",\n", 1);
@@ -435,6 +457,79 @@ async fn plate_csv_solve(
         assert!(r.detail().contains(words), "{q}: {}", r.detail());
     }
     solved
+}
+
+/// The same points as a JSON solve with `e1` and `e2` in the body, at each
+/// pair of values: the joints of the targets CSV's rows at those values (the
+/// query's `e1` and `frame` do not apply beside them); `e2` without `e1`,
+/// beside `frame` or a work object, or beyond ±720° is a 422.
+async fn plate_json_solve(
+    t: &TestApp,
+    rid: &str,
+    on_plate: &[Vector3<f64>],
+    values: &[[f64; 2]],
+    by_csv: &Value,
+) {
+    let targets: Vec<Value> = on_plate
+        .iter()
+        .map(|p| json!({ "xyz_mm": [p.x, p.y, p.z] }))
+        .collect();
+    for (k, v) in values.iter().enumerate() {
+        let body = json!({
+            "targets": targets, "e1": v[0], "e2": v[1],
+            "position_only": true, "payload_kg": PAYLOAD_KG,
+        });
+        let r = t
+            .send(
+                "POST",
+                SOLVE,
+                &[rid],
+                "?e1=100&frame=base",
+                Some("application/json"),
+                body.to_string().into_bytes(),
+            )
+            .await;
+        assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+        let doc = r.json();
+        assert_eq!(doc["solved"], on_plate.len(), "{doc}");
+        for i in 0..on_plate.len() {
+            let csv_row = &by_csv["results"][i * values.len() + k];
+            let (a, b) = (
+                numbers(&doc["results"][i]["joints_deg"]),
+                numbers(&csv_row["joints_deg"]),
+            );
+            assert_eq!(a.len(), 6);
+            for (x, y) in a.iter().zip(&b) {
+                assert!((x - y).abs() < 1e-9, "point {i} at {v:?}: JSON {x} CSV {y} deg");
+            }
+        }
+    }
+    for (extra, words) in [
+        (json!({ "e2": 5.0 }), "`e2` without `e1`"),
+        (json!({ "e1": 5.0, "e2": 5.0, "frame": "base" }), "face plate"),
+        (
+            json!({ "e1": 5.0, "e2": 5.0, "work_object": "fixture" }),
+            "face plate",
+        ),
+        (json!({ "e1": 900.0, "e2": 5.0 }), "within two turns"),
+    ] {
+        let mut body = json!({ "targets": targets, "position_only": true });
+        for (key, value) in extra.as_object().unwrap() {
+            body[key] = value.clone();
+        }
+        let r = t
+            .send(
+                "POST",
+                SOLVE,
+                &[rid],
+                "?e1=100",
+                Some("application/json"),
+                body.to_string().into_bytes(),
+            )
+            .await;
+        assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{extra}: {}", r.text());
+        assert!(r.detail().contains(words), "{extra}: {}", r.detail());
+    }
 }
 
 /// `predict` with `e1` and `e2` at the joints the solve returned for one

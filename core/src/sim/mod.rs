@@ -24,6 +24,7 @@
 mod perturb;
 mod poses;
 pub mod positioner;
+pub mod positioner_example;
 pub mod positioner_sets;
 pub mod study;
 mod synthetic;
