@@ -68,8 +68,13 @@ pub struct SimulateArgs {
 
 /// Points of a part on the face plate [mm, face plate frame] and the axis
 /// values `[tilt, rotate]` [deg] `part.csv` asks for them at.
-const PART_MM: [[f64; 3]; 3] = [[300.0, 200.0, 60.0], [-250.0, 280.0, 60.0], [50.0, -350.0, 80.0]];
-const PART_VALUES_DEG: [[f64; 2]; 4] = [[-30.0, 40.0], [15.0, -120.0], [35.0, 160.0], [-10.0, -45.0]];
+const PART_MM: [[f64; 3]; 3] = [
+    [300.0, 200.0, 60.0],
+    [-250.0, 280.0, 60.0],
+    [50.0, -350.0, 80.0],
+];
+const PART_VALUES_DEG: [[f64; 2]; 4] =
+    [[-30.0, 40.0], [15.0, -120.0], [35.0, 160.0], [-10.0, -45.0]];
 
 /// The positioner's base in the cell frame: 1.7 m in front of `robot`'s
 /// base, turned 30° about its vertical, 0.9 m below it.
@@ -83,7 +88,10 @@ fn in_front_of(robot: &Pose) -> Pose {
 /// Writes the files; what the command prints (the files and how to fit them).
 pub fn simulate_to_string(a: &SimulateArgs) -> anyhow::Result<String> {
     if !(a.noise_mm.is_finite() && a.noise_mm >= 0.0) {
-        anyhow::bail!("--noise-mm {}: give a non-negative number of mm", a.noise_mm);
+        anyhow::bail!(
+            "--noise-mm {}: give a non-negative number of mm",
+            a.noise_mm
+        );
     }
     if !(a.wobble_deg.is_finite() && a.wobble_deg.abs() <= 1.0) {
         anyhow::bail!(
@@ -131,7 +139,11 @@ pub fn simulate_to_string(a: &SimulateArgs) -> anyhow::Result<String> {
     let mut part = String::from("id,x,y,z,e1,e2\n");
     for (i, p) in PART_MM.iter().enumerate() {
         for (k, v) in PART_VALUES_DEG.iter().enumerate() {
-            writeln!(part, "p{i}v{k},{},{},{},{},{}", p[0], p[1], p[2], v[0], v[1])?;
+            writeln!(
+                part,
+                "p{i}v{k},{},{},{},{},{}",
+                p[0], p[1], p[2], v[0], v[1]
+            )?;
         }
     }
     written.extend(fits.iter().cloned());
@@ -153,7 +165,10 @@ pub fn simulate_to_string(a: &SimulateArgs) -> anyhow::Result<String> {
         .iter()
         .map(|p| format!("--reflector {},{},{}", p[0], p[1], p[2]))
         .collect();
-    let validate: Vec<String> = validations.iter().map(|v| format!("--validate {v}")).collect();
+    let validate: Vec<String> = validations
+        .iter()
+        .map(|v| format!("--validate {v}"))
+        .collect();
     writeln!(
         out,
         "fit it with: robocal positioner calibrate {} --nominal {} {} {} --out positioner.json",

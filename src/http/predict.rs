@@ -19,8 +19,8 @@
 //! `robocal predict --positioner --e1 --e2` states them.
 
 use super::input::{check_payload, objects, present};
-use super::solve_columns::axis_values;
 use super::solve::{convention, model_choice, target_id, ItemRef, VersionSelector};
+use super::solve_columns::axis_values;
 use super::{ApiError, ApiJson, ApiPath, AppState};
 use crate::records::CellKind;
 use crate::service;

@@ -376,48 +376,7 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
         )));
     }
     let (cell_solver, version, method) = prepare(state, &cmd).await?;
-    if let Some(values) = cmd.track_rows.take() {
-        let track = super::tracks::stored(state, cmd.robot_id).await?;
-        let Targets::Csv(csv) = &mut cmd.targets else {
-            return Err(ServiceError::Internal(
-                "a track value per row comes with a targets CSV".into(),
-            ));
-        };
-        place_on_track(csv, &values, &track, cmd.options.frame, None);
-        cmd.options.frame = TargetFrame::Base;
-    }
-    if let Some(values) = cmd.positioner_deg.take() {
-        let positioner = super::positioners::for_predict(state, cmd.robot_id).await?;
-        let robot = cell_solver.solver().model();
-        match &mut cmd.targets {
-            Targets::Csv(csv) => {
-                let every = super::positioners::PlateValues::every_row(csv, values);
-                super::positioners::place_rows(csv, &every, &positioner, &robot.cell_from_base);
-            }
-            Targets::Inputs(inputs) => {
-                let plate = WorkObject {
-                    name: "face_plate".into(),
-                    number: None,
-                    frame: WorkObjectFrame::Base,
-                    pose: base_from_part(robot, &positioner, values, &Pose::identity()),
-                };
-                // The false targets stay in the base frame, as a CSV's rows'.
-                cell_solver.targets_in(&plate, inputs.iter_mut());
-            }
-        }
-        cmd.options.frame = TargetFrame::Base;
-    }
-    if let Some(values) = cmd.positioner_rows.take() {
-        let positioner = super::positioners::for_rows(state, cmd.robot_id).await?;
-        let Targets::Csv(csv) = &mut cmd.targets else {
-            return Err(ServiceError::Internal(
-                "a positioner's values per row come with a targets CSV".into(),
-            ));
-        };
-        let robot = &cell_solver.solver().model().cell_from_base;
-        super::positioners::place_rows(csv, &values, &positioner, robot);
-        cmd.options.frame = TargetFrame::Base;
-    }
+    place_on_axes(state, &mut cmd, &cell_solver).await?;
     let work_object = match &cmd.work_object {
         None => None,
         Some(choice) => {
@@ -482,6 +441,59 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
         dof,
         results,
     })
+}
+
+/// Moves the command's targets into the robot's base frame along its
+/// external axes: a track value per CSV row, a positioner's values for every
+/// target, or per CSV row (module docs); the frame is then the base.
+async fn place_on_axes(
+    state: &AppState,
+    cmd: &mut SolveCommand,
+    cell_solver: &CellSolver,
+) -> Result<(), ServiceError> {
+    if let Some(values) = cmd.track_rows.take() {
+        let track = super::tracks::stored(state, cmd.robot_id).await?;
+        let Targets::Csv(csv) = &mut cmd.targets else {
+            return Err(ServiceError::Internal(
+                "a track value per row comes with a targets CSV".into(),
+            ));
+        };
+        place_on_track(csv, &values, &track, cmd.options.frame, None);
+        cmd.options.frame = TargetFrame::Base;
+    }
+    if let Some(values) = cmd.positioner_deg.take() {
+        let positioner = super::positioners::for_predict(state, cmd.robot_id).await?;
+        let robot = cell_solver.solver().model();
+        match &mut cmd.targets {
+            Targets::Csv(csv) => {
+                let every = super::positioners::PlateValues::every_row(csv, values);
+                super::positioners::place_rows(csv, &every, &positioner, &robot.cell_from_base);
+            }
+            Targets::Inputs(inputs) => {
+                let plate = WorkObject {
+                    name: "face_plate".into(),
+                    number: None,
+                    frame: WorkObjectFrame::Base,
+                    pose: base_from_part(robot, &positioner, values, &Pose::identity()),
+                };
+                // The false targets stay in the base frame, as a CSV's rows'.
+                cell_solver.targets_in(&plate, inputs.iter_mut());
+            }
+        }
+        cmd.options.frame = TargetFrame::Base;
+    }
+    if let Some(values) = cmd.positioner_rows.take() {
+        let positioner = super::positioners::for_rows(state, cmd.robot_id).await?;
+        let Targets::Csv(csv) = &mut cmd.targets else {
+            return Err(ServiceError::Internal(
+                "a positioner's values per row come with a targets CSV".into(),
+            ));
+        };
+        let robot = &cell_solver.solver().model().cell_from_base;
+        super::positioners::place_rows(csv, &values, &positioner, robot);
+        cmd.options.frame = TargetFrame::Base;
+    }
+    Ok(())
 }
 
 /// A tool or work object of a solve, resolved.

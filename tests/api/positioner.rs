@@ -103,6 +103,9 @@ fn cli(args: &[&str]) -> anyhow::Result<String> {
             robocal::cli::positioner::PositionerCommand::Calibrate(c) => {
                 robocal::cli::positioner::calibrate_to_string(&c)
             }
+            robocal::cli::positioner::PositionerCommand::Simulate(s) => {
+                robocal::cli::positioner_sim::simulate_to_string(&s)
+            }
         },
         robocal::cli::Command::Solve(a) => robocal::cli::solve::solve_to_string(&a),
         robocal::cli::Command::Predict(a) => robocal::cli::predict::predict_to_string(&a),
@@ -212,7 +215,7 @@ async fn a_positioner_fitted_over_http_is_the_command_lines_and_carries_a_target
         .post_json(
             SOLVE,
             &[&rid],
-            json!({ "targets": [{ "xyz_mm": [100.0, 0.0, 50.0] }], "e1": 10.0, "e2": 5.0 }),
+            json!({ "targets": [{ "x": 100.0, "y": 0.0, "z": 50.0 }], "e1": 10.0, "e2": 5.0 }),
         )
         .await;
     assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
@@ -313,7 +316,7 @@ async fn a_positioner_fitted_over_http_is_the_command_lines_and_carries_a_target
         .post_json(
             SOLVE,
             &[&rid],
-            json!({ "targets": [{ "xyz_mm": [100.0, 0.0, 50.0] }], "e1": 10.0, "e2": 5.0 }),
+            json!({ "targets": [{ "x": 100.0, "y": 0.0, "z": 50.0 }], "e1": 10.0, "e2": 5.0 }),
         )
         .await;
     assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
@@ -472,7 +475,7 @@ async fn plate_json_solve(
 ) {
     let targets: Vec<Value> = on_plate
         .iter()
-        .map(|p| json!({ "xyz_mm": [p.x, p.y, p.z] }))
+        .map(|p| json!({ "x": p.x, "y": p.y, "z": p.z }))
         .collect();
     for (k, v) in values.iter().enumerate() {
         let body = json!({
@@ -500,13 +503,19 @@ async fn plate_json_solve(
             );
             assert_eq!(a.len(), 6);
             for (x, y) in a.iter().zip(&b) {
-                assert!((x - y).abs() < 1e-9, "point {i} at {v:?}: JSON {x} CSV {y} deg");
+                assert!(
+                    (x - y).abs() < 1e-9,
+                    "point {i} at {v:?}: JSON {x} CSV {y} deg"
+                );
             }
         }
     }
     for (extra, words) in [
         (json!({ "e2": 5.0 }), "`e2` without `e1`"),
-        (json!({ "e1": 5.0, "e2": 5.0, "frame": "base" }), "face plate"),
+        (
+            json!({ "e1": 5.0, "e2": 5.0, "frame": "base" }),
+            "face plate",
+        ),
         (
             json!({ "e1": 5.0, "e2": 5.0, "work_object": "fixture" }),
             "face plate",
@@ -527,7 +536,12 @@ async fn plate_json_solve(
                 body.to_string().into_bytes(),
             )
             .await;
-        assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{extra}: {}", r.text());
+        assert_eq!(
+            r.status,
+            StatusCode::UNPROCESSABLE_ENTITY,
+            "{extra}: {}",
+            r.text()
+        );
         assert!(r.detail().contains(words), "{extra}: {}", r.detail());
     }
 }
