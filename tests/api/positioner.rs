@@ -202,24 +202,7 @@ async fn a_positioner_fitted_over_http_is_the_command_lines_and_carries_a_target
         .await;
     assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
     assert!(r.detail().contains("has no positioner"), "{}", r.detail());
-    let r = t
-        .post_json(
-            PREDICT,
-            &[&rid],
-            json!({ "readings": [{ "joints_deg": [0, -90, 90, 0, 45, 0] }], "e1": 10.0, "e2": 5.0 }),
-        )
-        .await;
-    assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
-    assert!(r.detail().contains("has no positioner"), "{}", r.detail());
-    let r = t
-        .post_json(
-            SOLVE,
-            &[&rid],
-            json!({ "targets": [{ "x": 100.0, "y": 0.0, "z": 50.0 }], "e1": 10.0, "e2": 5.0 }),
-        )
-        .await;
-    assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
-    assert!(r.detail().contains("has no positioner"), "{}", r.detail());
+    at_values_conflict(&t, &rid, json!([0, -90, 90, 0, 45, 0]), "has no positioner").await;
 
     // The fit over HTTP, stored; the same files through the command line.
     let r = t
@@ -303,24 +286,26 @@ async fn a_positioner_fitted_over_http_is_the_command_lines_and_carries_a_target
         .await;
     assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
     assert!(r.detail().contains("ambiguous"), "{}", r.detail());
-    let r = t
-        .post_json(
+    at_values_conflict(&t, &rid, json!(solved[0].0), "ambiguous").await;
+}
+
+/// A prediction at `joints` and a JSON solve, both at the positioner's
+/// values `e1`, `e2`: each a 409 whose detail says `words`.
+async fn at_values_conflict(t: &TestApp, rid: &str, joints: Value, words: &str) {
+    for (path, body) in [
+        (
             PREDICT,
-            &[&rid],
-            json!({ "readings": [{ "joints_deg": solved[0].0 }], "e1": 10.0, "e2": 5.0 }),
-        )
-        .await;
-    assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
-    assert!(r.detail().contains("ambiguous"), "{}", r.detail());
-    let r = t
-        .post_json(
+            json!({ "readings": [{ "joints_deg": joints }], "e1": 10.0, "e2": 5.0 }),
+        ),
+        (
             SOLVE,
-            &[&rid],
             json!({ "targets": [{ "x": 100.0, "y": 0.0, "z": 50.0 }], "e1": 10.0, "e2": 5.0 }),
-        )
-        .await;
-    assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
-    assert!(r.detail().contains("ambiguous"), "{}", r.detail());
+        ),
+    ] {
+        let r = t.post_json(path, &[rid], body).await;
+        assert_eq!(r.status, StatusCode::CONFLICT, "{path}: {}", r.text());
+        assert!(r.detail().contains(words), "{path}: {}", r.detail());
+    }
 }
 
 /// Points of a part on the plate, located on the face plate through the
