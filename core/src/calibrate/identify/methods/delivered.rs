@@ -35,7 +35,9 @@
 //!
 //! The regions are refitted side by side on `CompensatorOptions::parallel`
 //! threads (`compensate::select::run_jobs`), each on its own poses and fits,
-//! so the figures are the same bit for bit on any number of threads.
+//! so the figures are the same bit for bit on any number of threads; those
+//! with the most poses to refit on start first (the longest first), so
+//! that the threads finish close together.
 
 use super::cache::Cache;
 use super::context::Context;
@@ -213,18 +215,25 @@ impl DeliveredRegions {
         let opts = sub_options(ctx.opts);
         let count = self.regions.len().max(1) as f64;
         // The regions refit side by side (each on its own poses and cache,
-        // so the figures are the same on any number of threads); the bar
-        // stands at the share of regions before the lowest one under way.
+        // so the figures are the same on any number of threads), those with
+        // the most poses to refit on first, so that the last to finish are
+        // short and no thread waits long on another; the bar stands at the
+        // share of refits started before the earliest one under way.
+        let mut order: Vec<usize> = (0..self.regions.len()).collect();
+        order.sort_by_key(|&r| {
+            let region = &self.regions[r];
+            std::cmp::Reverse(region.ident.len() + region.training.len())
+        });
         let slots: Vec<Mutex<&mut Region>> = self.regions.iter_mut().map(Mutex::new).collect();
         let outcomes = run_jobs(
             slots.len(),
             Jobs {
                 parallel: ctx.opts.compensator.parallel,
-                progress: &mut |r, _, _| progress(r as f64 / count),
+                progress: &mut |j, _, _| progress(j as f64 / count),
                 cancelled: || MethodError::Cancelled,
             },
-            |r, report| {
-                let mut region = slots[r].lock().unwrap_or_else(|e| e.into_inner());
+            |j, report| {
+                let mut region = slots[order[j]].lock().unwrap_or_else(|e| e.into_inner());
                 match judge_region(ctx, &opts, &mut region, delivery, &mut || report(0, 0.0)) {
                     Ok(e) => Ok(Ok(e)),
                     Err(MethodError::Failed(f)) => Ok(Err(f.to_string())),
@@ -232,10 +241,14 @@ impl DeliveredRegions {
                 }
             },
         )?;
-        // The first region (in order) whose refit failed says why.
-        let mut per_region = Vec::with_capacity(outcomes.len());
+        let mut by_region: Vec<Option<Result<Vec<f64>, String>>> = vec![None; outcomes.len()];
+        for (j, o) in outcomes.into_iter().enumerate() {
+            by_region[order[j]] = Some(o);
+        }
+        // The first region (in the regions' order) whose refit failed says why.
+        let mut per_region = Vec::with_capacity(by_region.len());
         let mut failed = None;
-        for o in outcomes {
+        for o in by_region.into_iter().flatten() {
             match o {
                 Ok(e) => per_region.push(e),
                 Err(f) => {
