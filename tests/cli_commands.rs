@@ -493,8 +493,9 @@ fn cli_solves_targets_in_a_work_object_for_a_production_tool() {
 /// seconds since the run started, both never going back, and `end` last.
 #[test]
 fn bench_methods_prints_its_steps_with_phases() {
-    let dir = temp_path("bench-phases");
-    std::fs::create_dir_all(&dir).unwrap();
+    // A directory of its own: the simulate tests remove theirs when done.
+    let dir = tempfile::tempdir().unwrap();
+    let dir = dir.path();
     let args = [
         "bench",
         "methods",
@@ -507,7 +508,7 @@ fn bench_methods_prints_its_steps_with_phases() {
     ];
     let mut with = args.to_vec();
     with.push("--phases");
-    let out = common::robocal(&dir, &with);
+    let out = common::robocal(dir, &with);
     let err = common::text(&out.stderr);
     assert_eq!(common::code(&out), 0, "{err}");
     let steps: Vec<(f64, f64, String)> = err
@@ -534,7 +535,7 @@ fn bench_methods_prints_its_steps_with_phases() {
             .all(|w| w[0].0 <= w[1].0 && w[0].1 <= w[1].1),
         "{err}"
     );
-    let without = common::robocal(&dir, &args);
+    let without = common::robocal(dir, &args);
     assert!(!common::text(&without.stderr).contains("step "));
     let figures = |o: &std::process::Output| -> serde_json::Value {
         let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();

@@ -766,6 +766,10 @@ pub async fn solve(
     let (frame, position_only, path) = (cmd.options.frame, cmd.options.position_only, cmd.path);
     let frame = if cmd.work_object.is_some() {
         "work_object".to_string()
+    } else if cmd.positioner_deg.is_some() || cmd.positioner_rows.is_some() {
+        // The targets on the positioner's face plate, the false targets in
+        // the robot's base frame.
+        "face_plate".to_string()
     } else {
         frame.to_string()
     };

@@ -480,6 +480,8 @@ async fn plate_json_solve(
         assert_eq!(r.status, StatusCode::OK, "{}", r.text());
         let doc = r.json();
         assert_eq!(doc["solved"], on_plate.len(), "{doc}");
+        assert_eq!(doc["frame"], "face_plate", "{doc}");
+        assert_eq!(by_csv["frame"], "face_plate");
         for i in 0..on_plate.len() {
             let csv_row = &by_csv["results"][i * values.len() + k];
             let (a, b) = (
