@@ -168,7 +168,7 @@ pub struct SolveCommand {
     /// (`super::positioners::place_rows`; the cached solver serves).
     pub positioner_rows: Option<super::positioners::PlateValues>,
     /// A positioner's tilt and rotate values for every target [deg] (a JSON
-    /// body's or a query's `e1` and `e2`), the targets in its face plate
+    /// body's `e1` and `e2`), the targets in its face plate
     /// frame: moved into the base frame through the robot's stored
     /// positioner as a targets CSV's rows at those values are.
     pub positioner_deg: Option<AxisValues>,
