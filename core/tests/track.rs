@@ -15,62 +15,29 @@
 
 mod common;
 
-use common::track::{measure_on_track, true_pose, ys100_truth, STATIONS, TRACKER_SIGMA_MM};
+use common::track::{
+    calibrated_on_fixed_base, measure_on_track, true_pose, ys100_truth, STATIONS, TRACKER_SIGMA_MM,
+};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal_core::calibrate::external::track::{
     fit_track, fit_track_compensated, TrackFit, TrackFitRequest, TrackRefusalReason, TrackRefused,
     UnseenTerm, DEFAULT_MAX_ORDER,
 };
-use robocal_core::calibrate::identify::{calibrate, CalibrationOptions, Method};
 use robocal_core::measure::csv;
 use robocal_core::measure::external::{ExternalAxis, MeasurementSet};
-use robocal_core::measure::to_measurements;
 use robocal_core::model::calibrated::CompensatedModel;
 use robocal_core::model::external::CarriageTerm;
 use robocal_core::model::kinematics::fk;
 use robocal_core::model::{Pose, RobotModel};
+use robocal_core::sim::random_configurations;
 use robocal_core::sim::track::TrueTrack;
-use robocal_core::sim::{random_configurations, TrueRobot};
 use robocal_core::solve::external::{carried, TrackPoseError, TrackSolver};
 use robocal_core::solve::ik::{Goal, IkSettings, SolveOptions};
 
 /// Held-out track values [mm], between the fitted ones.
 const HELD_OUT: [f64; 6] = [200.0, 1000.0, 1400.0, 2600.0, 3000.0, 3800.0];
 const POSES_PER_STATION: usize = 15;
-/// The track's value while the robot is calibrated on a fixed base [mm].
-const FIXED_AT_MM: f64 = 2000.0;
-
-/// The robot calibrated on a fixed base (the track standing at
-/// `FIXED_AT_MM`): 40 identification and 30 validation poses, KM. The
-/// calibrated model and the validation RMS [mm].
-fn calibrated_on_fixed_base(
-    nominal: &RobotModel,
-    truth: &TrueRobot,
-    track: &TrueTrack,
-    rng: &mut ChaCha8Rng,
-) -> (RobotModel, f64) {
-    let mut fixed = truth.clone();
-    fixed.tracker_from_base = track.cell_from_base(FIXED_AT_MM);
-    let rows = |n: usize, rng: &mut ChaCha8Rng| {
-        let qs = random_configurations(nominal, n, rng);
-        let r = fixed
-            .measure(&qs, Some(nominal.payload.mass), None, rng)
-            .unwrap();
-        to_measurements(nominal, &r, nominal.payload.mass)
-    };
-    let id = rows(40, rng);
-    let va = rows(30, rng);
-    let opts = CalibrationOptions {
-        methods: vec![Method::Km],
-        ..Default::default()
-    };
-    let report = calibrate(nominal, &id, &va, &opts, &|_| true).unwrap();
-    let km = &report.methods["km"];
-    let val = km.validation.as_ref().unwrap().stats.rms_mm;
-    (km.calibrated.clone(), val)
-}
-
 fn request<'a>(
     robot: &'a RobotModel,
     set: &'a MeasurementSet,

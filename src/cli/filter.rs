@@ -3,9 +3,13 @@
 //! false target on the calibrated model for its tool and work object; the
 //! rest of each file is unchanged. Tools and work objects the programs refer
 //! to by number or name come from a cell file (`core::cell::file`: mm,
-//! degrees); RAPID modules and URScript carry their own.
+//! degrees); RAPID modules and URScript carry their own. With `--track FILE
+//! --nominal-track FILE` the robot rides a linear track, axis 1 of the
+//! program (`core::program::axes`): each target composed at its own track
+//! value through the calibrated track, its false target through the
+//! controller's nominal one, the value kept.
 
-use crate::program::{filter, Language, ProgramFile};
+use crate::program::{filter_with, FilterAxes, FilterControl, Language, ProgramFile, TrackAxes};
 use crate::solve::ik::IkSettings;
 use anyhow::{bail, Context};
 use clap::Args;
@@ -29,6 +33,15 @@ pub struct FilterArgs {
     /// Payload mass [kg] (default: the model file's payload).
     #[arg(long)]
     pub payload_kg: Option<f64>,
+    /// The calibrated track the robot rides (`robocal track calibrate`'s
+    /// output), program axis 1 (KRL E1, RAPID eax_a, Fanuc E1); the cell
+    /// frame is its.
+    #[arg(long, requires = "nominal_track")]
+    pub track: Option<String>,
+    /// The controller's own track (the same JSON: its nominal rail, scale 1,
+    /// no maps, in the same cell frame), how it places the robot at a value.
+    #[arg(long, requires = "track")]
+    pub nominal_track: Option<String>,
     /// Directory for the filtered files (same names as the inputs).
     #[arg(long)]
     pub out_dir: PathBuf,
@@ -79,7 +92,25 @@ pub fn filter_report(a: &FilterArgs) -> anyhow::Result<super::exit::Outcome> {
             }
         }
     };
-    let out = filter(language, &files, &cell, &model, &IkSettings::default())?;
+    let tracks = match (&a.track, &a.nominal_track) {
+        (Some(t), Some(n)) => Some((super::track::read_track(t)?, super::track::read_track(n)?)),
+        _ => None,
+    };
+    let axes = FilterAxes {
+        track: tracks.as_ref().map(|(calibrated, nominal)| TrackAxes {
+            nominal,
+            calibrated,
+        }),
+    };
+    let out = filter_with(
+        language,
+        &files,
+        &cell,
+        &model,
+        &IkSettings::default(),
+        &axes,
+        &FilterControl::default(),
+    )?;
     std::fs::create_dir_all(&a.out_dir)
         .with_context(|| format!("cannot create {}", a.out_dir.display()))?;
     for f in &out.files {

@@ -7,10 +7,14 @@
 //! tool and base numbers and names refer to the robot's stored tools and work
 //! objects (`/tools`, `/frames`) and to what the program declares itself. A
 //! program that cannot be parsed is a 422 naming its file, line and column.
+//! With `controller_track` (the controller's own track) the robot rides its
+//! stored track, program axis 1 (`core::program::axes`), as `robocal filter
+//! --track --nominal-track` composes it.
 
 use super::input::{objects, present};
 use super::solve::{model_choice, VersionSelector};
 use super::{ApiError, ApiJson, ApiPath, AppState};
+use crate::model::external::TrackDescription;
 use crate::program::controller::{ExportOptions, RegisterRange, Renamed, UsedRegister};
 use crate::program::{FilterReport, Language, ProgramFile};
 use crate::service;
@@ -50,6 +54,10 @@ pub struct FilterRequest {
     /// Payload mass [kg] instead of the model's.
     #[serde(default, deserialize_with = "present")]
     pub payload_kg: Option<f64>,
+    /// The controller's own track (its nominal rail): the program's axis 1
+    /// is the robot's stored track.
+    #[serde(default, deserialize_with = "present")]
+    pub controller_track: Option<TrackDescription>,
 }
 
 /// The answer: the filtered files (same names and order) and the report.
@@ -114,10 +122,16 @@ fn command(robot_id: i64, req: FilterRequest) -> Result<FilterCommand, ApiError>
         super::input::check_payload("`payload_kg`", p)?;
     }
     let language = language_of(&req.language)?;
+    let controller_track = req
+        .controller_track
+        .map(|d| d.to_model())
+        .transpose()
+        .map_err(|e| ApiError::invalid(format!("`controller_track`: {e}")))?;
     Ok(FilterCommand {
         robot_id,
         model: model_choice(req.version.as_ref())?,
         payload_kg: req.payload_kg,
+        controller_track,
         language,
         files: req
             .files

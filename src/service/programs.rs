@@ -8,9 +8,11 @@
 use super::solve::{chosen_model, ModelChoice};
 use super::{AppState, ServiceError};
 use crate::program::{
-    filter_with, FilterControl, FilterError, FilterOutput, Language, ProgramFile,
+    filter_with, FilterAxes, FilterControl, FilterError, FilterOutput, Language, ProgramFile,
+    TrackAxes,
 };
 use crate::solve::ik::IkSettings;
+use robocal_core::model::external::LinearTrack;
 
 /// A filter, in domain terms.
 #[derive(Debug, Clone)]
@@ -21,6 +23,9 @@ pub struct FilterCommand {
     pub model: ModelChoice,
     /// Payload mass [kg] instead of the model's.
     pub payload_kg: Option<f64>,
+    /// The controller's own track: the robot rides its stored track,
+    /// the program's axis 1 (`core::program::axes`).
+    pub controller_track: Option<LinearTrack>,
     /// The program's language.
     pub language: Language,
     /// The program's files.
@@ -46,6 +51,13 @@ pub async fn filter_program(
     let language = cmd.language;
     let cell = super::cell::cell(state, cmd.robot_id).await?;
     let chosen = chosen_model(state, cmd.robot_id, cmd.model).await?;
+    let tracks = match cmd.controller_track {
+        Some(nominal) => Some((
+            super::tracks::stored_for(state, cmd.robot_id, "controller_track").await?,
+            nominal,
+        )),
+        None => None,
+    };
     let mut model = chosen.model;
     if let Some(p) = cmd.payload_kg {
         model.payload_kg = p;
@@ -58,12 +70,19 @@ pub async fn filter_program(
             max_targets: Some(max_targets),
             keep_going: &|| flag.still_waiting(),
         };
+        let axes = FilterAxes {
+            track: tracks.as_ref().map(|(calibrated, nominal)| TrackAxes {
+                nominal,
+                calibrated,
+            }),
+        };
         let out = filter_with(
             language,
             &files,
             &cell,
             &model,
             &IkSettings::default(),
+            &axes,
             &control,
         );
         if matches!(out, Err(FilterError::Cancelled)) {

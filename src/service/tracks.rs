@@ -194,9 +194,19 @@ pub async fn carry(
 /// (a value, or a column of a targets CSV): no track stored is a
 /// `Conflict` (the robot's state).
 pub async fn stored(state: &AppState, robot_id: i64) -> Result<LinearTrack, ServiceError> {
+    stored_for(state, robot_id, "e1").await
+}
+
+/// The robot's stored track as a model, for a request whose `field` needs
+/// it: no track stored is a `Conflict` naming the field.
+pub async fn stored_for(
+    state: &AppState,
+    robot_id: i64,
+    field: &str,
+) -> Result<LinearTrack, ServiceError> {
     let Some(row) = state.db().track(robot_id).await? else {
         return Err(ServiceError::Conflict(format!(
-            "`e1`: robot {robot_id} has no track; fit one with POST /v1/robots/{robot_id}/track/calibrate, or leave `e1` out"
+            "`{field}`: robot {robot_id} has no track; fit one with POST /v1/robots/{robot_id}/track/calibrate, or leave `{field}` out"
         )));
     };
     model_of(&row)

@@ -21,7 +21,8 @@
 //! `admission` (large requests share one admission), `slow_clients` (header
 //! and body timeouts, the connection cap), `exposure` (no open writes on a
 //! network by default), `track` (a robot's linear track: fitted, stored,
-//! and carrying predictions and solves, over HTTP and the CLI alike), `positioner`
+//! and carrying predictions and solves, over HTTP and the CLI alike; `track_filter`: a program on
+//! it filtered), `positioner`
 //! (a robot's two-axis positioner: fitted, stored, and carrying a targets CSV,
 //! over HTTP and the CLI alike); the harness is `support`.
 
@@ -63,3 +64,4 @@ mod stored;
 mod stored_jobs;
 mod support;
 mod track;
+mod track_filter;

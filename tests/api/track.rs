@@ -82,7 +82,7 @@ impl Rail {
     }
 
     /// The true pose of the measured point in the tracker frame (no noise).
-    fn true_pose(&self, q: &[f64], value_mm: f64) -> Pose {
+    pub(crate) fn true_pose(&self, q: &[f64], value_mm: f64) -> Pose {
         self.track
             .cell_from_base(value_mm)
             .compose(&self.truth.true_pose_base(q, Some(PAYLOAD_KG)).unwrap())
@@ -154,6 +154,7 @@ async fn a_track_fitted_over_http_is_the_command_lines_and_carries_predict_and_s
         .await;
     assert_eq!(r.status, StatusCode::CONFLICT);
     assert!(r.detail().contains("has no track"), "{}", r.detail());
+    super::track_filter::refused_without_a_track(&t, &rid).await;
 
     let rail = Rail::new(&model);
     let mut rng = ChaCha8Rng::seed_from_u64(11);
@@ -346,6 +347,18 @@ async fn a_track_fitted_over_http_is_the_command_lines_and_carries_predict_and_s
     // A targets CSV with an `e1` column: each row at its own value, over
     // HTTP as by the command line, and the true robot on each target.
     per_row_csv_solve(&t, &rid, &rail, &model, d, &mut rng).await;
+
+    // A program on the track, filtered over HTTP and by the command line.
+    super::track_filter::filters_as_the_command_line(
+        &t,
+        &rid,
+        &rail,
+        &model,
+        &d.join("rail.json"),
+        d,
+        &mut rng,
+    )
+    .await;
 
     // Beyond the travel measured: refused by predict and solve alike.
     for (route, body) in [

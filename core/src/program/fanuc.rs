@@ -5,8 +5,10 @@
 //! X = … mm, Y = … mm, Z = … mm, W = … deg, P = … deg, R = … deg`; joint
 //! positions (`J1 = …`) are not targets, nor are other groups. The user frame
 //! `UF` and tool `UT` are looked up in the cell by number (`UF : 0` is the
-//! base frame). A position with another group (`GP2`, a positioner) or an
-//! extended axis (`E1 = …` in `GP1`) is refused, naming it.
+//! base frame). A position with another group (`GP2`, a positioner) is
+//! refused, naming it; an extended axis of `GP1` (`E1 = …`) goes with the
+//! site to the filter (`program::axes`: the track's composed, any other
+//! refused).
 //!
 //! Motions: the `/MN` section's `J`, `L`, `C` and `A` instructions
 //! (`fanuc/motions.rs`) name the positions; a position in joint form is a
@@ -25,8 +27,8 @@ mod motions;
 
 use super::lex::{error, position, tokens, Fail, Tok, Token};
 use super::{
-    external_axis_refusal, Flags, FrameSpec, JointTarget, Motion, MotionTarget, ParseError,
-    ProgramFile, Site, Targets,
+    AxisValue, Flags, FrameSpec, JointTarget, Motion, MotionTarget, ParseError, ProgramFile, Site,
+    Targets,
 };
 use crate::model::orientation::{rotation_from, OrientationConvention};
 use crate::model::Pose;
@@ -126,8 +128,8 @@ struct Fields {
     group: u32,
     /// Groups other than 1 the position moves.
     other_groups: Vec<u32>,
-    /// The first extended axis of group 1 (`E1 = 100 mm`): its name and value.
-    extended: Option<(String, String)>,
+    /// The extended axes of group 1 (`E1 = 100 mm`), in the block's order.
+    extended: Vec<AxisValue>,
     uf: Option<u32>,
     ut: Option<u32>,
     flags: Option<Flags>,
@@ -204,9 +206,15 @@ impl Fields {
             match "XYZWPR".find(key.as_str()).filter(|_| key.len() == 1) {
                 Some(idx) => self.values[idx] = Some((sign * v, slot)),
                 None if key.starts_with('J') || key.starts_with('E') => {
-                    if key.starts_with('E') && self.extended.is_none() {
-                        let value = format!("{} {}", &text[slot.clone()], unit.unwrap_or(""));
-                        self.extended = Some((key.clone(), value.trim_end().to_string()));
+                    let extended = key.strip_prefix('E').and_then(|n| n.parse::<usize>().ok());
+                    if let Some(number) = extended {
+                        let written = format!("{} {}", &text[slot.clone()], unit.unwrap_or(""));
+                        self.extended.push(AxisValue {
+                            number,
+                            name: key.clone(),
+                            value: Some(sign * v),
+                            text: written.trim_end().to_string(),
+                        });
                     }
                     let axis = key.strip_prefix('J').and_then(|n| n.parse::<usize>().ok());
                     if let Some(n) = axis {
@@ -292,13 +300,9 @@ fn found(fi: usize, line: usize, name: String, mark_at: Range<usize>, f: Fields)
         ),
     };
     let spec = |v: Option<u32>| v.map_or(FrameSpec::Unset, |n| FrameSpec::Ref(CellRef::Number(n)));
-    let refuse = match (f.other_groups.first(), &f.extended) {
-        (Some(g), _) => Some(format!(
-            "the position also moves motion group GP{g} (another mechanical unit), which the cell does not model: not filtered"
-        )),
-        (None, Some((axis, value))) => Some(external_axis_refusal(axis, value)),
-        (None, None) => None,
-    };
+    let refuse = f.other_groups.first().map(|g| format!(
+        "the position also moves motion group GP{g} (another mechanical unit), which the cell does not model: not filtered"
+    ));
     Position::Cartesian(Box::new(Site {
         file: fi,
         line,
@@ -316,6 +320,7 @@ fn found(fi: usize, line: usize, name: String, mark_at: Range<usize>, f: Fields)
         after_joints: None,
         skip,
         refuse,
+        axes: f.extended,
         stationary_tool: false,
     }))
 }

@@ -11,7 +11,8 @@
 //! system variable (`$POS_ACT`), an array element, an expression, a point
 //! declared without a value or assigned in a `.src` is set at run time and
 //! skipped; a name no file declares (a `.src` without its `.dat`) fails;
-//! an `E6POS` whose external axes `E1..E6` are not 0 is refused.
+//! an `E6POS` carries its external axes' values `E1..E6` to the filter
+//! (`program::axes`: the track's composed, any other in use refused).
 //! Tool and base: `$TOOL = TOOL_DATA[n]`, `$BASE = BASE_DATA[n]`, inline
 //! frames, `$NULLFRAME`, `BAS(#TOOL, n)`, `BAS(#BASE, n)` and `FDAT_ACT = FP1`
 //! with `DECL FDAT FP1={TOOL_NO n, BASE_NO m, …}`; `TOOL_DATA[n]={…}` and
@@ -130,7 +131,7 @@ fn site_of(
         pose,
         flags,
         slots,
-        refuse,
+        axes,
     } = kind
     else {
         return None;
@@ -157,7 +158,8 @@ fn site_of(
         mark_at: line.end..line.end,
         after_joints: None,
         skip,
-        refuse,
+        refuse: None,
+        axes,
         stationary_tool: ctx.external,
     })
 }

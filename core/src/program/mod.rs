@@ -14,6 +14,7 @@
 //! Units: the programs' own (KRL: mm and degrees, A,B,C = `Rz(A)·Ry(B)·Rx(C)`);
 //! SI (m, rad) in [`Site::pose`].
 
+mod axes;
 pub mod controller;
 pub mod export;
 mod fanuc;
@@ -27,10 +28,11 @@ mod parsed;
 mod report;
 mod sites;
 
+pub use axes::{track_axis_name, FilterAxes, TrackAxes, TRACK_AXIS};
 pub use parsed::{
-    abb_cf, external_axis_refusal, fanuc_config, fanuc_config_text, kuka_status, kuka_turn, Flags,
-    FrameSpec, JointTarget, Language, Motion, MotionTarget, ParseError, Program, ProgramFile, Site,
-    Targets, UnknownLanguage,
+    abb_cf, external_axis_refusal, fanuc_config, fanuc_config_text, kuka_status, kuka_turn,
+    AxisValue, Flags, FrameSpec, JointTarget, Language, Motion, MotionTarget, ParseError, Program,
+    ProgramFile, Site, Targets, UnknownLanguage,
 };
 pub use report::{
     FilterReport, JointMotionReport, LoadSource, MotionPlace, Reachable, TargetReport,

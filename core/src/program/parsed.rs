@@ -315,9 +315,15 @@ pub struct Site {
     /// (an incomplete aggregate, a point set at run time, used with
     /// different tools, ...): reported `skipped`.
     pub skip: Option<String>,
-    /// Why the target is refused before any solve (it carries external-axis
-    /// values the cell does not model): reported `failed` and marked.
+    /// Why the target is refused before any solve (it moves another motion
+    /// group, or an external axis computed at run time): reported `failed`
+    /// and marked.
     pub refuse: Option<String>,
+    /// The external axes' values the target carries (KRL `E1..E6`, RAPID
+    /// `eax_a..eax_f` other than 9E9, Fanuc `E1..` of `GP1`), in the
+    /// program's order. The filter composes the cell's track through axis 1
+    /// and refuses any other axis in use (`program::axes`).
+    pub axes: Vec<AxisValue>,
     /// The roles swapped (RAPID `robhold FALSE` tooldata with a `robhold
     /// TRUE` wobjdata): `tool` is a stationary tool's pose in the base frame
     /// and `work_object` the work object on the flange (flange → work
@@ -330,6 +336,30 @@ impl Site {
     pub fn with_skip(mut self, skip: Option<String>) -> Self {
         self.skip = self.skip.or(skip);
         self
+    }
+}
+
+/// One external axis's value on a target, as the program writes it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AxisValue {
+    /// The controller's axis number, 1-based (KRL `E1`, RAPID `eax_a` and
+    /// Fanuc `E1` are 1).
+    pub number: usize,
+    /// The axis as the language names it (`E1`, `eax_a`).
+    pub name: String,
+    /// The value in the program's unit (mm for a linear axis, degrees for a
+    /// rotary one); `None` when it is computed at run time.
+    pub value: Option<f64>,
+    /// The value as written (with its unit where the program gives one).
+    pub text: String,
+}
+
+impl AxisValue {
+    /// Whether the value moves an axis: KRL's `E6POS` writes every external
+    /// axis, 0 for one the robot does not have; RAPID leaves an axis out
+    /// with 9E9 (never kept here) and Fanuc writes only the axes it has.
+    pub fn in_use(&self, language: Language) -> bool {
+        !(language == Language::Krl && self.value == Some(0.0))
     }
 }
 

@@ -25,8 +25,9 @@
 //! motion; `Offs(…)`, `RelTool(…)`, `CRobT()`, an array element chosen at
 //! run time, a routine's parameter, a robtarget declared without a value or
 //! assigned in a routine (`p10 := …`, `p10.trans.z := …`) are set at run
-//! time and skipped; a name no module declares fails; a robtarget whose
-//! external axes are not all 9E9 is refused.
+//! time and skipped; a name no module declares fails; a robtarget's
+//! external axes other than 9E9 go with the site to the filter
+//! (`program::axes`: the track's, `eax_a`, composed, any other refused).
 //!
 //! Units: mm, unit quaternions with the scalar `q1` first. `cf1, cf4, cf6`
 //! are the quadrants `⌊A/90°⌋` of axes 1, 4, 6; `cfx = 4·back + 2·down +
@@ -115,7 +116,8 @@ impl Parser<'_> {
             mark_at: end..end,
             after_joints: None,
             skip: None,
-            refuse: t.refuse,
+            refuse: None,
+            axes: t.axes,
             stationary_tool: ctx.stationary,
         }
         .with_skip(skip)

@@ -73,6 +73,10 @@ pub struct TargetReport {
     /// Distance the position moved [mm].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub shift_mm: Option<f64>,
+    /// The track value the position was composed at, kept as programmed
+    /// [mm] (a robot on a track: `program::axes`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub track_mm: Option<f64>,
     /// The load the solve carried (flange frame) and where it came from.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub load: Option<UsedLoad>,
@@ -155,8 +159,14 @@ pub struct FilterReport {
     pub unused: Vec<UnusedReport>,
     /// What the controller must hold for the filtered program, in its
     /// language (`cell::export`): the tools, loads and work objects the
-    /// filter used, work objects in the controller's base frame.
+    /// filter used, work objects in the controller's base frame (its world
+    /// frame for a robot on a track).
     pub controller_data: String,
+    /// The axis the robot's track is (`E1`, `eax_a`) when the filter
+    /// composed through one: its values are kept as programmed, each
+    /// position's in `track_mm`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub track_axis: Option<String>,
 }
 
 impl FilterReport {
@@ -167,6 +177,7 @@ impl FilterReport {
         joint_motions: Vec<JointMotionReport>,
         unused: Vec<UnusedReport>,
         controller_data: String,
+        track_axis: Option<String>,
     ) -> FilterReport {
         let count = |s: TargetStatus| targets.iter().filter(|t| t.status == s).count();
         FilterReport {
@@ -178,6 +189,7 @@ impl FilterReport {
             joint_motions,
             unused,
             controller_data,
+            track_axis,
         }
     }
 }

@@ -5,6 +5,7 @@
 //! values rewritten; one report line per position of a Cartesian motion
 //! (`report.rs`).
 
+use super::axes::{self, FilterAxes};
 use super::report::{
     FilterReport, JointMotionReport, MotionPlace, TargetReport, TargetStatus, UnusedReport,
 };
@@ -85,6 +86,7 @@ pub fn filter(
         cell,
         model,
         settings,
+        &FilterAxes::default(),
         &FilterControl::default(),
     )
     .map_err(|e| match e {
@@ -96,15 +98,17 @@ pub fn filter(
     })
 }
 
-/// [`filter`] within `control`'s bounds: a program with more targets than
-/// its cap is refused before any solve, and the filter stops between motions
-/// once `keep_going` says so.
+/// [`filter`] through the cell's external `axes` (a robot on a track:
+/// `program::axes`) within `control`'s bounds: a program with more targets
+/// than its cap is refused before any solve, and the filter stops between
+/// motions once `keep_going` says so.
 pub fn filter_with(
     language: Language,
     files: &[ProgramFile],
     cell: &Cell,
     model: &CompensatedModel,
     settings: &IkSettings,
+    axes: &FilterAxes,
     control: &FilterControl,
 ) -> Result<FilterOutput, FilterError> {
     let program = parse(language, files)?;
@@ -126,6 +130,7 @@ pub fn filter_with(
             settings,
             solvers: Vec::new(),
         },
+        axes: *axes,
         outcomes: vec![None; program.sites.len()],
         edits: vec![Vec::new(); files.len()],
         previous: None,
@@ -163,6 +168,7 @@ struct SolvedReport {
     joints_deg: Vec<f64>,
     configuration: Option<String>,
     shift_mm: f64,
+    track_mm: Option<f64>,
     load: super::report::UsedLoad,
     warnings: Vec<String>,
 }
@@ -172,6 +178,7 @@ struct Run<'a> {
     files: &'a [ProgramFile],
     program: &'a Program,
     context: Context<'a>,
+    axes: FilterAxes<'a>,
     /// Per site: `None` until a motion goes to it.
     outcomes: Vec<Option<Outcome>>,
     edits: Vec<Vec<(std::ops::Range<usize>, String)>>,
@@ -200,6 +207,7 @@ impl Run<'_> {
             configuration: None,
             joints_deg: None,
             shift_mm: None,
+            track_mm: None,
             load: None,
             warnings: Vec::new(),
             reachable: Vec::new(),
@@ -264,11 +272,18 @@ impl Run<'_> {
         if let Some(why) = &site.refuse {
             return failed(&mut self.edits, language, Failure::from(why.clone()));
         }
+        let on = match axes::place(language, site, &self.axes) {
+            Ok(on) => on,
+            Err(why) => return failed(&mut self.edits, language, Failure::from(why)),
+        };
         if let Some(j) = &site.after_joints {
             let rad: Vec<f64> = j.iter().map(|v| v.to_radians()).collect();
             self.previous = Some(self.context.model.nominal.joints_from_controller(&rad));
         }
-        match self.context.solve_site(site, self.previous.as_deref()) {
+        match self
+            .context
+            .solve_site(site, self.previous.as_deref(), on.as_ref())
+        {
             Ok(done) => self.solved(site, done),
             Err(f) => failed(&mut self.edits, language, f),
         }
@@ -287,6 +302,7 @@ impl Run<'_> {
             joints_deg: done.joints_deg,
             configuration: done.configuration,
             shift_mm: done.shift_m * 1e3,
+            track_mm: done.track_mm,
             load: done.load,
             warnings: done.warnings,
         }))
@@ -328,6 +344,9 @@ impl Run<'_> {
                 self.joint_motions,
                 unused,
                 controller_data,
+                self.axes
+                    .track
+                    .map(|_| axes::track_axis_name(language).to_string()),
             ),
         }
     }
@@ -342,6 +361,7 @@ fn describe(report: &mut TargetReport, outcome: Outcome, previous: &mut Option<V
             report.configuration = s.configuration;
             report.joints_deg = Some(s.joints_deg);
             report.shift_mm = Some(s.shift_mm);
+            report.track_mm = s.track_mm;
             report.load = Some(s.load);
             report.warnings = s.warnings;
             *previous = Some(s.q);

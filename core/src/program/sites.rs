@@ -15,6 +15,7 @@
 //! warns which configuration was taken and how to make sure. Units: SI, joints in the model
 //! convention [rad] but where named `deg` (controller convention).
 
+use super::axes::OnTrack;
 use super::report::{LoadSource, Reachable, UsedLoad};
 use super::{Flags, FrameSpec, Language, Site};
 use crate::model::calibrated::CompensatedModel;
@@ -33,6 +34,8 @@ pub(super) struct Solved {
     /// The same, controller convention [deg].
     pub(super) joints_deg: Vec<f64>,
     pub(super) false_target: Pose,
+    /// The track value the target was composed at, as programmed [mm].
+    pub(super) track_mm: Option<f64>,
     pub(super) configuration: Option<String>,
     pub(super) shift_m: f64,
     pub(super) load: UsedLoad,
@@ -135,6 +138,59 @@ fn resolve_work_object(spec: &FrameSpec, cell: &Cell) -> Result<WorkObject, Stri
     }
 }
 
+/// A site's work object in the cell (world) frame, for a robot on a track:
+/// the world itself for none or number 0 (KRL `$NULLFRAME`, RAPID `wobj0`,
+/// Fanuc `UF : 0`), an inline frame as given, a cell work object measured
+/// in the cell frame; one stated in the robot's base frame moves with the
+/// carriage and is refused.
+fn world_work_object(spec: &FrameSpec, cell: &Cell) -> Result<WorkObject, String> {
+    let world = |name: &str, number: Option<u32>, pose: Pose| WorkObject {
+        name: name.into(),
+        number,
+        frame: WorkObjectFrame::Measurement,
+        pose,
+    };
+    match spec {
+        FrameSpec::Unset => Ok(world("world", Some(0), Pose::identity())),
+        FrameSpec::Inline(p) => Ok(world("inline", None, *p)),
+        FrameSpec::Ref(r) if !cell.defines_work_object(r) => {
+            let w = cell.work_object(r).map_err(|e| e.to_string())?;
+            Ok(world("world", w.number, Pose::identity()))
+        }
+        FrameSpec::Ref(r) => {
+            let w = cell.work_object(r).map_err(|e| e.to_string())?;
+            match w.frame {
+                WorkObjectFrame::Measurement => Ok(w),
+                WorkObjectFrame::Base => Err(format!(
+                    "work object {} is stated in the robot's base frame, which the track carries: state it in the cell frame (frame measurement) for a robot on a track; not filtered",
+                    w.name
+                )),
+            }
+        }
+    }
+}
+
+/// The work object a site is solved in, and on a track its pose in the
+/// world frame: on a fixed base the cell's, program's or base frame; on a
+/// track the world-frame work object `W` moved into the robot's true base
+/// at the target's value, `B(e)⁻¹·W`, a base-frame work object.
+fn placed_work_object(
+    spec: &FrameSpec,
+    cell: &Cell,
+    on: Option<&OnTrack>,
+) -> Result<(WorkObject, Option<Pose>), String> {
+    let Some(on) = on else {
+        return Ok((resolve_work_object(spec, cell)?, None));
+    };
+    let world = world_work_object(spec, cell)?;
+    let in_base = WorkObject {
+        frame: WorkObjectFrame::Base,
+        pose: on.calibrated.inverse().compose(&world.pose),
+        ..world.clone()
+    };
+    Ok((in_base, Some(world.pose)))
+}
+
 /// The nominal controller's joints for a site: its solutions carrying the
 /// site's flags, the one nearest the rule's reference (`ik::choice`: the
 /// previous target's joints, else the middle of the ranges; model
@@ -234,21 +290,29 @@ impl Context<'_> {
         &self.solvers[index].2
     }
 
-    /// Solves one site after the joints `previous` (model convention).
+    /// Solves one site after the joints `previous` (model convention), its
+    /// robot base carried by the track when `on` says where (`axes`).
     pub(super) fn solve_site(
         &mut self,
         site: &Site,
         previous: Option<&[f64]>,
+        on: Option<&OnTrack>,
     ) -> Result<Solved, Failure> {
         let pose = site.pose.ok_or("the target is not a complete pose")?;
         if site.stationary_tool {
+            if on.is_some() {
+                return Err(
+                    "a stationary tool beside a robot on a track is not modelled: not filtered"
+                        .into(),
+                );
+            }
             return self.solve_stationary(site, &pose, previous);
         }
         let tool = resolve_tool(&site.tool, self.cell)?;
         let tcp = tool.tcp;
         let model = self.model;
         let (load, used_load, warnings) = choose_load(site.load, tool.load, model);
-        let wobj = resolve_work_object(&site.work_object, self.cell)?;
+        let (wobj, world) = placed_work_object(&site.work_object, self.cell, on)?;
         let used_tool = ControllerTool {
             name: tool.name,
             number: tool.number.unwrap_or(0),
@@ -259,10 +323,11 @@ impl Context<'_> {
                 inertia_kgm2: load.and_then(|l| l.inertia_kgm2),
             },
         };
+        // On a track the controller holds the work object in its world frame.
         let used_frame = ControllerFrame {
             name: wobj.name.clone(),
             number: wobj.number.unwrap_or(0),
-            pose: wobj.in_base(model),
+            pose: world.unwrap_or_else(|| wobj.in_base(model)),
         };
         // Only the cell's own items are the controller's data to hold: the
         // flange and the base frame are built in, inline frames in the program.
@@ -276,15 +341,20 @@ impl Context<'_> {
         let used_frame = cell_item(&site.work_object, false).then_some(used_frame);
         let language = self.language;
         let solver = self.solver(tcp, load);
-        let on = solve_on(solver, site, &wobj, &pose, previous, language)?;
+        let solved = solve_on(solver, site, &wobj, &pose, previous, language)?;
+        let false_target = match (on, world) {
+            (Some(on), Some(w)) => on.controller_target(&w, &solved.false_target),
+            _ => solved.false_target,
+        };
         Ok(Solved {
-            joints_deg: solver.solver().controller_degrees(&on.q),
-            shift_m: (on.false_target.p - pose.p).norm(),
-            configuration: on.configuration.map(|c| c.to_string()),
-            false_target: on.false_target,
-            q: on.q,
+            joints_deg: solver.solver().controller_degrees(&solved.q),
+            shift_m: (false_target.p - pose.p).norm(),
+            configuration: solved.configuration.map(|c| c.to_string()),
+            false_target,
+            track_mm: on.map(|o| o.value_mm),
+            q: solved.q,
             load: used_load,
-            warnings: warnings.into_iter().chain(on.warning).collect(),
+            warnings: warnings.into_iter().chain(solved.warning).collect(),
             tool: used_tool,
             frame: used_frame,
         })
@@ -340,6 +410,7 @@ impl Context<'_> {
             shift_m: (false_target.p - pose.p).norm(),
             configuration: on.configuration.map(|c| c.to_string()),
             false_target,
+            track_mm: None,
             q: on.q,
             load: used_load,
             warnings: warnings.into_iter().chain(on.warning).collect(),

@@ -175,6 +175,7 @@ impl Parser<'_> {
             after_joints: None,
             skip,
             refuse: None,
+            axes: Vec::new(),
             stationary_tool: false,
         }
     }

@@ -5,7 +5,9 @@
 //! column. Track values in millimetres; poses SI in the cell (tracker) frame.
 
 use rand_chacha::ChaCha8Rng;
+use robocal_core::calibrate::identify::{calibrate, CalibrationOptions, Method};
 use robocal_core::measure::external::{ExternalAxis, MeasurementSet};
+use robocal_core::measure::to_measurements;
 use robocal_core::model::{preset, Pose, RobotModel};
 use robocal_core::sim::track::TrueTrack;
 use robocal_core::sim::{perturb_geometry, random_configurations, ErrorMagnitudes, TrueRobot};
@@ -63,4 +65,37 @@ pub fn true_pose(truth: &TrueRobot, track: &TrueTrack, q: &[f64], value_mm: f64)
     track
         .cell_from_base(value_mm)
         .compose(&truth.true_pose_base(q, None).unwrap())
+}
+
+/// The track's value while the robot is calibrated on a fixed base [mm].
+pub const FIXED_AT_MM: f64 = 2000.0;
+
+/// The robot calibrated on a fixed base (the track standing at
+/// `FIXED_AT_MM`): 40 identification and 30 validation poses, KM. The
+/// calibrated model and the validation RMS [mm].
+pub fn calibrated_on_fixed_base(
+    nominal: &RobotModel,
+    truth: &TrueRobot,
+    track: &TrueTrack,
+    rng: &mut ChaCha8Rng,
+) -> (RobotModel, f64) {
+    let mut fixed = truth.clone();
+    fixed.tracker_from_base = track.cell_from_base(FIXED_AT_MM);
+    let rows = |n: usize, rng: &mut ChaCha8Rng| {
+        let qs = random_configurations(nominal, n, rng);
+        let r = fixed
+            .measure(&qs, Some(nominal.payload.mass), None, rng)
+            .unwrap();
+        to_measurements(nominal, &r, nominal.payload.mass)
+    };
+    let id = rows(40, rng);
+    let va = rows(30, rng);
+    let opts = CalibrationOptions {
+        methods: vec![Method::Km],
+        ..Default::default()
+    };
+    let report = calibrate(nominal, &id, &va, &opts, &|_| true).unwrap();
+    let km = &report.methods["km"];
+    let val = km.validation.as_ref().unwrap().stats.rms_mm;
+    (km.calibrated.clone(), val)
 }

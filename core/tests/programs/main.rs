@@ -7,6 +7,9 @@
 //! the nominal model on the program's configuration flags), brings the true
 //! robot's production TCP to the targets.
 
+#[path = "../common/mod.rs"]
+mod common;
+
 mod accounting;
 mod examples;
 mod export;
@@ -15,6 +18,7 @@ mod krl;
 mod motions;
 mod rapid;
 mod stationary;
+mod track;
 mod truth;
 mod urscript;
 

@@ -116,7 +116,11 @@ fn motions_name_their_positions_and_what_they_are() {
         let MotionTarget::Site(s) = found.motions[i].target else {
             panic!("{i}")
         };
-        found.sites[s].refuse.clone().unwrap()
+        let site = &found.sites[s];
+        let none = crate::program::FilterAxes::default();
+        site.refuse.clone().unwrap_or_else(|| {
+            crate::program::axes::place(crate::program::Language::Fanuc, site, &none).unwrap_err()
+        })
     };
     assert!(
         refused(4).contains("external axis E1 to 500.000 mm"),
@@ -124,5 +128,10 @@ fn motions_name_their_positions_and_what_they_are() {
         refused(4)
     );
     assert!(refused(5).contains("motion group GP2"), "{}", refused(5));
-    assert!(found.sites[0].refuse.is_none());
+    assert!(found.sites[0].refuse.is_none() && found.sites[0].axes.is_empty());
+    let MotionTarget::Site(s) = found.motions[4].target else {
+        panic!()
+    };
+    let e1 = &found.sites[s].axes[0];
+    assert_eq!((e1.number, e1.value), (1, Some(500.0)));
 }

@@ -3,7 +3,7 @@
 //! is (a Cartesian target, axis values, a frame, a load). Units: mm and
 //! degrees in the text, SI (m) in the poses, `R = Rz(A)·Ry(B)·Rx(C)`.
 
-use super::super::{external_axis_refusal, Flags};
+use super::super::{AxisValue, Flags};
 use crate::model::orientation::{rotation_from, OrientationConvention};
 use crate::model::Pose;
 use crate::solve::cell::Load;
@@ -233,12 +233,12 @@ pub(super) const POSE_KEYS: [&str; 6] = ["X", "Y", "Z", "A", "B", "C"];
 /// What an aggregate is.
 pub(super) enum Kind {
     /// A Cartesian target: its pose (or why not), flags, value ranges, and
-    /// why it is refused (an external axis `E1..E6` set to other than 0).
+    /// its external axes' values (`E1..E6` as given).
     Cartesian {
         pose: Result<Pose, String>,
         flags: Flags,
         slots: Vec<Range<usize>>,
-        refuse: Option<String>,
+        axes: Vec<AxisValue>,
     },
     /// Anything else (axis values `A1..A6`, `E1..E6` alone, a load).
     Other,
@@ -288,16 +288,26 @@ pub(super) fn classify(agg: &Agg, text: &str, offset: usize) -> Kind {
             .map(|r| Pose::new(r, Vector3::new(v[0], v[1], v[2]) * 1e-3))
             .map_err(|e| e.to_string())
     };
-    // E6POS carries the external axes E1..E6: 0 (or absent) is none.
-    let refuse = ["E1", "E2", "E3", "E4", "E5", "E6"].iter().find_map(|k| {
-        let (_, r) = get(k)?;
-        (real(value(r)) != Some(0.0)).then(|| external_axis_refusal(k, value(r)))
-    });
+    // E6POS carries the external axes E1..E6 (0 for an axis the robot does
+    // not have); a value that is not a number is one computed at run time.
+    let axes = ["E1", "E2", "E3", "E4", "E5", "E6"]
+        .iter()
+        .enumerate()
+        .filter_map(|(i, k)| {
+            let (_, r) = get(k)?;
+            Some(AxisValue {
+                number: i + 1,
+                name: (*k).to_string(),
+                value: real(value(r)),
+                text: value(r).to_string(),
+            })
+        })
+        .collect();
     Kind::Cartesian {
         pose,
         flags,
         slots,
-        refuse,
+        axes,
     }
 }
 

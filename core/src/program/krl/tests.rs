@@ -150,12 +150,16 @@ fn positions_set_at_run_time_are_named() {
 }
 
 #[test]
-fn external_axes_are_refused_naming_the_axis() {
+fn external_axes_are_read_and_refused_without_a_track_naming_the_axis() {
     let src =
         "LIN {X 1,Y 2,Z 3,A 0,B 0,C 0,E1 0.0,E2 0}\nLIN {X 1,Y 2,Z 3,A 0,B 0,C 0,E1 0,E2 250.5}\n";
     let sites = parse(&[file("e.src", src)]).unwrap().sites;
-    assert!(sites[0].refuse.is_none());
-    let why = sites[1].refuse.as_deref().unwrap();
+    let values: Vec<_> = sites[1].axes.iter().map(|a| (a.number, a.value)).collect();
+    assert_eq!(values, [(1, Some(0.0)), (2, Some(250.5))]);
+    let none = crate::program::FilterAxes::default();
+    let place = |s| crate::program::axes::place(crate::program::Language::Krl, s, &none);
+    assert!(place(&sites[0]).unwrap().is_none());
+    let why = place(&sites[1]).unwrap_err();
     assert!(why.contains("external axis E2 to 250.5"), "{why}");
 }
 

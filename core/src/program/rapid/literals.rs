@@ -5,7 +5,7 @@
 //! the text, SI (m) in the poses; unit quaternions, scalar `q1` first.
 
 use super::super::lex::{Fail, Tok, Token, Val};
-use super::super::{external_axis_refusal, Flags};
+use super::super::{AxisValue, Flags};
 use crate::model::orientation::{rotation_from, OrientationConvention};
 use crate::model::Pose;
 use crate::solve::cell::Load;
@@ -114,14 +114,14 @@ pub(super) fn tload(v: &Val) -> Option<Load> {
     })
 }
 
-/// A robtarget literal: pose, flags, value ranges, why it is refused (an
-/// external axis in use).
+/// A robtarget literal: pose, flags, value ranges, the external axes in
+/// use (not 9E9).
 pub(super) struct Target {
     pub(super) pose: Result<Pose, String>,
     pub(super) flags: Flags,
     pub(super) slots: Vec<Range<usize>>,
     pub(super) start: usize,
-    pub(super) refuse: Option<String>,
+    pub(super) axes: Vec<AxisValue>,
 }
 
 pub(super) fn robtarget(v: &Val) -> Result<Target, Fail> {
@@ -146,20 +146,30 @@ pub(super) fn robtarget(v: &Val) -> Result<Target, Fail> {
     };
     let extax = items[3].list().ok_or_else(bad)?;
     // 9E9 is an axis not in use.
-    let refuse = extax
+    let axes = extax
         .iter()
         .zip(EXTERNAL_AXES)
-        .find_map(|(e, axis)| match e {
-            Val::Num(x, _) if *x >= 8.99e9 => None,
-            Val::Num(x, _) => Some(external_axis_refusal(axis, &format!("{x}"))),
-            _ => Some(external_axis_refusal(axis, "a value computed at run time")),
-        });
+        .enumerate()
+        .filter_map(|(i, (e, axis))| {
+            let (value, text) = match e {
+                Val::Num(x, _) if *x >= 8.99e9 => return None,
+                Val::Num(x, _) => (Some(*x), format!("{x}")),
+                _ => (None, "a value computed at run time".to_string()),
+            };
+            Some(AxisValue {
+                number: i + 1,
+                name: axis.to_string(),
+                value,
+                text,
+            })
+        })
+        .collect();
     Ok(Target {
         pose,
         flags,
         slots,
         start: v.range().start,
-        refuse,
+        axes,
     })
 }
 

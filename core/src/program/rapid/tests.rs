@@ -187,6 +187,9 @@ ENDMODULE\n";
     let MotionTarget::Site(i) = found.motions[8].target else {
         panic!()
     };
-    let refused = found.sites[i].refuse.as_deref().unwrap();
+    let none = crate::program::FilterAxes::default();
+    let refused =
+        crate::program::axes::place(crate::program::Language::Rapid, &found.sites[i], &none)
+            .unwrap_err();
     assert!(refused.contains("external axis eax_b to 250"), "{refused}");
 }
