@@ -9,7 +9,7 @@
 //! value through the calibrated track, its false target through the
 //! controller's nominal one, the value kept.
 
-use crate::program::{filter_with, FilterAxes, FilterControl, Language, ProgramFile, TrackAxes};
+use crate::program::{filter_with, FilterAxes, FilterControl, Language, ProgramFile};
 use crate::solve::ik::IkSettings;
 use anyhow::{bail, Context};
 use clap::Args;
@@ -96,19 +96,13 @@ pub fn filter_report(a: &FilterArgs) -> anyhow::Result<super::exit::Outcome> {
         (Some(t), Some(n)) => Some((super::track::read_track(t)?, super::track::read_track(n)?)),
         _ => None,
     };
-    let axes = FilterAxes {
-        track: tracks.as_ref().map(|(calibrated, nominal)| TrackAxes {
-            nominal,
-            calibrated,
-        }),
-    };
     let out = filter_with(
         language,
         &files,
         &cell,
         &model,
         &IkSettings::default(),
-        &axes,
+        &FilterAxes::of_track(tracks.as_ref()),
         &FilterControl::default(),
     )?;
     std::fs::create_dir_all(&a.out_dir)

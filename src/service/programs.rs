@@ -9,7 +9,6 @@ use super::solve::{chosen_model, ModelChoice};
 use super::{AppState, ServiceError};
 use crate::program::{
     filter_with, FilterAxes, FilterControl, FilterError, FilterOutput, Language, ProgramFile,
-    TrackAxes,
 };
 use crate::solve::ik::IkSettings;
 use robocal_core::model::external::LinearTrack;
@@ -70,19 +69,13 @@ pub async fn filter_program(
             max_targets: Some(max_targets),
             keep_going: &|| flag.still_waiting(),
         };
-        let axes = FilterAxes {
-            track: tracks.as_ref().map(|(calibrated, nominal)| TrackAxes {
-                nominal,
-                calibrated,
-            }),
-        };
         let out = filter_with(
             language,
             &files,
             &cell,
             &model,
             &IkSettings::default(),
-            &axes,
+            &FilterAxes::of_track(tracks.as_ref()),
             &control,
         );
         if matches!(out, Err(FilterError::Cancelled)) {

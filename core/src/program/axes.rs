@@ -44,6 +44,19 @@ pub struct FilterAxes<'a> {
     pub track: Option<TrackAxes<'a>>,
 }
 
+impl<'a> FilterAxes<'a> {
+    /// The axes of a robot on a track, when `track` (calibrated, nominal)
+    /// is given; none otherwise.
+    pub fn of_track(track: Option<&'a (LinearTrack, LinearTrack)>) -> Self {
+        FilterAxes {
+            track: track.map(|(calibrated, nominal)| TrackAxes {
+                nominal,
+                calibrated,
+            }),
+        }
+    }
+}
+
 /// The controller's number of the track's axis.
 pub const TRACK_AXIS: usize = 1;
 

@@ -24,7 +24,7 @@ fn literal(p: &Pose, cf: [i32; 4]) -> String {
     )
 }
 
-fn frame(p: &Pose) -> String {
+pub(super) fn frame(p: &Pose) -> String {
     let q = rotation_to(OrientationConvention::AbbQ1q4, &p.r);
     format!(
         "[[{:.4},{:.4},{:.4}],[{:.9},{:.9},{:.9},{:.9}]]",

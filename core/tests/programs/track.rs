@@ -23,7 +23,7 @@ use robocal_core::model::external::{LinearTrack, Travel};
 use robocal_core::model::orientation::{rotation_to, OrientationConvention};
 use robocal_core::program::{
     abb_cf, fanuc_config, fanuc_config_text, filter_with, kuka_status, kuka_turn, track_axis_name,
-    FilterAxes, FilterControl, TrackAxes,
+    FilterAxes, FilterControl, FilterOutput, TrackAxes,
 };
 use robocal_core::sim::track::TrueTrack;
 use robocal_core::sim::TrueRobot;
@@ -264,19 +264,7 @@ fn krl(c: &TrackCell) -> Vec<ProgramFile> {
 /// RAPID with the torch and the part declared in the module, the part a
 /// fixed user frame in the world (`ufprog TRUE`, no mechanical unit).
 fn rapid(c: &TrackCell) -> Vec<ProgramFile> {
-    let frame = |p: &Pose| {
-        let q = rotation_to(OrientationConvention::AbbQ1q4, &p.r);
-        format!(
-            "[[{:.4},{:.4},{:.4}],[{:.9},{:.9},{:.9},{:.9}]]",
-            p.p.x * 1e3,
-            p.p.y * 1e3,
-            p.p.z * 1e3,
-            q[0],
-            q[1],
-            q[2],
-            q[3]
-        )
-    };
+    use super::rapid::frame;
     let mut text = format!(
         "MODULE Rail\r\n  PERS tooldata torch:=[TRUE,{},[10,[0,0,100],[1,0,0,0],0,0,0]];\r\n  \
          TASK PERS wobjdata part:=[FALSE,TRUE,\"\",{},[[0,0,0],[1,0,0,0]]];\r\n",
@@ -345,6 +333,20 @@ fn fanuc(c: &TrackCell) -> Vec<ProgramFile> {
     }]
 }
 
+/// `files` filtered through the cell's track.
+fn filter_on_track(c: &TrackCell, language: Language, files: &[ProgramFile]) -> FilterOutput {
+    filter_with(
+        language,
+        files,
+        &c.cell,
+        &c.model,
+        &settings(),
+        &c.axes(),
+        &FilterControl::default(),
+    )
+    .unwrap()
+}
+
 fn rms(v: &[f64]) -> f64 {
     (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
 }
@@ -356,16 +358,7 @@ fn rms(v: &[f64]) -> f64 {
 /// unfiltered program millimetres off.
 fn assert_on_track(language: Language, files: &[ProgramFile]) {
     let c = track_cell();
-    let out = filter_with(
-        language,
-        files,
-        &c.cell,
-        &c.model,
-        &settings(),
-        &c.axes(),
-        &FilterControl::default(),
-    )
-    .unwrap();
+    let out = filter_on_track(c, language, files);
     let r = &out.report;
     assert_eq!(
         (r.filtered, r.failed, r.skipped),
@@ -437,16 +430,7 @@ fn a_track_value_the_cell_cannot_compose_is_refused_naming_it() {
             text: files[1].text.replacen("E1 50.000", "E1 4100.000", 1),
         },
     ];
-    let out = filter_with(
-        Language::Krl,
-        &beyond,
-        &c.cell,
-        &c.model,
-        &settings(),
-        &c.axes(),
-        &FilterControl::default(),
-    )
-    .unwrap();
+    let out = filter_on_track(c, Language::Krl, &beyond);
     assert_eq!((out.report.filtered, out.report.failed), (49, 1));
     let why = out.report.targets[0].reason.as_deref().unwrap();
     assert!(
