@@ -132,3 +132,182 @@ fn filter_cli_reports_parse_errors_and_guesses_the_language() {
     .unwrap_err();
     assert!(err.to_string().contains("--language"), "{err}");
 }
+
+/// `--positioner FILE --nominal-positioner FILE`: a KRL program whose base 3
+/// sits on the positioner's face plate (cell file `frame: face_plate`), each
+/// target at its own `E1`, `E2`; the report names the axes and each
+/// target's values, and equals the core's filter through the same
+/// positioners. The CLI refuses a track beside a positioner and one of the
+/// pair alone; without the positioner every target fails naming its axis.
+/// (How close the filtered targets bring a true tool to the true part is
+/// the core's test, `core/tests/programs/positioner.rs`.)
+#[test]
+fn filter_cli_composes_a_positioner_with_its_values() {
+    use nalgebra::Vector3;
+    use robocal::model::external::{RotaryAxis, TiltRotate};
+    use robocal::model::Pose;
+    use robocal::program::{filter_with, kuka_status, kuka_turn, FilterAxes, FilterControl};
+    use robocal::solve::ik::{AnalyticIk, IkSettings};
+    let dir = tempfile::tempdir().unwrap();
+    let nominal = preset("ys100").unwrap();
+    let model = synthetic_calibration(&nominal, &SyntheticErrors::typical(1e-6), 4);
+    let model_path = dir.path().join("cal.json");
+    save_model_file(
+        &CalibratedModelFile::from_compensated(&model, "ys100", "km"),
+        &model_path,
+    )
+    .unwrap();
+    // The controller's positioner 1.6 m in front of the robot; the cell's
+    // with its rotate axis 0.3° round and its tilt axis 0.5 mm higher.
+    let drawing = TiltRotate {
+        cell_from_base: Pose::from_translation(Vector3::new(1.6, 0.0, -0.9)),
+        tilt: RotaryAxis::new(Vector3::x(), Vector3::new(0.0, 0.0, 0.8), 0.0, 1.0),
+        rotate: RotaryAxis::new(Vector3::z(), Vector3::zeros(), 0.0, 1.0),
+        face_plate: Pose::from_translation(Vector3::new(0.0, 0.0, 1.1)),
+    };
+    let mut cell_positioner = drawing;
+    cell_positioner.cell_from_base = model.cell_from_base.compose(&drawing.cell_from_base);
+    cell_positioner.rotate =
+        RotaryAxis::new(Vector3::z(), Vector3::zeros(), 0.3f64.to_radians(), 1.0);
+    cell_positioner.tilt = RotaryAxis::new(Vector3::x(), Vector3::new(0.0, 0.0, 0.8005), 0.0, 1.0);
+    let (positioner_path, drawing_path) =
+        (dir.path().join("stn.json"), dir.path().join("drawing.json"));
+    std::fs::write(&positioner_path, cell_positioner.to_json()).unwrap();
+    std::fs::write(&drawing_path, drawing.to_json()).unwrap();
+    let part = Pose::from_translation(Vector3::new(0.1, 0.05, 0.06));
+    let cell_path = dir.path().join("cell.json");
+    std::fs::write(
+        &cell_path,
+        r#"{"tools": [{"name": "torch", "number": 1, "xyz_mm": [125.0, 0.0, 216.50635], "rpy_deg": [0.0, 30.0, 0.0]}],
+            "work_objects": [{"name": "part", "number": 3, "frame": "face_plate", "xyz_mm": [100.0, 50.0, 60.0], "rpy_deg": [0.0, 0.0, 0.0]}]}"#,
+    )
+    .unwrap();
+    // Targets the controller reaches: where its nominal robot puts the
+    // torch at joints `q`, in the part as it computes it at values `v`.
+    let mut controller = nominal.clone();
+    controller.tool = robocal::model::Tool {
+        p: Vector3::new(0.125, 0.0, 0.21650635),
+        rpy: [0.0, 30f64.to_radians(), 0.0],
+    };
+    let ik = AnalyticIk::new(&controller).unwrap();
+    let (mut src, mut dat) = (
+        String::from("DEF turn()\r\nBAS(#TOOL, 1)\r\nBAS(#BASE, 3)\r\n"),
+        String::from("DEFDAT turn\r\n"),
+    );
+    let values = [[10.0, -30.0], [-20.0, 75.0], [35.0, 160.0], [0.0, 0.0]];
+    for (i, v) in values.iter().enumerate() {
+        let q = [0.1 * i as f64, 1.4, -0.2, 0.3, 0.8, -0.5];
+        // The controller's model carries the torch as its tool.
+        let tcp = robocal::model::kinematics::fk(&controller, &q).unwrap();
+        let t = drawing
+            .cell_from_face_plate(*v)
+            .compose(&part)
+            .inverse()
+            .compose(&tcp);
+        let abc = robocal::model::orientation::rotation_to(
+            robocal::model::orientation::OrientationConvention::KukaAbc,
+            &t.r,
+        );
+        let deg: Vec<f64> = controller
+            .joints_to_controller(&q)
+            .iter()
+            .map(|x| x.to_degrees())
+            .collect();
+        let conf = ik.configuration(&q).unwrap();
+        src.push_str(&format!("LIN XP{i}\r\n"));
+        dat.push_str(&format!(
+            "DECL E6POS XP{i}={{X {:.4},Y {:.4},Z {:.4},A {:.4},B {:.4},C {:.4},S {},T {},E1 {},E2 {},E3 0.0,E4 0.0,E5 0.0,E6 0.0}}\r\n",
+            t.p.x * 1e3, t.p.y * 1e3, t.p.z * 1e3, abc[0], abc[1], abc[2],
+            kuka_status(&deg, conf), kuka_turn(&deg), v[0], v[1]
+        ));
+    }
+    src.push_str("END\r\n");
+    dat.push_str("ENDDAT\r\n");
+    let (src_path, dat_path) = (dir.path().join("turn.src"), dir.path().join("turn.dat"));
+    std::fs::write(&src_path, &src).unwrap();
+    std::fs::write(&dat_path, &dat).unwrap();
+    let out_dir = dir.path().join("out");
+    let p = |x: &PathBuf| x.to_str().unwrap().to_string();
+    let base = [
+        "--model".to_string(),
+        p(&model_path),
+        "--cell".into(),
+        p(&cell_path),
+        "--out-dir".into(),
+        p(&out_dir),
+        p(&src_path),
+        p(&dat_path),
+    ];
+    let with = |extra: &[String]| {
+        let mut v: Vec<String> = base.to_vec();
+        v.extend_from_slice(extra);
+        v
+    };
+    let axes = [
+        "--positioner".to_string(),
+        p(&positioner_path),
+        "--nominal-positioner".into(),
+        p(&drawing_path),
+    ];
+    let argv = with(&axes);
+    let report =
+        filter_to_string(&args(&argv.iter().map(String::as_str).collect::<Vec<_>>())).unwrap();
+    let report: serde_json::Value = serde_json::from_str(&report).unwrap();
+    assert_eq!(report["positioner_axes"], serde_json::json!(["E1", "E2"]));
+    assert_eq!(
+        (report["filtered"].as_u64(), report["failed"].as_u64()),
+        (Some(4), Some(0)),
+        "{report:#}"
+    );
+    for (t, v) in report["targets"].as_array().unwrap().iter().zip(&values) {
+        assert_eq!(t["positioner_deg"], serde_json::json!(v));
+        // 0.3° about axis 2 and 0.5 mm: millimetres at the part.
+        assert!(t["shift_mm"].as_f64().unwrap() > 0.1, "{t}");
+    }
+    // The core's filter through the same positioners gives the same report.
+    let files = [file(&src_path), file(&dat_path)];
+    // The cell as the command line reads it (mm and degrees converted once).
+    let cell = robocal::cli::model_files::load_cell(Some(&p(&cell_path))).unwrap();
+    let read = |x: &PathBuf| TiltRotate::from_json(&std::fs::read_to_string(x).unwrap()).unwrap();
+    let pair = (read(&positioner_path), read(&drawing_path));
+    let loaded = robocal::cli::model_files::load_compensated(&p(&model_path)).unwrap();
+    let core = filter_with(
+        Language::Krl,
+        &files,
+        &cell,
+        &loaded,
+        &IkSettings::default(),
+        &FilterAxes::of_positioner(Some(&pair)),
+        &FilterControl::default(),
+    )
+    .unwrap();
+    assert_eq!(serde_json::to_value(&core.report).unwrap(), report);
+    // Refused: a track beside a positioner, one of the pair alone.
+    let track = [
+        "--track".to_string(),
+        p(&positioner_path),
+        "--nominal-track".into(),
+        p(&drawing_path),
+    ];
+    let both = with(&[axes.to_vec(), track.to_vec()].concat());
+    let mut v = vec!["robocal", "filter"];
+    v.extend(both.iter().map(String::as_str));
+    assert!(robocal::cli::Cli::try_parse_from(v).is_err());
+    let alone = with(&axes[..2]);
+    let mut v = vec!["robocal", "filter"];
+    v.extend(alone.iter().map(String::as_str));
+    assert!(robocal::cli::Cli::try_parse_from(v).is_err());
+    // Without the positioner every target fails naming its axis.
+    let report =
+        filter_to_string(&args(&base.iter().map(String::as_str).collect::<Vec<_>>())).unwrap();
+    let report: serde_json::Value = serde_json::from_str(&report).unwrap();
+    assert_eq!(report["failed"].as_u64(), Some(4));
+    assert!(report["targets"][0]["reason"]
+        .as_str()
+        .unwrap()
+        .contains("external axis E1"));
+    assert!(report["targets"][3]["reason"]
+        .as_str()
+        .unwrap()
+        .contains("work object part is on the positioner's face plate"));
+}

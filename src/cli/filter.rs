@@ -7,12 +7,18 @@
 //! --nominal-track FILE` the robot rides a linear track, axis 1 of the
 //! program (`core::program::axes`): each target composed at its own track
 //! value through the calibrated track, its false target through the
-//! controller's nominal one, the value kept.
+//! controller's nominal one, the value kept. With `--positioner FILE
+//! --nominal-positioner FILE` the work objects on the positioner's face
+//! plate (cell frame `face_plate`, RAPID `ufprog FALSE`) turn with it, axes 1
+//! and 2 of the program (Fanuc: `J1`, `J2` of `GP2`): each target composed
+//! at its own values through the calibrated positioner, its false target
+//! through the controller's nominal one, the values kept.
 
 use crate::program::{filter_with, FilterAxes, FilterControl, Language, ProgramFile};
 use crate::solve::ik::IkSettings;
 use anyhow::{bail, Context};
 use clap::Args;
+use robocal_core::model::external::TiltRotate;
 use std::path::{Path, PathBuf};
 
 /// Arguments of `robocal filter`.
@@ -42,6 +48,16 @@ pub struct FilterArgs {
     /// no maps, in the same cell frame), how it places the robot at a value.
     #[arg(long, requires = "track")]
     pub nominal_track: Option<String>,
+    /// The calibrated positioner carrying the face-plate work objects
+    /// (`robocal positioner calibrate`'s output, in the cell frame the
+    /// robot's model is registered in), program axes 1 and 2 (KRL E1, E2,
+    /// RAPID eax_a, eax_b, Fanuc J1, J2 of GP2).
+    #[arg(long, requires = "nominal_positioner", conflicts_with = "track")]
+    pub positioner: Option<String>,
+    /// The controller's own positioner (the same JSON: its drawing's or its
+    /// own calibration's axes), in its world frame: the robot's base frame.
+    #[arg(long, requires = "positioner")]
+    pub nominal_positioner: Option<String>,
     /// Directory for the filtered files (same names as the inputs).
     #[arg(long)]
     pub out_dir: PathBuf,
@@ -96,13 +112,21 @@ pub fn filter_report(a: &FilterArgs) -> anyhow::Result<super::exit::Outcome> {
         (Some(t), Some(n)) => Some((super::track::read_track(t)?, super::track::read_track(n)?)),
         _ => None,
     };
+    let positioners = match (&a.positioner, &a.nominal_positioner) {
+        (Some(p), Some(n)) => Some((read_positioner(p)?, read_positioner(n)?)),
+        _ => None,
+    };
+    let axes = match &positioners {
+        Some(_) => FilterAxes::of_positioner(positioners.as_ref()),
+        None => FilterAxes::of_track(tracks.as_ref()),
+    };
     let out = filter_with(
         language,
         &files,
         &cell,
         &model,
         &IkSettings::default(),
-        &FilterAxes::of_track(tracks.as_ref()),
+        &axes,
         &FilterControl::default(),
     )?;
     std::fs::create_dir_all(&a.out_dir)
@@ -117,6 +141,13 @@ pub fn filter_report(a: &FilterArgs) -> anyhow::Result<super::exit::Outcome> {
         not_done: out.report.failed + out.report.skipped,
         total: out.report.targets.len(),
     })
+}
+
+/// A positioner description file (`model::external::positioner`, JSON).
+fn read_positioner(path: &str) -> anyhow::Result<TiltRotate> {
+    let json = std::fs::read_to_string(path)
+        .with_context(|| format!("cannot read positioner file {path}"))?;
+    TiltRotate::from_json(&json).with_context(|| format!("positioner file {path}"))
 }
 
 /// Writes the filtered files and the report; the exit code says whether a

@@ -1,28 +1,43 @@
-//! External axes in the filter: the robot's linear track, controller axis 1
-//! (KRL `E1`, RAPID `eax_a`, Fanuc `E1` of `GP1`), composed both as the
-//! controller composes it (its nominal track) and as the cell really is (the
-//! calibrated track, `model::external::track`).
+//! External axes in the filter, composed both as the controller composes
+//! them (its nominal models) and as the cell really is (the calibrated
+//! ones): the robot's linear track, controller axis 1 (KRL `E1`, RAPID
+//! `eax_a`, Fanuc `E1` of `GP1`, `model::external::track`), or a two-axis
+//! positioner carrying the work object (KRL `E1`, `E2`, RAPID `eax_a`,
+//! `eax_b`, Fanuc `J1`, `J2` of `GP2`, `model::external::positioner`).
 //!
-//! Frames: the controller's world frame is the cell frame both tracks are
+//! One rule for both: the robot's own solve runs on the base-frame work
+//! object `S` as the cell really is, giving the calibrated joints `q` and,
+//! in `S`, the false target `F` with `S·F = FK_nominal(q)·tool` (DESIGN.md,
+//! false targets); the controller computes the work object as `S_nom` and,
+//! given `T'`, solves `S_nom·T'` on its nominal model, which must be
+//! `FK_nominal(q)·tool`: `T' = S_nom⁻¹·S·F` ([`controller_target`]).
+//!
+//! Track: the controller's world frame is the cell frame both tracks are
 //! stated in (the frame the track was measured in, where the controller's
 //! nominal rail is placed); the program's work objects are world frames
 //! (`$BASE` on `$WORLD`, a `wobjdata`'s user frame, a user frame `UF`). At a
 //! target's track value `e` [mm] the controller puts the robot base at
-//! `N(e)` (the nominal track) and the robot really stands at `B(e)` (the
-//! calibrated track). For a target `T` in work object `W` (cell frame):
-//! - the robot's own solve runs on the base-frame work object `B(e)⁻¹·W`,
-//!   giving the calibrated joints `q` and, in that frame, the false target
-//!   `F` with `B(e)⁻¹·W·F = FK_nominal(q)·tool` (DESIGN.md, false targets);
-//! - the controller, given `T'` at `e`, solves `N(e)⁻¹·W·T'` on its nominal
-//!   model, which must be `FK_nominal(q)·tool`: `T' = W⁻¹·N(e)·B(e)⁻¹·W·F`.
+//! `N(e)` (the nominal track), the robot really stands at `B(e)` (the
+//! calibrated track): for a work object `W`, `S = B(e)⁻¹·W`,
+//! `S_nom = N(e)⁻¹·W`.
 //!
-//! The track's value stays as programmed (the filter moves the target, not
-//! the carriage). Any other external axis in use is refused, naming it, as
-//! is a track value beyond either track's travel. Units: the programs' mm
-//! for track values, SI poses.
+//! Positioner: a work object `W_f` stated on the face plate (KRL `BASE_DATA`
+//! of a base coupled to the positioner, RAPID's object frame of a `wobjdata`
+//! with `ufprog FALSE`, Fanuc's user frame of coordinated motion). At the
+//! target's values `v` [deg] the calibrated positioner puts the plate at
+//! `P(v)` in the cell frame the robot is registered in (`base_from_cell`
+//! the robot's registration), the controller's nominal positioner at
+//! `P_nom(v)` in its world frame, which on a fixed base is the robot's base
+//! frame: `S = base_from_cell·P(v)·W_f`, `S_nom = P_nom(v)·W_f`.
+//!
+//! The axes' values stay as programmed (the filter moves the target, not
+//! the axes). Any other external axis in use is refused, naming it, as is a
+//! track value beyond either track's travel, and a track and a positioner
+//! together. Units: the programs' mm for track values and degrees for the
+//! positioner's, SI poses.
 
-use super::{external_axis_refusal, Language, Site};
-use crate::model::external::LinearTrack;
+use super::{external_axis_refusal, AxisValue, Language, Site};
+use crate::model::external::{LinearTrack, TiltRotate};
 use crate::model::Pose;
 
 /// The robot's linear track in a filter: what the controller computes and
@@ -36,12 +51,28 @@ pub struct TrackAxes<'a> {
     pub calibrated: &'a LinearTrack,
 }
 
+/// The positioner carrying work objects in a filter: what the controller
+/// computes and what the cell is.
+#[derive(Debug, Clone, Copy)]
+pub struct PositionerAxes<'a> {
+    /// The controller's own positioner (its drawing's or its own
+    /// calibration's axis lines), in the controller's world frame: the
+    /// robot's base frame on a fixed base.
+    pub nominal: &'a TiltRotate,
+    /// The calibrated positioner, in the cell (tracker) frame the robot's
+    /// calibrated model is registered in.
+    pub calibrated: &'a TiltRotate,
+}
+
 /// The external axes a filter composes through (none by default: every
 /// external axis in use is refused).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct FilterAxes<'a> {
     /// The track carrying the robot, controller axis 1.
     pub track: Option<TrackAxes<'a>>,
+    /// The positioner carrying work objects on its face plate, axes 1 and 2
+    /// (Fanuc: `J1`, `J2` of motion group 2).
+    pub positioner: Option<PositionerAxes<'a>>,
 }
 
 impl<'a> FilterAxes<'a> {
@@ -50,6 +81,19 @@ impl<'a> FilterAxes<'a> {
     pub fn of_track(track: Option<&'a (LinearTrack, LinearTrack)>) -> Self {
         FilterAxes {
             track: track.map(|(calibrated, nominal)| TrackAxes {
+                nominal,
+                calibrated,
+            }),
+            positioner: None,
+        }
+    }
+
+    /// The axes of a cell with a positioner, when `positioner`
+    /// (calibrated, nominal) is given; none otherwise.
+    pub fn of_positioner(positioner: Option<&'a (TiltRotate, TiltRotate)>) -> Self {
+        FilterAxes {
+            track: None,
+            positioner: positioner.map(|(calibrated, nominal)| PositionerAxes {
                 nominal,
                 calibrated,
             }),
@@ -68,6 +112,32 @@ pub fn track_axis_name(language: Language) -> &'static str {
     }
 }
 
+/// The motion group of the positioner's axes in a language: Fanuc moves a
+/// positioner as group 2, KRL and RAPID as the robot's external axes.
+pub fn positioner_group(language: Language) -> u32 {
+    match language {
+        Language::Fanuc => 2,
+        Language::Krl | Language::Rapid | Language::UrScript => 1,
+    }
+}
+
+/// The names a language gives the positioner's axes 1 (tilt) and 2
+/// (rotate).
+pub fn positioner_axis_names(language: Language) -> [&'static str; 2] {
+    match language {
+        Language::Rapid => ["eax_a", "eax_b"],
+        Language::Fanuc => ["J1 of motion group GP2", "J2 of motion group GP2"],
+        Language::Krl | Language::UrScript => ["E1", "E2"],
+    }
+}
+
+/// The controller's false target `T' = S_nom⁻¹·S·F` of the false target `F`
+/// solved in the base-frame work object `S` as the cell is, the controller
+/// computing that work object as `S_nom` (module docs).
+pub(super) fn controller_target(s_nom: &Pose, s: &Pose, false_in_s: &Pose) -> Pose {
+    s_nom.inverse().compose(s).compose(false_in_s)
+}
+
 /// A target's robot base, as the controller holds it and as it is, at the
 /// target's track value.
 #[derive(Debug, Clone, Copy)]
@@ -81,37 +151,93 @@ pub(super) struct OnTrack {
 }
 
 impl OnTrack {
-    /// The controller's false target `T' = W⁻¹·N(e)·B(e)⁻¹·W·F` of the false
-    /// target `F` solved in the base-frame work object `B(e)⁻¹·W`.
-    pub(super) fn controller_target(&self, work_object: &Pose, false_in_base: &Pose) -> Pose {
-        work_object
-            .inverse()
-            .compose(&self.nominal)
-            .compose(&self.calibrated.inverse())
-            .compose(work_object)
-            .compose(false_in_base)
+    /// `S = B(e)⁻¹·W` and `S_nom = N(e)⁻¹·W` of a world-frame work object
+    /// `W` (module docs).
+    pub(super) fn work_object(&self, world: &Pose) -> (Pose, Pose) {
+        (
+            self.calibrated.inverse().compose(world),
+            self.nominal.inverse().compose(world),
+        )
     }
 }
 
-/// Where a site's robot base is: `None` on a fixed base (no axis in use,
-/// no track), the track's two bases at its value, or why the site is
-/// refused (an axis the cell does not model, no track value, a value beyond
-/// the travel).
+/// A target's positioner face plate, as the controller holds it and as it
+/// is, at the target's values.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct OnPositioner {
+    /// The values as programmed, axis 1 and axis 2 [deg].
+    pub(super) values_deg: [f64; 2],
+    /// `P_nom(v)`: the plate in the controller's world (the robot's base
+    /// frame) by its nominal positioner.
+    pub(super) nominal: Pose,
+    /// `P(v)`: the plate in the cell frame by the calibrated positioner.
+    pub(super) calibrated: Pose,
+}
+
+impl OnPositioner {
+    /// `S = base_from_cell·P(v)·W_f` and `S_nom = P_nom(v)·W_f` of a work
+    /// object `W_f` on the face plate, `base_from_cell` the robot's
+    /// registration (module docs).
+    pub(super) fn work_object(&self, base_from_cell: &Pose, on_plate: &Pose) -> (Pose, Pose) {
+        (
+            base_from_cell.compose(&self.calibrated).compose(on_plate),
+            self.nominal.compose(on_plate),
+        )
+    }
+}
+
+/// Where a site's axes put the robot base and the positioner's face plate.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct Placement {
+    /// The track's two bases at the target's value, on a track.
+    pub(super) track: Option<OnTrack>,
+    /// The positioner's two face plates, when the target gives its values
+    /// (required of a target in a work object on the plate).
+    pub(super) positioner: Option<OnPositioner>,
+    /// Whether the filter was given a positioner at all.
+    pub(super) with_positioner: bool,
+}
+
+/// Whether `a` is one of the axes the cell's `axes` compose in `language`.
+fn composed(language: Language, axes: &FilterAxes, a: &AxisValue) -> bool {
+    let track = axes.track.is_some() && a.group == 1 && a.number == TRACK_AXIS;
+    let positioner = axes.positioner.is_some()
+        && a.group == positioner_group(language)
+        && (a.number == 1 || a.number == 2);
+    track || positioner
+}
+
+/// Where a site's axes put the robot base and the positioner's plate
+/// ([`Placement`], empty on a fixed base without axes in use), or why the
+/// site is refused (an axis the cell does not model, no track value, a value
+/// beyond the travel, a track and a positioner together, one positioner
+/// value without the other).
 pub(super) fn place(
     language: Language,
     site: &Site,
     axes: &FilterAxes,
-) -> Result<Option<OnTrack>, String> {
-    let track_number = axes.track.map(|_| TRACK_AXIS);
+) -> Result<Placement, String> {
+    if axes.track.is_some() && axes.positioner.is_some() {
+        return Err(
+            "a robot on a track with a part on a positioner is not modelled: not filtered".into(),
+        );
+    }
     if let Some(other) = site
         .axes
         .iter()
-        .find(|a| Some(a.number) != track_number && a.in_use(language))
+        .find(|a| !composed(language, axes, a) && a.in_use(language))
     {
         return Err(external_axis_refusal(&other.name, &other.text));
     }
+    if let Some(p) = axes.positioner {
+        return Ok(Placement {
+            track: None,
+            positioner: on_positioner(language, site, &p)?,
+            with_positioner: true,
+        });
+    }
     let Some(track) = axes.track else {
-        return Ok(None);
+        return Ok(Placement::default());
     };
     let name = track_axis_name(language);
     let given = site.axes.iter().find(|a| a.number == TRACK_AXIS);
@@ -139,10 +265,57 @@ pub(super) fn place(
         .calibrated
         .cell_from_base(value_mm)
         .map_err(|e| format!("the track's axis {name}: {e}: not filtered"))?;
-    Ok(Some(OnTrack {
-        value_mm,
-        nominal,
-        calibrated,
+    Ok(Placement {
+        track: Some(OnTrack {
+            value_mm,
+            nominal,
+            calibrated,
+        }),
+        positioner: None,
+        with_positioner: false,
+    })
+}
+
+/// The positioner's plates at a site's values: `None` when the site gives
+/// neither value; refused when it gives one without the other or one that
+/// is not a number.
+fn on_positioner(
+    language: Language,
+    site: &Site,
+    p: &PositionerAxes,
+) -> Result<Option<OnPositioner>, String> {
+    let group = positioner_group(language);
+    let names = positioner_axis_names(language);
+    let given = |k: usize| site.axes.iter().find(|a| a.group == group && a.number == k);
+    let values = match (given(1), given(2)) {
+        (None, None) => return Ok(None),
+        (Some(a), Some(b)) => [a, b].map(|a| a.value.ok_or_else(|| a.clone())),
+        (a, _) => {
+            let missing = if a.is_none() { names[0] } else { names[1] };
+            return Err(format!(
+                "the target moves the positioner and gives no value for its axis {missing}: not filtered"
+            ));
+        }
+    };
+    let [v1, v2] = values;
+    let value = |v: Result<f64, AxisValue>| {
+        v.map_err(|a| {
+            format!(
+                "the positioner's axis {} is {}: not filtered",
+                a.name,
+                if a.text.is_empty() {
+                    "not a number"
+                } else {
+                    &a.text
+                }
+            )
+        })
+    };
+    let values_deg = [value(v1)?, value(v2)?];
+    Ok(Some(OnPositioner {
+        values_deg,
+        nominal: p.nominal.cell_from_face_plate(values_deg),
+        calibrated: p.calibrated.cell_from_face_plate(values_deg),
     }))
 }
 
@@ -183,6 +356,7 @@ mod tests {
             name: name.into(),
             value,
             text: value.map_or("v".into(), |v| format!("{v}")),
+            group: 1,
         }
     }
 
@@ -205,7 +379,7 @@ mod tests {
     fn without_a_track_an_axis_in_use_is_refused_and_krl_zeros_are_none() {
         let none = FilterAxes::default();
         let krl = site(vec![axis(1, "E1", Some(0.0)), axis(2, "E2", Some(0.0))]);
-        assert!(place(Language::Krl, &krl, &none).unwrap().is_none());
+        assert!(place(Language::Krl, &krl, &none).unwrap().track.is_none());
         // A Fanuc or RAPID axis at 0 is an axis the robot has.
         let why = place(Language::Fanuc, &krl, &none).unwrap_err();
         assert!(why.contains("external axis E1 to 0"), "{why}");
@@ -225,9 +399,10 @@ mod tests {
                 nominal: &nominal,
                 calibrated: &calibrated,
             }),
+            positioner: None,
         };
         let s = site(vec![axis(1, "E1", Some(2000.0)), axis(2, "E2", Some(0.0))]);
-        let on = place(Language::Krl, &s, &axes).unwrap().unwrap();
+        let on = place(Language::Krl, &s, &axes).unwrap().track.unwrap();
         assert_eq!(on.value_mm, 2000.0);
         // Scale 1.0002: the calibrated base 0.4 mm further along the rail.
         assert!((on.calibrated.p.x - on.nominal.p.x - 0.0004).abs() < 1e-12);
@@ -235,7 +410,11 @@ mod tests {
         // A KRL value of 0 on the track is the track at 0.
         let s = site(vec![axis(1, "E1", Some(0.0))]);
         assert_eq!(
-            place(Language::Krl, &s, &axes).unwrap().unwrap().value_mm,
+            place(Language::Krl, &s, &axes)
+                .unwrap()
+                .track
+                .unwrap()
+                .value_mm,
             0.0
         );
         let cases = [
@@ -262,6 +441,7 @@ mod tests {
                 nominal: &nominal,
                 calibrated: &short,
             }),
+            positioner: None,
         };
         let why = place(
             Language::Krl,
@@ -288,10 +468,103 @@ mod tests {
             nominal: n,
             calibrated: b,
         };
-        let t = on.controller_target(&w, &f);
+        let (s, s_nom) = on.work_object(&w);
+        let t = controller_target(&s_nom, &s, &f);
         let controller = n.inverse().compose(&w).compose(&t);
         let truth = b.inverse().compose(&w).compose(&f);
         assert!((controller.p - truth.p).norm() < 1e-12);
         assert!((controller.r - truth.r).norm() < 1e-12);
+    }
+
+    fn turntable(zero_deg: f64) -> TiltRotate {
+        use crate::model::external::RotaryAxis;
+        TiltRotate {
+            cell_from_base: Pose::from_translation(Vector3::new(1.5, 0.0, 0.0)),
+            tilt: RotaryAxis::new(Vector3::x(), Vector3::zeros(), 0.0, 1.0),
+            rotate: RotaryAxis::new(Vector3::z(), Vector3::zeros(), zero_deg.to_radians(), 1.0),
+            face_plate: Pose::from_translation(Vector3::new(0.0, 0.0, 0.5)),
+        }
+    }
+
+    /// Closed form: a turntable whose calibrated zero is 1° off the
+    /// controller's, turned to 90°: the plate 90° round by the controller,
+    /// 91° by the cell; a part 1 m from the axis on the plate is 17.45 mm
+    /// from where the controller puts it.
+    #[test]
+    fn on_a_positioner_its_values_turn_both_plates_and_a_lone_value_is_refused() {
+        let (nominal, calibrated) = (turntable(0.0), turntable(1.0));
+        let axes = FilterAxes {
+            track: None,
+            positioner: Some(PositionerAxes {
+                nominal: &nominal,
+                calibrated: &calibrated,
+            }),
+        };
+        let s = site(vec![axis(1, "E1", Some(0.0)), axis(2, "E2", Some(90.0))]);
+        let on = place(Language::Krl, &s, &axes).unwrap().positioner.unwrap();
+        assert_eq!(on.values_deg, [0.0, 90.0]);
+        let part = Pose::from_translation(Vector3::new(1.0, 0.0, 0.0));
+        let (real, controller) = on.work_object(&Pose::identity(), &part);
+        assert!((controller.p - Vector3::new(1.5, 1.0, 0.5)).norm() < 1e-12);
+        let one = 1f64.to_radians();
+        let want = Vector3::new(1.5 - one.sin(), one.cos(), 0.5);
+        assert!((real.p - want).norm() < 1e-12, "{}", real.p);
+        // Fanuc: the positioner is motion group 2; GP1's E1 is not its axis.
+        let gp2 = |n: usize, v: f64| AxisValue {
+            group: 2,
+            ..axis(n, &format!("J{n} of motion group GP2"), Some(v))
+        };
+        let s = site(vec![gp2(1, 0.0), gp2(2, 90.0)]);
+        let on = place(Language::Fanuc, &s, &axes)
+            .unwrap()
+            .positioner
+            .unwrap();
+        assert_eq!(on.values_deg, [0.0, 90.0]);
+        // No value: no plate (a target in a fixed work object).
+        assert!(place(Language::Krl, &site(vec![]), &axes)
+            .unwrap()
+            .positioner
+            .is_none());
+        let cases = [
+            (
+                Language::Krl,
+                site(vec![axis(2, "E2", Some(5.0))]),
+                "no value for its axis E1",
+            ),
+            (
+                Language::Rapid,
+                site(vec![axis(1, "eax_a", Some(5.0))]),
+                "no value for its axis eax_b",
+            ),
+            (
+                Language::Fanuc,
+                site(vec![gp2(1, 5.0), gp2(3, 1.0)]),
+                "external axis J3 of motion group GP2 to 1",
+            ),
+            (
+                Language::Fanuc,
+                site(vec![gp2(1, 5.0), gp2(2, 1.0), axis(1, "E1", Some(3.0))]),
+                "external axis E1 to 3",
+            ),
+            (
+                Language::Krl,
+                site(vec![axis(1, "E1", Some(5.0)), axis(2, "E2", None)]),
+                "axis E2 is v",
+            ),
+        ];
+        for (language, s, want) in cases {
+            let why = place(language, &s, &axes).unwrap_err();
+            assert!(why.contains(want), "{language:?}: {why}");
+        }
+        let track = track(1.0);
+        let both = FilterAxes {
+            track: Some(TrackAxes {
+                nominal: &track,
+                calibrated: &track,
+            }),
+            ..axes
+        };
+        let why = place(Language::Krl, &site(vec![]), &both).unwrap_err();
+        assert!(why.contains("track with a part on a positioner"), "{why}");
     }
 }

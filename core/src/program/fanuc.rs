@@ -5,10 +5,11 @@
 //! X = … mm, Y = … mm, Z = … mm, W = … deg, P = … deg, R = … deg`; joint
 //! positions (`J1 = …`) are not targets, nor are other groups. The user frame
 //! `UF` and tool `UT` are looked up in the cell by number (`UF : 0` is the
-//! base frame). A position with another group (`GP2`, a positioner) is
-//! refused, naming it; an extended axis of `GP1` (`E1 = …`) goes with the
-//! site to the filter (`program::axes`: the track's composed, any other
-//! refused).
+//! base frame). An extended axis of `GP1` (`E1 = …`) and the joints of
+//! another group (`GP2: … J1 = 30.000 deg`, a positioner) go with the site
+//! to the filter (`program::axes`: a track's `E1` and a positioner's `GP2`
+//! `J1`, `J2` composed, any other refused naming it); another group in
+//! Cartesian form (a second robot) is refused, naming it.
 //!
 //! Motions: the `/MN` section's `J`, `L`, `C` and `A` instructions
 //! (`fanuc/motions.rs`) name the positions; a position in joint form is a
@@ -126,9 +127,10 @@ fn head(text: &str, toks: &[Token], i: usize) -> Result<(f64, Range<usize>, usiz
 #[derive(Default)]
 struct Fields {
     group: u32,
-    /// Groups other than 1 the position moves.
+    /// Groups other than 1 the position gives in Cartesian form.
     other_groups: Vec<u32>,
-    /// The extended axes of group 1 (`E1 = 100 mm`), in the block's order.
+    /// The extended axes of group 1 (`E1 = 100 mm`) and the joints of other
+    /// groups (`J1 = 30 deg` of `GP2`), in the block's order.
     extended: Vec<AxisValue>,
     uf: Option<u32>,
     ut: Option<u32>,
@@ -202,18 +204,37 @@ impl Fields {
         if punct(toks.get(j), ',') {
             j += 1;
         }
-        if self.group == 1 {
+        let written = || {
+            format!("{} {}", &text[slot.clone()], unit.unwrap_or(""))
+                .trim_end()
+                .to_string()
+        };
+        if self.group != 1 {
+            match key.strip_prefix('J').and_then(|n| n.parse::<usize>().ok()) {
+                Some(number) => self.extended.push(AxisValue {
+                    group: self.group,
+                    number,
+                    name: format!("{key} of motion group GP{}", self.group),
+                    value: Some(sign * v),
+                    text: written(),
+                }),
+                None if !self.other_groups.contains(&self.group) => {
+                    self.other_groups.push(self.group)
+                }
+                None => {}
+            }
+        } else {
             match "XYZWPR".find(key.as_str()).filter(|_| key.len() == 1) {
                 Some(idx) => self.values[idx] = Some((sign * v, slot)),
                 None if key.starts_with('J') || key.starts_with('E') => {
                     let extended = key.strip_prefix('E').and_then(|n| n.parse::<usize>().ok());
                     if let Some(number) = extended {
-                        let written = format!("{} {}", &text[slot.clone()], unit.unwrap_or(""));
                         self.extended.push(AxisValue {
+                            group: 1,
                             number,
                             name: key.clone(),
                             value: Some(sign * v),
-                            text: written.trim_end().to_string(),
+                            text: written(),
                         });
                     }
                     let axis = key.strip_prefix('J').and_then(|n| n.parse::<usize>().ok());
@@ -251,9 +272,6 @@ fn block(fi: usize, text: &str, toks: &[Token], i: usize) -> Result<(u32, Positi
             }
             Tok::Word(w) if w.starts_with("GP") && punct(toks.get(k + 1), ':') => {
                 fields.group = w[2..].parse().unwrap_or(0);
-                if fields.group != 1 {
-                    fields.other_groups.push(fields.group);
-                }
                 k + 2
             }
             Tok::Word(_) if punct(toks.get(k + 1), ':') => fields.colon(text, toks, k)?,
@@ -301,7 +319,7 @@ fn found(fi: usize, line: usize, name: String, mark_at: Range<usize>, f: Fields)
     };
     let spec = |v: Option<u32>| v.map_or(FrameSpec::Unset, |n| FrameSpec::Ref(CellRef::Number(n)));
     let refuse = f.other_groups.first().map(|g| format!(
-        "the position also moves motion group GP{g} (another mechanical unit), which the cell does not model: not filtered"
+        "the position also moves motion group GP{g} in Cartesian form (another robot), which the cell does not model: not filtered"
     ));
     Position::Cartesian(Box::new(Site {
         file: fi,

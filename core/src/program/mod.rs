@@ -28,7 +28,10 @@ mod parsed;
 mod report;
 mod sites;
 
-pub use axes::{track_axis_name, FilterAxes, TrackAxes, TRACK_AXIS};
+pub use axes::{
+    positioner_axis_names, positioner_group, track_axis_name, FilterAxes, PositionerAxes,
+    TrackAxes, TRACK_AXIS,
+};
 pub use parsed::{
     abb_cf, external_axis_refusal, fanuc_config, fanuc_config_text, kuka_status, kuka_turn,
     AxisValue, Flags, FrameSpec, JointTarget, Language, Motion, MotionTarget, ParseError, Program,

@@ -89,6 +89,10 @@ pub enum FrameSpec {
     Ref(CellRef),
     /// Given in the program itself (flange → TCP, or base → work object) [m].
     Inline(Pose),
+    /// A work object given in the program on the positioner's face plate
+    /// (RAPID's object frame of a `wobjdata` with `ufprog FALSE`): face
+    /// plate → work object [m] (`program::axes`).
+    FacePlate(Pose),
     /// The program does not say.
     Unset,
 }
@@ -342,8 +346,11 @@ impl Site {
 /// One external axis's value on a target, as the program writes it.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct AxisValue {
-    /// The controller's axis number, 1-based (KRL `E1`, RAPID `eax_a` and
-    /// Fanuc `E1` are 1).
+    /// The motion group the axis belongs to: 1 for the robot's own (every
+    /// KRL and RAPID axis, Fanuc's `GP1`), 2 for Fanuc's `GP2` (a positioner).
+    pub group: u32,
+    /// The controller's axis number in its group, 1-based (KRL `E1`, RAPID
+    /// `eax_a`, Fanuc `E1` of `GP1` and `J1` of `GP2` are 1).
     pub number: usize,
     /// The axis as the language names it (`E1`, `eax_a`).
     pub name: String,

@@ -6,9 +6,11 @@
 //! and `Trigg` forms). The tool is the motion's `Tool` argument, the work
 //! object its `\WObj`; both are read from the module's `tooldata`
 //! (`[robhold,[[x,y,z],[q1..q4]],[mass,[cx,cy,cz],…]]`) and `wobjdata`
-//! (`[robhold,ufprog,ufmec,uframe,oframe]`, the work object `uframe·oframe`),
-//! else looked up in the cell by name; `tool0` is the flange and `wobj0` the
-//! base frame. A tooldata's `robhold TRUE` is a tool the robot holds (the
+//! (`[robhold,ufprog,ufmec,uframe,oframe]`, the work object `uframe·oframe`;
+//! with `ufprog FALSE` a work object the mechanical unit `ufmec` moves,
+//! whose user frame the controller computes from the unit: `oframe` on the
+//! positioner's face plate, [`FrameSpec::FacePlate`]), else looked up in the
+//! cell by name; `tool0` is the flange and `wobj0` the base frame. A tooldata's `robhold TRUE` is a tool the robot holds (the
 //! ordinary case); `FALSE` a stationary tool, its `tframe` in the world
 //! (taken as the base) frame, used with a `wobjdata` of `robhold TRUE` whose
 //! `uframe·oframe` is in the flange (wrist) frame: the robot carries the work
@@ -73,6 +75,8 @@ struct Parser<'a> {
     /// Tools with `robhold FALSE` and work objects with `robhold TRUE`.
     stationary_tools: HashSet<String>,
     held_wobjs: HashSet<String>,
+    /// Work objects a mechanical unit moves (`ufprog FALSE`).
+    moved_wobjs: HashSet<String>,
     declared: Vec<Declared>,
     /// Declared robtargets by lower-case name (one per element of an array).
     by_name: HashMap<String, Vec<usize>>,
@@ -248,7 +252,8 @@ impl Parser<'_> {
     }
 
     /// A `wobjdata` declaration: user frame · object frame, held by the
-    /// robot when `robhold TRUE`, refused when a mechanical unit moves it.
+    /// robot when `robhold TRUE`; the object frame on the face plate of the
+    /// positioner when a mechanical unit moves it (`ufprog FALSE`).
     fn declare_wobj(&mut self, fi: usize, name: &str, key: String, v: &Val) -> Result<(), Fail> {
         let items = v.list().unwrap_or(&[]);
         let frames = (items.get(3).and_then(frame), items.get(4).and_then(frame));
@@ -262,17 +267,32 @@ impl Parser<'_> {
             .first()
             .map(|r| self.text_of(fi, r))
             .unwrap_or_default();
+        let ufprog = items
+            .get(1)
+            .map(|r| self.text_of(fi, r))
+            .unwrap_or_default();
         let ufmec = items
             .get(2)
             .map(|r| self.text_of(fi, r))
             .unwrap_or_default();
-        if robhold.eq_ignore_ascii_case("true") {
+        let held = robhold.eq_ignore_ascii_case("true");
+        if held {
             self.held_wobjs.insert(key.clone());
         }
-        let value = if ufmec.trim_matches('"').trim() != "" {
-            Err(format!("work object {name} moves with {ufmec}"))
-        } else {
+        let unit = ufmec.trim_matches('"').trim();
+        let value = if !ufprog.eq_ignore_ascii_case("false") {
             uf.and_then(|u| of.map(|o| u.compose(&o)))
+        } else if unit.is_empty() {
+            Err(format!(
+                "work object {name} is moved (ufprog FALSE) by no mechanical unit (ufmec empty)"
+            ))
+        } else if held {
+            Err(format!(
+                "work object {name} is held by the robot and moved by {ufmec}, which is not modelled"
+            ))
+        } else {
+            self.moved_wobjs.insert(key.clone());
+            of
         };
         self.wobjs.insert(key, value);
         Ok(())
@@ -425,6 +445,13 @@ impl Parser<'_> {
             None => (FrameSpec::Unset, None),
         };
         let (wobj, wobj_err) = Self::frame_spec(&self.wobjs, wobj_name.unwrap_or("wobj0"), "wobj0");
+        let moved = self
+            .moved_wobjs
+            .contains(&wobj_name.unwrap_or_default().to_ascii_lowercase());
+        let wobj = match wobj {
+            FrameSpec::Inline(p) if moved => FrameSpec::FacePlate(p),
+            other => other,
+        };
         let load = tool_name.and_then(|t| self.loads.get(&t.to_ascii_lowercase()).copied());
         let tool_key = tool_name.unwrap_or_default().to_ascii_lowercase();
         let wobj_key = wobj_name.unwrap_or_default().to_ascii_lowercase();
@@ -654,6 +681,7 @@ pub(super) fn parse(files: &[ProgramFile]) -> Result<Targets, ParseError> {
         wobjs: HashMap::new(),
         stationary_tools: HashSet::new(),
         held_wobjs: HashSet::new(),
+        moved_wobjs: HashSet::new(),
         declared: Vec::new(),
         by_name: HashMap::new(),
         joint_names: HashSet::new(),

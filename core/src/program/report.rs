@@ -77,6 +77,11 @@ pub struct TargetReport {
     /// [mm] (a robot on a track: `program::axes`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub track_mm: Option<f64>,
+    /// The positioner values (axis 1, axis 2) the position was composed at,
+    /// kept as programmed [deg] (a work object on the positioner's face
+    /// plate: `program::axes`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub positioner_deg: Option<[f64; 2]>,
     /// The load the solve carried (flange frame) and where it came from.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub load: Option<UsedLoad>,
@@ -167,6 +172,12 @@ pub struct FilterReport {
     /// position's in `track_mm`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub track_axis: Option<String>,
+    /// The positioner's axes 1 and 2 as the language names them (`E1`,
+    /// `E2`; `eax_a`, `eax_b`; `J1`, `J2` of `GP2`) when the filter was
+    /// given a positioner: their values are kept as programmed, each
+    /// position's in `positioner_deg`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub positioner_axes: Option<[String; 2]>,
 }
 
 impl FilterReport {
@@ -178,6 +189,7 @@ impl FilterReport {
         unused: Vec<UnusedReport>,
         controller_data: String,
         track_axis: Option<String>,
+        positioner_axes: Option<[String; 2]>,
     ) -> FilterReport {
         let count = |s: TargetStatus| targets.iter().filter(|t| t.status == s).count();
         FilterReport {
@@ -190,6 +202,7 @@ impl FilterReport {
             unused,
             controller_data,
             track_axis,
+            positioner_axes,
         }
     }
 }

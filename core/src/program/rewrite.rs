@@ -98,8 +98,8 @@ pub fn filter(
     })
 }
 
-/// [`filter`] through the cell's external `axes` (a robot on a track:
-/// `program::axes`) within `control`'s bounds: a program with more targets
+/// [`filter`] through the cell's external `axes` (a robot on a track, a
+/// positioner carrying the work objects: `program::axes`) within `control`'s bounds: a program with more targets
 /// than its cap is refused before any solve, and the filter stops between
 /// motions once `keep_going` says so.
 pub fn filter_with(
@@ -169,6 +169,7 @@ struct SolvedReport {
     configuration: Option<String>,
     shift_mm: f64,
     track_mm: Option<f64>,
+    positioner_deg: Option<[f64; 2]>,
     load: super::report::UsedLoad,
     warnings: Vec<String>,
 }
@@ -208,6 +209,7 @@ impl Run<'_> {
             joints_deg: None,
             shift_mm: None,
             track_mm: None,
+            positioner_deg: None,
             load: None,
             warnings: Vec::new(),
             reachable: Vec::new(),
@@ -272,18 +274,15 @@ impl Run<'_> {
         if let Some(why) = &site.refuse {
             return failed(&mut self.edits, language, Failure::from(why.clone()));
         }
-        let on = match axes::place(language, site, &self.axes) {
-            Ok(on) => on,
+        let at = match axes::place(language, site, &self.axes) {
+            Ok(at) => at,
             Err(why) => return failed(&mut self.edits, language, Failure::from(why)),
         };
         if let Some(j) = &site.after_joints {
             let rad: Vec<f64> = j.iter().map(|v| v.to_radians()).collect();
             self.previous = Some(self.context.model.nominal.joints_from_controller(&rad));
         }
-        match self
-            .context
-            .solve_site(site, self.previous.as_deref(), on.as_ref())
-        {
+        match self.context.solve_site(site, self.previous.as_deref(), &at) {
             Ok(done) => self.solved(site, done),
             Err(f) => failed(&mut self.edits, language, f),
         }
@@ -303,6 +302,7 @@ impl Run<'_> {
             configuration: done.configuration,
             shift_mm: done.shift_m * 1e3,
             track_mm: done.track_mm,
+            positioner_deg: done.positioner_deg,
             load: done.load,
             warnings: done.warnings,
         }))
@@ -347,6 +347,9 @@ impl Run<'_> {
                 self.axes
                     .track
                     .map(|_| axes::track_axis_name(language).to_string()),
+                self.axes
+                    .positioner
+                    .map(|_| axes::positioner_axis_names(language).map(|n| n.to_string())),
             ),
         }
     }
@@ -362,6 +365,7 @@ fn describe(report: &mut TargetReport, outcome: Outcome, previous: &mut Option<V
             report.joints_deg = Some(s.joints_deg);
             report.shift_mm = Some(s.shift_mm);
             report.track_mm = s.track_mm;
+            report.positioner_deg = s.positioner_deg;
             report.load = Some(s.load);
             report.warnings = s.warnings;
             *previous = Some(s.q);

@@ -15,7 +15,7 @@
 //! warns which configuration was taken and how to make sure. Units: SI, joints in the model
 //! convention [rad] but where named `deg` (controller convention).
 
-use super::axes::OnTrack;
+use super::axes::{controller_target, Placement};
 use super::report::{LoadSource, Reachable, UsedLoad};
 use super::{Flags, FrameSpec, Language, Site};
 use crate::model::calibrated::CompensatedModel;
@@ -36,6 +36,8 @@ pub(super) struct Solved {
     pub(super) false_target: Pose,
     /// The track value the target was composed at, as programmed [mm].
     pub(super) track_mm: Option<f64>,
+    /// The positioner values the target was composed at, as programmed [deg].
+    pub(super) positioner_deg: Option<[f64; 2]>,
     pub(super) configuration: Option<String>,
     pub(super) shift_m: f64,
     pub(super) load: UsedLoad,
@@ -88,6 +90,9 @@ fn resolve_tool(spec: &FrameSpec, cell: &Cell) -> Result<Tool, String> {
             load: None,
         }),
         FrameSpec::Unset => Err("the program selects no tool".into()),
+        FrameSpec::FacePlate(_) => {
+            Err("a tool on the positioner's face plate is not modelled".into())
+        }
     }
 }
 
@@ -135,6 +140,9 @@ fn resolve_work_object(spec: &FrameSpec, cell: &Cell) -> Result<WorkObject, Stri
             pose: *p,
         }),
         FrameSpec::Unset => Ok(WorkObject::base()),
+        FrameSpec::FacePlate(_) => Err(
+            "the work object is on the positioner's face plate and the filter was given no positioner: not filtered".into(),
+        ),
     }
 }
 
@@ -153,6 +161,9 @@ fn world_work_object(spec: &FrameSpec, cell: &Cell) -> Result<WorkObject, String
     match spec {
         FrameSpec::Unset => Ok(world("world", Some(0), Pose::identity())),
         FrameSpec::Inline(p) => Ok(world("inline", None, *p)),
+        FrameSpec::FacePlate(_) => Err(
+            "the work object is on a positioner's face plate, and a robot on a track with a part on a positioner is not modelled: not filtered".into(),
+        ),
         FrameSpec::Ref(r) if !cell.defines_work_object(r) => {
             let w = cell.work_object(r).map_err(|e| e.to_string())?;
             Ok(world("world", w.number, Pose::identity()))
@@ -161,7 +172,7 @@ fn world_work_object(spec: &FrameSpec, cell: &Cell) -> Result<WorkObject, String
             let w = cell.work_object(r).map_err(|e| e.to_string())?;
             match w.frame {
                 WorkObjectFrame::Measurement => Ok(w),
-                WorkObjectFrame::Base => Err(format!(
+                WorkObjectFrame::Base | WorkObjectFrame::FacePlate => Err(format!(
                     "work object {} is stated in the robot's base frame, which the track carries: state it in the cell frame (frame measurement) for a robot on a track; not filtered",
                     w.name
                 )),
@@ -170,25 +181,61 @@ fn world_work_object(spec: &FrameSpec, cell: &Cell) -> Result<WorkObject, String
     }
 }
 
-/// The work object a site is solved in, and on a track its pose in the
-/// world frame: on a fixed base the cell's, program's or base frame; on a
-/// track the world-frame work object `W` moved into the robot's true base
-/// at the target's value, `B(e)⁻¹·W`, a base-frame work object.
+/// The work object a site is solved in as the cell is, `S` (base frame),
+/// and, when the controller composes it through an external axis, the
+/// frame it computes instead, `S_nom`, and the pose it holds for it
+/// (`program::axes`): on a fixed base the cell's, program's or base frame
+/// (the controller holds it as it is); on a track the world-frame work
+/// object `W` at the target's value; on the positioner's face plate a
+/// plate work object `W_f` at the target's values. A plate work object
+/// without a positioner, or without the target's values, is refused.
 fn placed_work_object(
     spec: &FrameSpec,
     cell: &Cell,
-    on: Option<&OnTrack>,
-) -> Result<(WorkObject, Option<Pose>), String> {
-    let Some(on) = on else {
-        return Ok((resolve_work_object(spec, cell)?, None));
+    model: &CompensatedModel,
+    at: &Placement,
+) -> Result<(WorkObject, Option<(Pose, Pose)>), String> {
+    if let Some(on) = &at.track {
+        let world = world_work_object(spec, cell)?;
+        let (s, s_nom) = on.work_object(&world.pose);
+        let in_base = WorkObject {
+            frame: WorkObjectFrame::Base,
+            pose: s,
+            ..world.clone()
+        };
+        return Ok((in_base, Some((s_nom, world.pose))));
+    }
+    let w = match spec {
+        FrameSpec::FacePlate(p) => WorkObject {
+            name: "inline".into(),
+            number: None,
+            frame: WorkObjectFrame::FacePlate,
+            pose: *p,
+        },
+        FrameSpec::Ref(r) => cell.any_work_object(r).map_err(|e| e.to_string())?,
+        _ => resolve_work_object(spec, cell)?,
     };
-    let world = world_work_object(spec, cell)?;
+    if w.frame != WorkObjectFrame::FacePlate {
+        return Ok((w, None));
+    }
+    let Some(on) = &at.positioner else {
+        return Err(format!(
+            "work object {} is on the positioner's face plate and {}: not filtered",
+            w.name,
+            if at.with_positioner {
+                "the target gives no value for the positioner's axes"
+            } else {
+                "the filter was given no positioner"
+            }
+        ));
+    };
+    let (s, s_nom) = on.work_object(&model.cell_from_base.inverse(), &w.pose);
     let in_base = WorkObject {
         frame: WorkObjectFrame::Base,
-        pose: on.calibrated.inverse().compose(&world.pose),
-        ..world.clone()
+        pose: s,
+        ..w.clone()
     };
-    Ok((in_base, Some(world.pose)))
+    Ok((in_base, Some((s_nom, w.pose))))
 }
 
 /// The nominal controller's joints for a site: its solutions carrying the
@@ -296,11 +343,11 @@ impl Context<'_> {
         &mut self,
         site: &Site,
         previous: Option<&[f64]>,
-        on: Option<&OnTrack>,
+        at: &Placement,
     ) -> Result<Solved, Failure> {
         let pose = site.pose.ok_or("the target is not a complete pose")?;
         if site.stationary_tool {
-            if on.is_some() {
+            if at.track.is_some() {
                 return Err(
                     "a stationary tool beside a robot on a track is not modelled: not filtered"
                         .into(),
@@ -312,7 +359,7 @@ impl Context<'_> {
         let tcp = tool.tcp;
         let model = self.model;
         let (load, used_load, warnings) = choose_load(site.load, tool.load, model);
-        let (wobj, world) = placed_work_object(&site.work_object, self.cell, on)?;
+        let (wobj, composed) = placed_work_object(&site.work_object, self.cell, model, at)?;
         let used_tool = ControllerTool {
             name: tool.name,
             number: tool.number.unwrap_or(0),
@@ -323,11 +370,12 @@ impl Context<'_> {
                 inertia_kgm2: load.and_then(|l| l.inertia_kgm2),
             },
         };
-        // On a track the controller holds the work object in its world frame.
+        // On a track the controller holds the work object in its world
+        // frame, on a positioner on the face plate.
         let used_frame = ControllerFrame {
             name: wobj.name.clone(),
             number: wobj.number.unwrap_or(0),
-            pose: world.unwrap_or_else(|| wobj.in_base(model)),
+            pose: composed.map_or_else(|| wobj.in_base(model), |(_, held)| held),
         };
         // Only the cell's own items are the controller's data to hold: the
         // flange and the base frame are built in, inline frames in the program.
@@ -338,20 +386,31 @@ impl Context<'_> {
             _ => false,
         };
         let used_tool = cell_item(&site.tool, true).then_some(used_tool);
-        let used_frame = cell_item(&site.work_object, false).then_some(used_frame);
+        // A plate work object's controller form is not written (a coupled
+        // base, a moved work object): the controller keeps the cell's.
+        let mut warnings = warnings;
+        let on_plate = composed.is_some() && at.track.is_none();
+        if on_plate && cell_item(&site.work_object, false) {
+            warnings.push(format!(
+                "work object {} turns with the positioner: the controller data leaves it out; the controller must hold it on the face plate as the cell gives it",
+                wobj.name
+            ));
+        }
+        let used_frame = (cell_item(&site.work_object, false) && !on_plate).then_some(used_frame);
         let language = self.language;
         let solver = self.solver(tcp, load);
         let solved = solve_on(solver, site, &wobj, &pose, previous, language)?;
-        let false_target = match (on, world) {
-            (Some(on), Some(w)) => on.controller_target(&w, &solved.false_target),
-            _ => solved.false_target,
+        let false_target = match composed {
+            Some((s_nom, _)) => controller_target(&s_nom, &wobj.pose, &solved.false_target),
+            None => solved.false_target,
         };
         Ok(Solved {
             joints_deg: solver.solver().controller_degrees(&solved.q),
             shift_m: (false_target.p - pose.p).norm(),
             configuration: solved.configuration.map(|c| c.to_string()),
             false_target,
-            track_mm: on.map(|o| o.value_mm),
+            track_mm: at.track.map(|o| o.value_mm),
+            positioner_deg: at.positioner.map(|o| o.values_deg),
             q: solved.q,
             load: used_load,
             warnings: warnings.into_iter().chain(solved.warning).collect(),
@@ -386,6 +445,10 @@ impl Context<'_> {
                 .map_err(|e| format!("the stationary tool: {e}"))?
                 .in_base(model),
             FrameSpec::Unset => return Err("the program selects no stationary tool".into()),
+            FrameSpec::FacePlate(_) => return Err(
+                "a stationary tool on the positioner's face plate is not modelled: not filtered"
+                    .into(),
+            ),
         };
         let (held, cell_load) = match &site.work_object {
             FrameSpec::Inline(p) => (*p, None),
@@ -397,6 +460,9 @@ impl Context<'_> {
             }
             FrameSpec::Unset => {
                 return Err("the program selects no work piece for the robot to carry".into())
+            }
+            FrameSpec::FacePlate(_) => {
+                return Err("a work piece both carried by the robot and on the positioner is not modelled: not filtered".into())
             }
         };
         let (load, used_load, warnings) = choose_load(site.load, cell_load, model);
@@ -411,6 +477,7 @@ impl Context<'_> {
             configuration: on.configuration.map(|c| c.to_string()),
             false_target,
             track_mm: None,
+            positioner_deg: None,
             q: on.q,
             load: used_load,
             warnings: warnings.into_iter().chain(on.warning).collect(),

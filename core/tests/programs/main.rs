@@ -16,6 +16,7 @@ mod export;
 mod fanuc;
 mod krl;
 mod motions;
+mod positioner;
 mod rapid;
 mod stationary;
 mod track;

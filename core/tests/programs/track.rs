@@ -182,6 +182,7 @@ impl TrackCell {
                 nominal: &self.nominal_track,
                 calibrated: &self.fitted,
             }),
+            positioner: None,
         }
     }
 

@@ -71,6 +71,11 @@ pub struct ControllerExport {
 /// Why a cell cannot be exported for a controller: the item and the fix.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum ExportError {
+    /// A work object turns with the positioner: its controller form (a base
+    /// coupled to the positioner, a work object a mechanical unit moves, a
+    /// user frame of coordinated motion) is not written.
+    #[error("work object `{0}` is on the positioner's face plate: its controller form (a base coupled to the positioner, a work object a mechanical unit moves, a coordinated user frame) is not written; export the cell without it and keep it as the controller holds it")]
+    OnFacePlate(String),
     /// Two items of one kind have the same number.
     #[error("{0}")]
     Duplicate(#[from] DuplicateNumber),

@@ -108,6 +108,13 @@ pub fn export_cell(
     model: &CompensatedModel,
     options: &ExportOptions,
 ) -> Result<ControllerExport, ExportError> {
+    if let Some(w) = cell
+        .work_objects
+        .iter()
+        .find(|w| w.frame == crate::solve::cell::WorkObjectFrame::FacePlate)
+    {
+        return Err(ExportError::OnFacePlate(w.name.clone()));
+    }
     controller_text(language, &controller_data(cell, model), options)
 }
 

@@ -296,6 +296,7 @@ pub(super) fn classify(agg: &Agg, text: &str, offset: usize) -> Kind {
         .filter_map(|(i, k)| {
             let (_, r) = get(k)?;
             Some(AxisValue {
+                group: 1,
                 number: i + 1,
                 name: (*k).to_string(),
                 value: real(value(r)),

@@ -157,6 +157,7 @@ pub(super) fn robtarget(v: &Val) -> Result<Target, Fail> {
                 _ => (None, "a value computed at run time".to_string()),
             };
             Some(AxisValue {
+                group: 1,
                 number: i + 1,
                 name: axis.to_string(),
                 value,

@@ -66,6 +66,13 @@ pub enum WorkObjectFrame {
     Base,
     /// The measurement (tracker) frame of the calibration.
     Measurement,
+    /// The face plate of the cell's positioner (`model::external::positioner`):
+    /// the work object turns with it (KRL a base coupled to the positioner,
+    /// RAPID `ufprog FALSE`, Fanuc a user frame of coordinated motion) and
+    /// has a pose in the base frame only at the positioner's values, which
+    /// the program filter composes (`program::axes`); [`Cell::work_object`]
+    /// refuses it elsewhere.
+    FacePlate,
 }
 
 /// A work object / user frame.
@@ -95,10 +102,12 @@ impl WorkObject {
     }
 
     /// The work object in the robot base frame: `base_from_cell·pose` for a
-    /// measurement-frame work object.
+    /// measurement-frame work object. A face-plate work object has none
+    /// (it turns with the positioner): its pose on the plate, as the
+    /// controller holds it ([`Cell::work_object`] does not give one out).
     pub fn in_base(&self, model: &CompensatedModel) -> Pose {
         match self.frame {
-            WorkObjectFrame::Base => self.pose,
+            WorkObjectFrame::Base | WorkObjectFrame::FacePlate => self.pose,
             WorkObjectFrame::Measurement => model.cell_to_base(&self.pose),
         }
     }
@@ -143,6 +152,10 @@ pub enum CellError {
     /// No work object answers the reference (number 0, the base frame, always does).
     #[error("no work object {0} in the cell")]
     UnknownWorkObject(CellRef),
+    /// The work object turns with the positioner; only a program filter
+    /// with the positioner's values places it.
+    #[error("work object {0} is on the positioner's face plate: it has a pose only at the positioner's axis values, which the program filter composes given the positioner (robocal filter --positioner, --nominal-positioner)")]
+    OnFacePlate(String),
     /// Two items answer one reference (a number held twice, or one name
     /// in two ASCII cases).
     #[error("{} {reference} is ambiguous: both `{first}` and `{second}` answer it; give each its own name and number", .kind.label())]
@@ -229,8 +242,19 @@ impl Cell {
 
     /// The work object named or numbered `r`, carrying its controller number
     /// (`numbering`); number 0 is the base frame when the cell does not
-    /// define it.
+    /// define it. One on the positioner's face plate is refused
+    /// ([`CellError::OnFacePlate`]; [`Cell::any_work_object`] gives it).
     pub fn work_object(&self, r: &CellRef) -> Result<WorkObject, CellError> {
+        let w = self.any_work_object(r)?;
+        match w.frame {
+            WorkObjectFrame::FacePlate => Err(CellError::OnFacePlate(w.name)),
+            _ => Ok(w),
+        }
+    }
+
+    /// [`Cell::work_object`], a work object on the positioner's face plate
+    /// included.
+    pub fn any_work_object(&self, r: &CellRef) -> Result<WorkObject, CellError> {
         let numbers = self.work_object_numbers();
         let names: Vec<&str> = self.work_objects.iter().map(|w| w.name.as_str()).collect();
         match find(ItemKind::WorkObject, &names, &numbers, r)? {

@@ -144,7 +144,8 @@ pub fn place_on_track(
         Ok(match (work_object, frame) {
             (Some(w), _) => {
                 let wb = match w.frame {
-                    WorkObjectFrame::Base => w.pose,
+                    // `Cell::work_object` gives no face-plate work object.
+                    WorkObjectFrame::Base | WorkObjectFrame::FacePlate => w.pose,
                     WorkObjectFrame::Measurement => b.inverse().compose(&w.pose),
                 };
                 (wb, Some(wb))
