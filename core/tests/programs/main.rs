@@ -13,6 +13,7 @@ mod common;
 mod accounting;
 mod examples;
 mod export;
+mod external;
 mod fanuc;
 mod krl;
 mod motions;
