@@ -193,3 +193,42 @@ ENDMODULE\n";
             .unwrap_err();
     assert!(refused.contains("external axis eax_b to 250"), "{refused}");
 }
+
+/// A `wobjdata` with `ufprog FALSE` is moved by its mechanical unit: its
+/// object frame on the positioner's face plate (the user frame the
+/// controller's, so the one written is not used); moved by no unit, or held
+/// by the robot and moved, the target is skipped naming why; `ufprog TRUE`
+/// is fixed whatever `ufmec` says.
+#[test]
+fn a_work_object_a_mechanical_unit_moves_is_on_the_face_plate() {
+    let text = "MODULE turn\n\
+  PERS tooldata gun:=[TRUE,[[0,0,250],[1,0,0,0]],[2,[0,0,100],[1,0,0,0],0,0,0]];\n\
+  TASK PERS wobjdata moved:=[FALSE,FALSE,\"STN1\",[[900,0,0],[1,0,0,0]],[[100,50,60],[1,0,0,0]]];\n\
+  TASK PERS wobjdata nounit:=[FALSE,FALSE,\"\",[[0,0,0],[1,0,0,0]],[[0,0,0],[1,0,0,0]]];\n\
+  TASK PERS wobjdata held:=[TRUE,FALSE,\"STN1\",[[0,0,0],[1,0,0,0]],[[0,0,0],[1,0,0,0]]];\n\
+  TASK PERS wobjdata fixed:=[FALSE,TRUE,\"STN1\",[[900,0,0],[1,0,0,0]],[[100,0,0],[1,0,0,0]]];\n\
+  PROC main()\n\
+    MoveL [[1,2,3],[1,0,0,0],[0,0,0,0],[10,20,9E9,9E9,9E9,9E9]], v100, fine, gun\\WObj:=moved;\n\
+    MoveL [[1,2,3],[1,0,0,0],[0,0,0,0],[10,20,9E9,9E9,9E9,9E9]], v100, fine, gun\\WObj:=nounit;\n\
+    MoveL [[1,2,3],[1,0,0,0],[0,0,0,0],[10,20,9E9,9E9,9E9,9E9]], v100, fine, gun\\WObj:=held;\n\
+    MoveL [[1,2,3],[1,0,0,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]], v100, fine, gun\\WObj:=fixed;\n\
+  ENDPROC\n\
+ENDMODULE\n";
+    let sites = parse(&[file(text)]).unwrap().sites;
+    let FrameSpec::FacePlate(on_plate) = &sites[0].work_object else {
+        panic!("{:?}", sites[0].work_object)
+    };
+    assert!((on_plate.p - Vector3::new(0.1, 0.05, 0.06)).norm() < 1e-12);
+    assert!(sites[0].skip.is_none());
+    let values: Vec<(usize, Option<f64>)> =
+        sites[0].axes.iter().map(|a| (a.number, a.value)).collect();
+    assert_eq!(values, [(1, Some(10.0)), (2, Some(20.0))]);
+    let why = sites[1].skip.as_deref().unwrap();
+    assert!(why.contains("by no mechanical unit"), "{why}");
+    let why = sites[2].skip.as_deref().unwrap();
+    assert!(why.contains("held by the robot and moved"), "{why}");
+    let FrameSpec::Inline(fixed) = &sites[3].work_object else {
+        panic!("{:?}", sites[3].work_object)
+    };
+    assert!((fixed.p - Vector3::new(1.0, 0.0, 0.0)).norm() < 1e-12);
+}

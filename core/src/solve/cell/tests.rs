@@ -106,6 +106,46 @@ fn tools_and_work_objects_by_name_and_number() {
     assert!(cell.work_object(&CellRef::Name("fixture".into())).is_err());
 }
 
+/// A work object on the positioner's face plate has no pose in the base
+/// frame without the positioner's values: the lookup every command but the
+/// program filter uses refuses it, naming it; `any_work_object` gives it;
+/// the controller export refuses the cell, naming it.
+#[test]
+fn a_work_object_on_the_face_plate_is_refused_where_no_positioner_places_it() {
+    let (model, table) = fixture();
+    let part = WorkObject {
+        name: "part".into(),
+        number: Some(3),
+        frame: WorkObjectFrame::FacePlate,
+        pose: Pose::from_translation(Vector3::new(0.1, 0.0, 0.06)),
+    };
+    let cell = Cell {
+        tools: Vec::new(),
+        work_objects: vec![table, part.clone()],
+    };
+    assert_eq!(
+        cell.work_object(&CellRef::Number(3)),
+        Err(CellError::OnFacePlate("part".into()))
+    );
+    assert_eq!(
+        cell.any_work_object(&CellRef::Name("PART".into())),
+        Ok(part)
+    );
+    assert_eq!(cell.work_object(&CellRef::Number(2)).unwrap().name, "table");
+    let why = crate::program::controller::export_cell(
+        crate::program::Language::Krl,
+        &cell,
+        &model,
+        &Default::default(),
+    )
+    .unwrap_err();
+    assert!(
+        why.to_string()
+            .contains("work object `part` is on the positioner's face plate"),
+        "{why}"
+    );
+}
+
 /// The torques of the payload alone (the model's links massless), computed
 /// here from the flange pose: `τ_i = z_i·((c − o_i) × m g)`.
 fn payload_torques(
