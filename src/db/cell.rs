@@ -26,18 +26,19 @@ impl CellKind {
 }
 
 impl ItemFrame {
-    /// The frame as stored: `flange`, `base` or `measurement`.
+    /// The frame as stored: `flange`, `base`, `measurement` or `face_plate`.
     pub fn as_str(self) -> &'static str {
         match self {
             ItemFrame::Flange => "flange",
             ItemFrame::Base => "base",
             ItemFrame::Measurement => "measurement",
+            ItemFrame::FacePlate => "face_plate",
         }
     }
 }
 
 text_enum!(CellKind, [Tool, WorkObject]);
-text_enum!(ItemFrame, [Flange, Base, Measurement]);
+text_enum!(ItemFrame, [Flange, Base, Measurement, FacePlate]);
 
 const ITEM_SELECT: &str =
     "SELECT name, number, frame, pose_json, load_json, created_at, updated_at FROM cell_items";

@@ -194,9 +194,10 @@ pub(crate) fn checked(
         }
         (CellKind::WorkObject, None | Some("base")) => ItemFrame::Base,
         (CellKind::WorkObject, Some("measurement")) => ItemFrame::Measurement,
+        (CellKind::WorkObject, Some("face_plate")) => ItemFrame::FacePlate,
         (CellKind::WorkObject, Some(f)) => {
             return Err(ApiError::invalid(format!(
-                "`{name}`: `frame` must be base or measurement, got `{f}`"
+                "`{name}`: `frame` must be base, measurement or face_plate, got `{f}`"
             )))
         }
     };

@@ -9,12 +9,15 @@
 //! program that cannot be parsed is a 422 naming its file, line and column.
 //! With `controller_track` (the controller's own track) the robot rides its
 //! stored track, program axis 1 (`core::program::axes`), as `robocal filter
-//! --track --nominal-track` composes it.
+//! --track --nominal-track` composes it; with `controller_positioner` (the
+//! controller's own positioner) the work objects on the face plate turn
+//! with the robot's stored positioner, program axes 1 and 2, as `robocal
+//! filter --positioner --nominal-positioner` composes them.
 
 use super::input::{objects, present};
 use super::solve::{model_choice, VersionSelector};
 use super::{ApiError, ApiJson, ApiPath, AppState};
-use crate::model::external::TrackDescription;
+use crate::model::external::{TiltRotateDescription, TrackDescription};
 use crate::program::controller::{ExportOptions, RegisterRange, Renamed, UsedRegister};
 use crate::program::{FilterReport, Language, ProgramFile};
 use crate::service;
@@ -58,6 +61,11 @@ pub struct FilterRequest {
     /// is the robot's stored track.
     #[serde(default, deserialize_with = "present")]
     pub controller_track: Option<TrackDescription>,
+    /// The controller's own positioner (in its world: the robot's base
+    /// frame): the work objects on the face plate turn with the robot's
+    /// stored positioner, the program's axes 1 and 2.
+    #[serde(default, deserialize_with = "present")]
+    pub controller_positioner: Option<TiltRotateDescription>,
 }
 
 /// The answer: the filtered files (same names and order) and the report.
@@ -127,11 +135,22 @@ fn command(robot_id: i64, req: FilterRequest) -> Result<FilterCommand, ApiError>
         .map(|d| d.to_model())
         .transpose()
         .map_err(|e| ApiError::invalid(format!("`controller_track`: {e}")))?;
+    if controller_track.is_some() && req.controller_positioner.is_some() {
+        return Err(ApiError::invalid(
+            "`controller_track` and `controller_positioner` together: a robot on a track with a part on a positioner is not modelled; give one",
+        ));
+    }
+    let controller_positioner = req
+        .controller_positioner
+        .map(|d| d.to_model())
+        .transpose()
+        .map_err(|e| ApiError::invalid(format!("`controller_positioner`: {e}")))?;
     Ok(FilterCommand {
         robot_id,
         model: model_choice(req.version.as_ref())?,
         payload_kg: req.payload_kg,
         controller_track,
+        controller_positioner,
         language,
         files: req
             .files

@@ -25,6 +25,9 @@ pub enum ItemFrame {
     Base,
     /// The measurement (tracker) frame of the calibration (a work object's).
     Measurement,
+    /// The positioner's face plate (a work object's): only a program filter
+    /// given the positioner places it (`core::program::axes`).
+    FacePlate,
 }
 
 /// A tool or work object to store.

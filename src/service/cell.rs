@@ -107,6 +107,16 @@ pub async fn delete(
     Err(item_not_found(robot_id, kind, name))
 }
 
+/// The core's frame of a stored item's frame (a tool's flange is no work
+/// object frame: taken as the base, as a description has always read it).
+pub(crate) fn work_object_frame(frame: ItemFrame) -> WorkObjectFrame {
+    match frame {
+        ItemFrame::Measurement => WorkObjectFrame::Measurement,
+        ItemFrame::FacePlate => WorkObjectFrame::FacePlate,
+        ItemFrame::Base | ItemFrame::Flange => WorkObjectFrame::Base,
+    }
+}
+
 /// The stored tools and work objects as a cell file description.
 pub fn description(tools: &[CellItemRow], work_objects: &[CellItemRow]) -> CellDescription {
     let number = |n: Option<i64>| n.and_then(|n| u32::try_from(n).ok());
@@ -125,10 +135,7 @@ pub fn description(tools: &[CellItemRow], work_objects: &[CellItemRow]) -> CellD
             .map(|r| WorkObjectDescription {
                 name: r.name.clone(),
                 number: number(r.number),
-                frame: match r.frame {
-                    ItemFrame::Measurement => WorkObjectFrame::Measurement,
-                    ItemFrame::Base | ItemFrame::Flange => WorkObjectFrame::Base,
-                },
+                frame: work_object_frame(r.frame),
                 pose: r.pose_json.0.clone(),
             })
             .collect(),

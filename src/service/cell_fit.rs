@@ -95,6 +95,7 @@ fn entry_of(row: CellItemRow) -> StoredEntry {
             ItemFrame::Flange => None,
             ItemFrame::Base => Some(WorkObjectFrame::Base),
             ItemFrame::Measurement => Some(WorkObjectFrame::Measurement),
+            ItemFrame::FacePlate => Some(WorkObjectFrame::FacePlate),
         },
         xyz_mm: row.pose_json.0.xyz_mm,
         rpy_deg: row.pose_json.0.rpy_deg,

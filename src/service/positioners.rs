@@ -302,6 +302,23 @@ pub async fn for_rows(state: &AppState, robot_id: i64) -> Result<TiltRotate, Ser
     model_of(&row)
 }
 
+/// The robot's stored positioner for a request's `field` that composes
+/// through it (a filter's `controller_positioner`): no positioner is a
+/// `Conflict` naming the field.
+pub async fn stored_for(
+    state: &AppState,
+    robot_id: i64,
+    field: &str,
+) -> Result<TiltRotate, ServiceError> {
+    let Some(row) = state.db().positioner(robot_id).await? else {
+        super::robots::get(state, robot_id).await?;
+        return Err(ServiceError::Conflict(format!(
+            "`{field}`: robot {robot_id} has no positioner; fit one with POST /v1/robots/{robot_id}/positioner/calibrate, or leave `{field}` out"
+        )));
+    };
+    model_of(&row)
+}
+
 /// The robot's stored positioner for a prediction or a solve at its values
 /// (`e1` and `e2`): no positioner is a `Conflict`, and so is a robot with a track too
 /// (`e1` would be either's value: ambiguous), as for a targets CSV.

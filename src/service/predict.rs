@@ -15,12 +15,10 @@ use super::limits::SMALL_SOLVE_MAX;
 use super::solve::{choose_version, resolve, ItemChoice, ModelChoice};
 use super::{AppState, ServiceError};
 use crate::model::RobotModel;
-use crate::records::{CellKind, ItemFrame};
+use crate::records::CellKind;
 use crate::solve::cell::accuracy::{measurement_tool_accuracy, tool_accuracy, ToolAccuracy};
 use crate::solve::cell::joints_csv::JointReading;
-use crate::solve::cell::{
-    Forward, PredictError, PredictFrame, Predicted, WorkObject, WorkObjectFrame,
-};
+use crate::solve::cell::{Forward, PredictError, PredictFrame, Predicted};
 use crate::solve::ik::TargetFrame;
 use robocal_core::model::calibrated::ValidationEvidence;
 use robocal_core::model::calibrated::{CalibratedModelFile, CompensatedModel};
@@ -169,15 +167,7 @@ pub async fn predict(
         None => (PredictFrame::Frame(cmd.frame), frame_label(cmd.frame)),
         Some(choice) => {
             let item = resolve(state, cmd.robot_id, CellKind::WorkObject, choice).await?;
-            let wobj = WorkObject {
-                name: item.name,
-                number: None,
-                frame: match item.frame {
-                    ItemFrame::Measurement => WorkObjectFrame::Measurement,
-                    ItemFrame::Base | ItemFrame::Flange => WorkObjectFrame::Base,
-                },
-                pose: item.pose,
-            };
+            let wobj = item.placed_work_object()?;
             (
                 PredictFrame::WorkObject(wobj.in_base(forward.model())),
                 "work_object",

@@ -11,7 +11,7 @@ use crate::program::{
     filter_with, FilterAxes, FilterControl, FilterError, FilterOutput, Language, ProgramFile,
 };
 use crate::solve::ik::IkSettings;
-use robocal_core::model::external::LinearTrack;
+use robocal_core::model::external::{LinearTrack, TiltRotate};
 
 /// A filter, in domain terms.
 #[derive(Debug, Clone)]
@@ -25,6 +25,10 @@ pub struct FilterCommand {
     /// The controller's own track: the robot rides its stored track,
     /// the program's axis 1 (`core::program::axes`).
     pub controller_track: Option<LinearTrack>,
+    /// The controller's own positioner (its world: the robot's base frame):
+    /// the work objects on the face plate turn with the robot's stored
+    /// positioner, the program's axes 1 and 2 (`core::program::axes`).
+    pub controller_positioner: Option<TiltRotate>,
     /// The program's language.
     pub language: Language,
     /// The program's files.
@@ -57,6 +61,13 @@ pub async fn filter_program(
         )),
         None => None,
     };
+    let positioners = match cmd.controller_positioner {
+        Some(nominal) => Some((
+            super::positioners::stored_for(state, cmd.robot_id, "controller_positioner").await?,
+            nominal,
+        )),
+        None => None,
+    };
     let mut model = chosen.model;
     if let Some(p) = cmd.payload_kg {
         model.payload_kg = p;
@@ -75,7 +86,10 @@ pub async fn filter_program(
             &cell,
             &model,
             &IkSettings::default(),
-            &FilterAxes::of_track(tracks.as_ref()),
+            &match &positioners {
+                Some(_) => FilterAxes::of_positioner(positioners.as_ref()),
+                None => FilterAxes::of_track(tracks.as_ref()),
+            },
             &control,
         );
         if matches!(out, Err(FilterError::Cancelled)) {

@@ -381,15 +381,7 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
         None => None,
         Some(choice) => {
             let item = resolve(state, cmd.robot_id, CellKind::WorkObject, choice).await?;
-            Some(WorkObject {
-                name: item.name,
-                number: None,
-                frame: match item.frame {
-                    ItemFrame::Measurement => WorkObjectFrame::Measurement,
-                    ItemFrame::Base | ItemFrame::Flange => WorkObjectFrame::Base,
-                },
-                pose: item.pose,
-            })
+            Some(item.placed_work_object()?)
         }
     };
     let in_work_object = match &work_object {
@@ -504,6 +496,26 @@ pub(super) struct ResolvedItem {
     pub pose: Pose,
     /// A tool's load, on the flange.
     pub load: Option<Load>,
+}
+
+impl ResolvedItem {
+    /// The item as a work object a solve or a prediction places in the base
+    /// frame; one on the positioner's face plate is refused (409), naming
+    /// it: only a program filter given the positioner places it.
+    pub(super) fn placed_work_object(self) -> Result<WorkObject, ServiceError> {
+        if self.frame == ItemFrame::FacePlate {
+            return Err(ServiceError::Conflict(format!(
+                "work object `{}` is on the positioner's face plate: it has a pose only at the positioner's values; give the targets in the face plate frame with `e1` and `e2`, or filter a program with `controller_positioner`",
+                self.name
+            )));
+        }
+        Ok(WorkObject {
+            name: self.name,
+            number: None,
+            frame: super::cell::work_object_frame(self.frame),
+            pose: self.pose,
+        })
+    }
 }
 
 /// A stored or inline tool or work object (`NotFound` for an unknown name).

@@ -31,15 +31,7 @@ fn cell_file() -> Value {
 }
 
 async fn put(t: &TestApp, template: &str, args: &[&str], body: Value) -> Resp {
-    t.send(
-        "PUT",
-        template,
-        args,
-        "",
-        Some("application/json"),
-        body.to_string().into_bytes(),
-    )
-    .await
+    t.put_json(template, args, body).await
 }
 
 async fn delete(t: &TestApp, template: &str, args: &[&str]) -> Resp {

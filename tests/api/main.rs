@@ -51,6 +51,7 @@ mod numbers;
 mod one_answer;
 mod plans;
 mod positioner;
+mod positioner_filter;
 mod predict;
 mod progress;
 mod record;

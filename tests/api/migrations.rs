@@ -43,6 +43,31 @@ async fn sets_dump(pool: &SqlitePool) -> Vec<String> {
     .collect()
 }
 
+/// A SQLite file `old.db` in `dir` at schema `version` (migrations 1 to
+/// `version` applied): its URL, connection options (foreign keys on) and a
+/// pool on it.
+async fn at_schema(
+    dir: &std::path::Path,
+    version: i64,
+) -> (String, SqliteConnectOptions, SqlitePool) {
+    let url = format!("sqlite://{}?mode=rwc", dir.join("old.db").display());
+    let options = SqliteConnectOptions::from_str(&url)
+        .unwrap()
+        .foreign_keys(true);
+    let pool = SqlitePool::connect_with(options.clone()).await.unwrap();
+    let mut old = sqlx::migrate!("migrations/sqlite");
+    let before: Vec<_> = old
+        .migrations
+        .iter()
+        .filter(|m| m.version <= version)
+        .cloned()
+        .collect();
+    assert_eq!(before.len() as i64, version);
+    old.migrations = Cow::Owned(before);
+    old.run(&pool).await.unwrap();
+    (url, options, pool)
+}
+
 async fn pairs(pool: &SqlitePool, sql: &str) -> Vec<(i64, Option<i64>)> {
     sqlx::query_as(sql).fetch_all(pool).await.unwrap()
 }
@@ -50,23 +75,8 @@ async fn pairs(pool: &SqlitePool, sql: &str) -> Vec<(i64, Option<i64>)> {
 #[tokio::test]
 async fn sqlite_check_role_migration_keeps_sets_versions_and_check_references() {
     let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("old.db");
-    let url = format!("sqlite://{}?mode=rwc", path.display());
-    let options = SqliteConnectOptions::from_str(&url)
-        .unwrap()
-        .foreign_keys(true);
-    let pool = SqlitePool::connect_with(options.clone()).await.unwrap();
     // The schema as it was before the `check` role: migrations 1 to 6.
-    let mut old = sqlx::migrate!("migrations/sqlite");
-    let before: Vec<_> = old
-        .migrations
-        .iter()
-        .filter(|m| m.version <= 6)
-        .cloned()
-        .collect();
-    assert_eq!(before.len(), 6);
-    old.migrations = Cow::Owned(before);
-    old.run(&pool).await.unwrap();
+    let (url, options, pool) = at_schema(dir.path(), 6).await;
 
     let exec = |sql: &'static str| {
         let pool = pool.clone();
@@ -265,22 +275,7 @@ async fn schema_8_with_old_checks(
     dir: &std::path::Path,
     total: usize,
 ) -> (String, SqliteConnectOptions) {
-    let path = dir.join("old.db");
-    let url = format!("sqlite://{}?mode=rwc", path.display());
-    let options = SqliteConnectOptions::from_str(&url)
-        .unwrap()
-        .foreign_keys(true);
-    let pool = SqlitePool::connect_with(options.clone()).await.unwrap();
-    let mut old = sqlx::migrate!("migrations/sqlite");
-    let before: Vec<_> = old
-        .migrations
-        .iter()
-        .filter(|m| m.version <= 8)
-        .cloned()
-        .collect();
-    assert_eq!(before.len(), 8);
-    old.migrations = Cow::Owned(before);
-    old.run(&pool).await.unwrap();
+    let (url, options, pool) = at_schema(dir, 8).await;
     sqlx::query("INSERT INTO robots (name, model_json, dof) VALUES ('r', '{}', 6)")
         .execute(&pool)
         .await
@@ -437,4 +432,124 @@ async fn old_checks_read_through_the_service(db: Db, dir: tempfile::TempDir, tot
     assert_eq!(r.status, StatusCode::OK, "{}", r.text());
     assert_eq!(r.json()["status"], "recalibrate");
     assert_eq!(r.json()["shift"], serde_json::Value::Null);
+}
+
+/// Every column of every cell item, ordered by id, as text.
+async fn items_dump(pool: &SqlitePool) -> Vec<String> {
+    sqlx::query(
+        "SELECT id, robot_id, kind, name, name_key, number, frame, pose_json, created_at, \
+         updated_at, load_json FROM cell_items ORDER BY id",
+    )
+    .fetch_all(pool)
+    .await
+    .unwrap()
+    .iter()
+    .map(|r| {
+        let (number, load): (Option<i64>, Option<String>) = (r.get(5), r.get(10));
+        format!(
+            "{}|{}|{}|{}|{}|{number:?}|{}|{}|{}|{}|{load:?}",
+            r.get::<i64, _>(0),
+            r.get::<i64, _>(1),
+            r.get::<String, _>(2),
+            r.get::<String, _>(3),
+            r.get::<String, _>(4),
+            r.get::<String, _>(6),
+            r.get::<String, _>(7),
+            r.get::<String, _>(8),
+            r.get::<String, _>(9),
+        )
+    })
+    .collect()
+}
+
+/// `cell_items` at schema 12 (tools with and without loads, work objects in
+/// both frames, a deleted item) rebuilt for the `face_plate` frame
+/// (migration 0013): every row and the id counter survive; the new frame is
+/// stored, an unknown one still refused, the unique keys still hold.
+#[tokio::test]
+async fn sqlite_face_plate_migration_keeps_the_cell_items() {
+    let dir = tempfile::tempdir().unwrap();
+    let (url, options, pool) = at_schema(dir.path(), 12).await;
+    sqlx::query("INSERT INTO robots (name, model_json, dof) VALUES ('r', '{}', 6)")
+        .execute(&pool)
+        .await
+        .unwrap();
+    let insert = "INSERT INTO cell_items (robot_id, kind, name, name_key, number, frame, pose_json, load_json) \
+                  VALUES (1, $1, $2, $3, $4, $5, '{\"xyz_mm\":[1,2,3],\"rpy_deg\":[0,0,9]}', $6)";
+    for (kind, name, number, frame, load) in [
+        (
+            "tool",
+            "Torch",
+            Some(1),
+            "flange",
+            Some("{\"mass_kg\":2.5}"),
+        ),
+        ("tool", "gun", None, "flange", None),
+        ("work_object", "table", Some(2), "base", None),
+        ("work_object", "fixture", Some(3), "measurement", None),
+        ("work_object", "gone", Some(4), "base", None),
+    ] {
+        sqlx::query(insert)
+            .bind(kind)
+            .bind(name)
+            .bind(name.to_ascii_lowercase())
+            .bind(number)
+            .bind(frame)
+            .bind(load)
+            .execute(&pool)
+            .await
+            .unwrap();
+    }
+    sqlx::query("DELETE FROM cell_items WHERE name = 'gone'")
+        .execute(&pool)
+        .await
+        .unwrap();
+    let plate = |name: &'static str, number: i64| {
+        sqlx::query(insert)
+            .bind("work_object")
+            .bind(name)
+            .bind(name.to_ascii_lowercase())
+            .bind(number)
+            .bind("face_plate")
+            .bind(None::<String>)
+    };
+    assert!(plate("part", 6).execute(&pool).await.is_err());
+    let before = items_dump(&pool).await;
+    assert_eq!(before.len(), 4);
+    pool.close().await;
+
+    let db = Db::connect(&url).await.unwrap();
+    assert_eq!(db.pending_migrations().await.unwrap(), 0);
+    drop(db);
+    let pool = SqlitePool::connect_with(options).await.unwrap();
+    assert_eq!(items_dump(&pool).await, before);
+    let id = plate("part", 6)
+        .execute(&pool)
+        .await
+        .unwrap()
+        .last_insert_rowid();
+    assert_eq!(id, 6, "the deleted item's id is not handed out again");
+    let bogus = sqlx::query(insert)
+        .bind("work_object")
+        .bind("x")
+        .bind("x")
+        .bind(7)
+        .bind("world")
+        .bind(None::<String>)
+        .execute(&pool)
+        .await;
+    assert!(bogus.is_err());
+    assert!(
+        plate("PART", 8).execute(&pool).await.is_err(),
+        "name_key unique"
+    );
+    assert!(
+        plate("other", 6).execute(&pool).await.is_err(),
+        "number unique"
+    );
+    let dangling = sqlx::query("PRAGMA foreign_key_check")
+        .fetch_all(&pool)
+        .await
+        .unwrap();
+    assert!(dangling.is_empty());
 }

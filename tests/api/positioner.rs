@@ -203,6 +203,7 @@ async fn a_positioner_fitted_over_http_is_the_command_lines_and_carries_a_target
     assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
     assert!(r.detail().contains("has no positioner"), "{}", r.detail());
     at_values_conflict(&t, &rid, json!([0, -90, 90, 0, 45, 0]), "has no positioner").await;
+    super::positioner_filter::refused_without_a_positioner(&t, &rid, &nom).await;
 
     // The fit over HTTP, stored; the same files through the command line.
     let r = t
@@ -260,6 +261,16 @@ async fn a_positioner_fitted_over_http_is_the_command_lines_and_carries_a_target
 
     let solved = plate_csv_solve(&t, &rid, &robot, &robot_in_cell, &truth, &model, d).await;
     plate_predict(&t, &rid, &model, d, &solved).await;
+    super::positioner_filter::filters_as_the_command_line(
+        &t,
+        &rid,
+        &nom,
+        &robot_in_cell,
+        &model,
+        &d.join("p.json"),
+        d,
+    )
+    .await;
 
     // A robot with a track as well: the `e1` column could be either's.
     let rail = super::track::Rail::new(&model);

@@ -39,15 +39,7 @@ fn same(a: &Value, b: &Value) -> bool {
 }
 
 async fn put(t: &TestApp, template: &str, args: &[&str], body: Value) -> Resp {
-    t.send(
-        "PUT",
-        template,
-        args,
-        "",
-        Some("application/json"),
-        body.to_string().into_bytes(),
-    )
-    .await
+    t.put_json(template, args, body).await
 }
 
 /// Rows with every field at a bound of the stored form (mm, deg), and one

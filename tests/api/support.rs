@@ -326,8 +326,16 @@ impl TestApp {
     }
 
     pub(crate) async fn post_json(&self, template: &str, args: &[&str], body: Value) -> Resp {
+        self.json_body("POST", template, args, body).await
+    }
+
+    pub(crate) async fn put_json(&self, template: &str, args: &[&str], body: Value) -> Resp {
+        self.json_body("PUT", template, args, body).await
+    }
+
+    async fn json_body(&self, method: &str, template: &str, args: &[&str], body: Value) -> Resp {
         self.send(
-            "POST",
+            method,
             template,
             args,
             "",

@@ -139,6 +139,25 @@ pub(crate) async fn refused_without_a_track(t: &TestApp, rid: &str) {
     );
 }
 
+/// `robocal filter` run in-process with `argv` (writing into `out`) gives
+/// the HTTP answer `http`'s report and files, byte for byte, every target
+/// filtered.
+pub(crate) fn assert_cli_gives<const N: usize>(http: &Value, argv: [String; N], out: &Path) {
+    let robocal::cli::Command::Filter(a) = robocal::cli::Cli::try_parse_from(argv).unwrap().command
+    else {
+        unreachable!("a filter command line")
+    };
+    let by_cli = robocal::cli::filter::filter_report(&a).unwrap();
+    assert_eq!(by_cli.not_done, 0);
+    let cli_report: Value = serde_json::from_str(&by_cli.text).unwrap();
+    assert_eq!(http["report"], cli_report, "the report");
+    for f in http["files"].as_array().unwrap() {
+        let name = f["name"].as_str().unwrap();
+        let written = std::fs::read_to_string(out.join(name)).unwrap();
+        assert_eq!(f["content"].as_str().unwrap(), written, "{name}");
+    }
+}
+
 /// After the fit: the program filtered over HTTP and by the command line
 /// with the stored track's file `rail_json` and the model file `model`.
 pub(crate) async fn filters_as_the_command_line(
@@ -181,19 +200,7 @@ pub(crate) async fn filters_as_the_command_line(
         p(&dir.join("rail.src")),
         p(&dir.join("rail.dat")),
     ];
-    let robocal::cli::Command::Filter(a) = robocal::cli::Cli::try_parse_from(argv).unwrap().command
-    else {
-        unreachable!("a filter command line")
-    };
-    let by_cli = robocal::cli::filter::filter_report(&a).unwrap();
-    assert_eq!(by_cli.not_done, 0);
-    let cli_report: Value = serde_json::from_str(&by_cli.text).unwrap();
-    assert_eq!(*report, cli_report, "the report");
-    for f in http["files"].as_array().unwrap() {
-        let name = f["name"].as_str().unwrap();
-        let written = std::fs::read_to_string(out.join(name)).unwrap();
-        assert_eq!(f["content"].as_str().unwrap(), written, "{name}");
-    }
+    assert_cli_gives(&http, argv, &out);
     // The values stay as programmed.
     let filtered = http["files"][1]["content"].as_str().unwrap();
     for e in &values {

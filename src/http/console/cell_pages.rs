@@ -92,7 +92,7 @@ fn items_table(id: i64, kind: Kind, rows: &[CellItemRow]) -> Markup {
                         tr data-item=(r.name) {
                             td.name { (r.name) }
                             td.number { @if let Some(n) = r.number { (n) } @else { "—" } }
-                            @if frames { td { (if r.frame == ItemFrame::Measurement { "measurement" } else { "base" }) } }
+                            @if frames { td { (r.frame.as_str()) } }
                             td.pose { (pose_text(r)) }
                             @if !frames { td.load { (load_text(r)) } }
                             td {
@@ -141,11 +141,12 @@ fn item_form(id: i64, kind: Kind, item: Option<&CellItemRow>) -> Markup {
             }
             label { "Number " input name="number" type="number" min="0" max="999" step="1" value=[item.and_then(|r| r.number)]; }
             @if kind == Kind::WorkObject {
-                @let measured = item.is_some_and(|r| r.frame == ItemFrame::Measurement);
+                @let frame = item.map_or(ItemFrame::Base, |r| r.frame);
                 label { "Frame "
                     select name="frame" {
-                        option value="base" selected[!measured] { "robot base" }
-                        option value="measurement" selected[measured] { "tracker (measurement)" }
+                        option value="base" selected[frame == ItemFrame::Base] { "robot base" }
+                        option value="measurement" selected[frame == ItemFrame::Measurement] { "tracker (measurement)" }
+                        option value="face_plate" selected[frame == ItemFrame::FacePlate] { "positioner's face plate" }
                     }
                 }
             }

@@ -1,0 +1,229 @@
+//! A program whose base sits on the robot's stored positioner, filtered over
+//! HTTP with the controller's own positioner (`controller_positioner`) and
+//! by `robocal filter --positioner --nominal-positioner` with the stored
+//! positioner's file: the same files and the same report, byte for byte.
+//! The program is KRL, base 3 a work object stored on the face plate
+//! (`frame: face_plate`), every target an `E6POS` at its own `E1`, `E2`;
+//! the targets are where the nominal controller puts the reflector at
+//! random joints, in the part as it computes it. How close filtered
+//! programs bring a true tool to the true part is the core's test
+//! (`core/tests/programs/positioner.rs`); here the plumbing is.
+
+use crate::support::*;
+use axum::http::StatusCode;
+use nalgebra::Vector3;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use robocal::model::external::TiltRotate;
+use robocal::model::kinematics::{chain::tool_pose, fk};
+use robocal::model::orientation::{rotation_to, OrientationConvention};
+use robocal::model::{preset, Pose};
+use robocal::program::{kuka_status, kuka_turn};
+use robocal::sim::random_configurations;
+use robocal::solve::ik::{AnalyticIk, Elbow, Shoulder};
+use serde_json::{json, Value};
+use std::path::Path;
+
+const FILTER: &str = "/v1/robots/{id}/programs/filter";
+const FRAME: &str = "/v1/robots/{id}/frames/{name}";
+
+/// The part on the face plate: 120 mm out, 60 mm above it, turned 20°.
+const PART_XYZ_MM: [f64; 3] = [120.0, 80.0, 60.0];
+const PART_RPY_DEG: [f64; 3] = [0.0, 0.0, 20.0];
+
+/// The controller's positioner: `nominal` (cell frame) seen from the
+/// robot's base, `robot_in_cell` the robot's registration.
+fn controller(nominal: &TiltRotate, robot_in_cell: &Pose) -> TiltRotate {
+    TiltRotate {
+        cell_from_base: robot_in_cell.inverse().compose(&nominal.cell_from_base),
+        ..*nominal
+    }
+}
+
+fn request(src: &str, dat: &str, positioner: &TiltRotate) -> Value {
+    json!({
+        "language": "krl",
+        "files": [
+            { "name": "turn.src", "content": src },
+            { "name": "turn.dat", "content": dat }
+        ],
+        "controller_positioner": serde_json::from_str::<Value>(&positioner.to_json()).unwrap(),
+    })
+}
+
+/// A KRL program (the nominal reflector as its tool, base 3) to the poses
+/// the nominal controller gives the reflector at random joints, in the part
+/// as `controller` computes it at `values`, with those joints' flags.
+fn program(controller: &TiltRotate, values: &[[f64; 2]], rng: &mut ChaCha8Rng) -> (String, String) {
+    let nominal = preset("ys100").unwrap();
+    let ik = AnalyticIk::new(&nominal).unwrap();
+    let tool = tool_pose(&nominal);
+    let t = rotation_to(OrientationConvention::KukaAbc, &tool.r);
+    let mut src = format!(
+        "DEF turn()\n$TOOL = {{X {:.4},Y {:.4},Z {:.4},A {:.4},B {:.4},C {:.4}}}\nBAS(#BASE, 3)\n",
+        tool.p.x * 1e3,
+        tool.p.y * 1e3,
+        tool.p.z * 1e3,
+        t[0],
+        t[1],
+        t[2]
+    );
+    let part = Pose::new(
+        robocal::model::pose::rpy_matrix(0.0, 0.0, PART_RPY_DEG[2].to_radians()),
+        Vector3::from(PART_XYZ_MM) * 1e-3,
+    );
+    let mut dat = String::from("DEFDAT turn\n");
+    let mut i = 0;
+    while i < values.len() {
+        let q = random_configurations(&nominal, 1, rng).remove(0);
+        let deg: Vec<f64> = nominal
+            .joints_to_controller(&q)
+            .iter()
+            .map(|v| v.to_degrees())
+            .collect();
+        let Some(conf) = ik.configuration(&q) else {
+            continue;
+        };
+        // Away from the flags' boundaries and the back branches near the
+        // YS100's limits, where a target may have no solution on its flags.
+        if deg.iter().any(|v| v.abs() < 5.0)
+            || deg[4].abs() < 10.0
+            || conf.elbow != Elbow::Up
+            || conf.shoulder != Shoulder::Front
+        {
+            continue;
+        }
+        let v = values[i];
+        let frame = controller.cell_from_face_plate(v).compose(&part);
+        let p = frame.inverse().compose(&fk(&nominal, &q).unwrap());
+        let abc = rotation_to(OrientationConvention::KukaAbc, &p.r);
+        src.push_str(&format!("PTP XP{i}\n"));
+        dat.push_str(&format!(
+            "DECL E6POS XP{i}={{X {:.4},Y {:.4},Z {:.4},A {:.4},B {:.4},C {:.4},S {},T {},E1 {},E2 {}}}\n",
+            p.p.x * 1e3,
+            p.p.y * 1e3,
+            p.p.z * 1e3,
+            abc[0],
+            abc[1],
+            abc[2],
+            kuka_status(&deg, conf),
+            kuka_turn(&deg),
+            v[0],
+            v[1]
+        ));
+        i += 1;
+    }
+    (src + "END\n", dat + "ENDDAT\n")
+}
+
+/// Before the robot has a positioner: `controller_positioner` is a 409
+/// naming what to fit; one the model refuses a 422 naming its field, as is
+/// one beside `controller_track`.
+pub(crate) async fn refused_without_a_positioner(t: &TestApp, rid: &str, nominal: &TiltRotate) {
+    let src = "DEF a()\nPTP XP1\nEND\n";
+    let dat = "DEFDAT a\nDECL E6POS XP1={X 100,Y 0,Z 50,A 0,B 90,C 0,E1 10,E2 5}\nENDDAT\n";
+    let r = t
+        .post_json(FILTER, &[rid], request(src, dat, nominal))
+        .await;
+    assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
+    assert!(
+        r.detail().contains("`controller_positioner`: robot")
+            && r.detail().contains("has no positioner"),
+        "{}",
+        r.detail()
+    );
+    let mut body = request(src, dat, nominal);
+    body["controller_positioner"]["rotate"]["scale"] = json!(1.5);
+    let r = t.post_json(FILTER, &[rid], body).await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+    assert!(
+        r.detail().contains("`controller_positioner`") && r.detail().contains("scale"),
+        "{}",
+        r.detail()
+    );
+    let mut body = request(src, dat, nominal);
+    body["controller_track"] = json!({});
+    let r = t.post_json(FILTER, &[rid], body).await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+}
+
+/// After the fit: the part stored on the face plate; the program filtered
+/// over HTTP and by the command line with the stored positioner's file
+/// `fitted` (`nominal`: the drawing, cell frame) and the model file `model`;
+/// a solve in the plate work object is a 409 naming it.
+pub(crate) async fn filters_as_the_command_line(
+    t: &TestApp,
+    rid: &str,
+    nominal: &TiltRotate,
+    robot_in_cell: &Pose,
+    model: &Path,
+    fitted: &Path,
+    dir: &Path,
+) {
+    let part = json!({ "number": 3, "frame": "face_plate", "xyz_mm": PART_XYZ_MM, "rpy_deg": PART_RPY_DEG });
+    let r = t.put_json(FRAME, &[rid, "part"], part.clone()).await;
+    assert!(r.status.is_success(), "{}", r.text());
+    let stored = t.get(FRAME, &[rid, "part"]).await.json();
+    assert_eq!(stored["frame"], "face_plate");
+    let controller = controller(nominal, robot_in_cell);
+    let values: Vec<[f64; 2]> = (0..10)
+        .map(|i| [-45.0 + 10.0 * f64::from(i), 170.0 - 35.0 * f64::from(i)])
+        .collect();
+    let (src, dat) = program(&controller, &values, &mut ChaCha8Rng::seed_from_u64(31));
+    let r = t
+        .post_json(FILTER, &[rid], request(&src, &dat, &controller))
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let http = r.json();
+    let report = &http["report"];
+    assert_eq!(report["filtered"], 10, "{report}");
+    assert_eq!(report["positioner_axes"], json!(["E1", "E2"]));
+    for (line, v) in report["targets"].as_array().unwrap().iter().zip(&values) {
+        assert_eq!(line["positioner_deg"], json!(v));
+    }
+
+    std::fs::write(dir.join("turn.src"), &src).unwrap();
+    std::fs::write(dir.join("turn.dat"), &dat).unwrap();
+    std::fs::write(dir.join("controller.json"), controller.to_json()).unwrap();
+    let mut entry = part;
+    entry["name"] = json!("part");
+    std::fs::write(
+        dir.join("cell.json"),
+        json!({ "work_objects": [entry] }).to_string(),
+    )
+    .unwrap();
+    let out = dir.join("filtered");
+    let p = |p: &Path| p.to_str().unwrap().to_string();
+    let argv = [
+        "robocal".to_string(),
+        "filter".into(),
+        "--model".into(),
+        p(model),
+        "--cell".into(),
+        p(&dir.join("cell.json")),
+        "--positioner".into(),
+        p(fitted),
+        "--nominal-positioner".into(),
+        p(&dir.join("controller.json")),
+        "--out-dir".into(),
+        p(&out),
+        p(&dir.join("turn.src")),
+        p(&dir.join("turn.dat")),
+    ];
+    super::track_filter::assert_cli_gives(&http, argv, &out);
+    // A solve in the plate work object: no pose without the values.
+    let r = t
+        .post_json(
+            "/v1/robots/{id}/solve",
+            &[rid],
+            json!({ "targets": [{ "x": 0, "y": 0, "z": 50 }], "work_object": "part", "position_only": true }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
+    assert!(
+        r.detail()
+            .contains("work object `part` is on the positioner's face plate"),
+        "{}",
+        r.detail()
+    );
+}
