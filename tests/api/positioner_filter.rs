@@ -9,17 +9,17 @@
 //! programs bring a true tool to the true part is the core's test
 //! (`core/tests/programs/positioner.rs`); here the plumbing is.
 
+use super::track_filter::{flagged_joints, krl_head};
 use crate::support::*;
 use axum::http::StatusCode;
 use nalgebra::Vector3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal::model::external::TiltRotate;
-use robocal::model::kinematics::{chain::tool_pose, fk};
+use robocal::model::kinematics::fk;
 use robocal::model::orientation::{rotation_to, OrientationConvention};
 use robocal::model::{preset, Pose};
 use robocal::program::{kuka_status, kuka_turn};
-use robocal::sim::random_configurations;
 use robocal::solve::ik::{AnalyticIk, Elbow, Shoulder};
 use serde_json::{json, Value};
 use std::path::Path;
@@ -57,43 +57,18 @@ fn request(src: &str, dat: &str, positioner: &TiltRotate) -> Value {
 fn program(controller: &TiltRotate, values: &[[f64; 2]], rng: &mut ChaCha8Rng) -> (String, String) {
     let nominal = preset("ys100").unwrap();
     let ik = AnalyticIk::new(&nominal).unwrap();
-    let tool = tool_pose(&nominal);
-    let t = rotation_to(OrientationConvention::KukaAbc, &tool.r);
-    let mut src = format!(
-        "DEF turn()\n$TOOL = {{X {:.4},Y {:.4},Z {:.4},A {:.4},B {:.4},C {:.4}}}\nBAS(#BASE, 3)\n",
-        tool.p.x * 1e3,
-        tool.p.y * 1e3,
-        tool.p.z * 1e3,
-        t[0],
-        t[1],
-        t[2]
-    );
+    let mut src = krl_head("turn", "BAS(#BASE, 3)");
     let part = Pose::new(
         robocal::model::pose::rpy_matrix(0.0, 0.0, PART_RPY_DEG[2].to_radians()),
         Vector3::from(PART_XYZ_MM) * 1e-3,
     );
     let mut dat = String::from("DEFDAT turn\n");
-    let mut i = 0;
-    while i < values.len() {
-        let q = random_configurations(&nominal, 1, rng).remove(0);
-        let deg: Vec<f64> = nominal
-            .joints_to_controller(&q)
-            .iter()
-            .map(|v| v.to_degrees())
-            .collect();
-        let Some(conf) = ik.configuration(&q) else {
-            continue;
-        };
-        // Away from the flags' boundaries and the back branches near the
-        // YS100's limits, where a target may have no solution on its flags.
-        if deg.iter().any(|v| v.abs() < 5.0)
-            || deg[4].abs() < 10.0
-            || conf.elbow != Elbow::Up
-            || conf.shoulder != Shoulder::Front
-        {
-            continue;
-        }
-        let v = values[i];
+    for (i, &v) in values.iter().enumerate() {
+        // The back branches near the YS100's limits may have no solution
+        // on their flags.
+        let (q, deg, conf) = flagged_joints(&ik, rng, |c| {
+            c.elbow == Elbow::Up && c.shoulder == Shoulder::Front
+        });
         let frame = controller.cell_from_face_plate(v).compose(&part);
         let p = frame.inverse().compose(&fk(&nominal, &q).unwrap());
         let abc = rotation_to(OrientationConvention::KukaAbc, &p.r);
@@ -111,7 +86,6 @@ fn program(controller: &TiltRotate, values: &[[f64; 2]], rng: &mut ChaCha8Rng) -
             v[0],
             v[1]
         ));
-        i += 1;
     }
     (src + "END\n", dat + "ENDDAT\n")
 }

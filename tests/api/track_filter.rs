@@ -21,7 +21,7 @@ use robocal::model::pose::rpy_matrix;
 use robocal::model::preset;
 use robocal::program::{kuka_status, kuka_turn};
 use robocal::sim::random_configurations;
-use robocal::solve::ik::{AnalyticIk, Elbow};
+use robocal::solve::ik::{AnalyticIk, Configuration, Elbow};
 use serde_json::{json, Value};
 use std::path::Path;
 
@@ -54,23 +54,32 @@ fn controller_track() -> Value {
 /// A KRL program (the nominal reflector as its tool, the world as its base)
 /// to the reflector poses the true robot reached at `values` [mm], with the
 /// nominal model's flags (joints away from the flags' boundaries, elbow up).
-fn program(rail: &Rail, values: &[f64], rng: &mut ChaCha8Rng) -> (String, String) {
-    let nominal = preset("ys100").unwrap();
-    let ik = AnalyticIk::new(&nominal).unwrap();
-    let tool = tool_pose(&nominal);
+/// The head of a KRL `.src` named `name` with the nominal YS100's
+/// reflector as its `$TOOL` and `base` (a `$BASE` or `BAS` line) after it.
+pub(crate) fn krl_head(name: &str, base: &str) -> String {
+    let tool = tool_pose(&preset("ys100").unwrap());
     let t = rotation_to(OrientationConvention::KukaAbc, &tool.r);
-    let mut src = format!(
-        "DEF rail()\n$TOOL = {{X {:.4},Y {:.4},Z {:.4},A {:.4},B {:.4},C {:.4}}}\n$BASE = $NULLFRAME\n",
+    format!(
+        "DEF {name}()\n$TOOL = {{X {:.4},Y {:.4},Z {:.4},A {:.4},B {:.4},C {:.4}}}\n{base}\n",
         tool.p.x * 1e3,
         tool.p.y * 1e3,
         tool.p.z * 1e3,
         t[0],
         t[1],
         t[2]
-    );
-    let mut dat = String::from("DEFDAT rail\n");
-    let mut i = 0;
-    while i < values.len() {
+    )
+}
+
+/// Random joints of the nominal YS100 (model convention), drawn until their
+/// flags are clear of the flags' boundaries (every joint 5° from 0, A5 10°)
+/// and `accept` takes their configuration; with their controller degrees.
+pub(crate) fn flagged_joints(
+    ik: &AnalyticIk,
+    rng: &mut ChaCha8Rng,
+    accept: impl Fn(Configuration) -> bool,
+) -> (Vec<f64>, Vec<f64>, Configuration) {
+    let nominal = preset("ys100").unwrap();
+    loop {
         let q = random_configurations(&nominal, 1, rng).remove(0);
         let deg: Vec<f64> = nominal
             .joints_to_controller(&q)
@@ -80,12 +89,21 @@ fn program(rail: &Rail, values: &[f64], rng: &mut ChaCha8Rng) -> (String, String
         let Some(conf) = ik.configuration(&q) else {
             continue;
         };
-        // Elbow down is near the YS100's limits: a target the true robot
-        // reached there may have no solution on its flags within them.
-        if deg.iter().any(|v| v.abs() < 5.0) || deg[4].abs() < 10.0 || conf.elbow != Elbow::Up {
+        if deg.iter().any(|v| v.abs() < 5.0) || deg[4].abs() < 10.0 || !accept(conf) {
             continue;
         }
-        let e = values[i];
+        return (q, deg, conf);
+    }
+}
+
+fn program(rail: &Rail, values: &[f64], rng: &mut ChaCha8Rng) -> (String, String) {
+    let ik = AnalyticIk::new(&preset("ys100").unwrap()).unwrap();
+    let mut src = krl_head("rail", "$BASE = $NULLFRAME");
+    let mut dat = String::from("DEFDAT rail\n");
+    for (i, &e) in values.iter().enumerate() {
+        // Elbow down is near the YS100's limits: a target the true robot
+        // reached there may have no solution on its flags within them.
+        let (q, deg, conf) = flagged_joints(&ik, rng, |c| c.elbow == Elbow::Up);
         let p = rail.true_pose(&q, e);
         let abc = rotation_to(OrientationConvention::KukaAbc, &p.r);
         let s = kuka_status(&deg, conf);
@@ -100,7 +118,6 @@ fn program(rail: &Rail, values: &[f64], rng: &mut ChaCha8Rng) -> (String, String
             abc[2],
             kuka_turn(&deg)
         ));
-        i += 1;
     }
     (src + "END\n", dat + "ENDDAT\n")
 }

@@ -130,22 +130,6 @@ fn choose_load(
     (load, used, warnings)
 }
 
-fn resolve_work_object(spec: &FrameSpec, cell: &Cell) -> Result<WorkObject, String> {
-    match spec {
-        FrameSpec::Ref(r) => cell.work_object(r).map_err(|e| e.to_string()),
-        FrameSpec::Inline(p) => Ok(WorkObject {
-            name: "inline".into(),
-            number: None,
-            frame: WorkObjectFrame::Base,
-            pose: *p,
-        }),
-        FrameSpec::Unset => Ok(WorkObject::base()),
-        FrameSpec::FacePlate(_) => Err(
-            "the work object is on the positioner's face plate and the filter was given no positioner: not filtered".into(),
-        ),
-    }
-}
-
 /// A site's work object in the cell (world) frame, for a robot on a track:
 /// the world itself for none or number 0 (KRL `$NULLFRAME`, RAPID `wobj0`,
 /// Fanuc `UF : 0`), an inline frame as given, a cell work object measured
@@ -205,15 +189,17 @@ fn placed_work_object(
         };
         return Ok((in_base, Some((s_nom, world.pose))));
     }
+    let inline = |frame, pose| WorkObject {
+        name: "inline".into(),
+        number: None,
+        frame,
+        pose,
+    };
     let w = match spec {
-        FrameSpec::FacePlate(p) => WorkObject {
-            name: "inline".into(),
-            number: None,
-            frame: WorkObjectFrame::FacePlate,
-            pose: *p,
-        },
         FrameSpec::Ref(r) => cell.any_work_object(r).map_err(|e| e.to_string())?,
-        _ => resolve_work_object(spec, cell)?,
+        FrameSpec::Inline(p) => inline(WorkObjectFrame::Base, *p),
+        FrameSpec::FacePlate(p) => inline(WorkObjectFrame::FacePlate, *p),
+        FrameSpec::Unset => WorkObject::base(),
     };
     if w.frame != WorkObjectFrame::FacePlate {
         return Ok((w, None));

@@ -68,23 +68,8 @@ pub fn rapid_program(name: &str, data: &str, targets: &[Written]) -> Vec<Program
     let mut text = format!("MODULE {name}\r\n{data}");
     let mut body = String::from("  PROC main()\r\n");
     for (i, w) in targets.iter().enumerate() {
-        let (t, cf) = (w.pose, abb_cf(w.deg, w.conf));
-        let q = rotation_to(OrientationConvention::AbbQ1q4, &t.r);
-        text.push_str(&format!(
-            "  CONST robtarget p{i}:=[[{:.4},{:.4},{:.4}],[{:.9},{:.9},{:.9},{:.9}],[{},{},{},{}],{}];\r\n",
-            t.p.x * 1e3,
-            t.p.y * 1e3,
-            t.p.z * 1e3,
-            q[0],
-            q[1],
-            q[2],
-            q[3],
-            cf[0],
-            cf[1],
-            cf[2],
-            cf[3],
-            w.rapid_axes
-        ));
+        let literal = super::rapid::robtarget(w.pose, abb_cf(w.deg, w.conf), &w.rapid_axes);
+        text.push_str(&format!("  CONST robtarget p{i}:={literal};\r\n"));
         body.push_str(&format!(
             "    MoveL p{i}, v200, fine, torch\\WObj:=part;\r\n"
         ));

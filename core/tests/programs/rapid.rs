@@ -7,9 +7,15 @@ use robocal_core::model::orientation::{rotation_to, OrientationConvention};
 use robocal_core::program::{abb_cf, filter, LoadSource, TargetStatus};
 
 fn literal(p: &Pose, cf: [i32; 4]) -> String {
+    robtarget(p, cf, "[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]")
+}
+
+/// A `robtarget` literal of `p` (mm, quaternion) with configuration `cf`
+/// and the external axes `axes` as written (`[eax_a,…,eax_f]`).
+pub(super) fn robtarget(p: &Pose, cf: [i32; 4], axes: &str) -> String {
     let q = rotation_to(OrientationConvention::AbbQ1q4, &p.r);
     format!(
-        "[[{:.4},{:.4},{:.4}],[{:.9},{:.9},{:.9},{:.9}],[{},{},{},{}],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]]",
+        "[[{:.4},{:.4},{:.4}],[{:.9},{:.9},{:.9},{:.9}],[{},{},{},{}],{axes}]",
         p.p.x * 1e3,
         p.p.y * 1e3,
         p.p.z * 1e3,
