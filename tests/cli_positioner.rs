@@ -732,3 +732,131 @@ fn simulate_writes_files_calibrate_fits_and_solve_reaches() {
         assert_refused(&out, flag);
     }
 }
+
+/// With `--robot`, `positioner simulate` also writes a KRL program on the
+/// part (base 3 on the face plate, `E1`, `E2` at each target), its cell
+/// file and the controller's positioner (the drawing in the robot's base
+/// frame), a target the robot cannot reach named as left out; fitted from
+/// the same directory's readings, `robocal filter --positioner
+/// --nominal-positioner` filters every target written, flags and
+/// values kept, nothing else in the files changed, and moves each by what
+/// the robot's errors (~1 mm / 0.1°) and the positioner's (zero offsets of
+/// 0.3° and −0.4° alone move a point 300 mm out by ~2 mm) amount to there.
+/// How close a filtered program brings a true tool to the true part is
+/// `core/tests/programs/positioner.rs`.
+#[test]
+fn simulate_with_a_robot_writes_a_program_the_filter_takes() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    robot_file(d);
+    let out = robocal(
+        d,
+        &[
+            "positioner",
+            "simulate",
+            "--out-dir",
+            "cell",
+            "--robot",
+            "robot.json",
+        ],
+    );
+    let printed = text(&out.stdout);
+    assert_eq!(code(&out), 0, "{printed}{}", text(&out.stderr));
+    for f in ["controller.json", "cell.json", "part.src", "part.dat"] {
+        assert!(
+            printed.contains(&format!("wrote cell/{f}")),
+            "{f}: {printed}"
+        );
+    }
+    // The controller's positioner: the drawing where it stands from the
+    // robot's base (this robot is registered at the cell's origin).
+    let read = |p: &str| std::fs::read_to_string(d.join(p)).unwrap();
+    let controller = TiltRotate::from_json(&read("cell/controller.json")).unwrap();
+    let drawing = nominal();
+    assert!((controller.cell_from_base.p - Vector3::new(1.7, 0.3, -0.9)).norm() < 1e-9);
+    assert_eq!(controller.tilt, drawing.tilt);
+    assert_eq!(controller.rotate, drawing.rotate);
+    let fit_line = printed
+        .lines()
+        .find_map(|l| l.strip_prefix("fit it with: robocal "))
+        .expect("the fit command");
+    let fit: Vec<&str> = fit_line.split(' ').collect();
+    let fitted = robocal(d, &fit);
+    assert_eq!(code(&fitted), 0, "{}", text(&fitted.stderr));
+
+    let out = robocal(
+        d,
+        &[
+            "filter",
+            "--model",
+            "robot.json",
+            "--cell",
+            "cell/cell.json",
+            "--positioner",
+            "positioner.json",
+            "--nominal-positioner",
+            "cell/controller.json",
+            "--out-dir",
+            "filtered",
+            "--report",
+            "report.json",
+            "cell/part.src",
+            "cell/part.dat",
+        ],
+    );
+    assert_eq!(code(&out), 0, "{}{}", text(&out.stdout), text(&out.stderr));
+    let report: serde_json::Value = serde_json::from_str(&read("report.json")).unwrap();
+    // The 12 targets of part.csv, each written or named as left out (out
+    // of the nominal robot's reach with the torch pointing into the part).
+    let written = read("cell/part.dat")
+        .lines()
+        .filter(|l| l.starts_with("DECL E6POS"))
+        .count();
+    let left_out = printed
+        .lines()
+        .filter(|l| l.starts_with("left out of part.src: point"))
+        .count();
+    println!("{written} targets written, {left_out} left out");
+    assert_eq!(written + left_out, 12, "{printed}");
+    assert!(written >= 9, "{printed}");
+    assert_eq!(report["filtered"], written, "{report}");
+    assert_eq!(report["failed"], 0, "{report}");
+    assert_eq!(report["skipped"], 0, "{report}");
+    assert_eq!(report["positioner_axes"], serde_json::json!(["E1", "E2"]));
+    assert_eq!(read("filtered/part.src"), read("cell/part.src"));
+    // Each target moved by millimetres, flags and values kept.
+    let numbers = |line: &str| -> Vec<(String, f64)> {
+        let body = &line[line.find('{').unwrap() + 1..line.rfind('}').unwrap()];
+        body.split(',')
+            .map(|kv| {
+                let (k, v) = kv.trim().split_once(' ').unwrap();
+                (k.to_string(), v.parse().unwrap())
+            })
+            .collect()
+    };
+    let before = read("cell/part.dat");
+    let after = read("filtered/part.dat");
+    let (b, a): (Vec<&str>, Vec<&str>) = (before.lines().collect(), after.lines().collect());
+    assert_eq!(b.len(), a.len());
+    let mut moved = Vec::new();
+    for (x, y) in b.iter().zip(&a) {
+        if !x.starts_with("DECL E6POS") {
+            assert_eq!(x, y);
+            continue;
+        }
+        let (x, y) = (numbers(x), numbers(y));
+        let get = |v: &[(String, f64)], k: &str| v.iter().find(|(n, _)| n == k).unwrap().1;
+        for k in ["S", "T", "E1", "E2"] {
+            assert_eq!(get(&x, k), get(&y, k), "{k} kept");
+        }
+        let shift = ["X", "Y", "Z"]
+            .iter()
+            .map(|k| (get(&x, k) - get(&y, k)).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        moved.push(shift);
+    }
+    assert_eq!(moved.len(), written);
+    println!("the filter moved the targets by {moved:.3?} mm");
+    assert!(moved.iter().all(|m| (0.2..20.0).contains(m)), "{moved:?}");
+}

@@ -17,6 +17,7 @@ pub mod model_files;
 pub mod orientation_arg;
 pub mod plan;
 pub mod positioner;
+mod positioner_part;
 pub mod positioner_sim;
 pub mod predict;
 pub mod progress;

@@ -14,7 +14,14 @@
 //!   frame;
 //! - `v0.csv`, `v1.csv`: held-out readings with both axes moved together;
 //! - `part.csv`: points of a part on the face plate (mm, face plate frame)
-//!   at four pairs of axis values, a targets file for `solve --positioner`.
+//!   at four pairs of axis values, a targets file for `solve --positioner`;
+//! - with `--robot`, a program on the part for `filter --positioner`
+//!   (`super::positioner_part`): `controller.json` (the nominal positioner
+//!   where the controller holds it, in the robot's base frame), `cell.json`
+//!   (the torch and base 3 on the face plate), `part.src` and `part.dat`
+//!   (those points at those values, the flags the nominal controller's); a
+//!   target out of the robot's reach is left out, named in the output, and
+//!   a robot that reaches none gets no program, the output saying why.
 //!
 //! The truth has what the nominal model lacks: each axis tilted by 0.05° and
 //! offset by ~0.5 mm, zero offsets of 0.3° and −0.4°, scale errors, the
@@ -27,6 +34,7 @@
 //! the tracker's noise from `ChaCha8Rng(seed)`, a stream per file.
 
 use super::model_files::load_compensated;
+use super::positioner_part::part_program;
 use anyhow::Context;
 use clap::Args;
 use nalgebra::Vector3;
@@ -35,6 +43,7 @@ use rand_chacha::ChaCha8Rng;
 use robocal_core::calibrate::external::readings::PositionerColumns;
 use robocal_core::measure::csv::write_set;
 use robocal_core::measure::external::ExternalAxis;
+use robocal_core::model::calibrated::CompensatedModel;
 use robocal_core::model::external::TiltRotate;
 use robocal_core::model::pose::rpy_matrix;
 use robocal_core::model::Pose;
@@ -104,11 +113,13 @@ pub fn simulate_to_string(a: &SimulateArgs) -> anyhow::Result<String> {
         noise_mm: a.noise_mm,
         ..truth(a.wobble_deg)
     };
+    let mut model = None;
     if let Some(robot) = &a.robot {
-        let model = load_compensated(robot).with_context(|| format!("--robot {robot}"))?;
-        let base = in_front_of(&model.cell_from_base);
+        let m = load_compensated(robot).with_context(|| format!("--robot {robot}"))?;
+        let base = in_front_of(&m.cell_from_base);
         nominal.cell_from_base = base;
         truth.cell_from_base = base;
+        model = Some(m);
     }
     let dir = Path::new(&a.out_dir);
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", a.out_dir))?;
@@ -149,6 +160,10 @@ pub fn simulate_to_string(a: &SimulateArgs) -> anyhow::Result<String> {
     written.extend(fits.iter().cloned());
     written.extend(validations.iter().cloned());
     written.push(write("part.csv", &part)?);
+    let (program, notes) = program_files(model.as_ref(), &nominal);
+    for (name, text) in &program {
+        written.push(write(name, text)?);
+    }
     let mut out = String::new();
     writeln!(
         out,
@@ -160,6 +175,9 @@ pub fn simulate_to_string(a: &SimulateArgs) -> anyhow::Result<String> {
     )?;
     for w in &written {
         writeln!(out, "wrote {w}")?;
+    }
+    for note in &notes {
+        writeln!(out, "{note}")?;
     }
     let reflectors: Vec<String> = DESIGN_MM
         .iter()
@@ -178,4 +196,48 @@ pub fn simulate_to_string(a: &SimulateArgs) -> anyhow::Result<String> {
         validate.join(" ")
     )?;
     Ok(out)
+}
+
+/// The program on the part for the controller in front of `model` (none
+/// without `--robot`): the files to write (name, text) and what to say of
+/// the targets left out or of no program at all.
+fn program_files(
+    model: Option<&CompensatedModel>,
+    nominal: &TiltRotate,
+) -> (Vec<(&'static str, String)>, Vec<String>) {
+    let Some(model) = model else {
+        return (Vec::new(), Vec::new());
+    };
+    match part_program(
+        model,
+        nominal,
+        in_front_of(&Pose::identity()),
+        &PART_MM,
+        &PART_VALUES_DEG,
+    ) {
+        Ok(files) => {
+            let notes = files
+                .left_out
+                .iter()
+                .map(|t| {
+                    format!("left out of part.src: {t} (out of the nominal robot's reach with the torch pointing into the part)")
+                })
+                .collect();
+            (
+                vec![
+                    ("controller.json", files.controller),
+                    ("cell.json", files.cell),
+                    ("part.src", files.src),
+                    ("part.dat", files.dat),
+                ],
+                notes,
+            )
+        }
+        Err(why) => (
+            Vec::new(),
+            vec![format!(
+                "no program on the part (controller.json, cell.json, part.src, part.dat): {why}"
+            )],
+        ),
+    }
 }

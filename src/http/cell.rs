@@ -55,7 +55,7 @@ pub struct ItemIn {
     /// The controller's number; `null` or absent: none.
     #[serde(default)]
     pub number: Option<super::input::Int<i64>>,
-    /// Work objects only: `base` (default) or `measurement`.
+    /// Work objects only: `base` (default), `measurement` or `face_plate`.
     #[serde(default, deserialize_with = "present")]
     pub frame: Option<String>,
     /// Position [mm]: the TCP in the flange frame (tool) or the work object's origin in its frame,
