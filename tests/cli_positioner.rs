@@ -684,18 +684,7 @@ fn simulate_writes_files_calibrate_fits_and_solve_reaches() {
 
     // In front of a robot: the nominal positioner's base is the robot's
     // registered base moved 1.7 m forward, and the part's 12 targets solve.
-    robot_file(d);
-    let out = robocal(
-        d,
-        &[
-            "positioner",
-            "simulate",
-            "--out-dir",
-            "cell",
-            "--robot",
-            "robot.json",
-        ],
-    );
+    let out = simulate_in_front(d);
     assert_eq!(code(&out), 0, "{}", text(&out.stderr));
     let placed =
         TiltRotate::from_json(&std::fs::read_to_string(d.join("cell/nominal.json")).unwrap())
@@ -733,6 +722,23 @@ fn simulate_writes_files_calibrate_fits_and_solve_reaches() {
     }
 }
 
+/// The robot file in `d` and `positioner simulate --robot` of it into
+/// `d/cell`.
+fn simulate_in_front(d: &Path) -> Output {
+    robot_file(d);
+    robocal(
+        d,
+        &[
+            "positioner",
+            "simulate",
+            "--out-dir",
+            "cell",
+            "--robot",
+            "robot.json",
+        ],
+    )
+}
+
 /// With `--robot`, `positioner simulate` also writes a KRL program on the
 /// part (base 3 on the face plate, `E1`, `E2` at each target), its cell
 /// file and the controller's positioner (the drawing in the robot's base
@@ -748,18 +754,7 @@ fn simulate_writes_files_calibrate_fits_and_solve_reaches() {
 fn simulate_with_a_robot_writes_a_program_the_filter_takes() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    robot_file(d);
-    let out = robocal(
-        d,
-        &[
-            "positioner",
-            "simulate",
-            "--out-dir",
-            "cell",
-            "--robot",
-            "robot.json",
-        ],
-    );
+    let out = simulate_in_front(d);
     let printed = text(&out.stdout);
     assert_eq!(code(&out), 0, "{printed}{}", text(&out.stderr));
     for f in ["controller.json", "cell.json", "part.src", "part.dat"] {
