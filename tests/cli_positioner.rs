@@ -13,7 +13,7 @@ mod common;
 #[path = "../core/tests/common/mod.rs"]
 mod core_common;
 
-use common::{assert_refused, code, line_rms, robocal, save_robot_file, text};
+use common::{assert_refused, code, line_rms, printed_fit, robocal, save_robot_file, text};
 use core_common::positioner::{nominal, sweeps};
 use core_common::track::ys100_truth;
 use nalgebra::Vector3;
@@ -29,6 +29,9 @@ use robocal::sim::positioner::TruePositioner;
 use robocal::sim::positioner_sets::positioner_set;
 use std::path::Path;
 use std::process::Output;
+
+#[path = "cli_positioner/held.rs"]
+mod held;
 
 const COLUMNS: PositionerColumns = PositionerColumns {
     tilt: ExternalAxis::E1,
@@ -627,11 +630,7 @@ fn simulate_writes_files_calibrate_fits_and_solve_reaches() {
             assert!(printed.contains(&name), "{name}: {printed}");
         }
         // The command it prints, run as printed (but for the binary's name).
-        let fit_line = printed
-            .lines()
-            .find_map(|l| l.strip_prefix("fit it with: robocal "))
-            .expect("the fit command");
-        let mut fit: Vec<&str> = fit_line.split(' ').collect();
+        let mut fit = printed_fit(&printed);
         let fitted = robocal(d, &fit);
         let report = text(&fitted.stdout);
         assert_eq!(code(&fitted), 0, "{report}{}", text(&fitted.stderr));
@@ -771,34 +770,11 @@ fn simulate_with_a_robot_writes_a_program_the_filter_takes() {
     assert!((controller.cell_from_base.p - Vector3::new(1.7, 0.3, -0.9)).norm() < 1e-9);
     assert_eq!(controller.tilt, drawing.tilt);
     assert_eq!(controller.rotate, drawing.rotate);
-    let fit_line = printed
-        .lines()
-        .find_map(|l| l.strip_prefix("fit it with: robocal "))
-        .expect("the fit command");
-    let fit: Vec<&str> = fit_line.split(' ').collect();
+    let fit = printed_fit(&printed);
     let fitted = robocal(d, &fit);
     assert_eq!(code(&fitted), 0, "{}", text(&fitted.stderr));
 
-    let out = robocal(
-        d,
-        &[
-            "filter",
-            "--model",
-            "robot.json",
-            "--cell",
-            "cell/cell.json",
-            "--positioner",
-            "positioner.json",
-            "--nominal-positioner",
-            "cell/controller.json",
-            "--out-dir",
-            "filtered",
-            "--report",
-            "report.json",
-            "cell/part.src",
-            "cell/part.dat",
-        ],
-    );
+    let out = held::filter_part(d, "cell/controller.json", "filtered", "report.json");
     assert_eq!(code(&out), 0, "{}{}", text(&out.stdout), text(&out.stderr));
     let report: serde_json::Value = serde_json::from_str(&read("report.json")).unwrap();
     // The 12 targets of part.csv, each written or named as left out (out
@@ -820,37 +796,10 @@ fn simulate_with_a_robot_writes_a_program_the_filter_takes() {
     assert_eq!(report["positioner_axes"], serde_json::json!(["E1", "E2"]));
     assert_eq!(read("filtered/part.src"), read("cell/part.src"));
     // Each target moved by millimetres, flags and values kept.
-    let numbers = |line: &str| -> Vec<(String, f64)> {
-        let body = &line[line.find('{').unwrap() + 1..line.rfind('}').unwrap()];
-        body.split(',')
-            .map(|kv| {
-                let (k, v) = kv.trim().split_once(' ').unwrap();
-                (k.to_string(), v.parse().unwrap())
-            })
-            .collect()
-    };
-    let before = read("cell/part.dat");
-    let after = read("filtered/part.dat");
-    let (b, a): (Vec<&str>, Vec<&str>) = (before.lines().collect(), after.lines().collect());
-    assert_eq!(b.len(), a.len());
-    let mut moved = Vec::new();
-    for (x, y) in b.iter().zip(&a) {
-        if !x.starts_with("DECL E6POS") {
-            assert_eq!(x, y);
-            continue;
-        }
-        let (x, y) = (numbers(x), numbers(y));
-        let get = |v: &[(String, f64)], k: &str| v.iter().find(|(n, _)| n == k).unwrap().1;
-        for k in ["S", "T", "E1", "E2"] {
-            assert_eq!(get(&x, k), get(&y, k), "{k} kept");
-        }
-        let shift = ["X", "Y", "Z"]
-            .iter()
-            .map(|k| (get(&x, k) - get(&y, k)).powi(2))
-            .sum::<f64>()
-            .sqrt();
-        moved.push(shift);
-    }
+    let moved: Vec<f64> = held::targets_moved(&read("cell/part.dat"), &read("filtered/part.dat"))
+        .iter()
+        .map(|m| m.norm())
+        .collect();
     assert_eq!(moved.len(), written);
     println!("the filter moved the targets by {moved:.3?} mm");
     assert!(moved.iter().all(|m| (0.2..20.0).contains(m)), "{moved:?}");

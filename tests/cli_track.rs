@@ -14,7 +14,7 @@ mod common;
 #[path = "../core/tests/common/mod.rs"]
 mod core_common;
 
-use common::{assert_refused, code, line_rms, robocal, save_robot_file, text};
+use common::{assert_refused, code, line_rms, printed_fit, robocal, save_robot_file, text};
 use core_common::track::{measure_on_track, true_pose, ys100_truth, STATIONS};
 use nalgebra::{UnitQuaternion, Vector3};
 use rand::SeedableRng;
@@ -558,4 +558,97 @@ fn numbers(v: &serde_json::Value) -> Vec<f64> {
         .iter()
         .map(|x| x.as_f64().unwrap())
         .collect()
+}
+
+/// `robocal track simulate` writes the readings of a robot (the model file
+/// given) on the example 4 m track and the drawing's track; the printed
+/// `track calibrate` command fits them, the held-out values within the
+/// judgement's limit, the fitted base within 0.05 mm of the truth's at a
+/// value the fit never saw; the same seed writes the same bytes.
+#[test]
+fn simulate_writes_files_the_printed_command_fits() {
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let cell = Cell::new(&mut rng);
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    save_robot(&cell, d);
+    let simulate = |out_dir: &str| {
+        let out = robocal(
+            d,
+            &[
+                "track",
+                "simulate",
+                "--out-dir",
+                out_dir,
+                "--robot",
+                "robot.json",
+            ],
+        );
+        assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+        text(&out.stdout)
+    };
+    let printed = simulate("sim");
+    print!("{printed}");
+    let read = |p: &str| std::fs::read_to_string(d.join(p)).unwrap();
+    assert_eq!(
+        LinearTrack::from_json(&read("sim/drawing.json")).unwrap(),
+        TrueTrack::drawing_4m()
+    );
+    let fit = printed_fit(&printed);
+    let out = robocal(d, &fit);
+    let report = text(&out.stdout);
+    assert_eq!(code(&out), 0, "{report}{}", text(&out.stderr));
+    print!("{report}");
+    assert!(report.starts_with("track fitted: 165 readings at 11 track values (e1)"));
+    let (line, rms) = line_rms(&report, "held out: 40 readings");
+    assert!(rms > 0.0 && rms < 0.052, "{line}");
+    let track = LinearTrack::from_json(&read("track.json")).unwrap();
+    let base = track.cell_from_base(HELD_OUT_MM).unwrap();
+    let truth = TrueTrack::rail_4m().cell_from_base(HELD_OUT_MM);
+    let off = (base.p - truth.p).norm() * 1e3;
+    println!("fitted base at {HELD_OUT_MM} mm: {off:.4} mm from the truth's");
+    assert!(off < 0.05, "{off}");
+    // The same seed, the same bytes; another seed, other readings.
+    simulate("again");
+    for f in ["stations.csv", "validate.csv", "drawing.json"] {
+        assert_eq!(
+            read(&format!("sim/{f}")),
+            read(&format!("again/{f}")),
+            "{f}"
+        );
+    }
+    let out = robocal(
+        d,
+        &[
+            "track",
+            "simulate",
+            "--out-dir",
+            "other",
+            "--robot",
+            "robot.json",
+            "--seed",
+            "2",
+        ],
+    );
+    assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+    assert_ne!(read("sim/stations.csv"), read("other/stations.csv"));
+    let out = robocal(
+        d,
+        &[
+            "track",
+            "simulate",
+            "--out-dir",
+            "x",
+            "--robot",
+            "robot.json",
+            "--poses",
+            "2",
+        ],
+    );
+    assert_ne!(code(&out), 0);
+    assert!(
+        text(&out.stderr).contains("--poses 2"),
+        "{}",
+        text(&out.stderr)
+    );
 }

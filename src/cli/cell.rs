@@ -6,8 +6,13 @@
 //! the output's header comment; a cell the controller could not load (a
 //! number 0 or beyond its range, one held twice) is refused naming the item;
 //! a Fanuc export writes position registers only with `--registers`.
+//! With `--positioner` or `--track` (KRL only) the calibrated axes are
+//! written too, as a KUKA external kinematic system
+//! (`core::program::controller::kinematics`), and `--held FILE` writes what
+//! the controller then computes, for the filter's `--nominal-positioner` or
+//! `--nominal-track`.
 
-use crate::program::controller::{export_cell, ExportOptions, RegisterRange};
+use crate::program::controller::{export_cell, ExportOptions, ExternalAxes, RegisterRange};
 use crate::program::Language;
 use crate::solve::cell::CellDescription;
 use anyhow::Context;
@@ -48,6 +53,21 @@ pub struct CellExportArgs {
     /// written and the frames are listed as remarks for entry by hand.
     #[arg(long)]
     pub registers: Option<RegisterRange>,
+    /// KRL: the calibrated positioner (`robocal positioner calibrate`'s
+    /// output) whose axes are written as an external kinematic system; work
+    /// objects on its face plate become bases coupled to it.
+    #[arg(long, conflicts_with = "track")]
+    pub positioner: Option<String>,
+    /// KRL: the calibrated track (`robocal track calibrate`'s output) whose
+    /// axis is written as the robot's root kinematic system; work objects are
+    /// written in the world, the cell frame.
+    #[arg(long)]
+    pub track: Option<String>,
+    /// Writes the positioner or track the controller computes from the
+    /// exported data (scales 1, no carriage maps): the filter's
+    /// `--nominal-positioner` or `--nominal-track` once the controller holds it.
+    #[arg(long)]
+    pub held: Option<String>,
 }
 
 /// The exported text.
@@ -59,11 +79,25 @@ pub fn export_to_string(a: &CellExportArgs) -> anyhow::Result<String> {
     let cell = CellDescription::from_json(&text)
         .and_then(|d| d.to_cell())
         .with_context(|| a.cell.clone())?;
+    let axes = match (&a.positioner, &a.track) {
+        (Some(p), _) => Some(ExternalAxes::Positioner(
+            super::positioner::read_positioner(p)?,
+        )),
+        (None, Some(t)) => Some(ExternalAxes::Track(super::track::read_track(t)?)),
+        (None, None) => None,
+    };
+    if a.held.is_some() && axes.is_none() {
+        anyhow::bail!("--held writes the positioner or track the controller holds: give --positioner or --track");
+    }
     let options = ExportOptions {
         registers: a.registers,
+        axes,
     };
     let done = export_cell(language, &cell, &model, &options)
         .with_context(|| format!("{}: cannot be exported for {}", a.cell, a.language))?;
+    if let (Some(path), Some(k)) = (&a.held, &done.kinematics) {
+        std::fs::write(path, k.held_json()).with_context(|| format!("cannot write {path}"))?;
+    }
     Ok(done.text)
 }
 

@@ -18,7 +18,6 @@ use crate::program::{filter_with, FilterAxes, FilterControl, Language, ProgramFi
 use crate::solve::ik::IkSettings;
 use anyhow::{bail, Context};
 use clap::Args;
-use robocal_core::model::external::TiltRotate;
 use std::path::{Path, PathBuf};
 
 /// Arguments of `robocal filter`.
@@ -113,7 +112,10 @@ pub fn filter_report(a: &FilterArgs) -> anyhow::Result<super::exit::Outcome> {
         _ => None,
     };
     let positioners = match (&a.positioner, &a.nominal_positioner) {
-        (Some(p), Some(n)) => Some((read_positioner(p)?, read_positioner(n)?)),
+        (Some(p), Some(n)) => Some((
+            super::positioner::read_positioner(p)?,
+            super::positioner::read_positioner(n)?,
+        )),
         _ => None,
     };
     let axes = match &positioners {
@@ -141,13 +143,6 @@ pub fn filter_report(a: &FilterArgs) -> anyhow::Result<super::exit::Outcome> {
         not_done: out.report.failed + out.report.skipped,
         total: out.report.targets.len(),
     })
-}
-
-/// A positioner description file (`model::external::positioner`, JSON).
-fn read_positioner(path: &str) -> anyhow::Result<TiltRotate> {
-    let json = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read positioner file {path}"))?;
-    TiltRotate::from_json(&json).with_context(|| format!("positioner file {path}"))
 }
 
 /// Writes the filtered files and the report; the exit code says whether a

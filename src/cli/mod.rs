@@ -27,6 +27,7 @@ pub mod simulate;
 pub mod solve;
 pub mod tcp;
 pub mod track;
+pub mod track_sim;
 
 pub use model_files::load_model;
 

@@ -375,10 +375,7 @@ impl OnPlate {
         text: &str,
         dialect: Dialect,
     ) -> anyhow::Result<OnPlate> {
-        let json = std::fs::read_to_string(path)
-            .with_context(|| format!("cannot read positioner file {path}"))?;
-        let positioner =
-            TiltRotate::from_json(&json).with_context(|| format!("positioner file {path}"))?;
+        let positioner = read_positioner(path)?;
         let tilt =
             target_column_values(text, dialect, TILT_COLUMN).with_context(|| file.to_string())?;
         let rotate =
@@ -455,4 +452,11 @@ impl OnPlate {
             &Pose::identity(),
         )))
     }
+}
+
+/// A positioner description file (`model::external::positioner`, JSON).
+pub(crate) fn read_positioner(path: &str) -> anyhow::Result<TiltRotate> {
+    let json = std::fs::read_to_string(path)
+        .with_context(|| format!("cannot read positioner file {path}"))?;
+    TiltRotate::from_json(&json).with_context(|| format!("positioner file {path}"))
 }

@@ -365,10 +365,7 @@ fn positioner_rows(
     text: &str,
     dialect: crate::measure::csv_text::Dialect,
 ) -> anyhow::Result<PlateRows> {
-    let json = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read positioner file {path}"))?;
-    let positioner =
-        TiltRotate::from_json(&json).with_context(|| format!("positioner file {path}"))?;
+    let positioner = super::positioner::read_positioner(path)?;
     let column = |name: &str, role: &str| -> anyhow::Result<Vec<TargetValue>> {
         target_column_values(text, dialect, name)
             .with_context(|| file.to_string())?

@@ -1,5 +1,6 @@
 //! `robocal track calibrate` and the `--track`/`--e1` options of `predict`
-//! and `solve`: a robot on a linear track.
+//! and `solve`: a robot on a linear track (`robocal track simulate`,
+//! `super::track_sim`, writes files to try them on).
 //!
 //! `track calibrate SET --model MODEL --out TRACK.json` reads a measurement
 //! file with the track's column (`e1` by default; docs/csv.md: controller
@@ -57,6 +58,8 @@ pub struct TrackArgs {
 pub enum TrackCommand {
     /// Fit a linear track carrying the robot from tracker readings at several track values.
     Calibrate(CalibrateArgs),
+    /// Write a robot on an example 4 m track measured by a simulated tracker (the files `calibrate` reads).
+    Simulate(super::track_sim::SimulateArgs),
 }
 
 /// Arguments of `robocal track calibrate`.
@@ -420,6 +423,10 @@ pub fn run(a: TrackArgs) -> anyhow::Result<()> {
     match a.command {
         TrackCommand::Calibrate(c) => {
             print!("{}", calibrate_to_string(&c)?);
+            Ok(())
+        }
+        TrackCommand::Simulate(s) => {
+            print!("{}", super::track_sim::simulate_to_string(&s)?);
             Ok(())
         }
     }

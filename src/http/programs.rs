@@ -18,7 +18,9 @@ use super::input::{objects, present};
 use super::solve::{model_choice, VersionSelector};
 use super::{ApiError, ApiJson, ApiPath, AppState};
 use crate::model::external::{TiltRotateDescription, TrackDescription};
-use crate::program::controller::{ExportOptions, RegisterRange, Renamed, UsedRegister};
+use crate::program::controller::{
+    ExportOptions, KinematicKind, NotHeld, RegisterRange, Renamed, UsedRegister,
+};
 use crate::program::{FilterReport, Language, ProgramFile};
 use crate::service;
 use crate::service::programs::FilterCommand;
@@ -213,6 +215,9 @@ pub struct CellExportRequest {
     /// The position registers a Fanuc export may overwrite.
     #[serde(default, deserialize_with = "present")]
     pub registers: Option<RegistersIn>,
+    /// KRL: the robot's stored positioner's or track's axes written too.
+    #[serde(default, deserialize_with = "present")]
+    pub axes: Option<KinematicKind>,
 }
 
 /// `registers`: `first..=last`.
@@ -245,6 +250,22 @@ pub struct CellExportResponse {
     pub renamed: Vec<Renamed>,
     /// The position registers the program overwrites (Fanuc with `registers`).
     pub registers: Vec<UsedRegister>,
+    /// With `axes`: the kinematic system written, what it does not hold,
+    /// and the positioner or track the controller then computes.
+    pub kinematics: Option<KinematicsOut>,
+}
+
+/// `kinematics` of a cell export with `axes`.
+#[derive(Debug, Serialize)]
+pub struct KinematicsOut {
+    /// `positioner` or `track`.
+    pub kind: KinematicKind,
+    /// The calibrated terms the controller's chain cannot hold.
+    pub not_held: Vec<NotHeld>,
+    /// The positioner or track description the controller computes (what
+    /// `robocal cell export --held` writes): the filter's controller
+    /// positioner or track once the controller holds the export.
+    pub held: serde_json::Value,
 }
 
 /// `POST /v1/robots/{id}/cell/export`: the robot's tools, loads and work objects as the controller
@@ -266,10 +287,29 @@ pub async fn export_cell(
         None => None,
     };
     let model = model_choice(req.version.as_ref())?;
-    let options = ExportOptions { registers };
-    let done =
-        service::programs::export_cell(&state, robot_id, model, req.payload_kg, language, &options)
-            .await?;
+    let options = ExportOptions {
+        registers,
+        axes: None,
+    };
+    let done = service::programs::export_cell(
+        &state,
+        robot_id,
+        model,
+        req.payload_kg,
+        language,
+        req.axes,
+        options,
+    )
+    .await?;
+    let kinematics = match &done.export.kinematics {
+        Some(k) => Some(KinematicsOut {
+            kind: k.kind,
+            not_held: k.not_held.clone(),
+            held: serde_json::from_str(&k.held_json())
+                .map_err(|e| ApiError::Internal(format!("held axes: {e}")))?,
+        }),
+        None => None,
+    };
     Ok(axum::Json(CellExportResponse {
         robot_id,
         version: done.version,
@@ -279,6 +319,7 @@ pub async fn export_cell(
         assigned: done.export.assigned,
         renamed: done.export.renamed,
         registers: done.export.registers,
+        kinematics,
     })
     .into_response())
 }

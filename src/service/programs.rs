@@ -7,6 +7,7 @@
 
 use super::solve::{chosen_model, ModelChoice};
 use super::{AppState, ServiceError};
+use crate::program::controller::KinematicKind;
 use crate::program::{
     filter_with, FilterAxes, FilterControl, FilterError, FilterOutput, Language, ProgramFile,
 };
@@ -138,16 +139,27 @@ pub async fn export_cell(
     model: ModelChoice,
     payload_kg: Option<f64>,
     language: Language,
-    options: &crate::program::controller::ExportOptions,
+    axes: Option<KinematicKind>,
+    mut options: crate::program::controller::ExportOptions,
 ) -> Result<CellExport, ServiceError> {
-    use crate::program::controller::{export_cell, ExportError};
+    use crate::program::controller::{export_cell, ExportError, ExternalAxes};
     let cell = super::cell::cell(state, robot_id).await?;
+    options.axes = match axes {
+        Some(KinematicKind::Positioner) => Some(ExternalAxes::Positioner(
+            super::positioners::stored_for(state, robot_id, "axes").await?,
+        )),
+        Some(KinematicKind::Track) => Some(ExternalAxes::Track(
+            super::tracks::stored_for(state, robot_id, "axes").await?,
+        )),
+        None => None,
+    };
     let chosen = chosen_model(state, robot_id, model).await?;
     let mut m = chosen.model;
     if let Some(p) = payload_kg {
         m.payload_kg = p;
     }
-    let export = export_cell(language, &cell, &m, options).map_err(|e| match e {
+    let export = export_cell(language, &cell, &m, &options).map_err(|e| match e {
+        ExportError::AxesNotWritten(_) => ServiceError::Invalid(format!("`axes`: {e}")),
         ExportError::TooFewRegisters { .. } => ServiceError::Conflict(format!(
             "`registers`: {e}; widen the range or remove items with DELETE /v1/robots/{robot_id}/tools/{{name}} or /frames/{{name}}"
         )),

@@ -12,6 +12,7 @@
 use super::track_filter::{flagged_joints, krl_head};
 use crate::support::*;
 use axum::http::StatusCode;
+use clap::Parser;
 use nalgebra::Vector3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -185,6 +186,12 @@ pub(crate) async fn filters_as_the_command_line(
         p(&dir.join("turn.dat")),
     ];
     super::track_filter::assert_cli_gives(&http, argv, &out);
+    let axes = Axes {
+        kind: "positioner",
+        file: fitted,
+        cell: &dir.join("cell.json"),
+    };
+    exports_as_the_command_line(t, rid, model, &axes, dir).await;
     // A solve in the plate work object: no pose without the values.
     let r = t
         .post_json(
@@ -197,6 +204,115 @@ pub(crate) async fn filters_as_the_command_line(
     assert!(
         r.detail()
             .contains("work object `part` is on the positioner's face plate"),
+        "{}",
+        r.detail()
+    );
+}
+
+/// A stored positioner's or track's axes, its file and the cell's file.
+pub(crate) struct Axes<'a> {
+    /// `positioner` or `track`.
+    pub kind: &'a str,
+    /// The stored positioner's or track's file.
+    pub file: &'a Path,
+    /// The robot's stored cell as a file.
+    pub cell: &'a Path,
+}
+
+/// The cell exported for KUKA with the stored positioner's or track's axes
+/// (`"axes": kind`) and by `robocal cell export --positioner|--track
+/// --held` with its file: the same text, byte for byte, and the same held
+/// positioner or track, scales 1; RAPID with `axes` is a 422, the kind the
+/// robot has not a 409.
+pub(crate) async fn exports_as_the_command_line(
+    t: &TestApp,
+    rid: &str,
+    model: &Path,
+    axes: &Axes<'_>,
+    dir: &Path,
+) {
+    const EXPORT: &str = "/v1/robots/{id}/cell/export";
+    let r = t
+        .post_json(
+            EXPORT,
+            &[rid],
+            json!({ "language": "krl", "axes": axes.kind }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let http = r.json();
+    let text = http["text"].as_str().unwrap();
+    let (mech, scale) = match axes.kind {
+        "positioner" => ("#EASYS", "tilt scale"),
+        _ => ("#ERSYS", "track scale"),
+    };
+    assert!(text.contains(&format!("$EX_KIN={{ET1 {mech},")), "{text}");
+    let k = &http["kinematics"];
+    assert_eq!(k["kind"], axes.kind);
+    let terms: Vec<&str> = k["not_held"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| n["term"].as_str().unwrap())
+        .collect();
+    assert_eq!(terms.first(), Some(&scale), "{k}");
+    let p = |p: &Path| p.to_str().unwrap().to_string();
+    let held = dir.join("held.json");
+    let argv = [
+        "robocal".to_string(),
+        "cell".into(),
+        "export".into(),
+        "--model".into(),
+        p(model),
+        "--cell".into(),
+        p(axes.cell),
+        "--language".into(),
+        "krl".into(),
+        format!("--{}", axes.kind),
+        p(axes.file),
+        "--held".into(),
+        p(&held),
+    ];
+    let robocal::cli::Command::Cell(a) = robocal::cli::Cli::try_parse_from(argv).unwrap().command
+    else {
+        unreachable!("a cell command line")
+    };
+    let robocal::cli::cell::CellCommand::Export(e) = a.command;
+    let by_cli = robocal::cli::cell::export_to_string(&e).unwrap();
+    assert_eq!(text, by_cli, "the exported text");
+    let written: Value = serde_json::from_str(&std::fs::read_to_string(&held).unwrap()).unwrap();
+    assert_eq!(k["held"], written, "the held {}", axes.kind);
+    match axes.kind {
+        "positioner" => assert_eq!(
+            (
+                written["tilt"]["scale"].as_f64(),
+                written["rotate"]["scale"].as_f64()
+            ),
+            (Some(1.0), Some(1.0))
+        ),
+        _ => assert_eq!(written["scale"].as_f64(), Some(1.0)),
+    }
+
+    let r = t
+        .post_json(
+            EXPORT,
+            &[rid],
+            json!({ "language": "rapid", "axes": axes.kind }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+    assert!(r.detail().contains("KRL only"), "{}", r.detail());
+    let other = if axes.kind == "positioner" {
+        "track"
+    } else {
+        "positioner"
+    };
+    let r = t
+        .post_json(EXPORT, &[rid], json!({ "language": "krl", "axes": other }))
+        .await;
+    assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
+    assert!(
+        r.detail().contains("`axes`: robot") && r.detail().contains(&format!("has no {other}")),
         "{}",
         r.detail()
     );

@@ -98,6 +98,9 @@ fn cli(args: &[&str]) -> anyhow::Result<String> {
             robocal::cli::track::TrackCommand::Calibrate(c) => {
                 robocal::cli::track::calibrate_to_string(&c)
             }
+            robocal::cli::track::TrackCommand::Simulate(s) => {
+                robocal::cli::track_sim::simulate_to_string(&s)
+            }
         },
         robocal::cli::Command::Predict(a) => robocal::cli::predict::predict_to_string(&a),
         robocal::cli::Command::Solve(a) => robocal::cli::solve::solve_to_string(&a),

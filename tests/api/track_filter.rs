@@ -12,12 +12,10 @@ use super::track::Rail;
 use crate::support::*;
 use axum::http::StatusCode;
 use clap::Parser;
-use nalgebra::Vector3;
 use rand_chacha::ChaCha8Rng;
-use robocal::model::external::{LinearTrack, Travel};
+use robocal::model::external::LinearTrack;
 use robocal::model::kinematics::chain::tool_pose;
 use robocal::model::orientation::{rotation_to, OrientationConvention};
-use robocal::model::pose::rpy_matrix;
 use robocal::model::preset;
 use robocal::program::{kuka_status, kuka_turn};
 use robocal::sim::random_configurations;
@@ -30,21 +28,7 @@ const FILTER: &str = "/v1/robots/{id}/programs/filter";
 /// The controller's track: the rail of the drawing, the base 350 mm above
 /// the carriage and 120 mm beside it, turned 90° about the vertical.
 fn drawing() -> LinearTrack {
-    let r = rpy_matrix(0.0, 0.0, 25f64.to_radians());
-    let start = Vector3::new(0.6, -3.1, -0.4) + r * Vector3::new(0.0, 0.12, 0.35);
-    let along = r.column(0).into_owned();
-    // `zero`: the base's travel at value 0 from the line's point closest to
-    // the cell origin.
-    LinearTrack::nominal(
-        along,
-        start,
-        start.dot(&along),
-        rpy_matrix(0.0, 0.0, std::f64::consts::FRAC_PI_2),
-        Travel {
-            lo_mm: 0.0,
-            hi_mm: 4000.0,
-        },
-    )
+    robocal::sim::track::TrueTrack::drawing_4m()
 }
 
 fn controller_track() -> Value {
@@ -218,6 +202,13 @@ pub(crate) async fn filters_as_the_command_line(
         p(&dir.join("rail.dat")),
     ];
     assert_cli_gives(&http, argv, &out);
+    std::fs::write(dir.join("cell.json"), "{}").unwrap();
+    let axes = super::positioner_filter::Axes {
+        kind: "track",
+        file: rail_json,
+        cell: &dir.join("cell.json"),
+    };
+    super::positioner_filter::exports_as_the_command_line(t, rid, model, &axes, dir).await;
     // The values stay as programmed.
     let filtered = http["files"][1]["content"].as_str().unwrap();
     for e in &values {

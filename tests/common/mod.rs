@@ -60,6 +60,17 @@ pub fn robocal_json(dir: &Path, args: &[&str]) -> serde_json::Value {
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
+/// The arguments of the `robocal` command a `simulate` printed after `fit it
+/// with: robocal `, as printed.
+pub fn printed_fit(printed: &str) -> Vec<&str> {
+    printed
+        .lines()
+        .find_map(|l| l.strip_prefix("fit it with: robocal "))
+        .unwrap_or_else(|| panic!("no fit command in\n{printed}"))
+        .split(' ')
+        .collect()
+}
+
 /// The line of a printed report that starts with `prefix` and the RMS [mm]
 /// it states (the number after `rms `).
 pub fn line_rms<'a>(report: &'a str, prefix: &str) -> (&'a str, f64) {

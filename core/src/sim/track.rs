@@ -28,6 +28,8 @@
 
 use super::{SimError, TrueRobot};
 use crate::measure::external::{ExternalAxis, ExternalValues, MeasurementSet};
+use crate::model::external::{LinearTrack, Travel};
+use crate::model::pose::rpy_matrix;
 use crate::model::Pose;
 use nalgebra::{Rotation3, Vector3};
 use rand::Rng;
@@ -122,6 +124,28 @@ impl TrueTrack {
                 Vector3::new(0.0, 0.12, 0.35),
             ),
         }
+    }
+
+    /// What a controller computes from [`TrueTrack::rail_4m`]'s drawing: the
+    /// rail 25° off the cell's x, horizontal, through the true rail's start;
+    /// the base 350 mm above the carriage's reference and 120 mm beside it,
+    /// turned 90° about the vertical; scale 1, no maps, travel 0–4000 mm.
+    pub fn drawing_4m() -> LinearTrack {
+        let r = rpy_matrix(0.0, 0.0, 25f64.to_radians());
+        let start = Vector3::new(0.6, -3.1, -0.4) + r * Vector3::new(0.0, 0.12, 0.35);
+        let along = r.column(0).into_owned();
+        // `zero`: the base's travel at value 0 from the line's point closest
+        // to the cell origin.
+        LinearTrack::nominal(
+            along,
+            start,
+            start.dot(&along),
+            rpy_matrix(0.0, 0.0, std::f64::consts::FRAC_PI_2),
+            Travel {
+                lo_mm: 0.0,
+                hi_mm: 4000.0,
+            },
+        )
     }
 
     /// Travel [m] at controller value `value_mm`.
@@ -231,6 +255,35 @@ mod tests {
         let chord = 2.0 * 1e-4 * (std::f64::consts::TAU * 0.3 / 4.0).sin() / 0.6;
         assert!((yaw - chord).abs() < 1e-15, "{yaw} {chord}");
         assert!((t.travel(4000.0) - 4.0008).abs() < 1e-12);
+    }
+
+    /// The drawing is the truth without its errors: at every value the
+    /// drawing's base is where the truth's would be with scale 1, straight
+    /// rails, no carriage angles and the rail not rising; the rise alone
+    /// (0.1° over 4 m: 7 mm) and the scale (0.8 mm) separate them.
+    #[test]
+    fn the_drawing_is_the_truth_without_its_errors() {
+        let mut ideal = TrueTrack::rail_4m();
+        ideal.scale_error = 0.0;
+        ideal.lateral.clear();
+        ideal.vertical.clear();
+        ideal.yaw_extra.clear();
+        ideal.pitch_extra.clear();
+        ideal.roll.clear();
+        let mut r = Pose::from_translation(ideal.cell_from_rail.p);
+        r.rot_z(25f64.to_radians());
+        ideal.cell_from_rail = r;
+        let drawing = TrueTrack::drawing_4m();
+        for i in 0..=40 {
+            let v = 100.0 * f64::from(i);
+            let (a, b) = (drawing.cell_from_base(v).unwrap(), ideal.cell_from_base(v));
+            assert!((a.p - b.p).norm() < 1e-12, "{v}: {:?} {:?}", a.p, b.p);
+            assert!((a.r - b.r).norm() < 1e-12, "{v}");
+        }
+        let off = (drawing.cell_from_base(4000.0).unwrap().p
+            - TrueTrack::rail_4m().cell_from_base(4000.0).p)
+            .norm();
+        assert!(off > 6e-3 && off < 9e-3, "{off}");
     }
 
     /// The acceptance truth has the sizes it is said to have: lateral

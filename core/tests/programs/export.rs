@@ -78,6 +78,7 @@ fn exported_cell_data_parse_back_to_what_the_filter_uses() {
         Language::Fanuc,
         &ExportOptions {
             registers: Some("91..99".parse().unwrap()),
+            ..Default::default()
         },
     );
     let register = |n: u32| -> Pose {

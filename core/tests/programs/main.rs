@@ -11,6 +11,7 @@
 mod common;
 
 mod accounting;
+mod axes_export;
 mod examples;
 mod export;
 mod external;
@@ -61,6 +62,16 @@ pub struct Fixture {
     pub wobj_cell: Pose,
     /// Joints of the 50 targets (model convention).
     pub joints: Vec<Vec<f64>>,
+}
+
+/// Tool 1, the torch, without a stated load.
+pub fn torch_tool() -> Tool {
+    Tool {
+        name: "torch".into(),
+        number: Some(1),
+        tcp: torch(),
+        load: None,
+    }
 }
 
 /// The production tool: 250 mm along its axis, tilted 30° about the flange's y.
@@ -161,12 +172,7 @@ fn build(
     w.rot_z(20f64.to_radians());
     let wobj_cell = truth.tracker_from_base.compose(&w);
     let cell = Cell {
-        tools: vec![Tool {
-            name: "torch".into(),
-            number: Some(1),
-            tcp: torch(),
-            load: None,
-        }],
+        tools: vec![torch_tool()],
         work_objects: vec![WorkObject {
             name: "table".into(),
             number: Some(2),

@@ -160,12 +160,7 @@ fn positioner_cell() -> &'static PositionerCell {
             .inverse()
             .compose(&true_part(&true_positioner, &body, [0.0, 0.0]));
         let cell = Cell {
-            tools: vec![Tool {
-                name: "torch".into(),
-                number: Some(1),
-                tcp: torch(),
-                load: None,
-            }],
+            tools: vec![torch_tool()],
             work_objects: vec![WorkObject {
                 name: "part".into(),
                 number: Some(3),

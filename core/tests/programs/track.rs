@@ -22,7 +22,7 @@ use super::*;
 use crate::common::track::{calibrated_on_fixed_base, measure_on_track, ys100_truth, STATIONS};
 use robocal_core::calibrate::external::track::{fit_track_compensated, DEFAULT_MAX_ORDER};
 use robocal_core::measure::external::ExternalAxis;
-use robocal_core::model::external::{LinearTrack, Travel};
+use robocal_core::model::external::LinearTrack;
 use robocal_core::program::{
     filter_with, track_axis_name, FilterAxes, FilterControl, FilterOutput, TrackAxes,
 };
@@ -52,8 +52,8 @@ struct TrackCell {
     flags: Vec<(Vec<f64>, Configuration)>,
 }
 
-/// The rail frame of the controller's drawing: 25° off the cell's x,
-/// horizontal, through the true rail's start.
+/// The rail frame of the controller's drawing (`TrueTrack::drawing_4m`):
+/// 25° off the cell's x, horizontal, through the true rail's start.
 fn drawing_rail() -> Pose {
     let mut r = Pose::from_translation(Vector3::new(0.6, -3.1, -0.4));
     r.rot_z(25f64.to_radians());
@@ -89,24 +89,7 @@ fn track_cell() -> &'static TrackCell {
         .model;
         // The drawing: the base 350 mm above the carriage and 120 mm beside
         // it, turned 90° about the vertical, as the truth's design.
-        let rail = drawing_rail();
-        let mount = rpy_matrix(0.0, 0.0, std::f64::consts::FRAC_PI_2);
-        // The base at value 0; `zero` is its travel from the rail line's
-        // point closest to the cell origin.
-        let (along, start) = (
-            rail.r.column(0).into_owned(),
-            rail.transform_point(&Vector3::new(0.0, 0.12, 0.35)),
-        );
-        let nominal_track = LinearTrack::nominal(
-            along,
-            start,
-            start.dot(&along),
-            mount,
-            Travel {
-                lo_mm: 0.0,
-                hi_mm: 4000.0,
-            },
-        );
+        let nominal_track = TrueTrack::drawing_4m();
         let mut controller = nominal.clone();
         controller.tool = robocal_core::model::Tool {
             p: torch().p,
@@ -114,14 +97,9 @@ fn track_cell() -> &'static TrackCell {
         };
         let mut on_rail = Pose::from_translation(Vector3::new(2.0, 1.3, -0.2));
         on_rail.rot_z(10f64.to_radians());
-        let part = rail.compose(&on_rail);
+        let part = drawing_rail().compose(&on_rail);
         let cell = Cell {
-            tools: vec![Tool {
-                name: "torch".into(),
-                number: Some(1),
-                tcp: torch(),
-                load: None,
-            }],
+            tools: vec![torch_tool()],
             work_objects: vec![WorkObject {
                 name: "part".into(),
                 number: Some(2),

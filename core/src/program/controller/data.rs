@@ -2,6 +2,7 @@
 //! tools, frames and loads with their numbers), the export's options and
 //! answer, why a cell cannot be exported, and names as comment text.
 
+use super::kinematics::{ExternalAxes, KukaKinematics};
 use super::names::Renamed;
 use super::numbers::{NumberRange, RegisterRange, UsedRegister};
 use crate::model::Pose;
@@ -52,6 +53,9 @@ pub struct ExportOptions {
     /// The position registers a Fanuc export may overwrite; `None`: none
     /// (the frames are listed for entry by hand, [`fanuc`]).
     pub registers: Option<RegisterRange>,
+    /// A calibrated positioner or track whose axes are written too (KRL:
+    /// an external kinematic system, [`super::kinematics`]).
+    pub axes: Option<ExternalAxes>,
 }
 
 /// The exported text and what it decided.
@@ -66,6 +70,8 @@ pub struct ControllerExport {
     pub renamed: Vec<Renamed>,
     /// The position registers the program overwrites (Fanuc).
     pub registers: Vec<UsedRegister>,
+    /// The positioner's or track's kinematic system written, when asked for.
+    pub kinematics: Option<KukaKinematics>,
 }
 
 /// Why a cell cannot be exported for a controller: the item and the fix.
@@ -76,6 +82,15 @@ pub enum ExportError {
     /// user frame of coordinated motion) is not written.
     #[error("work object `{0}` is on the positioner's face plate: its controller form (a base coupled to the positioner, a work object a mechanical unit moves, a coordinated user frame) is not written; export the cell without it and keep it as the controller holds it")]
     OnFacePlate(String),
+    /// A positioner's or track's controller data asked for in a language
+    /// it is not written in.
+    #[error("a positioner's or a track's controller data is written for KRL only (a KUKA external kinematic system); for {0:?} export the cell without the positioner or track")]
+    AxesNotWritten(crate::program::Language),
+    /// A work object stated in the robot's base frame in a track's export:
+    /// it rides the carriage, and a robot on a track holds its bases in the
+    /// world.
+    #[error("work object `{0}` is stated in the robot's base frame, which rides the track's carriage: a base of a robot on a track is held in the world (the cell frame); state it in the tracker frame (\"frame\": \"measurement\")")]
+    RidesTheCarriage(String),
     /// Two items of one kind have the same number.
     #[error("{0}")]
     Duplicate(#[from] DuplicateNumber),

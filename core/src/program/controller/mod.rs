@@ -32,6 +32,8 @@
 
 mod data;
 mod fanuc;
+mod frames;
+mod kinematics;
 mod names;
 mod numbers;
 
@@ -39,11 +41,15 @@ pub(crate) use data::comment;
 pub use data::{
     ControllerData, ControllerExport, ControllerFrame, ControllerTool, ExportError, ExportOptions,
 };
+use frames::{abb_frame, kuka_frame, ur_pose};
+pub use kinematics::{
+    kuka_positioner, kuka_track, ExternalAxes, HeldAxes, KinematicKind, KukaKinematics, NotHeld,
+    ANGLE_ARM_MM, SCALE_RADIUS_MM, SCALE_TURN_DEG,
+};
 pub use names::{RenameReason, Renamed};
 pub use numbers::{NumberRange, RegisterRange, UsedRegister};
 
 use crate::model::calibrated::CompensatedModel;
-use crate::model::orientation::{rotation_to, OrientationConvention};
 use crate::model::Pose;
 use crate::program::Language;
 use crate::solve::cell::numbering::{self, ItemKind};
@@ -101,21 +107,61 @@ pub fn controller_data(cell: &Cell, model: &CompensatedModel) -> ControllerData 
     }
 }
 
-/// The cell exported for `language` on the calibrated `model`.
+/// The cell exported for `language` on the calibrated `model`; with
+/// `options.axes`, the positioner's or track's kinematic system too (KRL
+/// only): work objects on the face plate are then bases coupled to the
+/// positioner, and on a track every work object is held in the world (the
+/// cell frame).
 pub fn export_cell(
     language: Language,
     cell: &Cell,
     model: &CompensatedModel,
     options: &ExportOptions,
 ) -> Result<ControllerExport, ExportError> {
-    if let Some(w) = cell
-        .work_objects
-        .iter()
-        .find(|w| w.frame == crate::solve::cell::WorkObjectFrame::FacePlate)
-    {
-        return Err(ExportError::OnFacePlate(w.name.clone()));
+    use crate::solve::cell::WorkObjectFrame;
+    let on = |frame: WorkObjectFrame| cell.work_objects.iter().find(|w| w.frame == frame);
+    let mut data = controller_data(cell, model);
+    let kinematics = match &options.axes {
+        Some(_) if language != Language::Krl => return Err(ExportError::AxesNotWritten(language)),
+        Some(ExternalAxes::Positioner(p)) => {
+            Some(kuka_positioner(p, &model.cell_to_base(&Pose::identity())))
+        }
+        Some(ExternalAxes::Track(t)) => {
+            if let Some(w) = on(WorkObjectFrame::FacePlate) {
+                return Err(ExportError::OnFacePlate(w.name.clone()));
+            }
+            if let Some(w) = on(WorkObjectFrame::Base) {
+                return Err(ExportError::RidesTheCarriage(w.name.clone()));
+            }
+            // The world is the cell frame: a measured work object as it is.
+            for (f, w) in data.frames.iter_mut().zip(&cell.work_objects) {
+                f.pose = w.pose;
+            }
+            Some(kuka_track(t))
+        }
+        None => {
+            if let Some(w) = on(WorkObjectFrame::FacePlate) {
+                return Err(ExportError::OnFacePlate(w.name.clone()));
+            }
+            None
+        }
+    };
+    let mut out = controller_text(language, &data, options)?;
+    if let Some(k) = &kinematics {
+        out.text.push_str(&k.text());
+        for (f, w) in data.frames.iter().zip(&cell.work_objects) {
+            if w.frame == WorkObjectFrame::FacePlate {
+                let _ = write!(
+                    out.text,
+                    "; BASE_DATA[{n}] {} is on the face plate: $BASE=EK(MACHINE_DEF[2].ROOT,MACHINE_DEF[2].MECH_TYPE,BASE_DATA[{n}])\r\n",
+                    comment(&f.name, Language::Krl),
+                    n = f.number
+                );
+            }
+        }
     }
-    controller_text(language, &controller_data(cell, model), options)
+    out.kinematics = kinematics;
+    Ok(out)
 }
 
 /// Refuses numbers the controller does not take, or one held twice.
@@ -188,41 +234,6 @@ fn assigned_lines(language: Language, data: &ControllerData) -> Vec<String> {
         .collect()
 }
 
-fn kuka_frame(p: &Pose) -> String {
-    let abc = rotation_to(OrientationConvention::KukaAbc, &p.r);
-    format!(
-        "{{X {:.6},Y {:.6},Z {:.6},A {:.9},B {:.9},C {:.9}}}",
-        p.p.x * 1e3,
-        p.p.y * 1e3,
-        p.p.z * 1e3,
-        abc[0],
-        abc[1],
-        abc[2]
-    )
-}
-
-fn abb_frame(p: &Pose) -> String {
-    let q = rotation_to(OrientationConvention::AbbQ1q4, &p.r);
-    format!(
-        "[[{:.6},{:.6},{:.6}],[{:.12},{:.12},{:.12},{:.12}]]",
-        p.p.x * 1e3,
-        p.p.y * 1e3,
-        p.p.z * 1e3,
-        q[0],
-        q[1],
-        q[2],
-        q[3]
-    )
-}
-
-fn ur_pose(p: &Pose) -> String {
-    let r = rotation_to(OrientationConvention::UrRotvec, &p.r);
-    format!(
-        "p[{:.9}, {:.9}, {:.9}, {:.12}, {:.12}, {:.12}]",
-        p.p.x, p.p.y, p.p.z, r[0], r[1], r[2]
-    )
-}
-
 fn inertia(l: &Load) -> [f64; 3] {
     l.inertia_kgm2.unwrap_or([0.0; 3])
 }
@@ -247,6 +258,7 @@ pub fn controller_text(
             .collect(),
         renamed: Vec::new(),
         registers: Vec::new(),
+        kinematics: None,
     };
     let notes = assigned_lines(language, data);
     match language {

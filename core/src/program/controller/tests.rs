@@ -271,6 +271,7 @@ fn fanuc_writes_position_registers_only_when_given_them() {
         .contains("! UTOOL[1] X 0.000000 Y 0.000000 Z 300.000000 ;"));
     let opts = ExportOptions {
         registers: Some("91..99".parse().unwrap()),
+        ..Default::default()
     };
     let with = export_cell(Language::Fanuc, &cell, &model(), &opts).unwrap();
     assert!(
@@ -301,6 +302,7 @@ fn fanuc_writes_position_registers_only_when_given_them() {
     );
     let short = ExportOptions {
         registers: Some("91..93".parse().unwrap()),
+        ..Default::default()
     };
     let e = export_cell(Language::Fanuc, &cell, &model(), &short).unwrap_err();
     assert!(
