@@ -5,7 +5,9 @@
 //! figures. Units as the programs write them: mm and degrees.
 
 use super::*;
-use robocal_core::model::orientation::{rotation_to, OrientationConvention};
+use robocal_core::model::orientation::{
+    rotation_angle_between, rotation_to, OrientationConvention,
+};
 use robocal_core::program::{abb_cf, fanuc_config, fanuc_config_text, kuka_status, kuka_turn};
 
 /// One target as a program writes it: its pose in the work object, the
@@ -153,33 +155,110 @@ fn rms(v: &[f64]) -> f64 {
     (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
 }
 
+/// How far the true torch is from a true target: its tip [mm] and its
+/// orientation [deg].
+#[derive(Debug, Clone, Copy)]
+pub struct Miss {
+    /// The tip's distance [mm].
+    pub mm: f64,
+    /// The angle between the torch's and the target's orientations [deg].
+    pub deg: f64,
+}
+
+impl Miss {
+    /// The miss of the true torch `got` from the true target `want`.
+    pub fn of(got: &Pose, want: &Pose) -> Miss {
+        Miss {
+            mm: (got.p - want.p).norm() * 1e3,
+            deg: rotation_angle_between(&got.r, &want.r).to_degrees(),
+        }
+    }
+}
+
+/// The calibration's validation error a program is judged against: RMS
+/// over poses it never fitted, of the tool tip [mm] and of its orientation
+/// [deg].
+#[derive(Debug, Clone, Copy)]
+pub struct Validation {
+    /// RMS of the tip's distance [mm].
+    pub mm: f64,
+    /// RMS of the orientation's angle [deg].
+    pub deg: f64,
+}
+
+/// The calibrated robot's orientation error [deg], RMS over `n` random
+/// configurations it never fitted: the angle between its flange's and the
+/// true robot's in the cell frame (the tools' own rotations taken off), the
+/// i-th configuration's bases placed by `place(i)`: (the model's, the
+/// truth's) base in the cell frame.
+pub fn orientation_rms_deg(
+    calibrated: &RobotModel,
+    truth: &robocal_core::sim::TrueRobot,
+    n: usize,
+    place: impl Fn(usize) -> (Pose, Pose),
+    rng: &mut ChaCha8Rng,
+) -> f64 {
+    let angles: Vec<f64> = random_configurations(calibrated, n, rng)
+        .iter()
+        .enumerate()
+        .map(|(i, q)| {
+            let (model_base, true_base) = place(i);
+            let model = model_base.r
+                * robocal_core::model::kinematics::fk(calibrated, q)
+                    .unwrap()
+                    .r
+                * tool_pose(calibrated).r.transpose();
+            let true_r = true_base.r
+                * truth.true_pose_base(q, None).unwrap().r
+                * tool_pose(&truth.model).r.transpose();
+            rotation_angle_between(&model, &true_r).to_degrees()
+        })
+        .collect();
+    rms(&angles)
+}
+
 /// The acceptance's figures, printed and asserted: every filtered target
-/// run by the controller, their true tool tip's distances [mm] within
-/// `1.5 × bound_mm` RMS of the true targets; the unfiltered program's more
-/// than 1 mm RMS off. `label` says where (`Krl on the track`), `bound` what
-/// the bound is.
+/// run by the controller, their true torch tips within `1.5 × bound.mm` RMS
+/// of the true targets and their orientations within `1.5 × bound.deg`
+/// RMS; the unfiltered program's tips more than 1 mm RMS off. `label` says
+/// where (`Krl on the track`), `bound_is` what the bound is.
 pub fn assert_figures(
     label: &str,
-    bound: &str,
-    bound_mm: f64,
-    filtered: Vec<Option<f64>>,
-    unfiltered: Vec<Option<f64>>,
+    bound_is: &str,
+    bound: Validation,
+    filtered: Vec<Option<Miss>>,
+    unfiltered: Vec<Option<Miss>>,
 ) {
-    let filtered: Vec<f64> = filtered
+    let filtered: Vec<Miss> = filtered
         .into_iter()
         .map(|e| e.expect("the controller runs every filtered target"))
         .collect();
-    let unfiltered: Vec<f64> = unfiltered.into_iter().flatten().collect();
+    let unfiltered: Vec<Miss> = unfiltered.into_iter().flatten().collect();
+    let mm = |v: &[Miss]| v.iter().map(|m| m.mm).collect::<Vec<f64>>();
+    let deg = |v: &[Miss]| v.iter().map(|m| m.deg).collect::<Vec<f64>>();
     let max = |v: &[f64]| v.iter().copied().fold(0.0, f64::max);
     println!(
-        "{label}: true torch tip off the true target, filtered rms {:.4} mm (max {:.4}, {} targets), unfiltered rms {:.3} mm (max {:.3}, {} runnable); {bound} {bound_mm:.4} mm",
-        rms(&filtered),
-        max(&filtered),
+        "{label}: true torch tip off the true target, filtered rms {:.4} mm (max {:.4}, {} targets), unfiltered rms {:.3} mm (max {:.3}, {} runnable); {bound_is} {:.4} mm",
+        rms(&mm(&filtered)),
+        max(&mm(&filtered)),
         filtered.len(),
-        rms(&unfiltered),
-        max(&unfiltered),
+        rms(&mm(&unfiltered)),
+        max(&mm(&unfiltered)),
         unfiltered.len(),
+        bound.mm
     );
-    assert!(rms(&filtered) <= 1.5 * bound_mm, "{label}");
-    assert!(rms(&unfiltered) > 1.0, "{label}");
+    println!(
+        "{label}: true torch orientation off the target's, filtered rms {:.5}° (max {:.5}°), unfiltered rms {:.4}° (max {:.4}°); {bound_is} {:.5}°",
+        rms(&deg(&filtered)),
+        max(&deg(&filtered)),
+        rms(&deg(&unfiltered)),
+        max(&deg(&unfiltered)),
+        bound.deg
+    );
+    assert!(rms(&mm(&filtered)) <= 1.5 * bound.mm, "{label}");
+    assert!(
+        rms(&deg(&filtered)) <= 1.5 * bound.deg,
+        "{label}: orientation"
+    );
+    assert!(rms(&mm(&unfiltered)) > 1.0, "{label}");
 }
