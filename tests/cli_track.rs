@@ -561,10 +561,12 @@ fn numbers(v: &serde_json::Value) -> Vec<f64> {
 }
 
 /// `robocal track simulate` writes the readings of a robot (the model file
-/// given) on the example 4 m track and the drawing's track; the printed
-/// `track calibrate` command fits them, the held-out values within the
-/// judgement's limit, the fitted base within 0.05 mm of the truth's at a
-/// value the fit never saw; the same seed writes the same bytes.
+/// given) on the example 4 m track, the drawing's track and a weld beside
+/// the rail; the printed `track calibrate` command fits them, the held-out
+/// values within the judgement's limit, the fitted base within 0.05 mm of
+/// the truth's at a value the fit never saw; `filter --track` filters every
+/// target written, the track values kept; the same seed writes the same
+/// bytes.
 #[test]
 fn simulate_writes_files_the_printed_command_fits() {
     let mut rng = ChaCha8Rng::seed_from_u64(5);
@@ -608,9 +610,63 @@ fn simulate_writes_files_the_printed_command_fits() {
     let off = (base.p - truth.p).norm() * 1e3;
     println!("fitted base at {HELD_OUT_MM} mm: {off:.4} mm from the truth's");
     assert!(off < 0.05, "{off}");
+    // The program beside the rail, filtered through the fitted track with
+    // the drawing's as the controller's: every target written filtered,
+    // each at its own track value, kept.
+    let written = read("sim/part.dat")
+        .lines()
+        .filter(|l| l.starts_with("DECL E6POS"))
+        .count();
+    let left_out = printed
+        .lines()
+        .filter(|l| l.starts_with("left out of part.src"))
+        .count();
+    assert_eq!(written + left_out, 9, "{printed}");
+    assert!(written >= 7, "{printed}");
+    let out = robocal(
+        d,
+        &[
+            "filter",
+            "--model",
+            "robot.json",
+            "--cell",
+            "sim/cell.json",
+            "--track",
+            "track.json",
+            "--nominal-track",
+            "sim/drawing.json",
+            "--out-dir",
+            "filtered",
+            "--report",
+            "report.json",
+            "sim/part.src",
+            "sim/part.dat",
+        ],
+    );
+    assert_eq!(code(&out), 0, "{}{}", text(&out.stdout), text(&out.stderr));
+    let report: serde_json::Value = serde_json::from_str(&read("report.json")).unwrap();
+    assert_eq!(report["filtered"], written, "{report}");
+    assert_eq!(report["track_axis"], "E1");
+    let e1 = |dat: &str| -> Vec<String> {
+        dat.lines()
+            .filter_map(|l| l.split(",E1 ").nth(1))
+            .map(|v| v.split(',').next().unwrap().to_string())
+            .collect()
+    };
+    assert_eq!(e1(&read("sim/part.dat")), e1(&read("filtered/part.dat")));
+    assert_ne!(read("sim/part.dat"), read("filtered/part.dat"));
+    assert_eq!(read("sim/part.src"), read("filtered/part.src"));
+
     // The same seed, the same bytes; another seed, other readings.
     simulate("again");
-    for f in ["stations.csv", "validate.csv", "drawing.json"] {
+    for f in [
+        "stations.csv",
+        "validate.csv",
+        "drawing.json",
+        "cell.json",
+        "part.src",
+        "part.dat",
+    ] {
         assert_eq!(
             read(&format!("sim/{f}")),
             read(&format!("again/{f}")),

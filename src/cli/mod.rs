@@ -27,7 +27,9 @@ pub mod simulate;
 pub mod solve;
 pub mod tcp;
 pub mod track;
+mod track_part;
 pub mod track_sim;
+mod weld;
 
 pub use model_files::load_model;
 

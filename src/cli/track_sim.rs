@@ -14,6 +14,12 @@
 //! - `drawing.json`: the track the controller computes from its drawing
 //!   (`TrueTrack::drawing_4m`: scale 1, straight, no carriage angles), the
 //!   filter's `--nominal-track`;
+//! - a program for `filter --track` (`super::track_part`): `cell.json` (the
+//!   torch and base 2, a part beside the rail measured in the cell frame),
+//!   `part.src` and `part.dat` (a weld along it, each target at the track
+//!   value that puts the robot beside it); a target out of the robot's
+//!   reach is left out, named in the output, and a robot that reaches none
+//!   gets no program, the output saying why;
 //!
 //! and prints the `track calibrate` command that fits them.
 //!
@@ -26,6 +32,7 @@
 //! tracker's noise from `ChaCha8Rng(seed)`, one stream per file.
 
 use super::model_files::load_compensated;
+use super::track_part::track_program;
 use anyhow::Context;
 use clap::Args;
 use rand::SeedableRng;
@@ -113,6 +120,25 @@ pub fn simulate_to_string(a: &SimulateArgs) -> anyhow::Result<String> {
     let stations = write("stations.csv", &set(0, &STATIONS_MM, a.poses)?)?;
     let validate = write("validate.csv", &set(1, &HELD_OUT_MM, HELD_OUT_POSES)?)?;
     let drawing = write("drawing.json", &TrueTrack::drawing_4m().to_json())?;
+    let mut written = vec![stations.clone(), validate.clone(), drawing];
+    let mut notes = Vec::new();
+    match track_program(&model, &TrueTrack::drawing_4m()) {
+        Ok(program) => {
+            for (name, text) in [
+                ("cell.json", &program.cell),
+                ("part.src", &program.src),
+                ("part.dat", &program.dat),
+            ] {
+                written.push(write(name, text)?);
+            }
+            notes.extend(program.left_out.iter().map(|t| {
+                format!("left out of part.src: {t} (out of the nominal robot's reach with the torch pointing into the part)")
+            }));
+        }
+        Err(why) => notes.push(format!(
+            "no program beside the rail (cell.json, part.src, part.dat): {why}"
+        )),
+    }
     let mut out = String::new();
     writeln!(
         out,
@@ -122,8 +148,11 @@ pub fn simulate_to_string(a: &SimulateArgs) -> anyhow::Result<String> {
         HELD_OUT_MM.len(),
         a.noise_mm
     )?;
-    for w in [&stations, &validate, &drawing] {
+    for w in &written {
         writeln!(out, "wrote {w}")?;
+    }
+    for note in &notes {
+        writeln!(out, "{note}")?;
     }
     writeln!(
         out,

@@ -131,9 +131,9 @@ impl TrueTrack {
     /// the base 350 mm above the carriage's reference and 120 mm beside it,
     /// turned 90° about the vertical; scale 1, no maps, travel 0–4000 mm.
     pub fn drawing_4m() -> LinearTrack {
-        let r = rpy_matrix(0.0, 0.0, 25f64.to_radians());
-        let start = Vector3::new(0.6, -3.1, -0.4) + r * Vector3::new(0.0, 0.12, 0.35);
-        let along = r.column(0).into_owned();
+        let rail = TrueTrack::drawing_rail_4m();
+        let start = rail.transform_point(&Vector3::new(0.0, 0.12, 0.35));
+        let along = rail.r.column(0).into_owned();
         // `zero`: the base's travel at value 0 from the line's point closest
         // to the cell origin.
         LinearTrack::nominal(
@@ -145,6 +145,17 @@ impl TrueTrack {
                 lo_mm: 0.0,
                 hi_mm: 4000.0,
             },
+        )
+    }
+
+    /// The rail frame of [`TrueTrack::drawing_4m`] in the cell frame: x
+    /// along the rail (25° off the cell's x, horizontal), z up, the origin
+    /// the rail's start (the robot's base 350 mm above it and 120 mm beside
+    /// it at value 0).
+    pub fn drawing_rail_4m() -> Pose {
+        Pose::new(
+            rpy_matrix(0.0, 0.0, 25f64.to_radians()),
+            Vector3::new(0.6, -3.1, -0.4),
         )
     }
 

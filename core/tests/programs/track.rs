@@ -57,14 +57,6 @@ struct TrackCell {
     flags: Vec<(Vec<f64>, Configuration)>,
 }
 
-/// The rail frame of the controller's drawing (`TrueTrack::drawing_4m`):
-/// 25° off the cell's x, horizontal, through the true rail's start.
-fn drawing_rail() -> Pose {
-    let mut r = Pose::from_translation(Vector3::new(0.6, -3.1, -0.4));
-    r.rot_z(25f64.to_radians());
-    r
-}
-
 fn track_cell() -> &'static TrackCell {
     static C: OnceLock<TrackCell> = OnceLock::new();
     C.get_or_init(|| {
@@ -102,7 +94,7 @@ fn track_cell() -> &'static TrackCell {
         };
         let mut on_rail = Pose::from_translation(Vector3::new(2.0, 1.3, -0.2));
         on_rail.rot_z(10f64.to_radians());
-        let part = drawing_rail().compose(&on_rail);
+        let part = TrueTrack::drawing_rail_4m().compose(&on_rail);
         let cell = Cell {
             tools: vec![torch_tool()],
             work_objects: vec![WorkObject {
