@@ -23,6 +23,7 @@ pub mod predict;
 pub mod progress;
 pub mod reregister;
 pub mod serve;
+mod sim_files;
 pub mod simulate;
 pub mod solve;
 pub mod tcp;

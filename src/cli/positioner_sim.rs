@@ -35,6 +35,7 @@
 
 use super::model_files::load_compensated;
 use super::positioner_part::part_program;
+use super::sim_files::{check_noise, left_out_note, list, OutDir};
 use anyhow::Context;
 use clap::Args;
 use nalgebra::Vector3;
@@ -51,7 +52,6 @@ use robocal_core::sim::positioner::TruePositioner;
 use robocal_core::sim::positioner_example::{held_out, nominal, sweeps, truth, DESIGN_MM};
 use robocal_core::sim::positioner_sets::positioner_set;
 use std::fmt::Write as _;
-use std::path::Path;
 
 /// Arguments of `robocal positioner simulate`.
 #[derive(Debug, Args)]
@@ -96,12 +96,7 @@ fn in_front_of(robot: &Pose) -> Pose {
 
 /// Writes the files; what the command prints (the files and how to fit them).
 pub fn simulate_to_string(a: &SimulateArgs) -> anyhow::Result<String> {
-    if !(a.noise_mm.is_finite() && a.noise_mm >= 0.0) {
-        anyhow::bail!(
-            "--noise-mm {}: give a non-negative number of mm",
-            a.noise_mm
-        );
-    }
+    check_noise(a.noise_mm)?;
     if !(a.wobble_deg.is_finite() && a.wobble_deg.abs() <= 1.0) {
         anyhow::bail!(
             "--wobble-deg {}: give a nod of at most 1° (a finite number)",
@@ -121,13 +116,8 @@ pub fn simulate_to_string(a: &SimulateArgs) -> anyhow::Result<String> {
         truth.cell_from_base = base;
         model = Some(m);
     }
-    let dir = Path::new(&a.out_dir);
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", a.out_dir))?;
-    let write = |name: &str, text: &str| -> anyhow::Result<String> {
-        let path = dir.join(name);
-        std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))?;
-        Ok(path.display().to_string())
-    };
+    let dir = OutDir::create(&a.out_dir)?;
+    let write = |name: &str, text: &str| dir.write(name, text);
     let columns = PositionerColumns {
         tilt: ExternalAxis::E1,
         rotate: ExternalAxis::E2,
@@ -173,12 +163,7 @@ pub fn simulate_to_string(a: &SimulateArgs) -> anyhow::Result<String> {
         a.noise_mm,
         a.wobble_deg
     )?;
-    for w in &written {
-        writeln!(out, "wrote {w}")?;
-    }
-    for note in &notes {
-        writeln!(out, "{note}")?;
-    }
+    list(&mut out, &written, &notes);
     let reflectors: Vec<String> = DESIGN_MM
         .iter()
         .map(|p| format!("--reflector {},{},{}", p[0], p[1], p[2]))
@@ -216,13 +201,7 @@ fn program_files(
         &PART_VALUES_DEG,
     ) {
         Ok(files) => {
-            let notes = files
-                .left_out
-                .iter()
-                .map(|t| {
-                    format!("left out of part.src: {t} (out of the nominal robot's reach with the torch pointing into the part)")
-                })
-                .collect();
+            let notes = files.left_out.iter().map(|t| left_out_note(t)).collect();
             (
                 vec![
                     ("controller.json", files.controller),

@@ -55,16 +55,17 @@ pub(crate) fn track_program(
 ) -> Result<TrackProgram, String> {
     let part = part_in_cell();
     let travel = drawing.travel;
+    // The robot's base at the travel's start: the values count from it.
+    let start = drawing
+        .cell_from_base(travel.lo_mm)
+        .map_err(|e| e.to_string())?
+        .p;
     let stations = SEAM_M
         .iter()
         .map(|x| {
             let at = Vector3::new(*x, 0.0, 0.0);
             let in_cell = part.transform_point(&at);
-            let base_at = drawing
-                .cell_from_base(travel.lo_mm)
-                .map_err(|e| e.to_string())?
-                .p;
-            let e = ((in_cell - base_at).dot(&drawing.rail.direction) * 1e3)
+            let e = (travel.lo_mm + (in_cell - start).dot(&drawing.rail.direction) * 1e3)
                 .round()
                 .clamp(travel.lo_mm, travel.hi_mm);
             let base = drawing.cell_from_base(e).map_err(|e| e.to_string())?;

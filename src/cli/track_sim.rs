@@ -32,6 +32,7 @@
 //! tracker's noise from `ChaCha8Rng(seed)`, one stream per file.
 
 use super::model_files::load_compensated;
+use super::sim_files::{check_noise, left_out_note, list, OutDir};
 use super::track_part::track_program;
 use anyhow::Context;
 use clap::Args;
@@ -42,7 +43,6 @@ use robocal_core::measure::external::ExternalAxis;
 use robocal_core::sim::track::TrueTrack;
 use robocal_core::sim::{random_configurations, TrueRobot};
 use std::fmt::Write as _;
-use std::path::Path;
 
 /// The fitted stations [mm]: every 400 mm over the 4 m.
 const STATIONS_MM: [f64; 11] = [
@@ -76,12 +76,7 @@ pub struct SimulateArgs {
 
 /// Writes the files; what the command prints (the files and how to fit them).
 pub fn simulate_to_string(a: &SimulateArgs) -> anyhow::Result<String> {
-    if !(a.noise_mm.is_finite() && a.noise_mm >= 0.0) {
-        anyhow::bail!(
-            "--noise-mm {}: give a non-negative number of mm",
-            a.noise_mm
-        );
-    }
+    check_noise(a.noise_mm)?;
     if !(3..=1000).contains(&a.poses) {
         anyhow::bail!(
             "--poses {}: give 3 to 1000 poses per station (the fit needs 3 not on a line at each)",
@@ -92,13 +87,8 @@ pub fn simulate_to_string(a: &SimulateArgs) -> anyhow::Result<String> {
     let mut robot = TrueRobot::new(model.calibrated.clone());
     robot.noise_mm = a.noise_mm;
     let track = TrueTrack::rail_4m();
-    let dir = Path::new(&a.out_dir);
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", a.out_dir))?;
-    let write = |name: &str, text: &str| -> anyhow::Result<String> {
-        let path = dir.join(name);
-        std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))?;
-        Ok(path.display().to_string())
-    };
+    let dir = OutDir::create(&a.out_dir)?;
+    let write = |name: &str, text: &str| dir.write(name, text);
     let set = |stream: u64, values: &[f64], n: usize| -> anyhow::Result<String> {
         let mut rng = ChaCha8Rng::seed_from_u64(a.seed);
         rng.set_stream(stream);
@@ -131,9 +121,7 @@ pub fn simulate_to_string(a: &SimulateArgs) -> anyhow::Result<String> {
             ] {
                 written.push(write(name, text)?);
             }
-            notes.extend(program.left_out.iter().map(|t| {
-                format!("left out of part.src: {t} (out of the nominal robot's reach with the torch pointing into the part)")
-            }));
+            notes.extend(program.left_out.iter().map(|t| left_out_note(t)));
         }
         Err(why) => notes.push(format!(
             "no program beside the rail (cell.json, part.src, part.dat): {why}"
@@ -148,12 +136,7 @@ pub fn simulate_to_string(a: &SimulateArgs) -> anyhow::Result<String> {
         HELD_OUT_MM.len(),
         a.noise_mm
     )?;
-    for w in &written {
-        writeln!(out, "wrote {w}")?;
-    }
-    for note in &notes {
-        writeln!(out, "{note}")?;
-    }
+    list(&mut out, &written, &notes);
     writeln!(
         out,
         "fit it with: robocal track calibrate {stations} --model {} --validate {validate} --out track.json",
