@@ -137,8 +137,9 @@ fn filter_cli_reports_parse_errors_and_guesses_the_language() {
 /// sits on the positioner's face plate (cell file `frame: face_plate`), each
 /// target at its own `E1`, `E2`; the report names the axes and each
 /// target's values, and equals the core's filter through the same
-/// positioners. The CLI refuses a track beside a positioner and one of the
-/// pair alone; without the positioner every target fails naming its axis.
+/// positioners. The CLI refuses one of the pair alone; beside a track the
+/// positioner's axes are E2 and E3, so these targets fail naming E3; without
+/// the positioner every target fails naming its axis.
 /// (How close the filtered targets bring a true tool to the true part is
 /// the core's test, `core/tests/programs/positioner.rs`.)
 #[test]
@@ -282,17 +283,84 @@ fn filter_cli_composes_a_positioner_with_its_values() {
     )
     .unwrap();
     assert_eq!(serde_json::to_value(&core.report).unwrap(), report);
-    // Refused: a track beside a positioner, one of the pair alone.
-    let track = [
-        "--track".to_string(),
-        p(&positioner_path),
-        "--nominal-track".into(),
+    // Beside a track: the track is E1 and the positioner E2, E3. A track
+    // that is where the controller believes it (nominal = calibrated, the
+    // base at the cell frame's origin at 0) adds nothing: the program with
+    // E1 0 and the values moved to E2, E3, and the positioner stated in
+    // that frame (the robot's base frame), gives the fixed base's joints
+    // and shifts.
+    let rail = robocal::model::external::LinearTrack::nominal(
+        Vector3::x(),
+        Vector3::zeros(),
+        0.0,
+        nalgebra::Matrix3::identity(),
+        robocal::model::external::Travel {
+            lo_mm: -100.0,
+            hi_mm: 2000.0,
+        },
+    );
+    let mut in_base = cell_positioner;
+    in_base.cell_from_base = drawing.cell_from_base;
+    let (rail_path, in_base_path) = (dir.path().join("rail.json"), dir.path().join("stn0.json"));
+    std::fs::write(&rail_path, rail.to_json()).unwrap();
+    std::fs::write(&in_base_path, in_base.to_json()).unwrap();
+    let mut moved = String::from("DEFDAT turn\r\n");
+    for line in dat.lines().filter(|l| l.starts_with("DECL")) {
+        let (head, tail) = line.split_at(line.find(",E1 ").unwrap());
+        let v: Vec<&str> = tail.split(',').collect();
+        // ",E1 a,E2 b,E3 0.0,…" → ",E1 0.0,E2 a,E3 b,…"
+        let (a, b) = (&v[1][3..], &v[2][3..]);
+        moved.push_str(&format!(
+            "{head},E1 0.0,E2 {a},E3 {b},E4 0.0,E5 0.0,E6 0.0}}\r\n"
+        ));
+    }
+    moved.push_str("ENDDAT\r\n");
+    let moved_dir = dir.path().join("on_track");
+    std::fs::create_dir_all(&moved_dir).unwrap();
+    let (src2, dat2) = (moved_dir.join("turn.src"), moved_dir.join("turn.dat"));
+    std::fs::write(&src2, &src).unwrap();
+    std::fs::write(&dat2, &moved).unwrap();
+    let both = [
+        "--model".to_string(),
+        p(&model_path),
+        "--cell".into(),
+        p(&cell_path),
+        "--out-dir".into(),
+        p(&moved_dir.join("out")),
+        p(&src2),
+        p(&dat2),
+        "--positioner".into(),
+        p(&in_base_path),
+        "--nominal-positioner".into(),
         p(&drawing_path),
+        "--track".into(),
+        p(&rail_path),
+        "--nominal-track".into(),
+        p(&rail_path),
     ];
-    let both = with(&[axes.to_vec(), track.to_vec()].concat());
-    let mut v = vec!["robocal", "filter"];
-    v.extend(both.iter().map(String::as_str));
-    assert!(robocal::cli::Cli::try_parse_from(v).is_err());
+    let on_track =
+        filter_to_string(&args(&both.iter().map(String::as_str).collect::<Vec<_>>())).unwrap();
+    let on_track: serde_json::Value = serde_json::from_str(&on_track).unwrap();
+    assert_eq!(on_track["positioner_axes"], serde_json::json!(["E2", "E3"]));
+    assert_eq!(on_track["track_axis"], "E1");
+    assert_eq!(on_track["filtered"].as_u64(), Some(4), "{on_track:#}");
+    for (t, fixed) in on_track["targets"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(report["targets"].as_array().unwrap())
+    {
+        assert_eq!(t["track_mm"], 0.0);
+        assert_eq!(t["positioner_deg"], fixed["positioner_deg"]);
+        let shift = |x: &serde_json::Value| x["shift_mm"].as_f64().unwrap();
+        assert!((shift(t) - shift(fixed)).abs() < 1e-9, "{t} {fixed}");
+        let joints = |x: &serde_json::Value| -> Vec<f64> {
+            serde_json::from_value(x["joints_deg"].clone()).unwrap()
+        };
+        for (a, b) in joints(t).iter().zip(joints(fixed)) {
+            assert!((a - b).abs() < 1e-9, "{t} {fixed}");
+        }
+    }
     let alone = with(&axes[..2]);
     let mut v = vec!["robocal", "filter"];
     v.extend(alone.iter().map(String::as_str));

@@ -21,7 +21,9 @@ mod common;
 use common::{measure_truth, real, shipped_model};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use robocal_core::calibrate::compensate::select::Parallelism;
 use robocal_core::calibrate::compensate::CompensatorSpec;
+use robocal_core::calibrate::identify::joint_maps::JointMapSettings;
 use robocal_core::calibrate::identify::progress::ETA_FROM_FRACTION;
 use robocal_core::calibrate::identify::{
     calibrate, calibrate_with_training, CalibrationOptions, CalibrationReport, CompensatorOptions,
@@ -94,15 +96,37 @@ struct Study {
     report: CalibrationReport,
 }
 
+/// The threads a calibration's cross-validations run on: the cores
+/// available, or `ROBOCAL_TEST_THREADS` when set (`scripts/idle_core.sh`
+/// runs this file with 1, every fold after the other, to measure what the
+/// second core saves; the results are the same on any number).
+fn parallelism() -> Parallelism {
+    match std::env::var("ROBOCAL_TEST_THREADS") {
+        Ok(v) => Parallelism {
+            threads: v
+                .parse()
+                .expect("ROBOCAL_TEST_THREADS: a number of threads"),
+        },
+        Err(_) => Parallelism::default(),
+    }
+}
+
 fn options(methods: &[Method], seed: u64, cv_folds: usize) -> CalibrationOptions {
+    let parallel = parallelism();
+    let d = CalibrationOptions::default();
     CalibrationOptions {
         methods: methods.to_vec(),
         compensator: CompensatorOptions {
             seed,
             cv_folds,
+            parallel,
             ..Default::default()
         },
-        ..Default::default()
+        joint_maps: JointMapSettings {
+            parallel,
+            ..d.joint_maps
+        },
+        ..d
     }
 }
 

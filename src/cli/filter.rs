@@ -12,7 +12,10 @@
 //! plate (cell frame `face_plate`, RAPID `ufprog FALSE`) turn with it, axes 1
 //! and 2 of the program (Fanuc: `J1`, `J2` of `GP2`): each target composed
 //! at its own values through the calibrated positioner, its false target
-//! through the controller's nominal one, the values kept.
+//! through the controller's nominal one, the values kept. Both together: the
+//! robot rides the track (axis 1) and the positioner's axes are the
+//! program's 2 and 3 (KRL E2, E3, RAPID eax_b, eax_c; Fanuc J1, J2 of GP2),
+//! both models in the cell frame.
 
 use crate::program::{filter_with, FilterAxes, FilterControl, Language, ProgramFile};
 use crate::solve::ik::IkSettings;
@@ -50,11 +53,14 @@ pub struct FilterArgs {
     /// The calibrated positioner carrying the face-plate work objects
     /// (`robocal positioner calibrate`'s output, in the cell frame the
     /// robot's model is registered in), program axes 1 and 2 (KRL E1, E2,
-    /// RAPID eax_a, eax_b, Fanuc J1, J2 of GP2).
-    #[arg(long, requires = "nominal_positioner", conflicts_with = "track")]
+    /// RAPID eax_a, eax_b, Fanuc J1, J2 of GP2); with --track, axes 2 and 3
+    /// (KRL E2, E3, RAPID eax_b, eax_c; Fanuc's GP2 as before), in the
+    /// track's cell frame.
+    #[arg(long, requires = "nominal_positioner")]
     pub positioner: Option<String>,
     /// The controller's own positioner (the same JSON: its drawing's or its
-    /// own calibration's axes), in its world frame: the robot's base frame.
+    /// own calibration's axes), in its world frame: the robot's base frame,
+    /// or with --track the cell frame.
     #[arg(long, requires = "positioner")]
     pub nominal_positioner: Option<String>,
     /// Directory for the filtered files (same names as the inputs).
@@ -118,10 +124,7 @@ pub fn filter_report(a: &FilterArgs) -> anyhow::Result<super::exit::Outcome> {
         )),
         _ => None,
     };
-    let axes = match &positioners {
-        Some(_) => FilterAxes::of_positioner(positioners.as_ref()),
-        None => FilterAxes::of_track(tracks.as_ref()),
-    };
+    let axes = FilterAxes::of_cell(tracks.as_ref(), positioners.as_ref());
     let out = filter_with(
         language,
         &files,

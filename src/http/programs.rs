@@ -12,7 +12,9 @@
 //! --track --nominal-track` composes it; with `controller_positioner` (the
 //! controller's own positioner) the work objects on the face plate turn
 //! with the robot's stored positioner, program axes 1 and 2, as `robocal
-//! filter --positioner --nominal-positioner` composes them.
+//! filter --positioner --nominal-positioner` composes them; with both, the
+//! robot rides the track and the positioner's axes are the program's 2 and
+//! 3 (Fanuc: J1, J2 of GP2 as before).
 
 use super::input::{objects, present};
 use super::solve::{model_choice, VersionSelector};
@@ -64,8 +66,9 @@ pub struct FilterRequest {
     #[serde(default, deserialize_with = "present")]
     pub controller_track: Option<TrackDescription>,
     /// The controller's own positioner (in its world: the robot's base
-    /// frame): the work objects on the face plate turn with the robot's
-    /// stored positioner, the program's axes 1 and 2.
+    /// frame, or with `controller_track` the cell frame): the work objects
+    /// on the face plate turn with the robot's stored positioner, the
+    /// program's axes 1 and 2 (2 and 3 with `controller_track`).
     #[serde(default, deserialize_with = "present")]
     pub controller_positioner: Option<TiltRotateDescription>,
 }
@@ -137,11 +140,6 @@ fn command(robot_id: i64, req: FilterRequest) -> Result<FilterCommand, ApiError>
         .map(|d| d.to_model())
         .transpose()
         .map_err(|e| ApiError::invalid(format!("`controller_track`: {e}")))?;
-    if controller_track.is_some() && req.controller_positioner.is_some() {
-        return Err(ApiError::invalid(
-            "`controller_track` and `controller_positioner` together: a robot on a track with a part on a positioner is not modelled; give one",
-        ));
-    }
     let controller_positioner = req
         .controller_positioner
         .map(|d| d.to_model())

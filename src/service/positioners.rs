@@ -296,7 +296,7 @@ pub async fn for_rows(state: &AppState, robot_id: i64) -> Result<TiltRotate, Ser
     };
     if state.db().track(robot_id).await?.is_some() {
         return Err(ServiceError::Conflict(format!(
-            "robot {robot_id} has a track and a positioner: the targets CSV's `e1` column could be the track's value or the positioner's tilt, which is ambiguous (a track and a positioner in one cell are not modelled); solve on the positioner with a robot that has no track, or on the track with an `e1` column alone"
+            "robot {robot_id} has a track and a positioner: the targets CSV's `e1` column could be the track's value or the positioner's tilt, which is ambiguous (a solve on both axes is not built; the program filter composes both); solve on the positioner with a robot that has no track, or on the track with an `e1` column alone"
         )));
     }
     model_of(&row)
@@ -331,7 +331,7 @@ pub async fn for_predict(state: &AppState, robot_id: i64) -> Result<TiltRotate, 
     };
     if state.db().track(robot_id).await?.is_some() {
         return Err(ServiceError::Conflict(format!(
-            "robot {robot_id} has a track and a positioner: `e1` could be the track's value or the positioner's tilt, which is ambiguous (a track and a positioner in one cell are not modelled)"
+            "robot {robot_id} has a track and a positioner: `e1` could be the track's value or the positioner's tilt, which is ambiguous (a solve on both axes is not built; the program filter composes both)"
         )));
     }
     model_of(&row)

@@ -87,10 +87,7 @@ pub async fn filter_program(
             &cell,
             &model,
             &IkSettings::default(),
-            &match &positioners {
-                Some(_) => FilterAxes::of_positioner(positioners.as_ref()),
-                None => FilterAxes::of_track(tracks.as_ref()),
-            },
+            &FilterAxes::of_cell(tracks.as_ref(), positioners.as_ref()),
             &control,
         );
         if matches!(out, Err(FilterError::Cancelled)) {

@@ -298,6 +298,19 @@ async fn a_positioner_fitted_over_http_is_the_command_lines_and_carries_a_target
     assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
     assert!(r.detail().contains("ambiguous"), "{}", r.detail());
     at_values_conflict(&t, &rid, json!(solved[0].0), "ambiguous").await;
+    // The program filter composes both.
+    let stored_track = t.get("/v1/robots/{id}/track", &[&rid]).await.json();
+    std::fs::write(d.join("track.json"), stored_track["track"].to_string()).unwrap();
+    super::positioner_filter::filters_beside_the_track(
+        &t,
+        &rid,
+        &nom,
+        &model,
+        &d.join("p.json"),
+        &d.join("track.json"),
+        d,
+    )
+    .await;
 }
 
 /// A prediction at `joints` and a JSON solve, both at the positioner's

@@ -52,30 +52,34 @@ fn request(src: &str, dat: &str, positioner: &TiltRotate) -> Value {
     })
 }
 
-/// A KRL program (the nominal reflector as its tool, base 3) to the poses
-/// the nominal controller gives the reflector at random joints, in the part
-/// as `controller` computes it at `values`, with those joints' flags.
-fn program(controller: &TiltRotate, values: &[[f64; 2]], rng: &mut ChaCha8Rng) -> (String, String) {
-    let nominal = preset("ys100").unwrap();
-    let ik = AnalyticIk::new(&nominal).unwrap();
-    let mut src = krl_head("turn", "BAS(#BASE, 3)");
-    let part = Pose::new(
+/// The part on the face plate (`PART_XYZ_MM`, `PART_RPY_DEG`).
+fn part_pose() -> Pose {
+    Pose::new(
         robocal::model::pose::rpy_matrix(0.0, 0.0, PART_RPY_DEG[2].to_radians()),
         Vector3::from(PART_XYZ_MM) * 1e-3,
-    );
-    let mut dat = String::from("DEFDAT turn\n");
-    for (i, &v) in values.iter().enumerate() {
+    )
+}
+
+/// A KRL program `name` (the nominal reflector as its tool, base 3) to the
+/// poses the nominal controller gives the reflector at random joints, each
+/// in its target's part frame as the controller computes it (base frame),
+/// with those joints' flags and the target's external axes (`E1 …,E2 …`).
+fn program(name: &str, targets: &[(Pose, String)], rng: &mut ChaCha8Rng) -> (String, String) {
+    let nominal = preset("ys100").unwrap();
+    let ik = AnalyticIk::new(&nominal).unwrap();
+    let mut src = krl_head(name, "BAS(#BASE, 3)");
+    let mut dat = format!("DEFDAT {name}\n");
+    for (i, (frame, axes)) in targets.iter().enumerate() {
         // The back branches near the YS100's limits may have no solution
         // on their flags.
         let (q, deg, conf) = flagged_joints(&ik, rng, |c| {
             c.elbow == Elbow::Up && c.shoulder == Shoulder::Front
         });
-        let frame = controller.cell_from_face_plate(v).compose(&part);
         let p = frame.inverse().compose(&fk(&nominal, &q).unwrap());
         let abc = rotation_to(OrientationConvention::KukaAbc, &p.r);
         src.push_str(&format!("PTP XP{i}\n"));
         dat.push_str(&format!(
-            "DECL E6POS XP{i}={{X {:.4},Y {:.4},Z {:.4},A {:.4},B {:.4},C {:.4},S {},T {},E1 {},E2 {}}}\n",
+            "DECL E6POS XP{i}={{X {:.4},Y {:.4},Z {:.4},A {:.4},B {:.4},C {:.4},S {},T {},{axes}}}\n",
             p.p.x * 1e3,
             p.p.y * 1e3,
             p.p.z * 1e3,
@@ -84,8 +88,6 @@ fn program(controller: &TiltRotate, values: &[[f64; 2]], rng: &mut ChaCha8Rng) -
             abc[2],
             kuka_status(&deg, conf),
             kuka_turn(&deg),
-            v[0],
-            v[1]
         ));
     }
     (src + "END\n", dat + "ENDDAT\n")
@@ -93,7 +95,7 @@ fn program(controller: &TiltRotate, values: &[[f64; 2]], rng: &mut ChaCha8Rng) -
 
 /// Before the robot has a positioner: `controller_positioner` is a 409
 /// naming what to fit; one the model refuses a 422 naming its field, as is
-/// one beside `controller_track`.
+/// a `controller_track` beside it that is no track.
 pub(crate) async fn refused_without_a_positioner(t: &TestApp, rid: &str, nominal: &TiltRotate) {
     let src = "DEF a()\nPTP XP1\nEND\n";
     let dat = "DEFDAT a\nDECL E6POS XP1={X 100,Y 0,Z 50,A 0,B 90,C 0,E1 10,E2 5}\nENDDAT\n";
@@ -144,7 +146,16 @@ pub(crate) async fn filters_as_the_command_line(
     let values: Vec<[f64; 2]> = (0..10)
         .map(|i| [-45.0 + 10.0 * f64::from(i), 170.0 - 35.0 * f64::from(i)])
         .collect();
-    let (src, dat) = program(&controller, &values, &mut ChaCha8Rng::seed_from_u64(31));
+    let targets: Vec<(Pose, String)> = values
+        .iter()
+        .map(|v| {
+            (
+                controller.cell_from_face_plate(*v).compose(&part_pose()),
+                format!("E1 {},E2 {}", v[0], v[1]),
+            )
+        })
+        .collect();
+    let (src, dat) = program("turn", &targets, &mut ChaCha8Rng::seed_from_u64(31));
     let r = t
         .post_json(FILTER, &[rid], request(&src, &dat, &controller))
         .await;
@@ -316,4 +327,86 @@ pub(crate) async fn exports_as_the_command_line(
         "{}",
         r.detail()
     );
+}
+
+/// With a track stored as well (`track`: its file) the robot rides it and
+/// the part turns beside it: a KRL program at its own `E1` (the track) and
+/// `E2`, `E3` (the positioner) filtered over HTTP with `controller_track`
+/// (the rail's drawing) and `controller_positioner` (`nominal`, in the cell
+/// frame, the controller's world beside a track), and by the command line
+/// with both files: the same files and report, byte for byte, every target
+/// filtered at its values.
+pub(crate) async fn filters_beside_the_track(
+    t: &TestApp,
+    rid: &str,
+    nominal: &TiltRotate,
+    model: &Path,
+    fitted: &Path,
+    track: &Path,
+    dir: &Path,
+) {
+    let drawing = super::track_filter::drawing();
+    let values: Vec<(f64, [f64; 2])> = (0..8)
+        .map(|i| {
+            let i = f64::from(i);
+            (300.0 + 250.0 * i, [-35.0 + 10.0 * i, 160.0 - 40.0 * i])
+        })
+        .collect();
+    // The part in the base as the controller computes it: N(e)⁻¹·P_nom(v)·W_f.
+    let targets: Vec<(Pose, String)> = values
+        .iter()
+        .map(|(e, v)| {
+            let frame = drawing
+                .cell_from_base(*e)
+                .unwrap()
+                .inverse()
+                .compose(&nominal.cell_from_face_plate(*v))
+                .compose(&part_pose());
+            (frame, format!("E1 {e:.3},E2 {},E3 {}", v[0], v[1]))
+        })
+        .collect();
+    let (src, dat) = program("weld", &targets, &mut ChaCha8Rng::seed_from_u64(32));
+    let mut body = request(&src, &dat, nominal);
+    body["files"][0]["name"] = json!("weld.src");
+    body["files"][1]["name"] = json!("weld.dat");
+    body["controller_track"] = super::track_filter::controller_track();
+    let r = t.post_json(FILTER, &[rid], body).await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let http = r.json();
+    let report = &http["report"];
+    assert_eq!(report["filtered"], values.len(), "{report}");
+    assert_eq!(report["track_axis"], "E1");
+    assert_eq!(report["positioner_axes"], json!(["E2", "E3"]));
+    for (line, (e, v)) in report["targets"].as_array().unwrap().iter().zip(&values) {
+        assert_eq!(line["track_mm"].as_f64(), Some(*e));
+        assert_eq!(line["positioner_deg"], json!(v));
+    }
+
+    std::fs::write(dir.join("weld.src"), &src).unwrap();
+    std::fs::write(dir.join("weld.dat"), &dat).unwrap();
+    std::fs::write(dir.join("rail_drawing.json"), drawing.to_json()).unwrap();
+    std::fs::write(dir.join("nominal_cell.json"), nominal.to_json()).unwrap();
+    let out = dir.join("filtered_beside_the_track");
+    let p = |p: &Path| p.to_str().unwrap().to_string();
+    let argv = [
+        "robocal".to_string(),
+        "filter".into(),
+        "--model".into(),
+        p(model),
+        "--cell".into(),
+        p(&dir.join("cell.json")),
+        "--track".into(),
+        p(track),
+        "--nominal-track".into(),
+        p(&dir.join("rail_drawing.json")),
+        "--positioner".into(),
+        p(fitted),
+        "--nominal-positioner".into(),
+        p(&dir.join("nominal_cell.json")),
+        "--out-dir".into(),
+        p(&out),
+        p(&dir.join("weld.src")),
+        p(&dir.join("weld.dat")),
+    ];
+    super::track_filter::assert_cli_gives(&http, argv, &out);
 }

@@ -27,11 +27,11 @@ const FILTER: &str = "/v1/robots/{id}/programs/filter";
 
 /// The controller's track: the rail of the drawing, the base 350 mm above
 /// the carriage and 120 mm beside it, turned 90° about the vertical.
-fn drawing() -> LinearTrack {
+pub(crate) fn drawing() -> LinearTrack {
     robocal::sim::track::TrueTrack::drawing_4m()
 }
 
-fn controller_track() -> Value {
+pub(crate) fn controller_track() -> Value {
     serde_json::from_str(&drawing().to_json()).unwrap()
 }
 

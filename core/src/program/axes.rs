@@ -30,11 +30,17 @@
 //! `P_nom(v)` in its world frame, which on a fixed base is the robot's base
 //! frame: `S = base_from_cell·P(v)·W_f`, `S_nom = P_nom(v)·W_f`.
 //!
+//! Track and positioner together: the robot rides the track (axis 1) and
+//! the part turns on the positioner, its axes then the program's axes 2 and
+//! 3 of the robot's group (KRL `E2`, `E3`; RAPID `eax_b`, `eax_c`; Fanuc's
+//! group 2 `J1`, `J2` as before). Both models are stated in the cell frame,
+//! the controller's world: `S = B(e)⁻¹·P(v)·W_f`,
+//! `S_nom = N(e)⁻¹·P_nom(v)·W_f`.
+//!
 //! The axes' values stay as programmed (the filter moves the target, not
 //! the axes). Any other external axis in use is refused, naming it, as is a
-//! track value beyond either track's travel, and a track and a positioner
-//! together. Units: the programs' mm for track values and degrees for the
-//! positioner's, SI poses.
+//! track value beyond either track's travel. Units: the programs' mm for
+//! track values and degrees for the positioner's, SI poses.
 
 use super::{external_axis_refusal, AxisValue, Language, Site};
 use crate::model::external::{LinearTrack, TiltRotate};
@@ -57,7 +63,7 @@ pub struct TrackAxes<'a> {
 pub struct PositionerAxes<'a> {
     /// The controller's own positioner (its drawing's or its own
     /// calibration's axis lines), in the controller's world frame: the
-    /// robot's base frame on a fixed base.
+    /// robot's base frame on a fixed base, the cell frame beside a track.
     pub nominal: &'a TiltRotate,
     /// The calibrated positioner, in the cell (tracker) frame the robot's
     /// calibrated model is registered in.
@@ -91,13 +97,38 @@ impl<'a> FilterAxes<'a> {
     /// The axes of a cell with a positioner, when `positioner`
     /// (calibrated, nominal) is given; none otherwise.
     pub fn of_positioner(positioner: Option<&'a (TiltRotate, TiltRotate)>) -> Self {
+        Self::of_cell(None, positioner)
+    }
+
+    /// The axes of a cell with a track, a positioner, both or neither, each
+    /// given as (calibrated, nominal).
+    pub fn of_cell(
+        track: Option<&'a (LinearTrack, LinearTrack)>,
+        positioner: Option<&'a (TiltRotate, TiltRotate)>,
+    ) -> Self {
         FilterAxes {
-            track: None,
+            track: Self::of_track(track).track,
             positioner: positioner.map(|(calibrated, nominal)| PositionerAxes {
                 nominal,
                 calibrated,
             }),
         }
+    }
+
+    /// The program's numbers of the positioner's axes 1 and 2 in
+    /// `language`, within its group ([`positioner_group`]): 1 and 2, or 2
+    /// and 3 after the track's axis 1 when the robot also rides a track
+    /// (Fanuc's group 2 is the positioner's alone: 1 and 2).
+    pub fn positioner_numbers(&self, language: Language) -> [usize; 2] {
+        positioner_numbers(language, self.track.is_some())
+    }
+}
+
+fn positioner_numbers(language: Language, on_track: bool) -> [usize; 2] {
+    if on_track && positioner_group(language) == 1 {
+        [2, 3]
+    } else {
+        [1, 2]
     }
 }
 
@@ -122,12 +153,16 @@ pub fn positioner_group(language: Language) -> u32 {
 }
 
 /// The names a language gives the positioner's axes 1 (tilt) and 2
-/// (rotate).
-pub fn positioner_axis_names(language: Language) -> [&'static str; 2] {
+/// (rotate), with the robot on a track (`on_track`, the positioner's axes
+/// after the track's: [`FilterAxes::positioner_numbers`]) or not.
+pub fn positioner_axis_names(language: Language, on_track: bool) -> [&'static str; 2] {
+    let robot_group = |n: usize| match language {
+        Language::Rapid => ["eax_a", "eax_b", "eax_c"][n - 1],
+        _ => ["E1", "E2", "E3"][n - 1],
+    };
     match language {
-        Language::Rapid => ["eax_a", "eax_b"],
         Language::Fanuc => ["J1 of motion group GP2", "J2 of motion group GP2"],
-        Language::Krl | Language::UrScript => ["E1", "E2"],
+        _ => positioner_numbers(language, on_track).map(robot_group),
     }
 }
 
@@ -154,9 +189,16 @@ impl OnTrack {
     /// `S = B(e)⁻¹·W` and `S_nom = N(e)⁻¹·W` of a world-frame work object
     /// `W` (module docs).
     pub(super) fn work_object(&self, world: &Pose) -> (Pose, Pose) {
+        self.moved_work_object(world, world)
+    }
+
+    /// `S = B(e)⁻¹·W` and `S_nom = N(e)⁻¹·W_nom` of a work object that is
+    /// `W` in the world as the cell is and `W_nom` as the controller
+    /// computes it (on a positioner's plate: `P(v)·W_f`, `P_nom(v)·W_f`).
+    pub(super) fn moved_work_object(&self, world: &Pose, world_nom: &Pose) -> (Pose, Pose) {
         (
             self.calibrated.inverse().compose(world),
-            self.nominal.inverse().compose(world),
+            self.nominal.inverse().compose(world_nom),
         )
     }
 }
@@ -179,8 +221,15 @@ impl OnPositioner {
     /// object `W_f` on the face plate, `base_from_cell` the robot's
     /// registration (module docs).
     pub(super) fn work_object(&self, base_from_cell: &Pose, on_plate: &Pose) -> (Pose, Pose) {
+        let (world, world_nom) = self.in_world(on_plate);
+        (base_from_cell.compose(&world), world_nom)
+    }
+
+    /// `P(v)·W_f` in the cell frame and `P_nom(v)·W_f` in the controller's
+    /// world of a work object `W_f` on the face plate.
+    pub(super) fn in_world(&self, on_plate: &Pose) -> (Pose, Pose) {
         (
-            base_from_cell.compose(&self.calibrated).compose(on_plate),
+            self.calibrated.compose(on_plate),
             self.nominal.compose(on_plate),
         )
     }
@@ -203,25 +252,19 @@ fn composed(language: Language, axes: &FilterAxes, a: &AxisValue) -> bool {
     let track = axes.track.is_some() && a.group == 1 && a.number == TRACK_AXIS;
     let positioner = axes.positioner.is_some()
         && a.group == positioner_group(language)
-        && (a.number == 1 || a.number == 2);
+        && axes.positioner_numbers(language).contains(&a.number);
     track || positioner
 }
 
 /// Where a site's axes put the robot base and the positioner's plate
 /// ([`Placement`], empty on a fixed base without axes in use), or why the
 /// site is refused (an axis the cell does not model, no track value, a value
-/// beyond the travel, a track and a positioner together, one positioner
-/// value without the other).
+/// beyond the travel, one positioner value without the other).
 pub(super) fn place(
     language: Language,
     site: &Site,
     axes: &FilterAxes,
 ) -> Result<Placement, String> {
-    if axes.track.is_some() && axes.positioner.is_some() {
-        return Err(
-            "a robot on a track with a part on a positioner is not modelled: not filtered".into(),
-        );
-    }
     if let Some(other) = site
         .axes
         .iter()
@@ -229,16 +272,23 @@ pub(super) fn place(
     {
         return Err(external_axis_refusal(&other.name, &other.text));
     }
-    if let Some(p) = axes.positioner {
-        return Ok(Placement {
-            track: None,
-            positioner: on_positioner(language, site, &p)?,
-            with_positioner: true,
-        });
-    }
-    let Some(track) = axes.track else {
-        return Ok(Placement::default());
+    let track = match &axes.track {
+        Some(t) => Some(on_track(language, site, t)?),
+        None => None,
     };
+    let positioner = match &axes.positioner {
+        Some(p) => on_positioner(language, site, p, axes.track.is_some())?,
+        None => None,
+    };
+    Ok(Placement {
+        track,
+        positioner,
+        with_positioner: axes.positioner.is_some(),
+    })
+}
+
+/// The track's bases at a site's value, or why it has none.
+fn on_track(language: Language, site: &Site, track: &TrackAxes) -> Result<OnTrack, String> {
     let name = track_axis_name(language);
     let given = site.axes.iter().find(|a| a.number == TRACK_AXIS);
     let value_mm = match given {
@@ -265,29 +315,27 @@ pub(super) fn place(
         .calibrated
         .cell_from_base(value_mm)
         .map_err(|e| format!("the track's axis {name}: {e}: not filtered"))?;
-    Ok(Placement {
-        track: Some(OnTrack {
-            value_mm,
-            nominal,
-            calibrated,
-        }),
-        positioner: None,
-        with_positioner: false,
+    Ok(OnTrack {
+        value_mm,
+        nominal,
+        calibrated,
     })
 }
 
-/// The positioner's plates at a site's values: `None` when the site gives
-/// neither value; refused when it gives one without the other or one that
-/// is not a number.
+/// The positioner's plates at a site's values (its axes after the track's
+/// when `on_track`): `None` when the site gives neither value; refused when
+/// it gives one without the other or one that is not a number.
 fn on_positioner(
     language: Language,
     site: &Site,
     p: &PositionerAxes,
+    on_track: bool,
 ) -> Result<Option<OnPositioner>, String> {
     let group = positioner_group(language);
-    let names = positioner_axis_names(language);
+    let names = positioner_axis_names(language, on_track);
+    let numbers = positioner_numbers(language, on_track);
     let given = |k: usize| site.axes.iter().find(|a| a.group == group && a.number == k);
-    let values = match (given(1), given(2)) {
+    let values = match (given(numbers[0]), given(numbers[1])) {
         (None, None) => return Ok(None),
         (Some(a), Some(b)) => [a, b].map(|a| a.value.ok_or_else(|| a.clone())),
         (a, _) => {
@@ -556,15 +604,75 @@ mod tests {
             let why = place(language, &s, &axes).unwrap_err();
             assert!(why.contains(want), "{language:?}: {why}");
         }
-        let track = track(1.0);
-        let both = FilterAxes {
+    }
+
+    /// Closed form, a robot on a track beside the turntable: the track's
+    /// scale 1.0002 puts the real base 0.4 mm further along the rail at
+    /// 2000 mm, the zero 1° turns the real part; the positioner's axes are
+    /// then the program's second and third.
+    #[test]
+    fn on_a_track_beside_a_positioner_both_compose_and_its_axes_follow_the_track() {
+        let (nominal, calibrated) = (turntable(0.0), turntable(1.0));
+        let (rail, real_rail) = (track(1.0), track(1.0002));
+        let axes = FilterAxes {
             track: Some(TrackAxes {
-                nominal: &track,
-                calibrated: &track,
+                nominal: &rail,
+                calibrated: &real_rail,
             }),
-            ..axes
+            positioner: Some(PositionerAxes {
+                nominal: &nominal,
+                calibrated: &calibrated,
+            }),
         };
-        let why = place(Language::Krl, &site(vec![]), &both).unwrap_err();
-        assert!(why.contains("track with a part on a positioner"), "{why}");
+        assert_eq!(axes.positioner_numbers(Language::Krl), [2, 3]);
+        assert_eq!(axes.positioner_numbers(Language::Fanuc), [1, 2]);
+        assert_eq!(
+            positioner_axis_names(Language::Rapid, true),
+            ["eax_b", "eax_c"]
+        );
+        let s = site(vec![
+            axis(1, "E1", Some(2000.0)),
+            axis(2, "E2", Some(0.0)),
+            axis(3, "E3", Some(90.0)),
+        ]);
+        let at = place(Language::Krl, &s, &axes).unwrap();
+        let (on_track, on_plate) = (at.track.unwrap(), at.positioner.unwrap());
+        assert_eq!(
+            (on_track.value_mm, on_plate.values_deg),
+            (2000.0, [0.0, 90.0])
+        );
+        let part = Pose::from_translation(Vector3::new(1.0, 0.0, 0.0));
+        let (world, world_nom) = on_plate.in_world(&part);
+        let (s, s_nom) = on_track.moved_work_object(&world, &world_nom);
+        let one = 1f64.to_radians();
+        let real_part = Vector3::new(1.5 - one.sin(), one.cos(), 0.5);
+        // The part in the real base: where the real base sees the real part.
+        let seen = real_part - Vector3::new(2.0004, 1.0, 0.0);
+        assert!((s.p - seen).norm() < 1e-12, "{}", s.p);
+        let seen_nom = Vector3::new(1.5, 1.0, 0.5) - Vector3::new(2.0, 1.0, 0.0);
+        assert!((s_nom.p - seen_nom).norm() < 1e-12, "{}", s_nom.p);
+        let cases = [
+            (
+                site(vec![axis(1, "E1", Some(100.0)), axis(2, "E2", Some(5.0))]),
+                "no value for its axis E3",
+            ),
+            (
+                site(vec![axis(2, "E2", Some(5.0)), axis(3, "E3", Some(5.0))]),
+                "gives no value for it",
+            ),
+            (
+                site(vec![
+                    axis(1, "E1", Some(100.0)),
+                    axis(2, "E2", Some(5.0)),
+                    axis(3, "E3", Some(5.0)),
+                    axis(4, "E4", Some(1.0)),
+                ]),
+                "external axis E4 to 1",
+            ),
+        ];
+        for (s, want) in cases {
+            let why = place(Language::Krl, &s, &axes).unwrap_err();
+            assert!(why.contains(want), "{why}");
+        }
     }
 }

@@ -347,9 +347,10 @@ impl Run<'_> {
                 self.axes
                     .track
                     .map(|_| axes::track_axis_name(language).to_string()),
-                self.axes
-                    .positioner
-                    .map(|_| axes::positioner_axis_names(language).map(|n| n.to_string())),
+                self.axes.positioner.map(|_| {
+                    axes::positioner_axis_names(language, self.axes.track.is_some())
+                        .map(|n| n.to_string())
+                }),
             ),
         }
     }

@@ -15,7 +15,7 @@
 //! warns which configuration was taken and how to make sure. Units: SI, joints in the model
 //! convention [rad] but where named `deg` (controller convention).
 
-use super::axes::{controller_target, Placement};
+use super::axes::{controller_target, OnPositioner, Placement};
 use super::report::{LoadSource, Reachable, UsedLoad};
 use super::{Flags, FrameSpec, Language, Site};
 use crate::model::calibrated::CompensatedModel;
@@ -133,8 +133,9 @@ fn choose_load(
 /// A site's work object in the cell (world) frame, for a robot on a track:
 /// the world itself for none or number 0 (KRL `$NULLFRAME`, RAPID `wobj0`,
 /// Fanuc `UF : 0`), an inline frame as given, a cell work object measured
-/// in the cell frame; one stated in the robot's base frame moves with the
-/// carriage and is refused.
+/// in the cell frame, or one on a positioner's face plate (its frame
+/// `FacePlate`, its pose on the plate); one stated in the robot's base
+/// frame moves with the carriage and is refused.
 fn world_work_object(spec: &FrameSpec, cell: &Cell) -> Result<WorkObject, String> {
     let world = |name: &str, number: Option<u32>, pose: Pose| WorkObject {
         name: name.into(),
@@ -145,18 +146,19 @@ fn world_work_object(spec: &FrameSpec, cell: &Cell) -> Result<WorkObject, String
     match spec {
         FrameSpec::Unset => Ok(world("world", Some(0), Pose::identity())),
         FrameSpec::Inline(p) => Ok(world("inline", None, *p)),
-        FrameSpec::FacePlate(_) => Err(
-            "the work object is on a positioner's face plate, and a robot on a track with a part on a positioner is not modelled: not filtered".into(),
-        ),
+        FrameSpec::FacePlate(p) => Ok(WorkObject {
+            frame: WorkObjectFrame::FacePlate,
+            ..world("inline", None, *p)
+        }),
         FrameSpec::Ref(r) if !cell.defines_work_object(r) => {
             let w = cell.work_object(r).map_err(|e| e.to_string())?;
             Ok(world("world", w.number, Pose::identity()))
         }
         FrameSpec::Ref(r) => {
-            let w = cell.work_object(r).map_err(|e| e.to_string())?;
+            let w = cell.any_work_object(r).map_err(|e| e.to_string())?;
             match w.frame {
-                WorkObjectFrame::Measurement => Ok(w),
-                WorkObjectFrame::Base | WorkObjectFrame::FacePlate => Err(format!(
+                WorkObjectFrame::Measurement | WorkObjectFrame::FacePlate => Ok(w),
+                WorkObjectFrame::Base => Err(format!(
                     "work object {} is stated in the robot's base frame, which the track carries: state it in the cell frame (frame measurement) for a robot on a track; not filtered",
                     w.name
                 )),
@@ -165,29 +167,68 @@ fn world_work_object(spec: &FrameSpec, cell: &Cell) -> Result<WorkObject, String
     }
 }
 
+/// A site's work object placed ([`placed_work_object`]).
+struct Placed {
+    /// `S`: the work object as the cell is, in the robot's base frame.
+    wobj: WorkObject,
+    /// When the controller composes it through an external axis: the frame
+    /// it computes instead, `S_nom`, and the pose it holds for it.
+    composed: Option<(Pose, Pose)>,
+    /// Whether it is on the positioner's face plate.
+    on_plate: bool,
+}
+
+/// The positioner's plates at the site's values, or why a plate work
+/// object `w` has none.
+fn plate_of<'a>(at: &'a Placement, w: &WorkObject) -> Result<&'a OnPositioner, String> {
+    at.positioner.as_ref().ok_or_else(|| {
+        format!(
+            "work object {} is on the positioner's face plate and {}: not filtered",
+            w.name,
+            if at.with_positioner {
+                "the target gives no value for the positioner's axes"
+            } else {
+                "the filter was given no positioner"
+            }
+        )
+    })
+}
+
 /// The work object a site is solved in as the cell is, `S` (base frame),
 /// and, when the controller composes it through an external axis, the
 /// frame it computes instead, `S_nom`, and the pose it holds for it
 /// (`program::axes`): on a fixed base the cell's, program's or base frame
 /// (the controller holds it as it is); on a track the world-frame work
 /// object `W` at the target's value; on the positioner's face plate a
-/// plate work object `W_f` at the target's values. A plate work object
-/// without a positioner, or without the target's values, is refused.
+/// plate work object `W_f` at the target's values (beside a track, carried
+/// to the world by the positioner and seen from the base at the track's
+/// value). A plate work object without a positioner, or without the
+/// target's values, is refused.
 fn placed_work_object(
     spec: &FrameSpec,
     cell: &Cell,
     model: &CompensatedModel,
     at: &Placement,
-) -> Result<(WorkObject, Option<(Pose, Pose)>), String> {
+) -> Result<Placed, String> {
+    let in_base = |w: &WorkObject, s: Pose| WorkObject {
+        frame: WorkObjectFrame::Base,
+        pose: s,
+        ..w.clone()
+    };
     if let Some(on) = &at.track {
-        let world = world_work_object(spec, cell)?;
-        let (s, s_nom) = on.work_object(&world.pose);
-        let in_base = WorkObject {
-            frame: WorkObjectFrame::Base,
-            pose: s,
-            ..world.clone()
+        let w = world_work_object(spec, cell)?;
+        let on_plate = w.frame == WorkObjectFrame::FacePlate;
+        let (s, s_nom) = if on_plate {
+            let (world, world_nom) = plate_of(at, &w)?.in_world(&w.pose);
+            on.moved_work_object(&world, &world_nom)
+        } else {
+            on.work_object(&w.pose)
         };
-        return Ok((in_base, Some((s_nom, world.pose))));
+        return Ok(Placed {
+            wobj: in_base(&w, s),
+            composed: Some((s_nom, w.pose)),
+            on_plate,
+        });
     }
     let inline = |frame, pose| WorkObject {
         name: "inline".into(),
@@ -202,26 +243,18 @@ fn placed_work_object(
         FrameSpec::Unset => WorkObject::base(),
     };
     if w.frame != WorkObjectFrame::FacePlate {
-        return Ok((w, None));
+        return Ok(Placed {
+            wobj: w,
+            composed: None,
+            on_plate: false,
+        });
     }
-    let Some(on) = &at.positioner else {
-        return Err(format!(
-            "work object {} is on the positioner's face plate and {}: not filtered",
-            w.name,
-            if at.with_positioner {
-                "the target gives no value for the positioner's axes"
-            } else {
-                "the filter was given no positioner"
-            }
-        ));
-    };
-    let (s, s_nom) = on.work_object(&model.cell_from_base.inverse(), &w.pose);
-    let in_base = WorkObject {
-        frame: WorkObjectFrame::Base,
-        pose: s,
-        ..w.clone()
-    };
-    Ok((in_base, Some((s_nom, w.pose))))
+    let (s, s_nom) = plate_of(at, &w)?.work_object(&model.cell_from_base.inverse(), &w.pose);
+    Ok(Placed {
+        wobj: in_base(&w, s),
+        composed: Some((s_nom, w.pose)),
+        on_plate: true,
+    })
 }
 
 /// The nominal controller's joints for a site: its solutions carrying the
@@ -345,7 +378,11 @@ impl Context<'_> {
         let tcp = tool.tcp;
         let model = self.model;
         let (load, used_load, warnings) = choose_load(site.load, tool.load, model);
-        let (wobj, composed) = placed_work_object(&site.work_object, self.cell, model, at)?;
+        let Placed {
+            wobj,
+            composed,
+            on_plate,
+        } = placed_work_object(&site.work_object, self.cell, model, at)?;
         let used_tool = ControllerTool {
             name: tool.name,
             number: tool.number.unwrap_or(0),
@@ -375,7 +412,6 @@ impl Context<'_> {
         // A plate work object's controller form is not written (a coupled
         // base, a moved work object): the controller keeps the cell's.
         let mut warnings = warnings;
-        let on_plate = composed.is_some() && at.track.is_none();
         if on_plate && cell_item(&site.work_object, false) {
             warnings.push(format!(
                 "work object {} turns with the positioner: the controller data leaves it out; the controller must hold it on the face plate as the cell gives it",

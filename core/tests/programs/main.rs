@@ -22,6 +22,7 @@ mod positioner;
 mod rapid;
 mod stationary;
 mod track;
+mod track_and_positioner;
 mod truth;
 mod urscript;
 

@@ -67,7 +67,7 @@ struct PositionerCell {
 
 /// The robot's place in the cell (the tracker frame): 1.6 m from the
 /// positioner's base, facing it, as its drawing has it.
-fn robot_in_cell() -> Pose {
+pub(super) fn robot_in_cell() -> Pose {
     let mut p = Pose::from_translation(Vector3::new(1.1, -1.6, -0.9));
     p.rot_z(35f64.to_radians());
     p
@@ -75,7 +75,7 @@ fn robot_in_cell() -> Pose {
 
 /// The part's true pose in the cell at values `v`: its origin and its axes'
 /// tips carried by the true positioner's physics.
-fn true_part(t: &TruePositioner, body: &Pose, v: [f64; 2]) -> Pose {
+pub(super) fn true_part(t: &TruePositioner, body: &Pose, v: [f64; 2]) -> Pose {
     let arm = 0.1;
     let o = t.point(v, &body.p);
     let axis = |k: usize| (t.point(v, &(body.p + body.r.column(k) * arm)) - o) / arm;
@@ -113,6 +113,95 @@ fn calibrated_robot(
     (model, km.validation.as_ref().unwrap().stats.rms_mm)
 }
 
+/// A target's positioner values (tilt −40…40°, rotate −170…170°) and its
+/// pose on the part: within 150 mm of its origin, the torch pointing into
+/// it within 20° of its normal.
+pub(super) fn draw_on_part(rng: &mut ChaCha8Rng) -> ([f64; 2], Pose) {
+    let v = [rng.gen_range(-40.0..40.0), rng.gen_range(-170.0..170.0)];
+    let mut t = Pose::from_translation(Vector3::new(
+        rng.gen_range(-0.15..0.15),
+        rng.gen_range(-0.15..0.15),
+        rng.gen_range(0.0..0.05),
+    ));
+    t.r = rpy_matrix(
+        std::f64::consts::PI + rng.gen_range(-0.35..0.35),
+        rng.gen_range(-0.35..0.35),
+        rng.gen_range(-3.1..3.1),
+    );
+    (v, t)
+}
+
+/// A positioner fitted from its truth's readings, its validation and the
+/// part taught on it.
+pub(super) struct Fitted {
+    /// The fitted positioner, in the frame the truth is read in.
+    pub model: TiltRotate,
+    /// The reference reflector's RMS [mm] at the 56 held-out pairs of
+    /// values, and the taught part's orientation RMS [deg] there, both
+    /// against the truth.
+    pub validation: Validation,
+    /// The part `body` taught on the plate: measured with both axes at 0
+    /// and located on the plate through the fitted positioner.
+    pub taught: Pose,
+}
+
+/// The positioner `truth` fitted from 50 readings of two reflectors from
+/// its drawing `nominal` (in the same frame), judged at the held-out pairs,
+/// and the part on its rotate body at `body` taught on it.
+pub(super) fn fit_and_teach(
+    truth: &TruePositioner,
+    nominal: TiltRotate,
+    body: &Pose,
+    rng: &mut ChaCha8Rng,
+) -> Fitted {
+    let fit = fit_positioner(&PositionerFitRequest {
+        nominal,
+        reflectors_mm: DESIGN_MM.to_vec(),
+        readings: truth.read(&fit_plan(), rng),
+        tracker_sigma_mm: TRACKER_SIGMA_MM,
+    })
+    .unwrap();
+    // The positioner's validation: the reference reflector at the 56
+    // held-out pairs of values, read by the tracker, against the model.
+    let held: Vec<(usize, [f64; 2])> = example::held_out().into_iter().map(|v| (0, v)).collect();
+    let on_plate = Vector3::from(fit.reflectors_mm[0]) * 1e-3;
+    let errors: Vec<f64> = truth
+        .read(&held, rng)
+        .iter()
+        .map(|r| {
+            let got = fit.model.point_in_cell(r.values_deg, &on_plate);
+            (got - Vector3::from(r.xyz_mm) * 1e-3).norm() * 1e3
+        })
+        .collect();
+    let rms = |v: &[f64]| (v.iter().map(|e| e * e).sum::<f64>() / v.len() as f64).sqrt();
+    // Taught at axes 0: measured in the cell, located on the plate through
+    // the calibrated positioner.
+    let taught = fit
+        .model
+        .cell_from_face_plate([0.0, 0.0])
+        .inverse()
+        .compose(&true_part(truth, body, [0.0, 0.0]));
+    // The positioner's orientation error at the held-out pairs: the taught
+    // part carried by the fitted positioner against the true, moved part
+    // (the nod no rigid model holds is in it).
+    let turns: Vec<f64> = example::held_out()
+        .iter()
+        .map(|v| {
+            let got = fit.model.cell_from_face_plate(*v).compose(&taught);
+            let want = true_part(truth, body, *v);
+            rotation_angle_between(&got.r, &want.r).to_degrees()
+        })
+        .collect();
+    Fitted {
+        model: fit.model,
+        validation: Validation {
+            mm: rms(&errors),
+            deg: rms(&turns),
+        },
+        taught,
+    }
+}
+
 fn positioner_cell() -> &'static PositionerCell {
     static C: OnceLock<PositionerCell> = OnceLock::new();
     C.get_or_init(|| {
@@ -123,28 +212,9 @@ fn positioner_cell() -> &'static PositionerCell {
         truth.tracker_from_base = robot_in_cell();
         let (model, robot_rms_mm) = calibrated_robot(&nominal, &truth, &mut rng);
         let true_positioner = example::truth(0.003);
-        let fit = fit_positioner(&PositionerFitRequest {
-            nominal: example::nominal(),
-            reflectors_mm: DESIGN_MM.to_vec(),
-            readings: true_positioner.read(&fit_plan(), &mut rng),
-            tracker_sigma_mm: TRACKER_SIGMA_MM,
-        })
-        .unwrap();
-        // The positioner's validation: the reference reflector at the 56
-        // held-out pairs of values, read by the tracker, against the model.
-        let held: Vec<(usize, [f64; 2])> =
-            example::held_out().into_iter().map(|v| (0, v)).collect();
-        let on_plate = Vector3::from(fit.reflectors_mm[0]) * 1e-3;
-        let errors: Vec<f64> = true_positioner
-            .read(&held, &mut rng)
-            .iter()
-            .map(|r| {
-                let got = fit.model.point_in_cell(r.values_deg, &on_plate);
-                (got - Vector3::from(r.xyz_mm) * 1e-3).norm() * 1e3
-            })
-            .collect();
-        let positioner_rms_mm =
-            (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
+        // The part: 60 mm above the plate, 150 mm from axis 2, turned.
+        let body = Pose::new(rpy_matrix(0.0, 0.0, 0.6), Vector3::new(0.12, 0.09, 1.16));
+        let fit = fit_and_teach(&true_positioner, example::nominal(), &body, &mut rng);
         // The controller's positioner: the drawing, in its world (the
         // robot's base frame, where the drawing puts the robot).
         let mut nominal_positioner = example::nominal();
@@ -156,34 +226,13 @@ fn positioner_cell() -> &'static PositionerCell {
             p: torch().p,
             rpy: fixed_xyz_angles(&torch().r),
         };
-        // The part: 60 mm above the plate, 150 mm from axis 2, turned.
-        let body = Pose::new(rpy_matrix(0.0, 0.0, 0.6), Vector3::new(0.12, 0.09, 1.16));
-        // Taught at axes 0: measured in the cell, located on the plate
-        // through the calibrated positioner.
-        let taught = fit
-            .model
-            .cell_from_face_plate([0.0, 0.0])
-            .inverse()
-            .compose(&true_part(&true_positioner, &body, [0.0, 0.0]));
-        // The positioner's orientation error at the held-out pairs: the
-        // taught part carried by the fitted positioner against the true,
-        // moved part (the nod no rigid model holds is in it).
-        let turns: Vec<f64> = example::held_out()
-            .iter()
-            .map(|v| {
-                let got = fit.model.cell_from_face_plate(*v).compose(&taught);
-                let want = true_part(&true_positioner, &body, *v);
-                rotation_angle_between(&got.r, &want.r).to_degrees()
-            })
-            .collect();
-        let positioner_deg = (turns.iter().map(|e| e * e).sum::<f64>() / turns.len() as f64).sqrt();
         let cell = Cell {
             tools: vec![torch_tool()],
             work_objects: vec![WorkObject {
                 name: "part".into(),
                 number: Some(3),
                 frame: WorkObjectFrame::FacePlate,
-                pose: taught,
+                pose: fit.taught,
             }],
         };
         // The robot's orientation against the truth at poses it never
@@ -204,8 +253,8 @@ fn positioner_cell() -> &'static PositionerCell {
             fitted: fit.model,
             nominal_positioner,
             validation: Validation {
-                mm: robot_rms_mm.hypot(positioner_rms_mm),
-                deg: orientation_deg.hypot(positioner_deg),
+                mm: robot_rms_mm.hypot(fit.validation.mm),
+                deg: orientation_deg.hypot(fit.validation.deg),
             },
             body,
             cell,
@@ -228,17 +277,7 @@ impl PositionerCell {
         while self.targets.len() < 50 {
             k += 1;
             assert!(k < 2000, "no reachable targets");
-            let v = [rng.gen_range(-40.0..40.0), rng.gen_range(-170.0..170.0)];
-            let mut t = Pose::from_translation(Vector3::new(
-                rng.gen_range(-0.15..0.15),
-                rng.gen_range(-0.15..0.15),
-                rng.gen_range(0.0..0.05),
-            ));
-            t.r = rpy_matrix(
-                std::f64::consts::PI + rng.gen_range(-0.35..0.35),
-                rng.gen_range(-0.35..0.35),
-                rng.gen_range(-3.1..3.1),
-            );
+            let (v, t) = draw_on_part(rng);
             let tcp = self.controller_frame(v).compose(&t);
             let found = ik
                 .solve(&tcp, None)
@@ -364,14 +403,21 @@ fn krl(c: &PositionerCell) -> Vec<ProgramFile> {
 /// work object the positioner `STN1` moves (`ufprog FALSE`): its object
 /// frame on the face plate, its user frame the controller's.
 fn rapid(c: &PositionerCell) -> Vec<ProgramFile> {
+    rapid_on_plate("Turn", &c.cell.work_objects[0].pose, &written(c))
+}
+
+/// A RAPID module `name` declaring the torch and the part, a work object
+/// the positioner `STN1` moves (`ufprog FALSE`) whose object frame on the
+/// face plate is `on_plate`.
+pub(super) fn rapid_on_plate(name: &str, on_plate: &Pose, targets: &[Written]) -> Vec<ProgramFile> {
     use super::rapid::frame;
     let data = format!(
         "  PERS tooldata torch:=[TRUE,{},[10,[0,0,100],[1,0,0,0],0,0,0]];\r\n  \
          TASK PERS wobjdata part:=[FALSE,FALSE,\"STN1\",[[0,0,0],[1,0,0,0]],{}];\r\n",
         frame(&torch()),
-        frame(&c.cell.work_objects[0].pose)
+        frame(on_plate)
     );
-    rapid_program("Turn", &data, &written(c))
+    rapid_program(name, &data, targets)
 }
 
 /// Fanuc with user frame 3 (the part, coordinated with the positioner) and
@@ -415,7 +461,7 @@ fn assert_on_positioner(language: Language, files: &[ProgramFile]) {
     );
     assert_eq!(
         r.positioner_axes,
-        Some(positioner_axis_names(language).map(String::from))
+        Some(positioner_axis_names(language, false).map(String::from))
     );
     for (t, (v, _)) in r.targets.iter().zip(&c.targets) {
         let got = t.positioner_deg.unwrap();

@@ -33,31 +33,31 @@ use robocal_core::sim::track::TrueTrack;
 use robocal_core::sim::TrueRobot;
 
 /// The cell on the track and its truth.
-struct TrackCell {
+pub(super) struct TrackCell {
     /// Calibrated robot (reflector tool), fixed-base registration unused.
-    model: CompensatedModel,
+    pub(super) model: CompensatedModel,
     /// The nominal robot carrying the torch: the controller.
-    controller: RobotModel,
-    truth: TrueRobot,
-    true_track: TrueTrack,
+    pub(super) controller: RobotModel,
+    pub(super) truth: TrueRobot,
+    pub(super) true_track: TrueTrack,
     /// The fitted track and the controller's own.
-    fitted: LinearTrack,
-    nominal_track: LinearTrack,
+    pub(super) fitted: LinearTrack,
+    pub(super) nominal_track: LinearTrack,
     /// The robot's validation error on a fixed base: its tip's RMS [mm] on
     /// the calibration's held-out poses, its orientation's RMS [deg] on
     /// others against the truth.
-    validation: Validation,
+    pub(super) validation: Validation,
     /// The part's frame in the cell frame (work object 2, measured).
-    part: Pose,
-    cell: Cell,
+    pub(super) part: Pose,
+    pub(super) cell: Cell,
     /// Per target: its track value [mm] and its pose in the part's frame
     /// (where the true torch tip was at the target's joints).
-    targets: Vec<(f64, Pose)>,
+    pub(super) targets: Vec<(f64, Pose)>,
     /// The targets' controller joints [deg] and configurations, for flags.
-    flags: Vec<(Vec<f64>, Configuration)>,
+    pub(super) flags: Vec<(Vec<f64>, Configuration)>,
 }
 
-fn track_cell() -> &'static TrackCell {
+pub(super) fn track_cell() -> &'static TrackCell {
     static C: OnceLock<TrackCell> = OnceLock::new();
     C.get_or_init(|| {
         let mut rng = ChaCha8Rng::seed_from_u64(11);
@@ -154,7 +154,7 @@ fn track_cell() -> &'static TrackCell {
 
 impl TrackCell {
     /// The true torch tip in the cell frame at joints `q` and track value `e`.
-    fn true_tip(&self, q: &[f64], e: f64) -> Pose {
+    pub(super) fn true_tip(&self, q: &[f64], e: f64) -> Pose {
         let reflector = tool_pose(&self.truth.model);
         self.true_track
             .cell_from_base(e)
@@ -163,7 +163,7 @@ impl TrackCell {
             .compose(&torch())
     }
 
-    fn degrees(&self, q: &[f64]) -> Vec<f64> {
+    pub(super) fn degrees(&self, q: &[f64]) -> Vec<f64> {
         self.controller
             .joints_to_controller(q)
             .iter()
