@@ -278,7 +278,7 @@ fn filter_cli_composes_a_positioner_with_its_values() {
         &cell,
         &loaded,
         &IkSettings::default(),
-        &FilterAxes::of_positioner(Some(&pair)),
+        &FilterAxes::of_cell(None, Some(&pair)),
         &FilterControl::default(),
     )
     .unwrap();

@@ -82,24 +82,6 @@ pub struct FilterAxes<'a> {
 }
 
 impl<'a> FilterAxes<'a> {
-    /// The axes of a robot on a track, when `track` (calibrated, nominal)
-    /// is given; none otherwise.
-    pub fn of_track(track: Option<&'a (LinearTrack, LinearTrack)>) -> Self {
-        FilterAxes {
-            track: track.map(|(calibrated, nominal)| TrackAxes {
-                nominal,
-                calibrated,
-            }),
-            positioner: None,
-        }
-    }
-
-    /// The axes of a cell with a positioner, when `positioner`
-    /// (calibrated, nominal) is given; none otherwise.
-    pub fn of_positioner(positioner: Option<&'a (TiltRotate, TiltRotate)>) -> Self {
-        Self::of_cell(None, positioner)
-    }
-
     /// The axes of a cell with a track, a positioner, both or neither, each
     /// given as (calibrated, nominal).
     pub fn of_cell(
@@ -107,7 +89,10 @@ impl<'a> FilterAxes<'a> {
         positioner: Option<&'a (TiltRotate, TiltRotate)>,
     ) -> Self {
         FilterAxes {
-            track: Self::of_track(track).track,
+            track: track.map(|(calibrated, nominal)| TrackAxes {
+                nominal,
+                calibrated,
+            }),
             positioner: positioner.map(|(calibrated, nominal)| PositionerAxes {
                 nominal,
                 calibrated,

@@ -8,7 +8,9 @@ use super::*;
 use robocal_core::model::orientation::{
     rotation_angle_between, rotation_to, OrientationConvention,
 };
-use robocal_core::program::{abb_cf, fanuc_config, fanuc_config_text, kuka_status, kuka_turn};
+use robocal_core::program::{
+    abb_cf, fanuc_config, fanuc_config_text, kuka_status, kuka_turn, FilterReport,
+};
 
 /// One target as a program writes it: its pose in the work object, the
 /// controller joints [deg] and configuration its flags come from, and its
@@ -261,4 +263,30 @@ pub fn assert_figures(
         "{label}: orientation"
     );
     assert!(rms(&mm(&unfiltered)) > 1.0, "{label}");
+}
+
+/// Every one of the report's `n` targets filtered, none failed or skipped
+/// (else the first with a reason is shown).
+pub fn assert_every_target_filtered(r: &FilterReport, n: usize) {
+    assert_eq!(
+        (r.filtered, r.failed, r.skipped),
+        (n, 0, 0),
+        "{:?}",
+        r.targets.iter().find(|t| t.reason.is_some())
+    );
+}
+
+/// The report names the positioner's axes `names` and each target's values
+/// are `want`'s, kept as programmed (within 1e-3°: the programs write 4
+/// decimals).
+pub fn assert_positioner_values_kept(
+    r: &FilterReport,
+    names: [&str; 2],
+    want: impl IntoIterator<Item = [f64; 2]>,
+) {
+    assert_eq!(r.positioner_axes, Some(names.map(String::from)));
+    for (t, v) in r.targets.iter().zip(want) {
+        let got = t.positioner_deg.unwrap();
+        assert!((got[0] - v[0]).abs() < 1e-3 && (got[1] - v[1]).abs() < 1e-3);
+    }
 }
