@@ -30,6 +30,8 @@ use robocal::sim::positioner_sets::positioner_set;
 use std::path::Path;
 use std::process::Output;
 
+#[path = "cli_positioner/beside_track.rs"]
+mod beside_track;
 #[path = "cli_positioner/held.rs"]
 mod held;
 
@@ -214,10 +216,16 @@ fn near(mut t: TruePositioner) -> TruePositioner {
     t
 }
 
-#[test]
-fn solve_takes_targets_on_the_face_plate_at_each_rows_axis_values() {
-    let dir = tempfile::tempdir().unwrap();
-    let d = dir.path();
+/// The robot file and the positioner 1.7 m in front of it, fitted.
+struct Near {
+    robot: robocal::sim::TrueRobot,
+    truth: TruePositioner,
+    nominal: TiltRotate,
+}
+
+/// Writes `robot.json`, the nominal positioner `nominal.json` (at the true
+/// base), two reflectors' sweeps and the fitted `p.json` in `d`.
+fn fitted_near(d: &Path) -> Near {
     let robot = robot_file(d);
     let t = near(truth());
     let mut nom = nominal();
@@ -227,6 +235,22 @@ fn solve_takes_targets_on_the_face_plate_at_each_rows_axis_values() {
     write(d, "r1.csv", &t, 1, &sweeps(), 2);
     let out = calibrate(d, ["r0.csv", "r1.csv"], &[]);
     assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+    Near {
+        robot,
+        truth: t,
+        nominal: nom,
+    }
+}
+
+#[test]
+fn solve_takes_targets_on_the_face_plate_at_each_rows_axis_values() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let Near {
+        robot,
+        truth: t,
+        nominal: nom,
+    } = fitted_near(d);
     let fitted =
         TiltRotate::from_json(&std::fs::read_to_string(d.join("p.json")).unwrap()).unwrap();
 
@@ -310,8 +334,8 @@ fn solve_takes_targets_on_the_face_plate_at_each_rows_axis_values() {
     assert!(worst(&cal) < 0.052, "{cal:?}");
     assert!(worst(&nom_miss) > 0.5, "{nom_miss:?}");
 
-    // A row without its rotate value fails alone; a file without `e2` and
-    // --positioner beside --track are refused.
+    // A row without its rotate value fails alone; a file without `e2` is
+    // refused.
     let text_cal = targets(&fitted).replacen(",40\n", ",\n", 1);
     std::fs::write(d.join("gap.csv"), text_cal).unwrap();
     let out = robocal(
@@ -354,22 +378,6 @@ fn solve_takes_targets_on_the_face_plate_at_each_rows_axis_values() {
         ],
     );
     assert_refused(&out, "an `e2` column");
-    let out = robocal(
-        d,
-        &[
-            "solve",
-            "--model",
-            "robot.json",
-            "--targets",
-            "cal.csv",
-            "--positioner",
-            "p.json",
-            "--track",
-            "rail.json",
-            "--position-only",
-        ],
-    );
-    assert_refused(&out, "cannot be used with");
 }
 
 /// `predict --positioner` states the tool's pose in the face plate frame at
@@ -380,15 +388,9 @@ fn solve_takes_targets_on_the_face_plate_at_each_rows_axis_values() {
 fn predict_states_the_pose_on_the_face_plate_at_the_axis_values() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let robot = robot_file(d);
-    let t = near(truth());
-    let mut nom = nominal();
-    nom.cell_from_base = t.cell_from_base;
-    std::fs::write(d.join("nominal.json"), nom.to_json()).unwrap();
-    write(d, "r0.csv", &t, 0, &sweeps(), 1);
-    write(d, "r1.csv", &t, 1, &sweeps(), 2);
-    let out = calibrate(d, ["r0.csv", "r1.csv"], &[]);
-    assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+    let Near {
+        robot, truth: t, ..
+    } = fitted_near(d);
     let fitted =
         TiltRotate::from_json(&std::fs::read_to_string(d.join("p.json")).unwrap()).unwrap();
     let on_body = [
@@ -528,8 +530,8 @@ fn predict_states_the_pose_on_the_face_plate_at_the_axis_values() {
     assert!(off > 0.5, "{off}");
 
     // Refusals: a row without its `e2` fails alone naming line and column;
-    // one flag alone, the flags beside the columns and --positioner beside
-    // --track or --work-object are refused.
+    // one flag alone, the flags beside the columns, --e3 without --track
+    // and --positioner beside --work-object are refused.
     let gap = std::fs::read_to_string(d.join("joints.csv"))
         .unwrap()
         .replacen(",40\n", ",\n", 1);
@@ -565,8 +567,8 @@ fn predict_states_the_pose_on_the_face_plate_at_the_axis_values() {
             "ambiguous",
         ),
         (
-            vec!["--positioner", "p.json", "--track", "rail.json"],
-            "cannot be used with",
+            vec!["--positioner", "p.json", "--e2", "5", "--e3", "10"],
+            "--track",
         ),
         (
             vec![

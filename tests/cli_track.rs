@@ -14,7 +14,10 @@ mod common;
 #[path = "../core/tests/common/mod.rs"]
 mod core_common;
 
-use common::{assert_refused, code, line_rms, printed_fit, robocal, save_robot_file, text};
+use common::{
+    assert_refused, code, json_numbers as numbers, line_rms, printed_fit, robocal, save_robot_file,
+    text,
+};
 use core_common::track::{measure_on_track, true_pose, ys100_truth, STATIONS};
 use nalgebra::{UnitQuaternion, Vector3};
 use rand::SeedableRng;
@@ -550,14 +553,6 @@ fn solve_reads_a_track_value_per_row_from_the_targets_file() {
         &["solve", "--model", "robot.json", "--targets", "rows.csv"],
     );
     assert_refused(&out, "give --track FILE");
-}
-
-fn numbers(v: &serde_json::Value) -> Vec<f64> {
-    v.as_array()
-        .unwrap()
-        .iter()
-        .map(|x| x.as_f64().unwrap())
-        .collect()
 }
 
 /// `robocal track simulate` writes the readings of a robot (the model file

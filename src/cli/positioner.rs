@@ -45,7 +45,7 @@ use robocal_core::model::external::TiltRotate;
 use robocal_core::model::Pose;
 use robocal_core::solve::cell::PredictFrame;
 use robocal_core::solve::external::{
-    base_from_part, target_column_values, AxisValues, TargetValue, ROTATE_COLUMN, TILT_COLUMN,
+    base_from_part, positioner_columns, target_column_values, AxisValues, TargetValue,
 };
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -360,29 +360,36 @@ pub struct OnPlate {
     path: String,
     positioner: TiltRotate,
     values: PlateValues,
+    /// The tilt's and the rotate's columns (`positioner_columns`): `e1`,
+    /// `e2`, or `e2`, `e3` beside a track.
+    columns: [&'static str; 2],
 }
 
 impl OnPlate {
-    /// Reads the positioner file `path` and the values: `--e1` and `--e2`
-    /// together, or (neither given) the joints file's `e1` and `e2`
-    /// columns; one flag alone, the flags beside such a column, or a file
-    /// without both columns is refused.
+    /// Reads the positioner file `path` and the values: the tilt and rotate
+    /// flags together (`flags`: `--e1`, `--e2`; beside a track, `on_track`,
+    /// `--e2`, `--e3`, the track's value being `--e1`), or (neither given)
+    /// the joints file's columns of the same names; one flag alone, the
+    /// flags beside such a column, or a file without both columns is
+    /// refused.
     pub fn read(
         path: &str,
-        e1: Option<f64>,
-        e2: Option<f64>,
+        flags: [Option<f64>; 2],
+        on_track: bool,
         file: &str,
         text: &str,
         dialect: Dialect,
     ) -> anyhow::Result<OnPlate> {
         let positioner = read_positioner(path)?;
-        let tilt =
-            target_column_values(text, dialect, TILT_COLUMN).with_context(|| file.to_string())?;
+        let columns = positioner_columns(on_track);
+        let [t_col, r_col] = columns;
+        let [t_flag, r_flag] = columns.map(|c| format!("--{c}"));
+        let tilt = target_column_values(text, dialect, t_col).with_context(|| file.to_string())?;
         let rotate =
-            target_column_values(text, dialect, ROTATE_COLUMN).with_context(|| file.to_string())?;
-        let values = match (e1, e2, tilt, rotate) {
-            (Some(t), Some(r), None, None) => {
-                for (v, flag) in [(t, "--e1"), (r, "--e2")] {
+            target_column_values(text, dialect, r_col).with_context(|| file.to_string())?;
+        let values = match (flags, tilt, rotate) {
+            ([Some(t), Some(r)], None, None) => {
+                for (v, flag) in [(t, &t_flag), (r, &r_flag)] {
                     if !v.is_finite() || v.abs() > 720.0 {
                         anyhow::bail!("{flag} {v}: a positioner axis's value is a finite number of degrees within two turns (±720)");
                     }
@@ -392,34 +399,36 @@ impl OnPlate {
                     rotate_deg: r,
                 })
             }
-            (Some(_), Some(_), _, _) => anyhow::bail!(
-                "{file}: the file has an `{TILT_COLUMN}` or `{ROTATE_COLUMN}` column and --e1, --e2 are given: ambiguous (give the flags or the columns)"
+            ([Some(_), Some(_)], _, _) => anyhow::bail!(
+                "{file}: the file has an `{t_col}` or `{r_col}` column and {t_flag}, {r_flag} are given: ambiguous (give the flags or the columns)"
             ),
-            (None, None, Some(tilt), Some(rotate)) => PlateValues::PerRow { tilt, rotate },
-            (None, None, t, _) => {
-                let name = if t.is_none() { TILT_COLUMN } else { ROTATE_COLUMN };
+            ([None, None], Some(tilt), Some(rotate)) => PlateValues::PerRow { tilt, rotate },
+            ([None, None], t, _) => {
+                let name = if t.is_none() { t_col } else { r_col };
                 anyhow::bail!(
-                    "{file}: --positioner needs --e1 DEG --e2 DEG (tilt, rotate) or an `{TILT_COLUMN}` and an `{ROTATE_COLUMN}` column, and the file has no `{name}` column"
+                    "{file}: --positioner needs {t_flag} DEG {r_flag} DEG (tilt, rotate) or an `{t_col}` and an `{r_col}` column, and the file has no `{name}` column"
                 )
             }
-            _ => anyhow::bail!("--positioner needs both --e1 (tilt) and --e2 (rotate) [deg], or neither (each row's `{TILT_COLUMN}` and `{ROTATE_COLUMN}` columns)"),
+            _ => anyhow::bail!("--positioner needs both {t_flag} (tilt) and {r_flag} (rotate) [deg], or neither (each row's `{t_col}` and `{r_col}` columns)"),
         };
         Ok(OnPlate {
             path: path.to_string(),
             positioner,
             values,
+            columns,
         })
     }
 
     /// The frame's name for the output's header.
     pub fn label(&self) -> String {
+        let [t, r] = self.columns;
         match &self.values {
             PlateValues::Fixed(v) => format!(
-                "face plate of positioner {} at e1 (tilt) {} deg, e2 (rotate) {} deg",
+                "face plate of positioner {} at {t} (tilt) {} deg, {r} (rotate) {} deg",
                 self.path, v.tilt_deg, v.rotate_deg
             ),
             PlateValues::PerRow { .. } => format!(
-                "face plate of positioner {} at each row's e1 (tilt), e2 (rotate)",
+                "face plate of positioner {} at each row's {t} (tilt), {r} (rotate)",
                 self.path
             ),
         }
@@ -427,8 +436,9 @@ impl OnPlate {
 
     /// The face plate at row `line`'s values in `model`'s base frame,
     /// `robot.cell_from_base⁻¹·F(v)` (a pose predicted in it is
-    /// `F(v)⁻¹·cell_from_base·pose`), or the row's error naming its line and
-    /// column.
+    /// `F(v)⁻¹·cell_from_base·pose`; beside a track `model` is carried to
+    /// the row's value, so `F(v)⁻¹·B(e)·pose`), or the row's error naming
+    /// its line and column.
     pub fn frame_at(&self, line: usize, model: &CompensatedModel) -> Result<PredictFrame, String> {
         let values = match &self.values {
             PlateValues::Fixed(v) => *v,
@@ -440,8 +450,8 @@ impl OnPlate {
                     )
                 };
                 AxisValues {
-                    tilt_deg: at(tilt, TILT_COLUMN)?,
-                    rotate_deg: at(rotate, ROTATE_COLUMN)?,
+                    tilt_deg: at(tilt, self.columns[0])?,
+                    rotate_deg: at(rotate, self.columns[1])?,
                 }
             }
         };

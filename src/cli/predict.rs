@@ -19,7 +19,10 @@
 //! beyond the track's travel fails its row alone). With `--positioner FILE
 //! --e1 DEG --e2 DEG` (or each row's `e1`, `e2` columns) the poses are in
 //! the positioner's face plate frame at those values (`super::positioner::
-//! OnPlate`): `F(v)⁻¹·cell_from_base·pose`.
+//! OnPlate`): `F(v)⁻¹·cell_from_base·pose`. With both, `--track FILE
+//! --positioner FILE`, the robot rides the track beside the positioner
+//! (both in the track's cell frame): `e1` the track's value, `e2`, `e3` the
+//! positioner's, as flags or columns: `F(v)⁻¹·B(e)·pose`.
 
 use super::solve::OutputFormat;
 use crate::measure::csv_text::dialect_from_names;
@@ -90,12 +93,18 @@ pub struct PredictArgs {
     /// Calibrated positioner (`robocal positioner calibrate --out`, in the
     /// robot's measurement frame): the poses are stated in its face plate
     /// frame at `--e1` (tilt) and `--e2` (rotate) [deg], or at each row's
-    /// `e1` and `e2` columns.
-    #[arg(long, conflicts_with_all = ["work_object", "track", "frame"])]
+    /// `e1` and `e2` columns; beside --track (in the track's cell frame) at
+    /// `--e2` (tilt) and `--e3` (rotate) or each row's `e2`, `e3`, the
+    /// track's value `--e1` or each row's `e1`.
+    #[arg(long, conflicts_with_all = ["work_object", "frame"])]
     pub positioner: Option<String>,
-    /// The positioner's rotate (axis 2) value [deg], beside `--e1` its tilt.
+    /// The positioner's rotate (axis 2) value [deg], beside `--e1` its tilt;
+    /// beside --track, its tilt (axis 1).
     #[arg(long, requires = "positioner", allow_hyphen_values = true)]
     pub e2: Option<f64>,
+    /// Beside --track: the positioner's rotate (axis 2) value [deg].
+    #[arg(long, requires_all = ["positioner", "track"], allow_hyphen_values = true)]
+    pub e3: Option<f64>,
 }
 
 /// The validation evidence of a calibrated model file (none for presets and
@@ -130,8 +139,14 @@ pub fn predict_outcome(a: &PredictArgs) -> anyhow::Result<super::exit::Outcome> 
         .with_context(|| format!("cannot read joints file {}", a.joints))?;
     let dialect = dialect_from_names(a.delimiter.as_deref(), a.decimal.as_deref())
         .map_err(anyhow::Error::msg)?;
+    let on_track = a.track.track.is_some();
+    let flags = if on_track {
+        [a.e2, a.e3]
+    } else {
+        [a.track.e1, a.e2]
+    };
     let plate = a.positioner.as_ref().map(|path| {
-        super::positioner::OnPlate::read(path, a.track.e1, a.e2, &a.joints, &text, dialect)
+        super::positioner::OnPlate::read(path, flags, on_track, &a.joints, &text, dialect)
     });
     let plate = plate.transpose()?;
     // `--track` without `--e1`: each row's value from the file's `e1` column.
@@ -175,7 +190,13 @@ pub fn predict_outcome(a: &PredictArgs) -> anyhow::Result<super::exit::Outcome> 
         Placed { forward, frame }
     };
     let frame_label = match (&wobj, &per_row) {
-        _ if plate.is_some() => plate.as_ref().map(|p| p.label()).unwrap_or_default(),
+        _ if plate.is_some() => {
+            let label = plate.as_ref().map(|p| p.label()).unwrap_or_default();
+            match per_row {
+                Some(_) => a.track.label_per_row(label),
+                None => a.track.label(label),
+            }
+        }
         (Some(w), _) => format!("work object {}", w.name),
         (None, Some(_)) => a.track.label_per_row(frame.to_string()),
         (None, None) => a.track.label(frame.to_string()),

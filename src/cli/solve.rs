@@ -25,7 +25,10 @@
 //! (`solve::external::targets`: a row beyond the travel, or without a
 //! number there, fails alone). With `--positioner FILE` the targets are in
 //! a calibrated positioner's face plate frame, each row at its `e1` (tilt)
-//! and `e2` (rotate) values [deg] (`solve::external::place_on_positioner`).
+//! and `e2` (rotate) values [deg] (`solve::external::place_on_positioner`);
+//! with `--track` beside it, at its `e2` (tilt) and `e3` (rotate), the
+//! robot carried to the row's `e1` (or `--e1`) along the track, both in the
+//! track's cell frame (`place_on_track_and_positioner`: `B(e)⁻¹·F(v)·T`).
 //! The false targets stay in the controller's base frame (or the work
 //! object).
 
@@ -39,10 +42,10 @@ use crate::solve::ik::{
 use anyhow::{bail, Context};
 use clap::{Args, ValueEnum};
 use robocal_core::model::calibrated::CompensatedModel;
-use robocal_core::model::external::TiltRotate;
+use robocal_core::model::external::{LinearTrack, TiltRotate};
 use robocal_core::solve::external::{
-    place_on_positioner, place_on_track, target_column_values, TargetValue, ROTATE_COLUMN,
-    TILT_COLUMN, TRACK_COLUMN,
+    place_on_positioner, place_on_track, place_on_track_and_positioner, positioner_columns,
+    target_column_values, TargetValue, TRACK_COLUMN,
 };
 use serde_json::json;
 use std::fmt::Write as _;
@@ -148,8 +151,10 @@ pub struct SolveArgs {
     pub track: super::track::OnTrack,
     /// Calibrated positioner (`robocal positioner calibrate --out`, in the
     /// robot's measurement frame): the targets are in its face plate frame,
-    /// each row at its `e1` (tilt) and `e2` (rotate) values [deg].
-    #[arg(long, conflicts_with_all = ["work_object", "track"])]
+    /// each row at its `e1` (tilt) and `e2` (rotate) values [deg]; beside
+    /// --track (in the track's cell frame) at `e2` (tilt) and `e3` (rotate),
+    /// the track's value its `e1` column or --e1.
+    #[arg(long, conflicts_with_all = ["work_object"])]
     pub positioner: Option<String>,
 }
 
@@ -190,14 +195,16 @@ pub fn solve_outcome(a: &SolveArgs) -> anyhow::Result<super::exit::Outcome> {
         .with_context(|| format!("cannot read targets file {}", a.targets))?;
     let dialect = dialect_from_names(a.delimiter.as_deref(), a.decimal.as_deref())
         .map_err(anyhow::Error::msg)?;
+    let on_track = a.track.track.is_some();
     let on_plate = match &a.positioner {
-        Some(path) => Some(positioner_rows(path, &a.targets, &text, dialect)?),
+        Some(path) => Some(positioner_rows(path, &a.targets, &text, dialect, on_track)?),
         None => None,
     };
-    // `--track` without `--e1`: each row's value from the file's `e1` column.
-    let per_row = match on_plate {
-        Some(_) => None,
-        None => a.track.per_target(&a.targets, &text, dialect)?,
+    // `--track` without `--e1`: each row's value from the file's `e1` column
+    // (on a positioner without a track, `e1` is its tilt).
+    let per_row = match (&on_plate, on_track) {
+        (Some(_), false) => None,
+        _ => a.track.per_target(&a.targets, &text, dialect)?,
     };
     let loaded = super::model_files::load_with_payload(&a.model, a.payload_kg)?;
     let model = match per_row {
@@ -234,13 +241,15 @@ pub fn solve_outcome(a: &SolveArgs) -> anyhow::Result<super::exit::Outcome> {
         bail!("--jump-deg must be a positive number of degrees");
     }
     // The external-axis columns read per row, passed over by the parser.
-    let beside: &[&str] = match (&on_plate, &per_row) {
-        (Some(_), _) => &[TILT_COLUMN, ROTATE_COLUMN],
-        (None, Some(_)) => &[TRACK_COLUMN],
-        (None, None) => &[],
+    let mut beside: Vec<&str> = match &per_row {
+        Some(_) => vec![TRACK_COLUMN],
+        None => vec![],
     };
+    if on_plate.is_some() {
+        beside.extend(positioner_columns(on_track));
+    }
     let mut csv =
-        parse_targets_csv_beside(&text, dialect, beside).with_context(|| a.targets.clone())?;
+        parse_targets_csv_beside(&text, dialect, &beside).with_context(|| a.targets.clone())?;
     if csv.convention.is_none() && !a.position_only {
         bail!(
             "{}: no orientation columns ({CONVENTION_COLUMNS}); add them or pass --position-only",
@@ -253,14 +262,25 @@ pub fn solve_outcome(a: &SolveArgs) -> anyhow::Result<super::exit::Outcome> {
         ..IkSettings::default()
     };
     let cell_solver = CellSolver::for_tool(&model, tool.as_ref(), settings);
-    // Per row: each target moved into the base frame at its own value.
-    let on_track = per_row.as_ref().map(|(track, values)| {
-        let placed = place_on_track(&mut csv, values, track, frame, work_object.as_ref());
-        frame = TargetFrame::Base;
-        placed
-    });
-    if let Some(rows) = &on_plate {
-        frame_label = rows.place(&mut csv, &model);
+    // Per row: each target moved into the base frame at its own values.
+    let mut on_track = None;
+    match (&on_plate, &per_row) {
+        (None, Some((track, values))) => {
+            on_track = Some(place_on_track(
+                &mut csv,
+                values,
+                track,
+                frame,
+                work_object.as_ref(),
+            ));
+        }
+        (Some(rows), Some((track, values))) => {
+            frame_label = rows.place_beside_track(&mut csv, track, values, &a.track);
+        }
+        (Some(rows), None) => frame_label = rows.place(&mut csv, &model, &a.track),
+        (None, None) => {}
+    }
+    if on_track.is_some() || on_plate.is_some() {
         frame = TargetFrame::Base;
     }
     let in_work_object = match (&work_object, &on_track) {
@@ -335,14 +355,22 @@ struct PlateRows {
     /// The positioner file.
     path: String,
     positioner: TiltRotate,
+    /// The tilt's and the rotate's columns (`positioner_columns`).
+    columns: [&'static str; 2],
     tilt: Vec<TargetValue>,
     rotate: Vec<TargetValue>,
 }
 
 impl PlateRows {
     /// Moves `csv`'s targets (face plate frame) into `model`'s base frame
-    /// at each row's values; the frame's name for the output's header.
-    fn place(&self, csv: &mut crate::solve::ik::TargetsCsv, model: &CompensatedModel) -> String {
+    /// at each row's values (`model` carried to `--e1` by `track`, if
+    /// given); the frame's name for the output's header.
+    fn place(
+        &self,
+        csv: &mut crate::solve::ik::TargetsCsv,
+        model: &CompensatedModel,
+        track: &super::track::OnTrack,
+    ) -> String {
         place_on_positioner(
             csv,
             &self.tilt,
@@ -350,20 +378,47 @@ impl PlateRows {
             &self.positioner,
             &model.cell_from_base,
         );
+        track.label(self.label())
+    }
+
+    /// Moves `csv`'s targets (face plate frame) into the base frame of the
+    /// robot carried by `track` to each row's `e1`, at each row's values.
+    fn place_beside_track(
+        &self,
+        csv: &mut crate::solve::ik::TargetsCsv,
+        track: &LinearTrack,
+        values: &[TargetValue],
+        on_track: &super::track::OnTrack,
+    ) -> String {
+        place_on_track_and_positioner(
+            csv,
+            values,
+            track,
+            &self.tilt,
+            &self.rotate,
+            &self.positioner,
+        );
+        on_track.label_per_row(self.label())
+    }
+
+    fn label(&self) -> String {
+        let [tilt, rotate] = self.columns;
         format!(
-            "face plate of positioner {} at each row's e1 (tilt), e2 (rotate)",
+            "face plate of positioner {} at each row's {tilt} (tilt), {rotate} (rotate)",
             self.path
         )
     }
 }
 
-/// `--positioner FILE`: the positioner and the targets file's `e1` (tilt)
-/// and `e2` (rotate) columns, both required.
+/// `--positioner FILE`: the positioner and the targets file's tilt and
+/// rotate columns, both required: `e1`, `e2`, or beside a track
+/// (`on_track`) `e2`, `e3`.
 fn positioner_rows(
     path: &str,
     file: &str,
     text: &str,
     dialect: crate::measure::csv_text::Dialect,
+    on_track: bool,
 ) -> anyhow::Result<PlateRows> {
     let positioner = super::positioner::read_positioner(path)?;
     let column = |name: &str, role: &str| -> anyhow::Result<Vec<TargetValue>> {
@@ -373,10 +428,12 @@ fn positioner_rows(
                 format!("{file}: --positioner reads each row's {role} value [deg] from an `{name}` column, and the file has none")
             })
     };
+    let columns = positioner_columns(on_track);
     Ok(PlateRows {
         path: path.to_string(),
-        tilt: column(TILT_COLUMN, "tilt (axis 1)")?,
-        rotate: column(ROTATE_COLUMN, "rotate (axis 2)")?,
+        tilt: column(columns[0], "tilt (axis 1)")?,
+        rotate: column(columns[1], "rotate (axis 2)")?,
+        columns,
         positioner,
     })
 }

@@ -16,7 +16,10 @@
 //! track (`service::tracks::carry`), and the cell frame is the track's.
 //! With `e1` and `e2` [deg] the poses are in the stored positioner's face
 //! plate frame at those tilt and rotate values (`frame: face_plate`), as
-//! `robocal predict --positioner --e1 --e2` states them.
+//! `robocal predict --positioner --e1 --e2` states them. With `e1` [mm],
+//! `e2` and `e3` [deg] the robot rides its stored track beside its stored
+//! positioner: the base carried to `e1`, the poses on the face plate at
+//! tilt `e2`, rotate `e3`.
 
 use super::input::{check_payload, objects, present};
 use super::solve::{convention, model_choice, target_id, ItemRef, VersionSelector};
@@ -75,9 +78,15 @@ pub struct PredictRequest {
     #[serde(default, deserialize_with = "present")]
     pub e1: Option<f64>,
     /// The positioner's rotate value [deg] (with `e1` its tilt): the poses
-    /// in the stored positioner's face plate frame.
+    /// in the stored positioner's face plate frame; with `e3`, the
+    /// positioner's tilt beside the track's `e1`.
     #[serde(default, deserialize_with = "present")]
     pub e2: Option<f64>,
+    /// The rotate value [deg] of a positioner beside the robot's track:
+    /// `e1` the track's value [mm], `e2` the tilt, the poses in the stored
+    /// positioner's face plate frame.
+    #[serde(default, deserialize_with = "present")]
+    pub e3: Option<f64>,
 }
 
 /// A predicted orientation in the request's `convention`.
@@ -169,6 +178,7 @@ fn command(robot_id: i64, req: &PredictRequest) -> Result<PredictCommand, ApiErr
     let axes = axis_values(
         req.e1,
         req.e2,
+        req.e3,
         req.frame.is_some() || req.work_object.is_some(),
     )?;
     let readings = req

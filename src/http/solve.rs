@@ -19,10 +19,12 @@
 //! track's (`service::tracks::carry`); a targets CSV may instead carry an
 //! `e1` column, a value per row (both: 422), or `e1` and `e2` columns, a
 //! positioner's tilt and rotate values per row with the targets on its face
-//! plate (`solve_columns` reads them). With `e1` and `e2` in a JSON body the
-//! targets are on the stored positioner's face plate at those values (tilt,
-//! rotate [deg]), as a targets CSV's rows with those values are; the query's
-//! `e1` and `frame` then do not apply. The handler turns either body into a
+//! plate (`solve_columns` reads them), or `e1`, `e2` and `e3` columns, the
+//! track's value and the positioner's beside it. With `e1` and `e2` in a
+//! JSON body the targets are on the stored positioner's face plate at those
+//! values (tilt, rotate [deg]), as a targets CSV's rows with those values
+//! are (with `e3` too: the track's `e1`, the positioner's `e2`, `e3`); the
+//! query's `e1` and `frame` then do not apply. The handler turns either body into a
 //! `service::solve::SolveCommand`; the service picks the model and runs it.
 
 use super::error::{content_type, json_content_type};
@@ -178,9 +180,15 @@ pub struct SolveRequest {
     #[serde(default, deserialize_with = "present")]
     pub e1: Option<f64>,
     /// The positioner's rotate value [deg]: with it, `e1` is the tilt and
-    /// the targets are in the stored positioner's face plate frame.
+    /// the targets are in the stored positioner's face plate frame; with
+    /// `e3`, the positioner's tilt beside the track's `e1`.
     #[serde(default, deserialize_with = "present")]
     pub e2: Option<f64>,
+    /// The rotate value [deg] of a positioner beside the robot's track:
+    /// `e1` the track's value [mm], `e2` the tilt, the targets in the
+    /// stored positioner's face plate frame.
+    #[serde(default, deserialize_with = "present")]
+    pub e3: Option<f64>,
 }
 
 /// A tool or work object of a solve: a stored one's name, or one inline.
@@ -379,6 +387,7 @@ struct Common<'a> {
     path: bool,
     e1: Option<f64>,
     e2: Option<f64>,
+    e3: Option<f64>,
     /// Whether the request names a work object.
     work_object: bool,
 }
@@ -434,7 +443,7 @@ fn command(robot_id: i64, c: Common) -> Result<SolveCommand, ApiError> {
         .map(|name| convention(name, "`convention`"))
         .transpose()?;
     let model = model_choice(c.version)?;
-    let axes = axis_values(c.e1, c.e2, c.frame.is_some() || c.work_object)?;
+    let axes = axis_values(c.e1, c.e2, c.e3, c.frame.is_some() || c.work_object)?;
     Ok(SolveCommand {
         robot_id,
         model,
@@ -503,6 +512,7 @@ pub fn json_command(
                 req.e1.or(query.e1)
             },
             e2: req.e2,
+            e3: req.e3,
             work_object: req.work_object.is_some(),
         },
     )?;
@@ -661,6 +671,7 @@ pub fn csv_command(robot_id: i64, q: &CsvSolveQuery, text: &str) -> Result<Solve
             path: query.path.unwrap_or(false),
             e1: query.e1,
             e2: None,
+            e3: None,
             work_object: false,
         },
     )?;
@@ -672,6 +683,10 @@ pub fn csv_command(robot_id: i64, q: &CsvSolveQuery, text: &str) -> Result<Solve
         AxisColumns::None => {}
         AxisColumns::Track(rows) => cmd.track_rows = Some(rows),
         AxisColumns::Positioner(rows) => cmd.positioner_rows = Some(rows),
+        AxisColumns::TrackAndPositioner { track, plate } => {
+            cmd.track_rows = Some(track);
+            cmd.positioner_rows = Some(plate);
+        }
     }
     if csv.rows.is_empty() {
         return Err(ApiError::invalid(

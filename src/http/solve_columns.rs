@@ -5,18 +5,24 @@
 //! along its stored track, `service::tracks`); `e1` and `e2` together are a
 //! positioner's tilt and rotate values [deg], the targets given in its face
 //! plate frame (`service::positioners`: a robot without a positioner, or
-//! with a track as well, is a 409). An `e2` column without `e1`, the query's
-//! `e1` beside either, and `frame` beside a positioner's columns are 422.
+//! with a track as well, is a 409); `e1`, `e2` and `e3` are the track's
+//! value and the positioner's tilt and rotate beside it, as the programs
+//! number them (`core::solve::external::positioner_columns`; a robot
+//! without both is a 409). An `e2` column without `e1`, an `e3` without
+//! both, the query's `e1` beside any, and `frame` beside a positioner's
+//! columns are 422.
 //!
 //! The same axes as single values ([`axis_values`], a JSON body's or a
-//! query's `e1` and `e2`, for solve and predict): `e1` alone is the track's
-//! value, `e1` and `e2` a positioner's, the poses on its face plate.
+//! query's `e1`, `e2` and `e3`, for solve and predict): `e1` alone is the
+//! track's value, `e1` and `e2` a positioner's, the poses on its face
+//! plate, and `e1`, `e2`, `e3` the track's and the positioner's beside it.
 
 use super::ApiError;
 use crate::measure::csv_text::Dialect;
 use crate::service::positioners::PlateValues;
 use robocal_core::solve::external::{
-    target_column_values, AxisValues, TargetValue, ROTATE_COLUMN, TILT_COLUMN, TRACK_COLUMN,
+    positioner_columns, target_column_values, AxisValues, TargetValue, ROTATE_COLUMN, TILT_COLUMN,
+    TRACK_COLUMN,
 };
 
 /// What a targets CSV's external-axis columns carry, per row.
@@ -28,6 +34,14 @@ pub enum AxisColumns {
     Track(Vec<TargetValue>),
     /// `e1` and `e2` columns: a positioner's tilt and rotate values per row.
     Positioner(PlateValues),
+    /// `e1`, `e2` and `e3` columns: the track's value and, beside it, the
+    /// positioner's tilt and rotate values per row.
+    TrackAndPositioner {
+        /// The track's value per row (`e1`) [mm].
+        track: Vec<TargetValue>,
+        /// The positioner's values per row (`e2`, `e3`) [deg].
+        plate: PlateValues,
+    },
 }
 
 impl AxisColumns {
@@ -37,6 +51,7 @@ impl AxisColumns {
             AxisColumns::None => &[],
             AxisColumns::Track(_) => &[TRACK_COLUMN],
             AxisColumns::Positioner(_) => &[TILT_COLUMN, ROTATE_COLUMN],
+            AxisColumns::TrackAndPositioner { .. } => &CELL_COLUMNS,
         }
     }
 }
@@ -55,6 +70,9 @@ pub fn axis_columns(
     };
     let tilt = read(TILT_COLUMN)?;
     let rotate = read(ROTATE_COLUMN)?;
+    if let Some(third) = read(CELL_COLUMNS[2])? {
+        return beside_track(tilt, rotate, third, query_e1, frame_given);
+    }
     match (tilt, rotate) {
         (None, None) => Ok(AxisColumns::None),
         (Some(_), None) if query_e1.is_some() => Err(ApiError::invalid(format!(
@@ -74,6 +92,44 @@ pub fn axis_columns(
     }
 }
 
+/// A track's value and a positioner's beside it: `e1`, `e2`, `e3`.
+const CELL_COLUMNS: [&str; 3] = {
+    let [tilt, rotate] = positioner_columns(true);
+    [TRACK_COLUMN, tilt, rotate]
+};
+
+/// A targets CSV with an `e3` column: the track's `e1` and the
+/// positioner's `e2`, `e3` per row, all three, without the query's `e1` or
+/// `frame` (422 otherwise).
+fn beside_track(
+    track: Option<Vec<TargetValue>>,
+    tilt: Option<Vec<TargetValue>>,
+    rotate: Vec<TargetValue>,
+    query_e1: Option<f64>,
+    frame_given: bool,
+) -> Result<AxisColumns, ApiError> {
+    let [e1, e2, e3] = CELL_COLUMNS;
+    let (Some(track), Some(tilt)) = (track, tilt) else {
+        return Err(ApiError::invalid(format!(
+            "targets CSV: an `{e3}` column without `{e1}` and `{e2}`: a robot on a track beside a positioner gives each target the track's value `{e1}` [mm], the positioner's tilt `{e2}` and rotate `{e3}` [deg]"
+        )));
+    };
+    if query_e1.is_some() {
+        return Err(ApiError::invalid(format!(
+            "the targets CSV has `{e1}`, `{e2}` and `{e3}` columns (the track's and the positioner's values per row) and the query gives `e1`: which holds is ambiguous; leave `e1` out"
+        )));
+    }
+    if frame_given {
+        return Err(ApiError::invalid(format!(
+            "`frame`: the targets of a CSV with `{e1}`, `{e2}` and `{e3}` columns are in the positioner's face plate frame; leave `frame` out"
+        )));
+    }
+    Ok(AxisColumns::TrackAndPositioner {
+        track,
+        plate: PlateValues { tilt, rotate },
+    })
+}
+
 /// The external axes of a request as single values.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct AxisSettings {
@@ -85,12 +141,27 @@ pub struct AxisSettings {
 
 /// `e1` alone: a track value [mm]; `e1` and `e2`: a positioner's tilt and
 /// rotate [deg], the poses on its face plate, so `frame_given` (a `frame`
-/// or a work object beside them) is a 422; `e2` alone a 422.
+/// or a work object beside them) is a 422; `e2` alone a 422; `e1`, `e2`,
+/// `e3`: the track's value and the positioner's tilt and rotate beside it
+/// (`e3` without both others a 422).
 pub fn axis_values(
     e1: Option<f64>,
     e2: Option<f64>,
+    e3: Option<f64>,
     frame_given: bool,
 ) -> Result<AxisSettings, ApiError> {
+    if let Some(rotate) = e3 {
+        let (Some(track), Some(tilt)) = (e1, e2) else {
+            return Err(ApiError::invalid(
+                "`e3` without `e1` and `e2`: beside a track, `e1` is its value [mm] and `e2`, `e3` the positioner's tilt and rotate [deg], all three",
+            ));
+        };
+        let plate = positioner_values(tilt, rotate, frame_given, ["e2", "e3"])?;
+        return Ok(AxisSettings {
+            track_mm: Some(track),
+            positioner_deg: Some(plate),
+        });
+    }
     let (tilt, rotate) = match (e1, e2) {
         (e1, None) => {
             return Ok(AxisSettings {
@@ -105,23 +176,36 @@ pub fn axis_values(
         }
         (Some(t), Some(r)) => (t, r),
     };
+    Ok(AxisSettings {
+        track_mm: None,
+        positioner_deg: Some(positioner_values(tilt, rotate, frame_given, ["e1", "e2"])?),
+    })
+}
+
+/// A positioner's tilt and rotate [deg], the fields named `names`; the
+/// poses are on its face plate, so `frame_given` is a 422, and so is a
+/// value beyond two turns.
+fn positioner_values(
+    tilt: f64,
+    rotate: f64,
+    frame_given: bool,
+    names: [&str; 2],
+) -> Result<AxisValues, ApiError> {
+    let [t, r] = names;
     if frame_given {
-        return Err(ApiError::invalid(
-            "`e1` and `e2` state the poses in the positioner's face plate frame: `frame` and `work_object` beside them are ambiguous; leave them out",
-        ));
+        return Err(ApiError::invalid(format!(
+            "`{t}` and `{r}` state the poses in the positioner's face plate frame: `frame` and `work_object` beside them are ambiguous; leave them out"
+        )));
     }
-    for (v, name) in [(tilt, "e1"), (rotate, "e2")] {
+    for (v, name) in [(tilt, t), (rotate, r)] {
         if !v.is_finite() || v.abs() > 720.0 {
             return Err(ApiError::invalid(format!(
                 "`{name}`: {v} is not a positioner axis's value: a finite number of degrees within two turns (±720)"
             )));
         }
     }
-    Ok(AxisSettings {
-        track_mm: None,
-        positioner_deg: Some(AxisValues {
-            tilt_deg: tilt,
-            rotate_deg: rotate,
-        }),
+    Ok(AxisValues {
+        tilt_deg: tilt,
+        rotate_deg: rotate,
     })
 }

@@ -285,18 +285,29 @@ impl PlateValues {
     }
 }
 
-/// The robot's stored positioner for a targets CSV with `e1` and `e2`
-/// columns: no positioner is a `Conflict` (the robot's state), and so is a
-/// robot with a track too (`e1` would be either's value: ambiguous).
-pub async fn for_rows(state: &AppState, robot_id: i64) -> Result<TiltRotate, ServiceError> {
+/// The robot's stored positioner for a targets CSV with a positioner's
+/// columns: `e1` and `e2` (`beside_track` false), or `e2` and `e3` beside
+/// the track's `e1`. No positioner is a `Conflict` (the robot's state), and
+/// so is a robot with a track too when the rows give `e1` and `e2` alone
+/// (`e1` would be either's value: ambiguous).
+pub async fn for_rows(
+    state: &AppState,
+    robot_id: i64,
+    beside_track: bool,
+) -> Result<TiltRotate, ServiceError> {
     let Some(row) = state.db().positioner(robot_id).await? else {
+        let columns = if beside_track {
+            "`e1`, `e2` and `e3` columns, a track's value and a positioner's tilt and rotate values per row,"
+        } else {
+            "`e1` and `e2` columns, a positioner's tilt and rotate values per row,"
+        };
         return Err(ServiceError::Conflict(format!(
-            "the targets CSV has `e1` and `e2` columns, a positioner's tilt and rotate values per row, and robot {robot_id} has no positioner; fit one with POST /v1/robots/{robot_id}/positioner/calibrate (a track's value per row is an `e1` column alone)"
+            "the targets CSV has {columns} and robot {robot_id} has no positioner; fit one with POST /v1/robots/{robot_id}/positioner/calibrate (a track's value per row is an `e1` column alone)"
         )));
     };
-    if state.db().track(robot_id).await?.is_some() {
+    if !beside_track && state.db().track(robot_id).await?.is_some() {
         return Err(ServiceError::Conflict(format!(
-            "robot {robot_id} has a track and a positioner: the targets CSV's `e1` column could be the track's value or the positioner's tilt, which is ambiguous (a solve on both axes is not built; the program filter composes both); solve on the positioner with a robot that has no track, or on the track with an `e1` column alone"
+            "robot {robot_id} has a track and a positioner: the targets CSV's `e1` column could be the track's value or the positioner's tilt, which is ambiguous; give each row the track's value `e1` [mm] and the positioner's tilt `e2` and rotate `e3` [deg], as its programs number them"
         )));
     }
     model_of(&row)
@@ -320,18 +331,28 @@ pub async fn stored_for(
 }
 
 /// The robot's stored positioner for a prediction or a solve at its values
-/// (`e1` and `e2`): no positioner is a `Conflict`, and so is a robot with a track too
-/// (`e1` would be either's value: ambiguous), as for a targets CSV.
-pub async fn for_predict(state: &AppState, robot_id: i64) -> Result<TiltRotate, ServiceError> {
+/// (`e1` and `e2`, or `e2` and `e3` beside the track's `e1`): no positioner
+/// is a `Conflict`, and so is a robot with a track too given `e1` and `e2`
+/// alone (`e1` would be either's value: ambiguous), as for a targets CSV.
+pub async fn for_predict(
+    state: &AppState,
+    robot_id: i64,
+    beside_track: bool,
+) -> Result<TiltRotate, ServiceError> {
     let Some(row) = state.db().positioner(robot_id).await? else {
         super::robots::get(state, robot_id).await?;
+        let fields = if beside_track {
+            "`e2` and `e3` are a positioner's tilt and rotate values beside the track's `e1`,"
+        } else {
+            "`e1` and `e2` are a positioner's tilt and rotate values,"
+        };
         return Err(ServiceError::Conflict(format!(
-            "`e1` and `e2` are a positioner's tilt and rotate values, and robot {robot_id} has no positioner; fit one with POST /v1/robots/{robot_id}/positioner/calibrate (a track's value is `e1` alone)"
+            "{fields} and robot {robot_id} has no positioner; fit one with POST /v1/robots/{robot_id}/positioner/calibrate (a track's value is `e1` alone)"
         )));
     };
-    if state.db().track(robot_id).await?.is_some() {
+    if !beside_track && state.db().track(robot_id).await?.is_some() {
         return Err(ServiceError::Conflict(format!(
-            "robot {robot_id} has a track and a positioner: `e1` could be the track's value or the positioner's tilt, which is ambiguous (a solve on both axes is not built; the program filter composes both)"
+            "robot {robot_id} has a track and a positioner: `e1` could be the track's value or the positioner's tilt, which is ambiguous; give the track's value `e1` [mm] and the positioner's tilt `e2` and rotate `e3` [deg], as its programs number them"
         )));
     }
     model_of(&row)

@@ -6,7 +6,9 @@
 //! (`core::cell::accuracy`). A track value carries the model's base along
 //! the robot's stored track first (`super::tracks::carry`). Positioner
 //! values state the poses in the stored positioner's face plate frame at
-//! them (`super::positioners::for_predict`): `F(v)⁻¹·cell_from_base·pose`.
+//! them (`super::positioners::for_predict`): `F(v)⁻¹·cell_from_base·pose`;
+//! with a track value beside them (`e1`, and the positioner's `e2`, `e3`)
+//! `cell_from_base` is the carried base `B(e)`, so `F(v)⁻¹·B(e)·pose`.
 //!
 //! Units at this boundary: joint readings in the controller convention in
 //! degrees; poses SI (the handler writes mm and degrees).
@@ -156,7 +158,9 @@ pub async fn predict(
     );
     let (frame, label) = match &cmd.work_object {
         None if cmd.positioner_deg.is_some() => {
-            let positioner = super::positioners::for_predict(state, cmd.robot_id).await?;
+            let positioner =
+                super::positioners::for_predict(state, cmd.robot_id, cmd.track_mm.is_some())
+                    .await?;
             let values = cmd.positioner_deg.unwrap_or(AxisValues {
                 tilt_deg: 0.0,
                 rotate_deg: 0.0,

@@ -24,7 +24,13 @@
 //! plate frame: each row is moved into the base frame through the robot's
 //! stored positioner (`super::positioners::place_rows`) and solved by the
 //! cached solver; `e1` and `e2` for the whole request place every target
-//! (JSON or CSV) on the face plate at those values the same way.
+//! (JSON or CSV) on the face plate at those values the same way. A robot
+//! on its track beside its positioner takes `e1` (the track), `e2`, `e3`
+//! (the positioner), as its programs number them: per CSV row, each target
+//! moved to `B(e)⁻¹·F(v)·T` (`core::solve::external::
+//! place_on_track_and_positioner`); for the whole request, the solver's
+//! model carried to `e1` and the targets placed on the face plate at `e2`,
+//! `e3` through it.
 //!
 //! Units at this boundary: targets in mm and degrees (`TargetInput`), joint
 //! seeds and commands in the controller convention in degrees.
@@ -41,7 +47,9 @@ use crate::solve::ik::{
     IkSettings, IkSolver, SolveMode, SolveOptions, TargetInput, TargetResult, TargetsCsv,
 };
 use robocal_core::model::calibrated::{CalibratedModelFile, CompensatedModel};
-use robocal_core::solve::external::{base_from_part, place_on_track, AxisValues, TargetValue};
+use robocal_core::solve::external::{
+    base_from_part, place_on_track, place_on_track_and_positioner, AxisValues, TargetValue,
+};
 use std::sync::Arc;
 
 /// Which model to solve with.
@@ -450,11 +458,29 @@ async fn place_on_axes(
                 "a track value per row comes with a targets CSV".into(),
             ));
         };
-        place_on_track(csv, &values, &track, cmd.options.frame, None);
+        match cmd.positioner_rows.take() {
+            // Beside a positioner: the rows are on its face plate.
+            Some(plate) => {
+                let positioner = super::positioners::for_rows(state, cmd.robot_id, true).await?;
+                place_on_track_and_positioner(
+                    csv,
+                    &values,
+                    &track,
+                    &plate.tilt,
+                    &plate.rotate,
+                    &positioner,
+                );
+            }
+            None => {
+                place_on_track(csv, &values, &track, cmd.options.frame, None);
+            }
+        }
         cmd.options.frame = TargetFrame::Base;
     }
     if let Some(values) = cmd.positioner_deg.take() {
-        let positioner = super::positioners::for_predict(state, cmd.robot_id).await?;
+        // Beside the track's `e1`, the solver's model is carried to it.
+        let positioner =
+            super::positioners::for_predict(state, cmd.robot_id, cmd.track_mm.is_some()).await?;
         let robot = cell_solver.solver().model();
         match &mut cmd.targets {
             Targets::Csv(csv) => {
@@ -475,7 +501,7 @@ async fn place_on_axes(
         cmd.options.frame = TargetFrame::Base;
     }
     if let Some(values) = cmd.positioner_rows.take() {
-        let positioner = super::positioners::for_rows(state, cmd.robot_id).await?;
+        let positioner = super::positioners::for_rows(state, cmd.robot_id, false).await?;
         let Targets::Csv(csv) = &mut cmd.targets else {
             return Err(ServiceError::Internal(
                 "a positioner's values per row come with a targets CSV".into(),

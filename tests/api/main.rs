@@ -28,6 +28,7 @@
 
 mod abandoned;
 mod admission;
+mod beside_track;
 mod cell;
 mod cell_fit;
 mod check_reads;

@@ -95,7 +95,7 @@ fn set_text(t: &TruePositioner, k: usize, values: &[[f64; 2]], seed: u64) -> Str
 }
 
 /// Runs a `robocal` command line in-process; what it prints.
-fn cli(args: &[&str]) -> anyhow::Result<String> {
+pub(crate) fn cli(args: &[&str]) -> anyhow::Result<String> {
     let mut argv = vec!["robocal"];
     argv.extend_from_slice(args);
     match robocal::cli::Cli::try_parse_from(argv).unwrap().command {
@@ -152,7 +152,7 @@ fn body(sets: &[&str], nominal: &TiltRotate, extra: Value) -> Value {
     b
 }
 
-fn numbers(v: &Value) -> Vec<f64> {
+pub(crate) fn numbers(v: &Value) -> Vec<f64> {
     v.as_array()
         .unwrap()
         .iter()
@@ -272,7 +272,8 @@ async fn a_positioner_fitted_over_http_is_the_command_lines_and_carries_a_target
     )
     .await;
 
-    // A robot with a track as well: the `e1` column could be either's.
+    // A robot with a track as well: an `e1` column beside `e2` alone could be
+    // either's (the positioner's values are then `e2`, `e3`).
     let rail = super::track::Rail::new(&model);
     let mut rng = ChaCha8Rng::seed_from_u64(21);
     let stations = &super::track::STATIONS[..7];
@@ -305,6 +306,16 @@ async fn a_positioner_fitted_over_http_is_the_command_lines_and_carries_a_target
         &t,
         &rid,
         &nom,
+        &model,
+        &d.join("p.json"),
+        &d.join("track.json"),
+        d,
+    )
+    .await;
+    // Solves and predictions on both: `e1` the track, `e2`, `e3` the positioner.
+    super::beside_track::solves_beside_the_track(
+        &t,
+        &rid,
         &model,
         &d.join("p.json"),
         &d.join("track.json"),

@@ -225,3 +225,12 @@ pub async fn oneshot(router: &Router, req: Request<Body>) -> (StatusCode, Header
         .to_vec();
     (status, headers, body)
 }
+
+/// A JSON array of numbers.
+pub fn json_numbers(v: &serde_json::Value) -> Vec<f64> {
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect()
+}

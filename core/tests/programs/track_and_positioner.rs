@@ -295,3 +295,79 @@ fn rapid_on_a_track_reaches_the_part_on_the_positioner() {
 fn fanuc_on_a_track_reaches_the_part_on_the_positioner() {
     assert_in_cell(Language::Fanuc, &fanuc(both_cell()));
 }
+
+/// The same 50 targets as a targets file, not a program: each row the
+/// target on the taught part in the face plate frame (`W_f·t`, mm and a
+/// rotation matrix) with its track value `e1` and positioner values `e2`,
+/// `e3`, placed through the fitted track and positioner
+/// (`place_on_track_and_positioner`: `B(e)⁻¹·F(v)·T`) and solved as a path
+/// by the calibrated robot carrying the torch. The commanded joints, run on
+/// the true robot on the true track at each row's value, put the true torch
+/// on the target on the true, moved part within 1.5× the calibration's
+/// validation error; the nominal controller's own composition of the same
+/// targets (the program as written) misses by millimetres.
+#[test]
+fn targets_on_the_part_solve_at_their_track_and_positioner_values() {
+    use robocal_core::solve::cell::CellSolver;
+    use robocal_core::solve::external::{
+        place_on_track_and_positioner, positioner_columns, target_column_values, TRACK_COLUMN,
+    };
+    use robocal_core::solve::ik::targets_csv::parse_targets_csv_beside;
+    use robocal_core::solve::ik::{SolveOptions, TargetFrame};
+    let c = both_cell();
+    let on_plate = &c.cell.work_objects[0].pose;
+    let mut text = String::from("id,x,y,z,r11,r12,r13,r21,r22,r23,r31,r32,r33,e1,e2,e3\n");
+    for (k, (e, v, t)) in c.targets.iter().enumerate() {
+        let p = on_plate.compose(t);
+        let xyz = p.p * 1e3;
+        let r: Vec<String> = (0..3)
+            .flat_map(|i| (0..3).map(move |j| (i, j)))
+            .map(|(i, j)| format!("{:.12}", p.r[(i, j)]))
+            .collect();
+        text += &format!(
+            "t{k},{:.6},{:.6},{:.6},{},{e},{},{}\n",
+            xyz.x,
+            xyz.y,
+            xyz.z,
+            r.join(","),
+            v[0],
+            v[1]
+        );
+    }
+    let d = Default::default();
+    let read = |column: &str| target_column_values(&text, d, column).unwrap().unwrap();
+    let [tilt, rotate] = positioner_columns(true);
+    let mut csv = parse_targets_csv_beside(&text, d, &[TRACK_COLUMN, tilt, rotate]).unwrap();
+    place_on_track_and_positioner(
+        &mut csv,
+        &read(TRACK_COLUMN),
+        &c.track.fitted,
+        &read(tilt),
+        &read(rotate),
+        &c.fitted,
+    );
+    let cell_solver = CellSolver::for_tool(&c.track.model, Some(&torch_tool()), settings());
+    let solver = cell_solver.solver();
+    let options = SolveOptions {
+        frame: TargetFrame::Base,
+        false_target_convention: csv.convention,
+        ..SolveOptions::default()
+    };
+    let results = csv.solve(solver, &options, true);
+    let solved: Vec<Option<Miss>> = results
+        .iter()
+        .zip(&c.targets)
+        .map(|(r, (e, v, t))| {
+            assert!(r.solution.converged, "{}: {:?}", r.id, r.solution.reason);
+            let want = true_part(&c.true_positioner, &c.body, *v).compose(t);
+            Some(Miss::of(&c.track.true_tip(&r.solution.q, *e), &want))
+        })
+        .collect();
+    assert_figures(
+        "targets solved on the track beside the positioner",
+        "the calibration's validation rms (the robot's and the positioner's)",
+        c.validation,
+        solved,
+        c.run(Language::Krl, &krl(c)),
+    );
+}

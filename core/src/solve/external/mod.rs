@@ -11,7 +11,7 @@ pub mod track;
 pub use positioner::{base_from_part, cell_from_part, part_from_cell, AxisValues};
 pub use rows::{track_values, RowValue, TrackColumnError, TRACK_COLUMN};
 pub use targets::{
-    place_on_positioner, place_on_track, target_column_values, target_track_values, PlacedRows,
-    TargetValue, ROTATE_COLUMN, TILT_COLUMN,
+    place_on_positioner, place_on_track, place_on_track_and_positioner, positioner_columns,
+    target_column_values, target_track_values, PlacedRows, TargetValue, ROTATE_COLUMN, TILT_COLUMN,
 };
 pub use track::{carried, TrackPoseError, TrackSolver};

@@ -4,7 +4,9 @@
 //! ([`place_on_track`]); or a positioner's `e1` (tilt) and `e2` (rotate)
 //! columns, the target given in its face plate frame
 //! ([`place_on_positioner`]: `robot_cell_from_base⁻¹·F(v)·T`,
-//! `solve::external::positioner`).
+//! `solve::external::positioner`); or both, the robot on a track beside a
+//! positioner, `e1` the track and `e2`, `e3` the positioner's axes
+//! ([`place_on_track_and_positioner`]: `B(e)⁻¹·F(v)·T`).
 //!
 //! Frames: a target `T` in the track's cell frame (the tracker frame the
 //! track was measured in) is the base-frame target `B(e)⁻¹·T`, with
@@ -133,14 +135,7 @@ pub fn place_on_track(
     work_object: Option<&WorkObject>,
 ) -> PlacedRows {
     place(csv, |line| {
-        let v = value_at(values, line, TRACK_COLUMN)?;
-        let b = track
-            .cell_from_base(v)
-            .map_err(|travel| RowError::OutsideTravel {
-                line,
-                column: TRACK_COLUMN.into(),
-                travel,
-            })?;
+        let b = base_at(track, values, line)?;
         Ok(match (work_object, frame) {
             (Some(w), _) => {
                 let wb = match w.frame {
@@ -182,10 +177,69 @@ pub fn place_on_positioner(
     })
 }
 
+/// Moves every valid row of `csv`, a target `T` given in a positioner's
+/// face plate frame, into the base frame of a robot carried by a track, at
+/// the row's track value (`track_values` [mm]) and axis values (`tilt`,
+/// `rotate` [deg]), all matched by line: `B(e)⁻¹·F(v)·T`, the track and the
+/// positioner registered in the same cell frame (the controller's world).
+/// The columns are the programs' numbering beside a track
+/// ([`positioner_columns`]`(true)`: `e1` the track, `e2` the tilt, `e3` the
+/// rotate). The targets are then solved with `TargetFrame::Base`; their
+/// false targets stay in the controller's base frame at the row's track
+/// value. A row without a number in a column, or beyond the travel the
+/// track was measured over, becomes invalid (it fails alone, naming its
+/// line and column).
+pub fn place_on_track_and_positioner(
+    csv: &mut TargetsCsv,
+    track_values: &[TargetValue],
+    track: &LinearTrack,
+    tilt: &[TargetValue],
+    rotate: &[TargetValue],
+    positioner: &TiltRotate,
+) -> PlacedRows {
+    let [tilt_column, rotate_column] = positioner_columns(true);
+    place(csv, |line| {
+        let b = base_at(track, track_values, line)?;
+        let values = AxisValues {
+            tilt_deg: value_at(tilt, line, tilt_column)?,
+            rotate_deg: value_at(rotate, line, rotate_column)?,
+        };
+        let w = b
+            .inverse()
+            .compose(&positioner.cell_from_face_plate(values.as_array()));
+        Ok((w, None))
+    })
+}
+
 /// The columns of a positioner's axes in a targets file: axis 1 (tilt).
 pub const TILT_COLUMN: &str = "e1";
 /// The columns of a positioner's axes in a targets file: axis 2 (rotate).
 pub const ROTATE_COLUMN: &str = "e2";
+
+/// The targets-file columns of a positioner's tilt and rotate axes: `e1`,
+/// `e2` ([`TILT_COLUMN`], [`ROTATE_COLUMN`]) with the robot on a fixed
+/// base; `e2`, `e3` beside a track (`on_track`), whose value is `e1`, as
+/// the programs number them (`program::axes::FilterAxes::positioner_numbers`).
+pub const fn positioner_columns(on_track: bool) -> [&'static str; 2] {
+    if on_track {
+        ["e2", "e3"]
+    } else {
+        [TILT_COLUMN, ROTATE_COLUMN]
+    }
+}
+
+/// The robot's base `B(e)` in the cell frame at row `line`'s track value
+/// in `values`, or the row's error (no number, or beyond the travel).
+fn base_at(track: &LinearTrack, values: &[TargetValue], line: usize) -> Result<Pose, RowError> {
+    let e = value_at(values, line, TRACK_COLUMN)?;
+    track
+        .cell_from_base(e)
+        .map_err(|travel| RowError::OutsideTravel {
+            line,
+            column: TRACK_COLUMN.into(),
+            travel,
+        })
+}
 
 /// Row `line`'s value in `values`, or its error (no value read: empty).
 fn value_at(values: &[TargetValue], line: usize, column: &str) -> Result<f64, RowError> {
@@ -350,5 +404,48 @@ mod tests {
         );
         let e = csv.rows[1].target.as_ref().unwrap_err().to_string();
         assert_eq!(e, "line 3: column `e2`: `` is not a number");
+    }
+
+    /// Closed form: the same turntable beside a straight track along cell
+    /// x; with the base carried to 200 mm, the quarter-turned target at
+    /// (0, 1, 0.5) in the cell is at (−0.2, 1, 0.5) in the base. A row
+    /// beyond the travel, or without its rotate value (`e3` there), fails
+    /// alone, naming the column.
+    #[test]
+    fn beside_a_track_a_plate_target_is_moved_by_its_rows_track_and_axis_values() {
+        use crate::model::external::RotaryAxis;
+        let p = TiltRotate {
+            cell_from_base: Pose::identity(),
+            tilt: RotaryAxis::new(Vector3::x(), Vector3::zeros(), 0.0, 1.0),
+            rotate: RotaryAxis::new(Vector3::z(), Vector3::zeros(), 0.0, 1.0),
+            face_plate: Pose::from_translation(Vector3::new(0.0, 0.0, 0.5)),
+        };
+        let text = "x,y,z,e1,e2,e3\n1000,0,0,200,0,90\n1000,0,0,1200,0,90\n1000,0,0,200,0,\n";
+        let d = Dialect::default();
+        let [tilt_column, rotate_column] = positioner_columns(true);
+        let read = |c: &str| target_column_values(text, d, c).unwrap().unwrap();
+        let mut csv = parse_targets_csv_beside(text, d, &["e1", "e2", "e3"]).unwrap();
+        let placed = place_on_track_and_positioner(
+            &mut csv,
+            &read(TRACK_COLUMN),
+            &straight(),
+            &read(tilt_column),
+            &read(rotate_column),
+            &p,
+        );
+        let at = csv.rows[0].target.as_ref().unwrap().xyz_mm;
+        assert!(
+            (Vector3::from(at) - Vector3::new(-200.0, 1000.0, 500.0)).norm() < 1e-9,
+            "{at:?}"
+        );
+        let msg = |i: usize| csv.rows[i].target.as_ref().unwrap_err().to_string();
+        assert!(
+            msg(1).starts_with("line 3: column `e1`: value 1200 mm is outside"),
+            "{}",
+            msg(1)
+        );
+        assert_eq!(msg(2), "line 4: column `e3`: `` is not a number");
+        assert_eq!(placed.work_objects, vec![None; 3]);
+        assert_eq!(positioner_columns(false), [TILT_COLUMN, ROTATE_COLUMN]);
     }
 }
