@@ -131,6 +131,17 @@ fn filter_cli_reports_parse_errors_and_guesses_the_language() {
     ]))
     .unwrap_err();
     assert!(err.to_string().contains("--language"), "{err}");
+    // --correct-axes without a track or a positioner has nothing to correct.
+    let err = filter_to_string(&args(&[
+        "--model",
+        "ur5",
+        "--correct-axes",
+        "--out-dir",
+        out.to_str().unwrap(),
+        bad.to_str().unwrap(),
+    ]))
+    .unwrap_err();
+    assert!(err.to_string().contains("--correct-axes"), "{err}");
 }
 
 /// `--positioner FILE --nominal-positioner FILE`: a KRL program whose base 3

@@ -63,6 +63,13 @@ pub struct FilterArgs {
     /// or with --track the cell frame.
     #[arg(long, requires = "positioner")]
     pub nominal_positioner: Option<String>,
+    /// Rewrite the track's and the positioner's values so the real axes
+    /// stand where the controller believes the programmed values put them
+    /// (the track's scale and along-rail error, the positioner's zeros and
+    /// scales); the report gives each written value beside the programmed
+    /// one. Without it the values stay as programmed.
+    #[arg(long)]
+    pub correct_axes: bool,
     /// Directory for the filtered files (same names as the inputs).
     #[arg(long)]
     pub out_dir: PathBuf,
@@ -124,7 +131,11 @@ pub fn filter_report(a: &FilterArgs) -> anyhow::Result<super::exit::Outcome> {
         )),
         _ => None,
     };
-    let axes = FilterAxes::of_cell(tracks.as_ref(), positioners.as_ref());
+    if a.correct_axes && tracks.is_none() && positioners.is_none() {
+        anyhow::bail!("--correct-axes corrects the values of a --track or a --positioner, and neither is given");
+    }
+    let axes = FilterAxes::of_cell(tracks.as_ref(), positioners.as_ref())
+        .correcting_values(a.correct_axes);
     let out = filter_with(
         language,
         &files,

@@ -71,6 +71,12 @@ pub struct FilterRequest {
     /// program's axes 1 and 2 (2 and 3 with `controller_track`).
     #[serde(default, deserialize_with = "present")]
     pub controller_positioner: Option<TiltRotateDescription>,
+    /// Rewrite the track's and the positioner's values so the real axes
+    /// stand where the controller believes the programmed values put them
+    /// (default false: kept as programmed); needs `controller_track` or
+    /// `controller_positioner`.
+    #[serde(default, deserialize_with = "present")]
+    pub correct_axes: Option<bool>,
 }
 
 /// The answer: the filtered files (same names and order) and the report.
@@ -145,12 +151,19 @@ fn command(robot_id: i64, req: FilterRequest) -> Result<FilterCommand, ApiError>
         .map(|d| d.to_model())
         .transpose()
         .map_err(|e| ApiError::invalid(format!("`controller_positioner`: {e}")))?;
+    let correct_axes = req.correct_axes.unwrap_or(false);
+    if correct_axes && controller_track.is_none() && controller_positioner.is_none() {
+        return Err(ApiError::invalid(
+            "`correct_axes` corrects the values of the axes `controller_track` or `controller_positioner` composes, and neither is given",
+        ));
+    }
     Ok(FilterCommand {
         robot_id,
         model: model_choice(req.version.as_ref())?,
         payload_kg: req.payload_kg,
         controller_track,
         controller_positioner,
+        correct_axes,
         language,
         files: req
             .files

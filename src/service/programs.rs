@@ -30,6 +30,9 @@ pub struct FilterCommand {
     /// the work objects on the face plate turn with the robot's stored
     /// positioner, the program's axes 1 and 2 (`core::program::axes`).
     pub controller_positioner: Option<TiltRotate>,
+    /// Rewrite the axes' values so the real axes stand where the controller
+    /// believes the programmed values put them (`core::program::axes`).
+    pub correct_axes: bool,
     /// The program's language.
     pub language: Language,
     /// The program's files.
@@ -87,7 +90,8 @@ pub async fn filter_program(
             &cell,
             &model,
             &IkSettings::default(),
-            &FilterAxes::of_cell(tracks.as_ref(), positioners.as_ref()),
+            &FilterAxes::of_cell(tracks.as_ref(), positioners.as_ref())
+                .correcting_values(cmd.correct_axes),
             &control,
         );
         if matches!(out, Err(FilterError::Cancelled)) {

@@ -370,7 +370,7 @@ pub(crate) async fn filters_beside_the_track(
     body["files"][0]["name"] = json!("weld.src");
     body["files"][1]["name"] = json!("weld.dat");
     body["controller_track"] = super::track_filter::controller_track();
-    let r = t.post_json(FILTER, &[rid], body).await;
+    let r = t.post_json(FILTER, &[rid], body.clone()).await;
     assert_eq!(r.status, StatusCode::OK, "{}", r.text());
     let http = r.json();
     let report = &http["report"];
@@ -408,5 +408,42 @@ pub(crate) async fn filters_beside_the_track(
         p(&dir.join("weld.src")),
         p(&dir.join("weld.dat")),
     ];
-    super::track_filter::assert_cli_gives(&http, argv, &out);
+    super::track_filter::assert_cli_gives(&http, argv.clone(), &out);
+
+    // The axes' values corrected: the same over HTTP and by the command
+    // line, the report saying so and giving each written value, written in
+    // the program in place of the programmed one.
+    body["correct_axes"] = json!(true);
+    let r = t.post_json(FILTER, &[rid], body.clone()).await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let corrected = r.json();
+    let report = &corrected["report"];
+    assert_eq!(report["filtered"], values.len(), "{report}");
+    assert_eq!(report["axis_values"], "corrected");
+    assert_eq!(http["report"]["axis_values"], "kept");
+    let written_dat = corrected["files"][1]["content"].as_str().unwrap();
+    for (line, (e, v)) in report["targets"].as_array().unwrap().iter().zip(&values) {
+        assert_eq!(line["track_mm"].as_f64(), Some(*e));
+        assert_eq!(line["positioner_deg"], json!(v));
+        let e2 = line["track_written_mm"].as_f64().unwrap();
+        let v2: Vec<f64> = serde_json::from_value(line["positioner_written_deg"].clone()).unwrap();
+        assert!(e2 != *e && v2 != v.to_vec(), "{line}");
+        let axes = format!("E1 {e2:.3},E2 {:.4},E3 {:.4}", v2[0], v2[1]);
+        assert!(written_dat.contains(&axes), "{axes} not in {written_dat}");
+    }
+    let out = dir.join("corrected_beside_the_track");
+    let mut argv = argv.to_vec();
+    let at = argv.iter().position(|x| x == "--out-dir").unwrap();
+    argv[at + 1] = out.to_str().unwrap().to_string();
+    argv.insert(at, "--correct-axes".into());
+    let argv: [String; 19] = argv.try_into().unwrap();
+    super::track_filter::assert_cli_gives(&corrected, argv, &out);
+    // Nothing to correct without the axes: 422.
+    let mut bare = body.clone();
+    for field in ["controller_track", "controller_positioner"] {
+        bare.as_object_mut().unwrap().remove(field);
+    }
+    let r = t.post_json(FILTER, &[rid], bare).await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+    assert!(r.detail().contains("`correct_axes`"), "{}", r.detail());
 }

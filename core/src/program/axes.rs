@@ -38,11 +38,16 @@
 //! `S_nom = N(e)⁻¹·P_nom(v)·W_f`.
 //!
 //! The axes' values stay as programmed (the filter moves the target, not
-//! the axes). Any other external axis in use is refused, naming it, as is a
-//! track value beyond either track's travel. Units: the programs' mm for
+//! the axes) unless the filter is asked to correct them
+//! ([`FilterAxes::correct_values`], `corrected_values`): then each value is
+//! rewritten to the one at which the real axis stands where the controller
+//! believes the programmed one puts it, and the target is composed, as
+//! above, at the written values `e'`, `v'`. Any other external axis in use
+//! is refused, naming it, as is a track value beyond either track's
+//! travel. Units: the programs' mm for
 //! track values and degrees for the positioner's, SI poses.
 
-use super::{external_axis_refusal, AxisValue, Language, Site};
+use super::{corrected_values, external_axis_refusal, AxisValue, Language, Site};
 use crate::model::external::{LinearTrack, TiltRotate};
 use crate::model::Pose;
 
@@ -79,6 +84,11 @@ pub struct FilterAxes<'a> {
     /// The positioner carrying work objects on its face plate, axes 1 and 2
     /// (Fanuc: `J1`, `J2` of motion group 2).
     pub positioner: Option<PositionerAxes<'a>>,
+    /// Rewrite the axes' values so the real axes stand where the
+    /// controller believes the programmed values put them (the track's
+    /// scale, zero and error along the rail; the positioner's zeros and
+    /// scales); `false` (the default) keeps them as programmed.
+    pub correct_values: bool,
 }
 
 impl<'a> FilterAxes<'a> {
@@ -97,6 +107,15 @@ impl<'a> FilterAxes<'a> {
                 nominal,
                 calibrated,
             }),
+            correct_values: false,
+        }
+    }
+
+    /// The same axes, their values corrected (`correct`) or kept.
+    pub fn correcting_values(self, correct: bool) -> Self {
+        FilterAxes {
+            correct_values: correct,
+            ..self
         }
     }
 
@@ -164,9 +183,13 @@ pub(super) fn controller_target(s_nom: &Pose, s: &Pose, false_in_s: &Pose) -> Po
 pub(super) struct OnTrack {
     /// The track value as programmed [mm].
     pub(super) value_mm: f64,
-    /// `N(e)`: the base in the cell frame by the controller's nominal track.
+    /// The value written to the program [mm]: the programmed one, or its
+    /// correction.
+    pub(super) written_mm: f64,
+    /// `N(e')`: the base in the cell frame by the controller's nominal
+    /// track at the written value.
     pub(super) nominal: Pose,
-    /// `B(e)`: the base in the cell frame by the calibrated track.
+    /// `B(e')`: the base in the cell frame by the calibrated track.
     pub(super) calibrated: Pose,
 }
 
@@ -194,6 +217,9 @@ impl OnTrack {
 pub(super) struct OnPositioner {
     /// The values as programmed, axis 1 and axis 2 [deg].
     pub(super) values_deg: [f64; 2],
+    /// The values written to the program [deg]: the programmed ones, or
+    /// their correction (the plates below are at these).
+    pub(super) written_deg: [f64; 2],
     /// `P_nom(v)`: the plate in the controller's world (the robot's base
     /// frame) by its nominal positioner.
     pub(super) nominal: Pose,
@@ -244,11 +270,14 @@ fn composed(language: Language, axes: &FilterAxes, a: &AxisValue) -> bool {
 /// Where a site's axes put the robot base and the positioner's plate
 /// ([`Placement`], empty on a fixed base without axes in use), or why the
 /// site is refused (an axis the cell does not model, no track value, a value
-/// beyond the travel, one positioner value without the other).
+/// beyond the travel, one positioner value without the other, a
+/// correction beyond the travel). `base_from_cell` is the robot's
+/// registration, the controller's world on a fixed base.
 pub(super) fn place(
     language: Language,
     site: &Site,
     axes: &FilterAxes,
+    base_from_cell: &Pose,
 ) -> Result<Placement, String> {
     if let Some(other) = site
         .axes
@@ -258,11 +287,19 @@ pub(super) fn place(
         return Err(external_axis_refusal(&other.name, &other.text));
     }
     let track = match &axes.track {
-        Some(t) => Some(on_track(language, site, t)?),
+        Some(t) => Some(on_track(language, site, t, axes.correct_values)?),
         None => None,
     };
     let positioner = match &axes.positioner {
-        Some(p) => on_positioner(language, site, p, axes.track.is_some())?,
+        Some(p) => {
+            // The controller's world: the cell beside a track, else the base.
+            let world_from_cell = match axes.track {
+                Some(_) => Pose::identity(),
+                None => *base_from_cell,
+            };
+            let correct = axes.correct_values.then_some(&world_from_cell);
+            on_positioner(language, site, p, axes.track.is_some(), correct)?
+        }
         None => None,
     };
     Ok(Placement {
@@ -272,8 +309,14 @@ pub(super) fn place(
     })
 }
 
-/// The track's bases at a site's value, or why it has none.
-fn on_track(language: Language, site: &Site, track: &TrackAxes) -> Result<OnTrack, String> {
+/// The track's bases at a site's value (`correct`: at its correction), or
+/// why it has none.
+fn on_track(
+    language: Language,
+    site: &Site,
+    track: &TrackAxes,
+    correct: bool,
+) -> Result<OnTrack, String> {
     let name = track_axis_name(language);
     let given = site.axes.iter().find(|a| a.number == TRACK_AXIS);
     let value_mm = match given {
@@ -290,31 +333,47 @@ fn on_track(language: Language, site: &Site, track: &TrackAxes) -> Result<OnTrac
             )
         })?,
     };
-    let nominal = track.nominal.cell_from_base(value_mm).map_err(|e| {
-        format!(
-            "the track's axis {name}: value {} mm is beyond the controller's nominal travel, [{}, {}] mm: not filtered",
-            e.value_mm, e.lo_mm, e.hi_mm
-        )
-    })?;
+    let nominal_at = |e: f64| {
+        track.nominal.cell_from_base(e).map_err(|e| {
+            format!(
+                "the track's axis {name}: value {} mm is beyond the controller's nominal travel, [{}, {}] mm: not filtered",
+                e.value_mm, e.lo_mm, e.hi_mm
+            )
+        })
+    };
+    // The programmed value within the controller's own travel.
+    nominal_at(value_mm)?;
+    let written_mm = if correct {
+        corrected_values::track_value(track.calibrated, track.nominal, value_mm).map_err(|e| {
+            format!(
+                "the track's axis {name}: the value correcting {value_mm} mm, {e}: not filtered"
+            )
+        })?
+    } else {
+        value_mm
+    };
     let calibrated = track
         .calibrated
-        .cell_from_base(value_mm)
+        .cell_from_base(written_mm)
         .map_err(|e| format!("the track's axis {name}: {e}: not filtered"))?;
     Ok(OnTrack {
         value_mm,
-        nominal,
+        written_mm,
+        nominal: nominal_at(written_mm)?,
         calibrated,
     })
 }
 
 /// The positioner's plates at a site's values (its axes after the track's
-/// when `on_track`): `None` when the site gives neither value; refused when
-/// it gives one without the other or one that is not a number.
+/// when `on_track`; corrected when given the controller's world,
+/// `correct`): `None` when the site gives neither value; refused when it
+/// gives one without the other or one that is not a number.
 fn on_positioner(
     language: Language,
     site: &Site,
     p: &PositionerAxes,
     on_track: bool,
+    correct: Option<&Pose>,
 ) -> Result<Option<OnPositioner>, String> {
     let group = positioner_group(language);
     let names = positioner_axis_names(language, on_track);
@@ -345,10 +404,26 @@ fn on_positioner(
         })
     };
     let values_deg = [value(v1)?, value(v2)?];
+    let written_deg = match correct {
+        None => values_deg,
+        Some(world_from_cell) => corrected_values::positioner_values(
+            p.calibrated,
+            p.nominal,
+            world_from_cell,
+            values_deg,
+        )
+        .ok_or_else(|| {
+            format!(
+                "the positioner's axes {} and {}: no correction of {values_deg:?} (the axes do not turn the plate independently there): not filtered",
+                names[0], names[1]
+            )
+        })?,
+    };
     Ok(Some(OnPositioner {
         values_deg,
-        nominal: p.nominal.cell_from_face_plate(values_deg),
-        calibrated: p.calibrated.cell_from_face_plate(values_deg),
+        written_deg,
+        nominal: p.nominal.cell_from_face_plate(written_deg),
+        calibrated: p.calibrated.cell_from_face_plate(written_deg),
     }))
 }
 
@@ -389,6 +464,7 @@ mod tests {
             name: name.into(),
             value,
             text: value.map_or("v".into(), |v| format!("{v}")),
+            slot: None,
             group: 1,
         }
     }
@@ -412,12 +488,15 @@ mod tests {
     fn without_a_track_an_axis_in_use_is_refused_and_krl_zeros_are_none() {
         let none = FilterAxes::default();
         let krl = site(vec![axis(1, "E1", Some(0.0)), axis(2, "E2", Some(0.0))]);
-        assert!(place(Language::Krl, &krl, &none).unwrap().track.is_none());
+        assert!(place(Language::Krl, &krl, &none, &Pose::identity())
+            .unwrap()
+            .track
+            .is_none());
         // A Fanuc or RAPID axis at 0 is an axis the robot has.
-        let why = place(Language::Fanuc, &krl, &none).unwrap_err();
+        let why = place(Language::Fanuc, &krl, &none, &Pose::identity()).unwrap_err();
         assert!(why.contains("external axis E1 to 0"), "{why}");
         let krl = site(vec![axis(1, "E1", Some(0.0)), axis(3, "E3", Some(5.0))]);
-        let why = place(Language::Krl, &krl, &none).unwrap_err();
+        let why = place(Language::Krl, &krl, &none, &Pose::identity()).unwrap_err();
         assert!(
             why.contains("E3 to 5") && why.contains("does not model"),
             "{why}"
@@ -428,6 +507,7 @@ mod tests {
     fn on_a_track_the_value_places_both_bases_and_other_axes_are_refused() {
         let (nominal, calibrated) = (track(1.0), track(1.0002));
         let axes = FilterAxes {
+            correct_values: false,
             track: Some(TrackAxes {
                 nominal: &nominal,
                 calibrated: &calibrated,
@@ -435,7 +515,10 @@ mod tests {
             positioner: None,
         };
         let s = site(vec![axis(1, "E1", Some(2000.0)), axis(2, "E2", Some(0.0))]);
-        let on = place(Language::Krl, &s, &axes).unwrap().track.unwrap();
+        let on = place(Language::Krl, &s, &axes, &Pose::identity())
+            .unwrap()
+            .track
+            .unwrap();
         assert_eq!(on.value_mm, 2000.0);
         // Scale 1.0002: the calibrated base 0.4 mm further along the rail.
         assert!((on.calibrated.p.x - on.nominal.p.x - 0.0004).abs() < 1e-12);
@@ -443,7 +526,7 @@ mod tests {
         // A KRL value of 0 on the track is the track at 0.
         let s = site(vec![axis(1, "E1", Some(0.0))]);
         assert_eq!(
-            place(Language::Krl, &s, &axes)
+            place(Language::Krl, &s, &axes, &Pose::identity())
                 .unwrap()
                 .track
                 .unwrap()
@@ -463,13 +546,14 @@ mod tests {
             ),
         ];
         for (s, want) in cases {
-            let why = place(Language::Krl, &s, &axes).unwrap_err();
+            let why = place(Language::Krl, &s, &axes, &Pose::identity()).unwrap_err();
             assert!(why.contains(want), "{why}");
         }
         // The calibrated travel can be shorter than the controller's.
         let mut short = track(1.0);
         short.travel.hi_mm = 3000.0;
         let axes = FilterAxes {
+            correct_values: false,
             track: Some(TrackAxes {
                 nominal: &nominal,
                 calibrated: &short,
@@ -480,6 +564,7 @@ mod tests {
             Language::Krl,
             &site(vec![axis(1, "E1", Some(3500.0))]),
             &axes,
+            &Pose::identity(),
         )
         .unwrap_err();
         assert!(why.contains("outside the travel measured"), "{why}");
@@ -498,6 +583,7 @@ mod tests {
         f.rot_z(-0.7);
         let on = OnTrack {
             value_mm: 0.0,
+            written_mm: 0.0,
             nominal: n,
             calibrated: b,
         };
@@ -527,6 +613,7 @@ mod tests {
     fn on_a_positioner_its_values_turn_both_plates_and_a_lone_value_is_refused() {
         let (nominal, calibrated) = (turntable(0.0), turntable(1.0));
         let axes = FilterAxes {
+            correct_values: false,
             track: None,
             positioner: Some(PositionerAxes {
                 nominal: &nominal,
@@ -534,7 +621,10 @@ mod tests {
             }),
         };
         let s = site(vec![axis(1, "E1", Some(0.0)), axis(2, "E2", Some(90.0))]);
-        let on = place(Language::Krl, &s, &axes).unwrap().positioner.unwrap();
+        let on = place(Language::Krl, &s, &axes, &Pose::identity())
+            .unwrap()
+            .positioner
+            .unwrap();
         assert_eq!(on.values_deg, [0.0, 90.0]);
         let part = Pose::from_translation(Vector3::new(1.0, 0.0, 0.0));
         let (real, controller) = on.work_object(&Pose::identity(), &part);
@@ -548,16 +638,18 @@ mod tests {
             ..axis(n, &format!("J{n} of motion group GP2"), Some(v))
         };
         let s = site(vec![gp2(1, 0.0), gp2(2, 90.0)]);
-        let on = place(Language::Fanuc, &s, &axes)
+        let on = place(Language::Fanuc, &s, &axes, &Pose::identity())
             .unwrap()
             .positioner
             .unwrap();
         assert_eq!(on.values_deg, [0.0, 90.0]);
         // No value: no plate (a target in a fixed work object).
-        assert!(place(Language::Krl, &site(vec![]), &axes)
-            .unwrap()
-            .positioner
-            .is_none());
+        assert!(
+            place(Language::Krl, &site(vec![]), &axes, &Pose::identity())
+                .unwrap()
+                .positioner
+                .is_none()
+        );
         let cases = [
             (
                 Language::Krl,
@@ -586,7 +678,7 @@ mod tests {
             ),
         ];
         for (language, s, want) in cases {
-            let why = place(language, &s, &axes).unwrap_err();
+            let why = place(language, &s, &axes, &Pose::identity()).unwrap_err();
             assert!(why.contains(want), "{language:?}: {why}");
         }
     }
@@ -600,6 +692,7 @@ mod tests {
         let (nominal, calibrated) = (turntable(0.0), turntable(1.0));
         let (rail, real_rail) = (track(1.0), track(1.0002));
         let axes = FilterAxes {
+            correct_values: false,
             track: Some(TrackAxes {
                 nominal: &rail,
                 calibrated: &real_rail,
@@ -620,7 +713,7 @@ mod tests {
             axis(2, "E2", Some(0.0)),
             axis(3, "E3", Some(90.0)),
         ]);
-        let at = place(Language::Krl, &s, &axes).unwrap();
+        let at = place(Language::Krl, &s, &axes, &Pose::identity()).unwrap();
         let (on_track, on_plate) = (at.track.unwrap(), at.positioner.unwrap());
         assert_eq!(
             (on_track.value_mm, on_plate.values_deg),
@@ -656,7 +749,7 @@ mod tests {
             ),
         ];
         for (s, want) in cases {
-            let why = place(Language::Krl, &s, &axes).unwrap_err();
+            let why = place(Language::Krl, &s, &axes, &Pose::identity()).unwrap_err();
             assert!(why.contains(want), "{why}");
         }
     }

@@ -217,6 +217,7 @@ impl Fields {
                     name: format!("{key} of motion group GP{}", self.group),
                     value: Some(sign * v),
                     text: written(),
+                    slot: Some(slot.clone()),
                 }),
                 None if !self.other_groups.contains(&self.group) => {
                     self.other_groups.push(self.group)
@@ -235,6 +236,7 @@ impl Fields {
                             name: key.clone(),
                             value: Some(sign * v),
                             text: written(),
+                            slot: Some(slot.clone()),
                         });
                     }
                     let axis = key.strip_prefix('J').and_then(|n| n.parse::<usize>().ok());

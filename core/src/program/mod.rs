@@ -16,6 +16,7 @@
 
 mod axes;
 pub mod controller;
+mod corrected_values;
 pub mod export;
 mod fanuc;
 mod krl;
@@ -38,8 +39,8 @@ pub use parsed::{
     ProgramFile, Site, Targets, UnknownLanguage,
 };
 pub use report::{
-    FilterReport, JointMotionReport, LoadSource, MotionPlace, Reachable, TargetReport,
-    TargetStatus, UnusedReport, UsedLoad,
+    AxisValuesWritten, FilterReport, JointMotionReport, LoadSource, MotionPlace, Reachable,
+    ReportedAxes, TargetReport, TargetStatus, UnusedReport, UsedLoad,
 };
 pub use rewrite::{filter, filter_with, FilterControl, FilterError, FilterOutput};
 

@@ -359,6 +359,10 @@ pub struct AxisValue {
     pub value: Option<f64>,
     /// The value as written (with its unit where the program gives one).
     pub text: String,
+    /// Bytes of the number in the site's file, which a corrected value
+    /// replaces (`None`: the parser cannot point at it).
+    #[serde(skip)]
+    pub slot: Option<Range<usize>>,
 }
 
 impl AxisValue {

@@ -73,15 +73,25 @@ pub struct TargetReport {
     /// Distance the position moved [mm].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub shift_mm: Option<f64>,
-    /// The track value the position was composed at, kept as programmed
-    /// [mm] (a robot on a track: `program::axes`).
+    /// The track value as programmed [mm] (a robot on a track:
+    /// `program::axes`); the position was composed at it unless
+    /// `track_written_mm` gives its correction.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub track_mm: Option<f64>,
-    /// The positioner values (axis 1, axis 2) the position was composed at,
-    /// kept as programmed [deg] (a work object on the positioner's face
-    /// plate: `program::axes`).
+    /// The positioner values (axis 1, axis 2) as programmed [deg] (a work
+    /// object on the positioner's face plate: `program::axes`); the
+    /// position was composed at them unless `positioner_written_deg` gives
+    /// their correction.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub positioner_deg: Option<[f64; 2]>,
+    /// The track value written in place of `track_mm` when the filter
+    /// corrects the axes' values [mm] (`FilterReport::axis_values`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub track_written_mm: Option<f64>,
+    /// The positioner values written in place of `positioner_deg` when the
+    /// filter corrects the axes' values [deg].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub positioner_written_deg: Option<[f64; 2]>,
     /// The load the solve carried (flange frame) and where it came from.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub load: Option<UsedLoad>,
@@ -168,16 +178,43 @@ pub struct FilterReport {
     /// frame for a robot on a track).
     pub controller_data: String,
     /// The axis the robot's track is (`E1`, `eax_a`) when the filter
-    /// composed through one: its values are kept as programmed, each
-    /// position's in `track_mm`.
+    /// composed through one: each position's value in `track_mm` (and,
+    /// corrected, `track_written_mm`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub track_axis: Option<String>,
     /// The positioner's axes 1 and 2 as the language names them (`E1`,
     /// `E2`; `eax_a`, `eax_b`; `J1`, `J2` of `GP2`) when the filter was
-    /// given a positioner: their values are kept as programmed, each
-    /// position's in `positioner_deg`.
+    /// given a positioner: each position's values in `positioner_deg`
+    /// (and, corrected, `positioner_written_deg`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub positioner_axes: Option<[String; 2]>,
+    /// Whether the external axes' values were kept as programmed or
+    /// corrected (`program::corrected_values`), when the filter composed
+    /// any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub axis_values: Option<AxisValuesWritten>,
+}
+
+/// What the filter did with the external axes' values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AxisValuesWritten {
+    /// Kept as programmed; only the targets changed.
+    Kept,
+    /// Rewritten so the real axes stand where the controller believes the
+    /// programmed values put them.
+    Corrected,
+}
+
+/// The external axes a filter composed, as its report names them.
+#[derive(Debug, Clone, Default)]
+pub struct ReportedAxes {
+    /// The track's axis as the language names it.
+    pub track_axis: Option<String>,
+    /// The positioner's two axes as the language names them.
+    pub positioner_axes: Option<[String; 2]>,
+    /// Whether their values were corrected.
+    pub corrected: bool,
 }
 
 impl FilterReport {
@@ -188,9 +225,19 @@ impl FilterReport {
         joint_motions: Vec<JointMotionReport>,
         unused: Vec<UnusedReport>,
         controller_data: String,
-        track_axis: Option<String>,
-        positioner_axes: Option<[String; 2]>,
+        axes: ReportedAxes,
     ) -> FilterReport {
+        let ReportedAxes {
+            track_axis,
+            positioner_axes,
+            corrected,
+        } = axes;
+        let axis_values =
+            (track_axis.is_some() || positioner_axes.is_some()).then_some(if corrected {
+                AxisValuesWritten::Corrected
+            } else {
+                AxisValuesWritten::Kept
+            });
         let count = |s: TargetStatus| targets.iter().filter(|t| t.status == s).count();
         FilterReport {
             language,
@@ -203,6 +250,7 @@ impl FilterReport {
             controller_data,
             track_axis,
             positioner_axes,
+            axis_values,
         }
     }
 }

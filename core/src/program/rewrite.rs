@@ -5,9 +5,11 @@
 //! values rewritten; one report line per position of a Cartesian motion
 //! (`report.rs`).
 
-use super::axes::{self, FilterAxes};
+use super::axes::{self, FilterAxes, Placement};
+use super::corrected_values::written_edits;
 use super::report::{
-    FilterReport, JointMotionReport, MotionPlace, TargetReport, TargetStatus, UnusedReport,
+    FilterReport, JointMotionReport, MotionPlace, ReportedAxes, TargetReport, TargetStatus,
+    UnusedReport,
 };
 use super::sites::{Context, Failure, Solved};
 use super::{mark, parse, Language, Motion, MotionTarget, ParseError, Program, ProgramFile, Site};
@@ -170,6 +172,8 @@ struct SolvedReport {
     shift_mm: f64,
     track_mm: Option<f64>,
     positioner_deg: Option<[f64; 2]>,
+    track_written_mm: Option<f64>,
+    positioner_written_deg: Option<[f64; 2]>,
     load: super::report::UsedLoad,
     warnings: Vec<String>,
 }
@@ -210,6 +214,8 @@ impl Run<'_> {
             shift_mm: None,
             track_mm: None,
             positioner_deg: None,
+            track_written_mm: None,
+            positioner_written_deg: None,
             load: None,
             warnings: Vec::new(),
             reachable: Vec::new(),
@@ -274,8 +280,13 @@ impl Run<'_> {
         if let Some(why) = &site.refuse {
             return failed(&mut self.edits, language, Failure::from(why.clone()));
         }
-        let at = match axes::place(language, site, &self.axes) {
+        let base_from_cell = self.context.model.cell_from_base.inverse();
+        let at = match axes::place(language, site, &self.axes, &base_from_cell) {
             Ok(at) => at,
+            Err(why) => return failed(&mut self.edits, language, Failure::from(why)),
+        };
+        let axis_edits = match written_edits(language, site, &self.axes, &at) {
+            Ok(e) => e,
             Err(why) => return failed(&mut self.edits, language, Failure::from(why)),
         };
         if let Some(j) = &site.after_joints {
@@ -283,12 +294,20 @@ impl Run<'_> {
             self.previous = Some(self.context.model.nominal.joints_from_controller(&rad));
         }
         match self.context.solve_site(site, self.previous.as_deref(), &at) {
-            Ok(done) => self.solved(site, done),
+            Ok(done) => self.solved(site, done, axis_edits, &at),
             Err(f) => failed(&mut self.edits, language, f),
         }
     }
 
-    fn solved(&mut self, site: &Site, done: Solved) -> Outcome {
+    /// A solved site's edits (its pose's values and, when corrected, its
+    /// axes' `axis_edits` at `at`'s written values) and report fields.
+    fn solved(
+        &mut self,
+        site: &Site,
+        done: Solved,
+        axis_edits: Vec<(std::ops::Range<usize>, String)>,
+        at: &Placement,
+    ) -> Outcome {
         if let Some(t) = done.tool.filter(|t| !self.used_tools.contains(t)) {
             self.used_tools.push(t);
         }
@@ -296,6 +315,8 @@ impl Run<'_> {
             self.used_frames.push(f);
         }
         self.edits[site.file].extend(values(site, &done.false_target));
+        let corrected = !axis_edits.is_empty();
+        self.edits[site.file].extend(axis_edits);
         Outcome::Filtered(Box::new(SolvedReport {
             q: done.q,
             joints_deg: done.joints_deg,
@@ -303,6 +324,8 @@ impl Run<'_> {
             shift_mm: done.shift_m * 1e3,
             track_mm: done.track_mm,
             positioner_deg: done.positioner_deg,
+            track_written_mm: at.track.filter(|_| corrected).map(|t| t.written_mm),
+            positioner_written_deg: at.positioner.filter(|_| corrected).map(|p| p.written_deg),
             load: done.load,
             warnings: done.warnings,
         }))
@@ -344,13 +367,17 @@ impl Run<'_> {
                 self.joint_motions,
                 unused,
                 controller_data,
-                self.axes
-                    .track
-                    .map(|_| axes::track_axis_name(language).to_string()),
-                self.axes.positioner.map(|_| {
-                    axes::positioner_axis_names(language, self.axes.track.is_some())
-                        .map(|n| n.to_string())
-                }),
+                ReportedAxes {
+                    track_axis: self
+                        .axes
+                        .track
+                        .map(|_| axes::track_axis_name(language).to_string()),
+                    positioner_axes: self.axes.positioner.map(|_| {
+                        axes::positioner_axis_names(language, self.axes.track.is_some())
+                            .map(|n| n.to_string())
+                    }),
+                    corrected: self.axes.correct_values,
+                },
             ),
         }
     }
@@ -367,6 +394,8 @@ fn describe(report: &mut TargetReport, outcome: Outcome, previous: &mut Option<V
             report.shift_mm = Some(s.shift_mm);
             report.track_mm = s.track_mm;
             report.positioner_deg = s.positioner_deg;
+            report.track_written_mm = s.track_written_mm;
+            report.positioner_written_deg = s.positioner_written_deg;
             report.load = Some(s.load);
             report.warnings = s.warnings;
             *previous = Some(s.q);

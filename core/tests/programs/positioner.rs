@@ -326,6 +326,7 @@ impl PositionerCell {
                 nominal: &self.nominal_positioner,
                 calibrated: &self.fitted,
             }),
+            correct_values: false,
         }
     }
 

@@ -178,6 +178,7 @@ impl TrackCell {
                 calibrated: &self.fitted,
             }),
             positioner: None,
+            correct_values: false,
         }
     }
 

@@ -151,6 +151,7 @@ impl BothCell {
                 nominal: &self.nominal_positioner,
                 calibrated: &self.fitted,
             }),
+            correct_values: false,
         }
     }
 
@@ -160,6 +161,19 @@ impl BothCell {
     /// target on the true, moved part (`None` where the controller has no
     /// solution on the target's flags).
     fn run(&self, language: Language, files: &[ProgramFile]) -> Vec<Option<Miss>> {
+        let values: Vec<(f64, [f64; 2])> = self.targets.iter().map(|(e, v, _)| (*e, *v)).collect();
+        self.run_at(language, files, &values)
+    }
+
+    /// [`Self::run`] of a program whose targets carry the axis values
+    /// `values` (programmed, or written by a filter correcting them): the
+    /// controller composes them, the true track and positioner stand at them.
+    fn run_at(
+        &self,
+        language: Language,
+        files: &[ProgramFile],
+        values: &[(f64, [f64; 2])],
+    ) -> Vec<Option<Miss>> {
         let program = parse(language, files).unwrap();
         let ik = AnalyticIk::new(&self.track.controller).unwrap();
         assert_eq!(program.sites.len(), self.targets.len());
@@ -169,7 +183,8 @@ impl BothCell {
         );
         let mut previous: Option<Vec<f64>> = None;
         let mut errors = Vec::new();
-        for (site, (e, v, target)) in program.sites.iter().zip(&self.targets) {
+        for ((site, (_, _, target)), (e, v)) in program.sites.iter().zip(&self.targets).zip(values)
+        {
             let value = |g: u32, n: usize| {
                 site.axes
                     .iter()
@@ -370,4 +385,99 @@ fn targets_on_the_part_solve_at_their_track_and_positioner_values() {
         solved,
         c.run(Language::Krl, &krl(c)),
     );
+}
+
+/// The root-mean-square of `v`.
+fn rms_of(v: &[f64]) -> f64 {
+    (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
+}
+
+/// The acceptance of the corrected axis values in one language: every
+/// target filtered, the report saying the values were corrected and giving
+/// each written value beside the programmed one; the real axes at the
+/// written values move nearer as the controller believes the programmed
+/// ones move them (the true base's move from mid-travel at `e'` against
+/// the drawing's at `e`; the true part's orientation at `v'` against the
+/// drawing's part at `v`) than at the programmed values; and through the
+/// controller at
+/// the written values, the true torch within 1.5× the calibration's
+/// validation error of the target on the true part.
+fn assert_corrected_in_cell(language: Language, files: &[ProgramFile]) {
+    use robocal_core::model::orientation::rotation_angle_between;
+    use robocal_core::program::AxisValuesWritten;
+    let c = both_cell();
+    let axes = c.axes().correcting_values(true);
+    let out = filter_with(
+        language,
+        files,
+        &c.cell,
+        &c.track.model,
+        &settings(),
+        &axes,
+        &FilterControl::default(),
+    )
+    .unwrap();
+    let r = &out.report;
+    assert_every_target_filtered(r, 50);
+    assert_eq!(r.axis_values, Some(AxisValuesWritten::Corrected));
+    let on_plate = &c.cell.work_objects[0].pose;
+    let (mut base, mut part) = ([Vec::new(), Vec::new()], [Vec::new(), Vec::new()]);
+    let mut sideways = [Vec::new(), Vec::new()];
+    let mut written = Vec::new();
+    for (t, (e, v, _)) in r.targets.iter().zip(&c.targets) {
+        // The programmed values, as the program writes them (4 decimals of
+        // a degree).
+        assert_eq!(t.track_mm, Some(*e));
+        let programmed = t.positioner_deg.unwrap();
+        assert!((0..2).all(|k| (programmed[k] - v[k]).abs() < 1e-4));
+        let (e2, v2) = (
+            t.track_written_mm.unwrap(),
+            t.positioner_written_deg.unwrap(),
+        );
+        // The base's move from the middle of the travel, as the controller
+        // believes it and as the true track makes it.
+        let mid = (c.track.fitted.travel.lo_mm + c.track.fitted.travel.hi_mm) / 2.0;
+        let nominal = |x: f64| c.track.nominal_track.cell_from_base(x).unwrap().p;
+        let believed = nominal(*e) - nominal(mid);
+        let along = (nominal(mid + 1000.0) - nominal(mid)).normalize();
+        let intended = c
+            .nominal_positioner
+            .cell_from_face_plate(programmed)
+            .compose(on_plate);
+        for (k, (at_e, at_v)) in [(*e, programmed), (e2, v2)].into_iter().enumerate() {
+            let real = |x: f64| c.track.true_track.cell_from_base(x).p;
+            let off = real(at_e) - real(mid) - believed;
+            base[k].push(off.dot(&along) * 1e3);
+            sideways[k].push((off - along * off.dot(&along)).norm() * 1e3);
+            let turned = true_part(&c.true_positioner, &c.body, at_v).r;
+            part[k].push(rotation_angle_between(&turned, &intended.r).to_degrees());
+        }
+        written.push((e2, v2));
+    }
+    println!(
+        "{language:?} corrected: the true base's move from mid-travel off the controller's, along the rail rms {:.4} mm as programmed, {:.4} mm at the written values (sideways {:.4} and {:.4} mm, no value holds it); the true part's orientation off the controller's, rms {:.4}° as programmed, {:.4}° written",
+        rms_of(&base[0]),
+        rms_of(&base[1]),
+        rms_of(&sideways[0]),
+        rms_of(&sideways[1]),
+        rms_of(&part[0]),
+        rms_of(&part[1])
+    );
+    assert!(rms_of(&base[1]) < 0.5 * rms_of(&base[0]), "{base:?}");
+    assert!(rms_of(&part[1]) < 0.5 * rms_of(&part[0]), "{part:?}");
+    assert_figures(
+        &format!("{language:?} on the track beside the positioner, axis values corrected"),
+        "the calibration's validation rms (the robot's and the positioner's)",
+        c.validation,
+        c.run_at(language, &out.files, &written),
+        c.run(language, files),
+    );
+}
+
+#[test]
+fn corrected_axis_values_put_the_real_axes_where_the_controller_believes_them() {
+    let c = both_cell();
+    assert_corrected_in_cell(Language::Krl, &krl(c));
+    assert_corrected_in_cell(Language::Rapid, &rapid(c));
+    assert_corrected_in_cell(Language::Fanuc, &fanuc(c));
 }

@@ -119,7 +119,13 @@ fn motions_name_their_positions_and_what_they_are() {
         let site = &found.sites[s];
         let none = crate::program::FilterAxes::default();
         site.refuse.clone().unwrap_or_else(|| {
-            crate::program::axes::place(crate::program::Language::Fanuc, site, &none).unwrap_err()
+            crate::program::axes::place(
+                crate::program::Language::Fanuc,
+                site,
+                &none,
+                &Pose::identity(),
+            )
+            .unwrap_err()
         })
     };
     assert!(

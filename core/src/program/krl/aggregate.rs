@@ -301,6 +301,7 @@ pub(super) fn classify(agg: &Agg, text: &str, offset: usize) -> Kind {
                 name: (*k).to_string(),
                 value: real(value(r)),
                 text: value(r).to_string(),
+                slot: Some(r.clone()),
             })
         })
         .collect();

@@ -157,7 +157,8 @@ fn external_axes_are_read_and_refused_without_a_track_naming_the_axis() {
     let values: Vec<_> = sites[1].axes.iter().map(|a| (a.number, a.value)).collect();
     assert_eq!(values, [(1, Some(0.0)), (2, Some(250.5))]);
     let none = crate::program::FilterAxes::default();
-    let place = |s| crate::program::axes::place(crate::program::Language::Krl, s, &none);
+    let place =
+        |s| crate::program::axes::place(crate::program::Language::Krl, s, &none, &Pose::identity());
     assert!(place(&sites[0]).unwrap().track.is_none());
     let why = place(&sites[1]).unwrap_err();
     assert!(why.contains("external axis E2 to 250.5"), "{why}");

@@ -151,10 +151,10 @@ pub(super) fn robtarget(v: &Val) -> Result<Target, Fail> {
         .zip(EXTERNAL_AXES)
         .enumerate()
         .filter_map(|(i, (e, axis))| {
-            let (value, text) = match e {
+            let (value, text, slot) = match e {
                 Val::Num(x, _) if *x >= 8.99e9 => return None,
-                Val::Num(x, _) => (Some(*x), format!("{x}")),
-                _ => (None, "a value computed at run time".to_string()),
+                Val::Num(x, r) => (Some(*x), format!("{x}"), Some(r.clone())),
+                _ => (None, "a value computed at run time".to_string(), None),
             };
             Some(AxisValue {
                 group: 1,
@@ -162,6 +162,7 @@ pub(super) fn robtarget(v: &Val) -> Result<Target, Fail> {
                 name: axis.to_string(),
                 value,
                 text,
+                slot,
             })
         })
         .collect();

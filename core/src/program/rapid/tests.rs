@@ -188,9 +188,13 @@ ENDMODULE\n";
         panic!()
     };
     let none = crate::program::FilterAxes::default();
-    let refused =
-        crate::program::axes::place(crate::program::Language::Rapid, &found.sites[i], &none)
-            .unwrap_err();
+    let refused = crate::program::axes::place(
+        crate::program::Language::Rapid,
+        &found.sites[i],
+        &none,
+        &Pose::identity(),
+    )
+    .unwrap_err();
     assert!(refused.contains("external axis eax_b to 250"), "{refused}");
 }
 

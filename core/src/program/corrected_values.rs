@@ -1,0 +1,243 @@
+//! External-axis values corrected on request (`FilterAxes::correct_values`):
+//! the value written to the program is the one at which the real axis
+//! stands where the controller believes the programmed value puts it, so
+//! the robot's correction is left with what no axis value can hold.
+//!
+//! Track: the programmed value `e` moves the robot's base by
+//! `N(e) − N(r)` from the middle of the travel measured, `r`, by the
+//! controller's nominal track; the written value `e'` is the one at which
+//! the calibrated track moves it most nearly so, `B(e') − B(r)` (the
+//! scale and the carriage's error along the rail). Displacements, not
+//! places: the track's zero along the rail and the robot's registration
+//! are one unknown of the fit (the calibrated robot's base frame is its
+//! own convention), so a place would trade the one for the other. A bent
+//! rail's sideways and vertical errors, the carriage's angles and any
+//! offset at `r` stay the robot's to correct. Newton steps along the rail,
+//! the slope by a 1 mm difference.
+//!
+//! Positioner: the programmed values `v` turn the face plate to `P_nom(v)`
+//! in the controller's world; the written values `v'` are those at which
+//! the calibrated plate `P(v')`, seen in that world, turns the part most
+//! nearly as the controller believes (the zero offsets and scales; tilted
+//! axis lines stay the robot's to correct): Gauss–Newton on `sin θ·n` of
+//! `R_nom(v)ᵀ·R(v') = Rot(n, θ)`, the Jacobian by 1e-4° differences. The
+//! part's position follows from the robot's solve as before.
+//!
+//! Units: track values in mm, positioner values in degrees, poses SI.
+
+use super::axes::{positioner_group, FilterAxes, Placement, TRACK_AXIS};
+use super::{Language, Site};
+use crate::model::external::{LinearTrack, OutsideTravel, TiltRotate};
+use crate::model::Pose;
+use nalgebra::{Matrix3x2, Vector2, Vector3};
+use std::ops::Range;
+
+/// The edits writing a site's corrected values (`at`'s written values) over
+/// the programmed ones, or why they cannot be written (a value the parser
+/// cannot point at); none when `axes` keeps the values. Lengths with at
+/// least 3 decimals, angles with at least 4, or as many as the program
+/// wrote.
+pub(super) fn written_edits(
+    language: Language,
+    site: &Site,
+    axes: &FilterAxes,
+    at: &Placement,
+) -> Result<Vec<(Range<usize>, String)>, String> {
+    if !axes.correct_values {
+        return Ok(Vec::new());
+    }
+    let mut wanted: Vec<(u32, usize, f64, usize)> = Vec::new();
+    if let Some(t) = &at.track {
+        wanted.push((1, TRACK_AXIS, t.written_mm, 3));
+    }
+    if let Some(p) = &at.positioner {
+        let numbers = axes.positioner_numbers(language);
+        for (number, value) in numbers.into_iter().zip(p.written_deg) {
+            wanted.push((positioner_group(language), number, value, 4));
+        }
+    }
+    wanted
+        .into_iter()
+        .map(|(group, number, value, least)| {
+            let a = site
+                .axes
+                .iter()
+                .find(|a| a.group == group && a.number == number)
+                .ok_or_else(|| format!("no value of axis {number} to correct: not filtered"))?;
+            let slot = a.slot.clone().ok_or_else(|| {
+                format!("the value of axis {} cannot be rewritten where the program gives it: not filtered", a.name)
+            })?;
+            let written = a.text.split_whitespace().next().unwrap_or("");
+            let decimals = written.split_once('.').map_or(0, |(_, d)| d.len()).max(least);
+            Ok((slot, format!("{:.*}", decimals, value + 0.0)))
+        })
+        .collect()
+}
+
+/// The track value [mm], to 0.001 mm, at which `calibrated` moves the
+/// robot's base from the middle of its travel most nearly as `nominal`
+/// does at `programmed` (module docs); refused when it lies beyond either
+/// travel.
+pub(super) fn track_value(
+    calibrated: &LinearTrack,
+    nominal: &LinearTrack,
+    programmed: f64,
+) -> Result<f64, OutsideTravel> {
+    let r = (calibrated.travel.lo_mm + calibrated.travel.hi_mm) / 2.0;
+    let moved = nominal.cell_from_base(programmed)?.p - nominal.cell_from_base(r)?.p;
+    let want = calibrated.cell_from_base(r)?.p + moved;
+    let mut e = programmed;
+    for _ in 0..8 {
+        let here = calibrated.cell_from_base(e)?.p;
+        let slope = slope_at(calibrated, e, &here)?;
+        let step = (want - here).dot(&slope) / slope.norm_squared();
+        e += step;
+        if step.abs() < 1e-9 {
+            break;
+        }
+    }
+    // Written with 3 decimals: composed at what the controller will run.
+    let e = (e * 1e3).round() / 1e3;
+    calibrated.cell_from_base(e)?;
+    Ok(e)
+}
+
+/// `dB(e)/de` [m/mm] by a 1 mm difference, backwards at the travel's end.
+fn slope_at(
+    track: &LinearTrack,
+    e: f64,
+    here: &Vector3<f64>,
+) -> Result<Vector3<f64>, OutsideTravel> {
+    match track.cell_from_base(e + 1.0) {
+        Ok(ahead) => Ok(ahead.p - here),
+        Err(_) => Ok(here - track.cell_from_base(e - 1.0)?.p),
+    }
+}
+
+/// The positioner values [deg], to 0.0001°, at which `calibrated` (cell frame), seen in
+/// the controller's world through `world_from_cell`, turns the face plate
+/// most nearly as `nominal` (the controller's world) does at `programmed`;
+/// `None` when the axes cannot turn the plate independently there.
+pub(super) fn positioner_values(
+    calibrated: &TiltRotate,
+    nominal: &TiltRotate,
+    world_from_cell: &Pose,
+    programmed: [f64; 2],
+) -> Option<[f64; 2]> {
+    let want = nominal.cell_from_face_plate(programmed).r.transpose();
+    let calibrated_in_world =
+        |v: [f64; 2]| world_from_cell.r * calibrated.cell_from_face_plate(v).r;
+    let residual = |v: [f64; 2]| -> Vector3<f64> {
+        // sin θ times the axis of `R_nom(v)ᵀ·R(v')`: exact to the last
+        // digits near the identity, where an arccos is not.
+        let d = want * calibrated_in_world(v);
+        Vector3::new(
+            d[(2, 1)] - d[(1, 2)],
+            d[(0, 2)] - d[(2, 0)],
+            d[(1, 0)] - d[(0, 1)],
+        ) / 2.0
+    };
+    const H_DEG: f64 = 1e-4;
+    let mut v = programmed;
+    for _ in 0..10 {
+        let r = residual(v);
+        let column = |k: usize| {
+            let mut at = v;
+            at[k] += H_DEG;
+            (residual(at) - r) / H_DEG
+        };
+        let j = Matrix3x2::from_columns(&[column(0), column(1)]);
+        let step: Vector2<f64> = (j.transpose() * j).try_inverse()? * (j.transpose() * -r);
+        v = [v[0] + step[0], v[1] + step[1]];
+        if step.norm() < 1e-10 {
+            break;
+        }
+    }
+    // Written with 4 decimals: composed at what the controller will run.
+    Some(v.map(|x| (x * 1e4).round() / 1e4))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::external::{RotaryAxis, Travel};
+    use nalgebra::Matrix3;
+
+    /// The angle [rad] between two rotations a small angle apart, by its
+    /// sine (an arccos of the trace loses the last 8 digits there).
+    fn angle(a: &Matrix3<f64>, b: &Matrix3<f64>) -> f64 {
+        let d = a.transpose() * b;
+        let s = Vector3::new(
+            d[(2, 1)] - d[(1, 2)],
+            d[(0, 2)] - d[(2, 0)],
+            d[(1, 0)] - d[(0, 1)],
+        );
+        (s.norm() / 2.0).asin()
+    }
+
+    fn rail(scale: f64, zero_m: f64) -> LinearTrack {
+        let mut t = LinearTrack::nominal(
+            Vector3::x(),
+            Vector3::zeros(),
+            zero_m,
+            Matrix3::identity(),
+            Travel {
+                lo_mm: 0.0,
+                hi_mm: 4000.0,
+            },
+        );
+        t.scale = scale;
+        t
+    }
+
+    /// Closed form: a track with scale 1.0002 (and a zero 0.3 mm off, which
+    /// the displacement does not see) moves the base from the middle of
+    /// the travel, 2000 mm, as the nominal one does when
+    /// `1.0002·(e' − 2000) = e − 2000` [mm].
+    #[test]
+    fn a_tracks_scale_is_undone_in_closed_form() {
+        let (cal, nom) = (rail(1.0002, 0.3e-3), rail(1.0, 0.0));
+        for e in [0.5, 1000.0, 2345.6, 3999.0] {
+            let got = track_value(&cal, &nom, e).unwrap();
+            let expected = 2000.0 + (e - 2000.0) / 1.0002;
+            // Rounded to the 3 decimals written.
+            assert_eq!(got, (expected * 1e3).round() / 1e3, "{e}: {expected}");
+        }
+        // Where the calibrated travel cannot reach: refused.
+        assert!(track_value(&rail(0.9999, 0.0), &nom, 0.0).is_err());
+    }
+
+    fn table(zero: [f64; 2], scale: [f64; 2]) -> TiltRotate {
+        TiltRotate {
+            cell_from_base: Pose::identity(),
+            tilt: RotaryAxis::new(Vector3::x(), Vector3::zeros(), zero[0], scale[0]),
+            rotate: RotaryAxis::new(Vector3::z(), Vector3::zeros(), zero[1], scale[1]),
+            face_plate: Pose::from_translation(Vector3::new(0.0, 0.0, 0.5)),
+        }
+    }
+
+    /// Closed form: zero offsets of 0.2° and −0.1° and a rotate scale of
+    /// 1.001 are undone, `v' = (v − δ)/s` on each axis; the plate then
+    /// turns as the nominal one does at `v`.
+    #[test]
+    fn a_positioners_zeros_and_scales_are_undone_in_closed_form() {
+        let (d1, d2, s2) = (0.2f64, -0.1f64, 1.001);
+        let cal = table([d1.to_radians(), d2.to_radians()], [1.0, s2]);
+        let nom = table([0.0, 0.0], [1.0, 1.0]);
+        for v in [[0.0, 0.0], [-35.0, 120.0], [20.0, -170.0]] {
+            let got = positioner_values(&cal, &nom, &Pose::identity(), v).unwrap();
+            let expected = [v[0] - d1, (v[1] - d2) / s2];
+            for k in 0..2 {
+                // Rounded to the 4 decimals written.
+                assert!((got[k] - expected[k]).abs() <= 5e-5, "{v:?}: {got:?}");
+                assert_eq!(got[k], (expected[k] * 1e4).round() / 1e4, "{v:?}: {got:?}");
+            }
+            let turned = angle(
+                &nom.cell_from_face_plate(v).r,
+                &cal.cell_from_face_plate(got).r,
+            );
+            // Half of 0.0001° on each axis at most: 1.23e-6 rad.
+            assert!(turned < 1.3e-6, "{turned}");
+        }
+    }
+}
