@@ -125,6 +125,28 @@ pub fn predict_to_string(a: &PredictArgs) -> anyhow::Result<String> {
     predict_outcome(a).map(|o| o.text)
 }
 
+/// `--positioner`: the positioner and the values each reading is stated at,
+/// read from the flags or the joints file's columns (`--e1`, `--e2`; beside
+/// `--track`, `--e2`, `--e3`, the track's value `--e1`).
+fn on_plate(
+    a: &PredictArgs,
+    text: &str,
+    dialect: crate::measure::csv_text::Dialect,
+) -> anyhow::Result<Option<super::positioner::OnPlate>> {
+    let on_track = a.track.track.is_some();
+    let flags = if on_track {
+        [a.e2, a.e3]
+    } else {
+        [a.track.e1, a.e2]
+    };
+    a.positioner
+        .as_ref()
+        .map(|path| {
+            super::positioner::OnPlate::read(path, flags, on_track, &a.joints, text, dialect)
+        })
+        .transpose()
+}
+
 /// Where each reading is predicted: one forward model, or (a track value
 /// per row) one per distinct value, or why a value has none.
 struct Placed {
@@ -139,16 +161,7 @@ pub fn predict_outcome(a: &PredictArgs) -> anyhow::Result<super::exit::Outcome> 
         .with_context(|| format!("cannot read joints file {}", a.joints))?;
     let dialect = dialect_from_names(a.delimiter.as_deref(), a.decimal.as_deref())
         .map_err(anyhow::Error::msg)?;
-    let on_track = a.track.track.is_some();
-    let flags = if on_track {
-        [a.e2, a.e3]
-    } else {
-        [a.track.e1, a.e2]
-    };
-    let plate = a.positioner.as_ref().map(|path| {
-        super::positioner::OnPlate::read(path, flags, on_track, &a.joints, &text, dialect)
-    });
-    let plate = plate.transpose()?;
+    let plate = on_plate(a, &text, dialect)?;
     // `--track` without `--e1`: each row's value from the file's `e1` column.
     let per_row = a.track.per_row(&a.joints, &text, dialect)?;
     let model = match per_row {
@@ -189,17 +202,15 @@ pub fn predict_outcome(a: &PredictArgs) -> anyhow::Result<super::exit::Outcome> 
         };
         Placed { forward, frame }
     };
-    let frame_label = match (&wobj, &per_row) {
-        _ if plate.is_some() => {
-            let label = plate.as_ref().map(|p| p.label()).unwrap_or_default();
-            match per_row {
-                Some(_) => a.track.label_per_row(label),
-                None => a.track.label(label),
-            }
-        }
-        (Some(w), _) => format!("work object {}", w.name),
-        (None, Some(_)) => a.track.label_per_row(frame.to_string()),
-        (None, None) => a.track.label(frame.to_string()),
+    let frame_label = match (&plate, &wobj) {
+        (Some(p), _) => p.label(),
+        (None, Some(w)) => format!("work object {}", w.name),
+        (None, None) => frame.to_string(),
+    };
+    let frame_label = match (&per_row, &wobj) {
+        (_, Some(_)) => frame_label,
+        (Some(_), None) => a.track.label_per_row(frame_label),
+        (None, None) => a.track.label(frame_label),
     };
     let one = place(&model);
     let dof = model.dof();

@@ -216,20 +216,11 @@ pub fn solve_outcome(a: &SolveArgs) -> anyhow::Result<super::exit::Outcome> {
         Some(_) => a.track.label_per_row(frame.to_string()),
         None => a.track.label(frame.to_string()),
     };
-    let cell = super::model_files::load_cell(a.cell.as_deref())?;
-    let tool = match &a.tool {
-        Some(t) => Some(cell.tool(&t.parse::<CellRef>()?)?),
-        None => None,
-    };
-    let work_object = match &a.work_object {
-        None => None,
-        Some(w) => {
-            let wobj = cell.work_object(&w.parse::<CellRef>()?)?;
-            frame = TargetFrame::Base;
-            frame_label = format!("work object {}", wobj.name);
-            Some(wobj)
-        }
-    };
+    let (tool, work_object) = cell_items(a)?;
+    if let Some(w) = &work_object {
+        frame = TargetFrame::Base;
+        frame_label = format!("work object {}", w.name);
+    }
     let branch = a
         .branch
         .as_deref()
@@ -248,14 +239,7 @@ pub fn solve_outcome(a: &SolveArgs) -> anyhow::Result<super::exit::Outcome> {
     if on_plate.is_some() {
         beside.extend(positioner_columns(on_track));
     }
-    let mut csv =
-        parse_targets_csv_beside(&text, dialect, &beside).with_context(|| a.targets.clone())?;
-    if csv.convention.is_none() && !a.position_only {
-        bail!(
-            "{}: no orientation columns ({CONVENTION_COLUMNS}); add them or pass --position-only",
-            a.targets
-        );
-    }
+    let mut csv = read_targets(a, &text, dialect, &beside)?;
     let settings = IkSettings {
         threads: a.threads,
         jump_threshold_rad: a.jump_deg.to_radians(),
@@ -263,23 +247,24 @@ pub fn solve_outcome(a: &SolveArgs) -> anyhow::Result<super::exit::Outcome> {
     };
     let cell_solver = CellSolver::for_tool(&model, tool.as_ref(), settings);
     // Per row: each target moved into the base frame at its own values.
-    let mut on_track = None;
-    match (&on_plate, &per_row) {
-        (None, Some((track, values))) => {
-            on_track = Some(place_on_track(
-                &mut csv,
-                values,
-                track,
-                frame,
-                work_object.as_ref(),
-            ));
-        }
+    let on_track = match (&on_plate, &per_row) {
+        (None, Some((track, values))) => Some(place_on_track(
+            &mut csv,
+            values,
+            track,
+            frame,
+            work_object.as_ref(),
+        )),
         (Some(rows), Some((track, values))) => {
             frame_label = rows.place_beside_track(&mut csv, track, values, &a.track);
+            None
         }
-        (Some(rows), None) => frame_label = rows.place(&mut csv, &model, &a.track),
-        (None, None) => {}
-    }
+        (Some(rows), None) => {
+            frame_label = rows.place(&mut csv, &model, &a.track);
+            None
+        }
+        (None, None) => None,
+    };
     if on_track.is_some() || on_plate.is_some() {
         frame = TargetFrame::Base;
     }
@@ -322,6 +307,44 @@ pub fn solve_outcome(a: &SolveArgs) -> anyhow::Result<super::exit::Outcome> {
         not_done: results.iter().filter(|r| !r.solution.converged).count(),
         total: results.len(),
     })
+}
+
+/// `--tool` and `--work-object` from `--cell`.
+fn cell_items(
+    a: &SolveArgs,
+) -> anyhow::Result<(
+    Option<crate::solve::cell::Tool>,
+    Option<crate::solve::cell::WorkObject>,
+)> {
+    let cell = super::model_files::load_cell(a.cell.as_deref())?;
+    let tool = match &a.tool {
+        Some(t) => Some(cell.tool(&t.parse::<CellRef>()?)?),
+        None => None,
+    };
+    let work_object = match &a.work_object {
+        Some(w) => Some(cell.work_object(&w.parse::<CellRef>()?)?),
+        None => None,
+    };
+    Ok((tool, work_object))
+}
+
+/// The targets file's rows, the columns `beside` passed over (read as
+/// external-axis values); a file without orientation columns is refused
+/// unless `--position-only`.
+fn read_targets(
+    a: &SolveArgs,
+    text: &str,
+    dialect: crate::measure::csv_text::Dialect,
+    beside: &[&str],
+) -> anyhow::Result<crate::solve::ik::TargetsCsv> {
+    let csv = parse_targets_csv_beside(text, dialect, beside).with_context(|| a.targets.clone())?;
+    if csv.convention.is_none() && !a.position_only {
+        bail!(
+            "{}: no orientation columns ({CONVENTION_COLUMNS}); add them or pass --position-only",
+            a.targets
+        );
+    }
+    Ok(csv)
 }
 
 /// The results as `format` prints them.

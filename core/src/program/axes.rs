@@ -50,6 +50,7 @@
 use super::{corrected_values, external_axis_refusal, AxisValue, Language, Site};
 use crate::model::external::{LinearTrack, TiltRotate};
 use crate::model::Pose;
+use std::ops::Range;
 
 /// The robot's linear track in a filter: what the controller computes and
 /// what the cell is.
@@ -425,6 +426,48 @@ fn on_positioner(
         nominal: p.nominal.cell_from_face_plate(written_deg),
         calibrated: p.calibrated.cell_from_face_plate(written_deg),
     }))
+}
+
+/// The edits writing a site's corrected values (`at`'s written values) over
+/// the programmed ones, or why they cannot be written (a value the parser
+/// cannot point at); none when `axes` keeps the values. Lengths with at
+/// least 3 decimals, angles with at least 4, or as many as the program
+/// wrote.
+pub(super) fn written_edits(
+    language: Language,
+    site: &Site,
+    axes: &FilterAxes,
+    at: &Placement,
+) -> Result<Vec<(Range<usize>, String)>, String> {
+    if !axes.correct_values {
+        return Ok(Vec::new());
+    }
+    let mut wanted: Vec<(u32, usize, f64, usize)> = Vec::new();
+    if let Some(t) = &at.track {
+        wanted.push((1, TRACK_AXIS, t.written_mm, 3));
+    }
+    if let Some(p) = &at.positioner {
+        let numbers = axes.positioner_numbers(language);
+        for (number, value) in numbers.into_iter().zip(p.written_deg) {
+            wanted.push((positioner_group(language), number, value, 4));
+        }
+    }
+    wanted
+        .into_iter()
+        .map(|(group, number, value, least)| {
+            let a = site
+                .axes
+                .iter()
+                .find(|a| a.group == group && a.number == number)
+                .ok_or_else(|| format!("no value of axis {number} to correct: not filtered"))?;
+            let slot = a.slot.clone().ok_or_else(|| {
+                format!("the value of axis {} cannot be rewritten where the program gives it: not filtered", a.name)
+            })?;
+            let written = a.text.split_whitespace().next().unwrap_or("");
+            let decimals = written.split_once('.').map_or(0, |(_, d)| d.len()).max(least);
+            Ok((slot, format!("{:.*}", decimals, value + 0.0)))
+        })
+        .collect()
 }
 
 #[cfg(test)]

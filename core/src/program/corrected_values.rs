@@ -25,54 +25,9 @@
 //!
 //! Units: track values in mm, positioner values in degrees, poses SI.
 
-use super::axes::{positioner_group, FilterAxes, Placement, TRACK_AXIS};
-use super::{Language, Site};
 use crate::model::external::{LinearTrack, OutsideTravel, TiltRotate};
 use crate::model::Pose;
 use nalgebra::{Matrix3x2, Vector2, Vector3};
-use std::ops::Range;
-
-/// The edits writing a site's corrected values (`at`'s written values) over
-/// the programmed ones, or why they cannot be written (a value the parser
-/// cannot point at); none when `axes` keeps the values. Lengths with at
-/// least 3 decimals, angles with at least 4, or as many as the program
-/// wrote.
-pub(super) fn written_edits(
-    language: Language,
-    site: &Site,
-    axes: &FilterAxes,
-    at: &Placement,
-) -> Result<Vec<(Range<usize>, String)>, String> {
-    if !axes.correct_values {
-        return Ok(Vec::new());
-    }
-    let mut wanted: Vec<(u32, usize, f64, usize)> = Vec::new();
-    if let Some(t) = &at.track {
-        wanted.push((1, TRACK_AXIS, t.written_mm, 3));
-    }
-    if let Some(p) = &at.positioner {
-        let numbers = axes.positioner_numbers(language);
-        for (number, value) in numbers.into_iter().zip(p.written_deg) {
-            wanted.push((positioner_group(language), number, value, 4));
-        }
-    }
-    wanted
-        .into_iter()
-        .map(|(group, number, value, least)| {
-            let a = site
-                .axes
-                .iter()
-                .find(|a| a.group == group && a.number == number)
-                .ok_or_else(|| format!("no value of axis {number} to correct: not filtered"))?;
-            let slot = a.slot.clone().ok_or_else(|| {
-                format!("the value of axis {} cannot be rewritten where the program gives it: not filtered", a.name)
-            })?;
-            let written = a.text.split_whitespace().next().unwrap_or("");
-            let decimals = written.split_once('.').map_or(0, |(_, d)| d.len()).max(least);
-            Ok((slot, format!("{:.*}", decimals, value + 0.0)))
-        })
-        .collect()
-}
 
 /// The track value [mm], to 0.001 mm, at which `calibrated` moves the
 /// robot's base from the middle of its travel most nearly as `nominal`

@@ -5,8 +5,7 @@
 //! values rewritten; one report line per position of a Cartesian motion
 //! (`report.rs`).
 
-use super::axes::{self, FilterAxes, Placement};
-use super::corrected_values::written_edits;
+use super::axes::{self, written_edits, FilterAxes, Placement};
 use super::report::{
     FilterReport, JointMotionReport, MotionPlace, ReportedAxes, TargetReport, TargetStatus,
     UnusedReport,
