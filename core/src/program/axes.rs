@@ -796,4 +796,63 @@ mod tests {
             assert!(why.contains(want), "{why}");
         }
     }
+
+    /// Corrected on request: the track's scale of 1.0002 undone from
+    /// mid-travel (2000 mm) and the turntable's 1° zero undone, composed at
+    /// the written values and written in place of the programmed ones with
+    /// the program's decimals (at least 3 for mm, 4 for degrees); a value
+    /// the parser cannot point at refuses the target, naming the axis.
+    #[test]
+    fn corrected_values_are_composed_and_written_in_place() {
+        let (nominal, calibrated) = (turntable(0.0), turntable(1.0));
+        let (rail, real_rail) = (track(1.0), track(1.0002));
+        let axes = FilterAxes::of_cell(None, None);
+        let pair = (calibrated, nominal);
+        let rails = (real_rail, rail);
+        let axes = FilterAxes {
+            track: FilterAxes::of_cell(Some(&rails), None).track,
+            positioner: FilterAxes::of_cell(None, Some(&pair)).positioner,
+            ..axes
+        }
+        .correcting_values(true);
+        let slotted = |n: usize, name: &str, v: f64, text: &str, at: usize| AxisValue {
+            text: text.into(),
+            slot: Some(at..at + text.len()),
+            ..axis(n, name, Some(v))
+        };
+        let s = site(vec![
+            slotted(1, "E1", 3000.0, "3000.0", 10),
+            slotted(2, "E2", 0.0, "0", 30),
+            slotted(3, "E3", 90.0, "90.00000", 40),
+        ]);
+        let at = place(Language::Krl, &s, &axes, &Pose::identity()).unwrap();
+        let (t, p) = (at.track.unwrap(), at.positioner.unwrap());
+        let e = ((2000.0 + 1000.0 / 1.0002) * 1e3_f64).round() / 1e3;
+        assert_eq!((t.value_mm, t.written_mm), (3000.0, e));
+        assert_eq!((p.values_deg, p.written_deg), ([0.0, 90.0], [0.0, 89.0]));
+        // Composed at the written values: the real plate at 89° + 1°.
+        let real = p.calibrated.compose(&Pose::from_translation(Vector3::x()));
+        assert!(
+            (real.p - Vector3::new(1.5, 1.0, 0.5)).norm() < 1e-9,
+            "{}",
+            real.p
+        );
+        let edits = written_edits(Language::Krl, &s, &axes, &at).unwrap();
+        assert_eq!(
+            edits,
+            vec![
+                (10..16, format!("{e:.3}")),
+                (30..31, "0.0000".to_string()),
+                (40..48, "89.00000".to_string()),
+            ]
+        );
+        let mut unslotted = s.clone();
+        unslotted.axes[2].slot = None;
+        let why = written_edits(Language::Krl, &unslotted, &axes, &at).unwrap_err();
+        assert!(why.contains("axis E3 cannot be rewritten"), "{why}");
+        let kept = axes.correcting_values(false);
+        assert!(written_edits(Language::Krl, &s, &kept, &at)
+            .unwrap()
+            .is_empty());
+    }
 }
