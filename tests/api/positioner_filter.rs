@@ -436,7 +436,6 @@ pub(crate) async fn filters_beside_the_track(
     let at = argv.iter().position(|x| x == "--out-dir").unwrap();
     argv[at + 1] = out.to_str().unwrap().to_string();
     argv.insert(at, "--correct-axes".into());
-    let argv: [String; 19] = argv.try_into().unwrap();
     super::track_filter::assert_cli_gives(&corrected, argv, &out);
     // Nothing to correct without the axes: 422.
     let mut bare = body.clone();

@@ -143,7 +143,7 @@ pub(crate) async fn refused_without_a_track(t: &TestApp, rid: &str) {
 /// `robocal filter` run in-process with `argv` (writing into `out`) gives
 /// the HTTP answer `http`'s report and files, byte for byte, every target
 /// filtered.
-pub(crate) fn assert_cli_gives<const N: usize>(http: &Value, argv: [String; N], out: &Path) {
+pub(crate) fn assert_cli_gives(http: &Value, argv: impl IntoIterator<Item = String>, out: &Path) {
     let robocal::cli::Command::Filter(a) = robocal::cli::Cli::try_parse_from(argv).unwrap().command
     else {
         unreachable!("a filter command line")

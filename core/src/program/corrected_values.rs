@@ -19,13 +19,16 @@
 //! in the controller's world; the written values `v'` are those at which
 //! the calibrated plate `P(v')`, seen in that world, turns the part most
 //! nearly as the controller believes (the zero offsets and scales; tilted
-//! axis lines stay the robot's to correct): Gauss–Newton on `sin θ·n` of
-//! `R_nom(v)ᵀ·R(v') = Rot(n, θ)`, the Jacobian by 1e-4° differences. The
+//! axis lines stay the robot's to correct): Gauss–Newton on the rotation
+//! vector `θ·n` of `R_nom(v)ᵀ·R(v') = Rot(n, θ)` (`orientation::
+//! rotation_log`, exact near the identity), the Jacobian by 1e-4°
+//! differences. The
 //! part's position follows from the robot's solve as before.
 //!
 //! Units: track values in mm, positioner values in degrees, poses SI.
 
 use crate::model::external::{LinearTrack, OutsideTravel, TiltRotate};
+use crate::model::orientation::rotation_log;
 use crate::model::Pose;
 use nalgebra::{Matrix3x2, Vector2, Vector3};
 
@@ -82,16 +85,7 @@ pub(super) fn positioner_values(
     let want = nominal.cell_from_face_plate(programmed).r.transpose();
     let calibrated_in_world =
         |v: [f64; 2]| world_from_cell.r * calibrated.cell_from_face_plate(v).r;
-    let residual = |v: [f64; 2]| -> Vector3<f64> {
-        // sin θ times the axis of `R_nom(v)ᵀ·R(v')`: exact to the last
-        // digits near the identity, where an arccos is not.
-        let d = want * calibrated_in_world(v);
-        Vector3::new(
-            d[(2, 1)] - d[(1, 2)],
-            d[(0, 2)] - d[(2, 0)],
-            d[(1, 0)] - d[(0, 1)],
-        ) / 2.0
-    };
+    let residual = |v: [f64; 2]| -> Vector3<f64> { rotation_log(&(want * calibrated_in_world(v))) };
     const H_DEG: f64 = 1e-4;
     let mut v = programmed;
     for _ in 0..10 {
@@ -116,19 +110,8 @@ pub(super) fn positioner_values(
 mod tests {
     use super::*;
     use crate::model::external::{RotaryAxis, Travel};
+    use crate::model::orientation::rotation_angle_between;
     use nalgebra::Matrix3;
-
-    /// The angle [rad] between two rotations a small angle apart, by its
-    /// sine (an arccos of the trace loses the last 8 digits there).
-    fn angle(a: &Matrix3<f64>, b: &Matrix3<f64>) -> f64 {
-        let d = a.transpose() * b;
-        let s = Vector3::new(
-            d[(2, 1)] - d[(1, 2)],
-            d[(0, 2)] - d[(2, 0)],
-            d[(1, 0)] - d[(0, 1)],
-        );
-        (s.norm() / 2.0).asin()
-    }
 
     fn rail(scale: f64, zero_m: f64) -> LinearTrack {
         let mut t = LinearTrack::nominal(
@@ -187,7 +170,7 @@ mod tests {
                 assert!((got[k] - expected[k]).abs() <= 5e-5, "{v:?}: {got:?}");
                 assert_eq!(got[k], (expected[k] * 1e4).round() / 1e4, "{v:?}: {got:?}");
             }
-            let turned = angle(
+            let turned = rotation_angle_between(
                 &nom.cell_from_face_plate(v).r,
                 &cal.cell_from_face_plate(got).r,
             );

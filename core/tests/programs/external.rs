@@ -153,7 +153,8 @@ pub fn controller_solution(
         .min_by(|a, b| d(a).total_cmp(&d(b)))
 }
 
-fn rms(v: &[f64]) -> f64 {
+/// The root-mean-square of `v`.
+pub fn rms(v: &[f64]) -> f64 {
     (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
 }
 

@@ -22,7 +22,7 @@
 
 use super::external::{
     assert_every_target_filtered, assert_figures, assert_positioner_values_kept,
-    controller_solution, fanuc_program, krl_program, Miss, Validation, Written,
+    controller_solution, fanuc_program, krl_program, rms, Miss, Validation, Written,
 };
 use super::positioner::{draw_on_part, fit_and_teach, rapid_on_plate, robot_in_cell, true_part};
 use super::track::{track_cell, TrackCell};
@@ -387,11 +387,6 @@ fn targets_on_the_part_solve_at_their_track_and_positioner_values() {
     );
 }
 
-/// The root-mean-square of `v`.
-fn rms_of(v: &[f64]) -> f64 {
-    (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
-}
-
 /// The acceptance of the corrected axis values in one language: every
 /// target filtered, the report saying the values were corrected and giving
 /// each written value beside the programmed one; the real axes at the
@@ -456,15 +451,15 @@ fn assert_corrected_in_cell(language: Language, files: &[ProgramFile]) {
     }
     println!(
         "{language:?} corrected: the true base's move from mid-travel off the controller's, along the rail rms {:.4} mm as programmed, {:.4} mm at the written values (sideways {:.4} and {:.4} mm, no value holds it); the true part's orientation off the controller's, rms {:.4}° as programmed, {:.4}° written",
-        rms_of(&base[0]),
-        rms_of(&base[1]),
-        rms_of(&sideways[0]),
-        rms_of(&sideways[1]),
-        rms_of(&part[0]),
-        rms_of(&part[1])
+        rms(&base[0]),
+        rms(&base[1]),
+        rms(&sideways[0]),
+        rms(&sideways[1]),
+        rms(&part[0]),
+        rms(&part[1])
     );
-    assert!(rms_of(&base[1]) < 0.5 * rms_of(&base[0]), "{base:?}");
-    assert!(rms_of(&part[1]) < 0.5 * rms_of(&part[0]), "{part:?}");
+    assert!(rms(&base[1]) < 0.5 * rms(&base[0]), "{base:?}");
+    assert!(rms(&part[1]) < 0.5 * rms(&part[0]), "{part:?}");
     assert_figures(
         &format!("{language:?} on the track beside the positioner, axis values corrected"),
         "the calibration's validation rms (the robot's and the positioner's)",

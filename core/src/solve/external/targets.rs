@@ -376,19 +376,25 @@ mod tests {
         assert_eq!(target_track_values("x,y,z\n1,2,3\n", d).unwrap(), None);
     }
 
+    /// A turntable at the cell's origin, its plate 0.5 m up: axis 1 (tilt)
+    /// about x, axis 2 (rotate) about z, no offsets.
+    fn turntable() -> TiltRotate {
+        use crate::model::external::RotaryAxis;
+        TiltRotate {
+            cell_from_base: Pose::identity(),
+            tilt: RotaryAxis::new(Vector3::x(), Vector3::zeros(), 0.0, 1.0),
+            rotate: RotaryAxis::new(Vector3::z(), Vector3::zeros(), 0.0, 1.0),
+            face_plate: Pose::from_translation(Vector3::new(0.0, 0.0, 0.5)),
+        }
+    }
+
     /// Closed form: a turntable (axis 1 at 0) at a quarter turn carries a
     /// target at (1, 0, 0) on the plate, 0.5 m above the base, to (0, 1,
     /// 0.5) in a robot base standing at the cell's origin; a row without its
     /// rotate value fails alone.
     #[test]
     fn a_target_on_the_face_plate_is_moved_by_its_rows_axis_values() {
-        use crate::model::external::RotaryAxis;
-        let p = TiltRotate {
-            cell_from_base: Pose::identity(),
-            tilt: RotaryAxis::new(Vector3::x(), Vector3::zeros(), 0.0, 1.0),
-            rotate: RotaryAxis::new(Vector3::z(), Vector3::zeros(), 0.0, 1.0),
-            face_plate: Pose::from_translation(Vector3::new(0.0, 0.0, 0.5)),
-        };
+        let p = turntable();
         let text = "x,y,z,e1,e2\n1000,0,0,0,90\n1000,0,0,0,\n";
         let d = Dialect::default();
         let tilt = target_column_values(text, d, TILT_COLUMN).unwrap().unwrap();
@@ -413,13 +419,7 @@ mod tests {
     /// alone, naming the column.
     #[test]
     fn beside_a_track_a_plate_target_is_moved_by_its_rows_track_and_axis_values() {
-        use crate::model::external::RotaryAxis;
-        let p = TiltRotate {
-            cell_from_base: Pose::identity(),
-            tilt: RotaryAxis::new(Vector3::x(), Vector3::zeros(), 0.0, 1.0),
-            rotate: RotaryAxis::new(Vector3::z(), Vector3::zeros(), 0.0, 1.0),
-            face_plate: Pose::from_translation(Vector3::new(0.0, 0.0, 0.5)),
-        };
+        let p = turntable();
         let text = "x,y,z,e1,e2,e3\n1000,0,0,200,0,90\n1000,0,0,1200,0,90\n1000,0,0,200,0,\n";
         let d = Dialect::default();
         let [tilt_column, rotate_column] = positioner_columns(true);
