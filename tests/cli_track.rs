@@ -703,3 +703,158 @@ fn simulate_writes_files_the_printed_command_fits() {
         text(&out.stderr)
     );
 }
+
+/// A cell engineer's loop over a track on the command line: `robocal plan
+/// --track` lays out 11 stations of 4 poses (the CSV is the core's plan,
+/// byte for byte; the program moves the track with the robot), the
+/// simulated tracker reads them on the true rail, `plan join` carries each
+/// pose's `e1` into the measurement file and `track calibrate` accepts it;
+/// plans the track cannot carry are refused.
+#[test]
+fn a_planned_track_measurement_is_joined_and_fitted() {
+    use robocal::plan::{make_track_plan, plan_csv, PlanSettings, TrackPlanSettings, TrackerSight};
+    let d = tempfile::tempdir().unwrap();
+    let drawing = TrueTrack::drawing_4m();
+    std::fs::write(d.path().join("drawing.json"), drawing.to_json()).unwrap();
+    let plan_args = [
+        "plan",
+        "--model",
+        "ys100",
+        "--track",
+        "drawing.json",
+        "--tracker",
+        "0,0,0",
+        "--seed",
+        "5",
+    ];
+    let with =
+        |extra: &[&'static str]| -> Vec<&str> { plan_args.iter().chain(extra).copied().collect() };
+    let out = robocal(d.path(), &with(&["--out", "plan.csv"]));
+    assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+    let table = text(&out.stdout);
+    assert!(
+        table.starts_with("# 44 poses of ys100 at 11 stations of e1"),
+        "{table}"
+    );
+    let model = robocal::model::preset("ys100").unwrap();
+    let settings = TrackPlanSettings {
+        poses: PlanSettings {
+            poses: 4,
+            tracker: Some(TrackerSight {
+                position_mm: [0.0; 3],
+                ..TrackerSight::default()
+            }),
+            seed: 5,
+            ..PlanSettings::default()
+        },
+        ..TrackPlanSettings::default()
+    };
+    let plan = make_track_plan(&model, &drawing, &settings).unwrap();
+    let csv_text = std::fs::read_to_string(d.path().join("plan.csv")).unwrap();
+    assert_eq!(csv_text, plan_csv(&plan.points));
+    assert!(csv_text.starts_with("point,q1,q2,q3,q4,q5,q6,e1\n"));
+    // The program: each pose with its station's E1.
+    let out = robocal(d.path(), &with(&["--format", "krl", "--out", "plan.src"]));
+    assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+    let src = std::fs::read_to_string(d.path().join("plan.src")).unwrap();
+    for s in &plan.stations {
+        let e = format!(",E1 {:.3}}}", s.value_mm);
+        assert_eq!(src.matches(&e).count(), 4, "{e}: {src}");
+    }
+    // The tracker reads the plan on the true rail; its export names the points.
+    let truth = {
+        let mut t = TrueRobot::new(model.clone());
+        t.noise_mm = 0.01;
+        t
+    };
+    let stations: Vec<(f64, Vec<Vec<f64>>)> = plan
+        .stations
+        .iter()
+        .map(|s| {
+            (
+                s.value_mm,
+                s.points.iter().map(|&k| plan.q[k].clone()).collect(),
+            )
+        })
+        .collect();
+    let mut rng = ChaCha8Rng::seed_from_u64(9);
+    let read = TrueTrack::rail_4m()
+        .measure(
+            &truth,
+            robocal::measure::external::ExternalAxis::E1,
+            &stations,
+            None,
+            &mut rng,
+        )
+        .unwrap();
+    let mut export = String::from("name,x,y,z\n");
+    for (p, m) in plan.points.iter().zip(&read.poses) {
+        let [x, y, z] = m.xyz_mm;
+        export.push_str(&format!("{},{x},{y},{z}\n", p.name));
+    }
+    std::fs::write(d.path().join("export.csv"), export).unwrap();
+    let out = robocal(
+        d.path(),
+        &[
+            "plan",
+            "join",
+            "--plan",
+            "plan.csv",
+            "--tracker-export",
+            "export.csv",
+            "--out",
+            "joined.csv",
+        ],
+    );
+    assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+    let joined = std::fs::read_to_string(d.path().join("joined.csv")).unwrap();
+    assert!(
+        joined.starts_with("q1,q2,q3,q4,q5,q6,e1,x,y,z\n"),
+        "{joined}"
+    );
+    let set = robocal::measure::csv::parse_set(&joined).unwrap();
+    for (r, m) in set.readings().zip(read.readings()) {
+        assert_eq!((r.external, r.pose.xyz_mm), (m.external, m.pose.xyz_mm));
+    }
+    let out = robocal(
+        d.path(),
+        &[
+            "track",
+            "calibrate",
+            "joined.csv",
+            "--model",
+            "ys100",
+            "--out",
+            "rail.json",
+        ],
+    );
+    assert_eq!(code(&out), 0, "{}{}", text(&out.stdout), text(&out.stderr));
+    let fitted =
+        LinearTrack::from_json(&std::fs::read_to_string(d.path().join("rail.json")).unwrap())
+            .unwrap();
+    println!(
+        "planned track fit: scale {:.7} (truth 1.0002000)",
+        fitted.scale
+    );
+    assert!((fitted.scale - 1.0002).abs() < 2e-5, "{}", fitted.scale);
+    // Refused, naming why.
+    assert_refused(
+        &robocal(d.path(), &with(&["--format", "urscript"])),
+        "URScript programs carry no external axes",
+    );
+    assert_refused(
+        &robocal(d.path(), &with(&["--stations", "4"])),
+        "at least 5 stations",
+    );
+    assert_refused(
+        &robocal(d.path(), &with(&["--travel", "0,5000"])),
+        "beyond the track model's 0 .. 4000 mm",
+    );
+    let out = robocal(d.path(), &["plan", "--model", "ys100", "--stations", "8"]);
+    assert_ne!(code(&out), 0);
+    assert!(
+        text(&out.stderr).contains("--track"),
+        "{}",
+        text(&out.stderr)
+    );
+}

@@ -30,8 +30,12 @@ use robocal_core::model::calibrated::CompensatedModel;
 use robocal_core::model::external::CarriageTerm;
 use robocal_core::model::kinematics::fk;
 use robocal_core::model::{Pose, RobotModel};
-use robocal_core::sim::random_configurations;
+use robocal_core::plan::{
+    join, make_track_plan, plan_csv, read_plan_csv, JoinOptions, PlanSettings, TrackPlan,
+    TrackPlanSettings, TrackerSight,
+};
 use robocal_core::sim::track::TrueTrack;
+use robocal_core::sim::{random_configurations, TrueRobot};
 use robocal_core::solve::external::{carried, TrackPoseError, TrackSolver};
 use robocal_core::solve::ik::{Goal, IkSettings, SolveOptions};
 
@@ -66,6 +70,17 @@ fn prediction_errors(fit: &TrackFit, robot: &RobotModel, set: &MeasurementSet) -
             (x - nalgebra::Vector3::from(r.pose.xyz_mm)).norm()
         })
         .collect()
+}
+
+/// [`POSES_PER_STATION`] random poses at each [`HELD_OUT`] value, read on
+/// the truth.
+fn held_out(
+    truth: &TrueRobot,
+    nominal: &RobotModel,
+    track: &TrueTrack,
+    rng: &mut ChaCha8Rng,
+) -> MeasurementSet {
+    measure_on_track(truth, nominal, track, &HELD_OUT, POSES_PER_STATION, rng)
 }
 
 fn rms(v: &[f64]) -> f64 {
@@ -106,14 +121,7 @@ fn held_out_track_positions_are_predicted_within_the_robots_own_error() {
                 e.fit.as_ref().map(|f| (&f.maps, &f.stations))
             )
         });
-        let held = measure_on_track(
-            &truth,
-            &nominal,
-            &track,
-            &HELD_OUT,
-            POSES_PER_STATION,
-            &mut rng,
-        );
+        let held = held_out(&truth, &nominal, &track, &mut rng);
         let errors = prediction_errors(&fit, &calibrated, &held);
         let (held_rms, held_max) = (rms(&errors), max(&errors));
         // Without maps (a straight rail: line, scale, zero, mount).
@@ -491,5 +499,142 @@ fn predictions_and_solves_through_the_track_land_on_the_truth() {
             .solve(&goal, f64::NAN, &SolveOptions::default())
             .is_err());
         assert!(carried(&model, &fit.model, 4001.0).is_err());
+    }
+}
+
+/// The poses of `plan` grouped by station: `(value_mm, configurations)`.
+fn planned_stations(plan: &TrackPlan) -> Vec<(f64, Vec<Vec<f64>>)> {
+    plan.stations
+        .iter()
+        .map(|s| {
+            (
+                s.value_mm,
+                s.points.iter().map(|&k| plan.q[k].clone()).collect(),
+            )
+        })
+        .collect()
+}
+
+/// `√(Σ σ²)` of the base's three turns [arcsec] from reflector positions
+/// `p` [m]: `σ²·trace((Σ|a'|²·I − a'·a'ᵀ)⁻¹)`, `a'` about the centroid.
+fn turn_sigma_arcsec(p: &[nalgebra::Vector3<f64>]) -> f64 {
+    let c = p.iter().sum::<nalgebra::Vector3<f64>>() / p.len() as f64;
+    let inertia = p.iter().fold(nalgebra::Matrix3::zeros(), |m, x| {
+        let a = x - c;
+        m + nalgebra::Matrix3::identity() * a.norm_squared() - a * a.transpose()
+    });
+    let trace = inertia.try_inverse().map_or(f64::INFINITY, |m| m.trace());
+    TRACKER_SIGMA_MM * 1e-3 * trace.sqrt() * 180.0 * 3600.0 / std::f64::consts::PI
+}
+
+/// A plan over the track (`plan::make_track_plan`: by default a station
+/// every 400 mm over the 4 m, 4 D-optimal poses each, the tracker at the cell frame's origin seeing
+/// the reflector within 60° from each station through the drawing's track)
+/// measured on the truth, joined back through the plan's CSV and a tracker
+/// export into a measurement CSV with its `e1` column, and fitted: accepted,
+/// held-out track positions within 1.5× the robot's own validation error on
+/// a fixed base; the plan's predicted turn σ are the fit's station σ; random
+/// poses at the same stations see the base's turns worse.
+#[test]
+fn a_planned_track_measurement_fits_and_validates() {
+    let track = TrueTrack::rail_4m();
+    let drawing = TrueTrack::drawing_4m();
+    for seed in [1u64, 2, 3] {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let (nominal, truth) = ys100_truth(&mut rng);
+        let (calibrated, robot_val_rms) =
+            calibrated_on_fixed_base(&nominal, &truth, &track, &mut rng);
+        let settings = TrackPlanSettings {
+            poses: PlanSettings {
+                tracker: Some(TrackerSight {
+                    position_mm: [0.0, 0.0, 0.0],
+                    ..TrackerSight::default()
+                }),
+                seed,
+                ..TrackPlanSettings::default().poses
+            },
+            ..TrackPlanSettings::default()
+        };
+        let plan = make_track_plan(&calibrated, &drawing, &settings).unwrap();
+        assert_eq!(plan.stations.len(), 11);
+        assert_eq!(plan.points.len(), 44);
+        let stations = planned_stations(&plan);
+        let measured = track
+            .measure(
+                &truth,
+                ExternalAxis::E1,
+                &stations,
+                Some(nominal.payload.mass),
+                &mut rng,
+            )
+            .unwrap();
+        // The tracker's export names each point; joined back to the plan's CSV.
+        let mut export = String::from("name,x,y,z\n");
+        for (p, m) in plan.points.iter().zip(&measured.poses).rev() {
+            let [x, y, z] = m.xyz_mm;
+            export.push_str(&format!("{},{x},{y},{z}\n", p.name));
+        }
+        let points = read_plan_csv(&plan_csv(&plan.points)).unwrap();
+        assert_eq!(points, plan.points);
+        let joined = join(&points, &export, &JoinOptions::default()).unwrap();
+        let set = csv::parse_set(&csv::write_set(&joined.set())).unwrap();
+        assert_eq!(set.axes, vec![ExternalAxis::E1]);
+        for ((r, m), p) in set
+            .readings()
+            .zip(&measured.readings().collect::<Vec<_>>())
+            .zip(&plan.points)
+        {
+            assert_eq!(r.external, m.external);
+            assert_eq!(r.pose.xyz_mm, m.pose.xyz_mm);
+            for (a, b) in r.pose.q_deg.iter().zip(&m.pose.q_deg) {
+                assert!((a - b).abs() < 1e-9, "{}: {a} vs {b}", p.name);
+            }
+        }
+        let fit = fit_track(&request(&calibrated, &set, DEFAULT_MAX_ORDER))
+            .unwrap_or_else(|e| panic!("seed {seed}: the planned measurements refused: {e}"));
+        let held = held_out(&truth, &nominal, &track, &mut rng);
+        let errors = prediction_errors(&fit, &calibrated, &held);
+        let (held_rms, held_max) = (rms(&errors), max(&errors));
+        // The plan's predicted turn σ against the fit's, and random poses'.
+        let mut ratios = Vec::new();
+        for (planned, (value, qs)) in plan.stations.iter().zip(&stations) {
+            let fitted = fit.stations.iter().find(|s| s.value_mm == *value).unwrap();
+            let norm = |v: [f64; 3]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            let (p, f) = (
+                norm(planned.angle_sigma_arcsec),
+                norm(fitted.sigma_angles_arcsec),
+            );
+            assert!(
+                (p - f).abs() < 1e-6 * f,
+                "{value} mm: planned {p} vs fitted {f}"
+            );
+            let at = |qs: &[Vec<f64>]| {
+                qs.iter()
+                    .map(|q| fk(&calibrated, q).unwrap().p)
+                    .collect::<Vec<_>>()
+            };
+            assert!((turn_sigma_arcsec(&at(qs)) - p).abs() < 1e-6 * p);
+            let mut random: Vec<f64> = (0..25)
+                .map(|_| turn_sigma_arcsec(&at(&random_configurations(&calibrated, 4, &mut rng))))
+                .collect();
+            random.sort_by(f64::total_cmp);
+            ratios.push(random[12] / p);
+        }
+        println!(
+            "seed {seed}: planned {} stations x 4 poses; robot on a fixed base validated at rms {robot_val_rms:.4} mm; \
+             held-out track positions rms {held_rms:.4} mm (max {held_max:.4}), ratio {:.2}; \
+             turn sigma planned {:.3}..{:.3} arcsec, random 4 poses' median / planned {:.2}..{:.2}",
+            plan.stations.len(),
+            held_rms / robot_val_rms,
+            plan.stations.iter().map(|s| s.angle_sigma_arcsec.iter().map(|x| x * x).sum::<f64>().sqrt()).fold(f64::INFINITY, f64::min),
+            plan.stations.iter().map(|s| s.angle_sigma_arcsec.iter().map(|x| x * x).sum::<f64>().sqrt()).fold(0.0, f64::max),
+            ratios.iter().copied().fold(f64::INFINITY, f64::min),
+            ratios.iter().copied().fold(0.0, f64::max),
+        );
+        assert!(
+            held_rms <= 1.5 * robot_val_rms,
+            "seed {seed}: held-out rms {held_rms} vs robot {robot_val_rms}"
+        );
+        assert!(ratios.iter().all(|r| *r > 1.0), "{ratios:?}");
     }
 }

@@ -10,17 +10,24 @@
 //!     --tracker "2500,0,500" --max-angle-deg 60 --noise-mm 0.01 --format krl --out plan.src \
 //!     --csv plan.csv
 //! robocal plan join --plan plan.csv --tracker-export export.csv --out measurements.csv
+//! robocal plan --model cal.json --track drawing.json --tracker "0,0,0" --csv plan.csv --out plan.src \
+//!     --format krl
 //! ```
 //!
-//! Box and tracker position: base frame, mm; the reflector axis: tool frame.
+//! Box and tracker position: base frame, mm (with `--track`, the tracker's
+//! position is in the cell frame and each pose carries the track's value,
+//! `core::plan::track`); the reflector axis: tool frame.
 
 use crate::plan::{
-    join, make_plan, plan_csv, plan_program, read_plan_csv, JoinBy, JoinOptions, MeasurementPlan,
-    PlanSettings, TrackerSight, Units, WorkspaceBox,
+    join, make_plan, make_track_plan, plan_csv, points_program, read_plan_csv, JoinBy, JoinOptions,
+    MeasurementPlan, PlanPoint, PlanSettings, TrackPlan, TrackPlanSettings, TrackerSight, Units,
+    WorkspaceBox,
 };
 use crate::program::Language;
 use anyhow::{bail, Context};
 use clap::{Args, Subcommand, ValueEnum};
+use robocal_core::measure::external::ExternalAxis;
+use robocal_core::model::RobotModel;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
@@ -64,18 +71,31 @@ pub struct MakeArgs {
     /// Robot model: a preset (ys100, hh800, ur5, ur10) or a model JSON file.
     #[arg(long)]
     pub model: Option<String>,
-    /// Number of poses.
-    #[arg(long, default_value_t = 50)]
-    pub poses: usize,
+    /// Number of poses (default 50); with `--track`, per station (default 4).
+    #[arg(long)]
+    pub poses: Option<usize>,
     /// Random candidate configurations drawn within the joint limits.
     #[arg(long, default_value_t = 1000)]
     pub candidates: usize,
     /// Workspace box of the TCP, base frame: "xmin,ymin,zmin,xmax,ymax,zmax" [mm].
     #[arg(long = "box", allow_hyphen_values = true)]
     pub workspace: Option<String>,
-    /// Tracker position in the base frame: "x,y,z" [mm].
+    /// Tracker position in the base frame (with `--track`, the cell frame): "x,y,z" [mm].
     #[arg(long, allow_hyphen_values = true)]
     pub tracker: Option<String>,
+    /// The robot's linear track (JSON, nominal or calibrated): plan poses at
+    /// stations spread over its travel, each pose with the track's value.
+    #[arg(long)]
+    pub track: Option<String>,
+    /// Stations along the track, at least 5 (default: one every 400 mm).
+    #[arg(long, requires = "track")]
+    pub stations: Option<usize>,
+    /// The track's column in the plan and the measurements, e1 … e6.
+    #[arg(long, requires = "track", default_value = "e1", value_parser = super::track::parse_axis)]
+    pub column: ExternalAxis,
+    /// The stations' lowest and highest value: "lo,hi" [mm] (default: the track's travel).
+    #[arg(long, requires = "track", allow_hyphen_values = true)]
+    pub travel: Option<String>,
     /// Reflector axis in the tool frame: "x,y,z" (default: the tool's z axis).
     #[arg(long, allow_hyphen_values = true)]
     pub reflector_axis: Option<String>,
@@ -163,7 +183,7 @@ fn settings(a: &MakeArgs) -> anyhow::Result<PlanSettings> {
         None => None,
     };
     Ok(PlanSettings {
-        poses: a.poses,
+        poses: a.poses.unwrap_or(if a.track.is_some() { 4 } else { 50 }),
         candidates: a.candidates,
         workspace,
         tracker,
@@ -200,23 +220,91 @@ pub fn sigma_table(plan: &MeasurementPlan) -> String {
     s
 }
 
+/// The σ table of a track plan: per station its value, poses, the
+/// candidates in sight and the predicted σ of the base's pose.
+pub fn track_table(plan: &TrackPlan) -> String {
+    let c = plan.counts;
+    let mut s = format!(
+        "# {} poses of {} at {} stations of {}: {} candidates drawn, {} reachable, {} inside the box\n\
+         # predicted standard deviations of the base's pose at each station for a tracker noise of {} mm per axis\n\
+         # {:>12} {:>6} {:>10} {:>12} {:>12} {:>12} {:>12}\n",
+        plan.points.len(),
+        plan.robot,
+        plan.stations.len(),
+        plan.axis,
+        c.drawn,
+        c.reachable,
+        c.in_box,
+        plan.noise_mm,
+        "value_mm",
+        "poses",
+        "in_sight",
+        "position_mm",
+        "rx_arcsec",
+        "ry_arcsec",
+        "rz_arcsec"
+    );
+    for st in &plan.stations {
+        let [x, y, z] = st.angle_sigma_arcsec;
+        let _ = writeln!(
+            s,
+            "  {:>12.3} {:>6} {:>10} {:>12.4e} {:>12.4} {:>12.4} {:>12.4}",
+            st.value_mm,
+            st.points.len(),
+            st.in_sight,
+            st.position_sigma_mm,
+            x,
+            y,
+            z
+        );
+    }
+    s
+}
+
+fn language(format: PlanFormat) -> Option<Language> {
+    match format {
+        PlanFormat::Csv => None,
+        PlanFormat::Krl => Some(Language::Krl),
+        PlanFormat::Rapid => Some(Language::Rapid),
+        PlanFormat::Fanuc => Some(Language::Fanuc),
+        PlanFormat::Urscript => Some(Language::UrScript),
+    }
+}
+
+/// The plan's points and σ table: over the track's stations with `--track`.
+fn planned(a: &MakeArgs, model: &RobotModel) -> anyhow::Result<(Vec<PlanPoint>, String)> {
+    let Some(path) = &a.track else {
+        let plan = make_plan(model, &settings(a)?)?;
+        return Ok((plan.points.clone(), sigma_table(&plan)));
+    };
+    let track = super::track::read_track(path)?;
+    let travel_mm = match &a.travel {
+        Some(t) => Some(numbers::<2>("--travel", t)?),
+        None => None,
+    };
+    let plan = make_track_plan(
+        model,
+        &track,
+        &TrackPlanSettings {
+            stations: a.stations,
+            axis: a.column,
+            travel_mm,
+            poses: settings(a)?,
+        },
+    )?;
+    Ok((plan.points.clone(), track_table(&plan)))
+}
+
 /// Makes the plan and writes its exports; returns the σ table.
 pub fn make(a: &MakeArgs) -> anyhow::Result<String> {
     let Some(model) = &a.model else {
         bail!("--model is required (or use `robocal plan join`)");
     };
     let model = super::model_files::load_model(model)?;
-    let plan = make_plan(&model, &settings(a)?)?;
-    let language = match a.format {
-        PlanFormat::Csv => None,
-        PlanFormat::Krl => Some(Language::Krl),
-        PlanFormat::Rapid => Some(Language::Rapid),
-        PlanFormat::Fanuc => Some(Language::Fanuc),
-        PlanFormat::Urscript => Some(Language::UrScript),
-    };
-    let text = match language {
-        None => plan_csv(&plan.points),
-        Some(l) => plan_program(&plan, l, &a.name, a.wait_s)?
+    let (points, table) = planned(a, &model)?;
+    let text = match language(a.format) {
+        None => plan_csv(&points),
+        Some(l) => points_program(&points, l, &a.name, a.wait_s)?
             .into_iter()
             .map(|f| f.text)
             .collect(),
@@ -226,10 +314,10 @@ pub fn make(a: &MakeArgs) -> anyhow::Result<String> {
         Some(path) => std::fs::write(path, text).with_context(|| format!("cannot write {path}"))?,
     }
     if let Some(path) = &a.csv {
-        std::fs::write(path, plan_csv(&plan.points))
+        std::fs::write(path, plan_csv(&points))
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
-    Ok(sigma_table(&plan))
+    Ok(table)
 }
 
 /// Joins the tracker export; returns a one-line summary.
@@ -261,7 +349,7 @@ pub fn join_files(a: &JoinArgs) -> anyhow::Result<String> {
     let options = join_options(&a.units, &a.by)?;
     let joined = join(&plan, &read(&a.tracker_export)?, &options)
         .with_context(|| a.tracker_export.display().to_string())?;
-    std::fs::write(&a.out, crate::measure::csv::write(&joined.rows))
+    std::fs::write(&a.out, crate::measure::csv::write_set(&joined.set()))
         .with_context(|| format!("cannot write {}", a.out.display()))?;
     Ok(format!(
         "{} measurements joined by {} (positions read in {}) into {}\n",

@@ -96,7 +96,7 @@ pub struct CalibrateArgs {
     pub json: bool,
 }
 
-fn parse_axis(s: &str) -> Result<ExternalAxis, String> {
+pub(crate) fn parse_axis(s: &str) -> Result<ExternalAxis, String> {
     ExternalAxis::ALL
         .into_iter()
         .find(|a| a.column().eq_ignore_ascii_case(s.trim()))

@@ -1,14 +1,15 @@
 //! A plan's exports: the joint CSV `point,q1..qN` (controller convention,
 //! degrees; read back by [`read_plan_csv`] and by `robocal plan join`) and a
 //! joint program in each language that visits every pose and waits there
-//! (`program::export::joint_program`).
+//! (`program::export::labelled_joint_program`).
 
 use super::MeasurementPlan;
 use crate::csv_write::{push_header, push_row, read_text, Cell};
-use crate::measure::bounds::{within, JOINT_DEG};
+use crate::measure::bounds::{within, EXTERNAL_VALUE, JOINT_DEG};
 use crate::measure::csv_text::{self, Dialect, FieldCount};
+use crate::measure::external::{ExternalAxis, ExternalValues};
 use crate::model::bounds::show;
-use crate::program::export::joint_program;
+use crate::program::export::{labelled_joint_program, LabelledJoints, TrackValue};
 use crate::program::{Language, ProgramFile};
 use serde::{Deserialize, Serialize};
 
@@ -20,6 +21,10 @@ pub struct PlanPoint {
     pub name: String,
     /// Joint values in the controller convention [deg], `q1..qN`.
     pub q_deg: Vec<f64>,
+    /// External-axis values at the pose (a track plan's value [mm]); empty
+    /// for a robot on a fixed base. Written as the CSV's `e1`…`e6` columns.
+    #[serde(skip)]
+    pub external: ExternalValues,
 }
 
 /// Why a plan CSV cannot be read or exported.
@@ -55,6 +60,19 @@ pub enum PlanCsvError {
         /// The value read [deg].
         value: f64,
     },
+    /// An external-axis value is beyond the bound of a controller's value.
+    #[error("the plan CSV, line {line}, column `{column}`: {} is beyond the bound ±{} (mm or deg)", show(*value), EXTERNAL_VALUE.max)]
+    External {
+        /// 1-based line of the record in the text.
+        line: usize,
+        /// The axis's column.
+        column: ExternalAxis,
+        /// The value read.
+        value: f64,
+    },
+    /// URScript programs carry no external axes.
+    #[error("URScript programs carry no external axes; write the plan's CSV or a KRL, RAPID or Fanuc program")]
+    NoExternalAxes,
     /// A point name appears twice; the name.
     #[error("the plan CSV: point `{0}` appears twice")]
     Duplicate(String),
@@ -63,16 +81,34 @@ pub enum PlanCsvError {
     Axes(usize),
 }
 
-/// The joint CSV of `points`: `point,q1..qN`, degrees (point names as
-/// `csv_write` writes every text).
+/// The external-axis columns any of `points` carries, in axis order.
+pub fn plan_axes(points: &[PlanPoint]) -> Vec<ExternalAxis> {
+    ExternalAxis::ALL
+        .into_iter()
+        .filter(|a| points.iter().any(|p| p.external.get(*a).is_some()))
+        .collect()
+}
+
+/// The joint CSV of `points`: `point,q1..qN`, degrees, then the
+/// external-axis columns any point carries (`e1`…, mm or degrees; point
+/// names as `csv_write` writes every text).
 pub fn plan_csv(points: &[PlanPoint]) -> String {
     let n = points.iter().map(|p| p.q_deg.len()).max().unwrap_or(0);
+    let axes = plan_axes(points);
     let mut s = String::new();
-    let header = std::iter::once("point".to_string()).chain((1..=n).map(|i| format!("q{i}")));
+    let header = std::iter::once("point".to_string())
+        .chain((1..=n).map(|i| format!("q{i}")))
+        .chain(axes.iter().map(|a| a.column().to_string()));
     push_header(&mut s, header);
     for p in points {
         let mut row = vec![Cell::text(&p.name)];
         row.extend(p.q_deg.iter().map(|v| Cell::num(*v)));
+        for a in &axes {
+            row.push(match p.external.get(*a) {
+                Some(v) => Cell::num(v),
+                None => Cell::text(""),
+            });
+        }
         push_row(&mut s, &row);
     }
     s
@@ -91,6 +127,10 @@ pub fn read_plan_csv(text: &str) -> Result<Vec<PlanPoint>, PlanCsvError> {
     let (Some(point), false) = (point, joints.is_empty()) else {
         return Err(PlanCsvError::Header(t.header.join(",")));
     };
+    let axes: Vec<(ExternalAxis, usize)> = ExternalAxis::ALL
+        .into_iter()
+        .filter_map(|a| Some((a, names.iter().position(|h| h == a.column())?)))
+        .collect();
     let mut out: Vec<PlanPoint> = Vec::new();
     for r in &t.records {
         t.check_shape(r)?;
@@ -98,16 +138,18 @@ pub fn read_plan_csv(text: &str) -> Result<Vec<PlanPoint>, PlanCsvError> {
         if out.iter().any(|p| p.name == name) {
             return Err(PlanCsvError::Duplicate(name));
         }
+        let number = |c: usize| {
+            t.number(r.fields[c].trim())
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| PlanCsvError::Number {
+                    line: r.line,
+                    field: csv_text::short_text(&r.fields[c]),
+                })
+        };
         let q_deg = joints
             .iter()
             .map(|&c| {
-                let v = t
-                    .number(r.fields[c].trim())
-                    .filter(|v| v.is_finite())
-                    .ok_or_else(|| PlanCsvError::Number {
-                        line: r.line,
-                        field: csv_text::short_text(&r.fields[c]),
-                    })?;
+                let v = number(c)?;
                 if !within(v, &JOINT_DEG) {
                     return Err(PlanCsvError::Joint {
                         line: r.line,
@@ -118,7 +160,23 @@ pub fn read_plan_csv(text: &str) -> Result<Vec<PlanPoint>, PlanCsvError> {
                 Ok(v)
             })
             .collect::<Result<Vec<f64>, _>>()?;
-        out.push(PlanPoint { name, q_deg });
+        let mut external = ExternalValues::default();
+        for &(a, c) in &axes {
+            let v = number(c)?;
+            if !within(v, &EXTERNAL_VALUE) {
+                return Err(PlanCsvError::External {
+                    line: r.line,
+                    column: a,
+                    value: v,
+                });
+            }
+            external.0[a.index()] = Some(v);
+        }
+        out.push(PlanPoint {
+            name,
+            q_deg,
+            external,
+        });
     }
     if out.is_empty() {
         return Err(PlanCsvError::Empty);
@@ -133,12 +191,42 @@ pub fn plan_program(
     name: &str,
     wait_s: f64,
 ) -> Result<Vec<ProgramFile>, PlanCsvError> {
-    let joints = plan
-        .points
-        .iter()
-        .map(|p| {
-            <[f64; 6]>::try_from(p.q_deg.as_slice()).map_err(|_| PlanCsvError::Axes(p.q_deg.len()))
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    Ok(joint_program(language, name, &joints, wait_s))
+    points_program(&plan.points, language, name, wait_s)
+}
+
+/// `points` as a program in `language` named `name`, waiting `wait_s` at
+/// each pose; a point's external-axis value (a track plan's) moves the
+/// track with the robot (KRL `E1`…, RAPID `eax_a`…, Fanuc `E1` in `GP1`, mm).
+pub fn points_program(
+    points: &[PlanPoint],
+    language: Language,
+    name: &str,
+    wait_s: f64,
+) -> Result<Vec<ProgramFile>, PlanCsvError> {
+    let mut targets = Vec::with_capacity(points.len());
+    for (i, p) in points.iter().enumerate() {
+        let joints_deg = <[f64; 6]>::try_from(p.q_deg.as_slice())
+            .map_err(|_| PlanCsvError::Axes(p.q_deg.len()))?;
+        let track = ExternalAxis::ALL.into_iter().find_map(|axis| {
+            Some(TrackValue {
+                axis,
+                value_mm: p.external.get(axis)?,
+            })
+        });
+        if track.is_some() && language == Language::UrScript {
+            return Err(PlanCsvError::NoExternalAxes);
+        }
+        targets.push(LabelledJoints {
+            label: format!("pose {}", i + 1),
+            joints_deg,
+            track,
+        });
+    }
+    let head = format!(
+        "robocal measurement plan: {} poses, a wait of {wait_s} s at each",
+        points.len()
+    );
+    Ok(labelled_joint_program(
+        language, name, &head, &targets, wait_s,
+    ))
 }

@@ -8,6 +8,7 @@ use super::PlanPoint;
 use crate::csv_write::read_text;
 use crate::measure::bounds::{within, POSITION_MM};
 use crate::measure::csv_text::{self, Dialect, FieldCount};
+use crate::measure::external::{ExternalAxis, ExternalValues, MeasurementSet};
 use crate::measure::MeasuredPose;
 use crate::model::bounds::show;
 use serde::{Deserialize, Serialize};
@@ -64,6 +65,23 @@ pub struct Joined {
     pub units: Units,
     /// How the points were matched (never `Detect`).
     pub by: JoinBy,
+    /// The plan's external-axis columns (a track plan's `e1`), carried to
+    /// every row.
+    pub axes: Vec<ExternalAxis>,
+    /// Each row's external-axis values, in the order of `rows`.
+    pub external: Vec<ExternalValues>,
+}
+
+impl Joined {
+    /// The rows as a measurement set with the plan's external-axis columns
+    /// (what `measure::csv::write_set` writes and the track fit reads).
+    pub fn set(&self) -> MeasurementSet {
+        MeasurementSet {
+            poses: self.rows.clone(),
+            external: self.external.clone(),
+            axes: self.axes.clone(),
+        }
+    }
 }
 
 /// Spread of the points [in their own unit] below which they are read as
@@ -297,5 +315,11 @@ pub fn join(plan: &[PlanPoint], text: &str, opts: &JoinOptions) -> Result<Joined
             Ok(MeasuredPose::position_only(p.q_deg.clone(), xyz_mm))
         })
         .collect::<Result<_, _>>()?;
-    Ok(Joined { rows, units, by })
+    Ok(Joined {
+        rows,
+        units,
+        by,
+        axes: super::export::plan_axes(plan),
+        external: plan.iter().map(|p| p.external).collect(),
+    })
 }

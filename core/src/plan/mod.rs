@@ -16,13 +16,18 @@ pub mod join;
 pub mod pose_selection;
 mod predict;
 mod settings;
+pub mod track;
 
-pub use export::{plan_csv, plan_program, read_plan_csv, PlanCsvError, PlanPoint};
+pub use export::{
+    plan_axes, plan_csv, plan_program, points_program, read_plan_csv, PlanCsvError, PlanPoint,
+};
 pub use join::{join, JoinBy, JoinError, JoinOptions, Joined, Units};
 pub use predict::{ParamPrediction, PredictedStd};
 
 pub use settings::{FilterCounts, PlanError, PlanSettings, TrackerSight, WorkspaceBox};
+pub use track::{make_track_plan, PlannedStation, TrackPlan, TrackPlanSettings};
 
+use crate::measure::external::ExternalValues;
 use crate::model::RobotModel;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -86,6 +91,7 @@ pub fn make_plan(model: &RobotModel, s: &PlanSettings) -> Result<MeasurementPlan
                 .into_iter()
                 .map(f64::to_degrees)
                 .collect(),
+            external: ExternalValues::default(),
         })
         .collect();
     Ok(MeasurementPlan {

@@ -60,6 +60,21 @@ pub fn select_d_optimal(
             b.column_mut(c).scale_mut(*s);
         }
     }
+    let (index, blocks): (Vec<usize>, Vec<DMatrix<f64>>) = blocks.into_iter().unzip();
+    greedy_d_optimal(&blocks, n)
+        .into_iter()
+        .map(|k| index[k])
+        .collect()
+}
+
+/// Indices of `n` of `blocks` (each three rows: one reading's position
+/// Jacobian over the same columns) chosen greedily to maximise
+/// `log det(εI + Σ JᵢᵀJᵢ)`, ε = 1e-6, by the determinant lemma and a
+/// Woodbury update of the inverse.
+pub fn greedy_d_optimal(blocks: &[DMatrix<f64>], n: usize) -> Vec<usize> {
+    let Some(p) = blocks.first().map(|b| b.ncols()) else {
+        return Vec::new();
+    };
     let eps = 1e-6;
     let mut a_inv = DMatrix::<f64>::identity(p, p) / eps;
     let mut chosen = Vec::new();
@@ -67,7 +82,7 @@ pub fn select_d_optimal(
     while chosen.len() < n.min(blocks.len()) {
         let mut best = None;
         let mut best_gain = f64::NEG_INFINITY;
-        for (k, (_, b)) in blocks.iter().enumerate() {
+        for (k, b) in blocks.iter().enumerate() {
             if used[k] {
                 continue;
             }
@@ -83,9 +98,9 @@ pub fn select_d_optimal(
         }
         let Some(k) = best else { break };
         used[k] = true;
-        chosen.push(blocks[k].0);
+        chosen.push(k);
         // Woodbury: (A + BᵀB)⁻¹ = A⁻¹ − A⁻¹Bᵀ (I + B A⁻¹ Bᵀ)⁻¹ B A⁻¹.
-        let b = &blocks[k].1;
+        let b = &blocks[k];
         let ab = &a_inv * b.transpose();
         let mut s = b * &ab;
         for i in 0..s.nrows() {

@@ -84,6 +84,17 @@ pub enum PlanError {
         /// Poses asked.
         needed: usize,
     },
+    /// Fewer candidates than poses asked are in the tracker's sight from a
+    /// track's station.
+    #[error("only {in_sight} candidates are in the tracker's sight from the station at {value_mm} mm, {needed} poses asked; draw more candidates, widen the angle or move the tracker")]
+    StationSight {
+        /// The station's track value [mm].
+        value_mm: f64,
+        /// Candidates in sight there.
+        in_sight: usize,
+        /// Poses asked per station.
+        needed: usize,
+    },
     /// The chosen poses leave the parameters unidentifiable; the reason.
     #[error("the chosen poses identify too little: {0}")]
     Unidentifiable(String),

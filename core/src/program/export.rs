@@ -4,6 +4,7 @@
 //! ([`super::Program::joints`]).
 
 use super::{Language, ProgramFile};
+use crate::measure::external::ExternalAxis;
 use std::fmt::Write as _;
 
 /// A program `name` moving to each of `joints_deg` (6 axes) and waiting
@@ -22,6 +23,7 @@ pub fn joint_program(
         .map(|(i, q)| LabelledJoints {
             label: format!("pose {}", i + 1),
             joints_deg: *q,
+            track: None,
         })
         .collect();
     labelled_joint_program(language, name, &head, &targets, wait_s)
@@ -34,6 +36,18 @@ pub struct LabelledJoints {
     pub label: String,
     /// Controller convention [deg].
     pub joints_deg: [f64; 6],
+    /// The track's value the robot stands at (a track plan's), if any.
+    pub track: Option<TrackValue>,
+}
+
+/// A linear track's value at a joint target: its controller axis (`e1` is
+/// KRL's `E1`, RAPID's `eax_a`, Fanuc's `E1` in `GP1`) and value [mm].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrackValue {
+    /// The track's axis.
+    pub axis: ExternalAxis,
+    /// Its value [mm].
+    pub value_mm: f64,
 }
 
 /// A program `name` headed by the comment `head`, moving to each target and
@@ -52,12 +66,15 @@ pub fn labelled_joint_program(
         Language::Krl => {
             let _ = write!(s, "&ACCESS RVP\r\nDEF {name}()\r\n; {head}\r\n");
             for t in targets {
-                let axes: Vec<String> = t
+                let mut axes: Vec<String> = t
                     .joints_deg
                     .iter()
                     .enumerate()
                     .map(|(k, v)| format!("A{} {v:.4}", k + 1))
                     .collect();
+                if let Some(e) = t.track {
+                    axes.push(format!("E{} {:.3}", e.axis.index() + 1, e.value_mm));
+                }
                 let _ = write!(
                     s,
                     "PTP {{{}}} ; {}\r\nWAIT SEC {wait_s}\r\n",
@@ -71,10 +88,22 @@ pub fn labelled_joint_program(
         Language::Rapid => {
             let _ = write!(s, "MODULE {name}\r\n  ! {head}\r\n  PROC main()\r\n");
             for t in targets {
+                let mut eax = [
+                    "9E+09".to_string(),
+                    "9E+09".into(),
+                    "9E+09".into(),
+                    "9E+09".into(),
+                    "9E+09".into(),
+                    "9E+09".into(),
+                ];
+                if let Some(e) = t.track {
+                    eax[e.axis.index()] = format!("{:.3}", e.value_mm);
+                }
                 let _ = write!(
                     s,
-                    "    MoveAbsJ [[{}],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]], v100, fine, tool0; ! {}\r\n    WaitTime {wait_s};\r\n",
+                    "    MoveAbsJ [[{}],[{}]], v100, fine, tool0; ! {}\r\n    WaitTime {wait_s};\r\n",
                     list(&t.joints_deg, &|v| format!("{v:.4}")),
+                    eax.join(","),
                     t.label
                 );
             }
@@ -104,9 +133,13 @@ pub fn labelled_joint_program(
                 let _ = write!(s, "P[{}]{{\r\n   GP1:\r\n\tUF : 0, UT : 0,\r\n", i + 1);
                 let _ = write!(
                     s,
-                    "\tJ1= {:.4} deg,\tJ2= {:.4} deg,\tJ3= {:.4} deg,\r\n\tJ4= {:.4} deg,\tJ5= {:.4} deg,\tJ6= {:.4} deg\r\n}};\r\n",
+                    "\tJ1= {:.4} deg,\tJ2= {:.4} deg,\tJ3= {:.4} deg,\r\n\tJ4= {:.4} deg,\tJ5= {:.4} deg,\tJ6= {:.4} deg",
                     q[0], q[1], q[2], q[3], q[4], q[5]
                 );
+                if let Some(e) = t.track {
+                    let _ = write!(s, ",\r\n\tE{}= {:.3} mm", e.axis.index() + 1, e.value_mm);
+                }
+                s.push_str("\r\n};\r\n");
             }
             s.push_str("/END\r\n");
             vec![file(format!("{upper}.LS"), s)]
@@ -157,6 +190,46 @@ mod tests {
             for (g, w) in got.iter().zip(&joints) {
                 for (a, b) in g.iter().zip(w) {
                     assert!((a - b).abs() < 1e-5, "{language:?}: {g:?} vs {w:?}");
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod track_tests {
+    use super::super::parse;
+    use super::*;
+
+    /// A track plan's joint programs carry the track's value with each
+    /// pose and parse back to the same joints.
+    #[test]
+    fn track_values_ride_with_the_joints() {
+        let targets: Vec<LabelledJoints> = [(0.0, 0.0), (-35.25, 1234.5678)]
+            .iter()
+            .map(|&(a1, e)| LabelledJoints {
+                label: format!("at {e}"),
+                joints_deg: [a1, 90.0, -20.0, 0.0, 45.0, 0.0],
+                track: Some(TrackValue {
+                    axis: ExternalAxis::E1,
+                    value_mm: e,
+                }),
+            })
+            .collect();
+        for (language, written) in [
+            (Language::Krl, "E1 1234.568}"),
+            (Language::Rapid, "[1234.568,9E+09,9E+09,9E+09,9E+09,9E+09]]"),
+            (Language::Fanuc, "E1= 1234.568 mm\r\n};"),
+        ] {
+            let files = labelled_joint_program(language, "plan", "head", &targets, 1.0);
+            let text: String = files.iter().map(|f| f.text.as_str()).collect();
+            assert!(text.contains(written), "{language:?}: {text}");
+            let p = parse(language, &files).unwrap();
+            let got: Vec<Vec<f64>> = p.joints.iter().map(|j| j.deg.clone()).collect();
+            assert_eq!(got.len(), 2, "{language:?}");
+            for (g, t) in got.iter().zip(&targets) {
+                for (a, b) in g.iter().zip(&t.joints_deg) {
+                    assert!((a - b).abs() < 1e-9, "{language:?}: {g:?}");
                 }
             }
         }

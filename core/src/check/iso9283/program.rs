@@ -32,6 +32,7 @@ pub fn cycle_program(
             joints.iter().map(move |(pose, q)| LabelledJoints {
                 label: format!("{pose} cycle {k}"),
                 joints_deg: *q,
+                track: None,
             })
         })
         .collect();
