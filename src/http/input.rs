@@ -11,6 +11,7 @@
 //!   ([`Page`]).
 
 use super::ApiError;
+use crate::measure::external::ExternalAxis;
 use crate::service::limits::{PAGE_DEFAULT, PAYLOAD_MAX_KG};
 use serde::de::{DeserializeOwned, Deserializer, MapAccess, Visitor};
 use serde::Deserialize;
@@ -314,6 +315,26 @@ pub fn page_body<T: serde::Serialize>(
     let mut out = page_fields(page, total);
     out[key] = serde_json::to_value(items).map_err(|e| ApiError::Internal(e.to_string()))?;
     Ok(out)
+}
+
+/// An `e1` … `e6` column of field `field`, `default` when left out (422
+/// naming the field otherwise).
+pub fn external_axis(
+    field: &str,
+    given: Option<&str>,
+    default: ExternalAxis,
+) -> Result<ExternalAxis, ApiError> {
+    match given {
+        None => Ok(default),
+        Some(c) => ExternalAxis::ALL
+            .into_iter()
+            .find(|a| a.column() == c)
+            .ok_or_else(|| {
+                ApiError::invalid(format!(
+                    "`{field}`: `{c}`; give an external-axis column, e1 … e6"
+                ))
+            }),
+    }
 }
 
 #[cfg(test)]

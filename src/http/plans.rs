@@ -3,17 +3,23 @@
 //! workspace box and the tracker's line of sight, with the parameter standard
 //! deviations they predict for the tracker noise; the joints as a CSV and,
 //! when `language` is given, as a program visiting them with a wait at each.
-//! The same as `robocal plan`.
+//! The same as `robocal plan`; with `track` (a linear track's JSON
+//! description) the same as `robocal plan --track`: `poses` per station at
+//! stations over its travel, each pose with the track's value.
 
-use super::input::present_int;
+use super::input::{external_axis, present_int};
 use super::programs::FileIn;
 use super::{ApiError, ApiJson, ApiPath, AppState};
+use crate::measure::external::ExternalAxis;
+use crate::model::external::LinearTrack;
 use crate::plan::{
-    FilterCounts, PlanPoint, PlanSettings, PredictedStd, TrackerSight, WorkspaceBox,
+    stations_over, FilterCounts, PlanPoint, PlanSettings, PlannedStation, PredictedStd,
+    TrackerSight, WorkspaceBox,
 };
 use crate::program::Language;
 use crate::service;
 use crate::service::plans::PlanCommand;
+use crate::service::plans::{OverTrack, PlanMade};
 use axum::extract::State;
 use axum::response::{IntoResponse, Response};
 use serde::{Deserialize, Serialize};
@@ -24,6 +30,8 @@ pub const PLAN_POSES_MAX: usize = 300;
 pub const PLAN_CANDIDATES_MAX: usize = 5000;
 /// Longest wait at a pose [s].
 pub const WAIT_MAX_S: f64 = 3600.0;
+/// Most stations of a plan over a track.
+pub const STATIONS_MAX: usize = 100;
 
 /// A box for the TCP, base frame [mm].
 #[derive(Debug, Deserialize)]
@@ -39,7 +47,7 @@ pub struct BoxIn {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TrackerIn {
-    /// The tracker's position in the base frame [mm].
+    /// The tracker's position in the base frame (with `track`, the cell frame) [mm].
     pub position_mm: [f64; 3],
     /// The reflector's axis in the tool frame (default: z).
     #[serde(default)]
@@ -52,9 +60,22 @@ pub struct TrackerIn {
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PlanRequest {
-    /// Poses to choose, 1 to [`PLAN_POSES_MAX`]; absent: 50.
+    /// Poses to choose, 1 to [`PLAN_POSES_MAX`]; absent: 50. With `track`,
+    /// per station, at least 3; absent: 4.
     #[serde(default, deserialize_with = "present_int")]
     pub poses: Option<usize>,
+    /// A linear track carrying the robot, its JSON description (as `robocal
+    /// track calibrate --out` writes it): plan over its stations.
+    pub track: Option<serde_json::Value>,
+    /// Stations over the track's travel, 5 to [`STATIONS_MAX`]; absent: one
+    /// every 400 mm (needs `track`).
+    #[serde(default, deserialize_with = "present_int")]
+    pub stations: Option<usize>,
+    /// The stations' lowest and highest value [mm]; absent: the track's
+    /// travel (needs `track`).
+    pub travel_mm: Option<[f64; 2]>,
+    /// The track's column, `e1` … `e6`; absent: `e1` (needs `track`).
+    pub column: Option<String>,
     /// Random configurations drawn, from `poses` to [`PLAN_CANDIDATES_MAX`]; absent: 1000 (or
     /// `poses` when more).
     #[serde(default, deserialize_with = "present_int")]
@@ -99,11 +120,22 @@ pub struct PlanResponse {
     pub counts: FilterCounts,
     /// The tracker noise the prediction used, standard deviation per axis [mm].
     pub noise_mm: f64,
-    /// The payload mass the plan used [kg].
-    pub payload_kg: f64,
-    /// Per method, the parameter standard deviations the poses predict.
-    pub predicted: Vec<PredictedStd>,
-    /// The chosen poses: point names and controller joints [deg].
+    /// The payload mass the plan used [kg] (a plan on a fixed base).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub payload_kg: Option<f64>,
+    /// Per method, the parameter standard deviations the poses predict (a
+    /// plan on a fixed base).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub predicted: Option<Vec<PredictedStd>>,
+    /// The track's column (a plan over a track).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub column: Option<String>,
+    /// Per station its value, points and predicted σ of the base's pose (a
+    /// plan over a track).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stations: Option<Vec<PlannedStation>>,
+    /// The chosen poses: point names, controller joints [deg] and, over a
+    /// track, `external: {"e1": mm}`.
     pub points: Vec<PlanPoint>,
     /// The chosen poses' joints as a CSV.
     pub joints_csv: String,
@@ -121,15 +153,52 @@ fn finite3(what: &str, v: &[f64; 3]) -> Result<(), ApiError> {
     }
 }
 
+/// The track of a plan over one (422 naming what is wrong): its
+/// description, stations, travel and column, within the request's limits.
+fn over_track(req: &PlanRequest, poses: usize) -> Result<Option<OverTrack>, ApiError> {
+    let Some(description) = &req.track else {
+        if req.stations.is_some() || req.travel_mm.is_some() || req.column.is_some() {
+            return Err(ApiError::invalid(
+                "`stations`, `travel_mm` and `column` lay out a plan over a track: give `track` too",
+            ));
+        }
+        return Ok(None);
+    };
+    let track = LinearTrack::from_json(&description.to_string())
+        .map_err(|e| ApiError::invalid(format!("`track`: {e}")))?;
+    let axis = external_axis("column", req.column.as_deref(), ExternalAxis::E1)?;
+    let over = OverTrack {
+        track,
+        stations: req.stations,
+        axis,
+        travel_mm: req.travel_mm,
+    };
+    let settings = over.settings(&PlanSettings {
+        poses,
+        ..PlanSettings::default()
+    });
+    let (_, stations) =
+        stations_over(&over.track, &settings).map_err(|e| ApiError::invalid(e.to_string()))?;
+    if stations > STATIONS_MAX || stations * poses > PLAN_POSES_MAX {
+        return Err(ApiError::invalid(format!(
+            "{stations} stations of {poses} poses: at most {STATIONS_MAX} stations and {PLAN_POSES_MAX} poses in all in one request; give fewer `stations` or `poses`, or use `robocal plan --track`"
+        )));
+    }
+    Ok(Some(over))
+}
+
 /// The request as a service command (422 naming what is wrong).
 fn command(robot_id: i64, req: PlanRequest) -> Result<PlanCommand, ApiError> {
     let d = PlanSettings::default();
-    let poses = req.poses.unwrap_or(d.poses);
+    let poses = req
+        .poses
+        .unwrap_or(if req.track.is_some() { 4 } else { d.poses });
     if !(1..=PLAN_POSES_MAX).contains(&poses) {
         return Err(ApiError::invalid(format!(
             "`poses`: 1 to {PLAN_POSES_MAX}, got {poses}"
         )));
     }
+    let over_track = over_track(&req, poses)?;
     let candidates = req.candidates.unwrap_or(d.candidates.max(poses));
     if !(poses..=PLAN_CANDIDATES_MAX).contains(&candidates) {
         return Err(ApiError::invalid(format!(
@@ -232,6 +301,7 @@ fn command(robot_id: i64, req: PlanRequest) -> Result<PlanCommand, ApiError> {
             ..d
         },
         program,
+        over_track,
     })
 }
 
@@ -245,14 +315,30 @@ pub async fn plan(
     let cmd = command(robot_id, req)?;
     let language = cmd.program.as_ref().map(|p| p.0);
     let done = service::plans::make(&state, cmd).await?;
+    let (counts, noise_mm) = match &done.plan {
+        PlanMade::FixedBase(p) => (p.counts, p.noise_mm),
+        PlanMade::Track(p) => (p.counts, p.noise_mm),
+    };
+    let (payload_kg, predicted, column, stations, points) = match done.plan {
+        PlanMade::FixedBase(p) => (Some(p.payload_kg), Some(p.predicted), None, None, p.points),
+        PlanMade::Track(p) => (
+            None,
+            None,
+            Some(p.axis.column().into()),
+            Some(p.stations),
+            p.points,
+        ),
+    };
     Ok(axum::Json(PlanResponse {
         robot_id,
-        poses: done.plan.points.len(),
-        counts: done.plan.counts,
-        noise_mm: done.plan.noise_mm,
-        payload_kg: done.plan.payload_kg,
-        predicted: done.plan.predicted,
-        points: done.plan.points,
+        poses: points.len(),
+        counts,
+        noise_mm,
+        payload_kg,
+        predicted,
+        column,
+        stations,
+        points,
         joints_csv: done.joints_csv,
         program: done.program.zip(language).map(|(files, l)| ProgramOut {
             language: l,

@@ -13,7 +13,7 @@
 //! (tilt) and `e2` (rotate) columns is solved through it
 //! (`service::positioners::place_rows`).
 
-use super::input::present;
+use super::input::{external_axis, present};
 use super::{ApiError, ApiJson, ApiPath, AppState};
 use crate::records::PositionerRow;
 use crate::service;
@@ -127,21 +127,6 @@ struct FittedOut {
     validation: Option<HeldOut>,
 }
 
-/// An `e1` … `e6` column of field `field`, `default` when left out.
-fn axis(field: &str, given: Option<&str>, default: ExternalAxis) -> Result<ExternalAxis, ApiError> {
-    match given {
-        None => Ok(default),
-        Some(c) => ExternalAxis::ALL
-            .into_iter()
-            .find(|a| a.column() == c)
-            .ok_or_else(|| {
-                ApiError::invalid(format!(
-                    "`{field}`: `{c}`; give an external-axis column, e1 … e6"
-                ))
-            }),
-    }
-}
-
 fn calibration(id: i64, body: PositionerCalibrateIn) -> Result<PositionerCalibration, ApiError> {
     let n = body.sets.len();
     if n == 0 || n > POSITIONER_REFLECTORS_MAX {
@@ -178,8 +163,8 @@ fn calibration(id: i64, body: PositionerCalibrateIn) -> Result<PositionerCalibra
     let nominal = TiltRotate::from_json(&body.nominal.to_string())
         .map_err(|e| ApiError::invalid(format!("`nominal`: {e}")))?;
     let columns = PositionerColumns {
-        tilt: axis("tilt_column", body.tilt_column.as_deref(), ExternalAxis::E1)?,
-        rotate: axis(
+        tilt: external_axis("tilt_column", body.tilt_column.as_deref(), ExternalAxis::E1)?,
+        rotate: external_axis(
             "rotate_column",
             body.rotate_column.as_deref(),
             ExternalAxis::E2,

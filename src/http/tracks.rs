@@ -10,7 +10,7 @@
 //! Predictions and solves take `e1` [mm] to carry the robot along it
 //! (`service::tracks::carry`).
 
-use super::input::{check_payload, present, Int};
+use super::input::{check_payload, external_axis, present, Int};
 use super::{ApiError, ApiJson, ApiPath, AppState};
 use crate::records::TrackRow;
 use crate::service;
@@ -119,15 +119,7 @@ struct FittedOut {
 }
 
 fn calibration(id: i64, body: TrackCalibrateIn) -> Result<TrackCalibration, ApiError> {
-    let column = match body.column.as_deref() {
-        None => ExternalAxis::E1,
-        Some(c) => ExternalAxis::ALL
-            .into_iter()
-            .find(|a| a.column() == c)
-            .ok_or_else(|| {
-                ApiError::invalid(format!("`column`: `{c}`; give the track's column, e1 … e6"))
-            })?,
-    };
+    let column = external_axis("column", body.column.as_deref(), ExternalAxis::E1)?;
     let sigma_mm = body.sigma_mm.unwrap_or(DEFAULT_SIGMA_MM);
     if !(sigma_mm.is_finite() && sigma_mm > 0.0 && sigma_mm <= SIGMA_MAX_MM) {
         return Err(ApiError::invalid(format!(

@@ -2,12 +2,19 @@
 //! identifiability on the robot's nominal model within its joint limits, a
 //! workspace box and the tracker's line of sight, with the parameter standard
 //! deviations they predict, as a joint CSV and optionally a program.
+//! Over a linear track (`core::plan::track`), the poses are laid out at
+//! stations over its travel, D-optimal for each station's base pose.
 //! CPU-bound (forward kinematics of every candidate, a greedy D-optimal
 //! choice): runs on the solve workers behind their admission control.
 
 use super::solve::{chosen_model, ModelChoice};
 use super::{AppState, ServiceError};
-use crate::plan::{make_plan, plan_csv, plan_program, MeasurementPlan, PlanSettings};
+use crate::measure::external::ExternalAxis;
+use crate::model::external::LinearTrack;
+use crate::plan::{
+    make_plan, make_track_plan, plan_csv, points_program, MeasurementPlan, PlanPoint, PlanSettings,
+    TrackPlan, TrackPlanSettings,
+};
 use crate::program::{Language, ProgramFile};
 
 /// Most work a plan request may ask (module docs of [`make`]).
@@ -23,14 +30,61 @@ pub struct PlanCommand {
     /// Also write the plan as a program in this language, named `name`,
     /// waiting `wait_s` at each pose.
     pub program: Option<(Language, String, f64)>,
+    /// Plan over this track's stations (`settings.poses` per station, the
+    /// tracker in the cell frame) instead of a fixed base.
+    pub over_track: Option<OverTrack>,
+}
+
+/// A plan over a linear track: the track and its stations.
+#[derive(Debug, Clone)]
+pub struct OverTrack {
+    /// The track carrying the robot (nominal or calibrated).
+    pub track: LinearTrack,
+    /// Stations over the travel (default: one every 400 mm).
+    pub stations: Option<usize>,
+    /// The track's column.
+    pub axis: ExternalAxis,
+    /// The stations' lowest and highest value [mm] (default: the travel).
+    pub travel_mm: Option<[f64; 2]>,
+}
+
+impl OverTrack {
+    /// The core's settings with `poses` per station.
+    pub fn settings(&self, poses: &PlanSettings) -> TrackPlanSettings {
+        TrackPlanSettings {
+            stations: self.stations,
+            axis: self.axis,
+            travel_mm: self.travel_mm,
+            poses: poses.clone(),
+        }
+    }
+}
+
+/// The plan made: on a fixed base, or over a track's stations.
+#[derive(Debug)]
+pub enum PlanMade {
+    /// Poses for the robot's calibration, with predicted parameter σ.
+    FixedBase(MeasurementPlan),
+    /// Poses at a track's stations, with each station's predicted σ.
+    Track(TrackPlan),
+}
+
+impl PlanMade {
+    /// The chosen poses.
+    pub fn points(&self) -> &[PlanPoint] {
+        match self {
+            PlanMade::FixedBase(p) => &p.points,
+            PlanMade::Track(p) => &p.points,
+        }
+    }
 }
 
 /// What a plan request produced.
 #[derive(Debug)]
 pub struct PlanOutcome {
-    /// The chosen poses, their filter counts and predicted standard deviations.
-    pub plan: MeasurementPlan,
-    /// `point,q1..qN` in controller degrees.
+    /// The chosen poses and what they predict.
+    pub plan: PlanMade,
+    /// `point,q1..qN` in controller degrees (then a track's column).
     pub joints_csv: String,
     /// The program's files, when a language was given.
     pub program: Option<Vec<ProgramFile>>,
@@ -47,7 +101,9 @@ pub async fn make(state: &AppState, cmd: PlanCommand) -> Result<PlanOutcome, Ser
     // for many seconds.
     let p = (4 * nominal.dof() + 6) as f64;
     let work = cmd.settings.candidates as f64 * cmd.settings.poses as f64 * p * p;
-    if work > PLAN_WORK_MAX {
+    // Over a track the D-optimal choice is over 6 columns per station: the
+    // candidates' forward kinematics dominate, bounded by `candidates`.
+    if cmd.over_track.is_none() && work > PLAN_WORK_MAX {
         return Err(ServiceError::Invalid(format!(
             "a plan of {} poses among {} candidates of a {}-joint robot is too much work for one request (candidates × poses × (4·joints + 6)² is {work:.1e}, at most {PLAN_WORK_MAX:.0e}); ask fewer candidates or poses, or use `robocal plan`",
             cmd.settings.poses,
@@ -56,17 +112,24 @@ pub async fn make(state: &AppState, cmd: PlanCommand) -> Result<PlanOutcome, Ser
         )));
     }
     super::heavy::run(state, "plan", move |_| {
-        let plan =
-            make_plan(&nominal, &cmd.settings).map_err(|e| ServiceError::Invalid(e.to_string()))?;
+        let invalid = |e: &dyn std::fmt::Display| ServiceError::Invalid(e.to_string());
+        let plan = match &cmd.over_track {
+            None => {
+                PlanMade::FixedBase(make_plan(&nominal, &cmd.settings).map_err(|e| invalid(&e))?)
+            }
+            Some(t) => PlanMade::Track(
+                make_track_plan(&nominal, &t.track, &t.settings(&cmd.settings))
+                    .map_err(|e| invalid(&e))?,
+            ),
+        };
         let program = match &cmd.program {
             Some((language, name, wait_s)) => Some(
-                plan_program(&plan, *language, name, *wait_s)
-                    .map_err(|e| ServiceError::Invalid(e.to_string()))?,
+                points_program(plan.points(), *language, name, *wait_s).map_err(|e| invalid(&e))?,
             ),
             None => None,
         };
         Ok(PlanOutcome {
-            joints_csv: plan_csv(&plan.points),
+            joints_csv: plan_csv(plan.points()),
             plan,
             program,
         })

@@ -128,3 +128,127 @@ async fn plan_requests_that_cannot_be_met_say_why() {
     let r = t.post_json(PLANS, &["999999"], json!({})).await;
     assert_eq!(r.status, StatusCode::NOT_FOUND);
 }
+
+/// A plan over a track over HTTP is `robocal plan --track` on the same
+/// track file: the joints CSV and the program byte for byte, the points
+/// with their track values and the stations' σ the library's; requests the
+/// track cannot carry are 422s naming why.
+#[tokio::test]
+async fn a_plan_over_a_track_is_the_command_lines() {
+    use clap::Parser;
+    use robocal::plan::{make_track_plan, TrackPlanSettings};
+    let t = setup().await;
+    let rid = t.create_robot("ys100").await.to_string();
+    let drawing = robocal::sim::track::TrueTrack::drawing_4m();
+    let track: serde_json::Value = serde_json::from_str(&drawing.to_json()).unwrap();
+    let body = json!({
+        "track": track,
+        "stations": 6,
+        "travel_mm": [500, 3500],
+        "tracker": { "position_mm": [0, 0, 0], "max_angle_deg": 60 },
+        "seed": 7,
+        "language": "rapid",
+        "name": "rail_plan",
+    });
+    let r = t.post_json(PLANS, &[&rid], body).await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let v = r.json();
+    assert_eq!(v["poses"], 24);
+    assert_eq!(v["column"], "e1");
+    assert!(
+        v.get("predicted").is_none() && v.get("payload_kg").is_none(),
+        "{v}"
+    );
+    // The command line on the same track file.
+    let d = tempfile::tempdir().unwrap();
+    let file = |n: &str| d.path().join(n).to_str().unwrap().to_string();
+    std::fs::write(file("rail.json"), drawing.to_json()).unwrap();
+    let argv = [
+        "robocal",
+        "plan",
+        "--model",
+        "ys100",
+        "--track",
+        &file("rail.json"),
+        "--stations",
+        "6",
+        "--travel",
+        "500,3500",
+        "--tracker",
+        "0,0,0",
+        "--seed",
+        "7",
+        "--format",
+        "rapid",
+        "--name",
+        "rail_plan",
+        "--wait-s",
+        "1",
+        "--out",
+        &file("plan.mod"),
+        "--csv",
+        &file("plan.csv"),
+    ];
+    let robocal::cli::Command::Plan(a) = robocal::cli::Cli::try_parse_from(argv).unwrap().command
+    else {
+        panic!("not a plan")
+    };
+    robocal::cli::plan::make(&a.make).unwrap();
+    let read = |n: &str| std::fs::read_to_string(file(n)).unwrap();
+    assert_eq!(v["joints_csv"].as_str().unwrap(), read("plan.csv"));
+    assert_eq!(v["program"]["files"][0]["name"], "rail_plan.mod");
+    assert_eq!(
+        v["program"]["files"][0]["content"].as_str().unwrap(),
+        read("plan.mod")
+    );
+    // The library's plan: points with their values, the stations' σ.
+    let want = make_track_plan(
+        &preset("ys100").unwrap(),
+        &drawing,
+        &TrackPlanSettings {
+            stations: Some(6),
+            travel_mm: Some([500.0, 3500.0]),
+            poses: PlanSettings {
+                poses: 4,
+                tracker: Some(TrackerSight {
+                    position_mm: [0.0; 3],
+                    ..TrackerSight::default()
+                }),
+                seed: 7,
+                ..PlanSettings::default()
+            },
+            ..TrackPlanSettings::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(serde_json::to_value(&want.points).unwrap(), v["points"]);
+    assert_eq!(v["points"][4]["external"], json!({ "e1": 1100.0 }));
+    assert_eq!(serde_json::to_value(&want.stations).unwrap(), v["stations"]);
+    // Refused, naming why.
+    for (body, words) in [
+        (json!({ "stations": 8 }), "give `track` too"),
+        (json!({ "track": { "direction": [1, 0, 0] } }), "`track`"),
+        (
+            json!({ "track": track, "stations": 4 }),
+            "at least 5 stations",
+        ),
+        (json!({ "track": track, "poses": 2 }), "at least 3 poses"),
+        (
+            json!({ "track": track, "travel_mm": [0, 5000] }),
+            "beyond the track model's",
+        ),
+        (
+            json!({ "track": track, "stations": 80 }),
+            "at most 100 stations and 300 poses",
+        ),
+        (json!({ "track": track, "column": "e9" }), "`column`"),
+        (
+            json!({ "track": track, "language": "urscript" }),
+            "no external axes",
+        ),
+    ] {
+        let r = t.post_json(PLANS, &[&rid], body.clone()).await;
+        assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{body}");
+        assert!(r.text().contains(words), "{body}: {}", r.text());
+    }
+}

@@ -22,9 +22,26 @@ pub struct PlanPoint {
     /// Joint values in the controller convention [deg], `q1..qN`.
     pub q_deg: Vec<f64>,
     /// External-axis values at the pose (a track plan's value [mm]); empty
-    /// for a robot on a fixed base. Written as the CSV's `e1`…`e6` columns.
-    #[serde(skip)]
+    /// for a robot on a fixed base. Written as the CSV's `e1`…`e6` columns
+    /// and in JSON as `external: {"e1": …}` (left out when empty).
+    #[serde(
+        skip_deserializing,
+        skip_serializing_if = "ExternalValues::is_empty",
+        serialize_with = "external_by_column"
+    )]
     pub external: ExternalValues,
+}
+
+/// `{"e1": value, …}` of the axes `v` carries.
+fn external_by_column<S: serde::Serializer>(v: &ExternalValues, s: S) -> Result<S::Ok, S::Error> {
+    use serde::ser::SerializeMap;
+    let mut m = s.serialize_map(None)?;
+    for a in ExternalAxis::ALL {
+        if let Some(x) = v.get(a) {
+            m.serialize_entry(a.column(), &x)?;
+        }
+    }
+    m.end()
 }
 
 /// Why a plan CSV cannot be read or exported.

@@ -25,7 +25,7 @@ pub use join::{join, JoinBy, JoinError, JoinOptions, Joined, Units};
 pub use predict::{ParamPrediction, PredictedStd};
 
 pub use settings::{FilterCounts, PlanError, PlanSettings, TrackerSight, WorkspaceBox};
-pub use track::{make_track_plan, PlannedStation, TrackPlan, TrackPlanSettings};
+pub use track::{make_track_plan, stations_over, PlannedStation, TrackPlan, TrackPlanSettings};
 
 use crate::measure::external::ExternalValues;
 use crate::model::RobotModel;

@@ -148,8 +148,12 @@ fn predicted_sigma(blocks: &[&DMatrix<f64>], noise_mm: f64) -> Option<(f64, [f64
     Some((s * position * 1e3, [turn(0), turn(1), turn(2)]))
 }
 
-/// The travel planned over and the number of stations.
-fn check(track: &LinearTrack, s: &TrackPlanSettings) -> Result<([f64; 2], usize), PlanError> {
+/// The travel planned over and the number of stations, or why `s` cannot
+/// be planned on `track`.
+pub fn stations_over(
+    track: &LinearTrack,
+    s: &TrackPlanSettings,
+) -> Result<([f64; 2], usize), PlanError> {
     if let Some(n) = s.stations.filter(|n| *n < MIN_STATIONS) {
         return Err(PlanError::Setting(format!(
             "at least {MIN_STATIONS} stations (the track fit needs them), got {n}"
@@ -190,7 +194,7 @@ pub fn make_track_plan(
     track: &LinearTrack,
     s: &TrackPlanSettings,
 ) -> Result<TrackPlan, PlanError> {
-    let ([lo, hi], count) = check(track, s)?;
+    let ([lo, hi], count) = stations_over(track, s)?;
     let pool_settings = PlanSettings {
         tracker: None,
         ..s.poses.clone()
