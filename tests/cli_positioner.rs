@@ -34,6 +34,8 @@ use std::process::Output;
 mod beside_track;
 #[path = "cli_positioner/held.rs"]
 mod held;
+#[path = "cli_positioner/planned.rs"]
+mod planned;
 
 const COLUMNS: PositionerColumns = PositionerColumns {
     tilt: ExternalAxis::E1,

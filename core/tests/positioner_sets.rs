@@ -139,3 +139,117 @@ fn the_positioner_fit_reads_measurement_sets_by_their_columns() {
         .to_string()
         .contains("`e1`"));
 }
+
+/// Standard deviation of `v` about its mean.
+fn spread_of(v: &[f64]) -> f64 {
+    let m = v.iter().sum::<f64>() / v.len() as f64;
+    (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() - 1) as f64).sqrt()
+}
+
+/// A positioner's plan (`plan::make_positioner_plan`: the two sweeps, every
+/// reflector at every value) through its files: the plan's CSV (`point,e1,e2`,
+/// no joints), one tracker export per reflector joined back into a
+/// measurement file with its `e1`, `e2` columns, read by the columns' roles
+/// and fitted; over 30 seeds of the truth without its nod (noise alone) the
+/// fitted zero offsets, scales and axis directions scatter as the plan
+/// predicted (within 2×, as the robot's plans are held).
+#[test]
+fn a_planned_positioner_measurement_scatters_as_predicted() {
+    use robocal_core::plan::{
+        join, make_positioner_plan, plan_csv, read_plan_csv, JoinOptions, PositionerPlanSettings,
+    };
+    use robocal_core::sim::positioner_example as example;
+    let nominal = example::nominal();
+    let plan = make_positioner_plan(
+        &nominal,
+        &PositionerPlanSettings {
+            reflectors_mm: example::DESIGN_MM.to_vec(),
+            ..PositionerPlanSettings::default()
+        },
+    )
+    .unwrap();
+    let text = plan_csv(&plan.points);
+    assert!(text.starts_with("point,e1,e2\nP1,0,-165\n"), "{text}");
+    let points = read_plan_csv(&text).unwrap();
+    assert_eq!(points, plan.points);
+    let truth = example::truth(0.0);
+    let columns = PositionerColumns {
+        tilt: ExternalAxis::E1,
+        rotate: ExternalAxis::E2,
+    };
+    let u1n = nominal.tilt.direction;
+    let mut got: [Vec<f64>; 6] = Default::default();
+    let mut directions = Vec::new();
+    for seed in 1..=30u64 {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let mut readings = Vec::new();
+        for k in 0..example::DESIGN_MM.len() {
+            let at: Vec<(usize, [f64; 2])> = plan.values_deg.iter().map(|v| (k, *v)).collect();
+            let mut export = String::from("name,x,y,z\n");
+            for (p, r) in points.iter().zip(truth.read(&at, &mut rng)) {
+                let [x, y, z] = r.xyz_mm;
+                export.push_str(&format!("{},{x},{y},{z}\n", p.name));
+            }
+            let joined = join(&points, &export, &JoinOptions::default()).unwrap();
+            let file = csv::write_set(&joined.set());
+            assert!(file.starts_with("e1,e2,x,y,z\n"), "{file}");
+            readings
+                .extend(positioner_readings(&csv::parse_set(&file).unwrap(), columns, k).unwrap());
+        }
+        let fit = fit_positioner(&PositionerFitRequest {
+            nominal,
+            reflectors_mm: example::DESIGN_MM.to_vec(),
+            readings,
+            tracker_sigma_mm: example::TRACKER_SIGMA_MM,
+        })
+        .unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+        let m = &fit.model;
+        got[0].push(m.tilt.zero_offset.to_degrees());
+        got[1].push(m.rotate.zero_offset.to_degrees());
+        got[2].push(m.tilt.scale);
+        got[3].push(m.rotate.scale);
+        got[5].push(m.rotate.direction.dot(&u1n).asin().to_degrees());
+        directions.push(m.tilt.direction);
+    }
+    let mean = directions.iter().sum::<Vector3<f64>>().normalize();
+    let n = directions.len() as f64;
+    let tilt_direction_rms = (directions
+        .iter()
+        .map(|d| d.angle(&mean).powi(2))
+        .sum::<f64>()
+        / (n - 1.0))
+        .sqrt();
+    let [t, r] = plan.sigma;
+    let rows = [
+        (
+            "axis 1 zero offset [deg]",
+            spread_of(&got[0]),
+            t.zero_offset_deg,
+        ),
+        (
+            "axis 2 zero offset [deg]",
+            spread_of(&got[1]),
+            r.zero_offset_deg,
+        ),
+        ("axis 1 scale", spread_of(&got[2]), t.scale),
+        ("axis 2 scale", spread_of(&got[3]), r.scale),
+        (
+            "axis 1 direction [deg]",
+            tilt_direction_rms.to_degrees(),
+            t.direction_deg,
+        ),
+        (
+            "axis 2 direction [deg]",
+            spread_of(&got[5]),
+            r.direction_deg,
+        ),
+    ];
+    for (name, empirical, predicted) in rows {
+        let ratio = empirical / predicted;
+        println!("{name}: predicted {predicted:.3e}, 30 fits {empirical:.3e}, ratio {ratio:.2}");
+        assert!(
+            (0.5..=2.0).contains(&ratio),
+            "{name}: {empirical} vs {predicted}"
+        );
+    }
+}

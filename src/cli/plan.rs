@@ -19,14 +19,16 @@
 //! `core::plan::track`); the reflector axis: tool frame.
 
 use crate::plan::{
-    join, make_plan, make_track_plan, plan_csv, points_program, read_plan_csv, JoinBy, JoinOptions,
-    MeasurementPlan, PlanPoint, PlanSettings, TrackPlan, TrackPlanSettings, TrackerSight, Units,
-    WorkspaceBox,
+    join, make_plan, make_positioner_plan, make_track_plan, plan_csv, points_program,
+    read_plan_csv, JoinBy, JoinOptions, MeasurementPlan, PlanPoint, PlanSettings, PositionerPlan,
+    PositionerPlanSettings, TrackPlan, TrackPlanSettings, TrackerSight, Units, WorkspaceBox,
 };
 use crate::program::Language;
 use anyhow::{bail, Context};
 use clap::{Args, Subcommand, ValueEnum};
+use robocal_core::calibrate::external::readings::PositionerColumns;
 use robocal_core::measure::external::ExternalAxis;
+use robocal_core::model::external::TiltRotate;
 use robocal_core::model::RobotModel;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -96,6 +98,32 @@ pub struct MakeArgs {
     /// The stations' lowest and highest value: "lo,hi" [mm] (default: the track's travel).
     #[arg(long, requires = "track", allow_hyphen_values = true)]
     pub travel: Option<String>,
+    /// A tilt-rotate positioner (JSON, its nominal model): plan its two
+    /// axes' sweeps for `positioner calibrate` instead of robot poses.
+    #[arg(long, conflicts_with_all = ["track", "model"])]
+    pub positioner: Option<String>,
+    /// A reflector's design position on the face plate, "x,y,z" [mm]; repeat
+    /// for each (the first is the reference).
+    #[arg(long, requires = "positioner", allow_hyphen_values = true)]
+    pub reflector: Vec<String>,
+    /// Axis 1's (tilt) sweep: "lo,hi" [deg] (default -90,90).
+    #[arg(long, requires = "positioner", allow_hyphen_values = true)]
+    pub tilt: Option<String>,
+    /// Values of axis 1's sweep, evenly over it.
+    #[arg(long, requires = "positioner", default_value_t = 13)]
+    pub tilt_values: usize,
+    /// Axis 2's (rotate) sweep: "lo,hi" [deg] (default -165,165).
+    #[arg(long, requires = "positioner", allow_hyphen_values = true)]
+    pub rotate: Option<String>,
+    /// Values of axis 2's sweep, evenly over it.
+    #[arg(long, requires = "positioner", default_value_t = 12)]
+    pub rotate_values: usize,
+    /// Axis 1's (tilt) column, e1 … e6.
+    #[arg(long, requires = "positioner", default_value = "e1", value_parser = super::track::parse_axis)]
+    pub tilt_column: ExternalAxis,
+    /// Axis 2's (rotate) column, e1 … e6.
+    #[arg(long, requires = "positioner", default_value = "e2", value_parser = super::track::parse_axis)]
+    pub rotate_column: ExternalAxis,
     /// Reflector axis in the tool frame: "x,y,z" (default: the tool's z axis).
     #[arg(long, allow_hyphen_values = true)]
     pub reflector_axis: Option<String>,
@@ -261,6 +289,74 @@ pub fn track_table(plan: &TrackPlan) -> String {
     s
 }
 
+/// The σ table of a positioner's plan: the sweeps and the predicted σ of
+/// each axis's parameters and each reflector's position.
+pub fn positioner_table(plan: &PositionerPlan, s: &PositionerPlanSettings) -> String {
+    let mut out = format!(
+        "# {} values of the positioner's two axes, each of the {} reflectors read at every one: \
+         axis 2 at {} values over {}..{} deg with axis 1 at {} deg, axis 1 at {} values over {}..{} deg with axis 2 at {} deg\n\
+         # predicted standard deviations for a tracker noise of {} mm per axis (condition number {:.1e})\n",
+        plan.values_deg.len(),
+        s.reflectors_mm.len(),
+        s.rotate_values,
+        s.rotate_deg[0],
+        s.rotate_deg[1],
+        plan.tilt_held_deg,
+        s.tilt_values,
+        s.tilt_deg[0],
+        s.tilt_deg[1],
+        plan.rotate_held_deg,
+        plan.noise_mm,
+        plan.condition
+    );
+    for (name, a) in ["axis 1 (tilt)", "axis 2 (rotate)"].iter().zip(&plan.sigma) {
+        let _ = writeln!(
+            out,
+            "{name}: direction {:.3e} deg, line {:.3e} mm, zero offset {:.3e} deg, scale {:.3e}",
+            a.direction_deg, a.point_mm, a.zero_offset_deg, a.scale
+        );
+    }
+    for (k, r) in plan.reflector_sigma_mm.iter().enumerate() {
+        let _ = writeln!(out, "reflector {}: {r:.3e} mm", k + 1);
+    }
+    out
+}
+
+/// The positioner's plan of `a` (`--positioner`).
+fn positioner_plan(a: &MakeArgs, path: &str) -> anyhow::Result<(Vec<PlanPoint>, String)> {
+    if a.format != PlanFormat::Csv {
+        bail!(
+            "a positioner's plan moves only the positioner's axes: write its CSV (--format csv); programs that move a positioner alone are not written"
+        );
+    }
+    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {path}"))?;
+    let nominal =
+        TiltRotate::from_json(&text).with_context(|| format!("positioner file {path}"))?;
+    let d = PositionerPlanSettings::default();
+    let range = |flag: &str, given: &Option<String>, default: [f64; 2]| match given {
+        Some(t) => numbers::<2>(flag, t),
+        None => Ok(default),
+    };
+    let settings = PositionerPlanSettings {
+        reflectors_mm: a
+            .reflector
+            .iter()
+            .map(|r| numbers::<3>("--reflector", r))
+            .collect::<anyhow::Result<_>>()?,
+        tilt_deg: range("--tilt", &a.tilt, d.tilt_deg)?,
+        tilt_values: a.tilt_values,
+        rotate_deg: range("--rotate", &a.rotate, d.rotate_deg)?,
+        rotate_values: a.rotate_values,
+        columns: PositionerColumns {
+            tilt: a.tilt_column,
+            rotate: a.rotate_column,
+        },
+        noise_mm: a.noise_mm,
+    };
+    let plan = make_positioner_plan(&nominal, &settings)?;
+    Ok((plan.points.clone(), positioner_table(&plan, &settings)))
+}
+
 fn language(format: PlanFormat) -> Option<Language> {
     match format {
         PlanFormat::Csv => None,
@@ -297,11 +393,11 @@ fn planned(a: &MakeArgs, model: &RobotModel) -> anyhow::Result<(Vec<PlanPoint>, 
 
 /// Makes the plan and writes its exports; returns the σ table.
 pub fn make(a: &MakeArgs) -> anyhow::Result<String> {
-    let Some(model) = &a.model else {
-        bail!("--model is required (or use `robocal plan join`)");
+    let (points, table) = match (&a.positioner, &a.model) {
+        (Some(path), _) => positioner_plan(a, path)?,
+        (None, Some(model)) => planned(a, &super::model_files::load_model(model)?)?,
+        (None, None) => bail!("--model is required (or --positioner, or `robocal plan join`)"),
     };
-    let model = super::model_files::load_model(model)?;
-    let (points, table) = planned(a, &model)?;
     let text = match language(a.format) {
         None => plan_csv(&points),
         Some(l) => points_program(&points, l, &a.name, a.wait_s)?

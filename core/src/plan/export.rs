@@ -53,8 +53,8 @@ pub enum PlanCsvError {
     /// The CSV has no data rows.
     #[error("the plan CSV has no data rows")]
     Empty,
-    /// The header lacks `point` or `q1`; the header as read.
-    #[error("the plan CSV's header needs `point` and `q1`, `q2`, …; got {0}")]
+    /// The header lacks `point`, or both `q1` and an `e` column; the header as read.
+    #[error("the plan CSV's header needs `point` and `q1`, `q2`, … (or a positioner's `e` columns); got {0}")]
     Header(String),
     /// A joint value is not a finite number.
     #[error("the plan CSV, line {line}: `{field}` is not a number")]
@@ -141,13 +141,14 @@ pub fn read_plan_csv(text: &str) -> Result<Vec<PlanPoint>, PlanCsvError> {
     let joints: Vec<usize> = (1..)
         .map_while(|i| names.iter().position(|h| *h == format!("q{i}")))
         .collect();
-    let (Some(point), false) = (point, joints.is_empty()) else {
-        return Err(PlanCsvError::Header(t.header.join(",")));
-    };
     let axes: Vec<(ExternalAxis, usize)> = ExternalAxis::ALL
         .into_iter()
         .filter_map(|a| Some((a, names.iter().position(|h| h == a.column())?)))
         .collect();
+    // A positioner's plan moves only its axes: no joints, `e` columns.
+    let (Some(point), false) = (point, joints.is_empty() && axes.is_empty()) else {
+        return Err(PlanCsvError::Header(t.header.join(",")));
+    };
     let mut out: Vec<PlanPoint> = Vec::new();
     for r in &t.records {
         t.check_shape(r)?;

@@ -14,6 +14,7 @@ mod candidates;
 pub mod export;
 pub mod join;
 pub mod pose_selection;
+pub mod positioner;
 mod predict;
 mod settings;
 pub mod track;
@@ -24,6 +25,7 @@ pub use export::{
 pub use join::{join, JoinBy, JoinError, JoinOptions, Joined, Units};
 pub use predict::{ParamPrediction, PredictedStd};
 
+pub use positioner::{make_positioner_plan, PositionerPlan, PositionerPlanSettings};
 pub use settings::{FilterCounts, PlanError, PlanSettings, TrackerSight, WorkspaceBox};
 pub use track::{make_track_plan, stations_over, PlannedStation, TrackPlan, TrackPlanSettings};
 

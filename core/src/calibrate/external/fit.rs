@@ -319,7 +319,7 @@ fn start(
     Ok(state)
 }
 
-fn axis_sigma(axis: Axis, var: &DVector<f64>, first: usize) -> AxisSigma {
+pub(crate) fn axis_sigma(axis: Axis, var: &DVector<f64>, first: usize) -> AxisSigma {
     let sd = |i: usize| var[first + i].max(0.0);
     match axis {
         Axis::Tilt => AxisSigma {
@@ -339,8 +339,27 @@ fn axis_sigma(axis: Axis, var: &DVector<f64>, first: usize) -> AxisSigma {
     }
 }
 
+/// 1σ of each reflector's fitted position [mm] from the parameters'
+/// variances `var` (reflector 0: its two free directions).
+pub(crate) fn reflector_sigmas(state: &State, var: &DVector<f64>) -> Vec<f64> {
+    (0..state.reflectors())
+        .map(|k| {
+            let (first, n) = if k == 0 {
+                (AXIS_PARAMETERS, 2)
+            } else {
+                (AXIS_PARAMETERS + 2 + 3 * (k - 1), 3)
+            };
+            (first..first + n)
+                .map(|i| var[i].max(0.0))
+                .sum::<f64>()
+                .sqrt()
+                * 1e3
+        })
+        .collect()
+}
+
 /// The diagonal of `s²·(JᵀJ)⁻¹` with its condition number (column-scaled).
-fn variances(j: &DMatrix<f64>, s2: f64) -> (DVector<f64>, f64) {
+pub(crate) fn variances(j: &DMatrix<f64>, s2: f64) -> (DVector<f64>, f64) {
     let n = j.ncols();
     let d = DVector::from_iterator(n, j.column_iter().map(|c| 1.0 / c.norm().max(1e-300)));
     let mut a = j.tr_mul(j);
@@ -393,20 +412,7 @@ pub fn fit_positioner(req: &PositionerFitRequest) -> Result<PositionerFit, Refus
         .collect();
     let (rms_mm, max_mm) = rms_max(&residual_mm);
     let model: TiltRotate = state.model(&gauge);
-    let reflector_sigma_mm = (0..state.reflectors())
-        .map(|k| {
-            let (first, n) = if k == 0 {
-                (AXIS_PARAMETERS, 2)
-            } else {
-                (AXIS_PARAMETERS + 2 + 3 * (k - 1), 3)
-            };
-            (first..first + n)
-                .map(|i| var[i].max(0.0))
-                .sum::<f64>()
-                .sqrt()
-                * 1e3
-        })
-        .collect();
+    let reflector_sigma_mm = reflector_sigmas(&state, &var);
     let fit = PositionerFit {
         description: model.describe(),
         model,
