@@ -10,8 +10,12 @@
 use super::input::{external_axis, present_int};
 use super::programs::FileIn;
 use super::{ApiError, ApiJson, ApiPath, AppState};
+use crate::calibrate::external::readings::PositionerColumns;
+use crate::calibrate::external::AxisSigma;
 use crate::measure::external::ExternalAxis;
 use crate::model::external::LinearTrack;
+use crate::model::external::TiltRotate;
+use crate::plan::PositionerPlanSettings;
 use crate::plan::{
     stations_over, FilterCounts, PlanPoint, PlanSettings, PlannedStation, PredictedStd,
     TrackerSight, WorkspaceBox,
@@ -19,7 +23,7 @@ use crate::plan::{
 use crate::program::Language;
 use crate::service;
 use crate::service::plans::PlanCommand;
-use crate::service::plans::{OverTrack, PlanMade};
+use crate::service::plans::{ForPositioner, OverTrack, PlanKind, PlanMade};
 use axum::extract::State;
 use axum::response::{IntoResponse, Response};
 use serde::{Deserialize, Serialize};
@@ -76,6 +80,8 @@ pub struct PlanRequest {
     pub travel_mm: Option<[f64; 2]>,
     /// The track's column, `e1` … `e6`; absent: `e1` (needs `track`).
     pub column: Option<String>,
+    /// A tilt-rotate positioner's sweeps instead of robot poses.
+    pub positioner: Option<PositionerPlanIn>,
     /// Random configurations drawn, from `poses` to [`PLAN_CANDIDATES_MAX`]; absent: 1000 (or
     /// `poses` when more).
     #[serde(default, deserialize_with = "present_int")]
@@ -100,6 +106,37 @@ pub struct PlanRequest {
     pub wait_s: Option<f64>,
 }
 
+/// A positioner's plan: its nominal model, the reflectors and the sweeps.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PositionerPlanIn {
+    /// The nominal positioner's JSON description (the file `robocal plan
+    /// --positioner` reads).
+    pub nominal: serde_json::Value,
+    /// The reflectors' design positions on the face plate [mm]; the first is
+    /// the reference.
+    pub reflectors: Vec<[f64; 3]>,
+    /// Axis 1's sweep, lowest and highest value [deg]; absent: −90, 90.
+    pub tilt_deg: Option<[f64; 2]>,
+    /// Values of axis 1's sweep, 4 to [`SWEEP_VALUES_MAX`]; absent: 13.
+    #[serde(default, deserialize_with = "present_int")]
+    pub tilt_values: Option<usize>,
+    /// Axis 2's sweep [deg]; absent: −165, 165.
+    pub rotate_deg: Option<[f64; 2]>,
+    /// Values of axis 2's sweep, 4 to [`SWEEP_VALUES_MAX`]; absent: 12.
+    #[serde(default, deserialize_with = "present_int")]
+    pub rotate_values: Option<usize>,
+    /// Axis 1's column, `e1` … `e6`; absent: `e1`.
+    pub tilt_column: Option<String>,
+    /// Axis 2's column; absent: `e2`.
+    pub rotate_column: Option<String>,
+}
+
+/// Most values of one sweep of a positioner's plan.
+pub const SWEEP_VALUES_MAX: usize = 150;
+/// Most reflectors of a positioner's plan.
+pub const REFLECTORS_MAX: usize = 16;
+
 /// The plan as a program.
 #[derive(Debug, Serialize)]
 pub struct ProgramOut {
@@ -116,8 +153,9 @@ pub struct PlanResponse {
     pub robot_id: i64,
     /// Poses chosen.
     pub poses: usize,
-    /// How many candidates passed each filter, in order.
-    pub counts: FilterCounts,
+    /// How many candidates passed each filter, in order (robot poses).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub counts: Option<FilterCounts>,
     /// The tracker noise the prediction used, standard deviation per axis [mm].
     pub noise_mm: f64,
     /// The payload mass the plan used [kg] (a plan on a fixed base).
@@ -134,8 +172,15 @@ pub struct PlanResponse {
     /// plan over a track).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub stations: Option<Vec<PlannedStation>>,
+    /// A positioner's plan: the predicted σ of each axis's parameters.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sigma: Option<[AxisSigma; 2]>,
+    /// A positioner's plan: the predicted σ of each reflector's position [mm].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reflector_sigma_mm: Option<Vec<f64>>,
     /// The chosen poses: point names, controller joints [deg] and, over a
-    /// track, `external: {"e1": mm}`.
+    /// track or for a positioner, `external: {"e1": …}` (no joints for a
+    /// positioner).
     pub points: Vec<PlanPoint>,
     /// The chosen poses' joints as a CSV.
     pub joints_csv: String,
@@ -187,8 +232,94 @@ fn over_track(req: &PlanRequest, poses: usize) -> Result<Option<OverTrack>, ApiE
     Ok(Some(over))
 }
 
+/// A positioner's plan as a service command (422 naming what is wrong).
+fn positioner_command(
+    robot_id: i64,
+    req: &PlanRequest,
+    p: &PositionerPlanIn,
+) -> Result<PlanCommand, ApiError> {
+    let robot_fields = [
+        ("poses", req.poses.is_some()),
+        ("candidates", req.candidates.is_some()),
+        ("workspace", req.workspace.is_some()),
+        ("tracker", req.tracker.is_some()),
+        ("payload_kg", req.payload_kg.is_some()),
+        ("seed", req.seed.is_some()),
+        ("track", req.track.is_some()),
+        ("stations", req.stations.is_some()),
+        ("travel_mm", req.travel_mm.is_some()),
+        ("column", req.column.is_some()),
+    ];
+    if let Some((field, _)) = robot_fields.iter().find(|(_, given)| *given) {
+        return Err(ApiError::invalid(format!(
+            "`{field}` lays out robot poses; a positioner's plan takes `positioner` and `noise_mm`"
+        )));
+    }
+    if req.language.is_some() || req.name.is_some() || req.wait_s.is_some() {
+        return Err(ApiError::invalid(
+            "a positioner's plan moves only the positioner's axes: its joints CSV is answered; programs that move a positioner alone are not written",
+        ));
+    }
+    let nominal = TiltRotate::from_json(&p.nominal.to_string())
+        .map_err(|e| ApiError::invalid(format!("`positioner.nominal`: {e}")))?;
+    if !(1..=REFLECTORS_MAX).contains(&p.reflectors.len()) {
+        return Err(ApiError::invalid(format!(
+            "`positioner.reflectors`: 1 to {REFLECTORS_MAX} design positions, got {}",
+            p.reflectors.len()
+        )));
+    }
+    let d = PositionerPlanSettings::default();
+    let values = |field: &str, v: Option<usize>, default: usize| {
+        let n = v.unwrap_or(default);
+        if n > SWEEP_VALUES_MAX {
+            return Err(ApiError::invalid(format!(
+                "`positioner.{field}`: at most {SWEEP_VALUES_MAX}, got {n}"
+            )));
+        }
+        Ok(n)
+    };
+    let noise_mm = req.noise_mm.unwrap_or(d.noise_mm);
+    if !(noise_mm.is_finite() && noise_mm > 0.0 && noise_mm <= 100.0) {
+        return Err(ApiError::invalid(format!(
+            "`noise_mm`: above 0 and at most 100 mm, got {noise_mm}"
+        )));
+    }
+    let settings = PositionerPlanSettings {
+        reflectors_mm: p.reflectors.clone(),
+        tilt_deg: p.tilt_deg.unwrap_or(d.tilt_deg),
+        tilt_values: values("tilt_values", p.tilt_values, d.tilt_values)?,
+        rotate_deg: p.rotate_deg.unwrap_or(d.rotate_deg),
+        rotate_values: values("rotate_values", p.rotate_values, d.rotate_values)?,
+        columns: PositionerColumns {
+            tilt: external_axis(
+                "positioner.tilt_column",
+                p.tilt_column.as_deref(),
+                d.columns.tilt,
+            )?,
+            rotate: external_axis(
+                "positioner.rotate_column",
+                p.rotate_column.as_deref(),
+                d.columns.rotate,
+            )?,
+        },
+        noise_mm,
+    };
+    Ok(PlanCommand {
+        robot_id,
+        settings: PlanSettings {
+            noise_mm,
+            ..PlanSettings::default()
+        },
+        program: None,
+        kind: PlanKind::Positioner(ForPositioner { nominal, settings }),
+    })
+}
+
 /// The request as a service command (422 naming what is wrong).
 fn command(robot_id: i64, req: PlanRequest) -> Result<PlanCommand, ApiError> {
+    if let Some(p) = &req.positioner {
+        return positioner_command(robot_id, &req, p);
+    }
     let d = PlanSettings::default();
     let poses = req
         .poses
@@ -301,7 +432,7 @@ fn command(robot_id: i64, req: PlanRequest) -> Result<PlanCommand, ApiError> {
             ..d
         },
         program,
-        over_track,
+        kind: over_track.map_or(PlanKind::FixedBase, PlanKind::Track),
     })
 }
 
@@ -315,43 +446,64 @@ pub async fn plan(
     let cmd = command(robot_id, req)?;
     let language = cmd.program.as_ref().map(|p| p.0);
     let done = service::plans::make(&state, cmd).await?;
-    let (counts, noise_mm) = match &done.plan {
-        PlanMade::FixedBase(p) => (p.counts, p.noise_mm),
-        PlanMade::Track(p) => (p.counts, p.noise_mm),
-    };
-    let (payload_kg, predicted, column, stations, points) = match done.plan {
-        PlanMade::FixedBase(p) => (Some(p.payload_kg), Some(p.predicted), None, None, p.points),
-        PlanMade::Track(p) => (
-            None,
-            None,
-            Some(p.axis.column().into()),
-            Some(p.stations),
-            p.points,
-        ),
-    };
-    Ok(axum::Json(PlanResponse {
+    let program = done.program.zip(language).map(|(files, l)| ProgramOut {
+        language: l,
+        files: files
+            .into_iter()
+            .map(|f| FileIn {
+                name: f.name,
+                content: f.text,
+            })
+            .collect(),
+    });
+    Ok(axum::Json(response(robot_id, done.plan, done.joints_csv, program)).into_response())
+}
+
+/// The answer of a plan made.
+fn response(
+    robot_id: i64,
+    plan: PlanMade,
+    joints_csv: String,
+    program: Option<ProgramOut>,
+) -> PlanResponse {
+    let mut out = PlanResponse {
         robot_id,
-        poses: points.len(),
-        counts,
-        noise_mm,
-        payload_kg,
-        predicted,
-        column,
-        stations,
-        points,
-        joints_csv: done.joints_csv,
-        program: done.program.zip(language).map(|(files, l)| ProgramOut {
-            language: l,
-            files: files
-                .into_iter()
-                .map(|f| FileIn {
-                    name: f.name,
-                    content: f.text,
-                })
-                .collect(),
-        }),
-    })
-    .into_response())
+        poses: plan.points().len(),
+        counts: None,
+        noise_mm: 0.0,
+        payload_kg: None,
+        predicted: None,
+        column: None,
+        stations: None,
+        sigma: None,
+        reflector_sigma_mm: None,
+        points: Vec::new(),
+        joints_csv,
+        program,
+    };
+    match plan {
+        PlanMade::FixedBase(p) => {
+            out.counts = Some(p.counts);
+            out.noise_mm = p.noise_mm;
+            out.payload_kg = Some(p.payload_kg);
+            out.predicted = Some(p.predicted);
+            out.points = p.points;
+        }
+        PlanMade::Track(p) => {
+            out.counts = Some(p.counts);
+            out.noise_mm = p.noise_mm;
+            out.column = Some(p.axis.column().into());
+            out.stations = Some(p.stations);
+            out.points = p.points;
+        }
+        PlanMade::Positioner(p) => {
+            out.noise_mm = p.noise_mm;
+            out.sigma = Some(p.sigma);
+            out.reflector_sigma_mm = Some(p.reflector_sigma_mm);
+            out.points = p.points;
+        }
+    }
+    out
 }
 
 /// The route of measurement plans.

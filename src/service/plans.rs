@@ -3,17 +3,18 @@
 //! workspace box and the tracker's line of sight, with the parameter standard
 //! deviations they predict, as a joint CSV and optionally a program.
 //! Over a linear track (`core::plan::track`), the poses are laid out at
-//! stations over its travel, D-optimal for each station's base pose.
+//! stations over its travel, D-optimal for each station's base pose; for a
+//! positioner (`core::plan::positioner`), its two sweeps.
 //! CPU-bound (forward kinematics of every candidate, a greedy D-optimal
 //! choice): runs on the solve workers behind their admission control.
 
 use super::solve::{chosen_model, ModelChoice};
 use super::{AppState, ServiceError};
 use crate::measure::external::ExternalAxis;
-use crate::model::external::LinearTrack;
+use crate::model::external::{LinearTrack, TiltRotate};
 use crate::plan::{
-    make_plan, make_track_plan, plan_csv, points_program, MeasurementPlan, PlanPoint, PlanSettings,
-    TrackPlan, TrackPlanSettings,
+    make_plan, make_positioner_plan, make_track_plan, plan_csv, points_program, MeasurementPlan,
+    PlanPoint, PlanSettings, PositionerPlan, PositionerPlanSettings, TrackPlan, TrackPlanSettings,
 };
 use crate::program::{Language, ProgramFile};
 
@@ -30,9 +31,30 @@ pub struct PlanCommand {
     /// Also write the plan as a program in this language, named `name`,
     /// waiting `wait_s` at each pose.
     pub program: Option<(Language, String, f64)>,
-    /// Plan over this track's stations (`settings.poses` per station, the
-    /// tracker in the cell frame) instead of a fixed base.
-    pub over_track: Option<OverTrack>,
+    /// What is planned: robot poses on a fixed base or over a track's
+    /// stations, or a positioner's sweeps.
+    pub kind: PlanKind,
+}
+
+/// What a plan lays out.
+#[derive(Debug, Clone)]
+pub enum PlanKind {
+    /// Robot poses on a fixed base.
+    FixedBase,
+    /// Robot poses over a track's stations (`settings.poses` per station,
+    /// the tracker in the cell frame).
+    Track(OverTrack),
+    /// A positioner's two sweeps (the robot's settings unused).
+    Positioner(ForPositioner),
+}
+
+/// A positioner's plan: its nominal model and sweeps.
+#[derive(Debug, Clone)]
+pub struct ForPositioner {
+    /// The nominal positioner.
+    pub nominal: TiltRotate,
+    /// The sweeps, reflectors and columns.
+    pub settings: PositionerPlanSettings,
 }
 
 /// A plan over a linear track: the track and its stations.
@@ -67,6 +89,8 @@ pub enum PlanMade {
     FixedBase(MeasurementPlan),
     /// Poses at a track's stations, with each station's predicted σ.
     Track(TrackPlan),
+    /// A positioner's sweeps, with the σ of its parameters.
+    Positioner(PositionerPlan),
 }
 
 impl PlanMade {
@@ -75,6 +99,7 @@ impl PlanMade {
         match self {
             PlanMade::FixedBase(p) => &p.points,
             PlanMade::Track(p) => &p.points,
+            PlanMade::Positioner(p) => &p.points,
         }
     }
 }
@@ -103,7 +128,7 @@ pub async fn make(state: &AppState, cmd: PlanCommand) -> Result<PlanOutcome, Ser
     let work = cmd.settings.candidates as f64 * cmd.settings.poses as f64 * p * p;
     // Over a track the D-optimal choice is over 6 columns per station: the
     // candidates' forward kinematics dominate, bounded by `candidates`.
-    if cmd.over_track.is_none() && work > PLAN_WORK_MAX {
+    if matches!(cmd.kind, PlanKind::FixedBase) && work > PLAN_WORK_MAX {
         return Err(ServiceError::Invalid(format!(
             "a plan of {} poses among {} candidates of a {}-joint robot is too much work for one request (candidates × poses × (4·joints + 6)² is {work:.1e}, at most {PLAN_WORK_MAX:.0e}); ask fewer candidates or poses, or use `robocal plan`",
             cmd.settings.poses,
@@ -113,13 +138,16 @@ pub async fn make(state: &AppState, cmd: PlanCommand) -> Result<PlanOutcome, Ser
     }
     super::heavy::run(state, "plan", move |_| {
         let invalid = |e: &dyn std::fmt::Display| ServiceError::Invalid(e.to_string());
-        let plan = match &cmd.over_track {
-            None => {
+        let plan = match &cmd.kind {
+            PlanKind::FixedBase => {
                 PlanMade::FixedBase(make_plan(&nominal, &cmd.settings).map_err(|e| invalid(&e))?)
             }
-            Some(t) => PlanMade::Track(
+            PlanKind::Track(t) => PlanMade::Track(
                 make_track_plan(&nominal, &t.track, &t.settings(&cmd.settings))
                     .map_err(|e| invalid(&e))?,
+            ),
+            PlanKind::Positioner(p) => PlanMade::Positioner(
+                make_positioner_plan(&p.nominal, &p.settings).map_err(|e| invalid(&e))?,
             ),
         };
         let program = match &cmd.program {

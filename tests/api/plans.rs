@@ -252,3 +252,117 @@ async fn a_plan_over_a_track_is_the_command_lines() {
         assert!(r.text().contains(words), "{body}: {}", r.text());
     }
 }
+
+/// A positioner's plan over HTTP is `robocal plan --positioner` on the same
+/// nominal file: the CSV byte for byte, the points and predicted σ the
+/// library's; what does not apply to a positioner is a 422 naming it.
+#[tokio::test]
+async fn a_positioners_plan_is_the_command_lines() {
+    use clap::Parser;
+    use robocal::plan::{make_positioner_plan, PositionerPlanSettings};
+    use robocal::sim::positioner_example as example;
+    let t = setup().await;
+    let rid = t.create_robot("ys100").await.to_string();
+    let nominal = example::nominal();
+    let description: serde_json::Value = serde_json::from_str(&nominal.to_json()).unwrap();
+    let positioner = json!({
+        "nominal": description,
+        "reflectors": [[400, 0, 20], [-150, 100, 20]],
+        "tilt_deg": [-60, 60],
+        "tilt_values": 7,
+    });
+    let r = t
+        .post_json(
+            PLANS,
+            &[&rid],
+            json!({ "positioner": positioner, "noise_mm": 0.02 }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let v = r.json();
+    assert_eq!(v["poses"], 19);
+    assert!(
+        v.get("counts").is_none() && v.get("predicted").is_none(),
+        "{v}"
+    );
+    let d = tempfile::tempdir().unwrap();
+    let file = |n: &str| d.path().join(n).to_str().unwrap().to_string();
+    std::fs::write(file("stn.json"), nominal.to_json()).unwrap();
+    let argv = [
+        "robocal",
+        "plan",
+        "--positioner",
+        &file("stn.json"),
+        "--reflector",
+        "400,0,20",
+        "--reflector",
+        "-150,100,20",
+        "--tilt",
+        "-60,60",
+        "--tilt-values",
+        "7",
+        "--noise-mm",
+        "0.02",
+        "--out",
+        &file("plan.csv"),
+    ];
+    let robocal::cli::Command::Plan(a) = robocal::cli::Cli::try_parse_from(argv).unwrap().command
+    else {
+        panic!("not a plan")
+    };
+    robocal::cli::plan::make(&a.make).unwrap();
+    let csv = std::fs::read_to_string(file("plan.csv")).unwrap();
+    assert_eq!(v["joints_csv"].as_str().unwrap(), csv);
+    assert!(csv.starts_with("point,e1,e2\n"));
+    let want = make_positioner_plan(
+        &nominal,
+        &PositionerPlanSettings {
+            reflectors_mm: example::DESIGN_MM.to_vec(),
+            tilt_deg: [-60.0, 60.0],
+            tilt_values: 7,
+            noise_mm: 0.02,
+            ..PositionerPlanSettings::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(serde_json::to_value(&want.points).unwrap(), v["points"]);
+    assert_eq!(
+        v["points"][0],
+        json!({ "name": "P1", "q_deg": [], "external": { "e1": 0.0, "e2": -165.0 } })
+    );
+    assert_eq!(serde_json::to_value(want.sigma).unwrap(), v["sigma"]);
+    assert_eq!(
+        serde_json::to_value(&want.reflector_sigma_mm).unwrap(),
+        v["reflector_sigma_mm"]
+    );
+    for (body, words) in [
+        (
+            json!({ "positioner": positioner, "poses": 10 }),
+            "`poses` lays out robot poses",
+        ),
+        (
+            json!({ "positioner": positioner, "language": "krl" }),
+            "programs that move a positioner alone are not written",
+        ),
+        (
+            json!({ "positioner": { "nominal": {}, "reflectors": [[400, 0, 20]] } }),
+            "`positioner.nominal`",
+        ),
+        (
+            json!({ "positioner": { "nominal": description, "reflectors": [[5, 0, 20]] } }),
+            "5.0 mm from axis 2",
+        ),
+        (
+            json!({ "positioner": { "nominal": description, "reflectors": [[400, 0, 20]], "tilt_deg": [-30, 30] } }),
+            "spans 60°",
+        ),
+        (
+            json!({ "positioner": { "nominal": description, "reflectors": [[400, 0, 20]], "rotate_column": "e1" } }),
+            "both axes",
+        ),
+    ] {
+        let r = t.post_json(PLANS, &[&rid], body.clone()).await;
+        assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{body}");
+        assert!(r.text().contains(words), "{body}: {}", r.text());
+    }
+}
