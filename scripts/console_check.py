@@ -13,7 +13,10 @@ screenshot of each step:
   prefilled form and read back over the API, delete confirmed) ->
   controller data -> predict -> fit a work object, a tool from a tracker
   point and a tool from a 6-D probe (readings made from a known tool offset
-  with seeded noise; the fit must find it within the noise) -> filter a
+  with seeded noise; the fit must find it within the noise) -> external axes
+  on a second robot (a YS100): a track fitted from `robocal track simulate`'s
+  file, a refused one shown, the track deleted (confirmed), a positioner
+  fitted from `robocal positioner simulate`'s files and deleted -> filter a
   URScript program (files and report downloaded) -> measurement plan ->
   ISO 9283 -> delete a set and a robot (confirmed) -> robot list with the
   latest check's status
@@ -43,6 +46,7 @@ import sys
 import tempfile
 import time
 
+from console_check_axes import check_external_axes
 from console_check_rotations import (fixed_xyz, intrinsic_xyz, matmul, rotation,
                                      rotation_angle, rotation_rpy)
 from selenium import webdriver
@@ -710,6 +714,9 @@ def main():
         driver.get(robot_url)
         wait.until(EC.presence_of_element_located((By.ID, "add-tool")))
         n_sets += 1
+
+        # 7f. External axes on a second robot (scripts/console_check_axes.py).
+        check_external_axes(driver, wait, shot, base, args.robocal, work, robot_url, sys.modules[__name__])
 
         # 8. Filter the sample URScript program: the report lists its targets
         # and the filtered file is offered for download.

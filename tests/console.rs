@@ -239,3 +239,222 @@ async fn a_tools_edit_form_holds_every_stored_field() {
         "data-delete=\"/v1/robots/{id}/tools/torch\" data-confirm=\"Delete tool torch?"
     )));
 }
+
+/// The robot page's `#axes-section`, from its opening tag to its end.
+fn axes_section(html: &str) -> &str {
+    let at = html
+        .find("<section id=\"axes-section\"")
+        .expect("no external axes section");
+    &html[at..at + html[at..].find("</section>").unwrap()]
+}
+
+/// The text of the cell `<td class="{class}">` in `table`.
+fn cell<'a>(table: &'a str, class: &str) -> &'a str {
+    let open = format!("<td class=\"{class}\">");
+    let at = table
+        .find(&open)
+        .unwrap_or_else(|| panic!("no cell {class}"))
+        + open.len();
+    &table[at..at + table[at..].find("</td>").unwrap()]
+}
+
+/// `POST`s `body` and returns the JSON answer, asserting `want`.
+async fn post_json(
+    state: &AppState,
+    uri: &str,
+    body: &serde_json::Value,
+    want: StatusCode,
+) -> serde_json::Value {
+    let (s, text) = call(state, "POST", uri, Some(&body.to_string())).await;
+    assert_eq!(s, want, "{uri}: {text}");
+    serde_json::from_str(&text).unwrap()
+}
+
+/// A ys100 robot with a KM calibration of 30 simulated poses (the thesis's
+/// Table 7.1 robot, 0.01 mm tracker noise) as its active version; its id.
+async fn calibrated_ys100(state: &AppState) -> i64 {
+    use rand::SeedableRng;
+    let robot = post_json(
+        state,
+        "/v1/robots",
+        &serde_json::json!({ "name": "rail robot", "preset": "ys100" }),
+        StatusCode::CREATED,
+    )
+    .await;
+    let id = robot["id"].as_i64().unwrap();
+    let mut truth = robocal::sim::TrueRobot::new(robocal::sim::ys100_table_7_1());
+    truth.tracker_from_base = robocal::sim::tracker_frame(0.0, 0.0, 90.0, [500.0, -3240.0, 0.0]);
+    truth.noise_mm = 0.01;
+    let nominal = robocal::model::preset("ys100").unwrap();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+    let qs = robocal::sim::try_random_configurations(
+        &nominal,
+        30,
+        &robocal::sim::PoseFilter::default(),
+        &mut rng,
+        |q| truth.true_position(q, Some(110.0)).is_ok(),
+    )
+    .unwrap();
+    let rows = truth.measure(&qs, Some(110.0), None, &mut rng).unwrap();
+    let req = Request::builder()
+        .method("POST")
+        .uri(format!(
+            "/v1/robots/{id}/measurement-sets?role=identification"
+        ))
+        .header("content-type", "text/csv")
+        .body(Body::from(robocal::measure::csv::write(&rows)))
+        .unwrap();
+    let res = app(state.clone()).oneshot(req).await.unwrap();
+    assert_eq!(res.status(), StatusCode::CREATED);
+    let job = post_json(
+        state,
+        &format!("/v1/robots/{id}/calibrations"),
+        &serde_json::json!({ "methods": ["km"], "seed": 1 }),
+        StatusCode::ACCEPTED,
+    )
+    .await;
+    let url = format!("/v1/robots/{id}/calibrations/{}", job["id"]);
+    let end = std::time::Instant::now() + std::time::Duration::from_secs(300);
+    loop {
+        let (_, text) = call(state, "GET", &url, None).await;
+        let j: serde_json::Value = serde_json::from_str(&text).unwrap();
+        match j["status"].as_str().unwrap() {
+            "succeeded" => return id,
+            "queued" | "running" if std::time::Instant::now() < end => {
+                tokio::time::sleep(std::time::Duration::from_millis(200)).await
+            }
+            _ => panic!("the calibration did not succeed: {j}"),
+        }
+    }
+}
+
+/// The external axes section: "none stored" for a fresh robot; the stored
+/// track and positioner as tables once fitted through the API (each from
+/// the files `robocal track simulate` and `positioner simulate` write: the
+/// robot on the rail is the active version's geometry), with their figures
+/// as the API gives them and a delete that asks first.
+#[tokio::test]
+async fn the_robot_page_shows_its_stored_track_and_positioner() {
+    let (state, dir) = state().await;
+    let id = calibrated_ys100(&state).await;
+    let page = format!("/ui/robots/{id}");
+    let (s, html) = call(&state, "GET", &page, None).await;
+    assert_eq!(s, StatusCode::OK);
+    let section = axes_section(&html);
+    assert!(section.contains("No track stored."), "{section}");
+    assert!(section.contains("No positioner stored."), "{section}");
+    assert!(!section.contains("id=\"track-stored\""));
+    assert!(!section.contains("id=\"positioner-stored\""));
+    for part in [
+        "<form id=\"calibrate-track\" data-action=\"calibrate-track\"",
+        "<form id=\"calibrate-positioner\" data-action=\"calibrate-positioner\"",
+        "name=\"sets\" multiple",
+    ] {
+        assert!(section.contains(part), "the section lacks {part}");
+    }
+    assert_eq!(selected(section, "column").as_deref(), Some("e1"));
+    assert_eq!(selected(section, "tilt_column").as_deref(), Some("e1"));
+    assert_eq!(selected(section, "rotate_column").as_deref(), Some("e2"));
+    assert_eq!(input_value(section, "sigma_mm").as_deref(), Some("0.01"));
+    assert_eq!(input_value(section, "max_order").as_deref(), Some("6"));
+
+    // The track, from the active version's model file on the simulated rail.
+    let (s, model) = call(
+        &state,
+        "GET",
+        &format!("/v1/robots/{id}/versions/1/model.json"),
+        None,
+    )
+    .await;
+    assert_eq!(s, StatusCode::OK);
+    let files = dir.path().join("axes");
+    std::fs::create_dir_all(&files).unwrap();
+    let model_path = files.join("model.json");
+    std::fs::write(&model_path, model).unwrap();
+    robocal::cli::track_sim::simulate_to_string(&robocal::cli::track_sim::SimulateArgs {
+        out_dir: files.display().to_string(),
+        robot: model_path.display().to_string(),
+        seed: 5,
+        noise_mm: 0.01,
+        poses: 15,
+    })
+    .unwrap();
+    let csv = std::fs::read_to_string(files.join("stations.csv")).unwrap();
+    post_json(
+        &state,
+        &format!("/v1/robots/{id}/track/calibrate"),
+        &serde_json::json!({ "csv": csv }),
+        StatusCode::CREATED,
+    )
+    .await;
+    // The positioner, from the files `positioner simulate` writes.
+    robocal::cli::positioner_sim::simulate_to_string(&robocal::cli::positioner_sim::SimulateArgs {
+        out_dir: files.display().to_string(),
+        robot: None,
+        seed: 1,
+        noise_mm: 0.01,
+        wobble_deg: 0.003,
+    })
+    .unwrap();
+    let read = |name: &str| std::fs::read_to_string(files.join(name)).unwrap();
+    let nominal: serde_json::Value = serde_json::from_str(&read("nominal.json")).unwrap();
+    post_json(
+        &state,
+        &format!("/v1/robots/{id}/positioner/calibrate"),
+        &serde_json::json!({
+            "sets": [read("r0.csv"), read("r1.csv")],
+            "reflectors": robocal::sim::positioner_example::DESIGN_MM,
+            "nominal": nominal,
+        }),
+        StatusCode::CREATED,
+    )
+    .await;
+
+    let (_, html) = call(&state, "GET", &page, None).await;
+    let section = axes_section(&html);
+    assert!(!section.contains("No track stored."), "{section}");
+    assert!(!section.contains("No positioner stored."), "{section}");
+    let get = |what: &'static str| {
+        let state = state.clone();
+        async move {
+            let (s, text) = call(&state, "GET", &format!("/v1/robots/{id}/{what}"), None).await;
+            assert_eq!(s, StatusCode::OK, "{text}");
+            serde_json::from_str::<serde_json::Value>(&text).unwrap()
+        }
+    };
+    let mm = |v: &serde_json::Value| format!("{:.3}", v.as_f64().unwrap());
+    let track = get("track").await;
+    let at = section
+        .find("<table id=\"track-stored\"")
+        .expect("no track table");
+    let table = &section[at..at + section[at..].find("</table>").unwrap()];
+    assert_eq!(cell(table, "column"), "e1");
+    assert_eq!(cell(table, "version"), "v1");
+    assert_eq!(cell(table, "stations"), "11");
+    assert_eq!(cell(table, "stations"), track["stations"].to_string());
+    assert_eq!(cell(table, "readings"), track["readings"].to_string());
+    assert_eq!(cell(table, "rms"), mm(&track["rms_mm"]));
+    assert_eq!(cell(table, "max"), mm(&track["max_mm"]));
+    assert_eq!(cell(table, "sigma"), "0.010");
+    assert!(table.contains(&format!(
+        "<time datetime=\"{}\">",
+        track["created_at"].as_str().unwrap()
+    )));
+    assert!(table.contains(&format!(
+        "data-delete=\"/v1/robots/{id}/track\" data-confirm=\"Delete the track of robot {id} (rail robot)?"
+    )));
+    let positioner = get("positioner").await;
+    let at = section
+        .find("<table id=\"positioner-stored\"")
+        .expect("no positioner table");
+    let table = &section[at..at + section[at..].find("</table>").unwrap()];
+    assert_eq!(cell(table, "tilt"), "e1");
+    assert_eq!(cell(table, "rotate"), "e2");
+    assert_eq!(cell(table, "reflectors"), "2");
+    assert_eq!(cell(table, "readings"), positioner["readings"].to_string());
+    assert_eq!(cell(table, "rms"), mm(&positioner["rms_mm"]));
+    assert_eq!(cell(table, "max"), mm(&positioner["max_mm"]));
+    assert!(table.contains(&format!(
+        "data-delete=\"/v1/robots/{id}/positioner\" data-confirm=\"Delete the positioner of robot {id} (rail robot)?"
+    )));
+}

@@ -35,7 +35,8 @@ async function api(method, url, body, contentType, accept) {
   if (!res.ok) {
     let detail = text;
     try { detail = JSON.parse(text).detail || text; } catch (e) { /* not JSON */ }
-    throw new Error(res.status + ": " + detail);
+    // The status and the problem's detail, for handlers that answer one kind apart.
+    throw Object.assign(new Error(res.status + ": " + detail), { status: res.status, detail });
   }
   return { text, json: () => JSON.parse(text), type: res.headers.get("Content-Type") || "", headers: res.headers };
 }
@@ -659,3 +660,90 @@ handlers["fit-frame"] = async function (form) {
   const r = (await sendJson("POST", `/v1/robots/${form.dataset.robot}/frames/${encodeURIComponent(name)}/fit`, body)).json();
   fitAnswer(r, "work object " + name);
 };
+
+// External axes: a fit is stored (the page reloads and says so) or refused
+// (a 422: nothing stored, what was stored is kept; the reason and the
+// message are shown, with what the form can change). `hint(reason, detail)`
+// says what to change when the form's choices can be the cause; the box
+// under the form (`track-result`, `positioner-result`) and the page's
+// message say it.
+async function axisFit(what, url, body, fitted, hint) {
+  let r;
+  try {
+    r = (await sendJson("POST", url, body)).json();
+  } catch (e) {
+    if (e.status !== 422) throw e;
+    const detail = String(e.detail).replace(/[.\s]+$/, "");
+    const reason = (detail.match(/^not fitted \(([a-z_]+)\)/) || [])[1];
+    const more = hint(reason, detail);
+    const noun = what.toLowerCase();
+    const kept = document.getElementById(noun + "-stored") ? `the stored ${noun} is kept` : `no ${noun} is stored`;
+    const box = document.getElementById(noun + "-result");
+    box.textContent = `${what} ${detail.startsWith("not fitted") ? "" : "not fitted: "}${detail}.${more ? " " + more : ""} Nothing was stored: ${kept}.`;
+    box.className = "bad";
+    box.hidden = false;
+    show(box.textContent, false);
+    return;
+  }
+  flash(fitted(r));
+  location.reload();
+}
+
+handlers["calibrate-track"] = async function (form) {
+  const csv = await fileOrText(form, "file", "csv");
+  if (!csv) throw new Error("choose the measurement file or paste its text");
+  const column = formValue(form, "column");
+  const body = { csv, column };
+  for (const name of ["sigma_mm", "max_order", "version", "payload_kg"]) {
+    const v = formValue(form, name);
+    if (v) body[name] = Number(v);
+  }
+  await axisFit("Track", `/v1/robots/${form.dataset.robot}/track/calibrate`, body,
+    (r) => `Track fitted: RMS ${fmtMm(r.rms_mm)} mm over ${r.stations} stations (${r.readings} readings, max ${fmtMm(r.max_mm)} mm; model v${r.version} held)`,
+    (reason) => (reason === "missing_column" ? `The form reads the track's value from column ${column}: choose the file's track column.` : ""));
+};
+
+// The reflectors' design positions: one x, y, z line [mm] per measurement file.
+function reflectorLines(text) {
+  return rows(text).map((r, i) => {
+    if (r.word !== null || r.values.length !== 3 || !r.values.every(isFinite)) {
+      throw new Error(`reflector position line ${i + 1}: give x, y, z in mm (three numbers)`);
+    }
+    return r.values;
+  });
+}
+
+handlers["calibrate-positioner"] = async function (form) {
+  const nominalText = await fileOrText(form, "nominal_file", "nominal");
+  if (!nominalText) throw new Error("choose the nominal positioner's JSON file or paste it");
+  let nominal;
+  try {
+    nominal = JSON.parse(nominalText);
+  } catch (e) {
+    throw new Error("the nominal positioner is not JSON: " + e.message);
+  }
+  const files = form.elements["sets"].files;
+  if (!files.length) throw new Error("choose the measurement files, one per reflector");
+  const reflectors = reflectorLines(formValue(form, "reflectors"));
+  if (reflectors.length !== files.length) {
+    throw new Error(`${reflectors.length} reflector position lines for ${files.length} measurement files: give one x, y, z line per file, in the files' order`);
+  }
+  const body = { sets: [], reflectors, nominal, tilt_column: formValue(form, "tilt_column"), rotate_column: formValue(form, "rotate_column") };
+  if (body.tilt_column === body.rotate_column) throw new Error(`the tilt and rotate columns are both ${body.tilt_column}: choose two columns`);
+  for (const f of files) body.sets.push(await f.text());
+  const sigma = formValue(form, "sigma_mm");
+  if (sigma) body.sigma_mm = Number(sigma);
+  await axisFit("Positioner", `/v1/robots/${form.dataset.robot}/positioner/calibrate`, body,
+    (r) => `Positioner fitted: RMS ${fmtMm(r.rms_mm)} mm over ${r.readings} readings of ${r.reflectors} reflectors (max ${fmtMm(r.max_mm)} mm)`,
+    (reason, detail) => (/\bcolumn/.test(detail) ? `The form reads the tilt from column ${body.tilt_column} and the rotate from ${body.rotate_column}: choose the files' columns.` : ""));
+};
+
+// The positioner's measurement files in the order they were chosen, the
+// order the reflector lines follow.
+document.addEventListener("change", (ev) => {
+  const input = ev.target;
+  if (input.name !== "sets" || !input.form || input.form.id !== "calibrate-positioner") return;
+  const names = [...input.files].map((f, i) => `${i + 1}. ${f.name}`);
+  document.getElementById("positioner-files").textContent =
+    names.length ? `Files in this order (one reflector line each, in the same order): ${names.join(", ")}` : "";
+});

@@ -3,8 +3,9 @@
 //! progress, reports, model versions with activate and rollback (each
 //! confirmed first), checks with their status, trend and history, the
 //! comparison of versions on one set, solving a targets CSV, tools and work
-//! objects, and filtering robot programs; times shown in the browser's
-//! local time. The
+//! objects, the external axes (a linear track, a positioner: stored, fitted
+//! from measurement files, deleted after a confirmation), and filtering
+//! robot programs; times shown in the browser's local time. The
 //! pages read through the service layer; every write is made by the
 //! page's own script through the REST API (`/v1`), so the console obeys the
 //! same API keys, limits and validation as any client. No external assets:
@@ -18,6 +19,7 @@
 //! opens a page). Each page is sent with a `Content-Security-Policy` (see
 //! [`pages::content_security_policy`]) and `X-Frame-Options: DENY`.
 
+mod axes_pages;
 mod cell_pages;
 mod check_detail;
 mod check_pages;
@@ -76,10 +78,23 @@ async fn robot_page(
         versions: service::versions::list(&state, id).await?,
         tools: service::cell::list(&state, id, CellKind::Tool).await?,
         work_objects: service::cell::list(&state, id, CellKind::WorkObject).await?,
+        track: stored(service::tracks::get(&state, id).await)?,
+        positioner: stored(service::positioners::get(&state, id).await)?,
         keys: !state.config().api_keys.is_empty(),
         robot,
     };
     Ok(page(pages::robot(&view)))
+}
+
+/// A stored item of the robot, `None` when it has none (the robot itself
+/// was read first, so not found means nothing stored); any other error is
+/// the page's.
+fn stored<T>(read: Result<T, service::ServiceError>) -> Result<Option<T>, ApiError> {
+    match read {
+        Ok(row) => Ok(Some(row)),
+        Err(service::ServiceError::NotFound(_)) => Ok(None),
+        Err(e) => Err(e.into()),
+    }
 }
 
 async fn check_page(

@@ -67,6 +67,9 @@ pub(super) struct RobotView {
     pub versions: Vec<VersionRow>,
     pub tools: Vec<CellItemRow>,
     pub work_objects: Vec<CellItemRow>,
+    /// The stored track and positioner, if any.
+    pub track: Option<crate::records::TrackRow>,
+    pub positioner: Option<crate::records::PositionerRow>,
     pub keys: bool,
     /// The latest check's status, the thresholds and the history (oldest first).
     pub status: Option<robocal_core::check::CheckStatus>,
@@ -210,6 +213,11 @@ pub(super) fn robot(v: &RobotView) -> Markup {
                 versions: &v.versions,
             }))
             (super::cell_pages::cell_section(id, &v.tools, &v.work_objects))
+            (super::axes_pages::axes_section(&super::axes_pages::AxesView {
+                robot: r,
+                track: v.track.as_ref(),
+                positioner: v.positioner.as_ref(),
+            }))
             (super::cell_pages::predict_section(id, &v.versions, &v.tools, &v.work_objects))
             (super::cell_pages::filter_section(id, &v.versions))
             (super::plan_pages::plan_sections(id))

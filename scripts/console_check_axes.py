@@ -1,0 +1,205 @@
+"""The web console's external-axes section, a step of scripts/console_check.py
+(which calls `check_external_axes` with its driver and helpers): a track and a
+positioner fitted, refused and deleted through the robot page's forms, each
+answer compared with the API's. Python 3 standard library and Selenium.
+"""
+import pathlib
+import re
+import subprocess
+import time
+
+from selenium.webdriver.common.by import By
+from selenium.webdriver.support import expected_conditions as EC
+from selenium.webdriver.support.ui import Select
+
+
+def api_raw(key, base, method, path, data=None, content_type=None):
+    """A request over the API (not through the page): the status and the
+    body's bytes, an error status included."""
+    import urllib.error
+    import urllib.request
+    headers = {"Authorization": f"Bearer {key}"}
+    if content_type:
+        headers["Content-Type"] = content_type
+    req = urllib.request.Request(base + path, data=data, method=method, headers=headers)
+    try:
+        with urllib.request.urlopen(req, timeout=60) as r:
+            return r.status, r.read()
+    except urllib.error.HTTPError as e:
+        return e.code, e.read()
+
+
+def printed_fit(printed):
+    """The arguments of the `robocal ...` command a `simulate` printed after
+    `fit it with: robocal `."""
+    import shlex
+    for line in printed.splitlines():
+        if line.startswith("fit it with: robocal "):
+            return shlex.split(line[len("fit it with: robocal "):])
+    raise AssertionError(f"no fit command in\n{printed}")
+
+
+def check_external_axes(driver, wait, shot, base, robocal, work, robot_url, h):
+    """Step 7f; `h` is console_check's module (its API and page helpers)."""
+    # 7f. External axes, on a second robot: a YS100 (created over the
+    # API) calibrated by KM from 30 simulated poses (`robocal simulate`),
+    # so it has the active version a track fit holds. The track's file
+    # is `robocal track simulate --seed 5` on that version's model file
+    # (the robot on the rail is the held version's geometry): fitted in
+    # the page's form, the page shows the stored track as the API gives
+    # it; the same file with its `e1` column renamed `e2` while the form
+    # says e1 is refused (`missing_column`, shown, nothing replaced); the
+    # track deleted (the question dismissed once, then accepted). Then a
+    # positioner from `robocal positioner simulate --robot ys100`'s
+    # files (the nominal JSON, one file per reflector, the reflectors'
+    # positions from the command it prints), after the page refuses a
+    # reflector line short of the files.
+    axes = pathlib.Path(work) / "axes"
+    axes.mkdir()
+    rail = h.api_post(base, "/v1/robots", {"name": "YS100 on the rail", "preset": "ys100"})
+    rail_id = rail["id"]
+    ident = axes / "ys100-identification.csv"
+    subprocess.run([robocal, "simulate", "--preset", "ys100", "--poses", "30", "--seed", "5",
+                    "--out", str(ident)], check=True, capture_output=True)
+    status, body = api_raw(h.KEY, base, "POST", f"/v1/robots/{rail_id}/measurement-sets?role=identification",
+                           ident.read_bytes(), "text/csv")
+    assert status == 201, (status, body)
+    job = h.api_post(base, f"/v1/robots/{rail_id}/calibrations", {"methods": ["km"], "seed": 1})
+    end = time.time() + 300
+    while (j := h.api_get(base, f"/v1/robots/{rail_id}/calibrations/{job['id']}"))["status"] in ("queued", "running"):
+        assert time.time() < end, f"the YS100's calibration still {j['status']} after 300 s"
+        time.sleep(0.5)
+    assert j["status"] == "succeeded", j
+    held = h.api_get(base, f"/v1/robots/{rail_id}")["active_version"]
+    status, model = api_raw(h.KEY, base, "GET", f"/v1/robots/{rail_id}/versions/{held}/model.json")
+    assert status == 200, status
+    (axes / "model.json").write_bytes(model)
+    printed = subprocess.run([robocal, "track", "simulate", "--out-dir", str(axes / "track"),
+                              "--robot", str(axes / "model.json"), "--seed", "5"],
+                             check=True, capture_output=True, text=True).stdout
+    stations = axes / "track" / "stations.csv"
+    assert str(stations) in printed, printed
+    rail_url = f"{base}/ui/robots/{rail_id}"
+    driver.get(rail_url)
+    wait.until(EC.presence_of_element_located((By.ID, "calibrate-track")))
+    section = driver.find_element(By.ID, "axes-section").text
+    assert "No track stored." in section and "No positioner stored." in section, section
+    form = driver.find_element(By.ID, "calibrate-track")
+    assert Select(form.find_element(By.NAME, "column")).first_selected_option.get_attribute("value") == "e1"
+    assert form.find_element(By.NAME, "sigma_mm").get_attribute("value") == "0.01"
+    assert form.find_element(By.NAME, "max_order").get_attribute("value") == "6"
+    shot("axes-none", "axes-section")
+    form.find_element(By.NAME, "file").send_keys(str(stations))
+    form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+    # The page's message box: the fit's flash after the reload, or why not.
+    msg = wait.until(lambda d: h.text_of(d, "#message"))
+    assert re.fullmatch(r"Track fitted: RMS \d+\.\d{3} mm over 11 stations \(165 readings, max \d+\.\d{3} mm; "
+                        f"model v{held} held\\)", msg), msg
+
+    def track_cells():
+        return {c: driver.find_element(By.CSS_SELECTOR, f"#track-stored td.{c}").text
+                for c in ("column", "version", "stations", "readings", "rms", "max", "sigma")}
+    stored = h.api_get(base, f"/v1/robots/{rail_id}/track")
+    shown = track_cells()
+    assert shown == {"column": "e1", "version": f"v{held}", "stations": "11",
+                     "readings": str(stored["readings"]), "rms": f"{stored['rms_mm']:.3f}",
+                     "max": f"{stored['max_mm']:.3f}", "sigma": "0.010"}, (shown, stored)
+    assert stored["stations"] == 11 and stored["column"] == "e1" and stored["version"] == held, stored
+    assert float(shown["rms"]) < 0.05, f"the track's RMS: {shown['rms']} mm"
+    assert f"over 11 stations" in msg and f"RMS {shown['rms']} mm" in msg, msg
+    created = driver.find_element(By.CSS_SELECTOR, "#track-stored time")
+    assert created.get_attribute("datetime") == stored["created_at"], created.get_attribute("datetime")
+    assert created.text != stored["created_at"], "the time is not shown in local time"
+    print(f"console_check: track fitted, RMS {shown['rms']} mm, max {shown['max']} mm over 11 stations")
+    shot("track-fitted", "axes-section")
+    # Refused: the track's values in `e2` while the form reads e1.
+    renamed = axes / "stations-e2.csv"
+    lines = stations.read_text().splitlines(keepends=True)
+    header = lines[0].rstrip("\r\n").split(",")
+    assert header.count("e1") == 1 and "e2" not in header, header
+    renamed.write_text(",".join("e2" if h == "e1" else h for h in header) + "\n" + "".join(lines[1:]))
+    form = driver.find_element(By.ID, "calibrate-track")
+    form.find_element(By.NAME, "file").send_keys(str(renamed))
+    form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+    wait.until(EC.visibility_of_element_located((By.ID, "track-result")))
+    refusal = driver.find_element(By.ID, "track-result").text
+    msg = driver.find_element(By.ID, "message").text
+    assert msg == refusal and "msg bad" in driver.find_element(By.ID, "message").get_attribute("class"), msg
+    assert refusal.startswith("Track not fitted (missing_column): ") and "`e1`" in refusal \
+        and "column e1" in refusal and refusal.endswith("Nothing was stored: the stored track is kept."), refusal
+    assert form.is_enabled(), "a refused fit must not reload the page"
+    assert h.api_get(base, f"/v1/robots/{rail_id}/track") == stored, "a refused fit replaced the track"
+    assert track_cells() == shown
+    print(f"console_check: refused: {refusal}")
+    shot("track-refused", "calibrate-track")
+    # Delete the track: asked first; dismissed, it stays; accepted, it is gone.
+    button = driver.find_element(By.ID, "delete-track")
+    button.click()
+    alert = wait.until(EC.alert_is_present())
+    assert alert.text.startswith(f"Delete the track of robot {rail_id} (YS100 on the rail)?"), alert.text
+    alert.dismiss()
+    assert driver.find_elements(By.ID, "track-stored") and button.is_enabled(), "a dismissed delete must not be sent"
+    assert api_raw(h.KEY, base, "GET", f"/v1/robots/{rail_id}/track")[0] == 200
+    button.click()
+    wait.until(EC.alert_is_present()).accept()
+    wait.until(h.replaced(button))
+    wait.until(EC.presence_of_element_located((By.ID, "calibrate-track")))
+    assert not driver.find_elements(By.ID, "track-stored")
+    assert "No track stored." in driver.find_element(By.ID, "axes-section").text
+    assert api_raw(h.KEY, base, "GET", f"/v1/robots/{rail_id}/track")[0] == 404
+    shot("track-deleted", "axes-section")
+    # The positioner, from the files `positioner simulate` writes and the
+    # reflectors' positions in the command it prints.
+    printed = subprocess.run([robocal, "positioner", "simulate", "--out-dir", str(axes / "positioner"),
+                              "--robot", "ys100"], check=True, capture_output=True, text=True).stdout
+    fit = printed_fit(printed)
+    assert fit[:2] == ["positioner", "calibrate"], fit
+    sets = fit[2:fit.index("--nominal")]
+    nominal = fit[fit.index("--nominal") + 1]
+    reflectors = [fit[i + 1] for i, a in enumerate(fit) if a == "--reflector"]
+    assert len(sets) == len(reflectors) >= 2 and all(pathlib.Path(f).exists() for f in sets + [nominal]), fit
+    form = driver.find_element(By.ID, "calibrate-positioner")
+    assert [Select(form.find_element(By.NAME, n)).first_selected_option.get_attribute("value")
+            for n in ("tilt_column", "rotate_column")] == ["e1", "e2"]
+    form.find_element(By.NAME, "nominal_file").send_keys(nominal)
+    form.find_element(By.NAME, "sets").send_keys("\n".join(sets))
+    order = driver.find_element(By.ID, "positioner-files").text
+    assert order.endswith(", ".join(f"{i + 1}. {pathlib.Path(f).name}" for i, f in enumerate(sets))), order
+    # One line short: the page says so and sends nothing.
+    form.find_element(By.NAME, "reflectors").send_keys(reflectors[0].replace(",", ", "))
+    form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+    wait.until(lambda d: "reflector position lines" in (h.text_of(d, "#message") or ""))
+    msg = driver.find_element(By.ID, "message").text
+    assert msg == f"1 reflector position lines for {len(sets)} measurement files: " \
+        "give one x, y, z line per file, in the files' order", msg
+    assert api_raw(h.KEY, base, "GET", f"/v1/robots/{rail_id}/positioner")[0] == 404
+    box = form.find_element(By.NAME, "reflectors")
+    box.clear()
+    box.send_keys("\n".join(r.replace(",", ", ") for r in reflectors))
+    form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+    refused = msg
+    msg = wait.until(lambda d: (t := h.text_of(d, "#message")) and t != refused and t)
+    assert msg.startswith("Positioner fitted: "), msg
+    wait.until(EC.presence_of_element_located((By.ID, "positioner-stored")))
+    stored = h.api_get(base, f"/v1/robots/{rail_id}/positioner")
+    shown = {c: driver.find_element(By.CSS_SELECTOR, f"#positioner-stored td.{c}").text
+             for c in ("tilt", "rotate", "reflectors", "readings", "rms", "max", "sigma")}
+    assert shown == {"tilt": "e1", "rotate": "e2", "reflectors": str(len(sets)),
+                     "readings": str(stored["readings"]), "rms": f"{stored['rms_mm']:.3f}",
+                     "max": f"{stored['max_mm']:.3f}", "sigma": "0.010"}, (shown, stored)
+    assert stored["reflectors"] == len(sets), stored
+    assert msg == f"Positioner fitted: RMS {shown['rms']} mm over {shown['readings']} readings of " \
+        f"{len(sets)} reflectors (max {shown['max']} mm)", msg
+    print(f"console_check: positioner fitted, RMS {shown['rms']} mm over {shown['readings']} readings")
+    shot("positioner-fitted", "axes-section")
+    button = driver.find_element(By.ID, "delete-positioner")
+    button.click()
+    alert = wait.until(EC.alert_is_present())
+    assert alert.text.startswith(f"Delete the positioner of robot {rail_id} (YS100 on the rail)?"), alert.text
+    alert.accept()
+    wait.until(h.replaced(button))
+    wait.until(EC.presence_of_element_located((By.ID, "calibrate-positioner")))
+    assert "No positioner stored." in driver.find_element(By.ID, "axes-section").text
+    assert api_raw(h.KEY, base, "GET", f"/v1/robots/{rail_id}/positioner")[0] == 404
+    driver.get(robot_url)
+    wait.until(EC.presence_of_element_located((By.ID, "add-tool")))

@@ -1,0 +1,164 @@
+//! The console's external axes section of a robot page: the linear track
+//! carrying the robot and the two-axis positioner in its cell, each as
+//! stored (what it was fitted on, its residuals, delete after a
+//! confirmation) or "none stored", and the form that fits it from
+//! measurement files (`POST …/track/calibrate`, `POST
+//! …/positioner/calibrate`). A refused fit stores nothing; the page shows
+//! why and keeps what was stored. Lengths in mm to 0.001.
+
+use super::format::mm;
+use crate::http::{tracks, PAYLOAD_MAX_KG};
+use crate::records::{PositionerRow, RobotRow, TrackRow};
+use maud::{html, Markup};
+use robocal_core::calibrate::external::track::DEFAULT_MAX_ORDER;
+use robocal_core::measure::external::ExternalAxis;
+use robocal_core::model::external::travel_map::MAX_MAP_ORDER;
+
+/// What the section shows: the robot's stored track and positioner, if any.
+pub(super) struct AxesView<'a> {
+    pub robot: &'a RobotRow,
+    pub track: Option<&'a TrackRow>,
+    pub positioner: Option<&'a PositionerRow>,
+}
+
+/// The section `#axes-section` of robot `v.robot`.
+pub(super) fn axes_section(v: &AxesView) -> Markup {
+    let id = v.robot.id;
+    html! {
+        section #axes-section {
+            h2 { "External axes" }
+            p.note { "A linear track carrying the robot and a two-axis (tilt-rotate) positioner in its cell, each fitted from the tracker's readings and stored for this robot. A fit is judged before it is stored: a refused fit stores nothing, and the page says why." }
+            h3 { "Linear track" }
+            div #track-stored-box {
+                @match v.track {
+                    Some(t) => { (track_table(v.robot, t)) }
+                    None => { p.empty #no-track { "No track stored." } }
+                }
+            }
+            (track_form(id))
+            h3 { "Positioner" }
+            div #positioner-stored-box {
+                @match v.positioner {
+                    Some(p) => { (positioner_table(v.robot, p)) }
+                    None => { p.empty #no-positioner { "No positioner stored." } }
+                }
+            }
+            (positioner_form(id))
+        }
+    }
+}
+
+/// The stored track: what it was fitted on and its residuals.
+fn track_table(r: &RobotRow, t: &TrackRow) -> Markup {
+    let url = format!("/v1/robots/{}/track", r.id);
+    html! {
+        table #track-stored {
+            thead { tr { th { "Column" } th { "Model version held" } th { "Stations" } th { "Readings" } th { "RMS [mm]" } th { "Max [mm]" } th { "σ [mm]" } th { "Created" } th {} } }
+            tbody {
+                tr {
+                    td.column { (t.axis_column) }
+                    td.version { "v" (t.version) }
+                    td.stations { (t.stations) }
+                    td.readings { (t.readings) }
+                    td.rms { (mm(t.rms_mm)) }
+                    td.max { (mm(t.max_mm)) }
+                    td.sigma { (mm(t.sigma_mm)) }
+                    td { time datetime=(t.created_at) { (t.created_at) } }
+                    td {
+                        a href=(url) { "track JSON" } " "
+                        button.small.danger #delete-track data-delete=(url)
+                            data-confirm={ "Delete the track of robot " (r.id) " (" (r.name) ")? Predictions, solves and filters that give a track value are refused until a track is fitted again." } { "Delete the track" }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The stored positioner: what it was fitted on and its residuals.
+fn positioner_table(r: &RobotRow, p: &PositionerRow) -> Markup {
+    let url = format!("/v1/robots/{}/positioner", r.id);
+    html! {
+        table #positioner-stored {
+            thead { tr { th { "Tilt column" } th { "Rotate column" } th { "Reflectors" } th { "Readings" } th { "RMS [mm]" } th { "Max [mm]" } th { "σ [mm]" } th { "Created" } th {} } }
+            tbody {
+                tr {
+                    td.tilt { (p.tilt_column) }
+                    td.rotate { (p.rotate_column) }
+                    td.reflectors { (p.reflectors) }
+                    td.readings { (p.readings) }
+                    td.rms { (mm(p.rms_mm)) }
+                    td.max { (mm(p.max_mm)) }
+                    td.sigma { (mm(p.sigma_mm)) }
+                    td { time datetime=(p.created_at) { (p.created_at) } }
+                    td {
+                        a href=(url) { "positioner JSON" } " "
+                        button.small.danger #delete-positioner data-delete=(url)
+                            data-confirm={ "Delete the positioner of robot " (r.id) " (" (r.name) ")? Solves, predictions and filters that give positioner values are refused until a positioner is fitted again." } { "Delete the positioner" }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// A select of the columns `e1` … `e6`, `default` chosen.
+fn column_select(label: &str, name: &str, default: ExternalAxis) -> Markup {
+    html! {
+        label { (label) " "
+            select name=(name) {
+                @for a in ExternalAxis::ALL {
+                    option value=(a.column()) selected[a == default] { (a.column()) }
+                }
+            }
+        }
+    }
+}
+
+/// The tracker's σ per coordinate, prefilled with the API's default.
+fn sigma_input(default: f64) -> Markup {
+    html! {
+        label title="The tracker's noise per coordinate, 1σ; the fit is judged against it" { "Tracker σ [mm] "
+            input name="sigma_mm" type="number" step="any" min="0" max="10" value=(default) required; }
+    }
+}
+
+/// The form that fits the track (`POST …/track/calibrate`).
+fn track_form(id: i64) -> Markup {
+    html! {
+        p.note { "One measurement file: the reflector at 3 or more robot poses (not on a line) at each of 5 or more track values; columns q1…qN (controller degrees), the track's value [mm] in an e column, x, y, z [mm] in the tracker frame. The robot's calibrated version is held (the active one unless a version is given). A fit replaces the stored track." }
+        form #calibrate-track data-action="calibrate-track" data-robot=(id) {
+            label.wide { "Measurement file " input type="file" name="file" accept=".csv,text/csv"; }
+            label.wide { "or paste it " textarea name="csv" rows="3" placeholder="q1,q2,q3,q4,q5,q6,e1,x,y,z" {} }
+            (column_select("Track column", "column", ExternalAxis::E1))
+            (sigma_input(tracks::DEFAULT_SIGMA_MM))
+            label title="The highest order of the carriage maps tried; 0: a straight rail" { "Highest map order "
+                input name="max_order" type="number" min="0" max=(MAX_MAP_ORDER) step="1" value=(DEFAULT_MAX_ORDER) required; }
+            label title="The calibrated version held; empty: the active one" { "Version "
+                input name="version" type="number" min="1" step="1" placeholder="active"; }
+            label title="The payload of readings that give none; empty: the version's" { "Payload [kg] "
+                input name="payload_kg" type="number" step="any" min="0" max=(PAYLOAD_MAX_KG) placeholder="version's"; }
+            button type="submit" { "Fit the track" }
+        }
+        p #track-result hidden {}
+    }
+}
+
+/// The form that fits the positioner (`POST …/positioner/calibrate`).
+fn positioner_form(id: i64) -> Markup {
+    html! {
+        p.note { "One measurement file per reflector on the face plate: each axis swept over 90° or more at 4 or more values with the other held; the axes' values [°] in two e columns, x, y, z [mm] in the tracker frame; no joints needed. The reflectors' design positions on the face plate [mm], one x, y, z line per file, in the files' order (the first is the reference). A fit replaces the stored positioner." }
+        form #calibrate-positioner data-action="calibrate-positioner" data-robot=(id) {
+            label.wide { "Nominal positioner (JSON) " input type="file" name="nominal_file" accept=".json,application/json"; }
+            label.wide { "or paste it " textarea name="nominal" rows="3" placeholder="{\"cell_from_base\": ..., \"tilt\": ..., \"rotate\": ..., \"face_plate\": ...}" {} }
+            label.wide { "Measurement files, one per reflector " input type="file" name="sets" multiple accept=".csv,text/csv"; }
+            p.note.files #positioner-files {}
+            label.wide { "Reflectors' design positions [mm], one x, y, z line per file " textarea name="reflectors" rows="3" placeholder="400, 0, 20" {} }
+            (column_select("Tilt column", "tilt_column", ExternalAxis::E1))
+            (column_select("Rotate column", "rotate_column", ExternalAxis::E2))
+            (sigma_input(crate::http::positioners::DEFAULT_SIGMA_MM))
+            button type="submit" { "Fit the positioner" }
+        }
+        p #positioner-result hidden {}
+    }
+}
