@@ -8,7 +8,6 @@
 
 use super::input::present_int;
 use super::plans::{ProgramOut, WAIT_MAX_S};
-use super::programs::FileIn;
 use super::{ApiError, ApiJson, ApiPath, AppState};
 use crate::plan::WorkspaceBox;
 use crate::program::Language;
@@ -158,16 +157,7 @@ pub async fn plan(
         centre_mm: p.cube.centre_mm,
         poses: p.poses,
         plan_csv: done.plan_csv,
-        program: done.program.zip(language).map(|(files, l)| ProgramOut {
-            language: l,
-            files: files
-                .into_iter()
-                .map(|f| FileIn {
-                    name: f.name,
-                    content: f.text,
-                })
-                .collect(),
-        }),
+        program: ProgramOut::of(done.program, language),
     })
     .into_response())
 }

@@ -146,6 +146,25 @@ pub struct ProgramOut {
     pub files: Vec<FileIn>,
 }
 
+impl ProgramOut {
+    /// The program's files as answered, `None` without a program.
+    pub fn of(
+        files: Option<Vec<crate::program::ProgramFile>>,
+        language: Option<Language>,
+    ) -> Option<Self> {
+        files.zip(language).map(|(files, language)| ProgramOut {
+            language,
+            files: files
+                .into_iter()
+                .map(|f| FileIn {
+                    name: f.name,
+                    content: f.text,
+                })
+                .collect(),
+        })
+    }
+}
+
 /// The answer.
 #[derive(Debug, Serialize)]
 pub struct PlanResponse {
@@ -446,16 +465,7 @@ pub async fn plan(
     let cmd = command(robot_id, req)?;
     let language = cmd.program.as_ref().map(|p| p.0);
     let done = service::plans::make(&state, cmd).await?;
-    let program = done.program.zip(language).map(|(files, l)| ProgramOut {
-        language: l,
-        files: files
-            .into_iter()
-            .map(|f| FileIn {
-                name: f.name,
-                content: f.text,
-            })
-            .collect(),
-    });
+    let program = ProgramOut::of(done.program, language);
     Ok(axum::Json(response(robot_id, done.plan, done.joints_csv, program)).into_response())
 }
 
