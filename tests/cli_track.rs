@@ -787,11 +787,12 @@ fn a_planned_track_measurement_is_joined_and_fitted() {
             &mut rng,
         )
         .unwrap();
-    let mut export = String::from("name,x,y,z\n");
-    for (p, m) in plan.points.iter().zip(&read.poses) {
-        let [x, y, z] = m.xyz_mm;
-        export.push_str(&format!("{},{x},{y},{z}\n", p.name));
-    }
+    let export = core_common::tracker_export(
+        plan.points
+            .iter()
+            .zip(&read.poses)
+            .map(|(p, m)| (p.name.as_str(), m.xyz_mm)),
+    );
     std::fs::write(d.path().join("export.csv"), export).unwrap();
     let out = robocal(
         d.path(),

@@ -185,11 +185,13 @@ fn a_planned_positioner_measurement_scatters_as_predicted() {
         let mut readings = Vec::new();
         for k in 0..example::DESIGN_MM.len() {
             let at: Vec<(usize, [f64; 2])> = plan.values_deg.iter().map(|v| (k, *v)).collect();
-            let mut export = String::from("name,x,y,z\n");
-            for (p, r) in points.iter().zip(truth.read(&at, &mut rng)) {
-                let [x, y, z] = r.xyz_mm;
-                export.push_str(&format!("{},{x},{y},{z}\n", p.name));
-            }
+            let read = truth.read(&at, &mut rng);
+            let export = common::tracker_export(
+                points
+                    .iter()
+                    .zip(&read)
+                    .map(|(p, r)| (p.name.as_str(), r.xyz_mm)),
+            );
             let joined = join(&points, &export, &JoinOptions::default()).unwrap();
             let file = csv::write_set(&joined.set());
             assert!(file.starts_with("e1,e2,x,y,z\n"), "{file}");

@@ -16,7 +16,8 @@
 mod common;
 
 use common::track::{
-    calibrated_on_fixed_base, measure_on_track, true_pose, ys100_truth, STATIONS, TRACKER_SIGMA_MM,
+    calibrated_on_fixed_base, measure_on_track, read_stations, true_pose, ys100_truth, STATIONS,
+    TRACKER_SIGMA_MM,
 };
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -312,15 +313,7 @@ fn fits_the_readings_cannot_carry_are_refused() {
             })
             .collect::<Vec<_>>(),
     )];
-    let again = track
-        .measure(
-            &truth,
-            ExternalAxis::E1,
-            &stations,
-            Some(nominal.payload.mass),
-            &mut rng,
-        )
-        .unwrap();
+    let again = read_stations(&truth, &nominal, &track, &stations, &mut rng);
     for (k, &i) in rows.iter().enumerate() {
         line.poses[i] = again.poses[k].clone();
     }
@@ -598,21 +591,15 @@ fn a_planned_track_measurement_fits_and_validates() {
         assert_eq!(plan.stations.len(), 11);
         assert_eq!(plan.points.len(), 44);
         let stations = planned_stations(&plan);
-        let measured = track
-            .measure(
-                &truth,
-                ExternalAxis::E1,
-                &stations,
-                Some(nominal.payload.mass),
-                &mut rng,
-            )
-            .unwrap();
+        let measured = read_stations(&truth, &nominal, &track, &stations, &mut rng);
         // The tracker's export names each point; joined back to the plan's CSV.
-        let mut export = String::from("name,x,y,z\n");
-        for (p, m) in plan.points.iter().zip(&measured.poses).rev() {
-            let [x, y, z] = m.xyz_mm;
-            export.push_str(&format!("{},{x},{y},{z}\n", p.name));
-        }
+        let export = common::tracker_export(
+            plan.points
+                .iter()
+                .zip(&measured.poses)
+                .rev()
+                .map(|(p, m)| (p.name.as_str(), m.xyz_mm)),
+        );
         let points = read_plan_csv(&plan_csv(&plan.points)).unwrap();
         assert_eq!(points, plan.points);
         let joined = join(&points, &export, &JoinOptions::default()).unwrap();
@@ -642,15 +629,13 @@ fn a_planned_track_measurement_fits_and_validates() {
             ..settings.clone()
         };
         let sparse = make_track_plan(&calibrated, &drawing, &sparse).unwrap();
-        let read = track
-            .measure(
-                &truth,
-                ExternalAxis::E1,
-                &planned_stations(&sparse),
-                Some(nominal.payload.mass),
-                &mut rng,
-            )
-            .unwrap();
+        let read = read_stations(
+            &truth,
+            &nominal,
+            &track,
+            &planned_stations(&sparse),
+            &mut rng,
+        );
         // A sparse plan may be refused (the rail bending faster than it samples).
         let sparse = match fit_track(&request(&calibrated, &read, DEFAULT_MAX_ORDER)) {
             Ok(f) => {

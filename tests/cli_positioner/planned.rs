@@ -56,11 +56,13 @@ fn a_planned_positioner_measurement_is_joined_and_fitted() {
     let mut rng = ChaCha8Rng::seed_from_u64(3);
     for k in 0..2 {
         let at: Vec<(usize, [f64; 2])> = plan.values_deg.iter().map(|v| (k, *v)).collect();
-        let mut export = String::from("name,x,y,z\n");
-        for (p, r) in plan.points.iter().zip(truth.read(&at, &mut rng)) {
-            let [x, y, z] = r.xyz_mm;
-            export.push_str(&format!("{},{x},{y},{z}\n", p.name));
-        }
+        let read = truth.read(&at, &mut rng);
+        let export = crate::core_common::tracker_export(
+            plan.points
+                .iter()
+                .zip(&read)
+                .map(|(p, r)| (p.name.as_str(), r.xyz_mm)),
+        );
         std::fs::write(d.path().join(format!("nest{k}.csv")), export).unwrap();
         let (nest, set) = (format!("nest{k}.csv"), format!("r{k}.csv"));
         let out = robocal(

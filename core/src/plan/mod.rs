@@ -106,3 +106,15 @@ pub fn make_plan(model: &RobotModel, s: &PlanSettings) -> Result<MeasurementPlan
         predicted,
     })
 }
+
+/// `n` (at least 2) values evenly over `[lo, hi]`, both ends included,
+/// rounded to `decimals` decimals (a track's stations, a positioner's sweeps).
+pub(crate) fn evenly([lo, hi]: [f64; 2], n: usize, decimals: i32) -> Vec<f64> {
+    let k = 10f64.powi(decimals);
+    (0..n)
+        .map(|i| {
+            let v = lo + (hi - lo) * i as f64 / (n - 1) as f64;
+            (v * k).round() / k
+        })
+        .collect()
+}

@@ -21,14 +21,13 @@
 //! face plate frame [mm]; axis values in the controller's degrees.
 
 use super::settings::PlanError;
-use super::PlanPoint;
+use super::{evenly, PlanPoint};
 use crate::calibrate::external::fit::{axis_sigma, reflector_sigmas, variances};
 use crate::calibrate::external::judge::{MAX_CONDITION, MIN_ANGLES, MIN_RADIUS_MM, MIN_SPAN_DEG};
 use crate::calibrate::external::outcome::{Axis, AxisSigma};
 use crate::calibrate::external::problem::{jacobian, Gauge, Row, State};
 use crate::calibrate::external::readings::PositionerColumns;
 use crate::measure::external::{ExternalAxis, ExternalValues};
-use crate::model::external::rotary::Line;
 use crate::model::external::TiltRotate;
 use nalgebra::Vector3;
 
@@ -93,16 +92,6 @@ pub struct PositionerPlan {
     pub noise_mm: f64,
 }
 
-/// `n` values evenly over `[lo, hi]`, rounded to 0.0001°.
-fn spread(lo: f64, hi: f64, n: usize) -> Vec<f64> {
-    (0..n)
-        .map(|i| {
-            let v = lo + (hi - lo) * i as f64 / (n - 1) as f64;
-            (v * 1e4).round() / 1e4
-        })
-        .collect()
-}
-
 fn check_sweep(name: &str, range: [f64; 2], values: usize) -> Result<(), PlanError> {
     let [lo, hi] = range;
     if !(lo.is_finite() && hi.is_finite() && lo < hi && lo >= -360.0 && hi <= 360.0) {
@@ -124,12 +113,6 @@ fn check_sweep(name: &str, range: [f64; 2], values: usize) -> Result<(), PlanErr
     Ok(())
 }
 
-/// Distance of `p` [m] from `line` [mm].
-fn from_line_mm(line: &Line, p: &Vector3<f64>) -> f64 {
-    let d = p - line.point;
-    (d - line.direction * line.direction.dot(&d)).norm() * 1e3
-}
-
 /// Refuses a reflector nearer than the judgement's radius to either axis at
 /// the sweeps' held values.
 fn check_radii(
@@ -138,20 +121,16 @@ fn check_radii(
     held: [f64; 2],
 ) -> Result<(), PlanError> {
     for (k, r) in s.reflectors_mm.iter().enumerate() {
-        let on_plate = Vector3::from(*r) * 1e-3;
-        // About axis 2 (rotate frame) and about axis 1 at the held rotate value (base frame).
-        let in_rotate = nominal.face_plate.transform_point(&on_plate);
-        let rotate_line = Line {
-            direction: nominal.rotate.direction,
-            point: nominal.rotate.point,
-        };
-        let in_base = nominal
-            .base_from_face_plate([0.0, held[1]])
-            .transform_point(&on_plate);
-        for (axis, mm) in [
-            ("axis 2", from_line_mm(&rotate_line, &in_rotate)),
-            ("axis 1", from_line_mm(&nominal.tilt_line(), &in_base)),
+        // At the held values, in the base frame (a turn about an axis keeps
+        // the distance from it).
+        let p = nominal
+            .base_from_face_plate(held)
+            .transform_point(&(Vector3::from(*r) * 1e-3));
+        for (axis, line) in [
+            ("axis 2", nominal.rotate_line(held[0])),
+            ("axis 1", nominal.tilt_line()),
         ] {
+            let mm = line.distance_of(&p) * 1e3;
             if mm.is_nan() || mm < MIN_RADIUS_MM {
                 return Err(PlanError::Setting(format!(
                     "reflector {} is {mm:.1} mm from {axis}; the fit needs at least {MIN_RADIUS_MM} mm (its circle fixes the axis's line)",
@@ -201,11 +180,11 @@ pub fn make_positioner_plan(
         0.0f64.clamp(s.rotate_deg[0], s.rotate_deg[1]),
     ];
     check_radii(nominal, s, held)?;
-    let values_deg: Vec<[f64; 2]> = spread(s.rotate_deg[0], s.rotate_deg[1], s.rotate_values)
+    let values_deg: Vec<[f64; 2]> = evenly(s.rotate_deg, s.rotate_values, 4)
         .into_iter()
         .map(|r| [held[0], r])
         .chain(
-            spread(s.tilt_deg[0], s.tilt_deg[1], s.tilt_values)
+            evenly(s.tilt_deg, s.tilt_values, 4)
                 .into_iter()
                 .map(|t| [t, held[1]]),
         )

@@ -23,7 +23,7 @@
 use super::candidates::{self, sight_angle_deg};
 use super::pose_selection::greedy_d_optimal;
 use super::settings::{FilterCounts, PlanError, PlanSettings};
-use super::PlanPoint;
+use super::{evenly, PlanPoint};
 use crate::measure::external::{ExternalAxis, ExternalValues};
 use crate::model::external::LinearTrack;
 use crate::model::kinematics::fk;
@@ -109,16 +109,6 @@ pub struct TrackPlan {
     pub counts: FilterCounts,
     /// Tracker noise the prediction assumes [mm].
     pub noise_mm: f64,
-}
-
-/// The stations' values: `n` evenly over `[lo, hi]`, rounded to 0.001 mm.
-fn station_values(lo: f64, hi: f64, n: usize) -> Vec<f64> {
-    (0..n)
-        .map(|i| {
-            let v = lo + (hi - lo) * i as f64 / (n - 1) as f64;
-            (v * 1e3).round() / 1e3
-        })
-        .collect()
 }
 
 /// One reading's block `[I₃, −[p]×]` at reflector position `p` [m].
@@ -210,7 +200,7 @@ pub fn make_track_plan(
     let mut stations = Vec::new();
     let mut points = Vec::new();
     let mut q_model = Vec::new();
-    for value_mm in station_values(lo, hi, count) {
+    for value_mm in evenly([lo, hi], count, 3) {
         let cell_from_base = track
             .cell_from_base(value_mm)
             .map_err(|e| PlanError::Setting(format!("station at {value_mm} mm: {e}")))?;
@@ -287,10 +277,10 @@ mod tests {
     #[test]
     fn stations_cover_the_travel_evenly_with_both_ends() {
         assert_eq!(
-            station_values(0.0, 4000.0, 5),
+            evenly([0.0, 4000.0], 5, 3),
             vec![0.0, 1000.0, 2000.0, 3000.0, 4000.0]
         );
-        assert_eq!(station_values(-100.0, 200.0, 7)[1], -50.0);
+        assert_eq!(evenly([-100.0, 200.0], 7, 3)[1], -50.0);
     }
 
     /// The turns' block of `(JᵀJ)⁻¹` is the station fit's

@@ -178,3 +178,13 @@ pub fn noisy_measurement(
         std: None,
     }
 }
+
+/// A tracker's export naming each point: `name,x,y,z` [mm], the rows in the
+/// order given (a plan's point name and the position read there).
+pub fn tracker_export<'a>(rows: impl IntoIterator<Item = (&'a str, [f64; 3])>) -> String {
+    let mut export = String::from("name,x,y,z\n");
+    for (name, [x, y, z]) in rows {
+        export.push_str(&format!("{name},{x},{y},{z}\n"));
+    }
+    export
+}

@@ -48,11 +48,23 @@ pub fn measure_on_track(
         .iter()
         .map(|v| (*v, random_configurations(nominal, n, rng)))
         .collect();
+    read_stations(truth, nominal, track, &stations, rng)
+}
+
+/// `truth` carried by `track` read at each station's configurations (model
+/// convention, rad) with the nominal payload, as a set with column e1.
+pub fn read_stations(
+    truth: &TrueRobot,
+    nominal: &RobotModel,
+    track: &TrueTrack,
+    stations: &[(f64, Vec<Vec<f64>>)],
+    rng: &mut ChaCha8Rng,
+) -> MeasurementSet {
     track
         .measure(
             truth,
             ExternalAxis::E1,
-            &stations,
+            stations,
             Some(nominal.payload.mass),
             rng,
         )
