@@ -1,6 +1,8 @@
 //! `robocal calibrate`: identify calibrated models from measurement CSVs and
 //! print the comparison of methods (like the thesis's Tables 2.5/2.6) with the
-//! identifiability report, or the same as JSON.
+//! identifiability report, or the same as JSON. With `--track-column e1` the
+//! files are a robot on a linear track read at several track values, each
+//! value a tracker session of its own (`MeasurementSet::stations_as_sessions`).
 
 mod render;
 
@@ -88,6 +90,13 @@ pub struct CalibrateArgs {
     /// recognised as a quaternion without it; default fixed_xyz).
     #[arg(long, value_parser = super::orientation_arg::OrientationValues)]
     pub orientation: Option<crate::measure::convention::MeasuredOrientation>,
+    /// The robot stands on a linear track and every file carries the
+    /// track's column (e1 … e6, mm): each track value is a station, its own
+    /// tracker session (there the base stands still in the tracker's
+    /// frame), so the robot is identified over every station. `robocal
+    /// track calibrate` then fits the track with the saved model.
+    #[arg(long, value_parser = super::track::parse_axis)]
+    pub track_column: Option<crate::measure::external::ExternalAxis>,
     /// Print the full report as JSON on stdout.
     #[arg(long)]
     pub json: bool,
@@ -149,8 +158,17 @@ impl TypedValueParser for MethodValues {
     }
 }
 
-fn read_rows(path: &str, read: csv::ReadOptions) -> anyhow::Result<Vec<measure::MeasuredPose>> {
-    super::orientation_arg::read_measurements(std::path::Path::new(path), read)
+/// The rows of one file; with `--track-column`, each in its station's session.
+fn read_rows(
+    a: &CalibrateArgs,
+    path: &str,
+    read: csv::ReadOptions,
+) -> anyhow::Result<Vec<measure::MeasuredPose>> {
+    let path = std::path::Path::new(path);
+    match a.track_column {
+        Some(axis) => super::orientation_arg::read_stations(path, read, axis),
+        None => super::orientation_arg::read_measurements(path, read),
+    }
 }
 
 /// Measured rows of one role, each with its tracker-session label.
@@ -180,7 +198,7 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     }
     let payload = a.payload_kg.unwrap_or(model.payload.mass);
     let rows = read_rows_by_role(&a, read, &model)?;
-    let sessions = sessions_of(&rows)?;
+    let sessions = sessions_of(&rows, a.track_column)?;
     let ident = to_si(&rows.identification, &sessions, &model, payload);
     let valid = to_si(&rows.validation, &sessions, &model, payload);
     let training = to_si(&rows.training, &sessions, &model, payload);
@@ -232,7 +250,7 @@ fn read_rows_by_role(
         sources: PoseSources::default(),
     };
     for (i, path) in a.identify.iter().enumerate() {
-        let rows = read_rows(path, read)?;
+        let rows = read_rows(a, path, read)?;
         csv::check_joint_count(&rows, model.dof()).with_context(|| path.clone())?;
         for (k, r) in rows.into_iter().enumerate() {
             let s = r.session.clone().unwrap_or_else(|| label(i));
@@ -254,7 +272,7 @@ fn read_rows_by_role(
         }
     }
     for path in &a.train {
-        let more = read_rows(path, read)?;
+        let more = read_rows(a, path, read)?;
         csv::check_joint_count(&more, model.dof()).with_context(|| path.clone())?;
         for (k, r) in more.into_iter().enumerate() {
             let s = r.session.clone().unwrap_or_else(|| label(0));
@@ -264,7 +282,7 @@ fn read_rows_by_role(
     }
     let same_count = a.validate.len() == a.identify.len();
     for (j, path) in a.validate.iter().enumerate() {
-        let more = read_rows(path, read)?;
+        let more = read_rows(a, path, read)?;
         csv::check_joint_count(&more, model.dof()).with_context(|| path.clone())?;
         let own = label(if same_count { j } else { 0 });
         for (k, r) in more.into_iter().enumerate() {
@@ -278,13 +296,27 @@ fn read_rows_by_role(
 
 /// The tracker sessions in order of their first identification row; an
 /// error when validation or training rows come from a session without
-/// identification rows (its frame could not be registered).
-fn sessions_of(rows: &RowsByRole) -> anyhow::Result<Vec<String>> {
+/// identification rows (its frame could not be registered). With a track
+/// (`--track-column`) a session is a station, and the message says so.
+fn sessions_of(
+    rows: &RowsByRole,
+    track: Option<crate::measure::external::ExternalAxis>,
+) -> anyhow::Result<Vec<String>> {
     let mut sessions: Vec<String> = Vec::new();
     for (s, _) in &rows.identification {
         if !sessions.contains(s) {
             sessions.push(s.clone());
         }
+    }
+    let unregistered = rows
+        .validation
+        .iter()
+        .chain(&rows.training)
+        .find(|(s, _)| !sessions.contains(s));
+    if let (Some(axis), Some((s, _))) = (track, unregistered) {
+        bail!(
+            "readings at station `{s}` are for validation or training only: with --track-column {axis} every station needs identification readings, which fit its frame; readings at track values never fitted validate the track (`robocal track calibrate --validate`)"
+        );
     }
     if let Some((s, _)) = rows.validation.iter().find(|(s, _)| !sessions.contains(s)) {
         bail!(

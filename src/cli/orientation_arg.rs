@@ -52,3 +52,20 @@ pub fn read_measurements(
         std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
     crate::measure::csv::parse_opts(&text, &read).with_context(|| path.display().to_string())
 }
+
+/// Reads a measurement CSV carrying a track's column `track`, each
+/// reading in the tracker session of its station
+/// (`MeasurementSet::stations_as_sessions`).
+pub fn read_stations(
+    path: &std::path::Path,
+    read: crate::measure::csv::ReadOptions,
+    track: crate::measure::external::ExternalAxis,
+) -> anyhow::Result<Vec<crate::measure::MeasuredPose>> {
+    use anyhow::Context;
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let set = crate::measure::csv::parse_set_opts(&text, &read)
+        .with_context(|| path.display().to_string())?;
+    set.stations_as_sessions(track)
+        .with_context(|| format!("{} (--track-column {track})", path.display()))
+}

@@ -125,6 +125,64 @@ impl MeasurementSet {
     pub fn has(&self, axis: ExternalAxis) -> bool {
         self.axes.contains(&axis)
     }
+
+    /// The readings as robot-only rows, each in its own tracker session per
+    /// value of the track's `axis` (its label `e1=400`, after the row's own
+    /// `session` label when it has one): at one track value the robot's
+    /// base stands still in the tracker's frame, so a robot calibration can
+    /// take each station as a session whose frame it fits, and identify the
+    /// robot over every station. Refused, naming the column: a set without
+    /// `axis`, or with another external axis (whose motion the robot's
+    /// calibration would ignore).
+    pub fn stations_as_sessions(
+        &self,
+        axis: ExternalAxis,
+    ) -> Result<Vec<MeasuredPose>, StationSessionsError> {
+        if !self.has(axis) {
+            return Err(StationSessionsError::MissingColumn(axis));
+        }
+        if let Some(other) = self.axes.iter().find(|a| **a != axis) {
+            return Err(StationSessionsError::OtherAxis {
+                axis,
+                other: *other,
+            });
+        }
+        Ok(self
+            .readings()
+            .map(|r| {
+                let value = r
+                    .external
+                    .get(axis)
+                    .expect("every reading carries the set's axes");
+                let station = format!("{axis}={value}");
+                let session = match &r.pose.session {
+                    Some(s) => format!("{s} {station}"),
+                    None => station,
+                };
+                MeasuredPose {
+                    session: Some(session),
+                    ..r.pose.clone()
+                }
+            })
+            .collect())
+    }
+}
+
+/// Why a set's stations cannot be read as tracker sessions
+/// ([`MeasurementSet::stations_as_sessions`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum StationSessionsError {
+    /// The set has no column for the track.
+    #[error("the file has no `{0}` column: give the track's value of every reading")]
+    MissingColumn(ExternalAxis),
+    /// The set carries another external axis too.
+    #[error("the file has an `{other}` column besides the track's `{axis}`: a robot calibration over track stations composes through the track alone, and would read `{other}` as standing still")]
+    OtherAxis {
+        /// The track's column.
+        axis: ExternalAxis,
+        /// The other column.
+        other: ExternalAxis,
+    },
 }
 
 /// One reading of a [`MeasurementSet`].

@@ -258,7 +258,7 @@ pub enum CsvError {
     },
     /// External-axis values given to a reader that does not compose them (a
     /// robot calibration, check or solve).
-    #[error("line {line}, column `{column}`: external-axis values are read by the track and positioner fits only (docs/external-axes.md); a robot calibration, check or solve does not compose through external axes yet, so the file is refused rather than read as if the axes stood still")]
+    #[error("line {line}, column `{column}`: external-axis values are read by the track and positioner fits only (docs/external-axes.md); a robot calibration, check or solve does not compose through external axes yet, so the file is refused rather than read as if the axes stood still (a robot on a track is calibrated over its stations with `robocal calibrate --track-column {column}`)")]
     ExternalNotComposed {
         /// 1-based line of the header.
         line: usize,
