@@ -70,6 +70,29 @@ impl SetFormat {
     }
 }
 
+/// The statement inserting the set `$s`, returning its id.
+macro_rules! insert_set {
+    ($s:expr) => {
+        sqlx::query_scalar(
+            "INSERT INTO measurement_sets (robot_id, name, role, session, payload_kg, \
+             length_unit, angle_unit, format, original, rows_json, row_count, dof) \
+             VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12) RETURNING id",
+        )
+        .bind($s.robot_id)
+        .bind($s.name)
+        .bind($s.role)
+        .bind($s.session)
+        .bind($s.payload_kg)
+        .bind($s.length_unit)
+        .bind($s.angle_unit)
+        .bind($s.format)
+        .bind($s.original)
+        .bind(Json($s.rows))
+        .bind($s.row_count)
+        .bind($s.dof)
+    };
+}
+
 impl Db {
     /// Stores a set; `None` when its robot does not exist (any more).
     pub async fn insert_set(&self, s: &NewSet<'_>) -> Result<Option<SetRow>, StoreError> {
@@ -77,26 +100,34 @@ impl Db {
             let Some(mut tx) = write_for_robot!(p, k, s.robot_id) else {
                 return Ok(None);
             };
-            let id: i64 = sqlx::query_scalar(
-                "INSERT INTO measurement_sets (robot_id, name, role, session, payload_kg, \
-                 length_unit, angle_unit, format, original, rows_json, row_count, dof) \
-                 VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12) RETURNING id",
-            )
-            .bind(s.robot_id)
-            .bind(s.name)
-            .bind(s.role)
-            .bind(s.session)
-            .bind(s.payload_kg)
-            .bind(s.length_unit)
-            .bind(s.angle_unit)
-            .bind(s.format)
-            .bind(s.original)
-            .bind(Json(s.rows))
-            .bind(s.row_count)
-            .bind(s.dof)
-            .fetch_one(&mut *tx)
-            .await?;
+            let id: i64 = insert_set!(s).fetch_one(&mut *tx).await?;
             Some(commit_inserted!(tx, SetRow, SET_SELECT, "id", id))
+        }))
+    }
+
+    /// Stores sets of one robot in one transaction, all or none, in their
+    /// order; `None` when the robot does not exist (any more).
+    pub async fn insert_sets(
+        &self,
+        robot_id: i64,
+        sets: &[NewSet<'_>],
+    ) -> Result<Option<Vec<SetRow>>, StoreError> {
+        Ok(on_pool!(self, |p, k| {
+            let Some(mut tx) = write_for_robot!(p, k, robot_id) else {
+                return Ok(None);
+            };
+            let mut rows = Vec::with_capacity(sets.len());
+            for s in sets {
+                debug_assert_eq!(s.robot_id, robot_id);
+                let id: i64 = insert_set!(s).fetch_one(&mut *tx).await?;
+                let row = sqlx::query_as::<_, SetRow>(&format!("{SET_SELECT} WHERE id = $1"))
+                    .bind(id)
+                    .fetch_one(&mut *tx)
+                    .await?;
+                rows.push(row);
+            }
+            tx.commit().await?;
+            Some(rows)
         }))
     }
 

@@ -18,8 +18,7 @@ use serde::Deserialize;
 use std::fmt;
 use std::marker::PhantomData;
 
-/// Longest accepted robot, set or session name (characters).
-pub const NAME_MAX: usize = 200;
+pub use crate::service::limits::NAME_MAX;
 
 /// Parses a JSON object body: 400 when it is not JSON, 422 when it is JSON of
 /// the wrong shape (an array, a scalar, a wrong field).

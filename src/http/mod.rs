@@ -47,6 +47,7 @@ pub mod server;
 pub mod sets;
 pub mod solve;
 pub mod solve_columns;
+pub mod station_sets;
 pub mod tracks;
 pub mod versions;
 
@@ -84,6 +85,7 @@ fn routes() -> Vec<Route> {
     all.extend(record::routes());
     all.extend(iso9283::routes());
     all.extend(tracks::routes());
+    all.extend(station_sets::routes());
     all.extend(positioners::routes());
     all
 }

@@ -196,16 +196,16 @@ impl MeasurementSet {
 type Length = LengthUnit;
 type Angle = AngleUnit;
 
-struct Checked {
-    name: String,
-    role: Option<SetRole>,
-    session: String,
-    payload_kg: Option<f64>,
-    length: Length,
-    angle: Angle,
+pub(super) struct Checked {
+    pub(super) name: String,
+    pub(super) role: Option<SetRole>,
+    pub(super) session: String,
+    pub(super) payload_kg: Option<f64>,
+    pub(super) length: Length,
+    pub(super) angle: Angle,
 }
 
-fn check_params(p: &SetParams) -> Result<Checked, ApiError> {
+pub(super) fn check_params(p: &SetParams) -> Result<Checked, ApiError> {
     let role = p
         .role
         .as_deref()
@@ -438,7 +438,7 @@ fn check_std(n: usize, r: &RowInput, first: bool) -> Result<(), ApiError> {
 }
 
 /// The CSV reading options of an upload's query.
-fn read_options(q: &SetParams, c: &Checked) -> Result<ReadOptions, ApiError> {
+pub(super) fn read_options(q: &SetParams, c: &Checked) -> Result<ReadOptions, ApiError> {
     let dif = match q.dif_sign.as_deref() {
         None | Some("plus") => DifSign::Plus,
         Some("minus") => DifSign::Minus,

@@ -24,6 +24,9 @@ use std::time::Duration;
 /// gravity-torque arithmetic.
 pub const PAYLOAD_MAX_KG: f64 = 10_000.0;
 
+/// Longest accepted robot, set or session name (characters).
+pub const NAME_MAX: usize = 200;
+
 /// Most sets one calibration may use (per role).
 pub const MAX_SETS: usize = 100;
 

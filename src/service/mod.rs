@@ -37,6 +37,7 @@ pub mod sets;
 pub mod solve;
 mod start;
 mod state;
+pub mod station_sets;
 pub mod tracks;
 pub mod versions;
 mod waiting;

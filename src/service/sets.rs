@@ -54,7 +54,7 @@ pub struct NewSetCommand {
     pub content: SetContent,
 }
 
-fn csv_error(e: CsvError) -> ServiceError {
+pub(super) fn csv_error(e: CsvError) -> ServiceError {
     let hint = match e {
         CsvError::PositionUnits => "; if the file is in metres, upload it with ?length_unit=m",
         _ => "",
@@ -88,7 +88,11 @@ fn read_csv(
 /// unit conversion: the readers check them first, naming line or row; this
 /// is what keeps a record that could not be read back out of the store).
 /// Rows whose joint count is not the robot's conflict with the robot.
-fn check_rows(rows: &[MeasuredPose], dof: usize, max_rows: usize) -> Result<(), ServiceError> {
+pub(super) fn check_rows(
+    rows: &[MeasuredPose],
+    dof: usize,
+    max_rows: usize,
+) -> Result<(), ServiceError> {
     if rows.len() > max_rows {
         return Err(ServiceError::Invalid(format!(
             "{} rows in one set; at most {max_rows} (`--max-poses-per-set`): split the upload",

@@ -22,7 +22,8 @@
 //! and body timeouts, the connection cap), `exposure` (no open writes on a
 //! network by default), `track` (a robot's linear track: fitted, stored,
 //! and carrying predictions and solves, over HTTP and the CLI alike; `track_filter`: a program on
-//! it filtered), `positioner`
+//! it filtered; `track_sets`: a robot on a track uploaded one set per station
+//! and calibrated over them), `positioner`
 //! (a robot's two-axis positioner: fitted, stored, and carrying a targets CSV,
 //! over HTTP and the CLI alike); the harness is `support`.
 
@@ -39,6 +40,9 @@ mod contract;
 #[path = "../../core/tests/common/positioner.rs"]
 #[allow(dead_code)]
 mod core_positioner;
+#[path = "../../core/tests/common/track.rs"]
+#[allow(dead_code)]
+mod core_track;
 mod exposure;
 mod flow;
 mod hostile;
@@ -67,3 +71,4 @@ mod stored_jobs;
 mod support;
 mod track;
 mod track_filter;
+mod track_sets;

@@ -1,0 +1,194 @@
+//! A robot on a linear track measured at several track values, uploaded as
+//! one measurement CSV with the track's column and stored as one set per
+//! value (station): at one track value the base stands still in the
+//! tracker's frame, so each station is a tracker session of its own
+//! (`MeasurementSet::stations_as_sessions`, the command line's `calibrate
+//! --track-column`), and a calibration over the station sets identifies the
+//! robot over every station.
+//!
+//! Each station's set keeps, as its original, the upload's lines up to its
+//! header and the lines of its own rows, verbatim; the stations' originals
+//! together hold every line of the upload once. Every station is checked
+//! before any is stored, and they are stored in one transaction.
+
+use super::sets::{check_rows, csv_error, NewSetCommand, SetContent};
+use super::{AppState, ServiceError};
+use crate::db::NewSet;
+use crate::measure::csv::{self, ReadOptions};
+use crate::measure::csv_text;
+use crate::measure::external::ExternalAxis;
+use crate::measure::{MeasuredPose, SetRole};
+use crate::records::{SetFormat, SetRow};
+use crate::service::limits::{MAX_SETS, NAME_MAX};
+
+/// One station of an upload: its session, rows and lines.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Station {
+    /// The tracker session, `e1=400` (after the upload's session when given).
+    pub session: String,
+    /// Its rows (mm, deg).
+    pub rows: Vec<MeasuredPose>,
+    /// The upload's lines up to its header, then its rows' lines, verbatim.
+    pub original: String,
+}
+
+/// Splits a measurement CSV with the track's `column` into its stations in
+/// order of first appearance; `session`, when given, goes before each
+/// station's label (and a `session` column must agree with it).
+pub fn stations_of(
+    text: &str,
+    read: &ReadOptions,
+    column: ExternalAxis,
+    session: Option<&str>,
+) -> Result<Vec<Station>, ServiceError> {
+    let mut set = csv::parse_set_opts(text, read).map_err(csv_error)?;
+    for (i, r) in set.poses.iter_mut().enumerate() {
+        match (&r.session, session) {
+            (Some(s), Some(given)) if s != given => {
+                return Err(ServiceError::Invalid(format!(
+                    "row {}: the `session` column says `{s}` but the upload's session is `{given}`",
+                    i + 1
+                )))
+            }
+            (None, Some(given)) => r.session = Some(given.to_string()),
+            _ => {}
+        }
+    }
+    let rows = set
+        .stations_as_sessions(column)
+        .map_err(|e| ServiceError::Invalid(format!("measurement CSV: {e}")))?;
+    let table = csv_text::read(text, read.dialect)
+        .map_err(|e| ServiceError::Invalid(format!("measurement CSV: {e}")))?
+        .ok_or_else(|| ServiceError::Invalid("measurement CSV: empty".into()))?;
+    let lines: Vec<&str> = text
+        .strip_prefix('\u{feff}')
+        .unwrap_or(text)
+        .split_inclusive('\n')
+        .collect();
+    let head: String = lines[..table.header_line.min(lines.len())].concat();
+    let mut stations: Vec<Station> = Vec::new();
+    for (k, row) in rows.into_iter().enumerate() {
+        let start = table.records[k].line - 1;
+        let end = table
+            .records
+            .get(k + 1)
+            .map_or(lines.len(), |r| r.line - 1)
+            .min(lines.len());
+        let label = row
+            .session
+            .clone()
+            .expect("every station row has a session");
+        let i = match stations.iter().position(|s| s.session == label) {
+            Some(i) => i,
+            None => {
+                stations.push(Station {
+                    session: label,
+                    rows: Vec::new(),
+                    original: head.clone(),
+                });
+                stations.len() - 1
+            }
+        };
+        stations[i].rows.push(row);
+        stations[i].original.push_str(&lines[start..end].concat());
+    }
+    if stations.len() > MAX_SETS {
+        return Err(ServiceError::Invalid(format!(
+            "{} track values in one upload; at most {MAX_SETS} (a calibration takes at most {MAX_SETS} sets of a role)",
+            stations.len()
+        )));
+    }
+    Ok(stations)
+}
+
+/// Reads, checks and stores a track's measurement CSV as one set per
+/// station (module docs); the sets in order of first appearance.
+pub async fn upload(
+    state: &AppState,
+    cmd: NewSetCommand,
+    column: ExternalAxis,
+    session: Option<String>,
+) -> Result<Vec<SetRow>, ServiceError> {
+    let robot_id = cmd.robot_id;
+    let robot = state
+        .db()
+        .robot(robot_id)
+        .await?
+        .ok_or_else(|| ServiceError::robot_not_found(robot_id))?;
+    let dof = robot.dof as usize;
+    let max_rows = state.limits().poses_per_set;
+    let SetContent::Csv { text, read } = cmd.content else {
+        return Err(ServiceError::Invalid(
+            "a track's stations are read from a measurement CSV with the track's column".into(),
+        ));
+    };
+    if text.contains('\0') {
+        return Err(ServiceError::Invalid(
+            "the upload contains the NUL character (U+0000); measurement files are text".into(),
+        ));
+    }
+    let stations = tokio::task::spawn_blocking(move || {
+        let stations = stations_of(&text, &read, column, session.as_deref())?;
+        for s in &stations {
+            check_rows(&s.rows, dof, max_rows).map_err(|e| at_station(e, &s.session))?;
+        }
+        Ok::<_, ServiceError>(stations)
+    })
+    .await
+    .map_err(|e| ServiceError::Internal(format!("upload parser: {e}")))??;
+
+    let names: Vec<(String, SetRole)> = stations
+        .iter()
+        .map(|s| {
+            let role = cmd.role.unwrap_or_else(|| match s.rows[0].set {
+                Some(r) if s.rows.iter().all(|x| x.set == Some(r)) => r,
+                _ => SetRole::Identification,
+            });
+            let base = if cmd.name.is_empty() {
+                role.as_str()
+            } else {
+                cmd.name.as_str()
+            };
+            (format!("{base} {}", s.session), role)
+        })
+        .collect();
+    for (name, _) in &names {
+        if name.chars().count() > NAME_MAX {
+            return Err(ServiceError::Invalid(format!(
+                "the station set's name `{name}` is longer than {NAME_MAX} characters: give a shorter `name` or `session`"
+            )));
+        }
+    }
+    let sets: Vec<NewSet> = stations
+        .iter()
+        .zip(&names)
+        .map(|(s, (name, role))| NewSet {
+            robot_id,
+            name,
+            role: (*role).into(),
+            session: &s.session,
+            payload_kg: cmd.payload_kg,
+            length_unit: cmd.length,
+            angle_unit: cmd.angle,
+            format: SetFormat::Csv,
+            original: &s.original,
+            rows: &s.rows,
+            row_count: s.rows.len() as i64,
+            dof: dof as i64,
+        })
+        .collect();
+    state
+        .db()
+        .insert_sets(robot_id, &sets)
+        .await?
+        .ok_or_else(|| ServiceError::robot_not_found(robot_id))
+}
+
+/// A station's refusal, naming the station.
+fn at_station(e: ServiceError, station: &str) -> ServiceError {
+    match e {
+        ServiceError::Invalid(m) => ServiceError::Invalid(format!("station `{station}`: {m}")),
+        ServiceError::Conflict(m) => ServiceError::Conflict(format!("station `{station}`: {m}")),
+        other => other,
+    }
+}
