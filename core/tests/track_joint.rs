@@ -14,7 +14,9 @@
 mod common;
 
 use common::track::TRACKER_SIGMA_MM;
-use common::track::{calibrated_on_fixed_base, measure_on_track, ys100_truth, STATIONS};
+use common::track::{
+    calibrated_on_fixed_base, measure_on_track, physical_effects, ys100_truth, STATIONS,
+};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal_core::calibrate::external::track::{fit_track, TrackFit, TrackFitRequest};
@@ -183,11 +185,7 @@ fn the_robot_identified_over_the_stations_predicts_held_out_track_values() {
 /// links bending under gravity (`UnmodelledEffects::link_bending`).
 #[test]
 fn with_effects_the_model_lacks_the_stations_still_do_no_worse() {
-    let effects = UnmodelledEffects {
-        gear_error: Some((1e-5, 2)),
-        link_bending: 1e-8,
-        ..UnmodelledEffects::default()
-    };
+    let effects = physical_effects();
     for seed in [1u64, 2, 3] {
         let f = compare(seed, &effects);
         assert!(f.joint_rms <= 1.5 * f.fixed_val, "seed {seed}");

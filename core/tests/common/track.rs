@@ -10,7 +10,9 @@ use robocal_core::measure::external::{ExternalAxis, MeasurementSet};
 use robocal_core::measure::to_measurements;
 use robocal_core::model::{preset, Pose, RobotModel};
 use robocal_core::sim::track::TrueTrack;
-use robocal_core::sim::{perturb_geometry, random_configurations, ErrorMagnitudes, TrueRobot};
+use robocal_core::sim::{
+    perturb_geometry, random_configurations, ErrorMagnitudes, TrueRobot, UnmodelledEffects,
+};
 
 /// The tracker's noise per coordinate, 1σ [mm].
 pub const TRACKER_SIGMA_MM: f64 = 0.01;
@@ -31,6 +33,18 @@ pub fn ys100_truth(rng: &mut ChaCha8Rng) -> (RobotModel, TrueRobot) {
     ));
     truth.noise_mm = TRACKER_SIGMA_MM;
     (nominal, truth)
+}
+
+/// Effects a kinematic model cannot hold, for truths built from physics: a
+/// reducer's periodic transmission error (10 µrad at twice each joint's
+/// angle) and links bending under gravity (`link_bending` 1e-8 rad/(N·m²),
+/// some 0.02 mm on the YS100's arm).
+pub fn physical_effects() -> UnmodelledEffects {
+    UnmodelledEffects {
+        gear_error: Some((1e-5, 2)),
+        link_bending: 1e-8,
+        ..UnmodelledEffects::default()
+    }
 }
 
 /// `n` random poses of `nominal` at each of `values` [mm], measured on

@@ -2,7 +2,8 @@
 //! positioner's face plate, `E1`, `E2` of an `E6POS`), RAPID (a `wobjdata`
 //! moved by the unit `STN1`, `ufprog FALSE`, `eax_a`, `eax_b`) and Fanuc
 //! (`J1`, `J2` of motion group `GP2`). The truth: the YS100 with ~1 mm / 0.1°
-//! geometric errors (d6 and θ6 as designed) 1.6 m beside the positioner of
+//! geometric errors (d6 and θ6 as designed) and effects the kinematic model
+//! lacks (`common::track::physical_effects`) 1.6 m beside the positioner of
 //! `sim::positioner_example` (axes tilted 0.05° and offset 0.5 mm from their
 //! drawing, zero offsets, scale errors and a nod of the rotate axis no rigid
 //! model holds, from its physics). Calibrated: the robot on its fixed base
@@ -208,6 +209,7 @@ fn positioner_cell() -> &'static PositionerCell {
     C.get_or_init(|| {
         let mut rng = ChaCha8Rng::seed_from_u64(12);
         let (nominal, mut truth) = ys100_truth(&mut rng);
+        truth.effects = crate::common::track::physical_effects();
         truth.model.links[5].d = nominal.links[5].d;
         truth.model.links[5].theta = nominal.links[5].theta;
         truth.tracker_from_base = robot_in_cell();

@@ -1,7 +1,8 @@
 //! A robot on a linear track, in KRL (`E1` of an `E6POS`), RAPID (`eax_a`)
 //! and Fanuc (`E1` of `GP1`): the truth is the YS100 with ~1 mm / 0.1°
 //! geometric errors (d6 and θ6 as designed: a reflector cannot tell them
-//! from its own offset) on the simulated 4 m track from its physics
+//! from its own offset) and effects the kinematic model lacks (a reducer's
+//! periodic error, links bending: `common::track::physical_effects`) on the simulated 4 m track from its physics
 //! (`sim::track::TrueTrack::rail_4m`: rails bent by sines, a carriage
 //! yawing and pitching on its blocks, its rail rising 0.1° and its scale off
 //! by 0.2 mm/m); calibrated on a fixed base (KM), the track fitted from
@@ -62,6 +63,7 @@ pub(super) fn track_cell() -> &'static TrackCell {
     C.get_or_init(|| {
         let mut rng = ChaCha8Rng::seed_from_u64(11);
         let (nominal, mut truth) = ys100_truth(&mut rng);
+        truth.effects = crate::common::track::physical_effects();
         truth.model.links[5].d = nominal.links[5].d;
         truth.model.links[5].theta = nominal.links[5].theta;
         let true_track = TrueTrack::rail_4m();
