@@ -20,8 +20,9 @@
 
 use crate::plan::{
     join, make_plan, make_positioner_plan, make_track_plan, plan_csv, points_program,
-    read_plan_csv, JoinBy, JoinOptions, MeasurementPlan, PlanPoint, PlanSettings, PositionerPlan,
-    PositionerPlanSettings, TrackPlan, TrackPlanSettings, TrackerSight, Units, WorkspaceBox,
+    program_columns, read_plan_csv, JoinBy, JoinOptions, MeasurementPlan, PlanPoint, PlanSettings,
+    PositionerPlan, PositionerPlanSettings, TrackPlan, TrackPlanSettings, TrackerSight, Units,
+    WorkspaceBox,
 };
 use crate::program::Language;
 use anyhow::{bail, Context};
@@ -324,11 +325,6 @@ pub fn positioner_table(plan: &PositionerPlan, s: &PositionerPlanSettings) -> St
 
 /// The positioner's plan of `a` (`--positioner`).
 fn positioner_plan(a: &MakeArgs, path: &str) -> anyhow::Result<(Vec<PlanPoint>, String)> {
-    if a.format != PlanFormat::Csv {
-        bail!(
-            "a positioner's plan moves only the positioner's axes: write its CSV (--format csv); programs that move a positioner alone are not written"
-        );
-    }
     let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {path}"))?;
     let nominal =
         TiltRotate::from_json(&text).with_context(|| format!("positioner file {path}"))?;
@@ -353,6 +349,9 @@ fn positioner_plan(a: &MakeArgs, path: &str) -> anyhow::Result<(Vec<PlanPoint>, 
         },
         noise_mm: a.noise_mm,
     };
+    if let Some(l) = language(a.format) {
+        program_columns(&settings.columns, l)?;
+    }
     let plan = make_positioner_plan(&nominal, &settings)?;
     Ok((plan.points.clone(), positioner_table(&plan, &settings)))
 }

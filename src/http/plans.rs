@@ -15,7 +15,7 @@ use crate::calibrate::external::AxisSigma;
 use crate::measure::external::ExternalAxis;
 use crate::model::external::LinearTrack;
 use crate::model::external::TiltRotate;
-use crate::plan::PositionerPlanSettings;
+use crate::plan::{program_columns, PositionerPlanSettings};
 use crate::plan::{
     stations_over, FilterCounts, PlanPoint, PlanSettings, PlannedStation, PredictedStd,
     TrackerSight, WorkspaceBox,
@@ -274,11 +274,7 @@ fn positioner_command(
             "`{field}` lays out robot poses; a positioner's plan takes `positioner` and `noise_mm`"
         )));
     }
-    if req.language.is_some() || req.name.is_some() || req.wait_s.is_some() {
-        return Err(ApiError::invalid(
-            "a positioner's plan moves only the positioner's axes: its joints CSV is answered; programs that move a positioner alone are not written",
-        ));
-    }
+    let program = program_of(req)?;
     let nominal = TiltRotate::from_json(&p.nominal.to_string())
         .map_err(|e| ApiError::invalid(format!("`positioner.nominal`: {e}")))?;
     if !(1..=REFLECTORS_MAX).contains(&p.reflectors.len()) {
@@ -323,15 +319,58 @@ fn positioner_command(
         },
         noise_mm,
     };
+    if let Some((language, _, _)) = &program {
+        program_columns(&settings.columns, *language)
+            .map_err(|e| ApiError::invalid(e.to_string()))?;
+    }
     Ok(PlanCommand {
         robot_id,
         settings: PlanSettings {
             noise_mm,
             ..PlanSettings::default()
         },
-        program: None,
+        program,
         kind: PlanKind::Positioner(ForPositioner { nominal, settings }),
     })
+}
+
+/// The program a request asks (`language`, `name`, `wait_s`), if any.
+fn program_of(req: &PlanRequest) -> Result<Option<(Language, String, f64)>, ApiError> {
+    let program = match req.language.as_deref() {
+        None => None,
+        Some(l @ ("krl" | "rapid" | "fanuc" | "urscript")) => {
+            let language = l
+                .parse::<Language>()
+                .map_err(|e| ApiError::invalid(format!("`language`: {e}")))?;
+            let name = req.name.clone().unwrap_or_else(|| "plan".into());
+            let ok = name.len() <= 24
+                && name.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
+                && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+            if !ok {
+                return Err(ApiError::invalid(format!(
+                    "`name`: a letter, then up to 23 letters, digits or `_`, got `{name}`"
+                )));
+            }
+            let wait_s = req.wait_s.unwrap_or(1.0);
+            if !(wait_s.is_finite() && (0.0..=WAIT_MAX_S).contains(&wait_s)) {
+                return Err(ApiError::invalid(format!(
+                    "`wait_s`: 0 to {WAIT_MAX_S} s, got {wait_s}"
+                )));
+            }
+            Some((language, name, wait_s))
+        }
+        Some(l) => {
+            return Err(ApiError::invalid(format!(
+                "`language` must be krl, rapid, fanuc or urscript, got `{l}`"
+            )))
+        }
+    };
+    if program.is_none() && (req.name.is_some() || req.wait_s.is_some()) {
+        return Err(ApiError::invalid(
+            "`name` and `wait_s` shape the program: give `language` too",
+        ));
+    }
+    Ok(program)
 }
 
 /// The request as a service command (422 naming what is wrong).
@@ -349,6 +388,7 @@ fn command(robot_id: i64, req: PlanRequest) -> Result<PlanCommand, ApiError> {
         )));
     }
     let over_track = over_track(&req, poses)?;
+    let program = program_of(&req)?;
     let candidates = req.candidates.unwrap_or(d.candidates.max(poses));
     if !(poses..=PLAN_CANDIDATES_MAX).contains(&candidates) {
         return Err(ApiError::invalid(format!(
@@ -403,40 +443,6 @@ fn command(robot_id: i64, req: PlanRequest) -> Result<PlanCommand, ApiError> {
     }
     if let Some(p) = req.payload_kg {
         super::input::check_payload("`payload_kg`", p)?;
-    }
-    let program = match req.language.as_deref() {
-        None => None,
-        Some(l @ ("krl" | "rapid" | "fanuc" | "urscript")) => {
-            let language = l
-                .parse::<Language>()
-                .map_err(|e| ApiError::invalid(format!("`language`: {e}")))?;
-            let name = req.name.clone().unwrap_or_else(|| "plan".into());
-            let ok = name.len() <= 24
-                && name.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
-                && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
-            if !ok {
-                return Err(ApiError::invalid(format!(
-                    "`name`: a letter, then up to 23 letters, digits or `_`, got `{name}`"
-                )));
-            }
-            let wait_s = req.wait_s.unwrap_or(1.0);
-            if !(wait_s.is_finite() && (0.0..=WAIT_MAX_S).contains(&wait_s)) {
-                return Err(ApiError::invalid(format!(
-                    "`wait_s`: 0 to {WAIT_MAX_S} s, got {wait_s}"
-                )));
-            }
-            Some((language, name, wait_s))
-        }
-        Some(l) => {
-            return Err(ApiError::invalid(format!(
-                "`language` must be krl, rapid, fanuc or urscript, got `{l}`"
-            )))
-        }
-    };
-    if program.is_none() && (req.name.is_some() || req.wait_s.is_some()) {
-        return Err(ApiError::invalid(
-            "`name` and `wait_s` shape the program: give `language` too",
-        ));
     }
     Ok(PlanCommand {
         robot_id,

@@ -314,6 +314,39 @@ async fn a_positioners_plan_is_the_command_lines() {
     let csv = std::fs::read_to_string(file("plan.csv")).unwrap();
     assert_eq!(v["joints_csv"].as_str().unwrap(), csv);
     assert!(csv.starts_with("point,e1,e2\n"));
+    // Its program (the positioner's axes alone), as `--format rapid` writes it.
+    let r = t
+        .post_json(
+            PLANS,
+            &[&rid],
+            json!({ "positioner": positioner, "noise_mm": 0.02, "language": "rapid", "name": "stn", "wait_s": 2 }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let mut with_program = argv.to_vec();
+    let out = file("stn.mod");
+    with_program.extend(["--format", "rapid", "--name", "stn", "--wait-s", "2"]);
+    *with_program
+        .iter_mut()
+        .find(|a| a.ends_with("plan.csv"))
+        .unwrap() = &out;
+    let robocal::cli::Command::Plan(b) = robocal::cli::Cli::try_parse_from(&with_program)
+        .unwrap()
+        .command
+    else {
+        panic!("not a plan")
+    };
+    robocal::cli::plan::make(&b.make).unwrap();
+    let program = r.json()["program"].clone();
+    assert_eq!(program["language"], "rapid");
+    assert_eq!(
+        program["files"][0]["content"].as_str().unwrap(),
+        std::fs::read_to_string(&out).unwrap()
+    );
+    assert!(program["files"][0]["content"]
+        .as_str()
+        .unwrap()
+        .contains("MoveExtJ [[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09],[0.0000,-165.0000,9E+09,9E+09,9E+09,9E+09]], vrot10, fine; ! P1"));
     let want = make_positioner_plan(
         &nominal,
         &PositionerPlanSettings {
@@ -341,8 +374,12 @@ async fn a_positioners_plan_is_the_command_lines() {
             "`poses` lays out robot poses",
         ),
         (
-            json!({ "positioner": positioner, "language": "krl" }),
-            "programs that move a positioner alone are not written",
+            json!({ "positioner": positioner, "language": "urscript" }),
+            "URScript programs carry no external axes",
+        ),
+        (
+            json!({ "positioner": { "nominal": description, "reflectors": [[400, 0, 20]], "tilt_column": "e3" }, "language": "fanuc" }),
+            "give the tilt a column before the rotate's",
         ),
         (
             json!({ "positioner": { "nominal": {}, "reflectors": [[400, 0, 20]] } }),

@@ -108,8 +108,53 @@ fn a_planned_positioner_measurement_is_joined_and_fitted() {
         .to_degrees();
     println!("planned positioner fit: axis 1 {angle:.5} deg from the truth's");
     assert!(angle < 0.005, "{angle}");
-    // Programs that move the positioner alone are not written.
-    let out = robocal(d.path(), &with(&["--format", "krl"]));
+    // Programs move the positioner alone through the plan's values, in
+    // its order: KRL `PTP {E1 …,E2 …}`, RAPID `MoveExtJ`, Fanuc group 2.
+    for (format, line) in [
+        (
+            "krl",
+            (|p: &[f64; 2], name: &str| {
+                format!("PTP {{E1 {:.4},E2 {:.4}}} ; {name}\r\n", p[0], p[1])
+            }) as fn(&[f64; 2], &str) -> String,
+        ),
+        ("rapid", |p, name| {
+            format!(
+                "MoveExtJ [[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09],[{:.4},{:.4},9E+09,9E+09,9E+09,9E+09]], vrot10, fine; ! {name}\r\n",
+                p[0], p[1]
+            )
+        }),
+        ("fanuc", |p, _| {
+            format!("\tJ1= {:.4} deg,\tJ2= {:.4} deg\r\n", p[0], p[1])
+        }),
+    ] {
+        let out = robocal(d.path(), &with(&["--format", format, "--out", "stn.txt"]));
+        assert_eq!(code(&out), 0, "{format}: {}", text(&out.stderr));
+        let program = std::fs::read_to_string(d.path().join("stn.txt")).unwrap();
+        let mut at = 0;
+        for (p, v) in plan.points.iter().zip(&plan.values_deg) {
+            let want = line(v, &p.name);
+            let found = program[at..].find(&want);
+            assert!(
+                found.is_some(),
+                "{format}: {want:?} after byte {at} in\n{program}"
+            );
+            at += found.unwrap() + want.len();
+        }
+    }
+    // URScript has no external axes; Fanuc writes group 2 in column order,
+    // so a tilt after the rotate is refused.
+    let out = robocal(d.path(), &with(&["--format", "urscript"]));
     assert_eq!(code(&out), 1);
-    assert!(text(&out.stderr).contains("programs that move a positioner alone are not written"));
+    assert!(text(&out.stderr).contains("URScript programs carry no external axes"));
+    let swapped = [
+        "--format",
+        "fanuc",
+        "--tilt-column",
+        "e2",
+        "--rotate-column",
+        "e1",
+    ];
+    let out = robocal(d.path(), &with(&swapped));
+    assert_eq!(code(&out), 1);
+    assert!(text(&out.stderr).contains("give the tilt a column before the rotate's"));
 }

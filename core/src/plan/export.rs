@@ -9,6 +9,7 @@ use crate::measure::bounds::{within, EXTERNAL_VALUE, JOINT_DEG};
 use crate::measure::csv_text::{self, Dialect, FieldCount};
 use crate::measure::external::{ExternalAxis, ExternalValues};
 use crate::model::bounds::show;
+use crate::program::axes_only::{axes_only_program, AxesOnlyError, AxesStop};
 use crate::program::export::{labelled_joint_program, LabelledJoints, TrackValue};
 use crate::program::{Language, ProgramFile};
 use serde::{Deserialize, Serialize};
@@ -96,6 +97,12 @@ pub enum PlanCsvError {
     /// A program needs 6 axes; the plan's number of joints.
     #[error("programs take 6 axes; this plan has {0}")]
     Axes(usize),
+    /// A point without joints moves other external axes than the first
+    /// does, or none; its 1-based index.
+    #[error(
+        "point {0} of a plan without joints moves other external axes than the first point does"
+    )]
+    StopAxes(usize),
 }
 
 /// The external-axis columns any of `points` carries, in axis order.
@@ -215,12 +222,18 @@ pub fn plan_program(
 /// `points` as a program in `language` named `name`, waiting `wait_s` at
 /// each pose; a point's external-axis value (a track plan's) moves the
 /// track with the robot (KRL `E1`…, RAPID `eax_a`…, Fanuc `E1` in `GP1`, mm).
+/// Points without joints (a positioner's plan) move the external axes alone
+/// (`program::axes_only`: KRL `PTP {E1 …, E2 …}`, RAPID `MoveExtJ`, Fanuc
+/// motion group 2).
 pub fn points_program(
     points: &[PlanPoint],
     language: Language,
     name: &str,
     wait_s: f64,
 ) -> Result<Vec<ProgramFile>, PlanCsvError> {
+    if !points.is_empty() && points.iter().all(|p| p.q_deg.is_empty()) {
+        return axes_program(points, language, name, wait_s);
+    }
     let mut targets = Vec::with_capacity(points.len());
     for (i, p) in points.iter().enumerate() {
         let joints_deg = <[f64; 6]>::try_from(p.q_deg.as_slice())
@@ -247,4 +260,31 @@ pub fn points_program(
     Ok(labelled_joint_program(
         language, name, &head, &targets, wait_s,
     ))
+}
+
+/// Points without joints as a program moving their external axes alone.
+fn axes_program(
+    points: &[PlanPoint],
+    language: Language,
+    name: &str,
+    wait_s: f64,
+) -> Result<Vec<ProgramFile>, PlanCsvError> {
+    let stops: Vec<AxesStop> = points
+        .iter()
+        .map(|p| AxesStop {
+            label: p.name.clone(),
+            values: ExternalAxis::ALL
+                .into_iter()
+                .filter_map(|a| Some((a, p.external.get(a)?)))
+                .collect(),
+        })
+        .collect();
+    let head = format!(
+        "robocal measurement plan: {} stops of the external axes alone, a wait of {wait_s} s at each",
+        points.len()
+    );
+    axes_only_program(language, name, &head, &stops, wait_s).map_err(|e| match e {
+        AxesOnlyError::UrScript => PlanCsvError::NoExternalAxes,
+        AxesOnlyError::Axes(i) => PlanCsvError::StopAxes(i),
+    })
 }

@@ -25,7 +25,9 @@ pub use export::{
 pub use join::{join, JoinBy, JoinError, JoinOptions, Joined, Units};
 pub use predict::{ParamPrediction, PredictedStd};
 
-pub use positioner::{make_positioner_plan, PositionerPlan, PositionerPlanSettings};
+pub use positioner::{
+    make_positioner_plan, program_columns, PositionerPlan, PositionerPlanSettings,
+};
 pub use settings::{FilterCounts, PlanError, PlanSettings, TrackerSight, WorkspaceBox};
 pub use track::{make_track_plan, stations_over, PlannedStation, TrackPlan, TrackPlanSettings};
 

@@ -29,6 +29,7 @@ use crate::calibrate::external::problem::{jacobian, Gauge, Row, State};
 use crate::calibrate::external::readings::PositionerColumns;
 use crate::measure::external::{ExternalAxis, ExternalValues};
 use crate::model::external::TiltRotate;
+use crate::program::Language;
 use nalgebra::Vector3;
 
 /// How a positioner's plan is made.
@@ -90,6 +91,20 @@ pub struct PositionerPlan {
     pub condition: f64,
     /// Tracker noise the prediction assumes [mm].
     pub noise_mm: f64,
+}
+
+/// Whether a program in `language` carries the plan's columns as the
+/// filter reads them: Fanuc writes motion group 2's axes in column order
+/// (`program::axes_only`), and the filter takes the tilt for `J1` and the
+/// rotate for `J2`, so the tilt's column must come first.
+pub fn program_columns(columns: &PositionerColumns, language: Language) -> Result<(), PlanError> {
+    if language == Language::Fanuc && columns.tilt > columns.rotate {
+        return Err(PlanError::Setting(format!(
+            "a Fanuc program writes motion group 2's J1, J2 in column order, and the tilt is J1: give the tilt a column before the rotate's (tilt `{}`, rotate `{}`)",
+            columns.tilt, columns.rotate
+        )));
+    }
+    Ok(())
 }
 
 fn check_sweep(name: &str, range: [f64; 2], values: usize) -> Result<(), PlanError> {

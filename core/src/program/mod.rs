@@ -15,6 +15,7 @@
 //! SI (m, rad) in [`Site::pose`].
 
 mod axes;
+pub mod axes_only;
 pub mod controller;
 mod corrected_values;
 pub mod export;
