@@ -36,6 +36,8 @@ mod beside_track;
 mod held;
 #[path = "cli_positioner/planned.rs"]
 mod planned;
+#[path = "cli_positioner/touches.rs"]
+mod touches;
 
 const COLUMNS: PositionerColumns = PositionerColumns {
     tilt: ExternalAxis::E1,

@@ -19,6 +19,7 @@ pub mod plan;
 pub mod positioner;
 mod positioner_part;
 pub mod positioner_sim;
+mod positioner_touches;
 pub mod predict;
 pub mod progress;
 pub mod reregister;

@@ -21,7 +21,9 @@
 //! held-out readings of reflector k) the held-out readings are predicted
 //! through the fitted positioner: their RMS and maximum. A refused fit
 //! writes nothing and exits with `refused` (1), printing its reason code and
-//! message (with `--json` also the refusal as JSON on stdout).
+//! message (with `--json` also the refusal as JSON on stdout). With
+//! `--touched-with MODEL --cell CELL --tool NAME` the files are touches of
+//! features with a calibrated tool (`super::positioner_touches`).
 //!
 //! `predict --positioner FILE` states the predicted poses in the
 //! positioner's face plate frame at `--e1` (tilt) and `--e2` (rotate)
@@ -31,6 +33,7 @@
 //! the part.
 
 use super::judged_fit;
+use super::positioner_touches::Touches;
 use crate::service::positioners::{held_out, set_readings, HeldOut};
 use anyhow::Context;
 use clap::{Args, Subcommand};
@@ -92,9 +95,23 @@ pub struct CalibrateArgs {
     /// The rotate axis's (axis 2's) column, e1 … e6.
     #[arg(long, default_value = "e2", value_parser = parse_axis)]
     pub rotate_column: ExternalAxis,
-    /// The tracker's noise per coordinate, 1σ [mm]: the fit is judged against it.
-    #[arg(long, default_value_t = 0.01)]
-    pub sigma_mm: f64,
+    /// The readings' noise per coordinate, 1σ [mm]: the fit is judged
+    /// against it (default: a tracker's 0.01; with --touched-with it must be
+    /// given, the robot's accuracy at the tool's tip).
+    #[arg(long)]
+    pub sigma_mm: Option<f64>,
+    /// The files are touches with a calibrated tool, not tracker readings:
+    /// joints files (`q1…qN` controller degrees) with the axes' columns, one
+    /// per feature touched, placed by this calibrated model carrying
+    /// --tool of --cell.
+    #[arg(long, requires_all = ["cell", "tool"])]
+    pub touched_with: Option<String>,
+    /// Cell file whose --tool touched the features.
+    #[arg(long, requires = "touched_with")]
+    pub cell: Option<String>,
+    /// The touching tool (a name or number of --cell).
+    #[arg(long, requires = "touched_with")]
+    pub tool: Option<String>,
     /// Held-out readings (same columns), the k-th file of reflector k,
     /// predicted through the fitted positioner.
     #[arg(long)]
@@ -139,15 +156,21 @@ pub struct Validation {
     pub held_out: HeldOut,
 }
 
-/// Every file's rows as readings of its reflector (the file's index).
+/// Every file's rows as readings of its reflector (the file's index);
+/// with `touches`, each file's touches placed by the robot.
 fn read_readings(
     files: &[String],
     columns: PositionerColumns,
+    touches: Option<&Touches>,
 ) -> anyhow::Result<Vec<PositionerReading>> {
     let mut out = Vec::new();
     for (k, path) in files.iter().enumerate() {
         let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {path}"))?;
-        out.extend(set_readings(&text, columns, k).with_context(|| path.clone())?);
+        let read = match touches {
+            Some(t) => t.readings(&text, columns, k),
+            None => set_readings(&text, columns, k).map_err(anyhow::Error::from),
+        };
+        out.extend(read.with_context(|| path.clone())?);
     }
     Ok(out)
 }
@@ -156,9 +179,10 @@ fn read_readings(
 fn validate(
     files: &[String],
     columns: PositionerColumns,
+    touches: Option<&Touches>,
     fit: &PositionerFit,
 ) -> anyhow::Result<Validation> {
-    let readings = read_readings(files, columns)?;
+    let readings = read_readings(files, columns, touches)?;
     let held_out = held_out(&readings, fit).context("--validate: no readings")?;
     Ok(Validation {
         files: files.to_vec(),
@@ -195,11 +219,22 @@ pub fn calibrate_to_string(a: &CalibrateArgs) -> anyhow::Result<String> {
         tilt: a.tilt_column,
         rotate: a.rotate_column,
     };
+    let touches = match (&a.touched_with, &a.cell, &a.tool) {
+        (Some(m), Some(c), Some(t)) => Some(Touches::read(m, c, t)?),
+        _ => None,
+    };
+    let sigma_mm = match (a.sigma_mm, &touches) {
+        (Some(s), _) => s,
+        (None, None) => 0.01,
+        (None, Some(_)) => anyhow::bail!(
+            "--touched-with needs --sigma-mm: the touches' σ per coordinate is the robot's accuracy at the tool's tip (e.g. its validation RMS / √3), not a tracker's"
+        ),
+    };
     let request = PositionerFitRequest {
         nominal,
         reflectors_mm,
-        readings: read_readings(&a.sets, columns)?,
-        tracker_sigma_mm: a.sigma_mm,
+        readings: read_readings(&a.sets, columns, touches.as_ref())?,
+        tracker_sigma_mm: sigma_mm,
     };
     let fit = match fit_positioner(&request) {
         Ok(f) => f,
@@ -211,7 +246,7 @@ pub fn calibrate_to_string(a: &CalibrateArgs) -> anyhow::Result<String> {
     let validation = if a.validate.is_empty() {
         None
     } else {
-        Some(validate(&a.validate, columns, &fit)?)
+        Some(validate(&a.validate, columns, touches.as_ref(), &fit)?)
     };
     let written = judged_fit::write_fitted(
         "positioner",
@@ -236,12 +271,16 @@ fn report(
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "positioner fitted: {} readings of {} reflectors (tilt {}, rotate {}), nominal {}",
+        "positioner fitted: {} readings of {} reflectors (tilt {}, rotate {}), nominal {}{}",
         request.readings.len(),
         request.reflectors_mm.len(),
         a.tilt_column,
         a.rotate_column,
-        a.nominal
+        a.nominal,
+        match (&a.touched_with, &a.tool) {
+            (Some(m), Some(t)) => format!(", touches with tool {t} of {m}"),
+            _ => String::new(),
+        }
     );
     let d = &fit.description;
     for (axis, desc, sigma) in [

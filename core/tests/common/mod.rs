@@ -3,12 +3,13 @@
 //! of a ground-truth robot, the real laser-tracker data
 //! (data/ur5-wam-laser-tracker in the repository, or `ROBOCAL_DATA_DIR`), the
 //! shipped model files (models/*.json), the IK tests' fixtures (`ik`), the
-//! simulated positioner (`positioner`) and the simulated robot on a track
-//! (`track`).
+//! simulated positioner (`positioner`), touches of its face plate with a
+//! calibrated tool (`touches`) and the simulated robot on a track (`track`).
 #![allow(dead_code)]
 
 pub mod ik;
 pub mod positioner;
+pub mod touches;
 pub mod track;
 
 use rand::SeedableRng;

@@ -23,7 +23,6 @@ pub mod outcome;
 pub mod problem;
 pub mod readings;
 pub mod refusal;
-pub mod touches;
 pub mod track;
 
 pub use fit::fit_positioner;

@@ -14,7 +14,7 @@
 //! judged against the σ the caller gives. Frames: joints controller
 //! degrees in, positions mm in the calibrated model's cell frame out.
 
-use super::readings::PositionerColumns;
+use crate::calibrate::external::readings::PositionerColumns;
 use crate::measure::csv_text::Dialect;
 use crate::measure::external::{ExternalValues, MeasurementSet};
 use crate::measure::MeasuredPose;

@@ -1,0 +1,46 @@
+//! `positioner calibrate --touched-with MODEL --cell CELL --tool NAME`: the
+//! files are touches with a calibrated tool instead of tracker readings —
+//! joints files (`id`, `q1…qN` controller degrees) with the axes' columns,
+//! one per feature on the face plate — placed by the calibrated robot
+//! carrying the cell's tool (`cell_fit::positioner_touches`) and fitted as
+//! a tracker's readings would be. Their σ is the robot's accuracy at the
+//! tool's tip, which `--sigma-mm` must give.
+
+use crate::calibrate::external::readings::{positioner_readings, PositionerColumns};
+use crate::calibrate::external::PositionerReading;
+use crate::cell_fit::positioner_touches::{read_touches, touched_positions};
+use crate::measure::csv_text::Dialect;
+use crate::solve::cell::{CellRef, Forward};
+use anyhow::Context;
+
+/// The calibrated robot with the touching tool.
+pub(super) struct Touches {
+    forward: Forward,
+    dof: usize,
+}
+
+impl Touches {
+    /// The robot of the model file `model` carrying the tool `tool` of the
+    /// cell file `cell`.
+    pub(super) fn read(model: &str, cell: &str, tool: &str) -> anyhow::Result<Touches> {
+        let m = super::model_files::load_with_payload(model, None)?;
+        let cell_file = super::model_files::load_cell(Some(cell))?;
+        let t = cell_file.tool(&tool.parse::<CellRef>()?)?;
+        Ok(Touches {
+            forward: Forward::new(&m, Some(&t.tcp), t.load.as_ref()),
+            dof: m.dof(),
+        })
+    }
+
+    /// A touches file's rows as readings of feature `k`.
+    pub(super) fn readings(
+        &self,
+        text: &str,
+        columns: PositionerColumns,
+        k: usize,
+    ) -> anyhow::Result<Vec<PositionerReading>> {
+        let set = read_touches(text, Dialect::default(), self.dof, columns)?;
+        let placed = touched_positions(&self.forward, &set)?;
+        positioner_readings(&placed, columns, k).context("the placed touches")
+    }
+}
