@@ -16,8 +16,8 @@
 mod common;
 
 use common::track::{
-    calibrated_on_fixed_base, measure_on_track, read_stations, true_pose, ys100_truth, STATIONS,
-    TRACKER_SIGMA_MM,
+    calibrated_on_fixed_base, measure_on_track, prediction_errors, read_stations, true_pose,
+    ys100_truth, STATIONS, TRACKER_SIGMA_MM,
 };
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -56,21 +56,6 @@ fn request<'a>(
         tracker_sigma_mm: TRACKER_SIGMA_MM,
         max_order,
     }
-}
-
-/// 3-D errors [mm] of the readings of `set` predicted through `fit`'s
-/// track and the robot model `robot`.
-fn prediction_errors(fit: &TrackFit, robot: &RobotModel, set: &MeasurementSet) -> Vec<f64> {
-    set.readings()
-        .map(|r| {
-            let v = r.external.get(ExternalAxis::E1).unwrap();
-            let q_ctrl: Vec<f64> = r.pose.q_deg.iter().map(|d| d.to_radians()).collect();
-            let q = robot.joints_from_controller(&q_ctrl);
-            let p = fk(robot, &q).unwrap().p;
-            let x = fit.model.cell_from_base(v).unwrap().transform_point(&p) * 1e3;
-            (x - nalgebra::Vector3::from(r.pose.xyz_mm)).norm()
-        })
-        .collect()
 }
 
 /// [`POSES_PER_STATION`] random poses at each [`HELD_OUT`] value, read on

@@ -15,7 +15,8 @@ mod common;
 
 use common::track::TRACKER_SIGMA_MM;
 use common::track::{
-    calibrated_on_fixed_base, measure_on_track, physical_effects, ys100_truth, STATIONS,
+    calibrated_on_fixed_base, measure_on_track, physical_effects, prediction_errors, ys100_truth,
+    STATIONS,
 };
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -23,7 +24,6 @@ use robocal_core::calibrate::external::track::{fit_track, TrackFit, TrackFitRequ
 use robocal_core::calibrate::identify::{calibrate, CalibrationOptions, Method};
 use robocal_core::measure::external::{ExternalAxis, MeasurementSet, StationSessionsError};
 use robocal_core::measure::{MeasuredPose, Measurement};
-use robocal_core::model::kinematics::fk;
 use robocal_core::model::RobotModel;
 use robocal_core::sim::track::TrueTrack;
 use robocal_core::sim::UnmodelledEffects;
@@ -33,20 +33,6 @@ const POSES_PER_STATION: usize = 15;
 
 fn rms(v: &[f64]) -> f64 {
     (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
-}
-
-/// 3-D errors [mm] of `set`'s readings predicted through `fit` and `robot`.
-fn prediction_errors(fit: &TrackFit, robot: &RobotModel, set: &MeasurementSet) -> Vec<f64> {
-    set.readings()
-        .map(|r| {
-            let v = r.external.get(ExternalAxis::E1).unwrap();
-            let q_ctrl: Vec<f64> = r.pose.q_deg.iter().map(|d| d.to_radians()).collect();
-            let q = robot.joints_from_controller(&q_ctrl);
-            let p = fk(robot, &q).unwrap().p;
-            let x = fit.model.cell_from_base(v).unwrap().transform_point(&p) * 1e3;
-            (x - nalgebra::Vector3::from(r.pose.xyz_mm)).norm()
-        })
-        .collect()
 }
 
 /// `rows` in SI with each labelled session's index in `labels` (labels

@@ -5,9 +5,11 @@
 //! column. Track values in millimetres; poses SI in the cell (tracker) frame.
 
 use rand_chacha::ChaCha8Rng;
+use robocal_core::calibrate::external::track::TrackFit;
 use robocal_core::calibrate::identify::{calibrate, CalibrationOptions, Method};
 use robocal_core::measure::external::{ExternalAxis, MeasurementSet};
 use robocal_core::measure::to_measurements;
+use robocal_core::model::kinematics::fk;
 use robocal_core::model::{preset, Pose, RobotModel};
 use robocal_core::sim::track::TrueTrack;
 use robocal_core::sim::{
@@ -124,4 +126,19 @@ pub fn calibrated_on_fixed_base(
     let km = &report.methods["km"];
     let val = km.validation.as_ref().unwrap().stats.rms_mm;
     (km.calibrated.clone(), val)
+}
+
+/// 3-D errors [mm] of the readings of `set` predicted through `fit`'s
+/// track and the robot model `robot` (its geometry, at the readings' `e1`).
+pub fn prediction_errors(fit: &TrackFit, robot: &RobotModel, set: &MeasurementSet) -> Vec<f64> {
+    set.readings()
+        .map(|r| {
+            let v = r.external.get(ExternalAxis::E1).unwrap();
+            let q_ctrl: Vec<f64> = r.pose.q_deg.iter().map(|d| d.to_radians()).collect();
+            let q = robot.joints_from_controller(&q_ctrl);
+            let p = fk(robot, &q).unwrap().p;
+            let x = fit.model.cell_from_base(v).unwrap().transform_point(&p) * 1e3;
+            (x - nalgebra::Vector3::from(r.pose.xyz_mm)).norm()
+        })
+        .collect()
 }

@@ -69,11 +69,7 @@ struct PositionerCell {
 
 /// The robot's place in the cell (the tracker frame): 1.6 m from the
 /// positioner's base, facing it, as its drawing has it.
-pub(super) fn robot_in_cell() -> Pose {
-    let mut p = Pose::from_translation(Vector3::new(1.1, -1.6, -0.9));
-    p.rot_z(35f64.to_radians());
-    p
-}
+pub(super) use crate::common::touches::robot_in_cell;
 
 /// The part's true pose in the cell at values `v`: its origin and its axes'
 /// tips carried by the true positioner's physics.
@@ -82,37 +78,6 @@ pub(super) fn true_part(t: &TruePositioner, body: &Pose, v: [f64; 2]) -> Pose {
     let o = t.point(v, &body.p);
     let axis = |k: usize| (t.point(v, &(body.p + body.r.column(k) * arm)) - o) / arm;
     Pose::new(Matrix3::from_columns(&[axis(0), axis(1), axis(2)]), o)
-}
-
-/// The robot calibrated on its fixed base (KM, 40 + 30 poses): the
-/// compensated model registered in the tracker frame and its validation RMS.
-fn calibrated_robot(
-    nominal: &RobotModel,
-    truth: &TrueRobot,
-    rng: &mut ChaCha8Rng,
-) -> (CompensatedModel, f64) {
-    let rows = |n: usize, rng: &mut ChaCha8Rng| {
-        let qs = random_configurations(nominal, n, rng);
-        let r = truth
-            .measure(&qs, Some(nominal.payload.mass), None, rng)
-            .unwrap();
-        measure::to_measurements(nominal, &r, nominal.payload.mass)
-    };
-    let (id, va) = (rows(40, rng), rows(30, rng));
-    let opts = CalibrationOptions {
-        methods: vec![Method::Km],
-        ..Default::default()
-    };
-    let report = calibrate(nominal, &id, &va, &opts, &|_| true).unwrap();
-    let km = &report.methods["km"];
-    let model = CompensatedModel {
-        calibrated: km.calibrated.clone(),
-        nominal: nominal.clone(),
-        cell_from_base: report.tracker_to_base.inverse(),
-        payload_kg: nominal.payload.mass,
-        compensator: None,
-    };
-    (model, km.validation.as_ref().unwrap().stats.rms_mm)
 }
 
 /// A target's positioner values (tilt −40…40°, rotate −170…170°) and its
@@ -213,7 +178,7 @@ fn positioner_cell() -> &'static PositionerCell {
         truth.model.links[5].d = nominal.links[5].d;
         truth.model.links[5].theta = nominal.links[5].theta;
         truth.tracker_from_base = robot_in_cell();
-        let (model, robot_rms_mm) = calibrated_robot(&nominal, &truth, &mut rng);
+        let (model, robot_rms_mm) = crate::common::touches::calibrated(&nominal, &truth, &mut rng);
         let true_positioner = example::truth(0.003);
         // The part: 60 mm above the plate, 150 mm from axis 2, turned.
         let body = Pose::new(rpy_matrix(0.0, 0.0, 0.6), Vector3::new(0.12, 0.09, 1.16));
