@@ -57,6 +57,9 @@ pub struct NewSetCommand {
 pub(super) fn csv_error(e: CsvError) -> ServiceError {
     let hint = match e {
         CsvError::PositionUnits => "; if the file is in metres, upload it with ?length_unit=m",
+        CsvError::ExternalNotComposed { .. } => {
+            "; over HTTP, a robot on a track read at several track values is uploaded to POST /v1/robots/{id}/track/measurement-sets, one set per station"
+        }
         _ => "",
     };
     ServiceError::Invalid(format!("measurement CSV: {e}{hint}"))

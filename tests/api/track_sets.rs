@@ -191,6 +191,23 @@ async fn a_track_upload_the_stations_cannot_carry_stores_nothing() {
         assert_eq!(r.status.as_u16(), status, "{query}: {}", r.text());
         assert!(r.detail().contains(needle), "{needle}: {}", r.detail());
     }
+    // The set upload refuses the track's column, naming this upload.
+    let r = t
+        .send(
+            "POST",
+            "/v1/robots/{id}/measurement-sets",
+            &[&rid],
+            "",
+            Some("text/csv"),
+            one.as_bytes().to_vec(),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY);
+    assert!(
+        r.detail().contains("/track/measurement-sets"),
+        "{}",
+        r.detail()
+    );
     let sets = t
         .get("/v1/robots/{id}/measurement-sets", &[&rid])
         .await
