@@ -20,6 +20,11 @@ use axum::response::Response;
 use robocal_core::measure::external::ExternalAxis;
 use serde::{Deserialize, Serialize};
 
+/// Longest `name` and `session` of a track's upload (characters): with the
+/// station's label (`e1=` and a value, at most 28) a set's name stays
+/// within the 200 of any name.
+pub const STATION_NAME_MAX: usize = 80;
+
 /// The query of a track's measurement upload.
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -76,6 +81,15 @@ pub async fn upload(
         orientation: q.orientation,
         ..SetParams::default()
     };
+    for (field, v) in [("name", &params.name), ("session", &params.session)] {
+        if v.as_ref()
+            .is_some_and(|v| v.chars().count() > STATION_NAME_MAX)
+        {
+            return Err(ApiError::invalid(format!(
+                "`{field}` is longer than {STATION_NAME_MAX} characters: a station set's name is `NAME SESSION e1=VALUE`, at most 200"
+            )));
+        }
+    }
     let c = check_params(&params)?;
     let read = read_options(&params, &c)?;
     let text = String::from_utf8(body?.to_vec())

@@ -185,6 +185,13 @@ async fn a_track_upload_the_stations_cannot_carry_stores_nothing() {
         ),
         ("", "application/json", "{}".into(), 415, "text/csv"),
         ("?column=e7", "text/csv", one.to_string(), 422, "`column`"),
+        (
+            "?name=nnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnn",
+            "text/csv",
+            one.to_string(),
+            422,
+            "`name` is longer than 80 characters",
+        ),
     ];
     for (query, ct, body, status, needle) in cases {
         let r = upload(&t, &rid, query, ct, &body).await;
