@@ -17,8 +17,7 @@
 
 mod common;
 
-use common::touches::{calibrated, robot_in_cell, tool, touches_file};
-use common::track::{physical_effects, ys100_truth};
+use common::touches::{calibrated, robot_beside_positioner, tool, toucher, touches_file};
 use nalgebra::Vector3;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -28,7 +27,7 @@ use robocal_core::cell_fit::positioner_touches::{read_touches, touched_positions
 use robocal_core::measure::csv_text::Dialect;
 use robocal_core::measure::external::ExternalAxis;
 use robocal_core::model::calibrated::CompensatedModel;
-use robocal_core::model::{Pose, Tool};
+use robocal_core::model::Pose;
 use robocal_core::sim::positioner_example as example;
 
 use robocal_core::solve::cell::Forward;
@@ -44,22 +43,9 @@ fn a_positioner_is_fitted_from_touches_with_a_calibrated_tool() {
     let truth_positioner = example::truth(0.003);
     for seed in [1u64, 2, 3] {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let (nominal, mut truth) = ys100_truth(&mut rng);
-        truth.effects = physical_effects();
-        truth.tracker_from_base = robot_in_cell();
-        // d6 and θ6 as designed: a reflector cannot tell them from its own
-        // offset, so the calibrated flange holds them only with the
-        // reflector; a tool on the flange needs its own TCP calibration
-        // otherwise (as the program tests).
-        truth.model.links[5].d = nominal.links[5].d;
-        truth.model.links[5].theta = nominal.links[5].theta;
+        let (nominal, truth) = robot_beside_positioner(&mut rng);
         let (model, robot_rms) = calibrated(&nominal, &truth, &mut rng);
-        let mut toucher = truth.clone();
-        toucher.noise_mm = 0.0;
-        toucher.model.tool = Tool {
-            p: tool().p,
-            rpy: [0.0; 3],
-        };
+        let toucher = toucher(&truth);
         let forward = Forward::new(&model, Some(&tool()), None);
         let solver = IkSolver::new(forward.model().clone(), IkSettings::default());
         let sweeps = example::sweeps();

@@ -7,7 +7,7 @@
 //! answer names the version and its SHA-256.
 
 use super::input::present_int;
-use super::plans::{ProgramOut, WAIT_MAX_S};
+use super::plans::{program_name, program_wait, ProgramOut};
 use super::{ApiError, ApiJson, ApiPath, AppState};
 use crate::plan::WorkspaceBox;
 use crate::program::Language;
@@ -104,21 +104,8 @@ fn command(robot_id: i64, req: CubeRequest) -> Result<CubeCommand, ApiError> {
                     "`cycles`: 2 to {CYCLES_MAX}, got {cycles}"
                 )));
             }
-            let name = req.name.unwrap_or_else(|| "iso9283".into());
-            let ok = name.len() <= 24
-                && name.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
-                && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
-            if !ok {
-                return Err(ApiError::invalid(format!(
-                    "`name`: a letter, then up to 23 letters, digits or `_`, got `{name}`"
-                )));
-            }
-            let wait_s = req.wait_s.unwrap_or(2.0);
-            if !(wait_s.is_finite() && (0.0..=WAIT_MAX_S).contains(&wait_s)) {
-                return Err(ApiError::invalid(format!(
-                    "`wait_s`: 0 to {WAIT_MAX_S} s, got {wait_s}"
-                )));
-            }
+            let name = program_name(req.name, "iso9283")?;
+            let wait_s = program_wait(req.wait_s, 2.0)?;
             Some((language, name, cycles, wait_s))
         }
     };

@@ -334,6 +334,33 @@ fn positioner_command(
     })
 }
 
+/// A program's `name` (`default` when absent): a letter, then up to 23
+/// letters, digits or `_`, a name every language takes.
+pub(super) fn program_name(name: Option<String>, default: &str) -> Result<String, ApiError> {
+    let name = name.unwrap_or_else(|| default.into());
+    let ok = name.len() <= 24
+        && name.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
+        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+    if !ok {
+        return Err(ApiError::invalid(format!(
+            "`name`: a letter, then up to 23 letters, digits or `_`, got `{name}`"
+        )));
+    }
+    Ok(name)
+}
+
+/// A program's wait at each pose, `wait_s` [s] (`default` when absent), 0 to
+/// [`WAIT_MAX_S`].
+pub(super) fn program_wait(wait_s: Option<f64>, default: f64) -> Result<f64, ApiError> {
+    let wait_s = wait_s.unwrap_or(default);
+    if !(wait_s.is_finite() && (0.0..=WAIT_MAX_S).contains(&wait_s)) {
+        return Err(ApiError::invalid(format!(
+            "`wait_s`: 0 to {WAIT_MAX_S} s, got {wait_s}"
+        )));
+    }
+    Ok(wait_s)
+}
+
 /// The program a request asks (`language`, `name`, `wait_s`), if any.
 fn program_of(req: &PlanRequest) -> Result<Option<(Language, String, f64)>, ApiError> {
     let program = match req.language.as_deref() {
@@ -342,21 +369,8 @@ fn program_of(req: &PlanRequest) -> Result<Option<(Language, String, f64)>, ApiE
             let language = l
                 .parse::<Language>()
                 .map_err(|e| ApiError::invalid(format!("`language`: {e}")))?;
-            let name = req.name.clone().unwrap_or_else(|| "plan".into());
-            let ok = name.len() <= 24
-                && name.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
-                && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
-            if !ok {
-                return Err(ApiError::invalid(format!(
-                    "`name`: a letter, then up to 23 letters, digits or `_`, got `{name}`"
-                )));
-            }
-            let wait_s = req.wait_s.unwrap_or(1.0);
-            if !(wait_s.is_finite() && (0.0..=WAIT_MAX_S).contains(&wait_s)) {
-                return Err(ApiError::invalid(format!(
-                    "`wait_s`: 0 to {WAIT_MAX_S} s, got {wait_s}"
-                )));
-            }
+            let name = program_name(req.name.clone(), "plan")?;
+            let wait_s = program_wait(req.wait_s, 1.0)?;
             Some((language, name, wait_s))
         }
         Some(l) => {

@@ -11,7 +11,7 @@ use super::input::external_axis;
 use super::sets::{check_params, read_options, MeasurementSet, SetParams};
 use super::{ApiError, ApiPath, ApiQuery, AppState};
 use crate::service;
-use crate::service::sets::{NewSetCommand, SetContent};
+use crate::service::station_sets::StationUpload;
 use axum::body::Bytes;
 use axum::extract::rejection::BytesRejection;
 use axum::extract::State;
@@ -94,17 +94,17 @@ pub async fn upload(
     let read = read_options(&params, &c)?;
     let text = String::from_utf8(body?.to_vec())
         .map_err(|_| ApiError::invalid("the upload is not UTF-8 text"))?;
-    let cmd = NewSetCommand {
+    let cmd = StationUpload {
         robot_id,
         name: c.name,
         role: c.role,
-        session: c.session,
+        session: q.session,
         payload_kg: c.payload_kg,
-        length: c.length,
-        angle: c.angle,
-        content: SetContent::Csv { text, read },
+        column,
+        text,
+        read,
     };
-    let rows = service::station_sets::upload(&state, cmd, column, q.session).await?;
+    let rows = service::station_sets::upload(&state, cmd).await?;
     let body = StationSetsOut {
         column: column.column(),
         measurement_sets: rows

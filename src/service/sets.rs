@@ -113,6 +113,26 @@ pub(super) fn check_rows(
     Ok(())
 }
 
+/// Refuses an upload holding NUL: text columns hold none on PostgreSQL, and
+/// SQLite refuses it alike.
+pub(super) fn refuse_nul(text: &str) -> Result<(), ServiceError> {
+    if text.contains('\0') {
+        return Err(ServiceError::Invalid(
+            "the upload contains the NUL character (U+0000); measurement files are text".into(),
+        ));
+    }
+    Ok(())
+}
+
+/// A set's role: `declared`, else the rows' common `set` value, else
+/// identification.
+pub(super) fn role_of(declared: Option<SetRole>, rows: &[MeasuredPose]) -> SetRole {
+    declared.unwrap_or_else(|| match rows.first().and_then(|r| r.set) {
+        Some(r) if rows.iter().all(|x| x.set == Some(r)) => r,
+        _ => SetRole::Identification,
+    })
+}
+
 /// Reads, checks and stores a measurement set.
 pub async fn upload(state: &AppState, cmd: NewSetCommand) -> Result<SetRow, ServiceError> {
     let robot_id = cmd.robot_id;
@@ -126,14 +146,8 @@ pub async fn upload(state: &AppState, cmd: NewSetCommand) -> Result<SetRow, Serv
     let session = cmd.session.clone();
     let (rows, format, original) = tokio::task::spawn_blocking(move || {
         let (rows, format, original) = match cmd.content {
-            // Text columns hold no NUL on PostgreSQL; refused alike on SQLite.
-            SetContent::Csv { text, .. } if text.contains('\0') => {
-                return Err(ServiceError::Invalid(
-                    "the upload contains the NUL character (U+0000); measurement files are text"
-                        .into(),
-                ))
-            }
             SetContent::Csv { text, read } => {
+                refuse_nul(&text)?;
                 (read_csv(&text, &read, &session)?, SetFormat::Csv, text)
             }
             SetContent::Rows { rows, original } => (rows, SetFormat::Json, original),
@@ -144,11 +158,7 @@ pub async fn upload(state: &AppState, cmd: NewSetCommand) -> Result<SetRow, Serv
     .await
     .map_err(|e| ServiceError::Internal(format!("upload parser: {e}")))??;
 
-    // Role: declared, else the rows' common `set` value, else identification.
-    let role = cmd.role.unwrap_or_else(|| match rows[0].set {
-        Some(r) if rows.iter().all(|x| x.set == Some(r)) => r,
-        _ => SetRole::Identification,
-    });
+    let role = role_of(cmd.role, &rows);
     let name = if cmd.name.is_empty() {
         role.as_str().to_string()
     } else {

@@ -11,14 +11,14 @@
 //! together hold every line of the upload once. Every station is checked
 //! before any is stored, and they are stored in one transaction.
 
-use super::sets::{check_rows, csv_error, NewSetCommand, SetContent};
+use super::sets::{check_rows, csv_error, refuse_nul, role_of};
 use super::{AppState, ServiceError};
 use crate::db::NewSet;
 use crate::measure::csv::{self, ReadOptions};
 use crate::measure::csv_text;
 use crate::measure::external::ExternalAxis;
 use crate::measure::{MeasuredPose, SetRole};
-use crate::records::{SetFormat, SetRow};
+use crate::records::{AngleUnit, LengthUnit, SetFormat, SetRow};
 use crate::service::limits::{MAX_SETS, NAME_MAX};
 
 /// One station of an upload: its session, rows and lines.
@@ -101,14 +101,32 @@ pub fn stations_of(
     Ok(stations)
 }
 
+/// A track's measurement upload, in domain terms.
+#[derive(Debug, Clone)]
+pub struct StationUpload {
+    /// The robot the sets belong to.
+    pub robot_id: i64,
+    /// Goes before each set's session in its name (empty: the role's name).
+    pub name: String,
+    /// Declared role of every set; `None`: each station's rows' common `set`,
+    /// else identification.
+    pub role: Option<SetRole>,
+    /// Goes before each station's session label, when given.
+    pub session: Option<String>,
+    /// Payload of rows that carry none [kg].
+    pub payload_kg: Option<f64>,
+    /// The track's column.
+    pub column: ExternalAxis,
+    /// The CSV text as uploaded.
+    pub text: String,
+    /// How to read it (millimetres and degrees: the external-axis columns
+    /// are read as written).
+    pub read: ReadOptions,
+}
+
 /// Reads, checks and stores a track's measurement CSV as one set per
 /// station (module docs); the sets in order of first appearance.
-pub async fn upload(
-    state: &AppState,
-    cmd: NewSetCommand,
-    column: ExternalAxis,
-    session: Option<String>,
-) -> Result<Vec<SetRow>, ServiceError> {
+pub async fn upload(state: &AppState, cmd: StationUpload) -> Result<Vec<SetRow>, ServiceError> {
     let robot_id = cmd.robot_id;
     let robot = state
         .db()
@@ -117,16 +135,8 @@ pub async fn upload(
         .ok_or_else(|| ServiceError::robot_not_found(robot_id))?;
     let dof = robot.dof as usize;
     let max_rows = state.limits().poses_per_set;
-    let SetContent::Csv { text, read } = cmd.content else {
-        return Err(ServiceError::Invalid(
-            "a track's stations are read from a measurement CSV with the track's column".into(),
-        ));
-    };
-    if text.contains('\0') {
-        return Err(ServiceError::Invalid(
-            "the upload contains the NUL character (U+0000); measurement files are text".into(),
-        ));
-    }
+    refuse_nul(&cmd.text)?;
+    let (text, read, column, session) = (cmd.text, cmd.read, cmd.column, cmd.session);
     let stations = tokio::task::spawn_blocking(move || {
         let stations = stations_of(&text, &read, column, session.as_deref())?;
         for s in &stations {
@@ -140,10 +150,7 @@ pub async fn upload(
     let names: Vec<(String, SetRole)> = stations
         .iter()
         .map(|s| {
-            let role = cmd.role.unwrap_or_else(|| match s.rows[0].set {
-                Some(r) if s.rows.iter().all(|x| x.set == Some(r)) => r,
-                _ => SetRole::Identification,
-            });
+            let role = role_of(cmd.role, &s.rows);
             let base = if cmd.name.is_empty() {
                 role.as_str()
             } else {
@@ -168,8 +175,8 @@ pub async fn upload(
             role: (*role).into(),
             session: &s.session,
             payload_kg: cmd.payload_kg,
-            length_unit: cmd.length,
-            angle_unit: cmd.angle,
+            length_unit: LengthUnit::Mm,
+            angle_unit: AngleUnit::Deg,
             format: SetFormat::Csv,
             original: &s.original,
             rows: &s.rows,

@@ -6,25 +6,21 @@
 //! model file and the tool as a cell file.
 
 use super::{code, robocal, text};
-use crate::core_common::touches::{calibrated, robot_in_cell, tool, touches_file};
-use crate::core_common::track::{physical_effects, ys100_truth};
+use crate::core_common::touches::{
+    calibrated, robot_beside_positioner, tool, toucher, touches_file,
+};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal::cli::model_files::save_model_file;
 use robocal::model::calibrated::CalibratedModelFile;
 use robocal::model::external::TiltRotate;
-use robocal::model::Tool;
 use robocal::sim::positioner_example as example;
 use robocal::solve::ik::{IkSettings, IkSolver};
 
 #[test]
 fn a_positioner_is_fitted_from_touches_on_the_command_line() {
     let mut rng = ChaCha8Rng::seed_from_u64(1);
-    let (nominal, mut truth) = ys100_truth(&mut rng);
-    truth.effects = physical_effects();
-    truth.tracker_from_base = robot_in_cell();
-    truth.model.links[5].d = nominal.links[5].d;
-    truth.model.links[5].theta = nominal.links[5].theta;
+    let (nominal, truth) = robot_beside_positioner(&mut rng);
     let (model, robot_rms) = calibrated(&nominal, &truth, &mut rng);
     let d = tempfile::tempdir().unwrap();
     let p = |f: &str| d.path().join(f);
@@ -39,12 +35,7 @@ fn a_positioner_is_fitted_from_touches_on_the_command_line() {
     )
     .unwrap();
     std::fs::write(p("stn.json"), example::nominal().to_json()).unwrap();
-    let mut toucher = truth.clone();
-    toucher.noise_mm = 0.0;
-    toucher.model.tool = Tool {
-        p: tool().p,
-        rpy: [0.0; 3],
-    };
+    let toucher = toucher(&truth);
     let forward = robocal::solve::cell::Forward::new(&model, Some(&tool()), None);
     let solver = IkSolver::new(forward.model().clone(), IkSettings::default());
     let positioner = example::truth(0.003);

@@ -13,6 +13,7 @@
 //!   lowest column is `J1`);
 //! - URScript has no external axes and is refused.
 
+use super::export::fanuc_stops;
 use super::{Language, ProgramFile};
 use crate::measure::external::ExternalAxis;
 use std::fmt::Write as _;
@@ -104,18 +105,7 @@ pub fn axes_only_program(
                 "/PROG  {upper}\r\n/ATTR\r\nCOMMENT\t\t= \"robocal plan\";\r\nDEFAULT_GROUP\t= *,1,*,*,*;\r\n/MN\r\n   1:  ! {} stops of group 2 ;\r\n",
                 stops.len()
             );
-            for (i, t) in stops.iter().enumerate() {
-                let _ = write!(
-                    s,
-                    "{:4}:  ! {} ;\r\n{:4}:J P[{}] 20% FINE    ;\r\n{:4}:  WAIT {wait_s:.2}(sec) ;\r\n",
-                    3 * i + 2,
-                    t.label,
-                    3 * i + 3,
-                    i + 1,
-                    3 * i + 4
-                );
-            }
-            s.push_str("/POS\r\n");
+            fanuc_stops(&mut s, stops.iter().map(|t| t.label.as_str()), wait_s);
             for (i, t) in stops.iter().enumerate() {
                 let joints: Vec<String> = t
                     .values

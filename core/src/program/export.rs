@@ -116,18 +116,7 @@ pub fn labelled_joint_program(
                 s,
                 "/PROG  {upper}\r\n/ATTR\r\nCOMMENT\t\t= \"robocal plan\";\r\nDEFAULT_GROUP\t= 1,*,*,*,*;\r\n/MN\r\n   1:  ! {n} poses ;\r\n"
             );
-            for (i, t) in targets.iter().enumerate() {
-                let _ = write!(
-                    s,
-                    "{:4}:  ! {} ;\r\n{:4}:J P[{}] 20% FINE    ;\r\n{:4}:  WAIT {wait_s:.2}(sec) ;\r\n",
-                    3 * i + 2,
-                    t.label,
-                    3 * i + 3,
-                    i + 1,
-                    3 * i + 4
-                );
-            }
-            s.push_str("/POS\r\n");
+            fanuc_stops(&mut s, targets.iter().map(|t| t.label.as_str()), wait_s);
             for (i, t) in targets.iter().enumerate() {
                 let q = &t.joints_deg;
                 let _ = write!(s, "P[{}]{{\r\n   GP1:\r\n\tUF : 0, UT : 0,\r\n", i + 1);
@@ -158,6 +147,23 @@ pub fn labelled_joint_program(
             vec![file(format!("{name}.script"), s)]
         }
     }
+}
+
+/// A Fanuc `/MN` section's stops after its line 1, one per label: the
+/// label as a remark, a joint move to `P[i]` and a wait of `wait_s`; then
+/// `/POS`, whose positions the caller writes.
+pub(super) fn fanuc_stops<'a>(s: &mut String, labels: impl Iterator<Item = &'a str>, wait_s: f64) {
+    for (i, label) in labels.enumerate() {
+        let _ = write!(
+            s,
+            "{:4}:  ! {label} ;\r\n{:4}:J P[{}] 20% FINE    ;\r\n{:4}:  WAIT {wait_s:.2}(sec) ;\r\n",
+            3 * i + 2,
+            3 * i + 3,
+            i + 1,
+            3 * i + 4
+        );
+    }
+    s.push_str("/POS\r\n");
 }
 
 fn file(name: String, text: String) -> ProgramFile {

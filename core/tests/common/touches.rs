@@ -10,7 +10,7 @@ use rand_chacha::ChaCha8Rng;
 use robocal_core::calibrate::identify::{calibrate, CalibrationOptions, Method};
 use robocal_core::measure::to_measurements;
 use robocal_core::model::calibrated::CompensatedModel;
-use robocal_core::model::{Pose, RobotModel};
+use robocal_core::model::{Pose, RobotModel, Tool};
 use robocal_core::sim::positioner::TruePositioner;
 use robocal_core::sim::{random_configurations, TrueRobot};
 use robocal_core::solve::ik::{IkSolver, SolveOptions};
@@ -20,6 +20,33 @@ pub fn robot_in_cell() -> Pose {
     let mut p = Pose::from_translation(Vector3::new(1.1, -1.6, -0.9));
     p.rot_z(35f64.to_radians());
     p
+}
+
+/// The YS100 of `rng` beside the positioner (nominal and truth): ~1 mm /
+/// 0.1° errors, the effects its model lacks (`track::physical_effects`),
+/// its base at [`robot_in_cell`]; d6 and θ6 as designed: a reflector cannot
+/// tell them from its own offset, so the calibrated flange holds them only
+/// with the reflector and a tool would need its own TCP calibration
+/// otherwise (as in the program tests).
+pub fn robot_beside_positioner(rng: &mut ChaCha8Rng) -> (RobotModel, TrueRobot) {
+    let (nominal, mut truth) = super::track::ys100_truth(rng);
+    truth.effects = super::track::physical_effects();
+    truth.tracker_from_base = robot_in_cell();
+    truth.model.links[5].d = nominal.links[5].d;
+    truth.model.links[5].theta = nominal.links[5].theta;
+    (nominal, truth)
+}
+
+/// `truth` carrying the pointed [`tool`], without the tracker's noise: what
+/// touches the features.
+pub fn toucher(truth: &TrueRobot) -> TrueRobot {
+    let mut t = truth.clone();
+    t.noise_mm = 0.0;
+    t.model.tool = Tool {
+        p: tool().p,
+        rpy: [0.0; 3],
+    };
+    t
 }
 
 /// The pointed tool: 200 mm along the flange's z.
