@@ -183,8 +183,8 @@ def check_external_axes(driver, wait, shot, base, robocal, work, robot_url, h):
     wait.until(EC.presence_of_element_located((By.ID, "positioner-stored")))
     stored = h.api_get(base, f"/v1/robots/{rail_id}/positioner")
     shown = {c: driver.find_element(By.CSS_SELECTOR, f"#positioner-stored td.{c}").text
-             for c in ("tilt", "rotate", "reflectors", "readings", "rms", "max", "sigma")}
-    assert shown == {"tilt": "e1", "rotate": "e2", "reflectors": str(len(sets)),
+             for c in ("tilt", "rotate", "from", "reflectors", "readings", "rms", "max", "sigma")}
+    assert shown == {"tilt": "e1", "rotate": "e2", "from": "tracker", "reflectors": str(len(sets)),
                      "readings": str(stored["readings"]), "rms": f"{stored['rms_mm']:.3f}",
                      "max": f"{stored['max_mm']:.3f}", "sigma": "0.010"}, (shown, stored)
     assert stored["reflectors"] == len(sets), stored

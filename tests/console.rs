@@ -450,6 +450,8 @@ async fn the_robot_page_shows_its_stored_track_and_positioner() {
     let table = &section[at..at + section[at..].find("</table>").unwrap()];
     assert_eq!(cell(table, "tilt"), "e1");
     assert_eq!(cell(table, "rotate"), "e2");
+    assert_eq!(positioner["readings_from"]["kind"], "tracker");
+    assert_eq!(cell(table, "from"), "tracker");
     assert_eq!(cell(table, "reflectors"), "2");
     assert_eq!(cell(table, "readings"), positioner["readings"].to_string());
     assert_eq!(cell(table, "rms"), mm(&positioner["rms_mm"]));

@@ -74,7 +74,7 @@ fn about_line(u: Vector3<f64>, c: Vector3<f64>, angle: f64, x: Vector3<f64>) -> 
 }
 
 /// The zero offsets the fit's definitions give on the truth
-/// (docs/external-axes.md): axis 1's is the true angle at which axis 2
+/// (docs/external-axes/positioner.md): axis 1's is the true angle at which axis 2
 /// lies in the plane of nominal axes 1 and 2; axis 2's the true angle at
 /// which reflector 0 stands on its design azimuth in the face plate frame.
 fn expected_zero_offsets(t: &TruePositioner) -> [f64; 2] {

@@ -1,9 +1,12 @@
 //! What `robocal track calibrate` and `robocal positioner calibrate` print and
 //! write for a fit judged before it is written: a refusal (`--json`: the
 //! reason code and the refusal's fields, nothing written), or the model file
-//! written and the fit with its held-out validation (`--json`: one object).
+//! written and the fit with its held-out validation (`--json`: one object;
+//! a positioner's also says where its readings came from, `readings_from`:
+//! a tracker, or touches).
 //! Errors of the held-out readings are in mm.
 
+use crate::service::positioners::ReadingsFrom;
 use anyhow::Context;
 use robocal_core::stats::ErrorStats;
 use serde::Serialize;
@@ -12,6 +15,8 @@ use serde::Serialize;
 struct Fitted<'a, F, V> {
     fitted: bool,
     out: &'a str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    readings_from: Option<&'a ReadingsFrom>,
     fit: &'a F,
     validation: Option<&'a V>,
 }
@@ -38,12 +43,13 @@ pub fn print_refusal<R: Serialize>(json: bool, reason: &str, refused: &R) -> any
 }
 
 /// Writes `model_json` (the `what` file) to `out`; with `json`, returns the
-/// fit and its validation as one JSON object, else `None` (the caller
-/// renders its text report).
+/// fit, where its readings came from (when given) and its validation as one
+/// JSON object, else `None` (the caller renders its text report).
 pub fn write_fitted<F: Serialize, V: Serialize>(
     what: &str,
     out: &str,
     model_json: String,
+    readings_from: Option<&ReadingsFrom>,
     fit: &F,
     validation: Option<&V>,
     json: bool,
@@ -56,6 +62,7 @@ pub fn write_fitted<F: Serialize, V: Serialize>(
     let body = Fitted {
         fitted: true,
         out,
+        readings_from,
         fit,
         validation,
     };

@@ -34,7 +34,7 @@
 
 use super::judged_fit;
 use super::positioner_touches::Touches;
-use crate::service::positioners::{held_out, set_readings, HeldOut};
+use crate::service::positioners::{held_out, set_readings, HeldOut, ReadingsFrom};
 use anyhow::Context;
 use clap::{Args, Subcommand};
 use robocal_core::calibrate::external::readings::PositionerColumns;
@@ -252,6 +252,7 @@ pub fn calibrate_to_string(a: &CalibrateArgs) -> anyhow::Result<String> {
         "positioner",
         &a.out,
         fit.model.to_json(),
+        Some(touches.as_ref().map_or(&ReadingsFrom::Tracker, |t| &t.from)),
         &fit,
         validation.as_ref(),
         a.json,

@@ -5,7 +5,7 @@
 //! - `controller.json`: the nominal positioner (the drawing) in the
 //!   controller's world, which on a fixed base is the robot's base frame:
 //!   where the drawing puts it relative to the robot (`P_nom(v)` of
-//!   docs/external-axes.md "Programs on a positioner").
+//!   docs/external-axes/programs.md "Programs on a positioner").
 //! - `cell.json`: tool 1, a torch 250 mm from the flange tilted 30° (the
 //!   examples' `cell.json`), and base 3, the part on the face plate (frame
 //!   `face_plate`, 60 mm above the plate).

@@ -6,17 +6,17 @@
 //! a tracker's readings would be. Their σ is the robot's accuracy at the
 //! tool's tip, which `--sigma-mm` must give.
 
-use crate::calibrate::external::readings::{positioner_readings, PositionerColumns};
+use crate::calibrate::external::readings::PositionerColumns;
 use crate::calibrate::external::PositionerReading;
-use crate::cell_fit::positioner_touches::{read_touches, touched_positions};
-use crate::measure::csv_text::Dialect;
+use crate::cell_fit::positioner_touches::touch_readings;
+use crate::service::positioners::ReadingsFrom;
 use crate::solve::cell::{CellRef, Forward};
-use anyhow::Context;
 
 /// The calibrated robot with the touching tool.
 pub(super) struct Touches {
     forward: Forward,
-    dof: usize,
+    /// Where the readings come from, as the `--json` answer states it.
+    pub(super) from: ReadingsFrom,
 }
 
 impl Touches {
@@ -28,7 +28,11 @@ impl Touches {
         let t = cell_file.tool(&tool.parse::<CellRef>()?)?;
         Ok(Touches {
             forward: Forward::new(&m, Some(&t.tcp), t.load.as_ref()),
-            dof: m.dof(),
+            from: ReadingsFrom::Touches {
+                model: Some(model.to_string()),
+                version: None,
+                tool: tool.to_string(),
+            },
         })
     }
 
@@ -39,8 +43,6 @@ impl Touches {
         columns: PositionerColumns,
         k: usize,
     ) -> anyhow::Result<Vec<PositionerReading>> {
-        let set = read_touches(text, Dialect::default(), self.dof, columns)?;
-        let placed = touched_positions(&self.forward, &set)?;
-        positioner_readings(&placed, columns, k).context("the placed touches")
+        Ok(touch_readings(&self.forward, text, columns, k)?)
     }
 }

@@ -318,6 +318,7 @@ pub fn calibrate_to_string(a: &CalibrateArgs) -> anyhow::Result<String> {
         "track",
         &a.out,
         fit.model.to_json(),
+        None,
         &fit,
         validation.as_ref(),
         a.json,

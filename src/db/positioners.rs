@@ -5,7 +5,8 @@ use super::{on_pool, write_for_robot, Db, StoreError};
 use crate::records::{NewPositioner, PositionerRow};
 
 const POSITIONER_SELECT: &str = "SELECT robot_id, tilt_column, rotate_column, sigma_mm, \
-     reflectors, readings, rms_mm, max_mm, positioner_json, created_at FROM robot_positioners";
+     reflectors, readings, rms_mm, max_mm, positioner_json, created_at, touched_version, \
+     touched_tool FROM robot_positioners";
 
 impl Db {
     /// The robot's stored positioner, if it has one.
@@ -38,8 +39,8 @@ impl Db {
                 .rows_affected();
             sqlx::query(
                 "INSERT INTO robot_positioners (robot_id, tilt_column, rotate_column, sigma_mm, \
-                 reflectors, readings, rms_mm, max_mm, positioner_json) \
-                 VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9)",
+                 reflectors, readings, rms_mm, max_mm, positioner_json, touched_version, \
+                 touched_tool) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11)",
             )
             .bind(robot_id)
             .bind(&positioner.tilt_column)
@@ -50,6 +51,8 @@ impl Db {
             .bind(positioner.rms_mm)
             .bind(positioner.max_mm)
             .bind(&positioner.positioner_json)
+            .bind(positioner.touched_version)
+            .bind(&positioner.touched_tool)
             .execute(&mut *tx)
             .await?;
             let row =

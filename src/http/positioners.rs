@@ -11,14 +11,18 @@
 //! JSON description, as `positioner calibrate --out` writes it, and what it
 //! was fitted on), `DELETE …/positioner` removes it. A targets CSV with `e1`
 //! (tilt) and `e2` (rotate) columns is solved through it
-//! (`service::positioners::place_rows`).
+//! (`service::positioners::place_rows`). With `touched_with` (a version and
+//! a stored tool) the texts are touches files instead, placed by that
+//! version's robot carrying that tool, as `--touched-with` places them; the
+//! stored positioner says so in `readings_from`.
 
-use super::input::{external_axis, present};
+use super::input::{check_name, external_axis, present};
 use super::{ApiError, ApiJson, ApiPath, AppState};
 use crate::records::PositionerRow;
 use crate::service;
 use crate::service::positioners::{
-    HeldOut, PositionerCalibration, StoredPositioner, POSITIONER_REFLECTORS_MAX,
+    HeldOut, PositionerCalibration, ReadingsFrom, StoredPositioner, TouchedWith,
+    POSITIONER_REFLECTORS_MAX,
 };
 use axum::extract::State;
 use axum::http::StatusCode;
@@ -61,6 +65,21 @@ pub struct PositionerCalibrateIn {
     /// Held-out measurement file texts, the k-th of reflector k.
     #[serde(default, deserialize_with = "present")]
     pub validate: Option<Vec<String>>,
+    /// The texts are touches files (`id,q1…qN` controller degrees and the
+    /// axes' columns), one per face-plate feature, placed by this version's
+    /// robot carrying this stored tool; `sigma_mm` is then required.
+    #[serde(default, deserialize_with = "present")]
+    pub touched_with: Option<TouchedWithIn>,
+}
+
+/// The robot and tool that touched a positioner's features.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TouchedWithIn {
+    /// The robot's model version whose calibrated robot places the touches.
+    pub version: i64,
+    /// The name of the robot's stored tool that touched.
+    pub tool: String,
 }
 
 /// A stored positioner.
@@ -86,6 +105,9 @@ pub struct PositionerOut {
     pub created_at: String,
     /// The positioner's JSON description (`robocal positioner calibrate --out`).
     pub positioner: Value,
+    /// Where the fit's readings came from: a tracker, or touches placed by a
+    /// version's robot carrying a tool.
+    pub readings_from: ReadingsFrom,
     /// Links to the positioner, its fit and the robot.
     pub links: Value,
 }
@@ -96,6 +118,7 @@ impl PositionerOut {
             ApiError::Internal(format!("stored positioner of robot {}: {e}", row.robot_id))
         })?;
         let base = format!("/v1/robots/{}/positioner", row.robot_id);
+        let readings_from = ReadingsFrom::of_row(&row);
         Ok(PositionerOut {
             robot_id: row.robot_id,
             tilt_column: row.tilt_column,
@@ -107,6 +130,7 @@ impl PositionerOut {
             max_mm: row.max_mm,
             created_at: row.created_at,
             positioner,
+            readings_from,
             links: serde_json::json!({
                 "self": base,
                 "calibrate": format!("{base}/calibrate"),
@@ -176,10 +200,17 @@ fn calibration(id: i64, body: PositionerCalibrateIn) -> Result<PositionerCalibra
             columns.tilt.column()
         )));
     }
-    let sigma_mm = body.sigma_mm.unwrap_or(DEFAULT_SIGMA_MM);
+    let touched_with = body.touched_with.map(touched_with).transpose()?;
+    let sigma_mm = match (body.sigma_mm, &touched_with) {
+        (Some(s), _) => s,
+        (None, None) => DEFAULT_SIGMA_MM,
+        (None, Some(_)) => return Err(ApiError::invalid(
+            "`touched_with` needs `sigma_mm`: the touches' σ per coordinate is the robot's accuracy at the tool's tip (e.g. its validation RMS / √3), not a tracker's",
+        )),
+    };
     if !(sigma_mm.is_finite() && sigma_mm > 0.0 && sigma_mm <= SIGMA_MAX_MM) {
         return Err(ApiError::invalid(format!(
-            "`sigma_mm`: the tracker's σ per coordinate, above 0 and at most {SIGMA_MAX_MM} mm, got {sigma_mm}"
+            "`sigma_mm`: the readings' σ per coordinate, above 0 and at most {SIGMA_MAX_MM} mm, got {sigma_mm}"
         )));
     }
     Ok(PositionerCalibration {
@@ -190,6 +221,21 @@ fn calibration(id: i64, body: PositionerCalibrateIn) -> Result<PositionerCalibra
         columns,
         sigma_mm,
         validate,
+        touched_with,
+    })
+}
+
+fn touched_with(t: TouchedWithIn) -> Result<TouchedWith, ApiError> {
+    if t.version < 1 {
+        return Err(ApiError::invalid(format!(
+            "`touched_with.version`: {}; give the number of one of the robot's model versions (1 or more)",
+            t.version
+        )));
+    }
+    check_name(&t.tool, "`touched_with.tool`")?;
+    Ok(TouchedWith {
+        version: t.version,
+        tool: t.tool,
     })
 }
 

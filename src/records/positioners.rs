@@ -1,5 +1,6 @@
 //! A two-axis positioner beside a robot, as stored: the calibrated
-//! positioner's JSON description and what its fit was made on and judged
+//! positioner's JSON description and what its fit was made on (tracker
+//! readings, or touches placed by a model version carrying a tool) and judged
 //! against.
 
 use sqlx::FromRow;
@@ -23,6 +24,11 @@ pub struct NewPositioner {
     pub max_mm: f64,
     /// `TiltRotate::to_json`: mm, degrees.
     pub positioner_json: String,
+    /// The model version whose robot placed the touches the fit read
+    /// (`None`: tracker readings).
+    pub touched_version: Option<i64>,
+    /// The cell tool that touched (`None`: tracker readings).
+    pub touched_tool: Option<String>,
 }
 
 /// A robot's stored positioner.
@@ -48,4 +54,9 @@ pub struct PositionerRow {
     pub positioner_json: String,
     /// When it was stored (UTC, RFC 3339).
     pub created_at: String,
+    /// The model version whose robot placed the touches the fit read
+    /// (`None`: tracker readings).
+    pub touched_version: Option<i64>,
+    /// The cell tool that touched (`None`: tracker readings).
+    pub touched_tool: Option<String>,
 }

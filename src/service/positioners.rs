@@ -3,7 +3,10 @@
 //! fitted from one measurement file per face-plate reflector
 //! (`core::calibrate::external::fit_positioner`, the fit `robocal positioner
 //! calibrate` makes, reading its files through [`set_readings`] and its
-//! held-out files through [`held_out`] as the command line does), judged
+//! held-out files through [`held_out`] as the command line does), or from
+//! one touches file per face-plate feature placed by one of the robot's
+//! model versions carrying one of its cell's tools (`--touched-with`'s
+//! `core::cell_fit::positioner_touches::touch_readings`), judged
 //! before it is stored, read back and deleted; and the rows of a targets CSV
 //! with `e1` (tilt) and `e2` (rotate) columns moved into the robot's base
 //! frame through it (`core::solve::external::place_on_positioner`:
@@ -24,9 +27,12 @@ use robocal_core::calibrate::external::readings::{
 use robocal_core::calibrate::external::{
     fit_positioner, PositionerFit, PositionerFitRequest, PositionerReading, Refused,
 };
+use robocal_core::cell_fit::positioner_touches::touch_readings;
 use robocal_core::measure::csv::{parse_set, CsvError};
+use robocal_core::model::calibrated::parse_compensated;
 use robocal_core::model::external::TiltRotate;
 use robocal_core::model::Pose;
+use robocal_core::solve::cell::{CellRef, Forward};
 use robocal_core::solve::external::{place_on_positioner, AxisValues, TargetValue};
 use robocal_core::solve::ik::TargetsCsv;
 use robocal_core::stats::ErrorStats;
@@ -36,6 +42,51 @@ use serde::Serialize;
 pub const POSITIONER_READINGS_MAX: usize = 20_000;
 /// Most reflectors (measurement files) one positioner fit takes.
 pub const POSITIONER_REFLECTORS_MAX: usize = 32;
+
+/// Where a positioner fit's readings came from (every fit's answer and
+/// every stored positioner states it as `readings_from`).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum ReadingsFrom {
+    /// A tracker's readings of reflectors on the face plate.
+    Tracker,
+    /// Touches of features on the face plate, placed by a calibrated robot
+    /// carrying a tool.
+    Touches {
+        /// The model file that placed them (the command line).
+        #[serde(skip_serializing_if = "Option::is_none")]
+        model: Option<String>,
+        /// The robot's model version that placed them (the service).
+        #[serde(skip_serializing_if = "Option::is_none")]
+        version: Option<i64>,
+        /// The cell's tool that touched.
+        tool: String,
+    },
+}
+
+impl ReadingsFrom {
+    /// A stored positioner's: touches when the row names a version and a tool.
+    pub fn of_row(row: &PositionerRow) -> ReadingsFrom {
+        match (row.touched_version, &row.touched_tool) {
+            (Some(v), Some(tool)) => ReadingsFrom::Touches {
+                model: None,
+                version: Some(v),
+                tool: tool.clone(),
+            },
+            _ => ReadingsFrom::Tracker,
+        }
+    }
+}
+
+/// Touches placed by one of the robot's model versions carrying one of its
+/// cell's tools, instead of tracker readings.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct TouchedWith {
+    /// The model version whose calibrated robot places the touches.
+    pub version: i64,
+    /// The stored tool (name) that touched.
+    pub tool: String,
+}
 
 /// A positioner fit, in domain terms.
 #[derive(Debug, Clone)]
@@ -55,6 +106,10 @@ pub struct PositionerCalibration {
     pub sigma_mm: f64,
     /// Held-out measurement file texts, the k-th of reflector k.
     pub validate: Vec<String>,
+    /// The texts are touches files placed by this version and tool
+    /// (`cell_fit::positioner_touches`), not tracker readings; `sigma_mm`
+    /// is then the robot's accuracy at the tool's tip.
+    pub touched_with: Option<TouchedWith>,
 }
 
 /// Why a measurement file's text is not a reflector's readings.
@@ -140,16 +195,68 @@ pub struct StoredPositioner {
     pub validation: Option<HeldOut>,
 }
 
+/// How a fit's texts are read: a tracker's files, or touches files placed
+/// by the robot carrying the touching tool.
+enum Reader {
+    Tracker,
+    Touches(Box<Forward>),
+}
+
+impl Reader {
+    /// The robot of `t`'s version carrying its tool (`NotFound` for a
+    /// missing version or tool), or the tracker's reader.
+    async fn of(
+        state: &AppState,
+        robot_id: i64,
+        t: Option<&TouchedWith>,
+    ) -> Result<Reader, ServiceError> {
+        let Some(t) = t else {
+            return Ok(Reader::Tracker);
+        };
+        let (_, text) = super::versions::with_model(state, robot_id, t.version).await?;
+        let model = parse_compensated(&text).map_err(|e| {
+            ServiceError::Internal(format!("stored model version {}: {e}", t.version))
+        })?;
+        // The stored cell's tool, as the command line takes its cell file's.
+        let cell = super::cell::cell(state, robot_id).await?;
+        let tool = cell.tool(&CellRef::Name(t.tool.clone())).map_err(|_| {
+            ServiceError::NotFound(format!(
+                "`touched_with.tool`: robot {robot_id} has no tool `{}`; GET /v1/robots/{robot_id}/tools lists its tools",
+                t.tool
+            ))
+        })?;
+        Ok(Reader::Touches(Box::new(Forward::new(
+            &model,
+            Some(&tool.tcp),
+            tool.load.as_ref(),
+        ))))
+    }
+
+    fn readings(
+        &self,
+        text: &str,
+        columns: PositionerColumns,
+        k: usize,
+    ) -> Result<Vec<PositionerReading>, String> {
+        match self {
+            Reader::Tracker => set_readings(text, columns, k).map_err(|e| e.to_string()),
+            Reader::Touches(f) => touch_readings(f, text, columns, k).map_err(|e| e.to_string()),
+        }
+    }
+}
+
 /// Every text's readings, the k-th as reflector k's; an error names the
 /// field and the text (`sets[k]`, `validate[k]`).
 fn readings_of(
     field: &str,
     texts: &[String],
     columns: PositionerColumns,
+    reader: &Reader,
 ) -> Result<Vec<PositionerReading>, ServiceError> {
     let mut out = Vec::new();
     for (k, text) in texts.iter().enumerate() {
-        let r = set_readings(text, columns, k)
+        let r = reader
+            .readings(text, columns, k)
             .map_err(|e| ServiceError::Invalid(format!("`{field}[{k}]`: {e}")))?;
         out.extend(r);
         if out.len() > POSITIONER_READINGS_MAX {
@@ -169,8 +276,9 @@ pub async fn calibrate(
     cmd: PositionerCalibration,
 ) -> Result<StoredPositioner, ServiceError> {
     super::robots::get(state, cmd.robot_id).await?;
-    let readings = readings_of("sets", &cmd.sets, cmd.columns)?;
-    let held = readings_of("validate", &cmd.validate, cmd.columns)?;
+    let reader = Reader::of(state, cmd.robot_id, cmd.touched_with.as_ref()).await?;
+    let readings = readings_of("sets", &cmd.sets, cmd.columns, &reader)?;
+    let held = readings_of("validate", &cmd.validate, cmd.columns, &reader)?;
     if readings.len() + held.len() > POSITIONER_READINGS_MAX {
         return Err(ServiceError::Invalid(format!(
             "`sets` and `validate`: {} readings; at most {POSITIONER_READINGS_MAX} in one fit",
@@ -209,6 +317,8 @@ pub async fn calibrate(
         rms_mm: fit.rms_mm,
         max_mm: fit.max_mm,
         positioner_json: fit.model.to_json(),
+        touched_version: cmd.touched_with.as_ref().map(|t| t.version),
+        touched_tool: cmd.touched_with.map(|t| t.tool),
     };
     let (row, created) = state
         .db()

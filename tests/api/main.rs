@@ -25,7 +25,8 @@
 //! it filtered; `track_sets`: a robot on a track uploaded one set per station
 //! and calibrated over them), `positioner`
 //! (a robot's two-axis positioner: fitted, stored, and carrying a targets CSV,
-//! over HTTP and the CLI alike); the harness is `support`.
+//! over HTTP and the CLI alike; `positioner_touches`: fitted from touches
+//! with a stored version and tool); the harness is `support`.
 
 mod abandoned;
 mod admission;
@@ -57,6 +58,7 @@ mod one_answer;
 mod plans;
 mod positioner;
 mod positioner_filter;
+mod positioner_touches;
 mod predict;
 mod progress;
 mod record;

@@ -61,7 +61,7 @@ fn placed(robot: &Pose) -> Pose {
 
 /// The nominal positioner of the positioner tests (`core/tests/common/positioner.rs`), placed
 /// in front of `robot`.
-fn nominal(robot: &Pose) -> TiltRotate {
+pub(crate) fn nominal(robot: &Pose) -> TiltRotate {
     TiltRotate {
         cell_from_base: placed(robot),
         ..shared::nominal()
@@ -70,7 +70,7 @@ fn nominal(robot: &Pose) -> TiltRotate {
 
 /// The true positioner of `tests/cli_positioner.rs` (the shared truth with its 0.003° nod), at
 /// the same place.
-fn truth(robot: &Pose) -> TruePositioner {
+pub(crate) fn truth(robot: &Pose) -> TruePositioner {
     TruePositioner {
         cell_from_base: placed(robot),
         ..shared::truth(0.003)
@@ -78,7 +78,7 @@ fn truth(robot: &Pose) -> TruePositioner {
 }
 
 /// Both axes moved together, none a fitted pair.
-fn held_out() -> Vec<[f64; 2]> {
+pub(crate) fn held_out() -> Vec<[f64; 2]> {
     let mut v = Vec::new();
     for a in [-80.0, -23.0, 37.0, 84.0] {
         for b in [-172.0, -71.0, 19.0, 107.0] {
@@ -89,7 +89,7 @@ fn held_out() -> Vec<[f64; 2]> {
 }
 
 /// Reflector `k`'s readings at `values`, as a measurement file's text.
-fn set_text(t: &TruePositioner, k: usize, values: &[[f64; 2]], seed: u64) -> String {
+pub(crate) fn set_text(t: &TruePositioner, k: usize, values: &[[f64; 2]], seed: u64) -> String {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     write_set(&positioner_set(t, k, values, COLUMNS, &mut rng))
 }
@@ -233,6 +233,8 @@ async fn a_positioner_fitted_over_http_is_the_command_lines_and_carries_a_target
     .unwrap();
     let by_cli: Value = serde_json::from_str(&printed).unwrap();
     assert_eq!(fitted["fit"], by_cli["fit"], "the fit's report");
+    assert_eq!(fitted["readings_from"], json!({ "kind": "tracker" }));
+    assert_eq!(by_cli["readings_from"], fitted["readings_from"]);
     let mut cli_validation = by_cli["validation"].clone();
     cli_validation.as_object_mut().unwrap().remove("files");
     assert_eq!(fitted["validation"], cli_validation, "the held-out figures");

@@ -14,7 +14,8 @@
 //! judged against the σ the caller gives. Frames: joints controller
 //! degrees in, positions mm in the calibrated model's cell frame out.
 
-use crate::calibrate::external::readings::PositionerColumns;
+use crate::calibrate::external::readings::{positioner_readings, PositionerColumns};
+use crate::calibrate::external::PositionerReading;
 use crate::measure::csv_text::Dialect;
 use crate::measure::external::{ExternalValues, MeasurementSet};
 use crate::measure::MeasuredPose;
@@ -132,4 +133,19 @@ pub fn touched_positions(
         pose.std_deg = None;
     }
     Ok(out)
+}
+
+/// Feature `k`'s readings from a touches file's `text`: [`read_touches`],
+/// then [`touched_positions`] by `forward`, read as the positioner's fit
+/// reads a reflector's file (what `robocal positioner calibrate
+/// --touched-with` and the service's fit from touches both read).
+pub fn touch_readings(
+    forward: &Forward,
+    text: &str,
+    columns: PositionerColumns,
+    k: usize,
+) -> Result<Vec<PositionerReading>, TouchError> {
+    let set = read_touches(text, Dialect::default(), forward.model().dof(), columns)?;
+    let placed = touched_positions(forward, &set)?;
+    positioner_readings(&placed, columns, k).map_err(|e| TouchError::File(e.to_string()))
 }

@@ -80,11 +80,17 @@ fn positioner_table(r: &RobotRow, p: &PositionerRow) -> Markup {
     let url = format!("/v1/robots/{}/positioner", r.id);
     html! {
         table #positioner-stored {
-            thead { tr { th { "Tilt column" } th { "Rotate column" } th { "Reflectors" } th { "Readings" } th { "RMS [mm]" } th { "Max [mm]" } th { "σ [mm]" } th { "Created" } th {} } }
+            thead { tr { th { "Tilt column" } th { "Rotate column" } th { "Readings from" } th { "Reflectors" } th { "Readings" } th { "RMS [mm]" } th { "Max [mm]" } th { "σ [mm]" } th { "Created" } th {} } }
             tbody {
                 tr {
                     td.tilt { (p.tilt_column) }
                     td.rotate { (p.rotate_column) }
+                    td.from {
+                        @match (p.touched_version, &p.touched_tool) {
+                            (Some(v), Some(t)) => { "touches with tool " (t) " of version " (v) }
+                            _ => { "tracker" }
+                        }
+                    }
                     td.reflectors { (p.reflectors) }
                     td.readings { (p.readings) }
                     td.rms { (mm(p.rms_mm)) }

@@ -13,7 +13,7 @@
 //!
 //! Frames: readings in the cell (tracker) frame; the nominal model places the
 //! positioner base in it; lines of axis 1 in the base frame, of axis 2 in the
-//! tilt frame (docs/external-axes.md). Units: mm and degrees in the inputs
+//! tilt frame (docs/external-axes/positioner.md). Units: mm and degrees in the inputs
 //! and reports, m and rad inside.
 
 pub mod circle;

@@ -62,7 +62,7 @@ pub struct PositionerFitRequest {
     pub nominal: TiltRotate,
     /// The reflectors' design positions in the face plate frame [mm]. The
     /// first is the reference: its azimuth about axis 2 is held at the design
-    /// one, which defines axis 2's zero (docs/external-axes.md).
+    /// one, which defines axis 2's zero (docs/external-axes/positioner.md).
     pub reflectors_mm: Vec<[f64; 3]>,
     /// The tracker readings, every reflector at every pair of values.
     pub readings: Vec<PositionerReading>,
