@@ -1,6 +1,7 @@
 """The web console's external-axes section, a step of scripts/console_check.py
 (which calls `check_external_axes` with its driver and helpers): a track and a
-positioner fitted, refused and deleted through the robot page's forms, each
+positioner fitted, refused and deleted through the robot page's forms, poses
+predicted and targets solved on the stored positioner's face plate, each
 answer compared with the API's. Python 3 standard library and Selenium.
 """
 import pathlib
@@ -53,7 +54,9 @@ def check_external_axes(driver, wait, shot, base, robocal, work, robot_url, h):
     # positioner from `robocal positioner simulate --robot ys100`'s
     # files (the nominal JSON, one file per reflector, the reflectors'
     # positions from the command it prints), after the page refuses a
-    # reflector line short of the files.
+    # reflector line short of the files; with it stored (and no track),
+    # the page's predict and solve forms on its face plate
+    # (`predict_and_solve_on_positioner`), then it is deleted.
     axes = pathlib.Path(work) / "axes"
     axes.mkdir()
     rail = h.api_post(base, "/v1/robots", {"name": "YS100 on the rail", "preset": "ys100"})
@@ -192,6 +195,8 @@ def check_external_axes(driver, wait, shot, base, robocal, work, robot_url, h):
         f"{len(sets)} reflectors (max {shown['max']} mm)", msg
     print(f"console_check: positioner fitted, RMS {shown['rms']} mm over {shown['readings']} readings")
     shot("positioner-fitted", "axes-section")
+    assert api_raw(h.KEY, base, "GET", f"/v1/robots/{rail_id}/track")[0] == 404, "a track is still stored"
+    predict_and_solve_on_positioner(driver, wait, shot, base, rail_id, h)
     button = driver.find_element(By.ID, "delete-positioner")
     button.click()
     alert = wait.until(EC.alert_is_present())
@@ -203,3 +208,105 @@ def check_external_axes(driver, wait, shot, base, robocal, work, robot_url, h):
     assert api_raw(h.KEY, base, "GET", f"/v1/robots/{rail_id}/positioner")[0] == 404
     driver.get(robot_url)
     wait.until(EC.presence_of_element_located((By.ID, "add-tool")))
+
+
+def shown_number(v, decimals):
+    """A number as console.js's `fixed` writes it: `decimals` places, never "-0"."""
+    s = f"{v:.{decimals}f}"
+    return s[1:] if re.fullmatch(r"-[0.]*", s) else s
+
+
+def predict_and_solve_on_positioner(driver, wait, shot, base, rail_id, h):
+    """The rail robot with its positioner stored and no track: the page's
+    predict form given e1 = 20, e2 = 35 (the positioner's tilt and rotate)
+    states the poses on the face plate as the API's predict does for the
+    same body; `e2` without `e1` is refused with the API's reason; the
+    predicted points, as a targets CSV with `e1`, `e2` columns, are solved
+    in the page's solve form as the API solves them, and the solved joints
+    put the measured point back on those points."""
+    import json
+    # Within the YS100's joint limits (J2 20..160, J3 -110..90 deg), so the
+    # points can be solved back.
+    readings = [("p1", [10, 90, -20, 0, 45, 0]), ("p2", [0, 100, 0, 0, 60, 0])]
+    form = driver.find_element(By.ID, "predict")
+    assert Select(form.find_element(By.NAME, "frame")).first_selected_option.get_attribute("value") == ""
+    assert [form.find_element(By.NAME, n).get_attribute("value") for n in ("e1", "e2", "e3")] == ["", "", ""]
+    form.find_element(By.NAME, "readings").send_keys(
+        "\n".join(f"{i}, " + ", ".join(str(q) for q in js) for i, js in readings))
+    form.find_element(By.NAME, "e1").send_keys("20")
+    form.find_element(By.NAME, "e2").send_keys("35")
+    form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+    wait.until(EC.visibility_of_element_located((By.ID, "predict-result")))
+    summary = driver.find_element(By.ID, "predict-summary").text
+    rows = [[td.text for td in r.find_elements(By.TAG_NAME, "td")]
+            for r in driver.find_elements(By.CSS_SELECTOR, "#predict-table tbody tr")]
+    # The same body over the API (the page sends the model select's `active`).
+    body = {"readings": [{"id": i, "joints_deg": js} for i, js in readings], "version": "active",
+            "e1": 20, "e2": 35}
+    want = h.api_post(base, f"/v1/robots/{rail_id}/predict", body)
+    assert want["frame"] == "face_plate", want["frame"]
+    assert summary.startswith("2 poses of the measured point in the face_plate frame (e1 = 20, e2 = 35) at "), summary
+    assert [(r["status"], r["outside_limits"]) for r in want["results"]] == [("ok", [])] * 2, want["results"]
+    for row, p in zip(rows, want["results"], strict=True):
+        expected = [p["id"], p["status"]] + [shown_number(p[k], 3) for k in "xyz"] \
+            + [shown_number(p[k], 4) for k in ("rx", "ry", "rz")]
+        assert row[:8] == expected, (row, expected)
+    # The face plate is not the cell frame: the same readings without the axes.
+    cell = h.api_post(base, f"/v1/robots/{rail_id}/predict", {"readings": body["readings"]})["results"]
+    moved = min(sum((c[k] - p[k]) ** 2 for k in "xyz") ** 0.5 for c, p in zip(cell, want["results"]))
+    assert moved > 1.0, f"the face plate's poses are only {moved:.3f} mm from the cell frame's"
+    print(f"console_check: predicted on the positioner at e1 = 20, e2 = 35: {summary}; "
+          f"p1 at {', '.join(rows[0][2:5])} mm, as the API gives it")
+    shot("predicted-on-positioner", "predict-section")
+    # Refused: e2 without e1, the API's 422 and its reason shown; the table kept.
+    form.find_element(By.NAME, "e1").clear()
+    assert form.find_element(By.NAME, "e2").get_attribute("value") == "35"
+    status, answer = api_raw(h.KEY, base, "POST", f"/v1/robots/{rail_id}/predict",
+                             json.dumps({"readings": body["readings"], "version": "active", "e2": 35}).encode(),
+                             "application/json")
+    assert status == 422, (status, answer)
+    refusal = f"422: {json.loads(answer)['detail']}"
+    assert "`e2` without `e1`" in refusal, refusal
+    form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+    msg = wait.until(lambda d: (t := h.text_of(d, "#message")) and t.startswith("422") and t)
+    assert msg == refusal, (msg, refusal)
+    assert "msg bad" in driver.find_element(By.ID, "message").get_attribute("class")
+    assert driver.find_element(By.ID, "predict-summary").text == summary
+    print(f"console_check: refused: {msg}")
+    shot("predict-refused", "predict-section")
+    # Solve: the predicted points as targets on the face plate, each row at
+    # its e1, e2, position only; the page's CSV is the API's.
+    csv = "id,x,y,z,e1,e2\n" + "".join(f"{p['id']},{p['x']!r},{p['y']!r},{p['z']!r},20,35\n"
+                                       for p in want["results"])
+    form = driver.find_element(By.ID, "solve")
+    assert Select(form.find_element(By.NAME, "frame")).first_selected_option.get_attribute("value") == ""
+    form.find_element(By.NAME, "csv").send_keys(csv)
+    form.find_element(By.NAME, "position_only").click()
+    form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+    # The answer, or the page's message saying why not (the refusal above until then).
+    wait.until(lambda d: d.find_element(By.ID, "solve-result").is_displayed() or h.text_of(d, "#message") != msg)
+    assert driver.find_element(By.ID, "solve-result").is_displayed(), driver.find_element(By.ID, "message").text
+    summary = driver.find_element(By.ID, "solve-summary").text
+    shown = driver.execute_script("return document.getElementById('solve-csv').textContent")
+    assert summary.startswith("2 of 2 targets solved"), (summary, shown)
+    status, answer = api_raw(h.KEY, base, "POST", f"/v1/robots/{rail_id}/solve?version=active&position_only=true",
+                             csv.encode(), "text/csv")
+    assert status == 200, (status, answer)
+    assert shown == answer.decode(), (shown, answer.decode())
+    table = list(csv_rows(shown))
+    assert [r["status"] for r in table] == ["ok", "ok"], table
+    joints = [[float(r[f"j{j}_deg"]) for j in range(1, 7)] for r in table]
+    back = h.api_post(base, f"/v1/robots/{rail_id}/predict", {
+        "readings": [{"id": r["id"], "joints_deg": js} for r, js in zip(table, joints)], "e1": 20, "e2": 35})
+    worst = max(sum((b[k] - p[k]) ** 2 for k in "xyz") ** 0.5 for b, p in zip(back["results"], want["results"]))
+    assert worst < 0.01, f"the solved joints put the point {worst} mm from its target on the face plate"
+    print(f"console_check: solved on the positioner: {summary}; the solved joints put the point within "
+          f"{worst:.1e} mm of its target on the face plate")
+    shot("solved-on-positioner", "solve-section")
+
+
+def csv_rows(text):
+    """The rows of CSV `text` as dicts."""
+    import csv
+    import io
+    return csv.DictReader(io.StringIO(text))

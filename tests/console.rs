@@ -240,6 +240,83 @@ async fn a_tools_edit_form_holds_every_stored_field() {
     )));
 }
 
+/// The form `<form id="{id}"` of a page, from its opening tag to its end.
+fn form<'a>(html: &'a str, id: &str) -> &'a str {
+    let at = html
+        .find(&format!("<form id=\"{id}\""))
+        .unwrap_or_else(|| panic!("no form {id}"));
+    &html[at..at + html[at..].find("</form>").unwrap()]
+}
+
+/// The predict form takes the external axes' values `e1`, `e2`, `e3` as
+/// numbers, each labelled with what it is, empty by default; its frame and
+/// the solve form's are sent only when chosen (a positioner's values put
+/// the poses and targets on its face plate, where the API refuses a frame),
+/// and the solve section says a targets CSV may carry the axes' columns.
+#[tokio::test]
+async fn the_predict_form_takes_the_external_axes_values() {
+    let (state, _dir) = state().await;
+    let robot = post_json(
+        &state,
+        "/v1/robots",
+        &serde_json::json!({ "name": "cell", "preset": "ur5" }),
+        StatusCode::CREATED,
+    )
+    .await;
+    let id = robot["id"].as_i64().unwrap();
+    let (s, html) = call(&state, "GET", &format!("/ui/robots/{id}"), None).await;
+    assert_eq!(s, StatusCode::OK);
+    let predict = form(&html, "predict");
+    assert!(predict.contains(&format!(
+        "<form id=\"predict\" data-action=\"predict\" data-robot=\"{id}\""
+    )));
+    for (name, label) in [
+        (
+            "e1",
+            "e1 (track [mm], or the positioner's tilt [°] without a track)",
+        ),
+        (
+            "e2",
+            "e2 (the positioner's tilt [°] beside a track, else its rotate)",
+        ),
+        ("e3", "e3 (the positioner's rotate [°] beside a track)"),
+    ] {
+        let input = format!("<input name=\"{name}\" type=\"number\" step=\"any\">");
+        let at = predict
+            .find(&input)
+            .unwrap_or_else(|| panic!("the predict form lacks {input}"));
+        let open = predict[..at].rfind("<label").unwrap();
+        let text = predict[open..at]
+            .replace("&#39;", "'")
+            .replace("&apos;", "'");
+        assert!(text.ends_with(&format!("{label} ")), "{name}: {text}");
+        assert_eq!(input_value(predict, name), None, "{name} is prefilled");
+    }
+    // The frame: none sent unless base or a work object is chosen.
+    for f in [predict, form(&html, "solve")] {
+        let at = f.find("<select name=\"frame\">").expect("no frame select");
+        assert!(
+            f[at..].starts_with("<select name=\"frame\"><option value=\"\">"),
+            "{}",
+            &f[at..]
+        );
+        assert!(!f.contains("value=\"cell\""));
+        assert!(f.contains("<option value=\"base\">robot base</option>"));
+    }
+    assert!(html.contains("<p class=\"note\" id=\"predict-axes-note\">External axes"));
+    let at = html
+        .find("<p class=\"note\" id=\"solve-axes-note\">")
+        .expect("no note on the solve form's axes");
+    let note = &html[at..at + html[at..].find("</p>").unwrap()];
+    for part in [
+        "an e1 column alone is the track",
+        "e1, e2 the positioner",
+        "e1, e2, e3 the track",
+    ] {
+        assert!(note.contains(part), "{note}");
+    }
+}
+
 /// The robot page's `#axes-section`, from its opening tag to its end.
 fn axes_section(html: &str) -> &str {
     let at = html

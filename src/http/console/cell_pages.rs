@@ -308,7 +308,8 @@ pub(super) fn filter_section(id: i64, versions: &[VersionRow]) -> Markup {
 
 /// Predict poses from joint readings (`POST …/predict`) for robot `id`:
 /// every option of the API — model, tool, frame (tracker, base or a work
-/// object), payload and a second orientation convention.
+/// object), payload, a second orientation convention and the external
+/// axes' values `e1`, `e2`, `e3` (the robot's stored track and positioner).
 pub(super) fn predict_section(
     id: i64,
     versions: &[VersionRow],
@@ -319,6 +320,7 @@ pub(super) fn predict_section(
         section #predict-section {
             h2 { "Predict poses" }
             p.note { "Controller joint readings in degrees, one reading a line (an id first is optional: p1, 10, -80, 95, 0, 45, 0); the pose of the measured point or of a tool, in mm and degrees (R = Rz·Ry·Rx), and in a controller's convention when one is chosen." }
+            p.note #predict-axes-note { "External axes, as the controller shows them, through the robot's stored track and positioner: e1 alone is the track's value [mm]; e1, e2 the positioner's tilt and rotate [°], the poses then on its face plate (keep the first Frame entry); e1, e2, e3 the track's value [mm] and, beside it, the positioner's tilt and rotate [°]. Leave them empty for none; the service refuses a combination the stored axes do not fit, saying why." }
             form #predict data-action="predict" data-robot=(id) {
                 label.wide { "Joint readings " textarea name="readings" rows="3" placeholder="p1, 10, -80, 95, 0, 45, 0" {} }
                 (model_select(versions))
@@ -330,7 +332,8 @@ pub(super) fn predict_section(
                 }
                 label { "Frame "
                     select name="frame" {
-                        option value="cell" { "tracker (measurement frame)" }
+                        // No frame sent: the tracker's, or the positioner's face plate with e2.
+                        option value="" { "tracker (measurement frame); the positioner's face plate with e2" }
                         option value="base" { "robot base" }
                         @for w in work_objects { option value={ "wobj:" (w.name) } { "work object " (w.name) } }
                     }
@@ -343,6 +346,12 @@ pub(super) fn predict_section(
                         @for c in OrientationConvention::ALL { option value=(c.name()) { (c.name()) } }
                     }
                 }
+                label { "e1 (track [mm], or the positioner's tilt [°] without a track) "
+                    input name="e1" type="number" step="any"; }
+                label { "e2 (the positioner's tilt [°] beside a track, else its rotate) "
+                    input name="e2" type="number" step="any"; }
+                label { "e3 (the positioner's rotate [°] beside a track) "
+                    input name="e3" type="number" step="any"; }
                 button type="submit" { "Predict" }
             }
             div #predict-result hidden {

@@ -352,11 +352,22 @@ handlers.predict = async function (form) {
     readings.push(reading);
   }
   if (!readings.length) throw new Error("give at least one joint reading");
-  // The frame: the tracker's, the base, or a work object ("wobj:<name>").
+  // The frame: none (the tracker's, or the positioner's face plate with
+  // e2), the base, or a work object ("wobj:<name>").
   const frame = formValue(form, "frame");
   const body = { readings };
   if (frame.startsWith("wobj:")) body.work_object = frame.slice(5);
-  else body.frame = frame;
+  else if (frame) body.frame = frame;
+  // The external axes' values given (e1 the track's [mm] or the positioner's
+  // tilt [deg], e2, e3 the positioner's); the API refuses a combination the
+  // robot's stored axes do not fit, and its reason is shown.
+  const axes = [];
+  for (const name of ["e1", "e2", "e3"]) {
+    const v = formValue(form, name);
+    if (!v) continue;
+    body[name] = Number(v);
+    axes.push(`${name} = ${v}`);
+  }
   const version = formValue(form, "version");
   if (version) body.version = /^[0-9]+$/.test(version) ? Number(version) : version;
   const tool = formValue(form, "tool");
@@ -383,7 +394,9 @@ handlers.predict = async function (form) {
   }
   const acc = r.accuracy && r.accuracy.mean_mm !== undefined ? `; expected error ${fmtMm(r.accuracy.mean_mm)} mm mean` : "";
   document.getElementById("predict-convention").textContent = convention || "Convention";
-  const summary = `${r.results.length} poses of ${r.tool || "the measured point"} in the ${r.frame} frame at ${fixed(r.payload_kg, 3)} kg (model: ${r.version === null ? "nominal" : "v" + r.version} ${r.method})${acc}`;
+  // The axes' values as sent (the answer names the frame, not the values).
+  const at = axes.length ? ` (${axes.join(", ")})` : "";
+  const summary = `${r.results.length} poses of ${r.tool || "the measured point"} in the ${r.frame} frame${at} at ${fixed(r.payload_kg, 3)} kg (model: ${r.version === null ? "nominal" : "v" + r.version} ${r.method})${acc}`;
   document.getElementById("predict-summary").textContent = summary;
   document.getElementById("predict-result").hidden = false;
   show(summary, true);
