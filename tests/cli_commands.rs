@@ -192,6 +192,7 @@ fn cli_args(model: &str, targets: &str) -> SolveArgs {
         failures: Default::default(),
         track: Default::default(),
         positioner: None,
+        turntable: None,
     }
 }
 

@@ -31,6 +31,7 @@ pub mod tcp;
 pub mod track;
 mod track_part;
 pub mod track_sim;
+pub mod turntable;
 mod weld;
 
 pub use model_files::load_model;
@@ -103,6 +104,9 @@ pub enum Command {
     /// A two-axis positioner: fit its axes from tracker readings of reflectors on its face plate.
     #[command(after_help = exit::help_for("positioner"))]
     Positioner(positioner::PositionerArgs),
+    /// A one-axis turntable: fit its axis from tracker readings of reflectors on its face plate.
+    #[command(after_help = exit::help_for("turntable"))]
+    Turntable(turntable::TurntableArgs),
     /// Run the HTTP service.
     #[command(after_help = exit::help_for("serve"))]
     Serve(serve::ServeArgs),
@@ -136,6 +140,7 @@ pub fn run(cli: Cli) -> anyhow::Result<exit::Exit> {
         Command::WorkObject(a) => done(tcp::run_work_object(a)),
         Command::Track(a) => done(track::run(a)),
         Command::Positioner(a) => done(positioner::run(a)),
+        Command::Turntable(a) => done(turntable::run(a)),
         Command::Serve(a) => done(serve::run(a)),
         Command::Keygen(a) => done(keygen::run(a)),
         Command::Bench(a) => done(bench::run(a)),

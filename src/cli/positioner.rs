@@ -121,7 +121,7 @@ pub struct CalibrateArgs {
     pub json: bool,
 }
 
-fn parse_axis(s: &str) -> Result<ExternalAxis, String> {
+pub(super) fn parse_axis(s: &str) -> Result<ExternalAxis, String> {
     ExternalAxis::ALL
         .into_iter()
         .find(|a| a.column().eq_ignore_ascii_case(s.trim()))
@@ -129,7 +129,7 @@ fn parse_axis(s: &str) -> Result<ExternalAxis, String> {
 }
 
 /// `x,y,z` [mm] of a `--reflector`.
-fn parse_point(s: &str) -> anyhow::Result<[f64; 3]> {
+pub(super) fn parse_point(s: &str) -> anyhow::Result<[f64; 3]> {
     let v: Vec<f64> = s
         .split(',')
         .map(|x| x.trim().parse::<f64>())

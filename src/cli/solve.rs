@@ -156,6 +156,12 @@ pub struct SolveArgs {
     /// the track's value its `e1` column or --e1.
     #[arg(long, conflicts_with_all = ["work_object"])]
     pub positioner: Option<String>,
+    /// Calibrated one-axis turntable (`robocal turntable calibrate --out`,
+    /// in the robot's measurement frame): the targets are in its face plate
+    /// frame, each row at its `e1` value [deg]; beside --track (in the
+    /// track's cell frame) at `e2`, the track's value its `e1` column or --e1.
+    #[arg(long, conflicts_with_all = ["work_object", "positioner"])]
+    pub turntable: Option<String>,
 }
 
 /// How `robocal solve` prints its results.
@@ -196,9 +202,10 @@ pub fn solve_outcome(a: &SolveArgs) -> anyhow::Result<super::exit::Outcome> {
     let dialect = dialect_from_names(a.delimiter.as_deref(), a.decimal.as_deref())
         .map_err(anyhow::Error::msg)?;
     let on_track = a.track.track.is_some();
-    let on_plate = match &a.positioner {
-        Some(path) => Some(positioner_rows(path, &a.targets, &text, dialect, on_track)?),
-        None => None,
+    let on_plate = match (&a.positioner, &a.turntable) {
+        (Some(path), _) => Some(positioner_rows(path, &a.targets, &text, dialect, on_track)?),
+        (None, Some(path)) => Some(turntable_rows(path, &a.targets, &text, dialect, on_track)?),
+        (None, None) => None,
     };
     // `--track` without `--e1`: each row's value from the file's `e1` column
     // (on a positioner without a track, `e1` is its tilt).
@@ -236,8 +243,8 @@ pub fn solve_outcome(a: &SolveArgs) -> anyhow::Result<super::exit::Outcome> {
         Some(_) => vec![TRACK_COLUMN],
         None => vec![],
     };
-    if on_plate.is_some() {
-        beside.extend(positioner_columns(on_track));
+    if let Some(rows) = &on_plate {
+        beside.extend(rows.columns.iter());
     }
     let mut csv = read_targets(a, &text, dialect, &beside)?;
     let settings = IkSettings {
@@ -373,13 +380,15 @@ fn seed_joints(a: &SolveArgs, model: &CompensatedModel) -> anyhow::Result<Option
 }
 
 /// A targets file's rows on a positioner: the positioner and each row's
-/// values of its two axes [deg].
+/// values of its two axes [deg]. A turntable is the positioner whose axis 1
+/// stands at 0 (`Turntable::as_tilt_rotate`), its one column the rotate's.
 struct PlateRows {
     /// The positioner file.
     path: String,
     positioner: TiltRotate,
-    /// The tilt's and the rotate's columns (`positioner_columns`).
-    columns: [&'static str; 2],
+    /// The columns read: the tilt's and the rotate's (`positioner_columns`),
+    /// or a turntable's one.
+    columns: Vec<&'static str>,
     tilt: Vec<TargetValue>,
     rotate: Vec<TargetValue>,
 }
@@ -425,11 +434,16 @@ impl PlateRows {
     }
 
     fn label(&self) -> String {
-        let [tilt, rotate] = self.columns;
-        format!(
-            "face plate of positioner {} at each row's {tilt} (tilt), {rotate} (rotate)",
-            self.path
-        )
+        match self.columns[..] {
+            [tilt, rotate] => format!(
+                "face plate of positioner {} at each row's {tilt} (tilt), {rotate} (rotate)",
+                self.path
+            ),
+            _ => format!(
+                "face plate of turntable {} at each row's {}",
+                self.path, self.columns[0]
+            ),
+        }
     }
 }
 
@@ -456,8 +470,40 @@ fn positioner_rows(
         path: path.to_string(),
         tilt: column(columns[0], "tilt (axis 1)")?,
         rotate: column(columns[1], "rotate (axis 2)")?,
-        columns,
+        columns: columns.to_vec(),
         positioner,
+    })
+}
+
+/// `--turntable FILE`: the turntable as the positioner whose axis 1 stands
+/// at 0, and the targets file's column of its value, required: `e1`, or
+/// `e2` beside a track (`on_track`).
+fn turntable_rows(
+    path: &str,
+    file: &str,
+    text: &str,
+    dialect: crate::measure::csv_text::Dialect,
+    on_track: bool,
+) -> anyhow::Result<PlateRows> {
+    let turntable = super::turntable::read_turntable(path)?;
+    let name = if on_track { "e2" } else { "e1" };
+    let rotate = target_column_values(text, dialect, name)
+        .with_context(|| file.to_string())?
+        .with_context(|| {
+            format!("{file}: --turntable reads each row's value [deg] from an `{name}` column, and the file has none")
+        })?;
+    Ok(PlateRows {
+        path: path.to_string(),
+        tilt: rotate
+            .iter()
+            .map(|t| TargetValue {
+                line: t.line,
+                value: Ok(0.0),
+            })
+            .collect(),
+        rotate,
+        columns: vec![name],
+        positioner: turntable.as_tilt_rotate(),
     })
 }
 

@@ -30,6 +30,7 @@ pub mod study;
 mod synthetic;
 pub mod track;
 mod truth;
+pub mod turntable_example;
 
 pub use perturb::{
     perturb_geometry, perturb_geometry_with, ys100_table_7_1, ErrorDistribution, ErrorMagnitudes,

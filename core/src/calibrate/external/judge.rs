@@ -17,7 +17,8 @@
 //! reading, named). Effects the model lacks (an axis's wobble, a reflector
 //! knocked, a positioner that moved) show there.
 
-use super::outcome::{FitLimits, RefusalReason, Refused};
+use super::outcome::{FitLimits, RefusalReason};
+use super::refusal::Refusal;
 
 /// Fewest distinct values of an axis in its sweep.
 pub const MIN_ANGLES: usize = 4;
@@ -59,10 +60,13 @@ pub fn rms_max(v: &[f64]) -> (f64, f64) {
 
 /// The first of the residuals [mm] beyond `limits`: the RMS, then the worst
 /// reading (1-based row).
-pub fn check_residuals(residual_mm: &[f64], limits: &FitLimits) -> Result<(), Refused> {
+pub fn check_residuals<F>(
+    residual_mm: &[f64],
+    limits: &FitLimits,
+) -> Result<(), Refusal<RefusalReason, F>> {
     let (rms, max) = rms_max(residual_mm);
     if !within(rms, limits.rms_mm) {
-        return Err(Refused::new(
+        return Err(Refusal::new(
             RefusalReason::ResidualsTooLarge,
             format!(
                 "the readings do not follow one rigid positioner: residuals rms {rms:.4} mm (max {max:.4} mm), \
@@ -79,7 +83,7 @@ pub fn check_residuals(residual_mm: &[f64], limits: &FitLimits) -> Result<(), Re
         .enumerate()
         .find(|(_, r)| !within(**r, limits.max_mm))
     {
-        return Err(Refused::new(
+        return Err(Refusal::new(
             RefusalReason::ResidualOutlier,
             format!(
                 "reading {}: its residual of {r:.4} mm is beyond the tracker's noise (at most {:.4} mm: \

@@ -24,6 +24,7 @@ pub mod problem;
 pub mod readings;
 pub mod refusal;
 pub mod track;
+pub mod turntable;
 
 pub use fit::fit_positioner;
 pub use outcome::{

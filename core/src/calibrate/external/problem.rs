@@ -210,7 +210,7 @@ pub fn residuals(g: &Gauge, s: &State, rows: &[Row]) -> DVector<f64> {
 }
 
 /// `ω × (R·z) − R·(ω × z)`: the move of `R·z` when the axis turns by `ω`.
-fn turned_axis(w: &Vector3<f64>, r: &Matrix3<f64>, z: &Vector3<f64>) -> Vector3<f64> {
+pub(crate) fn turned_axis(w: &Vector3<f64>, r: &Matrix3<f64>, z: &Vector3<f64>) -> Vector3<f64> {
     w.cross(&(r * z)) - r * w.cross(z)
 }
 

@@ -3,9 +3,11 @@
 //! external-axis columns that hold the positioner's axes (which column is
 //! the tilt and which the rotate axis is the caller's: [`PositionerColumns`]).
 //! One set holds one reflector's readings (a tracker's file per nest); the
-//! request gathers the sets of every reflector.
+//! request gathers the sets of every reflector. A turntable's readings are
+//! read alike from its one column ([`turntable_readings`]).
 
 use super::outcome::PositionerReading;
+use super::turntable::TurntableReading;
 use crate::measure::external::{ExternalAxis, MeasurementSet};
 
 /// Which external-axis column holds which positioner axis.
@@ -28,7 +30,7 @@ pub enum ColumnsError {
     Missing {
         /// The column named for the axis.
         column: ExternalAxis,
-        /// `tilt` or `rotate`.
+        /// `tilt`, `rotate` or `turntable`.
         role: &'static str,
         /// The set's external-axis columns, comma-separated (`none`).
         has: String,
@@ -78,6 +80,40 @@ pub fn positioner_readings(
             Ok(PositionerReading {
                 reflector,
                 values_deg: [value(columns.tilt)?, value(columns.rotate)?],
+                xyz_mm: r.pose.xyz_mm,
+            })
+        })
+        .collect()
+}
+
+/// Every row of `set` as a turntable's reading of reflector `reflector` at
+/// the value of `column` [deg] (one set per reflector, as a positioner's).
+pub fn turntable_readings(
+    set: &MeasurementSet,
+    column: ExternalAxis,
+    reflector: usize,
+) -> Result<Vec<TurntableReading>, ColumnsError> {
+    if !set.has(column) {
+        let has: Vec<&str> = set.axes.iter().map(|a| a.column()).collect();
+        return Err(ColumnsError::Missing {
+            column,
+            role: "turntable",
+            has: if has.is_empty() {
+                "none".into()
+            } else {
+                has.join(", ")
+            },
+        });
+    }
+    set.readings()
+        .enumerate()
+        .map(|(i, r)| {
+            Ok(TurntableReading {
+                reflector,
+                value_deg: r
+                    .external
+                    .get(column)
+                    .ok_or(ColumnsError::MissingValue { row: i + 1, column })?,
                 xyz_mm: r.pose.xyz_mm,
             })
         })

@@ -1,0 +1,252 @@
+//! `robocal turntable simulate` and `robocal turntable calibrate`, driven as
+//! a process on files: the example turntable (`sim::turntable_example`,
+//! rotations about a true line tilted 0.05° and offset ~0.5 mm, a zero
+//! offset, a scale error and a nod the model lacks), read with 0.01 mm
+//! tracker noise. The written turntable is checked against the truth at
+//! held-out values; `--json` says the readings came from a tracker; refusals
+//! exit with `refused` (1), write nothing and (with `--json`) print the
+//! refusal. `robocal solve --turntable` takes targets on its face plate at
+//! each row's value: the true robot at the solved joints against the true
+//! point on the true turntable.
+
+mod common;
+#[path = "../core/tests/common/mod.rs"]
+mod core_common;
+
+use common::{assert_refused, code, printed_fit, robocal, save_robot_file, text};
+use core_common::track::ys100_truth;
+use nalgebra::Vector3;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use robocal::measure::csv::write_set;
+use robocal::measure::external::ExternalAxis;
+use robocal::model::external::Turntable;
+use robocal::model::pose::rpy_matrix;
+use robocal::model::Pose;
+use robocal::sim::turntable_example::{held_out, nominal, sweep, truth, turntable_set};
+use serde_json::Value;
+
+#[test]
+fn a_simulated_turntable_is_fitted_written_and_judged() {
+    let d = tempfile::tempdir().unwrap();
+    let out = robocal(d.path(), &["turntable", "simulate", "--out-dir", "."]);
+    assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+    let printed = text(&out.stdout);
+    let args = printed_fit(&printed);
+    let out = robocal(d.path(), &args);
+    assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+    let report = text(&out.stdout);
+    println!("{report}");
+    assert!(report.starts_with("turntable fitted: 24 readings of 2 reflectors (column e1)"));
+    assert!(
+        report.contains("held out: 32 readings at 16 values"),
+        "{report}"
+    );
+
+    // The file, against the truth (no nod, no noise) at the held-out values:
+    // the reference reflector, 400 mm from the axis, at its fitted position.
+    let file = std::fs::read_to_string(d.path().join("turntable.json")).unwrap();
+    let fitted = Turntable::from_json(&file).unwrap();
+    let t = truth(0.003);
+    let json_args: Vec<&str> = args
+        .iter()
+        .copied()
+        .chain(["--json"])
+        .map(|a| {
+            if a == "turntable.json" {
+                "again.json"
+            } else {
+                a
+            }
+        })
+        .collect();
+    let out = robocal(d.path(), &json_args);
+    assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+    let doc: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(doc["fitted"], true);
+    assert_eq!(
+        doc["readings_from"],
+        serde_json::json!({ "kind": "tracker" })
+    );
+    assert_eq!(doc["validation"]["readings"], 32);
+    let p0: Vec<f64> = doc["fit"]["reflectors_mm"][0]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap() * 1e-3)
+        .collect();
+    let p0 = Vector3::new(p0[0], p0[1], p0[2]);
+    let max = held_out()
+        .iter()
+        .map(|v| (fitted.point_in_cell(*v, &p0) - t.reflector(0, [0.0, *v])).norm() * 1e3)
+        .fold(0.0, f64::max);
+    println!("the written turntable at 16 held-out values, 400 mm from the axis: max {max:.4} mm");
+    assert!(max <= 0.03, "{max}");
+
+    // Refused: σ a tenth of the noise (residuals beyond it), as JSON, nothing
+    // written; a column the files do not have; a reflector line short.
+    let mut strict = json_args.clone();
+    strict.extend(["--sigma-mm", "0.001"]);
+    strict.iter_mut().for_each(|a| {
+        if *a == "again.json" {
+            *a = "strict.json"
+        }
+    });
+    let out = robocal(d.path(), &strict);
+    assert_eq!(code(&out), 1, "{}", text(&out.stderr));
+    let doc: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(doc["fitted"], false);
+    assert_eq!(doc["reason"], "residuals_too_large");
+    assert!(!d.path().join("strict.json").exists());
+    let mut other = args.clone();
+    other.extend(["--column", "e2"]);
+    assert_refused(&robocal(d.path(), &other), "no column `e2`");
+    let short: Vec<&str> = args
+        .iter()
+        .copied()
+        .filter(|a| *a != "-150,100,20")
+        .collect();
+    let short: Vec<&str> = short
+        .iter()
+        .enumerate()
+        .filter(|(i, a)| !(**a == "--reflector" && short.get(i + 1) == Some(&"--validate")))
+        .map(|(_, a)| *a)
+        .collect();
+    assert_refused(&robocal(d.path(), &short), "--reflector positions");
+}
+
+#[test]
+fn solve_takes_targets_on_the_turntables_face_plate_at_each_rows_value() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // The robot (its file holds its true geometry: the robot's own
+    // calibration is tested elsewhere) and the turntable 1.7 m in front of
+    // it, fitted from two reflectors' sweeps.
+    let (robot_nominal, robot) = ys100_truth(&mut ChaCha8Rng::seed_from_u64(9));
+    save_robot_file(&robot.model, &robot_nominal, &d.join("robot.json"));
+    let base = Pose::new(
+        rpy_matrix(0.0, 0.0, 30f64.to_radians()),
+        Vector3::new(1.7, 0.3, -0.9),
+    );
+    let mut t = truth(0.003);
+    t.cell_from_base = base;
+    let mut nom = nominal();
+    nom.cell_from_base = base;
+    std::fs::write(d.join("nominal.json"), nom.to_json()).unwrap();
+    for k in 0..2 {
+        let mut rng = ChaCha8Rng::seed_from_u64(k + 1);
+        let set = turntable_set(&t, k as usize, &sweep(), ExternalAxis::E1, &mut rng);
+        std::fs::write(d.join(format!("r{k}.csv")), write_set(&set)).unwrap();
+    }
+    let out = robocal(
+        d,
+        &[
+            "turntable",
+            "calibrate",
+            "r0.csv",
+            "r1.csv",
+            "--nominal",
+            "nominal.json",
+            "--reflector",
+            "400,0,20",
+            "--reflector",
+            "-150,100,20",
+            "--out",
+            "t.json",
+        ],
+    );
+    assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+    let fitted = Turntable::from_json(&std::fs::read_to_string(d.join("t.json")).unwrap()).unwrap();
+
+    // Points of a part located on the face plate through each model at 0
+    // (as a part is taught), then asked for at other values in `e1`.
+    let on_body = [
+        Vector3::new(0.30, 0.20, 1.16),
+        Vector3::new(-0.25, 0.28, 1.16),
+        Vector3::new(0.05, -0.35, 1.18),
+    ];
+    let values = [40.0, -120.0, 160.0, -45.0];
+    let targets = |m: &Turntable| -> String {
+        let mut rows = vec!["id,x,y,z,e1".to_string()];
+        for (i, p) in on_body.iter().enumerate() {
+            let fp = m
+                .cell_from_face_plate(0.0)
+                .inverse()
+                .transform_point(&t.point([0.0, 0.0], p))
+                * 1e3;
+            for (k, v) in values.iter().enumerate() {
+                rows.push(format!("p{i}v{k},{},{},{},{v}", fp.x, fp.y, fp.z));
+            }
+        }
+        rows.join("\n") + "\n"
+    };
+    let misses = |file: &str, turntable: &str| -> Vec<f64> {
+        let out = robocal(
+            d,
+            &[
+                "solve",
+                "--model",
+                "robot.json",
+                "--targets",
+                file,
+                "--turntable",
+                turntable,
+                "--position-only",
+                "--json",
+            ],
+        );
+        assert_eq!(code(&out), 0, "{}{}", text(&out.stdout), text(&out.stderr));
+        let doc: Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(
+            doc["frame"],
+            format!("face plate of turntable {turntable} at each row's e1")
+        );
+        let mut out = Vec::new();
+        for (i, p) in on_body.iter().enumerate() {
+            for (k, v) in values.iter().enumerate() {
+                let deg: Vec<f64> = doc["targets"][i * values.len() + k]["joints_deg"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|x| x.as_f64().unwrap().to_radians())
+                    .collect();
+                let q = robot_nominal.joints_from_controller(&deg);
+                let tip = robot.true_pose_base(&q, None).unwrap().p;
+                out.push((tip - t.point([0.0, *v], p)).norm() * 1e3);
+            }
+        }
+        out
+    };
+    std::fs::write(d.join("cal.csv"), targets(&fitted)).unwrap();
+    std::fs::write(d.join("nom.csv"), targets(&nom)).unwrap();
+    let cal = misses("cal.csv", "t.json");
+    let nom_miss = misses("nom.csv", "nominal.json");
+    let worst = |v: &[f64]| v.iter().copied().fold(0.0, f64::max);
+    println!(
+        "true tool tip on the true part on the turntable at 12 targets: calibrated max {:.4} mm, nominal max {:.3} mm",
+        worst(&cal),
+        worst(&nom_miss)
+    );
+    // The fit's RMS limit, 3·√3·σ for σ = 0.01 mm, as for a positioner.
+    assert!(worst(&cal) < 0.052, "{cal:?}");
+    assert!(worst(&nom_miss) > 0.5, "{nom_miss:?}");
+    // A file without `e1` is refused, naming the column.
+    std::fs::write(d.join("bare.csv"), "id,x,y,z\np,300,200,60\n").unwrap();
+    let out = robocal(
+        d,
+        &[
+            "solve",
+            "--model",
+            "robot.json",
+            "--targets",
+            "bare.csv",
+            "--turntable",
+            "t.json",
+            "--position-only",
+        ],
+    );
+    assert_refused(
+        &out,
+        "--turntable reads each row's value [deg] from an `e1` column",
+    );
+}
