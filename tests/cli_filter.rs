@@ -390,3 +390,172 @@ fn filter_cli_composes_a_positioner_with_its_values() {
         .unwrap()
         .contains("work object part is on the positioner's face plate"));
 }
+
+/// `robocal filter --turntable --nominal-turntable`: a part on a one-axis
+/// turntable's face plate (base 3), each target at its own `E1`; the report
+/// names the one axis and each target's values `[0, v]`, and equals the
+/// core's filter through the same turntables (as positioners whose axis 1
+/// stands at 0, `FilterAxes::turntable`). A target that also moves `E2`
+/// fails naming it; `--correct-axes` is refused with a turntable. (How
+/// close the filtered targets bring a true tool to the true part is the
+/// core's test, `core/tests/programs/turntable.rs`.)
+#[test]
+fn filter_cli_composes_a_turntable_with_its_value() {
+    use nalgebra::Vector3;
+    use robocal::model::external::{RotaryAxis, Turntable};
+    use robocal::model::Pose;
+    use robocal::program::{filter_with, kuka_status, kuka_turn, FilterAxes, FilterControl};
+    use robocal::solve::ik::{AnalyticIk, IkSettings};
+    let dir = tempfile::tempdir().unwrap();
+    let nominal = preset("ys100").unwrap();
+    let model = synthetic_calibration(&nominal, &SyntheticErrors::typical(1e-6), 4);
+    let model_path = dir.path().join("cal.json");
+    save_model_file(
+        &CalibratedModelFile::from_compensated(&model, "ys100", "km"),
+        &model_path,
+    )
+    .unwrap();
+    // The controller's turntable 1.6 m in front of the robot; the cell's
+    // turned 0.3° further and its axis 0.5 mm off.
+    let drawing = Turntable {
+        cell_from_base: Pose::from_translation(Vector3::new(1.6, 0.0, -0.9)),
+        axis: RotaryAxis::new(Vector3::z(), Vector3::zeros(), 0.0, 1.0),
+        face_plate: Pose::from_translation(Vector3::new(0.0, 0.0, 1.1)),
+    };
+    let mut cell_turntable = drawing;
+    cell_turntable.cell_from_base = model.cell_from_base.compose(&drawing.cell_from_base);
+    cell_turntable.axis = RotaryAxis::new(
+        Vector3::z(),
+        Vector3::new(0.0005, 0.0, 0.0),
+        0.3f64.to_radians(),
+        1.0,
+    );
+    let p = |x: &Path| x.to_str().unwrap().to_string();
+    let (turntable_path, drawing_path) =
+        (dir.path().join("tt.json"), dir.path().join("drawing.json"));
+    std::fs::write(&turntable_path, cell_turntable.to_json()).unwrap();
+    std::fs::write(&drawing_path, drawing.to_json()).unwrap();
+    let part = Pose::from_translation(Vector3::new(0.1, 0.05, 0.06));
+    let cell_path = dir.path().join("cell.json");
+    std::fs::write(
+        &cell_path,
+        r#"{"tools": [{"name": "torch", "number": 1, "xyz_mm": [125.0, 0.0, 216.50635], "rpy_deg": [0.0, 30.0, 0.0]}],
+            "work_objects": [{"name": "part", "number": 3, "frame": "face_plate", "xyz_mm": [100.0, 50.0, 60.0], "rpy_deg": [0.0, 0.0, 0.0]}]}"#,
+    )
+    .unwrap();
+    let mut controller = nominal.clone();
+    controller.tool = robocal::model::Tool {
+        p: Vector3::new(0.125, 0.0, 0.21650635),
+        rpy: [0.0, 30f64.to_radians(), 0.0],
+    };
+    let ik = AnalyticIk::new(&controller).unwrap();
+    let values = [-30.0, 75.0, 160.0, 0.0];
+    // The program with `E2` at `second` beside each target's `E1`.
+    let program = |second: f64| {
+        let (mut src, mut dat) = (
+            String::from("DEF turn()\r\nBAS(#TOOL, 1)\r\nBAS(#BASE, 3)\r\n"),
+            String::from("DEFDAT turn\r\n"),
+        );
+        for (i, v) in values.iter().enumerate() {
+            let q = [0.1 * i as f64, 1.4, -0.2, 0.3, 0.8, -0.5];
+            let tcp = robocal::model::kinematics::fk(&controller, &q).unwrap();
+            let t = drawing
+                .cell_from_face_plate(*v)
+                .compose(&part)
+                .inverse()
+                .compose(&tcp);
+            let abc = robocal::model::orientation::rotation_to(
+                robocal::model::orientation::OrientationConvention::KukaAbc,
+                &t.r,
+            );
+            let deg: Vec<f64> = controller
+                .joints_to_controller(&q)
+                .iter()
+                .map(|x| x.to_degrees())
+                .collect();
+            let conf = ik.configuration(&q).unwrap();
+            src.push_str(&format!("LIN XP{i}\r\n"));
+            dat.push_str(&format!(
+                "DECL E6POS XP{i}={{X {:.4},Y {:.4},Z {:.4},A {:.4},B {:.4},C {:.4},S {},T {},E1 {v},E2 {second},E3 0.0,E4 0.0,E5 0.0,E6 0.0}}\r\n",
+                t.p.x * 1e3, t.p.y * 1e3, t.p.z * 1e3, abc[0], abc[1], abc[2],
+                kuka_status(&deg, conf), kuka_turn(&deg)
+            ));
+        }
+        src.push_str("END\r\n");
+        dat.push_str("ENDDAT\r\n");
+        let (src_path, dat_path) = (dir.path().join("turn.src"), dir.path().join("turn.dat"));
+        std::fs::write(&src_path, &src).unwrap();
+        std::fs::write(&dat_path, &dat).unwrap();
+        (src_path, dat_path)
+    };
+    let run = |second: f64, extra: &[&str]| {
+        let (src, dat) = program(second);
+        let (m, c, o) = (p(&model_path), p(&cell_path), p(&dir.path().join("out")));
+        let (t, n) = (p(&turntable_path), p(&drawing_path));
+        let mut argv = vec![
+            "--model",
+            &m,
+            "--cell",
+            &c,
+            "--out-dir",
+            &o,
+            "--turntable",
+            &t,
+            "--nominal-turntable",
+            &n,
+        ];
+        argv.extend_from_slice(extra);
+        let (s, d) = (p(&src), p(&dat));
+        argv.extend([s.as_str(), d.as_str()]);
+        let mut v = vec!["robocal", "filter"];
+        v.extend_from_slice(&argv);
+        robocal::cli::Cli::try_parse_from(v).map(|cli| match cli.command {
+            robocal::cli::Command::Filter(a) => filter_to_string(&a).unwrap(),
+            other => panic!("{other:?}"),
+        })
+    };
+    let report: serde_json::Value = serde_json::from_str(&run(0.0, &[]).unwrap()).unwrap();
+    assert_eq!(report["positioner_axes"], serde_json::json!(["E1"]));
+    assert_eq!(
+        (report["filtered"].as_u64(), report["failed"].as_u64()),
+        (Some(4), Some(0)),
+        "{report:#}"
+    );
+    for (t, v) in report["targets"].as_array().unwrap().iter().zip(&values) {
+        assert_eq!(t["positioner_deg"], serde_json::json!([0.0, v]));
+        // 0.3° about the axis and 0.5 mm: millimetres at the part.
+        assert!(t["shift_mm"].as_f64().unwrap() > 0.1, "{t}");
+    }
+    // The core's filter through the same turntables gives the same report.
+    let (src, dat) = program(0.0);
+    let files = [file(&src), file(&dat)];
+    let cell = robocal::cli::model_files::load_cell(Some(&p(&cell_path))).unwrap();
+    let read = |x: &Path| {
+        Turntable::from_json(&std::fs::read_to_string(x).unwrap())
+            .unwrap()
+            .as_tilt_rotate()
+    };
+    let pair = (read(&turntable_path), read(&drawing_path));
+    let loaded = robocal::cli::model_files::load_compensated(&p(&model_path)).unwrap();
+    let core = filter_with(
+        Language::Krl,
+        &files,
+        &cell,
+        &loaded,
+        &IkSettings::default(),
+        &FilterAxes::of_cell(None, Some(&pair)).turntable(),
+        &FilterControl::default(),
+    )
+    .unwrap();
+    assert_eq!(serde_json::to_value(&core.report).unwrap(), report);
+    // `E2` in use: an axis the turntable does not have.
+    let report: serde_json::Value = serde_json::from_str(&run(12.5, &[]).unwrap()).unwrap();
+    assert_eq!(report["failed"].as_u64(), Some(4), "{report:#}");
+    let why = report["targets"][0]["reason"].as_str().unwrap();
+    assert!(
+        why.contains("E2") && why.contains("does not model"),
+        "{why}"
+    );
+    // A correction of the turntable's value is refused by the arguments.
+    assert!(run(0.0, &["--correct-axes"]).is_err());
+}

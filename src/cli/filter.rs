@@ -15,7 +15,11 @@
 //! through the controller's nominal one, the values kept. Both together: the
 //! robot rides the track (axis 1) and the positioner's axes are the
 //! program's 2 and 3 (KRL E2, E3, RAPID eax_b, eax_c; Fanuc J1, J2 of GP2),
-//! both models in the cell frame.
+//! both models in the cell frame. With `--turntable FILE
+//! --nominal-turntable FILE` a one-axis turntable instead of the
+//! positioner: its one axis the program's first positioner axis (KRL E1,
+//! RAPID eax_a, Fanuc J1 of GP2; E2, eax_b beside a track), the value kept
+//! (`--correct-axes` is refused with it: not built).
 
 use crate::program::{filter_with, FilterAxes, FilterControl, Language, ProgramFile};
 use crate::solve::ik::IkSettings;
@@ -63,6 +67,16 @@ pub struct FilterArgs {
     /// or with --track the cell frame.
     #[arg(long, requires = "positioner")]
     pub nominal_positioner: Option<String>,
+    /// The calibrated one-axis turntable carrying the face-plate work
+    /// objects (`robocal turntable calibrate`'s output, in the cell frame
+    /// the robot's model is registered in), program axis 1 (KRL E1, RAPID
+    /// eax_a, Fanuc J1 of GP2); with --track, axis 2 (KRL E2, RAPID eax_b).
+    #[arg(long, requires = "nominal_turntable", conflicts_with_all = ["positioner", "correct_axes"])]
+    pub turntable: Option<String>,
+    /// The controller's own turntable (the same JSON), in its world frame:
+    /// the robot's base frame, or with --track the cell frame.
+    #[arg(long, requires = "turntable")]
+    pub nominal_turntable: Option<String>,
     /// Rewrite the track's and the positioner's values so the real axes
     /// stand where the controller believes the programmed values put them
     /// (the track's scale and along-rail error, the positioner's zeros and
@@ -124,18 +138,31 @@ pub fn filter_report(a: &FilterArgs) -> anyhow::Result<super::exit::Outcome> {
         (Some(t), Some(n)) => Some((super::track::read_track(t)?, super::track::read_track(n)?)),
         _ => None,
     };
-    let positioners = match (&a.positioner, &a.nominal_positioner) {
-        (Some(p), Some(n)) => Some((
+    // A turntable is the positioner whose axis 1 stands at 0.
+    let positioners = match (
+        &a.positioner,
+        &a.nominal_positioner,
+        &a.turntable,
+        &a.nominal_turntable,
+    ) {
+        (Some(p), Some(n), _, _) => Some((
             super::positioner::read_positioner(p)?,
             super::positioner::read_positioner(n)?,
+        )),
+        (_, _, Some(t), Some(n)) => Some((
+            super::turntable::read_turntable(t)?.as_tilt_rotate(),
+            super::turntable::read_turntable(n)?.as_tilt_rotate(),
         )),
         _ => None,
     };
     if a.correct_axes && tracks.is_none() && positioners.is_none() {
         anyhow::bail!("--correct-axes corrects the values of a --track or a --positioner, and neither is given");
     }
-    let axes = FilterAxes::of_cell(tracks.as_ref(), positioners.as_ref())
+    let mut axes = FilterAxes::of_cell(tracks.as_ref(), positioners.as_ref())
         .correcting_values(a.correct_axes);
+    if a.turntable.is_some() {
+        axes = axes.turntable();
+    }
     let out = filter_with(
         language,
         &files,

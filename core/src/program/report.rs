@@ -184,10 +184,11 @@ pub struct FilterReport {
     pub track_axis: Option<String>,
     /// The positioner's axes 1 and 2 as the language names them (`E1`,
     /// `E2`; `eax_a`, `eax_b`; `J1`, `J2` of `GP2`) when the filter was
-    /// given a positioner: each position's values in `positioner_deg`
-    /// (and, corrected, `positioner_written_deg`).
+    /// given a positioner, a turntable's one axis alone: each position's
+    /// values in `positioner_deg` (a turntable's `[0, v]`; and, corrected,
+    /// `positioner_written_deg`).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub positioner_axes: Option<[String; 2]>,
+    pub positioner_axes: Option<Vec<String>>,
     /// Whether the external axes' values were kept as programmed or
     /// corrected (`program::corrected_values`), when the filter composed
     /// any.
@@ -211,8 +212,9 @@ pub enum AxisValuesWritten {
 pub struct ReportedAxes {
     /// The track's axis as the language names it.
     pub track_axis: Option<String>,
-    /// The positioner's two axes as the language names them.
-    pub positioner_axes: Option<[String; 2]>,
+    /// The positioner's axes in use as the language names them (two, a
+    /// turntable's one).
+    pub positioner_axes: Option<Vec<String>>,
     /// Whether their values were corrected.
     pub corrected: bool,
 }

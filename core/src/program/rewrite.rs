@@ -372,8 +372,11 @@ impl Run<'_> {
                         .track
                         .map(|_| axes::track_axis_name(language).to_string()),
                     positioner_axes: self.axes.positioner.map(|_| {
-                        axes::positioner_axis_names(language, self.axes.track.is_some())
-                            .map(|n| n.to_string())
+                        self.axes
+                            .plate_axis_names(language)
+                            .into_iter()
+                            .map(str::to_string)
+                            .collect()
                     }),
                     corrected: self.axes.correct_values,
                 },

@@ -282,10 +282,11 @@ pub fn assert_every_target_filtered(r: &FilterReport, n: usize) {
 /// decimals).
 pub fn assert_positioner_values_kept(
     r: &FilterReport,
-    names: [&str; 2],
+    names: &[&str],
     want: impl IntoIterator<Item = [f64; 2]>,
 ) {
-    assert_eq!(r.positioner_axes, Some(names.map(String::from)));
+    let names: Vec<String> = names.iter().map(|n| n.to_string()).collect();
+    assert_eq!(r.positioner_axes, Some(names));
     for (t, v) in r.targets.iter().zip(want) {
         let got = t.positioner_deg.unwrap();
         assert!((got[0] - v[0]).abs() < 1e-3 && (got[1] - v[1]).abs() < 1e-3);

@@ -24,6 +24,7 @@ mod stationary;
 mod track;
 mod track_and_positioner;
 mod truth;
+mod turntable;
 mod urscript;
 
 use truth::FlangeTruth;

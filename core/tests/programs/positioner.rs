@@ -292,6 +292,7 @@ impl PositionerCell {
             positioner: Some(PositionerAxes {
                 nominal: &self.nominal_positioner,
                 calibrated: &self.fitted,
+                turntable: false,
             }),
             correct_values: false,
         }
@@ -425,7 +426,7 @@ fn assert_on_positioner(language: Language, files: &[ProgramFile]) {
     assert_every_target_filtered(r, 50);
     assert_positioner_values_kept(
         r,
-        positioner_axis_names(language, false),
+        &positioner_axis_names(language, false),
         c.targets.iter().map(|(v, _)| *v),
     );
     assert_only_targets_changed(language, files, &out.files);

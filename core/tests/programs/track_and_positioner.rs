@@ -150,6 +150,7 @@ impl BothCell {
             positioner: Some(PositionerAxes {
                 nominal: &self.nominal_positioner,
                 calibrated: &self.fitted,
+                turntable: false,
             }),
             correct_values: false,
         }
@@ -280,7 +281,7 @@ fn assert_in_cell(language: Language, files: &[ProgramFile]) {
     assert_eq!(r.track_axis.as_deref(), Some(track_axis_name(language)));
     assert_positioner_values_kept(
         r,
-        positioner_axis_names(language, true),
+        &positioner_axis_names(language, true),
         c.targets.iter().map(|(_, v, _)| *v),
     );
     for (t, (e, _, _)) in r.targets.iter().zip(&c.targets) {
