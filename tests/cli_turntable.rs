@@ -230,6 +230,104 @@ fn solve_takes_targets_on_the_turntables_face_plate_at_each_rows_value() {
     // The fit's RMS limit, 3·√3·σ for σ = 0.01 mm, as for a positioner.
     assert!(worst(&cal) < 0.052, "{cal:?}");
     assert!(worst(&nom_miss) > 0.5, "{nom_miss:?}");
+    // `predict --turntable` at the solved joints, each row at its `e1`: the
+    // robot's tool pose (its geometry is the model file's) carried by hand
+    // into the written turntable's face plate at the row's value.
+    let out = robocal(
+        d,
+        &[
+            "solve",
+            "--model",
+            "robot.json",
+            "--targets",
+            "cal.csv",
+            "--turntable",
+            "t.json",
+            "--position-only",
+            "--json",
+        ],
+    );
+    let doc: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let mut lines = vec!["id,q1,q2,q3,q4,q5,q6,e1".to_string()];
+    let mut rows = Vec::new();
+    for (k, r) in doc["targets"].as_array().unwrap().iter().enumerate() {
+        let deg: Vec<f64> = r["joints_deg"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        let v = values[k % values.len()];
+        let q: Vec<String> = deg.iter().map(|x| format!("{x:.10}")).collect();
+        lines.push(format!("r{k},{},{v}", q.join(",")));
+        rows.push((deg, v));
+    }
+    std::fs::write(d.join("joints.csv"), lines.join("\n") + "\n").unwrap();
+    let predict = |extra: &[&str], file: &str| {
+        let mut args = vec![
+            "predict",
+            "--model",
+            "robot.json",
+            "--joints",
+            file,
+            "--json",
+        ];
+        args.extend_from_slice(extra);
+        robocal(d, &args)
+    };
+    let out = predict(&["--turntable", "t.json"], "joints.csv");
+    assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+    let doc: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(
+        doc["frame"],
+        "face plate of turntable t.json at each row's e1"
+    );
+    let xyz = |r: &Value| {
+        Vector3::new(
+            r["x"].as_f64().unwrap(),
+            r["y"].as_f64().unwrap(),
+            r["z"].as_f64().unwrap(),
+        )
+    };
+    let by_hand = |deg: &[f64], v: f64| {
+        let q = robot_nominal
+            .joints_from_controller(&deg.iter().map(|x| x.to_radians()).collect::<Vec<_>>());
+        fitted
+            .cell_from_face_plate(v)
+            .inverse()
+            .compose(&robot.true_pose_base(&q, None).unwrap())
+            .p
+            * 1e3
+    };
+    let mut worst: f64 = 0.0;
+    for (r, (deg, v)) in doc["results"].as_array().unwrap().iter().zip(&rows) {
+        assert_eq!(r["status"], "ok", "{r}");
+        worst = worst.max((xyz(r) - by_hand(deg, *v)).norm());
+    }
+    assert!(worst < 1e-6, "{worst}");
+    // One row with `--e1` instead of the column gives the same; `--e2`
+    // without a track is refused (a turntable has one axis).
+    let (deg, v) = &rows[5];
+    let q: Vec<String> = deg.iter().map(|x| format!("{x:.10}")).collect();
+    std::fs::write(
+        d.join("one.csv"),
+        format!("q1,q2,q3,q4,q5,q6\n{}\n", q.join(",")),
+    )
+    .unwrap();
+    let value = v.to_string();
+    let out = predict(&["--turntable", "t.json", "--e1", &value], "one.csv");
+    assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+    let one: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!((xyz(&one["results"][0]) - by_hand(deg, *v)).norm() < 1e-6);
+    assert_eq!(
+        one["frame"],
+        format!("face plate of turntable t.json at e1 {v} deg")
+    );
+    let out = predict(
+        &["--turntable", "t.json", "--e1", "0", "--e2", "5"],
+        "one.csv",
+    );
+    assert_refused(&out, "a turntable has one axis");
     // A file without `e1` is refused, naming the column.
     std::fs::write(d.join("bare.csv"), "id,x,y,z\np,300,200,60\n").unwrap();
     let out = robocal(

@@ -401,8 +401,11 @@ pub struct OnPlate {
     positioner: TiltRotate,
     values: PlateValues,
     /// The tilt's and the rotate's columns (`positioner_columns`): `e1`,
-    /// `e2`, or `e2`, `e3` beside a track.
+    /// `e2`, or `e2`, `e3` beside a track; a turntable's one column twice.
     columns: [&'static str; 2],
+    /// A one-axis turntable (`Turntable::as_tilt_rotate`): its value is
+    /// axis 2's, axis 1 stands at 0.
+    turntable: bool,
 }
 
 impl OnPlate {
@@ -456,12 +459,76 @@ impl OnPlate {
             positioner,
             values,
             columns,
+            turntable: false,
+        })
+    }
+
+    /// Reads the turntable file `path` and its value: the flag (`--e1`;
+    /// beside a track, `on_track`, `--e2`) or (not given) the joints file's
+    /// column of the same name; the flag beside such a column, or a file
+    /// without it, is refused.
+    pub fn read_turntable(
+        path: &str,
+        flag: Option<f64>,
+        on_track: bool,
+        file: &str,
+        text: &str,
+        dialect: Dialect,
+    ) -> anyhow::Result<OnPlate> {
+        let turntable = super::turntable::read_turntable(path)?;
+        let column = if on_track { "e2" } else { "e1" };
+        let given =
+            target_column_values(text, dialect, column).with_context(|| file.to_string())?;
+        let values = match (flag, given) {
+            (Some(v), None) => {
+                if !v.is_finite() || v.abs() > 720.0 {
+                    anyhow::bail!("--{column} {v}: a turntable's value is a finite number of degrees within two turns (±720)");
+                }
+                PlateValues::Fixed(AxisValues {
+                    tilt_deg: 0.0,
+                    rotate_deg: v,
+                })
+            }
+            (Some(_), Some(_)) => anyhow::bail!(
+                "{file}: the file has an `{column}` column and --{column} is given: ambiguous (give the flag or the column)"
+            ),
+            (None, Some(rotate)) => PlateValues::PerRow {
+                tilt: rotate
+                    .iter()
+                    .map(|t| TargetValue {
+                        line: t.line,
+                        value: Ok(0.0),
+                    })
+                    .collect(),
+                rotate,
+            },
+            (None, None) => anyhow::bail!(
+                "{file}: --turntable needs --{column} DEG or an `{column}` column, and the file has none"
+            ),
+        };
+        Ok(OnPlate {
+            path: path.to_string(),
+            positioner: turntable.as_tilt_rotate(),
+            values,
+            columns: [column, column],
+            turntable: true,
         })
     }
 
     /// The frame's name for the output's header.
     pub fn label(&self) -> String {
         let [t, r] = self.columns;
+        if self.turntable {
+            return match &self.values {
+                PlateValues::Fixed(v) => format!(
+                    "face plate of turntable {} at {r} {} deg",
+                    self.path, v.rotate_deg
+                ),
+                PlateValues::PerRow { .. } => {
+                    format!("face plate of turntable {} at each row's {r}", self.path)
+                }
+            };
+        }
         match &self.values {
             PlateValues::Fixed(v) => format!(
                 "face plate of positioner {} at {t} (tilt) {} deg, {r} (rotate) {} deg",

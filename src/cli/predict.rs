@@ -43,7 +43,8 @@ use std::fmt::Write as _;
 
 /// Arguments of `robocal predict`.
 #[derive(Debug, Args)]
-#[command(group = clap::ArgGroup::new("external_axis").multiple(true).args(["track", "positioner"]))]
+#[command(group = clap::ArgGroup::new("external_axis").multiple(true).args(["track", "positioner", "turntable"]))]
+#[command(group = clap::ArgGroup::new("plate").args(["positioner", "turntable"]))]
 pub struct PredictArgs {
     /// Robot model: a calibrated model file (`robocal calibrate --save`), a
     /// model JSON file or a preset (ys100, hh800, ur5, ur10).
@@ -98,9 +99,15 @@ pub struct PredictArgs {
     /// track's value `--e1` or each row's `e1`.
     #[arg(long, conflicts_with_all = ["work_object", "frame"])]
     pub positioner: Option<String>,
+    /// Calibrated one-axis turntable (`robocal turntable calibrate --out`,
+    /// in the robot's measurement frame): the poses are stated in its face
+    /// plate frame at `--e1` [deg] or each row's `e1`; beside --track at
+    /// `--e2` or each row's `e2`, the track's value `--e1` or each row's `e1`.
+    #[arg(long, conflicts_with_all = ["work_object", "frame", "positioner"])]
+    pub turntable: Option<String>,
     /// The positioner's rotate (axis 2) value [deg], beside `--e1` its tilt;
-    /// beside --track, its tilt (axis 1).
-    #[arg(long, requires = "positioner", allow_hyphen_values = true)]
+    /// beside --track, its tilt (axis 1), or a turntable's value.
+    #[arg(long, requires = "plate", allow_hyphen_values = true)]
     pub e2: Option<f64>,
     /// Beside --track: the positioner's rotate (axis 2) value [deg].
     #[arg(long, requires_all = ["positioner", "track"], allow_hyphen_values = true)]
@@ -139,6 +146,17 @@ fn on_plate(
     } else {
         [a.track.e1, a.e2]
     };
+    if let Some(path) = &a.turntable {
+        if !on_track && a.e2.is_some() {
+            anyhow::bail!(
+                "--e2: a turntable has one axis, its value is --e1 (--e2 beside --track)"
+            );
+        }
+        return super::positioner::OnPlate::read_turntable(
+            path, flags[0], on_track, &a.joints, text, dialect,
+        )
+        .map(Some);
+    }
     a.positioner
         .as_ref()
         .map(|path| {
