@@ -396,7 +396,7 @@ fn filter_cli_composes_a_positioner_with_its_values() {
 /// names the one axis and each target's values `[0, v]`, and equals the
 /// core's filter through the same turntables (as positioners whose axis 1
 /// stands at 0, `FilterAxes::turntable`). A target that also moves `E2`
-/// fails naming it; `--correct-axes` is refused with a turntable. (How
+/// fails naming it; `--correct-axes` writes each value corrected. (How
 /// close the filtered targets bring a true tool to the true part is the
 /// core's test, `core/tests/programs/turntable.rs`.)
 #[test]
@@ -556,6 +556,15 @@ fn filter_cli_composes_a_turntable_with_its_value() {
         why.contains("E2") && why.contains("does not model"),
         "{why}"
     );
-    // A correction of the turntable's value is refused by the arguments.
-    assert!(run(0.0, &["--correct-axes"]).is_err());
+    // Corrected on request: the cell's turntable stands 0.3° further round
+    // on the drawing's line (the frames coincide), so each value is written
+    // 0.3° less.
+    let report: serde_json::Value =
+        serde_json::from_str(&run(0.0, &["--correct-axes"]).unwrap()).unwrap();
+    assert_eq!(report["axis_values"], "corrected");
+    assert_eq!(report["filtered"].as_u64(), Some(4), "{report:#}");
+    for (t, v) in report["targets"].as_array().unwrap().iter().zip(&values) {
+        let written = t["positioner_written_deg"][1].as_f64().unwrap();
+        assert!((written - (v - 0.3)).abs() < 1e-3, "{t}");
+    }
 }

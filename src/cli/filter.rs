@@ -19,7 +19,7 @@
 //! --nominal-turntable FILE` a one-axis turntable instead of the
 //! positioner: its one axis the program's first positioner axis (KRL E1,
 //! RAPID eax_a, Fanuc J1 of GP2; E2, eax_b beside a track), the value kept
-//! (`--correct-axes` is refused with it: not built).
+//! unless `--correct-axes` asks for it corrected.
 
 use crate::program::{filter_with, FilterAxes, FilterControl, Language, ProgramFile};
 use crate::solve::ik::IkSettings;
@@ -71,16 +71,16 @@ pub struct FilterArgs {
     /// objects (`robocal turntable calibrate`'s output, in the cell frame
     /// the robot's model is registered in), program axis 1 (KRL E1, RAPID
     /// eax_a, Fanuc J1 of GP2); with --track, axis 2 (KRL E2, RAPID eax_b).
-    #[arg(long, requires = "nominal_turntable", conflicts_with_all = ["positioner", "correct_axes"])]
+    #[arg(long, requires = "nominal_turntable", conflicts_with = "positioner")]
     pub turntable: Option<String>,
     /// The controller's own turntable (the same JSON), in its world frame:
     /// the robot's base frame, or with --track the cell frame.
     #[arg(long, requires = "turntable")]
     pub nominal_turntable: Option<String>,
-    /// Rewrite the track's and the positioner's values so the real axes
-    /// stand where the controller believes the programmed values put them
-    /// (the track's scale and along-rail error, the positioner's zeros and
-    /// scales); the report gives each written value beside the programmed
+    /// Rewrite the track's, the positioner's or the turntable's values so
+    /// the real axes stand where the controller believes the programmed
+    /// values put them (the track's scale and along-rail error, the
+    /// positioner's or turntable's zeros and scales); the report gives each written value beside the programmed
     /// one. Without it the values stay as programmed.
     #[arg(long)]
     pub correct_axes: bool,
@@ -156,7 +156,7 @@ pub fn filter_report(a: &FilterArgs) -> anyhow::Result<super::exit::Outcome> {
         _ => None,
     };
     if a.correct_axes && tracks.is_none() && positioners.is_none() {
-        anyhow::bail!("--correct-axes corrects the values of a --track or a --positioner, and neither is given");
+        anyhow::bail!("--correct-axes corrects the values of a --track, a --positioner or a --turntable, and none is given");
     }
     let mut axes = FilterAxes::of_cell(tracks.as_ref(), positioners.as_ref())
         .correcting_values(a.correct_axes);

@@ -35,8 +35,8 @@
 //! program gives one value, its first positioner axis (KRL `E1`, RAPID
 //! `eax_a`, Fanuc `J1` of `GP2`; `E2`, `eax_b` beside a track), composed at
 //! `[0, v]`; a second positioner axis in use is refused, as any axis the
-//! cell does not model. Correcting a turntable's value is not built: the
-//! site is refused.
+//! cell does not model. Its value is corrected as a positioner's are, axis 2
+//! alone (`corrected_values::turntable_value`).
 //!
 //! Track and positioner together: the robot rides the track (axis 1) and
 //! the part turns on the positioner, its axes then the program's axes 2 and
@@ -344,7 +344,7 @@ pub(super) fn place(
             };
             let correct = axes.correct_values.then_some(&world_from_cell);
             if p.turntable {
-                on_turntable(language, site, p, axes.track.is_some(), correct.is_some())?
+                on_turntable(language, site, p, axes.track.is_some(), correct)?
             } else {
                 on_positioner(language, site, p, axes.track.is_some(), correct)?
             }
@@ -477,14 +477,15 @@ fn on_positioner(
 }
 
 /// The turntable's plates at a site's value (its axis after the track's
-/// when `on_track`): `None` when the site gives none; refused when it is
-/// not a number, or when asked to correct it (not built).
+/// when `on_track`; corrected when given the controller's world,
+/// `correct`): `None` when the site gives none; refused when it is not a
+/// number.
 fn on_turntable(
     language: Language,
     site: &Site,
     p: &PositionerAxes,
     on_track: bool,
-    correct: bool,
+    correct: Option<&Pose>,
 ) -> Result<Option<OnPositioner>, String> {
     let group = positioner_group(language);
     let number = positioner_numbers(language, on_track)[0];
@@ -495,12 +496,6 @@ fn on_turntable(
     else {
         return Ok(None);
     };
-    if correct {
-        return Err(format!(
-            "correcting a turntable's value ({}) is not built: not filtered; filter it with its values kept",
-            a.name
-        ));
-    }
     let v = a.value.ok_or_else(|| {
         format!(
             "the turntable's axis {} is {}: not filtered",
@@ -513,11 +508,24 @@ fn on_turntable(
         )
     })?;
     let values_deg = [0.0, v];
+    let written_deg = match correct {
+        None => values_deg,
+        Some(world_from_cell) => {
+            let w = corrected_values::turntable_value(p.calibrated, p.nominal, world_from_cell, v)
+                .ok_or_else(|| {
+                    format!(
+                        "the turntable's axis {}: no correction of {v}°: not filtered",
+                        a.name
+                    )
+                })?;
+            [0.0, w]
+        }
+    };
     Ok(Some(OnPositioner {
         values_deg,
-        written_deg: values_deg,
-        nominal: p.nominal.cell_from_face_plate(values_deg),
-        calibrated: p.calibrated.cell_from_face_plate(values_deg),
+        written_deg,
+        nominal: p.nominal.cell_from_face_plate(written_deg),
+        calibrated: p.calibrated.cell_from_face_plate(written_deg),
     }))
 }
 

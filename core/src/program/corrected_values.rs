@@ -23,7 +23,8 @@
 //! vector `θ·n` of `R_nom(v)ᵀ·R(v') = Rot(n, θ)` (`orientation::
 //! rotation_log`, exact near the identity), the Jacobian by 1e-4°
 //! differences. The
-//! part's position follows from the robot's solve as before.
+//! part's position follows from the robot's solve as before. A one-axis
+//! turntable's value likewise, its axis 1 standing at 0 ([`turntable_value`]).
 //!
 //! Units: track values in mm, positioner values in degrees, poses SI.
 
@@ -106,12 +107,67 @@ pub(super) fn positioner_values(
     Some(v.map(|x| (x * 1e4).round() / 1e4))
 }
 
+/// A one-axis turntable's value [deg], to 0.0001°, at which `calibrated`
+/// (the positioner whose axis 1 stands at 0, cell frame), seen in the
+/// controller's world through `world_from_cell`, turns the face plate most
+/// nearly as `nominal` does at `programmed`: [`positioner_values`] with
+/// axis 2 alone free; `None` when the axis does not turn the plate there.
+pub(super) fn turntable_value(
+    calibrated: &TiltRotate,
+    nominal: &TiltRotate,
+    world_from_cell: &Pose,
+    programmed: f64,
+) -> Option<f64> {
+    let want = nominal
+        .cell_from_face_plate([0.0, programmed])
+        .r
+        .transpose();
+    let residual = |v: f64| -> Vector3<f64> {
+        rotation_log(&(want * world_from_cell.r * calibrated.cell_from_face_plate([0.0, v]).r))
+    };
+    const H_DEG: f64 = 1e-4;
+    let mut v = programmed;
+    for _ in 0..10 {
+        let r = residual(v);
+        let j = (residual(v + H_DEG) - r) / H_DEG;
+        if j.norm_squared() < 1e-12 {
+            return None;
+        }
+        let step = -j.dot(&r) / j.norm_squared();
+        v += step;
+        if step.abs() < 1e-10 {
+            break;
+        }
+    }
+    Some((v * 1e4).round() / 1e4)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::model::external::{RotaryAxis, Travel};
     use crate::model::orientation::rotation_angle_between;
     use nalgebra::Matrix3;
+
+    /// Closed form: a turntable whose calibrated zero is 1° and scale 1e-3
+    /// off the controller's, on the same line, is written `(v − 1°)/1.001`.
+    #[test]
+    fn a_turntables_value_follows_its_zero_and_scale() {
+        use crate::model::external::Turntable;
+        let table = |zero_deg: f64, scale: f64| {
+            Turntable {
+                cell_from_base: Pose::from_translation(Vector3::new(1.5, 0.2, -0.9)),
+                axis: RotaryAxis::new(Vector3::z(), Vector3::zeros(), zero_deg.to_radians(), scale),
+                face_plate: Pose::from_translation(Vector3::new(0.0, 0.0, 0.9)),
+            }
+            .as_tilt_rotate()
+        };
+        let (nominal, calibrated) = (table(0.0, 1.0), table(1.0, 1.001));
+        for v in [-170.0, -35.5, 0.0, 48.25, 179.0] {
+            let w = turntable_value(&calibrated, &nominal, &Pose::identity(), v).unwrap();
+            assert!((w - (v - 1.0) / 1.001).abs() < 1e-4, "{v}: {w}");
+        }
+    }
 
     fn rail(scale: f64, zero_m: f64) -> LinearTrack {
         let mut t = LinearTrack::nominal(
