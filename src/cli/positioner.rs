@@ -128,6 +128,30 @@ pub(super) fn parse_axis(s: &str) -> Result<ExternalAxis, String> {
         .ok_or_else(|| format!("`{s}`: give an external-axis column, e1 … e6"))
 }
 
+/// The `--reflector` positions [mm], one per file of `sets`, and no more
+/// `--validate` files than `sets` (a positioner's or a turntable's fit).
+pub(super) fn reflectors_of(
+    sets: &[String],
+    reflector: &[String],
+    validate: &[String],
+) -> anyhow::Result<Vec<[f64; 3]>> {
+    if reflector.len() != sets.len() {
+        anyhow::bail!(
+            "{} files and {} --reflector positions: give one design position per file (the file's reflector)",
+            sets.len(),
+            reflector.len()
+        );
+    }
+    if validate.len() > sets.len() {
+        anyhow::bail!(
+            "{} --validate files for {} reflectors: the k-th holds reflector k's held-out readings",
+            validate.len(),
+            sets.len()
+        );
+    }
+    reflector.iter().map(|s| parse_point(s)).collect()
+}
+
 /// `x,y,z` [mm] of a `--reflector`.
 pub(super) fn parse_point(s: &str) -> anyhow::Result<[f64; 3]> {
     let v: Vec<f64> = s
@@ -192,25 +216,7 @@ fn validate(
 
 /// Fits, judges, validates and writes the positioner; what the command prints.
 pub fn calibrate_to_string(a: &CalibrateArgs) -> anyhow::Result<String> {
-    if a.reflector.len() != a.sets.len() {
-        anyhow::bail!(
-            "{} files and {} --reflector positions: give one design position per file (the file's reflector)",
-            a.sets.len(),
-            a.reflector.len()
-        );
-    }
-    if a.validate.len() > a.sets.len() {
-        anyhow::bail!(
-            "{} --validate files for {} reflectors: the k-th holds reflector k's held-out readings",
-            a.validate.len(),
-            a.sets.len()
-        );
-    }
-    let reflectors_mm = a
-        .reflector
-        .iter()
-        .map(|s| parse_point(s))
-        .collect::<anyhow::Result<Vec<_>>>()?;
+    let reflectors_mm = reflectors_of(&a.sets, &a.reflector, &a.validate)?;
     let text = std::fs::read_to_string(&a.nominal)
         .with_context(|| format!("cannot read nominal positioner {}", a.nominal))?;
     let nominal = TiltRotate::from_json(&text)
@@ -493,13 +499,7 @@ impl OnPlate {
                 "{file}: the file has an `{column}` column and --{column} is given: ambiguous (give the flag or the column)"
             ),
             (None, Some(rotate)) => PlateValues::PerRow {
-                tilt: rotate
-                    .iter()
-                    .map(|t| TargetValue {
-                        line: t.line,
-                        value: Ok(0.0),
-                    })
-                    .collect(),
+                tilt: TargetValue::held_at_zero(&rotate),
                 rotate,
             },
             (None, None) => anyhow::bail!(

@@ -494,13 +494,7 @@ fn turntable_rows(
         })?;
     Ok(PlateRows {
         path: path.to_string(),
-        tilt: rotate
-            .iter()
-            .map(|t| TargetValue {
-                line: t.line,
-                value: Ok(0.0),
-            })
-            .collect(),
+        tilt: TargetValue::held_at_zero(&rotate),
         rotate,
         columns: vec![name],
         positioner: turntable.as_tilt_rotate(),

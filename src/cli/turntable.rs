@@ -19,7 +19,7 @@
 //! tracker's noise from `ChaCha8Rng(seed)`, a stream per file.
 
 use super::judged_fit;
-use super::positioner::{parse_axis, parse_point};
+use super::positioner::{parse_axis, reflectors_of};
 use super::sim_files::{check_noise, list, OutDir};
 use crate::service::positioners::ReadingsFrom;
 use anyhow::Context;
@@ -145,25 +145,7 @@ fn validate(
 
 /// Fits, judges, validates and writes the turntable; what the command prints.
 pub fn calibrate_to_string(a: &CalibrateArgs) -> anyhow::Result<String> {
-    if a.reflector.len() != a.sets.len() {
-        anyhow::bail!(
-            "{} files and {} --reflector positions: give one design position per file (the file's reflector)",
-            a.sets.len(),
-            a.reflector.len()
-        );
-    }
-    if a.validate.len() > a.sets.len() {
-        anyhow::bail!(
-            "{} --validate files for {} reflectors: the k-th holds reflector k's held-out readings",
-            a.validate.len(),
-            a.sets.len()
-        );
-    }
-    let reflectors_mm = a
-        .reflector
-        .iter()
-        .map(|s| parse_point(s))
-        .collect::<anyhow::Result<Vec<_>>>()?;
+    let reflectors_mm = reflectors_of(&a.sets, &a.reflector, &a.validate)?;
     let text = std::fs::read_to_string(&a.nominal)
         .with_context(|| format!("cannot read nominal turntable {}", a.nominal))?;
     let nominal =

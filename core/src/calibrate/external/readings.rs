@@ -56,18 +56,7 @@ pub fn positioner_readings(
         return Err(ColumnsError::SameColumn(columns.tilt));
     }
     for (column, role) in [(columns.tilt, "tilt"), (columns.rotate, "rotate")] {
-        if !set.has(column) {
-            let has: Vec<&str> = set.axes.iter().map(|a| a.column()).collect();
-            return Err(ColumnsError::Missing {
-                column,
-                role,
-                has: if has.is_empty() {
-                    "none".into()
-                } else {
-                    has.join(", ")
-                },
-            });
-        }
+        has_column(set, column, role)?;
     }
     set.readings()
         .enumerate()
@@ -93,18 +82,7 @@ pub fn turntable_readings(
     column: ExternalAxis,
     reflector: usize,
 ) -> Result<Vec<TurntableReading>, ColumnsError> {
-    if !set.has(column) {
-        let has: Vec<&str> = set.axes.iter().map(|a| a.column()).collect();
-        return Err(ColumnsError::Missing {
-            column,
-            role: "turntable",
-            has: if has.is_empty() {
-                "none".into()
-            } else {
-                has.join(", ")
-            },
-        });
-    }
+    has_column(set, column, "turntable")?;
     set.readings()
         .enumerate()
         .map(|(i, r)| {
@@ -118,4 +96,25 @@ pub fn turntable_readings(
             })
         })
         .collect()
+}
+
+/// `Missing` unless `set` has `column` (read for the axis `role`).
+fn has_column(
+    set: &MeasurementSet,
+    column: ExternalAxis,
+    role: &'static str,
+) -> Result<(), ColumnsError> {
+    if set.has(column) {
+        return Ok(());
+    }
+    let has: Vec<&str> = set.axes.iter().map(|a| a.column()).collect();
+    Err(ColumnsError::Missing {
+        column,
+        role,
+        has: if has.is_empty() {
+            "none".into()
+        } else {
+            has.join(", ")
+        },
+    })
 }

@@ -47,6 +47,20 @@ pub struct TargetValue {
     pub value: Result<f64, RowError>,
 }
 
+impl TargetValue {
+    /// A turntable's axis 1, standing at 0, on every row of `values` (a
+    /// turntable is the positioner whose axis 1 stands at 0).
+    pub fn held_at_zero(values: &[TargetValue]) -> Vec<TargetValue> {
+        values
+            .iter()
+            .map(|t| TargetValue {
+                line: t.line,
+                value: Ok(0.0),
+            })
+            .collect()
+    }
+}
+
 /// The `e1` value of every row of a targets file `text`, or `None` when its
 /// header has no `e1` column (any ASCII case) or it has no header
 /// ([`target_column_values`]).
