@@ -44,7 +44,7 @@ use robocal_core::calibrate::external::{
 use robocal_core::measure::csv_text::Dialect;
 use robocal_core::measure::external::ExternalAxis;
 use robocal_core::model::calibrated::CompensatedModel;
-use robocal_core::model::external::TiltRotate;
+use robocal_core::model::external::{TiltRotate, Turntable};
 use robocal_core::model::Pose;
 use robocal_core::solve::cell::PredictFrame;
 use robocal_core::solve::external::{
@@ -469,19 +469,19 @@ impl OnPlate {
         })
     }
 
-    /// Reads the turntable file `path` and its value: the flag (`--e1`;
+    /// The turntable of the file `path` and its value: the flag (`--e1`;
     /// beside a track, `on_track`, `--e2`) or (not given) the joints file's
     /// column of the same name; the flag beside such a column, or a file
     /// without it, is refused.
     pub fn read_turntable(
         path: &str,
+        turntable: &Turntable,
         flag: Option<f64>,
         on_track: bool,
         file: &str,
         text: &str,
         dialect: Dialect,
     ) -> anyhow::Result<OnPlate> {
-        let turntable = super::turntable::read_turntable(path)?;
         let column = if on_track { "e2" } else { "e1" };
         let given =
             target_column_values(text, dialect, column).with_context(|| file.to_string())?;

@@ -152,8 +152,9 @@ fn on_plate(
                 "--e2: a turntable has one axis, its value is --e1 (--e2 beside --track)"
             );
         }
+        let turntable = super::turntable::read_turntable(path)?;
         return super::positioner::OnPlate::read_turntable(
-            path, flags[0], on_track, &a.joints, text, dialect,
+            path, &turntable, flags[0], on_track, &a.joints, text, dialect,
         )
         .map(Some);
     }

@@ -22,14 +22,14 @@ use super::judged_fit;
 use super::positioner::{parse_axis, reflectors_of};
 use super::sim_files::{check_noise, list, OutDir};
 use crate::service::positioners::ReadingsFrom;
+use crate::service::turntables::{held_out, HeldOut};
 use anyhow::Context;
 use clap::{Args, Subcommand};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use robocal_core::calibrate::external::readings::turntable_readings;
 use robocal_core::calibrate::external::turntable::{
-    fit_turntable, held_out_errors_mm, TurntableFit, TurntableFitRequest, TurntableReading,
-    TurntableRefused,
+    fit_turntable, TurntableFit, TurntableFitRequest, TurntableReading, TurntableRefused,
 };
 use robocal_core::measure::csv::{parse_set, write_set};
 use robocal_core::measure::external::ExternalAxis;
@@ -94,19 +94,15 @@ pub struct CalibrateArgs {
 #[error("not fitted ({}): {}", judged_fit::code(&.0.reason), .0.message)]
 pub struct TurntableNotFitted(pub Box<TurntableRefused>);
 
-/// Held-out readings predicted through the fitted turntable [mm].
+/// Held-out readings predicted through the fitted turntable [mm]: the
+/// files and the figures the service gives for the same readings.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Validation {
     /// The held-out files, the k-th of reflector k.
     pub files: Vec<String>,
-    /// The held-out readings.
-    pub readings: usize,
-    /// Distinct values of the axis among them.
-    pub values: usize,
-    /// RMS of the 3-D errors [mm].
-    pub rms_mm: f64,
-    /// Largest 3-D error [mm].
-    pub max_mm: f64,
+    /// Their readings' figures through the fitted turntable.
+    #[serde(flatten)]
+    pub held_out: HeldOut,
 }
 
 /// Every file's rows as readings of its reflector (the file's index).
@@ -126,20 +122,10 @@ fn validate(
     fit: &TurntableFit,
 ) -> anyhow::Result<Validation> {
     let readings = read_readings(files, column)?;
-    if readings.is_empty() {
-        anyhow::bail!("--validate: no readings");
-    }
-    let errors = held_out_errors_mm(fit, &readings);
-    let (rms_mm, max_mm) = judged_fit::rms_and_max_mm(&errors);
-    let mut values: Vec<f64> = readings.iter().map(|r| r.value_deg).collect();
-    values.sort_by(f64::total_cmp);
-    values.dedup();
+    let held_out = held_out(&readings, fit).context("--validate: no readings")?;
     Ok(Validation {
         files: files.to_vec(),
-        readings: readings.len(),
-        values: values.len(),
-        rms_mm,
-        max_mm,
+        held_out,
     })
 }
 
@@ -260,11 +246,11 @@ fn report(
         let _ = writeln!(
             s,
             "held out: {} readings at {} values ({}): rms {:.4} mm, max {:.4} mm",
-            v.readings,
-            v.values,
+            v.held_out.readings,
+            v.held_out.values,
             v.files.join(", "),
-            v.rms_mm,
-            v.max_mm
+            v.held_out.rms_mm,
+            v.held_out.max_mm
         );
     }
     let _ = writeln!(s, "written: {}", a.out);

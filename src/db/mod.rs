@@ -1,7 +1,7 @@
 //! The store (sqlx): SQLite (the embedded default) or PostgreSQL (shared by
 //! several replicas), connection set-up, migrations, and the queries of the
 //! service, one file per resource (`robots`, `sets`, `calibrations`,
-//! `versions`, `cell`, `tracks`, `positioners`). No SQL is written outside this module, and no `sqlx` error
+//! `versions`, `cell`, `tracks`, `positioners`, `turntables`). No SQL is written outside this module, and no `sqlx` error
 //! leaves it: callers get a [`StoreError`].
 //!
 //! - `DATABASE_URL` picks the backend: `postgres://…`/`postgresql://…` is
@@ -88,6 +88,7 @@ mod robots;
 mod set_usage;
 mod sets;
 mod tracks;
+mod turntables;
 mod types;
 mod versions;
 

@@ -49,6 +49,7 @@ pub mod solve;
 pub mod solve_columns;
 pub mod station_sets;
 pub mod tracks;
+pub mod turntables;
 pub mod versions;
 
 pub use crate::service::limits::{
@@ -87,6 +88,7 @@ fn routes() -> Vec<Route> {
     all.extend(tracks::routes());
     all.extend(station_sets::routes());
     all.extend(positioners::routes());
+    all.extend(turntables::routes());
     all
 }
 

@@ -1,6 +1,6 @@
 //! What the store keeps, as the service and the HTTP layer see it: robots,
 //! measurement sets, calibration jobs, model versions, checks, tools and work
-//! objects, linear tracks, positioners. Plain data shared by the store (`crate::db`, which reads and
+//! objects, linear tracks, positioners, turntables. Plain data shared by the store (`crate::db`, which reads and
 //! writes these rows and maps its columns onto them) and the service (which
 //! answers with them); neither layer owns the vocabulary, so the HTTP layer
 //! reads it here without naming the store.
@@ -12,6 +12,7 @@ mod positioners;
 mod robots;
 mod sets;
 mod tracks;
+mod turntables;
 mod versions;
 
 pub use calibrations::{CalibrationRow, JobStatus, JobSummary, ProgressDetail};
@@ -21,6 +22,7 @@ pub use positioners::{NewPositioner, PositionerRow};
 pub use robots::{NewRobot, RobotRow};
 pub use sets::{AngleUnit, LengthUnit, SetFormat, SetRow, StoredRole};
 pub use tracks::{NewTrack, TrackRow};
+pub use turntables::{NewTurntable, TurntableRow};
 pub use versions::VersionRow;
 
 /// A JSON document stored as text (its column mapping: `crate::db`).

@@ -39,6 +39,7 @@ mod start;
 mod state;
 pub mod station_sets;
 pub mod tracks;
+pub mod turntables;
 pub mod versions;
 mod waiting;
 

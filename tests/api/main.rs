@@ -26,7 +26,9 @@
 //! and calibrated over them), `positioner`
 //! (a robot's two-axis positioner: fitted, stored, and carrying a targets CSV,
 //! over HTTP and the CLI alike; `positioner_touches`: fitted from touches
-//! with a stored version and tool); the harness is `support`.
+//! with a stored version and tool), `turntable` (a robot's one-axis
+//! turntable: fitted, stored, refitted and deleted, over HTTP and the CLI
+//! alike); the harness is `support`.
 
 mod abandoned;
 mod admission;
@@ -74,3 +76,4 @@ mod support;
 mod track;
 mod track_filter;
 mod track_sets;
+mod turntable;
