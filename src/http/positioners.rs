@@ -151,20 +151,29 @@ struct FittedOut {
     validation: Option<HeldOut>,
 }
 
-fn calibration(id: i64, body: PositionerCalibrateIn) -> Result<PositionerCalibration, ApiError> {
-    let n = body.sets.len();
-    if n == 0 || n > POSITIONER_REFLECTORS_MAX {
+/// A face plate's files checked (a positioner's or a turntable's fit): 1 to
+/// `max` files in `sets`, one design position per file in `reflectors`
+/// (mm, each within ±[`REFLECTOR_MAX_MM`]) and no more `validate` files than
+/// `sets`; the held-out files.
+pub(super) fn reflector_files(
+    sets: &[String],
+    reflectors: &[[f64; 3]],
+    validate: Vec<String>,
+    max: usize,
+) -> Result<Vec<String>, ApiError> {
+    let n = sets.len();
+    if n == 0 || n > max {
         return Err(ApiError::invalid(format!(
-            "`sets`: {n} measurement files; give one per reflector, 1 to {POSITIONER_REFLECTORS_MAX}"
+            "`sets`: {n} measurement files; give one per reflector, 1 to {max}"
         )));
     }
-    if body.reflectors.len() != n {
+    if reflectors.len() != n {
         return Err(ApiError::invalid(format!(
             "`reflectors`: {} design positions for {n} files in `sets`; give one per file (the file's reflector)",
-            body.reflectors.len()
+            reflectors.len()
         )));
     }
-    if let Some(k) = body.reflectors.iter().position(|p| {
+    if let Some(k) = reflectors.iter().position(|p| {
         p.iter()
             .any(|v| !v.is_finite() || v.abs() > REFLECTOR_MAX_MM)
     }) {
@@ -172,13 +181,22 @@ fn calibration(id: i64, body: PositionerCalibrateIn) -> Result<PositionerCalibra
             "`reflectors[{k}]`: give x, y, z in mm on the face plate, each within ±{REFLECTOR_MAX_MM}"
         )));
     }
-    let validate = body.validate.unwrap_or_default();
     if validate.len() > n {
         return Err(ApiError::invalid(format!(
             "`validate`: {} files for {n} reflectors; the k-th holds reflector k's held-out readings",
             validate.len()
         )));
     }
+    Ok(validate)
+}
+
+fn calibration(id: i64, body: PositionerCalibrateIn) -> Result<PositionerCalibration, ApiError> {
+    let validate = reflector_files(
+        &body.sets,
+        &body.reflectors,
+        body.validate.unwrap_or_default(),
+        POSITIONER_REFLECTORS_MAX,
+    )?;
     if !body.nominal.is_object() {
         return Err(ApiError::invalid(
             "`nominal`: give the nominal positioner's JSON description (an object: cell_from_base, tilt, rotate, face_plate)",

@@ -30,8 +30,6 @@ use serde_json::Value;
 
 /// Largest tracker σ a fit is judged against [mm].
 const SIGMA_MAX_MM: f64 = 10.0;
-/// Largest coordinate of a reflector's design position [mm].
-const REFLECTOR_MAX_MM: f64 = 100_000.0;
 
 /// `POST /v1/robots/{id}/turntable/calibrate` body.
 #[derive(Debug, Deserialize)]
@@ -117,33 +115,12 @@ struct FittedOut {
 }
 
 fn calibration(id: i64, body: TurntableCalibrateIn) -> Result<TurntableCalibration, ApiError> {
-    let n = body.sets.len();
-    if n == 0 || n > TURNTABLE_REFLECTORS_MAX {
-        return Err(ApiError::invalid(format!(
-            "`sets`: {n} measurement files; give one per reflector, 1 to {TURNTABLE_REFLECTORS_MAX}"
-        )));
-    }
-    if body.reflectors.len() != n {
-        return Err(ApiError::invalid(format!(
-            "`reflectors`: {} design positions for {n} files in `sets`; give one per file (the file's reflector)",
-            body.reflectors.len()
-        )));
-    }
-    if let Some(k) = body.reflectors.iter().position(|p| {
-        p.iter()
-            .any(|v| !v.is_finite() || v.abs() > REFLECTOR_MAX_MM)
-    }) {
-        return Err(ApiError::invalid(format!(
-            "`reflectors[{k}]`: give x, y, z in mm on the face plate, each within ±{REFLECTOR_MAX_MM}"
-        )));
-    }
-    let validate = body.validate.unwrap_or_default();
-    if validate.len() > n {
-        return Err(ApiError::invalid(format!(
-            "`validate`: {} files for {n} reflectors; the k-th holds reflector k's held-out readings",
-            validate.len()
-        )));
-    }
+    let validate = super::positioners::reflector_files(
+        &body.sets,
+        &body.reflectors,
+        body.validate.unwrap_or_default(),
+        TURNTABLE_REFLECTORS_MAX,
+    )?;
     if !body.nominal.is_object() {
         return Err(ApiError::invalid(
             "`nominal`: give the nominal turntable's JSON description (an object: cell_from_base, axis, face_plate)",
