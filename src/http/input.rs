@@ -336,6 +336,16 @@ pub fn external_axis(
     }
 }
 
+/// 201 for a resource stored for the first time, 200 for one replaced (a
+/// fit stored per robot: track, positioner, turntable).
+pub fn created_or_ok(created: bool) -> axum::http::StatusCode {
+    if created {
+        axum::http::StatusCode::CREATED
+    } else {
+        axum::http::StatusCode::OK
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -271,11 +271,7 @@ pub async fn calibrate(
         fit,
         validation,
     } = service::positioners::calibrate(&s, cmd).await?;
-    let status = if created {
-        StatusCode::CREATED
-    } else {
-        StatusCode::OK
-    };
+    let status = super::input::created_or_ok(created);
     let body = FittedOut {
         fitted: true,
         stored: PositionerOut::from_row(row)?,

@@ -164,11 +164,7 @@ pub async fn calibrate(
 ) -> Result<Response, ApiError> {
     let cmd = calibration(id, body)?;
     let StoredTrack { row, created, fit } = service::tracks::calibrate(&s, cmd).await?;
-    let status = if created {
-        StatusCode::CREATED
-    } else {
-        StatusCode::OK
-    };
+    let status = super::input::created_or_ok(created);
     let body = FittedOut {
         fitted: true,
         stored: TrackOut::from_row(row)?,

@@ -160,11 +160,7 @@ pub async fn calibrate(
         fit,
         validation,
     } = service::turntables::calibrate(&s, cmd).await?;
-    let status = if created {
-        StatusCode::CREATED
-    } else {
-        StatusCode::OK
-    };
+    let status = super::input::created_or_ok(created);
     let body = FittedOut {
         fitted: true,
         stored: TurntableOut::from_row(row)?,

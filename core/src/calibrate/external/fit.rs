@@ -19,7 +19,8 @@
 
 use super::circle::fit_circle;
 use super::judge::{
-    check_residuals, rms_max, within, MAX_CONDITION, MIN_ANGLES, MIN_RADIUS_MM, MIN_SPAN_DEG,
+    check_reflector_inputs, check_residuals, rms_max, within, MAX_CONDITION, MIN_ANGLES,
+    MIN_RADIUS_MM, MIN_SPAN_DEG,
 };
 use super::outcome::{
     Axis, AxisSigma, CircleReport, FitLimits, PositionerFit, PositionerFitRequest, RefusalReason,
@@ -98,61 +99,20 @@ fn sweeps(req: &PositionerFitRequest) -> Vec<Sweep> {
 }
 
 fn check_inputs(req: &PositionerFitRequest) -> Result<(), Refused> {
-    if req.reflectors_mm.is_empty() {
-        return Err(Refused::new(
-            RefusalReason::UnknownReflector,
-            "no reflectors: give the design position on the face plate of each reflector read"
-                .into(),
-        ));
-    }
-    if !(req.tracker_sigma_mm > 0.0 && req.tracker_sigma_mm.is_finite()) {
-        return Err(Refused::new(
-            RefusalReason::NotFinite,
-            format!(
-                "the tracker's noise σ is {} mm; give a positive number",
-                req.tracker_sigma_mm
-            ),
-        ));
-    }
-    if req.reflectors_mm.iter().flatten().any(|v| !v.is_finite()) {
-        return Err(Refused::new(
-            RefusalReason::NotFinite,
-            "a reflector's design position is not finite".into(),
-        ));
-    }
-    for (i, r) in req.readings.iter().enumerate() {
-        if r.values_deg.iter().chain(&r.xyz_mm).any(|v| !v.is_finite()) {
-            return Err(Refused::new(
-                RefusalReason::NotFinite,
-                format!("reading {}: a value is not finite", i + 1),
-            )
-            .at_row(i + 1));
-        }
-        if r.reflector >= req.reflectors_mm.len() {
-            return Err(Refused::new(
-                RefusalReason::UnknownReflector,
-                format!(
-                    "reading {} names reflector {}, but {} reflector(s) are given",
-                    i + 1,
-                    r.reflector,
-                    req.reflectors_mm.len()
-                ),
-            )
-            .at_row(i + 1));
-        }
-    }
-    if let Some(k) =
-        (0..req.reflectors_mm.len()).find(|k| !req.readings.iter().any(|r| r.reflector == *k))
-    {
-        let what = if k == 0 {
-            "reflector 0, the reference that defines axis 2's zero, has no readings; read it, or list a reflector that was read first"
-                .to_string()
-        } else {
-            format!("reflector {k} is given but has no readings; leave it out")
-        };
-        return Err(Refused::new(RefusalReason::UnknownReflector, what));
-    }
-    Ok(())
+    let readings: Vec<(usize, bool)> = req
+        .readings
+        .iter()
+        .map(|r| {
+            let finite = r.values_deg.iter().chain(&r.xyz_mm).all(|v| v.is_finite());
+            (r.reflector, finite)
+        })
+        .collect();
+    check_reflector_inputs(
+        &req.reflectors_mm,
+        req.tracker_sigma_mm,
+        &readings,
+        "axis 2's",
+    )
 }
 
 /// The best sweep of `axis` (most angles, then widest), judged.

@@ -98,3 +98,64 @@ pub fn check_residuals<F>(
     }
     Ok(())
 }
+
+/// The inputs every face-plate fit checks before fitting: reflectors given
+/// and finite, σ positive, each reading finite (`readings[i]`: its
+/// reflector and whether its values are finite) and naming a given
+/// reflector, every reflector read; `zero` names the zero reflector 0
+/// defines (`axis 2's`, `the axis's`).
+pub fn check_reflector_inputs<F>(
+    reflectors_mm: &[[f64; 3]],
+    sigma_mm: f64,
+    readings: &[(usize, bool)],
+    zero: &str,
+) -> Result<(), Refusal<RefusalReason, F>> {
+    if reflectors_mm.is_empty() {
+        return Err(Refusal::new(
+            RefusalReason::UnknownReflector,
+            "no reflectors: give the design position on the face plate of each reflector read"
+                .into(),
+        ));
+    }
+    if !(sigma_mm > 0.0 && sigma_mm.is_finite()) {
+        return Err(Refusal::new(
+            RefusalReason::NotFinite,
+            format!("the tracker's noise σ is {sigma_mm} mm; give a positive number"),
+        ));
+    }
+    if reflectors_mm.iter().flatten().any(|v| !v.is_finite()) {
+        return Err(Refusal::new(
+            RefusalReason::NotFinite,
+            "a reflector's design position is not finite".into(),
+        ));
+    }
+    for (i, &(reflector, finite)) in readings.iter().enumerate() {
+        if !finite {
+            return Err(Refusal::new(
+                RefusalReason::NotFinite,
+                format!("reading {}: a value is not finite", i + 1),
+            )
+            .at_row(i + 1));
+        }
+        if reflector >= reflectors_mm.len() {
+            return Err(Refusal::new(
+                RefusalReason::UnknownReflector,
+                format!(
+                    "reading {} names reflector {reflector}, but {} reflector(s) are given",
+                    i + 1,
+                    reflectors_mm.len()
+                ),
+            )
+            .at_row(i + 1));
+        }
+    }
+    if let Some(k) = (0..reflectors_mm.len()).find(|k| !readings.iter().any(|r| r.0 == *k)) {
+        let what = if k == 0 {
+            format!("reflector 0, the reference that defines {zero} zero, has no readings; read it, or list a reflector that was read first")
+        } else {
+            format!("reflector {k} is given but has no readings; leave it out")
+        };
+        return Err(Refusal::new(RefusalReason::UnknownReflector, what));
+    }
+    Ok(())
+}

@@ -275,22 +275,53 @@ pub fn jacobian(g: &Gauge, s: &State, rows: &[Row]) -> DMatrix<f64> {
     j
 }
 
-/// The problem the LM driver moves.
-pub struct Problem<'a> {
+/// A point of an external axis fit's parameter space, what [`Problem`]
+/// moves: its readings' residuals and their Jacobian at it, and the point
+/// `self ⊕ delta` (the positioner's [`State`], the turntable's).
+pub trait FitState: Clone {
     /// What stays fixed.
-    pub gauge: &'a Gauge,
+    type Gauge;
+    /// One reading.
+    type Row;
+    /// Residuals `x_measured − x` of every row (3 per row) [m].
+    fn residuals(&self, g: &Self::Gauge, rows: &[Self::Row]) -> DVector<f64>;
+    /// The Jacobian of the predictions (`r(x ⊕ δ) ≈ r − J·δ`).
+    fn jacobian(&self, g: &Self::Gauge, rows: &[Self::Row]) -> DMatrix<f64>;
+    /// The point `self ⊕ delta`.
+    fn step(&self, g: &Self::Gauge, delta: &DVector<f64>) -> Self;
+}
+
+impl FitState for State {
+    type Gauge = Gauge;
+    type Row = Row;
+    fn residuals(&self, g: &Gauge, rows: &[Row]) -> DVector<f64> {
+        residuals(g, self, rows)
+    }
+    fn jacobian(&self, g: &Gauge, rows: &[Row]) -> DMatrix<f64> {
+        jacobian(g, self, rows)
+    }
+    fn step(&self, g: &Gauge, delta: &DVector<f64>) -> State {
+        State::step(self, g, delta)
+    }
+}
+
+/// The problem the LM driver moves: a fit's readings under its gauge, from
+/// a starting point.
+pub struct Problem<'a, S: FitState> {
+    /// What stays fixed.
+    pub gauge: &'a S::Gauge,
     /// The readings.
-    pub rows: &'a [Row],
+    pub rows: &'a [S::Row],
     /// The current point of the parameter space.
-    pub state: State,
-    next: Option<State>,
+    pub state: S,
+    next: Option<S>,
     r: DVector<f64>,
     j: DMatrix<f64>,
 }
 
-impl<'a> Problem<'a> {
+impl<'a, S: FitState> Problem<'a, S> {
     /// The problem of `rows` under `gauge`, started at `state`.
-    pub fn new(gauge: &'a Gauge, rows: &'a [Row], state: State) -> Self {
+    pub fn new(gauge: &'a S::Gauge, rows: &'a [S::Row], state: S) -> Self {
         Problem {
             gauge,
             rows,
@@ -302,13 +333,13 @@ impl<'a> Problem<'a> {
     }
 }
 
-impl LeastSquaresProblem for Problem<'_> {
+impl<S: FitState> LeastSquaresProblem for Problem<'_, S> {
     fn cost(&self) -> f64 {
-        residuals(self.gauge, &self.state, self.rows).norm_squared()
+        self.state.residuals(self.gauge, self.rows).norm_squared()
     }
     fn linearise(&mut self) -> &mut DMatrix<f64> {
-        self.r = residuals(self.gauge, &self.state, self.rows);
-        self.j = jacobian(self.gauge, &self.state, self.rows);
+        self.r = self.state.residuals(self.gauge, self.rows);
+        self.j = self.state.jacobian(self.gauge, self.rows);
         &mut self.j
     }
     fn residuals(&self) -> &DVector<f64> {
@@ -319,7 +350,7 @@ impl LeastSquaresProblem for Problem<'_> {
     }
     fn trial(&mut self, delta: &mut DVector<f64>) -> Option<f64> {
         let s = self.state.step(self.gauge, delta);
-        let c = residuals(self.gauge, &s, self.rows).norm_squared();
+        let c = s.residuals(self.gauge, self.rows).norm_squared();
         self.next = Some(s);
         c.is_finite().then_some(c)
     }

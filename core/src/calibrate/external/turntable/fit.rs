@@ -18,13 +18,15 @@
 use super::super::circle::fit_circle;
 use super::super::fit::variances;
 use super::super::judge::{
-    check_residuals, rms_max, within, MAX_CONDITION, MIN_ANGLES, MIN_RADIUS_MM, MIN_SPAN_DEG,
+    check_reflector_inputs, check_residuals, rms_max, within, MAX_CONDITION, MIN_ANGLES,
+    MIN_RADIUS_MM, MIN_SPAN_DEG,
 };
 use super::super::outcome::{
     Axis, AxisSigma, CircleReport, FitLimits, RefusalReason, SolverOutcome,
 };
+use super::super::problem::Problem;
 use super::outcome::{TurntableFit, TurntableFitRequest, TurntableReading, TurntableRefused};
-use super::problem::{jacobian, residuals, Gauge, Problem, Row, State, AXIS_PARAMETERS};
+use super::problem::{jacobian, residuals, Gauge, Row, State, AXIS_PARAMETERS};
 use crate::model::external::{RotaryAxis, Turntable};
 use crate::optim::lm::{minimise, Settings};
 use nalgebra::{DVector, Vector3};
@@ -37,60 +39,20 @@ fn refused(reason: RefusalReason, message: String) -> TurntableRefused {
 }
 
 fn check_inputs(req: &TurntableFitRequest) -> Result<(), TurntableRefused> {
-    if req.reflectors_mm.is_empty() {
-        return Err(refused(
-            RefusalReason::UnknownReflector,
-            "no reflectors: give the design position on the face plate of each reflector read"
-                .into(),
-        ));
-    }
-    if !(req.tracker_sigma_mm > 0.0 && req.tracker_sigma_mm.is_finite()) {
-        return Err(refused(
-            RefusalReason::NotFinite,
-            format!(
-                "the tracker's noise σ is {} mm; give a positive number",
-                req.tracker_sigma_mm
-            ),
-        ));
-    }
-    if req.reflectors_mm.iter().flatten().any(|v| !v.is_finite()) {
-        return Err(refused(
-            RefusalReason::NotFinite,
-            "a reflector's design position is not finite".into(),
-        ));
-    }
-    for (i, r) in req.readings.iter().enumerate() {
-        if !r.value_deg.is_finite() || r.xyz_mm.iter().any(|v| !v.is_finite()) {
-            return Err(refused(
-                RefusalReason::NotFinite,
-                format!("reading {}: a value is not finite", i + 1),
-            )
-            .at_row(i + 1));
-        }
-        if r.reflector >= req.reflectors_mm.len() {
-            return Err(refused(
-                RefusalReason::UnknownReflector,
-                format!(
-                    "reading {} names reflector {}, but {} reflector(s) are given",
-                    i + 1,
-                    r.reflector,
-                    req.reflectors_mm.len()
-                ),
-            )
-            .at_row(i + 1));
-        }
-    }
-    if let Some(k) =
-        (0..req.reflectors_mm.len()).find(|k| !req.readings.iter().any(|r| r.reflector == *k))
-    {
-        let what = if k == 0 {
-            "reflector 0, the reference that defines the axis's zero, has no readings; read it, or list a reflector that was read first".to_string()
-        } else {
-            format!("reflector {k} is given but has no readings; leave it out")
-        };
-        return Err(refused(RefusalReason::UnknownReflector, what));
-    }
-    Ok(())
+    let readings: Vec<(usize, bool)> = req
+        .readings
+        .iter()
+        .map(|r| {
+            let finite = r.value_deg.is_finite() && r.xyz_mm.iter().all(|v| v.is_finite());
+            (r.reflector, finite)
+        })
+        .collect();
+    check_reflector_inputs(
+        &req.reflectors_mm,
+        req.tracker_sigma_mm,
+        &readings,
+        "the axis's",
+    )
 }
 
 /// One reflector's readings, by increasing value, with their distinct

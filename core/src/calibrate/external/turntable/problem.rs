@@ -23,13 +23,13 @@
 //! a move `e` of the line `(I − R)·e`; a rotation `ω` of the direction
 //! `ω × (R·z) − R·(ω × z)`; the angle `u × (R·z)`; a reflector's move `d`
 //! `R·F.r·d`; all carried into the cell frame by `T.r`. Checked against
-//! central differences in the tests.
+//! central differences in the tests. The LM driver moves it through
+//! `super::super::problem::Problem` ([`FitState`]).
 
-use super::super::problem::{across, turned_axis};
+use super::super::problem::{across, turned_axis, FitState};
 use crate::model::external::rotary::closest_to_origin;
 use crate::model::external::{RotaryAxis, Turntable};
 use crate::model::Pose;
-use crate::optim::lm::LeastSquaresProblem;
 use nalgebra::{DMatrix, DVector, Rotation3, Vector3};
 
 /// Parameters before the reflectors'.
@@ -195,58 +195,17 @@ pub fn jacobian(g: &Gauge, s: &State, rows: &[Row]) -> DMatrix<f64> {
     j
 }
 
-/// The problem the LM driver moves.
-pub struct Problem<'a> {
-    /// What stays fixed.
-    pub gauge: &'a Gauge,
-    /// The readings.
-    pub rows: &'a [Row],
-    /// The current point of the parameter space.
-    pub state: State,
-    next: Option<State>,
-    r: DVector<f64>,
-    j: DMatrix<f64>,
-}
-
-impl<'a> Problem<'a> {
-    /// The problem of `rows` under `gauge`, started at `state`.
-    pub fn new(gauge: &'a Gauge, rows: &'a [Row], state: State) -> Self {
-        Problem {
-            gauge,
-            rows,
-            state,
-            next: None,
-            r: DVector::zeros(0),
-            j: DMatrix::zeros(0, 0),
-        }
+impl FitState for State {
+    type Gauge = Gauge;
+    type Row = Row;
+    fn residuals(&self, g: &Gauge, rows: &[Row]) -> DVector<f64> {
+        residuals(g, self, rows)
     }
-}
-
-impl LeastSquaresProblem for Problem<'_> {
-    fn cost(&self) -> f64 {
-        residuals(self.gauge, &self.state, self.rows).norm_squared()
+    fn jacobian(&self, g: &Gauge, rows: &[Row]) -> DMatrix<f64> {
+        jacobian(g, self, rows)
     }
-    fn linearise(&mut self) -> &mut DMatrix<f64> {
-        self.r = residuals(self.gauge, &self.state, self.rows);
-        self.j = jacobian(self.gauge, &self.state, self.rows);
-        &mut self.j
-    }
-    fn residuals(&self) -> &DVector<f64> {
-        &self.r
-    }
-    fn jacobian(&self) -> &DMatrix<f64> {
-        &self.j
-    }
-    fn trial(&mut self, delta: &mut DVector<f64>) -> Option<f64> {
-        let s = self.state.step(delta);
-        let c = residuals(self.gauge, &s, self.rows).norm_squared();
-        self.next = Some(s);
-        c.is_finite().then_some(c)
-    }
-    fn accept(&mut self) {
-        if let Some(s) = self.next.take() {
-            self.state = s;
-        }
+    fn step(&self, _: &Gauge, delta: &DVector<f64>) -> State {
+        State::step(self, delta)
     }
 }
 
