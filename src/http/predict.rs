@@ -23,7 +23,7 @@
 
 use super::input::{check_payload, objects, present};
 use super::solve::{convention, model_choice, target_id, ItemRef, VersionSelector};
-use super::solve_columns::axis_values;
+use super::solve_columns::{axis_values, plate_of};
 use super::{ApiError, ApiJson, ApiPath, AppState};
 use crate::records::CellKind;
 use crate::service;
@@ -87,6 +87,11 @@ pub struct PredictRequest {
     /// positioner's face plate frame.
     #[serde(default, deserialize_with = "present")]
     pub e3: Option<f64>,
+    /// The part is on the robot's stored one-axis turntable: `e1` is its
+    /// value [deg] (or `e2` beside the track's `e1` [mm]), the poses in its
+    /// face plate frame.
+    #[serde(default, deserialize_with = "present")]
+    pub turntable: Option<bool>,
 }
 
 /// A predicted orientation in the request's `convention`.
@@ -180,6 +185,7 @@ fn command(robot_id: i64, req: &PredictRequest) -> Result<PredictCommand, ApiErr
         req.e2,
         req.e3,
         req.frame.is_some() || req.work_object.is_some(),
+        plate_of(req.turntable),
     )?;
     let readings = req
         .readings
@@ -217,6 +223,7 @@ fn command(robot_id: i64, req: &PredictRequest) -> Result<PredictCommand, ApiErr
         frame,
         track_mm: axes.track_mm,
         positioner_deg: axes.positioner_deg,
+        plate: axes.plate,
     })
 }
 

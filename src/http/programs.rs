@@ -14,12 +14,15 @@
 //! with the robot's stored positioner, program axes 1 and 2, as `robocal
 //! filter --positioner --nominal-positioner` composes them; with both, the
 //! robot rides the track and the positioner's axes are the program's 2 and
-//! 3 (Fanuc: J1, J2 of GP2 as before).
+//! 3 (Fanuc: J1, J2 of GP2 as before). With `controller_turntable` (the
+//! controller's own one-axis turntable) the work objects on the face plate
+//! turn with the robot's stored turntable, the program's axis 1 (2 beside
+//! a track), as `robocal filter --turntable --nominal-turntable` composes it.
 
 use super::input::{objects, present};
 use super::solve::{model_choice, VersionSelector};
 use super::{ApiError, ApiJson, ApiPath, AppState};
-use crate::model::external::{TiltRotateDescription, TrackDescription};
+use crate::model::external::{TiltRotateDescription, TrackDescription, TurntableDescription};
 use crate::program::controller::{
     ExportOptions, KinematicKind, NotHeld, RegisterRange, Renamed, UsedRegister,
 };
@@ -71,10 +74,16 @@ pub struct FilterRequest {
     /// program's axes 1 and 2 (2 and 3 with `controller_track`).
     #[serde(default, deserialize_with = "present")]
     pub controller_positioner: Option<TiltRotateDescription>,
-    /// Rewrite the track's and the positioner's values so the real axes
-    /// stand where the controller believes the programmed values put them
-    /// (default false: kept as programmed); needs `controller_track` or
-    /// `controller_positioner`.
+    /// The controller's own one-axis turntable (in its world, as
+    /// `controller_positioner`'s): the work objects on the face plate turn
+    /// with the robot's stored turntable, the program's axis 1 (2 with
+    /// `controller_track`). Not beside `controller_positioner`.
+    #[serde(default, deserialize_with = "present")]
+    pub controller_turntable: Option<TurntableDescription>,
+    /// Rewrite the track's, the positioner's and the turntable's values so
+    /// the real axes stand where the controller believes the programmed
+    /// values put them (default false: kept as programmed); needs
+    /// `controller_track`, `controller_positioner` or `controller_turntable`.
     #[serde(default, deserialize_with = "present")]
     pub correct_axes: Option<bool>,
 }
@@ -151,10 +160,24 @@ fn command(robot_id: i64, req: FilterRequest) -> Result<FilterCommand, ApiError>
         .map(|d| d.to_model())
         .transpose()
         .map_err(|e| ApiError::invalid(format!("`controller_positioner`: {e}")))?;
-    let correct_axes = req.correct_axes.unwrap_or(false);
-    if correct_axes && controller_track.is_none() && controller_positioner.is_none() {
+    let controller_turntable = req
+        .controller_turntable
+        .map(|d| d.to_model())
+        .transpose()
+        .map_err(|e| ApiError::invalid(format!("`controller_turntable`: {e}")))?;
+    if controller_positioner.is_some() && controller_turntable.is_some() {
         return Err(ApiError::invalid(
-            "`correct_axes` corrects the values of the axes `controller_track` or `controller_positioner` composes, and neither is given",
+            "`controller_positioner` and `controller_turntable` both carry the face plate's work objects: give one",
+        ));
+    }
+    let correct_axes = req.correct_axes.unwrap_or(false);
+    if correct_axes
+        && controller_track.is_none()
+        && controller_positioner.is_none()
+        && controller_turntable.is_none()
+    {
+        return Err(ApiError::invalid(
+            "`correct_axes` corrects the values of the axes `controller_track`, `controller_positioner` or `controller_turntable` composes, and none is given",
         ));
     }
     Ok(FilterCommand {
@@ -163,6 +186,7 @@ fn command(robot_id: i64, req: FilterRequest) -> Result<FilterCommand, ApiError>
         payload_kg: req.payload_kg,
         controller_track,
         controller_positioner,
+        controller_turntable,
         correct_axes,
         language,
         files: req

@@ -29,12 +29,13 @@
 
 use super::error::{content_type, json_content_type};
 use super::input::{check_payload, from_json_object, object_or_null, objects, present, Int};
-use super::solve_columns::{axis_columns, axis_values, AxisColumns};
+use super::solve_columns::{axis_columns, axis_values, plate_of, AxisColumns};
 use super::{ApiError, ApiPath, ApiQuery, AppState};
 use crate::measure::csv_text::{dialect_from_names, Dialect};
 use crate::model::orientation::OrientationConvention;
 use crate::records::CellKind;
 use crate::service;
+use crate::service::positioners::Plate;
 use crate::service::solve::{ItemChoice, ModelChoice, SolveCommand, SolveOutcome, Targets};
 use crate::solve::ik::targets_csv::parse_targets_csv_beside;
 use crate::solve::ik::{
@@ -189,6 +190,11 @@ pub struct SolveRequest {
     /// stored positioner's face plate frame.
     #[serde(default, deserialize_with = "present")]
     pub e3: Option<f64>,
+    /// The part is on the robot's stored one-axis turntable: `e1` is its
+    /// value [deg] (or `e2` beside the track's `e1` [mm]), the targets in
+    /// its face plate frame.
+    #[serde(default, deserialize_with = "present")]
+    pub turntable: Option<bool>,
 }
 
 /// A tool or work object of a solve: a stored one's name, or one inline.
@@ -390,6 +396,8 @@ struct Common<'a> {
     e3: Option<f64>,
     /// Whether the request names a work object.
     work_object: bool,
+    /// What carries the part at the values.
+    plate: Plate,
 }
 
 /// The model a `version` field names (absent: the active version).
@@ -443,7 +451,13 @@ fn command(robot_id: i64, c: Common) -> Result<SolveCommand, ApiError> {
         .map(|name| convention(name, "`convention`"))
         .transpose()?;
     let model = model_choice(c.version)?;
-    let axes = axis_values(c.e1, c.e2, c.e3, c.frame.is_some() || c.work_object)?;
+    let axes = axis_values(
+        c.e1,
+        c.e2,
+        c.e3,
+        c.frame.is_some() || c.work_object,
+        c.plate,
+    )?;
     Ok(SolveCommand {
         robot_id,
         model,
@@ -465,6 +479,7 @@ fn command(robot_id: i64, c: Common) -> Result<SolveCommand, ApiError> {
         track_rows: None,
         positioner_rows: None,
         positioner_deg: axes.positioner_deg,
+        plate: axes.plate,
     })
 }
 
@@ -483,6 +498,10 @@ pub fn json_command(
     }
     let query = q.options()?;
     let seed_in_body = req.branch.is_some() || req.seed_deg.is_some();
+    let plate = plate_of(req.turntable.or(query.turntable));
+    // A positioner's or a turntable's values state the targets' frame (its
+    // face plate): the query's `frame` does not stand in for the body's.
+    let on_plate = req.e2.is_some() || plate == Plate::Turntable;
     let (branch, seed_deg) = if seed_in_body {
         (req.branch.as_deref(), req.seed_deg.clone())
     } else {
@@ -494,9 +513,7 @@ pub fn json_command(
             version: req.version.as_ref().or(query.version.as_ref()),
             payload_kg: req.payload_kg.or(query.payload_kg),
             jump_deg: req.jump_deg.or(query.jump_deg),
-            // A positioner's values state the targets' frame (its face
-            // plate): the query's `frame` does not stand in for the body's.
-            frame: if req.e2.is_some() {
+            frame: if on_plate {
                 req.frame.as_deref()
             } else {
                 req.frame.as_deref().or(query.frame)
@@ -514,6 +531,7 @@ pub fn json_command(
             e2: req.e2,
             e3: req.e3,
             work_object: req.work_object.is_some(),
+            plate,
         },
     )?;
     cmd.tool = req
@@ -558,8 +576,13 @@ pub struct CsvSolveQuery {
     pub position_only: Option<bool>,
     /// Path mode: solve in order, each target seeded by the previous solution.
     pub path: Option<bool>,
-    /// The track's value [mm] (the robot carried along its stored track).
+    /// The track's value [mm] (the robot carried along its stored track);
+    /// with `turntable`, the turntable's value [deg] for every row.
     pub e1: Option<f64>,
+    /// The targets are on the robot's stored one-axis turntable, in its
+    /// face plate frame: a CSV's `e1` column is its value per row (or `e2`
+    /// beside the track's `e1`).
+    pub turntable: Option<bool>,
     /// `point` or `comma` (detected when absent).
     pub decimal: Option<String>,
 }
@@ -576,6 +599,7 @@ struct QueryOptions<'a> {
     position_only: Option<bool>,
     path: Option<bool>,
     e1: Option<f64>,
+    turntable: Option<bool>,
 }
 
 /// A decimal number as `openapi.yaml`'s `seed_deg` pattern writes it: an
@@ -645,6 +669,7 @@ impl CsvSolveQuery {
             position_only: self.position_only,
             path: self.path,
             e1: self.e1,
+            turntable: self.turntable,
         })
     }
 }
@@ -657,6 +682,12 @@ pub fn dialect(decimal: Option<&str>) -> Result<Dialect, ApiError> {
 /// A targets CSV and its query as a service command.
 pub fn csv_command(robot_id: i64, q: &CsvSolveQuery, text: &str) -> Result<SolveCommand, ApiError> {
     let query = q.options()?;
+    let d = dialect(q.decimal.as_deref())?;
+    // External-axis columns: a track's value or a positioner's or a
+    // turntable's values per row.
+    let plate = plate_of(query.turntable);
+    let columns = axis_columns(text, d, query.e1, query.frame.is_some(), plate)?;
+    let per_row = !matches!(columns, AxisColumns::None);
     let mut cmd = command(
         robot_id,
         Common {
@@ -673,11 +704,11 @@ pub fn csv_command(robot_id: i64, q: &CsvSolveQuery, text: &str) -> Result<Solve
             e2: None,
             e3: None,
             work_object: false,
+            // A turntable's values per row: its columns, read above.
+            plate: if per_row { Plate::Positioner } else { plate },
         },
     )?;
-    let d = dialect(q.decimal.as_deref())?;
-    // External-axis columns: a track's value or a positioner's values per row.
-    let columns = axis_columns(text, d, query.e1, query.frame.is_some())?;
+    cmd.plate = plate;
     let csv = parse_targets_csv_beside(text, d, columns.beside())?;
     match columns {
         AxisColumns::None => {}

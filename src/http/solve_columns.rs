@@ -16,10 +16,17 @@
 //! query's `e1`, `e2` and `e3`, for solve and predict): `e1` alone is the
 //! track's value, `e1` and `e2` a positioner's, the poses on its face
 //! plate, and `e1`, `e2`, `e3` the track's and the positioner's beside it.
+//!
+//! With `turntable` the part is on the robot's stored one-axis turntable
+//! (`service::turntables::for_plate`), the targets or poses in its face
+//! plate frame: `e1` (a column or a value) is the turntable's value [deg],
+//! or `e1` the track's [mm] and `e2` the turntable's beside it; an `e3` and
+//! a `frame` are 422. The turntable is composed as the positioner whose
+//! axis 1 stands at 0, so its value is carried as the rotate value.
 
 use super::ApiError;
 use crate::measure::csv_text::Dialect;
-use crate::service::positioners::PlateValues;
+use crate::service::positioners::{Plate, PlateValues};
 use robocal_core::solve::external::{
     positioner_columns, target_column_values, AxisValues, TargetValue, ROTATE_COLUMN, TILT_COLUMN,
     TRACK_COLUMN,
@@ -58,11 +65,13 @@ impl AxisColumns {
 
 /// The external-axis columns of targets CSV `text`; `query_e1` is the
 /// query's track value and `frame_given` whether the query names a frame.
+/// With `plate` a turntable, [`turntable_columns`].
 pub fn axis_columns(
     text: &str,
     dialect: Dialect,
     query_e1: Option<f64>,
     frame_given: bool,
+    plate: Plate,
 ) -> Result<AxisColumns, ApiError> {
     let read = |column: &str| {
         target_column_values(text, dialect, column)
@@ -70,6 +79,15 @@ pub fn axis_columns(
     };
     let tilt = read(TILT_COLUMN)?;
     let rotate = read(ROTATE_COLUMN)?;
+    if plate == Plate::Turntable {
+        return turntable_columns(
+            tilt,
+            rotate,
+            read(CELL_COLUMNS[2])?.is_some(),
+            query_e1,
+            frame_given,
+        );
+    }
     if let Some(third) = read(CELL_COLUMNS[2])? {
         return beside_track(tilt, rotate, third, query_e1, frame_given);
     }
@@ -130,6 +148,63 @@ fn beside_track(
     })
 }
 
+/// A turntable's targets CSV (`turntable`): an `e1` column alone is the
+/// turntable's value per row; `e1` and `e2` columns the track's value and
+/// the turntable's beside it. An `e3` column, an `e2` without `e1`, the
+/// query's `e1` beside a column and `frame` are 422; no column is no
+/// values per row (the query's `e1` then gives every row's).
+fn turntable_columns(
+    first: Option<Vec<TargetValue>>,
+    second: Option<Vec<TargetValue>>,
+    has_third: bool,
+    query_e1: Option<f64>,
+    frame_given: bool,
+) -> Result<AxisColumns, ApiError> {
+    if has_third {
+        return Err(ApiError::invalid(format!(
+            "targets CSV: an `{}` column with `turntable`: a turntable has one axis, `{TRACK_COLUMN}` its value [deg], or `{TILT_COLUMN}` beside a track's `{TRACK_COLUMN}` [mm]",
+            CELL_COLUMNS[2]
+        )));
+    }
+    if first.is_none() && second.is_some() {
+        return Err(ApiError::invalid(format!(
+            "targets CSV: an `{ROTATE_COLUMN}` column without `{TILT_COLUMN}`: with `turntable`, `{TILT_COLUMN}` is its value [deg], or the track's [mm] beside the turntable's `{ROTATE_COLUMN}`"
+        )));
+    }
+    if first.is_some() && query_e1.is_some() {
+        return Err(ApiError::invalid(format!(
+            "the targets CSV has an `{TRACK_COLUMN}` column and the query gives `e1`: which value holds is ambiguous; give one or the other"
+        )));
+    }
+    if frame_given {
+        return Err(ApiError::invalid(
+            "`frame`: with `turntable` the targets are in the turntable's face plate frame; leave `frame` out",
+        ));
+    }
+    let on_plate = |values: Vec<TargetValue>| PlateValues {
+        tilt: TargetValue::held_at_zero(&values),
+        rotate: values,
+    };
+    Ok(match (first, second) {
+        (Some(track), Some(values)) => AxisColumns::TrackAndPositioner {
+            track,
+            plate: on_plate(values),
+        },
+        (Some(values), None) => AxisColumns::Positioner(on_plate(values)),
+        _ => AxisColumns::None,
+    })
+}
+
+/// What carries the part: the stored turntable when a request's
+/// `turntable` is true, else the stored positioner.
+pub fn plate_of(turntable: Option<bool>) -> Plate {
+    if turntable == Some(true) {
+        Plate::Turntable
+    } else {
+        Plate::Positioner
+    }
+}
+
 /// The external axes of a request as single values.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct AxisSettings {
@@ -137,19 +212,70 @@ pub struct AxisSettings {
     pub track_mm: Option<f64>,
     /// `e1` and `e2`: the positioner's tilt and rotate values [deg].
     pub positioner_deg: Option<AxisValues>,
+    /// What carries the part at `positioner_deg`.
+    pub plate: Plate,
+}
+
+/// With `turntable`: `e1` alone is the turntable's value [deg], `e1` and
+/// `e2` the track's [mm] and the turntable's beside it, carried as the
+/// rotate value with the tilt at 0; no value, an `e3` and `frame_given` are
+/// 422, and so is a value beyond two turns.
+fn turntable_values(
+    e1: Option<f64>,
+    e2: Option<f64>,
+    e3: Option<f64>,
+    frame_given: bool,
+) -> Result<AxisSettings, ApiError> {
+    if e3.is_some() {
+        return Err(ApiError::invalid(
+            "`e3` with `turntable`: a turntable has one axis, `e1` its value [deg], or `e2` beside the track's `e1` [mm]",
+        ));
+    }
+    let (track_mm, value, name) = match (e1, e2) {
+        (Some(v), None) => (None, v, "e1"),
+        (Some(t), Some(v)) => (Some(t), v, "e2"),
+        (None, _) => {
+            return Err(ApiError::invalid(
+                "`turntable` needs the turntable's value: `e1` [deg] (a targets CSV's `e1` column, or the query's `e1` for every row), or `e2` beside the track's `e1` [mm]",
+            ))
+        }
+    };
+    if frame_given {
+        return Err(ApiError::invalid(
+            "`turntable` states the poses in the turntable's face plate frame: `frame` and `work_object` beside it are ambiguous; leave them out",
+        ));
+    }
+    if !value.is_finite() || value.abs() > 720.0 {
+        return Err(ApiError::invalid(format!(
+            "`{name}`: {value} is not a turntable's value: a finite number of degrees within two turns (±720)"
+        )));
+    }
+    Ok(AxisSettings {
+        track_mm,
+        positioner_deg: Some(AxisValues {
+            tilt_deg: 0.0,
+            rotate_deg: value,
+        }),
+        plate: Plate::Turntable,
+    })
 }
 
 /// `e1` alone: a track value [mm]; `e1` and `e2`: a positioner's tilt and
 /// rotate [deg], the poses on its face plate, so `frame_given` (a `frame`
 /// or a work object beside them) is a 422; `e2` alone a 422; `e1`, `e2`,
 /// `e3`: the track's value and the positioner's tilt and rotate beside it
-/// (`e3` without both others a 422).
+/// (`e3` without both others a 422). With `plate` a turntable,
+/// [`turntable_values`].
 pub fn axis_values(
     e1: Option<f64>,
     e2: Option<f64>,
     e3: Option<f64>,
     frame_given: bool,
+    plate: Plate,
 ) -> Result<AxisSettings, ApiError> {
+    if plate == Plate::Turntable {
+        return turntable_values(e1, e2, e3, frame_given);
+    }
     if let Some(rotate) = e3 {
         let (Some(track), Some(tilt)) = (e1, e2) else {
             return Err(ApiError::invalid(
@@ -160,6 +286,7 @@ pub fn axis_values(
         return Ok(AxisSettings {
             track_mm: Some(track),
             positioner_deg: Some(plate),
+            plate: Plate::Positioner,
         });
     }
     let (tilt, rotate) = match (e1, e2) {
@@ -167,6 +294,7 @@ pub fn axis_values(
             return Ok(AxisSettings {
                 track_mm: e1,
                 positioner_deg: None,
+                plate: Plate::Positioner,
             })
         }
         (None, Some(_)) => {
@@ -179,6 +307,7 @@ pub fn axis_values(
     Ok(AxisSettings {
         track_mm: None,
         positioner_deg: Some(positioner_values(tilt, rotate, frame_given, ["e1", "e2"])?),
+        plate: Plate::Positioner,
     })
 }
 

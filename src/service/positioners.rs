@@ -395,16 +395,35 @@ impl PlateValues {
     }
 }
 
+/// What carries the part whose values a request gives: the robot's stored
+/// two-axis positioner (the default), or its stored one-axis turntable,
+/// composed as the positioner whose axis 1 stands at 0
+/// (`Turntable::as_tilt_rotate`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum Plate {
+    /// The stored tilt-rotate positioner: tilt and rotate values.
+    #[default]
+    Positioner,
+    /// The stored one-axis turntable: its value is the rotate value, the
+    /// tilt held at 0.
+    Turntable,
+}
+
 /// The robot's stored positioner for a targets CSV with a positioner's
 /// columns: `e1` and `e2` (`beside_track` false), or `e2` and `e3` beside
 /// the track's `e1`. No positioner is a `Conflict` (the robot's state), and
 /// so is a robot with a track too when the rows give `e1` and `e2` alone
-/// (`e1` would be either's value: ambiguous).
+/// (`e1` would be either's value: ambiguous). With `Plate::Turntable` the
+/// robot's stored turntable instead (`super::turntables::for_plate`).
 pub async fn for_rows(
     state: &AppState,
     robot_id: i64,
     beside_track: bool,
+    plate: Plate,
 ) -> Result<TiltRotate, ServiceError> {
+    if plate == Plate::Turntable {
+        return super::turntables::for_plate(state, robot_id, beside_track).await;
+    }
     let Some(row) = state.db().positioner(robot_id).await? else {
         let columns = if beside_track {
             "`e1`, `e2` and `e3` columns, a track's value and a positioner's tilt and rotate values per row,"
@@ -444,11 +463,16 @@ pub async fn stored_for(
 /// (`e1` and `e2`, or `e2` and `e3` beside the track's `e1`): no positioner
 /// is a `Conflict`, and so is a robot with a track too given `e1` and `e2`
 /// alone (`e1` would be either's value: ambiguous), as for a targets CSV.
+/// With `Plate::Turntable` the robot's stored turntable instead.
 pub async fn for_predict(
     state: &AppState,
     robot_id: i64,
     beside_track: bool,
+    plate: Plate,
 ) -> Result<TiltRotate, ServiceError> {
+    if plate == Plate::Turntable {
+        return super::turntables::for_plate(state, robot_id, beside_track).await;
+    }
     let Some(row) = state.db().positioner(robot_id).await? else {
         super::robots::get(state, robot_id).await?;
         let fields = if beside_track {

@@ -48,6 +48,9 @@ pub struct PredictCommand {
     pub track_mm: Option<f64>,
     /// The positioner's values [deg]: the poses in its face plate frame.
     pub positioner_deg: Option<robocal_core::solve::external::AxisValues>,
+    /// What carries the part at those values: the stored positioner, or
+    /// the stored turntable (its value the rotate value, the tilt 0).
+    pub plate: super::positioners::Plate,
 }
 
 /// What a prediction produced.
@@ -158,9 +161,13 @@ pub async fn predict(
     );
     let (frame, label) = match &cmd.work_object {
         None if cmd.positioner_deg.is_some() => {
-            let positioner =
-                super::positioners::for_predict(state, cmd.robot_id, cmd.track_mm.is_some())
-                    .await?;
+            let positioner = super::positioners::for_predict(
+                state,
+                cmd.robot_id,
+                cmd.track_mm.is_some(),
+                cmd.plate,
+            )
+            .await?;
             let values = cmd.positioner_deg.unwrap_or(AxisValues {
                 tilt_deg: 0.0,
                 rotate_deg: 0.0,

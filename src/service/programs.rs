@@ -12,7 +12,7 @@ use crate::program::{
     filter_with, FilterAxes, FilterControl, FilterError, FilterOutput, Language, ProgramFile,
 };
 use crate::solve::ik::IkSettings;
-use robocal_core::model::external::{LinearTrack, TiltRotate};
+use robocal_core::model::external::{LinearTrack, TiltRotate, Turntable};
 
 /// A filter, in domain terms.
 #[derive(Debug, Clone)]
@@ -30,6 +30,10 @@ pub struct FilterCommand {
     /// the work objects on the face plate turn with the robot's stored
     /// positioner, the program's axes 1 and 2 (`core::program::axes`).
     pub controller_positioner: Option<TiltRotate>,
+    /// The controller's own one-axis turntable (its world as the
+    /// positioner's): the work objects on the face plate turn with the
+    /// robot's stored turntable, the program's axis 1 (2 beside a track).
+    pub controller_turntable: Option<Turntable>,
     /// Rewrite the axes' values so the real axes stand where the controller
     /// believes the programmed values put them (`core::program::axes`).
     pub correct_axes: bool,
@@ -65,13 +69,19 @@ pub async fn filter_program(
         )),
         None => None,
     };
-    let positioners = match cmd.controller_positioner {
-        Some(nominal) => Some((
+    let positioners = match (cmd.controller_positioner, &cmd.controller_turntable) {
+        (Some(nominal), _) => Some((
             super::positioners::stored_for(state, cmd.robot_id, "controller_positioner").await?,
             nominal,
         )),
-        None => None,
+        // A turntable is the positioner whose axis 1 stands at 0.
+        (None, Some(nominal)) => Some((
+            super::turntables::stored_for(state, cmd.robot_id, "controller_turntable").await?,
+            nominal.as_tilt_rotate(),
+        )),
+        (None, None) => None,
     };
+    let turntable = cmd.controller_turntable.is_some();
     let mut model = chosen.model;
     if let Some(p) = cmd.payload_kg {
         model.payload_kg = p;
@@ -84,14 +94,18 @@ pub async fn filter_program(
             max_targets: Some(max_targets),
             keep_going: &|| flag.still_waiting(),
         };
+        let mut axes = FilterAxes::of_cell(tracks.as_ref(), positioners.as_ref())
+            .correcting_values(cmd.correct_axes);
+        if turntable {
+            axes = axes.turntable();
+        }
         let out = filter_with(
             language,
             &files,
             &cell,
             &model,
             &IkSettings::default(),
-            &FilterAxes::of_cell(tracks.as_ref(), positioners.as_ref())
-                .correcting_values(cmd.correct_axes),
+            &axes,
             &control,
         );
         if matches!(out, Err(FilterError::Cancelled)) {

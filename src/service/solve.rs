@@ -180,6 +180,9 @@ pub struct SolveCommand {
     /// frame: moved into the base frame through the robot's stored
     /// positioner as a targets CSV's rows at those values are.
     pub positioner_deg: Option<AxisValues>,
+    /// What carries the part at those values: the stored positioner, or
+    /// the stored turntable (its value the rotate value, the tilt 0).
+    pub plate: super::positioners::Plate,
 }
 
 /// A tool or work object of a solve: stored by name, or given inline.
@@ -461,7 +464,8 @@ async fn place_on_axes(
         match cmd.positioner_rows.take() {
             // Beside a positioner: the rows are on its face plate.
             Some(plate) => {
-                let positioner = super::positioners::for_rows(state, cmd.robot_id, true).await?;
+                let positioner =
+                    super::positioners::for_rows(state, cmd.robot_id, true, cmd.plate).await?;
                 place_on_track_and_positioner(
                     csv,
                     &values,
@@ -480,7 +484,8 @@ async fn place_on_axes(
     if let Some(values) = cmd.positioner_deg.take() {
         // Beside the track's `e1`, the solver's model is carried to it.
         let positioner =
-            super::positioners::for_predict(state, cmd.robot_id, cmd.track_mm.is_some()).await?;
+            super::positioners::for_predict(state, cmd.robot_id, cmd.track_mm.is_some(), cmd.plate)
+                .await?;
         let robot = cell_solver.solver().model();
         match &mut cmd.targets {
             Targets::Csv(csv) => {
@@ -501,7 +506,8 @@ async fn place_on_axes(
         cmd.options.frame = TargetFrame::Base;
     }
     if let Some(values) = cmd.positioner_rows.take() {
-        let positioner = super::positioners::for_rows(state, cmd.robot_id, false).await?;
+        let positioner =
+            super::positioners::for_rows(state, cmd.robot_id, false, cmd.plate).await?;
         let Targets::Csv(csv) = &mut cmd.targets else {
             return Err(ServiceError::Internal(
                 "a positioner's values per row come with a targets CSV".into(),

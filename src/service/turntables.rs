@@ -19,7 +19,7 @@ use robocal_core::calibrate::external::turntable::{
 };
 use robocal_core::measure::csv::parse_set;
 use robocal_core::measure::external::ExternalAxis;
-use robocal_core::model::external::Turntable;
+use robocal_core::model::external::{TiltRotate, Turntable};
 use robocal_core::stats::ErrorStats;
 use serde::Serialize;
 
@@ -209,4 +209,44 @@ pub fn model_of(row: &TurntableRow) -> Result<Turntable, ServiceError> {
     Turntable::from_json(&row.turntable_json).map_err(|e| {
         ServiceError::Internal(format!("stored turntable of robot {}: {e}", row.robot_id))
     })
+}
+
+/// The robot's stored turntable for a solve, a prediction or a filter at its
+/// values, as the positioner whose axis 1 stands at 0: its value `e1`, or
+/// `e2` beside the track's `e1` (`beside_track`). No turntable is a
+/// `Conflict` (the robot's state), and so is a robot with a track given the
+/// turntable's value alone (the robot's place on the track unknown).
+pub async fn for_plate(
+    state: &AppState,
+    robot_id: i64,
+    beside_track: bool,
+) -> Result<TiltRotate, ServiceError> {
+    let Some(row) = state.db().turntable(robot_id).await? else {
+        super::robots::get(state, robot_id).await?;
+        return Err(ServiceError::Conflict(format!(
+            "`turntable`: robot {robot_id} has no turntable; fit one with POST /v1/robots/{robot_id}/turntable/calibrate, or leave `turntable` out"
+        )));
+    };
+    if !beside_track && state.db().track(robot_id).await?.is_some() {
+        return Err(ServiceError::Conflict(format!(
+            "robot {robot_id} rides a track: with `turntable`, give the track's value `e1` [mm] and the turntable's `e2` [deg], as its programs number them"
+        )));
+    }
+    Ok(model_of(&row)?.as_tilt_rotate())
+}
+
+/// The robot's stored turntable, composed as a positioner, for a program
+/// filter's `field` (`Conflict` naming it when the robot has none).
+pub async fn stored_for(
+    state: &AppState,
+    robot_id: i64,
+    field: &str,
+) -> Result<TiltRotate, ServiceError> {
+    let Some(row) = state.db().turntable(robot_id).await? else {
+        super::robots::get(state, robot_id).await?;
+        return Err(ServiceError::Conflict(format!(
+            "`{field}`: robot {robot_id} has no turntable; fit one with POST /v1/robots/{robot_id}/turntable/calibrate, or leave `{field}` out"
+        )));
+    };
+    Ok(model_of(&row)?.as_tilt_rotate())
 }

@@ -77,3 +77,4 @@ mod track;
 mod track_filter;
 mod track_sets;
 mod turntable;
+mod turntable_use;

@@ -52,7 +52,7 @@ const COLUMNS: PositionerColumns = PositionerColumns {
 
 /// The positioner base 1.7 m in front of the robot's base, turned 30°,
 /// stated in the cell frame the robot is registered in (`robot`).
-fn placed(robot: &Pose) -> Pose {
+pub(crate) fn placed(robot: &Pose) -> Pose {
     robot.compose(&Pose::new(
         rpy_matrix(0.0, 0.0, 30f64.to_radians()),
         Vector3::new(1.7, 0.3, -0.9),
@@ -113,7 +113,7 @@ pub(crate) fn cli(args: &[&str]) -> anyhow::Result<String> {
     }
 }
 
-fn path(p: &Path) -> &str {
+pub(crate) fn path(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 

@@ -29,8 +29,8 @@ const FILTER: &str = "/v1/robots/{id}/programs/filter";
 const FRAME: &str = "/v1/robots/{id}/frames/{name}";
 
 /// The part on the face plate: 120 mm out, 60 mm above it, turned 20°.
-const PART_XYZ_MM: [f64; 3] = [120.0, 80.0, 60.0];
-const PART_RPY_DEG: [f64; 3] = [0.0, 0.0, 20.0];
+pub(crate) const PART_XYZ_MM: [f64; 3] = [120.0, 80.0, 60.0];
+pub(crate) const PART_RPY_DEG: [f64; 3] = [0.0, 0.0, 20.0];
 
 /// The controller's positioner: `nominal` (cell frame) seen from the
 /// robot's base, `robot_in_cell` the robot's registration.
@@ -53,7 +53,7 @@ fn request(src: &str, dat: &str, positioner: &TiltRotate) -> Value {
 }
 
 /// The part on the face plate (`PART_XYZ_MM`, `PART_RPY_DEG`).
-fn part_pose() -> Pose {
+pub(crate) fn part_pose() -> Pose {
     Pose::new(
         robocal::model::pose::rpy_matrix(0.0, 0.0, PART_RPY_DEG[2].to_radians()),
         Vector3::from(PART_XYZ_MM) * 1e-3,
@@ -64,7 +64,11 @@ fn part_pose() -> Pose {
 /// poses the nominal controller gives the reflector at random joints, each
 /// in its target's part frame as the controller computes it (base frame),
 /// with those joints' flags and the target's external axes (`E1 …,E2 …`).
-fn program(name: &str, targets: &[(Pose, String)], rng: &mut ChaCha8Rng) -> (String, String) {
+pub(crate) fn program(
+    name: &str,
+    targets: &[(Pose, String)],
+    rng: &mut ChaCha8Rng,
+) -> (String, String) {
     let nominal = preset("ys100").unwrap();
     let ik = AnalyticIk::new(&nominal).unwrap();
     let mut src = krl_head(name, "BAS(#BASE, 3)");
