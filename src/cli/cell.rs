@@ -56,16 +56,23 @@ pub struct CellExportArgs {
     /// KRL: the calibrated positioner (`robocal positioner calibrate`'s
     /// output) whose axes are written as an external kinematic system; work
     /// objects on its face plate become bases coupled to it.
-    #[arg(long, conflicts_with = "track")]
+    #[arg(long, conflicts_with_all = ["track", "turntable"])]
     pub positioner: Option<String>,
     /// KRL: the calibrated track (`robocal track calibrate`'s output) whose
     /// axis is written as the robot's root kinematic system; work objects are
     /// written in the world, the cell frame.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "turntable")]
     pub track: Option<String>,
-    /// Writes the positioner or track the controller computes from the
-    /// exported data (scales 1, no carriage maps): the filter's
-    /// `--nominal-positioner` or `--nominal-track` once the controller holds it.
+    /// KRL: the calibrated one-axis turntable (`robocal turntable
+    /// calibrate`'s output) whose axis is written as an external kinematic
+    /// system with one axis; work objects on its face plate become bases
+    /// coupled to it.
+    #[arg(long)]
+    pub turntable: Option<String>,
+    /// Writes the positioner, track or turntable the controller computes
+    /// from the exported data (scales 1, no carriage maps): the filter's
+    /// `--nominal-positioner`, `--nominal-track` or `--nominal-turntable`
+    /// once the controller holds it.
     #[arg(long)]
     pub held: Option<String>,
 }
@@ -79,15 +86,18 @@ pub fn export_to_string(a: &CellExportArgs) -> anyhow::Result<String> {
     let cell = CellDescription::from_json(&text)
         .and_then(|d| d.to_cell())
         .with_context(|| a.cell.clone())?;
-    let axes = match (&a.positioner, &a.track) {
-        (Some(p), _) => Some(ExternalAxes::Positioner(
+    let axes = match (&a.positioner, &a.track, &a.turntable) {
+        (Some(p), _, _) => Some(ExternalAxes::Positioner(
             super::positioner::read_positioner(p)?,
         )),
-        (None, Some(t)) => Some(ExternalAxes::Track(super::track::read_track(t)?)),
-        (None, None) => None,
+        (None, Some(t), _) => Some(ExternalAxes::Track(super::track::read_track(t)?)),
+        (None, None, Some(t)) => Some(ExternalAxes::Turntable(super::turntable::read_turntable(
+            t,
+        )?)),
+        (None, None, None) => None,
     };
     if a.held.is_some() && axes.is_none() {
-        anyhow::bail!("--held writes the positioner or track the controller holds: give --positioner or --track");
+        anyhow::bail!("--held writes the positioner, track or turntable the controller holds: give --positioner, --track or --turntable");
     }
     let options = ExportOptions {
         registers: a.registers,

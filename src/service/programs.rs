@@ -76,7 +76,9 @@ pub async fn filter_program(
         )),
         // A turntable is the positioner whose axis 1 stands at 0.
         (None, Some(nominal)) => Some((
-            super::turntables::stored_for(state, cmd.robot_id, "controller_turntable").await?,
+            super::turntables::stored_for(state, cmd.robot_id, "controller_turntable")
+                .await?
+                .as_tilt_rotate(),
             nominal.as_tilt_rotate(),
         )),
         (None, None) => None,
@@ -165,6 +167,9 @@ pub async fn export_cell(
         )),
         Some(KinematicKind::Track) => Some(ExternalAxes::Track(
             super::tracks::stored_for(state, robot_id, "axes").await?,
+        )),
+        Some(KinematicKind::Turntable) => Some(ExternalAxes::Turntable(
+            super::turntables::stored_for(state, robot_id, "axes").await?,
         )),
         None => None,
     };

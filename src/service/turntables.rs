@@ -235,18 +235,18 @@ pub async fn for_plate(
     Ok(model_of(&row)?.as_tilt_rotate())
 }
 
-/// The robot's stored turntable, composed as a positioner, for a program
-/// filter's `field` (`Conflict` naming it when the robot has none).
+/// The robot's stored turntable for a program filter's or a cell export's
+/// `field` (`Conflict` naming it when the robot has none).
 pub async fn stored_for(
     state: &AppState,
     robot_id: i64,
     field: &str,
-) -> Result<TiltRotate, ServiceError> {
+) -> Result<Turntable, ServiceError> {
     let Some(row) = state.db().turntable(robot_id).await? else {
         super::robots::get(state, robot_id).await?;
         return Err(ServiceError::Conflict(format!(
             "`{field}`: robot {robot_id} has no turntable; fit one with POST /v1/robots/{robot_id}/turntable/calibrate, or leave `{field}` out"
         )));
     };
-    Ok(model_of(&row)?.as_tilt_rotate())
+    model_of(&row)
 }

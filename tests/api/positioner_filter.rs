@@ -224,9 +224,10 @@ pub(crate) async fn filters_as_the_command_line(
     );
 }
 
-/// A stored positioner's or track's axes, its file and the cell's file.
+/// A stored positioner's, track's or turntable's axes, its file and the
+/// cell's file.
 pub(crate) struct Axes<'a> {
-    /// `positioner` or `track`.
+    /// `positioner`, `track` or `turntable`.
     pub kind: &'a str,
     /// The stored positioner's or track's file.
     pub file: &'a Path,
@@ -234,10 +235,10 @@ pub(crate) struct Axes<'a> {
     pub cell: &'a Path,
 }
 
-/// The cell exported for KUKA with the stored positioner's or track's axes
-/// (`"axes": kind`) and by `robocal cell export --positioner|--track
-/// --held` with its file: the same text, byte for byte, and the same held
-/// positioner or track, scales 1; RAPID with `axes` is a 422, the kind the
+/// The cell exported for KUKA with the stored positioner's, track's or
+/// turntable's axes (`"axes": kind`) and by `robocal cell export
+/// --positioner|--track|--turntable --held` with its file: the same text,
+/// byte for byte, and the same held positioner, track or turntable, scales 1; RAPID with `axes` is a 422, the kind the
 /// robot has not a 409.
 pub(crate) async fn exports_as_the_command_line(
     t: &TestApp,
@@ -259,6 +260,7 @@ pub(crate) async fn exports_as_the_command_line(
     let text = http["text"].as_str().unwrap();
     let (mech, scale) = match axes.kind {
         "positioner" => ("#EASYS", "tilt scale"),
+        "turntable" => ("#EASYS", "turntable scale"),
         _ => ("#ERSYS", "track scale"),
     };
     assert!(text.contains(&format!("$EX_KIN={{ET1 {mech},")), "{text}");
@@ -305,6 +307,7 @@ pub(crate) async fn exports_as_the_command_line(
             ),
             (Some(1.0), Some(1.0))
         ),
+        "turntable" => assert_eq!(written["axis"]["scale"].as_f64(), Some(1.0)),
         _ => assert_eq!(written["scale"].as_f64(), Some(1.0)),
     }
 

@@ -3,7 +3,10 @@
 //! `turntable` and `e1`, and a KRL program filtered with
 //! `controller_turntable`, each against the command line's `solve
 //! --turntable`, `predict --turntable --e1` and `filter --turntable
-//! --nominal-turntable` on the same files. The turntable is the example one
+//! --nominal-turntable` on the same files; the cell exported for KUKA with
+//! `"axes": "turntable"` against `cell export --turntable --held`; and on a
+//! robot riding a track too, `e1` the track's value and `e2` the
+//! turntable's. The turntable is the example one
 //! (`sim::turntable_example`: an axis tilted and offset from the nominal
 //! one, a zero offset, a scale error and a nod the model lacks), placed
 //! 1.7 m in front of the calibrated robot and fitted over HTTP. The robot's
@@ -516,6 +519,12 @@ async fn filters(
     ]
     .map(String::from);
     super::track_filter::assert_cli_gives(&http, argv, &out);
+    let axes = super::positioner_filter::Axes {
+        kind: "turntable",
+        file: &d.join("t.json"),
+        cell: &d.join("cell.json"),
+    };
+    super::positioner_filter::exports_as_the_command_line(t, rid, model, &axes, d).await;
 }
 
 /// The robot on a track too: the turntable's value alone is a 409 (the

@@ -1,4 +1,4 @@
-//! `cell export` with a positioner's or a track's axes (KRL: a KUKA external
+//! `cell export` with a positioner's, a turntable's or a track's axes (KRL: a KUKA external
 //! kinematic system). The exported text is read back here with this file's
 //! own reader and composed as the controller composes it,
 //! `ROOT·TA1KR·J1(E1)·TA2A1·J2(E2)·TA3A2·TFLA3` with `J` a turn about or a
@@ -10,7 +10,9 @@
 use super::*;
 use crate::common::positioner as example;
 use nalgebra::{Isometry3, Rotation3, Translation3, UnitQuaternion};
-use robocal_core::model::external::{LinearTrack, RotaryAxis, TiltRotate, Travel, TravelMap};
+use robocal_core::model::external::{
+    LinearTrack, RotaryAxis, TiltRotate, Travel, TravelMap, Turntable,
+};
 use robocal_core::model::pose::rpy_matrix;
 use robocal_core::program::controller::{
     export_cell, ExportError, ExportOptions, ExternalAxes, HeldAxes, ANGLE_ARM_MM, SCALE_RADIUS_MM,
@@ -405,4 +407,102 @@ fn the_held_positioner_differs_from_the_calibrated_one_only_by_its_scales() {
     let want = base_from_cell.compose(&p.cell_from_base);
     assert!((held.cell_from_base.p - want.p).norm() < 1e-12);
     assert!((held.cell_from_base.r - want.r).norm() < 1e-12);
+}
+
+/// The calibrated turntable: the example's drawing with its axis tilted by
+/// 0.05° about x, moved by 0.5 mm, a zero offset of −0.4° and a scale off by
+/// `scale_error`.
+fn calibrated_turntable(scale_error: f64) -> Turntable {
+    let d = robocal_core::sim::turntable_example::nominal();
+    let tilt = Rotation3::from_axis_angle(&Vector3::x_axis(), 0.05f64.to_radians());
+    Turntable {
+        axis: RotaryAxis::new(
+            tilt * d.axis.direction,
+            d.axis.point + Vector3::new(0.0005, -0.0002, 0.0),
+            (-0.4f64).to_radians(),
+            1.0 + scale_error,
+        ),
+        ..d
+    }
+}
+
+#[test]
+fn a_turntable_exported_for_kuka_composes_to_the_calibrated_turntable() {
+    let (model, cell, part) = positioner_cell();
+    let base_from_cell = model.cell_from_base.inverse();
+    for scale_error in [0.0, -1.5e-4] {
+        let t = calibrated_turntable(scale_error);
+        let options = ExportOptions {
+            axes: Some(ExternalAxes::Turntable(t)),
+            ..Default::default()
+        };
+        let out = export_cell(Language::Krl, &cell, &model, &options).unwrap();
+        let text = &out.text;
+        assert!(text.contains("$EX_KIN={ET1 #EASYS,"), "{text}");
+        assert!(text.contains("$ET1_AX={TR_A1 #E1,TR_A2 #NONE,TR_A3 #NONE}"));
+        assert!(text.contains("NAME[] \"TURNTABLE\""), "{text}");
+        assert!(
+            text.contains("; BASE_DATA[3] part is on the face plate: $BASE=EK(MACHINE_DEF[2].ROOT,MACHINE_DEF[2].MECH_TYPE,BASE_DATA[3])"),
+            "{text}"
+        );
+        let k = out.kinematics.as_ref().unwrap();
+        let HeldAxes::Turntable(held) = &k.held else {
+            panic!("{:?}", k.held)
+        };
+        let base3 = frame_after(text, "BASE_DATA[3]=");
+        let (mut worst_held, mut worst_calibrated) = ((0.0f64, 0.0f64), 0.0f64);
+        for v in values().iter().map(|v| v[1]) {
+            // One axis: E2 is #NONE, so no joint between TA2A1 and TA3A2.
+            let got = frame_after(text, ",ROOT ")
+                * frame_after(text, "$ET1_TA1KR=")
+                * turn(v)
+                * frame_after(text, "$ET1_TA2A1=")
+                * frame_after(text, "$ET1_TA3A2=")
+                * frame_after(text, "$ET1_TFLA3=")
+                * base3;
+            let held_part = iso(&held.cell_from_face_plate(v).compose(&part));
+            let (d, a) = apart(&got, &held_part);
+            worst_held = (worst_held.0.max(d), worst_held.1.max(a));
+            let calibrated = iso(&base_from_cell
+                .compose(&t.cell_from_face_plate(v))
+                .compose(&part));
+            worst_calibrated = worst_calibrated.max(apart(&got, &calibrated).0);
+        }
+        eprintln!(
+            "turntable scale error {scale_error}: chain vs held {:.2e} mm / {:.2e} rad; vs calibrated {worst_calibrated:.4} mm (not held: {:?})",
+            worst_held.0, worst_held.1, k.not_held
+        );
+        assert!(
+            worst_held.0 < ROUNDING_MM && worst_held.1 < 1e-9,
+            "{worst_held:?}"
+        );
+        if scale_error == 0.0 {
+            assert!(k.not_held.is_empty(), "{:?}", k.not_held);
+            assert!(worst_calibrated < ROUNDING_MM, "{worst_calibrated}");
+            assert!(text.contains("; every calibrated term is held"));
+        } else {
+            let names: Vec<&str> = k.not_held.iter().map(|n| n.term.as_str()).collect();
+            assert_eq!(names, ["turntable scale"]);
+            let want = 1.5e-4 * SCALE_TURN_DEG.to_radians() * SCALE_RADIUS_MM;
+            assert!((k.not_held[0].miss_mm - want).abs() < 1e-12);
+            // The part is within 500 mm of the axis: the scale's miss at
+            // 500 mm over 180° bounds it.
+            assert!(
+                worst_calibrated > 0.01 && worst_calibrated <= want,
+                "{worst_calibrated} vs {want}"
+            );
+            assert!(text.contains(
+                "the filter corrects it when given this chain as its controller turntable"
+            ));
+        }
+        assert_eq!(held.axis.scale, 1.0);
+        assert_eq!(held.axis.zero_offset, t.axis.zero_offset);
+        let want = base_from_cell.compose(&t.cell_from_base);
+        assert!((held.cell_from_base.p - want.p).norm() < 1e-12);
+        // The fixture, measured in the tracker frame: in the robot's base frame.
+        let fixture = frame_after(text, "BASE_DATA[2]=");
+        let want = iso(&model.cell_to_base(&cell.work_objects[0].pose));
+        let (d, a) = apart(&fixture, &want);
+        assert!(d < 1e-6 && a < 1e-9, "{d} {a}");
+    }
 }

@@ -18,12 +18,17 @@
 //!   frame; axis k's frame has its origin at the calibrated line's point
 //!   closest to its parent's origin and z along the line; a zero offset `δ`
 //!   is the next link turned by `Rz(δ)` (exact).
+//! - A one-axis turntable is a base kinematic system with one axis
+//!   (`#EASYS`, `E1` its axis, `TR_A2 #NONE`): the positioner's root and
+//!   flange; `$ET1_TA1KR` the axis frame, `$ET1_TA2A1` and `$ET1_TA3A2`
+//!   identities, `$ET1_TFLA3` the face plate from the axis (its zero offset
+//!   `Rz(δ)` first).
 //! - A track is a robot-root kinematic system (`#ERSYS`, `E1`): its root
 //!   `$ERSYSROOT` sits on the rail at value 0 with z along the rail (the
 //!   cell frame is the world, as for the filter's controller track), the
 //!   flange is the robot's base frame.
 //!
-//! Not held: a rotary axis's or the track's scale (the controller turns or
+//! Not held: a rotary axis's, the turntable's or the track's scale (the controller turns or
 //! moves its frame by the value; the gear ratio is the drive's) and the
 //! carriage's maps along the rail. [`KukaKinematics::held`] is what the
 //! controller then computes: given to the filter as its controller
@@ -32,7 +37,7 @@
 //! `R = Rz(A)·Ry(B)·Rx(C)`.
 
 use super::frames::kuka_frame;
-use crate::model::external::{CarriageTerm, LinearTrack, TiltRotate, TravelMap};
+use crate::model::external::{CarriageTerm, LinearTrack, TiltRotate, TravelMap, Turntable};
 use crate::model::pose::rpy_matrix;
 use crate::model::Pose;
 use nalgebra::{Matrix3, Vector3};
@@ -55,9 +60,12 @@ pub enum ExternalAxes {
     Positioner(TiltRotate),
     /// A track in the cell frame, the controller's world.
     Track(LinearTrack),
+    /// A one-axis turntable in the cell frame the robot's model is
+    /// registered in.
+    Turntable(Turntable),
 }
 
-/// The two kinds of external kinematic system written (the HTTP export's
+/// The kinds of external kinematic system written (the HTTP export's
 /// `axes`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -67,6 +75,9 @@ pub enum KinematicKind {
     /// A linear track carrying the robot: a robot-root kinematic system,
     /// `#ERSYS`.
     Track,
+    /// A one-axis turntable: a base kinematic system with one axis,
+    /// `#EASYS`.
+    Turntable,
 }
 
 /// The axes as the controller holds them.
@@ -76,6 +87,8 @@ pub enum HeldAxes {
     Positioner(TiltRotate),
     /// The track the chain computes, in the cell frame.
     Track(LinearTrack),
+    /// The turntable the chain computes, stated in the robot's base frame.
+    Turntable(Turntable),
 }
 
 /// One calibrated term the controller's chain cannot hold.
@@ -166,6 +179,39 @@ pub fn kuka_positioner(p: &TiltRotate, world_from_cell: &Pose) -> KukaKinematics
     }
 }
 
+/// The calibrated turntable `t` (in the cell frame) as a one-axis base
+/// kinematic system in the robot's base frame, `world_from_cell` the
+/// calibrated model's base-from-cell.
+pub fn kuka_turntable(t: &Turntable, world_from_cell: &Pose) -> KukaKinematics {
+    let root = world_from_cell.compose(&t.cell_from_base);
+    let f1 = axis_frame(&t.axis.direction, t.axis.point);
+    let links = [
+        f1,
+        Pose::identity(),
+        Pose::identity(),
+        rz(t.axis.zero_offset).compose(&f1.inverse().compose(&t.face_plate)),
+    ];
+    let mut held = *t;
+    held.cell_from_base = root;
+    held.axis.scale = 1.0;
+    let not_held = (t.axis.scale != 1.0)
+        .then(|| NotHeld {
+            term: "turntable scale".into(),
+            value: t.axis.scale,
+            unit: "",
+            miss_mm: (t.axis.scale - 1.0).abs() * SCALE_TURN_DEG.to_radians() * SCALE_RADIUS_MM,
+        })
+        .into_iter()
+        .collect();
+    KukaKinematics {
+        kind: KinematicKind::Turntable,
+        root,
+        links,
+        held: HeldAxes::Turntable(held),
+        not_held,
+    }
+}
+
 /// The calibrated track `t` (in the cell frame, the controller's world) as a
 /// robot-root kinematic system.
 pub fn kuka_track(t: &LinearTrack) -> KukaKinematics {
@@ -229,6 +275,7 @@ impl KukaKinematics {
         match &self.held {
             HeldAxes::Positioner(p) => p.to_json(),
             HeldAxes::Track(t) => t.to_json(),
+            HeldAxes::Turntable(t) => t.to_json(),
         }
     }
 
@@ -246,6 +293,11 @@ impl KukaKinematics {
             KinematicKind::Track => (
                 "the calibrated track as external kinematic system ET1 (E1 the carriage), its flange the robot's base; the world is the cell frame",
                 "#ERSYS",
+                "{TR_A1 #E1,TR_A2 #NONE,TR_A3 #NONE}",
+            ),
+            KinematicKind::Turntable => (
+                "the calibrated turntable as external kinematic system ET1 (E1 its axis), its flange the face plate; the world is the robot's base frame ($ROBROOT the null frame)",
+                "#EASYS",
                 "{TR_A1 #E1,TR_A2 #NONE,TR_A3 #NONE}",
             ),
         };
@@ -266,14 +318,18 @@ impl KukaKinematics {
         for (name, link) in ["TA1KR", "TA2A1", "TA3A2", "TFLA3"].iter().zip(&self.links) {
             let _ = writeln!(s, "FRAME $ET1_{name}={}", kuka_frame(link));
         }
-        if self.kind == KinematicKind::Positioner {
+        if self.kind != KinematicKind::Track {
+            let name = match self.kind {
+                KinematicKind::Turntable => "TURNTABLE",
+                _ => "POSITIONER",
+            };
             let _ = writeln!(
                 s,
                 "; $config.dat: the root in the world (MACHINE_DEF[1] is the robot)"
             );
             let _ = writeln!(
                 s,
-                "MACHINE_DEF[2]={{NAME[] \"POSITIONER\",COOP_KRC_INDEX 1,PARENT[] \"WORLD\",ROOT {},MECH_TYPE #EASYS,GEOMETRY[] \" \"}}",
+                "MACHINE_DEF[2]={{NAME[] \"{name}\",COOP_KRC_INDEX 1,PARENT[] \"WORLD\",ROOT {},MECH_TYPE #EASYS,GEOMETRY[] \" \"}}",
                 kuka_frame(&self.root)
             );
         }
@@ -286,6 +342,7 @@ impl KukaKinematics {
                 match self.kind {
                     KinematicKind::Positioner => "positioner",
                     KinematicKind::Track => "track",
+                    KinematicKind::Turntable => "turntable",
                 }
             );
             for n in &self.not_held {

@@ -43,8 +43,8 @@ pub use data::{
 };
 use frames::{abb_frame, kuka_frame, ur_pose};
 pub use kinematics::{
-    kuka_positioner, kuka_track, ExternalAxes, HeldAxes, KinematicKind, KukaKinematics, NotHeld,
-    ANGLE_ARM_MM, SCALE_RADIUS_MM, SCALE_TURN_DEG,
+    kuka_positioner, kuka_track, kuka_turntable, ExternalAxes, HeldAxes, KinematicKind,
+    KukaKinematics, NotHeld, ANGLE_ARM_MM, SCALE_RADIUS_MM, SCALE_TURN_DEG,
 };
 pub use names::{RenameReason, Renamed};
 pub use numbers::{NumberRange, RegisterRange, UsedRegister};
@@ -125,6 +125,9 @@ pub fn export_cell(
         Some(_) if language != Language::Krl => return Err(ExportError::AxesNotWritten(language)),
         Some(ExternalAxes::Positioner(p)) => {
             Some(kuka_positioner(p, &model.cell_to_base(&Pose::identity())))
+        }
+        Some(ExternalAxes::Turntable(t)) => {
+            Some(kuka_turntable(t, &model.cell_to_base(&Pose::identity())))
         }
         Some(ExternalAxes::Track(t)) => {
             if let Some(w) = on(WorkObjectFrame::FacePlate) {
