@@ -348,3 +348,137 @@ fn solve_takes_targets_on_the_turntables_face_plate_at_each_rows_value() {
         "--turntable reads each row's value [deg] from an `e1` column",
     );
 }
+
+/// A turntable's measurement planned, read and fitted on the command line:
+/// `robocal plan --turntable` writes the sweep (`point,e1`, the library's
+/// plan byte for byte, its σ table beside it), the simulated tracker reads
+/// each reflector at every value (one export per reflector, naming the
+/// points), `plan join` turns each export into a measurement file with the
+/// axis's column and `turntable calibrate` fits them: accepted, its line on
+/// the truth's. Programs move the turntable alone through the plan's
+/// values: KRL `PTP {E1 …}`, RAPID `MoveExtJ`, Fanuc group 2's `J1`.
+#[test]
+fn a_planned_turntable_measurement_is_joined_and_fitted() {
+    use robocal::plan::{make_turntable_plan, plan_csv, TurntablePlanSettings};
+    use robocal::sim::turntable_example::DESIGN_MM;
+    let d = tempfile::tempdir().unwrap();
+    std::fs::write(d.path().join("nominal.json"), nominal().to_json()).unwrap();
+    let args = [
+        "plan",
+        "--turntable",
+        "nominal.json",
+        "--reflector",
+        "400,0,20",
+        "--reflector",
+        "-150,100,20",
+        "--travel=-120,150",
+        "--values",
+        "9",
+    ];
+    let with =
+        |extra: &[&'static str]| -> Vec<&str> { args.iter().chain(extra).copied().collect() };
+    let out = robocal(d.path(), &with(&["--out", "plan.csv"]));
+    assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+    let table = text(&out.stdout);
+    assert!(
+        table.starts_with("# 9 values of the turntable's axis over -120..150 deg"),
+        "{table}"
+    );
+    let plan = make_turntable_plan(
+        &nominal(),
+        &TurntablePlanSettings {
+            reflectors_mm: DESIGN_MM.to_vec(),
+            travel_deg: [-120.0, 150.0],
+            values: 9,
+            ..TurntablePlanSettings::default()
+        },
+    )
+    .unwrap();
+    let written = std::fs::read_to_string(d.path().join("plan.csv")).unwrap();
+    assert_eq!(written, plan_csv(&plan.points));
+    let t = truth(0.003);
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    for k in 0..2 {
+        let at: Vec<(usize, [f64; 2])> = plan.values_deg.iter().map(|v| (k, [0.0, *v])).collect();
+        let read = t.read(&at, &mut rng);
+        let export = core_common::tracker_export(
+            plan.points
+                .iter()
+                .zip(&read)
+                .map(|(p, r)| (p.name.as_str(), r.xyz_mm)),
+        );
+        std::fs::write(d.path().join(format!("nest{k}.csv")), export).unwrap();
+        let (nest, set) = (format!("nest{k}.csv"), format!("r{k}.csv"));
+        let out = robocal(
+            d.path(),
+            &[
+                "plan",
+                "join",
+                "--plan",
+                "plan.csv",
+                "--tracker-export",
+                &nest,
+                "--out",
+                &set,
+            ],
+        );
+        assert_eq!(code(&out), 0, "{}", text(&out.stderr));
+    }
+    let out = robocal(
+        d.path(),
+        &[
+            "turntable",
+            "calibrate",
+            "r0.csv",
+            "r1.csv",
+            "--nominal",
+            "nominal.json",
+            "--reflector",
+            "400,0,20",
+            "--reflector",
+            "-150,100,20",
+            "--out",
+            "t.json",
+        ],
+    );
+    assert_eq!(code(&out), 0, "{}{}", text(&out.stdout), text(&out.stderr));
+    let fitted =
+        Turntable::from_json(&std::fs::read_to_string(d.path().join("t.json")).unwrap()).unwrap();
+    let truth_direction = t.cell_from_base.r * t.rotate.direction;
+    let angle = fitted
+        .line_in_cell()
+        .direction
+        .angle(&truth_direction)
+        .to_degrees();
+    println!("planned turntable fit: its axis {angle:.5} deg from the truth's");
+    assert!(angle < 0.005, "{angle}");
+    for (format, first) in [
+        ("krl", "PTP {E1 -120.0000} ; P1\r\n"),
+        (
+            "rapid",
+            "MoveExtJ [[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09],[-120.0000,9E+09,9E+09,9E+09,9E+09,9E+09]], vrot10, fine; ! P1\r\n",
+        ),
+        ("fanuc", "\tJ1= -120.0000 deg\r\n"),
+    ] {
+        let out = robocal(d.path(), &with(&["--format", format, "--out", "tt.txt"]));
+        assert_eq!(code(&out), 0, "{format}: {}", text(&out.stderr));
+        let program = std::fs::read_to_string(d.path().join("tt.txt")).unwrap();
+        assert!(program.contains(first), "{format}: {first:?} in\n{program}");
+    }
+    // A reflector on the axis is refused before anything is written.
+    let out = robocal(
+        d.path(),
+        &[
+            "plan",
+            "--turntable",
+            "nominal.json",
+            "--reflector",
+            "5,0,20",
+            "--out",
+            "bad.csv",
+        ],
+    );
+    assert_eq!(code(&out), 1, "{}", text(&out.stderr));
+    assert!(text(&out.stderr).contains("reflector 1 is 5.0 mm from the axis"));
+    assert!(!d.path().join("bad.csv").exists());
+}

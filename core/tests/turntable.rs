@@ -199,3 +199,65 @@ fn fits_the_readings_cannot_carry_are_refused() {
     let r = refused(request(readings));
     assert_eq!((r.reason, r.row), (RefusalReason::NotFinite, Some(4)));
 }
+
+/// Standard deviation of `v` about its mean.
+fn spread_of(v: &[f64]) -> f64 {
+    let m = v.iter().sum::<f64>() / v.len() as f64;
+    (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() - 1) as f64).sqrt()
+}
+
+/// A turntable's plan (`plan::make_turntable_plan`: one sweep, every
+/// reflector at every value, 9 values over −120…150°, not the example's)
+/// read from the truth without its nod (noise alone) over 30 seeds and
+/// fitted: the fitted zero offset, scale, direction and reference
+/// reflector scatter as the plan predicted (within 2×, as the positioner's
+/// and the robot's plans are held).
+#[test]
+fn a_planned_turntable_measurement_scatters_as_predicted() {
+    use robocal_core::plan::{make_turntable_plan, plan_csv, TurntablePlanSettings};
+    let plan = make_turntable_plan(
+        &nominal(),
+        &TurntablePlanSettings {
+            reflectors_mm: DESIGN_MM.to_vec(),
+            travel_deg: [-120.0, 150.0],
+            values: 9,
+            ..TurntablePlanSettings::default()
+        },
+    )
+    .unwrap();
+    let text = plan_csv(&plan.points);
+    assert!(text.starts_with("point,e1\nP1,-120\n"), "{text}");
+    let t = truth(0.0);
+    let (mut zero, mut scale, mut directions) = (Vec::new(), Vec::new(), Vec::new());
+    for seed in 1..=30u64 {
+        let fit = fit_turntable(&request(read(&t, &plan.values_deg, seed)))
+            .unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+        zero.push(fit.model.axis.zero_offset.to_degrees());
+        scale.push(fit.model.axis.scale);
+        directions.push(fit.model.axis.direction);
+    }
+    let mean = directions.iter().sum::<Vector3<f64>>().normalize();
+    let direction_rms = (directions
+        .iter()
+        .map(|d| d.angle(&mean).powi(2))
+        .sum::<f64>()
+        / (directions.len() as f64 - 1.0))
+        .sqrt();
+    let s = plan.sigma;
+    for (name, empirical, predicted) in [
+        ("zero offset [deg]", spread_of(&zero), s.zero_offset_deg),
+        ("scale", spread_of(&scale), s.scale),
+        (
+            "direction [deg]",
+            direction_rms.to_degrees(),
+            s.direction_deg,
+        ),
+    ] {
+        let ratio = empirical / predicted;
+        println!("turntable {name}: predicted {predicted:.3e}, 30 fits {empirical:.3e}, ratio {ratio:.2}");
+        assert!(
+            (0.5..=2.0).contains(&ratio),
+            "{name}: {empirical} vs {predicted}"
+        );
+    }
+}

@@ -19,10 +19,10 @@
 //! `core::plan::track`); the reflector axis: tool frame.
 
 use crate::plan::{
-    join, make_plan, make_positioner_plan, make_track_plan, plan_csv, points_program,
-    program_columns, read_plan_csv, JoinBy, JoinOptions, MeasurementPlan, PlanPoint, PlanSettings,
-    PositionerPlan, PositionerPlanSettings, TrackPlan, TrackPlanSettings, TrackerSight, Units,
-    WorkspaceBox,
+    join, make_plan, make_positioner_plan, make_track_plan, make_turntable_plan, plan_csv,
+    points_program, program_columns, read_plan_csv, JoinBy, JoinOptions, MeasurementPlan,
+    PlanPoint, PlanSettings, PositionerPlan, PositionerPlanSettings, TrackPlan, TrackPlanSettings,
+    TrackerSight, TurntablePlan, TurntablePlanSettings, Units, WorkspaceBox,
 };
 use crate::program::Language;
 use anyhow::{bail, Context};
@@ -70,6 +70,8 @@ pub enum PlanFormat {
 
 /// Arguments of `robocal plan` without a subcommand: the plan to make.
 #[derive(Debug, Args)]
+#[command(group = clap::ArgGroup::new("one_axis").args(["track", "turntable"]))]
+#[command(group = clap::ArgGroup::new("face_plate").args(["positioner", "turntable"]))]
 pub struct MakeArgs {
     /// Robot model: a preset (ys100, hh800, ur5, ur10) or a model JSON file.
     #[arg(long)]
@@ -93,19 +95,29 @@ pub struct MakeArgs {
     /// Stations along the track, at least 5 (default: one every 400 mm).
     #[arg(long, requires = "track")]
     pub stations: Option<usize>,
-    /// The track's column in the plan and the measurements, e1 … e6.
-    #[arg(long, requires = "track", default_value = "e1", value_parser = super::track::parse_axis)]
+    /// The track's or the turntable's column in the plan and the
+    /// measurements, e1 … e6.
+    #[arg(long, requires = "one_axis", default_value = "e1", value_parser = super::track::parse_axis)]
     pub column: ExternalAxis,
-    /// The stations' lowest and highest value: "lo,hi" [mm] (default: the track's travel).
-    #[arg(long, requires = "track", allow_hyphen_values = true)]
+    /// The stations' lowest and highest value: "lo,hi" [mm] (default: the
+    /// track's travel); with `--turntable` its sweep [deg] (default
+    /// -165,165).
+    #[arg(long, requires = "one_axis", allow_hyphen_values = true)]
     pub travel: Option<String>,
     /// A tilt-rotate positioner (JSON, its nominal model): plan its two
     /// axes' sweeps for `positioner calibrate` instead of robot poses.
     #[arg(long, conflicts_with_all = ["track", "model"])]
     pub positioner: Option<String>,
+    /// A one-axis turntable (JSON, its nominal model): plan its sweep for
+    /// `turntable calibrate` instead of robot poses.
+    #[arg(long, conflicts_with_all = ["track", "model", "positioner"])]
+    pub turntable: Option<String>,
+    /// Values of the turntable's sweep, evenly over `--travel`.
+    #[arg(long, requires = "turntable", default_value_t = 12)]
+    pub values: usize,
     /// A reflector's design position on the face plate, "x,y,z" [mm]; repeat
     /// for each (the first is the reference).
-    #[arg(long, requires = "positioner", allow_hyphen_values = true)]
+    #[arg(long, requires = "face_plate", allow_hyphen_values = true)]
     pub reflector: Vec<String>,
     /// Axis 1's (tilt) sweep: "lo,hi" [deg] (default -90,90).
     #[arg(long, requires = "positioner", allow_hyphen_values = true)]
@@ -323,6 +335,56 @@ pub fn positioner_table(plan: &PositionerPlan, s: &PositionerPlanSettings) -> St
     out
 }
 
+/// The σ table of a turntable's plan: the sweep and the predicted σ of the
+/// axis's parameters and each reflector's position.
+pub fn turntable_table(plan: &TurntablePlan, s: &TurntablePlanSettings) -> String {
+    let a = &plan.sigma;
+    let mut out = format!(
+        "# {} values of the turntable's axis over {}..{} deg, each of the {} reflectors read at every one\n\
+         # predicted standard deviations for a tracker noise of {} mm per axis (condition number {:.1e})\n\
+         axis: direction {:.3e} deg, line {:.3e} mm, zero offset {:.3e} deg, scale {:.3e}\n",
+        plan.values_deg.len(),
+        s.travel_deg[0],
+        s.travel_deg[1],
+        s.reflectors_mm.len(),
+        plan.noise_mm,
+        plan.condition,
+        a.direction_deg,
+        a.point_mm,
+        a.zero_offset_deg,
+        a.scale
+    );
+    for (k, r) in plan.reflector_sigma_mm.iter().enumerate() {
+        let _ = writeln!(out, "reflector {}: {r:.3e} mm", k + 1);
+    }
+    out
+}
+
+/// The turntable's plan of `a` (`--turntable`).
+fn turntable_plan(a: &MakeArgs, path: &str) -> anyhow::Result<(Vec<PlanPoint>, String)> {
+    let nominal = super::turntable::read_turntable(path)?;
+    let settings = TurntablePlanSettings {
+        reflectors_mm: reflectors(a)?,
+        travel_deg: match &a.travel {
+            Some(t) => numbers::<2>("--travel", t)?,
+            None => TurntablePlanSettings::default().travel_deg,
+        },
+        values: a.values,
+        column: a.column,
+        noise_mm: a.noise_mm,
+    };
+    let plan = make_turntable_plan(&nominal, &settings)?;
+    Ok((plan.points.clone(), turntable_table(&plan, &settings)))
+}
+
+/// The `--reflector` positions [mm].
+fn reflectors(a: &MakeArgs) -> anyhow::Result<Vec<[f64; 3]>> {
+    a.reflector
+        .iter()
+        .map(|r| numbers::<3>("--reflector", r))
+        .collect()
+}
+
 /// The positioner's plan of `a` (`--positioner`).
 fn positioner_plan(a: &MakeArgs, path: &str) -> anyhow::Result<(Vec<PlanPoint>, String)> {
     let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {path}"))?;
@@ -334,11 +396,7 @@ fn positioner_plan(a: &MakeArgs, path: &str) -> anyhow::Result<(Vec<PlanPoint>, 
         None => Ok(default),
     };
     let settings = PositionerPlanSettings {
-        reflectors_mm: a
-            .reflector
-            .iter()
-            .map(|r| numbers::<3>("--reflector", r))
-            .collect::<anyhow::Result<_>>()?,
+        reflectors_mm: reflectors(a)?,
         tilt_deg: range("--tilt", &a.tilt, d.tilt_deg)?,
         tilt_values: a.tilt_values,
         rotate_deg: range("--rotate", &a.rotate, d.rotate_deg)?,
@@ -392,10 +450,13 @@ fn planned(a: &MakeArgs, model: &RobotModel) -> anyhow::Result<(Vec<PlanPoint>, 
 
 /// Makes the plan and writes its exports; returns the σ table.
 pub fn make(a: &MakeArgs) -> anyhow::Result<String> {
-    let (points, table) = match (&a.positioner, &a.model) {
-        (Some(path), _) => positioner_plan(a, path)?,
-        (None, Some(model)) => planned(a, &super::model_files::load_model(model)?)?,
-        (None, None) => bail!("--model is required (or --positioner, or `robocal plan join`)"),
+    let (points, table) = match (&a.positioner, &a.turntable, &a.model) {
+        (Some(path), _, _) => positioner_plan(a, path)?,
+        (None, Some(path), _) => turntable_plan(a, path)?,
+        (None, None, Some(model)) => planned(a, &super::model_files::load_model(model)?)?,
+        (None, None, None) => {
+            bail!("--model is required (or --positioner, --turntable, or `robocal plan join`)")
+        }
     };
     let text = match language(a.format) {
         None => plan_csv(&points),

@@ -18,6 +18,7 @@ pub mod positioner;
 mod predict;
 mod settings;
 pub mod track;
+pub mod turntable;
 
 pub use export::{
     plan_axes, plan_csv, plan_program, points_program, read_plan_csv, PlanCsvError, PlanPoint,
@@ -30,6 +31,7 @@ pub use positioner::{
 };
 pub use settings::{FilterCounts, PlanError, PlanSettings, TrackerSight, WorkspaceBox};
 pub use track::{make_track_plan, stations_over, PlannedStation, TrackPlan, TrackPlanSettings};
+pub use turntable::{make_turntable_plan, TurntablePlan, TurntablePlanSettings};
 
 use crate::measure::external::ExternalValues;
 use crate::model::RobotModel;

@@ -107,7 +107,9 @@ pub fn program_columns(columns: &PositionerColumns, language: Language) -> Resul
     Ok(())
 }
 
-fn check_sweep(name: &str, range: [f64; 2], values: usize) -> Result<(), PlanError> {
+/// Refuses a sweep the fit would refuse: its range, span and count
+/// (`calibrate::external::judge`).
+pub(super) fn check_sweep(name: &str, range: [f64; 2], values: usize) -> Result<(), PlanError> {
     let [lo, hi] = range;
     if !(lo.is_finite() && hi.is_finite() && lo < hi && lo >= -360.0 && hi <= 360.0) {
         return Err(PlanError::Setting(format!(

@@ -216,8 +216,8 @@ fn start(
 }
 
 /// 1σ of each reflector's fitted position [mm] (reflector 0: its two free
-/// directions).
-fn reflector_sigmas(state: &State, var: &DVector<f64>) -> Vec<f64> {
+/// directions), from the parameters' variances `var` (a fit's or a plan's).
+pub(crate) fn reflector_sigmas(state: &State, var: &DVector<f64>) -> Vec<f64> {
     (0..state.reflectors())
         .map(|k| {
             let (first, n) = if k == 0 {
@@ -232,6 +232,19 @@ fn reflector_sigmas(state: &State, var: &DVector<f64>) -> Vec<f64> {
                 * 1e3
         })
         .collect()
+}
+
+/// 1σ of the axis's parameters from the parameters' variances `var` (a
+/// fit's or a plan's): its direction and line across it, zero offset, scale.
+pub(crate) fn axis_sigma(var: &DVector<f64>) -> AxisSigma {
+    let sd = |i: usize| var[i].max(0.0);
+    AxisSigma {
+        axis: Axis::Rotate,
+        direction_deg: (sd(0) + sd(1)).sqrt().to_degrees(),
+        point_mm: (sd(2) + sd(3)).sqrt() * 1e3,
+        zero_offset_deg: sd(4).sqrt().to_degrees(),
+        scale: sd(5).sqrt(),
+    }
 }
 
 /// Fits the turntable, or refuses with the reason (module docs).
@@ -264,7 +277,6 @@ pub fn fit_turntable(req: &TurntableFitRequest) -> Result<TurntableFit, Turntabl
         .collect();
     let (rms_mm, max_mm) = rms_max(&residual_mm);
     let model: Turntable = state.model(&gauge);
-    let sd = |i: usize| var[i].max(0.0);
     let fit = TurntableFit {
         description: model.describe(),
         model,
@@ -272,13 +284,7 @@ pub fn fit_turntable(req: &TurntableFitRequest) -> Result<TurntableFit, Turntabl
             .map(|k| (state.reflector(&gauge, k) * 1e3).into())
             .collect(),
         reflector_sigma_mm: reflector_sigmas(&state, &var),
-        sigma: AxisSigma {
-            axis: Axis::Rotate,
-            direction_deg: (sd(0) + sd(1)).sqrt().to_degrees(),
-            point_mm: (sd(2) + sd(3)).sqrt() * 1e3,
-            zero_offset_deg: sd(4).sqrt().to_degrees(),
-            scale: sd(5).sqrt(),
-        },
+        sigma: axis_sigma(&var),
         residual_mm,
         rms_mm,
         max_mm,
