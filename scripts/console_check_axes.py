@@ -206,8 +206,214 @@ def check_external_axes(driver, wait, shot, base, robocal, work, robot_url, h):
     wait.until(EC.presence_of_element_located((By.ID, "calibrate-positioner")))
     assert "No positioner stored." in driver.find_element(By.ID, "axes-section").text
     assert api_raw(h.KEY, base, "GET", f"/v1/robots/{rail_id}/positioner")[0] == 404
+    turntable_through_the_form(driver, wait, shot, base, robocal, axes, rail_id, h)
+    positioner_from_touches(driver, wait, shot, base, robocal, axes, rail_id, held, h)
     driver.get(robot_url)
     wait.until(EC.presence_of_element_located((By.ID, "add-tool")))
+
+
+def simulated_fit(robocal, what, out_dir, *extra):
+    """`robocal WHAT simulate --out-dir OUT_DIR EXTRA...`: the measurement
+    files, the nominal JSON and the reflectors' positions of the command it
+    prints."""
+    printed = subprocess.run([robocal, what, "simulate", "--out-dir", str(out_dir), *extra],
+                             check=True, capture_output=True, text=True).stdout
+    fit = printed_fit(printed)
+    assert fit[:2] == [what, "calibrate"], fit
+    sets = fit[2:fit.index("--nominal")]
+    nominal = fit[fit.index("--nominal") + 1]
+    reflectors = [fit[i + 1] for i, a in enumerate(fit) if a == "--reflector"]
+    assert len(sets) == len(reflectors) >= 2 and all(pathlib.Path(f).exists() for f in sets + [nominal]), fit
+    return sets, nominal, reflectors
+
+
+def fill_reflector_form(driver, form, what, nominal, sets, reflectors):
+    """The nominal JSON file, the measurement files (listed in the order
+    they are sent) and one reflector line per file, put into the form of
+    `what` (`positioner`, `turntable`)."""
+    form.find_element(By.NAME, "nominal_file").send_keys(nominal)
+    form.find_element(By.NAME, "sets").send_keys("\n".join(sets))
+    order = driver.find_element(By.ID, f"{what}-files").text
+    assert order.endswith(", ".join(f"{i + 1}. {pathlib.Path(f).name}" for i, f in enumerate(sets))), order
+    box = form.find_element(By.NAME, "reflectors")
+    box.clear()
+    box.send_keys("\n".join(r.replace(",", ", ") for r in reflectors))
+
+
+def new_message(driver, wait, h, before):
+    """The page's message once it differs from `before` (a reload's flash
+    or a refusal)."""
+    return wait.until(lambda d: (t := h.text_of(d, "#message")) and t != before and t)
+
+
+def turntable_cells(driver):
+    """The stored turntable's row as the page shows it."""
+    return {c: driver.find_element(By.CSS_SELECTOR, f"#turntable-stored td.{c}").text
+            for c in ("column", "reflectors", "readings", "direction", "point", "zero", "scale",
+                      "rms", "max", "sigma")}
+
+
+def turntable_as_shown(stored):
+    """`GET …/turntable`'s answer written as the page writes it: mm to
+    0.001, degrees to 0.0001, the direction and the scale to 1e-6."""
+    axis = stored["turntable"]["axis"]
+    return {"column": stored["column"], "reflectors": str(stored["reflectors"]),
+            "readings": str(stored["readings"]),
+            "direction": ", ".join(shown_number(x, 6) for x in axis["direction"]),
+            "point": ", ".join(shown_number(x, 3) for x in axis["point_mm"]),
+            "zero": shown_number(axis["zero_offset_deg"], 4), "scale": shown_number(axis["scale"], 6),
+            "rms": shown_number(stored["rms_mm"], 3), "max": shown_number(stored["max_mm"], 3),
+            "sigma": shown_number(stored["sigma_mm"], 3)}
+
+
+def turntable_through_the_form(driver, wait, shot, base, robocal, axes, rail_id, h):
+    """The one-axis turntable of `robocal turntable simulate` (its axis
+    tilted 0.05°, a zero offset of -0.4°, a scale off by -1.5e-4): fitted in
+    the page's form, shown as `GET …/turntable` gives it (every figure,
+    the axis's line, zero offset and scale among them); the same files with
+    the form reading `e2` refused with the reason shown and the stored
+    turntable kept; deleted after a confirmation."""
+    sets, nominal, reflectors = simulated_fit(robocal, "turntable", axes / "turntable")
+    assert "No turntable stored." in driver.find_element(By.ID, "axes-section").text
+    assert api_raw(h.KEY, base, "GET", f"/v1/robots/{rail_id}/turntable")[0] == 404
+    form = driver.find_element(By.ID, "calibrate-turntable")
+    assert Select(form.find_element(By.NAME, "column")).first_selected_option.get_attribute("value") == "e1"
+    assert form.find_element(By.NAME, "sigma_mm").get_attribute("value") == "0.01"
+    fill_reflector_form(driver, form, "turntable", nominal, sets, reflectors)
+    before = h.text_of(driver, "#message")
+    form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+    msg = new_message(driver, wait, h, before)
+    assert msg.startswith("Turntable fitted: "), msg
+    wait.until(EC.presence_of_element_located((By.ID, "turntable-stored")))
+    stored = h.api_get(base, f"/v1/robots/{rail_id}/turntable")
+    shown = turntable_cells(driver)
+    assert shown == turntable_as_shown(stored), (shown, stored)
+    assert shown["column"] == "e1" and stored["reflectors"] == len(sets), stored
+    assert msg == f"Turntable fitted: RMS {shown['rms']} mm over {shown['readings']} readings of " \
+        f"{len(sets)} reflectors (max {shown['max']} mm)", msg
+    axis = stored["turntable"]["axis"]
+    assert abs(axis["zero_offset_deg"] + 0.4) < 0.1 and abs(axis["scale"] - (1 - 1.5e-4)) < 5e-5, axis
+    created = driver.find_element(By.CSS_SELECTOR, "#turntable-stored time")
+    assert created.get_attribute("datetime") == stored["created_at"], created.get_attribute("datetime")
+    print(f"console_check: turntable fitted, RMS {shown['rms']} mm over {shown['readings']} readings; "
+          f"zero offset {shown['zero']}°, scale {shown['scale']}, axis through {shown['point']} mm")
+    shot("turntable-fitted", "turntable-stored-box")
+    # Refused: the form reads the axis's value from e2, the files have e1.
+    form = driver.find_element(By.ID, "calibrate-turntable")
+    Select(form.find_element(By.NAME, "column")).select_by_value("e2")
+    fill_reflector_form(driver, form, "turntable", nominal, sets, reflectors)
+    form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+    wait.until(EC.visibility_of_element_located((By.ID, "turntable-result")))
+    refusal = driver.find_element(By.ID, "turntable-result").text
+    msg = driver.find_element(By.ID, "message").text
+    assert msg == refusal and "msg bad" in driver.find_element(By.ID, "message").get_attribute("class"), msg
+    assert refusal.startswith("Turntable not fitted") and "`e2`" in refusal and "column e2" in refusal \
+        and refusal.endswith("Nothing was stored: the stored turntable is kept."), refusal
+    assert h.api_get(base, f"/v1/robots/{rail_id}/turntable") == stored, "a refused fit replaced the turntable"
+    assert turntable_cells(driver) == shown
+    print(f"console_check: refused: {refusal}")
+    shot("turntable-refused", "calibrate-turntable")
+    button = driver.find_element(By.ID, "delete-turntable")
+    button.click()
+    alert = wait.until(EC.alert_is_present())
+    assert alert.text.startswith(f"Delete the turntable of robot {rail_id} (YS100 on the rail)?"), alert.text
+    alert.accept()
+    wait.until(h.replaced(button))
+    wait.until(EC.presence_of_element_located((By.ID, "calibrate-turntable")))
+    assert "No turntable stored." in driver.find_element(By.ID, "axes-section").text
+    assert api_raw(h.KEY, base, "GET", f"/v1/robots/{rail_id}/turntable")[0] == 404
+    shot("turntable-deleted", "turntable-stored-box")
+
+
+def touches_file(base, rail_id, version, tracker_file, h):
+    """A touches file (`id,q1…q6,e1,e2`) of the points a tracker's file
+    read: each point solved over the API (position only) for version
+    `version` carrying the stored tool `pointer`, at the file's axis values;
+    a point the robot does not reach is left out."""
+    import csv
+    rows = list(csv.DictReader(open(tracker_file)))
+    targets = [{"id": f"t{i + 1}", "x": float(r["x"]), "y": float(r["y"]), "z": float(r["z"])}
+               for i, r in enumerate(rows)]
+    solved = h.api_post(base, f"/v1/robots/{rail_id}/solve",
+                        {"targets": targets, "position_only": True, "tool": "pointer", "version": version})
+    lines = ["id,q1,q2,q3,q4,q5,q6,e1,e2"]
+    for r, s in zip(rows, solved["results"], strict=True):
+        if s["status"] == "ok":
+            lines.append(",".join([s["id"]] + [repr(q) for q in s["joints_deg"]] + [r["e1"], r["e2"]]))
+    assert len(lines) > 9, f"the robot reaches {len(lines) - 1} of {len(rows)} points of {tracker_file}"
+    return "\n".join(lines) + "\n", len(lines) - 1, len(rows)
+
+
+def positioner_from_touches(driver, wait, shot, base, robocal, axes, rail_id, held, h):
+    """A positioner fitted in the page's form from touches: the tool
+    `pointer` (200 mm along the flange's z) stored; the points of
+    `robocal positioner simulate --robot <the version's model.json>`'s files
+    solved over the API for the held version carrying it, written as touches
+    files; the form with "touches" chosen clears the tracker's σ and refuses
+    to send without one; with σ the fit is stored, shown as `GET
+    …/positioner` gives it (readings from touches with that tool and
+    version), and equal to the API's answer for the same body."""
+    import json
+    status, body = api_raw(h.KEY, base, "PUT", f"/v1/robots/{rail_id}/tools/pointer",
+                           json.dumps({"number": 1, "xyz_mm": [0, 0, 200], "rpy_deg": [0, 0, 0]}).encode(),
+                           "application/json")
+    assert status in (200, 201), (status, body)
+    sets, nominal, reflectors = simulated_fit(robocal, "positioner", axes / "touched",
+                                              "--robot", str(axes / "model.json"), "--seed", "3")
+    touched = []
+    for k, f in enumerate(sets):
+        text, reached, of = touches_file(base, rail_id, held, f, h)
+        path = axes / "touched" / f"touches{k}.csv"
+        path.write_text(text)
+        touched.append(str(path))
+        print(f"console_check: touches of feature {k}: {reached} of {of} points reached")
+    driver.get(f"{base}/ui/robots/{rail_id}")
+    wait.until(EC.presence_of_element_located((By.ID, "calibrate-positioner")))
+    form = driver.find_element(By.ID, "calibrate-positioner")
+    assert not driver.find_element(By.ID, "positioner-touches").is_displayed()
+    form.find_element(By.CSS_SELECTOR, "input[name=readings_from][value=touches]").click()
+    assert driver.find_element(By.ID, "positioner-touches").is_displayed()
+    assert form.find_element(By.NAME, "sigma_mm").get_attribute("value") == "", "the tracker's σ kept for touches"
+    version = Select(form.find_element(By.NAME, "touched_version"))
+    assert version.first_selected_option.get_attribute("value") == str(held)
+    Select(form.find_element(By.NAME, "touched_tool")).select_by_value("pointer")
+    fill_reflector_form(driver, form, "positioner", nominal, touched, reflectors)
+    # No σ: the page says so and sends nothing.
+    form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+    wait.until(lambda d: "touches need σ" in (h.text_of(d, "#message") or ""))
+    refused = driver.find_element(By.ID, "message").text
+    assert refused.startswith("touches need σ [mm]: the robot's accuracy at the tool's tip"), refused
+    assert api_raw(h.KEY, base, "GET", f"/v1/robots/{rail_id}/positioner")[0] == 404
+    shot("positioner-touches-refused", "calibrate-positioner")
+    form.find_element(By.NAME, "sigma_mm").send_keys("0.01")
+    form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+    msg = new_message(driver, wait, h, refused)
+    assert msg.startswith("Positioner fitted: "), msg
+    wait.until(EC.presence_of_element_located((By.ID, "positioner-stored")))
+    stored = h.api_get(base, f"/v1/robots/{rail_id}/positioner")
+    shown = {c: driver.find_element(By.CSS_SELECTOR, f"#positioner-stored td.{c}").text
+             for c in ("tilt", "rotate", "from", "reflectors", "readings", "rms", "max", "sigma")}
+    assert shown == {"tilt": "e1", "rotate": "e2", "from": f"touches with tool pointer of version {held}",
+                     "reflectors": str(len(sets)), "readings": str(stored["readings"]),
+                     "rms": f"{stored['rms_mm']:.3f}", "max": f"{stored['max_mm']:.3f}", "sigma": "0.010"}, \
+        (shown, stored)
+    assert stored["readings_from"] == {"kind": "touches", "version": held, "tool": "pointer"}, stored
+    assert msg == f"Positioner fitted: RMS {shown['rms']} mm over {shown['readings']} readings of " \
+        f"{len(sets)} reflectors (max {shown['max']} mm); touches with tool pointer of version {held}", msg
+    # The API's answer for the same body: the same positioner and figures.
+    same = {"sets": [pathlib.Path(f).read_text() for f in touched],
+            "reflectors": [[float(x) for x in r.split(",")] for r in reflectors],
+            "nominal": json.loads(pathlib.Path(nominal).read_text()), "tilt_column": "e1", "rotate_column": "e2",
+            "sigma_mm": 0.01, "touched_with": {"version": held, "tool": "pointer"}}
+    answer = h.api_post(base, f"/v1/robots/{rail_id}/positioner/calibrate", same)
+    for k in ("positioner", "readings", "reflectors", "rms_mm", "max_mm", "sigma_mm", "readings_from",
+              "tilt_column", "rotate_column"):
+        assert answer[k] == stored[k], (k, answer[k], stored[k])
+    print(f"console_check: positioner fitted from touches (tool pointer of v{held}), RMS {shown['rms']} mm "
+          f"over {shown['readings']} touches, as the API fits the same body")
+    shot("positioner-touched", "positioner-stored-box")
+    status, _ = api_raw(h.KEY, base, "DELETE", f"/v1/robots/{rail_id}/positioner")
+    assert status == 204, status
 
 
 def shown_number(v, decimals):

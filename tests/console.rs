@@ -537,3 +537,98 @@ async fn the_robot_page_shows_its_stored_track_and_positioner() {
         "data-delete=\"/v1/robots/{id}/positioner\" data-confirm=\"Delete the positioner of robot {id} (rail robot)?"
     )));
 }
+
+/// The turntable and the positioner's touches: a robot without versions
+/// shows "No turntable stored.", the turntable's form and, for touches, a
+/// version number field and a select of its stored tools (hidden until
+/// touches are chosen); its turntable, fitted through the API from the
+/// files `robocal turntable simulate` writes, is shown with every figure as
+/// `GET …/turntable` gives it (the axis's line, zero offset and scale from
+/// the stored JSON) and a delete that asks first.
+#[tokio::test]
+async fn the_robot_page_shows_its_stored_turntable_and_the_touches_choice() {
+    let (state, dir) = state().await;
+    let robot = serde_json::json!({ "name": "table robot", "preset": "ys100" });
+    let id = post_json(&state, "/v1/robots", &robot, StatusCode::CREATED).await["id"].clone();
+    let tools = serde_json::json!({ "tools": [{ "name": "pointer", "xyz_mm": [0, 0, 200], "rpy_deg": [0, 0, 0] }] });
+    let (s, text) = call(
+        &state,
+        "PUT",
+        &format!("/v1/robots/{id}/tools"),
+        Some(&tools.to_string()),
+    )
+    .await;
+    assert_eq!(s, StatusCode::OK, "{text}");
+    let page = format!("/ui/robots/{id}");
+    let (_, html) = call(&state, "GET", &page, None).await;
+    let section = axes_section(&html);
+    for part in [
+        "No turntable stored.",
+        "<form id=\"calibrate-turntable\" data-action=\"calibrate-turntable\"",
+        "<p class=\"note files\" id=\"turntable-files\">",
+        "<input type=\"radio\" name=\"readings_from\" value=\"tracker\" checked>",
+        "<fieldset id=\"positioner-touches\" hidden>",
+        "<input name=\"touched_version\" type=\"number\"",
+        "<select name=\"touched_tool\"><option value=\"pointer\">pointer</option></select>",
+    ] {
+        assert!(
+            section.contains(part),
+            "the section lacks {part}: {section}"
+        );
+    }
+    let files = dir.path().join("turntable");
+    robocal::cli::turntable::simulate_to_string(&robocal::cli::turntable::SimulateArgs {
+        out_dir: files.display().to_string(),
+        seed: 1,
+        noise_mm: 0.01,
+        wobble_deg: 0.003,
+    })
+    .unwrap();
+    let read = |name: &str| std::fs::read_to_string(files.join(name)).unwrap();
+    let nominal: serde_json::Value = serde_json::from_str(&read("nominal.json")).unwrap();
+    let body = serde_json::json!({
+        "sets": [read("r0.csv"), read("r1.csv")],
+        "reflectors": robocal::sim::turntable_example::DESIGN_MM,
+        "nominal": nominal,
+    });
+    let uri = format!("/v1/robots/{id}/turntable/calibrate");
+    post_json(&state, &uri, &body, StatusCode::CREATED).await;
+    let (_, html) = call(&state, "GET", &page, None).await;
+    let section = axes_section(&html);
+    assert!(!section.contains("No turntable stored."), "{section}");
+    let (_, text) = call(&state, "GET", &format!("/v1/robots/{id}/turntable"), None).await;
+    let stored: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let at = section
+        .find("<table id=\"turntable-stored\"")
+        .expect("no turntable table");
+    let table = &section[at..at + section[at..].find("</table>").unwrap()];
+    // As the page writes numbers: never "-0".
+    let fixed = |v: &serde_json::Value, d: usize| {
+        let s = format!("{:.d$}", v.as_f64().unwrap());
+        let unsigned = s.trim_start_matches('-');
+        match unsigned.bytes().all(|b| b == b'0' || b == b'.') {
+            true => unsigned.to_string(),
+            false => s,
+        }
+    };
+    let axis = &stored["turntable"]["axis"];
+    let three = |k: &str, d: usize| {
+        (0..3)
+            .map(|i| fixed(&axis[k][i], d))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    assert_eq!(cell(table, "column"), "e1");
+    assert_eq!(cell(table, "reflectors"), "2");
+    assert_eq!(cell(table, "readings"), stored["readings"].to_string());
+    assert_eq!(cell(table, "direction"), three("direction", 6));
+    assert_eq!(cell(table, "point"), three("point_mm", 3));
+    assert_eq!(cell(table, "zero"), fixed(&axis["zero_offset_deg"], 4));
+    assert_eq!(cell(table, "scale"), fixed(&axis["scale"], 6));
+    assert_eq!(cell(table, "rms"), fixed(&stored["rms_mm"], 3));
+    assert_eq!(cell(table, "max"), fixed(&stored["max_mm"], 3));
+    assert_eq!(cell(table, "sigma"), "0.010");
+    assert!(table.contains(&format!(
+        "data-delete=\"/v1/robots/{id}/turntable\" data-confirm=\"Delete the turntable of robot {id} (table robot)?"
+    )));
+}

@@ -1,24 +1,35 @@
 //! The console's external axes section of a robot page: the linear track
-//! carrying the robot and the two-axis positioner in its cell, each as
-//! stored (what it was fitted on, its residuals, delete after a
-//! confirmation) or "none stored", and the form that fits it from
+//! carrying the robot, the two-axis positioner and the one-axis turntable in
+//! its cell, each as stored (what it was fitted on, its residuals, delete
+//! after a confirmation) or "none stored", and the form that fits it from
 //! measurement files (`POST …/track/calibrate`, `POST
-//! …/positioner/calibrate`). A refused fit stores nothing; the page shows
-//! why and keeps what was stored. Lengths in mm to 0.001.
+//! …/positioner/calibrate`, `POST …/turntable/calibrate`); the positioner
+//! also from touches with one of the robot's stored tools, placed by one of
+//! its versions. A refused fit stores nothing; the page shows why and keeps
+//! what was stored. Lengths in mm to 0.001, angles in degrees to 0.0001.
 
-use super::format::mm;
+use super::format::{deg, fixed, mm};
 use crate::http::{tracks, PAYLOAD_MAX_KG};
-use crate::records::{PositionerRow, RobotRow, TrackRow};
+use crate::records::{CellItemRow, PositionerRow, RobotRow, TrackRow, TurntableRow, VersionRow};
 use maud::{html, Markup};
 use robocal_core::calibrate::external::track::DEFAULT_MAX_ORDER;
 use robocal_core::measure::external::ExternalAxis;
 use robocal_core::model::external::travel_map::MAX_MAP_ORDER;
+use robocal_core::model::external::TurntableDescription;
 
-/// What the section shows: the robot's stored track and positioner, if any.
+/// Decimals of a unitless figure: a unit direction's components, a scale.
+const UNITLESS_DECIMALS: usize = 6;
+
+/// What the section shows: the robot's stored track, positioner and
+/// turntable, if any, and the versions and tools a positioner can be
+/// touched with.
 pub(super) struct AxesView<'a> {
     pub robot: &'a RobotRow,
     pub track: Option<&'a TrackRow>,
     pub positioner: Option<&'a PositionerRow>,
+    pub turntable: Option<&'a TurntableRow>,
+    pub versions: &'a [VersionRow],
+    pub tools: &'a [CellItemRow],
 }
 
 /// The section `#axes-section` of robot `v.robot`.
@@ -27,7 +38,7 @@ pub(super) fn axes_section(v: &AxesView) -> Markup {
     html! {
         section #axes-section {
             h2 { "External axes" }
-            p.note { "A linear track carrying the robot and a two-axis (tilt-rotate) positioner in its cell, each fitted from the tracker's readings and stored for this robot. A fit is judged before it is stored: a refused fit stores nothing, and the page says why." }
+            p.note { "A linear track carrying the robot, a two-axis (tilt-rotate) positioner and a one-axis turntable in its cell, each fitted from the tracker's readings (the positioner also from touches with a calibrated tool) and stored for this robot. A fit is judged before it is stored: a refused fit stores nothing, and the page says why." }
             h3 { "Linear track" }
             div #track-stored-box {
                 @match v.track {
@@ -43,7 +54,15 @@ pub(super) fn axes_section(v: &AxesView) -> Markup {
                     None => { p.empty #no-positioner { "No positioner stored." } }
                 }
             }
-            (positioner_form(id))
+            (positioner_form(v))
+            h3 { "Turntable" }
+            div #turntable-stored-box {
+                @match v.turntable {
+                    Some(t) => { (turntable_table(v.robot, t)) }
+                    None => { p.empty #no-turntable { "No turntable stored." } }
+                }
+            }
+            (turntable_form(id))
         }
     }
 }
@@ -150,21 +169,124 @@ fn track_form(id: i64) -> Markup {
     }
 }
 
-/// The form that fits the positioner (`POST …/positioner/calibrate`).
-fn positioner_form(id: i64) -> Markup {
+/// The form that fits the positioner (`POST …/positioner/calibrate`), from
+/// tracker files or from touches (`touched_with`).
+fn positioner_form(v: &AxesView) -> Markup {
     html! {
-        p.note { "One measurement file per reflector on the face plate: each axis swept over 90° or more at 4 or more values with the other held; the axes' values [°] in two e columns, x, y, z [mm] in the tracker frame; no joints needed. The reflectors' design positions on the face plate [mm], one x, y, z line per file, in the files' order (the first is the reference). A fit replaces the stored positioner." }
-        form #calibrate-positioner data-action="calibrate-positioner" data-robot=(id) {
-            label.wide { "Nominal positioner (JSON) " input type="file" name="nominal_file" accept=".json,application/json"; }
-            label.wide { "or paste it " textarea name="nominal" rows="3" placeholder="{\"cell_from_base\": ..., \"tilt\": ..., \"rotate\": ..., \"face_plate\": ...}" {} }
-            label.wide { "Measurement files, one per reflector " input type="file" name="sets" multiple accept=".csv,text/csv"; }
-            p.note.files #positioner-files {}
-            label.wide { "Reflectors' design positions [mm], one x, y, z line per file " textarea name="reflectors" rows="3" placeholder="400, 0, 20" {} }
+        p.note { "One measurement file per reflector on the face plate: each axis swept over 90° or more at 4 or more values with the other held; the axes' values [°] in two e columns, x, y, z [mm] in the tracker frame; no joints needed. Or, with readings from touches, one touches file per feature on the face plate (id, q1…qN controller degrees and the axes' two e columns), placed by the chosen version's robot carrying the chosen stored tool; σ is then the robot's accuracy at the tool's tip and must be given. The reflectors' (features') design positions on the face plate [mm], one x, y, z line per file, in the files' order (the first is the reference). A fit replaces the stored positioner." }
+        form #calibrate-positioner data-action="calibrate-positioner" data-robot=(v.robot.id) {
+            (nominal_inputs("positioner", "{\"cell_from_base\": ..., \"tilt\": ..., \"rotate\": ..., \"face_plate\": ...}"))
+            (readings_from(v))
+            (reflector_inputs("positioner"))
             (column_select("Tilt column", "tilt_column", ExternalAxis::E1))
             (column_select("Rotate column", "rotate_column", ExternalAxis::E2))
-            (sigma_input(crate::http::positioners::DEFAULT_SIGMA_MM))
+            label title="Tracker files: the tracker's noise per coordinate, 1σ (empty: 0.01). Touches: the robot's accuracy at the tool's tip, 1σ (required). The fit is judged against it" { "σ [mm] "
+                input name="sigma_mm" type="number" step="any" min="0" max="10" value=(crate::http::positioners::DEFAULT_SIGMA_MM); }
             button type="submit" { "Fit the positioner" }
         }
         p #positioner-result hidden {}
+    }
+}
+
+/// The nominal axis's JSON: a file, or its text pasted.
+fn nominal_inputs(what: &str, placeholder: &str) -> Markup {
+    html! {
+        label.wide { "Nominal " (what) " (JSON) " input type="file" name="nominal_file" accept=".json,application/json"; }
+        label.wide { "or paste it " textarea name="nominal" rows="3" placeholder=(placeholder) {} }
+    }
+}
+
+/// One measurement file per reflector (the order they are sent listed in
+/// `#{what}-files`) and the reflectors' design positions, a line per file.
+fn reflector_inputs(what: &str) -> Markup {
+    html! {
+        label.wide { "Measurement files, one per reflector " input type="file" name="sets" multiple accept=".csv,text/csv"; }
+        p.note.files id={ (what) "-files" } {}
+        label.wide { "Reflectors' design positions [mm], one x, y, z line per file " textarea name="reflectors" rows="3" placeholder="400, 0, 20" {} }
+    }
+}
+
+/// Where the positioner's readings come from: tracker files, or touches
+/// placed by one of the robot's versions (newest first, the active one
+/// chosen; a number without any) carrying one of its stored tools.
+fn readings_from(v: &AxesView) -> Markup {
+    html! {
+        fieldset.readings-from {
+            legend { "Readings from" }
+            label.check { input type="radio" name="readings_from" value="tracker" checked; " tracker files" }
+            label.check { input type="radio" name="readings_from" value="touches"; " touches" }
+        }
+        fieldset #positioner-touches hidden {
+            legend { "Touched with" }
+            @if v.versions.is_empty() {
+                label title="The model version whose calibrated robot placed the touches" { "Version "
+                    input name="touched_version" type="number" min="1" step="1" placeholder="none calibrated"; }
+            } @else {
+                label title="The model version whose calibrated robot placed the touches" { "Version "
+                    select name="touched_version" {
+                        @for ver in v.versions.iter().rev() {
+                            option value=(ver.version) selected[v.robot.active_version == Some(ver.version)] { "v" (ver.version) " " (ver.method) }
+                        }
+                    }
+                }
+            }
+            label title="The robot's stored tool that touched the features" { "Tool "
+                select name="touched_tool" {
+                    @if v.tools.is_empty() { option value="" { "no tool stored" } }
+                    @for t in v.tools { option value=(t.name) { (t.name) } }
+                }
+            }
+        }
+    }
+}
+
+/// The stored turntable: what it was fitted on, its residuals and its axis
+/// (the line in its base frame, the zero offset, the scale), from the
+/// stored JSON.
+fn turntable_table(r: &RobotRow, t: &TurntableRow) -> Markup {
+    let url = format!("/v1/robots/{}/turntable", r.id);
+    let described: Option<TurntableDescription> = serde_json::from_str(&t.turntable_json).ok();
+    let axis = described.map(|d| d.axis);
+    let triple = |v: [f64; 3], f: &dyn Fn(f64) -> String| v.map(f).join(", ");
+    let unitless = |x: f64| fixed(x, UNITLESS_DECIMALS);
+    html! {
+        table #turntable-stored {
+            thead { tr { th { "Column" } th { "Reflectors" } th { "Readings" } th { "Axis direction" } th { "Axis point [mm]" } th { "Zero offset [°]" } th { "Scale" } th { "RMS [mm]" } th { "Max [mm]" } th { "σ [mm]" } th { "Created" } th {} } }
+            tbody {
+                tr {
+                    td.column { (t.value_column) }
+                    td.reflectors { (t.reflectors) }
+                    td.readings { (t.readings) }
+                    td.direction { (axis.map_or("—".into(), |a| triple(a.direction, &unitless))) }
+                    td.point { (axis.map_or("—".into(), |a| triple(a.point_mm, &mm))) }
+                    td.zero { (axis.map_or("—".into(), |a| deg(a.zero_offset_deg))) }
+                    td.scale { (axis.map_or("—".into(), |a| unitless(a.scale))) }
+                    td.rms { (mm(t.rms_mm)) }
+                    td.max { (mm(t.max_mm)) }
+                    td.sigma { (mm(t.sigma_mm)) }
+                    td { time datetime=(t.created_at) { (t.created_at) } }
+                    td {
+                        a href=(url) { "turntable JSON" } " "
+                        button.small.danger #delete-turntable data-delete=(url)
+                            data-confirm={ "Delete the turntable of robot " (r.id) " (" (r.name) ")? Fitting it again needs its measurement files." } { "Delete the turntable" }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The form that fits the turntable (`POST …/turntable/calibrate`).
+fn turntable_form(id: i64) -> Markup {
+    html! {
+        p.note { "One measurement file per reflector on the face plate: the axis swept over 90° or more at 4 or more values; its value [°] in an e column, x, y, z [mm] in the tracker frame; no joints needed. The reflectors' design positions on the face plate [mm], one x, y, z line per file, in the files' order (the first is the reference). No calibrated version is needed. A fit replaces the stored turntable." }
+        form #calibrate-turntable data-action="calibrate-turntable" data-robot=(id) {
+            (nominal_inputs("turntable", "{\"cell_from_base\": ..., \"axis\": ..., \"face_plate\": ...}"))
+            (reflector_inputs("turntable"))
+            (column_select("Axis column", "column", ExternalAxis::E1))
+            (sigma_input(crate::http::positioners::DEFAULT_SIGMA_MM))
+            button type="submit" { "Fit the turntable" }
+        }
+        p #turntable-result hidden {}
     }
 }

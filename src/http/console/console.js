@@ -726,37 +726,97 @@ function reflectorLines(text) {
   });
 }
 
-handlers["calibrate-positioner"] = async function (form) {
-  const nominalText = await fileOrText(form, "nominal_file", "nominal");
-  if (!nominalText) throw new Error("choose the nominal positioner's JSON file or paste it");
-  let nominal;
+// A form's nominal axis (`what`): its JSON file or pasted text, parsed.
+async function nominalJson(form, what) {
+  const text = await fileOrText(form, "nominal_file", "nominal");
+  if (!text) throw new Error(`choose the nominal ${what}'s JSON file or paste it`);
   try {
-    nominal = JSON.parse(nominalText);
+    return JSON.parse(text);
   } catch (e) {
-    throw new Error("the nominal positioner is not JSON: " + e.message);
+    throw new Error(`the nominal ${what} is not JSON: ` + e.message);
   }
+}
+
+// A form's measurement files (their texts, in the order chosen) and the
+// reflectors' design positions, one line per file.
+async function reflectorSets(form) {
   const files = form.elements["sets"].files;
   if (!files.length) throw new Error("choose the measurement files, one per reflector");
   const reflectors = reflectorLines(formValue(form, "reflectors"));
   if (reflectors.length !== files.length) {
     throw new Error(`${reflectors.length} reflector position lines for ${files.length} measurement files: give one x, y, z line per file, in the files' order`);
   }
-  const body = { sets: [], reflectors, nominal, tilt_column: formValue(form, "tilt_column"), rotate_column: formValue(form, "rotate_column") };
-  if (body.tilt_column === body.rotate_column) throw new Error(`the tilt and rotate columns are both ${body.tilt_column}: choose two columns`);
-  for (const f of files) body.sets.push(await f.text());
+  const sets = [];
+  for (const f of files) sets.push(await f.text());
+  return { sets, reflectors };
+}
+
+// Touches (the positioner form's "readings from"): the version and stored
+// tool that placed them; σ is the robot's at the tool's tip, not a tracker's,
+// so it must be given.
+function touchedWith(form, sigma) {
+  const version = Number(formValue(form, "touched_version"));
+  if (!(Number.isInteger(version) && version >= 1)) throw new Error("touches: choose the model version that placed them");
+  const tool = formValue(form, "touched_tool");
+  if (!tool) throw new Error("touches: choose the stored tool that touched (store it under Tools first)");
+  if (!sigma) throw new Error("touches need σ [mm]: the robot's accuracy at the tool's tip (e.g. its validation RMS / √3), not a tracker's");
+  return { version, tool };
+}
+
+handlers["calibrate-positioner"] = async function (form) {
+  const nominal = await nominalJson(form, "positioner");
+  const tilt = formValue(form, "tilt_column");
+  const rotate = formValue(form, "rotate_column");
+  if (tilt === rotate) throw new Error(`the tilt and rotate columns are both ${tilt}: choose two columns`);
   const sigma = formValue(form, "sigma_mm");
+  const touches = formValue(form, "readings_from") === "touches" ? touchedWith(form, sigma) : null;
+  const body = { ...(await reflectorSets(form)), nominal, tilt_column: tilt, rotate_column: rotate };
   if (sigma) body.sigma_mm = Number(sigma);
+  if (touches) body.touched_with = touches;
+  const from = touches ? `; touches with tool ${touches.tool} of version ${touches.version}` : "";
   await axisFit("Positioner", `/v1/robots/${form.dataset.robot}/positioner/calibrate`, body,
-    (r) => `Positioner fitted: RMS ${fmtMm(r.rms_mm)} mm over ${r.readings} readings of ${r.reflectors} reflectors (max ${fmtMm(r.max_mm)} mm)`,
-    (reason, detail) => (/\bcolumn/.test(detail) ? `The form reads the tilt from column ${body.tilt_column} and the rotate from ${body.rotate_column}: choose the files' columns.` : ""));
+    (r) => `Positioner fitted: RMS ${fmtMm(r.rms_mm)} mm over ${r.readings} readings of ${r.reflectors} reflectors (max ${fmtMm(r.max_mm)} mm)${from}`,
+    (reason, detail) => (/\bcolumn/.test(detail) ? `The form reads the tilt from column ${tilt} and the rotate from ${rotate}: choose the files' columns.` : ""));
 };
 
-// The positioner's measurement files in the order they were chosen, the
-// order the reflector lines follow.
+handlers["calibrate-turntable"] = async function (form) {
+  const nominal = await nominalJson(form, "turntable");
+  const body = { ...(await reflectorSets(form)), nominal, column: formValue(form, "column") };
+  const sigma = formValue(form, "sigma_mm");
+  if (sigma) body.sigma_mm = Number(sigma);
+  await axisFit("Turntable", `/v1/robots/${form.dataset.robot}/turntable/calibrate`, body,
+    (r) => `Turntable fitted: RMS ${fmtMm(r.rms_mm)} mm over ${r.readings} readings of ${r.reflectors} reflectors (max ${fmtMm(r.max_mm)} mm)`,
+    (reason, detail) => (/\bcolumn/.test(detail) ? `The form reads the axis's value from column ${body.column}: choose the files' column.` : ""));
+};
+
+// A fit's measurement files in the order they were chosen, the order the
+// reflector lines follow, listed in the form's note.
 document.addEventListener("change", (ev) => {
   const input = ev.target;
-  if (input.name !== "sets" || !input.form || input.form.id !== "calibrate-positioner") return;
+  const note = input.name === "sets" && input.form && input.form.querySelector("p.files");
+  if (!note) return;
   const names = [...input.files].map((f, i) => `${i + 1}. ${f.name}`);
-  document.getElementById("positioner-files").textContent =
-    names.length ? `Files in this order (one reflector line each, in the same order): ${names.join(", ")}` : "";
+  note.textContent = names.length ? `Files in this order (one reflector line each, in the same order): ${names.join(", ")}` : "";
+});
+
+// The positioner's readings: touches show the version and tool to choose,
+// and σ is then the robot's, so the tracker's default is cleared (and put
+// back for tracker files when nothing else was typed).
+document.addEventListener("change", (ev) => {
+  const input = ev.target;
+  if (input.name !== "readings_from" || !input.form) return;
+  const touches = input.value === "touches";
+  document.getElementById("positioner-touches").hidden = !touches;
+  const sigma = input.form.elements["sigma_mm"];
+  if (touches && sigma.value === sigma.defaultValue) sigma.value = "";
+  if (!touches && !sigma.value) sigma.value = sigma.defaultValue;
+  sigma.placeholder = touches ? "required with touches" : "";
+});
+
+// A form the browser restores (a back navigation) keeps its choice of
+// readings: the touches group shows when "touches" is still checked.
+window.addEventListener("pageshow", () => {
+  const checked = document.querySelector('input[name="readings_from"]:checked');
+  const group = document.getElementById("positioner-touches");
+  if (checked && group) group.hidden = checked.value !== "touches";
 });

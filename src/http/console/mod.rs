@@ -3,8 +3,9 @@
 //! progress, reports, model versions with activate and rollback (each
 //! confirmed first), checks with their status, trend and history, the
 //! comparison of versions on one set, solving a targets CSV, tools and work
-//! objects, the external axes (a linear track, a positioner: stored, fitted
-//! from measurement files, deleted after a confirmation), and filtering
+//! objects, the external axes (a linear track, a positioner, a turntable:
+//! stored, fitted from measurement files, the positioner also from touches,
+//! deleted after a confirmation), and filtering
 //! robot programs; times shown in the browser's local time. The
 //! pages read through the service layer; every write is made by the
 //! page's own script through the REST API (`/v1`), so the console obeys the
@@ -80,6 +81,7 @@ async fn robot_page(
         work_objects: service::cell::list(&state, id, CellKind::WorkObject).await?,
         track: stored(service::tracks::get(&state, id).await)?,
         positioner: stored(service::positioners::get(&state, id).await)?,
+        turntable: stored(service::turntables::get(&state, id).await)?,
         keys: !state.config().api_keys.is_empty(),
         robot,
     };

@@ -67,9 +67,10 @@ pub(super) struct RobotView {
     pub versions: Vec<VersionRow>,
     pub tools: Vec<CellItemRow>,
     pub work_objects: Vec<CellItemRow>,
-    /// The stored track and positioner, if any.
+    /// The stored track, positioner and turntable, if any.
     pub track: Option<crate::records::TrackRow>,
     pub positioner: Option<crate::records::PositionerRow>,
+    pub turntable: Option<crate::records::TurntableRow>,
     pub keys: bool,
     /// The latest check's status, the thresholds and the history (oldest first).
     pub status: Option<robocal_core::check::CheckStatus>,
@@ -217,6 +218,9 @@ pub(super) fn robot(v: &RobotView) -> Markup {
                 robot: r,
                 track: v.track.as_ref(),
                 positioner: v.positioner.as_ref(),
+                turntable: v.turntable.as_ref(),
+                versions: &v.versions,
+                tools: &v.tools,
             }))
             (super::cell_pages::predict_section(id, &v.versions, &v.tools, &v.work_objects))
             (super::cell_pages::filter_section(id, &v.versions))
