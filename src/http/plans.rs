@@ -5,7 +5,9 @@
 //! when `language` is given, as a program visiting them with a wait at each.
 //! The same as `robocal plan`; with `track` (a linear track's JSON
 //! description) the same as `robocal plan --track`: `poses` per station at
-//! stations over its travel, each pose with the track's value.
+//! stations over its travel, each pose with the track's value; with
+//! `positioner` or `turntable` (its nominal model and reflectors) the same as
+//! `robocal plan --positioner` or `--turntable`: the axes' sweeps.
 
 use super::input::{external_axis, present_int};
 use super::programs::FileIn;
@@ -14,8 +16,8 @@ use crate::calibrate::external::readings::PositionerColumns;
 use crate::calibrate::external::AxisSigma;
 use crate::measure::external::ExternalAxis;
 use crate::model::external::LinearTrack;
-use crate::model::external::TiltRotate;
-use crate::plan::{program_columns, PositionerPlanSettings};
+use crate::model::external::{TiltRotate, Turntable};
+use crate::plan::{program_columns, PositionerPlanSettings, TurntablePlanSettings};
 use crate::plan::{
     stations_over, FilterCounts, PlanPoint, PlanSettings, PlannedStation, PredictedStd,
     TrackerSight, WorkspaceBox,
@@ -23,7 +25,7 @@ use crate::plan::{
 use crate::program::Language;
 use crate::service;
 use crate::service::plans::PlanCommand;
-use crate::service::plans::{ForPositioner, OverTrack, PlanKind, PlanMade};
+use crate::service::plans::{ForPositioner, ForTurntable, OverTrack, PlanKind, PlanMade};
 use axum::extract::State;
 use axum::response::{IntoResponse, Response};
 use serde::{Deserialize, Serialize};
@@ -82,6 +84,8 @@ pub struct PlanRequest {
     pub column: Option<String>,
     /// A tilt-rotate positioner's sweeps instead of robot poses.
     pub positioner: Option<PositionerPlanIn>,
+    /// A one-axis turntable's sweep instead of robot poses.
+    pub turntable: Option<TurntablePlanIn>,
     /// Random configurations drawn, from `poses` to [`PLAN_CANDIDATES_MAX`]; absent: 1000 (or
     /// `poses` when more).
     #[serde(default, deserialize_with = "present_int")]
@@ -130,6 +134,25 @@ pub struct PositionerPlanIn {
     pub tilt_column: Option<String>,
     /// Axis 2's column; absent: `e2`.
     pub rotate_column: Option<String>,
+}
+
+/// A turntable's plan: its nominal model, the reflectors and the sweep.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TurntablePlanIn {
+    /// The nominal turntable's JSON description (the file `robocal plan
+    /// --turntable` reads).
+    pub nominal: serde_json::Value,
+    /// The reflectors' design positions on the face plate [mm]; the first is
+    /// the reference.
+    pub reflectors: Vec<[f64; 3]>,
+    /// The sweep, lowest and highest value [deg]; absent: −165, 165.
+    pub travel_deg: Option<[f64; 2]>,
+    /// Values of the sweep, 4 to [`SWEEP_VALUES_MAX`]; absent: 12.
+    #[serde(default, deserialize_with = "present_int")]
+    pub values: Option<usize>,
+    /// The axis's column, `e1` … `e6`; absent: `e1`.
+    pub column: Option<String>,
 }
 
 /// Most values of one sweep of a positioner's plan.
@@ -191,10 +214,12 @@ pub struct PlanResponse {
     /// plan over a track).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub stations: Option<Vec<PlannedStation>>,
-    /// A positioner's plan: the predicted σ of each axis's parameters.
+    /// A positioner's or a turntable's plan: the predicted σ of each axis's
+    /// parameters (a turntable's one, `rotate`).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub sigma: Option<[AxisSigma; 2]>,
-    /// A positioner's plan: the predicted σ of each reflector's position [mm].
+    pub sigma: Option<Vec<AxisSigma>>,
+    /// A positioner's or a turntable's plan: the predicted σ of each
+    /// reflector's position [mm].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reflector_sigma_mm: Option<Vec<f64>>,
     /// The chosen poses: point names, controller joints [deg] and, over a
@@ -251,12 +276,10 @@ fn over_track(req: &PlanRequest, poses: usize) -> Result<Option<OverTrack>, ApiE
     Ok(Some(over))
 }
 
-/// A positioner's plan as a service command (422 naming what is wrong).
-fn positioner_command(
-    robot_id: i64,
-    req: &PlanRequest,
-    p: &PositionerPlanIn,
-) -> Result<PlanCommand, ApiError> {
+/// A face plate's plan (`what`: `positioner` or `turntable`): a field that
+/// lays out robot poses is a 422 naming it; its reflectors (1 to
+/// [`REFLECTORS_MAX`]) and `noise_mm` checked, the noise returned.
+fn plate_only(req: &PlanRequest, what: &str, reflectors: usize) -> Result<f64, ApiError> {
     let robot_fields = [
         ("poses", req.poses.is_some()),
         ("candidates", req.candidates.is_some()),
@@ -271,18 +294,73 @@ fn positioner_command(
     ];
     if let Some((field, _)) = robot_fields.iter().find(|(_, given)| *given) {
         return Err(ApiError::invalid(format!(
-            "`{field}` lays out robot poses; a positioner's plan takes `positioner` and `noise_mm`"
+            "`{field}` lays out robot poses; a {what}'s plan takes `{what}` and `noise_mm`"
         )));
     }
+    if !(1..=REFLECTORS_MAX).contains(&reflectors) {
+        return Err(ApiError::invalid(format!(
+            "`{what}.reflectors`: 1 to {REFLECTORS_MAX} design positions, got {reflectors}"
+        )));
+    }
+    let noise_mm = req.noise_mm.unwrap_or(PlanSettings::default().noise_mm);
+    if !(noise_mm.is_finite() && noise_mm > 0.0 && noise_mm <= 100.0) {
+        return Err(ApiError::invalid(format!(
+            "`noise_mm`: above 0 and at most 100 mm, got {noise_mm}"
+        )));
+    }
+    Ok(noise_mm)
+}
+
+/// A turntable's plan as a service command (422 naming what is wrong).
+fn turntable_command(
+    robot_id: i64,
+    req: &PlanRequest,
+    t: &TurntablePlanIn,
+) -> Result<PlanCommand, ApiError> {
+    if req.positioner.is_some() {
+        return Err(ApiError::invalid(
+            "`positioner` and `turntable` each lay out a face plate's sweeps: give one",
+        ));
+    }
+    let noise_mm = plate_only(req, "turntable", t.reflectors.len())?;
+    let program = program_of(req)?;
+    let nominal = Turntable::from_json(&t.nominal.to_string())
+        .map_err(|e| ApiError::invalid(format!("`turntable.nominal`: {e}")))?;
+    let d = TurntablePlanSettings::default();
+    let values = t.values.unwrap_or(d.values);
+    if values > SWEEP_VALUES_MAX {
+        return Err(ApiError::invalid(format!(
+            "`turntable.values`: at most {SWEEP_VALUES_MAX}, got {values}"
+        )));
+    }
+    let settings = TurntablePlanSettings {
+        reflectors_mm: t.reflectors.clone(),
+        travel_deg: t.travel_deg.unwrap_or(d.travel_deg),
+        values,
+        column: external_axis("turntable.column", t.column.as_deref(), d.column)?,
+        noise_mm,
+    };
+    Ok(PlanCommand {
+        robot_id,
+        settings: PlanSettings {
+            noise_mm,
+            ..PlanSettings::default()
+        },
+        program,
+        kind: PlanKind::Turntable(ForTurntable { nominal, settings }),
+    })
+}
+
+/// A positioner's plan as a service command (422 naming what is wrong).
+fn positioner_command(
+    robot_id: i64,
+    req: &PlanRequest,
+    p: &PositionerPlanIn,
+) -> Result<PlanCommand, ApiError> {
+    let noise_mm = plate_only(req, "positioner", p.reflectors.len())?;
     let program = program_of(req)?;
     let nominal = TiltRotate::from_json(&p.nominal.to_string())
         .map_err(|e| ApiError::invalid(format!("`positioner.nominal`: {e}")))?;
-    if !(1..=REFLECTORS_MAX).contains(&p.reflectors.len()) {
-        return Err(ApiError::invalid(format!(
-            "`positioner.reflectors`: 1 to {REFLECTORS_MAX} design positions, got {}",
-            p.reflectors.len()
-        )));
-    }
     let d = PositionerPlanSettings::default();
     let values = |field: &str, v: Option<usize>, default: usize| {
         let n = v.unwrap_or(default);
@@ -293,12 +371,6 @@ fn positioner_command(
         }
         Ok(n)
     };
-    let noise_mm = req.noise_mm.unwrap_or(d.noise_mm);
-    if !(noise_mm.is_finite() && noise_mm > 0.0 && noise_mm <= 100.0) {
-        return Err(ApiError::invalid(format!(
-            "`noise_mm`: above 0 and at most 100 mm, got {noise_mm}"
-        )));
-    }
     let settings = PositionerPlanSettings {
         reflectors_mm: p.reflectors.clone(),
         tilt_deg: p.tilt_deg.unwrap_or(d.tilt_deg),
@@ -389,6 +461,9 @@ fn program_of(req: &PlanRequest) -> Result<Option<(Language, String, f64)>, ApiE
 
 /// The request as a service command (422 naming what is wrong).
 fn command(robot_id: i64, req: PlanRequest) -> Result<PlanCommand, ApiError> {
+    if let Some(t) = &req.turntable {
+        return turntable_command(robot_id, &req, t);
+    }
     if let Some(p) = &req.positioner {
         return positioner_command(robot_id, &req, p);
     }
@@ -528,7 +603,13 @@ fn response(
         }
         PlanMade::Positioner(p) => {
             out.noise_mm = p.noise_mm;
-            out.sigma = Some(p.sigma);
+            out.sigma = Some(p.sigma.to_vec());
+            out.reflector_sigma_mm = Some(p.reflector_sigma_mm);
+            out.points = p.points;
+        }
+        PlanMade::Turntable(p) => {
+            out.noise_mm = p.noise_mm;
+            out.sigma = Some(vec![p.sigma]);
             out.reflector_sigma_mm = Some(p.reflector_sigma_mm);
             out.points = p.points;
         }

@@ -4,17 +4,19 @@
 //! deviations they predict, as a joint CSV and optionally a program.
 //! Over a linear track (`core::plan::track`), the poses are laid out at
 //! stations over its travel, D-optimal for each station's base pose; for a
-//! positioner (`core::plan::positioner`), its two sweeps.
+//! positioner (`core::plan::positioner`), its two sweeps; for a turntable
+//! (`core::plan::turntable`), its one.
 //! CPU-bound (forward kinematics of every candidate, a greedy D-optimal
 //! choice): runs on the solve workers behind their admission control.
 
 use super::solve::{chosen_model, ModelChoice};
 use super::{AppState, ServiceError};
 use crate::measure::external::ExternalAxis;
-use crate::model::external::{LinearTrack, TiltRotate};
+use crate::model::external::{LinearTrack, TiltRotate, Turntable};
 use crate::plan::{
-    make_plan, make_positioner_plan, make_track_plan, plan_csv, points_program, MeasurementPlan,
-    PlanPoint, PlanSettings, PositionerPlan, PositionerPlanSettings, TrackPlan, TrackPlanSettings,
+    make_plan, make_positioner_plan, make_track_plan, make_turntable_plan, plan_csv,
+    points_program, MeasurementPlan, PlanPoint, PlanSettings, PositionerPlan,
+    PositionerPlanSettings, TrackPlan, TrackPlanSettings, TurntablePlan, TurntablePlanSettings,
 };
 use crate::program::{Language, ProgramFile};
 
@@ -46,6 +48,17 @@ pub enum PlanKind {
     Track(OverTrack),
     /// A positioner's two sweeps (the robot's settings unused).
     Positioner(ForPositioner),
+    /// A turntable's sweep (the robot's settings unused).
+    Turntable(ForTurntable),
+}
+
+/// A turntable's plan: its nominal model and sweep.
+#[derive(Debug, Clone)]
+pub struct ForTurntable {
+    /// The nominal turntable.
+    pub nominal: Turntable,
+    /// The sweep, reflectors and column.
+    pub settings: TurntablePlanSettings,
 }
 
 /// A positioner's plan: its nominal model and sweeps.
@@ -91,6 +104,8 @@ pub enum PlanMade {
     Track(TrackPlan),
     /// A positioner's sweeps, with the σ of its parameters.
     Positioner(PositionerPlan),
+    /// A turntable's sweep, with the σ of its parameters.
+    Turntable(TurntablePlan),
 }
 
 impl PlanMade {
@@ -100,6 +115,7 @@ impl PlanMade {
             PlanMade::FixedBase(p) => &p.points,
             PlanMade::Track(p) => &p.points,
             PlanMade::Positioner(p) => &p.points,
+            PlanMade::Turntable(p) => &p.points,
         }
     }
 }
@@ -148,6 +164,9 @@ pub async fn make(state: &AppState, cmd: PlanCommand) -> Result<PlanOutcome, Ser
             ),
             PlanKind::Positioner(p) => PlanMade::Positioner(
                 make_positioner_plan(&p.nominal, &p.settings).map_err(|e| invalid(&e))?,
+            ),
+            PlanKind::Turntable(t) => PlanMade::Turntable(
+                make_turntable_plan(&t.nominal, &t.settings).map_err(|e| invalid(&e))?,
             ),
         };
         let program = match &cmd.program {

@@ -403,3 +403,115 @@ async fn a_positioners_plan_is_the_command_lines() {
         assert!(r.text().contains(words), "{body}: {}", r.text());
     }
 }
+
+/// A turntable's plan over HTTP is `robocal plan --turntable` on the same
+/// nominal file: the CSV and the Fanuc program byte for byte, the points and
+/// predicted σ the library's; what does not apply is a 422 naming it.
+#[tokio::test]
+async fn a_turntables_plan_is_the_command_lines() {
+    use clap::Parser;
+    use robocal::plan::{make_turntable_plan, TurntablePlanSettings};
+    use robocal::sim::turntable_example as example;
+    let t = setup().await;
+    let rid = t.create_robot("ys100").await.to_string();
+    let nominal = example::nominal();
+    let description: serde_json::Value = serde_json::from_str(&nominal.to_json()).unwrap();
+    let turntable = json!({
+        "nominal": description,
+        "reflectors": [[400, 0, 20], [-150, 100, 20]],
+        "travel_deg": [-120, 150],
+        "values": 9,
+    });
+    let body = json!({ "turntable": turntable, "noise_mm": 0.02, "language": "fanuc", "name": "tt", "wait_s": 2 });
+    let r = t.post_json(PLANS, &[&rid], body).await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let v = r.json();
+    assert_eq!(v["poses"], 9);
+    let d = tempfile::tempdir().unwrap();
+    let file = |n: &str| d.path().join(n).to_str().unwrap().to_string();
+    std::fs::write(file("tt.json"), nominal.to_json()).unwrap();
+    let (tt, csv, ls) = (file("tt.json"), file("plan.csv"), file("tt.ls"));
+    let argv = [
+        "robocal",
+        "plan",
+        "--turntable",
+        &tt,
+        "--reflector",
+        "400,0,20",
+        "--reflector",
+        "-150,100,20",
+        "--travel=-120,150",
+        "--values",
+        "9",
+        "--noise-mm",
+        "0.02",
+        "--format",
+        "fanuc",
+        "--name",
+        "tt",
+        "--out",
+        &ls,
+        "--csv",
+        &csv,
+    ];
+    let robocal::cli::Command::Plan(a) = robocal::cli::Cli::try_parse_from(argv).unwrap().command
+    else {
+        panic!("not a plan")
+    };
+    robocal::cli::plan::make(&a.make).unwrap();
+    let written = std::fs::read_to_string(&csv).unwrap();
+    assert_eq!(v["joints_csv"].as_str().unwrap(), written);
+    assert!(written.starts_with("point,e1\nP1,-120\n"), "{written}");
+    assert_eq!(
+        v["program"]["files"][0]["content"].as_str().unwrap(),
+        std::fs::read_to_string(&ls).unwrap()
+    );
+    let want = make_turntable_plan(
+        &nominal,
+        &TurntablePlanSettings {
+            reflectors_mm: example::DESIGN_MM.to_vec(),
+            travel_deg: [-120.0, 150.0],
+            values: 9,
+            noise_mm: 0.02,
+            ..TurntablePlanSettings::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(serde_json::to_value(&want.points).unwrap(), v["points"]);
+    assert_eq!(serde_json::to_value([want.sigma]).unwrap(), v["sigma"]);
+    assert_eq!(v["sigma"][0]["axis"], "rotate");
+    assert_eq!(
+        serde_json::to_value(&want.reflector_sigma_mm).unwrap(),
+        v["reflector_sigma_mm"]
+    );
+    for (body, words) in [
+        (
+            json!({ "turntable": turntable, "poses": 10 }),
+            "`poses` lays out robot poses",
+        ),
+        (
+            json!({ "turntable": turntable, "positioner": { "nominal": {}, "reflectors": [[1, 2, 3]] } }),
+            "give one",
+        ),
+        (
+            json!({ "turntable": { "nominal": {}, "reflectors": [[400, 0, 20]] } }),
+            "`turntable.nominal`",
+        ),
+        (
+            json!({ "turntable": { "nominal": description, "reflectors": [[5, 0, 20]] } }),
+            "5.0 mm from the axis",
+        ),
+        (
+            json!({ "turntable": { "nominal": description, "reflectors": [[400, 0, 20]], "travel_deg": [-30, 30] } }),
+            "spans 60°",
+        ),
+        (
+            json!({ "turntable": { "nominal": description, "reflectors": [] } }),
+            "`turntable.reflectors`",
+        ),
+    ] {
+        let r = t.post_json(PLANS, &[&rid], body.clone()).await;
+        assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{body}");
+        assert!(r.text().contains(words), "{body}: {}", r.text());
+    }
+}
