@@ -298,6 +298,7 @@ def turntable_through_the_form(driver, wait, shot, base, robocal, axes, rail_id,
     print(f"console_check: turntable fitted, RMS {shown['rms']} mm over {shown['readings']} readings; "
           f"zero offset {shown['zero']}°, scale {shown['scale']}, axis through {shown['point']} mm")
     shot("turntable-fitted", "turntable-stored-box")
+    predict_and_solve_on_turntable(driver, wait, shot, base, rail_id, h)
     # Refused: the form reads the axis's value from e2, the files have e1.
     form = driver.find_element(By.ID, "calibrate-turntable")
     Select(form.find_element(By.NAME, "column")).select_by_value("e2")
@@ -509,6 +510,65 @@ def predict_and_solve_on_positioner(driver, wait, shot, base, rail_id, h):
     print(f"console_check: solved on the positioner: {summary}; the solved joints put the point within "
           f"{worst:.1e} mm of its target on the face plate")
     shot("solved-on-positioner", "solve-section")
+
+
+def predict_and_solve_on_turntable(driver, wait, shot, base, rail_id, h):
+    """The rail robot with its turntable stored and no track: the page's
+    predict form ticked "on the turntable" with e1 = 40 states the poses on
+    its face plate as the API's predict with `turntable` does; the points,
+    as a targets CSV with an `e1` column, are solved in the solve form
+    ticked likewise as the API solves them (`?turntable=true`)."""
+    readings = [("t1", [10, 90, -20, 0, 45, 0]), ("t2", [0, 100, 0, 0, 60, 0])]
+    form = driver.find_element(By.ID, "predict")
+    form.find_element(By.NAME, "readings").clear()
+    form.find_element(By.NAME, "readings").send_keys(
+        "\n".join(f"{i}, " + ", ".join(str(q) for q in js) for i, js in readings))
+    for name in ("e1", "e2", "e3"):
+        form.find_element(By.NAME, name).clear()
+    form.find_element(By.NAME, "e1").send_keys("40")
+    form.find_element(By.NAME, "turntable").click()
+    form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+    wait.until(lambda d: "on the turntable" in (h.text_of(d, "#predict-summary") or "")
+               or (h.text_of(d, "#message") or "").startswith("4"))
+    summary = driver.find_element(By.ID, "predict-summary").text
+    rows = [[td.text for td in r.find_elements(By.TAG_NAME, "td")]
+            for r in driver.find_elements(By.CSS_SELECTOR, "#predict-table tbody tr")]
+    body = {"readings": [{"id": i, "joints_deg": js} for i, js in readings], "version": "active",
+            "turntable": True, "e1": 40}
+    want = h.api_post(base, f"/v1/robots/{rail_id}/predict", body)
+    assert want["frame"] == "face_plate", want["frame"]
+    assert summary.startswith("2 poses of the measured point in the face_plate frame (e1 = 40, on the turntable) at "), \
+        (summary, h.text_of(driver, "#message"))
+    for row, p in zip(rows, want["results"], strict=True):
+        expected = [p["id"], p["status"]] + [shown_number(p[k], 3) for k in "xyz"] \
+            + [shown_number(p[k], 4) for k in ("rx", "ry", "rz")]
+        assert row[:8] == expected, (row, expected)
+    print(f"console_check: predicted on the turntable at e1 = 40: {summary}, as the API gives it")
+    shot("predicted-on-turntable", "predict-section")
+    form.find_element(By.NAME, "turntable").click()
+    form.find_element(By.NAME, "e1").clear()
+    csv = "id,x,y,z,e1\n" + "".join(f"{p['id']},{p['x']!r},{p['y']!r},{p['z']!r},40\n" for p in want["results"])
+    form = driver.find_element(By.ID, "solve")
+    form.find_element(By.NAME, "csv").clear()
+    form.find_element(By.NAME, "csv").send_keys(csv)
+    if not form.find_element(By.NAME, "position_only").is_selected():
+        form.find_element(By.NAME, "position_only").click()
+    form.find_element(By.NAME, "turntable").click()
+    before = h.text_of(driver, "#solve-summary")
+    form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+    wait.until(lambda d: (h.text_of(d, "#solve-summary") or before) != before
+               or (h.text_of(d, "#message") or "").startswith("4"))
+    summary = driver.find_element(By.ID, "solve-summary").text
+    shown = driver.execute_script("return document.getElementById('solve-csv').textContent")
+    assert summary.startswith("2 of 2 targets solved"), (summary, h.text_of(driver, "#message"))
+    status, answer = api_raw(h.KEY, base, "POST",
+                             f"/v1/robots/{rail_id}/solve?version=active&position_only=true&turntable=true",
+                             csv.encode(), "text/csv")
+    assert status == 200, (status, answer)
+    assert shown == answer.decode(), (shown, answer.decode())
+    print(f"console_check: solved on the turntable: {summary}, the page's CSV the API's")
+    shot("solved-on-turntable", "solve-section")
+    form.find_element(By.NAME, "turntable").click()
 
 
 def csv_rows(text):

@@ -286,7 +286,7 @@ pub struct CellExportResponse {
     /// The position registers the program overwrites (Fanuc with `registers`).
     pub registers: Vec<UsedRegister>,
     /// With `axes`: the kinematic system written, what it does not hold,
-    /// and the positioner or track the controller then computes.
+    /// and the positioner, track or turntable the controller then computes.
     pub kinematics: Option<KinematicsOut>,
 }
 

@@ -107,11 +107,11 @@ fn a_controller_holding_the_exported_positioner_leaves_the_filter_the_scales() {
         .collect();
     assert_eq!(not_held.len(), 2, "{exported}");
     let bound: f64 = not_held.iter().sum();
-    // `--held` without the axes it would write is refused, naming both.
+    // `--held` without the axes it would write is refused, naming them.
     let out = robocal(d, &[&export[..8], &["--held", "x.json"]].concat());
     assert_ne!(code(&out), 0);
     assert!(
-        text(&out.stderr).contains("--positioner or --track"),
+        text(&out.stderr).contains("--positioner, --track or --turntable"),
         "{}",
         text(&out.stderr)
     );

@@ -107,6 +107,35 @@ pub fn program_columns(columns: &PositionerColumns, language: Language) -> Resul
     Ok(())
 }
 
+/// Refuses a face plate's plan without reflectors, with a reflector's
+/// position that is not finite numbers of at most 100 000 mm, or a tracker
+/// noise that is not a positive number of mm.
+pub(super) fn check_reflectors_and_noise(
+    reflectors_mm: &[[f64; 3]],
+    noise_mm: f64,
+) -> Result<(), PlanError> {
+    if reflectors_mm.is_empty() {
+        return Err(PlanError::Setting(
+            "give the reflectors' design positions on the face plate (the first is the reference)"
+                .into(),
+        ));
+    }
+    if reflectors_mm
+        .iter()
+        .any(|r| r.iter().any(|v| !(v.is_finite() && v.abs() <= 100_000.0)))
+    {
+        return Err(PlanError::Setting(
+            "a reflector's position: finite numbers of at most 100 000 mm".into(),
+        ));
+    }
+    if !(noise_mm.is_finite() && noise_mm > 0.0) {
+        return Err(PlanError::Setting(format!(
+            "the tracker noise must be a positive number of mm, got {noise_mm}"
+        )));
+    }
+    Ok(())
+}
+
 /// Refuses a sweep the fit would refuse: its range, span and count
 /// (`calibrate::external::judge`).
 pub(super) fn check_sweep(name: &str, range: [f64; 2], values: usize) -> Result<(), PlanError> {
@@ -164,26 +193,7 @@ pub fn make_positioner_plan(
     nominal: &TiltRotate,
     s: &PositionerPlanSettings,
 ) -> Result<PositionerPlan, PlanError> {
-    if s.reflectors_mm.is_empty() {
-        return Err(PlanError::Setting(
-            "give the reflectors' design positions on the face plate (the first is the reference)"
-                .into(),
-        ));
-    }
-    if s.reflectors_mm
-        .iter()
-        .any(|r| r.iter().any(|v| !(v.is_finite() && v.abs() <= 100_000.0)))
-    {
-        return Err(PlanError::Setting(
-            "a reflector's position: finite numbers of at most 100 000 mm".into(),
-        ));
-    }
-    if !(s.noise_mm.is_finite() && s.noise_mm > 0.0) {
-        return Err(PlanError::Setting(format!(
-            "the tracker noise must be a positive number of mm, got {}",
-            s.noise_mm
-        )));
-    }
+    check_reflectors_and_noise(&s.reflectors_mm, s.noise_mm)?;
     if s.columns.tilt == s.columns.rotate {
         return Err(PlanError::Setting(format!(
             "one column, {}, for both axes",

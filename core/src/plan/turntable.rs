@@ -16,7 +16,7 @@
 //! the scale; per reflector its position [mm]). Frames: reflectors in the
 //! face plate frame [mm]; values in the controller's degrees.
 
-use super::positioner::check_sweep;
+use super::positioner::{check_reflectors_and_noise, check_sweep};
 use super::settings::PlanError;
 use super::{evenly, PlanPoint};
 use crate::calibrate::external::fit::variances;
@@ -79,26 +79,7 @@ pub struct TurntablePlan {
 
 /// Refuses settings the fit would refuse, or that are not numbers.
 fn check(nominal: &Turntable, s: &TurntablePlanSettings) -> Result<(), PlanError> {
-    if s.reflectors_mm.is_empty() {
-        return Err(PlanError::Setting(
-            "give the reflectors' design positions on the face plate (the first is the reference)"
-                .into(),
-        ));
-    }
-    if s.reflectors_mm
-        .iter()
-        .any(|r| r.iter().any(|v| !(v.is_finite() && v.abs() <= 100_000.0)))
-    {
-        return Err(PlanError::Setting(
-            "a reflector's position: finite numbers of at most 100 000 mm".into(),
-        ));
-    }
-    if !(s.noise_mm.is_finite() && s.noise_mm > 0.0) {
-        return Err(PlanError::Setting(format!(
-            "the tracker noise must be a positive number of mm, got {}",
-            s.noise_mm
-        )));
-    }
+    check_reflectors_and_noise(&s.reflectors_mm, s.noise_mm)?;
     check_sweep("the turntable", s.travel_deg, s.values)?;
     // In the base frame at value 0 (a turn about the axis keeps the
     // distance from it).

@@ -320,7 +320,7 @@ pub(super) fn predict_section(
         section #predict-section {
             h2 { "Predict poses" }
             p.note { "Controller joint readings in degrees, one reading a line (an id first is optional: p1, 10, -80, 95, 0, 45, 0); the pose of the measured point or of a tool, in mm and degrees (R = Rz·Ry·Rx), and in a controller's convention when one is chosen." }
-            p.note #predict-axes-note { "External axes, as the controller shows them, through the robot's stored track and positioner: e1 alone is the track's value [mm]; e1, e2 the positioner's tilt and rotate [°], the poses then on its face plate (keep the first Frame entry); e1, e2, e3 the track's value [mm] and, beside it, the positioner's tilt and rotate [°]. Leave them empty for none; the service refuses a combination the stored axes do not fit, saying why." }
+            p.note #predict-axes-note { "External axes, as the controller shows them, through the robot's stored track and positioner: e1 alone is the track's value [mm]; e1, e2 the positioner's tilt and rotate [°], the poses then on its face plate (keep the first Frame entry); e1, e2, e3 the track's value [mm] and, beside it, the positioner's tilt and rotate [°]. On the turntable (ticked): e1 is the stored turntable's value [°], or e2 beside the track's e1. Leave them empty for none; the service refuses a combination the stored axes do not fit, saying why." }
             form #predict data-action="predict" data-robot=(id) {
                 label.wide { "Joint readings " textarea name="readings" rows="3" placeholder="p1, 10, -80, 95, 0, 45, 0" {} }
                 (model_select(versions))
@@ -352,6 +352,8 @@ pub(super) fn predict_section(
                     input name="e2" type="number" step="any"; }
                 label { "e3 (the positioner's rotate [°] beside a track) "
                     input name="e3" type="number" step="any"; }
+                label title="The part is on the robot's stored turntable: e1 is its value [°] (e2 beside a track's e1), the poses on its face plate" {
+                    input type="checkbox" name="turntable" value="true"; " on the turntable" }
                 button type="submit" { "Predict" }
             }
             div #predict-result hidden {

@@ -85,6 +85,7 @@ const handlers = {
       if (v) q.set(k, v);
     }
     if (form.elements["position_only"].checked) q.set("position_only", "true");
+    if (form.elements["turntable"].checked) q.set("turntable", "true");
     const r = await api("POST", `/v1/robots/${robot}/solve?${q}`, text, "text/csv", "text/csv");
     // "solved/total" of the whole batch, from the answer's header.
     const [solved, total] = (r.headers.get("X-Robocal-Solved") || "0/0").split("/");
@@ -367,6 +368,11 @@ handlers.predict = async function (form) {
     if (!v) continue;
     body[name] = Number(v);
     axes.push(`${name} = ${v}`);
+  }
+  // On the stored turntable: e1 is its value (e2 beside a track's e1).
+  if (form.elements["turntable"].checked) {
+    body.turntable = true;
+    axes.push("on the turntable");
   }
   const version = formValue(form, "version");
   if (version) body.version = /^[0-9]+$/.test(version) ? Number(version) : version;

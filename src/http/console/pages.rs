@@ -480,7 +480,7 @@ fn solve_section(id: i64, versions: &[VersionRow]) -> Markup {
         section #solve-section {
             h2 { "Solve targets" }
             p.note { "A targets CSV (id, x, y, z in mm and the orientation columns of one convention, e.g. a,b,c) in, joint commands and false targets out, as CSV." }
-            p.note #solve-axes-note { "The CSV may carry the external axes' values per row, as the controller shows them, solved through the robot's stored track and positioner: an e1 column alone is the track's value [mm]; e1, e2 the positioner's tilt and rotate [°], the targets then on its face plate (keep the first Frame entry); e1, e2, e3 the track's value [mm] and, beside it, the positioner's tilt and rotate [°]." }
+            p.note #solve-axes-note { "The CSV may carry the external axes' values per row, as the controller shows them, solved through the robot's stored track and positioner: an e1 column alone is the track's value [mm]; e1, e2 the positioner's tilt and rotate [°], the targets then on its face plate (keep the first Frame entry); e1, e2, e3 the track's value [mm] and, beside it, the positioner's tilt and rotate [°]. On the turntable (ticked): an e1 column is the stored turntable's value [°], or e2 beside the track's e1." }
             form #solve data-action="solve" data-robot=(id) {
                 label.wide { "Targets CSV " input type="file" name="file" accept=".csv,text/csv"; }
                 label.wide { "or paste it " textarea name="csv" rows="3" placeholder="id,x,y,z,a,b,c" {} }
@@ -492,6 +492,8 @@ fn solve_section(id: i64, versions: &[VersionRow]) -> Markup {
                 label { "Payload [kg] " input name="payload_kg" type="number" step="any" min="0"; }
                 label { "Branch " input name="branch" placeholder="e.g. front,up,noflip"; }
                 label { input type="checkbox" name="position_only" value="true"; " position only" }
+                label title="The targets are on the robot's stored turntable, in its face plate frame: an e1 column is its value [°] (e2 beside a track's e1)" {
+                    input type="checkbox" name="turntable" value="true"; " on the turntable" }
                 button type="submit" { "Solve" }
             }
             div #solve-result hidden {
