@@ -498,9 +498,11 @@ pub fn json_command(
     }
     let query = q.options()?;
     let seed_in_body = req.branch.is_some() || req.seed_deg.is_some();
-    let plate = plate_of(req.turntable.or(query.turntable));
+    // The body says whether its targets are on the turntable (the query's
+    // `turntable` is a targets CSV's).
+    let plate = plate_of(req.turntable);
     // A positioner's or a turntable's values state the targets' frame (its
-    // face plate): the query's `frame` does not stand in for the body's.
+    // face plate): the query's `frame` and `e1` do not stand in for the body's.
     let on_plate = req.e2.is_some() || plate == Plate::Turntable;
     let (branch, seed_deg) = if seed_in_body {
         (req.branch.as_deref(), req.seed_deg.clone())
@@ -523,7 +525,7 @@ pub fn json_command(
             convention: req.convention.as_deref().or(query.convention),
             position_only: req.position_only.or(query.position_only).unwrap_or(false),
             path: req.path.or(query.path).unwrap_or(false),
-            e1: if req.e2.is_some() {
+            e1: if on_plate {
                 req.e1
             } else {
                 req.e1.or(query.e1)
@@ -579,9 +581,10 @@ pub struct CsvSolveQuery {
     /// The track's value [mm] (the robot carried along its stored track);
     /// with `turntable`, the turntable's value [deg] for every row.
     pub e1: Option<f64>,
-    /// The targets are on the robot's stored one-axis turntable, in its
-    /// face plate frame: a CSV's `e1` column is its value per row (or `e2`
-    /// beside the track's `e1`).
+    /// A targets CSV's targets are on the robot's stored one-axis
+    /// turntable, in its face plate frame: its `e1` column is the value per
+    /// row (or `e2` beside the track's `e1`). Not used by JSON solves, whose
+    /// body gives `turntable`.
     pub turntable: Option<bool>,
     /// `point` or `comma` (detected when absent).
     pub decimal: Option<String>,

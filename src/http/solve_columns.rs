@@ -236,7 +236,7 @@ fn turntable_values(
         (Some(t), Some(v)) => (Some(t), v, "e2"),
         (None, _) => {
             return Err(ApiError::invalid(
-                "`turntable` needs the turntable's value: `e1` [deg] (a targets CSV's `e1` column, or the query's `e1` for every row), or `e2` beside the track's `e1` [mm]",
+                "`turntable` needs the turntable's value: `e1` [deg] (a JSON body's, a targets CSV's `e1` column, or the query's `e1` for every row of a CSV), or `e2` beside the track's `e1` [mm]",
             ))
         }
     };

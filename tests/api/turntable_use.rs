@@ -280,9 +280,9 @@ fn taught(fitted: &Turntable, real: &TruePositioner, p: &Vector3<f64>) -> Vector
 }
 
 /// The same points as a JSON solve with `turntable` and `e1` at each value:
-/// the targets CSV's joints at that value; the query's `e1` is the value
-/// when the body gives none; `e3`, `frame` and a value beyond two turns
-/// are 422.
+/// the targets CSV's joints at that value, the query's `e1`, `frame` and
+/// `turntable` not standing in for the body's; no value, `e3`, `frame`,
+/// a work object and a value beyond two turns are 422.
 async fn json_solve(
     t: &TestApp,
     rid: &str,
@@ -298,10 +298,14 @@ async fn json_solve(
         })
         .collect();
     for (k, v) in VALUES.iter().enumerate() {
-        // The value in the body, then in the query.
+        // The value in the body; the query's `e1` and `turntable` do not
+        // stand in for the body's.
         for (q, body) in [
             ("".to_string(), json!({ "turntable": true, "e1": v })),
-            (format!("?e1={v}&turntable=true"), json!({})),
+            (
+                "?e1=7&frame=base&turntable=false".to_string(),
+                json!({ "turntable": true, "e1": v }),
+            ),
         ] {
             let mut body = body;
             body["targets"] = json!(targets);
@@ -335,6 +339,10 @@ async fn json_solve(
     }
     for (extra, words) in [
         (json!({ "turntable": true }), "needs the turntable's value"),
+        (
+            json!({ "turntable": true, "e2": 5.0 }),
+            "needs the turntable's value",
+        ),
         (
             json!({ "turntable": true, "e1": 5.0, "e2": 5.0, "e3": 1.0 }),
             "one axis",
