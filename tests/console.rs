@@ -317,6 +317,74 @@ async fn the_predict_form_takes_the_external_axes_values() {
     }
 }
 
+/// The filter form takes the controller's track and its positioner or
+/// turntable (a file or pasted JSON, the kind chosen) and "correct the
+/// axes' values"; the plan form chooses what to plan, each subject's inputs
+/// in its fieldset, hidden until chosen, empty for the API's defaults.
+#[tokio::test]
+async fn the_filter_and_plan_forms_take_the_external_axes() {
+    let (state, _dir) = state().await;
+    let robot = post_json(
+        &state,
+        "/v1/robots",
+        &serde_json::json!({ "name": "cell", "preset": "ur5" }),
+        StatusCode::CREATED,
+    )
+    .await;
+    let id = robot["id"].as_i64().unwrap();
+    let (s, html) = call(&state, "GET", &format!("/ui/robots/{id}"), None).await;
+    assert_eq!(s, StatusCode::OK);
+    let filter = form(&html, "filter");
+    for field in [
+        "<input type=\"file\" name=\"controller_track_file\"",
+        "<textarea name=\"controller_track\"",
+        "<select name=\"controller_plate_kind\"><option value=\"positioner\">",
+        "<option value=\"turntable\">turntable</option>",
+        "<input type=\"file\" name=\"controller_plate_file\"",
+        "<textarea name=\"controller_plate\"",
+        "<input type=\"checkbox\" name=\"correct_axes\" value=\"true\">",
+    ] {
+        assert!(filter.contains(field), "the filter form lacks {field}");
+    }
+    assert!(html.contains("<p id=\"filter-axes\" hidden>"));
+    let plan = form(&html, "measurement-plan");
+    assert!(plan.contains("<select name=\"what\"><option value=\"robot\">robot poses</option>"));
+    for what in ["track", "positioner", "turntable"] {
+        let open = format!("<fieldset class=\"plan-what\" data-what=\"{what}\" hidden>");
+        let at = plan
+            .find(&open)
+            .unwrap_or_else(|| panic!("no hidden fieldset for {what}"));
+        let set = &plan[at..at + plan[at..].find("</fieldset>").unwrap()];
+        assert!(set.contains(&format!("name=\"{what}_file\"")), "{set}");
+        assert!(
+            set.contains(&format!("<textarea name=\"{what}_json\"")),
+            "{set}"
+        );
+        assert_eq!(
+            set.contains(&format!("<textarea name=\"{what}_reflectors\"")),
+            what != "track",
+            "{set}"
+        );
+    }
+    for name in [
+        "stations",
+        "track_travel_min",
+        "travel_min",
+        "tilt_min",
+        "tilt_values",
+        "rotate_max",
+        "travel_values",
+    ] {
+        assert_eq!(input_value(plan, name), None, "{name} is prefilled");
+    }
+    for id in ["plan-stations", "plan-sigma"] {
+        assert!(
+            html.contains(&format!("<table id=\"{id}\" hidden>")),
+            "{id}"
+        );
+    }
+}
+
 /// The robot page's `#axes-section`, from its opening tag to its end.
 fn axes_section(html: &str) -> &str {
     let at = html

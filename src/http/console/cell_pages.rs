@@ -291,17 +291,42 @@ pub(super) fn filter_section(id: i64, versions: &[VersionRow]) -> Markup {
                         option value="fanuc" { "Fanuc .ls" } option value="urscript" { "URScript" }
                     }
                 }
+                (filter_axes_fields())
                 button type="submit" { "Filter" }
             }
             div #filter-result hidden {
                 p #filter-summary {}
+                p #filter-axes hidden {}
                 p #filter-downloads {}
                 p { a #filter-report-download download="filter-report.json" href="#" { "Download the report (JSON)" } }
                 table #filter-report {
-                    thead { tr { th { "File" } th { "Line" } th { "Motion" } th { "Status" } th { "Shift [mm]" } th { "Configuration" } th { "Reason" } } }
+                    thead { tr { th { "File" } th { "Line" } th { "Motion" } th { "Status" } th { "Shift [mm]" } th { "Configuration" } th { "Reason" } th { "Axes" } } }
                     tbody {}
                 }
             }
+        }
+    }
+}
+
+/// The filter's optional external axes: the controller's own track and its
+/// positioner or turntable (JSON files or pasted), and whether their values
+/// are corrected (`controller_track`, `controller_positioner`,
+/// `controller_turntable`, `correct_axes`).
+fn filter_axes_fields() -> Markup {
+    html! {
+        fieldset #filter-axes-fields {
+            legend { "External axes (optional): the controller's own, as it believes them; the robot's stored ones are the real" }
+            label.wide { "The controller's track (JSON) " input type="file" name="controller_track_file" accept=".json,application/json"; }
+            label.wide { "or paste it " textarea name="controller_track" rows="2" placeholder="{\"direction\": …}" {} }
+            label { "The face plate's axes "
+                select name="controller_plate_kind" {
+                    option value="positioner" { "positioner (tilt-rotate)" } option value="turntable" { "turntable" }
+                }
+            }
+            label.wide { "The controller's positioner or turntable (JSON) " input type="file" name="controller_plate_file" accept=".json,application/json"; }
+            label.wide { "or paste it " textarea name="controller_plate" rows="2" {} }
+            label title="Write the axes' values so the real axes stand where the controller believes the programmed values put them" {
+                input type="checkbox" name="correct_axes" value="true"; " correct the axes' values" }
         }
     }
 }

@@ -424,8 +424,10 @@ handlers.filter = async function (form) {
   const ext = files[0].name.split(".").pop().toLowerCase();
   body.language = formValue(form, "language") || byExtension[ext];
   if (!body.language) throw new Error("choose the program's language");
+  await filterAxes(form, body);
   const r = (await sendJson("POST", `/v1/robots/${robot}/programs/filter`, body)).json();
   const rep = r.report;
+  showFilterAxes(rep);
   const summary = `${rep.filtered} targets filtered, ${rep.failed} failed, ${rep.skipped} skipped; ${rep.joint_motions.length} joint motions (model: ${r.version === null ? "nominal" : "v" + r.version} ${r.method})`;
   document.getElementById("filter-summary").textContent = summary;
   const links = document.getElementById("filter-downloads");
@@ -434,7 +436,7 @@ handlers.filter = async function (form) {
   const tbody = document.querySelector("#filter-report tbody");
   tbody.textContent = "";
   for (const t of rep.targets) {
-    const cells = [t.motion.file, t.motion.line, `${t.motion.instruction} ${t.name}`, t.status, t.shift_mm === undefined ? "" : fmtMm(t.shift_mm), t.configuration || "", t.reason || ""];
+    const cells = [t.motion.file, t.motion.line, `${t.motion.instruction} ${t.name}`, t.status, t.shift_mm === undefined ? "" : fmtMm(t.shift_mm), t.configuration || "", t.reason || "", targetAxesText(t)];
     appendRow(tbody, cells, "target " + t.status);
   }
   const report = document.getElementById("filter-report-download");
@@ -476,8 +478,9 @@ function planDownloads(id, csvName, csv, program, className) {
 const triple = (form, prefix) => ["x", "y", "z"].map((a) => Number(formValue(form, `${prefix}_${a}`)));
 
 // A measurement plan: the poses, the parameters' predicted standard
-// deviations, the joints CSV and the program.
-handlers["measurement-plan"] = async function (form) {
+// deviations, the joints CSV and the program; with `overTrack`, the body is
+// handed to it (a plan over a track, console_axes.js).
+handlers["measurement-plan"] = async function (form, overTrack) {
   const body = {
     poses: Number(formValue(form, "poses")),
     candidates: Number(formValue(form, "candidates")),
@@ -498,6 +501,7 @@ handlers["measurement-plan"] = async function (form) {
     const name = formValue(form, "name");
     if (name) body.name = name;
   }
+  if (overTrack) return overTrack(body);
   const r = (await sendJson("POST", `/v1/robots/${form.dataset.robot}/measurement-plans`, body)).json();
   const c = r.counts;
   const summary = `${r.poses} poses chosen from ${c.drawn} candidates (${c.reachable} reachable, ${c.in_box} in the box, ${c.in_sight} in sight) at ${fixed(r.payload_kg, 3)} kg`;

@@ -19,7 +19,9 @@ use crate::service::check_reads::RobotWithCheck;
 use crate::service::checks::{shift_of, status_of};
 use maud::{html, Markup, PreEscaped, DOCTYPE};
 
-const SCRIPT: &str = include_str!("console.js");
+/// The page's script: `console.js` and, after it, `console_axes.js` (the
+/// filter's and the plan's external axes), inlined as one.
+const SCRIPT: &str = concat!(include_str!("console.js"), include_str!("console_axes.js"));
 const STYLE_SHEET: &str = include_str!("console.css");
 
 /// The console's one style sheet: `console.css` and the statuses' rules

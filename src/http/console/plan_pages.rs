@@ -33,6 +33,100 @@ fn language_select(optional: bool) -> Markup {
     }
 }
 
+/// The measurement plan's subject: robot poses, poses over a track, a
+/// positioner's sweeps or a turntable's sweep (`what`; the matching
+/// fieldset shows).
+fn what_to_plan() -> Markup {
+    html! {
+        label { "What to plan "
+            select name="what" {
+                option value="robot" { "robot poses" } option value="track" { "robot poses over a track" }
+                option value="positioner" { "a positioner's sweeps" } option value="turntable" { "a turntable's sweep" }
+            }
+        }
+    }
+}
+
+/// A nominal axis's JSON (file or pasted) and, for a face plate, the
+/// reflectors' design positions, inputs named `{what}_…`.
+fn nominal_inputs(what: &str, reflectors: bool) -> Markup {
+    html! {
+        label.wide { "Nominal " (what) " (JSON) " input type="file" name={ (what) "_file" } accept=".json,application/json"; }
+        label.wide { "or paste it " textarea name={ (what) "_json" } rows="2" {} }
+        @if reflectors {
+            label.wide title="The reflectors' design positions on the face plate [mm]; the first is the reference" { "Reflectors (x, y, z [mm], one a line) "
+                textarea name={ (what) "_reflectors" } rows="2" placeholder="400, 0, 20" {} }
+        }
+    }
+}
+
+/// A column select `name` (`e1` … `e6`), "API default" first.
+fn column_select(label: &str, name: &str) -> Markup {
+    html! {
+        label { (label) " "
+            select name=(name) {
+                option value="" { "default" }
+                @for c in ["e1", "e2", "e3", "e4", "e5", "e6"] { option value=(c) { (c) } }
+            }
+        }
+    }
+}
+
+/// A sweep's lowest and highest value and its count, each empty for the
+/// API's default (inputs `{prefix}_min`, `_max`, `_values`).
+fn sweep_inputs(label: &str, prefix: &str, unit: &str, default: &str) -> Markup {
+    html! {
+        label { (label) " from [" (unit) "] " input name={ (prefix) "_min" } type="number" step="any" placeholder=(default); }
+        label { "to [" (unit) "] " input name={ (prefix) "_max" } type="number" step="any"; }
+        label { "values " input name={ (prefix) "_values" } type="number" min="4" max="150" step="1" placeholder="default"; }
+    }
+}
+
+/// The inputs of a plan over a track, a positioner or a turntable, each in
+/// its fieldset, shown when chosen; empty fields take the API's defaults.
+fn axes_plan_fields() -> Markup {
+    html! {
+        fieldset.plan-what data-what="track" hidden {
+            legend { "Over a track: poses per station (Poses above, e.g. 4) at stations over its travel; the box, the tracker and the sight as above (the tracker in the cell frame)" }
+            (nominal_inputs("track", false))
+            label { "Stations " input name="stations" type="number" min="5" step="1" placeholder="one every 400 mm"; }
+            label { "Travel from [mm] " input name="track_travel_min" type="number" step="any" placeholder="the track's"; }
+            label { "to [mm] " input name="track_travel_max" type="number" step="any"; }
+            (column_select("Column", "track_column"))
+        }
+        fieldset.plan-what data-what="positioner" hidden {
+            legend { "A positioner's sweeps (the noise, program and name above apply)" }
+            (nominal_inputs("positioner", true))
+            (sweep_inputs("Tilt", "tilt", "°", "-90"))
+            (sweep_inputs("Rotate", "rotate", "°", "-165"))
+            (column_select("Tilt column", "tilt_column"))
+            (column_select("Rotate column", "rotate_column"))
+        }
+        fieldset.plan-what data-what="turntable" hidden {
+            legend { "A turntable's sweep (the noise, program and name above apply)" }
+            (nominal_inputs("turntable", true))
+            (sweep_inputs("Sweep", "travel", "°", "-165"))
+            (column_select("Column", "turntable_column"))
+        }
+    }
+}
+
+/// The answer of a plan over the axes: a track's stations, a face plate's
+/// σ per axis and per reflector.
+fn axes_plan_results() -> Markup {
+    html! {
+        table #plan-stations hidden {
+            thead { tr { th { "Station [mm]" } th { "Points" } th { "In sight" } th { "σ position [mm]" } th { "σ angles x, y, z [arcsec]" } } }
+            tbody {}
+        }
+        table #plan-sigma hidden {
+            thead { tr { th { "Axis" } th { "σ direction [°]" } th { "σ point [mm]" } th { "σ zero offset [°]" } th { "σ scale" } } }
+            tbody {}
+        }
+        p #plan-reflector-sigma hidden {}
+    }
+}
+
 /// Both sections, for robot `id`.
 pub(super) fn plan_sections(id: i64) -> Markup {
     html! {
@@ -40,6 +134,7 @@ pub(super) fn plan_sections(id: i64) -> Markup {
             h2 { "Plan the measurements" }
             p.note { "Poses chosen for D-optimality of the identification within a box (base frame) and the tracker's line of sight (a cone about the reflector's axis); the standard deviation each parameter would be identified with for the tracker's noise, at the payload given." }
             form #measurement-plan data-action="measurement-plan" data-robot=(id) {
+                (what_to_plan())
                 label { "Poses " input name="poses" type="number" min="1" max="300" step="1" value="30"; }
                 label { "Candidates " input name="candidates" type="number" min="1" max="5000" step="1" value="400"; }
                 (triple("Box min", "min", [-600.0, -600.0, 0.0]))
@@ -55,6 +150,7 @@ pub(super) fn plan_sections(id: i64) -> Markup {
                 label title="The payload carried while measuring; the robot's when empty" { "Payload [kg] "
                     input name="payload_kg" type="number" step="any" min="0" max=(crate::http::PAYLOAD_MAX_KG); }
                 label { "Seed " input name="seed" type="number" min="0" step="1" value="1"; }
+                (axes_plan_fields())
                 (language_select(true))
                 label { "Program name " input name="name" pattern="[A-Za-z][A-Za-z0-9_]{0,23}" placeholder="plan"; }
                 button type="submit" { "Plan" }
@@ -62,6 +158,7 @@ pub(super) fn plan_sections(id: i64) -> Markup {
             div #plan-result hidden {
                 p #plan-summary {}
                 p #plan-downloads {}
+                (axes_plan_results())
                 table #plan-params {
                     thead { tr { th { "Method" } th { "Parameter" } th { "Predicted std" } th { "Unit" } } }
                     tbody {}
