@@ -221,18 +221,13 @@ pub async fn for_plate(
     robot_id: i64,
     beside_track: bool,
 ) -> Result<TiltRotate, ServiceError> {
-    let Some(row) = state.db().turntable(robot_id).await? else {
-        super::robots::get(state, robot_id).await?;
-        return Err(ServiceError::Conflict(format!(
-            "`turntable`: robot {robot_id} has no turntable; fit one with POST /v1/robots/{robot_id}/turntable/calibrate, or leave `turntable` out"
-        )));
-    };
+    let turntable = stored_for(state, robot_id, "turntable").await?;
     if !beside_track && state.db().track(robot_id).await?.is_some() {
         return Err(ServiceError::Conflict(format!(
             "robot {robot_id} rides a track: with `turntable`, give the track's value `e1` [mm] and the turntable's `e2` [deg], as its programs number them"
         )));
     }
-    Ok(model_of(&row)?.as_tilt_rotate())
+    Ok(turntable.as_tilt_rotate())
 }
 
 /// The robot's stored turntable for a program filter's or a cell export's

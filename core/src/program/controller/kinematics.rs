@@ -140,6 +140,22 @@ fn rz(angle: f64) -> Pose {
     Pose::new(rpy_matrix(0.0, 0.0, angle), Vector3::zeros())
 }
 
+/// The rotary axes' scales other than 1, each with what it moves a point
+/// [`SCALE_RADIUS_MM`] from its axis over [`SCALE_TURN_DEG`] by: what a
+/// chain of frames cannot hold.
+fn rotary_scales(scales: &[(&str, f64)]) -> Vec<NotHeld> {
+    scales
+        .iter()
+        .filter(|(_, s)| *s != 1.0)
+        .map(|&(term, s)| NotHeld {
+            term: term.into(),
+            value: s,
+            unit: "",
+            miss_mm: (s - 1.0).abs() * SCALE_TURN_DEG.to_radians() * SCALE_RADIUS_MM,
+        })
+        .collect()
+}
+
 /// The calibrated positioner `p` (in the cell frame) as a base kinematic
 /// system in the robot's base frame, `world_from_cell` the calibrated
 /// model's base-from-cell.
@@ -157,19 +173,10 @@ pub fn kuka_positioner(p: &TiltRotate, world_from_cell: &Pose) -> KukaKinematics
     held.cell_from_base = root;
     held.tilt.scale = 1.0;
     held.rotate.scale = 1.0;
-    let not_held = [
+    let not_held = rotary_scales(&[
         ("tilt scale", p.tilt.scale),
         ("rotate scale", p.rotate.scale),
-    ]
-    .into_iter()
-    .filter(|(_, s)| *s != 1.0)
-    .map(|(term, s)| NotHeld {
-        term: term.into(),
-        value: s,
-        unit: "",
-        miss_mm: (s - 1.0).abs() * SCALE_TURN_DEG.to_radians() * SCALE_RADIUS_MM,
-    })
-    .collect();
+    ]);
     KukaKinematics {
         kind: KinematicKind::Positioner,
         root,
@@ -194,15 +201,7 @@ pub fn kuka_turntable(t: &Turntable, world_from_cell: &Pose) -> KukaKinematics {
     let mut held = *t;
     held.cell_from_base = root;
     held.axis.scale = 1.0;
-    let not_held = (t.axis.scale != 1.0)
-        .then(|| NotHeld {
-            term: "turntable scale".into(),
-            value: t.axis.scale,
-            unit: "",
-            miss_mm: (t.axis.scale - 1.0).abs() * SCALE_TURN_DEG.to_radians() * SCALE_RADIUS_MM,
-        })
-        .into_iter()
-        .collect();
+    let not_held = rotary_scales(&[("turntable scale", t.axis.scale)]);
     KukaKinematics {
         kind: KinematicKind::Turntable,
         root,
