@@ -6,11 +6,13 @@
 //! the output's header comment; a cell the controller could not load (a
 //! number 0 or beyond its range, one held twice) is refused naming the item;
 //! a Fanuc export writes position registers only with `--registers`.
-//! With `--positioner` or `--track` (KRL only) the calibrated axes are
-//! written too, as a KUKA external kinematic system
-//! (`core::program::controller::kinematics`), and `--held FILE` writes what
-//! the controller then computes, for the filter's `--nominal-positioner` or
-//! `--nominal-track`.
+//! With `--positioner`, `--turntable` or `--track` (KRL only; a track with a
+//! positioner or turntable beside it too) the calibrated axes are written
+//! too, as KUKA external kinematic systems
+//! (`core::program::controller::kinematics`), and `--held FILE` (beside a
+//! track also `--held-track FILE`) writes what the controller then
+//! computes, for the filter's `--nominal-positioner`, `--nominal-turntable`
+//! or `--nominal-track`.
 
 use crate::program::controller::{export_cell, ExportOptions, ExternalAxes, RegisterRange};
 use crate::program::Language;
@@ -56,12 +58,14 @@ pub struct CellExportArgs {
     /// KRL: the calibrated positioner (`robocal positioner calibrate`'s
     /// output) whose axes are written as an external kinematic system; work
     /// objects on its face plate become bases coupled to it.
-    #[arg(long, conflicts_with_all = ["track", "turntable"])]
+    #[arg(long, conflicts_with = "turntable")]
     pub positioner: Option<String>,
     /// KRL: the calibrated track (`robocal track calibrate`'s output) whose
     /// axis is written as the robot's root kinematic system; work objects are
-    /// written in the world, the cell frame.
-    #[arg(long, conflicts_with = "turntable")]
+    /// written in the world, the cell frame. Beside `--positioner` or
+    /// `--turntable` (stated in the same cell frame) the track is ET1 (`E1`)
+    /// and the positioner or turntable ET2 (`E2`, `E3`).
+    #[arg(long)]
     pub track: Option<String>,
     /// KRL: the calibrated one-axis turntable (`robocal turntable
     /// calibrate`'s output) whose axis is written as an external kinematic
@@ -72,9 +76,14 @@ pub struct CellExportArgs {
     /// Writes the positioner, track or turntable the controller computes
     /// from the exported data (scales 1, no carriage maps): the filter's
     /// `--nominal-positioner`, `--nominal-track` or `--nominal-turntable`
-    /// once the controller holds it.
+    /// once the controller holds it. With `--track` beside a positioner or
+    /// turntable: the positioner's or turntable's.
     #[arg(long)]
     pub held: Option<String>,
+    /// With `--track`: writes the track the controller computes (scale 1,
+    /// no carriage maps), the filter's `--nominal-track`.
+    #[arg(long, requires = "track")]
+    pub held_track: Option<String>,
 }
 
 /// The exported text.
@@ -86,14 +95,27 @@ pub fn export_to_string(a: &CellExportArgs) -> anyhow::Result<String> {
     let cell = CellDescription::from_json(&text)
         .and_then(|d| d.to_cell())
         .with_context(|| a.cell.clone())?;
-    let axes = match (&a.positioner, &a.track, &a.turntable) {
-        (Some(p), _, _) => Some(ExternalAxes::Positioner(
-            super::positioner::read_positioner(p)?,
-        )),
-        (None, Some(t), _) => Some(ExternalAxes::Track(super::track::read_track(t)?)),
-        (None, None, Some(t)) => Some(ExternalAxes::Turntable(super::turntable::read_turntable(
-            t,
-        )?)),
+    let track = a
+        .track
+        .as_deref()
+        .map(super::track::read_track)
+        .transpose()?;
+    let positioner = a
+        .positioner
+        .as_deref()
+        .map(super::positioner::read_positioner)
+        .transpose()?;
+    let turntable = a
+        .turntable
+        .as_deref()
+        .map(super::turntable::read_turntable)
+        .transpose()?;
+    let axes = match (track, positioner, turntable) {
+        (Some(t), Some(p), _) => Some(ExternalAxes::TrackAndPositioner(t, p)),
+        (Some(t), None, Some(tt)) => Some(ExternalAxes::TrackAndTurntable(t, tt)),
+        (Some(t), None, None) => Some(ExternalAxes::Track(t)),
+        (None, Some(p), _) => Some(ExternalAxes::Positioner(p)),
+        (None, None, Some(tt)) => Some(ExternalAxes::Turntable(tt)),
         (None, None, None) => None,
     };
     if a.held.is_some() && axes.is_none() {
@@ -105,8 +127,19 @@ pub fn export_to_string(a: &CellExportArgs) -> anyhow::Result<String> {
     };
     let done = export_cell(language, &cell, &model, &options)
         .with_context(|| format!("{}: cannot be exported for {}", a.cell, a.language))?;
-    if let (Some(path), Some(k)) = (&a.held, &done.kinematics) {
-        std::fs::write(path, k.held_json()).with_context(|| format!("cannot write {path}"))?;
+    // `--held` the last system (the only one, or the one beside the track),
+    // `--held-track` the track.
+    let track_system = done
+        .kinematics
+        .iter()
+        .find(|k| k.kind == crate::program::controller::KinematicKind::Track);
+    for (path, k) in [
+        (&a.held, done.kinematics.last()),
+        (&a.held_track, track_system),
+    ] {
+        if let (Some(path), Some(k)) = (path, k) {
+            std::fs::write(path, k.held_json()).with_context(|| format!("cannot write {path}"))?;
+        }
     }
     Ok(done.text)
 }

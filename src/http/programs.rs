@@ -24,7 +24,7 @@ use super::solve::{model_choice, VersionSelector};
 use super::{ApiError, ApiJson, ApiPath, AppState};
 use crate::model::external::{TiltRotateDescription, TrackDescription, TurntableDescription};
 use crate::program::controller::{
-    ExportOptions, KinematicKind, NotHeld, RegisterRange, Renamed, UsedRegister,
+    AxesKind, ExportOptions, NotHeld, RegisterRange, Renamed, UsedRegister,
 };
 use crate::program::{FilterReport, Language, ProgramFile};
 use crate::service;
@@ -250,9 +250,10 @@ pub struct CellExportRequest {
     /// The position registers a Fanuc export may overwrite.
     #[serde(default, deserialize_with = "present")]
     pub registers: Option<RegistersIn>,
-    /// KRL: the robot's stored positioner's or track's axes written too.
+    /// KRL: the robot's stored positioner's, turntable's or track's axes
+    /// (or the track's with the positioner's or turntable's) written too.
     #[serde(default, deserialize_with = "present")]
-    pub axes: Option<KinematicKind>,
+    pub axes: Option<AxesKind>,
 }
 
 /// `registers`: `first..=last`.
@@ -293,14 +294,44 @@ pub struct CellExportResponse {
 /// `kinematics` of a cell export with `axes`.
 #[derive(Debug, Serialize)]
 pub struct KinematicsOut {
-    /// `positioner` or `track`.
-    pub kind: KinematicKind,
-    /// The calibrated terms the controller's chain cannot hold.
+    /// The `axes` written.
+    pub kind: AxesKind,
+    /// The calibrated terms the controllers' chains cannot hold (the
+    /// track's first beside a positioner or turntable).
     pub not_held: Vec<NotHeld>,
-    /// The positioner or track description the controller computes (what
-    /// `robocal cell export --held` writes): the filter's controller
-    /// positioner or track once the controller holds the export.
+    /// The positioner, turntable or track description the controller
+    /// computes (what `robocal cell export --held` writes): the filter's
+    /// controller positioner, turntable or track once the controller holds
+    /// the export. With two systems, an object of both by their kind
+    /// (`track` and `positioner` or `turntable`; `--held-track` and
+    /// `--held`).
     pub held: serde_json::Value,
+}
+
+/// The answer's `kinematics` for the systems `written` as `kind`.
+fn kinematics_out(
+    kind: AxesKind,
+    written: &[crate::program::controller::KukaKinematics],
+) -> Result<KinematicsOut, ApiError> {
+    let held = |k: &crate::program::controller::KukaKinematics| {
+        serde_json::from_str::<serde_json::Value>(&k.held_json())
+            .map_err(|e| ApiError::Internal(format!("held axes: {e}")))
+    };
+    let held = match written {
+        [one] => held(one)?,
+        many => {
+            let mut both = serde_json::Map::new();
+            for k in many {
+                both.insert(k.kind.name().into(), held(k)?);
+            }
+            serde_json::Value::Object(both)
+        }
+    };
+    Ok(KinematicsOut {
+        kind,
+        not_held: written.iter().flat_map(|k| k.not_held.clone()).collect(),
+        held,
+    })
 }
 
 /// `POST /v1/robots/{id}/cell/export`: the robot's tools, loads and work objects as the controller
@@ -336,13 +367,8 @@ pub async fn export_cell(
         options,
     )
     .await?;
-    let kinematics = match &done.export.kinematics {
-        Some(k) => Some(KinematicsOut {
-            kind: k.kind,
-            not_held: k.not_held.clone(),
-            held: serde_json::from_str(&k.held_json())
-                .map_err(|e| ApiError::Internal(format!("held axes: {e}")))?,
-        }),
+    let kinematics = match req.axes {
+        Some(kind) => Some(kinematics_out(kind, &done.export.kinematics)?),
         None => None,
     };
     Ok(axum::Json(CellExportResponse {

@@ -7,7 +7,7 @@
 
 use super::solve::{chosen_model, ModelChoice};
 use super::{AppState, ServiceError};
-use crate::program::controller::KinematicKind;
+use crate::program::controller::AxesKind;
 use crate::program::{
     filter_with, FilterAxes, FilterControl, FilterError, FilterOutput, Language, ProgramFile,
 };
@@ -156,20 +156,25 @@ pub async fn export_cell(
     model: ModelChoice,
     payload_kg: Option<f64>,
     language: Language,
-    axes: Option<KinematicKind>,
+    axes: Option<AxesKind>,
     mut options: crate::program::controller::ExportOptions,
 ) -> Result<CellExport, ServiceError> {
     use crate::program::controller::{export_cell, ExportError, ExternalAxes};
     let cell = super::cell::cell(state, robot_id).await?;
+    let track = || super::tracks::stored_for(state, robot_id, "axes");
+    let positioner = || super::positioners::stored_for(state, robot_id, "axes");
+    let turntable = || super::turntables::stored_for(state, robot_id, "axes");
     options.axes = match axes {
-        Some(KinematicKind::Positioner) => Some(ExternalAxes::Positioner(
-            super::positioners::stored_for(state, robot_id, "axes").await?,
+        Some(AxesKind::Positioner) => Some(ExternalAxes::Positioner(positioner().await?)),
+        Some(AxesKind::Track) => Some(ExternalAxes::Track(track().await?)),
+        Some(AxesKind::Turntable) => Some(ExternalAxes::Turntable(turntable().await?)),
+        Some(AxesKind::TrackAndPositioner) => Some(ExternalAxes::TrackAndPositioner(
+            track().await?,
+            positioner().await?,
         )),
-        Some(KinematicKind::Track) => Some(ExternalAxes::Track(
-            super::tracks::stored_for(state, robot_id, "axes").await?,
-        )),
-        Some(KinematicKind::Turntable) => Some(ExternalAxes::Turntable(
-            super::turntables::stored_for(state, robot_id, "axes").await?,
+        Some(AxesKind::TrackAndTurntable) => Some(ExternalAxes::TrackAndTurntable(
+            track().await?,
+            turntable().await?,
         )),
         None => None,
     };

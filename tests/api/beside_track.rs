@@ -17,6 +17,7 @@
 use super::positioner::{cli, numbers};
 use crate::support::*;
 use axum::http::StatusCode;
+use clap::Parser as _;
 use nalgebra::Vector3;
 use robocal::model::external::{LinearTrack, TiltRotate};
 use serde_json::{json, Value};
@@ -275,4 +276,136 @@ async fn refusals(t: &TestApp, rid: &str, text: &str) {
             "{path}: {d}"
         );
     }
+}
+
+/// The cell exported for KUKA with the stored track and positioner together
+/// (`"axes": "track_and_positioner"`) is `robocal cell export --track
+/// --positioner --held --held-track` on their files byte for byte: the track
+/// ET1 (`E1`), the positioner ET2 (`E2`, `E3`), `held.track` and
+/// `held.positioner` the files written, scales 1. Given to the filter as its
+/// controller track and positioner (the controller holding the export), the
+/// program of `filters_beside_the_track` (`weld.src`, `weld.dat` in `dir`)
+/// is filtered over HTTP as by the command line with the held files, every
+/// target at its values. Without a turntable, `track_and_turntable` is a
+/// 409 naming it.
+pub(crate) async fn exports_beside_the_track(
+    t: &TestApp,
+    rid: &str,
+    model: &Path,
+    fitted: &Path,
+    track: &Path,
+    dir: &Path,
+) {
+    const EXPORT: &str = "/v1/robots/{id}/cell/export";
+    let r = t
+        .post_json(
+            EXPORT,
+            &[rid],
+            json!({ "language": "krl", "axes": "track_and_positioner" }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let http = r.json();
+    let text = http["text"].as_str().unwrap();
+    assert!(
+        text.contains("$EX_KIN={ET1 #ERSYS,ET2 #EASYS,ET3 #NONE,"),
+        "{text}"
+    );
+    assert!(text.contains("$ET2_AX={TR_A1 #E2,TR_A2 #E3,TR_A3 #NONE}"));
+    let k = &http["kinematics"];
+    assert_eq!(k["kind"], "track_and_positioner");
+    let terms: Vec<&str> = k["not_held"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| n["term"].as_str().unwrap())
+        .collect();
+    assert_eq!(terms.first(), Some(&"track scale"), "{k}");
+    assert!(terms.contains(&"tilt scale"), "{k}");
+    let p = |p: &Path| p.to_str().unwrap().to_string();
+    let (held, held_track) = (dir.join("held_p.json"), dir.join("held_track.json"));
+    let argv = [
+        "robocal".to_string(),
+        "cell".into(),
+        "export".into(),
+        "--model".into(),
+        p(model),
+        "--cell".into(),
+        p(&dir.join("cell.json")),
+        "--language".into(),
+        "krl".into(),
+        "--track".into(),
+        p(track),
+        "--positioner".into(),
+        p(fitted),
+        "--held".into(),
+        p(&held),
+        "--held-track".into(),
+        p(&held_track),
+    ];
+    let robocal::cli::Command::Cell(a) = robocal::cli::Cli::try_parse_from(argv).unwrap().command
+    else {
+        unreachable!("a cell command line")
+    };
+    let robocal::cli::cell::CellCommand::Export(e) = a.command;
+    let by_cli = robocal::cli::cell::export_to_string(&e).unwrap();
+    assert_eq!(text, by_cli, "the exported text");
+    let read =
+        |f: &Path| -> Value { serde_json::from_str(&std::fs::read_to_string(f).unwrap()).unwrap() };
+    let (written, written_track) = (read(&held), read(&held_track));
+    assert_eq!(k["held"]["positioner"], written, "the held positioner");
+    assert_eq!(k["held"]["track"], written_track, "the held track");
+    assert_eq!(written_track["scale"].as_f64(), Some(1.0));
+    assert_eq!(written["tilt"]["scale"].as_f64(), Some(1.0));
+    assert_eq!(written["rotate"]["scale"].as_f64(), Some(1.0));
+
+    // The controller holding the export: the held models as its track and
+    // positioner.
+    let body = json!({
+        "language": "krl",
+        "files": [
+            { "name": "weld.src", "content": std::fs::read_to_string(dir.join("weld.src")).unwrap() },
+            { "name": "weld.dat", "content": std::fs::read_to_string(dir.join("weld.dat")).unwrap() }
+        ],
+        "controller_track": k["held"]["track"],
+        "controller_positioner": k["held"]["positioner"],
+    });
+    let r = t
+        .post_json("/v1/robots/{id}/programs/filter", &[rid], body)
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let filtered = r.json();
+    assert_eq!(filtered["report"]["filtered"], 8, "{}", filtered["report"]);
+    let out = dir.join("filtered_held");
+    let argv = [
+        "robocal".to_string(),
+        "filter".into(),
+        "--model".into(),
+        p(model),
+        "--cell".into(),
+        p(&dir.join("cell.json")),
+        "--track".into(),
+        p(track),
+        "--nominal-track".into(),
+        p(&held_track),
+        "--positioner".into(),
+        p(fitted),
+        "--nominal-positioner".into(),
+        p(&held),
+        "--out-dir".into(),
+        p(&out),
+        p(&dir.join("weld.src")),
+        p(&dir.join("weld.dat")),
+    ];
+    super::track_filter::assert_cli_gives(&filtered, argv, &out);
+
+    let r = t
+        .post_json(
+            EXPORT,
+            &[rid],
+            json!({ "language": "krl", "axes": "track_and_turntable" }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::CONFLICT, "{}", r.text());
+    assert!(r.detail().contains("has no turntable"), "{}", r.detail());
 }

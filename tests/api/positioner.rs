@@ -323,6 +323,15 @@ async fn a_positioner_fitted_over_http_is_the_command_lines_and_carries_a_target
         &d.join("track.json"),
         d,
     )
+    .await; // Both written for the controller together.
+    super::beside_track::exports_beside_the_track(
+        &t,
+        &rid,
+        &model,
+        &d.join("p.json"),
+        &d.join("track.json"),
+        d,
+    )
     .await;
 }
 

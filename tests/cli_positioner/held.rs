@@ -116,6 +116,15 @@ fn a_controller_holding_the_exported_positioner_leaves_the_filter_the_scales() {
         text(&out.stderr)
     );
     assert!(!d.join("x.json").exists());
+    // `--held-track` without the track it would write is refused, naming it.
+    let out = robocal(d, &[&export[..], &["--held-track", "y.json"]].concat());
+    assert_ne!(code(&out), 0);
+    assert!(
+        text(&out.stderr).contains("--track"),
+        "{}",
+        text(&out.stderr)
+    );
+    assert!(!d.join("y.json").exists());
     let mut rapid = export.to_vec();
     rapid[7] = "rapid";
     let out = robocal(d, &rapid);

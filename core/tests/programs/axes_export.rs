@@ -19,6 +19,8 @@ use robocal_core::program::controller::{
     SCALE_TURN_DEG,
 };
 
+mod beside_track;
+
 /// `{X …,Y …,Z …,A …,B …,C …}` after `key` in `text`, as an isometry [mm].
 fn frame_after(text: &str, key: &str) -> Isometry3<f64> {
     let start = text
@@ -162,7 +164,7 @@ fn a_positioner_exported_for_kuka_composes_to_the_calibrated_positioner() {
             text.contains("; BASE_DATA[3] part is on the face plate: $BASE=EK(MACHINE_DEF[2].ROOT,MACHINE_DEF[2].MECH_TYPE,BASE_DATA[3])"),
             "{text}"
         );
-        let k = out.kinematics.as_ref().unwrap();
+        let k = out.kinematics.first().unwrap();
         let HeldAxes::Positioner(held) = &k.held else {
             panic!("{:?}", k.held)
         };
@@ -198,7 +200,7 @@ fn a_positioner_exported_for_kuka_composes_to_the_calibrated_positioner() {
         if scale_error == 0.0 {
             assert!(k.not_held.is_empty(), "{:?}", k.not_held);
             assert!(worst_calibrated < ROUNDING_MM, "{worst_calibrated}");
-            assert!(text.contains("; every calibrated term is held"));
+            assert!(text.contains("; every calibrated term of the positioner is held"));
         } else {
             let names: Vec<&str> = k.not_held.iter().map(|n| n.term.as_str()).collect();
             assert_eq!(names, ["tilt scale", "rotate scale"]);
@@ -289,7 +291,7 @@ fn a_track_exported_for_kuka_composes_to_the_calibrated_track() {
         let out = export_cell(Language::Krl, &cell, &model, &options).unwrap();
         let text = &out.text;
         assert!(text.contains("$EX_KIN={ET1 #ERSYS,"), "{text}");
-        let k = out.kinematics.as_ref().unwrap();
+        let k = out.kinematics.first().unwrap();
         let HeldAxes::Track(held) = &k.held else {
             panic!("{:?}", k.held)
         };
@@ -397,7 +399,7 @@ fn the_held_positioner_differs_from_the_calibrated_one_only_by_its_scales() {
         ..Default::default()
     };
     let out = export_cell(Language::Krl, &cell, &model, &options).unwrap();
-    let HeldAxes::Positioner(held) = out.kinematics.unwrap().held else {
+    let HeldAxes::Positioner(held) = out.kinematics[0].held else {
         panic!()
     };
     assert_eq!(held.tilt.scale, 1.0);
@@ -445,7 +447,7 @@ fn a_turntable_exported_for_kuka_composes_to_the_calibrated_turntable() {
             text.contains("; BASE_DATA[3] part is on the face plate: $BASE=EK(MACHINE_DEF[2].ROOT,MACHINE_DEF[2].MECH_TYPE,BASE_DATA[3])"),
             "{text}"
         );
-        let k = out.kinematics.as_ref().unwrap();
+        let k = out.kinematics.first().unwrap();
         let HeldAxes::Turntable(held) = &k.held else {
             panic!("{:?}", k.held)
         };
@@ -479,7 +481,7 @@ fn a_turntable_exported_for_kuka_composes_to_the_calibrated_turntable() {
         if scale_error == 0.0 {
             assert!(k.not_held.is_empty(), "{:?}", k.not_held);
             assert!(worst_calibrated < ROUNDING_MM, "{worst_calibrated}");
-            assert!(text.contains("; every calibrated term is held"));
+            assert!(text.contains("; every calibrated term of the turntable is held"));
         } else {
             let names: Vec<&str> = k.not_held.iter().map(|n| n.term.as_str()).collect();
             assert_eq!(names, ["turntable scale"]);

@@ -53,8 +53,9 @@ pub struct ExportOptions {
     /// The position registers a Fanuc export may overwrite; `None`: none
     /// (the frames are listed for entry by hand, [`fanuc`]).
     pub registers: Option<RegisterRange>,
-    /// A calibrated positioner or track whose axes are written too (KRL:
-    /// an external kinematic system, [`super::kinematics`]).
+    /// A calibrated positioner, turntable or track (or a track with a
+    /// positioner or turntable beside it) whose axes are written too (KRL:
+    /// external kinematic systems, [`super::kinematics`]).
     pub axes: Option<ExternalAxes>,
 }
 
@@ -70,17 +71,19 @@ pub struct ControllerExport {
     pub renamed: Vec<Renamed>,
     /// The position registers the program overwrites (Fanuc).
     pub registers: Vec<UsedRegister>,
-    /// The positioner's or track's kinematic system written, when asked for.
-    pub kinematics: Option<KukaKinematics>,
+    /// The kinematic systems written, when asked for: the positioner's, the
+    /// turntable's or the track's, or the track's (ET1) and the positioner's
+    /// or turntable's beside it (ET2).
+    pub kinematics: Vec<KukaKinematics>,
 }
 
 /// Why a cell cannot be exported for a controller: the item and the fix.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum ExportError {
-    /// A work object turns with the positioner: its controller form (a base
-    /// coupled to the positioner, a work object a mechanical unit moves, a
-    /// user frame of coordinated motion) is not written.
-    #[error("work object `{0}` is on the positioner's face plate: its controller form (a base coupled to the positioner, a work object a mechanical unit moves, a coordinated user frame) is not written; export the cell without it and keep it as the controller holds it")]
+    /// A work object turns with the positioner, and the export has not the
+    /// positioner's or turntable's axes: its controller form (a base coupled
+    /// to them) is written only with them (KRL).
+    #[error("work object `{0}` is on the positioner's face plate: its controller form is written only with the positioner's or turntable's axes (KRL: a base coupled to its external kinematic system); export with them, or export the cell without it and keep it as the controller holds it")]
     OnFacePlate(String),
     /// A positioner's or track's controller data asked for in a language
     /// it is not written in.

@@ -27,6 +27,10 @@
 //!   `$ERSYSROOT` sits on the rail at value 0 with z along the rail (the
 //!   cell frame is the world, as for the filter's controller track), the
 //!   flange is the robot's base frame.
+//! - A track with a positioner or a turntable beside it: the track is ET1
+//!   (`E1`), the positioner or turntable ET2 (`$ET2_…`, its axes `E2`, `E3`,
+//!   as the filter numbers them) with its root `MACHINE_DEF[2].ROOT` in the
+//!   world, which is then the cell frame (`world_from_cell` the identity).
 //!
 //! Not held: a rotary axis's, the turntable's or the track's scale (the controller turns or
 //! moves its frame by the value; the gear ratio is the drive's) and the
@@ -36,14 +40,12 @@
 //! Units: m and rad inside, the text in mm and degrees with
 //! `R = Rz(A)·Ry(B)·Rx(C)`.
 
-use super::frames::kuka_frame;
 use crate::model::external::{CarriageTerm, LinearTrack, TiltRotate, TravelMap, Turntable};
 use crate::model::pose::rpy_matrix;
 use crate::model::Pose;
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::FRAC_PI_2;
-use std::fmt::Write as _;
 
 /// Distance from an axis at which a rotary scale's miss is stated [mm].
 pub const SCALE_RADIUS_MM: f64 = 500.0;
@@ -63,6 +65,76 @@ pub enum ExternalAxes {
     /// A one-axis turntable in the cell frame the robot's model is
     /// registered in.
     Turntable(Turntable),
+    /// A track and, beside it, a positioner, both in the track's cell frame
+    /// (the controller's world).
+    TrackAndPositioner(LinearTrack, TiltRotate),
+    /// A track and, beside it, a one-axis turntable, both in the track's
+    /// cell frame (the controller's world).
+    TrackAndTurntable(LinearTrack, Turntable),
+}
+
+impl ExternalAxes {
+    /// Which axes these are.
+    pub fn kind(&self) -> AxesKind {
+        match self {
+            Self::Positioner(_) => AxesKind::Positioner,
+            Self::Track(_) => AxesKind::Track,
+            Self::Turntable(_) => AxesKind::Turntable,
+            Self::TrackAndPositioner(..) => AxesKind::TrackAndPositioner,
+            Self::TrackAndTurntable(..) => AxesKind::TrackAndTurntable,
+        }
+    }
+}
+
+/// The external axes a cell export writes (the HTTP export's `axes`): one
+/// kinematic system, or a track with a positioner or a turntable beside it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AxesKind {
+    /// A tilt-rotate positioner (ET1).
+    Positioner,
+    /// A linear track carrying the robot (ET1).
+    Track,
+    /// A one-axis turntable (ET1).
+    Turntable,
+    /// A track (ET1) and a positioner beside it (ET2).
+    TrackAndPositioner,
+    /// A track (ET1) and a turntable beside it (ET2).
+    TrackAndTurntable,
+}
+
+impl AxesKind {
+    /// Every kind, in the order the API lists them.
+    pub const ALL: [AxesKind; 5] = [
+        AxesKind::Positioner,
+        AxesKind::Track,
+        AxesKind::Turntable,
+        AxesKind::TrackAndPositioner,
+        AxesKind::TrackAndTurntable,
+    ];
+
+    /// The kinematic systems written, in their order (ET1, ET2).
+    pub fn systems(self) -> &'static [KinematicKind] {
+        match self {
+            Self::Positioner => &[KinematicKind::Positioner],
+            Self::Track => &[KinematicKind::Track],
+            Self::Turntable => &[KinematicKind::Turntable],
+            Self::TrackAndPositioner => &[KinematicKind::Track, KinematicKind::Positioner],
+            Self::TrackAndTurntable => &[KinematicKind::Track, KinematicKind::Turntable],
+        }
+    }
+}
+
+impl KinematicKind {
+    /// The kind's name as the API spells it (`positioner`, `track`,
+    /// `turntable`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Positioner => "positioner",
+            Self::Track => "track",
+            Self::Turntable => "turntable",
+        }
+    }
 }
 
 /// The kinds of external kinematic system written (the HTTP export's
@@ -83,11 +155,13 @@ pub enum KinematicKind {
 /// The axes as the controller holds them.
 #[derive(Debug, Clone, PartialEq)]
 pub enum HeldAxes {
-    /// The positioner the chain computes, stated in the robot's base frame.
+    /// The positioner the chain computes, stated in the world: the robot's
+    /// base frame, or beside a track the cell frame.
     Positioner(TiltRotate),
     /// The track the chain computes, in the cell frame.
     Track(LinearTrack),
-    /// The turntable the chain computes, stated in the robot's base frame.
+    /// The turntable the chain computes, stated in the world: the robot's
+    /// base frame, or beside a track the cell frame.
     Turntable(Turntable),
 }
 
@@ -113,6 +187,9 @@ pub struct NotHeld {
 pub struct KukaKinematics {
     /// Positioner or track.
     pub kind: KinematicKind,
+    /// Its number `n` (`$ETn_…`): 1, or 2 for a positioner or turntable
+    /// beside a track (ET1). Its first axis is `En`.
+    pub system: u8,
     /// The root in the world (`MACHINE_DEF[2].ROOT` or `$ERSYSROOT`).
     pub root: Pose,
     /// `$ET1_TA1KR`, `$ET1_TA2A1`, `$ET1_TA3A2`, `$ET1_TFLA3`.
@@ -179,6 +256,7 @@ pub fn kuka_positioner(p: &TiltRotate, world_from_cell: &Pose) -> KukaKinematics
     ]);
     KukaKinematics {
         kind: KinematicKind::Positioner,
+        system: 1,
         root,
         links,
         held: HeldAxes::Positioner(held),
@@ -204,6 +282,7 @@ pub fn kuka_turntable(t: &Turntable, world_from_cell: &Pose) -> KukaKinematics {
     let not_held = rotary_scales(&[("turntable scale", t.axis.scale)]);
     KukaKinematics {
         kind: KinematicKind::Turntable,
+        system: 1,
         root,
         links,
         held: HeldAxes::Turntable(held),
@@ -260,6 +339,7 @@ pub fn kuka_track(t: &LinearTrack) -> KukaKinematics {
     }
     KukaKinematics {
         kind: KinematicKind::Track,
+        system: 1,
         root,
         links,
         held: HeldAxes::Track(held),
@@ -277,85 +357,9 @@ impl KukaKinematics {
             HeldAxes::Turntable(t) => t.to_json(),
         }
     }
-
-    /// The lines for `$machine.dat` and `$config.dat` (CR LF line ends, as
-    /// the cell's data), with comments saying where each goes and what is
-    /// not held.
-    pub fn text(&self) -> String {
-        let mut s = String::new();
-        let (what, kind, axes) = match self.kind {
-            KinematicKind::Positioner => (
-                "the calibrated positioner as external kinematic system ET1 (E1 the tilt, E2 the rotate), its flange the face plate; the world is the robot's base frame ($ROBROOT the null frame)",
-                "#EASYS",
-                "{TR_A1 #E1,TR_A2 #E2,TR_A3 #NONE}",
-            ),
-            KinematicKind::Track => (
-                "the calibrated track as external kinematic system ET1 (E1 the carriage), its flange the robot's base; the world is the cell frame",
-                "#ERSYS",
-                "{TR_A1 #E1,TR_A2 #NONE,TR_A3 #NONE}",
-            ),
-            KinematicKind::Turntable => (
-                "the calibrated turntable as external kinematic system ET1 (E1 its axis), its flange the face plate; the world is the robot's base frame ($ROBROOT the null frame)",
-                "#EASYS",
-                "{TR_A1 #E1,TR_A2 #NONE,TR_A3 #NONE}",
-            ),
-        };
-        let _ = writeln!(s, "; {what}");
-        let _ = writeln!(
-            s,
-            "; mm and degrees, R = Rz(A)*Ry(B)*Rx(C); each axis moves its frame about or along that frame's z"
-        );
-        let _ = writeln!(s, "; $machine.dat");
-        let _ = writeln!(
-            s,
-            "DECL EX_KIN $EX_KIN={{ET1 {kind},ET2 #NONE,ET3 #NONE,ET4 #NONE,ET5 #NONE,ET6 #NONE}}"
-        );
-        let _ = writeln!(s, "DECL ET_AX $ET1_AX={axes}");
-        if self.kind == KinematicKind::Track {
-            let _ = writeln!(s, "FRAME $ERSYSROOT={}", kuka_frame(&self.root));
-        }
-        for (name, link) in ["TA1KR", "TA2A1", "TA3A2", "TFLA3"].iter().zip(&self.links) {
-            let _ = writeln!(s, "FRAME $ET1_{name}={}", kuka_frame(link));
-        }
-        if self.kind != KinematicKind::Track {
-            let name = match self.kind {
-                KinematicKind::Turntable => "TURNTABLE",
-                _ => "POSITIONER",
-            };
-            let _ = writeln!(
-                s,
-                "; $config.dat: the root in the world (MACHINE_DEF[1] is the robot)"
-            );
-            let _ = writeln!(
-                s,
-                "MACHINE_DEF[2]={{NAME[] \"{name}\",COOP_KRC_INDEX 1,PARENT[] \"WORLD\",ROOT {},MECH_TYPE #EASYS,GEOMETRY[] \" \"}}",
-                kuka_frame(&self.root)
-            );
-        }
-        if self.not_held.is_empty() {
-            let _ = writeln!(s, "; every calibrated term is held");
-        } else {
-            let _ = writeln!(
-                s,
-                "; not held by the controller (the filter corrects it when given this chain as its controller {}):",
-                match self.kind {
-                    KinematicKind::Positioner => "positioner",
-                    KinematicKind::Track => "track",
-                    KinematicKind::Turntable => "turntable",
-                }
-            );
-            for n in &self.not_held {
-                let _ = writeln!(
-                    s,
-                    ";   {} {:.9}{}{}: {:.4} mm",
-                    n.term,
-                    n.value,
-                    if n.unit.is_empty() { "" } else { " " },
-                    n.unit,
-                    n.miss_mm
-                );
-            }
-        }
-        s.replace('\n', "\r\n")
+    /// This system as ET2 beside a track's ET1: its axes from `E2`, its
+    /// root in the cell frame.
+    pub fn beside_track(self) -> Self {
+        Self { system: 2, ..self }
     }
 }

@@ -34,6 +34,7 @@ mod data;
 mod fanuc;
 mod frames;
 mod kinematics;
+mod kinematics_text;
 mod names;
 mod numbers;
 
@@ -43,9 +44,10 @@ pub use data::{
 };
 use frames::{abb_frame, kuka_frame, ur_pose};
 pub use kinematics::{
-    kuka_positioner, kuka_track, kuka_turntable, ExternalAxes, HeldAxes, KinematicKind,
+    kuka_positioner, kuka_track, kuka_turntable, AxesKind, ExternalAxes, HeldAxes, KinematicKind,
     KukaKinematics, NotHeld, ANGLE_ARM_MM, SCALE_RADIUS_MM, SCALE_TURN_DEG,
 };
+pub use kinematics_text::kuka_text;
 pub use names::{RenameReason, Renamed};
 pub use numbers::{NumberRange, RegisterRange, UsedRegister};
 
@@ -108,10 +110,10 @@ pub fn controller_data(cell: &Cell, model: &CompensatedModel) -> ControllerData 
 }
 
 /// The cell exported for `language` on the calibrated `model`; with
-/// `options.axes`, the positioner's or track's kinematic system too (KRL
-/// only): work objects on the face plate are then bases coupled to the
-/// positioner, and on a track every work object is held in the world (the
-/// cell frame).
+/// `options.axes`, the positioner's, turntable's or track's kinematic
+/// systems too (KRL only): work objects on the face plate are then bases
+/// coupled to the positioner, and on a track every work object is held in
+/// the world (the cell frame).
 pub fn export_cell(
     language: Language,
     cell: &Cell,
@@ -121,37 +123,51 @@ pub fn export_cell(
     use crate::solve::cell::WorkObjectFrame;
     let on = |frame: WorkObjectFrame| cell.work_objects.iter().find(|w| w.frame == frame);
     let mut data = controller_data(cell, model);
+    if options.axes.is_some() && language != Language::Krl {
+        return Err(ExportError::AxesNotWritten(language));
+    }
+    let world_from_cell = model.cell_to_base(&Pose::identity());
+    let on_a_track = matches!(
+        options.axes,
+        Some(
+            ExternalAxes::Track(_)
+                | ExternalAxes::TrackAndPositioner(..)
+                | ExternalAxes::TrackAndTurntable(..)
+        )
+    );
+    let with_a_plate = !matches!(options.axes, None | Some(ExternalAxes::Track(_)));
+    if !with_a_plate {
+        if let Some(w) = on(WorkObjectFrame::FacePlate) {
+            return Err(ExportError::OnFacePlate(w.name.clone()));
+        }
+    }
+    if on_a_track {
+        if let Some(w) = on(WorkObjectFrame::Base) {
+            return Err(ExportError::RidesTheCarriage(w.name.clone()));
+        }
+        // The world is the cell frame: a measured work object as it is, one
+        // on the face plate as its pose on the plate.
+        for (f, w) in data.frames.iter_mut().zip(&cell.work_objects) {
+            f.pose = w.pose;
+        }
+    }
     let kinematics = match &options.axes {
-        Some(_) if language != Language::Krl => return Err(ExportError::AxesNotWritten(language)),
-        Some(ExternalAxes::Positioner(p)) => {
-            Some(kuka_positioner(p, &model.cell_to_base(&Pose::identity())))
-        }
-        Some(ExternalAxes::Turntable(t)) => {
-            Some(kuka_turntable(t, &model.cell_to_base(&Pose::identity())))
-        }
-        Some(ExternalAxes::Track(t)) => {
-            if let Some(w) = on(WorkObjectFrame::FacePlate) {
-                return Err(ExportError::OnFacePlate(w.name.clone()));
-            }
-            if let Some(w) = on(WorkObjectFrame::Base) {
-                return Err(ExportError::RidesTheCarriage(w.name.clone()));
-            }
-            // The world is the cell frame: a measured work object as it is.
-            for (f, w) in data.frames.iter_mut().zip(&cell.work_objects) {
-                f.pose = w.pose;
-            }
-            Some(kuka_track(t))
-        }
-        None => {
-            if let Some(w) = on(WorkObjectFrame::FacePlate) {
-                return Err(ExportError::OnFacePlate(w.name.clone()));
-            }
-            None
-        }
+        None => vec![],
+        Some(ExternalAxes::Positioner(p)) => vec![kuka_positioner(p, &world_from_cell)],
+        Some(ExternalAxes::Turntable(t)) => vec![kuka_turntable(t, &world_from_cell)],
+        Some(ExternalAxes::Track(t)) => vec![kuka_track(t)],
+        Some(ExternalAxes::TrackAndPositioner(t, p)) => vec![
+            kuka_track(t),
+            kuka_positioner(p, &Pose::identity()).beside_track(),
+        ],
+        Some(ExternalAxes::TrackAndTurntable(t, tt)) => vec![
+            kuka_track(t),
+            kuka_turntable(tt, &Pose::identity()).beside_track(),
+        ],
     };
     let mut out = controller_text(language, &data, options)?;
-    if let Some(k) = &kinematics {
-        out.text.push_str(&k.text());
+    if !kinematics.is_empty() {
+        out.text.push_str(&kuka_text(&kinematics));
         for (f, w) in data.frames.iter().zip(&cell.work_objects) {
             if w.frame == WorkObjectFrame::FacePlate {
                 let _ = write!(
@@ -261,7 +277,7 @@ pub fn controller_text(
             .collect(),
         renamed: Vec::new(),
         registers: Vec::new(),
-        kinematics: None,
+        kinematics: Vec::new(),
     };
     let notes = assigned_lines(language, data);
     match language {
