@@ -27,7 +27,8 @@ use super::solve_columns::{axis_values, plate_of};
 use super::{ApiError, ApiJson, ApiPath, AppState};
 use crate::records::CellKind;
 use crate::service;
-use crate::service::predict::PredictCommand;
+use crate::service::positioners::Plate;
+use crate::service::predict::{PredictCommand, ReadingAxes};
 use crate::solve::cell::accuracy::ToolAccuracy;
 use crate::solve::cell::joints_csv::JointReading;
 use crate::solve::cell::PoseOut;
@@ -46,6 +47,15 @@ pub struct ReadingIn {
     pub id: Option<Value>,
     /// Controller joint readings [deg].
     pub joints_deg: Vec<f64>,
+    /// This reading's own `e1` (as the body's, for this reading alone).
+    #[serde(default, deserialize_with = "present")]
+    pub e1: Option<f64>,
+    /// This reading's own `e2`.
+    #[serde(default, deserialize_with = "present")]
+    pub e2: Option<f64>,
+    /// This reading's own `e3`.
+    #[serde(default, deserialize_with = "present")]
+    pub e3: Option<f64>,
 }
 
 /// `POST /v1/robots/{id}/predict` body.
@@ -180,13 +190,18 @@ fn command(robot_id: i64, req: &PredictRequest) -> Result<PredictCommand, ApiErr
             )))
         }
     };
-    let axes = axis_values(
-        req.e1,
-        req.e2,
-        req.e3,
-        req.frame.is_some() || req.work_object.is_some(),
-        plate_of(req.turntable),
-    )?;
+    let frame_given = req.frame.is_some() || req.work_object.is_some();
+    let per_reading = per_reading(req, frame_given)?;
+    let axes = match &per_reading {
+        // Each reading's values are its own; what carries the part is the
+        // same for every reading.
+        Some((_, plate)) => super::solve_columns::AxisSettings {
+            track_mm: None,
+            positioner_deg: None,
+            plate: *plate,
+        },
+        None => axis_values(req.e1, req.e2, req.e3, frame_given, plate_of(req.turntable))?,
+    };
     let readings = req
         .readings
         .iter()
@@ -224,7 +239,62 @@ fn command(robot_id: i64, req: &PredictRequest) -> Result<PredictCommand, ApiErr
         track_mm: axes.track_mm,
         positioner_deg: axes.positioner_deg,
         plate: axes.plate,
+        per_reading: per_reading.map(|(values, _)| values),
     })
+}
+
+/// The readings' own `e1`, `e2`, `e3`, when they carry them: each read as
+/// the body's would be (`axis_values`, its refusal prefixed with the
+/// reading), every reading with the same fields, none beside the body's.
+fn per_reading(
+    req: &PredictRequest,
+    frame_given: bool,
+) -> Result<Option<(Vec<ReadingAxes>, Plate)>, ApiError> {
+    let given = |r: &ReadingIn| [r.e1.is_some(), r.e2.is_some(), r.e3.is_some()];
+    let Some(first) = req.readings.iter().position(|r| given(r) != [false; 3]) else {
+        return Ok(None);
+    };
+    let names = |g: [bool; 3]| {
+        let listed: Vec<&str> = ["`e1`", "`e2`", "`e3`"]
+            .into_iter()
+            .zip(g)
+            .filter_map(|(n, on)| on.then_some(n))
+            .collect();
+        if listed.is_empty() {
+            "none".to_string()
+        } else {
+            listed.join(", ")
+        }
+    };
+    if req.e1.is_some() || req.e2.is_some() || req.e3.is_some() {
+        return Err(ApiError::invalid(format!(
+            "`readings[{first}]` has its own {} and the body gives `e1`, `e2` or `e3` for every reading: which holds is ambiguous; give the values per reading or in the body",
+            names(given(&req.readings[first]))
+        )));
+    }
+    let want = given(&req.readings[first]);
+    let plate = plate_of(req.turntable);
+    let mut out = Vec::with_capacity(req.readings.len());
+    let mut carried = plate;
+    for (i, r) in req.readings.iter().enumerate() {
+        if given(r) != want {
+            return Err(ApiError::invalid(format!(
+                "`readings[{i}]` gives {} and `readings[{first}]` {}: give every reading the same axes' values",
+                names(given(r)),
+                names(want)
+            )));
+        }
+        let at = axis_values(r.e1, r.e2, r.e3, frame_given, plate).map_err(|e| match e {
+            ApiError::Unprocessable(m) => ApiError::Unprocessable(format!("`readings[{i}]`: {m}")),
+            other => other,
+        })?;
+        carried = at.plate;
+        out.push(ReadingAxes {
+            track_mm: at.track_mm,
+            positioner_deg: at.positioner_deg,
+        });
+    }
+    Ok(Some((out, carried)))
 }
 
 /// `POST /v1/robots/{id}/predict`: the readings' poses on the chosen model.

@@ -9,6 +9,10 @@
 //! them (`super::positioners::for_predict`): `F(v)⁻¹·cell_from_base·pose`;
 //! with a track value beside them (`e1`, and the positioner's `e2`, `e3`)
 //! `cell_from_base` is the carried base `B(e)`, so `F(v)⁻¹·B(e)·pose`.
+//! Readings may each carry their own values ([`ReadingAxes`]): each is
+//! then predicted in its own frame, `X(v)⁻¹·B(e)·pose_base` with `X` the
+//! face plate, the work object or the cell frame, and a track value beyond
+//! the travel fails its reading alone.
 //!
 //! Units at this boundary: joint readings in the controller convention in
 //! degrees; poses SI (the handler writes mm and degrees).
@@ -25,7 +29,7 @@ use crate::solve::ik::TargetFrame;
 use robocal_core::model::calibrated::ValidationEvidence;
 use robocal_core::model::calibrated::{CalibratedModelFile, CompensatedModel};
 use robocal_core::model::Pose;
-use robocal_core::solve::external::{base_from_part, AxisValues};
+use robocal_core::solve::external::{base_from_part, cell_from_part, AxisValues};
 
 /// A prediction, in domain terms.
 #[derive(Debug, Clone)]
@@ -51,6 +55,27 @@ pub struct PredictCommand {
     /// What carries the part at those values: the stored positioner, or
     /// the stored turntable (its value the rotate value, the tilt 0).
     pub plate: super::positioners::Plate,
+    /// Each reading's own values, in reading order (`track_mm` and
+    /// `positioner_deg` are then `None`).
+    pub per_reading: Option<Vec<ReadingAxes>>,
+}
+
+/// One reading's own external-axis values.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReadingAxes {
+    /// The track's value [mm]: the base carried along the stored track.
+    pub track_mm: Option<f64>,
+    /// The positioner's (or turntable's) values [deg]: the pose in its face
+    /// plate frame.
+    pub positioner_deg: Option<AxisValues>,
+}
+
+/// The frame every reading is predicted in, or each reading's own.
+enum Frames {
+    /// One frame for every reading.
+    One(PredictFrame),
+    /// Each reading's frame at its values, or why it has none.
+    Each(Vec<Result<PredictFrame, PredictError>>),
 }
 
 /// What a prediction produced.
@@ -160,6 +185,9 @@ pub async fn predict(
         tool.as_ref().and_then(|t| t.load.as_ref()),
     );
     let (frame, label) = match &cmd.work_object {
+        _ if cmd.per_reading.is_some() => {
+            per_reading_frames(state, &cmd, forward.model().cell_from_base).await?
+        }
         None if cmd.positioner_deg.is_some() => {
             let positioner = super::positioners::for_predict(
                 state,
@@ -173,14 +201,17 @@ pub async fn predict(
                 rotate_deg: 0.0,
             });
             let plate = base_from_part(forward.model(), &positioner, values, &Pose::identity());
-            (PredictFrame::WorkObject(plate), "face_plate")
+            (Frames::One(PredictFrame::WorkObject(plate)), "face_plate")
         }
-        None => (PredictFrame::Frame(cmd.frame), frame_label(cmd.frame)),
+        None => (
+            Frames::One(PredictFrame::Frame(cmd.frame)),
+            frame_label(cmd.frame),
+        ),
         Some(choice) => {
             let item = resolve(state, cmd.robot_id, CellKind::WorkObject, choice).await?;
             let wobj = item.placed_work_object()?;
             (
-                PredictFrame::WorkObject(wobj.in_base(forward.model())),
+                Frames::One(PredictFrame::WorkObject(wobj.in_base(forward.model()))),
                 "work_object",
             )
         }
@@ -212,15 +243,78 @@ pub async fn predict(
 fn predict_all(
     forward: &Forward,
     readings: Vec<JointReading>,
-    frame: &PredictFrame,
+    frames: &Frames,
 ) -> Vec<(JointReading, Result<Predicted, PredictError>)> {
     readings
         .into_iter()
-        .map(|r| {
-            let p = forward.predict_deg(&r.joints_deg, frame);
+        .enumerate()
+        .map(|(i, r)| {
+            let p = match frames {
+                Frames::One(frame) => forward.predict_deg(&r.joints_deg, frame),
+                Frames::Each(each) => each[i]
+                    .clone()
+                    .and_then(|frame| forward.predict_deg(&r.joints_deg, &frame)),
+            };
             (r, p)
         })
         .collect()
+}
+
+/// Each reading's frame at its own values (`cmd.per_reading`), the robot
+/// registered at `cell_from_base` without a track value: `X(v)⁻¹·B(e)` as
+/// a work object in the base frame, `X` the face plate at the reading's
+/// positioner values, the work object or the cell frame. The stored track
+/// and positioner (or turntable) are read once; a track value beyond the
+/// travel fails its reading alone.
+async fn per_reading_frames(
+    state: &AppState,
+    cmd: &PredictCommand,
+    cell_from_base: Pose,
+) -> Result<(Frames, &'static str), ServiceError> {
+    let values = cmd.per_reading.as_deref().unwrap_or_default();
+    let track = match values.iter().any(|v| v.track_mm.is_some()) {
+        true => Some(super::tracks::stored(state, cmd.robot_id).await?),
+        false => None,
+    };
+    let positioner = match values.iter().any(|v| v.positioner_deg.is_some()) {
+        true => Some(
+            super::positioners::for_predict(state, cmd.robot_id, track.is_some(), cmd.plate)
+                .await?,
+        ),
+        false => None,
+    };
+    let wobj = match &cmd.work_object {
+        Some(choice) => Some(
+            resolve(state, cmd.robot_id, CellKind::WorkObject, choice)
+                .await?
+                .placed_work_object()?,
+        ),
+        None => None,
+    };
+    let label = match (&positioner, &wobj) {
+        (Some(_), _) => "face_plate",
+        (None, Some(_)) => "work_object",
+        (None, None) => frame_label(cmd.frame),
+    };
+    let frames = values
+        .iter()
+        .map(|v| {
+            let base = match (v.track_mm, &track) {
+                (Some(e), Some(t)) => t.cell_from_base(e)?,
+                _ => cell_from_base,
+            };
+            Ok(match (v.positioner_deg, &positioner, &wobj) {
+                (Some(at), Some(p), _) => PredictFrame::WorkObject(
+                    base.inverse()
+                        .compose(&cell_from_part(p, at, &Pose::identity())),
+                ),
+                (_, _, Some(w)) => PredictFrame::WorkObject(w.in_base_at(&base)),
+                _ if cmd.frame == TargetFrame::Cell => PredictFrame::WorkObject(base.inverse()),
+                _ => PredictFrame::Frame(cmd.frame),
+            })
+        })
+        .collect();
+    Ok((Frames::Each(frames), label))
 }
 
 fn frame_label(f: TargetFrame) -> &'static str {

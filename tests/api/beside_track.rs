@@ -149,6 +149,20 @@ pub(crate) async fn solves_beside_the_track(
         }
     }
 
+    // Each reading at its own values in one prediction.
+    let at: Vec<super::per_reading::Reading> = rows
+        .iter()
+        .zip(values())
+        .enumerate()
+        .map(|(k, (row, (e, v)))| super::per_reading::Reading {
+            joints: joints(row),
+            e,
+            v,
+            on_plate: on_plate(k),
+        })
+        .collect();
+    super::per_reading::predicts_per_reading(t, rid, model, fitted, track_file, dir, &at).await;
+
     // A JSON solve and a prediction at one set of values: the CSV's row,
     // and the target back on the face plate.
     let (k, (e, v)) = (3, values()[3]);

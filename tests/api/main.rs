@@ -57,6 +57,7 @@ mod jobs;
 mod migrations;
 mod numbers;
 mod one_answer;
+mod per_reading;
 mod plans;
 mod positioner;
 mod positioner_filter;

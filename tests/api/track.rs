@@ -264,6 +264,32 @@ async fn a_track_fitted_over_http_is_the_command_lines_and_carries_predict_and_s
         assert!((xyz(h) - want).norm() < 0.05, "{} {want}", xyz(h));
     }
 
+    // Each reading at its own track value, held-out values between the
+    // stations, in one request: each within 0.05 mm of the true reflector
+    // there, as at one value.
+    let own: Vec<f64> = (0..qs.len()).map(|i| 300.0 + 450.0 * i as f64).collect();
+    let readings: Vec<Value> = qs
+        .iter()
+        .zip(&own)
+        .map(|(q, e)| json!({ "joints_deg": controller_deg(q), "e1": e }))
+        .collect();
+    let r = t
+        .post_json(
+            PREDICT,
+            &[&rid],
+            json!({ "readings": readings, "payload_kg": PAYLOAD_KG }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let each = r.json();
+    let mut worst = 0.0f64;
+    for ((q, e), h) in qs.iter().zip(&own).zip(each["results"].as_array().unwrap()) {
+        let want = rail.true_pose(q, *e).p * 1e3;
+        worst = worst.max((xyz(h) - want).norm());
+    }
+    eprintln!("per reading on the track: {} readings at 300–{} mm within {worst:.4} mm of the true reflector", qs.len(), own[own.len() - 1]);
+    assert!(worst < 0.05, "{worst}");
+
     // Solve the poses the true robot reached there, over HTTP and by the
     // command line: the same joints, and the true robot at them within
     // 0.05 mm of each target.

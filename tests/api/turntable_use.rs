@@ -437,6 +437,51 @@ async fn predict(t: &TestApp, rid: &str, model: &Path, d: &Path, by_csv: &Value)
         )
         .await;
     assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+    // Every solved row in one prediction, each reading at its own value:
+    // as the rows of each value predicted with the body's `e1`.
+    let rows = on_body().len() * VALUES.len();
+    let own: Vec<Value> = (0..rows)
+        .map(|n| json!({ "joints_deg": numbers(&by_csv["results"][n]["joints_deg"]), "e1": VALUES[n % VALUES.len()] }))
+        .collect();
+    let r = t
+        .post_json(
+            PREDICT,
+            &[rid],
+            json!({ "readings": own, "turntable": true, "payload_kg": PAYLOAD_KG }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let each = r.json();
+    assert_eq!(each["frame"], "face_plate");
+    for (k, value) in VALUES.iter().enumerate() {
+        let alone: Vec<Value> = (0..on_body().len())
+            .map(|i| json!({ "joints_deg": numbers(&by_csv["results"][i * VALUES.len() + k]["joints_deg"]) }))
+            .collect();
+        let r = t
+            .post_json(
+                PREDICT,
+                &[rid],
+                json!({ "readings": alone, "turntable": true, "e1": value, "payload_kg": PAYLOAD_KG }),
+            )
+            .await;
+        let alone = r.json();
+        for i in 0..on_body().len() {
+            let (a, b) = (&each["results"][i * VALUES.len() + k], &alone["results"][i]);
+            for name in ["x", "y", "z", "rx", "ry", "rz"] {
+                assert_eq!(a[name], b[name], "reading {i} at {value}: {name}");
+            }
+        }
+    }
+    // A reading's own value with `frame`: 422 naming the reading.
+    let r = t
+        .post_json(
+            PREDICT,
+            &[rid],
+            json!({ "readings": [{ "joints_deg": joints[0], "e1": 5.0 }], "turntable": true, "frame": "base" }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+    assert!(r.detail().contains("`readings[0]`"), "{}", r.detail());
 }
 
 /// A filter request for KRL files with the controller's turntable.

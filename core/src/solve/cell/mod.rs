@@ -106,9 +106,16 @@ impl WorkObject {
     /// (it turns with the positioner): its pose on the plate, as the
     /// controller holds it ([`Cell::work_object`] does not give one out).
     pub fn in_base(&self, model: &CompensatedModel) -> Pose {
+        self.in_base_at(&model.cell_from_base)
+    }
+
+    /// [`Self::in_base`] with the robot's base at `cell_from_base` (a base
+    /// a track carries): `cell_from_base⁻¹·pose` for a measurement-frame
+    /// work object.
+    pub fn in_base_at(&self, cell_from_base: &Pose) -> Pose {
         match self.frame {
             WorkObjectFrame::Base | WorkObjectFrame::FacePlate => self.pose,
-            WorkObjectFrame::Measurement => model.cell_to_base(&self.pose),
+            WorkObjectFrame::Measurement => cell_from_base.inverse().compose(&self.pose),
         }
     }
 }

@@ -64,6 +64,10 @@ pub enum PredictError {
     /// The model's kinematics failed at these joints.
     #[error("the model cannot evaluate these joints: {0}")]
     Kinematics(#[from] KinematicsError),
+    /// The reading's own track value is beyond the travel the track was
+    /// measured over.
+    #[error("`e1`: {0}")]
+    OutsideTravel(#[from] crate::model::external::OutsideTravel),
 }
 
 /// One predicted pose.
