@@ -299,11 +299,13 @@ def turntable_through_the_form(driver, wait, shot, base, robocal, axes, rail_id,
           f"zero offset {shown['zero']}°, scale {shown['scale']}, axis through {shown['point']} mm")
     shot("turntable-fitted", "turntable-stored-box")
     predict_and_solve_on_turntable(driver, wait, shot, base, rail_id, h)
-    # The filter and the plans over the axes (scripts/console_check_axes_programs.py).
-    from console_check_axes_programs import filter_on_turntable, plan_sweeps
+    # The filter, the controller data and the plans over the axes
+    # (scripts/console_check_axes_programs.py).
+    from console_check_axes_programs import export_on_turntable, filter_on_turntable, plan_sweeps
     import sys
     p_sets, p_nominal, p_reflectors = simulated_fit(robocal, "positioner", axes / "plan-positioner")
     filter_on_turntable(driver, wait, shot, base, rail_id, nominal, p_nominal, sys.modules[__name__], h)
+    export_on_turntable(driver, wait, shot, base, rail_id, sys.modules[__name__], h)
     plan_sweeps(driver, wait, shot, base, rail_id, "turntable", nominal, reflectors, sys.modules[__name__], h)
     plan_sweeps(driver, wait, shot, base, rail_id, "positioner", p_nominal, p_reflectors, sys.modules[__name__], h)
     # Refused: the form reads the axis's value from e2, the files have e1.

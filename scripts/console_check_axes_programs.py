@@ -1,9 +1,11 @@
-"""The web console's filter and measurement plan over the external axes, a
-step of scripts/console_check_axes.py: a KRL program whose targets carry
-`E1` filtered through the robot page's form with the controller's turntable,
-a refusal shown with the API's reason, a turntable's and a positioner's
-sweeps planned through the plan form; each answer compared with the API's
-for the same body. Python 3 standard library and Selenium.
+"""The web console's filter, controller data and measurement plan over the
+external axes, a step of scripts/console_check_axes.py: a KRL program whose
+targets carry `E1` filtered through the robot page's form with the
+controller's turntable, a refusal shown with the API's reason, the
+controller data exported with the stored turntable's axes (and a track it
+has not stored refused), a turntable's and a positioner's sweeps planned
+through the plan form; each answer compared with the API's for the same
+body. Python 3 standard library and Selenium.
 """
 import json
 import pathlib
@@ -148,3 +150,57 @@ def plan_sweeps(driver, wait, shot, base, rail_id, what, nominal, reflectors, ax
     print(f"console_check: planned the {what}: {summary}; σ {'; '.join(' '.join(r) for r in rows)}; "
           f"{refl}; the CSV and {len(files) - 1} program files the API's")
     shot(f"plan-{what}", "plan-section")
+
+
+def export_on_turntable(driver, wait, shot, base, rail_id, axes_mod, h):
+    """The rail robot with its turntable stored (and no track): the
+    controller data form's KRL export with the external axes `turntable`
+    shows the API's text for the same body, the not-held table lists the
+    API's `kinematics.not_held` terms (the turntable's scale), and the
+    `held.json` download is its `kinematics.held`; `track` (none stored) is
+    refused with the API's 409 and its detail."""
+    form = wait.until(lambda d: d.find_element(By.ID, "export-cell"))
+    Select(form.find_element(By.NAME, "language")).select_by_value("krl")
+    axes = Select(form.find_element(By.NAME, "axes"))
+    assert axes.first_selected_option.get_attribute("value") == "", "an axes kind is chosen by default"
+    assert [o.get_attribute("value") for o in axes.options] == \
+        ["", "positioner", "track", "turntable", "track_and_positioner", "track_and_turntable"], axes.options
+    axes.select_by_value("turntable")
+    before = h.text_of(driver, "#message")
+    form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+    msg = wait.until(lambda d: (t := h.text_of(d, "#message")) and t != before and t)
+    want = h.api_post(base, f"/v1/robots/{rail_id}/cell/export", {"language": "krl", "axes": "turntable"})
+    k = want["kinematics"]
+    assert k["kind"] == "turntable" and k["not_held"], (msg, k)
+    assert msg.startswith("Controller data for krl with the turntable ("), msg
+    text = driver.execute_script("return document.getElementById('export-text').textContent")
+    assert text == want["text"], "the page's text differs from the API's"
+    assert "MACHINE_DEF[2]" in text, text
+    rows = [[td.text for td in r.find_elements(By.TAG_NAME, "td")]
+            for r in driver.find_elements(By.CSS_SELECTOR, "#export-not-held tbody tr")]
+    assert [r[0] for r in rows] == [n["term"] for n in k["not_held"]], (rows, k["not_held"])
+    for row, n in zip(rows, k["not_held"], strict=True):
+        assert row[2] == axes_mod.shown_number(n["miss_mm"], 3), (row, n)
+    assert not driver.find_element(By.ID, "export-all-held").is_displayed()
+    files = driver.execute_async_script(
+        "const done = arguments[0];"
+        "Promise.all([...document.querySelectorAll('#export-held-downloads a.held-file')]"
+        ".map(a => fetch(a.href).then(r => r.json()).then(j => [a.download, j]))).then(done);")
+    assert [f[0] for f in files] == ["held.json"], files
+    assert files[0][1] == k["held"], (files[0][1], k["held"])
+    print(f"console_check: exported with the turntable: {msg}; not held: "
+          f"{'; '.join(' '.join(r) for r in rows)}; the text, the terms and held.json the API's")
+    shot("export-turntable", "export-cell")
+    # Refused: the track, and the robot has none stored.
+    status, answer = axes_mod.api_raw(h.KEY, base, "POST", f"/v1/robots/{rail_id}/cell/export",
+                                      json.dumps({"language": "krl", "axes": "track"}).encode(), "application/json")
+    assert status == 409, (status, answer)
+    refusal = f"409: {json.loads(answer)['detail']}"
+    axes.select_by_value("track")
+    form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+    msg = wait.until(lambda d: (t := h.text_of(d, "#message")) and t.startswith("409") and t)
+    assert msg == refusal, (msg, refusal)
+    assert "msg bad" in driver.find_element(By.ID, "message").get_attribute("class")
+    print(f"console_check: refused: {msg}")
+    shot("export-refused", "export-cell")
+    driver.get(driver.current_url)

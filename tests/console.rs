@@ -385,6 +385,58 @@ async fn the_filter_and_plan_forms_take_the_external_axes() {
     }
 }
 
+/// The controller data form offers the external axes (KRL): "none" first
+/// (nothing sent), then every kind the API takes (`AxesKind::ALL`, by its
+/// serde name, labelled in words); the answer's not-held table and held
+/// downloads wait hidden under the text.
+#[tokio::test]
+async fn the_export_form_offers_every_external_axes_kind() {
+    let (state, _dir) = state().await;
+    let robot = post_json(
+        &state,
+        "/v1/robots",
+        &serde_json::json!({ "name": "cell", "preset": "ur5" }),
+        StatusCode::CREATED,
+    )
+    .await;
+    let id = robot["id"].as_i64().unwrap();
+    let (s, html) = call(&state, "GET", &format!("/ui/robots/{id}"), None).await;
+    assert_eq!(s, StatusCode::OK);
+    let export = form(&html, "export-cell");
+    assert!(export.contains(&format!(
+        "<form id=\"export-cell\" data-action=\"export-cell\" data-robot=\"{id}\""
+    )));
+    let at = export
+        .find("<select name=\"axes\">")
+        .expect("no axes select");
+    let select = &export[at..at + export[at..].find("</select>").unwrap()];
+    let open = export[..at].rfind("<label").unwrap();
+    assert!(
+        export[open..at].ends_with(">External axes (KRL) "),
+        "{}",
+        &export[open..at]
+    );
+    let mut want = String::from("<select name=\"axes\"><option value=\"\">none</option>");
+    for k in robocal::program::controller::AxesKind::ALL {
+        let name = serde_json::to_value(k).unwrap();
+        let name = name.as_str().unwrap();
+        want += &format!(
+            "<option value=\"{name}\">{}</option>",
+            name.replace('_', " ")
+        );
+    }
+    assert_eq!(select, want);
+    assert_eq!(selected(export, "axes"), None, "an axes kind is chosen");
+    for part in [
+        "<div id=\"export-kinematics\" hidden>",
+        "<p id=\"export-held-downloads\"></p>",
+        "<p id=\"export-all-held\" hidden>Every calibrated term is held.</p>",
+        "<table id=\"export-not-held\"><thead><tr><th>Not held</th><th>Value</th><th>Miss [mm]</th></tr></thead>",
+    ] {
+        assert!(html.contains(part), "the page lacks {part}");
+    }
+}
+
 /// The robot page's `#axes-section`, from its opening tag to its end.
 fn axes_section(html: &str) -> &str {
     let at = html

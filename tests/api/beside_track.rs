@@ -17,7 +17,6 @@
 use super::positioner::{cli, numbers};
 use crate::support::*;
 use axum::http::StatusCode;
-use clap::Parser as _;
 use nalgebra::Vector3;
 use robocal::model::external::{LinearTrack, TiltRotate};
 use serde_json::{json, Value};
@@ -357,13 +356,11 @@ pub(crate) async fn exports_beside_the_track(
         "--held-track".into(),
         p(&held_track),
     ];
-    let robocal::cli::Command::Cell(a) = robocal::cli::Cli::try_parse_from(argv).unwrap().command
-    else {
-        unreachable!("a cell command line")
-    };
-    let robocal::cli::cell::CellCommand::Export(e) = a.command;
-    let by_cli = robocal::cli::cell::export_to_string(&e).unwrap();
-    assert_eq!(text, by_cli, "the exported text");
+    assert_eq!(
+        text,
+        super::positioner_filter::cell_export(argv),
+        "the exported text"
+    );
     let read =
         |f: &Path| -> Value { serde_json::from_str(&std::fs::read_to_string(f).unwrap()).unwrap() };
     let (written, written_track) = (read(&held), read(&held_track));

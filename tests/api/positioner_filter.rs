@@ -224,6 +224,16 @@ pub(crate) async fn filters_as_the_command_line(
     );
 }
 
+/// `robocal cell export` run in-process with `argv`: the text it prints.
+pub(crate) fn cell_export(argv: impl IntoIterator<Item = String>) -> String {
+    let robocal::cli::Command::Cell(a) = robocal::cli::Cli::try_parse_from(argv).unwrap().command
+    else {
+        unreachable!("a cell command line")
+    };
+    let robocal::cli::cell::CellCommand::Export(e) = a.command;
+    robocal::cli::cell::export_to_string(&e).unwrap()
+}
+
 /// A stored positioner's, track's or turntable's axes, its file and the
 /// cell's file.
 pub(crate) struct Axes<'a> {
@@ -290,13 +300,7 @@ pub(crate) async fn exports_as_the_command_line(
         "--held".into(),
         p(&held),
     ];
-    let robocal::cli::Command::Cell(a) = robocal::cli::Cli::try_parse_from(argv).unwrap().command
-    else {
-        unreachable!("a cell command line")
-    };
-    let robocal::cli::cell::CellCommand::Export(e) = a.command;
-    let by_cli = robocal::cli::cell::export_to_string(&e).unwrap();
-    assert_eq!(text, by_cli, "the exported text");
+    assert_eq!(text, cell_export(argv), "the exported text");
     let written: Value = serde_json::from_str(&std::fs::read_to_string(&held).unwrap()).unwrap();
     assert_eq!(k["held"], written, "the held {}", axes.kind);
     match axes.kind {

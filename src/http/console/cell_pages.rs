@@ -6,6 +6,7 @@
 
 use super::fields::model_select;
 use super::format::{deg, fixed, kg, mm, trimmed, DEG_DECIMALS, KG_DECIMALS, MM_DECIMALS};
+use crate::program::controller::AxesKind;
 use crate::records::VersionRow;
 use crate::records::{CellItemRow, ItemFrame};
 use maud::{html, Markup};
@@ -199,7 +200,9 @@ pub(super) fn cell_section(id: i64, tools: &[CellItemRow], work_objects: &[CellI
     }
 }
 
-/// The controller's tool, load and work object data (`POST …/cell/export`).
+/// The controller's tool, load and work object data (`POST …/cell/export`),
+/// with the robot's stored external axes for KRL (`axes`, every
+/// [`AxesKind`]): what the controller cannot hold and what it then computes.
 fn export_form(id: i64) -> Markup {
     html! {
         h3 { "Controller data" }
@@ -210,11 +213,25 @@ fn export_form(id: i64) -> Markup {
                     option value="fanuc" { "Fanuc TP" } option value="urscript" { "URScript" }
                 }
             }
+            label title="KRL only: the robot's stored axes written as the controller's external kinematic systems" { "External axes (KRL) "
+                select name="axes" {
+                    option value="" { "none" }
+                    @for k in AxesKind::ALL { option value=(k.name()) { (k.name().replace('_', " ")) } }
+                }
+            }
             button type="submit" { "Export" }
         }
         div #export-result hidden {
             p { a #export-download href="#" { "Download" } }
             pre #export-text {}
+            div #export-kinematics hidden {
+                p #export-held-downloads {}
+                p #export-all-held hidden { "Every calibrated term is held." }
+                table #export-not-held {
+                    thead { tr { th { "Not held" } th { "Value" } th { "Miss [mm]" } } }
+                    tbody {}
+                }
+            }
         }
     }
 }

@@ -328,17 +328,22 @@ handlers.reregister = async function (form) {
   location.href = `/ui/robots/${robot}#versions`;
 };
 
-// The controller's tool, load and work object data, shown and offered.
+// The controller's tool, load and work object data, shown and offered;
+// with external axes chosen, what the controller holds of them
+// (console_axes.js).
 handlers["export-cell"] = async function (form) {
   const language = formValue(form, "language");
-  const r = (await api("POST", `/v1/robots/${form.dataset.robot}/cell/export`, JSON.stringify({ language }), "application/json")).json();
+  const axes = formValue(form, "axes");
+  const body = axes ? { language, axes } : { language };
+  const r = (await sendJson("POST", `/v1/robots/${form.dataset.robot}/cell/export`, body)).json();
   document.getElementById("export-text").textContent = r.text;
   const link = document.getElementById("export-download");
   link.href = URL.createObjectURL(new Blob([r.text], { type: "text/plain" }));
   link.download = { krl: "config.dat", rapid: "cell.mod", fanuc: "cell.ls", urscript: "cell.script" }[language];
   link.textContent = "Download " + link.download;
+  const held = showExportKinematics(r.kinematics);
   document.getElementById("export-result").hidden = false;
-  show(`Controller data for ${language} (model: ${r.version === null ? "nominal" : "v" + r.version})`, true);
+  show(`Controller data for ${language}${held} (model: ${r.version === null ? "nominal" : "v" + r.version})`, true);
 };
 
 // Predict: joint readings in, poses out.

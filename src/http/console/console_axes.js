@@ -1,5 +1,6 @@
-// robocal web console, the external axes of the filter and of the measurement
-// plan (inlined after console.js, whose helpers it uses).
+// robocal web console, the external axes of the filter, of the measurement
+// plan and of the controller data (inlined after console.js, whose helpers it
+// uses).
 
 // A JSON text from a file input or a paste area, parsed; null when both are empty.
 async function optionalJson(form, fileName, textName, what) {
@@ -189,4 +190,31 @@ async function plannedOverTrack(form, robotBody) {
     planTables(["plan-params"]);
     return robotPlan(form);
   };
+}
+
+// A cell export's external axes (`kinematics`, with `axes` chosen): the
+// calibrated terms the controller cannot hold as a table (or that every one
+// is), and the positioner, track or turntable it then computes as JSON
+// downloads: `held.json`, or beside a track `held-track.json` and
+// `held-positioner.json` or `held-turntable.json`. Answers the message's
+// words for the axes ("" without them).
+function showExportKinematics(k) {
+  document.getElementById("export-kinematics").hidden = !k;
+  if (!k) return "";
+  const tbody = document.querySelector("#export-not-held tbody");
+  tbody.textContent = "";
+  for (const n of k.not_held) {
+    const value = fixed(n.value, { mm: 3, arcsec: 2 }[n.unit] ?? 6) + (n.unit ? " " + n.unit : "");
+    appendRow(tbody, [n.term, value, fmtMm(n.miss_mm)], "not-held");
+  }
+  document.getElementById("export-not-held").hidden = !k.not_held.length;
+  document.getElementById("export-all-held").hidden = k.not_held.length > 0;
+  const beside = k.kind.startsWith("track_and_") ? k.kind.slice("track_and_".length) : null;
+  const files = beside ? [["track", k.held.track], [beside, k.held[beside]]].map(([kind, held]) => [`held-${kind}.json`, held]) : [["held.json", k.held]];
+  const links = document.getElementById("export-held-downloads");
+  links.textContent = "What the controller then computes: ";
+  for (const [name, held] of files) downloadLink(links, name, JSON.stringify(held, null, 2), "held-file");
+  const n = k.not_held.length;
+  const missed = n ? `${n} term${n === 1 ? "" : "s"} not held` : "every calibrated term held";
+  return ` with the ${k.kind.replaceAll("_", " ")} (${missed})`;
 }

@@ -113,6 +113,17 @@ impl AxesKind {
         AxesKind::TrackAndTurntable,
     ];
 
+    /// The kind's name as the API spells it (its serde name).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Positioner => "positioner",
+            Self::Track => "track",
+            Self::Turntable => "turntable",
+            Self::TrackAndPositioner => "track_and_positioner",
+            Self::TrackAndTurntable => "track_and_turntable",
+        }
+    }
+
     /// The kinematic systems written, in their order (ET1, ET2).
     pub fn systems(self) -> &'static [KinematicKind] {
         match self {
