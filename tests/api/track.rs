@@ -289,6 +289,35 @@ async fn a_track_fitted_over_http_is_the_command_lines_and_carries_predict_and_s
     }
     eprintln!("per reading on the track: {} readings at 300–{} mm within {worst:.4} mm of the true reflector", qs.len(), own[own.len() - 1]);
     assert!(worst < 0.05, "{worst}");
+    // In a work object measured in the cell frame: each reading as that
+    // reading predicted alone with the body's `e1`.
+    let wobj = json!({ "frame": "measurement", "xyz_mm": [1800.0, 400.0, -200.0], "rpy_deg": [0.0, 0.0, 30.0] });
+    let readings: Vec<Value> = qs
+        .iter()
+        .zip(&own)
+        .map(|(q, e)| json!({ "joints_deg": controller_deg(q), "e1": e }))
+        .collect();
+    let r = t
+        .post_json(
+            PREDICT,
+            &[&rid],
+            json!({ "readings": readings, "work_object": wobj, "payload_kg": PAYLOAD_KG }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let each = r.json();
+    assert_eq!(each["frame"], "work_object");
+    for ((q, e), h) in qs.iter().zip(&own).zip(each["results"].as_array().unwrap()) {
+        let body = json!({ "readings": [{ "joints_deg": controller_deg(q) }], "e1": e, "work_object": wobj, "payload_kg": PAYLOAD_KG });
+        let alone = t.post_json(PREDICT, &[&rid], body).await.json();
+        for k in ["x", "y", "z", "rx", "ry", "rz"] {
+            let (a, b) = (
+                h[k].as_f64().unwrap(),
+                alone["results"][0][k].as_f64().unwrap(),
+            );
+            assert!((a - b).abs() < 1e-9, "{k} at {e} mm: {a} vs {b}");
+        }
+    }
 
     // Solve the poses the true robot reached there, over HTTP and by the
     // command line: the same joints, and the true robot at them within
