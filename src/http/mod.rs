@@ -48,6 +48,7 @@ pub mod sets;
 pub mod solve;
 pub mod solve_columns;
 pub mod station_sets;
+pub mod target_values;
 pub mod tracks;
 pub mod turntables;
 pub mod versions;

@@ -132,6 +132,16 @@ pub struct TargetIn {
     /// The target's orientation (absent or null: a position-only target).
     #[serde(default, deserialize_with = "object_or_null")]
     pub orientation: Option<OrientationIn>,
+    /// This target's own `e1`, `e2`, `e3` (as the body's, for this target
+    /// alone; `target_values`).
+    #[serde(default, deserialize_with = "present")]
+    pub e1: Option<f64>,
+    /// This target's own `e2`.
+    #[serde(default, deserialize_with = "present")]
+    pub e2: Option<f64>,
+    /// This target's own `e3`.
+    #[serde(default, deserialize_with = "present")]
+    pub e3: Option<f64>,
 }
 
 /// `POST /v1/robots/{id}/solve` body.
@@ -503,7 +513,17 @@ pub fn json_command(
     let plate = plate_of(req.turntable);
     // A positioner's or a turntable's values state the targets' frame (its
     // face plate): the query's `frame` and `e1` do not stand in for the body's.
-    let on_plate = req.e2.is_some() || plate == Plate::Turntable;
+    let own = super::target_values::own_values(
+        &req.targets
+            .iter()
+            .map(|t| [t.e1, t.e2, t.e3])
+            .collect::<Vec<_>>(),
+        [req.e1, req.e2, req.e3],
+        req.work_object.is_some(),
+        plate,
+        req.frame.is_some(),
+    )?;
+    let on_plate = req.e2.is_some() || plate == Plate::Turntable || own.is_some();
     let (branch, seed_deg) = if seed_in_body {
         (req.branch.as_deref(), req.seed_deg.clone())
     } else {
@@ -533,7 +553,12 @@ pub fn json_command(
             e2: req.e2,
             e3: req.e3,
             work_object: req.work_object.is_some(),
-            plate,
+            // Each target's values: read above.
+            plate: if own.is_some() {
+                Plate::Positioner
+            } else {
+                plate
+            },
         },
     )?;
     cmd.tool = req
@@ -551,7 +576,15 @@ pub fn json_command(
     req.convention = req
         .convention
         .or_else(|| query.convention.map(str::to_string));
-    cmd.targets = Targets::Inputs(to_inputs(&req)?);
+    let inputs = to_inputs(&req)?;
+    match own {
+        None => cmd.targets = Targets::Inputs(inputs),
+        Some(own) => {
+            cmd.plate = own.plate;
+            own.columns.set_on(&mut cmd);
+            cmd.targets = Targets::Csv(super::target_values::as_rows(inputs));
+        }
+    }
     Ok(cmd)
 }
 
@@ -713,15 +746,7 @@ pub fn csv_command(robot_id: i64, q: &CsvSolveQuery, text: &str) -> Result<Solve
     )?;
     cmd.plate = plate;
     let csv = parse_targets_csv_beside(text, d, columns.beside())?;
-    match columns {
-        AxisColumns::None => {}
-        AxisColumns::Track(rows) => cmd.track_rows = Some(rows),
-        AxisColumns::Positioner(rows) => cmd.positioner_rows = Some(rows),
-        AxisColumns::TrackAndPositioner { track, plate } => {
-            cmd.track_rows = Some(track);
-            cmd.positioner_rows = Some(plate);
-        }
-    }
+    columns.set_on(&mut cmd);
     if csv.rows.is_empty() {
         return Err(ApiError::invalid(
             "targets CSV: no target rows after the header",
@@ -812,6 +837,8 @@ pub async fn solve(
         ));
     }
     let cmd = solve_command(robot_id, &query, request_is_csv, &body?)?;
+    // A JSON solve's targets at their own values run as rows.
+    let own_values = !request_is_csv && matches!(cmd.targets, Targets::Csv(_));
     let (frame, position_only, path) = (cmd.options.frame, cmd.options.position_only, cmd.path);
     let frame = if cmd.work_object.is_some() {
         "work_object".to_string()
@@ -831,7 +858,12 @@ pub async fn solve(
     if wants_csv(&headers, request_is_csv) {
         return Ok(csv_answer(&done, out_conv, solved));
     }
-    let out: Vec<TargetOut> = done.results.into_iter().map(TargetOut::from).collect();
+    let mut out: Vec<TargetOut> = done.results.into_iter().map(TargetOut::from).collect();
+    for (i, t) in out.iter_mut().enumerate().filter(|_| own_values) {
+        if let Some(r) = t.reason.as_mut() {
+            super::target_values::in_json_terms(i, &mut r.message);
+        }
+    }
     Ok(axum::Json(SolveResponse {
         robot_id,
         version: done.version,

@@ -52,6 +52,19 @@ pub enum AxisColumns {
 }
 
 impl AxisColumns {
+    /// Gives `cmd` these values per row.
+    pub fn set_on(self, cmd: &mut crate::service::solve::SolveCommand) {
+        match self {
+            AxisColumns::None => {}
+            AxisColumns::Track(rows) => cmd.track_rows = Some(rows),
+            AxisColumns::Positioner(rows) => cmd.positioner_rows = Some(rows),
+            AxisColumns::TrackAndPositioner { track, plate } => {
+                cmd.track_rows = Some(track);
+                cmd.positioner_rows = Some(plate);
+            }
+        }
+    }
+
     /// The columns the targets parser passes over (read here, not targets' columns).
     pub fn beside(&self) -> &'static [&'static str] {
         match self {

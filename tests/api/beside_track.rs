@@ -161,6 +161,7 @@ pub(crate) async fn solves_beside_the_track(
         })
         .collect();
     super::per_reading::predicts_per_reading(t, rid, model, fitted, track_file, dir, &at).await;
+    super::per_reading::solves_per_target(t, rid, &at).await;
 
     // A JSON solve and a prediction at one set of values: the CSV's row,
     // and the target back on the face plate.

@@ -154,3 +154,113 @@ pub(crate) async fn predicts_per_reading(
         assert!(r.detail().contains(words), "{}", r.detail());
     }
 }
+
+/// A JSON solve whose targets each carry their own `e1`, `e2`, `e3` (the
+/// points of `at` on the face plate at their values): the joints of the
+/// targets CSV with those columns answered as JSON, a ninth target beyond
+/// the travel failing alone in the JSON's words (`targets[8].e1`), and the
+/// refusals naming the target.
+pub(crate) async fn solves_per_target(t: &TestApp, rid: &str, at: &[Reading]) {
+    const SOLVE: &str = "/v1/robots/{id}/solve";
+    let mut targets: Vec<Value> = at
+        .iter()
+        .map(|r| {
+            let p = r.on_plate;
+            json!({ "x": p.x, "y": p.y, "z": p.z, "e1": r.e, "e2": r.v[0], "e3": r.v[1] })
+        })
+        .collect();
+    targets.push(json!({ "x": 100.0, "y": 0.0, "z": 50.0, "e1": 9000.0, "e2": 0.0, "e3": 0.0 }));
+    let r = t
+        .post_json(
+            SOLVE,
+            &[rid],
+            json!({ "targets": targets, "position_only": true }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let doc = r.json();
+    assert_eq!(doc["frame"], "face_plate", "{doc}");
+    let results = doc["results"].as_array().unwrap();
+    let last = &results[at.len()];
+    assert_eq!(last["status"], "failed", "{last}");
+    assert_eq!(last["reason"]["code"], "invalid_target", "{last}");
+    let message = last["reason"]["message"].as_str().unwrap();
+    assert!(
+        message.contains(&format!("`targets[{}].e1`: ", at.len()))
+            && message.contains("outside the travel")
+            && !message.contains("line"),
+        "{message}"
+    );
+    // The same targets as a CSV with `e1`, `e2`, `e3` columns, answered as
+    // JSON (every digit).
+    let mut csv = vec!["id,x,y,z,e1,e2,e3".to_string()];
+    for (k, r) in at.iter().enumerate() {
+        let p = r.on_plate;
+        csv.push(format!(
+            "{},{:?},{:?},{:?},{:?},{:?},{:?}",
+            k + 1,
+            p.x,
+            p.y,
+            p.z,
+            r.e,
+            r.v[0],
+            r.v[1]
+        ));
+    }
+    let by_csv = t
+        .send_with(
+            "POST",
+            SOLVE,
+            &[rid],
+            "?position_only=true",
+            &[("content-type", "text/csv"), ("accept", "application/json")],
+            (csv.join("\n") + "\n").into_bytes(),
+        )
+        .await;
+    assert_eq!(by_csv.status, StatusCode::OK, "{}", by_csv.text());
+    let by_csv = by_csv.json();
+    let mut worst = 0.0f64;
+    for (got, want) in results.iter().zip(by_csv["results"].as_array().unwrap()) {
+        assert_eq!(got["status"], "ok", "{got}");
+        let q: Vec<f64> = serde_json::from_value(got["joints_deg"].clone()).unwrap();
+        let w: Vec<f64> = serde_json::from_value(want["joints_deg"].clone()).unwrap();
+        for (a, b) in q.iter().zip(&w) {
+            worst = worst.max((a - b).abs());
+        }
+    }
+    eprintln!(
+        "per target: {} targets at their own e1, e2, e3 solved as the targets CSV's rows within {worst:.1e} deg",
+        at.len()
+    );
+    assert!(worst < 1e-9, "{worst}");
+
+    let one = |extra: Value| {
+        let mut t = json!({ "x": 100.0, "y": 0.0, "z": 50.0, "e1": 500.0, "e2": 1.0, "e3": 2.0 });
+        for (k, v) in extra.as_object().unwrap() {
+            t[k] = v.clone();
+        }
+        t
+    };
+    for (body, words) in [
+        (
+            json!({ "targets": [one(json!({}))], "e1": 500.0, "position_only": true }),
+            "which holds is ambiguous",
+        ),
+        (
+            json!({ "targets": [one(json!({})), { "x": 1.0, "y": 2.0, "z": 3.0, "e1": 500.0, "e2": 1.0 }], "position_only": true }),
+            "`targets[1]` gives `e1`, `e2` and `targets[0]` `e1`, `e2`, `e3`",
+        ),
+        (
+            json!({ "targets": [{ "x": 1.0, "y": 2.0, "z": 3.0, "e3": 2.0 }], "position_only": true }),
+            "`targets[0]`: `e3` without `e1` and `e2`",
+        ),
+        (
+            json!({ "targets": [one(json!({}))], "work_object": "part", "position_only": true }),
+            "`work_object` beside the targets' own",
+        ),
+    ] {
+        let r = t.post_json(SOLVE, &[rid], body).await;
+        assert_eq!(r.status, StatusCode::UNPROCESSABLE_ENTITY, "{}", r.text());
+        assert!(r.detail().contains(words), "{}", r.detail());
+    }
+}

@@ -727,6 +727,50 @@ async fn per_row_csv_solve(
         let miss = (rail.true_pose(&solved, v).p - rail.true_pose(&qs[i], v).p).norm();
         assert!(miss < 0.05e-3, "row {i}: {} mm", miss * 1e3);
     }
+    // The same targets as JSON, each with its own `e1`: the same statuses,
+    // the rows beyond the travel failing alone in the JSON's words, and the
+    // true robot at the joints within 0.05 mm of each target.
+    let targets: Vec<Value> = qs
+        .iter()
+        .enumerate()
+        .map(|(i, q)| {
+            let p = rail.true_pose(q, values[i % 4].min(2600.0));
+            let u = UnitQuaternion::from_matrix(&p.r);
+            json!({ "x": p.p.x * 1e3, "y": p.p.y * 1e3, "z": p.p.z * 1e3, "e1": values[i % 4],
+                    "orientation": { "convention": "quaternion", "values": [u.w, u.i, u.j, u.k] } })
+        })
+        .collect();
+    let r = t
+        .post_json(
+            SOLVE,
+            &[rid],
+            json!({ "targets": targets, "payload_kg": 110 }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let own = r.json();
+    assert_eq!(own["solved"], 6, "{own}");
+    let mut worst = 0.0f64;
+    for (i, got) in own["results"].as_array().unwrap().iter().enumerate() {
+        if i % 4 == 3 {
+            assert_eq!(got["reason"]["code"], "invalid_target", "{got}");
+            let message = got["reason"]["message"].as_str().unwrap();
+            assert!(
+                message.contains(&format!(
+                    "`targets[{i}].e1`: value 4500 mm is outside the travel measured, [0, 4000] mm"
+                )),
+                "{message}"
+            );
+            continue;
+        }
+        let deg: Vec<f64> = serde_json::from_value(got["joints_deg"].clone()).unwrap();
+        let rad: Vec<f64> = deg.iter().map(|v| v.to_radians()).collect();
+        let solved = nominal.joints_from_controller(&rad);
+        let v = values[i % 4];
+        worst = worst.max((rail.true_pose(&solved, v).p - rail.true_pose(&qs[i], v).p).norm());
+    }
+    eprintln!("per target on the track: 6 of 8 JSON targets at their own e1 solved, the true robot within {:.4} mm", worst * 1e3);
+    assert!(worst < 0.05e-3, "{} mm", worst * 1e3);
     // The column and the query's `e1` together: which holds is ambiguous.
     let r = t
         .send(

@@ -337,6 +337,35 @@ async fn json_solve(
             }
         }
     }
+    // Every row in one JSON solve, each target at its own `e1`: the CSV's
+    // joints, row for row.
+    let own: Vec<Value> = targets
+        .iter()
+        .flat_map(|t| {
+            VALUES.iter().map(move |v| {
+                let mut t = t.clone();
+                t["e1"] = json!(v);
+                t
+            })
+        })
+        .collect();
+    let r = t
+        .post_json(
+            SOLVE,
+            &[rid],
+            json!({ "targets": own, "turntable": true, "position_only": true, "payload_kg": PAYLOAD_KG }),
+        )
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let doc = r.json();
+    assert_eq!(doc["frame"], "face_plate", "{doc}");
+    for n in 0..own.len() {
+        assert_eq!(
+            numbers(&doc["results"][n]["joints_deg"]),
+            numbers(&by_csv["results"][n]["joints_deg"]),
+            "row {n}"
+        );
+    }
     for (extra, words) in [
         (json!({ "turntable": true }), "needs the turntable's value"),
         (
