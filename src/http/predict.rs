@@ -243,58 +243,33 @@ fn command(robot_id: i64, req: &PredictRequest) -> Result<PredictCommand, ApiErr
     })
 }
 
-/// The readings' own `e1`, `e2`, `e3`, when they carry them: each read as
-/// the body's would be (`axis_values`, its refusal prefixed with the
-/// reading), every reading with the same fields, none beside the body's.
+/// The readings' own `e1`, `e2`, `e3`, when they carry them
+/// (`target_values::each_own`: each read as the body's would be, every
+/// reading with the same fields, none beside the body's), and what carries
+/// the part.
 fn per_reading(
     req: &PredictRequest,
     frame_given: bool,
 ) -> Result<Option<(Vec<ReadingAxes>, Plate)>, ApiError> {
-    let given = |r: &ReadingIn| [r.e1.is_some(), r.e2.is_some(), r.e3.is_some()];
-    let Some(first) = req.readings.iter().position(|r| given(r) != [false; 3]) else {
+    let values: Vec<[Option<f64>; 3]> = req.readings.iter().map(|r| [r.e1, r.e2, r.e3]).collect();
+    let Some(each) = super::target_values::each_own(
+        &values,
+        super::target_values::READINGS,
+        [req.e1, req.e2, req.e3],
+        frame_given,
+        plate_of(req.turntable),
+    )?
+    else {
         return Ok(None);
     };
-    let names = |g: [bool; 3]| {
-        let listed: Vec<&str> = ["`e1`", "`e2`", "`e3`"]
-            .into_iter()
-            .zip(g)
-            .filter_map(|(n, on)| on.then_some(n))
-            .collect();
-        if listed.is_empty() {
-            "none".to_string()
-        } else {
-            listed.join(", ")
-        }
-    };
-    if req.e1.is_some() || req.e2.is_some() || req.e3.is_some() {
-        return Err(ApiError::invalid(format!(
-            "`readings[{first}]` has its own {} and the body gives `e1`, `e2` or `e3` for every reading: which holds is ambiguous; give the values per reading or in the body",
-            names(given(&req.readings[first]))
-        )));
-    }
-    let want = given(&req.readings[first]);
-    let plate = plate_of(req.turntable);
-    let mut out = Vec::with_capacity(req.readings.len());
-    let mut carried = plate;
-    for (i, r) in req.readings.iter().enumerate() {
-        if given(r) != want {
-            return Err(ApiError::invalid(format!(
-                "`readings[{i}]` gives {} and `readings[{first}]` {}: give every reading the same axes' values",
-                names(given(r)),
-                names(want)
-            )));
-        }
-        let at = axis_values(r.e1, r.e2, r.e3, frame_given, plate).map_err(|e| match e {
-            ApiError::Unprocessable(m) => ApiError::Unprocessable(format!("`readings[{i}]`: {m}")),
-            other => other,
-        })?;
-        carried = at.plate;
-        out.push(ReadingAxes {
+    let axes = each
+        .iter()
+        .map(|at| ReadingAxes {
             track_mm: at.track_mm,
             positioner_deg: at.positioner_deg,
-        });
-    }
-    Ok(Some((out, carried)))
+        })
+        .collect();
+    Ok(Some((axes, each[0].plate)))
 }
 
 /// `POST /v1/robots/{id}/predict`: the readings' poses on the chosen model.

@@ -9,7 +9,7 @@
 //! failed row's words are given back in the JSON's terms
 //! (`targets[i].e1`).
 
-use super::solve_columns::{axis_values, AxisColumns};
+use super::solve_columns::{axis_values, AxisColumns, AxisSettings};
 use super::ApiError;
 use crate::service::positioners::{Plate, PlateValues};
 use crate::solve::ik::{TargetInput, TargetRow, TargetsCsv};
@@ -40,10 +40,75 @@ fn names(g: [bool; 3]) -> String {
     }
 }
 
+/// The items of a body that carry their own values: `readings` of a
+/// prediction, `targets` of a solve.
+#[derive(Debug, Clone, Copy)]
+pub struct Items {
+    /// The body's field, e.g. `readings`.
+    pub field: &'static str,
+    /// One of them, e.g. `reading`.
+    pub one: &'static str,
+}
+
+/// A prediction's readings.
+pub const READINGS: Items = Items {
+    field: "readings",
+    one: "reading",
+};
+
+/// A solve's targets.
+pub const TARGETS: Items = Items {
+    field: "targets",
+    one: "target",
+};
+
+/// Each item's own `e1`, `e2`, `e3` (`values`, one per item) read as the
+/// body's would be (`axis_values` with `frame_given` and `plate`, a refusal
+/// naming the item), when any item gives one: every item the same fields,
+/// none beside the body's own `body`. `None` when no item gives one.
+pub fn each_own(
+    values: &[[Option<f64>; 3]],
+    items: Items,
+    body: [Option<f64>; 3],
+    frame_given: bool,
+    plate: Plate,
+) -> Result<Option<Vec<AxisSettings>>, ApiError> {
+    let Items { field, one } = items;
+    let Some(first) = values.iter().position(|t| given(t) != [false; 3]) else {
+        return Ok(None);
+    };
+    let want = given(&values[first]);
+    if given(&body) != [false; 3] {
+        return Err(ApiError::invalid(format!(
+            "`{field}[{first}]` has its own {} and the body gives `e1`, `e2` or `e3` for every {one}: which holds is ambiguous; give the values per {one} or in the body",
+            names(want)
+        )));
+    }
+    let mut out = Vec::with_capacity(values.len());
+    for (i, t) in values.iter().enumerate() {
+        if given(t) != want {
+            return Err(ApiError::invalid(format!(
+                "`{field}[{i}]` gives {} and `{field}[{first}]` {}: give every {one} the same axes' values",
+                names(given(t)),
+                names(want)
+            )));
+        }
+        out.push(
+            axis_values(t[0], t[1], t[2], frame_given, plate).map_err(|e| match e {
+                ApiError::Unprocessable(m) => {
+                    ApiError::Unprocessable(format!("`{field}[{i}]`: {m}"))
+                }
+                other => other,
+            })?,
+        );
+    }
+    Ok(Some(out))
+}
+
 /// The targets' own values (`targets`, each target's `e1`, `e2`, `e3`),
-/// when they carry them, beside the body's `body` values, its work object
-/// (`work_object` whether it names one), `plate` (its `turntable`) and
-/// `frame_given` (whether it names a frame).
+/// when they carry them ([`each_own`]), beside the body's `body` values,
+/// its work object (`work_object` whether it names one), `plate` (its
+/// `turntable`) and `frame_given` (whether it names a frame).
 pub fn own_values(
     targets: &[[Option<f64>; 3]],
     body: [Option<f64>; 3],
@@ -51,37 +116,17 @@ pub fn own_values(
     plate: Plate,
     frame_given: bool,
 ) -> Result<Option<OwnValues>, ApiError> {
-    let Some(first) = targets.iter().position(|t| given(t) != [false; 3]) else {
+    let Some(each) = each_own(targets, TARGETS, body, frame_given, plate)? else {
         return Ok(None);
     };
-    let want = given(&targets[first]);
-    if given(&body) != [false; 3] {
-        return Err(ApiError::invalid(format!(
-            "`targets[{first}]` has its own {} and the body gives `e1`, `e2` or `e3` for every target: which holds is ambiguous; give the values per target or in the body",
-            names(want)
-        )));
-    }
     if work_object {
         return Err(ApiError::invalid(format!(
             "`work_object` beside the targets' own {}: a target at its own values is in the cell frame, the base frame or on the face plate; give the values in the body to solve in a work object",
-            names(want)
+            names(given(&targets[0]))
         )));
     }
     let (mut track, mut tilt, mut rotate) = (Vec::new(), Vec::new(), Vec::new());
-    let mut carried = plate;
-    for (i, t) in targets.iter().enumerate() {
-        if given(t) != want {
-            return Err(ApiError::invalid(format!(
-                "`targets[{i}]` gives {} and `targets[{first}]` {}: give every target the same axes' values",
-                names(given(t)),
-                names(want)
-            )));
-        }
-        let at = axis_values(t[0], t[1], t[2], frame_given, plate).map_err(|e| match e {
-            ApiError::Unprocessable(m) => ApiError::Unprocessable(format!("`targets[{i}]`: {m}")),
-            other => other,
-        })?;
-        carried = at.plate;
+    for (i, at) in each.iter().enumerate() {
         let line = i + 1;
         if let Some(v) = at.track_mm {
             track.push(TargetValue { line, value: Ok(v) });
@@ -108,7 +153,7 @@ pub fn own_values(
     };
     Ok(Some(OwnValues {
         columns,
-        plate: carried,
+        plate: each[0].plate,
     }))
 }
 
