@@ -523,7 +523,12 @@ pub fn json_command(
         plate,
         req.frame.is_some(),
     )?;
-    let on_plate = req.e2.is_some() || plate == Plate::Turntable || own.is_some();
+    if own.is_some() && query.e1.is_some() {
+        return Err(ApiError::invalid("the query's `e1` beside the targets' own values: which holds is ambiguous; leave it out"));
+    }
+    // A track's values alone leave the frame to the body or the query.
+    let on_plate =
+        req.e2.is_some() || plate == Plate::Turntable || own.as_ref().is_some_and(|o| o.on_plate());
     let (branch, seed_deg) = if seed_in_body {
         (req.branch.as_deref(), req.seed_deg.clone())
     } else {

@@ -23,6 +23,14 @@ pub struct OwnValues {
     pub plate: Plate,
 }
 
+impl OwnValues {
+    /// The targets are on the face plate (a positioner's or a turntable's
+    /// values), not in the cell or base frame along a track alone.
+    pub fn on_plate(&self) -> bool {
+        !matches!(self.columns, AxisColumns::None | AxisColumns::Track(_))
+    }
+}
+
 fn given(t: &[Option<f64>; 3]) -> [bool; 3] {
     t.map(|v| v.is_some())
 }

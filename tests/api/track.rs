@@ -771,6 +771,30 @@ async fn per_row_csv_solve(
     }
     eprintln!("per target on the track: 6 of 8 JSON targets at their own e1 solved, the true robot within {:.4} mm", worst * 1e3);
     assert!(worst < 0.05e-3, "{} mm", worst * 1e3);
+    // The query's `frame` stands in for the body's beside a track's values
+    // alone; its `e1` beside the targets' own is ambiguous.
+    let body = json!({ "targets": [targets[0].clone()], "payload_kg": 110 }).to_string();
+    for (query, status) in [
+        ("?frame=base", StatusCode::OK),
+        ("?e1=1000", StatusCode::UNPROCESSABLE_ENTITY),
+    ] {
+        let r = t
+            .send(
+                "POST",
+                SOLVE,
+                &[rid],
+                query,
+                Some("application/json"),
+                body.clone().into_bytes(),
+            )
+            .await;
+        assert_eq!(r.status, status, "{query}: {}", r.text());
+        if status == StatusCode::OK {
+            assert_eq!(r.json()["frame"], "base", "{query}");
+        } else {
+            assert!(r.detail().contains("the query's `e1`"), "{}", r.detail());
+        }
+    }
     // The column and the query's `e1` together: which holds is ambiguous.
     let r = t
         .send(
