@@ -29,7 +29,7 @@ use crate::solve::ik::TargetFrame;
 use robocal_core::model::calibrated::ValidationEvidence;
 use robocal_core::model::calibrated::{CalibratedModelFile, CompensatedModel};
 use robocal_core::model::Pose;
-use robocal_core::solve::external::{base_from_part, cell_from_part, AxisValues};
+use robocal_core::solve::external::{base_from_part, base_from_part_at, AxisValues};
 
 /// A prediction, in domain terms.
 #[derive(Debug, Clone)]
@@ -304,10 +304,9 @@ async fn per_reading_frames(
                 _ => cell_from_base,
             };
             Ok(match (v.positioner_deg, &positioner, &wobj) {
-                (Some(at), Some(p), _) => PredictFrame::WorkObject(
-                    base.inverse()
-                        .compose(&cell_from_part(p, at, &Pose::identity())),
-                ),
+                (Some(at), Some(p), _) => {
+                    PredictFrame::WorkObject(base_from_part_at(&base, p, at, &Pose::identity()))
+                }
                 (_, _, Some(w)) => PredictFrame::WorkObject(w.in_base_at(&base)),
                 _ if cmd.frame == TargetFrame::Cell => PredictFrame::WorkObject(base.inverse()),
                 _ => PredictFrame::Frame(cmd.frame),

@@ -127,15 +127,12 @@ pub fn export_cell(
         return Err(ExportError::AxesNotWritten(language));
     }
     let world_from_cell = model.cell_to_base(&Pose::identity());
-    let on_a_track = matches!(
-        options.axes,
-        Some(
-            ExternalAxes::Track(_)
-                | ExternalAxes::TrackAndPositioner(..)
-                | ExternalAxes::TrackAndTurntable(..)
-        )
-    );
-    let with_a_plate = !matches!(options.axes, None | Some(ExternalAxes::Track(_)));
+    let systems = options
+        .axes
+        .as_ref()
+        .map_or(&[][..], |a| a.kind().systems());
+    let on_a_track = systems.contains(&KinematicKind::Track);
+    let with_a_plate = systems.iter().any(|k| *k != KinematicKind::Track);
     if !with_a_plate {
         if let Some(w) = on(WorkObjectFrame::FacePlate) {
             return Err(ExportError::OnFacePlate(w.name.clone()));

@@ -8,7 +8,9 @@ pub mod rows;
 pub mod targets;
 pub mod track;
 
-pub use positioner::{base_from_part, cell_from_part, part_from_cell, AxisValues};
+pub use positioner::{
+    base_from_part, base_from_part_at, cell_from_part, part_from_cell, AxisValues,
+};
 pub use rows::{track_values, RowValue, TrackColumnError, TRACK_COLUMN};
 pub use targets::{
     place_on_positioner, place_on_track, place_on_track_and_positioner, positioner_columns,

@@ -56,7 +56,20 @@ pub fn base_from_part(
     values: AxisValues,
     part: &Pose,
 ) -> Pose {
-    robot.cell_to_base(&cell_from_part(positioner, values, part))
+    base_from_part_at(&robot.cell_from_base, positioner, values, part)
+}
+
+/// [`base_from_part`] with the robot's base at `cell_from_base` (a base a
+/// track carries): `cell_from_base⁻¹·F(v)·P`.
+pub fn base_from_part_at(
+    cell_from_base: &Pose,
+    positioner: &TiltRotate,
+    values: AxisValues,
+    part: &Pose,
+) -> Pose {
+    cell_from_base
+        .inverse()
+        .compose(&cell_from_part(positioner, values, part))
 }
 
 /// A pose `in_cell` measured in the cell frame with the positioner at
