@@ -10,13 +10,13 @@ use super::report::{
     FilterReport, JointMotionReport, MotionPlace, ReportedAxes, TargetReport, TargetStatus,
     UnusedReport,
 };
-use super::sites::{Context, Failure, Solved};
+use super::sites::{Context, Failure, Solved, UsedFrame};
 use super::{mark, parse, Language, Motion, MotionTarget, ParseError, Program, ProgramFile, Site};
 use crate::model::calibrated::CompensatedModel;
 use crate::model::orientation::rotation_to;
 use crate::model::Pose;
 use crate::program::controller::{
-    controller_text, ControllerData, ControllerFrame, ControllerTool, ExportOptions,
+    controller_text, coupled_base_line, ControllerData, ControllerTool, ExportOptions,
 };
 use crate::solve::cell::Cell;
 use crate::solve::ik::IkSettings;
@@ -191,7 +191,7 @@ struct Run<'a> {
     targets: Vec<TargetReport>,
     joint_motions: Vec<JointMotionReport>,
     used_tools: Vec<ControllerTool>,
-    used_frames: Vec<ControllerFrame>,
+    used_frames: Vec<UsedFrame>,
 }
 
 impl Run<'_> {
@@ -455,20 +455,22 @@ fn apply(text: &str, mut edits: Vec<(std::ops::Range<usize>, String)>) -> String
 }
 
 /// The controller data of the cell's items a filter used (numbers as the
-/// program named them, no position registers), or a comment of the language
-/// saying why they cannot be written.
-fn used_data(
-    language: Language,
-    tools: Vec<ControllerTool>,
-    frames: Vec<ControllerFrame>,
-) -> String {
+/// program named them, no position registers; KRL's bases on the face plate
+/// each with the line coupling it to the positioner), or a comment of the
+/// language saying why they cannot be written.
+fn used_data(language: Language, tools: Vec<ControllerTool>, frames: Vec<UsedFrame>) -> String {
+    let coupled: String = frames
+        .iter()
+        .filter(|f| f.on_plate)
+        .map(|f| coupled_base_line(&f.frame))
+        .collect();
     let data = ControllerData {
         tools,
-        frames,
+        frames: frames.into_iter().map(|f| f.frame).collect(),
         assigned: Vec::new(),
     };
     match controller_text(language, &data, &ExportOptions::default()) {
-        Ok(e) => e.text,
+        Ok(e) => e.text + &coupled,
         Err(e) => {
             let lead = match language {
                 Language::Krl => ";",

@@ -45,7 +45,17 @@ pub(super) struct Solved {
     /// The tool and work object as the controller holds them (`None` for a
     /// stationary tool, which `program::controller` does not write).
     pub(super) tool: Option<ControllerTool>,
-    pub(super) frame: Option<ControllerFrame>,
+    pub(super) frame: Option<UsedFrame>,
+}
+
+/// A cell work object a site used, as the controller holds it.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct UsedFrame {
+    /// Its number and pose: base frame, world frame on a track, or on the
+    /// face plate.
+    pub(super) frame: ControllerFrame,
+    /// On the positioner's face plate (KRL: a coupled base).
+    pub(super) on_plate: bool,
 }
 
 /// Why a site was not solved, and the configurations that reach it.
@@ -409,16 +419,24 @@ impl Context<'_> {
             _ => false,
         };
         let used_tool = cell_item(&site.tool, true).then_some(used_tool);
-        // A plate work object's controller form is not written (a coupled
-        // base, a moved work object): the controller keeps the cell's.
+        // A plate work object's controller form: in KRL a base coupled to
+        // the positioner's kinematic system, its pose on the face plate
+        // (`cell export --positioner` writes that system); RAPID's moved work
+        // object and Fanuc's coordinated frame are not written, so there the
+        // controller keeps the cell's.
         let mut warnings = warnings;
-        if on_plate && cell_item(&site.work_object, false) {
+        let coupled = on_plate && self.language == Language::Krl;
+        if on_plate && !coupled && cell_item(&site.work_object, false) {
             warnings.push(format!(
                 "work object {} turns with the positioner: the controller data leaves it out; the controller must hold it on the face plate as the cell gives it",
                 wobj.name
             ));
         }
-        let used_frame = (cell_item(&site.work_object, false) && !on_plate).then_some(used_frame);
+        let used_frame =
+            (cell_item(&site.work_object, false) && (!on_plate || coupled)).then_some(UsedFrame {
+                frame: used_frame,
+                on_plate,
+            });
         let language = self.language;
         let solver = self.solver(tcp, load);
         let solved = solve_on(solver, site, &wobj, &pose, previous, language)?;

@@ -22,7 +22,7 @@ use robocal_core::program::controller::{
 mod beside_track;
 
 /// `{X …,Y …,Z …,A …,B …,C …}` after `key` in `text`, as an isometry [mm].
-fn frame_after(text: &str, key: &str) -> Isometry3<f64> {
+pub(super) fn frame_after(text: &str, key: &str) -> Isometry3<f64> {
     let start = text
         .find(key)
         .unwrap_or_else(|| panic!("{key} not in\n{text}"))
@@ -54,7 +54,7 @@ fn shift(mm: f64) -> Isometry3<f64> {
     Isometry3::translation(0.0, 0.0, mm)
 }
 
-fn iso(p: &Pose) -> Isometry3<f64> {
+pub(super) fn iso(p: &Pose) -> Isometry3<f64> {
     Isometry3::from_parts(
         Translation3::from(p.p * 1e3),
         UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(p.r)),
@@ -64,10 +64,10 @@ fn iso(p: &Pose) -> Isometry3<f64> {
 /// What the text's rounding leaves [mm]: up to six frames chained (the
 /// root, four links and a base), each written to 1e-6 mm (half of it per
 /// coordinate), the angles to 1e-9°.
-const ROUNDING_MM: f64 = 6.0 * 0.5e-6 * 1.7320508075688772 + 1e-7;
+pub(super) const ROUNDING_MM: f64 = 6.0 * 0.5e-6 * 1.7320508075688772 + 1e-7;
 
 /// Position [mm] and angle [rad] between two frames.
-fn apart(a: &Isometry3<f64>, b: &Isometry3<f64>) -> (f64, f64) {
+pub(super) fn apart(a: &Isometry3<f64>, b: &Isometry3<f64>) -> (f64, f64) {
     (
         (a.translation.vector - b.translation.vector).norm(),
         a.rotation.angle_to(&b.rotation),

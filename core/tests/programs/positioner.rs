@@ -500,3 +500,44 @@ fn a_positioner_target_the_cell_cannot_compose_is_refused_naming_it() {
     );
     assert!(out.files[1].text.contains("robocal: not filtered"));
 }
+
+/// The report's controller data: in KRL the part as a base coupled to the
+/// positioner, its pose on the face plate, which the controller's own
+/// positioner carries to the very frame the programs ran in (read back with
+/// the export test's reader); Fanuc, whose coordinated frame is not
+/// written, leaves the part out and says so at every target.
+#[test]
+fn the_report_holds_the_plate_work_object_as_a_coupled_base_in_krl() {
+    use super::axes_export::{apart, frame_after, iso, ROUNDING_MM};
+    let c = positioner_cell();
+    let out = filter_on_positioner(c, Language::Krl, &krl(c));
+    let data = &out.report.controller_data;
+    assert!(
+        data.contains("; BASE_DATA[3] part is on the face plate: $BASE=EK(MACHINE_DEF[2].ROOT,MACHINE_DEF[2].MECH_TYPE,BASE_DATA[3])"),
+        "{data}"
+    );
+    let base3 = frame_after(data, "BASE_DATA[3]=");
+    for (v, _) in &c.targets {
+        let got = iso(&c.nominal_positioner.cell_from_face_plate(*v)) * base3;
+        let (d, a) = apart(&got, &iso(&c.controller_frame(*v)));
+        assert!(d < ROUNDING_MM && a < 1e-9, "{v:?}: {d} mm, {a} rad");
+    }
+    let turns = |r: &robocal_core::program::FilterReport| {
+        r.targets
+            .iter()
+            .filter(|t| {
+                t.warnings
+                    .iter()
+                    .any(|w| w.contains("turns with the positioner"))
+            })
+            .count()
+    };
+    assert_eq!(turns(&out.report), 0);
+    let out = filter_on_positioner(c, Language::Fanuc, &fanuc(c));
+    assert_eq!(turns(&out.report), 50);
+    assert!(
+        !out.report.controller_data.contains("part"),
+        "{}",
+        out.report.controller_data
+    );
+}

@@ -167,17 +167,22 @@ pub fn export_cell(
         out.text.push_str(&kuka_text(&kinematics));
         for (f, w) in data.frames.iter().zip(&cell.work_objects) {
             if w.frame == WorkObjectFrame::FacePlate {
-                let _ = write!(
-                    out.text,
-                    "; BASE_DATA[{n}] {} is on the face plate: $BASE=EK(MACHINE_DEF[2].ROOT,MACHINE_DEF[2].MECH_TYPE,BASE_DATA[{n}])\r\n",
-                    comment(&f.name, Language::Krl),
-                    n = f.number
-                );
+                out.text.push_str(&coupled_base_line(f));
             }
         }
     }
     out.kinematics = kinematics;
     Ok(out)
+}
+
+/// The KRL comment saying that base `f` (its pose on the face plate) is
+/// coupled to the positioner's or turntable's kinematic system, `MACHINE_DEF[2]`.
+pub(crate) fn coupled_base_line(f: &ControllerFrame) -> String {
+    format!(
+        "; BASE_DATA[{n}] {} is on the face plate: $BASE=EK(MACHINE_DEF[2].ROOT,MACHINE_DEF[2].MECH_TYPE,BASE_DATA[{n}])\r\n",
+        comment(&f.name, Language::Krl),
+        n = f.number
+    )
 }
 
 /// Refuses numbers the controller does not take, or one held twice.
