@@ -115,8 +115,9 @@ pub fn each_own(
 
 /// The targets' own values (`targets`, each target's `e1`, `e2`, `e3`),
 /// when they carry them ([`each_own`]), beside the body's `body` values,
-/// its work object (`work_object` whether it names one), `plate` (its
-/// `turntable`) and `frame_given` (whether it names a frame).
+/// its work object (`work_object` whether it names one; with a track's
+/// values alone), `plate` (its `turntable`) and `frame_given` (whether it
+/// names a frame).
 pub fn own_values(
     targets: &[[Option<f64>; 3]],
     body: [Option<f64>; 3],
@@ -127,9 +128,12 @@ pub fn own_values(
     let Some(each) = each_own(targets, TARGETS, body, frame_given, plate)? else {
         return Ok(None);
     };
-    if work_object {
+    // A work object beside a track's values alone holds at each target's
+    // value (as a targets CSV's `e1` with `robocal solve --work-object`);
+    // a target at its own positioner values is on the face plate.
+    if work_object && each.iter().any(|at| at.positioner_deg.is_some()) {
         return Err(ApiError::invalid(format!(
-            "`work_object` beside the targets' own {}: a target at its own values is in the cell frame, the base frame or on the face plate; give the values in the body to solve in a work object",
+            "`work_object` beside the targets' own {}: a target at its own positioner values is on the face plate; give the targets in the face plate frame, or the values in the body to solve in a work object",
             names(given(&targets[0]))
         )));
     }

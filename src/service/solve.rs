@@ -48,7 +48,8 @@ use crate::solve::ik::{
 };
 use robocal_core::model::calibrated::{CalibratedModelFile, CompensatedModel};
 use robocal_core::solve::external::{
-    base_from_part, place_on_track, place_on_track_and_positioner, AxisValues, TargetValue,
+    base_from_part, place_on_track, place_on_track_and_positioner, AxisValues, PlacedRows,
+    TargetValue,
 };
 use std::sync::Arc;
 
@@ -387,7 +388,6 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
         )));
     }
     let (cell_solver, version, method) = prepare(state, &cmd).await?;
-    place_on_axes(state, &mut cmd, &cell_solver).await?;
     let work_object = match &cmd.work_object {
         None => None,
         Some(choice) => {
@@ -395,9 +395,11 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
             Some(item.placed_work_object()?)
         }
     };
-    let in_work_object = match &work_object {
-        None => None,
-        Some(wobj) => {
+    // Rows at their own track values take the work object row by row.
+    let placed_rows = place_on_axes(state, &mut cmd, &cell_solver, work_object.as_ref()).await?;
+    let in_work_object = match (&work_object, &placed_rows) {
+        (_, Some(_)) | (None, None) => None,
+        (Some(wobj), None) => {
             let Targets::Inputs(inputs) = &mut cmd.targets else {
                 return Err(ServiceError::Invalid(
                     "a work object needs JSON targets (the targets CSV has no work object)".into(),
@@ -437,6 +439,9 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
     if let Some(w) = &in_work_object {
         w.false_targets_back(&mut results);
     }
+    if let Some(placed) = &placed_rows {
+        placed.false_targets_back(&mut results);
+    }
     Ok(SolveOutcome {
         version,
         method,
@@ -448,12 +453,23 @@ pub async fn solve(state: &AppState, mut cmd: SolveCommand) -> Result<SolveOutco
 
 /// Moves the command's targets into the robot's base frame along its
 /// external axes: a track value per CSV row, a positioner's values for every
-/// target, or per CSV row (module docs); the frame is then the base.
+/// target, or per CSV row (module docs); the frame is then the base. Rows
+/// at their own track values in `work_object` are placed in it at their
+/// values (`W_b(e)·T`), and the rows' placement, which returns their false
+/// targets to it, is the answer; a work object beside per-row positioner
+/// values is refused (its pose does not follow the plate row by row).
 async fn place_on_axes(
     state: &AppState,
     cmd: &mut SolveCommand,
     cell_solver: &CellSolver,
-) -> Result<(), ServiceError> {
+    work_object: Option<&WorkObject>,
+) -> Result<Option<PlacedRows>, ServiceError> {
+    if work_object.is_some() && cmd.positioner_rows.is_some() {
+        return Err(ServiceError::Invalid(
+            "a work object beside the targets' own positioner values: give the targets on the face plate, or the values for the whole request".into(),
+        ));
+    }
+    let mut placed_rows = None;
     if let Some(values) = cmd.track_rows.take() {
         let track = super::tracks::stored(state, cmd.robot_id).await?;
         let Targets::Csv(csv) = &mut cmd.targets else {
@@ -476,7 +492,8 @@ async fn place_on_axes(
                 );
             }
             None => {
-                place_on_track(csv, &values, &track, cmd.options.frame, None);
+                let placed = place_on_track(csv, &values, &track, cmd.options.frame, work_object);
+                placed_rows = work_object.map(|_| placed);
             }
         }
         cmd.options.frame = TargetFrame::Base;
@@ -517,7 +534,7 @@ async fn place_on_axes(
         super::positioners::place_rows(csv, &values, &positioner, robot);
         cmd.options.frame = TargetFrame::Base;
     }
-    Ok(())
+    Ok(placed_rows)
 }
 
 /// A tool or work object of a solve, resolved.
