@@ -75,8 +75,9 @@ macro_rules! insert_set {
     ($s:expr) => {
         sqlx::query_scalar(
             "INSERT INTO measurement_sets (robot_id, name, role, session, payload_kg, \
-             length_unit, angle_unit, format, original, rows_json, row_count, dof) \
-             VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12) RETURNING id",
+             length_unit, angle_unit, format, original, rows_json, row_count, dof, \
+             axis_column, axis_value) \
+             VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13, $14) RETURNING id",
         )
         .bind($s.robot_id)
         .bind($s.name)
@@ -90,6 +91,8 @@ macro_rules! insert_set {
         .bind(Json($s.rows))
         .bind($s.row_count)
         .bind($s.dof)
+        .bind($s.axis.map(|a| a.0))
+        .bind($s.axis.map(|a| a.1))
     };
 }
 
@@ -198,7 +201,7 @@ impl Db {
 }
 
 const SET_SELECT: &str = "SELECT id, robot_id, name, role, session, payload_kg, length_unit, \
-    angle_unit, format, row_count, dof, created_at FROM measurement_sets";
+    angle_unit, format, row_count, dof, created_at, axis_column, axis_value FROM measurement_sets";
 
 /// A measurement set to insert.
 #[derive(Debug)]
@@ -227,4 +230,6 @@ pub struct NewSet<'a> {
     pub row_count: i64,
     /// Joints per row (the robot's).
     pub dof: i64,
+    /// A track's station set: the track's column and its value there [mm].
+    pub axis: Option<(&'a str, f64)>,
 }

@@ -5,7 +5,7 @@ use super::{on_pool, write_for_robot, Db, StoreError};
 use crate::records::{NewTrack, TrackRow};
 
 const TRACK_SELECT: &str = "SELECT robot_id, version, axis_column, sigma_mm, max_order, readings, \
-     stations, rms_mm, max_mm, track_json, created_at FROM robot_tracks";
+     stations, rms_mm, max_mm, track_json, created_at, set_ids FROM robot_tracks";
 
 impl Db {
     /// The robot's stored track, if it has one.
@@ -36,8 +36,8 @@ impl Db {
                 .rows_affected();
             sqlx::query(
                 "INSERT INTO robot_tracks (robot_id, version, axis_column, sigma_mm, max_order, \
-                 readings, stations, rms_mm, max_mm, track_json) \
-                 VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10)",
+                 readings, stations, rms_mm, max_mm, track_json, set_ids) \
+                 VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11)",
             )
             .bind(robot_id)
             .bind(track.version)
@@ -49,6 +49,7 @@ impl Db {
             .bind(track.rms_mm)
             .bind(track.max_mm)
             .bind(&track.track_json)
+            .bind(&track.set_ids)
             .execute(&mut *tx)
             .await?;
             let row = super::commit_inserted!(tx, TrackRow, TRACK_SELECT, "robot_id", robot_id);

@@ -165,9 +165,21 @@ pub struct MeasurementSet {
     pub dof: i64,
     /// When it was stored (UTC, RFC 3339).
     pub created_at: String,
+    /// A track's station set: the track's column and its value there.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub station: Option<StationValue>,
     /// The rows in mm/deg (single-set responses only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rows: Option<Vec<MeasuredPose>>,
+}
+
+/// The track's value a station set was measured at.
+#[derive(Debug, Serialize)]
+pub struct StationValue {
+    /// The track's column, `e1` … `e6`.
+    pub column: String,
+    /// Its value at every row of the set [mm], as the file gave it.
+    pub value_mm: f64,
 }
 
 impl MeasurementSet {
@@ -188,6 +200,10 @@ impl MeasurementSet {
             row_count: r.row_count,
             dof: r.dof,
             created_at: r.created_at,
+            station: r
+                .axis_column
+                .zip(r.axis_value)
+                .map(|(column, value_mm)| StationValue { column, value_mm }),
             rows,
         }
     }

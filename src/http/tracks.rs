@@ -14,7 +14,7 @@ use super::input::{check_payload, external_axis, present, Int};
 use super::{ApiError, ApiJson, ApiPath, AppState};
 use crate::records::TrackRow;
 use crate::service;
-use crate::service::tracks::{StoredTrack, TrackCalibration};
+use crate::service::tracks::{StoredTrack, TrackCalibration, TrackReadings};
 use axum::extract::State;
 use axum::http::StatusCode;
 use axum::response::{IntoResponse, Response};
@@ -34,8 +34,12 @@ const SIGMA_MAX_MM: f64 = 10.0;
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TrackCalibrateIn {
-    /// The measurement file's text.
-    pub csv: String,
+    /// The measurement file's text (or `set_ids`).
+    #[serde(default, deserialize_with = "present")]
+    pub csv: Option<String>,
+    /// The robot's station sets to fit from, by id (or `csv`).
+    #[serde(default, deserialize_with = "present")]
+    pub set_ids: Option<Vec<Int<i64>>>,
     /// The track's column, `e1` … `e6` (default `e1`).
     #[serde(default, deserialize_with = "present")]
     pub column: Option<String>,
@@ -76,6 +80,8 @@ pub struct TrackOut {
     pub max_mm: f64,
     /// When it was stored (UTC, RFC 3339).
     pub created_at: String,
+    /// The station sets it was fitted from (`null`: a posted file).
+    pub set_ids: Option<Vec<i64>>,
     /// The track's JSON description (`robocal track calibrate --out`).
     pub track: Value,
     /// Links to the track, its calibration and the robot.
@@ -87,6 +93,17 @@ impl TrackOut {
         let track = serde_json::from_str(&row.track_json).map_err(|e| {
             ApiError::Internal(format!("stored track of robot {}: {e}", row.robot_id))
         })?;
+        let set_ids = row
+            .set_ids
+            .as_deref()
+            .map(serde_json::from_str)
+            .transpose()
+            .map_err(|e| {
+                ApiError::Internal(format!(
+                    "stored track of robot {}: set ids: {e}",
+                    row.robot_id
+                ))
+            })?;
         let base = format!("/v1/robots/{}/track", row.robot_id);
         Ok(TrackOut {
             robot_id: row.robot_id,
@@ -99,6 +116,7 @@ impl TrackOut {
             rms_mm: row.rms_mm,
             max_mm: row.max_mm,
             created_at: row.created_at,
+            set_ids,
             track,
             links: serde_json::json!({
                 "self": base,
@@ -145,10 +163,19 @@ fn calibration(id: i64, body: TrackCalibrateIn) -> Result<TrackCalibration, ApiE
     if let Some(p) = body.payload_kg {
         check_payload("`payload_kg`", p)?;
     }
+    let readings = match (body.csv, body.set_ids) {
+        (Some(text), None) => TrackReadings::Csv(text),
+        (None, Some(ids)) => TrackReadings::Sets(ids.into_iter().map(|i| i.0).collect()),
+        _ => {
+            return Err(ApiError::invalid(
+                "give the readings as `csv` (a measurement file with the track's column) or as `set_ids` (the robot's station sets from POST …/track/measurement-sets), one of them",
+            ))
+        }
+    };
     Ok(TrackCalibration {
         robot_id: id,
         version: body.version.map(|v| v.0),
-        csv: body.csv,
+        readings,
         column,
         sigma_mm,
         max_order,

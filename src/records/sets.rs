@@ -70,4 +70,10 @@ pub struct SetRow {
     pub dof: i64,
     /// When it was stored (UTC, RFC 3339).
     pub created_at: String,
+    /// A track's station set: the track's column, `e1` … `e6` (`None` for
+    /// every other set).
+    pub axis_column: Option<String>,
+    /// A track's station set: the track's value at every row [mm], as the
+    /// file gave it.
+    pub axis_value: Option<f64>,
 }

@@ -24,6 +24,9 @@ pub struct NewTrack {
     pub max_mm: f64,
     /// `LinearTrack::to_json`: mm, degrees, arcsec.
     pub track_json: String,
+    /// The station sets it was fitted from, a JSON array of ids (`None`: a
+    /// posted file).
+    pub set_ids: Option<String>,
 }
 
 /// A robot's stored track.
@@ -51,4 +54,7 @@ pub struct TrackRow {
     pub track_json: String,
     /// When it was stored (UTC, RFC 3339).
     pub created_at: String,
+    /// The station sets it was fitted from, a JSON array of ids (`None`: a
+    /// posted file).
+    pub set_ids: Option<String>,
 }

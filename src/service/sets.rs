@@ -179,6 +179,7 @@ pub async fn upload(state: &AppState, cmd: NewSetCommand) -> Result<SetRow, Serv
             rows: &rows,
             row_count: rows.len() as i64,
             dof: dof as i64,
+            axis: None,
         })
         .await?
         .ok_or_else(|| ServiceError::robot_not_found(robot_id))

@@ -8,7 +8,9 @@
 //!
 //! Each station's set keeps, as its original, the upload's lines up to its
 //! header and the lines of its own rows, verbatim; the stations' originals
-//! together hold every line of the upload once. Every station is checked
+//! together hold every line of the upload once. Each names the track's
+//! column and its value there, so the track can be fitted from the stored
+//! sets (`super::tracks`). Every station is checked
 //! before any is stored, and they are stored in one transaction.
 
 use super::sets::{check_rows, csv_error, refuse_nul, role_of};
@@ -16,7 +18,7 @@ use super::{AppState, ServiceError};
 use crate::db::NewSet;
 use crate::measure::csv::{self, ReadOptions};
 use crate::measure::csv_text;
-use crate::measure::external::ExternalAxis;
+use crate::measure::external::{ExternalAxis, ExternalValues, MeasurementSet};
 use crate::measure::{MeasuredPose, SetRole};
 use crate::records::{AngleUnit, LengthUnit, SetFormat, SetRow};
 use crate::service::limits::{MAX_SETS, NAME_MAX};
@@ -26,6 +28,8 @@ use crate::service::limits::{MAX_SETS, NAME_MAX};
 pub struct Station {
     /// The tracker session, `e1=400` (after the upload's session when given).
     pub session: String,
+    /// The track's value at every row of the station [mm], as the file gave it.
+    pub value: f64,
     /// Its rows (mm, deg).
     pub rows: Vec<MeasuredPose>,
     /// The upload's lines up to its header, then its rows' lines, verbatim.
@@ -57,6 +61,11 @@ pub fn stations_of(
     let rows = set
         .stations_as_sessions(column)
         .map_err(|e| ServiceError::Invalid(format!("measurement CSV: {e}")))?;
+    let values: Vec<f64> = set
+        .external
+        .iter()
+        .map(|e| e.get(column).expect("every reading carries the set's axes"))
+        .collect();
     let table = csv_text::read(text, read.dialect)
         .map_err(|e| ServiceError::Invalid(format!("measurement CSV: {e}")))?
         .ok_or_else(|| ServiceError::Invalid("measurement CSV: empty".into()))?;
@@ -83,6 +92,7 @@ pub fn stations_of(
             None => {
                 stations.push(Station {
                     session: label,
+                    value: values[k],
                     rows: Vec::new(),
                     original: head.clone(),
                 });
@@ -182,6 +192,7 @@ pub async fn upload(state: &AppState, cmd: StationUpload) -> Result<Vec<SetRow>,
             rows: &s.rows,
             row_count: s.rows.len() as i64,
             dof: dof as i64,
+            axis: Some((column.column(), s.value)),
         })
         .collect();
     state
@@ -189,6 +200,84 @@ pub async fn upload(state: &AppState, cmd: StationUpload) -> Result<Vec<SetRow>,
         .insert_sets(robot_id, &sets)
         .await?
         .ok_or_else(|| ServiceError::robot_not_found(robot_id))
+}
+
+/// The readings of the robot's stored station sets `ids`, in the order
+/// given, as the measurement file they were uploaded in reads (each row's
+/// value in the track's `column`, its session as the file gave it, the
+/// set's payload on rows without their own): a track is fitted from them
+/// as from that file. Refused: an id given twice, a set that is not a
+/// station set of `column` (`Invalid`, naming it), one the robot does not
+/// have (`NotFound`), more than `max_readings` rows together.
+pub async fn track_readings(
+    state: &AppState,
+    robot_id: i64,
+    ids: &[i64],
+    column: ExternalAxis,
+    max_readings: usize,
+) -> Result<MeasurementSet, ServiceError> {
+    if ids.is_empty() || ids.len() > MAX_SETS {
+        return Err(ServiceError::Invalid(format!(
+            "`set_ids`: 1 to {MAX_SETS} station sets, got {}",
+            ids.len()
+        )));
+    }
+    if let Some(i) = (1..ids.len()).find(|&i| ids[..i].contains(&ids[i])) {
+        return Err(ServiceError::Invalid(format!(
+            "`set_ids`: set {} is given twice",
+            ids[i]
+        )));
+    }
+    super::robots::get(state, robot_id).await?;
+    let mut set = MeasurementSet {
+        axes: vec![column],
+        ..MeasurementSet::default()
+    };
+    for &id in ids {
+        let missing =
+            || ServiceError::NotFound(format!("robot {robot_id} has no measurement set {id}"));
+        let row = state.db().set(robot_id, id).await?.ok_or_else(missing)?;
+        let value = match (row.axis_column.as_deref(), row.axis_value) {
+            (Some(c), Some(v)) if c == column.column() => v,
+            (Some(c), Some(_)) => {
+                return Err(ServiceError::Invalid(format!(
+                    "measurement set {id} (`{}`) is a station of the track's `{c}`, not of `{column}`: give `column` `{c}`",
+                    row.name
+                )))
+            }
+            _ => {
+                return Err(ServiceError::Invalid(format!(
+                    "measurement set {id} (`{}`) holds no track value: only sets stored by POST /v1/robots/{robot_id}/track/measurement-sets do (since schema version 16); post the file as `csv`, or upload it there again",
+                    row.name
+                )))
+            }
+        };
+        let station = format!("{column}={value}");
+        let rows = state
+            .db()
+            .set_rows(robot_id, id)
+            .await?
+            .ok_or_else(missing)?;
+        for mut pose in rows {
+            // The row's session as the file gave it, before the station's label.
+            pose.session = pose.session.as_deref().and_then(|s| {
+                s.strip_suffix(station.as_str())
+                    .and_then(|rest| rest.strip_suffix(' '))
+                    .map(str::to_string)
+            });
+            pose.payload_kg = pose.payload_kg.or(row.payload_kg);
+            let mut values = ExternalValues::default();
+            values.0[column.index()] = Some(value);
+            set.poses.push(pose);
+            set.external.push(values);
+        }
+        if set.poses.len() > max_readings {
+            return Err(ServiceError::Invalid(format!(
+                "`set_ids`: more than {max_readings} readings in one fit"
+            )));
+        }
+    }
+    Ok(set)
 }
 
 /// A station's refusal, naming the station.

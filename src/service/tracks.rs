@@ -30,8 +30,8 @@ pub struct TrackCalibration {
     pub robot_id: i64,
     /// The calibrated version held (`None`: the active one).
     pub version: Option<i64>,
-    /// The measurement file's text (`robocal track calibrate`'s input).
-    pub csv: String,
+    /// Where the readings come from.
+    pub readings: TrackReadings,
     /// The track's column.
     pub column: ExternalAxis,
     /// The tracker's σ per coordinate [mm] the fit is judged against.
@@ -40,6 +40,16 @@ pub struct TrackCalibration {
     pub max_order: usize,
     /// Payload mass [kg] of rows that give none (`None`: the model's).
     pub payload_kg: Option<f64>,
+}
+
+/// Where a track fit's readings come from.
+#[derive(Debug, Clone)]
+pub enum TrackReadings {
+    /// A measurement file's text (`robocal track calibrate`'s input).
+    Csv(String),
+    /// The robot's stored station sets by id, in the order given
+    /// (`super::station_sets::track_readings`).
+    Sets(Vec<i64>),
 }
 
 /// A stored fit: the row as stored, whether the robot had no track before,
@@ -109,14 +119,32 @@ pub async fn calibrate(
     state: &AppState,
     cmd: TrackCalibration,
 ) -> Result<StoredTrack, ServiceError> {
-    let set =
-        parse_set(&cmd.csv).map_err(|e| ServiceError::Invalid(format!("measurement CSV: {e}")))?;
-    if set.poses.len() > TRACK_READINGS_MAX {
-        return Err(ServiceError::Invalid(format!(
-            "measurement CSV: {} readings; at most {TRACK_READINGS_MAX} in one fit",
-            set.poses.len()
-        )));
-    }
+    let (set, set_ids) = match &cmd.readings {
+        TrackReadings::Csv(text) => {
+            let set = parse_set(text)
+                .map_err(|e| ServiceError::Invalid(format!("measurement CSV: {e}")))?;
+            if set.poses.len() > TRACK_READINGS_MAX {
+                return Err(ServiceError::Invalid(format!(
+                    "measurement CSV: {} readings; at most {TRACK_READINGS_MAX} in one fit",
+                    set.poses.len()
+                )));
+            }
+            (set, None)
+        }
+        TrackReadings::Sets(ids) => {
+            let set = super::station_sets::track_readings(
+                state,
+                cmd.robot_id,
+                ids,
+                cmd.column,
+                TRACK_READINGS_MAX,
+            )
+            .await?;
+            let ids = serde_json::to_string(ids)
+                .map_err(|e| ServiceError::Internal(format!("set ids: {e}")))?;
+            (set, Some(ids))
+        }
+    };
     let (mut model, version) = held_model(state, cmd.robot_id, cmd.version).await?;
     if let Some(p) = cmd.payload_kg {
         model.payload_kg = p;
@@ -137,6 +165,7 @@ pub async fn calibrate(
         rms_mm: fit.rms_mm,
         max_mm: fit.max_mm,
         track_json: fit.model.to_json(),
+        set_ids,
     };
     let (row, created) = state
         .db()

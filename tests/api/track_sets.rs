@@ -18,6 +18,7 @@ use serde_json::{json, Value};
 use std::time::Duration;
 
 const UPLOAD: &str = "/v1/robots/{id}/track/measurement-sets";
+const CALIBRATE: &str = "/v1/robots/{id}/track/calibrate";
 
 async fn upload(t: &TestApp, rid: &str, query: &str, ct: &str, body: &str) -> Resp {
     t.send(
@@ -138,13 +139,107 @@ async fn a_track_upload_is_stored_per_station_and_calibrates_as_the_command_line
 
     // The track fitted on that version (the robot over the stations).
     let r = t
-        .post_json(
-            "/v1/robots/{id}/track/calibrate",
+        .post_json(CALIBRATE, &[&rid], json!({ "csv": stations }))
+        .await;
+    assert_eq!(r.status, StatusCode::CREATED, "{}", r.text());
+    let from_file = r.json();
+    assert_eq!(from_file["set_ids"], Value::Null);
+
+    // Each station set keeps its track value, and the track fitted from the
+    // stored sets is the one fitted from the file: over HTTP, and by
+    // `robocal track calibrate` on the file with the command line's model.
+    for (s, v) in sets.iter().zip(STATIONS) {
+        assert_eq!(s["station"], json!({ "column": "e1", "value_mm": v }));
+    }
+    let r = t
+        .post_json(CALIBRATE, &[&rid], json!({ "set_ids": ids(&ident) }))
+        .await;
+    assert_eq!(r.status, StatusCode::OK, "{}", r.text());
+    let from_sets = r.json();
+    assert_eq!(from_sets["set_ids"], json!(ids(&ident)));
+    for key in ["track", "fit", "readings", "stations", "rms_mm", "max_mm"] {
+        assert_eq!(from_sets[key], from_file[key], "{key}");
+    }
+    let out = robocal(
+        d,
+        &[
+            "track",
+            "calibrate",
+            "stations.csv",
+            "--model",
+            "robot.json",
+            "--out",
+            "rail.json",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let rail: Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("rail.json")).unwrap()).unwrap();
+    assert_eq!(from_sets["track"], rail);
+    let stored = t.get("/v1/robots/{id}/track", &[&rid]).await.json();
+    assert_eq!(stored["set_ids"], json!(ids(&ident)));
+
+    // Refused, naming why, and nothing replaced: a set without a track
+    // value, a station of another column, a set given twice, both forms or
+    // neither (422); a set the robot does not have (404).
+    let plain: Vec<String> = checks
+        .lines()
+        .map(|l| {
+            let mut f: Vec<&str> = l.split(',').collect();
+            f.remove(6);
+            f.join(",")
+        })
+        .collect();
+    let r = t
+        .send(
+            "POST",
+            "/v1/robots/{id}/measurement-sets",
             &[&rid],
-            json!({ "csv": stations }),
+            "",
+            Some("text/csv"),
+            (plain.join("\n") + "\n").into_bytes(),
         )
         .await;
     assert_eq!(r.status, StatusCode::CREATED, "{}", r.text());
+    let plain_id = r.json()["id"].clone();
+    let first = ids(&ident)[0].clone();
+    for (body, status, words) in [
+        (
+            json!({ "set_ids": [first, plain_id] }),
+            StatusCode::UNPROCESSABLE_ENTITY,
+            "holds no track value",
+        ),
+        (
+            json!({ "set_ids": [first], "column": "e2" }),
+            StatusCode::UNPROCESSABLE_ENTITY,
+            "is a station of the track's `e1`, not of `e2`",
+        ),
+        (
+            json!({ "set_ids": [first, first] }),
+            StatusCode::UNPROCESSABLE_ENTITY,
+            "given twice",
+        ),
+        (
+            json!({ "set_ids": [first], "csv": stations }),
+            StatusCode::UNPROCESSABLE_ENTITY,
+            "one of them",
+        ),
+        (
+            json!({ "sigma_mm": 0.01 }),
+            StatusCode::UNPROCESSABLE_ENTITY,
+            "one of them",
+        ),
+        (
+            json!({ "set_ids": [first, 999_999] }),
+            StatusCode::NOT_FOUND,
+            "no measurement set 999999",
+        ),
+    ] {
+        let r = t.post_json(CALIBRATE, &[&rid], body.clone()).await;
+        assert_eq!(r.status, status, "{body}: {}", r.text());
+        assert!(r.detail().contains(words), "{body}: {}", r.detail());
+    }
+    assert_eq!(t.get("/v1/robots/{id}/track", &[&rid]).await.json(), stored);
 }
 
 #[tokio::test]
