@@ -15,7 +15,8 @@ screenshot of each step:
   point and a tool from a 6-D probe (readings made from a known tool offset
   with seeded noise; the fit must find it within the noise) -> external axes
   on a second robot (a YS100): a track fitted from `robocal track simulate`'s
-  file, a refused one shown, the track deleted (confirmed), a positioner
+  file, a refused one shown, the file as station sets and the track
+  refitted from them, the track deleted (confirmed), a positioner
   fitted from `robocal positioner simulate`'s files and deleted -> filter a
   URScript program (files and report downloaded) -> measurement plan ->
   ISO 9283 -> delete a set and a robot (confirmed) -> robot list with the

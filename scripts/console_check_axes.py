@@ -50,6 +50,8 @@ def check_external_axes(driver, wait, shot, base, robocal, work, robot_url, h):
     # the page's form, the page shows the stored track as the API gives
     # it; the same file with its `e1` column renamed `e2` while the form
     # says e1 is refused (`missing_column`, shown, nothing replaced); the
+    # file uploaded as station sets (the sets form's track column) and the
+    # track refitted from their ids; the
     # track deleted (the question dismissed once, then accepted). Then a
     # positioner from `robocal positioner simulate --robot ys100`'s
     # files (the nominal JSON, one file per reflector, the reflectors'
@@ -101,10 +103,10 @@ def check_external_axes(driver, wait, shot, base, robocal, work, robot_url, h):
 
     def track_cells():
         return {c: driver.find_element(By.CSS_SELECTOR, f"#track-stored td.{c}").text
-                for c in ("column", "version", "stations", "readings", "rms", "max", "sigma")}
+                for c in ("column", "from", "version", "stations", "readings", "rms", "max", "sigma")}
     stored = h.api_get(base, f"/v1/robots/{rail_id}/track")
     shown = track_cells()
-    assert shown == {"column": "e1", "version": f"v{held}", "stations": "11",
+    assert shown == {"column": "e1", "from": "a posted file", "version": f"v{held}", "stations": "11",
                      "readings": str(stored["readings"]), "rms": f"{stored['rms_mm']:.3f}",
                      "max": f"{stored['max_mm']:.3f}", "sigma": "0.010"}, (shown, stored)
     assert stored["stations"] == 11 and stored["column"] == "e1" and stored["version"] == held, stored
@@ -135,6 +137,37 @@ def check_external_axes(driver, wait, shot, base, robocal, work, robot_url, h):
     assert track_cells() == shown
     print(f"console_check: refused: {refusal}")
     shot("track-refused", "calibrate-track")
+    # The same file as station sets (the upload form's track column), each
+    # set listed with its track value; the track refitted from their ids (the
+    # track form's station sets) is the one fitted from the file.
+    upload = driver.find_element(By.ID, "upload")
+    upload.find_element(By.NAME, "file").send_keys(str(stations))
+    Select(upload.find_element(By.NAME, "track_column")).select_by_value("e1")
+    upload.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+    wait.until(h.replaced(upload))
+    wait.until(EC.presence_of_element_located((By.ID, "calibrate-track")))
+    listed = h.api_get(base, f"/v1/robots/{rail_id}/measurement-sets")["measurement_sets"]
+    station_sets = [s for s in listed if "station" in s]
+    assert len(station_sets) == 11, listed
+
+    def shown_value(v):  # as the page prints a number: 400, not 400.0
+        return str(int(v)) if float(v).is_integer() else repr(v)
+    cells = [c.text for c in driver.find_elements(By.CSS_SELECTOR, "#sets td.station")]
+    assert [c for c in cells if c != "—"] == [f"e1 = {shown_value(s['station']['value_mm'])} mm"
+                                              for s in station_sets], cells
+    ids = [s["id"] for s in station_sets]
+    assert ids == list(range(ids[0], ids[0] + 11)), ids
+    form = driver.find_element(By.ID, "calibrate-track")
+    form.find_element(By.NAME, "set_ids").send_keys(f"{ids[0]}-{ids[-1]}")
+    form.find_element(By.CSS_SELECTOR, "button[type=submit]").click()
+    wait.until(h.replaced(form))
+    msg = wait.until(lambda d: (t := h.text_of(d, "#message")) and t.startswith("Track fitted") and t)
+    refit = h.api_get(base, f"/v1/robots/{rail_id}/track")
+    assert refit["set_ids"] == ids and refit["track"] == stored["track"], (refit, stored)
+    from_cell = driver.find_element(By.CSS_SELECTOR, "#track-stored td.from").text
+    assert from_cell == f"station sets {ids[0]}–{ids[-1]}", from_cell
+    print(f"console_check: the stations uploaded as 11 station sets, the track refitted from them: {msg}")
+    shot("track-from-sets", "axes-section")
     # Delete the track: asked first; dismissed, it stays; accepted, it is gone.
     button = driver.find_element(By.ID, "delete-track")
     button.click()

@@ -626,6 +626,7 @@ async fn the_robot_page_shows_its_stored_track_and_positioner() {
         .expect("no track table");
     let table = &section[at..at + section[at..].find("</table>").unwrap()];
     assert_eq!(cell(table, "column"), "e1");
+    assert_eq!(cell(table, "from"), "a posted file");
     assert_eq!(cell(table, "version"), "v1");
     assert_eq!(cell(table, "stations"), "11");
     assert_eq!(cell(table, "stations"), track["stations"].to_string());
@@ -640,6 +641,52 @@ async fn the_robot_page_shows_its_stored_track_and_positioner() {
     assert!(table.contains(&format!(
         "data-delete=\"/v1/robots/{id}/track\" data-confirm=\"Delete the track of robot {id} (rail robot)?"
     )));
+    // The same file as station sets (the upload form's track column), each
+    // listed with its track value, and the track refitted from them (the
+    // track form's set ids): the table says which.
+    assert!(form(&html, "upload")
+        .contains("<select name=\"track_column\"><option value=\"\">none</option>"));
+    for c in ["e1", "e6"] {
+        assert!(form(&html, "upload").contains(&format!("<option value=\"{c}\">{c}</option>")));
+    }
+    assert!(form(section, "calibrate-track").contains("name=\"set_ids\""));
+    let req = Request::builder()
+        .method("POST")
+        .uri(format!("/v1/robots/{id}/track/measurement-sets?column=e1"))
+        .header("content-type", "text/csv")
+        .body(Body::from(csv.clone()))
+        .unwrap();
+    let res = app(state.clone()).oneshot(req).await.unwrap();
+    assert_eq!(res.status(), StatusCode::CREATED);
+    let bytes = axum::body::to_bytes(res.into_body(), 1 << 24)
+        .await
+        .unwrap();
+    let uploaded: serde_json::Value = serde_json::from_slice(&bytes).unwrap();
+    let sets = uploaded["measurement_sets"].as_array().unwrap();
+    let ids: Vec<i64> = sets.iter().map(|s| s["id"].as_i64().unwrap()).collect();
+    post_json(
+        &state,
+        &format!("/v1/robots/{id}/track/calibrate"),
+        &serde_json::json!({ "set_ids": ids }),
+        StatusCode::OK,
+    )
+    .await;
+    let (_, html) = call(&state, "GET", &page, None).await;
+    for s in sets {
+        let value = s["station"]["value_mm"].as_f64().unwrap();
+        assert!(
+            html.contains(&format!("<td class=\"station\">e1 = {value} mm</td>")),
+            "set {} at {value} mm",
+            s["id"]
+        );
+    }
+    let section = axes_section(&html);
+    let at = section.find("<table id=\"track-stored\"").unwrap();
+    let table = &section[at..at + section[at..].find("</table>").unwrap()];
+    assert_eq!(
+        cell(table, "from"),
+        format!("station sets {}–{}", ids[0], ids[ids.len() - 1])
+    );
     let positioner = get("positioner").await;
     let at = section
         .find("<table id=\"positioner-stored\"")

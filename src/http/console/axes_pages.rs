@@ -72,10 +72,11 @@ fn track_table(r: &RobotRow, t: &TrackRow) -> Markup {
     let url = format!("/v1/robots/{}/track", r.id);
     html! {
         table #track-stored {
-            thead { tr { th { "Column" } th { "Model version held" } th { "Stations" } th { "Readings" } th { "RMS [mm]" } th { "Max [mm]" } th { "σ [mm]" } th { "Created" } th {} } }
+            thead { tr { th { "Column" } th { "Readings from" } th { "Model version held" } th { "Stations" } th { "Readings" } th { "RMS [mm]" } th { "Max [mm]" } th { "σ [mm]" } th { "Created" } th {} } }
             tbody {
                 tr {
                     td.column { (t.axis_column) }
+                    td.from { (track_readings_from(t)) }
                     td.version { "v" (t.version) }
                     td.stations { (t.stations) }
                     td.readings { (t.readings) }
@@ -92,6 +93,36 @@ fn track_table(r: &RobotRow, t: &TrackRow) -> Markup {
             }
         }
     }
+}
+
+/// Where a stored track's readings came from: its station sets' ids
+/// (runs of consecutive ids as `12–22`), or a posted file.
+fn track_readings_from(t: &TrackRow) -> String {
+    let Some(ids) = t
+        .set_ids
+        .as_deref()
+        .and_then(|s| serde_json::from_str::<Vec<i64>>(s).ok())
+    else {
+        return "a posted file".into();
+    };
+    let mut runs: Vec<(i64, i64)> = Vec::new();
+    for id in ids {
+        match runs.last_mut() {
+            Some((_, end)) if *end + 1 == id => *end = id,
+            _ => runs.push((id, id)),
+        }
+    }
+    let runs: Vec<String> = runs
+        .iter()
+        .map(|&(a, b)| {
+            if a == b {
+                a.to_string()
+            } else {
+                format!("{a}–{b}")
+            }
+        })
+        .collect();
+    format!("station sets {}", runs.join(", "))
 }
 
 /// The stored positioner: what it was fitted on and its residuals.
@@ -151,10 +182,12 @@ fn sigma_input(default: f64) -> Markup {
 /// The form that fits the track (`POST …/track/calibrate`).
 fn track_form(id: i64) -> Markup {
     html! {
-        p.note { "One measurement file: the reflector at 3 or more robot poses (not on a line) at each of 5 or more track values; columns q1…qN (controller degrees), the track's value [mm] in an e column, x, y, z [mm] in the tracker frame. The robot's calibrated version is held (the active one unless a version is given). A fit replaces the stored track." }
+        p.note { "One measurement file: the reflector at 3 or more robot poses (not on a line) at each of 5 or more track values; columns q1…qN (controller degrees), the track's value [mm] in an e column, x, y, z [mm] in the tracker frame. Or the station sets that file was uploaded as (Measurement sets, with a track column), read as the file. The robot's calibrated version is held (the active one unless a version is given). A fit replaces the stored track." }
         form #calibrate-track data-action="calibrate-track" data-robot=(id) {
             label.wide { "Measurement file " input type="file" name="file" accept=".csv,text/csv"; }
             label.wide { "or paste it " textarea name="csv" rows="3" placeholder="q1,q2,q3,q4,q5,q6,e1,x,y,z" {} }
+            label.wide title="The ids of station sets stored from one file with a track column, in the file's order" { "or its station sets "
+                input name="set_ids" placeholder="e.g. 12-22 or 12, 13, 14"; }
             (column_select("Track column", "column", ExternalAxis::E1))
             (sigma_input(tracks::DEFAULT_SIGMA_MM))
             label title="The highest order of the carriage maps tried; 0: a straight rail" { "Highest map order "

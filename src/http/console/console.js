@@ -68,11 +68,22 @@ const handlers = {
     const text = await fileOrText(form, "file", "csv");
     if (!text) throw new Error("choose a CSV file or paste its text");
     const q = new URLSearchParams();
-    for (const k of ["name", "role", "orientation", "session", "payload_kg", "length_unit", "angle_unit", "decimal", "dif_sign"]) {
+    for (const k of ["name", "role", "orientation", "session", "payload_kg", "decimal", "dif_sign"]) {
       const v = formValue(form, k);
       if (v) q.set(k, v);
     }
-    await api("POST", `/v1/robots/${robot}/measurement-sets?${q}`, text, "text/csv");
+    // With a track column: one set per track value (station), in mm and degrees.
+    const column = formValue(form, "track_column");
+    if (column) {
+      if (formValue(form, "length_unit") !== "mm" || formValue(form, "angle_unit") !== "deg") {
+        throw new Error("a file with a track column is read in mm and degrees: choose those units");
+      }
+      q.set("column", column);
+      await api("POST", `/v1/robots/${robot}/track/measurement-sets?${q}`, text, "text/csv");
+    } else {
+      for (const k of ["length_unit", "angle_unit"]) q.set(k, formValue(form, k));
+      await api("POST", `/v1/robots/${robot}/measurement-sets?${q}`, text, "text/csv");
+    }
     location.reload();
   },
   async solve(form) {
@@ -717,11 +728,26 @@ async function axisFit(what, url, body, fitted, hint) {
   location.reload();
 }
 
+// Set ids as typed: "12-22", "12, 13, 14", or both ("3, 7-9").
+function setIds(text) {
+  const ids = [];
+  for (const part of text.split(",").map((p) => p.trim()).filter((p) => p)) {
+    const m = part.match(/^(\d+)(?:\s*[-–]\s*(\d+))?$/);
+    if (!m) throw new Error(`station sets: "${part}" is neither an id nor a range of ids (12-22)`);
+    const [a, b] = [Number(m[1]), Number(m[2] || m[1])];
+    if (b < a || b - a >= 100) throw new Error(`station sets: "${part}" is not a range of at most 100 ids`);
+    for (let i = a; i <= b; i++) ids.push(i);
+  }
+  return ids;
+}
+
 handlers["calibrate-track"] = async function (form) {
   const csv = await fileOrText(form, "file", "csv");
-  if (!csv) throw new Error("choose the measurement file or paste its text");
+  const sets = formValue(form, "set_ids");
+  if (csv && sets) throw new Error("give the measurement file or its station sets, not both");
+  if (!csv && !sets) throw new Error("choose the measurement file, paste its text, or give its station sets");
   const column = formValue(form, "column");
-  const body = { csv, column };
+  const body = csv ? { csv, column } : { set_ids: setIds(sets), column };
   for (const name of ["sigma_mm", "max_order", "version", "payload_kg"]) {
     const v = formValue(form, name);
     if (v) body[name] = Number(v);

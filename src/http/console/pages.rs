@@ -7,6 +7,7 @@ use crate::calibrate::identify::progress::time_left;
 use crate::calibrate::identify::Method;
 use crate::http::calibrations::DEFAULT_METHODS;
 use crate::measure::convention::MeasuredOrientation;
+use crate::measure::external::ExternalAxis;
 use crate::measure::SetRole;
 use crate::model::presets::PRESETS;
 use crate::records::CellItemRow;
@@ -255,11 +256,17 @@ fn sets_section(id: i64, sets: &[SetRow]) -> Markup {
                 p.empty { "No measurements yet: upload a laser-tracker CSV below." }
             } @else {
                 table {
-                    thead { tr { th { "Id" } th { "Name" } th { "Role" } th { "Session" } th { "Poses" } th { "Payload [kg]" } th { "Uploaded" } th {} } }
+                    thead { tr { th { "Id" } th { "Name" } th { "Role" } th { "Session" } th { "Track value" } th { "Poses" } th { "Payload [kg]" } th { "Uploaded" } th {} } }
                     tbody {
                         @for s in sets {
                             tr {
                                 td { (s.id) } td { (s.name) } td { (SetRole::from(s.role).as_str()) } td { (s.session) }
+                                td.station {
+                                    @match (&s.axis_column, s.axis_value) {
+                                        (Some(c), Some(v)) => { (c) " = " (v) " mm" }
+                                        _ => { "—" }
+                                    }
+                                }
                                 td { (s.row_count) }
                                 td { @if let Some(p) = s.payload_kg { (kg(p)) } @else { "—" } }
                                 td { time datetime=(s.created_at) { (s.created_at) } }
@@ -299,6 +306,14 @@ fn upload_form(id: i64) -> Markup {
                 }
             }
             label { "Tracker session " input name="session" placeholder="default"; }
+            label title="A robot on a linear track measured at several track values: the file is stored as one set per value (station), each its own tracker session, in mm and degrees" { "Track column "
+                select name="track_column" {
+                    option value="" { "none" }
+                    @for a in ExternalAxis::ALL {
+                        option value=(a.column()) { (a.column()) }
+                    }
+                }
+            }
             label { "Payload [kg] " input name="payload_kg" type="number" step="any" min="0"; }
             label { "Lengths "
                 select name="length_unit" { option value="mm" { "mm" } option value="m" { "m" } }
