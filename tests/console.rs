@@ -627,6 +627,7 @@ async fn the_robot_page_shows_its_stored_track_and_positioner() {
     let table = &section[at..at + section[at..].find("</table>").unwrap()];
     assert_eq!(cell(table, "column"), "e1");
     assert_eq!(cell(table, "from"), "a posted file");
+    assert!(table.contains(&format!("<a href=\"/v1/robots/{id}/track/fit-request\"")));
     assert_eq!(cell(table, "version"), "v1");
     assert_eq!(cell(table, "stations"), "11");
     assert_eq!(cell(table, "stations"), track["stations"].to_string());

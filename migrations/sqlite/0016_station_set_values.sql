@@ -11,3 +11,10 @@ ALTER TABLE measurement_sets ADD COLUMN axis_value REAL;
 -- A stored track fitted from stored sets names them (a JSON array of ids);
 -- NULL for one fitted from a posted file.
 ALTER TABLE robot_tracks ADD COLUMN set_ids TEXT;
+-- Each stored track, positioner and turntable keeps the request that fitted
+-- it (its calibrate body as JSON, the track's with the version it held), so
+-- its readings are not lost and GET …/fit-request gives a body that fits it
+-- again; NULL for fits stored before this version.
+ALTER TABLE robot_tracks ADD COLUMN fit_request TEXT;
+ALTER TABLE robot_positioners ADD COLUMN fit_request TEXT;
+ALTER TABLE robot_turntables ADD COLUMN fit_request TEXT;

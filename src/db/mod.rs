@@ -82,6 +82,7 @@ impl From<sqlx::migrate::MigrateError> for StoreError {
 mod calibrations;
 mod cell;
 mod checks;
+mod fit_requests;
 mod positioners;
 mod queue;
 mod robots;

@@ -40,7 +40,8 @@ impl Db {
             sqlx::query(
                 "INSERT INTO robot_positioners (robot_id, tilt_column, rotate_column, sigma_mm, \
                  reflectors, readings, rms_mm, max_mm, positioner_json, touched_version, \
-                 touched_tool) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11)",
+                 touched_tool, fit_request) \
+                 VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12)",
             )
             .bind(robot_id)
             .bind(&positioner.tilt_column)
@@ -53,6 +54,7 @@ impl Db {
             .bind(&positioner.positioner_json)
             .bind(positioner.touched_version)
             .bind(&positioner.touched_tool)
+            .bind(&positioner.fit_request)
             .execute(&mut *tx)
             .await?;
             let row =

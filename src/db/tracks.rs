@@ -36,8 +36,8 @@ impl Db {
                 .rows_affected();
             sqlx::query(
                 "INSERT INTO robot_tracks (robot_id, version, axis_column, sigma_mm, max_order, \
-                 readings, stations, rms_mm, max_mm, track_json, set_ids) \
-                 VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11)",
+                 readings, stations, rms_mm, max_mm, track_json, set_ids, fit_request) \
+                 VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12)",
             )
             .bind(robot_id)
             .bind(track.version)
@@ -50,6 +50,7 @@ impl Db {
             .bind(track.max_mm)
             .bind(&track.track_json)
             .bind(&track.set_ids)
+            .bind(&track.fit_request)
             .execute(&mut *tx)
             .await?;
             let row = super::commit_inserted!(tx, TrackRow, TRACK_SELECT, "robot_id", robot_id);

@@ -38,7 +38,8 @@ impl Db {
                 .rows_affected();
             sqlx::query(
                 "INSERT INTO robot_turntables (robot_id, value_column, sigma_mm, reflectors, \
-                 readings, rms_mm, max_mm, turntable_json) VALUES ($1, $2, $3, $4, $5, $6, $7, $8)",
+                 readings, rms_mm, max_mm, turntable_json, fit_request) \
+                 VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9)",
             )
             .bind(robot_id)
             .bind(&turntable.value_column)
@@ -48,6 +49,7 @@ impl Db {
             .bind(turntable.rms_mm)
             .bind(turntable.max_mm)
             .bind(&turntable.turntable_json)
+            .bind(&turntable.fit_request)
             .execute(&mut *tx)
             .await?;
             let row =

@@ -14,7 +14,7 @@ use super::ApiError;
 use crate::measure::external::ExternalAxis;
 use crate::service::limits::{PAGE_DEFAULT, PAYLOAD_MAX_KG};
 use serde::de::{DeserializeOwned, Deserializer, MapAccess, Visitor};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::marker::PhantomData;
 
@@ -100,6 +100,12 @@ where
 /// types refuse `3.0`), within the range of `T`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Int<T>(pub T);
+
+impl<T: Serialize> Serialize for Int<T> {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        self.0.serialize(s)
+    }
+}
 
 impl<'de, T: TryFrom<i128>> Deserialize<'de> for Int<T> {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {

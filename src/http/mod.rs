@@ -31,6 +31,7 @@ pub mod checks;
 pub mod console;
 pub mod error;
 pub mod extract;
+pub mod fit_requests;
 pub mod input;
 pub mod iso9283;
 pub mod iso9283_plan;
@@ -90,6 +91,7 @@ fn routes() -> Vec<Route> {
     all.extend(station_sets::routes());
     all.extend(positioners::routes());
     all.extend(turntables::routes());
+    all.extend(fit_requests::routes());
     all
 }
 

@@ -43,7 +43,7 @@ const SIGMA_MAX_MM: f64 = 10.0;
 const REFLECTOR_MAX_MM: f64 = 100_000.0;
 
 /// `POST /v1/robots/{id}/positioner/calibrate` body.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct PositionerCalibrateIn {
     /// One measurement file's text per reflector, in the order of `reflectors`.
@@ -55,25 +55,30 @@ pub struct PositionerCalibrateIn {
     pub nominal: Value,
     /// The tilt axis's (axis 1's) column, `e1` … `e6` (default `e1`).
     #[serde(default, deserialize_with = "present")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub tilt_column: Option<String>,
     /// The rotate axis's (axis 2's) column, `e1` … `e6` (default `e2`).
     #[serde(default, deserialize_with = "present")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub rotate_column: Option<String>,
     /// The tracker's noise per coordinate, 1σ [mm] (default 0.01).
     #[serde(default, deserialize_with = "present")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub sigma_mm: Option<f64>,
     /// Held-out measurement file texts, the k-th of reflector k.
     #[serde(default, deserialize_with = "present")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub validate: Option<Vec<String>>,
     /// The texts are touches files (`id,q1…qN` controller degrees and the
     /// axes' columns), one per face-plate feature, placed by this version's
     /// robot carrying this stored tool; `sigma_mm` is then required.
     #[serde(default, deserialize_with = "present")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub touched_with: Option<TouchedWithIn>,
 }
 
 /// The robot and tool that touched a positioner's features.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct TouchedWithIn {
     /// The robot's model version whose calibrated robot places the touches.
@@ -191,6 +196,9 @@ pub(super) fn reflector_files(
 }
 
 fn calibration(id: i64, body: PositionerCalibrateIn) -> Result<PositionerCalibration, ApiError> {
+    // The body as posted, kept with the fit (`GET …/fit-request`).
+    let request = serde_json::to_value(&body)
+        .map_err(|e| ApiError::Internal(format!("the calibrate request as JSON: {e}")))?;
     let validate = reflector_files(
         &body.sets,
         &body.reflectors,
@@ -232,6 +240,7 @@ fn calibration(id: i64, body: PositionerCalibrateIn) -> Result<PositionerCalibra
         )));
     }
     Ok(PositionerCalibration {
+        request,
         robot_id: id,
         sets: body.sets,
         reflectors_mm: body.reflectors,

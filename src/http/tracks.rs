@@ -31,29 +31,36 @@ pub const DEFAULT_SIGMA_MM: f64 = 0.01;
 const SIGMA_MAX_MM: f64 = 10.0;
 
 /// `POST /v1/robots/{id}/track/calibrate` body.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct TrackCalibrateIn {
     /// The measurement file's text (or `set_ids`).
     #[serde(default, deserialize_with = "present")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub csv: Option<String>,
     /// The robot's station sets to fit from, by id (or `csv`).
     #[serde(default, deserialize_with = "present")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub set_ids: Option<Vec<Int<i64>>>,
     /// The track's column, `e1` … `e6` (default `e1`).
     #[serde(default, deserialize_with = "present")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub column: Option<String>,
     /// The tracker's noise per coordinate, 1σ [mm], the fit is judged against (default 0.01).
     #[serde(default, deserialize_with = "present")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub sigma_mm: Option<f64>,
     /// Highest order of the carriage maps tried (default 6; 0: a straight rail).
     #[serde(default)]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub max_order: Option<Int<i64>>,
     /// The calibrated version held (default: the active one).
     #[serde(default)]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub version: Option<Int<i64>>,
     /// Payload of rows that give none [kg] (default: the version's).
     #[serde(default, deserialize_with = "present")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub payload_kg: Option<f64>,
 }
 
@@ -137,6 +144,9 @@ struct FittedOut {
 }
 
 fn calibration(id: i64, body: TrackCalibrateIn) -> Result<TrackCalibration, ApiError> {
+    // The body as posted, kept with the fit (`GET …/fit-request`).
+    let request = serde_json::to_value(&body)
+        .map_err(|e| ApiError::Internal(format!("the calibrate request as JSON: {e}")))?;
     let column = external_axis("column", body.column.as_deref(), ExternalAxis::E1)?;
     let sigma_mm = body.sigma_mm.unwrap_or(DEFAULT_SIGMA_MM);
     if !(sigma_mm.is_finite() && sigma_mm > 0.0 && sigma_mm <= SIGMA_MAX_MM) {
@@ -173,6 +183,7 @@ fn calibration(id: i64, body: TrackCalibrateIn) -> Result<TrackCalibration, ApiE
         }
     };
     Ok(TrackCalibration {
+        request,
         robot_id: id,
         version: body.version.map(|v| v.0),
         readings,

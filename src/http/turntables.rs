@@ -32,7 +32,7 @@ use serde_json::Value;
 const SIGMA_MAX_MM: f64 = 10.0;
 
 /// `POST /v1/robots/{id}/turntable/calibrate` body.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct TurntableCalibrateIn {
     /// One measurement file's text per reflector, in the order of `reflectors`.
@@ -44,12 +44,15 @@ pub struct TurntableCalibrateIn {
     pub nominal: Value,
     /// The axis's column, `e1` … `e6` (default `e1`).
     #[serde(default, deserialize_with = "present")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub column: Option<String>,
     /// The tracker's noise per coordinate, 1σ [mm] (default 0.01).
     #[serde(default, deserialize_with = "present")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub sigma_mm: Option<f64>,
     /// Held-out measurement file texts, the k-th of reflector k.
     #[serde(default, deserialize_with = "present")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub validate: Option<Vec<String>>,
 }
 
@@ -115,6 +118,9 @@ struct FittedOut {
 }
 
 fn calibration(id: i64, body: TurntableCalibrateIn) -> Result<TurntableCalibration, ApiError> {
+    // The body as posted, kept with the fit (`GET …/fit-request`).
+    let request = serde_json::to_value(&body)
+        .map_err(|e| ApiError::Internal(format!("the calibrate request as JSON: {e}")))?;
     let validate = super::positioners::reflector_files(
         &body.sets,
         &body.reflectors,
@@ -136,6 +142,7 @@ fn calibration(id: i64, body: TurntableCalibrateIn) -> Result<TurntableCalibrati
         )));
     }
     Ok(TurntableCalibration {
+        request,
         robot_id: id,
         sets: body.sets,
         reflectors_mm: body.reflectors,

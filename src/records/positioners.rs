@@ -29,6 +29,8 @@ pub struct NewPositioner {
     pub touched_version: Option<i64>,
     /// The cell tool that touched (`None`: tracker readings).
     pub touched_tool: Option<String>,
+    /// The calibrate request that fitted it, as JSON (`GET …/fit-request`).
+    pub fit_request: String,
 }
 
 /// A robot's stored positioner.

@@ -27,6 +27,8 @@ pub struct NewTrack {
     /// The station sets it was fitted from, a JSON array of ids (`None`: a
     /// posted file).
     pub set_ids: Option<String>,
+    /// The calibrate request that fitted it, as JSON (`GET …/fit-request`).
+    pub fit_request: String,
 }
 
 /// A robot's stored track.

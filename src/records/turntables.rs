@@ -21,6 +21,8 @@ pub struct NewTurntable {
     pub max_mm: f64,
     /// `Turntable::to_json`: mm, degrees.
     pub turntable_json: String,
+    /// The calibrate request that fitted it, as JSON (`GET …/fit-request`).
+    pub fit_request: String,
 }
 
 /// A robot's stored turntable.

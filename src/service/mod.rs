@@ -17,6 +17,7 @@ pub mod cell_fit;
 mod changes;
 pub mod check_reads;
 pub mod checks;
+pub mod fit_requests;
 pub(crate) mod gate;
 mod heap;
 mod heavy;

@@ -110,6 +110,8 @@ pub struct PositionerCalibration {
     /// (`cell_fit::positioner_touches`), not tracker readings; `sigma_mm`
     /// is then the robot's accuracy at the tool's tip.
     pub touched_with: Option<TouchedWith>,
+    /// The calibrate request as posted (JSON), kept with the fit.
+    pub request: serde_json::Value,
 }
 
 /// Why a measurement file's text is not a reflector's readings.
@@ -308,6 +310,7 @@ pub async fn calibrate(
     .await?;
     let (fit, validation, readings, reflectors) =
         fitted.map_err(|r| ServiceError::Invalid(refusal_detail(&r)))?;
+    let fit_request = cmd.request.to_string();
     let new = NewPositioner {
         tilt_column: cmd.columns.tilt.column().to_string(),
         rotate_column: cmd.columns.rotate.column().to_string(),
@@ -319,6 +322,7 @@ pub async fn calibrate(
         positioner_json: fit.model.to_json(),
         touched_version: cmd.touched_with.as_ref().map(|t| t.version),
         touched_tool: cmd.touched_with.map(|t| t.tool),
+        fit_request,
     };
     let (row, created) = state
         .db()

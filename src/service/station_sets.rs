@@ -247,7 +247,7 @@ pub async fn track_readings(
             }
             _ => {
                 return Err(ServiceError::Invalid(format!(
-                    "measurement set {id} (`{}`) holds no track value: only sets stored by POST /v1/robots/{robot_id}/track/measurement-sets do (since schema version 16); post the file as `csv`, or upload it there again",
+                    "measurement set {id} (`{}`) holds no track value: only sets stored by POST /v1/robots/{robot_id}/track/measurement-sets do (since migrations sqlite/0016, postgres/0015); post the file as `csv`, or upload it there again",
                     row.name
                 )))
             }

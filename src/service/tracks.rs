@@ -40,6 +40,8 @@ pub struct TrackCalibration {
     pub max_order: usize,
     /// Payload mass [kg] of rows that give none (`None`: the model's).
     pub payload_kg: Option<f64>,
+    /// The calibrate request as posted (JSON), kept with the fit.
+    pub request: serde_json::Value,
 }
 
 /// Where a track fit's readings come from.
@@ -155,6 +157,13 @@ pub async fn calibrate(
     })
     .await?;
     let (fit, readings) = fitted.map_err(|r| ServiceError::Invalid(refusal_detail(&r)))?;
+    // The request kept with the fit names the version it held, so that
+    // posting it again fits the same track whatever is active then.
+    let mut request = cmd.request.clone();
+    if let Some(fields) = request.as_object_mut() {
+        fields.insert("version".into(), version.into());
+    }
+    let fit_request = request.to_string();
     let new = NewTrack {
         version,
         axis_column: cmd.column.column().to_string(),
@@ -166,6 +175,7 @@ pub async fn calibrate(
         max_mm: fit.max_mm,
         track_json: fit.model.to_json(),
         set_ids,
+        fit_request,
     };
     let (row, created) = state
         .db()

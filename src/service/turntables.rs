@@ -46,6 +46,8 @@ pub struct TurntableCalibration {
     pub sigma_mm: f64,
     /// Held-out measurement file texts, the k-th of reflector k.
     pub validate: Vec<String>,
+    /// The calibrate request as posted (JSON), kept with the fit.
+    pub request: serde_json::Value,
 }
 
 /// Held-out readings predicted through a fitted turntable at the fitted
@@ -156,6 +158,7 @@ pub async fn calibrate(
     .await?;
     let (fit, validation, readings, reflectors) =
         fitted.map_err(|r| ServiceError::Invalid(super::refusal::detail(&r.reason, &r.message)))?;
+    let fit_request = cmd.request.to_string();
     let new = NewTurntable {
         value_column: cmd.column.column().to_string(),
         sigma_mm: cmd.sigma_mm,
@@ -164,6 +167,7 @@ pub async fn calibrate(
         rms_mm: fit.rms_mm,
         max_mm: fit.max_mm,
         turntable_json: fit.model.to_json(),
+        fit_request,
     };
     let (row, created) = state
         .db()

@@ -47,6 +47,7 @@ mod core_positioner;
 #[allow(dead_code)]
 mod core_track;
 mod exposure;
+mod fit_request;
 mod flow;
 mod hostile;
 #[path = "../common/html_table.rs"]

@@ -206,17 +206,13 @@ async fn a_positioner_fitted_over_http_is_the_command_lines_and_carries_a_target
     super::positioner_filter::refused_without_a_positioner(&t, &rid, &nom).await;
 
     // The fit over HTTP, stored; the same files through the command line.
-    let r = t
-        .post_json(
-            CALIBRATE,
-            &[&rid],
-            body(
-                &[&texts[0], &texts[1]],
-                &nom,
-                json!({ "validate": [&texts[2], &texts[3]] }),
-            ),
-        )
-        .await;
+    super::fit_request::none_without_a_fit(&t, &rid, "positioner").await;
+    let posted = body(
+        &[&texts[0], &texts[1]],
+        &nom,
+        json!({ "validate": [&texts[2], &texts[3]] }),
+    );
+    let r = t.post_json(CALIBRATE, &[&rid], posted.clone()).await;
     assert_eq!(r.status, StatusCode::CREATED, "{}", r.text());
     let fitted = r.json();
     assert_eq!(fitted["fitted"], true);
@@ -260,6 +256,7 @@ async fn a_positioner_fitted_over_http_is_the_command_lines_and_carries_a_target
         "the stored positioner is the file"
     );
     assert_eq!(stored["created_at"], fitted["created_at"]);
+    super::fit_request::refits_from_its_request(&t, &rid, "positioner", &posted).await;
 
     let solved = plate_csv_solve(&t, &rid, &robot, &robot_in_cell, &truth, &model, d).await;
     plate_predict(&t, &rid, &model, d, &solved).await;

@@ -138,10 +138,19 @@ async fn a_track_upload_is_stored_per_station_and_calibrates_as_the_command_line
     }
 
     // The track fitted on that version (the robot over the stations).
+    super::fit_request::none_without_a_fit(&t, &rid, "track").await;
     let r = t
         .post_json(CALIBRATE, &[&rid], json!({ "csv": stations }))
         .await;
     assert_eq!(r.status, StatusCode::CREATED, "{}", r.text());
+    // Its request kept (the version it held named): posted again, the same track.
+    super::fit_request::refits_from_its_request(
+        &t,
+        &rid,
+        "track",
+        &json!({ "csv": stations, "version": 1 }),
+    )
+    .await;
     let from_file = r.json();
     assert_eq!(from_file["set_ids"], Value::Null);
 
@@ -176,6 +185,13 @@ async fn a_track_upload_is_stored_per_station_and_calibrates_as_the_command_line
     let rail: Value =
         serde_json::from_str(&std::fs::read_to_string(d.join("rail.json")).unwrap()).unwrap();
     assert_eq!(from_sets["track"], rail);
+    super::fit_request::refits_from_its_request(
+        &t,
+        &rid,
+        "track",
+        &json!({ "set_ids": ids(&ident), "version": 1 }),
+    )
+    .await;
     let stored = t.get("/v1/robots/{id}/track", &[&rid]).await.json();
     assert_eq!(stored["set_ids"], json!(ids(&ident)));
 

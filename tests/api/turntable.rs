@@ -104,16 +104,12 @@ async fn a_turntable_fitted_over_http_is_the_command_lines() {
     );
 
     // The fit over HTTP, stored; the same files through the command line.
-    let r = t
-        .post_json(
-            CALIBRATE,
-            &[&rid],
-            body(
-                &[&texts[0], &texts[1]],
-                json!({ "validate": [&texts[2], &texts[3]] }),
-            ),
-        )
-        .await;
+    super::fit_request::none_without_a_fit(&t, &rid, "turntable").await;
+    let posted = body(
+        &[&texts[0], &texts[1]],
+        json!({ "validate": [&texts[2], &texts[3]] }),
+    );
+    let r = t.post_json(CALIBRATE, &[&rid], posted.clone()).await;
     assert_eq!(r.status, StatusCode::CREATED, "{}", r.text());
     let fitted = r.json();
     assert_eq!(fitted["fitted"], true);
@@ -162,6 +158,7 @@ async fn a_turntable_fitted_over_http_is_the_command_lines() {
     );
     assert_eq!(stored["created_at"], fitted["created_at"]);
     Turntable::from_json(&stored["turntable"].to_string()).unwrap();
+    super::fit_request::refits_from_its_request(&t, &rid, "turntable", &posted).await;
 
     // A refit replaces it (200); a refused refit (σ 0.001 mm against the
     // 0.01 mm noise) is the command line's refusal and keeps it.

@@ -86,6 +86,7 @@ fn track_table(r: &RobotRow, t: &TrackRow) -> Markup {
                     td { time datetime=(t.created_at) { (t.created_at) } }
                     td {
                         a href=(url) { "track JSON" } " "
+                        a href={ (url) "/fit-request" } title="The calibrate request that fitted it, readings included; post it again to refit" { "fit request" } " "
                         button.small.danger #delete-track data-delete=(url)
                             data-confirm={ "Delete the track of robot " (r.id) " (" (r.name) ")? Predictions, solves and filters that give a track value are refused until a track is fitted again." } { "Delete the track" }
                     }
@@ -149,6 +150,7 @@ fn positioner_table(r: &RobotRow, p: &PositionerRow) -> Markup {
                     td { time datetime=(p.created_at) { (p.created_at) } }
                     td {
                         a href=(url) { "positioner JSON" } " "
+                        a href={ (url) "/fit-request" } title="The calibrate request that fitted it, readings included; post it again to refit" { "fit request" } " "
                         button.small.danger #delete-positioner data-delete=(url)
                             data-confirm={ "Delete the positioner of robot " (r.id) " (" (r.name) ")? Solves, predictions and filters that give positioner values are refused until a positioner is fitted again." } { "Delete the positioner" }
                     }
@@ -300,6 +302,7 @@ fn turntable_table(r: &RobotRow, t: &TurntableRow) -> Markup {
                     td { time datetime=(t.created_at) { (t.created_at) } }
                     td {
                         a href=(url) { "turntable JSON" } " "
+                        a href={ (url) "/fit-request" } title="The calibrate request that fitted it, readings included; post it again to refit" { "fit request" } " "
                         button.small.danger #delete-turntable data-delete=(url)
                             data-confirm={ "Delete the turntable of robot " (r.id) " (" (r.name) ")? Fitting it again needs its measurement files." } { "Delete the turntable" }
                     }
