@@ -208,7 +208,7 @@ pub async fn upload(state: &AppState, cmd: StationUpload) -> Result<Vec<SetRow>,
 /// set's payload on rows without their own): a track is fitted from them
 /// as from that file. Refused: an id given twice, a set that is not a
 /// station set of `column` (`Invalid`, naming it), one the robot does not
-/// have (`NotFound`), more than `max_readings` rows together.
+/// have (`Conflict`), more than `max_readings` rows together.
 pub async fn track_readings(
     state: &AppState,
     robot_id: i64,
@@ -234,8 +234,9 @@ pub async fn track_readings(
         ..MeasurementSet::default()
     };
     for &id in ids {
-        let missing =
-            || ServiceError::NotFound(format!("robot {robot_id} has no measurement set {id}"));
+        // A set the body names that the robot lacks is the robot's state
+        // (409), as for a check's or a calibration's sets; 404 is the path's.
+        let missing = || super::checks::conflict(ServiceError::set_not_found(robot_id, id));
         let row = state.db().set(robot_id, id).await?.ok_or_else(missing)?;
         let value = match (row.axis_column.as_deref(), row.axis_value) {
             (Some(c), Some(v)) if c == column.column() => v,

@@ -197,7 +197,7 @@ async fn a_track_upload_is_stored_per_station_and_calibrates_as_the_command_line
 
     // Refused, naming why, and nothing replaced: a set without a track
     // value, a station of another column, a set given twice, both forms or
-    // neither (422); a set the robot does not have (404).
+    // neither (422); a set the robot does not have (409).
     let plain: Vec<String> = checks
         .lines()
         .map(|l| {
@@ -247,8 +247,8 @@ async fn a_track_upload_is_stored_per_station_and_calibrates_as_the_command_line
         ),
         (
             json!({ "set_ids": [first, 999_999] }),
-            StatusCode::NOT_FOUND,
-            "no measurement set 999999",
+            StatusCode::CONFLICT,
+            "measurement set 999999 of robot",
         ),
     ] {
         let r = t.post_json(CALIBRATE, &[&rid], body.clone()).await;
