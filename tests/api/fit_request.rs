@@ -7,20 +7,6 @@ use crate::support::*;
 use axum::http::StatusCode;
 use serde_json::Value;
 
-/// `a` and `b` equal as JSON, numbers compared by value (`100` is `100.0`).
-fn same(a: &Value, b: &Value) -> bool {
-    match (a, b) {
-        (Value::Number(x), Value::Number(y)) => x.as_f64() == y.as_f64(),
-        (Value::Array(x), Value::Array(y)) => {
-            x.len() == y.len() && x.iter().zip(y).all(|(x, y)| same(x, y))
-        }
-        (Value::Object(x), Value::Object(y)) => {
-            x.len() == y.len() && x.iter().all(|(k, v)| y.get(k).is_some_and(|w| same(v, w)))
-        }
-        _ => a == b,
-    }
-}
-
 /// The robot's stored `axis` kept `posted` as its request, and that
 /// request posted again refits it: 200, the same model description.
 pub(crate) async fn refits_from_its_request(t: &TestApp, rid: &str, axis: &str, posted: &Value) {
@@ -29,7 +15,7 @@ pub(crate) async fn refits_from_its_request(t: &TestApp, rid: &str, axis: &str, 
         .await;
     assert_eq!(r.status, StatusCode::OK, "{}", r.text());
     let kept = r.json();
-    assert!(same(&kept, posted), "kept {kept}\nposted {posted}");
+    assert!(same_json(&kept, posted), "kept {kept}\nposted {posted}");
     let before = t
         .get(&format!("/v1/robots/{{id}}/{axis}"), &[rid])
         .await

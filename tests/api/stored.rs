@@ -23,21 +23,6 @@ fn hostile_name(tag: &str) -> String {
     head + &"x".repeat(200 - n)
 }
 
-/// JSON values equal as data: numbers as the f64 they are (`100000` and
-/// `100000.0` alike), everything else exactly.
-fn same(a: &Value, b: &Value) -> bool {
-    match (a, b) {
-        (Value::Number(x), Value::Number(y)) => x.as_f64() == y.as_f64(),
-        (Value::Array(x), Value::Array(y)) => {
-            x.len() == y.len() && x.iter().zip(y).all(|(p, q)| same(p, q))
-        }
-        (Value::Object(x), Value::Object(y)) => {
-            x.len() == y.len() && x.iter().all(|(k, v)| y.get(k).is_some_and(|w| same(v, w)))
-        }
-        _ => a == b,
-    }
-}
-
 async fn put(t: &TestApp, template: &str, args: &[&str], body: Value) -> Resp {
     t.put_json(template, args, body).await
 }
@@ -232,7 +217,7 @@ async fn cell(t: &TestApp, rid: &str) {
                 .unwrap_or_else(|| panic!("{} missing: {got}", s["name"]));
             for k in ["number", "xyz_mm", "rpy_deg", "load", "frame"] {
                 if let Some(v) = s.get(k) {
-                    assert!(same(&g[k], v), "{k} of {}: {} vs {v}", s["name"], g[k]);
+                    assert!(same_json(&g[k], v), "{k} of {}: {} vs {v}", s["name"], g[k]);
                 }
             }
             let one = format!("{list}/{{name}}");

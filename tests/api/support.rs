@@ -561,3 +561,20 @@ pub(crate) fn targets_small() -> Vec<Value> {
         .map(|i| json!({"x": 1500.0, "y": i as f64 * 10.0, "z": 1200.0}))
         .collect()
 }
+
+/// JSON values equal as data: numbers as the f64 they are (`100000` and
+/// `100000.0` alike), everything else exactly.
+pub(crate) fn same_json(a: &Value, b: &Value) -> bool {
+    match (a, b) {
+        (Value::Number(x), Value::Number(y)) => x.as_f64() == y.as_f64(),
+        (Value::Array(x), Value::Array(y)) => {
+            x.len() == y.len() && x.iter().zip(y).all(|(p, q)| same_json(p, q))
+        }
+        (Value::Object(x), Value::Object(y)) => {
+            x.len() == y.len()
+                && x.iter()
+                    .all(|(k, v)| y.get(k).is_some_and(|w| same_json(v, w)))
+        }
+        _ => a == b,
+    }
+}

@@ -629,6 +629,14 @@ fn csv_rows(text: &str) -> Vec<std::collections::HashMap<String, String>> {
         .collect()
 }
 
+/// A JSON solve's target at pose `p` (mm, a quaternion) with its own
+/// track value `e1` [mm].
+fn target_at(p: &Pose, e1: f64) -> Value {
+    let u = UnitQuaternion::from_matrix(&p.r);
+    json!({ "x": p.p.x * 1e3, "y": p.p.y * 1e3, "z": p.p.z * 1e3, "e1": e1,
+            "orientation": { "convention": "quaternion", "values": [u.w, u.i, u.j, u.k] } })
+}
+
 /// The targets CSV solve with a track value per row (`e1` column) against
 /// `robocal solve --track` on the same file and against the truth; a row
 /// beyond the travel fails alone; the column beside `?e1=` is a 422.
@@ -733,12 +741,7 @@ async fn per_row_csv_solve(
     let targets: Vec<Value> = qs
         .iter()
         .enumerate()
-        .map(|(i, q)| {
-            let p = rail.true_pose(q, values[i % 4].min(2600.0));
-            let u = UnitQuaternion::from_matrix(&p.r);
-            json!({ "x": p.p.x * 1e3, "y": p.p.y * 1e3, "z": p.p.z * 1e3, "e1": values[i % 4],
-                    "orientation": { "convention": "quaternion", "values": [u.w, u.i, u.j, u.k] } })
-        })
+        .map(|(i, q)| target_at(&rail.true_pose(q, values[i % 4].min(2600.0)), values[i % 4]))
         .collect();
     let r = t
         .post_json(
@@ -809,10 +812,8 @@ async fn per_row_csv_solve(
     let in_w: Vec<Value> = kept
         .iter()
         .map(|&i| {
-            let p = w.inverse().compose(&rail.true_pose(&qs[i], values[i % 4]));
-            let u = UnitQuaternion::from_matrix(&p.r);
-            json!({ "x": p.p.x * 1e3, "y": p.p.y * 1e3, "z": p.p.z * 1e3, "e1": values[i % 4],
-                    "orientation": { "convention": "quaternion", "values": [u.w, u.i, u.j, u.k] } })
+            let v = values[i % 4];
+            target_at(&w.inverse().compose(&rail.true_pose(&qs[i], v)), v)
         })
         .collect();
     let r = t
