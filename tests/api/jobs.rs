@@ -258,10 +258,24 @@ async fn cancelling_a_big_tlbo_job_takes_effect_quickly() {
 /// of its robot answers 404 or succeeds before the delete: never 500.
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn writes_racing_a_robot_delete_never_fail_with_500() {
-    let t = setup_with(&[], 1).await;
+    // Room for every job the 30 rounds can start: the jobs of deleted robots
+    // drain at the machine's pace, and admission (429, tested above) must not
+    // decide the outcome here.
+    const ROUNDS: usize = 30;
+    let t = setup_config(ServiceConfig {
+        workers: 1,
+        solve_workers: 2,
+        progress_interval: Duration::from_millis(20),
+        limits: robocal::http::Limits {
+            queued_jobs: ROUNDS,
+            ..Default::default()
+        },
+        ..ServiceConfig::default()
+    })
+    .await;
     let text = simulated_csv(5, 30);
     let mut outcomes: BTreeSet<(u16, u16, u16, u16)> = BTreeSet::new();
-    for i in 0..30 {
+    for i in 0..ROUNDS {
         let robot = t.create_robot("ys100").await;
         let rid = robot.to_string();
         let args: [&str; 1] = [&rid];
