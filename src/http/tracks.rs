@@ -100,17 +100,12 @@ impl TrackOut {
         let track = serde_json::from_str(&row.track_json).map_err(|e| {
             ApiError::Internal(format!("stored track of robot {}: {e}", row.robot_id))
         })?;
-        let set_ids = row
-            .set_ids
-            .as_deref()
-            .map(serde_json::from_str)
-            .transpose()
-            .map_err(|e| {
-                ApiError::Internal(format!(
-                    "stored track of robot {}: set ids: {e}",
-                    row.robot_id
-                ))
-            })?;
+        let set_ids = row.fitted_from_sets().map_err(|e| {
+            ApiError::Internal(format!(
+                "stored track of robot {}: set ids: {e}",
+                row.robot_id
+            ))
+        })?;
         let base = format!("/v1/robots/{}/track", row.robot_id);
         Ok(TrackOut {
             robot_id: row.robot_id,

@@ -60,3 +60,14 @@ pub struct TrackRow {
     /// posted file).
     pub set_ids: Option<String>,
 }
+
+impl TrackRow {
+    /// The station sets it was fitted from (`None`: a posted file), read
+    /// from their stored JSON array.
+    pub fn fitted_from_sets(&self) -> Result<Option<Vec<i64>>, serde_json::Error> {
+        self.set_ids
+            .as_deref()
+            .map(serde_json::from_str)
+            .transpose()
+    }
+}

@@ -18,7 +18,9 @@ use super::{AppState, ServiceError};
 use crate::db::NewSet;
 use crate::measure::csv::{self, ReadOptions};
 use crate::measure::csv_text;
-use crate::measure::external::{ExternalAxis, ExternalValues, MeasurementSet};
+use crate::measure::external::{
+    session_before_station, ExternalAxis, ExternalValues, MeasurementSet,
+};
 use crate::measure::{MeasuredPose, SetRole};
 use crate::records::{AngleUnit, LengthUnit, SetFormat, SetRow};
 use crate::service::limits::{MAX_SETS, NAME_MAX};
@@ -253,7 +255,6 @@ pub async fn track_readings(
                 )))
             }
         };
-        let station = format!("{column}={value}");
         let rows = state
             .db()
             .set_rows(robot_id, id)
@@ -261,11 +262,10 @@ pub async fn track_readings(
             .ok_or_else(missing)?;
         for mut pose in rows {
             // The row's session as the file gave it, before the station's label.
-            pose.session = pose.session.as_deref().and_then(|s| {
-                s.strip_suffix(station.as_str())
-                    .and_then(|rest| rest.strip_suffix(' '))
-                    .map(str::to_string)
-            });
+            pose.session = pose
+                .session
+                .as_deref()
+                .and_then(|s| session_before_station(s, column, value));
             pose.payload_kg = pose.payload_kg.or(row.payload_kg);
             let mut values = ExternalValues::default();
             values.0[column.index()] = Some(value);

@@ -154,11 +154,7 @@ impl MeasurementSet {
                     .external
                     .get(axis)
                     .expect("every reading carries the set's axes");
-                let station = format!("{axis}={value}");
-                let session = match &r.pose.session {
-                    Some(s) => format!("{s} {station}"),
-                    None => station,
-                };
+                let session = station_session(r.pose.session.as_deref(), axis, value);
                 MeasuredPose {
                     session: Some(session),
                     ..r.pose.clone()
@@ -166,6 +162,26 @@ impl MeasurementSet {
             })
             .collect())
     }
+}
+
+/// The tracker session of a reading at the track's `axis` value `value`:
+/// `e1=400`, after the reading's own `session` label when it has one
+/// (`S e1=400`).
+pub fn station_session(session: Option<&str>, axis: ExternalAxis, value: f64) -> String {
+    match session {
+        Some(s) => format!("{s} {axis}={value}"),
+        None => format!("{axis}={value}"),
+    }
+}
+
+/// The reading's own session label back from its station session
+/// ([`station_session`] at `axis` and `value`): `None` where it had none,
+/// or where `label` is not a session of that station.
+pub fn session_before_station(label: &str, axis: ExternalAxis, value: f64) -> Option<String> {
+    label
+        .strip_suffix(&station_session(None, axis, value))
+        .and_then(|rest| rest.strip_suffix(' '))
+        .map(str::to_string)
 }
 
 /// Why a set's stations cannot be read as tracker sessions
@@ -192,4 +208,31 @@ pub struct Reading<'a> {
     pub pose: &'a MeasuredPose,
     /// Its external-axis values (mm or degrees as the controller shows them).
     pub external: ExternalValues,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A reading's own session comes back from its station session, with
+    /// or without one, and a label of another station gives none.
+    #[test]
+    fn a_station_session_gives_back_the_readings_own() {
+        for (own, value) in [(Some("S 2"), 400.0), (None, 1250.5), (Some("x"), -0.25)] {
+            let label = station_session(own, ExternalAxis::E1, value);
+            assert_eq!(
+                session_before_station(&label, ExternalAxis::E1, value).as_deref(),
+                own,
+                "{label}"
+            );
+        }
+        assert_eq!(
+            station_session(Some("S"), ExternalAxis::E2, 400.0),
+            "S e2=400"
+        );
+        assert_eq!(
+            session_before_station("S e1=400", ExternalAxis::E1, 800.0),
+            None
+        );
+    }
 }

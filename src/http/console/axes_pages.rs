@@ -99,12 +99,10 @@ fn track_table(r: &RobotRow, t: &TrackRow) -> Markup {
 /// Where a stored track's readings came from: its station sets' ids
 /// (runs of consecutive ids as `12–22`), or a posted file.
 fn track_readings_from(t: &TrackRow) -> String {
-    let Some(ids) = t
-        .set_ids
-        .as_deref()
-        .and_then(|s| serde_json::from_str::<Vec<i64>>(s).ok())
-    else {
-        return "a posted file".into();
+    let ids = match t.fitted_from_sets() {
+        Ok(Some(ids)) => ids,
+        Ok(None) => return "a posted file".into(),
+        Err(e) => return format!("station sets (unreadable: {e})"),
     };
     let mut runs: Vec<(i64, i64)> = Vec::new();
     for id in ids {
